@@ -1,0 +1,83 @@
+#include "core/atomic_file.h"
+
+#include "core/error.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <system_error>
+
+namespace fs = std::filesystem;
+
+namespace lamina {
+
+namespace {
+
+std::string unique_suffix() {
+    static std::atomic<unsigned> counter{0};
+    return fmt::format("{}.{}", ::getpid(), counter++);
+}
+
+void write_all(const fs::path& path, std::string_view content) {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) throw InputError(path.string(), "", "cannot open for writing");
+    const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
+    const bool flushed = std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
+    const bool closed = std::fclose(f) == 0;
+    if (!ok || !flushed || !closed) {
+        std::error_code ec;
+        fs::remove(path, ec);
+        throw InputError(path.string(), "", "write failed (disk full or not writable?)");
+    }
+}
+
+}  // namespace
+
+void write_file_atomic(const fs::path& path, std::string_view content) {
+    const fs::path tmp =
+        path.parent_path() / ("." + path.filename().string() + ".tmp-" + unique_suffix());
+    write_all(tmp, content);
+    std::error_code ec;
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw InputError(path.string(), "", "cannot move the finished file into place");
+    }
+}
+
+StagedOutput::StagedOutput(fs::path dir) : dir_(std::move(dir)) {
+    std::error_code ec;
+    fs::create_directories(dir_, ec);
+    if (ec || !fs::is_directory(dir_))
+        throw InputError(dir_.string(), "--out",
+                         "cannot create the output folder: " + ec.message());
+    if (::access(dir_.c_str(), W_OK) != 0)
+        throw InputError(dir_.string(), "--out", "the output folder is not writable");
+    staging_ = dir_ / (".staging-" + unique_suffix());
+    fs::create_directory(staging_, ec);
+    if (ec)
+        throw InputError(dir_.string(), "--out", "cannot create a staging folder: " + ec.message());
+}
+
+StagedOutput::~StagedOutput() {
+    std::error_code ec;
+    fs::remove_all(staging_, ec);
+}
+
+void StagedOutput::add(const std::string& name, std::string_view content) {
+    write_all(staging_ / name, content);
+    names_.push_back(name);
+}
+
+void StagedOutput::commit() {
+    for (const auto& name : names_) {
+        std::error_code ec;
+        fs::rename(staging_ / name, dir_ / name, ec);
+        if (ec) throw InputError((dir_ / name).string(), "", "cannot move the file into place");
+    }
+    committed_ = true;
+}
+
+}  // namespace lamina

@@ -1,0 +1,40 @@
+#pragma once
+// Output that is never half-written: data goes to a temporary file beside the target and is
+// renamed into place only once complete (rename is atomic within a file system).
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace lamina {
+
+/// Writes `content` to `path` atomically. Throws InputError naming the path on failure; the
+/// temporary file is removed and any previous `path` is left untouched.
+void write_file_atomic(const std::filesystem::path& path, std::string_view content);
+
+/// A set of files written together into one folder: every file is staged in a hidden temporary
+/// folder inside the target, and `commit()` renames them all into place. If the object is destroyed
+/// without commit (an error, an exception), nothing staged reaches the target folder.
+class StagedOutput {
+  public:
+    /// Creates `dir` if needed and checks it is writable; throws InputError otherwise.
+    explicit StagedOutput(std::filesystem::path dir);
+    ~StagedOutput();
+    StagedOutput(const StagedOutput&) = delete;
+    StagedOutput& operator=(const StagedOutput&) = delete;
+
+    /// Stages one file (name relative to the target folder).
+    void add(const std::string& name, std::string_view content);
+    /// Moves every staged file into the target folder.
+    void commit();
+
+    const std::filesystem::path& dir() const { return dir_; }
+
+  private:
+    std::filesystem::path dir_, staging_;
+    std::vector<std::string> names_;
+    bool committed_ = false;
+};
+
+}  // namespace lamina

@@ -1,0 +1,38 @@
+#pragma once
+// Small numeric helpers and constants shared by every layer of lamina.
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace lamina {
+
+template <typename T>
+inline constexpr T kPi = std::numbers::pi_v<T>;
+template <typename T>
+inline constexpr T kInvPi = std::numbers::inv_pi_v<T>;
+
+template <typename T>
+constexpr T sqr(T x) {
+    return x * x;
+}
+
+/// sqrt clamped at zero: guards against tiny negative arguments produced by rounding.
+template <typename T>
+inline T safe_sqrt(T x) {
+    return std::sqrt(std::max(x, T(0)));
+}
+
+template <typename T>
+constexpr T clamp(T x, T lo, T hi) {
+    return std::min(std::max(x, lo), hi);
+}
+
+constexpr double deg_to_rad(double deg) {
+    return deg * std::numbers::pi / 180.0;
+}
+constexpr double rad_to_deg(double rad) {
+    return rad * 180.0 / std::numbers::pi;
+}
+
+}  // namespace lamina

@@ -1,0 +1,90 @@
+#pragma once
+// A layer stack as data (physics.md §2; style.md §5). Every estimator — the goniophotometer, the
+// analytic models, the random walk — reads this same description.
+//
+// From top to bottom: the ambient medium (index `ambient_eta`, default 1), then layers. A layer is
+// an interface and, below it, an optional homogeneous medium whose refractive index is the `eta`
+// of the interface above it. The last interface is the base: a dielectric base makes a slab (light
+// leaving downwards is the BTDF, into a half-space of index eta), a conductor or Lambertian base is
+// opaque. Opaque interfaces may only be last; the last layer has no medium.
+
+#include "core/rgb.h"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+enum class InterfaceType { Dielectric, Conductor, Lambertian };
+
+struct InterfaceSpec {
+    InterfaceType type = InterfaceType::Dielectric;
+    /// Dielectric: absolute index of what lies below (scalar: one path serves all channels).
+    double eta = 1.5;
+    /// Conductor: absolute complex index eta_rgb + i·k (RGB).
+    Rgbd eta_rgb{1.0};
+    Rgbd k{0.0};
+    /// GGX roughness α ∈ [0, 1] of dielectric and conductor interfaces; 0 = smooth.
+    double alpha = 0.0;
+    /// Lambertian albedo ∈ [0, 1] (RGB).
+    Rgbd albedo{0.0};
+
+    bool is_opaque() const { return type != InterfaceType::Dielectric; }
+    bool operator==(const InterfaceSpec&) const = default;
+};
+
+/// A homogeneous medium described by its normal optical depths (physics.md §4).
+struct MediumSpec {
+    Rgbd tau_a{0.0};  ///< absorption optical depth ≥ 0
+    Rgbd tau_s{0.0};  ///< scattering optical depth ≥ 0
+    Rgbd g{0.0};      ///< Henyey–Greenstein mean cosine, |g| < 1
+
+    Rgbd tau_t() const { return tau_a + tau_s; }
+    bool scatters() const { return tau_s.max() > 0; }
+    bool is_empty() const { return tau_a.max() == 0 && tau_s.max() == 0; }
+    bool operator==(const MediumSpec&) const = default;
+};
+
+struct Layer {
+    InterfaceSpec interface;
+    bool has_medium = false;
+    MediumSpec medium;
+    bool operator==(const Layer&) const = default;
+};
+
+struct Stack {
+    std::string name;
+    double ambient_eta = 1.0;
+    std::vector<Layer> layers;
+
+    const InterfaceSpec& base() const { return layers.back().interface; }
+    /// True when light can leave through the bottom (the base is a dielectric).
+    bool transmits() const { return !base().is_opaque(); }
+    /// Index of the medium just above layer i's interface.
+    double eta_above(std::size_t i) const {
+        return i == 0 ? ambient_eta : layers[i - 1].interface.eta;
+    }
+    bool operator==(const Stack&) const = default;
+};
+
+/// Parses and validates a stack from JSON. `where` names the source (a file) in error messages.
+/// Throws InputError naming `where`, the JSON pointer of the field, the value and what is allowed,
+/// for: unknown keys, wrong types, RGB arrays of the wrong length, NaN/inf, eta ≤ 0, alpha outside
+/// [0, 1], optical depths < 0, |g| ≥ 1, albedo outside [0, 1], k < 0, an opaque interface that is
+/// not last, a medium under the last interface, an empty stack.
+Stack stack_from_json(const nlohmann::json& j, const std::string& where);
+
+/// Reads and parses a stack file (InputError on unreadable or malformed JSON too).
+Stack load_stack(const std::filesystem::path& path);
+
+/// Canonical JSON form (every RGB quantity as a 3-array); stack_from_json(stack_to_json(s)) == s.
+nlohmann::json stack_to_json(const Stack& stack);
+
+/// One line describing the stack, e.g. `red plastic: air | dielectric η=1.5 α=0.05 | τa=(0.1,0,0.9)
+/// | lambertian ρ=(0.8,0.2,0.1)`.
+std::string describe(const Stack& stack);
+
+}  // namespace lamina

@@ -1,0 +1,148 @@
+#pragma once
+// A dielectric interface between two non-absorbing media: smooth (α = 0, delta reflection and
+// refraction) or rough (GGX, single-scattering microfacet BSDF of Walter et al. 2007, "Microfacet
+// models for refraction through rough surfaces", EGSR). Conventions: physics/bsdf.h.
+//
+// eta = η_below / η_above > 0, eta ≠ 1 is allowed to equal 1 (an index-matched interface is a pass-
+// through when smooth and a pure refraction lobe of zero width in the limit). α ∈ [0, 1].
+
+#include "core/math.h"
+#include "physics/bsdf.h"
+#include "physics/fresnel.h"
+#include "physics/microfacet.h"
+
+#include <cmath>
+#include <optional>
+
+namespace lamina {
+
+template <typename T>
+struct DielectricInterface {
+    T eta;
+    T alpha;
+    /// Use the uncorrelated G1·G1 instead of the height-correlated G2 (an option for ablations).
+    bool uncorrelated_shadowing = false;
+
+    bool is_smooth() const { return alpha == 0; }
+    GGX<T> distribution() const { return {alpha}; }
+
+    /// η(wo's side) / η(wi's side) — the ratio that appears in the refraction Jacobian.
+    T eta_ratio(const Vec3<T>& wi, const Vec3<T>& wo) const {
+        if (same_hemisphere(wi, wo)) return T(1);
+        return wi.z > 0 ? eta : T(1) / eta;
+    }
+
+    T masking_shadowing(const Vec3<T>& wi, const Vec3<T>& wo) const {
+        const GGX<T> ggx = distribution();
+        return uncorrelated_shadowing ? ggx.G2_uncorrelated(wi, wo) : ggx.G2(wi, wo);
+    }
+
+    /// Generalized half vector, in the upper hemisphere, or nothing for a degenerate pair.
+    /// Reflection: wi + wo (Walter Eq. 13); transmission: −(η_i wi + η_o wo) (Walter Eq. 16).
+    std::optional<Vec3<T>> half_vector(const Vec3<T>& wi, const Vec3<T>& wo) const {
+        Vec3<T> wm = wi + wo * eta_ratio(wi, wo);
+        const T len2 = dot(wm, wm);
+        if (len2 == 0) return std::nullopt;
+        wm = wm / std::sqrt(len2);
+        if (wm.z < 0) wm = -wm;
+        // Both directions must see the microfacet from their own side.
+        if (dot(wm, wi) * wi.z <= 0 || dot(wm, wo) * wo.z <= 0) return std::nullopt;
+        return wm;
+    }
+
+    /// Radiance BSDF, 1/sr, cosine excluded; zero for smooth interfaces (delta lobes).
+    T eval(const Vec3<T>& wi, const Vec3<T>& wo) const {
+        if (is_smooth() || wi.z == 0 || wo.z == 0) return T(0);
+        const auto wm = half_vector(wi, wo);
+        if (!wm) return T(0);
+        const GGX<T> ggx = distribution();
+        const T F = fresnel_dielectric(dot(wi, *wm), eta);
+        const T G = masking_shadowing(wi, wo);
+        if (same_hemisphere(wi, wo)) {
+            // Walter Eq. 20: f_r = F G D / (4 |cos θi| |cos θo|).
+            return F * ggx.D(*wm) * G / std::abs(T(4) * wi.z * wo.z);
+        }
+        // Walter Eq. 21 (radiance, light from wi to wo):
+        // f_t = |wi·wm| |wo·wm| η_o² (1 − F) G D / (|cos θi| |cos θo| (η_i wi·wm + η_o wo·wm)²).
+        const T r = eta_ratio(wi, wo);  // η_o / η_i
+        const T denom = sqr(dot(wi, *wm) + r * dot(wo, *wm));
+        return (T(1) - F) * ggx.D(*wm) * G * sqr(r) * std::abs(dot(wi, *wm) * dot(wo, *wm)) /
+               (std::abs(wi.z * wo.z) * denom);
+    }
+
+    /// Density of sample(wi, ·) at wo (solid angle); zero for smooth interfaces.
+    T pdf(const Vec3<T>& wi, const Vec3<T>& wo) const {
+        if (is_smooth() || wi.z == 0 || wo.z == 0) return T(0);
+        const auto wm = half_vector(wi, wo);
+        if (!wm) return T(0);
+        const GGX<T> ggx = distribution();
+        const T F = fresnel_dielectric(dot(wi, *wm), eta);
+        const T pdf_wm = ggx.pdf_visible_normal(wi, *wm);
+        if (same_hemisphere(wi, wo)) {
+            // Walter Eq. 14: dωm/dωo = 1 / (4 |wo·wm|).
+            return F * pdf_wm / (T(4) * std::abs(dot(wo, *wm)));
+        }
+        // Walter Eq. 17: dωm/dωo = η_o² |wo·wm| / (η_i wi·wm + η_o wo·wm)².
+        const T r = eta_ratio(wi, wo);
+        const T jacobian = sqr(r) * std::abs(dot(wo, *wm)) / sqr(dot(wi, *wm) + r * dot(wo, *wm));
+        return (T(1) - F) * pdf_wm * jacobian;
+    }
+
+    /// Follows a particle arriving from wi: picks a visible microfacet normal (Heitz 2018),
+    /// reflects with probability F and refracts otherwise, and keeps the fraction G2/G1 that
+    /// escapes the microsurface (physics.md §3). uc picks the Fresnel branch; u1, u2 the normal.
+    /// kWithPdf = false skips the density (the particle tracer only needs the weight).
+    template <bool kWithPdf = true>
+    std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T uc, T u1, T u2) const {
+        if (wi.z == 0) return std::nullopt;
+        if (is_smooth()) return sample_smooth(wi, uc);
+        const GGX<T> ggx = distribution();
+        const Vec3<T> wm = ggx.sample_visible_normal(wi, u1, u2);
+        const T cos_i_m = dot(wi, wm);
+        const T F = fresnel_dielectric(cos_i_m, eta);
+        BsdfSample<T> s;
+        if (uc < F) {
+            s.wo = reflect(wi, wm);
+            if (!same_hemisphere(wi, s.wo)) return lost_to_microsurface(s);
+        } else {
+            const auto wt = refract(wi, wm, eta);
+            if (!wt) return std::nullopt;  // unreachable: F = 1 under TIR
+            s.wo = *wt;
+            s.is_transmission = true;
+            if (same_hemisphere(wi, s.wo) || s.wo.z == 0) return lost_to_microsurface(s);
+        }
+        // Weight f·|cos θo|/pdf = G2(wi, wo)/G1(wi): the Fresnel branch probability cancels F
+        // (Heitz 2018, §2; Walter Eq. 41 with visible-normal sampling).
+        s.shadowing = masking_shadowing(wi, s.wo) / ggx.G1(wi);
+        s.weight = Rgb<T>(s.shadowing);
+        if constexpr (kWithPdf) s.pdf = pdf(wi, s.wo);
+        return s;
+    }
+
+  private:
+    static std::optional<BsdfSample<T>> lost_to_microsurface(BsdfSample<T> s) {
+        // The single-scattering model lets this energy go (G2 = 0 for the pair).
+        s.shadowing = 0;
+        s.weight = Rgb<T>(T(0));
+        return s;
+    }
+
+    std::optional<BsdfSample<T>> sample_smooth(const Vec3<T>& wi, T uc) const {
+        const Vec3<T> n(0, 0, 1);
+        const T F = fresnel_dielectric(wi.z, eta);
+        BsdfSample<T> s;
+        s.is_delta = true;
+        s.weight = Rgb<T>(T(1));  // flux: the branch probability equals its Fresnel factor
+        if (uc < F) {
+            s.wo = Vec3<T>(-wi.x, -wi.y, wi.z);
+        } else {
+            const auto wt = refract(wi, n, eta);
+            if (!wt) return std::nullopt;  // unreachable: F = 1 under TIR
+            s.wo = *wt;
+            s.is_transmission = true;
+        }
+        return s;
+    }
+};
+
+}  // namespace lamina

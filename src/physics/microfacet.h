@@ -1,0 +1,92 @@
+#pragma once
+// The GGX (Trowbridge–Reitz) microfacet distribution as a value type.
+//
+// Local frame, z = macro-surface normal. α is the GGX roughness itself (no remapping), isotropic,
+// α > 0 (α = 0, a smooth interface, is handled by the interfaces as a delta lobe).
+// Microfacet normals wm lie in the upper hemisphere. A direction w below the surface (w.z < 0)
+// sees the same microsurface from below: its visible normals are those with w·wm < 0, and every
+// function below treats such w through −w (the microsurface is point-symmetric).
+
+#include "core/math.h"
+#include "core/vec.h"
+
+#include <cmath>
+#include <limits>
+
+namespace lamina {
+
+template <typename T>
+struct GGX {
+    T alpha;
+
+    /// Normal distribution D(wm), 1/sr: Walter et al. 2007, "Microfacet models for refraction
+    /// through rough surfaces", Eq. 33, written as α² / (π (sin²θm + α² cos²θm)²) to keep precision
+    /// for tiny α. Zero for wm.z ≤ 0. Normalized: ∫ D(wm) cos θm dωm = 1.
+    T D(const Vec3<T>& wm) const {
+        if (wm.z <= 0) return T(0);
+        const T alpha2 = sqr(alpha);
+        const T denom = sqr(wm.x) + sqr(wm.y) + alpha2 * sqr(wm.z);
+        return alpha2 / (kPi<T> * sqr(denom));
+    }
+
+    /// Smith Λ(w) for GGX: Heitz 2014, "Understanding the masking-shadowing function in
+    /// microfacet-based BRDFs", JCGT 3(2), Eq. 72: Λ = (−1 + sqrt(1 + α² tan²θ)) / 2.
+    /// Symmetric in w.z; infinite at grazing (w.z = 0).
+    T lambda(const Vec3<T>& w) const {
+        const T cos2 = sqr(w.z);
+        if (cos2 == 0) return std::numeric_limits<T>::infinity();
+        const T alpha2_tan2 = sqr(alpha) * (sqr(w.x) + sqr(w.y)) / cos2;
+        // (sqrt(1+x) − 1)/2 = x / (2 (sqrt(1+x) + 1)): no cancellation for small α.
+        return alpha2_tan2 / (T(2) * (std::sqrt(T(1) + alpha2_tan2) + T(1)));
+    }
+
+    /// Smith masking G1(w) = 1 / (1 + Λ(w)) (Heitz 2014, Eq. 43).
+    T G1(const Vec3<T>& w) const { return T(1) / (T(1) + lambda(w)); }
+
+    /// Height-correlated masking-shadowing G2 = 1 / (1 + Λ(wi) + Λ(wo)) (Heitz 2014, Eq. 99).
+    /// The caller is responsible for the side checks (χ+ terms) of the lobe it evaluates.
+    T G2(const Vec3<T>& wi, const Vec3<T>& wo) const {
+        return T(1) / (T(1) + lambda(wi) + lambda(wo));
+    }
+
+    /// Uncorrelated (separable) masking-shadowing G1(wi) G1(wo) (Heitz 2014, Eq. 98); an option.
+    T G2_uncorrelated(const Vec3<T>& wi, const Vec3<T>& wo) const { return G1(wi) * G1(wo); }
+
+    /// Distribution of normals visible from w: D_w(wm) = G1(w) max(0, w·wm) D(wm) / cos θ
+    /// (Heitz 2014, Eq. 38), with w below the surface seen through −w. ∫ D_w dωm = 1.
+    T D_visible(const Vec3<T>& w, const Vec3<T>& wm) const {
+        const T sign = w.z < 0 ? T(-1) : T(1);
+        const T cos_w_wm = sign * dot(w, wm);
+        if (cos_w_wm <= 0 || w.z == 0) return T(0);
+        return G1(w) * cos_w_wm * D(wm) / std::abs(w.z);
+    }
+
+    /// Samples wm ∝ D_w(wm) from two uniform numbers in [0, 1): Heitz 2018, "Sampling the GGX
+    /// distribution of visible normals", JCGT 7(4), Listing 1 (the w.z < 0 case through −w).
+    Vec3<T> sample_visible_normal(Vec3<T> w, T u1, T u2) const {
+        if (w.z < 0) w = -w;
+        // Section 3.2: the view direction in the hemisphere configuration (α = 1).
+        const Vec3<T> vh = normalize(Vec3<T>(alpha * w.x, alpha * w.y, w.z));
+        // Section 4.1: orthonormal basis around vh.
+        const T len2 = sqr(vh.x) + sqr(vh.y);
+        const Vec3<T> t1 =
+            len2 > 0 ? Vec3<T>(-vh.y, vh.x, T(0)) / std::sqrt(len2) : Vec3<T>(T(1), T(0), T(0));
+        const Vec3<T> t2 = cross(vh, t1);
+        // Section 4.2: a point on the projected area, warped towards the visible half disk.
+        const T r = std::sqrt(u1);
+        const T phi = T(2) * kPi<T> * u2;
+        const T p1 = r * std::cos(phi);
+        T p2 = r * std::sin(phi);
+        const T s = T(0.5) * (T(1) + vh.z);
+        p2 = (T(1) - s) * safe_sqrt(T(1) - sqr(p1)) + s * p2;
+        // Section 4.3: reprojection onto the hemisphere.
+        const Vec3<T> nh = t1 * p1 + t2 * p2 + vh * safe_sqrt(T(1) - sqr(p1) - sqr(p2));
+        // Section 3.4: back to the ellipsoid configuration.
+        return normalize(Vec3<T>(alpha * nh.x, alpha * nh.y, std::max(T(0), nh.z)));
+    }
+
+    /// Density of sample_visible_normal, with respect to solid angle of wm.
+    T pdf_visible_normal(const Vec3<T>& w, const Vec3<T>& wm) const { return D_visible(w, wm); }
+};
+
+}  // namespace lamina

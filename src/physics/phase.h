@@ -1,0 +1,49 @@
+#pragma once
+// The Henyey–Greenstein phase function (Henyey & Greenstein 1941, ApJ 93, Eq. 3).
+//
+// Directions here are *propagation* directions: `d_in` is where the particle travels before the
+// scattering event, `d_out` after. cos_theta = d_in·d_out; g ∈ (−1, 1) is the mean cosine
+// (g > 0 forward scattering). The phase function is normalized over the sphere (1/sr).
+
+#include "core/frame.h"
+#include "core/math.h"
+#include "core/vec.h"
+
+#include <cmath>
+
+namespace lamina {
+
+template <typename T>
+inline T hg_phase(T cos_theta, T g) {
+    const T denom = T(1) + sqr(g) - T(2) * g * cos_theta;
+    return (T(1) - sqr(g)) / (T(4) * kPi<T> * denom * safe_sqrt(denom));
+}
+
+/// cos θ of a sample of HG from u in [0, 1) by inverting its CDF (e.g. Pharr, Jakob, Humphreys,
+/// PBR 4th ed., §11.3.1); uniform when |g| is tiny.
+template <typename T>
+inline T sample_hg_cos_theta(T g, T u) {
+    if (std::abs(g) < T(1e-3)) return T(1) - T(2) * u;
+    const T s = (T(1) - sqr(g)) / (T(1) + g - T(2) * g * u);
+    return clamp((T(1) + sqr(g) - sqr(s)) / (T(2) * g), T(-1), T(1));
+}
+
+/// Propagation direction after scattering d_in (unit) with HG(g), from two uniforms in [0, 1).
+template <typename T>
+inline Vec3<T> sample_hg(const Vec3<T>& d_in, T g, T u1, T u2) {
+    const T cos_theta = sample_hg_cos_theta(g, u1);
+    const T sin_theta = safe_sqrt(T(1) - sqr(cos_theta));
+    const T phi = T(2) * kPi<T> * u2;
+    const Frame<T> frame = Frame<T>::from_normal(d_in);
+    return frame.to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta});
+}
+
+/// Inverse of sample_hg_cos_theta: the u that produces cos_theta.
+template <typename T>
+inline T invert_hg_cos_theta(T g, T cos_theta) {
+    if (std::abs(g) < T(1e-3)) return (T(1) - cos_theta) / T(2);
+    const T s = std::sqrt(T(1) + sqr(g) - T(2) * g * cos_theta);
+    return (T(1) + g - (T(1) - sqr(g)) / s) / (T(2) * g);
+}
+
+}  // namespace lamina
