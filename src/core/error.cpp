@@ -1,13 +1,14 @@
 #include "core/error.h"
 
+#include <fmt/format.h>
+
 namespace lamina {
 
 namespace {
 std::string compose(const std::string& where, const std::string& field,
                     const std::string& problem) {
-    std::string msg = where;
-    if (!field.empty()) msg += ": " + field;
-    return msg + ": " + problem;
+    return field.empty() ? fmt::format("{}: {}", where, problem)
+                         : fmt::format("{}: {}: {}", where, field, problem);
 }
 }  // namespace
 

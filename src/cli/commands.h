@@ -1,0 +1,17 @@
+#pragma once
+// Each subcommand lives in its own cmd_*.cpp and registers itself through one function listed in
+// main.cpp. A command's run function returns the process exit code; InputError escaping it is
+// printed as "lamina: <file>: <field>: <problem>" with exit code 1.
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace lamina::cli {
+
+using Runner = std::function<int()>;
+
+/// Adds the subcommand to `app` and returns what runs it once parsed.
+Runner add_validate(CLI::App& app);
+
+}  // namespace lamina::cli

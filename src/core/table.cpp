@@ -1,0 +1,133 @@
+#include "core/table.h"
+
+#include "core/error.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace lamina {
+
+BinnedTable BinnedTable::zeros(const HemisphereGrid& grid, const std::vector<double>& theta_i_deg,
+                               bool reflection, bool transmission) {
+    BinnedTable t{grid, theta_i_deg, reflection, transmission, {}};
+    t.lobes.resize(theta_i_deg.size());
+    for (auto& pair : t.lobes) {
+        if (reflection) pair[0] = {std::vector<Rgbd>(grid.size()), std::vector<Rgbd>(grid.size())};
+        if (transmission)
+            pair[1] = {std::vector<Rgbd>(grid.size()), std::vector<Rgbd>(grid.size())};
+    }
+    return t;
+}
+
+Rgbd BinnedTable::albedo(std::size_t incidence, Side side) const {
+    const BinnedLobe& l = lobe(incidence, side);
+    Rgbd sum(0.0);
+    for (std::size_t j = 0; j < l.f.size(); ++j) sum += l.f[j] * grid.projected_solid_angle(j);
+    return sum;
+}
+
+std::string BinnedTable::to_csv() const {
+    std::string out = std::string(kBrdfCsvHeader) + "\n";
+    for (std::size_t i = 0; i < theta_i_deg.size(); ++i) {
+        for (const Side side : {Side::Reflection, Side::Transmission}) {
+            if (side == Side::Reflection ? !has_reflection : !has_transmission) continue;
+            const BinnedLobe& l = lobe(i, side);
+            for (int t = 0; t < grid.n_theta(); ++t) {
+                for (int p = 0; p < grid.n_phi(); ++p) {
+                    const std::size_t j = std::size_t(t) * grid.n_phi() + p;
+                    fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},{},{},{},{},{}\n",
+                                   theta_i_deg[i], side == Side::Reflection ? 'R' : 'T',
+                                   rad_to_deg(grid.theta_lo(t)), rad_to_deg(grid.theta_hi(t)),
+                                   rad_to_deg(grid.phi_lo(p)), rad_to_deg(grid.phi_hi(p)),
+                                   l.f[j][0], l.f[j][1], l.f[j][2], l.se[j][0], l.se[j][1],
+                                   l.se[j][2]);
+                }
+            }
+        }
+    }
+    return out;
+}
+
+BinnedTable BinnedTable::from_csv(const std::string& text, const std::string& where) {
+    std::istringstream in(text);
+    std::string line;
+    if (!std::getline(in, line) || line != kBrdfCsvHeader)
+        throw InputError(where, "line 1", fmt::format("expected the header '{}'", kBrdfCsvHeader));
+    struct Row {
+        double theta_i;
+        char side;
+        int t, p;
+        Rgbd f, se;
+    };
+    std::vector<Row> rows;
+    int max_t = -1, max_p = -1, n_theta_guess = 0, n_phi_guess = 0;
+    std::size_t line_no = 1;
+    while (std::getline(in, line)) {
+        ++line_no;
+        if (line.empty()) continue;
+        std::vector<std::string> cells;
+        std::stringstream ls(line);
+        for (std::string cell; std::getline(ls, cell, ',');) cells.push_back(cell);
+        if (cells.size() != 12)
+            throw InputError(where, fmt::format("line {}", line_no),
+                             fmt::format("expected 12 columns, found {}", cells.size()));
+        auto num = [&](int c) {
+            try {
+                std::size_t used = 0;
+                const double v = std::stod(cells[c], &used);
+                if (used != cells[c].size() || !std::isfinite(v)) throw std::invalid_argument("");
+                return v;
+            } catch (const std::exception&) {
+                throw InputError(where, fmt::format("line {}, column {}", line_no, c + 1),
+                                 fmt::format("'{}' is not a finite number", cells[c]));
+            }
+        };
+        if (cells[1] != "R" && cells[1] != "T")
+            throw InputError(where, fmt::format("line {}, column 2", line_no),
+                             fmt::format("side '{}' must be R or T", cells[1]));
+        const double theta_lo = num(2), theta_hi = num(3), phi_lo = num(4), phi_hi = num(5);
+        const int n_theta = int(std::lround(90.0 / (theta_hi - theta_lo)));
+        const int n_phi = int(std::lround(180.0 / (phi_hi - phi_lo)));
+        n_theta_guess = n_theta;
+        n_phi_guess = n_phi;
+        Row r{num(0), cells[1][0], int(std::lround(theta_lo / 90.0 * n_theta)),
+              int(std::lround(phi_lo / 180.0 * n_phi)), Rgbd(num(6), num(7), num(8)),
+              Rgbd(num(9), num(10), num(11))};
+        max_t = std::max(max_t, r.t);
+        max_p = std::max(max_p, r.p);
+        rows.push_back(r);
+    }
+    if (rows.empty()) throw InputError(where, "", "the table has no rows");
+    const HemisphereGrid grid(n_theta_guess, n_phi_guess);
+    if (max_t + 1 != grid.n_theta() || max_p + 1 != grid.n_phi())
+        throw InputError(where, "", "the bins do not form a regular grid");
+    std::vector<double> incidences;
+    bool has_r = false, has_t = false;
+    for (const Row& r : rows) {
+        if (incidences.empty() || incidences.back() != r.theta_i) {
+            if (std::find(incidences.begin(), incidences.end(), r.theta_i) == incidences.end())
+                incidences.push_back(r.theta_i);
+        }
+        (r.side == 'R' ? has_r : has_t) = true;
+    }
+    BinnedTable table = zeros(grid, incidences, has_r, has_t);
+    std::size_t expected = incidences.size() * grid.size() * (has_r + has_t);
+    if (rows.size() != expected)
+        throw InputError(where, "",
+                         fmt::format("expected {} rows for {} incidences on a {} grid, found {}",
+                                     expected, incidences.size(), grid.to_string(), rows.size()));
+    for (const Row& r : rows) {
+        const std::size_t i =
+            std::find(incidences.begin(), incidences.end(), r.theta_i) - incidences.begin();
+        BinnedLobe& l = table.lobe(i, r.side == 'R' ? Side::Reflection : Side::Transmission);
+        const std::size_t j = std::size_t(r.t) * grid.n_phi() + r.p;
+        l.f[j] = r.f;
+        l.se[j] = r.se;
+    }
+    return table;
+}
+
+}  // namespace lamina
