@@ -13,5 +13,6 @@ using Runner = std::function<int()>;
 
 /// Adds the subcommand to `app` and returns what runs it once parsed.
 Runner add_validate(CLI::App& app);
+Runner add_simulate(CLI::App& app);
 
 }  // namespace lamina::cli

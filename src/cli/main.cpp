@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
         commands.emplace_back(app.get_subcommands({}).back(), std::move(runner));
     };
     add(lamina::cli::add_validate);
+    add(lamina::cli::add_simulate);
 
     CLI11_PARSE(app, argc, argv);
     try {

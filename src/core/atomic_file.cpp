@@ -37,7 +37,7 @@ void write_all(const fs::path& path, std::string_view content) {
 
 void write_file_atomic(const fs::path& path, std::string_view content) {
     const fs::path tmp =
-        path.parent_path() / ("." + path.filename().string() + ".tmp-" + unique_suffix());
+        path.parent_path() / fmt::format(".{}.tmp-{}", path.filename().string(), unique_suffix());
     write_all(tmp, content);
     std::error_code ec;
     fs::rename(tmp, path, ec);
@@ -55,7 +55,7 @@ StagedOutput::StagedOutput(fs::path dir) : dir_(std::move(dir)) {
                          "cannot create the output folder: " + ec.message());
     if (::access(dir_.c_str(), W_OK) != 0)
         throw InputError(dir_.string(), "--out", "the output folder is not writable");
-    staging_ = dir_ / (".staging-" + unique_suffix());
+    staging_ = dir_ / fmt::format(".staging-{}", unique_suffix());
     fs::create_directory(staging_, ec);
     if (ec)
         throw InputError(dir_.string(), "--out", "cannot create a staging folder: " + ec.message());

@@ -17,9 +17,9 @@ constexpr int kGuessResolution = 4096;
 std::vector<int> make_guess(const std::vector<double>& edges, double x_min) {
     std::vector<int> guess(kGuessResolution + 1);
     const int n = int(edges.size()) - 1;
+    int b = 0;  // x decreases with c, so the bin only moves forward: one pass
     for (int c = 0; c <= kGuessResolution; ++c) {
         const double x = x_min + (1.0 - x_min) * (kGuessResolution - c) / kGuessResolution;
-        int b = 0;
         while (b < n - 1 && x < edges[b + 1]) ++b;  // x at a cell's top: the smallest bin
         guess[c] = b;
     }

@@ -49,7 +49,8 @@ struct ConductorInterface {
         return distribution().pdf_visible_normal(wi, wm) / (T(4) * dot(wo, wm));
     }
 
-    /// Reflects a particle arriving from wi off a visible microfacet (Heitz 2018); weight
+    /// Reflects a particle arriving from wi off a visible microfacet (Heitz 2018 density, drawn as
+    /// in Dupuy & Benyoub 2023); weight
     /// F(wi·wm)·G2/G1. kWithPdf = false skips the density.
     template <bool kWithPdf = true>
     std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T u1, T u2) const {
@@ -63,13 +64,19 @@ struct ConductorInterface {
             return s;
         }
         const GGX<T> ggx = distribution();
-        const Vec3<T> wm = ggx.sample_visible_normal(wi, u1, u2);
+        const Vec3<T> wm = ggx.sample_visible_normal_caps(wi, u1, u2);
         s.wo = reflect(wi, wm);
         s.fresnel_weight = fresnel(dot(wi, wm));
         if (s.wo.z <= 0) {
             s.shadowing = 0;
         } else {
-            s.shadowing = masking_shadowing(wi, s.wo) / ggx.G1(wi);
+            // G2/G1 = (1 + r_i)/(r_i + r_o) with r = 1 + 2Λ (see dielectric.h).
+            if (uncorrelated_shadowing) {
+                s.shadowing = ggx.G1(s.wo);
+            } else {
+                const T r_i = ggx.smith_root(wi), r_o = ggx.smith_root(s.wo);
+                s.shadowing = (T(1) + r_i) / (r_i + r_o);
+            }
             if constexpr (kWithPdf) s.pdf = ggx.pdf_visible_normal(wi, wm) / (T(4) * dot(s.wo, wm));
         }
         s.weight = s.fresnel_weight * s.shadowing;

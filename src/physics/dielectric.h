@@ -88,38 +88,47 @@ struct DielectricInterface {
         return (T(1) - F) * pdf_wm * jacobian;
     }
 
-    /// Follows a particle arriving from wi: picks a visible microfacet normal (Heitz 2018),
-    /// reflects with probability F and refracts otherwise, and keeps the fraction G2/G1 that
-    /// escapes the microsurface (physics.md §3). uc picks the Fresnel branch; u1, u2 the normal.
+    /// Follows a particle arriving from wi: picks a visible microfacet normal (Heitz 2018, drawn
+    /// with the equivalent spherical-cap construction of Dupuy & Benyoub 2023), reflects with
+    /// probability F and refracts otherwise, and keeps the fraction G2/G1 that escapes the
+    /// microsurface (physics.md §3). uc picks the Fresnel branch; u1, u2 the normal.
     /// kWithPdf = false skips the density (the particle tracer only needs the weight).
     template <bool kWithPdf = true>
     std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T uc, T u1, T u2) const {
         if (wi.z == 0) return std::nullopt;
         if (is_smooth()) return sample_smooth(wi, uc);
         const GGX<T> ggx = distribution();
-        const Vec3<T> wm = ggx.sample_visible_normal(wi, u1, u2);
-        const T cos_i_m = dot(wi, wm);
-        const T F = fresnel_dielectric(cos_i_m, eta);
+        const Vec3<T> wm = ggx.sample_visible_normal_caps(wi, u1, u2);
+        const T cos_i_m = dot(wi, wm);  // < 0 when wi is below: seen from the other side
+        const FresnelDielectric<T> fr = fresnel_dielectric_full(cos_i_m, eta);
         BsdfSample<T> s;
-        if (uc < F) {
+        if (uc < fr.reflectance) {
             s.wo = reflect(wi, wm);
             if (!same_hemisphere(wi, s.wo)) return lost_to_microsurface(s);
         } else {
-            const auto wt = refract(wi, wm, eta);
-            if (!wt) return std::nullopt;  // unreachable: F = 1 under TIR
-            s.wo = *wt;
+            // Snell about wm (fresnel.h refract), reusing the refracted cosine: with m = ±wm on
+            // wi's side, wt = −wi/η + m (cos θi/η − cos θt).
+            const T sign = cos_i_m < 0 ? T(-1) : T(1);
+            const T inv_eta = T(1) / fr.eta;
+            s.wo = wi * (-inv_eta) + wm * (sign * (std::abs(cos_i_m) * inv_eta - fr.cos_theta_t));
             s.is_transmission = true;
             if (same_hemisphere(wi, s.wo) || s.wo.z == 0) return lost_to_microsurface(s);
         }
         // Weight f·|cos θo|/pdf = G2(wi, wo)/G1(wi): the Fresnel branch probability cancels F
-        // (Heitz 2018, §2; Walter Eq. 41 with visible-normal sampling).
-        s.shadowing = masking_shadowing(wi, s.wo) / ggx.G1(wi);
+        // (Heitz 2018, §2; Walter Eq. 41 with visible-normal sampling). With r = √(1 + α²tan²θ)
+        // = 1 + 2Λ (Heitz 2014, Eq. 72), height-correlated G2/G1 = (1 + r_i) / (r_i + r_o).
+        if (uncorrelated_shadowing) {
+            s.shadowing = ggx.G1(s.wo);
+        } else {
+            const T r_i = ggx.smith_root(wi), r_o = ggx.smith_root(s.wo);
+            s.shadowing = (T(1) + r_i) / (r_i + r_o);
+        }
         s.weight = Rgb<T>(s.shadowing);
         if constexpr (kWithPdf) s.pdf = pdf(wi, s.wo);
         return s;
     }
 
-  private:
+private:
     static std::optional<BsdfSample<T>> lost_to_microsurface(BsdfSample<T> s) {
         // The single-scattering model lets this energy go (G2 = 0 for the pair).
         s.shadowing = 0;

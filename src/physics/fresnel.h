@@ -14,32 +14,76 @@
 
 namespace lamina {
 
+/// Fresnel reflectance of a dielectric interface together with the refracted cosine, for code that
+/// refracts after choosing (sharing the square root). `eta` is the relative index actually crossed
+/// (1/eta when the light arrives from the other side); cos_theta_t = 0 under total reflection.
+template <typename T>
+struct FresnelDielectric {
+    T reflectance;
+    T cos_theta_t;
+    T eta;
+};
+
 /// Exact unpolarized Fresnel reflectance of a dielectric interface (the mean of the s and p
-/// reflectances; Born & Wolf, Principles of Optics, §1.5.2, Eqs. 21a–b).
+/// reflectances; Born & Wolf, Principles of Optics, §1.5.2, Eqs. 21a–b), with the refracted cosine.
 /// cos_theta_i: cosine between the arriving direction and the normal, in [−1, 1]; a negative value
 /// means the light arrives from the other side, where the relative index is 1/eta.
-/// eta > 0. Returns 1 under total internal reflection (sin θt ≥ 1).
+/// eta > 0. The reflectance is 1 under total internal reflection (sin θt ≥ 1).
 template <typename T>
-inline T fresnel_dielectric(T cos_theta_i, T eta) {
+inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta) {
     cos_theta_i = clamp(cos_theta_i, T(-1), T(1));
     if (cos_theta_i < 0) {
         eta = T(1) / eta;
         cos_theta_i = -cos_theta_i;
     }
     const T sin2_theta_t = (T(1) - sqr(cos_theta_i)) / sqr(eta);
-    if (sin2_theta_t >= T(1)) return T(1);  // total internal reflection
+    if (sin2_theta_t >= T(1)) return {T(1), T(0), eta};  // total internal reflection
     const T cos_theta_t = safe_sqrt(T(1) - sin2_theta_t);
-    const T r_parallel = (eta * cos_theta_i - cos_theta_t) / (eta * cos_theta_i + cos_theta_t);
-    const T r_perpendicular = (cos_theta_i - eta * cos_theta_t) / (cos_theta_i + eta * cos_theta_t);
-    return (sqr(r_parallel) + sqr(r_perpendicular)) / T(2);
+    // r_parallel = a/b, r_perpendicular = c/d; (a²d² + c²b²) / (b²d²) needs a single division.
+    const T a = eta * cos_theta_i - cos_theta_t, b = eta * cos_theta_i + cos_theta_t;
+    const T c = cos_theta_i - eta * cos_theta_t, d = cos_theta_i + eta * cos_theta_t;
+    const T b2d2 = sqr(b * d);
+    const T reflectance = b2d2 > 0 ? (sqr(a * d) + sqr(c * b)) / (T(2) * b2d2) : T(1);
+    return {reflectance, cos_theta_t, eta};
+}
+
+/// Exact unpolarized Fresnel reflectance of a dielectric interface; see fresnel_dielectric_full.
+/// Returns 1 under total internal reflection.
+template <typename T>
+inline T fresnel_dielectric(T cos_theta_i, T eta) {
+    return fresnel_dielectric_full(cos_theta_i, eta).reflectance;
 }
 
 /// Exact unpolarized Fresnel reflectance of a conductor with relative complex index
 /// eta + i·k (k ≥ 0), light arriving from the dielectric side with cos_theta_i in [0, 1].
-/// The same Fresnel equations as the dielectric case with a complex index (Born & Wolf §14.2);
-/// with k = 0 it equals fresnel_dielectric, including total internal reflection when eta < 1.
+/// The Fresnel equations with a complex index (Born & Wolf §14.2) written in real arithmetic:
+/// with a² + b² = √((η² − k² − sin²θ)² + 4η²k²) and a = √((a² + b² + η² − k² − sin²θ)/2),
+///   R_s = (a² + b² + cos²θ − 2a cos θ) / (a² + b² + cos²θ + 2a cos θ),
+///   R_p = R_s (cos²θ (a² + b²) + sin⁴θ − 2a cos θ sin²θ) / (cos²θ (a² + b²) + sin⁴θ + 2a cos θ sin²θ)
+/// (e.g. Lagarde 2013, "Memo on Fresnel equations"; pbrt-v3 FrConductor). With k = 0 it equals
+/// fresnel_dielectric, including total internal reflection (a = 0 gives R = 1) when eta < 1.
 template <typename T>
 inline T fresnel_conductor(T cos_theta_i, T eta, T k) {
+    cos_theta_i = clamp(cos_theta_i, T(0), T(1));
+    const T cos2 = sqr(cos_theta_i);
+    const T sin2 = T(1) - cos2;
+    const T eta2 = sqr(eta), k2 = sqr(k);
+    const T t0 = eta2 - k2 - sin2;
+    const T a2_plus_b2 = std::sqrt(sqr(t0) + T(4) * eta2 * k2);
+    const T a = safe_sqrt(T(0.5) * (a2_plus_b2 + t0));
+    const T t1 = a2_plus_b2 + cos2;
+    const T t2 = T(2) * cos_theta_i * a;
+    const T r_s = (t1 - t2) / (t1 + t2);
+    const T t3 = cos2 * a2_plus_b2 + sqr(sin2);
+    const T t4 = t2 * sin2;
+    const T r_p = t3 + t4 > 0 ? r_s * (t3 - t4) / (t3 + t4) : r_s;
+    return (r_s + r_p) / T(2);
+}
+
+/// The same reflectance evaluated with std::complex, as written in Born & Wolf: an independent
+/// form for tests (slower: complex division and square root).
+template <typename T>
+inline T fresnel_conductor_complex(T cos_theta_i, T eta, T k) {
     using C = std::complex<T>;
     cos_theta_i = clamp(cos_theta_i, T(0), T(1));
     const C eta_c(eta, k);

@@ -1,0 +1,81 @@
+// Goniophotometer throughput (issue 3): particles per second for the benchmark plastic and the
+// benchmark metallic paint at θi = 30°, on 1 and 2 threads, with events per particle.
+#include "layers/stack.h"
+#include "simulator/goniophotometer.h"
+
+#include <benchmark/benchmark.h>
+
+namespace {
+
+using namespace lamina;
+
+Layer coat(double alpha, Rgbd tau_a) {
+    Layer l;
+    l.interface.type = InterfaceType::Dielectric;
+    l.interface.eta = 1.5;
+    l.interface.alpha = alpha;
+    l.has_medium = true;
+    l.medium.tau_a = tau_a;
+    return l;
+}
+
+Stack bench_plastic() {
+    Layer base;
+    base.interface.type = InterfaceType::Lambertian;
+    base.interface.albedo = Rgbd(0.8);
+    return {"bench plastic", 1.0, {coat(0.2, Rgbd(0.1, 0.0, 0.9)), base}};
+}
+
+Stack bench_metallic_paint() {
+    Layer base;
+    base.interface.type = InterfaceType::Conductor;
+    base.interface.eta_rgb = Rgbd(0.2);
+    base.interface.k = Rgbd(3.0);
+    base.interface.alpha = 0.3;
+    return {"bench metallic paint", 1.0, {coat(0.05, Rgbd(0.1)), base}};
+}
+
+void run(benchmark::State& state, const Stack& stack) {
+    SimulationSettings s;
+    s.theta_i_deg = {30.0};
+    s.particles = 1'000'000;
+    s.threads = int(state.range(0));
+    double events = 0;
+    for (auto _ : state) {
+        const SimulationResult r = simulate(stack, s);
+        events = r.incidences[0].events_per_particle;
+        benchmark::DoNotOptimize(r.table.lobes.data());
+    }
+    state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(s.particles));
+    state.counters["events_per_particle"] = events;
+    state.counters["threads"] = double(s.threads);
+}
+
+void BM_SimulatePlastic(benchmark::State& state) { run(state, bench_plastic()); }
+void BM_SimulateMetallicPaint(benchmark::State& state) { run(state, bench_metallic_paint()); }
+
+BENCHMARK(BM_SimulatePlastic)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SimulateMetallicPaint)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+namespace {
+// Cost anatomy: a Lambertian alone (one event per particle) and a single rough interface.
+lamina::Stack bench_lambertian() {
+    lamina::Layer base;
+    base.interface.type = lamina::InterfaceType::Lambertian;
+    base.interface.albedo = lamina::Rgbd(0.8);
+    return {"lambertian", 1.0, {base}};
+}
+lamina::Stack bench_rough_interface() {
+    lamina::Layer l;
+    l.interface.type = lamina::InterfaceType::Dielectric;
+    l.interface.eta = 1.5;
+    l.interface.alpha = 0.2;
+    return {"rough dielectric", 1.0, {l}};
+}
+void BM_SimulateLambertian(benchmark::State& state) { run(state, bench_lambertian()); }
+void BM_SimulateRoughInterface(benchmark::State& state) { run(state, bench_rough_interface()); }
+BENCHMARK(BM_SimulateLambertian)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SimulateRoughInterface)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+}  // namespace

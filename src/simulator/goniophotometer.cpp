@@ -1,0 +1,410 @@
+#include "simulator/goniophotometer.h"
+
+#include "core/check.h"
+#include "core/error.h"
+#include "core/math.h"
+#include "core/rng.h"
+#include "core/spherical.h"
+#include "physics/phase.h"
+#include "simulator/trace_stack.h"
+
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <bit>
+#include <chrono>
+#include <cmath>
+
+namespace lamina {
+
+Rgbd EnergyBudget::sum() const {
+    Rgbd s(0.0);
+    for (const Rgbd& t : term) s += t;
+    return s;
+}
+
+void validate_settings(const SimulationSettings& s) {
+    if (s.theta_i_deg.empty())
+        throw InputError("command line", "--theta-i", "at least one incidence is needed");
+    for (double t : s.theta_i_deg)
+        if (!(t >= 0 && t < 90))
+            throw InputError("command line", "--theta-i",
+                             fmt::format("{} is outside the allowed range [0, 90) degrees", t));
+    if (s.particles == 0)
+        throw InputError("command line", "--particles", "the particle count must be > 0");
+    if (s.threads < 0)
+        throw InputError("command line", "--threads",
+                         fmt::format("{} is not allowed: use ≥ 1, or 0 for all cores", s.threads));
+    if (s.max_events < 1)
+        throw InputError("command line", "--max-events", "must be ≥ 1");
+}
+
+namespace {
+
+// ---- Fixed-point tallies -----------------------------------------------------------------------
+// Flux is added in 128-bit integers with 2^-56 resolution: integer addition is associative, so the
+// sums (and the tables) are identical whatever the order in which threads or processes add them.
+// A particle's flux never exceeds 2^6 (the spectral MIS weights are bounded by 3), so one
+// contribution fits an int64 before widening.
+using Fixed = __int128;
+constexpr double kFixedScale = 0x1p56;
+constexpr double kFixedInvScale = 0x1p-56;
+
+inline Fixed to_fixed(double x) { return Fixed(std::llrint(x * kFixedScale)); }
+
+// The same for |x| < 2^39 (block sums): split into an integer part at scale 2^24 and the exact
+// remainder, each converted separately.
+inline Fixed to_fixed_wide(double x) {
+    const double scaled = x * 0x1p24;  // exact: a power-of-two scaling
+    const double hi = std::floor(scaled);
+    const double lo = scaled - hi;  // exact: the fractional part, in [0, 1)
+    return (Fixed(std::int64_t(hi)) << 32) + Fixed(std::llrint(lo * 0x1p32));
+}
+inline double from_fixed(Fixed x) { return double(x) * kFixedInvScale; }
+
+// Per (side, bin): Σ flux and Σ flux² per channel, side by side in memory (one cache line pair).
+struct BinAccumulator {
+    std::array<Fixed, 3> sum{}, sum_sq{};
+};
+
+// Budget terms summed in double over one block of particles (a fixed range of particle indices,
+// traced in order by one thread, so the sum does not depend on the thread count), then added to
+// the 128-bit tallies once per block.
+struct BlockBudget {
+    std::array<Rgbd, kBudgetTerms> term{};
+    Rgbd reflected_sq{0.0}, transmitted_sq{0.0};
+};
+
+struct Tally {
+    std::vector<BinAccumulator> bins;  // [side · n_bins + bin]
+    std::array<std::array<Fixed, 3>, kBudgetTerms> budget{};
+    std::array<Fixed, 3> reflected_sq{}, transmitted_sq{};
+    std::uint64_t events = 0, degenerate = 0;
+
+    explicit Tally(std::size_t n_bins) : bins(2 * n_bins) {}
+
+    void exit(std::size_t index, const Rgbf& flux) {
+        BinAccumulator& acc = bins[index];
+        for (int c = 0; c < 3; ++c) {
+            const double x = flux[c];
+            acc.sum[c] += to_fixed(x);
+            acc.sum_sq[c] += to_fixed(x * x);
+        }
+    }
+    void add_block(const BlockBudget& b) {
+        for (int t = 0; t < kBudgetTerms; ++t)
+            for (int c = 0; c < 3; ++c) budget[t][c] += to_fixed_wide(b.term[t][c]);
+        for (int c = 0; c < 3; ++c) {
+            reflected_sq[c] += to_fixed_wide(b.reflected_sq[c]);
+            transmitted_sq[c] += to_fixed_wide(b.transmitted_sq[c]);
+        }
+    }
+    void merge(const Tally& o) {
+        for (std::size_t i = 0; i < bins.size(); ++i)
+            for (int c = 0; c < 3; ++c) {
+                bins[i].sum[c] += o.bins[i].sum[c];
+                bins[i].sum_sq[c] += o.bins[i].sum_sq[c];
+            }
+        for (int t = 0; t < kBudgetTerms; ++t)
+            for (int c = 0; c < 3; ++c) budget[t][c] += o.budget[t][c];
+        for (int c = 0; c < 3; ++c) {
+            reflected_sq[c] += o.reflected_sq[c];
+            transmitted_sq[c] += o.transmitted_sq[c];
+        }
+        events += o.events;
+        degenerate += o.degenerate;
+    }
+};
+
+bool is_black(const Rgbf& w) { return w[0] == 0.f && w[1] == 0.f && w[2] == 0.f; }
+
+// The flux a particle loses along its path, per budget term, in registers; added to the block's
+// double sums once, when the particle ends.
+struct PathLosses {
+    std::array<Rgbf, kBudgetTerms> term{};
+
+    void add(BudgetTerm t, const Rgbf& lost) { term[int(t)] += lost; }
+    void flush(BlockBudget& block) const {
+        for (int t = int(BudgetTerm::AbsorbedMedium); t < kBudgetTerms; ++t)
+            for (int c = 0; c < 3; ++c) block.term[t][c] += double(term[t][c]);
+    }
+};
+
+// ---- Media (physics.md §4) ---------------------------------------------------------------------
+// Depth s ∈ [0, 1] across the layer (0 at its top); a direction d with |d.z| = μ crosses the whole
+// layer along a path of optical depth τ/μ. Returns true if the particle leaves through the top.
+struct MediumWalk {
+    const TraceMedium& m;
+    ParticleRng& rng;
+    PathLosses& losses;
+
+    bool traverse(Vec3f& d, Rgbf& w, int& events, int max_events) {
+        if (!m.scatters) {
+            // Pure absorption: Beer–Lambert along the straight path, no sampling.
+            const float inv_mu = 1.f / std::abs(d.z);
+            const Rgbf before = w;
+            for (int c = 0; c < 3; ++c)
+                if (m.tau_a[c] > 0) w[c] *= std::exp(-m.tau_a[c] * inv_mu);
+            losses.add(BudgetTerm::AbsorbedMedium, before - w);
+            return d.z > 0;
+        }
+        return walk(d, w, events, max_events);
+    }
+
+    // Scattering: free flights sampled from a mixture of the per-channel exponentials with channel
+    // probabilities ∝ current flux, per-channel weights = channel density / mixture density
+    // (one-sample spectral MIS, balance heuristic: Veach 1997, §9.2.4; Miller, Georgiev & Jarosz
+    // 2019, "A null-scattering path integral formulation of light transport", §6). Unbiased for
+    // every channel whatever the sampling channel.
+    bool walk(Vec3f& d, Rgbf& w, int& events, int max_events) {
+        float s = d.z < 0 ? 0.f : 1.f;
+        while (true) {
+            const float mu = std::abs(d.z);
+            const float to_boundary = mu > 0 ? (d.z < 0 ? 1.f - s : s) / mu : INFINITY;
+            // Channel probabilities ∝ flux.
+            const float total = w[0] + w[1] + w[2];
+            if (total <= 0) return d.z > 0;
+            const float p[3] = {w[0] / total, w[1] / total, w[2] / total};
+            const float uc = rng.uniform_float();
+            const int c = uc < p[0] ? 0 : (uc < p[0] + p[1] ? 1 : 2);
+            const float sigma_c = m.tau_t[c];
+            const float u = rng.uniform_float();
+            const float flight = sigma_c > 0 ? -std::log1p(-u) / sigma_c : INFINITY;
+            const Rgbf before = w;
+            if (flight >= to_boundary) {
+                // Leaves the layer: weight_c = T_c / Σ_k p_k T_k.
+                float mix = 0;
+                Rgbf transmittance;
+                for (int k = 0; k < 3; ++k) {
+                    transmittance[k] = std::exp(-m.tau_t[k] * to_boundary);
+                    mix += p[k] * transmittance[k];
+                }
+                for (int k = 0; k < 3; ++k) w[k] *= transmittance[k] / mix;
+                losses.add(BudgetTerm::AbsorbedMedium, before - w);
+                return d.z > 0;
+            }
+            // Scatters at distance `flight`: weight_c = σs_c e^{−σt_c t} / Σ_k p_k σt_k e^{−σt_k t}.
+            float mix = 0;
+            Rgbf numerator;
+            for (int k = 0; k < 3; ++k) {
+                const float e = std::exp(-m.tau_t[k] * flight);
+                numerator[k] = m.tau_s[k] * e;
+                mix += p[k] * m.tau_t[k] * e;
+            }
+            for (int k = 0; k < 3; ++k) w[k] *= numerator[k] / mix;
+            s -= d.z * flight;
+            s = clamp(s, 0.f, 1.f);
+            // New direction from HG; per-channel g needs MIS over the channels' phase functions.
+            const Vec3f d_new = sample_hg(d, m.g[c], rng.uniform_float(), rng.uniform_float());
+            if (!m.uniform_g) {
+                const float cos_theta = dot(d, d_new);
+                float mix_phase = 0;
+                Rgbf phase;
+                for (int k = 0; k < 3; ++k) {
+                    phase[k] = hg_phase(cos_theta, m.g[k]);
+                    mix_phase += p[k] * phase[k];
+                }
+                for (int k = 0; k < 3; ++k) w[k] *= phase[k] / mix_phase;
+            }
+            d = d_new;
+            losses.add(BudgetTerm::AbsorbedMedium, before - w);
+            if (is_black(w)) return d.z > 0;
+            if (++events >= max_events) return d.z > 0;  // the caller books the cut-off
+        }
+    }
+};
+
+inline void escape(Rgbd& sum, Rgbd& sum_sq, const Rgbf& w) {
+    for (int c = 0; c < 3; ++c) {
+        sum[c] += w[c];
+        sum_sq[c] += double(w[c]) * double(w[c]);
+    }
+}
+
+// ---- One particle ------------------------------------------------------------------------------
+// physics.md §3: at an interface the particle (arriving along −wi) draws an outgoing direction
+// from the interface's BSDF sampler; its flux is multiplied by the sample weight and the parts
+// that do not continue are booked (absorbed by the base, lost to the microsurface).
+void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const Vec3f& wi,
+                    ParticleRng& rng, int max_events, Tally& tally, BlockBudget& block) {
+    const int n_layers = int(stack.layers.size());
+    Vec3f d = -wi;  // propagation direction
+    Rgbf w(1.f);
+    PathLosses losses;
+    int k = 0;  // the interface the particle is about to meet
+    int events = 0;
+    while (true) {
+        if (events >= max_events) {
+            losses.add(BudgetTerm::CutOff, w);
+            break;
+        }
+        ++events;
+        const TraceLayer& layer = stack.layers[k];
+        const Vec3f wi_local = -d;
+        std::optional<BsdfSample<float>> s;
+        switch (layer.type) {
+            case InterfaceType::Dielectric: {
+                const float uc = rng.uniform_float(), u1 = rng.uniform_float(),
+                            u2 = rng.uniform_float();
+                s = layer.dielectric.sample<false>(wi_local, uc, u1, u2);
+                break;
+            }
+            case InterfaceType::Conductor: {
+                const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
+                s = layer.conductor.sample<false>(wi_local, u1, u2);
+                break;
+            }
+            case InterfaceType::Lambertian: {
+                const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
+                s = layer.lambertian.sample(wi_local, u1, u2);
+                break;
+            }
+        }
+        if (!s) {  // a numerical degeneracy: counted and reported, its flux dropped as lost
+            ++tally.degenerate;
+            losses.add(BudgetTerm::LostMicrosurface, w);
+            break;
+        }
+        // weight = fresnel_weight (absorbed by an opaque base) · shadowing (lost on the microsurface)
+        if (layer.type != InterfaceType::Dielectric) {  // a dielectric's fresnel_weight is 1
+            const Rgbf kept = w * s->fresnel_weight;
+            losses.add(BudgetTerm::AbsorbedBase, w - kept);
+            w = kept;
+        }
+        if (s->shadowing != 1.f) {
+            const Rgbf kept = w * s->shadowing;
+            losses.add(BudgetTerm::LostMicrosurface, w - kept);
+            w = kept;
+        }
+        d = s->wo;
+        if (is_black(w)) break;
+        if (d.z > 0) {
+            if (k == 0) {  // leaves the stack upwards: reflection
+                tally.exit(grid.bin_of(d), w);
+                escape(block.term[int(BudgetTerm::Reflected)], block.reflected_sq, w);
+                break;
+            }
+            // Up through the medium below interface k − 1.
+            const TraceMedium& m = stack.layers[k - 1].medium;
+            bool up = true;
+            if (!m.is_empty()) {
+                MediumWalk walk{m, rng, losses};
+                up = walk.traverse(d, w, events, max_events);
+                if (is_black(w)) break;
+            }
+            if (up) --k;
+        } else {
+            if (k == n_layers - 1) {  // leaves through the final dielectric: transmission
+                tally.exit(grid.size() + grid.bin_of(d), w);
+                escape(block.term[int(BudgetTerm::Transmitted)], block.transmitted_sq, w);
+                break;
+            }
+            const TraceMedium& m = layer.medium;
+            bool up = false;
+            if (!m.is_empty()) {
+                MediumWalk walk{m, rng, losses};
+                up = walk.traverse(d, w, events, max_events);
+                if (is_black(w)) break;
+            }
+            if (!up) ++k;
+        }
+    }
+    losses.flush(block);
+    tally.events += std::uint64_t(events);
+}
+
+std::uint64_t incidence_stream(double theta_i_deg) {
+    // The stream is the incidence itself, so a result does not depend on which other incidences
+    // were simulated with it.
+    return std::bit_cast<std::uint64_t>(theta_i_deg);
+}
+
+}  // namespace
+
+SimulationResult simulate(const Stack& stack, const SimulationSettings& settings,
+                          const std::function<void(std::uint64_t)>& on_progress) {
+    validate_settings(settings);
+    const auto start = std::chrono::steady_clock::now();
+    const TraceStack trace(stack);
+    const HemisphereGrid& grid = settings.grid;
+    const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
+
+    SimulationResult result;
+    result.settings = settings;
+    result.threads_used = threads;
+    result.table = BinnedTable::zeros(grid, settings.theta_i_deg, true, trace.transmits);
+
+    const std::uint64_t n = settings.particles;
+    // Particles per block: the unit of scheduling and of the double-precision budget sums. Blocks
+    // are ranges of particle indices, so a run split at block boundaries (first_particle) adds up
+    // to the same integers as one run.
+    constexpr std::uint64_t kBlock = kParticlesPerBlock;
+    const std::uint64_t blocks = (n + kBlock - 1) / kBlock;
+
+    for (std::size_t inc = 0; inc < settings.theta_i_deg.size(); ++inc) {
+        const auto inc_start = std::chrono::steady_clock::now();
+        const double theta_i = deg_to_rad(settings.theta_i_deg[inc]);
+        const Vec3f wi(incident_direction(theta_i));
+        const std::uint64_t stream = incidence_stream(settings.theta_i_deg[inc]);
+        Tally total(grid.size());
+
+#pragma omp parallel num_threads(threads)
+        {
+            Tally local(grid.size());
+#pragma omp for schedule(dynamic, 1)
+            for (std::uint64_t b = 0; b < blocks; ++b) {
+                const std::uint64_t lo = b * kBlock, hi = std::min(n, lo + kBlock);
+                BlockBudget block;
+                for (std::uint64_t p = lo; p < hi; ++p) {
+                    ParticleRng rng(settings.seed, stream, settings.first_particle + p);
+                    trace_particle(trace, grid, wi, rng, settings.max_events, local, block);
+                }
+                local.add_block(block);
+                if (on_progress) on_progress(hi - lo);
+            }
+#pragma omp critical
+            total.merge(local);  // integer sums: the order of merging does not matter
+        }
+
+        // ---- Estimates (physics.md §5) ----
+        IncidenceStats stats;
+        const double inv_n = 1.0 / double(n);
+        for (int side = 0; side < (trace.transmits ? 2 : 1); ++side) {
+            BinnedLobe& lobe =
+                result.table.lobe(inc, side == 0 ? Side::Reflection : Side::Transmission);
+            for (std::size_t j = 0; j < grid.size(); ++j) {
+                const double omega = grid.projected_solid_angle(j);
+                const BinAccumulator& acc = total.bins[side * grid.size() + j];
+                for (int c = 0; c < 3; ++c) {
+                    const double mean = from_fixed(acc.sum[c]) * inv_n;
+                    const double mean_sq = from_fixed(acc.sum_sq[c]) * inv_n;
+                    // Standard error of the mean of N per-particle contributions.
+                    const double var = std::max(0.0, mean_sq - mean * mean);
+                    lobe.f[j][c] = mean / omega;
+                    lobe.se[j][c] = n > 1 ? std::sqrt(var / double(n - 1)) / omega : 0.0;
+                }
+            }
+        }
+        for (int t = 0; t < kBudgetTerms; ++t)
+            for (int c = 0; c < 3; ++c)
+                stats.budget.term[t][c] = from_fixed(total.budget[t][c]) * inv_n;
+        for (int c = 0; c < 3; ++c) {
+            const double r = stats.budget.term[int(BudgetTerm::Reflected)][c];
+            const double t = stats.budget.term[int(BudgetTerm::Transmitted)][c];
+            const double r2 = from_fixed(total.reflected_sq[c]) * inv_n;
+            const double t2 = from_fixed(total.transmitted_sq[c]) * inv_n;
+            const double dn = n > 1 ? double(n - 1) : 1.0;
+            stats.budget.reflected_se[c] = std::sqrt(std::max(0.0, r2 - r * r) / dn);
+            stats.budget.transmitted_se[c] = std::sqrt(std::max(0.0, t2 - t * t) / dn);
+        }
+        stats.events_per_particle = double(total.events) * inv_n;
+        stats.degenerate_samples = total.degenerate;
+        stats.seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - inc_start).count();
+        result.incidences.push_back(stats);
+    }
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+}  // namespace lamina

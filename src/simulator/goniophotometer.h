@@ -1,0 +1,88 @@
+#pragma once
+// The virtual goniophotometer (physics.md §5): Monte-Carlo particles traced through a layer stack,
+// the BRDF and BTDF tabulated on a discretized hemisphere with a standard error per bin, and the
+// energy budget of every incidence.
+//
+// Estimator: f_j = W_j / (N Ω⊥_j), W_j the flux of the particles leaving into bin j, Ω⊥_j the bin's
+// projected solid angle: the cos-weighted bin average of the BSDF. The standard error comes from
+// the second moment of the per-particle contributions.
+//
+// Reproducibility: each particle draws its random numbers from a generator keyed by (seed,
+// incidence, particle index) (core/rng.h), and every tally is accumulated in 128-bit fixed point,
+// whose sums do not depend on order: the output is bitwise identical for any thread count.
+
+#include "core/grid.h"
+#include "core/rgb.h"
+#include "core/table.h"
+#include "layers/stack.h"
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+/// Particles per block (see simulate); a split run's first_particle must be a multiple of it.
+inline constexpr std::uint64_t kParticlesPerBlock = 4096;
+
+struct SimulationSettings {
+    std::vector<double> theta_i_deg{0, 15, 30, 45, 60, 70, 80};  ///< each in [0, 90)
+    std::uint64_t particles = 1'000'000;                         ///< per incidence, > 0
+    std::uint64_t seed = 1;
+    int threads = 0;  ///< 0: all available
+    HemisphereGrid grid{90, 90};
+    /// Safety cap on interface and scattering events per particle; flux still travelling then is
+    /// reported as `cut_off` (physics.md §5: must be ≈ 0).
+    int max_events = 10'000;
+    /// First particle index (a simulation may be split into ranges of particles, e.g. across
+    /// processes; the union of ranges equals one run of all particles, bit for bit).
+    std::uint64_t first_particle = 0;
+};
+
+/// Where the flux of an incidence went, per channel; the terms sum to 1 to rounding.
+enum class BudgetTerm {
+    Reflected,
+    Transmitted,
+    AbsorbedMedium,
+    AbsorbedBase,
+    LostMicrosurface,
+    CutOff
+};
+inline constexpr int kBudgetTerms = 6;
+inline constexpr std::array<const char*, kBudgetTerms> kBudgetTermNames = {
+    "reflected", "transmitted", "absorbed_medium", "absorbed_base", "lost_microsurface", "cut_off"};
+
+struct EnergyBudget {
+    std::array<Rgbd, kBudgetTerms> term{};
+    Rgbd reflected_se{0.0}, transmitted_se{0.0};  ///< standard errors of R and T
+
+    const Rgbd& operator[](BudgetTerm t) const { return term[int(t)]; }
+    Rgbd sum() const;
+};
+
+struct IncidenceStats {
+    EnergyBudget budget;
+    double events_per_particle = 0;  ///< interface + scattering events, averaged
+    std::uint64_t degenerate_samples = 0;  ///< numerical degeneracies (counted, flux dropped)
+    double seconds = 0;
+};
+
+struct SimulationResult {
+    SimulationSettings settings;
+    BinnedTable table;  ///< reflection, and transmission when the stack transmits
+    std::vector<IncidenceStats> incidences;
+    double seconds = 0;
+    int threads_used = 1;
+};
+
+/// Checks settings (InputError naming the option and the allowed range).
+void validate_settings(const SimulationSettings& settings);
+
+/// Runs the goniophotometer. `on_progress(particles_done)` is called from worker threads (may be
+/// empty). Settings must be valid (validate_settings).
+SimulationResult simulate(const Stack& stack, const SimulationSettings& settings,
+                          const std::function<void(std::uint64_t)>& on_progress = {});
+
+}  // namespace lamina

@@ -1,0 +1,41 @@
+#pragma once
+// The stack as the particle tracer sees it: per interface the BSDF with *relative* indices (against
+// the medium above it), per medium its optical depths, all in float (physics.md §2–§4).
+// Built once per simulation from the layers::Stack description; no virtual calls, no allocation
+// while tracing.
+
+#include "core/rgb.h"
+#include "layers/stack.h"
+#include "physics/conductor.h"
+#include "physics/dielectric.h"
+#include "physics/lambertian.h"
+
+#include <vector>
+
+namespace lamina {
+
+struct TraceMedium {
+    Rgbf tau_a{0.f}, tau_s{0.f}, tau_t{0.f}, g{0.f};
+    bool absorbs = false;
+    bool scatters = false;
+    /// All channels share one g: the phase function needs no spectral MIS.
+    bool uniform_g = true;
+    bool is_empty() const { return !absorbs && !scatters; }
+};
+
+struct TraceLayer {
+    InterfaceType type = InterfaceType::Dielectric;
+    DielectricInterface<float> dielectric{1.f, 0.f};
+    ConductorInterface<float> conductor{Rgbf(1.f), Rgbf(0.f), 0.f};
+    LambertianInterface<float> lambertian{Rgbf(0.f)};
+    TraceMedium medium;  ///< the medium below this interface (empty for the last layer)
+};
+
+struct TraceStack {
+    std::vector<TraceLayer> layers;
+    bool transmits = false;  ///< the base is a dielectric: light can leave downwards
+
+    explicit TraceStack(const Stack& stack);
+};
+
+}  // namespace lamina

@@ -1,0 +1,363 @@
+// The goniophotometer against exact solutions (physics.md §6), with tolerances from the standard
+// errors it reports. Suites ending in Stat are the `stat` label.
+#include "core/error.h"
+#include "physics/conductor.h"
+#include "physics/dielectric.h"
+#include "physics/fresnel.h"
+#include "simulator/goniophotometer.h"
+#include "support/adding_doubling.h"
+#include "support/quadrature.h"
+#include "support/stacks.h"
+#include "support/table_checks.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace lamina {
+namespace {
+
+using test::compare_lobe;
+using test::expect_agreement;
+
+SimulationSettings settings(std::vector<double> theta_i, std::uint64_t n, HemisphereGrid grid,
+                            std::uint64_t seed = 7) {
+    SimulationSettings s;
+    s.theta_i_deg = std::move(theta_i);
+    s.particles = n;
+    s.grid = grid;
+    s.seed = seed;
+    return s;
+}
+
+// Standard error of a budget term from its own estimate; the closed forms are exact, so
+// |estimate − exact| < 5 se holds with probability 1 − 6e-7.
+void expect_within_se(double estimate, double exact, double se, const char* what) {
+    EXPECT_LT(std::abs(estimate - exact), 5 * se + 1e-12)
+        << what << ": estimate " << estimate << " ± " << se << ", exact " << exact;
+}
+
+// Every budget sums to 1 to rounding (physics.md §5).
+void expect_budget_closes(const SimulationResult& r) {
+    for (const IncidenceStats& st : r.incidences)
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(st.budget.sum()[c], 1.0, 1e-6);
+}
+
+// §6.2: a Lambertian base alone reflects albedo/π in every direction; every particle leaves
+// with flux exactly ρ, so the reflected budget is ρ exactly.
+TEST(GoniophotometerStat, LambertianAlone) {
+    const Rgbd albedo(0.8, 0.5, 0.2);
+    const Stack stack = test::make_stack({test::lambertian_layer(albedo)});
+    const auto r = simulate(stack, settings({40}, 400'000, HemisphereGrid(9, 9)));
+    expect_agreement(compare_lobe(r.table, 0, Side::Reflection,
+                                  [&](std::size_t) { return albedo * kInvPi<double>; }));
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(r.incidences[0].budget[BudgetTerm::Reflected][c], albedo[c], 1e-9);
+        EXPECT_NEAR(r.incidences[0].budget[BudgetTerm::AbsorbedBase][c], 1 - albedo[c], 1e-9);
+    }
+    expect_budget_closes(r);
+}
+
+// §6.3: smooth coat (η) over a Lambertian (ρ) with absorption τ between, all orders:
+//   f = ρ/(πη²) (1 − F(μi)) e^{−τ/μi'} (1 − F(μo)) e^{−τ/μo'} / (1 − ρ r),
+//   r = 2∫₀¹ F_inside(μ) e^{−2τ/μ} μ dμ (relative index 1/η, TIR → 1),
+// plus the mirror reflection F(μi) in the bin of the mirror direction. Its albedo is
+//   F(μi) + (1 − F(μi)) e^{−τ/μi'} ρ t / (1 − ρ r), t = 2∫₀¹ (1 − F_inside(μ)) e^{−τ/μ} μ dμ.
+TEST(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
+    const double eta = 1.5, theta_i = 35.0;
+    const Rgbd tau(0.1, 0.5, 0.0), rho(0.8, 0.5, 1.0);
+    const Stack stack = test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), tau),
+                                          test::lambertian_layer(rho)});
+    const HemisphereGrid grid(18, 18);
+    const auto r = simulate(stack, settings({theta_i}, 1'000'000, grid));
+
+    const double mu_c = std::sqrt(1 - 1 / (eta * eta));  // critical cosine inside
+    auto refracted_cos = [&](double mu) { return std::sqrt(1 - (1 - mu * mu) / (eta * eta)); };
+    Rgbd internal(0.0), escape(0.0);
+    for (int c = 0; c < 3; ++c) {
+        auto f_in = [&](double mu) { return fresnel_dielectric(mu, 1 / eta); };
+        internal[c] = 2 * (test::integrate([&](double mu) { return mu * std::exp(-2 * tau[c] / mu); },
+                                           0, mu_c, 32, 8) +
+                           test::integrate([&](double mu) {
+                               return f_in(mu) * std::exp(-2 * tau[c] / mu) * mu;
+                           }, mu_c, 1, 32, 8));
+        escape[c] = 2 * test::integrate([&](double mu) {
+            return (1 - f_in(mu)) * std::exp(-tau[c] / mu) * mu;
+        }, mu_c, 1, 32, 8);
+    }
+    const double mu_i = std::cos(deg_to_rad(theta_i));
+    const double F_i = fresnel_dielectric(mu_i, eta);
+    auto diffuse = [&](const Vec3d& wo) {
+        const double mu_o = std::abs(wo.z);
+        Rgbd f;
+        for (int c = 0; c < 3; ++c)
+            f[c] = rho[c] / (kPi<double> * eta * eta) * (1 - F_i) *
+                   std::exp(-tau[c] / refracted_cos(mu_i)) * (1 - fresnel_dielectric(mu_o, eta)) *
+                   std::exp(-tau[c] / refracted_cos(mu_o)) / (1 - rho[c] * internal[c]);
+        return f;
+    };
+    // The tracer's mirror direction, in its own float arithmetic, decides the bin.
+    const Vec3f wi_f(incident_direction(deg_to_rad(theta_i)));
+    const std::size_t mirror_bin = grid.bin_of(Vec3f(-wi_f.x, -wi_f.y, wi_f.z));
+    expect_agreement(compare_lobe(r.table, 0, Side::Reflection, [&](std::size_t j) {
+        Rgbd e = test::bin_average(grid, j, Side::Reflection, diffuse);
+        if (j == mirror_bin) e += Rgbd(F_i / grid.projected_solid_angle(j));
+        return e;
+    }));
+    const EnergyBudget& b = r.incidences[0].budget;
+    for (int c = 0; c < 3; ++c) {
+        const double albedo = F_i + (1 - F_i) * std::exp(-tau[c] / refracted_cos(mu_i)) * rho[c] *
+                                        escape[c] / (1 - rho[c] * internal[c]);
+        expect_within_se(b[BudgetTerm::Reflected][c], albedo, b.reflected_se[c], "albedo");
+    }
+    // Blue: τ = 0 and ρ = 1: nothing is absorbed, every particle leaves (white furnace).
+    EXPECT_NEAR(b[BudgetTerm::Reflected][2] + b[BudgetTerm::CutOff][2], 1.0, 1e-9);
+    EXPECT_LT(b[BudgetTerm::CutOff][2], 1e-9);
+    expect_budget_closes(r);
+}
+
+// §6.4: smooth slab of index η and absorption τ in air, with F = F(μi), a = e^{−τ/μi'}:
+//   R = F + (1 − F)² F a² / (1 − F² a²),  T = (1 − F)² a / (1 − F² a²).
+// All reflected flux leaves in the mirror bin, all transmitted flux straight through.
+TEST(GoniophotometerStat, SmoothSlab) {
+    const double eta = 1.5;
+    const Rgbd tau(0.0, 0.2, 1.0);
+    const Stack stack = test::make_stack(
+        {test::with_medium(test::dielectric_layer(eta, 0.0), tau), test::dielectric_layer(1.0, 0.0)});
+    const auto r = simulate(stack, settings({30, 75}, 400'000, HemisphereGrid(18, 18)));
+    for (std::size_t i = 0; i < 2; ++i) {
+        const double mu_i = std::cos(deg_to_rad(r.settings.theta_i_deg[i]));
+        const double mu_t = std::sqrt(1 - (1 - mu_i * mu_i) / (eta * eta));
+        const double F = fresnel_dielectric(mu_i, eta);
+        const EnergyBudget& b = r.incidences[i].budget;
+        for (int c = 0; c < 3; ++c) {
+            const double a = std::exp(-tau[c] / mu_t);
+            const double R = F + sqr(1 - F) * F * a * a / (1 - sqr(F * a));
+            const double T = sqr(1 - F) * a / (1 - sqr(F * a));
+            expect_within_se(b[BudgetTerm::Reflected][c], R, b.reflected_se[c], "R");
+            expect_within_se(b[BudgetTerm::Transmitted][c], T, b.transmitted_se[c], "T");
+            EXPECT_NEAR(b[BudgetTerm::LostMicrosurface][c], 0.0, 1e-12);
+        }
+        // Delta lobes: one bin each holds all of R and of T.
+        for (const Side side : {Side::Reflection, Side::Transmission}) {
+            int hit = 0;
+            for (const Rgbd& f : r.table.lobe(i, side).f) hit += f[0] > 0;
+            EXPECT_EQ(hit, 1);
+        }
+    }
+    expect_budget_closes(r);
+}
+
+// §6.5: smooth coat over a smooth conductor: R = F + (1 − F)² Rc a² / (1 − F Rc a²), Rc the
+// conductor's Fresnel at μi' for the relative index (η_c + i k_c)/η, a = e^{−τ/μi'}.
+TEST(GoniophotometerStat, CoatedSmoothConductor) {
+    const double eta = 1.5;
+    const Rgbd tau(0.1, 0.3, 0.0), eta_c(0.143, 0.374, 1.442), k_c(3.983, 2.385, 1.603);
+    const Stack stack = test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), tau),
+                                          test::conductor_layer(eta_c, k_c, 0.0)});
+    const auto r = simulate(stack, settings({20, 60}, 400'000, HemisphereGrid(18, 18)));
+    for (std::size_t i = 0; i < 2; ++i) {
+        const double mu_i = std::cos(deg_to_rad(r.settings.theta_i_deg[i]));
+        const double mu_t = std::sqrt(1 - (1 - mu_i * mu_i) / (eta * eta));
+        const double F = fresnel_dielectric(mu_i, eta);
+        const EnergyBudget& b = r.incidences[i].budget;
+        for (int c = 0; c < 3; ++c) {
+            const double a = std::exp(-tau[c] / mu_t);
+            const double Rc = fresnel_conductor_complex(mu_t, eta_c[c] / eta, k_c[c] / eta);
+            const double R = F + sqr(1 - F) * Rc * a * a / (1 - F * Rc * a * a);
+            expect_within_se(b[BudgetTerm::Reflected][c], R, b.reflected_se[c], "R");
+        }
+    }
+    expect_budget_closes(r);
+}
+
+// §6.6: one rough interface: the table equals the Walter et al. 2007 BSDF (with the height-
+// correlated G2) averaged over the bins, reflection and transmission, from both sides.
+void check_single_rough_dielectric(double ambient_eta, double eta, double alpha, double theta_i) {
+    Stack stack = test::make_stack({test::dielectric_layer(eta, alpha)});
+    stack.ambient_eta = ambient_eta;
+    const HemisphereGrid grid(18, 18);
+    const auto r = simulate(stack, settings({theta_i}, 1'000'000, grid));
+    const DielectricInterface<double> interface{eta / ambient_eta, alpha};
+    const Vec3d wi = incident_direction(deg_to_rad(theta_i));
+    for (const Side side : {Side::Reflection, Side::Transmission}) {
+        SCOPED_TRACE(side == Side::Reflection ? "reflection" : "transmission");
+        expect_agreement(compare_lobe(r.table, 0, side, [&](std::size_t j) {
+            return test::bin_average(grid, j, side, [&](const Vec3d& wo) {
+                return Rgbd(interface.eval(wi, wo));
+            }, 12);
+        }));
+    }
+    expect_budget_closes(r);
+}
+
+TEST(GoniophotometerStat, SingleRoughDielectricFromAbove) {
+    check_single_rough_dielectric(1.0, 1.5, 0.3, 40);
+}
+
+TEST(GoniophotometerStat, SingleRoughDielectricFromDenseSide) {
+    // η = 1/1.5 seen by the light: total internal reflection beyond ~41.8°.
+    check_single_rough_dielectric(1.5, 1.0, 0.3, 50);
+}
+
+TEST(GoniophotometerStat, SingleRoughConductor) {
+    const Rgbd eta_c(0.143, 0.374, 1.442), k_c(3.983, 2.385, 1.603);
+    const double alpha = 0.25, theta_i = 55;
+    const Stack stack = test::make_stack({test::conductor_layer(eta_c, k_c, alpha)});
+    const HemisphereGrid grid(18, 18);
+    const auto r = simulate(stack, settings({theta_i}, 1'000'000, grid));
+    const ConductorInterface<double> interface{eta_c, k_c, alpha};
+    const Vec3d wi = incident_direction(deg_to_rad(theta_i));
+    expect_agreement(compare_lobe(r.table, 0, Side::Reflection, [&](std::size_t j) {
+        return test::bin_average(grid, j, Side::Reflection,
+                                 [&](const Vec3d& wo) { return interface.eval(wi, wo); }, 12);
+    }));
+    expect_budget_closes(r);
+}
+
+// §6.7: white furnace: with nothing absorbing, R + T + microsurface loss = 1 for every
+// configuration, nothing is cut off, and the loss is what single scattering loses (> 0 for rough).
+TEST(GoniophotometerStat, WhiteFurnace) {
+    const std::vector<Stack> stacks = {
+        test::make_stack({test::dielectric_layer(1.5, 0.3), test::dielectric_layer(1.0, 0.5)}),
+        test::make_stack({test::dielectric_layer(1.5, 0.5), test::lambertian_layer(Rgbd(1.0))}),
+        test::make_stack({test::dielectric_layer(1.3, 0.2), test::dielectric_layer(1.7, 0.4),
+                          test::dielectric_layer(1.0, 0.1)}),
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.0),
+                                            Rgbd(0.7), Rgbd(0.3)),
+                          test::lambertian_layer(Rgbd(1.0))}),
+    };
+    for (const Stack& stack : stacks) {
+        const auto r = simulate(stack, settings({0, 45, 80}, 100'000, HemisphereGrid(9, 9)));
+        for (const IncidenceStats& st : r.incidences) {
+            const EnergyBudget& b = st.budget;
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_NEAR(b[BudgetTerm::Reflected][c] + b[BudgetTerm::Transmitted][c] +
+                                b[BudgetTerm::LostMicrosurface][c],
+                            1.0, 1e-6);
+                EXPECT_NEAR(b[BudgetTerm::AbsorbedMedium][c], 0.0, 1e-9);
+                EXPECT_EQ(b[BudgetTerm::CutOff][c], 0.0);
+                EXPECT_GT(b[BudgetTerm::LostMicrosurface][c], 0.0);
+            }
+        }
+    }
+}
+
+// §6.9: reciprocity of the tabulated BRDF: with incidences at bin centres, f(θa → bin of θb) =
+// f(θb → bin of θa) at every φ bin, within the combined standard errors (the bin-averaging
+// asymmetry is second order in the 5° bin width, far below the noise here).
+TEST(GoniophotometerStat, TabulatedReciprocity) {
+    const Stack stack = test::make_stack(
+        {test::with_medium(test::dielectric_layer(1.5, 0.3), Rgbd(0.2, 0.05, 0.5)),
+         test::lambertian_layer(Rgbd(0.7, 0.9, 0.5))});
+    const HemisphereGrid grid(18, 18);
+    const auto r = simulate(stack, settings({22.5, 52.5}, 2'000'000, grid));
+    const int ta = 4, tb = 10;  // the θ bins [20°, 25°] and [50°, 55°]
+    test::TableComparison cmp;
+    for (int p = 0; p < grid.n_phi(); ++p) {
+        const std::size_t ja = std::size_t(tb) * grid.n_phi() + p;  // from θa into θb's bin
+        const std::size_t jb = std::size_t(ta) * grid.n_phi() + p;
+        for (int c = 0; c < 3; ++c) {
+            const double fa = r.table.lobe(0, Side::Reflection).f[ja][c];
+            const double fb = r.table.lobe(1, Side::Reflection).f[jb][c];
+            const double se = std::hypot(r.table.lobe(0, Side::Reflection).se[ja][c],
+                                         r.table.lobe(1, Side::Reflection).se[jb][c]);
+            ASSERT_GT(se, 0);
+            const double z = (fa - fb) / se;
+            ++cmp.bins;
+            cmp.chi2 += z * z;
+            cmp.max_abs_z = std::max(cmp.max_abs_z, std::abs(z));
+        }
+    }
+    expect_agreement(cmp);
+}
+
+// §6.8: a scattering medium against adding–doubling (support/adding_doubling.h): an index-matched
+// slab (smooth interfaces of relative index 1 are pass-throughs), per channel its own τ, ω and g —
+// which exercises the spectral MIS of free flights and of the phase function.
+TEST(GoniophotometerStat, ScatteringSlabAgainstAddingDoubling) {
+    const Rgbd tau_s(1.0, 0.5, 2.0), tau_a(0.0, 0.5, 0.1), g(0.0, 0.5, -0.3);
+    const Stack stack = test::make_stack(
+        {test::with_medium(test::dielectric_layer(1.0, 0.0), tau_a, tau_s, g),
+         test::dielectric_layer(1.0, 0.0)});
+    // Incidences on the reference's quadrature nodes, so it needs no interpolation.
+    const test::AddingDoubling probe(1.0, 1.0, 0.0, 24);
+    const std::vector<int> nodes = {23, 15, 6};  // μ ≈ 1.0, 0.7, 0.2
+    std::vector<double> theta_i;
+    for (int j : nodes) theta_i.push_back(rad_to_deg(std::acos(probe.mu(j))));
+    const auto r = simulate(stack, settings(theta_i, 400'000, HemisphereGrid(9, 9)));
+    for (int c = 0; c < 3; ++c) {
+        const double tau = tau_s[c] + tau_a[c];
+        const test::AddingDoubling ad(tau, tau_s[c] / tau, g[c], 24);
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+            const EnergyBudget& b = r.incidences[i].budget;
+            // The reference's own accuracy (checked by ReferenceConservesEnergy) is < 1e-5.
+            EXPECT_LT(std::abs(b[BudgetTerm::Reflected][c] - ad.albedo_reflected(nodes[i])),
+                      5 * b.reflected_se[c] + 1e-5)
+                << "channel " << c << " θi " << theta_i[i] << ": R " << b[BudgetTerm::Reflected][c]
+                << " ± " << b.reflected_se[c] << " vs " << ad.albedo_reflected(nodes[i]);
+            EXPECT_LT(std::abs(b[BudgetTerm::Transmitted][c] - ad.albedo_transmitted(nodes[i])),
+                      5 * b.transmitted_se[c] + 1e-5)
+                << "channel " << c << " θi " << theta_i[i] << ": T "
+                << b[BudgetTerm::Transmitted][c] << " ± " << b.transmitted_se[c] << " vs "
+                << ad.albedo_transmitted(nodes[i]);
+        }
+    }
+    expect_budget_closes(r);
+}
+
+// The reference itself: conservative scattering (ω = 1) must give R + T = 1, and the thin slab
+// limit must match single scattering to first order.
+TEST(AddingDoublingReference, ConservesEnergy) {
+    for (const double g : {0.0, 0.5, -0.3}) {
+        const test::AddingDoubling ad(1.0, 1.0, g, 24);
+        for (int j = 0; j < ad.size(); ++j)
+            EXPECT_NEAR(ad.albedo_reflected(j) + ad.albedo_transmitted(j), 1.0, 1e-5) << g;
+    }
+    // No scattering: T = e^{−τ/μ} exactly.
+    const test::AddingDoubling clear(0.7, 0.0, 0.0, 16);
+    for (int j = 0; j < clear.size(); ++j) {
+        EXPECT_NEAR(clear.albedo_transmitted(j), std::exp(-0.7 / clear.mu(j)), 1e-12);
+        EXPECT_NEAR(clear.albedo_reflected(j), 0.0, 1e-15);
+    }
+}
+
+// Reproducibility: the same stack, grid, N and seed give bitwise-identical output for any thread
+// count; a different seed gives different output.
+TEST(Goniophotometer, BitwiseIdenticalAcrossThreadCounts) {
+    const Stack stack = test::make_stack(
+        {test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.1, 0.0, 0.9), Rgbd(0.3),
+                           Rgbd(0.2)),
+         test::lambertian_layer(Rgbd(0.8))});
+    SimulationSettings s = settings({0, 60}, 50'000, HemisphereGrid(30, 30));
+    s.threads = 1;
+    const auto one = simulate(stack, s);
+    s.threads = 2;
+    const auto two = simulate(stack, s);
+    s.threads = 3;
+    const auto three = simulate(stack, s);
+    for (std::size_t i = 0; i < 2; ++i) {
+        EXPECT_EQ(one.table.lobe(i, Side::Reflection).f, two.table.lobe(i, Side::Reflection).f);
+        EXPECT_EQ(one.table.lobe(i, Side::Reflection).se, two.table.lobe(i, Side::Reflection).se);
+        EXPECT_EQ(one.table.lobe(i, Side::Reflection).f, three.table.lobe(i, Side::Reflection).f);
+        EXPECT_EQ(one.incidences[i].budget.term, two.incidences[i].budget.term);
+        EXPECT_EQ(one.incidences[i].budget.term, three.incidences[i].budget.term);
+    }
+    s.seed = 8;
+    const auto other = simulate(stack, s);
+    EXPECT_NE(one.table.lobe(0, Side::Reflection).f, other.table.lobe(0, Side::Reflection).f);
+}
+
+TEST(Goniophotometer, RejectsBadSettings) {
+    SimulationSettings s;
+    s.theta_i_deg = {90};
+    EXPECT_THROW(validate_settings(s), InputError);
+    s.theta_i_deg = {-1};
+    EXPECT_THROW(validate_settings(s), InputError);
+    s.theta_i_deg = {30};
+    s.particles = 0;
+    EXPECT_THROW(validate_settings(s), InputError);
+}
+
+}  // namespace
+}  // namespace lamina

@@ -1,0 +1,84 @@
+#pragma once
+// Statistical comparison of a simulated table with expected values, with tolerances from the
+// table's own standard errors.
+
+#include "core/table.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <string>
+
+namespace lamina::test {
+
+/// Two-sided normal quantile for a tail probability p (Acklam's rational approximation refined by
+/// one Newton step with std::erfc; accurate to ~1e-9).
+inline double normal_quantile_upper(double p) {
+    // Bisection on erfc: simple and exact enough for test thresholds.
+    double lo = 0, hi = 40;
+    for (int i = 0; i < 200; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (0.5 * std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+struct TableComparison {
+    int bins = 0;            ///< bins compared (expected > 0 or observed > 0)
+    double chi2 = 0;         ///< Σ z²
+    double max_abs_z = 0;    ///< largest |z|
+    std::string worst;       ///< where
+};
+
+/// Compares lobe (incidence i, side) channel by channel with expected(j) in bins whose standard
+/// error is positive; bins expected zero must be observed zero (no particle may land there).
+inline TableComparison compare_lobe(const BinnedTable& table, std::size_t i, Side side,
+                                    const std::function<Rgbd(std::size_t)>& expected,
+                                    double extra_relative_error = 0) {
+    TableComparison r;
+    const BinnedLobe& lobe = table.lobe(i, side);
+    for (std::size_t j = 0; j < table.grid.size(); ++j) {
+        const Rgbd e = expected(j);
+        for (int c = 0; c < 3; ++c) {
+            const double f = lobe.f[j][c], se = lobe.se[j][c];
+            if (se == 0) {
+                if (e[c] != 0 || f != 0) {
+                    // A bin nobody hit while something was expected: fail loudly unless tiny.
+                    const double z = e[c] > 0 ? 1e9 : 0;
+                    if (z > r.max_abs_z) {
+                        r.max_abs_z = z;
+                        r.worst = "bin " + std::to_string(j) + " empty, expected " +
+                                  std::to_string(e[c]);
+                    }
+                }
+                continue;
+            }
+            const double sigma = std::sqrt(se * se + std::pow(extra_relative_error * e[c], 2));
+            const double z = (f - e[c]) / sigma;
+            ++r.bins;
+            r.chi2 += z * z;
+            if (std::abs(z) > r.max_abs_z) {
+                r.max_abs_z = std::abs(z);
+                r.worst = "bin " + std::to_string(j) + " channel " + std::to_string(c) +
+                          ": observed " + std::to_string(f) + " ± " + std::to_string(se) +
+                          ", expected " + std::to_string(e[c]);
+            }
+        }
+    }
+    return r;
+}
+
+/// The agreement criterion used by the goniophotometer tests: the largest |z| below the Šidák
+/// threshold for the number of bins at family-wise significance `alpha`, and Σz² within
+/// 5 standard deviations of its χ²(k) mean k (√(2k)).
+inline void expect_agreement(const TableComparison& r, double alpha = 1e-3) {
+    ASSERT_GT(r.bins, 0);
+    const double per_bin = 1 - std::pow(1 - alpha, 1.0 / r.bins);
+    const double z_max = normal_quantile_upper(per_bin / 2);
+    EXPECT_LT(r.max_abs_z, z_max) << "worst: " << r.worst;
+    EXPECT_LT(std::abs(r.chi2 - r.bins) / std::sqrt(2.0 * r.bins), 5.0)
+        << "chi2 = " << r.chi2 << " over " << r.bins << " bins; worst: " << r.worst;
+}
+
+}  // namespace lamina::test
