@@ -130,7 +130,11 @@ std::string suggestion(std::string_view key, Keys allowed) {
     std::string_view best;
     std::size_t best_distance = 3;  // suggest only within two edits...
     for (auto candidate : allowed) {
-        const std::size_t distance = edit_distance(key, candidate);
+        std::size_t distance = edit_distance(key, candidate);
+        // A truncated name ("lambert", "diel") counts as one edit.
+        if (key.size() >= 3 && key.size() < candidate.size() &&
+            edit_distance(key, candidate.substr(0, key.size())) == 0)
+            distance = std::min<std::size_t>(distance, 1);
         // ...and never by rewriting the whole word ("g" is not a typo of "k").
         if (distance < best_distance && distance < candidate.size()) {
             best = candidate;
