@@ -188,6 +188,12 @@ class Reader {
                 fail("/name", fmt::format("expected a non-empty string, got {}: {}",
                                           type_phrase(*name), show(*name)));
             s.name = name->get<std::string>();
+            // The name is printed on one line (describe, reports): no line breaks or tabs.
+            if (std::any_of(s.name.begin(), s.name.end(),
+                            [](unsigned char c) { return c < 0x20 || c == 0x7f; }))
+                fail("/name", fmt::format("got {}; allowed: a name without control characters "
+                                          "(line breaks, tabs)",
+                                          show(*name)));
         } else {
             s.name = std::filesystem::path(where_).stem().string();
             if (s.name.empty()) s.name = "stack";

@@ -478,8 +478,10 @@ TEST(StackReject, MissingLayers) {
                     {"bad.json", "/layers", "missing required key \"layers\""});
 }
 
-TEST(StackReject, EmptyName) {
+TEST(StackReject, NameEmptyOrWithControlCharacters) {
     expect_mentions(error_of(with(plastic(), "/name", "")), {"/name", "non-empty string"});
+    expect_mentions(error_of(with(plastic(), "/name", "two\nlines")),
+                    {"/name", "\"two\\nlines\"", "without control characters"});
 }
 
 TEST(StackLoad, MissingOrUnreadableFile) {
