@@ -158,7 +158,6 @@ constexpr std::string_view kDielectricKeys[] = {"type", "eta", "alpha"};
 constexpr std::string_view kConductorKeys[] = {"type", "eta", "k", "alpha"};
 constexpr std::string_view kLambertianKeys[] = {"type", "albedo"};
 constexpr std::string_view kMediumKeys[] = {"tau_a", "tau_s", "g"};
-constexpr std::string_view kAnyInterfaceKeys[] = {"type", "..."};
 
 constexpr std::string_view kAlphaHint = "GGX roughness in [0, 1]; write 0 for a smooth interface";
 
@@ -220,11 +219,10 @@ class Reader {
         throw InputError(where_, pointer, std::move(problem));
     }
 
-    void expect_object(const json& j, const std::string& pointer, std::string_view what,
-                       Keys keys) const {
+    /// `what` names the object and its keys, e.g. `a medium (an object with keys ...)`.
+    void expect_object(const json& j, const std::string& pointer, const std::string& what) const {
         if (!j.is_object())
-            fail(pointer, fmt::format("expected {} (an object with keys {}), got {}: {}", what,
-                                      quoted_list(keys), type_phrase(j), show(j)));
+            fail(pointer, fmt::format("expected {}, got {}: {}", what, type_phrase(j), show(j)));
     }
 
     /// Every key of `object` must be one of `allowed`.
@@ -275,7 +273,8 @@ class Reader {
     }
 
     Layer layer(const json& j, const std::string& pointer, std::size_t index, std::size_t count) {
-        expect_object(j, pointer, "a layer", kLayerKeys);
+        expect_object(j, pointer,
+                      fmt::format("a layer (an object with keys {})", quoted_list(kLayerKeys)));
         check_keys(j, pointer, kLayerKeys, "a layer");
         const bool last = index + 1 == count;
 
@@ -306,7 +305,9 @@ class Reader {
     }
 
     InterfaceSpec interface(const json& j, const std::string& pointer) const {
-        expect_object(j, pointer, "an interface", kAnyInterfaceKeys);
+        expect_object(j, pointer,
+                      fmt::format("an interface (an object with a \"type\", one of {})",
+                                  quoted_list(kInterfaceTypes)));
         const std::string tp = child(pointer, "type");
         const json& type = required(j, pointer, "type",
                                     "one of \"dielectric\", \"conductor\", "
@@ -364,7 +365,8 @@ class Reader {
     }
 
     MediumSpec medium(const json& j, const std::string& pointer) const {
-        expect_object(j, pointer, "a medium", kMediumKeys);
+        expect_object(j, pointer,
+                      fmt::format("a medium (an object with keys {})", quoted_list(kMediumKeys)));
         check_keys(j, pointer, kMediumKeys, "a medium");
         MediumSpec out;
         if (j.contains("tau_a"))
