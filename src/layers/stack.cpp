@@ -361,7 +361,7 @@ class Reader {
     double alpha(const json& j, const std::string& pointer, std::string_view type) const {
         const json& v = required(j, pointer, "alpha",
                                  fmt::format("a {} needs an explicit {}", type, kAlphaHint));
-        return number(v, child(pointer, "alpha"), kUnit, kAlphaHint);
+        return number(v, child(pointer, "alpha"), kUnit, "GGX roughness, 0 = smooth");
     }
 
     MediumSpec medium(const json& j, const std::string& pointer) const {
