@@ -71,13 +71,13 @@ struct Stack {
 };
 
 /// Parses and validates a stack from JSON (format: docs/stack-format.md). `where` names the source
-/// (a file) in error messages; `name` defaults to its stem. Throws one InputError naming `where`, the
-/// JSON pointer of the field, the value and what is allowed, for: unknown keys (with the allowed
-/// keys and the closest one), missing required keys (`layers`, `interface`, `type`, and every key of
-/// an interface type, `alpha` included), wrong types, RGB arrays of the wrong length, NaN/inf,
-/// eta ≤ 0 (or an RGB dielectric eta), alpha outside [0, 1], optical depths < 0, |g| ≥ 1, albedo
-/// outside [0, 1], k < 0, an unknown interface type, an opaque interface that is not last, a medium
-/// under the last interface, an empty or missing `layers`, an empty name.
+/// (a file) in error messages; `name` defaults to its stem. Throws one InputError naming `where`,
+/// the JSON pointer of the field, the value and what is allowed, for: unknown keys (with the
+/// allowed keys and the closest one), missing required keys (`layers`, `interface`, `type`, and
+/// every key of an interface type, `alpha` included), wrong types, RGB arrays of the wrong length,
+/// NaN/inf, eta ≤ 0 (or an RGB dielectric eta), alpha outside [0, 1], optical depths < 0, |g| ≥ 1,
+/// albedo outside [0, 1], k < 0, an unknown interface type, an opaque interface that is not last, a
+/// medium under the last interface, an empty or missing `layers`, an empty name.
 Stack stack_from_json(const nlohmann::json& j, const std::string& where);
 
 /// Reads and parses a stack file. InputError also on a missing or unreadable file, malformed JSON
