@@ -38,7 +38,7 @@ check no-subcommand 106 "$lamina"
 
 # validate: every example is valid and described on one line.
 for example in "$src"/examples/*.json; do
-    check_says "validate $(basename "$example")" 0 ": air | dielectric η=1.5" \
+    check_says "validate $(basename "$example")" 0 " | " \
         "$lamina" validate "$example"
 done
 check_says validate-describes 0 "plastic: air | dielectric η=1.5 α=0.2 | medium τa=(0.1, 0, 0.9)" \
