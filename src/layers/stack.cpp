@@ -18,11 +18,11 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <set>
 #include <span>
 #include <sstream>
 #include <string_view>
+#include <vector>
 
 namespace lamina {
 
