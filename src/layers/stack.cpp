@@ -1,23 +1,578 @@
+// Stack files: parsing with validation, the canonical JSON form, and a one-line description.
+// The format is documented for users in docs/stack-format.md; physics in physics.md §2.
+//
+// Every rejection is one InputError naming the file, the JSON pointer (RFC 6901) of the field, the
+// offending value and what is allowed. Keys are never ignored: an unknown key is an error that
+// lists the allowed keys and suggests the closest one, so a typo cannot silently fall back to a
+// default.
 #include "layers/stack.h"
 
 #include "core/error.h"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <span>
+#include <sstream>
+#include <string_view>
+#include <vector>
 
 namespace lamina {
 
-// Placeholder: the parser and validator are being written (issue 2).
-Stack stack_from_json(const nlohmann::json&, const std::string& where) {
-    throw InputError(where, "", "stack parsing not implemented yet");
+namespace {
+
+using json = nlohmann::json;
+using Keys = std::span<const std::string_view>;
+
+// ---- JSON pointers and how values are shown -------------------------------------------------
+
+/// RFC 6901 escaping of one reference token: '~' → "~0", '/' → "~1".
+std::string escape_token(std::string_view key) {
+    std::string out;
+    for (char c : key) {
+        if (c == '~')
+            out += "~0";
+        else if (c == '/')
+            out += "~1";
+        else
+            out += c;
+    }
+    return out;
 }
+
+std::string child(const std::string& pointer, std::string_view key) {
+    return pointer + "/" + escape_token(key);
+}
+std::string child(const std::string& pointer, std::size_t index) {
+    return pointer + "/" + std::to_string(index);
+}
+
+/// The value as the user wrote it (numbers in shortest round-trip form; NaN and inf by name,
+/// which json::dump would print as null), shortened to one readable line.
+std::string show(const json& value) {
+    std::string text =
+        value.is_number_float() ? fmt::format("{}", value.get<double>()) : value.dump();
+    constexpr std::size_t kMax = 60;
+    if (text.size() > kMax) text = text.substr(0, kMax - 3) + "...";
+    return text;
+}
+
+std::string type_phrase(const json& value) {
+    switch (value.type()) {
+        case json::value_t::null:
+            return "null";
+        case json::value_t::boolean:
+            return "a boolean";
+        case json::value_t::string:
+            return "a string";
+        case json::value_t::array:
+            return fmt::format("an array of {}", value.size());
+        case json::value_t::object:
+            return "an object";
+        default:
+            return "a number";
+    }
+}
+
+std::string quoted_list(Keys keys) {
+    std::string out;
+    for (auto k : keys)
+        out += (out.empty() ? "\"" : ", \"") + std::string(k) + "\"";
+    return out;
+}
+
+// ---- Suggestions for unknown keys and types -------------------------------------------------
+
+/// Optimal-string-alignment distance (Levenshtein plus adjacent transpositions), case-insensitive,
+/// so that "alpah" is one edit from "alpha".
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+    auto lower = [](char c) {
+        return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    };
+    const std::size_t n = a.size(), m = b.size();
+    std::vector<std::vector<std::size_t>> d(n + 1, std::vector<std::size_t>(m + 1));
+    for (std::size_t i = 0; i <= n; ++i)
+        d[i][0] = i;
+    for (std::size_t j = 0; j <= m; ++j)
+        d[0][j] = j;
+    for (std::size_t i = 1; i <= n; ++i) {
+        for (std::size_t j = 1; j <= m; ++j) {
+            const std::size_t cost = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
+            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+            if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) &&
+                lower(a[i - 2]) == lower(b[j - 1]))
+                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+        }
+    }
+    return d[n][m];
+}
+
+/// Names users reach for from other renderers, mapped to lamina's key.
+std::string_view synonym(std::string_view key) {
+    static constexpr std::pair<std::string_view, std::string_view> kSynonyms[] = {
+        {"roughness", "alpha"},    {"ior", "eta"},      {"kappa", "k"},
+        {"reflectance", "albedo"}, {"color", "albedo"}, {"absorption", "tau_a"},
+        {"scattering", "tau_s"},   {"anisotropy", "g"}, {"kind", "type"}};
+    for (auto [from, to] : kSynonyms)
+        if (edit_distance(key, from) == 0) return to;
+    return {};
+}
+
+/// " did you mean \"alpha\"?" when one allowed name is close to `key`, else "".
+std::string suggestion(std::string_view key, Keys allowed) {
+    std::string_view best;
+    std::size_t best_distance = 3;  // suggest only within two edits...
+    for (auto candidate : allowed) {
+        std::size_t distance = edit_distance(key, candidate);
+        // A truncated name ("lambert", "diel") counts as one edit.
+        if (key.size() >= 3 && key.size() < candidate.size() &&
+            edit_distance(key, candidate.substr(0, key.size())) == 0)
+            distance = std::min<std::size_t>(distance, 1);
+        // ...and never by rewriting the whole word ("g" is not a typo of "k").
+        if (distance < best_distance && distance < candidate.size()) {
+            best = candidate;
+            best_distance = distance;
+        }
+    }
+    if (best.empty()) {
+        const std::string_view to = synonym(key);
+        if (!to.empty() && std::find(allowed.begin(), allowed.end(), to) != allowed.end())
+            best = to;
+    }
+    return best.empty() ? "" : fmt::format(" did you mean \"{}\"?", best);
+}
+
+// ---- The validating reader ------------------------------------------------------------------
+
+constexpr std::string_view kStackKeys[] = {"name", "ambient_eta", "layers"};
+constexpr std::string_view kLayerKeys[] = {"interface", "medium"};
+constexpr std::string_view kInterfaceTypes[] = {"dielectric", "conductor", "lambertian"};
+constexpr std::string_view kDielectricKeys[] = {"type", "eta", "alpha"};
+constexpr std::string_view kConductorKeys[] = {"type", "eta", "k", "alpha"};
+constexpr std::string_view kLambertianKeys[] = {"type", "albedo"};
+constexpr std::string_view kMediumKeys[] = {"tau_a", "tau_s", "g"};
+
+constexpr std::string_view kAlphaHint = "GGX roughness in [0, 1]; write 0 for a smooth interface";
+
+/// A constraint on one number: the test and how it reads in a message.
+struct Allowed {
+    bool (*ok)(double);
+    std::string_view text;
+};
+constexpr Allowed kPositive{[](double v) { return v > 0; }, "> 0"};
+constexpr Allowed kNonNegative{[](double v) { return v >= 0; }, ">= 0"};
+constexpr Allowed kUnit{[](double v) { return v >= 0 && v <= 1; }, "[0, 1]"};
+constexpr Allowed kOpenUnitBall{[](double v) { return v > -1 && v < 1; }, "(-1, 1), i.e. |g| < 1"};
+
+class Reader {
+  public:
+    explicit Reader(std::string where) : where_(std::move(where)) {}
+
+    Stack stack(const json& j) {
+        if (!j.is_object())
+            fail("", fmt::format("a stack file must hold a JSON object with keys {}, got {}: {}",
+                                 quoted_list(kStackKeys), type_phrase(j), show(j)));
+        check_keys(j, "", kStackKeys, "the stack");
+
+        Stack s;
+        if (const json* name = j.contains("name") ? &j["name"] : nullptr) {
+            if (!name->is_string() || name->get<std::string>().empty())
+                fail("/name", fmt::format("expected a non-empty string, got {}: {}",
+                                          type_phrase(*name), show(*name)));
+            s.name = name->get<std::string>();
+            // The name is printed on one line (describe, reports): no line breaks or tabs.
+            if (std::any_of(s.name.begin(), s.name.end(),
+                            [](unsigned char c) { return c < 0x20 || c == 0x7f; }))
+                fail("/name", fmt::format("got {}; allowed: a name without control characters "
+                                          "(line breaks, tabs)",
+                                          show(*name)));
+        } else {
+            s.name = std::filesystem::path(where_).stem().string();
+            if (s.name.empty()) s.name = "stack";
+        }
+        if (j.contains("ambient_eta"))
+            s.ambient_eta = number(j["ambient_eta"], "/ambient_eta", kPositive,
+                                   "absolute refractive index of the ambient medium");
+
+        const json& layers = required(j, "", "layers", "an array of layers, top to bottom");
+        if (!layers.is_array())
+            fail("/layers", fmt::format("expected an array of layers (top to bottom), got {}: {}",
+                                        type_phrase(layers), show(layers)));
+        if (layers.empty())
+            fail("/layers",
+                 "the stack has no layers; give at least one, the last being the base, e.g. "
+                 "{\"interface\": {\"type\": \"lambertian\", \"albedo\": 0.8}}");
+        for (std::size_t i = 0; i < layers.size(); ++i)
+            s.layers.push_back(layer(layers[i], child("/layers", i), i, layers.size()));
+        return s;
+    }
+
+  private:
+    [[noreturn]] void fail(const std::string& pointer, std::string problem) const {
+        throw InputError(where_, pointer, std::move(problem));
+    }
+
+    /// `what` names the object and its keys, e.g. `a medium (an object with keys ...)`.
+    void expect_object(const json& j, const std::string& pointer, const std::string& what) const {
+        if (!j.is_object())
+            fail(pointer, fmt::format("expected {}, got {}: {}", what, type_phrase(j), show(j)));
+    }
+
+    /// Every key of `object` must be one of `allowed`.
+    void check_keys(const json& object, const std::string& pointer, Keys allowed,
+                    std::string_view what) const {
+        for (const auto& item : object.items()) {
+            const std::string& key = item.key();
+            if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+            fail(child(pointer, key),
+                 fmt::format("unknown key \"{}\" in {};{} allowed keys: {}", key, what,
+                             suggestion(key, allowed), quoted_list(allowed)));
+        }
+    }
+
+    const json& required(const json& object, const std::string& pointer, std::string_view key,
+                         std::string_view hint) const {
+        if (!object.contains(key))
+            fail(child(pointer, key), fmt::format("missing required key \"{}\" ({})", key, hint));
+        return *object.find(key);
+    }
+
+    double number(const json& v, const std::string& pointer, Allowed allowed,
+                  std::string_view meaning) const {
+        if (!v.is_number())
+            fail(pointer, fmt::format("expected a number ({}), got {}: {}", meaning, type_phrase(v),
+                                      show(v)));
+        const double x = v.get<double>();
+        if (!std::isfinite(x))
+            fail(pointer,
+                 fmt::format("got {}; allowed: a finite number {} ({})", x, allowed.text, meaning));
+        if (!allowed.ok(x))
+            fail(pointer, fmt::format("got {}; allowed: {} ({})", show(v), allowed.text, meaning));
+        return x;
+    }
+
+    /// A number (broadcast to the three channels) or an array of exactly three numbers.
+    Rgbd rgb(const json& v, const std::string& pointer, Allowed allowed,
+             std::string_view meaning) const {
+        if (v.is_number()) return Rgbd(number(v, pointer, allowed, meaning));
+        if (!v.is_array() || v.size() != 3)
+            fail(pointer, fmt::format("expected a number or an array of 3 numbers [R, G, B] "
+                                      "({}), got {}: {}",
+                                      meaning, type_phrase(v), show(v)));
+        Rgbd out;
+        for (std::size_t c = 0; c < 3; ++c)
+            out[c] = number(v[c], child(pointer, c), allowed, meaning);
+        return out;
+    }
+
+    Layer layer(const json& j, const std::string& pointer, std::size_t index, std::size_t count) {
+        expect_object(j, pointer,
+                      fmt::format("a layer (an object with keys {})", quoted_list(kLayerKeys)));
+        check_keys(j, pointer, kLayerKeys, "a layer");
+        const bool last = index + 1 == count;
+
+        Layer out;
+        const std::string ip = child(pointer, "interface");
+        out.interface = interface(required(j, pointer, "interface",
+                                           "the interface at the top of this layer, an object "
+                                           "with a \"type\""),
+                                  ip);
+        if (out.interface.is_opaque() && !last)
+            fail(child(ip, "type"),
+                 fmt::format("a {} interface is opaque and must be the last one (the base), but "
+                             "{} more layer{} follow{} it; move it to the bottom or remove the "
+                             "layers below",
+                             j["interface"]["type"].get<std::string>(), count - index - 1,
+                             count - index - 1 == 1 ? "" : "s", count - index - 1 == 1 ? "s" : ""));
+        if (j.contains("medium")) {
+            const std::string mp = child(pointer, "medium");
+            if (last)
+                fail(mp,
+                     "the last interface (the base) cannot have a medium below it: it would be a "
+                     "semi-infinite medium, which is not supported; remove \"medium\" here, or "
+                     "close the medium with another interface below (a dielectric makes a slab)");
+            out.has_medium = true;
+            out.medium = medium(j["medium"], mp);
+        }
+        return out;
+    }
+
+    InterfaceSpec interface(const json& j, const std::string& pointer) const {
+        expect_object(j, pointer,
+                      fmt::format("an interface (an object with a \"type\", one of {})",
+                                  quoted_list(kInterfaceTypes)));
+        const std::string tp = child(pointer, "type");
+        const json& type = required(j, pointer, "type",
+                                    "one of \"dielectric\", \"conductor\", "
+                                    "\"lambertian\"");
+        if (!type.is_string())
+            fail(tp, fmt::format("expected a string, one of {}; got {}: {}",
+                                 quoted_list(kInterfaceTypes), type_phrase(type), show(type)));
+        const std::string name = type.get<std::string>();
+
+        InterfaceSpec out;
+        if (name == "dielectric") {
+            out.type = InterfaceType::Dielectric;
+            check_keys(j, pointer, kDielectricKeys, "a dielectric interface");
+            const json& eta =
+                required(j, pointer, "eta", "absolute refractive index of what lies below, > 0");
+            if (eta.is_array())
+                fail(child(pointer, "eta"),
+                     fmt::format("a dielectric's eta must be a single number, got {}: {}; one "
+                                 "refraction path serves all channels, so RGB (dispersive) "
+                                 "indices are not supported",
+                                 type_phrase(eta), show(eta)));
+            out.eta = number(eta, child(pointer, "eta"), kPositive,
+                             "absolute refractive index of what lies below");
+            out.alpha = alpha(j, pointer, "dielectric");
+        } else if (name == "conductor") {
+            out.type = InterfaceType::Conductor;
+            check_keys(j, pointer, kConductorKeys, "a conductor interface");
+            out.eta_rgb =
+                rgb(required(j, pointer, "eta",
+                             "real part of the absolute complex "
+                             "index, > 0, number or [R, G, B]"),
+                    child(pointer, "eta"), kPositive, "real part of the absolute complex index");
+            out.k = rgb(required(j, pointer, "k",
+                                 "extinction coefficient, >= 0, number or "
+                                 "[R, G, B]"),
+                        child(pointer, "k"), kNonNegative,
+                        "extinction coefficient, imaginary part of the absolute index");
+            out.alpha = alpha(j, pointer, "conductor");
+        } else if (name == "lambertian") {
+            out.type = InterfaceType::Lambertian;
+            check_keys(j, pointer, kLambertianKeys, "a lambertian interface");
+            out.albedo = rgb(required(j, pointer, "albedo", "in [0, 1], number or [R, G, B]"),
+                             child(pointer, "albedo"), kUnit, "Lambertian albedo");
+        } else {
+            fail(tp, fmt::format("unknown interface type \"{}\";{} allowed: {}", name,
+                                 suggestion(name, kInterfaceTypes), quoted_list(kInterfaceTypes)));
+        }
+        return out;
+    }
+
+    double alpha(const json& j, const std::string& pointer, std::string_view type) const {
+        const json& v = required(j, pointer, "alpha",
+                                 fmt::format("a {} needs an explicit {}", type, kAlphaHint));
+        return number(v, child(pointer, "alpha"), kUnit, "GGX roughness, 0 = smooth");
+    }
+
+    MediumSpec medium(const json& j, const std::string& pointer) const {
+        expect_object(j, pointer,
+                      fmt::format("a medium (an object with keys {})", quoted_list(kMediumKeys)));
+        check_keys(j, pointer, kMediumKeys, "a medium");
+        MediumSpec out;
+        if (j.contains("tau_a"))
+            out.tau_a = rgb(j["tau_a"], child(pointer, "tau_a"), kNonNegative,
+                            "absorption normal optical depth, dimensionless");
+        if (j.contains("tau_s"))
+            out.tau_s = rgb(j["tau_s"], child(pointer, "tau_s"), kNonNegative,
+                            "scattering normal optical depth, dimensionless");
+        if (j.contains("g"))
+            out.g =
+                rgb(j["g"], child(pointer, "g"), kOpenUnitBall, "Henyey-Greenstein mean cosine");
+        return out;
+    }
+
+    std::string where_;
+};
+
+// ---- Parsing the text: duplicate keys and number overflow -----------------------------------
+
+/// Follows the parser through the document (nlohmann's parser callback) to know the JSON pointer
+/// of what it is reading. It rejects duplicate keys, which JSON parsers silently resolve to the
+/// last one, and names the field when a number overflows (1e999 is refused by the parser).
+class PathTracker {
+  public:
+    explicit PathTracker(const std::string& where) : where_(where) {}
+
+    bool operator()(int, json::parse_event_t event, json& parsed) {
+        switch (event) {
+            case json::parse_event_t::object_start:
+                element_starts();
+                frames_.push_back({true, {}, {}, 0});
+                break;
+            case json::parse_event_t::array_start:
+                element_starts();
+                frames_.push_back({false, {}, {}, 0});
+                break;
+            case json::parse_event_t::object_end:
+            case json::parse_event_t::array_end:
+                frames_.pop_back();
+                break;
+            case json::parse_event_t::value:
+                element_starts();
+                break;
+            case json::parse_event_t::key: {
+                Frame& f = frames_.back();
+                f.key = parsed.get<std::string>();
+                if (!f.keys.insert(f.key).second)
+                    throw InputError(where_, pending_pointer(),
+                                     fmt::format("duplicate key \"{}\"; each key may appear once "
+                                                 "in an object (a parser would silently keep "
+                                                 "the last one)",
+                                                 f.key));
+                break;
+            }
+        }
+        return true;
+    }
+
+    /// The pointer of the value being read now (the one after the last key or array element).
+    std::string pending_pointer() const {
+        std::string out;
+        for (std::size_t i = 0; i < frames_.size(); ++i) {
+            const Frame& f = frames_[i];
+            if (f.is_object)
+                out = child(out, f.key);
+            else  // elements before the innermost are in progress; the innermost's is next
+                out = child(out, i + 1 == frames_.size() ? f.count : f.count - 1);
+        }
+        return out;
+    }
+
+  private:
+    struct Frame {
+        bool is_object;
+        std::set<std::string> keys;
+        std::string key;
+        std::size_t count;
+    };
+    void element_starts() {
+        if (!frames_.empty() && !frames_.back().is_object) ++frames_.back().count;
+    }
+
+    const std::string& where_;
+    std::vector<Frame> frames_;
+};
+
+/// Drops nlohmann's "[json.exception.parse_error.101] " prefix.
+std::string parser_message(const json::exception& e) {
+    std::string_view text = e.what();
+    if (const auto end = text.find("] "); text.starts_with("[json.exception.") && end != text.npos)
+        text.remove_prefix(end + 2);
+    return std::string(text);
+}
+
+json parse_text(const std::string& text, const std::string& where) {
+    PathTracker tracker(where);
+    try {
+        return json::parse(text, std::ref(tracker));
+    } catch (const json::parse_error& e) {
+        const std::string near = tracker.pending_pointer();
+        throw InputError(where, "",
+                         fmt::format("malformed JSON: {}{}", parser_message(e),
+                                     near.empty() ? "" : fmt::format(" (near {})", near)));
+    } catch (const json::out_of_range& e) {
+        // 406: a number literal beyond the range of a double, e.g. 1e999 (it would be infinite).
+        throw InputError(
+            where, tracker.pending_pointer(),
+            fmt::format("{}: not a finite number; allowed: finite numbers", parser_message(e)));
+    } catch (const json::exception& e) {
+        throw InputError(where, "", fmt::format("malformed JSON: {}", parser_message(e)));
+    }
+}
+
+// ---- Describing -----------------------------------------------------------------------------
+
+/// "0.1" when the three channels agree, else "(0.1, 0, 0.9)".
+std::string show_rgb(const Rgbd& v) {
+    if (v[0] == v[1] && v[1] == v[2]) return fmt::format("{}", v[0]);
+    return fmt::format("({}, {}, {})", v[0], v[1], v[2]);
+}
+
+json rgb_json(const Rgbd& v) {
+    return json::array({v[0], v[1], v[2]});
+}
+
+}  // namespace
+
+Stack stack_from_json(const nlohmann::json& j, const std::string& where) {
+    return Reader(where).stack(j);
+}
+
 Stack load_stack(const std::filesystem::path& path) {
-    throw InputError(path.string(), "", "stack parsing not implemented yet");
+    const std::string where = path.string();
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+        throw InputError(where, "", "cannot read the stack file: no such file");
+    if (std::filesystem::is_directory(path, ec))
+        throw InputError(where, "", "cannot read the stack file: it is a directory");
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        throw InputError(where, "",
+                         fmt::format("cannot read the stack file: {}", std::strerror(errno)));
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (in.bad())
+        throw InputError(where, "",
+                         fmt::format("cannot read the stack file: {}", std::strerror(errno)));
+    return stack_from_json(parse_text(text.str(), where), where);
 }
-nlohmann::json stack_to_json(const Stack&) {
-    return nlohmann::json::object();
+
+nlohmann::json stack_to_json(const Stack& stack) {
+    json layers = json::array();
+    for (const Layer& layer : stack.layers) {
+        const InterfaceSpec& i = layer.interface;
+        json interface;
+        switch (i.type) {
+            case InterfaceType::Dielectric:
+                interface = {{"type", "dielectric"}, {"eta", i.eta}, {"alpha", i.alpha}};
+                break;
+            case InterfaceType::Conductor:
+                interface = {{"type", "conductor"},
+                             {"eta", rgb_json(i.eta_rgb)},
+                             {"k", rgb_json(i.k)},
+                             {"alpha", i.alpha}};
+                break;
+            case InterfaceType::Lambertian:
+                interface = {{"type", "lambertian"}, {"albedo", rgb_json(i.albedo)}};
+                break;
+        }
+        json l = {{"interface", interface}};
+        if (layer.has_medium)
+            l["medium"] = {{"tau_a", rgb_json(layer.medium.tau_a)},
+                           {"tau_s", rgb_json(layer.medium.tau_s)},
+                           {"g", rgb_json(layer.medium.g)}};
+        layers.push_back(std::move(l));
+    }
+    return {{"name", stack.name}, {"ambient_eta", stack.ambient_eta}, {"layers", layers}};
 }
+
 std::string describe(const Stack& stack) {
-    return stack.name;
+    std::string out = fmt::format("{}: ", stack.name);
+    out += stack.ambient_eta == 1.0 ? "air" : fmt::format("ambient η={}", stack.ambient_eta);
+    for (std::size_t n = 0; n < stack.layers.size(); ++n) {
+        const Layer& layer = stack.layers[n];
+        const InterfaceSpec& i = layer.interface;
+        switch (i.type) {
+            case InterfaceType::Dielectric:
+                out += fmt::format(" | dielectric η={} α={}", i.eta, i.alpha);
+                if (n + 1 == stack.layers.size())
+                    out += fmt::format(" (slab: transmits into η={})", i.eta);
+                break;
+            case InterfaceType::Conductor:
+                out += fmt::format(" | conductor η={} k={} α={}", show_rgb(i.eta_rgb),
+                                   show_rgb(i.k), i.alpha);
+                break;
+            case InterfaceType::Lambertian:
+                out += fmt::format(" | lambertian ρ={}", show_rgb(i.albedo));
+                break;
+        }
+        if (layer.has_medium) {
+            const MediumSpec& m = layer.medium;
+            out += fmt::format(" | medium τa={}", show_rgb(m.tau_a));
+            if (m.scatters()) out += fmt::format(" τs={} g={}", show_rgb(m.tau_s), show_rgb(m.g));
+        }
+    }
+    return out;
 }
 
 }  // namespace lamina

@@ -70,21 +70,26 @@ struct Stack {
     bool operator==(const Stack&) const = default;
 };
 
-/// Parses and validates a stack from JSON. `where` names the source (a file) in error messages.
-/// Throws InputError naming `where`, the JSON pointer of the field, the value and what is allowed,
-/// for: unknown keys, wrong types, RGB arrays of the wrong length, NaN/inf, eta ≤ 0, alpha outside
-/// [0, 1], optical depths < 0, |g| ≥ 1, albedo outside [0, 1], k < 0, an opaque interface that is
-/// not last, a medium under the last interface, an empty stack.
+/// Parses and validates a stack from JSON (format: docs/stack-format.md). `where` names the source
+/// (a file) in error messages; `name` defaults to its stem. Throws one InputError naming `where`,
+/// the JSON pointer of the field, the value and what is allowed, for: unknown keys (with the
+/// allowed keys and the closest one), missing required keys (`layers`, `interface`, `type`, and
+/// every key of an interface type, `alpha` included), wrong types, RGB arrays of the wrong length,
+/// NaN/inf, eta ≤ 0 (or an RGB dielectric eta), alpha outside [0, 1], optical depths < 0, |g| ≥ 1,
+/// albedo outside [0, 1], k < 0, an unknown interface type, an opaque interface that is not last, a
+/// medium under the last interface, an empty or missing `layers`, an empty name.
 Stack stack_from_json(const nlohmann::json& j, const std::string& where);
 
-/// Reads and parses a stack file (InputError on unreadable or malformed JSON too).
+/// Reads and parses a stack file. InputError also on a missing or unreadable file, malformed JSON
+/// (with line and column), duplicate keys, and numbers that overflow a double (1e999).
 Stack load_stack(const std::filesystem::path& path);
 
 /// Canonical JSON form (every RGB quantity as a 3-array); stack_from_json(stack_to_json(s)) == s.
 nlohmann::json stack_to_json(const Stack& stack);
 
-/// One line describing the stack, e.g. `red plastic: air | dielectric η=1.5 α=0.05 | τa=(0.1,0,0.9)
-/// | lambertian ρ=(0.8,0.2,0.1)`.
+/// One line describing the stack, e.g. `red plastic: air | dielectric η=1.5 α=0.05 | medium
+/// τa=(0.1, 0, 0.9) | lambertian ρ=(0.8, 0.2, 0.1)`; scattering media add τs and g, a slab ends
+/// with `(slab: transmits into η=…)`.
 std::string describe(const Stack& stack);
 
 }  // namespace lamina

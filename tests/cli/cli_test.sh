@@ -16,9 +16,98 @@ check() {  # check NAME EXPECTED_RC COMMAND...
         pass=$((pass + 1))
     fi
 }
+check_says() {  # check_says NAME EXPECTED_RC TEXT COMMAND...: exit code and TEXT in the output
+    local name=$1 want=$2 text=$3
+    shift 3
+    "$@" >/tmp/lamina-cli-out.$$ 2>&1
+    local rc=$?
+    if [ "$rc" -ne "$want" ]; then
+        echo "FAIL $name: exit $rc, wanted $want"; cat /tmp/lamina-cli-out.$$; fails=$((fails + 1))
+    elif ! grep -qF -- "$text" /tmp/lamina-cli-out.$$; then
+        echo "FAIL $name: output lacks '$text':"; cat /tmp/lamina-cli-out.$$; fails=$((fails + 1))
+    else
+        pass=$((pass + 1))
+    fi
+}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp" /tmp/lamina-cli-out.$$' EXIT
+
 check version 0 "$lamina" --version
 check help 0 "$lamina" --help
 check no-subcommand 106 "$lamina"
-rm -f /tmp/lamina-cli-out.$$
+
+# validate: every example is valid and described on one line.
+for example in "$src"/examples/*.json; do
+    check_says "validate $(basename "$example")" 0 " | " \
+        "$lamina" validate "$example"
+done
+check_says validate-describes 0 "plastic: air | dielectric η=1.5 α=0.2 | medium τa=(0.1, 0, 0.9)" \
+    "$lamina" validate "$src/examples/plastic.json"
+check_says validate-slab 0 "transmits" "$lamina" validate "$src/examples/slab.json"
+check_says validate-scattering 0 "τs=0.5 g=0.3" "$lamina" validate "$src/examples/milky-coat.json"
+check validate-no-file 106 "$lamina" validate
+
+# validate: each kind of bad input fails and the message names the field.
+bad() {  # bad NAME FIELD_TEXT JSON: validate must fail and say FIELD_TEXT
+    printf '%s\n' "$3" >"$tmp/$1.json"
+    check_says "validate-bad-$1" 1 "$tmp/$1.json: $2" "$lamina" validate "$tmp/$1.json"
+}
+coat='{"type": "dielectric", "eta": 1.5, "alpha": 0.1}'
+base='{"interface": {"type": "lambertian", "albedo": 0.8}}'
+bad malformed 'malformed JSON: parse error at line 2' '{"layers": [
+  {"interface" {"type": "lambertian"}}]}'
+bad not-object 'a stack file must hold a JSON object' '[1, 2, 3]'
+bad unknown-key '/layers/0/interface/alpah: unknown key "alpah"' \
+    '{"layers": [{"interface": {"type": "dielectric", "eta": 1.5, "alpah": 0.1}}]}'
+bad unknown-top-key '/layer: unknown key "layer" in the stack; did you mean "layers"?' \
+    "{\"layer\": [$base]}"
+bad unknown-medium-key '/layers/0/medium/tau: unknown key' \
+    "{\"layers\": [{\"interface\": $coat, \"medium\": {\"tau\": 1}}, $base]}"
+bad duplicate-key '/layers/0/interface/albedo: duplicate key' \
+    '{"layers": [{"interface": {"type": "lambertian", "albedo": 0.8, "albedo": 0.5}}]}'
+bad wrong-type '/layers/0/interface/eta: expected a number' \
+    '{"layers": [{"interface": {"type": "dielectric", "eta": "1.5", "alpha": 0.1}}]}'
+bad rgb-length '/layers/0/interface/albedo: expected a number or an array of 3 numbers' \
+    '{"layers": [{"interface": {"type": "lambertian", "albedo": [0.8, 0.2]}}]}'
+bad overflow '/layers/0/medium/tau_a/1: number overflow parsing '"'"'1e999'"'" \
+    "{\"layers\": [{\"interface\": $coat, \"medium\": {\"tau_a\": [0, 1e999, 0]}}, $base]}"
+bad eta '/layers/0/interface/eta: got -1.5; allowed: > 0' \
+    '{"layers": [{"interface": {"type": "dielectric", "eta": -1.5, "alpha": 0.1}}]}'
+bad eta-rgb '/layers/0/interface/eta: a dielectric'"'"'s eta must be a single number' \
+    '{"layers": [{"interface": {"type": "dielectric", "eta": [1.5, 1.5, 1.5], "alpha": 0.1}}]}'
+bad ambient-eta '/ambient_eta: got 0; allowed: > 0' "{\"ambient_eta\": 0, \"layers\": [$base]}"
+bad alpha '/layers/0/interface/alpha: got 1.5; allowed: [0, 1]' \
+    '{"layers": [{"interface": {"type": "dielectric", "eta": 1.5, "alpha": 1.5}}]}'
+bad alpha-missing '/layers/0/interface/alpha: missing required key "alpha"' \
+    '{"layers": [{"interface": {"type": "conductor", "eta": 0.2, "k": 3}}]}'
+bad tau '/layers/0/medium/tau_s: got -0.5; allowed: >= 0' \
+    "{\"layers\": [{\"interface\": $coat, \"medium\": {\"tau_s\": -0.5}}, $base]}"
+bad g '/layers/0/medium/g: got 1; allowed: (-1, 1)' \
+    "{\"layers\": [{\"interface\": $coat, \"medium\": {\"g\": 1}}, $base]}"
+bad albedo '/layers/0/interface/albedo/0: got 1.2; allowed: [0, 1]' \
+    '{"layers": [{"interface": {"type": "lambertian", "albedo": [1.2, 0.2, 0.1]}}]}'
+bad k '/layers/0/interface/k/2: got -3; allowed: >= 0' \
+    '{"layers": [{"interface": {"type": "conductor", "eta": 0.2, "k": [3, 3, -3], "alpha": 0}}]}'
+bad interface-type '/layers/0/interface/type: unknown interface type "metal"' \
+    '{"layers": [{"interface": {"type": "metal", "eta": 0.2, "k": 3, "alpha": 0}}]}'
+bad opaque-not-last '/layers/0/interface/type: a lambertian interface is opaque and must be the last' \
+    "{\"layers\": [$base, {\"interface\": $coat}]}"
+bad medium-under-base '/layers/1/medium: the last interface (the base) cannot have a medium' \
+    "{\"layers\": [{\"interface\": $coat}, {\"interface\": $coat, \"medium\": {}}]}"
+bad empty-layers '/layers: the stack has no layers' '{"layers": []}'
+bad missing-layers '/layers: missing required key "layers"' '{"name": "nothing"}'
+check_says validate-missing-file 1 "$tmp/no-such.json: cannot read the stack file: no such file" \
+    "$lamina" validate "$tmp/no-such.json"
+
+# validate: one line per valid file on stdout, one error per bad file on stderr, exit 1 if any failed.
+"$lamina" validate "$src/examples/plastic.json" "$tmp/alpha.json" "$src/examples/slab.json" \
+    "$tmp/no-such.json" >"$tmp/out" 2>"$tmp/err"
+rc=$?
+if [ "$rc" -eq 1 ] && [ "$(wc -l <"$tmp/out")" -eq 2 ] && [ "$(wc -l <"$tmp/err")" -eq 2 ]; then
+    pass=$((pass + 1))
+else
+    echo "FAIL validate-mixed: exit $rc, stdout and stderr:"; cat "$tmp/out" "$tmp/err"
+    fails=$((fails + 1))
+fi
 echo "$pass passed, $fails failed"
 [ "$fails" -eq 0 ]
