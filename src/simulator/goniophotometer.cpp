@@ -19,7 +19,8 @@ namespace lamina {
 
 Rgbd EnergyBudget::sum() const {
     Rgbd s(0.0);
-    for (const Rgbd& t : term) s += t;
+    for (const Rgbd& t : term)
+        s += t;
     return s;
 }
 
@@ -35,8 +36,7 @@ void validate_settings(const SimulationSettings& s) {
     if (s.threads < 0)
         throw InputError("command line", "--threads",
                          fmt::format("{} is not allowed: use ≥ 1, or 0 for all cores", s.threads));
-    if (s.max_events < 1)
-        throw InputError("command line", "--max-events", "must be ≥ 1");
+    if (s.max_events < 1) throw InputError("command line", "--max-events", "must be ≥ 1");
 }
 
 namespace {
@@ -50,7 +50,9 @@ using Fixed = __int128;
 constexpr double kFixedScale = 0x1p56;
 constexpr double kFixedInvScale = 0x1p-56;
 
-inline Fixed to_fixed(double x) { return Fixed(std::llrint(x * kFixedScale)); }
+inline Fixed to_fixed(double x) {
+    return Fixed(std::llrint(x * kFixedScale));
+}
 
 // The same for |x| < 2^39 (block sums): split into an integer part at scale 2^24 and the exact
 // remainder, each converted separately.
@@ -60,7 +62,9 @@ inline Fixed to_fixed_wide(double x) {
     const double lo = scaled - hi;  // exact: the fractional part, in [0, 1)
     return (Fixed(std::int64_t(hi)) << 32) + Fixed(std::llrint(lo * 0x1p32));
 }
-inline double from_fixed(Fixed x) { return double(x) * kFixedInvScale; }
+inline double from_fixed(Fixed x) {
+    return double(x) * kFixedInvScale;
+}
 
 // Per (side, bin): Σ flux and Σ flux² per channel, side by side in memory (one cache line pair).
 struct BinAccumulator {
@@ -93,7 +97,8 @@ struct Tally {
     }
     void add_block(const BlockBudget& b) {
         for (int t = 0; t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c) budget[t][c] += to_fixed_wide(b.term[t][c]);
+            for (int c = 0; c < 3; ++c)
+                budget[t][c] += to_fixed_wide(b.term[t][c]);
         for (int c = 0; c < 3; ++c) {
             reflected_sq[c] += to_fixed_wide(b.reflected_sq[c]);
             transmitted_sq[c] += to_fixed_wide(b.transmitted_sq[c]);
@@ -106,7 +111,8 @@ struct Tally {
                 bins[i].sum_sq[c] += o.bins[i].sum_sq[c];
             }
         for (int t = 0; t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c) budget[t][c] += o.budget[t][c];
+            for (int c = 0; c < 3; ++c)
+                budget[t][c] += o.budget[t][c];
         for (int c = 0; c < 3; ++c) {
             reflected_sq[c] += o.reflected_sq[c];
             transmitted_sq[c] += o.transmitted_sq[c];
@@ -116,7 +122,9 @@ struct Tally {
     }
 };
 
-bool is_black(const Rgbf& w) { return w[0] == 0.f && w[1] == 0.f && w[2] == 0.f; }
+bool is_black(const Rgbf& w) {
+    return w[0] == 0.f && w[1] == 0.f && w[2] == 0.f;
+}
 
 // The flux a particle loses along its path, per budget term, in registers; added to the block's
 // double sums once, when the particle ends.
@@ -126,7 +134,8 @@ struct PathLosses {
     void add(BudgetTerm t, const Rgbf& lost) { term[int(t)] += lost; }
     void flush(BlockBudget& block) const {
         for (int t = int(BudgetTerm::AbsorbedMedium); t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c) block.term[t][c] += double(term[t][c]);
+            for (int c = 0; c < 3; ++c)
+                block.term[t][c] += double(term[t][c]);
     }
 };
 
@@ -171,7 +180,12 @@ struct MediumWalk {
             const float u = rng.uniform_float();
             const float flight = sigma_c > 0 ? -std::log1p(-u) / sigma_c : INFINITY;
             const Rgbf before = w;
-            if (flight >= to_boundary) {
+            if (m.uniform_tau_t) {
+                // One extinction for all channels: the flight pdf is the channels' own, and only
+                // the single-scattering albedo weights a scattering event.
+                if (flight >= to_boundary) return d.z > 0;
+                w *= m.single_scattering_albedo;
+            } else if (flight >= to_boundary) {
                 // Leaves the layer: weight_c = T_c / Σ_k p_k T_k.
                 float mix = 0;
                 Rgbf transmittance;
@@ -179,23 +193,35 @@ struct MediumWalk {
                     transmittance[k] = std::exp(-m.tau_t[k] * to_boundary);
                     mix += p[k] * transmittance[k];
                 }
-                for (int k = 0; k < 3; ++k) w[k] *= transmittance[k] / mix;
+                for (int k = 0; k < 3; ++k)
+                    w[k] *= transmittance[k] / mix;
                 losses.add(BudgetTerm::AbsorbedMedium, before - w);
                 return d.z > 0;
+            } else {
+                // Scatters at distance `flight`:
+                // weight_c = σs_c e^{−σt_c t} / Σ_k p_k σt_k e^{−σt_k t}.
+                float mix = 0;
+                Rgbf numerator;
+                for (int k = 0; k < 3; ++k) {
+                    const float e = std::exp(-m.tau_t[k] * flight);
+                    numerator[k] = m.tau_s[k] * e;
+                    mix += p[k] * m.tau_t[k] * e;
+                }
+                for (int k = 0; k < 3; ++k)
+                    w[k] *= numerator[k] / mix;
             }
-            // Scatters at distance `flight`: weight_c = σs_c e^{−σt_c t} / Σ_k p_k σt_k e^{−σt_k t}.
-            float mix = 0;
-            Rgbf numerator;
-            for (int k = 0; k < 3; ++k) {
-                const float e = std::exp(-m.tau_t[k] * flight);
-                numerator[k] = m.tau_s[k] * e;
-                mix += p[k] * m.tau_t[k] * e;
-            }
-            for (int k = 0; k < 3; ++k) w[k] *= numerator[k] / mix;
             s -= d.z * flight;
             s = clamp(s, 0.f, 1.f);
             // New direction from HG; per-channel g needs MIS over the channels' phase functions.
-            const Vec3f d_new = sample_hg(d, m.g[c], rng.uniform_float(), rng.uniform_float());
+            // The phase channel is drawn afresh (∝ the same p), so the joint density of
+            // (distance, direction) factorizes into the two mixtures used for the weights.
+            int c_phase = c;
+            if (!m.uniform_g) {
+                const float up = rng.uniform_float();
+                c_phase = up < p[0] ? 0 : (up < p[0] + p[1] ? 1 : 2);
+            }
+            const Vec3f d_new =
+                sample_hg(d, m.g[c_phase], rng.uniform_float(), rng.uniform_float());
             if (!m.uniform_g) {
                 const float cos_theta = dot(d, d_new);
                 float mix_phase = 0;
@@ -204,7 +230,8 @@ struct MediumWalk {
                     phase[k] = hg_phase(cos_theta, m.g[k]);
                     mix_phase += p[k] * phase[k];
                 }
-                for (int k = 0; k < 3; ++k) w[k] *= phase[k] / mix_phase;
+                for (int k = 0; k < 3; ++k)
+                    w[k] *= phase[k] / mix_phase;
             }
             d = d_new;
             losses.add(BudgetTerm::AbsorbedMedium, before - w);
@@ -265,7 +292,8 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
             losses.add(BudgetTerm::LostMicrosurface, w);
             break;
         }
-        // weight = fresnel_weight (absorbed by an opaque base) · shadowing (lost on the microsurface)
+        // weight = fresnel_weight (absorbed by an opaque base) · shadowing (lost on the
+        // microsurface)
         if (layer.type != InterfaceType::Dielectric) {  // a dielectric's fresnel_weight is 1
             const Rgbf kept = w * s->fresnel_weight;
             losses.add(BudgetTerm::AbsorbedBase, w - kept);
@@ -403,7 +431,8 @@ SimulationResult simulate(const Stack& stack, const SimulationSettings& settings
             std::chrono::duration<double>(std::chrono::steady_clock::now() - inc_start).count();
         result.incidences.push_back(stats);
     }
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
 }
 

@@ -31,6 +31,11 @@ TraceStack::TraceStack(const Stack& stack) : transmits(stack.transmits()) {
             t.medium.absorbs = m.tau_a.max() > 0;
             t.medium.scatters = m.tau_s.max() > 0;
             t.medium.uniform_g = m.g[0] == m.g[1] && m.g[1] == m.g[2];
+            const Rgbf tau_t = t.medium.tau_t;
+            t.medium.uniform_tau_t = tau_t[0] == tau_t[1] && tau_t[1] == tau_t[2];
+            for (int c = 0; c < 3; ++c)
+                t.medium.single_scattering_albedo[c] =
+                    tau_t[c] > 0 ? float(m.tau_s[c] / m.tau_t()[c]) : 0.f;
         }
         layers.push_back(t);
     }

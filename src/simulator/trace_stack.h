@@ -20,6 +20,10 @@ struct TraceMedium {
     bool scatters = false;
     /// All channels share one g: the phase function needs no spectral MIS.
     bool uniform_g = true;
+    /// All channels share one extinction τt: free flights need no spectral MIS, and a scattering
+    /// event multiplies the flux by the single-scattering albedo τs/τt (exactly 1 when τa = 0).
+    bool uniform_tau_t = true;
+    Rgbf single_scattering_albedo{0.f};
     bool is_empty() const { return !absorbs && !scatters; }
 };
 

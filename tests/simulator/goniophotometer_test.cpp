@@ -1,10 +1,10 @@
 // The goniophotometer against exact solutions (physics.md §6), with tolerances from the standard
 // errors it reports. Suites ending in Stat are the `stat` label.
+#include "simulator/goniophotometer.h"
 #include "core/error.h"
 #include "physics/conductor.h"
 #include "physics/dielectric.h"
 #include "physics/fresnel.h"
-#include "simulator/goniophotometer.h"
 #include "support/adding_doubling.h"
 #include "support/quadrature.h"
 #include "support/stacks.h"
@@ -40,7 +40,8 @@ void expect_within_se(double estimate, double exact, double se, const char* what
 // Every budget sums to 1 to rounding (physics.md §5).
 void expect_budget_closes(const SimulationResult& r) {
     for (const IncidenceStats& st : r.incidences)
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(st.budget.sum()[c], 1.0, 1e-6);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(st.budget.sum()[c], 1.0, 1e-6);
 }
 
 // §6.2: a Lambertian base alone reflects albedo/π in every direction; every particle leaves
@@ -49,11 +50,13 @@ TEST(GoniophotometerStat, LambertianAlone) {
     const Rgbd albedo(0.8, 0.5, 0.2);
     const Stack stack = test::make_stack({test::lambertian_layer(albedo)});
     const auto r = simulate(stack, settings({40}, 400'000, HemisphereGrid(9, 9)));
-    expect_agreement(compare_lobe(r.table, 0, Side::Reflection,
-                                  [&](std::size_t) { return albedo * kInvPi<double>; }));
+    expect_agreement(compare_lobe(
+        r.table, 0, Side::Reflection, [&](std::size_t) { return albedo * kInvPi<double>; },
+        400'000));
+    // The tracer holds ρ in float: exact to its rounding, 2^-24 relative.
     for (int c = 0; c < 3; ++c) {
-        EXPECT_NEAR(r.incidences[0].budget[BudgetTerm::Reflected][c], albedo[c], 1e-9);
-        EXPECT_NEAR(r.incidences[0].budget[BudgetTerm::AbsorbedBase][c], 1 - albedo[c], 1e-9);
+        EXPECT_NEAR(r.incidences[0].budget[BudgetTerm::Reflected][c], albedo[c], 1e-7);
+        EXPECT_NEAR(r.incidences[0].budget[BudgetTerm::AbsorbedBase][c], 1 - albedo[c], 1e-7);
     }
     expect_budget_closes(r);
 }
@@ -66,8 +69,8 @@ TEST(GoniophotometerStat, LambertianAlone) {
 TEST(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
     const double eta = 1.5, theta_i = 35.0;
     const Rgbd tau(0.1, 0.5, 0.0), rho(0.8, 0.5, 1.0);
-    const Stack stack = test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), tau),
-                                          test::lambertian_layer(rho)});
+    const Stack stack = test::make_stack(
+        {test::with_medium(test::dielectric_layer(eta, 0.0), tau), test::lambertian_layer(rho)});
     const HemisphereGrid grid(18, 18);
     const auto r = simulate(stack, settings({theta_i}, 1'000'000, grid));
 
@@ -76,14 +79,15 @@ TEST(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
     Rgbd internal(0.0), escape(0.0);
     for (int c = 0; c < 3; ++c) {
         auto f_in = [&](double mu) { return fresnel_dielectric(mu, 1 / eta); };
-        internal[c] = 2 * (test::integrate([&](double mu) { return mu * std::exp(-2 * tau[c] / mu); },
-                                           0, mu_c, 32, 8) +
-                           test::integrate([&](double mu) {
-                               return f_in(mu) * std::exp(-2 * tau[c] / mu) * mu;
-                           }, mu_c, 1, 32, 8));
-        escape[c] = 2 * test::integrate([&](double mu) {
-            return (1 - f_in(mu)) * std::exp(-tau[c] / mu) * mu;
-        }, mu_c, 1, 32, 8);
+        internal[c] =
+            2 *
+            (test::integrate([&](double mu) { return mu * std::exp(-2 * tau[c] / mu); }, 0, mu_c,
+                             32, 8) +
+             test::integrate([&](double mu) { return f_in(mu) * std::exp(-2 * tau[c] / mu) * mu; },
+                             mu_c, 1, 32, 8));
+        escape[c] = 2 * test::integrate(
+                            [&](double mu) { return (1 - f_in(mu)) * std::exp(-tau[c] / mu) * mu; },
+                            mu_c, 1, 32, 8);
     }
     const double mu_i = std::cos(deg_to_rad(theta_i));
     const double F_i = fresnel_dielectric(mu_i, eta);
@@ -99,11 +103,14 @@ TEST(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
     // The tracer's mirror direction, in its own float arithmetic, decides the bin.
     const Vec3f wi_f(incident_direction(deg_to_rad(theta_i)));
     const std::size_t mirror_bin = grid.bin_of(Vec3f(-wi_f.x, -wi_f.y, wi_f.z));
-    expect_agreement(compare_lobe(r.table, 0, Side::Reflection, [&](std::size_t j) {
-        Rgbd e = test::bin_average(grid, j, Side::Reflection, diffuse);
-        if (j == mirror_bin) e += Rgbd(F_i / grid.projected_solid_angle(j));
-        return e;
-    }));
+    expect_agreement(compare_lobe(
+        r.table, 0, Side::Reflection,
+        [&](std::size_t j) {
+            Rgbd e = test::bin_average(grid, j, Side::Reflection, diffuse);
+            if (j == mirror_bin) e += Rgbd(F_i / grid.projected_solid_angle(j));
+            return e;
+        },
+        1e6));
     const EnergyBudget& b = r.incidences[0].budget;
     for (int c = 0; c < 3; ++c) {
         const double albedo = F_i + (1 - F_i) * std::exp(-tau[c] / refracted_cos(mu_i)) * rho[c] *
@@ -122,8 +129,8 @@ TEST(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
 TEST(GoniophotometerStat, SmoothSlab) {
     const double eta = 1.5;
     const Rgbd tau(0.0, 0.2, 1.0);
-    const Stack stack = test::make_stack(
-        {test::with_medium(test::dielectric_layer(eta, 0.0), tau), test::dielectric_layer(1.0, 0.0)});
+    const Stack stack = test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), tau),
+                                          test::dielectric_layer(1.0, 0.0)});
     const auto r = simulate(stack, settings({30, 75}, 400'000, HemisphereGrid(18, 18)));
     for (std::size_t i = 0; i < 2; ++i) {
         const double mu_i = std::cos(deg_to_rad(r.settings.theta_i_deg[i]));
@@ -141,7 +148,8 @@ TEST(GoniophotometerStat, SmoothSlab) {
         // Delta lobes: one bin each holds all of R and of T.
         for (const Side side : {Side::Reflection, Side::Transmission}) {
             int hit = 0;
-            for (const Rgbd& f : r.table.lobe(i, side).f) hit += f[0] > 0;
+            for (const Rgbd& f : r.table.lobe(i, side).f)
+                hit += f[0] > 0;
             EXPECT_EQ(hit, 1);
         }
     }
@@ -178,15 +186,24 @@ void check_single_rough_dielectric(double ambient_eta, double eta, double alpha,
     stack.ambient_eta = ambient_eta;
     const HemisphereGrid grid(18, 18);
     const auto r = simulate(stack, settings({theta_i}, 1'000'000, grid));
-    const DielectricInterface<double> interface{eta / ambient_eta, alpha};
+    const DielectricInterface<double> interface { eta / ambient_eta, alpha };
     const Vec3d wi = incident_direction(deg_to_rad(theta_i));
     for (const Side side : {Side::Reflection, Side::Transmission}) {
         SCOPED_TRACE(side == Side::Reflection ? "reflection" : "transmission");
-        expect_agreement(compare_lobe(r.table, 0, side, [&](std::size_t j) {
-            return test::bin_average(grid, j, side, [&](const Vec3d& wo) {
-                return Rgbd(interface.eval(wi, wo));
-            }, 12);
-        }));
+        std::vector<Rgbd> expected(grid.size());
+        double albedo = 0;  // Σ_j f̄_j Ω⊥_j: the lobe's directional albedo by quadrature
+        for (std::size_t j = 0; j < grid.size(); ++j) {
+            expected[j] = test::bin_average(
+                grid, j, side, [&](const Vec3d& wo) { return Rgbd(interface.eval(wi, wo)); }, 12);
+            albedo += expected[j][0] * grid.projected_solid_angle(j);
+        }
+        expect_agreement(compare_lobe(
+            r.table, 0, side, [&](std::size_t j) { return expected[j]; }, 1e6));
+        const EnergyBudget& b = r.incidences[0].budget;
+        if (side == Side::Reflection)
+            expect_within_se(b[BudgetTerm::Reflected][0], albedo, b.reflected_se[0], "R");
+        else
+            expect_within_se(b[BudgetTerm::Transmitted][0], albedo, b.transmitted_se[0], "T");
     }
     expect_budget_closes(r);
 }
@@ -206,12 +223,16 @@ TEST(GoniophotometerStat, SingleRoughConductor) {
     const Stack stack = test::make_stack({test::conductor_layer(eta_c, k_c, alpha)});
     const HemisphereGrid grid(18, 18);
     const auto r = simulate(stack, settings({theta_i}, 1'000'000, grid));
-    const ConductorInterface<double> interface{eta_c, k_c, alpha};
+    const ConductorInterface<double> interface { eta_c, k_c, alpha };
     const Vec3d wi = incident_direction(deg_to_rad(theta_i));
-    expect_agreement(compare_lobe(r.table, 0, Side::Reflection, [&](std::size_t j) {
-        return test::bin_average(grid, j, Side::Reflection,
-                                 [&](const Vec3d& wo) { return interface.eval(wi, wo); }, 12);
-    }));
+    expect_agreement(compare_lobe(
+        r.table, 0, Side::Reflection,
+        [&](std::size_t j) {
+            return test::bin_average(
+                grid, j, Side::Reflection, [&](const Vec3d& wo) { return interface.eval(wi, wo); },
+                12);
+        },
+        1e6));
     expect_budget_closes(r);
 }
 
@@ -223,9 +244,9 @@ TEST(GoniophotometerStat, WhiteFurnace) {
         test::make_stack({test::dielectric_layer(1.5, 0.5), test::lambertian_layer(Rgbd(1.0))}),
         test::make_stack({test::dielectric_layer(1.3, 0.2), test::dielectric_layer(1.7, 0.4),
                           test::dielectric_layer(1.0, 0.1)}),
-        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.0),
-                                            Rgbd(0.7), Rgbd(0.3)),
-                          test::lambertian_layer(Rgbd(1.0))}),
+        test::make_stack(
+            {test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.0), Rgbd(0.7), Rgbd(0.3)),
+             test::lambertian_layer(Rgbd(1.0))}),
     };
     for (const Stack& stack : stacks) {
         const auto r = simulate(stack, settings({0, 45, 80}, 100'000, HemisphereGrid(9, 9)));
@@ -247,9 +268,9 @@ TEST(GoniophotometerStat, WhiteFurnace) {
 // f(θb → bin of θa) at every φ bin, within the combined standard errors (the bin-averaging
 // asymmetry is second order in the 5° bin width, far below the noise here).
 TEST(GoniophotometerStat, TabulatedReciprocity) {
-    const Stack stack = test::make_stack(
-        {test::with_medium(test::dielectric_layer(1.5, 0.3), Rgbd(0.2, 0.05, 0.5)),
-         test::lambertian_layer(Rgbd(0.7, 0.9, 0.5))});
+    const Stack stack =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.3), Rgbd(0.2, 0.05, 0.5)),
+                          test::lambertian_layer(Rgbd(0.7, 0.9, 0.5))});
     const HemisphereGrid grid(18, 18);
     const auto r = simulate(stack, settings({22.5, 52.5}, 2'000'000, grid));
     const int ta = 4, tb = 10;  // the θ bins [20°, 25°] and [50°, 55°]
@@ -277,14 +298,15 @@ TEST(GoniophotometerStat, TabulatedReciprocity) {
 // which exercises the spectral MIS of free flights and of the phase function.
 TEST(GoniophotometerStat, ScatteringSlabAgainstAddingDoubling) {
     const Rgbd tau_s(1.0, 0.5, 2.0), tau_a(0.0, 0.5, 0.1), g(0.0, 0.5, -0.3);
-    const Stack stack = test::make_stack(
-        {test::with_medium(test::dielectric_layer(1.0, 0.0), tau_a, tau_s, g),
-         test::dielectric_layer(1.0, 0.0)});
+    const Stack stack =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.0, 0.0), tau_a, tau_s, g),
+                          test::dielectric_layer(1.0, 0.0)});
     // Incidences on the reference's quadrature nodes, so it needs no interpolation.
     const test::AddingDoubling probe(1.0, 1.0, 0.0, 24);
-    const std::vector<int> nodes = {23, 15, 6};  // μ ≈ 1.0, 0.7, 0.2
+    const std::vector<int> nodes = {0, 6, 15};  // μ ≈ 1.0, 0.82, 0.38
     std::vector<double> theta_i;
-    for (int j : nodes) theta_i.push_back(rad_to_deg(std::acos(probe.mu(j))));
+    for (int j : nodes)
+        theta_i.push_back(rad_to_deg(std::acos(probe.mu(j))));
     const auto r = simulate(stack, settings(theta_i, 400'000, HemisphereGrid(9, 9)));
     for (int c = 0; c < 3; ++c) {
         const double tau = tau_s[c] + tau_a[c];
@@ -312,12 +334,13 @@ TEST(AddingDoublingReference, ConservesEnergy) {
     for (const double g : {0.0, 0.5, -0.3}) {
         const test::AddingDoubling ad(1.0, 1.0, g, 24);
         for (int j = 0; j < ad.size(); ++j)
-            EXPECT_NEAR(ad.albedo_reflected(j) + ad.albedo_transmitted(j), 1.0, 1e-5) << g;
+            EXPECT_NEAR(ad.albedo_reflected(j) + ad.albedo_transmitted(j), 1.0, 2e-6) << g;
     }
     // No scattering: T = e^{−τ/μ} exactly.
     const test::AddingDoubling clear(0.7, 0.0, 0.0, 16);
     for (int j = 0; j < clear.size(); ++j) {
-        EXPECT_NEAR(clear.albedo_transmitted(j), std::exp(-0.7 / clear.mu(j)), 1e-12);
+        // 24 doublings multiply e^{−Δτ/μ} by itself: rounding grows to ~2^24 ulp.
+        EXPECT_NEAR(clear.albedo_transmitted(j), std::exp(-0.7 / clear.mu(j)), 1e-8);
         EXPECT_NEAR(clear.albedo_reflected(j), 0.0, 1e-15);
     }
 }
@@ -325,10 +348,10 @@ TEST(AddingDoublingReference, ConservesEnergy) {
 // Reproducibility: the same stack, grid, N and seed give bitwise-identical output for any thread
 // count; a different seed gives different output.
 TEST(Goniophotometer, BitwiseIdenticalAcrossThreadCounts) {
-    const Stack stack = test::make_stack(
-        {test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.1, 0.0, 0.9), Rgbd(0.3),
-                           Rgbd(0.2)),
-         test::lambertian_layer(Rgbd(0.8))});
+    const Stack stack =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.1, 0.0, 0.9),
+                                            Rgbd(0.3), Rgbd(0.2)),
+                          test::lambertian_layer(Rgbd(0.8))});
     SimulationSettings s = settings({0, 60}, 50'000, HemisphereGrid(30, 30));
     s.threads = 1;
     const auto one = simulate(stack, s);

@@ -22,7 +22,7 @@
 namespace lamina::test {
 
 class AddingDoubling {
-public:
+  public:
     /// Slab of optical depth tau, single-scattering albedo omega, HG asymmetry g; n nodes.
     AddingDoubling(double tau, double omega, double g, int n = 32) : n_(n) {
         const auto gl = gauss_legendre(n);
@@ -30,12 +30,10 @@ public:
             mu_.push_back(0.5 * (x + 1));
             w_.push_back(0.5 * w);
         }
-        int doublings = 0;
-        double dtau = tau;
-        while (dtau > 1e-7 * std::max(1.0, tau) || doublings < 20) {
-            dtau /= 2;
-            ++doublings;
-        }
+        // Thin starting layer: 2^-24 of the slab. Its single scattering is exact (below), so the
+        // error is its missing double scattering, O(Δτ²) per starting layer.
+        const int doublings = 24;
+        const double dtau = std::ldexp(tau, -doublings);
         // Azimuthally averaged HG phase function between propagation cosines a and b.
         const auto gl_phi = gauss_legendre(128);
         auto p0 = [&](double a, double b) {
@@ -51,14 +49,26 @@ public:
         T_.assign(n * n, 0.0);
         for (int i = 0; i < n; ++i) {
             for (int j = 0; j < n; ++j) {
-                // Incident travelling down (cos −μ_j); reflected up (+μ_i), transmitted down (−μ_i).
-                const double common = 2 * kPi<double> * omega * dtau * w_[j] / mu_[i];
-                R_[i * n + j] = common * p0(mu_[i], -mu_[j]);
-                T_[i * n + j] = common * p0(-mu_[i], -mu_[j]);
+                // Incident travelling down (cos −μ_j); reflected up (+μ_i), transmitted down
+                // (−μ_i). Exact single scattering of a layer Δτ (van de Hulst 1980, §4.2):
+                //   f_R = ω p (1 − e^{−Δτ(1/μ + 1/μ0)}) / (μ + μ0),
+                //   f_T = ω p (e^{−Δτ/μ} − e^{−Δτ/μ0}) / (μ − μ0)   (→ ω p Δτ e^{−Δτ/μ}/μ² at μ =
+                //   μ0),
+                // and the operator entry is 2π f μ_j w_j.
+                const double mi = mu_[i], mj = mu_[j];
+                const double fr = (-std::expm1(-dtau * (1 / mi + 1 / mj))) / (mi + mj);
+                const double ft = i == j
+                                      ? dtau * std::exp(-dtau / mi) / (mi * mi)
+                                      : (std::exp(-dtau / mi) - std::exp(-dtau / mj)) / (mi - mj);
+                const double common = 2 * kPi<double> * omega * mj * w_[j];
+                R_[i * n + j] = common * fr * p0(mi, -mj);
+                T_[i * n + j] = common * ft * p0(-mi, -mj);
             }
+            // The direct beam: a radiance vector passes unchanged in direction, attenuated.
             T_[i * n + i] += std::exp(-dtau / mu_[i]);
         }
-        for (int k = 0; k < doublings; ++k) double_layer();
+        for (int k = 0; k < doublings; ++k)
+            double_layer();
     }
 
     int size() const { return n_; }
@@ -68,7 +78,7 @@ public:
     double albedo_reflected(int j) const { return flux(R_, j); }
     double albedo_transmitted(int j) const { return flux(T_, j); }
 
-private:
+  private:
     using Matrix = std::vector<double>;
 
     Matrix mul(const Matrix& a, const Matrix& b) const {
@@ -76,7 +86,8 @@ private:
         for (int i = 0; i < n_; ++i)
             for (int k = 0; k < n_; ++k) {
                 const double aik = a[i * n_ + k];
-                for (int j = 0; j < n_; ++j) c[i * n_ + j] += aik * b[k * n_ + j];
+                for (int j = 0; j < n_; ++j)
+                    c[i * n_ + j] += aik * b[k * n_ + j];
             }
         return c;
     }
@@ -84,7 +95,8 @@ private:
     // (I − A)⁻¹ B by Gauss–Jordan elimination with partial pivoting.
     Matrix solve(const Matrix& a, const Matrix& b) const {
         Matrix m(n_ * n_), x = b;
-        for (int i = 0; i < n_ * n_; ++i) m[i] = (i / n_ == i % n_ ? 1.0 : 0.0) - a[i];
+        for (int i = 0; i < n_ * n_; ++i)
+            m[i] = (i / n_ == i % n_ ? 1.0 : 0.0) - a[i];
         for (int col = 0; col < n_; ++col) {
             int pivot = col;
             for (int r = col + 1; r < n_; ++r)
@@ -117,7 +129,8 @@ private:
         const Matrix x_t = solve(rr, T_);            // (I − RR)⁻¹ T
         const Matrix r_new = mul(T_, x_rt);
         const Matrix t_new = mul(T_, x_t);
-        for (int i = 0; i < n_ * n_; ++i) R_[i] += r_new[i];
+        for (int i = 0; i < n_ * n_; ++i)
+            R_[i] += r_new[i];
         T_ = t_new;
     }
 
@@ -125,7 +138,8 @@ private:
     // leaving is Σ_i 2π μ_i w_i L_out(μ_i).
     double flux(const Matrix& m, int j) const {
         double s = 0;
-        for (int i = 0; i < n_; ++i) s += mu_[i] * w_[i] * m[i * n_ + j];
+        for (int i = 0; i < n_; ++i)
+            s += mu_[i] * w_[i] * m[i * n_ + j];
         return s / (mu_[j] * w_[j]);
     }
 
