@@ -306,6 +306,16 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
         }
         d = s->wo;
         if (is_black(w)) break;
+        if (d.z == 0) {
+            // An exactly grazing direction (a sampler at the edge of its domain, probability
+            // ~2^-24): it belongs to neither hemisphere. Its G2 is zero on a microsurface, and it
+            // is counted and reported as degenerate on any interface.
+            ++tally.degenerate;
+            losses.add(layer.type == InterfaceType::Dielectric ? BudgetTerm::LostMicrosurface
+                                                               : BudgetTerm::AbsorbedBase,
+                       w);
+            break;
+        }
         if (d.z > 0) {
             if (k == 0) {  // leaves the stack upwards: reflection
                 tally.exit(grid.bin_of(d), w);

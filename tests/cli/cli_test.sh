@@ -109,5 +109,40 @@ else
     echo "FAIL validate-mixed: exit $rc, stdout and stderr:"; cat "$tmp/out" "$tmp/err"
     fails=$((fails + 1))
 fi
+
+# simulate: a small run writes the three documented files, with their headers.
+check simulate-runs 0 "$lamina" simulate "$src/examples/slab.json" --theta-i 0,45 --particles 2e4 \
+    --grid 9x9 --seed 3 --out "$tmp/sim"
+for f in result.json brdf.csv energy.csv; do
+    if [ -s "$tmp/sim/$f" ]; then pass=$((pass + 1)); else echo "FAIL simulate: no $f"; fails=$((fails + 1)); fi
+done
+check_says simulate-brdf-header 0 "theta_i,side,theta_lo,theta_hi,phi_lo,phi_hi,f_r,f_g,f_b,se_r,se_g,se_b" \
+    head -1 "$tmp/sim/brdf.csv"
+check_says simulate-energy-header 0 \
+    "theta_i,channel,reflected,transmitted,absorbed_medium,absorbed_base,lost_microsurface,cut_off" \
+    head -1 "$tmp/sim/energy.csv"
+# 2 incidences × 2 sides × 81 bins + header; the slab transmits, so T rows are present.
+check_says simulate-rows 0 "325" sh -c "wc -l <'$tmp/sim/brdf.csv'"
+check_says simulate-has-T 0 "45,T,0,10,0,20" grep -m1 "^45,T," "$tmp/sim/brdf.csv"
+# Same seed, different thread counts: identical tables.
+check simulate-threads 0 "$lamina" simulate "$src/examples/slab.json" --theta-i 0,45 --particles 2e4 \
+    --grid 9x9 --seed 3 --threads 1 --out "$tmp/sim1"
+check simulate-reproducible 0 cmp "$tmp/sim/brdf.csv" "$tmp/sim1/brdf.csv"
+
+# simulate: bad arguments fail clearly and leave nothing behind.
+check_says simulate-theta-90 1 "--theta-i: 90 is outside the allowed range [0, 90)" \
+    "$lamina" simulate "$src/examples/plastic.json" --theta-i 90 --out "$tmp/bad1"
+check_says simulate-theta-text 1 "--theta-i: 'abc' is not a number" \
+    "$lamina" simulate "$src/examples/plastic.json" --theta-i abc --out "$tmp/bad1"
+check_says simulate-zero-particles 1 "--particles: '0' is not allowed" \
+    "$lamina" simulate "$src/examples/plastic.json" --particles 0 --out "$tmp/bad1"
+check_says simulate-bad-grid 1 "--grid: '90by90' is not a grid" \
+    "$lamina" simulate "$src/examples/plastic.json" --grid 90by90 --out "$tmp/bad1"
+check_says simulate-bad-stack 1 "no-such.json" \
+    "$lamina" simulate "$tmp/no-such.json" --out "$tmp/bad1"
+if [ -e "$tmp/bad1" ]; then echo "FAIL simulate: a failed run left $tmp/bad1"; fails=$((fails + 1)); else pass=$((pass + 1)); fi
+touch "$tmp/a-file"
+check_says simulate-unwritable 1 "--out" \
+    "$lamina" simulate "$src/examples/plastic.json" --particles 100 --out "$tmp/a-file/sub"
 echo "$pass passed, $fails failed"
 [ "$fails" -eq 0 ]

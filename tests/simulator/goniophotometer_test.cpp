@@ -259,6 +259,9 @@ TEST(GoniophotometerStat, WhiteFurnace) {
                 EXPECT_NEAR(b[BudgetTerm::AbsorbedMedium][c], 0.0, 1e-9);
                 EXPECT_EQ(b[BudgetTerm::CutOff][c], 0.0);
                 EXPECT_GT(b[BudgetTerm::LostMicrosurface][c], 0.0);
+                if (!stack.transmits()) {
+                    EXPECT_EQ(b[BudgetTerm::Transmitted][c], 0.0);
+                }
             }
         }
     }
