@@ -42,31 +42,33 @@ void validate_settings(const SimulationSettings& s) {
 namespace {
 
 // ---- Fixed-point tallies -----------------------------------------------------------------------
-// Flux is added in 128-bit integers with 2^-56 resolution: integer addition is associative, so the
-// sums (and the tables) are identical whatever the order in which threads or processes add them.
-// A particle's flux never exceeds 2^6 (the spectral MIS weights are bounded by 3), so one
-// contribution fits an int64 before widening.
+// Flux is added in integers: integer addition is associative, so the sums (and the tables) are
+// identical whatever the order in which threads or processes add them. A particle's flux per
+// channel never exceeds 3 (the spectral MIS of media conserves the sum of the channels' fluxes, and
+// every other event only removes flux), so one contribution is below 2^2.
+//
+// Exits first go to per-thread 64-bit sums (half the memory of 128-bit ones, so the bins stay in
+// cache), at scale 2^40 for Σ flux and 2^38 for Σ flux²; every 2^18 particles of a thread they are
+// widened into 128-bit sums, before 2^18 · 2^2 · 2^40 = 2^60 (resp. 2^18 · 2^4 · 2^38) could
+// overflow. Resolution 2^-40 ≈ 10^-12 of the incident flux per contribution.
 using Fixed = __int128;
-constexpr double kFixedScale = 0x1p56;
-constexpr double kFixedInvScale = 0x1p-56;
+constexpr double kSumScale = 0x1p40, kSqScale = 0x1p38;
+constexpr double kBudgetScale = 0x1p56;
+constexpr std::uint64_t kFlushParticles = std::uint64_t(1) << 18;
 
-inline Fixed to_fixed(double x) {
-    return Fixed(std::llrint(x * kFixedScale));
-}
-
-// The same for |x| < 2^39 (block sums): split into an integer part at scale 2^24 and the exact
-// remainder, each converted separately.
+// |x| < 2^39: an integer part at scale 2^24 and the exact remainder, converted separately, at
+// scale 2^56 in all (budget sums over blocks of particles).
 inline Fixed to_fixed_wide(double x) {
     const double scaled = x * 0x1p24;  // exact: a power-of-two scaling
     const double hi = std::floor(scaled);
     const double lo = scaled - hi;  // exact: the fractional part, in [0, 1)
     return (Fixed(std::int64_t(hi)) << 32) + Fixed(std::llrint(lo * 0x1p32));
 }
-inline double from_fixed(Fixed x) {
-    return double(x) * kFixedInvScale;
-}
 
-// Per (side, bin): Σ flux and Σ flux² per channel, side by side in memory (one cache line pair).
+// Per (side, bin): Σ flux and Σ flux² per channel.
+struct BinSums {
+    std::array<std::int64_t, 3> sum{}, sum_sq{};
+};
 struct BinAccumulator {
     std::array<Fixed, 3> sum{}, sum_sq{};
 };
@@ -80,39 +82,55 @@ struct BlockBudget {
 };
 
 struct Tally {
-    std::vector<BinAccumulator> bins;  // [side · n_bins + bin]
+    std::vector<BinSums> recent;       // [side · n_bins + bin], since the last widening
+    std::vector<BinAccumulator> bins;  // widened sums
+    std::uint64_t particles_since_widening = 0;
     std::array<std::array<Fixed, 3>, kBudgetTerms> budget{};
     std::array<Fixed, 3> reflected_sq{}, transmitted_sq{};
     std::uint64_t events = 0, degenerate = 0;
 
-    explicit Tally(std::size_t n_bins) : bins(2 * n_bins) {}
+    explicit Tally(std::size_t n_bins) : recent(2 * n_bins), bins(2 * n_bins) {}
 
     void exit(std::size_t index, const Rgbf& flux) {
-        BinAccumulator& acc = bins[index];
+        LAMINA_DCHECK(flux.max() <= 4.f);
+        BinSums& acc = recent[index];
         for (int c = 0; c < 3; ++c) {
             const double x = flux[c];
-            acc.sum[c] += to_fixed(x);
-            acc.sum_sq[c] += to_fixed(x * x);
+            acc.sum[c] += std::llrint(x * kSumScale);
+            acc.sum_sq[c] += std::llrint(x * x * kSqScale);
         }
+    }
+    void widen() {
+        for (std::size_t i = 0; i < bins.size(); ++i) {
+            for (int c = 0; c < 3; ++c) {
+                bins[i].sum[c] += recent[i].sum[c];
+                bins[i].sum_sq[c] += recent[i].sum_sq[c];
+            }
+            recent[i] = BinSums{};
+        }
+        particles_since_widening = 0;
+    }
+    void count_particles(std::uint64_t n) {
+        particles_since_widening += n;
+        if (particles_since_widening >= kFlushParticles) widen();
     }
     void add_block(const BlockBudget& b) {
         for (int t = 0; t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c)
-                budget[t][c] += to_fixed_wide(b.term[t][c]);
+            for (int c = 0; c < 3; ++c) budget[t][c] += to_fixed_wide(b.term[t][c]);
         for (int c = 0; c < 3; ++c) {
             reflected_sq[c] += to_fixed_wide(b.reflected_sq[c]);
             transmitted_sq[c] += to_fixed_wide(b.transmitted_sq[c]);
         }
     }
-    void merge(const Tally& o) {
+    void merge(Tally& o) {
+        o.widen();
         for (std::size_t i = 0; i < bins.size(); ++i)
             for (int c = 0; c < 3; ++c) {
                 bins[i].sum[c] += o.bins[i].sum[c];
                 bins[i].sum_sq[c] += o.bins[i].sum_sq[c];
             }
         for (int t = 0; t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c)
-                budget[t][c] += o.budget[t][c];
+            for (int c = 0; c < 3; ++c) budget[t][c] += o.budget[t][c];
         for (int c = 0; c < 3; ++c) {
             reflected_sq[c] += o.reflected_sq[c];
             transmitted_sq[c] += o.transmitted_sq[c];
@@ -268,43 +286,46 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
         ++events;
         const TraceLayer& layer = stack.layers[k];
         const Vec3f wi_local = -d;
-        std::optional<BsdfSample<float>> s;
+        // Applies a sample (taken by reference: no copy of the optional in the hot loop).
+        // weight = fresnel_weight (absorbed by an opaque base) · shadowing (lost on the
+        // microsurface); a missing sample is a numerical degeneracy, counted and reported.
+        auto apply = [&](const std::optional<BsdfSample<float>>& s, bool opaque) {
+            if (!s) {
+                ++tally.degenerate;
+                losses.add(BudgetTerm::LostMicrosurface, w);
+                w = Rgbf(0.f);
+                return;
+            }
+            if (opaque) {  // a dielectric's fresnel_weight is 1
+                const Rgbf kept = w * s->fresnel_weight;
+                losses.add(BudgetTerm::AbsorbedBase, w - kept);
+                w = kept;
+            }
+            if (s->shadowing != 1.f) {
+                const Rgbf kept = w * s->shadowing;
+                losses.add(BudgetTerm::LostMicrosurface, w - kept);
+                w = kept;
+            }
+            d = s->wo;
+        };
         switch (layer.type) {
             case InterfaceType::Dielectric: {
                 const float uc = rng.uniform_float(), u1 = rng.uniform_float(),
                             u2 = rng.uniform_float();
-                s = layer.dielectric.sample<false>(wi_local, uc, u1, u2);
+                apply(layer.dielectric.sample<false>(wi_local, uc, u1, u2), false);
                 break;
             }
             case InterfaceType::Conductor: {
                 const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
-                s = layer.conductor.sample<false>(wi_local, u1, u2);
+                apply(layer.conductor.sample<false>(wi_local, u1, u2), true);
                 break;
             }
             case InterfaceType::Lambertian: {
                 const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
-                s = layer.lambertian.sample(wi_local, u1, u2);
+                apply(layer.lambertian.sample(wi_local, u1, u2), true);
                 break;
             }
         }
-        if (!s) {  // a numerical degeneracy: counted and reported, its flux dropped as lost
-            ++tally.degenerate;
-            losses.add(BudgetTerm::LostMicrosurface, w);
-            break;
-        }
-        // weight = fresnel_weight (absorbed by an opaque base) · shadowing (lost on the
-        // microsurface)
-        if (layer.type != InterfaceType::Dielectric) {  // a dielectric's fresnel_weight is 1
-            const Rgbf kept = w * s->fresnel_weight;
-            losses.add(BudgetTerm::AbsorbedBase, w - kept);
-            w = kept;
-        }
-        if (s->shadowing != 1.f) {
-            const Rgbf kept = w * s->shadowing;
-            losses.add(BudgetTerm::LostMicrosurface, w - kept);
-            w = kept;
-        }
-        d = s->wo;
         if (is_black(w)) break;
         if (d.z == 0) {
             // An exactly grazing direction (a sampler at the edge of its domain, probability
@@ -398,6 +419,7 @@ SimulationResult simulate(const Stack& stack, const SimulationSettings& settings
                     trace_particle(trace, grid, wi, rng, settings.max_events, local, block);
                 }
                 local.add_block(block);
+                local.count_particles(hi - lo);
                 if (on_progress) on_progress(hi - lo);
             }
 #pragma omp critical
@@ -414,8 +436,8 @@ SimulationResult simulate(const Stack& stack, const SimulationSettings& settings
                 const double omega = grid.projected_solid_angle(j);
                 const BinAccumulator& acc = total.bins[side * grid.size() + j];
                 for (int c = 0; c < 3; ++c) {
-                    const double mean = from_fixed(acc.sum[c]) * inv_n;
-                    const double mean_sq = from_fixed(acc.sum_sq[c]) * inv_n;
+                    const double mean = double(acc.sum[c]) / kSumScale * inv_n;
+                    const double mean_sq = double(acc.sum_sq[c]) / kSqScale * inv_n;
                     // Standard error of the mean of N per-particle contributions.
                     const double var = std::max(0.0, mean_sq - mean * mean);
                     lobe.f[j][c] = mean / omega;
@@ -425,12 +447,12 @@ SimulationResult simulate(const Stack& stack, const SimulationSettings& settings
         }
         for (int t = 0; t < kBudgetTerms; ++t)
             for (int c = 0; c < 3; ++c)
-                stats.budget.term[t][c] = from_fixed(total.budget[t][c]) * inv_n;
+                stats.budget.term[t][c] = double(total.budget[t][c]) / kBudgetScale * inv_n;
         for (int c = 0; c < 3; ++c) {
             const double r = stats.budget.term[int(BudgetTerm::Reflected)][c];
             const double t = stats.budget.term[int(BudgetTerm::Transmitted)][c];
-            const double r2 = from_fixed(total.reflected_sq[c]) * inv_n;
-            const double t2 = from_fixed(total.transmitted_sq[c]) * inv_n;
+            const double r2 = double(total.reflected_sq[c]) / kBudgetScale * inv_n;
+            const double t2 = double(total.transmitted_sq[c]) / kBudgetScale * inv_n;
             const double dn = n > 1 ? double(n - 1) : 1.0;
             stats.budget.reflected_se[c] = std::sqrt(std::max(0.0, r2 - r * r) / dn);
             stats.budget.transmitted_se[c] = std::sqrt(std::max(0.0, t2 - t * t) / dn);
