@@ -48,10 +48,10 @@ inline T length(const Vec3<T>& v) {
     return std::sqrt(dot(v, v));
 }
 
-/// Unit vector along v. v must be non-zero.
+/// Unit vector along v. v must be non-zero. (One division: v times the reciprocal length.)
 template <typename T>
 inline Vec3<T> normalize(const Vec3<T>& v) {
-    return v / length(v);
+    return v * (T(1) / length(v));
 }
 
 /// Mirror of w about z = 0 (used for transmitted lobes drawn as mirrored reflection lobes).

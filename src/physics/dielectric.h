@@ -24,6 +24,7 @@ struct DielectricInterface {
     bool uncorrelated_shadowing = false;
 
     bool is_smooth() const { return alpha == 0; }
+    T inv_eta() const { return T(1) / eta; }
     GGX<T> distribution() const { return {alpha}; }
 
     /// η(wo's side) / η(wi's side) — the ratio that appears in the refraction Jacobian.
@@ -100,7 +101,7 @@ struct DielectricInterface {
         const GGX<T> ggx = distribution();
         const Vec3<T> wm = ggx.sample_visible_normal_caps(wi, u1, u2);
         const T cos_i_m = dot(wi, wm);  // < 0 when wi is below: seen from the other side
-        const FresnelDielectric<T> fr = fresnel_dielectric_full(cos_i_m, eta);
+        const FresnelDielectric<T> fr = fresnel_dielectric_full(cos_i_m, eta, inv_eta());
         BsdfSample<T> s;
         if (uc < fr.reflectance) {
             s.wo = reflect(wi, wm);
@@ -109,8 +110,8 @@ struct DielectricInterface {
             // Snell about wm (fresnel.h refract), reusing the refracted cosine: with m = ±wm on
             // wi's side, wt = −wi/η + m (cos θi/η − cos θt).
             const T sign = cos_i_m < 0 ? T(-1) : T(1);
-            const T inv_eta = T(1) / fr.eta;
-            s.wo = wi * (-inv_eta) + wm * (sign * (std::abs(cos_i_m) * inv_eta - fr.cos_theta_t));
+            s.wo = wi * (-fr.inv_eta) +
+                   wm * (sign * (std::abs(cos_i_m) * fr.inv_eta - fr.cos_theta_t));
             s.is_transmission = true;
             if (same_hemisphere(wi, s.wo) || s.wo.z == 0) return lost_to_microsurface(s);
         }

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <complex>
 #include <optional>
+#include <utility>
 
 namespace lamina {
 
@@ -21,8 +22,12 @@ template <typename T>
 struct FresnelDielectric {
     T reflectance;
     T cos_theta_t;
-    T eta;
+    T eta;      ///< the relative index crossed
+    T inv_eta;  ///< its reciprocal
 };
+
+template <typename T>
+inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_eta);
 
 /// Exact unpolarized Fresnel reflectance of a dielectric interface (the mean of the s and p
 /// reflectances; Born & Wolf, Principles of Optics, §1.5.2, Eqs. 21a–b), with the refracted cosine.
@@ -31,20 +36,26 @@ struct FresnelDielectric {
 /// eta > 0. The reflectance is 1 under total internal reflection (sin θt ≥ 1).
 template <typename T>
 inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta) {
+    return fresnel_dielectric_full(cos_theta_i, eta, T(1) / eta);
+}
+
+/// The same with 1/eta supplied (interfaces keep it, saving a division per event).
+template <typename T>
+inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_eta) {
     cos_theta_i = clamp(cos_theta_i, T(-1), T(1));
     if (cos_theta_i < 0) {
-        eta = T(1) / eta;
+        std::swap(eta, inv_eta);
         cos_theta_i = -cos_theta_i;
     }
-    const T sin2_theta_t = (T(1) - sqr(cos_theta_i)) / sqr(eta);
-    if (sin2_theta_t >= T(1)) return {T(1), T(0), eta};  // total internal reflection
+    const T sin2_theta_t = (T(1) - sqr(cos_theta_i)) * sqr(inv_eta);
+    if (sin2_theta_t >= T(1)) return {T(1), T(0), eta, inv_eta};  // total internal reflection
     const T cos_theta_t = safe_sqrt(T(1) - sin2_theta_t);
     // r_parallel = a/b, r_perpendicular = c/d; (a²d² + c²b²) / (b²d²) needs a single division.
     const T a = eta * cos_theta_i - cos_theta_t, b = eta * cos_theta_i + cos_theta_t;
     const T c = cos_theta_i - eta * cos_theta_t, d = cos_theta_i + eta * cos_theta_t;
     const T b2d2 = sqr(b * d);
     const T reflectance = b2d2 > 0 ? (sqr(a * d) + sqr(c * b)) / (T(2) * b2d2) : T(1);
-    return {reflectance, cos_theta_t, eta};
+    return {reflectance, cos_theta_t, eta, inv_eta};
 }
 
 /// Exact unpolarized Fresnel reflectance of a dielectric interface; see fresnel_dielectric_full.
