@@ -40,4 +40,9 @@ Rgbd cos_weighted_average(const IncidentEvaluator& f, Side side, double u0, doub
                           double phi1, const std::vector<Vec3d>& peaks,
                           const BinnedOptions& options = {});
 
+/// Directional albedo ∫ f |cos θo| dωo of one side (RGB) for incidence wi, by the same adaptive
+/// rule over the whole hemisphere, plus the delta lobes' energies on that side.
+Rgbd model_albedo(const Model& model, const Vec3d& wi, Side side,
+                  const BinnedOptions& options = {});
+
 }  // namespace lamina

@@ -121,6 +121,7 @@ double fresnel_complex_fast(double cos_theta, double eta, double k) {
     const double t1 = a2_plus_b2 + cos2;
     const double a = safe_sqrt(0.5 * (a2_plus_b2 + t0));
     const double t2 = 2 * cos_theta * a;
+    if (t1 + t2 <= 0) return 1;  // grazing onto an index-matched interface: the limit c → 0
     const double rs = (t1 - t2) / (t1 + t2);
     const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
     const double t4 = t2 * sin2;
