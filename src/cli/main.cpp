@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
         commands.emplace_back(app.get_subcommands({}).back(), std::move(runner));
     };
     add(lamina::cli::add_validate);
+    add(lamina::cli::add_models);
+    add(lamina::cli::add_eval);
 
     CLI11_PARSE(app, argc, argv);
     try {

@@ -1,7 +1,7 @@
 #include "models/ww_family.h"
 
 #include "core/math.h"
-#include "physics/conductor.h"
+#include "models/fgd_table.h"
 #include "physics/dielectric.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
@@ -111,9 +111,9 @@ class WWModel final : public Model {
 
     Rgbd base_fresnel(double cos_theta) const {
         if (coat_.base_type == InterfaceType::Conductor)
-            return {fresnel_conductor(cos_theta, coat_.base_eta[0], coat_.base_k[0]),
-                    fresnel_conductor(cos_theta, coat_.base_eta[1], coat_.base_k[1]),
-                    fresnel_conductor(cos_theta, coat_.base_eta[2], coat_.base_k[2])};
+            return {fresnel_complex_fast(cos_theta, coat_.base_eta[0], coat_.base_k[0]),
+                    fresnel_complex_fast(cos_theta, coat_.base_eta[1], coat_.base_k[1]),
+                    fresnel_complex_fast(cos_theta, coat_.base_eta[2], coat_.base_k[2])};
         return Rgbd(fresnel_dielectric(cos_theta, coat_.base_eta[0]));
     }
 
@@ -122,9 +122,15 @@ class WWModel final : public Model {
         switch (coat_.base_type) {
             case InterfaceType::Lambertian:
                 return coat_.albedo * kInvPi<double>;
-            case InterfaceType::Conductor:
-                return ConductorInterface<double>{coat_.base_eta, coat_.base_k, base_alpha_}.eval(
-                    wi, wo);
+            case InterfaceType::Conductor: {
+                // Walter et al. 2007, Eq. 20 with the conductor Fresnel factor per channel (the
+                // closed form of fresnel_complex_fast: ConductorInterface::eval's std::complex
+                // path costs 3× more here).
+                if (base_alpha_ <= 0 || wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
+                const Vec3d h = normalize(wi + wo);
+                const GGX<double> ggx{base_alpha_};
+                return base_fresnel(dot(wi, h)) * (ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z));
+            }
             case InterfaceType::Dielectric:
                 return Rgbd(
                     DielectricInterface<double>{coat_.base_eta[0], base_alpha_}.eval(wi, wo));
