@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
     };
     add(lamina::cli::add_validate);
     add(lamina::cli::add_simulate);
+    add(lamina::cli::add_models);
+    add(lamina::cli::add_eval);
 
     CLI11_PARSE(app, argc, argv);
     try {

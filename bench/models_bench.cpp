@@ -1,0 +1,114 @@
+// Speed of the analytic models (docs/performance.md, "Models"): evaluations per second (single
+// thread) and the time to produce one binned table (7 incidences, 90x90, every supported side,
+// all OpenMP threads).
+#include "core/rng.h"
+#include "core/spherical.h"
+#include "models/binned.h"
+#include "models/fgd_table.h"
+#include "models/registry.h"
+#include "models/tir_table.h"
+
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <vector>
+
+namespace {
+
+using namespace lamina;
+
+Stack typical_stack(bool slab) {
+    // A rough clear coat (η 1.5, α 0.1) with some absorption over rough gold (α 0.2), or over a
+    // rough dielectric (η 1.33, α 0.2) for the slab.
+    Stack s;
+    Layer coat;
+    coat.interface.type = InterfaceType::Dielectric;
+    coat.interface.eta = 1.5;
+    coat.interface.alpha = 0.1;
+    coat.has_medium = true;
+    coat.medium.tau_a = Rgbd(0.05, 0.1, 0.2);
+    Layer base;
+    if (slab) {
+        base.interface.type = InterfaceType::Dielectric;
+        base.interface.eta = 1.33;
+    } else {
+        base.interface.type = InterfaceType::Conductor;
+        base.interface.eta_rgb = Rgbd(0.18, 0.42, 1.37);
+        base.interface.k = Rgbd(3.4, 2.35, 1.85);
+    }
+    base.interface.alpha = 0.2;
+    s.layers = {coat, base};
+    return s;
+}
+
+struct Pairs {
+    std::vector<Vec3d> wi, wo;
+    Pairs() {
+        ParticleRng rng(1, 0, 0);
+        for (int n = 0; n < 4096; ++n) {
+            wi.push_back(direction_from_angles(1.5 * rng.uniform_double(), 0.0));
+            wo.push_back(
+                direction_from_angles(1.5 * rng.uniform_double(), 6.283 * rng.uniform_double()));
+        }
+    }
+};
+
+void warm_tables() {
+    FgdTable::get();
+    TirTable::get();
+}
+
+/// Model::eval(wi, wo) for random pairs (the forward Belcour variants redo their lobe statistics
+/// per call here).
+void BM_ModelEval(benchmark::State& state, const std::string& name) {
+    warm_tables();
+    const auto model = make_model(name, typical_stack(false));
+    static const Pairs pairs;
+    std::size_t n = 0;
+    for (auto _ : state) {
+        const std::size_t i = n++ & 4095;
+        benchmark::DoNotOptimize(model->eval(pairs.wi[i], pairs.wo[i]));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+
+/// The prepared per-incidence evaluator (what the binned tables and the study use).
+void BM_ModelPreparedEval(benchmark::State& state, const std::string& name) {
+    warm_tables();
+    const auto model = make_model(name, typical_stack(false));
+    static const Pairs pairs;
+    const auto ev = model->prepare(pairs.wi[0]);
+    std::size_t n = 0;
+    for (auto _ : state)
+        benchmark::DoNotOptimize(ev->eval(pairs.wo[n++ & 4095]));
+    state.SetItemsProcessed(state.iterations());
+}
+
+/// One binned table: 7 incidences, 90x90 grid, both sides where supported.
+void BM_BinnedTable(benchmark::State& state, const std::string& name, bool slab) {
+    warm_tables();
+    const auto model = make_model(name, typical_stack(slab));
+    const HemisphereGrid grid(90, 90);
+    for (auto _ : state)
+        benchmark::DoNotOptimize(bin_model(*model, grid, {0, 15, 30, 45, 60, 70, 80}));
+    state.counters["threads"] = omp_get_max_threads();
+}
+
+const int registered = [] {
+    for (const auto& e : model_registry()) {
+        benchmark::RegisterBenchmark(("BM_ModelEval/" + e.name).c_str(), BM_ModelEval, e.name);
+        benchmark::RegisterBenchmark(("BM_ModelPreparedEval/" + e.name).c_str(),
+                                     BM_ModelPreparedEval, e.name);
+        benchmark::RegisterBenchmark(("BM_BinnedTable/" + e.name + "/coated-gold").c_str(),
+                                     BM_BinnedTable, e.name, false)
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+    }
+    benchmark::RegisterBenchmark("BM_BinnedTable/bel-prime/slab-both-sides", BM_BinnedTable,
+                                 std::string("bel-prime"), true)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    return 0;
+}();
+
+}  // namespace

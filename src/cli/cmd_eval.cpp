@@ -1,0 +1,192 @@
+// lamina eval: a model's BSDF at points, at a batch of directions, or averaged over the
+// goniophotometer's bins (docs/models.md, "Evaluating a model").
+#include "cli/commands.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/math.h"
+#include "core/spherical.h"
+#include "layers/stack.h"
+#include "models/binned.h"
+#include "models/registry.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace lamina::cli {
+
+namespace {
+
+struct EvalArgs {
+    std::string model, stack, theta_i, directions, out, grid = "90x90", side = "R";
+    double theta_o = std::nan(""), phi_o = std::nan("");
+    bool binned = false;
+    std::vector<std::string> options;
+};
+
+double parse_number(const std::string& text, const std::string& where, const std::string& field) {
+    const char* begin = text.c_str();
+    char* end = nullptr;
+    const double v = std::strtod(begin, &end);
+    if (text.empty() || end != begin + text.size() || !std::isfinite(v))
+        throw InputError(where, field, fmt::format("'{}' is not a finite number", text));
+    return v;
+}
+
+/// θ in degrees within [lo, hi) or [lo, hi] (closed_hi).
+void check_angle(double v, double lo, double hi, bool closed_hi, const std::string& where,
+                 const std::string& field) {
+    if (v < lo || (closed_hi ? v > hi : v >= hi))
+        throw InputError(
+            where, field,
+            fmt::format("{} degrees is outside [{}, {}{}", v, lo, hi, closed_hi ? "]" : ")"));
+}
+
+std::vector<double> parse_theta_list(const std::string& text) {
+    std::vector<double> out;
+    std::stringstream ss(text);
+    for (std::string item; std::getline(ss, item, ',');) {
+        const double v = parse_number(item, "command line", "--theta-i");
+        check_angle(v, 0, 90, false, "command line", "--theta-i");
+        out.push_back(v);
+    }
+    if (out.empty())
+        throw InputError("command line", "--theta-i", "expected a comma list of angles");
+    return out;
+}
+
+Side parse_side(const std::string& s, const std::string& where, const std::string& field) {
+    if (s == "R") return Side::Reflection;
+    if (s == "T") return Side::Transmission;
+    throw InputError(where, field, fmt::format("side '{}' must be R or T", s));
+}
+
+void require_side(const Model& model, Side side, const std::string& where) {
+    const Support s = model.support();
+    if (side == Side::Reflection ? !s.brdf : !s.btdf)
+        throw InputError(where, "--model",
+                         fmt::format("not supported: {} ({})", s.reason,
+                                     side == Side::Reflection ? "BRDF" : "BTDF"));
+}
+
+Rgbd eval_at(const Model& model, double theta_i, double theta_o, double phi_o, Side side) {
+    return model.eval(incident_direction(deg_to_rad(theta_i)),
+                      direction_from_angles(deg_to_rad(theta_o), deg_to_rad(phi_o), side));
+}
+
+int run_eval(const EvalArgs& a) {
+    const ModelEntry& entry = find_model(a.model);
+    const ModelOptions options = resolve_options(entry, a.options);
+    const int modes = int(a.binned) + int(!a.directions.empty());
+    if (modes > 1)
+        throw InputError("command line", "--binned",
+                         "--binned and --directions are different modes; use one");
+    if ((a.binned || !a.directions.empty()) && a.out.empty())
+        throw InputError("command line", "--out", "this mode writes a CSV file: give --out");
+
+    if (a.binned) {
+        const std::vector<double> thetas =
+            parse_theta_list(a.theta_i.empty() ? "0,15,30,45,60,70,80" : a.theta_i);
+        const HemisphereGrid grid = HemisphereGrid::parse(a.grid, "--grid");
+        const Stack stack = load_stack(a.stack);
+        const auto model = entry.make(stack, options);
+        const Support s = model->support();
+        if (!s.brdf && !s.btdf) throw InputError(a.stack, "--model", "not supported: " + s.reason);
+        write_file_atomic(a.out, bin_model(*model, grid, thetas).to_csv());
+        return 0;
+    }
+
+    if (!a.directions.empty()) {
+        std::ifstream in(a.directions);
+        if (!in) throw InputError(a.directions, "", "cannot read the file");
+        std::string line;
+        if (!std::getline(in, line) || line != "theta_i,theta_o,phi_o,side")
+            throw InputError(a.directions, "line 1",
+                             "expected the header 'theta_i,theta_o,phi_o,side'");
+        struct Row {
+            double ti, to, po;
+            Side side;
+            std::string text;
+        };
+        std::vector<Row> rows;
+        for (int n = 2; std::getline(in, line); ++n) {
+            if (!line.empty() && line.back() == '\r') line.pop_back();
+            if (line.empty()) continue;
+            std::vector<std::string> cells;
+            std::stringstream ls(line);
+            for (std::string c; std::getline(ls, c, ',');)
+                cells.push_back(c);
+            const std::string where = fmt::format("line {}", n);
+            if (cells.size() != 4)
+                throw InputError(a.directions, where,
+                                 fmt::format("expected 4 columns, found {}", cells.size()));
+            Row r{parse_number(cells[0], a.directions, where + ", theta_i"),
+                  parse_number(cells[1], a.directions, where + ", theta_o"),
+                  parse_number(cells[2], a.directions, where + ", phi_o"),
+                  parse_side(cells[3], a.directions, where + ", side"), line};
+            check_angle(r.ti, 0, 90, false, a.directions, where + ", theta_i");
+            check_angle(r.to, 0, 90, true, a.directions, where + ", theta_o");
+            rows.push_back(r);
+        }
+        const Stack stack = load_stack(a.stack);
+        const auto model = entry.make(stack, options);
+        std::string out = "theta_i,theta_o,phi_o,side,f_r,f_g,f_b\n";
+        for (const Row& r : rows) {
+            require_side(*model, r.side, a.stack);
+            const Rgbd f = eval_at(*model, r.ti, r.to, r.po, r.side);
+            fmt::format_to(std::back_inserter(out), "{},{},{},{}\n", r.text, f[0], f[1], f[2]);
+        }
+        write_file_atomic(a.out, out);
+        return 0;
+    }
+
+    // One point.
+    const std::vector<double> thetas = parse_theta_list(a.theta_i);
+    if (thetas.size() != 1)
+        throw InputError("command line", "--theta-i",
+                         "a point evaluation takes one angle (lists are for --binned)");
+    if (std::isnan(a.theta_o)) throw InputError("command line", "--theta-o", "required");
+    if (std::isnan(a.phi_o)) throw InputError("command line", "--phi-o", "required");
+    check_angle(a.theta_o, 0, 90, true, "command line", "--theta-o");
+    if (!std::isfinite(a.phi_o)) throw InputError("command line", "--phi-o", "must be finite");
+    const Side side = parse_side(a.side, "command line", "--side");
+    const Stack stack = load_stack(a.stack);
+    const auto model = entry.make(stack, options);
+    require_side(*model, side, a.stack);
+    const Rgbd f = eval_at(*model, thetas[0], a.theta_o, a.phi_o, side);
+    fmt::print("{} {} {}\n", f[0], f[1], f[2]);
+    return 0;
+}
+
+}  // namespace
+
+Runner add_eval(CLI::App& app) {
+    auto a = std::make_shared<EvalArgs>();
+    auto* cmd = app.add_subcommand(
+        "eval", "Evaluate an analytic model: at a point, a batch of directions, or on the bins");
+    cmd->add_option("--model", a->model, "Model name (see `lamina models`)")->required();
+    cmd->add_option("--stack", a->stack, "Stack JSON file")->required();
+    cmd->add_option("--theta-i", a->theta_i,
+                    "Incidence(s) in degrees, [0, 90); a comma list with --binned "
+                    "(default 0,15,30,45,60,70,80)");
+    cmd->add_option("--theta-o", a->theta_o, "Outgoing polar angle in degrees, [0, 90]");
+    cmd->add_option("--phi-o", a->phi_o, "Outgoing azimuth in degrees (mirror at 180)");
+    cmd->add_option("--side", a->side, "R (reflection) or T (transmission; θo from -z)");
+    cmd->add_option("--directions", a->directions,
+                    "CSV of directions: header theta_i,theta_o,phi_o,side");
+    cmd->add_flag("--binned", a->binned,
+                  "Cos-weighted bin averages in the goniophotometer's brdf.csv format");
+    cmd->add_option("--grid", a->grid, "Bins for --binned, NTHETAxNPHI (default 90x90)");
+    cmd->add_option("--out", a->out, "Output CSV (written atomically)");
+    cmd->add_option("--option", a->options,
+                    "Model flag KEY=VALUE, repeatable (see `lamina models --options`)");
+    return [a] { return run_eval(*a); };
+}
+
+}  // namespace lamina::cli

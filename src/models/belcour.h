@@ -1,0 +1,72 @@
+#pragma once
+// Belcour 2018, "Efficient rendering of layered materials using an atomic decomposition with
+// statistical operators", ACM TOG 37(4) (SIGGRAPH): the BRDF is a sum of GGX lobes, one per
+// interface, whose energies and roughnesses come from tracking three statistics of a lobe
+// (energy per RGB, mean cosine, scalar variance) through the stack with an adding–doubling
+// scheme (models.md, "Belcour 2018 and Bel'"; paper §4–6). Bel18 forward, Bel18 symmetric and
+// Bel' are one engine with the choices below; each has its own source file with its defaults.
+
+#include "models/model.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+struct BelcourChoices {
+    /// Cosine fed to the adding scheme: |wi·h| (symmetric, reciprocal) or μi (forward).
+    bool symmetric = false;
+    /// Total internal reflection below the top interface (paper §6), from the τ_TIR table.
+    bool tir = true;
+    /// Transmission variances: the author's code (false) or the paper's Eq. 10 (true).
+    bool sigma_t_paper = false;
+    /// Roughness ↔ variance: the author's σ = α^1.1/(1 − α^1.1) (false) or σ = α²/(1 − α²).
+    bool quadratic_mapping = false;
+    /// Bel': lobe 0 replaced by the exact reflection of the top interface.
+    bool exact_top = false;
+    /// Bel': the slab's BTDF as one mirrored GGX lobe.
+    bool btdf = false;
+};
+
+/// The statistics the adding scheme produces for one incident cosine.
+struct BelcourStats {
+    static constexpr int kMaxLobes = 8;
+    struct Lobe {
+        Rgbd energy{0.0};
+        double alpha = 0;
+    };
+    std::array<Lobe, kMaxLobes> lobes{};
+    int n_lobes = 0;
+    /// Energy leaving through the bottom (after the last dielectric), its roughness and the mean
+    /// cosine of its direction in the exit medium; valid when `transmits`.
+    Rgbd transmitted{0.0};
+    double alpha_t = 0;
+    double cos_t = 1;
+    bool transmits = false;
+};
+
+/// One operator of the stack, top to bottom: an interface or a medium.
+struct BelcourOperator {
+    enum Kind { Dielectric, Conductor, Medium } kind = Dielectric;
+    double n12 = 1;    ///< relative index (conductor: mean of η over RGB)
+    Rgbd eta{1.0};     ///< conductor: relative η per channel (dielectric: n12)
+    Rgbd k{0.0};       ///< conductor: relative κ per channel
+    double alpha = 0;  ///< GGX roughness of an interface
+    Rgbd tau_a{0.0}, tau_s{0.0};
+    double g = 0;  ///< HG mean cosine (mean over RGB)
+};
+
+/// Runs the adding scheme (models.md) for mean incident cosine c0 ∈ (0, 1].
+BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
+                            const BelcourChoices& choices);
+
+/// The flags of the engine, with the given defaults.
+std::vector<OptionSpec> belcour_option_specs(const BelcourChoices& defaults);
+/// Choices named by validated options (the variant-fixed ones, exact_top and btdf, from `base`).
+BelcourChoices belcour_choices(const ModelOptions& options, BelcourChoices base);
+
+std::unique_ptr<Model> make_belcour_model(std::string model_name, const Stack& stack,
+                                          const BelcourChoices& choices);
+
+}  // namespace lamina

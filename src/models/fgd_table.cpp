@@ -1,0 +1,180 @@
+#include "models/fgd_table.h"
+
+#include "core/math.h"
+#include "models/quadrature.h"
+#include "models/table_cache.h"
+#include "physics/fresnel.h"
+#include "physics/microfacet.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+
+namespace lamina {
+
+namespace {
+
+constexpr int kBins = 64;     // x = wi·wm bins per (c, α)
+constexpr int kTableNr = 48;  // Gauss–Legendre nodes in r (weight 2r) on Heitz's disk
+constexpr int kTableNphi = 64;
+constexpr double kCMin = 1e-4;      // c = 0 is evaluated at this cosine (G1 → 0 at grazing)
+constexpr double kAlphaMin = 1e-5;  // α = 0 is evaluated at this roughness (the smooth limit)
+constexpr const char* kCodeVersion = "fgd-v4";
+
+// c and α are tabulated on squared axes (node = s², s uniform): the shadowing at grazing varies
+// on the scale c ~ α, which needs dense nodes near 0 on both axes.
+double c_node(int i) {
+    return std::max(kCMin, sqr(double(i) / (FgdTable::kNc - 1)));
+}
+double alpha_node(int i) {
+    return std::max(kAlphaMin, sqr(double(i) / (FgdTable::kNalpha - 1)));
+}
+double eta_node(int i) {
+    return std::exp2(FgdTable::kLog2EtaMin +
+                     (FgdTable::kLog2EtaMax - FgdTable::kLog2EtaMin) * i / (FgdTable::kNeta - 1));
+}
+double k_node(int i) {
+    return FgdTable::kKMax * sqr(double(i) / (FgdTable::kNk - 1));
+}
+
+/// Calls visit(x = wi·wm, weight·G2/G1) for each node of the n_r × n_phi visible-normal rule.
+template <typename Visit>
+void visible_normal_rule(double c, double alpha, int n_r, int n_phi, Visit&& visit) {
+    const Vec3d wi(safe_sqrt(1 - c * c), 0, c);
+    const GGX<double> ggx{alpha};
+    const QuadratureRule qr = gauss_legendre(n_r);
+    const double G1i = ggx.G1(wi);
+    for (int a = 0; a < n_r; ++a) {
+        const double r = qr.x[a];
+        const double wr = qr.w[a] * 2 * r;  // ∫ g du1 with u1 = r²
+        for (int b = 0; b < n_phi; ++b) {
+            const double u2 = (b + 0.5) / n_phi;  // trapezoid rule for the periodic φ
+            const Vec3d wm = ggx.sample_visible_normal(wi, r * r, u2);
+            const Vec3d wo = reflect(wi, wm);
+            if (wo.z <= 0) continue;
+            visit(dot(wi, wm), wr / n_phi * ggx.G2(wi, wo) / G1i);
+        }
+    }
+}
+
+/// Weight of the control variate F(c): 1 for smooth interfaces, fading out by α ≈ 0.1.
+double smooth_weight(double alpha) {
+    return std::exp(-alpha / 0.03);
+}
+
+double fresnel_any(double x, double eta, double k) {
+    return k == 0 ? fresnel_dielectric(x, eta) : fresnel_complex_fast(x, eta, k);
+}
+
+std::vector<float> compute_fgd() {
+    using T = FgdTable;
+    std::vector<float> v(std::size_t(T::kNc) * T::kNalpha * T::kNeta * T::kNk);
+#pragma omp parallel for schedule(dynamic) collapse(2)
+    for (int ic = 0; ic < T::kNc; ++ic) {
+        for (int ia = 0; ia < T::kNalpha; ++ia) {
+            std::array<double, kBins> W{}, X{};
+            visible_normal_rule(c_node(ic), alpha_node(ia), kTableNr, kTableNphi,
+                                [&](double x, double w) {
+                                    const int b = std::min(kBins - 1, int(x * kBins));
+                                    W[b] += w;
+                                    X[b] += w * x;
+                                });
+            int nb = 0;
+            std::array<double, kBins> Wc{}, Xc{};
+            for (int b = 0; b < kBins; ++b)
+                if (W[b] > 0) {
+                    Wc[nb] = W[b];
+                    Xc[nb] = X[b] / W[b];
+                    ++nb;
+                }
+            for (int ie = 0; ie < T::kNeta; ++ie) {
+                const double eta = eta_node(ie);
+                for (int ik = 0; ik < T::kNk; ++ik) {
+                    const double k = k_node(ik);
+                    double sum = 0;
+                    for (int b = 0; b < nb; ++b)
+                        sum += Wc[b] * fresnel_any(Xc[b], eta, k);
+                    // Stored as the residual from w(α)·F(c), the smooth limit (a control variate
+                    // that fades out with roughness): the lookup adds the exact w(α)F(c) back, so
+                    // the step-like kink of F at the critical angle (η < 1) is not interpolated
+                    // where the lobe is narrow enough to keep it.
+                    sum -= smooth_weight(alpha_node(ia)) * fresnel_any(c_node(ic), eta, k);
+                    v[((std::size_t(ic) * T::kNalpha + ia) * T::kNeta + ie) * T::kNk + ik] =
+                        float(sum);
+                }
+            }
+        }
+    }
+    return v;
+}
+
+}  // namespace
+
+double fresnel_complex_fast(double cos_theta, double eta, double k) {
+    cos_theta = clamp(cos_theta, 0.0, 1.0);
+    const double cos2 = cos_theta * cos_theta;
+    const double sin2 = 1 - cos2;
+    const double eta2 = eta * eta, k2 = k * k;
+    const double t0 = eta2 - k2 - sin2;
+    const double a2_plus_b2 = std::sqrt(t0 * t0 + 4 * eta2 * k2);
+    const double t1 = a2_plus_b2 + cos2;
+    const double a = safe_sqrt(0.5 * (a2_plus_b2 + t0));
+    const double t2 = 2 * cos_theta * a;
+    if (t1 + t2 <= 0) return 1;  // grazing onto an index-matched interface: the limit c → 0
+    const double rs = (t1 - t2) / (t1 + t2);
+    const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
+    const double t4 = t2 * sin2;
+    const double rp = rs * (t3 - t4) / (t3 + t4);
+    return 0.5 * (rp + rs);
+}
+
+double FgdTable::direct(double c, double alpha, double eta, double k, int n_r, int n_phi) {
+    if (alpha <= 0) return fresnel_any(c, eta, k);
+    double sum = 0;
+    visible_normal_rule(std::max(c, kCMin), alpha, n_r, n_phi,
+                        [&](double x, double w) { sum += w * fresnel_any(x, eta, k); });
+    return sum;
+}
+
+FgdTable::FgdTable() {
+    const TableKey key{"fgd",
+                       fmt::format("{} c{} a{} e{}:{}:{} k{}:{} bins{} nr{} nphi{} cmin{} amin{}",
+                                   kCodeVersion, kNc, kNalpha, kNeta, kLog2EtaMin, kLog2EtaMax, kNk,
+                                   kKMax, kBins, kTableNr, kTableNphi, kCMin, kAlphaMin),
+                       {kNc, kNalpha, kNeta, kNk}};
+    values_ = cached_table(key, compute_fgd);
+    data_ = values_.data();
+}
+
+const FgdTable& FgdTable::get() {
+    static const FgdTable table;  // thread-safe initialization (C++11 magic statics)
+    return table;
+}
+
+double FgdTable::operator()(double c, double alpha, double eta, double k) const {
+    if (alpha <= 0) return fresnel_any(c, eta, k);  // the smooth limit is exact Fresnel
+    const double fc = std::sqrt(clamp(c, 0.0, 1.0)) * (kNc - 1);
+    const double fa = std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1);
+    const double fe = (clamp(std::log2(eta), kLog2EtaMin, kLog2EtaMax) - kLog2EtaMin) /
+                      (kLog2EtaMax - kLog2EtaMin) * (kNeta - 1);
+    const double fk = std::sqrt(clamp(k, 0.0, kKMax) / kKMax) * (kNk - 1);
+    const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2),
+              ie = std::min(int(fe), kNeta - 2), ik = std::min(int(fk), kNk - 2);
+    const double tc = fc - ic, ta = fa - ia, te = fe - ie, tk = fk - ik;
+    double sum = 0;
+    for (int dc = 0; dc < 2; ++dc) {
+        const double wc = dc ? tc : 1 - tc;
+        for (int da = 0; da < 2; ++da) {
+            const double wa = wc * (da ? ta : 1 - ta);
+            const float* row =
+                data_ + ((std::size_t(ic + dc) * kNalpha + (ia + da)) * kNeta + ie) * kNk + ik;
+            const double v0 = (1 - tk) * row[0] + tk * row[1];
+            const double v1 = (1 - tk) * row[kNk] + tk * row[kNk + 1];
+            sum += wa * ((1 - te) * v0 + te * v1);
+        }
+    }
+    return clamp(sum + smooth_weight(alpha) * fresnel_any(c, eta, k), 0.0, 1.0);
+}
+
+}  // namespace lamina

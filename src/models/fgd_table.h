@@ -1,0 +1,52 @@
+#pragma once
+// FGD(c, α, η, κ): the directional albedo of a single GGX microfacet reflection lobe with exact
+// Fresnel (Belcour 2018, §5.1 and supplemental: the tabulated "FGD" term),
+//
+//     FGD = ∫ F(wi·h; η + iκ) D_α(h) G2_α(wi, wo) / (4 μi μo) μo dωo,   μi = c,
+//
+// with the height-correlated G2 (Heitz 2014, Eq. 99) and relative index η + iκ (κ = 0: dielectric,
+// η < 1 included: light from the denser side, with total internal reflection). lamina computes it
+// itself (never copies the author's table): for each (c, α) the integral is written over the
+// visible normals (Heitz 2018), FGD = ∫ D_wi(wm) F(wi·wm) G2/G1(wi) dwm, evaluated by a product
+// Gauss–Legendre (in r, weight 2r) × trapezoid (in φ) rule on Heitz's sampling disk, whose nodes
+// are then grouped by x = wi·wm into 64 bins (weight and weighted mean x): FGD = Σ_b W_b F(x̄_b).
+// The Fresnel factor only depends on x, so one set of bins serves every (η, κ).
+//
+// Axes (docs/models.md has the measured accuracy): c = s² (41 nodes, s uniform in [0, 1]),
+// α = s² (33 nodes), log2 η ∈ [−5, 3] (81, η = 1 is a node), κ = 10 s², s ∈ [0, 1] (21); outside,
+// the arguments are clamped. Multilinear interpolation; α = 0 returns the exact Fresnel factor.
+// Computed on first use (≈1 s on 2 cores) and cached on disk (models/table_cache.h).
+
+#include <vector>
+
+namespace lamina {
+
+class FgdTable {
+  public:
+    /// The process-wide table (computed or loaded once, thread-safe).
+    static const FgdTable& get();
+
+    /// Interpolated FGD. c = cos θi ∈ [0, 1], α ∈ [0, 1], η > 0, κ ≥ 0 (clamped to the axes).
+    double operator()(double c, double alpha, double eta, double k) const;
+
+    /// The same integral computed directly (no table, no binning) with an n_r × n_phi rule: the
+    /// reference the table is tested against.
+    static double direct(double c, double alpha, double eta, double k, int n_r = 96,
+                         int n_phi = 128);
+
+    static constexpr int kNc = 41, kNalpha = 33, kNeta = 81, kNk = 21;
+    static constexpr double kLog2EtaMin = -5, kLog2EtaMax = 3, kKMax = 10;
+
+  private:
+    FgdTable();
+    const float* data_;
+    std::vector<float> values_;
+};
+
+/// Unpolarized Fresnel reflectance for a complex relative index η + iκ with light arriving from
+/// the real (dielectric) side at cos_theta ∈ [0, 1]: the closed form in a², b² (Pharr, Jakob &
+/// Humphreys, PBR 3rd ed., §8.2.1, FrConductor; after Born & Wolf §14.2). With κ = 0 and η < 1 it
+/// gives 1 under total internal reflection. Equal to fresnel_conductor, about 4× faster.
+double fresnel_complex_fast(double cos_theta, double eta, double k);
+
+}  // namespace lamina

@@ -1,0 +1,115 @@
+#pragma once
+// The analytic layered BRDF models lamina compares (docs/models.md; ../shared/models.md).
+//
+// A Model is built for one Stack and one set of Options (the documented ablation flags) and then
+// evaluated like any BSDF in lamina (physics/bsdf.h): eval(wi, wo) is the radiance BSDF from the
+// light direction wi to the viewer wo, in 1/sr, cosine excluded; wo below the surface is the BTDF.
+// Construction never fails for a well-formed stack: a configuration the model cannot represent
+// reports support().brdf/btdf = false with the reason, and the callers (eval, the study) report
+// "not supported: reason" instead of using its (zero) values.
+//
+// Smooth interfaces give delta lobes, which eval() leaves out (their value is infinite at one
+// direction); delta_lobes(wi) lists them with their energies so that bin averages can add
+// energy / Ω⊥ to the bin they hit. Virtual calls are fine here: this is not the particle hot path.
+// Nothing in eval/prepare/delta_lobes throws.
+
+#include "core/rgb.h"
+#include "core/vec.h"
+#include "layers/stack.h"
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+/// The ablation flags of a model: key → value, validated against the model's OptionSpecs.
+using ModelOptions = std::map<std::string, std::string>;
+
+/// One flag a model accepts: its key, allowed values, default, and what it changes.
+struct OptionSpec {
+    std::string key;
+    std::vector<std::string> values;
+    std::string default_value;
+    std::string help;
+};
+
+/// What a model can represent for its stack.
+struct Support {
+    bool brdf = false;
+    bool btdf = false;
+    /// Why brdf or btdf is false (empty when both are supported).
+    std::string reason;
+};
+
+/// A delta lobe (smooth interfaces): all its energy leaves along `direction`.
+struct DeltaLobe {
+    Vec3d direction;
+    /// ∫ f |cos θo| dωo over the lobe: the flux fraction it carries (RGB).
+    Rgbd energy;
+};
+
+/// A model with everything that depends only on the incident direction already computed (e.g.
+/// the lobe statistics of the forward Belcour variants). eval(wo) == Model::eval(wi, wo).
+class IncidentEvaluator {
+  public:
+    virtual ~IncidentEvaluator() = default;
+    virtual Rgbd eval(const Vec3d& wo) const = 0;
+};
+
+class Model {
+  public:
+    virtual ~Model() = default;
+
+    virtual std::string name() const = 0;
+    virtual Support support() const = 0;
+
+    /// Radiance BSDF (1/sr, no cosine), delta lobes excluded. wi.z > 0; wo on either side. Zero
+    /// on a side the model does not support (check support() first).
+    virtual Rgbd eval(const Vec3d& wi, const Vec3d& wo) const = 0;
+
+    /// Per-incidence precomputation; the default simply forwards to eval(wi, ·).
+    virtual std::unique_ptr<IncidentEvaluator> prepare(const Vec3d& wi) const;
+
+    /// Delta lobes for incidence wi (empty when every interface the model uses is rough).
+    virtual std::vector<DeltaLobe> delta_lobes(const Vec3d& /*wi*/) const { return {}; }
+
+    /// Directions where the model's lobes peak (narrow lobes hide there): binned quadrature always
+    /// refines towards them. Default: the mirror direction of wi.
+    virtual std::vector<Vec3d> peak_directions(const Vec3d& wi) const;
+};
+
+/// Mirror direction of wi about the macro normal.
+inline Vec3d mirror_direction(const Vec3d& wi) {
+    return {-wi.x, -wi.y, wi.z};
+}
+
+/// Reads an option's value (the registry has already validated and filled in every default).
+const std::string& option_value(const ModelOptions& options, const std::string& key);
+
+/// The stack shape of the Weidlich–Wilkie family and of WW' (models.md): ambient | dielectric
+/// coat (eta0, alpha0) | optional medium | base. Indices are relative: eta0 = η_coat/η_ambient;
+/// the base's eta/k are relative to the coat (physics.md §2).
+struct CoatedStack {
+    double eta0 = 1.5;
+    double alpha0 = 0.0;
+    Rgbd tau_a{0.0};
+    Rgbd tau_s{0.0};
+    Rgbd g{0.0};
+    InterfaceType base_type = InterfaceType::Lambertian;
+    Rgbd base_eta{1.0};  ///< relative to the coat (conductor: RGB; dielectric: all equal)
+    Rgbd base_k{0.0};
+    double base_alpha = 0.0;
+    Rgbd albedo{0.0};
+};
+
+/// Extracts the coated shape, or explains (in `why`) why the stack has another shape.
+bool coated_stack(const Stack& stack, CoatedStack& out, std::string& why);
+
+/// exp of each channel.
+inline Rgbd exp_rgb(const Rgbd& x) {
+    return {std::exp(x[0]), std::exp(x[1]), std::exp(x[2])};
+}
+
+}  // namespace lamina

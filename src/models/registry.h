@@ -1,0 +1,39 @@
+#pragma once
+// The one table of analytic models (style.md §12: an explicit registry, like Tungsten's
+// BsdfFactory, no static self-registration). `lamina models`, `lamina eval`, the study and the
+// explorer all find models here. Adding a model = one source file with its factory and options
+// (declared in models/factories.h) + one line in registry.cpp.
+
+#include "models/model.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+struct ModelEntry {
+    std::string name;
+    std::string description;  ///< one line
+    std::string supports;     ///< bases and sides, one line
+    std::vector<OptionSpec> (*options)();
+    std::unique_ptr<Model> (*make)(const Stack& stack, const ModelOptions& options);
+};
+
+/// Every model, in the order `lamina models` lists them.
+const std::vector<ModelEntry>& model_registry();
+
+/// The entry called `name`; InputError (naming `field`) listing the known names otherwise.
+const ModelEntry& find_model(const std::string& name, const std::string& field = "--model");
+
+/// Validates `key=value` assignments against the model's options and fills in the defaults.
+/// InputError naming `field` for a malformed assignment, an unknown key (listing the known ones)
+/// or a value outside the allowed ones.
+ModelOptions resolve_options(const ModelEntry& entry, const std::vector<std::string>& assignments,
+                             const std::string& field = "--option");
+
+/// find_model + resolve_options + make.
+std::unique_ptr<Model> make_model(const std::string& name, const Stack& stack,
+                                  const std::vector<std::string>& assignments = {});
+
+}  // namespace lamina

@@ -1,0 +1,217 @@
+#include "models/ww_family.h"
+
+#include "core/math.h"
+#include "models/fgd_table.h"
+#include "physics/dielectric.h"
+#include "physics/fresnel.h"
+#include "physics/microfacet.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <optional>
+
+namespace lamina {
+
+namespace {
+
+const char* on_off(bool b) {
+    return b ? "on" : "off";
+}
+
+class WWModel final : public Model {
+  public:
+    WWModel(std::string name, const Stack& stack, const WWChoices& choices)
+        : name_(std::move(name)), choices_(choices) {
+        std::string why;
+        if (!coated_stack(stack, coat_, why)) {
+            support_.reason = fmt::format("{} {}", name_, why);
+            return;
+        }
+        if (coat_.tau_s.max() > 0) {
+            support_.reason = fmt::format("{} has no scattering medium", name_);
+            return;
+        }
+        support_.brdf = true;
+        if (coat_.base_type == InterfaceType::Dielectric)
+            support_.reason = fmt::format("{} gives only the slab's reflection (no BTDF)", name_);
+        // Elek 2010, Algorithm 1: the base is at least as rough as the coat.
+        base_alpha_ =
+            choices_.max_roughness ? std::max(coat_.alpha0, coat_.base_alpha) : coat_.base_alpha;
+        has_absorption_ = coat_.tau_a.max() > 0;
+    }
+
+    std::string name() const override { return name_; }
+    Support support() const override { return support_; }
+
+    Rgbd eval(const Vec3d& wi, const Vec3d& wo) const override {
+        if (!support_.brdf || wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
+        const Vec3d h = normalize(wi + wo);
+        Rgbd f(0.0);
+        const GGX<double> ggx0{coat_.alpha0};
+        const double G0 = coat_.alpha0 > 0 ? ggx0.G2(wi, wo) : 1.0;
+        // Top reflection (models.md; Walter et al. 2007, Eq. 20); a delta lobe when smooth.
+        if (coat_.alpha0 > 0)
+            f = Rgbd(fresnel_dielectric(dot(wi, h), coat_.eta0) * ggx0.D(h) * G0 /
+                     (4 * wi.z * wo.z));
+        if (base_is_delta()) return f;
+        const std::optional<Rgbd> base = base_term(wi, wo, h, G0);
+        return base ? f + *base : f;
+    }
+
+    std::vector<DeltaLobe> delta_lobes(const Vec3d& wi) const override {
+        std::vector<DeltaLobe> lobes;
+        if (!support_.brdf || wi.z <= 0) return lobes;
+        const Vec3d wr = mirror_direction(wi);
+        if (coat_.alpha0 == 0) lobes.push_back({wr, Rgbd(fresnel_dielectric(wi.z, coat_.eta0))});
+        if (base_is_delta()) {
+            // A smooth base under the coat: its mirror lobe leaves along wr. In the delta limit
+            // f_base = F_b δ(wo* − r(wi*)) / μo*; with f_base at the refracted directions the
+            // delta is in the coat's solid angle, and ∫ ... μo dωo = η0² ∫ ... μo' dωo' (Snell's
+            // law of solid angles, η0² μo' dωo' = μo dωo) gives the factor η0² that the 1/η0² of
+            // WW' cancels. At the mirror pair h = n, so every variant's T01, T10 and refractions
+            // are the normal-incidence ones of wi.
+            const double G0 = coat_.alpha0 > 0 ? GGX<double>{coat_.alpha0}.G2(wi, wr) : 1.0;
+            const Vec3d n(0, 0, 1);
+            const auto in = refract_in(wi, n);
+            if (in) {
+                const Vec3d wb = choices_.base_at_outside ? wi : *in;
+                const Rgbd Fb = base_fresnel(wb.z);
+                const double T01 = 1 - fresnel_dielectric(wi.z, coat_.eta0);
+                const double T10 = T01;  // Fresnel is the same from both sides of one pair
+                const double t = choices_.exit_t_term ? (1 - G0) + T10 * G0 : T10;
+                const Rgbd a = absorption(in->z, in->z);
+                double scale = T01 * t;
+                if (choices_.eta2_factor) scale /= sqr(coat_.eta0);
+                if (!choices_.base_at_outside) scale *= sqr(coat_.eta0);
+                lobes.push_back({wr, Fb * a * scale});
+            }
+        }
+        return lobes;
+    }
+
+  private:
+    bool base_is_delta() const {
+        return coat_.base_type != InterfaceType::Lambertian && base_alpha_ == 0;
+    }
+
+    /// "Refract w about m" (models.md): the direction inside the coat, pointing away from the
+    /// base, whose refraction through the top interface is w; nothing if it does not exist.
+    std::optional<Vec3d> refract_in(const Vec3d& w, const Vec3d& m) const {
+        const auto t = refract(w, m, coat_.eta0);  // points down, into the coat
+        if (!t || t->z >= 0) return std::nullopt;
+        return -*t;
+    }
+
+    /// Beer–Lambert along both refracted paths: a = exp(−τ (1/μi' + 1/μo')).
+    Rgbd absorption(double mu_i, double mu_o) const {
+        if (!has_absorption_) return Rgbd(1.0);
+        return exp_rgb(coat_.tau_a * -(1 / mu_i + 1 / mu_o));
+    }
+
+    Rgbd base_fresnel(double cos_theta) const {
+        if (coat_.base_type == InterfaceType::Conductor)
+            return {fresnel_complex_fast(cos_theta, coat_.base_eta[0], coat_.base_k[0]),
+                    fresnel_complex_fast(cos_theta, coat_.base_eta[1], coat_.base_k[1]),
+                    fresnel_complex_fast(cos_theta, coat_.base_eta[2], coat_.base_k[2])};
+        return Rgbd(fresnel_dielectric(cos_theta, coat_.base_eta[0]));
+    }
+
+    /// The base's own BRDF (relative indices against the coat), rough or Lambertian.
+    Rgbd base_brdf(const Vec3d& wi, const Vec3d& wo) const {
+        switch (coat_.base_type) {
+            case InterfaceType::Lambertian:
+                return coat_.albedo * kInvPi<double>;
+            case InterfaceType::Conductor: {
+                // Walter et al. 2007, Eq. 20 with the conductor Fresnel factor per channel (the
+                // closed form of fresnel_complex_fast: ConductorInterface::eval's std::complex
+                // path costs 3× more here).
+                if (base_alpha_ <= 0 || wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
+                const Vec3d h = normalize(wi + wo);
+                const GGX<double> ggx{base_alpha_};
+                return base_fresnel(dot(wi, h)) * (ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z));
+            }
+            case InterfaceType::Dielectric:
+                return Rgbd(
+                    DielectricInterface<double>{coat_.base_eta[0], base_alpha_}.eval(wi, wo));
+        }
+        return Rgbd(0.0);
+    }
+
+    std::optional<Rgbd> base_term(const Vec3d& wi, const Vec3d& wo, const Vec3d& h,
+                                  double G0) const {
+        const Vec3d n(0, 0, 1);
+        const Vec3d& m_fresnel = choices_.fresnel_at_h ? h : n;
+        const Vec3d& m_refract = choices_.refract_about_h ? h : n;
+        const auto in_i = refract_in(wi, m_refract);
+        const auto in_o = refract_in(wo, m_refract);
+        if (!in_i || !in_o) return std::nullopt;
+        // Fresnel transmittances; leaving through m from inside equals entering along wo
+        // (Fresnel reflectance is the same from both sides of one refraction pair).
+        const double T01 = 1 - fresnel_dielectric(dot(wi, m_fresnel), coat_.eta0);
+        const double T10 = 1 - fresnel_dielectric(dot(wo, m_fresnel), coat_.eta0);
+        // Weidlich & Wilkie 2007, §4.2: t = (1 − G) + T10·G lets shadowed light through
+        // unattenuated.
+        const double t = choices_.exit_t_term ? (1 - G0) + T10 * G0 : T10;
+        const Rgbd fb = choices_.base_at_outside ? base_brdf(wi, wo) : base_brdf(*in_i, *in_o);
+        double scale = T01 * t;
+        if (choices_.eta2_factor) scale /= sqr(coat_.eta0);  // Hanrahan & Krueger 1993, Eq. 8
+        return fb * absorption(in_i->z, in_o->z) * scale;
+    }
+
+    std::string name_;
+    WWChoices choices_;
+    CoatedStack coat_;
+    Support support_;
+    double base_alpha_ = 0;
+    bool has_absorption_ = false;
+};
+
+}  // namespace
+
+std::vector<OptionSpec> ww_option_specs(const WWChoices& d) {
+    return {
+        {"fresnel-normal",
+         {"h", "n"},
+         d.fresnel_at_h ? "h" : "n",
+         "normal of the Fresnel transmittances T01, T10: half vector h or macro normal n"},
+        {"refraction-normal",
+         {"h", "n"},
+         d.refract_about_h ? "h" : "n",
+         "normal the directions are refracted about"},
+        {"base-directions",
+         {"outside", "refracted"},
+         d.base_at_outside ? "outside" : "refracted",
+         "directions f_base is evaluated at"},
+        {"exit",
+         {"t", "T10"},
+         d.exit_t_term ? "t" : "T10",
+         "exit factor: t = (1 - G) + T10 G (Weidlich & Wilkie) or the exit transmission T10"},
+        {"eta2",
+         {"on", "off"},
+         on_off(d.eta2_factor),
+         "the 1/eta0^2 solid-angle compression factor on the base term"},
+        {"max-roughness",
+         {"on", "off"},
+         on_off(d.max_roughness),
+         "alpha1 <- max(alpha0, alpha1) (Elek 2010)"},
+    };
+}
+
+WWChoices ww_choices(const ModelOptions& o) {
+    WWChoices c;
+    c.fresnel_at_h = option_value(o, "fresnel-normal") == "h";
+    c.refract_about_h = option_value(o, "refraction-normal") == "h";
+    c.base_at_outside = option_value(o, "base-directions") == "outside";
+    c.exit_t_term = option_value(o, "exit") == "t";
+    c.eta2_factor = option_value(o, "eta2") == "on";
+    c.max_roughness = option_value(o, "max-roughness") == "on";
+    return c;
+}
+
+std::unique_ptr<Model> make_ww_model(std::string model_name, const Stack& stack,
+                                     const WWChoices& choices) {
+    return std::make_unique<WWModel>(std::move(model_name), stack, choices);
+}
+
+}  // namespace lamina

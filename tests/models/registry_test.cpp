@@ -1,0 +1,48 @@
+// The registry: one table of models, explicit errors for unknown names and options.
+#include "models/registry.h"
+#include "core/error.h"
+#include "test_stacks.h"
+
+#include <gtest/gtest.h>
+
+namespace lamina {
+namespace {
+
+TEST(ModelRegistry, ListsTheSixModelsOfTheStudy) {
+    std::vector<std::string> names;
+    for (const auto& e : model_registry()) {
+        names.push_back(e.name);
+        EXPECT_FALSE(e.description.empty());
+        EXPECT_FALSE(e.supports.empty());
+        for (const auto& o : e.options()) {
+            EXPECT_NE(std::find(o.values.begin(), o.values.end(), o.default_value), o.values.end())
+                << e.name << " " << o.key;
+        }
+    }
+    EXPECT_EQ(names, (std::vector<std::string>{"ww09", "ele10", "ww-prime", "bel18-forward",
+                                               "bel18-symmetric", "bel-prime"}));
+}
+
+TEST(ModelRegistry, UnknownNameListsTheKnownOnes) {
+    try {
+        find_model("ww10");
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.field(), "--model");
+        EXPECT_NE(std::string(e.what()).find("ww-prime"), std::string::npos);
+    }
+}
+
+TEST(ModelRegistry, OptionsAreValidated) {
+    const ModelEntry& ww = find_model("ww09");
+    EXPECT_EQ(resolve_options(ww, {}).at("refraction-normal"), "h");
+    EXPECT_EQ(resolve_options(ww, {"refraction-normal=n"}).at("refraction-normal"), "n");
+    EXPECT_THROW(resolve_options(ww, {"refraction-normal"}), InputError);
+    EXPECT_THROW(resolve_options(ww, {"refraction-normal=x"}), InputError);
+    EXPECT_THROW(resolve_options(ww, {"tir=on"}), InputError);
+    EXPECT_EQ(resolve_options(find_model("bel18-symmetric"), {}).at("cosine"), "symmetric");
+    EXPECT_EQ(resolve_options(find_model("bel-prime"), {}).at("cosine"), "forward");
+}
+
+}  // namespace
+}  // namespace lamina
