@@ -105,6 +105,31 @@ TEST(Fresnel, ConductorAtNormalIncidence) {
     }
 }
 
+TEST(Fresnel, ConductorMatchesTheRealArithmeticForm) {
+    // An independent form of the conductor Fresnel equations without complex numbers (Born & Wolf
+    // §14.2; as in pbrt-v3's FrConductor, after Lazányi & Szirmay-Kalos 2005): with
+    // a² + b² = √((η² − k² − sin²θ)² + 4η²k²) and a = √((a² + b² + η² − k² − sin²θ)/2),
+    //   R_s = (a² + b² − 2a cos θ + cos²θ)/(a² + b² + 2a cos θ + cos²θ),
+    //   R_p = R_s (cos²θ (a² + b²) − 2a cos θ sin²θ + sin⁴θ)/(cos²θ (a² + b²) + 2a cos θ sin²θ
+    //         + sin⁴θ),
+    // F = (R_s + R_p)/2. Agreement to 1e-12 (both are a few dozen flops on O(1) numbers).
+    const double etas[] = {0.143, 0.374, 1.442, 2.9, 0.2}, ks[] = {3.983, 2.385, 1.603, 3.0, 0.1};
+    for (int m = 0; m < 5; ++m) {
+        const double eta = etas[m], k = ks[m];
+        for (int i = 0; i <= 100; ++i) {
+            const double c = i / 100.0, s2 = 1 - c * c;
+            const double t0 = sqr(eta) - sqr(k) - s2;
+            const double a2b2 = std::sqrt(sqr(t0) + 4 * sqr(eta) * sqr(k));
+            const double a = std::sqrt((a2b2 + t0) / 2);
+            const double rs = (a2b2 - 2 * a * c + c * c) / (a2b2 + 2 * a * c + c * c);
+            const double rp = rs * (c * c * a2b2 - 2 * a * c * s2 + s2 * s2) /
+                              (c * c * a2b2 + 2 * a * c * s2 + s2 * s2);
+            EXPECT_NEAR(fresnel_conductor(c, eta, k), (rs + rp) / 2, 1e-12)
+                << eta << ' ' << k << ' ' << c;
+        }
+    }
+}
+
 TEST(Fresnel, GoldIsAReflectanceAtEveryAngle) {
     // Gold-like RGB (η, k) ≈ (0.143, 3.983), (0.374, 2.385), (1.442, 1.603) (Johnson & Christy
     // 1972 at ≈ 650, 550, 450 nm): F ∈ [0, 1], red reflects more than blue at normal incidence

@@ -96,8 +96,9 @@ Chi2Draw draw_of(const std::optional<BsdfSample<double>>& s) {
 }
 
 // Number of chi-square tests in InterfacesStat (Šidák correction, 1 % for the suite): rough
-// dielectric 2 η × 2 α × 2 sides + 1 grazing, conductor 2 α × 2 incidences, Lambertian 2 sides.
-constexpr int kInterfaceChi2Tests = 15;
+// dielectric 2 η × 2 α × 2 sides + 1 grazing + 1 in float, conductor 2 α × 2 incidences,
+// Lambertian 2 sides.
+constexpr int kInterfaceChi2Tests = 16;
 
 test::Chi2Options interface_options(const std::string& name) {
     test::Chi2Options o;
@@ -136,6 +137,24 @@ TEST(InterfacesStat, RoughDielectricChi2) {
             [&](const Vec3d& wo) { return iface.pdf(c.wi, wo); });
         EXPECT_TRUE(r.passed) << r.message;
     }
+}
+
+TEST(InterfacesStat, RoughDielectricFloatChi2) {
+    // The particle tracer runs in float: its sampler (24-bit uniforms) against the double density.
+    // Float rounding moves directions by ~1e-7, far below a cell (≈ 0.04 rad), so the same test
+    // applies.
+    const DielectricInterface<float> f{1.5f, 0.2f};
+    const DielectricInterface<double> d{1.5, 0.2};
+    const Vec3f wi(kAbove);
+    const auto r = test::run_chi2(
+        interface_options("dielectric_float"),
+        [&](const std::array<double, 3>& u) {
+            const auto s = f.sample(wi, float(u[0]), float(u[1]), float(u[2]));
+            if (!s || s->shadowing == 0) return Chi2Draw::none();
+            return Chi2Draw::direction(normalize(Vec3d(s->wo)));
+        },
+        [&](const Vec3d& wo) { return d.pdf(Vec3d(wi), wo); });
+    EXPECT_TRUE(r.passed) << r.message;
 }
 
 TEST(InterfacesStat, RoughConductorChi2) {
@@ -330,6 +349,69 @@ TEST(Interfaces, ConductorSampleWeightMatchesEvalAndPdf) {
         // Light from below an opaque conductor: no sample, no value.
         EXPECT_FALSE(c.sample(kBelow, 0.3, 0.3).has_value());
         EXPECT_EQ(c.eval(kBelow, kAbove), Rgbd(0.0));
+    }
+}
+
+TEST(Interfaces, FloatSamplersStayFinite) {
+    // The tracer's float samplers, down to α = 1e-3 and near-grazing incidence, from both sides:
+    // every weight is finite and in [0, 1] (G2/G1 ≤ 1, F ≤ 1), every direction is unit (to float
+    // rounding, 1e-5) and on the side its branch says. A NaN here would poison a whole table.
+    ParticleRng rng(44, 0, 0);
+    for (float alpha : {1e-3f, 0.05f, 0.5f, 1.0f}) {
+        for (float eta : {1.5f, 1 / 1.5f}) {
+            const DielectricInterface<float> d{eta, alpha};
+            const ConductorInterface<float> c{Rgbf(kGoldEta), Rgbf(kGoldK), alpha};
+            for (float z : {1.0f, 0.6f, 1e-3f, -1e-3f, -0.6f}) {
+                const Vec3f wi(std::sqrt(1 - z * z), 0.0f, z);
+                for (int i = 0; i < 5000; ++i) {
+                    const float u0 = rng.uniform<float>(), u1 = rng.uniform<float>(),
+                                u2 = rng.uniform<float>();
+                    const auto s = d.template sample<false>(wi, u0, u1, u2);
+                    ASSERT_TRUE(s.has_value());
+                    ASSERT_TRUE(std::isfinite(s->weight[0])) << alpha << ' ' << eta << ' ' << z;
+                    ASSERT_GE(s->weight[0], 0);
+                    ASSERT_LE(s->weight[0], 1 + 1e-6f);
+                    ASSERT_NEAR(length(s->wo), 1, 1e-5f);
+                    if (s->shadowing > 0) {
+                        ASSERT_EQ(s->is_transmission, !same_hemisphere(wi, s->wo));
+                    }
+                    if (z < 0) continue;
+                    const auto t = c.template sample<false>(wi, u1, u2);
+                    ASSERT_TRUE(t.has_value());
+                    for (int ch = 0; ch < 3; ++ch) {
+                        ASSERT_TRUE(std::isfinite(t->weight[ch]));
+                        ASSERT_GE(t->weight[ch], 0);
+                        ASSERT_LE(t->weight[ch], 1 + 1e-6f);
+                    }
+                    ASSERT_NEAR(length(t->wo), 1, 1e-5f);
+                }
+            }
+        }
+    }
+}
+
+TEST(Interfaces, UncorrelatedShadowingOptionIsConsistent) {
+    // With G2 = G1(wi) G1(wo) the weight is G1(wo), and still eval·|cos θo|/pdf.
+    ParticleRng rng(45, 0, 0);
+    DielectricInterface<double> d{1.5, 0.5};
+    d.uncorrelated_shadowing = true;
+    ConductorInterface<double> c{kGoldEta, kGoldK, 0.5};
+    c.uncorrelated_shadowing = true;
+    const GGX<double> ggx{0.5};
+    for (int i = 0; i < 2000; ++i) {
+        const auto s =
+            d.sample(kAbove, rng.uniform_double(), rng.uniform_double(), rng.uniform_double());
+        ASSERT_TRUE(s.has_value());
+        if (s->shadowing > 0) {
+            EXPECT_NEAR(s->weight[0], ggx.G1(s->wo), 1e-12);
+            EXPECT_NEAR(s->weight[0], d.eval(kAbove, s->wo) * std::abs(s->wo.z) / s->pdf,
+                        1e-9 * s->weight[0]);
+        }
+        const auto t = c.sample(kAbove, rng.uniform_double(), rng.uniform_double());
+        ASSERT_TRUE(t.has_value());
+        if (t->shadowing > 0) {
+            EXPECT_NEAR(t->shadowing, ggx.G1(t->wo), 1e-12);
+        }
     }
 }
 
