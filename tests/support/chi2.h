@@ -67,7 +67,10 @@ struct Chi2Options {
     /// Number of chi-square tests in the suite (Šidák correction).
     int test_count = 1;
     double significance = 0.01;
-    std::uint64_t seed = 0x1a31a;
+    /// 0: derived from `name` (FNV-1a), so that the tests of a suite draw independent numbers, as
+    /// the Šidák correction assumes, and each test is reproducible on its own. The environment
+    /// variable LAMINA_CHI2_SEED (an integer) is mixed in, to rerun a suite on other numbers.
+    std::uint64_t seed = 0;
     /// Absolute tolerance of the quadrature of the density over one cell (in probability).
     double cell_tolerance = 1e-10;
 };

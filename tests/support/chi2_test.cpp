@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 namespace lamina::test {
 namespace {
@@ -68,6 +69,12 @@ TEST(Chi2Harness, RejectsAWrongDensity) {
                             [](const Vec3d& w) { return w.z > 0 ? 1 / (2 * kPi<double>) : 0.0; });
     EXPECT_FALSE(r.passed);
     EXPECT_LT(r.p_value, 1e-10);
+    // The failure message names the dumped histograms, which exist.
+    const auto at = r.message.find(" and ");
+    ASSERT_NE(at, std::string::npos) << r.message;
+    const std::string pgm = r.message.substr(at + 5);
+    EXPECT_TRUE(std::filesystem::exists(pgm)) << pgm;
+    EXPECT_NE(pgm.find(".pgm"), std::string::npos);
 }
 
 TEST(Chi2Harness, RejectsDrawsOutsideTheSupport) {
