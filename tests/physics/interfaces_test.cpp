@@ -96,9 +96,9 @@ Chi2Draw draw_of(const std::optional<BsdfSample<double>>& s) {
 }
 
 // Number of chi-square tests in InterfacesStat (Šidák correction, 1 % for the suite): rough
-// dielectric 2 η × 2 α × 2 sides + 1 grazing + 1 in float, conductor 2 α × 2 incidences,
-// Lambertian 2 sides.
-constexpr int kInterfaceChi2Tests = 16;
+// dielectric 2 η × 2 α × 2 sides + 1 grazing + 1 in float + 2 zoomed, conductor 2 α × 2
+// incidences + 1 zoomed, Lambertian 2 sides.
+constexpr int kInterfaceChi2Tests = 19;
 
 test::Chi2Options interface_options(const std::string& name) {
     test::Chi2Options o;
@@ -155,6 +155,32 @@ TEST(InterfacesStat, RoughDielectricFloatChi2) {
         },
         [&](const Vec3d& wo) { return d.pdf(Vec3d(wi), wo); });
     EXPECT_TRUE(r.passed) << r.message;
+}
+
+TEST(InterfacesStat, SharpLobesChi2) {
+    // α = 0.05 near normal incidence: each lobe lies within 1 − |cos θo| ≲ 2α² of a pole, inside
+    // one cell of the full grid. The grid is zoomed onto |cos θo| ∈ [1 − 16α², 1] for the
+    // dielectric's reflection and transmission lobes and the conductor's lobe; everything else
+    // (the other lobe, the tails, lost samples) joins the absent bin.
+    const Vec3d wi = direction_at(0.9995, 0.0);
+    const DielectricInterface<double> d{1.5, 0.05};
+    const ConductorInterface<double> c{kGoldEta, kGoldK, 0.05};
+    const double band = 16 * sqr(0.05);
+    for (int lobe = 0; lobe < 3; ++lobe) {
+        auto o = interface_options(lobe == 0   ? "zoomed_dielectric_reflection"
+                                   : lobe == 1 ? "zoomed_dielectric_transmission"
+                                               : "zoomed_conductor");
+        o.cos_theta_min = lobe == 1 ? -1 : 1 - band;
+        o.cos_theta_max = lobe == 1 ? -1 + band : 1;
+        const auto r = test::run_chi2(
+            o,
+            [&](const std::array<double, 3>& u) {
+                return lobe < 2 ? draw_of(d.sample(wi, u[0], u[1], u[2]))
+                                : draw_of(c.sample(wi, u[1], u[2]));
+            },
+            [&](const Vec3d& wo) { return lobe < 2 ? d.pdf(wi, wo) : c.pdf(wi, wo); });
+        EXPECT_TRUE(r.passed) << r.message;
+    }
 }
 
 TEST(InterfacesStat, RoughConductorChi2) {

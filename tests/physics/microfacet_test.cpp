@@ -171,6 +171,10 @@ TEST(Microfacet, MaskingShadowingBounds) {
     }
 }
 
+// Chi-square tests in MicrofacetStat (Šidák correction, 1 % for the suite): 7 views below and 2
+// zoomed sharp lobes.
+constexpr int kVisibleNormalChi2Tests = 9;
+
 TEST(MicrofacetStat, VisibleNormalSamplingChi2) {
     // sample_visible_normal against pdf_visible_normal (= D_w), for several α and views: normal,
     // oblique, near grazing, and below the surface (oblique and near grazing). Every draw must be
@@ -183,12 +187,12 @@ TEST(MicrofacetStat, VisibleNormalSamplingChi2) {
                           {0.2, direction_at(0.02, 2.0)},  {0.5, direction_at(-0.5, 1.0)},
                           {0.5, direction_at(0.3, 5.0)},   {1.0, direction_at(-0.02, 5.5)},
                           {0.05, direction_at(-0.05, 1.0)}};
-    const int count = int(std::size(cases));
+    static_assert(std::size(cases) + 2 == kVisibleNormalChi2Tests);
     for (const Case& c : cases) {
         const GGX<double> ggx{c.alpha};
         test::Chi2Options o;
         o.name = "visible_normals_a" + std::to_string(c.alpha) + "_z" + std::to_string(c.w.z);
-        o.test_count = count;
+        o.test_count = kVisibleNormalChi2Tests;
         o.cos_theta_min = 0;
         const auto r = test::run_chi2(
             o,
@@ -198,6 +202,28 @@ TEST(MicrofacetStat, VisibleNormalSamplingChi2) {
             [&](const Vec3d& wm) { return ggx.pdf_visible_normal(c.w, wm); });
         EXPECT_TRUE(r.passed) << r.message;
         EXPECT_NEAR(r.pdf_integral, 1, 1e-6) << o.name;
+    }
+}
+
+TEST(MicrofacetStat, SharpVisibleNormalLobeChi2) {
+    // α = 0.05 and 0.01 seen from the normal: the lobe has 1 − cos θm ≈ α²/2, inside one cell of
+    // the full grid, so the grid is zoomed onto cos θm ∈ [1 − 8α², 1]. GGX puts
+    // P(tan²θm > T) = α²/(α² + T) outside (T ≈ 16α², i.e. ≈ 6 %), which joins the absent bin.
+    for (double alpha : {0.05, 0.01}) {
+        const GGX<double> ggx{alpha};
+        const Vec3d w = direction_at(0.999, 1.0);
+        test::Chi2Options o;
+        o.name = "visible_normals_zoomed_a" + std::to_string(alpha);
+        o.test_count = kVisibleNormalChi2Tests;
+        o.cos_theta_min = 1 - 8 * sqr(alpha);
+        const auto r = test::run_chi2(
+            o,
+            [&](const std::array<double, 3>& u) {
+                return Chi2Draw::direction(ggx.sample_visible_normal(w, u[0], u[1]));
+            },
+            [&](const Vec3d& wm) { return ggx.pdf_visible_normal(w, wm); });
+        EXPECT_TRUE(r.passed) << r.message;
+        EXPECT_GT(r.absent_fraction, 0.03);  // the zoom really cuts the tails
     }
 }
 

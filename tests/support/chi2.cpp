@@ -166,9 +166,12 @@ Chi2Result run_chi2(const Chi2Options& o, const Chi2SampleFn& sample, const Chi2
         }
         const Vec3d w = *d.w;
         const bool finite = std::isfinite(w.x) && std::isfinite(w.y) && std::isfinite(w.z);
-        if (!finite || std::abs(length(w) - 1) > 1e-6 || w.z < o.cos_theta_min - 1e-12 ||
-            w.z > o.cos_theta_max + 1e-12) {
+        if (!finite || std::abs(length(w) - 1) > 1e-6) {
             if (bad++ == 0) bad_example = w;
+            continue;
+        }
+        if (w.z < o.cos_theta_min || w.z > o.cos_theta_max) {  // outside a zoomed domain
+            absent += 1;
             continue;
         }
         double phi = std::atan2(w.y, w.x);
@@ -199,12 +202,14 @@ Chi2Result run_chi2(const Chi2Options& o, const Chi2SampleFn& sample, const Chi2
         if (expected[i] <= kZero && observed[i] > 0) outside += std::size_t(observed[i]);
     }
     if (bad > 0) {
-        why << bad << " draws are not unit directions of the domain, e.g. (" << bad_example.x
-            << ", " << bad_example.y << ", " << bad_example.z << "). ";
+        why << bad << " draws are not unit directions, e.g. (" << bad_example.x << ", "
+            << bad_example.y << ", " << bad_example.z << "). ";
     }
     if (outside > 0) why << outside << " draws fall where the pdf is zero. ";
     if (absent_expected <= kZero && absent > 0) {
-        why << absent << " draws are absent (failed, lost or delta) but the pdf integrates to "
+        why << absent
+            << " draws are absent (failed, lost, delta or outside the domain) but the pdf "
+               "integrates to "
             << result.pdf_integral << ". ";
     }
     if (result.pdf_integral > 1 + 1e-6) {

@@ -16,10 +16,13 @@
 // lands in a cell (expected N·∫_cell pdf) or is absent (expected N·(1 − P), P computed by the same
 // quadrature). The absent outcome is one more bin of the Pearson statistic, so both the shape of
 // the density and the missing mass are tested, and the expected total equals N exactly.
+// Zoomed domains: with cos θ restricted to [c_min, c_max] (to resolve a sharp lobe), draws outside
+// it join the absent bin, whose expected count is then N·(1 − ∫_domain pdf dω) by the same rule.
 //
 // Support: a sample in a cell whose expected count is numerically zero (≤ 1e-9, so the chance of a
 // legitimate hit there is < 1e-9 per cell) fails the test outright, as does a non-finite or
-// non-unit direction, or an absent sample when the pdf integrates to 1 (same rule, absent bin).
+// non-unit direction, or an absent sample when the pdf integrates to 1 over the domain (same
+// rule, absent bin).
 //
 // Pooling: cells with expected count < 5 are pooled (in increasing order of expected count) until
 // the pool reaches 5, as in Mitsuba's chi2.py; degrees of freedom = bins after pooling − 1.

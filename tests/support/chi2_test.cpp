@@ -62,6 +62,22 @@ TEST(Chi2Harness, PassesACorrectSampler) {
     EXPECT_NEAR(r.pdf_integral, 1, 1e-8);
 }
 
+TEST(Chi2Harness, ZoomedDomain) {
+    // Cosine draws on cos θ ∈ [0.5, 1]: 2π ∫_{0.5}^{1} c/π dc = 1 − 0.25 = 0.75, so a quarter
+    // of the draws fall outside and join the absent bin. A wrong density is still rejected.
+    auto o = small("harness_zoomed");
+    o.cos_theta_min = 0.5;
+    const auto r =
+        run_chi2(o, cosine_draw, [](const Vec3d& w) { return pdf_cosine_hemisphere(w); });
+    EXPECT_TRUE(r.passed) << r.message;
+    EXPECT_NEAR(r.pdf_integral, 0.75, 1e-9);
+    EXPECT_NEAR(r.absent_fraction, 0.25, 5 * std::sqrt(0.25 * 0.75 / 1e5));  // 5 binomial SEs
+    o.name = "harness_zoomed_wrong";
+    const auto wrong = run_chi2(
+        o, cosine_draw, [](const Vec3d& w) { return w.z > 0 ? 1 / (2 * kPi<double>) : 0.0; });
+    EXPECT_FALSE(wrong.passed);
+}
+
 TEST(Chi2Harness, RejectsAWrongDensity) {
     // Cosine-distributed draws against the uniform-hemisphere density 1/(2π): the cell counts
     // differ by up to a factor 2, far beyond the noise of 10⁵ draws.
