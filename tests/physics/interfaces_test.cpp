@@ -514,8 +514,51 @@ TEST(Interfaces, SmoothDielectricSplitsExactlyByFresnel) {
     }
 }
 
-// --- Energy
-// ---------------------------------------------------------------------------------------
+TEST(Interfaces, IndexMatchedRoughDielectricIsADeltaPassThrough) {
+    // η = 1 (two layers of the same index) is allowed by dielectric.h. Then F = 0 for every
+    // microfacet and Snell's law refracts every visible microfacet's ray straight on, to −wi: the
+    // rough BTDF of Walter et al. collapses to a delta lobe, which eval and pdf (densities) cannot
+    // represent. The sample must say so (is_delta, pdf 0, bsdf.h) and carry the η → 1 limit of
+    // the lobe's energy, E[(1 − F) G2/G1] → G2(wi, −wi)/G1(wi) (every refracted direction tends to
+    // −wi); eval and pdf are 0 everywhere, including at rounding distance from −wi.
+    for (double alpha : {0.05, 0.3, 1.0}) {
+        const DielectricInterface<double> d{1.0, alpha};
+        const GGX<double> ggx{alpha};
+        ParticleRng rng(46, 0, 0);
+        for (const Vec3d& wi : {kAbove, kBelow, kGrazing}) {
+            const double limit = ggx.G2(wi, -wi) / ggx.G1(wi);
+            for (int i = 0; i < 200; ++i) {
+                const auto s =
+                    d.sample(wi, rng.uniform_double(), rng.uniform_double(), rng.uniform_double());
+                ASSERT_TRUE(s.has_value());
+                EXPECT_TRUE(s->is_delta);
+                EXPECT_TRUE(s->is_transmission);
+                EXPECT_EQ(s->pdf, 0.0);
+                EXPECT_EQ(s->wo, -wi);
+                EXPECT_NEAR(s->weight[0], limit, 1e-15);
+                EXPECT_EQ(d.eval(wi, s->wo), 0.0);
+                EXPECT_EQ(d.pdf(wi, s->wo), 0.0);
+                const Vec3d near_wo = normalize(-wi + Vec3d(1e-17, -2e-17, 1e-17));
+                EXPECT_EQ(d.eval(wi, near_wo), 0.0);
+                EXPECT_EQ(d.pdf(wi, near_wo), 0.0);
+            }
+            // Continuity: at η = 1 + 1e-9 the (non-delta) samples' directions are within
+            // O((η − 1) tan θ) of −wi, θ the angle to the microfacet, and G2 is smooth away from
+            // the horizon: weights are within 1e-4 of the limit unless a microfacet is seen at <
+            // 1e-5 rad from grazing (probability ~1e-5 per draw, a 0.4 % chance in 600 draws).
+            const DielectricInterface<double> near{1 + 1e-9, alpha};
+            for (int i = 0; i < 200; ++i) {
+                const auto s = near.sample(wi, rng.uniform_double(), rng.uniform_double(),
+                                           rng.uniform_double());
+                ASSERT_TRUE(s.has_value());
+                if (!s->is_transmission || s->shadowing == 0) continue;
+                EXPECT_NEAR(s->weight[0], limit, 1e-4) << alpha << ' ' << wi.z;
+            }
+        }
+    }
+}
+
+// --- Energy ------------------------------------------------------------------------------------
 
 // Albedo ∫ eval(wi, wo)|cos θo| dωo over the whole sphere (reflection + transmission), by
 // deterministic quadrature in wo.
