@@ -27,7 +27,7 @@ Vec3d direction_at(double cos_theta, double phi) {
     return test::direction_of(cos_theta, phi);
 }
 
-// Gold-like relative complex index per RGB channel (Johnson & Christy 1972, ≈ 650/550/450 nm).
+// Gold-like relative complex index per RGB channel (the usual rendering values for gold).
 const Rgbd kGoldEta(0.143, 0.374, 1.442), kGoldK(3.983, 2.385, 1.603);
 
 // Incidences of physics.md §1 (φi = 0): oblique from above, near grazing, oblique from below.

@@ -99,7 +99,7 @@ double lambda_closed_form(double alpha, double cos_theta) {
 }
 
 TEST(Microfacet, ProjectedAreas) {
-    // Heitz 2014, Eq. 5 (and §2.2): the signed projected area of the microsurface onto any w is
+    // Heitz 2014, §2 (projected areas): the signed projected area of the microsurface onto any w is
     // that of the macrosurface, ∫ (w·wm) D(wm) dωm = cos θ. Eq. 25 with Smith's G1 = 1/(1 + Λ):
     // the visible part projects to ∫ max(0, w·wm) D(wm) dωm = cos θ (1 + Λ(w)), i.e.
     // ∫ G1(w) max(0, w·wm) D(wm) dωm = cos θ. For w below the surface the same holds with −w.
