@@ -3,8 +3,9 @@
 // refraction) or rough (GGX, single-scattering microfacet BSDF of Walter et al. 2007, "Microfacet
 // models for refraction through rough surfaces", EGSR). Conventions: physics/bsdf.h.
 //
-// eta = η_below / η_above > 0, eta ≠ 1 is allowed to equal 1 (an index-matched interface is a pass-
-// through when smooth and a pure refraction lobe of zero width in the limit). α ∈ [0, 1].
+// eta = η_below / η_above > 0; eta = 1 is allowed: an index-matched interface is a delta pass-
+// through, smooth or rough (for α > 0 the limit η → 1 of the rough BTDF, a refraction lobe of zero
+// width; see sample_index_matched). α ∈ [0, 1].
 
 #include "core/math.h"
 #include "physics/bsdf.h"
@@ -25,6 +26,8 @@ struct DielectricInterface {
 
     bool is_smooth() const { return alpha == 0; }
     T inv_eta() const { return T(1) / eta; }
+    /// η = 1: no reflection (F = 0) and straight-through transmission, a delta lobe for any α.
+    bool is_index_matched() const { return eta == T(1); }
     GGX<T> distribution() const { return {alpha}; }
 
     /// η(wo's side) / η(wi's side) — the ratio that appears in the refraction Jacobian.
@@ -51,9 +54,10 @@ struct DielectricInterface {
         return wm;
     }
 
-    /// Radiance BSDF, 1/sr, cosine excluded; zero for smooth interfaces (delta lobes).
+    /// Radiance BSDF, 1/sr, cosine excluded; zero for smooth and index-matched interfaces (delta
+    /// lobes).
     T eval(const Vec3<T>& wi, const Vec3<T>& wo) const {
-        if (is_smooth() || wi.z == 0 || wo.z == 0) return T(0);
+        if (is_smooth() || is_index_matched() || wi.z == 0 || wo.z == 0) return T(0);
         const auto wm = half_vector(wi, wo);
         if (!wm) return T(0);
         const GGX<T> ggx = distribution();
@@ -71,9 +75,9 @@ struct DielectricInterface {
                (std::abs(wi.z * wo.z) * denom);
     }
 
-    /// Density of sample(wi, ·) at wo (solid angle); zero for smooth interfaces.
+    /// Density of sample(wi, ·) at wo (solid angle); zero for smooth and index-matched interfaces.
     T pdf(const Vec3<T>& wi, const Vec3<T>& wo) const {
-        if (is_smooth() || wi.z == 0 || wo.z == 0) return T(0);
+        if (is_smooth() || is_index_matched() || wi.z == 0 || wo.z == 0) return T(0);
         const auto wm = half_vector(wi, wo);
         if (!wm) return T(0);
         const GGX<T> ggx = distribution();
@@ -98,6 +102,7 @@ struct DielectricInterface {
     std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T uc, T u1, T u2) const {
         if (wi.z == 0) return std::nullopt;
         if (is_smooth()) return sample_smooth(wi, uc);
+        if (is_index_matched()) return sample_index_matched(wi);
         const GGX<T> ggx = distribution();
         const Vec3<T> wm = ggx.sample_visible_normal_caps(wi, u1, u2);
         const T cos_i_m = dot(wi, wm);  // < 0 when wi is below: seen from the other side
@@ -134,6 +139,21 @@ private:
         // The single-scattering model lets this energy go (G2 = 0 for the pair).
         s.shadowing = 0;
         s.weight = Rgb<T>(T(0));
+        return s;
+    }
+
+    /// Rough and η = 1: F = 0 on every microfacet and Snell's law sends every refracted ray
+    /// straight on, so the BTDF of Walter et al. collapses onto a delta lobe at −wi, which eval
+    /// and pdf (densities) cannot represent. Its weight is the η → 1 limit of the lobe's energy,
+    /// E[(1 − F) G2/G1] → G2(wi, −wi)/G1(wi) (every refracted direction tends to −wi), so the
+    /// interface is continuous in η; the single-scattering microsurface still loses 1 − that.
+    std::optional<BsdfSample<T>> sample_index_matched(const Vec3<T>& wi) const {
+        BsdfSample<T> s;
+        s.wo = -wi;
+        s.is_delta = true;
+        s.is_transmission = true;
+        s.shadowing = masking_shadowing(wi, s.wo) / distribution().G1(wi);
+        s.weight = Rgb<T>(s.shadowing);
         return s;
     }
 
