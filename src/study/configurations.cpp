@@ -1,0 +1,236 @@
+#include "study/configurations.h"
+
+#include "core/error.h"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace lamina {
+
+namespace {
+
+std::string num(double v) { return fmt::format("{}", v); }
+
+// α1 in ids as in study.md's example `paint-a0.001-a1.3`: "a1" followed by the value without its
+// leading zero.
+std::string alpha1_id(double v) {
+    std::string s = num(v);
+    return s.rfind("0.", 0) == 0 ? s.substr(1) : s;
+}
+
+std::string rgb_text(const Rgbd& v) {
+    if (v[0] == v[1] && v[1] == v[2]) return num(v[0]);
+    return fmt::format("({}, {}, {})", v[0], v[1], v[2]);
+}
+
+Layer coat(double alpha0, const Rgbd& tau_a) {
+    Layer l;
+    l.interface.type = InterfaceType::Dielectric;
+    l.interface.eta = 1.5;  // study.md: η0 = 1.5 throughout
+    l.interface.alpha = alpha0;
+    l.has_medium = true;
+    l.medium.tau_a = tau_a;
+    return l;
+}
+
+Layer lambertian(const Rgbd& rho) {
+    Layer l;
+    l.interface.type = InterfaceType::Lambertian;
+    l.interface.albedo = rho;
+    return l;
+}
+
+Layer conductor(const Rgbd& eta, const Rgbd& k, double alpha) {
+    Layer l;
+    l.interface.type = InterfaceType::Conductor;
+    l.interface.eta_rgb = eta;
+    l.interface.k = k;
+    l.interface.alpha = alpha;
+    return l;
+}
+
+Layer dielectric(double eta, double alpha) {
+    Layer l;
+    l.interface.type = InterfaceType::Dielectric;
+    l.interface.eta = eta;
+    l.interface.alpha = alpha;
+    return l;
+}
+
+StudyConfiguration make(std::string id, std::string category, std::vector<Layer> layers) {
+    StudyConfiguration c;
+    c.id = std::move(id);
+    c.category = std::move(category);
+    c.stack = Stack{c.id, 1.0, std::move(layers)};
+    c.parameters = describe_parameters(c.stack);
+    return c;
+}
+
+bool glob_match(const char* p, const char* s) {
+    if (*p == '\0') return *s == '\0';
+    if (*p == '*') return glob_match(p + 1, s) || (*s != '\0' && glob_match(p, s + 1));
+    if (*s != '\0' && (*p == '?' || *p == *s)) return glob_match(p + 1, s + 1);
+    return false;
+}
+
+}  // namespace
+
+std::map<std::string, std::string> describe_parameters(const Stack& stack) {
+    std::map<std::string, std::string> p;
+    if (stack.layers.empty()) return p;
+    const Layer& top = stack.layers.front();
+    if (top.interface.type == InterfaceType::Dielectric) {
+        p["eta0"] = num(top.interface.eta);
+        p["alpha0"] = num(top.interface.alpha);
+        p["tau"] = rgb_text(top.has_medium ? top.medium.tau_a : Rgbd(0.0));
+        if (top.has_medium && top.medium.scatters()) p["tau_s"] = rgb_text(top.medium.tau_s);
+    }
+    if (stack.layers.size() >= 2) {
+        const InterfaceSpec& base = stack.base();
+        switch (base.type) {
+            case InterfaceType::Lambertian:
+                p["base"] = "lambertian";
+                p["rho"] = rgb_text(base.albedo);
+                break;
+            case InterfaceType::Conductor:
+                p["base"] = "conductor";
+                p["alpha1"] = num(base.alpha);
+                p["eta1"] = rgb_text(base.eta_rgb);
+                p["kappa1"] = rgb_text(base.k);
+                break;
+            case InterfaceType::Dielectric:
+                p["base"] = "dielectric";
+                p["alpha1"] = num(base.alpha);
+                p["eta1"] = num(base.eta);
+                break;
+        }
+    }
+    return p;
+}
+
+std::vector<StudyConfiguration> builtin_configurations() {
+    std::vector<StudyConfiguration> out;
+    const std::vector<double> alpha0_plastic = {0.001, 0.05, 0.1, 0.3, 0.5};
+    // Plastics: α0 × (τa, ρ) pairs P1–P4.
+    struct PlasticPair {
+        const char* id;
+        Rgbd tau, rho;
+    };
+    const PlasticPair pairs[] = {{"P1", Rgbd(0.0), Rgbd(0.8)},
+                                 {"P2", Rgbd(0.0), Rgbd(0.8, 0.2, 0.1)},
+                                 {"P3", Rgbd(0.1, 0.0, 0.9), Rgbd(0.8)},
+                                 {"P4", Rgbd(0.1, 0.0, 0.9), Rgbd(0.1, 0.0, 0.0)}};
+    for (const PlasticPair& pair : pairs)
+        for (double a0 : alpha0_plastic)
+            out.push_back(make(fmt::format("plastic-{}-a{}", pair.id, a0), "plastic",
+                               {coat(a0, pair.tau), lambertian(pair.rho)}));
+    // Metallic paints: τa = 0.1, conductor η1 = 1.45, κ1 = (1.0, 0.01, 0.01), rougher than the coat.
+    for (double a0 : {0.001, 0.05})
+        for (double a1 : {0.1, 0.2, 0.3, 0.4, 0.5})
+            out.push_back(make(fmt::format("paint-a{}-a1{}", a0, alpha1_id(a1)), "metallic-paint",
+                               {coat(a0, Rgbd(0.1)),
+                                conductor(Rgbd(1.45), Rgbd(1.0, 0.01, 0.01), a1)}));
+    // Frosted metals: τa = 0, gold, smoother than the coat.
+    const Rgbd gold_eta(0.143, 0.374, 1.442), gold_k(3.983, 2.385, 1.603);
+    for (double a0 : {0.1, 0.2, 0.3, 0.4, 0.5})
+        for (double a1 : {0.001, 0.05})
+            out.push_back(make(fmt::format("frosted-a{}-a1{}", a0, alpha1_id(a1)), "frosted-metal",
+                               {coat(a0, Rgbd(0.0)), conductor(gold_eta, gold_k, a1)}));
+    // Slabs: back to air (η1 = 1), BRDF and BTDF.
+    for (double a0 : alpha0_plastic)
+        for (double a1 : {0.001, 0.3})
+            for (int t = 0; t < 2; ++t)
+                out.push_back(make(
+                    fmt::format("slab-a{}-a1{}-{}", a0, alpha1_id(a1), t == 0 ? "clear" : "tinted"), "slab",
+                    {coat(a0, t == 0 ? Rgbd(0.0) : Rgbd(0.1, 0.0, 0.9)), dielectric(1.0, a1)}));
+    return out;
+}
+
+std::vector<StudyConfiguration> load_configurations(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    std::ifstream in(path);
+    if (!in) throw InputError(where, "", "cannot read the configurations file");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(ss.str());
+    } catch (const nlohmann::json::parse_error& e) {
+        throw InputError(where, "", fmt::format("malformed JSON: {}", e.what()));
+    }
+    if (!j.is_object() || !j.contains("configurations") || !j["configurations"].is_array())
+        throw InputError(where, "/configurations",
+                         "expected {\"configurations\": [{\"id\": ..., \"stack\": {...}}, ...]}");
+    for (const auto& [key, value] : j.items())
+        if (key != "configurations")
+            throw InputError(where, "/" + key, "unknown key; allowed: configurations");
+    std::vector<StudyConfiguration> out;
+    std::set<std::string> ids;
+    const auto& list = j["configurations"];
+    if (list.empty()) throw InputError(where, "/configurations", "the list is empty");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string at = fmt::format("/configurations/{}", i);
+        const auto& item = list[i];
+        if (!item.is_object()) throw InputError(where, at, "expected an object");
+        for (const auto& [key, value] : item.items())
+            if (key != "id" && key != "category" && key != "stack")
+                throw InputError(where, at + "/" + key,
+                                 "unknown key; allowed: id, category, stack");
+        if (!item.contains("id") || !item["id"].is_string())
+            throw InputError(where, at + "/id", "a string id is required");
+        StudyConfiguration c;
+        c.id = item["id"].get<std::string>();
+        if (c.id.empty() || c.id.find_first_of("/\\ \t\n") != std::string::npos || c.id[0] == '.')
+            throw InputError(where, at + "/id",
+                             fmt::format("'{}' is not usable as a file name (no spaces, slashes, "
+                                         "or leading dot)",
+                                         c.id));
+        if (!ids.insert(c.id).second)
+            throw InputError(where, at + "/id", fmt::format("'{}' appears twice", c.id));
+        c.category = "custom";
+        if (item.contains("category")) {
+            if (!item["category"].is_string())
+                throw InputError(where, at + "/category", "must be a string");
+            c.category = item["category"].get<std::string>();
+        }
+        if (!item.contains("stack")) throw InputError(where, at + "/stack", "a stack is required");
+        try {
+            c.stack = stack_from_json(item["stack"], where);
+        } catch (const InputError& e) {
+            // Re-anchor the stack's JSON pointer inside the configurations file.
+            throw InputError(where, at + "/stack" + e.field(), e.problem());
+        }
+        c.parameters = describe_parameters(c.stack);
+        out.push_back(std::move(c));
+    }
+    return out;
+}
+
+std::vector<StudyConfiguration> filter_configurations(std::vector<StudyConfiguration> configs,
+                                                      const std::string& pattern) {
+    if (pattern.empty()) return configs;
+    std::vector<std::string> patterns;
+    std::stringstream ss(pattern);
+    for (std::string p; std::getline(ss, p, ',');)
+        if (!p.empty()) patterns.push_back(p);
+    std::vector<StudyConfiguration> out;
+    for (auto& c : configs)
+        for (const auto& p : patterns)
+            if (glob_match(p.c_str(), c.id.c_str())) {
+                out.push_back(std::move(c));
+                break;
+            }
+    if (out.empty())
+        throw InputError("command line", "--only",
+                         fmt::format("'{}' matches no configuration (ids look like "
+                                     "plastic-P1-a0.05, paint-a0.001-a1.3, frosted-a0.1-a1.05, "
+                                     "slab-a0.1-a1.3-clear; * and ? are wildcards)",
+                                     pattern));
+    return out;
+}
+
+}  // namespace lamina

@@ -1,0 +1,38 @@
+#pragma once
+// The study's configurations (../shared/study.md): 60 two-interface stacks under air — plastics,
+// metallic paints, frosted metals and slabs — built into lamina, plus a user's own list.
+
+#include "layers/stack.h"
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+struct StudyConfiguration {
+    std::string id;        ///< stable, readable, used as a file name (e.g. plastic-P1-a0.05)
+    std::string category;  ///< plastic, metallic-paint, frosted-metal, slab (or the user's)
+    Stack stack;
+    /// The parameters a reader filters by (the original explorer's widgets): alpha0, eta0, tau,
+    /// base, alpha1, eta1, kappa1, rho — as display strings.
+    std::map<std::string, std::string> parameters;
+};
+
+/// The 60 configurations of study.md, in a fixed order.
+std::vector<StudyConfiguration> builtin_configurations();
+
+/// A user's list: {"configurations": [{"id": ..., "category": ..., "stack": {...}}, ...]}
+/// (`category` optional, default "custom"). InputError naming the file and the JSON pointer.
+std::vector<StudyConfiguration> load_configurations(const std::filesystem::path& path);
+
+/// Keeps the configurations whose id matches `pattern` (a glob with * and ?; several patterns
+/// separated by commas). InputError if none matches.
+std::vector<StudyConfiguration> filter_configurations(std::vector<StudyConfiguration> configs,
+                                                      const std::string& pattern);
+
+/// The parameters of a stack of the study's shape, derived from it (for user configurations).
+std::map<std::string, std::string> describe_parameters(const Stack& stack);
+
+}  // namespace lamina
