@@ -14,6 +14,9 @@ using Runner = std::function<int()>;
 /// Adds the subcommand to `app` and returns what runs it once parsed.
 Runner add_validate(CLI::App& app);
 Runner add_simulate(CLI::App& app);
+/// `lamina study` and `lamina compare` (cmd_study.cpp).
+Runner add_study(CLI::App& app);
+Runner add_compare(CLI::App& app);
 /// `lamina models`: the analytic models of the registry (cmd_models.cpp).
 Runner add_models(CLI::App& app);
 /// `lamina eval`: a model at points, a batch of directions, or on the bins (cmd_eval.cpp).

@@ -59,6 +59,13 @@ void Progress::draw(std::uint64_t done) {
     std::fflush(stderr);
 }
 
+void Progress::clear_line() {
+    if (!enabled_) return;
+    std::lock_guard lock(mutex_);
+    std::fprintf(stderr, "\r\033[K");
+    std::fflush(stderr);
+}
+
 void Progress::finish() {
     if (!enabled_) return;
     std::lock_guard lock(mutex_);

@@ -17,6 +17,9 @@ class Progress {
     ~Progress();
 
     void advance(std::uint64_t n);
+    /// Clears the progress line so that a caller can print a line of its own; the next advance()
+    /// draws it again.
+    void clear_line();
     /// Clears the line; called by the destructor too.
     void finish();
 

@@ -13,7 +13,9 @@ namespace lamina {
 
 namespace {
 
-std::string num(double v) { return fmt::format("{}", v); }
+std::string num(double v) {
+    return fmt::format("{}", v);
+}
 
 // α1 in ids as in study.md's example `paint-a0.001-a1.3`: "a1" followed by the value without its
 // leading zero.
@@ -128,12 +130,13 @@ std::vector<StudyConfiguration> builtin_configurations() {
         for (double a0 : alpha0_plastic)
             out.push_back(make(fmt::format("plastic-{}-a{}", pair.id, a0), "plastic",
                                {coat(a0, pair.tau), lambertian(pair.rho)}));
-    // Metallic paints: τa = 0.1, conductor η1 = 1.45, κ1 = (1.0, 0.01, 0.01), rougher than the coat.
+    // Metallic paints: τa = 0.1, conductor η1 = 1.45, κ1 = (1.0, 0.01, 0.01), rougher than the
+    // coat.
     for (double a0 : {0.001, 0.05})
         for (double a1 : {0.1, 0.2, 0.3, 0.4, 0.5})
-            out.push_back(make(fmt::format("paint-a{}-a1{}", a0, alpha1_id(a1)), "metallic-paint",
-                               {coat(a0, Rgbd(0.1)),
-                                conductor(Rgbd(1.45), Rgbd(1.0, 0.01, 0.01), a1)}));
+            out.push_back(
+                make(fmt::format("paint-a{}-a1{}", a0, alpha1_id(a1)), "metallic-paint",
+                     {coat(a0, Rgbd(0.1)), conductor(Rgbd(1.45), Rgbd(1.0, 0.01, 0.01), a1)}));
     // Frosted metals: τa = 0, gold, smoother than the coat.
     const Rgbd gold_eta(0.143, 0.374, 1.442), gold_k(3.983, 2.385, 1.603);
     for (double a0 : {0.1, 0.2, 0.3, 0.4, 0.5})
@@ -145,7 +148,8 @@ std::vector<StudyConfiguration> builtin_configurations() {
         for (double a1 : {0.001, 0.3})
             for (int t = 0; t < 2; ++t)
                 out.push_back(make(
-                    fmt::format("slab-a{}-a1{}-{}", a0, alpha1_id(a1), t == 0 ? "clear" : "tinted"), "slab",
+                    fmt::format("slab-a{}-a1{}-{}", a0, alpha1_id(a1), t == 0 ? "clear" : "tinted"),
+                    "slab",
                     {coat(a0, t == 0 ? Rgbd(0.0) : Rgbd(0.1, 0.0, 0.9)), dielectric(1.0, a1)}));
     return out;
 }

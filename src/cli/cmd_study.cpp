@@ -1,0 +1,133 @@
+// lamina study [--preset quick|standard|paper] [--only PATTERN] [--models …] [--configs FILE]
+//              [--out DIR]: the 60 configurations (or a user's list) against every model.
+// lamina compare STACK.json [--theta-i …] [--particles N] [--models …] --out DIR: one stack.
+#include "cli/commands.h"
+#include "cli/options.h"
+#include "core/error.h"
+#include "study/configurations.h"
+#include "study/study.h"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+namespace lamina::cli {
+
+namespace {
+
+struct CommonArgs {
+    std::string theta_i = "0,15,30,45,60,70,80", particles, grid = "90x90", models, out;
+    std::uint64_t seed = 1;
+    int threads = 0;
+};
+
+void add_common(CLI::App* cmd, CommonArgs& a) {
+    cmd->add_option("--theta-i", a.theta_i, "Incidences in degrees, comma-separated, in [0, 90)")
+        ->capture_default_str();
+    cmd->add_option("--particles,-n", a.particles,
+                    "Particles per incidence (overrides the preset; 1e7-style accepted)");
+    cmd->add_option("--models", a.models, "Models to compare, comma-separated (default: all)");
+    cmd->add_option("--seed", a.seed, "Random seed")->capture_default_str();
+    cmd->add_option("--threads", a.threads, "Threads (0 = all cores)")->capture_default_str();
+    cmd->add_option("--grid", a.grid, "Bins NTHETAxNPHI")->capture_default_str();
+}
+
+StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
+    StudySettings s;
+    s.preset = preset;
+    s.particles =
+        a.particles.empty() ? preset_particles(preset) : parse_count(a.particles, "--particles");
+    s.seed = a.seed;
+    s.threads = a.threads;
+    s.theta_i_deg = parse_angle_list(a.theta_i, "--theta-i");
+    for (double t : s.theta_i_deg)
+        if (!(t >= 0 && t < 90))
+            throw InputError("command line", "--theta-i",
+                             fmt::format("{} is outside the allowed range [0, 90) degrees", t));
+    s.grid = HemisphereGrid::parse(a.grid);
+    if (!a.models.empty()) {
+        std::stringstream ss(a.models);
+        for (std::string m; std::getline(ss, m, ',');)
+            if (!m.empty()) s.models.push_back(m);
+    }
+    if (s.threads < 0) throw InputError("command line", "--threads", "use ≥ 1, or 0 for all cores");
+    return s;
+}
+
+// Prints the findings section of summary.md (the part a reader wants first).
+void print_findings(const std::filesystem::path& dir) {
+    std::ifstream in(dir / "summary.md");
+    std::string line;
+    bool inside = false;
+    while (std::getline(in, line)) {
+        if (line.rfind("## ", 0) == 0) {
+            if (inside) break;
+            inside = line == "## Findings";
+        }
+        if (inside) fmt::print("{}\n", line);
+    }
+}
+
+}  // namespace
+
+Runner add_study(CLI::App& app) {
+    struct Args : CommonArgs {
+        std::string preset = "quick", only, configs;
+    };
+    auto a = std::make_shared<Args>();
+    auto* cmd = app.add_subcommand(
+        "study", "Compare every model with the reference on the study's 60 configurations");
+    cmd->add_option("--preset", a->preset,
+                    "Particle budget: quick (10^6 per incidence), standard (10^7), paper (1.6e8)")
+        ->capture_default_str();
+    cmd->add_option("--only", a->only, "Only configurations whose id matches (globs, commas)");
+    cmd->add_option("--configs", a->configs, "A JSON list of your own configurations");
+    add_common(cmd, *a);
+    cmd->add_option("--out,-o", a->out, "Output folder (default out/study-PRESET)");
+    return [a] {
+        const StudySettings s = settings_from(*a, a->preset);
+        auto configs =
+            a->configs.empty() ? builtin_configurations() : load_configurations(a->configs);
+        configs = filter_configurations(std::move(configs), a->only);
+        const std::filesystem::path out =
+            a->out.empty() ? std::filesystem::path("out") / ("study-" + a->preset)
+                           : std::filesystem::path(a->out);
+        run_study(configs, s, out);
+        fmt::print("\n");
+        print_findings(out);
+        fmt::print("\nReport: {}/summary.md (metrics: {}/metrics.csv)\n", out.string(),
+                   out.string());
+        return 0;
+    };
+}
+
+Runner add_compare(CLI::App& app) {
+    struct Args : CommonArgs {
+        std::string stack;
+    };
+    auto a = std::make_shared<Args>();
+    auto* cmd = app.add_subcommand(
+        "compare", "Simulate one stack and compare every model with it on the same bins");
+    cmd->add_option("STACK", a->stack, "Stack JSON file")->required();
+    add_common(cmd, *a);
+    cmd->add_option("--out,-o", a->out, "Output folder")->required();
+    return [a] {
+        StudySettings s = settings_from(*a, "quick");
+        if (!a->particles.empty()) s.preset = "custom";
+        StudyConfiguration c;
+        c.stack = load_stack(a->stack);
+        c.id = std::filesystem::path(a->stack).stem().string();
+        c.category = "custom";
+        c.parameters = describe_parameters(c.stack);
+        run_study({c}, s, a->out);
+        fmt::print("\n");
+        print_findings(a->out);
+        fmt::print("\nReport: {}/summary.md (metrics: {}/metrics.csv)\n", a->out, a->out);
+        return 0;
+    };
+}
+
+}  // namespace lamina::cli

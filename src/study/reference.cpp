@@ -1,0 +1,217 @@
+#include "study/reference.h"
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "lamina/version.h"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace lamina {
+
+namespace {
+
+constexpr const char* kMagic = "lamina-reference-piece v1\n";
+
+std::uint64_t fnv1a(const std::string& s) {
+    // Fowler–Noll–Vo FNV-1a, 64 bits (offset basis and prime from the FNV specification).
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    for (unsigned char c : s) {
+        h ^= c;
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+nlohmann::json metrics_json(const LobeMetrics& m) {
+    auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+    return {{"misplaced_energy", num(m.misplaced_energy)},
+            {"albedo_ref", m.albedo_ref},
+            {"albedo_model", m.albedo_model},
+            {"albedo_error", num(m.albedo_error)},
+            {"rmse", m.rmse},
+            {"log_rmse", m.log_rmse}};
+}
+
+LobeMetrics metrics_from_json(const nlohmann::json& j) {
+    auto num = [](const nlohmann::json& v) { return v.is_null() ? NAN : v.get<double>(); };
+    LobeMetrics m;
+    m.misplaced_energy = num(j.at("misplaced_energy"));
+    m.albedo_ref = j.at("albedo_ref").get<double>();
+    m.albedo_model = j.at("albedo_model").get<double>();
+    m.albedo_error = num(j.at("albedo_error"));
+    m.rmse = j.at("rmse").get<double>();
+    m.log_rmse = j.at("log_rmse").get<double>();
+    return m;
+}
+
+// Layout: magic line, one line of JSON (key, budget, floor, sizes), then float32 data:
+// for each side present, f then se, bins × 3 channels.
+std::string serialize(const ReferenceKey& key, const ReferencePiece& p) {
+    nlohmann::json meta;
+    meta["key"] = key.canonical();
+    meta["has_transmission"] = p.has_transmission;
+    meta["bins"] = key.grid.size();
+    meta["seconds"] = p.seconds;
+    nlohmann::json budget;
+    for (int t = 0; t < kBudgetTerms; ++t)
+        budget[kBudgetTermNames[t]] = {p.budget.term[t][0], p.budget.term[t][1],
+                                       p.budget.term[t][2]};
+    budget["reflected_se"] = {p.budget.reflected_se[0], p.budget.reflected_se[1],
+                              p.budget.reflected_se[2]};
+    budget["transmitted_se"] = {p.budget.transmitted_se[0], p.budget.transmitted_se[1],
+                                p.budget.transmitted_se[2]};
+    meta["budget"] = budget;
+    for (int side = 0; side < 2; ++side)
+        for (int c = 0; c < 3; ++c)
+            meta["floor"][side][c] = metrics_json(p.floor[side][c]);
+    std::string out = kMagic + meta.dump() + "\n";
+    std::vector<float> data;
+    for (int side = 0; side < (p.has_transmission ? 2 : 1); ++side)
+        for (const auto* v : {&p.f[side], &p.se[side]})
+            for (const Rgbd& x : *v)
+                for (int c = 0; c < 3; ++c)
+                    data.push_back(float(x[c]));
+    const std::size_t offset = out.size();
+    out.resize(offset + data.size() * sizeof(float));
+    std::memcpy(out.data() + offset, data.data(), data.size() * sizeof(float));
+    return out;
+}
+
+bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePiece& p) {
+    const std::size_t magic_len = std::strlen(kMagic);
+    if (bytes.compare(0, magic_len, kMagic) != 0) return false;
+    const std::size_t eol = bytes.find('\n', magic_len);
+    if (eol == std::string::npos) return false;
+    nlohmann::json meta;
+    try {
+        meta = nlohmann::json::parse(bytes.substr(magic_len, eol - magic_len));
+        if (meta.at("key").get<std::string>() != key.canonical()) return false;
+        if (meta.at("bins").get<std::size_t>() != key.grid.size()) return false;
+        p.has_transmission = meta.at("has_transmission").get<bool>();
+        p.seconds = meta.at("seconds").get<double>();
+        const auto& budget = meta.at("budget");
+        for (int t = 0; t < kBudgetTerms; ++t)
+            for (int c = 0; c < 3; ++c)
+                p.budget.term[t][c] = budget.at(kBudgetTermNames[t]).at(c).get<double>();
+        for (int c = 0; c < 3; ++c) {
+            p.budget.reflected_se[c] = budget.at("reflected_se").at(c).get<double>();
+            p.budget.transmitted_se[c] = budget.at("transmitted_se").at(c).get<double>();
+        }
+        for (int side = 0; side < 2; ++side)
+            for (int c = 0; c < 3; ++c)
+                p.floor[side][c] = metrics_from_json(meta.at("floor").at(side).at(c));
+    } catch (const std::exception&) {
+        return false;
+    }
+    const std::size_t sides = p.has_transmission ? 2 : 1;
+    const std::size_t n = key.grid.size();
+    const std::size_t expected = sides * 2 * n * 3 * sizeof(float);
+    if (bytes.size() != eol + 1 + expected) return false;
+    std::vector<float> data(expected / sizeof(float));
+    std::memcpy(data.data(), bytes.data() + eol + 1, expected);
+    std::size_t at = 0;
+    for (std::size_t side = 0; side < sides; ++side)
+        for (auto* v : {&p.f[side], &p.se[side]}) {
+            v->resize(n);
+            for (Rgbd& x : *v)
+                for (int c = 0; c < 3; ++c)
+                    x[c] = data[at++];
+        }
+    return true;
+}
+
+std::string read_file(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+}  // namespace
+
+std::string ReferenceKey::canonical() const {
+    return fmt::format(
+        "lamina {} | config {} | stack {} | theta_i {} | particles {} | seed {} | "
+        "grid {}",
+        kVersion, config_id, stack_to_json(stack).dump(), theta_i_deg, particles, seed,
+        grid.to_string());
+}
+
+std::string ReferenceKey::file_name() const {
+    return fmt::format("theta{}-n{}-s{}-{:016x}.bin", theta_i_deg, particles, seed,
+                       fnv1a(canonical()));
+}
+
+std::uint64_t second_half_seed(std::uint64_t seed) {
+    // A fixed odd offset (the 64-bit golden ratio): a different key for Philox, never equal.
+    return seed + 0x9e3779b97f4a7c15ull;
+}
+
+ReferencePiece reference_piece(const std::filesystem::path& cache_dir, const ReferenceKey& key,
+                               int threads, const std::function<void(std::uint64_t)>& on_progress,
+                               bool* computed) {
+    const std::filesystem::path dir = cache_dir / key.config_id;
+    const std::filesystem::path file = dir / key.file_name();
+    ReferencePiece piece;
+    if (std::filesystem::exists(file) && deserialize(read_file(file), key, piece)) {
+        if (computed) *computed = false;
+        return piece;
+    }
+    // Two halves with different seeds; the same stream (the incidence) in each.
+    SimulationSettings s;
+    s.theta_i_deg = {key.theta_i_deg};
+    s.grid = key.grid;
+    s.threads = threads;
+    s.particles = (key.particles + 1) / 2;
+    s.seed = key.seed;
+    const SimulationResult a = simulate(key.stack, s, on_progress);
+    const std::uint64_t n_a = s.particles;
+    s.particles = key.particles - n_a;
+    s.seed = second_half_seed(key.seed);
+    const SimulationResult b = simulate(key.stack, s, on_progress);
+    const std::uint64_t n_b = s.particles;
+    const double wa = double(n_a) / double(key.particles), wb = double(n_b) / double(key.particles);
+
+    piece.has_transmission = a.table.has_transmission;
+    piece.seconds = a.seconds + b.seconds;
+    for (int side = 0; side < (piece.has_transmission ? 2 : 1); ++side) {
+        const Side sd = side == 0 ? Side::Reflection : Side::Transmission;
+        const BinnedLobe& la = a.table.lobe(0, sd);
+        const BinnedLobe& lb = b.table.lobe(0, sd);
+        piece.f[side].resize(key.grid.size());
+        piece.se[side].resize(key.grid.size());
+        for (std::size_t j = 0; j < key.grid.size(); ++j)
+            for (int c = 0; c < 3; ++c) {
+                piece.f[side][j][c] = wa * la.f[j][c] + wb * lb.f[j][c];
+                piece.se[side][j][c] = std::hypot(wa * la.se[j][c], wb * lb.se[j][c]);
+            }
+        for (int c = 0; c < 3; ++c)
+            piece.floor[side][c] = noise_floor(key.grid, la.f, lb.f, c);
+    }
+    const EnergyBudget& ba = a.incidences[0].budget;
+    const EnergyBudget& bb = b.incidences[0].budget;
+    for (int t = 0; t < kBudgetTerms; ++t)
+        piece.budget.term[t] = ba.term[t] * wa + bb.term[t] * wb;
+    for (int c = 0; c < 3; ++c) {
+        piece.budget.reflected_se[c] = std::hypot(wa * ba.reflected_se[c], wb * bb.reflected_se[c]);
+        piece.budget.transmitted_se[c] =
+            std::hypot(wa * ba.transmitted_se[c], wb * bb.transmitted_se[c]);
+    }
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    const std::string bytes = serialize(key, piece);
+    write_file_atomic(file, bytes);
+    // Return exactly what a later run will read back (float32 tables), so that a resumed study
+    // computes the same metrics as an uninterrupted one.
+    ReferencePiece stored;
+    deserialize(bytes, key, stored);
+    if (computed) *computed = true;
+    return stored;
+}
+
+}  // namespace lamina

@@ -1,0 +1,54 @@
+#pragma once
+// The study's reference for one (configuration, incidence): the goniophotometer run as two
+// independent halves (different seeds), stored once on disk and reused by every later run
+// (resumable studies). The reference is the halves' average; the metrics between the halves give
+// the noise floor.
+
+#include "core/grid.h"
+#include "core/rgb.h"
+#include "layers/stack.h"
+#include "simulator/goniophotometer.h"
+#include "study/metrics.h"
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+struct ReferenceKey {
+    std::string config_id;
+    Stack stack;
+    double theta_i_deg = 0;
+    std::uint64_t particles = 0;  ///< in all, both halves together
+    std::uint64_t seed = 1;
+    HemisphereGrid grid;
+
+    /// A canonical text of every field (and lamina's version) and its 64-bit FNV-1a hash.
+    std::string canonical() const;
+    std::string file_name() const;
+};
+
+struct ReferencePiece {
+    bool has_transmission = false;
+    /// [side][bin]: the average of the halves and its standard error, as stored (float32).
+    std::array<std::vector<Rgbd>, 2> f, se;
+    EnergyBudget budget;                              ///< average of the halves
+    std::array<std::array<LobeMetrics, 3>, 2> floor;  ///< [side][channel]
+    double seconds = 0;
+};
+
+/// Loads the piece for `key` from `cache_dir` if it is there and intact (its stored key equals
+/// `key`, its sizes match); otherwise simulates it (threads: 0 = all), stores it atomically and
+/// returns it. `on_progress` receives particle counts while simulating. `computed` tells which.
+ReferencePiece reference_piece(const std::filesystem::path& cache_dir, const ReferenceKey& key,
+                               int threads, const std::function<void(std::uint64_t)>& on_progress,
+                               bool* computed = nullptr);
+
+/// The seed of the second half, derived from the study's seed.
+std::uint64_t second_half_seed(std::uint64_t seed);
+
+}  // namespace lamina

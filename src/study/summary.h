@@ -1,0 +1,24 @@
+#pragma once
+// The study's findings at a glance (summary.md, summary.json): per category and overall, each
+// model's mean and worst misplaced energy and albedo error, the ranking, the challenging cases,
+// what is not supported, and the approximations assessment (errors by the factors that stress
+// each approximation: coat roughness, base albedo, incidence).
+
+#include "study/configurations.h"
+#include "study/study.h"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+/// A configuration is "challenging" when even its best supporting model misplaces more than this
+/// fraction of the reference's energy on average over incidences, sides and channels.
+inline constexpr double kChallengingThreshold = 0.2;
+
+void write_summary(const std::filesystem::path& out_dir,
+                   const std::vector<StudyConfiguration>& configs, const StudySettings& settings,
+                   const std::vector<std::string>& models, const std::vector<MetricRow>& rows);
+
+}  // namespace lamina
