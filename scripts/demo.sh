@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# `make demo`: the main job as it exists. Validates the example stacks and runs the reference
-# (the virtual goniophotometer) on each, printing its energy budget.
+# `make demo`: lamina's main job. Runs the quick study (the 60 configurations, 10^6 particles per
+# incidence, every model) and says where the report is. Resumable: a second run reuses what is done.
 set -euo pipefail
 build=${1:-build}
 cd "$(dirname "$0")/.."
@@ -8,13 +8,12 @@ lamina="$build/lamina"
 
 echo "== The example stacks"
 "$lamina" validate examples/*.json
-
-for stack in examples/*.json; do
-    name=$(basename "$stack" .json)
-    out="out/simulate/$name"
-    echo
-    echo "== Goniophotometer: $name (7 incidences, 10^6 particles each) -> $out"
-    "$lamina" simulate "$stack" --particles 1e6 --out "$out"
-done
 echo
-echo "Tables and budgets are in out/simulate/*/ (formats: docs/formats.md)."
+echo "== The quick study: 60 configurations x 7 incidences x 10^6 particles, every model"
+start=$(date +%s)
+"$lamina" study --preset quick --out out/study-quick
+echo
+echo "Done in $(( $(date +%s) - start )) s. Report: out/study-quick/summary.md"
+if [ -f out/study-quick/index.html ]; then
+    echo "Explorer: open out/study-quick/index.html in a browser (figures in out/study-quick/figures/)."
+fi

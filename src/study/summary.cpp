@@ -273,9 +273,10 @@ void write_summary(const std::filesystem::path& out_dir,
             continue;
         }
         const Aggregate& best = agg[g][rk.front()];
-        out("- **{}** ({} configurations): use **{}** — mean misplaced energy {} (noise floor {}), "
+        out("- **{}** ({} configuration{}): use **{}** — mean misplaced energy {} (noise floor {}), "
             "worst {} ({}); mean |albedo error| {}.",
-            g, configs_in[g], rk.front(), pct(best.mean_e()), pct(best.mean_floor()),
+            g, configs_in[g], configs_in[g] == 1 ? "" : "s", rk.front(), pct(best.mean_e()),
+            pct(best.mean_floor()),
             pct(best.worst_e), where(best.worst_e_row), pct(best.mean_abs_albedo()));
         if (rk.size() > 1) {
             out(" Then ");

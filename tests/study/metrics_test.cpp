@@ -1,0 +1,161 @@
+// The study's metrics on hand-computed tables.
+#include "study/metrics.h"
+#include "study/configurations.h"
+#include "study/reference.h"
+#include "support/stacks.h"
+
+#include "core/error.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+namespace lamina {
+namespace {
+
+std::vector<Rgbd> constant(const HemisphereGrid& grid, double v) {
+    return std::vector<Rgbd>(grid.size(), Rgbd(v));
+}
+
+TEST(StudyMetrics, IdenticalTablesHaveNoError) {
+    const HemisphereGrid grid(9, 9);
+    std::vector<Rgbd> f(grid.size());
+    for (std::size_t j = 0; j < f.size(); ++j)
+        f[j] = Rgbd(0.1 * (j % 7), 0.2, 0.01 * j);
+    for (int c = 0; c < 3; ++c) {
+        const LobeMetrics m = lobe_metrics(grid, f, f, c);
+        EXPECT_EQ(m.misplaced_energy, 0.0);
+        EXPECT_EQ(m.albedo_error, 0.0);
+        EXPECT_EQ(m.rmse, 0.0);
+        EXPECT_EQ(m.log_rmse, 0.0);
+    }
+}
+
+TEST(StudyMetrics, DoubleTheEnergyMisplacesAllOfIt) {
+    // f = 2 f̂ everywhere: Σ|f − f̂|Ω⊥ / Σ f̂Ω⊥ = 1 and the albedo error is +100%.
+    const HemisphereGrid grid(9, 9);
+    const auto ref = constant(grid, 1 / kPi<double>);  // a white Lambertian: albedo exactly 1
+    const auto model = constant(grid, 2 / kPi<double>);
+    const LobeMetrics m = lobe_metrics(grid, ref, model, 0);
+    EXPECT_NEAR(m.misplaced_energy, 1.0, 1e-12);
+    EXPECT_NEAR(m.albedo_ref, 1.0, 1e-12);  // Σ Ω⊥ over the hemisphere is π
+    EXPECT_NEAR(m.albedo_error, 1.0, 1e-12);
+    // Weighted RMSE of a constant offset 1/π is 1/π; log-RMSE of log(1+2/π) − log(1+1/π).
+    EXPECT_NEAR(m.rmse, 1 / kPi<double>, 1e-12);
+    EXPECT_NEAR(m.log_rmse, std::log1p(2 / kPi<double>) - std::log1p(1 / kPi<double>), 1e-12);
+}
+
+TEST(StudyMetrics, MovedEnergyIsMisplacedTwice) {
+    // Moving a fraction q of the energy from one half of the bins to the other keeps the albedo
+    // and misplaces 2q: what leaves one place and arrives elsewhere both count.
+    const HemisphereGrid grid(2, 1);  // two θ bins with Ω⊥ = π/2 each (sin² 45° = 1/2)
+    const std::vector<Rgbd> ref = {Rgbd(1.0), Rgbd(1.0)};
+    const std::vector<Rgbd> model = {Rgbd(1.25), Rgbd(0.75)};
+    const LobeMetrics m = lobe_metrics(grid, ref, model, 1);
+    EXPECT_NEAR(m.albedo_error, 0.0, 1e-15);
+    EXPECT_NEAR(m.misplaced_energy, 0.25, 1e-15);  // (0.25 + 0.25)·π/2 / (2·π/2)
+}
+
+TEST(StudyMetrics, EmptyReferenceHasNoRelativeError) {
+    const HemisphereGrid grid(3, 3);
+    const LobeMetrics m = lobe_metrics(grid, constant(grid, 0), constant(grid, 0.1), 0);
+    EXPECT_TRUE(std::isnan(m.misplaced_energy));
+    EXPECT_TRUE(std::isnan(m.albedo_error));
+    EXPECT_GT(m.rmse, 0);
+}
+
+// The noise floor shrinks as 1/√N, and matches its expected value. For a white-ish Lambertian each
+// particle lands in bin j with probability p_j = Ω⊥_j/π carrying flux ρ, so a half-reference of n
+// particles estimates f_j with relative standard deviation s_j = √((1 − p_j)/(n p_j)); the halves'
+// relative difference D_j has √2 s_j. The floor Σ_j p_j |D_j| / 2 (normalizing by the reference
+// energy, whose own noise is negligible) has mean Σ p_j √(2/π) √2 s_j / 2 and standard deviation
+// √(Σ p_j² 2 s_j² (1 − 2/π)) / 2 (|Z| of a normal Z has mean √(2/π), variance 1 − 2/π).
+TEST(StudyMetricsStat, NoiseFloorShrinksAsOneOverSqrtN) {
+    const Stack stack = test::make_stack({test::lambertian_layer(Rgbd(0.8))});
+    const HemisphereGrid grid(9, 9);
+    auto floor_at = [&](std::uint64_t n) {
+        SimulationSettings s;
+        s.theta_i_deg = {30};
+        s.grid = grid;
+        s.particles = n;
+        s.seed = 11;
+        const auto a = simulate(stack, s);
+        s.seed = second_half_seed(11);
+        const auto b = simulate(stack, s);
+        return noise_floor(grid, a.table.lobe(0, Side::Reflection).f,
+                           b.table.lobe(0, Side::Reflection).f, 0)
+            .misplaced_energy;
+    };
+    auto expected = [&](double n, double* sd) {
+        double mean = 0, var = 0;
+        for (std::size_t j = 0; j < grid.size(); ++j) {
+            const double p = grid.projected_solid_angle(j) / kPi<double>;
+            const double s_d = std::sqrt(2 * (1 - p) / (n * p));  // of the halves' difference
+            mean += p * std::sqrt(2 / kPi<double>) * s_d / 2;
+            var += p * p * s_d * s_d * (1 - 2 / kPi<double>) / 4;
+        }
+        *sd = std::sqrt(var);
+        return mean;
+    };
+    double sd1, sd4;
+    const double e1 = expected(40'000, &sd1), e4 = expected(160'000, &sd4);
+    const double f1 = floor_at(40'000), f4 = floor_at(160'000);
+    EXPECT_NEAR(f1, e1, 4 * sd1);
+    EXPECT_NEAR(f4, e4, 4 * sd4);
+    // The ratio is 2 to within the propagated 4σ.
+    const double ratio_sd = 2 * std::hypot(sd1 / e1, sd4 / e4);
+    EXPECT_NEAR(f1 / f4, 2.0, 4 * ratio_sd) << f1 << " " << f4;
+}
+
+TEST(StudyConfigurations, SixtyWithStableUniqueIds) {
+    const auto configs = builtin_configurations();
+    ASSERT_EQ(configs.size(), 60u);
+    std::set<std::string> ids;
+    std::map<std::string, int> per_category;
+    for (const auto& c : configs) {
+        EXPECT_TRUE(ids.insert(c.id).second) << c.id;
+        ++per_category[c.category];
+        EXPECT_EQ(c.stack.layers.size(), 2u);
+        EXPECT_EQ(c.stack.layers[0].interface.eta, 1.5);
+    }
+    EXPECT_EQ(per_category["plastic"], 20);
+    EXPECT_EQ(per_category["metallic-paint"], 10);
+    EXPECT_EQ(per_category["frosted-metal"], 10);
+    EXPECT_EQ(per_category["slab"], 20);
+    // study.md's example ids.
+    EXPECT_TRUE(ids.count("plastic-P1-a0.05"));
+    EXPECT_TRUE(ids.count("paint-a0.001-a1.3"));
+    const auto only = filter_configurations(configs, "slab-*-tinted");
+    EXPECT_EQ(only.size(), 10u);
+    EXPECT_THROW(filter_configurations(configs, "nothing*"), InputError);
+}
+
+TEST(StudyReference, CachedPieceIsReusedAndAMismatchIsRecomputed) {
+    const std::filesystem::path dir =
+        std::filesystem::path(LAMINA_BINARY_DIR) / "test-output" / "reference-cache";
+    std::filesystem::remove_all(dir);
+    ReferenceKey key{
+        "lambertian",        test::make_stack({test::lambertian_layer(Rgbd(0.5))}), 30.0, 20'000, 5,
+        HemisphereGrid(9, 9)};
+    bool computed = false;
+    const ReferencePiece first = reference_piece(dir, key, 0, {}, &computed);
+    EXPECT_TRUE(computed);
+    const ReferencePiece again = reference_piece(dir, key, 0, {}, &computed);
+    EXPECT_FALSE(computed);
+    EXPECT_EQ(first.f[0], again.f[0]);
+    EXPECT_EQ(first.se[0], again.se[0]);
+    // A truncated file is never trusted.
+    const auto file = dir / key.config_id / key.file_name();
+    std::filesystem::resize_file(file, std::filesystem::file_size(file) - 7);
+    const ReferencePiece redone = reference_piece(dir, key, 0, {}, &computed);
+    EXPECT_TRUE(computed);
+    EXPECT_EQ(first.f[0], redone.f[0]);
+    // Another seed is another piece.
+    key.seed = 6;
+    reference_piece(dir, key, 0, {}, &computed);
+    EXPECT_TRUE(computed);
+}
+
+}  // namespace
+}  // namespace lamina
