@@ -5,6 +5,10 @@
 #include <cmath>
 #include <numbers>
 
+/// Forces inlining of small hot-path functions the compiler's heuristics would keep out of line
+/// (the particle tracer's interface samplers).
+#define LAMINA_FORCE_INLINE inline __attribute__((always_inline))
+
 namespace lamina {
 
 template <typename T>

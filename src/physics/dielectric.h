@@ -99,7 +99,8 @@ struct DielectricInterface {
     /// microsurface (physics.md §3). uc picks the Fresnel branch; u1, u2 the normal.
     /// kWithPdf = false skips the density (the particle tracer only needs the weight).
     template <bool kWithPdf = true>
-    std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T uc, T u1, T u2) const {
+    LAMINA_FORCE_INLINE std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T uc, T u1,
+                                                             T u2) const {
         if (wi.z == 0) return std::nullopt;
         if (is_smooth()) return sample_smooth(wi, uc);
         if (is_index_matched()) return sample_index_matched(wi);

@@ -99,28 +99,42 @@ void write_summary(const std::filesystem::path& out_dir,
     std::map<std::string, const StudyConfiguration*> by_id;
     std::vector<std::string> categories;
     std::map<std::string, int> configs_in;
+    bool any_transmission = false;
     for (const StudyConfiguration& c : configs) {
         by_id[c.id] = &c;
         if (std::find(categories.begin(), categories.end(), c.category) == categories.end())
             categories.push_back(c.category);
         ++configs_in[c.category];
         ++configs_in["all"];
+        if (c.stack.transmits()) {
+            ++configs_in[c.category + " BTDF"];
+            ++configs_in["all BTDF"];
+            any_transmission = true;
+        }
     }
+    // Groups: each category's BRDF, then the BTDF of the categories that transmit (a model's
+    // reflection and transmission errors are never averaged together: most models have no BTDF).
     std::vector<std::string> groups = categories;
+    for (const std::string& c : categories)
+        if (configs_in.count(c + " BTDF")) groups.push_back(c + " BTDF");
     groups.push_back("all");
+    if (any_transmission) groups.push_back("all BTDF");
+    auto group_of = [](const MetricRow& r) {
+        return r.side == 'T' ? r.category + " BTDF" : r.category;
+    };
 
     // Aggregates per (group, model).
     std::map<std::string, std::map<std::string, Aggregate>> agg;
     for (const MetricRow& r : rows) {
-        agg[r.category][r.model].add(r);
-        agg["all"][r.model].add(r);
+        agg[group_of(r)][r.model].add(r);
+        agg[r.side == 'T' ? "all BTDF" : "all"][r.model].add(r);
     }
 
     // Per configuration and model: the mean misplaced energy; support.
     std::map<std::string, std::map<std::string, Aggregate>> per_config;
     std::map<std::string, std::map<std::string, std::set<char>>> unsupported;
     for (const MetricRow& r : rows) {
-        per_config[r.config][r.model].add(r);
+        if (r.side == 'R') per_config[r.config][r.model].add(r);  // challenging: the BRDF
         if (!r.supported) unsupported[r.model][r.config].insert(r.side);
     }
 
@@ -195,9 +209,10 @@ void write_summary(const std::filesystem::path& out_dir,
         for (const std::string& m : models)
             assessment[f][m].resize(factors[f].levels.size());
     for (const MetricRow& r : rows)
-        for (std::size_t f = 0; f < factors.size(); ++f)
-            for (std::size_t l = 0; l < factors[f].levels.size(); ++l)
-                if (factors[f].levels[l].second(r)) assessment[f][r.model][l].add(r);
+        if (r.side == 'R')
+            for (std::size_t f = 0; f < factors.size(); ++f)
+                for (std::size_t l = 0; l < factors[f].levels.size(); ++l)
+                    if (factors[f].levels[l].second(r)) assessment[f][r.model][l].add(r);
 
     // ---- summary.json ----
     nlohmann::json j;
@@ -267,17 +282,18 @@ void write_summary(const std::filesystem::path& out_dir,
     out("## Findings\n\n");
     for (const std::string& g : groups) {
         const auto& rk = ranking[g];
-        if (g == "all") continue;
+        if (g == "all" || g == "all BTDF") continue;
         if (rk.empty()) {
             out("- **{}** ({} configurations): no model supports it.\n", g, configs_in[g]);
             continue;
         }
         const Aggregate& best = agg[g][rk.front()];
-        out("- **{}** ({} configuration{}): use **{}** — mean misplaced energy {} (noise floor {}), "
+        out("- **{}** ({} configuration{}): use **{}** — mean misplaced energy {} (noise floor "
+            "{}), "
             "worst {} ({}); mean |albedo error| {}.",
             g, configs_in[g], configs_in[g] == 1 ? "" : "s", rk.front(), pct(best.mean_e()),
-            pct(best.mean_floor()),
-            pct(best.worst_e), where(best.worst_e_row), pct(best.mean_abs_albedo()));
+            pct(best.mean_floor()), pct(best.worst_e), where(best.worst_e_row),
+            pct(best.mean_abs_albedo()));
         if (rk.size() > 1) {
             out(" Then ");
             for (std::size_t k = 1; k < rk.size(); ++k)
@@ -343,14 +359,14 @@ void write_summary(const std::filesystem::path& out_dir,
     out("## Worst cases\n\n| model | group | worst misplaced energy | where "
         "|\n|---|---|---|---|\n");
     for (const std::string& m : models)
-        for (const std::string& g : categories)
-            if (agg[g][m].n)
+        for (const std::string& g : groups)
+            if (g != "all" && g != "all BTDF" && agg[g][m].n)
                 out("| {} | {} | {} | {} |\n", m, g, pct(agg[g][m].worst_e),
                     where(agg[g][m].worst_e_row));
     out("\n");
 
     out("## Challenging cases\n\nConfigurations where even the best supporting model misplaces "
-        "more than {} of the energy on average over incidences, sides and channels.\n\n",
+        "more than {} of the reflected energy on average over incidences and channels.\n\n",
         pct(kChallengingThreshold));
     if (challenging.empty()) {
         out("None.\n\n");
@@ -362,8 +378,9 @@ void write_summary(const std::filesystem::path& out_dir,
         out("\n");
     }
 
-    out("## Approximations assessment\n\nMean misplaced energy of each model, rows grouped by the "
-        "factor that stresses an approximation (as in the original study's assessment).\n\n");
+    out("## Approximations assessment\n\nMean misplaced energy of each model's BRDF, rows grouped "
+        "by the factor that stresses an approximation (as in the original study's assessment); "
+        "in parentheses the noise floor.\n\n");
     for (std::size_t f = 0; f < factors.size(); ++f) {
         out("### {}\n\n{}\n\n| model |", factors[f].title, factors[f].explanation);
         for (const auto& level : factors[f].levels)
