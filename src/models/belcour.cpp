@@ -63,9 +63,11 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         double alpha_eff = 0;
         const bool is_interface = op.kind != BelcourOperator::Medium;
         if (is_interface) {
-            sR12 = variance_of(op.alpha, q);
-            // Roughness the lobe sees: what was accumulated above plus this interface's own.
-            alpha_eff = alpha_of(sT0i + sR12, q);
+            const bool pre = op.precomputed && op.precomputed_quadratic == q;
+            sR12 = pre ? op.sigma_r : variance_of(op.alpha, q);
+            // Roughness the lobe sees: what was accumulated above plus this interface's own
+            // (nothing above: α itself, α(σ(α)) = α).
+            alpha_eff = pre && sT0i == 0 ? op.alpha_clamped : alpha_of(sT0i + sR12, q);
             if (op.kind == BelcourOperator::Dielectric) {
                 // Snell's law on the mean direction; TIR: no transmission.
                 const double sin2_t = (1 - c * c) / sqr(op.n12);
@@ -82,8 +84,10 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
                         sT21 = variance_of(op.alpha * 0.5 * std::abs(1 - op.n12 * ct / c), q);
                     } else {
                         // The author's code (models.md): angle-independent scalings.
-                        sT12 = variance_of(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
-                        sT21 = variance_of(op.alpha * 0.5 * std::abs(1 - op.n12), q);
+                        sT12 = pre ? op.sigma_t12
+                                   : variance_of(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
+                        sT21 = pre ? op.sigma_t21
+                                   : variance_of(op.alpha * 0.5 * std::abs(1 - op.n12), q);
                     }
                 }
             } else {
@@ -111,7 +115,9 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         if (is_interface && out.n_lobes < BelcourStats::kMaxLobes) {
             // The lobe variance uses J0i before this layer, as the author's code does.
             const double sigma_k = sTi0 + J0i * (sT0i + sR12 + rr * (sR12 + sRi0));
-            out.lobes[out.n_lobes++] = {E, alpha_of(sigma_k, q)};
+            const bool only_own = op.precomputed && op.precomputed_quadratic == q &&
+                                  sigma_k == sR12;  // nothing accumulated: α itself
+            out.lobes[out.n_lobes++] = {E, only_own ? op.alpha_clamped : alpha_of(sigma_k, q)};
             const double w_old = mean(R0i), w_new = mean(E);
             if (w_old + w_new > 0) sR0i = (w_old * sR0i + w_new * sigma_k) / (w_old + w_new);
         }
@@ -158,6 +164,17 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         out.cos_t = c;
     }
     return out;
+}
+
+void precompute_variances(std::vector<BelcourOperator>& ops, bool q) {
+    for (BelcourOperator& op : ops) {
+        op.precomputed = true;
+        op.precomputed_quadratic = q;
+        op.alpha_clamped = alpha_of(variance_of(op.alpha, q), q);
+        op.sigma_r = variance_of(op.alpha, q);
+        op.sigma_t12 = variance_of(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
+        op.sigma_t21 = variance_of(op.alpha * 0.5 * std::abs(1 - op.n12), q);
+    }
 }
 
 namespace {
@@ -224,6 +241,7 @@ class BelcourModel final : public Model {
             support_.btdf = ch_.btdf;
             if (!ch_.btdf) support_.reason = fmt::format("{} gives no BTDF (Bel' does)", name_);
         }
+        precompute_variances(ops_, ch_.quadratic_mapping);
         top_ = ops_.front();
         if (stack.transmits()) exit_eta_ = stack.layers.back().interface.eta / stack.ambient_eta;
     }

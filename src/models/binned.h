@@ -7,11 +7,12 @@
 // sin θ cos θ in the integrand. (The measure is uniform in u = sin²θ, but in u the integrand has
 // square-root edges at the normal and at grazing that adaptive bisection cannot shake off; in θ it
 // is smooth up to both ends.)
-// Each rectangle gets a 2×2 and a 3×3 Gauss–Legendre product rule (13 evaluations); if they differ
-// by more than the bin's tolerance τ = rel_tol·|bin average| + abs_tol (largest channel), it is
-// bisected in both coordinates (recursively, up to max_depth, within an evaluation budget per
-// bin), and the 3×3 value of accepted rectangles is kept; the error estimate |I3 − I2| bounds
-// the error of I2, so the kept I3 is conservative. A rectangle that contains one of the model's
+// Each rectangle gets the 3×3 Gauss–Legendre product rule and the degree-3 rule embedded in its
+// centre and axis nodes (9 evaluations); if they differ by more than the bin's tolerance
+// τ = rel_tol·|bin average| + abs_tol (largest channel), it is bisected in both coordinates
+// (recursively, up to max_depth, within an evaluation budget per bin), and the 3×3 value of
+// accepted rectangles is kept; the difference estimates the error of the lower-degree rule, so
+// the kept value is conservative. A rectangle that contains one of the model's
 // peak directions (mirror; refracted for a BTDF) is always bisected towards it, down to a size of
 // ~1e-10 in u: a lobe of α = 0.001 inside one bin is then resolved even though no coarse node sees
 // it. Delta lobes add energy / Ω⊥ to the bin they hit. Parallel over (incidence, side, θ row) with
