@@ -317,9 +317,7 @@ class BelcourModel final : public Model {
 
     Rgbd top_fresnel(double cos_theta) const {
         if (top_.kind == BelcourOperator::Conductor)
-            return {fresnel_complex_fast(cos_theta, top_.eta[0], top_.k[0]),
-                    fresnel_complex_fast(cos_theta, top_.eta[1], top_.k[1]),
-                    fresnel_complex_fast(cos_theta, top_.eta[2], top_.k[2])};
+            return fresnel_complex_rgb(cos_theta, top_.eta, top_.k);
         return Rgbd(fresnel_dielectric(cos_theta, top_.n12));
     }
 

@@ -129,6 +129,29 @@ double fresnel_complex_fast(double cos_theta, double eta, double k) {
     return 0.5 * (rp + rs);
 }
 
+Rgbd fresnel_complex_rgb(double cos_theta, const Rgbd& eta, const Rgbd& k) {
+    cos_theta = clamp(cos_theta, 0.0, 1.0);
+    const double cos2 = cos_theta * cos_theta;
+    const double sin2 = 1 - cos2;
+    alignas(32) double e[4] = {eta[0], eta[1], eta[2], 1.5}, kk[4] = {k[0], k[1], k[2], 0.0};
+    alignas(32) double out[4];
+    // PBR 3rd ed., §8.2.1 (FrConductor), lane by lane.
+    for (int c = 0; c < 4; ++c) {
+        const double eta2 = e[c] * e[c], k2 = kk[c] * kk[c];
+        const double t0 = eta2 - k2 - sin2;
+        const double a2_plus_b2 = std::sqrt(t0 * t0 + 4 * eta2 * k2);
+        const double t1 = a2_plus_b2 + cos2;
+        const double a = std::sqrt(std::max(0.5 * (a2_plus_b2 + t0), 0.0));
+        const double t2 = 2 * cos_theta * a;
+        const double rs = (t1 - t2) / std::max(t1 + t2, 1e-300);
+        const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
+        const double t4 = t2 * sin2;
+        const double rp = rs * (t3 - t4) / std::max(t3 + t4, 1e-300);
+        out[c] = t1 + t2 > 0 ? 0.5 * (rp + rs) : 1.0;
+    }
+    return {out[0], out[1], out[2]};
+}
+
 double FgdTable::direct(double c, double alpha, double eta, double k, int n_r, int n_phi) {
     if (alpha <= 0) return fresnel_any(c, eta, k);
     double sum = 0;

@@ -17,6 +17,8 @@
 // the arguments are clamped. Multilinear interpolation; α = 0 returns the exact Fresnel factor.
 // Computed on first use (≈1 s on 2 cores) and cached on disk (models/table_cache.h).
 
+#include "core/rgb.h"
+
 #include <vector>
 
 namespace lamina {
@@ -48,5 +50,9 @@ class FgdTable {
 /// Humphreys, PBR 3rd ed., §8.2.1, FrConductor; after Born & Wolf §14.2). With κ = 0 and η < 1 it
 /// gives 1 under total internal reflection. Equal to fresnel_conductor, about 4× faster.
 double fresnel_complex_fast(double cos_theta, double eta, double k);
+
+/// The same for three channels at once (written as one loop over 4 lanes so the compiler
+/// vectorizes it; lamina_models is built with -fno-math-errno for that).
+Rgbd fresnel_complex_rgb(double cos_theta, const Rgbd& eta, const Rgbd& k);
 
 }  // namespace lamina

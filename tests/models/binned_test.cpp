@@ -96,7 +96,8 @@ TEST(Binned, BinAveragesAreGoodTo1e4Relative) {
             const auto& fa = a.lobe(0, Side::Reflection).f;
             const auto& fb = b.lobe(0, Side::Reflection).f;
             double peak = 0;
-            for (const Rgbd& v : fb) peak = std::max(peak, v.max());
+            for (const Rgbd& v : fb)
+                peak = std::max(peak, v.max());
             for (std::size_t j = 0; j < fa.size(); ++j)
                 for (int c = 0; c < 3; ++c)
                     ASSERT_NEAR(fa[j][c], fb[j][c], 1e-4 * fb[j][c] + 1e-10 * peak)

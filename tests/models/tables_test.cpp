@@ -27,6 +27,9 @@ TEST(FgdTable, FastComplexFresnelEqualsReference) {
                 const double want =
                     k == 0 ? fresnel_dielectric(c, eta) : fresnel_conductor(c, eta, k);
                 EXPECT_NEAR(fresnel_complex_fast(c, eta, k), want, 1e-12);
+                const Rgbd rgb = fresnel_complex_rgb(c, Rgbd(eta, 1.0, 2.0), Rgbd(k, 0.5, 1.0));
+                EXPECT_NEAR(rgb[0], want, 1e-12);
+                EXPECT_NEAR(rgb[2], fresnel_conductor(c, 2.0, 1.0), 1e-12);
             }
 }
 
