@@ -88,6 +88,8 @@ const TirTable& TirTable::get() {
 
 double TirTable::operator()(double c, double alpha, double eta) const {
     if (eta >= 1) return 1;
+    // Smooth interface: the exact step at the critical cosine (the table would blur it).
+    if (alpha <= 0) return c > std::sqrt(1 - eta * eta) ? 1.0 : 0.0;
     const double fc = clamp(c, 0.0, 1.0) * (kNc - 1);
     const double fa = clamp(alpha, 0.0, 1.0) * (kNalpha - 1);
     const double fe = (clamp(eta, kEtaMin, 1.0) - kEtaMin) / (1 - kEtaMin) * (kNeta - 1);

@@ -10,7 +10,8 @@
 // lamina computes the table itself by stratified Monte Carlo through the interface: 32 × 32
 // jittered strata of Heitz's sampling square per node, fixed seeds (bitwise reproducible). Axes:
 // c ∈ [0, 1] (33 uniform nodes), α ∈ [0, 1] (33), η ∈ [0.2, 1] (33); τ = 1 for η ≥ 1, η below
-// 0.2 clamped. Trilinear interpolation. Cached on disk like the FGD table.
+// 0.2 clamped. Trilinear interpolation; α = 0 gives the exact step at the critical cosine. Cached
+// on disk like the FGD table.
 
 #include <cstdint>
 #include <vector>

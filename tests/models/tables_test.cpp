@@ -108,6 +108,8 @@ TEST(TirTableStat, TableMatchesDirectMonteCarloOffGrid) {
 TEST(TirTable, SmoothLimitIsTheCriticalAngle) {
     EXPECT_EQ(TirTable::direct_mc(0.9, 0.0, 1 / 1.5, 1000), 1.0);  // c above √(1 − 1/2.25) ≈ 0.745
     EXPECT_EQ(TirTable::direct_mc(0.6, 0.0, 1 / 1.5, 1000), 0.0);
+    EXPECT_EQ(TirTable::get()(0.75, 0.0, 1 / 1.5), 1.0);  // just above: no interpolation blur
+    EXPECT_EQ(TirTable::get()(0.74, 0.0, 1 / 1.5), 0.0);
 }
 
 class CacheDir : public ::testing::Test {
