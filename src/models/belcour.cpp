@@ -109,7 +109,9 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
 
         // Adding (models.md): Dn = 1 − Ri0·R12 sums the inter-reflections between this operator
         // and everything above.
-        const Rgbd Dn = Rgbd(1.0) - Ri0 * R12;
+        Rgbd Dn = Rgbd(1.0) - Ri0 * R12;
+        for (int i = 0; i < 3; ++i)
+            Dn[i] = std::max(Dn[i], 1e-9);  // two perfect mirrors facing
         const Rgbd E = T0i * R12 * Ti0 / Dn;
         const double rr = mean(Ri0 * R12 / Dn);
         if (is_interface && out.n_lobes < BelcourStats::kMaxLobes) {
@@ -156,7 +158,7 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         last_transmits = transmits;
         if (op.kind == BelcourOperator::Conductor || (is_interface && !transmits)) break;
     }
-    (void)sR0i;
+    (void)sR0i;  // the reflected variance, tracked as models.md writes it; no lobe uses it
     if (last_was_dielectric && last_transmits) {
         out.transmits = true;
         out.transmitted = T0i;
