@@ -73,7 +73,8 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
                 const double sin2_t = (1 - c * c) / sqr(op.n12);
                 transmits = sin2_t < 1;
                 if (transmits) ct = std::max(std::sqrt(1 - sin2_t), 1e-6);
-                R12 = Rgbd(fgd(c, alpha_eff, op.n12, 0.0));
+                R12 =
+                    Rgbd(pre ? fgd(c, alpha_eff, op.fgd_index[0]) : fgd(c, alpha_eff, op.n12, 0.0));
                 if (transmits) {
                     T12 = Rgbd(1.0) - R12;
                     J12 = op.n12 * ct / c;  // Jacobian of the refracted variance
@@ -91,8 +92,12 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
                     }
                 }
             } else {
-                R12 = {fgd(c, alpha_eff, op.eta[0], op.k[0]), fgd(c, alpha_eff, op.eta[1], op.k[1]),
-                       fgd(c, alpha_eff, op.eta[2], op.k[2])};
+                if (pre) {
+                    R12 = fgd.rgb(c, alpha_eff, op.fgd_index);
+                } else {
+                    for (int i = 0; i < 3; ++i)
+                        R12[i] = fgd(c, alpha_eff, op.eta[i], op.k[i]);
+                }
             }
         } else {
             // Medium (models.md "Per medium"): unscattered plus once forward-scattered light,
@@ -176,6 +181,10 @@ void precompute_variances(std::vector<BelcourOperator>& ops, bool q) {
         op.sigma_r = variance_of(op.alpha, q);
         op.sigma_t12 = variance_of(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
         op.sigma_t21 = variance_of(op.alpha * 0.5 * std::abs(1 - op.n12), q);
+        for (int i = 0; i < 3; ++i)
+            op.fgd_index[i] = op.kind == BelcourOperator::Conductor
+                                  ? FgdTable::locate(op.eta[i], op.k[i])
+                                  : FgdTable::locate(op.n12, 0.0);
     }
 }
 

@@ -6,6 +6,7 @@
 // scheme (models.md, "Belcour 2018 and Bel'"; paper §4–6). Bel18 forward, Bel18 symmetric and
 // Bel' are one engine with the choices below; each has its own source file with its defaults.
 
+#include "models/fgd_table.h"
 #include "models/model.h"
 
 #include <array>
@@ -61,6 +62,7 @@ struct BelcourOperator {
     bool precomputed = false;
     bool precomputed_quadratic = false;
     double sigma_r = 0, sigma_t12 = 0, sigma_t21 = 0, alpha_clamped = 0;
+    std::array<FgdTable::Index, 3> fgd_index{};  ///< per channel (dielectric: all equal)
 };
 
 /// Fills the angle-independent variances of every operator for the given mapping.

@@ -19,6 +19,7 @@
 
 #include "core/rgb.h"
 
+#include <array>
 #include <vector>
 
 namespace lamina {
@@ -30,6 +31,18 @@ class FgdTable {
 
     /// Interpolated FGD. c = cos θi ∈ [0, 1], α ∈ [0, 1], η > 0, κ ≥ 0 (clamped to the axes).
     double operator()(double c, double alpha, double eta, double k) const;
+
+    /// The (η, κ) part of a lookup, located once per interface (the symmetric Belcour variant
+    /// looks the same indices up for every evaluation).
+    struct Index {
+        double eta = 1, k = 0;
+        int ie = 0, ik = 0;
+        double te = 0, tk = 0;
+    };
+    static Index locate(double eta, double k);
+    double operator()(double c, double alpha, const Index& at) const;
+    /// Three channels at once (a conductor), sharing the (c, α) part of the lookup.
+    Rgbd rgb(double c, double alpha, const std::array<Index, 3>& at) const;
 
     /// The same integral computed directly (no table, no binning) with an n_r × n_phi rule: the
     /// reference the table is tested against.

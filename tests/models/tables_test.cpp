@@ -82,6 +82,19 @@ TEST(FgdTable, TableMatchesDirectIntegrationOffGrid) {
     EXPECT_LT(sum_c / n, 1e-3);
 }
 
+// The RGB lookup equals three scalar lookups (one shared (c, α) part; the same interpolation).
+TEST(FgdTable, RgbLookupEqualsScalarLookups) {
+    const FgdTable& table = FgdTable::get();
+    const std::array<FgdTable::Index, 3> at = {
+        FgdTable::locate(0.18, 3.4), FgdTable::locate(0.42, 2.35), FgdTable::locate(1.37, 0.0)};
+    for (double c : {0.05, 0.5, 0.93})
+        for (double a : {0.0, 0.07, 0.3, 0.8}) {
+            const Rgbd v = table.rgb(c, a, at);
+            for (int i = 0; i < 3; ++i)
+                EXPECT_NEAR(v[i], table(c, a, at[i].eta, at[i].k), 1e-12) << c << " " << a;
+        }
+}
+
 // Smooth limit: α = 0 is the Fresnel factor itself, including total internal reflection.
 TEST(FgdTable, SmoothLimitIsFresnel) {
     const FgdTable& table = FgdTable::get();
