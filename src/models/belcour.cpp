@@ -254,7 +254,6 @@ class BelcourModel final : public Model {
         }
         precompute_variances(ops_, ch_.quadratic_mapping);
         top_ = ops_.front();
-        if (stack.transmits()) exit_eta_ = stack.layers.back().interface.eta / stack.ambient_eta;
     }
 
     std::string name() const override { return name_; }
@@ -356,7 +355,6 @@ class BelcourModel final : public Model {
     std::vector<BelcourOperator> ops_;
     BelcourOperator top_;
     Support support_;
-    double exit_eta_ = 1;
 };
 
 class BelcourForwardEvaluator final : public IncidentEvaluator {
