@@ -103,17 +103,23 @@ TEST(FgdTable, SmoothLimitIsFresnel) {
 }
 
 // TIR table against plain Monte Carlo (independent random numbers, 2·10⁵ samples, standard error
-// ≤ 1.2e-3) at off-grid points; the budget adds the table's stratified-MC noise (32×32 strata)
-// and the trilinear interpolation error, measured ≤ 6e-3 away from the sharp TIR edge of tiny α.
+// ≤ 1.2e-3) at off-grid points with α ≥ 0.05. Budget: the measured error of the table (stratified
+// MC noise + trilinear interpolation; docs/models.md): max 2.4e-2 (next to the critical angle at
+// small α, where τ is nearly a step), mean 1.5e-3 over 150 random points; tolerances 3e-2 / 4e-3.
 TEST(TirTableStat, TableMatchesDirectMonteCarloOffGrid) {
     const TirTable& table = TirTable::get();
     ParticleRng rng(5, 0, 0);
-    for (int i = 0; i < 40; ++i) {
+    double sum = 0;
+    const int n = 40;
+    for (int i = 0; i < n; ++i) {
         const double c = rng.uniform_double(), a = 0.05 + 0.9 * rng.uniform_double();
         const double eta = 0.4 + 0.55 * rng.uniform_double();
         const double mc = TirTable::direct_mc(c, a, eta, 200000, 100 + i);
-        EXPECT_NEAR(table(c, a, eta), mc, 1.5e-2) << c << " " << a << " " << eta;
+        const double err = std::abs(table(c, a, eta) - mc);
+        EXPECT_LT(err, 3e-2) << c << " " << a << " " << eta;
+        sum += err;
     }
+    EXPECT_LT(sum / n, 4e-3);
     EXPECT_EQ(table(0.5, 0.3, 1.2), 1.0);  // no TIR towards a denser medium
 }
 
