@@ -50,12 +50,13 @@ class WWModel final : public Model {
     /// What depends on wi alone (cached by prepare: the per-incidence path of the study).
     struct Incident {
         Vec3d wi;
-        double lambda0 = 0;  ///< Λ_α0(wi)
-        bool in_ok = false;  ///< wi refracted about n exists
-        Vec3d wi_in;         ///< wi refracted about n
-        Rgbd att{1.0};       ///< exp(−τ/μi') about n
-        double lambda1 = 0;  ///< Λ_α1(wi') of the base, about n
-        double T01_n = 0;    ///< 1 − F(μi)
+        double lambda0 = 0;      ///< Λ_α0(wi)
+        bool in_ok = false;      ///< wi refracted about n exists
+        Vec3d wi_in;             ///< wi refracted about n
+        Rgbd att{1.0};           ///< exp(−τ/μi') about n
+        double lambda1 = 0;      ///< Λ_α1(wi') of the base, about n
+        double lambda1_out = 0;  ///< Λ_α1(wi) of the base (f_base at the outside directions)
+        double T01_n = 0;        ///< 1 − F(μi)
     };
 
     Incident incident(const Vec3d& wi) const {
@@ -63,6 +64,7 @@ class WWModel final : public Model {
         in.wi = wi;
         if (!support_.brdf || wi.z <= 0) return in;
         if (coat_.alpha0 > 0) in.lambda0 = GGX<double>{coat_.alpha0}.lambda(wi);
+        if (base_alpha_ > 0) in.lambda1_out = GGX<double>{base_alpha_}.lambda(wi);
         in.T01_n = 1 - fresnel_coat(wi.z);
         if (const auto w = refract_in_n(wi)) {
             in.in_ok = true;
@@ -94,7 +96,7 @@ class WWModel final : public Model {
         }
         if (base_is_delta()) return f;
         if (choices_.refract_about_h) {
-            const std::optional<Rgbd> base = base_term(wi, wo, h, G0);
+            const std::optional<Rgbd> base = base_term_about_h(in, wo, h, cos_h, G0);
             return base ? f + *base : f;
         }
         // Refraction about n: the incident half is cached in `in`.
@@ -106,7 +108,7 @@ class WWModel final : public Model {
         const double T10 = choices_.fresnel_at_h ? T01 : 1 - fresnel_coat(wo.z);
         // Weidlich & Wilkie 2007, §4.2: t = (1 − G) + T10·G.
         const double t = choices_.exit_t_term ? (1 - G0) + T10 * G0 : T10;
-        const Rgbd fb = choices_.base_at_outside ? base_brdf(wi, wo)
+        const Rgbd fb = choices_.base_at_outside ? base_brdf_in(wi, wo, in.lambda1_out)
                                                  : base_brdf_in(in.wi_in, *wo_in, in.lambda1);
         double scale = T01 * t;
         if (choices_.eta2_factor) scale *= inv_eta0_sq_;  // Hanrahan & Krueger 1993, Eq. 8
@@ -172,7 +174,7 @@ class WWModel final : public Model {
         return exp_rgb(coat_.tau_a * (-1 / mu));
     }
 
-    /// f_base at the refracted directions, with Λ(wi') cached.
+    /// f_base with Λ of its incident direction cached.
     Rgbd base_brdf_in(const Vec3d& wi, const Vec3d& wo, double lambda_i) const {
         if (coat_.base_type != InterfaceType::Conductor) return base_brdf(wi, wo);
         if (base_alpha_ <= 0) return Rgbd(0.0);
@@ -228,25 +230,30 @@ class WWModel final : public Model {
         return Rgbd(0.0);
     }
 
-    std::optional<Rgbd> base_term(const Vec3d& wi, const Vec3d& wo, const Vec3d& h,
-                                  double G0) const {
-        const Vec3d n(0, 0, 1);
-        const Vec3d& m_fresnel = choices_.fresnel_at_h ? h : n;
-        const Vec3d& m_refract = choices_.refract_about_h ? h : n;
-        const auto in_i = refract_in(wi, m_refract);
-        const auto in_o = refract_in(wo, m_refract);
-        if (!in_i || !in_o) return std::nullopt;
+    /// The base term when the directions are refracted about h (WW09): wi·h = wo·h, so both
+    /// refractions share their cosines.
+    std::optional<Rgbd> base_term_about_h(const Incident& in, const Vec3d& wo, const Vec3d& h,
+                                          double cos_h, double G0) const {
+        const Vec3d& wi = in.wi;
+        const double sin2_t = (1 - cos_h * cos_h) * inv_eta0_sq_;
+        if (sin2_t >= 1) return std::nullopt;
+        // "Refract w about h": the inside direction w/η0 − h (cos/η0 − cos θt), pointing away
+        // from the base (the negative of physics' refract(w, h, η0)).
+        const double k = cos_h * inv_eta0_ - std::sqrt(1 - sin2_t);
+        const Vec3d in_i = wi * inv_eta0_ - h * k, in_o = wo * inv_eta0_ - h * k;
+        if (in_i.z <= 0 || in_o.z <= 0) return std::nullopt;
         // Fresnel transmittances; leaving through m from inside equals entering along wo
         // (Fresnel reflectance is the same from both sides of one refraction pair).
-        const double T01 = 1 - fresnel_dielectric(dot(wi, m_fresnel), coat_.eta0);
-        const double T10 = 1 - fresnel_dielectric(dot(wo, m_fresnel), coat_.eta0);
+        const double T01 = choices_.fresnel_at_h ? 1 - fresnel_coat(cos_h) : in.T01_n;
+        const double T10 = choices_.fresnel_at_h ? T01 : 1 - fresnel_coat(wo.z);
         // Weidlich & Wilkie 2007, §4.2: t = (1 − G) + T10·G lets shadowed light through
         // unattenuated.
         const double t = choices_.exit_t_term ? (1 - G0) + T10 * G0 : T10;
-        const Rgbd fb = choices_.base_at_outside ? base_brdf(wi, wo) : base_brdf(*in_i, *in_o);
+        const Rgbd fb =
+            choices_.base_at_outside ? base_brdf_in(wi, wo, in.lambda1_out) : base_brdf(in_i, in_o);
         double scale = T01 * t;
-        if (choices_.eta2_factor) scale /= sqr(coat_.eta0);  // Hanrahan & Krueger 1993, Eq. 8
-        return fb * absorption(in_i->z, in_o->z) * scale;
+        if (choices_.eta2_factor) scale *= inv_eta0_sq_;  // Hanrahan & Krueger 1993, Eq. 8
+        return fb * absorption(in_i.z, in_o.z) * scale;
     }
 
     std::string name_;
