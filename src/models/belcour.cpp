@@ -253,6 +253,10 @@ class BelcourModel final : public Model {
             if (!ch_.btdf) support_.reason = fmt::format("{} gives no BTDF (Bel' does)", name_);
         }
         precompute_variances(ops_, ch_.quadratic_mapping);
+        // Build (or load) the tables now, outside any parallel region of the callers: a first
+        // use inside one would compute them with a single thread.
+        FgdTable::get();
+        if (ch_.tir) TirTable::get();
         top_ = ops_.front();
     }
 
