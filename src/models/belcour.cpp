@@ -63,15 +63,18 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         double alpha_eff = 0;
         const bool is_interface = op.kind != BelcourOperator::Medium;
         if (is_interface) {
-            sR12 = variance_of(op.alpha, q);
-            // Roughness the lobe sees: what was accumulated above plus this interface's own.
-            alpha_eff = alpha_of(sT0i + sR12, q);
+            const bool pre = op.precomputed && op.precomputed_quadratic == q;
+            sR12 = pre ? op.sigma_r : variance_of(op.alpha, q);
+            // Roughness the lobe sees: what was accumulated above plus this interface's own
+            // (nothing above: α itself, α(σ(α)) = α).
+            alpha_eff = pre && sT0i == 0 ? op.alpha_clamped : alpha_of(sT0i + sR12, q);
             if (op.kind == BelcourOperator::Dielectric) {
                 // Snell's law on the mean direction; TIR: no transmission.
                 const double sin2_t = (1 - c * c) / sqr(op.n12);
                 transmits = sin2_t < 1;
                 if (transmits) ct = std::max(std::sqrt(1 - sin2_t), 1e-6);
-                R12 = Rgbd(fgd(c, alpha_eff, op.n12, 0.0));
+                R12 =
+                    Rgbd(pre ? fgd(c, alpha_eff, op.fgd_index[0]) : fgd(c, alpha_eff, op.n12, 0.0));
                 if (transmits) {
                     T12 = Rgbd(1.0) - R12;
                     J12 = op.n12 * ct / c;  // Jacobian of the refracted variance
@@ -82,13 +85,19 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
                         sT21 = variance_of(op.alpha * 0.5 * std::abs(1 - op.n12 * ct / c), q);
                     } else {
                         // The author's code (models.md): angle-independent scalings.
-                        sT12 = variance_of(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
-                        sT21 = variance_of(op.alpha * 0.5 * std::abs(1 - op.n12), q);
+                        sT12 = pre ? op.sigma_t12
+                                   : variance_of(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
+                        sT21 = pre ? op.sigma_t21
+                                   : variance_of(op.alpha * 0.5 * std::abs(1 - op.n12), q);
                     }
                 }
             } else {
-                R12 = {fgd(c, alpha_eff, op.eta[0], op.k[0]), fgd(c, alpha_eff, op.eta[1], op.k[1]),
-                       fgd(c, alpha_eff, op.eta[2], op.k[2])};
+                if (pre) {
+                    R12 = fgd.rgb(c, alpha_eff, op.fgd_index);
+                } else {
+                    for (int i = 0; i < 3; ++i)
+                        R12[i] = fgd(c, alpha_eff, op.eta[i], op.k[i]);
+                }
             }
         } else {
             // Medium (models.md "Per medium"): unscattered plus once forward-scattered light,
@@ -105,13 +114,17 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
 
         // Adding (models.md): Dn = 1 − Ri0·R12 sums the inter-reflections between this operator
         // and everything above.
-        const Rgbd Dn = Rgbd(1.0) - Ri0 * R12;
+        Rgbd Dn = Rgbd(1.0) - Ri0 * R12;
+        for (int i = 0; i < 3; ++i)
+            Dn[i] = std::max(Dn[i], 1e-9);  // two perfect mirrors facing
         const Rgbd E = T0i * R12 * Ti0 / Dn;
         const double rr = mean(Ri0 * R12 / Dn);
         if (is_interface && out.n_lobes < BelcourStats::kMaxLobes) {
             // The lobe variance uses J0i before this layer, as the author's code does.
             const double sigma_k = sTi0 + J0i * (sT0i + sR12 + rr * (sR12 + sRi0));
-            out.lobes[out.n_lobes++] = {E, alpha_of(sigma_k, q)};
+            const bool only_own = op.precomputed && op.precomputed_quadratic == q &&
+                                  sigma_k == sR12;  // nothing accumulated: α itself
+            out.lobes[out.n_lobes++] = {E, only_own ? op.alpha_clamped : alpha_of(sigma_k, q)};
             const double w_old = mean(R0i), w_new = mean(E);
             if (w_old + w_new > 0) sR0i = (w_old * sR0i + w_new * sigma_k) / (w_old + w_new);
         }
@@ -150,7 +163,7 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         last_transmits = transmits;
         if (op.kind == BelcourOperator::Conductor || (is_interface && !transmits)) break;
     }
-    (void)sR0i;
+    (void)sR0i;  // the reflected variance, tracked as models.md writes it; no lobe uses it
     if (last_was_dielectric && last_transmits) {
         out.transmits = true;
         out.transmitted = T0i;
@@ -158,6 +171,21 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         out.cos_t = c;
     }
     return out;
+}
+
+void precompute_variances(std::vector<BelcourOperator>& ops, bool q) {
+    for (BelcourOperator& op : ops) {
+        op.precomputed = true;
+        op.precomputed_quadratic = q;
+        op.alpha_clamped = alpha_of(variance_of(op.alpha, q), q);
+        op.sigma_r = variance_of(op.alpha, q);
+        op.sigma_t12 = variance_of(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
+        op.sigma_t21 = variance_of(op.alpha * 0.5 * std::abs(1 - op.n12), q);
+        for (int i = 0; i < 3; ++i)
+            op.fgd_index[i] = op.kind == BelcourOperator::Conductor
+                                  ? FgdTable::locate(op.eta[i], op.k[i])
+                                  : FgdTable::locate(op.n12, 0.0);
+    }
 }
 
 namespace {
@@ -224,8 +252,12 @@ class BelcourModel final : public Model {
             support_.btdf = ch_.btdf;
             if (!ch_.btdf) support_.reason = fmt::format("{} gives no BTDF (Bel' does)", name_);
         }
+        precompute_variances(ops_, ch_.quadratic_mapping);
+        // Build (or load) the tables now, outside any parallel region of the callers: a first
+        // use inside one would compute them with a single thread.
+        FgdTable::get();
+        if (ch_.tir) TirTable::get();
         top_ = ops_.front();
-        if (stack.transmits()) exit_eta_ = stack.layers.back().interface.eta / stack.ambient_eta;
     }
 
     std::string name() const override { return name_; }
@@ -299,9 +331,7 @@ class BelcourModel final : public Model {
 
     Rgbd top_fresnel(double cos_theta) const {
         if (top_.kind == BelcourOperator::Conductor)
-            return {fresnel_complex_fast(cos_theta, top_.eta[0], top_.k[0]),
-                    fresnel_complex_fast(cos_theta, top_.eta[1], top_.k[1]),
-                    fresnel_complex_fast(cos_theta, top_.eta[2], top_.k[2])};
+            return fresnel_complex_rgb(cos_theta, top_.eta, top_.k);
         return Rgbd(fresnel_dielectric(cos_theta, top_.n12));
     }
 
@@ -329,7 +359,6 @@ class BelcourModel final : public Model {
     std::vector<BelcourOperator> ops_;
     BelcourOperator top_;
     Support support_;
-    double exit_eta_ = 1;
 };
 
 class BelcourForwardEvaluator final : public IncidentEvaluator {

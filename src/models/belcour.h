@@ -6,6 +6,7 @@
 // scheme (models.md, "Belcour 2018 and Bel'"; paper §4–6). Bel18 forward, Bel18 symmetric and
 // Bel' are one engine with the choices below; each has its own source file with its defaults.
 
+#include "models/fgd_table.h"
 #include "models/model.h"
 
 #include <array>
@@ -55,7 +56,17 @@ struct BelcourOperator {
     double alpha = 0;  ///< GGX roughness of an interface
     Rgbd tau_a{0.0}, tau_s{0.0};
     double g = 0;  ///< HG mean cosine (mean over RGB)
+
+    /// Angle-independent variances, filled by precompute_variances (pow is the cost of the
+    /// symmetric variant, which runs the scheme per evaluation); unused unless `precomputed`.
+    bool precomputed = false;
+    bool precomputed_quadratic = false;
+    double sigma_r = 0, sigma_t12 = 0, sigma_t21 = 0, alpha_clamped = 0;
+    std::array<FgdTable::Index, 3> fgd_index{};  ///< per channel (dielectric: all equal)
 };
+
+/// Fills the angle-independent variances of every operator for the given mapping.
+void precompute_variances(std::vector<BelcourOperator>& ops, bool quadratic_mapping);
 
 /// Runs the adding scheme (models.md) for mean incident cosine c0 ∈ (0, 1].
 BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,

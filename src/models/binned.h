@@ -3,16 +3,20 @@
 // bin, the cos-weighted average ∫_bin f |cos θ| dω / ∫_bin |cos θ| dω, in exactly the BinnedTable
 // (`brdf.csv`) form of the reference.
 //
-// Quadrature: the measure |cos θ| dω = ½ d(sin²θ) dφ is uniform in (u = sin²θ, φ), so the bin
-// average is a plain average over a rectangle in (u, φ) (one folded half: the stack is isotropic).
-// Each rectangle gets a 2×2 and a 3×3 Gauss–Legendre product rule (13 evaluations); if they differ
-// by more than rel_tol·|I| + abs_tol in any channel, it is bisected in both coordinates
+// Quadrature: over one folded half (the stack is isotropic), in (θ, φ) with the weight
+// sin θ cos θ in the integrand. (The measure is uniform in u = sin²θ, but in u the integrand has
+// square-root edges at the normal and at grazing that adaptive bisection cannot shake off; in θ it
+// is smooth up to both ends.)
+// Each rectangle gets the 3×3 Gauss–Legendre product rule and the degree-3 rule embedded in its
+// centre and axis nodes (9 evaluations); if they differ by more than the bin's tolerance
+// τ = rel_tol·|bin average| + abs_tol (largest channel), it is bisected in both coordinates
 // (recursively, up to max_depth, within an evaluation budget per bin), and the 3×3 value of
-// accepted rectangles is kept. A rectangle that contains one of the model's peak directions
-// (mirror; refracted for a BTDF) is always bisected towards it, down to a size of ~1e-10 in u:
-// a lobe of α = 0.001 inside one bin is then resolved even though no coarse node sees it. Delta
-// lobes add energy / Ω⊥ to the bin they hit. Parallel over (incidence, side, θ row) with OpenMP;
-// every bin is computed independently, so the output does not depend on the thread count.
+// accepted rectangles is kept; the difference estimates the error of the lower-degree rule, so
+// the kept value is conservative. A rectangle that contains one of the model's
+// peak directions (mirror; refracted for a BTDF) is always bisected towards it, down to a size of
+// ~1e-10 in u: a lobe of α = 0.001 inside one bin is then resolved even though no coarse node sees
+// it. Delta lobes add energy / Ω⊥ to the bin they hit. Parallel over (incidence, side, θ row) with
+// OpenMP; every bin is computed independently, so the output does not depend on the thread count.
 
 #include "core/grid.h"
 #include "core/table.h"
@@ -34,10 +38,10 @@ struct BinnedOptions {
 BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
                       const std::vector<double>& theta_i_deg, const BinnedOptions& options = {});
 
-/// The cos-weighted average of f over one rectangle of (u = sin²θ, φ) (radians) on `side`, by the
-/// same adaptive rule (exposed for tests).
-Rgbd cos_weighted_average(const IncidentEvaluator& f, Side side, double u0, double u1, double phi0,
-                          double phi1, const std::vector<Vec3d>& peaks,
+/// The cos-weighted average of f over one rectangle [θ0, θ1] × [φ0, φ1] (radians) on `side`, by
+/// the same adaptive rule.
+Rgbd cos_weighted_average(const IncidentEvaluator& f, Side side, double theta0, double theta1,
+                          double phi0, double phi1, const std::vector<Vec3d>& peaks,
                           const BinnedOptions& options = {});
 
 /// Directional albedo ∫ f |cos θo| dωo of one side (RGB) for incidence wi, by the same adaptive

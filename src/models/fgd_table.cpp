@@ -129,6 +129,29 @@ double fresnel_complex_fast(double cos_theta, double eta, double k) {
     return 0.5 * (rp + rs);
 }
 
+Rgbd fresnel_complex_rgb(double cos_theta, const Rgbd& eta, const Rgbd& k) {
+    cos_theta = clamp(cos_theta, 0.0, 1.0);
+    const double cos2 = cos_theta * cos_theta;
+    const double sin2 = 1 - cos2;
+    alignas(32) double e[4] = {eta[0], eta[1], eta[2], 1.5}, kk[4] = {k[0], k[1], k[2], 0.0};
+    alignas(32) double out[4];
+    // PBR 3rd ed., §8.2.1 (FrConductor), lane by lane.
+    for (int c = 0; c < 4; ++c) {
+        const double eta2 = e[c] * e[c], k2 = kk[c] * kk[c];
+        const double t0 = eta2 - k2 - sin2;
+        const double a2_plus_b2 = std::sqrt(t0 * t0 + 4 * eta2 * k2);
+        const double t1 = a2_plus_b2 + cos2;
+        const double a = std::sqrt(std::max(0.5 * (a2_plus_b2 + t0), 0.0));
+        const double t2 = 2 * cos_theta * a;
+        const double rs = (t1 - t2) / std::max(t1 + t2, 1e-300);
+        const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
+        const double t4 = t2 * sin2;
+        const double rp = rs * (t3 - t4) / std::max(t3 + t4, 1e-300);
+        out[c] = t1 + t2 > 0 ? 0.5 * (rp + rs) : 1.0;
+    }
+    return {out[0], out[1], out[2]};
+}
+
 double FgdTable::direct(double c, double alpha, double eta, double k, int n_r, int n_phi) {
     if (alpha <= 0) return fresnel_any(c, eta, k);
     double sum = 0;
@@ -152,29 +175,74 @@ const FgdTable& FgdTable::get() {
     return table;
 }
 
-double FgdTable::operator()(double c, double alpha, double eta, double k) const {
-    if (alpha <= 0) return fresnel_any(c, eta, k);  // the smooth limit is exact Fresnel
-    const double fc = std::sqrt(clamp(c, 0.0, 1.0)) * (kNc - 1);
-    const double fa = std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1);
+FgdTable::Index FgdTable::locate(double eta, double k) {
     const double fe = (clamp(std::log2(eta), kLog2EtaMin, kLog2EtaMax) - kLog2EtaMin) /
                       (kLog2EtaMax - kLog2EtaMin) * (kNeta - 1);
     const double fk = std::sqrt(clamp(k, 0.0, kKMax) / kKMax) * (kNk - 1);
-    const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2),
-              ie = std::min(int(fe), kNeta - 2), ik = std::min(int(fk), kNk - 2);
-    const double tc = fc - ic, ta = fa - ia, te = fe - ie, tk = fk - ik;
+    Index at;
+    at.eta = eta;
+    at.k = k;
+    at.ie = std::min(int(fe), kNeta - 2);
+    at.ik = std::min(int(fk), kNk - 2);
+    at.te = fe - at.ie;
+    at.tk = fk - at.ik;
+    return at;
+}
+
+double FgdTable::operator()(double c, double alpha, double eta, double k) const {
+    return (*this)(c, alpha, locate(eta, k));
+}
+
+Rgbd FgdTable::rgb(double c, double alpha, const std::array<Index, 3>& at) const {
+    const Rgbd eta(at[0].eta, at[1].eta, at[2].eta), k(at[0].k, at[1].k, at[2].k);
+    if (alpha <= 0) return fresnel_complex_rgb(c, eta, k);
+    const double fc = std::sqrt(clamp(c, 0.0, 1.0)) * (kNc - 1);
+    const double fa = std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1);
+    const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2);
+    const double tc = fc - ic, ta = fa - ia;
+    Rgbd out(0.0);
+    for (int dc = 0; dc < 2; ++dc) {
+        const double wc = dc ? tc : 1 - tc;
+        for (int da = 0; da < 2; ++da) {
+            const double wa = wc * (da ? ta : 1 - ta);
+            const float* block = data_ + (std::size_t(ic + dc) * kNalpha + (ia + da)) * kNeta * kNk;
+            for (int i = 0; i < 3; ++i) {
+                const float* row = block + std::size_t(at[i].ie) * kNk + at[i].ik;
+                const double tk = at[i].tk, te = at[i].te;
+                const double v0 = (1 - tk) * row[0] + tk * row[1];
+                const double v1 = (1 - tk) * row[kNk] + tk * row[kNk + 1];
+                out[i] += wa * ((1 - te) * v0 + te * v1);
+            }
+        }
+    }
+    if (alpha < 0.5) out += fresnel_complex_rgb(c, eta, k) * smooth_weight(alpha);
+    for (int i = 0; i < 3; ++i)
+        out[i] = clamp(out[i], 0.0, 1.0);
+    return out;
+}
+
+double FgdTable::operator()(double c, double alpha, const Index& at) const {
+    if (alpha <= 0) return fresnel_any(c, at.eta, at.k);  // the smooth limit is exact Fresnel
+    const double fc = std::sqrt(clamp(c, 0.0, 1.0)) * (kNc - 1);
+    const double fa = std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1);
+    const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2);
+    const double tc = fc - ic, ta = fa - ia, te = at.te, tk = at.tk;
     double sum = 0;
     for (int dc = 0; dc < 2; ++dc) {
         const double wc = dc ? tc : 1 - tc;
         for (int da = 0; da < 2; ++da) {
             const double wa = wc * (da ? ta : 1 - ta);
             const float* row =
-                data_ + ((std::size_t(ic + dc) * kNalpha + (ia + da)) * kNeta + ie) * kNk + ik;
+                data_ + ((std::size_t(ic + dc) * kNalpha + (ia + da)) * kNeta + at.ie) * kNk +
+                at.ik;
             const double v0 = (1 - tk) * row[0] + tk * row[1];
             const double v1 = (1 - tk) * row[kNk] + tk * row[kNk + 1];
             sum += wa * ((1 - te) * v0 + te * v1);
         }
     }
-    return clamp(sum + smooth_weight(alpha) * fresnel_any(c, eta, k), 0.0, 1.0);
+    // The control variate w(α)F(c) (see compute_fgd); below 6e-8 beyond α = 0.5, skipped there.
+    if (alpha < 0.5) sum += smooth_weight(alpha) * fresnel_any(c, at.eta, at.k);
+    return clamp(sum, 0.0, 1.0);
 }
 
 }  // namespace lamina

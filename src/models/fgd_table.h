@@ -17,6 +17,9 @@
 // the arguments are clamped. Multilinear interpolation; α = 0 returns the exact Fresnel factor.
 // Computed on first use (≈1 s on 2 cores) and cached on disk (models/table_cache.h).
 
+#include "core/rgb.h"
+
+#include <array>
 #include <vector>
 
 namespace lamina {
@@ -28,6 +31,18 @@ class FgdTable {
 
     /// Interpolated FGD. c = cos θi ∈ [0, 1], α ∈ [0, 1], η > 0, κ ≥ 0 (clamped to the axes).
     double operator()(double c, double alpha, double eta, double k) const;
+
+    /// The (η, κ) part of a lookup, located once per interface (the symmetric Belcour variant
+    /// looks the same indices up for every evaluation).
+    struct Index {
+        double eta = 1, k = 0;
+        int ie = 0, ik = 0;
+        double te = 0, tk = 0;
+    };
+    static Index locate(double eta, double k);
+    double operator()(double c, double alpha, const Index& at) const;
+    /// Three channels at once (a conductor), sharing the (c, α) part of the lookup.
+    Rgbd rgb(double c, double alpha, const std::array<Index, 3>& at) const;
 
     /// The same integral computed directly (no table, no binning) with an n_r × n_phi rule: the
     /// reference the table is tested against.
@@ -48,5 +63,9 @@ class FgdTable {
 /// Humphreys, PBR 3rd ed., §8.2.1, FrConductor; after Born & Wolf §14.2). With κ = 0 and η < 1 it
 /// gives 1 under total internal reflection. Equal to fresnel_conductor, about 4× faster.
 double fresnel_complex_fast(double cos_theta, double eta, double k);
+
+/// The same for three channels at once (written as one loop over 4 lanes so the compiler
+/// vectorizes it; lamina_models is built with -fno-math-errno for that).
+Rgbd fresnel_complex_rgb(double cos_theta, const Rgbd& eta, const Rgbd& k);
 
 }  // namespace lamina

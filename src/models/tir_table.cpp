@@ -16,16 +16,41 @@ namespace lamina {
 namespace {
 constexpr int kStrata = 32;  // per axis of the sampling square
 constexpr double kCMin = 1e-4, kAlphaMin = 1e-5;
-constexpr const char* kCodeVersion = "tir-v1";
+constexpr const char* kCodeVersion = "tir-v3";
+constexpr int kSplit = 16;  // c nodes 0..kSplit cover [0, c_crit], the rest [c_crit, 1]
 
-double c_node(int i) {
-    return std::max(kCMin, double(i) / (TirTable::kNc - 1));
+/// Critical cosine of relative index η < 1: below it a smooth interface reflects totally.
+double critical_cosine(double eta) {
+    return std::sqrt(std::max(0.0, 1 - eta * eta));
 }
+
+// The c axis is relative to the critical cosine of each η node and dense next to it on both
+// sides (τ is a smoothed step there, of width ~α): node j ≤ kSplit sits at
+// c_crit (1 − (1 − j/kSplit)²), node j ≥ kSplit at c_crit + (1 − c_crit)((j −
+// kSplit)/(N−1−kSplit))².
+double c_node(int j, double c_crit) {
+    if (j <= kSplit) return std::max(kCMin, c_crit * (1 - sqr(1 - double(j) / kSplit)));
+    return c_crit + (1 - c_crit) * sqr(double(j - kSplit) / (TirTable::kNc - 1 - kSplit));
+}
+/// Fractional node index of c for the η node whose critical cosine is c_crit.
+double c_index(double c, double c_crit) {
+    c = clamp(c, 0.0, 1.0);
+    if (c >= c_crit)
+        return kSplit + (TirTable::kNc - 1 - kSplit) * std::sqrt((c - c_crit) / (1 - c_crit));
+    return kSplit * (1 - std::sqrt(1 - c / c_crit));
+}
+// α on a squared axis (dense at small α, where the step is sharp).
 double alpha_node(int i) {
-    return std::max(kAlphaMin, double(i) / (TirTable::kNalpha - 1));
+    return std::max(kAlphaMin, sqr(double(i) / (TirTable::kNalpha - 1)));
+}
+// η nodes uniform in the critical cosine c_crit = √(1 − η²) ∈ [0, √(1 − η_min²)]: c_crit, which
+// places the step, moves fastest with η near 1.
+double max_critical_cosine() {
+    return critical_cosine(TirTable::kEtaMin);
 }
 double eta_node(int i) {
-    return TirTable::kEtaMin + (1 - TirTable::kEtaMin) * double(i) / (TirTable::kNeta - 1);
+    const double cc = max_critical_cosine() * double(i) / (TirTable::kNeta - 1);
+    return std::sqrt(1 - cc * cc);
 }
 
 std::vector<float> compute_tir() {
@@ -42,7 +67,8 @@ std::vector<float> compute_tir() {
                     for (int b = 0; b < kStrata; ++b) {
                         const double u1 = (a + rng.uniform_double()) / kStrata;
                         const double u2 = (b + rng.uniform_double()) / kStrata;
-                        through += T::transmits(c_node(ic), alpha_node(ia), eta_node(ie), u1, u2);
+                        through += T::transmits(c_node(ic, critical_cosine(eta_node(ie))),
+                                                alpha_node(ia), eta_node(ie), u1, u2);
                     }
                 v[index] = float(double(through) / (kStrata * kStrata));
             }
@@ -88,19 +114,23 @@ const TirTable& TirTable::get() {
 
 double TirTable::operator()(double c, double alpha, double eta) const {
     if (eta >= 1) return 1;
-    const double fc = clamp(c, 0.0, 1.0) * (kNc - 1);
-    const double fa = clamp(alpha, 0.0, 1.0) * (kNalpha - 1);
-    const double fe = (clamp(eta, kEtaMin, 1.0) - kEtaMin) / (1 - kEtaMin) * (kNeta - 1);
-    const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2),
-              ie = std::min(int(fe), kNeta - 2);
-    const double tc = fc - ic, ta = fa - ia, te = fe - ie;
+    // Smooth interface: the exact step at the critical cosine (the table would blur it).
+    if (alpha <= 0) return c > critical_cosine(eta) ? 1.0 : 0.0;
+    const double fa = std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1);
+    const double fe = std::min(critical_cosine(eta) / max_critical_cosine(), 1.0) * (kNeta - 1);
+    const int ia = std::min(int(fa), kNalpha - 2), ie = std::min(int(fe), kNeta - 2);
+    const double ta = fa - ia, te = fe - ie;
     double sum = 0;
-    for (int dc = 0; dc < 2; ++dc)
-        for (int da = 0; da < 2; ++da) {
-            const float* row =
-                values_.data() + (std::size_t(ic + dc) * kNalpha + (ia + da)) * kNeta + ie;
-            sum += (dc ? tc : 1 - tc) * (da ? ta : 1 - ta) * ((1 - te) * row[0] + te * row[1]);
-        }
+    for (int de = 0; de < 2; ++de) {
+        // Each η node has its own c axis (relative to its critical cosine).
+        const double fc = c_index(c, critical_cosine(eta_node(ie + de)));
+        const int ic = std::min(int(fc), kNc - 2);
+        const double tc = fc - ic;
+        for (int dc = 0; dc < 2; ++dc)
+            for (int da = 0; da < 2; ++da)
+                sum += (de ? te : 1 - te) * (dc ? tc : 1 - tc) * (da ? ta : 1 - ta) *
+                       values_[(std::size_t(ic + dc) * kNalpha + (ia + da)) * kNeta + ie + de];
+    }
     return sum;
 }
 

@@ -9,8 +9,11 @@
 //
 // lamina computes the table itself by stratified Monte Carlo through the interface: 32 × 32
 // jittered strata of Heitz's sampling square per node, fixed seeds (bitwise reproducible). Axes:
-// c ∈ [0, 1] (33 uniform nodes), α ∈ [0, 1] (33), η ∈ [0.2, 1] (33); τ = 1 for η ≥ 1, η below
-// 0.2 clamped. Trilinear interpolation. Cached on disk like the FGD table.
+// η ∈ [0.2, 1] (33 nodes uniform in c_crit = √(1 − η²)); α = s² (33 nodes, s uniform); c (49 nodes)
+// relative to each η node's critical cosine c_crit = √(1 − η²), dense on both sides of it (16 nodes
+// below, 32 above, quadratic spacing), where τ is a step smoothed over a width ~α. τ = 1 for η ≥ 1;
+// η below 0.2 clamped; α = 0 gives the exact step. Interpolation: bilinear in (c, α) at each of the
+// two η nodes (each with its own c axis), then linear in η. Cached on disk like the FGD table.
 
 #include <cstdint>
 #include <vector>
@@ -30,7 +33,7 @@ class TirTable {
     /// The same fraction for one pair of uniforms: 1 if the sampled microfacet transmits.
     static bool transmits(double c, double alpha, double eta, double u1, double u2);
 
-    static constexpr int kNc = 33, kNalpha = 33, kNeta = 33;
+    static constexpr int kNc = 49, kNalpha = 33, kNeta = 33;
     static constexpr double kEtaMin = 0.2;
 
   private:

@@ -39,25 +39,83 @@ class WWModel final : public Model {
         base_alpha_ =
             choices_.max_roughness ? std::max(coat_.alpha0, coat_.base_alpha) : coat_.base_alpha;
         has_absorption_ = coat_.tau_a.max() > 0;
+        gray_tau_ = coat_.tau_a.min() == coat_.tau_a.max();
+        inv_eta0_ = 1 / coat_.eta0;
+        inv_eta0_sq_ = inv_eta0_ * inv_eta0_;
     }
 
     std::string name() const override { return name_; }
     Support support() const override { return support_; }
 
+    /// What depends on wi alone (cached by prepare: the per-incidence path of the study).
+    struct Incident {
+        Vec3d wi;
+        double lambda0 = 0;      ///< Λ_α0(wi)
+        bool in_ok = false;      ///< wi refracted about n exists
+        Vec3d wi_in;             ///< wi refracted about n
+        Rgbd att{1.0};           ///< exp(−τ/μi') about n
+        double lambda1 = 0;      ///< Λ_α1(wi') of the base, about n
+        double lambda1_out = 0;  ///< Λ_α1(wi) of the base (f_base at the outside directions)
+        double T01_n = 0;        ///< 1 − F(μi)
+    };
+
+    Incident incident(const Vec3d& wi) const {
+        Incident in;
+        in.wi = wi;
+        if (!support_.brdf || wi.z <= 0) return in;
+        if (coat_.alpha0 > 0) in.lambda0 = GGX<double>{coat_.alpha0}.lambda(wi);
+        if (base_alpha_ > 0) in.lambda1_out = GGX<double>{base_alpha_}.lambda(wi);
+        in.T01_n = 1 - fresnel_coat(wi.z);
+        if (const auto w = refract_in_n(wi)) {
+            in.in_ok = true;
+            in.wi_in = *w;
+            in.att = attenuation(w->z);
+            if (base_alpha_ > 0) in.lambda1 = GGX<double>{base_alpha_}.lambda(*w);
+        }
+        return in;
+    }
+
     Rgbd eval(const Vec3d& wi, const Vec3d& wo) const override {
         if (!support_.brdf || wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
-        const Vec3d h = normalize(wi + wo);
-        Rgbd f(0.0);
-        const GGX<double> ggx0{coat_.alpha0};
-        const double G0 = coat_.alpha0 > 0 ? ggx0.G2(wi, wo) : 1.0;
-        // Top reflection (models.md; Walter et al. 2007, Eq. 20); a delta lobe when smooth.
-        if (coat_.alpha0 > 0)
-            f = Rgbd(fresnel_dielectric(dot(wi, h), coat_.eta0) * ggx0.D(h) * G0 /
-                     (4 * wi.z * wo.z));
-        if (base_is_delta()) return f;
-        const std::optional<Rgbd> base = base_term(wi, wo, h, G0);
-        return base ? f + *base : f;
+        return eval_with(incident(wi), wo);
     }
+
+    Rgbd eval_with(const Incident& in, const Vec3d& wo) const {
+        const Vec3d& wi = in.wi;
+        if (!support_.brdf || wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
+        const Vec3d h = normalize(wi + wo);
+        const double cos_h = dot(wi, h);  // = wo·h
+        Rgbd f(0.0);
+        double G0 = 1;
+        if (coat_.alpha0 > 0) {
+            // Top reflection (models.md; Walter et al. 2007, Eq. 20; height-correlated G2,
+            // Heitz 2014, Eq. 99); a delta lobe when smooth.
+            const GGX<double> ggx0{coat_.alpha0};
+            G0 = 1 / (1 + in.lambda0 + ggx0.lambda(wo));
+            f = Rgbd(fresnel_coat(cos_h) * ggx0.D(h) * G0 / (4 * wi.z * wo.z));
+        }
+        if (base_is_delta()) return f;
+        if (choices_.refract_about_h) {
+            const std::optional<Rgbd> base = base_term_about_h(in, wo, h, cos_h, G0);
+            return base ? f + *base : f;
+        }
+        // Refraction about n: the incident half is cached in `in`.
+        if (!in.in_ok) return f;
+        const auto wo_in = refract_in_n(wo);
+        if (!wo_in) return f;
+        // Fresnel transmittances at h (wi·h = wo·h: T01 = T10) or at n.
+        const double T01 = choices_.fresnel_at_h ? 1 - fresnel_coat(cos_h) : in.T01_n;
+        const double T10 = choices_.fresnel_at_h ? T01 : 1 - fresnel_coat(wo.z);
+        // Weidlich & Wilkie 2007, §4.2: t = (1 − G) + T10·G.
+        const double t = choices_.exit_t_term ? (1 - G0) + T10 * G0 : T10;
+        const Rgbd fb = choices_.base_at_outside ? base_brdf_in(wi, wo, in.lambda1_out)
+                                                 : base_brdf_in(in.wi_in, *wo_in, in.lambda1);
+        double scale = T01 * t;
+        if (choices_.eta2_factor) scale *= inv_eta0_sq_;  // Hanrahan & Krueger 1993, Eq. 8
+        return f + fb * (in.att * attenuation(wo_in->z)) * scale;
+    }
+
+    std::unique_ptr<IncidentEvaluator> prepare(const Vec3d& wi) const override;
 
     std::vector<DeltaLobe> delta_lobes(const Vec3d& wi) const override {
         std::vector<DeltaLobe> lobes;
@@ -91,6 +149,42 @@ class WWModel final : public Model {
     }
 
   private:
+    /// F(c; η0) for light arriving from outside, c ∈ [0, 1] (the same as fresnel_dielectric,
+    /// with 1/η0² precomputed: this is the hot path of the study).
+    double fresnel_coat(double c) const {
+        const double sin2_t = (1 - c * c) * inv_eta0_sq_;
+        if (sin2_t >= 1) return 1;
+        const double ct = std::sqrt(1 - sin2_t), e = coat_.eta0;
+        const double r_par = (e * c - ct) / (e * c + ct);
+        const double r_perp = (c - e * ct) / (c + e * ct);
+        return 0.5 * (r_par * r_par + r_perp * r_perp);
+    }
+
+    /// "Refract w about n" for n the macro normal: (w.x/η0, w.y/η0, cos θ') inside the coat.
+    std::optional<Vec3d> refract_in_n(const Vec3d& w) const {
+        const double sin2_t = (1 - w.z * w.z) * inv_eta0_sq_;
+        if (sin2_t >= 1) return std::nullopt;
+        return Vec3d(w.x * inv_eta0_, w.y * inv_eta0_, std::sqrt(1 - sin2_t));
+    }
+
+    /// Beer–Lambert along one refracted path: exp(−τ/μ').
+    Rgbd attenuation(double mu) const {
+        if (!has_absorption_) return Rgbd(1.0);
+        if (gray_tau_) return Rgbd(std::exp(-coat_.tau_a[0] / mu));
+        return exp_rgb(coat_.tau_a * (-1 / mu));
+    }
+
+    /// f_base with Λ of its incident direction cached.
+    Rgbd base_brdf_in(const Vec3d& wi, const Vec3d& wo, double lambda_i) const {
+        if (coat_.base_type != InterfaceType::Conductor) return base_brdf(wi, wo);
+        if (base_alpha_ <= 0) return Rgbd(0.0);
+        // Walter et al. 2007, Eq. 20, conductor Fresnel per channel.
+        const Vec3d h = normalize(wi + wo);
+        const GGX<double> ggx{base_alpha_};
+        const double G = 1 / (1 + lambda_i + ggx.lambda(wo));
+        return base_fresnel(dot(wi, h)) * (ggx.D(h) * G / (4 * wi.z * wo.z));
+    }
+
     bool base_is_delta() const {
         return coat_.base_type != InterfaceType::Lambertian && base_alpha_ == 0;
     }
@@ -111,9 +205,7 @@ class WWModel final : public Model {
 
     Rgbd base_fresnel(double cos_theta) const {
         if (coat_.base_type == InterfaceType::Conductor)
-            return {fresnel_complex_fast(cos_theta, coat_.base_eta[0], coat_.base_k[0]),
-                    fresnel_complex_fast(cos_theta, coat_.base_eta[1], coat_.base_k[1]),
-                    fresnel_complex_fast(cos_theta, coat_.base_eta[2], coat_.base_k[2])};
+            return fresnel_complex_rgb(cos_theta, coat_.base_eta, coat_.base_k);
         return Rgbd(fresnel_dielectric(cos_theta, coat_.base_eta[0]));
     }
 
@@ -138,25 +230,30 @@ class WWModel final : public Model {
         return Rgbd(0.0);
     }
 
-    std::optional<Rgbd> base_term(const Vec3d& wi, const Vec3d& wo, const Vec3d& h,
-                                  double G0) const {
-        const Vec3d n(0, 0, 1);
-        const Vec3d& m_fresnel = choices_.fresnel_at_h ? h : n;
-        const Vec3d& m_refract = choices_.refract_about_h ? h : n;
-        const auto in_i = refract_in(wi, m_refract);
-        const auto in_o = refract_in(wo, m_refract);
-        if (!in_i || !in_o) return std::nullopt;
+    /// The base term when the directions are refracted about h (WW09): wi·h = wo·h, so both
+    /// refractions share their cosines.
+    std::optional<Rgbd> base_term_about_h(const Incident& in, const Vec3d& wo, const Vec3d& h,
+                                          double cos_h, double G0) const {
+        const Vec3d& wi = in.wi;
+        const double sin2_t = (1 - cos_h * cos_h) * inv_eta0_sq_;
+        if (sin2_t >= 1) return std::nullopt;
+        // "Refract w about h": the inside direction w/η0 − h (cos/η0 − cos θt), pointing away
+        // from the base (the negative of physics' refract(w, h, η0)).
+        const double k = cos_h * inv_eta0_ - std::sqrt(1 - sin2_t);
+        const Vec3d in_i = wi * inv_eta0_ - h * k, in_o = wo * inv_eta0_ - h * k;
+        if (in_i.z <= 0 || in_o.z <= 0) return std::nullopt;
         // Fresnel transmittances; leaving through m from inside equals entering along wo
         // (Fresnel reflectance is the same from both sides of one refraction pair).
-        const double T01 = 1 - fresnel_dielectric(dot(wi, m_fresnel), coat_.eta0);
-        const double T10 = 1 - fresnel_dielectric(dot(wo, m_fresnel), coat_.eta0);
+        const double T01 = choices_.fresnel_at_h ? 1 - fresnel_coat(cos_h) : in.T01_n;
+        const double T10 = choices_.fresnel_at_h ? T01 : 1 - fresnel_coat(wo.z);
         // Weidlich & Wilkie 2007, §4.2: t = (1 − G) + T10·G lets shadowed light through
         // unattenuated.
         const double t = choices_.exit_t_term ? (1 - G0) + T10 * G0 : T10;
-        const Rgbd fb = choices_.base_at_outside ? base_brdf(wi, wo) : base_brdf(*in_i, *in_o);
+        const Rgbd fb =
+            choices_.base_at_outside ? base_brdf_in(wi, wo, in.lambda1_out) : base_brdf(in_i, in_o);
         double scale = T01 * t;
-        if (choices_.eta2_factor) scale /= sqr(coat_.eta0);  // Hanrahan & Krueger 1993, Eq. 8
-        return fb * absorption(in_i->z, in_o->z) * scale;
+        if (choices_.eta2_factor) scale *= inv_eta0_sq_;  // Hanrahan & Krueger 1993, Eq. 8
+        return fb * absorption(in_i.z, in_o.z) * scale;
     }
 
     std::string name_;
@@ -165,7 +262,24 @@ class WWModel final : public Model {
     Support support_;
     double base_alpha_ = 0;
     bool has_absorption_ = false;
+    bool gray_tau_ = true;
+    double inv_eta0_ = 1, inv_eta0_sq_ = 1;
 };
+
+class WWEvaluator final : public IncidentEvaluator {
+  public:
+    WWEvaluator(const WWModel& model, const Vec3d& wi)
+        : model_(model), incident_(model.incident(wi)) {}
+    Rgbd eval(const Vec3d& wo) const override { return model_.eval_with(incident_, wo); }
+
+  private:
+    const WWModel& model_;
+    WWModel::Incident incident_;
+};
+
+std::unique_ptr<IncidentEvaluator> WWModel::prepare(const Vec3d& wi) const {
+    return std::make_unique<WWEvaluator>(*this, wi);
+}
 
 }  // namespace
 

@@ -8,6 +8,7 @@
 #include "models/registry.h"
 #include "physics/conductor.h"
 #include "physics/dielectric.h"
+#include "physics/fresnel.h"
 #include "physics/microfacet.h"
 #include "test_stacks.h"
 
@@ -94,6 +95,57 @@ TEST(BelPrimeGolden, LobeZeroIsTheExactTopReflection) {
                     EXPECT_NEAR(prime->eval(wi, wo)[c] - fwd->eval(wi, wo)[c], exact - lobe0,
                                 1e-9 * (exact + lobe0) + 1e-12);
             }
+}
+
+// Bel' BTDF of a smooth two-interface slab without absorption: a delta along the direction Snell's
+// law gives through both interfaces (sin θt = sin θi / η_exit, azimuth opposite the light) with
+// energy T0i = T1 T2 / (1 − R1 R2), R1 = F(μi; η1), R2 = F(μ1; η2/η1) at the refracted cosine μ1,
+// T = 1 − R: the incoherent sum of all orders of inter-reflection between two smooth interfaces
+// (the adding scheme is exact here; TIR cannot occur for light that entered). Independent of
+// the model's code: fresnel_dielectric and Snell directly. The two mirror lobes (energies R1 and
+// T1² R2/(1 − R1R2)) close the energy balance.
+TEST(BelPrimeGolden, SmoothSlabTransmitsTheIncoherentTwoInterfaceSum) {
+    const double eta1 = 1.5, eta2 = 1.2;
+    const auto model = make_model("bel-prime", coated(eta1, 0.0, test::dielectric(eta2, 0.0)));
+    ASSERT_TRUE(model->support().btdf);
+    for (double ti : {0.0, 30.0, 70.0}) {
+        const Vec3d wi = dir(ti, 0);
+        const double mu1 = std::sqrt(1 - (1 - wi.z * wi.z) / (eta1 * eta1));
+        const double R1 = fresnel_dielectric(wi.z, eta1), R2 = fresnel_dielectric(mu1, eta2 / eta1);
+        const double T = (1 - R1) * (1 - R2) / (1 - R1 * R2);
+        const double R = R1 + (1 - R1) * (1 - R1) * R2 / (1 - R1 * R2);
+        double got_t = 0, got_r = 0;
+        for (const DeltaLobe& d : model->delta_lobes(wi)) {
+            if (d.direction.z < 0) {
+                got_t += d.energy[0];
+                const double sin_t = std::sin(deg_to_rad(ti)) / eta2;
+                EXPECT_NEAR(d.direction.x, -sin_t, 1e-12);
+                EXPECT_NEAR(d.direction.z, -std::sqrt(1 - sin_t * sin_t), 1e-12);
+            } else {
+                got_r += d.energy[0];
+            }
+        }
+        EXPECT_NEAR(got_t, T, 1e-12) << ti;
+        EXPECT_NEAR(got_r, R, 1e-12) << ti;
+    }
+}
+
+// Bel18's top lobe alone (a base that reflects nothing) is not the exact microfacet reflection,
+// and the model does not claim it is: lobe 0 is E0·D·G2/(4μiμo) with E0 = FGD(μi) — the Fresnel
+// factor averaged over the lobe (and the shadowing counted twice). Shown: it equals that formula
+// to rounding and differs from Walter's f_top by more than 10% where F(wi·h) varies (grazing).
+TEST(Bel18, TopLobeAloneIsFgdWeightedNotExact) {
+    const double eta = 1.5, alpha = 0.3;
+    const auto model =
+        make_model("bel18-forward", coated(eta, alpha, test::conductor(Rgbd(eta), Rgbd(0.0), 0.3)));
+    const DielectricInterface<double> top{eta, alpha};
+    const GGX<double> ggx{alpha};
+    const Vec3d wi = dir(75, 0), wo = dir(60, 40);
+    const Vec3d h = normalize(wi + wo);
+    const double lobe0 =
+        FgdTable::get()(wi.z, alpha, eta, 0) * ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
+    EXPECT_NEAR(model->eval(wi, wo)[0], lobe0, 1e-12 * lobe0);
+    EXPECT_GT(std::abs(lobe0 - top.eval(wi, wo)) / top.eval(wi, wo), 0.1);
 }
 
 // Bel18 symmetric feeds c0 = |wi·h| = |wo·h| to the adding scheme, so the lobe statistics are

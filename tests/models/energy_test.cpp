@@ -26,15 +26,14 @@ std::vector<std::pair<std::string, Stack>> sweep() {
         {"dielectric 1.33 a=0.2", test::dielectric(1.33, 0.2)},
     };
     for (const auto& [bname, base] : bases)
-        for (double eta : {1.2, 2.0})
+        for (double eta : {1.2, 1.5, 2.0})
             for (double alpha : {0.0, 0.1, 0.5})
                 out.push_back({fmt::format("eta0={} a0={} base {}", eta, alpha, bname),
                                coated(eta, alpha, base)});
     return out;
 }
 
-// Slow (a sweep of binned albedos): in the `stat` label with the other long-running checks.
-TEST(ModelsEnergyStat, AlbedoAtMostOne) {
+TEST(ModelsEnergy, AlbedoAtMostOne) {
     BinnedOptions o;
     o.rel_tol = 1e-3;
     for (const auto& entry : model_registry()) {
@@ -42,7 +41,11 @@ TEST(ModelsEnergyStat, AlbedoAtMostOne) {
         if (entry.name == "ww09" || entry.name == "ele10") continue;
         // Bel18/Bel' energies come from the FGD table: its interpolation budget for conductors
         // (max 6.3e-3, docs/models.md) adds to the quadrature tolerance (1e-3).
-        const double tol = entry.name.rfind("bel", 0) == 0 ? 1e-3 + 6.3e-3 : 1e-3;
+        // Bel18 symmetric is not conservative by construction (Bel18SymmetricCanExceedOne below):
+        // its budget is the measured excess over a wider sweep, 1.24e-2, rounded up.
+        const double tol = entry.name == "bel18-symmetric"   ? 2e-2
+                           : entry.name.rfind("bel", 0) == 0 ? 1e-3 + 6.3e-3
+                                                             : 1e-3;
         for (const auto& [what, stack] : sweep()) {
             const auto model = entry.make(stack, resolve_options(entry, {}));
             if (!model->support().brdf) continue;
@@ -78,6 +81,19 @@ TEST(ModelsEnergy, WW09ExceedsOneAtGrazingIncidence) {
     const auto model = make_model("ww09", coated(1.5, 0.1, test::lambertian(Rgbd(1.0))));
     EXPECT_GT(model_albedo(*model, incident_direction(deg_to_rad(80.0)), Side::Reflection).max(),
               1.1);
+}
+
+// Bel18 symmetric runs the adding scheme at c0 = |wi·h|, a different cosine for every outgoing
+// direction: the lobe energies E_k(c0(wo)) are then not one partition of the incident energy, and
+// nothing bounds ∫ Σ E_k(c0(wo)) lobe_k(wo) μo dωo by 1. Over coats η0 ∈ [1.1, 2], α0 ∈ [0, 0.5]
+// over a near-perfect mirror the excess reaches 1.2% (η0 = 1.2, α0 = 0.1, θi = 60°), mostly
+// through TIR at the grazing c0 of far-off-specular pairs. Shown, not hidden.
+TEST(ModelsEnergy, Bel18SymmetricCanExceedOne) {
+    const auto model = make_model("bel18-symmetric",
+                                  coated(1.2, 0.1, test::conductor(Rgbd(0.05), Rgbd(8.0), 0.0)));
+    const Rgbd a = model_albedo(*model, incident_direction(deg_to_rad(60.0)), Side::Reflection);
+    EXPECT_GT(a.max(), 1.005);
+    EXPECT_LT(a.max(), 1.02);
 }
 
 }  // namespace

@@ -27,6 +27,9 @@ TEST(FgdTable, FastComplexFresnelEqualsReference) {
                 const double want =
                     k == 0 ? fresnel_dielectric(c, eta) : fresnel_conductor(c, eta, k);
                 EXPECT_NEAR(fresnel_complex_fast(c, eta, k), want, 1e-12);
+                const Rgbd rgb = fresnel_complex_rgb(c, Rgbd(eta, 1.0, 2.0), Rgbd(k, 0.5, 1.0));
+                EXPECT_NEAR(rgb[0], want, 1e-12);
+                EXPECT_NEAR(rgb[2], fresnel_conductor(c, 2.0, 1.0), 1e-12);
             }
 }
 
@@ -79,6 +82,19 @@ TEST(FgdTable, TableMatchesDirectIntegrationOffGrid) {
     EXPECT_LT(sum_c / n, 1e-3);
 }
 
+// The RGB lookup equals three scalar lookups (one shared (c, α) part; the same interpolation).
+TEST(FgdTable, RgbLookupEqualsScalarLookups) {
+    const FgdTable& table = FgdTable::get();
+    const std::array<FgdTable::Index, 3> at = {
+        FgdTable::locate(0.18, 3.4), FgdTable::locate(0.42, 2.35), FgdTable::locate(1.37, 0.0)};
+    for (double c : {0.05, 0.5, 0.93})
+        for (double a : {0.0, 0.07, 0.3, 0.8}) {
+            const Rgbd v = table.rgb(c, a, at);
+            for (int i = 0; i < 3; ++i)
+                EXPECT_NEAR(v[i], table(c, a, at[i].eta, at[i].k), 1e-12) << c << " " << a;
+        }
+}
+
 // Smooth limit: α = 0 is the Fresnel factor itself, including total internal reflection.
 TEST(FgdTable, SmoothLimitIsFresnel) {
     const FgdTable& table = FgdTable::get();
@@ -87,17 +103,23 @@ TEST(FgdTable, SmoothLimitIsFresnel) {
 }
 
 // TIR table against plain Monte Carlo (independent random numbers, 2·10⁵ samples, standard error
-// ≤ 1.2e-3) at off-grid points; the budget adds the table's stratified-MC noise (32×32 strata)
-// and the trilinear interpolation error, measured ≤ 6e-3 away from the sharp TIR edge of tiny α.
+// ≤ 1.2e-3) at off-grid points with α ≥ 0.05. Budget: the measured error of the table (stratified
+// MC noise + interpolation; docs/models.md): max 1.1e-2 (next to the critical angle, where τ is
+// nearly a step), mean 1.8e-3 over 150 random points; tolerances 2e-2 / 4e-3.
 TEST(TirTableStat, TableMatchesDirectMonteCarloOffGrid) {
     const TirTable& table = TirTable::get();
     ParticleRng rng(5, 0, 0);
-    for (int i = 0; i < 40; ++i) {
+    double sum = 0;
+    const int n = 40;
+    for (int i = 0; i < n; ++i) {
         const double c = rng.uniform_double(), a = 0.05 + 0.9 * rng.uniform_double();
         const double eta = 0.4 + 0.55 * rng.uniform_double();
         const double mc = TirTable::direct_mc(c, a, eta, 200000, 100 + i);
-        EXPECT_NEAR(table(c, a, eta), mc, 1.5e-2) << c << " " << a << " " << eta;
+        const double err = std::abs(table(c, a, eta) - mc);
+        EXPECT_LT(err, 2e-2) << c << " " << a << " " << eta;
+        sum += err;
     }
+    EXPECT_LT(sum / n, 4e-3);
     EXPECT_EQ(table(0.5, 0.3, 1.2), 1.0);  // no TIR towards a denser medium
 }
 
@@ -105,6 +127,8 @@ TEST(TirTableStat, TableMatchesDirectMonteCarloOffGrid) {
 TEST(TirTable, SmoothLimitIsTheCriticalAngle) {
     EXPECT_EQ(TirTable::direct_mc(0.9, 0.0, 1 / 1.5, 1000), 1.0);  // c above √(1 − 1/2.25) ≈ 0.745
     EXPECT_EQ(TirTable::direct_mc(0.6, 0.0, 1 / 1.5, 1000), 0.0);
+    EXPECT_EQ(TirTable::get()(0.75, 0.0, 1 / 1.5), 1.0);  // just above: no interpolation blur
+    EXPECT_EQ(TirTable::get()(0.74, 0.0, 1 / 1.5), 0.0);
 }
 
 class CacheDir : public ::testing::Test {

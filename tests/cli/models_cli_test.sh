@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# End-to-end checks of `lamina models` and `lamina eval`. Usage: models_cli_test.sh LAMINA
+# The checks that read a stack file need the stack parser (issue 2); until it is merged they are
+# skipped with a message, never silently passed.
+set -u
+lamina=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fails=0
+pass=0
+check() {  # check NAME EXPECTED_RC COMMAND...
+    local name=$1 want=$2
+    shift 2
+    "$@" >"$tmp/out" 2>&1
+    local rc=$?
+    if [ "$rc" -ne "$want" ]; then
+        echo "FAIL $name: exit $rc, wanted $want"; cat "$tmp/out"; fails=$((fails + 1))
+    else
+        pass=$((pass + 1))
+    fi
+}
+expect_output() {  # expect_output NAME PATTERN: the last command's output matches PATTERN
+    if grep -q -- "$2" "$tmp/out"; then pass=$((pass + 1)); else
+        echo "FAIL $1: output lacks '$2'"; cat "$tmp/out"; fails=$((fails + 1)); fi
+}
+
+check models 0 "$lamina" models --options
+for m in ww09 ele10 ww-prime bel18-forward bel18-symmetric bel-prime; do expect_output "models $m" "^$m "; done
+check unknown-model 1 "$lamina" eval --model ww10 --stack x.json --theta-i 30 --theta-o 45 --phi-o 180
+expect_output unknown-model-lists "known models: ww09"
+check theta-i-range 1 "$lamina" eval --model ww09 --stack x.json --theta-i 90 --theta-o 45 --phi-o 180
+expect_output theta-i-range-says "theta-i"
+check theta-o-range 1 "$lamina" eval --model ww09 --stack x.json --theta-i 30 --theta-o 91 --phi-o 180
+check bad-option 1 "$lamina" eval --model ww09 --stack x.json --theta-i 30 --theta-o 45 --phi-o 180 --option tir=on
+expect_output bad-option-lists "its options"
+check bad-option-value 1 "$lamina" eval --model bel-prime --stack x.json --theta-i 30 --theta-o 45 --phi-o 180 --option tir=maybe
+check binned-needs-out 1 "$lamina" eval --model ww09 --stack x.json --binned
+
+cat >"$tmp/gold.json" <<'JSON'
+{"name": "coated gold", "layers": [
+  {"interface": {"type": "dielectric", "eta": 1.5, "alpha": 0.1}, "medium": {"tau_a": 0.1}},
+  {"interface": {"type": "conductor", "eta": [0.18, 0.42, 1.37], "k": [3.4, 2.35, 1.85], "alpha": 0.2}}]}
+JSON
+cat >"$tmp/plastic.json" <<'JSON'
+{"name": "plastic", "layers": [
+  {"interface": {"type": "dielectric", "eta": 1.5, "alpha": 0.2}},
+  {"interface": {"type": "lambertian", "albedo": 0.8}}]}
+JSON
+if "$lamina" validate "$tmp/gold.json" >/dev/null 2>&1; then
+    check point 0 "$lamina" eval --model bel-prime --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180
+    expect_output point-three-numbers "^[0-9.e+-]* [0-9.e+-]* [0-9.e+-]*$"
+    check not-supported 1 "$lamina" eval --model bel18-forward --stack "$tmp/plastic.json" --theta-i 30 --theta-o 45 --phi-o 180
+    expect_output not-supported-says "not supported: bel18-forward has no Lambertian base"
+    check no-btdf 1 "$lamina" eval --model ww09 --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180 --side T
+    printf 'theta_i,theta_o,phi_o,side\n30,45,180,R\n0,10,0,R\n' >"$tmp/dirs.csv"
+    check batch 0 "$lamina" eval --model ww-prime --stack "$tmp/plastic.json" --directions "$tmp/dirs.csv" --out "$tmp/f.csv"
+    if head -1 "$tmp/f.csv" | grep -q '^theta_i,theta_o,phi_o,side,f_r,f_g,f_b$' && [ "$(wc -l <"$tmp/f.csv")" -eq 3 ]; then
+        pass=$((pass + 1)); else echo "FAIL batch output"; cat "$tmp/f.csv"; fails=$((fails + 1)); fi
+    printf 'theta_i,theta_o\n30,45\n' >"$tmp/bad.csv"
+    check batch-bad-header 1 "$lamina" eval --model ww-prime --stack "$tmp/plastic.json" --directions "$tmp/bad.csv" --out "$tmp/g.csv"
+    check binned 0 "$lamina" eval --model bel18-symmetric --stack "$tmp/gold.json" --theta-i 0,30,60 --binned --grid 9x6 --out "$tmp/b.csv"
+    if head -1 "$tmp/b.csv" | grep -q '^theta_i,side,theta_lo,theta_hi,phi_lo,phi_hi,f_r,f_g,f_b,se_r,se_g,se_b$' && [ "$(wc -l <"$tmp/b.csv")" -eq $((1 + 3 * 54)) ]; then
+        pass=$((pass + 1)); else echo "FAIL binned output"; head -3 "$tmp/b.csv"; fails=$((fails + 1)); fi
+else
+    echo "SKIP the stack-reading checks: 'lamina validate' cannot parse a stack yet (issue 2 not merged)"
+fi
+echo "$pass passed, $fails failed"
+[ "$fails" -eq 0 ]
