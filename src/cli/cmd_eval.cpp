@@ -1,6 +1,7 @@
 // lamina eval: a model's BSDF at points, at a batch of directions, or averaged over the
 // goniophotometer's bins (docs/models.md, "Evaluating a model").
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/math.h"
@@ -48,19 +49,6 @@ void check_angle(double v, double lo, double hi, bool closed_hi, const std::stri
             fmt::format("{} degrees is outside [{}, {}{}", v, lo, hi, closed_hi ? "]" : ")"));
 }
 
-std::vector<double> parse_theta_list(const std::string& text) {
-    std::vector<double> out;
-    std::stringstream ss(text);
-    for (std::string item; std::getline(ss, item, ',');) {
-        const double v = parse_number(item, "command line", "--theta-i");
-        check_angle(v, 0, 90, false, "command line", "--theta-i");
-        out.push_back(v);
-    }
-    if (out.empty())
-        throw InputError("command line", "--theta-i", "expected a comma list of angles");
-    return out;
-}
-
 Side parse_side(const std::string& s, const std::string& where, const std::string& field) {
     if (s == "R") return Side::Reflection;
     if (s == "T") return Side::Transmission;
@@ -92,7 +80,7 @@ int run_eval(const EvalArgs& a) {
 
     if (a.binned) {
         const std::vector<double> thetas =
-            parse_theta_list(a.theta_i.empty() ? "0,15,30,45,60,70,80" : a.theta_i);
+            parse_incidences(a.theta_i.empty() ? "0,15,30,45,60,70,80" : a.theta_i, "--theta-i");
         const HemisphereGrid grid = HemisphereGrid::parse(a.grid, "--grid");
         const Stack stack = load_stack(a.stack);
         const auto model = entry.make(stack, options);
@@ -147,7 +135,7 @@ int run_eval(const EvalArgs& a) {
     }
 
     // One point.
-    const std::vector<double> thetas = parse_theta_list(a.theta_i);
+    const std::vector<double> thetas = parse_incidences(a.theta_i, "--theta-i");
     if (thetas.size() != 1)
         throw InputError("command line", "--theta-i",
                          "a point evaluation takes one angle (lists are for --binned)");

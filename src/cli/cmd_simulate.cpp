@@ -41,7 +41,7 @@ Runner add_simulate(CLI::App& app) {
     return [a] {
         const Stack stack = load_stack(a->stack);
         SimulationSettings s;
-        s.theta_i_deg = parse_angle_list(a->theta_i, "--theta-i");
+        s.theta_i_deg = parse_incidences(a->theta_i, "--theta-i");
         s.particles = parse_count(a->particles, "--particles");
         s.seed = a->seed;
         s.threads = a->threads;
@@ -57,15 +57,15 @@ Runner add_simulate(CLI::App& app) {
         write_simulation(a->out, stack, result);
         for (std::size_t i = 0; i < result.incidences.size(); ++i) {
             const EnergyBudget& b = result.incidences[i].budget;
-            fmt::print("θi = {:>4}°  R = {}  T = {}  lost = {}  absorbed = {}\n",
-                       s.theta_i_deg[i], format_rgb(b[BudgetTerm::Reflected]),
-                       format_rgb(b[BudgetTerm::Transmitted]),
+            fmt::print("θi = {:>4}°  R = {}  T = {}  lost = {}  absorbed = {}\n", s.theta_i_deg[i],
+                       format_rgb(b[BudgetTerm::Reflected]), format_rgb(b[BudgetTerm::Transmitted]),
                        format_rgb(b[BudgetTerm::LostMicrosurface]),
                        format_rgb(b[BudgetTerm::AbsorbedMedium] + b[BudgetTerm::AbsorbedBase]));
         }
-        fmt::print("{:.3g} particles/s on {} threads; wrote {}/{{result.json,brdf.csv,energy.csv}}\n",
-                   double(s.particles * s.theta_i_deg.size()) / result.seconds,
-                   result.threads_used, a->out);
+        fmt::print(
+            "{:.3g} particles/s on {} threads; wrote {}/{{result.json,brdf.csv,energy.csv}}\n",
+            double(s.particles * s.theta_i_deg.size()) / result.seconds, result.threads_used,
+            a->out);
         return 0;
     };
 }

@@ -42,11 +42,7 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
         a.particles.empty() ? preset_particles(preset) : parse_count(a.particles, "--particles");
     s.seed = a.seed;
     s.threads = a.threads;
-    s.theta_i_deg = parse_angle_list(a.theta_i, "--theta-i");
-    for (double t : s.theta_i_deg)
-        if (!(t >= 0 && t < 90))
-            throw InputError("command line", "--theta-i",
-                             fmt::format("{} is outside the allowed range [0, 90) degrees", t));
+    s.theta_i_deg = parse_incidences(a.theta_i, "--theta-i");
     s.grid = HemisphereGrid::parse(a.grid);
     if (!a.models.empty()) {
         std::stringstream ss(a.models);

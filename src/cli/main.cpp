@@ -3,8 +3,8 @@
 #include "core/error.h"
 #include "lamina/version.h"
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <exception>
 #include <utility>

@@ -27,13 +27,22 @@ std::vector<double> parse_angle_list(const std::string& text, const std::string&
     for (std::string item; std::getline(ss, item, ',');) {
         double v;
         if (!parse_double(item, v))
-            throw InputError("command line", option,
-                             fmt::format("'{}' is not a number (expected degrees, e.g. 0,30,60)",
-                                         item));
+            throw InputError(
+                "command line", option,
+                fmt::format("'{}' is not a number (expected degrees, e.g. 0,30,60)", item));
         out.push_back(v);
     }
     if (out.empty())
         throw InputError("command line", option, "expected at least one angle, e.g. 0,30,60");
+    return out;
+}
+
+std::vector<double> parse_incidences(const std::string& text, const std::string& option) {
+    std::vector<double> out = parse_angle_list(text, option);
+    for (double t : out)
+        if (!(t >= 0 && t < 90))
+            throw InputError("command line", option,
+                             fmt::format("{} is outside the allowed range [0, 90) degrees", t));
     return out;
 }
 
