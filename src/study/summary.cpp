@@ -168,7 +168,9 @@ void write_summary(const std::filesystem::path& out_dir,
                 floor = a.mean_floor();
             }
         }
-        if (!best.empty() && best_e > kChallengingThreshold)
+        // Noise-dominated configurations are not flagged: the best model must also be clearly
+        // (2×) above the reference's noise floor.
+        if (!best.empty() && best_e > kChallengingThreshold && !(best_e <= 2 * floor))
             challenging.push_back({c.id, best, best_e, floor});
     }
 
@@ -315,7 +317,8 @@ void write_summary(const std::filesystem::path& out_dir,
             return t + " (mean misplaced energy over the configurations each supports)";
         }());
     out(
-        "- **Challenging cases** (even the best model misplaces more than {} on average): {}.\n\n",
+        "- **Challenging cases** (even the best model misplaces more than {} of the reflected "
+        "energy on average, and more than twice the noise floor): {}.\n\n",
         pct(kChallengingThreshold), challenging.empty() ? std::string("none") : [&] {
             std::string t;
             for (std::size_t k = 0; k < challenging.size(); ++k)
@@ -366,7 +369,8 @@ void write_summary(const std::filesystem::path& out_dir,
     out("\n");
 
     out("## Challenging cases\n\nConfigurations where even the best supporting model misplaces "
-        "more than {} of the reflected energy on average over incidences and channels.\n\n",
+        "more than {} of the reflected energy on average over incidences and channels, and more "
+        "than twice the reference's noise floor.\n\n",
         pct(kChallengingThreshold));
     if (challenging.empty()) {
         out("None.\n\n");

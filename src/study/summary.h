@@ -14,7 +14,8 @@
 namespace lamina {
 
 /// A configuration is "challenging" when even its best supporting model misplaces more than this
-/// fraction of the reference's energy on average over incidences, sides and channels.
+/// fraction of the reference's reflected energy on average over incidences and channels (and more
+/// than twice the noise floor, so that noise alone never makes a case challenging).
 inline constexpr double kChallengingThreshold = 0.2;
 
 void write_summary(const std::filesystem::path& out_dir,
