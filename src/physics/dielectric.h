@@ -100,7 +100,7 @@ struct DielectricInterface {
     /// kWithPdf = false skips the density (the particle tracer only needs the weight).
     template <bool kWithPdf = true>
     LAMINA_FORCE_INLINE std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T uc, T u1,
-                                                             T u2) const {
+                                                            T u2) const {
         if (wi.z == 0) return std::nullopt;
         if (is_smooth()) return sample_smooth(wi, uc);
         if (is_index_matched()) return sample_index_matched(wi);
@@ -108,19 +108,21 @@ struct DielectricInterface {
         const Vec3<T> wm = ggx.sample_visible_normal_caps(wi, u1, u2);
         const T cos_i_m = dot(wi, wm);  // < 0 when wi is below: seen from the other side
         const FresnelDielectric<T> fr = fresnel_dielectric_full(cos_i_m, eta, inv_eta());
+        // Both candidate directions are formed and one is selected: the Fresnel choice is a coin
+        // flip no branch predictor can learn. Snell about wm (fresnel.h refract) reuses the
+        // refracted cosine: with m = ±wm on wi's side, wt = −wi/η + m (cos θi/η − cos θt) (under
+        // total reflection F = 1 and the refracted candidate is never selected).
+        const T sign = cos_i_m < 0 ? T(-1) : T(1);
+        const Vec3<T> reflected = reflect(wi, wm);
+        const Vec3<T> refracted =
+            wi * (-fr.inv_eta) + wm * (sign * (std::abs(cos_i_m) * fr.inv_eta - fr.cos_theta_t));
+        const bool is_reflection = uc < fr.reflectance;
         BsdfSample<T> s;
-        if (uc < fr.reflectance) {
-            s.wo = reflect(wi, wm);
-            if (!same_hemisphere(wi, s.wo)) return lost_to_microsurface(s);
-        } else {
-            // Snell about wm (fresnel.h refract), reusing the refracted cosine: with m = ±wm on
-            // wi's side, wt = −wi/η + m (cos θi/η − cos θt).
-            const T sign = cos_i_m < 0 ? T(-1) : T(1);
-            s.wo = wi * (-fr.inv_eta) +
-                   wm * (sign * (std::abs(cos_i_m) * fr.inv_eta - fr.cos_theta_t));
-            s.is_transmission = true;
-            if (same_hemisphere(wi, s.wo) || s.wo.z == 0) return lost_to_microsurface(s);
-        }
+        s.wo = is_reflection ? reflected : refracted;
+        s.is_transmission = !is_reflection;
+        // A reflection must stay on wi's side and a refraction cross: otherwise the single-
+        // scattering microsurface loses the energy (G2 = 0 for the pair).
+        const bool escapes = s.wo.z != 0 && (same_hemisphere(wi, s.wo) == is_reflection);
         // Weight f·|cos θo|/pdf = G2(wi, wo)/G1(wi): the Fresnel branch probability cancels F
         // (Heitz 2018, §2; Walter Eq. 41 with visible-normal sampling). With r = √(1 + α²tan²θ)
         // = 1 + 2Λ (Heitz 2014, Eq. 72), height-correlated G2/G1 = (1 + r_i) / (r_i + r_o).
@@ -130,19 +132,13 @@ struct DielectricInterface {
             const T r_i = ggx.smith_root(wi), r_o = ggx.smith_root(s.wo);
             s.shadowing = (T(1) + r_i) / (r_i + r_o);
         }
+        if (!escapes) s.shadowing = 0;
         s.weight = Rgb<T>(s.shadowing);
         if constexpr (kWithPdf) s.pdf = pdf(wi, s.wo);
         return s;
     }
 
-private:
-    static std::optional<BsdfSample<T>> lost_to_microsurface(BsdfSample<T> s) {
-        // The single-scattering model lets this energy go (G2 = 0 for the pair).
-        s.shadowing = 0;
-        s.weight = Rgb<T>(T(0));
-        return s;
-    }
-
+  private:
     /// Rough and η = 1: F = 0 on every microfacet and Snell's law sends every refracted ray
     /// straight on, so the BTDF of Walter et al. collapses onto a delta lobe at −wi, which eval
     /// and pdf (densities) cannot represent. Its weight is the η → 1 limit of the lobe's energy,
