@@ -19,13 +19,15 @@ Layer coat(double alpha, Rgbd tau_a) {
     return l;
 }
 
+// The benchmark plastic: α0 = 0.2, τa = (0.1, 0, 0.9), a white (ρ = 1) Lambertian.
 Stack bench_plastic() {
     Layer base;
     base.interface.type = InterfaceType::Lambertian;
-    base.interface.albedo = Rgbd(0.8);
+    base.interface.albedo = Rgbd(1.0);
     return {"bench plastic", 1.0, {coat(0.2, Rgbd(0.1, 0.0, 0.9)), base}};
 }
 
+// The benchmark metallic paint: α0 = 0.05, τa = 0.1, conductor η = 0.2, k = 3, α1 = 0.3.
 Stack bench_metallic_paint() {
     Layer base;
     base.interface.type = InterfaceType::Conductor;
