@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
     add(lamina::cli::add_simulate);
     add(lamina::cli::add_models);
     add(lamina::cli::add_eval);
+    add(lamina::cli::add_explorer);
+    add(lamina::cli::add_figures);
 
     CLI11_PARSE(app, argc, argv);
     try {

@@ -1,0 +1,422 @@
+#include "report/explorer.h"
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "report/assets.h"
+#include "report/npy.h"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace lamina {
+
+namespace {
+
+// ---- Reading the study directory ------------------------------------------------------------
+
+json read_json(const fs::path& path, const char* what) {
+    std::ifstream in(path);
+    if (!in)
+        throw InputError(path.string(), "",
+                         fmt::format("cannot read {} (is this a study directory written by `lamina "
+                                     "study` or `lamina compare`?)",
+                                     what));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    try {
+        return json::parse(ss.str());
+    } catch (const json::parse_error& e) {
+        throw InputError(path.string(), "", fmt::format("malformed JSON: {}", e.what()));
+    }
+}
+
+template <class T>
+T field(const json& j, const std::string& key, const fs::path& file) {
+    if (!j.contains(key)) throw InputError(file.string(), "/" + key, "missing");
+    try {
+        return j.at(key).get<T>();
+    } catch (const json::exception& e) {
+        throw InputError(file.string(), "/" + key, fmt::format("wrong type: {}", e.what()));
+    }
+}
+
+std::vector<std::string> split_csv_line(const std::string& line) {
+    std::vector<std::string> out;
+    std::string cur;
+    for (char c : line) {
+        if (c == ',') {
+            out.push_back(cur);
+            cur.clear();
+        } else if (c != '\r') {
+            cur += c;
+        }
+    }
+    out.push_back(cur);
+    return out;
+}
+
+// metrics.csv → {config: {model: {side: {metric: [incidence][channel]}}}}, null where empty.
+json read_metrics(const fs::path& path, const std::vector<double>& theta_i) {
+    json out = json::object();
+    std::ifstream in(path);
+    if (!in) return out;  // the page then shows no leaderboard, and says so
+    std::string line;
+    std::getline(in, line);
+    const std::vector<std::string> header = split_csv_line(line);
+    auto column = [&](const char* name) {
+        const auto it = std::find(header.begin(), header.end(), name);
+        if (it == header.end()) throw InputError(path.string(), name, "column missing");
+        return std::size_t(it - header.begin());
+    };
+    const std::size_t c_config = column("config"), c_model = column("model"),
+                      c_theta = column("theta_i"), c_side = column("side"),
+                      c_channel = column("channel"), c_supported = column("supported");
+    const std::pair<const char*, std::size_t> metrics[] = {{"me", column("misplaced_energy")},
+                                                           {"nf", column("noise_floor")},
+                                                           {"ae", column("albedo_error")},
+                                                           {"lr", column("log_rmse")}};
+    std::size_t row = 1;
+    while (std::getline(in, line)) {
+        ++row;
+        if (line.empty()) continue;
+        const std::vector<std::string> v = split_csv_line(line);
+        if (v.size() != header.size())
+            throw InputError(path.string(), fmt::format("row {}", row),
+                             fmt::format("{} fields, the header has {}", v.size(), header.size()));
+        const double t = std::atof(v[c_theta].c_str());
+        std::size_t i = 0;
+        while (i < theta_i.size() && std::abs(theta_i[i] - t) > 1e-6)
+            ++i;
+        if (i == theta_i.size()) continue;  // an incidence study.json does not list
+        const int ch = v[c_channel] == "r" ? 0 : v[c_channel] == "g" ? 1 : 2;
+        json& cell = out[v[c_config]][v[c_model]][v[c_side]];
+        for (const auto& [key, col] : metrics) {
+            if (!cell.contains(key)) cell[key] = json::array();
+            json& arr = cell[key];
+            while (arr.size() < theta_i.size())
+                arr.push_back(json{nullptr, nullptr, nullptr});
+            if (v[c_supported] == "true" && !v[col].empty()) {
+                const double x = std::atof(v[col].c_str());
+                if (std::isfinite(x)) arr[i][ch] = x;
+            }
+        }
+    }
+    return out;
+}
+
+// ---- Encoding ---------------------------------------------------------------------------------
+
+std::string base64(const void* data, std::size_t n) {
+    static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const auto* p = static_cast<const unsigned char*>(data);
+    std::string out;
+    out.reserve((n + 2) / 3 * 4);
+    std::size_t i = 0;
+    for (; i + 2 < n; i += 3) {
+        const unsigned v = (p[i] << 16) | (p[i + 1] << 8) | p[i + 2];
+        out += k[v >> 18];
+        out += k[(v >> 12) & 63];
+        out += k[(v >> 6) & 63];
+        out += k[v & 63];
+    }
+    if (i + 1 == n) {
+        const unsigned v = p[i] << 16;
+        out += k[v >> 18];
+        out += k[(v >> 12) & 63];
+        out += "==";
+    } else if (i + 2 == n) {
+        const unsigned v = (p[i] << 16) | (p[i + 1] << 8);
+        out += k[v >> 18];
+        out += k[(v >> 12) & 63];
+        out += k[(v >> 6) & 63];
+        out += '=';
+    }
+    return out;
+}
+
+// The hemisphere maps are stored as 16-bit codes of log10 f (docs/explorer.md, "Data"): 0 is
+// f <= 0, 65535 is NaN (not supported), 1..65534 cover [lo, hi] in log10 f uniformly. Ten decades
+// over 65533 steps: a relative step of 0.035 %, invisible on any map.
+constexpr double kLogDecades = 10.0;
+constexpr std::uint16_t kCodeNaN = 65535;
+
+struct LogCodec {
+    double lo = -10.0, hi = 0.0;
+    std::uint16_t encode(float f) const {
+        if (std::isnan(f)) return kCodeNaN;
+        if (!(f > 0)) return 0;
+        const double u = (std::log10(double(f)) - lo) / (hi - lo);
+        return std::uint16_t(1 + std::lround(std::clamp(u, 0.0, 1.0) * 65533.0));
+    }
+};
+
+// The folded grid of docs/formats.md: θ uniform over [0°, 90°], φ uniform over [0°, 180°].
+double omega_perp(int n_theta, int n_phi, int t, int p) {
+    (void)p;
+    const double dphi = M_PI / n_phi;
+    const double s0 = std::sin(0.5 * M_PI * t / n_theta),
+                 s1 = std::sin(0.5 * M_PI * (t + 1) / n_theta);
+    return dphi * (s1 * s1 - s0 * s0);
+}
+
+// Groups of `k` consecutive bins (the last one may be shorter): the edges of the merged bins.
+std::vector<int> merged_edges(int n, int k) {
+    std::vector<int> e;
+    for (int i = 0; i < n; i += k)
+        e.push_back(i);
+    e.push_back(n);
+    return e;
+}
+
+struct ConfigData {
+    std::string script;      ///< explorer/data/<id>.js
+    json albedo, albedo_se;  ///< for the index
+};
+
+// Reads one configuration and encodes what the page draws (docs/explorer.md, "Data").
+ConfigData encode_configuration(const fs::path& dir, const std::string& id,
+                                const std::vector<double>& theta_i, int n_theta, int n_phi,
+                                json& entry) {
+    const fs::path cfg_path = dir / "config.json";
+    const json cfg = read_json(cfg_path, "the configuration");
+    const auto sources = field<std::vector<std::string>>(cfg, "sources", cfg_path);
+    const auto sides = field<std::vector<std::string>>(cfg, "sides", cfg_path);
+    const NpyFloat32 tab = read_npy_float32(dir / "tables.npy");
+    const std::size_t S = sources.size(), I = theta_i.size(), D = sides.size(), T = n_theta,
+                      P = n_phi;
+    const std::vector<std::size_t> want = {S, I, D, T, P, 3};
+    if (tab.shape != want)
+        throw InputError((dir / "tables.npy").string(), "shape",
+                         fmt::format("[{}]: expected [sources {}, incidences {}, sides {}, θ {}, φ "
+                                     "{}, 3] from config.json and study.json",
+                                     fmt::format("{}", fmt::join(tab.shape, ", ")), S, I, D, T, P));
+    NpyFloat32 se;
+    const bool has_se = fs::exists(dir / "reference_se.npy");
+    if (has_se) {
+        se = read_npy_float32(dir / "reference_se.npy");
+        const std::vector<std::size_t> want_se = {I, D, T, P, 3};
+        if (se.shape != want_se)
+            throw InputError((dir / "reference_se.npy").string(), "shape",
+                             fmt::format("expected [{}, {}, {}, {}, 3]", I, D, T, P));
+    }
+    auto at = [&](std::size_t s, std::size_t i, std::size_t d, std::size_t t, std::size_t p,
+                  std::size_t c) {
+        return tab.data[((((s * I + i) * D + d) * T + t) * P + p) * 3 + c];
+    };
+    auto se_at = [&](std::size_t i, std::size_t d, std::size_t t, std::size_t p, std::size_t c) {
+        return se.data[(((i * D + d) * T + t) * P + p) * 3 + c];
+    };
+
+    // 1. The incident-plane slice at full resolution, float32 [source, incidence, side, 2T, 3]:
+    //    x < T is the light's side (φ bin 0, θ descending), x >= T the mirror side (last φ bin).
+    std::vector<float> slice, slice_se;
+    slice.reserve(S * I * D * 2 * T * 3);
+    auto plane_bin = [&](std::size_t x) {
+        return x < T ? std::pair<std::size_t, std::size_t>{T - 1 - x, 0}
+                     : std::pair<std::size_t, std::size_t>{x - T, P - 1};
+    };
+    for (std::size_t s = 0; s < S; ++s)
+        for (std::size_t i = 0; i < I; ++i)
+            for (std::size_t d = 0; d < D; ++d)
+                for (std::size_t x = 0; x < 2 * T; ++x)
+                    for (std::size_t c = 0; c < 3; ++c) {
+                        const auto [t, p] = plane_bin(x);
+                        slice.push_back(at(s, i, d, t, p, c));
+                    }
+    for (std::size_t i = 0; i < I && has_se; ++i)
+        for (std::size_t d = 0; d < D; ++d)
+            for (std::size_t x = 0; x < 2 * T; ++x)
+                for (std::size_t c = 0; c < 3; ++c) {
+                    const auto [t, p] = plane_bin(x);
+                    slice_se.push_back(se_at(i, d, t, p, c));
+                }
+
+    // 2. Albedos Σ f Ω⊥ of every source, and the reference's standard error (bins taken as
+    //    independent: a slight overestimate, since one particle lands in one bin only).
+    json albedo = json::object(), albedo_se = json::object();
+    for (std::size_t s = 0; s < S; ++s) {
+        json per_side = json::object();
+        for (std::size_t d = 0; d < D; ++d) {
+            json per_inc = json::array();
+            json se_inc = json::array();
+            for (std::size_t i = 0; i < I; ++i) {
+                double a[3] = {0, 0, 0}, v[3] = {0, 0, 0};
+                bool nan = false;
+                for (std::size_t t = 0; t < T; ++t)
+                    for (std::size_t p = 0; p < P; ++p) {
+                        const double w = omega_perp(T, P, int(t), int(p));
+                        for (std::size_t c = 0; c < 3; ++c) {
+                            const float f = at(s, i, d, t, p, c);
+                            if (std::isnan(f)) nan = true;
+                            a[c] += f * w;
+                            if (s == 0 && has_se) v[c] += std::pow(se_at(i, d, t, p, c) * w, 2);
+                        }
+                    }
+                per_inc.push_back(nan ? json(nullptr) : json{a[0], a[1], a[2]});
+                se_inc.push_back(json{std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2])});
+            }
+            per_side[sides[d]] = per_inc;
+            if (s == 0 && has_se) albedo_se[sides[d]] = se_inc;
+        }
+        albedo[sources[s]] = per_side;
+    }
+
+    // 3. The hemisphere for the iso-value maps: bins merged to at most ~45 × 45 (cos-weighted
+    //    averages, weights Ω⊥), then 16-bit log codes.
+    const int kt = (int(T) + 44) / 45, kp = (int(P) + 44) / 45;
+    const std::vector<int> et = merged_edges(int(T), kt), ep = merged_edges(int(P), kp);
+    const std::size_t T2 = et.size() - 1, P2 = ep.size() - 1;
+    std::vector<float> hemi(S * I * D * T2 * P2 * 3);
+    float max_f = 0;
+    std::size_t h = 0;
+    for (std::size_t s = 0; s < S; ++s)
+        for (std::size_t i = 0; i < I; ++i)
+            for (std::size_t d = 0; d < D; ++d)
+                for (std::size_t t2 = 0; t2 < T2; ++t2)
+                    for (std::size_t p2 = 0; p2 < P2; ++p2)
+                        for (std::size_t c = 0; c < 3; ++c) {
+                            double num = 0, den = 0;
+                            for (int t = et[t2]; t < et[t2 + 1]; ++t)
+                                for (int p = ep[p2]; p < ep[p2 + 1]; ++p) {
+                                    const double w = omega_perp(T, P, t, p);
+                                    num += at(s, i, d, t, p, c) * w;
+                                    den += w;
+                                }
+                            const float f = float(num / den);
+                            hemi[h++] = f;
+                            if (std::isfinite(f)) max_f = std::max(max_f, f);
+                        }
+    LogCodec codec;
+    codec.hi = max_f > 0 ? std::log10(double(max_f)) : 0.0;
+    codec.lo = codec.hi - kLogDecades;
+    std::vector<std::uint16_t> codes(hemi.size());
+    for (std::size_t k = 0; k < hemi.size(); ++k)
+        codes[k] = codec.encode(hemi[k]);
+    std::vector<double> theta_edges, phi_edges;
+    for (int e : et)
+        theta_edges.push_back(90.0 * e / T);
+    for (int e : ep)
+        phi_edges.push_back(180.0 * e / P);
+
+    // Support and reasons: from config.json, else derived from the NaNs of the tables.
+    json supported = cfg.value("supported", json::object());
+    for (std::size_t s = 1; s < S; ++s)
+        if (!supported.contains(sources[s])) {
+            json m = json::object();
+            for (std::size_t d = 0; d < D; ++d)
+                m[sides[d]] = !albedo[sources[s]][sides[d]][0].is_null();
+            supported[sources[s]] = m;
+        }
+    entry["supported"] = supported;
+    entry["sources"] = sources;
+    entry["sides"] = sides;
+
+    // Sphere renderings (optional, a later issue writes them): configs/<id>/renders/<source>.png.
+    json renders = json::object();
+    for (const std::string& s : sources)
+        if (fs::exists(dir / "renders" / (s + ".png")))
+            renders[s] = fmt::format("configs/{}/renders/{}.png", id, s);
+    entry["renders"] = renders;
+
+    json data = {
+        {"id", id},
+        {"sources", sources},
+        {"sides", sides},
+        {"slice", base64(slice.data(), slice.size() * sizeof(float))},
+        {"slice_se",
+         has_se ? json(base64(slice_se.data(), slice_se.size() * sizeof(float))) : json(nullptr)},
+        {"hemi",
+         {{"n_theta", T2},
+          {"n_phi", P2},
+          {"theta_edges", theta_edges},
+          {"phi_edges", phi_edges},
+          {"lo", codec.lo},
+          {"hi", codec.hi},
+          {"codes", base64(codes.data(), codes.size() * sizeof(std::uint16_t))}}},
+    };
+    ConfigData out;
+    out.script = fmt::format("(window.LAMINA_DATA = window.LAMINA_DATA || {{}})[{}] = {};\n",
+                             json(id).dump(), data.dump());
+    out.albedo = albedo;
+    out.albedo_se = albedo_se;
+    return out;
+}
+
+std::string_view checked(std::string_view asset, const char* name) {
+    if (asset.empty())
+        throw InputError(name, "",
+                         "was not embedded when lamina was built: run `make deps` (it installs the "
+                         "npm packages), then reconfigure and rebuild");
+    return asset;
+}
+
+}  // namespace
+
+ExplorerSummary write_explorer(const fs::path& study_dir) {
+    const fs::path study_path = study_dir / "study.json";
+    if (!fs::exists(study_path))
+        throw InputError(study_path.string(), "",
+                         "not found: expected a study directory written by `lamina study` or "
+                         "`lamina compare`");
+    const json study = read_json(study_path, "the study's description");
+    const auto theta_i = field<std::vector<double>>(study, "theta_i", study_path);
+    const json grid = field<json>(study, "grid", study_path);
+    const int n_theta = field<int>(grid, "n_theta", study_path);
+    const int n_phi = field<int>(grid, "n_phi", study_path);
+    const json configurations = field<json>(study, "configurations", study_path);
+    const std::string_view plotly = checked(assets::plotly_js(), "plotly.min.js");
+
+    // Stage everything first: a failure leaves the previous page untouched.
+    StagedOutput data_out(study_dir / "explorer" / "data");
+    ExplorerSummary summary;
+    json index = {{"study", json::object()}, {"configs", json::array()}};
+    for (const char* key : {"preset", "particles", "seed", "lamina_version", "models", "grid"})
+        if (study.contains(key)) index["study"][key] = study[key];
+    index["study"]["theta_i"] = theta_i;
+    index["study"]["name"] = fs::absolute(study_dir).lexically_normal().filename().string();
+    if (index["study"]["name"] == "")
+        index["study"]["name"] =
+            fs::absolute(study_dir).lexically_normal().parent_path().filename().string();
+    for (const json& c : configurations) {
+        const std::string id = field<std::string>(c, "id", study_path);
+        json entry = {{"id", id},
+                      {"category", c.value("category", "custom")},
+                      {"parameters", c.value("parameters", json::object())}};
+        ConfigData d =
+            encode_configuration(study_dir / "configs" / id, id, theta_i, n_theta, n_phi, entry);
+        entry["albedo"] = d.albedo;
+        entry["albedo_se"] = d.albedo_se;
+        summary.data_bytes += d.script.size();
+        data_out.add(id + ".js", d.script);
+        index["configs"].push_back(entry);
+        ++summary.configurations;
+    }
+    index["metrics"] = read_metrics(study_dir / "metrics.csv", theta_i);
+    const std::string index_js = "window.LAMINA_INDEX = " + index.dump() + ";\n";
+    summary.data_bytes += index_js.size();
+    data_out.add("index.js", index_js);
+
+    StagedOutput page_out(study_dir / "explorer");
+    page_out.add("plotly.min.js", plotly);
+    page_out.add("explorer.js", assets::explorer_js());
+    page_out.add("explorer.css", assets::explorer_css());
+    StagedOutput root_out(study_dir);
+    root_out.add("index.html", assets::explorer_html());
+    data_out.commit();
+    page_out.commit();
+    root_out.commit();
+    return summary;
+}
+
+}  // namespace lamina
