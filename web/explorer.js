@@ -351,6 +351,12 @@
     const xs = sliceAngles();
     const inc = state.incidence, side = state.side;
     const traces = [];
+    // On a log scale, at most six decades below the highest value drawn (zeros have no place).
+    let fmax = 0;
+    for (const c of chans) for (const s of ["reference"].concat(models.filter((m) => state.shown.has(m) && isSupported(cfg, m, side))))
+      for (const v of slicePlane(d, s, inc, side, c)) if (v > fmax) fmax = v;
+    const logTop = Math.log10(fmax || 1) + 0.25, logBottom = logTop - 6.25;
+    const floor = Math.pow(10, logBottom);
     chans.forEach((c, k) => {
       const ax = { xaxis: "x" + axisSuffix(k), yaxis: "y" + axisSuffix(k) };
       const ref = slicePlane(d, "reference", inc, side, c);
@@ -358,7 +364,7 @@
       if (se) {
         const lo = ref.map((f, x) => {
           const v = f - 2 * se[x];
-          return state.log ? (v > 0 ? v : (f > 0 ? f * 1e-3 : null)) : v;
+          return state.log ? Math.max(v, floor) : v;
         });
         const hi = ref.map((f, x) => f + 2 * se[x]);
         traces.push(Object.assign({ x: xs, y: lo, type: "scatter", mode: "lines", line: { width: 0 },
@@ -380,6 +386,16 @@
     const layout = channelGrid(chans, "θo (°)", (side === "R" ? "BRDF" : "BTDF") + " f (1/sr)", 420);
     chans.forEach((c, k) => {
       Object.assign(layout["xaxis" + axisSuffix(k)], { range: [-90, 90], tickvals: [-90, -60, -30, 0, 30, 60, 90] });
+      if (state.log) {
+        // Let the data decide within the six decades; label decades only when the span is wide.
+        const ya = layout["yaxis" + axisSuffix(k)];
+        let lo = Infinity;
+        for (const t of traces) if (t.yaxis === "y" + axisSuffix(k) && t.hoverinfo !== "skip")
+          for (const v of t.y) if (v > 0 && v < lo) lo = v;
+        const bottom = Math.max(logBottom, Math.log10(lo) - 0.15);
+        ya.range = [bottom, logTop];
+        ya.dtick = logTop - bottom > 2.5 ? 1 : "D2";
+      }
     });
     layout.title = { text: cfg.id + " · θi = " + THETA_I[inc] + "° · " + (side === "R" ? "reflection" : "transmission"),
       font: { size: 13 }, x: 0.01, y: 0.985 };
@@ -396,7 +412,7 @@
 
   // ---- View 2: iso-values on the projected disk -----------------------------------------------------
 
-  const ISO_N = 121;
+  const ISO_N = 101;
   let isoLookupCache = null;
 
   // For each pixel of the projected disk (x = −sinθ cosφ so that the light is on the left), the
@@ -444,33 +460,46 @@
     return text.split(/[,\s]+/).map(Number).filter((v) => isFinite(v) && (!state.log || v > 0));
   }
 
-  function autoLevels(zmax) {
-    if (!(zmax > 0)) return [];
-    if (state.log) {
-      const out = [];
-      for (let e = Math.floor(Math.log10(zmax)) ; out.length < 9; --e) {
-        for (const m of [3, 1]) { const v = m * Math.pow(10, e); if (v <= zmax) out.push(v); }
-      }
-      return out.reverse();
-    }
-    const step = zmax / 8;
-    return Array.from({ length: 7 }, (_, k) => step * (k + 1));
+  // Automatic levels are evenly spaced in what is shown (half decades on a log scale, eighths of
+  // the maximum on a linear one), so one Plotly contour trace draws them all; chosen levels get a
+  // line trace each.
+  function autoLevels(dmin, dmax) {
+    if (!(dmax > dmin)) return null;
+    if (state.log) return { start: Math.ceil(dmin * 2) / 2, end: dmax, size: 0.5 };
+    const size = dmax / 8;
+    return { start: size, end: dmax - size / 2, size };
   }
 
-  function isoTraces(z, levels, zmin, zmax, title, showScale) {
+  function levelValues(auto) {
+    const out = [];
+    for (let v = auto.start; v <= auto.end + 1e-9; v += auto.size) out.push(state.log ? Math.pow(10, v) : v);
+    return out;
+  }
+
+  function isoTraces(z, levels, auto, zmin, zmax, title, showScale) {
     const L = isoLookupCache;
     const toDisplay = (v) => (v === null || !isFinite(v)) ? null : state.log ? (v > 0 ? Math.log10(v) : null) : v;
     const zd = z.map((row) => row.map(toDisplay));
-    const traces = [{
-      type: "heatmap", x: L.axis, y: L.axis, z: zd, zmin, zmax, colorscale: "Viridis", showscale: showScale,
+    const common = {
+      x: L.axis, y: L.axis, z: zd, zmin, zmax, colorscale: "Viridis", showscale: showScale,
       hovertemplate: title + "<br>f %{customdata:.4g} 1/sr<extra></extra>", customdata: z,
       colorbar: { title: { text: state.log ? "log10 f" : "f (1/sr)", side: "right" }, thickness: 12, len: 0.9 },
-    }];
+    };
+    if (auto) {
+      return [Object.assign(common, {
+        type: "contour", autocontour: false,
+        contours: { start: auto.start, end: auto.end, size: auto.size, coloring: "heatmap", showlines: true,
+          showlabels: !state.log, labelfont: { size: 9, color: "#fff" } },
+        line: { color: "rgba(255,255,255,0.85)", width: 1 },
+      })];
+    }
+    const traces = [Object.assign(common, { type: "heatmap" })];
     for (const level of levels) {
       const lv = state.log ? Math.log10(level) : level;
       traces.push({
         type: "contour", x: L.axis, y: L.axis, z: zd, showscale: false, hoverinfo: "skip",
-        autocontour: false, contours: { start: lv, end: lv, size: 1, coloring: "none", showlabels: true,
+        autocontour: false, showlegend: false,
+        contours: { start: lv, end: lv, size: 1, coloring: "none", showlabels: !state.log,
           labelfont: { size: 9, color: "#fff" } },
         line: { color: "rgba(255,255,255,0.9)", width: 1 }, name: "f = " + fmt(level),
       });
@@ -486,7 +515,7 @@
       shapes: [{ type: "circle", x0: -1, x1: 1, y0: -1, y1: 1, line: { color: "#888", width: 1 } },
         { type: "line", x0: -1, x1: 1, y0: 0, y1: 0, line: { color: "#bbb", width: 0.7, dash: "dot" } }],
       annotations: [{ x: -0.98, y: -0.98, text: "light", showarrow: false, font: { size: 10, color: "#777" }, xanchor: "left" }],
-      plot_bgcolor: "#fff",
+      plot_bgcolor: "#fff", showlegend: false,
     };
   }
 
@@ -497,21 +526,25 @@
     const mod = supported ? hemiMap(d, m, inc, side, c) : null;
     let zmax = 0;
     for (const z of [ref, mod]) if (z) for (const row of z) for (const v of row) if (v > zmax) zmax = v;
-    const levels = state.levels.trim() ? parseLevels(state.levels) : autoLevels(zmax);
     const dmax = state.log ? Math.log10(zmax || 1) : zmax;
     const dmin = state.log ? dmax - 4 : 0;
+    const auto = state.levels.trim() ? null : autoLevels(dmin, dmax);
+    const levels = auto ? levelValues(auto) : parseLevels(state.levels);
     const ch = CHANNELS[c];
-    Plotly.react($("iso-ref"), isoTraces(ref, levels, dmin, dmax, "reference", false),
-      diskLayout("reference · " + ch + " · θi = " + THETA_I[inc] + "°"), PLOT_CONFIG);
+    const refLayout = diskLayout("reference · " + ch + " · θi = " + THETA_I[inc] + "°");
+    refLayout.annotations.push({ x: 0, y: -1.02, yanchor: "top", showarrow: false, font: { size: 10, color: "#555" },
+      text: "contours (white) at f = " + levels.map(fmt).join(", ") + " 1/sr" });
+    refLayout.margin.b = 24;
+    Plotly.react($("iso-ref"), isoTraces(ref, levels, auto, dmin, dmax, "reference", false), refLayout, PLOT_CONFIG);
     if (mod) {
-      Plotly.react($("iso-model"), isoTraces(mod, levels, dmin, dmax, m, true), diskLayout(m + " · " + ch), PLOT_CONFIG);
+      Plotly.react($("iso-model"), isoTraces(mod, levels, auto, dmin, dmax, m, true), diskLayout(m + " · " + ch), PLOT_CONFIG);
       const diff = mod.map((row, j) => row.map((v, i) => (v === null || ref[j][i] === null) ? null : v - ref[j][i]));
       let amax = 0;
       for (const row of diff) for (const v of row) if (v !== null && isFinite(v)) amax = Math.max(amax, Math.abs(v));
       amax = amax || 1;
       Plotly.react($("iso-diff"), [{
         type: "contour", x: isoLookupCache.axis, y: isoLookupCache.axis, z: diff, zmin: -amax, zmax: amax, zmid: 0,
-        colorscale: "RdBu", reversescale: true, ncontours: 10, contours: { coloring: "heatmap", showlines: true },
+        colorscale: "RdBu", ncontours: 10, contours: { coloring: "heatmap", showlines: true },
         line: { color: "rgba(40,40,40,0.5)", width: 0.6 },
         colorbar: { title: { text: "Δf (1/sr)", side: "right" }, thickness: 12, len: 0.9 },
         hovertemplate: "model − reference<br>Δf %{z:.3g} 1/sr<extra></extra>",
@@ -578,9 +611,10 @@
   function drawLeaderboard() {
     const side = state.side, metric = state.lbMetric;
     const cols = ["noise floor"].concat(models);
-    const rows = configs.map((c) => c.id);
+    const shownConfigs = configs.filter((c) => c.sides.includes(side));
+    const rows = shownConfigs.map((c) => c.id);
     const z = [], text = [], hover = [];
-    for (const cfg of configs) {
+    for (const cfg of shownConfigs) {
       const mm = (INDEX.metrics || {})[cfg.id] || {};
       const zr = [], tr = [], hr = [];
       // The noise floor: what a perfect model would score against this reference (misplaced energy).
@@ -610,7 +644,7 @@
     const cur = rows.indexOf(state.config);
     const trace = {
       type: "heatmap", x: cols, y: rows, z, text, customdata: hover, zmin, zmax,
-      texttemplate: "%{text}", textfont: { size: 10 }, colorscale: "YlOrRd", xgap: 1, ygap: 1,
+      texttemplate: "%{text}", textfont: { size: 10 }, colorscale: "YlOrRd", reversescale: true, xgap: 1, ygap: 1,
       hovertemplate: "%{customdata}<extra></extra>",
       colorbar: { title: { text: "log scale" }, tickvals: ticks, ticktext: ticks.map((e) => fmt(Math.pow(10, e))), thickness: 12 },
     };
@@ -683,12 +717,14 @@
       return;
     }
     if (serial !== renderSerial) return;  // a later change superseded this one
-    const t0 = performance.now();
-    drawSlice(d, cfg);
-    drawIso(d, cfg);
-    drawAlbedo(cfg);
-    drawLeaderboard();
+    const t0 = performance.now(), times = {};
+    const timed = (name, f) => { const t = performance.now(); f(); times[name] = Math.round(performance.now() - t); };
+    timed("slice", () => drawSlice(d, cfg));
+    timed("iso", () => drawIso(d, cfg));
+    timed("albedo", () => drawAlbedo(cfg));
+    timed("leaderboard", () => drawLeaderboard());
     drawRenders(cfg);
+    document.body.dataset.viewMs = JSON.stringify(times);
     writeHash();
     status("");
     document.body.dataset.config = cfg.id;

@@ -70,7 +70,7 @@ async function main() {
     const t0 = Date.now();
     await page.goto(url);
     await page.waitForFunction(() => Number(document.body.dataset.renders || 0) >= 1, null, { timeout: 15000 });
-    console.log(`first draw ${Date.now() - t0} ms after navigation (draw ${await page.evaluate(() => document.body.dataset.drawMs)} ms)`);
+    console.log(`first draw ${Date.now() - t0} ms after navigation (draw ${await page.evaluate(() => document.body.dataset.drawMs)} ms: ${await page.evaluate(() => document.body.dataset.viewMs)})`);
     check(await page.evaluate(() => typeof Plotly === "object" && !!window.LAMINA_INDEX), "the page loads Plotly and the study index");
     check((await page.evaluate(() => document.getElementById("slice").data.length)) > 3, "the slice shows the reference, its band and models");
     await page.screenshot({ path: path.join(shotDir, "explorer-initial.png"), fullPage: true });
