@@ -344,6 +344,20 @@
   }
   const axisSuffix = (k) => (k === 0 ? "" : String(k + 1));
 
+  // Ticks of a log axis over [lo, hi] (log10): decades, or 1-2-5 when the span is short, written
+  // as plain numbers (0.02, 5, 300) or 1e-5 beyond.
+  function logTicks(lo, hi) {
+    const vals = [];
+    const mantissas = hi - lo > 2.5 ? [1] : hi - lo > 1.2 ? [1, 3] : [1, 2, 5];
+    for (let e = Math.floor(lo); e <= Math.ceil(hi); ++e)
+      for (const m of mantissas) {
+        const v = m * Math.pow(10, e);
+        if (Math.log10(v) >= lo && Math.log10(v) <= hi) vals.push(v);
+      }
+    const text = vals.map((v) => (v >= 1e-3 && v < 1e5) ? String(Number(v.toPrecision(1))) : v.toExponential(0).replace("e+", "e"));
+    return { tickmode: "array", tickvals: vals, ticktext: text };
+  }
+
   // ---- View 1: the incident-plane slice ------------------------------------------------------------
 
   function drawSlice(d, cfg) {
@@ -394,7 +408,7 @@
           for (const v of t.y) if (v > 0 && v < lo) lo = v;
         const bottom = Math.max(logBottom, Math.log10(lo) - 0.15);
         ya.range = [bottom, logTop];
-        ya.dtick = logTop - bottom > 2.5 ? 1 : "D2";
+        Object.assign(ya, logTicks(bottom, logTop));
       }
     });
     layout.title = { text: cfg.id + " · θi = " + THETA_I[inc] + "° · " + (side === "R" ? "reflection" : "transmission"),
@@ -532,9 +546,9 @@
     const levels = auto ? levelValues(auto) : parseLevels(state.levels);
     const ch = CHANNELS[c];
     const refLayout = diskLayout("reference · " + ch + " · θi = " + THETA_I[inc] + "°");
-    refLayout.annotations.push({ x: 0, y: -1.02, yanchor: "top", showarrow: false, font: { size: 10, color: "#555" },
-      text: "contours (white) at f = " + levels.map(fmt).join(", ") + " 1/sr" });
-    refLayout.margin.b = 24;
+    $("iso-levels").textContent = "White contour lines at f = " + levels.map(fmt).join(", ") + " 1/sr" +
+      (auto && state.log ? " (every half decade)" : "") + "; reference and model share one colour scale" +
+      (state.log ? " (log10 f, four decades)" : "") + ".";
     Plotly.react($("iso-ref"), isoTraces(ref, levels, auto, dmin, dmax, "reference", false), refLayout, PLOT_CONFIG);
     if (mod) {
       Plotly.react($("iso-model"), isoTraces(mod, levels, auto, dmin, dmax, m, true), diskLayout(m + " · " + ch), PLOT_CONFIG);
