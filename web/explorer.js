@@ -411,7 +411,15 @@
         Object.assign(ya, logTicks(bottom, logTop));
       }
     });
-    layout.title = { text: cfg.id + " · θi = " + THETA_I[inc] + "° · " + (side === "R" ? "reflection" : "transmission"),
+    // The light's direction (−θi) and the mirror or straight-through direction (+θi), dotted.
+    layout.shapes = [];
+    chans.forEach((c, k) => {
+      for (const x of [-THETA_I[inc], THETA_I[inc]])
+        layout.shapes.push({ type: "line", xref: "x" + axisSuffix(k), yref: "y" + axisSuffix(k) + " domain", x0: x, x1: x, y0: 0, y1: 1,
+          line: { color: x < 0 ? "#c9a227" : "#999", width: 1, dash: "dot" } });
+    });
+    layout.title = { text: cfg.id + " · θi = " + THETA_I[inc] + "° · " + (side === "R" ? "reflection" : "transmission") +
+      " · dotted: the light's direction (−θi) and the " + (side === "R" ? "mirror" : "straight-through") + " direction",
       font: { size: 13 }, x: 0.01, y: 0.985 };
     layout.margin.t = 46;
     for (const a of layout.annotations) a.y = 1.0;

@@ -17,6 +17,7 @@ import math
 import os
 import struct
 import sys
+import zlib
 from array import array
 
 THETA_I = [0.0, 30.0, 60.0]
@@ -105,6 +106,31 @@ def write_npy(path, shape, values):
         f.write(data.tobytes())
 
 
+def write_sphere_png(path, rgb):
+    """A 48×48 shaded sphere (Lambert, light from the upper left) as an 8-bit RGB PNG."""
+    n = 48
+    rows = []
+    for j in range(n):
+        row = bytearray([0])  # filter: none
+        for i in range(n):
+            x, y = (i + 0.5) / n * 2 - 1, 1 - (j + 0.5) / n * 2
+            r2 = x * x + y * y
+            if r2 > 1:
+                row += bytes([255, 255, 255])
+                continue
+            z = math.sqrt(1 - r2)
+            shade = max(0.0, (-0.4 * x + 0.5 * y + 0.77 * z)) * 0.9 + 0.1
+            row += bytes(int(255 * min(1.0, c * shade)) for c in rgb)
+        rows.append(bytes(row))
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff))
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", n, n, 8, 2, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(b"".join(rows))) + chunk(b"IEND", b""))
+
+
 def supported(model, cfg_id, side):
     if model == "bel18-forward":
         return not cfg_id.startswith("plastic") and side == "R"
@@ -157,6 +183,11 @@ def main():
                   "supported": support, "albedo": albedo,
                   "energy": [{"theta_i": ti, "reflected": albedo["reference"]["R"][i]}
                              for i, ti in enumerate(THETA_I)]}
+        if cfg_id == "paint-a0.05-a1.3":  # sphere renderings for one configuration only
+            os.makedirs(os.path.join(d, "renders"), exist_ok=True)
+            for k, s in enumerate(sources):
+                write_sphere_png(os.path.join(d, "renders", s + ".png"),
+                                 (0.9, 0.25 + 0.1 * k, 0.2))
         with open(os.path.join(d, "config.json"), "w") as f:
             json.dump(config, f, indent=1)
         study_configs.append({"id": cfg_id, "category": category, "parameters": params,
