@@ -353,12 +353,18 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     return out;
 }
 
-std::string_view checked(std::string_view asset, const char* name) {
-    if (asset.empty())
-        throw InputError(name, "",
-                         "was not embedded when lamina was built: run `make deps` (it installs the "
-                         "npm packages), then reconfigure and rebuild");
-    return asset;
+// Plotly as embedded at build time or, when `make deps` installed it after the build was
+// configured, as installed in the source tree.
+std::string plotly_bundle() {
+    if (!assets::plotly_js().empty()) return std::string(assets::plotly_js());
+    std::ifstream in(LAMINA_PLOTLY_INSTALLED, std::ios::binary);
+    std::stringstream ss;
+    if (in) ss << in.rdbuf();
+    if (ss.str().empty())
+        throw InputError(LAMINA_PLOTLY_INSTALLED, "",
+                         "Plotly is not installed, nor embedded in this lamina: run `make deps` "
+                         "(npm ci), then rebuild");
+    return ss.str();
 }
 
 }  // namespace
@@ -375,7 +381,7 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
     const int n_theta = field<int>(grid, "n_theta", study_path);
     const int n_phi = field<int>(grid, "n_phi", study_path);
     const json configurations = field<json>(study, "configurations", study_path);
-    const std::string_view plotly = checked(assets::plotly_js(), "plotly.min.js");
+    const std::string plotly = plotly_bundle();
 
     // Stage everything first: a failure leaves the previous page untouched.
     StagedOutput data_out(study_dir / "explorer" / "data");
