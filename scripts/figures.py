@@ -286,7 +286,7 @@ def albedo_curves(study, formats, cache):
             for d, side in enumerate(cfg["sides"]):
                 style = "-" if side == "R" else "--"
                 # Σ f Ω⊥ per source and incidence, averaged over RGB.
-                alb = (np.asarray(tables[:, :, d]) * om[None, None, :, :, None]).sum(axis=(2, 3))
+                alb = np.nansum(np.asarray(tables[:, :, d]) * om[None, None, :, :, None], axis=(2, 3))
                 alb = alb.mean(axis=-1)
                 err = None
                 if se is not None:
@@ -310,7 +310,9 @@ def albedo_curves(study, formats, cache):
         for ax in axes.flat:
             for h, l in zip(*ax.get_legend_handles_labels()):
                 seen.setdefault(l.replace(" (T dashed)", ""), h)
-        fig.legend(seen.values(), seen.keys(), loc="lower center", ncol=min(len(seen), 7),
+        order = sorted(seen, key=lambda l: (not l.startswith("reference"),
+                                            study.models.index(l) if l in study.models else 0))
+        fig.legend([seen[l] for l in order], order, loc="lower center", ncol=min(len(seen), 7),
                    frameon=False)
         fig.suptitle(f"{cat}: directional albedo against θi"
                      + (" (reflection solid, transmission dashed)" if any(

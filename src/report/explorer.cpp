@@ -251,19 +251,21 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
             json per_inc = json::array();
             json se_inc = json::array();
             for (std::size_t i = 0; i < I; ++i) {
+                // NaN bins (a side a model does not support) are skipped; all NaN: no albedo.
                 double a[3] = {0, 0, 0}, v[3] = {0, 0, 0};
-                bool nan = false;
+                bool finite = false;
                 for (std::size_t t = 0; t < T; ++t)
                     for (std::size_t p = 0; p < P; ++p) {
                         const double w = omega_perp(T, P, int(t), int(p));
                         for (std::size_t c = 0; c < 3; ++c) {
                             const float f = at(s, i, d, t, p, c);
-                            if (std::isnan(f)) nan = true;
+                            if (std::isnan(f)) continue;
+                            finite = true;
                             a[c] += f * w;
                             if (s == 0 && has_se) v[c] += std::pow(se_at(i, d, t, p, c) * w, 2);
                         }
                     }
-                per_inc.push_back(nan ? json(nullptr) : json{a[0], a[1], a[2]});
+                per_inc.push_back(finite ? json{a[0], a[1], a[2]} : json(nullptr));
                 se_inc.push_back(json{std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2])});
             }
             per_side[sides[d]] = per_inc;
