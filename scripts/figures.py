@@ -277,8 +277,11 @@ def albedo_curves(study, formats, cache):
         members = [c for c in study.configs if c["category"] == cat]
         ncol = min(5, len(members))
         nrow = math.ceil(len(members) / ncol)
-        fig, axes = plt.subplots(nrow, ncol, figsize=(1.6 * ncol + 0.6, 1.45 * nrow + 0.8),
-                                 sharex=True, sharey=True, squeeze=False)
+        width, height = 1.6 * ncol + 0.7, 1.5 * nrow + 1.0
+        fig, axes = plt.subplots(nrow, ncol, figsize=(width, height), sharex=True, sharey=True,
+                                 squeeze=False)
+        fig.subplots_adjust(left=0.6 / width, right=1 - 0.1 / width, bottom=0.8 / height,
+                            top=1 - 0.45 / height, wspace=0.08, hspace=0.3)
         for ax in axes.flat[len(members):]:
             ax.axis("off")
         for ax, meta in zip(axes.flat, members):
@@ -316,9 +319,9 @@ def albedo_curves(study, formats, cache):
                    frameon=False)
         fig.suptitle(f"{cat}: directional albedo against θi"
                      + (" (reflection solid, transmission dashed)" if any(
-                         "T" in c["sides"] for c in members) else ""), fontsize=9)
-        fig.tight_layout(rect=(0, 0.06, 1, 1))
-        save(fig, os.path.join(study.root, "figures", f"albedo-{cat}"), formats)
+                         "T" in c["sides"] for c in members) else ""), fontsize=9,
+                     y=1 - 0.08 / height, va="top")
+        save(fig, os.path.join(study.root, "figures", f"albedo-{cat}"), formats, tight=False)
 
 
 def main():
