@@ -672,8 +672,11 @@
     };
     const layout = {
       height: 110 + 19 * rows.length, margin: { l: 200, r: 20, t: 70, b: 10 },
-      xaxis: { side: "top", tickangle: 0, fixedrange: true },
-      yaxis: { autorange: "reversed", fixedrange: true, tickfont: { size: 11 }, type: "category" },
+      // Explicit categories and ranges: the grid stays drawn even where every cell is empty.
+      xaxis: { side: "top", tickangle: 0, fixedrange: true, type: "category", categoryorder: "array",
+        categoryarray: cols, range: [-0.5, cols.length - 0.5] },
+      yaxis: { fixedrange: true, tickfont: { size: 11 }, type: "category", categoryorder: "array",
+        categoryarray: rows, range: [rows.length - 0.5, -0.5] },
       plot_bgcolor: "#e9ebef",
       shapes: cur < 0 ? [] : [{ type: "rect", xref: "paper", x0: 0, x1: 1, yref: "y", y0: cur - 0.5, y1: cur + 0.5,
         line: { color: "#2458a6", width: 2 } }],
@@ -682,8 +685,21 @@
           (state.lbIncidence === "all" ? "all incidences" : "θi = " + THETA_I[Number(state.lbIncidence)] + "°") +
           " and the selected channels · ≈: within 2× the noise floor · n/s: not supported", font: { size: 11, color: "#555" } }],
     };
+    if (!all.length) {
+      // Plotly draws no text on a heat map without values: a text trace says what each cell is.
+      trace.showscale = false;
+      layout.annotations.push({ xref: "paper", yref: "paper", x: 0.5, y: -0.02, yanchor: "top", showarrow: false,
+        text: "no model has this metric for the " + (side === "R" ? "BRDF" : "BTDF") + " of these configurations",
+        font: { size: 12, color: "#8a1c1c" } });
+      layout.margin.b = 30;
+    }
+    const cellText = {
+      type: "scatter", mode: "text", hoverinfo: "skip", showlegend: false, textfont: { size: 10, color: "#555" },
+      x: [], y: [], text: [],
+    };
+    if (!all.length) rows.forEach((r, i) => cols.forEach((c, j) => { cellText.x.push(c); cellText.y.push(r); cellText.text.push(text[i][j]); }));
     const gd = $("leaderboard");
-    Plotly.react(gd, [trace], layout, PLOT_CONFIG);
+    Plotly.react(gd, all.length ? [trace] : [trace, cellText], layout, PLOT_CONFIG);
     if (!gd.dataset.clickBound) {
       gd.on("plotly_click", (ev) => {
         const p = ev.points && ev.points[0];
