@@ -54,7 +54,7 @@ SIDE_NAME = {"R": "BRDF", "T": "BTDF"}
 plt.rcParams.update({
     "font.family": "DejaVu Sans", "font.size": 8, "axes.titlesize": 8, "axes.labelsize": 8,
     "legend.fontsize": 7, "xtick.labelsize": 7, "ytick.labelsize": 7, "axes.linewidth": 0.6,
-    "lines.linewidth": 1.1, "pdf.fonttype": 42, "svg.fonttype": "none", "savefig.dpi": 200,
+    "lines.linewidth": 1.1, "pdf.fonttype": 42, "svg.fonttype": "none", "savefig.dpi": 160,
     "figure.dpi": 100,
 })
 

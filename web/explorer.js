@@ -5,6 +5,11 @@
 "use strict";
 
 (function () {
+  if (!window.LAMINA_INDEX || typeof Plotly !== "object") {
+    document.getElementById("status").textContent = (window.LAMINA_INDEX ? "explorer/plotly.min.js" : "explorer/data/index.js") +
+      " did not load: regenerate the page with `lamina explorer DIR`.";
+    return;
+  }
   const INDEX = window.LAMINA_INDEX;
   const STUDY = INDEX.study;
   const THETA_I = STUDY.theta_i;

@@ -161,12 +161,12 @@ struct LogCodec {
     }
 };
 
-// The folded grid of docs/formats.md: θ uniform over [0°, 90°], φ uniform over [0°, 180°].
-double omega_perp(int n_theta, int n_phi, int t, int p) {
-    (void)p;
+// Ω⊥ of a bin of θ row `t` on the folded grid of docs/formats.md (θ uniform over [0°, 90°], φ
+// uniform over [0°, 180°]; both folded halves): Δφ (sin²θ_hi − sin²θ_lo), the same for every φ bin.
+double omega_perp(int n_theta, int n_phi, int t) {
     const double dphi = M_PI / n_phi;
-    const double s0 = std::sin(0.5 * M_PI * t / n_theta),
-                 s1 = std::sin(0.5 * M_PI * (t + 1) / n_theta);
+    const double s0 = std::sin(0.5 * M_PI * t / n_theta);
+    const double s1 = std::sin(0.5 * M_PI * (t + 1) / n_theta);
     return dphi * (s1 * s1 - s0 * s0);
 }
 
@@ -256,7 +256,7 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
                 bool finite = false;
                 for (std::size_t t = 0; t < T; ++t)
                     for (std::size_t p = 0; p < P; ++p) {
-                        const double w = omega_perp(T, P, int(t), int(p));
+                        const double w = omega_perp(T, P, int(t));
                         for (std::size_t c = 0; c < 3; ++c) {
                             const float f = at(s, i, d, t, p, c);
                             if (std::isnan(f)) continue;
@@ -291,7 +291,7 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
                             double num = 0, den = 0;
                             for (int t = et[t2]; t < et[t2 + 1]; ++t)
                                 for (int p = ep[p2]; p < ep[p2 + 1]; ++p) {
-                                    const double w = omega_perp(T, P, t, p);
+                                    const double w = omega_perp(T, P, t);
                                     num += at(s, i, d, t, p, c) * w;
                                     den += w;
                                 }
@@ -392,10 +392,10 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
     for (const char* key : {"preset", "particles", "seed", "lamina_version", "models", "grid"})
         if (study.contains(key)) index["study"][key] = study[key];
     index["study"]["theta_i"] = theta_i;
-    index["study"]["name"] = fs::absolute(study_dir).lexically_normal().filename().string();
-    if (index["study"]["name"] == "")
-        index["study"]["name"] =
-            fs::absolute(study_dir).lexically_normal().parent_path().filename().string();
+    // The page's title: the study folder's name (`out/study-quick/` → study-quick).
+    fs::path folder = fs::absolute(study_dir).lexically_normal();
+    if (folder.filename().empty()) folder = folder.parent_path();
+    index["study"]["name"] = folder.filename().string();
     for (const json& c : configurations) {
         const std::string id = field<std::string>(c, "id", study_path);
         json entry = {{"id", id},
