@@ -55,7 +55,7 @@ plt.rcParams.update({
     "font.family": "DejaVu Sans", "font.size": 8, "axes.titlesize": 8, "axes.labelsize": 8,
     "legend.fontsize": 7, "xtick.labelsize": 7, "ytick.labelsize": 7, "axes.linewidth": 0.6,
     "lines.linewidth": 1.1, "pdf.fonttype": 42, "svg.fonttype": "none", "savefig.dpi": 160,
-    "figure.dpi": 100,
+    "figure.dpi": 100, "svg.hashsalt": "lamina",
 })
 
 
@@ -70,8 +70,11 @@ def save(fig, path_stem, formats, tight=True):
     """Writes each format. `tight=False` for figures laid out by hand: matplotlib's tight boxes
     measure every tick label again, the bulk of the time for grids of log axes."""
     os.makedirs(os.path.dirname(path_stem), exist_ok=True)
+    # No creation dates: the same study gives byte-identical PDF and SVG files.
+    metadata = {"pdf": {"CreationDate": None}, "svg": {"Date": None}, "png": {}}
     for f in formats:
-        fig.savefig(f"{path_stem}.{f}", bbox_inches="tight" if tight else None)
+        fig.savefig(f"{path_stem}.{f}", bbox_inches="tight" if tight else None,
+                    metadata=metadata[f])
     plt.close(fig)
 
 
