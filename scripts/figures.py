@@ -165,11 +165,13 @@ def slice_figure(args):
     incs = pick_incidences(study.theta_i)
     models = [m for m in cfg["sources"][1:]]
     for d, side in enumerate(cfg["sides"]):
-        height = 1.85 * len(incs) + 1.1
+        ns = [m for m in models if not supported(cfg, m, side)]
+        top = 0.55 + (0.17 if ns else 0.0)  # inches above the panels: title, channel names
+        height = 1.85 * len(incs) + 0.55 + top
         fig, axes = plt.subplots(len(incs), 3, figsize=(7.0, height), sharex=True, squeeze=False)
         # Fixed margins (inches) instead of tight_layout: a third of the time per figure.
         fig.subplots_adjust(left=0.85 / 7.0, right=1 - 0.1 / 7.0, bottom=0.85 / height,
-                            top=1 - 0.55 / height, wspace=0.28, hspace=0.12)
+                            top=1 - top / height, wspace=0.28, hspace=0.12)
         for r, i in enumerate(incs):
             for c in range(3):
                 ax = axes[r][c]
@@ -208,7 +210,6 @@ def slice_figure(args):
                     ax.set_ylabel(f"θi = {study.theta_i[i]:g}°\n{SIDE_NAME[side]} f (1/sr)")
                 if r == len(incs) - 1:
                     ax.set_xlabel("θo (°), light's side negative")
-        ns = [m for m in models if not supported(cfg, m, side)]
         handles, labels = axes[0][0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 8), frameon=False,
                    bbox_to_anchor=(0.5, 0.0), columnspacing=0.9, handlelength=1.3)
