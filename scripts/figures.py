@@ -48,6 +48,8 @@ MODEL_COLORS = {
     "bel-prime": "#0072B2",
 }
 EXTRA_COLORS = ["#8c564b", "#7f7f7f", "#bcbd22", "#17becf", "#9467bd", "#F0E442"]
+# Variants dashed, as in the explorer: they often coincide with the model they vary.
+MODEL_DASH = {"ele10": (0, (4, 2)), "bel18-symmetric": (0, (4, 2))}
 CHANNELS = ["R", "G", "B"]
 SIDE_NAME = {"R": "BRDF", "T": "BTDF"}
 
@@ -188,7 +190,8 @@ def slice_figure(args):
                 for k, m in enumerate(models):
                     if supported(cfg, m, side):
                         f = plane(k + 1)
-                        ax.plot(x, f, color=model_color(m, study.models), label=m)
+                        ax.plot(x, f, color=model_color(m, study.models), label=m,
+                                ls=MODEL_DASH.get(m, "-"))
                         if np.any(f > 0):
                             top = max(top, float(np.nanmax(f)))
                 ax.set_yscale("log")
@@ -291,7 +294,7 @@ def albedo_curves(study, formats, cache):
         for ax, meta in zip(axes.flat, members):
             cfg, tables, se = cache[meta["id"]]
             for d, side in enumerate(cfg["sides"]):
-                style = "-" if side == "R" else "--"
+                style = "-" if side == "R" else ":"
                 # Σ f Ω⊥ per source and incidence, averaged over RGB.
                 alb = np.nansum(np.asarray(tables[:, :, d]) * om[None, None, :, :, None], axis=(2, 3))
                 alb = alb.mean(axis=-1)
@@ -301,11 +304,11 @@ def albedo_curves(study, formats, cache):
                     err = 2 * np.sqrt(v.mean(axis=-1))
                 ax.errorbar(study.theta_i, alb[0], yerr=err, color="k", lw=1.3, ls=style,
                             capsize=1.5, elinewidth=0.6,
-                            label="reference ±2·se" + (" (T dashed)" if side == "T" else ""))
+                            label="reference ±2·se" + (" (T dotted)" if side == "T" else ""))
                 for k, m in enumerate(cfg["sources"][1:]):
                     if supported(cfg, m, side):
                         ax.plot(study.theta_i, alb[k + 1], color=model_color(m, study.models),
-                                ls=style, lw=0.9, label=m)
+                                ls=MODEL_DASH.get(m, "-") if side == "R" else ":", lw=0.9, label=m)
             ax.set_title(meta["id"], fontsize=6.5)
             ax.grid(True, lw=0.3, color="0.88")
             ax.set_xticks([0, 30, 60, 90])
@@ -316,13 +319,13 @@ def albedo_curves(study, formats, cache):
         seen = {}
         for ax in axes.flat:
             for h, l in zip(*ax.get_legend_handles_labels()):
-                seen.setdefault(l.replace(" (T dashed)", ""), h)
+                seen.setdefault(l.replace(" (T dotted)", ""), h)
         order = sorted(seen, key=lambda l: (not l.startswith("reference"),
                                             study.models.index(l) if l in study.models else 0))
         fig.legend([seen[l] for l in order], order, loc="lower center", ncol=min(len(seen), 7),
                    frameon=False)
         fig.suptitle(f"{cat}: directional albedo against θi"
-                     + (" (reflection solid, transmission dashed)" if any(
+                     + (" (transmission dotted)" if any(
                          "T" in c["sides"] for c in members) else ""), fontsize=9,
                      y=1 - 0.08 / height, va="top")
         save(fig, os.path.join(study.root, "figures", f"albedo-{cat}"), formats, tight=False)

@@ -27,6 +27,10 @@
     "bel-prime": "#0072B2",
   };
   const EXTRA_COLORS = ["#8c564b", "#7f7f7f", "#bcbd22", "#17becf", "#9467bd", "#F0E442"];
+  // Variants are dashed: Ele10 is WW09 with one change and often coincides with it, and so do
+  // the two Bel18 cosines; a dashed line on top lets the solid one show through.
+  const MODEL_DASH = { ele10: "dash", "bel18-symmetric": "dash" };
+  const modelDash = (name) => MODEL_DASH[name] || "solid";
 
   // The configuration widgets, in the order of the original study's explorer.
   const PARAMS = [
@@ -163,6 +167,12 @@
     return (s && s.reason) ? s.reason : "";
   }
 
+  // "m (reason)", or the reason alone when it already names the model.
+  const unsupportedText = (cfg, m) => {
+    const r = unsupportedReason(cfg, m);
+    return !r ? m : r.startsWith(m) ? r : m + " (" + r + ")";
+  };
+
   const selectedChannels = () => [0, 1, 2].filter((c) => state.channels[c]);
 
   // ---- Widgets ----------------------------------------------------------------------------------
@@ -254,7 +264,8 @@
       });
       const sw = document.createElement("span");
       sw.className = "swatch";
-      sw.style.background = modelColor(m);
+      sw.style.background = modelDash(m) === "dash"
+        ? "repeating-linear-gradient(90deg, " + modelColor(m) + " 0 6px, transparent 6px 9px)" : modelColor(m);
       l.append(cb, sw, document.createTextNode(m));
       if (!ok) {
         const t = document.createElement("span");
@@ -263,6 +274,11 @@
         l.appendChild(t);
       }
       box.appendChild(l);
+    }
+    // The iso-value view follows to a model that supports this configuration when its own does not.
+    if (!isSupported(cur, state.isoModel, state.side)) {
+      const ok = models.find((m) => isSupported(cur, m, state.side));
+      if (ok) state.isoModel = ok;
     }
     setOptions($("w-iso-model"), models.map((m) => [m, m + (isSupported(cur, m, state.side) ? "" : " (not supported)")]), state.isoModel);
   }
@@ -398,7 +414,7 @@
       for (const m of models) {
         if (!state.shown.has(m) || !isSupported(cfg, m, side)) continue;
         traces.push(Object.assign({ x: xs, y: slicePlane(d, m, inc, side, c), type: "scatter", mode: "lines",
-          name: m, legendgroup: m, showlegend: k === 0, line: { color: modelColor(m), width: 1.6 },
+          name: m, legendgroup: m, showlegend: k === 0, line: { color: modelColor(m), width: 1.6, dash: modelDash(m) },
           hovertemplate: m + "<br>θo %{x:.1f}°<br>f %{y:.4g} 1/sr<extra></extra>" }, ax));
       }
     });
@@ -431,7 +447,7 @@
     Plotly.react($("slice"), traces, layout, PLOT_CONFIG);
 
     const missing = models.filter((m) => !isSupported(cfg, m, side))
-      .map((m) => m + (unsupportedReason(cfg, m) ? " (" + unsupportedReason(cfg, m) + ")" : ""));
+      .map((m) => unsupportedText(cfg, m));
     $("unsupported").textContent = missing.length
       ? "Not supported for this configuration's " + (side === "R" ? "BRDF" : "BTDF") + ": " + missing.join("; ")
       : "";
@@ -604,7 +620,7 @@
         if (!state.shown.has(m) || !isSupported(cfg, m, side) || !cfg.albedo[m]) continue;
         traces.push(Object.assign({ x: THETA_I, y: cfg.albedo[m][side].map((v) => (v ? v[c] : null)),
           type: "scatter", mode: "lines+markers", name: m, legendgroup: m, showlegend: k === 0,
-          line: { color: modelColor(m), width: 1.5 }, marker: { size: 5 },
+          line: { color: modelColor(m), width: 1.5, dash: modelDash(m) }, marker: { size: 5 },
           hovertemplate: m + "<br>θi %{x}°<br>albedo %{y:.4f}<extra></extra>" }, ax));
       }
     });
