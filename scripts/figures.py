@@ -284,10 +284,16 @@ def albedo_curves(study, formats, cache):
         members = [c for c in study.configs if c["category"] == cat]
         ncol = min(5, len(members))
         nrow = math.ceil(len(members) / ncol)
-        width, height = 1.6 * ncol + 0.7, 1.5 * nrow + 1.0
+        width = max(1.6 * ncol + 0.7, 3.6)
+        # The legend: one entry per 1.2 inch of width, as many rows as that takes.
+        entries = 1 + len(study.models)
+        legend_cols = max(2, min(entries, int(width / 1.2)))
+        legend_rows = math.ceil(entries / legend_cols)
+        bottom = 0.55 + 0.2 * legend_rows
+        height = 1.5 * nrow + 0.45 + bottom
         fig, axes = plt.subplots(nrow, ncol, figsize=(width, height), sharex=True, sharey=True,
                                  squeeze=False)
-        fig.subplots_adjust(left=0.6 / width, right=1 - 0.1 / width, bottom=0.8 / height,
+        fig.subplots_adjust(left=0.6 / width, right=1 - 0.1 / width, bottom=bottom / height,
                             top=1 - 0.45 / height, wspace=0.08, hspace=0.3)
         for ax in axes.flat[len(members):]:
             ax.axis("off")
@@ -322,8 +328,8 @@ def albedo_curves(study, formats, cache):
                 seen.setdefault(l.replace(" (T dotted)", ""), h)
         order = sorted(seen, key=lambda l: (not l.startswith("reference"),
                                             study.models.index(l) if l in study.models else 0))
-        fig.legend([seen[l] for l in order], order, loc="lower center", ncol=min(len(seen), 7),
-                   frameon=False)
+        fig.legend([seen[l] for l in order], order, loc="lower center", ncol=legend_cols,
+                   frameon=False, columnspacing=0.9, handlelength=1.5)
         fig.suptitle(f"{cat}: directional albedo against θi"
                      + (" (transmission dotted)" if any(
                          "T" in c["sides"] for c in members) else ""), fontsize=9,
