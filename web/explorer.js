@@ -746,13 +746,25 @@
       return;
     }
     for (const s of ["reference"].concat(models)) {
-      if (!cfg.renders[s]) continue;
+      if (!cfg.renders[s]) {
+        // A model the renderer could not draw: say so in its place.
+        const err = cfg.render_errors && cfg.render_errors[s];
+        if (err !== undefined && isNaN(Number(err))) {
+          const f = document.createElement("figure");
+          f.innerHTML = '<div class="render-missing"></div><figcaption></figcaption>';
+          f.querySelector(".render-missing").textContent = err;
+          f.querySelector("figcaption").textContent = s;
+          box.appendChild(f);
+        }
+        continue;
+      }
       const f = document.createElement("figure");
       const img = document.createElement("img");
       img.src = cfg.renders[s];
       img.alt = s;
       const cap = document.createElement("figcaption");
-      cap.textContent = s;
+      const err = cfg.render_errors && cfg.render_errors[s];
+      cap.textContent = s + (err === undefined ? "" : isNaN(Number(err)) ? " · " + err : " · rel. RMSE " + fmt(Number(err)));
       cap.style.color = modelColor(s);
       f.append(img, cap);
       box.appendChild(f);

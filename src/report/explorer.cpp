@@ -324,12 +324,31 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     entry["sources"] = sources;
     entry["sides"] = sides;
 
-    // Sphere renderings (optional, a later issue writes them): configs/<id>/renders/<source>.png.
+    // Sphere renderings (optional, a later issue writes them): configs/<id>/renders/<source>.png,
+    // the reference as reference.png or random-walk.png (what `lamina render --compare` names it),
+    // and the relative RMSE of each model's image from renders/errors.csv when present.
     json renders = json::object();
-    for (const std::string& s : sources)
-        if (fs::exists(dir / "renders" / (s + ".png")))
-            renders[s] = fmt::format("configs/{}/renders/{}.png", id, s);
+    for (const std::string& s : sources) {
+        const std::vector<std::string> names =
+            s == "reference" ? std::vector<std::string>{"reference", "random-walk"}
+                             : std::vector<std::string>{s};
+        for (const std::string& n : names)
+            if (fs::exists(dir / "renders" / (n + ".png"))) {
+                renders[s] = fmt::format("configs/{}/renders/{}.png", id, n);
+                break;
+            }
+    }
     entry["renders"] = renders;
+    json render_errors = json::object();
+    if (std::ifstream err(dir / "renders" / "errors.csv"); err) {
+        std::string line;
+        std::getline(err, line);  // model,rel_rmse,seconds
+        while (std::getline(err, line)) {
+            const std::vector<std::string> v = split_csv_line(line);
+            if (v.size() >= 2 && !v[1].empty()) render_errors[v[0]] = v[1];
+        }
+    }
+    entry["render_errors"] = render_errors;
 
     json data = {
         {"id", id},

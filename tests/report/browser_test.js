@@ -127,8 +127,10 @@ async function main() {
     check((await page.evaluate(() => document.body.dataset.config)) === target, `a leaderboard click opens ${target}`);
     check((await page.evaluate(() => window.LAMINA_EXPLORER.state.isoModel)) === "ww-prime", "… with the clicked model in the iso view");
     await page.waitForFunction(() => Array.from(document.querySelectorAll("#renders img")).every((i) => i.complete));
-    check((await page.evaluate(() => Array.from(document.querySelectorAll("#renders img")).filter((i) => i.naturalWidth > 0).length)) === 4,
-      "its four sphere renderings are shown");
+    check((await page.evaluate(() => Array.from(document.querySelectorAll("#renders img")).filter((i) => i.naturalWidth > 0).length)) === 3,
+      "its three sphere renderings are shown");
+    check(await page.evaluate(() => /rel\. RMSE 0\.13/.test(document.getElementById("renders").textContent) &&
+      /not supported/.test(document.getElementById("renders").textContent)), "… with their errors, and the one that could not be drawn named");
     check(pos.y !== undefined && cfg0 !== target, "the click target differs from the first configuration");
     await page.screenshot({ path: path.join(shotDir, "explorer-after-click.png"), fullPage: true });
 

@@ -185,9 +185,16 @@ def main():
                              for i, ti in enumerate(THETA_I)]}
         if cfg_id == "paint-a0.05-a1.3":  # sphere renderings for one configuration only
             os.makedirs(os.path.join(d, "renders"), exist_ok=True)
+            # as `lamina render --compare` names them: the reference is random-walk.png
             for k, s in enumerate(sources):
-                write_sphere_png(os.path.join(d, "renders", s + ".png"),
+                if s == "bel18-forward":
+                    continue
+                write_sphere_png(os.path.join(d, "renders",
+                                              ("random-walk" if s == "reference" else s) + ".png"),
                                  (0.9, 0.25 + 0.1 * k, 0.2))
+            with open(os.path.join(d, "renders", "errors.csv"), "w") as f:
+                f.write("model,rel_rmse,seconds\nww09,0.125,1.0\nww-prime,0.05,1.0\n"
+                        "bel18-forward,not supported,\n")
         with open(os.path.join(d, "config.json"), "w") as f:
             json.dump(config, f, indent=1)
         study_configs.append({"id": cfg_id, "category": category, "parameters": params,
