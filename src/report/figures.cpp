@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 
@@ -62,9 +63,12 @@ void write_figures(const fs::path& study_dir, const FigureOptions& options) {
     if (!options.only.empty()) command += " --only " + shell_quote(options.only);
     std::FILE* pipe = ::popen(command.c_str(), "w");
     if (!pipe) throw InputError(python, "", "cannot start the figure script's interpreter");
+    // An interpreter that exits before reading the script must not kill lamina with SIGPIPE.
+    const auto previous = std::signal(SIGPIPE, SIG_IGN);
     const std::string_view script = assets::figures_py();
     std::fwrite(script.data(), 1, script.size(), pipe);
     const int status = ::pclose(pipe);
+    std::signal(SIGPIPE, previous);
     if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
         throw InputError(

@@ -25,6 +25,9 @@ ok grep -q "no-such-study/study.json: not found" <<<"$out"
 out=$("$lamina" figures "$study" --formats gif 2>&1); rc=$?
 ok test $rc -eq 1
 ok grep -q "'gif' is not a figure format" <<<"$out"
+out=$("$lamina" figures "$study" --python "$build/no-such-python" 2>&1); rc=$?
+ok test $rc -eq 1
+ok grep -q "cannot run" <<<"$out"
 out=$("$lamina" explorer "$build/no-such-study" 2>&1); rc=$?
 ok test $rc -eq 1
 ok grep -q "no-such-study/study.json: not found" <<<"$out"
