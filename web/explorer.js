@@ -680,6 +680,20 @@
       }
       z.push(zr); text.push(tr); hover.push(hr);
     }
+    // A last row: each model's mean over the configurations it supports (never counting n/s as 0),
+    // the ranking of the models at a glance.
+    if (rows.length > 1) {
+      const MEAN = "mean of supported";
+      const zr = [], tr = [], hr = [];
+      cols.forEach((col, j) => {
+        const vals = z.map((r) => r[j]).filter((v) => v !== null).map((v) => Math.pow(10, v));
+        const m = vals.length ? vals.reduce((a, b) => a + b, 0) / vals.length : null;
+        zr.push(m !== null && m > 0 ? Math.log10(m) : null);
+        tr.push(m === null ? "" : "<b>" + fmt(m) + "</b>");
+        hr.push(col + "<br>mean over the " + vals.length + " configurations with a value");
+      });
+      rows.push(MEAN); z.push(zr); text.push(tr); hover.push(hr);
+    }
     const all = z.flat().filter((v) => v !== null);
     const zmin = all.length ? Math.min(...all) : -3, zmax = all.length ? Math.max(...all) : 0;
     const ticks = [];
@@ -699,8 +713,12 @@
       yaxis: { fixedrange: true, tickfont: { size: 11 }, type: "category", categoryorder: "array",
         categoryarray: rows, range: [rows.length - 0.5, -0.5] },
       plot_bgcolor: "#e9ebef",
-      shapes: cur < 0 ? [] : [{ type: "rect", xref: "paper", x0: 0, x1: 1, yref: "y", y0: cur - 0.5, y1: cur + 0.5,
-        line: { color: "#2458a6", width: 2 } }],
+      shapes: (cur < 0 ? [] : [{ type: "rect", xref: "paper", x0: 0, x1: 1, yref: "y", y0: cur - 0.5, y1: cur + 0.5,
+        line: { color: "#2458a6", width: 2 } }]).concat(
+        // the noise floor apart from the models, the mean row apart from the configurations
+        [{ type: "line", xref: "x", x0: 0.5, x1: 0.5, yref: "paper", y0: 0, y1: 1, line: { color: "#333", width: 1.5 } }],
+        rows.length > shownConfigs.length ? [{ type: "line", xref: "paper", x0: 0, x1: 1, yref: "y",
+          y0: shownConfigs.length - 0.5, y1: shownConfigs.length - 0.5, line: { color: "#333", width: 1.5 } }] : []),
       annotations: [{ xref: "paper", yref: "paper", x: 0, y: 1, yanchor: "bottom", yshift: 34, showarrow: false, align: "left",
         text: (side === "R" ? "BRDF" : "BTDF") + " · " + (state.lbAgg === "max" ? "worst" : "mean") + " over " +
           (state.lbIncidence === "all" ? "all incidences" : "θi = " + THETA_I[Number(state.lbIncidence)] + "°") +
