@@ -61,6 +61,7 @@
     shown: new Set(models),
     isoModel: models[0],
     isoChannel: 0,
+    diffMode: "f",
     levels: "",
     lbMetric: "me",
     lbIncidence: "all",
@@ -86,13 +87,19 @@
 
   function decode(raw) {
     const h = raw.hemi;
-    const codes = new Uint16Array(bytesOf(h.codes));
-    const hemi = new Float32Array(codes.length);
-    const step = (h.hi - h.lo) / 65533;
-    for (let k = 0; k < codes.length; ++k) {
-      const q = codes[k];
-      hemi[k] = q === 0 ? 0 : q === 65535 ? NaN : Math.pow(10, h.lo + (q - 1) * step);
-    }
+    // 16-bit codes of log10 f (docs/explorer.md, "Data"): 0 is zero, 65535 not supported.
+    const logDecode = (b64, lo, hi) => {
+      const codes = new Uint16Array(bytesOf(b64));
+      const out = new Float32Array(codes.length);
+      const step = (hi - lo) / 65533;
+      for (let k = 0; k < codes.length; ++k) {
+        const q = codes[k];
+        out[k] = q === 0 ? 0 : q === 65535 ? NaN : Math.pow(10, lo + (q - 1) * step);
+      }
+      return out;
+    };
+    const hemi = logDecode(h.codes, h.lo, h.hi);
+    const hemiSe = h.se_codes ? logDecode(h.se_codes, h.se_lo, h.se_hi) : null;
     return {
       raw,
       sources: raw.sources,
@@ -100,6 +107,7 @@
       slice: new Float32Array(bytesOf(raw.slice)),
       sliceSe: raw.slice_se ? new Float32Array(bytesOf(raw.slice_se)) : null,
       hemi,
+      hemiSe,
       hemiShape: h,
     };
   }
@@ -312,6 +320,7 @@
     $("w-iso-model").addEventListener("change", () => { state.isoModel = $("w-iso-model").value; render(); });
     $("w-iso-channel").addEventListener("change", () => { state.isoChannel = Number($("w-iso-channel").value); render(); });
     $("w-levels").addEventListener("change", () => { state.levels = $("w-levels").value; render(); });
+    $("w-diff").addEventListener("change", () => { state.diffMode = $("w-diff").value; render(); });
     $("w-lb-metric").addEventListener("change", () => { state.lbMetric = $("w-lb-metric").value; render(); });
     $("w-lb-incidence").addEventListener("change", () => { state.lbIncidence = $("w-lb-incidence").value; render(); });
     $("w-lb-agg").addEventListener("change", () => { state.lbAgg = $("w-lb-agg").value; render(); });
@@ -482,17 +491,20 @@
     return isoLookupCache;
   }
 
+  // `source` "se" is the reference's standard error.
   function hemiMap(d, source, inc, side, channel) {
     const h = d.hemiShape, L = isoLookup(h);
     const I = THETA_I.length, D = d.sides.length;
-    const s = d.sources.indexOf(source), sd = d.sides.indexOf(side);
-    const base = ((s * I + inc) * D + sd) * h.n_theta * h.n_phi;
+    const isSe = source === "se";
+    const s = isSe ? 0 : d.sources.indexOf(source), sd = d.sides.indexOf(side);
+    const base = isSe ? (inc * D + sd) * h.n_theta * h.n_phi : ((s * I + inc) * D + sd) * h.n_theta * h.n_phi;
+    const table = isSe ? d.hemiSe : d.hemi;
     const z = [];
     for (let j = 0; j < ISO_N; ++j) {
       const row = new Array(ISO_N);
       for (let i = 0; i < ISO_N; ++i) {
         const k = L.idx[j * ISO_N + i];
-        row[i] = k < 0 ? null : d.hemi[(base + k) * 3 + channel];
+        row[i] = k < 0 ? null : table[(base + k) * 3 + channel];
       }
       z.push(row);
     }
@@ -577,21 +589,32 @@
     const refLayout = diskLayout("reference · " + ch + " · θi = " + THETA_I[inc] + "°");
     $("iso-levels").textContent = "White contour lines at f = " + levels.map(fmt).join(", ") + " 1/sr" +
       (auto && state.log ? " (every half decade)" : "") + "; reference and model share one colour scale" +
-      (state.log ? " (log10 f, four decades)" : "") + ".";
+      (state.log ? " (log10 f, four decades)" : "") +
+      ". Difference: red where the model puts too much energy, blue too little" +
+      (state.diffMode === "sigma" ? "; in units of the reference's standard error, |Δf / se| < 2 is within its noise." : ".");
     Plotly.react($("iso-ref"), isoTraces(ref, levels, auto, dmin, dmax, "reference", false), refLayout, PLOT_CONFIG);
     if (mod) {
       Plotly.react($("iso-model"), isoTraces(mod, levels, auto, dmin, dmax, m, true), diskLayout(m + " · " + ch), PLOT_CONFIG);
-      const diff = mod.map((row, j) => row.map((v, i) => (v === null || ref[j][i] === null) ? null : v - ref[j][i]));
+      // Δf in 1/sr, or in units of the reference's standard error (|z| < 2: within the noise).
+      const sigma = state.diffMode === "sigma" && d.hemiSe ? hemiMap(d, "se", inc, side, c) : null;
+      const diff = mod.map((row, j) => row.map((v, i) => {
+        if (v === null || ref[j][i] === null) return null;
+        if (!sigma) return v - ref[j][i];
+        const e = sigma[j][i];
+        return e > 0 ? (v - ref[j][i]) / e : null;
+      }));
       let amax = 0;
       for (const row of diff) for (const v of row) if (v !== null && isFinite(v)) amax = Math.max(amax, Math.abs(v));
-      amax = amax || 1;
+      amax = sigma ? Math.min(Math.max(amax, 4), 20) : amax || 1;
       Plotly.react($("iso-diff"), [{
         type: "contour", x: isoLookupCache.axis, y: isoLookupCache.axis, z: diff, zmin: -amax, zmax: amax, zmid: 0,
-        colorscale: "RdBu", ncontours: 10, contours: { coloring: "heatmap", showlines: true },
+        colorscale: "RdBu", ncontours: sigma ? undefined : 10, autocontour: !sigma,
+        contours: sigma ? { start: -amax, end: amax, size: Math.max(2, Math.round(amax / 5)), coloring: "heatmap", showlines: true }
+          : { coloring: "heatmap", showlines: true },
         line: { color: "rgba(40,40,40,0.5)", width: 0.6 },
-        colorbar: { title: { text: "Δf (1/sr)", side: "right" }, thickness: 12, len: 0.9 },
-        hovertemplate: "model − reference<br>Δf %{z:.3g} 1/sr<extra></extra>",
-      }], diskLayout(m + " − reference (blue: too little, red: too much)"), PLOT_CONFIG);
+        colorbar: { title: { text: sigma ? "Δf / se" : "Δf (1/sr)", side: "right" }, thickness: 12, len: 0.9 },
+        hovertemplate: sigma ? "(model − reference) / se<br>%{z:.2f}<extra></extra>" : "model − reference<br>Δf %{z:.3g} 1/sr<extra></extra>",
+      }], diskLayout(m + " − reference" + (sigma ? ", in se" : "")), PLOT_CONFIG);
     } else {
       const layout = diskLayout(m + " · " + ch);
       layout.annotations.push({ x: 0, y: 0, text: "<b>not supported</b><br>" + (unsupportedReason(cfg, m) || ""),

@@ -305,6 +305,35 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     std::vector<std::uint16_t> codes(hemi.size());
     for (std::size_t k = 0; k < hemi.size(); ++k)
         codes[k] = codec.encode(hemi[k]);
+    // The reference's standard error on the same merged bins, √Σ(se_j w_j)² / Σ w_j (bins taken as
+    // independent), for the significance of differences: its own log codes.
+    std::vector<std::uint16_t> se_codes;
+    LogCodec se_codec;
+    if (has_se) {
+        std::vector<float> hemi_se;
+        hemi_se.reserve(I * D * T2 * P2 * 3);
+        float max_se = 0;
+        for (std::size_t i = 0; i < I; ++i)
+            for (std::size_t d = 0; d < D; ++d)
+                for (std::size_t t2 = 0; t2 < T2; ++t2)
+                    for (std::size_t p2 = 0; p2 < P2; ++p2)
+                        for (std::size_t c = 0; c < 3; ++c) {
+                            double var = 0, den = 0;
+                            for (int t = et[t2]; t < et[t2 + 1]; ++t)
+                                for (int p = ep[p2]; p < ep[p2 + 1]; ++p) {
+                                    const double w = omega_perp(T, P, t);
+                                    var += std::pow(se_at(i, d, t, p, c) * w, 2);
+                                    den += w;
+                                }
+                            const float e = float(std::sqrt(var) / den);
+                            hemi_se.push_back(e);
+                            if (std::isfinite(e)) max_se = std::max(max_se, e);
+                        }
+        se_codec.hi = max_se > 0 ? std::log10(double(max_se)) : 0.0;
+        se_codec.lo = se_codec.hi - kLogDecades;
+        for (float e : hemi_se)
+            se_codes.push_back(se_codec.encode(e));
+    }
     std::vector<double> theta_edges, phi_edges;
     for (int e : et)
         theta_edges.push_back(90.0 * e / T);
@@ -364,7 +393,12 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
           {"phi_edges", phi_edges},
           {"lo", codec.lo},
           {"hi", codec.hi},
-          {"codes", base64(codes.data(), codes.size() * sizeof(std::uint16_t))}}},
+          {"codes", base64(codes.data(), codes.size() * sizeof(std::uint16_t))},
+          {"se_lo", se_codec.lo},
+          {"se_hi", se_codec.hi},
+          {"se_codes", has_se
+                           ? json(base64(se_codes.data(), se_codes.size() * sizeof(std::uint16_t)))
+                           : json(nullptr)}}},
     };
     ConfigData out;
     out.script = fmt::format("(window.LAMINA_DATA = window.LAMINA_DATA || {{}})[{}] = {};\n",

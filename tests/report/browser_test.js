@@ -84,6 +84,7 @@ async function main() {
     check(await page.evaluate(() => !document.getElementById("slice").data.some((t) => t.name === "ww09")), "an unticked model is not drawn");
     await changes("the iso model", () => page.selectOption("#w-iso-model", "ww-prime"), ["iso-model", "iso-diff"]);
     await changes("the iso channel", () => page.selectOption("#w-iso-channel", "2"), ["iso-ref", "iso-model"]);
+    await changes("the difference mode", () => page.selectOption("#w-diff", "sigma"), ["iso-diff"]);
     await changes("the contour levels", async () => { await page.fill("#w-levels", "0.05, 0.2, 1"); await page.press("#w-levels", "Enter"); }, ["iso-ref"]);
     check(await page.evaluate(() => document.getElementById("iso-ref").data.length === 4), "three chosen levels: three contour traces");
     await changes("the leaderboard metric", () => page.selectOption("#w-lb-metric", "ae"), ["leaderboard"]);
