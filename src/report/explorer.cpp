@@ -9,11 +9,13 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -179,6 +181,92 @@ std::vector<int> merged_edges(int n, int k) {
     return e;
 }
 
+// A table whose last three axes are θ bin, φ bin, channel, seen as consecutive blocks of
+// T × P × 3 floats: block (s·I + i)·D + d of tables.npy, block i·D + d of reference_se.npy.
+struct BinBlocks {
+    const std::vector<float>& data;
+    std::size_t T, P;
+    std::size_t blocks() const { return data.size() / (T * P * 3); }
+    float at(std::size_t block, std::size_t t, std::size_t p, std::size_t c) const {
+        return data[((block * T + t) * P + p) * 3 + c];
+    }
+};
+
+// The incident plane of every block at full resolution, [block, 2T, 3]: x < T is the light's
+// side (φ bin 0, θ descending), x >= T the mirror side (the last φ bin, θ ascending).
+std::vector<float> incident_plane(const BinBlocks& b) {
+    std::vector<float> out;
+    out.reserve(b.blocks() * 2 * b.T * 3);
+    for (std::size_t k = 0; k < b.blocks(); ++k)
+        for (std::size_t x = 0; x < 2 * b.T; ++x)
+            for (std::size_t c = 0; c < 3; ++c)
+                out.push_back(x < b.T ? b.at(k, b.T - 1 - x, 0, c) : b.at(k, x - b.T, b.P - 1, c));
+    return out;
+}
+
+// Bins merged into groups (edges `et` × `ep`), [block, T2, P2, 3]. Values: the cos-weighted
+// average Σ f_j Ω⊥_j / Σ Ω⊥_j; standard errors (`quadrature`): √Σ (se_j Ω⊥_j)² / Σ Ω⊥_j, the
+// bins taken as independent.
+std::vector<float> merge_bins(const BinBlocks& b, const std::vector<int>& et,
+                              const std::vector<int>& ep, bool quadrature) {
+    std::vector<float> out;
+    out.reserve(b.blocks() * (et.size() - 1) * (ep.size() - 1) * 3);
+    for (std::size_t k = 0; k < b.blocks(); ++k)
+        for (std::size_t t2 = 0; t2 + 1 < et.size(); ++t2)
+            for (std::size_t p2 = 0; p2 + 1 < ep.size(); ++p2)
+                for (std::size_t c = 0; c < 3; ++c) {
+                    double num = 0, den = 0;
+                    for (int t = et[t2]; t < et[t2 + 1]; ++t)
+                        for (int p = ep[p2]; p < ep[p2 + 1]; ++p) {
+                            const double w = omega_perp(int(b.T), int(b.P), t);
+                            const double v = b.at(k, t, p, c) * w;
+                            num += quadrature ? v * v : v;
+                            den += w;
+                        }
+                    out.push_back(float((quadrature ? std::sqrt(num) : num) / den));
+                }
+    return out;
+}
+
+// 16-bit log codes of `values` over the ten decades below their maximum.
+std::vector<std::uint16_t> log_codes(const std::vector<float>& values, LogCodec& codec) {
+    float max_v = 0;
+    for (float v : values)
+        if (std::isfinite(v)) max_v = std::max(max_v, v);
+    codec.hi = max_v > 0 ? std::log10(double(max_v)) : 0.0;
+    codec.lo = codec.hi - kLogDecades;
+    std::vector<std::uint16_t> codes;
+    codes.reserve(values.size());
+    for (float v : values)
+        codes.push_back(codec.encode(v));
+    return codes;
+}
+
+// Σ_j f_j Ω⊥_j per block and channel (NaN bins, a side a model does not support, skipped; a block
+// of NaN only has no albedo), or with `quadrature` √Σ (se_j Ω⊥_j)² — the reference's standard
+// error with the bins taken as independent (a slight overestimate: a particle lands in one bin).
+std::vector<std::optional<std::array<double, 3>>> albedos(const BinBlocks& b, bool quadrature) {
+    std::vector<std::optional<std::array<double, 3>>> out;
+    for (std::size_t k = 0; k < b.blocks(); ++k) {
+        std::array<double, 3> a = {0, 0, 0};
+        bool finite = false;
+        for (std::size_t t = 0; t < b.T; ++t)
+            for (std::size_t p = 0; p < b.P; ++p)
+                for (std::size_t c = 0; c < 3; ++c) {
+                    const float f = b.at(k, t, p, c);
+                    if (std::isnan(f)) continue;
+                    finite = true;
+                    const double v = f * omega_perp(int(b.T), int(b.P), int(t));
+                    a[c] += quadrature ? v * v : v;
+                }
+        if (quadrature)
+            for (double& v : a)
+                v = std::sqrt(v);
+        out.push_back(finite ? std::optional(a) : std::nullopt);
+    }
+    return out;
+}
+
 struct ConfigData {
     std::string script;      ///< explorer/data/<id>.js
     json albedo, albedo_se;  ///< for the index
@@ -192,11 +280,10 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     const json cfg = read_json(cfg_path, "the configuration");
     const auto sources = field<std::vector<std::string>>(cfg, "sources", cfg_path);
     const auto sides = field<std::vector<std::string>>(cfg, "sides", cfg_path);
-    const NpyFloat32 tab = read_npy_float32(dir / "tables.npy");
     const std::size_t S = sources.size(), I = theta_i.size(), D = sides.size(), T = n_theta,
                       P = n_phi;
-    const std::vector<std::size_t> want = {S, I, D, T, P, 3};
-    if (tab.shape != want)
+    const NpyFloat32 tab = read_npy_float32(dir / "tables.npy");
+    if (tab.shape != std::vector<std::size_t>{S, I, D, T, P, 3})
         throw InputError((dir / "tables.npy").string(), "shape",
                          fmt::format("[{}]: expected [sources {}, incidences {}, sides {}, θ {}, φ "
                                      "{}, 3] from config.json and study.json",
@@ -205,135 +292,39 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     const bool has_se = fs::exists(dir / "reference_se.npy");
     if (has_se) {
         se = read_npy_float32(dir / "reference_se.npy");
-        const std::vector<std::size_t> want_se = {I, D, T, P, 3};
-        if (se.shape != want_se)
+        if (se.shape != std::vector<std::size_t>{I, D, T, P, 3})
             throw InputError((dir / "reference_se.npy").string(), "shape",
                              fmt::format("expected [{}, {}, {}, {}, 3]", I, D, T, P));
     }
-    auto at = [&](std::size_t s, std::size_t i, std::size_t d, std::size_t t, std::size_t p,
-                  std::size_t c) {
-        return tab.data[((((s * I + i) * D + d) * T + t) * P + p) * 3 + c];
-    };
-    auto se_at = [&](std::size_t i, std::size_t d, std::size_t t, std::size_t p, std::size_t c) {
-        return se.data[(((i * D + d) * T + t) * P + p) * 3 + c];
-    };
+    const BinBlocks f{tab.data, T, P}, f_se{se.data, T, P};
 
-    // 1. The incident-plane slice at full resolution, float32 [source, incidence, side, 2T, 3]:
-    //    x < T is the light's side (φ bin 0, θ descending), x >= T the mirror side (last φ bin).
-    std::vector<float> slice, slice_se;
-    slice.reserve(S * I * D * 2 * T * 3);
-    auto plane_bin = [&](std::size_t x) {
-        return x < T ? std::pair<std::size_t, std::size_t>{T - 1 - x, 0}
-                     : std::pair<std::size_t, std::size_t>{x - T, P - 1};
-    };
-    for (std::size_t s = 0; s < S; ++s)
-        for (std::size_t i = 0; i < I; ++i)
-            for (std::size_t d = 0; d < D; ++d)
-                for (std::size_t x = 0; x < 2 * T; ++x)
-                    for (std::size_t c = 0; c < 3; ++c) {
-                        const auto [t, p] = plane_bin(x);
-                        slice.push_back(at(s, i, d, t, p, c));
-                    }
-    for (std::size_t i = 0; i < I && has_se; ++i)
-        for (std::size_t d = 0; d < D; ++d)
-            for (std::size_t x = 0; x < 2 * T; ++x)
-                for (std::size_t c = 0; c < 3; ++c) {
-                    const auto [t, p] = plane_bin(x);
-                    slice_se.push_back(se_at(i, d, t, p, c));
-                }
+    // 1. The incident-plane slice at full resolution, float32 [source, incidence, side, 2T, 3].
+    const std::vector<float> slice = incident_plane(f);
+    const std::vector<float> slice_se = has_se ? incident_plane(f_se) : std::vector<float>();
 
-    // 2. Albedos Σ f Ω⊥ of every source, and the reference's standard error (bins taken as
-    //    independent: a slight overestimate, since one particle lands in one bin only).
+    // 2. Albedos of every source, and the reference's standard error.
+    const auto a = albedos(f, false);
+    const auto a_se = has_se ? albedos(f_se, true) : decltype(a)();
+    auto rgb = [](const std::optional<std::array<double, 3>>& v) {
+        return v ? json{(*v)[0], (*v)[1], (*v)[2]} : json(nullptr);
+    };
     json albedo = json::object(), albedo_se = json::object();
-    for (std::size_t s = 0; s < S; ++s) {
-        json per_side = json::object();
-        for (std::size_t d = 0; d < D; ++d) {
-            json per_inc = json::array();
-            json se_inc = json::array();
+    for (std::size_t s = 0; s < S; ++s)
+        for (std::size_t d = 0; d < D; ++d)
             for (std::size_t i = 0; i < I; ++i) {
-                // NaN bins (a side a model does not support) are skipped; all NaN: no albedo.
-                double a[3] = {0, 0, 0}, v[3] = {0, 0, 0};
-                bool finite = false;
-                for (std::size_t t = 0; t < T; ++t)
-                    for (std::size_t p = 0; p < P; ++p) {
-                        const double w = omega_perp(T, P, int(t));
-                        for (std::size_t c = 0; c < 3; ++c) {
-                            const float f = at(s, i, d, t, p, c);
-                            if (std::isnan(f)) continue;
-                            finite = true;
-                            a[c] += f * w;
-                            if (s == 0 && has_se) v[c] += std::pow(se_at(i, d, t, p, c) * w, 2);
-                        }
-                    }
-                per_inc.push_back(finite ? json{a[0], a[1], a[2]} : json(nullptr));
-                se_inc.push_back(json{std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2])});
+                albedo[sources[s]][sides[d]].push_back(rgb(a[(s * I + i) * D + d]));
+                if (s == 0 && has_se) albedo_se[sides[d]].push_back(rgb(a_se[i * D + d]));
             }
-            per_side[sides[d]] = per_inc;
-            if (s == 0 && has_se) albedo_se[sides[d]] = se_inc;
-        }
-        albedo[sources[s]] = per_side;
-    }
 
-    // 3. The hemisphere for the iso-value maps: bins merged to at most ~45 × 45 (cos-weighted
-    //    averages, weights Ω⊥), then 16-bit log codes.
+    // 3. The hemisphere for the iso-value maps, and the reference's se for the significance of
+    //    differences: bins merged to at most ~45 × 45, then 16-bit log codes.
     const int kt = (int(T) + 44) / 45, kp = (int(P) + 44) / 45;
     const std::vector<int> et = merged_edges(int(T), kt), ep = merged_edges(int(P), kp);
+    LogCodec codec, se_codec;
+    const std::vector<std::uint16_t> codes = log_codes(merge_bins(f, et, ep, false), codec);
+    const std::vector<std::uint16_t> se_codes =
+        has_se ? log_codes(merge_bins(f_se, et, ep, true), se_codec) : std::vector<std::uint16_t>();
     const std::size_t T2 = et.size() - 1, P2 = ep.size() - 1;
-    std::vector<float> hemi(S * I * D * T2 * P2 * 3);
-    float max_f = 0;
-    std::size_t h = 0;
-    for (std::size_t s = 0; s < S; ++s)
-        for (std::size_t i = 0; i < I; ++i)
-            for (std::size_t d = 0; d < D; ++d)
-                for (std::size_t t2 = 0; t2 < T2; ++t2)
-                    for (std::size_t p2 = 0; p2 < P2; ++p2)
-                        for (std::size_t c = 0; c < 3; ++c) {
-                            double num = 0, den = 0;
-                            for (int t = et[t2]; t < et[t2 + 1]; ++t)
-                                for (int p = ep[p2]; p < ep[p2 + 1]; ++p) {
-                                    const double w = omega_perp(T, P, t);
-                                    num += at(s, i, d, t, p, c) * w;
-                                    den += w;
-                                }
-                            const float f = float(num / den);
-                            hemi[h++] = f;
-                            if (std::isfinite(f)) max_f = std::max(max_f, f);
-                        }
-    LogCodec codec;
-    codec.hi = max_f > 0 ? std::log10(double(max_f)) : 0.0;
-    codec.lo = codec.hi - kLogDecades;
-    std::vector<std::uint16_t> codes(hemi.size());
-    for (std::size_t k = 0; k < hemi.size(); ++k)
-        codes[k] = codec.encode(hemi[k]);
-    // The reference's standard error on the same merged bins, √Σ(se_j w_j)² / Σ w_j (bins taken as
-    // independent), for the significance of differences: its own log codes.
-    std::vector<std::uint16_t> se_codes;
-    LogCodec se_codec;
-    if (has_se) {
-        std::vector<float> hemi_se;
-        hemi_se.reserve(I * D * T2 * P2 * 3);
-        float max_se = 0;
-        for (std::size_t i = 0; i < I; ++i)
-            for (std::size_t d = 0; d < D; ++d)
-                for (std::size_t t2 = 0; t2 < T2; ++t2)
-                    for (std::size_t p2 = 0; p2 < P2; ++p2)
-                        for (std::size_t c = 0; c < 3; ++c) {
-                            double var = 0, den = 0;
-                            for (int t = et[t2]; t < et[t2 + 1]; ++t)
-                                for (int p = ep[p2]; p < ep[p2 + 1]; ++p) {
-                                    const double w = omega_perp(T, P, t);
-                                    var += std::pow(se_at(i, d, t, p, c) * w, 2);
-                                    den += w;
-                                }
-                            const float e = float(std::sqrt(var) / den);
-                            hemi_se.push_back(e);
-                            if (std::isfinite(e)) max_se = std::max(max_se, e);
-                        }
-        se_codec.hi = max_se > 0 ? std::log10(double(max_se)) : 0.0;
-        se_codec.lo = se_codec.hi - kLogDecades;
-        for (float e : hemi_se)
-            se_codes.push_back(se_codec.encode(e));
-    }
     std::vector<double> theta_edges, phi_edges;
     for (int e : et)
         theta_edges.push_back(90.0 * e / T);
