@@ -679,15 +679,16 @@
     const cols = ["noise floor"].concat(models);
     const shownConfigs = configs.filter((c) => c.sides.includes(side));
     const rows = shownConfigs.map((c) => c.id);
-    const z = [], text = [], hover = [];
+    const z = [], text = [], hover = [], raw = [];
     for (const cfg of shownConfigs) {
       const mm = (INDEX.metrics || {})[cfg.id] || {};
-      const zr = [], tr = [], hr = [];
+      const zr = [], tr = [], hr = [], rr = [];
       // The noise floor: what a perfect model would score against this reference (misplaced energy).
       let nf = null;
       for (const m of models) if (mm[m] && mm[m][side]) { nf = aggregate(cellValues(mm[m][side], "nf")); if (nf !== null) break; }
       const nfShown = metric === "me" ? nf : null;
       zr.push(nfShown !== null && nfShown > 0 ? Math.log10(nfShown) : null);
+      rr.push(nfShown);
       tr.push(metric === "me" ? fmt(nf) : "");
       hr.push(cfg.id + "<br>noise floor " + fmt(nf));
       for (const m of models) {
@@ -695,13 +696,14 @@
         const ok = has && isSupported(cfg, m, side);
         const v = ok && mm[m] ? aggregate(cellValues(mm[m][side], metric)) : null;
         zr.push(v !== null && v > 0 ? Math.log10(v) : null);
+        rr.push(v);
         const below = metric === "me" && v !== null && nf !== null && v <= 2 * nf;
         tr.push(!has ? "" : !ok ? "n/s" : fmt(v) + (below ? "≈" : ""));
         hr.push(cfg.id + " · " + m + "<br>" + (!has ? "no " + (side === "R" ? "BRDF" : "BTDF")
           : !ok ? "not supported" + (unsupportedReason(cfg, m) ? ": " + unsupportedReason(cfg, m) : "")
           : $("w-lb-metric").selectedOptions[0].textContent + " " + fmt(v) + (below ? " (within 2× the noise floor)" : "")));
       }
-      z.push(zr); text.push(tr); hover.push(hr);
+      z.push(zr); text.push(tr); hover.push(hr); raw.push(rr);
     }
     // A last row: each model's mean over the configurations it supports (never counting n/s as 0),
     // the ranking of the models at a glance.
@@ -709,7 +711,7 @@
       const MEAN = "mean of supported";
       const zr = [], tr = [], hr = [];
       cols.forEach((col, j) => {
-        const vals = z.map((r) => r[j]).filter((v) => v !== null).map((v) => Math.pow(10, v));
+        const vals = raw.map((r) => r[j]).filter((v) => v !== null && isFinite(v));
         const m = vals.length ? vals.reduce((a, b) => a + b, 0) / vals.length : null;
         zr.push(m !== null && m > 0 ? Math.log10(m) : null);
         tr.push(m === null ? "" : "<b>" + fmt(m) + "</b>");
