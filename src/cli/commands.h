@@ -21,5 +21,9 @@ Runner add_compare(CLI::App& app);
 Runner add_models(CLI::App& app);
 /// `lamina eval`: a model at points, a batch of directions, or on the bins (cmd_eval.cpp).
 Runner add_eval(CLI::App& app);
+/// `lamina explorer DIR`: a study directory's explorer page (cmd_explorer.cpp).
+Runner add_explorer(CLI::App& app);
+/// `lamina figures DIR`: a study directory's paper figures (cmd_figures.cpp).
+Runner add_figures(CLI::App& app);
 
 }  // namespace lamina::cli

@@ -27,6 +27,8 @@ int main(int argc, char** argv) {
     add(lamina::cli::add_eval);
     add(lamina::cli::add_compare);
     add(lamina::cli::add_study);
+    add(lamina::cli::add_explorer);
+    add(lamina::cli::add_figures);
 
     CLI11_PARSE(app, argc, argv);
     try {

@@ -1,0 +1,376 @@
+#!/usr/bin/env python3
+"""Paper-ready figures of a lamina study directory (docs/explorer.md, "Figures").
+
+    figures.py STUDY_DIR [--formats pdf,svg,png] [--only GLOB[,GLOB...]] [--jobs N]
+
+Reads study.json, metrics.csv and configs/<id>/{config.json, tables.npy, reference_se.npy}
+(docs/formats.md) and writes STUDY_DIR/figures/:
+
+  slices/<id>-R.<fmt> (and -T for slabs)  incident-plane slices: rows = incidences, columns = RGB
+                                          channels; reference with its ±2·se band, every model
+  error-matrix-R.<fmt> (and -T)           configurations × models, mean misplaced energy, log colours,
+                                          the noise floor as the first column
+  albedo-<category>.<fmt>                 directional albedo against θi, one panel per configuration
+
+`lamina figures` runs this script (embedded in the binary) with Debian's python3; it can also be run
+directly. Exit code 3: matplotlib or numpy is missing (install python3-matplotlib: `make deps`).
+"""
+import argparse
+import csv
+import fnmatch
+import json
+import math
+import os
+import sys
+import time
+
+try:
+    import numpy as np
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import LogNorm
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
+except ImportError as e:  # pragma: no cover - reported by `lamina figures`
+    print(f"figures.py: {e}: install Debian's python3-matplotlib and python3-numpy (make deps)",
+          file=sys.stderr)
+    sys.exit(3)
+
+# One colour per model, the same as the explorer page (web/explorer.js): Okabe–Ito palette.
+MODEL_COLORS = {
+    "reference": "#000000",
+    "ww09": "#E69F00",
+    "ele10": "#56B4E9",
+    "ww-prime": "#009E73",
+    "bel18-forward": "#D55E00",
+    "bel18-symmetric": "#CC79A7",
+    "bel-prime": "#0072B2",
+}
+EXTRA_COLORS = ["#8c564b", "#7f7f7f", "#bcbd22", "#17becf", "#9467bd", "#F0E442"]
+# Variants dashed, as in the explorer: they often coincide with the model they vary.
+MODEL_DASH = {"ele10": (0, (4, 2)), "bel18-symmetric": (0, (4, 2))}
+CHANNELS = ["R", "G", "B"]
+SIDE_NAME = {"R": "BRDF", "T": "BTDF"}
+
+plt.rcParams.update({
+    "font.family": "DejaVu Sans", "font.size": 8, "axes.titlesize": 8, "axes.labelsize": 8,
+    "legend.fontsize": 7, "xtick.labelsize": 7, "ytick.labelsize": 7, "axes.linewidth": 0.6,
+    "lines.linewidth": 1.1, "pdf.fonttype": 42, "svg.fonttype": "none", "savefig.dpi": 160,
+    "figure.dpi": 100, "svg.hashsalt": "lamina",
+})
+
+
+def model_color(name, models):
+    if name in MODEL_COLORS:
+        return MODEL_COLORS[name]
+    k = models.index(name) if name in models else 0
+    return EXTRA_COLORS[k % len(EXTRA_COLORS)]
+
+
+def save(fig, path_stem, formats, tight=True):
+    """Writes each format. `tight=False` for figures laid out by hand: matplotlib's tight boxes
+    measure every tick label again, the bulk of the time for grids of log axes."""
+    os.makedirs(os.path.dirname(path_stem), exist_ok=True)
+    # No creation dates: the same study gives byte-identical PDF and SVG files.
+    metadata = {"pdf": {"CreationDate": None}, "svg": {"Date": None}, "png": {}}
+    for f in formats:
+        fig.savefig(f"{path_stem}.{f}", bbox_inches="tight" if tight else None,
+                    metadata=metadata[f])
+    plt.close(fig)
+
+
+def omega_perp(n_theta, n_phi):
+    """Ω⊥ of the folded grid's bins (docs/formats.md), shape [n_theta, 1]."""
+    edges = np.radians(np.linspace(0, 90, n_theta + 1))
+    s2 = np.sin(edges) ** 2
+    return ((s2[1:] - s2[:-1]) * math.pi / n_phi)[:, None]
+
+
+class Study:
+    def __init__(self, root):
+        self.root = root
+        path = os.path.join(root, "study.json")
+        try:
+            with open(path) as f:
+                self.meta = json.load(f)
+        except OSError as e:
+            sys.exit(f"figures.py: {path}: {e.strerror}")
+        self.theta_i = [float(t) for t in self.meta["theta_i"]]
+        self.n_theta = int(self.meta["grid"]["n_theta"])
+        self.n_phi = int(self.meta["grid"]["n_phi"])
+        self.configs = self.meta["configurations"]
+        self.models = list(self.meta.get("models") or [])
+        self.metrics = self._read_metrics()
+
+    def _read_metrics(self):
+        """{(config, model, side): {'me': [I][3], 'nf': [I][3]}} with NaN for unsupported."""
+        out = {}
+        path = os.path.join(self.root, "metrics.csv")
+        if not os.path.exists(path):
+            return out
+        with open(path, newline="") as f:
+            for row in csv.DictReader(f):
+                key = (row["config"], row["model"], row["side"])
+                cell = out.setdefault(key, {k: np.full((len(self.theta_i), 3), np.nan)
+                                            for k in ("me", "nf")})
+                try:
+                    i = self.theta_i.index(float(row["theta_i"]))
+                except ValueError:
+                    continue
+                c = "rgb".index(row["channel"])
+                if row["supported"] == "true":
+                    for k, col in (("me", "misplaced_energy"), ("nf", "noise_floor")):
+                        if row[col]:
+                            cell[k][i, c] = float(row[col])
+        return out
+
+    def load(self, cid):
+        d = os.path.join(self.root, "configs", cid)
+        with open(os.path.join(d, "config.json")) as f:
+            cfg = json.load(f)
+        tables = np.load(os.path.join(d, "tables.npy"), mmap_mode="r")
+        se_path = os.path.join(d, "reference_se.npy")
+        se = np.load(se_path, mmap_mode="r") if os.path.exists(se_path) else None
+        return cfg, tables, se
+
+
+def supported(cfg, model, side):
+    if model not in cfg["sources"]:
+        return False
+    s = (cfg.get("supported") or {}).get(model)
+    return True if s is None else s.get(side, True) is not False
+
+
+def pick_incidences(theta_i, wanted=(0, 45, 70)):
+    """Up to three incidences closest to 0°, 45° and 70° (distinct), in order."""
+    out = []
+    for w in wanted:
+        k = min(range(len(theta_i)), key=lambda i: abs(theta_i[i] - w))
+        if k not in out:
+            out.append(k)
+    return sorted(out)
+
+
+# ---- Per-configuration incident-plane slices ----------------------------------------------------
+
+_STUDY = None  # set before the worker processes fork, shared by them
+
+
+def slice_figure(args):
+    root, cid, formats = args
+    study = _STUDY if _STUDY is not None and _STUDY.root == root else Study(root)
+    cfg, tables, se = study.load(cid)
+    T = study.n_theta
+    centres = (np.arange(T) + 0.5) * 90.0 / T
+    x = np.concatenate([-centres[::-1], centres])  # negative: the light's side (φ bin 0)
+    incs = pick_incidences(study.theta_i)
+    models = [m for m in cfg["sources"][1:]]
+    for d, side in enumerate(cfg["sides"]):
+        ns = [m for m in models if not supported(cfg, m, side)]
+        top = 0.55 + (0.17 if ns else 0.0)  # inches above the panels: title, channel names
+        height = 1.85 * len(incs) + 0.55 + top
+        fig, axes = plt.subplots(len(incs), 3, figsize=(7.0, height), sharex=True, squeeze=False)
+        # Fixed margins (inches) instead of tight_layout: a third of the time per figure.
+        fig.subplots_adjust(left=0.85 / 7.0, right=1 - 0.1 / 7.0, bottom=0.85 / height,
+                            top=1 - top / height, wspace=0.28, hspace=0.12)
+        for r, i in enumerate(incs):
+            for c in range(3):
+                ax = axes[r][c]
+                plane = lambda s: np.concatenate([tables[s, i, d, ::-1, 0, c],
+                                                  tables[s, i, d, :, -1, c]])
+                ref = plane(0)
+                if se is not None:
+                    e = np.concatenate([se[i, d, ::-1, 0, c], se[i, d, :, -1, c]])
+                    lo = np.where(ref - 2 * e > 0, ref - 2 * e, ref * 1e-3)
+                    ax.fill_between(x, lo, ref + 2 * e, color="0.75", lw=0,
+                                    label="reference ±2·se")
+                ax.plot(x, ref, color="k", lw=1.4, label="reference")
+                top = np.nanmax(ref) if np.any(ref > 0) else 0.0
+                for k, m in enumerate(models):
+                    if supported(cfg, m, side):
+                        f = plane(k + 1)
+                        ax.plot(x, f, color=model_color(m, study.models), label=m,
+                                ls=MODEL_DASH.get(m, "-"))
+                        if np.any(f > 0):
+                            top = max(top, float(np.nanmax(f)))
+                ax.set_yscale("log")
+                positive = ref[ref > 0]
+                lo, hi = 1e-3, 1.0
+                if positive.size:
+                    lo, hi = max(positive.min(), top * 1e-5) * 0.5, top * 2
+                    ax.set_ylim(lo, hi)
+                # Plain-number ticks: decades on a wide range, 1-2-5 on a short one.
+                ax.yaxis.set_major_locator(LogLocator(10, subs=(1.0,) if hi / lo > 300 else (1.0, 2.0, 5.0)))
+                ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+                ax.yaxis.set_minor_locator(NullLocator())
+                ax.set_xlim(-90, 90)
+                ax.set_xticks([-90, -60, -30, 0, 30, 60, 90])
+                ax.grid(True, lw=0.3, color="0.88")
+                if r == 0:
+                    ax.set_title(f"{CHANNELS[c]} channel", color=["#b8322f", "#2e8540", "#2c5aa0"][c])
+                if c == 0:
+                    ax.set_ylabel(f"θi = {study.theta_i[i]:g}°\n{SIDE_NAME[side]} f (1/sr)")
+                if r == len(incs) - 1:
+                    ax.set_xlabel("θo (°), light's side negative")
+        handles, labels = axes[0][0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 8), frameon=False,
+                   bbox_to_anchor=(0.5, 0.0), columnspacing=0.9, handlelength=1.3)
+        title = f"{cid} — {SIDE_NAME[side]} on the incident plane"
+        if ns:
+            title += "\nnot supported: " + ", ".join(ns)
+        fig.suptitle(title, fontsize=9, y=1 - 0.08 / height, va="top")
+        save(fig, os.path.join(root, "figures", "slices", f"{cid}-{side}"), formats, tight=False)
+    return cid
+
+
+# ---- The configurations × models error matrix --------------------------------------------------
+
+def error_matrix(study, formats):
+    sides = ["R"] + (["T"] if any("T" in c["sides"] for c in study.configs) else [])
+    for side in sides:
+        rows = [c for c in study.configs if side in c["sides"]]
+        cols = ["noise floor"] + study.models
+        z = np.full((len(rows), len(cols)), np.nan)
+        ns = np.zeros_like(z, dtype=bool)
+        for r, cfg in enumerate(rows):
+            for k, m in enumerate(study.models):
+                cell = study.metrics.get((cfg["id"], m, side))
+                if cell is None or np.all(np.isnan(cell["me"])):
+                    ns[r, k + 1] = True
+                    continue
+                z[r, k + 1] = np.nanmean(cell["me"])
+                if np.isnan(z[r, 0]):
+                    z[r, 0] = np.nanmean(cell["nf"])
+        fig, ax = plt.subplots(figsize=(1.1 + 0.75 * len(cols), 0.8 + 0.16 * len(rows)))
+        finite = z[np.isfinite(z) & (z > 0)]
+        norm = LogNorm(vmin=finite.min(), vmax=finite.max()) if finite.size else None
+        im = ax.imshow(np.ma.masked_invalid(z), aspect="auto", cmap="YlOrRd", norm=norm,
+                       interpolation="nearest")
+        ax.set_facecolor("0.9")
+        for r in range(len(rows)):
+            for k in range(len(cols)):
+                if ns[r, k]:
+                    ax.text(k, r, "n/s", ha="center", va="center", fontsize=5.5, color="0.35")
+                elif np.isfinite(z[r, k]):
+                    below = k > 0 and np.isfinite(z[r, 0]) and z[r, k] <= 2 * z[r, 0]
+                    v = z[r, k]
+                    dark = norm is not None and norm(v) > 0.6
+                    ax.text(k, r, f"{v:.2g}" + ("≈" if below else ""), ha="center", va="center",
+                            fontsize=5.5, color="white" if dark else "black")
+        ax.set_xticks(range(len(cols)), cols, rotation=35, ha="left")
+        ax.xaxis.tick_top()
+        ax.set_yticks(range(len(rows)), [c["id"] for c in rows], fontsize=6)
+        ax.axvline(0.5, color="k", lw=0.8)
+        for r in range(1, len(rows)):  # a line between categories
+            if rows[r]["category"] != rows[r - 1]["category"]:
+                ax.axhline(r - 0.5, color="k", lw=0.8)
+        cb = fig.colorbar(im, ax=ax, fraction=0.04, pad=0.02)
+        cb.set_label("misplaced energy (mean over θi and RGB)")
+        ax.set_title(f"{SIDE_NAME[side]}: misplaced energy, configurations × models "
+                     "(≈: within 2× the noise floor; n/s: not supported)", fontsize=8, pad=6)
+        save(fig, os.path.join(study.root, "figures", f"error-matrix-{side}"), formats)
+
+
+# ---- Albedo against θi, per category -----------------------------------------------------------
+
+def albedo_curves(study, formats, cache):
+    cats = []
+    for c in study.configs:
+        if c["category"] not in cats:
+            cats.append(c["category"])
+    om = omega_perp(study.n_theta, study.n_phi)
+    for cat in cats:
+        members = [c for c in study.configs if c["category"] == cat]
+        ncol = min(5, len(members))
+        nrow = math.ceil(len(members) / ncol)
+        width = max(1.6 * ncol + 0.7, 3.6)
+        # The legend: one entry per 1.2 inch of width, as many rows as that takes.
+        entries = 1 + len(study.models)
+        legend_cols = max(2, min(entries, int(width / 1.2)))
+        legend_rows = math.ceil(entries / legend_cols)
+        bottom = 0.55 + 0.2 * legend_rows
+        height = 1.5 * nrow + 0.45 + bottom
+        fig, axes = plt.subplots(nrow, ncol, figsize=(width, height), sharex=True, sharey=True,
+                                 squeeze=False)
+        fig.subplots_adjust(left=0.6 / width, right=1 - 0.1 / width, bottom=bottom / height,
+                            top=1 - 0.45 / height, wspace=0.08, hspace=0.3)
+        for ax in axes.flat[len(members):]:
+            ax.axis("off")
+        for ax, meta in zip(axes.flat, members):
+            cfg, tables, se = cache[meta["id"]]
+            for d, side in enumerate(cfg["sides"]):
+                style = "-" if side == "R" else ":"
+                # Σ f Ω⊥ per source and incidence, averaged over RGB.
+                alb = np.nansum(np.asarray(tables[:, :, d]) * om[None, None, :, :, None], axis=(2, 3))
+                alb = alb.mean(axis=-1)
+                err = None
+                if se is not None:
+                    v = ((np.asarray(se[:, d]) * om[None, :, :, None]) ** 2).sum(axis=(1, 2))
+                    err = 2 * np.sqrt(v.mean(axis=-1))
+                ax.errorbar(study.theta_i, alb[0], yerr=err, color="k", lw=1.3, ls=style,
+                            capsize=1.5, elinewidth=0.6,
+                            label="reference ±2·se" + (" (T dotted)" if side == "T" else ""))
+                for k, m in enumerate(cfg["sources"][1:]):
+                    if supported(cfg, m, side):
+                        ax.plot(study.theta_i, alb[k + 1], color=model_color(m, study.models),
+                                ls=MODEL_DASH.get(m, "-") if side == "R" else ":", lw=0.9, label=m)
+            ax.set_title(meta["id"], fontsize=6.5)
+            ax.grid(True, lw=0.3, color="0.88")
+            ax.set_xticks([0, 30, 60, 90])
+        for ax in axes[-1]:
+            ax.set_xlabel("θi (°)")
+        for row in axes:
+            row[0].set_ylabel("albedo (RGB mean)")
+        seen = {}
+        for ax in axes.flat:
+            for h, l in zip(*ax.get_legend_handles_labels()):
+                seen.setdefault(l.replace(" (T dotted)", ""), h)
+        order = sorted(seen, key=lambda l: (not l.startswith("reference"),
+                                            study.models.index(l) if l in study.models else 0))
+        fig.legend([seen[l] for l in order], order, loc="lower center", ncol=legend_cols,
+                   frameon=False, columnspacing=0.9, handlelength=1.5)
+        fig.suptitle(f"{cat}: directional albedo against θi"
+                     + (" (transmission dotted)" if any(
+                         "T" in c["sides"] for c in members) else ""), fontsize=9,
+                     y=1 - 0.08 / height, va="top")
+        save(fig, os.path.join(study.root, "figures", f"albedo-{cat}"), formats, tight=False)
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("study_dir")
+    p.add_argument("--formats", default="pdf,svg,png")
+    p.add_argument("--only", default="", help="configuration ids (globs) for the slices")
+    p.add_argument("--jobs", type=int, default=min(4, os.cpu_count() or 1))
+    a = p.parse_args()
+    formats = [f for f in a.formats.split(",") if f]
+    for f in formats:
+        if f not in ("pdf", "svg", "png"):
+            sys.exit(f"figures.py: --formats: '{f}' is not one of pdf, svg, png")
+    t0 = time.time()
+    global _STUDY
+    study = _STUDY = Study(a.study_dir)
+    ids = [c["id"] for c in study.configs]
+    if a.only:
+        pats = [g for g in a.only.split(",") if g]
+        ids = [i for i in ids if any(fnmatch.fnmatchcase(i, g) for g in pats)]
+        if not ids:
+            sys.exit(f"figures.py: --only {a.only}: no configuration matches")
+    jobs = [(a.study_dir, cid, formats) for cid in ids]
+    if a.jobs > 1 and len(jobs) > 1:
+        import multiprocessing
+        with multiprocessing.get_context("fork").Pool(a.jobs) as pool:
+            list(pool.imap_unordered(slice_figure, jobs))
+    else:
+        for j in jobs:
+            slice_figure(j)
+    cache = {c["id"]: study.load(c["id"]) for c in study.configs}
+    error_matrix(study, formats)
+    albedo_curves(study, formats, cache)
+    print(f"figures: {len(ids)} configurations, {len(formats)} formats, "
+          f"{time.time() - t0:.1f} s -> {os.path.join(a.study_dir, 'figures')}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,17 @@
+#pragma once
+// Files embedded in the binary at build time (assets.cpp.in): the explorer page's HTML, JS and CSS
+// (web/), the vendored Plotly bundle (node_modules, installed by `make deps`) and the figure
+// script.
+
+#include <string_view>
+
+namespace lamina::assets {
+
+std::string_view explorer_html();
+std::string_view explorer_js();
+std::string_view explorer_css();
+/// Empty when node_modules/plotly.js-dist-min was absent when the build was configured.
+std::string_view plotly_js();
+std::string_view figures_py();
+
+}  // namespace lamina::assets

@@ -1,0 +1,474 @@
+#include "report/explorer.h"
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "report/assets.h"
+#include "report/npy.h"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <optional>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace lamina {
+
+namespace {
+
+// ---- Reading the study directory ------------------------------------------------------------
+
+json read_json(const fs::path& path, const char* what) {
+    std::ifstream in(path);
+    if (!in)
+        throw InputError(path.string(), "",
+                         fmt::format("cannot read {} (is this a study directory written by `lamina "
+                                     "study` or `lamina compare`?)",
+                                     what));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    try {
+        return json::parse(ss.str());
+    } catch (const json::parse_error& e) {
+        throw InputError(path.string(), "", fmt::format("malformed JSON: {}", e.what()));
+    }
+}
+
+template <class T>
+T field(const json& j, const std::string& key, const fs::path& file) {
+    if (!j.contains(key)) throw InputError(file.string(), "/" + key, "missing");
+    try {
+        return j.at(key).get<T>();
+    } catch (const json::exception& e) {
+        throw InputError(file.string(), "/" + key, fmt::format("wrong type: {}", e.what()));
+    }
+}
+
+std::vector<std::string> split_csv_line(const std::string& line) {
+    std::vector<std::string> out;
+    std::string cur;
+    for (char c : line) {
+        if (c == ',') {
+            out.push_back(cur);
+            cur.clear();
+        } else if (c != '\r') {
+            cur += c;
+        }
+    }
+    out.push_back(cur);
+    return out;
+}
+
+// metrics.csv → {config: {model: {side: {metric: [incidence][channel]}}}}, null where empty.
+json read_metrics(const fs::path& path, const std::vector<double>& theta_i) {
+    json out = json::object();
+    std::ifstream in(path);
+    if (!in) return out;  // the page then shows no leaderboard, and says so
+    std::string line;
+    std::getline(in, line);
+    const std::vector<std::string> header = split_csv_line(line);
+    auto column = [&](const char* name) {
+        const auto it = std::find(header.begin(), header.end(), name);
+        if (it == header.end()) throw InputError(path.string(), name, "column missing");
+        return std::size_t(it - header.begin());
+    };
+    const std::size_t c_config = column("config"), c_model = column("model"),
+                      c_theta = column("theta_i"), c_side = column("side"),
+                      c_channel = column("channel"), c_supported = column("supported");
+    const std::pair<const char*, std::size_t> metrics[] = {{"me", column("misplaced_energy")},
+                                                           {"nf", column("noise_floor")},
+                                                           {"ae", column("albedo_error")},
+                                                           {"lr", column("log_rmse")}};
+    std::size_t row = 1;
+    while (std::getline(in, line)) {
+        ++row;
+        if (line.empty()) continue;
+        const std::vector<std::string> v = split_csv_line(line);
+        if (v.size() != header.size())
+            throw InputError(path.string(), fmt::format("row {}", row),
+                             fmt::format("{} fields, the header has {}", v.size(), header.size()));
+        const double t = std::atof(v[c_theta].c_str());
+        std::size_t i = 0;
+        while (i < theta_i.size() && std::abs(theta_i[i] - t) > 1e-6)
+            ++i;
+        if (i == theta_i.size()) continue;  // an incidence study.json does not list
+        const int ch = v[c_channel] == "r" ? 0 : v[c_channel] == "g" ? 1 : 2;
+        json& cell = out[v[c_config]][v[c_model]][v[c_side]];
+        for (const auto& [key, col] : metrics) {
+            if (!cell.contains(key)) cell[key] = json::array();
+            json& arr = cell[key];
+            while (arr.size() < theta_i.size())
+                arr.push_back(json{nullptr, nullptr, nullptr});
+            if (v[c_supported] == "true" && !v[col].empty()) {
+                const double x = std::atof(v[col].c_str());
+                if (std::isfinite(x)) arr[i][ch] = x;
+            }
+        }
+    }
+    return out;
+}
+
+// ---- Encoding ---------------------------------------------------------------------------------
+
+std::string base64(const void* data, std::size_t n) {
+    static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const auto* p = static_cast<const unsigned char*>(data);
+    std::string out;
+    out.reserve((n + 2) / 3 * 4);
+    std::size_t i = 0;
+    for (; i + 2 < n; i += 3) {
+        const unsigned v = (p[i] << 16) | (p[i + 1] << 8) | p[i + 2];
+        out += k[v >> 18];
+        out += k[(v >> 12) & 63];
+        out += k[(v >> 6) & 63];
+        out += k[v & 63];
+    }
+    if (i + 1 == n) {
+        const unsigned v = p[i] << 16;
+        out += k[v >> 18];
+        out += k[(v >> 12) & 63];
+        out += "==";
+    } else if (i + 2 == n) {
+        const unsigned v = (p[i] << 16) | (p[i + 1] << 8);
+        out += k[v >> 18];
+        out += k[(v >> 12) & 63];
+        out += k[(v >> 6) & 63];
+        out += '=';
+    }
+    return out;
+}
+
+// The hemisphere maps are stored as 16-bit codes of log10 f (docs/explorer.md, "Data"): 0 is
+// f <= 0, 65535 is NaN (not supported), 1..65534 cover [lo, hi] in log10 f uniformly. Ten decades
+// over 65533 steps: a relative step of 0.035 %, invisible on any map.
+constexpr double kLogDecades = 10.0;
+constexpr std::uint16_t kCodeNaN = 65535;
+
+struct LogCodec {
+    double lo = -10.0, hi = 0.0;
+    std::uint16_t encode(float f) const {
+        if (std::isnan(f)) return kCodeNaN;
+        if (!(f > 0)) return 0;
+        const double u = (std::log10(double(f)) - lo) / (hi - lo);
+        return std::uint16_t(1 + std::lround(std::clamp(u, 0.0, 1.0) * 65533.0));
+    }
+};
+
+// Ω⊥ of a bin of θ row `t` on the folded grid of docs/formats.md (θ uniform over [0°, 90°], φ
+// uniform over [0°, 180°]; both folded halves): Δφ (sin²θ_hi − sin²θ_lo), the same for every φ bin.
+double omega_perp(int n_theta, int n_phi, int t) {
+    const double dphi = M_PI / n_phi;
+    const double s0 = std::sin(0.5 * M_PI * t / n_theta);
+    const double s1 = std::sin(0.5 * M_PI * (t + 1) / n_theta);
+    return dphi * (s1 * s1 - s0 * s0);
+}
+
+// Groups of `k` consecutive bins (the last one may be shorter): the edges of the merged bins.
+std::vector<int> merged_edges(int n, int k) {
+    std::vector<int> e;
+    for (int i = 0; i < n; i += k)
+        e.push_back(i);
+    e.push_back(n);
+    return e;
+}
+
+// A table whose last three axes are θ bin, φ bin, channel, seen as consecutive blocks of
+// T × P × 3 floats: block (s·I + i)·D + d of tables.npy, block i·D + d of reference_se.npy.
+struct BinBlocks {
+    const std::vector<float>& data;
+    std::size_t T, P;
+    std::size_t blocks() const { return data.size() / (T * P * 3); }
+    float at(std::size_t block, std::size_t t, std::size_t p, std::size_t c) const {
+        return data[((block * T + t) * P + p) * 3 + c];
+    }
+};
+
+// The incident plane of every block at full resolution, [block, 2T, 3]: x < T is the light's
+// side (φ bin 0, θ descending), x >= T the mirror side (the last φ bin, θ ascending).
+std::vector<float> incident_plane(const BinBlocks& b) {
+    std::vector<float> out;
+    out.reserve(b.blocks() * 2 * b.T * 3);
+    for (std::size_t k = 0; k < b.blocks(); ++k)
+        for (std::size_t x = 0; x < 2 * b.T; ++x)
+            for (std::size_t c = 0; c < 3; ++c)
+                out.push_back(x < b.T ? b.at(k, b.T - 1 - x, 0, c) : b.at(k, x - b.T, b.P - 1, c));
+    return out;
+}
+
+// Bins merged into groups (edges `et` × `ep`), [block, T2, P2, 3]. Values: the cos-weighted
+// average Σ f_j Ω⊥_j / Σ Ω⊥_j; standard errors (`quadrature`): √Σ (se_j Ω⊥_j)² / Σ Ω⊥_j, the
+// bins taken as independent.
+std::vector<float> merge_bins(const BinBlocks& b, const std::vector<int>& et,
+                              const std::vector<int>& ep, bool quadrature) {
+    std::vector<float> out;
+    out.reserve(b.blocks() * (et.size() - 1) * (ep.size() - 1) * 3);
+    for (std::size_t k = 0; k < b.blocks(); ++k)
+        for (std::size_t t2 = 0; t2 + 1 < et.size(); ++t2)
+            for (std::size_t p2 = 0; p2 + 1 < ep.size(); ++p2)
+                for (std::size_t c = 0; c < 3; ++c) {
+                    double num = 0, den = 0;
+                    for (int t = et[t2]; t < et[t2 + 1]; ++t)
+                        for (int p = ep[p2]; p < ep[p2 + 1]; ++p) {
+                            const double w = omega_perp(int(b.T), int(b.P), t);
+                            const double v = b.at(k, t, p, c) * w;
+                            num += quadrature ? v * v : v;
+                            den += w;
+                        }
+                    out.push_back(float((quadrature ? std::sqrt(num) : num) / den));
+                }
+    return out;
+}
+
+// 16-bit log codes of `values` over the ten decades below their maximum.
+std::vector<std::uint16_t> log_codes(const std::vector<float>& values, LogCodec& codec) {
+    float max_v = 0;
+    for (float v : values)
+        if (std::isfinite(v)) max_v = std::max(max_v, v);
+    codec.hi = max_v > 0 ? std::log10(double(max_v)) : 0.0;
+    codec.lo = codec.hi - kLogDecades;
+    std::vector<std::uint16_t> codes;
+    codes.reserve(values.size());
+    for (float v : values)
+        codes.push_back(codec.encode(v));
+    return codes;
+}
+
+// Σ_j f_j Ω⊥_j per block and channel (NaN bins, a side a model does not support, skipped; a block
+// of NaN only has no albedo), or with `quadrature` √Σ (se_j Ω⊥_j)² — the reference's standard
+// error with the bins taken as independent (a slight overestimate: a particle lands in one bin).
+std::vector<std::optional<std::array<double, 3>>> albedos(const BinBlocks& b, bool quadrature) {
+    std::vector<std::optional<std::array<double, 3>>> out;
+    for (std::size_t k = 0; k < b.blocks(); ++k) {
+        std::array<double, 3> a = {0, 0, 0};
+        bool finite = false;
+        for (std::size_t t = 0; t < b.T; ++t)
+            for (std::size_t p = 0; p < b.P; ++p)
+                for (std::size_t c = 0; c < 3; ++c) {
+                    const float f = b.at(k, t, p, c);
+                    if (std::isnan(f)) continue;
+                    finite = true;
+                    const double v = f * omega_perp(int(b.T), int(b.P), int(t));
+                    a[c] += quadrature ? v * v : v;
+                }
+        if (quadrature)
+            for (double& v : a)
+                v = std::sqrt(v);
+        out.push_back(finite ? std::optional(a) : std::nullopt);
+    }
+    return out;
+}
+
+struct ConfigData {
+    std::string script;      ///< explorer/data/<id>.js
+    json albedo, albedo_se;  ///< for the index
+};
+
+// Reads one configuration and encodes what the page draws (docs/explorer.md, "Data").
+ConfigData encode_configuration(const fs::path& dir, const std::string& id,
+                                const std::vector<double>& theta_i, int n_theta, int n_phi,
+                                json& entry) {
+    const fs::path cfg_path = dir / "config.json";
+    const json cfg = read_json(cfg_path, "the configuration");
+    const auto sources = field<std::vector<std::string>>(cfg, "sources", cfg_path);
+    const auto sides = field<std::vector<std::string>>(cfg, "sides", cfg_path);
+    const std::size_t S = sources.size(), I = theta_i.size(), D = sides.size(), T = n_theta,
+                      P = n_phi;
+    const NpyFloat32 tab = read_npy_float32(dir / "tables.npy");
+    if (tab.shape != std::vector<std::size_t>{S, I, D, T, P, 3})
+        throw InputError((dir / "tables.npy").string(), "shape",
+                         fmt::format("[{}]: expected [sources {}, incidences {}, sides {}, θ {}, φ "
+                                     "{}, 3] from config.json and study.json",
+                                     fmt::format("{}", fmt::join(tab.shape, ", ")), S, I, D, T, P));
+    NpyFloat32 se;
+    const bool has_se = fs::exists(dir / "reference_se.npy");
+    if (has_se) {
+        se = read_npy_float32(dir / "reference_se.npy");
+        if (se.shape != std::vector<std::size_t>{I, D, T, P, 3})
+            throw InputError((dir / "reference_se.npy").string(), "shape",
+                             fmt::format("expected [{}, {}, {}, {}, 3]", I, D, T, P));
+    }
+    const BinBlocks f{tab.data, T, P}, f_se{se.data, T, P};
+
+    // 1. The incident-plane slice at full resolution, float32 [source, incidence, side, 2T, 3].
+    const std::vector<float> slice = incident_plane(f);
+    const std::vector<float> slice_se = has_se ? incident_plane(f_se) : std::vector<float>();
+
+    // 2. Albedos of every source, and the reference's standard error.
+    const auto a = albedos(f, false);
+    const auto a_se = has_se ? albedos(f_se, true) : decltype(a)();
+    auto rgb = [](const std::optional<std::array<double, 3>>& v) {
+        return v ? json{(*v)[0], (*v)[1], (*v)[2]} : json(nullptr);
+    };
+    json albedo = json::object(), albedo_se = json::object();
+    for (std::size_t s = 0; s < S; ++s)
+        for (std::size_t d = 0; d < D; ++d)
+            for (std::size_t i = 0; i < I; ++i) {
+                albedo[sources[s]][sides[d]].push_back(rgb(a[(s * I + i) * D + d]));
+                if (s == 0 && has_se) albedo_se[sides[d]].push_back(rgb(a_se[i * D + d]));
+            }
+
+    // 3. The hemisphere for the iso-value maps, and the reference's se for the significance of
+    //    differences: bins merged to at most ~45 × 45, then 16-bit log codes.
+    const int kt = (int(T) + 44) / 45, kp = (int(P) + 44) / 45;
+    const std::vector<int> et = merged_edges(int(T), kt), ep = merged_edges(int(P), kp);
+    LogCodec codec, se_codec;
+    const std::vector<std::uint16_t> codes = log_codes(merge_bins(f, et, ep, false), codec);
+    const std::vector<std::uint16_t> se_codes =
+        has_se ? log_codes(merge_bins(f_se, et, ep, true), se_codec) : std::vector<std::uint16_t>();
+    const std::size_t T2 = et.size() - 1, P2 = ep.size() - 1;
+    std::vector<double> theta_edges, phi_edges;
+    for (int e : et)
+        theta_edges.push_back(90.0 * e / T);
+    for (int e : ep)
+        phi_edges.push_back(180.0 * e / P);
+
+    // Support and reasons: from config.json, else derived from the NaNs of the tables.
+    json supported = cfg.value("supported", json::object());
+    for (std::size_t s = 1; s < S; ++s)
+        if (!supported.contains(sources[s])) {
+            json m = json::object();
+            for (std::size_t d = 0; d < D; ++d)
+                m[sides[d]] = !albedo[sources[s]][sides[d]][0].is_null();
+            supported[sources[s]] = m;
+        }
+    entry["supported"] = supported;
+    entry["sources"] = sources;
+    entry["sides"] = sides;
+
+    // Sphere renderings (optional, a later issue writes them): configs/<id>/renders/<source>.png,
+    // the reference as reference.png or random-walk.png (what `lamina render --compare` names it),
+    // and the relative RMSE of each model's image from renders/errors.csv when present.
+    json renders = json::object();
+    for (const std::string& s : sources) {
+        const std::vector<std::string> names =
+            s == "reference" ? std::vector<std::string>{"reference", "random-walk"}
+                             : std::vector<std::string>{s};
+        for (const std::string& n : names)
+            if (fs::exists(dir / "renders" / (n + ".png"))) {
+                renders[s] = fmt::format("configs/{}/renders/{}.png", id, n);
+                break;
+            }
+    }
+    entry["renders"] = renders;
+    json render_errors = json::object();
+    if (std::ifstream err(dir / "renders" / "errors.csv"); err) {
+        std::string line;
+        std::getline(err, line);  // model,rel_rmse,seconds
+        while (std::getline(err, line)) {
+            const std::vector<std::string> v = split_csv_line(line);
+            if (v.size() >= 2 && !v[1].empty()) render_errors[v[0]] = v[1];
+        }
+    }
+    entry["render_errors"] = render_errors;
+
+    json data = {
+        {"id", id},
+        {"sources", sources},
+        {"sides", sides},
+        {"slice", base64(slice.data(), slice.size() * sizeof(float))},
+        {"slice_se",
+         has_se ? json(base64(slice_se.data(), slice_se.size() * sizeof(float))) : json(nullptr)},
+        {"hemi",
+         {{"n_theta", T2},
+          {"n_phi", P2},
+          {"theta_edges", theta_edges},
+          {"phi_edges", phi_edges},
+          {"lo", codec.lo},
+          {"hi", codec.hi},
+          {"codes", base64(codes.data(), codes.size() * sizeof(std::uint16_t))},
+          {"se_lo", se_codec.lo},
+          {"se_hi", se_codec.hi},
+          {"se_codes", has_se
+                           ? json(base64(se_codes.data(), se_codes.size() * sizeof(std::uint16_t)))
+                           : json(nullptr)}}},
+    };
+    ConfigData out;
+    out.script = fmt::format("(window.LAMINA_DATA = window.LAMINA_DATA || {{}})[{}] = {};\n",
+                             json(id).dump(), data.dump());
+    out.albedo = albedo;
+    out.albedo_se = albedo_se;
+    return out;
+}
+
+// Plotly as embedded at build time or, when `make deps` installed it after the build was
+// configured, as installed in the source tree.
+std::string plotly_bundle() {
+    if (!assets::plotly_js().empty()) return std::string(assets::plotly_js());
+    std::ifstream in(LAMINA_PLOTLY_INSTALLED, std::ios::binary);
+    std::stringstream ss;
+    if (in) ss << in.rdbuf();
+    if (ss.str().empty())
+        throw InputError(LAMINA_PLOTLY_INSTALLED, "",
+                         "Plotly is not installed, nor embedded in this lamina: run `make deps` "
+                         "(npm ci), then rebuild");
+    return ss.str();
+}
+
+}  // namespace
+
+ExplorerSummary write_explorer(const fs::path& study_dir) {
+    const fs::path study_path = study_dir / "study.json";
+    if (!fs::exists(study_path))
+        throw InputError(study_path.string(), "",
+                         "not found: expected a study directory written by `lamina study` or "
+                         "`lamina compare`");
+    const json study = read_json(study_path, "the study's description");
+    const auto theta_i = field<std::vector<double>>(study, "theta_i", study_path);
+    const json grid = field<json>(study, "grid", study_path);
+    const int n_theta = field<int>(grid, "n_theta", study_path);
+    const int n_phi = field<int>(grid, "n_phi", study_path);
+    const json configurations = field<json>(study, "configurations", study_path);
+    const std::string plotly = plotly_bundle();
+
+    // Stage everything first: a failure leaves the previous page untouched.
+    StagedOutput data_out(study_dir / "explorer" / "data");
+    ExplorerSummary summary;
+    json index = {{"study", json::object()}, {"configs", json::array()}};
+    for (const char* key : {"preset", "particles", "seed", "lamina_version", "models", "grid"})
+        if (study.contains(key)) index["study"][key] = study[key];
+    index["study"]["theta_i"] = theta_i;
+    // The page's title: the study folder's name (`out/study-quick/` → study-quick).
+    fs::path folder = fs::absolute(study_dir).lexically_normal();
+    if (folder.filename().empty()) folder = folder.parent_path();
+    index["study"]["name"] = folder.filename().string();
+    for (const json& c : configurations) {
+        const std::string id = field<std::string>(c, "id", study_path);
+        json entry = {{"id", id},
+                      {"category", c.value("category", "custom")},
+                      {"parameters", c.value("parameters", json::object())}};
+        ConfigData d =
+            encode_configuration(study_dir / "configs" / id, id, theta_i, n_theta, n_phi, entry);
+        entry["albedo"] = d.albedo;
+        entry["albedo_se"] = d.albedo_se;
+        summary.data_bytes += d.script.size();
+        data_out.add(id + ".js", d.script);
+        index["configs"].push_back(entry);
+        ++summary.configurations;
+    }
+    index["metrics"] = read_metrics(study_dir / "metrics.csv", theta_i);
+    const std::string index_js = "window.LAMINA_INDEX = " + index.dump() + ";\n";
+    summary.data_bytes += index_js.size();
+    data_out.add("index.js", index_js);
+
+    StagedOutput page_out(study_dir / "explorer");
+    page_out.add("plotly.min.js", plotly);
+    page_out.add("explorer.js", assets::explorer_js());
+    page_out.add("explorer.css", assets::explorer_css());
+    StagedOutput root_out(study_dir);
+    root_out.add("index.html", assets::explorer_html());
+    data_out.commit();
+    page_out.commit();
+    root_out.commit();
+    return summary;
+}
+
+}  // namespace lamina

@@ -1,0 +1,23 @@
+#pragma once
+// The explorer page of a study directory (docs/explorer.md): DIR/index.html and DIR/explorer/,
+// one page that works from file:// with no network and no server. It reads what `lamina study`
+// wrote (docs/formats.md: study.json, metrics.csv, configs/<id>/{config.json, tables.npy,
+// reference_se.npy}) and nothing else, so it can be regenerated at any time.
+
+#include <cstdint>
+#include <filesystem>
+
+namespace lamina {
+
+struct ExplorerSummary {
+    std::size_t configurations = 0;
+    std::uintmax_t data_bytes = 0;  ///< DIR/explorer/data/*.js, all together
+};
+
+/// Writes DIR/index.html, DIR/explorer/{plotly.min.js, explorer.js, explorer.css} and
+/// DIR/explorer/data/{index.js, <id>.js}. Throws InputError naming the file for a missing or
+/// malformed study file (study.json first) or a folder that cannot be written; files are staged and
+/// moved into place only when every one is written.
+ExplorerSummary write_explorer(const std::filesystem::path& study_dir);
+
+}  // namespace lamina

@@ -1,0 +1,90 @@
+#include "report/npy.h"
+
+#include "core/error.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <string>
+
+namespace lamina {
+
+namespace {
+
+// The value of `key` in the header dict, e.g. 'descr': '<f4' → "'<f4'" (up to the next comma at
+// depth 0, parentheses included).
+std::string header_value(const std::string& header, const std::string& key) {
+    const std::size_t k = header.find("'" + key + "'");
+    if (k == std::string::npos) return {};
+    std::size_t i = header.find(':', k);
+    if (i == std::string::npos) return {};
+    ++i;
+    int depth = 0;
+    std::string out;
+    for (; i < header.size(); ++i) {
+        const char c = header[i];
+        if (c == '(') ++depth;
+        if (c == ')') --depth;
+        if (depth == 0 && (c == ',' || c == '}')) break;
+        out += c;
+        if (depth < 0) break;
+    }
+    const auto b = out.find_first_not_of(" ");
+    return b == std::string::npos ? std::string() : out.substr(b);
+}
+
+}  // namespace
+
+NpyFloat32 read_npy_float32(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(where, "", "cannot read the file");
+    char magic[8];
+    if (!in.read(magic, 8) || std::memcmp(magic, "\x93NUMPY", 6) != 0)
+        throw InputError(where, "", "not a NumPy .npy file");
+    std::uint32_t header_len = 0;
+    if (magic[6] == 1) {
+        unsigned char b[2];
+        in.read(reinterpret_cast<char*>(b), 2);
+        header_len = b[0] | (b[1] << 8);
+    } else {
+        unsigned char b[4];
+        in.read(reinterpret_cast<char*>(b), 4);
+        header_len = b[0] | (b[1] << 8) | (b[2] << 16) | (std::uint32_t(b[3]) << 24);
+    }
+    std::string header(header_len, '\0');
+    if (!in.read(header.data(), header_len)) throw InputError(where, "", "truncated header");
+    const std::string descr = header_value(header, "descr");
+    if (descr != "'<f4'")
+        throw InputError(where, "descr",
+                         fmt::format("{}: expected '<f4' (little-endian float32)", descr));
+    if (header_value(header, "fortran_order") != "False")
+        throw InputError(where, "fortran_order", "expected False (C order)");
+    const std::string shape_text = header_value(header, "shape");
+    NpyFloat32 a;
+    std::size_t count = 1;
+    for (std::size_t i = 0; i < shape_text.size();) {
+        if (std::isdigit(static_cast<unsigned char>(shape_text[i]))) {
+            std::size_t used = 0;
+            const std::size_t n = std::stoull(shape_text.substr(i), &used);
+            a.shape.push_back(n);
+            count *= n;
+            i += used;
+        } else {
+            ++i;
+        }
+    }
+    if (a.shape.empty())
+        throw InputError(where, "shape", fmt::format("cannot read {}", shape_text));
+    a.data.resize(count);
+    if (!in.read(reinterpret_cast<char*>(a.data.data()), std::streamsize(count * sizeof(float))))
+        throw InputError(
+            where, "",
+            fmt::format("truncated: the header announces shape [{}]", fmt::join(a.shape, ", ")));
+    return a;
+}
+
+}  // namespace lamina

@@ -1,0 +1,152 @@
+// The explorer page in a real browser (Debian's chromium driven by playwright-core; no browser is
+// ever downloaded). Usage: node browser_test.js STUDY_DIR SCREENSHOT_DIR
+//
+// Opens STUDY_DIR/index.html from file:// (a study made by make_fixture.py), then checks: no
+// console error or page error; each widget changes the data drawn (read back from Plotly's `data`
+// on the plot elements); a click on a leaderboard cell opens that configuration. Screenshots go to
+// SCREENSHOT_DIR. Exit code 0 when every check passes.
+"use strict";
+const fs = require("fs");
+const os = require("os");
+const path = require("path");
+const { chromium } = require("playwright-core");
+
+const [studyDir, shotDir] = process.argv.slice(2);
+const CHROMIUM = process.env.LAMINA_CHROMIUM || "/usr/bin/chromium";
+let failures = 0, passes = 0;
+const check = (ok, what) => {
+  if (ok) { passes++; console.log("ok   " + what); } else { failures++; console.log("FAIL " + what); }
+};
+
+async function main() {
+  if (!fs.existsSync(CHROMIUM)) {
+    console.log(`FAIL ${CHROMIUM} is missing: run \`make deps\` (Debian's chromium)`);
+    process.exit(1);
+  }
+  fs.mkdirSync(shotDir, { recursive: true });
+  const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), "lamina-chromium-"));
+  const context = await chromium.launchPersistentContext(userDataDir, {
+    executablePath: CHROMIUM,
+    headless: true,
+    args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+      "--disable-background-networking", "--disable-component-update", "--disable-sync"],
+    viewport: { width: 1400, height: 1000 },
+  });
+  const errors = [];
+  try {
+    const page = context.pages()[0] || (await context.newPage());
+    page.on("console", (m) => { if (m.type() === "error") errors.push("console: " + m.text()); });
+    page.on("pageerror", (e) => errors.push("page error: " + e.message));
+    // Nothing may leave the machine: the page must work from file:// alone.
+    await page.route(/^(https?|wss?):/, (route) => { errors.push("network request: " + route.request().url()); route.abort(); });
+
+    const renders = () => page.evaluate(() => Number(document.body.dataset.renders || 0));
+    const waitRender = async (before) => {
+      await page.waitForFunction((n) => Number(document.body.dataset.renders || 0) > n, before, { timeout: 10000 });
+    };
+    // A digest of what a plot draws: its traces' names, x, y and z, and its axis types.
+    const digest = (id) => page.evaluate((id) => {
+      const gd = document.getElementById(id);
+      const data = (gd.data || []).map((t) => [t.name, t.type, t.x && Array.from(t.x), t.y && Array.from(t.y), t.z, t.text]);
+      const lay = gd.layout ? [gd.layout.yaxis && gd.layout.yaxis.type, gd.layout.title && gd.layout.title.text] : [];
+      return JSON.stringify([data, lay]);
+    }, id);
+    const digests = async () => {
+      const out = {};
+      for (const id of ["slice", "iso-ref", "iso-model", "iso-diff", "albedo", "leaderboard"]) out[id] = await digest(id);
+      return out;
+    };
+    // Runs `action`, waits for the page to redraw, and checks that the named plots changed.
+    const changes = async (what, action, plots) => {
+      const before = await digests();
+      const n = await renders();
+      await action();
+      await waitRender(n);
+      const after = await digests();
+      for (const p of plots) check(before[p] !== after[p], `${what} changes the ${p} plot`);
+    };
+
+    const url = "file://" + path.resolve(studyDir, "index.html");
+    const t0 = Date.now();
+    await page.goto(url);
+    await page.waitForFunction(() => Number(document.body.dataset.renders || 0) >= 1, null, { timeout: 15000 });
+    console.log(`first draw ${Date.now() - t0} ms after navigation (draw ${await page.evaluate(() => document.body.dataset.drawMs)} ms: ${await page.evaluate(() => document.body.dataset.viewMs)})`);
+    check(await page.evaluate(() => typeof Plotly === "object" && !!window.LAMINA_INDEX), "the page loads Plotly and the study index");
+    check((await page.evaluate(() => document.getElementById("slice").data.length)) > 3, "the slice shows the reference, its band and models");
+    await page.screenshot({ path: path.join(shotDir, "explorer-initial.png"), fullPage: true });
+
+    const cfg0 = await page.evaluate(() => document.body.dataset.config);
+    await changes("the incidence", () => page.selectOption("#w-incidence", "0"), ["slice", "iso-ref", "iso-model", "iso-diff"]);
+    await changes("the G channel", () => page.uncheck("#w-ch-g"), ["slice", "albedo", "leaderboard"]);
+    check(await page.evaluate(() => !document.getElementById("slice").data.some((t) => t.xaxis === "x3")), "two channels: two subplots");
+    await changes("the log scale", () => page.uncheck("#w-log"), ["slice"]);
+    await changes("a model", () => page.uncheck("#w-model-ww09"), ["slice", "albedo"]);
+    check(await page.evaluate(() => !document.getElementById("slice").data.some((t) => t.name === "ww09")), "an unticked model is not drawn");
+    await changes("the iso model", () => page.selectOption("#w-iso-model", "ww-prime"), ["iso-model", "iso-diff"]);
+    await changes("the iso channel", () => page.selectOption("#w-iso-channel", "2"), ["iso-ref", "iso-model"]);
+    await changes("the difference mode", () => page.selectOption("#w-diff", "sigma"), ["iso-diff"]);
+    await changes("the contour levels", async () => { await page.fill("#w-levels", "0.05, 0.2, 1"); await page.press("#w-levels", "Enter"); }, ["iso-ref"]);
+    check(await page.evaluate(() => document.getElementById("iso-ref").data.length === 4), "three chosen levels: three contour traces");
+    await changes("the leaderboard metric", () => page.selectOption("#w-lb-metric", "ae"), ["leaderboard"]);
+    await changes("the leaderboard incidence", () => page.selectOption("#w-lb-incidence", "1"), ["leaderboard"]);
+    await changes("the leaderboard aggregate", () => page.selectOption("#w-lb-agg", "max"), ["leaderboard"]);
+    await page.check("#w-log");
+    await page.check("#w-ch-g");
+    await page.check("#w-model-ww09");
+    await changes("a top-layer parameter (α0)", () => page.selectOption("#w-param-alpha0", "0.3"), ["slice", "iso-ref", "albedo"]);
+    check((await page.evaluate(() => document.body.dataset.config)) === "plastic-P2-a0.3", "α0 = 0.3 opens plastic-P2-a0.3");
+    check(await page.evaluate(() => /bel18-forward/.test(document.getElementById("unsupported").textContent)), "an unsupported model is named as such");
+    await changes("the category", () => page.selectOption("#w-category", "slab"), ["slice", "albedo"]);
+    check((await page.evaluate(() => document.body.dataset.config)) === "slab-a0.1-a1.3-clear", "the slab category opens the slab");
+    check(await page.evaluate(() => !document.getElementById("w-side-T").disabled), "a slab enables the BTDF");
+    await changes("the hemisphere", () => page.check("#w-side-T"), ["slice", "iso-ref", "albedo"]);
+    await page.screenshot({ path: path.join(shotDir, "explorer-slab-btdf.png"), fullPage: true });
+    await changes("the configuration list", () => page.selectOption("#w-config", "slab-a0.1-a1.3-clear"), []);  // same: still redraws
+    await page.check("#w-side-R");
+
+    // Click the leaderboard cell (paint-a0.05-a1.3, ww-prime): the page opens that configuration.
+    const target = "paint-a0.05-a1.3";
+    await page.selectOption("#w-lb-metric", "me");
+    await page.waitForTimeout(200);
+    const pos = await page.evaluate((id) => {
+      const gd = document.getElementById("leaderboard");
+      const xa = gd._fullLayout.xaxis, ya = gd._fullLayout.yaxis;
+      const r = gd.getBoundingClientRect();
+      return { x: r.left + xa._offset + xa.d2p("ww-prime"), y: r.top + ya._offset + ya.d2p(id) };
+    }, target);
+    await page.evaluate(() => document.getElementById("leaderboard").scrollIntoView());
+    const pos2 = await page.evaluate((id) => {
+      const gd = document.getElementById("leaderboard");
+      const xa = gd._fullLayout.xaxis, ya = gd._fullLayout.yaxis;
+      const r = gd.getBoundingClientRect();
+      return { x: r.left + xa._offset + xa.d2p("ww-prime"), y: r.top + ya._offset + ya.d2p(id) };
+    }, target);
+    await page.screenshot({ path: path.join(shotDir, "explorer-leaderboard.png") });
+    const n = await renders();
+    await page.mouse.click(pos2.x, pos2.y);
+    await waitRender(n);
+    check((await page.evaluate(() => document.body.dataset.config)) === target, `a leaderboard click opens ${target}`);
+    check((await page.evaluate(() => window.LAMINA_EXPLORER.state.isoModel)) === "ww-prime", "… with the clicked model in the iso view");
+    await page.waitForFunction(() => Array.from(document.querySelectorAll("#renders img")).every((i) => i.complete));
+    check((await page.evaluate(() => Array.from(document.querySelectorAll("#renders img")).filter((i) => i.naturalWidth > 0).length)) === 3,
+      "its three sphere renderings are shown");
+    check(await page.evaluate(() => /rel\. RMSE 0\.13/.test(document.getElementById("renders").textContent) &&
+      /not supported/.test(document.getElementById("renders").textContent)), "… with their errors, and the one that could not be drawn named");
+    check(pos.y !== undefined && cfg0 !== target, "the click target differs from the first configuration");
+    await page.screenshot({ path: path.join(shotDir, "explorer-after-click.png"), fullPage: true });
+
+    // The state is in the address: reloading keeps the configuration.
+    await page.reload();
+    await page.waitForFunction(() => Number(document.body.dataset.renders || 0) >= 1);
+    check((await page.evaluate(() => document.body.dataset.config)) === target, "a reload keeps the configuration (#config=…)");
+  } finally {
+    await context.close();
+    fs.rmSync(userDataDir, { recursive: true, force: true });
+  }
+  for (const e of errors) console.log("FAIL " + e);
+  check(errors.length === 0, "no console errors, page errors or network requests");
+  console.log(`${passes} passed, ${failures} failed`);
+  process.exit(failures ? 1 : 0);
+}
+
+main().catch((e) => { console.log("FAIL " + (e && e.stack || e)); process.exit(1); });

@@ -1,0 +1,156 @@
+// The report library without a browser: the .npy reader and write_explorer on a tiny study
+// directory written here (docs/formats.md). The page itself is tested in Chromium by the ctest
+// `browser` (tests/report/browser_test.js).
+#include "report/explorer.h"
+#include "core/error.h"
+#include "report/npy.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace lamina {
+namespace {
+
+fs::path fresh_dir(const std::string& name) {
+    const fs::path d = fs::temp_directory_path() / ("lamina-report-test-" + name);
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+void write_text(const fs::path& p, const std::string& text) {
+    fs::create_directories(p.parent_path());
+    std::ofstream(p) << text;
+}
+
+// A version 1.0 .npy file, header padded to a multiple of 64 bytes as NumPy writes it.
+void write_npy(const fs::path& p, const std::vector<std::size_t>& shape,
+               const std::vector<float>& data, const std::string& descr = "<f4") {
+    std::string dims;
+    for (std::size_t n : shape)
+        dims += std::to_string(n) + ", ";
+    std::string header =
+        "{'descr': '" + descr + "', 'fortran_order': False, 'shape': (" + dims + "), }";
+    header += std::string((64 - (10 + header.size() + 1) % 64) % 64, ' ') + "\n";
+    std::ofstream out(p, std::ios::binary);
+    out.write("\x93NUMPY\x01\x00", 8);
+    const std::uint16_t len = std::uint16_t(header.size());
+    out.put(char(len & 0xff));
+    out.put(char(len >> 8));
+    out << header;
+    out.write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size() * 4));
+}
+
+std::string read_text(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+TEST(Npy, ReadsShapeAndData) {
+    const fs::path d = fresh_dir("npy");
+    write_npy(d / "a.npy", {2, 3}, {0, 1, 2, 3, 4, 5.5f});
+    const NpyFloat32 a = read_npy_float32(d / "a.npy");
+    EXPECT_EQ(a.shape, (std::vector<std::size_t>{2, 3}));
+    ASSERT_EQ(a.data.size(), 6u);
+    EXPECT_EQ(a.data[5], 5.5f);
+}
+
+TEST(Npy, RejectsOtherTypesAndTruncation) {
+    const fs::path d = fresh_dir("npy-bad");
+    write_npy(d / "f8.npy", {1}, {0, 0}, "<f8");
+    EXPECT_THROW(read_npy_float32(d / "f8.npy"), InputError);
+    write_npy(d / "short.npy", {4}, {1, 2});
+    try {
+        read_npy_float32(d / "short.npy");
+        FAIL() << "a truncated file was read";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("short.npy"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(read_npy_float32(d / "missing.npy"), InputError);
+}
+
+TEST(Explorer, MissingStudyNamesStudyJson) {
+    const fs::path d = fresh_dir("missing");
+    try {
+        write_explorer(d);
+        FAIL() << "no study.json, yet a page was written";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("study.json"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(d / "index.html"));
+}
+
+// One configuration, reference + one model, one incidence, a 2 × 2 grid, f = 1/π everywhere for
+// the reference (albedo exactly 1: Σ Ω⊥ over the hemisphere is π) and 2/π for the model.
+TEST(Explorer, WritesPageDataAndAlbedos) {
+    const fs::path d = fresh_dir("tiny");
+    write_text(d / "study.json", R"({"theta_i": [30], "grid": {"n_theta": 2, "n_phi": 2},
+        "models": ["ww09"], "preset": "test",
+        "configurations": [{"id": "c1", "category": "plastic",
+                            "parameters": {"alpha0": "0.1"}, "sides": ["R"]}]})");
+    write_text(d / "configs/c1/config.json", R"({"id": "c1", "sources": ["reference", "ww09"],
+        "sides": ["R"], "supported": {"ww09": {"R": true, "T": false, "reason": ""}}})");
+    std::vector<float> tables(2 * 2 * 2 * 3);
+    for (std::size_t k = 0; k < tables.size(); ++k)
+        tables[k] = float((k < 12 ? 1 : 2) / M_PI);
+    write_npy(d / "configs/c1/tables.npy", {2, 1, 1, 2, 2, 3}, tables);
+    write_npy(d / "configs/c1/reference_se.npy", {1, 1, 2, 2, 3}, std::vector<float>(12, 0.01f));
+    write_text(d / "metrics.csv",
+               "config,category,model,theta_i,side,channel,misplaced_energy,albedo_ref,"
+               "albedo_model,albedo_error,rmse,log_rmse,noise_floor,supported\n"
+               "c1,plastic,ww09,30,R,g,1,1,2,1,0.3,0.2,0.01,true\n");
+
+    const ExplorerSummary s = write_explorer(d);
+    EXPECT_EQ(s.configurations, 1u);
+    for (const char* f : {"index.html", "explorer/plotly.min.js", "explorer/explorer.js",
+                          "explorer/explorer.css", "explorer/data/index.js", "explorer/data/c1.js"})
+        EXPECT_TRUE(fs::exists(d / f)) << f;
+    EXPECT_GT(fs::file_size(d / "explorer/plotly.min.js"), 1000000u);
+    EXPECT_NE(read_text(d / "index.html").find("explorer/data/index.js"), std::string::npos);
+
+    std::string index = read_text(d / "explorer/data/index.js");
+    const std::string prefix = "window.LAMINA_INDEX = ";
+    ASSERT_EQ(index.rfind(prefix, 0), 0u);
+    index = index.substr(prefix.size());
+    index.erase(index.find_last_of(';'));
+    const nlohmann::json j = nlohmann::json::parse(index);
+    const auto& c = j["configs"][0];
+    EXPECT_EQ(c["id"], "c1");
+    EXPECT_NEAR(c["albedo"]["reference"]["R"][0][1].get<double>(), 1.0, 1e-6);
+    EXPECT_NEAR(c["albedo"]["ww09"]["R"][0][1].get<double>(), 2.0, 1e-6);
+    EXPECT_NEAR(j["metrics"]["c1"]["ww09"]["R"]["me"][0][1].get<double>(), 1.0, 1e-12);
+    EXPECT_TRUE(j["metrics"]["c1"]["ww09"]["R"]["me"][0][0].is_null());  // a row not given
+    EXPECT_NE(read_text(d / "explorer/data/c1.js").find("LAMINA_DATA"), std::string::npos);
+    // No staging folder is left behind.
+    for (const auto& e : fs::recursive_directory_iterator(d))
+        EXPECT_EQ(e.path().filename().string().rfind(".staging", 0), std::string::npos) << e.path();
+}
+
+TEST(Explorer, TableShapeMismatchNamesTheFile) {
+    const fs::path d = fresh_dir("shape");
+    write_text(d / "study.json", R"({"theta_i": [0, 30], "grid": {"n_theta": 2, "n_phi": 2},
+        "configurations": [{"id": "c1", "category": "x", "sides": ["R"]}]})");
+    write_text(d / "configs/c1/config.json", R"({"sources": ["reference"], "sides": ["R"]})");
+    write_npy(d / "configs/c1/tables.npy", {1, 1, 1, 2, 2, 3}, std::vector<float>(12, 1.0f));
+    try {
+        write_explorer(d);
+        FAIL() << "a table of the wrong shape was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("tables.npy"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace lamina

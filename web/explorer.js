@@ -1,0 +1,857 @@
+// lamina explorer: the views of a study directory (docs/explorer.md). Plain browser JavaScript,
+// no build step. Data: window.LAMINA_INDEX (explorer/data/index.js) and, per configuration,
+// window.LAMINA_DATA[id] (explorer/data/<id>.js, loaded on demand by a <script> tag: file:// pages
+// cannot fetch). Drawing: Plotly (explorer/plotly.min.js, vendored from npm at build time).
+"use strict";
+
+(function () {
+  if (!window.LAMINA_INDEX || typeof Plotly !== "object") {
+    document.getElementById("status").textContent = (window.LAMINA_INDEX ? "explorer/plotly.min.js" : "explorer/data/index.js") +
+      " did not load: regenerate the page with `lamina explorer DIR`.";
+    return;
+  }
+  const INDEX = window.LAMINA_INDEX;
+  const STUDY = INDEX.study;
+  const THETA_I = STUDY.theta_i;
+  const CHANNELS = ["R", "G", "B"];
+  const CHANNEL_COLORS = ["#b8322f", "#2e8540", "#2c5aa0"];
+
+  // One colour per model, the same in every view and in scripts/figures.py (Okabe–Ito palette).
+  const MODEL_COLORS = {
+    reference: "#000000",
+    ww09: "#E69F00",
+    ele10: "#56B4E9",
+    "ww-prime": "#009E73",
+    "bel18-forward": "#D55E00",
+    "bel18-symmetric": "#CC79A7",
+    "bel-prime": "#0072B2",
+  };
+  const EXTRA_COLORS = ["#8c564b", "#7f7f7f", "#bcbd22", "#17becf", "#9467bd", "#F0E442"];
+  // Variants are dashed: Ele10 is WW09 with one change and often coincides with it, and so do
+  // the two Bel18 cosines; a dashed line on top lets the solid one show through.
+  const MODEL_DASH = { ele10: "dash", "bel18-symmetric": "dash" };
+  const modelDash = (name) => MODEL_DASH[name] || "solid";
+
+  // The configuration widgets, in the order of the original study's explorer.
+  const PARAMS = [
+    ["alpha0", "α0 (top roughness)"], ["eta0", "η0 (top IOR)"], ["tau", "τa (absorption)"],
+    ["tau_s", "τs (scattering)"], ["base", "base"], ["alpha1", "α1 (base roughness)"],
+    ["eta1", "η1 (base IOR)"], ["kappa1", "κ1 (base extinction)"], ["rho", "ρ (base albedo)"],
+  ];
+
+  const configs = INDEX.configs;
+  const byId = new Map(configs.map((c) => [c.id, c]));
+  const models = (STUDY.models && STUDY.models.length)
+    ? STUDY.models.slice()
+    : Array.from(new Set(configs.flatMap((c) => c.sources.slice(1))));
+  const categories = Array.from(new Set(configs.map((c) => c.category)));
+
+  function modelColor(name) {
+    if (MODEL_COLORS[name]) return MODEL_COLORS[name];
+    const k = models.indexOf(name);
+    return EXTRA_COLORS[(k < 0 ? 0 : k) % EXTRA_COLORS.length];
+  }
+
+  const state = {
+    config: configs.length ? configs[0].id : null,
+    incidence: Math.min(2, THETA_I.length - 1),
+    channels: [true, true, true],
+    side: "R",
+    log: true,
+    shown: new Set(models),
+    isoModel: models[0],
+    isoChannel: 0,
+    diffMode: "f",
+    levels: "",
+    lbMetric: "me",
+    lbIncidence: "all",
+    lbAgg: "mean",
+  };
+
+  const $ = (id) => document.getElementById(id);
+  const status = (text) => { $("status").textContent = text || ""; };
+  const fmt = (v) => (v === null || v === undefined || !isFinite(v)) ? "–"
+    : (Math.abs(v) >= 100 ? v.toFixed(0) : Number(v.toPrecision(2)).toString());
+  const PLOT_CONFIG = { displaylogo: false, responsive: true, toImageButtonOptions: { format: "svg" } };
+
+  // ---- Data: loading and decoding -------------------------------------------------------------
+
+  const decoded = new Map();
+
+  function bytesOf(b64) {
+    const bin = atob(b64);
+    const bytes = new Uint8Array(bin.length);
+    for (let i = 0; i < bin.length; ++i) bytes[i] = bin.charCodeAt(i);
+    return bytes.buffer;
+  }
+
+  function decode(raw) {
+    const h = raw.hemi;
+    // 16-bit codes of log10 f (docs/explorer.md, "Data"): 0 is zero, 65535 not supported.
+    const logDecode = (b64, lo, hi) => {
+      const codes = new Uint16Array(bytesOf(b64));
+      const out = new Float32Array(codes.length);
+      const step = (hi - lo) / 65533;
+      for (let k = 0; k < codes.length; ++k) {
+        const q = codes[k];
+        out[k] = q === 0 ? 0 : q === 65535 ? NaN : Math.pow(10, lo + (q - 1) * step);
+      }
+      return out;
+    };
+    const hemi = logDecode(h.codes, h.lo, h.hi);
+    const hemiSe = h.se_codes ? logDecode(h.se_codes, h.se_lo, h.se_hi) : null;
+    return {
+      raw,
+      sources: raw.sources,
+      sides: raw.sides,
+      slice: new Float32Array(bytesOf(raw.slice)),
+      sliceSe: raw.slice_se ? new Float32Array(bytesOf(raw.slice_se)) : null,
+      hemi,
+      hemiSe,
+      hemiShape: h,
+    };
+  }
+
+  function loadConfig(id) {
+    if (decoded.has(id)) return Promise.resolve(decoded.get(id));
+    return new Promise((resolve, reject) => {
+      const done = () => {
+        const raw = window.LAMINA_DATA && window.LAMINA_DATA[id];
+        if (!raw) { reject(new Error("explorer/data/" + id + ".js did not define the configuration")); return; }
+        const d = decode(raw);
+        decoded.set(id, d);
+        resolve(d);
+      };
+      if (window.LAMINA_DATA && window.LAMINA_DATA[id]) { done(); return; }
+      const s = document.createElement("script");
+      s.src = "explorer/data/" + encodeURIComponent(id) + ".js";
+      s.onload = done;
+      s.onerror = () => reject(new Error("cannot load explorer/data/" + id + ".js"));
+      document.head.appendChild(s);
+    });
+  }
+
+  const nTheta = () => STUDY.grid.n_theta;
+
+  // f on the incident plane: x from −90° (light's side) to +90° (mirror / straight through).
+  function slicePlane(d, source, inc, side, channel) {
+    const T = nTheta(), I = THETA_I.length, D = d.sides.length;
+    const s = d.sources.indexOf(source), sd = d.sides.indexOf(side);
+    const out = new Array(2 * T);
+    const base = ((s * I + inc) * D + sd) * 2 * T;
+    for (let x = 0; x < 2 * T; ++x) out[x] = d.slice[(base + x) * 3 + channel];
+    return out;
+  }
+
+  function sliceSe(d, inc, side, channel) {
+    if (!d.sliceSe) return null;
+    const T = nTheta(), D = d.sides.length, sd = d.sides.indexOf(side);
+    const base = (inc * D + sd) * 2 * T;
+    const out = new Array(2 * T);
+    for (let x = 0; x < 2 * T; ++x) out[x] = d.sliceSe[(base + x) * 3 + channel];
+    return out;
+  }
+
+  function sliceAngles() {
+    const T = nTheta(), xs = new Array(2 * T);
+    for (let x = 0; x < 2 * T; ++x) {
+      const t = x < T ? T - 1 - x : x - T;
+      const c = (t + 0.5) * 90 / T;
+      xs[x] = x < T ? -c : c;
+    }
+    return xs;
+  }
+
+  function isSupported(cfg, model, side) {
+    const s = cfg.supported && cfg.supported[model];
+    if (!cfg.sources.includes(model)) return false;
+    if (!s) return true;
+    return s[side] !== false;
+  }
+
+  function unsupportedReason(cfg, model) {
+    const s = cfg.supported && cfg.supported[model];
+    if (!cfg.sources.includes(model)) return "not in this study";
+    return (s && s.reason) ? s.reason : "";
+  }
+
+  // "m (reason)", or the reason alone when it already names the model.
+  const unsupportedText = (cfg, m) => {
+    const r = unsupportedReason(cfg, m);
+    return !r ? m : r.startsWith(m) ? r : m + " (" + r + ")";
+  };
+
+  const selectedChannels = () => [0, 1, 2].filter((c) => state.channels[c]);
+
+  // ---- Widgets ----------------------------------------------------------------------------------
+
+  function setOptions(select, items, value) {
+    select.innerHTML = "";
+    for (const [v, label] of items) {
+      const o = document.createElement("option");
+      o.value = v;
+      o.textContent = label;
+      select.appendChild(o);
+    }
+    select.value = value;
+  }
+
+  function numericSort(values) {
+    const num = values.every((v) => v !== "" && !isNaN(Number(v)));
+    return values.sort((a, b) => num ? Number(a) - Number(b) : a.localeCompare(b));
+  }
+
+  // The configuration with parameter `key` = `value` that keeps most of the others (earlier
+  // widgets weigh more), within the current category.
+  function bestMatch(key, value) {
+    const cur = byId.get(state.config);
+    let best = null, bestScore = -1;
+    for (const c of configs) {
+      if (c.category !== cur.category || c.parameters[key] !== value) continue;
+      let score = 0;
+      PARAMS.forEach(([k], n) => {
+        if (k !== key && c.parameters[k] === cur.parameters[k]) score += 1 << (PARAMS.length - n);
+      });
+      if (score > bestScore) { best = c; bestScore = score; }
+    }
+    return best;
+  }
+
+  function buildConfigWidgets() {
+    const cur = byId.get(state.config);
+    setOptions($("w-category"), categories.map((c) => [c, c + " (" + configs.filter((x) => x.category === c).length + ")"]), cur.category);
+    const inCategory = configs.filter((c) => c.category === cur.category);
+    const box = $("param-widgets");
+    box.innerHTML = "";
+    for (const [key, label] of PARAMS) {
+      const values = numericSort(Array.from(new Set(inCategory.map((c) => c.parameters[key]).filter((v) => v !== undefined))));
+      if (!values.length) continue;
+      const l = document.createElement("label");
+      l.textContent = label + " ";
+      const sel = document.createElement("select");
+      sel.id = "w-param-" + key;
+      sel.dataset.param = key;
+      // Values that need other widgets to change are marked with an arrow.
+      setOptions(sel, values.map((v) => {
+        const exact = inCategory.some((c) => c.parameters[key] === v &&
+          PARAMS.every(([k]) => k === key || c.parameters[k] === cur.parameters[k]));
+        return [v, exact ? v : v + "  →"];
+      }), cur.parameters[key] !== undefined ? cur.parameters[key] : values[0]);
+      sel.disabled = values.length < 2;
+      sel.addEventListener("change", () => {
+        const c = bestMatch(key, sel.value);
+        if (c) selectConfig(c.id);
+      });
+      l.appendChild(sel);
+      box.appendChild(l);
+    }
+    setOptions($("w-config"), inCategory.map((c) => [c.id, c.id]), cur.id);
+    $("config-desc").textContent = cur.sides.includes("T") ? "BRDF and BTDF (a slab)" : "BRDF (opaque base)";
+    // The hemisphere widget: BTDF only where the configuration transmits.
+    $("w-side-T").disabled = !cur.sides.includes("T");
+    if (!cur.sides.includes(state.side)) state.side = "R";
+    $("w-side-" + state.side).checked = true;
+    buildModelWidgets();
+  }
+
+  function buildModelWidgets() {
+    const cur = byId.get(state.config);
+    const box = $("w-models");
+    box.innerHTML = "";
+    for (const m of models) {
+      const ok = isSupported(cur, m, state.side);
+      const l = document.createElement("label");
+      l.className = "model-row" + (ok ? "" : " ns");
+      const cb = document.createElement("input");
+      cb.type = "checkbox";
+      cb.id = "w-model-" + m;
+      cb.checked = state.shown.has(m);
+      cb.addEventListener("change", () => {
+        if (cb.checked) state.shown.add(m); else state.shown.delete(m);
+        render();
+      });
+      const sw = document.createElement("span");
+      sw.className = "swatch";
+      sw.style.background = modelDash(m) === "dash"
+        ? "repeating-linear-gradient(90deg, " + modelColor(m) + " 0 6px, transparent 6px 9px)" : modelColor(m);
+      l.append(cb, sw, document.createTextNode(m));
+      if (!ok) {
+        const t = document.createElement("span");
+        t.className = "ns-tag";
+        t.textContent = "not supported";
+        l.appendChild(t);
+      }
+      box.appendChild(l);
+    }
+    // The iso-value view follows to a model that supports this configuration when its own does not.
+    if (!isSupported(cur, state.isoModel, state.side)) {
+      const ok = models.find((m) => isSupported(cur, m, state.side));
+      if (ok) state.isoModel = ok;
+    }
+    setOptions($("w-iso-model"), models.map((m) => [m, m + (isSupported(cur, m, state.side) ? "" : " (not supported)")]), state.isoModel);
+  }
+
+  function buildStaticWidgets() {
+    $("study-name").textContent = "— " + (STUDY.name || "");
+    const parts = [configs.length + " configurations", models.length + " models"];
+    if (STUDY.preset) parts.push("preset " + STUDY.preset);
+    if (STUDY.particles) parts.push(Number(STUDY.particles).toExponential(1).replace("e+", "·10^") + " particles per incidence");
+    parts.push("grid " + STUDY.grid.n_theta + "×" + STUDY.grid.n_phi);
+    if (STUDY.lamina_version) parts.push("lamina " + STUDY.lamina_version);
+    $("study-info").textContent = parts.join(" · ");
+    setOptions($("w-incidence"), THETA_I.map((t, i) => [i, t + "°"]), state.incidence);
+    setOptions($("w-lb-incidence"), [["all", "all θi"]].concat(THETA_I.map((t, i) => [i, "θi = " + t + "°"])), "all");
+
+    $("w-category").addEventListener("change", () => {
+      const first = configs.find((c) => c.category === $("w-category").value);
+      if (first) selectConfig(first.id);
+    });
+    $("w-config").addEventListener("change", () => selectConfig($("w-config").value));
+    $("w-incidence").addEventListener("change", () => { state.incidence = Number($("w-incidence").value); render(); });
+    CHANNELS.forEach((c, k) => $("w-ch-" + c.toLowerCase()).addEventListener("change", (e) => {
+      state.channels[k] = e.target.checked;
+      if (!selectedChannels().length) { state.channels[k] = true; e.target.checked = true; }
+      render();
+    }));
+    for (const side of ["R", "T"]) $("w-side-" + side).addEventListener("change", () => {
+      state.side = side; buildModelWidgets(); render();
+    });
+    $("w-log").addEventListener("change", () => { state.log = $("w-log").checked; render(); });
+    $("w-iso-model").addEventListener("change", () => { state.isoModel = $("w-iso-model").value; render(); });
+    $("w-iso-channel").addEventListener("change", () => { state.isoChannel = Number($("w-iso-channel").value); render(); });
+    $("w-levels").addEventListener("change", () => { state.levels = $("w-levels").value; render(); });
+    $("w-diff").addEventListener("change", () => { state.diffMode = $("w-diff").value; render(); });
+    $("w-lb-metric").addEventListener("change", () => { state.lbMetric = $("w-lb-metric").value; render(); });
+    $("w-lb-incidence").addEventListener("change", () => { state.lbIncidence = $("w-lb-incidence").value; render(); });
+    $("w-lb-agg").addEventListener("change", () => { state.lbAgg = $("w-lb-agg").value; render(); });
+  }
+
+  function selectConfig(id) {
+    if (!byId.has(id)) return;
+    state.config = id;
+    buildConfigWidgets();
+    writeHash();
+    render();
+  }
+
+  // The state in the address (#config=…&ti=…&side=…): a view can be shared as a link.
+  function writeHash() {
+    const h = "config=" + encodeURIComponent(state.config) + "&ti=" + THETA_I[state.incidence] + "&side=" + state.side;
+    if (location.hash.slice(1) !== h) history.replaceState(null, "", "#" + h);
+  }
+
+  function readHash() {
+    const p = new URLSearchParams(location.hash.slice(1));
+    if (p.get("config") && byId.has(p.get("config"))) state.config = p.get("config");
+    const ti = THETA_I.indexOf(Number(p.get("ti")));
+    if (p.get("ti") !== null && ti >= 0) state.incidence = ti;
+    if (p.get("side") === "T" && byId.get(state.config).sides.includes("T")) state.side = "T";
+  }
+
+  // ---- Layout helpers ---------------------------------------------------------------------------
+
+  // n side-by-side subplots, one per channel: axis names and a layout skeleton.
+  function channelGrid(channels, xTitle, yTitle, height) {
+    const n = channels.length, gap = 0.045;
+    const layout = {
+      height, margin: { l: 62, r: 12, t: 30, b: 48 }, hovermode: "closest",
+      legend: { orientation: "h", y: -0.2, x: 0 }, annotations: [], plot_bgcolor: "#fff",
+    };
+    channels.forEach((c, k) => {
+      const sx = k === 0 ? "" : String(k + 1);
+      const x0 = k / n + (k ? gap / 2 : 0), x1 = (k + 1) / n - (k < n - 1 ? gap / 2 : 0);
+      layout["xaxis" + sx] = { domain: [x0, x1], anchor: "y" + sx, title: { text: xTitle }, zeroline: false, gridcolor: "#e8e8e8" };
+      layout["yaxis" + sx] = {
+        anchor: "x" + sx, title: { text: k === 0 ? yTitle : "" }, type: state.log ? "log" : "linear",
+        gridcolor: "#e8e8e8", exponentformat: "power",
+      };
+      layout.annotations.push({
+        text: "<b>" + CHANNELS[c] + " channel</b>", xref: "paper", yref: "paper", x: (x0 + x1) / 2, y: 1.0,
+        xanchor: "center", yanchor: "bottom", showarrow: false, font: { color: CHANNEL_COLORS[c] },
+      });
+    });
+    return layout;
+  }
+  const axisSuffix = (k) => (k === 0 ? "" : String(k + 1));
+
+  // Ticks of a log axis over [lo, hi] (log10): decades, or 1-2-5 when the span is short, written
+  // as plain numbers (0.02, 5, 300) or 1e-5 beyond.
+  function logTicks(lo, hi) {
+    const vals = [];
+    const mantissas = hi - lo > 2.5 ? [1] : hi - lo > 1.2 ? [1, 3] : [1, 2, 5];
+    for (let e = Math.floor(lo); e <= Math.ceil(hi); ++e)
+      for (const m of mantissas) {
+        const v = m * Math.pow(10, e);
+        if (Math.log10(v) >= lo && Math.log10(v) <= hi) vals.push(v);
+      }
+    const text = vals.map((v) => (v >= 1e-3 && v < 1e5) ? String(Number(v.toPrecision(1))) : v.toExponential(0).replace("e+", "e"));
+    return { tickmode: "array", tickvals: vals, ticktext: text };
+  }
+
+  // ---- View 1: the incident-plane slice ------------------------------------------------------------
+
+  function drawSlice(d, cfg) {
+    const chans = selectedChannels();
+    const xs = sliceAngles();
+    const inc = state.incidence, side = state.side;
+    const traces = [];
+    // On a log scale, at most six decades below the highest value drawn (zeros have no place).
+    let fmax = 0;
+    for (const c of chans) for (const s of ["reference"].concat(models.filter((m) => state.shown.has(m) && isSupported(cfg, m, side))))
+      for (const v of slicePlane(d, s, inc, side, c)) if (v > fmax) fmax = v;
+    const logTop = Math.log10(fmax || 1) + 0.25, logBottom = logTop - 6.25;
+    const floor = Math.pow(10, logBottom);
+    chans.forEach((c, k) => {
+      const ax = { xaxis: "x" + axisSuffix(k), yaxis: "y" + axisSuffix(k) };
+      const ref = slicePlane(d, "reference", inc, side, c);
+      const se = sliceSe(d, inc, side, c);
+      if (se) {
+        const lo = ref.map((f, x) => {
+          const v = f - 2 * se[x];
+          return state.log ? Math.max(v, floor) : v;
+        });
+        const hi = ref.map((f, x) => f + 2 * se[x]);
+        traces.push(Object.assign({ x: xs, y: lo, type: "scatter", mode: "lines", line: { width: 0 },
+          hoverinfo: "skip", showlegend: false, legendgroup: "reference", name: "reference −2·se" }, ax));
+        traces.push(Object.assign({ x: xs, y: hi, type: "scatter", mode: "lines", line: { width: 0 },
+          fill: "tonexty", fillcolor: "rgba(0,0,0,0.18)", hoverinfo: "skip", legendgroup: "reference",
+          name: "reference ±2·se", showlegend: k === 0 }, ax));
+      }
+      traces.push(Object.assign({ x: xs, y: ref, type: "scatter", mode: "lines", name: "reference",
+        legendgroup: "reference", showlegend: k === 0, line: { color: modelColor("reference"), width: 2 },
+        hovertemplate: "reference<br>θo %{x:.1f}°<br>f %{y:.4g} 1/sr<extra></extra>" }, ax));
+      for (const m of models) {
+        if (!state.shown.has(m) || !isSupported(cfg, m, side)) continue;
+        traces.push(Object.assign({ x: xs, y: slicePlane(d, m, inc, side, c), type: "scatter", mode: "lines",
+          name: m, legendgroup: m, showlegend: k === 0, line: { color: modelColor(m), width: 1.6, dash: modelDash(m) },
+          hovertemplate: m + "<br>θo %{x:.1f}°<br>f %{y:.4g} 1/sr<extra></extra>" }, ax));
+      }
+    });
+    const layout = channelGrid(chans, "θo (°)", (side === "R" ? "BRDF" : "BTDF") + " f (1/sr)", 420);
+    chans.forEach((c, k) => {
+      Object.assign(layout["xaxis" + axisSuffix(k)], { range: [-90, 90], tickvals: [-90, -60, -30, 0, 30, 60, 90] });
+      if (state.log) {
+        // Let the data decide within the six decades; label decades only when the span is wide.
+        const ya = layout["yaxis" + axisSuffix(k)];
+        let lo = Infinity;
+        for (const t of traces) if (t.yaxis === "y" + axisSuffix(k) && t.hoverinfo !== "skip")
+          for (const v of t.y) if (v > 0 && v < lo) lo = v;
+        const bottom = Math.max(logBottom, Math.log10(lo) - 0.15);
+        ya.range = [bottom, logTop];
+        Object.assign(ya, logTicks(bottom, logTop));
+      }
+    });
+    // The light's direction (−θi) and the mirror or straight-through direction (+θi), dotted.
+    layout.shapes = [];
+    chans.forEach((c, k) => {
+      for (const x of [-THETA_I[inc], THETA_I[inc]])
+        layout.shapes.push({ type: "line", xref: "x" + axisSuffix(k), yref: "y" + axisSuffix(k) + " domain", x0: x, x1: x, y0: 0, y1: 1,
+          line: { color: x < 0 ? "#c9a227" : "#999", width: 1, dash: "dot" } });
+    });
+    layout.title = { text: cfg.id + " · θi = " + THETA_I[inc] + "° · " + (side === "R" ? "reflection" : "transmission") +
+      " · dotted: the light's direction (−θi) and the " + (side === "R" ? "mirror" : "straight-through") + " direction",
+      font: { size: 13 }, x: 0.01, y: 0.985 };
+    layout.margin.t = 46;
+    for (const a of layout.annotations) a.y = 1.0;
+    Plotly.react($("slice"), traces, layout, PLOT_CONFIG);
+
+    const missing = models.filter((m) => !isSupported(cfg, m, side))
+      .map((m) => unsupportedText(cfg, m));
+    $("unsupported").textContent = missing.length
+      ? "Not supported for this configuration's " + (side === "R" ? "BRDF" : "BTDF") + ": " + missing.join("; ")
+      : "";
+  }
+
+  // ---- View 2: iso-values on the projected disk -----------------------------------------------------
+
+  const ISO_N = 101;
+  let isoLookupCache = null;
+
+  // For each pixel of the projected disk (x = −sinθ cosφ so that the light is on the left), the
+  // index of its (θ, φ) bin in the merged hemisphere table, or −1 outside the disk.
+  function isoLookup(h) {
+    const key = h.theta_edges.join() + "|" + h.phi_edges.join();
+    if (isoLookupCache && isoLookupCache.key === key) return isoLookupCache;
+    const axis = Array.from({ length: ISO_N }, (_, i) => -1 + 2 * i / (ISO_N - 1));
+    const idx = new Int32Array(ISO_N * ISO_N);
+    const find = (edges, v) => {
+      let k = 0;
+      while (k < edges.length - 2 && v >= edges[k + 1]) ++k;
+      return k;
+    };
+    for (let j = 0; j < ISO_N; ++j)
+      for (let i = 0; i < ISO_N; ++i) {
+        const x = axis[i], y = axis[j], r = Math.hypot(x, y);
+        if (r > 1) { idx[j * ISO_N + i] = -1; continue; }
+        const theta = Math.asin(Math.min(1, r)) * 180 / Math.PI;
+        const phi = Math.atan2(Math.abs(y), -x) * 180 / Math.PI;
+        idx[j * ISO_N + i] = find(h.theta_edges, theta) * h.n_phi + find(h.phi_edges, phi);
+      }
+    isoLookupCache = { key, idx, axis };
+    return isoLookupCache;
+  }
+
+  // `source` "se" is the reference's standard error.
+  function hemiMap(d, source, inc, side, channel) {
+    const h = d.hemiShape, L = isoLookup(h);
+    const I = THETA_I.length, D = d.sides.length;
+    const isSe = source === "se";
+    const s = isSe ? 0 : d.sources.indexOf(source), sd = d.sides.indexOf(side);
+    const base = isSe ? (inc * D + sd) * h.n_theta * h.n_phi : ((s * I + inc) * D + sd) * h.n_theta * h.n_phi;
+    const table = isSe ? d.hemiSe : d.hemi;
+    const z = [];
+    for (let j = 0; j < ISO_N; ++j) {
+      const row = new Array(ISO_N);
+      for (let i = 0; i < ISO_N; ++i) {
+        const k = L.idx[j * ISO_N + i];
+        row[i] = k < 0 ? null : table[(base + k) * 3 + channel];
+      }
+      z.push(row);
+    }
+    return z;
+  }
+
+  function parseLevels(text) {
+    return text.split(/[,\s]+/).map(Number).filter((v) => isFinite(v) && (!state.log || v > 0));
+  }
+
+  // Automatic levels are evenly spaced in what is shown (half decades on a log scale, eighths of
+  // the maximum on a linear one), so one Plotly contour trace draws them all; chosen levels get a
+  // line trace each.
+  function autoLevels(dmin, dmax) {
+    if (!(dmax > dmin)) return null;
+    if (state.log) return { start: Math.ceil(dmin * 2) / 2, end: dmax, size: 0.5 };
+    const size = dmax / 8;
+    return { start: size, end: dmax - size / 2, size };
+  }
+
+  function levelValues(auto) {
+    const out = [];
+    for (let v = auto.start; v <= auto.end + 1e-9; v += auto.size) out.push(state.log ? Math.pow(10, v) : v);
+    return out;
+  }
+
+  function isoTraces(z, levels, auto, zmin, zmax, title, showScale) {
+    const L = isoLookupCache;
+    const toDisplay = (v) => (v === null || !isFinite(v)) ? null : state.log ? (v > 0 ? Math.log10(v) : null) : v;
+    const zd = z.map((row) => row.map(toDisplay));
+    const common = {
+      x: L.axis, y: L.axis, z: zd, zmin, zmax, colorscale: "Viridis", showscale: showScale,
+      hovertemplate: title + "<br>f %{customdata:.4g} 1/sr<extra></extra>", customdata: z,
+      colorbar: { title: { text: state.log ? "log10 f" : "f (1/sr)", side: "right" }, thickness: 12, len: 0.9 },
+    };
+    if (auto) {
+      return [Object.assign(common, {
+        type: "contour", autocontour: false,
+        contours: { start: auto.start, end: auto.end, size: auto.size, coloring: "heatmap", showlines: true,
+          showlabels: !state.log, labelfont: { size: 9, color: "#fff" } },
+        line: { color: "rgba(255,255,255,0.85)", width: 1 },
+      })];
+    }
+    const traces = [Object.assign(common, { type: "heatmap" })];
+    for (const level of levels) {
+      const lv = state.log ? Math.log10(level) : level;
+      traces.push({
+        type: "contour", x: L.axis, y: L.axis, z: zd, showscale: false, hoverinfo: "skip",
+        autocontour: false, showlegend: false,
+        contours: { start: lv, end: lv, size: 1, coloring: "none", showlabels: !state.log,
+          labelfont: { size: 9, color: "#fff" } },
+        line: { color: "rgba(255,255,255,0.9)", width: 1 }, name: "f = " + fmt(level),
+      });
+    }
+    return traces;
+  }
+
+  function diskLayout(title) {
+    return {
+      height: 340, margin: { l: 8, r: 8, t: 34, b: 8 }, title: { text: title, font: { size: 12 } },
+      xaxis: { visible: false, range: [-1.04, 1.04], constrain: "domain" },
+      yaxis: { visible: false, range: [-1.04, 1.04], scaleanchor: "x" },
+      shapes: [{ type: "circle", x0: -1, x1: 1, y0: -1, y1: 1, line: { color: "#888", width: 1 } },
+        { type: "line", x0: -1, x1: 1, y0: 0, y1: 0, line: { color: "#bbb", width: 0.7, dash: "dot" } }],
+      annotations: [{ x: -0.98, y: -0.98, text: "light", showarrow: false, font: { size: 10, color: "#777" }, xanchor: "left" }],
+      plot_bgcolor: "#fff", showlegend: false,
+    };
+  }
+
+  function drawIso(d, cfg) {
+    const inc = state.incidence, side = state.side, c = state.isoChannel, m = state.isoModel;
+    const ref = hemiMap(d, "reference", inc, side, c);
+    const supported = isSupported(cfg, m, side);
+    const mod = supported ? hemiMap(d, m, inc, side, c) : null;
+    let zmax = 0;
+    for (const z of [ref, mod]) if (z) for (const row of z) for (const v of row) if (v > zmax) zmax = v;
+    const dmax = state.log ? Math.log10(zmax || 1) : zmax;
+    const dmin = state.log ? dmax - 4 : 0;
+    const auto = state.levels.trim() ? null : autoLevels(dmin, dmax);
+    const levels = auto ? levelValues(auto) : parseLevels(state.levels);
+    const ch = CHANNELS[c];
+    const refLayout = diskLayout("reference · " + ch + " · θi = " + THETA_I[inc] + "°");
+    $("iso-levels").textContent = "White contour lines at f = " + levels.map(fmt).join(", ") + " 1/sr" +
+      (auto && state.log ? " (every half decade)" : "") + "; reference and model share one colour scale" +
+      (state.log ? " (log10 f, four decades)" : "") +
+      ". Difference: red where the model puts too much energy, blue too little" +
+      (state.diffMode === "sigma" ? "; in units of the reference's standard error, |Δf / se| < 2 is within its noise." : ".");
+    Plotly.react($("iso-ref"), isoTraces(ref, levels, auto, dmin, dmax, "reference", false), refLayout, PLOT_CONFIG);
+    if (mod) {
+      Plotly.react($("iso-model"), isoTraces(mod, levels, auto, dmin, dmax, m, true), diskLayout(m + " · " + ch), PLOT_CONFIG);
+      // Δf in 1/sr, or in units of the reference's standard error (|z| < 2: within the noise).
+      const sigma = state.diffMode === "sigma" && d.hemiSe ? hemiMap(d, "se", inc, side, c) : null;
+      const diff = mod.map((row, j) => row.map((v, i) => {
+        if (v === null || ref[j][i] === null) return null;
+        if (!sigma) return v - ref[j][i];
+        const e = sigma[j][i];
+        return e > 0 ? (v - ref[j][i]) / e : null;
+      }));
+      let amax = 0;
+      for (const row of diff) for (const v of row) if (v !== null && isFinite(v)) amax = Math.max(amax, Math.abs(v));
+      amax = sigma ? Math.min(Math.max(amax, 4), 20) : amax || 1;
+      Plotly.react($("iso-diff"), [{
+        type: "contour", x: isoLookupCache.axis, y: isoLookupCache.axis, z: diff, zmin: -amax, zmax: amax, zmid: 0,
+        colorscale: "RdBu", ncontours: sigma ? undefined : 10, autocontour: !sigma,
+        contours: sigma ? { start: -amax, end: amax, size: Math.max(2, Math.round(amax / 5)), coloring: "heatmap", showlines: true }
+          : { coloring: "heatmap", showlines: true },
+        line: { color: "rgba(40,40,40,0.5)", width: 0.6 },
+        colorbar: { title: { text: sigma ? "Δf / se" : "Δf (1/sr)", side: "right" }, thickness: 12, len: 0.9 },
+        hovertemplate: sigma ? "(model − reference) / se<br>%{z:.2f}<extra></extra>" : "model − reference<br>Δf %{z:.3g} 1/sr<extra></extra>",
+      }], diskLayout(m + " − reference" + (sigma ? ", in se" : "")), PLOT_CONFIG);
+    } else {
+      const layout = diskLayout(m + " · " + ch);
+      layout.annotations.push({ x: 0, y: 0, text: "<b>not supported</b><br>" + (unsupportedReason(cfg, m) || ""),
+        showarrow: false, font: { size: 14, color: "#8a1c1c" } });
+      Plotly.react($("iso-model"), [], layout, PLOT_CONFIG);
+      const dl = diskLayout(m + " − reference");
+      dl.annotations.push({ x: 0, y: 0, text: "<b>not supported</b>", showarrow: false, font: { size: 14, color: "#8a1c1c" } });
+      Plotly.react($("iso-diff"), [], dl, PLOT_CONFIG);
+    }
+  }
+
+  // ---- View 3: directional albedo against θi -------------------------------------------------------
+
+  function drawAlbedo(cfg) {
+    const chans = selectedChannels(), side = state.side;
+    const traces = [];
+    chans.forEach((c, k) => {
+      const ax = { xaxis: "x" + axisSuffix(k), yaxis: "y" + axisSuffix(k) };
+      const ref = cfg.albedo.reference[side].map((v) => (v ? v[c] : null));
+      const se = cfg.albedo_se && cfg.albedo_se[side] ? cfg.albedo_se[side].map((v) => 2 * v[c]) : null;
+      traces.push(Object.assign({ x: THETA_I, y: ref, type: "scatter", mode: "lines+markers", name: "reference (±2·se)",
+        legendgroup: "reference", showlegend: k === 0, line: { color: "#000", width: 2 },
+        error_y: se ? { type: "data", array: se, visible: true, color: "#555" } : undefined,
+        hovertemplate: "reference<br>θi %{x}°<br>albedo %{y:.4f}<extra></extra>" }, ax));
+      for (const m of models) {
+        if (!state.shown.has(m) || !isSupported(cfg, m, side) || !cfg.albedo[m]) continue;
+        traces.push(Object.assign({ x: THETA_I, y: cfg.albedo[m][side].map((v) => (v ? v[c] : null)),
+          type: "scatter", mode: "lines+markers", name: m, legendgroup: m, showlegend: k === 0,
+          line: { color: modelColor(m), width: 1.5, dash: modelDash(m) }, marker: { size: 5 },
+          hovertemplate: m + "<br>θi %{x}°<br>albedo %{y:.4f}<extra></extra>" }, ax));
+      }
+    });
+    const layout = channelGrid(chans, "θi (°)", (side === "R" ? "reflected" : "transmitted") + " albedo", 330);
+    chans.forEach((c, k) => {
+      layout["yaxis" + axisSuffix(k)].type = "linear";
+      Object.assign(layout["xaxis" + axisSuffix(k)], { range: [-3, 90], tickvals: THETA_I });
+    });
+    Plotly.react($("albedo"), traces, layout, PLOT_CONFIG);
+  }
+
+  // ---- View 4: the leaderboard -----------------------------------------------------------------------
+
+  function aggregate(values) {
+    const v = values.filter((x) => x !== null && x !== undefined && isFinite(x));
+    if (!v.length) return null;
+    return state.lbAgg === "max" ? Math.max(...v) : v.reduce((a, b) => a + b, 0) / v.length;
+  }
+
+  function cellValues(cell, key) {
+    if (!cell || !cell[key]) return [];
+    const incs = state.lbIncidence === "all" ? THETA_I.map((_, i) => i) : [Number(state.lbIncidence)];
+    const out = [];
+    for (const i of incs) for (const c of selectedChannels()) {
+      const v = cell[key][i] ? cell[key][i][c] : null;
+      out.push(v === null ? null : key === "ae" ? Math.abs(v) : v);
+    }
+    return out;
+  }
+
+  function drawLeaderboard() {
+    const side = state.side, metric = state.lbMetric;
+    const cols = ["noise floor"].concat(models);
+    const shownConfigs = configs.filter((c) => c.sides.includes(side));
+    const rows = shownConfigs.map((c) => c.id);
+    const z = [], text = [], hover = [], raw = [];
+    for (const cfg of shownConfigs) {
+      const mm = (INDEX.metrics || {})[cfg.id] || {};
+      const zr = [], tr = [], hr = [], rr = [];
+      // The noise floor: what a perfect model would score against this reference (misplaced energy).
+      let nf = null;
+      for (const m of models) if (mm[m] && mm[m][side]) { nf = aggregate(cellValues(mm[m][side], "nf")); if (nf !== null) break; }
+      const nfShown = metric === "me" ? nf : null;
+      zr.push(nfShown !== null && nfShown > 0 ? Math.log10(nfShown) : null);
+      rr.push(nfShown);
+      tr.push(metric === "me" ? fmt(nf) : "");
+      hr.push(cfg.id + "<br>noise floor " + fmt(nf));
+      for (const m of models) {
+        const has = cfg.sides.includes(side);
+        const ok = has && isSupported(cfg, m, side);
+        const v = ok && mm[m] ? aggregate(cellValues(mm[m][side], metric)) : null;
+        zr.push(v !== null && v > 0 ? Math.log10(v) : null);
+        rr.push(v);
+        const below = metric === "me" && v !== null && nf !== null && v <= 2 * nf;
+        tr.push(!has ? "" : !ok ? "n/s" : fmt(v) + (below ? "≈" : ""));
+        hr.push(cfg.id + " · " + m + "<br>" + (!has ? "no " + (side === "R" ? "BRDF" : "BTDF")
+          : !ok ? "not supported" + (unsupportedReason(cfg, m) ? ": " + unsupportedReason(cfg, m) : "")
+          : $("w-lb-metric").selectedOptions[0].textContent + " " + fmt(v) + (below ? " (within 2× the noise floor)" : "")));
+      }
+      z.push(zr); text.push(tr); hover.push(hr); raw.push(rr);
+    }
+    // A last row: each model's mean over the configurations it supports (never counting n/s as 0),
+    // the ranking of the models at a glance.
+    if (rows.length > 1) {
+      const MEAN = "mean of supported";
+      const zr = [], tr = [], hr = [];
+      cols.forEach((col, j) => {
+        const vals = raw.map((r) => r[j]).filter((v) => v !== null && isFinite(v));
+        const m = vals.length ? vals.reduce((a, b) => a + b, 0) / vals.length : null;
+        zr.push(m !== null && m > 0 ? Math.log10(m) : null);
+        tr.push(m === null ? "" : "<b>" + fmt(m) + "</b>");
+        hr.push(col + "<br>mean over the " + vals.length + " configurations with a value");
+      });
+      rows.push(MEAN); z.push(zr); text.push(tr); hover.push(hr);
+    }
+    const all = z.flat().filter((v) => v !== null);
+    const zmin = all.length ? Math.min(...all) : -3, zmax = all.length ? Math.max(...all) : 0;
+    const ticks = [];
+    for (let e = Math.floor(zmin); e <= Math.ceil(zmax); ++e) ticks.push(e);
+    const cur = rows.indexOf(state.config);
+    const trace = {
+      type: "heatmap", x: cols, y: rows, z, text, customdata: hover, zmin, zmax,
+      texttemplate: "%{text}", textfont: { size: 10 }, colorscale: "YlOrRd", reversescale: true, xgap: 1, ygap: 1,
+      hovertemplate: "%{customdata}<extra></extra>",
+      colorbar: { title: { text: "log scale" }, tickvals: ticks, ticktext: ticks.map((e) => fmt(Math.pow(10, e))), thickness: 12 },
+    };
+    const layout = {
+      height: 110 + 19 * rows.length, margin: { l: 200, r: 20, t: 70, b: 10 },
+      // Explicit categories and ranges: the grid stays drawn even where every cell is empty.
+      xaxis: { side: "top", tickangle: 0, fixedrange: true, type: "category", categoryorder: "array",
+        categoryarray: cols, range: [-0.5, cols.length - 0.5] },
+      yaxis: { fixedrange: true, tickfont: { size: 11 }, type: "category", categoryorder: "array",
+        categoryarray: rows, range: [rows.length - 0.5, -0.5] },
+      plot_bgcolor: "#e9ebef",
+      shapes: (cur < 0 ? [] : [{ type: "rect", xref: "paper", x0: 0, x1: 1, yref: "y", y0: cur - 0.5, y1: cur + 0.5,
+        line: { color: "#2458a6", width: 2 } }]).concat(
+        // the noise floor apart from the models, the mean row apart from the configurations
+        [{ type: "line", xref: "x", x0: 0.5, x1: 0.5, yref: "paper", y0: 0, y1: 1, line: { color: "#333", width: 1.5 } }],
+        rows.length > shownConfigs.length ? [{ type: "line", xref: "paper", x0: 0, x1: 1, yref: "y",
+          y0: shownConfigs.length - 0.5, y1: shownConfigs.length - 0.5, line: { color: "#333", width: 1.5 } }] : []),
+      annotations: [{ xref: "paper", yref: "paper", x: 0, y: 1, yanchor: "bottom", yshift: 34, showarrow: false, align: "left",
+        text: (side === "R" ? "BRDF" : "BTDF") + " · " + (state.lbAgg === "max" ? "worst" : "mean") + " over " +
+          (state.lbIncidence === "all" ? "all incidences" : "θi = " + THETA_I[Number(state.lbIncidence)] + "°") +
+          " and the selected channels · ≈: within 2× the noise floor · n/s: not supported", font: { size: 11, color: "#555" } }],
+    };
+    if (!all.length) {
+      // Plotly draws no text on a heat map without values: a text trace says what each cell is.
+      trace.showscale = false;
+      layout.annotations.push({ xref: "paper", yref: "paper", x: 0.5, y: -0.02, yanchor: "top", showarrow: false,
+        text: "no model has this metric for the " + (side === "R" ? "BRDF" : "BTDF") + " of these configurations",
+        font: { size: 12, color: "#8a1c1c" } });
+      layout.margin.b = 30;
+    }
+    const cellText = {
+      type: "scatter", mode: "text", hoverinfo: "skip", showlegend: false, textfont: { size: 10, color: "#555" },
+      x: [], y: [], text: [],
+    };
+    if (!all.length) rows.forEach((r, i) => cols.forEach((c, j) => { cellText.x.push(c); cellText.y.push(r); cellText.text.push(text[i][j]); }));
+    const gd = $("leaderboard");
+    Plotly.react(gd, all.length ? [trace] : [trace, cellText], layout, PLOT_CONFIG);
+    if (!gd.dataset.clickBound) {
+      gd.on("plotly_click", (ev) => {
+        const p = ev.points && ev.points[0];
+        if (p && byId.has(p.y)) {
+          const col = p.x;
+          if (models.includes(col)) { state.isoModel = col; state.shown.add(col); }
+          selectConfig(p.y);
+          $("slice").scrollIntoView({ behavior: "instant", block: "start" });
+        }
+      });
+      gd.dataset.clickBound = "1";
+    }
+  }
+
+  // ---- View 5: sphere renderings -----------------------------------------------------------------------
+
+  function drawRenders(cfg) {
+    const box = $("renders");
+    box.innerHTML = "";
+    const names = Object.keys(cfg.renders || {});
+    if (!names.length) {
+      box.textContent = "This study has no sphere renderings for " + cfg.id + " (configs/" + cfg.id + "/renders/<source>.png).";
+      return;
+    }
+    for (const s of ["reference"].concat(models)) {
+      if (!cfg.renders[s]) {
+        // A model the renderer could not draw: say so in its place.
+        const err = cfg.render_errors && cfg.render_errors[s];
+        if (err !== undefined && isNaN(Number(err))) {
+          const f = document.createElement("figure");
+          f.innerHTML = '<div class="render-missing"></div><figcaption></figcaption>';
+          f.querySelector(".render-missing").textContent = err;
+          f.querySelector("figcaption").textContent = s;
+          box.appendChild(f);
+        }
+        continue;
+      }
+      const f = document.createElement("figure");
+      const img = document.createElement("img");
+      img.src = cfg.renders[s];
+      img.alt = s;
+      const cap = document.createElement("figcaption");
+      const err = cfg.render_errors && cfg.render_errors[s];
+      cap.textContent = s + (err === undefined ? "" : isNaN(Number(err)) ? " · " + err : " · rel. RMSE " + fmt(Number(err)));
+      cap.style.color = modelColor(s);
+      f.append(img, cap);
+      box.appendChild(f);
+    }
+  }
+
+  // ---- Rendering ---------------------------------------------------------------------------------------
+
+  let renderSerial = 0;
+
+  async function render() {
+    const serial = ++renderSerial;
+    const cfg = byId.get(state.config);
+    status("loading " + cfg.id + " …");
+    let d;
+    try {
+      d = await loadConfig(cfg.id);
+    } catch (e) {
+      status(e.message);
+      console.error(e.message);
+      return;
+    }
+    if (serial !== renderSerial) return;  // a later change superseded this one
+    const t0 = performance.now(), times = {};
+    const timed = (name, f) => { const t = performance.now(); f(); times[name] = Math.round(performance.now() - t); };
+    timed("slice", () => drawSlice(d, cfg));
+    timed("iso", () => drawIso(d, cfg));
+    timed("albedo", () => drawAlbedo(cfg));
+    timed("leaderboard", () => drawLeaderboard());
+    drawRenders(cfg);
+    document.body.dataset.viewMs = JSON.stringify(times);
+    writeHash();
+    status("");
+    document.body.dataset.config = cfg.id;
+    document.body.dataset.renders = String(Number(document.body.dataset.renders || 0) + 1);
+    document.body.dataset.drawMs = (performance.now() - t0).toFixed(0);
+  }
+
+  window.LAMINA_EXPLORER = { state, selectConfig, render, models, configs };
+
+  if (!configs.length) { status("This study has no configurations."); return; }
+  readHash();
+  buildStaticWidgets();
+  buildConfigWidgets();
+  $("w-incidence").value = state.incidence;
+  render();
+})();
