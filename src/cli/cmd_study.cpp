@@ -4,6 +4,8 @@
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "core/error.h"
+#include "report/explorer.h"
+#include "report/figures.h"
 #include "study/configurations.h"
 #include "study/study.h"
 
@@ -22,6 +24,7 @@ struct CommonArgs {
     std::string theta_i = "0,15,30,45,60,70,80", particles, grid = "90x90", models, out;
     std::uint64_t seed = 1;
     int threads = 0;
+    bool no_figures = false;
 };
 
 void add_common(CLI::App* cmd, CommonArgs& a) {
@@ -33,6 +36,8 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
     cmd->add_option("--seed", a.seed, "Random seed")->capture_default_str();
     cmd->add_option("--threads", a.threads, "Threads (0 = all cores)")->capture_default_str();
     cmd->add_option("--grid", a.grid, "Bins NTHETAxNPHI")->capture_default_str();
+    cmd->add_flag("--no-figures", a.no_figures,
+                  "Skip the paper figures (the explorer page is always written)");
 }
 
 StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
@@ -51,6 +56,17 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
     }
     if (s.threads < 0) throw InputError("command line", "--threads", "use ≥ 1, or 0 for all cores");
     return s;
+}
+
+// The explorer page, then the figures (a failure there is a warning: the study itself is done).
+void write_report(const std::filesystem::path& dir, bool figures) {
+    write_explorer(dir);
+    if (!figures) return;
+    try {
+        write_figures(dir);
+    } catch (const InputError& e) {
+        fmt::print(stderr, "lamina: warning: figures not written: {}\n", e.what());
+    }
 }
 
 // Prints the findings section of summary.md (the part a reader wants first).
@@ -92,10 +108,12 @@ Runner add_study(CLI::App& app) {
             a->out.empty() ? std::filesystem::path("out") / ("study-" + a->preset)
                            : std::filesystem::path(a->out);
         run_study(configs, s, out);
+        write_report(out, !a->no_figures);
         fmt::print("\n");
         print_findings(out);
-        fmt::print("\nReport: {}/summary.md (metrics: {}/metrics.csv)\n", out.string(),
-                   out.string());
+        fmt::print(
+            "\nReport: {0}/summary.md (metrics: {0}/metrics.csv); explorer: {0}/index.html\n",
+            out.string());
         return 0;
     };
 }
@@ -119,9 +137,12 @@ Runner add_compare(CLI::App& app) {
         c.category = "custom";
         c.parameters = describe_parameters(c.stack);
         run_study({c}, s, a->out);
+        write_report(a->out, !a->no_figures);
         fmt::print("\n");
         print_findings(a->out);
-        fmt::print("\nReport: {}/summary.md (metrics: {}/metrics.csv)\n", a->out, a->out);
+        fmt::print(
+            "\nReport: {0}/summary.md (metrics: {0}/metrics.csv); explorer: {0}/index.html\n",
+            a->out);
         return 0;
     };
 }

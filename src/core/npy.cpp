@@ -4,6 +4,10 @@
 #include "core/error.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <cstdint>
+#include <fstream>
+#include <string>
 
 #include <bit>
 #include <cstring>
@@ -41,41 +45,79 @@ std::string npy_float32(const std::vector<float>& data, const std::vector<std::s
     return out;
 }
 
-std::vector<float> read_npy_float32(const std::string& bytes, const std::string& where,
-                                    std::vector<std::size_t>* shape) {
-    if (bytes.size() < 10 || bytes.compare(0, 6, "\x93NUMPY") != 0 || bytes[6] != 1)
-        throw InputError(where, "", "not a version 1.0 .npy file");
-    const std::size_t len = std::uint8_t(bytes[8]) | (std::size_t(std::uint8_t(bytes[9])) << 8);
-    if (bytes.size() < 10 + len) throw InputError(where, "", "truncated .npy header");
-    const std::string header = bytes.substr(10, len);
-    if (header.find("'descr': '<f4'") == std::string::npos ||
-        header.find("'fortran_order': False") == std::string::npos)
-        throw InputError(where, "", "expected a C-ordered little-endian float32 array");
-    const auto open = header.find("'shape': (");
-    const auto close = header.find(')', open);
-    if (open == std::string::npos || close == std::string::npos)
-        throw InputError(where, "", "no shape in the .npy header");
-    std::vector<std::size_t> dims;
-    std::size_t count = 1;
-    const std::string list = header.substr(open + 10, close - open - 10);
-    std::size_t pos = 0;
-    while (pos < list.size()) {
-        while (pos < list.size() && (list[pos] == ' ' || list[pos] == ','))
-            ++pos;
-        if (pos >= list.size()) break;
-        std::size_t used = 0;
-        const std::size_t d = std::stoull(list.substr(pos), &used);
-        dims.push_back(d);
-        count *= d;
-        pos += used;
+namespace {
+
+// The value of `key` in the header dict, e.g. 'descr': '<f4' → "'<f4'" (up to the next comma at
+// depth 0, parentheses included).
+std::string header_value(const std::string& header, const std::string& key) {
+    const std::size_t k = header.find("'" + key + "'");
+    if (k == std::string::npos) return {};
+    std::size_t i = header.find(':', k);
+    if (i == std::string::npos) return {};
+    ++i;
+    int depth = 0;
+    std::string out;
+    for (; i < header.size(); ++i) {
+        const char c = header[i];
+        if (c == '(') ++depth;
+        if (c == ')') --depth;
+        if (depth == 0 && (c == ',' || c == '}')) break;
+        out += c;
+        if (depth < 0) break;
     }
-    const std::size_t offset = 10 + len;
-    if (bytes.size() != offset + count * sizeof(float))
-        throw InputError(where, "", "the .npy data size does not match its shape (truncated?)");
-    std::vector<float> data(count);
-    std::memcpy(data.data(), bytes.data() + offset, count * sizeof(float));
-    if (shape) *shape = dims;
-    return data;
+    const auto b = out.find_first_not_of(" ");
+    return b == std::string::npos ? std::string() : out.substr(b);
+}
+
+}  // namespace
+
+NpyFloat32 read_npy_float32(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(where, "", "cannot read the file");
+    char magic[8];
+    if (!in.read(magic, 8) || std::memcmp(magic, "\x93NUMPY", 6) != 0)
+        throw InputError(where, "", "not a NumPy .npy file");
+    std::uint32_t header_len = 0;
+    if (magic[6] == 1) {
+        unsigned char b[2];
+        in.read(reinterpret_cast<char*>(b), 2);
+        header_len = b[0] | (b[1] << 8);
+    } else {
+        unsigned char b[4];
+        in.read(reinterpret_cast<char*>(b), 4);
+        header_len = b[0] | (b[1] << 8) | (b[2] << 16) | (std::uint32_t(b[3]) << 24);
+    }
+    std::string header(header_len, '\0');
+    if (!in.read(header.data(), header_len)) throw InputError(where, "", "truncated header");
+    const std::string descr = header_value(header, "descr");
+    if (descr != "'<f4'")
+        throw InputError(where, "descr",
+                         fmt::format("{}: expected '<f4' (little-endian float32)", descr));
+    if (header_value(header, "fortran_order") != "False")
+        throw InputError(where, "fortran_order", "expected False (C order)");
+    const std::string shape_text = header_value(header, "shape");
+    NpyFloat32 a;
+    std::size_t count = 1;
+    for (std::size_t i = 0; i < shape_text.size();) {
+        if (std::isdigit(static_cast<unsigned char>(shape_text[i]))) {
+            std::size_t used = 0;
+            const std::size_t n = std::stoull(shape_text.substr(i), &used);
+            a.shape.push_back(n);
+            count *= n;
+            i += used;
+        } else {
+            ++i;
+        }
+    }
+    if (a.shape.empty())
+        throw InputError(where, "shape", fmt::format("cannot read {}", shape_text));
+    a.data.resize(count);
+    if (!in.read(reinterpret_cast<char*>(a.data.data()), std::streamsize(count * sizeof(float))))
+        throw InputError(
+            where, "",
+            fmt::format("truncated: the header announces shape [{}]", fmt::join(a.shape, ", ")));
+    return a;
 }
 
 }  // namespace lamina

@@ -3,7 +3,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "report/assets.h"
-#include "report/npy.h"
+#include "core/npy.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>

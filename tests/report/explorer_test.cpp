@@ -3,7 +3,7 @@
 // `browser` (tests/report/browser_test.js).
 #include "report/explorer.h"
 #include "core/error.h"
-#include "report/npy.h"
+#include "core/npy.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
