@@ -21,15 +21,24 @@ constexpr T sqr(T x) {
     return x * x;
 }
 
+/// max(x, 0) written so that compilers emit one branch-free max instruction (std::max returns a
+/// reference and is often compiled to a branch, which mispredicts in the particle tracer).
+template <typename T>
+constexpr T max0(T x) {
+    return x > T(0) ? x : T(0);
+}
+
 /// sqrt clamped at zero: guards against tiny negative arguments produced by rounding.
 template <typename T>
 inline T safe_sqrt(T x) {
-    return std::sqrt(std::max(x, T(0)));
+    return std::sqrt(max0(x));
 }
 
+/// x limited to [lo, hi] (branch-free min/max, as max0).
 template <typename T>
 constexpr T clamp(T x, T lo, T hi) {
-    return std::min(std::max(x, lo), hi);
+    x = x < lo ? lo : x;
+    return x > hi ? hi : x;
 }
 
 constexpr double deg_to_rad(double deg) {

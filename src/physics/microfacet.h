@@ -82,7 +82,7 @@ struct GGX {
         // Section 4.3: reprojection onto the hemisphere.
         const Vec3<T> nh = t1 * p1 + t2 * p2 + vh * safe_sqrt(T(1) - sqr(p1) - sqr(p2));
         // Section 3.4: back to the ellipsoid configuration.
-        return normalize(Vec3<T>(alpha * nh.x, alpha * nh.y, std::max(T(0), nh.z)));
+        return normalize(Vec3<T>(alpha * nh.x, alpha * nh.y, max0(nh.z)));
     }
 
     /// Samples the same density D_w(wm) as sample_visible_normal by the spherical-cap
@@ -100,7 +100,7 @@ struct GGX {
         const Vec3<T> c(sin_theta * std::cos(phi), sin_theta * std::sin(phi), z);
         // The halfway direction of the cap point and wh, warped back to the ellipsoid.
         const Vec3<T> h = c + wh;
-        return normalize(Vec3<T>(alpha * h.x, alpha * h.y, std::max(T(0), h.z)));
+        return normalize(Vec3<T>(alpha * h.x, alpha * h.y, max0(h.z)));
     }
 
     /// √(1 + α² tan²θ) = 1 + 2Λ(w): the quantity from which G1 and G2 follow without cancellation.
