@@ -21,5 +21,7 @@ Runner add_compare(CLI::App& app);
 Runner add_models(CLI::App& app);
 /// `lamina eval`: a model at points, a batch of directions, or on the bins (cmd_eval.cpp).
 Runner add_eval(CLI::App& app);
+/// `lamina render`: sphere renderings and the comparison sheet (cmd_render.cpp).
+Runner add_render(CLI::App& app);
 
 }  // namespace lamina::cli
