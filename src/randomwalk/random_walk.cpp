@@ -18,6 +18,15 @@ namespace lamina {
 // / from above to the exit towards wo, per channel.
 struct RandomWalkStack::Connection {
     bool top = true;  ///< the exit is upwards (BRDF) rather than downwards (BTDF)
+    /// Strategy 2 applies: the exit interface (the top for the BRDF, the base for the BTDF) is a
+    /// rough dielectric with a region on its inner side (`inner`, 1 or L − 1) whose vertices —
+    /// interface `vertex_interface` (1 or L − 2) and scattering events — it connects.
+    bool rough_exit = false;
+    int exit_interface = 0, inner = 1, vertex_interface = 1;
+    /// Propagation towards the exit in the inner region: +1 up (top), −1 down (base).
+    double towards = 1;
+    /// The depth-distance from depth s of the inner region to the exit interface.
+    double distance(double s) const { return top ? s : 1 - s; }
     int L = 0;
     std::vector<char> valid;      ///< region r has a propagating direction
     std::vector<double> mu;       ///< its |cos|
@@ -154,6 +163,12 @@ static void build_connection(const std::vector<double>& eta, const auto& interfa
     c.scale.assign(R, 0.0);
     c.up.assign(L, Rgbd(0.0));
     c.down.assign(L, Rgbd(0.0));
+    c.exit_interface = top ? 0 : L - 1;
+    c.inner = top ? 1 : L - 1;
+    c.vertex_interface = top ? 1 : L - 2;
+    c.towards = top ? 1 : -1;
+    c.rough_exit = L >= 2 && interfaces[c.exit_interface].type == InterfaceType::Dielectric &&
+                   !interfaces[c.exit_interface].delta;
     const int exit_region = top ? 0 : L;
     const double eta_e = eta[exit_region];
     const double sin2_exit = sqr(wo.x) + sqr(wo.y);
@@ -238,16 +253,74 @@ static void build_connection(const std::vector<double>& eta, const auto& interfa
     }
 }
 
+// ---- The second connection strategy through a rough top (docs/rendering.md §1.3) ---------------
+// Under a rough top interface the first strategy (the walk reaches the top and evaluates the top's
+// BTDF towards wo) is noisy for narrow lobes: the walk's direction must fall into the lobe. The
+// second strategy samples the top's transmission from the viewer side, t ~ pdf_top(wo, t) (the
+// adjoint of the exit), and connects a non-delta vertex v of region 1 along ω = −t:
+//     w · k_v(ω) · T_v(ω) · f_top(t, wo) / pdf_top(wo, t),
+// k_v = f_v·|cos ω| (interface) or the HG phase (medium), T_v the unscattered transmittance from v
+// to the top. Both strategies sample the same paths (v → top → wo); they are combined with the
+// balance heuristic w_s = p_s / (p_1 + p_2), with
+//     p_1(ω) = pdf_v(ω) · P̃(ℓ),  P̃(ℓ) = exp(−mean_c(τt_c) · ℓ) in a scattering medium, else 1,
+//     p_2(ω) = pdf_top(wo, −ω),
+// ℓ = depth of v / |cos ω| the normal-optical-depth path factor. P̃ approximates the survival
+// probability of the walk's free flight; the weights are unbiased for any such choice because both
+// strategies compute them with the same function of the same path (Veach 1997, §9.2.2).
+struct RandomWalkStack::WalkState {
+    Vec3d d;      ///< propagation direction
+    Rgbd w{1.0};  ///< flux weight
+    int events = 0;
+    bool delta_only = true;
+    bool prev_mis = false;  ///< the last vertex was non-delta, in the inner region, and sent the
+                            ///< walk towards the exit interface
+    double prev_pdf = 0;    ///< its sampling density of the current direction
+    double prev_depth =
+        0;  ///< its depth-distance to the exit interface (1 at the vertex interface)
+};
+
+double RandomWalkStack::survival_proxy(int region, double path) const {
+    const Medium& m = media_[region];
+    return m.scatters ? std::exp(-m.tau_t.mean() * path) : 1.0;
+}
+
+// Strategy 2 at a vertex of the inner region that emits `k_v(ω)` (per channel, kernel incl. cos
+// for an interface) with pdf `pdf_v(ω)`, at depth-distance `depth` from the exit (1: the vertex
+// interface). The exit's transmission is sampled from wo (t on the inner side); ω = −t.
+template <typename Kernel, typename Pdf>
+void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& wo, double depth,
+                                           const Rgbd& w, ParticleRng& rng, const Kernel& kernel,
+                                           const Pdf& pdf_v, Rgbd& f) const {
+    const DielectricInterface<double>& exit = interfaces_[conn.exit_interface].dielectric;
+    const double uc = rng.uniform_double(), u1 = rng.uniform_double(), u2 = rng.uniform_double();
+    const auto st = exit.sample<true>(wo, uc, u1, u2);
+    if (!st || !st->is_transmission || st->shadowing == 0 || st->pdf <= 0) return;
+    const Vec3d omega = -st->wo;
+    if (omega.z * conn.towards <= 0) return;
+    const double mu = std::abs(omega.z);
+    const double f_exit = exit.eval(st->wo, wo);
+    if (f_exit == 0) return;
+    const Rgbd kv = kernel(omega);
+    if (is_black(kv)) return;
+    const Medium& m = media_[conn.inner];
+    const Rgbd tr = m.empty ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
+    const double p1 = pdf_v(omega) * survival_proxy(conn.inner, depth / mu);
+    const double mis = st->pdf / (st->pdf + p1);
+    f += w * kv * tr * (f_exit / st->pdf * mis);
+}
+
 // ---- Media (physics.md §4), as the goniophotometer traverses them ------------------------------
 // Depth s ∈ [0, 1] across the layer (0 at its top). Returns true if the particle leaves through
 // the top. Free flights from a mixture of the channels' exponentials with probabilities ∝ flux and
 // per-channel weights (one-sample spectral MIS, balance heuristic: Veach 1997, §9.2.4), exactly as
 // simulator/goniophotometer.cpp. Each scattering event is a non-delta vertex: it connects along
 // d_r up and down with the channel's own HG phase and the unscattered transmittance to the
-// boundary, e^{−τt·s/μ} (up) or e^{−τt·(1 − s)/μ} (down).
+// boundary, e^{−τt·s/μ} (up) or e^{−τt·(1 − s)/μ} (down), and below a rough top by strategy 2.
 template <bool kConnect>
-bool RandomWalkStack::traverse_medium(int region, Vec3d& d, Rgbd& w, int& events, ParticleRng& rng,
-                                      const Connection* conn, Rgbd& f, bool& delta_only) const {
+bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rng,
+                                      const Connection* conn, const Vec3d& wo, Rgbd& f) const {
+    Vec3d& d = ws.d;
+    Rgbd& w = ws.w;
     const Medium& m = media_[region];
     if (!m.scatters) {
         const double inv_mu = 1 / std::abs(d.z);
@@ -291,7 +364,15 @@ bool RandomWalkStack::traverse_medium(int region, Vec3d& d, Rgbd& w, int& events
                 w[k] *= num[k] / mix;
         }
         s = clamp(s - d.z * flight, 0.0, 1.0);
-        delta_only = false;
+        ws.delta_only = false;
+        // The phase-sampling density: the mixture Σ p_k HG_k when g differs per channel.
+        auto phase_pdf = [&](double cos_theta) {
+            if (m.uniform_g) return hg_phase(cos_theta, m.g[0]);
+            double q = 0;
+            for (int k = 0; k < 3; ++k)
+                q += p[k] * hg_phase(cos_theta, m.g[k]);
+            return q;
+        };
         if constexpr (kConnect) {
             // Next event: flux w scattered into dω_d with density p_c(d_in·d) becomes, through
             // the delta chains, flux w p Q (η_e/η_r)² cos_e/|cos d| dω_e.
@@ -311,6 +392,17 @@ bool RandomWalkStack::traverse_medium(int region, Vec3d& d, Rgbd& w, int& events
                               hg_phase(cd, g) * tr_down[ch] * below[ch]);
                 }
             }
+            if (conn->rough_exit && region == conn->inner) {
+                const Vec3d d_in = d;
+                connect_through_exit(
+                    *conn, wo, conn->distance(s), w, rng,
+                    [&](const Vec3d& om) {
+                        const double ct = dot(d_in, om);
+                        return Rgbd(hg_phase(ct, m.g[0]), hg_phase(ct, m.g[1]),
+                                    hg_phase(ct, m.g[2]));
+                    },
+                    [&](const Vec3d& om) { return phase_pdf(dot(d_in, om)); }, f);
+            }
         }
         int c_phase = c;
         if (!m.uniform_g) {
@@ -319,8 +411,8 @@ bool RandomWalkStack::traverse_medium(int region, Vec3d& d, Rgbd& w, int& events
         }
         const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
         const Vec3d d_new = sample_hg(d, m.g[c_phase], u1, u2);
+        const double cos_theta = dot(d, d_new);
         if (!m.uniform_g) {
-            const double cos_theta = dot(d, d_new);
             double mix = 0;
             Rgbd ph;
             for (int k = 0; k < 3; ++k) {
@@ -330,9 +422,15 @@ bool RandomWalkStack::traverse_medium(int region, Vec3d& d, Rgbd& w, int& events
             for (int k = 0; k < 3; ++k)
                 w[k] *= ph[k] / mix;
         }
+        // The walk's own strategy for the same paths (strategy 1, weighted at the exit). Only
+        // meaningful while connecting (conn is null for sample()).
+        ws.prev_mis =
+            kConnect && conn->rough_exit && region == conn->inner && d_new.z * conn->towards > 0;
+        ws.prev_pdf = phase_pdf(cos_theta);
+        ws.prev_depth = kConnect ? conn->distance(s) : 0;
         d = d_new;
         if (is_black(w)) return d.z > 0;
-        if (++events >= max_events_) {
+        if (++ws.events >= max_events_) {
             w = Rgbd(0.0);
             return d.z > 0;
         }
@@ -341,41 +439,55 @@ bool RandomWalkStack::traverse_medium(int region, Vec3d& d, Rgbd& w, int& events
 
 // ---- One walk ----------------------------------------------------------------------------------
 template <bool kConnect>
-void RandomWalkStack::walk(const Vec3d& wi, ParticleRng& rng, const Connection* conn, Rgbd& f,
+void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
+                           const Connection* conn, Rgbd& f,
                            std::optional<RandomWalkSample>* exit) const {
     const int L = int(interfaces_.size());
-    Vec3d d = -wi;  // propagation direction
-    Rgbd w(1.0);
+    WalkState ws;
+    ws.d = -wi;
+    Vec3d& d = ws.d;
+    Rgbd& w = ws.w;
     int k = 0;  // the interface the particle is about to meet
-    int events = 0;
-    bool delta_only = true;
-    while (events++ < max_events_) {
+    while (ws.events++ < max_events_) {
         const Interface& it = interfaces_[k];
         const Vec3d wi_local = -d;
+        // Strategy 1's balance-heuristic weight at the exit interface (1 for other paths): the
+        // particle arrives from the inner region straight from a vertex that strategy 2 connects.
+        auto exit_mis = [&](int at) {
+            if constexpr (!kConnect)
+                return 1.0;
+            else {
+                if (!conn->rough_exit || at != conn->exit_interface || !ws.prev_mis ||
+                    d.z * conn->towards <= 0)
+                    return 1.0;
+                const double p1 =
+                    ws.prev_pdf * survival_proxy(conn->inner, ws.prev_depth / std::abs(d.z));
+                const double p2 = it.dielectric.pdf(wo, wi_local);
+                return p1 / (p1 + p2);
+            }
+        };
         // Next event at a non-delta interface: into region k (up) and, for a dielectric, region
         // k + 1 (down); the kernel f·|cos| and the Jacobian's 1/|cos| cancel.
         if constexpr (kConnect) {
             if (!it.delta) {
                 if (conn->valid[k]) {
                     const Vec3d& du = conn->dir_up[k];
-                    Rgbd fv;
-                    switch (it.type) {
-                        case InterfaceType::Dielectric:
-                            fv = Rgbd(it.dielectric.eval(wi_local, du));
-                            break;
-                        case InterfaceType::Conductor:
-                            fv = it.conductor.eval(wi_local, du);
-                            break;
-                        case InterfaceType::Lambertian:
-                            fv = it.lambertian.eval(wi_local, du);
-                            break;
-                    }
-                    f += w * fv * conn->from_bottom_up(k) * conn->scale[k];
+                    Rgbd fv = eval_interface(it, wi_local, du);
+                    f += w * fv * conn->from_bottom_up(k) * (conn->scale[k] * exit_mis(k));
                 }
                 if (it.type == InterfaceType::Dielectric && conn->valid[k + 1]) {
                     const Vec3d& dd = conn->dir_down[k + 1];
                     f += w * Rgbd(it.dielectric.eval(wi_local, dd)) * conn->from_top_down(k + 1) *
-                         conn->scale[k + 1];
+                         (conn->scale[k + 1] * exit_mis(k));
+                }
+                // Strategy 2 from the vertex interface emitting into the inner region.
+                if (conn->rough_exit && k == conn->vertex_interface) {
+                    connect_through_exit(
+                        *conn, wo, 1.0, w, rng,
+                        [&](const Vec3d& om) {
+                            return eval_interface(it, wi_local, om) * std::abs(om.z);
+                        },
+                        [&](const Vec3d& om) { return pdf_interface(it, wi_local, om); }, f);
                 }
             }
         }
@@ -384,12 +496,12 @@ void RandomWalkStack::walk(const Vec3d& wi, ParticleRng& rng, const Connection* 
             case InterfaceType::Dielectric: {
                 const double uc = rng.uniform_double(), u1 = rng.uniform_double(),
                              u2 = rng.uniform_double();
-                s = it.dielectric.sample<false>(wi_local, uc, u1, u2);
+                s = it.dielectric.sample<true>(wi_local, uc, u1, u2);
                 break;
             }
             case InterfaceType::Conductor: {
                 const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
-                s = it.conductor.sample<false>(wi_local, u1, u2);
+                s = it.conductor.sample<true>(wi_local, u1, u2);
                 break;
             }
             case InterfaceType::Lambertian: {
@@ -400,31 +512,58 @@ void RandomWalkStack::walk(const Vec3d& wi, ParticleRng& rng, const Connection* 
         }
         if (!s) return;  // a numerical degeneracy: the flux is dropped
         w *= s->weight;
-        if (!it.delta) delta_only = false;
+        if (!it.delta) ws.delta_only = false;
         d = s->wo;
+        if constexpr (kConnect)
+            ws.prev_mis = conn->rough_exit && k == conn->vertex_interface && !it.delta &&
+                          d.z * conn->towards > 0;
+        ws.prev_pdf = s->pdf;
+        ws.prev_depth = 1;
         if (is_black(w) || d.z == 0) return;
         if (d.z > 0) {
             if (k == 0) {  // leaves upwards
-                if (exit) *exit = RandomWalkSample{d, w, delta_only};
+                if (exit) *exit = RandomWalkSample{d, w, ws.delta_only};
                 return;
             }
             bool up = true;
-            if (!media_[k].empty)
-                up = traverse_medium<kConnect>(k, d, w, events, rng, conn, f, delta_only);
+            if (!media_[k].empty) up = traverse_medium<kConnect>(k, ws, rng, conn, wo, f);
             if (is_black(w)) return;
             if (up) --k;
         } else {
             if (k == L - 1) {  // leaves through the final dielectric
-                if (exit) *exit = RandomWalkSample{d, w, delta_only};
+                if (exit) *exit = RandomWalkSample{d, w, ws.delta_only};
                 return;
             }
             bool up = false;
-            if (!media_[k + 1].empty)
-                up = traverse_medium<kConnect>(k + 1, d, w, events, rng, conn, f, delta_only);
+            if (!media_[k + 1].empty) up = traverse_medium<kConnect>(k + 1, ws, rng, conn, wo, f);
             if (is_black(w)) return;
             if (!up) ++k;
         }
     }
+}
+
+Rgbd RandomWalkStack::eval_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo) {
+    switch (it.type) {
+        case InterfaceType::Dielectric:
+            return Rgbd(it.dielectric.eval(wi, wo));
+        case InterfaceType::Conductor:
+            return it.conductor.eval(wi, wo);
+        case InterfaceType::Lambertian:
+            return it.lambertian.eval(wi, wo);
+    }
+    return Rgbd(0.0);
+}
+
+double RandomWalkStack::pdf_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo) {
+    switch (it.type) {
+        case InterfaceType::Dielectric:
+            return it.dielectric.pdf(wi, wo);
+        case InterfaceType::Conductor:
+            return it.conductor.pdf(wi, wo);
+        case InterfaceType::Lambertian:
+            return it.lambertian.pdf(wi, wo);
+    }
+    return 0;
 }
 
 Rgbd RandomWalkStack::eval_once(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng) const {
@@ -432,7 +571,7 @@ Rgbd RandomWalkStack::eval_once(const Vec3d& wi, const Vec3d& wo, ParticleRng& r
     Connection conn;
     build_connection(eta_, interfaces_, media_, wo, wo.z > 0, conn);
     Rgbd f(0.0);
-    walk<true>(wi, rng, &conn, f, nullptr);
+    walk<true>(wi, wo, rng, &conn, f, nullptr);
     return f;
 }
 
@@ -468,7 +607,7 @@ RandomWalkEstimate RandomWalkStack::eval(const Vec3d& wi, const Vec3d& wo, std::
     for (std::uint64_t i = 0; i < walks; ++i) {
         ParticleRng rng(seed, stream, i);
         Rgbd f(0.0);
-        walk<true>(wi, rng, &conn, f, nullptr);
+        walk<true>(wi, wo, rng, &conn, f, nullptr);
         sum += f;
         sum_sq += f * f;
     }
@@ -484,7 +623,7 @@ RandomWalkEstimate RandomWalkStack::eval(const Vec3d& wi, const Vec3d& wo, std::
 std::optional<RandomWalkSample> RandomWalkStack::sample(const Vec3d& wi, ParticleRng& rng) const {
     std::optional<RandomWalkSample> exit;
     Rgbd unused(0.0);
-    walk<false>(wi, rng, nullptr, unused, &exit);
+    walk<false>(wi, wi, rng, nullptr, unused, &exit);
     return exit;
 }
 

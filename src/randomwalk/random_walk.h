@@ -109,12 +109,20 @@ class RandomWalkStack {
         bool scatters = false, empty = true, uniform_tau_t = true, uniform_g = true;
     };
 
+    struct WalkState;
     template <bool kConnect>
-    void walk(const Vec3d& wi, ParticleRng& rng, const Connection* conn, Rgbd& f,
+    void walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng, const Connection* conn, Rgbd& f,
               std::optional<RandomWalkSample>* exit) const;
     template <bool kConnect>
-    bool traverse_medium(int region, Vec3d& d, Rgbd& w, int& events, ParticleRng& rng,
-                         const Connection* conn, Rgbd& f, bool& delta_only) const;
+    bool traverse_medium(int region, WalkState& ws, ParticleRng& rng, const Connection* conn,
+                         const Vec3d& wo, Rgbd& f) const;
+    template <typename Kernel, typename Pdf>
+    void connect_through_exit(const Connection& conn, const Vec3d& wo, double depth, const Rgbd& w,
+                              ParticleRng& rng, const Kernel& kernel, const Pdf& pdf_v,
+                              Rgbd& f) const;
+    double survival_proxy(int region, double path) const;
+    static Rgbd eval_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo);
+    static double pdf_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo);
 
     std::vector<Interface> interfaces_;  ///< top to bottom
     std::vector<Medium> media_;          ///< per region 0..L (0 and L empty)
