@@ -124,8 +124,12 @@ double relative_rmse(const Image& image, const Image& reference, const std::vect
 Image contact_sheet(const std::vector<SheetEntry>& entries, const std::vector<char>& mask,
                     double ev) {
     const Image& ref = entries.at(0).image;
-    const int S = ref.width, pad = 12, label = 28, n = int(entries.size());
-    const int W = n * (S + pad) + pad, H = 2 * (S + label + pad) + pad + 30;
+    const int S = ref.width, pad = 12, n = int(entries.size());
+    // Font scale: 2 when a tile holds ~20 characters at that size, else 1 (labels never overlap).
+    const int fs = S >= 6 * 2 * 20 ? 2 : 1, label = 10 * fs + 8;
+    const std::size_t max_chars = std::size_t(std::max(1, (S + pad) / (6 * fs) - 1));
+    auto fit = [&](const std::string& t) { return t.substr(0, max_chars); };
+    const int W = n * (S + pad) + pad, H = 2 * (S + label + pad) + pad + 10 * fs + 8;
     Image sheet(W, H, Rgbf(0.02f));
     const Rgbf white(0.9f), grey(0.5f);
     double mean_ref = 0;
@@ -140,9 +144,9 @@ Image contact_sheet(const std::vector<SheetEntry>& entries, const std::vector<ch
     for (int k = 0; k < n; ++k) {
         const SheetEntry& e = entries[k];
         const int x0 = pad + k * (S + pad), y0 = pad + label;
-        draw_text(sheet, x0, pad, k == 0 ? e.label + " (REFERENCE)" : e.label, 2, white);
+        draw_text(sheet, x0, pad, fit(k == 0 ? e.label + " (REF)" : e.label), fs, white);
         if (!e.supported) {
-            draw_text(sheet, x0 + 4, y0 + S / 2 - 10, "NOT SUPPORTED", 2, grey);
+            draw_text(sheet, x0 + 4, y0 + S / 2 - 10, fit("NOT SUPPORTED"), fs, grey);
             draw_text(sheet, x0 + 4, y0 + S / 2 + 10, e.reason.substr(0, std::size_t(S / 6)), 1,
                       grey);
             continue;
@@ -160,11 +164,11 @@ Image contact_sheet(const std::vector<SheetEntry>& entries, const std::vector<ch
             for (int x = 0; x < bw; ++x)
                 for (int y = 0; y < 20; ++y)
                     sheet.at(bx + x, by + y) = diverging(2.0 * x / (bw - 1) - 1);
-            draw_text(sheet, bx, by + 26, "-50%", 2, white);
-            draw_text(sheet, bx + bw / 2 - 6, by + 26, "0", 2, white);
-            draw_text(sheet, bx + bw - 48, by + 26, "+50%", 2, white);
-            draw_text(sheet, bx, by - 40, "(MODEL - REF)", 2, white);
-            draw_text(sheet, bx, by - 22, "/ MEAN REF", 2, white);
+            draw_text(sheet, bx, by + 26, "-50%", fs, white);
+            draw_text(sheet, bx + bw / 2 - 3 * fs, by + 26, "0", fs, white);
+            draw_text(sheet, bx + bw - 24 * fs, by + 26, "+50%", fs, white);
+            draw_text(sheet, bx, by - 20 * fs - 4, fit("(MODEL - REF)"), fs, white);
+            draw_text(sheet, bx, by - 10 * fs - 2, fit("/ MEAN REF"), fs, white);
             continue;
         }
         for (int y = 0; y < S; ++y)
@@ -176,7 +180,7 @@ Image contact_sheet(const std::vector<SheetEntry>& entries, const std::vector<ch
                             : Rgbf(0.1f);
             }
         draw_text(sheet, x0, y1 + S + 6,
-                  fmt::format("REL. RMSE {:.3f}", relative_rmse(e.image, ref, mask)), 2, white);
+                  fit(fmt::format("RMSE {:.3f}", relative_rmse(e.image, ref, mask))), fs, white);
     }
     return sheet;
 }
