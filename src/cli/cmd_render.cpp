@@ -61,33 +61,7 @@ int run_render(const RenderArgs& a) {
 
     // --compare: the reference and every analytic model, one sheet.
     const std::filesystem::path dir = a.out;
-    std::filesystem::create_directories(dir);
-    std::vector<SheetEntry> entries;
-    const auto reference = make_model("random-walk", stack, a.options);
-    Rendering ref = render_sphere(*reference, env, s);
-    write_pair(dir / "random-walk.png", ref.image, a.exposure);
-    entries.push_back({"random-walk", ref.image, true, ""});
-    std::string summary = "model,rel_rmse,seconds\n";
-    for (const ModelEntry& e : model_registry()) {
-        if (e.stochastic) continue;
-        const auto model = e.make(stack, resolve_options(e, {}));
-        if (!model->support().brdf) {
-            entries.push_back({e.name, Image(), false, model->support().reason});
-            summary += fmt::format("{},not supported,\n", e.name);
-            continue;
-        }
-        const Rendering r = render_sphere(*model, env, s);
-        write_pair(dir / (e.name + ".png"), r.image, a.exposure);
-        const double err = relative_rmse(r.image, ref.image, ref.mask);
-        summary += fmt::format("{},{:.6f},{:.2f}\n", e.name, err, r.seconds);
-        entries.push_back({e.name, r.image, true, ""});
-    }
-    write_png(dir / "compare.png", contact_sheet(entries, ref.mask, a.exposure), 0, false);
-    std::FILE* f = std::fopen((dir / "errors.csv").c_str(), "w");
-    if (f) {
-        std::fputs(summary.c_str(), f);
-        std::fclose(f);
-    }
+    write_comparison(stack, env, s, dir, a.exposure, a.options);
     fmt::print(stderr, "lamina render --compare: {} -> {}\n", stack.name,
                (dir / "compare.png").string());
     return 0;

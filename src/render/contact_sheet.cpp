@@ -2,7 +2,11 @@
 
 #include "core/math.h"
 
+#include "models/registry.h"
+
 #include <fmt/format.h>
+
+#include <cstdio>
 
 #include <algorithm>
 #include <array>
@@ -183,6 +187,43 @@ Image contact_sheet(const std::vector<SheetEntry>& entries, const std::vector<ch
                   fit(fmt::format("RMSE {:.3f}", relative_rmse(e.image, ref, mask))), fs, white);
     }
     return sheet;
+}
+
+std::string write_comparison(const Stack& stack, const Environment& env, const RenderSettings& s,
+                             const std::filesystem::path& dir, double exposure_ev,
+                             const std::vector<std::string>& rw_options) {
+    std::filesystem::create_directories(dir);
+    auto write_pair = [&](const std::string& name, const Image& img) {
+        write_png(dir / (name + ".png"), img, exposure_ev);
+        write_exr(dir / (name + ".exr"), img);
+    };
+    std::vector<SheetEntry> entries;
+    const auto reference = make_model("random-walk", stack, rw_options);
+    const Rendering ref = render_sphere(*reference, env, s);
+    write_pair("random-walk", ref.image);
+    entries.push_back({"random-walk", ref.image, true, ""});
+    std::string summary =
+        fmt::format("model,rel_rmse,seconds\nrandom-walk,0,{:.2f}\n", ref.seconds);
+    for (const ModelEntry& e : model_registry()) {
+        if (e.stochastic) continue;
+        const auto model = e.make(stack, resolve_options(e, {}));
+        if (!model->support().brdf) {
+            entries.push_back({e.name, Image(), false, model->support().reason});
+            summary += fmt::format("{},not supported,\n", e.name);
+            continue;
+        }
+        const Rendering r = render_sphere(*model, env, s);
+        write_pair(e.name, r.image);
+        summary += fmt::format("{},{:.6f},{:.2f}\n", e.name,
+                               relative_rmse(r.image, ref.image, ref.mask), r.seconds);
+        entries.push_back({e.name, r.image, true, ""});
+    }
+    write_png(dir / "compare.png", contact_sheet(entries, ref.mask, exposure_ev), 0, false);
+    if (std::FILE* f = std::fopen((dir / "errors.csv").c_str(), "w")) {
+        std::fputs(summary.c_str(), f);
+        std::fclose(f);
+    }
+    return summary;
 }
 
 }  // namespace lamina

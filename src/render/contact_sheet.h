@@ -8,7 +8,12 @@
 // channel pooled. Labels are drawn with a built-in 5×7 bitmap font (upper case, digits, . - + % :
 // =).
 
+#include "layers/stack.h"
+#include "render/environment.h"
 #include "render/image.h"
+#include "render/renderer.h"
+
+#include <filesystem>
 
 #include <string>
 #include <vector>
@@ -29,6 +34,13 @@ double relative_rmse(const Image& image, const Image& reference, const std::vect
 /// entries[0] is the reference.
 Image contact_sheet(const std::vector<SheetEntry>& entries, const std::vector<char>& mask,
                     double exposure_ev);
+
+/// Renders the random-walk reference and every analytic model of the registry for `stack` with
+/// the same settings and writes, into `dir`: one PNG + EXR per model, errors.csv
+/// (model,rel_rmse,seconds; "not supported" rows) and compare.png. Returns the errors.csv text.
+std::string write_comparison(const Stack& stack, const Environment& env,
+                             const RenderSettings& settings, const std::filesystem::path& dir,
+                             double exposure_ev, const std::vector<std::string>& rw_options = {});
 
 /// Draws `text` at (x, y) (top-left), scale s pixels per font pixel, colour c.
 void draw_text(Image& img, int x, int y, const std::string& text, int s, Rgbf c);
