@@ -43,6 +43,7 @@ int run_render(const RenderArgs& a) {
     s.spp = a.spp;
     s.seed = a.seed;
     s.threads = a.threads;
+    s.lobe_alpha = lobe_alpha_for(stack);  // a proposal density only (renderer.h)
     if (a.out.empty()) throw InputError("command line", "--out", "required");
 
     if (!a.compare) {

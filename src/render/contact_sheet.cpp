@@ -189,9 +189,11 @@ Image contact_sheet(const std::vector<SheetEntry>& entries, const std::vector<ch
     return sheet;
 }
 
-std::string write_comparison(const Stack& stack, const Environment& env, const RenderSettings& s,
-                             const std::filesystem::path& dir, double exposure_ev,
-                             const std::vector<std::string>& rw_options) {
+std::string write_comparison(const Stack& stack, const Environment& env,
+                             const RenderSettings& settings, const std::filesystem::path& dir,
+                             double exposure_ev, const std::vector<std::string>& rw_options) {
+    RenderSettings s = settings;
+    s.lobe_alpha = lobe_alpha_for(stack);
     std::filesystem::create_directories(dir);
     auto write_pair = [&](const std::string& name, const Image& img) {
         write_png(dir / (name + ".png"), img, exposure_ev);

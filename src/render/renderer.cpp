@@ -5,6 +5,8 @@
 #include "core/progress.h"
 #include "core/rng.h"
 #include "models/random_walk_model.h"
+#include "physics/fresnel.h"
+#include "physics/microfacet.h"
 #include "physics/sampling.h"
 
 #include <omp.h>
@@ -16,33 +18,43 @@ namespace lamina {
 
 namespace {
 
-// The light-sampling mixture of strategy A: cosine about n with probability c_cos, cap k with
-// (1 − c_cos)/K, each cap uniform over its cone (solid angle 2π(1 − cos_max)).
+// The light-sampling mixture of strategy A: cosine about n, a GGX lobe (visible normals seen from
+// the view direction wo, reflected: the density of a rough mirror, Heitz 2018) and the cap lights
+// (uniform in their cones, solid angle 2π(1 − cos_max)), with probabilities c_cos, c_lobe and
+// c_cap each. `wi`, `wo` are local to the shading frame, `d_world` is wi in the world.
 struct Mixture {
     const Environment& env;
-    double c_cos;
+    GGX<double> ggx;
+    double c_cos, c_lobe, c_cap;
 
-    explicit Mixture(const Environment& e) : env(e), c_cos(e.caps.empty() ? 1.0 : 0.5) {}
-
-    double cap_weight() const {
-        return env.caps.empty() ? 0 : (1 - c_cos) / double(env.caps.size());
+    Mixture(const Environment& e, double alpha) : env(e), ggx{std::max(alpha, 1e-3)} {
+        const bool caps = !e.caps.empty(), lobe = alpha > 0;
+        c_lobe = lobe ? (caps ? 0.3 : 0.5) : 0.0;
+        c_cap = caps ? (lobe ? 0.4 : 0.5) / double(e.caps.size()) : 0.0;
+        c_cos = 1 - c_lobe - c_cap * double(e.caps.size());
     }
 
-    double pdf(const Vec3d& d, const Vec3d& n) const {
-        const double cos_n = dot(d, n);
-        double p = cos_n > 0 ? c_cos * cos_n * kInvPi<double> : 0.0;
-        for (const CapLight& c : env.caps)
-            if (dot(d, c.direction) >= c.cos_max)
-                p += cap_weight() / (2 * kPi<double> * (1 - c.cos_max));
+    double pdf(const Vec3d& d_world, const Vec3d& wi, const Vec3d& wo) const {
+        double p = wi.z > 0 ? c_cos * wi.z * kInvPi<double> : 0.0;
+        if (c_lobe > 0 && wi.z > 0) {
+            const Vec3d wm = normalize(wi + wo);
+            const double c = dot(wo, wm);
+            if (c > 0) p += c_lobe * ggx.pdf_visible_normal(wo, wm) / (4 * c);
+        }
+        for (const CapLight& cap : env.caps)
+            if (dot(d_world, cap.direction) >= cap.cos_max)
+                p += c_cap / (2 * kPi<double> * (1 - cap.cos_max));
         return p;
     }
 
-    Vec3d sample(const Frame<double>& frame, ParticleRng& rng) const {
+    Vec3d sample(const Frame<double>& frame, const Vec3d& wo, ParticleRng& rng) const {
         const double us = rng.uniform_double(), u1 = rng.uniform_double(),
                      u2 = rng.uniform_double();
         if (us < c_cos) return frame.to_world(sample_cosine_hemisphere(u1, u2));
-        const std::size_t k = std::min(env.caps.size() - 1,
-                                       std::size_t((us - c_cos) / (1 - c_cos) * env.caps.size()));
+        if (us < c_cos + c_lobe)
+            return frame.to_world(reflect(wo, ggx.sample_visible_normal_caps(wo, u1, u2)));
+        const std::size_t k =
+            std::min(env.caps.size() - 1, std::size_t((us - c_cos - c_lobe) / c_cap));
         const CapLight& c = env.caps[k];
         const double cos_t = 1 - u1 * (1 - c.cos_max);
         const double sin_t = safe_sqrt(1 - cos_t * cos_t);
@@ -62,7 +74,7 @@ Rendering render_sphere(const Model& model, const Environment& env, const Render
     Rendering out;
     out.image = Image(N, N);
     out.mask.assign(std::size_t(N) * N, 0);
-    const Mixture mix(env);
+    const Mixture mix(env, s.lobe_alpha);
     const Vec3d view(0, 0, 1);
     const double px = 2 * s.extent / N;
     const int threads = s.threads > 0 ? s.threads : omp_get_max_threads();
@@ -80,10 +92,10 @@ Rendering render_sphere(const Model& model, const Environment& env, const Render
         };
         // (A) the light-sampling mixture.
         {
-            const Vec3d d = mix.sample(frame, rng);
+            const Vec3d d = mix.sample(frame, wo, rng);
             const Vec3d wi = frame.to_local(d);
             if (wi.z > 0) {
-                const double p = mix.pdf(d, n);
+                const double p = mix.pdf(d, wi, wo);
                 double w = 1;
                 if (walker) w = p / (p + wi.z * kInvPi<double>);
                 if (p > 0) L += f_at(wi) * env.radiance(d) * (wi.z * w / p);
@@ -94,7 +106,7 @@ Rendering render_sphere(const Model& model, const Environment& env, const Render
             if (const auto smp = walker->sample(wo, rng); smp && !smp->is_delta && smp->wo.z > 0) {
                 const Vec3d d = frame.to_world(smp->wo);
                 const double q = smp->wo.z * kInvPi<double>;
-                L += smp->weight * env.radiance(d) * (q / (mix.pdf(d, n) + q));
+                L += smp->weight * env.radiance(d) * (q / (mix.pdf(d, smp->wo, wo) + q));
             }
         }
         // Delta lobes, exactly (reciprocity: the lobes seen from wo).
@@ -134,6 +146,12 @@ Rendering render_sphere(const Model& model, const Environment& env, const Render
     progress.finish();
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
+}
+
+double lobe_alpha_for(const Stack& stack) {
+    const InterfaceSpec& top = stack.layers.front().interface;
+    if (top.type == InterfaceType::Lambertian) return 0;
+    return std::clamp(top.alpha, 0.02, 1.0);
 }
 
 }  // namespace lamina
