@@ -8,6 +8,7 @@
 #include "core/spherical.h"
 #include "layers/stack.h"
 #include "models/binned.h"
+#include "models/random_walk_model.h"
 #include "models/registry.h"
 
 #include <fmt/format.h>
@@ -29,7 +30,22 @@ struct EvalArgs {
     double theta_o = std::nan(""), phi_o = std::nan("");
     bool binned = false;
     std::vector<std::string> options;
+    std::uint64_t samples = 0, seed = 0;  ///< random-walk only; 0: the model's own option
 };
+
+/// Applies --samples/--seed to a random-walk model; rejects them for the analytic models.
+RandomWalkModel* configure_random_walk(Model& model, const EvalArgs& a) {
+    auto* rw = dynamic_cast<RandomWalkModel*>(&model);
+    if (!rw) {
+        if (a.samples != 0 || a.seed != 0)
+            throw InputError("command line", a.samples != 0 ? "--samples" : "--seed",
+                             "only the stochastic model random-walk takes a sample count or seed");
+        return nullptr;
+    }
+    if (a.samples != 0) rw->set_samples(a.samples);
+    if (a.seed != 0) rw->set_seed(a.seed);
+    return rw;
+}
 
 double parse_number(const std::string& text, const std::string& where, const std::string& field) {
     const char* begin = text.c_str();
@@ -84,6 +100,7 @@ int run_eval(const EvalArgs& a) {
         const HemisphereGrid grid = HemisphereGrid::parse(a.grid, "--grid");
         const Stack stack = load_stack(a.stack);
         const auto model = entry.make(stack, options);
+        configure_random_walk(*model, a);
         const Support s = model->support();
         if (!s.brdf && !s.btdf) throw InputError(a.stack, "--model", "not supported: " + s.reason);
         write_file_atomic(a.out, bin_model(*model, grid, thetas).to_csv());
@@ -124,6 +141,7 @@ int run_eval(const EvalArgs& a) {
         }
         const Stack stack = load_stack(a.stack);
         const auto model = entry.make(stack, options);
+        configure_random_walk(*model, a);
         std::string out = "theta_i,theta_o,phi_o,side,f_r,f_g,f_b\n";
         for (const Row& r : rows) {
             require_side(*model, r.side, a.stack);
@@ -147,6 +165,14 @@ int run_eval(const EvalArgs& a) {
     const Stack stack = load_stack(a.stack);
     const auto model = entry.make(stack, options);
     require_side(*model, side, a.stack);
+    if (const RandomWalkModel* rw = configure_random_walk(*model, a)) {
+        // f_r f_g f_b se_r se_g se_b: the estimate and its standard error.
+        const RandomWalkEstimate e =
+            rw->estimate(incident_direction(deg_to_rad(thetas[0])),
+                         direction_from_angles(deg_to_rad(a.theta_o), deg_to_rad(a.phi_o), side));
+        fmt::print("{} {} {} {} {} {}\n", e.f[0], e.f[1], e.f[2], e.se[0], e.se[1], e.se[2]);
+        return 0;
+    }
     const Rgbd f = eval_at(*model, thetas[0], a.theta_o, a.phi_o, side);
     fmt::print("{} {} {}\n", f[0], f[1], f[2]);
     return 0;
@@ -172,6 +198,12 @@ Runner add_eval(CLI::App& app) {
                   "Cos-weighted bin averages in the goniophotometer's brdf.csv format");
     cmd->add_option("--grid", a->grid, "Bins for --binned, NTHETAxNPHI (default 90x90)");
     cmd->add_option("--out", a->out, "Output CSV (written atomically)");
+    cmd->add_option("--samples", a->samples,
+                    "random-walk: walks per query (default: its samples option, 1024); a point "
+                    "evaluation then prints f_r f_g f_b se_r se_g se_b")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--seed", a->seed, "random-walk: seed of the walks (≥ 1)")
+        ->check(CLI::PositiveNumber);
     cmd->add_option("--option", a->options,
                     "Model flag KEY=VALUE, repeatable (see `lamina models --options`)");
     return [a] { return run_eval(*a); };

@@ -3,7 +3,9 @@
 // lamina compare STACK.json [--theta-i …] [--particles N] [--models …] --out DIR: one stack.
 #include "cli/commands.h"
 #include "cli/options.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "render/contact_sheet.h"
 #include "report/explorer.h"
 #include "report/figures.h"
 #include "study/configurations.h"
@@ -88,6 +90,8 @@ void print_findings(const std::filesystem::path& dir) {
 Runner add_study(CLI::App& app) {
     struct Args : CommonArgs {
         std::string preset = "quick", only, configs;
+        bool render = false;
+        int render_size = 160, render_spp = 32;
     };
     auto a = std::make_shared<Args>();
     auto* cmd = app.add_subcommand(
@@ -99,6 +103,15 @@ Runner add_study(CLI::App& app) {
     cmd->add_option("--configs", a->configs, "A JSON list of your own configurations");
     add_common(cmd, *a);
     cmd->add_option("--out,-o", a->out, "Output folder (default out/study-PRESET)");
+    cmd->add_flag(
+        "--render", a->render,
+        "Also render every configuration (reference and models, studio lighting) into "
+        "OUT/configs/ID/renders/ (compare.png, PNG + EXR per model, errors.csv), shown by "
+        "the explorer");
+    cmd->add_option("--render-size", a->render_size, "Pixels of each rendering (default 160)")
+        ->check(CLI::Range(8, 4096));
+    cmd->add_option("--render-spp", a->render_spp, "Samples per pixel (default 32)")
+        ->check(CLI::Range(1, 1 << 20));
     return [a] {
         const StudySettings s = settings_from(*a, a->preset);
         auto configs =
@@ -108,6 +121,29 @@ Runner add_study(CLI::App& app) {
             a->out.empty() ? std::filesystem::path("out") / ("study-" + a->preset)
                            : std::filesystem::path(a->out);
         run_study(configs, s, out);
+        if (a->render) {
+            // Renderings of every configuration: reproducible (seed), the same settings for all.
+            RenderSettings rs;
+            rs.size = a->render_size;
+            rs.spp = a->render_spp;
+            rs.seed = s.seed;
+            rs.threads = s.threads;
+            rs.progress = !s.quiet;
+            const Environment env = Environment::named("studio");
+            std::string index = "config,model,rel_rmse,seconds\n";
+            for (const StudyConfiguration& c : configs) {
+                const std::string csv =
+                    write_comparison(c.stack, env, rs, out / "configs" / c.id / "renders", 0.0);
+                std::stringstream lines(csv);
+                std::string line;
+                std::getline(lines, line);  // header
+                while (std::getline(lines, line))
+                    index += c.id + "," + line + "\n";
+            }
+            write_file_atomic(out / "renders.csv", index);
+            fmt::print("Renderings: {0}/configs/ID/renders/compare.png (errors: {0}/renders.csv)\n",
+                       out.string());
+        }
         write_report(out, !a->no_figures);
         fmt::print("\n");
         print_findings(out);

@@ -25,5 +25,7 @@ Runner add_eval(CLI::App& app);
 Runner add_explorer(CLI::App& app);
 /// `lamina figures DIR`: a study directory's paper figures (cmd_figures.cpp).
 Runner add_figures(CLI::App& app);
+/// `lamina render`: sphere renderings and the comparison sheet (cmd_render.cpp).
+Runner add_render(CLI::App& app);
 
 }  // namespace lamina::cli

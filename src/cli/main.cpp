@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
     add(lamina::cli::add_simulate);
     add(lamina::cli::add_models);
     add(lamina::cli::add_eval);
+    add(lamina::cli::add_render);
     add(lamina::cli::add_compare);
     add(lamina::cli::add_study);
     add(lamina::cli::add_explorer);

@@ -25,4 +25,8 @@ std::vector<OptionSpec> bel18_symmetric_options();
 std::unique_ptr<Model> make_bel_prime(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> bel_prime_options();
 
+// random_walk_model.cpp: the per-query stochastic reference (randomwalk/random_walk.h)
+std::unique_ptr<Model> make_random_walk(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> random_walk_options();
+
 }  // namespace lamina

@@ -34,6 +34,10 @@ const std::vector<ModelEntry>& model_registry() {
         {"bel-prime", "Bel': Bel18 forward with the exact top reflection and a slab BTDF lobe",
          "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R, T (slab)",
          bel_prime_options, make_bel_prime},
+        {"random-walk",
+         "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "
+         "per-query reference, unbiased",
+         "every stack; sides: R, T (slab)", random_walk_options, make_random_walk, true},
     };
     return entries;
 }

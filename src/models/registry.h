@@ -18,6 +18,9 @@ struct ModelEntry {
     std::string supports;     ///< bases and sides, one line
     std::vector<OptionSpec> (*options)();
     std::unique_ptr<Model> (*make)(const Stack& stack, const ModelOptions& options);
+    /// A stochastic estimator (the random walk): its eval is noisy and slow, so the study's
+    /// default model list and the analytic-model sweeps leave it out.
+    bool stochastic = false;
 };
 
 /// Every model, in the order `lamina models` lists them.

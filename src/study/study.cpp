@@ -210,7 +210,7 @@ std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
     std::vector<std::string> model_names = s.models;
     if (model_names.empty())
         for (const ModelEntry& e : model_registry())
-            model_names.push_back(e.name);
+            if (!e.stochastic) model_names.push_back(e.name);
     for (const std::string& name : model_names)
         find_model(name, "--models");  // validates
 

@@ -144,5 +144,27 @@ if [ -e "$tmp/bad1" ]; then echo "FAIL simulate: a failed run left $tmp/bad1"; f
 touch "$tmp/a-file"
 check_says simulate-unwritable 1 "--out" \
     "$lamina" simulate "$src/examples/plastic.json" --particles 100 --out "$tmp/a-file/sub"
+# eval --model random-walk: six numbers (f and its standard error), reproducible for a seed.
+check_says eval-rw-six 0 "six" sh -c "'$lamina' eval --model random-walk --stack '$src/examples/plastic.json' --theta-i 30 --theta-o 45 --phi-o 180 --samples 2000 --seed 3 | awk '{ if (NF == 6) print \"six\"; else print \"wrong\" }' | grep -x six"
+"$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 --theta-o 45 --phi-o 180 --samples 2000 --seed 3 >"$tmp/rw1"
+"$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 --theta-o 45 --phi-o 180 --samples 2000 --seed 3 >"$tmp/rw2"
+check eval-rw-reproducible 0 cmp "$tmp/rw1" "$tmp/rw2"
+check_says eval-samples-analytic 1 "only the stochastic model random-walk" \
+    "$lamina" eval --model ww-prime --stack "$src/examples/plastic.json" --theta-i 30 --theta-o 45 --phi-o 180 --samples 10
+
+# render: a PNG and an EXR; the comparison sheet; identical images for any thread count.
+check render-png 0 "$lamina" render "$src/examples/plastic.json" --size 24 --spp 2 --threads 1 --out "$tmp/r1.png"
+check render-exr 0 test -s "$tmp/r1.exr"
+check render-threads 0 "$lamina" render "$src/examples/plastic.json" --size 24 --spp 2 --threads 2 --out "$tmp/r2.png"
+check render-reproducible 0 cmp "$tmp/r1.exr" "$tmp/r2.exr"
+check render-compare 0 "$lamina" render "$src/examples/metallic-paint.json" --compare --size 24 --spp 2 --out "$tmp/cmp"
+check render-sheet 0 test -s "$tmp/cmp/compare.png"
+check_says render-errors 0 "ww-prime," cat "$tmp/cmp/errors.csv"
+check_says render-bad-env 1 "unknown environment" \
+    "$lamina" render "$src/examples/plastic.json" --env moon --out "$tmp/r3.png"
+check study-render 0 "$lamina" study --only 'plastic-P2-a0.05*' --particles 2e4 --grid 9x9 --theta-i 30 \
+    --render --render-size 24 --render-spp 2 --out "$tmp/study-r"
+check study-render-sheet 0 test -s "$tmp/study-r/renders/plastic-P2-a0.05/compare.png"
+check_says study-render-index 0 "plastic-P2-a0.05,ww-prime," cat "$tmp/study-r/renders/errors.csv"
 echo "$pass passed, $fails failed"
 [ "$fails" -eq 0 ]

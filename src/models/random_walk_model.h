@@ -1,0 +1,43 @@
+#pragma once
+// The `random-walk` model: the stack's per-query stochastic estimator (randomwalk/random_walk.h)
+// behind the Model interface, so that `lamina eval`, the binned comparisons and the renderer find
+// it in the one registry table. The estimator itself lives in lamina_randomwalk, which depends only
+// on layers and physics; the models library wraps it (models → randomwalk), so dependencies keep
+// pointing one way: core ← physics ← layers ← randomwalk ← models ← study ← cli.
+//
+// eval(wi, wo) is a deterministic function of (wi, wo, seed): the walks of one query use the
+// counter-based generator keyed by (seed, hash of the two directions' bits, walk index).
+
+#include "models/model.h"
+#include "randomwalk/random_walk.h"
+
+#include <cstdint>
+
+namespace lamina {
+
+class RandomWalkModel final : public Model {
+  public:
+    RandomWalkModel(const Stack& stack, std::uint64_t samples, std::uint64_t seed);
+
+    std::string name() const override { return "random-walk"; }
+    Support support() const override;
+    Rgbd eval(const Vec3d& wi, const Vec3d& wo) const override;
+    std::vector<DeltaLobe> delta_lobes(const Vec3d& wi) const override;
+
+    /// The estimate with its standard error (what `lamina eval` prints).
+    RandomWalkEstimate estimate(const Vec3d& wi, const Vec3d& wo) const;
+
+    void set_samples(std::uint64_t n) { samples_ = n; }
+    void set_seed(std::uint64_t s) { seed_ = s; }
+    const RandomWalkStack& walker() const { return walker_; }
+
+  private:
+    RandomWalkStack walker_;
+    std::uint64_t samples_, seed_;
+};
+
+/// The stream of a query: a hash of the two directions' bits (splitmix64 finalizer, Steele et al.
+/// 2014), so that different queries use independent walks.
+std::uint64_t query_stream(const Vec3d& wi, const Vec3d& wo);
+
+}  // namespace lamina

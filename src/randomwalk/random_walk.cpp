@@ -1,0 +1,630 @@
+#include "randomwalk/random_walk.h"
+
+#include "core/check.h"
+#include "core/math.h"
+#include "physics/fresnel.h"
+#include "physics/phase.h"
+
+#include <array>
+#include <cmath>
+
+namespace lamina {
+
+// ---- The connection towards wo (docs/rendering.md §1.2) ----------------------------------------
+// Regions r = 0..L: 0 the ambient medium, r the medium below interface r − 1, L below the base.
+// At the Snell invariant of wo every region r has one horizontal component h_r = (η_e/η_r)·wo_xy
+// (η_e the index of the exit region) and a cosine μ_r = √(1 − |h_r|²), or none (evanescent).
+// up[k] / down[k] = throughput of every delta chain from light arriving at interface k from below
+// / from above to the exit towards wo, per channel.
+struct RandomWalkStack::Connection {
+    bool top = true;  ///< the exit is upwards (BRDF) rather than downwards (BTDF)
+    /// Strategy 2 applies: the exit interface (the top for the BRDF, the base for the BTDF) is a
+    /// rough dielectric with a region on its inner side (`inner`, 1 or L − 1) whose vertices —
+    /// interface `vertex_interface` (1 or L − 2) and scattering events — it connects.
+    bool rough_exit = false;
+    int exit_interface = 0, inner = 1, vertex_interface = 1;
+    /// Propagation towards the exit in the inner region: +1 up (top), −1 down (base).
+    double towards = 1;
+    /// The depth-distance from depth s of the inner region to the exit interface.
+    double distance(double s) const { return top ? s : 1 - s; }
+    int L = 0;
+    std::vector<char> valid;      ///< region r has a propagating direction
+    std::vector<double> mu;       ///< its |cos|
+    std::vector<Vec3d> dir_up;    ///< propagation direction up in region r
+    std::vector<Vec3d> dir_down;  ///< and down
+    std::vector<Rgbd> t;          ///< unscattered transmittance of region r's whole medium
+    std::vector<double> scale;    ///< (η_e/η_r)²: radiance compression
+    std::vector<Rgbd> up, down;   ///< A_k^↑, A_k^↓
+
+    /// Throughput of leaving upwards from the bottom of region r (just above interface r).
+    Rgbd from_bottom_up(int r) const {
+        if (!valid[r]) return Rgbd(0.0);
+        if (r == 0) return Rgbd(top ? 1.0 : 0.0);
+        return t[r] * up[r - 1];
+    }
+    /// Throughput of leaving downwards from the top of region r (just below interface r − 1).
+    Rgbd from_top_down(int r) const {
+        if (!valid[r]) return Rgbd(0.0);
+        if (r == L) return Rgbd(top ? 0.0 : 1.0);
+        return t[r] * down[r];
+    }
+};
+
+namespace {
+
+// Solves M x = b (n ≤ a few dozen) by Gaussian elimination with partial pivoting.
+void solve_dense(std::vector<double>& M, std::vector<double>& b, int n) {
+    for (int col = 0; col < n; ++col) {
+        int piv = col;
+        for (int r = col + 1; r < n; ++r)
+            if (std::abs(M[r * n + col]) > std::abs(M[piv * n + col])) piv = r;
+        if (piv != col) {
+            for (int c = 0; c < n; ++c)
+                std::swap(M[col * n + c], M[piv * n + c]);
+            std::swap(b[col], b[piv]);
+        }
+        const double p = M[col * n + col];
+        if (p == 0) continue;  // an unreachable unknown: its row and column are zero
+        for (int r = col + 1; r < n; ++r) {
+            const double m = M[r * n + col] / p;
+            if (m == 0) continue;
+            for (int c = col; c < n; ++c)
+                M[r * n + c] -= m * M[col * n + c];
+            b[r] -= m * b[col];
+        }
+    }
+    for (int r = n - 1; r >= 0; --r) {
+        double s = b[r];
+        for (int c = r + 1; c < n; ++c)
+            s -= M[r * n + c] * b[c];
+        b[r] = M[r * n + r] != 0 ? s / M[r * n + r] : 0.0;
+    }
+}
+
+bool is_black(const Rgbd& w) {
+    return w[0] == 0 && w[1] == 0 && w[2] == 0;
+}
+
+Rgbd exp_neg(const Rgbd& x) {
+    return {std::exp(-x[0]), std::exp(-x[1]), std::exp(-x[2])};
+}
+
+}  // namespace
+
+RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events)
+    : transmits_(stack.transmits()), max_events_(max_events) {
+    LAMINA_CHECK(max_events >= 1);
+    const int L = int(stack.layers.size());
+    eta_.assign(L + 1, 1.0);
+    media_.assign(L + 1, Medium{});
+    eta_[0] = stack.ambient_eta;
+    for (int k = 0; k < L; ++k) {
+        const Layer& layer = stack.layers[k];
+        const InterfaceSpec& spec = layer.interface;
+        const double eta_above = stack.eta_above(k);
+        Interface it;
+        it.type = spec.type;
+        switch (spec.type) {
+            case InterfaceType::Dielectric:
+                it.dielectric = {spec.eta / eta_above, spec.alpha};
+                it.delta = it.dielectric.is_smooth() || it.dielectric.is_index_matched();
+                eta_[k + 1] = spec.eta;
+                break;
+            case InterfaceType::Conductor:
+                it.conductor = {spec.eta_rgb / eta_above, spec.k / eta_above, spec.alpha};
+                it.delta = it.conductor.is_smooth();
+                eta_[k + 1] = eta_above;  // no region below an opaque base
+                break;
+            case InterfaceType::Lambertian:
+                it.lambertian = {spec.albedo};
+                it.delta = false;
+                eta_[k + 1] = eta_above;
+                break;
+        }
+        interfaces_.push_back(it);
+        if (layer.has_medium) {
+            const MediumSpec& m = layer.medium;
+            Medium& md = media_[k + 1];
+            md.tau_s = m.tau_s;
+            md.tau_t = m.tau_t();
+            md.g = m.g;
+            md.scatters = m.scatters();
+            md.empty = m.is_empty();
+            md.uniform_tau_t = md.tau_t[0] == md.tau_t[1] && md.tau_t[1] == md.tau_t[2];
+            md.uniform_g = m.g[0] == m.g[1] && m.g[1] == m.g[2];
+            for (int c = 0; c < 3; ++c)
+                md.single_scattering_albedo[c] = md.tau_t[c] > 0 ? m.tau_s[c] / md.tau_t[c] : 0.0;
+        }
+    }
+}
+
+// ---- Building the connection: the delta-chain ladder
+// --------------------------------------------- For interface k (regions k above, k + 1 below),
+// with t_r the unscattered transmittance of region r at μ_r and E_top/E_bot = 1 for the exit side
+// and 0 for the other:
+//   A_k^↑ = T_k^↑ · (k = 0 ? E_top : t_k A_{k−1}^↑) + R_k^↑ · (k + 1 = L ? E_bot : t_{k+1}
+//   A_{k+1}^↓) A_k^↓ = R_k^↓ · (k = 0 ? E_top : t_k A_{k−1}^↑) + T_k^↓ · (k + 1 = L ? E_bot :
+//   t_{k+1} A_{k+1}^↓)
+// with Fresnel R, T = 1 − R of a smooth dielectric (T = G2/G1, R = 0 for a rough index-matched
+// one), R = F_conductor for a smooth conductor, and A = 0 at a non-delta interface (a path that
+// meets one has a later non-delta vertex, which connects instead).
+static void build_connection(const std::vector<double>& eta, const auto& interfaces,
+                             const auto& media, const Vec3d& wo, bool top,
+                             RandomWalkStack::Connection& c) {
+    const int L = int(interfaces.size());
+    c.top = top;
+    c.L = L;
+    const int R = L + 1;
+    c.valid.assign(R, 0);
+    c.mu.assign(R, 0.0);
+    c.dir_up.assign(R, Vec3d());
+    c.dir_down.assign(R, Vec3d());
+    c.t.assign(R, Rgbd(0.0));
+    c.scale.assign(R, 0.0);
+    c.up.assign(L, Rgbd(0.0));
+    c.down.assign(L, Rgbd(0.0));
+    c.exit_interface = top ? 0 : L - 1;
+    c.inner = top ? 1 : L - 1;
+    c.vertex_interface = top ? 1 : L - 2;
+    c.towards = top ? 1 : -1;
+    c.rough_exit = L >= 2 && interfaces[c.exit_interface].type == InterfaceType::Dielectric &&
+                   !interfaces[c.exit_interface].delta;
+    const int exit_region = top ? 0 : L;
+    const double eta_e = eta[exit_region];
+    const double sin2_exit = sqr(wo.x) + sqr(wo.y);
+    // Regions are reachable from the exit only through propagating regions: walk away from it.
+    bool reachable = true;
+    for (int i = 0; i < R; ++i) {
+        const int r = top ? i : L - i;
+        const double ratio = eta_e / eta[r];
+        const double sin2 = sqr(ratio) * sin2_exit;
+        if (!(sin2 < 1)) reachable = false;
+        if (!reachable) continue;
+        c.valid[r] = 1;
+        if (r == exit_region) {
+            c.mu[r] = std::abs(wo.z);
+        } else {
+            c.mu[r] = std::sqrt(1 - sin2);
+        }
+        const Vec3d h(wo.x * ratio, wo.y * ratio, 0.0);
+        c.dir_up[r] = Vec3d(h.x, h.y, c.mu[r]);
+        c.dir_down[r] = Vec3d(h.x, h.y, -c.mu[r]);
+        if (r == exit_region) (top ? c.dir_up[r] : c.dir_down[r]) = wo;
+        c.t[r] = media[r].empty ? Rgbd(1.0) : exp_neg(media[r].tau_t / c.mu[r]);
+        c.scale[r] = sqr(ratio);
+    }
+    // Unknowns x = (A_0^↑ … A_{L−1}^↑, A_0^↓ … A_{L−1}^↓), one system per channel.
+    const int n = 2 * L;
+    for (int ch = 0; ch < 3; ++ch) {
+        std::vector<double> M(std::size_t(n) * n, 0.0), b(n, 0.0);
+        for (int i = 0; i < n; ++i)
+            M[i * n + i] = 1;
+        auto up = [&](int k) { return k; };
+        auto down = [&](int k) { return L + k; };
+        // "Goes up into region k" and "goes down into region k + 1" from interface k.
+        auto add_up = [&](int row, int k, double coeff) {
+            if (coeff == 0 || !c.valid[k]) return;
+            if (k == 0)
+                b[row] += coeff * (top ? 1.0 : 0.0);
+            else
+                M[row * n + up(k - 1)] -= coeff * c.t[k][ch];
+        };
+        auto add_down = [&](int row, int k, double coeff) {
+            if (coeff == 0 || !c.valid[k + 1]) return;
+            if (k + 1 == L)
+                b[row] += coeff * (top ? 0.0 : 1.0);
+            else
+                M[row * n + down(k + 1)] -= coeff * c.t[k + 1][ch];
+        };
+        for (int k = 0; k < L; ++k) {
+            const auto& it = interfaces[k];
+            if (!it.delta) continue;  // rows stay x = 0
+            if (it.type == InterfaceType::Conductor) {
+                if (c.valid[k]) add_up(down(k), k, it.conductor.fresnel(c.mu[k])[ch]);
+                continue;
+            }
+            const auto& d = it.dielectric;
+            if (d.is_index_matched()) {
+                // A pass-through: T = G2(w, −w)/G1(w) (1 when smooth), R = 0.
+                auto pass = [&](const Vec3d& w) {
+                    return d.is_smooth() ? 1.0
+                                         : d.masking_shadowing(w, -w) / d.distribution().G1(w);
+                };
+                if (c.valid[k + 1]) add_up(up(k), k, pass(-c.dir_up[k + 1]));
+                if (c.valid[k]) add_down(down(k), k, pass(-c.dir_down[k]));
+                continue;
+            }
+            if (c.valid[k + 1]) {  // arriving from below, cosine μ_{k+1}
+                const double F = fresnel_dielectric(-c.mu[k + 1], d.eta);
+                add_up(up(k), k, 1 - F);
+                add_down(up(k), k, F);
+            }
+            if (c.valid[k]) {  // arriving from above, cosine μ_k
+                const double F = fresnel_dielectric(c.mu[k], d.eta);
+                add_up(down(k), k, F);
+                add_down(down(k), k, 1 - F);
+            }
+        }
+        solve_dense(M, b, n);
+        for (int k = 0; k < L; ++k) {
+            c.up[k][ch] = b[up(k)];
+            c.down[k][ch] = b[down(k)];
+        }
+    }
+}
+
+// ---- The second connection strategy through a rough top (docs/rendering.md §1.3) ---------------
+// Under a rough top interface the first strategy (the walk reaches the top and evaluates the top's
+// BTDF towards wo) is noisy for narrow lobes: the walk's direction must fall into the lobe. The
+// second strategy samples the top's transmission from the viewer side, t ~ pdf_top(wo, t) (the
+// adjoint of the exit), and connects a non-delta vertex v of region 1 along ω = −t:
+//     w · k_v(ω) · T_v(ω) · f_top(t, wo) / pdf_top(wo, t),
+// k_v = f_v·|cos ω| (interface) or the HG phase (medium), T_v the unscattered transmittance from v
+// to the top. Both strategies sample the same paths (v → top → wo); they are combined with the
+// balance heuristic w_s = p_s / (p_1 + p_2), with
+//     p_1(ω) = pdf_v(ω) · P̃(ℓ),  P̃(ℓ) = exp(−mean_c(τt_c) · ℓ) in a scattering medium, else 1,
+//     p_2(ω) = pdf_top(wo, −ω),
+// ℓ = depth of v / |cos ω| the normal-optical-depth path factor. P̃ approximates the survival
+// probability of the walk's free flight; the weights are unbiased for any such choice because both
+// strategies compute them with the same function of the same path (Veach 1997, §9.2.2).
+struct RandomWalkStack::WalkState {
+    Vec3d d;      ///< propagation direction
+    Rgbd w{1.0};  ///< flux weight
+    int events = 0;
+    bool delta_only = true;
+    bool prev_mis = false;  ///< the last vertex was non-delta, in the inner region, and sent the
+                            ///< walk towards the exit interface
+    double prev_pdf = 0;    ///< its sampling density of the current direction
+    double prev_depth =
+        0;  ///< its depth-distance to the exit interface (1 at the vertex interface)
+};
+
+double RandomWalkStack::survival_proxy(int region, double path) const {
+    const Medium& m = media_[region];
+    return m.scatters ? std::exp(-m.tau_t.mean() * path) : 1.0;
+}
+
+// Strategy 2 at a vertex of the inner region that emits `k_v(ω)` (per channel, kernel incl. cos
+// for an interface) with pdf `pdf_v(ω)`, at depth-distance `depth` from the exit (1: the vertex
+// interface). The exit's transmission is sampled from wo (t on the inner side); ω = −t.
+template <typename Kernel, typename Pdf>
+void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& wo, double depth,
+                                           const Rgbd& w, ParticleRng& rng, const Kernel& kernel,
+                                           const Pdf& pdf_v, Rgbd& f) const {
+    const DielectricInterface<double>& exit = interfaces_[conn.exit_interface].dielectric;
+    const double uc = rng.uniform_double(), u1 = rng.uniform_double(), u2 = rng.uniform_double();
+    const auto st = exit.sample<true>(wo, uc, u1, u2);
+    if (!st || !st->is_transmission || st->shadowing == 0 || st->pdf <= 0) return;
+    const Vec3d omega = -st->wo;
+    if (omega.z * conn.towards <= 0) return;
+    const double mu = std::abs(omega.z);
+    const double f_exit = exit.eval(st->wo, wo);
+    if (f_exit == 0) return;
+    const Rgbd kv = kernel(omega);
+    if (is_black(kv)) return;
+    const Medium& m = media_[conn.inner];
+    const Rgbd tr = m.empty ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
+    const double p1 = pdf_v(omega) * survival_proxy(conn.inner, depth / mu);
+    const double mis = st->pdf / (st->pdf + p1);
+    f += w * kv * tr * (f_exit / st->pdf * mis);
+}
+
+// ---- Media (physics.md §4), as the goniophotometer traverses them ------------------------------
+// Depth s ∈ [0, 1] across the layer (0 at its top). Returns true if the particle leaves through
+// the top. Free flights from a mixture of the channels' exponentials with probabilities ∝ flux and
+// per-channel weights (one-sample spectral MIS, balance heuristic: Veach 1997, §9.2.4), exactly as
+// simulator/goniophotometer.cpp. Each scattering event is a non-delta vertex: it connects along
+// d_r up and down with the channel's own HG phase and the unscattered transmittance to the
+// boundary, e^{−τt·s/μ} (up) or e^{−τt·(1 − s)/μ} (down), and below a rough top by strategy 2.
+template <bool kConnect>
+bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rng,
+                                      const Connection* conn, const Vec3d& wo, Rgbd& f) const {
+    Vec3d& d = ws.d;
+    Rgbd& w = ws.w;
+    const Medium& m = media_[region];
+    if (!m.scatters) {
+        const double inv_mu = 1 / std::abs(d.z);
+        w *= exp_neg(m.tau_t * inv_mu);
+        return d.z > 0;
+    }
+    double s = d.z < 0 ? 0 : 1;
+    while (true) {
+        const double mu = std::abs(d.z);
+        const double to_boundary = (d.z < 0 ? 1 - s : s) / mu;
+        const double total = w[0] + w[1] + w[2];
+        if (total <= 0) return d.z > 0;
+        const double p[3] = {w[0] / total, w[1] / total, w[2] / total};
+        const double uc = rng.uniform_double();
+        const int c = uc < p[0] ? 0 : (uc < p[0] + p[1] ? 1 : 2);
+        const double sigma_c = m.tau_t[c];
+        const double u = rng.uniform_double();
+        const double flight = sigma_c > 0 ? -std::log1p(-u) / sigma_c : INFINITY;
+        if (m.uniform_tau_t) {
+            if (flight >= to_boundary) return d.z > 0;
+            w *= m.single_scattering_albedo;
+        } else if (flight >= to_boundary) {
+            double mix = 0;
+            Rgbd tr;
+            for (int k = 0; k < 3; ++k) {
+                tr[k] = std::exp(-m.tau_t[k] * to_boundary);
+                mix += p[k] * tr[k];
+            }
+            for (int k = 0; k < 3; ++k)
+                w[k] *= tr[k] / mix;
+            return d.z > 0;
+        } else {
+            double mix = 0;
+            Rgbd num;
+            for (int k = 0; k < 3; ++k) {
+                const double e = std::exp(-m.tau_t[k] * flight);
+                num[k] = m.tau_s[k] * e;
+                mix += p[k] * m.tau_t[k] * e;
+            }
+            for (int k = 0; k < 3; ++k)
+                w[k] *= num[k] / mix;
+        }
+        s = clamp(s - d.z * flight, 0.0, 1.0);
+        ws.delta_only = false;
+        // The phase-sampling density: the mixture Σ p_k HG_k when g differs per channel.
+        auto phase_pdf = [&](double cos_theta) {
+            if (m.uniform_g) return hg_phase(cos_theta, m.g[0]);
+            double q = 0;
+            for (int k = 0; k < 3; ++k)
+                q += p[k] * hg_phase(cos_theta, m.g[k]);
+            return q;
+        };
+        if constexpr (kConnect) {
+            // Next event: flux w scattered into dω_d with density p_c(d_in·d) becomes, through
+            // the delta chains, flux w p Q (η_e/η_r)² cos_e/|cos d| dω_e.
+            if (conn->valid[region]) {
+                const double mu_r = conn->mu[region];
+                const Rgbd above = region >= 1 ? conn->up[region - 1] : Rgbd(0.0);
+                const Rgbd below = region < conn->L ? conn->down[region] : Rgbd(0.0);
+                const Rgbd tr_up = exp_neg(m.tau_t * (s / mu_r));
+                const Rgbd tr_down = exp_neg(m.tau_t * ((1 - s) / mu_r));
+                const double cu = dot(d, conn->dir_up[region]);
+                const double cd = dot(d, conn->dir_down[region]);
+                const double k = conn->scale[region] / mu_r;
+                for (int ch = 0; ch < 3; ++ch) {
+                    const double g = m.g[ch];
+                    f[ch] += w[ch] * k *
+                             (hg_phase(cu, g) * tr_up[ch] * above[ch] +
+                              hg_phase(cd, g) * tr_down[ch] * below[ch]);
+                }
+            }
+            if (conn->rough_exit && region == conn->inner) {
+                const Vec3d d_in = d;
+                connect_through_exit(
+                    *conn, wo, conn->distance(s), w, rng,
+                    [&](const Vec3d& om) {
+                        const double ct = dot(d_in, om);
+                        return Rgbd(hg_phase(ct, m.g[0]), hg_phase(ct, m.g[1]),
+                                    hg_phase(ct, m.g[2]));
+                    },
+                    [&](const Vec3d& om) { return phase_pdf(dot(d_in, om)); }, f);
+            }
+        }
+        int c_phase = c;
+        if (!m.uniform_g) {
+            const double up = rng.uniform_double();
+            c_phase = up < p[0] ? 0 : (up < p[0] + p[1] ? 1 : 2);
+        }
+        const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
+        const Vec3d d_new = sample_hg(d, m.g[c_phase], u1, u2);
+        const double cos_theta = dot(d, d_new);
+        if (!m.uniform_g) {
+            double mix = 0;
+            Rgbd ph;
+            for (int k = 0; k < 3; ++k) {
+                ph[k] = hg_phase(cos_theta, m.g[k]);
+                mix += p[k] * ph[k];
+            }
+            for (int k = 0; k < 3; ++k)
+                w[k] *= ph[k] / mix;
+        }
+        // The walk's own strategy for the same paths (strategy 1, weighted at the exit). Only
+        // meaningful while connecting (conn is null for sample()).
+        ws.prev_mis =
+            kConnect && conn->rough_exit && region == conn->inner && d_new.z * conn->towards > 0;
+        ws.prev_pdf = phase_pdf(cos_theta);
+        ws.prev_depth = kConnect ? conn->distance(s) : 0;
+        d = d_new;
+        if (is_black(w)) return d.z > 0;
+        if (++ws.events >= max_events_) {
+            w = Rgbd(0.0);
+            return d.z > 0;
+        }
+    }
+}
+
+// ---- One walk ----------------------------------------------------------------------------------
+template <bool kConnect>
+void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
+                           const Connection* conn, Rgbd& f,
+                           std::optional<RandomWalkSample>* exit) const {
+    const int L = int(interfaces_.size());
+    WalkState ws;
+    ws.d = -wi;
+    Vec3d& d = ws.d;
+    Rgbd& w = ws.w;
+    int k = 0;  // the interface the particle is about to meet
+    while (ws.events++ < max_events_) {
+        const Interface& it = interfaces_[k];
+        const Vec3d wi_local = -d;
+        // Strategy 1's balance-heuristic weight at the exit interface (1 for other paths): the
+        // particle arrives from the inner region straight from a vertex that strategy 2 connects.
+        auto exit_mis = [&](int at) {
+            if constexpr (!kConnect)
+                return 1.0;
+            else {
+                if (!conn->rough_exit || at != conn->exit_interface || !ws.prev_mis ||
+                    d.z * conn->towards <= 0)
+                    return 1.0;
+                const double p1 =
+                    ws.prev_pdf * survival_proxy(conn->inner, ws.prev_depth / std::abs(d.z));
+                const double p2 = it.dielectric.pdf(wo, wi_local);
+                return p1 / (p1 + p2);
+            }
+        };
+        // Next event at a non-delta interface: into region k (up) and, for a dielectric, region
+        // k + 1 (down); the kernel f·|cos| and the Jacobian's 1/|cos| cancel.
+        if constexpr (kConnect) {
+            if (!it.delta) {
+                if (conn->valid[k]) {
+                    const Vec3d& du = conn->dir_up[k];
+                    Rgbd fv = eval_interface(it, wi_local, du);
+                    f += w * fv * conn->from_bottom_up(k) * (conn->scale[k] * exit_mis(k));
+                }
+                if (it.type == InterfaceType::Dielectric && conn->valid[k + 1]) {
+                    const Vec3d& dd = conn->dir_down[k + 1];
+                    f += w * Rgbd(it.dielectric.eval(wi_local, dd)) * conn->from_top_down(k + 1) *
+                         (conn->scale[k + 1] * exit_mis(k));
+                }
+                // Strategy 2 from the vertex interface emitting into the inner region.
+                if (conn->rough_exit && k == conn->vertex_interface) {
+                    connect_through_exit(
+                        *conn, wo, 1.0, w, rng,
+                        [&](const Vec3d& om) {
+                            return eval_interface(it, wi_local, om) * std::abs(om.z);
+                        },
+                        [&](const Vec3d& om) { return pdf_interface(it, wi_local, om); }, f);
+                }
+            }
+        }
+        std::optional<BsdfSample<double>> s;
+        switch (it.type) {
+            case InterfaceType::Dielectric: {
+                const double uc = rng.uniform_double(), u1 = rng.uniform_double(),
+                             u2 = rng.uniform_double();
+                s = it.dielectric.sample<true>(wi_local, uc, u1, u2);
+                break;
+            }
+            case InterfaceType::Conductor: {
+                const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
+                s = it.conductor.sample<true>(wi_local, u1, u2);
+                break;
+            }
+            case InterfaceType::Lambertian: {
+                const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
+                s = it.lambertian.sample(wi_local, u1, u2);
+                break;
+            }
+        }
+        if (!s) return;  // a numerical degeneracy: the flux is dropped
+        w *= s->weight;
+        if (!it.delta) ws.delta_only = false;
+        d = s->wo;
+        if constexpr (kConnect)
+            ws.prev_mis = conn->rough_exit && k == conn->vertex_interface && !it.delta &&
+                          d.z * conn->towards > 0;
+        ws.prev_pdf = s->pdf;
+        ws.prev_depth = 1;
+        if (is_black(w) || d.z == 0) return;
+        if (d.z > 0) {
+            if (k == 0) {  // leaves upwards
+                if (exit) *exit = RandomWalkSample{d, w, ws.delta_only};
+                return;
+            }
+            bool up = true;
+            if (!media_[k].empty) up = traverse_medium<kConnect>(k, ws, rng, conn, wo, f);
+            if (is_black(w)) return;
+            if (up) --k;
+        } else {
+            if (k == L - 1) {  // leaves through the final dielectric
+                if (exit) *exit = RandomWalkSample{d, w, ws.delta_only};
+                return;
+            }
+            bool up = false;
+            if (!media_[k + 1].empty) up = traverse_medium<kConnect>(k + 1, ws, rng, conn, wo, f);
+            if (is_black(w)) return;
+            if (!up) ++k;
+        }
+    }
+}
+
+Rgbd RandomWalkStack::eval_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo) {
+    switch (it.type) {
+        case InterfaceType::Dielectric:
+            return Rgbd(it.dielectric.eval(wi, wo));
+        case InterfaceType::Conductor:
+            return it.conductor.eval(wi, wo);
+        case InterfaceType::Lambertian:
+            return it.lambertian.eval(wi, wo);
+    }
+    return Rgbd(0.0);
+}
+
+double RandomWalkStack::pdf_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo) {
+    switch (it.type) {
+        case InterfaceType::Dielectric:
+            return it.dielectric.pdf(wi, wo);
+        case InterfaceType::Conductor:
+            return it.conductor.pdf(wi, wo);
+        case InterfaceType::Lambertian:
+            return it.lambertian.pdf(wi, wo);
+    }
+    return 0;
+}
+
+Rgbd RandomWalkStack::eval_once(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng) const {
+    if (wi.z <= 0 || wo.z == 0 || (wo.z < 0 && !transmits_)) return Rgbd(0.0);
+    Connection conn;
+    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, conn);
+    Rgbd f(0.0);
+    walk<true>(wi, wo, rng, &conn, f, nullptr);
+    return f;
+}
+
+std::vector<RandomWalkStack::DeltaExit> RandomWalkStack::delta_lobes(const Vec3d& wi) const {
+    std::vector<DeltaExit> out;
+    if (wi.z <= 0 || !interfaces_[0].delta) return out;
+    // Light entering along −wi at interface 0 from above is A_0^↓ at wi's Snell invariant.
+    const Vec3d mirror(-wi.x, -wi.y, wi.z);
+    Connection conn;
+    build_connection(eta_, interfaces_, media_, mirror, true, conn);
+    if (conn.down[0].max() > 0) out.push_back({mirror, conn.down[0]});
+    if (transmits_) {
+        const int L = int(interfaces_.size());
+        const double ratio = eta_[0] / eta_[L];
+        const double sin2 = sqr(ratio) * (sqr(wi.x) + sqr(wi.y));
+        if (sin2 < 1) {
+            const Vec3d wt(-wi.x * ratio, -wi.y * ratio, -std::sqrt(1 - sin2));
+            build_connection(eta_, interfaces_, media_, wt, false, conn);
+            if (conn.down[0].max() > 0) out.push_back({wt, conn.down[0]});
+        }
+    }
+    return out;
+}
+
+RandomWalkEstimate RandomWalkStack::eval(const Vec3d& wi, const Vec3d& wo, std::uint64_t walks,
+                                         std::uint64_t seed, std::uint64_t stream) const {
+    RandomWalkEstimate e;
+    e.walks = walks;
+    if (walks == 0 || wi.z <= 0 || wo.z == 0 || (wo.z < 0 && !transmits_)) return e;
+    Connection conn;
+    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, conn);
+    Rgbd sum(0.0), sum_sq(0.0);
+    for (std::uint64_t i = 0; i < walks; ++i) {
+        ParticleRng rng(seed, stream, i);
+        Rgbd f(0.0);
+        walk<true>(wi, wo, rng, &conn, f, nullptr);
+        sum += f;
+        sum_sq += f * f;
+    }
+    const double n = double(walks);
+    for (int c = 0; c < 3; ++c) {
+        const double mean = sum[c] / n;
+        e.f[c] = mean;
+        e.se[c] = walks > 1 ? std::sqrt(std::max(0.0, sum_sq[c] / n - mean * mean) / (n - 1)) : 0;
+    }
+    return e;
+}
+
+std::optional<RandomWalkSample> RandomWalkStack::sample(const Vec3d& wi, ParticleRng& rng) const {
+    std::optional<RandomWalkSample> exit;
+    Rgbd unused(0.0);
+    walk<false>(wi, wi, rng, nullptr, unused, &exit);
+    return exit;
+}
+
+}  // namespace lamina

@@ -1,0 +1,134 @@
+#pragma once
+// A per-query stochastic estimator of a layer stack's BSDF f(wi, wo): position-free Monte Carlo
+// random walks through the layers (Guo, Hašan & Zhao 2018, "Position-free Monte Carlo simulation
+// for arbitrary layered BSDFs", ACM TOG 37(6)), reading the same Stack and the same interface and
+// phase-function code as the goniophotometer (physics/*.h), in double precision.
+//
+// Estimator (docs/rendering.md §1 has the derivation). A walk follows light exactly as the
+// goniophotometer does: it enters along −wi, samples every interface and medium with the shared
+// samplers and carries the same flux weights (spectral MIS in media). At every *non-delta* vertex v
+// (a rough interface, a Lambertian base, a scattering event) it adds a next-event connection
+// towards wo:
+//
+//     w_v · k_v(d_r) · Q_r(d_r) · (η_exit/η_r)² / |cos d_r|,
+//
+// where r is the region (medium) the connection leaves into, d_r the one direction in r that a
+// chain of smooth interfaces maps onto wo (Snell's invariant η·sinθ and the azimuth are kept by
+// every smooth reflection and refraction), k_v the vertex's flux kernel (f·|cos| of an interface
+// or the HG phase function), and Q_r(d_r) the *exact* total throughput of all delta chains from v
+// to the exit (any number of smooth reflections between smooth interfaces, unscattered
+// transmittance e^{−τt/μ} through media), obtained by solving a small linear system once per wo
+// (the adding equations of a 1-D ladder at a fixed Snell invariant). (η_exit/η_r)²/|cos| is the
+// étendue Jacobian dω_r/dω_exit·cos_exit/cos_r (radiance compression through refractions).
+//
+// Every light path from wi to wo that carries a non-delta part has exactly one last non-delta
+// vertex, and it is counted exactly once, at that vertex: the estimator is unbiased for the
+// non-delta part of f (delta lobes, paths made only of smooth events, are left out, as
+// Model::eval leaves them out). Because the light-side walk *is* the goniophotometer's particle
+// and the connection replaces its binning, both estimate the same quantity.
+//
+// sample(wi) returns the walk's own exit: an unbiased "stochastic-weight" sample of the stack
+// (E[weight·g(wo)] = ∫ f g |cos θo| dωo for every g). Its density has no closed form; the renderer
+// combines it with light sampling through MIS weights built from a proxy density, which keeps the
+// combination unbiased (weights sum to one per direction; docs/rendering.md §2).
+//
+// Thread safety: const methods only; each call owns its random-number generator.
+
+#include "core/rgb.h"
+#include "core/rng.h"
+#include "core/vec.h"
+#include "layers/stack.h"
+#include "physics/conductor.h"
+#include "physics/dielectric.h"
+#include "physics/lambertian.h"
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace lamina {
+
+struct RandomWalkEstimate {
+    Rgbd f{0.0};   ///< mean over walks, 1/sr
+    Rgbd se{0.0};  ///< standard error of the mean
+    std::uint64_t walks = 0;
+};
+
+struct RandomWalkSample {
+    Vec3d wo;               ///< exit direction (below the surface: transmitted)
+    Rgbd weight{0.0};       ///< flux weight: E[weight·g(wo)] = ∫ f g |cos θo| dωo
+    bool is_delta = false;  ///< every event of the walk was a delta event (smooth interfaces,
+                            ///< unscattered media): a delta lobe of the stack
+};
+
+/// The stack compiled for random walks (double precision, relative indices per interface).
+class RandomWalkStack {
+  public:
+    /// `max_events`: safety cap on events per walk (as the goniophotometer's); ≥ 1.
+    explicit RandomWalkStack(const Stack& stack, int max_events = 10'000);
+
+    bool transmits() const { return transmits_; }
+    int interfaces() const { return int(interfaces_.size()); }
+
+    /// The non-delta part of f(wi, wo) (1/sr, no cosine), averaged over `walks` walks of the
+    /// counter-based generator (seed, stream, walk index): deterministic for a seed. wi.z > 0;
+    /// wo below the surface is the BTDF (zero for an opaque base). Standard error from the spread
+    /// of the per-walk estimates.
+    RandomWalkEstimate eval(const Vec3d& wi, const Vec3d& wo, std::uint64_t walks,
+                            std::uint64_t seed, std::uint64_t stream) const;
+
+    /// One walk's estimate of the non-delta f(wi, wo) with the caller's generator (renderers).
+    Rgbd eval_once(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng) const;
+
+    /// Follows one particle from wi to its exit (empty when it is absorbed, lost or cut off).
+    std::optional<RandomWalkSample> sample(const Vec3d& wi, ParticleRng& rng) const;
+
+    /// The delta lobes of the stack for incidence wi (paths made only of smooth events and
+    /// unscattered flights): the mirror lobe and, for a slab, the straight-through lobe, with their
+    /// exact energies from the same delta-chain ladder (empty when the top interface is rough).
+    struct DeltaExit {
+        Vec3d direction;
+        Rgbd energy;
+    };
+    std::vector<DeltaExit> delta_lobes(const Vec3d& wi) const;
+
+    /// The delta-chain throughput Q for a connection towards wo: exposed for tests. Region r = 0 is
+    /// the ambient medium, r = L (interfaces()) below the base.
+    struct Connection;
+
+  private:
+    struct Interface {
+        InterfaceType type = InterfaceType::Dielectric;
+        DielectricInterface<double> dielectric{1.0, 0.0};
+        ConductorInterface<double> conductor{Rgbd(1.0), Rgbd(0.0), 0.0};
+        LambertianInterface<double> lambertian{Rgbd(0.0)};
+        bool delta = true;  ///< smooth or index-matched: no density, no connection
+    };
+    struct Medium {
+        Rgbd tau_s{0.0}, tau_t{0.0}, g{0.0}, single_scattering_albedo{0.0};
+        bool scatters = false, empty = true, uniform_tau_t = true, uniform_g = true;
+    };
+
+    struct WalkState;
+    template <bool kConnect>
+    void walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng, const Connection* conn, Rgbd& f,
+              std::optional<RandomWalkSample>* exit) const;
+    template <bool kConnect>
+    bool traverse_medium(int region, WalkState& ws, ParticleRng& rng, const Connection* conn,
+                         const Vec3d& wo, Rgbd& f) const;
+    template <typename Kernel, typename Pdf>
+    void connect_through_exit(const Connection& conn, const Vec3d& wo, double depth, const Rgbd& w,
+                              ParticleRng& rng, const Kernel& kernel, const Pdf& pdf_v,
+                              Rgbd& f) const;
+    double survival_proxy(int region, double path) const;
+    static Rgbd eval_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo);
+    static double pdf_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo);
+
+    std::vector<Interface> interfaces_;  ///< top to bottom
+    std::vector<Medium> media_;          ///< per region 0..L (0 and L empty)
+    std::vector<double> eta_;            ///< absolute index per region 0..L
+    bool transmits_ = false;
+    int max_events_;
+};
+
+}  // namespace lamina

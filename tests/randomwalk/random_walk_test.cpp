@@ -1,0 +1,435 @@
+// The random-walk estimator (randomwalk/random_walk.h) against the goniophotometer and the exact
+// solutions of physics.md §6, with tolerances from standard errors only. Suites ending in Stat are
+// the `stat` label, Golden the closed forms.
+#include "randomwalk/random_walk.h"
+
+#include "core/math.h"
+#include "core/spherical.h"
+#include "layers/stack.h"
+#include "physics/fresnel.h"
+#include "simulator/goniophotometer.h"
+#include "study/configurations.h"
+#include "support/quadrature.h"
+#include "support/stacks.h"
+#include "support/table_checks.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+namespace lamina {
+namespace {
+
+// ---- Binning the random walk like the goniophotometer ------------------------------------------
+// The cos-weighted bin average ∫_bin f |cos θ| dω / Ω⊥ is a plain average over the bin's rectangle
+// in (u = sin²θ, φ) (binned.h). Each bin gets p×p jittered-stratified points, each point its own
+// independent estimate of `walks` walks. The bin's standard error is the larger of two estimates:
+// the walks' own, pooled over the points (√Σ se_i² / p², many degrees of freedom), and the spread
+// of the point estimates / p (which also holds the variation of f over the bin: conservative for
+// stratified points, but with only p² − 1 degrees of freedom). Delta lobes add energy / Ω⊥ to the
+// bin they hit, as the goniophotometer's particles do.
+struct BinnedWalk {
+    std::vector<Rgbd> f, se;
+    Rgbd albedo{0.0}, albedo_se{0.0};
+};
+
+BinnedWalk bin_random_walk(const RandomWalkStack& rw, double theta_i_deg,
+                           const HemisphereGrid& grid, Side side, int p, std::uint64_t walks,
+                           std::uint64_t seed) {
+    const Vec3d wi = incident_direction(deg_to_rad(theta_i_deg));
+    BinnedWalk out;
+    out.f.assign(grid.size(), Rgbd(0.0));
+    out.se.assign(grid.size(), Rgbd(0.0));
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::size_t j = 0; j < grid.size(); ++j) {
+        const int t = int(j) / grid.n_phi(), q = int(j) % grid.n_phi();
+        const double u0 = sqr(std::sin(grid.theta_lo(t))), u1 = sqr(std::sin(grid.theta_hi(t)));
+        Rgbd sum(0.0), sum_sq(0.0), pooled(0.0);
+        ParticleRng jitter(seed, 0xB1B1, j);
+        for (int a = 0; a < p; ++a)
+            for (int b = 0; b < p; ++b) {
+                const double u = u0 + (u1 - u0) * (a + jitter.uniform_double()) / p;
+                const double phi = grid.phi_lo(q) + (grid.phi_hi(q) - grid.phi_lo(q)) *
+                                                        (b + jitter.uniform_double()) / p;
+                const double st = std::sqrt(u), ct = std::sqrt(std::max(0.0, 1 - u));
+                const Vec3d wo(st * std::cos(phi), st * std::sin(phi),
+                               side == Side::Reflection ? ct : -ct);
+                const RandomWalkEstimate est =
+                    rw.eval(wi, wo, walks, seed, j * 4096 + std::uint64_t(a * p + b));
+                const Rgbd& e = est.f;
+                sum += e;
+                sum_sq += e * e;
+                pooled += est.se * est.se;
+            }
+        const double n = double(p) * p;
+        for (int c = 0; c < 3; ++c) {
+            const double mean = sum[c] / n;
+            out.f[j][c] = mean;
+            const double spread = std::sqrt(std::max(0.0, sum_sq[c] / n - mean * mean) / (n - 1));
+            out.se[j][c] = std::max(spread, std::sqrt(pooled[c]) / n);
+        }
+    }
+    for (const auto& d : rw.delta_lobes(wi)) {
+        if ((d.direction.z > 0) != (side == Side::Reflection)) continue;
+        // The goniophotometer decides the bin in float arithmetic.
+        const std::size_t j = grid.bin_of(Vec3f(d.direction));
+        out.f[j] += d.energy / grid.projected_solid_angle(j);
+    }
+    for (std::size_t j = 0; j < grid.size(); ++j) {
+        const double omega = grid.projected_solid_angle(j);
+        out.albedo += out.f[j] * omega;
+        for (int c = 0; c < 3; ++c)
+            out.albedo_se[c] += sqr(out.se[j][c] * omega);
+    }
+    for (int c = 0; c < 3; ++c)
+        out.albedo_se[c] = std::sqrt(out.albedo_se[c]);
+    return out;
+}
+
+// The Šidák bound on max |z| (table_checks.h) and an upper bound on Σz² (χ²(k) mean k plus five
+// standard deviations √(2k)); no lower bound, because the bin errors above are conservative.
+void expect_agreement_conservative(const test::TableComparison& r, double alpha = 1e-3) {
+    ASSERT_GT(r.bins, 0);
+    const double per_bin = 1 - std::pow(1 - alpha, 1.0 / r.bins);
+    EXPECT_LT(r.max_abs_z, test::normal_quantile_upper(per_bin / 2)) << "worst: " << r.worst;
+    EXPECT_LT(r.chi2, r.bins + 5 * std::sqrt(2.0 * r.bins))
+        << "chi2 = " << r.chi2 << " over " << r.bins << " bins; worst: " << r.worst;
+}
+
+SimulationResult simulate_one(const Stack& stack, double theta_i, std::uint64_t particles,
+                              const HemisphereGrid& grid) {
+    SimulationSettings s;
+    s.theta_i_deg = {theta_i};
+    s.particles = particles;
+    s.grid = grid;
+    s.seed = 11;
+    return simulate(stack, s);
+}
+
+// z-scores of (random walk − goniophotometer) per bin and channel with the combined standard
+// error; the criterion of the goniophotometer's own tests (table_checks.h: Šidák max |z| and χ²).
+void expect_tables_agree(const Stack& stack, double theta_i, int p, std::uint64_t walks,
+                         std::uint64_t particles, const std::string& what) {
+    const HemisphereGrid grid(9, 9);
+    const RandomWalkStack rw(stack);
+    const SimulationResult ref = simulate_one(stack, theta_i, particles, grid);
+    for (Side side : {Side::Reflection, Side::Transmission}) {
+        if (side == Side::Transmission && !stack.transmits()) continue;
+        const BinnedWalk b = bin_random_walk(rw, theta_i, grid, side, p, walks, 5);
+        const BinnedLobe& lobe = ref.table.lobe(0, side);
+        test::TableComparison r;
+        for (std::size_t j = 0; j < grid.size(); ++j)
+            for (int c = 0; c < 3; ++c) {
+                const double se = std::hypot(b.se[j][c], lobe.se[j][c]);
+                if (se == 0) {
+                    EXPECT_NEAR(b.f[j][c], lobe.f[j][c], 1e-9 * (1 + lobe.f[j][c]))
+                        << what << " bin " << j << " (no spread on either side)";
+                    continue;
+                }
+                const double z = (b.f[j][c] - lobe.f[j][c]) / se;
+                ++r.bins;
+                r.chi2 += z * z;
+                if (std::abs(z) > r.max_abs_z) {
+                    r.max_abs_z = std::abs(z);
+                    r.worst = what + " side " + std::to_string(int(side)) + " bin " +
+                              std::to_string(j) + " ch " + std::to_string(c) + ": walk " +
+                              std::to_string(b.f[j][c]) + " ± " + std::to_string(b.se[j][c]) +
+                              ", goniophotometer " + std::to_string(lobe.f[j][c]) + " ± " +
+                              std::to_string(lobe.se[j][c]);
+                }
+            }
+        expect_agreement_conservative(r);
+        // The hemispherical integral: the goniophotometer's budget (R or T).
+        const EnergyBudget& budget = ref.incidences[0].budget;
+        for (int c = 0; c < 3; ++c) {
+            const double want = side == Side::Reflection ? budget[BudgetTerm::Reflected][c]
+                                                         : budget[BudgetTerm::Transmitted][c];
+            const double se_ref =
+                side == Side::Reflection ? budget.reflected_se[c] : budget.transmitted_se[c];
+            const double se = std::hypot(b.albedo_se[c], se_ref);
+            EXPECT_LT(std::abs(b.albedo[c] - want), 4.5 * se + 1e-12)
+                << what << " albedo side " << int(side) << " ch " << c << ": walk " << b.albedo[c]
+                << " ± " << b.albedo_se[c] << ", goniophotometer " << want << " ± " << se_ref;
+        }
+    }
+}
+
+Stack example(const std::string& name) {
+    return load_stack(std::string(LAMINA_SOURCE_DIR) + "/examples/" + name + ".json");
+}
+
+// ---- Agreement with the goniophotometer --------------------------------------------------------
+TEST(RandomWalkStat, AgreesWithTheGoniophotometerOnEveryExample) {
+    for (const char* name : {"plastic", "metallic-paint", "frosted-gold", "milky-coat", "slab"})
+        for (double ti : {35.0, 65.0})
+            expect_tables_agree(example(name), ti, 3, 1500, 4'000'000,
+                                std::string(name) + " θi=" + std::to_string(ti));
+}
+
+TEST(RandomWalkStat, AgreesWithTheGoniophotometerOnStudyConfigurations) {
+    // Two of each category, plus hand-built stacks that exercise what the examples do not: a
+    // smooth coat (delta chains, TIR), per-channel scattering (spectral MIS), a three-interface
+    // stack with two smooth interfaces (multiply reflected delta chains). Interfaces with
+    // 0 < α < 0.02 are left out: their lobes are narrower than the stratified points of a 10° bin
+    // can resolve (the estimator is fine there, the test's bin quadrature is not).
+    std::vector<std::pair<std::string, Stack>> stacks;
+    auto resolvable = [](const Stack& s) {
+        for (const Layer& l : s.layers)
+            if (l.interface.type != InterfaceType::Lambertian && l.interface.alpha > 0 &&
+                l.interface.alpha < 0.02)
+                return false;
+        return true;
+    };
+    const auto configs = builtin_configurations();
+    for (const char* cat : {"plastic", "metallic-paint", "frosted-metal", "slab"}) {
+        int taken = 0, seen = 0;
+        for (const auto& c : configs) {
+            if (c.category != cat || !resolvable(c.stack)) continue;
+            if (seen++ % 3 != 0 || taken == 2) continue;  // spread over the category's list
+            stacks.push_back({c.id, c.stack});
+            ++taken;
+        }
+    }
+    stacks.push_back(
+        {"smooth coat, scattering per channel, lambertian",
+         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.05, 0.2, 0.0),
+                                             Rgbd(0.5, 1.0, 2.0), Rgbd(0.3, 0.6, -0.2)),
+                           test::lambertian_layer(Rgbd(0.6, 0.3, 0.9))})});
+    stacks.push_back(
+        {"smooth | absorbing | smooth 1.3 | scattering | rough conductor",
+         test::make_stack(
+             {test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.1)),
+              test::with_medium(test::dielectric_layer(1.3, 0.0), Rgbd(0.0), Rgbd(0.7), Rgbd(0.5)),
+              test::conductor_layer(Rgbd(0.2, 0.4, 1.4), Rgbd(3.9, 2.4, 1.6), 0.2)})});
+    stacks.push_back({"smooth slab with scattering",
+                      test::make_stack({test::with_medium(test::dielectric_layer(1.4, 0.0),
+                                                          Rgbd(0.1), Rgbd(1.0), Rgbd(0.7)),
+                                        test::dielectric_layer(1.0, 0.0)})});
+    for (const auto& [name, stack] : stacks)
+        for (double ti : {35.0, 75.0})
+            expect_tables_agree(stack, ti, 3, 1500, 4'000'000, name);
+}
+
+// ---- Exact solutions ---------------------------------------------------------------------------
+// §6.3: smooth coat (η) over a Lambertian (ρ) with absorption τ: the diffuse part
+//   f = ρ/(πη²) (1 − F(μi)) e^{−τ/μi'} (1 − F(μo)) e^{−τ/μo'} / (1 − ρ r),
+//   r = 2∫₀¹ F_inside(μ) e^{−2τ/μ} μ dμ,
+// and the delta lobe F(μi) (the ladder's value: exact to rounding).
+TEST(RandomWalkStat, SmoothCoatOverLambertianSeries) {
+    const double eta = 1.5;
+    const Rgbd tau(0.1, 0.5, 0.0), rho(0.8, 0.5, 1.0);
+    const Stack stack = test::make_stack(
+        {test::with_medium(test::dielectric_layer(eta, 0.0), tau), test::lambertian_layer(rho)});
+    const RandomWalkStack rw(stack);
+    const double mu_c = std::sqrt(1 - 1 / (eta * eta));
+    auto refracted_cos = [&](double mu) { return std::sqrt(1 - (1 - mu * mu) / (eta * eta)); };
+    Rgbd internal(0.0);
+    for (int c = 0; c < 3; ++c) {
+        auto f_in = [&](double mu) { return fresnel_dielectric(mu, 1 / eta); };
+        internal[c] =
+            2 *
+            (test::integrate([&](double mu) { return mu * std::exp(-2 * tau[c] / mu); }, 0, mu_c,
+                             32, 8) +
+             test::integrate([&](double mu) { return f_in(mu) * std::exp(-2 * tau[c] / mu) * mu; },
+                             mu_c, 1, 32, 8));
+    }
+    int n = 0;
+    double worst = 0;
+    for (double ti : {0.0, 30.0, 60.0, 85.0})
+        for (double to : {10.0, 45.0, 80.0})
+            for (double po : {0.0, 100.0}) {
+                const Vec3d wi = incident_direction(deg_to_rad(ti));
+                const Vec3d wo = direction_from_angles(deg_to_rad(to), deg_to_rad(po));
+                const double mi = wi.z, mo = wo.z;
+                const RandomWalkEstimate e = rw.eval(wi, wo, 20000, 3, std::uint64_t(n));
+                for (int c = 0; c < 3; ++c) {
+                    const double want =
+                        rho[c] / (kPi<double> * eta * eta) * (1 - fresnel_dielectric(mi, eta)) *
+                        std::exp(-tau[c] / refracted_cos(mi)) * (1 - fresnel_dielectric(mo, eta)) *
+                        std::exp(-tau[c] / refracted_cos(mo)) / (1 - rho[c] * internal[c]);
+                    const double z = (e.f[c] - want) / e.se[c];
+                    worst = std::max(worst, std::abs(z));
+                    EXPECT_LT(std::abs(z), 4.8)  // Šidák for 72 tests at 1e-3
+                        << "θi " << ti << " θo " << to << " φo " << po << " ch " << c << ": "
+                        << e.f[c] << " ± " << e.se[c] << " vs " << want;
+                }
+                ++n;
+            }
+    RecordProperty("worst_z", std::to_string(worst));
+    const auto lobes = rw.delta_lobes(incident_direction(deg_to_rad(40.0)));
+    ASSERT_EQ(lobes.size(), 1u);
+    EXPECT_NEAR(lobes[0].energy[0], fresnel_dielectric(std::cos(deg_to_rad(40.0)), eta), 1e-14);
+}
+
+// The ladder of delta chains against §6.4 (smooth slab) and §6.5 (coat over a smooth conductor):
+// R = F + (1 − F)² F a² / (1 − F² a²), T = (1 − F)² a / (1 − F² a²);
+// R = F + (1 − F)² Rc a² / (1 − F Rc a²).
+TEST(RandomWalkGolden, DeltaLobesOfSmoothSlabAndCoatedConductor) {
+    const double eta = 1.5, tau = 0.3;
+    for (double ti : {0.0, 40.0, 80.0}) {
+        const Vec3d wi = incident_direction(deg_to_rad(ti));
+        const double F = fresnel_dielectric(wi.z, eta);
+        const double mu_t = std::sqrt(1 - (1 - wi.z * wi.z) / (eta * eta));
+        const double a = std::exp(-tau / mu_t);
+        {
+            const RandomWalkStack rw(
+                test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), Rgbd(tau)),
+                                  test::dielectric_layer(1.0, 0.0)}));
+            const auto lobes = rw.delta_lobes(wi);
+            ASSERT_EQ(lobes.size(), 2u);
+            EXPECT_NEAR(lobes[0].energy[1], F + sqr(1 - F) * F * a * a / (1 - F * F * a * a),
+                        1e-13);
+            EXPECT_NEAR(lobes[1].energy[1], sqr(1 - F) * a / (1 - F * F * a * a), 1e-13);
+            EXPECT_NEAR(lobes[1].direction.x, -wi.x, 1e-15);  // η = 1 below: straight through
+            EXPECT_NEAR(lobes[1].direction.z, -wi.z, 1e-15);
+        }
+        {
+            const Rgbd ce(0.2, 0.4, 1.4), ck(3.9, 2.4, 1.6);
+            const RandomWalkStack rw(
+                test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), Rgbd(tau)),
+                                  test::conductor_layer(ce, ck, 0.0)}));
+            const auto lobes = rw.delta_lobes(wi);
+            ASSERT_EQ(lobes.size(), 1u);
+            for (int c = 0; c < 3; ++c) {
+                const double Rc = fresnel_conductor(mu_t, ce[c] / eta, ck[c] / eta);
+                EXPECT_NEAR(lobes[0].energy[c], F + sqr(1 - F) * Rc * a * a / (1 - F * Rc * a * a),
+                            1e-13);
+            }
+        }
+    }
+}
+
+// ---- Reciprocity: f(wi, wo) = f(wo, wi) within noise, for BRDFs -------------------------------
+TEST(RandomWalkStat, Reciprocity) {
+    std::vector<Stack> stacks = {example("plastic"), example("metallic-paint"),
+                                 example("milky-coat"), example("frosted-gold")};
+    stacks.push_back(test::make_stack(
+        {test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.1), Rgbd(1.0), Rgbd(0.6)),
+         test::conductor_layer(Rgbd(0.2), Rgbd(3.0), 0.3)}));
+    std::uint64_t stream = 0;
+    int tests = 0;
+    double worst = 0;
+    for (const Stack& s : stacks) {
+        const RandomWalkStack rw(s);
+        for (const auto& [a, b] : std::vector<std::pair<Vec3d, Vec3d>>{
+                 {direction_from_angles(0.3, 0.0), direction_from_angles(1.1, 2.0)},
+                 {direction_from_angles(1.3, 0.5), direction_from_angles(0.2, 3.0)},
+                 {direction_from_angles(0.8, 0.0), direction_from_angles(0.75, 3.3)}}) {
+            const RandomWalkEstimate ab = rw.eval(a, b, 40000, 9, ++stream);
+            const RandomWalkEstimate ba = rw.eval(b, a, 40000, 9, ++stream);
+            for (int c = 0; c < 3; ++c) {
+                const double se = std::hypot(ab.se[c], ba.se[c]);
+                if (se == 0) {
+                    EXPECT_EQ(ab.f[c], ba.f[c]);
+                    continue;
+                }
+                const double z = (ab.f[c] - ba.f[c]) / se;
+                worst = std::max(worst, std::abs(z));
+                ++tests;
+                EXPECT_LT(std::abs(z), 4.6) << s.name << " ch " << c << ": " << ab.f[c] << " ± "
+                                            << ab.se[c] << " vs " << ba.f[c] << " ± " << ba.se[c];
+            }
+        }
+    }
+    RecordProperty("worst_z", std::to_string(worst));
+}
+
+// ---- sample() against eval(): the walk's exits, binned, are the bin averages of f --------------
+// E[weight · 1_bin(wo)] = ∫_bin f |cos θo| dωo: the histogram of sample weights (non-delta exits)
+// equals the binned eval (both with standard errors), and the delta exits' total equals the
+// ladder's delta-lobe energies.
+TEST(RandomWalkStat, SampleAgreesWithEval) {
+    for (const char* name : {"plastic", "slab", "milky-coat"}) {
+        const Stack stack = example(name);
+        const RandomWalkStack rw(stack);
+        const HemisphereGrid grid(9, 9);
+        const double ti = 35;
+        const Vec3d wi = incident_direction(deg_to_rad(ti));
+        const std::uint64_t n = 400000;
+        std::vector<Rgbd> sum(2 * grid.size(), Rgbd(0.0)), sum_sq(2 * grid.size(), Rgbd(0.0));
+        Rgbd delta(0.0);
+        for (std::uint64_t i = 0; i < n; ++i) {
+            ParticleRng rng(21, 0, i);
+            const auto s = rw.sample(wi, rng);
+            if (!s) continue;
+            if (s->is_delta) {
+                delta += s->weight;
+                continue;
+            }
+            const std::size_t j = (s->wo.z > 0 ? 0 : grid.size()) + grid.bin_of(s->wo);
+            sum[j] += s->weight;
+            sum_sq[j] += s->weight * s->weight;
+        }
+        Rgbd delta_want(0.0);
+        for (const auto& d : rw.delta_lobes(wi))
+            delta_want += d.energy;
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(delta[c] / n, delta_want[c], 5 * std::sqrt(delta_want[c] / n) + 1e-12)
+                << name;
+        for (Side side : {Side::Reflection, Side::Transmission}) {
+            if (side == Side::Transmission && !stack.transmits()) continue;
+            BinnedWalk b = bin_random_walk(rw, ti, grid, side, 3, 1500, 8);
+            for (const auto& d : rw.delta_lobes(wi)) {  // eval's side without the delta lobes
+                if ((d.direction.z > 0) != (side == Side::Reflection)) continue;
+                const std::size_t j = grid.bin_of(Vec3f(d.direction));
+                b.f[j] = b.f[j] - d.energy / grid.projected_solid_angle(j);
+            }
+            test::TableComparison r;
+            const std::size_t off = side == Side::Reflection ? 0 : grid.size();
+            for (std::size_t j = 0; j < grid.size(); ++j) {
+                const double omega = grid.projected_solid_angle(j);
+                for (int c = 0; c < 3; ++c) {
+                    const double mean = sum[off + j][c] / n;
+                    const double se_s =
+                        std::sqrt(std::max(0.0, sum_sq[off + j][c] / n - mean * mean) / (n - 1)) /
+                        omega;
+                    const double se = std::hypot(se_s, b.se[j][c]);
+                    if (se == 0) continue;
+                    const double z = (mean / omega - b.f[j][c]) / se;
+                    ++r.bins;
+                    r.chi2 += z * z;
+                    if (std::abs(z) > r.max_abs_z) {
+                        r.max_abs_z = std::abs(z);
+                        r.worst = std::string(name) + " bin " + std::to_string(j) + ": sample " +
+                                  std::to_string(mean / omega) + " eval " +
+                                  std::to_string(b.f[j][c]);
+                    }
+                }
+            }
+            expect_agreement_conservative(r);
+        }
+    }
+}
+
+// ---- Reproducibility ---------------------------------------------------------------------------
+TEST(RandomWalk, DeterministicForASeedAndNoisierWithFewerWalks) {
+    const RandomWalkStack rw(example("milky-coat"));
+    const Vec3d wi = incident_direction(0.5), wo = direction_from_angles(0.9, 2.5);
+    const RandomWalkEstimate a = rw.eval(wi, wo, 2000, 1, 7), b = rw.eval(wi, wo, 2000, 1, 7);
+    const RandomWalkEstimate c = rw.eval(wi, wo, 2000, 2, 7);
+    const RandomWalkEstimate d = rw.eval(wi, wo, 32000, 1, 7);
+    EXPECT_EQ(a.f, b.f);
+    EXPECT_EQ(a.se, b.se);
+    EXPECT_NE(a.f, c.f);
+    EXPECT_LT(d.se[0], a.se[0]);
+    EXPECT_GT(a.f[0], 0);
+}
+
+TEST(RandomWalk, OpaqueBaseHasNoBtdfAndBlackStackIsBlack) {
+    const RandomWalkStack black(test::make_stack({test::lambertian_layer(Rgbd(0.0))}));
+    const Vec3d wi = incident_direction(0.4);
+    EXPECT_EQ(black.eval(wi, direction_from_angles(0.3, 1.0), 100, 1, 1).f, Rgbd(0.0));
+    const RandomWalkStack plastic(example("plastic"));
+    EXPECT_EQ(plastic.eval(wi, direction_from_angles(0.3, 1.0, Side::Transmission), 100, 1, 1).f,
+              Rgbd(0.0));
+    // A Lambertian alone: every walk connects once, exactly albedo/π (zero variance).
+    const RandomWalkStack lambert(test::make_stack({test::lambertian_layer(Rgbd(0.25, 0.5, 1.0))}));
+    const RandomWalkEstimate e = lambert.eval(wi, direction_from_angles(1.2, 2.0), 50, 1, 1);
+    const Rgbd albedo(0.25, 0.5, 1.0);
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(e.f[c], albedo[c] / kPi<double>, 1e-15);
+}
+
+}  // namespace
+}  // namespace lamina

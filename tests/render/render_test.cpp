@@ -1,0 +1,137 @@
+// Sphere renderings (render/renderer.h): the proofs of issue 7 — white furnace, black stack,
+// WW' equal to the reference where it is exact, identical images across thread counts — and the
+// image files.
+#include "render/renderer.h"
+
+#include "models/random_walk_model.h"
+#include "models/registry.h"
+#include "render/contact_sheet.h"
+#include "render/image.h"
+#include "support/stacks.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+namespace lamina {
+namespace {
+
+RenderSettings small(int size, int spp, int threads = 0) {
+    RenderSettings s;
+    s.size = size;
+    s.spp = spp;
+    s.threads = threads;
+    s.progress = false;
+    return s;
+}
+
+// A white Lambertian under a uniform white environment: L = ∫ (1/π) · 1 · cos dω = 1. With the
+// random walk both strategies are exact here (its connection is ρ/π and its sample weight ρ; the
+// MIS weights p/(p + q) and q/(p + q) are ½ each), so every pixel is 1 to rounding.
+TEST(Render, WhiteFurnaceLambertianIsOne) {
+    const Stack white = test::make_stack({test::lambertian_layer(Rgbd(1.0))});
+    const auto rw = make_model("random-walk", white);
+    const Rendering r = render_sphere(*rw, Environment::named("uniform"), small(24, 4));
+    int n = 0;
+    for (std::size_t i = 0; i < r.mask.size(); ++i)
+        if (r.mask[i]) {
+            ++n;
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(r.image.pixels[i][c], 1.0, 1e-5);
+        }
+    EXPECT_GT(n, 200);
+}
+
+// A smooth coat (τ = 0) over a white Lambertian has albedo exactly 1 (physics.md §6.3), so under
+// the uniform environment it renders 1 within noise: the sphere's mean over n pixels has standard
+// error σ/√n, estimated from the pixels themselves.
+TEST(RenderStat, WhiteFurnaceSmoothCoatOverWhiteIsOne) {
+    const Stack coated =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.0)),
+                          test::lambertian_layer(Rgbd(1.0))});
+    const auto rw = make_model("random-walk", coated);
+    const Rendering r = render_sphere(*rw, Environment::named("uniform"), small(32, 16));
+    double sum = 0, sum_sq = 0;
+    int n = 0;
+    for (std::size_t i = 0; i < r.mask.size(); ++i)
+        if (r.mask[i]) {
+            const double v = r.image.pixels[i][1];
+            sum += v;
+            sum_sq += v * v;
+            ++n;
+        }
+    const double mean = sum / n, se = std::sqrt((sum_sq / n - mean * mean) / (n - 1));
+    EXPECT_LT(std::abs(mean - 1), 5 * se) << mean << " ± " << se;
+    EXPECT_LT(se, 0.02);
+}
+
+TEST(Render, BlackStackRendersBlack) {
+    const Stack black = test::make_stack({test::lambertian_layer(Rgbd(0.0))});
+    const auto rw = make_model("random-walk", black);
+    RenderSettings s = small(16, 2);
+    const Rendering r = render_sphere(*rw, Environment::named("studio"), s);
+    for (std::size_t i = 0; i < r.mask.size(); ++i)
+        if (r.mask[i]) {
+            EXPECT_EQ(r.image.pixels[i], Rgbf(0.f));
+        }
+}
+
+// WW' is exact for a smooth coat over a black base (only the top's mirror reflection F(μ)
+// remains): its rendering equals the reference's within noise (here both are exact: the
+// reference's delta lobe is the ladder's F, and its walks below the coat die on the black base).
+TEST(Render, WWPrimeMatchesTheReferenceWhereItIsExact) {
+    const Stack s =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.0)),
+                          test::lambertian_layer(Rgbd(0.0))});
+    const auto ref = make_model("random-walk", s);
+    const auto ww = make_model("ww-prime", s);
+    ASSERT_TRUE(ww->support().brdf);
+    const Environment env = Environment::named("studio");
+    const Rendering a = render_sphere(*ref, env, small(32, 8));
+    const Rendering b = render_sphere(*ww, env, small(32, 8));
+    EXPECT_LT(relative_rmse(b.image, a.image, a.mask), 1e-5);
+    double total = 0;
+    for (const Rgbf& p : a.image.pixels)
+        total += p[0];
+    EXPECT_GT(total, 0);
+}
+
+TEST(Render, IdenticalAcrossThreadCounts) {
+    const Stack s = load_stack(std::string(LAMINA_SOURCE_DIR) + "/examples/milky-coat.json");
+    const auto rw = make_model("random-walk", s);
+    Environment env = Environment::named("studio");
+    env.sun = DirectionalLight{normalize(Vec3d(0.3, 0.5, 0.8)), Rgbd(2.0)};
+    const Rendering one = render_sphere(*rw, env, small(20, 3, 1));
+    const Rendering three = render_sphere(*rw, env, small(20, 3, 3));
+    EXPECT_EQ(one.image.pixels, three.image.pixels);
+    const auto ww = make_model("bel18-forward", load_stack(std::string(LAMINA_SOURCE_DIR) +
+                                                           "/examples/metallic-paint.json"));
+    EXPECT_EQ(render_sphere(*ww, env, small(20, 3, 1)).image.pixels,
+              render_sphere(*ww, env, small(20, 3, 2)).image.pixels);
+}
+
+TEST(Render, ExrRoundTripAndPngAndSheet) {
+    Image img(7, 5);
+    for (int y = 0; y < 5; ++y)
+        for (int x = 0; x < 7; ++x)
+            img.at(x, y) = Rgbf(float(x) * 0.5f, float(y), 1e3f + float(x * y));
+    const auto dir = std::filesystem::path(LAMINA_BINARY_DIR) / "render_test";
+    std::filesystem::create_directories(dir);
+    write_exr(dir / "a.exr", img);
+    const Image back = read_exr(dir / "a.exr");
+    EXPECT_EQ(back.width, 7);
+    EXPECT_EQ(back.height, 5);
+    EXPECT_EQ(back.pixels, img.pixels);
+    write_png(dir / "a.png", img, 0);
+    EXPECT_GT(std::filesystem::file_size(dir / "a.png"), 50u);
+    EXPECT_EQ(tone_map_channel(0, 0), 0);
+    EXPECT_EQ(tone_map_channel(1e9, 0), 255);
+    const Image sheet =
+        contact_sheet({{"ref", img, true, ""}, {"m", img, true, ""}, {"x", Image(), false, "why"}},
+                      std::vector<char>(35, 1), 0);
+    EXPECT_GT(sheet.width, 3 * 7);
+}
+
+}  // namespace
+}  // namespace lamina
