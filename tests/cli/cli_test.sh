@@ -164,7 +164,7 @@ check_says render-bad-env 1 "unknown environment" \
     "$lamina" render "$src/examples/plastic.json" --env moon --out "$tmp/r3.png"
 check study-render 0 "$lamina" study --only 'plastic-P2-a0.05*' --particles 2e4 --grid 9x9 --theta-i 30 \
     --render --render-size 24 --render-spp 2 --out "$tmp/study-r"
-check study-render-sheet 0 test -s "$tmp/study-r/renders/plastic-P2-a0.05/compare.png"
-check_says study-render-index 0 "plastic-P2-a0.05,ww-prime," cat "$tmp/study-r/renders/errors.csv"
+check study-render-sheet 0 test -s "$tmp/study-r/configs/plastic-P2-a0.05/renders/compare.png"
+check_says study-render-index 0 "plastic-P2-a0.05,ww-prime," cat "$tmp/study-r/renders.csv"
 echo "$pass passed, $fails failed"
 [ "$fails" -eq 0 ]
