@@ -6,6 +6,7 @@
 #include "physics/dielectric.h"
 #include "physics/fresnel.h"
 #include "support/adding_doubling.h"
+#include "support/closed_forms.h"
 #include "support/quadrature.h"
 #include "support/stacks.h"
 #include "support/table_checks.h"
@@ -74,32 +75,10 @@ TEST(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
     const HemisphereGrid grid(18, 18);
     const auto r = simulate(stack, settings({theta_i}, 1'000'000, grid));
 
-    const double mu_c = std::sqrt(1 - 1 / (eta * eta));  // critical cosine inside
-    auto refracted_cos = [&](double mu) { return std::sqrt(1 - (1 - mu * mu) / (eta * eta)); };
-    Rgbd internal(0.0), escape(0.0);
-    for (int c = 0; c < 3; ++c) {
-        auto f_in = [&](double mu) { return fresnel_dielectric(mu, 1 / eta); };
-        internal[c] =
-            2 *
-            (test::integrate([&](double mu) { return mu * std::exp(-2 * tau[c] / mu); }, 0, mu_c,
-                             32, 8) +
-             test::integrate([&](double mu) { return f_in(mu) * std::exp(-2 * tau[c] / mu) * mu; },
-                             mu_c, 1, 32, 8));
-        escape[c] = 2 * test::integrate(
-                            [&](double mu) { return (1 - f_in(mu)) * std::exp(-tau[c] / mu) * mu; },
-                            mu_c, 1, 32, 8);
-    }
+    const test::CoatedLambertianSeries series(eta, tau, rho);
     const double mu_i = std::cos(deg_to_rad(theta_i));
-    const double F_i = fresnel_dielectric(mu_i, eta);
-    auto diffuse = [&](const Vec3d& wo) {
-        const double mu_o = std::abs(wo.z);
-        Rgbd f;
-        for (int c = 0; c < 3; ++c)
-            f[c] = rho[c] / (kPi<double> * eta * eta) * (1 - F_i) *
-                   std::exp(-tau[c] / refracted_cos(mu_i)) * (1 - fresnel_dielectric(mu_o, eta)) *
-                   std::exp(-tau[c] / refracted_cos(mu_o)) / (1 - rho[c] * internal[c]);
-        return f;
-    };
+    const double F_i = series.specular(mu_i);
+    auto diffuse = [&](const Vec3d& wo) { return series.diffuse(mu_i, std::abs(wo.z)); };
     // The tracer's mirror direction, in its own float arithmetic, decides the bin.
     const Vec3f wi_f(incident_direction(deg_to_rad(theta_i)));
     const std::size_t mirror_bin = grid.bin_of(Vec3f(-wi_f.x, -wi_f.y, wi_f.z));
@@ -112,11 +91,9 @@ TEST(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
         },
         1e6));
     const EnergyBudget& b = r.incidences[0].budget;
-    for (int c = 0; c < 3; ++c) {
-        const double albedo = F_i + (1 - F_i) * std::exp(-tau[c] / refracted_cos(mu_i)) * rho[c] *
-                                        escape[c] / (1 - rho[c] * internal[c]);
-        expect_within_se(b[BudgetTerm::Reflected][c], albedo, b.reflected_se[c], "albedo");
-    }
+    const Rgbd albedo = series.albedo(mu_i);
+    for (int c = 0; c < 3; ++c)
+        expect_within_se(b[BudgetTerm::Reflected][c], albedo[c], b.reflected_se[c], "albedo");
     // Blue: τ = 0 and ρ = 1: nothing is absorbed, every particle leaves (white furnace).
     EXPECT_NEAR(b[BudgetTerm::Reflected][2] + b[BudgetTerm::CutOff][2], 1.0, 1e-9);
     EXPECT_LT(b[BudgetTerm::CutOff][2], 1e-9);
