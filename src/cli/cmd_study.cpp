@@ -44,9 +44,10 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
 
 StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
     StudySettings s;
-    s.preset = preset;
-    s.particles =
-        a.particles.empty() ? preset_particles(preset) : parse_count(a.particles, "--particles");
+    s.particles = preset_particles(preset);  // validates --preset in every case
+    if (!a.particles.empty()) s.particles = parse_count(a.particles, "--particles");
+    // A particle count given by hand is not the preset's budget: say so wherever it is shown.
+    s.preset = a.particles.empty() ? preset : "custom";
     s.seed = a.seed;
     s.threads = a.threads;
     s.theta_i_deg = parse_incidences(a.theta_i, "--theta-i");
@@ -165,8 +166,7 @@ Runner add_compare(CLI::App& app) {
     add_common(cmd, *a);
     cmd->add_option("--out,-o", a->out, "Output folder")->required();
     return [a] {
-        StudySettings s = settings_from(*a, "quick");
-        if (!a->particles.empty()) s.preset = "custom";
+        const StudySettings s = settings_from(*a, "quick");
         StudyConfiguration c;
         c.stack = load_stack(a->stack);
         c.id = std::filesystem::path(a->stack).stem().string();

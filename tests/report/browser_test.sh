@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# ctest `browser`: the explorer page of a small synthetic study in headless Chromium.
+# ctest `browser`: the explorer page of a small synthetic study, then of a small real study, in
+# headless Chromium.
 # Usage: browser_test.sh LAMINA SRC_DIR BUILD_DIR
 set -euo pipefail
 lamina=$1 src=$2 build=$3
@@ -11,3 +12,10 @@ if [ ! -d "$src/node_modules/playwright-core" ]; then
     echo "FAIL playwright-core is not installed: run \`make deps\` (npm ci)"; exit 1
 fi
 node "$src/tests/report/browser_test.js" "$study" "$build/screenshots"
+
+# And the page of a small real study, end to end: lamina study writes it, Chromium opens it.
+real="$build/report-real-study"
+rm -rf "$real"
+"$lamina" study --only 'plastic-P1-a0.05,slab-a0.1-a1.3-clear' --theta-i 30 --particles 2e4 \
+    --grid 18x18 --no-figures --out "$real" >/dev/null
+node "$src/tests/report/browser_smoke.js" "$real" "$build/screenshots/real-study.png"
