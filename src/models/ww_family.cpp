@@ -42,6 +42,10 @@ class WWModel final : public Model {
         gray_tau_ = coat_.tau_a.min() == coat_.tau_a.max();
         inv_eta0_ = 1 / coat_.eta0;
         inv_eta0_sq_ = inv_eta0_ * inv_eta0_;
+        for (int c = 0; c < 3; ++c) {
+            base_eta_f_[c] = float(coat_.base_eta[c]);
+            base_k_f_[c] = float(coat_.base_k[c]);
+        }
     }
 
     std::string name() const override { return name_; }
@@ -204,8 +208,16 @@ class WWModel final : public Model {
     }
 
     Rgbd base_fresnel(double cos_theta) const {
-        if (coat_.base_type == InterfaceType::Conductor)
-            return fresnel_complex_rgb(cos_theta, coat_.base_eta, coat_.base_k);
+        if (coat_.base_type == InterfaceType::Conductor) {
+            // The base's conductor Fresnel in float (physics/fresnel.h, exact equations; ~1e-7
+            // relative rounding, far below any model's own error): three independent float
+            // chains of square roots and divisions are about a third faster than the double
+            // ones, and this factor is a third of a WW evaluation.
+            const float c = float(cos_theta);
+            return {double(fresnel_conductor(c, base_eta_f_[0], base_k_f_[0])),
+                    double(fresnel_conductor(c, base_eta_f_[1], base_k_f_[1])),
+                    double(fresnel_conductor(c, base_eta_f_[2], base_k_f_[2]))};
+        }
         return Rgbd(fresnel_dielectric(cos_theta, coat_.base_eta[0]));
     }
 
@@ -264,6 +276,7 @@ class WWModel final : public Model {
     bool has_absorption_ = false;
     bool gray_tau_ = true;
     double inv_eta0_ = 1, inv_eta0_sq_ = 1;
+    float base_eta_f_[3] = {1, 1, 1}, base_k_f_[3] = {0, 0, 0};
 };
 
 class WWEvaluator final : public IncidentEvaluator {
