@@ -3,6 +3,8 @@
 // image files.
 #include "render/renderer.h"
 
+#include "core/math.h"
+
 #include "models/random_walk_model.h"
 #include "models/registry.h"
 #include "render/contact_sheet.h"
@@ -95,6 +97,54 @@ TEST(Render, WWPrimeMatchesTheReferenceWhereItIsExact) {
     for (const Rgbf& p : a.image.pixels)
         total += p[0];
     EXPECT_GT(total, 0);
+}
+
+// A rough coat (α = 0.3) over a black base: WW' is exactly the Walter et al. 2007 top reflection
+// (its base term vanishes with ρ = 0), and so is the stack — light refracted into the coat is
+// absorbed by the base. The random walk estimates it by its own connections, with noise; the two
+// renderings (independent seeds) must agree within that noise. Over the sphere's pixel-channels,
+// with x = rw − ww, a = rw − rw', b = ww − ww' (four independent seeds), an unbiased pair has
+// E[Σx²] = σ_rw² + σ_ww² summed = E[Σa² + Σb²]/2; a bias β per pixel adds Σβ². The statistic
+// D = Σx² − (Σa² + Σb²)/2 has variance ≈ Σx⁴ + (Σa⁴ + Σb⁴)/4 (Var y² ≤ E y⁴, conservative):
+// |D| must stay below 4 of its standard deviations.
+TEST(RenderStat, WWPrimeMatchesTheRandomWalkOnARoughCoatOverBlack) {
+    const Stack s =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.3), Rgbd(0.0)),
+                          test::lambertian_layer(Rgbd(0.0))});
+    const auto rw = make_model("random-walk", s);
+    const auto ww = make_model("ww-prime", s);
+    const Environment env = Environment::named("studio");
+    auto render = [&](const Model& m, std::uint64_t seed) {
+        RenderSettings rs = small(32, 128);
+        rs.seed = seed;
+        rs.lobe_alpha = 0.3;
+        return render_sphere(m, env, rs);
+    };
+    const Rendering rw1 = render(*rw, 1), rw2 = render(*rw, 2);
+    const Rendering ww1 = render(*ww, 3), ww2 = render(*ww, 4);
+    double x2 = 0, a2 = 0, b2 = 0, x4 = 0, a4 = 0, b4 = 0, signal = 0;
+    int n = 0;
+    for (std::size_t i = 0; i < rw1.mask.size(); ++i) {
+        if (!rw1.mask[i]) continue;
+        for (int c = 0; c < 3; ++c) {
+            const double x = rw1.image.pixels[i][c] - ww1.image.pixels[i][c];
+            const double a = rw1.image.pixels[i][c] - rw2.image.pixels[i][c];
+            const double b = ww1.image.pixels[i][c] - ww2.image.pixels[i][c];
+            x2 += x * x;
+            a2 += a * a;
+            b2 += b * b;
+            x4 += sqr(x * x);
+            a4 += sqr(a * a);
+            b4 += sqr(b * b);
+            signal += rw1.image.pixels[i][c];
+            ++n;
+        }
+    }
+    ASSERT_GT(n, 100);
+    ASSERT_GT(signal, 0);
+    const double d = x2 - (a2 + b2) / 2;
+    const double sd = std::sqrt(x4 + (a4 + b4) / 4);
+    EXPECT_LT(std::abs(d), 4 * sd) << "Σx² " << x2 << ", noise " << (a2 + b2) / 2 << ", sd " << sd;
 }
 
 TEST(Render, IdenticalAcrossThreadCounts) {
