@@ -2,6 +2,11 @@
 
 #include "core/error.h"
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
 #include <fmt/format.h>
 #include <png.h>
 
@@ -67,117 +72,53 @@ void write_png(const std::filesystem::path& path, const Image& image, double exp
 // magic 20000630, version 2 (single-part scanline), header attributes (name, type, size, value),
 // an empty name ends the header, then one 64-bit offset per scanline block and the blocks:
 // y (int), byte count (int), then each channel's row in alphabetical order (B, G, R).
-namespace {
-struct Writer {
-    std::string bytes;
-    template <typename T>
-    void put(T v) {
-        char b[sizeof(T)];
-        std::memcpy(b, &v, sizeof(T));  // little-endian hosts (x86-64, arm64), as EXR requires
-        bytes.append(b, sizeof(T));
-    }
-    void str(const std::string& s) { bytes.append(s.c_str(), s.size() + 1); }
-    void attribute(const std::string& name, const std::string& type, const std::string& value) {
-        str(name);
-        str(type);
-        put<std::int32_t>(std::int32_t(value.size()));
-        bytes += value;
-    }
-};
-}  // namespace
-
+// EXR through OpenEXR (Debian's libopenexr-dev): 32-bit float R, G, B scanlines, ZIP compression,
+// written to a temporary file and renamed into place.
 void write_exr(const std::filesystem::path& path, const Image& image) {
-    Writer h;
-    h.put<std::int32_t>(20000630);
-    h.put<std::int32_t>(2);
-    {
-        Writer ch;
-        for (const char* name : {"B", "G", "R"}) {
-            ch.str(name);
-            ch.put<std::int32_t>(2);  // FLOAT
-            ch.put<std::uint8_t>(0);  // pLinear
-            ch.put<std::uint8_t>(0);
-            ch.put<std::uint8_t>(0);
-            ch.put<std::uint8_t>(0);
-            ch.put<std::int32_t>(1);
-            ch.put<std::int32_t>(1);
-        }
-        ch.put<std::uint8_t>(0);
-        h.attribute("channels", "chlist", ch.bytes);
+    const std::filesystem::path tmp = path.string() + ".tmp-exr";
+    try {
+        Imf::Header header(image.width, image.height);
+        header.compression() = Imf::ZIP_COMPRESSION;
+        for (const char* c : {"R", "G", "B"})
+            header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+        Imf::OutputFile file(tmp.c_str(), header);
+        Imf::FrameBuffer fb;
+        char* base = reinterpret_cast<char*>(const_cast<Rgbf*>(image.pixels.data()));
+        const std::size_t xs = sizeof(Rgbf), ys = sizeof(Rgbf) * std::size_t(image.width);
+        fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+        fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+        fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        file.setFrameBuffer(fb);
+        file.writePixels(image.height);
+    } catch (const std::exception& e) {
+        std::error_code ec;
+        std::filesystem::remove(tmp, ec);
+        throw InputError(path.string(), "", fmt::format("cannot write the EXR file: {}", e.what()));
     }
-    h.attribute("compression", "compression", std::string(1, '\0'));
-    Writer box;
-    for (int v : {0, 0, image.width - 1, image.height - 1})
-        box.put<std::int32_t>(v);
-    h.attribute("dataWindow", "box2i", box.bytes);
-    h.attribute("displayWindow", "box2i", box.bytes);
-    h.attribute("lineOrder", "lineOrder", std::string(1, '\0'));
-    Writer f1;
-    f1.put<float>(1.f);
-    h.attribute("pixelAspectRatio", "float", f1.bytes);
-    Writer v2;
-    v2.put<float>(0.f);
-    v2.put<float>(0.f);
-    h.attribute("screenWindowCenter", "v2f", v2.bytes);
-    h.attribute("screenWindowWidth", "float", f1.bytes);
-    h.put<std::uint8_t>(0);
-    const std::uint64_t row_bytes = std::uint64_t(image.width) * 3 * 4;
-    const std::uint64_t first = h.bytes.size() + 8 * std::uint64_t(image.height);
-    for (int y = 0; y < image.height; ++y)
-        h.put<std::uint64_t>(first + std::uint64_t(y) * (8 + row_bytes));
-    for (int y = 0; y < image.height; ++y) {
-        h.put<std::int32_t>(y);
-        h.put<std::int32_t>(std::int32_t(row_bytes));
-        for (int c : {2, 1, 0})
-            for (int x = 0; x < image.width; ++x)
-                h.put<float>(image.at(x, y)[c]);
-    }
-    std::ofstream out(path, std::ios::binary);
-    out.write(h.bytes.data(), std::streamsize(h.bytes.size()));
-    if (!out) throw InputError(path.string(), "", "cannot write the EXR file");
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) throw InputError(path.string(), "", "cannot move the EXR file into place");
 }
 
 Image read_exr(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    const std::string b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::size_t p = 8;
-    auto cstr = [&] {
-        const std::string s(b.c_str() + p);
-        p += s.size() + 1;
-        return s;
-    };
-    auto get_i32 = [&](std::size_t at) {
-        std::int32_t v;
-        std::memcpy(&v, b.data() + at, 4);
-        return v;
-    };
-    int w = 0, h = 0;
-    while (true) {
-        const std::string name = cstr();
-        if (name.empty()) break;
-        cstr();
-        const std::int32_t size = get_i32(p);
-        p += 4;
-        if (name == "dataWindow") {
-            w = get_i32(p + 8) + 1;
-            h = get_i32(p + 12) + 1;
-        }
-        p += std::size_t(size);
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imath::Box2i dw = file.header().dataWindow();
+        Image image(dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1);
+        Imf::FrameBuffer fb;
+        char* base = reinterpret_cast<char*>(image.pixels.data()) -
+                     (std::ptrdiff_t(dw.min.x) + std::ptrdiff_t(dw.min.y) * image.width) *
+                         std::ptrdiff_t(sizeof(Rgbf));
+        const std::size_t xs = sizeof(Rgbf), ys = sizeof(Rgbf) * std::size_t(image.width);
+        fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+        fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+        fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        file.setFrameBuffer(fb);
+        file.readPixels(dw.min.y, dw.max.y);
+        return image;
+    } catch (const std::exception& e) {
+        throw InputError(path.string(), "", fmt::format("cannot read the EXR file: {}", e.what()));
     }
-    Image img(w, h);
-    p += 8 * std::size_t(h);
-    for (int y = 0; y < h; ++y) {
-        const int row = get_i32(p);
-        p += 8;
-        for (int c : {2, 1, 0})
-            for (int x = 0; x < w; ++x) {
-                float v;
-                std::memcpy(&v, b.data() + p, 4);
-                p += 4;
-                img.at(x, row)[c] = v;
-            }
-    }
-    return img;
 }
 
 }  // namespace lamina

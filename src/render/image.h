@@ -1,7 +1,6 @@
 #pragma once
 // Linear RGB images and their files: a tone-mapped 8-bit PNG (libpng) and a linear 32-bit float
-// EXR written by lamina itself (uncompressed scanlines, OpenEXR file layout 2.0; readable by any
-// EXR reader — Debian 12's OpenEXR 3.1 is not needed for writing). Tone mapping: exposure 2^EV,
+// EXR (OpenEXR, ZIP-compressed scanlines). Tone mapping: exposure 2^EV,
 // the ACES filmic fit of Narkowicz 2015 ("ACES filmic tone mapping curve"), then the sRGB
 // transfer function (IEC 61966-2-1).
 
@@ -32,10 +31,10 @@ std::uint8_t tone_map_channel(double linear, double exposure_ev);
 void write_png(const std::filesystem::path& path, const Image& image, double exposure_ev = 0,
                bool tone_map = true);
 
-/// Writes the linear image as an uncompressed RGB float EXR.
+/// Writes the linear image as an RGB float EXR (OpenEXR), atomically.
 void write_exr(const std::filesystem::path& path, const Image& image);
 
-/// Reads back what write_exr wrote (tests).
+/// Reads the R, G, B channels of an EXR file as float (InputError naming the file otherwise).
 Image read_exr(const std::filesystem::path& path);
 
 }  // namespace lamina
