@@ -6,6 +6,8 @@
 #include "core/rng.h"
 #include "core/spherical.h"
 #include "physics/phase.h"
+#include "simulator/kernel_simd.h"
+#include "simulator/tally.h"
 #include "simulator/trace_stack.h"
 
 #include <fmt/format.h>
@@ -41,121 +43,9 @@ void validate_settings(const SimulationSettings& s) {
 
 namespace {
 
-// ---- Fixed-point tallies -----------------------------------------------------------------------
-// Flux is added in integers: integer addition is associative, so the sums (and the tables) are
-// identical whatever the order in which threads or processes add them. A particle's flux per
-// channel never exceeds 3 (the spectral MIS of media conserves the sum of the channels' fluxes, and
-// every other event only removes flux), so one contribution is below 2^2.
-//
-// Exits first go to per-thread 64-bit sums (half the memory of 128-bit ones, so the bins stay in
-// cache), at scale 2^40 for Σ flux and 2^38 for Σ flux²; every 2^18 particles of a thread they are
-// widened into 128-bit sums, before 2^18 · 2^2 · 2^40 = 2^60 (resp. 2^18 · 2^4 · 2^38) could
-// overflow. Resolution 2^-40 ≈ 10^-12 of the incident flux per contribution.
-using Fixed = __int128;
-constexpr double kSumScale = 0x1p40, kSqScale = 0x1p38;
-constexpr double kBudgetScale = 0x1p56;
-constexpr std::uint64_t kFlushParticles = std::uint64_t(1) << 18;
-
-// |x| < 2^39: an integer part at scale 2^24 and the exact remainder, converted separately, at
-// scale 2^56 in all (budget sums over blocks of particles).
-inline Fixed to_fixed_wide(double x) {
-    const double scaled = x * 0x1p24;  // exact: a power-of-two scaling
-    const double hi = std::floor(scaled);
-    const double lo = scaled - hi;  // exact: the fractional part, in [0, 1)
-    return (Fixed(std::int64_t(hi)) << 32) + Fixed(std::llrint(lo * 0x1p32));
-}
-
-// Per (side, bin): Σ flux and Σ flux² per channel.
-struct BinSums {
-    std::array<std::int64_t, 3> sum{}, sum_sq{};
-};
-struct BinAccumulator {
-    std::array<Fixed, 3> sum{}, sum_sq{};
-};
-
-// Budget terms summed in double over one block of particles (a fixed range of particle indices,
-// traced in order by one thread, so the sum does not depend on the thread count), then added to
-// the 128-bit tallies once per block.
-struct BlockBudget {
-    std::array<Rgbd, kBudgetTerms> term{};
-    Rgbd reflected_sq{0.0}, transmitted_sq{0.0};
-};
-
-struct Tally {
-    std::vector<BinSums> recent;       // [side · n_bins + bin], since the last widening
-    std::vector<BinAccumulator> bins;  // widened sums
-    std::uint64_t particles_since_widening = 0;
-    std::array<std::array<Fixed, 3>, kBudgetTerms> budget{};
-    std::array<Fixed, 3> reflected_sq{}, transmitted_sq{};
-    std::uint64_t events = 0, degenerate = 0;
-
-    explicit Tally(std::size_t n_bins) : recent(2 * n_bins), bins(2 * n_bins) {}
-
-    void exit(std::size_t index, const Rgbf& flux) {
-        LAMINA_DCHECK(flux.max() <= 4.f);
-        BinSums& acc = recent[index];
-        for (int c = 0; c < 3; ++c) {
-            const double x = flux[c];
-            acc.sum[c] += std::llrint(x * kSumScale);
-            acc.sum_sq[c] += std::llrint(x * x * kSqScale);
-        }
-    }
-    void widen() {
-        for (std::size_t i = 0; i < bins.size(); ++i) {
-            for (int c = 0; c < 3; ++c) {
-                bins[i].sum[c] += recent[i].sum[c];
-                bins[i].sum_sq[c] += recent[i].sum_sq[c];
-            }
-            recent[i] = BinSums{};
-        }
-        particles_since_widening = 0;
-    }
-    void count_particles(std::uint64_t n) {
-        particles_since_widening += n;
-        if (particles_since_widening >= kFlushParticles) widen();
-    }
-    void add_block(const BlockBudget& b) {
-        for (int t = 0; t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c) budget[t][c] += to_fixed_wide(b.term[t][c]);
-        for (int c = 0; c < 3; ++c) {
-            reflected_sq[c] += to_fixed_wide(b.reflected_sq[c]);
-            transmitted_sq[c] += to_fixed_wide(b.transmitted_sq[c]);
-        }
-    }
-    void merge(Tally& o) {
-        o.widen();
-        for (std::size_t i = 0; i < bins.size(); ++i)
-            for (int c = 0; c < 3; ++c) {
-                bins[i].sum[c] += o.bins[i].sum[c];
-                bins[i].sum_sq[c] += o.bins[i].sum_sq[c];
-            }
-        for (int t = 0; t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c) budget[t][c] += o.budget[t][c];
-        for (int c = 0; c < 3; ++c) {
-            reflected_sq[c] += o.reflected_sq[c];
-            transmitted_sq[c] += o.transmitted_sq[c];
-        }
-        events += o.events;
-        degenerate += o.degenerate;
-    }
-};
-
 bool is_black(const Rgbf& w) {
     return w[0] == 0.f && w[1] == 0.f && w[2] == 0.f;
 }
-
-// The flux a particle loses along its path, per budget term, in registers; added to the block's
-// double sums once, when the particle ends.
-struct PathLosses {
-    std::array<Rgbf, kBudgetTerms> term{};
-
-    void add(BudgetTerm t, const Rgbf& lost) { term[int(t)] += lost; }
-    void flush(BlockBudget& block) const {
-        for (int t = int(BudgetTerm::AbsorbedMedium); t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c)
-                block.term[t][c] += double(term[t][c]);
-    }
-};
 
 // ---- Media (physics.md §4) ---------------------------------------------------------------------
 // Depth s ∈ [0, 1] across the layer (0 at its top); a direction d with |d.z| = μ crosses the whole
@@ -259,13 +149,6 @@ struct MediumWalk {
     }
 };
 
-inline void escape(Rgbd& sum, Rgbd& sum_sq, const Rgbf& w) {
-    for (int c = 0; c < 3; ++c) {
-        sum[c] += w[c];
-        sum_sq[c] += double(w[c]) * double(w[c]);
-    }
-}
-
 // ---- One particle ------------------------------------------------------------------------------
 // physics.md §3: at an interface the particle (arriving along −wi) draws an outgoing direction
 // from the interface's BSDF sampler; its flux is multiplied by the sample weight and the parts
@@ -291,7 +174,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
         // microsurface); a missing sample is a numerical degeneracy, counted and reported.
         auto apply = [&](const std::optional<BsdfSample<float>>& s, bool opaque) {
             if (!s) {
-                ++tally.degenerate;
+                ++tally.sums.degenerate;
                 losses.add(BudgetTerm::LostMicrosurface, w);
                 w = Rgbf(0.f);
                 return;
@@ -331,7 +214,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
             // An exactly grazing direction (a sampler at the edge of its domain, probability
             // ~2^-24): it belongs to neither hemisphere. Its G2 is zero on a microsurface, and it
             // is counted and reported as degenerate on any interface.
-            ++tally.degenerate;
+            ++tally.sums.degenerate;
             losses.add(layer.type == InterfaceType::Dielectric ? BudgetTerm::LostMicrosurface
                                                                : BudgetTerm::AbsorbedBase,
                        w);
@@ -340,7 +223,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
         if (d.z > 0) {
             if (k == 0) {  // leaves the stack upwards: reflection
                 tally.exit(grid.bin_of(d), w);
-                escape(block.term[int(BudgetTerm::Reflected)], block.reflected_sq, w);
+                block.escape_reflected(w);
                 break;
             }
             // Up through the medium below interface k − 1.
@@ -355,7 +238,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
         } else {
             if (k == n_layers - 1) {  // leaves through the final dielectric: transmission
                 tally.exit(grid.size() + grid.bin_of(d), w);
-                escape(block.term[int(BudgetTerm::Transmitted)], block.transmitted_sq, w);
+                block.escape_transmitted(w);
                 break;
             }
             const TraceMedium& m = layer.medium;
@@ -369,7 +252,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
         }
     }
     losses.flush(block);
-    tally.events += std::uint64_t(events);
+    tally.sums.events += std::uint64_t(events);
 }
 
 std::uint64_t incidence_stream(double theta_i_deg) {
@@ -380,19 +263,46 @@ std::uint64_t incidence_stream(double theta_i_deg) {
 
 }  // namespace
 
-SimulationResult simulate(const Stack& stack, const SimulationSettings& settings,
-                          const std::function<void(std::uint64_t)>& on_progress) {
+void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block) {
+    for (std::uint64_t p = job.first; p < job.first + job.count; ++p) {
+        ParticleRng rng(job.seed, job.stream, p);
+        trace_particle(*job.stack, *job.grid, job.wi, rng, job.max_events, tally, block);
+    }
+}
+
+const char* kernel_name(Kernel kernel) {
+    return kernel == Kernel::Simd ? "simd" : "scalar";
+}
+
+Kernel parse_kernel(const std::string& text, const std::string& option) {
+    if (text == "scalar") return Kernel::Scalar;
+    if (text == "simd") return Kernel::Simd;
+    throw InputError("command line", option,
+                     fmt::format("'{}' is not a kernel: use scalar or simd", text));
+}
+
+void IncidenceSums::add(const IncidenceSums& o) {
+    LAMINA_CHECK(bins.size() == o.bins.size());
+    for (std::size_t i = 0; i < bins.size(); ++i)
+        for (int k = 0; k < 6; ++k) bins[i][k] += o.bins[i][k];
+    for (std::size_t t = 0; t < budget.size(); ++t)
+        for (int c = 0; c < 3; ++c) budget[t][c] += o.budget[t][c];
+    events += o.events;
+    degenerate += o.degenerate;
+}
+
+SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,
+                             const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);
     const auto start = std::chrono::steady_clock::now();
     const TraceStack trace(stack);
     const HemisphereGrid& grid = settings.grid;
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
+    const auto trace_block =
+        settings.kernel == Kernel::Simd ? trace_block_simd : trace_block_scalar;
 
-    SimulationResult result;
-    result.settings = settings;
+    SimulationSums result;
     result.threads_used = threads;
-    result.table = BinnedTable::zeros(grid, settings.theta_i_deg, true, trace.transmits);
-
     const std::uint64_t n = settings.particles;
     // Particles per block: the unit of scheduling and of the double-precision budget sums. Blocks
     // are ranges of particle indices, so a run split at block boundaries (first_particle) adds up
@@ -403,45 +313,75 @@ SimulationResult simulate(const Stack& stack, const SimulationSettings& settings
     for (std::size_t inc = 0; inc < settings.theta_i_deg.size(); ++inc) {
         const auto inc_start = std::chrono::steady_clock::now();
         const double theta_i = deg_to_rad(settings.theta_i_deg[inc]);
-        const Vec3f wi(incident_direction(theta_i));
-        const std::uint64_t stream = incidence_stream(settings.theta_i_deg[inc]);
-        Tally total(grid.size());
+        BlockJob job{&trace,
+                     &grid,
+                     Vec3f(incident_direction(theta_i)),
+                     settings.seed,
+                     incidence_stream(settings.theta_i_deg[inc]),
+                     0,
+                     0,
+                     settings.max_events};
+        IncidenceSums total;
+        total.bins.resize(2 * grid.size());
 
-#pragma omp parallel num_threads(threads)
+#pragma omp parallel num_threads(threads) firstprivate(job)
         {
             Tally local(grid.size());
 #pragma omp for schedule(dynamic, 1)
             for (std::uint64_t b = 0; b < blocks; ++b) {
                 const std::uint64_t lo = b * kBlock, hi = std::min(n, lo + kBlock);
                 BlockBudget block;
-                for (std::uint64_t p = lo; p < hi; ++p) {
-                    ParticleRng rng(settings.seed, stream, settings.first_particle + p);
-                    trace_particle(trace, grid, wi, rng, settings.max_events, local, block);
-                }
+                job.first = settings.first_particle + lo;
+                job.count = hi - lo;
+                trace_block(job, local, block);
                 local.add_block(block);
                 local.count_particles(hi - lo);
                 if (on_progress) on_progress(hi - lo);
             }
+            const IncidenceSums& mine = local.finish();
 #pragma omp critical
-            total.merge(local);  // integer sums: the order of merging does not matter
+            total.add(mine);  // integer sums: the order of merging does not matter
         }
+        result.incidences.push_back(std::move(total));
+        result.incidence_seconds.push_back(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - inc_start).count());
+    }
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
 
-        // ---- Estimates (physics.md §5) ----
+SimulationResult finalize_simulation(const Stack& stack, const SimulationSettings& settings,
+                                     const SimulationSums& sums) {
+    LAMINA_CHECK(sums.incidences.size() == settings.theta_i_deg.size());
+    const HemisphereGrid& grid = settings.grid;
+    const bool transmits = stack.transmits();
+    SimulationResult result;
+    result.settings = settings;
+    result.threads_used = sums.threads_used;
+    result.seconds = sums.seconds;
+    result.table = BinnedTable::zeros(grid, settings.theta_i_deg, true, transmits);
+    const std::uint64_t n = settings.particles;
+    const double inv_n = 1.0 / double(n);
+    const double dn = n > 1 ? double(n - 1) : 1.0;
+
+    for (std::size_t inc = 0; inc < settings.theta_i_deg.size(); ++inc) {
+        const IncidenceSums& total = sums.incidences[inc];
+        LAMINA_CHECK(total.bins.size() == 2 * grid.size());
         IncidenceStats stats;
-        const double inv_n = 1.0 / double(n);
-        for (int side = 0; side < (trace.transmits ? 2 : 1); ++side) {
+        for (int side = 0; side < (transmits ? 2 : 1); ++side) {
             BinnedLobe& lobe =
                 result.table.lobe(inc, side == 0 ? Side::Reflection : Side::Transmission);
             for (std::size_t j = 0; j < grid.size(); ++j) {
                 const double omega = grid.projected_solid_angle(j);
-                const BinAccumulator& acc = total.bins[side * grid.size() + j];
+                const auto& acc = total.bins[side * grid.size() + j];
                 for (int c = 0; c < 3; ++c) {
-                    const double mean = double(acc.sum[c]) / kSumScale * inv_n;
-                    const double mean_sq = double(acc.sum_sq[c]) / kSqScale * inv_n;
+                    const double mean = double(acc[c]) / kSumScale * inv_n;
+                    const double mean_sq = double(acc[3 + c]) / kSqScale * inv_n;
                     // Standard error of the mean of N per-particle contributions.
                     const double var = std::max(0.0, mean_sq - mean * mean);
                     lobe.f[j][c] = mean / omega;
-                    lobe.se[j][c] = n > 1 ? std::sqrt(var / double(n - 1)) / omega : 0.0;
+                    lobe.se[j][c] = n > 1 ? std::sqrt(var / dn) / omega : 0.0;
                 }
             }
         }
@@ -451,21 +391,22 @@ SimulationResult simulate(const Stack& stack, const SimulationSettings& settings
         for (int c = 0; c < 3; ++c) {
             const double r = stats.budget.term[int(BudgetTerm::Reflected)][c];
             const double t = stats.budget.term[int(BudgetTerm::Transmitted)][c];
-            const double r2 = double(total.reflected_sq[c]) / kBudgetScale * inv_n;
-            const double t2 = double(total.transmitted_sq[c]) / kBudgetScale * inv_n;
-            const double dn = n > 1 ? double(n - 1) : 1.0;
+            const double r2 = double(total.budget[kBudgetTerms][c]) / kBudgetScale * inv_n;
+            const double t2 = double(total.budget[kBudgetTerms + 1][c]) / kBudgetScale * inv_n;
             stats.budget.reflected_se[c] = std::sqrt(std::max(0.0, r2 - r * r) / dn);
             stats.budget.transmitted_se[c] = std::sqrt(std::max(0.0, t2 - t * t) / dn);
         }
         stats.events_per_particle = double(total.events) * inv_n;
         stats.degenerate_samples = total.degenerate;
-        stats.seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - inc_start).count();
+        stats.seconds = inc < sums.incidence_seconds.size() ? sums.incidence_seconds[inc] : 0.0;
         result.incidences.push_back(stats);
     }
-    result.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
+}
+
+SimulationResult simulate(const Stack& stack, const SimulationSettings& settings,
+                          const std::function<void(std::uint64_t)>& on_progress) {
+    return finalize_simulation(stack, settings, simulate_sums(stack, settings, on_progress));
 }
 
 }  // namespace lamina

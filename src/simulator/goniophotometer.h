@@ -27,6 +27,15 @@ namespace lamina {
 /// Particles per block (see simulate); a split run's first_particle must be a multiple of it.
 inline constexpr std::uint64_t kParticlesPerBlock = 4096;
 
+/// The particle kernel: `scalar` traces one particle at a time (the readable reference path);
+/// `simd` traces a batch of particles as the lanes of SIMD vectors (kernel_simd.h), dispatched at
+/// run time to what the CPU offers. Each is bitwise reproducible for any thread or process count on
+/// a given machine; the two agree in distribution (a two-sample chi-square test), not bit for bit.
+enum class Kernel { Scalar, Simd };
+const char* kernel_name(Kernel kernel);
+/// "scalar" | "simd" (InputError naming `option` otherwise).
+Kernel parse_kernel(const std::string& text, const std::string& option = "--kernel");
+
 struct SimulationSettings {
     std::vector<double> theta_i_deg{0, 15, 30, 45, 60, 70, 80};  ///< each in [0, 90)
     std::uint64_t particles = 1'000'000;                         ///< per incidence, > 0
@@ -39,6 +48,7 @@ struct SimulationSettings {
     /// First particle index (a simulation may be split into ranges of particles, e.g. across
     /// processes; the union of ranges equals one run of all particles, bit for bit).
     std::uint64_t first_particle = 0;
+    Kernel kernel = Kernel::Scalar;
 };
 
 /// Where the flux of an incidence went, per channel; the terms sum to 1 to rounding.
@@ -69,6 +79,30 @@ struct IncidenceStats {
     double seconds = 0;
 };
 
+/// 128-bit fixed-point sums (simulator/tally.h for the scales).
+using Fixed128 = __int128;
+
+/// The integer sums of one incidence, from which every estimate follows (finalize_simulation).
+/// Integer addition is associative: the sums of disjoint particle ranges add up to those of their
+/// union bit for bit, whoever computed them (threads, processes).
+struct IncidenceSums {
+    /// Per (side · n_bins + bin): Σ flux per channel (0–2, scale 2^40), Σ flux² (3–5, scale 2^38).
+    std::vector<std::array<Fixed128, 6>> bins;
+    /// Budget terms [t][channel], then Σ R² and Σ T² per particle (rows kBudgetTerms and
+    /// kBudgetTerms + 1), scale 2^56.
+    std::array<std::array<Fixed128, 3>, kBudgetTerms + 2> budget{};
+    std::uint64_t events = 0, degenerate = 0;
+
+    void add(const IncidenceSums& o);
+};
+
+struct SimulationSums {
+    std::vector<IncidenceSums> incidences;  ///< one per settings.theta_i_deg
+    std::vector<double> incidence_seconds;  ///< wall time of each incidence
+    double seconds = 0;
+    int threads_used = 1;
+};
+
 struct SimulationResult {
     SimulationSettings settings;
     BinnedTable table;  ///< reflection, and transmission when the stack transmits
@@ -80,7 +114,17 @@ struct SimulationResult {
 /// Checks settings (InputError naming the option and the allowed range).
 void validate_settings(const SimulationSettings& settings);
 
-/// Runs the goniophotometer. `on_progress(particles_done)` is called from worker threads (may be
+/// Traces particles [first_particle, first_particle + particles) of every incidence and returns
+/// the raw sums. A run split into ranges that start at multiples of kParticlesPerBlock adds up
+/// (IncidenceSums::add) to the sums of one run, bit for bit.
+SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,
+                             const std::function<void(std::uint64_t)>& on_progress = {});
+
+/// The estimates (physics.md §5) from the sums of all `settings.particles` particles.
+SimulationResult finalize_simulation(const Stack& stack, const SimulationSettings& settings,
+                                     const SimulationSums& sums);
+
+/// Runs the goniophotometer: simulate_sums then finalize_simulation. `on_progress(particles_done)` is called from worker threads (may be
 /// empty). Settings must be valid (validate_settings).
 SimulationResult simulate(const Stack& stack, const SimulationSettings& settings,
                           const std::function<void(std::uint64_t)>& on_progress = {});

@@ -1,0 +1,136 @@
+#pragma once
+// Order-free tallies of the goniophotometer, shared by its kernels (scalar and SIMD). Internal to
+// the simulator: users see IncidenceSums (goniophotometer.h) and the finished SimulationResult.
+//
+// Flux is added in integers: integer addition is associative, so the sums (and the tables) are
+// identical whatever the order in which threads or processes add them. A particle's flux per
+// channel never exceeds 3 (the spectral MIS of media conserves the sum of the channels' fluxes, and
+// every other event only removes flux), so one contribution is below 2^2.
+//
+// Exits first go to per-thread 64-bit sums (half the memory of 128-bit ones, so the bins stay in
+// cache), at scale 2^40 for Σ flux and 2^38 for Σ flux²; every 2^18 particles of a thread they are
+// widened into 128-bit sums, before 2^18 · 2^2 · 2^40 = 2^60 (resp. 2^18 · 2^4 · 2^38) could
+// overflow. Resolution 2^-40 ≈ 10^-12 of the incident flux per contribution.
+
+#include "core/check.h"
+#include "core/grid.h"
+#include "core/rgb.h"
+#include "core/vec.h"
+#include "simulator/goniophotometer.h"
+#include "simulator/trace_stack.h"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace lamina {
+
+inline constexpr double kSumScale = 0x1p40, kSqScale = 0x1p38;
+inline constexpr double kBudgetScale = 0x1p56;
+inline constexpr std::uint64_t kFlushParticles = std::uint64_t(1) << 18;
+
+/// |x| < 2^39 to fixed point at scale 2^56: an integer part at scale 2^24 and the exact remainder,
+/// converted separately (budget sums over blocks of particles).
+inline Fixed128 to_fixed_wide(double x) {
+    const double scaled = x * 0x1p24;  // exact: a power-of-two scaling
+    const double hi = std::floor(scaled);
+    const double lo = scaled - hi;  // exact: the fractional part, in [0, 1)
+    return (Fixed128(std::int64_t(hi)) << 32) + Fixed128(std::llrint(lo * 0x1p32));
+}
+
+/// Budget terms summed in double over one block of particles (a fixed range of particle indices,
+/// traced in a fixed order by one thread, so the sum does not depend on the thread count), then
+/// added to the 128-bit tallies once per block.
+struct BlockBudget {
+    std::array<Rgbd, kBudgetTerms> term{};
+    Rgbd reflected_sq{0.0}, transmitted_sq{0.0};
+
+    void escape_reflected(const Rgbf& w) { escape(BudgetTerm::Reflected, reflected_sq, w); }
+    void escape_transmitted(const Rgbf& w) { escape(BudgetTerm::Transmitted, transmitted_sq, w); }
+
+  private:
+    void escape(BudgetTerm t, Rgbd& sum_sq, const Rgbf& w) {
+        for (int c = 0; c < 3; ++c) {
+            term[int(t)][c] += w[c];
+            sum_sq[c] += double(w[c]) * double(w[c]);
+        }
+    }
+};
+
+/// The flux a particle loses along its path, per budget term, in registers; added to the block's
+/// double sums once, when the particle ends.
+struct PathLosses {
+    std::array<Rgbf, kBudgetTerms> term{};
+
+    void add(BudgetTerm t, const Rgbf& lost) { term[int(t)] += lost; }
+    void flush(BlockBudget& block) const {
+        for (int t = int(BudgetTerm::AbsorbedMedium); t < kBudgetTerms; ++t)
+            for (int c = 0; c < 3; ++c) block.term[t][c] += double(term[t][c]);
+    }
+};
+
+/// One thread's tallies of one incidence.
+struct Tally {
+    struct Recent {
+        std::array<std::int64_t, 3> sum{}, sum_sq{};
+    };
+    std::vector<Recent> recent;  // [side · n_bins + bin], since the last widening
+    IncidenceSums sums;          // widened sums
+    std::uint64_t particles_since_widening = 0;
+
+    explicit Tally(std::size_t n_bins) : recent(2 * n_bins) { sums.bins.resize(2 * n_bins); }
+
+    /// A particle leaving into bin `index` (side · n_bins + bin) with flux `flux`.
+    void exit(std::size_t index, const Rgbf& flux) {
+        LAMINA_DCHECK(flux.max() <= 4.f);
+        Recent& acc = recent[index];
+        for (int c = 0; c < 3; ++c) {
+            const double x = flux[c];
+            acc.sum[c] += std::llrint(x * kSumScale);
+            acc.sum_sq[c] += std::llrint(x * x * kSqScale);
+        }
+    }
+    void widen() {
+        for (std::size_t i = 0; i < recent.size(); ++i) {
+            for (int c = 0; c < 3; ++c) {
+                sums.bins[i][c] += recent[i].sum[c];
+                sums.bins[i][3 + c] += recent[i].sum_sq[c];
+            }
+            recent[i] = Recent{};
+        }
+        particles_since_widening = 0;
+    }
+    void count_particles(std::uint64_t n) {
+        particles_since_widening += n;
+        if (particles_since_widening >= kFlushParticles) widen();
+    }
+    void add_block(const BlockBudget& b) {
+        for (int t = 0; t < kBudgetTerms; ++t)
+            for (int c = 0; c < 3; ++c) sums.budget[t][c] += to_fixed_wide(b.term[t][c]);
+        for (int c = 0; c < 3; ++c) {
+            sums.budget[kBudgetTerms][c] += to_fixed_wide(b.reflected_sq[c]);
+            sums.budget[kBudgetTerms + 1][c] += to_fixed_wide(b.transmitted_sq[c]);
+        }
+    }
+    /// The widened sums (widens first).
+    const IncidenceSums& finish() {
+        widen();
+        return sums;
+    }
+};
+
+/// A block of particles [first, first + count) of one incidence, traced by one kernel into
+/// `tally` (exits, events, degeneracies) and `block` (the budget). Particle p draws its numbers
+/// from ParticleRng(seed, stream, p).
+struct BlockJob {
+    const TraceStack* stack;
+    const HemisphereGrid* grid;
+    Vec3f wi;
+    std::uint64_t seed, stream, first, count;
+    int max_events;
+};
+
+void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block);
+
+}  // namespace lamina
