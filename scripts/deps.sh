@@ -7,7 +7,7 @@ packages=(
   build-essential cmake pkg-config git
   libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  librandom123-dev libpcg-cpp-dev libomp-dev libpng-dev libopenexr-dev
+  librandom123-dev libpcg-cpp-dev libomp-dev libpng-dev libopenexr-dev libhwy-dev
   python3 python3-numpy python3-matplotlib   # lamina figures (scripts/figures.py)
   chromium fonts-dejavu-core                 # the explorer's browser test (tests/report)
 )

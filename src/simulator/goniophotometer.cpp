@@ -284,9 +284,11 @@ Kernel parse_kernel(const std::string& text, const std::string& option) {
 void IncidenceSums::add(const IncidenceSums& o) {
     LAMINA_CHECK(bins.size() == o.bins.size());
     for (std::size_t i = 0; i < bins.size(); ++i)
-        for (int k = 0; k < 6; ++k) bins[i][k] += o.bins[i][k];
+        for (int k = 0; k < 6; ++k)
+            bins[i][k] += o.bins[i][k];
     for (std::size_t t = 0; t < budget.size(); ++t)
-        for (int c = 0; c < 3; ++c) budget[t][c] += o.budget[t][c];
+        for (int c = 0; c < 3; ++c)
+            budget[t][c] += o.budget[t][c];
     events += o.events;
     degenerate += o.degenerate;
 }

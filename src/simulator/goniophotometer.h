@@ -74,7 +74,7 @@ struct EnergyBudget {
 
 struct IncidenceStats {
     EnergyBudget budget;
-    double events_per_particle = 0;  ///< interface + scattering events, averaged
+    double events_per_particle = 0;        ///< interface + scattering events, averaged
     std::uint64_t degenerate_samples = 0;  ///< numerical degeneracies (counted, flux dropped)
     double seconds = 0;
 };
@@ -124,8 +124,8 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
 SimulationResult finalize_simulation(const Stack& stack, const SimulationSettings& settings,
                                      const SimulationSums& sums);
 
-/// Runs the goniophotometer: simulate_sums then finalize_simulation. `on_progress(particles_done)` is called from worker threads (may be
-/// empty). Settings must be valid (validate_settings).
+/// Runs the goniophotometer: simulate_sums then finalize_simulation. `on_progress(particles_done)`
+/// is called from worker threads (may be empty). Settings must be valid (validate_settings).
 SimulationResult simulate(const Stack& stack, const SimulationSettings& settings,
                           const std::function<void(std::uint64_t)>& on_progress = {});
 

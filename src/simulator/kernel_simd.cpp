@@ -1,12 +1,840 @@
+// The batched SIMD particle kernel (kernel_simd.h): the physics of trace_particle
+// (goniophotometer.cpp) written once more on SIMD vectors, particles as lanes.
+//
+// Layout. A block's particles run through a fixed set of lanes; a lane whose particle ends (exit,
+// absorption, cut-off) takes the block's next particle, so all lanes stay busy until the block's
+// tail. Per iteration every live lane does one step: an interface event followed, for lanes that
+// continue, by the crossing of the medium behind it (Beer–Lambert for absorbing media), or — for a
+// lane inside a scattering medium — one free flight with its scattering event. Interfaces are
+// evaluated layer by layer under the mask of the lanes that sit at that layer, with the layer's
+// parameters broadcast; no lane-dependent branches. What a lane does per step is exactly what
+// trace_particle does per loop (same samplers, same weights, same budget bookkeeping, same event
+// count), so the two kernels estimate the same tables (tests/simulator: every exact-solution test
+// runs on both, and a two-sample chi-square test compares them).
+//
+// Random numbers. Each lane draws from the particle's own PCG32 generator (O'Neill 2014), seeded
+// as in core/rng.h from one Philox4x32-10 evaluation (Salmon et al. 2011) keyed by (seed, stream,
+// particle index): the very streams of the scalar kernel. Both generators are evaluated here on
+// vectors (Highway has no RNG); tests check them bit for bit against Random123 and pcg-cpp. Every
+// lane draws at every step, used or not: a particle's draws are then not those of the scalar
+// kernel, but each is still a fresh uniform number independent of the particle's past.
+//
+// Reproducibility. A block is traced in a fixed order by one thread; exits go to the integer
+// tallies and the budget to the block's double sums in a fixed lane order: the output depends on
+// the block only, never on the thread count. It may differ between instruction sets (the vector
+// math rounds differently), so it is reproducible for a given kernel and machine.
+
 #include "simulator/kernel_simd.h"
 
-namespace lamina {
+#include "core/math.h"
 
-// Placeholder while the Highway kernel is written: the scalar path.
-void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
-    trace_block_scalar(job, tally, block);
+#include <cstring>
+#include <vector>
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "simulator/kernel_simd.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <hwy/contrib/math/math-inl.h>
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace lamina {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+using DF = hn::ScalableTag<float>;
+using DI = hn::RebindToSigned<DF>;
+using DU = hn::RebindToUnsigned<DF>;
+using D64 = hn::Repartition<std::uint64_t, DF>;
+using VF = hn::Vec<DF>;
+using VI = hn::Vec<DI>;
+using VU = hn::Vec<DU>;
+using V64 = hn::Vec<D64>;
+using MF = hn::Mask<DF>;
+using MI = hn::Mask<DI>;
+
+constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(float);
+
+// ---- Random numbers ---------------------------------------------------------------------------
+
+// 32 × 32 → 64-bit products of u32 lanes: low and high words (Philox's mulhilo).
+HWY_INLINE void MulHiLo32(VU a, VU b, VU& lo, VU& hi) {
+    const DU du;
+    const D64 d64;
+    lo = a * b;
+    const V64 even = hn::MulEven(a, b);
+    const V64 odd = hn::MulEven(hn::BitCast(du, hn::ShiftRight<32>(hn::BitCast(d64, a))),
+                                hn::BitCast(du, hn::ShiftRight<32>(hn::BitCast(d64, b))));
+    hi = hn::OddEven(hn::BitCast(du, odd), hn::BitCast(du, hn::ShiftRight<32>(even)));
 }
 
-const char* simd_target_name() { return "scalar-fallback"; }
+// Philox4x32-10 (Salmon et al. 2011, §4.2; the constants of Random123's philox.h) on lanes.
+HWY_INLINE void Philox4x32(VU c[4], std::uint32_t k0, std::uint32_t k1) {
+    const DU du;
+    const VU m0 = hn::Set(du, 0xD2511F53u), m1 = hn::Set(du, 0xCD9E8D57u);
+    for (int round = 0; round < 10; ++round) {
+        VU lo0, hi0, lo1, hi1;
+        MulHiLo32(m0, c[0], lo0, hi0);
+        MulHiLo32(m1, c[2], lo1, hi1);
+        const VU n0 = hn::Xor(hn::Xor(hi1, c[1]), hn::Set(du, k0));
+        const VU n2 = hn::Xor(hn::Xor(hi0, c[3]), hn::Set(du, k1));
+        c[0] = n0;
+        c[1] = lo1;
+        c[2] = n2;
+        c[3] = lo0;
+        k0 += 0x9E3779B9u;  // the Weyl key schedule
+        k1 += 0xBB67AE85u;
+    }
+}
+
+constexpr std::uint64_t kPcgMultiplier = 6364136223846793005ull;
+
+// The PCG32 generator (pcg-cpp's pcg32: 64-bit LCG state, XSH-RR output of the previous state) of
+// particle p, seeded as ParticleRng(seed, stream, p) seeds it.
+void SeedParticles(std::uint64_t seed, std::uint64_t stream, std::uint64_t first,
+                   std::uint64_t count, std::uint64_t* state, std::uint64_t* inc) {
+    const DU du;
+    const std::size_t n = hn::Lanes(du);
+    HWY_ALIGN std::uint32_t idx_lo[kMaxLanes], idx_hi[kMaxLanes], out[4][kMaxLanes];
+    for (std::uint64_t base = 0; base < count; base += n) {
+        for (std::size_t l = 0; l < n; ++l) {
+            const std::uint64_t p = first + base + l;
+            idx_lo[l] = std::uint32_t(p);
+            idx_hi[l] = std::uint32_t(p >> 32);
+        }
+        VU c[4] = {hn::Load(du, idx_lo), hn::Load(du, idx_hi), hn::Set(du, std::uint32_t(stream)),
+                   hn::Set(du, std::uint32_t(stream >> 32))};
+        Philox4x32(c, std::uint32_t(seed), std::uint32_t(seed >> 32));
+        for (int w = 0; w < 4; ++w)
+            hn::Store(c[w], du, out[w]);
+        for (std::size_t l = 0; l < n && base + l < count; ++l) {
+            const std::uint64_t initstate = (std::uint64_t(out[1][l]) << 32) | out[0][l];
+            const std::uint64_t sequence = (std::uint64_t(out[3][l]) << 32) | out[2][l];
+            const std::uint64_t increment = (sequence << 1) | 1u;
+            state[base + l] = (initstate + increment) * kPcgMultiplier + increment;
+            inc[base + l] = increment;
+        }
+    }
+}
+
+// x · kPcgMultiplier mod 2^64 from 32 × 32 → 64-bit products (64-bit lane products are not on
+// every target).
+HWY_INLINE V64 MulPcg(V64 x) {
+    const DU du;
+    const VU x32 = hn::BitCast(du, x);
+    const VU m_lo = hn::Set(du, std::uint32_t(kPcgMultiplier));
+    const VU m_hi = hn::Set(du, std::uint32_t(kPcgMultiplier >> 32));
+    const V64 lo_lo = hn::MulEven(x32, m_lo);
+    const V64 cross =
+        hn::Add(hn::MulEven(hn::BitCast(du, hn::ShiftRight<32>(x)), m_lo), hn::MulEven(x32, m_hi));
+    return hn::Add(lo_lo, hn::ShiftLeft<32>(cross));
+}
+
+// The lanes' generators; one call draws one uniform float per lane, as ParticleRng::uniform_float.
+struct LaneRng {
+    HWY_ALIGN std::uint64_t state[kMaxLanes];
+    HWY_ALIGN std::uint64_t inc[kMaxLanes];
+
+    HWY_INLINE VU NextU32() {
+        const D64 d64;
+        const DU du;
+        const std::size_t n64 = hn::Lanes(d64);
+        V64 xs[2], rot[2];
+        for (int h = 0; h < 2; ++h) {
+            const V64 old = hn::Load(d64, state + h * n64);
+            hn::Store(hn::Add(MulPcg(old), hn::Load(d64, inc + h * n64)), d64, state + h * n64);
+            // XSH-RR: xorshift by 18, keep bits 27..58, rotate by the top 5 bits.
+            xs[h] = hn::ShiftRight<27>(hn::Xor(old, hn::ShiftRight<18>(old)));
+            rot[h] = hn::ShiftRight<59>(old);
+        }
+        // The low words of the 64-bit lanes, in lane order.
+        const VU x = hn::ConcatEven(du, hn::BitCast(du, xs[1]), hn::BitCast(du, xs[0]));
+        const VU r = hn::ConcatEven(du, hn::BitCast(du, rot[1]), hn::BitCast(du, rot[0]));
+        const VU left = hn::And(hn::Sub(hn::Set(du, 32u), r), hn::Set(du, 31u));
+        return hn::Or(x >> r, x << left);
+    }
+    HWY_INLINE VF Uniform() {
+        const DF df;
+        const DI di;
+        return hn::Mul(hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<8>(NextU32()))),
+                       hn::Set(df, 0x1p-24f));
+    }
+};
+
+// ---- Vector geometry ---------------------------------------------------------------------------
+
+struct V3 {
+    VF x, y, z;
+};
+
+HWY_INLINE VF Dot(const V3& a, const V3& b) {
+    return hn::MulAdd(a.x, b.x, hn::MulAdd(a.y, b.y, hn::Mul(a.z, b.z)));
+}
+HWY_INLINE V3 Normalize(const V3& a) {
+    const DF df;
+    const VF inv = hn::Div(hn::Set(df, 1.f), hn::Sqrt(Dot(a, a)));
+    return {hn::Mul(a.x, inv), hn::Mul(a.y, inv), hn::Mul(a.z, inv)};
+}
+HWY_INLINE V3 Select(MF m, const V3& a, const V3& b) {
+    return {hn::IfThenElse(m, a.x, b.x), hn::IfThenElse(m, a.y, b.y), hn::IfThenElse(m, a.z, b.z)};
+}
+HWY_INLINE VF SafeSqrt(VF x) {
+    return hn::Sqrt(hn::ZeroIfNegative(x));
+}
+
+// cos and sin of 2π u, u ∈ [0, 1).
+HWY_INLINE void CosSin2Pi(VF u, VF& c, VF& s) {
+    const DF df;
+    const VF phi = hn::Mul(u, hn::Set(df, 2.f * kPi<float>));
+    c = hn::Cos(df, phi);
+    s = hn::Sin(df, phi);
+}
+
+// GGX visible normals by spherical caps: microfacet.h sample_visible_normal_caps (Dupuy & Benyoub
+// 2023, Listing 3), w below the surface through −w.
+HWY_INLINE V3 SampleVisibleNormalCaps(const V3& wi, float alpha, VF u1, VF u2) {
+    const DF df;
+    const VF a = hn::Set(df, alpha), one = hn::Set(df, 1.f);
+    const VF sign = hn::IfThenElse(hn::Lt(wi.z, hn::Zero(df)), hn::Set(df, -1.f), one);
+    const V3 wh = Normalize(
+        {hn::Mul(hn::Mul(a, sign), wi.x), hn::Mul(hn::Mul(a, sign), wi.y), hn::Mul(sign, wi.z)});
+    VF cos_phi, sin_phi;
+    CosSin2Pi(u1, cos_phi, sin_phi);
+    const VF z = hn::Sub(hn::Mul(hn::Sub(one, u2), hn::Add(one, wh.z)), wh.z);
+    const VF sin_theta = SafeSqrt(hn::NegMulAdd(z, z, one));
+    const V3 h = {hn::MulAdd(sin_theta, cos_phi, wh.x), hn::MulAdd(sin_theta, sin_phi, wh.y),
+                  hn::Add(z, wh.z)};
+    return Normalize({hn::Mul(a, h.x), hn::Mul(a, h.y), hn::ZeroIfNegative(h.z)});
+}
+
+// √(1 + α² tan²θ) = 1 + 2Λ (microfacet.h smith_root; Heitz 2014, Eq. 72); +∞ at grazing.
+HWY_INLINE VF SmithRoot(const V3& w, float alpha) {
+    const DF df;
+    const VF xy2 = hn::MulAdd(w.x, w.x, hn::Mul(w.y, w.y));
+    return hn::Sqrt(
+        hn::MulAdd(hn::Set(df, alpha * alpha), hn::Div(xy2, hn::Mul(w.z, w.z)), hn::Set(df, 1.f)));
+}
+
+// G2/G1 = (1 + r_i)/(r_i + r_o) (dielectric.h, height-correlated), or G1(wo) = 2/(1 + r_o)
+// (uncorrelated option).
+HWY_INLINE VF Shadowing(const V3& wi, const V3& wo, float alpha, bool uncorrelated) {
+    const DF df;
+    const VF one = hn::Set(df, 1.f);
+    const VF r_o = SmithRoot(wo, alpha);
+    if (uncorrelated) return hn::Div(hn::Set(df, 2.f), hn::Add(one, r_o));
+    const VF r_i = SmithRoot(wi, alpha);
+    return hn::Div(hn::Add(one, r_i), hn::Add(r_i, r_o));
+}
+
+// fresnel.h fresnel_conductor (real-arithmetic complex Fresnel), cos θ in [0, 1].
+HWY_INLINE VF FresnelConductor(VF cos_theta, float eta, float k) {
+    const DF df;
+    const VF one = hn::Set(df, 1.f);
+    const VF c = hn::Min(hn::ZeroIfNegative(cos_theta), one);
+    const VF cos2 = hn::Mul(c, c);
+    const VF sin2 = hn::Sub(one, cos2);
+    const float eta2 = eta * eta, k2 = k * k;
+    const VF t0 = hn::Sub(hn::Set(df, eta2 - k2), sin2);
+    const VF a2b2 = hn::Sqrt(hn::MulAdd(t0, t0, hn::Set(df, 4.f * eta2 * k2)));
+    const VF a = SafeSqrt(hn::Mul(hn::Set(df, 0.5f), hn::Add(a2b2, t0)));
+    const VF t1 = hn::Add(a2b2, cos2);
+    const VF t2 = hn::Mul(hn::Mul(hn::Set(df, 2.f), c), a);
+    const VF r_s = hn::Div(hn::Sub(t1, t2), hn::Add(t1, t2));
+    const VF t3 = hn::MulAdd(cos2, a2b2, hn::Mul(sin2, sin2));
+    const VF t4 = hn::Mul(t2, sin2);
+    const VF sum34 = hn::Add(t3, t4);
+    const VF r_p = hn::IfThenElse(hn::Gt(sum34, hn::Zero(df)),
+                                  hn::Div(hn::Mul(r_s, hn::Sub(t3, t4)), sum34), r_s);
+    return hn::Mul(hn::Add(r_s, r_p), hn::Set(df, 0.5f));
+}
+
+// ---- Lane state ---------------------------------------------------------------------------------
+
+enum LossTerm { kLossMedium = 0, kLossBase = 1, kLossMicro = 2, kLossCutOff = 3, kLossTerms = 4 };
+
+// Why a lane's particle ended this step.
+enum Finish : std::int32_t { kGoesOn = 0, kReflected = 1, kTransmitted = 2, kEnded = 3 };
+
+struct Lanes {
+    HWY_ALIGN float dx[kMaxLanes], dy[kMaxLanes], dz[kMaxLanes];
+    HWY_ALIGN float w[3][kMaxLanes];
+    HWY_ALIGN float depth[kMaxLanes];  // inside a scattering medium: 0 at its top, 1 at its bottom
+    HWY_ALIGN float loss[kLossTerms][3][kMaxLanes];
+    HWY_ALIGN std::int32_t k[kMaxLanes];  // at an interface: its index; in a medium: its layer
+    HWY_ALIGN std::int32_t in_medium[kMaxLanes];
+    HWY_ALIGN std::int32_t events[kMaxLanes];
+    HWY_ALIGN std::int32_t live[kMaxLanes];
+    HWY_ALIGN std::int32_t finish[kMaxLanes];
+    LaneRng rng;
+};
+
+struct LaneVectors {
+    V3 d;
+    VF w[3];
+    VF depth;
+    VF loss[kLossTerms][3];
+    VI k, in_medium, events, live, finish;
+
+    HWY_INLINE void load(const Lanes& s) {
+        const DF df;
+        const DI di;
+        d = {hn::Load(df, s.dx), hn::Load(df, s.dy), hn::Load(df, s.dz)};
+        for (int c = 0; c < 3; ++c)
+            w[c] = hn::Load(df, s.w[c]);
+        depth = hn::Load(df, s.depth);
+        for (int t = 0; t < kLossTerms; ++t)
+            for (int c = 0; c < 3; ++c)
+                loss[t][c] = hn::Load(df, s.loss[t][c]);
+        k = hn::Load(di, s.k);
+        in_medium = hn::Load(di, s.in_medium);
+        events = hn::Load(di, s.events);
+        live = hn::Load(di, s.live);
+        finish = hn::Zero(di);
+    }
+    HWY_INLINE void store(Lanes& s) const {
+        const DF df;
+        const DI di;
+        hn::Store(d.x, df, s.dx);
+        hn::Store(d.y, df, s.dy);
+        hn::Store(d.z, df, s.dz);
+        for (int c = 0; c < 3; ++c)
+            hn::Store(w[c], df, s.w[c]);
+        hn::Store(depth, df, s.depth);
+        for (int t = 0; t < kLossTerms; ++t)
+            for (int c = 0; c < 3; ++c)
+                hn::Store(loss[t][c], df, s.loss[t][c]);
+        hn::Store(k, di, s.k);
+        hn::Store(in_medium, di, s.in_medium);
+        hn::Store(events, di, s.events);
+        hn::Store(live, di, s.live);
+        hn::Store(finish, di, s.finish);
+    }
+
+    // Multiplies the flux of the lanes in m by `factor` (per channel) and books what is taken
+    // under `term`.
+    HWY_INLINE void Keep(MF m, int term, const VF factor[3]) {
+        for (int c = 0; c < 3; ++c) {
+            const VF kept = hn::Mul(w[c], factor[c]);
+            loss[term][c] = hn::Add(loss[term][c], hn::IfThenElseZero(m, hn::Sub(w[c], kept)));
+            w[c] = hn::IfThenElse(m, kept, w[c]);
+        }
+    }
+    HWY_INLINE void Keep(MF m, int term, VF factor) {
+        const VF f[3] = {factor, factor, factor};
+        Keep(m, term, f);
+    }
+    HWY_INLINE MF Black() const {
+        const DF df;
+        const VF zero = hn::Zero(df);
+        return hn::And(hn::And(hn::Eq(w[0], zero), hn::Eq(w[1], zero)), hn::Eq(w[2], zero));
+    }
+    HWY_INLINE void End(MF m, Finish why) {
+        const DI di;
+        finish = hn::IfThenElse(hn::RebindMask(di, m), hn::Set(di, why), finish);
+    }
+};
+
+HWY_INLINE MF LaneIs(VI v, std::int32_t value) {
+    const DF df;
+    const DI di;
+    return hn::RebindMask(df, hn::Eq(v, hn::Set(di, value)));
+}
+
+// ---- Interface events (goniophotometer.cpp trace_particle, `apply`) ----------------------------
+
+// A rough or smooth dielectric (dielectric.h sample): the particle arrives along d (wi = −d).
+HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
+                                VF uc, VF u1, VF u2, MF& degenerate) {
+    const DF df;
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
+    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
+    const MF grazing = hn::And(m, hn::Eq(wi.z, zero));  // sample() returns nothing
+    degenerate = hn::Or(degenerate, grazing);
+    const MF ok = hn::AndNot(grazing, m);
+    V3 wo;
+    VF shadowing = one;
+    if (iface.is_index_matched()) {
+        // Straight through; rough: weight G2(wi, −wi)/G1(wi) = (1 + r)/(2r) (dielectric.h
+        // sample_index_matched, with r = 1 + 2Λ).
+        wo = v.d;
+        if (!iface.is_smooth()) {
+            if (iface.uncorrelated_shadowing) {
+                shadowing = hn::Div(hn::Set(df, 2.f), hn::Add(one, SmithRoot(wi, iface.alpha)));
+            } else {
+                const VF r = SmithRoot(wi, iface.alpha);
+                shadowing = hn::Div(hn::Add(one, r), hn::Add(r, r));
+            }
+        }
+    } else {
+        // The microfacet normal: drawn for a rough interface, the macro normal for a smooth one
+        // (then both branches below reduce to the mirror and Snell's law, shadowing 1).
+        const V3 wm = iface.is_smooth() ? V3{zero, zero, one}
+                                        : SampleVisibleNormalCaps(wi, iface.alpha, u1, u2);
+        const VF cos_i_m = Dot(wi, wm);
+        // fresnel.h fresnel_dielectric_full: from below, the crossed index is 1/η.
+        const MF below = hn::Lt(cos_i_m, zero);
+        const VF eta = hn::IfThenElse(below, hn::Set(df, iface.inv_eta()), hn::Set(df, iface.eta));
+        const VF inv_eta =
+            hn::IfThenElse(below, hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()));
+        const VF cos_i = hn::Min(hn::Abs(cos_i_m), one);
+        const VF sin2_t = hn::Mul(hn::NegMulAdd(cos_i, cos_i, one), hn::Mul(inv_eta, inv_eta));
+        const MF tir = hn::Ge(sin2_t, one);
+        const VF cos_t = SafeSqrt(hn::Sub(one, sin2_t));
+        // Born & Wolf §1.5.2, Eqs. 21a–b, as in fresnel_dielectric_full.
+        const VF a = hn::MulSub(eta, cos_i, cos_t), b = hn::MulAdd(eta, cos_i, cos_t);
+        const VF c = hn::NegMulAdd(eta, cos_t, cos_i), d = hn::MulAdd(eta, cos_t, cos_i);
+        const VF bd = hn::Mul(b, d);
+        const VF b2d2 = hn::Mul(bd, bd);
+        const VF ad = hn::Mul(a, d), cb = hn::Mul(c, b);
+        VF reflectance = hn::Div(hn::MulAdd(ad, ad, hn::Mul(cb, cb)), hn::Add(b2d2, b2d2));
+        reflectance = hn::IfThenElse(hn::Or(tir, hn::Le(b2d2, zero)), one, reflectance);
+        // Both candidates, one selected (dielectric.h): mirror about wm, or Snell about wm.
+        const VF two_cos = hn::Add(cos_i_m, cos_i_m);
+        const V3 reflected = {hn::MulSub(two_cos, wm.x, wi.x), hn::MulSub(two_cos, wm.y, wi.y),
+                              hn::MulSub(two_cos, wm.z, wi.z)};
+        const VF sign = hn::IfThenElse(below, hn::Set(df, -1.f), one);
+        const VF along = hn::Mul(sign, hn::MulSub(cos_i, inv_eta, cos_t));
+        const VF neg_inv_eta = hn::Neg(inv_eta);
+        const V3 refracted = {hn::MulAdd(wi.x, neg_inv_eta, hn::Mul(wm.x, along)),
+                              hn::MulAdd(wi.y, neg_inv_eta, hn::Mul(wm.y, along)),
+                              hn::MulAdd(wi.z, neg_inv_eta, hn::Mul(wm.z, along))};
+        const MF is_reflection = hn::Lt(uc, reflectance);
+        wo = Select(is_reflection, reflected, refracted);
+        if (!iface.is_smooth()) {
+            // A reflection must stay on wi's side and a refraction cross, else G2 = 0.
+            const MF same_side = hn::Gt(hn::Mul(wi.z, wo.z), zero);
+            const MF escapes =
+                hn::AndNot(hn::Eq(wo.z, zero), hn::Not(hn::Xor(same_side, is_reflection)));
+            shadowing = hn::IfThenElseZero(
+                escapes, Shadowing(wi, wo, iface.alpha, iface.uncorrelated_shadowing));
+        }
+    }
+    v.Keep(ok, kLossMicro, shadowing);
+    v.d = Select(ok, wo, v.d);
+}
+
+// A rough or smooth conductor (conductor.h sample): light from above only.
+HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v, VF u1,
+                               VF u2, MF& degenerate) {
+    const DF df;
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
+    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
+    const MF bad = hn::And(m, hn::Le(wi.z, zero));
+    degenerate = hn::Or(degenerate, bad);
+    const MF ok = hn::AndNot(bad, m);
+    const V3 wm =
+        iface.is_smooth() ? V3{zero, zero, one} : SampleVisibleNormalCaps(wi, iface.alpha, u1, u2);
+    const VF cos_i_m = Dot(wi, wm);
+    const VF two_cos = hn::Add(cos_i_m, cos_i_m);
+    const V3 wo = {hn::MulSub(two_cos, wm.x, wi.x), hn::MulSub(two_cos, wm.y, wi.y),
+                   hn::MulSub(two_cos, wm.z, wi.z)};
+    VF fresnel[3];
+    for (int c = 0; c < 3; ++c)
+        fresnel[c] = FresnelConductor(cos_i_m, iface.eta[c], iface.k[c]);
+    v.Keep(ok, kLossBase, fresnel);
+    if (!iface.is_smooth()) {
+        const VF shadowing = hn::IfThenElseZero(
+            hn::Gt(wo.z, zero), Shadowing(wi, wo, iface.alpha, iface.uncorrelated_shadowing));
+        v.Keep(ok, kLossMicro, shadowing);
+    }
+    v.d = Select(ok, wo, v.d);
+}
+
+// Lambertian (lambertian.h sample): cosine-distributed on wi's side, weight = albedo. The disk
+// point is drawn by the polar map (r = √u1, φ = 2πu2): the same cosine density as the scalar
+// kernel's concentric map, fewer operations on vectors.
+HWY_INLINE void LambertianEvent(const LambertianInterface<float>& iface, MF m, LaneVectors& v,
+                                VF u1, VF u2, MF& degenerate) {
+    const DF df;
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
+    const MF bad = hn::And(m, hn::Eq(v.d.z, zero));
+    degenerate = hn::Or(degenerate, bad);
+    const MF ok = hn::AndNot(bad, m);
+    VF cos_phi, sin_phi;
+    CosSin2Pi(u2, cos_phi, sin_phi);
+    const VF r = hn::Sqrt(u1);
+    const VF z = SafeSqrt(hn::Sub(one, u1));
+    // wi = −d: the new direction is on wi's side, i.e. against the arriving d.
+    const V3 wo = {hn::Mul(r, cos_phi), hn::Mul(r, sin_phi),
+                   hn::IfThenElse(hn::Gt(v.d.z, zero), hn::Neg(z), z)};
+    const VF albedo[3] = {hn::Set(df, iface.albedo[0]), hn::Set(df, iface.albedo[1]),
+                          hn::Set(df, iface.albedo[2])};
+    v.Keep(ok, kLossBase, albedo);
+    v.d = Select(ok, wo, v.d);
+}
+
+// ---- Media (goniophotometer.cpp MediumWalk) -----------------------------------------------------
+
+// Henyey–Greenstein direction (phase.h sample_hg), Duff et al. 2017 frame about d.
+HWY_INLINE V3 SampleHg(const V3& d, VF g, VF u1, VF u2) {
+    const DF df;
+    const VF one = hn::Set(df, 1.f), two = hn::Set(df, 2.f);
+    const VF g2 = hn::Mul(g, g);
+    const VF s = hn::Div(hn::Sub(one, g2), hn::Sub(hn::Add(one, g), hn::Mul(hn::Mul(two, g), u1)));
+    VF cos_theta = hn::Div(hn::Sub(hn::Add(one, g2), hn::Mul(s, s)), hn::Mul(two, g));
+    cos_theta = hn::Min(hn::Max(cos_theta, hn::Set(df, -1.f)), one);
+    cos_theta = hn::IfThenElse(hn::Lt(hn::Abs(g), hn::Set(df, 1e-3f)), hn::NegMulAdd(two, u1, one),
+                               cos_theta);
+    const VF sin_theta = SafeSqrt(hn::NegMulAdd(cos_theta, cos_theta, one));
+    VF cos_phi, sin_phi;
+    CosSin2Pi(u2, cos_phi, sin_phi);
+    const VF lx = hn::Mul(sin_theta, cos_phi), ly = hn::Mul(sin_theta, sin_phi);
+    const VF sign = hn::CopySign(one, d.z);
+    const VF a = hn::Div(hn::Set(df, -1.f), hn::Add(sign, d.z));
+    const VF b = hn::Mul(hn::Mul(d.x, d.y), a);
+    const V3 s_axis = {hn::Add(one, hn::Mul(hn::Mul(sign, hn::Mul(d.x, d.x)), a)), hn::Mul(sign, b),
+                       hn::Neg(hn::Mul(sign, d.x))};
+    const V3 t_axis = {b, hn::MulAdd(hn::Mul(d.y, d.y), a, sign), hn::Neg(d.y)};
+    return {hn::MulAdd(s_axis.x, lx, hn::MulAdd(t_axis.x, ly, hn::Mul(d.x, cos_theta))),
+            hn::MulAdd(s_axis.y, lx, hn::MulAdd(t_axis.y, ly, hn::Mul(d.y, cos_theta))),
+            hn::MulAdd(s_axis.z, lx, hn::MulAdd(t_axis.z, ly, hn::Mul(d.z, cos_theta)))};
+}
+
+HWY_INLINE VF HgPhase(VF cos_theta, VF g) {
+    const DF df;
+    const VF one = hn::Set(df, 1.f);
+    const VF g2 = hn::Mul(g, g);
+    const VF denom = hn::Sub(hn::Add(one, g2), hn::Mul(hn::Mul(hn::Set(df, 2.f), g), cos_theta));
+    return hn::Div(hn::Sub(one, g2),
+                   hn::Mul(hn::Set(df, 4.f * kPi<float>), hn::Mul(denom, SafeSqrt(denom))));
+}
+
+// One scattering-medium step for the lanes in m (inside layer `layer`'s medium): a free flight by
+// one-sample spectral MIS (balance heuristic over channels ∝ flux; Veach 1997 §9.2.4), then either
+// the crossing to the next interface or a scattering event with HG (per-channel g by the same MIS).
+HWY_INLINE void ScatteringStep(const TraceMedium& med, MF m, LaneVectors& v, VF u_channel,
+                               VF u_flight, VF u_phase, VF u_hg1, VF u_hg2) {
+    const DF df;
+    const DI di;
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
+    const VF mu = hn::Abs(v.d.z);
+    const MF down = hn::Lt(v.d.z, zero);
+    const VF to_boundary = hn::IfThenElse(
+        hn::Gt(mu, zero), hn::Div(hn::IfThenElse(down, hn::Sub(one, v.depth), v.depth), mu),
+        hn::Set(df, HUGE_VALF));
+    const VF total = hn::Add(hn::Add(v.w[0], v.w[1]), v.w[2]);
+    const MF has_flux = hn::Gt(total, zero);
+    const VF inv_total = hn::Div(one, hn::IfThenElse(has_flux, total, one));
+    const VF p[3] = {hn::Mul(v.w[0], inv_total), hn::Mul(v.w[1], inv_total),
+                     hn::Mul(v.w[2], inv_total)};
+    const VF p01 = hn::Add(p[0], p[1]);
+    auto pick = [&](VF u, const float* values) {
+        return hn::IfThenElse(
+            hn::Lt(u, p[0]), hn::Set(df, values[0]),
+            hn::IfThenElse(hn::Lt(u, p01), hn::Set(df, values[1]), hn::Set(df, values[2])));
+    };
+    const float tau_t[3] = {med.tau_t[0], med.tau_t[1], med.tau_t[2]};
+    const VF sigma = pick(u_channel, tau_t);
+    const VF flight = hn::IfThenElse(hn::Gt(sigma, zero),
+                                     hn::Div(hn::Neg(hn::Log1p(df, hn::Neg(u_flight))),
+                                             hn::IfThenElse(hn::Gt(sigma, zero), sigma, one)),
+                                     hn::Set(df, HUGE_VALF));
+    const MF leaves = hn::And(m, hn::Or(hn::Not(has_flux), hn::Ge(flight, to_boundary)));
+    const MF scatters = hn::AndNot(leaves, m);
+
+    // Leaves the layer: weight_c = T_c / Σ_k p_k T_k (arrives at the next interface).
+    // Scatters at `flight`: weight_c = σs_c e^{−σt_c t} / Σ_k p_k σt_k e^{−σt_k t}.
+    const VF t = hn::IfThenElse(leaves, to_boundary, hn::IfThenElseZero(scatters, flight));
+    VF e[3], mix = zero, mix_scatter = zero;
+    for (int c = 0; c < 3; ++c) {
+        e[c] = hn::Exp(df, hn::Mul(hn::Set(df, -med.tau_t[c]), t));
+        mix = hn::MulAdd(p[c], e[c], mix);
+        mix_scatter = hn::MulAdd(hn::Mul(p[c], hn::Set(df, med.tau_t[c])), e[c], mix_scatter);
+    }
+    const MF mix_ok = hn::And(hn::Gt(mix, zero), has_flux);
+    const VF inv_mix = hn::Div(one, hn::IfThenElse(mix_ok, mix, one));
+    const VF inv_mix_s = hn::Div(one, hn::IfThenElse(hn::Gt(mix_scatter, zero), mix_scatter, one));
+    VF factor[3];
+    if (med.uniform_tau_t) {
+        // One extinction for all channels: no spectral MIS; leaving keeps the flux, a scattering
+        // event multiplies it by the single-scattering albedo (as the scalar kernel).
+        for (int c = 0; c < 3; ++c)
+            factor[c] = hn::IfThenElse(leaves, one, hn::Set(df, med.single_scattering_albedo[c]));
+    } else {
+        for (int c = 0; c < 3; ++c)
+            factor[c] =
+                hn::IfThenElse(leaves, hn::IfThenElse(has_flux, hn::Mul(e[c], inv_mix), one),
+                               hn::Mul(hn::Mul(hn::Set(df, med.tau_s[c]), e[c]), inv_mix_s));
+    }
+    v.Keep(m, kLossMedium, factor);
+
+    // Leaving lanes arrive at the interface above (k) or below (k + 1).
+    const MI leave_i = hn::RebindMask(di, leaves);
+    v.k = hn::IfThenElse(hn::And(leave_i, hn::RebindMask(di, down)), hn::Add(v.k, hn::Set(di, 1)),
+                         v.k);
+    v.in_medium = hn::IfThenElseZero(hn::Not(leave_i), v.in_medium);
+
+    if (hn::AllFalse(df, scatters)) return;
+    v.depth = hn::IfThenElse(
+        scatters, hn::Min(hn::Max(hn::NegMulAdd(v.d.z, flight, v.depth), zero), one), v.depth);
+    const float g[3] = {med.g[0], med.g[1], med.g[2]};
+    const VF g_lane = med.uniform_g ? hn::Set(df, med.g[0]) : pick(u_phase, g);
+    const V3 d_new = SampleHg(v.d, g_lane, u_hg1, u_hg2);
+    if (!med.uniform_g) {
+        const VF cos_theta = Dot(v.d, d_new);
+        VF phase[3], mix_phase = zero;
+        for (int c = 0; c < 3; ++c) {
+            phase[c] = HgPhase(cos_theta, hn::Set(df, med.g[c]));
+            mix_phase = hn::MulAdd(p[c], phase[c], mix_phase);
+        }
+        const VF inv = hn::Div(one, hn::IfThenElse(hn::Gt(mix_phase, zero), mix_phase, one));
+        VF f[3];
+        for (int c = 0; c < 3; ++c)
+            f[c] = hn::Mul(phase[c], inv);
+        v.Keep(scatters, kLossMedium, f);
+    }
+    v.d = Select(scatters, d_new, v.d);
+    v.events =
+        hn::IfThenElse(hn::RebindMask(di, scatters), hn::Add(v.events, hn::Set(di, 1)), v.events);
+}
+
+// ---- The block --------------------------------------------------------------------------------
+
+struct Scratch {
+    std::vector<std::uint64_t> state, inc;
+};
+
+void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
+    const DF df;
+    const DI di;
+    const std::size_t n_lanes = hn::Lanes(df);
+    const TraceStack& stack = *job.stack;
+    const HemisphereGrid& grid = *job.grid;
+    const int n_layers = int(stack.layers.size());
+
+    thread_local Scratch scratch;
+    scratch.state.resize(job.count);
+    scratch.inc.resize(job.count);
+    SeedParticles(job.seed, job.stream, job.first, job.count, scratch.state.data(),
+                  scratch.inc.data());
+
+    Lanes lanes;
+    std::memset(&lanes, 0, sizeof(lanes));
+    std::uint64_t next = 0;  // the block's next particle
+    auto start_particle = [&](std::size_t l) {
+        if (next < job.count) {
+            lanes.dx[l] = -job.wi.x;
+            lanes.dy[l] = -job.wi.y;
+            lanes.dz[l] = -job.wi.z;
+            for (int c = 0; c < 3; ++c)
+                lanes.w[c][l] = 1.f;
+            for (int t = 0; t < kLossTerms; ++t)
+                for (int c = 0; c < 3; ++c)
+                    lanes.loss[t][c][l] = 0.f;
+            lanes.k[l] = 0;
+            lanes.in_medium[l] = 0;
+            lanes.events[l] = 0;
+            lanes.live[l] = 1;
+            lanes.rng.state[l] = scratch.state[next];
+            lanes.rng.inc[l] = scratch.inc[next];
+            ++next;
+        } else {
+            lanes.live[l] = 0;
+            for (int c = 0; c < 3; ++c)
+                lanes.w[c][l] = 0.f;
+            lanes.dz[l] = -1.f;
+            lanes.rng.inc[l] = 1;
+        }
+    };
+    for (std::size_t l = 0; l < n_lanes; ++l)
+        start_particle(l);
+
+    bool any_scattering = false;
+    for (const TraceLayer& layer : stack.layers)
+        any_scattering |= layer.medium.scatters;
+    const VF zero = hn::Zero(df);
+    std::uint64_t degenerate = 0;
+
+    LaneVectors v;
+    while (true) {
+        v.load(lanes);
+        const MF live = hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di)));
+        if (hn::AllFalse(df, live)) break;
+
+        // Cut-off (trace_particle: checked before every event).
+        const MF cut =
+            hn::And(live, hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job.max_events - 1))));
+        for (int c = 0; c < 3; ++c) {
+            v.loss[kLossCutOff][c] =
+                hn::Add(v.loss[kLossCutOff][c], hn::IfThenElseZero(cut, v.w[c]));
+            v.w[c] = hn::IfThenElseZero(hn::Not(cut), v.w[c]);
+        }
+        v.End(cut, kEnded);
+        const MF going = hn::AndNot(cut, live);
+        const MF in_med = hn::And(going, hn::RebindMask(df, hn::Ne(v.in_medium, hn::Zero(di))));
+        const MF at_interface = hn::AndNot(in_med, going);
+
+        const VF u0 = lanes.rng.Uniform(), u1 = lanes.rng.Uniform(), u2 = lanes.rng.Uniform();
+
+        // ---- Scattering-medium steps (lanes that entered a medium on an earlier step) ----
+        if (any_scattering && !hn::AllFalse(df, in_med)) {
+            const VF u3 = lanes.rng.Uniform(), u4 = lanes.rng.Uniform();
+            for (int j = 0; j < n_layers; ++j) {
+                const TraceMedium& med = stack.layers[j].medium;
+                if (!med.scatters) continue;
+                const MF mj = hn::And(in_med, LaneIs(v.k, j));
+                if (hn::AllFalse(df, mj)) continue;
+                ScatteringStep(med, mj, v, u0, u1, u2, u3, u4);
+            }
+            const MF black = hn::And(in_med, v.Black());
+            v.End(black, kEnded);
+        }
+
+        // ---- Interface events ----
+        if (!hn::AllFalse(df, at_interface)) {
+            v.events = hn::IfThenElse(hn::RebindMask(di, at_interface),
+                                      hn::Add(v.events, hn::Set(di, 1)), v.events);
+            MF degenerate_event = hn::FirstN(df, 0);  // all false
+            MF at_dielectric = degenerate_event;
+            for (int j = 0; j < n_layers; ++j) {
+                const MF mj = hn::And(at_interface, LaneIs(v.k, j));
+                if (hn::AllFalse(df, mj)) continue;
+                const TraceLayer& layer = stack.layers[j];
+                switch (layer.type) {
+                    case InterfaceType::Dielectric:
+                        DielectricEvent(layer.dielectric, mj, v, u0, u1, u2, degenerate_event);
+                        at_dielectric = hn::Or(at_dielectric, mj);
+                        break;
+                    case InterfaceType::Conductor:
+                        ConductorEvent(layer.conductor, mj, v, u1, u2, degenerate_event);
+                        break;
+                    case InterfaceType::Lambertian:
+                        LambertianEvent(layer.lambertian, mj, v, u1, u2, degenerate_event);
+                        break;
+                }
+            }
+            // A failed sample loses the flux to the microsurface; an exactly grazing new direction
+            // is lost to the microsurface (dielectric) or the base (opaque), as in trace_particle.
+            const MF grazing =
+                hn::AndNot(degenerate_event, hn::And(at_interface, hn::Eq(v.d.z, zero)));
+            const MF to_micro = hn::Or(degenerate_event, hn::And(grazing, at_dielectric));
+            const MF to_base = hn::AndNot(at_dielectric, grazing);
+            v.Keep(to_micro, kLossMicro, zero);
+            v.Keep(to_base, kLossBase, zero);
+            degenerate += hn::CountTrue(df, hn::Or(degenerate_event, grazing));
+            const MF black = hn::And(at_interface, v.Black());
+            v.End(hn::Or(black, hn::Or(degenerate_event, grazing)), kEnded);
+            const MF continues =
+                hn::AndNot(hn::Or(black, hn::Or(degenerate_event, grazing)), at_interface);
+
+            // Exits.
+            const MF up = hn::Gt(v.d.z, zero);
+            const MF reflected = hn::And(hn::And(continues, up), LaneIs(v.k, 0));
+            v.End(reflected, kReflected);
+            const MF transmitted = hn::And(hn::AndNot(up, continues), LaneIs(v.k, n_layers - 1));
+            v.End(transmitted, kTransmitted);
+            const MF moves = hn::AndNot(hn::Or(reflected, transmitted), continues);
+
+            // Into the medium behind: below interface k going down, below k − 1 going up.
+            const VI k_medium =
+                hn::IfThenElse(hn::RebindMask(di, up), hn::Sub(v.k, hn::Set(di, 1)), v.k);
+            const VI k_next = hn::IfThenElse(hn::RebindMask(di, up), hn::Sub(v.k, hn::Set(di, 1)),
+                                             hn::Add(v.k, hn::Set(di, 1)));
+            MF enters_scattering = hn::FirstN(df, 0);
+            for (int j = 0; j + 1 < n_layers; ++j) {
+                const TraceMedium& med = stack.layers[j].medium;
+                if (med.is_empty()) continue;
+                const MF mj = hn::And(moves, LaneIs(k_medium, j));
+                if (hn::AllFalse(df, mj)) continue;
+                if (med.scatters) {
+                    enters_scattering = hn::Or(enters_scattering, mj);
+                    continue;
+                }
+                // Pure absorption: Beer–Lambert along the straight path.
+                const VF inv_mu = hn::Div(hn::Set(df, 1.f), hn::Abs(v.d.z));
+                VF transmittance[3];
+                for (int c = 0; c < 3; ++c)
+                    transmittance[c] =
+                        med.tau_a[c] > 0 ? hn::Exp(df, hn::Mul(hn::Set(df, -med.tau_a[c]), inv_mu))
+                                         : hn::Set(df, 1.f);
+                v.Keep(mj, kLossMedium, transmittance);
+            }
+            const MI scat_i = hn::RebindMask(di, enters_scattering);
+            const MI moves_i = hn::RebindMask(di, hn::AndNot(enters_scattering, moves));
+            v.k = hn::IfThenElse(moves_i, k_next, hn::IfThenElse(scat_i, k_medium, v.k));
+            v.in_medium = hn::IfThenElse(scat_i, hn::Set(di, 1), v.in_medium);
+            v.depth = hn::IfThenElse(enters_scattering, hn::IfThenElse(up, hn::Set(df, 1.f), zero),
+                                     v.depth);
+            const MF black_after = hn::And(moves, v.Black());
+            v.End(black_after, kEnded);
+        }
+        v.store(lanes);
+
+        // ---- Ended particles: tallies in lane order, then the block's next particle ----
+        const MF ended = hn::RebindMask(df, hn::Ne(v.finish, hn::Zero(di)));
+        if (hn::AllFalse(df, ended)) continue;
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            const std::int32_t why = lanes.finish[l];
+            if (why == kGoesOn) continue;
+            const Rgbf w(lanes.w[0][l], lanes.w[1][l], lanes.w[2][l]);
+            const Vec3f d(lanes.dx[l], lanes.dy[l], lanes.dz[l]);
+            if (why == kReflected) {
+                tally.exit(grid.bin_of(d), w);
+                block.escape_reflected(w);
+            } else if (why == kTransmitted) {
+                tally.exit(grid.size() + grid.bin_of(d), w);
+                block.escape_transmitted(w);
+            }
+            for (int t = 0; t < kLossTerms; ++t)
+                for (int c = 0; c < 3; ++c)
+                    block.term[int(BudgetTerm::AbsorbedMedium) + t][c] +=
+                        double(lanes.loss[t][c][l]);
+            tally.sums.events += std::uint64_t(lanes.events[l]);
+            start_particle(l);
+        }
+    }
+    tally.sums.degenerate += degenerate;
+}
+
+std::uint32_t PcgDrawsForTest(std::uint64_t seed, std::uint64_t stream, std::uint64_t first,
+                              std::uint64_t n_particles, std::uint64_t n_draws, float* out) {
+    const std::size_t n_lanes = hn::Lanes(DF());
+    std::vector<std::uint64_t> state(n_particles), inc(n_particles);
+    SeedParticles(seed, stream, first, n_particles, state.data(), inc.data());
+    for (std::uint64_t base = 0; base < n_particles; base += n_lanes) {
+        LaneRng rng;
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            rng.state[l] = base + l < n_particles ? state[base + l] : 0;
+            rng.inc[l] = base + l < n_particles ? inc[base + l] : 1;
+        }
+        for (std::uint64_t i = 0; i < n_draws; ++i) {
+            HWY_ALIGN float u[kMaxLanes];
+            hn::Store(rng.Uniform(), DF(), u);
+            for (std::size_t l = 0; l < n_lanes && base + l < n_particles; ++l)
+                out[(base + l) * n_draws + i] = u[l];
+        }
+    }
+    return std::uint32_t(n_lanes);
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace lamina
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace lamina {
+
+HWY_EXPORT(TraceBlockSimd);
+HWY_EXPORT(PcgDrawsForTest);
+
+void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
+    HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
+}
+
+const char* simd_target_name() {
+    // Dynamic dispatch picks the best target that is both compiled and supported: the lowest bit.
+    const std::int64_t targets = hwy::SupportedTargets() & HWY_TARGETS;
+    return hwy::TargetName(targets & -targets);
+}
+
+std::vector<float> simd_particle_uniforms(std::uint64_t seed, std::uint64_t stream,
+                                          std::uint64_t first, std::uint64_t n_particles,
+                                          std::uint64_t n_draws) {
+    std::vector<float> out(n_particles * n_draws);
+    HWY_DYNAMIC_DISPATCH(PcgDrawsForTest)(seed, stream, first, n_particles, n_draws, out.data());
+    return out;
+}
 
 }  // namespace lamina
+#endif

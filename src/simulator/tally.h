@@ -66,7 +66,8 @@ struct PathLosses {
     void add(BudgetTerm t, const Rgbf& lost) { term[int(t)] += lost; }
     void flush(BlockBudget& block) const {
         for (int t = int(BudgetTerm::AbsorbedMedium); t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c) block.term[t][c] += double(term[t][c]);
+            for (int c = 0; c < 3; ++c)
+                block.term[t][c] += double(term[t][c]);
     }
 };
 
@@ -107,7 +108,8 @@ struct Tally {
     }
     void add_block(const BlockBudget& b) {
         for (int t = 0; t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c) sums.budget[t][c] += to_fixed_wide(b.term[t][c]);
+            for (int c = 0; c < 3; ++c)
+                sums.budget[t][c] += to_fixed_wide(b.term[t][c]);
         for (int c = 0; c < 3; ++c) {
             sums.budget[kBudgetTerms][c] += to_fixed_wide(b.reflected_sq[c]);
             sums.budget[kBudgetTerms + 1][c] += to_fixed_wide(b.transmitted_sq[c]);

@@ -21,15 +21,35 @@ namespace {
 using test::compare_lobe;
 using test::expect_agreement;
 
+// Every exact-solution test runs on both kernels (the fixtures set the kernel under test).
+Kernel g_kernel = Kernel::Scalar;
+
 SimulationSettings settings(std::vector<double> theta_i, std::uint64_t n, HemisphereGrid grid,
                             std::uint64_t seed = 7) {
     SimulationSettings s;
+    s.kernel = g_kernel;
     s.theta_i_deg = std::move(theta_i);
     s.particles = n;
     s.grid = grid;
     s.seed = seed;
     return s;
 }
+
+class GoniophotometerStat : public ::testing::TestWithParam<Kernel> {
+  protected:
+    void SetUp() override { g_kernel = GetParam(); }
+};
+class Goniophotometer : public ::testing::TestWithParam<Kernel> {
+  protected:
+    void SetUp() override { g_kernel = GetParam(); }
+};
+std::string kernel_test_name(const ::testing::TestParamInfo<Kernel>& info) {
+    return kernel_name(info.param);
+}
+INSTANTIATE_TEST_SUITE_P(Kernels, GoniophotometerStat,
+                         ::testing::Values(Kernel::Scalar, Kernel::Simd), kernel_test_name);
+INSTANTIATE_TEST_SUITE_P(Kernels, Goniophotometer, ::testing::Values(Kernel::Scalar, Kernel::Simd),
+                         kernel_test_name);
 
 // Standard error of a budget term from its own estimate; the closed forms are exact, so
 // |estimate − exact| < 5 se holds with probability 1 − 6e-7.
@@ -47,7 +67,7 @@ void expect_budget_closes(const SimulationResult& r) {
 
 // §6.2: a Lambertian base alone reflects albedo/π in every direction; every particle leaves
 // with flux exactly ρ, so the reflected budget is ρ exactly.
-TEST(GoniophotometerStat, LambertianAlone) {
+TEST_P(GoniophotometerStat, LambertianAlone) {
     const Rgbd albedo(0.8, 0.5, 0.2);
     const Stack stack = test::make_stack({test::lambertian_layer(albedo)});
     const auto r = simulate(stack, settings({40}, 400'000, HemisphereGrid(9, 9)));
@@ -67,7 +87,7 @@ TEST(GoniophotometerStat, LambertianAlone) {
 //   r = 2∫₀¹ F_inside(μ) e^{−2τ/μ} μ dμ (relative index 1/η, TIR → 1),
 // plus the mirror reflection F(μi) in the bin of the mirror direction. Its albedo is
 //   F(μi) + (1 − F(μi)) e^{−τ/μi'} ρ t / (1 − ρ r), t = 2∫₀¹ (1 − F_inside(μ)) e^{−τ/μ} μ dμ.
-TEST(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
+TEST_P(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
     const double eta = 1.5, theta_i = 35.0;
     const Rgbd tau(0.1, 0.5, 0.0), rho(0.8, 0.5, 1.0);
     const Stack stack = test::make_stack(
@@ -103,7 +123,7 @@ TEST(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
 // §6.4: smooth slab of index η and absorption τ in air, with F = F(μi), a = e^{−τ/μi'}:
 //   R = F + (1 − F)² F a² / (1 − F² a²),  T = (1 − F)² a / (1 − F² a²).
 // All reflected flux leaves in the mirror bin, all transmitted flux straight through.
-TEST(GoniophotometerStat, SmoothSlab) {
+TEST_P(GoniophotometerStat, SmoothSlab) {
     const double eta = 1.5;
     const Rgbd tau(0.0, 0.2, 1.0);
     const Stack stack = test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), tau),
@@ -135,7 +155,7 @@ TEST(GoniophotometerStat, SmoothSlab) {
 
 // §6.5: smooth coat over a smooth conductor: R = F + (1 − F)² Rc a² / (1 − F Rc a²), Rc the
 // conductor's Fresnel at μi' for the relative index (η_c + i k_c)/η, a = e^{−τ/μi'}.
-TEST(GoniophotometerStat, CoatedSmoothConductor) {
+TEST_P(GoniophotometerStat, CoatedSmoothConductor) {
     const double eta = 1.5;
     const Rgbd tau(0.1, 0.3, 0.0), eta_c(0.143, 0.374, 1.442), k_c(3.983, 2.385, 1.603);
     const Stack stack = test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), tau),
@@ -185,16 +205,16 @@ void check_single_rough_dielectric(double ambient_eta, double eta, double alpha,
     expect_budget_closes(r);
 }
 
-TEST(GoniophotometerStat, SingleRoughDielectricFromAbove) {
+TEST_P(GoniophotometerStat, SingleRoughDielectricFromAbove) {
     check_single_rough_dielectric(1.0, 1.5, 0.3, 40);
 }
 
-TEST(GoniophotometerStat, SingleRoughDielectricFromDenseSide) {
+TEST_P(GoniophotometerStat, SingleRoughDielectricFromDenseSide) {
     // η = 1/1.5 seen by the light: total internal reflection beyond ~41.8°.
     check_single_rough_dielectric(1.5, 1.0, 0.3, 50);
 }
 
-TEST(GoniophotometerStat, SingleRoughConductor) {
+TEST_P(GoniophotometerStat, SingleRoughConductor) {
     const Rgbd eta_c(0.143, 0.374, 1.442), k_c(3.983, 2.385, 1.603);
     const double alpha = 0.25, theta_i = 55;
     const Stack stack = test::make_stack({test::conductor_layer(eta_c, k_c, alpha)});
@@ -215,7 +235,7 @@ TEST(GoniophotometerStat, SingleRoughConductor) {
 
 // §6.7: white furnace: with nothing absorbing, R + T + microsurface loss = 1 for every
 // configuration, nothing is cut off, and the loss is what single scattering loses (> 0 for rough).
-TEST(GoniophotometerStat, WhiteFurnace) {
+TEST_P(GoniophotometerStat, WhiteFurnace) {
     const std::vector<Stack> stacks = {
         test::make_stack({test::dielectric_layer(1.5, 0.3), test::dielectric_layer(1.0, 0.5)}),
         test::make_stack({test::dielectric_layer(1.5, 0.5), test::lambertian_layer(Rgbd(1.0))}),
@@ -247,7 +267,7 @@ TEST(GoniophotometerStat, WhiteFurnace) {
 // §6.9: reciprocity of the tabulated BRDF: with incidences at bin centres, f(θa → bin of θb) =
 // f(θb → bin of θa) at every φ bin, within the combined standard errors (the bin-averaging
 // asymmetry is second order in the 5° bin width, far below the noise here).
-TEST(GoniophotometerStat, TabulatedReciprocity) {
+TEST_P(GoniophotometerStat, TabulatedReciprocity) {
     const Stack stack =
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.3), Rgbd(0.2, 0.05, 0.5)),
                           test::lambertian_layer(Rgbd(0.7, 0.9, 0.5))});
@@ -276,7 +296,7 @@ TEST(GoniophotometerStat, TabulatedReciprocity) {
 // §6.8: a scattering medium against adding–doubling (support/adding_doubling.h): an index-matched
 // slab (smooth interfaces of relative index 1 are pass-throughs), per channel its own τ, ω and g —
 // which exercises the spectral MIS of free flights and of the phase function.
-TEST(GoniophotometerStat, ScatteringSlabAgainstAddingDoubling) {
+TEST_P(GoniophotometerStat, ScatteringSlabAgainstAddingDoubling) {
     const Rgbd tau_s(1.0, 0.5, 2.0), tau_a(0.0, 0.5, 0.1), g(0.0, 0.5, -0.3);
     const Stack stack =
         test::make_stack({test::with_medium(test::dielectric_layer(1.0, 0.0), tau_a, tau_s, g),
@@ -327,7 +347,7 @@ TEST(AddingDoublingReference, ConservesEnergy) {
 
 // Reproducibility: the same stack, grid, N and seed give bitwise-identical output for any thread
 // count; a different seed gives different output.
-TEST(Goniophotometer, BitwiseIdenticalAcrossThreadCounts) {
+TEST_P(Goniophotometer, BitwiseIdenticalAcrossThreadCounts) {
     const Stack stack =
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.1, 0.0, 0.9),
                                             Rgbd(0.3), Rgbd(0.2)),
@@ -351,7 +371,7 @@ TEST(Goniophotometer, BitwiseIdenticalAcrossThreadCounts) {
     EXPECT_NE(one.table.lobe(0, Side::Reflection).f, other.table.lobe(0, Side::Reflection).f);
 }
 
-TEST(Goniophotometer, RejectsBadSettings) {
+TEST_P(Goniophotometer, RejectsBadSettings) {
     SimulationSettings s;
     s.theta_i_deg = {90};
     EXPECT_THROW(validate_settings(s), InputError);
