@@ -19,7 +19,7 @@
 namespace lamina {
 
 class HemisphereGrid {
-public:
+  public:
     /// n_theta, n_phi ≥ 1 (checked by parse_grid for user input).
     HemisphereGrid(int n_theta = 90, int n_phi = 90);
 
@@ -49,6 +49,11 @@ public:
     }
 
     int theta_bin(double cos_theta) const;
+    /// The exact edges bin_of compares with (vectorized binning follows the same rule): cos θ
+    /// (decreasing, n_theta + 1, the last 0) and the folded cos φ (decreasing, n_phi + 1, the last
+    /// −1); bin b holds edge[b] ≥ x > edge[b + 1], the last bin also x = its lower edge.
+    const std::vector<double>& cos_theta_edges() const { return cos_theta_edge_; }
+    const std::vector<double>& cos_phi_edges() const { return cos_phi_edge_; }
     int phi_bin(double x, double y) const;
 
     /// "90x90"-style description, and its parser (InputError naming `option` on bad text).
@@ -59,10 +64,10 @@ public:
         return n_theta_ == o.n_theta_ && n_phi_ == o.n_phi_;
     }
 
-private:
+  private:
     int n_theta_, n_phi_;
-    std::vector<double> cos_theta_edge_;  ///< cos of θ edges, decreasing, size n_theta + 1
-    std::vector<double> cos_phi_edge_;    ///< cos of φ edges, decreasing, size n_phi + 1
+    std::vector<double> cos_theta_edge_;        ///< cos of θ edges, decreasing, size n_theta + 1
+    std::vector<double> cos_phi_edge_;          ///< cos of φ edges, decreasing, size n_phi + 1
     std::vector<int> theta_guess_, phi_guess_;  ///< first guesses indexed by cos quantized
 };
 

@@ -589,6 +589,89 @@ HWY_INLINE void ScatteringStep(const TraceMedium& med, MF m, LaneVectors& v, VF 
         hn::IfThenElse(hn::RebindMask(di, scatters), hn::Add(v.events, hn::Set(di, 1)), v.events);
 }
 
+// ---- Binning
+// -------------------------------------------------------------------------------------
+
+// HemisphereGrid::bin_of on lanes, bit for bit: a first guess from the angle (vector acos, off by
+// at most one bin near an edge), corrected against the grid's exact edges in double precision with
+// the scalar rule (bin b holds edge[b] ≥ x > edge[b + 1]).
+using DD = hn::Repartition<double, DF>;
+using DL = hn::RebindToSigned<DD>;
+using VD = hn::Vec<DD>;
+using VL = hn::Vec<DL>;
+
+HWY_INLINE VL RefineBin(VD x, VL b, const double* edges, int n) {
+    const DD dd;
+    const DL dl;
+    while (true) {  // down while x > edge[b]
+        const auto m = hn::And(hn::RebindMask(dl, hn::Gt(x, hn::GatherIndex(dd, edges, b))),
+                               hn::Gt(b, hn::Zero(dl)));
+        if (hn::AllFalse(dl, m)) break;
+        b = hn::IfThenElse(m, hn::Sub(b, hn::Set(dl, 1)), b);
+    }
+    while (true) {  // up while x ≤ edge[b + 1]
+        const auto m = hn::And(hn::RebindMask(dl, hn::Le(x, hn::GatherIndex(dd, edges + 1, b))),
+                               hn::Lt(b, hn::Set(dl, n - 1)));
+        if (hn::AllFalse(dl, m)) break;
+        b = hn::IfThenElse(m, hn::Add(b, hn::Set(dl, 1)), b);
+    }
+    return b;
+}
+
+struct BinEdges {
+    const double* cos_theta;
+    const double* cos_phi;
+    int n_theta, n_phi;
+};
+
+HWY_INLINE void BinsOf(const V3& d, const BinEdges& edges, std::int64_t* bins) {
+    const DF df;
+    const DI di;
+    const DD dd;
+    const DL dl;
+    const hn::Half<DF> dfh;
+    const hn::Half<DI> dih;
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
+    // First guesses in float.
+    const VF cos_theta_f = hn::Min(hn::Abs(d.z), one);
+    const VF r_f = hn::Sqrt(hn::MulAdd(d.x, d.x, hn::Mul(d.y, d.y)));
+    const VF cos_phi_f = hn::Min(
+        hn::Max(hn::Div(d.x, hn::IfThenElse(hn::Gt(r_f, zero), r_f, one)), hn::Set(df, -1.f)), one);
+    const VI guess_theta =
+        hn::Min(hn::ConvertTo(di, hn::Mul(hn::Acos(df, cos_theta_f),
+                                          hn::Set(df, float(edges.n_theta) / (0.5f * kPi<float>)))),
+                hn::Set(di, edges.n_theta - 1));
+    const VI guess_phi = hn::Min(
+        hn::ConvertTo(
+            di, hn::Mul(hn::Acos(df, cos_phi_f), hn::Set(df, float(edges.n_phi) / kPi<float>))),
+        hn::Set(di, edges.n_phi - 1));
+    const std::size_t half = hn::Lanes(dd);
+    for (int h = 0; h < 2; ++h) {
+        auto widen = [&](VF v) {
+            return h == 0 ? hn::PromoteTo(dd, hn::LowerHalf(dfh, v))
+                          : hn::PromoteTo(dd, hn::UpperHalf(dfh, v));
+        };
+        auto widen_i = [&](VI v) {
+            return h == 0 ? hn::PromoteTo(dl, hn::LowerHalf(dih, v))
+                          : hn::PromoteTo(dl, hn::UpperHalf(dih, v));
+        };
+        // Exactly HemisphereGrid::theta_bin / phi_bin's arithmetic, in double.
+        const VD x = widen(d.x), y = widen(d.y);
+        const VD cos_theta = hn::Min(hn::Abs(widen(d.z)), hn::Set(dd, 1.0));
+        const VD r = hn::Sqrt(hn::MulAdd(x, x, hn::Mul(y, y)));
+        const auto r_zero = hn::Eq(r, hn::Zero(dd));
+        const VD cos_phi = hn::Min(
+            hn::Max(hn::Div(x, hn::IfThenElse(r_zero, hn::Set(dd, 1.0), r)), hn::Set(dd, -1.0)),
+            hn::Set(dd, 1.0));
+        const VL b_theta = RefineBin(cos_theta, hn::Max(widen_i(guess_theta), hn::Zero(dl)),
+                                     edges.cos_theta, edges.n_theta);
+        VL b_phi = RefineBin(cos_phi, hn::Max(widen_i(guess_phi), hn::Zero(dl)), edges.cos_phi,
+                             edges.n_phi);
+        b_phi = hn::IfThenZeroElse(hn::RebindMask(dl, r_zero), b_phi);
+        hn::Store(hn::Add(hn::Mul(b_theta, hn::Set(dl, edges.n_phi)), b_phi), dl, bins + h * half);
+    }
+}
+
 // ---- The block --------------------------------------------------------------------------------
 
 struct Scratch {
@@ -602,6 +685,8 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     const TraceStack& stack = *job.stack;
     const HemisphereGrid& grid = *job.grid;
     const int n_layers = int(stack.layers.size());
+    const BinEdges edges{grid.cos_theta_edges().data(), grid.cos_phi_edges().data(), grid.n_theta(),
+                         grid.n_phi()};
 
     thread_local Scratch scratch;
     scratch.state.resize(job.count);
@@ -611,6 +696,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
 
     Lanes lanes;
     std::memset(&lanes, 0, sizeof(lanes));
+    HWY_ALIGN std::int64_t bins[kMaxLanes];
     std::uint64_t next = 0;  // the block's next particle
     auto start_particle = [&](std::size_t l) {
         if (next < job.count) {
@@ -640,9 +726,6 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     for (std::size_t l = 0; l < n_lanes; ++l)
         start_particle(l);
 
-    bool any_scattering = false;
-    for (const TraceLayer& layer : stack.layers)
-        any_scattering |= layer.medium.scatters;
     const VF zero = hn::Zero(df);
     std::uint64_t degenerate = 0;
 
@@ -652,128 +735,146 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         const MF live = hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di)));
         if (hn::AllFalse(df, live)) break;
 
+        // One group of lanes steps: those at one interface, or those inside one scattering
+        // medium, whichever group is largest (ties to the first). The lanes of a two-interface
+        // stack then alternate between its interfaces nearly in phase, so each step runs one
+        // interface's code on nearly full vectors.
+        const MF in_med = hn::And(live, hn::RebindMask(df, hn::Ne(v.in_medium, hn::Zero(di))));
+        const MF at_interface = hn::AndNot(in_med, live);
+        int group = 0;
+        bool group_is_medium = false;
+        std::size_t group_size = 0;
+        for (int j = 0; j < n_layers; ++j) {
+            const std::size_t at_j = hn::CountTrue(df, hn::And(at_interface, LaneIs(v.k, j)));
+            if (at_j > group_size) {
+                group = j;
+                group_size = at_j;
+            }
+        }
+        if (!hn::AllFalse(df, in_med))
+            for (int j = 0; j < n_layers; ++j) {
+                if (!stack.layers[j].medium.scatters) continue;
+                const std::size_t in_j = hn::CountTrue(df, hn::And(in_med, LaneIs(v.k, j)));
+                if (in_j > group_size) {
+                    group = j;
+                    group_is_medium = true;
+                    group_size = in_j;
+                }
+            }
+        const MF stepped = hn::And(group_is_medium ? in_med : at_interface, LaneIs(v.k, group));
+
         // Cut-off (trace_particle: checked before every event).
         const MF cut =
-            hn::And(live, hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job.max_events - 1))));
+            hn::And(stepped, hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job.max_events - 1))));
         for (int c = 0; c < 3; ++c) {
             v.loss[kLossCutOff][c] =
                 hn::Add(v.loss[kLossCutOff][c], hn::IfThenElseZero(cut, v.w[c]));
             v.w[c] = hn::IfThenElseZero(hn::Not(cut), v.w[c]);
         }
         v.End(cut, kEnded);
-        const MF going = hn::AndNot(cut, live);
-        const MF in_med = hn::And(going, hn::RebindMask(df, hn::Ne(v.in_medium, hn::Zero(di))));
-        const MF at_interface = hn::AndNot(in_med, going);
+        const MF going = hn::AndNot(cut, stepped);
 
-        const VF u0 = lanes.rng.Uniform(), u1 = lanes.rng.Uniform(), u2 = lanes.rng.Uniform();
-
-        // ---- Scattering-medium steps (lanes that entered a medium on an earlier step) ----
-        if (any_scattering && !hn::AllFalse(df, in_med)) {
+        if (group_is_medium) {
+            // ---- A scattering-medium step ----
+            const VF u0 = lanes.rng.Uniform(), u1 = lanes.rng.Uniform(), u2 = lanes.rng.Uniform();
             const VF u3 = lanes.rng.Uniform(), u4 = lanes.rng.Uniform();
-            for (int j = 0; j < n_layers; ++j) {
-                const TraceMedium& med = stack.layers[j].medium;
-                if (!med.scatters) continue;
-                const MF mj = hn::And(in_med, LaneIs(v.k, j));
-                if (hn::AllFalse(df, mj)) continue;
-                ScatteringStep(med, mj, v, u0, u1, u2, u3, u4);
-            }
-            const MF black = hn::And(in_med, v.Black());
-            v.End(black, kEnded);
-        }
-
-        // ---- Interface events ----
-        if (!hn::AllFalse(df, at_interface)) {
-            v.events = hn::IfThenElse(hn::RebindMask(di, at_interface),
-                                      hn::Add(v.events, hn::Set(di, 1)), v.events);
+            ScatteringStep(stack.layers[group].medium, going, v, u0, u1, u2, u3, u4);
+            v.End(hn::And(going, v.Black()), kEnded);
+        } else {
+            // ---- An interface event ----
+            v.events = hn::IfThenElse(hn::RebindMask(di, going), hn::Add(v.events, hn::Set(di, 1)),
+                                      v.events);
             MF degenerate_event = hn::FirstN(df, 0);  // all false
-            MF at_dielectric = degenerate_event;
-            for (int j = 0; j < n_layers; ++j) {
-                const MF mj = hn::And(at_interface, LaneIs(v.k, j));
-                if (hn::AllFalse(df, mj)) continue;
-                const TraceLayer& layer = stack.layers[j];
-                switch (layer.type) {
-                    case InterfaceType::Dielectric:
-                        DielectricEvent(layer.dielectric, mj, v, u0, u1, u2, degenerate_event);
-                        at_dielectric = hn::Or(at_dielectric, mj);
-                        break;
-                    case InterfaceType::Conductor:
-                        ConductorEvent(layer.conductor, mj, v, u1, u2, degenerate_event);
-                        break;
-                    case InterfaceType::Lambertian:
-                        LambertianEvent(layer.lambertian, mj, v, u1, u2, degenerate_event);
-                        break;
+            const TraceLayer& layer = stack.layers[group];
+            const bool dielectric = layer.type == InterfaceType::Dielectric;
+            switch (layer.type) {
+                case InterfaceType::Dielectric: {
+                    const VF uc = lanes.rng.Uniform(), u1 = lanes.rng.Uniform(),
+                             u2 = lanes.rng.Uniform();
+                    DielectricEvent(layer.dielectric, going, v, uc, u1, u2, degenerate_event);
+                    break;
+                }
+                case InterfaceType::Conductor: {
+                    const VF u1 = lanes.rng.Uniform(), u2 = lanes.rng.Uniform();
+                    ConductorEvent(layer.conductor, going, v, u1, u2, degenerate_event);
+                    break;
+                }
+                case InterfaceType::Lambertian: {
+                    const VF u1 = lanes.rng.Uniform(), u2 = lanes.rng.Uniform();
+                    LambertianEvent(layer.lambertian, going, v, u1, u2, degenerate_event);
+                    break;
                 }
             }
             // A failed sample loses the flux to the microsurface; an exactly grazing new direction
             // is lost to the microsurface (dielectric) or the base (opaque), as in trace_particle.
-            const MF grazing =
-                hn::AndNot(degenerate_event, hn::And(at_interface, hn::Eq(v.d.z, zero)));
-            const MF to_micro = hn::Or(degenerate_event, hn::And(grazing, at_dielectric));
-            const MF to_base = hn::AndNot(at_dielectric, grazing);
-            v.Keep(to_micro, kLossMicro, zero);
-            v.Keep(to_base, kLossBase, zero);
-            degenerate += hn::CountTrue(df, hn::Or(degenerate_event, grazing));
-            const MF black = hn::And(at_interface, v.Black());
-            v.End(hn::Or(black, hn::Or(degenerate_event, grazing)), kEnded);
-            const MF continues =
-                hn::AndNot(hn::Or(black, hn::Or(degenerate_event, grazing)), at_interface);
+            const MF grazing = hn::AndNot(degenerate_event, hn::And(going, hn::Eq(v.d.z, zero)));
+            const MF lost = hn::Or(degenerate_event, grazing);
+            v.Keep(dielectric ? lost : degenerate_event, kLossMicro, zero);
+            if (!dielectric) v.Keep(grazing, kLossBase, zero);
+            degenerate += hn::CountTrue(df, lost);
+            const MF black = hn::And(going, v.Black());
+            const MF ends = hn::Or(black, lost);
+            v.End(ends, kEnded);
+            const MF continues = hn::AndNot(ends, going);
 
-            // Exits.
+            // Exits, then the medium behind: below the interface going down, above it going up.
             const MF up = hn::Gt(v.d.z, zero);
-            const MF reflected = hn::And(hn::And(continues, up), LaneIs(v.k, 0));
-            v.End(reflected, kReflected);
-            const MF transmitted = hn::And(hn::AndNot(up, continues), LaneIs(v.k, n_layers - 1));
-            v.End(transmitted, kTransmitted);
-            const MF moves = hn::AndNot(hn::Or(reflected, transmitted), continues);
-
-            // Into the medium behind: below interface k going down, below k − 1 going up.
-            const VI k_medium =
-                hn::IfThenElse(hn::RebindMask(di, up), hn::Sub(v.k, hn::Set(di, 1)), v.k);
-            const VI k_next = hn::IfThenElse(hn::RebindMask(di, up), hn::Sub(v.k, hn::Set(di, 1)),
-                                             hn::Add(v.k, hn::Set(di, 1)));
-            MF enters_scattering = hn::FirstN(df, 0);
-            for (int j = 0; j + 1 < n_layers; ++j) {
-                const TraceMedium& med = stack.layers[j].medium;
-                if (med.is_empty()) continue;
-                const MF mj = hn::And(moves, LaneIs(k_medium, j));
-                if (hn::AllFalse(df, mj)) continue;
+            const MF goes_up = hn::And(continues, up), goes_down = hn::AndNot(up, continues);
+            MF moves_up = goes_up, moves_down = goes_down;
+            if (group == 0) {
+                v.End(goes_up, kReflected);
+                moves_up = hn::FirstN(df, 0);
+            }
+            if (group == n_layers - 1) {
+                v.End(goes_down, kTransmitted);
+                moves_down = hn::FirstN(df, 0);
+            }
+            for (int side = 0; side < 2; ++side) {
+                const MF moving = side == 0 ? moves_up : moves_down;
+                const int medium_layer = side == 0 ? group - 1 : group;
+                const int k_next = side == 0 ? group - 1 : group + 1;
+                if (hn::AllFalse(df, moving)) continue;
+                const TraceMedium& med = stack.layers[medium_layer].medium;
                 if (med.scatters) {
-                    enters_scattering = hn::Or(enters_scattering, mj);
+                    // Enters the medium: its free flights are later steps.
+                    const auto mi = hn::RebindMask(di, moving);
+                    v.in_medium = hn::IfThenElse(mi, hn::Set(di, 1), v.in_medium);
+                    v.k = hn::IfThenElse(mi, hn::Set(di, medium_layer), v.k);
+                    v.depth = hn::IfThenElse(moving, hn::Set(df, side == 0 ? 1.f : 0.f), v.depth);
                     continue;
                 }
-                // Pure absorption: Beer–Lambert along the straight path.
-                const VF inv_mu = hn::Div(hn::Set(df, 1.f), hn::Abs(v.d.z));
-                VF transmittance[3];
-                for (int c = 0; c < 3; ++c)
-                    transmittance[c] =
-                        med.tau_a[c] > 0 ? hn::Exp(df, hn::Mul(hn::Set(df, -med.tau_a[c]), inv_mu))
-                                         : hn::Set(df, 1.f);
-                v.Keep(mj, kLossMedium, transmittance);
+                if (med.absorbs) {
+                    // Pure absorption: Beer–Lambert along the straight path.
+                    const VF inv_mu = hn::Div(hn::Set(df, 1.f), hn::Abs(v.d.z));
+                    VF transmittance[3];
+                    for (int c = 0; c < 3; ++c)
+                        transmittance[c] =
+                            med.tau_a[c] > 0
+                                ? hn::Exp(df, hn::Mul(hn::Set(df, -med.tau_a[c]), inv_mu))
+                                : hn::Set(df, 1.f);
+                    v.Keep(moving, kLossMedium, transmittance);
+                    v.End(hn::And(moving, v.Black()), kEnded);
+                }
+                v.k = hn::IfThenElse(hn::RebindMask(di, moving), hn::Set(di, k_next), v.k);
             }
-            const MI scat_i = hn::RebindMask(di, enters_scattering);
-            const MI moves_i = hn::RebindMask(di, hn::AndNot(enters_scattering, moves));
-            v.k = hn::IfThenElse(moves_i, k_next, hn::IfThenElse(scat_i, k_medium, v.k));
-            v.in_medium = hn::IfThenElse(scat_i, hn::Set(di, 1), v.in_medium);
-            v.depth = hn::IfThenElse(enters_scattering, hn::IfThenElse(up, hn::Set(df, 1.f), zero),
-                                     v.depth);
-            const MF black_after = hn::And(moves, v.Black());
-            v.End(black_after, kEnded);
         }
         v.store(lanes);
 
         // ---- Ended particles: tallies in lane order, then the block's next particle ----
         const MF ended = hn::RebindMask(df, hn::Ne(v.finish, hn::Zero(di)));
         if (hn::AllFalse(df, ended)) continue;
+        const MF exits = hn::RebindMask(
+            df, hn::And(hn::Ne(v.finish, hn::Zero(di)), hn::Lt(v.finish, hn::Set(di, kEnded))));
+        if (!hn::AllFalse(df, exits)) BinsOf(v.d, edges, bins);
         for (std::size_t l = 0; l < n_lanes; ++l) {
             const std::int32_t why = lanes.finish[l];
             if (why == kGoesOn) continue;
             const Rgbf w(lanes.w[0][l], lanes.w[1][l], lanes.w[2][l]);
-            const Vec3f d(lanes.dx[l], lanes.dy[l], lanes.dz[l]);
             if (why == kReflected) {
-                tally.exit(grid.bin_of(d), w);
+                tally.exit(std::size_t(bins[l]), w);
                 block.escape_reflected(w);
             } else if (why == kTransmitted) {
-                tally.exit(grid.size() + grid.bin_of(d), w);
+                tally.exit(grid.size() + std::size_t(bins[l]), w);
                 block.escape_transmitted(w);
             }
             for (int t = 0; t < kLossTerms; ++t)
