@@ -121,6 +121,9 @@ void SeedParticles(std::uint64_t seed, std::uint64_t stream, std::uint64_t first
 // x · kPcgMultiplier mod 2^64 from 32 × 32 → 64-bit products (64-bit lane products are not on
 // every target).
 HWY_INLINE V64 MulPcg(V64 x) {
+#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+    return hn::Mul(x, hn::Set(D64(), kPcgMultiplier));  // AVX-512DQ has 64-bit lane products
+#else
     const DU du;
     const VU x32 = hn::BitCast(du, x);
     const VU m_lo = hn::Set(du, std::uint32_t(kPcgMultiplier));
@@ -129,6 +132,7 @@ HWY_INLINE V64 MulPcg(V64 x) {
     const V64 cross =
         hn::Add(hn::MulEven(hn::BitCast(du, hn::ShiftRight<32>(x)), m_lo), hn::MulEven(x32, m_hi));
     return hn::Add(lo_lo, hn::ShiftLeft<32>(cross));
+#endif
 }
 
 // The lanes' generators; one call draws one uniform float per lane, as ParticleRng::uniform_float.
@@ -171,9 +175,17 @@ struct V3 {
 HWY_INLINE VF Dot(const V3& a, const V3& b) {
     return hn::MulAdd(a.x, b.x, hn::MulAdd(a.y, b.y, hn::Mul(a.z, b.z)));
 }
-HWY_INLINE V3 Normalize(const V3& a) {
+// 1/√x from the hardware estimate refined by one Newton step (y ← y (3 − x y²)/2): ≤ 2^-22
+// relative error whatever the estimate's precision (≥ 12 bits on every target), a fraction of the
+// cost of a square root and a division.
+HWY_INLINE VF InvSqrt(VF x) {
     const DF df;
-    const VF inv = hn::Div(hn::Set(df, 1.f), hn::Sqrt(Dot(a, a)));
+    const VF y = hn::ApproximateReciprocalSqrt(x);
+    const VF half_x_y2 = hn::Mul(hn::Mul(hn::Set(df, 0.5f), x), hn::Mul(y, y));
+    return hn::Mul(y, hn::Sub(hn::Set(df, 1.5f), half_x_y2));
+}
+HWY_INLINE V3 Normalize(const V3& a) {
+    const VF inv = InvSqrt(Dot(a, a));
     return {hn::Mul(a.x, inv), hn::Mul(a.y, inv), hn::Mul(a.z, inv)};
 }
 HWY_INLINE V3 Select(MF m, const V3& a, const V3& b) {
@@ -256,64 +268,20 @@ enum LossTerm { kLossMedium = 0, kLossBase = 1, kLossMicro = 2, kLossCutOff = 3,
 // Why a lane's particle ended this step.
 enum Finish : std::int32_t { kGoesOn = 0, kReflected = 1, kTransmitted = 2, kEnded = 3 };
 
-struct Lanes {
-    HWY_ALIGN float dx[kMaxLanes], dy[kMaxLanes], dz[kMaxLanes];
-    HWY_ALIGN float w[3][kMaxLanes];
-    HWY_ALIGN float depth[kMaxLanes];  // inside a scattering medium: 0 at its top, 1 at its bottom
-    HWY_ALIGN float loss[kLossTerms][3][kMaxLanes];
-    HWY_ALIGN std::int32_t k[kMaxLanes];  // at an interface: its index; in a medium: its layer
-    HWY_ALIGN std::int32_t in_medium[kMaxLanes];
-    HWY_ALIGN std::int32_t events[kMaxLanes];
-    HWY_ALIGN std::int32_t live[kMaxLanes];
-    HWY_ALIGN std::int32_t finish[kMaxLanes];
-    LaneRng rng;
-};
-
+// The state of the lanes' particles, kept in vectors from step to step.
 struct LaneVectors {
     V3 d;
     VF w[3];
-    VF depth;
-    VF loss[kLossTerms][3];
-    VI k, in_medium, events, live, finish;
-
-    HWY_INLINE void load(const Lanes& s) {
-        const DF df;
-        const DI di;
-        d = {hn::Load(df, s.dx), hn::Load(df, s.dy), hn::Load(df, s.dz)};
-        for (int c = 0; c < 3; ++c)
-            w[c] = hn::Load(df, s.w[c]);
-        depth = hn::Load(df, s.depth);
-        for (int t = 0; t < kLossTerms; ++t)
-            for (int c = 0; c < 3; ++c)
-                loss[t][c] = hn::Load(df, s.loss[t][c]);
-        k = hn::Load(di, s.k);
-        in_medium = hn::Load(di, s.in_medium);
-        events = hn::Load(di, s.events);
-        live = hn::Load(di, s.live);
-        finish = hn::Zero(di);
-    }
-    HWY_INLINE void store(Lanes& s) const {
-        const DF df;
-        const DI di;
-        hn::Store(d.x, df, s.dx);
-        hn::Store(d.y, df, s.dy);
-        hn::Store(d.z, df, s.dz);
-        for (int c = 0; c < 3; ++c)
-            hn::Store(w[c], df, s.w[c]);
-        hn::Store(depth, df, s.depth);
-        for (int t = 0; t < kLossTerms; ++t)
-            for (int c = 0; c < 3; ++c)
-                hn::Store(loss[t][c], df, s.loss[t][c]);
-        hn::Store(k, di, s.k);
-        hn::Store(in_medium, di, s.in_medium);
-        hn::Store(events, di, s.events);
-        hn::Store(live, di, s.live);
-        hn::Store(finish, di, s.finish);
-    }
+    VF depth;  // inside a scattering medium: 0 at its top, 1 at its bottom
+    VF loss[kLossTerms][3];  // the flux the particle has lost so far, per budget term
+    VI k;                    // at an interface: its index; in a medium: its layer
+    VI in_medium, events, live, finish;
+    bool touched[kLossTerms] = {};  // loss terms some lane may have booked in this block
 
     // Multiplies the flux of the lanes in m by `factor` (per channel) and books what is taken
     // under `term`.
     HWY_INLINE void Keep(MF m, int term, const VF factor[3]) {
+        touched[term] = true;
         for (int c = 0; c < 3; ++c) {
             const VF kept = hn::Mul(w[c], factor[c]);
             loss[term][c] = hn::Add(loss[term][c], hn::IfThenElseZero(m, hn::Sub(w[c], kept)));
@@ -678,6 +646,67 @@ struct Scratch {
     std::vector<std::uint64_t> state, inc;
 };
 
+// Per-lane double sums of what ended particles carry (budget terms, R and T with their squares)
+// and their event counts; reduced in lane order at the end of the block.
+struct LaneSums {
+    static constexpr int kTerms = kLossTerms + 4;  // losses, then R, R², T, T² (per channel)
+    VD sum[kTerms][3][2];
+    VL events[2];
+
+    HWY_INLINE void zero() {
+        const DD dd;
+        const DL dl;
+        for (auto& term : sum)
+            for (auto& channel : term) channel[0] = channel[1] = hn::Zero(dd);
+        events[0] = events[1] = hn::Zero(dl);
+    }
+    // Adds x (zero in lanes that must not count) to sum[t][c], in double.
+    HWY_INLINE void add(int t, int c, VF x, bool squared = false) {
+        const DD dd;
+        const hn::Half<DF> dfh;
+        VD lo = hn::PromoteTo(dd, hn::LowerHalf(dfh, x));
+        VD hi = hn::PromoteTo(dd, hn::UpperHalf(dfh, x));
+        if (squared) {
+            lo = hn::Mul(lo, lo);
+            hi = hn::Mul(hi, hi);
+        }
+        sum[t][c][0] = hn::Add(sum[t][c][0], lo);
+        sum[t][c][1] = hn::Add(sum[t][c][1], hi);
+    }
+    HWY_INLINE void add_events(VI e) {
+        const DL dl;
+        const hn::Half<DI> dih;
+        events[0] = hn::Add(events[0], hn::PromoteTo(dl, hn::LowerHalf(dih, e)));
+        events[1] = hn::Add(events[1], hn::PromoteTo(dl, hn::UpperHalf(dih, e)));
+    }
+    // Lane order, fixed: the block's sums do not depend on anything but the block.
+    void reduce(BlockBudget& block, std::uint64_t& events_total) const {
+        const DD dd;
+        const DL dl;
+        const std::size_t half = hn::Lanes(dd);
+        HWY_ALIGN double buf[kMaxLanes];
+        HWY_ALIGN std::int64_t ibuf[kMaxLanes];
+        auto total = [&](const VD (&v)[2]) {
+            hn::Store(v[0], dd, buf);
+            hn::Store(v[1], dd, buf + half);
+            double t = 0;
+            for (std::size_t l = 0; l < 2 * half; ++l) t += buf[l];
+            return t;
+        };
+        for (int c = 0; c < 3; ++c) {
+            for (int t = 0; t < kLossTerms; ++t)
+                block.term[int(BudgetTerm::AbsorbedMedium) + t][c] += total(sum[t][c]);
+            block.term[int(BudgetTerm::Reflected)][c] += total(sum[kLossTerms][c]);
+            block.reflected_sq[c] += total(sum[kLossTerms + 1][c]);
+            block.term[int(BudgetTerm::Transmitted)][c] += total(sum[kLossTerms + 2][c]);
+            block.transmitted_sq[c] += total(sum[kLossTerms + 3][c]);
+        }
+        hn::Store(events[0], dl, ibuf);
+        hn::Store(events[1], dl, ibuf + half);
+        for (std::size_t l = 0; l < 2 * half; ++l) events_total += std::uint64_t(ibuf[l]);
+    }
+};
+
 void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     const DF df;
     const DI di;
@@ -685,8 +714,8 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     const TraceStack& stack = *job.stack;
     const HemisphereGrid& grid = *job.grid;
     const int n_layers = int(stack.layers.size());
-    const BinEdges edges{grid.cos_theta_edges().data(), grid.cos_phi_edges().data(), grid.n_theta(),
-                         grid.n_phi()};
+    const BinEdges edges{grid.cos_theta_edges().data(), grid.cos_phi_edges().data(),
+                         grid.n_theta(), grid.n_phi()};
 
     thread_local Scratch scratch;
     scratch.state.resize(job.count);
@@ -694,53 +723,69 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     SeedParticles(job.seed, job.stream, job.first, job.count, scratch.state.data(),
                   scratch.inc.data());
 
-    Lanes lanes;
-    std::memset(&lanes, 0, sizeof(lanes));
+    LaneRng rng;
+    HWY_ALIGN std::int32_t live[kMaxLanes];
+    HWY_ALIGN std::int32_t finish[kMaxLanes];
+    HWY_ALIGN float w_out[3][kMaxLanes];
     HWY_ALIGN std::int64_t bins[kMaxLanes];
     std::uint64_t next = 0;  // the block's next particle
-    auto start_particle = [&](std::size_t l) {
+    // Gives lane l the block's next particle's generator, or retires it when none is left.
+    auto take_particle = [&](std::size_t l) {
         if (next < job.count) {
-            lanes.dx[l] = -job.wi.x;
-            lanes.dy[l] = -job.wi.y;
-            lanes.dz[l] = -job.wi.z;
-            for (int c = 0; c < 3; ++c)
-                lanes.w[c][l] = 1.f;
-            for (int t = 0; t < kLossTerms; ++t)
-                for (int c = 0; c < 3; ++c)
-                    lanes.loss[t][c][l] = 0.f;
-            lanes.k[l] = 0;
-            lanes.in_medium[l] = 0;
-            lanes.events[l] = 0;
-            lanes.live[l] = 1;
-            lanes.rng.state[l] = scratch.state[next];
-            lanes.rng.inc[l] = scratch.inc[next];
+            rng.state[l] = scratch.state[next];
+            rng.inc[l] = scratch.inc[next];
+            live[l] = 1;
             ++next;
         } else {
-            lanes.live[l] = 0;
-            for (int c = 0; c < 3; ++c)
-                lanes.w[c][l] = 0.f;
-            lanes.dz[l] = -1.f;
-            lanes.rng.inc[l] = 1;
+            rng.state[l] = 0;
+            rng.inc[l] = 1;
+            live[l] = 0;
         }
     };
-    for (std::size_t l = 0; l < n_lanes; ++l)
-        start_particle(l);
-
-    const VF zero = hn::Zero(df);
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
+    // A fresh particle in the lanes of `fresh` (they read live[] for whether one was left).
+    LaneVectors v;
+    auto restart = [&](MF fresh) {
+        v.live = hn::IfThenElse(hn::RebindMask(di, fresh), hn::Load(di, live), v.live);
+        const MF alive = hn::And(fresh, hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di))));
+        v.d = Select(fresh, V3{hn::Set(df, -job.wi.x), hn::Set(df, -job.wi.y),
+                               hn::Set(df, -job.wi.z)}, v.d);
+        for (int c = 0; c < 3; ++c) v.w[c] = hn::IfThenElse(fresh, hn::IfThenElseZero(alive, one), v.w[c]);
+        for (int t = 0; t < kLossTerms; ++t)
+            if (v.touched[t])
+                for (auto& channel : v.loss[t]) channel = hn::IfThenElseZero(hn::Not(fresh), channel);
+        const auto fresh_i = hn::RebindMask(di, fresh);
+        v.k = hn::IfThenZeroElse(fresh_i, v.k);
+        v.in_medium = hn::IfThenZeroElse(fresh_i, v.in_medium);
+        v.events = hn::IfThenZeroElse(fresh_i, v.events);
+    };
+    for (std::size_t l = 0; l < n_lanes; ++l) take_particle(l);
+    {
+        const MF all = hn::FirstN(df, n_lanes);
+        v.live = hn::Zero(di);
+        v.d = {zero, zero, zero};
+        v.depth = zero;
+        for (int c = 0; c < 3; ++c) v.w[c] = zero;
+        for (auto& term : v.loss)
+            for (auto& channel : term) channel = zero;
+        v.k = v.in_medium = v.events = hn::Zero(di);
+        restart(all);
+    }
+    LaneSums sums;
+    sums.zero();
     std::uint64_t degenerate = 0;
 
-    LaneVectors v;
     while (true) {
-        v.load(lanes);
-        const MF live = hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di)));
-        if (hn::AllFalse(df, live)) break;
-
+        v.finish = hn::Zero(di);
+        const MF live_mask = hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di)));
+        if (hn::AllFalse(df, live_mask)) break;
         // One group of lanes steps: those at one interface, or those inside one scattering
         // medium, whichever group is largest (ties to the first). The lanes of a two-interface
         // stack then alternate between its interfaces nearly in phase, so each step runs one
         // interface's code on nearly full vectors.
-        const MF in_med = hn::And(live, hn::RebindMask(df, hn::Ne(v.in_medium, hn::Zero(di))));
-        const MF at_interface = hn::AndNot(in_med, live);
+        const MF in_med =
+            hn::And(live_mask, hn::RebindMask(df, hn::Ne(v.in_medium, hn::Zero(di))));
+        const MF at_interface = hn::AndNot(in_med, live_mask);
         int group = 0;
         bool group_is_medium = false;
         std::size_t group_size = 0;
@@ -766,18 +811,14 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         // Cut-off (trace_particle: checked before every event).
         const MF cut =
             hn::And(stepped, hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job.max_events - 1))));
-        for (int c = 0; c < 3; ++c) {
-            v.loss[kLossCutOff][c] =
-                hn::Add(v.loss[kLossCutOff][c], hn::IfThenElseZero(cut, v.w[c]));
-            v.w[c] = hn::IfThenElseZero(hn::Not(cut), v.w[c]);
-        }
+        if (!hn::AllFalse(df, cut)) v.Keep(cut, kLossCutOff, zero);
         v.End(cut, kEnded);
         const MF going = hn::AndNot(cut, stepped);
 
         if (group_is_medium) {
             // ---- A scattering-medium step ----
-            const VF u0 = lanes.rng.Uniform(), u1 = lanes.rng.Uniform(), u2 = lanes.rng.Uniform();
-            const VF u3 = lanes.rng.Uniform(), u4 = lanes.rng.Uniform();
+            const VF u0 = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
+            const VF u3 = rng.Uniform(), u4 = rng.Uniform();
             ScatteringStep(stack.layers[group].medium, going, v, u0, u1, u2, u3, u4);
             v.End(hn::And(going, v.Black()), kEnded);
         } else {
@@ -789,18 +830,18 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             const bool dielectric = layer.type == InterfaceType::Dielectric;
             switch (layer.type) {
                 case InterfaceType::Dielectric: {
-                    const VF uc = lanes.rng.Uniform(), u1 = lanes.rng.Uniform(),
-                             u2 = lanes.rng.Uniform();
+                    const VF uc = rng.Uniform(), u1 = rng.Uniform(),
+                             u2 = rng.Uniform();
                     DielectricEvent(layer.dielectric, going, v, uc, u1, u2, degenerate_event);
                     break;
                 }
                 case InterfaceType::Conductor: {
-                    const VF u1 = lanes.rng.Uniform(), u2 = lanes.rng.Uniform();
+                    const VF u1 = rng.Uniform(), u2 = rng.Uniform();
                     ConductorEvent(layer.conductor, going, v, u1, u2, degenerate_event);
                     break;
                 }
                 case InterfaceType::Lambertian: {
-                    const VF u1 = lanes.rng.Uniform(), u2 = lanes.rng.Uniform();
+                    const VF u1 = rng.Uniform(), u2 = rng.Uniform();
                     LambertianEvent(layer.lambertian, going, v, u1, u2, degenerate_event);
                     break;
                 }
@@ -858,33 +899,45 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
                 v.k = hn::IfThenElse(hn::RebindMask(di, moving), hn::Set(di, k_next), v.k);
             }
         }
-        v.store(lanes);
-
-        // ---- Ended particles: tallies in lane order, then the block's next particle ----
+        // ---- Ended particles: sums on vectors, exits binned, fresh particles in their lanes ----
         const MF ended = hn::RebindMask(df, hn::Ne(v.finish, hn::Zero(di)));
         if (hn::AllFalse(df, ended)) continue;
-        const MF exits = hn::RebindMask(
-            df, hn::And(hn::Ne(v.finish, hn::Zero(di)), hn::Lt(v.finish, hn::Set(di, kEnded))));
-        if (!hn::AllFalse(df, exits)) BinsOf(v.d, edges, bins);
-        for (std::size_t l = 0; l < n_lanes; ++l) {
-            const std::int32_t why = lanes.finish[l];
-            if (why == kGoesOn) continue;
-            const Rgbf w(lanes.w[0][l], lanes.w[1][l], lanes.w[2][l]);
-            if (why == kReflected) {
-                tally.exit(std::size_t(bins[l]), w);
-                block.escape_reflected(w);
-            } else if (why == kTransmitted) {
-                tally.exit(grid.size() + std::size_t(bins[l]), w);
-                block.escape_transmitted(w);
-            }
+        const MF reflected = LaneIs(v.finish, kReflected);
+        const MF transmitted = LaneIs(v.finish, kTransmitted);
+        for (int c = 0; c < 3; ++c) {
             for (int t = 0; t < kLossTerms; ++t)
-                for (int c = 0; c < 3; ++c)
-                    block.term[int(BudgetTerm::AbsorbedMedium) + t][c] +=
-                        double(lanes.loss[t][c][l]);
-            tally.sums.events += std::uint64_t(lanes.events[l]);
-            start_particle(l);
+                if (v.touched[t]) sums.add(t, c, hn::IfThenElseZero(ended, v.loss[t][c]));
+            if (!hn::AllFalse(df, reflected)) {
+                const VF wr = hn::IfThenElseZero(reflected, v.w[c]);
+                sums.add(kLossTerms, c, wr);
+                sums.add(kLossTerms + 1, c, wr, true);
+            }
+            if (!hn::AllFalse(df, transmitted)) {
+                const VF wt = hn::IfThenElseZero(transmitted, v.w[c]);
+                sums.add(kLossTerms + 2, c, wt);
+                sums.add(kLossTerms + 3, c, wt, true);
+            }
         }
+        sums.add_events(hn::IfThenElseZero(hn::RebindMask(di, ended), v.events));
+        const MF exits = hn::Or(reflected, transmitted);
+        hn::Store(v.finish, di, finish);
+        if (!hn::AllFalse(df, exits)) {
+            BinsOf(v.d, edges, bins);
+            for (int c = 0; c < 3; ++c) hn::Store(v.w[c], df, w_out[c]);
+        }
+        // Lane order: the particles of the block are handed out in a fixed order.
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            const std::int32_t why = finish[l];
+            if (why == kGoesOn) continue;
+            if (why != kEnded) {
+                const Rgbf w(w_out[0][l], w_out[1][l], w_out[2][l]);
+                tally.exit((why == kTransmitted ? grid.size() : 0) + std::size_t(bins[l]), w);
+            }
+            take_particle(l);
+        }
+        restart(ended);
     }
+    sums.reduce(block, tally.sums.events);
     tally.sums.degenerate += degenerate;
 }
 
