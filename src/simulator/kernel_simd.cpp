@@ -28,6 +28,7 @@
 
 #include "core/math.h"
 
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -272,7 +273,7 @@ enum Finish : std::int32_t { kGoesOn = 0, kReflected = 1, kTransmitted = 2, kEnd
 struct LaneVectors {
     V3 d;
     VF w[3];
-    VF depth;  // inside a scattering medium: 0 at its top, 1 at its bottom
+    VF depth;                // inside a scattering medium: 0 at its top, 1 at its bottom
     VF loss[kLossTerms][3];  // the flux the particle has lost so far, per budget term
     VI k;                    // at an interface: its index; in a medium: its layer
     VI in_medium, events, live, finish;
@@ -557,90 +558,71 @@ HWY_INLINE void ScatteringStep(const TraceMedium& med, MF m, LaneVectors& v, VF 
         hn::IfThenElse(hn::RebindMask(di, scatters), hn::Add(v.events, hn::Set(di, 1)), v.events);
 }
 
-// ---- Binning
-// -------------------------------------------------------------------------------------
+// ---- Binning ---------------------------------------------------------------------------------
 
-// HemisphereGrid::bin_of on lanes, bit for bit: a first guess from the angle (vector acos, off by
-// at most one bin near an edge), corrected against the grid's exact edges in double precision with
-// the scalar rule (bin b holds edge[b] ≥ x > edge[b + 1]).
+// A first guess of acos(x), x ∈ [−1, 1], within 10^-4 rad: Abramowitz & Stegun 1964, Eq. 4.4.45
+// (|ε| ≤ 5·10^-5 on [0, 1]) with acos(−x) = π − acos(x). Only a guess: RefineBin corrects it
+// against the exact edges, so its error only costs refinement steps, never a wrong bin.
+HWY_INLINE VF AcosGuess(VF x) {
+    const DF df;
+    const VF a = hn::Abs(x);
+    VF p = hn::MulAdd(hn::Set(df, -0.0187293f), a, hn::Set(df, 0.0742610f));
+    p = hn::MulAdd(p, a, hn::Set(df, -0.2121144f));
+    p = hn::MulAdd(p, a, hn::Set(df, 1.5707288f));
+    const VF r = hn::Mul(SafeSqrt(hn::Sub(hn::Set(df, 1.f), a)), p);
+    return hn::IfThenElse(hn::Lt(x, hn::Zero(df)), hn::Sub(hn::Set(df, kPi<float>), r), r);
+}
+
+// Guesses of the θ and φ bins of the lanes' directions (the bins are uniform in angle).
+HWY_INLINE void BinGuesses(const V3& d, int n_theta, int n_phi, std::int32_t* theta_guess,
+                           std::int32_t* phi_guess) {
+    const DF df;
+    const DI di;
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
+    const VF cos_theta = hn::Min(hn::Abs(d.z), one);
+    const VF r = hn::Sqrt(hn::MulAdd(d.x, d.x, hn::Mul(d.y, d.y)));
+    const VF cos_phi = hn::Min(
+        hn::Max(hn::Div(d.x, hn::IfThenElse(hn::Gt(r, zero), r, one)), hn::Set(df, -1.f)), one);
+    const VF to_theta_bin = hn::Set(df, float(n_theta) / (0.5f * kPi<float>));
+    const VF to_phi_bin = hn::Set(df, float(n_phi) / kPi<float>);
+    hn::Store(hn::ConvertTo(di, hn::Mul(AcosGuess(cos_theta), to_theta_bin)), di, theta_guess);
+    hn::Store(hn::ConvertTo(di, hn::Mul(AcosGuess(cos_phi), to_phi_bin)), di, phi_guess);
+}
+
+// The bin of x among decreasing edges (HemisphereGrid's rule: bin b holds edge[b] ≥ x >
+// edge[b + 1], the last bin also its lower edge), from any first guess.
+inline int RefineBin(double x, int b, const double* edges, int n) {
+    b = std::clamp(b, 0, n - 1);
+    while (b > 0 && x > edges[b])
+        --b;
+    while (b < n - 1 && x <= edges[b + 1])
+        ++b;
+    return b;
+}
+
+// HemisphereGrid::bin_of, bit for bit (the same double arithmetic and edges), from the guesses;
+// only for the lanes that leave the stack.
+inline std::size_t BinOf(float x, float y, float z, std::int32_t theta_guess,
+                         std::int32_t phi_guess, const HemisphereGrid& grid) {
+    const double cos_theta = std::min(double(std::abs(z)), 1.0);
+    const int b_theta =
+        RefineBin(cos_theta, theta_guess, grid.cos_theta_edges().data(), grid.n_theta());
+    const double xd = x, yd = y;
+    const double r = std::sqrt(xd * xd + yd * yd);
+    int b_phi = 0;
+    if (r != 0) {
+        const double cos_phi = std::clamp(xd / r, -1.0, 1.0);
+        b_phi = RefineBin(cos_phi, phi_guess, grid.cos_phi_edges().data(), grid.n_phi());
+    }
+    return std::size_t(b_theta) * std::size_t(grid.n_phi()) + std::size_t(b_phi);
+}
+
+// ---- The block ----
+
 using DD = hn::Repartition<double, DF>;
 using DL = hn::RebindToSigned<DD>;
 using VD = hn::Vec<DD>;
 using VL = hn::Vec<DL>;
-
-HWY_INLINE VL RefineBin(VD x, VL b, const double* edges, int n) {
-    const DD dd;
-    const DL dl;
-    while (true) {  // down while x > edge[b]
-        const auto m = hn::And(hn::RebindMask(dl, hn::Gt(x, hn::GatherIndex(dd, edges, b))),
-                               hn::Gt(b, hn::Zero(dl)));
-        if (hn::AllFalse(dl, m)) break;
-        b = hn::IfThenElse(m, hn::Sub(b, hn::Set(dl, 1)), b);
-    }
-    while (true) {  // up while x ≤ edge[b + 1]
-        const auto m = hn::And(hn::RebindMask(dl, hn::Le(x, hn::GatherIndex(dd, edges + 1, b))),
-                               hn::Lt(b, hn::Set(dl, n - 1)));
-        if (hn::AllFalse(dl, m)) break;
-        b = hn::IfThenElse(m, hn::Add(b, hn::Set(dl, 1)), b);
-    }
-    return b;
-}
-
-struct BinEdges {
-    const double* cos_theta;
-    const double* cos_phi;
-    int n_theta, n_phi;
-};
-
-HWY_INLINE void BinsOf(const V3& d, const BinEdges& edges, std::int64_t* bins) {
-    const DF df;
-    const DI di;
-    const DD dd;
-    const DL dl;
-    const hn::Half<DF> dfh;
-    const hn::Half<DI> dih;
-    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
-    // First guesses in float.
-    const VF cos_theta_f = hn::Min(hn::Abs(d.z), one);
-    const VF r_f = hn::Sqrt(hn::MulAdd(d.x, d.x, hn::Mul(d.y, d.y)));
-    const VF cos_phi_f = hn::Min(
-        hn::Max(hn::Div(d.x, hn::IfThenElse(hn::Gt(r_f, zero), r_f, one)), hn::Set(df, -1.f)), one);
-    const VI guess_theta =
-        hn::Min(hn::ConvertTo(di, hn::Mul(hn::Acos(df, cos_theta_f),
-                                          hn::Set(df, float(edges.n_theta) / (0.5f * kPi<float>)))),
-                hn::Set(di, edges.n_theta - 1));
-    const VI guess_phi = hn::Min(
-        hn::ConvertTo(
-            di, hn::Mul(hn::Acos(df, cos_phi_f), hn::Set(df, float(edges.n_phi) / kPi<float>))),
-        hn::Set(di, edges.n_phi - 1));
-    const std::size_t half = hn::Lanes(dd);
-    for (int h = 0; h < 2; ++h) {
-        auto widen = [&](VF v) {
-            return h == 0 ? hn::PromoteTo(dd, hn::LowerHalf(dfh, v))
-                          : hn::PromoteTo(dd, hn::UpperHalf(dfh, v));
-        };
-        auto widen_i = [&](VI v) {
-            return h == 0 ? hn::PromoteTo(dl, hn::LowerHalf(dih, v))
-                          : hn::PromoteTo(dl, hn::UpperHalf(dih, v));
-        };
-        // Exactly HemisphereGrid::theta_bin / phi_bin's arithmetic, in double.
-        const VD x = widen(d.x), y = widen(d.y);
-        const VD cos_theta = hn::Min(hn::Abs(widen(d.z)), hn::Set(dd, 1.0));
-        const VD r = hn::Sqrt(hn::MulAdd(x, x, hn::Mul(y, y)));
-        const auto r_zero = hn::Eq(r, hn::Zero(dd));
-        const VD cos_phi = hn::Min(
-            hn::Max(hn::Div(x, hn::IfThenElse(r_zero, hn::Set(dd, 1.0), r)), hn::Set(dd, -1.0)),
-            hn::Set(dd, 1.0));
-        const VL b_theta = RefineBin(cos_theta, hn::Max(widen_i(guess_theta), hn::Zero(dl)),
-                                     edges.cos_theta, edges.n_theta);
-        VL b_phi = RefineBin(cos_phi, hn::Max(widen_i(guess_phi), hn::Zero(dl)), edges.cos_phi,
-                             edges.n_phi);
-        b_phi = hn::IfThenZeroElse(hn::RebindMask(dl, r_zero), b_phi);
-        hn::Store(hn::Add(hn::Mul(b_theta, hn::Set(dl, edges.n_phi)), b_phi), dl, bins + h * half);
-    }
-}
-
-// ---- The block --------------------------------------------------------------------------------
 
 struct Scratch {
     std::vector<std::uint64_t> state, inc;
@@ -657,7 +639,8 @@ struct LaneSums {
         const DD dd;
         const DL dl;
         for (auto& term : sum)
-            for (auto& channel : term) channel[0] = channel[1] = hn::Zero(dd);
+            for (auto& channel : term)
+                channel[0] = channel[1] = hn::Zero(dd);
         events[0] = events[1] = hn::Zero(dl);
     }
     // Adds x (zero in lanes that must not count) to sum[t][c], in double.
@@ -686,11 +669,12 @@ struct LaneSums {
         const std::size_t half = hn::Lanes(dd);
         HWY_ALIGN double buf[kMaxLanes];
         HWY_ALIGN std::int64_t ibuf[kMaxLanes];
-        auto total = [&](const VD (&v)[2]) {
+        auto total = [&](const VD(&v)[2]) {
             hn::Store(v[0], dd, buf);
             hn::Store(v[1], dd, buf + half);
             double t = 0;
-            for (std::size_t l = 0; l < 2 * half; ++l) t += buf[l];
+            for (std::size_t l = 0; l < 2 * half; ++l)
+                t += buf[l];
             return t;
         };
         for (int c = 0; c < 3; ++c) {
@@ -703,7 +687,8 @@ struct LaneSums {
         }
         hn::Store(events[0], dl, ibuf);
         hn::Store(events[1], dl, ibuf + half);
-        for (std::size_t l = 0; l < 2 * half; ++l) events_total += std::uint64_t(ibuf[l]);
+        for (std::size_t l = 0; l < 2 * half; ++l)
+            events_total += std::uint64_t(ibuf[l]);
     }
 };
 
@@ -714,8 +699,6 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     const TraceStack& stack = *job.stack;
     const HemisphereGrid& grid = *job.grid;
     const int n_layers = int(stack.layers.size());
-    const BinEdges edges{grid.cos_theta_edges().data(), grid.cos_phi_edges().data(),
-                         grid.n_theta(), grid.n_phi()};
 
     thread_local Scratch scratch;
     scratch.state.resize(job.count);
@@ -727,7 +710,8 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_ALIGN std::int32_t live[kMaxLanes];
     HWY_ALIGN std::int32_t finish[kMaxLanes];
     HWY_ALIGN float w_out[3][kMaxLanes];
-    HWY_ALIGN std::int64_t bins[kMaxLanes];
+    HWY_ALIGN std::int32_t theta_guess[kMaxLanes], phi_guess[kMaxLanes];
+    HWY_ALIGN float d_out[3][kMaxLanes];
     std::uint64_t next = 0;  // the block's next particle
     // Gives lane l the block's next particle's generator, or retires it when none is left.
     auto take_particle = [&](std::size_t l) {
@@ -748,26 +732,31 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     auto restart = [&](MF fresh) {
         v.live = hn::IfThenElse(hn::RebindMask(di, fresh), hn::Load(di, live), v.live);
         const MF alive = hn::And(fresh, hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di))));
-        v.d = Select(fresh, V3{hn::Set(df, -job.wi.x), hn::Set(df, -job.wi.y),
-                               hn::Set(df, -job.wi.z)}, v.d);
-        for (int c = 0; c < 3; ++c) v.w[c] = hn::IfThenElse(fresh, hn::IfThenElseZero(alive, one), v.w[c]);
+        v.d = Select(
+            fresh, V3{hn::Set(df, -job.wi.x), hn::Set(df, -job.wi.y), hn::Set(df, -job.wi.z)}, v.d);
+        for (int c = 0; c < 3; ++c)
+            v.w[c] = hn::IfThenElse(fresh, hn::IfThenElseZero(alive, one), v.w[c]);
         for (int t = 0; t < kLossTerms; ++t)
             if (v.touched[t])
-                for (auto& channel : v.loss[t]) channel = hn::IfThenElseZero(hn::Not(fresh), channel);
+                for (auto& channel : v.loss[t])
+                    channel = hn::IfThenElseZero(hn::Not(fresh), channel);
         const auto fresh_i = hn::RebindMask(di, fresh);
         v.k = hn::IfThenZeroElse(fresh_i, v.k);
         v.in_medium = hn::IfThenZeroElse(fresh_i, v.in_medium);
         v.events = hn::IfThenZeroElse(fresh_i, v.events);
     };
-    for (std::size_t l = 0; l < n_lanes; ++l) take_particle(l);
+    for (std::size_t l = 0; l < n_lanes; ++l)
+        take_particle(l);
     {
         const MF all = hn::FirstN(df, n_lanes);
         v.live = hn::Zero(di);
         v.d = {zero, zero, zero};
         v.depth = zero;
-        for (int c = 0; c < 3; ++c) v.w[c] = zero;
+        for (int c = 0; c < 3; ++c)
+            v.w[c] = zero;
         for (auto& term : v.loss)
-            for (auto& channel : term) channel = zero;
+            for (auto& channel : term)
+                channel = zero;
         v.k = v.in_medium = v.events = hn::Zero(di);
         restart(all);
     }
@@ -783,8 +772,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         // medium, whichever group is largest (ties to the first). The lanes of a two-interface
         // stack then alternate between its interfaces nearly in phase, so each step runs one
         // interface's code on nearly full vectors.
-        const MF in_med =
-            hn::And(live_mask, hn::RebindMask(df, hn::Ne(v.in_medium, hn::Zero(di))));
+        const MF in_med = hn::And(live_mask, hn::RebindMask(df, hn::Ne(v.in_medium, hn::Zero(di))));
         const MF at_interface = hn::AndNot(in_med, live_mask);
         int group = 0;
         bool group_is_medium = false;
@@ -830,8 +818,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             const bool dielectric = layer.type == InterfaceType::Dielectric;
             switch (layer.type) {
                 case InterfaceType::Dielectric: {
-                    const VF uc = rng.Uniform(), u1 = rng.Uniform(),
-                             u2 = rng.Uniform();
+                    const VF uc = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
                     DielectricEvent(layer.dielectric, going, v, uc, u1, u2, degenerate_event);
                     break;
                 }
@@ -922,8 +909,12 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         const MF exits = hn::Or(reflected, transmitted);
         hn::Store(v.finish, di, finish);
         if (!hn::AllFalse(df, exits)) {
-            BinsOf(v.d, edges, bins);
-            for (int c = 0; c < 3; ++c) hn::Store(v.w[c], df, w_out[c]);
+            BinGuesses(v.d, grid.n_theta(), grid.n_phi(), theta_guess, phi_guess);
+            hn::Store(v.d.x, df, d_out[0]);
+            hn::Store(v.d.y, df, d_out[1]);
+            hn::Store(v.d.z, df, d_out[2]);
+            for (int c = 0; c < 3; ++c)
+                hn::Store(v.w[c], df, w_out[c]);
         }
         // Lane order: the particles of the block are handed out in a fixed order.
         for (std::size_t l = 0; l < n_lanes; ++l) {
@@ -931,7 +922,9 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             if (why == kGoesOn) continue;
             if (why != kEnded) {
                 const Rgbf w(w_out[0][l], w_out[1][l], w_out[2][l]);
-                tally.exit((why == kTransmitted ? grid.size() : 0) + std::size_t(bins[l]), w);
+                const std::size_t bin = BinOf(d_out[0][l], d_out[1][l], d_out[2][l], theta_guess[l],
+                                              phi_guess[l], grid);
+                tally.exit((why == kTransmitted ? grid.size() : 0) + bin, w);
             }
             take_particle(l);
         }
