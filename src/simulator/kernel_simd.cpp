@@ -196,12 +196,39 @@ HWY_INLINE VF SafeSqrt(VF x) {
     return hn::Sqrt(hn::ZeroIfNegative(x));
 }
 
-// cos and sin of 2π u, u ∈ [0, 1).
+// cos and sin of 2π u for u ∈ [0, 1) (a uniform azimuth), both at once. 2πu = (π/4)(j + f) with
+// j = ⌊8u⌋ and f = 8u − j, exact in float (u has 24 bits); the octant's angle a ∈ [0, π/4] goes
+// through the minimax polynomials of the Cephes library's sinf/cosf (Moshier 1992, "Methods and
+// Programs for Mathematical Functions"; errors below 1 ulp on [−π/4, π/4]), and the octant's
+// symmetries give cos and sin of the whole angle. One reduction for both instead of two.
 HWY_INLINE void CosSin2Pi(VF u, VF& c, VF& s) {
     const DF df;
-    const VF phi = hn::Mul(u, hn::Set(df, 2.f * kPi<float>));
-    c = hn::Cos(df, phi);
-    s = hn::Sin(df, phi);
+    const DI di;
+    const VF t = hn::Mul(u, hn::Set(df, 8.f));
+    const VF j_f = hn::Floor(t);
+    const VI j = hn::ConvertTo(di, j_f);
+    const VF f = hn::Sub(t, j_f);
+    const auto odd = hn::RebindMask(df, hn::Ne(hn::And(j, hn::Set(di, 1)), hn::Zero(di)));
+    const VF a = hn::Mul(hn::IfThenElse(odd, hn::Sub(hn::Set(df, 1.f), f), f),
+                         hn::Set(df, 0.25f * kPi<float>));
+    const VF z = hn::Mul(a, a);
+    VF sin_a = hn::MulAdd(z, hn::Set(df, -1.9515295891e-4f), hn::Set(df, 8.3321608736e-3f));
+    sin_a = hn::MulAdd(z, sin_a, hn::Set(df, -1.6666654611e-1f));
+    sin_a = hn::MulAdd(hn::Mul(z, a), sin_a, a);
+    VF cos_a =
+        hn::MulAdd(z, hn::Set(df, 2.443315711809948e-5f), hn::Set(df, -1.388731625493765e-3f));
+    cos_a = hn::MulAdd(z, cos_a, hn::Set(df, 4.166664568298827e-2f));
+    cos_a = hn::MulAdd(hn::Mul(z, z), cos_a, hn::NegMulAdd(hn::Set(df, 0.5f), z, hn::Set(df, 1.f)));
+    // Octants 1, 2, 5, 6 swap sin and cos; cos < 0 in octants 2–5, sin < 0 in octants 4–7.
+    const auto swap = hn::RebindMask(
+        df, hn::Ne(hn::And(hn::Add(j, hn::Set(di, 1)), hn::Set(di, 2)), hn::Zero(di)));
+    const auto cos_negative = hn::RebindMask(
+        df, hn::Ne(hn::And(hn::Add(j, hn::Set(di, 2)), hn::Set(di, 4)), hn::Zero(di)));
+    const auto sin_negative = hn::RebindMask(df, hn::Ne(hn::And(j, hn::Set(di, 4)), hn::Zero(di)));
+    const VF c_abs = hn::IfThenElse(swap, sin_a, cos_a);
+    const VF s_abs = hn::IfThenElse(swap, cos_a, sin_a);
+    c = hn::IfThenElse(cos_negative, hn::Neg(c_abs), c_abs);
+    s = hn::IfThenElse(sin_negative, hn::Neg(s_abs), s_abs);
 }
 
 // GGX visible normals by spherical caps: microfacet.h sample_visible_normal_caps (Dupuy & Benyoub
@@ -273,9 +300,14 @@ enum Finish : std::int32_t { kGoesOn = 0, kReflected = 1, kTransmitted = 2, kEnd
 struct LaneVectors {
     V3 d;
     VF w[3];
-    VF depth;                // inside a scattering medium: 0 at its top, 1 at its bottom
-    VF loss[kLossTerms][3];  // the flux the particle has lost so far, per budget term
-    VI k;                    // at an interface: its index; in a medium: its layer
+    VF depth;  // inside a scattering medium: 0 at its top, 1 at its bottom
+    // Flux lost per budget term, summed in float over the lane's recent steps (whatever particle
+    // each step belonged to) and moved into double sums every kFlushSteps steps: a few particles'
+    // worth of float additions at most, rounding-level like the particle's own float arithmetic.
+    VF loss[kLossTerms][3];
+    VF exit_sum[4][3];  // the same for R, R², T, T² of the particles that left
+    VI events_done;     // events of the lane's ended particles
+    VI k;               // at an interface: its index; in a medium: its layer
     VI in_medium, events, live, finish;
     bool touched[kLossTerms] = {};  // loss terms some lane may have booked in this block
 
@@ -736,10 +768,6 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             fresh, V3{hn::Set(df, -job.wi.x), hn::Set(df, -job.wi.y), hn::Set(df, -job.wi.z)}, v.d);
         for (int c = 0; c < 3; ++c)
             v.w[c] = hn::IfThenElse(fresh, hn::IfThenElseZero(alive, one), v.w[c]);
-        for (int t = 0; t < kLossTerms; ++t)
-            if (v.touched[t])
-                for (auto& channel : v.loss[t])
-                    channel = hn::IfThenElseZero(hn::Not(fresh), channel);
         const auto fresh_i = hn::RebindMask(di, fresh);
         v.k = hn::IfThenZeroElse(fresh_i, v.k);
         v.in_medium = hn::IfThenZeroElse(fresh_i, v.in_medium);
@@ -757,14 +785,37 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         for (auto& term : v.loss)
             for (auto& channel : term)
                 channel = zero;
-        v.k = v.in_medium = v.events = hn::Zero(di);
+        for (auto& term : v.exit_sum)
+            for (auto& channel : term)
+                channel = zero;
+        v.k = v.in_medium = v.events = v.events_done = hn::Zero(di);
         restart(all);
     }
     LaneSums sums;
     sums.zero();
     std::uint64_t degenerate = 0;
+    bool left[2] = {false, false};  // some particle was reflected / transmitted in this block
+    // Moves the lanes' float sums into the double ones.
+    constexpr int kFlushSteps = 4;
+    int steps_since_flush = 0;
+    auto flush = [&] {
+        for (int c = 0; c < 3; ++c) {
+            for (int t = 0; t < kLossTerms; ++t)
+                if (v.touched[t]) {
+                    sums.add(t, c, v.loss[t][c]);
+                    v.loss[t][c] = zero;
+                }
+            for (int e = 0; e < 4; ++e)
+                if (left[e / 2]) {
+                    sums.add(kLossTerms + e, c, v.exit_sum[e][c]);
+                    v.exit_sum[e][c] = zero;
+                }
+        }
+        steps_since_flush = 0;
+    };
 
     while (true) {
+        if (++steps_since_flush == kFlushSteps) flush();
         v.finish = hn::Zero(di);
         const MF live_mask = hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di)));
         if (hn::AllFalse(df, live_mask)) break;
@@ -891,21 +942,19 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         if (hn::AllFalse(df, ended)) continue;
         const MF reflected = LaneIs(v.finish, kReflected);
         const MF transmitted = LaneIs(v.finish, kTransmitted);
-        for (int c = 0; c < 3; ++c) {
-            for (int t = 0; t < kLossTerms; ++t)
-                if (v.touched[t]) sums.add(t, c, hn::IfThenElseZero(ended, v.loss[t][c]));
-            if (!hn::AllFalse(df, reflected)) {
-                const VF wr = hn::IfThenElseZero(reflected, v.w[c]);
-                sums.add(kLossTerms, c, wr);
-                sums.add(kLossTerms + 1, c, wr, true);
-            }
-            if (!hn::AllFalse(df, transmitted)) {
-                const VF wt = hn::IfThenElseZero(transmitted, v.w[c]);
-                sums.add(kLossTerms + 2, c, wt);
-                sums.add(kLossTerms + 3, c, wt, true);
+        for (int side = 0; side < 2; ++side) {
+            const MF leaves = side == 0 ? reflected : transmitted;
+            if (hn::AllFalse(df, leaves)) continue;
+            left[side] = true;
+            for (int c = 0; c < 3; ++c) {
+                const VF w_out_c = hn::IfThenElseZero(leaves, v.w[c]);
+                v.exit_sum[2 * side][c] = hn::Add(v.exit_sum[2 * side][c], w_out_c);
+                v.exit_sum[2 * side + 1][c] =
+                    hn::MulAdd(w_out_c, w_out_c, v.exit_sum[2 * side + 1][c]);
             }
         }
-        sums.add_events(hn::IfThenElseZero(hn::RebindMask(di, ended), v.events));
+        v.events_done =
+            hn::Add(v.events_done, hn::IfThenElseZero(hn::RebindMask(di, ended), v.events));
         const MF exits = hn::Or(reflected, transmitted);
         hn::Store(v.finish, di, finish);
         if (!hn::AllFalse(df, exits)) {
@@ -930,6 +979,8 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         }
         restart(ended);
     }
+    flush();
+    sums.add_events(v.events_done);
     sums.reduce(block, tally.sums.events);
     tally.sums.degenerate += degenerate;
 }
@@ -955,6 +1006,24 @@ std::uint32_t PcgDrawsForTest(std::uint64_t seed, std::uint64_t stream, std::uin
     return std::uint32_t(n_lanes);
 }
 
+void CosSin2PiForTest(const float* u, std::size_t n, float* c, float* s) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in[kMaxLanes], out_c[kMaxLanes], out_s[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l)
+            in[l] = base + l < n ? u[base + l] : 0.f;
+        VF vc, vs;
+        CosSin2Pi(hn::Load(df, in), vc, vs);
+        hn::Store(vc, df, out_c);
+        hn::Store(vs, df, out_s);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l) {
+            c[base + l] = out_c[l];
+            s[base + l] = out_s[l];
+        }
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace lamina
 HWY_AFTER_NAMESPACE();
@@ -964,6 +1033,7 @@ namespace lamina {
 
 HWY_EXPORT(TraceBlockSimd);
 HWY_EXPORT(PcgDrawsForTest);
+HWY_EXPORT(CosSin2PiForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -981,6 +1051,12 @@ std::vector<float> simd_particle_uniforms(std::uint64_t seed, std::uint64_t stre
     std::vector<float> out(n_particles * n_draws);
     HWY_DYNAMIC_DISPATCH(PcgDrawsForTest)(seed, stream, first, n_particles, n_draws, out.data());
     return out;
+}
+
+void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::vector<float>& s) {
+    c.resize(u.size());
+    s.resize(u.size());
+    HWY_DYNAMIC_DISPATCH(CosSin2PiForTest)(u.data(), u.size(), c.data(), s.data());
 }
 
 }  // namespace lamina

@@ -3,10 +3,23 @@
 
 #include "simulator/tally.h"
 
+#include <cstdint>
+#include <vector>
+
 namespace lamina {
 
 /// Traces the block's particles as lanes of SIMD vectors; same contract as trace_block_scalar.
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block);
+
+/// For tests: the first `n_draws` uniform floats of particles [first, first + n_particles) as the
+/// SIMD kernel's lanes draw them (row-major: particle, then draw). They must equal
+/// ParticleRng(seed, stream, p).uniform_float() bit for bit.
+std::vector<float> simd_particle_uniforms(std::uint64_t seed, std::uint64_t stream,
+                                          std::uint64_t first, std::uint64_t n_particles,
+                                          std::uint64_t n_draws);
+
+/// For tests: the kernel's azimuth cos(2πu), sin(2πu) for u in [0, 1).
+void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::vector<float>& s);
 
 /// The instruction set the SIMD kernel dispatches to on this machine (e.g. "AVX3_ZEN4").
 const char* simd_target_name();

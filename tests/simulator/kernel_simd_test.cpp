@@ -1,0 +1,149 @@
+// The SIMD kernel (simulator/kernel_simd.h): its random numbers and azimuths against the
+// libraries and closed forms they stand for, and its tables against the scalar kernel's by a
+// two-sample chi-square test. (Every exact-solution test of goniophotometer_test.cpp also runs on
+// it.)
+#include "simulator/kernel_simd.h"
+
+#include "core/rng.h"
+#include "simulator/goniophotometer.h"
+#include "support/chi2.h"
+#include "support/stacks.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace lamina {
+namespace {
+
+// The lanes draw the very numbers of ParticleRng (Philox4x32-10 seeding PCG32, Random123 and
+// pcg-cpp), bit for bit, for particles on both sides of a 32-bit index boundary and a stream with
+// both 32-bit halves set.
+TEST(KernelSimd, LanesDrawTheParticlesOwnNumbers) {
+    const std::uint64_t seed = 0x0123456789abcdefull, stream = 0xfedcba9876543210ull;
+    const std::uint64_t first = (std::uint64_t(1) << 32) - 21, n_particles = 45, n_draws = 70;
+    const std::vector<float> lanes =
+        simd_particle_uniforms(seed, stream, first, n_particles, n_draws);
+    ASSERT_EQ(lanes.size(), n_particles * n_draws);
+    for (std::uint64_t p = 0; p < n_particles; ++p) {
+        ParticleRng rng(seed, stream, first + p);
+        for (std::uint64_t i = 0; i < n_draws; ++i)
+            ASSERT_EQ(lanes[p * n_draws + i], rng.uniform_float())
+                << "particle " << first + p << ", draw " << i;
+    }
+}
+
+// cos and sin of 2πu against double precision for every 2^-18 step of u and around every octant
+// boundary, within 2 float ulps of 1.
+TEST(KernelSimd, AzimuthCosineAndSine) {
+    std::vector<float> u;
+    for (int i = 0; i < (1 << 18); ++i)
+        u.push_back(float(i) * 0x1p-18f);
+    for (int j = 1; j < 8; ++j)
+        for (int d = -4; d <= 4; ++d)
+            u.push_back(float(j) * 0.125f + float(d) * 0x1p-24f);
+    u.push_back(1.f - 0x1p-24f);
+    std::vector<float> c, s;
+    simd_cos_sin_2pi(u, c, s);
+    double worst = 0;
+    for (std::size_t i = 0; i < u.size(); ++i) {
+        const double phi = 2 * M_PI * double(u[i]);
+        worst = std::max(worst, std::abs(double(c[i]) - std::cos(phi)));
+        worst = std::max(worst, std::abs(double(s[i]) - std::sin(phi)));
+    }
+    EXPECT_LT(worst, 2 * 0x1p-24) << "largest error";
+}
+
+// Two-sample chi-square: the scalar and SIMD kernels, with different seeds, tabulate the same
+// distribution. Per bin and channel z = (f_a − f_b)/√(se_a² + se_b²) is standard normal when both
+// come from the same distribution (central limit: bins with at least ~100 expected exits); Σ z²
+// over the bins of one channel is χ² with as many degrees of freedom. Each channel is one test at
+// the Šidák-corrected level of the suite (1 % overall for the 24 tests below).
+constexpr int kTwoSampleTests = 24;
+
+void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
+                              std::uint64_t particles) {
+    SimulationSettings s;
+    s.theta_i_deg = std::move(theta_i);
+    s.particles = particles;
+    s.grid = HemisphereGrid(18, 18);
+    s.kernel = Kernel::Scalar;
+    s.seed = 11;
+    const SimulationResult a = simulate(stack, s);
+    s.kernel = Kernel::Simd;
+    s.seed = 12;
+    const SimulationResult b = simulate(stack, s);
+    const double level = 1 - std::pow(1 - 0.01, 1.0 / kTwoSampleTests);
+    for (std::size_t inc = 0; inc < s.theta_i_deg.size(); ++inc) {
+        for (const Side side : {Side::Reflection, Side::Transmission}) {
+            if (side == Side::Transmission && !a.table.has_transmission) continue;
+            const BinnedLobe& la = a.table.lobe(inc, side);
+            const BinnedLobe& lb = b.table.lobe(inc, side);
+            for (int c = 0; c < 3; ++c) {
+                double chi2 = 0;
+                int dof = 0;
+                for (std::size_t j = 0; j < s.grid.size(); ++j) {
+                    // Expected exits ≈ N · f · Ω⊥ (flux fraction, weights of order one).
+                    const double exits =
+                        double(particles) * la.f[j][c] * s.grid.projected_solid_angle(j);
+                    if (exits < 100) continue;
+                    const double se2 = la.se[j][c] * la.se[j][c] + lb.se[j][c] * lb.se[j][c];
+                    ASSERT_GT(se2, 0);
+                    chi2 += (la.f[j][c] - lb.f[j][c]) * (la.f[j][c] - lb.f[j][c]) / se2;
+                    ++dof;
+                }
+                ASSERT_GE(dof, 10) << "too few populated bins to test";
+                const double p = test::gamma_q(dof / 2.0, chi2 / 2.0);
+                EXPECT_GE(p, level)
+                    << "θi " << s.theta_i_deg[inc] << "° side " << int(side) << " channel " << c
+                    << ": χ² = " << chi2 << " for " << dof << " bins";
+            }
+            // The budgets too, within 5 combined standard errors.
+            const EnergyBudget& ba = a.incidences[inc].budget;
+            const EnergyBudget& bb = b.incidences[inc].budget;
+            for (int c = 0; c < 3; ++c) {
+                const double r_se = std::hypot(ba.reflected_se[c], bb.reflected_se[c]);
+                EXPECT_LT(std::abs(ba[BudgetTerm::Reflected][c] - bb[BudgetTerm::Reflected][c]),
+                          5 * r_se + 1e-12);
+                const double t_se = std::hypot(ba.transmitted_se[c], bb.transmitted_se[c]);
+                EXPECT_LT(std::abs(ba[BudgetTerm::Transmitted][c] - bb[BudgetTerm::Transmitted][c]),
+                          5 * t_se + 1e-12);
+            }
+        }
+    }
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarPlastic) {
+    // The benchmark plastic: rough coat, absorbing medium, Lambertian base.
+    expect_same_distribution(
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.1, 0.0, 0.9)),
+                          test::lambertian_layer(Rgbd(0.8, 0.5, 1.0))}),
+        {0, 60}, 1'000'000);
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarMetallicPaint) {
+    expect_same_distribution(
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.05), Rgbd(0.1)),
+                          test::conductor_layer(Rgbd(0.2, 1.0, 1.45), Rgbd(3.0, 2.0, 0.01), 0.3)}),
+        {30, 75}, 1'000'000);
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarRoughSlab) {
+    // Reflection and transmission, total internal reflection inside.
+    expect_same_distribution(
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.3), Rgbd(0.1, 0.0, 0.9)),
+                          test::dielectric_layer(1.0, 0.5)}),
+        {10, 70}, 1'000'000);
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarScatteringMediumSpectral) {
+    // Per-channel extinction and anisotropy: the spectral MIS of free flights and phase functions.
+    expect_same_distribution(
+        test::make_stack({test::with_medium(test::dielectric_layer(1.3, 0.1), Rgbd(0.05, 0.2, 0.0),
+                                            Rgbd(0.5, 1.5, 0.8), Rgbd(0.6, -0.2, 0.3)),
+                          test::lambertian_layer(Rgbd(0.6))}),
+        {45}, 400'000);
+}
+
+}  // namespace
+}  // namespace lamina
