@@ -33,6 +33,10 @@ RandomWalkEstimate RandomWalkModel::estimate(const Vec3d& wi, const Vec3d& wo) c
     return walker_.eval(wi, wo, samples_, seed_, query_stream(wi, wo));
 }
 
+RandomWalkPdf RandomWalkModel::pdf_estimate(const Vec3d& wi, const Vec3d& wo) const {
+    return walker_.pdf(wi, wo, samples_, seed_, ~query_stream(wi, wo));
+}
+
 Rgbd RandomWalkModel::eval(const Vec3d& wi, const Vec3d& wo) const {
     return estimate(wi, wo).f;
 }

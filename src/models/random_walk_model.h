@@ -27,6 +27,11 @@ class RandomWalkModel final : public Model {
     /// The estimate with its standard error (what `lamina eval` prints).
     RandomWalkEstimate estimate(const Vec3d& wi, const Vec3d& wo) const;
 
+    /// The exit density of the walk's sampling at wo (RandomWalkStack::pdf; `lamina eval --pdf`),
+    /// with the same walks count and a stream of its own. Model has no pdf in its interface (the
+    /// analytic models do not sample), so this lives here.
+    RandomWalkPdf pdf_estimate(const Vec3d& wi, const Vec3d& wo) const;
+
     void set_samples(std::uint64_t n) { samples_ = n; }
     void set_seed(std::uint64_t s) { seed_ = s; }
     const RandomWalkStack& walker() const { return walker_; }
