@@ -12,6 +12,7 @@
 #include "randomwalk/random_walk.h"
 
 #include <cstdint>
+#include <memory>
 
 namespace lamina {
 
@@ -35,9 +36,13 @@ class RandomWalkModel final : public Model {
     void set_samples(std::uint64_t n) { samples_ = n; }
     void set_seed(std::uint64_t s) { seed_ = s; }
     const RandomWalkStack& walker() const { return walker_; }
+    /// The stack seen from below (flipped_stack), for light meeting a transmitting stack from
+    /// its bottom side (the renderer's transparent spheres); null for an opaque base.
+    const RandomWalkStack* flipped_walker() const { return flipped_.get(); }
 
   private:
     RandomWalkStack walker_;
+    std::unique_ptr<RandomWalkStack> flipped_;
     std::uint64_t samples_, seed_;
 };
 

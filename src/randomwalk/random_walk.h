@@ -78,6 +78,9 @@ class RandomWalkStack {
     explicit RandomWalkStack(const Stack& stack, int max_events = 10'000);
 
     bool transmits() const { return transmits_; }
+    /// Absolute indices of the ambient medium (above) and of the half-space below the base.
+    double eta_top() const { return eta_.front(); }
+    double eta_bottom() const { return eta_.back(); }
     int interfaces() const { return int(interfaces_.size()); }
 
     /// The non-delta part of f(wi, wo) (1/sr, no cosine), averaged over `walks` walks of the
