@@ -12,7 +12,8 @@
 //   (B) random walk only: its own sample (a walk from v, reciprocity), weight·L;
 //   A and B are combined with MIS weights p_mix/(p_mix + q) and q/(p_mix + q), q = cos θ/π a proxy
 //   of the walk's exit density: the weights sum to one for every direction, so the combination is
-//   unbiased whatever q is (Veach 1997, §9.2.2); delta exits of B are dropped because delta lobes
+//   unbiased whatever q is (Veach 1997, §9.2.2; why not the walk's own pdf estimate:
+//   docs/rendering.md §2); delta exits of B are dropped because delta lobes
 //   are added exactly (Model::delta_lobes) for every model, the random walk included.
 // A transmitting stack (a slab) rendered by the random walk is a transparent sphere: the walk's
 // exits below the surface continue inside the sphere, meet the far side's stack from below and
