@@ -28,7 +28,7 @@ namespace {
 struct EvalArgs {
     std::string model, stack, theta_i, directions, out, grid = "90x90", side = "R";
     double theta_o = std::nan(""), phi_o = std::nan("");
-    bool binned = false;
+    bool binned = false, pdf = false;
     std::vector<std::string> options;
     std::uint64_t samples = 0, seed = 0;  ///< random-walk only; 0: the model's own option
 };
@@ -40,6 +40,9 @@ RandomWalkModel* configure_random_walk(Model& model, const EvalArgs& a) {
         if (a.samples != 0 || a.seed != 0)
             throw InputError("command line", a.samples != 0 ? "--samples" : "--seed",
                              "only the stochastic model random-walk takes a sample count or seed");
+        if (a.pdf)
+            throw InputError("command line", "--pdf",
+                             "only the stochastic model random-walk has a sampling density here");
         return nullptr;
     }
     if (a.samples != 0) rw->set_samples(a.samples);
@@ -166,10 +169,16 @@ int run_eval(const EvalArgs& a) {
     const auto model = entry.make(stack, options);
     require_side(*model, side, a.stack);
     if (const RandomWalkModel* rw = configure_random_walk(*model, a)) {
+        const Vec3d wi = incident_direction(deg_to_rad(thetas[0]));
+        const Vec3d wo = direction_from_angles(deg_to_rad(a.theta_o), deg_to_rad(a.phi_o), side);
+        if (a.pdf) {
+            // pdf se: the exit density of the walk's sample() at wo (docs/rendering.md §1.4).
+            const RandomWalkPdf p = rw->pdf_estimate(wi, wo);
+            fmt::print("{} {}\n", p.pdf, p.se);
+            return 0;
+        }
         // f_r f_g f_b se_r se_g se_b: the estimate and its standard error.
-        const RandomWalkEstimate e =
-            rw->estimate(incident_direction(deg_to_rad(thetas[0])),
-                         direction_from_angles(deg_to_rad(a.theta_o), deg_to_rad(a.phi_o), side));
+        const RandomWalkEstimate e = rw->estimate(wi, wo);
         fmt::print("{} {} {} {} {} {}\n", e.f[0], e.f[1], e.f[2], e.se[0], e.se[1], e.se[2]);
         return 0;
     }
@@ -202,6 +211,9 @@ Runner add_eval(CLI::App& app) {
                     "random-walk: walks per query (default: its samples option, 1024); a point "
                     "evaluation then prints f_r f_g f_b se_r se_g se_b")
         ->check(CLI::PositiveNumber);
+    cmd->add_flag("--pdf", a->pdf,
+                  "random-walk, one point: print the exit density of its sampling at wo and its "
+                  "standard error (pdf se, 1/sr) instead of f");
     cmd->add_option("--seed", a->seed, "random-walk: seed of the walks (≥ 1)")
         ->check(CLI::PositiveNumber);
     cmd->add_option("--option", a->options,

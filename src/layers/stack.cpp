@@ -7,6 +7,7 @@
 // default.
 #include "layers/stack.h"
 
+#include "core/check.h"
 #include "core/error.h"
 
 #include <fmt/format.h>
@@ -571,6 +572,26 @@ std::string describe(const Stack& stack) {
             out += fmt::format(" | medium τa={}", show_rgb(m.tau_a));
             if (m.scatters()) out += fmt::format(" τs={} g={}", show_rgb(m.tau_s), show_rgb(m.g));
         }
+    }
+    return out;
+}
+
+Stack flipped_stack(const Stack& stack) {
+    LAMINA_CHECK(!stack.layers.empty() && stack.transmits());
+    const std::size_t L = stack.layers.size();
+    Stack out;
+    out.name = stack.name + " (from below)";
+    out.ambient_eta = stack.base().eta;
+    for (std::size_t j = 0; j < L; ++j) {
+        const std::size_t k = L - 1 - j;  // the old interface
+        Layer layer;
+        layer.interface = stack.layers[k].interface;
+        layer.interface.eta = stack.eta_above(k);
+        if (k >= 1) {  // the old region above interface k is the medium of layer k − 1
+            layer.has_medium = stack.layers[k - 1].has_medium;
+            layer.medium = stack.layers[k - 1].medium;
+        }
+        out.layers.push_back(layer);
     }
     return out;
 }

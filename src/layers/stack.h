@@ -84,6 +84,13 @@ Stack stack_from_json(const nlohmann::json& j, const std::string& where);
 /// (with line and column), duplicate keys, and numbers that overflow a double (1e999).
 Stack load_stack(const std::filesystem::path& path);
 
+/// The same stack seen from below (z flipped), for light that meets a transmitting stack from
+/// its bottom side: the ambient index is the old η below the base, the interfaces come in reverse
+/// order (each with the absolute index of what now lies below it, the old index above it, and the
+/// same roughness), and each medium moves with the region it fills. Isotropic media (HG) and
+/// interfaces are unchanged by the flip. Requires stack.transmits() (every interface a dielectric).
+Stack flipped_stack(const Stack& stack);
+
 /// Canonical JSON form (every RGB quantity as a 3-array); stack_from_json(stack_to_json(s)) == s.
 nlohmann::json stack_to_json(const Stack& stack);
 

@@ -23,7 +23,9 @@ std::uint64_t query_stream(const Vec3d& wi, const Vec3d& wo) {
 }
 
 RandomWalkModel::RandomWalkModel(const Stack& stack, std::uint64_t samples, std::uint64_t seed)
-    : walker_(stack), samples_(samples), seed_(seed) {}
+    : walker_(stack), samples_(samples), seed_(seed) {
+    if (stack.transmits()) flipped_ = std::make_unique<RandomWalkStack>(flipped_stack(stack));
+}
 
 Support RandomWalkModel::support() const {
     return {true, walker_.transmits(), walker_.transmits() ? "" : "opaque base: no BTDF"};
@@ -31,6 +33,10 @@ Support RandomWalkModel::support() const {
 
 RandomWalkEstimate RandomWalkModel::estimate(const Vec3d& wi, const Vec3d& wo) const {
     return walker_.eval(wi, wo, samples_, seed_, query_stream(wi, wo));
+}
+
+RandomWalkPdf RandomWalkModel::pdf_estimate(const Vec3d& wi, const Vec3d& wo) const {
+    return walker_.pdf(wi, wo, samples_, seed_, ~query_stream(wi, wo));
 }
 
 Rgbd RandomWalkModel::eval(const Vec3d& wi, const Vec3d& wo) const {

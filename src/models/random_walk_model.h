@@ -12,6 +12,7 @@
 #include "randomwalk/random_walk.h"
 
 #include <cstdint>
+#include <memory>
 
 namespace lamina {
 
@@ -27,12 +28,21 @@ class RandomWalkModel final : public Model {
     /// The estimate with its standard error (what `lamina eval` prints).
     RandomWalkEstimate estimate(const Vec3d& wi, const Vec3d& wo) const;
 
+    /// The exit density of the walk's sampling at wo (RandomWalkStack::pdf; `lamina eval --pdf`),
+    /// with the same walks count and a stream of its own. Model has no pdf in its interface (the
+    /// analytic models do not sample), so this lives here.
+    RandomWalkPdf pdf_estimate(const Vec3d& wi, const Vec3d& wo) const;
+
     void set_samples(std::uint64_t n) { samples_ = n; }
     void set_seed(std::uint64_t s) { seed_ = s; }
     const RandomWalkStack& walker() const { return walker_; }
+    /// The stack seen from below (flipped_stack), for light meeting a transmitting stack from
+    /// its bottom side (the renderer's transparent spheres); null for an opaque base.
+    const RandomWalkStack* flipped_walker() const { return flipped_.get(); }
 
   private:
     RandomWalkStack walker_;
+    std::unique_ptr<RandomWalkStack> flipped_;
     std::uint64_t samples_, seed_;
 };
 

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <utility>
 
 namespace lamina {
 
@@ -89,6 +90,22 @@ Rgbd exp_neg(const Rgbd& x) {
     return {std::exp(-x[0]), std::exp(-x[1]), std::exp(-x[2])};
 }
 
+// The probability that the walk, with flux weight W (per channel, ≥ 0) just after a vertex, is
+// carried to the exit by the delta chains whose per-channel probability ladder is Q
+// (docs/rendering.md §1.4): Σ_c W_c Q_c / Σ_c W_c. In a scattering medium the walk draws its
+// free flight from channel c with probability ∝ W_c and then reweights W_c by e^{−τ_c ℓ}/(that
+// mixture probability); across successive flights the mixture probabilities telescope to the
+// W-weighted mean of the per-channel products. A black W kills the walk: probability 0.
+double chain_probability(const Rgbd& W, const Rgbd& Q) {
+    const double total = W[0] + W[1] + W[2];
+    if (!(total > 0)) return 0;
+    return (W[0] * Q[0] + W[1] * Q[1] + W[2] * Q[2]) / total;
+}
+
+bool is_grey(const Rgbd& x) {
+    return x[0] == x[1] && x[1] == x[2];
+}
+
 }  // namespace
 
 RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events)
@@ -98,6 +115,9 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events)
     eta_.assign(L + 1, 1.0);
     media_.assign(L + 1, Medium{});
     eta_[0] = stack.ambient_eta;
+    // For pdf_is_unbiased(): per-channel extinction in a scattering medium, and per-channel
+    // weights of delta events that are not flights through one.
+    bool chromatic_scatterer = false, chromatic_weight = false;
     for (int k = 0; k < L; ++k) {
         const Layer& layer = stack.layers[k];
         const InterfaceSpec& spec = layer.interface;
@@ -121,6 +141,9 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events)
                 eta_[k + 1] = eta_above;
                 break;
         }
+        if (spec.type == InterfaceType::Conductor && it.delta &&
+            !(is_grey(spec.eta_rgb) && is_grey(spec.k)))
+            chromatic_weight = true;
         interfaces_.push_back(it);
         if (layer.has_medium) {
             const MediumSpec& m = layer.medium;
@@ -134,8 +157,11 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events)
             md.uniform_g = m.g[0] == m.g[1] && m.g[1] == m.g[2];
             for (int c = 0; c < 3; ++c)
                 md.single_scattering_albedo[c] = md.tau_t[c] > 0 ? m.tau_s[c] / md.tau_t[c] : 0.0;
+            if (md.scatters && !md.uniform_tau_t) chromatic_scatterer = true;
+            if (!md.scatters && !md.uniform_tau_t) chromatic_weight = true;
         }
     }
+    pdf_unbiased_ = !(chromatic_scatterer && chromatic_weight);
 }
 
 // ---- Building the connection: the delta-chain ladder
@@ -148,8 +174,14 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events)
 // with Fresnel R, T = 1 − R of a smooth dielectric (T = G2/G1, R = 0 for a rough index-matched
 // one), R = F_conductor for a smooth conductor, and A = 0 at a non-delta interface (a path that
 // meets one has a later non-delta vertex, which connects instead).
+//
+// Probability mode (pdf, docs/rendering.md §1.4): the same ladder with the walk's *branch
+// probabilities* instead of its flux factors: Fresnel R, T of a smooth dielectric (the walk's coin
+// flip), 1 for a smooth conductor and an index-matched pass-through (always taken; their factors
+// are weights), t_r = 1 through a non-scattering medium (a weight) and, through a scattering one,
+// t_r = e^{−τt_c/μ_r} per channel: the probability that channel c's free flight crosses it.
 static void build_connection(const std::vector<double>& eta, const auto& interfaces,
-                             const auto& media, const Vec3d& wo, bool top,
+                             const auto& media, const Vec3d& wo, bool top, bool probability,
                              RandomWalkStack::Connection& c) {
     const int L = int(interfaces.size());
     c.top = top;
@@ -190,7 +222,8 @@ static void build_connection(const std::vector<double>& eta, const auto& interfa
         c.dir_up[r] = Vec3d(h.x, h.y, c.mu[r]);
         c.dir_down[r] = Vec3d(h.x, h.y, -c.mu[r]);
         if (r == exit_region) (top ? c.dir_up[r] : c.dir_down[r]) = wo;
-        c.t[r] = media[r].empty ? Rgbd(1.0) : exp_neg(media[r].tau_t / c.mu[r]);
+        const bool opaque_flight = probability ? media[r].scatters : !media[r].empty;
+        c.t[r] = opaque_flight ? exp_neg(media[r].tau_t / c.mu[r]) : Rgbd(1.0);
         c.scale[r] = sqr(ratio);
     }
     // Unknowns x = (A_0^↑ … A_{L−1}^↑, A_0^↓ … A_{L−1}^↓), one system per channel.
@@ -220,15 +253,17 @@ static void build_connection(const std::vector<double>& eta, const auto& interfa
             const auto& it = interfaces[k];
             if (!it.delta) continue;  // rows stay x = 0
             if (it.type == InterfaceType::Conductor) {
-                if (c.valid[k]) add_up(down(k), k, it.conductor.fresnel(c.mu[k])[ch]);
+                if (c.valid[k])
+                    add_up(down(k), k, probability ? 1.0 : it.conductor.fresnel(c.mu[k])[ch]);
                 continue;
             }
             const auto& d = it.dielectric;
             if (d.is_index_matched()) {
                 // A pass-through: T = G2(w, −w)/G1(w) (1 when smooth), R = 0.
                 auto pass = [&](const Vec3d& w) {
-                    return d.is_smooth() ? 1.0
-                                         : d.masking_shadowing(w, -w) / d.distribution().G1(w);
+                    return d.is_smooth() || probability
+                               ? 1.0
+                               : d.masking_shadowing(w, -w) / d.distribution().G1(w);
                 };
                 if (c.valid[k + 1]) add_up(up(k), k, pass(-c.dir_up[k + 1]));
                 if (c.valid[k]) add_down(down(k), k, pass(-c.dir_down[k]));
@@ -287,7 +322,13 @@ double RandomWalkStack::survival_proxy(int region, double path) const {
 // Strategy 2 at a vertex of the inner region that emits `k_v(ω)` (per channel, kernel incl. cos
 // for an interface) with pdf `pdf_v(ω)`, at depth-distance `depth` from the exit (1: the vertex
 // interface). The exit's transmission is sampled from wo (t on the inner side); ω = −t.
-template <typename Kernel, typename Pdf>
+//
+// Pdf mode (docs/rendering.md §1.4): the same two strategies estimate the exit density of the
+// paths v → exit → wo, Σ over arrivals of pdf_exit(−d, wo): strategy 2 adds
+//     pdf_v(ω) · P_v(ω) · pdf_exit(t, wo) / pdf_exit(wo, t) · w₂,
+// P_v the probability that the walk's flight from v reaches the exit unscattered (chain
+// probability of the weight w·k_v(ω), 1 through a non-scattering medium), with the same w₁, w₂.
+template <RandomWalkStack::Mode kMode, typename Kernel, typename Pdf>
 void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& wo, double depth,
                                            const Rgbd& w, ParticleRng& rng, const Kernel& kernel,
                                            const Pdf& pdf_v, Rgbd& f) const {
@@ -303,10 +344,16 @@ void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& 
     const Rgbd kv = kernel(omega);
     if (is_black(kv)) return;
     const Medium& m = media_[conn.inner];
-    const Rgbd tr = m.empty ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
-    const double p1 = pdf_v(omega) * survival_proxy(conn.inner, depth / mu);
+    const double pv = pdf_v(omega);
+    const double p1 = pv * survival_proxy(conn.inner, depth / mu);
     const double mis = st->pdf / (st->pdf + p1);
-    f += w * kv * tr * (f_exit / st->pdf * mis);
+    if constexpr (kMode == Mode::Pdf) {
+        const Rgbd pass = m.scatters ? exp_neg(m.tau_t * (depth / mu)) : Rgbd(1.0);
+        f[0] += pv * chain_probability(w * kv, pass) * exit.pdf(st->wo, wo) / st->pdf * mis;
+    } else {
+        const Rgbd tr = m.empty ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
+        f += w * kv * tr * (f_exit / st->pdf * mis);
+    }
 }
 
 // ---- Media (physics.md §4), as the goniophotometer traverses them ------------------------------
@@ -316,9 +363,11 @@ void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& 
 // simulator/goniophotometer.cpp. Each scattering event is a non-delta vertex: it connects along
 // d_r up and down with the channel's own HG phase and the unscattered transmittance to the
 // boundary, e^{−τt·s/μ} (up) or e^{−τt·(1 − s)/μ} (down), and below a rough top by strategy 2.
-template <bool kConnect>
+template <RandomWalkStack::Mode kMode>
 bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rng,
                                       const Connection* conn, const Vec3d& wo, Rgbd& f) const {
+    constexpr bool kConnect = kMode == Mode::Eval;
+    constexpr bool kEstimate = kMode != Mode::Sample;  // eval and pdf share strategy 2's MIS
     Vec3d& d = ws.d;
     Rgbd& w = ws.w;
     const Medium& m = media_[region];
@@ -394,7 +443,39 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
             }
             if (conn->rough_exit && region == conn->inner) {
                 const Vec3d d_in = d;
-                connect_through_exit(
+                connect_through_exit<kMode>(
+                    *conn, wo, conn->distance(s), w, rng,
+                    [&](const Vec3d& om) {
+                        const double ct = dot(d_in, om);
+                        return Rgbd(hg_phase(ct, m.g[0]), hg_phase(ct, m.g[1]),
+                                    hg_phase(ct, m.g[2]));
+                    },
+                    [&](const Vec3d& om) { return phase_pdf(dot(d_in, om)); }, f);
+            }
+        }
+        if constexpr (kMode == Mode::Pdf) {
+            // Exit density (docs/rendering.md §1.4): the phase-sampling density of d_r± times the
+            // probability that the delta chains carry the walk from there to the exit (the rest
+            // of this medium, then the ladder), times dω_r/dω_e = (η_e/η_r)² cos θ_e / μ_r. The
+            // weight just after the vertex is ∝ w_c·HG_c(d·d_r) per channel.
+            if (conn->valid[region]) {
+                const double mu_r = conn->mu[region];
+                const double jacobian = conn->scale[region] * std::abs(wo.z) / mu_r;
+                const Rgbd above = conn->up[region - 1];
+                const Rgbd below = region < conn->L ? conn->down[region] : Rgbd(0.0);
+                const Rgbd q_up = exp_neg(m.tau_t * (s / mu_r)) * above;
+                const Rgbd q_down = exp_neg(m.tau_t * ((1 - s) / mu_r)) * below;
+                for (const auto& [dir, q] : {std::pair{conn->dir_up[region], q_up},
+                                             std::pair{conn->dir_down[region], q_down}}) {
+                    const double ct = dot(d, dir);
+                    const Rgbd W =
+                        w * Rgbd(hg_phase(ct, m.g[0]), hg_phase(ct, m.g[1]), hg_phase(ct, m.g[2]));
+                    f[0] += phase_pdf(ct) * chain_probability(W, q) * jacobian;
+                }
+            }
+            if (conn->rough_exit && region == conn->inner) {
+                const Vec3d d_in = d;
+                connect_through_exit<kMode>(
                     *conn, wo, conn->distance(s), w, rng,
                     [&](const Vec3d& om) {
                         const double ct = dot(d_in, om);
@@ -425,9 +506,9 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
         // The walk's own strategy for the same paths (strategy 1, weighted at the exit). Only
         // meaningful while connecting (conn is null for sample()).
         ws.prev_mis =
-            kConnect && conn->rough_exit && region == conn->inner && d_new.z * conn->towards > 0;
+            kEstimate && conn->rough_exit && region == conn->inner && d_new.z * conn->towards > 0;
         ws.prev_pdf = phase_pdf(cos_theta);
-        ws.prev_depth = kConnect ? conn->distance(s) : 0;
+        ws.prev_depth = kEstimate ? conn->distance(s) : 0;
         d = d_new;
         if (is_black(w)) return d.z > 0;
         if (++ws.events >= max_events_) {
@@ -438,10 +519,12 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
 }
 
 // ---- One walk ----------------------------------------------------------------------------------
-template <bool kConnect>
+template <RandomWalkStack::Mode kMode>
 void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                            const Connection* conn, Rgbd& f,
                            std::optional<RandomWalkSample>* exit) const {
+    constexpr bool kConnect = kMode == Mode::Eval;
+    constexpr bool kEstimate = kMode != Mode::Sample;  // eval and pdf share strategy 2's MIS
     const int L = int(interfaces_.size());
     WalkState ws;
     ws.d = -wi;
@@ -454,7 +537,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
         // Strategy 1's balance-heuristic weight at the exit interface (1 for other paths): the
         // particle arrives from the inner region straight from a vertex that strategy 2 connects.
         auto exit_mis = [&](int at) {
-            if constexpr (!kConnect)
+            if constexpr (!kEstimate)
                 return 1.0;
             else {
                 if (!conn->rough_exit || at != conn->exit_interface || !ws.prev_mis ||
@@ -482,7 +565,42 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 }
                 // Strategy 2 from the vertex interface emitting into the inner region.
                 if (conn->rough_exit && k == conn->vertex_interface) {
-                    connect_through_exit(
+                    connect_through_exit<kMode>(
+                        *conn, wo, 1.0, w, rng,
+                        [&](const Vec3d& om) {
+                            return eval_interface(it, wi_local, om) * std::abs(om.z);
+                        },
+                        [&](const Vec3d& om) { return pdf_interface(it, wi_local, om); }, f);
+                }
+            }
+        }
+        // Exit density at a non-delta interface (docs/rendering.md §1.4): its sampling density of
+        // d_r times the chains' probability of reaching the exit from there, times
+        // dω_r/dω_e = (η_e/η_r)² cos θ_e / μ_r (1 when r is the exit region). The weight just
+        // after the vertex is ∝ w·f (per channel; f·|cos|/pdf with grey |cos|/pdf).
+        if constexpr (kMode == Mode::Pdf) {
+            if (!it.delta) {
+                const double cos_e = std::abs(wo.z);
+                if (conn->valid[k]) {
+                    const Vec3d& du = conn->dir_up[k];
+                    const double p = pdf_interface(it, wi_local, du);
+                    if (p > 0)
+                        f[0] += p *
+                                chain_probability(w * eval_interface(it, wi_local, du),
+                                                  conn->from_bottom_up(k)) *
+                                conn->scale[k] * cos_e / conn->mu[k] * exit_mis(k);
+                }
+                if (it.type == InterfaceType::Dielectric && conn->valid[k + 1]) {
+                    const Vec3d& dd = conn->dir_down[k + 1];
+                    const double p = it.dielectric.pdf(wi_local, dd);
+                    if (p > 0)
+                        f[0] += p *
+                                chain_probability(w * it.dielectric.eval(wi_local, dd),
+                                                  conn->from_top_down(k + 1)) *
+                                conn->scale[k + 1] * cos_e / conn->mu[k + 1] * exit_mis(k);
+                }
+                if (conn->rough_exit && k == conn->vertex_interface) {
+                    connect_through_exit<kMode>(
                         *conn, wo, 1.0, w, rng,
                         [&](const Vec3d& om) {
                             return eval_interface(it, wi_local, om) * std::abs(om.z);
@@ -514,7 +632,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
         w *= s->weight;
         if (!it.delta) ws.delta_only = false;
         d = s->wo;
-        if constexpr (kConnect)
+        if constexpr (kEstimate)
             ws.prev_mis = conn->rough_exit && k == conn->vertex_interface && !it.delta &&
                           d.z * conn->towards > 0;
         ws.prev_pdf = s->pdf;
@@ -526,7 +644,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 return;
             }
             bool up = true;
-            if (!media_[k].empty) up = traverse_medium<kConnect>(k, ws, rng, conn, wo, f);
+            if (!media_[k].empty) up = traverse_medium<kMode>(k, ws, rng, conn, wo, f);
             if (is_black(w)) return;
             if (up) --k;
         } else {
@@ -535,7 +653,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 return;
             }
             bool up = false;
-            if (!media_[k + 1].empty) up = traverse_medium<kConnect>(k + 1, ws, rng, conn, wo, f);
+            if (!media_[k + 1].empty) up = traverse_medium<kMode>(k + 1, ws, rng, conn, wo, f);
             if (is_black(w)) return;
             if (!up) ++k;
         }
@@ -569,9 +687,9 @@ double RandomWalkStack::pdf_interface(const Interface& it, const Vec3d& wi, cons
 Rgbd RandomWalkStack::eval_once(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng) const {
     if (wi.z <= 0 || wo.z == 0 || (wo.z < 0 && !transmits_)) return Rgbd(0.0);
     Connection conn;
-    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, conn);
+    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, false, conn);
     Rgbd f(0.0);
-    walk<true>(wi, wo, rng, &conn, f, nullptr);
+    walk<Mode::Eval>(wi, wo, rng, &conn, f, nullptr);
     return f;
 }
 
@@ -581,7 +699,7 @@ std::vector<RandomWalkStack::DeltaExit> RandomWalkStack::delta_lobes(const Vec3d
     // Light entering along −wi at interface 0 from above is A_0^↓ at wi's Snell invariant.
     const Vec3d mirror(-wi.x, -wi.y, wi.z);
     Connection conn;
-    build_connection(eta_, interfaces_, media_, mirror, true, conn);
+    build_connection(eta_, interfaces_, media_, mirror, true, false, conn);
     if (conn.down[0].max() > 0) out.push_back({mirror, conn.down[0]});
     if (transmits_) {
         const int L = int(interfaces_.size());
@@ -589,7 +707,7 @@ std::vector<RandomWalkStack::DeltaExit> RandomWalkStack::delta_lobes(const Vec3d
         const double sin2 = sqr(ratio) * (sqr(wi.x) + sqr(wi.y));
         if (sin2 < 1) {
             const Vec3d wt(-wi.x * ratio, -wi.y * ratio, -std::sqrt(1 - sin2));
-            build_connection(eta_, interfaces_, media_, wt, false, conn);
+            build_connection(eta_, interfaces_, media_, wt, false, false, conn);
             if (conn.down[0].max() > 0) out.push_back({wt, conn.down[0]});
         }
     }
@@ -602,12 +720,12 @@ RandomWalkEstimate RandomWalkStack::eval(const Vec3d& wi, const Vec3d& wo, std::
     e.walks = walks;
     if (walks == 0 || wi.z <= 0 || wo.z == 0 || (wo.z < 0 && !transmits_)) return e;
     Connection conn;
-    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, conn);
+    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, false, conn);
     Rgbd sum(0.0), sum_sq(0.0);
     for (std::uint64_t i = 0; i < walks; ++i) {
         ParticleRng rng(seed, stream, i);
         Rgbd f(0.0);
-        walk<true>(wi, wo, rng, &conn, f, nullptr);
+        walk<Mode::Eval>(wi, wo, rng, &conn, f, nullptr);
         sum += f;
         sum_sq += f * f;
     }
@@ -620,10 +738,40 @@ RandomWalkEstimate RandomWalkStack::eval(const Vec3d& wi, const Vec3d& wo, std::
     return e;
 }
 
+double RandomWalkStack::pdf_once(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng) const {
+    if (wi.z <= 0 || wo.z == 0 || (wo.z < 0 && !transmits_)) return 0;
+    Connection conn;
+    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, true, conn);
+    Rgbd p(0.0);
+    walk<Mode::Pdf>(wi, wo, rng, &conn, p, nullptr);
+    return p[0];
+}
+
+RandomWalkPdf RandomWalkStack::pdf(const Vec3d& wi, const Vec3d& wo, std::uint64_t walks,
+                                   std::uint64_t seed, std::uint64_t stream) const {
+    RandomWalkPdf e;
+    e.walks = walks;
+    if (walks == 0 || wi.z <= 0 || wo.z == 0 || (wo.z < 0 && !transmits_)) return e;
+    Connection conn;
+    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, true, conn);
+    double sum = 0, sum_sq = 0;
+    for (std::uint64_t i = 0; i < walks; ++i) {
+        ParticleRng rng(seed, stream, i);
+        Rgbd p(0.0);
+        walk<Mode::Pdf>(wi, wo, rng, &conn, p, nullptr);
+        sum += p[0];
+        sum_sq += p[0] * p[0];
+    }
+    const double n = double(walks);
+    e.pdf = sum / n;
+    e.se = walks > 1 ? std::sqrt(std::max(0.0, sum_sq / n - e.pdf * e.pdf) / (n - 1)) : 0;
+    return e;
+}
+
 std::optional<RandomWalkSample> RandomWalkStack::sample(const Vec3d& wi, ParticleRng& rng) const {
     std::optional<RandomWalkSample> exit;
     Rgbd unused(0.0);
-    walk<false>(wi, wi, rng, nullptr, unused, &exit);
+    walk<Mode::Sample>(wi, wi, rng, nullptr, unused, &exit);
     return exit;
 }
 

@@ -28,9 +28,12 @@
 // and the connection replaces its binning, both estimate the same quantity.
 //
 // sample(wi) returns the walk's own exit: an unbiased "stochastic-weight" sample of the stack
-// (E[weight·g(wo)] = ∫ f g |cos θo| dωo for every g). Its density has no closed form; the renderer
-// combines it with light sampling through MIS weights built from a proxy density, which keeps the
-// combination unbiased (weights sum to one per direction; docs/rendering.md §2).
+// (E[weight·g(wo)] = ∫ f g |cos θo| dωo for every g). Its density has no closed form; pdf(wi, wo)
+// is an unbiased stochastic estimate of it (docs/rendering.md §1.4): the sub-probability density
+// p(wo | wi) of the exit direction of sample(wi) over the walks that leave the stack through at
+// least one non-delta event (delta exits, absorbed, lost and cut-off walks are the missing mass:
+// ∫ p dω = P(sample returns a non-delta exit)). The renderer keeps a proxy density in its MIS
+// weights (docs/rendering.md §2 says why).
 //
 // Thread safety: const methods only; each call owns its random-number generator.
 
@@ -54,6 +57,13 @@ struct RandomWalkEstimate {
     std::uint64_t walks = 0;
 };
 
+/// A stochastic estimate of the exit density of sample() (docs/rendering.md §1.4), 1/sr.
+struct RandomWalkPdf {
+    double pdf = 0;  ///< mean over walks
+    double se = 0;   ///< standard error of the mean
+    std::uint64_t walks = 0;
+};
+
 struct RandomWalkSample {
     Vec3d wo;               ///< exit direction (below the surface: transmitted)
     Rgbd weight{0.0};       ///< flux weight: E[weight·g(wo)] = ∫ f g |cos θo| dωo
@@ -68,6 +78,9 @@ class RandomWalkStack {
     explicit RandomWalkStack(const Stack& stack, int max_events = 10'000);
 
     bool transmits() const { return transmits_; }
+    /// Absolute indices of the ambient medium (above) and of the half-space below the base.
+    double eta_top() const { return eta_.front(); }
+    double eta_bottom() const { return eta_.back(); }
     int interfaces() const { return int(interfaces_.size()); }
 
     /// The non-delta part of f(wi, wo) (1/sr, no cosine), averaged over `walks` walks of the
@@ -82,6 +95,25 @@ class RandomWalkStack {
 
     /// Follows one particle from wi to its exit (empty when it is absorbed, lost or cut off).
     std::optional<RandomWalkSample> sample(const Vec3d& wi, ParticleRng& rng) const;
+
+    /// Unbiased estimate of p(wo | wi), the sub-probability density (1/sr, solid angle) of the
+    /// non-delta exits of sample(wi) at wo (either side), averaged over `walks` walks of
+    /// (seed, stream, walk index); zero for wi.z ≤ 0 or wo.z = 0. Exact in expectation when
+    /// pdf_is_unbiased(); otherwise see there. Delta exits (is_delta) have no density and are
+    /// left out, as are walks that return no exit: ∫ p dω = P(non-delta exit).
+    RandomWalkPdf pdf(const Vec3d& wi, const Vec3d& wo, std::uint64_t walks, std::uint64_t seed,
+                      std::uint64_t stream) const;
+
+    /// One walk's estimate of p(wo | wi) with the caller's generator.
+    double pdf_once(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng) const;
+
+    /// The delta chains' exit probabilities are linear in the per-channel ladder (exact pdf)
+    /// unless a scattering medium with per-channel extinction meets, in one delta chain, a
+    /// per-channel weight that is not a flight through such a medium (a smooth conductor with
+    /// per-channel Fresnel, an absorbing non-scattering medium with per-channel τ): then the
+    /// spectral-MIS channel probabilities make the exit probability a non-linear function of the
+    /// flux weights and pdf() is an approximation (docs/rendering.md §1.4). False only then.
+    bool pdf_is_unbiased() const { return pdf_unbiased_; }
 
     /// The delta lobes of the stack for incidence wi (paths made only of smooth events and
     /// unscattered flights): the mirror lobe and, for a slab, the straight-through lobe, with their
@@ -110,13 +142,16 @@ class RandomWalkStack {
     };
 
     struct WalkState;
-    template <bool kConnect>
+    /// What a walk adds up: nothing (sample), f towards wo (eval), the exit density at wo (pdf;
+    /// accumulated in channel 0 of the Rgbd).
+    enum class Mode { Sample, Eval, Pdf };
+    template <Mode kMode>
     void walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng, const Connection* conn, Rgbd& f,
               std::optional<RandomWalkSample>* exit) const;
-    template <bool kConnect>
+    template <Mode kMode>
     bool traverse_medium(int region, WalkState& ws, ParticleRng& rng, const Connection* conn,
                          const Vec3d& wo, Rgbd& f) const;
-    template <typename Kernel, typename Pdf>
+    template <Mode kMode, typename Kernel, typename Pdf>
     void connect_through_exit(const Connection& conn, const Vec3d& wo, double depth, const Rgbd& w,
                               ParticleRng& rng, const Kernel& kernel, const Pdf& pdf_v,
                               Rgbd& f) const;
@@ -128,6 +163,7 @@ class RandomWalkStack {
     std::vector<Medium> media_;          ///< per region 0..L (0 and L empty)
     std::vector<double> eta_;            ///< absolute index per region 0..L
     bool transmits_ = false;
+    bool pdf_unbiased_ = true;
     int max_events_;
 };
 

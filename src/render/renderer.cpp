@@ -18,6 +18,8 @@ namespace lamina {
 
 namespace {
 
+constexpr int kMaxChords = 10'000;  ///< safety cap on chords inside a transparent sphere
+
 // The light-sampling mixture of strategy A: cosine about n, a GGX lobe (visible normals seen from
 // the view direction wo, reflected: the density of a rough mirror, Heitz 2018) and the cap lights
 // (uniform in their cones, solid angle 2π(1 − cos_max)), with probabilities c_cos, c_lobe and
@@ -70,6 +72,14 @@ Rendering render_sphere(const Model& model, const Environment& env, const Render
     const auto start = std::chrono::steady_clock::now();
     const auto* rw = dynamic_cast<const RandomWalkModel*>(&model);
     const RandomWalkStack* walker = rw ? &rw->walker() : nullptr;
+    // Transparent spheres (docs/rendering.md §2.1): the random walk of a transmitting stack, seen
+    // from below inside the sphere.
+    const RandomWalkStack* flipped = walker && s.transparent ? rw->flipped_walker() : nullptr;
+    // Generalized reciprocity, f(wi, wo)/η_o² = f(wo, wi)/η_i² (bsdf.h; Veach 1997, §6.2):
+    // a walk from the viewer estimates f(v → w); light from w on the other side needs
+    // f(w → v) = f(v → w)·(η_v/η_w)².
+    const double out_over_in =
+        flipped ? sqr(walker->eta_top() / walker->eta_bottom()) : 1.0;  // (η_outside/η_inside)²
     const int N = s.size;
     Rendering out;
     out.image = Image(N, N);
@@ -80,6 +90,46 @@ Rendering render_sphere(const Model& model, const Environment& env, const Render
     const int threads = s.threads > 0 ? s.threads : omp_get_max_threads();
     Progress progress("render " + model.name(), "rows", std::uint64_t(N));
     if (!s.progress) progress.finish();
+
+    // Radiance arriving at the sphere point x (|x| = 1) from inside, travelling against `d` (d
+    // points from x into the sphere): the ray crosses the sphere's inside (homogeneous, index
+    // η_inside, no medium) to the far side, whose stack is met from below — the flipped stack,
+    // with its top towards the inside. A walk of the flipped stack from the direction back to x
+    // either exits to the outside (the environment, through (η_inside/η_outside)²) or reflects
+    // into the sphere (the next chord). The directional light is added by next-event estimation at
+    // every inner vertex (a delta light cannot be hit). Russian roulette after 8 chords with
+    // survival min(0.95, max throughput), divided out (unbiased; ends almost surely).
+    auto inside = [&](Vec3d x, Vec3d d, ParticleRng& rng) {
+        Rgbd L(0.0), throughput(1.0);
+        for (int chord = 0; chord < kMaxChords; ++chord) {
+            const double t = -2 * dot(x, d);  // |x + t d| = 1
+            if (!(t > 0)) break;              // tangent: no far side
+            x = normalize(x + d * t);
+            const Frame<double> inner = Frame<double>::from_normal(-x);
+            const Vec3d v = inner.to_local(-d);
+            if (v.z <= 0) break;
+            if (env.sun) {
+                const Vec3d sun = inner.to_local(env.sun->direction);
+                if (sun.z < 0)
+                    L += throughput * flipped->eval_once(v, sun, rng) * env.sun->irradiance *
+                         (-sun.z / out_over_in);
+            }
+            const auto smp = flipped->sample(v, rng);
+            if (!smp) break;
+            throughput *= smp->weight;
+            d = inner.to_world(smp->wo);
+            if (smp->wo.z < 0) {
+                L += throughput * env.radiance(d) / out_over_in;
+                break;
+            }
+            if (chord >= 8) {
+                const double q = std::min(0.95, throughput.max());
+                if (!(rng.uniform_double() < q)) break;
+                throughput = throughput / q;
+            }
+        }
+        return L;
+    };
 
     // Radiance towards the camera from the sphere point with normal n, one sample.
     auto shade = [&](const Vec3d& n, ParticleRng& rng) {
@@ -102,11 +152,17 @@ Rendering render_sphere(const Model& model, const Environment& env, const Render
             }
         }
         // (B) the random walk's own sample (reciprocity: a walk from wo exits towards wi).
+        // Exits below the surface carry light from inside the sphere (transparent spheres only;
+        // delta exits too: no other strategy samples the inside).
         if (walker) {
-            if (const auto smp = walker->sample(wo, rng); smp && !smp->is_delta && smp->wo.z > 0) {
-                const Vec3d d = frame.to_world(smp->wo);
-                const double q = smp->wo.z * kInvPi<double>;
-                L += smp->weight * env.radiance(d) * (q / (mix.pdf(d, smp->wo, wo) + q));
+            if (const auto smp = walker->sample(wo, rng); smp && smp->wo.z > 0) {
+                if (!smp->is_delta) {
+                    const Vec3d d = frame.to_world(smp->wo);
+                    const double q = smp->wo.z * kInvPi<double>;
+                    L += smp->weight * env.radiance(d) * (q / (mix.pdf(d, smp->wo, wo) + q));
+                }
+            } else if (smp && flipped) {
+                L += smp->weight * inside(n, frame.to_world(smp->wo), rng) * out_over_in;
             }
         }
         // Delta lobes, exactly (reciprocity: the lobes seen from wo).

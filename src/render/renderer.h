@@ -12,9 +12,14 @@
 //   (B) random walk only: its own sample (a walk from v, reciprocity), weight·L;
 //   A and B are combined with MIS weights p_mix/(p_mix + q) and q/(p_mix + q), q = cos θ/π a proxy
 //   of the walk's exit density: the weights sum to one for every direction, so the combination is
-//   unbiased whatever q is (Veach 1997, §9.2.2); delta exits of B are dropped because delta lobes
+//   unbiased whatever q is (Veach 1997, §9.2.2; why not the walk's own pdf estimate:
+//   docs/rendering.md §2); delta exits of B are dropped because delta lobes
 //   are added exactly (Model::delta_lobes) for every model, the random walk included.
-// Only the BRDF is rendered (light from below the tangent plane is ignored, even for a slab).
+// A transmitting stack (a slab) rendered by the random walk is a transparent sphere: the walk's
+// exits below the surface continue inside the sphere, meet the far side's stack from below and
+// leave to the environment (docs/rendering.md §2.1; `settings.transparent`). The analytic models,
+// and the random walk with transparent = false, render the BRDF only (light from below the
+// tangent plane is ignored).
 //
 // Reproducible: sample s of pixel p draws from ParticleRng(seed, p, s) (core/rng.h), whatever
 // thread renders it. OpenMP over rows; progress on stderr.
@@ -40,6 +45,9 @@ struct RenderSettings {
     /// light-sampling mixture (0: none). Only a proposal density — values always come from the
     /// model — so any value is unbiased; `lobe_alpha_for(stack)` picks the top interface's α.
     double lobe_alpha = 0;
+    /// Render a transmitting stack as a transparent sphere (random walk only); false: the BRDF
+    /// only, as the analytic models are rendered (comparison sheets use false).
+    bool transparent = true;
 };
 
 struct Rendering {

@@ -149,6 +149,10 @@ check_says eval-rw-six 0 "six" sh -c "'$lamina' eval --model random-walk --stack
 "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 --theta-o 45 --phi-o 180 --samples 2000 --seed 3 >"$tmp/rw1"
 "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 --theta-o 45 --phi-o 180 --samples 2000 --seed 3 >"$tmp/rw2"
 check eval-rw-reproducible 0 cmp "$tmp/rw1" "$tmp/rw2"
+# eval --pdf: two numbers (the exit density and its standard error); a Lambertian's is cos/π exactly.
+check_says eval-rw-pdf 0 "two" sh -c "'$lamina' eval --model random-walk --stack '$src/examples/plastic.json' --theta-i 30 --theta-o 45 --phi-o 180 --samples 2000 --seed 3 --pdf | awk '{ if (NF == 2 && \$1 > 0) print \"two\"; else print \"wrong\" }' | grep -x two"
+check_says eval-pdf-analytic 1 "only the stochastic model random-walk" \
+    "$lamina" eval --model ww-prime --stack "$src/examples/plastic.json" --theta-i 30 --theta-o 45 --phi-o 180 --pdf
 check_says eval-samples-analytic 1 "only the stochastic model random-walk" \
     "$lamina" eval --model ww-prime --stack "$src/examples/plastic.json" --theta-i 30 --theta-o 45 --phi-o 180 --samples 10
 

@@ -323,6 +323,43 @@ TEST(RandomWalkStat, Reciprocity) {
     RecordProperty("worst_z", std::to_string(worst));
 }
 
+// ---- The flipped stack (layers/stack.h): a slab seen from below
+// ---------------------------------- Generalized reciprocity (bsdf.h): with wi above (index η_top)
+// and wo below (η_bottom), f(wo → wi) = f(wi → wo)·η_top²/η_bottom², and light from below is the
+// flipped stack's light from above: f_flipped(flip(wo), flip(wi)) = f(wi, wo)·(η_top/η_bottom)²,
+// flip = (x, y, −z). Flipping twice gives the stack back.
+TEST(RandomWalkStat, FlippedStackIsTheStackSeenFromBelow) {
+    const Stack ball =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.1, 0.0, 0.3),
+                                            Rgbd(0.5), Rgbd(0.4)),
+                          test::with_medium(test::dielectric_layer(1.2, 0.0), Rgbd(0.2)),
+                          test::dielectric_layer(1.33, 0.35)});
+    const Stack twice = flipped_stack(flipped_stack(ball));
+    EXPECT_EQ(twice.layers, ball.layers);
+    EXPECT_EQ(twice.ambient_eta, ball.ambient_eta);
+    const RandomWalkStack rw(ball), below(flipped_stack(ball));
+    EXPECT_EQ(below.eta_top(), 1.33);
+    EXPECT_EQ(below.eta_bottom(), 1.0);
+    const double ratio2 = sqr(rw.eta_top() / rw.eta_bottom());
+    auto flip = [](const Vec3d& w) { return Vec3d(w.x, w.y, -w.z); };
+    std::uint64_t stream = 0;
+    for (const auto& [wi, wo] : std::vector<std::pair<Vec3d, Vec3d>>{
+             {direction_from_angles(0.3, 0.0), direction_from_angles(0.5, 2.0, Side::Transmission)},
+             {direction_from_angles(1.1, 0.0), direction_from_angles(0.2, 3.0, Side::Transmission)},
+             {direction_from_angles(0.7, 0.0),
+              direction_from_angles(0.6, 3.1, Side::Transmission)}}) {
+        const RandomWalkEstimate a = rw.eval(wi, wo, 40000, 13, ++stream);
+        const RandomWalkEstimate b = below.eval(flip(wo), flip(wi), 40000, 13, ++stream);
+        for (int c = 0; c < 3; ++c) {
+            const double se = std::hypot(a.se[c] * ratio2, b.se[c]);
+            ASSERT_GT(se, 0);
+            EXPECT_LT(std::abs(a.f[c] * ratio2 - b.f[c]), 4.5 * se)  // Šidák, 9 tests at 1e-4
+                << "ch " << c << ": " << a.f[c] * ratio2 << " ± " << a.se[c] * ratio2 << " vs "
+                << b.f[c] << " ± " << b.se[c];
+        }
+    }
+}
+
 // ---- sample() against eval(): the walk's exits, binned, are the bin averages of f --------------
 // E[weight · 1_bin(wo)] = ∫_bin f |cos θo| dωo: the histogram of sample weights (non-delta exits)
 // equals the binned eval (both with standard errors), and the delta exits' total equals the

@@ -63,7 +63,7 @@ double simpson_step(const std::function<double(double)>& f, double a, double b, 
 }
 
 struct Bin {
-    double observed, expected;
+    double observed, expected, variance;
 };
 
 std::string dump_histograms(const std::string& name, int rows, int cols,
@@ -135,7 +135,15 @@ double integrate_cell(const Chi2PdfFn& pdf, double c0, double c1, double p0, dou
         c0, c1, eps);
 }
 
-Chi2Result run_chi2(const Chi2Options& o, const Chi2SampleFn& sample, const Chi2PdfFn& pdf) {
+namespace {
+
+// The expected counts N·mass per cell and the variance of each (0 for quadrature).
+struct Expected {
+    std::vector<double> count, variance;
+};
+
+Chi2Result run_chi2_impl(const Chi2Options& o, const Chi2SampleFn& sample,
+                         const std::function<Expected()>& expected_counts) {
     Chi2Result result;
     const int rows = o.cos_theta_bins, cols = o.phi_bins;
     const double dc = (o.cos_theta_max - o.cos_theta_min) / rows, dp = 2 * kPi<double> / cols;
@@ -181,17 +189,12 @@ Chi2Result run_chi2(const Chi2Options& o, const Chi2SampleFn& sample, const Chi2
         observed[std::size_t(r) * cols + c] += 1;
     }
 
-    // 2. Expected counts: N ∫_cell pdf dω.
-    std::vector<double> expected(observed.size(), 0.0);
-#pragma omp parallel for schedule(dynamic)
-    for (int r = 0; r < rows; ++r) {
-        for (int c = 0; c < cols; ++c) {
-            const double c0 = o.cos_theta_min + r * dc;
-            expected[std::size_t(r) * cols + c] =
-                n * integrate_cell(pdf, c0, c0 + dc, c * dp, (c + 1) * dp, o.cell_tolerance);
-        }
-    }
+    // 2. Expected counts: N ∫_cell pdf dω (and their variances when estimated).
+    const Expected e = expected_counts();
+    const std::vector<double>& expected = e.count;
     result.pdf_integral = std::accumulate(expected.begin(), expected.end(), 0.0) / n;
+    const double variance_sum = std::accumulate(e.variance.begin(), e.variance.end(), 0.0);
+    result.pdf_integral_se = std::sqrt(variance_sum) / n;
     result.absent_fraction = absent / n;
     const double absent_expected = std::max(0.0, n * (1 - result.pdf_integral));
 
@@ -212,7 +215,7 @@ Chi2Result run_chi2(const Chi2Options& o, const Chi2SampleFn& sample, const Chi2
                "integrates to "
             << result.pdf_integral << ". ";
     }
-    if (result.pdf_integral > 1 + 1e-6) {
+    if (result.pdf_integral > 1 + 1e-6 + 5 * result.pdf_integral_se) {
         why << "the pdf integrates to " << result.pdf_integral << " > 1. ";
     }
 
@@ -220,24 +223,25 @@ Chi2Result run_chi2(const Chi2Options& o, const Chi2SampleFn& sample, const Chi2
     std::vector<Bin> bins;
     bins.reserve(observed.size() + 1);
     for (std::size_t i = 0; i < observed.size(); ++i)
-        bins.push_back({observed[i], expected[i]});
-    bins.push_back({absent, absent_expected});
+        bins.push_back({observed[i], expected[i], e.variance[i]});
+    bins.push_back({absent, absent_expected, variance_sum});
     std::sort(bins.begin(), bins.end(),
               [](const Bin& a, const Bin& b) { return a.expected < b.expected; });
     constexpr double kMinExpected = 5;
-    double chi2 = 0, pooled_obs = 0, pooled_exp = 0;
+    double chi2 = 0, pooled_obs = 0, pooled_exp = 0, pooled_var = 0;
     int dof = 0;
     for (const Bin& b : bins) {
         if (b.expected < kMinExpected || (pooled_exp > 0 && pooled_exp < kMinExpected)) {
             pooled_obs += b.observed;
             pooled_exp += b.expected;
+            pooled_var += b.variance;
         } else {
-            chi2 += sqr(b.observed - b.expected) / b.expected;
+            chi2 += sqr(b.observed - b.expected) / (b.expected + b.variance);
             ++dof;
         }
     }
     if (pooled_exp > kZero) {
-        chi2 += sqr(pooled_obs - pooled_exp) / pooled_exp;
+        chi2 += sqr(pooled_obs - pooled_exp) / (pooled_exp + pooled_var);
         ++dof;
     }
     dof -= 1;
@@ -258,6 +262,48 @@ Chi2Result run_chi2(const Chi2Options& o, const Chi2SampleFn& sample, const Chi2
         result.message = o.name + ": " + why.str();
     }
     return result;
+}
+
+}  // namespace
+
+Chi2Result run_chi2(const Chi2Options& o, const Chi2SampleFn& sample, const Chi2PdfFn& pdf) {
+    return run_chi2_impl(o, sample, [&] {
+        const int rows = o.cos_theta_bins, cols = o.phi_bins;
+        const double dc = (o.cos_theta_max - o.cos_theta_min) / rows, dp = 2 * kPi<double> / cols;
+        Expected e{std::vector<double>(std::size_t(rows) * cols, 0.0),
+                   std::vector<double>(std::size_t(rows) * cols, 0.0)};
+#pragma omp parallel for schedule(dynamic)
+        for (int r = 0; r < rows; ++r) {
+            for (int c = 0; c < cols; ++c) {
+                const double c0 = o.cos_theta_min + r * dc;
+                e.count[std::size_t(r) * cols + c] =
+                    double(o.sample_count) *
+                    integrate_cell(pdf, c0, c0 + dc, c * dp, (c + 1) * dp, o.cell_tolerance);
+            }
+        }
+        return e;
+    });
+}
+
+Chi2Result run_chi2_estimated(const Chi2Options& o, const Chi2SampleFn& sample,
+                              const Chi2CellMassFn& cell_mass) {
+    return run_chi2_impl(o, sample, [&] {
+        const int rows = o.cos_theta_bins, cols = o.phi_bins;
+        const double dc = (o.cos_theta_max - o.cos_theta_min) / rows, dp = 2 * kPi<double> / cols;
+        const double n = double(o.sample_count);
+        Expected e{std::vector<double>(std::size_t(rows) * cols, 0.0),
+                   std::vector<double>(std::size_t(rows) * cols, 0.0)};
+#pragma omp parallel for schedule(dynamic)
+        for (int r = 0; r < rows; ++r) {
+            for (int c = 0; c < cols; ++c) {
+                const double c0 = o.cos_theta_min + r * dc;
+                const Chi2CellMass m = cell_mass(r, c, c0, c0 + dc, c * dp, (c + 1) * dp);
+                e.count[std::size_t(r) * cols + c] = n * m.mass;
+                e.variance[std::size_t(r) * cols + c] = n * n * m.variance;
+            }
+        }
+        return e;
+    });
 }
 
 }  // namespace lamina::test

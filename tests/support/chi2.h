@@ -32,6 +32,17 @@
 // 1 − (1 − 0.01)^(1/test_count) (Šidák 1967), so that a suite of test_count independent chi-square
 // tests has an overall false-alarm rate of 1 %.
 //
+// Estimated densities (run_chi2_estimated). A sampler whose density is known only through an
+// unbiased stochastic estimate (the random walk's pdf) gives, per cell, an independent unbiased
+// estimate m̂_j of its mass with the variance v_j of that estimate (e.g. the mean of a pdf
+// estimate at uniformly jittered directions of the cell, times its solid angle). The expected
+// counts Ê_j = N m̂_j are then noisy themselves, independent of the draws, and the Pearson terms
+// become (O_j − Ê_j)²/(Ê_j + N² v_j): Var(O_j − Ê_j) = E_j + N² v_j for the Poisson limit of a
+// cell (the multinomial covariance −N q_j q_k and the absent bin's coupling to the cells are
+// neglected, as Pearson's approximation already does for small cells). The absent bin's mass is
+// 1 − Σ m̂_j with variance Σ v_j; pooled bins add masses and variances. With v_j ≪ E_j/N² (many
+// more estimate walks than draws per cell) this is the plain test.
+//
 // On failure both histograms (observed, expected) are written, as text and as one PGM image (left:
 // observed, right: expected, same scale), to <build>/chi2/<name>.{txt,pgm}; the path is printed.
 
@@ -83,12 +94,28 @@ struct Chi2Result {
     double chi2 = 0, p_value = 0, level = 0;
     int dof = 0;
     double pdf_integral = 0;     ///< P = ∫ pdf over the domain, by quadrature
+    double pdf_integral_se = 0;  ///< its standard error (run_chi2_estimated; 0 otherwise)
     double absent_fraction = 0;  ///< fraction of absent draws
     std::string message;         ///< why it failed, and where the histograms were dumped
 };
 
 /// Runs the test. Use as `const auto r = run_chi2(...); EXPECT_TRUE(r.passed) << r.message;`.
 Chi2Result run_chi2(const Chi2Options& options, const Chi2SampleFn& sample, const Chi2PdfFn& pdf);
+
+/// An unbiased estimate of one cell's probability mass ∫_cell pdf dω, and its variance.
+struct Chi2CellMass {
+    double mass = 0;
+    double variance = 0;
+};
+
+/// Estimates the mass of cell (row, col) = [c0, c1] × [p0, p1] of (cos θ, φ); called once per
+/// cell, from several threads (it must be thread-safe and should key its random numbers by cell).
+using Chi2CellMassFn =
+    std::function<Chi2CellMass(int row, int col, double c0, double c1, double p0, double p1)>;
+
+/// run_chi2 for a density known through per-cell mass estimates (see "Estimated densities").
+Chi2Result run_chi2_estimated(const Chi2Options& options, const Chi2SampleFn& sample,
+                              const Chi2CellMassFn& cell_mass);
 
 /// Regularized upper incomplete gamma Q(a, x) = Γ(a, x)/Γ(a) (Numerical Recipes §6.2, gammq).
 double gamma_q(double a, double x);
