@@ -29,6 +29,7 @@
 #include "core/math.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstring>
 #include <vector>
 
@@ -966,9 +967,16 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
                 hn::Store(v.w[c], df, w_out[c]);
         }
         // Lane order: the particles of the block are handed out in a fixed order.
-        for (std::size_t l = 0; l < n_lanes; ++l) {
+        // (over the set bits of the mask: which lanes ended is random, a branch per lane would
+        // be mispredicted half of the time)
+        std::uint8_t mask_bytes[(kMaxLanes + 7) / 8] = {};
+        hn::StoreMaskBits(df, ended, mask_bytes);
+        std::uint64_t ended_bits = 0;
+        for (std::size_t i = 0; i < (n_lanes + 7) / 8; ++i)
+            ended_bits |= std::uint64_t(mask_bytes[i]) << (8 * i);
+        for (; ended_bits != 0; ended_bits &= ended_bits - 1) {
+            const std::size_t l = std::size_t(std::countr_zero(ended_bits));
             const std::int32_t why = finish[l];
-            if (why == kGoesOn) continue;
             if (why != kEnded) {
                 const Rgbf w(w_out[0][l], w_out[1][l], w_out[2][l]);
                 const std::size_t bin = BinOf(d_out[0][l], d_out[1][l], d_out[2][l], theta_guess[l],
