@@ -249,23 +249,25 @@ HWY_INLINE V3 SampleVisibleNormalCaps(const V3& wi, float alpha, VF u1, VF u2) {
     return Normalize({hn::Mul(a, h.x), hn::Mul(a, h.y), hn::ZeroIfNegative(h.z)});
 }
 
-// √(1 + α² tan²θ) = 1 + 2Λ (microfacet.h smith_root; Heitz 2014, Eq. 72); +∞ at grazing.
-HWY_INLINE VF SmithRoot(const V3& w, float alpha) {
+// |cos θ| · √(1 + α² tan²θ) = √(cos²θ + α² sin²θ) = |cos θ| (1 + 2Λ) (microfacet.h smith_root;
+// Heitz 2014, Eq. 72), without a division; zero at grazing, where 1 + 2Λ is infinite.
+HWY_INLINE VF SmithRootTimesCos(const V3& w, float alpha) {
     const DF df;
     const VF xy2 = hn::MulAdd(w.x, w.x, hn::Mul(w.y, w.y));
-    return hn::Sqrt(
-        hn::MulAdd(hn::Set(df, alpha * alpha), hn::Div(xy2, hn::Mul(w.z, w.z)), hn::Set(df, 1.f)));
+    return hn::Sqrt(hn::MulAdd(hn::Set(df, alpha * alpha), xy2, hn::Mul(w.z, w.z)));
 }
 
-// G2/G1 = (1 + r_i)/(r_i + r_o) (dielectric.h, height-correlated), or G1(wo) = 2/(1 + r_o)
-// (uncorrelated option).
+// G2/G1 = (1 + r_i)/(r_i + r_o) with r = 1 + 2Λ (dielectric.h, height-correlated), multiplied
+// through by |cos θi| |cos θo| to need one division: (|z_i| + s_i)|z_o| / (s_i|z_o| + s_o|z_i|),
+// s = |z| r. Or G1(wo) = 2/(1 + r_o) = 2|z_o|/(|z_o| + s_o) (uncorrelated option). Zero for a
+// grazing wo, as the scalar form.
 HWY_INLINE VF Shadowing(const V3& wi, const V3& wo, float alpha, bool uncorrelated) {
-    const DF df;
-    const VF one = hn::Set(df, 1.f);
-    const VF r_o = SmithRoot(wo, alpha);
-    if (uncorrelated) return hn::Div(hn::Set(df, 2.f), hn::Add(one, r_o));
-    const VF r_i = SmithRoot(wi, alpha);
-    return hn::Div(hn::Add(one, r_i), hn::Add(r_i, r_o));
+    const VF z_o = hn::Abs(wo.z);
+    const VF s_o = SmithRootTimesCos(wo, alpha);
+    if (uncorrelated) return hn::Div(hn::Add(z_o, z_o), hn::Add(z_o, s_o));
+    const VF z_i = hn::Abs(wi.z);
+    const VF s_i = SmithRootTimesCos(wi, alpha);
+    return hn::Div(hn::Mul(hn::Add(z_i, s_i), z_o), hn::MulAdd(s_i, z_o, hn::Mul(s_o, z_i)));
 }
 
 // fresnel.h fresnel_conductor (real-arithmetic complex Fresnel), cos θ in [0, 1].
@@ -303,7 +305,7 @@ struct LaneVectors {
     VF w[3];
     VF depth;  // inside a scattering medium: 0 at its top, 1 at its bottom
     // Flux lost per budget term, summed in float over the lane's recent steps (whatever particle
-    // each step belonged to) and moved into double sums every kFlushSteps steps: a few particles'
+    // each step belonged to) and moved into double sums every kFlushSteps (8) steps: a few particles'
     // worth of float additions at most, rounding-level like the particle's own float arithmetic.
     VF loss[kLossTerms][3];
     VF exit_sum[4][3];  // the same for R, R², T, T² of the particles that left
@@ -361,12 +363,8 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
         // sample_index_matched, with r = 1 + 2Λ).
         wo = v.d;
         if (!iface.is_smooth()) {
-            if (iface.uncorrelated_shadowing) {
-                shadowing = hn::Div(hn::Set(df, 2.f), hn::Add(one, SmithRoot(wi, iface.alpha)));
-            } else {
-                const VF r = SmithRoot(wi, iface.alpha);
-                shadowing = hn::Div(hn::Add(one, r), hn::Add(r, r));
-            }
+            // G2(wi, −wi)/G1(wi) = Shadowing(wi, −wi): (1 + r)/(2r), or G1 = 2/(1 + r).
+            shadowing = Shadowing(wi, v.d, iface.alpha, iface.uncorrelated_shadowing);
         }
     } else {
         // The microfacet normal: drawn for a rough interface, the macro normal for a smooth one
@@ -797,7 +795,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     std::uint64_t degenerate = 0;
     bool left[2] = {false, false};  // some particle was reflected / transmitted in this block
     // Moves the lanes' float sums into the double ones.
-    constexpr int kFlushSteps = 4;
+    constexpr int kFlushSteps = 8;
     int steps_since_flush = 0;
     auto flush = [&] {
         for (int c = 0; c < 3; ++c) {
