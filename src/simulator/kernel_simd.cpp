@@ -283,13 +283,10 @@ HWY_INLINE VF FresnelConductor(VF cos_theta, float eta, float k) {
     const VF a = SafeSqrt(hn::Mul(hn::Set(df, 0.5f), hn::Add(a2b2, t0)));
     const VF t1 = hn::Add(a2b2, cos2);
     const VF t2 = hn::Mul(hn::Mul(hn::Set(df, 2.f), c), a);
-    const VF r_s = hn::Div(hn::Sub(t1, t2), hn::Add(t1, t2));
+    // (R_s + R_p)/2 with R_p = R_s (t3 − t4)/(t3 + t4) is R_s t3/(t3 + t4): one division in all.
     const VF t3 = hn::MulAdd(cos2, a2b2, hn::Mul(sin2, sin2));
     const VF t4 = hn::Mul(t2, sin2);
-    const VF sum34 = hn::Add(t3, t4);
-    const VF r_p = hn::IfThenElse(hn::Gt(sum34, hn::Zero(df)),
-                                  hn::Div(hn::Mul(r_s, hn::Sub(t3, t4)), sum34), r_s);
-    return hn::Mul(hn::Add(r_s, r_p), hn::Set(df, 0.5f));
+    return hn::Div(hn::Mul(hn::Sub(t1, t2), t3), hn::Mul(hn::Add(t1, t2), hn::Add(t3, t4)));
 }
 
 // ---- Lane state ---------------------------------------------------------------------------------
@@ -430,8 +427,12 @@ HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, Lan
     const V3 wo = {hn::MulSub(two_cos, wm.x, wi.x), hn::MulSub(two_cos, wm.y, wi.y),
                    hn::MulSub(two_cos, wm.z, wi.z)};
     VF fresnel[3];
-    for (int c = 0; c < 3; ++c)
-        fresnel[c] = FresnelConductor(cos_i_m, iface.eta[c], iface.k[c]);
+    for (int c = 0; c < 3; ++c) {
+        // Channels with the same index share the computation.
+        const bool same =
+            c > 0 && iface.eta[c] == iface.eta[c - 1] && iface.k[c] == iface.k[c - 1];
+        fresnel[c] = same ? fresnel[c - 1] : FresnelConductor(cos_i_m, iface.eta[c], iface.k[c]);
+    }
     v.Keep(ok, kLossBase, fresnel);
     if (!iface.is_smooth()) {
         const VF shadowing = hn::IfThenElseZero(
