@@ -33,6 +33,12 @@
 #include <cstring>
 #include <vector>
 
+// Lane state is kept in structs of vectors, which the sizeless vector types of SVE cannot be
+// members of: Arm builds use NEON. The scalar fallback target has one lane, too few for the 64-bit
+// halves of the generators; EMU128 (portable C++, four lanes) stands in for it.
+#ifndef HWY_DISABLED_TARGETS
+#define HWY_DISABLED_TARGETS (HWY_SVE | HWY_SVE2 | HWY_SVE_256 | HWY_SVE2_128 | HWY_SCALAR)
+#endif
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "simulator/kernel_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
@@ -138,18 +144,33 @@ HWY_INLINE V64 MulPcg(V64 x) {
 }
 
 // The lanes' generators; one call draws one uniform float per lane, as ParticleRng::uniform_float.
+// The generators live in vectors; state[]/inc[] are where lanes are given new particles (Sync
+// out, patch, Sync in).
 struct LaneRng {
     HWY_ALIGN std::uint64_t state[kMaxLanes];
     HWY_ALIGN std::uint64_t inc[kMaxLanes];
+    V64 state_v[2], inc_v[2];
+
+    HWY_INLINE void SyncIn() {
+        const D64 d64;
+        const std::size_t n64 = hn::Lanes(d64);
+        for (int h = 0; h < 2; ++h) {
+            state_v[h] = hn::Load(d64, state + h * n64);
+            inc_v[h] = hn::Load(d64, inc + h * n64);
+        }
+    }
+    HWY_INLINE void SyncOut() {
+        const D64 d64;
+        const std::size_t n64 = hn::Lanes(d64);
+        for (int h = 0; h < 2; ++h) hn::Store(state_v[h], d64, state + h * n64);
+    }
 
     HWY_INLINE VU NextU32() {
-        const D64 d64;
         const DU du;
-        const std::size_t n64 = hn::Lanes(d64);
         V64 xs[2], rot[2];
         for (int h = 0; h < 2; ++h) {
-            const V64 old = hn::Load(d64, state + h * n64);
-            hn::Store(hn::Add(MulPcg(old), hn::Load(d64, inc + h * n64)), d64, state + h * n64);
+            const V64 old = state_v[h];
+            state_v[h] = hn::Add(MulPcg(old), inc_v[h]);
             // XSH-RR: xorshift by 18, keep bits 27..58, rotate by the top 5 bits.
             xs[h] = hn::ShiftRight<27>(hn::Xor(old, hn::ShiftRight<18>(old)));
             rot[h] = hn::ShiftRight<59>(old);
@@ -775,6 +796,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     };
     for (std::size_t l = 0; l < n_lanes; ++l)
         take_particle(l);
+    rng.SyncIn();
     {
         const MF all = hn::FirstN(df, n_lanes);
         v.live = hn::Zero(di);
@@ -968,6 +990,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         // Lane order: the particles of the block are handed out in a fixed order.
         // (over the set bits of the mask: which lanes ended is random, a branch per lane would
         // be mispredicted half of the time)
+        rng.SyncOut();
         std::uint8_t mask_bytes[(kMaxLanes + 7) / 8] = {};
         hn::StoreMaskBits(df, ended, mask_bytes);
         std::uint64_t ended_bits = 0;
@@ -984,6 +1007,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             }
             take_particle(l);
         }
+        rng.SyncIn();
         restart(ended);
     }
     flush();
@@ -1003,6 +1027,7 @@ std::uint32_t PcgDrawsForTest(std::uint64_t seed, std::uint64_t stream, std::uin
             rng.state[l] = base + l < n_particles ? state[base + l] : 0;
             rng.inc[l] = base + l < n_particles ? inc[base + l] : 1;
         }
+        rng.SyncIn();
         for (std::uint64_t i = 0; i < n_draws; ++i) {
             HWY_ALIGN float u[kMaxLanes];
             hn::Store(rng.Uniform(), DF(), u);
