@@ -274,6 +274,10 @@ const char* kernel_name(Kernel kernel) {
     return kernel == Kernel::Simd ? "simd" : "scalar";
 }
 
+std::string kernel_description(Kernel kernel) {
+    return kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name()) : "scalar";
+}
+
 Kernel parse_kernel(const std::string& text, const std::string& option) {
     if (text == "scalar") return Kernel::Scalar;
     if (text == "simd") return Kernel::Simd;

@@ -33,6 +33,9 @@ inline constexpr std::uint64_t kParticlesPerBlock = 4096;
 /// a given machine; the two agree in distribution (a two-sample chi-square test), not bit for bit.
 enum class Kernel { Scalar, Simd };
 const char* kernel_name(Kernel kernel);
+/// The kernel as it runs on this machine: "scalar", or "simd" with the instruction set dispatched
+/// to (e.g. "simd AVX3"). Tables are bitwise reproducible for equal descriptions.
+std::string kernel_description(Kernel kernel);
 /// "scalar" | "simd" (InputError naming `option` otherwise).
 Kernel parse_kernel(const std::string& text, const std::string& option = "--kernel");
 
@@ -48,7 +51,7 @@ struct SimulationSettings {
     /// First particle index (a simulation may be split into ranges of particles, e.g. across
     /// processes; the union of ranges equals one run of all particles, bit for bit).
     std::uint64_t first_particle = 0;
-    Kernel kernel = Kernel::Scalar;
+    Kernel kernel = Kernel::Simd;
 };
 
 /// Where the flux of an incidence went, per channel; the terms sum to 1 to rounding.

@@ -46,6 +46,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     j["seed"] = s.seed;
     j["first_particle"] = s.first_particle;
     j["max_events"] = s.max_events;
+    j["kernel"] = kernel_description(s.kernel);
     j["threads"] = result.threads_used;
     j["seconds"] = result.seconds;
     j["particles_per_second"] =
