@@ -74,7 +74,7 @@ struct EnergyBudget {
 
 struct IncidenceStats {
     EnergyBudget budget;
-    double events_per_particle = 0;  ///< interface + scattering events, averaged
+    double events_per_particle = 0;        ///< interface + scattering events, averaged
     std::uint64_t degenerate_samples = 0;  ///< numerical degeneracies (counted, flux dropped)
     double seconds = 0;
 };
@@ -108,7 +108,8 @@ struct SimulationResult {
     BinnedTable table;  ///< reflection, and transmission when the stack transmits
     std::vector<IncidenceStats> incidences;
     double seconds = 0;
-    int threads_used = 1;
+    int threads_used = 1;  ///< per process
+    int processes = 1;     ///< processes that shared the particles (distributed/split_simulation.h)
 };
 
 /// Checks settings (InputError naming the option and the allowed range).
@@ -124,8 +125,8 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
 SimulationResult finalize_simulation(const Stack& stack, const SimulationSettings& settings,
                                      const SimulationSums& sums);
 
-/// Runs the goniophotometer: simulate_sums then finalize_simulation. `on_progress(particles_done)` is called from worker threads (may be
-/// empty). Settings must be valid (validate_settings).
+/// Runs the goniophotometer: simulate_sums then finalize_simulation. `on_progress(particles_done)`
+/// is called from worker threads (may be empty). Settings must be valid (validate_settings).
 SimulationResult simulate(const Stack& stack, const SimulationSettings& settings,
                           const std::function<void(std::uint64_t)>& on_progress = {});
 

@@ -11,7 +11,9 @@ namespace lamina {
 namespace {
 constexpr const char* kChannels[3] = {"r", "g", "b"};
 
-nlohmann::json rgb_json(const Rgbd& v) { return nlohmann::json::array({v[0], v[1], v[2]}); }
+nlohmann::json rgb_json(const Rgbd& v) {
+    return nlohmann::json::array({v[0], v[1], v[2]});
+}
 }  // namespace
 
 std::string energy_csv(const SimulationResult& result) {
@@ -45,6 +47,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     j["first_particle"] = s.first_particle;
     j["max_events"] = s.max_events;
     j["threads"] = result.threads_used;
+    j["processes"] = result.processes;
     j["seconds"] = result.seconds;
     j["particles_per_second"] =
         result.seconds > 0 ? double(s.particles) * double(s.theta_i_deg.size()) / result.seconds
@@ -53,7 +56,8 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     for (std::size_t i = 0; i < result.incidences.size(); ++i) {
         const IncidenceStats& st = result.incidences[i];
         nlohmann::json budget;
-        for (int t = 0; t < kBudgetTerms; ++t) budget[kBudgetTermNames[t]] = rgb_json(st.budget.term[t]);
+        for (int t = 0; t < kBudgetTerms; ++t)
+            budget[kBudgetTermNames[t]] = rgb_json(st.budget.term[t]);
         budget["reflected_se"] = rgb_json(st.budget.reflected_se);
         budget["transmitted_se"] = rgb_json(st.budget.transmitted_se);
         budget["sum"] = rgb_json(st.budget.sum());
