@@ -111,14 +111,23 @@ std::size_t share_reference_pieces(Communicator& comm, const std::filesystem::pa
         }
     }
     // 3. The root waits for the rest; the others for the root to have received everything.
+    std::size_t computed = 0;
+    for (std::size_t i = rank; i < work.size(); i += size)
+        ++computed;
     if (comm.is_root()) {
-        const std::size_t own = (work.size() + size - 1) / size;
-        while (received < work.size() - own)
+        while (received < work.size() - computed)
             store(*comm.receive_at_root(true));
         progress->finish();
     } else {
         comm.flush_posts();
     }
+    // 4. Every piece once: the ranks' counts add up to the list (a check, cheap).
+    std::size_t total = 0;
+    for (const std::string& count : comm.gather(std::to_string(computed)))
+        total += std::stoull(count);
+    if (comm.is_root() && total != work.size())
+        comm.abort(fmt::format("internal error: {} reference pieces computed for {} listed", total,
+                               work.size()));
     return comm.is_root() ? work.size() : 0;
 }
 
