@@ -7,7 +7,9 @@ packages=(
   build-essential cmake pkg-config git
   libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  librandom123-dev libpcg-cpp-dev libomp-dev libpng-dev libopenexr-dev libhwy-dev
+  librandom123-dev libpcg-cpp-dev libomp-dev libpng-dev libopenexr-dev
+  libhwy-dev                                 # the SIMD kernel (Google Highway)
+  libopenmpi-dev openmpi-bin                 # mpirun -n K lamina simulate|study (docs/scaling.md)
   python3 python3-numpy python3-matplotlib   # lamina figures (scripts/figures.py)
   chromium fonts-dejavu-core                 # the explorer's browser test (tests/report)
 )

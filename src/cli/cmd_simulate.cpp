@@ -1,16 +1,22 @@
 // lamina simulate STACK.json --theta-i 0,30,60 --particles 1e7 [--seed S] [--threads T]
 //                 [--grid 90x90] --out DIR
+// Under `mpirun -n K` the particles are split over K processes (docs/scaling.md).
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "core/atomic_file.h"
 #include "core/progress.h"
+#include "distributed/communicator.h"
+#include "distributed/split_simulation.h"
 #include "layers/stack.h"
 #include "simulator/goniophotometer.h"
 #include "simulator/output.h"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
+#include <functional>
 #include <memory>
+#include <optional>
 
 namespace lamina::cli {
 
@@ -39,7 +45,9 @@ Runner add_simulate(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--out,-o", a->out, "Output folder")->required();
     return [a] {
-        const Stack stack = load_stack(a->stack);
+        // Under mpirun every process runs this; the particles are split over them
+        // (distributed/split_simulation.h) and only the root reads the stack and writes.
+        Communicator& world = Communicator::world();
         SimulationSettings s;
         s.theta_i_deg = parse_incidences(a->theta_i, "--theta-i");
         s.particles = parse_count(a->particles, "--particles");
@@ -48,12 +56,33 @@ Runner add_simulate(CLI::App& app) {
         s.grid = HemisphereGrid::parse(a->grid);
         s.max_events = a->max_events;
         validate_settings(s);
-        StagedOutput probe(a->out);  // fails now, not after the run, if DIR is not writable
-        Progress progress(fmt::format("simulate {}", stack.name), "particles",
-                          s.particles * s.theta_i_deg.size());
-        const SimulationResult result =
-            simulate(stack, s, [&](std::uint64_t n) { progress.advance(n); });
-        progress.finish();
+        if (world.distributed() && s.threads == 0) s.threads = default_threads_per_process(world);
+        // The root reads the stack and sends its canonical JSON to the others (no shared file
+        // system is assumed); stack_from_json(stack_to_json(s)) == s.
+        Stack stack;
+        std::string stack_text;
+        std::unique_ptr<StagedOutput> probe;
+        if (world.is_root()) {
+            stack = load_stack(a->stack);
+            stack_text = stack_to_json(stack).dump();
+            // Fails now, not after the run, if DIR is not writable.
+            probe = std::make_unique<StagedOutput>(a->out);
+        }
+        world.broadcast(stack_text);
+        if (!world.is_root()) stack = stack_from_json(nlohmann::json::parse(stack_text), a->stack);
+        // Progress of this process's share, drawn by the root only.
+        std::unique_ptr<Progress> progress;
+        std::function<void(std::uint64_t)> on_progress;
+        if (world.is_root()) {
+            const ParticleRange mine = particle_range(s.particles, world.rank(), world.size());
+            progress = std::make_unique<Progress>(fmt::format("simulate {}", stack.name),
+                                                  "particles", mine.count * s.theta_i_deg.size());
+            on_progress = [&](std::uint64_t n) { progress->advance(n); };
+        }
+        const std::optional<SimulationResult> split = simulate_split(world, stack, s, on_progress);
+        if (!split) return 0;  // not the root: its sums went to the root
+        const SimulationResult& result = *split;
+        progress->finish();
         write_simulation(a->out, stack, result);
         for (std::size_t i = 0; i < result.incidences.size(); ++i) {
             const EnergyBudget& b = result.incidences[i].budget;
@@ -62,10 +91,12 @@ Runner add_simulate(CLI::App& app) {
                        format_rgb(b[BudgetTerm::LostMicrosurface]),
                        format_rgb(b[BudgetTerm::AbsorbedMedium] + b[BudgetTerm::AbsorbedBase]));
         }
-        fmt::print(
-            "{:.3g} particles/s on {} threads; wrote {}/{{result.json,brdf.csv,energy.csv}}\n",
-            double(s.particles * s.theta_i_deg.size()) / result.seconds, result.threads_used,
-            a->out);
+        const std::string workers =
+            result.processes > 1
+                ? fmt::format("{} processes × {} threads", result.processes, result.threads_used)
+                : fmt::format("{} threads", result.threads_used);
+        fmt::print("{:.3g} particles/s on {}; wrote {}/{{result.json,brdf.csv,energy.csv}}\n",
+                   double(s.particles * s.theta_i_deg.size()) / result.seconds, workers, a->out);
         return 0;
     };
 }

@@ -1,14 +1,17 @@
 // lamina study [--preset quick|standard|paper] [--only PATTERN] [--models …] [--configs FILE]
 //              [--out DIR]: the 60 configurations (or a user's list) against every model.
+//              Under `mpirun -n K` the reference is spread over K processes (docs/scaling.md).
 // lamina compare STACK.json [--theta-i …] [--particles N] [--models …] --out DIR: one stack.
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "distributed/communicator.h"
 #include "render/contact_sheet.h"
 #include "report/explorer.h"
 #include "report/figures.h"
 #include "study/configurations.h"
+#include "study/distributed_reference.h"
 #include "study/study.h"
 
 #include <fmt/format.h>
@@ -114,13 +117,35 @@ Runner add_study(CLI::App& app) {
     cmd->add_option("--render-spp", a->render_spp, "Samples per pixel (default 32)")
         ->check(CLI::Range(1, 1 << 20));
     return [a] {
+        // Under mpirun every process runs this: the reference pieces are spread over them
+        // (study/distributed_reference.h); the root alone reads the inputs, then runs the rest
+        // of the study (models, metrics, report) on the cached pieces.
+        Communicator& world = Communicator::world();
         const StudySettings s = settings_from(*a, a->preset);
-        auto configs =
-            a->configs.empty() ? builtin_configurations() : load_configurations(a->configs);
-        configs = filter_configurations(std::move(configs), a->only);
+        std::vector<StudyConfiguration> configs;
         const std::filesystem::path out =
             a->out.empty() ? std::filesystem::path("out") / ("study-" + a->preset)
                            : std::filesystem::path(a->out);
+        if (world.is_root()) {
+            configs =
+                a->configs.empty() ? builtin_configurations() : load_configurations(a->configs);
+            configs = filter_configurations(std::move(configs), a->only);
+        }
+        if (world.distributed()) {
+            std::vector<ReferenceKey> keys;
+            if (world.is_root()) {
+                study_models(s);          // validates --models before any work
+                StagedOutput probe(out);  // and the output folder
+                keys = study_reference_keys(configs, s);
+            }
+            const int threads = s.threads > 0 ? s.threads : default_threads_per_process(world);
+            const std::size_t computed = share_reference_pieces(
+                world, world.is_root() ? reference_cache_dir(out) : std::filesystem::path(), keys,
+                threads);
+            if (!world.is_root()) return 0;
+            fmt::print("Reference: {} pieces computed over {} processes × {} threads\n", computed,
+                       world.size(), threads);
+        }
         run_study(configs, s, out);
         if (a->render) {
             // Renderings of every configuration: reproducible (seed), the same settings for all.

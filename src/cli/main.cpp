@@ -1,12 +1,14 @@
 // lamina command-line interface: one subcommand per cmd_*.cpp, registered in the table below.
 #include "cli/commands.h"
 #include "core/error.h"
+#include "distributed/communicator.h"
 #include "lamina/version.h"
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
 #include <exception>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -32,15 +34,30 @@ int main(int argc, char** argv) {
     add(lamina::cli::add_figures);
 
     CLI11_PARSE(app, argc, argv);
+    // Under an MPI launcher every process gets here; an error on any of them ends them all
+    // (distributed/communicator.h), so that none waits forever for the others.
+    lamina::Communicator* world = nullptr;
+    auto fail = [&](const std::string& message) {
+        if (world && world->distributed()) world->abort(message);
+        fmt::print(stderr, "lamina: {}\n", message);
+        return 1;
+    };
     try {
-        for (auto& [sub, run] : commands)
-            if (sub->parsed()) return run();
+        world = &lamina::Communicator::world();
+        for (auto& [sub, run] : commands) {
+            if (!sub->parsed()) continue;
+            if (world->distributed() && sub->get_name() != "simulate" && sub->get_name() != "study")
+                throw lamina::InputError(
+                    "command line", sub->get_name(),
+                    fmt::format("runs in one process, not {}: only simulate and study are "
+                                "spread over processes (mpirun -n K)",
+                                world->size()));
+            return run();
+        }
     } catch (const lamina::InputError& e) {
-        fmt::print(stderr, "lamina: {}\n", e.what());
-        return 1;
+        return fail(e.what());
     } catch (const std::exception& e) {
-        fmt::print(stderr, "lamina: error: {}\n", e.what());
-        return 1;
+        return fail(fmt::format("error: {}", e.what()));
     }
     return 0;
 }

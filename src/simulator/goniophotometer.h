@@ -111,7 +111,8 @@ struct SimulationResult {
     BinnedTable table;  ///< reflection, and transmission when the stack transmits
     std::vector<IncidenceStats> incidences;
     double seconds = 0;
-    int threads_used = 1;
+    int threads_used = 1;  ///< per process
+    int processes = 1;     ///< processes that shared the particles (distributed/split_simulation.h)
 };
 
 /// Checks settings (InputError naming the option and the allowed range).

@@ -48,6 +48,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     j["max_events"] = s.max_events;
     j["kernel"] = kernel_description(s.kernel);
     j["threads"] = result.threads_used;
+    j["processes"] = result.processes;
     j["seconds"] = result.seconds;
     j["particles_per_second"] =
         result.seconds > 0 ? double(s.particles) * double(s.theta_i_deg.size()) / result.seconds

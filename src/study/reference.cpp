@@ -152,16 +152,16 @@ std::uint64_t second_half_seed(std::uint64_t seed) {
     return seed + 0x9e3779b97f4a7c15ull;
 }
 
-ReferencePiece reference_piece(const std::filesystem::path& cache_dir, const ReferenceKey& key,
-                               int threads, const std::function<void(std::uint64_t)>& on_progress,
-                               bool* computed) {
-    const std::filesystem::path dir = cache_dir / key.config_id;
-    const std::filesystem::path file = dir / key.file_name();
+std::optional<ReferencePiece> load_reference_piece(const std::filesystem::path& cache_dir,
+                                                   const ReferenceKey& key) {
+    const std::filesystem::path file = cache_dir / key.config_id / key.file_name();
     ReferencePiece piece;
-    if (std::filesystem::exists(file) && deserialize(read_file(file), key, piece)) {
-        if (computed) *computed = false;
-        return piece;
-    }
+    if (std::filesystem::exists(file) && deserialize(read_file(file), key, piece)) return piece;
+    return std::nullopt;
+}
+
+std::string compute_reference_piece(const ReferenceKey& key, int threads,
+                                    const std::function<void(std::uint64_t)>& on_progress) {
     // Two halves with different seeds; the same stream (the incidence) in each.
     SimulationSettings s;
     s.theta_i_deg = {key.theta_i_deg};
@@ -177,6 +177,7 @@ ReferencePiece reference_piece(const std::filesystem::path& cache_dir, const Ref
     const std::uint64_t n_b = s.particles;
     const double wa = double(n_a) / double(key.particles), wb = double(n_b) / double(key.particles);
 
+    ReferencePiece piece;
     piece.has_transmission = a.table.has_transmission;
     piece.seconds = a.seconds + b.seconds;
     for (int side = 0; side < (piece.has_transmission ? 2 : 1); ++side) {
@@ -202,14 +203,34 @@ ReferencePiece reference_piece(const std::filesystem::path& cache_dir, const Ref
         piece.budget.transmitted_se[c] =
             std::hypot(wa * ba.transmitted_se[c], wb * bb.transmitted_se[c]);
     }
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    const std::string bytes = serialize(key, piece);
-    write_file_atomic(file, bytes);
+    return serialize(key, piece);
+}
+
+ReferencePiece store_reference_piece(const std::filesystem::path& cache_dir,
+                                     const ReferenceKey& key, const std::string& bytes) {
     // Return exactly what a later run will read back (float32 tables), so that a resumed study
     // computes the same metrics as an uninterrupted one.
     ReferencePiece stored;
-    deserialize(bytes, key, stored);
+    if (!deserialize(bytes, key, stored))
+        throw InputError(key.config_id, key.file_name(),
+                         "the computed reference piece does not match its key (a process of a "
+                         "different lamina version?)");
+    const std::filesystem::path dir = cache_dir / key.config_id;
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    write_file_atomic(dir / key.file_name(), bytes);
+    return stored;
+}
+
+ReferencePiece reference_piece(const std::filesystem::path& cache_dir, const ReferenceKey& key,
+                               int threads, const std::function<void(std::uint64_t)>& on_progress,
+                               bool* computed) {
+    if (std::optional<ReferencePiece> cached = load_reference_piece(cache_dir, key)) {
+        if (computed) *computed = false;
+        return *cached;
+    }
+    ReferencePiece stored =
+        store_reference_piece(cache_dir, key, compute_reference_piece(key, threads, on_progress));
     if (computed) *computed = true;
     return stored;
 }

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,19 @@ struct ReferencePiece {
 ReferencePiece reference_piece(const std::filesystem::path& cache_dir, const ReferenceKey& key,
                                int threads, const std::function<void(std::uint64_t)>& on_progress,
                                bool* computed = nullptr);
+
+/// The pieces of reference_piece, for callers that compute and store in different places (a
+/// study spread over processes, study/distributed_reference.h):
+/// the piece for `key` if `cache_dir` holds it intact, else empty;
+std::optional<ReferencePiece> load_reference_piece(const std::filesystem::path& cache_dir,
+                                                   const ReferenceKey& key);
+/// simulates the piece and returns the bytes its cache file holds (no file is touched);
+std::string compute_reference_piece(const ReferenceKey& key, int threads,
+                                    const std::function<void(std::uint64_t)>& on_progress);
+/// stores those bytes into `cache_dir` atomically and returns the piece as a later run reads it
+/// back. InputError if the bytes are not a piece of `key`.
+ReferencePiece store_reference_piece(const std::filesystem::path& cache_dir,
+                                     const ReferenceKey& key, const std::string& bytes);
 
 /// The seed of the second half, derived from the study's seed.
 std::uint64_t second_half_seed(std::uint64_t seed);

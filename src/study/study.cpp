@@ -46,7 +46,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     std::vector<ReferencePiece> pieces;
     for (double theta_i : s.theta_i_deg) {
         ReferenceKey key{config.id, config.stack, theta_i, s.particles, s.seed, grid};
-        pieces.push_back(reference_piece(out_dir / "cache" / "reference", key, s.threads,
+        pieces.push_back(reference_piece(reference_cache_dir(out_dir), key, s.threads,
                                          [&](std::uint64_t n) { progress.advance(n); }));
     }
     const bool transmits = pieces.front().has_transmission;
@@ -205,14 +205,23 @@ std::string metrics_csv(const std::vector<MetricRow>& rows) {
     return out;
 }
 
-std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
-                                 const StudySettings& s, const std::filesystem::path& out_dir) {
+std::vector<std::string> study_models(const StudySettings& s) {
     std::vector<std::string> model_names = s.models;
     if (model_names.empty())
         for (const ModelEntry& e : model_registry())
             if (!e.stochastic) model_names.push_back(e.name);
     for (const std::string& name : model_names)
         find_model(name, "--models");  // validates
+    return model_names;
+}
+
+std::filesystem::path reference_cache_dir(const std::filesystem::path& out_dir) {
+    return out_dir / "cache" / "reference";
+}
+
+std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
+                                 const StudySettings& s, const std::filesystem::path& out_dir) {
+    const std::vector<std::string> model_names = study_models(s);
 
     StagedOutput probe(out_dir);  // the folder must be writable before any work starts
     const auto start = std::chrono::steady_clock::now();

@@ -44,6 +44,13 @@ inline constexpr const char* kMetricsCsvHeader =
     "config,category,model,theta_i,side,channel,misplaced_energy,albedo_ref,albedo_model,"
     "albedo_error,rmse,log_rmse,noise_floor,supported";
 
+/// The models the study compares: settings.models, or every deterministic model of the registry
+/// when empty. InputError naming --models for a name the registry lacks.
+std::vector<std::string> study_models(const StudySettings& settings);
+
+/// Where a study in `out_dir` keeps its reference pieces (study/reference.h).
+std::filesystem::path reference_cache_dir(const std::filesystem::path& out_dir);
+
 /// Runs (or resumes) the study into `out_dir`; returns the metric rows it wrote. Progress with an
 /// overall ETA goes to stderr when it is a terminal.
 std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
