@@ -23,6 +23,7 @@ namespace lamina::cli {
 namespace {
 struct SimulateArgs {
     std::string stack, theta_i = "0,15,30,45,60,70,80", particles = "1e6", grid = "90x90", out;
+    std::string kernel = "simd";
     std::uint64_t seed = 1;
     int threads = 0, max_events = 10000;
 };
@@ -43,6 +44,10 @@ Runner add_simulate(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--max-events", a->max_events, "Safety cap on events per particle")
         ->capture_default_str();
+    cmd->add_option("--kernel", a->kernel,
+                    "Particle kernel: simd (vectorized, runtime dispatch) or scalar (reference "
+                    "path); tables are reproducible per kernel")
+        ->capture_default_str();
     cmd->add_option("--out,-o", a->out, "Output folder")->required();
     return [a] {
         // Under mpirun every process runs this; the particles are split over them
@@ -53,6 +58,7 @@ Runner add_simulate(CLI::App& app) {
         s.particles = parse_count(a->particles, "--particles");
         s.seed = a->seed;
         s.threads = a->threads;
+        s.kernel = parse_kernel(a->kernel);
         s.grid = HemisphereGrid::parse(a->grid);
         s.max_events = a->max_events;
         validate_settings(s);

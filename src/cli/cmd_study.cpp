@@ -27,6 +27,7 @@ namespace {
 
 struct CommonArgs {
     std::string theta_i = "0,15,30,45,60,70,80", particles, grid = "90x90", models, out;
+    std::string kernel = "simd";
     std::uint64_t seed = 1;
     int threads = 0;
     bool no_figures = false;
@@ -41,6 +42,9 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
     cmd->add_option("--seed", a.seed, "Random seed")->capture_default_str();
     cmd->add_option("--threads", a.threads, "Threads (0 = all cores)")->capture_default_str();
     cmd->add_option("--grid", a.grid, "Bins NTHETAxNPHI")->capture_default_str();
+    cmd->add_option("--kernel", a.kernel,
+                    "Particle kernel of the reference: simd (vectorized) or scalar")
+        ->capture_default_str();
     cmd->add_flag("--no-figures", a.no_figures,
                   "Skip the paper figures (the explorer page is always written)");
 }
@@ -53,6 +57,7 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
     s.preset = a.particles.empty() ? preset : "custom";
     s.seed = a.seed;
     s.threads = a.threads;
+    s.kernel = parse_kernel(a.kernel);
     s.theta_i_deg = parse_incidences(a.theta_i, "--theta-i");
     s.grid = HemisphereGrid::parse(a.grid);
     if (!a.models.empty()) {

@@ -21,6 +21,7 @@ nlohmann::json key_json(const ReferenceKey& key) {
             {"particles", key.particles},
             {"seed", key.seed},
             {"grid", key.grid.to_string()},
+            {"kernel", kernel_name(key.kernel)},
             {"canonical", key.canonical()}};
 }
 
@@ -30,7 +31,8 @@ ReferenceKey key_from_json(const nlohmann::json& j) {
                      j.at("theta_i").get<double>(),
                      j.at("particles").get<std::uint64_t>(),
                      j.at("seed").get<std::uint64_t>(),
-                     HemisphereGrid::parse(j.at("grid").get<std::string>())};
+                     HemisphereGrid::parse(j.at("grid").get<std::string>()),
+                     parse_kernel(j.at("kernel").get<std::string>(), "reference work list")};
     if (key.canonical() != j.at("canonical").get<std::string>())
         throw InputError("reference work list", key.config_id,
                          "this process describes the piece differently from the root: are all "
@@ -59,7 +61,8 @@ std::vector<ReferenceKey> study_reference_keys(const std::vector<StudyConfigurat
     std::vector<ReferenceKey> keys;
     for (const StudyConfiguration& config : configs)
         for (double theta_i : s.theta_i_deg)
-            keys.push_back({config.id, config.stack, theta_i, s.particles, s.seed, s.grid});
+            keys.push_back(
+                {config.id, config.stack, theta_i, s.particles, s.seed, s.grid, s.kernel});
     return keys;
 }
 

@@ -27,6 +27,9 @@ struct ReferenceKey {
     std::uint64_t particles = 0;  ///< in all, both halves together
     std::uint64_t seed = 1;
     HemisphereGrid grid;
+    /// The particle kernel; its description (with the SIMD instruction set) is part of the key,
+    /// since tables are bitwise reproducible per kernel description only.
+    Kernel kernel = Kernel::Simd;
 
     /// A canonical text of every field (and lamina's version) and its 64-bit FNV-1a hash.
     std::string canonical() const;

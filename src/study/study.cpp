@@ -45,7 +45,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     // 1. The reference, one resumable piece per incidence.
     std::vector<ReferencePiece> pieces;
     for (double theta_i : s.theta_i_deg) {
-        ReferenceKey key{config.id, config.stack, theta_i, s.particles, s.seed, grid};
+        ReferenceKey key{config.id, config.stack, theta_i, s.particles, s.seed, grid, s.kernel};
         pieces.push_back(reference_piece(reference_cache_dir(out_dir), key, s.threads,
                                          [&](std::uint64_t n) { progress.advance(n); }));
     }
@@ -248,6 +248,7 @@ std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
     sj["preset"] = s.preset;
     sj["particles"] = s.particles;
     sj["seed"] = s.seed;
+    sj["kernel"] = kernel_description(s.kernel);
     sj["theta_i"] = s.theta_i_deg;
     sj["grid"] = {{"n_theta", s.grid.n_theta()}, {"n_phi", s.grid.n_phi()}};
     sj["models"] = model_names;

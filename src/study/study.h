@@ -4,6 +4,7 @@
 // compared by the study's metrics. Writes the study directory of docs/formats.md.
 
 #include "core/grid.h"
+#include "simulator/goniophotometer.h"
 #include "study/configurations.h"
 #include "study/metrics.h"
 
@@ -22,6 +23,7 @@ struct StudySettings {
     HemisphereGrid grid{90, 90};
     std::vector<std::string> models;  ///< registry names; empty: every model
     int threads = 0;                  ///< 0: all cores
+    Kernel kernel = Kernel::Simd;     ///< the reference's particle kernel
     bool quiet = false;               ///< no per-configuration lines on stdout
 };
 
