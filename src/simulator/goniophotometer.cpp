@@ -304,6 +304,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
     const TraceStack trace(stack);
     const HemisphereGrid& grid = settings.grid;
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
+    if (settings.kernel == Kernel::Simd) select_simd_target();
     const auto trace_block =
         settings.kernel == Kernel::Simd ? trace_block_simd : trace_block_scalar;
 

@@ -26,18 +26,23 @@
 
 #include "simulator/kernel_simd.h"
 
+#include "core/error.h"
 #include "core/math.h"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <bit>
+#include <cstdlib>
 #include <cstring>
+#include <string>
 #include <vector>
 
 // Lane state is kept in structs of vectors, which the sizeless vector types of SVE cannot be
 // members of: Arm builds use NEON. The scalar fallback target has one lane, too few for the 64-bit
 // halves of the generators; EMU128 (portable C++, four lanes) stands in for it.
 #ifndef HWY_DISABLED_TARGETS
-#define HWY_DISABLED_TARGETS (HWY_SVE | HWY_SVE2 | HWY_SVE_256 | HWY_SVE2_128 | HWY_SCALAR)
+#define HWY_DISABLED_TARGETS (HWY_SVE | HWY_SVE2 | HWY_SVE_256 | HWY_SVE2_128)
 #endif
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "simulator/kernel_simd.cpp"
@@ -162,7 +167,8 @@ struct LaneRng {
     HWY_INLINE void SyncOut() {
         const D64 d64;
         const std::size_t n64 = hn::Lanes(d64);
-        for (int h = 0; h < 2; ++h) hn::Store(state_v[h], d64, state + h * n64);
+        for (int h = 0; h < 2; ++h)
+            hn::Store(state_v[h], d64, state + h * n64);
     }
 
     HWY_INLINE VU NextU32() {
@@ -323,8 +329,9 @@ struct LaneVectors {
     VF w[3];
     VF depth;  // inside a scattering medium: 0 at its top, 1 at its bottom
     // Flux lost per budget term, summed in float over the lane's recent steps (whatever particle
-    // each step belonged to) and moved into double sums every kFlushSteps (8) steps: a few particles'
-    // worth of float additions at most, rounding-level like the particle's own float arithmetic.
+    // each step belonged to) and moved into double sums every kFlushSteps (8) steps: a few
+    // particles' worth of float additions at most, rounding-level like the particle's own float
+    // arithmetic.
     VF loss[kLossTerms][3];
     VF exit_sum[4][3];  // the same for R, R², T, T² of the particles that left
     VI events_done;     // events of the lane's ended particles
@@ -450,8 +457,7 @@ HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, Lan
     VF fresnel[3];
     for (int c = 0; c < 3; ++c) {
         // Channels with the same index share the computation.
-        const bool same =
-            c > 0 && iface.eta[c] == iface.eta[c - 1] && iface.k[c] == iface.k[c - 1];
+        const bool same = c > 0 && iface.eta[c] == iface.eta[c - 1] && iface.k[c] == iface.k[c - 1];
         fresnel[c] = same ? fresnel[c - 1] : FresnelConductor(cos_i_m, iface.eta[c], iface.k[c]);
     }
     v.Keep(ok, kLossBase, fresnel);
@@ -1071,7 +1077,32 @@ void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
 }
 
+void select_simd_target() {
+    static const bool done = [] {
+        const char* wanted = std::getenv("LAMINA_SIMD_TARGET");
+        if (wanted == nullptr || *wanted == '\0') return true;
+        std::string names;
+        // Targets are bits, better ones lower: keep the wanted one and those below it.
+        for (std::int64_t targets = HWY_TARGETS; targets != 0; targets &= targets - 1) {
+            const std::int64_t bit = targets & -targets;
+            if (std::string(hwy::TargetName(bit)) == wanted) {
+                if ((hwy::SupportedTargets() & bit) == 0)
+                    throw InputError("environment", "LAMINA_SIMD_TARGET",
+                                     fmt::format("this CPU does not support {}", wanted));
+                hwy::DisableTargets(HWY_TARGETS & (bit - 1));
+                return true;
+            }
+            names += fmt::format("{}{}", names.empty() ? "" : ", ", hwy::TargetName(bit));
+        }
+        throw InputError(
+            "environment", "LAMINA_SIMD_TARGET",
+            fmt::format("'{}' is not an instruction set of this build ({})", wanted, names));
+    }();
+    (void)done;
+}
+
 const char* simd_target_name() {
+    select_simd_target();
     // Dynamic dispatch picks the best target that is both compiled and supported: the lowest bit.
     const std::int64_t targets = hwy::SupportedTargets() & HWY_TARGETS;
     return hwy::TargetName(targets & -targets);

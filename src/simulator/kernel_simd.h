@@ -21,7 +21,14 @@ std::vector<float> simd_particle_uniforms(std::uint64_t seed, std::uint64_t stre
 /// For tests: the kernel's azimuth cos(2πu), sin(2πu) for u in [0, 1).
 void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::vector<float>& s);
 
-/// The instruction set the SIMD kernel dispatches to on this machine (e.g. "AVX3_ZEN4").
+/// Applies LAMINA_SIMD_TARGET (an instruction set name as simd_target_name prints it, e.g. AVX2 or
+/// SSE4), which caps the dispatch at that set: the way to reproduce another machine's tables, or to
+/// test every compiled set on one machine. Once per process; InputError for an unknown or
+/// unsupported name.
+void select_simd_target();
+
+/// The instruction set the SIMD kernel dispatches to on this machine (e.g. "AVX3"), after
+/// LAMINA_SIMD_TARGET.
 const char* simd_target_name();
 
 }  // namespace lamina

@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <string>
 
 namespace lamina {
 namespace {
@@ -31,6 +33,14 @@ TEST(KernelSimd, LanesDrawTheParticlesOwnNumbers) {
             ASSERT_EQ(lanes[p * n_draws + i], rng.uniform_float())
                 << "particle " << first + p << ", draw " << i;
     }
+}
+
+// LAMINA_SIMD_TARGET (set by ctest's simd_AVX2 and simd_SSE4 runs) picks the instruction set.
+TEST(KernelSimd, RunsOnTheRequestedInstructionSet) {
+    const char* wanted = std::getenv("LAMINA_SIMD_TARGET");
+    if (wanted == nullptr) GTEST_SKIP() << "LAMINA_SIMD_TARGET is not set";
+    EXPECT_EQ(std::string(simd_target_name()), wanted);
+    EXPECT_EQ(kernel_description(Kernel::Simd), std::string("simd ") + wanted);
 }
 
 // cos and sin of 2πu against double precision for every 2^-18 step of u and around every octant
