@@ -683,9 +683,25 @@ using DL = hn::RebindToSigned<DD>;
 using VD = hn::Vec<DD>;
 using VL = hn::Vec<DL>;
 
+// A particle past its first event, waiting for a lane.
+struct Waiting {
+    float d[3], w[3], depth;
+    std::int32_t k, in_medium, events;
+    std::uint64_t state, inc;
+};
+using Queue = std::vector<Waiting>;
+
 struct Scratch {
     std::vector<std::uint64_t> state, inc;
+    Queue queue;
+    void resize(std::size_t n) {
+        state.resize(n);
+        inc.resize(n);
+        queue.reserve(n);
+    }
 };
+
+constexpr int kFlushSteps = 8;  // steps between moves of the lanes' float sums to double
 
 // Per-lane double sums of what ended particles carry (budget terms, R and T with their squares)
 // and their event counts; reduced in lane order at the end of the block.
@@ -758,75 +774,20 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     const TraceStack& stack = *job.stack;
     const HemisphereGrid& grid = *job.grid;
     const int n_layers = int(stack.layers.size());
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
 
     thread_local Scratch scratch;
-    scratch.state.resize(job.count);
-    scratch.inc.resize(job.count);
+    scratch.resize(job.count);
     SeedParticles(job.seed, job.stream, job.first, job.count, scratch.state.data(),
                   scratch.inc.data());
 
-    LaneRng rng;
-    HWY_ALIGN std::int32_t live[kMaxLanes];
-    HWY_ALIGN std::int32_t finish[kMaxLanes];
-    HWY_ALIGN float w_out[3][kMaxLanes];
-    HWY_ALIGN std::int32_t theta_guess[kMaxLanes], phi_guess[kMaxLanes];
-    HWY_ALIGN float d_out[3][kMaxLanes];
-    std::uint64_t next = 0;  // the block's next particle
-    // Gives lane l the block's next particle's generator, or retires it when none is left.
-    auto take_particle = [&](std::size_t l) {
-        if (next < job.count) {
-            rng.state[l] = scratch.state[next];
-            rng.inc[l] = scratch.inc[next];
-            live[l] = 1;
-            ++next;
-        } else {
-            rng.state[l] = 0;
-            rng.inc[l] = 1;
-            live[l] = 0;
-        }
-    };
-    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
-    // A fresh particle in the lanes of `fresh` (they read live[] for whether one was left).
-    LaneVectors v;
-    auto restart = [&](MF fresh) {
-        v.live = hn::IfThenElse(hn::RebindMask(di, fresh), hn::Load(di, live), v.live);
-        const MF alive = hn::And(fresh, hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di))));
-        v.d = Select(
-            fresh, V3{hn::Set(df, -job.wi.x), hn::Set(df, -job.wi.y), hn::Set(df, -job.wi.z)}, v.d);
-        for (int c = 0; c < 3; ++c)
-            v.w[c] = hn::IfThenElse(fresh, hn::IfThenElseZero(alive, one), v.w[c]);
-        const auto fresh_i = hn::RebindMask(di, fresh);
-        v.k = hn::IfThenZeroElse(fresh_i, v.k);
-        v.in_medium = hn::IfThenZeroElse(fresh_i, v.in_medium);
-        v.events = hn::IfThenZeroElse(fresh_i, v.events);
-    };
-    for (std::size_t l = 0; l < n_lanes; ++l)
-        take_particle(l);
-    rng.SyncIn();
-    {
-        const MF all = hn::FirstN(df, n_lanes);
-        v.live = hn::Zero(di);
-        v.d = {zero, zero, zero};
-        v.depth = zero;
-        for (int c = 0; c < 3; ++c)
-            v.w[c] = zero;
-        for (auto& term : v.loss)
-            for (auto& channel : term)
-                channel = zero;
-        for (auto& term : v.exit_sum)
-            for (auto& channel : term)
-                channel = zero;
-        v.k = v.in_medium = v.events = v.events_done = hn::Zero(di);
-        restart(all);
-    }
     LaneSums sums;
     sums.zero();
     std::uint64_t degenerate = 0;
     bool left[2] = {false, false};  // some particle was reflected / transmitted in this block
-    // Moves the lanes' float sums into the double ones.
-    constexpr int kFlushSteps = 8;
-    int steps_since_flush = 0;
-    auto flush = [&] {
+
+    // Moves a lane set's float sums into the double ones.
+    auto flush = [&](LaneVectors& v) {
         for (int c = 0; c < 3; ++c) {
             for (int t = 0; t < kLossTerms; ++t)
                 if (v.touched[t]) {
@@ -839,17 +800,281 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
                     v.exit_sum[e][c] = zero;
                 }
         }
-        steps_since_flush = 0;
+    };
+    auto clear = [&](LaneVectors& v) {
+        v.d = {zero, zero, zero};
+        v.depth = zero;
+        for (int c = 0; c < 3; ++c)
+            v.w[c] = zero;
+        for (auto& term : v.loss)
+            for (auto& channel : term)
+                channel = zero;
+        for (auto& term : v.exit_sum)
+            for (auto& channel : term)
+                channel = zero;
+        v.k = v.in_medium = v.events = v.events_done = v.live = v.finish = hn::Zero(di);
     };
 
+    // ---- One interface event of the lanes in `going`, all at interface `group` ----
+    auto interface_step = [&](LaneVectors& v, LaneRng& rng, int group, MF going) {
+        v.events =
+            hn::IfThenElse(hn::RebindMask(di, going), hn::Add(v.events, hn::Set(di, 1)), v.events);
+        MF degenerate_event = hn::FirstN(df, 0);  // all false
+        const TraceLayer& layer = stack.layers[group];
+        const bool dielectric = layer.type == InterfaceType::Dielectric;
+        switch (layer.type) {
+            case InterfaceType::Dielectric: {
+                const VF uc = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
+                DielectricEvent(layer.dielectric, going, v, uc, u1, u2, degenerate_event);
+                break;
+            }
+            case InterfaceType::Conductor: {
+                const VF u1 = rng.Uniform(), u2 = rng.Uniform();
+                ConductorEvent(layer.conductor, going, v, u1, u2, degenerate_event);
+                break;
+            }
+            case InterfaceType::Lambertian: {
+                const VF u1 = rng.Uniform(), u2 = rng.Uniform();
+                LambertianEvent(layer.lambertian, going, v, u1, u2, degenerate_event);
+                break;
+            }
+        }
+        // A failed sample loses the flux to the microsurface; an exactly grazing new direction is
+        // lost to the microsurface (dielectric) or the base (opaque), as in trace_particle.
+        const MF grazing = hn::AndNot(degenerate_event, hn::And(going, hn::Eq(v.d.z, zero)));
+        const MF lost = hn::Or(degenerate_event, grazing);
+        v.Keep(dielectric ? lost : degenerate_event, kLossMicro, zero);
+        if (!dielectric) v.Keep(grazing, kLossBase, zero);
+        degenerate += hn::CountTrue(df, lost);
+        const MF black = hn::And(going, v.Black());
+        const MF ends = hn::Or(black, lost);
+        v.End(ends, kEnded);
+        const MF continues = hn::AndNot(ends, going);
+
+        // Exits, then the medium behind: below the interface going down, above it going up.
+        const MF up = hn::Gt(v.d.z, zero);
+        const MF goes_up = hn::And(continues, up), goes_down = hn::AndNot(up, continues);
+        MF moves_up = goes_up, moves_down = goes_down;
+        if (group == 0) {
+            v.End(goes_up, kReflected);
+            moves_up = hn::FirstN(df, 0);
+        }
+        if (group == n_layers - 1) {
+            v.End(goes_down, kTransmitted);
+            moves_down = hn::FirstN(df, 0);
+        }
+        for (int side = 0; side < 2; ++side) {
+            const MF moving = side == 0 ? moves_up : moves_down;
+            const int medium_layer = side == 0 ? group - 1 : group;
+            const int k_next = side == 0 ? group - 1 : group + 1;
+            if (hn::AllFalse(df, moving)) continue;
+            const TraceMedium& med = stack.layers[medium_layer].medium;
+            if (med.scatters) {
+                // Enters the medium: its free flights are later steps.
+                const auto mi = hn::RebindMask(di, moving);
+                v.in_medium = hn::IfThenElse(mi, hn::Set(di, 1), v.in_medium);
+                v.k = hn::IfThenElse(mi, hn::Set(di, medium_layer), v.k);
+                v.depth = hn::IfThenElse(moving, hn::Set(df, side == 0 ? 1.f : 0.f), v.depth);
+                continue;
+            }
+            if (med.absorbs) {
+                // Pure absorption: Beer–Lambert along the straight path.
+                const VF inv_mu = hn::Div(one, hn::Abs(v.d.z));
+                VF transmittance[3];
+                for (int c = 0; c < 3; ++c) {
+                    if (c > 0 && med.tau_a[c] == med.tau_a[c - 1]) {
+                        transmittance[c] = transmittance[c - 1];  // a grey pair of channels
+                        continue;
+                    }
+                    transmittance[c] =
+                        med.tau_a[c] > 0 ? hn::Exp(df, hn::Mul(hn::Set(df, -med.tau_a[c]), inv_mu))
+                                         : one;
+                }
+                v.Keep(moving, kLossMedium, transmittance);
+                v.End(hn::And(moving, v.Black()), kEnded);
+            }
+            v.k = hn::IfThenElse(hn::RebindMask(di, moving), hn::Set(di, k_next), v.k);
+        }
+    };
+
+    // ---- Particles that ended in a step: sums on vectors, exits binned and tallied in lane
+    // order; on_lane(l) then runs for every ended lane, in lane order ----
+    HWY_ALIGN std::int32_t finish[kMaxLanes];
+    HWY_ALIGN float w_out[3][kMaxLanes];
+    HWY_ALIGN std::int32_t theta_guess[kMaxLanes], phi_guess[kMaxLanes];
+    HWY_ALIGN float d_out[3][kMaxLanes];
+    auto end_particles = [&](LaneVectors& v, MF ended, auto&& on_lane) {
+        const MF reflected = LaneIs(v.finish, kReflected);
+        const MF transmitted = LaneIs(v.finish, kTransmitted);
+        for (int side = 0; side < 2; ++side) {
+            const MF leaves = side == 0 ? reflected : transmitted;
+            if (hn::AllFalse(df, leaves)) continue;
+            left[side] = true;
+            for (int c = 0; c < 3; ++c) {
+                const VF w_out_c = hn::IfThenElseZero(leaves, v.w[c]);
+                v.exit_sum[2 * side][c] = hn::Add(v.exit_sum[2 * side][c], w_out_c);
+                v.exit_sum[2 * side + 1][c] =
+                    hn::MulAdd(w_out_c, w_out_c, v.exit_sum[2 * side + 1][c]);
+            }
+        }
+        v.events_done =
+            hn::Add(v.events_done, hn::IfThenElseZero(hn::RebindMask(di, ended), v.events));
+        const MF exits = hn::Or(reflected, transmitted);
+        hn::Store(v.finish, di, finish);
+        if (!hn::AllFalse(df, exits)) {
+            BinGuesses(v.d, grid.n_theta(), grid.n_phi(), theta_guess, phi_guess);
+            hn::Store(v.d.x, df, d_out[0]);
+            hn::Store(v.d.y, df, d_out[1]);
+            hn::Store(v.d.z, df, d_out[2]);
+            for (int c = 0; c < 3; ++c)
+                hn::Store(v.w[c], df, w_out[c]);
+        }
+        // Over the set bits of the mask: which lanes ended is random, a branch per lane would be
+        // mispredicted half of the time.
+        std::uint8_t mask_bytes[(kMaxLanes + 7) / 8] = {};
+        hn::StoreMaskBits(df, ended, mask_bytes);
+        std::uint64_t ended_bits = 0;
+        for (std::size_t i = 0; i < (n_lanes + 7) / 8; ++i)
+            ended_bits |= std::uint64_t(mask_bytes[i]) << (8 * i);
+        for (; ended_bits != 0; ended_bits &= ended_bits - 1) {
+            const std::size_t l = std::size_t(std::countr_zero(ended_bits));
+            const std::int32_t why = finish[l];
+            if (why != kEnded) {
+                const Rgbf w(w_out[0][l], w_out[1][l], w_out[2][l]);
+                const std::size_t bin = BinOf(d_out[0][l], d_out[1][l], d_out[2][l], theta_guess[l],
+                                              phi_guess[l], grid);
+                tally.exit((why == kTransmitted ? grid.size() : 0) + bin, w);
+            }
+            on_lane(l);
+        }
+    };
+
+    // ---- First events, on full vectors ----
+    // Every particle starts with the same event (interface 0 met from above), so the block's
+    // particles take it in order, all lanes busy; the survivors wait in a queue, in particle
+    // order. The main loop then hands out particles that are past their first event: the fresh
+    // particles of a two-interface stack join the others in phase (at the lower interface)
+    // instead of idling for a step.
+    Queue& queue = scratch.queue;
+    queue.clear();
+    {
+        LaneVectors p;
+        clear(p);
+        LaneRng prng;
+        HWY_ALIGN float qd[3][kMaxLanes], qw[3][kMaxLanes], qdepth[kMaxLanes];
+        HWY_ALIGN std::int32_t qk[kMaxLanes], qin[kMaxLanes], qevents[kMaxLanes];
+        std::uint64_t chunks = 0;
+        for (std::uint64_t base = 0; base < job.count; base += n_lanes) {
+            const std::size_t n = std::size_t(std::min<std::uint64_t>(n_lanes, job.count - base));
+            for (std::size_t l = 0; l < n_lanes; ++l) {
+                prng.state[l] = l < n ? scratch.state[base + l] : 0;
+                prng.inc[l] = l < n ? scratch.inc[base + l] : 1;
+            }
+            prng.SyncIn();
+            const MF going = hn::FirstN(df, n);
+            p.d = {hn::Set(df, -job.wi.x), hn::Set(df, -job.wi.y), hn::Set(df, -job.wi.z)};
+            for (int c = 0; c < 3; ++c)
+                p.w[c] = hn::IfThenElseZero(going, one);
+            p.k = p.in_medium = p.events = p.finish = hn::Zero(di);
+            p.depth = zero;
+            interface_step(p, prng, 0, going);
+            const MF ended = hn::RebindMask(df, hn::Ne(p.finish, hn::Zero(di)));
+            if (!hn::AllFalse(df, ended)) end_particles(p, ended, [](std::size_t) {});
+            prng.SyncOut();
+            const MF waits = hn::AndNot(ended, going);
+            hn::Store(p.d.x, df, qd[0]);
+            hn::Store(p.d.y, df, qd[1]);
+            hn::Store(p.d.z, df, qd[2]);
+            for (int c = 0; c < 3; ++c)
+                hn::Store(p.w[c], df, qw[c]);
+            hn::Store(p.depth, df, qdepth);
+            hn::Store(p.k, di, qk);
+            hn::Store(p.in_medium, di, qin);
+            hn::Store(p.events, di, qevents);
+            std::uint8_t mask_bytes[(kMaxLanes + 7) / 8] = {};
+            hn::StoreMaskBits(df, waits, mask_bytes);
+            std::uint64_t bits = 0;
+            for (std::size_t i = 0; i < (n_lanes + 7) / 8; ++i)
+                bits |= std::uint64_t(mask_bytes[i]) << (8 * i);
+            for (; bits != 0; bits &= bits - 1) {
+                const std::size_t l = std::size_t(std::countr_zero(bits));
+                queue.push_back({{qd[0][l], qd[1][l], qd[2][l]},
+                                 {qw[0][l], qw[1][l], qw[2][l]},
+                                 qdepth[l],
+                                 qk[l],
+                                 qin[l],
+                                 qevents[l],
+                                 prng.state[l],
+                                 prng.inc[l]});
+            }
+            if (++chunks % kFlushSteps == 0) flush(p);
+        }
+        flush(p);
+        sums.add_events(p.events_done);
+    }
+
+    // ---- The main loop ----
+    LaneRng rng;
+    HWY_ALIGN float sd[3][kMaxLanes], sw[3][kMaxLanes], sdepth[kMaxLanes];
+    HWY_ALIGN std::int32_t sk[kMaxLanes], s_in[kMaxLanes], sevents[kMaxLanes], live[kMaxLanes];
+    std::size_t next = 0;  // the queue's next particle
+    // Stages the queue's next particle for lane l, or retires the lane when none is left.
+    auto take_particle = [&](std::size_t l) {
+        if (next < queue.size()) {
+            const Waiting& q = queue[next++];
+            for (int i = 0; i < 3; ++i) {
+                sd[i][l] = q.d[i];
+                sw[i][l] = q.w[i];
+            }
+            sdepth[l] = q.depth;
+            sk[l] = q.k;
+            s_in[l] = q.in_medium;
+            sevents[l] = q.events;
+            rng.state[l] = q.state;
+            rng.inc[l] = q.inc;
+            live[l] = 1;
+        } else {
+            for (int i = 0; i < 3; ++i)
+                sw[i][l] = 0.f;
+            sd[2][l] = -1.f;
+            sdepth[l] = 0.f;
+            sk[l] = s_in[l] = sevents[l] = 0;
+            rng.state[l] = 0;
+            rng.inc[l] = 1;
+            live[l] = 0;
+        }
+    };
+    LaneVectors v;
+    clear(v);
+    // The staged particles into the lanes of `fresh`.
+    auto restart = [&](MF fresh) {
+        const auto fresh_i = hn::RebindMask(di, fresh);
+        v.d = Select(fresh, V3{hn::Load(df, sd[0]), hn::Load(df, sd[1]), hn::Load(df, sd[2])}, v.d);
+        for (int c = 0; c < 3; ++c)
+            v.w[c] = hn::IfThenElse(fresh, hn::Load(df, sw[c]), v.w[c]);
+        v.depth = hn::IfThenElse(fresh, hn::Load(df, sdepth), v.depth);
+        v.k = hn::IfThenElse(fresh_i, hn::Load(di, sk), v.k);
+        v.in_medium = hn::IfThenElse(fresh_i, hn::Load(di, s_in), v.in_medium);
+        v.events = hn::IfThenElse(fresh_i, hn::Load(di, sevents), v.events);
+        v.live = hn::IfThenElse(fresh_i, hn::Load(di, live), v.live);
+    };
+    for (std::size_t l = 0; l < n_lanes; ++l)
+        take_particle(l);
+    rng.SyncIn();
+    restart(hn::FirstN(df, n_lanes));
+
+    int steps_since_flush = 0;
     while (true) {
-        if (++steps_since_flush == kFlushSteps) flush();
+        if (++steps_since_flush == kFlushSteps) {
+            flush(v);
+            steps_since_flush = 0;
+        }
         v.finish = hn::Zero(di);
         const MF live_mask = hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di)));
         if (hn::AllFalse(df, live_mask)) break;
         // One group of lanes steps: those at one interface, or those inside one scattering
         // medium, whichever group is largest (ties to the first). The lanes of a two-interface
-        // stack then alternate between its interfaces nearly in phase, so each step runs one
+        // stack then alternate between its interfaces in phase, so each step runs one
         // interface's code on nearly full vectors.
         const MF in_med = hn::And(live_mask, hn::RebindMask(df, hn::Ne(v.in_medium, hn::Zero(di))));
         const MF at_interface = hn::AndNot(in_med, live_mask);
@@ -889,134 +1114,16 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             ScatteringStep(stack.layers[group].medium, going, v, u0, u1, u2, u3, u4);
             v.End(hn::And(going, v.Black()), kEnded);
         } else {
-            // ---- An interface event ----
-            v.events = hn::IfThenElse(hn::RebindMask(di, going), hn::Add(v.events, hn::Set(di, 1)),
-                                      v.events);
-            MF degenerate_event = hn::FirstN(df, 0);  // all false
-            const TraceLayer& layer = stack.layers[group];
-            const bool dielectric = layer.type == InterfaceType::Dielectric;
-            switch (layer.type) {
-                case InterfaceType::Dielectric: {
-                    const VF uc = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
-                    DielectricEvent(layer.dielectric, going, v, uc, u1, u2, degenerate_event);
-                    break;
-                }
-                case InterfaceType::Conductor: {
-                    const VF u1 = rng.Uniform(), u2 = rng.Uniform();
-                    ConductorEvent(layer.conductor, going, v, u1, u2, degenerate_event);
-                    break;
-                }
-                case InterfaceType::Lambertian: {
-                    const VF u1 = rng.Uniform(), u2 = rng.Uniform();
-                    LambertianEvent(layer.lambertian, going, v, u1, u2, degenerate_event);
-                    break;
-                }
-            }
-            // A failed sample loses the flux to the microsurface; an exactly grazing new direction
-            // is lost to the microsurface (dielectric) or the base (opaque), as in trace_particle.
-            const MF grazing = hn::AndNot(degenerate_event, hn::And(going, hn::Eq(v.d.z, zero)));
-            const MF lost = hn::Or(degenerate_event, grazing);
-            v.Keep(dielectric ? lost : degenerate_event, kLossMicro, zero);
-            if (!dielectric) v.Keep(grazing, kLossBase, zero);
-            degenerate += hn::CountTrue(df, lost);
-            const MF black = hn::And(going, v.Black());
-            const MF ends = hn::Or(black, lost);
-            v.End(ends, kEnded);
-            const MF continues = hn::AndNot(ends, going);
-
-            // Exits, then the medium behind: below the interface going down, above it going up.
-            const MF up = hn::Gt(v.d.z, zero);
-            const MF goes_up = hn::And(continues, up), goes_down = hn::AndNot(up, continues);
-            MF moves_up = goes_up, moves_down = goes_down;
-            if (group == 0) {
-                v.End(goes_up, kReflected);
-                moves_up = hn::FirstN(df, 0);
-            }
-            if (group == n_layers - 1) {
-                v.End(goes_down, kTransmitted);
-                moves_down = hn::FirstN(df, 0);
-            }
-            for (int side = 0; side < 2; ++side) {
-                const MF moving = side == 0 ? moves_up : moves_down;
-                const int medium_layer = side == 0 ? group - 1 : group;
-                const int k_next = side == 0 ? group - 1 : group + 1;
-                if (hn::AllFalse(df, moving)) continue;
-                const TraceMedium& med = stack.layers[medium_layer].medium;
-                if (med.scatters) {
-                    // Enters the medium: its free flights are later steps.
-                    const auto mi = hn::RebindMask(di, moving);
-                    v.in_medium = hn::IfThenElse(mi, hn::Set(di, 1), v.in_medium);
-                    v.k = hn::IfThenElse(mi, hn::Set(di, medium_layer), v.k);
-                    v.depth = hn::IfThenElse(moving, hn::Set(df, side == 0 ? 1.f : 0.f), v.depth);
-                    continue;
-                }
-                if (med.absorbs) {
-                    // Pure absorption: Beer–Lambert along the straight path.
-                    const VF inv_mu = hn::Div(hn::Set(df, 1.f), hn::Abs(v.d.z));
-                    VF transmittance[3];
-                    for (int c = 0; c < 3; ++c)
-                        transmittance[c] =
-                            med.tau_a[c] > 0
-                                ? hn::Exp(df, hn::Mul(hn::Set(df, -med.tau_a[c]), inv_mu))
-                                : hn::Set(df, 1.f);
-                    v.Keep(moving, kLossMedium, transmittance);
-                    v.End(hn::And(moving, v.Black()), kEnded);
-                }
-                v.k = hn::IfThenElse(hn::RebindMask(di, moving), hn::Set(di, k_next), v.k);
-            }
+            interface_step(v, rng, group, going);
         }
-        // ---- Ended particles: sums on vectors, exits binned, fresh particles in their lanes ----
         const MF ended = hn::RebindMask(df, hn::Ne(v.finish, hn::Zero(di)));
         if (hn::AllFalse(df, ended)) continue;
-        const MF reflected = LaneIs(v.finish, kReflected);
-        const MF transmitted = LaneIs(v.finish, kTransmitted);
-        for (int side = 0; side < 2; ++side) {
-            const MF leaves = side == 0 ? reflected : transmitted;
-            if (hn::AllFalse(df, leaves)) continue;
-            left[side] = true;
-            for (int c = 0; c < 3; ++c) {
-                const VF w_out_c = hn::IfThenElseZero(leaves, v.w[c]);
-                v.exit_sum[2 * side][c] = hn::Add(v.exit_sum[2 * side][c], w_out_c);
-                v.exit_sum[2 * side + 1][c] =
-                    hn::MulAdd(w_out_c, w_out_c, v.exit_sum[2 * side + 1][c]);
-            }
-        }
-        v.events_done =
-            hn::Add(v.events_done, hn::IfThenElseZero(hn::RebindMask(di, ended), v.events));
-        const MF exits = hn::Or(reflected, transmitted);
-        hn::Store(v.finish, di, finish);
-        if (!hn::AllFalse(df, exits)) {
-            BinGuesses(v.d, grid.n_theta(), grid.n_phi(), theta_guess, phi_guess);
-            hn::Store(v.d.x, df, d_out[0]);
-            hn::Store(v.d.y, df, d_out[1]);
-            hn::Store(v.d.z, df, d_out[2]);
-            for (int c = 0; c < 3; ++c)
-                hn::Store(v.w[c], df, w_out[c]);
-        }
-        // Lane order: the particles of the block are handed out in a fixed order.
-        // (over the set bits of the mask: which lanes ended is random, a branch per lane would
-        // be mispredicted half of the time)
         rng.SyncOut();
-        std::uint8_t mask_bytes[(kMaxLanes + 7) / 8] = {};
-        hn::StoreMaskBits(df, ended, mask_bytes);
-        std::uint64_t ended_bits = 0;
-        for (std::size_t i = 0; i < (n_lanes + 7) / 8; ++i)
-            ended_bits |= std::uint64_t(mask_bytes[i]) << (8 * i);
-        for (; ended_bits != 0; ended_bits &= ended_bits - 1) {
-            const std::size_t l = std::size_t(std::countr_zero(ended_bits));
-            const std::int32_t why = finish[l];
-            if (why != kEnded) {
-                const Rgbf w(w_out[0][l], w_out[1][l], w_out[2][l]);
-                const std::size_t bin = BinOf(d_out[0][l], d_out[1][l], d_out[2][l], theta_guess[l],
-                                              phi_guess[l], grid);
-                tally.exit((why == kTransmitted ? grid.size() : 0) + bin, w);
-            }
-            take_particle(l);
-        }
+        end_particles(v, ended, take_particle);
         rng.SyncIn();
         restart(ended);
     }
-    flush();
+    flush(v);
     sums.add_events(v.events_done);
     sums.reduce(block, tally.sums.events);
     tally.sums.degenerate += degenerate;
