@@ -4,6 +4,7 @@
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/progress.h"
 #include "distributed/communicator.h"
 #include "distributed/split_simulation.h"
@@ -76,6 +77,18 @@ Runner add_simulate(CLI::App& app) {
         }
         world.broadcast(stack_text);
         if (!world.is_root()) stack = stack_from_json(nlohmann::json::parse(stack_text), a->stack);
+        // Bitwise identity with a one-process run needs one kernel variant on every process: the
+        // SIMD kernel's results depend on the instruction set it dispatches to.
+        const std::vector<std::string> kernels = world.gather(kernel_description(s.kernel));
+        if (world.is_root())
+            for (std::size_t r = 1; r < kernels.size(); ++r)
+                if (kernels[r] != kernels[0])
+                    throw InputError(
+                        "command line", "--kernel",
+                        fmt::format("process {} runs the kernel '{}' and process 0 '{}': give "
+                                    "every process the same instruction set (LAMINA_SIMD_TARGET, "
+                                    "docs/scaling.md)",
+                                    r, kernels[r], kernels[0]));
         // Progress of this process's share, drawn by the root only.
         std::unique_ptr<Progress> progress;
         std::function<void(std::uint64_t)> on_progress;

@@ -36,7 +36,8 @@ ReferenceKey key_from_json(const nlohmann::json& j) {
     if (key.canonical() != j.at("canonical").get<std::string>())
         throw InputError("reference work list", key.config_id,
                          "this process describes the piece differently from the root: are all "
-                         "processes running the same lamina build?");
+                         "processes running the same lamina build, with the same SIMD "
+                         "instruction set (LAMINA_SIMD_TARGET, docs/scaling.md)?");
     return key;
 }
 
