@@ -150,6 +150,34 @@ void write_summary(const std::filesystem::path& out_dir,
         ranking[g] = ranked;
     }
 
+    // Like for like: the overall ranking above averages each model over the configurations it
+    // supports, so a model that skips the hard ones (Belcour's have no Lambertian base) looks
+    // better than it is. This one averages the BRDF rows of the configurations whose BRDF every
+    // model supports.
+    std::set<std::string> common;
+    for (const StudyConfiguration& c : configs) {
+        bool all = !models.empty();
+        for (const std::string& m : models) {
+            const auto it = per_config.find(c.id);
+            if (it == per_config.end() || !it->second.count(m) || it->second.at(m).n == 0 ||
+                (unsupported.count(m) && unsupported.at(m).count(c.id) &&
+                 unsupported.at(m).at(c.id).count('R')))
+                all = false;
+        }
+        if (all) common.insert(c.id);
+    }
+    std::map<std::string, Aggregate> agg_common;
+    for (const MetricRow& r : rows)
+        if (r.side == 'R' && common.count(r.config)) agg_common[r.model].add(r);
+    std::vector<std::string> ranking_common;
+    if (!common.empty()) {
+        ranking_common = models;
+        std::stable_sort(ranking_common.begin(), ranking_common.end(),
+                         [&](const auto& a, const auto& b) {
+                             return agg_common[a].mean_e() < agg_common[b].mean_e();
+                         });
+    }
+
     // Challenging cases: the best supporting model still misplaces > threshold on average.
     struct Challenge {
         std::string config, best;
@@ -241,6 +269,12 @@ void write_summary(const std::filesystem::path& out_dir,
         }
         j["groups"][g]["ranking"] = ranking[g];
     }
+    j["common"]["configurations"] = common.size();
+    j["common"]["ids"] = common;
+    j["common"]["ranking"] = ranking_common;
+    for (const std::string& m : models)
+        j["common"]["models"][m] = {{"mean_misplaced_energy", num(agg_common[m].mean_e())},
+                                    {"mean_noise_floor", num(agg_common[m].mean_floor())}};
     j["challenging"] = nlohmann::json::array();
     for (const Challenge& c : challenging)
         j["challenging"].push_back({{"config", c.config},
@@ -316,6 +350,20 @@ void write_summary(const std::filesystem::path& out_dir,
                                  pct(agg["all"][ranking["all"][k]].mean_e()));
             return t + " (mean misplaced energy over the configurations each supports)";
         }());
+    if (models.size() > 1) {
+        if (ranking_common.empty())
+            out("- **Like for like**: no configuration's BRDF is supported by every model.\n");
+        else
+            out("- **Like for like** (the BRDF of the {} configuration{} every model supports): "
+                "{}.\n",
+                common.size(), common.size() == 1 ? "" : "s", [&] {
+                    std::string t;
+                    for (std::size_t k = 0; k < ranking_common.size(); ++k)
+                        t += fmt::format("{}{} {}", k ? " < " : "", ranking_common[k],
+                                         pct(agg_common[ranking_common[k]].mean_e()));
+                    return t;
+                }());
+    }
     out(
         "- **Challenging cases** (even the best model misplaces more than {} of the reflected "
         "energy on average, and more than twice the noise floor): {}.\n\n",

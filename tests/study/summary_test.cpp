@@ -1,0 +1,82 @@
+// The summary's aggregates on hand-made metric rows: rankings per group, over the configurations
+// each model supports, and like for like over the configurations every model supports.
+#include "study/summary.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+namespace lamina {
+namespace {
+
+const StudyConfiguration& builtin(const std::string& id) {
+    static const std::vector<StudyConfiguration> all = builtin_configurations();
+    const auto it = std::find_if(all.begin(), all.end(), [&](const auto& c) { return c.id == id; });
+    if (it == all.end()) throw std::runtime_error("no built-in configuration " + id);
+    return *it;
+}
+
+// Rows of one (configuration, model): every channel of one incidence with the same error.
+void add_rows(std::vector<MetricRow>& rows, const StudyConfiguration& c, const std::string& model,
+              bool supported, double misplaced_energy) {
+    for (int channel = 0; channel < 3; ++channel) {
+        MetricRow r;
+        r.config = c.id;
+        r.category = c.category;
+        r.model = model;
+        r.theta_i = 30;
+        r.side = 'R';
+        r.channel = channel;
+        r.supported = supported;
+        r.metrics.misplaced_energy = supported ? misplaced_energy : NAN;
+        r.metrics.albedo_error = supported ? misplaced_energy : NAN;
+        r.floor.misplaced_energy = 0.01;
+        rows.push_back(r);
+    }
+}
+
+// Model "a" supports a plastic (where it misplaces 50%) and a paint (10%); model "b" supports
+// only the paint (20%). Over what each supports, b (20%) ranks before a (30%); like for like, on
+// the paint alone, a (10%) ranks before b (20%).
+TEST(StudySummary, LikeForLikeRankingUsesOnlyConfigurationsEveryModelSupports) {
+    const StudyConfiguration& plastic = builtin("plastic-P1-a0.05");
+    const StudyConfiguration& paint = builtin("paint-a0.05-a1.3");
+    std::vector<MetricRow> rows;
+    add_rows(rows, plastic, "a", true, 0.5);
+    add_rows(rows, plastic, "b", false, 0);
+    add_rows(rows, paint, "a", true, 0.1);
+    add_rows(rows, paint, "b", true, 0.2);
+
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "lamina-summary-test";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    StudySettings s;
+    s.theta_i_deg = {30};
+    write_summary(dir, {plastic, paint}, s, {"a", "b"}, rows);
+
+    std::ifstream in(dir / "summary.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["groups"]["all"]["ranking"], (nlohmann::json{"b", "a"}));
+    EXPECT_NEAR(j["groups"]["all"]["models"]["a"]["mean_misplaced_energy"].get<double>(), 0.3,
+                1e-12);
+    EXPECT_EQ(j["common"]["configurations"], 1);
+    EXPECT_EQ(j["common"]["ids"], (nlohmann::json{paint.id}));
+    EXPECT_EQ(j["common"]["ranking"], (nlohmann::json{"a", "b"}));
+    EXPECT_NEAR(j["common"]["models"]["a"]["mean_misplaced_energy"].get<double>(), 0.1, 1e-12);
+    EXPECT_NEAR(j["common"]["models"]["b"]["mean_misplaced_energy"].get<double>(), 0.2, 1e-12);
+
+    std::ifstream md_in(dir / "summary.md");
+    const std::string md((std::istreambuf_iterator<char>(md_in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(md.find("**Like for like** (the BRDF of the 1 configuration every model supports): "
+                      "a 10.0% < b 20.0%."),
+              std::string::npos)
+        << md;
+    std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lamina
