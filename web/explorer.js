@@ -639,6 +639,15 @@
         legendgroup: "reference", showlegend: k === 0, line: { color: "#000", width: 2 },
         error_y: se ? { type: "data", array: se, visible: true, color: "#555" } : undefined,
         hovertemplate: "reference<br>θi %{x}°<br>albedo %{y:.4f}<extra></extra>" }, ax));
+      // What the reference loses to its single-scattering microsurfaces (config.json → energy):
+      // energy that no side of the reference holds, and that models which conserve it put back.
+      const lost = cfg.budget && cfg.budget.lost_microsurface;
+      if (lost && lost.some((v) => v)) {
+        traces.push(Object.assign({ x: THETA_I, y: lost.map((v) => (v ? v[c] : null)), type: "scatter",
+          mode: "lines+markers", name: "reference: lost to microsurfaces", legendgroup: "lost", showlegend: k === 0,
+          line: { color: "#888", width: 1.5, dash: "dot" }, marker: { size: 4, symbol: "x" },
+          hovertemplate: "reference: lost to microsurfaces<br>θi %{x}°<br>fraction %{y:.4f}<extra></extra>" }, ax));
+      }
       for (const m of models) {
         if (!state.shown.has(m) || !isSupported(cfg, m, side) || !cfg.albedo[m]) continue;
         traces.push(Object.assign({ x: THETA_I, y: cfg.albedo[m][side].map((v) => (v ? v[c] : null)),

@@ -2,8 +2,8 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "report/assets.h"
 #include "core/npy.h"
+#include "report/assets.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -341,6 +341,25 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
             supported[sources[s]] = m;
         }
     entry["supported"] = supported;
+    // The reference's energy budget per incidence (config.json → energy, when present): what the
+    // albedo view shows next to the albedos, so a reader sees how much energy the reference itself
+    // drops to single-scattering microsurfaces or absorbs, and a model that does not cannot match.
+    if (cfg.contains("energy") && cfg["energy"].is_array()) {
+        json budget = json::object();
+        for (const char* term : {"lost_microsurface", "absorbed_medium", "absorbed_base"}) {
+            json per_incidence = json::array();
+            for (double t : theta_i) {
+                json v = nullptr;
+                for (const json& e : cfg["energy"])
+                    if (e.contains("theta_i") && e["theta_i"].is_number() &&
+                        e["theta_i"].get<double>() == t && e.contains(term))
+                        v = e[term];
+                per_incidence.push_back(v);
+            }
+            budget[term] = per_incidence;
+        }
+        entry["budget"] = budget;
+    }
     entry["sources"] = sources;
     entry["sides"] = sides;
 

@@ -32,6 +32,17 @@ async function main() {
     const names = await page.evaluate(() => document.getElementById("slice").data.map((t) => t.name));
     check(names.includes("reference"), "the slice draws the reference");
     check(names.some((n) => n !== "reference" && !/reference/.test(n || "")), "the slice draws a model");
+    // The albedo view draws the reference's microsurface loss from the study's config.json.
+    const shown = await page.evaluate(() => document.body.dataset.config);
+    const cfg = JSON.parse(fs.readFileSync(path.resolve(studyDir, "configs", shown, "config.json"), "utf8"));
+    const lost = await page.evaluate(() => {
+      const t = document.getElementById("albedo").data.find((t) => t.name === "reference: lost to microsurfaces");
+      return t ? Array.from(t.y) : null;
+    });
+    const expected = cfg.energy.map((e) => e.lost_microsurface[0]);
+    check(expected.some((v) => v > 0), `${shown} loses energy to its rough coat (test premise)`);
+    check(lost !== null && lost.length === expected.length && lost.every((v, i) => Math.abs(v - expected[i]) <= 1e-12 * Math.max(1, expected[i])),
+      `the albedo view draws the reference's microsurface loss (${lost} against config.json's ${expected})`);
     const cells = await page.evaluate(() => (document.getElementById("leaderboard").data[0] || {}).z);
     check(Array.isArray(cells) && cells.length >= 2, "the leaderboard lists the configurations");
     await page.screenshot({ path: shot, fullPage: true });
