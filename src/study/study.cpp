@@ -33,6 +33,7 @@ std::string csv_number(double v) {
 
 struct ConfigResult {
     std::vector<MetricRow> rows;
+    std::vector<Rgbd> lost_microsurface;  ///< the reference's, per incidence
 };
 
 // Evaluates one configuration: reference pieces, models, metrics; writes configs/<id>/.
@@ -142,6 +143,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     }
     nlohmann::json energy = nlohmann::json::array();
     for (std::size_t i = 0; i < n_inc; ++i) {
+        result.lost_microsurface.push_back(pieces[i].budget[BudgetTerm::LostMicrosurface]);
         nlohmann::json e;
         e["theta_i"] = s.theta_i_deg[i];
         for (int t = 0; t < kBudgetTerms; ++t)
@@ -227,10 +229,12 @@ std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
     const auto start = std::chrono::steady_clock::now();
     Progress progress("study", "particles", configs.size() * s.theta_i_deg.size() * s.particles);
     std::vector<MetricRow> rows;
+    ReferenceLoss lost;
     for (std::size_t k = 0; k < configs.size(); ++k) {
         const auto t0 = std::chrono::steady_clock::now();
         ConfigResult r = run_configuration(configs[k], s, model_names, out_dir, progress);
         rows.insert(rows.end(), r.rows.begin(), r.rows.end());
+        lost[configs[k].id] = r.lost_microsurface;
         if (!s.quiet) {
             progress.clear_line();
             fmt::print(
@@ -263,7 +267,7 @@ std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
     sj["configurations"] = list;
     write_file_atomic(out_dir / "study.json", sj.dump(1) + "\n");
     write_file_atomic(out_dir / "metrics.csv", metrics_csv(rows));
-    write_summary(out_dir, configs, s, model_names, rows);
+    write_summary(out_dir, configs, s, model_names, rows, lost);
     return rows;
 }
 

@@ -8,6 +8,7 @@
 #include "study/study.h"
 
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -18,8 +19,17 @@ namespace lamina {
 /// than twice the noise floor, so that noise alone never makes a case challenging).
 inline constexpr double kChallengingThreshold = 0.2;
 
+/// Per configuration id, per incidence of the settings: the fraction of the incident energy (RGB)
+/// the reference loses to its single-scattering microfacet interfaces (the energy budget's
+/// lost_microsurface). Energy on neither side of the reference: a model that conserves it errs by
+/// it, which the summary says next to the errors.
+using ReferenceLoss = std::map<std::string, std::vector<Rgbd>>;
+
+/// Writes summary.md and summary.json into out_dir (atomically). `lost` may lack configurations
+/// (then nothing is said of their loss).
 void write_summary(const std::filesystem::path& out_dir,
                    const std::vector<StudyConfiguration>& configs, const StudySettings& settings,
-                   const std::vector<std::string>& models, const std::vector<MetricRow>& rows);
+                   const std::vector<std::string>& models, const std::vector<MetricRow>& rows,
+                   const ReferenceLoss& lost = {});
 
 }  // namespace lamina

@@ -78,5 +78,44 @@ TEST(StudySummary, LikeForLikeRankingUsesOnlyConfigurationsEveryModelSupports) {
     std::filesystem::remove_all(dir);
 }
 
+// The reference's own microsurface loss, per category and overall: means over incidences and
+// channels, and the worst with where it is.
+TEST(StudySummary, ReportsTheReferencesMicrosurfaceLoss) {
+    const StudyConfiguration& plastic = builtin("plastic-P1-a0.05");
+    const StudyConfiguration& paint = builtin("paint-a0.05-a1.3");
+    std::vector<MetricRow> rows;
+    add_rows(rows, plastic, "a", true, 0.5);
+    add_rows(rows, paint, "a", true, 0.1);
+    const ReferenceLoss lost = {{plastic.id, {Rgbd(0.1, 0.2, 0.3)}},
+                                {paint.id, {Rgbd(0.0, 0.0, 0.9)}}};
+
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "lamina-summary-loss-test";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    StudySettings s;
+    s.theta_i_deg = {30};
+    write_summary(dir, {plastic, paint}, s, {"a"}, rows, lost);
+
+    std::ifstream in(dir / "summary.json");
+    const nlohmann::json j = nlohmann::json::parse(in)["reference_lost_microsurface"];
+    EXPECT_NEAR(j[plastic.category]["mean"].get<double>(), 0.2, 1e-12);
+    EXPECT_NEAR(j[paint.category]["mean"].get<double>(), 0.3, 1e-12);
+    EXPECT_NEAR(j["all"]["mean"].get<double>(), 0.25, 1e-12);
+    EXPECT_NEAR(j["all"]["worst"].get<double>(), 0.9, 1e-12);
+    EXPECT_EQ(j["all"]["worst_at"]["config"], paint.id);
+    EXPECT_EQ(j["all"]["worst_at"]["channel"], "b");
+    EXPECT_EQ(j[plastic.category]["worst_at"]["channel"], "b");
+
+    std::ifstream md_in(dir / "summary.md");
+    const std::string md((std::istreambuf_iterator<char>(md_in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(md.find("lose, on average over incidences and channels, plastic 20.0%, "
+                      "metallic-paint 30.0% of the incident energy (worst 90.0%: " +
+                      paint.id + ", θi 30°, b)"),
+              std::string::npos)
+        << md;
+    std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace lamina
