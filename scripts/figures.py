@@ -286,7 +286,7 @@ def albedo_curves(study, formats, cache):
         nrow = math.ceil(len(members) / ncol)
         width = max(1.6 * ncol + 0.7, 3.6)
         # The legend: one entry per 1.2 inch of width, as many rows as that takes.
-        entries = 1 + len(study.models)
+        entries = 2 + len(study.models)
         legend_cols = max(2, min(entries, int(width / 1.2)))
         legend_rows = math.ceil(entries / legend_cols)
         bottom = 0.55 + 0.2 * legend_rows
@@ -315,6 +315,12 @@ def albedo_curves(study, formats, cache):
                     if supported(cfg, m, side):
                         ax.plot(study.theta_i, alb[k + 1], color=model_color(m, study.models),
                                 ls=MODEL_DASH.get(m, "-") if side == "R" else ":", lw=0.9, label=m)
+            # What the reference loses to its single-scattering microsurfaces (config.json energy):
+            # on neither side, so a model that keeps it overshoots the albedo by as much.
+            lost = [e.get("lost_microsurface") for e in cfg.get("energy", [])]
+            if lost and len(lost) == len(study.theta_i) and all(lost) and max(map(max, lost)) > 0:
+                ax.plot(study.theta_i, [sum(v) / 3 for v in lost], color="0.55", ls="--", lw=0.8,
+                        marker="x", ms=2.5, label="reference: lost to microsurfaces")
             ax.set_title(meta["id"], fontsize=6.5)
             ax.grid(True, lw=0.3, color="0.88")
             ax.set_xticks([0, 30, 60, 90])
@@ -326,7 +332,8 @@ def albedo_curves(study, formats, cache):
         for ax in axes.flat:
             for h, l in zip(*ax.get_legend_handles_labels()):
                 seen.setdefault(l.replace(" (T dotted)", ""), h)
-        order = sorted(seen, key=lambda l: (not l.startswith("reference"),
+        order = sorted(seen, key=lambda l: (0 if l.startswith("reference ±") else
+                                            1 if l.startswith("reference") else 2,
                                             study.models.index(l) if l in study.models else 0))
         fig.legend([seen[l] for l in order], order, loc="lower center", ncol=legend_cols,
                    frameon=False, columnspacing=0.9, handlelength=1.5)
