@@ -38,6 +38,30 @@ void add_rows(std::vector<MetricRow>& rows, const StudyConfiguration& c, const s
     }
 }
 
+// Writes the summary of `rows` (one incidence, θi = 30°) into a fresh folder and reads it back.
+struct Written {
+    nlohmann::json json;
+    std::string md;
+};
+Written summarize(const std::vector<StudyConfiguration>& configs,
+                  const std::vector<std::string>& models, const std::vector<MetricRow>& rows,
+                  const ReferenceLoss& lost = {}) {
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "lamina-summary-test";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    StudySettings s;
+    s.theta_i_deg = {30};
+    write_summary(dir, configs, s, models, rows, lost);
+    Written w;
+    std::ifstream in(dir / "summary.json");
+    w.json = nlohmann::json::parse(in);
+    std::ifstream md_in(dir / "summary.md");
+    w.md.assign(std::istreambuf_iterator<char>(md_in), std::istreambuf_iterator<char>());
+    std::filesystem::remove_all(dir);
+    return w;
+}
+
 // Model "a" supports a plastic (where it misplaces 50%) and a paint (10%); model "b" supports
 // only the paint (20%). Over what each supports, b (20%) ranks before a (30%); like for like, on
 // the paint alone, a (10%) ranks before b (20%).
@@ -50,16 +74,8 @@ TEST(StudySummary, LikeForLikeRankingUsesOnlyConfigurationsEveryModelSupports) {
     add_rows(rows, paint, "a", true, 0.1);
     add_rows(rows, paint, "b", true, 0.2);
 
-    const std::filesystem::path dir =
-        std::filesystem::temp_directory_path() / "lamina-summary-test";
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    StudySettings s;
-    s.theta_i_deg = {30};
-    write_summary(dir, {plastic, paint}, s, {"a", "b"}, rows);
-
-    std::ifstream in(dir / "summary.json");
-    const nlohmann::json j = nlohmann::json::parse(in);
+    const Written w = summarize({plastic, paint}, {"a", "b"}, rows);
+    const nlohmann::json& j = w.json;
     EXPECT_EQ(j["groups"]["all"]["ranking"], (nlohmann::json{"b", "a"}));
     EXPECT_NEAR(j["groups"]["all"]["models"]["a"]["mean_misplaced_energy"].get<double>(), 0.3,
                 1e-12);
@@ -68,14 +84,10 @@ TEST(StudySummary, LikeForLikeRankingUsesOnlyConfigurationsEveryModelSupports) {
     EXPECT_EQ(j["common"]["ranking"], (nlohmann::json{"a", "b"}));
     EXPECT_NEAR(j["common"]["models"]["a"]["mean_misplaced_energy"].get<double>(), 0.1, 1e-12);
     EXPECT_NEAR(j["common"]["models"]["b"]["mean_misplaced_energy"].get<double>(), 0.2, 1e-12);
-
-    std::ifstream md_in(dir / "summary.md");
-    const std::string md((std::istreambuf_iterator<char>(md_in)), std::istreambuf_iterator<char>());
-    EXPECT_NE(md.find("**Like for like** (the BRDF of the 1 configuration every model supports): "
-                      "a 10.0% < b 20.0%."),
+    EXPECT_NE(w.md.find("**Like for like** (the BRDF of the 1 configuration every model "
+                        "supports): a 10.0% < b 20.0%."),
               std::string::npos)
-        << md;
-    std::filesystem::remove_all(dir);
+        << w.md;
 }
 
 // The reference's own microsurface loss, per category and overall: means over incidences and
@@ -89,16 +101,8 @@ TEST(StudySummary, ReportsTheReferencesMicrosurfaceLoss) {
     const ReferenceLoss lost = {{plastic.id, {Rgbd(0.1, 0.2, 0.3)}},
                                 {paint.id, {Rgbd(0.0, 0.0, 0.9)}}};
 
-    const std::filesystem::path dir =
-        std::filesystem::temp_directory_path() / "lamina-summary-loss-test";
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    StudySettings s;
-    s.theta_i_deg = {30};
-    write_summary(dir, {plastic, paint}, s, {"a"}, rows, lost);
-
-    std::ifstream in(dir / "summary.json");
-    const nlohmann::json j = nlohmann::json::parse(in)["reference_lost_microsurface"];
+    const Written w = summarize({plastic, paint}, {"a"}, rows, lost);
+    const nlohmann::json& j = w.json["reference_lost_microsurface"];
     EXPECT_NEAR(j[plastic.category]["mean"].get<double>(), 0.2, 1e-12);
     EXPECT_NEAR(j[paint.category]["mean"].get<double>(), 0.3, 1e-12);
     EXPECT_NEAR(j["all"]["mean"].get<double>(), 0.25, 1e-12);
@@ -106,15 +110,11 @@ TEST(StudySummary, ReportsTheReferencesMicrosurfaceLoss) {
     EXPECT_EQ(j["all"]["worst_at"]["config"], paint.id);
     EXPECT_EQ(j["all"]["worst_at"]["channel"], "b");
     EXPECT_EQ(j[plastic.category]["worst_at"]["channel"], "b");
-
-    std::ifstream md_in(dir / "summary.md");
-    const std::string md((std::istreambuf_iterator<char>(md_in)), std::istreambuf_iterator<char>());
-    EXPECT_NE(md.find("lose, on average over incidences and channels, plastic 20.0%, "
-                      "metallic-paint 30.0% of the incident energy (worst 90.0%: " +
-                      paint.id + ", θi 30°, b)"),
+    EXPECT_NE(w.md.find("lose, on average over incidences and channels, plastic 20.0%, "
+                        "metallic-paint 30.0% of the incident energy (worst 90.0%: " +
+                        paint.id + ", θi 30°, b)"),
               std::string::npos)
-        << md;
-    std::filesystem::remove_all(dir);
+        << w.md;
 }
 
 }  // namespace
