@@ -24,7 +24,7 @@ namespace lamina::cli {
 namespace {
 struct SimulateArgs {
     std::string stack, theta_i = "0,15,30,45,60,70,80", particles = "1e6", grid = "90x90", out;
-    std::string kernel = "simd";
+    std::string kernel = "simd", microsurface = "single";
     std::uint64_t seed = 1;
     int threads = 0, max_events = 10000;
 };
@@ -49,6 +49,11 @@ Runner add_simulate(CLI::App& app) {
                     "Particle kernel: simd (vectorized, runtime dispatch) or scalar (reference "
                     "path); tables are reproducible per kernel")
         ->capture_default_str();
+    cmd->add_option("--microsurface", a->microsurface,
+                    "Rough interfaces: single (single scattering, the masked energy reported as "
+                    "lost_microsurface) or multiple (Heitz et al. 2016 random walk; needs "
+                    "--kernel scalar)")
+        ->capture_default_str();
     cmd->add_option("--out,-o", a->out, "Output folder")->required();
     return [a] {
         // Under mpirun every process runs this; the particles are split over them
@@ -60,6 +65,7 @@ Runner add_simulate(CLI::App& app) {
         s.seed = a->seed;
         s.threads = a->threads;
         s.kernel = parse_kernel(a->kernel);
+        s.microsurface = parse_microsurface(a->microsurface);
         s.grid = HemisphereGrid::parse(a->grid);
         s.max_events = a->max_events;
         validate_settings(s);

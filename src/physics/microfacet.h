@@ -103,6 +103,32 @@ struct GGX {
         return normalize(Vec3<T>(alpha * h.x, alpha * h.y, max0(h.z)));
     }
 
+    /// The distribution of normals visible from any direction w, below the horizon too (a ray
+    /// inside the microsurface after a first bounce, microsurface_walk.h): max(0, w·wm) D(wm) /
+    /// A(w), with the projected area A(w) = ∫ max(0, w·wm) D(wm) dωm = cos θ (1 + Λ(w)) for
+    /// w.z > 0 and |cos θ| Λ(w) for w.z < 0 (Heitz 2014, Eq. 8 with the signed Λ of Heitz et al.
+    /// 2016). Unlike D_visible, a w below the horizon is *not* taken through −w. Zero at w.z = 0.
+    T D_visible_complete(const Vec3<T>& w, const Vec3<T>& wm) const {
+        const T cos_w_wm = dot(w, wm);
+        if (cos_w_wm <= 0 || w.z == 0) return T(0);
+        const T area = w.z > 0 ? w.z * (T(1) + lambda(w)) : -w.z * lambda(w);
+        return cos_w_wm * D(wm) / area;
+    }
+
+    /// Samples D_visible_complete(w, ·) by the spherical caps of Dupuy & Benyoub 2023 (Listing 3),
+    /// whose construction holds for every w, below the horizon included (the "complete" of their
+    /// title): the cap z ∈ (−wh.z, 1] then covers less than a hemisphere. For w.z ≥ 0 it is
+    /// sample_visible_normal_caps.
+    Vec3<T> sample_visible_normal_complete(const Vec3<T>& w, T u1, T u2) const {
+        const Vec3<T> wh = normalize(Vec3<T>(alpha * w.x, alpha * w.y, w.z));
+        const T phi = T(2) * kPi<T> * u1;
+        const T z = (T(1) - u2) * (T(1) + wh.z) - wh.z;
+        const T sin_theta = safe_sqrt(T(1) - sqr(z));
+        const Vec3<T> c(sin_theta * std::cos(phi), sin_theta * std::sin(phi), z);
+        const Vec3<T> h = c + wh;
+        return normalize(Vec3<T>(alpha * h.x, alpha * h.y, max0(h.z)));
+    }
+
     /// √(1 + α² tan²θ) = 1 + 2Λ(w): the quantity from which G1 and G2 follow without cancellation.
     T smith_root(const Vec3<T>& w) const {
         const T cos2 = sqr(w.z);

@@ -5,6 +5,7 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "physics/microsurface_walk.h"
 #include "physics/phase.h"
 #include "simulator/kernel_simd.h"
 #include "simulator/tally.h"
@@ -39,6 +40,12 @@ void validate_settings(const SimulationSettings& s) {
         throw InputError("command line", "--threads",
                          fmt::format("{} is not allowed: use ≥ 1, or 0 for all cores", s.threads));
     if (s.max_events < 1) throw InputError("command line", "--max-events", "must be ≥ 1");
+    if (s.microsurface == Microsurface::Multiple && s.kernel == Kernel::Simd)
+        throw InputError("command line", "--microsurface",
+                         "multiple scattering on the microsurfaces runs on the scalar kernel only: "
+                         "add --kernel scalar");
+    if (s.max_microsurface_order < 1)
+        throw InputError("settings", "max_microsurface_order", "must be ≥ 1");
 }
 
 namespace {
@@ -191,14 +198,46 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
             }
             d = s->wo;
         };
+        // A rough interface with multiple scattering: the microsurface walk (Heitz et al. 2016)
+        // replaces the single facet; its exit carries the conductor's Fresnel factors, and a walk
+        // that reaches the facet cap loses its flux to the microsurface.
+        auto apply_walk = [&](const std::optional<MicrosurfaceExit<float>>& e, bool opaque) {
+            if (!e) {
+                losses.add(BudgetTerm::LostMicrosurface, w);
+                w = Rgbf(0.f);
+                return;
+            }
+            if (opaque) {
+                const Rgbf kept = w * e->weight;
+                losses.add(BudgetTerm::AbsorbedBase, w - kept);
+                w = kept;
+            }
+            d = e->wo;
+        };
+        auto uniform = [&] { return rng.uniform_float(); };
         switch (layer.type) {
             case InterfaceType::Dielectric: {
+                if (stack.multiple_scattering && !layer.dielectric.is_smooth()) {
+                    apply_walk(
+                        walk_rough_dielectric(layer.dielectric.distribution(), layer.dielectric.eta,
+                                              wi_local, uniform, stack.max_microsurface_order),
+                        false);
+                    break;
+                }
                 const float uc = rng.uniform_float(), u1 = rng.uniform_float(),
                             u2 = rng.uniform_float();
                 apply(layer.dielectric.sample<false>(wi_local, uc, u1, u2), false);
                 break;
             }
             case InterfaceType::Conductor: {
+                if (stack.multiple_scattering && !layer.conductor.is_smooth()) {
+                    const ConductorInterface<float>& cond = layer.conductor;
+                    apply_walk(walk_rough_conductor(
+                                   cond.distribution(), [&](float c) { return cond.fresnel(c); },
+                                   wi_local, uniform, stack.max_microsurface_order),
+                               true);
+                    break;
+                }
                 const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
                 apply(layer.conductor.sample<false>(wi_local, u1, u2), true);
                 break;
@@ -278,6 +317,20 @@ std::string kernel_description(Kernel kernel) {
     return kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name()) : "scalar";
 }
 
+const char* microsurface_name(Microsurface microsurface) {
+    return microsurface == Microsurface::Multiple ? "multiple" : "single";
+}
+
+Microsurface parse_microsurface(const std::string& text, const std::string& option) {
+    if (text == "single") return Microsurface::Single;
+    if (text == "multiple") return Microsurface::Multiple;
+    throw InputError("command line", option,
+                     fmt::format("'{}' is not a microsurface model: use single (single "
+                                 "scattering, the lost energy reported) or multiple (Heitz et al. "
+                                 "2016 random walk, scalar kernel)",
+                                 text));
+}
+
 Kernel parse_kernel(const std::string& text, const std::string& option) {
     if (text == "scalar") return Kernel::Scalar;
     if (text == "simd") return Kernel::Simd;
@@ -301,7 +354,9 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
                              const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);
     const auto start = std::chrono::steady_clock::now();
-    const TraceStack trace(stack);
+    TraceStack trace(stack);
+    trace.multiple_scattering = settings.microsurface == Microsurface::Multiple;
+    trace.max_microsurface_order = settings.max_microsurface_order;
     const HemisphereGrid& grid = settings.grid;
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
     if (settings.kernel == Kernel::Simd) select_simd_target();

@@ -39,6 +39,20 @@ std::string kernel_description(Kernel kernel);
 /// "scalar" | "simd" (InputError naming `option` otherwise).
 Kernel parse_kernel(const std::string& text, const std::string& option = "--kernel");
 
+/// How a rough interface treats the light its first facet does not let escape: `single`
+/// (physics.md §3: single-scattering microfacet theory, the energy is lost to the microsurface and
+/// reported as lost_microsurface) or `multiple` (the microsurface random walk of Heitz et al. 2016,
+/// physics/microsurface_walk.h: nothing is lost; scalar kernel only).
+enum class Microsurface { Single, Multiple };
+const char* microsurface_name(Microsurface microsurface);
+/// "single" | "multiple" (InputError naming `option` otherwise).
+Microsurface parse_microsurface(const std::string& text,
+                                const std::string& option = "--microsurface");
+
+/// Facets a microsurface walk may meet before its particle is given up (reported as
+/// lost_microsurface); walks of a few facets are the rule, a hundred is never reached in practice.
+inline constexpr int kMaxMicrosurfaceOrder = 100;
+
 struct SimulationSettings {
     std::vector<double> theta_i_deg{0, 15, 30, 45, 60, 70, 80};  ///< each in [0, 90)
     std::uint64_t particles = 1'000'000;                         ///< per incidence, > 0
@@ -52,6 +66,10 @@ struct SimulationSettings {
     /// processes; the union of ranges equals one run of all particles, bit for bit).
     std::uint64_t first_particle = 0;
     Kernel kernel = Kernel::Simd;
+    Microsurface microsurface = Microsurface::Single;
+    /// Facets per microsurface walk (Microsurface::Multiple); 1 keeps only the first order, which
+    /// is the single-scattering interface (a test of the walk).
+    int max_microsurface_order = kMaxMicrosurfaceOrder;
 };
 
 /// Where the flux of an incidence went, per channel; the terms sum to 1 to rounding.

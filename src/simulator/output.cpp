@@ -47,6 +47,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     j["first_particle"] = s.first_particle;
     j["max_events"] = s.max_events;
     j["kernel"] = kernel_description(s.kernel);
+    j["microsurface"] = microsurface_name(s.microsurface);
     j["threads"] = result.threads_used;
     j["processes"] = result.processes;
     j["seconds"] = result.seconds;

@@ -38,6 +38,10 @@ struct TraceLayer {
 struct TraceStack {
     std::vector<TraceLayer> layers;
     bool transmits = false;  ///< the base is a dielectric: light can leave downwards
+    /// Rough interfaces scatter light on their microsurfaces until it leaves (Heitz et al. 2016)
+    /// instead of dropping what their first facet does not let escape; at most this many facets.
+    bool multiple_scattering = false;
+    int max_microsurface_order = 0;
 
     explicit TraceStack(const Stack& stack);
 };

@@ -27,8 +27,10 @@ Vec3d direction_at(double cos_theta, double phi) {
 // ∫ f(wm) dωm over the upper hemisphere, resolving a GGX peak of width α at the pole: the polar
 // range is cut at 1 − cos θm = α²·4^k (graded nodes, the peak's scale is sin²θm ≈ α²), and each
 // band is integrated by the harness's nested adaptive Simpson quadrature to tolerance eps.
-double integrate_hemisphere(const std::function<double(const Vec3d&)>& f, double alpha,
-                            double eps) {
+// `phi_pieces` splits the azimuth too, for integrands that vanish on most of a band (normals
+// visible from below the horizon), where Simpson's first nodes could all miss the support.
+double integrate_hemisphere(const std::function<double(const Vec3d&)>& f, double alpha, double eps,
+                            int phi_pieces = 1) {
     std::vector<double> s = {0.0};
     for (double x = sqr(alpha) / 64; x < 1; x *= 4)
         s.push_back(x);
@@ -38,7 +40,10 @@ double integrate_hemisphere(const std::function<double(const Vec3d&)>& f, double
         // D(wm) is defined as 0 on the horizon (wm.z = 0) while its limit is not: the lowest band
         // starts just above it, so that Simpson's end nodes see the limit (a null set either way).
         const double c0 = std::max(1 - s[k + 1], std::numeric_limits<double>::min());
-        total += test::integrate_cell(f, c0, 1 - s[k], 0, 2 * kPi<double>, eps / double(s.size()));
+        for (int p = 0; p < phi_pieces; ++p)
+            total += test::integrate_cell(f, c0, 1 - s[k], 2 * kPi<double> * p / phi_pieces,
+                                          2 * kPi<double> * (p + 1) / phi_pieces,
+                                          eps / double(s.size() * phi_pieces));
     }
     return total;
 }
@@ -87,6 +92,21 @@ TEST(Microfacet, VisibleNormalsAreNormalized) {
         for (const Vec3d& w : kViews) {
             const double total = integrate_hemisphere(
                 [&](const Vec3d& wm) { return ggx.D_visible(w, wm); }, alpha, 1e-10);
+            EXPECT_NEAR(total, 1, 1e-8) << "alpha = " << alpha << ", w.z = " << w.z;
+        }
+    }
+}
+
+TEST(Microfacet, CompleteVisibleNormalsAreNormalized) {
+    // The normals visible from any w on the *same* side of the microsurface (below the horizon: a
+    // ray inside the microsurface, microsurface_walk.h): ∫ max(0, w·wm) D(wm) dωm is the projected
+    // area, cos θ (1 + Λ) above and |cos θ| Λ below (the signed projected area ∫ (w·wm) D = cos θ
+    // minus the back-facing part). Λ from the independent closed form below.
+    for (double alpha : {0.05, 0.2, 0.5, 1.0}) {
+        const GGX<double> ggx{alpha};
+        for (const Vec3d& w : kViews) {
+            const double total = integrate_hemisphere(
+                [&](const Vec3d& wm) { return ggx.D_visible_complete(w, wm); }, alpha, 1e-10, 64);
             EXPECT_NEAR(total, 1, 1e-8) << "alpha = " << alpha << ", w.z = " << w.z;
         }
     }
@@ -173,7 +193,7 @@ TEST(Microfacet, MaskingShadowingBounds) {
 
 // Chi-square tests in MicrofacetStat (Šidák correction, 1 % for the suite): 7 views below and 2
 // zoomed sharp lobes.
-constexpr int kVisibleNormalChi2Tests = 9;
+constexpr int kVisibleNormalChi2Tests = 13;
 
 TEST(MicrofacetStat, VisibleNormalSamplingChi2) {
     // sample_visible_normal against pdf_visible_normal (= D_w), for several α and views: normal,
@@ -187,7 +207,7 @@ TEST(MicrofacetStat, VisibleNormalSamplingChi2) {
                           {0.2, direction_at(0.02, 2.0)},  {0.5, direction_at(-0.5, 1.0)},
                           {0.5, direction_at(0.3, 5.0)},   {1.0, direction_at(-0.02, 5.5)},
                           {0.05, direction_at(-0.05, 1.0)}};
-    static_assert(std::size(cases) + 2 == kVisibleNormalChi2Tests);
+    static_assert(std::size(cases) + 2 + 4 == kVisibleNormalChi2Tests);
     for (const Case& c : cases) {
         const GGX<double> ggx{c.alpha};
         test::Chi2Options o;
@@ -200,6 +220,37 @@ TEST(MicrofacetStat, VisibleNormalSamplingChi2) {
                 return Chi2Draw::direction(ggx.sample_visible_normal(c.w, u[0], u[1]));
             },
             [&](const Vec3d& wm) { return ggx.pdf_visible_normal(c.w, wm); });
+        EXPECT_TRUE(r.passed) << r.message;
+        EXPECT_NEAR(r.pdf_integral, 1, 1e-6) << o.name;
+    }
+}
+
+TEST(MicrofacetStat, CompleteVisibleNormalSamplingChi2) {
+    // sample_visible_normal_complete against D_visible_complete from views below the horizon on
+    // the same side (where it differs from sample_visible_normal) and one above (where it is the
+    // same construction).
+    struct Case {
+        double alpha;
+        Vec3d w;
+    };
+    const Case cases[] = {{0.5, direction_at(-0.5, 1.0)},
+                          {1.0, direction_at(-0.9, 2.0)},
+                          {0.2, direction_at(-0.05, 4.0)},
+                          {0.5, direction_at(0.4, 0.5)}};
+    static_assert(std::size(cases) + 7 + 2 == kVisibleNormalChi2Tests);
+    for (const Case& c : cases) {
+        const GGX<double> ggx{c.alpha};
+        test::Chi2Options o;
+        o.name =
+            "visible_normals_complete_a" + std::to_string(c.alpha) + "_z" + std::to_string(c.w.z);
+        o.test_count = kVisibleNormalChi2Tests;
+        o.cos_theta_min = 0;
+        const auto r = test::run_chi2(
+            o,
+            [&](const std::array<double, 3>& u) {
+                return Chi2Draw::direction(ggx.sample_visible_normal_complete(c.w, u[0], u[1]));
+            },
+            [&](const Vec3d& wm) { return ggx.D_visible_complete(c.w, wm); });
         EXPECT_TRUE(r.passed) << r.message;
         EXPECT_NEAR(r.pdf_integral, 1, 1e-6) << o.name;
     }
