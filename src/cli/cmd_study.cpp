@@ -27,7 +27,7 @@ namespace {
 
 struct CommonArgs {
     std::string theta_i = "0,15,30,45,60,70,80", particles, grid = "90x90", models, out;
-    std::string kernel = "simd";
+    std::string kernel = "simd", microsurface = "single";
     std::uint64_t seed = 1;
     int threads = 0;
     bool no_figures = false;
@@ -45,6 +45,11 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
     cmd->add_option("--kernel", a.kernel,
                     "Particle kernel of the reference: simd (vectorized) or scalar")
         ->capture_default_str();
+    cmd->add_option("--microsurface", a.microsurface,
+                    "Rough interfaces of the reference: single (single scattering, the masked "
+                    "energy reported as lost) or multiple (Heitz et al. 2016 random walk; needs "
+                    "--kernel scalar)")
+        ->capture_default_str();
     cmd->add_flag("--no-figures", a.no_figures,
                   "Skip the paper figures (the explorer page is always written)");
 }
@@ -58,6 +63,11 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
     s.seed = a.seed;
     s.threads = a.threads;
     s.kernel = parse_kernel(a.kernel);
+    s.microsurface = parse_microsurface(a.microsurface);
+    if (s.microsurface == Microsurface::Multiple && s.kernel == Kernel::Simd)
+        throw InputError("command line", "--microsurface",
+                         "multiple scattering on the microsurfaces runs on the scalar kernel only: "
+                         "add --kernel scalar");
     s.theta_i_deg = parse_incidences(a.theta_i, "--theta-i");
     s.grid = HemisphereGrid::parse(a.grid);
     if (!a.models.empty()) {

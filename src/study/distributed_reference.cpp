@@ -22,17 +22,20 @@ nlohmann::json key_json(const ReferenceKey& key) {
             {"seed", key.seed},
             {"grid", key.grid.to_string()},
             {"kernel", kernel_name(key.kernel)},
+            {"microsurface", microsurface_name(key.microsurface)},
             {"canonical", key.canonical()}};
 }
 
 ReferenceKey key_from_json(const nlohmann::json& j) {
-    ReferenceKey key{j.at("config_id").get<std::string>(),
-                     stack_from_json(j.at("stack"), "reference work list"),
-                     j.at("theta_i").get<double>(),
-                     j.at("particles").get<std::uint64_t>(),
-                     j.at("seed").get<std::uint64_t>(),
-                     HemisphereGrid::parse(j.at("grid").get<std::string>()),
-                     parse_kernel(j.at("kernel").get<std::string>(), "reference work list")};
+    ReferenceKey key{
+        j.at("config_id").get<std::string>(),
+        stack_from_json(j.at("stack"), "reference work list"),
+        j.at("theta_i").get<double>(),
+        j.at("particles").get<std::uint64_t>(),
+        j.at("seed").get<std::uint64_t>(),
+        HemisphereGrid::parse(j.at("grid").get<std::string>()),
+        parse_kernel(j.at("kernel").get<std::string>(), "reference work list"),
+        parse_microsurface(j.at("microsurface").get<std::string>(), "reference work list")};
     if (key.canonical() != j.at("canonical").get<std::string>())
         throw InputError("reference work list", key.config_id,
                          "this process describes the piece differently from the root: are all "

@@ -137,9 +137,10 @@ std::string read_file(const std::filesystem::path& path) {
 std::string ReferenceKey::canonical() const {
     return fmt::format(
         "lamina {} | config {} | stack {} | theta_i {} | particles {} | seed {} | "
-        "grid {} | kernel {}",
+        "grid {} | kernel {}{}",
         kVersion, config_id, stack_to_json(stack).dump(), theta_i_deg, particles, seed,
-        grid.to_string(), kernel_description(kernel));
+        grid.to_string(), kernel_description(kernel),
+        microsurface == Microsurface::Multiple ? " | microsurface multiple" : "");
 }
 
 std::string ReferenceKey::file_name() const {
@@ -170,6 +171,7 @@ std::string compute_reference_piece(const ReferenceKey& key, int threads,
     s.particles = (key.particles + 1) / 2;
     s.seed = key.seed;
     s.kernel = key.kernel;
+    s.microsurface = key.microsurface;
     const SimulationResult a = simulate(key.stack, s, on_progress);
     const std::uint64_t n_a = s.particles;
     s.particles = key.particles - n_a;

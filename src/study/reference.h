@@ -30,6 +30,9 @@ struct ReferenceKey {
     /// The particle kernel; its description (with the SIMD instruction set) is part of the key,
     /// since tables are bitwise reproducible per kernel description only.
     Kernel kernel = Kernel::Simd;
+    /// Single- or multiple-scattering microsurfaces (part of the key when multiple; the text of
+    /// single-scattering keys is what it was before the option existed, so their caches stay).
+    Microsurface microsurface = Microsurface::Single;
 
     /// A canonical text of every field (and lamina's version) and its 64-bit FNV-1a hash.
     std::string canonical() const;

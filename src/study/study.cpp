@@ -46,7 +46,8 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     // 1. The reference, one resumable piece per incidence.
     std::vector<ReferencePiece> pieces;
     for (double theta_i : s.theta_i_deg) {
-        ReferenceKey key{config.id, config.stack, theta_i, s.particles, s.seed, grid, s.kernel};
+        ReferenceKey key{config.id, config.stack, theta_i,  s.particles,
+                         s.seed,    grid,         s.kernel, s.microsurface};
         pieces.push_back(reference_piece(reference_cache_dir(out_dir), key, s.threads,
                                          [&](std::uint64_t n) { progress.advance(n); }));
     }
@@ -253,6 +254,7 @@ std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
     sj["particles"] = s.particles;
     sj["seed"] = s.seed;
     sj["kernel"] = kernel_description(s.kernel);
+    sj["microsurface"] = microsurface_name(s.microsurface);
     sj["theta_i"] = s.theta_i_deg;
     sj["grid"] = {{"n_theta", s.grid.n_theta()}, {"n_phi", s.grid.n_phi()}};
     sj["models"] = model_names;

@@ -21,10 +21,11 @@ struct StudySettings {
     std::uint64_t seed = 1;
     std::vector<double> theta_i_deg{0, 15, 30, 45, 60, 70, 80};
     HemisphereGrid grid{90, 90};
-    std::vector<std::string> models;  ///< registry names; empty: every model
-    int threads = 0;                  ///< 0: all cores
-    Kernel kernel = Kernel::Simd;     ///< the reference's particle kernel
-    bool quiet = false;               ///< no per-configuration lines on stdout
+    std::vector<std::string> models;                   ///< registry names; empty: every model
+    int threads = 0;                                   ///< 0: all cores
+    Kernel kernel = Kernel::Simd;                      ///< the reference's particle kernel
+    Microsurface microsurface = Microsurface::Single;  ///< the reference's rough interfaces
+    bool quiet = false;                                ///< no per-configuration lines on stdout
 };
 
 /// Particles per incidence of the presets: quick 10⁶ (demo and CI), standard 10⁷, paper 1.6·10⁸

@@ -280,6 +280,7 @@ void write_summary(const std::filesystem::path& out_dir,
     j["lamina_version"] = kVersion;
     j["preset"] = s.preset;
     j["particles"] = s.particles;
+    j["microsurface"] = microsurface_name(s.microsurface);
     j["theta_i"] = s.theta_i_deg;
     j["grid"] = s.grid.to_string();
     j["models"] = models;
@@ -346,9 +347,14 @@ void write_summary(const std::filesystem::path& out_dir,
     };
     out("# lamina study: which layered model, for which material, how wrong\n\n");
     out("Preset `{}`: {:.3g} particles per incidence (two independent halves), incidences {}°, "
-        "{} bins, {} configurations, models {}. lamina {}.\n\n",
+        "{} bins, {} configurations, models {}; the reference's rough interfaces {}. lamina "
+        "{}.\n\n",
         s.preset, double(s.particles), fmt::join(s.theta_i_deg, "°, "), s.grid.to_string(),
-        configs.size(), fmt::join(models, ", "), kVersion);
+        configs.size(), fmt::join(models, ", "),
+        s.microsurface == Microsurface::Multiple
+            ? "scatter multiply on their microsurfaces (Heitz et al. 2016: nothing is lost there)"
+            : "scatter once on their microsurfaces (the masked energy is lost and reported)",
+        kVersion);
     out("The primary metric is the **misplaced energy**: the fraction of the reference's reflected "
         "(or transmitted) energy a model puts in the wrong place, adds or removes (0 is perfect). "
         "Every number is next to the reference's **noise floor** — what Monte-Carlo noise alone "

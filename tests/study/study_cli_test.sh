@@ -81,5 +81,27 @@ expect_error "--theta-i: 95 is outside" study --theta-i 95 --out "$tmp/x"
 echo '{"configurations": [{"id": "a b", "stack": {}}]}' >"$tmp/bad.json"
 expect_error "/configurations/0/id" study --configs "$tmp/bad.json" --out "$tmp/x"
 
+expect_error "--microsurface: multiple scattering on the microsurfaces runs on the scalar kernel" \
+    study --microsurface multiple --only 'plastic-P1-a0.05' --out "$tmp/x"
+expect_error "--microsurface: 'double' is not a microsurface model" \
+    study --microsurface double --kernel scalar --only 'plastic-P1-a0.05' --out "$tmp/x"
+
+# 7. A multiple-scattering reference: its own cache pieces (the key says so), nothing lost to the
+#    microsurfaces in the budgets, and study.json and summary.json say which reference it is.
+ms=(--only 'plastic-P1-a0.05' --models ww-prime --theta-i 60 --particles 2e4 --grid 18x18
+    --no-figures --kernel scalar)
+"$lamina" study "${ms[@]}" --out "$tmp/m" >/dev/null 2>&1 && ok || fail "single-scattering study"
+"$lamina" study "${ms[@]}" --microsurface multiple --out "$tmp/m" >/dev/null 2>&1 \
+    && ok || fail "multiple-scattering study"
+[ "$(find "$tmp/m/cache" -name '*.bin' | wc -l)" -eq 2 ] && ok || fail "one cache piece per model"
+python3 - "$tmp/m" <<'PY' && ok || fail "multiple-scattering outputs"
+import json, sys
+d = sys.argv[1]
+assert json.load(open(d + "/study.json"))["microsurface"] == "multiple"
+assert json.load(open(d + "/summary.json"))["microsurface"] == "multiple"
+for e in json.load(open(d + "/configs/plastic-P1-a0.05/config.json"))["energy"]:
+    assert e["lost_microsurface"] == [0, 0, 0], e
+PY
+
 echo "$pass passed, $fails failed"
 [ "$fails" -eq 0 ]
