@@ -129,6 +129,12 @@ check simulate-threads 0 "$lamina" simulate "$src/examples/slab.json" --theta-i 
     --grid 9x9 --seed 3 --threads 1 --out "$tmp/sim1"
 check simulate-reproducible 0 cmp "$tmp/sim/brdf.csv" "$tmp/sim1/brdf.csv"
 
+# Multiple scattering on the microsurfaces: result.json says so, nothing is lost there.
+check simulate-multiple 0 "$lamina" simulate "$src/examples/frosted-gold.json" --theta-i 60 \
+    --particles 2e4 --grid 9x9 --kernel scalar --microsurface multiple --out "$tmp/ms"
+check_says simulate-multiple-json 0 '"microsurface": "multiple"' cat "$tmp/ms/result.json"
+check_says simulate-multiple-lost 0 "60,r" awk -F, '$1 == 60 && $7 == 0 {print $1 "," $2}' "$tmp/ms/energy.csv"
+
 # simulate: bad arguments fail clearly and leave nothing behind.
 check_says simulate-theta-90 1 "--theta-i: 90 is outside the allowed range [0, 90)" \
     "$lamina" simulate "$src/examples/plastic.json" --theta-i 90 --out "$tmp/bad1"
@@ -138,6 +144,10 @@ check_says simulate-zero-particles 1 "--particles: '0' is not allowed" \
     "$lamina" simulate "$src/examples/plastic.json" --particles 0 --out "$tmp/bad1"
 check_says simulate-bad-grid 1 "--grid: '90by90' is not a grid" \
     "$lamina" simulate "$src/examples/plastic.json" --grid 90by90 --out "$tmp/bad1"
+check_says simulate-multiple-simd 1 "--microsurface: multiple scattering on the microsurfaces runs on the scalar kernel only" \
+    "$lamina" simulate "$src/examples/plastic.json" --microsurface multiple --out "$tmp/bad1"
+check_says simulate-bad-microsurface 1 "--microsurface: 'many' is not a microsurface model" \
+    "$lamina" simulate "$src/examples/plastic.json" --microsurface many --kernel scalar --out "$tmp/bad1"
 check_says simulate-bad-stack 1 "no-such.json" \
     "$lamina" simulate "$tmp/no-such.json" --out "$tmp/bad1"
 if [ -e "$tmp/bad1" ]; then echo "FAIL simulate: a failed run left $tmp/bad1"; fails=$((fails + 1)); else pass=$((pass + 1)); fi
