@@ -10,10 +10,14 @@
 // (uniform on [−1, 1]; the paper shows the BSDF does not depend on it), scatters off a facet drawn
 // from the distribution of normals visible from its direction (which may point below the
 // horizon after a first bounce), and so on. Nothing is lost but what a conductor's Fresnel
-// factor absorbs; the first order of the walk is exactly the single-scattering interface with
-// the height-correlated G2 (shown in the paper; the tests check it): with c = C1(h) of the first
-// hit, c has density (1 + Λi) c^Λi and escapes towards wo with probability c^Λo, so the
-// first-order escape probability is (1 + Λi)/(1 + Λi + Λo) = G2/G1.
+// factor absorbs. The first order of the walk is the single-scattering interface with the
+// height-correlated Smith masking-shadowing (the tests check it bin by bin): with c = C1(h) of the
+// first hit, c has density (1 + Λi) c^Λi; a reflected ray escapes with probability c^Λo, so
+// G2/G1 = (1 + Λi)/(1 + Λi + Λo), the G2 of dielectric.h and conductor.h; a refracted ray leaves
+// below, where the heights above it have C1 = 1 − c, so G2/G1 = ∫ (1 + Λi) c^Λi (1 − c)^Λo dc =
+// (1 + Λi) B(1 + Λi, 1 + Λo) (B: Euler's Beta function). The single-scattering dielectric uses
+// 1/(1 + Λi + Λo) for its refraction lobe too (physics.md §3, as pbrt-v4 does); the two differ by
+// a few percent at grazing exits and by more when both Λ are large.
 //
 // Conventions as in bsdf.h: `wi` points away from the surface towards where the light comes from
 // (above: wi.z > 0; from below a dielectric: wi.z < 0). Directions of travel are written `wr`.
