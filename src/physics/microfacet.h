@@ -91,16 +91,7 @@ struct GGX {
     /// particle tracer's hot loop. w.z < 0 is handled through −w.
     Vec3<T> sample_visible_normal_caps(Vec3<T> w, T u1, T u2) const {
         if (w.z < 0) w = -w;
-        // Warp to the hemisphere configuration (α = 1).
-        const Vec3<T> wh = normalize(Vec3<T>(alpha * w.x, alpha * w.y, w.z));
-        // Sample a spherical cap in (−wh.z, 1].
-        const T phi = T(2) * kPi<T> * u1;
-        const T z = (T(1) - u2) * (T(1) + wh.z) - wh.z;
-        const T sin_theta = safe_sqrt(T(1) - sqr(z));
-        const Vec3<T> c(sin_theta * std::cos(phi), sin_theta * std::sin(phi), z);
-        // The halfway direction of the cap point and wh, warped back to the ellipsoid.
-        const Vec3<T> h = c + wh;
-        return normalize(Vec3<T>(alpha * h.x, alpha * h.y, max0(h.z)));
+        return sample_visible_normal_complete(w, u1, u2);
     }
 
     /// The distribution of normals visible from any direction w, below the horizon too (a ray
@@ -115,10 +106,11 @@ struct GGX {
         return cos_w_wm * D(wm) / area;
     }
 
-    /// Samples D_visible_complete(w, ·) by the spherical caps of Dupuy & Benyoub 2023 (Listing 3),
-    /// whose construction holds for every w, below the horizon included (the "complete" of their
-    /// title): the cap z ∈ (−wh.z, 1] then covers less than a hemisphere. For w.z ≥ 0 it is
-    /// sample_visible_normal_caps.
+    /// Samples D_visible_complete(w, ·) by the spherical caps of Dupuy & Benyoub 2023 (Listing 3):
+    /// warp w to the hemisphere configuration (α = 1), sample a spherical cap z ∈ (−wh.z, 1], take
+    /// the halfway direction of the cap point and wh, warp back. The construction holds for every
+    /// w, below the horizon included (the "complete" of their title: the cap then covers less than
+    /// a hemisphere). For w.z ≥ 0 it is sample_visible_normal_caps.
     Vec3<T> sample_visible_normal_complete(const Vec3<T>& w, T u1, T u2) const {
         const Vec3<T> wh = normalize(Vec3<T>(alpha * w.x, alpha * w.y, w.z));
         const T phi = T(2) * kPi<T> * u1;
