@@ -297,6 +297,8 @@
     if (STUDY.preset) parts.push("preset " + STUDY.preset);
     if (STUDY.particles) parts.push(Number(STUDY.particles).toExponential(1).replace("e+", "·10^") + " particles per incidence");
     parts.push("grid " + STUDY.grid.n_theta + "×" + STUDY.grid.n_phi);
+    // Which reference: its rough interfaces scatter once (the masked energy is lost) or multiply.
+    if (STUDY.microsurface) parts.push((STUDY.microsurface === "multiple" ? "multiple" : "single") + "-scattering microsurfaces");
     if (STUDY.lamina_version) parts.push("lamina " + STUDY.lamina_version);
     $("study-info").textContent = parts.join(" · ");
     setOptions($("w-incidence"), THETA_I.map((t, i) => [i, t + "°"]), state.incidence);

@@ -43,6 +43,8 @@ async function main() {
     check(expected.some((v) => v > 0), `${shown} loses energy to its rough coat (test premise)`);
     check(lost !== null && lost.length === expected.length && lost.every((v, i) => Math.abs(v - expected[i]) <= 1e-12 * Math.max(1, expected[i])),
       `the albedo view draws the reference's microsurface loss (${lost} against config.json's ${expected})`);
+    const info = await page.evaluate(() => document.getElementById("study-info").textContent);
+    check(info.includes("single-scattering microsurfaces"), `the header names the reference's microsurface model (${info})`);
     const cells = await page.evaluate(() => (document.getElementById("leaderboard").data[0] || {}).z);
     check(Array.isArray(cells) && cells.length >= 2, "the leaderboard lists the configurations");
     await page.screenshot({ path: shot, fullPage: true });
