@@ -41,14 +41,17 @@ Stack bench_metallic_paint() {
     return {"bench metallic paint", 1.0, {coat(0.05, Rgbd(0.1)), base}};
 }
 
-void run(benchmark::State& state, const Stack& stack) {
+void run(benchmark::State& state, const Stack& stack,
+         Microsurface microsurface = Microsurface::Single) {
     SimulationSettings s;
+    s.microsurface = microsurface;
     s.theta_i_deg = {30.0};
     s.particles = 1'000'000;
     s.threads = int(state.range(0));
     s.kernel = state.range(1) == 1 ? Kernel::Simd : Kernel::Scalar;
-    state.SetLabel(s.kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name())
-                                            : std::string("scalar"));
+    state.SetLabel((s.kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name())
+                                             : std::string("scalar")) +
+                   (microsurface == Microsurface::Multiple ? " multiple" : ""));
     double events = 0;
     for (auto _ : state) {
         const SimulationResult r = simulate(stack, s);
@@ -67,6 +70,14 @@ void BM_SimulateMetallicPaint(benchmark::State& state) {
     run(state, bench_metallic_paint());
 }
 
+// Multiple scattering on the microsurfaces (Heitz et al. 2016 walk): the scalar kernel only.
+void BM_SimulatePlasticMultiple(benchmark::State& state) {
+    run(state, bench_plastic(), Microsurface::Multiple);
+}
+void BM_SimulateMetallicPaintMultiple(benchmark::State& state) {
+    run(state, bench_metallic_paint(), Microsurface::Multiple);
+}
+
 BENCHMARK(BM_SimulatePlastic)
     ->ArgsProduct({{1, 2}, {0, 1}})
     ->ArgNames({"threads", "simd"})
@@ -74,6 +85,16 @@ BENCHMARK(BM_SimulatePlastic)
     ->UseRealTime();
 BENCHMARK(BM_SimulateMetallicPaint)
     ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "simd"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_SimulatePlasticMultiple)
+    ->ArgsProduct({{1, 2}, {0}})
+    ->ArgNames({"threads", "simd"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_SimulateMetallicPaintMultiple)
+    ->ArgsProduct({{1, 2}, {0}})
     ->ArgNames({"threads", "simd"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
