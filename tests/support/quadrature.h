@@ -52,32 +52,42 @@ inline double integrate(const std::function<double(double)>& f, double a, double
     const double h = (b - a) / pieces;
     for (int p = 0; p < pieces; ++p) {
         const double lo = a + p * h, mid = lo + h / 2;
-        for (const auto& [x, w] : cache) sum += w * f(mid + x * h / 2);
+        for (const auto& [x, w] : cache)
+            sum += w * f(mid + x * h / 2);
     }
     return sum * h / 2;
 }
 
 /// Cos-weighted average of f(wo) over grid bin j on one side: ∫ f |cos| dω / Ω⊥. The measure
 /// |cos θ| dω = ½ d(sin²θ) dφ is uniform in (u = sin²θ, φ); both folded halves are averaged.
+/// n Gauss–Legendre nodes per axis on each of pieces × pieces sub-rectangles (composite rule: a
+/// lobe that ends inside the bin, where one Gauss rule converges slowly, needs pieces > 1).
 inline Rgbd bin_average(const HemisphereGrid& grid, std::size_t j, Side side,
-                        const std::function<Rgbd(const Vec3d&)>& f, int n = 8) {
+                        const std::function<Rgbd(const Vec3d&)>& f, int n = 8, int pieces = 1) {
     const int t = int(j) / grid.n_phi(), p = int(j) % grid.n_phi();
-    const double u0 = sqr(std::sin(grid.theta_lo(t))), u1 = sqr(std::sin(grid.theta_hi(t)));
-    const double phi0 = grid.phi_lo(p), phi1 = grid.phi_hi(p);
+    const double u_lo = sqr(std::sin(grid.theta_lo(t))), u_hi = sqr(std::sin(grid.theta_hi(t)));
+    const double phi_lo = grid.phi_lo(p), phi_hi = grid.phi_hi(p);
     const auto nodes = gauss_legendre(n);
     Rgbd sum(0.0);
     double weight = 0;
-    for (const auto& [xu, wu] : nodes) {
-        const double u = 0.5 * (u0 + u1) + 0.5 * (u1 - u0) * xu;
-        const double theta = std::asin(std::sqrt(u));
-        for (const auto& [xp, wp] : nodes) {
-            const double phi = 0.5 * (phi0 + phi1) + 0.5 * (phi1 - phi0) * xp;
-            const Vec3d a = direction_from_angles(theta, phi, side);
-            const Vec3d b = direction_from_angles(theta, -phi, side);
-            sum += (f(a) + f(b)) * (0.5 * wu * wp);
-            weight += wu * wp;
+    for (int iu = 0; iu < pieces; ++iu)
+        for (int ip = 0; ip < pieces; ++ip) {
+            const double u0 = u_lo + (u_hi - u_lo) * iu / pieces;
+            const double u1 = u_lo + (u_hi - u_lo) * (iu + 1) / pieces;
+            const double phi0 = phi_lo + (phi_hi - phi_lo) * ip / pieces;
+            const double phi1 = phi_lo + (phi_hi - phi_lo) * (ip + 1) / pieces;
+            for (const auto& [xu, wu] : nodes) {
+                const double u = 0.5 * (u0 + u1) + 0.5 * (u1 - u0) * xu;
+                const double theta = std::asin(std::sqrt(u));
+                for (const auto& [xp, wp] : nodes) {
+                    const double phi = 0.5 * (phi0 + phi1) + 0.5 * (phi1 - phi0) * xp;
+                    const Vec3d a = direction_from_angles(theta, phi, side);
+                    const Vec3d b = direction_from_angles(theta, -phi, side);
+                    sum += (f(a) + f(b)) * (0.5 * wu * wp);
+                    weight += wu * wp;
+                }
+            }
         }
-    }
     return sum / weight;
 }
 
