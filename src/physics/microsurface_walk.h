@@ -73,20 +73,23 @@ inline T microsurface_next_height(const GGX<T>& ggx, const Vec3<T>& wr, T h, T u
 
 /// Where a walk left the microsurface: direction (pointing away from it), the flux weight it
 /// carries (RGB: a conductor's Fresnel factors; 1 for a dielectric) and the number of facets it
-/// met (the scattering order, ≥ 1).
+/// met (the scattering order, ≥ 1). `escaped` is false for a walk given up at its facet cap (it
+/// would meet one more facet): its flux is lost to the microsurface and wo is meaningless.
 template <typename T>
 struct MicrosurfaceExit {
     Vec3<T> wo;
     Rgb<T> weight{T(1)};
     int order = 0;
+    bool escaped = true;
 };
 
 /// The microsurface walk of a particle arriving from wi on a rough dielectric interface of
 /// relative index eta (below / above) and roughness ggx.alpha > 0, light from either side. Each
 /// facet reflects with its exact Fresnel probability and refracts otherwise (Heitz et al. 2016,
 /// the random walk with their dielectric phase function). `uniform()` returns uniform
-/// numbers in [0, 1). Returns nothing when the walk, after max_order facets, meets one more
-/// (its energy is then lost and reported by the caller) or on a numerical degeneracy.
+/// numbers in [0, 1). A walk that, after max_order facets, would meet one more is given up
+/// (escaped = false: the caller books its flux as lost to the microsurface); a numerical
+/// degeneracy returns nothing (the caller counts it).
 template <typename T, typename Uniform>
 std::optional<MicrosurfaceExit<T>> walk_rough_dielectric(const GGX<T>& ggx, T eta,
                                                          const Vec3<T>& wi, Uniform&& uniform,
@@ -105,7 +108,10 @@ std::optional<MicrosurfaceExit<T>> walk_rough_dielectric(const GGX<T>& ggx, T et
             exit.wo = wr;
             return exit;
         }
-        if (exit.order == max_order) return std::nullopt;
+        if (exit.order == max_order) {
+            exit.escaped = false;
+            return exit;
+        }
         ++exit.order;
         // A facet visible from the arriving direction (below the horizon after a first bounce).
         const Vec3<T> w = -wr;
@@ -130,8 +136,8 @@ std::optional<MicrosurfaceExit<T>> walk_rough_dielectric(const GGX<T>& ggx, T et
 
 /// The microsurface walk of a particle arriving from wi (wi.z > 0) on a rough conductor; each
 /// facet multiplies the flux by its Fresnel factor (Heitz et al. 2016, the conductor phase
-/// function). `fresnel(cos)` returns the RGB reflectance at a facet cosine. Returns nothing when
-/// the walk would meet a facet beyond max_order, or on a degeneracy.
+/// function). `fresnel(cos)` returns the RGB reflectance at a facet cosine. Given up past
+/// max_order facets and empty on a degeneracy, as walk_rough_dielectric.
 template <typename T, typename Fresnel, typename Uniform>
 std::optional<MicrosurfaceExit<T>> walk_rough_conductor(const GGX<T>& ggx, const Fresnel& fresnel,
                                                         const Vec3<T>& wi, Uniform&& uniform,
@@ -146,7 +152,10 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor(const GGX<T>& ggx, const
             exit.wo = wr;
             return exit;
         }
-        if (exit.order == max_order) return std::nullopt;
+        if (exit.order == max_order) {
+            exit.escaped = false;
+            return exit;
+        }
         ++exit.order;
         const Vec3<T> w = -wr;
         const T u1 = uniform(), u2 = uniform();

@@ -199,10 +199,12 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
             d = s->wo;
         };
         // A rough interface with multiple scattering: the microsurface walk (Heitz et al. 2016)
-        // replaces the single facet; its exit carries the conductor's Fresnel factors, and a walk
-        // that reaches the facet cap loses its flux to the microsurface.
+        // replaces the single facet; its exit carries the conductor's Fresnel factors. A walk
+        // given up at the facet cap loses its flux to the microsurface; a degenerate one too, and
+        // is counted as a degeneracy.
         auto apply_walk = [&](const std::optional<MicrosurfaceExit<float>>& e, bool opaque) {
-            if (!e) {
+            if (!e || !e->escaped) {
+                if (!e) ++tally.sums.degenerate;
                 losses.add(BudgetTerm::LostMicrosurface, w);
                 w = Rgbf(0.f);
                 return;
