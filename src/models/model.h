@@ -19,6 +19,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,13 @@ struct DeltaLobe {
     Rgbd energy;
 };
 
+/// A direction drawn by Model::sample: wo, its density (solid angle) and eval·|cos θo|/pdf.
+struct ModelSample {
+    Vec3d wo;
+    Rgbd weight;
+    double pdf = 0.0;
+};
+
 /// A model with everything that depends only on the incident direction already computed (e.g.
 /// the lobe statistics of the forward Belcour variants). eval(wo) == Model::eval(wi, wo).
 class IncidentEvaluator {
@@ -78,6 +86,17 @@ class Model {
     /// Directions where the model's lobes peak (narrow lobes hide there): binned quadrature always
     /// refines towards them. Default: the mirror direction of wi.
     virtual std::vector<Vec3d> peak_directions(const Vec3d& wi) const;
+
+    /// Importance sampling, for models a renderer can sample (physics/bsdf.h conventions):
+    /// sample(wi, u) draws wo from the density pdf(wi, wo) (solid angle, 1/sr, either side) from
+    /// three uniforms in [0, 1); the sample's weight is eval(wi, wo)·|cos θo| / pdf. Delta lobes
+    /// are not sampled here. Models without a sampler keep the defaults: has_sampling() false,
+    /// sample() empty, pdf() 0. Nothing here throws.
+    virtual bool has_sampling() const { return false; }
+    virtual std::optional<ModelSample> sample(const Vec3d& /*wi*/, const Vec3d& /*u*/) const {
+        return std::nullopt;
+    }
+    virtual double pdf(const Vec3d& /*wi*/, const Vec3d& /*wo*/) const { return 0.0; }
 };
 
 /// Mirror direction of wi about the macro normal.
