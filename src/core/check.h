@@ -1,5 +1,5 @@
 #pragma once
-// Invariant checks (style.md §8, tier 2). A failed CHECK is a bug in lamina, not bad input: it
+// Invariant checks (docs/style.md §8, tier 2). A failed CHECK is a bug in lamina, not bad input: it
 // prints where and aborts. Bad input is rejected earlier, at parse time, with lamina::InputError.
 
 #include <cstdio>

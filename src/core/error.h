@@ -1,7 +1,7 @@
 #pragma once
-// Errors a user can act on (style.md §8, tier 1): bad input rejected once, at parse time, with a
-// message that names the file, the field (a JSON pointer or an option name), the value and what is
-// allowed. The CLI prints what() and exits non-zero.
+// Errors a user can act on (docs/style.md §8, tier 1): bad input rejected once, at parse time, with
+// a message that names the file, the field (a JSON pointer or an option name), the value and what
+// is allowed. The CLI prints what() and exits non-zero.
 
 #include <stdexcept>
 #include <string>

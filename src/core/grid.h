@@ -1,5 +1,5 @@
 #pragma once
-// The goniophotometer's bins on a hemisphere (physics.md §5), shared by the reference (which
+// The goniophotometer's bins on a hemisphere (docs/physics.md §5), shared by the reference (which
 // tallies particles into them) and the models (which are averaged over them).
 //
 // θ ∈ [0°, 90°] in n_theta equal bins (measured from +z for reflection, from −z for transmission);

@@ -1,5 +1,5 @@
 #pragma once
-// RGB triples: three independent spectral channels (physics.md §1).
+// RGB triples: three independent spectral channels (docs/physics.md §1).
 
 #include <algorithm>
 #include <array>

@@ -1,5 +1,5 @@
 #pragma once
-// Spherical coordinates in lamina's conventions (physics.md §1).
+// Spherical coordinates in lamina's conventions (docs/physics.md §1).
 //
 // θ is measured from +z for upper-hemisphere (reflected) directions and from −z for
 // lower-hemisphere (transmitted) directions; φ is measured from +x. The light of an incidence θi

@@ -1,9 +1,9 @@
 #pragma once
 // Three-component vectors for directions in lamina's local frame.
 //
-// Conventions (physics.md §1): z is the geometric normal, pointing into the ambient medium above
-// the stack. Directions are unit vectors pointing *away* from the surface. Templated on the scalar
-// so the particle tracer can run in float while models and tests use double.
+// Conventions (docs/physics.md §1): z is the geometric normal, pointing into the ambient medium
+// above the stack. Directions are unit vectors pointing *away* from the surface. Templated on the
+// scalar so the particle tracer can run in float while models and tests use double.
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // Stack files: parsing with validation, the canonical JSON form, and a one-line description.
-// The format is documented for users in docs/stack-format.md; physics in physics.md §2.
+// The format is documented for users in docs/stack-format.md; physics in docs/physics.md §2.
 //
 // Every rejection is one InputError naming the file, the JSON pointer (RFC 6901) of the field, the
 // offending value and what is allowed. Keys are never ignored: an unknown key is an error that

@@ -1,6 +1,6 @@
 #pragma once
-// A layer stack as data (physics.md §2; style.md §5). Every estimator — the goniophotometer, the
-// analytic models, the random walk — reads this same description.
+// A layer stack as data (docs/physics.md §2; docs/style.md §5). Every estimator — the
+// goniophotometer, the analytic models, the random walk — reads this same description.
 //
 // From top to bottom: the ambient medium (index `ambient_eta`, default 1), then layers. A layer is
 // an interface and, below it, an optional homogeneous medium whose refractive index is the `eta`
@@ -36,7 +36,7 @@ struct InterfaceSpec {
     bool operator==(const InterfaceSpec&) const = default;
 };
 
-/// A homogeneous medium described by its normal optical depths (physics.md §4).
+/// A homogeneous medium described by its normal optical depths (docs/physics.md §4).
 struct MediumSpec {
     Rgbd tau_a{0.0};  ///< absorption optical depth ≥ 0
     Rgbd tau_s{0.0};  ///< scattering optical depth ≥ 0

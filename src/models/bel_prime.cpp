@@ -1,5 +1,5 @@
-// Bel': the study's correction of Belcour 2018 (models.md): Bel18 forward with lobe 0 replaced by
-// the exact microfacet reflection of the top interface (Walter et al. 2007, Eq. 20), and the
+// Bel': the study's correction of Belcour 2018 (docs/models.md): Bel18 forward with lobe 0 replaced
+// by the exact microfacet reflection of the top interface (Walter et al. 2007, Eq. 20), and the
 // slab's BTDF as one transmitted GGX lobe of energy T0i, roughness α(sT0i) and the refracted mean
 // direction, evaluated as the mirror image through z = 0 of a reflection lobe with those
 // statistics.

@@ -50,7 +50,7 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
     const FgdTable& fgd = FgdTable::get();
     BelcourStats out;
     const bool q = ch.quadratic_mapping;
-    // Initial state (models.md "Adding"): nothing reflected, everything transmitted.
+    // Initial state (docs/models.md "Adding"): nothing reflected, everything transmitted.
     Rgbd R0i(0.0), Ri0(0.0), T0i(1.0), Ti0(1.0);
     double sR0i = 0, sRi0 = 0, sT0i = 0, sTi0 = 0, J0i = 1, Ji0 = 1;
     double c = std::max(c0, 1e-6);
@@ -84,7 +84,7 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
                         sT12 = variance_of(op.alpha * 0.5 * std::abs(1 - c / (op.n12 * ct)), q);
                         sT21 = variance_of(op.alpha * 0.5 * std::abs(1 - op.n12 * ct / c), q);
                     } else {
-                        // The author's code (models.md): angle-independent scalings.
+                        // The author's code (docs/models.md): angle-independent scalings.
                         sT12 = pre ? op.sigma_t12
                                    : variance_of(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
                         sT21 = pre ? op.sigma_t21
@@ -100,7 +100,7 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
                 }
             }
         } else {
-            // Medium (models.md "Per medium"): unscattered plus once forward-scattered light,
+            // Medium (docs/models.md "Per medium"): unscattered plus once forward-scattered light,
             // T = (1 + τs L) e^{−(τa+τs) L}, L = 1/c; no reflection; the scattered part widens
             // the lobe by σ_HG(g) (only when the medium scatters).
             const double L = 1 / c;
@@ -112,8 +112,8 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         const Rgbd R21 = R12, T21 = T12;
         const double sR21 = sR12, J21 = 1 / J12;
 
-        // Adding (models.md): Dn = 1 − Ri0·R12 sums the inter-reflections between this operator
-        // and everything above.
+        // Adding (docs/models.md): Dn = 1 − Ri0·R12 sums the inter-reflections between this
+        // operator and everything above.
         Rgbd Dn = Rgbd(1.0) - Ri0 * R12;
         for (int i = 0; i < 3; ++i)
             Dn[i] = std::max(Dn[i], 1e-9);  // two perfect mirrors facing
@@ -163,7 +163,7 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         last_transmits = transmits;
         if (op.kind == BelcourOperator::Conductor || (is_interface && !transmits)) break;
     }
-    (void)sR0i;  // the reflected variance, tracked as models.md writes it; no lobe uses it
+    (void)sR0i;  // the reflected variance, tracked as docs/models.md writes it; no lobe uses it
     if (last_was_dielectric && last_transmits) {
         out.transmits = true;
         out.transmitted = T0i;
@@ -344,7 +344,7 @@ class BelcourModel final : public Model {
 
     /// Bel' BTDF: a GGX reflection lobe of energy T0i and roughness α(sT0i) for the virtual
     /// incidence wv at the transmitted mean cosine, mirrored through z = 0, so that its peak is
-    /// the refracted mean direction (models.md; lamina's documented choice).
+    /// the refracted mean direction (docs/models.md; lamina's documented choice).
     Rgbd eval_btdf(const BelcourStats& st, const Vec3d& wi, const Vec3d& wo) const {
         if (!support_.btdf || !st.transmits || st.alpha_t <= 0) return Rgbd(0.0);
         const Vec3d wt = transmitted_direction(wi, st.cos_t);

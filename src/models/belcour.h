@@ -3,7 +3,7 @@
 // statistical operators", ACM TOG 37(4) (SIGGRAPH): the BRDF is a sum of GGX lobes, one per
 // interface, whose energies and roughnesses come from tracking three statistics of a lobe
 // (energy per RGB, mean cosine, scalar variance) through the stack with an adding–doubling
-// scheme (models.md, "Belcour 2018 and Bel'"; paper §4–6). Bel18 forward, Bel18 symmetric and
+// scheme (docs/models.md, "Belcour 2018", "Bel'"; paper §4–6). Bel18 forward, Bel18 symmetric and
 // Bel' are one engine with the choices below; each has its own source file with its defaults.
 
 #include "models/fgd_table.h"
@@ -68,7 +68,7 @@ struct BelcourOperator {
 /// Fills the angle-independent variances of every operator for the given mapping.
 void precompute_variances(std::vector<BelcourOperator>& ops, bool quadratic_mapping);
 
-/// Runs the adding scheme (models.md) for mean incident cosine c0 ∈ (0, 1].
+/// Runs the adding scheme (docs/models.md) for mean incident cosine c0 ∈ (0, 1].
 BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
                             const BelcourChoices& choices);
 

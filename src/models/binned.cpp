@@ -212,7 +212,7 @@ BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
             lobe.f[std::size_t(t) * grid.n_phi() + p] = integrator.average(
                 grid.theta_lo(t), grid.theta_hi(t), grid.phi_lo(p), grid.phi_hi(p));
     }
-    // Delta lobes: energy / Ω⊥ of the bin they hit (physics.md §5).
+    // Delta lobes: energy / Ω⊥ of the bin they hit (docs/physics.md §5).
     for (std::size_t i = 0; i < n_inc; ++i) {
         for (const DeltaLobe& d : model.delta_lobes(wi[i])) {
             const Side side = d.direction.z > 0 ? Side::Reflection : Side::Transmission;

@@ -1,7 +1,7 @@
 #pragma once
-// A model averaged over the goniophotometer's bins (physics.md §5): for each incidence, side and
-// bin, the cos-weighted average ∫_bin f |cos θ| dω / ∫_bin |cos θ| dω, in exactly the BinnedTable
-// (`brdf.csv`) form of the reference.
+// A model averaged over the goniophotometer's bins (docs/physics.md §5): for each incidence, side
+// and bin, the cos-weighted average ∫_bin f |cos θ| dω / ∫_bin |cos θ| dω, in exactly the
+// BinnedTable (`brdf.csv`) form of the reference.
 //
 // Quadrature: over one folded half (the stack is isotropic), in (θ, φ) with the weight
 // sin θ cos θ in the integrand. (The measure is uniform in u = sin²θ, but in u the integrand has

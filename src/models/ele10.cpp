@@ -1,4 +1,4 @@
-// Ele10: Elek 2010, "Layered materials in real-time rendering", CESCG, Algorithm 1 (models.md
+// Ele10: Elek 2010, "Layered materials in real-time rendering", CESCG, Algorithm 1 (docs/models.md
 // table, row Ele10). T01 and t at the half vector h; refraction about the macro normal n; the base
 // BRDF at the refracted directions with α1 ← max(α0, α1); no 1/η0² factor.
 #include "models/factories.h"

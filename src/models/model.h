@@ -1,5 +1,5 @@
 #pragma once
-// The analytic layered BRDF models lamina compares (docs/models.md; ../shared/models.md).
+// The analytic layered BRDF models lamina compares (docs/models.md).
 //
 // A Model is built for one Stack and one set of Options (the documented ablation flags) and then
 // evaluated like any BSDF in lamina (physics/bsdf.h): eval(wi, wo) is the radiance BSDF from the
@@ -107,9 +107,9 @@ inline Vec3d mirror_direction(const Vec3d& wi) {
 /// Reads an option's value (the registry has already validated and filled in every default).
 const std::string& option_value(const ModelOptions& options, const std::string& key);
 
-/// The stack shape of the Weidlich–Wilkie family and of WW' (models.md): ambient | dielectric
+/// The stack shape of the Weidlich–Wilkie family and of WW' (docs/models.md): ambient | dielectric
 /// coat (eta0, alpha0) | optional medium | base. Indices are relative: eta0 = η_coat/η_ambient;
-/// the base's eta/k are relative to the coat (physics.md §2).
+/// the base's eta/k are relative to the coat (docs/physics.md §2).
 struct CoatedStack {
     double eta0 = 1.5;
     double alpha0 = 0.0;

@@ -1,5 +1,5 @@
 #pragma once
-// The one table of analytic models (style.md §12: an explicit registry, like Tungsten's
+// The one table of analytic models (docs/style.md §12: an explicit registry, like Tungsten's
 // BsdfFactory, no static self-registration). `lamina models`, `lamina eval`, the study and the
 // explorer all find models here. Adding a model = one source file with its factory and options
 // (declared in models/factories.h) + one line in registry.cpp.

@@ -1,5 +1,5 @@
 // WW09: Weidlich & Wilkie's layered model as implemented in their SIGGRAPH Asia 2009 course code
-// (models.md table, row WW09). T01 and the refractions use the half vector h; the base BRDF is
+// (docs/models.md table, row WW09). T01 and the refractions use the half vector h; the base BRDF is
 // evaluated at the *outside* directions (wi, wo) — this looks like a bug, but it is what the code
 // did, so lamina implements it faithfully; t = (1 − G) + T10·G (Weidlich & Wilkie 2007, §4.2).
 #include "models/factories.h"

@@ -92,7 +92,7 @@ class WWModel final : public Model {
         Rgbd f(0.0);
         double G0 = 1;
         if (coat_.alpha0 > 0) {
-            // Top reflection (models.md; Walter et al. 2007, Eq. 20; height-correlated G2,
+            // Top reflection (docs/models.md; Walter et al. 2007, Eq. 20; height-correlated G2,
             // Heitz 2014, Eq. 99); a delta lobe when smooth.
             const GGX<double> ggx0{coat_.alpha0};
             G0 = 1 / (1 + in.lambda0 + ggx0.lambda(wo));
@@ -193,7 +193,7 @@ class WWModel final : public Model {
         return coat_.base_type != InterfaceType::Lambertian && base_alpha_ == 0;
     }
 
-    /// "Refract w about m" (models.md): the direction inside the coat, pointing away from the
+    /// "Refract w about m" (docs/models.md): the direction inside the coat, pointing away from the
     /// base, whose refraction through the top interface is w; nothing if it does not exist.
     std::optional<Vec3d> refract_in(const Vec3d& w, const Vec3d& m) const {
         const auto t = refract(w, m, coat_.eta0);  // points down, into the coat

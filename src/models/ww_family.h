@@ -1,6 +1,6 @@
 #pragma once
-// The Weidlich–Wilkie family (models.md, "The Weidlich–Wilkie family"): WW09, Ele10 and WW' are
-// one formula with different choices, which are the flags below. Weidlich & Wilkie 2007,
+// The Weidlich–Wilkie family (docs/models.md, "The Weidlich–Wilkie family"): WW09, Ele10 and WW'
+// are one formula with different choices, which are the flags below. Weidlich & Wilkie 2007,
 // "Arbitrarily layered micro-facet surfaces" (GRAPHITE), §4:
 //
 //     f = f_top(wi, wo) + T01 · f_base(wi*, wo*) · a · t            (no inter-reflection)

@@ -1,9 +1,9 @@
-// WW': the study's correction of the Weidlich–Wilkie family (models.md table, row WW'):
+// WW': the study's correction of the Weidlich–Wilkie family (docs/models.md table, row WW'):
 //     f = f_top + T01(μi) · f_base(wi', wo') · a / η0² · T10(μo)
 // with Fresnel and refraction about the macro normal n, the exit transmission T10 instead of t,
 // the solid-angle compression 1/η0² (Hanrahan & Krueger 1993, Eq. 8) and α1 ← max(α0, α1). For a
 // smooth coat over a Lambertian base with τ = 0 it is the first term of the exact series
-// (physics.md §6.3).
+// (docs/physics.md §6.3).
 #include "models/factories.h"
 #include "models/ww_family.h"
 

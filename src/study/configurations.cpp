@@ -17,8 +17,8 @@ std::string num(double v) {
     return fmt::format("{}", v);
 }
 
-// α1 in ids as in study.md's example `paint-a0.001-a1.3`: "a1" followed by the value without its
-// leading zero.
+// α1 in ids as in docs/study.md's example `paint-a0.001-a1.3`: "a1" followed by the value without
+// its leading zero.
 std::string alpha1_id(double v) {
     std::string s = num(v);
     return s.rfind("0.", 0) == 0 ? s.substr(1) : s;
@@ -32,7 +32,7 @@ std::string rgb_text(const Rgbd& v) {
 Layer coat(double alpha0, const Rgbd& tau_a) {
     Layer l;
     l.interface.type = InterfaceType::Dielectric;
-    l.interface.eta = 1.5;  // study.md: η0 = 1.5 throughout
+    l.interface.eta = 1.5;  // docs/study.md: η0 = 1.5 throughout
     l.interface.alpha = alpha0;
     l.has_medium = true;
     l.medium.tau_a = tau_a;

@@ -1,5 +1,5 @@
 #pragma once
-// The study's configurations (../shared/study.md): 60 two-interface stacks under air — plastics,
+// The study's configurations (docs/study.md): 60 two-interface stacks under air — plastics,
 // metallic paints, frosted metals and slabs — built into lamina, plus a user's own list.
 
 #include "layers/stack.h"
@@ -20,7 +20,7 @@ struct StudyConfiguration {
     std::map<std::string, std::string> parameters;
 };
 
-/// The 60 configurations of study.md, in a fixed order.
+/// The 60 configurations of docs/study.md, in a fixed order.
 std::vector<StudyConfiguration> builtin_configurations();
 
 /// A user's list: {"configurations": [{"id": ..., "category": ..., "stack": {...}}, ...]}

@@ -1,5 +1,5 @@
 #pragma once
-// The study's error metrics (../shared/study.md, "Metrics"; docs/formats.md): a model's binned
+// The study's error metrics (docs/study.md, "Metrics"; docs/formats.md): a model's binned
 // lobe against the reference's, one channel at a time.
 
 #include "core/grid.h"

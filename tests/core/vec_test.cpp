@@ -24,7 +24,7 @@ TEST(Frame, IsOrthonormalAndRoundTrips) {
 }
 
 TEST(Spherical, ConventionsOfPhysicsNotes) {
-    // physics.md §1: wi = (sin θi, 0, cos θi); mirror at φ = 180°.
+    // docs/physics.md §1: wi = (sin θi, 0, cos θi); mirror at φ = 180°.
     const double theta = deg_to_rad(30.0);
     const Vec3d wi = incident_direction(theta);
     EXPECT_NEAR(wi.x, 0.5, 1e-15);

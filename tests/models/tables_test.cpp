@@ -98,7 +98,7 @@ TEST(FgdTable, RgbLookupEqualsScalarLookups) {
 // Smooth limit: α = 0 is the Fresnel factor itself, including total internal reflection.
 TEST(FgdTable, SmoothLimitIsFresnel) {
     const FgdTable& table = FgdTable::get();
-    EXPECT_NEAR(table(1.0, 0.0, 1.5, 0.0), 0.04, 1e-12);  // physics.md §6.1
+    EXPECT_NEAR(table(1.0, 0.0, 1.5, 0.0), 0.04, 1e-12);  // docs/physics.md §6.1
     EXPECT_EQ(table(0.3, 0.0, 1 / 1.5, 0.0), 1.0);        // TIR from inside glass
 }
 

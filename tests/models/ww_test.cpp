@@ -22,7 +22,7 @@ Vec3d dir(double theta_deg, double phi_deg) {
 
 // WW' with a smooth coat (η) over a Lambertian (ρ) and absorption τ between:
 //   f = ρ/(π η²) (1 − F(μi)) (1 − F(μo)) exp(−τ (1/μi' + 1/μo')),  μ' = √(1 − (1 − μ²)/η²),
-// the first term of the exact series of physics.md §6.3 (single pass through the coat, Snell's
+// the first term of the exact series of docs/physics.md §6.3 (single pass through the coat, Snell's
 // law of solid angles giving 1/η²). Computed here from fresnel_dielectric and Snell directly,
 // not through the model's code path. Away from the mirror direction (the delta lobe).
 TEST(WWPrimeGolden, SmoothCoatOverLambertianIsFirstTermOfExactSeries) {
@@ -115,7 +115,7 @@ TEST(WWFamily, WWPrimeIsReciprocal) {
     }
 }
 
-// WW09 and Ele10 as models.md specifies them are reciprocal too, although models.md calls the
+// WW09 and Ele10 as docs/models.md specifies them are reciprocal too, although the study calls the
 // family "non-reciprocal in general": with the Fresnel factors at the half vector, T01 = 1 −
 // F(wi·h) and T10 = 1 − F(wo·h) are equal (wi·h = wo·h), so T01·t is symmetric; the refractions
 // about h or n and Beer–Lambert are symmetric; f_base is reciprocal. Shown here. The

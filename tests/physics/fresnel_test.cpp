@@ -221,7 +221,7 @@ TEST(Fresnel, ReflectIsAnInvolutionAboutTheNormal) {
         EXPECT_NEAR(back.y, w.y, 1e-14);
         EXPECT_NEAR(back.z, w.z, 1e-14);
     }
-    // About +z: the mirror direction of physics.md §1 (φ → φ + 180°).
+    // About +z: the mirror direction of docs/physics.md §1 (φ → φ + 180°).
     const Vec3d m = reflect(Vec3d(0.6, 0.0, 0.8), Vec3d(0, 0, 1));
     EXPECT_NEAR(m.x, -0.6, 1e-15);
     EXPECT_NEAR(m.y, 0.0, 1e-15);

@@ -30,7 +30,7 @@ Vec3d direction_at(double cos_theta, double phi) {
 // Gold-like relative complex index per RGB channel (the usual rendering values for gold).
 const Rgbd kGoldEta(0.143, 0.374, 1.442), kGoldK(3.983, 2.385, 1.603);
 
-// Incidences of physics.md §1 (φi = 0): oblique from above, near grazing, oblique from below.
+// Incidences of docs/physics.md §1 (φi = 0): oblique from above, near grazing, oblique from below.
 const Vec3d kAbove = direction_at(0.6, 0), kGrazing = direction_at(0.1, 0),
             kBelow = direction_at(-0.8, 0);
 
@@ -254,7 +254,7 @@ TEST(Interfaces, ReflectionIsReciprocal) {
     const LambertianInterface<double> l{Rgbd(0.2, 0.5, 0.9)};
     for (const auto& [a, b] : pairs) {
         EXPECT_EQ(l.eval(a, b), l.eval(b, a));
-        // physics.md §6.2: f = albedo/π on the side of arrival, 0 across.
+        // docs/physics.md §6.2: f = albedo/π on the side of arrival, 0 across.
         EXPECT_EQ(l.eval(a, b)[1], same_hemisphere(a, b) ? 0.5 / kPi<double> : 0.0);
     }
 }
@@ -570,7 +570,7 @@ double dielectric_albedo(const DielectricInterface<double>& d, const Vec3d& wi, 
 
 // E[G2(wi, wo)/G1(wi)] over the sampling process, written in microfacet space independently of
 // eval and pdf: ∫ D_wi(wm) [F g(reflect(wi, wm)) + (1 − F) g(refract(wi, wm))] dωm, where g is
-// G2/G1 when the direction leaves on the expected side and 0 otherwise (physics.md §3).
+// G2/G1 when the direction leaves on the expected side and 0 otherwise (docs/physics.md §3).
 double dielectric_escape(const DielectricInterface<double>& d, const Vec3d& wi, double eps) {
     const GGX<double> ggx{d.alpha};
     return integrate_normals(
@@ -696,7 +696,7 @@ TEST(Interfaces, ConductorAlbedoIsBoundedByTheFresnelAverage) {
 }
 
 TEST(Interfaces, LambertianAlbedoIsItsAlbedo) {
-    // ∫ (ρ/π) |cos θo| dωo over wi's hemisphere = ρ (physics.md §6.2), from either side.
+    // ∫ (ρ/π) |cos θo| dωo over wi's hemisphere = ρ (docs/physics.md §6.2), from either side.
     const Rgbd albedo(0.2, 0.5, 0.9);
     const LambertianInterface<double> l{albedo};
     for (const Vec3d& wi : {kAbove, kBelow}) {

@@ -1,6 +1,6 @@
 // Warps of physics/sampling.h and the Henyey–Greenstein phase function of physics/phase.h, each
-// tested as a triple (style.md §4): round trip sample → invert, density integrating to one, and a
-// chi-square goodness-of-fit test of the samples against the density (support/chi2.h).
+// tested as a triple (docs/style.md §4): round trip sample → invert, density integrating to one,
+// and a chi-square goodness-of-fit test of the samples against the density (support/chi2.h).
 #include "physics/sampling.h"
 #include "core/math.h"
 #include "core/rng.h"

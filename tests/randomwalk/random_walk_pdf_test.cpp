@@ -80,7 +80,7 @@ TEST(RandomWalkPdf, OneInterfaceIsItsOwnSamplingDensity) {
 // non-absorbing, white one: with r = 2∫₀¹ F_inside(μ) μ dμ and dω'/dωo = μo/(η² μo'),
 //   p(wo) = Σ_n r^{n−1} (1 − F(μi)) (μo'/π) (1 − F(μo)) μo/(η² μo')
 //         = (1 − F(μi)) (1 − F(μo)) μo / (π η² (1 − r)),
-// which is physics.md §6.3's diffuse f for ρ = 1, τ = 0, times μo (CoatedLambertianSeries).
+// which is docs/physics.md §6.3's diffuse f for ρ = 1, τ = 0, times μo (CoatedLambertianSeries).
 TEST(RandomWalkPdfStat, SmoothCoatOverLambertianIsTheWhiteSeries) {
     const double eta = 1.5;
     const Stack stack =

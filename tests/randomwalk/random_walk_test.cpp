@@ -1,6 +1,6 @@
 // The random-walk estimator (randomwalk/random_walk.h) against the goniophotometer and the exact
-// solutions of physics.md §6, with tolerances from standard errors only. Suites ending in Stat are
-// the `stat` label, Golden the closed forms.
+// solutions of docs/physics.md §6, with tolerances from standard errors only. Suites ending in Stat
+// are the `stat` label, Golden the closed forms.
 #include "randomwalk/random_walk.h"
 
 #include "core/math.h"

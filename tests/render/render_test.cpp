@@ -45,9 +45,9 @@ TEST(Render, WhiteFurnaceLambertianIsOne) {
     EXPECT_GT(n, 200);
 }
 
-// A smooth coat (τ = 0) over a white Lambertian has albedo exactly 1 (physics.md §6.3), so under
-// the uniform environment it renders 1 within noise: the sphere's mean over n pixels has standard
-// error σ/√n, estimated from the pixels themselves.
+// A smooth coat (τ = 0) over a white Lambertian has albedo exactly 1 (docs/physics.md §6.3), so
+// under the uniform environment it renders 1 within noise: the sphere's mean over n pixels has
+// standard error σ/√n, estimated from the pixels themselves.
 TEST(RenderStat, WhiteFurnaceSmoothCoatOverWhiteIsOne) {
     const Stack coated =
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.0)),

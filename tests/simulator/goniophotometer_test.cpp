@@ -1,5 +1,5 @@
-// The goniophotometer against exact solutions (physics.md §6), with tolerances from the standard
-// errors it reports. Suites ending in Stat are the `stat` label.
+// The goniophotometer against exact solutions (docs/physics.md §6), with tolerances from the
+// standard errors it reports. Suites ending in Stat are the `stat` label.
 #include "simulator/goniophotometer.h"
 #include "core/error.h"
 #include "physics/conductor.h"
@@ -59,7 +59,7 @@ void expect_within_se(double estimate, double exact, double se, const char* what
         << what << ": estimate " << estimate << " ± " << se << ", exact " << exact;
 }
 
-// Every budget sums to 1 to rounding (physics.md §5).
+// Every budget sums to 1 to rounding (docs/physics.md §5).
 void expect_budget_closes(const SimulationResult& r) {
     for (const IncidenceStats& st : r.incidences)
         for (int c = 0; c < 3; ++c)
@@ -186,7 +186,7 @@ using Tweak = std::function<void(SimulationSettings&)>;
 // height-correlated form for refraction, B(1 + Λi, 1 + Λo) (Euler's Beta function; a ray entering
 // at height h with C1(h) = c is followed by one leaving below with probability (1 − c)^Λo, and c
 // has density (1 + Λi) c^Λi: ∫ (1 + Λi) c^Λi (1 − c)^Λo dc = (1 + Λi) B(1 + Λi, 1 + Λo) = G2/G1),
-// instead of the 1/(1 + Λi + Λo) of physics.md §3 (pbrt-v4's choice for both lobes).
+// instead of the 1/(1 + Λi + Λo) of docs/physics.md §3 (pbrt-v4's choice for both lobes).
 // `pieces`: sub-rectangles per axis of a bin's average (a lobe that ends inside a bin, as at
 // grazing incidence, needs a composite rule).
 // `reflection_only`: the transmission lobe's bin averages need the refraction Jacobian's

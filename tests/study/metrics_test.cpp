@@ -123,7 +123,7 @@ TEST(StudyConfigurations, SixtyWithStableUniqueIds) {
     EXPECT_EQ(per_category["metallic-paint"], 10);
     EXPECT_EQ(per_category["frosted-metal"], 10);
     EXPECT_EQ(per_category["slab"], 20);
-    // study.md's example ids.
+    // docs/study.md's example ids.
     EXPECT_TRUE(ids.count("plastic-P1-a0.05"));
     EXPECT_TRUE(ids.count("paint-a0.001-a1.3"));
     const auto only = filter_configurations(configs, "slab-*-tinted");

@@ -1,5 +1,5 @@
 #pragma once
-// A generic chi-square goodness-of-fit harness for direction samplers (style.md §9), after
+// A generic chi-square goodness-of-fit harness for direction samplers (docs/style.md §9), after
 // Mitsuba 3 `src/python/python/chi2.py` and pbrt-v4 `src/pbrt/bsdfs_test.cpp`.
 //
 // Domain: the sphere of directions, parameterized by (cos θ, φ) ∈ [c_min, c_max] × [0, 2π) and cut

@@ -1,5 +1,5 @@
 #pragma once
-// Closed forms of physics.md §6 used by several tests, each with its derivation.
+// Closed forms of docs/physics.md §6 used by several tests, each with its derivation.
 
 #include "core/math.h"
 #include "core/rgb.h"
