@@ -1,5 +1,6 @@
 #pragma once
-// Conventions shared by every BSDF in lamina (physics.md §1; style.md §3). Read this first.
+// Conventions shared by every BSDF in lamina (docs/physics.md §1; docs/style.md §3). Read this
+// first.
 //
 // - Local frame: z is the macro-surface normal, pointing up (into the medium above).
 // - `wi` points towards the light, `wo` towards the viewer; both point *away* from the surface and

@@ -2,7 +2,7 @@
 // A conductor (opaque) interface: smooth (delta mirror) or rough GGX reflection with the exact
 // complex Fresnel factor per RGB channel (Walter et al. 2007, Eq. 20 with conductor Fresnel).
 // Light arrives from above only (wi.z > 0). Relative complex index (eta + i k) per channel, taken
-// against the medium above (physics.md §2). Conventions: physics/bsdf.h.
+// against the medium above (docs/physics.md §2). Conventions: physics/bsdf.h.
 
 #include "core/rgb.h"
 #include "physics/bsdf.h"

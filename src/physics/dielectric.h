@@ -96,7 +96,7 @@ struct DielectricInterface {
     /// Follows a particle arriving from wi: picks a visible microfacet normal (Heitz 2018, drawn
     /// with the equivalent spherical-cap construction of Dupuy & Benyoub 2023), reflects with
     /// probability F and refracts otherwise, and keeps the fraction G2/G1 that escapes the
-    /// microsurface (physics.md §3). uc picks the Fresnel branch; u1, u2 the normal.
+    /// microsurface (docs/physics.md §3). uc picks the Fresnel branch; u1, u2 the normal.
     /// kWithPdf = false skips the density (the particle tracer only needs the weight).
     template <bool kWithPdf = true>
     LAMINA_FORCE_INLINE std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T uc, T u1,

@@ -4,20 +4,20 @@
 // 35(4) (SIGGRAPH 2016), for dielectric and conductor microsurfaces.
 //
 // The single-scattering interfaces (dielectric.h, conductor.h) keep the fraction G2/G1 of a
-// particle that escapes the microsurface after one facet and drop the rest (physics.md §3: "lost
-// to the microsurface"). The walk instead follows the particle from facet to facet until it leaves:
-// a ray meets the microsurface at a height drawn from the Smith model's uncorrelated heights
-// (uniform on [−1, 1]; the paper shows the BSDF does not depend on it), scatters off a facet drawn
-// from the distribution of normals visible from its direction (which may point below the
-// horizon after a first bounce), and so on. Nothing is lost but what a conductor's Fresnel
+// particle that escapes the microsurface after one facet and drop the rest (docs/physics.md §3:
+// "lost to the microsurface"). The walk instead follows the particle from facet to facet until it
+// leaves: a ray meets the microsurface at a height drawn from the Smith model's uncorrelated
+// heights (uniform on [−1, 1]; the paper shows the BSDF does not depend on it), scatters off a
+// facet drawn from the distribution of normals visible from its direction (which may point below
+// the horizon after a first bounce), and so on. Nothing is lost but what a conductor's Fresnel
 // factor absorbs. The first order of the walk is the single-scattering interface with the
 // height-correlated Smith masking-shadowing (the tests check it bin by bin): with c = C1(h) of the
 // first hit, c has density (1 + Λi) c^Λi; a reflected ray escapes with probability c^Λo, so
 // G2/G1 = (1 + Λi)/(1 + Λi + Λo), the G2 of dielectric.h and conductor.h; a refracted ray leaves
 // below, where the heights above it have C1 = 1 − c, so G2/G1 = ∫ (1 + Λi) c^Λi (1 − c)^Λo dc =
 // (1 + Λi) B(1 + Λi, 1 + Λo) (B: Euler's Beta function). The single-scattering dielectric uses
-// 1/(1 + Λi + Λo) for its refraction lobe too (physics.md §3, as pbrt-v4 does); the two differ by
-// a few percent at grazing exits and by more when both Λ are large.
+// 1/(1 + Λi + Λo) for its refraction lobe too (docs/physics.md §3, as pbrt-v4 does); the two differ
+// by a few percent at grazing exits and by more when both Λ are large.
 //
 // Conventions as in bsdf.h: `wi` points away from the surface towards where the light comes from
 // (above: wi.z > 0; from below a dielectric: wi.z < 0). Directions of travel are written `wr`.

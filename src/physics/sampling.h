@@ -1,5 +1,6 @@
 #pragma once
-// Warps from the unit square to directions, each as a triple sample / pdf / invert (style.md §4).
+// Warps from the unit square to directions, each as a triple sample / pdf / invert (docs/style.md
+// §4).
 
 #include "core/math.h"
 #include "core/vec.h"

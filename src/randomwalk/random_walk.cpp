@@ -356,7 +356,7 @@ void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& 
     }
 }
 
-// ---- Media (physics.md §4), as the goniophotometer traverses them ------------------------------
+// ---- Media (docs/physics.md §4), as the goniophotometer traverses them --------------------------
 // Depth s ∈ [0, 1] across the layer (0 at its top). Returns true if the particle leaves through
 // the top. Free flights from a mixture of the channels' exponentials with probabilities ∝ flux and
 // per-channel weights (one-sample spectral MIS, balance heuristic: Veach 1997, §9.2.4), exactly as

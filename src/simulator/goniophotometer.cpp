@@ -54,7 +54,7 @@ bool is_black(const Rgbf& w) {
     return w[0] == 0.f && w[1] == 0.f && w[2] == 0.f;
 }
 
-// ---- Media (physics.md §4) ---------------------------------------------------------------------
+// ---- Media (docs/physics.md §4) -----------------------------------------------------------------
 // Depth s ∈ [0, 1] across the layer (0 at its top); a direction d with |d.z| = μ crosses the whole
 // layer along a path of optical depth τ/μ. Returns true if the particle leaves through the top.
 struct MediumWalk {
@@ -157,7 +157,7 @@ struct MediumWalk {
 };
 
 // ---- One particle ------------------------------------------------------------------------------
-// physics.md §3: at an interface the particle (arriving along −wi) draws an outgoing direction
+// docs/physics.md §3: at an interface the particle (arriving along −wi) draws an outgoing direction
 // from the interface's BSDF sampler; its flux is multiplied by the sample weight and the parts
 // that do not continue are booked (absorbed by the base, lost to the microsurface).
 void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const Vec3f& wi,

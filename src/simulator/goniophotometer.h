@@ -1,7 +1,7 @@
 #pragma once
-// The virtual goniophotometer (physics.md §5): Monte-Carlo particles traced through a layer stack,
-// the BRDF and BTDF tabulated on a discretized hemisphere with a standard error per bin, and the
-// energy budget of every incidence.
+// The virtual goniophotometer (docs/physics.md §5): Monte-Carlo particles traced through a layer
+// stack, the BRDF and BTDF tabulated on a discretized hemisphere with a standard error per bin, and
+// the energy budget of every incidence.
 //
 // Estimator: f_j = W_j / (N Ω⊥_j), W_j the flux of the particles leaving into bin j, Ω⊥_j the bin's
 // projected solid angle: the cos-weighted bin average of the BSDF. The standard error comes from
@@ -40,9 +40,9 @@ std::string kernel_description(Kernel kernel);
 Kernel parse_kernel(const std::string& text, const std::string& option = "--kernel");
 
 /// How a rough interface treats the light its first facet does not let escape: `single`
-/// (physics.md §3: single-scattering microfacet theory, the energy is lost to the microsurface and
-/// reported as lost_microsurface) or `multiple` (the microsurface random walk of Heitz et al. 2016,
-/// physics/microsurface_walk.h: nothing is lost; scalar kernel only).
+/// (docs/physics.md §3: single-scattering microfacet theory, the energy is lost to the microsurface
+/// and reported as lost_microsurface) or `multiple` (the microsurface random walk of Heitz et al.
+/// 2016, physics/microsurface_walk.h: nothing is lost; scalar kernel only).
 enum class Microsurface { Single, Multiple };
 const char* microsurface_name(Microsurface microsurface);
 /// "single" | "multiple" (InputError naming `option` otherwise).
@@ -60,7 +60,7 @@ struct SimulationSettings {
     int threads = 0;  ///< 0: all available
     HemisphereGrid grid{90, 90};
     /// Safety cap on interface and scattering events per particle; flux still travelling then is
-    /// reported as `cut_off` (physics.md §5: must be ≈ 0).
+    /// reported as `cut_off` (docs/physics.md §5: must be ≈ 0).
     int max_events = 10'000;
     /// First particle index (a simulation may be split into ranges of particles, e.g. across
     /// processes; the union of ranges equals one run of all particles, bit for bit).
@@ -142,7 +142,7 @@ void validate_settings(const SimulationSettings& settings);
 SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,
                              const std::function<void(std::uint64_t)>& on_progress = {});
 
-/// The estimates (physics.md §5) from the sums of all `settings.particles` particles.
+/// The estimates (docs/physics.md §5) from the sums of all `settings.particles` particles.
 SimulationResult finalize_simulation(const Stack& stack, const SimulationSettings& settings,
                                      const SimulationSums& sums);
 

@@ -6,7 +6,7 @@ TraceStack::TraceStack(const Stack& stack) : transmits(stack.transmits()) {
     for (std::size_t i = 0; i < stack.layers.size(); ++i) {
         const Layer& layer = stack.layers[i];
         const InterfaceSpec& spec = layer.interface;
-        // Relative indices against the medium above (physics.md §2).
+        // Relative indices against the medium above (docs/physics.md §2).
         const double eta_above = stack.eta_above(i);
         TraceLayer t;
         t.type = spec.type;

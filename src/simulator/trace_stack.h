@@ -1,6 +1,6 @@
 #pragma once
 // The stack as the particle tracer sees it: per interface the BSDF with *relative* indices (against
-// the medium above it), per medium its optical depths, all in float (physics.md §2–§4).
+// the medium above it), per medium its optical depths, all in float (docs/physics.md §2–§4).
 // Built once per simulation from the layers::Stack description; no virtual calls, no allocation
 // while tracing.
 
