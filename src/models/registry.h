@@ -21,7 +21,14 @@ struct ModelEntry {
     /// A stochastic estimator (the random walk): its eval is noisy and slow, so the study's
     /// default model list and the analytic-model sweeps leave it out.
     bool stochastic = false;
+    /// The family a reader compares it within (the explorer's model groups): "2019" (the
+    /// models of the 2019 study), "successors" (Belcour 2018's statistical successors),
+    /// "production" (the coats engines ship) or "reference" (the stochastic estimator).
+    std::string group = "2019";
 };
+
+/// The groups of ModelEntry::group, in the order the explorer shows them.
+const std::vector<std::string>& model_groups();
 
 /// Every model, in the order `lamina models` lists them.
 const std::vector<ModelEntry>& model_registry();
