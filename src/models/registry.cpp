@@ -129,10 +129,36 @@ ModelOptions resolve_options(const ModelEntry& entry, const std::vector<std::str
     return out;
 }
 
+ModelSpec parse_model_spec(const std::string& spec, const std::string& field) {
+    ModelSpec out;
+    std::size_t start = 0;
+    std::vector<std::string> parts;
+    while (true) {
+        const std::size_t colon = spec.find(':', start);
+        parts.push_back(spec.substr(start, colon - start));
+        if (colon == std::string::npos) break;
+        start = colon + 1;
+    }
+    out.entry = &find_model(parts.front(), field);
+    out.assignments.assign(parts.begin() + 1, parts.end());
+    resolve_options(*out.entry, out.assignments, field);  // validates
+    return out;
+}
+
+std::vector<std::string> ablation_variants(const ModelEntry& entry) {
+    std::vector<std::string> out;
+    for (const OptionSpec& o : entry.options())
+        for (const std::string& v : o.values)
+            if (v != o.default_value) out.push_back(fmt::format("{}:{}={}", entry.name, o.key, v));
+    return out;
+}
+
 std::unique_ptr<Model> make_model(const std::string& name, const Stack& stack,
                                   const std::vector<std::string>& assignments) {
-    const ModelEntry& entry = find_model(name);
-    return entry.make(stack, resolve_options(entry, assignments));
+    const ModelSpec spec = parse_model_spec(name);
+    std::vector<std::string> all = spec.assignments;
+    all.insert(all.end(), assignments.begin(), assignments.end());
+    return spec.entry->make(stack, resolve_options(*spec.entry, all));
 }
 
 }  // namespace lamina

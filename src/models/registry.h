@@ -42,7 +42,20 @@ const ModelEntry& find_model(const std::string& name, const std::string& field =
 ModelOptions resolve_options(const ModelEntry& entry, const std::vector<std::string>& assignments,
                              const std::string& field = "--option");
 
-/// find_model + resolve_options + make.
+/// A model named with its flags in one word, "NAME[:KEY=VALUE]..." (e.g. openpbr:darkening=off):
+/// how the study names its ablation variants (no commas: the name is a CSV field and a list
+/// item of --models). InputError naming `field` as find_model and resolve_options do.
+struct ModelSpec {
+    const ModelEntry* entry = nullptr;
+    std::vector<std::string> assignments;
+};
+ModelSpec parse_model_spec(const std::string& spec, const std::string& field = "--model");
+
+/// The one-flag ablations of a model: for each flag, each value other than the default, as
+/// specs "NAME:KEY=VALUE" (the study's --ablations).
+std::vector<std::string> ablation_variants(const ModelEntry& entry);
+
+/// parse_model_spec + resolve_options (the spec's flags, then `assignments`) + make.
 std::unique_ptr<Model> make_model(const std::string& name, const Stack& stack,
                                   const std::vector<std::string>& assignments = {});
 
