@@ -46,11 +46,26 @@ MODEL_COLORS = {
     "bel18-forward": "#D55E00",
     "bel18-symmetric": "#CC79A7",
     "bel-prime": "#0072B2",
+    # The production coats (Tableau 10 and its darker tones), as in the explorer.
+    "openpbr": "#4E79A7",
+    "openpbr-adobe": "#A0CBE8",
+    "standard-surface": "#F28E2B",
+    "enterprise-pbr": "#59A14F",
+    "filament": "#B6992D",
+    "gltf-clearcoat": "#E15759",
+    "blender-principled": "#B07AA1",
+    "kulla-conty": "#9D7660",
 }
 EXTRA_COLORS = ["#8c564b", "#7f7f7f", "#bcbd22", "#17becf", "#9467bd", "#F0E442"]
 # Variants dashed, as in the explorer: they often coincide with the model they vary.
 MODEL_DASH = {"ele10": (0, (4, 2)), "bel18-symmetric": (0, (4, 2))}
 CHANNELS = ["R", "G", "B"]
+
+
+def model_dash(name):
+    return MODEL_DASH.get(name, (0, (4, 2)) if ":" in name else "-")
+
+
 SIDE_NAME = {"R": "BRDF", "T": "BTDF"}
 
 plt.rcParams.update({
@@ -64,6 +79,8 @@ plt.rcParams.update({
 def model_color(name, models):
     if name in MODEL_COLORS:
         return MODEL_COLORS[name]
+    if name.split(":")[0] in MODEL_COLORS:  # an ablation ("openpbr:darkening=off"): dashed
+        return MODEL_COLORS[name.split(":")[0]]
     k = models.index(name) if name in models else 0
     return EXTRA_COLORS[k % len(EXTRA_COLORS)]
 
@@ -191,7 +208,7 @@ def slice_figure(args):
                     if supported(cfg, m, side):
                         f = plane(k + 1)
                         ax.plot(x, f, color=model_color(m, study.models), label=m,
-                                ls=MODEL_DASH.get(m, "-"))
+                                ls=model_dash(m))
                         if np.any(f > 0):
                             top = max(top, float(np.nanmax(f)))
                 ax.set_yscale("log")
@@ -314,7 +331,7 @@ def albedo_curves(study, formats, cache):
                 for k, m in enumerate(cfg["sources"][1:]):
                     if supported(cfg, m, side):
                         ax.plot(study.theta_i, alb[k + 1], color=model_color(m, study.models),
-                                ls=MODEL_DASH.get(m, "-") if side == "R" else ":", lw=0.9, label=m)
+                                ls=model_dash(m) if side == "R" else ":", lw=0.9, label=m)
             # What the reference loses to its single-scattering microsurfaces (config.json energy):
             # on neither side, so a model that keeps it overshoots the albedo by as much.
             lost = [e.get("lost_microsurface") for e in cfg.get("energy", [])]

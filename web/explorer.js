@@ -25,12 +25,23 @@
     "bel18-forward": "#D55E00",
     "bel18-symmetric": "#CC79A7",
     "bel-prime": "#0072B2",
+    // The production coats (Tableau 10 and its darker tones; scripts/figures.py the same).
+    openpbr: "#4E79A7",
+    "openpbr-adobe": "#A0CBE8",
+    "standard-surface": "#F28E2B",
+    "enterprise-pbr": "#59A14F",
+    filament: "#B6992D",
+    "gltf-clearcoat": "#E15759",
+    "blender-principled": "#B07AA1",
+    "kulla-conty": "#9D7660",
   };
   const EXTRA_COLORS = ["#8c564b", "#7f7f7f", "#bcbd22", "#17becf", "#9467bd", "#F0E442"];
   // Variants are dashed: Ele10 is WW09 with one change and often coincides with it, and so do
   // the two Bel18 cosines; a dashed line on top lets the solid one show through.
+  // Ablations ("openpbr:darkening=off") are dashed in their model's colour.
   const MODEL_DASH = { ele10: "dash", "bel18-symmetric": "dash" };
-  const modelDash = (name) => MODEL_DASH[name] || "solid";
+  const baseName = (name) => name.split(":")[0];
+  const modelDash = (name) => MODEL_DASH[name] || (name.includes(":") ? "dash" : "solid");
 
   // The configuration widgets, in the order of the original study's explorer.
   const PARAMS = [
@@ -48,6 +59,7 @@
 
   function modelColor(name) {
     if (MODEL_COLORS[name]) return MODEL_COLORS[name];
+    if (MODEL_COLORS[baseName(name)]) return MODEL_COLORS[baseName(name)];
     const k = models.indexOf(name);
     return EXTRA_COLORS[(k < 0 ? 0 : k) % EXTRA_COLORS.length];
   }
@@ -254,34 +266,77 @@
     buildModelWidgets();
   }
 
+  // The model families (study.json model_groups, from the registry): the 2019 set, Belcour's
+  // statistical successors, the production coats, their one-flag ablations. A study without the
+  // field puts every model in one group.
+  const GROUP_NAMES = {
+    "2019": "2019 study", successors: "statistical successors", production: "production coats",
+    ablations: "production ablations", reference: "reference", other: "models",
+  };
+  const GROUP_ORDER = ["2019", "successors", "production", "ablations", "reference", "other"];
+  const modelGroup = (m) => (STUDY.model_groups && STUDY.model_groups[m]) || "other";
+  const groups = GROUP_ORDER.map((g) => [g, models.filter((m) => modelGroup(m) === g)])
+    .filter(([, ms]) => ms.length);
+
+  // Shows exactly the models of one group (or every model).
+  function showGroup(g) {
+    state.shown = new Set(g === "all" ? models : models.filter((m) => modelGroup(m) === g));
+    buildModelWidgets();
+    render();
+  }
+
   function buildModelWidgets() {
     const cur = byId.get(state.config);
     const box = $("w-models");
     box.innerHTML = "";
-    for (const m of models) {
-      const ok = isSupported(cur, m, state.side);
-      const l = document.createElement("label");
-      l.className = "model-row" + (ok ? "" : " ns");
-      const cb = document.createElement("input");
-      cb.type = "checkbox";
-      cb.id = "w-model-" + m;
-      cb.checked = state.shown.has(m);
-      cb.addEventListener("change", () => {
-        if (cb.checked) state.shown.add(m); else state.shown.delete(m);
-        render();
-      });
-      const sw = document.createElement("span");
-      sw.className = "swatch";
-      sw.style.background = modelDash(m) === "dash"
-        ? "repeating-linear-gradient(90deg, " + modelColor(m) + " 0 6px, transparent 6px 9px)" : modelColor(m);
-      l.append(cb, sw, document.createTextNode(m));
-      if (!ok) {
-        const t = document.createElement("span");
-        t.className = "ns-tag";
-        t.textContent = "not supported";
-        l.appendChild(t);
+    if (groups.length > 1) {
+      const bar = document.createElement("div");
+      bar.className = "group-bar";
+      for (const [g] of [["all"]].concat(groups)) {
+        const b = document.createElement("button");
+        b.type = "button";
+        b.id = "w-group-" + g;
+        b.textContent = g === "all" ? "all" : GROUP_NAMES[g];
+        b.title = "show only " + (g === "all" ? "every model" : "the " + GROUP_NAMES[g]);
+        b.addEventListener("click", () => showGroup(g));
+        bar.appendChild(b);
       }
-      box.appendChild(l);
+      box.appendChild(bar);
+    }
+    for (const [g, ms] of groups) {
+      if (groups.length > 1) {
+        const h = document.createElement("div");
+        h.className = "group-head";
+        h.id = "w-group-head-" + g;
+        h.textContent = GROUP_NAMES[g];
+        box.appendChild(h);
+      }
+      for (const m of ms) {
+        const ok = isSupported(cur, m, state.side);
+        const l = document.createElement("label");
+        l.className = "model-row" + (ok ? "" : " ns");
+        l.dataset.group = g;
+        const cb = document.createElement("input");
+        cb.type = "checkbox";
+        cb.id = "w-model-" + m;
+        cb.checked = state.shown.has(m);
+        cb.addEventListener("change", () => {
+          if (cb.checked) state.shown.add(m); else state.shown.delete(m);
+          render();
+        });
+        const sw = document.createElement("span");
+        sw.className = "swatch";
+        sw.style.background = modelDash(m) === "dash"
+          ? "repeating-linear-gradient(90deg, " + modelColor(m) + " 0 6px, transparent 6px 9px)" : modelColor(m);
+        l.append(cb, sw, document.createTextNode(m));
+        if (!ok) {
+          const t = document.createElement("span");
+          t.className = "ns-tag";
+          t.textContent = "not supported";
+          l.appendChild(t);
+        }
+        box.appendChild(l);
+      }
     }
     // The iso-value view follows to a model that supports this configuration when its own does not.
     if (!isSupported(cur, state.isoModel, state.side)) {
@@ -857,7 +912,7 @@
     document.body.dataset.drawMs = (performance.now() - t0).toFixed(0);
   }
 
-  window.LAMINA_EXPLORER = { state, selectConfig, render, models, configs };
+  window.LAMINA_EXPLORER = { state, selectConfig, render, models, configs, groups, showGroup };
 
   if (!configs.length) { status("This study has no configurations."); return; }
   readHash();

@@ -31,6 +31,7 @@ struct CommonArgs {
     std::uint64_t seed = 1;
     int threads = 0;
     bool no_figures = false;
+    bool ablations = false;
 };
 
 void add_common(CLI::App* cmd, CommonArgs& a) {
@@ -38,7 +39,11 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
         ->capture_default_str();
     cmd->add_option("--particles,-n", a.particles,
                     "Particles per incidence (overrides the preset; 1e7-style accepted)");
-    cmd->add_option("--models", a.models, "Models to compare, comma-separated (default: all)");
+    cmd->add_option("--models", a.models,
+                    "Models to compare, comma-separated (default: all); NAME:KEY=VALUE adds a "
+                    "model's flag");
+    cmd->add_flag("--ablations", a.ablations,
+                  "Also each production coat with one flag switched (openpbr:darkening=off, ...)");
     cmd->add_option("--seed", a.seed, "Random seed")->capture_default_str();
     cmd->add_option("--threads", a.threads, "Threads (0 = all cores)")->capture_default_str();
     cmd->add_option("--grid", a.grid, "Bins NTHETAxNPHI")->capture_default_str();
@@ -75,6 +80,7 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
         for (std::string m; std::getline(ss, m, ',');)
             if (!m.empty()) s.models.push_back(m);
     }
+    s.ablations = a.ablations;
     if (s.threads < 0) throw InputError("command line", "--threads", "use ≥ 1, or 0 for all cores");
     return s;
 }

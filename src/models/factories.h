@@ -29,4 +29,22 @@ std::vector<OptionSpec> bel_prime_options();
 std::unique_ptr<Model> make_random_walk(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> random_walk_options();
 
+// production_coats.cpp: the coats engines ship (models/production_coat.h)
+std::unique_ptr<Model> make_openpbr(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> openpbr_options();
+std::unique_ptr<Model> make_openpbr_adobe(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> openpbr_adobe_options();
+std::unique_ptr<Model> make_standard_surface(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> standard_surface_options();
+std::unique_ptr<Model> make_enterprise_pbr(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> enterprise_pbr_options();
+std::unique_ptr<Model> make_filament(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> filament_options();
+std::unique_ptr<Model> make_gltf_clearcoat(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> gltf_clearcoat_options();
+std::unique_ptr<Model> make_blender_principled(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> blender_principled_options();
+std::unique_ptr<Model> make_kulla_conty(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> kulla_conty_options();
+
 }  // namespace lamina

@@ -37,9 +37,52 @@ const std::vector<ModelEntry>& model_registry() {
         {"random-walk",
          "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "
          "per-query reference, unbiased",
-         "every stack; sides: R, T (slab)", random_walk_options, make_random_walk, true},
+         "every stack; sides: R, T (slab)", random_walk_options, make_random_walk, true,
+         "reference"},
+        // The coats engines ship (production_coats.cpp, docs/models.md "Production coats").
+        {"openpbr",
+         "OpenPBR Surface 1.1 specification: albedo-scaled coat, coat darkening, base "
+         "roughening, view-dependent tint",
+         "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_options, make_openpbr,
+         false, "production"},
+        {"openpbr-adobe",
+         "Adobe openpbr-bsdf: OpenPBR with view-only albedo scaling (reciprocal off), average "
+         "Fresnel darkening, IOR-scaled roughening",
+         "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_adobe_options,
+         make_openpbr_adobe, false, "production"},
+        {"standard-surface",
+         "Autodesk Standard Surface: coat + coat_color (1 - E_coat(wo)) base, view-only",
+         "bases: lambertian, conductor; media: absorbing; sides: R", standard_surface_options,
+         make_standard_surface, false, "production"},
+        {"enterprise-pbr",
+         "Dassault Enterprise PBR 2025x clearcoat: Schlick 0.04, base x (1 - max(Fc(n.v), "
+         "Fc(n.l))), reciprocal",
+         "bases: lambertian, conductor; eta0 = 1.5; sides: R", enterprise_pbr_options,
+         make_enterprise_pbr, false, "production"},
+        {"filament",
+         "Google Filament clear coat: Schlick 0.04 at l.h, Kelemen visibility, base x (1 - Fc), "
+         "base roughness >= coat's",
+         "bases: lambertian, conductor; eta0 = 1.5; sides: R", filament_options, make_filament,
+         false, "production"},
+        {"gltf-clearcoat", "glTF KHR_materials_clearcoat: mix(base, coat, 0.04 Schlick at n.v)",
+         "bases: lambertian, conductor; eta0 = 1.5; sides: R", gltf_clearcoat_options,
+         make_gltf_clearcoat, false, "production"},
+        {"blender-principled",
+         "Blender 4.x Principled coat: base x (1 - E_coat(wo)) x tint^(1/mu_t,o), view side only",
+         "bases: lambertian, conductor; media: absorbing; sides: R", blender_principled_options,
+         make_blender_principled, false, "production"},
+        {"kulla-conty",
+         "Kulla & Conty 2017 layering: base x (1 - E(mu_i))(1 - E(mu_o))/(1 - E_avg), reciprocal",
+         "bases: lambertian, conductor; media: absorbing; sides: R", kulla_conty_options,
+         make_kulla_conty, false, "production"},
     };
     return entries;
+}
+
+const std::vector<std::string>& model_groups() {
+    static const std::vector<std::string> groups = {"2019", "successors", "production",
+                                                    "reference"};
+    return groups;
 }
 
 const ModelEntry& find_model(const std::string& name, const std::string& field) {
@@ -86,10 +129,36 @@ ModelOptions resolve_options(const ModelEntry& entry, const std::vector<std::str
     return out;
 }
 
+ModelSpec parse_model_spec(const std::string& spec, const std::string& field) {
+    ModelSpec out;
+    std::size_t start = 0;
+    std::vector<std::string> parts;
+    while (true) {
+        const std::size_t colon = spec.find(':', start);
+        parts.push_back(spec.substr(start, colon - start));
+        if (colon == std::string::npos) break;
+        start = colon + 1;
+    }
+    out.entry = &find_model(parts.front(), field);
+    out.assignments.assign(parts.begin() + 1, parts.end());
+    resolve_options(*out.entry, out.assignments, field);  // validates
+    return out;
+}
+
+std::vector<std::string> ablation_variants(const ModelEntry& entry) {
+    std::vector<std::string> out;
+    for (const OptionSpec& o : entry.options())
+        for (const std::string& v : o.values)
+            if (v != o.default_value) out.push_back(fmt::format("{}:{}={}", entry.name, o.key, v));
+    return out;
+}
+
 std::unique_ptr<Model> make_model(const std::string& name, const Stack& stack,
                                   const std::vector<std::string>& assignments) {
-    const ModelEntry& entry = find_model(name);
-    return entry.make(stack, resolve_options(entry, assignments));
+    const ModelSpec spec = parse_model_spec(name);
+    std::vector<std::string> all = spec.assignments;
+    all.insert(all.end(), assignments.begin(), assignments.end());
+    return spec.entry->make(stack, resolve_options(*spec.entry, all));
 }
 
 }  // namespace lamina

@@ -21,7 +21,14 @@ struct ModelEntry {
     /// A stochastic estimator (the random walk): its eval is noisy and slow, so the study's
     /// default model list and the analytic-model sweeps leave it out.
     bool stochastic = false;
+    /// The family a reader compares it within (the explorer's model groups): "2019" (the
+    /// models of the 2019 study), "successors" (Belcour 2018's statistical successors),
+    /// "production" (the coats engines ship) or "reference" (the stochastic estimator).
+    std::string group = "2019";
 };
+
+/// The groups of ModelEntry::group, in the order the explorer shows them.
+const std::vector<std::string>& model_groups();
 
 /// Every model, in the order `lamina models` lists them.
 const std::vector<ModelEntry>& model_registry();
@@ -35,7 +42,20 @@ const ModelEntry& find_model(const std::string& name, const std::string& field =
 ModelOptions resolve_options(const ModelEntry& entry, const std::vector<std::string>& assignments,
                              const std::string& field = "--option");
 
-/// find_model + resolve_options + make.
+/// A model named with its flags in one word, "NAME[:KEY=VALUE]..." (e.g. openpbr:darkening=off):
+/// how the study names its ablation variants (no commas: the name is a CSV field and a list
+/// item of --models). InputError naming `field` as find_model and resolve_options do.
+struct ModelSpec {
+    const ModelEntry* entry = nullptr;
+    std::vector<std::string> assignments;
+};
+ModelSpec parse_model_spec(const std::string& spec, const std::string& field = "--model");
+
+/// The one-flag ablations of a model: for each flag, each value other than the default, as
+/// specs "NAME:KEY=VALUE" (the study's --ablations).
+std::vector<std::string> ablation_variants(const ModelEntry& entry);
+
+/// parse_model_spec + resolve_options (the spec's flags, then `assignments`) + make.
 std::unique_ptr<Model> make_model(const std::string& name, const Stack& stack,
                                   const std::vector<std::string>& assignments = {});
 

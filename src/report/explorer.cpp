@@ -452,8 +452,8 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
     StagedOutput data_out(study_dir / "explorer" / "data");
     ExplorerSummary summary;
     json index = {{"study", json::object()}, {"configs", json::array()}};
-    for (const char* key :
-         {"preset", "particles", "seed", "lamina_version", "models", "grid", "microsurface"})
+    for (const char* key : {"preset", "particles", "seed", "lamina_version", "models",
+                            "model_groups", "grid", "microsurface"})
         if (study.contains(key)) index["study"][key] = study[key];
     index["study"]["theta_i"] = theta_i;
     // The page's title: the study folder's name (`out/study-quick/` → study-quick).

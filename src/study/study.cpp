@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -214,7 +215,17 @@ std::vector<std::string> study_models(const StudySettings& s) {
         for (const ModelEntry& e : model_registry())
             if (!e.stochastic) model_names.push_back(e.name);
     for (const std::string& name : model_names)
-        find_model(name, "--models");  // validates
+        parse_model_spec(name, "--models");  // validates
+    if (s.ablations) {
+        const std::vector<std::string> chosen = model_names;
+        for (const std::string& name : chosen) {
+            const ModelSpec spec = parse_model_spec(name, "--models");
+            if (spec.entry->group != "production" || !spec.assignments.empty()) continue;
+            for (const std::string& v : ablation_variants(*spec.entry))
+                if (std::find(model_names.begin(), model_names.end(), v) == model_names.end())
+                    model_names.push_back(v);
+        }
+    }
     return model_names;
 }
 
@@ -258,6 +269,14 @@ std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
     sj["theta_i"] = s.theta_i_deg;
     sj["grid"] = {{"n_theta", s.grid.n_theta()}, {"n_phi", s.grid.n_phi()}};
     sj["models"] = model_names;
+    // The family of each model (the explorer groups them): its registry group, or "ablations"
+    // for a production coat with a flag switched.
+    nlohmann::json groups = nlohmann::json::object();
+    for (const std::string& name : model_names) {
+        const ModelSpec spec = parse_model_spec(name, "--models");
+        groups[name] = spec.assignments.empty() ? spec.entry->group : std::string("ablations");
+    }
+    sj["model_groups"] = groups;
     sj["seconds"] = seconds;
     nlohmann::json list = nlohmann::json::array();
     for (const StudyConfiguration& c : configs)

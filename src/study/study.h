@@ -21,7 +21,10 @@ struct StudySettings {
     std::uint64_t seed = 1;
     std::vector<double> theta_i_deg{0, 15, 30, 45, 60, 70, 80};
     HemisphereGrid grid{90, 90};
-    std::vector<std::string> models;                   ///< registry names; empty: every model
+    std::vector<std::string> models;  ///< registry names; empty: every model
+    /// Also every production model's one-flag ablations (models/registry.h ablation_variants),
+    /// "NAME:KEY=VALUE": the summary's engine-developer section says which heuristic helps.
+    bool ablations = false;
     int threads = 0;                                   ///< 0: all cores
     Kernel kernel = Kernel::Simd;                      ///< the reference's particle kernel
     Microsurface microsurface = Microsurface::Single;  ///< the reference's rough interfaces
@@ -48,7 +51,9 @@ inline constexpr const char* kMetricsCsvHeader =
     "albedo_error,rmse,log_rmse,noise_floor,supported";
 
 /// The models the study compares: settings.models, or every deterministic model of the registry
-/// when empty. InputError naming --models for a name the registry lacks.
+/// when empty; with settings.ablations, then the one-flag variants of each production model
+/// among them. Names may carry flags ("openpbr:darkening=off", models/registry.h). InputError
+/// naming --models for a name the registry lacks or a flag it does not have.
 std::vector<std::string> study_models(const StudySettings& settings);
 
 /// Where a study in `out_dir` keeps its reference pieces (study/reference.h).

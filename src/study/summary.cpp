@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.h"
 #include "lamina/version.h"
+#include "study/engine_findings.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -514,6 +515,11 @@ void write_summary(const std::filesystem::path& out_dir,
         }
         out("\n");
     }
+
+    // The engine developers' section (study/engine_findings.h): computed from the same rows.
+    const EngineFindings engine = compute_engine_findings(rows, models);
+    md += engine_findings_markdown(engine);
+    if (!engine.empty()) j["engine_developers"] = engine_findings_json(engine);
 
     out("## Not supported\n\n");
     if (unsupported.empty()) out("Every model supports every configuration.\n");

@@ -26,6 +26,11 @@ expect_output() {  # expect_output NAME PATTERN: the last command's output match
 
 check models 0 "$lamina" models --options
 for m in ww09 ele10 ww-prime bel18-forward bel18-symmetric bel-prime; do expect_output "models $m" "^$m "; done
+for m in openpbr openpbr-adobe standard-surface enterprise-pbr filament gltf-clearcoat \
+    blender-principled kulla-conty; do expect_output "models $m" "^$m "; done
+expect_output "models groups" "^\[production\]"
+expect_output "models production flags" "--option darkening={on,off} (default on)"
+expect_output "models leaves flag" "--option leaves={shipped,exact} (default shipped)"
 check unknown-model 1 "$lamina" eval --model ww10 --stack x.json --theta-i 30 --theta-o 45 --phi-o 180
 expect_output unknown-model-lists "known models: ww09"
 check theta-i-range 1 "$lamina" eval --model ww09 --stack x.json --theta-i 90 --theta-o 45 --phi-o 180
@@ -61,6 +66,11 @@ if "$lamina" validate "$tmp/gold.json" >/dev/null 2>&1; then
     check binned 0 "$lamina" eval --model bel18-symmetric --stack "$tmp/gold.json" --theta-i 0,30,60 --binned --grid 9x6 --out "$tmp/b.csv"
     if head -1 "$tmp/b.csv" | grep -q '^theta_i,side,theta_lo,theta_hi,phi_lo,phi_hi,f_r,f_g,f_b,se_r,se_g,se_b$' && [ "$(wc -l <"$tmp/b.csv")" -eq $((1 + 3 * 54)) ]; then
         pass=$((pass + 1)); else echo "FAIL binned output"; head -3 "$tmp/b.csv"; fails=$((fails + 1)); fi
+    # A production coat with a flag, and a flag it does not have.
+    check production 0 "$lamina" eval --model openpbr --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180 --option darkening=off --option leaves=exact
+    expect_output production-three-numbers "^[0-9.e+-]* [0-9.e+-]* [0-9.e+-]*$"
+    check production-bad-flag 1 "$lamina" eval --model filament --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180 --option darkening=off
+    expect_output production-bad-flag-lists "its options: attenuation, roughening, f0-conversion, leaves"
 else
     echo "SKIP the stack-reading checks: 'lamina validate' cannot parse a stack yet (issue 2 not merged)"
 fi

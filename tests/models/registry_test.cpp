@@ -5,22 +5,41 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
+
 namespace lamina {
 namespace {
 
 TEST(ModelRegistry, ListsTheSixModelsOfTheStudyAndTheRandomWalk) {
-    std::vector<std::string> names;
+    std::map<std::string, std::vector<std::string>> by_group;
     for (const auto& e : model_registry()) {
-        names.push_back(e.name);
+        by_group[e.group].push_back(e.name);
         EXPECT_FALSE(e.description.empty());
         EXPECT_FALSE(e.supports.empty());
+        const auto& groups = model_groups();
+        EXPECT_NE(std::find(groups.begin(), groups.end(), e.group), groups.end()) << e.name;
         for (const auto& o : e.options()) {
             EXPECT_NE(std::find(o.values.begin(), o.values.end(), o.default_value), o.values.end())
                 << e.name << " " << o.key;
         }
     }
-    EXPECT_EQ(names, (std::vector<std::string>{"ww09", "ele10", "ww-prime", "bel18-forward",
-                                               "bel18-symmetric", "bel-prime", "random-walk"}));
+    EXPECT_EQ(by_group["2019"],
+              (std::vector<std::string>{"ww09", "ele10", "ww-prime", "bel18-forward",
+                                        "bel18-symmetric", "bel-prime"}));
+    EXPECT_EQ(by_group["reference"], (std::vector<std::string>{"random-walk"}));
+}
+
+TEST(ModelRegistry, ListsTheProductionCoats) {
+    std::vector<std::string> names;
+    for (const auto& e : model_registry())
+        if (e.group == "production") {
+            names.push_back(e.name);
+            EXPECT_FALSE(e.stochastic);
+        }
+    EXPECT_EQ(names, (std::vector<std::string>{"openpbr", "openpbr-adobe", "standard-surface",
+                                               "enterprise-pbr", "filament", "gltf-clearcoat",
+                                               "blender-principled", "kulla-conty"}));
 }
 
 TEST(ModelRegistry, UnknownNameListsTheKnownOnes) {

@@ -82,6 +82,22 @@ async function main() {
     await changes("the log scale", () => page.uncheck("#w-log"), ["slice"]);
     await changes("a model", () => page.uncheck("#w-model-ww09"), ["slice", "albedo"]);
     check(await page.evaluate(() => !document.getElementById("slice").data.some((t) => t.name === "ww09")), "an unticked model is not drawn");
+    // The model groups (study.json model_groups): a heading per family, a button that shows one.
+    check(await page.evaluate(() => ["2019", "production", "ablations"].every((g) => document.getElementById("w-group-head-" + g))),
+      "the models are grouped: 2019 study, production coats, their ablations");
+    check(await page.evaluate(() => document.querySelector('#w-models label[data-group="production"]').textContent.includes("openpbr")),
+      "openpbr is listed under the production coats");
+    await changes("the production group", () => page.click("#w-group-production"), ["slice", "albedo"]);
+    check(await page.evaluate(() => {
+      const names = document.getElementById("slice").data.map((t) => t.name).filter((n) => window.LAMINA_EXPLORER.models.includes(n));
+      return names.length > 0 && names.every((n) => n === "openpbr");
+    }), "the production group alone: only openpbr is drawn");
+    check(await page.evaluate(() => {
+      const boxes = Array.from(document.querySelectorAll("#w-models input[type=checkbox]"));
+      return boxes.filter((b) => b.checked).map((b) => b.id).join() === "w-model-openpbr";
+    }), "its checkbox alone is ticked");
+    await changes("every group", () => page.click("#w-group-all"), ["slice", "albedo"]);
+    check(await page.evaluate(() => window.LAMINA_EXPLORER.state.shown.size === window.LAMINA_EXPLORER.models.length), "all: every model shown again");
     await changes("the iso model", () => page.selectOption("#w-iso-model", "ww-prime"), ["iso-model", "iso-diff"]);
     await changes("the iso channel", () => page.selectOption("#w-iso-channel", "2"), ["iso-ref", "iso-model"]);
     await changes("the difference mode", () => page.selectOption("#w-diff", "sigma"), ["iso-diff"]);
@@ -128,8 +144,8 @@ async function main() {
     check((await page.evaluate(() => document.body.dataset.config)) === target, `a leaderboard click opens ${target}`);
     check((await page.evaluate(() => window.LAMINA_EXPLORER.state.isoModel)) === "ww-prime", "… with the clicked model in the iso view");
     await page.waitForFunction(() => Array.from(document.querySelectorAll("#renders img")).every((i) => i.complete));
-    check((await page.evaluate(() => Array.from(document.querySelectorAll("#renders img")).filter((i) => i.naturalWidth > 0).length)) === 3,
-      "its three sphere renderings are shown");
+    check((await page.evaluate(() => Array.from(document.querySelectorAll("#renders img")).filter((i) => i.naturalWidth > 0).length)) === 4,
+      "its four sphere renderings are shown");
     check(await page.evaluate(() => /rel\. RMSE 0\.13/.test(document.getElementById("renders").textContent) &&
       /not supported/.test(document.getElementById("renders").textContent)), "… with their errors, and the one that could not be drawn named");
     check(pos.y !== undefined && cfg0 !== target, "the click target differs from the first configuration");

@@ -10,6 +10,8 @@ Shapes (f in 1/sr, at the bin centres):
   ww09        = the reference scaled by 1.1 (too bright everywhere)
   ww-prime    = the lobe twice as wide
   bel18-forward does not support a Lambertian base (all NaN, supported false) and is R only on slabs.
+  openpbr     = the reference scaled by 0.9 (a production coat: the explorer groups the models)
+  openpbr:darkening=off = the reference scaled by 0.95 (one of its ablations)
 The slab has a transmitted lobe around the straight-through direction.
 """
 import json
@@ -22,7 +24,9 @@ from array import array
 
 THETA_I = [0.0, 30.0, 60.0]
 N_THETA, N_PHI = 60, 40  # not the default grid on purpose: the explorer must read it from study.json
-MODELS = ["ww09", "ww-prime", "bel18-forward"]
+MODELS = ["ww09", "ww-prime", "bel18-forward", "openpbr", "openpbr:darkening=off"]
+MODEL_GROUPS = {"ww09": "2019", "ww-prime": "2019", "bel18-forward": "2019",
+                "openpbr": "production", "openpbr:darkening=off": "ablations"}
 CONFIGS = [
     # id, category, parameters, sides, diffuse rho (rgb), lobe width (rad), specular weight
     ("plastic-P1-a0.05", "plastic",
@@ -89,6 +93,10 @@ def table(kind, side, theta_i, rho, width, weight):
             f = [b + spec for b in base]
             if kind == "ww09":
                 f = [1.1 * v for v in f]
+            if kind == "openpbr":
+                f = [0.9 * v for v in f]
+            if kind == "openpbr:darkening=off":
+                f = [0.95 * v for v in f]
             row.append(f)
         out.append(row)
     return out
@@ -187,7 +195,7 @@ def main():
             os.makedirs(os.path.join(d, "renders"), exist_ok=True)
             # as `lamina render --compare` names them: the reference is random-walk.png
             for k, s in enumerate(sources):
-                if s == "bel18-forward":
+                if s == "bel18-forward" or ":" in s:  # render --compare draws no ablations
                     continue
                 write_sphere_png(os.path.join(d, "renders",
                                               ("random-walk" if s == "reference" else s) + ".png"),
@@ -222,6 +230,7 @@ def main():
                                        f"{am:.6g},{err:.6g},{e * 0.1:.6g},{e * 0.05:.6g},0.004,true")
     study = {"lamina_version": "fixture", "preset": "fixture", "particles": 1000, "seed": 1,
              "grid": {"n_theta": N_THETA, "n_phi": N_PHI}, "theta_i": THETA_I, "models": MODELS,
+             "model_groups": MODEL_GROUPS,
              "configurations": study_configs}
     with open(os.path.join(root, "study.json"), "w") as f:
         json.dump(study, f, indent=1)

@@ -1,0 +1,284 @@
+#include "study/engine_findings.h"
+
+#include "models/registry.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <tuple>
+
+namespace lamina {
+
+namespace {
+
+std::string pct(double v) {
+    return std::isfinite(v) ? fmt::format("{:.1f}%", 100 * v) : "–";
+}
+std::string signed_pct(double v) {
+    return std::isfinite(v) ? fmt::format("{:+.1f}%", 100 * v) : "–";
+}
+nlohmann::json num(double v) {
+    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+const ModelEntry* entry_of(const std::string& name) {
+    try {
+        return parse_model_spec(name).entry;
+    } catch (...) {
+        return nullptr;  // a model this lamina no longer has: not a production coat
+    }
+}
+
+bool is_production(const std::string& name) {
+    const ModelEntry* e = entry_of(name);
+    return e && e->group == "production" && name.find(':') == std::string::npos;
+}
+
+using RowKey = std::tuple<std::string, double, int>;  // config, θi, channel
+
+}  // namespace
+
+EngineFindings compute_engine_findings(const std::vector<MetricRow>& rows,
+                                       const std::vector<std::string>& models) {
+    EngineFindings f;
+    std::set<double> thetas;
+    for (const MetricRow& r : rows) {
+        if (r.side != 'R') continue;
+        thetas.insert(r.theta_i);
+        if (std::find(f.categories.begin(), f.categories.end(), r.category) == f.categories.end())
+            f.categories.push_back(r.category);
+    }
+    f.theta_i.assign(thetas.begin(), thetas.end());
+    std::vector<std::string> production;
+    for (const std::string& m : models)
+        if (is_production(m)) production.push_back(m);
+    if (production.empty()) return {};
+
+    // Per (model, category): the supported BRDF rows.
+    struct Acc {
+        std::set<std::string> configs;
+        double e_sum = 0;
+        int e_n = 0;
+        std::vector<double> a_sum, a_n;
+    };
+    std::map<std::pair<std::string, std::string>, Acc> acc;
+    std::map<std::string, std::map<RowKey, const MetricRow*>> by_model;
+    for (const MetricRow& r : rows) {
+        if (r.side != 'R' || !r.supported) continue;
+        by_model[r.model][{r.config, r.theta_i, r.channel}] = &r;
+        Acc& a = acc[{r.model, r.category}];
+        if (a.a_sum.empty()) a.a_sum.assign(f.theta_i.size(), 0), a.a_n.assign(f.theta_i.size(), 0);
+        a.configs.insert(r.config);
+        if (std::isfinite(r.metrics.misplaced_energy)) {
+            a.e_sum += r.metrics.misplaced_energy;
+            ++a.e_n;
+        }
+        const auto k =
+            std::lower_bound(f.theta_i.begin(), f.theta_i.end(), r.theta_i) - f.theta_i.begin();
+        if (std::isfinite(r.metrics.albedo_error)) {
+            a.a_sum[k] += r.metrics.albedo_error;
+            a.a_n[k] += 1;
+        }
+    }
+    auto mean_e = [&](const std::string& m, const std::string& c) {
+        const auto it = acc.find({m, c});
+        return it == acc.end() || it->second.e_n == 0 ? NAN : it->second.e_sum / it->second.e_n;
+    };
+
+    for (const std::string& c : f.categories) {
+        for (const std::string& m : production) {
+            EngineFindings::Cell cell{m, c, 0, NAN, std::vector<double>(f.theta_i.size(), NAN)};
+            const auto it = acc.find({m, c});
+            if (it != acc.end()) {
+                cell.configurations = int(it->second.configs.size());
+                cell.mean_misplaced = mean_e(m, c);
+                for (std::size_t k = 0; k < f.theta_i.size(); ++k)
+                    if (it->second.a_n[k] > 0)
+                        cell.albedo_error[k] = it->second.a_sum[k] / it->second.a_n[k];
+            }
+            f.cells.push_back(cell);
+            if (std::isfinite(cell.mean_misplaced) &&
+                (!f.best_production.count(c) || cell.mean_misplaced < f.best_production_error[c])) {
+                f.best_production[c] = m;
+                f.best_production_error[c] = cell.mean_misplaced;
+            }
+        }
+        for (const std::string& m : models) {
+            const double e = mean_e(m, c);
+            if (std::isfinite(e) && (!f.best_overall.count(c) || e < f.best_overall_error[c])) {
+                f.best_overall[c] = m;
+                f.best_overall_error[c] = e;
+            }
+        }
+    }
+
+    // Ablations: each variant "NAME:KEY=VALUE" of a production coat against NAME, row by row.
+    for (const std::string& v : models) {
+        const auto colon = v.find(':');
+        if (colon == std::string::npos) continue;
+        const std::string base = v.substr(0, colon);
+        if (!is_production(base) || !by_model.count(base) || !by_model.count(v)) continue;
+        std::map<std::string, EngineFindings::Ablation> per_category;
+        for (const auto& [key, rv] : by_model[v]) {
+            const auto it = by_model[base].find(key);
+            if (it == by_model[base].end()) continue;
+            const MetricRow& rb = *it->second;
+            if (!std::isfinite(rv->metrics.misplaced_energy) ||
+                !std::isfinite(rb.metrics.misplaced_energy))
+                continue;
+            EngineFindings::Ablation& a = per_category[rv->category];
+            a.rows++;
+            a.shipped += rb.metrics.misplaced_energy;
+            a.switched += rv->metrics.misplaced_energy;
+            if (std::isfinite(rv->metrics.albedo_error) && std::isfinite(rb.metrics.albedo_error)) {
+                a.shipped_albedo += std::abs(rb.metrics.albedo_error);
+                a.switched_albedo += std::abs(rv->metrics.albedo_error);
+            }
+        }
+        for (const std::string& c : f.categories) {
+            auto it = per_category.find(c);
+            if (it == per_category.end() || it->second.rows == 0) continue;
+            EngineFindings::Ablation a = it->second;
+            a.variant = v;
+            a.model = base;
+            a.flag = v.substr(colon + 1);
+            a.category = c;
+            a.shipped /= a.rows;
+            a.switched /= a.rows;
+            a.shipped_albedo /= a.rows;
+            a.switched_albedo /= a.rows;
+            f.ablations.push_back(a);
+        }
+    }
+    return f;
+}
+
+namespace {
+
+/// "too dark at every incidence (−3.1% at 0° to −9.0% at 80°)", "too bright at grazing incidence
+/// (+12% at 80°), too dark at normal incidence (−2% at 0°)", "within ±1% at every incidence".
+std::string albedo_words(const std::vector<double>& theta, const std::vector<double>& err) {
+    double lo = INFINITY, hi = -INFINITY;
+    std::size_t ilo = 0, ihi = 0;
+    for (std::size_t k = 0; k < err.size(); ++k) {
+        if (!std::isfinite(err[k])) continue;
+        if (err[k] < lo) lo = err[k], ilo = k;
+        if (err[k] > hi) hi = err[k], ihi = k;
+    }
+    if (!std::isfinite(lo)) return "no albedo error (no reference energy)";
+    const double tol = 0.01;
+    if (hi <= tol && lo >= -tol) return "its albedo is within ±1% at every incidence";
+    auto at = [&](std::size_t k) { return fmt::format("{} at {}°", signed_pct(err[k]), theta[k]); };
+    if (lo >= -tol) return fmt::format("too bright, most at {} (least {})", at(ihi), at(ilo));
+    if (hi <= tol) return fmt::format("too dark, most at {} (least {})", at(ilo), at(ihi));
+    return fmt::format("too bright at {}° ({}), too dark at {}° ({})", theta[ihi],
+                       signed_pct(err[ihi]), theta[ilo], signed_pct(err[ilo]));
+}
+
+}  // namespace
+
+std::string engine_findings_markdown(const EngineFindings& f) {
+    if (f.empty()) return "";
+    std::string md;
+    auto out = [&]<typename... A>(fmt::format_string<A...> format, A&&... args) {
+        fmt::format_to(std::back_inserter(md), format, std::forward<A>(args)...);
+    };
+    out("## For engine developers: the production coats\n\n");
+    out("The coats engines ship (`docs/models.md`, \"Production coats\"), on the BRDF of each "
+        "category: the mean signed albedo error (model − reference)/reference against θi "
+        "(negative: "
+        "the coat is too dark), the lobe error (mean misplaced energy), what each heuristic does "
+        "(the model with one flag switched, `NAME:KEY=VALUE`, against the model as shipped on the "
+        "same rows; `lamina study --ablations`), and the most accurate production coat.\n\n");
+    for (const std::string& c : f.categories) {
+        std::vector<const EngineFindings::Cell*> cells;
+        for (const auto& cell : f.cells)
+            if (cell.category == c && cell.configurations > 0) cells.push_back(&cell);
+        out("### {}\n\n", c);
+        if (cells.empty()) {
+            out("No production coat supports this category (see \"Not supported\").\n\n");
+            continue;
+        }
+        out("| model | misplaced energy |");
+        for (double t : f.theta_i)
+            out(" albedo error {}° |", t);
+        out("\n|---|---|");
+        for (std::size_t k = 0; k < f.theta_i.size(); ++k)
+            out("---|");
+        out("\n");
+        for (const auto* cell : cells) {
+            out("| {} | {} |", cell->model, pct(cell->mean_misplaced));
+            for (double e : cell->albedo_error)
+                out(" {} |", signed_pct(e));
+            out("\n");
+        }
+        out("\n");
+        for (const auto* cell : cells)
+            out("- **{}**: {}; misplaces {} of the reflected energy.\n", cell->model,
+                albedo_words(f.theta_i, cell->albedo_error), pct(cell->mean_misplaced));
+        if (f.best_production.count(c))
+            out("- Most accurate production coat here: **{}** ({}); best of every model: {} "
+                "({}).\n",
+                f.best_production.at(c), pct(f.best_production_error.at(c)), f.best_overall.at(c),
+                pct(f.best_overall_error.at(c)));
+        bool any = false;
+        for (const auto& a : f.ablations) {
+            if (a.category != c) continue;
+            if (!any) {
+                out("\nHeuristics and leaves (mean misplaced energy; mean |albedo error|):\n\n"
+                    "| model | switched | as shipped | switched | effect of the switch |\n"
+                    "|---|---|---|---|---|\n");
+                any = true;
+            }
+            const double d = a.switched - a.shipped;
+            const std::string effect =
+                std::abs(d) < 0.001 ? "no change (< 0.1 point)"
+                : d < 0
+                    ? fmt::format("lowers the error by {} points", fmt::format("{:.1f}", -100 * d))
+                    : fmt::format("raises the error by {} points", fmt::format("{:.1f}", 100 * d));
+            out("| {} | `{}` | {}; {} | {}; {} | {} |\n", a.model, a.flag, pct(a.shipped),
+                pct(a.shipped_albedo), pct(a.switched), pct(a.switched_albedo), effect);
+        }
+        out("\n");
+    }
+    return md;
+}
+
+nlohmann::json engine_findings_json(const EngineFindings& f) {
+    if (f.empty()) return nullptr;
+    nlohmann::json j;
+    j["theta_i"] = f.theta_i;
+    for (const std::string& c : f.categories) {
+        nlohmann::json jc;
+        for (const auto& cell : f.cells) {
+            if (cell.category != c || cell.configurations == 0) continue;
+            nlohmann::json ae = nlohmann::json::array();
+            for (double e : cell.albedo_error)
+                ae.push_back(num(e));
+            jc["models"][cell.model] = {{"configurations_supported", cell.configurations},
+                                        {"mean_misplaced_energy", num(cell.mean_misplaced)},
+                                        {"albedo_error_by_theta_i", ae}};
+        }
+        if (f.best_production.count(c)) {
+            jc["most_accurate_production"] = f.best_production.at(c);
+            jc["most_accurate_overall"] = f.best_overall.at(c);
+        }
+        for (const auto& a : f.ablations)
+            if (a.category == c)
+                jc["ablations"].push_back(
+                    {{"variant", a.variant},
+                     {"model", a.model},
+                     {"flag", a.flag},
+                     {"rows", a.rows},
+                     {"shipped_misplaced_energy", num(a.shipped)},
+                     {"switched_misplaced_energy", num(a.switched)},
+                     {"shipped_mean_abs_albedo_error", num(a.shipped_albedo)},
+                     {"switched_mean_abs_albedo_error", num(a.switched_albedo)}});
+        j["categories"][c] = jc;
+    }
+    return j;
+}
+
+}  // namespace lamina

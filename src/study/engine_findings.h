@@ -1,0 +1,59 @@
+#pragma once
+// The summary's section for engine developers (summary.md "For engine developers", summary.json
+// "engine_developers"): for each production coat (models/registry.h group "production") and
+// category, the albedo error against θi (is the coat too dark or too bright, and where), the
+// lobe error (mean misplaced energy), what each heuristic does (its one-flag ablation
+// "NAME:KEY=VALUE" against the model as shipped, on the same rows), and the most accurate
+// production coat per category. Computed from the metric rows alone (BRDF rows: the production
+// coats have no BTDF); the summary calls it with the rows it already has.
+
+#include "study/study.h"
+
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+struct EngineFindings {
+    /// One production coat in one category, over its supported BRDF rows.
+    struct Cell {
+        std::string model, category;
+        int configurations = 0;
+        double mean_misplaced = 0;  ///< mean misplaced energy
+        /// Mean signed albedo error (model − reference)/reference at each of theta_i (NaN where
+        /// no row).
+        std::vector<double> albedo_error;
+    };
+    /// A heuristic switched: the variant against its model as shipped, on the rows both support.
+    struct Ablation {
+        std::string variant, model, flag, category;
+        int rows = 0;
+        double shipped = 0, switched = 0;                ///< mean misplaced energy of each
+        double shipped_albedo = 0, switched_albedo = 0;  ///< mean |albedo error| of each
+    };
+    std::vector<double> theta_i;
+    std::vector<std::string> categories;
+    std::vector<Cell> cells;  ///< categories × production models, in the study's model order
+    std::vector<Ablation> ablations;
+    /// Per category: the production coat with the lowest mean misplaced energy, and the model of
+    /// any family with the lowest (for scale).
+    std::map<std::string, std::string> best_production, best_overall;
+    std::map<std::string, double> best_production_error, best_overall_error;
+
+    bool empty() const { return cells.empty(); }
+};
+
+/// Aggregates the rows (`models`: the study's, in its order). Empty when no production coat ran.
+EngineFindings compute_engine_findings(const std::vector<MetricRow>& rows,
+                                       const std::vector<std::string>& models);
+
+/// The Markdown section (empty string when `f` is empty).
+std::string engine_findings_markdown(const EngineFindings& f);
+
+/// The same as JSON (null when `f` is empty).
+nlohmann::json engine_findings_json(const EngineFindings& f);
+
+}  // namespace lamina

@@ -1,0 +1,107 @@
+// The engine developers' section of the summary, on hand-made metric rows whose aggregates are
+// known: a production coat too dark at grazing incidence, one of its ablations, a 2019 model
+// that is better, a category no production coat supports.
+#include "study/engine_findings.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace lamina {
+namespace {
+
+MetricRow row(const std::string& config, const std::string& category, const std::string& model,
+              double theta, int channel, bool supported, double misplaced, double albedo_error) {
+    MetricRow r;
+    r.config = config;
+    r.category = category;
+    r.model = model;
+    r.theta_i = theta;
+    r.side = 'R';
+    r.channel = channel;
+    r.supported = supported;
+    r.metrics.misplaced_energy = supported ? misplaced : NAN;
+    r.metrics.albedo_error = supported ? albedo_error : NAN;
+    return r;
+}
+
+std::vector<MetricRow> rows() {
+    std::vector<MetricRow> out;
+    for (const char* cfg : {"p1", "p2"})
+        for (double t : {0.0, 60.0})
+            for (int c = 0; c < 3; ++c) {
+                // openpbr: right at normal incidence, 10% too dark at 60°.
+                out.push_back(row(cfg, "plastic", "openpbr", t, c, true, 0.2, t == 0 ? 0.0 : -0.1));
+                out.push_back(row(cfg, "plastic", "openpbr:darkening=off", t, c, true, 0.3,
+                                  t == 0 ? 0.05 : 0.0));
+                out.push_back(row(cfg, "plastic", "filament", t, c, true, 0.25, 0.2));
+                out.push_back(row(cfg, "plastic", "ww-prime", t, c, true, 0.05, 0.01));
+                out.push_back(row("s1", "slab", "openpbr", t, c, false, 0, 0));
+            }
+    return out;
+}
+
+const std::vector<std::string> kModels = {"ww-prime", "openpbr", "filament",
+                                          "openpbr:darkening=off"};
+
+TEST(EngineFindings, AggregatesTheProductionCoats) {
+    const EngineFindings f = compute_engine_findings(rows(), kModels);
+    ASSERT_FALSE(f.empty());
+    EXPECT_EQ(f.theta_i, (std::vector<double>{0, 60}));
+    EXPECT_EQ(f.categories, (std::vector<std::string>{"plastic", "slab"}));
+    const EngineFindings::Cell* openpbr = nullptr;
+    for (const auto& c : f.cells)
+        if (c.model == "openpbr" && c.category == "plastic") openpbr = &c;
+    ASSERT_NE(openpbr, nullptr);
+    EXPECT_EQ(openpbr->configurations, 2);
+    EXPECT_NEAR(openpbr->mean_misplaced, 0.2, 1e-12);
+    EXPECT_NEAR(openpbr->albedo_error[0], 0.0, 1e-12);
+    EXPECT_NEAR(openpbr->albedo_error[1], -0.1, 1e-12);
+    // Only production coats get cells (ww-prime is a 2019 model, the variant an ablation).
+    for (const auto& c : f.cells)
+        EXPECT_TRUE(c.model == "openpbr" || c.model == "filament") << c.model;
+    EXPECT_EQ(f.best_production.at("plastic"), "openpbr");
+    EXPECT_EQ(f.best_overall.at("plastic"), "ww-prime");
+    EXPECT_FALSE(f.best_production.count("slab"));
+    ASSERT_EQ(f.ablations.size(), 1u);
+    const auto& a = f.ablations[0];
+    EXPECT_EQ(a.model, "openpbr");
+    EXPECT_EQ(a.flag, "darkening=off");
+    EXPECT_EQ(a.rows, 12);
+    EXPECT_NEAR(a.shipped, 0.2, 1e-12);
+    EXPECT_NEAR(a.switched, 0.3, 1e-12);
+    EXPECT_NEAR(a.shipped_albedo, 0.05, 1e-12);
+    EXPECT_NEAR(a.switched_albedo, 0.025, 1e-12);
+}
+
+TEST(EngineFindings, MarkdownReadsAsFindings) {
+    const std::string md = engine_findings_markdown(compute_engine_findings(rows(), kModels));
+    EXPECT_NE(md.find("## For engine developers"), std::string::npos);
+    EXPECT_NE(md.find("**openpbr**: too dark, most at -10.0% at 60°"), std::string::npos) << md;
+    EXPECT_NE(md.find("**filament**: too bright, most at +20.0% at 0°"), std::string::npos) << md;
+    EXPECT_NE(md.find("Most accurate production coat here: **openpbr** (20.0%); best of every "
+                      "model: ww-prime (5.0%)"),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("`darkening=off` | 20.0%; 5.0% | 30.0%; 2.5% | raises the error by 10.0 "
+                      "points"),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("No production coat supports this category"), std::string::npos);
+    const nlohmann::json j = engine_findings_json(compute_engine_findings(rows(), kModels));
+    EXPECT_EQ(j["categories"]["plastic"]["most_accurate_production"], "openpbr");
+    EXPECT_NEAR(
+        j["categories"]["plastic"]["models"]["openpbr"]["albedo_error_by_theta_i"][1].get<double>(),
+        -0.1, 1e-12);
+}
+
+TEST(EngineFindings, EmptyWithoutProductionCoats) {
+    std::vector<MetricRow> r = {row("p1", "plastic", "ww-prime", 0, 0, true, 0.1, 0.0)};
+    const EngineFindings f = compute_engine_findings(r, {"ww-prime"});
+    EXPECT_TRUE(f.empty());
+    EXPECT_EQ(engine_findings_markdown(f), "");
+    EXPECT_TRUE(engine_findings_json(f).is_null());
+}
+
+}  // namespace
+}  // namespace lamina
