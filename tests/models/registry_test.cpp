@@ -20,7 +20,8 @@ TEST(ModelRegistry, ListsTheSixModelsOfTheStudyAndTheRandomWalk) {
         }
     }
     EXPECT_EQ(names, (std::vector<std::string>{"ww09", "ele10", "ww-prime", "bel18-forward",
-                                               "bel18-symmetric", "bel-prime", "random-walk"}));
+                                               "bel18-symmetric", "bel-prime", "tm2",
+                                               "tm2-dielectric", "random-walk"}));
 }
 
 TEST(ModelRegistry, UnknownNameListsTheKnownOnes) {
