@@ -68,6 +68,26 @@ struct Factors {
     bool opaque = false;  ///< conductor, or a dielectric that reflects the mean direction totally
 };
 
+Rgbd max_rgb(const Rgbd& x, double lo) {
+    return {std::max(x[0], lo), std::max(x[1], lo), std::max(x[2], lo)};
+}
+
+/// A lobe's asymmetry from its g-weighted energy: g = weighted/energy (≤ 1), RGB means for the
+/// released scheme (one g per lobe), else per channel; α = α(g).
+void set_asymmetry(TmLobes::Lobe& lobe, const Rgbd& weighted, bool per_channel) {
+    const auto ratio = [](double w, double e) { return e > 0 ? std::min(w / e, 1.0) : 0.0; };
+    if (!per_channel) {
+        lobe.g = ratio(weighted.mean(), lobe.energy.mean());
+        lobe.alpha = tm_ggx_from_hg(lobe.g);
+        lobe.alpha_rgb = Rgbd(lobe.alpha);
+        return;
+    }
+    for (int c = 0; c < 3; ++c)
+        lobe.alpha_rgb[c] = tm_ggx_from_hg(ratio(weighted[c], lobe.energy[c]));
+    lobe.g = ratio(weighted.mean(), lobe.energy.mean());
+    lobe.alpha = tm_ggx_from_hg(lobe.g);
+}
+
 }  // namespace
 
 TmLobes tm_lobes(const std::vector<TmComponent>& comps, double c0, const TmChoices& ch) {
@@ -130,9 +150,11 @@ TmLobes tm_lobes(const std::vector<TmComponent>& comps, double c0, const TmChoic
     // 2. First-order asymmetries, TIR, matrix products and one lobe per interface
     //    (tm2.cpp / tm2_dielectric.cpp outgoing_lobes).
     auto E = Matrix2<Rgbd>::identity();
-    auto G = Matrix2<double>::identity();
+    auto G = Matrix2<Rgbd>::identity();
     Rgbd e_above(0.0);
-    double g_above = 0;
+    Rgbd g_above(0.0);
+    // The weights of the asymmetry matrices: the released RGB means, or each channel's own.
+    const auto weight = [&](const Rgbd& x) { return ch.per_channel_g ? x : Rgbd(x.mean()); };
     double g_T = 1;  // asymmetry of the light transmitted down to the current component
     bool smooth = true;
     bool opaque_end = false;
@@ -142,12 +164,12 @@ TmLobes tm_lobes(const std::vector<TmComponent>& comps, double c0, const TmChoic
         if (x.skip) continue;
         if (k.kind == TmComponent::Medium) {
             E = E * Matrix2<Rgbd>::component(x.r, x.t, x.rp, x.tp);
-            G = G * Matrix2<double>::component(0.0, x.t.mean(), 0.0, x.tp.mean());
+            G = G * Matrix2<Rgbd>::component(Rgbd(0.0), weight(x.t), Rgbd(0.0), weight(x.tp));
             continue;
         }
         smooth = smooth && k.alpha <= 0;
         Rgbd R;
-        double Rg;
+        Rgbd Rg;
         double g_T_next = g_T;
         if (!x.opaque) {
             // The asymmetry of the light refracted down, reflected by the next interface and
@@ -184,22 +206,20 @@ TmLobes tm_lobes(const std::vector<TmComponent>& comps, double c0, const TmChoic
                 x.tp[ch3] = std::max(x.tp[ch3], 0.0);
             }
             E = E * Matrix2<Rgbd>::component(x.r, x.t, x.rp, x.tp);
-            G = G * Matrix2<double>::component(x.gr * x.r.mean(),
-                                               std::max(x.gt * x.t.mean(), kTinyT),
-                                               x.grp * x.rp.mean(), x.gtp * x.tp.mean());
+            G = G * Matrix2<Rgbd>::component(weight(x.r) * x.gr,
+                                             max_rgb(weight(x.t) * x.gt, kTinyT),
+                                             weight(x.rp) * x.grp, weight(x.tp) * x.gtp);
             R = E.reflectance();
             Rg = G.reflectance();
         } else {
             R = E.reflectance_over(x.r);
-            Rg = G.reflectance_over(x.gr * x.r.mean());
+            Rg = G.reflectance_over(weight(x.r) * x.gr);
             opaque_end = true;
         }
         if (out.n_lobes < TmLobes::kMaxLobes) {
             TmLobes::Lobe& lobe = out.lobes[out.n_lobes++];
             lobe.energy = R - e_above;
-            const double em = lobe.energy.mean();
-            lobe.g = em > 0 ? std::min((Rg - g_above) / em, 1.0) : 0.0;
-            lobe.alpha = tm_ggx_from_hg(lobe.g);
+            set_asymmetry(lobe, Rg - g_above, ch.per_channel_g);
             lobe.delta = smooth;
         }
         e_above = R;
@@ -210,9 +230,7 @@ TmLobes tm_lobes(const std::vector<TmComponent>& comps, double c0, const TmChoic
     if (ch.slab && !opaque_end) {
         out.transmits = true;
         out.transmitted.energy = E.transmittance();
-        const double em = out.transmitted.energy.mean();
-        out.transmitted.g = em > 0 ? std::min(G.transmittance() / em, 1.0) : 0.0;
-        out.transmitted.alpha = tm_ggx_from_hg(out.transmitted.g);
+        set_asymmetry(out.transmitted, G.transmittance(), ch.per_channel_g);
         out.transmitted.delta = smooth;
         out.cos_t = c;
     }
@@ -326,7 +344,7 @@ class TmModel final : public Model {
             if (!support_.btdf || !st.transmits || t.delta) return Rgbd(0.0);
             const Vec3d wv = virtual_incidence(wi, st.cos_t);
             const Vec3d wo_up = flip_z(wo);
-            return t.energy * ggx_lobe_shape(t.alpha, wv, wo_up, normalize(wv + wo_up));
+            return lobe_value(t, wv, wo_up, normalize(wv + wo_up));
         }
         const Vec3d h = normalize(wi + wo);
         Rgbd f(0.0);
@@ -337,7 +355,7 @@ class TmModel final : public Model {
             }
             const TmLobes::Lobe& l = st.lobes[k];
             if (l.delta) continue;
-            f += l.energy * ggx_lobe_shape(l.alpha, wi, wo, h);
+            f += lobe_value(l, wi, wo, h);
         }
         return f;
     }
@@ -410,6 +428,17 @@ class TmModel final : public Model {
     }
 
   private:
+    /// energy · D G2/(4 μi μo) at the lobe's roughness (one per channel with
+    /// asymmetry=per-channel).
+    Rgbd lobe_value(const TmLobes::Lobe& l, const Vec3d& wi, const Vec3d& wo,
+                    const Vec3d& h) const {
+        if (!ch_.per_channel_g) return l.energy * ggx_lobe_shape(l.alpha, wi, wo, h);
+        Rgbd f;
+        for (int c = 0; c < 3; ++c)
+            f[c] = l.energy[c] * ggx_lobe_shape(l.alpha_rgb[c], wi, wo, h);
+        return f;
+    }
+
     struct Mixture {
         static constexpr int kMax = TmLobes::kMaxLobes + 1;
         std::array<double, kMax> w{}, alpha{};
@@ -510,6 +539,10 @@ std::vector<OptionSpec> tm_option_specs(const TmChoices& d) {
          d.upward_fgd ? "refracted" : "same-cosine",
          "upward reflectance r': r at the incident cosine (released) or FGD(mu_t, alpha, 1/eta)"},
         {"tir", {"on", "off"}, on_off(d.tir), "the TIR-table steps of the released code"},
+        {"asymmetry",
+         {"rgb-mean", "per-channel"},
+         d.per_channel_g ? "per-channel" : "rgb-mean",
+         "lobe asymmetry g from RGB-mean weights, one per lobe (released), or per channel"},
     };
 }
 
@@ -517,6 +550,7 @@ TmChoices tm_choices(const ModelOptions& o, TmChoices c) {
     c.exact_top = option_value(o, "top") == "exact";
     c.upward_fgd = option_value(o, "upward-fgd") == "refracted";
     c.tir = option_value(o, "tir") == "on";
+    c.per_channel_g = option_value(o, "asymmetry") == "per-channel";
     return c;
 }
 

@@ -53,6 +53,9 @@ struct TmChoices {
     bool upward_fgd = false;
     /// The TIR table steps of the released code (energy moved from transmission to reflection).
     bool tir = true;
+    /// The asymmetry matrices weighted per channel, one g (and GGX roughness) per channel and lobe
+    /// (true), or with the released RGB-mean weights, one g per lobe (false).
+    bool per_channel_g = false;
 };
 
 /// One component of the stack, top to bottom.
@@ -72,8 +75,9 @@ struct TmLobes {
     struct Lobe {
         Rgbd energy{0.0};
         double g = 0;
-        double alpha = 0;    ///< tm_ggx_from_hg(g)
-        bool delta = false;  ///< g = 1: every interface on its way is smooth
+        double alpha = 0;     ///< tm_ggx_from_hg(g)
+        Rgbd alpha_rgb{0.0};  ///< per channel (all equal to alpha unless per_channel_g)
+        bool delta = false;   ///< g = 1: every interface on its way is smooth
     };
     std::array<Lobe, kMaxLobes> lobes{};
     int n_lobes = 0;
