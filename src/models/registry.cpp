@@ -35,13 +35,10 @@ const std::vector<ModelEntry>& model_registry() {
          "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R, T (slab)",
          bel_prime_options, make_bel_prime},
         {"tm2",
-         "Randrianandrasana et al. 2021 transfer matrices: lobes by energy and HG asymmetry, "
-         "exact top reflection",
-         "bases: conductor; media: absorbing; sides: R", tm2_options, make_tm2},
-        {"tm2-dielectric",
-         "Randrianandrasana et al. 2021 transfer matrices, slab variant with a transmitted lobe",
-         "bases: dielectric (slab); media: absorbing; sides: R, T", tm2_dielectric_options,
-         make_tm2_dielectric},
+         "Randrianandrasana et al. 2021 transfer matrices: lobes by energy and HG asymmetry "
+         "(conductor base: plugin tm2, exact top; slab: tm2_dielectric, transmitted lobe)",
+         "bases: conductor, dielectric; media: absorbing; sides: R, T (slab)", tm2_options,
+         make_tm2},
         {"random-walk",
          "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "
          "per-query reference, unbiased",

@@ -307,18 +307,9 @@ class TmModel final : public Model {
                 fmt::format("{} needs 1 to {} interfaces", name_, int(TmLobes::kMaxLobes));
             return;
         }
-        if (ch_.slab && !stack.transmits()) {
-            support_.reason = fmt::format(
-                "{} is the slab variant (dielectric interfaces only); a conductor base is tm2",
-                name_);
-            return;
-        }
-        if (!ch_.slab && stack.transmits()) {
-            support_.reason = fmt::format(
-                "{} needs a conductor base (the released tm2 is opaque); a slab is tm2-dielectric",
-                name_);
-            return;
-        }
+        ch_.slab = stack.transmits();
+        ch_.exact_top =
+            ch_.top == TmChoices::Top::Exact || (ch_.top == TmChoices::Top::Released && !ch_.slab);
         support_.brdf = true;
         support_.btdf = ch_.slab;
         top_ = comps_.front();
@@ -528,12 +519,14 @@ std::unique_ptr<IncidentEvaluator> TmModel::prepare(const Vec3d& wi) const {
 
 }  // namespace
 
-std::vector<OptionSpec> tm_option_specs(const TmChoices& d) {
+std::vector<OptionSpec> tm_option_specs() {
+    const TmChoices d;
     return {
         {"top",
-         {"exact", "lobe"},
-         d.exact_top ? "exact" : "lobe",
-         "lobe 0: the exact top-interface reflection (tm2) or the matrices' FGD-weighted lobe"},
+         {"released", "exact", "lobe"},
+         "released",
+         "lobe 0: as released (exact over a conductor, from the matrices for a slab), the exact "
+         "top reflection, or the matrices' FGD-weighted lobe"},
         {"upward-fgd",
          {"same-cosine", "refracted"},
          d.upward_fgd ? "refracted" : "same-cosine",
@@ -546,8 +539,12 @@ std::vector<OptionSpec> tm_option_specs(const TmChoices& d) {
     };
 }
 
-TmChoices tm_choices(const ModelOptions& o, TmChoices c) {
-    c.exact_top = option_value(o, "top") == "exact";
+TmChoices tm_choices(const ModelOptions& o) {
+    TmChoices c;
+    const std::string& top = option_value(o, "top");
+    c.top = top == "exact"  ? TmChoices::Top::Exact
+            : top == "lobe" ? TmChoices::Top::Lobe
+                            : TmChoices::Top::Released;
     c.upward_fgd = option_value(o, "upward-fgd") == "refracted";
     c.tir = option_value(o, "tir") == "on";
     c.per_channel_g = option_value(o, "asymmetry") == "per-channel";

@@ -1,7 +1,9 @@
 #pragma once
 // Transfer-matrix layering: Randrianandrasana, Callet & Lucas 2021, "Transfer matrix based
 // layered materials rendering", ACM TOG 40(4), and its public code (laurent-lu/TMbLM-Rendering,
-// plugins tm2 and tm2_dielectric, read to understand them; this is lamina's own code).
+// plugins tm2 and tm2_dielectric, read to understand them; this is lamina's own code). One model,
+// `tm2`: over a conductor base it is the plugin tm2, over a dielectric base (a slab)
+// tm2_dielectric.
 //
 // Like Belcour 2018, the BRDF is a sum of GGX lobes, one per interface, plus (for a slab) one
 // transmitted lobe. Each lobe is described by its energy (RGB) and a Henyey–Greenstein asymmetry
@@ -42,10 +44,15 @@ double tm_hg_refract(double g, double eta);
 
 /// The ambiguous or quirky choices of the released code, each a flag (docs/models.md).
 struct TmChoices {
-    /// Lobe 0 replaced by the exact reflection of the top interface (tm2: "[Bati2019] top
-    /// reflection correction", i.e. Bel'); tm2-dielectric has none.
+    /// The `top` flag: lobe 0 as released (exact over a conductor base, as the plugin tm2 does;
+    /// from the matrices for a slab, as tm2_dielectric does), always exact, or always the
+    /// matrices' FGD-weighted lobe. The model resolves it into exact_top.
+    enum class Top { Released, Exact, Lobe } top = Top::Released;
+    /// Lobe 0 replaced by the exact reflection of the top interface (the released tm2's
+    /// "[Bati2019] top reflection correction", i.e. Bel').
     bool exact_top = true;
-    /// The slab variant: a transmitted lobe (tm2-dielectric).
+    /// A slab (dielectric base): the transmitted lobe (the released tm2_dielectric). Set by the
+    /// model from its stack.
     bool slab = false;
     /// Upward factors r′, t′: the released code's r′ = r at the same (incident) cosine (false) or
     /// a proper upward FGD, r′ = FGD(μt, α, 1/η) at the refracted cosine (true; this FGD already
@@ -91,10 +98,10 @@ struct TmLobes {
 /// Runs the 2×2 transfer-matrix scheme for incident cosine c0 ∈ (0, 1].
 TmLobes tm_lobes(const std::vector<TmComponent>& components, double c0, const TmChoices& choices);
 
-/// The flags shared by the transfer-matrix models, with these defaults.
-std::vector<OptionSpec> tm_option_specs(const TmChoices& defaults);
-/// Choices named by validated options (slab, fixed by the variant, from `base`).
-TmChoices tm_choices(const ModelOptions& options, TmChoices base);
+/// The flags of the transfer-matrix model, with the released defaults.
+std::vector<OptionSpec> tm_option_specs();
+/// Choices named by validated options.
+TmChoices tm_choices(const ModelOptions& options);
 
 std::unique_ptr<Model> make_tm_model(std::string model_name, const Stack& stack,
                                      const TmChoices& choices);

@@ -25,7 +25,7 @@ expect_output() {  # expect_output NAME PATTERN: the last command's output match
 }
 
 check models 0 "$lamina" models --options
-for m in ww09 ele10 ww-prime bel18-forward bel18-symmetric bel-prime tm2 tm2-dielectric; do expect_output "models $m" "^$m "; done
+for m in ww09 ele10 ww-prime bel18-forward bel18-symmetric bel-prime tm2; do expect_output "models $m" "^$m "; done
 check unknown-model 1 "$lamina" eval --model ww10 --stack x.json --theta-i 30 --theta-o 45 --phi-o 180
 expect_output unknown-model-lists "known models: ww09"
 check theta-i-range 1 "$lamina" eval --model ww09 --stack x.json --theta-i 90 --theta-o 45 --phi-o 180

@@ -19,9 +19,9 @@ TEST(ModelRegistry, ListsTheSixModelsOfTheStudyAndTheRandomWalk) {
                 << e.name << " " << o.key;
         }
     }
-    EXPECT_EQ(names, (std::vector<std::string>{"ww09", "ele10", "ww-prime", "bel18-forward",
-                                               "bel18-symmetric", "bel-prime", "tm2",
-                                               "tm2-dielectric", "random-walk"}));
+    EXPECT_EQ(names,
+              (std::vector<std::string>{"ww09", "ele10", "ww-prime", "bel18-forward",
+                                        "bel18-symmetric", "bel-prime", "tm2", "random-walk"}));
 }
 
 TEST(ModelRegistry, UnknownNameListsTheKnownOnes) {

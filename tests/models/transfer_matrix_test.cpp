@@ -1,6 +1,7 @@
-// Transfer-matrix models (Randrianandrasana, Callet & Lucas 2021): tm2 and tm2-dielectric. Limits,
-// the scheme at a few points against a hand computation of the paper's adding written here from
-// ray sums (not matrices), Bel' on the same stacks, reciprocity, support, sampling.
+// The transfer-matrix model tm2 (Randrianandrasana, Callet & Lucas 2021), over conductors and
+// slabs. Limits, the scheme at a few points against a hand computation of the paper's adding
+// written here from ray sums (not matrices), Bel' on the same stacks, reciprocity, support,
+// sampling.
 #include "models/transfer_matrix.h"
 
 #include "core/math.h"
@@ -174,8 +175,8 @@ TEST(TmGolden, PerChannelAsymmetryMatchesTheHandAdding) {
     }
     // Achromatic energies (a clear slab): both weightings give the same lobes.
     const Stack slab = coated(1.5, 0.3, test::dielectric(1.0, 0.2));
-    const auto mean_g = make_model("tm2-dielectric", slab);
-    const auto own_g = make_model("tm2-dielectric", slab, {"asymmetry=per-channel"});
+    const auto mean_g = make_model("tm2", slab);
+    const auto own_g = make_model("tm2", slab, {"asymmetry=per-channel"});
     for (Side side : {Side::Reflection, Side::Transmission}) {
         const Vec3d o = direction_from_angles(deg_to_rad(30.0), deg_to_rad(150.0), side);
         const Rgbd a = mean_g->eval(wi, o), b = own_g->eval(wi, o);
@@ -184,12 +185,13 @@ TEST(TmGolden, PerChannelAsymmetryMatchesTheHandAdding) {
     }
 }
 
-// A smooth glass sheet in air (1 | 1.5 | 1) through tm2-dielectric: with smooth interfaces the
-// released "same cosine" upward factor is exact (Stokes: r′ = r) and TIR cannot occur for light
-// that entered, so the scheme is the incoherent two-interface sum, R = 2F/(1 + F), T = (1 − F)/(1
+// A smooth glass sheet in air (1 | 1.5 | 1) through tm2 (the released tm2_dielectric): with smooth
+// interfaces the released "same cosine" upward factor is exact (Stokes: r′ = r) and TIR cannot
+// occur for light that entered, so the scheme is the incoherent two-interface sum, R = 2F/(1 + F),
+// T = (1 − F)/(1
 // + F), F = F(μi; 1.5), delta lobes along the mirror and the straight-through direction.
 TEST(TmGolden, SmoothGlassSheetIsTheIncoherentSum) {
-    const auto model = make_model("tm2-dielectric", coated(1.5, 0.0, test::dielectric(1.0, 0.0)));
+    const auto model = make_model("tm2", coated(1.5, 0.0, test::dielectric(1.0, 0.0)));
     ASSERT_TRUE(model->support().btdf);
     for (double ti : {0.0, 35.0, 70.0}) {
         const Vec3d wi = dir(ti, 0);
@@ -304,8 +306,8 @@ TEST(Tm2, IsNotReciprocal) {
 }
 
 TEST(Tm2, PreparedEvaluatorEqualsEval) {
-    const auto model = make_model(
-        "tm2-dielectric", coated(1.5, 0.1, test::dielectric(1.2, 0.2), Rgbd(0.1, 0.3, 0.6)));
+    const auto model =
+        make_model("tm2", coated(1.5, 0.1, test::dielectric(1.2, 0.2), Rgbd(0.1, 0.3, 0.6)));
     ASSERT_TRUE(model->support().btdf);
     const Vec3d wi = dir(40, 0);
     const auto prepared = model->prepare(wi);
@@ -318,22 +320,40 @@ TEST(Tm2, PreparedEvaluatorEqualsEval) {
 }
 
 TEST(Tm2, SupportIsExplicit) {
-    for (const char* name : {"tm2", "tm2-dielectric"}) {
-        const auto plastic = make_model(name, coated(1.5, 0.1, test::lambertian(Rgbd(0.5))));
-        EXPECT_FALSE(plastic->support().brdf);
-        EXPECT_NE(plastic->support().reason.find("no Lambertian"), std::string::npos);
-        const auto scatters =
-            make_model(name, coated(1.5, 0.1, test::gold(0.2), Rgbd(0.1), Rgbd(0.5), 0.3));
-        EXPECT_FALSE(scatters->support().brdf);
-        EXPECT_NE(scatters->support().reason.find("scattering"), std::string::npos);
-    }
-    const Stack slab = coated(1.5, 0.1, test::dielectric(1.2, 0.2));
-    EXPECT_FALSE(make_model("tm2", slab)->support().brdf);
-    EXPECT_NE(make_model("tm2", slab)->support().reason.find("tm2-dielectric"), std::string::npos);
-    const Stack metal = coated(1.5, 0.1, test::gold(0.2));
-    EXPECT_FALSE(make_model("tm2-dielectric", metal)->support().brdf);
-    EXPECT_TRUE(make_model("tm2", metal)->support().brdf);
-    EXPECT_TRUE(make_model("tm2", coated(1.5, 0.1, test::gold(0.2), Rgbd(0.3)))->support().brdf);
+    const auto plastic = make_model("tm2", coated(1.5, 0.1, test::lambertian(Rgbd(0.5))));
+    EXPECT_FALSE(plastic->support().brdf);
+    EXPECT_NE(plastic->support().reason.find("no Lambertian"), std::string::npos);
+    const auto scatters =
+        make_model("tm2", coated(1.5, 0.1, test::gold(0.2), Rgbd(0.1), Rgbd(0.5), 0.3));
+    EXPECT_FALSE(scatters->support().brdf);
+    EXPECT_NE(scatters->support().reason.find("scattering"), std::string::npos);
+    const auto slab = make_model("tm2", coated(1.5, 0.1, test::dielectric(1.2, 0.2)));
+    EXPECT_TRUE(slab->support().brdf);
+    EXPECT_TRUE(slab->support().btdf);
+    const auto metal = make_model("tm2", coated(1.5, 0.1, test::gold(0.2), Rgbd(0.3)));
+    EXPECT_TRUE(metal->support().brdf);
+    EXPECT_FALSE(metal->support().btdf);
+}
+
+// top=released is the plugin's choice per base: exact over a conductor (tm2), from the matrices
+// for a slab (tm2_dielectric); top=exact and top=lobe force one or the other. Over a black base
+// (a conductor matched to the coat) the exact top is Walter's reflection and the matrix lobe is
+// FGD(μi)·D·G2/(4μiμo); for a slab the lobe 0 difference is exactly f_top − FGD·D·G2/(4μiμo).
+TEST(Tm2, TopFlagFollowsTheReleasedPluginPerBase) {
+    const double eta = 1.5, a0 = 0.25;
+    const DielectricInterface<double> top{eta, a0};
+    const GGX<double> ggx{a0};
+    const Vec3d wi = dir(60, 0), wo = dir(45, 160), h = normalize(wi + wo);
+    const double lobe0 =
+        FgdTable::get()(wi.z, a0, eta, 0) * ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
+    const Stack black = coated(eta, a0, test::conductor(Rgbd(eta), Rgbd(0.0), 0.3));
+    EXPECT_NEAR(make_model("tm2", black)->eval(wi, wo)[0], top.eval(wi, wo), 1e-12);
+    EXPECT_NEAR(make_model("tm2", black, {"top=lobe"})->eval(wi, wo)[0], lobe0, 1e-12);
+    const Stack slab = coated(eta, a0, test::dielectric(1.0, 0.2));
+    const double released = make_model("tm2", slab)->eval(wi, wo)[0];
+    const double exact = make_model("tm2", slab, {"top=exact"})->eval(wi, wo)[0];
+    EXPECT_NEAR(exact - released, top.eval(wi, wo) - lobe0, 1e-12);
+    EXPECT_EQ(make_model("tm2", slab, {"top=lobe"})->eval(wi, wo)[0], released);
 }
 
 std::vector<std::string> options(const std::string& a, const std::string& b) {
@@ -355,16 +375,16 @@ TEST(Tm2, AlbedoAtMostOneOverTheFlags) {
     o.rel_tol = 1e-3;
     const double tol = 1e-3 + 6.3e-3;
     double worst = 0;
-    for (const char* name : {"tm2", "tm2-dielectric"})
+    for (const char* base_kind : {"conductor", "slab"})
         for (const char* up : {"upward-fgd=same-cosine", "upward-fgd=refracted"})
             for (const char* tir : {"tir=on", "tir=off asymmetry=per-channel"})
                 for (double eta : {1.2, 2.0})
                     for (double a0 : {0.05, 0.5}) {
-                        const InterfaceSpec base = std::string(name) == "tm2"
+                        const InterfaceSpec base = std::string(base_kind) == "conductor"
                                                        ? test::gold(0.3)
                                                        : test::dielectric(1.0, 0.3);
                         for (double tau : {0.0, 0.5}) {
-                            const auto model = make_model(name, coated(eta, a0, base, Rgbd(tau)),
+                            const auto model = make_model("tm2", coated(eta, a0, base, Rgbd(tau)),
                                                           options(up, tir));
                             ASSERT_TRUE(model->support().brdf);
                             for (double ti : {0.0, 60.0, 85.0}) {
@@ -374,7 +394,7 @@ TEST(Tm2, AlbedoAtMostOneOverTheFlags) {
                                     a += model_albedo(*model, wi, Side::Transmission, o);
                                 worst = std::max(worst, a.max());
                                 EXPECT_LE(a.max(), 1.0 + tol)
-                                    << name << " " << up << " " << tir << " eta=" << eta
+                                    << base_kind << " " << up << " " << tir << " eta=" << eta
                                     << " a0=" << a0 << " tau=" << tau << " ti=" << ti;
                             }
                         }
@@ -387,9 +407,9 @@ TEST(Tm2, AlbedoAtMostOneOverTheFlags) {
 // equals pdf(wi, wo)).
 TEST(Tm2, SamplerIsConsistentWithEvalAndPdf) {
     for (const auto& [name, stack] : std::vector<std::pair<std::string, Stack>>{
-             {"tm2", coated(1.5, 0.2, test::gold(0.4))},
-             {"tm2-dielectric", coated(1.5, 0.3, test::dielectric(1.0, 0.2))}}) {
-        const auto model = make_model(name, stack);
+             {"coated gold", coated(1.5, 0.2, test::gold(0.4))},
+             {"glass sheet", coated(1.5, 0.3, test::dielectric(1.0, 0.2))}}) {
+        const auto model = make_model("tm2", stack);
         ASSERT_TRUE(model->has_sampling());
         const Vec3d wi = dir(35, 0);
         ParticleRng rng(11, 0, 0);
