@@ -188,13 +188,16 @@ void precompute_variances(std::vector<BelcourOperator>& ops, bool q) {
     }
 }
 
-namespace {
-
-/// GGX reflection lobe shape D G2 / (4 μi μo) (Belcour 2018, Eq. 1 with the energy factored out).
-double lobe_shape(double alpha, const Vec3d& wi, const Vec3d& wo, const Vec3d& h) {
+double ggx_lobe_shape(double alpha, const Vec3d& wi, const Vec3d& wo, const Vec3d& h) {
     if (alpha <= 0) return 0;
     const GGX<double> ggx{alpha};
     return ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
+}
+
+namespace {
+
+double lobe_shape(double alpha, const Vec3d& wi, const Vec3d& wo, const Vec3d& h) {
+    return ggx_lobe_shape(alpha, wi, wo, h);
 }
 
 class BelcourModel final : public Model {

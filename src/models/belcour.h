@@ -77,6 +77,11 @@ std::vector<OptionSpec> belcour_option_specs(const BelcourChoices& defaults);
 /// Choices named by validated options (the variant-fixed ones, exact_top and btdf, from `base`).
 BelcourChoices belcour_choices(const ModelOptions& options, BelcourChoices base);
 
+/// GGX reflection lobe shape D G2 / (4 μi μo) with the energy factored out (Belcour 2018, Eq. 1;
+/// the lobe of every statistical model): wi, wo above the surface, h = normalize(wi + wo); 0 for
+/// α ≤ 0 (a smooth lobe is a delta lobe).
+double ggx_lobe_shape(double alpha, const Vec3d& wi, const Vec3d& wo, const Vec3d& h);
+
 std::unique_ptr<Model> make_belcour_model(std::string model_name, const Stack& stack,
                                           const BelcourChoices& choices);
 

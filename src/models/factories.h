@@ -25,6 +25,10 @@ std::vector<OptionSpec> bel18_symmetric_options();
 std::unique_ptr<Model> make_bel_prime(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> bel_prime_options();
 
+// tm2.cpp: the transfer-matrix model (Randrianandrasana, Callet & Lucas 2021)
+std::unique_ptr<Model> make_tm2(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> tm2_options();
+
 // random_walk_model.cpp: the per-query stochastic reference (randomwalk/random_walk.h)
 std::unique_ptr<Model> make_random_walk(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> random_walk_options();

@@ -34,6 +34,11 @@ const std::vector<ModelEntry>& model_registry() {
         {"bel-prime", "Bel': Bel18 forward with the exact top reflection and a slab BTDF lobe",
          "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R, T (slab)",
          bel_prime_options, make_bel_prime},
+        {"tm2",
+         "Randrianandrasana et al. 2021 transfer matrices: lobes by energy and HG asymmetry "
+         "(conductor base: plugin tm2, exact top; slab: tm2_dielectric, transmitted lobe)",
+         "bases: conductor, dielectric; media: absorbing; sides: R, T (slab)", tm2_options,
+         make_tm2, false, "successors"},
         {"random-walk",
          "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "
          "per-query reference, unbiased",
