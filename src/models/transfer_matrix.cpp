@@ -231,6 +231,7 @@ TmLobes tm_lobes(const std::vector<TmComponent>& comps, double c0, const TmChoic
             lobe.energy = max_of(R - e_above, Rgbd(0.0));
             set_asymmetry(lobe, Rg - g_above, ch.per_channel_g);
             lobe.delta = smooth;
+            lobe.component = i;
         }
         e_above = R;
         g_above = Rg;
@@ -350,7 +351,7 @@ class TmModel final : public Model {
         const Vec3d h = normalize(wi + wo);
         Rgbd f(0.0);
         for (int k = 0; k < st.n_lobes; ++k) {
-            if (k == 0 && ch_.exact_top) {
+            if (st.lobes[k].component == 0 && ch_.exact_top) {
                 f += exact_top(wi, wo, h);
                 continue;
             }
@@ -369,7 +370,7 @@ class TmModel final : public Model {
         const TmLobes st = lobes(wi.z);
         const Vec3d wr = mirror_direction(wi);
         for (int k = 0; k < st.n_lobes; ++k) {
-            if (k == 0 && ch_.exact_top) {
+            if (st.lobes[k].component == 0 && ch_.exact_top) {
                 if (top_.alpha <= 0) out.push_back({wr, top_fresnel(wi.z)});
                 continue;
             }
@@ -462,7 +463,7 @@ class TmModel final : public Model {
         };
         for (int k = 0; k < st.n_lobes; ++k) {
             const TmLobes::Lobe& l = st.lobes[k];
-            if (k == 0 && ch_.exact_top)
+            if (st.lobes[k].component == 0 && ch_.exact_top)
                 add(l.energy.mean(), top_.alpha, wi, false);
             else if (!l.delta)
                 add(l.energy.mean(), l.alpha, wi, false);

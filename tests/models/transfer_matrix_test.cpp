@@ -236,7 +236,11 @@ TEST(Tm2, IndexMatchedCoatGivesTheBaseEnergyNotItsShape) {
                     FgdTable::get()(std::cos(deg_to_rad(70.0)), 0.3, gold.eta_rgb[c], gold.k[c]),
                     1e-14);
     EXPECT_NEAR(st.lobes[0].alpha, 0.3, 1e-12);
-    const Vec3d wi = dir(80, 0), wo = dir(70, 150);
+    const Vec3d wi = dir(80, 0), wo = dir(70, 150), h = normalize(wi + wo);
+    const GGX<double> ggx{tm_ggx_from_hg(tm_hg_from_ggx(0.3))};
+    const double shape = ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
+    const double e = FgdTable::get()(wi.z, 0.3, gold.eta_rgb[0], gold.k[0]);
+    EXPECT_NEAR(matched->eval(wi, wo)[0], e * shape, 1e-12 * e * shape);
     EXPECT_GT(std::abs(matched->eval(wi, wo)[0] - bare->eval(wi, wo)[0]) / bare->eval(wi, wo)[0],
               0.05);
 }
