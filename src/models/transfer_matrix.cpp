@@ -38,6 +38,10 @@ constexpr double kMaxOpticalPath = 45;
 /// Below this a transmission factor is treated as zero (the matrix needs 1/t).
 constexpr double kTinyT = 1e-12;
 
+Rgbd max_of(const Rgbd& a, const Rgbd& b) {
+    return {std::max(a[0], b[0]), std::max(a[1], b[1]), std::max(a[2], b[2])};
+}
+
 /// A 2×2 transfer matrix with entries of type T (Rgbd for energies, double for asymmetries).
 template <typename T>
 struct Matrix2 {
@@ -56,7 +60,11 @@ struct Matrix2 {
     T reflectance() const { return m21 / m11; }
     T transmittance() const { return T(1.0) / m11; }
     /// Reflectance over an opaque base of reflectance rb.
-    T reflectance_over(const T& rb) const { return (m21 + m22 * rb) / (m11 + m12 * rb); }
+    /// Reflectance over an opaque base of reflectance rb; the denominator m11 (1 − r′ r_b) is kept
+    /// ≥ 1e−9 m11, as Belcour's adding keeps 1 − R R ≥ 1e−9 (two perfect mirrors facing).
+    T reflectance_over(const T& rb) const {
+        return (m21 + m22 * rb) / max_of(m11 + m12 * rb, m11 * 1e-9);
+    }
 };
 
 /// The transfer factors of one component at the mean direction of the light reaching it.
@@ -218,9 +226,12 @@ TmLobes tm_lobes(const std::vector<TmComponent>& comps, double c0, const TmChoic
         }
         if (out.n_lobes < TmLobes::kMaxLobes) {
             TmLobes::Lobe& lobe = out.lobes[out.n_lobes++];
-            lobe.energy = R - e_above;
+            // Clamped at 0 (as the released tm6 does): where a channel is absorbed the difference
+            // is 0 up to rounding (≈ −1e−17 otherwise).
+            lobe.energy = max_of(R - e_above, Rgbd(0.0));
             set_asymmetry(lobe, Rg - g_above, ch.per_channel_g);
             lobe.delta = smooth;
+            lobe.component = i;
         }
         e_above = R;
         g_above = Rg;
@@ -229,7 +240,7 @@ TmLobes tm_lobes(const std::vector<TmComponent>& comps, double c0, const TmChoic
     }
     if (ch.slab && !opaque_end) {
         out.transmits = true;
-        out.transmitted.energy = E.transmittance();
+        out.transmitted.energy = max_of(E.transmittance(), Rgbd(0.0));
         set_asymmetry(out.transmitted, G.transmittance(), ch.per_channel_g);
         out.transmitted.delta = smooth;
         out.cos_t = c;
@@ -340,7 +351,7 @@ class TmModel final : public Model {
         const Vec3d h = normalize(wi + wo);
         Rgbd f(0.0);
         for (int k = 0; k < st.n_lobes; ++k) {
-            if (k == 0 && ch_.exact_top) {
+            if (st.lobes[k].component == 0 && ch_.exact_top) {
                 f += exact_top(wi, wo, h);
                 continue;
             }
@@ -359,7 +370,7 @@ class TmModel final : public Model {
         const TmLobes st = lobes(wi.z);
         const Vec3d wr = mirror_direction(wi);
         for (int k = 0; k < st.n_lobes; ++k) {
-            if (k == 0 && ch_.exact_top) {
+            if (st.lobes[k].component == 0 && ch_.exact_top) {
                 if (top_.alpha <= 0) out.push_back({wr, top_fresnel(wi.z)});
                 continue;
             }
@@ -452,7 +463,7 @@ class TmModel final : public Model {
         };
         for (int k = 0; k < st.n_lobes; ++k) {
             const TmLobes::Lobe& l = st.lobes[k];
-            if (k == 0 && ch_.exact_top)
+            if (st.lobes[k].component == 0 && ch_.exact_top)
                 add(l.energy.mean(), top_.alpha, wi, false);
             else if (!l.delta)
                 add(l.energy.mean(), l.alpha, wi, false);

@@ -85,6 +85,9 @@ struct TmLobes {
         double alpha = 0;     ///< tm_ggx_from_hg(g)
         Rgbd alpha_rgb{0.0};  ///< per channel (all equal to alpha unless per_channel_g)
         bool delta = false;   ///< g = 1: every interface on its way is smooth
+        /// The component the lobe reflects from (0: the stack's top interface; an index-matched
+        /// interface is no component and has no lobe).
+        int component = 0;
     };
     std::array<Lobe, kMaxLobes> lobes{};
     int n_lobes = 0;
