@@ -124,8 +124,10 @@ SimulationResult simulate_interruptible(const Stack& stack, const SimulationSett
                                         bool show_progress) {
     validate_settings(s);
     const int threads = s.threads > 0 ? s.threads : omp_get_max_threads();
-    // Chunks of whole blocks: their integer sums add up to one run's, bit for bit.
-    const std::uint64_t chunk = kParticlesPerBlock * 32 * std::uint64_t(threads);
+    // Chunks of whole blocks: their integer sums add up to one run's, bit for bit. Each chunk
+    // costs a set-up (tallies allocated and merged), so chunks double while they take under
+    // 0.2 s: Ctrl-C is then seen within about half a second.
+    std::uint64_t chunk = kParticlesPerBlock * 16 * std::uint64_t(threads);
     SimulationSums total;
     total.incidences.resize(s.theta_i_deg.size());
     for (IncidenceSums& inc : total.incidences)
@@ -136,10 +138,11 @@ SimulationResult simulate_interruptible(const Stack& stack, const SimulationSett
         progress = std::make_unique<Progress>(fmt::format("simulate {}", stack.name), "particles",
                                               s.particles * s.theta_i_deg.size());
     const auto start = std::chrono::steady_clock::now();
-    for (std::uint64_t first = 0; first < s.particles; first += chunk) {
+    for (std::uint64_t first = 0, next = chunk; first < s.particles; first = next) {
+        const auto chunk_start = std::chrono::steady_clock::now();
         SimulationSettings part = s;
         part.first_particle = s.first_particle + first;
-        part.particles = std::min(chunk, s.particles - first);
+        part.particles = std::min(chunk, s.particles - first);  // a multiple of blocks
         SimulationSums sums;
         {
             py::gil_scoped_release release;
@@ -153,6 +156,10 @@ SimulationResult simulate_interruptible(const Stack& stack, const SimulationSett
         }
         total.threads_used = sums.threads_used;
         if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
+        const double took =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - chunk_start).count();
+        if (took < 0.2 && chunk < (std::uint64_t(1) << 40)) chunk *= 2;
+        next = first + part.particles;
     }
     if (progress) progress->finish();
     total.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
