@@ -30,6 +30,7 @@ namespace lamina::cli {
 namespace {
 
 struct ExportArgs {
+    std::string check;  ///< a file to check instead of writing one
     std::string simulation, study, config, source = "reference", model, stack, out, format;
     std::string theta_i, grid = "90x90";
     std::vector<std::string> options;
@@ -105,7 +106,28 @@ BinnedTable study_table(const ExportArgs& a) {
     }
 }
 
+// --check FILE: reads a .bsdf or MERL .binary as a reader would and describes it (InputError
+// naming the file and what is wrong for a malformed or truncated one).
+int run_check(const std::string& path) {
+    const std::string bytes = read_text(path);
+    if (bytes.rfind("tensor_file", 0) == 0 || std::filesystem::path(path).extension() == ".bsdf") {
+        const TensorFile file = parse_tensor_file(bytes, path);
+        check_rgl_bsdf(file, path);
+        const auto& spectra = file.at("spectra").shape;
+        fmt::print("{}: RGL .bsdf, {} incidences, {} × {} samples, {} wavelengths: \"{}\"\n", path,
+                   spectra[1], spectra[3], spectra[4], spectra[2], file.at("description").data);
+        return 0;
+    }
+    const MerlBrdf merl = parse_merl(bytes, path);
+    fmt::print(
+        "{}: MERL .binary, 90 × 90 × 180 × RGB, f at normal incidence and exit ({}, {}, {})\n",
+        path, merl.values[0], merl.values[90 * 90 * 180], merl.values[2 * 90 * 90 * 180]);
+    return 0;
+}
+
 int run_export(const ExportArgs& a) {
+    if (!a.check.empty()) return run_check(a.check);
+    if (a.out.empty()) throw InputError("command line", "--out", "give the output file");
     const int sources = int(!a.simulation.empty()) + int(!a.study.empty()) + int(!a.model.empty());
     if (sources != 1)
         throw InputError("command line", "--simulation",
@@ -245,7 +267,10 @@ Runner add_export(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--ndf-resolution", a->ndf_resolution, ".bsdf: NDF and σ nodes a side")
         ->capture_default_str();
-    cmd->add_option("--out,-o", a->out, "Output file")->required();
+    cmd->add_option("--out,-o", a->out, "Output file");
+    cmd->add_option("--check", a->check,
+                    "Read a .bsdf or MERL .binary file as a renderer would and describe it (a "
+                    "malformed or truncated file is refused with what is wrong)");
     return [a] { return run_export(*a); };
 }
 

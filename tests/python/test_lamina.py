@@ -266,3 +266,22 @@ def test_export_bsdf_and_merl_files(tmp_path):
     r = cli("export", "--model", "ww-prime", "--stack", PLASTIC, "--out", tmp_path / "x.txt",
             check=False)
     assert r.returncode == 1 and "--format" in r.stderr
+
+
+def test_export_check_refuses_truncated_files(tmp_path):
+    cli("export", "--model", "ww-prime", "--stack", PLASTIC, "--resolution", 8,
+        "--out", tmp_path / "ww.bsdf")
+    assert "RGL .bsdf" in cli("export", "--check", tmp_path / "ww.bsdf").stdout
+    data = (tmp_path / "ww.bsdf").read_bytes()
+    (tmp_path / "cut.bsdf").write_bytes(data[: len(data) // 2])
+    r = cli("export", "--check", tmp_path / "cut.bsdf", check=False)
+    assert r.returncode == 1 and "cut.bsdf" in r.stderr and "truncated" in r.stderr
+    (tmp_path / "junk.bsdf").write_bytes(b"not a tensor file at all")
+    r = cli("export", "--check", tmp_path / "junk.bsdf", check=False)
+    assert r.returncode == 1 and "not a tensor file" in r.stderr
+    cli("export", "--model", "ww-prime", "--stack", PLASTIC, "--out", tmp_path / "ww.binary")
+    assert "MERL" in cli("export", "--check", tmp_path / "ww.binary").stdout
+    raw = (tmp_path / "ww.binary").read_bytes()
+    (tmp_path / "cut.binary").write_bytes(raw[:-16])
+    r = cli("export", "--check", tmp_path / "cut.binary", check=False)
+    assert r.returncode == 1 and "truncated" in r.stderr
