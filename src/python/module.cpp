@@ -8,10 +8,14 @@
 // Long computations release the GIL; simulate() checks for Ctrl-C between chunks of particles and
 // raises KeyboardInterrupt, and its result is bitwise the CLI's (chunks start at block boundaries,
 // whose integer sums add up exactly: simulator/goniophotometer.h).
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/progress.h"
 #include "core/spherical.h"
 #include "core/table.h"
+#include "export/brdf_source.h"
+#include "export/merl.h"
+#include "export/rgl_bsdf.h"
 #include "layers/stack.h"
 #include "models/binned.h"
 #include "models/registry.h"
@@ -587,6 +591,41 @@ PYBIND11_MODULE(_lamina, m) {
         py::arg("threads"), py::arg("grid"), py::arg("kernel"), py::arg("microsurface"),
         py::arg("max_events"), py::arg("progress"));
 
+    m.def(
+        "_export",
+        [](py::object source, const std::filesystem::path& path, const std::string& format,
+           std::vector<double> theta_i, int resolution, const std::string& description) {
+            // source: a Model or a Table (its reflection side).
+            BrdfSource brdf;
+            if (py::isinstance<PyModel>(source)) {
+                const PyModel& pm = source.cast<const PyModel&>();
+                auto model = std::shared_ptr<const Model>(
+                    find_model(pm.name, "name").make(pm.stack, pm.options));
+                brdf = model_brdf(model, pm.name);
+            } else {
+                brdf = table_brdf(source.cast<const BinnedTable&>(), "table", "table");
+            }
+            std::string bytes;
+            {
+                py::gil_scoped_release release;
+                if (format == "bsdf") {
+                    RglOptions o;
+                    o.theta_i_deg = theta_i;
+                    o.resolution = resolution;
+                    o.description = description;
+                    const TensorFile file = rgl_bsdf(brdf, o);
+                    check_rgl_bsdf(file, path.string());
+                    bytes = tensor_file_bytes(file);
+                } else if (format == "merl") {
+                    bytes = merl_binary(brdf);
+                } else {
+                    throw InputError("arguments", "format", "'bsdf' or 'merl'");
+                }
+                write_file_atomic(path, bytes);
+            }
+        },
+        py::arg("source"), py::arg("path"), py::arg("format"), py::arg("theta_i"),
+        py::arg("resolution"), py::arg("description"));
     m.def("_table_from_arrays", &table_from_arrays, py::arg("f"), py::arg("theta_i"),
           py::arg("sides"));
     m.def("_run_study", &run_study_py, py::arg("configs"), py::arg("settings"),

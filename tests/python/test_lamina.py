@@ -285,3 +285,14 @@ def test_export_check_refuses_truncated_files(tmp_path):
     (tmp_path / "cut.binary").write_bytes(raw[:-16])
     r = cli("export", "--check", tmp_path / "cut.binary", check=False)
     assert r.returncode == 1 and "truncated" in r.stderr
+
+
+def test_export_from_python_is_the_cli_file(tmp_path):
+    cli("export", "--model", "ww-prime", "--stack", PLASTIC, "--out", tmp_path / "cli.binary")
+    lamina.export(lamina.Model("ww-prime", PLASTIC), tmp_path / "py.binary")
+    assert (tmp_path / "cli.binary").read_bytes() == (tmp_path / "py.binary").read_bytes()
+    r = lamina.simulate(PLASTIC, theta_i=[0, 40], particles=20_000, grid=(18, 12))
+    lamina.export(r, tmp_path / "ref.bsdf", resolution=8)
+    assert "2 incidences" in cli("export", "--check", tmp_path / "ref.bsdf").stdout
+    with pytest.raises(lamina.InputError):
+        lamina.export(r, tmp_path / "ref.txt")

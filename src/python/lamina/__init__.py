@@ -38,6 +38,7 @@ __all__ = [
     "Table",
     "bin_model",
     "compare",
+    "export",
     "Study",
     "load_study",
     "models",
@@ -71,6 +72,25 @@ def _stderr_is_terminal():
         return os.isatty(2)
     except OSError:
         return False
+
+
+def export(source, path, format=None, theta_i=None, resolution=32, description=""):
+    """Writes a Model, a Table or a SimulationResult (its reflection side) as an RGL .bsdf
+    (pbrt-v4, Mitsuba 3) or a MERL .binary file, as `lamina export` does (docs/formats.md).
+
+    format: "bsdf" or "merl" (default: from the path's extension). theta_i: a model's .bsdf
+    incidences in degrees (default 0..88 by 4; a table's are its own).
+    """
+    path = Path(path)
+    if format is None:
+        format = {".bsdf": "bsdf", ".binary": "merl"}.get(path.suffix)
+        if format is None:
+            raise input_error("arguments", "format",
+                              "give format='bsdf' or 'merl', or a path ending in .bsdf or .binary")
+    if isinstance(source, SimulationResult):
+        source = source.table
+    _lamina._export(source, str(path), format, [float(t) for t in (theta_i or [])],
+                    int(resolution), str(description))
 
 
 # ---- study directories ------------------------------------------------------------------------
