@@ -19,6 +19,7 @@ extern char** environ;
 
 namespace lamina::cli {
 
+#ifdef LAMINA_PYTHON_EXECUTABLE
 namespace {
 
 // Runs argv (searched on PATH) with PYTHONPATH prepended by `python_path`; returns the exit status.
@@ -46,6 +47,7 @@ int run_process(const std::vector<std::string>& argv, const std::string& python_
 }
 
 }  // namespace
+#endif
 
 ExternalModel model_plugin(const std::string& assignment, const StudySettings& settings) {
 #ifndef LAMINA_PYTHON_EXECUTABLE
