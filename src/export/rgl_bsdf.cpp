@@ -92,7 +92,7 @@ TensorFile rgl_bsdf(const BrdfSource& brdf, const RglOptions& o) {
     if (!(d_max > 0) || !std::isfinite(d_max))
         throw InputError(brdf.name, "f", "the BRDF is zero or not finite at retro-reflection");
     for (double& d : d_theta)
-        d = std::max(d, 1e-3 * d_max);
+        d = std::max(d, 2e-2 * d_max);  // D divides S: keep it away from 0
     NodeTable ndf{nd, nd, std::vector<float>(std::size_t(nd) * nd)};
     auto fill_ndf = [&](double scale) {
         for (int b = 0; b < nd; ++b)

@@ -17,8 +17,8 @@
 // Writing: S at each s node = f(ωi, ωo)|cos θo| 4σ(ωi)/D(ωm) with ωm the warp of s, D and σ the
 // values the reader interpolates from the written tables: at the nodes a reader gives back f
 // exactly (to float32), in between it interpolates. D is estimated from the BRDF's
-// retro-reflection (D ∝ f(ωm, ωm) cos²θm, the microfacet relation at ωi = ωo = ωm), so that the
-// samples gather where the lobe is.
+// retro-reflection (D ∝ f(ωm, ωm) cos²θm, the microfacet relation at ωi = ωo = ωm; floored at 2%
+// of its peak, since it divides S), so that the samples gather where the lobe is.
 //
 // Only the reflection side: neither pbrt-v4's nor Mitsuba 3's reader takes a BTDF. Isotropic:
 // phi_i holds two equal slices (φi = −π and π). RGB → spectra: lamina is RGB; the spectra are a

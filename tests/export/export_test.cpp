@@ -257,10 +257,10 @@ TEST(RglBsdf, HasTheFieldsTheReadersRequire) {
 // interpolation explains. Bilinear interpolation (in s, and linear in θi) errs by O(h²): the
 // error must fall by about 4× when the grids are refined 2× (at least 2.5× is asked). At the
 // finer resolution (48 s nodes a side, incidences every 2°) 90% of random pairs with θi, θo ≤ 80°
-// must agree to 2%, and 99% of those with θi, θo ≤ 70° to 5% (measured: 0.75% and 0.9%). Past
+// must agree to 2%, and 99% of those with θi, θo ≤ 70° to 5% (measured: 0.74% and 1.0%). Past
 // 70° both directions grazing, with half vectors far from the normal, the warp gives few nodes to
 // a region where S varies fast with θi: there the tail reaches tens of percent (measured p99 over
-// θ ≤ 80°: 35%; docs/formats.md says so).
+// θ ≤ 80°: 33%; docs/formats.md says so).
 TEST(RglBsdf, ReaderAgreesWithTheModel) {
     const BrdfSource src = model_brdf(plastic_model(), "test");
     const BsdfReader coarse(rgl_bsdf(src, options(24, 4)));
