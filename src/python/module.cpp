@@ -479,6 +479,10 @@ PYBIND11_MODULE(_lamina, m) {
                 return BinnedTable::from_csv(text, path.string());
             },
             py::arg("path"))
+        .def_static("from_arrays", &table_from_arrays, py::arg("f"), py::arg("theta_i"),
+                    py::arg("sides") = std::vector<std::string>{"R"},
+                    "A table from f [incidence, side, θ bin, φ bin, 3] (1/sr, cos-weighted bin "
+                    "averages; se = 0), e.g. to write a --model-table CSV with to_csv()")
         .def_property_readonly(
             "f", [](const BinnedTable& t) { return lobes_array(t, false); },
             "f [incidence, side, θ bin, φ bin, channel], 1/sr")

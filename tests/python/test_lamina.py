@@ -296,3 +296,15 @@ def test_export_from_python_is_the_cli_file(tmp_path):
     assert "2 incidences" in cli("export", "--check", tmp_path / "ref.bsdf").stdout
     with pytest.raises(lamina.InputError):
         lamina.export(r, tmp_path / "ref.txt")
+
+
+def test_table_from_arrays_round_trips():
+    t = lamina.Model("ww-prime", PLASTIC).binned([0, 60], grid=(9, 6))
+    u = lamina.Table.from_arrays(t.f, t.theta_i, t.sides)
+    assert u.to_csv() == t.to_csv()
+    with pytest.raises(lamina.InputError):
+        lamina.Table.from_arrays(t.f[:, :, :, :, :2], t.theta_i, t.sides)
+    bad = t.f.copy()
+    bad[0, 0, 0, 0, 0] = np.nan
+    with pytest.raises(lamina.InputError):
+        lamina.Table.from_arrays(bad, t.theta_i, t.sides)
