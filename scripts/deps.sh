@@ -11,6 +11,8 @@ packages=(
   libhwy-dev                                 # the SIMD kernel (Google Highway)
   libopenmpi-dev openmpi-bin                 # mpirun -n K lamina simulate|study (docs/scaling.md)
   python3 python3-numpy python3-matplotlib   # lamina figures (scripts/figures.py)
+  python3-dev pybind11-dev python3-pybind11  # the Python module `import lamina` (docs/python.md)
+  python3-pytest zlib1g-dev                  # its tests; .npz exports (docs/formats.md)
   chromium fonts-dejavu-core                 # the explorer's browser test (tests/report)
 )
 

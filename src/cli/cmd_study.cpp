@@ -3,6 +3,7 @@
 //              Under `mpirun -n K` the reference is spread over K processes (docs/scaling.md).
 // lamina compare STACK.json [--theta-i …] [--particles N] [--models …] --out DIR: one stack.
 #include "cli/commands.h"
+#include "cli/model_plugin.h"
 #include "cli/options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -32,6 +33,8 @@ struct CommonArgs {
     int threads = 0;
     bool no_figures = false;
     bool ablations = false;
+    std::vector<std::string> model_tables;   ///< NAME=FILE.csv (FILE may hold {id})
+    std::vector<std::string> model_plugins;  ///< [NAME=]FILE.py (docs/python.md)
 };
 
 void add_common(CLI::App* cmd, CommonArgs& a) {
@@ -55,8 +58,49 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
                     "energy reported as lost) or multiple (Heitz et al. 2016 random walk; needs "
                     "--kernel scalar)")
         ->capture_default_str();
+    cmd->add_option("--model-table", a.model_tables,
+                    "A model evaluated elsewhere, as NAME=FILE.csv in the brdf.csv format (lamina "
+                    "eval --binned writes it) on the study's grid and incidences; {id} in FILE "
+                    "stands for the configuration id; repeatable");
+    cmd->add_option("--model-plugin", a.model_plugins,
+                    "A Python model, [NAME=]FILE.py defining MODEL (a class with a vectorized "
+                    "eval(wi, wo), docs/python.md), binned by lamina's quadrature; repeatable");
     cmd->add_flag("--no-figures", a.no_figures,
                   "Skip the paper figures (the explorer page is always written)");
+}
+
+// --model-table NAME=FILE.csv: the table of each configuration read from FILE ({id} replaced by
+// the configuration's id); a missing file for a configuration means "not supported".
+ExternalModel model_table(const std::string& assignment) {
+    const auto eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == assignment.size())
+        throw InputError("command line", "--model-table",
+                         fmt::format("'{}' is not NAME=FILE.csv", assignment));
+    ExternalModel m;
+    m.name = assignment.substr(0, eq);
+    const std::string pattern = assignment.substr(eq + 1);
+    const bool per_config = pattern.find("{id}") != std::string::npos;
+    if (!per_config && !std::filesystem::is_regular_file(pattern))
+        throw InputError(pattern, "--model-table", "cannot read the file");
+    m.source = pattern;
+    m.table = [pattern, per_config](const StudyConfiguration& c) {
+        std::string path = pattern;
+        for (auto at = path.find("{id}"); at != std::string::npos; at = path.find("{id}"))
+            path.replace(at, 4, c.id);
+        std::ifstream in(path, std::ios::binary);
+        if (!in) {
+            if (per_config) {  // this configuration has no table: not supported
+                BinnedTable none;
+                none.has_reflection = false;
+                return none;
+            }
+            throw InputError(path, "--model-table", "cannot read the file");
+        }
+        std::ostringstream text;
+        text << in.rdbuf();
+        return BinnedTable::from_csv(text.str(), path);
+    };
+    return m;
 }
 
 StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
@@ -82,7 +126,22 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
     }
     s.ablations = a.ablations;
     if (s.threads < 0) throw InputError("command line", "--threads", "use ≥ 1, or 0 for all cores");
+    for (const std::string& assignment : a.model_tables)
+        s.external_models.push_back(model_table(assignment));
+    for (const std::string& assignment : a.model_plugins)
+        s.external_models.push_back(model_plugin(assignment, s));
     return s;
+}
+
+// A table file given for several configurations must name each one's file with {id}.
+void check_model_tables(const CommonArgs& a, const std::vector<StudyConfiguration>& configs) {
+    for (const std::string& assignment : a.model_tables)
+        if (configs.size() > 1 && assignment.find("{id}") == std::string::npos)
+            throw InputError("command line", "--model-table",
+                             fmt::format("'{}': a table describes one stack, and {} configurations "
+                                         "are selected: write FILE with {{id}} (e.g. "
+                                         "NAME=tables/{{id}}.csv) or select one with --only",
+                                         assignment, configs.size()));
 }
 
 // The explorer page, then the figures (a failure there is a warning: the study itself is done).
@@ -151,6 +210,7 @@ Runner add_study(CLI::App& app) {
             configs =
                 a->configs.empty() ? builtin_configurations() : load_configurations(a->configs);
             configs = filter_configurations(std::move(configs), a->only);
+            check_model_tables(*a, configs);
         }
         if (world.distributed()) {
             std::vector<ReferenceKey> keys;

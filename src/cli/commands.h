@@ -27,5 +27,7 @@ Runner add_explorer(CLI::App& app);
 Runner add_figures(CLI::App& app);
 /// `lamina render`: sphere renderings and the comparison sheet (cmd_render.cpp).
 Runner add_render(CLI::App& app);
+/// `lamina export`: .bsdf, MERL .binary or .npz files (cmd_export.cpp).
+Runner add_export(CLI::App& app);
 
 }  // namespace lamina::cli

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
     add(lamina::cli::add_study);
     add(lamina::cli::add_explorer);
     add(lamina::cli::add_figures);
+    add(lamina::cli::add_export);
 
     CLI11_PARSE(app, argc, argv);
     // Under an MPI launcher every process gets here; an error on any of them ends them all

@@ -25,7 +25,8 @@ BinnedTable BinnedTable::zeros(const HemisphereGrid& grid, const std::vector<dou
 Rgbd BinnedTable::albedo(std::size_t incidence, Side side) const {
     const BinnedLobe& l = lobe(incidence, side);
     Rgbd sum(0.0);
-    for (std::size_t j = 0; j < l.f.size(); ++j) sum += l.f[j] * grid.projected_solid_angle(j);
+    for (std::size_t j = 0; j < l.f.size(); ++j)
+        sum += l.f[j] * grid.projected_solid_angle(j);
     return sum;
 }
 
@@ -70,7 +71,8 @@ BinnedTable BinnedTable::from_csv(const std::string& text, const std::string& wh
         if (line.empty()) continue;
         std::vector<std::string> cells;
         std::stringstream ls(line);
-        for (std::string cell; std::getline(ls, cell, ',');) cells.push_back(cell);
+        for (std::string cell; std::getline(ls, cell, ',');)
+            cells.push_back(cell);
         if (cells.size() != 12)
             throw InputError(where, fmt::format("line {}", line_no),
                              fmt::format("expected 12 columns, found {}", cells.size()));
@@ -89,13 +91,36 @@ BinnedTable BinnedTable::from_csv(const std::string& text, const std::string& wh
             throw InputError(where, fmt::format("line {}, column 2", line_no),
                              fmt::format("side '{}' must be R or T", cells[1]));
         const double theta_lo = num(2), theta_hi = num(3), phi_lo = num(4), phi_hi = num(5);
+        if (!(theta_lo >= 0 && theta_hi > theta_lo && theta_hi <= 90 && phi_lo >= 0 &&
+              phi_hi > phi_lo && phi_hi <= 180))
+            throw InputError(where, fmt::format("line {}", line_no),
+                             "a bin must have 0 ≤ theta_lo < theta_hi ≤ 90 and 0 ≤ phi_lo < "
+                             "phi_hi ≤ 180 (degrees)");
         const int n_theta = int(std::lround(90.0 / (theta_hi - theta_lo)));
         const int n_phi = int(std::lround(180.0 / (phi_hi - phi_lo)));
+        if (n_theta > 3600 || n_phi > 3600 ||
+            (n_theta_guess != 0 && (n_theta != n_theta_guess || n_phi != n_phi_guess)))
+            throw InputError(where, fmt::format("line {}", line_no),
+                             "the bins do not form one regular grid (at most 3600 bins a side)");
         n_theta_guess = n_theta;
         n_phi_guess = n_phi;
-        Row r{num(0), cells[1][0], int(std::lround(theta_lo / 90.0 * n_theta)),
-              int(std::lround(phi_lo / 180.0 * n_phi)), Rgbd(num(6), num(7), num(8)),
+        Row r{num(0),
+              cells[1][0],
+              int(std::lround(theta_lo / 90.0 * n_theta)),
+              int(std::lround(phi_lo / 180.0 * n_phi)),
+              Rgbd(num(6), num(7), num(8)),
               Rgbd(num(9), num(10), num(11))};
+        if (!(r.theta_i >= 0 && r.theta_i < 90))
+            throw InputError(where, fmt::format("line {}, column 1", line_no),
+                             fmt::format("theta_i {} is outside [0, 90) degrees", r.theta_i));
+        // The edges must be the grid's (to rounding): a bin of another layout is refused.
+        if (std::abs(theta_lo - 90.0 * r.t / n_theta) > 1e-6 ||
+            std::abs(theta_hi - 90.0 * (r.t + 1) / n_theta) > 1e-6 ||
+            std::abs(phi_lo - 180.0 * r.p / n_phi) > 1e-6 ||
+            std::abs(phi_hi - 180.0 * (r.p + 1) / n_phi) > 1e-6)
+            throw InputError(where, fmt::format("line {}", line_no),
+                             "the bin's edges are not those of a uniform NTHETAxNPHI grid over "
+                             "θ ∈ [0°, 90°], φ ∈ [0°, 180°]");
         max_t = std::max(max_t, r.t);
         max_p = std::max(max_p, r.p);
         rows.push_back(r);
@@ -119,11 +144,22 @@ BinnedTable BinnedTable::from_csv(const std::string& text, const std::string& wh
         throw InputError(where, "",
                          fmt::format("expected {} rows for {} incidences on a {} grid, found {}",
                                      expected, incidences.size(), grid.to_string(), rows.size()));
+    std::vector<char> seen(expected, 0);
     for (const Row& r : rows) {
         const std::size_t i =
             std::find(incidences.begin(), incidences.end(), r.theta_i) - incidences.begin();
         BinnedLobe& l = table.lobe(i, r.side == 'R' ? Side::Reflection : Side::Transmission);
         const std::size_t j = std::size_t(r.t) * grid.n_phi() + r.p;
+        const std::size_t key =
+            (i * (has_r + has_t) + (r.side == 'R' || !has_r ? 0 : 1)) * grid.size() + j;
+        if (seen[key]++)
+            throw InputError(
+                where, "",
+                fmt::format("the bin θ ∈ [{}°, {}°], φ ∈ [{}°, {}°] of θi = {}°, side "
+                            "{} appears twice",
+                            90.0 * r.t / grid.n_theta(), 90.0 * (r.t + 1) / grid.n_theta(),
+                            180.0 * r.p / grid.n_phi(), 180.0 * (r.p + 1) / grid.n_phi(), r.theta_i,
+                            r.side));
         l.f[j] = r.f;
         l.se[j] = r.se;
     }

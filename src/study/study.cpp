@@ -11,6 +11,7 @@
 #include "study/summary.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -64,6 +65,24 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     std::vector<ModelOutcome> models;
     for (const std::string& name : model_names) {
         ModelOutcome m{name, {}, {}};
+        const auto external = std::find_if(s.external_models.begin(), s.external_models.end(),
+                                           [&](const ExternalModel& e) { return e.name == name; });
+        if (external != s.external_models.end()) {
+            // A table from elsewhere (model table, Python plugin), checked against the study.
+            m.table = external->table(config);
+            if (m.table.has_reflection || m.table.has_transmission)
+                check_external_table(m.table, grid, s.theta_i_deg, transmits, external->source);
+            m.support.brdf = m.table.has_reflection;
+            m.support.btdf = transmits && m.table.has_transmission;
+            if (!m.support.brdf || (transmits && !m.support.btdf))
+                m.support.reason =
+                    m.table.has_reflection || m.table.has_transmission
+                        ? fmt::format("{} has no {} rows", external->source,
+                                      m.support.brdf ? "T" : "R")
+                        : fmt::format("{} has no table for {}", external->source, config.id);
+            models.push_back(std::move(m));
+            continue;
+        }
         const std::unique_ptr<Model> model = make_model(name, config.stack);
         m.support = model->support();
         if (m.support.brdf || m.support.btdf) m.table = bin_model(*model, grid, s.theta_i_deg);
@@ -211,7 +230,7 @@ std::string metrics_csv(const std::vector<MetricRow>& rows) {
 
 std::vector<std::string> study_models(const StudySettings& s) {
     std::vector<std::string> model_names = s.models;
-    if (model_names.empty())
+    if (model_names.empty() && s.registry_models)
         for (const ModelEntry& e : model_registry())
             if (!e.stochastic) model_names.push_back(e.name);
     for (const std::string& name : model_names)
@@ -226,7 +245,44 @@ std::vector<std::string> study_models(const StudySettings& s) {
                     model_names.push_back(v);
         }
     }
+    for (const ExternalModel& e : s.external_models) {
+        if (e.name.empty() ||
+            std::find(model_names.begin(), model_names.end(), e.name) != model_names.end() ||
+            e.name == "reference")
+            throw InputError("command line", "--model-table",
+                             fmt::format("'{}' cannot name a model table: the name must be new "
+                                         "(not empty, 'reference' or a model already compared)",
+                                         e.name));
+        model_names.push_back(e.name);
+    }
     return model_names;
+}
+
+void check_external_table(const BinnedTable& table, const HemisphereGrid& grid,
+                          const std::vector<double>& theta_i_deg, bool transmits,
+                          const std::string& where) {
+    if (!(table.grid == grid))
+        throw InputError(where, "grid",
+                         fmt::format("the table's grid is {} but the study's is {} (--grid)",
+                                     table.grid.to_string(), grid.to_string()));
+    if (table.theta_i_deg != theta_i_deg)
+        throw InputError(
+            where, "theta_i",
+            fmt::format("the table's incidences are {} but the study's are {} "
+                        "(--theta-i): give the table every incidence, in order",
+                        fmt::join(table.theta_i_deg, ","), fmt::join(theta_i_deg, ",")));
+    if (table.has_transmission && !transmits)
+        throw InputError(where, "side",
+                         "the table has transmission (T) rows but the stack is opaque: is it "
+                         "the table of another stack?");
+    for (std::size_t i = 0; i < table.lobes.size(); ++i)
+        for (const BinnedLobe& lobe : table.lobes[i])
+            for (const Rgbd& f : lobe.f)
+                for (int c = 0; c < 3; ++c)
+                    if (!std::isfinite(f[c]))
+                        throw InputError(
+                            where, "f",
+                            fmt::format("a value at θi = {}° is not finite", theta_i_deg[i]));
 }
 
 std::filesystem::path reference_cache_dir(const std::filesystem::path& out_dir) {

@@ -10,10 +10,24 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
 namespace lamina {
+
+/// A model evaluated elsewhere that joins the study as binned tables, like a built-in model: a
+/// `--model-table NAME=FILE.csv` (a renderer's or a fit's values in the brdf.csv format) or a
+/// Python plugin binned by the Python module. Each table must have the study's grid and
+/// incidences (checked: InputError naming `source`).
+struct ExternalModel {
+    std::string name;
+    std::string source;  ///< where the tables come from (a file, a pattern, "python"), for messages
+    /// The table of one configuration: its R side (and T for a slab). A table with neither side
+    /// (has_reflection and has_transmission both false) means the model does not cover the
+    /// configuration (reported as not supported).
+    std::function<BinnedTable(const StudyConfiguration&)> table;
+};
 
 struct StudySettings {
     std::string preset = "quick";
@@ -29,6 +43,8 @@ struct StudySettings {
     Kernel kernel = Kernel::Simd;                      ///< the reference's particle kernel
     Microsurface microsurface = Microsurface::Single;  ///< the reference's rough interfaces
     bool quiet = false;                                ///< no per-configuration lines on stdout
+    std::vector<ExternalModel> external_models;        ///< compared after the registry's models
+    bool registry_models = true;  ///< false: no registry model unless named in `models`
 };
 
 /// Particles per incidence of the presets: quick 10⁶ (demo and CI), standard 10⁷, paper 1.6·10⁸
@@ -52,8 +68,9 @@ inline constexpr const char* kMetricsCsvHeader =
 
 /// The models the study compares: settings.models, or every deterministic model of the registry
 /// when empty; with settings.ablations, then the one-flag variants of each production model
-/// among them. Names may carry flags ("openpbr:darkening=off", models/registry.h). InputError
-/// naming --models for a name the registry lacks or a flag it does not have.
+/// among them; then the external models. Names may carry flags ("openpbr:darkening=off",
+/// models/registry.h). InputError naming --models for a name the registry lacks or a flag it
+/// does not have, and naming --model-table for an external name already taken.
 std::vector<std::string> study_models(const StudySettings& settings);
 
 /// Where a study in `out_dir` keeps its reference pieces (study/reference.h).
@@ -64,6 +81,12 @@ std::filesystem::path reference_cache_dir(const std::filesystem::path& out_dir);
 std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
                                  const StudySettings& settings,
                                  const std::filesystem::path& out_dir);
+
+/// Checks an external model's table against the study's grid and incidences and the stack's sides
+/// (InputError naming `where`, saying what differs).
+void check_external_table(const BinnedTable& table, const HemisphereGrid& grid,
+                          const std::vector<double>& theta_i_deg, bool transmits,
+                          const std::string& where);
 
 /// metrics.csv text of the rows.
 std::string metrics_csv(const std::vector<MetricRow>& rows);

@@ -1,0 +1,277 @@
+// lamina export: a simulate output, a study configuration's source or a model, as an RGL .bsdf
+// tensor file (pbrt-v4, Mitsuba 3), a MERL .binary or a NumPy .npz (docs/formats.md, "Exports").
+#include "cli/commands.h"
+#include "cli/options.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/npy.h"
+#include "export/brdf_source.h"
+#include "export/merl.h"
+#include "export/npz.h"
+#include "export/rgl_bsdf.h"
+#include "lamina/version.h"
+#include "layers/stack.h"
+#include "models/binned.h"
+#include "models/registry.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+namespace lamina::cli {
+
+namespace {
+
+struct ExportArgs {
+    std::string check;  ///< a file to check instead of writing one
+    std::string simulation, study, config, source = "reference", model, stack, out, format;
+    std::string theta_i, grid = "90x90";
+    std::vector<std::string> options;
+    int resolution = 32, vndf_resolution = 64, ndf_resolution = 64;
+};
+
+std::string read_text(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path.string(), "", "cannot read the file");
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+nlohmann::json read_json(const std::filesystem::path& path) {
+    try {
+        return nlohmann::json::parse(read_text(path));
+    } catch (const nlohmann::json::exception& e) {
+        throw InputError(path.string(), "", fmt::format("not valid JSON: {}", e.what()));
+    }
+}
+
+// A study configuration's source (the reference or a model) as a binned table.
+BinnedTable study_table(const ExportArgs& a) {
+    const std::filesystem::path dir = std::filesystem::path(a.study) / "configs" / a.config;
+    const nlohmann::json study = read_json(std::filesystem::path(a.study) / "study.json");
+    if (!std::filesystem::is_directory(dir))
+        throw InputError(a.study, "--config", fmt::format("no configuration '{}'", a.config));
+    const nlohmann::json cfg = read_json(dir / "config.json");
+    try {
+        const auto sources = cfg.at("sources").get<std::vector<std::string>>();
+        const auto it = std::find(sources.begin(), sources.end(), a.source);
+        if (it == sources.end())
+            throw InputError((dir / "config.json").string(), "--source",
+                             fmt::format("no source '{}'; this configuration has: {}", a.source,
+                                         fmt::join(sources, ", ")));
+        const std::size_t k = std::size_t(it - sources.begin());
+        const auto theta_i = cfg.at("theta_i").get<std::vector<double>>();
+        const auto sides = cfg.at("sides").get<std::vector<std::string>>();
+        const HemisphereGrid grid(study.at("grid").at("n_theta").get<int>(),
+                                  study.at("grid").at("n_phi").get<int>());
+        const NpyFloat32 t = read_npy_float32(dir / "tables.npy");
+        const std::vector<std::size_t> want = {sources.size(),
+                                               theta_i.size(),
+                                               sides.size(),
+                                               std::size_t(grid.n_theta()),
+                                               std::size_t(grid.n_phi()),
+                                               3};
+        if (t.shape != want)
+            throw InputError((dir / "tables.npy").string(), "shape",
+                             "does not match config.json and study.json");
+        BinnedTable table = BinnedTable::zeros(grid, theta_i, true, sides.size() == 2);
+        for (std::size_t i = 0; i < theta_i.size(); ++i)
+            for (std::size_t s = 0; s < sides.size(); ++s) {
+                BinnedLobe& lobe = table.lobe(i, s == 0 ? Side::Reflection : Side::Transmission);
+                for (std::size_t j = 0; j < grid.size(); ++j)
+                    for (int c = 0; c < 3; ++c)
+                        lobe.f[j][c] =
+                            t.data[((((k * theta_i.size() + i) * sides.size() + s) * grid.size()) +
+                                    j) *
+                                       3 +
+                                   c];
+            }
+        for (const auto& lobe : table.lobe(0, Side::Reflection).f)
+            if (!std::isfinite(lobe[0]))
+                throw InputError(
+                    (dir / "config.json").string(), "--source",
+                    fmt::format("'{}' does not support this configuration's BRDF", a.source));
+        return table;
+    } catch (const nlohmann::json::exception& e) {
+        throw InputError((dir / "config.json").string(), "",
+                         fmt::format("unexpected: {}", e.what()));
+    }
+}
+
+// --check FILE: reads a .bsdf or MERL .binary as a reader would and describes it (InputError
+// naming the file and what is wrong for a malformed or truncated one).
+int run_check(const std::string& path) {
+    const std::string bytes = read_text(path);
+    if (bytes.rfind("tensor_file", 0) == 0 || std::filesystem::path(path).extension() == ".bsdf") {
+        const TensorFile file = parse_tensor_file(bytes, path);
+        check_rgl_bsdf(file, path);
+        const auto& spectra = file.at("spectra").shape;
+        fmt::print("{}: RGL .bsdf, {} incidences, {} × {} samples, {} wavelengths: \"{}\"\n", path,
+                   spectra[1], spectra[3], spectra[4], spectra[2], file.at("description").data);
+        return 0;
+    }
+    const MerlBrdf merl = parse_merl(bytes, path);
+    fmt::print(
+        "{}: MERL .binary, 90 × 90 × 180 × RGB, f at normal incidence and exit ({}, {}, {})\n",
+        path, merl.values[0], merl.values[90 * 90 * 180], merl.values[2 * 90 * 90 * 180]);
+    return 0;
+}
+
+int run_export(const ExportArgs& a) {
+    if (!a.check.empty()) return run_check(a.check);
+    if (a.out.empty()) throw InputError("command line", "--out", "give the output file");
+    const int sources = int(!a.simulation.empty()) + int(!a.study.empty()) + int(!a.model.empty());
+    if (sources != 1)
+        throw InputError("command line", "--simulation",
+                         "give one source: --simulation DIR, --study DIR --config ID, or --model "
+                         "NAME --stack FILE");
+    std::string format = a.format;
+    if (format.empty()) {
+        const std::string ext = std::filesystem::path(a.out).extension().string();
+        format = ext == ".bsdf" ? "bsdf" : ext == ".binary" ? "merl" : ext == ".npz" ? "npz" : "";
+        if (format.empty())
+            throw InputError("command line", "--format",
+                             "give --format bsdf|merl|npz or an --out ending in .bsdf, .binary "
+                             "or .npz");
+    }
+    if (format != "bsdf" && format != "merl" && format != "npz")
+        throw InputError("command line", "--format",
+                         fmt::format("'{}' is not a format: bsdf, merl or npz", format));
+
+    // The source: a binned table (simulate, study) or a model.
+    BinnedTable table;
+    bool have_table = false;
+    std::shared_ptr<const Model> model;
+    nlohmann::json meta;
+    meta["lamina_version"] = kVersion;
+    if (!a.simulation.empty()) {
+        const std::filesystem::path dir = a.simulation;
+        table = BinnedTable::from_csv(read_text(dir / "brdf.csv"), (dir / "brdf.csv").string());
+        have_table = true;
+        meta["source"] = "simulation";
+        if (std::filesystem::exists(dir / "result.json"))
+            meta["result"] = read_json(dir / "result.json");
+    } else if (!a.study.empty()) {
+        if (a.config.empty()) throw InputError("command line", "--config", "required with --study");
+        table = study_table(a);
+        have_table = true;
+        meta["source"] = {{"study", a.study}, {"config", a.config}, {"source", a.source}};
+    } else {
+        if (a.stack.empty()) throw InputError("command line", "--stack", "required with --model");
+        const ModelEntry& entry = find_model(a.model);
+        const Stack stack = load_stack(a.stack);
+        model = entry.make(stack, resolve_options(entry, a.options));
+        meta["source"] = {{"model", a.model}, {"stack", stack_to_json(stack)}};
+    }
+
+    std::string bytes;
+    if (format == "npz") {
+        if (!have_table) {
+            const Support s = model->support();
+            if (!s.brdf && !s.btdf)
+                throw InputError(a.stack, "--model", "not supported: " + s.reason);
+            table =
+                bin_model(*model, HemisphereGrid::parse(a.grid),
+                          parse_incidences(a.theta_i.empty() ? "0,15,30,45,60,70,80" : a.theta_i,
+                                           "--theta-i"));
+        }
+        const std::size_t n_inc = table.theta_i_deg.size(),
+                          n_sides = table.has_transmission ? 2 : 1;
+        const HemisphereGrid& g = table.grid;
+        std::vector<float> f, se;
+        for (std::size_t i = 0; i < n_inc; ++i)
+            for (std::size_t s = 0; s < n_sides; ++s) {
+                const BinnedLobe& lobe =
+                    table.lobe(i, s == 0 ? Side::Reflection : Side::Transmission);
+                for (std::size_t j = 0; j < g.size(); ++j)
+                    for (int c = 0; c < 3; ++c) {
+                        f.push_back(float(lobe.f[j][c]));
+                        se.push_back(float(lobe.se.empty() ? 0.0 : lobe.se[j][c]));
+                    }
+            }
+        const std::vector<std::size_t> shape = {n_inc, n_sides, std::size_t(g.n_theta()),
+                                                std::size_t(g.n_phi()), 3};
+        std::vector<float> theta_i(table.theta_i_deg.begin(), table.theta_i_deg.end()), te, pe;
+        for (int t = 0; t <= g.n_theta(); ++t)
+            te.push_back(float(90.0 * t / g.n_theta()));
+        for (int p = 0; p <= g.n_phi(); ++p)
+            pe.push_back(float(180.0 * p / g.n_phi()));
+        meta["axes"] = {"incidence", "side", "theta_bin", "phi_bin", "channel"};
+        meta["sides"] = n_sides == 2 ? nlohmann::json{"R", "T"} : nlohmann::json{"R"};
+        meta["theta_i"] = table.theta_i_deg;
+        meta["grid"] = {{"n_theta", g.n_theta()}, {"n_phi", g.n_phi()}};
+        bytes = zip_stored({{"f.npy", npy_float32(f, shape)},
+                            {"se.npy", npy_float32(se, shape)},
+                            {"theta_i.npy", npy_float32(theta_i, {theta_i.size()})},
+                            {"theta_edges.npy", npy_float32(te, {te.size()})},
+                            {"phi_edges.npy", npy_float32(pe, {pe.size()})},
+                            {"metadata.json", meta.dump(1) + "\n"}});
+    } else {
+        const BrdfSource brdf =
+            have_table ? table_brdf(table, a.simulation.empty() ? a.source : "reference",
+                                    a.simulation.empty() ? a.study : a.simulation)
+                       : model_brdf(model, a.stack);
+        if (format == "bsdf") {
+            RglOptions o;
+            o.resolution = a.resolution;
+            o.vndf_resolution = a.vndf_resolution;
+            o.ndf_resolution = a.ndf_resolution;
+            if (!a.theta_i.empty()) o.theta_i_deg = parse_incidences(a.theta_i, "--theta-i");
+            o.description = fmt::format("lamina {} export: {}", kVersion, meta["source"].dump());
+            const TensorFile file = rgl_bsdf(brdf, o);
+            check_rgl_bsdf(file, a.out);
+            bytes = tensor_file_bytes(file);
+        } else {
+            bytes = merl_binary(brdf);
+        }
+    }
+    write_file_atomic(a.out, bytes);
+    fmt::print("wrote {} ({}, {:.1f} MB){}\n", a.out, format, bytes.size() / 1e6,
+               format == "npz" ? "" : ": the reflection side (BRDF) only");
+    return 0;
+}
+
+}  // namespace
+
+Runner add_export(CLI::App& app) {
+    auto a = std::make_shared<ExportArgs>();
+    auto* cmd = app.add_subcommand(
+        "export",
+        "Write a reference or a model as an RGL .bsdf (pbrt-v4, Mitsuba 3), MERL "
+        ".binary or NumPy .npz file");
+    cmd->add_option("--simulation", a->simulation, "A `lamina simulate` output folder");
+    cmd->add_option("--study", a->study, "A study folder (with --config, --source)");
+    cmd->add_option("--config", a->config, "The study configuration id");
+    cmd->add_option("--source", a->source, "reference or a model of the study")
+        ->capture_default_str();
+    cmd->add_option("--model", a->model, "A model name (with --stack, --option)");
+    cmd->add_option("--stack", a->stack, "The model's stack JSON file");
+    cmd->add_option("--option", a->options, "Model flag KEY=VALUE, repeatable");
+    cmd->add_option("--format", a->format, "bsdf, merl or npz (default: from --out's extension)");
+    cmd->add_option("--theta-i", a->theta_i,
+                    "Incidences (degrees): a model's .bsdf nodes (default 0..88 by 4) or .npz "
+                    "bins (default 0,15,30,45,60,70,80)");
+    cmd->add_option("--grid", a->grid, "Bins of a model's .npz, NTHETAxNPHI")
+        ->capture_default_str();
+    cmd->add_option("--resolution", a->resolution, ".bsdf: sample-grid nodes a side")
+        ->capture_default_str();
+    cmd->add_option("--vndf-resolution", a->vndf_resolution, ".bsdf: VNDF nodes a side")
+        ->capture_default_str();
+    cmd->add_option("--ndf-resolution", a->ndf_resolution, ".bsdf: NDF and σ nodes a side")
+        ->capture_default_str();
+    cmd->add_option("--out,-o", a->out, "Output file");
+    cmd->add_option("--check", a->check,
+                    "Read a .bsdf or MERL .binary file as a renderer would and describe it (a "
+                    "malformed or truncated file is refused with what is wrong)");
+    return [a] { return run_export(*a); };
+}
+
+}  // namespace lamina::cli

@@ -1,0 +1,109 @@
+#include "cli/model_plugin.h"
+
+#include "core/error.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+extern char** environ;
+
+namespace lamina::cli {
+
+#ifdef LAMINA_PYTHON_EXECUTABLE
+namespace {
+
+// Runs argv (searched on PATH) with PYTHONPATH prepended by `python_path`; returns the exit status.
+int run_process(const std::vector<std::string>& argv, const std::string& python_path) {
+    std::vector<std::string> env_strings;
+    for (char** e = environ; *e; ++e)
+        if (std::string(*e).rfind("PYTHONPATH=", 0) != 0) env_strings.emplace_back(*e);
+    const char* old = std::getenv("PYTHONPATH");
+    std::string path_entry = "PYTHONPATH=";
+    path_entry.append(python_path);
+    if (old && *old) path_entry.append(":").append(old);
+    env_strings.push_back(path_entry);
+    std::vector<char*> args, env;
+    for (const std::string& a : argv)
+        args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    for (const std::string& e : env_strings)
+        env.push_back(const_cast<char*>(e.c_str()));
+    env.push_back(nullptr);
+    pid_t pid = 0;
+    if (posix_spawnp(&pid, args[0], nullptr, nullptr, args.data(), env.data()) != 0) return -1;
+    int status = 0;
+    if (waitpid(pid, &status, 0) < 0) return -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+#endif
+
+ExternalModel model_plugin(const std::string& assignment, const StudySettings& settings) {
+#ifndef LAMINA_PYTHON_EXECUTABLE
+    (void)settings;
+    throw InputError("command line", "--model-plugin",
+                     fmt::format("'{}': this lamina was built without the Python module "
+                                 "(install python3-dev and pybind11-dev, then rebuild)",
+                                 assignment));
+#else
+    const auto eq = assignment.find('=');
+    const std::string file = eq == std::string::npos ? assignment : assignment.substr(eq + 1);
+    ExternalModel m;
+    m.name = eq == std::string::npos ? std::filesystem::path(file).stem().string()
+                                     : assignment.substr(0, eq);
+    if (!std::filesystem::is_regular_file(file))
+        throw InputError(file, "--model-plugin", "cannot read the file");
+    m.source = file;
+    const char* python_env = std::getenv("LAMINA_PYTHON");
+    const std::string python = python_env && *python_env ? python_env : LAMINA_PYTHON_EXECUTABLE;
+    const std::string theta_i = fmt::format("{}", fmt::join(settings.theta_i_deg, ","));
+    const std::string grid = settings.grid.to_string();
+    m.table = [file, python, theta_i, grid](const StudyConfiguration& c) {
+        std::string dir_template =
+            (std::filesystem::temp_directory_path() / "lamina-plugin-XXXXXX").string();
+        if (!mkdtemp(dir_template.data()))
+            throw InputError(file, "--model-plugin", "cannot create a temporary folder");
+        const std::filesystem::path dir = dir_template;
+        struct Cleanup {
+            std::filesystem::path dir;
+            ~Cleanup() {
+                std::error_code ec;
+                std::filesystem::remove_all(dir, ec);
+            }
+        } cleanup{dir};
+        std::ofstream(dir / "stack.json") << stack_to_json(c.stack).dump();
+        const int rc = run_process(
+            {python, "-m", "lamina.plugin_table", file, "--stack", (dir / "stack.json").string(),
+             "--theta-i", theta_i, "--grid", grid, "--out", (dir / "table.csv").string()},
+            LAMINA_PYTHON_DIR);
+        if (rc == 3) {  // the model supports neither side of this stack
+            BinnedTable none;
+            none.has_reflection = false;
+            return none;
+        }
+        if (rc != 0)
+            throw InputError(file, "--model-plugin",
+                             fmt::format("the Python model failed on {} (exit status {}; its "
+                                         "message is above; interpreter: {})",
+                                         c.id, rc, python));
+        std::ifstream in(dir / "table.csv", std::ios::binary);
+        std::ostringstream text;
+        text << in.rdbuf();
+        return BinnedTable::from_csv(text.str(), file);
+    };
+    return m;
+#endif
+}
+
+}  // namespace lamina::cli

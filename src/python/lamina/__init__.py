@@ -1,0 +1,263 @@
+"""lamina from Python: stacks, the virtual goniophotometer, the layered models and the study.
+
+Directions follow lamina's conventions (docs/notation.md): z is the macro-surface normal, wi the
+light direction (wi.z > 0), wo the viewer (wo.z < 0 for transmission); the light of incidence
+theta_i sits at phi = 0, so the mirror direction is at phi = 180 degrees; f is in 1/sr without the
+cosine. Binned arrays are [incidence, side, theta bin, phi bin, channel]. Bad input raises
+lamina.InputError (a ValueError) with .file, .field and .problem, as the CLI reports it.
+
+See docs/python.md.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ._lamina import (  # noqa: F401  (re-exported)
+    InputError,
+    Model,
+    SimulationResult,
+    Stack,
+    Table,
+    kernel_description,
+    models,
+)
+from . import _lamina
+from .plugins import bin_model, input_error, model_name
+
+__all__ = [
+    "InputError",
+    "Model",
+    "SimulationResult",
+    "Stack",
+    "Table",
+    "bin_model",
+    "compare",
+    "export",
+    "Study",
+    "load_study",
+    "models",
+    "simulate",
+    "study",
+]
+
+DEFAULT_THETA_I = (0, 15, 30, 45, 60, 70, 80)
+
+
+def simulate(stack, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, threads=0, grid=(90, 90),
+             kernel="simd", microsurface="single", max_events=10000, progress=None):
+    """Runs the goniophotometer (`lamina simulate`) and returns a SimulationResult.
+
+    stack: a Stack, a dict in the stack format or a path. theta_i: degrees in [0, 90), one or a
+    list. particles: per incidence. The tables are bitwise those of `lamina simulate` with the same
+    inputs (for the same kernel on the same machine) and do not depend on `threads`. The GIL is
+    released while particles are traced; Ctrl-C stops the run between chunks of particles and
+    raises KeyboardInterrupt. progress: draw a progress line on stderr (default: when it is a
+    terminal).
+    """
+    if progress is None:
+        progress = _stderr_is_terminal()
+    return _lamina._simulate(stack, theta_i, float(particles), int(seed), int(threads),
+                             (int(grid[0]), int(grid[1])), str(kernel), str(microsurface),
+                             int(max_events), bool(progress))
+
+
+def _stderr_is_terminal():
+    try:
+        return os.isatty(2)
+    except OSError:
+        return False
+
+
+def export(source, path, format=None, theta_i=None, resolution=32, description=""):
+    """Writes a Model, a Table or a SimulationResult (its reflection side) as an RGL .bsdf
+    (pbrt-v4, Mitsuba 3) or a MERL .binary file, as `lamina export` does (docs/formats.md).
+
+    format: "bsdf" or "merl" (default: from the path's extension). theta_i: a model's .bsdf
+    incidences in degrees (default 0..88 by 4; a table's are its own).
+    """
+    path = Path(path)
+    if format is None:
+        format = {".bsdf": "bsdf", ".binary": "merl"}.get(path.suffix)
+        if format is None:
+            raise input_error("arguments", "format",
+                              "give format='bsdf' or 'merl', or a path ending in .bsdf or .binary")
+    if isinstance(source, SimulationResult):
+        source = source.table
+    _lamina._export(source, str(path), format, [float(t) for t in (theta_i or [])],
+                    int(resolution), str(description))
+
+
+# ---- study directories ------------------------------------------------------------------------
+
+_METRIC_FLOATS = ("theta_i", "misplaced_energy", "albedo_ref", "albedo_model", "albedo_error",
+                  "rmse", "log_rmse", "noise_floor")
+
+
+def _read_metrics(path: Path) -> np.ndarray:
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        names = ("config", "category", "model", "side", "channel")
+        return np.zeros(0, dtype=[(n, "U1") for n in names] +
+                        [(n, "f8") for n in _METRIC_FLOATS] + [("supported", "?")])
+    width = {k: max(1, max(len(r[k]) for r in rows))
+             for k in ("config", "category", "model", "side", "channel")}
+    dtype = [("config", f"U{width['config']}"), ("category", f"U{width['category']}"),
+             ("model", f"U{width['model']}"), ("theta_i", "f8"), ("side", f"U{width['side']}"),
+             ("channel", f"U{width['channel']}")]
+    dtype += [(n, "f8") for n in _METRIC_FLOATS[1:]] + [("supported", "?")]
+    out = np.zeros(len(rows), dtype=dtype)
+    for k, r in enumerate(rows):
+        out[k] = tuple(
+            (float(r[n]) if r[n] != "" else np.nan) if n in _METRIC_FLOATS
+            else (r[n] == "true") if n == "supported" else r[n]
+            for n, _ in dtype)
+    return out
+
+
+class Study:
+    """A study directory (`lamina study`, `lamina compare`; docs/formats.md), read from disk.
+
+    .info: study.json; .metrics: metrics.csv as a numpy structured array (empty fields are NaN),
+    or a pandas DataFrame when pandas is installed and load_study(..., pandas=True);
+    .configs: the configuration ids; .config(id): its config.json; .tables(id): {source: array
+    [incidence, side, theta bin, phi bin, channel]} (float32; NaN on a side a model does not
+    support); .reference_se(id): the reference's standard errors, same axes.
+    """
+
+    def __init__(self, path, pandas=None):
+        self.path = Path(path)
+        info = self.path / "study.json"
+        if not info.is_file():
+            raise InputError(str(self.path), "study.json",
+                             "not a study directory: no study.json (run lamina study or compare)")
+        with open(info) as f:
+            self.info = json.load(f)
+        self.metrics = _read_metrics(self.path / "metrics.csv")
+        if pandas is None or pandas:
+            try:
+                import pandas as pd
+                self.metrics = pd.read_csv(self.path / "metrics.csv")
+            except ImportError:
+                if pandas:
+                    raise
+        self.configs = [c["id"] for c in self.info.get("configurations", [])]
+        self.theta_i = list(self.info.get("theta_i", []))
+        self.models = list(self.info.get("models", []))
+
+    def config(self, config_id):
+        with open(self._dir(config_id) / "config.json") as f:
+            return json.load(f)
+
+    def tables(self, config_id):
+        cfg = self.config(config_id)
+        t = np.load(self._dir(config_id) / "tables.npy")
+        return {name: t[k] for k, name in enumerate(cfg["sources"])}
+
+    def reference_se(self, config_id):
+        return np.load(self._dir(config_id) / "reference_se.npy")
+
+    def _dir(self, config_id):
+        if config_id not in self.configs:
+            raise InputError(str(self.path), "configurations",
+                             f"no configuration '{config_id}'; the study has: "
+                             + ", ".join(self.configs))
+        return self.path / "configs" / config_id
+
+    def __repr__(self):
+        return (f"<lamina.Study {self.path}: {len(self.configs)} configurations, "
+                f"models {', '.join(self.models)}>")
+
+
+def load_study(path, pandas=None) -> Study:
+    """Reads a study directory: metrics, configurations and tables (see Study)."""
+    return Study(path, pandas=pandas)
+
+
+# ---- the study with your own models ------------------------------------------------------------
+
+def _split_models(models):
+    """Registry names and Python models (docs/python.md, "Your own model")."""
+    names, plugins = [], []
+    for m in models or []:
+        if isinstance(m, str):
+            names.append(m)
+        elif hasattr(m, "eval"):
+            plugins.append(m)
+        else:
+            raise input_error("arguments", "models",
+                              f"{m!r} is neither a model name nor an object with eval(wi, wo)")
+    return names, plugins
+
+
+def _run(configs, models, theta_i, particles, preset, seed, threads, grid, kernel, microsurface,
+         out, figures, quiet, nodes, peak_nodes):
+    names, plugins = _split_models(models)
+    settings = {
+        "particles": int(particles), "preset": preset, "seed": int(seed),
+        "theta_i": [float(t) for t in np.atleast_1d(theta_i)], "grid": (int(grid[0]), int(grid[1])),
+        "models": names, "threads": int(threads), "kernel": kernel, "microsurface": microsurface,
+        "quiet": bool(quiet),
+        # models=None: every built-in model; a list: exactly the models it names.
+        "registry_models": models is None,
+    }
+    externals = []
+    for p in plugins:
+        def table(config_id, stack, p=p):
+            return bin_model(p, stack, settings["theta_i"], settings["grid"], nodes, peak_nodes)
+        externals.append((model_name(p), table))
+    if not names and not externals and models is not None:
+        raise input_error("arguments", "models", "no model to compare")
+    _lamina._run_study(configs, settings, externals, str(out), bool(figures))
+    return load_study(out)
+
+
+def compare(stack, models=None, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, threads=0,
+            grid=(90, 90), kernel="simd", microsurface="single", out=None, figures=False,
+            quiet=True, config_id=None, nodes=4, peak_nodes=32):
+    """`lamina compare` from Python: the reference for one stack and every model on its bins.
+
+    models: registry names and Python models (classes or objects with eval(wi, wo); see
+    lamina.plugins), default every built-in model. Writes the study directory `out` (metrics,
+    summary, explorer, and figures when figures=True) and returns it as a lamina.Study.
+    """
+    if out is None:
+        raise input_error("arguments", "out", "give the output folder (out=...)")
+    st = Stack(stack)
+    cid = config_id or (Path(os.fspath(stack)).stem if isinstance(stack, (str, os.PathLike))
+                        else (st.name or "stack"))
+    configs = [{"id": cid, "category": "custom", "stack": st}]
+    return _run(configs, models, theta_i, particles, "custom", seed, threads, grid, kernel,
+                microsurface, out, figures, quiet, nodes, peak_nodes)
+
+
+def study(models=None, preset="quick", only=None, configs=None, theta_i=DEFAULT_THETA_I,
+          particles=None, seed=1, threads=0, grid=(90, 90), kernel="simd", microsurface="single",
+          out=None, figures=False, quiet=True, nodes=4, peak_nodes=32):
+    """`lamina study` from Python, with Python models beside the built-in ones.
+
+    configs: None for the study's 60 configurations, or a list of {"id", "category", "stack"};
+    only: the CLI's --only globs. Returns the study directory `out` as a lamina.Study.
+    """
+    if out is None:
+        raise input_error("arguments", "out", "give the output folder (out=...)")
+    presets = {"quick": 1_000_000, "standard": 10_000_000, "paper": 160_000_000}
+    if preset not in presets:
+        raise input_error("arguments", "preset",
+                          f"'{preset}' is not a preset: use quick, standard or paper")
+    n = presets[preset] if particles is None else particles
+    label = preset if particles is None else "custom"
+    cs = _lamina._builtin_configurations() if configs is None else [
+        {"id": c["id"], "category": c.get("category", "custom"), "stack": Stack(c["stack"])}
+        for c in configs]
+    if only:
+        keep = set(_lamina._filter_configurations(cs, only))
+        cs = [c for c in cs if c["id"] in keep]
+    return _run(cs, models, theta_i, n, label, seed, threads, grid, kernel, microsurface, out,
+                figures, quiet, nodes, peak_nodes)

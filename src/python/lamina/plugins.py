@@ -1,0 +1,151 @@
+"""Your own model in lamina's study: a Python class with a vectorized eval (docs/python.md).
+
+A model is a class (instantiated with the stack: ``Model(stack)``) or an object with
+
+- ``eval(wi, wo)``: f in 1/sr (no cosine), wi and wo float64 arrays [N, 3] of unit vectors in
+  lamina's frame (wi.z > 0; wo.z < 0 is transmission), returning [N, 3] RGB (required);
+- ``name``: its name in the study (default: the class name);
+- ``supports(stack)``: (brdf, btdf) booleans, or a dict {"brdf", "btdf", "reason"} (default: the
+  BRDF only);
+- ``delta_lobes(wi)``: [(direction, energy RGB)] for one wi (smooth interfaces; default none);
+- ``peak_directions(wi)``: directions where narrow lobes peak (default: the mirror direction).
+
+lamina averages it over its bins with its own quadrature, in large batches: each bin gets the
+``nodes`` x ``nodes`` Gauss-Legendre product rule in (theta, phi) with the weight
+sin(theta) cos(theta) (normalized by the same rule, so that constants are exact), and the bins
+holding a peak direction get ``peak_nodes`` x ``peak_nodes``. The model must be isotropic (the
+bins fold phi and -phi together: it is evaluated on phi in [0, 180] degrees).
+"""
+
+from __future__ import annotations
+
+import inspect
+
+import numpy as np
+
+from . import _lamina
+
+_BATCH = 1 << 18  # directions per eval call
+
+
+def input_error(file, field, problem):
+    """A lamina.InputError with .file, .field and .problem, as the CLI's errors have."""
+    e = _lamina.InputError(f"{file}: {field}: {problem}" if field else f"{file}: {problem}")
+    e.file, e.field, e.problem = file, field, problem
+    return e
+
+
+def model_name(obj) -> str:
+    name = getattr(obj, "name", None)
+    if isinstance(name, str) and name:
+        return name
+    cls = obj if isinstance(obj, type) else type(obj)
+    return cls.__name__
+
+
+def instantiate(obj, stack):
+    """The model object for one stack (a class is called with the stack, or with nothing when its
+    constructor takes no argument)."""
+    if not isinstance(obj, type):
+        return obj
+    try:
+        inspect.signature(obj).bind(stack)
+    except TypeError:
+        return obj()
+    return obj(stack)
+
+
+def support(model, stack):
+    fn = getattr(model, "supports", None)
+    if fn is None:
+        return {"brdf": True, "btdf": False, "reason": ""}
+    s = fn(stack)
+    if isinstance(s, dict):
+        return {"brdf": bool(s.get("brdf", False)), "btdf": bool(s.get("btdf", False)),
+                "reason": str(s.get("reason", ""))}
+    brdf, btdf = s
+    return {"brdf": bool(brdf), "btdf": bool(btdf), "reason": ""}
+
+
+def _gauss(n):
+    x, w = np.polynomial.legendre.leggauss(n)
+    return (x + 1) / 2, w / 2
+
+
+def _eval(model, name, wi, wo):
+    out = np.empty((len(wo), 3))
+    for a in range(0, len(wo), _BATCH):
+        b = min(len(wo), a + _BATCH)
+        f = np.asarray(model.eval(np.broadcast_to(wi, (b - a, 3)), wo[a:b]), dtype=np.float64)
+        if f.shape != (b - a, 3):
+            raise input_error(f"Python model '{name}'", "eval",
+                              f"returned shape {f.shape}, expected ({b - a}, 3)")
+        if not np.all(np.isfinite(f)):
+            raise input_error(f"Python model '{name}'", "eval", "returned a non-finite value")
+        out[a:b] = f
+    return out
+
+
+def _average(model, name, wi, t0, t1, p0, p1, n, lower):
+    """Cos-weighted averages over the rectangles [t0, t1] x [p0, p1] (arrays, radians)."""
+    x, w = _gauss(n)
+    theta = t0[:, None] + (t1 - t0)[:, None] * x[None, :]          # [bins, n]
+    phi = p0[:, None] + (p1 - p0)[:, None] * x[None, :]            # [bins, n]
+    st, ct = np.sin(theta), np.cos(theta)
+    wo = np.stack(np.broadcast_arrays(
+        st[:, :, None] * np.cos(phi)[:, None, :], st[:, :, None] * np.sin(phi)[:, None, :],
+        (-ct if lower else ct)[:, :, None]), axis=-1)              # [bins, n, n, 3]
+    f = _eval(model, name, wi, wo.reshape(-1, 3)).reshape(wo.shape)
+    weight = (w[None, :] * st * ct)[:, :, None] * w[None, None, :]  # [bins, n, n]
+    return np.einsum("bij,bijc->bc", weight, f) / weight.sum(axis=(1, 2))[:, None]
+
+
+def bin_model(obj, stack, theta_i, grid=(90, 90), nodes=4, peak_nodes=32):
+    """A Python model on lamina's bins: a lamina.Table (the brdf.csv format), or None when the
+    model supports neither side of this stack."""
+    stack = _lamina.Stack(stack)
+    model = instantiate(obj, stack)
+    name = model_name(obj)
+    sup = support(model, stack)
+    sides = (["R"] if sup["brdf"] else []) + (["T"] if sup["btdf"] and stack.transmits else [])
+    if not sides:
+        return None
+    theta_i = [float(t) for t in np.atleast_1d(theta_i)]
+    n_theta, n_phi = int(grid[0]), int(grid[1])
+    t_edges = np.linspace(0, np.pi / 2, n_theta + 1)
+    p_edges = np.linspace(0, np.pi, n_phi + 1)
+    tt, pp = np.meshgrid(np.arange(n_theta), np.arange(n_phi), indexing="ij")
+    t0, t1 = t_edges[tt.ravel()], t_edges[tt.ravel() + 1]
+    p0, p1 = p_edges[pp.ravel()], p_edges[pp.ravel() + 1]
+    omega = (p1 - p0) * (np.sin(t1) ** 2 - np.sin(t0) ** 2)       # Ω⊥, both folded halves
+    f = np.zeros((len(theta_i), len(sides), n_theta * n_phi, 3))
+
+    def bin_of(d):
+        d = np.asarray(d, dtype=np.float64)
+        theta = np.arccos(min(1.0, abs(d[2])))
+        phi = np.arctan2(abs(d[1]), d[0])
+        return (min(n_theta - 1, int(theta / (np.pi / 2) * n_theta)) * n_phi
+                + min(n_phi - 1, int(phi / np.pi * n_phi)))
+
+    for i, ti in enumerate(theta_i):
+        a = np.radians(ti)
+        wi = np.array([np.sin(a), 0.0, np.cos(a)])
+        peaks_fn = getattr(model, "peak_directions", None)
+        peaks = [np.asarray(p, dtype=np.float64) for p in peaks_fn(wi)] if peaks_fn else \
+            [np.array([-wi[0], -wi[1], wi[2]])]
+        for k, side in enumerate(sides):
+            lower = side == "T"
+            f[i, k] = _average(model, name, wi, t0, t1, p0, p1, nodes, lower)
+            fine = sorted({bin_of(p) for p in peaks if (p[2] < 0) == lower})
+            if fine:
+                fine = np.array(fine)
+                f[i, k, fine] = _average(model, name, wi, t0[fine], t1[fine], p0[fine],
+                                         p1[fine], peak_nodes, lower)
+        lobes = getattr(model, "delta_lobes", None)
+        for direction, energy in (lobes(wi) if lobes else []):
+            side = "T" if direction[2] < 0 else "R"
+            if side in sides:
+                j = bin_of(direction)
+                f[i, sides.index(side), j] += np.asarray(energy, dtype=np.float64) / omega[j]
+    f = f.reshape(len(theta_i), len(sides), n_theta, n_phi, 3)
+    return _lamina._table_from_arrays(f, theta_i, sides)

@@ -1,0 +1,778 @@
+// The compiled half of `import lamina` (docs/python.md): stacks, the goniophotometer, the models
+// and the binned tables, with numpy arrays in and out. The pure-Python package around it
+// (src/python/lamina/) adds load_study, the Python model plugins and the documentation strings a
+// user reads first.
+//
+// Conventions are lamina's (docs/notation.md): z is the macro normal, wi the light direction
+// (wi.z > 0), wo the viewer (wo.z < 0: transmission), f in 1/sr without the cosine.
+// Long computations release the GIL; simulate() checks for Ctrl-C between chunks of particles and
+// raises KeyboardInterrupt, and its result is bitwise the CLI's (chunks start at block boundaries,
+// whose integer sums add up exactly: simulator/goniophotometer.h).
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/progress.h"
+#include "core/spherical.h"
+#include "core/table.h"
+#include "export/brdf_source.h"
+#include "export/merl.h"
+#include "export/rgl_bsdf.h"
+#include "layers/stack.h"
+#include "models/binned.h"
+#include "models/registry.h"
+#include "report/explorer.h"
+#include "report/figures.h"
+#include "simulator/goniophotometer.h"
+#include "simulator/output.h"
+#include "study/configurations.h"
+#include "study/study.h"
+
+#include <fmt/format.h>
+#include <omp.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace py = pybind11;
+
+namespace lamina {
+namespace {
+
+PyObject* g_input_error = nullptr;  // lamina.InputError, a subclass of ValueError
+
+nlohmann::json json_of(py::handle obj) {
+    const py::object dumps = py::module_::import("json").attr("dumps");
+    return nlohmann::json::parse(dumps(obj, py::arg("allow_nan") = false).cast<std::string>());
+}
+
+py::object python_of(const nlohmann::json& j) {
+    return py::module_::import("json").attr("loads")(j.dump());
+}
+
+/// A Stack, a dict in the stack format (docs/stack-format.md) or a path to a stack file.
+Stack stack_of(py::handle source) {
+    if (py::isinstance<Stack>(source)) return source.cast<Stack>();
+    if (py::isinstance<py::dict>(source)) return stack_from_json(json_of(source), "<dict>");
+    const py::object os = py::module_::import("os");
+    if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__"))
+        return load_stack(os.attr("fspath")(source).cast<std::string>());
+    throw py::type_error("a stack is a lamina.Stack, a dict in the stack format, or a file path");
+}
+
+HemisphereGrid grid_of(const std::pair<int, int>& grid) {
+    return HemisphereGrid::parse(fmt::format("{}x{}", grid.first, grid.second), "grid");
+}
+
+std::vector<double> incidences_of(py::handle theta_i) {
+    std::vector<double> out;
+    if (py::isinstance<py::float_>(theta_i) || py::isinstance<py::int_>(theta_i))
+        out.push_back(theta_i.cast<double>());
+    else
+        for (py::handle t : py::iter(theta_i))
+            out.push_back(t.cast<double>());
+    if (out.empty()) throw InputError("arguments", "theta_i", "at least one incidence is needed");
+    for (double t : out)
+        if (!(t >= 0 && t < 90))
+            throw InputError("arguments", "theta_i",
+                             fmt::format("{} is outside the allowed range [0, 90) degrees", t));
+    return out;
+}
+
+/// [n_inc, n_sides, n_theta, n_phi, 3] of the table's f (se: false) or se (true).
+py::array_t<double> lobes_array(const BinnedTable& t, bool se) {
+    const std::size_t n_inc = t.theta_i_deg.size();
+    std::vector<Side> sides;
+    if (t.has_reflection) sides.push_back(Side::Reflection);
+    if (t.has_transmission) sides.push_back(Side::Transmission);
+    py::array_t<double> a({n_inc, sides.size(), std::size_t(t.grid.n_theta()),
+                           std::size_t(t.grid.n_phi()), std::size_t(3)});
+    double* p = a.mutable_data();
+    for (std::size_t i = 0; i < n_inc; ++i)
+        for (Side side : sides) {
+            const BinnedLobe& lobe = t.lobe(i, side);
+            const std::vector<Rgbd>& v = se ? lobe.se : lobe.f;
+            for (std::size_t j = 0; j < t.grid.size(); ++j)
+                for (int c = 0; c < 3; ++c)
+                    *p++ = j < v.size() ? v[j][c] : 0.0;
+        }
+    return a;
+}
+
+py::list sides_of(const BinnedTable& t) {
+    py::list out;
+    if (t.has_reflection) out.append("R");
+    if (t.has_transmission) out.append("T");
+    return out;
+}
+
+py::array_t<double> edges_deg(int n, double range) {
+    py::array_t<double> a(n + 1);
+    for (int k = 0; k <= n; ++k)
+        a.mutable_data()[k] = range * k / n;
+    return a;
+}
+
+// ---- simulate --------------------------------------------------------------------------------
+
+SimulationResult simulate_interruptible(const Stack& stack, const SimulationSettings& s,
+                                        bool show_progress) {
+    validate_settings(s);
+    const int threads = s.threads > 0 ? s.threads : omp_get_max_threads();
+    // Chunks of whole blocks: their integer sums add up to one run's, bit for bit. Each chunk
+    // costs a set-up (tallies allocated and merged), so chunks double while they take under
+    // 0.2 s: Ctrl-C is then seen within about half a second.
+    std::uint64_t chunk = kParticlesPerBlock * 16 * std::uint64_t(threads);
+    SimulationSums total;
+    total.incidences.resize(s.theta_i_deg.size());
+    for (IncidenceSums& inc : total.incidences)
+        inc.bins.resize(2 * s.grid.size());
+    total.incidence_seconds.assign(s.theta_i_deg.size(), 0.0);
+    std::unique_ptr<Progress> progress;
+    if (show_progress)
+        progress = std::make_unique<Progress>(fmt::format("simulate {}", stack.name), "particles",
+                                              s.particles * s.theta_i_deg.size());
+    const auto start = std::chrono::steady_clock::now();
+    for (std::uint64_t first = 0, next = chunk; first < s.particles; first = next) {
+        const auto chunk_start = std::chrono::steady_clock::now();
+        SimulationSettings part = s;
+        part.first_particle = s.first_particle + first;
+        part.particles = std::min(chunk, s.particles - first);  // a multiple of blocks
+        SimulationSums sums;
+        {
+            py::gil_scoped_release release;
+            sums = simulate_sums(stack, part, [&](std::uint64_t n) {
+                if (progress) progress->advance(n);
+            });
+        }
+        for (std::size_t i = 0; i < total.incidences.size(); ++i) {
+            total.incidences[i].add(sums.incidences[i]);
+            total.incidence_seconds[i] += sums.incidence_seconds[i];
+        }
+        total.threads_used = sums.threads_used;
+        if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
+        const double took =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - chunk_start).count();
+        if (took < 0.2 && chunk < (std::uint64_t(1) << 40)) chunk *= 2;
+        next = first + part.particles;
+    }
+    if (progress) progress->finish();
+    total.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return finalize_simulation(stack, s, total);
+}
+
+struct PySimulation {
+    Stack stack;
+    SimulationResult result;
+};
+
+// ---- models ----------------------------------------------------------------------------------
+
+struct PyModel {
+    std::string name;
+    Stack stack;
+    ModelOptions options;
+    std::unique_ptr<Model> model;
+};
+
+std::string option_text(py::handle v) {
+    if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "on" : "off";
+    return py::str(v).cast<std::string>();
+}
+
+/// Directions as an [n, 3] C-contiguous float64 array, broadcast against each other; the shape of
+/// the leading axes comes back in `shape`.
+std::vector<py::array_t<double, py::array::c_style | py::array::forcecast>> broadcast_directions(
+    const std::vector<std::pair<const char*, py::handle>>& inputs,
+    std::vector<py::ssize_t>& shape) {
+    const py::object np = py::module_::import("numpy");
+    py::list arrays;
+    for (const auto& [name, obj] : inputs) {
+        py::array a = np.attr("asarray")(obj, py::arg("dtype") = "float64");
+        if (a.ndim() < 1 || a.shape(a.ndim() - 1) != 3)
+            throw InputError("arguments", name,
+                             "expected an array of 3-vectors (last axis of length 3)");
+        arrays.append(a);
+    }
+    py::tuple b = np.attr("broadcast_arrays")(*arrays);
+    std::vector<py::array_t<double, py::array::c_style | py::array::forcecast>> out;
+    for (std::size_t k = 0; k < inputs.size(); ++k) {
+        py::array a = b[k];
+        shape.assign(a.shape(), a.shape() + a.ndim() - 1);
+        out.push_back(np.attr("ascontiguousarray")(a).attr("reshape")(-1, 3));
+        const double* d = out.back().data();
+        for (py::ssize_t n = 0; n < out.back().shape(0); ++n) {
+            const double x = d[3 * n], y = d[3 * n + 1], z = d[3 * n + 2];
+            const double len = std::sqrt(x * x + y * y + z * z);
+            if (!std::isfinite(len) || std::abs(len - 1) > 1e-6)
+                throw InputError("arguments", inputs[k].first,
+                                 fmt::format("direction {} is ({}, {}, {}): directions must be "
+                                             "finite unit vectors",
+                                             n, x, y, z));
+        }
+    }
+    return out;
+}
+
+py::array_t<double> shaped(std::vector<py::ssize_t> shape, py::ssize_t last) {
+    if (last > 0) shape.push_back(last);
+    return py::array_t<double>(shape);
+}
+
+Vec3d vec_at(const double* d, py::ssize_t n) {
+    return {d[3 * n], d[3 * n + 1], d[3 * n + 2]};
+}
+
+py::array_t<double> model_eval(const PyModel& m, py::handle wi_obj, py::handle wo_obj) {
+    std::vector<py::ssize_t> shape;
+    auto arrays = broadcast_directions({{"wi", wi_obj}, {"wo", wo_obj}}, shape);
+    const double *wi = arrays[0].data(), *wo = arrays[1].data();
+    const py::ssize_t n = arrays[0].shape(0);
+    py::array_t<double> out = shaped(shape, 3);
+    double* f = out.mutable_data();
+    {
+        py::gil_scoped_release release;
+#pragma omp parallel for schedule(static)
+        for (py::ssize_t k = 0; k < n; ++k) {
+            const Vec3d a = vec_at(wi, k), b = vec_at(wo, k);
+            const Rgbd v = a.z > 0 ? m.model->eval(a, b) : Rgbd(0.0);
+            for (int c = 0; c < 3; ++c)
+                f[3 * k + c] = v[c];
+        }
+    }
+    return out;
+}
+
+void require_sampling(const PyModel& m) {
+    if (!m.model->has_sampling())
+        throw py::attribute_error(fmt::format(
+            "model '{}' has no importance sampling (Model.has_sampling is False)", m.name));
+}
+
+py::tuple model_sample(const PyModel& m, py::handle wi_obj, py::handle u_obj) {
+    require_sampling(m);
+    const py::object np = py::module_::import("numpy");
+    py::array u_in = np.attr("asarray")(u_obj, py::arg("dtype") = "float64");
+    if (u_in.ndim() < 1 || u_in.shape(u_in.ndim() - 1) != 3)
+        throw InputError("arguments", "u", "expected an array of 3 uniforms in [0, 1) per sample");
+    std::vector<py::ssize_t> shape;
+    // The uniforms are not directions: broadcast them with wi by hand.
+    py::tuple b = np.attr("broadcast_arrays")(np.attr("asarray")(wi_obj, "float64"), u_in);
+    auto arrays = broadcast_directions({{"wi", b[0]}}, shape);
+    py::array_t<double, py::array::c_style | py::array::forcecast> u =
+        np.attr("ascontiguousarray")(b[1]).attr("reshape")(-1, 3);
+    const double *wi = arrays[0].data(), *ud = u.data();
+    const py::ssize_t n = arrays[0].shape(0);
+    for (py::ssize_t k = 0; k < 3 * n; ++k)
+        if (!(ud[k] >= 0 && ud[k] < 1))
+            throw InputError("arguments", "u", fmt::format("{} is outside [0, 1)", ud[k]));
+    py::array_t<double> wo = shaped(shape, 3), weight = shaped(shape, 3), pdf = shaped(shape, 0);
+    py::array_t<bool> valid(shape);
+    double *wo_p = wo.mutable_data(), *w_p = weight.mutable_data(), *pdf_p = pdf.mutable_data();
+    bool* ok = valid.mutable_data();
+    {
+        py::gil_scoped_release release;
+#pragma omp parallel for schedule(static)
+        for (py::ssize_t k = 0; k < n; ++k) {
+            const Vec3d a = vec_at(wi, k);
+            const std::optional<ModelSample> s =
+                a.z > 0 ? m.model->sample(a, vec_at(ud, k)) : std::nullopt;
+            ok[k] = bool(s);
+            const ModelSample v = s.value_or(ModelSample{Vec3d(0, 0, 0), Rgbd(0.0), 0.0});
+            for (int c = 0; c < 3; ++c) {
+                wo_p[3 * k + c] = c == 0 ? v.wo.x : c == 1 ? v.wo.y : v.wo.z;
+                w_p[3 * k + c] = v.weight[c];
+            }
+            pdf_p[k] = v.pdf;
+        }
+    }
+    return py::make_tuple(wo, weight, pdf, valid);
+}
+
+py::array_t<double> model_pdf(const PyModel& m, py::handle wi_obj, py::handle wo_obj) {
+    require_sampling(m);
+    std::vector<py::ssize_t> shape;
+    auto arrays = broadcast_directions({{"wi", wi_obj}, {"wo", wo_obj}}, shape);
+    const double *wi = arrays[0].data(), *wo = arrays[1].data();
+    const py::ssize_t n = arrays[0].shape(0);
+    py::array_t<double> out = shaped(shape, 0);
+    double* p = out.mutable_data();
+    {
+        py::gil_scoped_release release;
+#pragma omp parallel for schedule(static)
+        for (py::ssize_t k = 0; k < n; ++k) {
+            const Vec3d a = vec_at(wi, k);
+            p[k] = a.z > 0 ? m.model->pdf(a, vec_at(wo, k)) : 0.0;
+        }
+    }
+    return out;
+}
+
+py::dict support_of(const Support& s) {
+    py::dict d;
+    d["brdf"] = s.brdf;
+    d["btdf"] = s.btdf;
+    d["reason"] = s.reason;
+    return d;
+}
+
+/// A table from numpy: f [n_inc, n_sides, n_theta, n_phi, 3] for `sides` ("R", "T"), se = 0.
+BinnedTable table_from_arrays(py::array_t<double, py::array::c_style | py::array::forcecast> f,
+                              const std::vector<double>& theta_i,
+                              const std::vector<std::string>& sides) {
+    if (f.ndim() != 5 || f.shape(4) != 3 || std::size_t(f.shape(0)) != theta_i.size() ||
+        std::size_t(f.shape(1)) != sides.size())
+        throw InputError("arguments", "f",
+                         "expected f of shape [incidence, side, θ bin, φ bin, 3] matching theta_i "
+                         "and sides");
+    bool r = false, t = false;
+    for (const std::string& side : sides) {
+        if (side != "R" && side != "T") throw InputError("arguments", "sides", "'R' or 'T'");
+        (side == "R" ? r : t) = true;
+    }
+    if (sides.size() == 2 && sides[0] != "R")
+        throw InputError("arguments", "sides", "use the order ['R', 'T']");
+    const HemisphereGrid grid = grid_of({int(f.shape(2)), int(f.shape(3))});
+    BinnedTable table = BinnedTable::zeros(grid, theta_i, r, t);
+    const double* p = f.data();
+    for (std::size_t i = 0; i < theta_i.size(); ++i)
+        for (const std::string& side : sides) {
+            BinnedLobe& lobe = table.lobe(i, side == "R" ? Side::Reflection : Side::Transmission);
+            for (std::size_t j = 0; j < grid.size(); ++j)
+                for (int c = 0; c < 3; ++c) {
+                    const double v = *p++;
+                    if (!std::isfinite(v))
+                        throw InputError(
+                            "arguments", "f",
+                            fmt::format("a value at θi = {}° is not finite", theta_i[i]));
+                    lobe.f[j][c] = v;
+                }
+        }
+    return table;
+}
+
+/// lamina.study / lamina.compare: run_study with Python models as external tables, then the
+/// explorer and the figures. `externals`: [(name, fn(config_id, stack) -> Table | None)].
+void run_study_py(py::list configs_in, py::dict settings, py::list externals,
+                  const std::filesystem::path& out, bool figures) {
+    std::vector<StudyConfiguration> configs;
+    for (py::handle c : configs_in) {
+        StudyConfiguration sc;
+        sc.id = c["id"].cast<std::string>();
+        sc.category = c["category"].cast<std::string>();
+        sc.stack = stack_of(c["stack"]);
+        sc.parameters = describe_parameters(sc.stack);
+        configs.push_back(std::move(sc));
+    }
+    StudySettings s;
+    s.particles = settings["particles"].cast<std::uint64_t>();
+    s.preset = settings["preset"].cast<std::string>();
+    s.seed = settings["seed"].cast<std::uint64_t>();
+    s.theta_i_deg = incidences_of(settings["theta_i"]);
+    s.grid = grid_of(settings["grid"].cast<std::pair<int, int>>());
+    s.models = settings["models"].cast<std::vector<std::string>>();
+    s.threads = settings["threads"].cast<int>();
+    s.kernel = parse_kernel(settings["kernel"].cast<std::string>(), "kernel");
+    s.microsurface =
+        parse_microsurface(settings["microsurface"].cast<std::string>(), "microsurface");
+    if (s.microsurface == Microsurface::Multiple && s.kernel == Kernel::Simd)
+        throw InputError("arguments", "microsurface",
+                         "multiple scattering on the microsurfaces runs on the scalar kernel only: "
+                         "add kernel='scalar'");
+    s.quiet = settings["quiet"].cast<bool>();
+    s.registry_models = settings["registry_models"].cast<bool>();
+    for (py::handle e : externals) {
+        ExternalModel m;
+        m.name = e[py::int_(0)].cast<std::string>();
+        m.source = "Python model '" + m.name + "'";
+        py::object fn = py::reinterpret_borrow<py::object>(e[py::int_(1)]);
+        m.table = [fn](const StudyConfiguration& c) {
+            py::gil_scoped_acquire gil;
+            py::object t = fn(c.id, c.stack);
+            if (t.is_none()) {
+                BinnedTable none;
+                none.has_reflection = false;
+                return none;
+            }
+            return t.cast<BinnedTable>();
+        };
+        s.external_models.push_back(std::move(m));
+    }
+    {
+        py::gil_scoped_release release;
+        run_study(configs, s, out);
+        write_explorer(out);
+        if (figures) {
+            try {
+                write_figures(out);
+            } catch (const InputError& e) {
+                py::gil_scoped_acquire gil;
+                PyErr_WarnEx(PyExc_RuntimeWarning,
+                             (std::string("figures not written: ") + e.what()).c_str(), 1);
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace lamina
+
+PYBIND11_MODULE(_lamina, m) {
+    using namespace lamina;
+    m.doc() = "lamina's compiled core (use the lamina package, docs/python.md)";
+
+    g_input_error = PyErr_NewExceptionWithDoc(
+        "lamina.InputError",
+        "Bad input, as the lamina CLI reports it: .file (or 'command line', 'arguments', "
+        "'<dict>'), .field (a JSON pointer or an argument name) and .problem (what is wrong and "
+        "what is allowed).",
+        PyExc_ValueError, nullptr);
+    m.attr("InputError") = py::handle(g_input_error);
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const InputError& e) {
+            py::object exc = py::handle(g_input_error)(e.what());
+            exc.attr("file") = e.where();
+            exc.attr("field") = e.field();
+            exc.attr("problem") = e.problem();
+            PyErr_SetObject(g_input_error, exc.ptr());
+        }
+    });
+
+    m.attr("kernel_description") = py::cpp_function(
+        [](const std::string& k) { return kernel_description(parse_kernel(k, "kernel")); });
+
+    // ---- Stack ----
+    py::class_<Stack>(m, "Stack", "A layer stack (docs/stack-format.md)")
+        .def(py::init([](py::handle source) { return stack_of(source); }), py::arg("source"),
+             "From a dict in the stack format or a path to a stack JSON file; lamina.InputError "
+             "names the file, the field and what is allowed")
+        .def_property_readonly("name", [](const Stack& s) { return s.name; })
+        .def_property_readonly("transmits", &Stack::transmits,
+                               "True for slabs (a dielectric base): the stack has a BTDF")
+        .def(
+            "to_dict", [](const Stack& s) { return python_of(stack_to_json(s)); },
+            "The canonical stack JSON as a dict (Stack(s.to_dict()) == s)")
+        .def("describe", [](const Stack& s) { return describe(s); })
+        .def("__eq__", [](const Stack& a, const Stack& b) { return a == b; })
+        .def("__repr__", [](const Stack& s) { return "<lamina.Stack " + describe(s) + ">"; });
+
+    // ---- Table ----
+    py::class_<BinnedTable>(m, "Table",
+                            "Binned BRDF/BTDF: cos-weighted bin averages, the brdf.csv format")
+        .def_static(
+            "from_csv",
+            [](const std::filesystem::path& path) {
+                std::ifstream in(path, std::ios::binary);
+                if (!in) throw InputError(path.string(), "", "cannot read the file");
+                std::string text((std::istreambuf_iterator<char>(in)), {});
+                return BinnedTable::from_csv(text, path.string());
+            },
+            py::arg("path"))
+        .def_static("from_arrays", &table_from_arrays, py::arg("f"), py::arg("theta_i"),
+                    py::arg("sides") = std::vector<std::string>{"R"},
+                    "A table from f [incidence, side, θ bin, φ bin, 3] (1/sr, cos-weighted bin "
+                    "averages; se = 0), e.g. to write a --model-table CSV with to_csv()")
+        .def_property_readonly(
+            "f", [](const BinnedTable& t) { return lobes_array(t, false); },
+            "f [incidence, side, θ bin, φ bin, channel], 1/sr")
+        .def_property_readonly(
+            "se", [](const BinnedTable& t) { return lobes_array(t, true); },
+            "standard errors, same shape (0 for deterministic models)")
+        .def_property_readonly("theta_i", [](const BinnedTable& t) { return t.theta_i_deg; })
+        .def_property_readonly("sides", [](const BinnedTable& t) { return sides_of(t); })
+        .def_property_readonly(
+            "grid",
+            [](const BinnedTable& t) { return std::make_pair(t.grid.n_theta(), t.grid.n_phi()); })
+        .def_property_readonly(
+            "theta_edges", [](const BinnedTable& t) { return edges_deg(t.grid.n_theta(), 90); },
+            "θ bin edges, degrees")
+        .def_property_readonly(
+            "phi_edges", [](const BinnedTable& t) { return edges_deg(t.grid.n_phi(), 180); },
+            "φ bin edges, degrees (folded: each bin covers ±φ)")
+        .def_property_readonly(
+            "projected_solid_angle",
+            [](const BinnedTable& t) {
+                py::array_t<double> a({t.grid.n_theta(), t.grid.n_phi()});
+                for (std::size_t j = 0; j < t.grid.size(); ++j)
+                    a.mutable_data()[j] = t.grid.projected_solid_angle(j);
+                return a;
+            },
+            "Ω⊥ of each bin [θ bin, φ bin], sr (both folded halves)")
+        .def("to_csv", &BinnedTable::to_csv, "The brdf.csv text")
+        .def("__repr__", [](const BinnedTable& t) {
+            return fmt::format("<lamina.Table {} incidences, sides {}, grid {}>",
+                               t.theta_i_deg.size(), t.has_transmission ? "R, T" : "R",
+                               t.grid.to_string());
+        });
+
+    // ---- simulate ----
+    py::class_<PySimulation>(m, "SimulationResult", "A goniophotometer run (lamina simulate)")
+        .def_property_readonly("stack", [](const PySimulation& r) { return r.stack; })
+        .def_property_readonly("table", [](const PySimulation& r) { return r.result.table; })
+        .def_property_readonly(
+            "f", [](const PySimulation& r) { return lobes_array(r.result.table, false); })
+        .def_property_readonly(
+            "se", [](const PySimulation& r) { return lobes_array(r.result.table, true); })
+        .def_property_readonly("theta_i",
+                               [](const PySimulation& r) { return r.result.settings.theta_i_deg; })
+        .def_property_readonly("sides",
+                               [](const PySimulation& r) { return sides_of(r.result.table); })
+        .def_property_readonly(
+            "theta_edges",
+            [](const PySimulation& r) { return edges_deg(r.result.settings.grid.n_theta(), 90); })
+        .def_property_readonly(
+            "phi_edges",
+            [](const PySimulation& r) { return edges_deg(r.result.settings.grid.n_phi(), 180); })
+        .def_property_readonly(
+            "energy",
+            [](const PySimulation& r) {
+                py::dict d;
+                const std::size_t n = r.result.incidences.size();
+                auto add = [&](const char* name, auto get) {
+                    py::array_t<double> a({n, std::size_t(3)});
+                    for (std::size_t i = 0; i < n; ++i)
+                        for (int c = 0; c < 3; ++c)
+                            a.mutable_data()[3 * i + c] = get(r.result.incidences[i].budget)[c];
+                    d[name] = a;
+                };
+                for (int t = 0; t < kBudgetTerms; ++t)
+                    add(kBudgetTermNames[t], [t](const EnergyBudget& b) { return b.term[t]; });
+                add("reflected_se", [](const EnergyBudget& b) { return b.reflected_se; });
+                add("transmitted_se", [](const EnergyBudget& b) { return b.transmitted_se; });
+                return d;
+            },
+            "Energy budget terms, each [incidence, channel] (fractions of the incident flux)")
+        .def_property_readonly(
+            "info", [](const PySimulation& r) { return python_of(result_json(r.stack, r.result)); },
+            "result.json as a dict")
+        .def(
+            "write",
+            [](const PySimulation& r, const std::filesystem::path& dir) {
+                write_simulation(dir, r.stack, r.result);
+            },
+            py::arg("dir"), "Writes DIR/{brdf.csv,energy.csv,result.json} as lamina simulate does")
+        .def("__repr__", [](const PySimulation& r) {
+            return fmt::format("<lamina.SimulationResult {}: {} incidences × {} particles>",
+                               r.stack.name, r.result.settings.theta_i_deg.size(),
+                               r.result.settings.particles);
+        });
+
+    m.def(
+        "_simulate",
+        [](py::handle stack_obj, py::handle theta_i, double particles, std::uint64_t seed,
+           int threads, std::pair<int, int> grid, const std::string& kernel,
+           const std::string& microsurface, int max_events, bool progress) {
+            SimulationSettings s;
+            s.theta_i_deg = incidences_of(theta_i);
+            if (!(particles >= 1 && particles <= 1e15 && particles == std::floor(particles)))
+                throw InputError("arguments", "particles",
+                                 fmt::format("{} is not allowed: expected a whole number in "
+                                             "[1, 1e15]",
+                                             particles));
+            s.particles = std::uint64_t(particles);
+            s.seed = seed;
+            s.threads = threads;
+            s.grid = grid_of(grid);
+            s.kernel = parse_kernel(kernel, "kernel");
+            s.microsurface = parse_microsurface(microsurface, "microsurface");
+            s.max_events = max_events;
+            PySimulation r{stack_of(stack_obj), {}};
+            r.result = simulate_interruptible(r.stack, s, progress);
+            return r;
+        },
+        py::arg("stack"), py::arg("theta_i"), py::arg("particles"), py::arg("seed"),
+        py::arg("threads"), py::arg("grid"), py::arg("kernel"), py::arg("microsurface"),
+        py::arg("max_events"), py::arg("progress"));
+
+    m.def(
+        "_export",
+        [](py::object source, const std::filesystem::path& path, const std::string& format,
+           std::vector<double> theta_i, int resolution, const std::string& description) {
+            // source: a Model or a Table (its reflection side).
+            BrdfSource brdf;
+            if (py::isinstance<PyModel>(source)) {
+                const PyModel& pm = source.cast<const PyModel&>();
+                auto model = std::shared_ptr<const Model>(
+                    find_model(pm.name, "name").make(pm.stack, pm.options));
+                brdf = model_brdf(model, pm.name);
+            } else {
+                brdf = table_brdf(source.cast<const BinnedTable&>(), "table", "table");
+            }
+            std::string bytes;
+            {
+                py::gil_scoped_release release;
+                if (format == "bsdf") {
+                    RglOptions o;
+                    o.theta_i_deg = theta_i;
+                    o.resolution = resolution;
+                    o.description = description;
+                    const TensorFile file = rgl_bsdf(brdf, o);
+                    check_rgl_bsdf(file, path.string());
+                    bytes = tensor_file_bytes(file);
+                } else if (format == "merl") {
+                    bytes = merl_binary(brdf);
+                } else {
+                    throw InputError("arguments", "format", "'bsdf' or 'merl'");
+                }
+                write_file_atomic(path, bytes);
+            }
+        },
+        py::arg("source"), py::arg("path"), py::arg("format"), py::arg("theta_i"),
+        py::arg("resolution"), py::arg("description"));
+    m.def("_table_from_arrays", &table_from_arrays, py::arg("f"), py::arg("theta_i"),
+          py::arg("sides"));
+    m.def("_run_study", &run_study_py, py::arg("configs"), py::arg("settings"),
+          py::arg("externals"), py::arg("out"), py::arg("figures"));
+    m.def("_builtin_configurations", [] {
+        py::list out;
+        for (const StudyConfiguration& c : builtin_configurations()) {
+            py::dict d;
+            d["id"] = c.id;
+            d["category"] = c.category;
+            d["stack"] = c.stack;
+            out.append(d);
+        }
+        return out;
+    });
+    m.def("_filter_configurations", [](py::list configs, const std::string& pattern) {
+        // Filters by id with the CLI's --only rule (globs, commas).
+        std::vector<StudyConfiguration> cs;
+        for (py::handle c : configs) {
+            StudyConfiguration sc;
+            sc.id = c["id"].cast<std::string>();
+            cs.push_back(sc);
+        }
+        std::vector<std::string> keep;
+        for (const StudyConfiguration& c : filter_configurations(cs, pattern))
+            keep.push_back(c.id);
+        return keep;
+    });
+
+    // ---- models ----
+    m.def(
+        "models",
+        [] {
+            py::list out;
+            for (const ModelEntry& e : model_registry()) {
+                py::list options;
+                for (const OptionSpec& o : e.options()) {
+                    py::dict d;
+                    d["key"] = o.key;
+                    d["values"] = o.values;
+                    d["default"] = o.default_value;
+                    d["help"] = o.help;
+                    options.append(d);
+                }
+                py::dict d;
+                d["name"] = e.name;
+                d["description"] = e.description;
+                d["supports"] = e.supports;
+                d["stochastic"] = e.stochastic;
+                d["options"] = options;
+                out.append(d);
+            }
+            return out;
+        },
+        "Every model of the registry (lamina models): name, description, supports, options");
+
+    py::class_<PyModel>(m, "Model", "An analytic layered model for one stack (docs/models.md)")
+        .def(py::init([](const std::string& name, py::handle stack, py::kwargs kwargs) {
+                 auto pm = std::make_unique<PyModel>();
+                 const ModelEntry& entry = find_model(name, "name");
+                 std::vector<std::string> assignments;
+                 for (auto [k, v] : kwargs)
+                     assignments.push_back(py::str(k).cast<std::string>() + "=" + option_text(v));
+                 pm->name = name;
+                 pm->stack = stack_of(stack);
+                 pm->options = resolve_options(entry, assignments, "options");
+                 pm->model = entry.make(pm->stack, pm->options);
+                 return pm;
+             }),
+             py::arg("name"), py::arg("stack"))
+        .def_property_readonly("name", [](const PyModel& m) { return m.name; })
+        .def_property_readonly("stack", [](const PyModel& m) { return m.stack; })
+        .def_property_readonly("options", [](const PyModel& m) { return m.options; })
+        .def_property_readonly("support",
+                               [](const PyModel& m) { return support_of(m.model->support()); })
+        .def_property_readonly("has_sampling",
+                               [](const PyModel& m) { return m.model->has_sampling(); })
+        .def("eval", &model_eval, py::arg("wi"), py::arg("wo"),
+             "f(wi, wo) in 1/sr (no cosine, delta lobes excluded), broadcast over [..., 3] "
+             "arrays of unit vectors; [..., 3] RGB. Zero where wi.z <= 0 or on an unsupported side")
+        .def("sample", &model_sample, py::arg("wi"), py::arg("u"),
+             "Importance sampling: (wo, weight = f|cos θo|/pdf, pdf, valid) for uniforms u "
+             "[..., 3] in [0, 1)")
+        .def("pdf", &model_pdf, py::arg("wi"), py::arg("wo"), "Density of sample() (1/sr)")
+        .def(
+            "delta_lobes",
+            [](const PyModel& m, std::array<double, 3> wi) {
+                py::list out;
+                for (const DeltaLobe& d : m.model->delta_lobes({wi[0], wi[1], wi[2]}))
+                    out.append(py::make_tuple(
+                        std::array<double, 3>{d.direction.x, d.direction.y, d.direction.z},
+                        std::array<double, 3>{d.energy[0], d.energy[1], d.energy[2]}));
+                return out;
+            },
+            py::arg("wi"), "Delta lobes for one wi: [(direction, energy RGB)]")
+        .def(
+            "peak_directions",
+            [](const PyModel& m, std::array<double, 3> wi) {
+                std::vector<std::array<double, 3>> out;
+                for (const Vec3d& d : m.model->peak_directions({wi[0], wi[1], wi[2]}))
+                    out.push_back({d.x, d.y, d.z});
+                return out;
+            },
+            py::arg("wi"))
+        .def(
+            "binned",
+            [](const PyModel& m, py::handle theta_i, std::pair<int, int> grid) {
+                const std::vector<double> thetas = incidences_of(theta_i);
+                const HemisphereGrid g = grid_of(grid);
+                const Support s = m.model->support();
+                if (!s.brdf && !s.btdf)
+                    throw InputError("arguments", "name", "not supported: " + s.reason);
+                py::gil_scoped_release release;
+                return bin_model(*m.model, g, thetas);
+            },
+            py::arg("theta_i") = std::vector<double>{0, 15, 30, 45, 60, 70, 80},
+            py::arg("grid") = std::make_pair(90, 90),
+            "Cos-weighted bin averages on the goniophotometer's bins (lamina eval --binned)")
+        .def(
+            "albedo",
+            [](const PyModel& m, py::handle theta_i, const std::string& side) {
+                const std::vector<double> thetas = incidences_of(theta_i);
+                if (side != "R" && side != "T")
+                    throw InputError("arguments", "side", "must be 'R' or 'T'");
+                const bool scalar =
+                    py::isinstance<py::float_>(theta_i) || py::isinstance<py::int_>(theta_i);
+                py::array_t<double> out(std::vector<py::ssize_t>{py::ssize_t(thetas.size()), 3});
+                {
+                    py::gil_scoped_release release;
+                    for (std::size_t i = 0; i < thetas.size(); ++i) {
+                        const Rgbd a =
+                            model_albedo(*m.model, incident_direction(deg_to_rad(thetas[i])),
+                                         side == "R" ? Side::Reflection : Side::Transmission);
+                        for (int c = 0; c < 3; ++c)
+                            out.mutable_data()[3 * i + c] = a[c];
+                    }
+                }
+                if (scalar) return py::array_t<double>(out.attr("reshape")(3));
+                return out;
+            },
+            py::arg("theta_i"), py::arg("side") = "R",
+            "Directional albedo ∫ f |cos θo| dωo (RGB) of one side, delta lobes included")
+        .def("__repr__", [](const PyModel& m) {
+            return fmt::format("<lamina.Model {} on {}>", m.name, m.stack.name);
+        });
+}
