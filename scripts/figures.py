@@ -182,7 +182,8 @@ def slice_figure(args):
     centres = (np.arange(T) + 0.5) * 90.0 / T
     x = np.concatenate([-centres[::-1], centres])  # negative: the light's side (φ bin 0)
     incs = pick_incidences(study.theta_i)
-    models = [m for m in cfg["sources"][1:]]
+    # Ablations (NAME:KEY=VALUE) stay in the error matrix; the slices show the models as shipped.
+    models = [m for m in cfg["sources"][1:] if ":" not in m]
     for d, side in enumerate(cfg["sides"]):
         ns = [m for m in models if not supported(cfg, m, side)]
         top = 0.55 + (0.17 if ns else 0.0)  # inches above the panels: title, channel names
@@ -204,9 +205,9 @@ def slice_figure(args):
                                     label="reference ±2·se")
                 ax.plot(x, ref, color="k", lw=1.4, label="reference")
                 top = np.nanmax(ref) if np.any(ref > 0) else 0.0
-                for k, m in enumerate(models):
+                for m in models:
                     if supported(cfg, m, side):
-                        f = plane(k + 1)
+                        f = plane(cfg["sources"].index(m))
                         ax.plot(x, f, color=model_color(m, study.models), label=m,
                                 ls=model_dash(m))
                         if np.any(f > 0):
@@ -329,7 +330,7 @@ def albedo_curves(study, formats, cache):
                             capsize=1.5, elinewidth=0.6,
                             label="reference ±2·se" + (" (T dotted)" if side == "T" else ""))
                 for k, m in enumerate(cfg["sources"][1:]):
-                    if supported(cfg, m, side):
+                    if supported(cfg, m, side) and ":" not in m:
                         ax.plot(study.theta_i, alb[k + 1], color=model_color(m, study.models),
                                 ls=model_dash(m) if side == "R" else ":", lw=0.9, label=m)
             # What the reference loses to its single-scattering microsurfaces (config.json energy):

@@ -88,8 +88,12 @@ Rgbd eval_at(const Model& model, double theta_i, double theta_o, double phi_o, S
 }
 
 int run_eval(const EvalArgs& a) {
-    const ModelEntry& entry = find_model(a.model);
-    const ModelOptions options = resolve_options(entry, a.options);
+    // NAME or NAME:KEY=VALUE... (the study's ablation names); --option adds to the flags.
+    const ModelSpec spec = parse_model_spec(a.model);
+    const ModelEntry& entry = *spec.entry;
+    std::vector<std::string> assignments = spec.assignments;
+    assignments.insert(assignments.end(), a.options.begin(), a.options.end());
+    const ModelOptions options = resolve_options(entry, assignments);
     const int modes = int(a.binned) + int(!a.directions.empty());
     if (modes > 1)
         throw InputError("command line", "--binned",

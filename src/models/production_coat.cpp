@@ -5,6 +5,7 @@
 #include "models/quadrature.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
+#include "physics/sampling.h"
 
 #include <fmt/format.h>
 
@@ -206,7 +207,56 @@ class ProductionCoat final : public Model {
         return lobes;
     }
 
+    /// Importance sampling: the coat lobe's visible normals (Heitz 2018) with probability p_c,
+    /// else the base (its GGX visible normals, or the cosine for a Lambertian). p_c is the coat's
+    /// Fresnel at μi (clamped to [0.1, 0.9]), 0 when the coat is smooth (a delta lobe, not
+    /// sampled here), 1 when the base is a smooth metal.
+    bool has_sampling() const override { return support_.brdf && sampled_lobes() > 0; }
+
+    std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override {
+        if (!has_sampling() || wi.z <= 0) return std::nullopt;
+        const double p_c = coat_probability(wi);
+        Vec3d wo;
+        if (u.z < p_c) {
+            const GGX<double> ggx{alpha_coat_};
+            wo = reflect(wi, ggx.sample_visible_normal(wi, u.x, u.y));
+        } else if (is_metal_) {
+            const GGX<double> ggx{alpha_base_};
+            wo = reflect(wi, ggx.sample_visible_normal(wi, u.x, u.y));
+        } else {
+            wo = sample_cosine_hemisphere(u.x, u.y);
+        }
+        if (wo.z <= 0) return std::nullopt;
+        const double density = pdf(wi, wo);
+        if (!(density > 0)) return std::nullopt;
+        return ModelSample{wo, eval(wi, wo) * (wo.z / density), density};
+    }
+
+    double pdf(const Vec3d& wi, const Vec3d& wo) const override {
+        if (!has_sampling() || wi.z <= 0 || wo.z <= 0) return 0;
+        const double p_c = coat_probability(wi);
+        const Vec3d h = normalize(wi + wo);
+        const double jacobian = 1 / (4 * dot(wo, h));  // dωh/dωo for reflection
+        double p = 0;
+        if (p_c > 0) p += p_c * GGX<double>{alpha_coat_}.pdf_visible_normal(wi, h) * jacobian;
+        if (p_c < 1) {
+            if (is_metal_)
+                p += (1 - p_c) * GGX<double>{alpha_base_}.pdf_visible_normal(wi, h) * jacobian;
+            else
+                p += (1 - p_c) * pdf_cosine_hemisphere(wo);
+        }
+        return p;
+    }
+
   private:
+    int sampled_lobes() const { return int(alpha_coat_ > 0) + int(!is_metal_ || alpha_base_ > 0); }
+
+    double coat_probability(const Vec3d& wi) const {
+        if (alpha_coat_ <= 0) return 0;
+        if (is_metal_ && alpha_base_ <= 0) return 1;
+        return clamp(coat_fresnel(wi.z), 0.1, 0.9);
+    }
+
     bool uses_albedo() const {
         using A = CoatRecipe::Attenuation;
         return r_.attenuation == A::AlbedoView || r_.attenuation == A::AlbedoReciprocal ||

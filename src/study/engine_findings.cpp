@@ -177,6 +177,28 @@ std::string albedo_words(const std::vector<double>& theta, const std::vector<dou
                        signed_pct(err[ihi]), theta[ilo], signed_pct(err[ilo]));
 }
 
+/// What an ablation says: switching a heuristic off (`=off`) that raises the error means the
+/// heuristic helps; switching one on that lowers it means it would help; `leaves=exact` measures
+/// the leaves' error; any other switch is reported as the change it makes.
+std::string switch_effect(const EngineFindings::Ablation& a) {
+    const double d = a.switched - a.shipped;
+    const std::string points = fmt::format("{:.1f} points", 100 * std::abs(d));
+    if (std::abs(d) < 0.001) return "no change (< 0.1 point)";
+    const std::string value = a.flag.substr(a.flag.find('=') + 1);
+    const std::string key = a.flag.substr(0, a.flag.find('='));
+    if (key == "leaves")
+        return d < 0 ? fmt::format("the shipped leaves cost {}", points)
+                     : fmt::format("the shipped leaves gain {} (errors that cancel)", points);
+    if (value == "off")
+        return d > 0 ? fmt::format("**{} helps** ({} without it)", key, points)
+                     : fmt::format("**{} hurts** ({} better without it)", key, points);
+    if (value == "on" || value == "1")
+        return d < 0 ? fmt::format("**{} would help** ({} better)", key, points)
+                     : fmt::format("{} would hurt ({} worse)", key, points);
+    return d < 0 ? fmt::format("`{}` is better by {}", a.flag, points)
+                 : fmt::format("`{}` is worse by {}", a.flag, points);
+}
+
 }  // namespace
 
 std::string engine_findings_markdown(const EngineFindings& f) {
@@ -219,8 +241,8 @@ std::string engine_findings_markdown(const EngineFindings& f) {
             out("- **{}**: {}; misplaces {} of the reflected energy.\n", cell->model,
                 albedo_words(f.theta_i, cell->albedo_error), pct(cell->mean_misplaced));
         if (f.best_production.count(c))
-            out("- Most accurate production coat here: **{}** ({}); best of every model: {} "
-                "({}).\n",
+            out("- Most accurate production coat here: **{}** ({}); best of every model run "
+                "(ablations included): {} ({}).\n",
                 f.best_production.at(c), pct(f.best_production_error.at(c)), f.best_overall.at(c),
                 pct(f.best_overall_error.at(c)));
         bool any = false;
@@ -228,18 +250,12 @@ std::string engine_findings_markdown(const EngineFindings& f) {
             if (a.category != c) continue;
             if (!any) {
                 out("\nHeuristics and leaves (mean misplaced energy; mean |albedo error|):\n\n"
-                    "| model | switched | as shipped | switched | effect of the switch |\n"
+                    "| model | switched | as shipped | switched | what it says |\n"
                     "|---|---|---|---|---|\n");
                 any = true;
             }
-            const double d = a.switched - a.shipped;
-            const std::string effect =
-                std::abs(d) < 0.001 ? "no change (< 0.1 point)"
-                : d < 0
-                    ? fmt::format("lowers the error by {} points", fmt::format("{:.1f}", -100 * d))
-                    : fmt::format("raises the error by {} points", fmt::format("{:.1f}", 100 * d));
             out("| {} | `{}` | {}; {} | {}; {} | {} |\n", a.model, a.flag, pct(a.shipped),
-                pct(a.shipped_albedo), pct(a.switched), pct(a.switched_albedo), effect);
+                pct(a.shipped_albedo), pct(a.switched), pct(a.switched_albedo), switch_effect(a));
         }
         out("\n");
     }

@@ -69,6 +69,11 @@ if "$lamina" validate "$tmp/gold.json" >/dev/null 2>&1; then
     # A production coat with a flag, and a flag it does not have.
     check production 0 "$lamina" eval --model openpbr --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180 --option darkening=off --option leaves=exact
     expect_output production-three-numbers "^[0-9.e+-]* [0-9.e+-]* [0-9.e+-]*$"
+    # The study's ablation names work too, and give the same value as --option.
+    "$lamina" eval --model openpbr --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180 --option darkening=off >"$tmp/a1" 2>&1
+    "$lamina" eval --model openpbr:darkening=off --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180 >"$tmp/a2" 2>&1
+    if cmp -s "$tmp/a1" "$tmp/a2" && grep -q "^[0-9]" "$tmp/a1"; then pass=$((pass + 1)); else
+        echo "FAIL spec name: '$(cat "$tmp/a2")' vs '$(cat "$tmp/a1")'"; fails=$((fails + 1)); fi
     check production-bad-flag 1 "$lamina" eval --model filament --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180 --option darkening=off
     expect_output production-bad-flag-lists "its options: attenuation, roughening, f0-conversion, leaves"
 else

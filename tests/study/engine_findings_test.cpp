@@ -80,11 +80,11 @@ TEST(EngineFindings, MarkdownReadsAsFindings) {
     EXPECT_NE(md.find("**openpbr**: too dark, most at -10.0% at 60°"), std::string::npos) << md;
     EXPECT_NE(md.find("**filament**: too bright, most at +20.0% at 0°"), std::string::npos) << md;
     EXPECT_NE(md.find("Most accurate production coat here: **openpbr** (20.0%); best of every "
-                      "model: ww-prime (5.0%)"),
+                      "model run (ablations included): ww-prime (5.0%)"),
               std::string::npos)
         << md;
-    EXPECT_NE(md.find("`darkening=off` | 20.0%; 5.0% | 30.0%; 2.5% | raises the error by 10.0 "
-                      "points"),
+    EXPECT_NE(md.find("`darkening=off` | 20.0%; 5.0% | 30.0%; 2.5% | **darkening helps** (10.0 "
+                      "points without it)"),
               std::string::npos)
         << md;
     EXPECT_NE(md.find("No production coat supports this category"), std::string::npos);

@@ -103,5 +103,29 @@ for e in json.load(open(d + "/configs/plastic-P1-a0.05/config.json"))["energy"]:
     assert e["lost_microsurface"] == [0, 0, 0], e
 PY
 
+# 8. Production coats and their ablations: NAME:KEY=VALUE in --models, --ablations adds each
+#    one-flag variant; study.json names their groups; the summary has the engine developers'
+#    section with the ablation's row.
+ab=(--only 'plastic-P1-a0.05' --models ww-prime,gltf-clearcoat,openpbr:darkening=off
+    --theta-i 60 --particles 2e4 --grid 18x18 --no-figures)
+"$lamina" study "${ab[@]}" --ablations --out "$tmp/p" >/dev/null 2>&1 && ok || fail "ablation study"
+python3 - "$tmp/p" <<'PY' && ok || fail "ablation outputs"
+import json, sys
+d = sys.argv[1]
+s = json.load(open(d + "/study.json"))
+assert s["models"] == ["ww-prime", "gltf-clearcoat", "openpbr:darkening=off",
+                       "gltf-clearcoat:coat-fresnel=h", "gltf-clearcoat:leaves=exact"], s["models"]
+assert s["model_groups"] == {"ww-prime": "2019", "gltf-clearcoat": "production",
+                             "openpbr:darkening=off": "ablations",
+                             "gltf-clearcoat:coat-fresnel=h": "ablations",
+                             "gltf-clearcoat:leaves=exact": "ablations"}, s["model_groups"]
+e = json.load(open(d + "/summary.json"))["engine_developers"]["categories"]["plastic"]
+assert e["most_accurate_production"] == "gltf-clearcoat", e
+assert [a["flag"] for a in e["ablations"]] == ["coat-fresnel=h", "leaves=exact"], e["ablations"]
+PY
+grep -q '^## For engine developers' "$tmp/p/summary.md" && ok || fail "engine developers section"
+expect_error "model 'openpbr' has no option 'tint'" study --models openpbr:tint=off \
+    --only 'plastic-P1-a0.05' --out "$tmp/x"
+
 echo "$pass passed, $fails failed"
 [ "$fails" -eq 0 ]
