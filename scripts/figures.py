@@ -94,7 +94,10 @@ def save(fig, path_stem, formats, tight=True):
 
 
 def omega_perp(n_theta, n_phi):
-    """Ω⊥ of the folded grid's bins (docs/formats.md), shape [n_theta, 1]."""
+    """Ω⊥ of the folded grid's bins (docs/formats.md), shape [n_theta, 1]: Δφ (sin²θ1 − sin²θ0).
+    It mirrors lamina's one formula (HemisphereGrid::projected_solid_angle, src/core/grid.cpp);
+    the study's CLI test checks that the albedo it gives from tables.npy is metrics.csv's
+    albedo_ref, which lamina computes with its own."""
     edges = np.radians(np.linspace(0, 90, n_theta + 1))
     s2 = np.sin(edges) ** 2
     return ((s2[1:] - s2[:-1]) * math.pi / n_phi)[:, None]

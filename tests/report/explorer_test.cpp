@@ -133,6 +133,9 @@ TEST(Explorer, WritesPageDataAndAlbedos) {
     EXPECT_NEAR(c["albedo"]["ww09"]["R"][0][1].get<double>(), 2.0, 1e-6);
     EXPECT_NEAR(j["metrics"]["c1"]["ww09"]["R"]["me"][0][1].get<double>(), 1.0, 1e-12);
     EXPECT_TRUE(j["metrics"]["c1"]["ww09"]["R"]["me"][0][0].is_null());  // a row not given
+    // The one colour table (web/model-colors.json) travels with the page.
+    EXPECT_EQ(j["palette"]["models"]["ww09"], "#E69F00");
+    EXPECT_TRUE(j["palette"]["extra"].is_array());
     EXPECT_NEAR(j["metrics"]["c1"]["ww09"]["R"]["mf"][0][1].get<double>(), 0.9, 1e-12);
     EXPECT_NEAR(j["metrics"]["c1"]["ww09"]["R"]["nf_mf"][0][1].get<double>(), 0.02, 1e-12);
     EXPECT_NE(read_text(d / "explorer/data/c1.js").find("LAMINA_DATA"), std::string::npos);
