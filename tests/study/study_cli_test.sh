@@ -65,7 +65,16 @@ done
 grep -qF ' 0 model tables computed (4 reused)' "$tmp/a4.log" && ok || { fail "back to two models:"; grep Work "$tmp/a4.log"; }
 cmp -s "$tmp/a/metrics.csv" "$tmp/a.metrics" && ok || fail "metrics after going back to two models"
 
-# 2c. Table formats: half (the default) is float16, full float32, none writes no tables (and the
+# 2c. Adding a configuration simulates and computes only that configuration; the other one is
+#     read back unchanged.
+"$lamina" study --only 'plastic-P1-a0.05' --models ww-prime,bel-prime --theta-i 0,60 --particles 4e4 \
+    --grid 18x18 --no-figures --out "$tmp/g" >/dev/null 2>&1 && ok || fail "one configuration"
+"$lamina" study "${tiny[@]}" --no-figures --out "$tmp/g" >"$tmp/g.log" 2>&1 && ok || fail "add a configuration"
+grep -qF 'Work: 2 reference pieces simulated, 2 model tables computed (2 reused), 1 configurations written (1 unchanged)' "$tmp/g.log" \
+    && ok || { fail "adding a configuration:"; grep Work "$tmp/g.log"; }
+cmp -s "$tmp/g/metrics.csv" "$tmp/a.metrics" && ok || fail "metrics after adding a configuration"
+
+# 2d. Table formats: half (the default) is float16, full float32, none writes no tables (and the
 #     metrics do not depend on it); the Ω⊥ of the figure script agrees with lamina's (the albedo
 #     it computes from the float32 tables is metrics.csv's albedo_ref).
 "$lamina" study "${tiny[@]}" --tables full --no-figures --out "$tmp/full" >/dev/null 2>&1 && ok || fail "--tables full"
