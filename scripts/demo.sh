@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # `make demo`: lamina's main job. Runs the quick study (the 60 configurations, 10^6 particles per
-# incidence, every model) and says where the report is. Resumable: a second run reuses what is done.
+# incidence, every model; PNG figures: `lamina study --formats png,pdf,svg` for more) and says where
+# the report is. Incremental: a second run does no work and rewrites no file.
 set -euo pipefail
 build=${1:-build}
 cd "$(dirname "$0")/.."

@@ -1,16 +1,20 @@
 #!/usr/bin/env python3
 """Paper-ready figures of a lamina study directory (docs/explorer.md, "Figures").
 
-    figures.py STUDY_DIR [--formats pdf,svg,png] [--only GLOB[,GLOB...]] [--jobs N]
+    figures.py STUDY_DIR [--formats png,pdf,svg] [--only GLOB[,GLOB...]] [--jobs N] [--force]
 
 Reads study.json, metrics.csv and configs/<id>/{config.json, tables.npy, reference_se.npy}
 (docs/formats.md) and writes STUDY_DIR/figures/:
 
   slices/<id>-R.<fmt> (and -T for slabs)  incident-plane slices: rows = incidences, columns = RGB
                                           channels; reference with its ±2·se band, every model
-  error-matrix-R.<fmt> (and -T)           configurations × models, mean misplaced energy, log colours,
-                                          the noise floor as the first column
+  error-matrix-R.<fmt> (and -T)           configurations × models, mean misplaced energy with the 5%
+                                          floor (misplaced_floor), log colours, the noise floor as
+                                          the first column, models ranked (best first)
   albedo-<category>.<fmt>                 directional albedo against θi, one panel per configuration
+
+Only the figures whose inputs changed are drawn again (their digests are in figures/.inputs.json;
+--force redraws all), in parallel over the cores (--jobs, default every core).
 
 `lamina figures` runs this script (embedded in the binary) with Debian's python3; it can also be run
 directly. Exit code 3: matplotlib or numpy is missing (install python3-matplotlib: `make deps`).
@@ -18,6 +22,7 @@ directly. Exit code 3: matplotlib or numpy is missing (install python3-matplotli
 import argparse
 import csv
 import fnmatch
+import hashlib
 import json
 import math
 import os
@@ -37,35 +42,26 @@ except ImportError as e:  # pragma: no cover - reported by `lamina figures`
           file=sys.stderr)
     sys.exit(3)
 
-# One colour per model, the same as the explorer page (web/explorer.js): Okabe–Ito palette.
-MODEL_COLORS = {
-    "reference": "#000000",
-    "ww09": "#E69F00",
-    "ele10": "#56B4E9",
-    "ww-prime": "#009E73",
-    "bel18-forward": "#D55E00",
-    "bel18-symmetric": "#CC79A7",
-    "bel-prime": "#0072B2",
-    # The production coats (Tableau 10 and its darker tones), as in the explorer.
-    "openpbr": "#4E79A7",
-    "openpbr-adobe": "#A0CBE8",
-    "standard-surface": "#F28E2B",
-    "enterprise-pbr": "#59A14F",
-    "filament": "#B6992D",
-    "gltf-clearcoat": "#E15759",
-    "blender-principled": "#B07AA1",
-    "kulla-conty": "#9D7660",
-}
-EXTRA_COLORS = ["#8c564b", "#7f7f7f", "#bcbd22", "#17becf", "#9467bd", "#F0E442"]
-# Variants dashed, as in the explorer: they often coincide with the model they vary.
-MODEL_DASH = {"ele10": (0, (4, 2)), "bel18-symmetric": (0, (4, 2))}
+
+
+def read_palette():
+    """The model colours: web/model-colors.json, the one table the explorer page reads too.
+    `lamina figures` passes its embedded copy in $LAMINA_MODEL_COLORS; run from the repository,
+    the script reads the file beside it."""
+    text = os.environ.get("LAMINA_MODEL_COLORS")
+    if not text:
+        here = os.path.dirname(os.path.abspath(__file__)) if "__file__" in globals() else ""
+        path = os.path.join(here, "..", "web", "model-colors.json")
+        if os.path.exists(path):
+            with open(path) as f:
+                text = f.read()
+    palette = json.loads(text) if text else {}
+    return (palette.get("models", {}), palette.get("extra", ["#555555"]),
+            {m: (0, (4, 2)) for m in palette.get("dashed", [])})
+
+
+MODEL_COLORS, EXTRA_COLORS, MODEL_DASH = read_palette()
 CHANNELS = ["R", "G", "B"]
-
-
-def model_dash(name):
-    return MODEL_DASH.get(name, (0, (4, 2)) if ":" in name else "-")
-
-
 SIDE_NAME = {"R": "BRDF", "T": "BTDF"}
 
 plt.rcParams.update({
@@ -74,6 +70,11 @@ plt.rcParams.update({
     "lines.linewidth": 1.1, "pdf.fonttype": 42, "svg.fonttype": "none", "savefig.dpi": 160,
     "figure.dpi": 100, "svg.hashsalt": "lamina",
 })
+
+
+def model_dash(name):
+    """Variants dashed; an ablation ("openpbr:darkening=off") dashed in its model's colour."""
+    return MODEL_DASH.get(name, (0, (4, 2)) if ":" in name else "-")
 
 
 def model_color(name, models):
@@ -86,19 +87,24 @@ def model_color(name, models):
 
 
 def save(fig, path_stem, formats, tight=True):
-    """Writes each format. `tight=False` for figures laid out by hand: matplotlib's tight boxes
-    measure every tick label again, the bulk of the time for grids of log axes."""
+    """Writes each format, atomically (a temporary file renamed into place). `tight=False` for
+    figures laid out by hand: matplotlib's tight boxes measure every tick label again, the bulk of
+    the time for grids of log axes."""
     os.makedirs(os.path.dirname(path_stem), exist_ok=True)
     # No creation dates: the same study gives byte-identical PDF and SVG files.
     metadata = {"pdf": {"CreationDate": None}, "svg": {"Date": None}, "png": {}}
     for f in formats:
-        fig.savefig(f"{path_stem}.{f}", bbox_inches="tight" if tight else None,
-                    metadata=metadata[f])
+        tmp = f"{path_stem}.tmp-{os.getpid()}.{f}"
+        fig.savefig(tmp, bbox_inches="tight" if tight else None, metadata=metadata[f])
+        os.replace(tmp, f"{path_stem}.{f}")
     plt.close(fig)
 
 
 def omega_perp(n_theta, n_phi):
-    """Ω⊥ of the folded grid's bins (docs/formats.md), shape [n_theta, 1]."""
+    """Ω⊥ of the folded grid's bins (docs/formats.md), shape [n_theta, 1]: Δφ (sin²θ1 − sin²θ0).
+    It mirrors lamina's one formula (HemisphereGrid::projected_solid_angle, src/core/grid.cpp);
+    the study's CLI test checks that the albedo it gives from tables.npy is metrics.csv's
+    albedo_ref, which lamina computes with its own."""
     edges = np.radians(np.linspace(0, 90, n_theta + 1))
     s2 = np.sin(edges) ** 2
     return ((s2[1:] - s2[:-1]) * math.pi / n_phi)[:, None]
@@ -121,24 +127,31 @@ class Study:
         self.metrics = self._read_metrics()
 
     def _read_metrics(self):
-        """{(config, model, side): {'me': [I][3], 'nf': [I][3]}} with NaN for unsupported."""
+        """{(config, model, side): {'me': [I][3], 'nf': [I][3], 'mf': …, 'nf_mf': …}} with NaN for
+        unsupported: misplaced energy (relative, 'me', and floored, 'mf') and their noise floors.
+        A study written before misplaced_floor existed has its 'mf' and 'nf_mf' all NaN."""
         out = {}
+        self.has_floored = False
         path = os.path.join(self.root, "metrics.csv")
         if not os.path.exists(path):
             return out
+        columns = (("me", "misplaced_energy"), ("nf", "noise_floor"), ("mf", "misplaced_floor"),
+                   ("nf_mf", "misplaced_floor_noise"))
         with open(path, newline="") as f:
-            for row in csv.DictReader(f):
+            reader = csv.DictReader(f)
+            self.has_floored = "misplaced_floor" in (reader.fieldnames or [])
+            for row in reader:
                 key = (row["config"], row["model"], row["side"])
                 cell = out.setdefault(key, {k: np.full((len(self.theta_i), 3), np.nan)
-                                            for k in ("me", "nf")})
+                                            for k, _ in columns})
                 try:
                     i = self.theta_i.index(float(row["theta_i"]))
                 except ValueError:
                     continue
                 c = "rgb".index(row["channel"])
                 if row["supported"] == "true":
-                    for k, col in (("me", "misplaced_energy"), ("nf", "noise_floor")):
-                        if row[col]:
+                    for k, col in columns:
+                        if row.get(col):
                             cell[k][i, c] = float(row[col])
         return out
 
@@ -171,12 +184,8 @@ def pick_incidences(theta_i, wanted=(0, 45, 70)):
 
 # ---- Per-configuration incident-plane slices ----------------------------------------------------
 
-_STUDY = None  # set before the worker processes fork, shared by them
-
-
-def slice_figure(args):
-    root, cid, formats = args
-    study = _STUDY if _STUDY is not None and _STUDY.root == root else Study(root)
+def slice_figure(study, cid, formats):
+    root = study.root
     cfg, tables, se = study.load(cid)
     T = study.n_theta
     centres = (np.arange(T) + 0.5) * 90.0 / T
@@ -244,157 +253,273 @@ def slice_figure(args):
 
 # ---- The configurations × models error matrix --------------------------------------------------
 
-def error_matrix(study, formats):
-    sides = ["R"] + (["T"] if any("T" in c["sides"] for c in study.configs) else [])
-    for side in sides:
-        rows = [c for c in study.configs if side in c["sides"]]
-        cols = ["noise floor"] + study.models
-        z = np.full((len(rows), len(cols)), np.nan)
-        ns = np.zeros_like(z, dtype=bool)
-        for r, cfg in enumerate(rows):
-            for k, m in enumerate(study.models):
-                cell = study.metrics.get((cfg["id"], m, side))
-                if cell is None or np.all(np.isnan(cell["me"])):
-                    ns[r, k + 1] = True
-                    continue
-                z[r, k + 1] = np.nanmean(cell["me"])
-                if np.isnan(z[r, 0]):
-                    z[r, 0] = np.nanmean(cell["nf"])
-        fig, ax = plt.subplots(figsize=(1.1 + 0.75 * len(cols), 0.8 + 0.16 * len(rows)))
-        finite = z[np.isfinite(z) & (z > 0)]
-        norm = LogNorm(vmin=finite.min(), vmax=finite.max()) if finite.size else None
-        im = ax.imshow(np.ma.masked_invalid(z), aspect="auto", cmap="YlOrRd", norm=norm,
-                       interpolation="nearest")
-        ax.set_facecolor("0.9")
-        for r in range(len(rows)):
-            for k in range(len(cols)):
-                if ns[r, k]:
-                    ax.text(k, r, "n/s", ha="center", va="center", fontsize=5.5, color="0.35")
-                elif np.isfinite(z[r, k]):
-                    below = k > 0 and np.isfinite(z[r, 0]) and z[r, k] <= 2 * z[r, 0]
-                    v = z[r, k]
-                    dark = norm is not None and norm(v) > 0.6
-                    ax.text(k, r, f"{v:.2g}" + ("≈" if below else ""), ha="center", va="center",
-                            fontsize=5.5, color="white" if dark else "black")
-        ax.set_xticks(range(len(cols)), cols, rotation=35, ha="left")
-        ax.xaxis.tick_top()
-        ax.set_yticks(range(len(rows)), [c["id"] for c in rows], fontsize=6)
-        ax.axvline(0.5, color="k", lw=0.8)
-        for r in range(1, len(rows)):  # a line between categories
-            if rows[r]["category"] != rows[r - 1]["category"]:
-                ax.axhline(r - 0.5, color="k", lw=0.8)
-        cb = fig.colorbar(im, ax=ax, fraction=0.04, pad=0.02)
-        cb.set_label("misplaced energy (mean over θi and RGB)")
-        ax.set_title(f"{SIDE_NAME[side]}: misplaced energy, configurations × models "
-                     "(≈: within 2× the noise floor; n/s: not supported)", fontsize=8, pad=6)
-        save(fig, os.path.join(study.root, "figures", f"error-matrix-{side}"), formats)
+def error_matrix(study, formats, side):
+    """The matrix of one side, by the floored misplaced energy (the study's ranking metric; the
+    relative one for a study written before it existed)."""
+    metric, floor_key = ("mf", "nf_mf") if study.has_floored else ("me", "nf")
+    label = "misplaced energy, 5% floor" if study.has_floored else "misplaced energy"
+    rows = [c for c in study.configs if side in c["sides"]]
+
+    def mean_of(m):  # over the configurations the model supports: its rank
+        v = [np.nanmean(c[metric]) for c in (study.metrics.get((cfg["id"], m, side))
+                                               for cfg in rows)
+             if c is not None and not np.all(np.isnan(c[metric]))]
+        return float(np.mean(v)) if v else math.inf
+
+    models = sorted(study.models, key=mean_of)  # stable: ties keep the study's order
+    cols = ["noise floor"] + models
+    z = np.full((len(rows), len(cols)), np.nan)
+    ns = np.zeros_like(z, dtype=bool)
+    for r, cfg in enumerate(rows):
+        for k, m in enumerate(models):
+            cell = study.metrics.get((cfg["id"], m, side))
+            if cell is None or np.all(np.isnan(cell[metric])):
+                ns[r, k + 1] = True
+                continue
+            z[r, k + 1] = np.nanmean(cell[metric])
+            if np.isnan(z[r, 0]):
+                z[r, 0] = np.nanmean(cell[floor_key])
+    fig, ax = plt.subplots(figsize=(1.1 + 0.75 * len(cols), 0.8 + 0.16 * len(rows)))
+    finite = z[np.isfinite(z) & (z > 0)]
+    norm = LogNorm(vmin=finite.min(), vmax=finite.max()) if finite.size else None
+    im = ax.imshow(np.ma.masked_invalid(z), aspect="auto", cmap="YlOrRd", norm=norm,
+                   interpolation="nearest")
+    ax.set_facecolor("0.9")
+    for r in range(len(rows)):
+        for k in range(len(cols)):
+            if ns[r, k]:
+                ax.text(k, r, "n/s", ha="center", va="center", fontsize=5.5, color="0.35")
+            elif np.isfinite(z[r, k]):
+                below = k > 0 and np.isfinite(z[r, 0]) and z[r, k] <= 2 * z[r, 0]
+                v = z[r, k]
+                dark = norm is not None and norm(v) > 0.6
+                ax.text(k, r, f"{v:.2g}" + ("≈" if below else ""), ha="center", va="center",
+                        fontsize=5.5, color="white" if dark else "black")
+    ax.set_xticks(range(len(cols)), cols, rotation=35, ha="left")
+    ax.xaxis.tick_top()
+    ax.set_yticks(range(len(rows)), [c["id"] for c in rows], fontsize=6)
+    ax.axvline(0.5, color="k", lw=0.8)
+    for r in range(1, len(rows)):  # a line between categories
+        if rows[r]["category"] != rows[r - 1]["category"]:
+            ax.axhline(r - 0.5, color="k", lw=0.8)
+    cb = fig.colorbar(im, ax=ax, fraction=0.04, pad=0.02)
+    cb.set_label(f"{label} (mean over θi and RGB)")
+    ax.set_title(f"{SIDE_NAME[side]}: {label}, configurations × models, best first "
+                 "(≈: within 2× the noise floor; n/s: not supported)", fontsize=8, pad=6)
+    save(fig, os.path.join(study.root, "figures", f"error-matrix-{side}"), formats)
 
 
 # ---- Albedo against θi, per category -----------------------------------------------------------
 
-def albedo_curves(study, formats, cache):
+def albedo_figure(study, cat, formats):
+    om = omega_perp(study.n_theta, study.n_phi)
+    cache = {c["id"]: study.load(c["id"]) for c in study.configs if c["category"] == cat}
+    members = [c for c in study.configs if c["category"] == cat]
+    ncol = min(5, len(members))
+    nrow = math.ceil(len(members) / ncol)
+    width = max(1.6 * ncol + 0.7, 3.6)
+    # The legend: one entry per 1.2 inch of width, as many rows as that takes.
+    entries = 2 + len(study.models)
+    legend_cols = max(2, min(entries, int(width / 1.2)))
+    legend_rows = math.ceil(entries / legend_cols)
+    bottom = 0.55 + 0.2 * legend_rows
+    height = 1.5 * nrow + 0.45 + bottom
+    fig, axes = plt.subplots(nrow, ncol, figsize=(width, height), sharex=True, sharey=True,
+                             squeeze=False)
+    fig.subplots_adjust(left=0.6 / width, right=1 - 0.1 / width, bottom=bottom / height,
+                        top=1 - 0.45 / height, wspace=0.08, hspace=0.3)
+    for ax in axes.flat[len(members):]:
+        ax.axis("off")
+    for ax, meta in zip(axes.flat, members):
+        cfg, tables, se = cache[meta["id"]]
+        for d, side in enumerate(cfg["sides"]):
+            style = "-" if side == "R" else ":"
+            # Σ f Ω⊥ per source and incidence, averaged over RGB.
+            alb = np.nansum(np.asarray(tables[:, :, d]) * om[None, None, :, :, None], axis=(2, 3))
+            alb = alb.mean(axis=-1)
+            err = None
+            if se is not None:
+                v = ((np.asarray(se[:, d]) * om[None, :, :, None]) ** 2).sum(axis=(1, 2))
+                err = 2 * np.sqrt(v.mean(axis=-1))
+            ax.errorbar(study.theta_i, alb[0], yerr=err, color="k", lw=1.3, ls=style,
+                        capsize=1.5, elinewidth=0.6,
+                        label="reference ±2·se" + (" (T dotted)" if side == "T" else ""))
+            for k, m in enumerate(cfg["sources"][1:]):
+                if supported(cfg, m, side) and ":" not in m:
+                    ax.plot(study.theta_i, alb[k + 1], color=model_color(m, study.models),
+                            ls=model_dash(m) if side == "R" else ":", lw=0.9, label=m)
+        # What the reference loses to its single-scattering microsurfaces (config.json energy):
+        # on neither side, so a model that keeps it overshoots the albedo by as much.
+        lost = [e.get("lost_microsurface") for e in cfg.get("energy", [])]
+        if lost and len(lost) == len(study.theta_i) and all(lost) and max(map(max, lost)) > 0:
+            ax.plot(study.theta_i, [sum(v) / 3 for v in lost], color="0.55", ls="--", lw=0.8,
+                    marker="x", ms=2.5, label="reference: lost to microsurfaces")
+        ax.set_title(meta["id"], fontsize=6.5)
+        ax.grid(True, lw=0.3, color="0.88")
+        ax.set_xticks([0, 30, 60, 90])
+    for ax in axes[-1]:
+        ax.set_xlabel("θi (°)")
+    for row in axes:
+        row[0].set_ylabel("albedo (RGB mean)")
+    seen = {}
+    for ax in axes.flat:
+        for h, l in zip(*ax.get_legend_handles_labels()):
+            seen.setdefault(l.replace(" (T dotted)", ""), h)
+    order = sorted(seen, key=lambda l: (0 if l.startswith("reference ±") else
+                                        1 if l.startswith("reference") else 2,
+                                        study.models.index(l) if l in study.models else 0))
+    fig.legend([seen[l] for l in order], order, loc="lower center", ncol=legend_cols,
+               frameon=False, columnspacing=0.9, handlelength=1.5)
+    fig.suptitle(f"{cat}: directional albedo against θi"
+                 + (" (transmission dotted)" if any(
+                     "T" in c["sides"] for c in members) else ""), fontsize=9,
+                 y=1 - 0.08 / height, va="top")
+    save(fig, os.path.join(study.root, "figures", f"albedo-{cat}"), formats, tight=False)
+
+
+# ---- What to draw, and what is already drawn ----------------------------------------------------
+#
+# Each figure is a task with the digest of everything it is drawn from (the files it reads, the
+# study's axes, the formats, the palette, this script). figures/.inputs.json keeps the digest of
+# every figure drawn; a figure whose digest is unchanged and whose files are all there is not drawn
+# again. The tasks run in parallel over the cores (one process each, forked).
+
+_STUDY = None  # set before the worker processes fork, shared by them
+_FILE_DIGESTS = {}
+
+
+def file_digest(path):
+    if path not in _FILE_DIGESTS:
+        h = hashlib.sha1()
+        try:
+            with open(path, "rb") as f:
+                for block in iter(lambda: f.read(1 << 20), b""):
+                    h.update(block)
+        except OSError:
+            h.update(b"missing")
+        _FILE_DIGESTS[path] = h.hexdigest()
+    return _FILE_DIGESTS[path]
+
+
+def config_files(study, cid):
+    d = os.path.join(study.root, "configs", cid)
+    return [os.path.join(d, n) for n in ("config.json", "tables.npy", "reference_se.npy")]
+
+
+def has_tables(study, cid):
+    return os.path.exists(os.path.join(study.root, "configs", cid, "tables.npy"))
+
+
+def plan(study, ids, formats, script_id):
+    """[(name, kind, argument, outputs, digest)] of every figure this study has."""
+    common = json.dumps([script_id, formats, study.theta_i, study.n_theta, study.n_phi,
+                         study.models, MODEL_COLORS, EXTRA_COLORS, sorted(MODEL_DASH)])
+    fig_dir = os.path.join(study.root, "figures")
+    outs = lambda stem: [os.path.join(fig_dir, f"{stem}.{f}") for f in formats]
+    digest = lambda *parts: hashlib.sha1("\n".join((common,) + parts).encode()).hexdigest()
+    tasks = []
+    by_id = {c["id"]: c for c in study.configs}
+    for cid in ids:
+        if not has_tables(study, cid):
+            continue
+        sides = by_id[cid].get("sides") or ["R"]
+        files = [file_digest(p) for p in config_files(study, cid)]
+        tasks.append((f"slices/{cid}", "slice", cid,
+                      sum((outs(f"slices/{cid}-{side}") for side in sides), []),
+                      digest("slice", cid, *files)))
+    metrics = file_digest(os.path.join(study.root, "metrics.csv"))
+    configs = json.dumps(study.configs)
+    for side in ["R"] + (["T"] if any("T" in c["sides"] for c in study.configs) else []):
+        tasks.append((f"error-matrix-{side}", "matrix", side, outs(f"error-matrix-{side}"),
+                      digest("matrix", side, metrics, configs)))
     cats = []
     for c in study.configs:
         if c["category"] not in cats:
             cats.append(c["category"])
-    om = omega_perp(study.n_theta, study.n_phi)
     for cat in cats:
         members = [c for c in study.configs if c["category"] == cat]
-        ncol = min(5, len(members))
-        nrow = math.ceil(len(members) / ncol)
-        width = max(1.6 * ncol + 0.7, 3.6)
-        # The legend: one entry per 1.2 inch of width, as many rows as that takes.
-        entries = 2 + len(study.models)
-        legend_cols = max(2, min(entries, int(width / 1.2)))
-        legend_rows = math.ceil(entries / legend_cols)
-        bottom = 0.55 + 0.2 * legend_rows
-        height = 1.5 * nrow + 0.45 + bottom
-        fig, axes = plt.subplots(nrow, ncol, figsize=(width, height), sharex=True, sharey=True,
-                                 squeeze=False)
-        fig.subplots_adjust(left=0.6 / width, right=1 - 0.1 / width, bottom=bottom / height,
-                            top=1 - 0.45 / height, wspace=0.08, hspace=0.3)
-        for ax in axes.flat[len(members):]:
-            ax.axis("off")
-        for ax, meta in zip(axes.flat, members):
-            cfg, tables, se = cache[meta["id"]]
-            for d, side in enumerate(cfg["sides"]):
-                style = "-" if side == "R" else ":"
-                # Σ f Ω⊥ per source and incidence, averaged over RGB.
-                alb = np.nansum(np.asarray(tables[:, :, d]) * om[None, None, :, :, None], axis=(2, 3))
-                alb = alb.mean(axis=-1)
-                err = None
-                if se is not None:
-                    v = ((np.asarray(se[:, d]) * om[None, :, :, None]) ** 2).sum(axis=(1, 2))
-                    err = 2 * np.sqrt(v.mean(axis=-1))
-                ax.errorbar(study.theta_i, alb[0], yerr=err, color="k", lw=1.3, ls=style,
-                            capsize=1.5, elinewidth=0.6,
-                            label="reference ±2·se" + (" (T dotted)" if side == "T" else ""))
-                for k, m in enumerate(cfg["sources"][1:]):
-                    if supported(cfg, m, side) and ":" not in m:
-                        ax.plot(study.theta_i, alb[k + 1], color=model_color(m, study.models),
-                                ls=model_dash(m) if side == "R" else ":", lw=0.9, label=m)
-            # What the reference loses to its single-scattering microsurfaces (config.json energy):
-            # on neither side, so a model that keeps it overshoots the albedo by as much.
-            lost = [e.get("lost_microsurface") for e in cfg.get("energy", [])]
-            if lost and len(lost) == len(study.theta_i) and all(lost) and max(map(max, lost)) > 0:
-                ax.plot(study.theta_i, [sum(v) / 3 for v in lost], color="0.55", ls="--", lw=0.8,
-                        marker="x", ms=2.5, label="reference: lost to microsurfaces")
-            ax.set_title(meta["id"], fontsize=6.5)
-            ax.grid(True, lw=0.3, color="0.88")
-            ax.set_xticks([0, 30, 60, 90])
-        for ax in axes[-1]:
-            ax.set_xlabel("θi (°)")
-        for row in axes:
-            row[0].set_ylabel("albedo (RGB mean)")
-        seen = {}
-        for ax in axes.flat:
-            for h, l in zip(*ax.get_legend_handles_labels()):
-                seen.setdefault(l.replace(" (T dotted)", ""), h)
-        order = sorted(seen, key=lambda l: (0 if l.startswith("reference ±") else
-                                            1 if l.startswith("reference") else 2,
-                                            study.models.index(l) if l in study.models else 0))
-        fig.legend([seen[l] for l in order], order, loc="lower center", ncol=legend_cols,
-                   frameon=False, columnspacing=0.9, handlelength=1.5)
-        fig.suptitle(f"{cat}: directional albedo against θi"
-                     + (" (transmission dotted)" if any(
-                         "T" in c["sides"] for c in members) else ""), fontsize=9,
-                     y=1 - 0.08 / height, va="top")
-        save(fig, os.path.join(study.root, "figures", f"albedo-{cat}"), formats, tight=False)
+        if not all(has_tables(study, c["id"]) for c in members):
+            continue
+        files = [file_digest(p) for c in members for p in config_files(study, c["id"])]
+        tasks.append((f"albedo-{cat}", "albedo", cat, outs(f"albedo-{cat}"),
+                      digest("albedo", cat, json.dumps(members), *files)))
+    return tasks
+
+
+def draw(task):
+    name, kind, arg, _, _ = task
+    formats = _FORMATS
+    if kind == "slice":
+        slice_figure(_STUDY, arg, formats)
+    elif kind == "matrix":
+        error_matrix(_STUDY, formats, arg)
+    else:
+        albedo_figure(_STUDY, arg, formats)
+    return name
+
+
+_FORMATS = []
 
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("study_dir")
-    p.add_argument("--formats", default="pdf,svg,png")
+    p.add_argument("--formats", default="png")
     p.add_argument("--only", default="", help="configuration ids (globs) for the slices")
-    p.add_argument("--jobs", type=int, default=min(4, os.cpu_count() or 1))
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    p.add_argument("--script-id", default="",
+                   help="digest of this script (lamina passes it: the script comes on stdin)")
+    p.add_argument("--force", action="store_true", help="redraw every figure")
     a = p.parse_args()
     formats = [f for f in a.formats.split(",") if f]
     for f in formats:
         if f not in ("pdf", "svg", "png"):
             sys.exit(f"figures.py: --formats: '{f}' is not one of pdf, svg, png")
     t0 = time.time()
-    global _STUDY
+    global _STUDY, _FORMATS
     study = _STUDY = Study(a.study_dir)
+    _FORMATS = formats
     ids = [c["id"] for c in study.configs]
     if a.only:
         pats = [g for g in a.only.split(",") if g]
         ids = [i for i in ids if any(fnmatch.fnmatchcase(i, g) for g in pats)]
         if not ids:
             sys.exit(f"figures.py: --only {a.only}: no configuration matches")
-    jobs = [(a.study_dir, cid, formats) for cid in ids]
-    if a.jobs > 1 and len(jobs) > 1:
+    script_id = a.script_id
+    if not script_id and "__file__" in globals() and os.path.exists(__file__):
+        script_id = file_digest(os.path.abspath(__file__))
+    fig_dir = os.path.join(a.study_dir, "figures")
+    os.makedirs(fig_dir, exist_ok=True)
+    stamp_path = os.path.join(fig_dir, ".inputs.json")
+    try:
+        with open(stamp_path) as f:
+            stamps = json.load(f)
+    except (OSError, ValueError):
+        stamps = {}
+    tasks = plan(study, ids, formats, script_id)
+    todo = [t for t in tasks if a.force or stamps.get(t[0]) != t[4]
+            or not all(os.path.exists(o) for o in t[3])]
+    # The largest first (albedo grids, then matrices), so the pool's last task is a short one.
+    todo.sort(key=lambda t: {"albedo": 0, "matrix": 1, "slice": 2}[t[1]])
+    if a.jobs > 1 and len(todo) > 1:
         import multiprocessing
-        with multiprocessing.get_context("fork").Pool(a.jobs) as pool:
-            list(pool.imap_unordered(slice_figure, jobs))
+        with multiprocessing.get_context("fork").Pool(min(a.jobs, len(todo))) as pool:
+            done = list(pool.imap_unordered(draw, todo))
     else:
-        for j in jobs:
-            slice_figure(j)
-    cache = {c["id"]: study.load(c["id"]) for c in study.configs}
-    error_matrix(study, formats)
-    albedo_curves(study, formats, cache)
-    print(f"figures: {len(ids)} configurations, {len(formats)} formats, "
-          f"{time.time() - t0:.1f} s -> {os.path.join(a.study_dir, 'figures')}", file=sys.stderr)
+        done = [draw(t) for t in todo]
+    for t in todo:
+        stamps[t[0]] = t[4]
+    if todo:  # nothing drawn, nothing rewritten
+        tmp = f"{stamp_path}.tmp-{os.getpid()}"
+        with open(tmp, "w") as f:
+            json.dump(stamps, f, indent=0, sort_keys=True)
+        os.replace(tmp, stamp_path)
+    skipped = [c for c in ids if not has_tables(study, c)]
+    if skipped:
+        print(f"figures: {len(skipped)} configurations without tables.npy (--tables none): "
+              "no slices or albedo curves for them", file=sys.stderr)
+    print(f"figures: {len(done)} drawn, {len(tasks) - len(todo)} unchanged, {len(formats)} "
+          f"format(s), {time.time() - t0:.1f} s -> {fig_dir}", file=sys.stderr)
 
 
 if __name__ == "__main__":

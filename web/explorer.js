@@ -16,30 +16,15 @@
   const CHANNELS = ["R", "G", "B"];
   const CHANNEL_COLORS = ["#b8322f", "#2e8540", "#2c5aa0"];
 
-  // One colour per model, the same in every view and in scripts/figures.py (Okabe–Ito palette).
-  const MODEL_COLORS = {
-    reference: "#000000",
-    ww09: "#E69F00",
-    ele10: "#56B4E9",
-    "ww-prime": "#009E73",
-    "bel18-forward": "#D55E00",
-    "bel18-symmetric": "#CC79A7",
-    "bel-prime": "#0072B2",
-    // The production coats (Tableau 10 and its darker tones; scripts/figures.py the same).
-    openpbr: "#4E79A7",
-    "openpbr-adobe": "#A0CBE8",
-    "standard-surface": "#F28E2B",
-    "enterprise-pbr": "#59A14F",
-    filament: "#B6992D",
-    "gltf-clearcoat": "#E15759",
-    "blender-principled": "#B07AA1",
-    "kulla-conty": "#9D7660",
-  };
-  const EXTRA_COLORS = ["#8c564b", "#7f7f7f", "#bcbd22", "#17becf", "#9467bd", "#F0E442"];
+  // One colour per model, the same in every view and in the figures: web/model-colors.json, the one
+  // table both read (lamina copies it into explorer/data/index.js as `palette`).
+  const PALETTE = INDEX.palette || { models: {}, extra: ["#555"], dashed: [] };
+  const MODEL_COLORS = PALETTE.models;
+  const EXTRA_COLORS = PALETTE.extra;
   // Variants are dashed: Ele10 is WW09 with one change and often coincides with it, and so do
   // the two Bel18 cosines; a dashed line on top lets the solid one show through.
+  const MODEL_DASH = Object.fromEntries((PALETTE.dashed || []).map((m) => [m, "dash"]));
   // Ablations ("openpbr:darkening=off") are dashed in their model's colour.
-  const MODEL_DASH = { ele10: "dash", "bel18-symmetric": "dash" };
   const baseName = (name) => name.split(":")[0];
   const modelDash = (name) => MODEL_DASH[name] || (name.includes(":") ? "dash" : "solid");
 
@@ -75,7 +60,7 @@
     isoChannel: 0,
     diffMode: "f",
     levels: "",
-    lbMetric: "me",
+    lbMetric: "mf",
     lbIncidence: "all",
     lbAgg: "mean",
   };
@@ -271,9 +256,11 @@
   // field puts every model in one group.
   const GROUP_NAMES = {
     "2019": "2019 study", successors: "statistical successors", production: "production coats",
-    ablations: "production ablations", reference: "reference", other: "models",
+    ablations: "production ablations", external: "your models (tables, Python)",
+    reference: "reference", other: "models",
   };
-  const GROUP_ORDER = ["2019", "successors", "production", "ablations", "reference", "other"];
+  const GROUP_ORDER = ["2019", "successors", "production", "ablations", "external", "reference",
+    "other"];
   const modelGroup = (m) => (STUDY.model_groups && STUDY.model_groups[m]) || "other";
   const groups = GROUP_ORDER.map((g) => [g, models.filter((m) => modelGroup(m) === g)])
     .filter(([, ms]) => ms.length);
@@ -358,6 +345,15 @@
     $("study-info").textContent = parts.join(" · ");
     setOptions($("w-incidence"), THETA_I.map((t, i) => [i, t + "°"]), state.incidence);
     setOptions($("w-lb-incidence"), [["all", "all θi"]].concat(THETA_I.map((t, i) => [i, "θi = " + t + "°"])), "all");
+    // A study written before misplaced_floor existed ranks by the relative misplaced energy.
+    const hasFloored = Object.values(INDEX.metrics || {}).some((mm) => Object.values(mm).some((sides) =>
+      Object.values(sides).some((cell) => cell && cell.mf)));
+    if (!hasFloored) {
+      state.lbMetric = "me";
+      const opt = $("w-lb-metric").querySelector('option[value="mf"]');
+      if (opt) opt.remove();
+    }
+    $("w-lb-metric").value = state.lbMetric;
 
     $("w-category").addEventListener("change", () => {
       const first = configs.find((c) => c.category === $("w-category").value);
@@ -740,6 +736,10 @@
     return out;
   }
 
+  // The leaderboard's metrics with a noise floor, and the metrics.csv column of that floor (data
+  // index keys: mf misplaced_floor, me misplaced_energy, nf noise_floor, nf_mf misplaced_floor_noise).
+  const NOISE_FLOOR_OF = { mf: "nf_mf", me: "nf" };
+
   function drawLeaderboard() {
     const side = state.side, metric = state.lbMetric;
     const cols = ["noise floor"].concat(models);
@@ -749,13 +749,14 @@
     for (const cfg of shownConfigs) {
       const mm = (INDEX.metrics || {})[cfg.id] || {};
       const zr = [], tr = [], hr = [], rr = [];
-      // The noise floor: what a perfect model would score against this reference (misplaced energy).
+      // The noise floor: what a perfect model would score against this reference (misplaced energy,
+      // relative or floored: each metric has its own).
+      const nfKey = NOISE_FLOOR_OF[metric];
       let nf = null;
-      for (const m of models) if (mm[m] && mm[m][side]) { nf = aggregate(cellValues(mm[m][side], "nf")); if (nf !== null) break; }
-      const nfShown = metric === "me" ? nf : null;
-      zr.push(nfShown !== null && nfShown > 0 ? Math.log10(nfShown) : null);
-      rr.push(nfShown);
-      tr.push(metric === "me" ? fmt(nf) : "");
+      if (nfKey) for (const m of models) if (mm[m] && mm[m][side]) { nf = aggregate(cellValues(mm[m][side], nfKey)); if (nf !== null) break; }
+      zr.push(nf !== null && nf > 0 ? Math.log10(nf) : null);
+      rr.push(nf);
+      tr.push(nfKey ? fmt(nf) : "");
       hr.push(cfg.id + "<br>noise floor " + fmt(nf));
       for (const m of models) {
         const has = cfg.sides.includes(side);
@@ -763,7 +764,7 @@
         const v = ok && mm[m] ? aggregate(cellValues(mm[m][side], metric)) : null;
         zr.push(v !== null && v > 0 ? Math.log10(v) : null);
         rr.push(v);
-        const below = metric === "me" && v !== null && nf !== null && v <= 2 * nf;
+        const below = nfKey && v !== null && nf !== null && v <= 2 * nf;
         tr.push(!has ? "" : !ok ? "n/s" : fmt(v) + (below ? "≈" : ""));
         hr.push(cfg.id + " · " + m + "<br>" + (!has ? "no " + (side === "R" ? "BRDF" : "BTDF")
           : !ok ? "not supported" + (unsupportedReason(cfg, m) ? ": " + unsupportedReason(cfg, m) : "")

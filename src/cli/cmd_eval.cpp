@@ -4,6 +4,7 @@
 #include "cli/options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/incidences.h"
 #include "core/math.h"
 #include "core/spherical.h"
 #include "layers/stack.h"
@@ -102,8 +103,8 @@ int run_eval(const EvalArgs& a) {
         throw InputError("command line", "--out", "this mode writes a CSV file: give --out");
 
     if (a.binned) {
-        const std::vector<double> thetas =
-            parse_incidences(a.theta_i.empty() ? "0,15,30,45,60,70,80" : a.theta_i, "--theta-i");
+        const std::vector<double> thetas = parse_incidences(
+            a.theta_i.empty() ? default_incidences_text() : a.theta_i, "--theta-i");
         const HemisphereGrid grid = HemisphereGrid::parse(a.grid, "--grid");
         const Stack stack = load_stack(a.stack);
         const auto model = entry.make(stack, options);
@@ -142,7 +143,7 @@ int run_eval(const EvalArgs& a) {
                   parse_number(cells[1], a.directions, where + ", theta_o"),
                   parse_number(cells[2], a.directions, where + ", phi_o"),
                   parse_side(cells[3], a.directions, where + ", side"), line};
-            check_angle(r.ti, 0, 90, false, a.directions, where + ", theta_i");
+            check_incidence(r.ti, a.directions, where + ", theta_i");
             check_angle(r.to, 0, 90, true, a.directions, where + ", theta_o");
             rows.push_back(r);
         }
@@ -200,8 +201,8 @@ Runner add_eval(CLI::App& app) {
     cmd->add_option("--model", a->model, "Model name (see `lamina models`)")->required();
     cmd->add_option("--stack", a->stack, "Stack JSON file")->required();
     cmd->add_option("--theta-i", a->theta_i,
-                    "Incidence(s) in degrees, [0, 90); a comma list with --binned "
-                    "(default 0,15,30,45,60,70,80)");
+                    "Incidence(s) in degrees, [0, 90); a comma list with --binned (default " +
+                        default_incidences_text() + ")");
     cmd->add_option("--theta-o", a->theta_o, "Outgoing polar angle in degrees, [0, 90]");
     cmd->add_option("--phi-o", a->phi_o, "Outgoing azimuth in degrees (mirror at 180)");
     cmd->add_option("--side", a->side, "R (reflection) or T (transmission; θo from -z)");

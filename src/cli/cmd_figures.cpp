@@ -12,16 +12,20 @@ namespace lamina::cli {
 
 Runner add_figures(CLI::App& app) {
     auto* cmd = app.add_subcommand(
-        "figures", "Write a study directory's figures (PDF, SVG, PNG) into DIR/figures/");
+        "figures",
+        "Write a study directory's figures (PNG; PDF, SVG on request) into DIR/figures/");
     struct Args {
-        std::string dir, formats = "pdf,svg,png", only, python;
+        std::string dir, formats = "png", only, python;
+        bool force = false;
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("DIR", a->dir,
                     "A study directory (written by `lamina study` or `lamina compare`)")
         ->required();
-    cmd->add_option("--formats", a->formats, "Comma-separated: pdf, svg, png")
+    cmd->add_option("--formats", a->formats, "Comma-separated: png, pdf, svg")
         ->capture_default_str();
+    cmd->add_flag("--force", a->force,
+                  "Redraw every figure (by default only those whose inputs changed)");
     cmd->add_option("--only", a->only,
                     "Configuration ids (globs, comma-separated) for the per-configuration slices");
     cmd->add_option(
@@ -35,6 +39,7 @@ Runner add_figures(CLI::App& app) {
             if (!f.empty()) o.formats.push_back(f);
         o.only = a->only;
         o.python = a->python;
+        o.force = a->force;
         write_figures(a->dir, o);
         fmt::print("{}/figures/: written\n", a->dir);
         return 0;

@@ -5,6 +5,7 @@
 #include "cli/options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/incidences.h"
 #include "core/progress.h"
 #include "distributed/communicator.h"
 #include "distributed/split_simulation.h"
@@ -23,7 +24,7 @@ namespace lamina::cli {
 
 namespace {
 struct SimulateArgs {
-    std::string stack, theta_i = "0,15,30,45,60,70,80", particles = "1e6", grid = "90x90", out;
+    std::string stack, theta_i = default_incidences_text(), particles = "1e6", grid = "90x90", out;
     std::string kernel = "simd", microsurface = "single";
     std::uint64_t seed = 1;
     int threads = 0, max_events = 10000;

@@ -7,6 +7,7 @@
 #include "cli/options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/incidences.h"
 #include "distributed/communicator.h"
 #include "render/contact_sheet.h"
 #include "report/explorer.h"
@@ -18,7 +19,6 @@
 #include <fmt/format.h>
 
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <sstream>
 
@@ -27,11 +27,11 @@ namespace lamina::cli {
 namespace {
 
 struct CommonArgs {
-    std::string theta_i = "0,15,30,45,60,70,80", particles, grid = "90x90", models, out;
-    std::string kernel = "simd", microsurface = "single";
+    std::string theta_i = default_incidences_text(), particles, grid = "90x90", models, out;
+    std::string kernel = "simd", microsurface = "single", tables = "half", formats = "png";
     std::uint64_t seed = 1;
     int threads = 0;
-    bool no_figures = false;
+    bool no_figures = false, recompute = false;
     bool ablations = false;
     std::vector<std::string> model_tables;   ///< NAME=FILE.csv (FILE may hold {id})
     std::vector<std::string> model_plugins;  ///< [NAME=]FILE.py (docs/python.md)
@@ -65,6 +65,15 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
     cmd->add_option("--model-plugin", a.model_plugins,
                     "A Python model, [NAME=]FILE.py defining MODEL (a class with a vectorized "
                     "eval(wi, wo), docs/python.md), binned by lamina's quadrature; repeatable");
+    cmd->add_option("--tables", a.tables,
+                    "configs/ID/tables.npy: full (float32), half (float16, half the size) or "
+                    "none (metrics and summary only: no explorer page, slices or albedo figures)")
+        ->capture_default_str();
+    cmd->add_option("--formats", a.formats, "Figure formats, comma-separated: png, pdf, svg")
+        ->capture_default_str();
+    cmd->add_flag("--recompute", a.recompute,
+                  "Recompute the models, metrics and outputs even where their inputs are "
+                  "unchanged (the reference pieces are still reused), and redraw every figure");
     cmd->add_flag("--no-figures", a.no_figures,
                   "Skip the paper figures (the explorer page is always written)");
 }
@@ -103,6 +112,24 @@ ExternalModel model_table(const std::string& assignment) {
     return m;
 }
 
+FigureOptions figure_options(const CommonArgs& a) {
+    FigureOptions o;
+    o.formats.clear();
+    std::stringstream ss(a.formats);
+    for (std::string f; std::getline(ss, f, ',');)
+        if (!f.empty()) {
+            if (f != "png" && f != "pdf" && f != "svg")
+                throw InputError(
+                    "command line", "--formats",
+                    fmt::format("'{}' is not a figure format; allowed: png, pdf, svg", f));
+            o.formats.push_back(f);
+        }
+    if (o.formats.empty())
+        throw InputError("command line", "--formats", "no format given; allowed: png, pdf, svg");
+    o.force = a.recompute;
+    return o;
+}
+
 StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
     StudySettings s;
     s.particles = preset_particles(preset);  // validates --preset in every case
@@ -118,6 +145,9 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
                          "multiple scattering on the microsurfaces runs on the scalar kernel only: "
                          "add --kernel scalar");
     s.theta_i_deg = parse_incidences(a.theta_i, "--theta-i");
+    s.tables = parse_tables_format(a.tables);
+    figure_options(a);  // validates --formats before any work
+    s.recompute = a.recompute;
     s.grid = HemisphereGrid::parse(a.grid);
     if (!a.models.empty()) {
         std::stringstream ss(a.models);
@@ -145,28 +175,24 @@ void check_model_tables(const CommonArgs& a, const std::vector<StudyConfiguratio
 }
 
 // The explorer page, then the figures (a failure there is a warning: the study itself is done).
-void write_report(const std::filesystem::path& dir, bool figures) {
-    write_explorer(dir);
-    if (!figures) return;
+// Without tables (--tables none) there is no page to draw: only the error matrices.
+void write_report(const std::filesystem::path& dir, const CommonArgs& a, const StudySettings& s) {
+    if (s.tables != TablesFormat::None) write_explorer(dir);
+    if (a.no_figures) return;
     try {
-        write_figures(dir);
+        write_figures(dir, figure_options(a));
     } catch (const InputError& e) {
         fmt::print(stderr, "lamina: warning: figures not written: {}\n", e.what());
     }
 }
 
-// Prints the findings section of summary.md (the part a reader wants first).
-void print_findings(const std::filesystem::path& dir) {
-    std::ifstream in(dir / "summary.md");
-    std::string line;
-    bool inside = false;
-    while (std::getline(in, line)) {
-        if (line.rfind("## ", 0) == 0) {
-            if (inside) break;
-            inside = line == "## Findings";
-        }
-        if (inside) fmt::print("{}\n", line);
-    }
+// What the run did, then the findings (the part of summary.md a reader wants first).
+void print_outcome(const StudyResult& r, const std::filesystem::path& dir, const StudySettings& s) {
+    fmt::print("\nWork: {}\n\n{}", describe_work(r.work), findings_headline(r.findings));
+    fmt::print("\nReport: {0}/summary.md (metrics: {0}/metrics.csv){1}\n", dir.string(),
+               s.tables == TablesFormat::None
+                   ? std::string("; no explorer page (--tables none)")
+                   : fmt::format("; explorer: {}/index.html", dir.string()));
 }
 
 }  // namespace
@@ -227,7 +253,7 @@ Runner add_study(CLI::App& app) {
             fmt::print("Reference: {} pieces computed over {} processes × {} threads\n", computed,
                        world.size(), threads);
         }
-        run_study(configs, s, out);
+        const StudyResult result = run_study(configs, s, out);
         if (a->render) {
             // Renderings of every configuration: reproducible (seed), the same settings for all.
             RenderSettings rs;
@@ -251,12 +277,8 @@ Runner add_study(CLI::App& app) {
             fmt::print("Renderings: {0}/configs/ID/renders/compare.png (errors: {0}/renders.csv)\n",
                        out.string());
         }
-        write_report(out, !a->no_figures);
-        fmt::print("\n");
-        print_findings(out);
-        fmt::print(
-            "\nReport: {0}/summary.md (metrics: {0}/metrics.csv); explorer: {0}/index.html\n",
-            out.string());
+        write_report(out, *a, s);
+        print_outcome(result, out, s);
         return 0;
     };
 }
@@ -278,13 +300,9 @@ Runner add_compare(CLI::App& app) {
         c.id = std::filesystem::path(a->stack).stem().string();
         c.category = "custom";
         c.parameters = describe_parameters(c.stack);
-        run_study({c}, s, a->out);
-        write_report(a->out, !a->no_figures);
-        fmt::print("\n");
-        print_findings(a->out);
-        fmt::print(
-            "\nReport: {0}/summary.md (metrics: {0}/metrics.csv); explorer: {0}/index.html\n",
-            a->out);
+        const StudyResult result = run_study({c}, s, a->out);
+        write_report(a->out, *a, s);
+        print_outcome(result, a->out, s);
         return 0;
     };
 }

@@ -1,6 +1,7 @@
 #include "cli/options.h"
 
 #include "core/error.h"
+#include "core/incidences.h"
 
 #include <fmt/format.h>
 
@@ -40,9 +41,7 @@ std::vector<double> parse_angle_list(const std::string& text, const std::string&
 std::vector<double> parse_incidences(const std::string& text, const std::string& option) {
     std::vector<double> out = parse_angle_list(text, option);
     for (double t : out)
-        if (!(t >= 0 && t < 90))
-            throw InputError("command line", option,
-                             fmt::format("{} is outside the allowed range [0, 90) degrees", t));
+        check_incidence(t, "command line", option);
     return out;
 }
 

@@ -7,7 +7,9 @@
 
 #include <atomic>
 #include <cstdio>
+#include <cstring>
 #include <system_error>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -47,6 +49,31 @@ void write_file_atomic(const fs::path& path, std::string_view content) {
     }
 }
 
+bool file_holds(const fs::path& path, std::string_view content) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) != content.size() || ec)
+        return false;
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return false;
+    std::vector<char> buffer(1 << 16);
+    std::size_t at = 0;
+    bool same = true;
+    while (same) {
+        const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), f);
+        if (n == 0) break;
+        same = at + n <= content.size() && std::memcmp(buffer.data(), content.data() + at, n) == 0;
+        at += n;
+    }
+    std::fclose(f);
+    return same && at == content.size();
+}
+
+bool write_file_if_changed(const fs::path& path, std::string_view content) {
+    if (file_holds(path, content)) return false;
+    write_file_atomic(path, content);
+    return true;
+}
+
 StagedOutput::StagedOutput(fs::path dir) : dir_(std::move(dir)) {
     std::error_code ec;
     fs::create_directories(dir_, ec);
@@ -69,6 +96,12 @@ StagedOutput::~StagedOutput() {
 void StagedOutput::add(const std::string& name, std::string_view content) {
     write_all(staging_ / name, content);
     names_.push_back(name);
+}
+
+bool StagedOutput::add_if_changed(const std::string& name, std::string_view content) {
+    if (file_holds(dir_ / name, content)) return false;
+    add(name, content);
+    return true;
 }
 
 void StagedOutput::commit() {

@@ -13,6 +13,14 @@ namespace lamina {
 /// temporary file is removed and any previous `path` is left untouched.
 void write_file_atomic(const std::filesystem::path& path, std::string_view content);
 
+/// write_file_atomic, except that a `path` already holding exactly `content` is left untouched
+/// (content and modification time): a re-run that changes nothing rewrites nothing. Returns
+/// whether it wrote.
+bool write_file_if_changed(const std::filesystem::path& path, std::string_view content);
+
+/// Whether `path` is a regular file holding exactly `content`.
+bool file_holds(const std::filesystem::path& path, std::string_view content);
+
 /// A set of files written together into one folder: every file is staged in a hidden temporary
 /// folder inside the target, and `commit()` renames them all into place. If the object is destroyed
 /// without commit (an error, an exception), nothing staged reaches the target folder.
@@ -26,6 +34,9 @@ class StagedOutput {
 
     /// Stages one file (name relative to the target folder).
     void add(const std::string& name, std::string_view content);
+    /// Stages it only if the target folder does not already hold exactly `content` under `name`
+    /// (which then keeps its modification time). Returns whether it staged.
+    bool add_if_changed(const std::string& name, std::string_view content);
     /// Moves every staged file into the target folder.
     void commit();
 

@@ -9,7 +9,9 @@
 #include <fstream>
 #include <string>
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <numeric>
 
@@ -17,16 +19,17 @@ namespace lamina {
 
 static_assert(std::endian::native == std::endian::little, "npy writer assumes little-endian");
 
-std::string npy_float32(const std::vector<float>& data, const std::vector<std::size_t>& shape) {
-    const std::size_t count =
-        std::accumulate(shape.begin(), shape.end(), std::size_t(1), std::multiplies<>());
-    LAMINA_CHECK(count == data.size());
+namespace {
+
+// Magic, version 1.0, the header dict padded to 64 bytes, then `bytes` of data.
+std::string npy_bytes(const char* descr, const void* data, std::size_t bytes,
+                      const std::vector<std::size_t>& shape) {
     std::string dims;
     for (std::size_t d : shape)
         dims += fmt::format("{}, ", d);
     if (shape.size() > 1) dims.resize(dims.size() - 2);  // "(n,)" for one dimension
     std::string header =
-        fmt::format("{{'descr': '<f4', 'fortran_order': False, 'shape': ({}), }}", dims);
+        fmt::format("{{'descr': '{}', 'fortran_order': False, 'shape': ({}), }}", descr, dims);
     // Pad with spaces so that magic (6) + version (2) + length (2) + header + '\n' is a multiple
     // of 64 (the format asks for 16; 64 aligns the data for any reader).
     const std::size_t unpadded = 10 + header.size() + 1;
@@ -40,9 +43,40 @@ std::string npy_float32(const std::vector<float>& data, const std::vector<std::s
     out += char(len >> 8);
     out += header;
     const std::size_t offset = out.size();
-    out.resize(offset + data.size() * sizeof(float));
-    std::memcpy(out.data() + offset, data.data(), data.size() * sizeof(float));
+    out.resize(offset + bytes);
+    std::memcpy(out.data() + offset, data, bytes);
     return out;
+}
+
+std::size_t element_count(const std::vector<std::size_t>& shape) {
+    return std::accumulate(shape.begin(), shape.end(), std::size_t(1), std::multiplies<>());
+}
+
+}  // namespace
+
+std::string npy_float32(const std::vector<float>& data, const std::vector<std::size_t>& shape) {
+    LAMINA_CHECK(element_count(shape) == data.size());
+    return npy_bytes("<f4", data.data(), data.size() * sizeof(float), shape);
+}
+
+std::uint16_t float_to_half(float v) {
+    // IEEE 754 binary16 by the compiler's conversion (round to nearest, ties to even), after
+    // clamping to the largest finite half so that nothing becomes infinite.
+    if (!std::isnan(v)) v = std::clamp(v, -kHalfMax, kHalfMax);
+    const _Float16 h = static_cast<_Float16>(v);
+    return std::bit_cast<std::uint16_t>(h);
+}
+
+float half_to_float(std::uint16_t bits) {
+    return static_cast<float>(std::bit_cast<_Float16>(bits));
+}
+
+std::string npy_float16(const std::vector<float>& data, const std::vector<std::size_t>& shape) {
+    LAMINA_CHECK(element_count(shape) == data.size());
+    std::vector<std::uint16_t> half(data.size());
+    for (std::size_t i = 0; i < data.size(); ++i)
+        half[i] = float_to_half(data[i]);
+    return npy_bytes("<f2", half.data(), half.size() * sizeof(std::uint16_t), shape);
 }
 
 namespace {
@@ -91,9 +125,12 @@ NpyFloat32 read_npy_float32(const std::filesystem::path& path) {
     std::string header(header_len, '\0');
     if (!in.read(header.data(), header_len)) throw InputError(where, "", "truncated header");
     const std::string descr = header_value(header, "descr");
-    if (descr != "'<f4'")
+    if (descr != "'<f4'" && descr != "'<f2'")
         throw InputError(where, "descr",
-                         fmt::format("{}: expected '<f4' (little-endian float32)", descr));
+                         fmt::format("{}: expected '<f4' or '<f2' (little-endian float32 or "
+                                     "float16)",
+                                     descr));
+    const bool half = descr == "'<f2'";
     if (header_value(header, "fortran_order") != "False")
         throw InputError(where, "fortran_order", "expected False (C order)");
     const std::string shape_text = header_value(header, "shape");
@@ -113,10 +150,16 @@ NpyFloat32 read_npy_float32(const std::filesystem::path& path) {
     if (a.shape.empty())
         throw InputError(where, "shape", fmt::format("cannot read {}", shape_text));
     a.data.resize(count);
-    if (!in.read(reinterpret_cast<char*>(a.data.data()), std::streamsize(count * sizeof(float))))
+    a.half = half;
+    std::vector<std::uint16_t> bits(half ? count : 0);
+    char* target =
+        half ? reinterpret_cast<char*>(bits.data()) : reinterpret_cast<char*>(a.data.data());
+    if (!in.read(target, std::streamsize(count * (half ? 2 : sizeof(float)))))
         throw InputError(
             where, "",
             fmt::format("truncated: the header announces shape [{}]", fmt::join(a.shape, ", ")));
+    for (std::size_t i = 0; i < bits.size(); ++i)
+        a.data[i] = half_to_float(bits[i]);
     return a;
 }
 

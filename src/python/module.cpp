@@ -389,6 +389,7 @@ void run_study_py(py::list configs_in, py::dict settings, py::list externals,
                          "multiple scattering on the microsurfaces runs on the scalar kernel only: "
                          "add kernel='scalar'");
     s.quiet = settings["quiet"].cast<bool>();
+    s.tables = parse_tables_format(settings["tables"].cast<std::string>(), "tables");
     s.registry_models = settings["registry_models"].cast<bool>();
     for (py::handle e : externals) {
         ExternalModel m;

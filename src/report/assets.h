@@ -10,6 +10,8 @@ namespace lamina::assets {
 std::string_view explorer_html();
 std::string_view explorer_js();
 std::string_view explorer_css();
+/// web/model-colors.json: the one table of model colours, for the page and the figures.
+std::string_view model_colors_json();
 /// Empty when node_modules/plotly.js-dist-min was absent when the build was configured.
 std::string_view plotly_js();
 std::string_view figures_py();

@@ -2,7 +2,10 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/grid.h"
+#include "core/hash.h"
 #include "core/npy.h"
+#include "lamina/version.h"
 #include "report/assets.h"
 
 #include <fmt/format.h>
@@ -84,10 +87,15 @@ json read_metrics(const fs::path& path, const std::vector<double>& theta_i) {
     const std::size_t c_config = column("config"), c_model = column("model"),
                       c_theta = column("theta_i"), c_side = column("side"),
                       c_channel = column("channel"), c_supported = column("supported");
-    const std::pair<const char*, std::size_t> metrics[] = {{"me", column("misplaced_energy")},
-                                                           {"nf", column("noise_floor")},
-                                                           {"ae", column("albedo_error")},
-                                                           {"lr", column("log_rmse")}};
+    std::vector<std::pair<const char*, std::size_t>> metrics = {{"me", column("misplaced_energy")},
+                                                                {"nf", column("noise_floor")},
+                                                                {"ae", column("albedo_error")},
+                                                                {"lr", column("log_rmse")}};
+    // The floored misplaced energy and its noise floor: absent from studies written before them.
+    for (const auto& [key, name] :
+         {std::pair{"mf", "misplaced_floor"}, std::pair{"nf_mf", "misplaced_floor_noise"}})
+        if (std::find(header.begin(), header.end(), name) != header.end())
+            metrics.emplace_back(key, column(name));
     std::size_t row = 1;
     while (std::getline(in, line)) {
         ++row;
@@ -163,13 +171,14 @@ struct LogCodec {
     }
 };
 
-// Ω⊥ of a bin of θ row `t` on the folded grid of docs/formats.md (θ uniform over [0°, 90°], φ
-// uniform over [0°, 180°]; both folded halves): Δφ (sin²θ_hi − sin²θ_lo), the same for every φ bin.
-double omega_perp(int n_theta, int n_phi, int t) {
-    const double dphi = M_PI / n_phi;
-    const double s0 = std::sin(0.5 * M_PI * t / n_theta);
-    const double s1 = std::sin(0.5 * M_PI * (t + 1) / n_theta);
-    return dphi * (s1 * s1 - s0 * s0);
+// Ω⊥ of each θ row's bins on the folded grid of docs/formats.md: the grid's own
+// (HemisphereGrid::projected_solid_angle, the same for every φ bin of a row).
+std::vector<double> omega_perp_rows(std::size_t n_theta, std::size_t n_phi) {
+    const HemisphereGrid grid{int(n_theta), int(n_phi)};
+    std::vector<double> rows(n_theta);
+    for (std::size_t t = 0; t < n_theta; ++t)
+        rows[t] = grid.projected_solid_angle(int(t), 0);
+    return rows;
 }
 
 // Groups of `k` consecutive bins (the last one may be shorter): the edges of the merged bins.
@@ -211,6 +220,7 @@ std::vector<float> merge_bins(const BinBlocks& b, const std::vector<int>& et,
                               const std::vector<int>& ep, bool quadrature) {
     std::vector<float> out;
     out.reserve(b.blocks() * (et.size() - 1) * (ep.size() - 1) * 3);
+    const std::vector<double> omega = omega_perp_rows(b.T, b.P);
     for (std::size_t k = 0; k < b.blocks(); ++k)
         for (std::size_t t2 = 0; t2 + 1 < et.size(); ++t2)
             for (std::size_t p2 = 0; p2 + 1 < ep.size(); ++p2)
@@ -218,7 +228,7 @@ std::vector<float> merge_bins(const BinBlocks& b, const std::vector<int>& et,
                     double num = 0, den = 0;
                     for (int t = et[t2]; t < et[t2 + 1]; ++t)
                         for (int p = ep[p2]; p < ep[p2 + 1]; ++p) {
-                            const double w = omega_perp(int(b.T), int(b.P), t);
+                            const double w = omega[t];
                             const double v = b.at(k, t, p, c) * w;
                             num += quadrature ? v * v : v;
                             den += w;
@@ -247,6 +257,7 @@ std::vector<std::uint16_t> log_codes(const std::vector<float>& values, LogCodec&
 // error with the bins taken as independent (a slight overestimate: a particle lands in one bin).
 std::vector<std::optional<std::array<double, 3>>> albedos(const BinBlocks& b, bool quadrature) {
     std::vector<std::optional<std::array<double, 3>>> out;
+    const std::vector<double> omega = omega_perp_rows(b.T, b.P);
     for (std::size_t k = 0; k < b.blocks(); ++k) {
         std::array<double, 3> a = {0, 0, 0};
         bool finite = false;
@@ -256,7 +267,7 @@ std::vector<std::optional<std::array<double, 3>>> albedos(const BinBlocks& b, bo
                     const float f = b.at(k, t, p, c);
                     if (std::isnan(f)) continue;
                     finite = true;
-                    const double v = f * omega_perp(int(b.T), int(b.P), int(t));
+                    const double v = f * omega[t];
                     a[c] += quadrature ? v * v : v;
                 }
         if (quadrature)
@@ -432,6 +443,28 @@ std::string plotly_bundle() {
     return ss.str();
 }
 
+// What a configuration's page data is encoded from: its files (config.json, the tables, the
+// renderings' names and errors.csv), its index entry, the study's axes and this lamina.
+std::string inputs_digest(const fs::path& dir, const json& entry,
+                          const std::vector<double>& theta_i, int n_theta, int n_phi) {
+    std::uint64_t h = fnv1a(fmt::format("explorer data v1 | lamina {} | {} | {} | {}x{}", kVersion,
+                                        entry.dump(), fmt::join(theta_i, ","), n_theta, n_phi));
+    for (const char* name :
+         {"config.json", "tables.npy", "reference_se.npy", "renders/errors.csv"}) {
+        std::ifstream in(dir / name, std::ios::binary);
+        std::stringstream ss;
+        if (in) ss << in.rdbuf();
+        h = fnv1a(fmt::format("| {} {} |", name, bool(in)), h);
+        h = fnv1a(ss.str(), h);
+    }
+    std::error_code ec;
+    std::vector<std::string> renders;
+    for (const auto& e : fs::directory_iterator(dir / "renders", ec))
+        if (e.path().extension() == ".png") renders.push_back(e.path().filename().string());
+    std::sort(renders.begin(), renders.end());
+    return digest_hex(fnv1a(fmt::format("{}", fmt::join(renders, ",")), h));
+}
+
 }  // namespace
 
 ExplorerSummary write_explorer(const fs::path& study_dir) {
@@ -460,31 +493,55 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
     fs::path folder = fs::absolute(study_dir).lexically_normal();
     if (folder.filename().empty()) folder = folder.parent_path();
     index["study"]["name"] = folder.filename().string();
+    // A configuration whose inputs (its files, the study's axes, this lamina) are those the last
+    // page was drawn from is not encoded again: its index entry comes from the stamps.
+    const fs::path stamps_path = study_dir / "explorer" / "data" / ".inputs.json";
+    json stamps = json::object(), new_stamps = json::object();
+    if (std::ifstream in(stamps_path); in) {
+        try {
+            stamps = json::parse(in);
+        } catch (const std::exception&) {
+            stamps = json::object();
+        }
+    }
     for (const json& c : configurations) {
         const std::string id = field<std::string>(c, "id", study_path);
         json entry = {{"id", id},
                       {"category", c.value("category", "custom")},
                       {"parameters", c.value("parameters", json::object())}};
-        ConfigData d =
-            encode_configuration(study_dir / "configs" / id, id, theta_i, n_theta, n_phi, entry);
-        entry["albedo"] = d.albedo;
-        entry["albedo_se"] = d.albedo_se;
-        summary.data_bytes += d.script.size();
-        data_out.add(id + ".js", d.script);
+        const fs::path dir = study_dir / "configs" / id;
+        const std::string digest = inputs_digest(dir, entry, theta_i, n_theta, n_phi);
+        const fs::path script = study_dir / "explorer" / "data" / (id + ".js");
+        if (stamps.contains(id) && stamps[id].is_object() &&
+            stamps[id].value("digest", "") == digest && stamps[id].contains("entry") &&
+            fs::exists(script)) {
+            entry = stamps[id]["entry"];
+            summary.data_bytes += fs::file_size(script);
+            ++summary.unchanged;
+        } else {
+            ConfigData d = encode_configuration(dir, id, theta_i, n_theta, n_phi, entry);
+            entry["albedo"] = d.albedo;
+            entry["albedo_se"] = d.albedo_se;
+            summary.data_bytes += d.script.size();
+            data_out.add_if_changed(id + ".js", d.script);
+        }
+        new_stamps[id] = {{"digest", digest}, {"entry", entry}};
         index["configs"].push_back(entry);
         ++summary.configurations;
     }
     index["metrics"] = read_metrics(study_dir / "metrics.csv", theta_i);
+    index["palette"] = json::parse(assets::model_colors_json());
     const std::string index_js = "window.LAMINA_INDEX = " + index.dump() + ";\n";
     summary.data_bytes += index_js.size();
-    data_out.add("index.js", index_js);
+    data_out.add_if_changed("index.js", index_js);
+    data_out.add_if_changed(".inputs.json", new_stamps.dump() + "\n");
 
     StagedOutput page_out(study_dir / "explorer");
-    page_out.add("plotly.min.js", plotly);
-    page_out.add("explorer.js", assets::explorer_js());
-    page_out.add("explorer.css", assets::explorer_css());
+    page_out.add_if_changed("plotly.min.js", plotly);
+    page_out.add_if_changed("explorer.js", assets::explorer_js());
+    page_out.add_if_changed("explorer.css", assets::explorer_css());
     StagedOutput root_out(study_dir);
-    root_out.add("index.html", assets::explorer_html());
+    root_out.add_if_changed("index.html", assets::explorer_html());
     data_out.commit();
     page_out.commit();
     root_out.commit();

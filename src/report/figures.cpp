@@ -1,6 +1,7 @@
 #include "report/figures.h"
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "report/assets.h"
 
 #include <fmt/format.h>
@@ -58,14 +59,20 @@ void write_figures(const fs::path& study_dir, const FigureOptions& options) {
 
     // The script is embedded; python reads it from standard input ("-").
     const std::string python = choose_python(options.python);
-    std::string command = fmt::format("{} - {} --formats {}", shell_quote(python),
-                                      shell_quote(study_dir.string()), formats);
+    const std::string_view script = assets::figures_py();
+    // The script's digest (it reads itself from stdin, so it cannot hash its own file): part of
+    // every figure's inputs, so a new lamina redraws what its script draws differently.
+    std::string command =
+        fmt::format("{} - {} --formats {} --script-id {:016x}", shell_quote(python),
+                    shell_quote(study_dir.string()), formats, fnv1a(script));
     if (!options.only.empty()) command += " --only " + shell_quote(options.only);
+    if (options.force) command += " --force";
+    // The palette the explorer page uses too (web/model-colors.json, embedded).
+    ::setenv("LAMINA_MODEL_COLORS", std::string(assets::model_colors_json()).c_str(), 1);
     std::FILE* pipe = ::popen(command.c_str(), "w");
     if (!pipe) throw InputError(python, "", "cannot start the figure script's interpreter");
     // An interpreter that exits before reading the script must not kill lamina with SIGPIPE.
     const auto previous = std::signal(SIGPIPE, SIG_IGN);
-    const std::string_view script = assets::figures_py();
     std::fwrite(script.data(), 1, script.size(), pipe);
     const int status = ::pclose(pipe);
     std::signal(SIGPIPE, previous);

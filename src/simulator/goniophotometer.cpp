@@ -2,6 +2,7 @@
 
 #include "core/check.h"
 #include "core/error.h"
+#include "core/incidences.h"
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
@@ -31,9 +32,7 @@ void validate_settings(const SimulationSettings& s) {
     if (s.theta_i_deg.empty())
         throw InputError("command line", "--theta-i", "at least one incidence is needed");
     for (double t : s.theta_i_deg)
-        if (!(t >= 0 && t < 90))
-            throw InputError("command line", "--theta-i",
-                             fmt::format("{} is outside the allowed range [0, 90) degrees", t));
+        check_incidence(t, "command line", "--theta-i");
     if (s.particles == 0)
         throw InputError("command line", "--particles", "the particle count must be > 0");
     if (s.threads < 0)

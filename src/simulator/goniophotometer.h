@@ -12,6 +12,7 @@
 // whose sums do not depend on order: the output is bitwise identical for any thread count.
 
 #include "core/grid.h"
+#include "core/incidences.h"
 #include "core/rgb.h"
 #include "core/table.h"
 #include "layers/stack.h"
@@ -54,7 +55,7 @@ Microsurface parse_microsurface(const std::string& text,
 inline constexpr int kMaxMicrosurfaceOrder = 100;
 
 struct SimulationSettings {
-    std::vector<double> theta_i_deg{0, 15, 30, 45, 60, 70, 80};  ///< each in [0, 90)
+    std::vector<double> theta_i_deg = default_incidences_deg();  ///< each in [0, 90)
     std::uint64_t particles = 1'000'000;                         ///< per incidence, > 0
     std::uint64_t seed = 1;
     int threads = 0;  ///< 0: all available

@@ -7,7 +7,7 @@
 // production coat per category. Computed from the metric rows alone (BRDF rows: the production
 // coats have no BTDF); the summary calls it with the rows it already has.
 
-#include "study/study.h"
+#include "study/settings.h"
 
 #include <nlohmann/json.hpp>
 

@@ -2,6 +2,8 @@
 
 #include "core/check.h"
 
+#include <algorithm>
+
 namespace lamina {
 
 LobeMetrics lobe_metrics(const HemisphereGrid& grid, const std::vector<Rgbd>& reference,
@@ -22,6 +24,7 @@ LobeMetrics lobe_metrics(const HemisphereGrid& grid, const std::vector<Rgbd>& re
     LobeMetrics m;
     m.albedo_ref = ref_energy;
     m.albedo_model = model_energy;
+    m.misplaced_floor = abs_diff / std::max(ref_energy, kMisplacedFloorEnergy);
     if (ref_energy > 0) {
         m.misplaced_energy = abs_diff / ref_energy;
         m.albedo_error = (model_energy - ref_energy) / ref_energy;
@@ -38,6 +41,7 @@ LobeMetrics noise_floor(const HemisphereGrid& grid, const std::vector<Rgbd>& hal
     // the noise of the mean is half the noise of the difference (in standard deviation: 1/2).
     LobeMetrics m = lobe_metrics(grid, half_a, half_b, channel);
     m.misplaced_energy /= 2;
+    m.misplaced_floor /= 2;
     m.albedo_error /= 2;
     m.rmse /= 2;
     m.log_rmse /= 2;

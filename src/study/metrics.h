@@ -10,10 +10,19 @@
 
 namespace lamina {
 
+/// The energy below which misplaced_floor stops dividing by the reference's own energy: 5% of the
+/// incident light (a directional albedo of 0.05).
+inline constexpr double kMisplacedFloorEnergy = 0.05;
+
 struct LobeMetrics {
     /// Σ|f − f̂|Ω⊥ / Σ f̂ Ω⊥: the fraction of the reference's energy misplaced, added or removed.
-    /// NaN when the reference lobe holds no energy.
+    /// NaN when the reference lobe holds no energy; unbounded where it holds almost none (a
+    /// tinted slab's blue transmission at grazing incidence).
     double misplaced_energy = NAN;
+    /// Σ|f − f̂|Ω⊥ / max(Σ f̂ Ω⊥, kMisplacedFloorEnergy): the misplaced energy relative to the
+    /// reference's energy where that is at least 5% of the incident light, relative to 5% of it
+    /// below. Always finite for finite tables; the study ranks models by it.
+    double misplaced_floor = 0;
     double albedo_ref = 0;    ///< Σ f̂ Ω⊥
     double albedo_model = 0;  ///< Σ f Ω⊥
     /// (albedo_model − albedo_ref) / albedo_ref; NaN when albedo_ref = 0.

@@ -2,11 +2,14 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/hash.h"
 #include "lamina/version.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -17,19 +20,10 @@ namespace {
 
 constexpr const char* kMagic = "lamina-reference-piece v1\n";
 
-std::uint64_t fnv1a(const std::string& s) {
-    // Fowler–Noll–Vo FNV-1a, 64 bits (offset basis and prime from the FNV specification).
-    std::uint64_t h = 0xcbf29ce484222325ull;
-    for (unsigned char c : s) {
-        h ^= c;
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}
-
 nlohmann::json metrics_json(const LobeMetrics& m) {
     auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
     return {{"misplaced_energy", num(m.misplaced_energy)},
+            {"misplaced_floor", m.misplaced_floor},
             {"albedo_ref", m.albedo_ref},
             {"albedo_model", m.albedo_model},
             {"albedo_error", num(m.albedo_error)},
@@ -46,6 +40,17 @@ LobeMetrics metrics_from_json(const nlohmann::json& j) {
     m.albedo_error = num(j.at("albedo_error"));
     m.rmse = j.at("rmse").get<double>();
     m.log_rmse = j.at("log_rmse").get<double>();
+    if (j.contains("misplaced_floor")) {
+        m.misplaced_floor = j.at("misplaced_floor").get<double>();
+    } else {
+        // A piece stored before misplaced_floor existed: the same Σ|b − a|Ω⊥ (halved) over the
+        // floored energy. With a's energy 0, |b − a| = b (tallies are ≥ 0), whose energy is
+        // albedo_model (not halved by noise_floor), so Σ|b − a|Ω⊥ / 2 = albedo_model / 2.
+        m.misplaced_floor =
+            m.albedo_ref > 0 && std::isfinite(m.misplaced_energy)
+                ? m.misplaced_energy * m.albedo_ref / std::max(m.albedo_ref, kMisplacedFloorEnergy)
+                : m.albedo_model / 2 / kMisplacedFloorEnergy;
+    }
     return m;
 }
 

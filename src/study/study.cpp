@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/npy.h"
 #include "core/progress.h"
 #include "lamina/version.h"
@@ -17,13 +18,16 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <memory>
+#include <optional>
 
 namespace lamina {
 
 namespace {
 
 constexpr const char* kChannels[3] = {"r", "g", "b"};
+constexpr const char* kStateFormat = "lamina-study-state v1";
 
 nlohmann::json rgb(const Rgbd& v) {
     return nlohmann::json::array({v[0], v[1], v[2]});
@@ -36,131 +40,332 @@ std::string csv_number(double v) {
 struct ConfigResult {
     std::vector<MetricRow> rows;
     std::vector<Rgbd> lost_microsurface;  ///< the reference's, per incidence
+    double reference_seconds = 0;         ///< the simulation time stored in its pieces
 };
 
-// Evaluates one configuration: reference pieces, models, metrics; writes configs/<id>/.
+// ---- The digests of a configuration's inputs ---------------------------------------------------
+
+// Everything a model's binned table depends on: the model (name, options, lamina's version), the
+// stack, the incidences, the grid and the binning rule.
+std::string model_key(const std::string& name, const StudyConfiguration& config,
+                      const StudySettings& s) {
+    // A model from elsewhere (a table file, a Python plugin) may change without its name
+    // changing: it is evaluated again on every run (a key no earlier run had).
+    for (const ExternalModel& e : s.external_models)
+        if (e.name == name)
+            return fmt::format("external {} | {} | run {}", name, e.source,
+                               std::chrono::system_clock::now().time_since_epoch().count());
+    const ModelSpec spec = parse_model_spec(name, "--models");
+    const BinnedOptions b;
+    return fmt::format(
+        "lamina {} | model {} | options {} | stack {} | theta_i {} | grid {} | binned {} {} {} {} "
+        "{}",
+        kVersion, name,
+        nlohmann::json(resolve_options(*spec.entry, spec.assignments, "--models")).dump(),
+        stack_to_json(config.stack).dump(), fmt::join(s.theta_i_deg, ","), s.grid.to_string(),
+        b.rel_tol, b.abs_tol, b.max_depth, b.peak_depth, b.eval_budget);
+}
+
+std::filesystem::path state_path(const std::filesystem::path& out_dir, const std::string& id) {
+    return out_dir / "cache" / "study" / (id + ".json");
+}
+
+nlohmann::json read_state(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    if (!in) return nullptr;
+    try {
+        nlohmann::json j = nlohmann::json::parse(in);
+        return j.is_object() ? j : nlohmann::json();
+    } catch (const std::exception&) {
+        return nullptr;  // a damaged state is recomputed, never trusted
+    }
+}
+
+nlohmann::json num(double v) {
+    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+double num_of(const nlohmann::json& v) {
+    return v.is_number() ? v.get<double>() : NAN;
+}
+
+// A metric row as the state keeps it (every double exactly: JSON numbers round-trip).
+nlohmann::json row_json(const MetricRow& r) {
+    const LobeMetrics &m = r.metrics, &f = r.floor;
+    return {r.theta_i,
+            std::string(1, r.side),
+            r.channel,
+            r.supported,
+            num(m.misplaced_energy),
+            num(m.misplaced_floor),
+            num(m.albedo_ref),
+            num(m.albedo_model),
+            num(m.albedo_error),
+            num(m.rmse),
+            num(m.log_rmse),
+            num(f.misplaced_energy),
+            num(f.misplaced_floor)};
+}
+
+MetricRow row_from_json(const nlohmann::json& j, const StudyConfiguration& c,
+                        const std::string& model) {
+    MetricRow r;
+    r.config = c.id;
+    r.category = c.category;
+    r.model = model;
+    r.theta_i = j.at(0).get<double>();
+    r.side = j.at(1).get<std::string>().at(0);
+    r.channel = j.at(2).get<int>();
+    r.supported = j.at(3).get<bool>();
+    r.metrics.misplaced_energy = num_of(j.at(4));
+    r.metrics.misplaced_floor = num_of(j.at(5));
+    r.metrics.albedo_ref = num_of(j.at(6));
+    r.metrics.albedo_model = num_of(j.at(7));
+    r.metrics.albedo_error = num_of(j.at(8));
+    r.metrics.rmse = num_of(j.at(9));
+    r.metrics.log_rmse = num_of(j.at(10));
+    r.floor.misplaced_energy = num_of(j.at(11));
+    r.floor.misplaced_floor = num_of(j.at(12));
+    return r;
+}
+
+std::string tables_bytes(TablesFormat format, const std::vector<float>& data,
+                         const std::vector<std::size_t>& shape) {
+    return format == TablesFormat::Half ? npy_float16(data, shape) : npy_float32(data, shape);
+}
+
+// ---- One configuration
+// ---------------------------------------------------------------------------
+
+struct ModelOutcome {
+    std::string name, key;
+    Support support;
+    std::vector<MetricRow> rows;
+    nlohmann::json albedo;     ///< {"R": [rgb or null per incidence], "T": …}
+    std::vector<float> table;  ///< [incidence][side][bin][channel]; NaN where not supported
+    bool reused = false;
+};
+
+// Evaluates one configuration: reference pieces, models, metrics; writes configs/<id>/ — or, when
+// its inputs are those of the last run, reads back what that run found.
 ConfigResult run_configuration(const StudyConfiguration& config, const StudySettings& s,
                                const std::vector<std::string>& model_names,
-                               const std::filesystem::path& out_dir, Progress& progress) {
+                               const std::filesystem::path& out_dir, Progress& progress,
+                               StudyWork& work) {
     const std::size_t n_inc = s.theta_i_deg.size();
     const HemisphereGrid& grid = s.grid;
+    const std::size_t bins = grid.size();
+    const std::filesystem::path config_dir = out_dir / "configs" / config.id;
+
+    // 0. The digests of the inputs, and what the last run left.
+    std::vector<ReferenceKey> keys;
+    std::uint64_t ref_digest = fnv1a("reference");
+    for (double theta_i : s.theta_i_deg) {
+        keys.push_back({config.id, config.stack, theta_i, s.particles, s.seed, grid, s.kernel,
+                        s.microsurface});
+        ref_digest = fnv1a(keys.back().canonical(), ref_digest);
+    }
+    std::vector<std::string> model_keys;
+    std::uint64_t outputs_digest =
+        fnv1a(fmt::format("{} | reference {} | tables {}", kStateFormat, digest_hex(ref_digest),
+                          tables_format_name(s.tables)));
+    for (const std::string& name : model_names) {
+        model_keys.push_back(digest_hex(fnv1a(model_key(name, config, s))));
+        outputs_digest = fnv1a(" | " + name + " " + model_keys.back(), outputs_digest);
+    }
+    const nlohmann::json state =
+        s.recompute ? nlohmann::json() : read_state(state_path(out_dir, config.id));
+    const bool outputs_there = std::filesystem::exists(config_dir / "config.json") &&
+                               (s.tables == TablesFormat::None ||
+                                (std::filesystem::exists(config_dir / "tables.npy") &&
+                                 std::filesystem::exists(config_dir / "reference_se.npy")));
+    ConfigResult result;
+    if (state.is_object() && state.value("outputs", "") == digest_hex(outputs_digest) &&
+        outputs_there) {
+        try {
+            for (const std::string& name : model_names)
+                for (const nlohmann::json& r : state.at("models").at(name).at("rows"))
+                    result.rows.push_back(row_from_json(r, config, name));
+            for (const nlohmann::json& v : state.at("lost_microsurface"))
+                result.lost_microsurface.push_back(
+                    Rgbd(v.at(0).get<double>(), v.at(1).get<double>(), v.at(2).get<double>()));
+            result.reference_seconds = state.value("reference_seconds", 0.0);
+            work.model_tables_reused += model_names.size();
+            ++work.configurations_unchanged;
+            return result;
+        } catch (const std::exception&) {
+            result = {};  // a damaged state: recompute below
+        }
+    }
 
     // 1. The reference, one resumable piece per incidence.
     std::vector<ReferencePiece> pieces;
-    for (double theta_i : s.theta_i_deg) {
-        ReferenceKey key{config.id, config.stack, theta_i,  s.particles,
-                         s.seed,    grid,         s.kernel, s.microsurface};
-        pieces.push_back(reference_piece(reference_cache_dir(out_dir), key, s.threads,
-                                         [&](std::uint64_t n) { progress.advance(n); }));
+    for (const ReferenceKey& key : keys) {
+        bool computed = false;
+        pieces.push_back(reference_piece(
+            reference_cache_dir(out_dir), key, s.threads,
+            [&](std::uint64_t n) { progress.advance(n); }, &computed));
+        work.reference_pieces_computed += computed;
+        result.reference_seconds += pieces.back().seconds;
     }
     const bool transmits = pieces.front().has_transmission;
     const int n_sides = transmits ? 2 : 1;
+    const std::size_t block = std::size_t(n_sides) * bins * 3;  // one incidence of one source
 
-    // 2. Every model on the same bins.
-    struct ModelOutcome {
-        std::string name;
-        Support support;
-        BinnedTable table;
+    // What the last run's tables hold, for the models whose inputs did not change (read once, when
+    // a model needs them; exact in the same format: a float16 or float32 is written back as read).
+    const bool same_reference =
+        state.is_object() && state.value("reference", "") == digest_hex(ref_digest);
+    std::optional<NpyFloat32> old_tables;
+    std::vector<std::string> old_sources;
+    bool old_loaded = false;
+    auto old_table_of = [&](const std::string& name) -> const float* {
+        if (s.tables == TablesFormat::None) return nullptr;
+        if (!old_loaded) {
+            old_loaded = true;
+            try {
+                if (state.value("tables", "") == tables_format_name(s.tables)) {
+                    std::ifstream in(config_dir / "config.json");
+                    const nlohmann::json cj = nlohmann::json::parse(in);
+                    old_sources = cj.at("sources").get<std::vector<std::string>>();
+                    NpyFloat32 t = read_npy_float32(config_dir / "tables.npy");
+                    if (t.shape == std::vector<std::size_t>{
+                                       old_sources.size(), n_inc, std::size_t(n_sides),
+                                       std::size_t(grid.n_theta()), std::size_t(grid.n_phi()), 3})
+                        old_tables = std::move(t);
+                }
+            } catch (const std::exception&) {
+                old_tables.reset();
+            }
+        }
+        if (!old_tables) return nullptr;
+        const auto it = std::find(old_sources.begin(), old_sources.end(), name);
+        if (it == old_sources.end()) return nullptr;
+        return old_tables->data.data() + std::size_t(it - old_sources.begin()) * n_inc * block;
     };
+
+    // 2. Every model on the same bins, unless its inputs and the reference are unchanged.
     std::vector<ModelOutcome> models;
-    for (const std::string& name : model_names) {
-        ModelOutcome m{name, {}, {}};
+    for (std::size_t k = 0; k < model_names.size(); ++k) {
+        const std::string& name = model_names[k];
+        ModelOutcome m{name, model_keys[k], {}, {}, {}, {}, false};
+        if (same_reference && state.contains("models") && state["models"].contains(name) &&
+            state["models"][name].value("key", "") == m.key) {
+            try {
+                const nlohmann::json& ms = state["models"][name];
+                const float* old = old_table_of(name);
+                if (s.tables == TablesFormat::None || old) {
+                    for (const nlohmann::json& r : ms.at("rows"))
+                        m.rows.push_back(row_from_json(r, config, name));
+                    m.support.brdf = ms.at("support").at("R").get<bool>();
+                    m.support.btdf = ms.at("support").at("T").get<bool>();
+                    m.support.reason = ms.at("support").at("reason").get<std::string>();
+                    m.albedo = ms.at("albedo");
+                    if (old) m.table.assign(old, old + n_inc * block);
+                    m.reused = true;
+                }
+            } catch (const std::exception&) {
+                m = ModelOutcome{name, model_keys[k], {}, {}, {}, {}, false};
+            }
+        }
+        if (m.reused) {
+            ++work.model_tables_reused;
+            models.push_back(std::move(m));
+            continue;
+        }
+        ++work.model_tables_computed;
+        BinnedTable table;
         const auto external = std::find_if(s.external_models.begin(), s.external_models.end(),
                                            [&](const ExternalModel& e) { return e.name == name; });
         if (external != s.external_models.end()) {
             // A table from elsewhere (model table, Python plugin), checked against the study.
-            m.table = external->table(config);
-            if (m.table.has_reflection || m.table.has_transmission)
-                check_external_table(m.table, grid, s.theta_i_deg, transmits, external->source);
-            m.support.brdf = m.table.has_reflection;
-            m.support.btdf = transmits && m.table.has_transmission;
+            table = external->table(config);
+            if (table.has_reflection || table.has_transmission)
+                check_external_table(table, grid, s.theta_i_deg, transmits, external->source);
+            m.support.brdf = table.has_reflection;
+            m.support.btdf = transmits && table.has_transmission;
             if (!m.support.brdf || (transmits && !m.support.btdf))
                 m.support.reason =
-                    m.table.has_reflection || m.table.has_transmission
+                    table.has_reflection || table.has_transmission
                         ? fmt::format("{} has no {} rows", external->source,
                                       m.support.brdf ? "T" : "R")
                         : fmt::format("{} has no table for {}", external->source, config.id);
-            models.push_back(std::move(m));
-            continue;
+        } else {
+            const std::unique_ptr<Model> model = make_model(name, config.stack);
+            m.support = model->support();
+            if (m.support.brdf || m.support.btdf) table = bin_model(*model, grid, s.theta_i_deg);
         }
-        const std::unique_ptr<Model> model = make_model(name, config.stack);
-        m.support = model->support();
-        if (m.support.brdf || m.support.btdf) m.table = bin_model(*model, grid, s.theta_i_deg);
-        models.push_back(std::move(m));
-    }
-
-    // 3. Metrics.
-    ConfigResult result;
-    for (const ModelOutcome& m : models) {
-        for (std::size_t i = 0; i < n_inc; ++i) {
+        m.table.assign(n_inc * block, NAN);
+        m.albedo = nlohmann::json::object();
+        for (std::size_t i = 0; i < n_inc; ++i)
             for (int side = 0; side < n_sides; ++side) {
                 const bool supported = side == 0 ? m.support.brdf : m.support.btdf;
-                for (int c = 0; c < 3; ++c) {
-                    MetricRow row{config.id,
-                                  config.category,
-                                  m.name,
-                                  s.theta_i_deg[i],
-                                  side == 0 ? 'R' : 'T',
-                                  c,
-                                  supported,
-                                  {},
-                                  pieces[i].floor[side][c]};
-                    if (supported) {
-                        const BinnedLobe& lobe =
-                            m.table.lobe(i, side == 0 ? Side::Reflection : Side::Transmission);
-                        row.metrics = lobe_metrics(grid, pieces[i].f[side], lobe.f, c);
-                    }
-                    result.rows.push_back(row);
+                const char* side_name = side == 0 ? "R" : "T";
+                if (!supported) {
+                    m.albedo[side_name].push_back(nullptr);
+                    for (int c = 0; c < 3; ++c)
+                        m.rows.push_back({config.id,
+                                          config.category,
+                                          name,
+                                          s.theta_i_deg[i],
+                                          side_name[0],
+                                          c,
+                                          false,
+                                          {},
+                                          pieces[i].floor[side][c]});
+                    continue;
                 }
+                const BinnedLobe& lobe =
+                    table.lobe(i, side == 0 ? Side::Reflection : Side::Transmission);
+                Rgbd a(0.0);
+                for (std::size_t j = 0; j < bins; ++j)
+                    for (int c = 0; c < 3; ++c) {
+                        m.table[(i * n_sides + side) * bins * 3 + j * 3 + c] = float(lobe.f[j][c]);
+                        a[c] += lobe.f[j][c] * grid.projected_solid_angle(j);
+                    }
+                m.albedo[side_name].push_back(rgb(a));
+                for (int c = 0; c < 3; ++c)
+                    m.rows.push_back({config.id, config.category, name, s.theta_i_deg[i],
+                                      side_name[0], c, true,
+                                      lobe_metrics(grid, pieces[i].f[side], lobe.f, c),
+                                      pieces[i].floor[side][c]});
             }
-        }
+        models.push_back(std::move(m));
     }
+    for (const ModelOutcome& m : models)
+        result.rows.insert(result.rows.end(), m.rows.begin(), m.rows.end());
 
-    // 4. configs/<id>/: config.json, tables.npy, reference_se.npy.
-    const std::size_t bins = grid.size();
+    // 3. configs/<id>/: config.json, tables.npy, reference_se.npy (each rewritten only if changed).
     const std::size_t n_sources = 1 + models.size();
-    std::vector<float> tables(n_sources * n_inc * n_sides * bins * 3, NAN);
-    std::vector<float> ses(n_inc * n_sides * bins * 3);
-    auto at = [&](std::size_t src, std::size_t i, int side, std::size_t j, int c) {
-        return (((src * n_inc + i) * n_sides + side) * bins + j) * 3 + c;
-    };
     nlohmann::json albedo;
+    nlohmann::json supported = nlohmann::json::object();
+    nlohmann::json sources = {"reference"};
+    std::vector<float> tables, ses;
+    if (s.tables != TablesFormat::None) {
+        tables.assign(n_sources * n_inc * block, NAN);
+        ses.assign(n_inc * block, 0.0f);
+    }
     for (std::size_t i = 0; i < n_inc; ++i)
         for (int side = 0; side < n_sides; ++side) {
             Rgbd a(0.0);
             for (std::size_t j = 0; j < bins; ++j)
                 for (int c = 0; c < 3; ++c) {
-                    tables[at(0, i, side, j, c)] = float(pieces[i].f[side][j][c]);
-                    ses[at(0, i, side, j, c)] = float(pieces[i].se[side][j][c]);
+                    const std::size_t at = (i * n_sides + side) * bins * 3 + j * 3 + c;
+                    if (!tables.empty()) {
+                        tables[at] = float(pieces[i].f[side][j][c]);
+                        ses[at] = float(pieces[i].se[side][j][c]);
+                    }
                     a[c] += pieces[i].f[side][j][c] * grid.projected_solid_angle(j);
                 }
             albedo["reference"][side == 0 ? "R" : "T"].push_back(rgb(a));
         }
-    nlohmann::json supported = nlohmann::json::object();
-    nlohmann::json sources = {"reference"};
     for (std::size_t k = 0; k < models.size(); ++k) {
         const ModelOutcome& m = models[k];
         sources.push_back(m.name);
         supported[m.name] = {
             {"R", m.support.brdf}, {"T", m.support.btdf}, {"reason", m.support.reason}};
-        for (int side = 0; side < n_sides; ++side) {
-            const bool ok = side == 0 ? m.support.brdf : m.support.btdf;
-            for (std::size_t i = 0; i < n_inc; ++i) {
-                if (!ok) {
-                    albedo[m.name][side == 0 ? "R" : "T"].push_back(nullptr);
-                    continue;
-                }
-                const BinnedLobe& lobe =
-                    m.table.lobe(i, side == 0 ? Side::Reflection : Side::Transmission);
-                Rgbd a(0.0);
-                for (std::size_t j = 0; j < bins; ++j)
-                    for (int c = 0; c < 3; ++c) {
-                        tables[at(1 + k, i, side, j, c)] = float(lobe.f[j][c]);
-                        a[c] += lobe.f[j][c] * grid.projected_solid_angle(j);
-                    }
-                albedo[m.name][side == 0 ? "R" : "T"].push_back(rgb(a));
-            }
-        }
+        albedo[m.name] = m.albedo;
+        if (!tables.empty())
+            std::copy(m.table.begin(), m.table.end(), tables.begin() + (1 + k) * n_inc * block);
     }
     nlohmann::json energy = nlohmann::json::array();
     for (std::size_t i = 0; i < n_inc; ++i) {
@@ -173,6 +378,12 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
         e["transmitted_se"] = rgb(pieces[i].budget.transmitted_se);
         energy.push_back(e);
     }
+    const std::vector<std::size_t> shape = {n_sources,
+                                            n_inc,
+                                            std::size_t(n_sides),
+                                            std::size_t(grid.n_theta()),
+                                            std::size_t(grid.n_phi()),
+                                            3};
     nlohmann::json cj;
     cj["id"] = config.id;
     cj["category"] = config.category;
@@ -184,18 +395,59 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     cj["supported"] = supported;
     cj["albedo"] = albedo;
     cj["energy"] = energy;
-    cj["tables"] = {{"file", "tables.npy"},
-                    {"shape", {n_sources, n_inc, n_sides, grid.n_theta(), grid.n_phi(), 3}},
-                    {"axes", {"source", "incidence", "side", "theta_bin", "phi_bin", "channel"}}};
-    StagedOutput out(out_dir / "configs" / config.id);
-    out.add("tables.npy",
-            npy_float32(tables, {n_sources, n_inc, std::size_t(n_sides),
-                                 std::size_t(grid.n_theta()), std::size_t(grid.n_phi()), 3}));
-    out.add("reference_se.npy",
-            npy_float32(ses, {n_inc, std::size_t(n_sides), std::size_t(grid.n_theta()),
-                              std::size_t(grid.n_phi()), 3}));
-    out.add("config.json", cj.dump(1) + "\n");
-    out.commit();
+    if (s.tables == TablesFormat::None)
+        cj["tables"] = nullptr;
+    else
+        cj["tables"] = {
+            {"file", "tables.npy"},
+            {"dtype", s.tables == TablesFormat::Half ? "float16" : "float32"},
+            {"shape", shape},
+            {"axes", {"source", "incidence", "side", "theta_bin", "phi_bin", "channel"}}};
+    bool wrote = false;
+    {
+        StagedOutput out(config_dir);
+        if (s.tables != TablesFormat::None) {
+            wrote |= out.add_if_changed("tables.npy", tables_bytes(s.tables, tables, shape));
+            wrote |= out.add_if_changed(
+                "reference_se.npy",
+                tables_bytes(s.tables, ses,
+                             std::vector<std::size_t>(shape.begin() + 1, shape.end())));
+        }
+        wrote |= out.add_if_changed("config.json", cj.dump(1) + "\n");
+        out.commit();
+    }
+    if (s.tables == TablesFormat::None)
+        for (const char* name : {"tables.npy", "reference_se.npy"}) {
+            std::error_code ec;
+            wrote |= std::filesystem::remove(config_dir / name, ec);
+        }
+    work.configurations_written += wrote;
+    work.configurations_unchanged += !wrote;
+
+    // 4. What a later run with the same inputs reads back instead of all of the above.
+    nlohmann::json st;
+    st["format"] = kStateFormat;
+    st["outputs"] = digest_hex(outputs_digest);
+    st["reference"] = digest_hex(ref_digest);
+    st["tables"] = tables_format_name(s.tables);
+    st["reference_seconds"] = result.reference_seconds;
+    st["lost_microsurface"] = nlohmann::json::array();
+    for (const Rgbd& v : result.lost_microsurface)
+        st["lost_microsurface"].push_back(rgb(v));
+    for (const ModelOutcome& m : models) {
+        nlohmann::json rows = nlohmann::json::array();
+        for (const MetricRow& r : m.rows)
+            rows.push_back(row_json(r));
+        st["models"][m.name] = {
+            {"key", m.key},
+            {"support",
+             {{"R", m.support.brdf}, {"T", m.support.btdf}, {"reason", m.support.reason}}},
+            {"albedo", m.albedo},
+            {"rows", rows}};
+    }
+    std::error_code ec;
+    std::filesystem::create_directories(state_path(out_dir, config.id).parent_path(), ec);
+    write_file_if_changed(state_path(out_dir, config.id), st.dump() + "\n");
     return result;
 }
 
@@ -217,13 +469,15 @@ std::string metrics_csv(const std::vector<MetricRow>& rows) {
         fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},", r.config, r.category, r.model,
                        r.theta_i, r.side, kChannels[r.channel]);
         if (r.supported)
-            fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},true\n",
-                           csv_number(r.metrics.misplaced_energy), csv_number(r.metrics.albedo_ref),
+            fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},{},{},true\n",
+                           csv_number(r.metrics.misplaced_energy),
+                           csv_number(r.metrics.misplaced_floor), csv_number(r.metrics.albedo_ref),
                            csv_number(r.metrics.albedo_model), csv_number(r.metrics.albedo_error),
                            csv_number(r.metrics.rmse), csv_number(r.metrics.log_rmse),
-                           csv_number(r.floor.misplaced_energy));
+                           csv_number(r.floor.misplaced_energy),
+                           csv_number(r.floor.misplaced_floor));
         else
-            out += ",,,,,,,false\n";
+            out += ",,,,,,,,,false\n";
     }
     return out;
 }
@@ -289,31 +543,62 @@ std::filesystem::path reference_cache_dir(const std::filesystem::path& out_dir) 
     return out_dir / "cache" / "reference";
 }
 
-std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
-                                 const StudySettings& s, const std::filesystem::path& out_dir) {
+const char* tables_format_name(TablesFormat format) {
+    switch (format) {
+        case TablesFormat::Full:
+            return "full";
+        case TablesFormat::Half:
+            return "half";
+        case TablesFormat::None:
+            return "none";
+    }
+    return "half";
+}
+
+TablesFormat parse_tables_format(const std::string& text, const std::string& option) {
+    if (text == "full") return TablesFormat::Full;
+    if (text == "half") return TablesFormat::Half;
+    if (text == "none") return TablesFormat::None;
+    throw InputError("command line", option,
+                     fmt::format("'{}' is not a table format: use full (float32), half (float16, "
+                                 "half the size) or none (metrics and summary only)",
+                                 text));
+}
+
+std::string describe_work(const StudyWork& w) {
+    return fmt::format(
+        "{} reference pieces simulated, {} model tables computed ({} reused), {} configurations "
+        "written ({} unchanged), {} summary files written",
+        w.reference_pieces_computed, w.model_tables_computed, w.model_tables_reused,
+        w.configurations_written, w.configurations_unchanged, w.files_written);
+}
+
+StudyResult run_study(const std::vector<StudyConfiguration>& configs, const StudySettings& s,
+                      const std::filesystem::path& out_dir) {
     const std::vector<std::string> model_names = study_models(s);
 
     StagedOutput probe(out_dir);  // the folder must be writable before any work starts
-    const auto start = std::chrono::steady_clock::now();
     Progress progress("study", "particles", configs.size() * s.theta_i_deg.size() * s.particles);
-    std::vector<MetricRow> rows;
+    StudyResult result;
     ReferenceLoss lost;
+    double reference_seconds = 0;
     for (std::size_t k = 0; k < configs.size(); ++k) {
         const auto t0 = std::chrono::steady_clock::now();
-        ConfigResult r = run_configuration(configs[k], s, model_names, out_dir, progress);
-        rows.insert(rows.end(), r.rows.begin(), r.rows.end());
+        const std::size_t written_before = result.work.configurations_written;
+        ConfigResult r =
+            run_configuration(configs[k], s, model_names, out_dir, progress, result.work);
+        result.rows.insert(result.rows.end(), r.rows.begin(), r.rows.end());
         lost[configs[k].id] = r.lost_microsurface;
+        reference_seconds += r.reference_seconds;
         if (!s.quiet) {
             progress.clear_line();
-            fmt::print(
-                "[{}/{}] {} ({:.1f} s)\n", k + 1, configs.size(), configs[k].id,
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+            fmt::print("[{}/{}] {} ({:.1f} s{})\n", k + 1, configs.size(), configs[k].id,
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                       result.work.configurations_written > written_before ? "" : ", unchanged");
             std::fflush(stdout);
         }
     }
     progress.finish();
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     nlohmann::json sj;
     sj["lamina_version"] = kVersion;
@@ -325,15 +610,22 @@ std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
     sj["theta_i"] = s.theta_i_deg;
     sj["grid"] = {{"n_theta", s.grid.n_theta()}, {"n_phi", s.grid.n_phi()}};
     sj["models"] = model_names;
-    // The family of each model (the explorer groups them): its registry group, or "ablations"
-    // for a production coat with a flag switched.
+    // The family of each model (the explorer groups them): its registry group, "ablations" for a
+    // production coat with a flag switched, "external" for a model table or a Python model.
     nlohmann::json groups = nlohmann::json::object();
     for (const std::string& name : model_names) {
+        if (std::any_of(s.external_models.begin(), s.external_models.end(),
+                        [&](const ExternalModel& e) { return e.name == name; })) {
+            groups[name] = "external";
+            continue;
+        }
         const ModelSpec spec = parse_model_spec(name, "--models");
         groups[name] = spec.assignments.empty() ? spec.entry->group : std::string("ablations");
     }
     sj["model_groups"] = groups;
-    sj["seconds"] = seconds;
+    sj["tables"] = tables_format_name(s.tables);
+    // The reference's simulation time as stored in its pieces: the same on every re-run.
+    sj["reference_seconds"] = reference_seconds;
     nlohmann::json list = nlohmann::json::array();
     for (const StudyConfiguration& c : configs)
         list.push_back(
@@ -342,10 +634,12 @@ std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
              {"parameters", c.parameters},
              {"sides", c.stack.transmits() ? nlohmann::json{"R", "T"} : nlohmann::json{"R"}}});
     sj["configurations"] = list;
-    write_file_atomic(out_dir / "study.json", sj.dump(1) + "\n");
-    write_file_atomic(out_dir / "metrics.csv", metrics_csv(rows));
-    write_summary(out_dir, configs, s, model_names, rows, lost);
-    return rows;
+    result.work.files_written += write_file_if_changed(out_dir / "study.json", sj.dump(1) + "\n");
+    result.work.files_written +=
+        write_file_if_changed(out_dir / "metrics.csv", metrics_csv(result.rows));
+    result.findings = compute_findings(configs, s, model_names, result.rows, lost);
+    result.work.files_written += write_summary(out_dir, result.findings);
+    return result;
 }
 
 }  // namespace lamina

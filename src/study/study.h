@@ -3,10 +3,9 @@
 // goniophotometer, resumable, as two halves for the noise floor) and every model on the same bins,
 // compared by the study's metrics. Writes the study directory of docs/formats.md.
 
-#include "core/grid.h"
-#include "simulator/goniophotometer.h"
 #include "study/configurations.h"
-#include "study/metrics.h"
+#include "study/settings.h"
+#include "study/summary.h"
 
 #include <cstdint>
 #include <filesystem>
@@ -16,55 +15,9 @@
 
 namespace lamina {
 
-/// A model evaluated elsewhere that joins the study as binned tables, like a built-in model: a
-/// `--model-table NAME=FILE.csv` (a renderer's or a fit's values in the brdf.csv format) or a
-/// Python plugin binned by the Python module. Each table must have the study's grid and
-/// incidences (checked: InputError naming `source`).
-struct ExternalModel {
-    std::string name;
-    std::string source;  ///< where the tables come from (a file, a pattern, "python"), for messages
-    /// The table of one configuration: its R side (and T for a slab). A table with neither side
-    /// (has_reflection and has_transmission both false) means the model does not cover the
-    /// configuration (reported as not supported).
-    std::function<BinnedTable(const StudyConfiguration&)> table;
-};
-
-struct StudySettings {
-    std::string preset = "quick";
-    std::uint64_t particles = 1'000'000;  ///< per incidence (both halves together)
-    std::uint64_t seed = 1;
-    std::vector<double> theta_i_deg{0, 15, 30, 45, 60, 70, 80};
-    HemisphereGrid grid{90, 90};
-    std::vector<std::string> models;  ///< registry names; empty: every model
-    /// Also every production model's one-flag ablations (models/registry.h ablation_variants),
-    /// "NAME:KEY=VALUE": the summary's engine-developer section says which heuristic helps.
-    bool ablations = false;
-    int threads = 0;                                   ///< 0: all cores
-    Kernel kernel = Kernel::Simd;                      ///< the reference's particle kernel
-    Microsurface microsurface = Microsurface::Single;  ///< the reference's rough interfaces
-    bool quiet = false;                                ///< no per-configuration lines on stdout
-    std::vector<ExternalModel> external_models;        ///< compared after the registry's models
-    bool registry_models = true;  ///< false: no registry model unless named in `models`
-};
-
 /// Particles per incidence of the presets: quick 10⁶ (demo and CI), standard 10⁷, paper 1.6·10⁸
 /// (the original study's budget). InputError naming --preset otherwise.
 std::uint64_t preset_particles(const std::string& preset);
-
-/// One row of metrics.csv.
-struct MetricRow {
-    std::string config, category, model;
-    double theta_i = 0;
-    char side = 'R';
-    int channel = 0;
-    bool supported = false;
-    LobeMetrics metrics;  ///< model against the reference (when supported)
-    LobeMetrics floor;    ///< the reference's noise floor
-};
-
-inline constexpr const char* kMetricsCsvHeader =
-    "config,category,model,theta_i,side,channel,misplaced_energy,albedo_ref,albedo_model,"
-    "albedo_error,rmse,log_rmse,noise_floor,supported";
 
 /// The models the study compares: settings.models, or every deterministic model of the registry
 /// when empty; with settings.ablations, then the one-flag variants of each production model
@@ -76,11 +29,34 @@ std::vector<std::string> study_models(const StudySettings& settings);
 /// Where a study in `out_dir` keeps its reference pieces (study/reference.h).
 std::filesystem::path reference_cache_dir(const std::filesystem::path& out_dir);
 
-/// Runs (or resumes) the study into `out_dir`; returns the metric rows it wrote. Progress with an
-/// overall ETA goes to stderr when it is a terminal.
-std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
-                                 const StudySettings& settings,
-                                 const std::filesystem::path& out_dir);
+/// What a run did, to tell an incremental re-run from a fresh one: every count is of work done in
+/// this run, not of what it found done.
+struct StudyWork {
+    std::size_t reference_pieces_computed = 0;  ///< (configuration, incidence) simulated
+    std::size_t model_tables_computed = 0;      ///< (configuration, model) binned and compared
+    std::size_t model_tables_reused = 0;        ///< (configuration, model) read from the cache
+    std::size_t configurations_written = 0;     ///< configs/<id>/ with a file (re)written
+    std::size_t configurations_unchanged = 0;   ///< configs/<id>/ whose inputs did not change
+    std::size_t files_written = 0;  ///< study.json, metrics.csv, summary.json, summary.md
+};
+
+struct StudyResult {
+    std::vector<MetricRow> rows;  ///< metrics.csv
+    StudyFindings findings;       ///< summary.md, summary.json
+    StudyWork work;
+};
+
+/// Runs (or resumes) the study into `out_dir`. Incremental: each configuration's outputs carry the
+/// digest of their inputs (the reference pieces' keys, each model's name, options and lamina
+/// version, the stack, incidences, grid and table format; cache/study/<id>.json), and work whose
+/// inputs are unchanged is read back, not redone; a file whose content is unchanged is not
+/// rewritten. Progress with an overall ETA goes to stderr when it is a terminal.
+StudyResult run_study(const std::vector<StudyConfiguration>& configs, const StudySettings& settings,
+                      const std::filesystem::path& out_dir);
+
+/// One line saying what a run did ("0 reference pieces simulated, 0 model tables computed (420
+/// reused), 0 configurations written (60 unchanged), 0 summary files written").
+std::string describe_work(const StudyWork& work);
 
 /// Checks an external model's table against the study's grid and incidences and the stack's sides
 /// (InputError naming `where`, saying what differs).

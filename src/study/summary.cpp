@@ -11,7 +11,6 @@
 #include <cmath>
 #include <functional>
 #include <limits>
-#include <map>
 #include <set>
 
 namespace lamina {
@@ -20,25 +19,35 @@ namespace {
 
 constexpr const char* kChannels[3] = {"r", "g", "b"};
 
-// Mean and worst of the supported rows of one (group, model).
-struct Aggregate {
-    double sum_e = 0, sum_abs_albedo = 0, sum_floor = 0;
-    int n = 0, n_albedo = 0;
-    double worst_e = -1;
-    const MetricRow* worst_e_row = nullptr;
-    double worst_albedo = 0;
-    const MetricRow* worst_albedo_row = nullptr;
+// ==== Computing the findings =====================================================================
+
+// Running sums of one (group, model) over its supported rows.
+struct Accumulator {
+    double sum_mf = 0, sum_mf_noise = 0, sum_me = 0, sum_me_noise = 0, sum_abs_albedo = 0;
+    int n_mf = 0, n_me = 0, n_albedo = 0;
+    double worst_mf = -1, worst_me = -1, worst_albedo = 0;
+    const MetricRow *worst_mf_row = nullptr, *worst_me_row = nullptr, *worst_albedo_row = nullptr;
     std::set<std::string> configs;
 
     void add(const MetricRow& r) {
-        if (!r.supported || !std::isfinite(r.metrics.misplaced_energy)) return;
-        sum_e += r.metrics.misplaced_energy;
-        sum_floor += std::isfinite(r.floor.misplaced_energy) ? r.floor.misplaced_energy : 0;
-        ++n;
+        if (!r.supported || !std::isfinite(r.metrics.misplaced_floor)) return;
+        const double mf = r.metrics.misplaced_floor;
+        sum_mf += mf;
+        sum_mf_noise += std::isfinite(r.floor.misplaced_floor) ? r.floor.misplaced_floor : 0;
+        ++n_mf;
         configs.insert(r.config);
-        if (r.metrics.misplaced_energy > worst_e) {
-            worst_e = r.metrics.misplaced_energy;
-            worst_e_row = &r;
+        if (mf > worst_mf) {
+            worst_mf = mf;
+            worst_mf_row = &r;
+        }
+        if (std::isfinite(r.metrics.misplaced_energy)) {
+            sum_me += r.metrics.misplaced_energy;
+            sum_me_noise += std::isfinite(r.floor.misplaced_energy) ? r.floor.misplaced_energy : 0;
+            ++n_me;
+            if (r.metrics.misplaced_energy > worst_me) {
+                worst_me = r.metrics.misplaced_energy;
+                worst_me_row = &r;
+            }
         }
         if (std::isfinite(r.metrics.albedo_error)) {
             sum_abs_albedo += std::abs(r.metrics.albedo_error);
@@ -49,31 +58,54 @@ struct Aggregate {
             }
         }
     }
-    double mean_e() const { return n ? sum_e / n : NAN; }
-    double mean_floor() const { return n ? sum_floor / n : NAN; }
-    double mean_abs_albedo() const { return n_albedo ? sum_abs_albedo / n_albedo : NAN; }
+
+    static std::optional<RowPlace> place(const MetricRow* r) {
+        if (!r) return std::nullopt;
+        return RowPlace{r->config, r->theta_i, r->side, r->channel};
+    }
+
+    ModelAggregate result() const {
+        ModelAggregate a;
+        a.rows = n_mf;
+        a.configurations_supported = configs.size();
+        if (n_mf) {
+            a.mean_misplaced_floor = sum_mf / n_mf;
+            a.mean_misplaced_floor_noise = sum_mf_noise / n_mf;
+            a.worst_misplaced_floor = worst_mf;
+            a.worst_misplaced_floor_at = place(worst_mf_row);
+        }
+        if (n_me) {
+            a.mean_misplaced_energy = sum_me / n_me;
+            a.mean_noise_floor = sum_me_noise / n_me;
+            a.worst_misplaced_energy = worst_me;
+            a.worst_misplaced_energy_at = place(worst_me_row);
+        }
+        if (n_albedo) {
+            a.mean_abs_albedo_error = sum_abs_albedo / n_albedo;
+            a.worst_albedo_error = worst_albedo;
+            a.worst_albedo_error_at = place(worst_albedo_row);
+        }
+        return a;
+    }
 };
 
-std::string pct(double v) {
-    if (!std::isfinite(v)) return "–";
-    return fmt::format("{:.1f}%", 100 * v);
-}
-
-std::string where(const MetricRow* r) {
-    if (!r) return "";
-    return fmt::format("{}, θi {}°, {}, {}", r->config, r->theta_i, r->side, kChannels[r->channel]);
-}
-
-nlohmann::json where_json(const MetricRow* r) {
-    if (!r) return nullptr;
-    return {{"config", r->config},
-            {"theta_i", r->theta_i},
-            {"side", std::string(1, r->side)},
-            {"channel", kChannels[r->channel]}};
-}
-
-nlohmann::json num(double v) {
-    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+// Models with rows in `aggregates`, by mean misplaced_floor (ties keep the study's order).
+std::vector<std::string> rank(const std::vector<std::string>& models,
+                              const std::map<std::string, ModelAggregate>& aggregates,
+                              bool keep_unsupported = false) {
+    std::vector<std::string> ranked;
+    for (const std::string& m : models)
+        if (keep_unsupported || (aggregates.count(m) && aggregates.at(m).rows > 0))
+            ranked.push_back(m);
+    auto mean = [&](const std::string& m) {
+        const auto it = aggregates.find(m);
+        return it == aggregates.end() || it->second.rows == 0
+                   ? std::numeric_limits<double>::infinity()
+                   : it->second.mean_misplaced_floor;
+    };
+    std::stable_sort(ranked.begin(), ranked.end(),
+                     [&](const auto& a, const auto& b) { return mean(a) < mean(b); });
+    return ranked;
 }
 
 double parameter(const StudyConfiguration& c, const std::string& key) {
@@ -92,20 +124,71 @@ struct Factor {
     std::vector<std::pair<std::string, std::function<bool(const MetricRow&)>>> levels;
 };
 
+std::vector<Factor> assessment_factors(
+    const std::map<std::string, const StudyConfiguration*>& by_id) {
+    auto config_of = [&by_id](const MetricRow& r) -> const StudyConfiguration& {
+        return *by_id.at(r.config);
+    };
+    return {
+        {"Coat roughness (transmission through the top interface)",
+         "Rows grouped by the top interface's roughness α0. The WW family refracts through a "
+         "single normal; Belcour's operators approximate rough transmission by lobe statistics.",
+         {{"smooth coat (α0 ≤ 0.05)",
+           [=](const MetricRow& r) { return parameter(config_of(r), "alpha0") <= 0.05; }},
+          {"rough coat (α0 ≥ 0.3)",
+           [=](const MetricRow& r) { return parameter(config_of(r), "alpha0") >= 0.3; }}}},
+        {"Base albedo (multiple bounces between base and coat)",
+         "Lambertian bases, per channel: a low albedo leaves mostly the first bounce, a high "
+         "albedo needs every inter-reflection (models without them fall short).",
+         {{"low (ρ ≤ 0.2)",
+           [=](const MetricRow& r) {
+               const auto& c = config_of(r);
+               return c.stack.base().type == InterfaceType::Lambertian &&
+                      c.stack.base().albedo[r.channel] <= 0.2;
+           }},
+          {"high (ρ ≥ 0.5)",
+           [=](const MetricRow& r) {
+               const auto& c = config_of(r);
+               return c.stack.base().type == InterfaceType::Lambertian &&
+                      c.stack.base().albedo[r.channel] >= 0.5;
+           }}}},
+        {"Incidence (grazing angles)",
+         "Rows grouped by θi: Fresnel, masking and path lengths in the coat all grow towards "
+         "grazing incidence.",
+         {{"θi ≤ 30°", [](const MetricRow& r) { return r.theta_i <= 30; }},
+          {"45° ≤ θi ≤ 60°", [](const MetricRow& r) { return r.theta_i >= 45 && r.theta_i <= 60; }},
+          {"θi ≥ 70°", [](const MetricRow& r) { return r.theta_i >= 70; }}}},
+    };
+}
+
 }  // namespace
 
-void write_summary(const std::filesystem::path& out_dir,
-                   const std::vector<StudyConfiguration>& configs, const StudySettings& s,
-                   const std::vector<std::string>& models, const std::vector<MetricRow>& rows,
-                   const ReferenceLoss& lost) {
+const GroupFindings* StudyFindings::group(const std::string& name) const {
+    for (const GroupFindings& g : groups)
+        if (g.name == name) return &g;
+    return nullptr;
+}
+
+StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
+                               const StudySettings& s, const std::vector<std::string>& models,
+                               const std::vector<MetricRow>& rows, const ReferenceLoss& lost) {
+    StudyFindings f;
+    f.preset = s.preset;
+    f.particles = s.particles;
+    f.microsurface = microsurface_name(s.microsurface);
+    f.theta_i = s.theta_i_deg;
+    f.grid = s.grid.to_string();
+    f.models = models;
+    f.configurations = configs.size();
+
     std::map<std::string, const StudyConfiguration*> by_id;
-    std::vector<std::string> categories;
     std::map<std::string, int> configs_in;
     bool any_transmission = false;
     for (const StudyConfiguration& c : configs) {
         by_id[c.id] = &c;
-        if (std::find(categories.begin(), categories.end(), c.category) == categories.end())
-            categories.push_back(c.category);
+        f.category_of[c.id] = c.category;
+        if (std::find(f.categories.begin(), f.categories.end(), c.category) == f.categories.end())
+            f.categories.push_back(c.category);
         ++configs_in[c.category];
         ++configs_in["all"];
         if (c.stack.transmits()) {
@@ -114,42 +197,36 @@ void write_summary(const std::filesystem::path& out_dir,
             any_transmission = true;
         }
     }
+
     // Groups: each category's BRDF, then the BTDF of the categories that transmit (a model's
     // reflection and transmission errors are never averaged together: most models have no BTDF).
-    std::vector<std::string> groups = categories;
-    for (const std::string& c : categories)
-        if (configs_in.count(c + " BTDF")) groups.push_back(c + " BTDF");
-    groups.push_back("all");
-    if (any_transmission) groups.push_back("all BTDF");
-    auto group_of = [](const MetricRow& r) {
-        return r.side == 'T' ? r.category + " BTDF" : r.category;
-    };
-
-    // Aggregates per (group, model).
-    std::map<std::string, std::map<std::string, Aggregate>> agg;
+    std::vector<std::string> group_names = f.categories;
+    for (const std::string& c : f.categories)
+        if (configs_in.count(c + " BTDF")) group_names.push_back(c + " BTDF");
+    group_names.push_back("all");
+    if (any_transmission) group_names.push_back("all BTDF");
+    std::map<std::string, std::map<std::string, Accumulator>> acc;
+    std::map<std::string, std::map<std::string, Accumulator>> per_config;  // BRDF rows
     for (const MetricRow& r : rows) {
-        agg[group_of(r)][r.model].add(r);
-        agg[r.side == 'T' ? "all BTDF" : "all"][r.model].add(r);
+        acc[r.side == 'T' ? r.category + " BTDF" : r.category][r.model].add(r);
+        acc[r.side == 'T' ? "all BTDF" : "all"][r.model].add(r);
+        if (r.side == 'R') per_config[r.config][r.model].add(r);
+        if (!r.supported) {
+            std::string& sides = f.not_supported[r.model][r.config];
+            if (sides.find(r.side) == std::string::npos) {
+                sides += r.side;
+                std::sort(sides.begin(), sides.end());
+            }
+        }
     }
-
-    // Per configuration and model: the mean misplaced energy; support.
-    std::map<std::string, std::map<std::string, Aggregate>> per_config;
-    std::map<std::string, std::map<std::string, std::set<char>>> unsupported;
-    for (const MetricRow& r : rows) {
-        if (r.side == 'R') per_config[r.config][r.model].add(r);  // challenging: the BRDF
-        if (!r.supported) unsupported[r.model][r.config].insert(r.side);
-    }
-
-    // Rankings: models by mean misplaced energy within each group (supported rows only).
-    std::map<std::string, std::vector<std::string>> ranking;
-    for (const std::string& g : groups) {
-        std::vector<std::string> ranked;
+    for (const std::string& g : group_names) {
+        GroupFindings gf;
+        gf.name = g;
+        gf.configurations = configs_in[g];
         for (const std::string& m : models)
-            if (agg[g][m].n > 0) ranked.push_back(m);
-        std::stable_sort(ranked.begin(), ranked.end(), [&](const auto& a, const auto& b) {
-            return agg[g][a].mean_e() < agg[g][b].mean_e();
-        });
-        ranking[g] = ranked;
+            gf.models[m] = acc[g][m].result();
+        gf.ranking = rank(models, gf.models);
+        f.groups.push_back(std::move(gf));
     }
 
     // Like for like: the overall ranking above averages each model over the configurations it
@@ -161,35 +238,28 @@ void write_summary(const std::filesystem::path& out_dir,
         bool all = !models.empty();
         for (const std::string& m : models) {
             const auto it = per_config.find(c.id);
-            if (it == per_config.end() || !it->second.count(m) || it->second.at(m).n == 0 ||
-                (unsupported.count(m) && unsupported.at(m).count(c.id) &&
-                 unsupported.at(m).at(c.id).count('R')))
+            const bool unsupported_r =
+                f.not_supported.count(m) && f.not_supported.at(m).count(c.id) &&
+                f.not_supported.at(m).at(c.id).find('R') != std::string::npos;
+            if (it == per_config.end() || !it->second.count(m) || it->second.at(m).n_mf == 0 ||
+                unsupported_r)
                 all = false;
         }
         if (all) common.insert(c.id);
     }
-    std::map<std::string, Aggregate> agg_common;
+    std::map<std::string, Accumulator> acc_common;
     for (const MetricRow& r : rows)
-        if (r.side == 'R' && common.count(r.config)) agg_common[r.model].add(r);
-    std::vector<std::string> ranking_common;
-    if (!common.empty()) {
-        ranking_common = models;
-        std::stable_sort(ranking_common.begin(), ranking_common.end(),
-                         [&](const auto& a, const auto& b) {
-                             return agg_common[a].mean_e() < agg_common[b].mean_e();
-                         });
-    }
+        if (r.side == 'R' && common.count(r.config)) acc_common[r.model].add(r);
+    for (const StudyConfiguration& c : configs)
+        if (common.count(c.id)) f.common.ids.push_back(c.id);
+    std::sort(f.common.ids.begin(), f.common.ids.end());
+    for (const std::string& m : models)
+        f.common.models[m] = acc_common[m].result();
+    if (!common.empty()) f.common.ranking = rank(models, f.common.models, true);
 
     // What the reference itself drops to its single-scattering microsurfaces, per category: the
     // mean over configurations, incidences and channels, and the worst.
-    struct Loss {
-        double sum = 0, worst = -1;
-        int n = 0;
-        std::string worst_config;
-        double worst_theta_i = 0;
-        int worst_channel = 0;
-    };
-    std::map<std::string, Loss> loss;
+    std::map<std::string, std::pair<double, int>> loss_sum;
     for (const StudyConfiguration& c : configs) {
         const auto it = lost.find(c.id);
         if (it == lost.end()) continue;
@@ -197,337 +267,411 @@ void write_summary(const std::filesystem::path& out_dir,
             for (int ch = 0; ch < 3; ++ch) {
                 const double v = it->second[i][ch];
                 for (const std::string& g : {c.category, std::string("all")}) {
-                    Loss& l = loss[g];
-                    l.sum += v;
-                    ++l.n;
-                    if (v > l.worst) {
+                    auto& [sum, n] = loss_sum[g];
+                    LossFindings& l = f.reference_loss[g];
+                    if (n == 0 || v > l.worst) {
                         l.worst = v;
-                        l.worst_config = c.id;
-                        l.worst_theta_i = s.theta_i_deg[i];
-                        l.worst_channel = ch;
+                        l.worst_at = {c.id, s.theta_i_deg[i], 'R', ch};
                     }
+                    sum += v;
+                    ++n;
+                    l.mean = sum / n;
                 }
             }
     }
 
     // Challenging cases: the best supporting model still misplaces > threshold on average.
-    struct Challenge {
-        std::string config, best;
-        double best_e, floor;
-    };
-    std::vector<Challenge> challenging;
     for (const StudyConfiguration& c : configs) {
-        std::string best;
-        double best_e = std::numeric_limits<double>::infinity();
-        double floor = NAN;
+        ChallengingCase best;
+        double best_mf = std::numeric_limits<double>::infinity();
         for (const std::string& m : models) {
-            const Aggregate& a = per_config[c.id][m];
-            if (a.n > 0 && a.mean_e() < best_e) {
-                best_e = a.mean_e();
-                best = m;
-                floor = a.mean_floor();
+            const ModelAggregate a = per_config[c.id][m].result();
+            if (a.rows > 0 && a.mean_misplaced_floor < best_mf) {
+                best_mf = a.mean_misplaced_floor;
+                best = {c.id, m, a.mean_misplaced_floor, a.mean_misplaced_floor_noise,
+                        a.mean_misplaced_energy};
             }
         }
         // Noise-dominated configurations are not flagged: the best model must also be clearly
         // (2×) above the reference's noise floor.
-        if (!best.empty() && best_e > kChallengingThreshold && !(best_e <= 2 * floor))
-            challenging.push_back({c.id, best, best_e, floor});
+        if (!best.best_model.empty() && best_mf > kChallengingThreshold &&
+            !(best_mf <= 2 * best.mean_misplaced_floor_noise))
+            f.challenging.push_back(best);
     }
 
     // The approximations assessment.
-    auto config_of = [&](const MetricRow& r) { return by_id.at(r.config); };
-    const std::vector<Factor> factors = {
-        {"Coat roughness (transmission through the top interface)",
-         "Rows grouped by the top interface's roughness α0. The WW family refracts through a "
-         "single normal; Belcour's operators approximate rough transmission by lobe statistics.",
-         {{"smooth coat (α0 ≤ 0.05)",
-           [&](const MetricRow& r) { return parameter(*config_of(r), "alpha0") <= 0.05; }},
-          {"rough coat (α0 ≥ 0.3)",
-           [&](const MetricRow& r) { return parameter(*config_of(r), "alpha0") >= 0.3; }}}},
-        {"Base albedo (multiple bounces between base and coat)",
-         "Lambertian bases, per channel: a low albedo leaves mostly the first bounce, a high "
-         "albedo needs every inter-reflection (models without them fall short).",
-         {{"low (ρ ≤ 0.2)",
-           [&](const MetricRow& r) {
-               const auto& c = *config_of(r);
-               return c.stack.base().type == InterfaceType::Lambertian &&
-                      c.stack.base().albedo[r.channel] <= 0.2;
-           }},
-          {"high (ρ ≥ 0.5)",
-           [&](const MetricRow& r) {
-               const auto& c = *config_of(r);
-               return c.stack.base().type == InterfaceType::Lambertian &&
-                      c.stack.base().albedo[r.channel] >= 0.5;
-           }}}},
-        {"Incidence (grazing angles)",
-         "Rows grouped by θi: Fresnel, masking and path lengths in the coat all grow towards "
-         "grazing incidence.",
-         {{"θi ≤ 30°", [](const MetricRow& r) { return r.theta_i <= 30; }},
-          {"45° ≤ θi ≤ 60°", [](const MetricRow& r) { return r.theta_i >= 45 && r.theta_i <= 60; }},
-          {"θi ≥ 70°", [](const MetricRow& r) { return r.theta_i >= 70; }}}},
-    };
-    std::vector<std::map<std::string, std::vector<Aggregate>>> assessment(factors.size());
-    for (std::size_t f = 0; f < factors.size(); ++f)
+    const std::vector<Factor> factors = assessment_factors(by_id);
+    for (const Factor& factor : factors) {
+        std::map<std::string, std::vector<Accumulator>> level_acc;
         for (const std::string& m : models)
-            assessment[f][m].resize(factors[f].levels.size());
-    for (const MetricRow& r : rows)
-        if (r.side == 'R')
-            for (std::size_t f = 0; f < factors.size(); ++f)
-                for (std::size_t l = 0; l < factors[f].levels.size(); ++l)
-                    if (factors[f].levels[l].second(r)) assessment[f][r.model][l].add(r);
-
-    // ---- summary.json ----
-    nlohmann::json j;
-    j["lamina_version"] = kVersion;
-    j["preset"] = s.preset;
-    j["particles"] = s.particles;
-    j["microsurface"] = microsurface_name(s.microsurface);
-    j["theta_i"] = s.theta_i_deg;
-    j["grid"] = s.grid.to_string();
-    j["models"] = models;
-    j["challenging_threshold"] = kChallengingThreshold;
-    for (const std::string& g : groups) {
-        for (const std::string& m : models) {
-            const Aggregate& a = agg[g][m];
-            j["groups"][g]["configurations"] = configs_in[g];
-            j["groups"][g]["models"][m] = {
-                {"mean_misplaced_energy", num(a.mean_e())},
-                {"worst_misplaced_energy", num(a.n ? a.worst_e : NAN)},
-                {"worst_misplaced_energy_at", where_json(a.worst_e_row)},
-                {"mean_abs_albedo_error", num(a.mean_abs_albedo())},
-                {"worst_albedo_error", num(a.n_albedo ? a.worst_albedo : NAN)},
-                {"worst_albedo_error_at", where_json(a.worst_albedo_row)},
-                {"mean_noise_floor", num(a.mean_floor())},
-                {"configurations_supported", a.configs.size()}};
-        }
-        j["groups"][g]["ranking"] = ranking[g];
+            level_acc[m].resize(factor.levels.size());
+        for (const MetricRow& r : rows)
+            if (r.side == 'R' && level_acc.count(r.model))
+                for (std::size_t l = 0; l < factor.levels.size(); ++l)
+                    if (factor.levels[l].second(r)) level_acc[r.model][l].add(r);
+        FactorFindings ff;
+        ff.title = factor.title;
+        ff.explanation = factor.explanation;
+        for (const auto& level : factor.levels)
+            ff.levels.push_back(level.first);
+        for (const std::string& m : models)
+            for (const Accumulator& a : level_acc[m])
+                ff.models[m].push_back(a.result());
+        f.assessment.push_back(std::move(ff));
     }
-    j["common"]["configurations"] = common.size();
-    j["common"]["ids"] = common;
-    j["common"]["ranking"] = ranking_common;
-    for (const std::string& m : models)
-        j["common"]["models"][m] = {{"mean_misplaced_energy", num(agg_common[m].mean_e())},
-                                    {"mean_noise_floor", num(agg_common[m].mean_floor())}};
+    // For engine developers (study/engine_findings.h): computed from the same rows.
+    f.engine = compute_engine_findings(rows, models);
+    return f;
+}
+
+// ==== Writing the findings =======================================================================
+//
+// Each section of summary.json and summary.md is one function of the findings; the tables below
+// list them in order. A new section of StudyFindings gets its writers here.
+
+namespace {
+
+nlohmann::json num(double v) {
+    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+nlohmann::json place_json(const std::optional<RowPlace>& p, bool with_side = true) {
+    if (!p) return nullptr;
+    nlohmann::json j = {{"config", p->config}, {"theta_i", p->theta_i}};
+    if (with_side) j["side"] = std::string(1, p->side);
+    j["channel"] = kChannels[p->channel];
+    return j;
+}
+
+nlohmann::json aggregate_json(const ModelAggregate& a) {
+    return {{"mean_misplaced_floor", num(a.mean_misplaced_floor)},
+            {"worst_misplaced_floor", num(a.worst_misplaced_floor)},
+            {"worst_misplaced_floor_at", place_json(a.worst_misplaced_floor_at)},
+            {"mean_misplaced_floor_noise", num(a.mean_misplaced_floor_noise)},
+            {"mean_misplaced_energy", num(a.mean_misplaced_energy)},
+            {"worst_misplaced_energy", num(a.worst_misplaced_energy)},
+            {"worst_misplaced_energy_at", place_json(a.worst_misplaced_energy_at)},
+            {"mean_abs_albedo_error", num(a.mean_abs_albedo_error)},
+            {"worst_albedo_error", num(a.worst_albedo_error)},
+            {"worst_albedo_error_at", place_json(a.worst_albedo_error_at)},
+            {"mean_noise_floor", num(a.mean_noise_floor)},
+            {"configurations_supported", a.configurations_supported}};
+}
+
+void json_header(const StudyFindings& f, nlohmann::json& j) {
+    j["lamina_version"] = kVersion;
+    j["preset"] = f.preset;
+    j["particles"] = f.particles;
+    j["microsurface"] = f.microsurface;
+    j["theta_i"] = f.theta_i;
+    j["grid"] = f.grid;
+    j["models"] = f.models;
+    j["ranking_metric"] = "misplaced_floor";
+    j["misplaced_floor_energy"] = kMisplacedFloorEnergy;
+    j["challenging_threshold"] = kChallengingThreshold;
+}
+
+void json_groups(const StudyFindings& f, nlohmann::json& j) {
+    for (const GroupFindings& g : f.groups) {
+        j["groups"][g.name]["configurations"] = g.configurations;
+        for (const auto& [m, a] : g.models)
+            j["groups"][g.name]["models"][m] = aggregate_json(a);
+        j["groups"][g.name]["ranking"] = g.ranking;
+    }
+}
+
+void json_common(const StudyFindings& f, nlohmann::json& j) {
+    j["common"]["configurations"] = f.common.ids.size();
+    j["common"]["ids"] = f.common.ids;
+    j["common"]["ranking"] = f.common.ranking;
+    for (const auto& [m, a] : f.common.models)
+        j["common"]["models"][m] = {
+            {"mean_misplaced_floor", num(a.mean_misplaced_floor)},
+            {"mean_misplaced_floor_noise", num(a.mean_misplaced_floor_noise)},
+            {"mean_misplaced_energy", num(a.mean_misplaced_energy)},
+            {"mean_noise_floor", num(a.mean_noise_floor)}};
+}
+
+void json_loss(const StudyFindings& f, nlohmann::json& j) {
     j["reference_lost_microsurface"] = nlohmann::json::object();
-    for (const auto& [g, l] : loss)
-        j["reference_lost_microsurface"][g] = {{"mean", l.sum / l.n},
-                                               {"worst", l.worst},
-                                               {"worst_at",
-                                                {{"config", l.worst_config},
-                                                 {"theta_i", l.worst_theta_i},
-                                                 {"channel", kChannels[l.worst_channel]}}}};
+    for (const auto& [g, l] : f.reference_loss)
+        j["reference_lost_microsurface"][g] = {
+            {"mean", l.mean}, {"worst", l.worst}, {"worst_at", place_json(l.worst_at, false)}};
+}
+
+void json_challenging(const StudyFindings& f, nlohmann::json& j) {
     j["challenging"] = nlohmann::json::array();
-    for (const Challenge& c : challenging)
-        j["challenging"].push_back({{"config", c.config},
-                                    {"best_model", c.best},
-                                    {"best_mean_misplaced_energy", c.best_e},
-                                    {"mean_noise_floor", num(c.floor)}});
-    for (std::size_t f = 0; f < factors.size(); ++f) {
+    for (const ChallengingCase& c : f.challenging)
+        j["challenging"].push_back(
+            {{"config", c.config},
+             {"best_model", c.best_model},
+             {"best_mean_misplaced_floor", num(c.best_mean_misplaced_floor)},
+             {"mean_misplaced_floor_noise", num(c.mean_misplaced_floor_noise)},
+             {"best_mean_misplaced_energy", num(c.best_mean_misplaced_energy)}});
+}
+
+void json_assessment(const StudyFindings& f, nlohmann::json& j) {
+    j["assessment"] = nlohmann::json::array();
+    for (const FactorFindings& ff : f.assessment) {
         nlohmann::json fj;
-        fj["factor"] = factors[f].title;
-        for (std::size_t l = 0; l < factors[f].levels.size(); ++l) {
-            fj["levels"].push_back(factors[f].levels[l].first);
-            for (const std::string& m : models)
-                fj["mean_misplaced_energy"][m].push_back(num(assessment[f][m][l].mean_e()));
-        }
+        fj["factor"] = ff.title;
+        fj["levels"] = ff.levels;
+        for (const auto& [m, levels] : ff.models)
+            for (const ModelAggregate& a : levels) {
+                fj["mean_misplaced_floor"][m].push_back(num(a.mean_misplaced_floor));
+                fj["mean_misplaced_energy"][m].push_back(num(a.mean_misplaced_energy));
+            }
         j["assessment"].push_back(fj);
     }
-    j["not_supported"] = nlohmann::json::object();
-    for (const auto& [m, cfgs] : unsupported)
-        for (const auto& [cfg, sides] : cfgs) {
-            std::string side_list;
-            for (char c : sides)
-                side_list += c;
-            j["not_supported"][m][cfg] = side_list;
-        }
+}
 
-    // ---- summary.md ----
-    std::string md;
-    auto out = [&]<typename... A>(fmt::format_string<A...> format, A&&... args) {
-        fmt::format_to(std::back_inserter(md), format, std::forward<A>(args)...);
-    };
+void json_not_supported(const StudyFindings& f, nlohmann::json& j) {
+    j["not_supported"] = nlohmann::json::object();
+    for (const auto& [m, cfgs] : f.not_supported)
+        for (const auto& [cfg, sides] : cfgs)
+            j["not_supported"][m][cfg] = sides;
+}
+
+// summary.json, section by section.
+using JsonSection = void (*)(const StudyFindings&, nlohmann::json&);
+void json_engine(const StudyFindings& f, nlohmann::json& j) {
+    if (!f.engine.empty()) j["engine_developers"] = engine_findings_json(f.engine);
+}
+
+constexpr JsonSection kJsonSections[] = {json_header,        json_groups,      json_common,
+                                         json_loss,          json_challenging, json_assessment,
+                                         json_not_supported, json_engine};
+
+// ---- summary.md ----
+
+std::string pct(double v) {
+    if (!std::isfinite(v)) return "–";
+    return fmt::format("{:.1f}%", 100 * v);
+}
+
+std::string where(const std::optional<RowPlace>& p) {
+    if (!p) return "";
+    return fmt::format("{}, θi {}°, {}, {}", p->config, p->theta_i, p->side, kChannels[p->channel]);
+}
+
+struct Markdown {
+    std::string text;
+    template <typename... A>
+    void operator()(fmt::format_string<A...> format, A&&... args) {
+        fmt::format_to(std::back_inserter(text), format, std::forward<A>(args)...);
+    }
+};
+
+bool is_total(const std::string& group) {
+    return group == "all" || group == "all BTDF";
+}
+
+void md_header(const StudyFindings& f, Markdown& out) {
     out("# lamina study: which layered model, for which material, how wrong\n\n");
     out("Preset `{}`: {:.3g} particles per incidence (two independent halves), incidences {}°, "
         "{} bins, {} configurations, models {}; the reference's rough interfaces {}. lamina "
         "{}.\n\n",
-        s.preset, double(s.particles), fmt::join(s.theta_i_deg, "°, "), s.grid.to_string(),
-        configs.size(), fmt::join(models, ", "),
-        s.microsurface == Microsurface::Multiple
+        f.preset, double(f.particles), fmt::join(f.theta_i, "°, "), f.grid, f.configurations,
+        fmt::join(f.models, ", "),
+        f.microsurface == "multiple"
             ? "scatter multiply on their microsurfaces (Heitz et al. 2016: nothing is lost there)"
             : "scatter once on their microsurfaces (the masked energy is lost and reported)",
         kVersion);
-    out("The primary metric is the **misplaced energy**: the fraction of the reference's reflected "
-        "(or transmitted) energy a model puts in the wrong place, adds or removes (0 is perfect). "
+    out("The primary metric is the **misplaced energy**: the energy a model puts in the wrong "
+        "place, adds or removes, as a fraction of the reference's reflected (or transmitted) "
+        "energy — or of {} of the incident light where the reference holds less (0 is perfect; "
+        "`misplaced_floor`, so that a lobe holding almost nothing cannot dominate a mean). "
+        "Models are ranked by it; the purely relative misplaced energy is shown beside it. "
         "Every number is next to the reference's **noise floor** — what Monte-Carlo noise alone "
-        "would show for a perfect model; differences below it mean nothing.\n\n");
+        "would show for a perfect model; differences below it mean nothing.\n\n",
+        pct(kMisplacedFloorEnergy));
+}
 
+void md_findings(const StudyFindings& f, Markdown& out) {
     out("## Findings\n\n");
-    for (const std::string& g : groups) {
-        const auto& rk = ranking[g];
-        if (g == "all" || g == "all BTDF") continue;
+    for (const GroupFindings& g : f.groups) {
+        if (is_total(g.name)) continue;
+        const auto& rk = g.ranking;
         if (rk.empty()) {
-            out("- **{}** ({} configurations): no model supports it.\n", g, configs_in[g]);
+            out("- **{}** ({} configurations): no model supports it.\n", g.name, g.configurations);
             continue;
         }
-        const Aggregate& best = agg[g][rk.front()];
+        const ModelAggregate& best = g.models.at(rk.front());
         out("- **{}** ({} configuration{}): use **{}** — mean misplaced energy {} (noise floor "
-            "{}), "
-            "worst {} ({}); mean |albedo error| {}.",
-            g, configs_in[g], configs_in[g] == 1 ? "" : "s", rk.front(), pct(best.mean_e()),
-            pct(best.mean_floor()), pct(best.worst_e), where(best.worst_e_row),
-            pct(best.mean_abs_albedo()));
+            "{}; relative {}), worst {} ({}); mean |albedo error| {}.",
+            g.name, g.configurations, g.configurations == 1 ? "" : "s", rk.front(),
+            pct(best.mean_misplaced_floor), pct(best.mean_misplaced_floor_noise),
+            pct(best.mean_misplaced_energy), pct(best.worst_misplaced_floor),
+            where(best.worst_misplaced_floor_at), pct(best.mean_abs_albedo_error));
         if (rk.size() > 1) {
             out(" Then ");
             for (std::size_t k = 1; k < rk.size(); ++k)
-                out("{}{} ({})", k > 1 ? ", " : "", rk[k], pct(agg[g][rk[k]].mean_e()));
+                out("{}{} ({})", k > 1 ? ", " : "", rk[k],
+                    pct(g.models.at(rk[k]).mean_misplaced_floor));
             out(".");
         }
         std::vector<std::string> none;
-        for (const std::string& m : models)
-            if (agg[g][m].n == 0) none.push_back(m);
+        for (const std::string& m : f.models)
+            if (g.models.at(m).rows == 0) none.push_back(m);
         if (!none.empty()) out(" Not supported: {}.", fmt::join(none, ", "));
         out("\n");
     }
-    if (!ranking["all"].empty())
-        out("- **Overall**: {}.\n", [&] {
-            std::string t;
-            for (std::size_t k = 0; k < ranking["all"].size(); ++k)
-                t += fmt::format("{}{} {}", k ? " < " : "", ranking["all"][k],
-                                 pct(agg["all"][ranking["all"][k]].mean_e()));
-            return t + " (mean misplaced energy over the configurations each supports)";
-        }());
-    if (models.size() > 1) {
-        if (ranking_common.empty())
+    auto chain = [](const std::vector<std::string>& ranking,
+                    const std::map<std::string, ModelAggregate>& models) {
+        std::string t;
+        for (std::size_t k = 0; k < ranking.size(); ++k)
+            t += fmt::format("{}{} {}", k ? " < " : "", ranking[k],
+                             pct(models.at(ranking[k]).mean_misplaced_floor));
+        return t;
+    };
+    if (const GroupFindings* all = f.group("all"); all && !all->ranking.empty())
+        out("- **Overall**: {} (mean misplaced energy over the configurations each supports).\n",
+            chain(all->ranking, all->models));
+    if (f.models.size() > 1) {
+        if (f.common.ranking.empty())
             out("- **Like for like**: no configuration's BRDF is supported by every model.\n");
         else
             out("- **Like for like** (the BRDF of the {} configuration{} every model supports): "
                 "{}.\n",
-                common.size(), common.size() == 1 ? "" : "s", [&] {
-                    std::string t;
-                    for (std::size_t k = 0; k < ranking_common.size(); ++k)
-                        t += fmt::format("{}{} {}", k ? " < " : "", ranking_common[k],
-                                         pct(agg_common[ranking_common[k]].mean_e()));
-                    return t;
-                }());
+                f.common.ids.size(), f.common.ids.size() == 1 ? "" : "s",
+                chain(f.common.ranking, f.common.models));
     }
     // Said when it matters (a multiple-scattering reference loses only the rare walk it gives up).
-    if (loss.count("all") && loss.at("all").worst >= 1e-3) {
+    if (f.reference_loss.count("all") && f.reference_loss.at("all").worst >= 1e-3) {
         std::string per_category;
-        for (const std::string& c : categories)
-            if (loss.count(c))
+        for (const std::string& c : f.categories)
+            if (f.reference_loss.count(c))
                 per_category += fmt::format("{}{} {}", per_category.empty() ? "" : ", ", c,
-                                            pct(loss.at(c).sum / loss.at(c).n));
-        const Loss& l = loss.at("all");
+                                            pct(f.reference_loss.at(c).mean));
+        const LossFindings& l = f.reference_loss.at("all");
         out("- **What the reference itself drops**: its single-scattering microfacet interfaces "
             "lose, on average over incidences and channels, {} of the incident energy (worst {}: "
             "{}, θi {}°, {}) — masked light, on neither side of the reference. A model that keeps "
             "this energy overshoots the reference's albedo by up to that much; where it belongs "
             "(R, T) is what multiple scattering on the microsurfaces would decide. The explorer's "
             "albedo view draws it.\n",
-            per_category, pct(l.worst), l.worst_config, l.worst_theta_i,
-            kChannels[l.worst_channel]);
+            per_category, pct(l.worst), l.worst_at.config, l.worst_at.theta_i,
+            kChannels[l.worst_at.channel]);
     }
-    out(
-        "- **Challenging cases** (even the best model misplaces more than {} of the reflected "
+    std::string list;
+    for (std::size_t k = 0; k < f.challenging.size(); ++k)
+        list += fmt::format("{}`{}`", k ? ", " : "", f.challenging[k].config);
+    out("- **Challenging cases** (even the best model misplaces more than {} of the reflected "
         "energy on average, and more than twice the noise floor): {}.\n\n",
-        pct(kChallengingThreshold), challenging.empty() ? std::string("none") : [&] {
-            std::string t;
-            for (std::size_t k = 0; k < challenging.size(); ++k)
-                t += fmt::format("{}`{}`", k ? ", " : "", challenging[k].config);
-            return t;
-        }());
+        pct(kChallengingThreshold), list.empty() ? std::string("none") : list);
+}
 
-    auto table_by_group = [&](const char* title, auto cell) {
+void md_tables(const StudyFindings& f, Markdown& out) {
+    auto table = [&](const char* title, auto cell) {
         out("## {}\n\n| model |", title);
-        for (const std::string& g : groups)
-            out(" {} |", g);
+        for (const GroupFindings& g : f.groups)
+            out(" {} |", g.name);
         out("\n|---|");
-        for (std::size_t k = 0; k < groups.size(); ++k)
+        for (std::size_t k = 0; k < f.groups.size(); ++k)
             out("---|");
         out("\n");
-        for (const std::string& m : models) {
+        for (const std::string& m : f.models) {
             out("| {} |", m);
-            for (const std::string& g : groups)
-                out(" {} |", cell(agg[g][m], g));
+            for (const GroupFindings& g : f.groups)
+                out(" {} |", cell(g.models.at(m), g));
             out("\n");
         }
         out("\n");
     };
-    table_by_group("Misplaced energy: mean / worst (noise floor)",
-                   [&](const Aggregate& a, const std::string&) {
-                       return a.n ? fmt::format("{} / {} ({})", pct(a.mean_e()), pct(a.worst_e),
-                                                pct(a.mean_floor()))
-                                  : std::string("not supported");
-                   });
-    table_by_group("Albedo error: mean |error| / worst", [&](const Aggregate& a,
-                                                             const std::string&) {
-        return a.n_albedo
-                   ? fmt::format("{} / {:+.1f}%", pct(a.mean_abs_albedo()), 100 * a.worst_albedo)
+    table("Misplaced energy (5% floor, the ranking metric): mean / worst (noise floor)",
+          [](const ModelAggregate& a, const GroupFindings&) {
+              return a.rows ? fmt::format("{} / {} ({})", pct(a.mean_misplaced_floor),
+                                          pct(a.worst_misplaced_floor),
+                                          pct(a.mean_misplaced_floor_noise))
+                            : std::string("not supported");
+          });
+    table("Misplaced energy (relative to the reference's energy): mean / worst (noise floor)",
+          [](const ModelAggregate& a, const GroupFindings&) {
+              return a.rows ? fmt::format("{} / {} ({})", pct(a.mean_misplaced_energy),
+                                          pct(a.worst_misplaced_energy), pct(a.mean_noise_floor))
+                            : std::string("not supported");
+          });
+    table("Albedo error: mean |error| / worst", [](const ModelAggregate& a, const GroupFindings&) {
+        return std::isfinite(a.mean_abs_albedo_error)
+                   ? fmt::format("{} / {:+.1f}%", pct(a.mean_abs_albedo_error),
+                                 100 * a.worst_albedo_error)
                    : std::string("not supported");
     });
-    table_by_group("Coverage: configurations supported",
-                   [&](const Aggregate& a, const std::string& g) {
-                       return fmt::format("{}/{}", a.configs.size(), configs_in[g]);
-                   });
+    table("Coverage: configurations supported",
+          [](const ModelAggregate& a, const GroupFindings& g) {
+              return fmt::format("{}/{}", a.configurations_supported, g.configurations);
+          });
+}
 
-    out("## Worst cases\n\n| model | group | worst misplaced energy | where "
-        "|\n|---|---|---|---|\n");
-    for (const std::string& m : models)
-        for (const std::string& g : groups)
-            if (g != "all" && g != "all BTDF" && agg[g][m].n)
-                out("| {} | {} | {} | {} |\n", m, g, pct(agg[g][m].worst_e),
-                    where(agg[g][m].worst_e_row));
+void md_worst(const StudyFindings& f, Markdown& out) {
+    out("## Worst cases\n\n| model | group | worst misplaced energy (5% floor) | where | worst "
+        "relative | where |\n|---|---|---|---|---|---|\n");
+    for (const std::string& m : f.models)
+        for (const GroupFindings& g : f.groups)
+            if (!is_total(g.name) && g.models.at(m).rows) {
+                const ModelAggregate& a = g.models.at(m);
+                out("| {} | {} | {} | {} | {} | {} |\n", m, g.name, pct(a.worst_misplaced_floor),
+                    where(a.worst_misplaced_floor_at), pct(a.worst_misplaced_energy),
+                    where(a.worst_misplaced_energy_at));
+            }
     out("\n");
+}
 
+void md_challenging(const StudyFindings& f, Markdown& out) {
     out("## Challenging cases\n\nConfigurations where even the best supporting model misplaces "
-        "more than {} of the reflected energy on average over incidences and channels, and more "
-        "than twice the reference's noise floor.\n\n",
+        "more than {} of the reflected energy (5% floor) on average over incidences and "
+        "channels, and more than twice the reference's noise floor.\n\n",
         pct(kChallengingThreshold));
-    if (challenging.empty()) {
+    if (f.challenging.empty()) {
         out("None.\n\n");
-    } else {
-        out("| configuration | best model | its mean misplaced energy | noise floor |\n"
-            "|---|---|---|---|\n");
-        for (const Challenge& c : challenging)
-            out("| {} | {} | {} | {} |\n", c.config, c.best, pct(c.best_e), pct(c.floor));
-        out("\n");
+        return;
     }
+    out("| configuration | best model | its mean misplaced energy (5% floor) | noise floor | "
+        "relative |\n|---|---|---|---|---|\n");
+    for (const ChallengingCase& c : f.challenging)
+        out("| {} | {} | {} | {} | {} |\n", c.config, c.best_model,
+            pct(c.best_mean_misplaced_floor), pct(c.mean_misplaced_floor_noise),
+            pct(c.best_mean_misplaced_energy));
+    out("\n");
+}
 
-    out("## Approximations assessment\n\nMean misplaced energy of each model's BRDF, rows grouped "
-        "by the factor that stresses an approximation (as in the original study's assessment); "
-        "in parentheses the noise floor.\n\n");
-    for (std::size_t f = 0; f < factors.size(); ++f) {
-        out("### {}\n\n{}\n\n| model |", factors[f].title, factors[f].explanation);
-        for (const auto& level : factors[f].levels)
-            out(" {} |", level.first);
+void md_assessment(const StudyFindings& f, Markdown& out) {
+    out("## Approximations assessment\n\nMean misplaced energy (5% floor) of each model's BRDF, "
+        "rows grouped by the factor that stresses an approximation (as in the original study's "
+        "assessment); in parentheses the noise floor.\n\n");
+    for (const FactorFindings& ff : f.assessment) {
+        out("### {}\n\n{}\n\n| model |", ff.title, ff.explanation);
+        for (const std::string& level : ff.levels)
+            out(" {} |", level);
         out("\n|---|");
-        for (std::size_t l = 0; l < factors[f].levels.size(); ++l)
+        for (std::size_t l = 0; l < ff.levels.size(); ++l)
             out("---|");
         out("\n");
-        for (const std::string& m : models) {
+        for (const std::string& m : f.models) {
             out("| {} |", m);
-            for (std::size_t l = 0; l < factors[f].levels.size(); ++l) {
-                const Aggregate& a = assessment[f][m][l];
-                out(" {} |", a.n ? fmt::format("{} ({})", pct(a.mean_e()), pct(a.mean_floor()))
-                                 : std::string("–"));
-            }
+            for (const ModelAggregate& a : ff.models.at(m))
+                out(" {} |", a.rows ? fmt::format("{} ({})", pct(a.mean_misplaced_floor),
+                                                  pct(a.mean_misplaced_floor_noise))
+                                    : std::string("–"));
             out("\n");
         }
         out("\n");
     }
+}
 
-    // The engine developers' section (study/engine_findings.h): computed from the same rows.
-    const EngineFindings engine = compute_engine_findings(rows, models);
-    md += engine_findings_markdown(engine);
-    if (!engine.empty()) j["engine_developers"] = engine_findings_json(engine);
+void md_engine(const StudyFindings& f, Markdown& out) {
+    out.text += engine_findings_markdown(f.engine);
+}
 
+void md_not_supported(const StudyFindings& f, Markdown& out) {
     out("## Not supported\n\n");
-    if (unsupported.empty()) out("Every model supports every configuration.\n");
-    for (const auto& [m, cfgs] : unsupported) {
+    if (f.not_supported.empty()) out("Every model supports every configuration.\n");
+    for (const auto& [m, cfgs] : f.not_supported) {
         std::map<std::string, int> per_category;
-        std::string reason;
         for (const auto& [cfg, sides] : cfgs) {
-            per_category[by_id.at(cfg)->category + (sides.count('R') ? "" : " (BTDF)")]++;
+            const auto it = f.category_of.find(cfg);
+            const std::string category = it == f.category_of.end() ? cfg : it->second;
+            per_category[category + (sides.find('R') != std::string::npos ? "" : " (BTDF)")]++;
         }
         out("- **{}**:", m);
         bool first = true;
@@ -539,9 +683,41 @@ void write_summary(const std::filesystem::path& out_dir,
     }
     out("\nDefinitions, formats and the noise floor: `docs/formats.md`. Per-row numbers: "
         "`metrics.csv`.\n");
+}
 
-    write_file_atomic(out_dir / "summary.json", j.dump(1) + "\n");
-    write_file_atomic(out_dir / "summary.md", md);
+// summary.md, section by section.
+using MarkdownSection = void (*)(const StudyFindings&, Markdown&);
+constexpr MarkdownSection kMarkdownSections[] = {md_header, md_findings,     md_tables,
+                                                 md_worst,  md_challenging,  md_assessment,
+                                                 md_engine, md_not_supported};
+
+}  // namespace
+
+nlohmann::json findings_json(const StudyFindings& f) {
+    nlohmann::json j;
+    for (JsonSection section : kJsonSections)
+        section(f, j);
+    return j;
+}
+
+std::string findings_markdown(const StudyFindings& f) {
+    Markdown out;
+    for (MarkdownSection section : kMarkdownSections)
+        section(f, out);
+    return out.text;
+}
+
+std::string findings_headline(const StudyFindings& f) {
+    Markdown out;
+    md_findings(f, out);
+    return out.text;
+}
+
+int write_summary(const std::filesystem::path& out_dir, const StudyFindings& f) {
+    int written = 0;
+    written += write_file_if_changed(out_dir / "summary.json", findings_json(f).dump(1) + "\n");
+    written += write_file_if_changed(out_dir / "summary.md", findings_markdown(f));
+    return written;
 }
 
 }  // namespace lamina

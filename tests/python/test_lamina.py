@@ -211,7 +211,7 @@ def test_albedo_agrees_with_the_binned_table():
 def test_load_study_metrics_agree_with_the_tables(tmp_path):
     out = tmp_path / "cmp"
     cli("compare", PLASTIC, "--particles", 40_000, "--theta-i", "0,45", "--grid", "18x12",
-        "--models", "ww-prime,ele10", "--no-figures", "--out", out)
+        "--models", "ww-prime,ele10", "--tables", "full", "--no-figures", "--out", out)
     s = lamina.load_study(out, pandas=False)
     assert s.configs == ["plastic"] and s.models == ["ww-prime", "ele10"]
     m = s.metrics

@@ -76,7 +76,7 @@ def test_delta_lobes_go_to_the_bin_they_hit():
 
 def test_compare_with_a_python_model_puts_it_in_the_study(tmp_path):
     s = lamina.compare(PLASTIC, models=["ww-prime", Lambert, WrappedWWPrime], particles=40_000,
-                       theta_i=[0, 45], grid=(18, 12), out=tmp_path / "cmp")
+                       theta_i=[0, 45], grid=(18, 12), out=tmp_path / "cmp", tables="full")
     assert s.models == ["ww-prime", "py-lambert", "py-ww-prime"]
     m = s.metrics
     assert set(np.unique(m["model"])) == {"ww-prime", "py-lambert", "py-ww-prime"}

@@ -108,9 +108,10 @@ TEST(Explorer, WritesPageDataAndAlbedos) {
     write_npy(d / "configs/c1/tables.npy", {2, 1, 1, 2, 2, 3}, tables);
     write_npy(d / "configs/c1/reference_se.npy", {1, 1, 2, 2, 3}, std::vector<float>(12, 0.01f));
     write_text(d / "metrics.csv",
-               "config,category,model,theta_i,side,channel,misplaced_energy,albedo_ref,"
-               "albedo_model,albedo_error,rmse,log_rmse,noise_floor,supported\n"
-               "c1,plastic,ww09,30,R,g,1,1,2,1,0.3,0.2,0.01,true\n");
+               "config,category,model,theta_i,side,channel,misplaced_energy,misplaced_floor,"
+               "albedo_ref,albedo_model,albedo_error,rmse,log_rmse,noise_floor,"
+               "misplaced_floor_noise,supported\n"
+               "c1,plastic,ww09,30,R,g,1,0.9,1,2,1,0.3,0.2,0.01,0.02,true\n");
 
     const ExplorerSummary s = write_explorer(d);
     EXPECT_EQ(s.configurations, 1u);
@@ -132,6 +133,11 @@ TEST(Explorer, WritesPageDataAndAlbedos) {
     EXPECT_NEAR(c["albedo"]["ww09"]["R"][0][1].get<double>(), 2.0, 1e-6);
     EXPECT_NEAR(j["metrics"]["c1"]["ww09"]["R"]["me"][0][1].get<double>(), 1.0, 1e-12);
     EXPECT_TRUE(j["metrics"]["c1"]["ww09"]["R"]["me"][0][0].is_null());  // a row not given
+    // The one colour table (web/model-colors.json) travels with the page.
+    EXPECT_EQ(j["palette"]["models"]["ww09"], "#E69F00");
+    EXPECT_TRUE(j["palette"]["extra"].is_array());
+    EXPECT_NEAR(j["metrics"]["c1"]["ww09"]["R"]["mf"][0][1].get<double>(), 0.9, 1e-12);
+    EXPECT_NEAR(j["metrics"]["c1"]["ww09"]["R"]["nf_mf"][0][1].get<double>(), 0.02, 1e-12);
     EXPECT_NE(read_text(d / "explorer/data/c1.js").find("LAMINA_DATA"), std::string::npos);
     // No staging folder is left behind.
     for (const auto& e : fs::recursive_directory_iterator(d))

@@ -150,8 +150,9 @@ def main():
     os.makedirs(os.path.join(root, "configs"), exist_ok=True)
     th, ph = bin_edges()
     sources = ["reference"] + MODELS
-    metrics = ["config,category,model,theta_i,side,channel,misplaced_energy,albedo_ref,"
-               "albedo_model,albedo_error,rmse,log_rmse,noise_floor,supported"]
+    metrics = ["config,category,model,theta_i,side,channel,misplaced_energy,misplaced_floor,"
+               "albedo_ref,albedo_model,albedo_error,rmse,log_rmse,noise_floor,"
+               "misplaced_floor_noise,supported"]
     study_configs = []
     for cfg_id, category, params, sides, rho, width, weight in CONFIGS:
         d = os.path.join(root, "configs", cfg_id)
@@ -213,7 +214,7 @@ def main():
                     for c, ch in enumerate("rgb"):
                         ok = supported(m, cfg_id, side)
                         if not ok:
-                            metrics.append(f"{cfg_id},{category},{m},{ti:g},{side},{ch},,,,,,,,false")
+                            metrics.append(f"{cfg_id},{category},{m},{ti:g},{side},{ch},,,,,,,,,,false")
                             continue
                         ref, mod = tables[("reference", i, side)], tables[(m, i, side)]
                         num = den = 0.0
@@ -223,11 +224,13 @@ def main():
                                 num += abs(mod[t][p][c] - ref[t][p][c]) * w
                                 den += ref[t][p][c] * w
                         e = num / den if den > 0 else float("nan")
+                        mf = num / max(den, 0.05)
                         ar = albedo["reference"][side][i][c]
                         am = albedo[m][side][i][c]
                         err = (am - ar) / ar if ar > 0 else float("nan")
-                        metrics.append(f"{cfg_id},{category},{m},{ti:g},{side},{ch},{e:.6g},{ar:.6g},"
-                                       f"{am:.6g},{err:.6g},{e * 0.1:.6g},{e * 0.05:.6g},0.004,true")
+                        metrics.append(f"{cfg_id},{category},{m},{ti:g},{side},{ch},{e:.6g},{mf:.6g},"
+                                       f"{ar:.6g},{am:.6g},{err:.6g},{e * 0.1:.6g},{e * 0.05:.6g},"
+                                       f"0.004,{0.004 * min(1.0, den / 0.05):.6g},true")
     study = {"lamina_version": "fixture", "preset": "fixture", "particles": 1000, "seed": 1,
              "grid": {"n_theta": N_THETA, "n_phi": N_PHI}, "theta_i": THETA_I, "models": MODELS,
              "model_groups": MODEL_GROUPS,

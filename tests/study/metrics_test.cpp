@@ -65,6 +65,82 @@ TEST(StudyMetrics, EmptyReferenceHasNoRelativeError) {
     EXPECT_GT(m.rmse, 0);
 }
 
+// misplaced_floor = Σ|f − f̂|Ω⊥ / max(Σ f̂Ω⊥, 0.05). Constant lobes on the whole hemisphere
+// (Σ Ω⊥ = π): a lobe c/π has the albedo c.
+TEST(StudyMetrics, MisplacedFloorIsRelativeAboveFivePercentOfTheLight) {
+    const HemisphereGrid grid(9, 9);
+    // Reference albedo 0.4, model 0.5: 0.1 misplaced, 25% of the reference's energy in both.
+    const LobeMetrics m =
+        lobe_metrics(grid, constant(grid, 0.4 / kPi<double>), constant(grid, 0.5 / kPi<double>), 2);
+    EXPECT_NEAR(m.misplaced_energy, 0.25, 1e-12);
+    EXPECT_NEAR(m.misplaced_floor, 0.25, 1e-12);
+    // At exactly 5% the two agree too: 0.05 against 0.06 misplaces 0.01, 20%.
+    const LobeMetrics e = lobe_metrics(grid, constant(grid, 0.05 / kPi<double>),
+                                       constant(grid, 0.06 / kPi<double>), 0);
+    EXPECT_NEAR(e.misplaced_energy, 0.2, 1e-12);
+    EXPECT_NEAR(e.misplaced_floor, 0.2, 1e-12);
+}
+
+TEST(StudyMetrics, MisplacedFloorIsRelativeToFivePercentBelowIt) {
+    const HemisphereGrid grid(9, 9);
+    // Reference albedo 0.01, model 0.03: 0.02 misplaced, 200% of the reference's energy but 40%
+    // of the 5% floor.
+    const LobeMetrics m = lobe_metrics(grid, constant(grid, 0.01 / kPi<double>),
+                                       constant(grid, 0.03 / kPi<double>), 1);
+    EXPECT_NEAR(m.misplaced_energy, 2.0, 1e-12);
+    EXPECT_NEAR(m.misplaced_floor, 0.4, 1e-12);
+    // Moving energy within a faint lobe: two θ bins of Ω⊥ = π/2, reference 0.01 in each (albedo
+    // 0.01π < 0.05), the model moves 0.005 from one to the other: Σ|Δ|Ω⊥ = 2 · 0.005 · π/2.
+    const HemisphereGrid two(2, 1);
+    const LobeMetrics moved =
+        lobe_metrics(two, {Rgbd(0.01), Rgbd(0.01)}, {Rgbd(0.015), Rgbd(0.005)}, 0);
+    EXPECT_NEAR(moved.misplaced_energy, 0.5, 1e-12);  // 0.005π / 0.01π
+    EXPECT_NEAR(moved.misplaced_floor, 0.005 * kPi<double> / 0.05, 1e-12);
+    // An empty reference: the relative metric has no value, the floored one is the model's
+    // whole energy over 5%.
+    const LobeMetrics empty =
+        lobe_metrics(grid, constant(grid, 0), constant(grid, 0.02 / kPi<double>), 0);
+    EXPECT_TRUE(std::isnan(empty.misplaced_energy));
+    EXPECT_NEAR(empty.misplaced_floor, 0.4, 1e-12);
+}
+
+TEST(StudyMetrics, NoiseFloorOfMisplacedFloorIsHalfTheHalvesDifference) {
+    const HemisphereGrid grid(9, 9);
+    // Halves of albedo 0.01 and 0.02: 0.01 apart, 0.2 of the 5% floor; halved, 0.1.
+    const LobeMetrics f = noise_floor(grid, constant(grid, 0.01 / kPi<double>),
+                                      constant(grid, 0.02 / kPi<double>), 0);
+    EXPECT_NEAR(f.misplaced_floor, 0.1, 1e-12);
+    EXPECT_NEAR(f.misplaced_energy, 0.5, 1e-12);  // 0.01 / 0.01, halved
+}
+
+// A reference piece stored before misplaced_floor existed has none in its floor: it is derived
+// from what the piece holds, and equals the one computed with the piece.
+TEST(StudyMetrics, OldReferencePiecesGetTheirMisplacedFloorNoise) {
+    const Stack stack = test::make_stack({test::lambertian_layer(Rgbd(0.8, 0.3, 0.02))});
+    ReferenceKey key{
+        "old", stack, 30, 4000, 3, HemisphereGrid(6, 6), Kernel::Scalar, Microsurface::Single};
+    std::string bytes = compute_reference_piece(key, 1, [](std::uint64_t) {});
+    const std::size_t eol = bytes.find('\n', bytes.find('\n') + 1);
+    std::string meta = bytes.substr(0, eol);
+    std::size_t removed = 0;
+    for (std::size_t at; (at = meta.find("\"misplaced_floor\":")) != std::string::npos; ++removed) {
+        const std::size_t end = meta.find(',', at);
+        meta.erase(at, end + 1 - at);
+    }
+    ASSERT_EQ(removed, 6u);  // 2 sides × 3 channels
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "lamina-old-piece-test";
+    std::filesystem::remove_all(dir);
+    const ReferencePiece now = store_reference_piece(dir, key, bytes);
+    const ReferencePiece old = store_reference_piece(dir, key, meta + bytes.substr(eol));
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_GT(now.floor[0][c].misplaced_floor, 0);
+        EXPECT_NEAR(old.floor[0][c].misplaced_floor, now.floor[0][c].misplaced_floor,
+                    1e-12 * now.floor[0][c].misplaced_floor);
+    }
+    std::filesystem::remove_all(dir);
+}
+
 // The noise floor shrinks as 1/√N, and matches its expected value. For a white-ish Lambertian each
 // particle lands in bin j with probability p_j = Ω⊥_j/π carrying flux ρ, so a half-reference of n
 // particles estimates f_j with relative standard deviation s_j = √((1 − p_j)/(n p_j)); the halves'

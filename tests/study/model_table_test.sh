@@ -67,7 +67,7 @@ mkdir -p "$tmp/tables"
 "$lamina" study "${only[@]}" --out "$tmp/st0" >/dev/null 2>&1 && ok || fail "study without tables"
 if "$lamina" study "${only[@]}" --model-table "mine=$tmp/tables/{id}.csv" --out "$tmp/st" \
     >"$tmp/st.log" 2>&1; then ok; else fail "study with a table pattern"; cat "$tmp/st.log"; fi
-grep -q '^slab-a0.1-a1.3-clear,slab,mine,0,R,r,,,,,,,,false$' "$tmp/st/metrics.csv" \
+grep -q '^slab-a0.1-a1.3-clear,slab,mine,0,R,r,,,,,,,,,,false$' "$tmp/st/metrics.csv" \
     && ok || fail "configuration without a table is not supported"
 
 echo "model_table: $pass passed, $fails failed"

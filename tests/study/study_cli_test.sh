@@ -22,12 +22,12 @@ for f in study.json metrics.csv summary.md summary.json \
     [ -s "$tmp/a/$f" ] && ok || fail "missing $f"
 done
 head -1 "$tmp/a/metrics.csv" | grep -qx \
-    'config,category,model,theta_i,side,channel,misplaced_energy,albedo_ref,albedo_model,albedo_error,rmse,log_rmse,noise_floor,supported' \
+    'config,category,model,theta_i,side,channel,misplaced_energy,misplaced_floor,albedo_ref,albedo_model,albedo_error,rmse,log_rmse,noise_floor,misplaced_floor_noise,supported' \
     && ok || fail "metrics.csv header"
 # plastic: 2 models × 2 incidences × R × 3 channels; slab: 2 × 2 × (R, T) × 3; plus the header.
 [ "$(wc -l <"$tmp/a/metrics.csv")" -eq 37 ] && ok || fail "metrics.csv rows: $(wc -l <"$tmp/a/metrics.csv")"
 # bel-prime has no Lambertian base: its plastic rows are 'not supported' with empty metrics.
-grep -q '^plastic-P1-a0.05,plastic,bel-prime,0,R,r,,,,,,,,false$' "$tmp/a/metrics.csv" \
+grep -q '^plastic-P1-a0.05,plastic,bel-prime,0,R,r,,,,,,,,,,false$' "$tmp/a/metrics.csv" \
     && ok || fail "unsupported rows"
 grep -q '^slab-a0.1-a1.3-clear,slab,bel-prime,60,T,b,[0-9]' "$tmp/a/metrics.csv" \
     && ok || fail "bel-prime BTDF rows"
@@ -35,9 +35,83 @@ grep -q '^## Findings' "$tmp/a/summary.md" && ok || fail "summary findings"
 grep -q '^## Approximations assessment' "$tmp/a/summary.md" && ok || fail "summary assessment"
 grep -q 'Findings' "$tmp/a.log" && ok || fail "findings printed"
 
-# 2. Re-running reuses every stored piece and gives the same metrics.
-"$lamina" study "${tiny[@]}" --out "$tmp/a" >/dev/null 2>&1
-cmp -s "$tmp/a/metrics.csv" "$tmp/a/metrics.csv" && ok || fail "rerun"
+# 2. Re-running a finished study does no work and rewrites nothing: the counts it reports are 0
+#    and every file keeps its modification time (and content).
+snapshot() { (cd "$1" && find . -type f -printf '%P %s %T@\n' | sort); }
+snapshot "$tmp/a" >"$tmp/a.before"
+cp "$tmp/a/metrics.csv" "$tmp/a.metrics"
+"$lamina" study "${tiny[@]}" --out "$tmp/a" >"$tmp/a2.log" 2>&1 && ok || fail "rerun"
+grep -qF 'Work: 0 reference pieces simulated, 0 model tables computed (4 reused), 0 configurations written (2 unchanged), 0 summary files written' "$tmp/a2.log" \
+    && ok || { fail "rerun did work:"; grep Work "$tmp/a2.log"; }
+grep -q 'figures: 0 drawn' "$tmp/a2.log" && ok || { fail "rerun redrew figures:"; grep figures: "$tmp/a2.log"; }
+snapshot "$tmp/a" >"$tmp/a.after"
+diff "$tmp/a.before" "$tmp/a.after" >"$tmp/a.diff" && ok || { fail "rerun rewrote files:"; cat "$tmp/a.diff"; }
+grep -q 'Findings' "$tmp/a2.log" && ok || fail "findings printed on a rerun"
+
+# 2b. Adding a model computes that model's tables only (no reference piece, nothing for the
+#     others), and gives bitwise the metrics and tables of a fresh study with the three models.
+three=(--only 'plastic-P1-a0.05,slab-a0.1-a1.3-clear' --models ww-prime,bel-prime,ww09
+       --theta-i 0,60 --particles 4e4 --grid 18x18)
+"$lamina" study "${three[@]}" --out "$tmp/a" >"$tmp/a3.log" 2>&1 && ok || fail "add a model"
+grep -qF 'Work: 0 reference pieces simulated, 2 model tables computed (4 reused), 2 configurations written' "$tmp/a3.log" \
+    && ok || { fail "adding a model:"; grep Work "$tmp/a3.log"; }
+"$lamina" study "${three[@]}" --no-figures --out "$tmp/f" >/dev/null 2>&1 && ok || fail "fresh three-model study"
+for f in metrics.csv summary.json configs/plastic-P1-a0.05/tables.npy configs/slab-a0.1-a1.3-clear/tables.npy \
+         configs/slab-a0.1-a1.3-clear/config.json configs/slab-a0.1-a1.3-clear/reference_se.npy; do
+    cmp -s "$tmp/a/$f" "$tmp/f/$f" && ok || fail "incremental $f differs from a fresh study's"
+done
+# Back to two models: nothing is computed, and the metrics are those of the first run.
+"$lamina" study "${tiny[@]}" --out "$tmp/a" >"$tmp/a4.log" 2>&1
+grep -qF ' 0 model tables computed (4 reused)' "$tmp/a4.log" && ok || { fail "back to two models:"; grep Work "$tmp/a4.log"; }
+cmp -s "$tmp/a/metrics.csv" "$tmp/a.metrics" && ok || fail "metrics after going back to two models"
+
+# 2c. Adding a configuration simulates and computes only that configuration; the other one is
+#     read back unchanged.
+"$lamina" study --only 'plastic-P1-a0.05' --models ww-prime,bel-prime --theta-i 0,60 --particles 4e4 \
+    --grid 18x18 --no-figures --out "$tmp/g" >/dev/null 2>&1 && ok || fail "one configuration"
+"$lamina" study "${tiny[@]}" --no-figures --out "$tmp/g" >"$tmp/g.log" 2>&1 && ok || fail "add a configuration"
+grep -qF 'Work: 2 reference pieces simulated, 2 model tables computed (2 reused), 1 configurations written (1 unchanged)' "$tmp/g.log" \
+    && ok || { fail "adding a configuration:"; grep Work "$tmp/g.log"; }
+cmp -s "$tmp/g/metrics.csv" "$tmp/a.metrics" && ok || fail "metrics after adding a configuration"
+
+# 2d. Table formats: half (the default) is float16, full float32, none writes no tables (and the
+#     metrics do not depend on it); the Ω⊥ of the figure script agrees with lamina's (the albedo
+#     it computes from the float32 tables is metrics.csv's albedo_ref).
+"$lamina" study "${tiny[@]}" --tables full --no-figures --out "$tmp/full" >/dev/null 2>&1 && ok || fail "--tables full"
+"$lamina" study "${tiny[@]}" --tables none --no-figures --out "$tmp/none" >/dev/null 2>&1 && ok || fail "--tables none"
+cmp -s "$tmp/full/metrics.csv" "$tmp/a.metrics" && ok || fail "metrics depend on --tables"
+cmp -s "$tmp/none/metrics.csv" "$tmp/a.metrics" && ok || fail "metrics depend on --tables none"
+[ ! -e "$tmp/none/configs/plastic-P1-a0.05/tables.npy" ] && ok || fail "--tables none wrote tables"
+# Debian's interpreter, the one with numpy and matplotlib (as `lamina figures` chooses it).
+py=python3
+[ -x /usr/bin/python3 ] && py=/usr/bin/python3
+"$py" - "$tmp" "$src/scripts/figures.py" <<'PY' && ok || fail "table formats / Ω⊥"
+import csv, importlib.util, json, sys
+import numpy as np
+tmp, script = sys.argv[1], sys.argv[2]
+spec = importlib.util.spec_from_file_location("figures", script)
+figures = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(figures)
+cid = "slab-a0.1-a1.3-clear"
+half = np.load(f"{tmp}/a/configs/{cid}/tables.npy")
+full = np.load(f"{tmp}/full/configs/{cid}/tables.npy")
+assert half.dtype == np.float16 and full.dtype == np.float32, (half.dtype, full.dtype)
+assert json.load(open(f"{tmp}/a/configs/{cid}/config.json"))["tables"]["dtype"] == "float16"
+ok = np.isfinite(full)
+assert np.array_equal(np.isnan(half), np.isnan(full))
+assert np.allclose(half[ok], full[ok], rtol=2 ** -11, atol=6e-8), "half is not full rounded"
+om = figures.omega_perp(18, 18)
+theta_i = json.load(open(f"{tmp}/full/study.json"))["theta_i"]
+n = 0
+for r in csv.DictReader(open(f"{tmp}/full/metrics.csv")):
+    if r["config"] != cid or r["supported"] != "true":
+        continue
+    i, d, c = theta_i.index(float(r["theta_i"])), "RT".index(r["side"]), "rgb".index(r["channel"])
+    albedo = float((full[0, i, d, :, :, c].astype(np.float64) * om).sum())
+    assert abs(albedo - float(r["albedo_ref"])) <= 1e-6 * float(r["albedo_ref"]), (r, albedo)
+    n += 1
+assert n >= 6, n
+PY
 
 # 3. Killed part-way (kill -9 as soon as the first piece is stored), then resumed: the same
 #    metrics.csv as the uninterrupted run.

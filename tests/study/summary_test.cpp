@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -20,8 +21,9 @@ const StudyConfiguration& builtin(const std::string& id) {
 }
 
 // Rows of one (configuration, model): every channel of one incidence with the same error.
+// misplaced_floor: the same as misplaced_energy unless given (a reference above 5% of the light).
 void add_rows(std::vector<MetricRow>& rows, const StudyConfiguration& c, const std::string& model,
-              bool supported, double misplaced_energy) {
+              bool supported, double misplaced_energy, double misplaced_floor = NAN) {
     for (int channel = 0; channel < 3; ++channel) {
         MetricRow r;
         r.config = c.id;
@@ -32,8 +34,11 @@ void add_rows(std::vector<MetricRow>& rows, const StudyConfiguration& c, const s
         r.channel = channel;
         r.supported = supported;
         r.metrics.misplaced_energy = supported ? misplaced_energy : NAN;
+        r.metrics.misplaced_floor =
+            supported ? (std::isnan(misplaced_floor) ? misplaced_energy : misplaced_floor) : NAN;
         r.metrics.albedo_error = supported ? misplaced_energy : NAN;
         r.floor.misplaced_energy = 0.01;
+        r.floor.misplaced_floor = 0.01;
         rows.push_back(r);
     }
 }
@@ -42,6 +47,7 @@ void add_rows(std::vector<MetricRow>& rows, const StudyConfiguration& c, const s
 struct Written {
     nlohmann::json json;
     std::string md;
+    StudyFindings findings;
 };
 Written summarize(const std::vector<StudyConfiguration>& configs,
                   const std::vector<std::string>& models, const std::vector<MetricRow>& rows,
@@ -52,8 +58,11 @@ Written summarize(const std::vector<StudyConfiguration>& configs,
     std::filesystem::create_directories(dir);
     StudySettings s;
     s.theta_i_deg = {30};
-    write_summary(dir, configs, s, models, rows, lost);
+    const StudyFindings findings = compute_findings(configs, s, models, rows, lost);
+    EXPECT_EQ(write_summary(dir, findings), 2);
+    EXPECT_EQ(write_summary(dir, findings), 0);  // unchanged: nothing rewritten
     Written w;
+    w.findings = findings;
     std::ifstream in(dir / "summary.json");
     w.json = nlohmann::json::parse(in);
     std::ifstream md_in(dir / "summary.md");
@@ -115,6 +124,45 @@ TEST(StudySummary, ReportsTheReferencesMicrosurfaceLoss) {
                         paint.id + ", θi 30°, b)"),
               std::string::npos)
         << w.md;
+}
+
+// The ranking is by misplaced_floor, not by the relative misplaced energy. Model "a" misplaces
+// 300% of a lobe holding 1% of the light (3% of the light: misplaced_floor 0.03 / 0.05 = 60%);
+// model "b" misplaces 80% of a lobe above 5% (both metrics 80%). Relative, a is worse; floored,
+// a is better, and ranks first.
+TEST(StudySummary, RanksByMisplacedFloorAndKeepsTheRelativeMetricBeside) {
+    const StudyConfiguration& paint = builtin("paint-a0.05-a1.3");
+    std::vector<MetricRow> rows;
+    add_rows(rows, paint, "a", true, 3.0, 0.6);
+    add_rows(rows, paint, "b", true, 0.8, 0.8);
+    const Written w = summarize({paint}, {"b", "a"}, rows);
+    const nlohmann::json& g = w.json["groups"][paint.category];
+    EXPECT_EQ(g["ranking"], (nlohmann::json{"a", "b"}));
+    EXPECT_NEAR(g["models"]["a"]["mean_misplaced_floor"].get<double>(), 0.6, 1e-12);
+    EXPECT_NEAR(g["models"]["a"]["mean_misplaced_energy"].get<double>(), 3.0, 1e-12);
+    EXPECT_NEAR(g["models"]["a"]["mean_misplaced_floor_noise"].get<double>(), 0.01, 1e-12);
+    EXPECT_EQ(w.json["ranking_metric"], "misplaced_floor");
+    EXPECT_EQ(w.json["common"]["ranking"], (nlohmann::json{"a", "b"}));
+    // Both are challenging (above 20% and twice the noise floor); the best is a, at 60%.
+    ASSERT_EQ(w.json["challenging"].size(), 1u);
+    EXPECT_EQ(w.json["challenging"][0]["best_model"], "a");
+    EXPECT_NEAR(w.json["challenging"][0]["best_mean_misplaced_floor"].get<double>(), 0.6, 1e-12);
+    EXPECT_NE(w.md.find("use **a** — mean misplaced energy 60.0% (noise floor 1.0%; relative "
+                        "300.0%)"),
+              std::string::npos)
+        << w.md;
+}
+
+// What `lamina study` prints is the Findings section of summary.md, from the same findings.
+TEST(StudySummary, HeadlineIsTheFindingsSectionOfTheMarkdown) {
+    const StudyConfiguration& paint = builtin("paint-a0.05-a1.3");
+    std::vector<MetricRow> rows;
+    add_rows(rows, paint, "a", true, 0.1);
+    const Written w = summarize({paint}, {"a"}, rows);
+    const std::string headline = findings_headline(w.findings);
+    EXPECT_EQ(headline.rfind("## Findings\n", 0), 0u);
+    EXPECT_NE(w.md.find(headline), std::string::npos);
+    EXPECT_EQ(findings_markdown(w.findings), w.md);
 }
 
 }  // namespace

@@ -197,13 +197,13 @@ def _split_models(models):
 
 
 def _run(configs, models, theta_i, particles, preset, seed, threads, grid, kernel, microsurface,
-         out, figures, quiet, nodes, peak_nodes):
+         out, figures, quiet, nodes, peak_nodes, tables="half"):
     names, plugins = _split_models(models)
     settings = {
         "particles": int(particles), "preset": preset, "seed": int(seed),
         "theta_i": [float(t) for t in np.atleast_1d(theta_i)], "grid": (int(grid[0]), int(grid[1])),
         "models": names, "threads": int(threads), "kernel": kernel, "microsurface": microsurface,
-        "quiet": bool(quiet),
+        "quiet": bool(quiet), "tables": str(tables),
         # models=None: every built-in model; a list: exactly the models it names.
         "registry_models": models is None,
     }
@@ -220,12 +220,14 @@ def _run(configs, models, theta_i, particles, preset, seed, threads, grid, kerne
 
 def compare(stack, models=None, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, threads=0,
             grid=(90, 90), kernel="simd", microsurface="single", out=None, figures=False,
-            quiet=True, config_id=None, nodes=4, peak_nodes=32):
+            quiet=True, config_id=None, nodes=4, peak_nodes=32, tables="half"):
     """`lamina compare` from Python: the reference for one stack and every model on its bins.
 
     models: registry names and Python models (classes or objects with eval(wi, wo); see
     lamina.plugins), default every built-in model. Writes the study directory `out` (metrics,
     summary, explorer, and figures when figures=True) and returns it as a lamina.Study.
+    tables: how configs/<id>/tables.npy is stored, "half" (float16), "full" or "none" (the CLI's
+    --tables).
     """
     if out is None:
         raise input_error("arguments", "out", "give the output folder (out=...)")
@@ -234,12 +236,12 @@ def compare(stack, models=None, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, 
                         else (st.name or "stack"))
     configs = [{"id": cid, "category": "custom", "stack": st}]
     return _run(configs, models, theta_i, particles, "custom", seed, threads, grid, kernel,
-                microsurface, out, figures, quiet, nodes, peak_nodes)
+                microsurface, out, figures, quiet, nodes, peak_nodes, tables)
 
 
 def study(models=None, preset="quick", only=None, configs=None, theta_i=DEFAULT_THETA_I,
           particles=None, seed=1, threads=0, grid=(90, 90), kernel="simd", microsurface="single",
-          out=None, figures=False, quiet=True, nodes=4, peak_nodes=32):
+          out=None, figures=False, quiet=True, nodes=4, peak_nodes=32, tables="half"):
     """`lamina study` from Python, with Python models beside the built-in ones.
 
     configs: None for the study's 60 configurations, or a list of {"id", "category", "stack"};
@@ -260,4 +262,4 @@ def study(models=None, preset="quick", only=None, configs=None, theta_i=DEFAULT_
         keep = set(_lamina._filter_configurations(cs, only))
         cs = [c for c in cs if c["id"] in keep]
     return _run(cs, models, theta_i, n, label, seed, threads, grid, kernel, microsurface, out,
-                figures, quiet, nodes, peak_nodes)
+                figures, quiet, nodes, peak_nodes, tables)

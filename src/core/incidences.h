@@ -1,0 +1,41 @@
+#pragma once
+// The incidences θi lamina uses when none are given (the original study's seven angles), and the
+// range every incidence must lie in: one owner for the simulator, the study and the CLI.
+//
+// Domain: θi in degrees from the macro-surface normal, [0, 90) — 90° is the horizon, where no
+// light reaches the surface.
+
+#include "core/error.h"
+
+#include <fmt/format.h>
+
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+/// 0, 15, 30, 45, 60, 70, 80 degrees.
+inline std::vector<double> default_incidences_deg() {
+    return {0, 15, 30, 45, 60, 70, 80};
+}
+
+/// The same as command-line text, "0,15,30,45,60,70,80".
+inline std::string default_incidences_text() {
+    return fmt::format("{}", fmt::join(default_incidences_deg(), ","));
+}
+
+/// θi in [0, 90) degrees (NaN is not).
+inline bool incidence_in_range(double theta_i_deg) {
+    return theta_i_deg >= 0 && theta_i_deg < 90;
+}
+
+/// InputError naming `where` and `field` for an incidence outside [0, 90) degrees.
+inline void check_incidence(double theta_i_deg, const std::string& where,
+                            const std::string& field) {
+    if (!incidence_in_range(theta_i_deg))
+        throw InputError(
+            where, field,
+            fmt::format("{} is outside the allowed range [0, 90) degrees", theta_i_deg));
+}
+
+}  // namespace lamina
