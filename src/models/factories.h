@@ -25,6 +25,10 @@ std::vector<OptionSpec> bel18_symmetric_options();
 std::unique_ptr<Model> make_bel_prime(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> bel_prime_options();
 
+// lamina1.cpp: lamina's own layered model (docs/models.md, "lamina-1")
+std::unique_ptr<Model> make_lamina1(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> lamina1_options();
+
 // random_walk_model.cpp: the per-query stochastic reference (randomwalk/random_walk.h)
 std::unique_ptr<Model> make_random_walk(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> random_walk_options();

@@ -34,6 +34,11 @@ const std::vector<ModelEntry>& model_registry() {
         {"bel-prime", "Bel': Bel18 forward with the exact top reflection and a slab BTDF lobe",
          "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R, T (slab)",
          bel_prime_options, make_bel_prime},
+        {"lamina-1",
+         "lamina-1: exact top reflection, first order through the coat's directional "
+         "transmittance, inter-reflection series, lobe widened by the coat's refraction spread",
+         "bases: lambertian, conductor, dielectric; media: absorbing; sides: R, T (slab)",
+         lamina1_options, make_lamina1},
         {"random-walk",
          "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "
          "per-query reference, unbiased",
