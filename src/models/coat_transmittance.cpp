@@ -18,7 +18,7 @@ constexpr int kTableNr = 32;    // Gauss–Legendre nodes in r on Heitz's disk
 constexpr int kTableNphi = 32;  // midpoint nodes in φ over the half disk (mirrored)
 constexpr double kCMin = 1e-4;
 constexpr double kAlphaMin = 1e-5;
-constexpr const char* kCodeVersion = "coat-t-v1";
+constexpr const char* kCodeVersion = "coat-t-v2";
 
 using T = CoatTransmittanceTable;
 
@@ -52,12 +52,12 @@ double integrate(double c, double alpha, double eta, RefractionMasking masking, 
         const double r = qr.x[a];
         const double w_r = qr.w[a] * 2 * r;  // ∫ g du1 with u1 = r²
         for (int b = 0; b < n_phi; ++b) {
-            // φ ∈ [0, π): the half disk; its mirror image p1 → −p1 (φ → π − φ, i.e. the normal's
+            // φ ∈ [−π/2, π/2): the half disk p1 ≥ 0; its mirror image p1 → −p1 (the normal's
             // y → −y) gives the same integrand, wi lying in the xz plane.
-            const double u2 = 0.5 * (b + 0.5) / n_phi;
+            const double u2 = 0.5 * (b + 0.5) / n_phi - 0.25;
             const Vec3d wm = ggx.sample_visible_normal(wi, r * r, u2);
             const FresnelDielectric<double> fr = fresnel_dielectric_full(dot(wi, wm), eta);
-            if (fr.reflectance >= 1) continue;
+            if (fr.reflectance >= 1) continue;  // total internal reflection
             const auto wt = refract(wi, wm, eta);
             if (!wt || wt->z >= 0) continue;  // masked: the single-scattering surface loses it
             const double g = refraction_escape(masking, lambda_i, ggx.lambda(*wt));

@@ -6,6 +6,7 @@
 #include "models/quadrature.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
+#include "physics/sampling.h"
 
 #include <fmt/format.h>
 
@@ -65,17 +66,18 @@ struct SplitCurve {
     }
 };
 
-/// ∫₀¹ f(μ) dμ by Gauss–Legendre, in two pieces split at `split` (a kink: a critical cosine).
+/// ∫₀¹ f(μ) dμ by Gauss–Legendre, in two pieces split at `split` (a critical cosine, where f has
+/// a square-root edge: Fresnel beyond total reflection). The upper piece is integrated in t with
+/// μ = split + (1 − split) t², which makes that edge smooth.
 template <typename V, typename F>
 V integrate01(F&& f, double split) {
     static const QuadratureRule q = gauss_legendre(kGauss);
     V sum{};
-    const double edges[3] = {0, clamp(split, 0.0, 1.0), 1};
-    for (int p = 0; p < 2; ++p) {
-        const double a = edges[p], b = edges[p + 1];
-        if (b <= a) continue;
-        for (int i = 0; i < kGauss; ++i)
-            sum += f(a + (b - a) * q.x[i]) * (q.w[i] * (b - a));
+    split = clamp(split, 0.0, 1.0);
+    for (int i = 0; i < kGauss; ++i) {
+        if (split > 0) sum += f(split * q.x[i]) * (q.w[i] * split);
+        const double t = q.x[i], d = 1 - split;
+        if (d > 0) sum += f(split + d * t * t) * (q.w[i] * 2 * d * t);
     }
     return sum;
 }
@@ -142,7 +144,7 @@ class Lamina1 final : public Model {
         in.wi_in = refract_in(wi, inv_eta0_);
         in.T = T_top_(wi.z);
         in.a = attenuation(in.wi_in.z);
-        if (series_on_) in.X = X_(wi.z);
+        if (series_on_) in.X = X_at(wi.z);
         if (alpha0_ > 0) in.lambda0 = GGX<double>{alpha0_}.lambda(wi);
         in.k_top = spread_factor(wi.z, in.wi_in.z, eta0_);
         return in;
@@ -173,7 +175,7 @@ class Lamina1 final : public Model {
         const Rgbd fb = base_lobe(in, wi.z, wo.z, wo_in);
         f += fb * (in.a * a_o) * (in.T * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
         if (series_on_) {
-            f += in.X * X_(wo.z) * K_ * (kInvPi<double> * inv_eta0_ * inv_eta0_);
+            f += in.X * X_at(wo.z) * K_ * (kInvPi<double> * inv_eta0_ * inv_eta0_);
         }
         return f;
     }
@@ -224,6 +226,16 @@ class Lamina1 final : public Model {
     double pdf(const Vec3d& wi, const Vec3d& wo) const override;
 
   private:
+    /// The sampling mixture for one incidence: lobe probabilities (top reflection, base lobe,
+    /// diffuse series; transmission lobe, diffuse transmission) and the lobes' roughnesses.
+    struct Mixture {
+        std::array<double, 5> p{};
+        Vec3d wi_in;
+        double alpha_base = 0, beta = 0;
+    };
+    Mixture mixture(const Incident& in) const;
+    double pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) const;
+
     /// The BTDF of a slab: the mirrored transmission lobe through both interfaces, and the
     /// diffuse light of the inter-reflections leaving through the bottom.
     Rgbd eval_btdf(const Incident& in, const Vec3d& wo) const {
@@ -232,7 +244,7 @@ class Lamina1 final : public Model {
         const Vec3d v(wo.x, wo.y, -wo.z);
         const auto v_in = refract_in_checked(v, 1 / eta_s_);
         if (!v_in) return Rgbd(0.0);
-        const double T_b = T_bot_(v.z);
+        const double T_b = T_bot_(v.z), T_b_in = T_bot_in_(v_in->z);
         const Rgbd a_v = attenuation(v_in->z);
         Rgbd f(0.0);
         const double beta = transmission_roughness(in.k_top, spread_factor(v.z, v_in->z, eta_s_));
@@ -240,7 +252,9 @@ class Lamina1 final : public Model {
             const GGX<double> ggx{beta};
             const Vec3d h = normalize(in.wi_in + *v_in);
             const double q = ggx.D(h) * ggx.G2(in.wi_in, *v_in) / (4 * in.wi_in.z * v_in->z);
-            f += in.a * a_v * (in.T * T_b * q / (eta_s_ * eta_s_));
+            // The narrow lobe leaves with the bottom's transmittance from inside, T_in(μv'):
+            // consistent with the bottom's reflection R_b(μ') (R_b + T_in + loss = 1).
+            f += in.a * a_v * (in.T * T_b_in * q / (eta_s_ * eta_s_));
         }
         if (series_on_) f += in.X * inv_one_minus_Er_ * (T_b * kInvPi<double> / (eta_s_ * eta_s_));
         return f;
@@ -274,6 +288,15 @@ class Lamina1 final : public Model {
     double spread_factor(double mu, double mu_in, double eta) const {
         if (ch_.spread == Lamina1Choices::Spread::Normal) return std::abs(1 - 1 / eta);
         return deflection(mu, mu_in, eta);
+    }
+
+    /// X(μ); exact for a Lambertian base when the light enters along the refracted direction
+    /// (X = T(μ) a(μ') ρ r̄), else the per-material curve.
+    Rgbd X_at(double mu) const {
+        if (!x_exact_) return X_(mu);
+        return coat_.albedo * r_bar_ *
+               attenuation(refract_in(Vec3d(safe_sqrt(1 - mu * mu), 0, mu), inv_eta0_).z) *
+               T_top_(mu);
     }
 
     /// The inside direction (pointing up) whose refraction through a flat interface of relative
@@ -336,7 +359,7 @@ class Lamina1 final : public Model {
     double eta_b_ = 1, eta_s_ = 1;
     bool has_absorption_ = false;
     std::array<FgdTable::Index, 3> base_fgd_{};
-    bool series_on_ = false;
+    bool series_on_ = false, x_exact_ = false;
     /// T(μ) of the coat from above and of the bottom from below: exact 1 − F(μ) when smooth (or
     /// with coat-transmittance=fresnel), else the per-material curve resampled from the table.
     struct Transmittance {
@@ -348,6 +371,9 @@ class Lamina1 final : public Model {
         }
     };
     Transmittance T_top_, T_bot_;
+    /// The bottom's transmittance for light inside the coat (the first-order BTDF's exit) and the
+    /// coat's for light inside it (the first order's consistency with R_in; see precompute).
+    Transmittance T_bot_in_, T_top_in_;
     /// X(μ): the flux the coat's bottom returns to the base after the first order, per unit flux
     /// arriving from outside at μ (outside cosines).
     CosineCurve<Rgbd> X_;
@@ -371,16 +397,35 @@ void Lamina1::precompute() {
         if (!t.exact) t.curve.fill([&](double mu) { return transmittance(mu, alpha, eta); });
     };
     setup(T_top_, alpha0_, eta0_);
-    if (support_.btdf) setup(T_bot_, alpha1_, eta_s_);
+    setup(T_top_in_, alpha0_, inv_eta0_);
+    if (support_.btdf) {
+        setup(T_bot_, alpha1_, eta_s_);
+        setup(T_bot_in_, alpha1_, eta_b_);
+    }
 
     // The coat's bottom seen from inside: R_in(μ) = FGD(μ, α0, 1/η0) (total internal reflection
     // included), and g(μ) = a(μ)² R_in(μ) for a return trip base → coat → base.
     const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
+    auto R_in = [&](double mu) { return fgd(mu, alpha0_, inv_eta0_, 0.0); };
+    r_bar_ = integrate01<Rgbd>(
+        [&](double mu) { return attenuation(mu) * attenuation(mu) * (2 * mu * R_in(mu)); },
+        mu_crit);
+    // What the first order does not send out is returned: light inside at μ'' within the exit
+    // cone leaves in the first order with the outside transmittance T(μ) (exact for a locally
+    // uniform inside radiance, by reciprocity), so the part returned to the base is
+    // R_eff = 1 − loss − T(μ) = R_in + T_in − T(μ), where R_in + T_in + loss = 1 from inside. For
+    // a smooth coat T_in = T and R_eff = R_in; for a rough one the facets' total internal
+    // reflection makes T_in < T near the critical angle, and R_in alone would count that light
+    // twice. Beyond the cone nothing leaves in the first order and R_eff = R_in.
     auto g = [&](double mu) {
         const Rgbd a = attenuation(mu);
-        return a * a * fgd(mu, alpha0_, inv_eta0_, 0.0);
+        double R = R_in(mu);
+        if (alpha0_ > 0 && mu > mu_crit) {
+            const double mu_out = safe_sqrt(1 - (1 - mu * mu) * sqr(eta0_));
+            R = std::max(0.0, R + T_top_in_(mu) - T_top_(mu_out));
+        }
+        return a * a * R;
     };
-    r_bar_ = integrate01<Rgbd>([&](double mu) { return g(mu) * (2 * mu); }, mu_crit);
     const double mu_crit_b = eta_b_ < 1 ? std::sqrt(1 - sqr(eta_b_)) : 0.0;
     E_bar_ = integrate01<Rgbd>([&](double mu) { return base_albedo(mu) * (2 * mu); }, mu_crit_b);
     auto inside_cos = [&](double mu) { return safe_sqrt(1 - (1 - mu * mu) * sqr(inv_eta0_)); };
@@ -405,7 +450,8 @@ void Lamina1::precompute() {
         for (int a = 0; a < kYnr; ++a) {
             const double r = qr.x[a], w_r = qr.w[a] * 2 * r;
             for (int b = 0; b < kYnphi; ++b) {
-                const Vec3d wm = ggx.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi);
+                const Vec3d wm =
+                    ggx.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi - 0.25);
                 const Vec3d w2 = reflect(w, wm);
                 if (w2.z <= 0) continue;
                 // Visible-normal weight: f_b μ'' dω'' = D_w F G2/G1 dwm (Heitz 2018, §2).
@@ -415,7 +461,10 @@ void Lamina1::precompute() {
         }
         return sum;
     };
-    if (alpha0_ == 0 || !ch_.directional_transmittance) {
+    x_exact_ = coat_.base_type == InterfaceType::Lambertian &&
+               (alpha0_ == 0 || !ch_.directional_transmittance);
+    if (x_exact_) {
+    } else if (alpha0_ == 0 || !ch_.directional_transmittance) {
         // The light enters along the refracted direction (smooth coat) or is taken to.
         X_.fill([&](double mu) {
             const double mu_in = inside_cos(mu);
@@ -436,7 +485,8 @@ void Lamina1::precompute() {
             for (int a = 0; a < kYnr; ++a) {
                 const double r = qr.x[a], w_r = qr.w[a] * 2 * r;
                 for (int b = 0; b < kYnphi; ++b) {
-                    const Vec3d wm = ggx0.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi);
+                    const Vec3d wm =
+                        ggx0.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi - 0.25);
                     const double F = fresnel_dielectric(dot(w, wm), eta0_);
                     const auto wt = refract(w, wm, eta0_);
                     if (!wt || wt->z >= 0) continue;
@@ -450,7 +500,8 @@ void Lamina1::precompute() {
         });
     }
     // X̄ = (2/η0²)∫ X(μ) μ dμ: the diffuse exit's normalization.
-    X_bar_ = integrate01<Rgbd>([&](double mu) { return X_(mu) * (2 * mu); }, 0.0) * sqr(inv_eta0_);
+    X_bar_ =
+        integrate01<Rgbd>([&](double mu) { return X_at(mu) * (2 * mu); }, 0.0) * sqr(inv_eta0_);
     for (int c = 0; c < 3; ++c) {
         const double one_minus = 1 - E_bar_[c] * r_bar_[c];
         inv_one_minus_Er_[c] = one_minus > 0 ? 1 / one_minus : 0;
@@ -475,11 +526,129 @@ std::unique_ptr<IncidentEvaluator> Lamina1::prepare(const Vec3d& wi) const {
     return std::make_unique<Lamina1Evaluator>(*this, wi);
 }
 
-std::optional<ModelSample> Lamina1::sample(const Vec3d&, const Vec3d&) const {
-    return std::nullopt;
+Lamina1::Mixture Lamina1::mixture(const Incident& in) const {
+    Mixture m;
+    if (!in.ok) return m;
+    m.wi_in = in.wi_in;
+    const double a = in.a.mean();
+    if (alpha0_ > 0) m.p[0] = fresnel_dielectric(in.wi.z, eta0_);
+    const double E_b = base_albedo(in.wi_in.z).mean();
+    if (coat_.base_type == InterfaceType::Lambertian) {
+        m.p[1] = in.T * a * E_b;
+    } else {
+        // The base lobe is drawn with its incident-side widening on both sides (k_o ≈ k_i).
+        m.alpha_base = effective_alpha(in.k_top, in.k_top);
+        if (m.alpha_base > 0) m.p[1] = in.T * a * E_b;
+    }
+    if (series_on_) m.p[2] = (in.X * K_ * X_bar_).mean();
+    if (support_.btdf) {
+        // The straight-through pair: v' = mirror(wi'), leaving at sin θv = η_s sin θi'.
+        const double s2 = sqr(eta_s_) * (1 - sqr(in.wi_in.z));
+        const double k_b = s2 < 1 ? spread_factor(std::sqrt(1 - s2), in.wi_in.z, eta_s_) : 1.0;
+        m.beta = transmission_roughness(in.k_top, k_b);
+        if (m.beta > 0) m.p[3] = in.T * a * std::max(0.0, 1 - E_b);
+        if (series_on_) m.p[4] = (in.X * inv_one_minus_Er_).mean() * 0.5;
+    }
+    double total = 0;
+    for (double p : m.p)
+        total += p;
+    if (!(total > 0)) return Mixture{};
+    for (double& p : m.p)
+        p /= total;
+    return m;
 }
-double Lamina1::pdf(const Vec3d&, const Vec3d&) const {
-    return 0;
+
+double Lamina1::pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) const {
+    if (!in.ok || wo.z == 0) return 0;
+    double pdf = 0;
+    if (wo.z > 0) {
+        if (m.p[0] > 0) {
+            const Vec3d h = normalize(in.wi + wo);
+            pdf += m.p[0] * GGX<double>{alpha0_}.D_visible(in.wi, h) / (4 * std::abs(dot(wo, h)));
+        }
+        if (m.p[1] > 0) {
+            if (coat_.base_type == InterfaceType::Lambertian) {
+                pdf += m.p[1] * wo.z * kInvPi<double>;
+            } else {
+                // Drawn inside the coat: dω'/dω = μo/(η0² μo') (Snell's law of solid angles).
+                const Vec3d wo_in = refract_in(wo, inv_eta0_);
+                const Vec3d h = normalize(m.wi_in + wo_in);
+                const double pdf_in =
+                    GGX<double>{m.alpha_base}.D_visible(m.wi_in, h) / (4 * std::abs(dot(wo_in, h)));
+                pdf += m.p[1] * pdf_in * wo.z / (sqr(eta0_) * wo_in.z);
+            }
+        }
+        if (m.p[2] > 0) pdf += m.p[2] * wo.z * kInvPi<double>;
+        return pdf;
+    }
+    if (m.p[3] > 0) {
+        const Vec3d v(wo.x, wo.y, -wo.z);
+        if (const auto v_in = refract_in_checked(v, 1 / eta_s_)) {
+            const Vec3d h = normalize(m.wi_in + *v_in);
+            const double pdf_in =
+                GGX<double>{m.beta}.D_visible(m.wi_in, h) / (4 * std::abs(dot(*v_in, h)));
+            pdf += m.p[3] * pdf_in * v.z / (sqr(eta_s_) * v_in->z);
+        }
+    }
+    if (m.p[4] > 0) pdf += m.p[4] * -wo.z * kInvPi<double>;
+    return pdf;
+}
+
+std::optional<ModelSample> Lamina1::sample(const Vec3d& wi, const Vec3d& u) const {
+    if (!support_.brdf || wi.z <= 0) return std::nullopt;
+    const Incident in = incident(wi);
+    const Mixture m = mixture(in);
+    // u.x picks the lobe, (u.y, u.z) draw its direction.
+    int lobe = 0;
+    double c = m.p[0];
+    while (lobe < 4 && u.x >= c)
+        c += m.p[++lobe];
+    if (m.p[lobe] <= 0) return std::nullopt;
+    Vec3d wo;
+    switch (lobe) {
+        case 0: {
+            const Vec3d wm = GGX<double>{alpha0_}.sample_visible_normal(wi, u.y, u.z);
+            wo = reflect(wi, wm);
+            if (wo.z <= 0) return std::nullopt;  // shadowed by the coat's microsurface
+            break;
+        }
+        case 1:
+            if (coat_.base_type == InterfaceType::Lambertian) {
+                wo = sample_cosine_hemisphere(u.y, u.z);
+            } else {
+                const Vec3d wm = GGX<double>{m.alpha_base}.sample_visible_normal(m.wi_in, u.y, u.z);
+                const Vec3d wo_in = reflect(m.wi_in, wm);
+                const double s2 = sqr(eta0_) * (1 - sqr(wo_in.z));
+                if (wo_in.z <= 0 || s2 >= 1) return std::nullopt;  // shadowed, or totally reflected
+                wo = Vec3d(wo_in.x * eta0_, wo_in.y * eta0_, std::sqrt(1 - s2));
+            }
+            break;
+        case 2:
+            wo = sample_cosine_hemisphere(u.y, u.z);
+            break;
+        case 3: {
+            const Vec3d wm = GGX<double>{m.beta}.sample_visible_normal(m.wi_in, u.y, u.z);
+            const Vec3d v_in = reflect(m.wi_in, wm);
+            const double s2 = sqr(eta_s_) * (1 - sqr(v_in.z));
+            if (v_in.z <= 0 || s2 >= 1) return std::nullopt;
+            wo = Vec3d(v_in.x * eta_s_, v_in.y * eta_s_, -std::sqrt(1 - s2));
+            break;
+        }
+        default: {
+            const Vec3d w = sample_cosine_hemisphere(u.y, u.z);
+            wo = Vec3d(w.x, w.y, -w.z);
+        }
+    }
+    if (wo.z == 0 || (wo.z < 0 && !support_.btdf)) return std::nullopt;
+    const double pdf = pdf_with(in, m, wo);
+    if (!(pdf > 0)) return std::nullopt;
+    return ModelSample{wo, eval_with(in, wo) * (std::abs(wo.z) / pdf), pdf};
+}
+
+double Lamina1::pdf(const Vec3d& wi, const Vec3d& wo) const {
+    if (!support_.brdf || wi.z <= 0) return 0;
+    const Incident in = incident(wi);
+    return pdf_with(in, mixture(in), wo);
 }
 
 const char* on_off(bool b) {

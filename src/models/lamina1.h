@@ -6,7 +6,8 @@
 //   f_R = f_top                                       exact Walter reflection of the coat
 //       + T(μi) T(μo) a(μi') a(μo') f_b(wi', wo'; α_e) / η0²     first order through the coat
 //       + K X(μi) X(μo) / (π η0²)                    inter-reflections (separable, reciprocal)
-//   f_T = T(μi) a(μi') T_b(μv) a(μv') q(wi', v'; β) / η_s² + X(μi) T_b(μv) / (π η_s² (1 − Ē_b r̄))
+//   f_T = T(μi) a(μi') T_b,in(μv') a(μv') q(wi', v'; β) / η_s² + X(μi) T_b(μv) / (π η_s² (1 − Ē_b
+//   r̄))
 //
 // T: the coat's directional transmittance (models/coat_transmittance.h), a: Beer–Lambert along
 // the refracted mean directions, α_e and β: the base lobe widened by the coat's refraction
