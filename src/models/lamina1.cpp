@@ -133,7 +133,7 @@ class Lamina1 final : public Model {
         double T = 0;  ///< T(μi)
         Rgbd a{1.0};   ///< exp(−τ/μi')
         Rgbd X{0.0};   ///< X(μi) = T(μi) a(μi') Y(μi')
-        double lambda0 = 0, k_top = 0;
+        double lambda0 = 0, k_top = 0, k_bottom = 1;
     };
 
     Incident incident(const Vec3d& wi) const {
@@ -147,6 +147,14 @@ class Lamina1 final : public Model {
         if (series_on_) in.X = X_at(wi.z);
         if (alpha0_ > 0) in.lambda0 = GGX<double>{alpha0_}.lambda(wi);
         in.k_top = spread_factor(wi.z, in.wi_in.z, eta0_);
+        if (support_.btdf) {
+            // The bottom's deflection at the straight-through pair v' = mirror(wi'), leaving at
+            // sin θv = η_s sin θi' (1 when it cannot leave). Taken there rather than at each wo:
+            // leaving a denser medium (η_s < 1) the factor grows without bound towards grazing,
+            // and a lobe whose width followed wo would no longer be normalized.
+            const double s2 = sqr(eta_s_) * (1 - sqr(in.wi_in.z));
+            in.k_bottom = s2 < 1 ? spread_factor(std::sqrt(1 - s2), in.wi_in.z, eta_s_) : 1.0;
+        }
         return in;
     }
 
@@ -247,7 +255,7 @@ class Lamina1 final : public Model {
         const double T_b = T_bot_(v.z), T_b_in = T_bot_in_(v_in->z);
         const Rgbd a_v = attenuation(v_in->z);
         Rgbd f(0.0);
-        const double beta = transmission_roughness(in.k_top, spread_factor(v.z, v_in->z, eta_s_));
+        const double beta = transmission_roughness(in.k_top, in.k_bottom);
         if (beta > 0) {
             const GGX<double> ggx{beta};
             const Vec3d h = normalize(in.wi_in + *v_in);
@@ -542,10 +550,7 @@ Lamina1::Mixture Lamina1::mixture(const Incident& in) const {
     }
     if (series_on_) m.p[2] = (in.X * K_ * X_bar_).mean();
     if (support_.btdf) {
-        // The straight-through pair: v' = mirror(wi'), leaving at sin θv = η_s sin θi'.
-        const double s2 = sqr(eta_s_) * (1 - sqr(in.wi_in.z));
-        const double k_b = s2 < 1 ? spread_factor(std::sqrt(1 - s2), in.wi_in.z, eta_s_) : 1.0;
-        m.beta = transmission_roughness(in.k_top, k_b);
+        m.beta = transmission_roughness(in.k_top, in.k_bottom);
         if (m.beta > 0) m.p[3] = in.T * a * std::max(0.0, 1 - E_b);
         if (series_on_) m.p[4] = (in.X * inv_one_minus_Er_).mean() * 0.5;
     }

@@ -273,7 +273,7 @@ TEST(CoatTransmittance, TableMatchesDirectIntegrationOffGrid) {
     struct Region {
         double eta_lo, eta_hi, max_bound, mean_bound;
     };
-    for (const Region& region : {Region{1.1, 2.5, 3e-3, 5e-4}, Region{0.4, 0.9, 3e-2, 2e-3}}) {
+    for (const Region& region : {Region{1.1, 2.5, 4e-3, 5e-4}, Region{0.4, 0.9, 3e-2, 2e-3}}) {
         ParticleRng rng(21, 0, 0);
         double max_err = 0, sum_err = 0;
         const int n = 300;
