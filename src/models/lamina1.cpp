@@ -19,22 +19,23 @@ namespace lamina {
 namespace {
 
 constexpr int kNmu = 65;    // nodes of the per-material curves over a cosine, μ = s²
-constexpr int kYnr = 8;     // visible-normal rule of Y: Gauss–Legendre in r ...
-constexpr int kYnphi = 12;  // ... × midpoint in φ over the half disk
+constexpr int kNx = 33;     // nodes of X(μ), μ = s²
+constexpr int kYnr = 6;     // visible-normal rules of Y and X: Gauss–Legendre in r ...
+constexpr int kYnphi = 8;   // ... × midpoint in φ over the half disk
 constexpr int kGauss = 24;  // Gauss–Legendre nodes per piece of the hemispherical integrals
 
 /// A curve over a cosine μ ∈ [0, 1] on nodes μ = s² (dense at grazing), linear in s.
-template <typename V>
+template <typename V, int kN = kNmu>
 struct CosineCurve {
-    std::array<V, kNmu> v{};
+    std::array<V, kN> v{};
     template <typename F>
     void fill(F&& f) {
-        for (int i = 0; i < kNmu; ++i)
-            v[i] = f(sqr(double(i) / (kNmu - 1)));
+        for (int i = 0; i < kN; ++i)
+            v[i] = f(sqr(double(i) / (kN - 1)));
     }
     V operator()(double mu) const {
-        const double s = std::sqrt(clamp(mu, 0.0, 1.0)) * (kNmu - 1);
-        const int i = std::min(int(s), kNmu - 2);
+        const double s = std::sqrt(clamp(mu, 0.0, 1.0)) * (kN - 1);
+        const int i = std::min(int(s), kN - 2);
         const double t = s - i;
         return v[i] * (1 - t) + v[i + 1] * t;
     }
@@ -42,8 +43,8 @@ struct CosineCurve {
 
 /// A curve over an inside cosine with a jump at the critical cosine μc (total internal reflection
 /// at a smooth coat): linear on nodes uniform in [0, μc) and in [μc, 1], each piece on its own.
+template <int kN>
 struct SplitCurve {
-    static constexpr int kN = 33;
     double split = 0;
     std::array<Rgbd, kN> below{}, above{};
     template <typename F>
@@ -384,7 +385,7 @@ class Lamina1 final : public Model {
     Transmittance T_bot_in_, T_top_in_;
     /// X(μ): the flux the coat's bottom returns to the base after the first order, per unit flux
     /// arriving from outside at μ (outside cosines).
-    CosineCurve<Rgbd> X_;
+    CosineCurve<Rgbd, kNx> X_;
     Rgbd K_{0.0};                 ///< the separable term's normalization
     Rgbd inv_one_minus_Er_{0.0};  ///< 1/(1 − Ē_b r̄)
     Rgbd r_bar_{0.0}, E_bar_{0.0}, t_bar_{0.0}, X_bar_{0.0};
@@ -425,7 +426,7 @@ void Lamina1::precompute() {
     // a smooth coat T_in = T and R_eff = R_in; for a rough one the facets' total internal
     // reflection makes T_in < T near the critical angle, and R_in alone would count that light
     // twice. Beyond the cone nothing leaves in the first order and R_eff = R_in.
-    auto g = [&](double mu) {
+    auto g_direct = [&](double mu) {
         const Rgbd a = attenuation(mu);
         double R = R_in(mu);
         if (alpha0_ > 0 && mu > mu_crit) {
@@ -434,6 +435,11 @@ void Lamina1::precompute() {
         }
         return a * a * R;
     };
+    // Tabulated once (Y's quadrature looks it up at every node); the node μ = 0 is taken at 1e-6,
+    // where an index-matched coat's Fresnel factor is its limit 0 (not the 0/0 of grazing).
+    SplitCurve<33> g_curve;
+    g_curve.fill(mu_crit, [&](double mu) { return g_direct(std::max(mu, 1e-6)); });
+    auto g = [&](double mu) { return g_curve(mu); };
     const double mu_crit_b = eta_b_ < 1 ? std::sqrt(1 - sqr(eta_b_)) : 0.0;
     E_bar_ = integrate01<Rgbd>([&](double mu) { return base_albedo(mu) * (2 * mu); }, mu_crit_b);
     auto inside_cos = [&](double mu) { return safe_sqrt(1 - (1 - mu * mu) * sqr(inv_eta0_)); };
@@ -483,7 +489,7 @@ void Lamina1::precompute() {
         // cone too (light there cannot leave through the first order and is returned): X(μ) =
         // ∫ t(μ → w') a(μ_w') Y(μ_w') dω' over the coat's transmitted light, by the visible-
         // normal rule of the coat (weight (1 − F) G_t/G1, as in its transmittance table).
-        SplitCurve Y_curve;
+        SplitCurve<17> Y_curve;
         Y_curve.fill(mu_crit, Y);
         const GGX<double> ggx0{alpha0_};
         X_.fill([&](double mu) {
