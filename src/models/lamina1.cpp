@@ -254,7 +254,7 @@ class Lamina1 final : public Model {
         const auto v_in = refract_in_checked(v, 1 / eta_s_);
         if (!v_in) return Rgbd(0.0);
         const double T_b = T_bot_(v.z), T_b_in = T_bot_in_(v_in->z);
-        const Rgbd a_v = attenuation(v_in->z);
+        const Rgbd a_v = has_absorption_ ? attenuation(v_in->z) : Rgbd(1.0);
         Rgbd f(0.0);
         const double beta = transmission_roughness(in.k_top, in.k_bottom);
         if (beta > 0) {
@@ -263,7 +263,13 @@ class Lamina1 final : public Model {
             const double q = ggx.D(h) * ggx.G2(in.wi_in, *v_in) / (4 * in.wi_in.z * v_in->z);
             // The narrow lobe leaves with the bottom's transmittance from inside, T_in(μv'):
             // consistent with the bottom's reflection R_b(μ') (R_b + T_in + loss = 1).
-            f += in.a * a_v * (in.T * T_b_in * q / (eta_s_ * eta_s_));
+            // The light crosses the coat's medium once: the geometric mean of the attenuations
+            // along the entering and the leaving direction (both e^{−τ/μi'} at the straight-
+            // through pair).
+            Rgbd a_once = in.a * a_v;
+            for (int c = 0; c < 3; ++c)
+                a_once[c] = std::sqrt(a_once[c]);
+            f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
         }
         if (series_on_) f += in.X * inv_one_minus_Er_ * (T_b * kInvPi<double> / (eta_s_ * eta_s_));
         return f;
