@@ -135,6 +135,8 @@ class Lamina1 final : public Model {
         Rgbd a{1.0};   ///< exp(−τ/μi')
         Rgbd X{0.0};   ///< X(μi) = T(μi) a(μi') Y(μi')
         double lambda0 = 0, k_top = 0, k_bottom = 1;
+        Vec3d wi_mean;     ///< the mean direction of the light the coat transmits (slabs)
+        Rgbd a_mean{1.0};  ///< exp(−τ/μ̄')
     };
 
     Incident incident(const Vec3d& wi) const {
@@ -149,12 +151,23 @@ class Lamina1 final : public Model {
         if (alpha0_ > 0) in.lambda0 = GGX<double>{alpha0_}.lambda(wi);
         in.k_top = spread_factor(wi.z, in.wi_in.z, eta0_);
         if (support_.btdf) {
+            in.wi_mean = in.wi_in;
+            in.a_mean = in.a;
+            if (mean_shift_) {
+                // The transmitted light's mean direction, in wi's plane of incidence.
+                const double mu = clamp(in.wi_in.z + mu_mean_(wi.z), 1e-4, 1.0);
+                const double sxy = std::hypot(in.wi_in.x, in.wi_in.y);
+                const double s_new = std::sqrt(1 - mu * mu);
+                in.wi_mean = sxy > 0 ? Vec3d(in.wi_in.x * s_new / sxy, in.wi_in.y * s_new / sxy, mu)
+                                     : in.wi_in;
+                in.a_mean = attenuation(mu);
+            }
             // The bottom's deflection at the straight-through pair v' = mirror(wi'), leaving at
             // sin θv = η_s sin θi' (1 when it cannot leave). Taken there rather than at each wo:
             // leaving a denser medium (η_s < 1) the factor grows without bound towards grazing,
             // and a lobe whose width followed wo would no longer be normalized.
-            const double s2 = sqr(eta_s_) * (1 - sqr(in.wi_in.z));
-            in.k_bottom = s2 < 1 ? spread_factor(std::sqrt(1 - s2), in.wi_in.z, eta_s_) : 1.0;
+            const double s2 = sqr(eta_s_) * (1 - sqr(in.wi_mean.z));
+            in.k_bottom = s2 < 1 ? spread_factor(std::sqrt(1 - s2), in.wi_mean.z, eta_s_) : 1.0;
         }
         return in;
     }
@@ -223,9 +236,14 @@ class Lamina1 final : public Model {
 
     std::vector<Vec3d> peak_directions(const Vec3d& wi) const override {
         std::vector<Vec3d> peaks{mirror_direction(wi)};
-        if (support_.btdf) {
+        if (support_.btdf && wi.z > 0) {
             const double sin_t = std::hypot(wi.x, wi.y) * inv_eta0_ * eta_s_;
             if (sin_t < 1) peaks.push_back(transmitted_direction(wi, std::sqrt(1 - sin_t * sin_t)));
+            if (mean_shift_) {  // the transmission lobe's own peak
+                const double sin_m = std::sqrt(1 - sqr(incident(wi).wi_mean.z)) * eta_s_;
+                if (sin_m < 1)
+                    peaks.push_back(transmitted_direction(wi, std::sqrt(1 - sin_m * sin_m)));
+            }
         }
         return peaks;
     }
@@ -239,7 +257,7 @@ class Lamina1 final : public Model {
     /// diffuse series; transmission lobe, diffuse transmission) and the lobes' roughnesses.
     struct Mixture {
         std::array<double, 5> p{};
-        Vec3d wi_in;
+        Vec3d wi_in, wi_mean;
         double alpha_base = 0, beta = 0;
     };
     Mixture mixture(const Incident& in) const;
@@ -259,14 +277,14 @@ class Lamina1 final : public Model {
         const double beta = transmission_roughness(in.k_top, in.k_bottom);
         if (beta > 0) {
             const GGX<double> ggx{beta};
-            const Vec3d h = normalize(in.wi_in + *v_in);
-            const double q = ggx.D(h) * ggx.G2(in.wi_in, *v_in) / (4 * in.wi_in.z * v_in->z);
+            const Vec3d h = normalize(in.wi_mean + *v_in);
+            const double q = ggx.D(h) * ggx.G2(in.wi_mean, *v_in) / (4 * in.wi_mean.z * v_in->z);
             // The narrow lobe leaves with the bottom's transmittance from inside, T_in(μv'):
             // consistent with the bottom's reflection R_b(μ') (R_b + T_in + loss = 1).
             // The light crosses the coat's medium once: the geometric mean of the attenuations
             // along the entering and the leaving direction (both e^{−τ/μi'} at the straight-
             // through pair).
-            Rgbd a_once = in.a * a_v;
+            Rgbd a_once = in.a_mean * a_v;
             for (int c = 0; c < 3; ++c)
                 a_once[c] = std::sqrt(a_once[c]);
             f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
@@ -374,7 +392,8 @@ class Lamina1 final : public Model {
     double eta_b_ = 1, eta_s_ = 1;
     bool has_absorption_ = false;
     std::array<FgdTable::Index, 3> base_fgd_{};
-    bool series_on_ = false, x_exact_ = false;
+    bool series_on_ = false, x_exact_ = false, mean_shift_ = false;
+    CosineCurve<double, kNx> mu_mean_;  ///< μ̄'(μ) − μ'(μ): the transmitted light's mean shift
     /// T(μ) of the coat from above and of the bottom from below: exact 1 − F(μ) when smooth (or
     /// with coat-transmittance=fresnel), else the per-material curve resampled from the table.
     struct Transmittance {
@@ -453,6 +472,35 @@ void Lamina1::precompute() {
         integrate01<Rgbd>(
             [&](double mu) { return attenuation(inside_cos(mu)) * (2 * mu * T_top_(mu)); }, 0.0) *
         sqr(inv_eta0_);
+
+    // The mean direction of the light a rough coat transmits (slab BTDF): the visible facets at
+    // grazing incidence lean towards the light and turn the refracted light away from the normal
+    // (by k δ per facet tilt δ, item 4 of docs/models.md), so its mean lies beyond the macro
+    // refraction — near grazing, beyond a slab's exit cone. By the coat's visible-normal rule.
+    mean_shift_ = support_.btdf && alpha0_ > 0 && ch_.directional_transmittance && ch_.mean_shift;
+    if (mean_shift_) {
+        static const QuadratureRule q = gauss_legendre(kYnr);
+        const GGX<double> ggx0{alpha0_};
+        mu_mean_.fill([&](double mu) {
+            const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+            double x = 0, z = 0;
+            for (int a = 0; a < kYnr; ++a)
+                for (int b = 0; b < kYnphi; ++b) {
+                    const double r = q.x[a], w_r = q.w[a] * 2 * r;
+                    const Vec3d wm =
+                        ggx0.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi - 0.25);
+                    const auto wt = refract(w, wm, eta0_);
+                    if (!wt || wt->z >= 0) continue;
+                    const double wgt = (1 - fresnel_dielectric(dot(w, wm), eta0_)) * w_r;
+                    x += wgt * wt->x;  // −wt: the inside direction pointing up, in −x
+                    z += wgt * -wt->z;
+                }
+            const double len = std::hypot(x, z);
+            // Stored as the shift from the macro refraction (which the lookup adds back exactly):
+            // it vanishes with α0, and so does its interpolation error under narrow lobes.
+            return (len > 0 ? z / len : inside_cos(mu)) - inside_cos(mu);
+        });
+    }
 
     const bool smooth_base = coat_.base_type != InterfaceType::Lambertian && alpha1_ == 0;
     series_on_ = ch_.inter_reflection && !(smooth_base && alpha0_ == 0);
@@ -550,6 +598,7 @@ Lamina1::Mixture Lamina1::mixture(const Incident& in) const {
     Mixture m;
     if (!in.ok) return m;
     m.wi_in = in.wi_in;
+    m.wi_mean = in.wi_mean;
     const double a = in.a.mean();
     if (alpha0_ > 0) m.p[0] = fresnel_dielectric(in.wi.z, eta0_);
     const double E_b = base_albedo(in.wi_in.z).mean();
@@ -601,9 +650,9 @@ double Lamina1::pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) 
     if (m.p[3] > 0) {
         const Vec3d v(wo.x, wo.y, -wo.z);
         if (const auto v_in = refract_in_checked(v, 1 / eta_s_)) {
-            const Vec3d h = normalize(m.wi_in + *v_in);
+            const Vec3d h = normalize(m.wi_mean + *v_in);
             const double pdf_in =
-                GGX<double>{m.beta}.D_visible(m.wi_in, h) / (4 * std::abs(dot(*v_in, h)));
+                GGX<double>{m.beta}.D_visible(m.wi_mean, h) / (4 * std::abs(dot(*v_in, h)));
             pdf += m.p[3] * pdf_in * v.z / (sqr(eta_s_) * v_in->z);
         }
     }
@@ -644,8 +693,8 @@ std::optional<ModelSample> Lamina1::sample(const Vec3d& wi, const Vec3d& u) cons
             wo = sample_cosine_hemisphere(u.y, u.z);
             break;
         case 3: {
-            const Vec3d wm = GGX<double>{m.beta}.sample_visible_normal(m.wi_in, u.y, u.z);
-            const Vec3d v_in = reflect(m.wi_in, wm);
+            const Vec3d wm = GGX<double>{m.beta}.sample_visible_normal(m.wi_mean, u.y, u.z);
+            const Vec3d v_in = reflect(m.wi_mean, wm);
             const double s2 = sqr(eta_s_) * (1 - sqr(v_in.z));
             if (v_in.z <= 0 || s2 >= 1) return std::nullopt;
             wo = Vec3d(v_in.x * eta_s_, v_in.y * eta_s_, -std::sqrt(1 - s2));
@@ -691,6 +740,11 @@ std::vector<OptionSpec> lamina1_option_specs() {
          on_off(d.inter_reflection),
          "inter-reflections between base and coat bottom (geometric series, separable lobe)"},
         {"eta2", {"on", "off"}, on_off(d.eta2_factor), "the 1/eta0^2 solid-angle compression"},
+        {"transmitted-direction",
+         {"mean", "refracted"},
+         d.mean_shift ? "mean" : "refracted",
+         "slab BTDF lobe centred on the rough coat's mean transmitted direction or on the macro "
+         "refraction"},
         {"spread",
          {"angular", "normal", "off"},
          "angular",
@@ -706,6 +760,7 @@ Lamina1Choices lamina1_choices(const ModelOptions& o) {
     c.directional_transmittance = option_value(o, "coat-transmittance") == "directional";
     c.inter_reflection = option_value(o, "inter-reflection") == "on";
     c.eta2_factor = option_value(o, "eta2") == "on";
+    c.mean_shift = option_value(o, "transmitted-direction") == "mean";
     const std::string& s = option_value(o, "spread");
     c.spread = s == "normal" ? Lamina1Choices::Spread::Normal
                : s == "off"  ? Lamina1Choices::Spread::Off

@@ -31,6 +31,9 @@ struct Lamina1Choices {
     bool directional_transmittance = true;
     /// Inter-reflections between base and coat bottom (the separable series term).
     bool inter_reflection = true;
+    /// The slab's transmission lobe centred on the mean direction of the light the rough coat
+    /// transmits (true) or on the macro refraction of wi (false).
+    bool mean_shift = true;
     /// The 1/η² solid-angle compression of the base term (Hanrahan & Krueger 1993, Eq. 8).
     bool eta2_factor = true;
     /// The base lobe widened by the coat's refraction spread: with the angle-dependent deflection

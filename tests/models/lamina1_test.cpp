@@ -338,7 +338,7 @@ TEST(Lamina1SamplingStat, ChiSquare) {
             const Vec3d wi = dir(ti, 0);
             test::Chi2Options o;
             o.name = fmt::format("lamina1-{}-{}", what, ti);
-            o.sample_count = 500'000;
+            o.sample_count = 200'000;
             o.test_count = count;
             const auto r = test::run_chi2(
                 o,

@@ -8,7 +8,7 @@
 namespace lamina {
 namespace {
 
-TEST(ModelRegistry, ListsTheSixModelsOfTheStudyAndTheRandomWalk) {
+TEST(ModelRegistry, ListsTheModelsOfTheStudyLamina1AndTheRandomWalk) {
     std::vector<std::string> names;
     for (const auto& e : model_registry()) {
         names.push_back(e.name);
@@ -20,7 +20,8 @@ TEST(ModelRegistry, ListsTheSixModelsOfTheStudyAndTheRandomWalk) {
         }
     }
     EXPECT_EQ(names, (std::vector<std::string>{"ww09", "ele10", "ww-prime", "bel18-forward",
-                                               "bel18-symmetric", "bel-prime", "random-walk"}));
+                                               "bel18-symmetric", "bel-prime", "lamina-1",
+                                               "random-walk"}));
 }
 
 TEST(ModelRegistry, UnknownNameListsTheKnownOnes) {
