@@ -503,7 +503,8 @@ void Lamina1::precompute() {
     }
 
     const bool smooth_base = coat_.base_type != InterfaceType::Lambertian && alpha1_ == 0;
-    series_on_ = ch_.inter_reflection && !(smooth_base && alpha0_ == 0);
+    series_on_ = ch_.inter_reflection && !(smooth_base && alpha0_ == 0) &&
+                 (coat_.base_type == InterfaceType::Lambertian || !ch_.series_lambertian_only);
     if (!series_on_) return;
     // Y(μ') = ∫ f_b(w', w'') μ'' g(μ'') dω'': what the base's first reflection of light arriving
     // at inside cosine μ' sends back down after one reflection at the coat's bottom.
@@ -736,9 +737,11 @@ std::vector<OptionSpec> lamina1_option_specs() {
          d.directional_transmittance ? "directional" : "fresnel",
          "the rough coat's directional transmittance (table) or 1 - F(mu) at the macro normal"},
         {"inter-reflection",
-         {"on", "off"},
-         on_off(d.inter_reflection),
-         "inter-reflections between base and coat bottom (geometric series, separable lobe)"},
+         {"lambertian", "on", "off"},
+         d.inter_reflection ? (d.series_lambertian_only ? "lambertian" : "on") : "off",
+         "inter-reflections between base and coat bottom (geometric series as a separable lobe): "
+         "under Lambertian bases only, always, or never (smooth stacks: the exact delta series "
+         "unless off)"},
         {"eta2", {"on", "off"}, on_off(d.eta2_factor), "the 1/eta0^2 solid-angle compression"},
         {"transmitted-direction",
          {"mean", "refracted"},
@@ -758,7 +761,8 @@ Lamina1Choices lamina1_choices(const ModelOptions& o) {
     c.masking = option_value(o, "refraction-masking") == "walter" ? RefractionMasking::Walter
                                                                   : RefractionMasking::SmithBeta;
     c.directional_transmittance = option_value(o, "coat-transmittance") == "directional";
-    c.inter_reflection = option_value(o, "inter-reflection") == "on";
+    c.inter_reflection = option_value(o, "inter-reflection") != "off";
+    c.series_lambertian_only = option_value(o, "inter-reflection") == "lambertian";
     c.eta2_factor = option_value(o, "eta2") == "on";
     c.mean_shift = option_value(o, "transmitted-direction") == "mean";
     const std::string& s = option_value(o, "spread");
