@@ -289,7 +289,8 @@ class Lamina1 final : public Model {
                 a_once[c] = std::sqrt(a_once[c]);
             f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
         }
-        if (series_on_) f += in.X * inv_one_minus_Er_ * (T_b * kInvPi<double> / (eta_s_ * eta_s_));
+        if (series_btdf_)
+            f += in.X * inv_one_minus_Er_ * (T_b * kInvPi<double> / (eta_s_ * eta_s_));
         return f;
     }
 
@@ -392,7 +393,7 @@ class Lamina1 final : public Model {
     double eta_b_ = 1, eta_s_ = 1;
     bool has_absorption_ = false;
     std::array<FgdTable::Index, 3> base_fgd_{};
-    bool series_on_ = false, x_exact_ = false, mean_shift_ = false;
+    bool series_on_ = false, series_btdf_ = false, x_exact_ = false, mean_shift_ = false;
     CosineCurve<double, kNx> mu_mean_;  ///< μ̄'(μ) − μ'(μ): the transmitted light's mean shift
     /// T(μ) of the coat from above and of the bottom from below: exact 1 − F(μ) when smooth (or
     /// with coat-transmittance=fresnel), else the per-material curve resampled from the table.
@@ -504,7 +505,9 @@ void Lamina1::precompute() {
 
     const bool smooth_base = coat_.base_type != InterfaceType::Lambertian && alpha1_ == 0;
     series_on_ = ch_.inter_reflection && !(smooth_base && alpha0_ == 0) &&
-                 (coat_.base_type == InterfaceType::Lambertian || !ch_.series_lambertian_only);
+                 (coat_.base_type == InterfaceType::Lambertian || !ch_.series_lambertian_only ||
+                  alpha1_ >= alpha0_);
+    series_btdf_ = series_on_ && !ch_.series_lambertian_only;
     if (!series_on_) return;
     // Y(μ') = ∫ f_b(w', w'') μ'' g(μ'') dω'': what the base's first reflection of light arriving
     // at inside cosine μ' sends back down after one reflection at the coat's bottom.
@@ -614,7 +617,7 @@ Lamina1::Mixture Lamina1::mixture(const Incident& in) const {
     if (support_.btdf) {
         m.beta = transmission_roughness(in.k_top, in.k_bottom);
         if (m.beta > 0) m.p[3] = in.T * a * std::max(0.0, 1 - E_b);
-        if (series_on_) m.p[4] = (in.X * inv_one_minus_Er_).mean() * 0.5;
+        if (series_btdf_) m.p[4] = (in.X * inv_one_minus_Er_).mean() * 0.5;
     }
     double total = 0;
     for (double p : m.p)
@@ -737,11 +740,11 @@ std::vector<OptionSpec> lamina1_option_specs() {
          d.directional_transmittance ? "directional" : "fresnel",
          "the rough coat's directional transmittance (table) or 1 - F(mu) at the macro normal"},
         {"inter-reflection",
-         {"lambertian", "on", "off"},
-         d.inter_reflection ? (d.series_lambertian_only ? "lambertian" : "on") : "off",
+         {"auto", "on", "off"},
+         d.inter_reflection ? (d.series_lambertian_only ? "auto" : "on") : "off",
          "inter-reflections between base and coat bottom (geometric series as a separable lobe): "
-         "under Lambertian bases only, always, or never (smooth stacks: the exact delta series "
-         "unless off)"},
+         "auto: reflected under Lambertian bases and bases at least as rough as the coat; on: "
+         "always, transmitted too; off: never (smooth stacks: the exact delta series unless off)"},
         {"eta2", {"on", "off"}, on_off(d.eta2_factor), "the 1/eta0^2 solid-angle compression"},
         {"transmitted-direction",
          {"mean", "refracted"},
@@ -762,7 +765,7 @@ Lamina1Choices lamina1_choices(const ModelOptions& o) {
                                                                   : RefractionMasking::SmithBeta;
     c.directional_transmittance = option_value(o, "coat-transmittance") == "directional";
     c.inter_reflection = option_value(o, "inter-reflection") != "off";
-    c.series_lambertian_only = option_value(o, "inter-reflection") == "lambertian";
+    c.series_lambertian_only = option_value(o, "inter-reflection") == "auto";
     c.eta2_factor = option_value(o, "eta2") == "on";
     c.mean_shift = option_value(o, "transmitted-direction") == "mean";
     const std::string& s = option_value(o, "spread");

@@ -31,10 +31,11 @@ struct Lamina1Choices {
     bool directional_transmittance = true;
     /// Inter-reflections between base and coat bottom (the separable series term).
     bool inter_reflection = true;
-    /// The separable series only where its uniform-radiance assumption holds, under a Lambertian
-    /// base (which re-diffuses the returned light exactly); over glossy bases the returned light
-    /// stays concentrated and is left out. With both interfaces smooth the exact delta series is
-    /// summed either way.
+    /// "auto": the separable series only where its uniform-radiance assumption can hold, where the
+    /// base re-diffuses the returned light at least as much as the coat spreads it: a Lambertian
+    /// base, or a base at least as rough as the coat (α1 ≥ α0); reflected only (the slab's
+    /// diffuse exit through the bottom only with "on"). With both interfaces smooth the exact
+    /// delta series is summed either way.
     bool series_lambertian_only = true;
     /// The slab's transmission lobe centred on the mean direction of the light the rough coat
     /// transmits (true) or on the macro refraction of wi (false).
