@@ -148,7 +148,7 @@ TEST(Lamina1, SmoothSlabIsTheExactSeries) {
 // smooth slab does (physics.md §6.4) up to 60°: what separates them is the microsurfaces' loss
 // (< 1e-4 there), the tables' interpolation (< 1e-3 at α = 10⁻³) and the binned quadrature
 // (1e-3 relative); the later orders, spread into the separable lobes (inter-reflection=on; by
-// default only a Lambertian base gets them), carry F²a² < 1% of the light.
+// default a slab gets none), carry F²a² < 1% of the light.
 TEST(Lamina1, NearlySmoothSlabIsTheSmoothSlab) {
     const Rgbd tau(0.1, 0.0, 0.9);
     const auto model = make_model("lamina-1", coated(1.5, 1e-3, test::dielectric(1.0, 1e-3), tau),
