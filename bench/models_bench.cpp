@@ -4,6 +4,7 @@
 #include "core/rng.h"
 #include "core/spherical.h"
 #include "models/binned.h"
+#include "models/coat_transmittance.h"
 #include "models/fgd_table.h"
 #include "models/registry.h"
 #include "models/tir_table.h"
@@ -62,6 +63,7 @@ Stack bench_stack(const std::string& name) {
 void warm_tables() {
     FgdTable::get();
     TirTable::get();
+    CoatTransmittanceTable::get(RefractionMasking::SmithBeta);
 }
 
 /// Model::eval(wi, wo) for random pairs (the forward Belcour variants redo their lobe statistics
@@ -99,6 +101,18 @@ void BM_BinnedTable(benchmark::State& state, const std::string& name, bool slab)
         benchmark::DoNotOptimize(bin_model(*model, grid, {0, 15, 30, 45, 60, 70, 80}));
     state.counters["threads"] = omp_get_max_threads();
 }
+
+/// lamina-1's per-material precomputation (its curves over cosines, hemispherical albedos and the
+/// inter-reflection normalization; the process-wide tables already loaded): the whole constructor.
+void BM_Lamina1Construct(benchmark::State& state, bool slab) {
+    warm_tables();
+    const Stack stack = typical_stack(slab);
+    for (auto _ : state)
+        benchmark::DoNotOptimize(make_model("lamina-1", stack));
+    state.SetLabel(slab ? "rough slab" : "rough coat over rough gold");
+}
+BENCHMARK_CAPTURE(BM_Lamina1Construct, coated_gold, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Lamina1Construct, slab, true)->Unit(benchmark::kMicrosecond);
 
 const int registered = [] {
     for (const auto& e : model_registry()) {

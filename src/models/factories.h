@@ -28,6 +28,9 @@ std::vector<OptionSpec> bel_prime_options();
 // tm2.cpp: the transfer-matrix model (Randrianandrasana, Callet & Lucas 2021)
 std::unique_ptr<Model> make_tm2(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> tm2_options();
+// lamina1.cpp: lamina's own layered model (docs/models.md, "lamina-1")
+std::unique_ptr<Model> make_lamina1(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> lamina1_options();
 
 // random_walk_model.cpp: the per-query stochastic reference (randomwalk/random_walk.h)
 std::unique_ptr<Model> make_random_walk(const Stack& stack, const ModelOptions& options);

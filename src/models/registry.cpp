@@ -39,6 +39,11 @@ const std::vector<ModelEntry>& model_registry() {
          "(conductor base: plugin tm2, exact top; slab: tm2_dielectric, transmitted lobe)",
          "bases: conductor, dielectric; media: absorbing; sides: R, T (slab)", tm2_options,
          make_tm2, false, "successors"},
+        {"lamina-1",
+         "lamina-1: exact top reflection, first order through the coat's directional "
+         "transmittance, inter-reflection series, lobe widened by the coat's refraction spread",
+         "bases: lambertian, conductor, dielectric; media: absorbing; sides: R, T (slab)",
+         lamina1_options, make_lamina1, false, "lamina"},
         {"random-walk",
          "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "
          "per-query reference, unbiased",
@@ -85,7 +90,7 @@ const std::vector<ModelEntry>& model_registry() {
 }
 
 const std::vector<std::string>& model_groups() {
-    static const std::vector<std::string> groups = {"2019", "successors", "production",
+    static const std::vector<std::string> groups = {"lamina", "2019", "successors", "production",
                                                     "reference"};
     return groups;
 }

@@ -23,7 +23,8 @@ struct ModelEntry {
     bool stochastic = false;
     /// The family a reader compares it within (the explorer's model groups): "2019" (the
     /// models of the 2019 study), "successors" (Belcour 2018's statistical successors),
-    /// "production" (the coats engines ship) or "reference" (the stochastic estimator).
+    /// "production" (the coats engines ship), "lamina" (lamina's own model) or "reference" (the
+    /// stochastic estimator).
     std::string group = "2019";
 };
 

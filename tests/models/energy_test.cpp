@@ -47,11 +47,14 @@ TEST(ModelsEnergy, AlbedoAtMostOne) {
         // (max 6.3e-3, docs/models.md) adds to the quadrature tolerance (1e-3).
         // Bel18 symmetric is not conservative by construction (Bel18SymmetricCanExceedOne below):
         // its budget is the measured excess over a wider sweep, 1.24e-2, rounded up.
-        // The transfer-matrix models (tm*) read the same table.
+        // The transfer-matrix models (tm*) read the same table; lamina-1's hemispherical albedos
+        // and its return of the first order come from the same FGD table (and its coat
+        // transmittance table, whose budget is smaller): the same budget.
+        const bool table_energies = entry.name.rfind("bel", 0) == 0 ||
+                                    entry.name.rfind("tm", 0) == 0 || entry.name == "lamina-1";
         const double tol = entry.name == "bel18-symmetric" ? 2e-2
-                           : entry.name.rfind("bel", 0) == 0 || entry.name.rfind("tm", 0) == 0
-                               ? 1e-3 + 6.3e-3
-                               : 1e-3;
+                           : table_energies                ? 1e-3 + 6.3e-3
+                                                           : 1e-3;
         for (const auto& [what, stack] : sweep()) {
             const auto model = entry.make(stack, resolve_options(entry, {}));
             if (!model->support().brdf) continue;

@@ -1,0 +1,786 @@
+#include "models/lamina1.h"
+
+#include "core/math.h"
+#include "models/factories.h"
+#include "models/fgd_table.h"
+#include "models/quadrature.h"
+#include "physics/fresnel.h"
+#include "physics/microfacet.h"
+#include "physics/sampling.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+#include <optional>
+
+namespace lamina {
+
+namespace {
+
+constexpr int kNmu = 65;    // nodes of the per-material curves over a cosine, μ = s²
+constexpr int kNx = 33;     // nodes of X(μ), μ = s²
+constexpr int kYnr = 6;     // visible-normal rules of Y and X: Gauss–Legendre in r ...
+constexpr int kYnphi = 8;   // ... × midpoint in φ over the half disk
+constexpr int kGauss = 24;  // Gauss–Legendre nodes per piece of the hemispherical integrals
+
+/// A curve over a cosine μ ∈ [0, 1] on nodes μ = s² (dense at grazing), linear in s.
+template <typename V, int kN = kNmu>
+struct CosineCurve {
+    std::array<V, kN> v{};
+    template <typename F>
+    void fill(F&& f) {
+        for (int i = 0; i < kN; ++i)
+            v[i] = f(sqr(double(i) / (kN - 1)));
+    }
+    V operator()(double mu) const {
+        const double s = std::sqrt(clamp(mu, 0.0, 1.0)) * (kN - 1);
+        const int i = std::min(int(s), kN - 2);
+        const double t = s - i;
+        return v[i] * (1 - t) + v[i + 1] * t;
+    }
+};
+
+/// A curve over an inside cosine with a jump at the critical cosine μc (total internal reflection
+/// at a smooth coat): linear on nodes uniform in [0, μc) and in [μc, 1], each piece on its own.
+template <int kN>
+struct SplitCurve {
+    double split = 0;
+    std::array<Rgbd, kN> below{}, above{};
+    template <typename F>
+    void fill(double mu_split, F&& f) {
+        split = clamp(mu_split, 0.0, 1.0);
+        for (int i = 0; i < kN; ++i) {
+            const double t = double(i) / (kN - 1);
+            below[i] = f(std::min(split * t, std::nextafter(split, 0.0)));
+            above[i] = f(split + (1 - split) * t);
+        }
+    }
+    Rgbd operator()(double mu) const {
+        const bool lower = mu < split;
+        const double a = lower ? 0 : split, b = lower ? split : 1;
+        const auto& v = lower ? below : above;
+        const double x = b > a ? clamp((mu - a) / (b - a), 0.0, 1.0) * (kN - 1) : 0;
+        const int i = std::min(int(x), kN - 2);
+        const double t = x - i;
+        return v[i] * (1 - t) + v[i + 1] * t;
+    }
+};
+
+/// ∫₀¹ f(μ) dμ by Gauss–Legendre, in two pieces split at `split` (a critical cosine, where f has
+/// a square-root edge: Fresnel beyond total reflection). The upper piece is integrated in t with
+/// μ = split + (1 − split) t², which makes that edge smooth.
+template <typename V, typename F>
+V integrate01(F&& f, double split) {
+    static const QuadratureRule q = gauss_legendre(kGauss);
+    V sum{};
+    split = clamp(split, 0.0, 1.0);
+    for (int i = 0; i < kGauss; ++i) {
+        if (split > 0) sum += f(split * q.x[i]) * (q.w[i] * split);
+        const double t = q.x[i], d = 1 - split;
+        if (d > 0) sum += f(split + d * t * t) * (q.w[i] * 2 * d * t);
+    }
+    return sum;
+}
+
+/// |1 − μ/(η μ')|: the rate at which a refracted direction turns with the tilt of the facet it
+/// crosses (differentiate Snell's law sin(θ − δ) = η sin(θ' + Δ − δ) in δ at δ = 0, for a facet
+/// tilted by δ in the plane of incidence: dΔ/dδ = 1 − cos θ/(η cos θ')). Belcour 2018, Eq. 10,
+/// is the same first-order deflection. At normal incidence 1 − 1/η.
+double deflection(double mu, double mu_in, double eta) {
+    return std::abs(1 - mu / (eta * mu_in));
+}
+
+class Lamina1 final : public Model {
+  public:
+    Lamina1(const Stack& stack, const Lamina1Choices& choices) : ch_(choices) {
+        std::string why;
+        if (!coated_stack(stack, coat_, why)) {
+            support_.reason = fmt::format("lamina-1 {}", why);
+            return;
+        }
+        if (coat_.tau_s.max() > 0) {
+            support_.reason = "lamina-1 has no scattering medium (absorbing media only)";
+            return;
+        }
+        if (coat_.eta0 < 1) {
+            support_.reason = "lamina-1 needs a coat at least as dense as the ambient medium";
+            return;
+        }
+        support_.brdf = true;
+        support_.btdf = coat_.base_type == InterfaceType::Dielectric;
+        eta0_ = coat_.eta0;
+        inv_eta0_ = 1 / eta0_;
+        alpha0_ = coat_.alpha0;
+        alpha1_ = coat_.base_alpha;
+        has_absorption_ = coat_.tau_a.max() > 0;
+        if (coat_.base_type == InterfaceType::Dielectric) {
+            eta_b_ = coat_.base_eta[0];  // η_below/η_coat
+            eta_s_ = 1 / eta_b_;         // the coat seen from below: η_coat/η_below
+        }
+        if (coat_.base_type == InterfaceType::Conductor)
+            for (int c = 0; c < 3; ++c)
+                base_fgd_[c] = FgdTable::locate(coat_.base_eta[c], coat_.base_k[c]);
+        precompute();
+    }
+
+    std::string name() const override { return "lamina-1"; }
+    Support support() const override { return support_; }
+
+    /// Everything that depends on wi alone.
+    struct Incident {
+        Vec3d wi, wi_in;  ///< wi and its refraction into the coat about n (pointing up)
+        bool ok = false;
+        double T = 0;  ///< T(μi)
+        Rgbd a{1.0};   ///< exp(−τ/μi')
+        Rgbd X{0.0};   ///< X(μi) = T(μi) a(μi') Y(μi')
+        double lambda0 = 0, k_top = 0, k_bottom = 1;
+        Vec3d wi_mean;     ///< the mean direction of the light the coat transmits (slabs)
+        Rgbd a_mean{1.0};  ///< exp(−τ/μ̄')
+    };
+
+    Incident incident(const Vec3d& wi) const {
+        Incident in;
+        in.wi = wi;
+        if (!support_.brdf || wi.z <= 0) return in;
+        in.ok = true;
+        in.wi_in = refract_in(wi, inv_eta0_);
+        in.T = T_top_(wi.z);
+        in.a = attenuation(in.wi_in.z);
+        if (series_on_) in.X = X_at(wi.z);
+        if (alpha0_ > 0) in.lambda0 = GGX<double>{alpha0_}.lambda(wi);
+        in.k_top = spread_factor(wi.z, in.wi_in.z, eta0_);
+        if (support_.btdf) {
+            in.wi_mean = in.wi_in;
+            in.a_mean = in.a;
+            if (mean_shift_) {
+                // The transmitted light's mean direction, in wi's plane of incidence.
+                const double mu = clamp(in.wi_in.z + mu_mean_(wi.z), 1e-4, 1.0);
+                const double sxy = std::hypot(in.wi_in.x, in.wi_in.y);
+                const double s_new = std::sqrt(1 - mu * mu);
+                in.wi_mean = sxy > 0 ? Vec3d(in.wi_in.x * s_new / sxy, in.wi_in.y * s_new / sxy, mu)
+                                     : in.wi_in;
+                in.a_mean = attenuation(mu);
+            }
+            // The bottom's deflection at the straight-through pair v' = mirror(wi'), leaving at
+            // sin θv = η_s sin θi' (1 when it cannot leave). Taken there rather than at each wo:
+            // leaving a denser medium (η_s < 1) the factor grows without bound towards grazing,
+            // and a lobe whose width followed wo would no longer be normalized.
+            const double s2 = sqr(eta_s_) * (1 - sqr(in.wi_mean.z));
+            in.k_bottom = s2 < 1 ? spread_factor(std::sqrt(1 - s2), in.wi_mean.z, eta_s_) : 1.0;
+        }
+        return in;
+    }
+
+    Rgbd eval(const Vec3d& wi, const Vec3d& wo) const override {
+        return eval_with(incident(wi), wo);
+    }
+
+    Rgbd eval_with(const Incident& in, const Vec3d& wo) const {
+        if (!in.ok || wo.z == 0) return Rgbd(0.0);
+        if (wo.z < 0) return support_.btdf ? eval_btdf(in, wo) : Rgbd(0.0);
+        const Vec3d& wi = in.wi;
+        Rgbd f(0.0);
+        if (alpha0_ > 0) {
+            // The coat's own reflection, exact: Walter et al. 2007, Eq. 20, with the height-
+            // correlated G2 (Heitz 2014, Eq. 99).
+            const GGX<double> ggx0{alpha0_};
+            const Vec3d h = normalize(wi + wo);
+            const double G = 1 / (1 + in.lambda0 + ggx0.lambda(wo));
+            f = Rgbd(fresnel_dielectric(dot(wi, h), eta0_) * ggx0.D(h) * G / (4 * wi.z * wo.z));
+        }
+        const Vec3d wo_in = refract_in(wo, inv_eta0_);
+        const double T_o = T_top_(wo.z);
+        const Rgbd a_o = attenuation(wo_in.z);
+        // First order: the base's lobe at the refracted directions, entering and leaving through
+        // the coat's directional transmittance; 1/η0² compresses the solid angle.
+        const Rgbd fb = base_lobe(in, wi.z, wo.z, wo_in);
+        f += fb * (in.a * a_o) * (in.T * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
+        if (series_on_) {
+            f += in.X * X_at(wo.z) * K_ * (kInvPi<double> * inv_eta0_ * inv_eta0_);
+        }
+        return f;
+    }
+
+    std::unique_ptr<IncidentEvaluator> prepare(const Vec3d& wi) const override;
+
+    std::vector<DeltaLobe> delta_lobes(const Vec3d& wi) const override {
+        std::vector<DeltaLobe> out;
+        if (!support_.brdf || wi.z <= 0) return out;
+        if (alpha0_ > 0) return out;
+        const Vec3d wr = mirror_direction(wi);
+        const double F = fresnel_dielectric(wi.z, eta0_);
+        out.push_back({wr, Rgbd(F)});
+        if (coat_.base_type == InterfaceType::Lambertian || alpha1_ > 0) return out;
+        // Both interfaces smooth: every order is specular (docs/physics.md §6.4–6.5 of the study):
+        // the series Σ (R_in R_b a²)^k with R_in = F(μi) (Fresnel is the same from both sides).
+        const Vec3d w_in = refract_in(wi, inv_eta0_);
+        const Rgbd a = attenuation(w_in.z);
+        const Rgbd Rb = base_fresnel(w_in.z);
+        const double T = 1 - F;
+        Rgbd series(1.0);
+        if (ch_.inter_reflection)
+            for (int c = 0; c < 3; ++c)
+                series[c] = 1 / (1 - F * Rb[c] * a[c] * a[c]);
+        out.push_back({wr, Rb * a * a * series * (T * T)});
+        if (support_.btdf) {
+            const double sin_t = std::hypot(wi.x, wi.y) * inv_eta0_ * eta_s_;
+            if (sin_t < 1) {
+                const double Tb = 1 - fresnel_dielectric(w_in.z, eta_b_);
+                out.push_back({transmitted_direction(wi, std::sqrt(1 - sin_t * sin_t)),
+                               a * series * (T * Tb)});
+            }
+        }
+        return out;
+    }
+
+    std::vector<Vec3d> peak_directions(const Vec3d& wi) const override {
+        std::vector<Vec3d> peaks{mirror_direction(wi)};
+        if (support_.btdf && wi.z > 0) {
+            const double sin_t = std::hypot(wi.x, wi.y) * inv_eta0_ * eta_s_;
+            if (sin_t < 1) peaks.push_back(transmitted_direction(wi, std::sqrt(1 - sin_t * sin_t)));
+            if (mean_shift_) {  // the transmission lobe's own peak
+                const double sin_m = std::sqrt(1 - sqr(incident(wi).wi_mean.z)) * eta_s_;
+                if (sin_m < 1)
+                    peaks.push_back(transmitted_direction(wi, std::sqrt(1 - sin_m * sin_m)));
+            }
+        }
+        return peaks;
+    }
+
+    bool has_sampling() const override { return support_.brdf; }
+    std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override;
+    double pdf(const Vec3d& wi, const Vec3d& wo) const override;
+
+  private:
+    /// The sampling mixture for one incidence: lobe probabilities (top reflection, base lobe,
+    /// diffuse series; transmission lobe, diffuse transmission) and the lobes' roughnesses.
+    struct Mixture {
+        std::array<double, 5> p{};
+        Vec3d wi_in, wi_mean;
+        double alpha_base = 0, beta = 0;
+    };
+    Mixture mixture(const Incident& in) const;
+    double pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) const;
+
+    /// The BTDF of a slab: the mirrored transmission lobe through both interfaces, and the
+    /// diffuse light of the inter-reflections leaving through the bottom.
+    Rgbd eval_btdf(const Incident& in, const Vec3d& wo) const {
+        // v: wo mirrored into the upper hemisphere; v' its refraction into the coat through the
+        // bottom (η_s = η_coat/η_below): the straight-through pair has v' = mirror(wi').
+        const Vec3d v(wo.x, wo.y, -wo.z);
+        const auto v_in = refract_in_checked(v, 1 / eta_s_);
+        if (!v_in) return Rgbd(0.0);
+        const double T_b = T_bot_(v.z), T_b_in = T_bot_in_(v_in->z);
+        const Rgbd a_v = has_absorption_ ? attenuation(v_in->z) : Rgbd(1.0);
+        Rgbd f(0.0);
+        const double beta = transmission_roughness(in.k_top, in.k_bottom);
+        if (beta > 0) {
+            const GGX<double> ggx{beta};
+            const Vec3d h = normalize(in.wi_mean + *v_in);
+            const double q = ggx.D(h) * ggx.G2(in.wi_mean, *v_in) / (4 * in.wi_mean.z * v_in->z);
+            // The narrow lobe leaves with the bottom's transmittance from inside, T_in(μv'):
+            // consistent with the bottom's reflection R_b(μ') (R_b + T_in + loss = 1).
+            // The light crosses the coat's medium once: the geometric mean of the attenuations
+            // along the entering and the leaving direction (both e^{−τ/μi'} at the straight-
+            // through pair).
+            Rgbd a_once = in.a_mean * a_v;
+            for (int c = 0; c < 3; ++c)
+                a_once[c] = std::sqrt(a_once[c]);
+            f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
+        }
+        if (series_btdf_)
+            f += in.X * inv_one_minus_Er_ * (T_b * kInvPi<double> / (eta_s_ * eta_s_));
+        return f;
+    }
+
+    /// The base's lobe at the refracted pair (wi', wo'), widened by the coat's refraction spread.
+    Rgbd base_lobe(const Incident& in, double /*mu_i*/, double mu_o, const Vec3d& wo_in) const {
+        if (coat_.base_type == InterfaceType::Lambertian) return coat_.albedo * kInvPi<double>;
+        const double alpha = effective_alpha(in.k_top, spread_factor(mu_o, wo_in.z, eta0_));
+        if (alpha <= 0) return Rgbd(0.0);  // a delta lobe (delta_lobes)
+        const GGX<double> ggx{alpha};
+        const Vec3d h = normalize(in.wi_in + wo_in);
+        const double G = ggx.G2(in.wi_in, wo_in);
+        return base_fresnel(dot(in.wi_in, h)) * (ggx.D(h) * G / (4 * in.wi_in.z * wo_in.z));
+    }
+
+    /// α_e² = α1² + (α0 k_i/2)² + (α0 k_o/2)²: a deflection of the light by ε turns the mirror
+    /// direction by ε, i.e. its half vector by ε/2; independent spreads add in variance (the
+    /// variance adding of Belcour 2018, §5, with GGX's α as the slope scale).
+    double effective_alpha(double k_i, double k_o) const {
+        if (ch_.spread == Lamina1Choices::Spread::Off) return alpha1_;
+        return std::sqrt(sqr(alpha1_) + 0.25 * sqr(alpha0_) * (sqr(k_i) + sqr(k_o)));
+    }
+
+    /// β² = ((α0 k_top)² + (α1 k_bottom)²)/4: the mirrored lobe of a slab's transmission.
+    double transmission_roughness(double k_top, double k_bottom) const {
+        if (ch_.spread == Lamina1Choices::Spread::Off) return std::max(alpha0_, alpha1_);
+        return 0.5 * std::sqrt(sqr(alpha0_ * k_top) + sqr(alpha1_ * k_bottom));
+    }
+
+    double spread_factor(double mu, double mu_in, double eta) const {
+        if (ch_.spread == Lamina1Choices::Spread::Normal) return std::abs(1 - 1 / eta);
+        return deflection(mu, mu_in, eta);
+    }
+
+    /// X(μ); exact for a Lambertian base when the light enters along the refracted direction
+    /// (X = T(μ) a(μ') ρ r̄), else the per-material curve.
+    Rgbd X_at(double mu) const {
+        if (!x_exact_) return X_(mu);
+        return coat_.albedo * r_bar_ *
+               attenuation(refract_in(Vec3d(safe_sqrt(1 - mu * mu), 0, mu), inv_eta0_).z) *
+               T_top_(mu);
+    }
+
+    /// The inside direction (pointing up) whose refraction through a flat interface of relative
+    /// index 1/inv_eta is w (w.z > 0, entering a denser medium: always exists).
+    static Vec3d refract_in(const Vec3d& w, double inv_eta) {
+        return {w.x * inv_eta, w.y * inv_eta, safe_sqrt(1 - (1 - w.z * w.z) * sqr(inv_eta))};
+    }
+    static std::optional<Vec3d> refract_in_checked(const Vec3d& w, double inv_eta) {
+        const double s2 = (1 - w.z * w.z) * sqr(inv_eta);
+        if (s2 >= 1) return std::nullopt;
+        return Vec3d(w.x * inv_eta, w.y * inv_eta, std::sqrt(1 - s2));
+    }
+
+    /// The straight-through direction with cosine cos_t below the surface, opposite wi's azimuth.
+    static Vec3d transmitted_direction(const Vec3d& wi, double cos_t) {
+        const double s = std::hypot(wi.x, wi.y);
+        const double sin_t = safe_sqrt(1 - cos_t * cos_t);
+        if (s == 0) return {0, 0, -1};
+        return {-sin_t * wi.x / s, -sin_t * wi.y / s, -cos_t};
+    }
+
+    /// Beer–Lambert along one path at inside cosine μ: exp(−τ/μ).
+    Rgbd attenuation(double mu) const {
+        if (!has_absorption_) return Rgbd(1.0);
+        if (mu <= 0) return Rgbd(0.0);
+        return exp_rgb(coat_.tau_a * (-1 / mu));
+    }
+
+    Rgbd base_fresnel(double c) const {
+        switch (coat_.base_type) {
+            case InterfaceType::Conductor:
+                return fresnel_complex_rgb(c, coat_.base_eta, coat_.base_k);
+            case InterfaceType::Dielectric:
+                return Rgbd(fresnel_dielectric(c, eta_b_));
+            case InterfaceType::Lambertian:
+                break;
+        }
+        return coat_.albedo;
+    }
+
+    /// The base's directional albedo seen from inside the coat, at inside cosine μ.
+    Rgbd base_albedo(double mu) const {
+        switch (coat_.base_type) {
+            case InterfaceType::Conductor:
+                return FgdTable::get().rgb(mu, alpha1_, base_fgd_);
+            case InterfaceType::Dielectric:
+                return Rgbd(FgdTable::get()(mu, alpha1_, eta_b_, 0.0));
+            case InterfaceType::Lambertian:
+                break;
+        }
+        return coat_.albedo;
+    }
+
+    void precompute();
+
+    Lamina1Choices ch_;
+    CoatedStack coat_;
+    Support support_;
+    double eta0_ = 1.5, inv_eta0_ = 1 / 1.5, alpha0_ = 0, alpha1_ = 0;
+    double eta_b_ = 1, eta_s_ = 1;
+    bool has_absorption_ = false;
+    std::array<FgdTable::Index, 3> base_fgd_{};
+    bool series_on_ = false, series_btdf_ = false, x_exact_ = false, mean_shift_ = false;
+    CosineCurve<double, kNx> mu_mean_;  ///< μ̄'(μ) − μ'(μ): the transmitted light's mean shift
+    /// T(μ) of the coat from above and of the bottom from below: exact 1 − F(μ) when smooth (or
+    /// with coat-transmittance=fresnel), else the per-material curve resampled from the table.
+    struct Transmittance {
+        CosineCurve<double> curve;
+        double eta = 1;
+        bool exact = true;
+        double operator()(double mu) const {
+            return exact ? 1 - fresnel_dielectric(mu, eta) : curve(mu);
+        }
+    };
+    Transmittance T_top_, T_bot_;
+    /// The bottom's transmittance for light inside the coat (the first-order BTDF's exit) and the
+    /// coat's for light inside it (the first order's consistency with R_in; see precompute).
+    Transmittance T_bot_in_, T_top_in_;
+    /// X(μ): the flux the coat's bottom returns to the base after the first order, per unit flux
+    /// arriving from outside at μ (outside cosines).
+    CosineCurve<Rgbd, kNx> X_;
+    Rgbd K_{0.0};                 ///< the separable term's normalization
+    Rgbd inv_one_minus_Er_{0.0};  ///< 1/(1 − Ē_b r̄)
+    Rgbd r_bar_{0.0}, E_bar_{0.0}, t_bar_{0.0}, X_bar_{0.0};
+
+    friend class Lamina1Evaluator;
+};
+
+void Lamina1::precompute() {
+    const auto& table = CoatTransmittanceTable::get(ch_.masking);
+    const auto& fgd = FgdTable::get();
+    auto transmittance = [&](double mu, double alpha, double eta) {
+        return ch_.directional_transmittance ? table(mu, alpha, eta)
+                                             : 1 - fresnel_dielectric(mu, eta);
+    };
+    auto setup = [&](Transmittance& t, double alpha, double eta) {
+        t.eta = eta;
+        t.exact = alpha == 0 || !ch_.directional_transmittance;
+        if (!t.exact) t.curve.fill([&](double mu) { return transmittance(mu, alpha, eta); });
+    };
+    setup(T_top_, alpha0_, eta0_);
+    setup(T_top_in_, alpha0_, inv_eta0_);
+    if (support_.btdf) {
+        setup(T_bot_, alpha1_, eta_s_);
+        setup(T_bot_in_, alpha1_, eta_b_);
+    }
+
+    // The coat's bottom seen from inside: R_in(μ) = FGD(μ, α0, 1/η0) (total internal reflection
+    // included), and g(μ) = a(μ)² R_in(μ) for a return trip base → coat → base.
+    const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
+    auto R_in = [&](double mu) { return fgd(mu, alpha0_, inv_eta0_, 0.0); };
+    r_bar_ = integrate01<Rgbd>(
+        [&](double mu) { return attenuation(mu) * attenuation(mu) * (2 * mu * R_in(mu)); },
+        mu_crit);
+    // What the first order does not send out is returned: light inside at μ'' within the exit
+    // cone leaves in the first order with the outside transmittance T(μ) (exact for a locally
+    // uniform inside radiance, by reciprocity), so the part returned to the base is
+    // R_eff = 1 − loss − T(μ) = R_in + T_in − T(μ), where R_in + T_in + loss = 1 from inside. For
+    // a smooth coat T_in = T and R_eff = R_in; for a rough one the facets' total internal
+    // reflection makes T_in < T near the critical angle, and R_in alone would count that light
+    // twice. Beyond the cone nothing leaves in the first order and R_eff = R_in.
+    auto g_direct = [&](double mu) {
+        const Rgbd a = attenuation(mu);
+        double R = R_in(mu);
+        if (alpha0_ > 0 && mu > mu_crit) {
+            const double mu_out = safe_sqrt(1 - (1 - mu * mu) * sqr(eta0_));
+            R = std::max(0.0, R + T_top_in_(mu) - T_top_(mu_out));
+        }
+        return a * a * R;
+    };
+    // Tabulated once (Y's quadrature looks it up at every node); the node μ = 0 is taken at 1e-6,
+    // where an index-matched coat's Fresnel factor is its limit 0 (not the 0/0 of grazing).
+    SplitCurve<33> g_curve;
+    g_curve.fill(mu_crit, [&](double mu) { return g_direct(std::max(mu, 1e-6)); });
+    auto g = [&](double mu) { return g_curve(mu); };
+    const double mu_crit_b = eta_b_ < 1 ? std::sqrt(1 - sqr(eta_b_)) : 0.0;
+    E_bar_ = integrate01<Rgbd>([&](double mu) { return base_albedo(mu) * (2 * mu); }, mu_crit_b);
+    auto inside_cos = [&](double mu) { return safe_sqrt(1 - (1 - mu * mu) * sqr(inv_eta0_)); };
+    t_bar_ =
+        integrate01<Rgbd>(
+            [&](double mu) { return attenuation(inside_cos(mu)) * (2 * mu * T_top_(mu)); }, 0.0) *
+        sqr(inv_eta0_);
+
+    // The mean direction of the light a rough coat transmits (slab BTDF): the visible facets at
+    // grazing incidence lean towards the light and turn the refracted light away from the normal
+    // (by k δ per facet tilt δ, item 4 of docs/models.md), so its mean lies beyond the macro
+    // refraction — near grazing, beyond a slab's exit cone. By the coat's visible-normal rule.
+    mean_shift_ = support_.btdf && alpha0_ > 0 && ch_.directional_transmittance && ch_.mean_shift;
+    if (mean_shift_) {
+        static const QuadratureRule q = gauss_legendre(kYnr);
+        const GGX<double> ggx0{alpha0_};
+        mu_mean_.fill([&](double mu) {
+            const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+            double x = 0, z = 0;
+            for (int a = 0; a < kYnr; ++a)
+                for (int b = 0; b < kYnphi; ++b) {
+                    const double r = q.x[a], w_r = q.w[a] * 2 * r;
+                    const Vec3d wm =
+                        ggx0.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi - 0.25);
+                    const auto wt = refract(w, wm, eta0_);
+                    if (!wt || wt->z >= 0) continue;
+                    const double wgt = (1 - fresnel_dielectric(dot(w, wm), eta0_)) * w_r;
+                    x += wgt * wt->x;  // −wt: the inside direction pointing up, in −x
+                    z += wgt * -wt->z;
+                }
+            const double len = std::hypot(x, z);
+            // Stored as the shift from the macro refraction (which the lookup adds back exactly):
+            // it vanishes with α0, and so does its interpolation error under narrow lobes.
+            return (len > 0 ? z / len : inside_cos(mu)) - inside_cos(mu);
+        });
+    }
+
+    const bool smooth_base = coat_.base_type != InterfaceType::Lambertian && alpha1_ == 0;
+    series_on_ = ch_.inter_reflection && !(smooth_base && alpha0_ == 0) &&
+                 (coat_.base_type == InterfaceType::Lambertian || !ch_.series_lambertian_only ||
+                  alpha1_ >= alpha0_);
+    series_btdf_ = series_on_ && !ch_.series_lambertian_only;
+    if (!series_on_) return;
+    // Y(μ') = ∫ f_b(w', w'') μ'' g(μ'') dω'': what the base's first reflection of light arriving
+    // at inside cosine μ' sends back down after one reflection at the coat's bottom.
+    static const QuadratureRule qr = gauss_legendre(kYnr);
+    auto Y = [&](double mu) -> Rgbd {
+        if (coat_.base_type == InterfaceType::Lambertian) return coat_.albedo * r_bar_;
+        if (smooth_base) return base_fresnel(mu) * g(mu);
+        const GGX<double> ggx{alpha1_};
+        const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+        const double lambda_w = ggx.lambda(w);
+        Rgbd sum(0.0);
+        for (int a = 0; a < kYnr; ++a) {
+            const double r = qr.x[a], w_r = qr.w[a] * 2 * r;
+            for (int b = 0; b < kYnphi; ++b) {
+                const Vec3d wm =
+                    ggx.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi - 0.25);
+                const Vec3d w2 = reflect(w, wm);
+                if (w2.z <= 0) continue;
+                // Visible-normal weight: f_b μ'' dω'' = D_w F G2/G1 dwm (Heitz 2018, §2).
+                const double escape = (1 + lambda_w) / (1 + lambda_w + ggx.lambda(w2));
+                sum += base_fresnel(dot(w, wm)) * g(w2.z) * (w_r / kYnphi * escape);
+            }
+        }
+        return sum;
+    };
+    x_exact_ = coat_.base_type == InterfaceType::Lambertian &&
+               (alpha0_ == 0 || !ch_.directional_transmittance);
+    if (x_exact_) {
+    } else if (alpha0_ == 0 || !ch_.directional_transmittance) {
+        // The light enters along the refracted direction (smooth coat) or is taken to.
+        X_.fill([&](double mu) {
+            const double mu_in = inside_cos(mu);
+            return Y(mu_in) * attenuation(mu_in) * T_top_(mu);
+        });
+    } else {
+        // A rough coat spreads the entering light over the inside directions, beyond the critical
+        // cone too (light there cannot leave through the first order and is returned): X(μ) =
+        // ∫ t(μ → w') a(μ_w') Y(μ_w') dω' over the coat's transmitted light, by the visible-
+        // normal rule of the coat (weight (1 − F) G_t/G1, as in its transmittance table).
+        SplitCurve<17> Y_curve;
+        Y_curve.fill(mu_crit, Y);
+        const GGX<double> ggx0{alpha0_};
+        X_.fill([&](double mu) {
+            const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+            const double lambda_w = ggx0.lambda(w);
+            Rgbd sum(0.0);
+            for (int a = 0; a < kYnr; ++a) {
+                const double r = qr.x[a], w_r = qr.w[a] * 2 * r;
+                for (int b = 0; b < kYnphi; ++b) {
+                    const Vec3d wm =
+                        ggx0.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi - 0.25);
+                    const double F = fresnel_dielectric(dot(w, wm), eta0_);
+                    const auto wt = refract(w, wm, eta0_);
+                    if (!wt || wt->z >= 0) continue;
+                    const double escape =
+                        refraction_escape(ch_.masking, lambda_w, ggx0.lambda(*wt));
+                    sum +=
+                        Y_curve(-wt->z) * attenuation(-wt->z) * ((1 - F) * escape * w_r / kYnphi);
+                }
+            }
+            return sum;
+        });
+    }
+    // X̄ = (2/η0²)∫ X(μ) μ dμ: the diffuse exit's normalization.
+    X_bar_ =
+        integrate01<Rgbd>([&](double mu) { return X_at(mu) * (2 * mu); }, 0.0) * sqr(inv_eta0_);
+    for (int c = 0; c < 3; ++c) {
+        const double one_minus = 1 - E_bar_[c] * r_bar_[c];
+        inv_one_minus_Er_[c] = one_minus > 0 ? 1 / one_minus : 0;
+        // The separable term X(μi)X(μo)K/(πη0²) must leave with the series' energy
+        // X(μi) Ē_b t̄/(1 − Ē_b r̄): ∫ X(μo)/(πη0²) μo dωo = X̄ fixes K.
+        K_[c] = X_bar_[c] > 0 ? E_bar_[c] * t_bar_[c] * inv_one_minus_Er_[c] / X_bar_[c] : 0;
+    }
+}
+
+class Lamina1Evaluator final : public IncidentEvaluator {
+  public:
+    Lamina1Evaluator(const Lamina1& model, const Vec3d& wi)
+        : model_(model), in_(model.incident(wi)) {}
+    Rgbd eval(const Vec3d& wo) const override { return model_.eval_with(in_, wo); }
+
+  private:
+    const Lamina1& model_;
+    Lamina1::Incident in_;
+};
+
+std::unique_ptr<IncidentEvaluator> Lamina1::prepare(const Vec3d& wi) const {
+    return std::make_unique<Lamina1Evaluator>(*this, wi);
+}
+
+Lamina1::Mixture Lamina1::mixture(const Incident& in) const {
+    Mixture m;
+    if (!in.ok) return m;
+    m.wi_in = in.wi_in;
+    m.wi_mean = in.wi_mean;
+    const double a = in.a.mean();
+    if (alpha0_ > 0) m.p[0] = fresnel_dielectric(in.wi.z, eta0_);
+    const double E_b = base_albedo(in.wi_in.z).mean();
+    if (coat_.base_type == InterfaceType::Lambertian) {
+        m.p[1] = in.T * a * E_b;
+    } else {
+        // The base lobe is drawn with its incident-side widening on both sides (k_o ≈ k_i).
+        m.alpha_base = effective_alpha(in.k_top, in.k_top);
+        if (m.alpha_base > 0) m.p[1] = in.T * a * E_b;
+    }
+    if (series_on_) m.p[2] = (in.X * K_ * X_bar_).mean();
+    if (support_.btdf) {
+        m.beta = transmission_roughness(in.k_top, in.k_bottom);
+        if (m.beta > 0) m.p[3] = in.T * a * std::max(0.0, 1 - E_b);
+        if (series_btdf_) m.p[4] = (in.X * inv_one_minus_Er_).mean() * 0.5;
+    }
+    double total = 0;
+    for (double p : m.p)
+        total += p;
+    if (!(total > 0)) return Mixture{};
+    for (double& p : m.p)
+        p /= total;
+    return m;
+}
+
+double Lamina1::pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) const {
+    if (!in.ok || wo.z == 0) return 0;
+    double pdf = 0;
+    if (wo.z > 0) {
+        if (m.p[0] > 0) {
+            const Vec3d h = normalize(in.wi + wo);
+            pdf += m.p[0] * GGX<double>{alpha0_}.D_visible(in.wi, h) / (4 * std::abs(dot(wo, h)));
+        }
+        if (m.p[1] > 0) {
+            if (coat_.base_type == InterfaceType::Lambertian) {
+                pdf += m.p[1] * wo.z * kInvPi<double>;
+            } else {
+                // Drawn inside the coat: dω'/dω = μo/(η0² μo') (Snell's law of solid angles).
+                const Vec3d wo_in = refract_in(wo, inv_eta0_);
+                const Vec3d h = normalize(m.wi_in + wo_in);
+                const double pdf_in =
+                    GGX<double>{m.alpha_base}.D_visible(m.wi_in, h) / (4 * std::abs(dot(wo_in, h)));
+                pdf += m.p[1] * pdf_in * wo.z / (sqr(eta0_) * wo_in.z);
+            }
+        }
+        if (m.p[2] > 0) pdf += m.p[2] * wo.z * kInvPi<double>;
+        return pdf;
+    }
+    if (m.p[3] > 0) {
+        const Vec3d v(wo.x, wo.y, -wo.z);
+        if (const auto v_in = refract_in_checked(v, 1 / eta_s_)) {
+            const Vec3d h = normalize(m.wi_mean + *v_in);
+            const double pdf_in =
+                GGX<double>{m.beta}.D_visible(m.wi_mean, h) / (4 * std::abs(dot(*v_in, h)));
+            pdf += m.p[3] * pdf_in * v.z / (sqr(eta_s_) * v_in->z);
+        }
+    }
+    if (m.p[4] > 0) pdf += m.p[4] * -wo.z * kInvPi<double>;
+    return pdf;
+}
+
+std::optional<ModelSample> Lamina1::sample(const Vec3d& wi, const Vec3d& u) const {
+    if (!support_.brdf || wi.z <= 0) return std::nullopt;
+    const Incident in = incident(wi);
+    const Mixture m = mixture(in);
+    // u.x picks the lobe, (u.y, u.z) draw its direction.
+    int lobe = 0;
+    double c = m.p[0];
+    while (lobe < 4 && u.x >= c)
+        c += m.p[++lobe];
+    if (m.p[lobe] <= 0) return std::nullopt;
+    Vec3d wo;
+    switch (lobe) {
+        case 0: {
+            const Vec3d wm = GGX<double>{alpha0_}.sample_visible_normal(wi, u.y, u.z);
+            wo = reflect(wi, wm);
+            if (wo.z <= 0) return std::nullopt;  // shadowed by the coat's microsurface
+            break;
+        }
+        case 1:
+            if (coat_.base_type == InterfaceType::Lambertian) {
+                wo = sample_cosine_hemisphere(u.y, u.z);
+            } else {
+                const Vec3d wm = GGX<double>{m.alpha_base}.sample_visible_normal(m.wi_in, u.y, u.z);
+                const Vec3d wo_in = reflect(m.wi_in, wm);
+                const double s2 = sqr(eta0_) * (1 - sqr(wo_in.z));
+                if (wo_in.z <= 0 || s2 >= 1) return std::nullopt;  // shadowed, or totally reflected
+                wo = Vec3d(wo_in.x * eta0_, wo_in.y * eta0_, std::sqrt(1 - s2));
+            }
+            break;
+        case 2:
+            wo = sample_cosine_hemisphere(u.y, u.z);
+            break;
+        case 3: {
+            const Vec3d wm = GGX<double>{m.beta}.sample_visible_normal(m.wi_mean, u.y, u.z);
+            const Vec3d v_in = reflect(m.wi_mean, wm);
+            const double s2 = sqr(eta_s_) * (1 - sqr(v_in.z));
+            if (v_in.z <= 0 || s2 >= 1) return std::nullopt;
+            wo = Vec3d(v_in.x * eta_s_, v_in.y * eta_s_, -std::sqrt(1 - s2));
+            break;
+        }
+        default: {
+            const Vec3d w = sample_cosine_hemisphere(u.y, u.z);
+            wo = Vec3d(w.x, w.y, -w.z);
+        }
+    }
+    if (wo.z == 0 || (wo.z < 0 && !support_.btdf)) return std::nullopt;
+    const double pdf = pdf_with(in, m, wo);
+    if (!(pdf > 0)) return std::nullopt;
+    return ModelSample{wo, eval_with(in, wo) * (std::abs(wo.z) / pdf), pdf};
+}
+
+double Lamina1::pdf(const Vec3d& wi, const Vec3d& wo) const {
+    if (!support_.brdf || wi.z <= 0) return 0;
+    const Incident in = incident(wi);
+    return pdf_with(in, mixture(in), wo);
+}
+
+const char* on_off(bool b) {
+    return b ? "on" : "off";
+}
+
+}  // namespace
+
+std::vector<OptionSpec> lamina1_option_specs() {
+    const Lamina1Choices d;
+    return {
+        {"refraction-masking",
+         {"smith-beta", "walter"},
+         d.masking == RefractionMasking::SmithBeta ? "smith-beta" : "walter",
+         "masking of refracted rays in the coat's transmittance: B(1+Li, 1+Lo) (Smith) or "
+         "1/(1+Li+Lo) (Walter)"},
+        {"coat-transmittance",
+         {"directional", "fresnel"},
+         d.directional_transmittance ? "directional" : "fresnel",
+         "the rough coat's directional transmittance (table) or 1 - F(mu) at the macro normal"},
+        {"inter-reflection",
+         {"auto", "on", "off"},
+         d.inter_reflection ? (d.series_lambertian_only ? "auto" : "on") : "off",
+         "inter-reflections between base and coat bottom (geometric series as a separable lobe): "
+         "auto: reflected under Lambertian bases and bases at least as rough as the coat; on: "
+         "always, transmitted too; off: never (smooth stacks: the exact delta series unless off)"},
+        {"eta2", {"on", "off"}, on_off(d.eta2_factor), "the 1/eta0^2 solid-angle compression"},
+        {"transmitted-direction",
+         {"mean", "refracted"},
+         d.mean_shift ? "mean" : "refracted",
+         "slab BTDF lobe centred on the rough coat's mean transmitted direction or on the macro "
+         "refraction"},
+        {"spread",
+         {"angular", "normal", "off"},
+         "angular",
+         "base lobe widened by the coat's refraction spread: angle-dependent deflection, its "
+         "normal-incidence value, or not widened"},
+    };
+}
+
+Lamina1Choices lamina1_choices(const ModelOptions& o) {
+    Lamina1Choices c;
+    c.masking = option_value(o, "refraction-masking") == "walter" ? RefractionMasking::Walter
+                                                                  : RefractionMasking::SmithBeta;
+    c.directional_transmittance = option_value(o, "coat-transmittance") == "directional";
+    c.inter_reflection = option_value(o, "inter-reflection") != "off";
+    c.series_lambertian_only = option_value(o, "inter-reflection") == "auto";
+    c.eta2_factor = option_value(o, "eta2") == "on";
+    c.mean_shift = option_value(o, "transmitted-direction") == "mean";
+    const std::string& s = option_value(o, "spread");
+    c.spread = s == "normal" ? Lamina1Choices::Spread::Normal
+               : s == "off"  ? Lamina1Choices::Spread::Off
+                             : Lamina1Choices::Spread::Angular;
+    return c;
+}
+
+std::vector<OptionSpec> lamina1_options() {
+    return lamina1_option_specs();
+}
+
+std::unique_ptr<Model> make_lamina1(const Stack& stack, const ModelOptions& options) {
+    return std::make_unique<Lamina1>(stack, lamina1_choices(options));
+}
+
+}  // namespace lamina

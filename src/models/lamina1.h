@@ -1,0 +1,53 @@
+#pragma once
+// lamina-1: lamina's own layered BSDF for a dielectric coat over a base (docs/models.md,
+// "lamina-1", has the derivation). For a coat (η0, α0) with an absorbing medium (τ) over a
+// Lambertian, conductor or dielectric base (α1):
+//
+//   f_R = f_top                                       exact Walter reflection of the coat
+//       + T(μi) T(μo) a(μi') a(μo') f_b(wi', wo'; α_e) / η0²     first order through the coat
+//       + K X(μi) X(μo) / (π η0²)                    inter-reflections (separable, reciprocal)
+//   f_T = T(μi) a(μi') T_b,in(μv') a(μv') q(wi', v'; β) / η_s² + X(μi) T_b(μv) / (π η_s² (1 − Ē_b
+//   r̄))
+//
+// T: the coat's directional transmittance (models/coat_transmittance.h), a: Beer–Lambert along
+// the refracted mean directions, α_e and β: the base lobe widened by the coat's refraction
+// spread, X: the light the coat's bottom sends back to the base after the first order, Ē_b and r̄
+// the base's and the coat bottom's hemispherical albedos, K the normalization that gives the
+// separable term the energy of the geometric series. Each approximation is a flag (Lamina1Choices).
+
+#include "models/coat_transmittance.h"
+#include "models/model.h"
+
+#include <memory>
+#include <vector>
+
+namespace lamina {
+
+struct Lamina1Choices {
+    /// Masking of the refracted rays in the coat's transmittance tables.
+    RefractionMasking masking = RefractionMasking::SmithBeta;
+    /// The coat's transmittance: the rough interface's directional transmittance (true) or the
+    /// smooth Fresnel transmittance 1 − F(μ) at the macro normal (false).
+    bool directional_transmittance = true;
+    /// Inter-reflections between base and coat bottom (the separable series term).
+    bool inter_reflection = true;
+    /// "auto": the separable series only where its uniform-radiance assumption can hold, where the
+    /// base re-diffuses the returned light at least as much as the coat spreads it: a Lambertian
+    /// base, or a base at least as rough as the coat (α1 ≥ α0); reflected only (the slab's
+    /// diffuse exit through the bottom only with "on"). With both interfaces smooth the exact
+    /// delta series is summed either way.
+    bool series_lambertian_only = true;
+    /// The slab's transmission lobe centred on the mean direction of the light the rough coat
+    /// transmits (true) or on the macro refraction of wi (false).
+    bool mean_shift = true;
+    /// The 1/η² solid-angle compression of the base term (Hanrahan & Krueger 1993, Eq. 8).
+    bool eta2_factor = true;
+    /// The base lobe widened by the coat's refraction spread: with the angle-dependent deflection
+    /// factor (Spread::Angular), its normal-incidence value 1 − 1/η (Normal), or not (Off).
+    enum class Spread { Angular, Normal, Off } spread = Spread::Angular;
+};
+
+std::vector<OptionSpec> lamina1_option_specs();
+Lamina1Choices lamina1_choices(const ModelOptions& options);
+
+}  // namespace lamina
