@@ -51,6 +51,21 @@
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
 
+// The lane headers (core/lane.h) once more, their templates compiled for this instruction set.
+#undef LAMINA_LANE_BEGIN
+#undef LAMINA_LANE_END
+#define LAMINA_LANE_BEGIN   \
+    HWY_BEFORE_NAMESPACE(); \
+    namespace lamina {      \
+    namespace HWY_NAMESPACE {
+#define LAMINA_LANE_END \
+    }                   \
+    }                   \
+    HWY_AFTER_NAMESPACE();
+#define LAMINA_LANE_TARGET
+#include "physics/smith_masking.h"
+#undef LAMINA_LANE_TARGET
+
 HWY_BEFORE_NAMESPACE();
 namespace lamina {
 namespace HWY_NAMESPACE {
@@ -297,6 +312,32 @@ HWY_INLINE VF Shadowing(const V3& wi, const V3& wo, float alpha, bool uncorrelat
     return hn::Div(hn::Mul(hn::Add(z_i, s_i), z_o), hn::MulAdd(s_i, z_o, hn::Mul(s_o, z_i)));
 }
 
+// The operations of core/lane.h on vectors: the physics templates written over a lane type
+// (core/beta_function.h, physics/microfacet.h smith_refraction_escape) instantiated on lanes.
+// Highway's contrib math functions: Log ≤ 4 ulp, Log1p ≤ 2 ulp, Exp ≤ 1 ulp (hwy/contrib/math).
+struct VecLane {
+    using Value = VF;
+    using Mask = MF;
+    static HWY_INLINE VF constant(double x) { return hn::Set(DF(), float(x)); }
+    static HWY_INLINE VF min(VF a, VF b) { return hn::Min(a, b); }
+    static HWY_INLINE VF max(VF a, VF b) { return hn::Max(a, b); }
+    static HWY_INLINE VF sqrt(VF x) { return hn::Sqrt(x); }
+    static HWY_INLINE VF log(VF x) { return hn::Log(DF(), x); }
+    static HWY_INLINE VF log1p(VF x) { return hn::Log1p(DF(), x); }
+    static HWY_INLINE VF exp(VF x) { return hn::Exp(DF(), x); }
+    static HWY_INLINE VF select(MF m, VF a, VF b) { return hn::IfThenElse(m, a, b); }
+    static HWY_INLINE MF less(VF a, VF b) { return hn::Lt(a, b); }
+    static constexpr double kBetaArgumentMax = Lane<float>::kBetaArgumentMax;
+};
+
+// The refraction escape G2/G1 = (1 + Λi) B(1 + Λi, 1 + Λo) of the Smith masking
+// (microfacet.h smith_refraction_escape, the same template), from s = |z| r (SmithRootTimesCos).
+HWY_INLINE VF SmithRefractionEscape(const V3& wi, const V3& wo, float alpha) {
+    const VF r_i = hn::Div(SmithRootTimesCos(wi, alpha), hn::Abs(wi.z));
+    const VF r_o = hn::Div(SmithRootTimesCos(wo, alpha), hn::Abs(wo.z));
+    return smith_refraction_escape<VF, VecLane>(r_i, r_o);
+}
+
 // fresnel.h fresnel_conductor (real-arithmetic complex Fresnel), cos θ in [0, 1].
 HWY_INLINE VF FresnelConductor(VF cos_theta, float eta, float k) {
     const DF df;
@@ -388,8 +429,13 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
         // sample_index_matched, with r = 1 + 2Λ).
         wo = v.d;
         if (!iface.is_smooth()) {
-            // G2(wi, −wi)/G1(wi) = Shadowing(wi, −wi): (1 + r)/(2r), or G1 = 2/(1 + r).
-            shadowing = Shadowing(wi, v.d, iface.alpha, iface.uncorrelated_shadowing);
+            // G2(wi, −wi)/G1(wi) = Shadowing(wi, −wi): (1 + r)/(2r), or G1 = 2/(1 + r); with the
+            // Smith refraction masking (1 + Λ) B(1 + Λ, 1 + Λ).
+            if (!iface.uncorrelated_shadowing &&
+                iface.transmission_masking == TransmissionMasking::Smith)
+                shadowing = SmithRefractionEscape(wi, v.d, iface.alpha);
+            else
+                shadowing = Shadowing(wi, v.d, iface.alpha, iface.uncorrelated_shadowing);
         }
     } else {
         // The microfacet normal: drawn for a rough interface, the macro normal for a smooth one
@@ -433,6 +479,15 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
                 hn::AndNot(hn::Eq(wo.z, zero), hn::Not(hn::Xor(same_side, is_reflection)));
             shadowing = hn::IfThenElseZero(
                 escapes, Shadowing(wi, wo, iface.alpha, iface.uncorrelated_shadowing));
+            // Refracted lanes under the Smith masking: (1 + Λi) B(1 + Λi, 1 + Λo) instead, computed
+            // only when some lane refracts.
+            if (!iface.uncorrelated_shadowing &&
+                iface.transmission_masking == TransmissionMasking::Smith) {
+                const MF refracts = hn::And(ok, hn::AndNot(is_reflection, escapes));
+                if (!hn::AllFalse(df, refracts))
+                    shadowing = hn::IfThenElse(refracts, SmithRefractionEscape(wi, wo, iface.alpha),
+                                               shadowing);
+            }
         }
     }
     v.Keep(ok, kLossMicro, shadowing);
@@ -1169,6 +1224,22 @@ void CosSin2PiForTest(const float* u, std::size_t n, float* c, float* s) {
     }
 }
 
+void SmithRefractionEscapeForTest(const float* r_i, const float* r_o, std::size_t n, float* out) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in_i[kMaxLanes], in_o[kMaxLanes], res[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            in_i[l] = base + l < n ? r_i[base + l] : 1.f;
+            in_o[l] = base + l < n ? r_o[base + l] : 1.f;
+        }
+        hn::Store(smith_refraction_escape<VF, VecLane>(hn::Load(df, in_i), hn::Load(df, in_o)), df,
+                  res);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l)
+            out[base + l] = res[l];
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace lamina
 HWY_AFTER_NAMESPACE();
@@ -1179,6 +1250,7 @@ namespace lamina {
 HWY_EXPORT(TraceBlockSimd);
 HWY_EXPORT(PcgDrawsForTest);
 HWY_EXPORT(CosSin2PiForTest);
+HWY_EXPORT(SmithRefractionEscapeForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -1227,6 +1299,15 @@ void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::v
     c.resize(u.size());
     s.resize(u.size());
     HWY_DYNAMIC_DISPATCH(CosSin2PiForTest)(u.data(), u.size(), c.data(), s.data());
+}
+
+std::vector<float> simd_smith_refraction_escape(const std::vector<float>& r_i,
+                                                const std::vector<float>& r_o) {
+    select_simd_target();
+    std::vector<float> out(r_i.size());
+    HWY_DYNAMIC_DISPATCH(SmithRefractionEscapeForTest)
+    (r_i.data(), r_o.data(), r_i.size(), out.data());
+    return out;
 }
 
 }  // namespace lamina

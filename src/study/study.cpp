@@ -48,6 +48,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     for (double theta_i : s.theta_i_deg) {
         ReferenceKey key{config.id, config.stack, theta_i,  s.particles,
                          s.seed,    grid,         s.kernel, s.microsurface};
+        key.transmission_masking = s.transmission_masking;
         pieces.push_back(reference_piece(reference_cache_dir(out_dir), key, s.threads,
                                          [&](std::uint64_t n) { progress.advance(n); }));
     }
@@ -255,6 +256,7 @@ std::vector<MetricRow> run_study(const std::vector<StudyConfiguration>& configs,
     sj["seed"] = s.seed;
     sj["kernel"] = kernel_description(s.kernel);
     sj["microsurface"] = microsurface_name(s.microsurface);
+    sj["transmission_masking"] = transmission_masking_name(s.transmission_masking);
     sj["theta_i"] = s.theta_i_deg;
     sj["grid"] = {{"n_theta", s.grid.n_theta()}, {"n_phi", s.grid.n_phi()}};
     sj["models"] = model_names;

@@ -25,7 +25,9 @@ struct StudySettings {
     int threads = 0;                                   ///< 0: all cores
     Kernel kernel = Kernel::Simd;                      ///< the reference's particle kernel
     Microsurface microsurface = Microsurface::Single;  ///< the reference's rough interfaces
-    bool quiet = false;                                ///< no per-configuration lines on stdout
+    /// The reference's refraction masking on single-scattering rough dielectrics.
+    TransmissionMasking transmission_masking = TransmissionMasking::Smith;
+    bool quiet = false;  ///< no per-configuration lines on stdout
 };
 
 /// Particles per incidence of the presets: quick 10⁶ (demo and CI), standard 10⁷, paper 1.6·10⁸
