@@ -1,10 +1,10 @@
-#pragma once
 // Fresnel reflectance, Snell refraction and mirror reflection.
 //
 // Relative index convention: `eta` is η_t / η_i, the index of the medium the light refracts *into*
 // over the index of the medium it arrives from, for light arriving on the side the normal points
 // to. At an interface of a stack (normal +z pointing up) eta = η_below / η_above.
 
+#include "core/lane.h"
 #include "core/math.h"
 #include "core/vec.h"
 
@@ -13,7 +13,25 @@
 #include <optional>
 #include <utility>
 
-namespace lamina {
+// A lane header (core/lane.h): included once as an ordinary header and once per SIMD target.
+#ifndef LAMINA_LANE_TARGET
+#ifndef LAMINA_PHYSICS_FRESNEL_H
+#define LAMINA_PHYSICS_FRESNEL_H
+#define LAMINA_PHYSICS_FRESNEL_BODY
+#endif
+#elif defined(LAMINA_PHYSICS_FRESNEL_TARGET) == defined(HWY_TARGET_TOGGLE)
+#ifdef LAMINA_PHYSICS_FRESNEL_TARGET
+#undef LAMINA_PHYSICS_FRESNEL_TARGET
+#else
+#define LAMINA_PHYSICS_FRESNEL_TARGET
+#endif
+#define LAMINA_PHYSICS_FRESNEL_BODY
+#endif
+
+#ifdef LAMINA_PHYSICS_FRESNEL_BODY
+#undef LAMINA_PHYSICS_FRESNEL_BODY
+
+LAMINA_LANE_BEGIN
 
 /// Fresnel reflectance of a dielectric interface together with the refracted cosine, for code that
 /// refracts after choosing (sharing the square root). `eta` is the relative index actually crossed
@@ -26,7 +44,7 @@ struct FresnelDielectric {
     T inv_eta;  ///< its reciprocal
 };
 
-template <typename T>
+template <typename T, typename L = Lane<T>>
 inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_eta);
 
 /// Exact unpolarized Fresnel reflectance of a dielectric interface (the mean of the s and p
@@ -39,23 +57,27 @@ inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta) {
     return fresnel_dielectric_full(cos_theta_i, eta, T(1) / eta);
 }
 
-/// The same with 1/eta supplied (interfaces keep it, saving a division per event).
-template <typename T>
+/// The same with 1/eta supplied (interfaces keep it, saving a division per event). A branch-free
+/// lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate these lines.
+template <typename T, typename L>
 inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_eta) {
-    cos_theta_i = clamp(cos_theta_i, T(-1), T(1));
-    if (cos_theta_i < 0) {
-        std::swap(eta, inv_eta);
-        cos_theta_i = -cos_theta_i;
-    }
-    const T sin2_theta_t = (T(1) - sqr(cos_theta_i)) * sqr(inv_eta);
-    if (sin2_theta_t >= T(1)) return {T(1), T(0), eta, inv_eta};  // total internal reflection
-    const T cos_theta_t = safe_sqrt(T(1) - sin2_theta_t);
+    const T zero = L::constant(0), one = L::constant(1);
+    cos_theta_i = L::min(L::max(cos_theta_i, zero - one), one);
+    // From the other side the relative index crossed is 1/η.
+    const auto below = L::less(cos_theta_i, zero);
+    const T eta_crossed = L::select(below, inv_eta, eta);
+    const T inv_eta_crossed = L::select(below, eta, inv_eta);
+    cos_theta_i = L::select(below, zero - cos_theta_i, cos_theta_i);
+    const T sin2_theta_t = (one - cos_theta_i * cos_theta_i) * (inv_eta_crossed * inv_eta_crossed);
+    const auto refracts = L::less(sin2_theta_t, one);  // otherwise total internal reflection
+    const T cos_theta_t = L::sqrt(L::max(one - sin2_theta_t, zero));
     // r_parallel = a/b, r_perpendicular = c/d; (a²d² + c²b²) / (b²d²) needs a single division.
-    const T a = eta * cos_theta_i - cos_theta_t, b = eta * cos_theta_i + cos_theta_t;
-    const T c = cos_theta_i - eta * cos_theta_t, d = cos_theta_i + eta * cos_theta_t;
-    const T b2d2 = sqr(b * d);
-    const T reflectance = b2d2 > 0 ? (sqr(a * d) + sqr(c * b)) / (T(2) * b2d2) : T(1);
-    return {reflectance, cos_theta_t, eta, inv_eta};
+    const T a = eta_crossed * cos_theta_i - cos_theta_t, b = eta_crossed * cos_theta_i + cos_theta_t;
+    const T c = cos_theta_i - eta_crossed * cos_theta_t, d = cos_theta_i + eta_crossed * cos_theta_t;
+    const T bd = b * d, ad = a * d, cb = c * b;
+    const T b2d2 = bd * bd;
+    const T reflectance = L::select(L::less(zero, b2d2), (ad * ad + cb * cb) / (b2d2 + b2d2), one);
+    return {L::select(refracts, reflectance, one), cos_theta_t, eta_crossed, inv_eta_crossed};
 }
 
 /// Exact unpolarized Fresnel reflectance of a dielectric interface; see fresnel_dielectric_full.
@@ -131,4 +153,6 @@ inline std::optional<Vec3<T>> refract(const Vec3<T>& w, Vec3<T> n, T eta) {
     return -w / eta + n * (cos_theta_i / eta - cos_theta_t);
 }
 
-}  // namespace lamina
+LAMINA_LANE_END
+
+#endif  // LAMINA_PHYSICS_FRESNEL_BODY

@@ -63,6 +63,7 @@
     }                   \
     HWY_AFTER_NAMESPACE();
 #define LAMINA_LANE_TARGET
+#include "physics/fresnel.h"
 #include "physics/smith_masking.h"
 #undef LAMINA_LANE_TARGET
 
@@ -443,23 +444,13 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
         const V3 wm = iface.is_smooth() ? V3{zero, zero, one}
                                         : SampleVisibleNormalCaps(wi, iface.alpha, u1, u2);
         const VF cos_i_m = Dot(wi, wm);
-        // fresnel.h fresnel_dielectric_full: from below, the crossed index is 1/η.
+        // fresnel.h fresnel_dielectric_full (the same template): from below, the crossed index
+        // is 1/η.
         const MF below = hn::Lt(cos_i_m, zero);
-        const VF eta = hn::IfThenElse(below, hn::Set(df, iface.inv_eta()), hn::Set(df, iface.eta));
-        const VF inv_eta =
-            hn::IfThenElse(below, hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()));
+        const FresnelDielectric<VF> fr = fresnel_dielectric_full<VF, VecLane>(
+            cos_i_m, hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()));
+        const VF inv_eta = fr.inv_eta, cos_t = fr.cos_theta_t, reflectance = fr.reflectance;
         const VF cos_i = hn::Min(hn::Abs(cos_i_m), one);
-        const VF sin2_t = hn::Mul(hn::NegMulAdd(cos_i, cos_i, one), hn::Mul(inv_eta, inv_eta));
-        const MF tir = hn::Ge(sin2_t, one);
-        const VF cos_t = SafeSqrt(hn::Sub(one, sin2_t));
-        // Born & Wolf §1.5.2, Eqs. 21a–b, as in fresnel_dielectric_full.
-        const VF a = hn::MulSub(eta, cos_i, cos_t), b = hn::MulAdd(eta, cos_i, cos_t);
-        const VF c = hn::NegMulAdd(eta, cos_t, cos_i), d = hn::MulAdd(eta, cos_t, cos_i);
-        const VF bd = hn::Mul(b, d);
-        const VF b2d2 = hn::Mul(bd, bd);
-        const VF ad = hn::Mul(a, d), cb = hn::Mul(c, b);
-        VF reflectance = hn::Div(hn::MulAdd(ad, ad, hn::Mul(cb, cb)), hn::Add(b2d2, b2d2));
-        reflectance = hn::IfThenElse(hn::Or(tir, hn::Le(b2d2, zero)), one, reflectance);
         // Both candidates, one selected (dielectric.h): mirror about wm, or Snell about wm.
         const VF two_cos = hn::Add(cos_i_m, cos_i_m);
         const V3 reflected = {hn::MulSub(two_cos, wm.x, wi.x), hn::MulSub(two_cos, wm.y, wi.y),
@@ -1240,6 +1231,25 @@ void SmithRefractionEscapeForTest(const float* r_i, const float* r_o, std::size_
     }
 }
 
+void FresnelDielectricForTest(const float* cos_theta, std::size_t n, float eta, float* reflectance,
+                              float* cos_theta_t) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in[kMaxLanes], r[kMaxLanes], t[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l)
+            in[l] = base + l < n ? cos_theta[base + l] : 1.f;
+        const FresnelDielectric<VF> fr = fresnel_dielectric_full<VF, VecLane>(
+            hn::Load(df, in), hn::Set(df, eta), hn::Set(df, 1.f / eta));
+        hn::Store(fr.reflectance, df, r);
+        hn::Store(fr.cos_theta_t, df, t);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l) {
+            reflectance[base + l] = r[l];
+            cos_theta_t[base + l] = t[l];
+        }
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace lamina
 HWY_AFTER_NAMESPACE();
@@ -1251,6 +1261,7 @@ HWY_EXPORT(TraceBlockSimd);
 HWY_EXPORT(PcgDrawsForTest);
 HWY_EXPORT(CosSin2PiForTest);
 HWY_EXPORT(SmithRefractionEscapeForTest);
+HWY_EXPORT(FresnelDielectricForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -1308,6 +1319,15 @@ std::vector<float> simd_smith_refraction_escape(const std::vector<float>& r_i,
     HWY_DYNAMIC_DISPATCH(SmithRefractionEscapeForTest)
     (r_i.data(), r_o.data(), r_i.size(), out.data());
     return out;
+}
+
+void simd_fresnel_dielectric(const std::vector<float>& cos_theta, float eta,
+                             std::vector<float>& reflectance, std::vector<float>& cos_theta_t) {
+    select_simd_target();
+    reflectance.resize(cos_theta.size());
+    cos_theta_t.resize(cos_theta.size());
+    HWY_DYNAMIC_DISPATCH(FresnelDielectricForTest)(cos_theta.data(), cos_theta.size(), eta,
+                                                   reflectance.data(), cos_theta_t.data());
 }
 
 }  // namespace lamina

@@ -26,6 +26,11 @@ void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::v
 std::vector<float> simd_smith_refraction_escape(const std::vector<float>& r_i,
                                                 const std::vector<float>& r_o);
 
+/// For tests: physics/fresnel.h fresnel_dielectric_full(cos_theta[j], eta) on the dispatched
+/// instruction set's vectors: its reflectance and refracted cosine.
+void simd_fresnel_dielectric(const std::vector<float>& cos_theta, float eta,
+                             std::vector<float>& reflectance, std::vector<float>& cos_theta_t);
+
 /// Applies LAMINA_SIMD_TARGET (an instruction set name as simd_target_name prints it, e.g. AVX2 or
 /// SSE4), which caps the dispatch at that set: the way to reproduce another machine's tables, or to
 /// test every compiled set on one machine. Once per process; InputError for an unknown or

@@ -288,17 +288,24 @@ TEST_P(GoniophotometerStat, SingleRoughDielectricFromDenseSide) {
     check_single_rough_dielectric(1.5, 1.0, 0.3, 50);
 }
 
-// The Smith refraction masking where it matters most (the issue that introduced it measured
-// T = 0.738 with the pbrt form against 0.505 with Smith's at α = 0.6, θi = 80°): rough and very
-// rough interfaces at grazing incidence, with either masking, bin by bin for reflection and for
-// transmission where the Gauss rules resolve the lobe, the transmitted albedo otherwise.
+// The Smith refraction masking where it matters most (T = 0.738 with the pbrt form against 0.505
+// with Smith's at α = 0.6, θi = 80°): with either masking, bin by bin for reflection, and for
+// transmission at α = 0.3 (where the Gauss rules resolve the lobe; the Smith form is
+// SingleRoughDielectricFromAbove); on rough and very rough interfaces at oblique and grazing
+// incidence the transmitted albedo (at α = 0.6, θi = 60°, the transmission lobe's bins next to
+// the horizon hold the Jacobian's edge singularity, which a 2 × 2 composite rule overestimates by
+// 12 % in one bin for either masking).
 TEST_P(GoniophotometerStat, SingleRoughDielectricSmithAndPbrtMasking) {
     for (const TransmissionMasking masking :
          {TransmissionMasking::Smith, TransmissionMasking::Pbrt}) {
         SCOPED_TRACE(transmission_masking_name(masking));
+        if (masking == TransmissionMasking::Pbrt) {
+            SCOPED_TRACE("alpha 0.3, 40 degrees");
+            check_single_rough_dielectric(1.0, 1.5, 0.3, 40, {}, masking);
+        }
         {
             SCOPED_TRACE("alpha 0.6, 60 degrees");
-            check_single_rough_dielectric(1.0, 1.5, 0.6, 60, {}, masking, 2);
+            check_single_rough_dielectric(1.0, 1.5, 0.6, 60, {}, masking, 2, true);
         }
         {
             SCOPED_TRACE("alpha 0.6, 80 degrees");

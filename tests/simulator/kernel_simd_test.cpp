@@ -5,6 +5,7 @@
 #include "simulator/kernel_simd.h"
 
 #include "core/rng.h"
+#include "physics/fresnel.h"
 #include "physics/microfacet.h"
 #include "simulator/goniophotometer.h"
 #include "support/chi2.h"
@@ -91,6 +92,47 @@ TEST(KernelSimd, SmithRefractionEscapeLanes) {
     RecordProperty("worst_vs_double", std::to_string(worst_double));
     std::printf("[ lanes    ] %s: |vector − scalar float| ≤ %.2g, |vector − double| ≤ %.2g\n",
                 simd_target_name(), worst_scalar, worst_double);
+}
+
+// The lane test of the dielectric Fresnel factor (physics/fresnel.h fresnel_dielectric_full, one
+// template): on the dispatched instruction set's vectors against the scalar float instantiation,
+// for random cosines on both sides and the edges (normal and grazing incidence from either side,
+// the critical angle, total internal reflection), for η above and below 1 and η = 1. The two
+// evaluate the same operations; the vectors may fuse a multiply-add where the scalar compiler does
+// not (or the reverse), so they agree to 4 float ulps of 1 (the results lie in [0, 1]) away from
+// the critical angle, and total internal reflection gives exactly R = 1 and cos θt = 0.
+TEST(KernelSimd, FresnelDielectricLanes) {
+    ParticleRng rng(18, 0, 0);
+    for (const float eta : {1.5f, 1 / 1.5f, 1.f, 2.4f, 1 / 2.4f}) {
+        std::vector<float> cos_theta = {0.f, -0.f, 1.f, -1.f, 1e-7f, -1e-7f, 0.5f, -0.5f};
+        const float critical = std::sqrt(std::max(0.f, 1 - eta * eta));  // from the side of 1/η
+        for (const float d : {-1e-6f, 0.f, 1e-6f})
+            cos_theta.insert(cos_theta.end(), {critical + d, -critical - d});
+        for (int k = 0; k < 4000; ++k)
+            cos_theta.push_back(2 * rng.uniform_float() - 1);
+        std::vector<float> r, t;
+        simd_fresnel_dielectric(cos_theta, eta, r, t);
+        ASSERT_EQ(r.size(), cos_theta.size());
+        double worst = 0;
+        for (std::size_t j = 0; j < cos_theta.size(); ++j) {
+            const FresnelDielectric<float> s = fresnel_dielectric_full(cos_theta[j], eta, 1 / eta);
+            ASSERT_TRUE(std::isfinite(r[j]) && std::isfinite(t[j])) << cos_theta[j];
+            const bool tir_scalar = s.reflectance == 1 && s.cos_theta_t == 0;
+            const bool tir_lanes = r[j] == 1 && t[j] == 0;
+            if (tir_scalar != tir_lanes) {
+                // Within rounding of the critical angle one may call it total reflection and the
+                // other not: cos θt = √(1 − sin²θt) is then at most √(4 ulp) ≈ 5e-4 and R within
+                // a few times that of 1.
+                EXPECT_LT(std::max(t[j], s.cos_theta_t), 1e-3f) << eta << ' ' << cos_theta[j];
+                EXPECT_GT(std::min(r[j], s.reflectance), 0.99f) << eta << ' ' << cos_theta[j];
+                continue;
+            }
+            if (tir_scalar) continue;  // both exactly R = 1, cos θt = 0
+            worst = std::max({worst, std::abs(double(r[j]) - s.reflectance),
+                              std::abs(double(t[j]) - s.cos_theta_t)});
+        }
+        EXPECT_LE(worst, 4 * 0x1p-24) << "η " << eta << " on " << simd_target_name();
+    }
 }
 
 // cos and sin of 2πu against double precision for every 2^-18 step of u and around every octant
