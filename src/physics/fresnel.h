@@ -72,8 +72,10 @@ inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_
     const auto refracts = L::less(sin2_theta_t, one);  // otherwise total internal reflection
     const T cos_theta_t = L::sqrt(L::max(one - sin2_theta_t, zero));
     // r_parallel = a/b, r_perpendicular = c/d; (a²d² + c²b²) / (b²d²) needs a single division.
-    const T a = eta_crossed * cos_theta_i - cos_theta_t, b = eta_crossed * cos_theta_i + cos_theta_t;
-    const T c = cos_theta_i - eta_crossed * cos_theta_t, d = cos_theta_i + eta_crossed * cos_theta_t;
+    const T a = eta_crossed * cos_theta_i - cos_theta_t,
+            b = eta_crossed * cos_theta_i + cos_theta_t;
+    const T c = cos_theta_i - eta_crossed * cos_theta_t,
+            d = cos_theta_i + eta_crossed * cos_theta_t;
     const T bd = b * d, ad = a * d, cb = c * b;
     const T b2d2 = bd * bd;
     const T reflectance = L::select(L::less(zero, b2d2), (ad * ad + cb * cb) / (b2d2 + b2d2), one);
@@ -92,25 +94,29 @@ inline T fresnel_dielectric(T cos_theta_i, T eta) {
 /// The Fresnel equations with a complex index (Born & Wolf §14.2) written in real arithmetic:
 /// with a² + b² = √((η² − k² − sin²θ)² + 4η²k²) and a = √((a² + b² + η² − k² − sin²θ)/2),
 ///   R_s = (a² + b² + cos²θ − 2a cos θ) / (a² + b² + cos²θ + 2a cos θ),
-///   R_p = R_s (cos²θ (a² + b²) + sin⁴θ − 2a cos θ sin²θ) / (cos²θ (a² + b²) + sin⁴θ + 2a cos θ sin²θ)
+///   R_p = R_s (cos²θ (a² + b²) + sin⁴θ − 2a cos θ sin²θ) / (cos²θ (a² + b²) + sin⁴θ + 2a cos θ
+///   sin²θ)
 /// (e.g. Lagarde 2013, "Memo on Fresnel equations"; pbrt-v3 FrConductor). With k = 0 it equals
 /// fresnel_dielectric, including total internal reflection (a = 0 gives R = 1) when eta < 1.
-template <typename T>
+/// A branch-free lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate
+/// these lines.
+template <typename T, typename L = Lane<T>>
 inline T fresnel_conductor(T cos_theta_i, T eta, T k) {
-    cos_theta_i = clamp(cos_theta_i, T(0), T(1));
-    const T cos2 = sqr(cos_theta_i);
-    const T sin2 = T(1) - cos2;
-    const T eta2 = sqr(eta), k2 = sqr(k);
+    const T zero = L::constant(0), one = L::constant(1), two = L::constant(2);
+    cos_theta_i = L::min(L::max(cos_theta_i, zero), one);
+    const T cos2 = cos_theta_i * cos_theta_i;
+    const T sin2 = one - cos2;
+    const T eta2 = eta * eta, k2 = k * k;
     const T t0 = eta2 - k2 - sin2;
-    const T a2_plus_b2 = std::sqrt(sqr(t0) + T(4) * eta2 * k2);
-    const T a = safe_sqrt(T(0.5) * (a2_plus_b2 + t0));
+    const T a2_plus_b2 = L::sqrt(t0 * t0 + L::constant(4) * eta2 * k2);
+    const T a = L::sqrt(L::max(L::constant(0.5) * (a2_plus_b2 + t0), zero));
     const T t1 = a2_plus_b2 + cos2;
-    const T t2 = T(2) * cos_theta_i * a;
+    const T t2 = two * cos_theta_i * a;
     const T r_s = (t1 - t2) / (t1 + t2);
-    const T t3 = cos2 * a2_plus_b2 + sqr(sin2);
+    const T t3 = cos2 * a2_plus_b2 + sin2 * sin2;
     const T t4 = t2 * sin2;
-    const T r_p = t3 + t4 > 0 ? r_s * (t3 - t4) / (t3 + t4) : r_s;
-    return (r_s + r_p) / T(2);
+    const T r_p = L::select(L::less(zero, t3 + t4), r_s * (t3 - t4) / (t3 + t4), r_s);
+    return (r_s + r_p) / two;
 }
 
 /// The same reflectance evaluated with std::complex, as written in Born & Wolf: an independent

@@ -339,23 +339,11 @@ HWY_INLINE VF SmithRefractionEscape(const V3& wi, const V3& wo, float alpha) {
     return smith_refraction_escape<VF, VecLane>(r_i, r_o);
 }
 
-// fresnel.h fresnel_conductor (real-arithmetic complex Fresnel), cos θ in [0, 1].
+// fresnel.h fresnel_conductor (real-arithmetic complex Fresnel, the same template), cos θ in
+// [0, 1].
 HWY_INLINE VF FresnelConductor(VF cos_theta, float eta, float k) {
     const DF df;
-    const VF one = hn::Set(df, 1.f);
-    const VF c = hn::Min(hn::ZeroIfNegative(cos_theta), one);
-    const VF cos2 = hn::Mul(c, c);
-    const VF sin2 = hn::Sub(one, cos2);
-    const float eta2 = eta * eta, k2 = k * k;
-    const VF t0 = hn::Sub(hn::Set(df, eta2 - k2), sin2);
-    const VF a2b2 = hn::Sqrt(hn::MulAdd(t0, t0, hn::Set(df, 4.f * eta2 * k2)));
-    const VF a = SafeSqrt(hn::Mul(hn::Set(df, 0.5f), hn::Add(a2b2, t0)));
-    const VF t1 = hn::Add(a2b2, cos2);
-    const VF t2 = hn::Mul(hn::Mul(hn::Set(df, 2.f), c), a);
-    // (R_s + R_p)/2 with R_p = R_s (t3 − t4)/(t3 + t4) is R_s t3/(t3 + t4): one division in all.
-    const VF t3 = hn::MulAdd(cos2, a2b2, hn::Mul(sin2, sin2));
-    const VF t4 = hn::Mul(t2, sin2);
-    return hn::Div(hn::Mul(hn::Sub(t1, t2), t3), hn::Mul(hn::Add(t1, t2), hn::Add(t3, t4)));
+    return fresnel_conductor<VF, VecLane>(cos_theta, hn::Set(df, eta), hn::Set(df, k));
 }
 
 // ---- Lane state ---------------------------------------------------------------------------------
@@ -1250,6 +1238,20 @@ void FresnelDielectricForTest(const float* cos_theta, std::size_t n, float eta, 
     }
 }
 
+void FresnelConductorForTest(const float* cos_theta, std::size_t n, float eta, float k,
+                             float* reflectance) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in[kMaxLanes], r[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l)
+            in[l] = base + l < n ? cos_theta[base + l] : 1.f;
+        hn::Store(FresnelConductor(hn::Load(df, in), eta, k), df, r);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l)
+            reflectance[base + l] = r[l];
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace lamina
 HWY_AFTER_NAMESPACE();
@@ -1262,6 +1264,7 @@ HWY_EXPORT(PcgDrawsForTest);
 HWY_EXPORT(CosSin2PiForTest);
 HWY_EXPORT(SmithRefractionEscapeForTest);
 HWY_EXPORT(FresnelDielectricForTest);
+HWY_EXPORT(FresnelConductorForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -1326,8 +1329,16 @@ void simd_fresnel_dielectric(const std::vector<float>& cos_theta, float eta,
     select_simd_target();
     reflectance.resize(cos_theta.size());
     cos_theta_t.resize(cos_theta.size());
-    HWY_DYNAMIC_DISPATCH(FresnelDielectricForTest)(cos_theta.data(), cos_theta.size(), eta,
-                                                   reflectance.data(), cos_theta_t.data());
+    HWY_DYNAMIC_DISPATCH(FresnelDielectricForTest)
+    (cos_theta.data(), cos_theta.size(), eta, reflectance.data(), cos_theta_t.data());
+}
+
+std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, float eta, float k) {
+    select_simd_target();
+    std::vector<float> out(cos_theta.size());
+    HWY_DYNAMIC_DISPATCH(FresnelConductorForTest)
+    (cos_theta.data(), cos_theta.size(), eta, k, out.data());
+    return out;
 }
 
 }  // namespace lamina

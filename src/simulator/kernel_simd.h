@@ -31,6 +31,10 @@ std::vector<float> simd_smith_refraction_escape(const std::vector<float>& r_i,
 void simd_fresnel_dielectric(const std::vector<float>& cos_theta, float eta,
                              std::vector<float>& reflectance, std::vector<float>& cos_theta_t);
 
+/// For tests: physics/fresnel.h fresnel_conductor(cos_theta[j], eta, k) on the dispatched
+/// instruction set's vectors.
+std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, float eta, float k);
+
 /// Applies LAMINA_SIMD_TARGET (an instruction set name as simd_target_name prints it, e.g. AVX2 or
 /// SSE4), which caps the dispatch at that set: the way to reproduce another machine's tables, or to
 /// test every compiled set on one machine. Once per process; InputError for an unknown or

@@ -135,6 +135,34 @@ TEST(KernelSimd, FresnelDielectricLanes) {
     }
 }
 
+// The lane test of the conductor Fresnel factor (physics/fresnel.h fresnel_conductor, one
+// template): on the dispatched instruction set's vectors against the scalar float instantiation,
+// for random cosines in [0, 1] and the edges (normal and grazing incidence), gold, a strong
+// absorber, a weak one and k = 0 (where it is the dielectric factor, total reflection included
+// for η < 1): within 8 float ulps of 1 (two divisions and two square roots, each ≤ 1 ulp, the
+// same operations on both; results in [0, 1]).
+TEST(KernelSimd, FresnelConductorLanes) {
+    ParticleRng rng(19, 0, 0);
+    struct Index {
+        float eta, k;
+    };
+    for (const Index ik : {Index{0.143f, 3.983f}, Index{2.9f, 3.1f}, Index{1.5f, 0.01f},
+                           Index{1.5f, 0.f}, Index{1 / 1.5f, 0.f}}) {
+        std::vector<float> cos_theta = {0.f, 1.f, 1e-7f, 0.5f, 1 - 1e-7f};
+        for (int j = 0; j < 4000; ++j)
+            cos_theta.push_back(rng.uniform_float());
+        const std::vector<float> r = simd_fresnel_conductor(cos_theta, ik.eta, ik.k);
+        double worst = 0;
+        for (std::size_t j = 0; j < cos_theta.size(); ++j) {
+            ASSERT_TRUE(std::isfinite(r[j])) << cos_theta[j];
+            worst = std::max(
+                worst, std::abs(double(r[j]) - fresnel_conductor(cos_theta[j], ik.eta, ik.k)));
+        }
+        EXPECT_LE(worst, 8 * 0x1p-24)
+            << "η " << ik.eta << " k " << ik.k << " on " << simd_target_name();
+    }
+}
+
 // cos and sin of 2πu against double precision for every 2^-18 step of u and around every octant
 // boundary, within 2 float ulps of 1.
 TEST(KernelSimd, AzimuthCosineAndSine) {
