@@ -68,9 +68,12 @@ std::vector<ReferenceKey> study_reference_keys(const std::vector<StudyConfigurat
                                                const StudySettings& s) {
     std::vector<ReferenceKey> keys;
     for (const StudyConfiguration& config : configs)
-        for (double theta_i : s.theta_i_deg)
-            keys.push_back(
-                {config.id, config.stack, theta_i, s.particles, s.seed, s.grid, s.kernel});
+        for (double theta_i : s.theta_i_deg) {
+            ReferenceKey key{config.id, config.stack, theta_i,  s.particles,
+                             s.seed,    s.grid,       s.kernel, s.microsurface};
+            key.transmission_masking = s.transmission_masking;
+            keys.push_back(key);
+        }
     return keys;
 }
 

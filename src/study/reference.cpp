@@ -145,7 +145,7 @@ std::string read_file(const std::filesystem::path& path) {
 std::string ReferenceKey::canonical() const {
     return fmt::format(
         "lamina {} | config {} | stack {} | theta_i {} | particles {} | seed {} | "
-        "grid {} | kernel {}{}",
+        "grid {} | kernel {}{}{}",
         kVersion, config_id, stack_to_json(stack).dump(), theta_i_deg, particles, seed,
         grid.to_string(), kernel_description(kernel),
         microsurface == Microsurface::Multiple ? " | microsurface multiple" : "",
