@@ -64,6 +64,7 @@
     HWY_AFTER_NAMESPACE();
 #define LAMINA_LANE_TARGET
 #include "physics/fresnel.h"
+#include "physics/phase.h"
 #include "physics/smith_masking.h"
 #undef LAMINA_LANE_TARGET
 
@@ -531,13 +532,8 @@ HWY_INLINE void LambertianEvent(const LambertianInterface<float>& iface, MF m, L
 // Henyey–Greenstein direction (phase.h sample_hg), Duff et al. 2017 frame about d.
 HWY_INLINE V3 SampleHg(const V3& d, VF g, VF u1, VF u2) {
     const DF df;
-    const VF one = hn::Set(df, 1.f), two = hn::Set(df, 2.f);
-    const VF g2 = hn::Mul(g, g);
-    const VF s = hn::Div(hn::Sub(one, g2), hn::Sub(hn::Add(one, g), hn::Mul(hn::Mul(two, g), u1)));
-    VF cos_theta = hn::Div(hn::Sub(hn::Add(one, g2), hn::Mul(s, s)), hn::Mul(two, g));
-    cos_theta = hn::Min(hn::Max(cos_theta, hn::Set(df, -1.f)), one);
-    cos_theta = hn::IfThenElse(hn::Lt(hn::Abs(g), hn::Set(df, 1e-3f)), hn::NegMulAdd(two, u1, one),
-                               cos_theta);
+    const VF one = hn::Set(df, 1.f);
+    const VF cos_theta = sample_hg_cos_theta<VF, VecLane>(g, u1);  // phase.h, the same template
     const VF sin_theta = SafeSqrt(hn::NegMulAdd(cos_theta, cos_theta, one));
     VF cos_phi, sin_phi;
     CosSin2Pi(u2, cos_phi, sin_phi);
@@ -553,13 +549,9 @@ HWY_INLINE V3 SampleHg(const V3& d, VF g, VF u1, VF u2) {
             hn::MulAdd(s_axis.z, lx, hn::MulAdd(t_axis.z, ly, hn::Mul(d.z, cos_theta)))};
 }
 
+// phase.h hg_phase (the same template).
 HWY_INLINE VF HgPhase(VF cos_theta, VF g) {
-    const DF df;
-    const VF one = hn::Set(df, 1.f);
-    const VF g2 = hn::Mul(g, g);
-    const VF denom = hn::Sub(hn::Add(one, g2), hn::Mul(hn::Mul(hn::Set(df, 2.f), g), cos_theta));
-    return hn::Div(hn::Sub(one, g2),
-                   hn::Mul(hn::Set(df, 4.f * kPi<float>), hn::Mul(denom, SafeSqrt(denom))));
+    return hg_phase<VF, VecLane>(cos_theta, g);
 }
 
 // One scattering-medium step for the lanes in m (inside layer `layer`'s medium): a free flight by
@@ -1252,6 +1244,26 @@ void FresnelConductorForTest(const float* cos_theta, std::size_t n, float eta, f
     }
 }
 
+void HenyeyGreensteinForTest(const float* g, const float* x, std::size_t n, float* phase,
+                             float* cos_theta) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in_g[kMaxLanes], in_x[kMaxLanes], p[kMaxLanes], c[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            in_g[l] = base + l < n ? g[base + l] : 0.f;
+            in_x[l] = base + l < n ? x[base + l] : 0.f;
+        }
+        const VF vg = hn::Load(df, in_g), vx = hn::Load(df, in_x);
+        hn::Store(HgPhase(vx, vg), df, p);
+        hn::Store(sample_hg_cos_theta<VF, VecLane>(vg, vx), df, c);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l) {
+            phase[base + l] = p[l];
+            cos_theta[base + l] = c[l];
+        }
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace lamina
 HWY_AFTER_NAMESPACE();
@@ -1265,6 +1277,7 @@ HWY_EXPORT(CosSin2PiForTest);
 HWY_EXPORT(SmithRefractionEscapeForTest);
 HWY_EXPORT(FresnelDielectricForTest);
 HWY_EXPORT(FresnelConductorForTest);
+HWY_EXPORT(HenyeyGreensteinForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -1339,6 +1352,15 @@ std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, f
     HWY_DYNAMIC_DISPATCH(FresnelConductorForTest)
     (cos_theta.data(), cos_theta.size(), eta, k, out.data());
     return out;
+}
+
+void simd_henyey_greenstein(const std::vector<float>& g, const std::vector<float>& x,
+                            std::vector<float>& phase, std::vector<float>& cos_theta) {
+    select_simd_target();
+    phase.resize(g.size());
+    cos_theta.resize(g.size());
+    HWY_DYNAMIC_DISPATCH(HenyeyGreensteinForTest)
+    (g.data(), x.data(), g.size(), phase.data(), cos_theta.data());
 }
 
 }  // namespace lamina

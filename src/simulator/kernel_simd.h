@@ -35,6 +35,11 @@ void simd_fresnel_dielectric(const std::vector<float>& cos_theta, float eta,
 /// instruction set's vectors.
 std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, float eta, float k);
 
+/// For tests: physics/phase.h hg_phase(x[j], g[j]) and sample_hg_cos_theta(g[j], x[j]) on the
+/// dispatched instruction set's vectors.
+void simd_henyey_greenstein(const std::vector<float>& g, const std::vector<float>& x,
+                            std::vector<float>& phase, std::vector<float>& cos_theta);
+
 /// Applies LAMINA_SIMD_TARGET (an instruction set name as simd_target_name prints it, e.g. AVX2 or
 /// SSE4), which caps the dispatch at that set: the way to reproduce another machine's tables, or to
 /// test every compiled set on one machine. Once per process; InputError for an unknown or

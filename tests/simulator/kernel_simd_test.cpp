@@ -7,6 +7,7 @@
 #include "core/rng.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
+#include "physics/phase.h"
 #include "simulator/goniophotometer.h"
 #include "support/chi2.h"
 #include "support/stacks.h"
@@ -161,6 +162,40 @@ TEST(KernelSimd, FresnelConductorLanes) {
         EXPECT_LE(worst, 8 * 0x1p-24)
             << "η " << ik.eta << " k " << ik.k << " on " << simd_target_name();
     }
+}
+
+// The lane test of Henyey–Greenstein (physics/phase.h hg_phase and sample_hg_cos_theta, one
+// template each): on the dispatched instruction set's vectors against the scalar float
+// instantiation, for g from −0.99 to 0.99 with the isotropic edge (|g| < 1e-3, g = 0) and random
+// cosines and uniforms including their ends. The phase value: its denominator 1 + g² − 2g cos θ
+// cancels (down to (1 − |g|)² = 1e-4 for g = 0.99 in the forward direction), so rounding — fused
+// multiply-adds on one side and not the other — is amplified by κ = (1 + g² + 2|g cos θ|)/denom,
+// and p ∝ denom^{−3/2} by 3/2 of it: relative error ≤ (1 + 1.5 κ) · 8 ulp. The sampled cosine:
+// 2e-6 absolute (its (1 + g² − s²)/(2g) loses up to a few ulp of 1/|g| relative: 1e-3 ≤ |g|).
+TEST(KernelSimd, HenyeyGreensteinLanes) {
+    ParticleRng rng(20, 0, 0);
+    std::vector<float> g, x;
+    for (const float gi : {0.f, 1e-4f, -5e-4f, 1e-3f, -1.5e-3f, 0.3f, -0.5f, 0.9f, -0.99f, 0.99f}) {
+        for (const float xi : {0.f, 1 - 0x1p-24f, 0.5f, -1.f, 1.f})
+            g.push_back(gi), x.push_back(xi);
+        for (int k = 0; k < 500; ++k)
+            g.push_back(gi), x.push_back(rng.uniform_float());
+    }
+    std::vector<float> phase, cos_theta;
+    simd_henyey_greenstein(g, x, phase, cos_theta);
+    double worst_phase = 0, worst_cos = 0;
+    for (std::size_t j = 0; j < g.size(); ++j) {
+        const float p = hg_phase(x[j], g[j]), c = sample_hg_cos_theta(g[j], x[j]);
+        ASSERT_TRUE(std::isfinite(phase[j]) && std::isfinite(cos_theta[j])) << g[j] << ' ' << x[j];
+        const double gd = g[j], xd = x[j];
+        const double denom = 1 + gd * gd - 2 * gd * xd;
+        const double kappa = (1 + gd * gd + 2 * std::abs(gd * xd)) / denom;
+        worst_phase = std::max(
+            worst_phase, std::abs(double(phase[j]) / p - 1) / ((1 + 1.5 * kappa) * 8 * 0x1p-24));
+        worst_cos = std::max(worst_cos, std::abs(double(cos_theta[j]) - c));
+    }
+    EXPECT_LE(worst_phase, 1.0) << simd_target_name();  // in units of the bound
+    EXPECT_LE(worst_cos, 2e-6) << simd_target_name();
 }
 
 // cos and sin of 2πu against double precision for every 2^-18 step of u and around every octant
