@@ -4,11 +4,13 @@
 #include "core/error.h"
 #include "layers/stack.h"
 #include "models/registry.h"
+#include "physics/microfacet.h"
 #include "render/contact_sheet.h"
 #include "render/renderer.h"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -20,6 +22,7 @@ namespace {
 
 struct RenderArgs {
     std::string stack, model = "random-walk", env = "studio", light, out;
+    std::string transmission_masking = "smith";
     std::vector<std::string> options;
     int size = 512, spp = 64, threads = 0;
     std::uint64_t seed = 1;
@@ -45,9 +48,20 @@ int run_render(const RenderArgs& a) {
     s.threads = a.threads;
     s.lobe_alpha = lobe_alpha_for(stack);  // a proposal density only (renderer.h)
     if (a.out.empty()) throw InputError("command line", "--out", "required");
+    // The reference's refraction masking, a model option of random-walk (validated there).
+    parse_transmission_masking(a.transmission_masking);
+    std::vector<std::string> options = a.options;
+    const bool given_as_option = std::any_of(options.begin(), options.end(), [](const auto& o) {
+        return o.rfind("transmission-masking=", 0) == 0;
+    });
+    if ((a.compare || a.model == "random-walk") && !given_as_option)
+        options.push_back("transmission-masking=" + a.transmission_masking);
+    else if (a.transmission_masking != "smith")
+        throw InputError("command line", "--transmission-masking",
+                         "applies to the random-walk reference only, not to --model " + a.model);
 
     if (!a.compare) {
-        const auto model = make_model(a.model, stack, a.options);
+        const auto model = make_model(a.model, stack, options);
         if (!model->support().brdf)
             throw InputError(a.stack, "--model", "not supported: " + model->support().reason);
         const Rendering r = render_sphere(*model, env, s);
@@ -62,7 +76,7 @@ int run_render(const RenderArgs& a) {
 
     // --compare: the reference and every analytic model, one sheet.
     const std::filesystem::path dir = a.out;
-    write_comparison(stack, env, s, dir, a.exposure, a.options);
+    write_comparison(stack, env, s, dir, a.exposure, options);
     fmt::print(stderr, "lamina render --compare: {} -> {}\n", stack.name,
                (dir / "compare.png").string());
     return 0;
@@ -88,6 +102,9 @@ Runner add_render(CLI::App& app) {
     cmd->add_option("--threads", a->threads, "Threads (default: all)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--exposure", a->exposure, "Exposure in stops for the PNG (default 0)");
+    cmd->add_option("--transmission-masking", a->transmission_masking,
+                    "The random-walk reference's masking of light refracted by a rough dielectric: "
+                    "smith (default, B(1+Λi, 1+Λo)) or pbrt (1/(1+Λi+Λo), as pbrt-v4)");
     cmd->add_flag("--compare", a->compare,
                   "Render the reference and every analytic model; --out is then a folder holding "
                   "compare.png, one PNG+EXR per model and errors.csv");

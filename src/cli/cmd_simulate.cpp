@@ -25,7 +25,7 @@ namespace lamina::cli {
 namespace {
 struct SimulateArgs {
     std::string stack, theta_i = default_incidences_text(), particles = "1e6", grid = "90x90", out;
-    std::string kernel = "simd", microsurface = "single";
+    std::string kernel = "simd", microsurface = "single", transmission_masking = "smith";
     std::uint64_t seed = 1;
     int threads = 0, max_events = 10000;
 };
@@ -55,6 +55,10 @@ Runner add_simulate(CLI::App& app) {
                     "lost_microsurface) or multiple (Heitz et al. 2016 random walk; needs "
                     "--kernel scalar)")
         ->capture_default_str();
+    cmd->add_option("--transmission-masking", a->transmission_masking,
+                    "Masking of light refracted by a rough dielectric (single scattering): smith "
+                    "(the Smith microsurface's B(1+Λi, 1+Λo)) or pbrt (1/(1+Λi+Λo), as pbrt-v4)")
+        ->capture_default_str();
     cmd->add_option("--out,-o", a->out, "Output folder")->required();
     return [a] {
         // Under mpirun every process runs this; the particles are split over them
@@ -67,6 +71,7 @@ Runner add_simulate(CLI::App& app) {
         s.threads = a->threads;
         s.kernel = parse_kernel(a->kernel);
         s.microsurface = parse_microsurface(a->microsurface);
+        s.transmission_masking = parse_transmission_masking(a->transmission_masking);
         s.grid = HemisphereGrid::parse(a->grid);
         s.max_events = a->max_events;
         validate_settings(s);

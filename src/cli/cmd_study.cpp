@@ -28,7 +28,8 @@ namespace {
 
 struct CommonArgs {
     std::string theta_i = default_incidences_text(), particles, grid = "90x90", models, out;
-    std::string kernel = "simd", microsurface = "single", tables = "half", formats = "png";
+    std::string kernel = "simd", microsurface = "single", transmission_masking = "smith",
+                tables = "half", formats = "png";
     std::uint64_t seed = 1;
     int threads = 0;
     bool no_figures = false, recompute = false;
@@ -74,6 +75,11 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
     cmd->add_flag("--recompute", a.recompute,
                   "Recompute the models, metrics and outputs even where their inputs are "
                   "unchanged (the reference pieces are still reused), and redraw every figure");
+    cmd->add_option("--transmission-masking", a.transmission_masking,
+                    "The reference's masking of light refracted by a rough dielectric (single "
+                    "scattering): smith (the Smith microsurface's B(1+Λi, 1+Λo)) or pbrt "
+                    "(1/(1+Λi+Λo), as pbrt-v4)")
+        ->capture_default_str();
     cmd->add_flag("--no-figures", a.no_figures,
                   "Skip the paper figures (the explorer page is always written)");
 }
@@ -140,6 +146,7 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
     s.threads = a.threads;
     s.kernel = parse_kernel(a.kernel);
     s.microsurface = parse_microsurface(a.microsurface);
+    s.transmission_masking = parse_transmission_masking(a.transmission_masking);
     if (s.microsurface == Microsurface::Multiple && s.kernel == Kernel::Simd)
         throw InputError("command line", "--microsurface",
                          "multiple scattering on the microsurfaces runs on the scalar kernel only: "
@@ -266,7 +273,8 @@ Runner add_study(CLI::App& app) {
             std::string index = "config,model,rel_rmse,seconds\n";
             for (const StudyConfiguration& c : configs) {
                 const std::string csv =
-                    write_comparison(c.stack, env, rs, out / "configs" / c.id / "renders", 0.0);
+                    write_comparison(c.stack, env, rs, out / "configs" / c.id / "renders", 0.0,
+                                     {"transmission-masking=" + a->transmission_masking});
                 std::stringstream lines(csv);
                 std::string line;
                 std::getline(lines, line);  // header

@@ -22,9 +22,11 @@ std::uint64_t query_stream(const Vec3d& wi, const Vec3d& wo) {
     return h;
 }
 
-RandomWalkModel::RandomWalkModel(const Stack& stack, std::uint64_t samples, std::uint64_t seed)
-    : walker_(stack), samples_(samples), seed_(seed) {
-    if (stack.transmits()) flipped_ = std::make_unique<RandomWalkStack>(flipped_stack(stack));
+RandomWalkModel::RandomWalkModel(const Stack& stack, std::uint64_t samples, std::uint64_t seed,
+                                 TransmissionMasking masking)
+    : walker_(stack, 10'000, masking), samples_(samples), seed_(seed) {
+    if (stack.transmits())
+        flipped_ = std::make_unique<RandomWalkStack>(flipped_stack(stack), 10'000, masking);
 }
 
 Support RandomWalkModel::support() const {
@@ -55,12 +57,20 @@ std::vector<OptionSpec> random_walk_options() {
              {"16", "64", "256", "1024", "4096", "16384", "65536"},
              "1024",
              "random walks per query (the noise falls as 1/sqrt(samples))"},
-            {"seed", {"1", "2", "3", "4", "5", "6", "7", "8"}, "1", "seed of the walks"}};
+            {"seed", {"1", "2", "3", "4", "5", "6", "7", "8"}, "1", "seed of the walks"},
+            {"transmission-masking",
+             {"smith", "pbrt"},
+             "smith",
+             "masking of light refracted by a rough dielectric: the Smith microsurface's "
+             "B(1+Λi, 1+Λo), or pbrt-v4's 1/(1+Λi+Λo)"}};
 }
 
 std::unique_ptr<Model> make_random_walk(const Stack& stack, const ModelOptions& options) {
-    return std::make_unique<RandomWalkModel>(stack, std::stoull(option_value(options, "samples")),
-                                             std::stoull(option_value(options, "seed")));
+    return std::make_unique<RandomWalkModel>(
+        stack, std::stoull(option_value(options, "samples")),
+        std::stoull(option_value(options, "seed")),
+        parse_transmission_masking(option_value(options, "transmission-masking"), "model option",
+                                   "transmission-masking"));
 }
 
 }  // namespace lamina

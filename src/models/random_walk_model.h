@@ -18,7 +18,10 @@ namespace lamina {
 
 class RandomWalkModel final : public Model {
   public:
-    RandomWalkModel(const Stack& stack, std::uint64_t samples, std::uint64_t seed);
+    /// `masking`: the rough dielectrics' refraction masking (physics/microfacet.h); the model
+    /// option `transmission-masking`.
+    RandomWalkModel(const Stack& stack, std::uint64_t samples, std::uint64_t seed,
+                    TransmissionMasking masking = TransmissionMasking::Smith);
 
     std::string name() const override { return "random-walk"; }
     Support support() const override;

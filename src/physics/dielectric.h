@@ -23,6 +23,9 @@ struct DielectricInterface {
     T alpha;
     /// Use the uncorrelated G1·G1 instead of the height-correlated G2 (an option for ablations).
     bool uncorrelated_shadowing = false;
+    /// The masking-shadowing of the refraction lobe (microfacet.h): the Smith microsurface's own
+    /// B(1 + Λi, 1 + Λo) by default, or pbrt-v4's 1/(1 + Λi + Λo).
+    TransmissionMasking transmission_masking = TransmissionMasking::Smith;
 
     bool is_smooth() const { return alpha == 0; }
     T inv_eta() const { return T(1) / eta; }
@@ -36,9 +39,13 @@ struct DielectricInterface {
         return wi.z > 0 ? eta : T(1) / eta;
     }
 
+    /// G2(wi, wo): reflection 1/(1 + Λi + Λo); refraction as transmission_masking says.
     T masking_shadowing(const Vec3<T>& wi, const Vec3<T>& wo) const {
         const GGX<T> ggx = distribution();
-        return uncorrelated_shadowing ? ggx.G2_uncorrelated(wi, wo) : ggx.G2(wi, wo);
+        if (uncorrelated_shadowing) return ggx.G2_uncorrelated(wi, wo);
+        if (transmission_masking == TransmissionMasking::Smith && !same_hemisphere(wi, wo))
+            return ggx.G2_transmission(wi, wo);
+        return ggx.G2(wi, wo);
     }
 
     /// Generalized half vector, in the upper hemisphere, or nothing for a degenerate pair.
@@ -96,8 +103,9 @@ struct DielectricInterface {
     /// Follows a particle arriving from wi: picks a visible microfacet normal (Heitz 2018, drawn
     /// with the equivalent spherical-cap construction of Dupuy & Benyoub 2023), reflects with
     /// probability F and refracts otherwise, and keeps the fraction G2/G1 that escapes the
-    /// microsurface (docs/physics.md §3). uc picks the Fresnel branch; u1, u2 the normal.
-    /// kWithPdf = false skips the density (the particle tracer only needs the weight).
+    /// microsurface (docs/physics.md §3), with the refraction lobe's G2 of transmission_masking. uc
+    /// picks the Fresnel branch; u1, u2 the normal. kWithPdf = false skips the density (the
+    /// particle tracer only needs the weight).
     template <bool kWithPdf = true>
     LAMINA_FORCE_INLINE std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T uc, T u1,
                                                             T u2) const {
@@ -124,13 +132,15 @@ struct DielectricInterface {
         // scattering microsurface loses the energy (G2 = 0 for the pair).
         const bool escapes = s.wo.z != 0 && (same_hemisphere(wi, s.wo) == is_reflection);
         // Weight f·|cos θo|/pdf = G2(wi, wo)/G1(wi): the Fresnel branch probability cancels F
-        // (Heitz 2018, §2; Walter Eq. 41 with visible-normal sampling). With r = √(1 + α²tan²θ)
-        // = 1 + 2Λ (Heitz 2014, Eq. 72), height-correlated G2/G1 = (1 + r_i) / (r_i + r_o).
+        // (Heitz 2018, §2; Walter Eq. 41 with visible-normal sampling), in terms of the Smith
+        // roots r = √(1 + α²tan²θ) = 1 + 2Λ (Heitz 2014, Eq. 72; microfacet.h).
         if (uncorrelated_shadowing) {
             s.shadowing = ggx.G1(s.wo);
         } else {
             const T r_i = ggx.smith_root(wi), r_o = ggx.smith_root(s.wo);
-            s.shadowing = (T(1) + r_i) / (r_i + r_o);
+            s.shadowing = is_reflection || transmission_masking == TransmissionMasking::Pbrt
+                              ? smith_reflection_escape(r_i, r_o)
+                              : smith_refraction_escape(r_i, r_o);
         }
         if (!escapes) s.shadowing = 0;
         s.weight = Rgb<T>(s.shadowing);
@@ -142,8 +152,9 @@ struct DielectricInterface {
     /// Rough and η = 1: F = 0 on every microfacet and Snell's law sends every refracted ray
     /// straight on, so the BTDF of Walter et al. collapses onto a delta lobe at −wi, which eval
     /// and pdf (densities) cannot represent. Its weight is the η → 1 limit of the lobe's energy,
-    /// E[(1 − F) G2/G1] → G2(wi, −wi)/G1(wi) (every refracted direction tends to −wi), so the
-    /// interface is continuous in η; the single-scattering microsurface still loses 1 − that.
+    /// E[(1 − F) G2/G1] → G2(wi, −wi)/G1(wi) (every refracted direction tends to −wi; G2 of the
+    /// refraction lobe, transmission_masking's), so the interface is continuous in η; the
+    /// single-scattering microsurface still loses 1 − that.
     std::optional<BsdfSample<T>> sample_index_matched(const Vec3<T>& wi) const {
         BsdfSample<T> s;
         s.wo = -wi;

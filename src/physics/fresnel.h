@@ -1,10 +1,10 @@
-#pragma once
 // Fresnel reflectance, Snell refraction and mirror reflection.
 //
 // Relative index convention: `eta` is η_t / η_i, the index of the medium the light refracts *into*
 // over the index of the medium it arrives from, for light arriving on the side the normal points
 // to. At an interface of a stack (normal +z pointing up) eta = η_below / η_above.
 
+#include "core/lane.h"
 #include "core/math.h"
 #include "core/vec.h"
 
@@ -13,7 +13,25 @@
 #include <optional>
 #include <utility>
 
-namespace lamina {
+// A lane header (core/lane.h): included once as an ordinary header and once per SIMD target.
+#ifndef LAMINA_LANE_TARGET
+#ifndef LAMINA_PHYSICS_FRESNEL_H
+#define LAMINA_PHYSICS_FRESNEL_H
+#define LAMINA_PHYSICS_FRESNEL_BODY
+#endif
+#elif defined(LAMINA_PHYSICS_FRESNEL_TARGET) == defined(HWY_TARGET_TOGGLE)
+#ifdef LAMINA_PHYSICS_FRESNEL_TARGET
+#undef LAMINA_PHYSICS_FRESNEL_TARGET
+#else
+#define LAMINA_PHYSICS_FRESNEL_TARGET
+#endif
+#define LAMINA_PHYSICS_FRESNEL_BODY
+#endif
+
+#ifdef LAMINA_PHYSICS_FRESNEL_BODY
+#undef LAMINA_PHYSICS_FRESNEL_BODY
+
+LAMINA_LANE_BEGIN
 
 /// Fresnel reflectance of a dielectric interface together with the refracted cosine, for code that
 /// refracts after choosing (sharing the square root). `eta` is the relative index actually crossed
@@ -26,7 +44,7 @@ struct FresnelDielectric {
     T inv_eta;  ///< its reciprocal
 };
 
-template <typename T>
+template <typename T, typename L = Lane<T>>
 inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_eta);
 
 /// Exact unpolarized Fresnel reflectance of a dielectric interface (the mean of the s and p
@@ -39,23 +57,29 @@ inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta) {
     return fresnel_dielectric_full(cos_theta_i, eta, T(1) / eta);
 }
 
-/// The same with 1/eta supplied (interfaces keep it, saving a division per event).
-template <typename T>
+/// The same with 1/eta supplied (interfaces keep it, saving a division per event). A branch-free
+/// lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate these lines.
+template <typename T, typename L>
 inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_eta) {
-    cos_theta_i = clamp(cos_theta_i, T(-1), T(1));
-    if (cos_theta_i < 0) {
-        std::swap(eta, inv_eta);
-        cos_theta_i = -cos_theta_i;
-    }
-    const T sin2_theta_t = (T(1) - sqr(cos_theta_i)) * sqr(inv_eta);
-    if (sin2_theta_t >= T(1)) return {T(1), T(0), eta, inv_eta};  // total internal reflection
-    const T cos_theta_t = safe_sqrt(T(1) - sin2_theta_t);
+    const T zero = L::constant(0), one = L::constant(1);
+    cos_theta_i = L::min(L::max(cos_theta_i, zero - one), one);
+    // From the other side the relative index crossed is 1/η.
+    const auto below = L::less(cos_theta_i, zero);
+    const T eta_crossed = L::select(below, inv_eta, eta);
+    const T inv_eta_crossed = L::select(below, eta, inv_eta);
+    cos_theta_i = L::select(below, zero - cos_theta_i, cos_theta_i);
+    const T sin2_theta_t = (one - cos_theta_i * cos_theta_i) * (inv_eta_crossed * inv_eta_crossed);
+    const auto refracts = L::less(sin2_theta_t, one);  // otherwise total internal reflection
+    const T cos_theta_t = L::sqrt(L::max(one - sin2_theta_t, zero));
     // r_parallel = a/b, r_perpendicular = c/d; (a²d² + c²b²) / (b²d²) needs a single division.
-    const T a = eta * cos_theta_i - cos_theta_t, b = eta * cos_theta_i + cos_theta_t;
-    const T c = cos_theta_i - eta * cos_theta_t, d = cos_theta_i + eta * cos_theta_t;
-    const T b2d2 = sqr(b * d);
-    const T reflectance = b2d2 > 0 ? (sqr(a * d) + sqr(c * b)) / (T(2) * b2d2) : T(1);
-    return {reflectance, cos_theta_t, eta, inv_eta};
+    const T a = eta_crossed * cos_theta_i - cos_theta_t,
+            b = eta_crossed * cos_theta_i + cos_theta_t;
+    const T c = cos_theta_i - eta_crossed * cos_theta_t,
+            d = cos_theta_i + eta_crossed * cos_theta_t;
+    const T bd = b * d, ad = a * d, cb = c * b;
+    const T b2d2 = bd * bd;
+    const T reflectance = L::select(L::less(zero, b2d2), (ad * ad + cb * cb) / (b2d2 + b2d2), one);
+    return {L::select(refracts, reflectance, one), cos_theta_t, eta_crossed, inv_eta_crossed};
 }
 
 /// Exact unpolarized Fresnel reflectance of a dielectric interface; see fresnel_dielectric_full.
@@ -70,25 +94,29 @@ inline T fresnel_dielectric(T cos_theta_i, T eta) {
 /// The Fresnel equations with a complex index (Born & Wolf §14.2) written in real arithmetic:
 /// with a² + b² = √((η² − k² − sin²θ)² + 4η²k²) and a = √((a² + b² + η² − k² − sin²θ)/2),
 ///   R_s = (a² + b² + cos²θ − 2a cos θ) / (a² + b² + cos²θ + 2a cos θ),
-///   R_p = R_s (cos²θ (a² + b²) + sin⁴θ − 2a cos θ sin²θ) / (cos²θ (a² + b²) + sin⁴θ + 2a cos θ sin²θ)
+///   R_p = R_s (cos²θ (a² + b²) + sin⁴θ − 2a cos θ sin²θ) / (cos²θ (a² + b²) + sin⁴θ + 2a cos θ
+///   sin²θ)
 /// (e.g. Lagarde 2013, "Memo on Fresnel equations"; pbrt-v3 FrConductor). With k = 0 it equals
 /// fresnel_dielectric, including total internal reflection (a = 0 gives R = 1) when eta < 1.
-template <typename T>
+/// A branch-free lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate
+/// these lines.
+template <typename T, typename L = Lane<T>>
 inline T fresnel_conductor(T cos_theta_i, T eta, T k) {
-    cos_theta_i = clamp(cos_theta_i, T(0), T(1));
-    const T cos2 = sqr(cos_theta_i);
-    const T sin2 = T(1) - cos2;
-    const T eta2 = sqr(eta), k2 = sqr(k);
+    const T zero = L::constant(0), one = L::constant(1), two = L::constant(2);
+    cos_theta_i = L::min(L::max(cos_theta_i, zero), one);
+    const T cos2 = cos_theta_i * cos_theta_i;
+    const T sin2 = one - cos2;
+    const T eta2 = eta * eta, k2 = k * k;
     const T t0 = eta2 - k2 - sin2;
-    const T a2_plus_b2 = std::sqrt(sqr(t0) + T(4) * eta2 * k2);
-    const T a = safe_sqrt(T(0.5) * (a2_plus_b2 + t0));
+    const T a2_plus_b2 = L::sqrt(t0 * t0 + L::constant(4) * eta2 * k2);
+    const T a = L::sqrt(L::max(L::constant(0.5) * (a2_plus_b2 + t0), zero));
     const T t1 = a2_plus_b2 + cos2;
-    const T t2 = T(2) * cos_theta_i * a;
+    const T t2 = two * cos_theta_i * a;
     const T r_s = (t1 - t2) / (t1 + t2);
-    const T t3 = cos2 * a2_plus_b2 + sqr(sin2);
+    const T t3 = cos2 * a2_plus_b2 + sin2 * sin2;
     const T t4 = t2 * sin2;
-    const T r_p = t3 + t4 > 0 ? r_s * (t3 - t4) / (t3 + t4) : r_s;
-    return (r_s + r_p) / T(2);
+    const T r_p = L::select(L::less(zero, t3 + t4), r_s * (t3 - t4) / (t3 + t4), r_s);
+    return (r_s + r_p) / two;
 }
 
 /// The same reflectance evaluated with std::complex, as written in Born & Wolf: an independent
@@ -131,4 +159,6 @@ inline std::optional<Vec3<T>> refract(const Vec3<T>& w, Vec3<T> n, T eta) {
     return -w / eta + n * (cos_theta_i / eta - cos_theta_t);
 }
 
-}  // namespace lamina
+LAMINA_LANE_END
+
+#endif  // LAMINA_PHYSICS_FRESNEL_BODY

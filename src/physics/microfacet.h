@@ -7,13 +7,34 @@
 // sees the same microsurface from below: its visible normals are those with w·wm < 0, and every
 // function below treats such w through −w (the microsurface is point-symmetric).
 
+#include "core/beta_function.h"
+#include "core/lane.h"
 #include "core/math.h"
 #include "core/vec.h"
+#include "physics/smith_masking.h"
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 namespace lamina {
+
+/// How a rough dielectric masks and shadows the light it *refracts* (its reflection lobe always
+/// has the height-correlated 1/(1 + Λi + Λo) of Heitz 2014, Eq. 99).
+enum class TransmissionMasking {
+    /// The Smith microsurface's own height-correlated form for a pair on opposite sides,
+    /// B(1 + Λi, 1 + Λo) (smith_refraction_escape): the default.
+    Smith,
+    /// 1/(1 + Λi + Λo) as for reflection: Walter et al. 2007 with the height-correlated G2, as
+    /// pbrt-v4 uses it; kept for comparisons with those renderers.
+    Pbrt,
+};
+/// "smith" | "pbrt".
+const char* transmission_masking_name(TransmissionMasking masking);
+/// "smith" | "pbrt"; InputError naming `where` (a file or "command line") and `field` otherwise.
+TransmissionMasking parse_transmission_masking(const std::string& text,
+                                               const std::string& where = "command line",
+                                               const std::string& field = "--transmission-masking");
 
 template <typename T>
 struct GGX {
@@ -47,6 +68,14 @@ struct GGX {
     /// The caller is responsible for the side checks (χ+ terms) of the lobe it evaluates.
     T G2(const Vec3<T>& wi, const Vec3<T>& wo) const {
         return T(1) / (T(1) + lambda(wi) + lambda(wo));
+    }
+
+    /// The Smith microsurface's height-correlated masking-shadowing for a refracted pair (wi and
+    /// wo on opposite sides): B(1 + Λ(wi), 1 + Λ(wo)) (smith_refraction_escape says why). Zero if
+    /// either direction is grazing.
+    T G2_transmission(const Vec3<T>& wi, const Vec3<T>& wo) const {
+        if (wi.z == 0 || wo.z == 0) return T(0);
+        return beta_function_scaled<T>(T(1) + lambda(wi), T(1) + lambda(wo), T(1));
     }
 
     /// Uncorrelated (separable) masking-shadowing G1(wi) G1(wo) (Heitz 2014, Eq. 98); an option.

@@ -15,9 +15,10 @@
 // first hit, c has density (1 + Λi) c^Λi; a reflected ray escapes with probability c^Λo, so
 // G2/G1 = (1 + Λi)/(1 + Λi + Λo), the G2 of dielectric.h and conductor.h; a refracted ray leaves
 // below, where the heights above it have C1 = 1 − c, so G2/G1 = ∫ (1 + Λi) c^Λi (1 − c)^Λo dc =
-// (1 + Λi) B(1 + Λi, 1 + Λo) (B: Euler's Beta function). The single-scattering dielectric uses
-// 1/(1 + Λi + Λo) for its refraction lobe too (docs/physics.md §3, as pbrt-v4 does); the two differ
-// by a few percent at grazing exits and by more when both Λ are large.
+// (1 + Λi) B(1 + Λi, 1 + Λo) (B: Euler's Beta function), the single-scattering dielectric's
+// default refraction masking (TransmissionMasking::Smith, physics/smith_masking.h); its `pbrt`
+// option, 1/(1 + Λi + Λo) as pbrt-v4 uses for both lobes, differs by a few percent at grazing
+// exits and by much more when both Λ are large.
 //
 // Conventions as in bsdf.h: `wi` points away from the surface towards where the light comes from
 // (above: wi.z > 0; from below a dielectric: wi.z < 0). Directions of travel are written `wr`.

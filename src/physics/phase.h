@@ -1,4 +1,3 @@
-#pragma once
 // The Henyey–Greenstein phase function (Henyey & Greenstein 1941, ApJ 93, Eq. 3).
 //
 // Directions here are *propagation* directions: `d_in` is where the particle travels before the
@@ -6,26 +5,51 @@
 // (g > 0 forward scattering). The phase function is normalized over the sphere (1/sr).
 
 #include "core/frame.h"
+#include "core/lane.h"
 #include "core/math.h"
 #include "core/vec.h"
 
 #include <cmath>
 
-namespace lamina {
+// A lane header (core/lane.h): included once as an ordinary header and once per SIMD target.
+#ifndef LAMINA_LANE_TARGET
+#ifndef LAMINA_PHYSICS_PHASE_H
+#define LAMINA_PHYSICS_PHASE_H
+#define LAMINA_PHYSICS_PHASE_BODY
+#endif
+#elif defined(LAMINA_PHYSICS_PHASE_TARGET) == defined(HWY_TARGET_TOGGLE)
+#ifdef LAMINA_PHYSICS_PHASE_TARGET
+#undef LAMINA_PHYSICS_PHASE_TARGET
+#else
+#define LAMINA_PHYSICS_PHASE_TARGET
+#endif
+#define LAMINA_PHYSICS_PHASE_BODY
+#endif
 
-template <typename T>
+#ifdef LAMINA_PHYSICS_PHASE_BODY
+#undef LAMINA_PHYSICS_PHASE_BODY
+
+LAMINA_LANE_BEGIN
+
+/// The phase function's value, 1/sr: (1 − g²) / (4π (1 + g² − 2g cos θ)^{3/2}). A lane template
+/// (core/lane.h), as sample_hg_cos_theta: the scalar and the SIMD kernels evaluate these lines.
+template <typename T, typename L = Lane<T>>
 inline T hg_phase(T cos_theta, T g) {
-    const T denom = T(1) + sqr(g) - T(2) * g * cos_theta;
-    return (T(1) - sqr(g)) / (T(4) * kPi<T> * denom * safe_sqrt(denom));
+    const T one = L::constant(1), two = L::constant(2);
+    const T denom = one + g * g - two * g * cos_theta;
+    return (one - g * g) / (L::constant(4) * L::constant(kPi<double>) * denom *
+                            L::sqrt(L::max(denom, L::constant(0))));
 }
 
 /// cos θ of a sample of HG from u in [0, 1) by inverting its CDF (e.g. Pharr, Jakob, Humphreys,
-/// PBR 4th ed., §11.3.1); uniform when |g| is tiny.
-template <typename T>
+/// PBR 4th ed., §11.3.1); uniform when |g| is tiny (|g| < 1e-3). Branch-free.
+template <typename T, typename L = Lane<T>>
 inline T sample_hg_cos_theta(T g, T u) {
-    if (std::abs(g) < T(1e-3)) return T(1) - T(2) * u;
-    const T s = (T(1) - sqr(g)) / (T(1) + g - T(2) * g * u);
-    return clamp((T(1) + sqr(g) - sqr(s)) / (T(2) * g), T(-1), T(1));
+    const T one = L::constant(1), two = L::constant(2);
+    const T s = (one - g * g) / (one + g - two * g * u);
+    const T inverted = L::min(L::max((one + g * g - s * s) / (two * g), L::constant(-1)), one);
+    const auto tiny = L::less(L::max(g, L::constant(0) - g), L::constant(1e-3));
+    return L::select(tiny, one - two * u, inverted);
 }
 
 /// Propagation direction after scattering d_in (unit) with HG(g), from two uniforms in [0, 1).
@@ -46,4 +70,6 @@ inline T invert_hg_cos_theta(T g, T cos_theta) {
     return (T(1) + g - (T(1) - sqr(g)) / s) / (T(2) * g);
 }
 
-}  // namespace lamina
+LAMINA_LANE_END
+
+#endif  // LAMINA_PHYSICS_PHASE_BODY

@@ -108,7 +108,7 @@ bool is_grey(const Rgbd& x) {
 
 }  // namespace
 
-RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events)
+RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events, TransmissionMasking masking)
     : transmits_(stack.transmits()), max_events_(max_events) {
     LAMINA_CHECK(max_events >= 1);
     const int L = int(stack.layers.size());
@@ -127,6 +127,7 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events)
         switch (spec.type) {
             case InterfaceType::Dielectric:
                 it.dielectric = {spec.eta / eta_above, spec.alpha};
+                it.dielectric.transmission_masking = masking;
                 it.delta = it.dielectric.is_smooth() || it.dielectric.is_index_matched();
                 eta_[k + 1] = spec.eta;
                 break;

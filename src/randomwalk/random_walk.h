@@ -75,7 +75,10 @@ struct RandomWalkSample {
 class RandomWalkStack {
   public:
     /// `max_events`: safety cap on events per walk (as the goniophotometer's); ≥ 1.
-    explicit RandomWalkStack(const Stack& stack, int max_events = 10'000);
+    /// `masking`: the refraction masking of the rough dielectrics (physics/microfacet.h), as the
+    /// goniophotometer's --transmission-masking.
+    explicit RandomWalkStack(const Stack& stack, int max_events = 10'000,
+                             TransmissionMasking masking = TransmissionMasking::Smith);
 
     bool transmits() const { return transmits_; }
     /// Absolute indices of the ambient medium (above) and of the half-space below the base.

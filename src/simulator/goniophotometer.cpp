@@ -355,7 +355,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
                              const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);
     const auto start = std::chrono::steady_clock::now();
-    TraceStack trace(stack);
+    TraceStack trace(stack, settings.transmission_masking);
     trace.multiple_scattering = settings.microsurface == Microsurface::Multiple;
     trace.max_microsurface_order = settings.max_microsurface_order;
     const HemisphereGrid& grid = settings.grid;

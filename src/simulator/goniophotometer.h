@@ -16,6 +16,7 @@
 #include "core/rgb.h"
 #include "core/table.h"
 #include "layers/stack.h"
+#include "physics/microfacet.h"
 
 #include <array>
 #include <cstdint>
@@ -71,6 +72,10 @@ struct SimulationSettings {
     /// Facets per microsurface walk (Microsurface::Multiple); 1 keeps only the first order, which
     /// is the single-scattering interface (a test of the walk).
     int max_microsurface_order = kMaxMicrosurfaceOrder;
+    /// The single-scattering rough dielectric's refraction masking (physics/microfacet.h): the
+    /// Smith microsurface's B(1 + Λi, 1 + Λo) or pbrt-v4's 1/(1 + Λi + Λo). The microsurface
+    /// walk (Microsurface::Multiple) has its own, which is the Smith one.
+    TransmissionMasking transmission_masking = TransmissionMasking::Smith;
 };
 
 /// Where the flux of an incidence went, per channel; the terms sum to 1 to rounding.

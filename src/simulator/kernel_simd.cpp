@@ -51,6 +51,23 @@
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
 
+// The lane headers (core/lane.h) once more, their templates compiled for this instruction set.
+#undef LAMINA_LANE_BEGIN
+#undef LAMINA_LANE_END
+#define LAMINA_LANE_BEGIN   \
+    HWY_BEFORE_NAMESPACE(); \
+    namespace lamina {      \
+    namespace HWY_NAMESPACE {
+#define LAMINA_LANE_END \
+    }                   \
+    }                   \
+    HWY_AFTER_NAMESPACE();
+#define LAMINA_LANE_TARGET
+#include "physics/fresnel.h"
+#include "physics/phase.h"
+#include "physics/smith_masking.h"
+#undef LAMINA_LANE_TARGET
+
 HWY_BEFORE_NAMESPACE();
 namespace lamina {
 namespace HWY_NAMESPACE {
@@ -297,23 +314,37 @@ HWY_INLINE VF Shadowing(const V3& wi, const V3& wo, float alpha, bool uncorrelat
     return hn::Div(hn::Mul(hn::Add(z_i, s_i), z_o), hn::MulAdd(s_i, z_o, hn::Mul(s_o, z_i)));
 }
 
-// fresnel.h fresnel_conductor (real-arithmetic complex Fresnel), cos θ in [0, 1].
+// The operations of core/lane.h on vectors: the physics templates written over a lane type
+// (core/beta_function.h, physics/microfacet.h smith_refraction_escape) instantiated on lanes.
+// Highway's contrib math functions: Log ≤ 4 ulp, Log1p ≤ 2 ulp, Exp ≤ 1 ulp (hwy/contrib/math).
+struct VecLane {
+    using Value = VF;
+    using Mask = MF;
+    static HWY_INLINE VF constant(double x) { return hn::Set(DF(), float(x)); }
+    static HWY_INLINE VF min(VF a, VF b) { return hn::Min(a, b); }
+    static HWY_INLINE VF max(VF a, VF b) { return hn::Max(a, b); }
+    static HWY_INLINE VF sqrt(VF x) { return hn::Sqrt(x); }
+    static HWY_INLINE VF log(VF x) { return hn::Log(DF(), x); }
+    static HWY_INLINE VF log1p(VF x) { return hn::Log1p(DF(), x); }
+    static HWY_INLINE VF exp(VF x) { return hn::Exp(DF(), x); }
+    static HWY_INLINE VF select(MF m, VF a, VF b) { return hn::IfThenElse(m, a, b); }
+    static HWY_INLINE MF less(VF a, VF b) { return hn::Lt(a, b); }
+    static constexpr double kBetaArgumentMax = Lane<float>::kBetaArgumentMax;
+};
+
+// The refraction escape G2/G1 = (1 + Λi) B(1 + Λi, 1 + Λo) of the Smith masking
+// (microfacet.h smith_refraction_escape, the same template), from s = |z| r (SmithRootTimesCos).
+HWY_INLINE VF SmithRefractionEscape(const V3& wi, const V3& wo, float alpha) {
+    const VF r_i = hn::Div(SmithRootTimesCos(wi, alpha), hn::Abs(wi.z));
+    const VF r_o = hn::Div(SmithRootTimesCos(wo, alpha), hn::Abs(wo.z));
+    return smith_refraction_escape<VF, VecLane>(r_i, r_o);
+}
+
+// fresnel.h fresnel_conductor (real-arithmetic complex Fresnel, the same template), cos θ in
+// [0, 1].
 HWY_INLINE VF FresnelConductor(VF cos_theta, float eta, float k) {
     const DF df;
-    const VF one = hn::Set(df, 1.f);
-    const VF c = hn::Min(hn::ZeroIfNegative(cos_theta), one);
-    const VF cos2 = hn::Mul(c, c);
-    const VF sin2 = hn::Sub(one, cos2);
-    const float eta2 = eta * eta, k2 = k * k;
-    const VF t0 = hn::Sub(hn::Set(df, eta2 - k2), sin2);
-    const VF a2b2 = hn::Sqrt(hn::MulAdd(t0, t0, hn::Set(df, 4.f * eta2 * k2)));
-    const VF a = SafeSqrt(hn::Mul(hn::Set(df, 0.5f), hn::Add(a2b2, t0)));
-    const VF t1 = hn::Add(a2b2, cos2);
-    const VF t2 = hn::Mul(hn::Mul(hn::Set(df, 2.f), c), a);
-    // (R_s + R_p)/2 with R_p = R_s (t3 − t4)/(t3 + t4) is R_s t3/(t3 + t4): one division in all.
-    const VF t3 = hn::MulAdd(cos2, a2b2, hn::Mul(sin2, sin2));
-    const VF t4 = hn::Mul(t2, sin2);
-    return hn::Div(hn::Mul(hn::Sub(t1, t2), t3), hn::Mul(hn::Add(t1, t2), hn::Add(t3, t4)));
+    return fresnel_conductor<VF, VecLane>(cos_theta, hn::Set(df, eta), hn::Set(df, k));
 }
 
 // ---- Lane state ---------------------------------------------------------------------------------
@@ -388,8 +419,13 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
         // sample_index_matched, with r = 1 + 2Λ).
         wo = v.d;
         if (!iface.is_smooth()) {
-            // G2(wi, −wi)/G1(wi) = Shadowing(wi, −wi): (1 + r)/(2r), or G1 = 2/(1 + r).
-            shadowing = Shadowing(wi, v.d, iface.alpha, iface.uncorrelated_shadowing);
+            // G2(wi, −wi)/G1(wi) = Shadowing(wi, −wi): (1 + r)/(2r), or G1 = 2/(1 + r); with the
+            // Smith refraction masking (1 + Λ) B(1 + Λ, 1 + Λ).
+            if (!iface.uncorrelated_shadowing &&
+                iface.transmission_masking == TransmissionMasking::Smith)
+                shadowing = SmithRefractionEscape(wi, v.d, iface.alpha);
+            else
+                shadowing = Shadowing(wi, v.d, iface.alpha, iface.uncorrelated_shadowing);
         }
     } else {
         // The microfacet normal: drawn for a rough interface, the macro normal for a smooth one
@@ -397,23 +433,13 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
         const V3 wm = iface.is_smooth() ? V3{zero, zero, one}
                                         : SampleVisibleNormalCaps(wi, iface.alpha, u1, u2);
         const VF cos_i_m = Dot(wi, wm);
-        // fresnel.h fresnel_dielectric_full: from below, the crossed index is 1/η.
+        // fresnel.h fresnel_dielectric_full (the same template): from below, the crossed index
+        // is 1/η.
         const MF below = hn::Lt(cos_i_m, zero);
-        const VF eta = hn::IfThenElse(below, hn::Set(df, iface.inv_eta()), hn::Set(df, iface.eta));
-        const VF inv_eta =
-            hn::IfThenElse(below, hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()));
+        const FresnelDielectric<VF> fr = fresnel_dielectric_full<VF, VecLane>(
+            cos_i_m, hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()));
+        const VF inv_eta = fr.inv_eta, cos_t = fr.cos_theta_t, reflectance = fr.reflectance;
         const VF cos_i = hn::Min(hn::Abs(cos_i_m), one);
-        const VF sin2_t = hn::Mul(hn::NegMulAdd(cos_i, cos_i, one), hn::Mul(inv_eta, inv_eta));
-        const MF tir = hn::Ge(sin2_t, one);
-        const VF cos_t = SafeSqrt(hn::Sub(one, sin2_t));
-        // Born & Wolf §1.5.2, Eqs. 21a–b, as in fresnel_dielectric_full.
-        const VF a = hn::MulSub(eta, cos_i, cos_t), b = hn::MulAdd(eta, cos_i, cos_t);
-        const VF c = hn::NegMulAdd(eta, cos_t, cos_i), d = hn::MulAdd(eta, cos_t, cos_i);
-        const VF bd = hn::Mul(b, d);
-        const VF b2d2 = hn::Mul(bd, bd);
-        const VF ad = hn::Mul(a, d), cb = hn::Mul(c, b);
-        VF reflectance = hn::Div(hn::MulAdd(ad, ad, hn::Mul(cb, cb)), hn::Add(b2d2, b2d2));
-        reflectance = hn::IfThenElse(hn::Or(tir, hn::Le(b2d2, zero)), one, reflectance);
         // Both candidates, one selected (dielectric.h): mirror about wm, or Snell about wm.
         const VF two_cos = hn::Add(cos_i_m, cos_i_m);
         const V3 reflected = {hn::MulSub(two_cos, wm.x, wi.x), hn::MulSub(two_cos, wm.y, wi.y),
@@ -433,6 +459,15 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
                 hn::AndNot(hn::Eq(wo.z, zero), hn::Not(hn::Xor(same_side, is_reflection)));
             shadowing = hn::IfThenElseZero(
                 escapes, Shadowing(wi, wo, iface.alpha, iface.uncorrelated_shadowing));
+            // Refracted lanes under the Smith masking: (1 + Λi) B(1 + Λi, 1 + Λo) instead, computed
+            // only when some lane refracts.
+            if (!iface.uncorrelated_shadowing &&
+                iface.transmission_masking == TransmissionMasking::Smith) {
+                const MF refracts = hn::And(ok, hn::AndNot(is_reflection, escapes));
+                if (!hn::AllFalse(df, refracts))
+                    shadowing = hn::IfThenElse(refracts, SmithRefractionEscape(wi, wo, iface.alpha),
+                                               shadowing);
+            }
         }
     }
     v.Keep(ok, kLossMicro, shadowing);
@@ -497,13 +532,8 @@ HWY_INLINE void LambertianEvent(const LambertianInterface<float>& iface, MF m, L
 // Henyey–Greenstein direction (phase.h sample_hg), Duff et al. 2017 frame about d.
 HWY_INLINE V3 SampleHg(const V3& d, VF g, VF u1, VF u2) {
     const DF df;
-    const VF one = hn::Set(df, 1.f), two = hn::Set(df, 2.f);
-    const VF g2 = hn::Mul(g, g);
-    const VF s = hn::Div(hn::Sub(one, g2), hn::Sub(hn::Add(one, g), hn::Mul(hn::Mul(two, g), u1)));
-    VF cos_theta = hn::Div(hn::Sub(hn::Add(one, g2), hn::Mul(s, s)), hn::Mul(two, g));
-    cos_theta = hn::Min(hn::Max(cos_theta, hn::Set(df, -1.f)), one);
-    cos_theta = hn::IfThenElse(hn::Lt(hn::Abs(g), hn::Set(df, 1e-3f)), hn::NegMulAdd(two, u1, one),
-                               cos_theta);
+    const VF one = hn::Set(df, 1.f);
+    const VF cos_theta = sample_hg_cos_theta<VF, VecLane>(g, u1);  // phase.h, the same template
     const VF sin_theta = SafeSqrt(hn::NegMulAdd(cos_theta, cos_theta, one));
     VF cos_phi, sin_phi;
     CosSin2Pi(u2, cos_phi, sin_phi);
@@ -519,13 +549,9 @@ HWY_INLINE V3 SampleHg(const V3& d, VF g, VF u1, VF u2) {
             hn::MulAdd(s_axis.z, lx, hn::MulAdd(t_axis.z, ly, hn::Mul(d.z, cos_theta)))};
 }
 
+// phase.h hg_phase (the same template).
 HWY_INLINE VF HgPhase(VF cos_theta, VF g) {
-    const DF df;
-    const VF one = hn::Set(df, 1.f);
-    const VF g2 = hn::Mul(g, g);
-    const VF denom = hn::Sub(hn::Add(one, g2), hn::Mul(hn::Mul(hn::Set(df, 2.f), g), cos_theta));
-    return hn::Div(hn::Sub(one, g2),
-                   hn::Mul(hn::Set(df, 4.f * kPi<float>), hn::Mul(denom, SafeSqrt(denom))));
+    return hg_phase<VF, VecLane>(cos_theta, g);
 }
 
 // One scattering-medium step for the lanes in m (inside layer `layer`'s medium): a free flight by
@@ -1169,6 +1195,75 @@ void CosSin2PiForTest(const float* u, std::size_t n, float* c, float* s) {
     }
 }
 
+void SmithRefractionEscapeForTest(const float* r_i, const float* r_o, std::size_t n, float* out) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in_i[kMaxLanes], in_o[kMaxLanes], res[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            in_i[l] = base + l < n ? r_i[base + l] : 1.f;
+            in_o[l] = base + l < n ? r_o[base + l] : 1.f;
+        }
+        hn::Store(smith_refraction_escape<VF, VecLane>(hn::Load(df, in_i), hn::Load(df, in_o)), df,
+                  res);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l)
+            out[base + l] = res[l];
+    }
+}
+
+void FresnelDielectricForTest(const float* cos_theta, std::size_t n, float eta, float* reflectance,
+                              float* cos_theta_t) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in[kMaxLanes], r[kMaxLanes], t[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l)
+            in[l] = base + l < n ? cos_theta[base + l] : 1.f;
+        const FresnelDielectric<VF> fr = fresnel_dielectric_full<VF, VecLane>(
+            hn::Load(df, in), hn::Set(df, eta), hn::Set(df, 1.f / eta));
+        hn::Store(fr.reflectance, df, r);
+        hn::Store(fr.cos_theta_t, df, t);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l) {
+            reflectance[base + l] = r[l];
+            cos_theta_t[base + l] = t[l];
+        }
+    }
+}
+
+void FresnelConductorForTest(const float* cos_theta, std::size_t n, float eta, float k,
+                             float* reflectance) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in[kMaxLanes], r[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l)
+            in[l] = base + l < n ? cos_theta[base + l] : 1.f;
+        hn::Store(FresnelConductor(hn::Load(df, in), eta, k), df, r);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l)
+            reflectance[base + l] = r[l];
+    }
+}
+
+void HenyeyGreensteinForTest(const float* g, const float* x, std::size_t n, float* phase,
+                             float* cos_theta) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in_g[kMaxLanes], in_x[kMaxLanes], p[kMaxLanes], c[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            in_g[l] = base + l < n ? g[base + l] : 0.f;
+            in_x[l] = base + l < n ? x[base + l] : 0.f;
+        }
+        const VF vg = hn::Load(df, in_g), vx = hn::Load(df, in_x);
+        hn::Store(HgPhase(vx, vg), df, p);
+        hn::Store(sample_hg_cos_theta<VF, VecLane>(vg, vx), df, c);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l) {
+            phase[base + l] = p[l];
+            cos_theta[base + l] = c[l];
+        }
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace lamina
 HWY_AFTER_NAMESPACE();
@@ -1179,6 +1274,10 @@ namespace lamina {
 HWY_EXPORT(TraceBlockSimd);
 HWY_EXPORT(PcgDrawsForTest);
 HWY_EXPORT(CosSin2PiForTest);
+HWY_EXPORT(SmithRefractionEscapeForTest);
+HWY_EXPORT(FresnelDielectricForTest);
+HWY_EXPORT(FresnelConductorForTest);
+HWY_EXPORT(HenyeyGreensteinForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -1227,6 +1326,41 @@ void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::v
     c.resize(u.size());
     s.resize(u.size());
     HWY_DYNAMIC_DISPATCH(CosSin2PiForTest)(u.data(), u.size(), c.data(), s.data());
+}
+
+std::vector<float> simd_smith_refraction_escape(const std::vector<float>& r_i,
+                                                const std::vector<float>& r_o) {
+    select_simd_target();
+    std::vector<float> out(r_i.size());
+    HWY_DYNAMIC_DISPATCH(SmithRefractionEscapeForTest)
+    (r_i.data(), r_o.data(), r_i.size(), out.data());
+    return out;
+}
+
+void simd_fresnel_dielectric(const std::vector<float>& cos_theta, float eta,
+                             std::vector<float>& reflectance, std::vector<float>& cos_theta_t) {
+    select_simd_target();
+    reflectance.resize(cos_theta.size());
+    cos_theta_t.resize(cos_theta.size());
+    HWY_DYNAMIC_DISPATCH(FresnelDielectricForTest)
+    (cos_theta.data(), cos_theta.size(), eta, reflectance.data(), cos_theta_t.data());
+}
+
+std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, float eta, float k) {
+    select_simd_target();
+    std::vector<float> out(cos_theta.size());
+    HWY_DYNAMIC_DISPATCH(FresnelConductorForTest)
+    (cos_theta.data(), cos_theta.size(), eta, k, out.data());
+    return out;
+}
+
+void simd_henyey_greenstein(const std::vector<float>& g, const std::vector<float>& x,
+                            std::vector<float>& phase, std::vector<float>& cos_theta) {
+    select_simd_target();
+    phase.resize(g.size());
+    cos_theta.resize(g.size());
+    HWY_DYNAMIC_DISPATCH(HenyeyGreensteinForTest)
+    (g.data(), x.data(), g.size(), phase.data(), cos_theta.data());
 }
 
 }  // namespace lamina

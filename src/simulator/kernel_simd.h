@@ -21,6 +21,25 @@ std::vector<float> simd_particle_uniforms(std::uint64_t seed, std::uint64_t stre
 /// For tests: the kernel's azimuth cos(2πu), sin(2πu) for u in [0, 1).
 void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::vector<float>& s);
 
+/// For tests: physics/microfacet.h smith_refraction_escape(r_i[j], r_o[j]) instantiated on the
+/// dispatched instruction set's vectors (the lane test compares it with the scalar instantiation).
+std::vector<float> simd_smith_refraction_escape(const std::vector<float>& r_i,
+                                                const std::vector<float>& r_o);
+
+/// For tests: physics/fresnel.h fresnel_dielectric_full(cos_theta[j], eta) on the dispatched
+/// instruction set's vectors: its reflectance and refracted cosine.
+void simd_fresnel_dielectric(const std::vector<float>& cos_theta, float eta,
+                             std::vector<float>& reflectance, std::vector<float>& cos_theta_t);
+
+/// For tests: physics/fresnel.h fresnel_conductor(cos_theta[j], eta, k) on the dispatched
+/// instruction set's vectors.
+std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, float eta, float k);
+
+/// For tests: physics/phase.h hg_phase(x[j], g[j]) and sample_hg_cos_theta(g[j], x[j]) on the
+/// dispatched instruction set's vectors.
+void simd_henyey_greenstein(const std::vector<float>& g, const std::vector<float>& x,
+                            std::vector<float>& phase, std::vector<float>& cos_theta);
+
 /// Applies LAMINA_SIMD_TARGET (an instruction set name as simd_target_name prints it, e.g. AVX2 or
 /// SSE4), which caps the dispatch at that set: the way to reproduce another machine's tables, or to
 /// test every compiled set on one machine. Once per process; InputError for an unknown or

@@ -48,6 +48,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     j["max_events"] = s.max_events;
     j["kernel"] = kernel_description(s.kernel);
     j["microsurface"] = microsurface_name(s.microsurface);
+    j["transmission_masking"] = transmission_masking_name(s.transmission_masking);
     j["threads"] = result.threads_used;
     j["processes"] = result.processes;
     j["seconds"] = result.seconds;

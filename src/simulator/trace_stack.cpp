@@ -2,7 +2,8 @@
 
 namespace lamina {
 
-TraceStack::TraceStack(const Stack& stack) : transmits(stack.transmits()) {
+TraceStack::TraceStack(const Stack& stack, TransmissionMasking masking)
+    : transmits(stack.transmits()) {
     for (std::size_t i = 0; i < stack.layers.size(); ++i) {
         const Layer& layer = stack.layers[i];
         const InterfaceSpec& spec = layer.interface;
@@ -13,6 +14,7 @@ TraceStack::TraceStack(const Stack& stack) : transmits(stack.transmits()) {
         switch (spec.type) {
             case InterfaceType::Dielectric:
                 t.dielectric = {float(spec.eta / eta_above), float(spec.alpha)};
+                t.dielectric.transmission_masking = masking;
                 break;
             case InterfaceType::Conductor:
                 t.conductor = {Rgbf(spec.eta_rgb / eta_above), Rgbf(spec.k / eta_above),

@@ -43,7 +43,9 @@ struct TraceStack {
     bool multiple_scattering = false;
     int max_microsurface_order = 0;
 
-    explicit TraceStack(const Stack& stack);
+    /// `masking`: the refraction masking of every rough dielectric (physics/microfacet.h).
+    explicit TraceStack(const Stack& stack,
+                        TransmissionMasking masking = TransmissionMasking::Smith);
 };
 
 }  // namespace lamina

@@ -23,6 +23,7 @@ nlohmann::json key_json(const ReferenceKey& key) {
             {"grid", key.grid.to_string()},
             {"kernel", kernel_name(key.kernel)},
             {"microsurface", microsurface_name(key.microsurface)},
+            {"transmission_masking", transmission_masking_name(key.transmission_masking)},
             {"canonical", key.canonical()}};
 }
 
@@ -36,6 +37,9 @@ ReferenceKey key_from_json(const nlohmann::json& j) {
         HemisphereGrid::parse(j.at("grid").get<std::string>()),
         parse_kernel(j.at("kernel").get<std::string>(), "reference work list"),
         parse_microsurface(j.at("microsurface").get<std::string>(), "reference work list")};
+    key.transmission_masking =
+        parse_transmission_masking(j.at("transmission_masking").get<std::string>(),
+                                   "reference work list", "transmission_masking");
     if (key.canonical() != j.at("canonical").get<std::string>())
         throw InputError("reference work list", key.config_id,
                          "this process describes the piece differently from the root: are all "
@@ -64,9 +68,12 @@ std::vector<ReferenceKey> study_reference_keys(const std::vector<StudyConfigurat
                                                const StudySettings& s) {
     std::vector<ReferenceKey> keys;
     for (const StudyConfiguration& config : configs)
-        for (double theta_i : s.theta_i_deg)
-            keys.push_back(
-                {config.id, config.stack, theta_i, s.particles, s.seed, s.grid, s.kernel});
+        for (double theta_i : s.theta_i_deg) {
+            ReferenceKey key{config.id, config.stack, theta_i,  s.particles,
+                             s.seed,    s.grid,       s.kernel, s.microsurface};
+            key.transmission_masking = s.transmission_masking;
+            keys.push_back(key);
+        }
     return keys;
 }
 

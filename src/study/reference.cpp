@@ -20,6 +20,14 @@ namespace {
 
 constexpr const char* kMagic = "lamina-reference-piece v1\n";
 
+// A rough dielectric interface somewhere in the stack: its refraction masking shapes the table.
+bool has_rough_dielectric(const Stack& stack) {
+    for (const Layer& layer : stack.layers)
+        if (layer.interface.type == InterfaceType::Dielectric && layer.interface.alpha > 0)
+            return true;
+    return false;
+}
+
 nlohmann::json metrics_json(const LobeMetrics& m) {
     auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
     return {{"misplaced_energy", num(m.misplaced_energy)},
@@ -142,10 +150,14 @@ std::string read_file(const std::filesystem::path& path) {
 std::string ReferenceKey::canonical() const {
     return fmt::format(
         "lamina {} | config {} | stack {} | theta_i {} | particles {} | seed {} | "
-        "grid {} | kernel {}{}",
+        "grid {} | kernel {}{}{}",
         kVersion, config_id, stack_to_json(stack).dump(), theta_i_deg, particles, seed,
         grid.to_string(), kernel_description(kernel),
-        microsurface == Microsurface::Multiple ? " | microsurface multiple" : "");
+        microsurface == Microsurface::Multiple ? " | microsurface multiple" : "",
+        microsurface == Microsurface::Single &&
+                transmission_masking == TransmissionMasking::Smith && has_rough_dielectric(stack)
+            ? " | transmission masking smith"
+            : "");
 }
 
 std::string ReferenceKey::file_name() const {
@@ -177,6 +189,7 @@ std::string compute_reference_piece(const ReferenceKey& key, int threads,
     s.seed = key.seed;
     s.kernel = key.kernel;
     s.microsurface = key.microsurface;
+    s.transmission_masking = key.transmission_masking;
     const SimulationResult a = simulate(key.stack, s, on_progress);
     const std::uint64_t n_a = s.particles;
     s.particles = key.particles - n_a;

@@ -33,6 +33,11 @@ struct ReferenceKey {
     /// Single- or multiple-scattering microsurfaces (part of the key when multiple; the text of
     /// single-scattering keys is what it was before the option existed, so their caches stay).
     Microsurface microsurface = Microsurface::Single;
+    /// The refraction masking of single-scattering rough dielectrics (physics/microfacet.h).
+    /// Part of the key where it changes the table (single scattering and a rough dielectric in
+    /// the stack) and it is `smith`: caches made before the option, with the pbrt form, are then
+    /// reused for `pbrt` only.
+    TransmissionMasking transmission_masking = TransmissionMasking::Smith;
 
     /// A canonical text of every field (and lamina's version) and its 64-bit FNV-1a hash.
     std::string canonical() const;

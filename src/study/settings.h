@@ -51,7 +51,9 @@ struct StudySettings {
     int threads = 0;                                   ///< 0: all cores
     Kernel kernel = Kernel::Simd;                      ///< the reference's particle kernel
     Microsurface microsurface = Microsurface::Single;  ///< the reference's rough interfaces
-    TablesFormat tables = TablesFormat::Half;          ///< configs/<id>/tables.npy
+    /// The reference's refraction masking on single-scattering rough dielectrics.
+    TransmissionMasking transmission_masking = TransmissionMasking::Smith;
+    TablesFormat tables = TablesFormat::Half;  ///< configs/<id>/tables.npy
     /// Ignore what an earlier run left (model tables, metrics, outputs) and compute it again; the
     /// reference pieces, keyed by everything they depend on, are still reused.
     bool recompute = false;

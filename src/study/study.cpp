@@ -160,8 +160,10 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     std::vector<ReferenceKey> keys;
     std::uint64_t ref_digest = fnv1a("reference");
     for (double theta_i : s.theta_i_deg) {
-        keys.push_back({config.id, config.stack, theta_i, s.particles, s.seed, grid, s.kernel,
-                        s.microsurface});
+        ReferenceKey key{config.id, config.stack, theta_i,  s.particles,
+                         s.seed,    grid,         s.kernel, s.microsurface};
+        key.transmission_masking = s.transmission_masking;
+        keys.push_back(key);
         ref_digest = fnv1a(keys.back().canonical(), ref_digest);
     }
     std::vector<std::string> model_keys;
@@ -607,6 +609,7 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
     sj["seed"] = s.seed;
     sj["kernel"] = kernel_description(s.kernel);
     sj["microsurface"] = microsurface_name(s.microsurface);
+    sj["transmission_masking"] = transmission_masking_name(s.transmission_masking);
     sj["theta_i"] = s.theta_i_deg;
     sj["grid"] = {{"n_theta", s.grid.n_theta()}, {"n_phi", s.grid.n_phi()}};
     sj["models"] = model_names;

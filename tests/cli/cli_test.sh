@@ -135,6 +135,18 @@ check simulate-multiple 0 "$lamina" simulate "$src/examples/frosted-gold.json" -
 check_says simulate-multiple-json 0 '"microsurface": "multiple"' cat "$tmp/ms/result.json"
 check_says simulate-multiple-lost 0 "60,r" awk -F, '$1 == 60 && $7 == 0 {print $1 "," $2}' "$tmp/ms/energy.csv"
 
+# The refraction masking of rough dielectrics: result.json names it (smith by default), and the
+# pbrt form keeps more of the light a rough slab transmits (B(1 + Λi, 1 + Λo) < 1/(1 + Λi + Λo)).
+check simulate-masking-pbrt 0 "$lamina" simulate "$src/examples/slab.json" --theta-i 80 \
+    --particles 2e4 --grid 9x9 --transmission-masking pbrt --out "$tmp/pbrt"
+check_says simulate-masking-default 0 '"transmission_masking": "smith"' cat "$tmp/sim/result.json"
+check_says simulate-masking-json 0 '"transmission_masking": "pbrt"' cat "$tmp/pbrt/result.json"
+check_says simulate-bad-masking 1 "--transmission-masking: 'walter' is not a transmission masking" \
+    "$lamina" simulate "$src/examples/plastic.json" --transmission-masking walter --out "$tmp/bad1"
+check_says render-bad-masking 1 "--transmission-masking: 'walter' is not a transmission masking" \
+    "$lamina" render "$src/examples/plastic.json" --transmission-masking walter --size 8 --spp 1 \
+    --out "$tmp/bad1/x.png"
+
 # simulate: bad arguments fail clearly and leave nothing behind.
 check_says simulate-theta-90 1 "--theta-i: 90 is outside the allowed range [0, 90)" \
     "$lamina" simulate "$src/examples/plastic.json" --theta-i 90 --out "$tmp/bad1"

@@ -34,6 +34,17 @@ const Rgbd kGoldEta(0.143, 0.374, 1.442), kGoldK(3.983, 2.385, 1.603);
 const Vec3d kAbove = direction_at(0.6, 0), kGrazing = direction_at(0.1, 0),
             kBelow = direction_at(-0.8, 0);
 
+constexpr TransmissionMasking kMaskings[] = {TransmissionMasking::Smith, TransmissionMasking::Pbrt};
+
+// G2(wi, wo) of a rough dielectric, written independently of microfacet.h's Beta function: the
+// reflection lobe's 1/(1 + Λi + Λo), and for a refracted pair either the same (pbrt) or the Smith
+// microsurface's B(1 + Λi, 1 + Λo) by the C++ library's std::beta.
+double expected_g2(const GGX<double>& ggx, const Vec3d& wi, const Vec3d& wo,
+                   TransmissionMasking masking) {
+    if (same_hemisphere(wi, wo) || masking == TransmissionMasking::Pbrt) return ggx.G2(wi, wo);
+    return std::beta(1 + ggx.lambda(wi), 1 + ggx.lambda(wo));
+}
+
 // --- Quadrature over directions ----------------------------------------------------------------
 
 // ∫_{S²} f dω. Bands of cos θ are cut at the poles, the horizon and the given lobe centres, and
@@ -295,50 +306,54 @@ TEST(Interfaces, TransmissionObeysGeneralizedReciprocity) {
 
 TEST(Interfaces, DielectricSampleWeightMatchesEvalAndPdf) {
     // For every non-lost sample: s.pdf = pdf(wi, wo), weight = eval·|cos θo|/pdf, and (Heitz 2018
-    // §2, Walter Eq. 41) weight = G2(wi, wo)/G1(wi). Lost samples carry weight 0 and really point
-    // into the wrong hemisphere. eval and pdf recompute the half vector from wo; near-grazing
-    // microfacets amplify rounding by 1/|wo·wm|, so the comparison is relative 1e-9.
+    // §2, Walter Eq. 41) weight = G2(wi, wo)/G1(wi), with the refraction lobe's G2 of either
+    // masking (written with std::beta, independently of core/beta_function.h: agreement to its
+    // stated 5e-11, asked 1e-9). Lost samples carry weight 0 and really point into the wrong
+    // hemisphere. eval and pdf recompute the half vector from wo; near-grazing microfacets
+    // amplify rounding by 1/|wo·wm|, so the comparison is relative 1e-9.
     ParticleRng rng(41, 0, 0);
-    for (double eta : {1.5, 1 / 1.5}) {
-        for (double alpha : {0.05, 0.2, 0.5, 1.0}) {
-            const DielectricInterface<double> d{eta, alpha};
-            const GGX<double> ggx{alpha};
-            for (const Vec3d& wi : {kAbove, kGrazing, kBelow, direction_at(-0.3, 1.0)}) {
-                int lost = 0, kept = 0, transmitted = 0;
-                for (int i = 0; i < 2000; ++i) {
-                    const auto s = d.sample(wi, rng.uniform_double(), rng.uniform_double(),
-                                            rng.uniform_double());
-                    ASSERT_TRUE(s.has_value());  // rough dielectrics never fail
-                    EXPECT_FALSE(s->is_delta);
-                    if (s->shadowing == 0) {
-                        ++lost;
-                        EXPECT_EQ(s->weight, Rgbd(0.0));
-                        EXPECT_TRUE(s->is_transmission == same_hemisphere(wi, s->wo) ||
-                                    s->wo.z == 0);
-                        continue;
+    for (const TransmissionMasking masking : kMaskings)
+        for (double eta : {1.5, 1 / 1.5}) {
+            for (double alpha : {0.05, 0.2, 0.5, 1.0}) {
+                DielectricInterface<double> d{eta, alpha};
+                d.transmission_masking = masking;
+                const GGX<double> ggx{alpha};
+                for (const Vec3d& wi : {kAbove, kGrazing, kBelow, direction_at(-0.3, 1.0)}) {
+                    int lost = 0, kept = 0, transmitted = 0;
+                    for (int i = 0; i < 2000; ++i) {
+                        const auto s = d.sample(wi, rng.uniform_double(), rng.uniform_double(),
+                                                rng.uniform_double());
+                        ASSERT_TRUE(s.has_value());  // rough dielectrics never fail
+                        EXPECT_FALSE(s->is_delta);
+                        if (s->shadowing == 0) {
+                            ++lost;
+                            EXPECT_EQ(s->weight, Rgbd(0.0));
+                            EXPECT_TRUE(s->is_transmission == same_hemisphere(wi, s->wo) ||
+                                        s->wo.z == 0);
+                            continue;
+                        }
+                        ++kept;
+                        transmitted += s->is_transmission;
+                        EXPECT_EQ(s->is_transmission, !same_hemisphere(wi, s->wo));
+                        const double pdf = d.pdf(wi, s->wo), f = d.eval(wi, s->wo);
+                        ASSERT_GT(pdf, 0);
+                        EXPECT_NEAR(s->pdf, pdf, 1e-9 * pdf);
+                        const double expected = f * std::abs(s->wo.z) / pdf;
+                        const double g = expected_g2(ggx, wi, s->wo, masking) / ggx.G1(wi);
+                        for (int ch = 0; ch < 3; ++ch) {
+                            EXPECT_NEAR(s->weight[ch], expected, 1e-9 * expected);
+                            EXPECT_NEAR(s->weight[ch], g, 1e-9 * g);
+                        }
+                        EXPECT_NEAR(s->shadowing, g, 1e-9 * g);
                     }
-                    ++kept;
-                    transmitted += s->is_transmission;
-                    EXPECT_EQ(s->is_transmission, !same_hemisphere(wi, s->wo));
-                    const double pdf = d.pdf(wi, s->wo), f = d.eval(wi, s->wo);
-                    ASSERT_GT(pdf, 0);
-                    EXPECT_NEAR(s->pdf, pdf, 1e-9 * pdf);
-                    const double expected = f * std::abs(s->wo.z) / pdf;
-                    const double g = ggx.G2(wi, s->wo) / ggx.G1(wi);
-                    for (int ch = 0; ch < 3; ++ch) {
-                        EXPECT_NEAR(s->weight[ch], expected, 1e-9 * expected);
-                        EXPECT_NEAR(s->weight[ch], g, 1e-12 * g);
+                    EXPECT_GT(kept, 1000);
+                    if (wi.z > 0 && eta > 1) {
+                        EXPECT_GT(transmitted, 500);  // (1 − F) ≥ 0.4 at these incidences
                     }
-                    EXPECT_NEAR(s->shadowing, g, 1e-12 * g);
+                    (void)lost;
                 }
-                EXPECT_GT(kept, 1000);
-                if (wi.z > 0 && eta > 1) {
-                    EXPECT_GT(transmitted, 500);  // (1 − F) ≥ 0.4 at these incidences
-                }
-                (void)lost;
             }
         }
-    }
 }
 
 TEST(Interfaces, ConductorSampleWeightMatchesEvalAndPdf) {
@@ -521,42 +536,45 @@ TEST(Interfaces, IndexMatchedRoughDielectricIsADeltaPassThrough) {
     // represent. The sample must say so (is_delta, pdf 0, bsdf.h) and carry the η → 1 limit of
     // the lobe's energy, E[(1 − F) G2/G1] → G2(wi, −wi)/G1(wi) (every refracted direction tends to
     // −wi); eval and pdf are 0 everywhere, including at rounding distance from −wi.
-    for (double alpha : {0.05, 0.3, 1.0}) {
-        const DielectricInterface<double> d{1.0, alpha};
-        const GGX<double> ggx{alpha};
-        ParticleRng rng(46, 0, 0);
-        for (const Vec3d& wi : {kAbove, kBelow, kGrazing}) {
-            const double limit = ggx.G2(wi, -wi) / ggx.G1(wi);
-            for (int i = 0; i < 200; ++i) {
-                const auto s =
-                    d.sample(wi, rng.uniform_double(), rng.uniform_double(), rng.uniform_double());
-                ASSERT_TRUE(s.has_value());
-                EXPECT_TRUE(s->is_delta);
-                EXPECT_TRUE(s->is_transmission);
-                EXPECT_EQ(s->pdf, 0.0);
-                EXPECT_EQ(s->wo, -wi);
-                EXPECT_NEAR(s->weight[0], limit, 1e-15);
-                EXPECT_EQ(d.eval(wi, s->wo), 0.0);
-                EXPECT_EQ(d.pdf(wi, s->wo), 0.0);
-                const Vec3d near_wo = normalize(-wi + Vec3d(1e-17, -2e-17, 1e-17));
-                EXPECT_EQ(d.eval(wi, near_wo), 0.0);
-                EXPECT_EQ(d.pdf(wi, near_wo), 0.0);
-            }
-            // Continuity: at η = 1 + 1e-9 the (non-delta) samples' directions are within
-            // O((η − 1) tan θ) of −wi, θ the angle of wi to the microfacet, and G2 is smooth
-            // away from the horizon (|∂Λ/∂θ| ≤ α/cos²θ ≤ 100 here): weights are within 1e-4 of
-            // the limit unless a microfacet is seen within 1e-3 rad of grazing, which D_w ∝ wi·wm
-            // makes an O(1e-6) event per draw (and the seed is fixed).
-            const DielectricInterface<double> near{1 + 1e-9, alpha};
-            for (int i = 0; i < 200; ++i) {
-                const auto s = near.sample(wi, rng.uniform_double(), rng.uniform_double(),
-                                           rng.uniform_double());
-                ASSERT_TRUE(s.has_value());
-                if (!s->is_transmission || s->shadowing == 0) continue;
-                EXPECT_NEAR(s->weight[0], limit, 1e-4) << alpha << ' ' << wi.z;
+    for (const TransmissionMasking masking : kMaskings)
+        for (double alpha : {0.05, 0.3, 1.0}) {
+            DielectricInterface<double> d{1.0, alpha};
+            d.transmission_masking = masking;
+            const GGX<double> ggx{alpha};
+            ParticleRng rng(46, 0, 0);
+            for (const Vec3d& wi : {kAbove, kBelow, kGrazing}) {
+                const double limit = expected_g2(ggx, wi, -wi, masking) / ggx.G1(wi);
+                for (int i = 0; i < 200; ++i) {
+                    const auto s = d.sample(wi, rng.uniform_double(), rng.uniform_double(),
+                                            rng.uniform_double());
+                    ASSERT_TRUE(s.has_value());
+                    EXPECT_TRUE(s->is_delta);
+                    EXPECT_TRUE(s->is_transmission);
+                    EXPECT_EQ(s->pdf, 0.0);
+                    EXPECT_EQ(s->wo, -wi);
+                    EXPECT_NEAR(s->weight[0], limit, 1e-9 * limit);
+                    EXPECT_EQ(d.eval(wi, s->wo), 0.0);
+                    EXPECT_EQ(d.pdf(wi, s->wo), 0.0);
+                    const Vec3d near_wo = normalize(-wi + Vec3d(1e-17, -2e-17, 1e-17));
+                    EXPECT_EQ(d.eval(wi, near_wo), 0.0);
+                    EXPECT_EQ(d.pdf(wi, near_wo), 0.0);
+                }
+                // Continuity: at η = 1 + 1e-9 the (non-delta) samples' directions are within
+                // O((η − 1) tan θ) of −wi, θ the angle of wi to the microfacet, and G2 is smooth
+                // away from the horizon (|∂Λ/∂θ| ≤ α/cos²θ ≤ 100 here): weights are within 1e-4 of
+                // the limit unless a microfacet is seen within 1e-3 rad of grazing, which D_w ∝
+                // wi·wm makes an O(1e-6) event per draw (and the seed is fixed).
+                DielectricInterface<double> near{1 + 1e-9, alpha};
+                near.transmission_masking = masking;
+                for (int i = 0; i < 200; ++i) {
+                    const auto s = near.sample(wi, rng.uniform_double(), rng.uniform_double(),
+                                               rng.uniform_double());
+                    ASSERT_TRUE(s.has_value());
+                    if (!s->is_transmission || s->shadowing == 0) continue;
+                    EXPECT_NEAR(s->weight[0], limit, 1e-4) << alpha << ' ' << wi.z;
+                }
             }
         }
-    }
 }
 
 // --- Energy ------------------------------------------------------------------------------------
@@ -582,7 +600,7 @@ double dielectric_escape(const DielectricInterface<double>& d, const Vec3d& wi, 
             const Vec3d wr = reflect(wi, wm);
             if (wr.z * wi.z > 0) sum += F * ggx.G2(wi, wr) / ggx.G1(wi);
             if (const auto wt = refract(wi, wm, d.eta); wt && wt->z * wi.z < 0)
-                sum += (1 - F) * ggx.G2(wi, *wt) / ggx.G1(wi);
+                sum += (1 - F) * expected_g2(ggx, wi, *wt, d.transmission_masking) / ggx.G1(wi);
             return dw * sum;
         },
         d.alpha, eps);
@@ -603,15 +621,20 @@ TEST(Interfaces, RoughDielectricEnergyIsWhatG2Keeps) {
                           {1.5, 0.2, kGrazing},
                           {1 / 1.5, 0.2, kBelow},
                           {1.5, 1.0, direction_at(0.3, 0)}};
-    for (const Case& c : cases) {
-        const DielectricInterface<double> d{c.eta, c.alpha};
-        const double albedo = dielectric_albedo(d, c.wi, 1e-8);
-        const double escape = dielectric_escape(d, c.wi, 1e-8);
-        EXPECT_NEAR(albedo, escape, 1e-6)
-            << "eta " << c.eta << " alpha " << c.alpha << ' ' << describe(c.wi);
-        EXPECT_LE(albedo, 1 + 1e-6);
-        EXPECT_GT(albedo, 0.5);  // loses a fraction, never most of it, at these incidences
-    }
+    for (const TransmissionMasking masking : kMaskings)
+        for (const Case& c : cases) {
+            DielectricInterface<double> d{c.eta, c.alpha};
+            d.transmission_masking = masking;
+            const double albedo = dielectric_albedo(d, c.wi, 1e-8);
+            const double escape = dielectric_escape(d, c.wi, 1e-8);
+            EXPECT_NEAR(albedo, escape, 1e-6)
+                << "eta " << c.eta << " alpha " << c.alpha << ' ' << describe(c.wi);
+            EXPECT_LE(albedo, 1 + 1e-6);
+            // Loses a fraction, never most of it, at these incidences — except with the Smith
+            // masking at α = 1 near grazing incidence (θi = 72.5°), which keeps 0.41: its B(1 + Λi,
+            // 1 + Λo) masks refracted light far more than 1/(1 + Λi + Λo) when Λi is large.
+            EXPECT_GT(albedo, masking == TransmissionMasking::Smith && c.alpha == 1.0 ? 0.35 : 0.5);
+        }
     // α → 0 at normal incidence: the albedo approaches 1 as 1 − c(η)·α². GGX's tails hold
     // P(tan²θm > T) = α²/(α² + T) of the normals (integrating D cos θm), and only normals tilted by
     // more than ≈ 33°–45° send light into the wrong hemisphere (reflection needs 2θm > 90°; for

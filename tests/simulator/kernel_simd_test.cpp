@@ -5,14 +5,21 @@
 #include "simulator/kernel_simd.h"
 
 #include "core/rng.h"
+#include "physics/fresnel.h"
+#include "physics/microfacet.h"
+#include "physics/phase.h"
 #include "simulator/goniophotometer.h"
 #include "support/chi2.h"
 #include "support/stacks.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <limits>
 #include <string>
 
 namespace lamina {
@@ -43,6 +50,154 @@ TEST(KernelSimd, RunsOnTheRequestedInstructionSet) {
     EXPECT_EQ(kernel_description(Kernel::Simd), std::string("simd ") + wanted);
 }
 
+// The lane test of the Smith refraction escape (physics/microfacet.h smith_refraction_escape, one
+// template): its instantiation on the dispatched instruction set's vectors (ctest runs this on
+// every compiled set through LAMINA_SIMD_TARGET) against the scalar float instantiation and the
+// double one, on random roots r = 1 + 2Λ from 1 to 1e4 (log-uniform) and the edges: r = 1 (the
+// normal), huge and infinite r (grazing). The result is in [0, 1]; the float formula's exponent is
+// a sum of terms up to ~50 in size that cancel, so its error is absolute, a few ulp of those terms
+// (core/beta_function.h): vector and scalar float agree to 2e-5, and both are within 2e-5 of the
+// double instantiation at the same arguments (beyond the float bound on 1 + Λ, 1e7, both are
+// evaluated at the bound: the double reference is given the bounded arguments).
+TEST(KernelSimd, SmithRefractionEscapeLanes) {
+    ParticleRng rng(17, 0, 0);
+    std::vector<float> r_i, r_o;
+    const float edges[] = {1.f,  1.0000001f, 2.f,
+                           1e4f, 1e9f,       std::numeric_limits<float>::infinity()};
+    for (float a : edges)
+        for (float b : edges) {
+            r_i.push_back(a);
+            r_o.push_back(b);
+        }
+    for (int k = 0; k < 20000; ++k) {
+        r_i.push_back(std::pow(1e4f, rng.uniform_float()));
+        r_o.push_back(std::pow(1e4f, rng.uniform_float()));
+    }
+    const std::vector<float> lanes = simd_smith_refraction_escape(r_i, r_o);
+    ASSERT_EQ(lanes.size(), r_i.size());
+    double worst_scalar = 0, worst_double = 0;
+    for (std::size_t j = 0; j < r_i.size(); ++j) {
+        const float scalar = smith_refraction_escape(r_i[j], r_o[j]);
+        const double bound = 2 * Lane<float>::kBetaArgumentMax - 1;  // r of 1 + Λ at the bound
+        const double exact = smith_refraction_escape(std::min(double(r_i[j]), bound),
+                                                     std::min(double(r_o[j]), bound));
+        ASSERT_TRUE(std::isfinite(lanes[j])) << r_i[j] << ' ' << r_o[j];
+        ASSERT_GE(lanes[j], 0.f);
+        ASSERT_LE(lanes[j], 1.f + 1e-5f);
+        worst_scalar = std::max(worst_scalar, std::abs(double(lanes[j]) - scalar));
+        worst_double = std::max(worst_double, std::abs(double(lanes[j]) - exact));
+    }
+    EXPECT_LT(worst_scalar, 2e-5) << simd_target_name();
+    EXPECT_LT(worst_double, 2e-5) << simd_target_name();
+    RecordProperty("worst_vs_scalar_float", std::to_string(worst_scalar));
+    RecordProperty("worst_vs_double", std::to_string(worst_double));
+    std::printf("[ lanes    ] %s: |vector − scalar float| ≤ %.2g, |vector − double| ≤ %.2g\n",
+                simd_target_name(), worst_scalar, worst_double);
+}
+
+// The lane test of the dielectric Fresnel factor (physics/fresnel.h fresnel_dielectric_full, one
+// template): on the dispatched instruction set's vectors against the scalar float instantiation,
+// for random cosines on both sides and the edges (normal and grazing incidence from either side,
+// the critical angle, total internal reflection), for η above and below 1 and η = 1. The two
+// evaluate the same operations; the vectors may fuse a multiply-add where the scalar compiler does
+// not (or the reverse), so they agree to 4 float ulps of 1 (the results lie in [0, 1]) away from
+// the critical angle, and total internal reflection gives exactly R = 1 and cos θt = 0.
+TEST(KernelSimd, FresnelDielectricLanes) {
+    ParticleRng rng(18, 0, 0);
+    for (const float eta : {1.5f, 1 / 1.5f, 1.f, 2.4f, 1 / 2.4f}) {
+        std::vector<float> cos_theta = {0.f, -0.f, 1.f, -1.f, 1e-7f, -1e-7f, 0.5f, -0.5f};
+        const float critical = std::sqrt(std::max(0.f, 1 - eta * eta));  // from the side of 1/η
+        for (const float d : {-1e-6f, 0.f, 1e-6f})
+            cos_theta.insert(cos_theta.end(), {critical + d, -critical - d});
+        for (int k = 0; k < 4000; ++k)
+            cos_theta.push_back(2 * rng.uniform_float() - 1);
+        std::vector<float> r, t;
+        simd_fresnel_dielectric(cos_theta, eta, r, t);
+        ASSERT_EQ(r.size(), cos_theta.size());
+        double worst = 0;
+        for (std::size_t j = 0; j < cos_theta.size(); ++j) {
+            const FresnelDielectric<float> s = fresnel_dielectric_full(cos_theta[j], eta, 1 / eta);
+            ASSERT_TRUE(std::isfinite(r[j]) && std::isfinite(t[j])) << cos_theta[j];
+            const bool tir_scalar = s.reflectance == 1 && s.cos_theta_t == 0;
+            const bool tir_lanes = r[j] == 1 && t[j] == 0;
+            if (tir_scalar != tir_lanes) {
+                // Within rounding of the critical angle one may call it total reflection and the
+                // other not: cos θt = √(1 − sin²θt) is then at most √(4 ulp) ≈ 5e-4 and R within
+                // a few times that of 1.
+                EXPECT_LT(std::max(t[j], s.cos_theta_t), 1e-3f) << eta << ' ' << cos_theta[j];
+                EXPECT_GT(std::min(r[j], s.reflectance), 0.99f) << eta << ' ' << cos_theta[j];
+                continue;
+            }
+            if (tir_scalar) continue;  // both exactly R = 1, cos θt = 0
+            worst = std::max({worst, std::abs(double(r[j]) - s.reflectance),
+                              std::abs(double(t[j]) - s.cos_theta_t)});
+        }
+        EXPECT_LE(worst, 4 * 0x1p-24) << "η " << eta << " on " << simd_target_name();
+    }
+}
+
+// The lane test of the conductor Fresnel factor (physics/fresnel.h fresnel_conductor, one
+// template): on the dispatched instruction set's vectors against the scalar float instantiation,
+// for random cosines in [0, 1] and the edges (normal and grazing incidence), gold, a strong
+// absorber, a weak one and k = 0 (where it is the dielectric factor, total reflection included
+// for η < 1): within 8 float ulps of 1 (two divisions and two square roots, each ≤ 1 ulp, the
+// same operations on both; results in [0, 1]).
+TEST(KernelSimd, FresnelConductorLanes) {
+    ParticleRng rng(19, 0, 0);
+    struct Index {
+        float eta, k;
+    };
+    for (const Index ik : {Index{0.143f, 3.983f}, Index{2.9f, 3.1f}, Index{1.5f, 0.01f},
+                           Index{1.5f, 0.f}, Index{1 / 1.5f, 0.f}}) {
+        std::vector<float> cos_theta = {0.f, 1.f, 1e-7f, 0.5f, 1 - 1e-7f};
+        for (int j = 0; j < 4000; ++j)
+            cos_theta.push_back(rng.uniform_float());
+        const std::vector<float> r = simd_fresnel_conductor(cos_theta, ik.eta, ik.k);
+        double worst = 0;
+        for (std::size_t j = 0; j < cos_theta.size(); ++j) {
+            ASSERT_TRUE(std::isfinite(r[j])) << cos_theta[j];
+            worst = std::max(
+                worst, std::abs(double(r[j]) - fresnel_conductor(cos_theta[j], ik.eta, ik.k)));
+        }
+        EXPECT_LE(worst, 8 * 0x1p-24)
+            << "η " << ik.eta << " k " << ik.k << " on " << simd_target_name();
+    }
+}
+
+// The lane test of Henyey–Greenstein (physics/phase.h hg_phase and sample_hg_cos_theta, one
+// template each): on the dispatched instruction set's vectors against the scalar float
+// instantiation, for g from −0.99 to 0.99 with the isotropic edge (|g| < 1e-3, g = 0) and random
+// cosines and uniforms including their ends. The phase value: its denominator 1 + g² − 2g cos θ
+// cancels (down to (1 − |g|)² = 1e-4 for g = 0.99 in the forward direction), so rounding — fused
+// multiply-adds on one side and not the other — is amplified by κ = (1 + g² + 2|g cos θ|)/denom,
+// and p ∝ denom^{−3/2} by 3/2 of it: relative error ≤ (1 + 1.5 κ) · 8 ulp. The sampled cosine:
+// 2e-6 absolute (its (1 + g² − s²)/(2g) loses up to a few ulp of 1/|g| relative: 1e-3 ≤ |g|).
+TEST(KernelSimd, HenyeyGreensteinLanes) {
+    ParticleRng rng(20, 0, 0);
+    std::vector<float> g, x;
+    for (const float gi : {0.f, 1e-4f, -5e-4f, 1e-3f, -1.5e-3f, 0.3f, -0.5f, 0.9f, -0.99f, 0.99f}) {
+        for (const float xi : {0.f, 1 - 0x1p-24f, 0.5f, -1.f, 1.f})
+            g.push_back(gi), x.push_back(xi);
+        for (int k = 0; k < 500; ++k)
+            g.push_back(gi), x.push_back(rng.uniform_float());
+    }
+    std::vector<float> phase, cos_theta;
+    simd_henyey_greenstein(g, x, phase, cos_theta);
+    double worst_phase = 0, worst_cos = 0;
+    for (std::size_t j = 0; j < g.size(); ++j) {
+        const float p = hg_phase(x[j], g[j]), c = sample_hg_cos_theta(g[j], x[j]);
+        ASSERT_TRUE(std::isfinite(phase[j]) && std::isfinite(cos_theta[j])) << g[j] << ' ' << x[j];
+        const double gd = g[j], xd = x[j];
+        const double denom = 1 + gd * gd - 2 * gd * xd;
+        const double kappa = (1 + gd * gd + 2 * std::abs(gd * xd)) / denom;
+        worst_phase = std::max(
+            worst_phase, std::abs(double(phase[j]) / p - 1) / ((1 + 1.5 * kappa) * 8 * 0x1p-24));
+        worst_cos = std::max(worst_cos, std::abs(double(cos_theta[j]) - c));
+    }
+    EXPECT_LE(worst_phase, 1.0) << simd_target_name();  // in units of the bound
+    EXPECT_LE(worst_cos, 2e-6) << simd_target_name();
+}
+
 // cos and sin of 2πu against double precision for every 2^-18 step of u and around every octant
 // boundary, within 2 float ulps of 1.
 TEST(KernelSimd, AzimuthCosineAndSine) {
@@ -69,17 +224,21 @@ TEST(KernelSimd, AzimuthCosineAndSine) {
 // come from the same distribution (central limit: bins with at least ~100 expected exits); Σ z²
 // over the bins of one channel is χ² with as many degrees of freedom. Each channel is one test at
 // the Šidák-corrected level of the suite (1 % overall for the 24 tests below).
-constexpr int kTwoSampleTests = 24;
+constexpr int kTwoSampleTests = 30;
 
+// `scalar_tweak` adjusts the scalar run's settings (the SIMD run keeps the defaults).
 void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
-                              std::uint64_t particles) {
+                              std::uint64_t particles,
+                              const std::function<void(SimulationSettings&)>& scalar_tweak = {}) {
     SimulationSettings s;
     s.theta_i_deg = std::move(theta_i);
     s.particles = particles;
     s.grid = HemisphereGrid(18, 18);
     s.kernel = Kernel::Scalar;
     s.seed = 11;
-    const SimulationResult a = simulate(stack, s);
+    SimulationSettings scalar = s;
+    if (scalar_tweak) scalar_tweak(scalar);
+    const SimulationResult a = simulate(stack, scalar);
     s.kernel = Kernel::Simd;
     s.seed = 12;
     const SimulationResult b = simulate(stack, s);
@@ -144,6 +303,18 @@ TEST(KernelSimdStat, SameTablesAsScalarRoughSlab) {
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.3), Rgbd(0.1, 0.0, 0.9)),
                           test::dielectric_layer(1.0, 0.5)}),
         {10, 70}, 1'000'000);
+}
+
+// The microsurface walk cut after its first facet (scalar kernel) and the single-scattering
+// interface with the default, Smith, refraction masking (SIMD kernel) are one BSDF
+// (physics/microsurface_walk.h derives it): a very rough slab at grazing incidence, where the
+// Smith and pbrt forms of the refraction masking differ by a third of the transmitted energy.
+TEST(KernelSimdStat, WalkFirstOrderIsTheSmithMaskedInterface) {
+    expect_same_distribution(test::make_stack({test::dielectric_layer(1.5, 0.7)}), {75}, 1'000'000,
+                             [](SimulationSettings& s) {
+                                 s.microsurface = Microsurface::Multiple;
+                                 s.max_microsurface_order = 1;
+                             });
 }
 
 TEST(KernelSimdStat, SameTablesAsScalarScatteringMediumSpectral) {

@@ -160,6 +160,9 @@ expect_error "--microsurface: multiple scattering on the microsurfaces runs on t
 expect_error "--microsurface: 'double' is not a microsurface model" \
     study --microsurface double --kernel scalar --only 'plastic-P1-a0.05' --out "$tmp/x"
 
+expect_error "--transmission-masking: 'walter' is not a transmission masking" \
+    study --transmission-masking walter --only 'plastic-P1-a0.05' --out "$tmp/x"
+
 # 7. A multiple-scattering reference: its own cache pieces (the key says so), nothing lost to the
 #    microsurfaces in the budgets, and study.json and summary.json say which reference it is.
 ms=(--only 'plastic-P1-a0.05' --models ww-prime --theta-i 60 --particles 2e4 --grid 18x18
@@ -200,6 +203,14 @@ PY
 grep -q '^## For engine developers' "$tmp/p/summary.md" && ok || fail "engine developers section"
 expect_error "model 'openpbr' has no option 'tint'" study --models openpbr:tint=off \
     --only 'plastic-P1-a0.05' --out "$tmp/x"
+# 9. The refraction masking: a pbrt reference of a rough-coated configuration is a cache piece of
+#    its own (a cache made before the option, with that form, stays valid for it; one made with
+#    the Smith form is never reused as pbrt), and study.json says which.
+"$lamina" study "${ms[@]}" --transmission-masking pbrt --out "$tmp/m" >/dev/null 2>&1 \
+    && ok || fail "pbrt-masking study"
+[ "$(find "$tmp/m/cache" -name '*.bin' | wc -l)" -eq 3 ] && ok || fail "one cache piece per masking"
+python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['transmission_masking'] == 'pbrt'" \
+    "$tmp/m/study.json" && ok || fail "study.json transmission_masking"
 
 echo "$pass passed, $fails failed"
 [ "$fails" -eq 0 ]

@@ -1,0 +1,56 @@
+#pragma once
+// Lane types. A formula written once as a branch-free template over a lane type T runs on one
+// value (T = float or double, masks are bool) and on the lanes of a SIMD vector (the particle
+// kernel instantiates it with Highway vectors, simulator/kernel_simd.cpp, through an operations
+// struct of the same shape as Lane<T>). The template reads its arithmetic from the operators
+// (+, −, ·, / are defined for both) and everything else from the operations struct L:
+//
+//   L::constant(x)   the double x as a lane value (rounded to T)
+//   L::min/max/sqrt  lane-wise
+//   L::log/log1p/exp lane-wise, the C library's (scalar) or Highway's (vectors: ≤ 4 ulp)
+//   L::select(m,a,b) a where the mask m holds, else b
+//   L::less(a, b)    the mask a < b
+//
+// Lane headers. Vector code must be compiled once per instruction set, inside Highway's target
+// regions, so a header of lane templates (core/beta_function.h, physics/smith_masking.h) is
+// included twice over: once as an ordinary header (its templates in namespace lamina, for scalar
+// code), and once per instruction set by the SIMD kernel, which defines LAMINA_LANE_TARGET and
+// LAMINA_LANE_BEGIN/END (simulator/kernel_simd.cpp) to put the same templates into that target's
+// namespace. Such a header has no #pragma once but the guard below (Highway's per-target
+// include guard, keyed on HWY_TARGET_TOGGLE), and holds nothing but lane templates.
+//
+// Scalar instantiations are the readable reference; the lane tests check the vector
+// instantiations against them (tests/simulator/kernel_simd_test.cpp).
+
+#include <cmath>
+#include <concepts>
+
+#ifndef LAMINA_LANE_BEGIN
+#define LAMINA_LANE_BEGIN namespace lamina {
+#define LAMINA_LANE_END }
+#endif
+
+namespace lamina {
+
+template <typename T>
+struct Lane;
+
+template <std::floating_point T>
+struct Lane<T> {
+    using Value = T;
+    using Mask = bool;
+    static T constant(double x) { return T(x); }
+    static T min(T a, T b) { return a < b ? a : b; }
+    static T max(T a, T b) { return a > b ? a : b; }
+    static T sqrt(T x) { return std::sqrt(x); }
+    static T log(T x) { return std::log(x); }
+    static T log1p(T x) { return std::log1p(x); }
+    static T exp(T x) { return std::exp(x); }
+    static T select(bool m, T a, T b) { return m ? a : b; }
+    static bool less(T a, T b) { return a < b; }
+    /// The largest argument the lane's special functions take without overflow in their
+    /// intermediate products (core/beta_function.h).
+    static constexpr double kBetaArgumentMax = sizeof(T) == 4 ? 1e7 : 1e15;
+};
+
+}  // namespace lamina
