@@ -38,6 +38,12 @@ double k_node(int i) {
     return FgdTable::kKMax * sqr(double(i) / (FgdTable::kNk - 1));
 }
 
+/// x limited to [lo, hi] for a table coordinate, NaN going to lo: an index computed from NaN would
+/// be undefined behaviour and read outside the table.
+double axis(double x, double lo, double hi) {
+    return x >= lo ? (x <= hi ? x : hi) : lo;
+}
+
 /// Calls visit(x = wi·wm, weight·G2/G1) for each node of the n_r × n_phi visible-normal rule.
 template <typename Visit>
 void visible_normal_rule(double c, double alpha, int n_r, int n_phi, Visit&& visit) {
@@ -176,9 +182,9 @@ const FgdTable& FgdTable::get() {
 }
 
 FgdTable::Index FgdTable::locate(double eta, double k) {
-    const double fe = (clamp(std::log2(eta), kLog2EtaMin, kLog2EtaMax) - kLog2EtaMin) /
+    const double fe = (axis(std::log2(eta), kLog2EtaMin, kLog2EtaMax) - kLog2EtaMin) /
                       (kLog2EtaMax - kLog2EtaMin) * (kNeta - 1);
-    const double fk = std::sqrt(clamp(k, 0.0, kKMax) / kKMax) * (kNk - 1);
+    const double fk = std::sqrt(axis(k, 0.0, kKMax) / kKMax) * (kNk - 1);
     Index at;
     at.eta = eta;
     at.k = k;
@@ -196,8 +202,8 @@ double FgdTable::operator()(double c, double alpha, double eta, double k) const 
 Rgbd FgdTable::rgb(double c, double alpha, const std::array<Index, 3>& at) const {
     const Rgbd eta(at[0].eta, at[1].eta, at[2].eta), k(at[0].k, at[1].k, at[2].k);
     if (alpha <= 0) return fresnel_complex_rgb(c, eta, k);
-    const double fc = std::sqrt(clamp(c, 0.0, 1.0)) * (kNc - 1);
-    const double fa = std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1);
+    const double fc = std::sqrt(axis(c, 0.0, 1.0)) * (kNc - 1);
+    const double fa = std::sqrt(axis(alpha, 0.0, 1.0)) * (kNalpha - 1);
     const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2);
     const double tc = fc - ic, ta = fa - ia;
     Rgbd out(0.0);
@@ -223,8 +229,8 @@ Rgbd FgdTable::rgb(double c, double alpha, const std::array<Index, 3>& at) const
 
 double FgdTable::operator()(double c, double alpha, const Index& at) const {
     if (alpha <= 0) return fresnel_any(c, at.eta, at.k);  // the smooth limit is exact Fresnel
-    const double fc = std::sqrt(clamp(c, 0.0, 1.0)) * (kNc - 1);
-    const double fa = std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1);
+    const double fc = std::sqrt(axis(c, 0.0, 1.0)) * (kNc - 1);
+    const double fa = std::sqrt(axis(alpha, 0.0, 1.0)) * (kNalpha - 1);
     const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2);
     const double tc = fc - ic, ta = fa - ia, te = at.te, tk = at.tk;
     double sum = 0;

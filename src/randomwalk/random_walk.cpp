@@ -546,7 +546,9 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 const double p1 =
                     ws.prev_pdf * survival_proxy(conn->inner, ws.prev_depth / std::abs(d.z));
                 const double p2 = it.dielectric.pdf(wo, wi_local);
-                return p1 / (p1 + p2);
+                // Both densities vanish when strategy 2 cannot make this path (p2 = 0) and the
+                // survival proxy underflows (a deep, dense medium): strategy 1 alone, weight 1.
+                return p1 + p2 > 0 ? p1 / (p1 + p2) : 1.0;
             }
         };
         // Next event at a non-delta interface: into region k (up) and, for a dielectric, region

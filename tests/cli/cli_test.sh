@@ -71,22 +71,22 @@ bad rgb-length '/layers/0/interface/albedo: expected a number or an array of 3 n
     '{"layers": [{"interface": {"type": "lambertian", "albedo": [0.8, 0.2]}}]}'
 bad overflow '/layers/0/medium/tau_a/1: number overflow parsing '"'"'1e999'"'" \
     "{\"layers\": [{\"interface\": $coat, \"medium\": {\"tau_a\": [0, 1e999, 0]}}, $base]}"
-bad eta '/layers/0/interface/eta: got -1.5; allowed: > 0' \
+bad eta '/layers/0/interface/eta: got -1.5; allowed: [1, 5]' \
     '{"layers": [{"interface": {"type": "dielectric", "eta": -1.5, "alpha": 0.1}}]}'
 bad eta-rgb '/layers/0/interface/eta: a dielectric'"'"'s eta must be a single number' \
     '{"layers": [{"interface": {"type": "dielectric", "eta": [1.5, 1.5, 1.5], "alpha": 0.1}}]}'
-bad ambient-eta '/ambient_eta: got 0; allowed: > 0' "{\"ambient_eta\": 0, \"layers\": [$base]}"
-bad alpha '/layers/0/interface/alpha: got 1.5; allowed: [0, 1]' \
+bad ambient-eta '/ambient_eta: got 0; allowed: [1, 5]' "{\"ambient_eta\": 0, \"layers\": [$base]}"
+bad alpha '/layers/0/interface/alpha: got 1.5; allowed: 0 (smooth) or [0.0001, 1]' \
     '{"layers": [{"interface": {"type": "dielectric", "eta": 1.5, "alpha": 1.5}}]}'
 bad alpha-missing '/layers/0/interface/alpha: missing required key "alpha"' \
     '{"layers": [{"interface": {"type": "conductor", "eta": 0.2, "k": 3}}]}'
-bad tau '/layers/0/medium/tau_s: got -0.5; allowed: >= 0' \
+bad tau '/layers/0/medium/tau_s: got -0.5; allowed: [0, 100]' \
     "{\"layers\": [{\"interface\": $coat, \"medium\": {\"tau_s\": -0.5}}, $base]}"
-bad g '/layers/0/medium/g: got 1; allowed: (-1, 1)' \
+bad g '/layers/0/medium/g: got 1; allowed: [-0.99, 0.99]' \
     "{\"layers\": [{\"interface\": $coat, \"medium\": {\"g\": 1}}, $base]}"
 bad albedo '/layers/0/interface/albedo/0: got 1.2; allowed: [0, 1]' \
     '{"layers": [{"interface": {"type": "lambertian", "albedo": [1.2, 0.2, 0.1]}}]}'
-bad k '/layers/0/interface/k/2: got -3; allowed: >= 0' \
+bad k '/layers/0/interface/k/2: got -3; allowed: [0, 10]' \
     '{"layers": [{"interface": {"type": "conductor", "eta": 0.2, "k": [3, 3, -3], "alpha": 0}}]}'
 bad interface-type '/layers/0/interface/type: unknown interface type "metal"' \
     '{"layers": [{"interface": {"type": "metal", "eta": 0.2, "k": 3, "alpha": 0}}]}'
