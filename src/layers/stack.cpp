@@ -526,9 +526,11 @@ json parse_text(const std::string& text, const std::string& where) {
                                      near.empty() ? "" : fmt::format(" (near {})", near)));
     } catch (const json::out_of_range& e) {
         // 406: a number literal beyond the range of a double, e.g. 1e999 (it would be infinite).
+        const std::string at = tracker.pending_pointer();
         throw InputError(
-            where, tracker.pending_pointer(),
-            fmt::format("{}: not a finite number; allowed: finite numbers", parser_message(e)));
+            where, at,
+            fmt::format("{}: not a finite number; allowed: finite numbers{}", parser_message(e),
+                        at.empty() ? " (the whole file is this number)" : ""));
     } catch (const json::exception& e) {
         throw InputError(where, "", fmt::format("malformed JSON: {}", parser_message(e)));
     }

@@ -128,10 +128,12 @@ double fresnel_complex_fast(double cos_theta, double eta, double k) {
     const double a = safe_sqrt(0.5 * (a2_plus_b2 + t0));
     const double t2 = 2 * cos_theta * a;
     if (t1 + t2 <= 0) return 1;  // grazing onto an index-matched interface: the limit c → 0
-    const double rs = (t1 - t2) / (t1 + t2);
+    // t1 − t2 and t3 − t4 are sums of squares (physics/fresnel.h, fresnel_conductor): clamped at 0
+    // against the rounding that makes them slightly negative near η = 1, κ = 0.
+    const double rs = max0(t1 - t2) / (t1 + t2);
     const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
     const double t4 = t2 * sin2;
-    const double rp = rs * (t3 - t4) / (t3 + t4);
+    const double rp = rs * max0(t3 - t4) / (t3 + t4);
     return 0.5 * (rp + rs);
 }
 
@@ -149,10 +151,11 @@ Rgbd fresnel_complex_rgb(double cos_theta, const Rgbd& eta, const Rgbd& k) {
         const double t1 = a2_plus_b2 + cos2;
         const double a = std::sqrt(std::max(0.5 * (a2_plus_b2 + t0), 0.0));
         const double t2 = 2 * cos_theta * a;
-        const double rs = (t1 - t2) / std::max(t1 + t2, 1e-300);
+        // Non-negative numerators (sums of squares; see fresnel_complex_fast), clamped at 0.
+        const double rs = std::max(t1 - t2, 0.0) / std::max(t1 + t2, 1e-300);
         const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
         const double t4 = t2 * sin2;
-        const double rp = rs * (t3 - t4) / std::max(t3 + t4, 1e-300);
+        const double rp = rs * std::max(t3 - t4, 0.0) / std::max(t3 + t4, 1e-300);
         out[c] = t1 + t2 > 0 ? 0.5 * (rp + rs) : 1.0;
     }
     return {out[0], out[1], out[2]};

@@ -70,7 +70,8 @@ inline T fresnel_dielectric(T cos_theta_i, T eta) {
 /// The Fresnel equations with a complex index (Born & Wolf §14.2) written in real arithmetic:
 /// with a² + b² = √((η² − k² − sin²θ)² + 4η²k²) and a = √((a² + b² + η² − k² − sin²θ)/2),
 ///   R_s = (a² + b² + cos²θ − 2a cos θ) / (a² + b² + cos²θ + 2a cos θ),
-///   R_p = R_s (cos²θ (a² + b²) + sin⁴θ − 2a cos θ sin²θ) / (cos²θ (a² + b²) + sin⁴θ + 2a cos θ sin²θ)
+///   R_p = R_s (cos²θ (a² + b²) + sin⁴θ − 2a cos θ sin²θ) / (cos²θ (a² + b²) + sin⁴θ + 2a cos θ
+///   sin²θ)
 /// (e.g. Lagarde 2013, "Memo on Fresnel equations"; pbrt-v3 FrConductor). With k = 0 it equals
 /// fresnel_dielectric, including total internal reflection (a = 0 gives R = 1) when eta < 1.
 template <typename T>
@@ -84,10 +85,13 @@ inline T fresnel_conductor(T cos_theta_i, T eta, T k) {
     const T a = safe_sqrt(T(0.5) * (a2_plus_b2 + t0));
     const T t1 = a2_plus_b2 + cos2;
     const T t2 = T(2) * cos_theta_i * a;
-    const T r_s = (t1 - t2) / (t1 + t2);
+    // The numerators are sums of squares, t1 − t2 = (a − cos θ)² + b² and t3 − t4 =
+    // (a cos θ − sin²θ)² + b² cos²θ, so never negative; near an index-matched interface (η ≈ 1,
+    // k ≈ 0) rounding leaves them at −1e-17 or so: clamped at 0, or R would be negative.
+    const T r_s = max0(t1 - t2) / (t1 + t2);
     const T t3 = cos2 * a2_plus_b2 + sqr(sin2);
     const T t4 = t2 * sin2;
-    const T r_p = t3 + t4 > 0 ? r_s * (t3 - t4) / (t3 + t4) : r_s;
+    const T r_p = t3 + t4 > 0 ? r_s * max0(t3 - t4) / (t3 + t4) : r_s;
     return (r_s + r_p) / T(2);
 }
 
