@@ -21,6 +21,7 @@
 #include "models/registry.h"
 #include "render/renderer.h"
 #include "simulator/goniophotometer.h"
+#include "study/configurations.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -35,6 +36,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <utility>
@@ -669,6 +671,24 @@ TEST(StackFuzz, EveryFileIsAcceptedInRangeOrRefusedByNameAndEveryResultIsFiniteA
     if (config.only < 0) {
         EXPECT_GT(accepted, cases / 5);
         EXPECT_GT(cases - accepted, cases / 5);
+    }
+}
+
+// The ranges keep every stack lamina ships valid: the examples and the study's configurations.
+TEST(StackFuzz, TheExamplesAndTheStudyConfigurationsLieInTheRanges) {
+    int examples = 0;
+    for (const auto& entry :
+         std::filesystem::directory_iterator(std::filesystem::path(LAMINA_SOURCE_DIR) / "examples"))
+        if (entry.path().extension() == ".json") {
+            EXPECT_NO_THROW(load_stack(entry.path())) << entry.path();
+            ++examples;
+        }
+    EXPECT_GE(examples, 5);
+    const auto configurations = builtin_configurations();
+    EXPECT_GE(configurations.size(), 60u);
+    for (const StudyConfiguration& c : configurations) {
+        EXPECT_EQ(outside_ranges(c.stack), "") << c.id;
+        EXPECT_NO_THROW(stack_from_json(stack_to_json(c.stack), c.id)) << c.id;
     }
 }
 
