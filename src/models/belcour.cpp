@@ -196,7 +196,12 @@ namespace {
 /// GGX reflection lobe shape D G2 / (4 μi μo) (Belcour 2018, Eq. 1 with the energy factored out).
 double lobe_shape(double alpha, const Vec3d& wi, const Vec3d& wo, const Vec3d& h) {
     if (alpha <= 0) return 0;
-    const GGX<double> ggx{alpha};
+    // Interfaces within rounding of index matching give accumulated lobes of roughness 1e-17 or
+    // less, whose peak 1/(πα²) overflows (found by the fuzz test). Below the smallest roughness a
+    // stack file may hold, 1e-4, a lobe is a mirror for every purpose: it is evaluated with that
+    // roughness (the same energy, a finite peak).
+    constexpr double kAlphaMin = 1e-4;
+    const GGX<double> ggx{std::max(alpha, kAlphaMin)};
     return ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
 }
 
