@@ -86,8 +86,11 @@ bool is_black(const Rgbd& w) {
     return w[0] == 0 && w[1] == 0 && w[2] == 0;
 }
 
+// A channel without extinction along a horizontal direction (an infinite path) has optical depth
+// 0 · ∞ = NaN: its transmittance is 1 (found by the fuzz test).
 Rgbd exp_neg(const Rgbd& x) {
-    return {std::exp(-x[0]), std::exp(-x[1]), std::exp(-x[2])};
+    auto t = [](double depth) { return std::isnan(depth) ? 1.0 : std::exp(-depth); };
+    return {t(x[0]), t(x[1]), t(x[2])};
 }
 
 // The probability that the walk, with flux weight W (per channel, ≥ 0) just after a vertex, is
@@ -395,7 +398,8 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
             double mix = 0;
             Rgbd tr;
             for (int k = 0; k < 3; ++k) {
-                tr[k] = std::exp(-m.tau_t[k] * to_boundary);
+                // τ = 0 along a horizontal path (to_boundary = ∞): 0 · ∞ would be NaN.
+                tr[k] = m.tau_t[k] > 0 ? std::exp(-m.tau_t[k] * to_boundary) : 1.0;
                 mix += p[k] * tr[k];
             }
             for (int k = 0; k < 3; ++k)

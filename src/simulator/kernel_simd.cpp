@@ -289,12 +289,17 @@ HWY_INLINE VF SmithRootTimesCos(const V3& w, float alpha) {
 // s = |z| r. Or G1(wo) = 2/(1 + r_o) = 2|z_o|/(|z_o| + s_o) (uncorrelated option). Zero for a
 // grazing wo, as the scalar form.
 HWY_INLINE VF Shadowing(const V3& wi, const V3& wo, float alpha, bool uncorrelated) {
+    // The ratio is ≤ 1 (Λ ≥ 0); float rounding can give 1 + 1 ulp, which booked a flux of −1e-8 as
+    // lost to the microsurface (found by the fuzz test): clamped at 1.
+    const DF df;
+    const VF one = hn::Set(df, 1.f);
     const VF z_o = hn::Abs(wo.z);
     const VF s_o = SmithRootTimesCos(wo, alpha);
-    if (uncorrelated) return hn::Div(hn::Add(z_o, z_o), hn::Add(z_o, s_o));
+    if (uncorrelated) return hn::Min(hn::Div(hn::Add(z_o, z_o), hn::Add(z_o, s_o)), one);
     const VF z_i = hn::Abs(wi.z);
     const VF s_i = SmithRootTimesCos(wi, alpha);
-    return hn::Div(hn::Mul(hn::Add(z_i, s_i), z_o), hn::MulAdd(s_i, z_o, hn::Mul(s_o, z_i)));
+    return hn::Min(
+        hn::Div(hn::Mul(hn::Add(z_i, s_i), z_o), hn::MulAdd(s_i, z_o, hn::Mul(s_o, z_i))), one);
 }
 
 // fresnel.h fresnel_conductor (real-arithmetic complex Fresnel), cos θ in [0, 1].
@@ -313,7 +318,10 @@ HWY_INLINE VF FresnelConductor(VF cos_theta, float eta, float k) {
     // (R_s + R_p)/2 with R_p = R_s (t3 − t4)/(t3 + t4) is R_s t3/(t3 + t4): one division in all.
     const VF t3 = hn::MulAdd(cos2, a2b2, hn::Mul(sin2, sin2));
     const VF t4 = hn::Mul(t2, sin2);
-    return hn::Div(hn::Mul(hn::Sub(t1, t2), t3), hn::Mul(hn::Add(t1, t2), hn::Add(t3, t4)));
+    // t1 − t2 = (a − cos θ)² + b² ≥ 0, but rounding makes it slightly negative near an
+    // index-matched conductor (η ≈ 1, k ≈ 0), and R with it: clamped at 0 (fresnel.h, as there).
+    return hn::Div(hn::Mul(hn::ZeroIfNegative(hn::Sub(t1, t2)), t3),
+                   hn::Mul(hn::Add(t1, t2), hn::Add(t3, t4)));
 }
 
 // ---- Lane state ---------------------------------------------------------------------------------
@@ -347,6 +355,14 @@ struct LaneVectors {
             const VF kept = hn::Mul(w[c], factor[c]);
             loss[term][c] = hn::Add(loss[term][c], hn::IfThenElseZero(m, hn::Sub(w[c], kept)));
             w[c] = hn::IfThenElse(m, kept, w[c]);
+        }
+    }
+    /// As Keep, with the kept flux itself rather than a factor.
+    HWY_INLINE void KeepFlux(MF m, int term, const VF kept[3]) {
+        touched[term] = true;
+        for (int c = 0; c < 3; ++c) {
+            loss[term][c] = hn::Add(loss[term][c], hn::IfThenElseZero(m, hn::Sub(w[c], kept[c])));
+            w[c] = hn::IfThenElse(m, kept[c], w[c]);
         }
     }
     HWY_INLINE void Keep(MF m, int term, VF factor) {
@@ -566,26 +582,41 @@ HWY_INLINE void ScatteringStep(const TraceMedium& med, MF m, LaneVectors& v, VF 
     const VF t = hn::IfThenElse(leaves, to_boundary, hn::IfThenElseZero(scatters, flight));
     VF e[3], mix = zero, mix_scatter = zero;
     for (int c = 0; c < 3; ++c) {
-        e[c] = hn::Exp(df, hn::Mul(hn::Set(df, -med.tau_t[c]), t));
+        // A clear channel along a horizontal path (t = ∞): 0 · ∞ would be NaN; transmittance 1.
+        e[c] = med.tau_t[c] > 0 ? hn::Exp(df, hn::Mul(hn::Set(df, -med.tau_t[c]), t)) : one;
         mix = hn::MulAdd(p[c], e[c], mix);
         mix_scatter = hn::MulAdd(hn::Mul(p[c], hn::Set(df, med.tau_t[c])), e[c], mix_scatter);
     }
     const MF mix_ok = hn::And(hn::Gt(mix, zero), has_flux);
-    const VF inv_mix = hn::Div(one, hn::IfThenElse(mix_ok, mix, one));
-    const VF inv_mix_s = hn::Div(one, hn::IfThenElse(hn::Gt(mix_scatter, zero), mix_scatter, one));
-    VF factor[3];
     if (med.uniform_tau_t) {
         // One extinction for all channels: no spectral MIS; leaving keeps the flux, a scattering
         // event multiplies it by the single-scattering albedo (as the scalar kernel).
+        VF factor[3];
         for (int c = 0; c < 3; ++c)
             factor[c] = hn::IfThenElse(leaves, one, hn::Set(df, med.single_scattering_albedo[c]));
+        v.Keep(m, kLossMedium, factor);
     } else {
-        for (int c = 0; c < 3; ++c)
-            factor[c] =
-                hn::IfThenElse(leaves, hn::IfThenElse(has_flux, hn::Mul(e[c], inv_mix), one),
-                               hn::Mul(hn::Mul(hn::Set(df, med.tau_s[c]), e[c]), inv_mix_s));
+        // The new flux w_c·T_c/mix written as total·(p_c T_c)/mix: p_c T_c ≤ mix, so the ratio
+        // is at most 1 and nothing overflows. (As w_c · (T_c/mix), a channel with a tiny share
+        // p_c, whose T_c/mix ≈ 1/p_c exceeds the float range, became ∞ or NaN: the fuzz test
+        // found it on stacks whose channels' optical depths differ by 10^150.)
+        VF kept[3];
+        for (int c = 0; c < 3; ++c) {
+            const VF leave_kept = hn::IfThenElse(
+                mix_ok,
+                hn::Mul(total, hn::Div(hn::Mul(p[c], e[c]), hn::IfThenElse(mix_ok, mix, one))),
+                hn::Mul(v.w[c], e[c]));
+            const VF share_s = hn::Mul(hn::Mul(p[c], hn::Set(df, med.tau_s[c])), e[c]);
+            const MF mix_s_ok = hn::Gt(mix_scatter, zero);
+            const VF scatter_kept = hn::IfThenElse(
+                mix_s_ok,
+                hn::Mul(total, hn::Div(share_s, hn::IfThenElse(mix_s_ok, mix_scatter, one))),
+                hn::Mul(v.w[c], hn::Mul(hn::Set(df, med.tau_s[c]), e[c])));
+            kept[c] =
+                hn::IfThenElse(leaves, hn::IfThenElse(has_flux, leave_kept, v.w[c]), scatter_kept);
+        }
+        v.KeepFlux(m, kLossMedium, kept);
     }
-    v.Keep(m, kLossMedium, factor);
 
     // Leaving lanes arrive at the interface above (k) or below (k + 1).
     const MI leave_i = hn::RebindMask(di, leaves);

@@ -10,7 +10,8 @@
 // In `make test` a fixed seed and a fixed number of cases (a few seconds). For longer runs:
 //   LAMINA_FUZZ_SECONDS=3600 build/lamina_tests --gtest_filter='StackFuzz.*'
 // with LAMINA_FUZZ_SEED to change the seed and LAMINA_FUZZ_CASE=N to rerun the one case N that
-// failed (each case is drawn from its own generator, keyed by seed and case number).
+// failed (each case is drawn from its own generator, keyed by seed and case number; its file is
+// then written to the working directory as fuzz-SEED-N.json).
 #include "core/error.h"
 #include "core/math.h"
 #include "core/rng.h"
@@ -37,6 +38,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <utility>
@@ -592,6 +594,7 @@ void run_case(const FuzzConfig& config, long index, Failures& failures, long& ac
         g_crash_note, sizeof g_crash_note,
         "\nfuzz: crashed in case %ld (rerun: LAMINA_FUZZ_SEED=%llu LAMINA_FUZZ_CASE=%ld)\n", index,
         static_cast<unsigned long long>(config.seed), index);
+    if (config.only >= 0) std::ofstream(c.where, std::ios::binary) << c.text;  // to reproduce
     Stack stack;
     try {
         stack = parse_stack(c.text, c.where);
