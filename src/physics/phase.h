@@ -15,6 +15,10 @@ namespace lamina {
 
 template <typename T>
 inline T hg_phase(T cos_theta, T g) {
+    // The dot product of two unit vectors in float can exceed 1 by rounding (1.00006 was seen);
+    // with |g| near 1 the denominator (1 − g)² − 2g(cos θ − 1) then turns negative and the phase
+    // infinite or NaN (found by the fuzz test): cos θ is clamped to [−1, 1].
+    cos_theta = clamp(cos_theta, T(-1), T(1));
     const T denom = T(1) + sqr(g) - T(2) * g * cos_theta;
     return (T(1) - sqr(g)) / (T(4) * kPi<T> * denom * safe_sqrt(denom));
 }

@@ -538,6 +538,8 @@ HWY_INLINE V3 SampleHg(const V3& d, VF g, VF u1, VF u2) {
 HWY_INLINE VF HgPhase(VF cos_theta, VF g) {
     const DF df;
     const VF one = hn::Set(df, 1.f);
+    // cos θ of two float unit vectors can exceed 1 by rounding: clamped (phase.h, as there).
+    cos_theta = hn::Min(hn::Max(cos_theta, hn::Neg(one)), one);
     const VF g2 = hn::Mul(g, g);
     const VF denom = hn::Sub(hn::Add(one, g2), hn::Mul(hn::Mul(hn::Set(df, 2.f), g), cos_theta));
     return hn::Div(hn::Sub(one, g2),
