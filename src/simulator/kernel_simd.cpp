@@ -357,14 +357,6 @@ struct LaneVectors {
             w[c] = hn::IfThenElse(m, kept, w[c]);
         }
     }
-    /// As Keep, with the kept flux itself rather than a factor.
-    HWY_INLINE void KeepFlux(MF m, int term, const VF kept[3]) {
-        touched[term] = true;
-        for (int c = 0; c < 3; ++c) {
-            loss[term][c] = hn::Add(loss[term][c], hn::IfThenElseZero(m, hn::Sub(w[c], kept[c])));
-            w[c] = hn::IfThenElse(m, kept[c], w[c]);
-        }
-    }
     HWY_INLINE void Keep(MF m, int term, VF factor) {
         const VF f[3] = {factor, factor, factor};
         Keep(m, term, f);
@@ -590,35 +582,21 @@ HWY_INLINE void ScatteringStep(const TraceMedium& med, MF m, LaneVectors& v, VF 
         mix_scatter = hn::MulAdd(hn::Mul(p[c], hn::Set(df, med.tau_t[c])), e[c], mix_scatter);
     }
     const MF mix_ok = hn::And(hn::Gt(mix, zero), has_flux);
+    const VF inv_mix = hn::Div(one, hn::IfThenElse(mix_ok, mix, one));
+    const VF inv_mix_s = hn::Div(one, hn::IfThenElse(hn::Gt(mix_scatter, zero), mix_scatter, one));
+    VF factor[3];
     if (med.uniform_tau_t) {
         // One extinction for all channels: no spectral MIS; leaving keeps the flux, a scattering
         // event multiplies it by the single-scattering albedo (as the scalar kernel).
-        VF factor[3];
         for (int c = 0; c < 3; ++c)
             factor[c] = hn::IfThenElse(leaves, one, hn::Set(df, med.single_scattering_albedo[c]));
-        v.Keep(m, kLossMedium, factor);
     } else {
-        // The new flux w_c·T_c/mix written as total·(p_c T_c)/mix: p_c T_c ≤ mix, so the ratio
-        // is at most 1 and nothing overflows. (As w_c · (T_c/mix), a channel with a tiny share
-        // p_c, whose T_c/mix ≈ 1/p_c exceeds the float range, became ∞ or NaN: the fuzz test
-        // found it on stacks whose channels' optical depths differ by 10^150.)
-        VF kept[3];
-        for (int c = 0; c < 3; ++c) {
-            const VF leave_kept = hn::IfThenElse(
-                mix_ok,
-                hn::Mul(total, hn::Div(hn::Mul(p[c], e[c]), hn::IfThenElse(mix_ok, mix, one))),
-                hn::Mul(v.w[c], e[c]));
-            const VF share_s = hn::Mul(hn::Mul(p[c], hn::Set(df, med.tau_s[c])), e[c]);
-            const MF mix_s_ok = hn::Gt(mix_scatter, zero);
-            const VF scatter_kept = hn::IfThenElse(
-                mix_s_ok,
-                hn::Mul(total, hn::Div(share_s, hn::IfThenElse(mix_s_ok, mix_scatter, one))),
-                hn::Mul(v.w[c], hn::Mul(hn::Set(df, med.tau_s[c]), e[c])));
-            kept[c] =
-                hn::IfThenElse(leaves, hn::IfThenElse(has_flux, leave_kept, v.w[c]), scatter_kept);
-        }
-        v.KeepFlux(m, kLossMedium, kept);
+        for (int c = 0; c < 3; ++c)
+            factor[c] =
+                hn::IfThenElse(leaves, hn::IfThenElse(has_flux, hn::Mul(e[c], inv_mix), one),
+                               hn::Mul(hn::Mul(hn::Set(df, med.tau_s[c]), e[c]), inv_mix_s));
     }
+    v.Keep(m, kLossMedium, factor);
 
     // Leaving lanes arrive at the interface above (k) or below (k + 1).
     const MI leave_i = hn::RebindMask(di, leaves);
