@@ -215,12 +215,12 @@ Runner add_eval(CLI::App& app) {
     cmd->add_option("--samples", a->samples,
                     "random-walk: walks per query (default: its samples option, 1024); a point "
                     "evaluation then prints f_r f_g f_b se_r se_g se_b")
-        ->check(CLI::PositiveNumber);
+        ->check(CLI::Range(1.0, 1.8e19));  // ≥ 1 (as a double: "-3" must not wrap around)
     cmd->add_flag("--pdf", a->pdf,
                   "random-walk, one point: print the exit density of its sampling at wo and its "
                   "standard error (pdf se, 1/sr) instead of f");
     cmd->add_option("--seed", a->seed, "random-walk: seed of the walks (≥ 1)")
-        ->check(CLI::PositiveNumber);
+        ->check(CLI::Range(1.0, 1.8e19));  // ≥ 1 (as a double: "-3" must not wrap around)
     cmd->add_option("--option", a->options,
                     "Model flag KEY=VALUE, repeatable (see `lamina models --options`)");
     return [a] { return run_eval(*a); };

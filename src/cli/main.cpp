@@ -1,5 +1,6 @@
 // lamina command-line interface: one subcommand per cmd_*.cpp, registered in the table below.
 #include "cli/commands.h"
+#include "cli/parse_errors.h"
 #include "core/error.h"
 #include "distributed/communicator.h"
 #include "lamina/version.h"
@@ -34,7 +35,6 @@ int main(int argc, char** argv) {
     add(lamina::cli::add_figures);
     add(lamina::cli::add_export);
 
-    CLI11_PARSE(app, argc, argv);
     // Under an MPI launcher every process gets here; an error on any of them ends them all
     // (distributed/communicator.h), so that none waits forever for the others.
     lamina::Communicator* world = nullptr;
@@ -43,6 +43,14 @@ int main(int argc, char** argv) {
         fmt::print(stderr, "lamina: {}\n", message);
         return 1;
     };
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::Success& e) {
+        return app.exit(e);  // --help, --version: printed by CLI11, exit code 0
+    } catch (const CLI::ParseError& e) {
+        // CLI11's errors exit like lamina's: one "lamina: command line: ..." line, exit code 1.
+        return fail(lamina::cli::input_error_from(e, app).what());
+    }
     try {
         world = &lamina::Communicator::world();
         for (auto& [sub, run] : commands) {

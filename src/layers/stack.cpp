@@ -56,12 +56,39 @@ std::string child(const std::string& pointer, std::size_t index) {
 }
 
 /// The value as the user wrote it (numbers in shortest round-trip form; NaN and inf by name,
-/// which json::dump would print as null), shortened to one readable line.
+/// which json::dump would print as null), shortened to one readable line. Written here rather
+/// than with json::dump, which recurses once per nesting level (a file of 10^5 nested brackets
+/// would overflow the stack) and prints the whole value before it could be shortened: this one
+/// stops after kShowMax characters and shows containers nested deeper than three levels as "...".
+constexpr std::size_t kShowMax = 60;
+void append_shown(std::string& out, const json& value, int depth) {
+    if (out.size() > kShowMax) return;
+    if (value.is_array() || value.is_object()) {
+        out += value.is_array() ? '[' : '{';
+        if (depth >= 3 && !value.empty())
+            out += "...";
+        else {
+            bool first = true;
+            for (auto it = value.begin(); it != value.end() && out.size() <= kShowMax; ++it) {
+                if (!first) out += ',';
+                first = false;
+                if (value.is_object()) out += json(it.key()).dump() + ':';
+                append_shown(out, *it, depth + 1);
+            }
+        }
+        out += value.is_array() ? ']' : '}';
+    } else if (value.is_number_float()) {
+        out += fmt::format("{}", value.get<double>());
+    } else if (value.is_string() && value.get_ref<const std::string&>().size() > kShowMax) {
+        out += json(value.get_ref<const std::string&>().substr(0, kShowMax)).dump();
+    } else {
+        out += value.dump();
+    }
+}
 std::string show(const json& value) {
-    std::string text =
-        value.is_number_float() ? fmt::format("{}", value.get<double>()) : value.dump();
-    constexpr std::size_t kMax = 60;
-    if (text.size() > kMax) text = text.substr(0, kMax - 3) + "...";
+    std::string text;
+    append_shown(text, value, 0);
+    if (text.size() > kShowMax) text = text.substr(0, kShowMax - 3) + "...";
     return text;
 }
 
@@ -160,17 +187,36 @@ constexpr std::string_view kConductorKeys[] = {"type", "eta", "k", "alpha"};
 constexpr std::string_view kLambertianKeys[] = {"type", "albedo"};
 constexpr std::string_view kMediumKeys[] = {"tau_a", "tau_s", "g"};
 
-constexpr std::string_view kAlphaHint = "GGX roughness in [0, 1]; write 0 for a smooth interface";
+constexpr std::string_view kAlphaHint =
+    "GGX roughness, 0 or in [0.0001, 1]; write 0 for a smooth interface";
 
 /// A constraint on one number: the test and how it reads in a message.
 struct Allowed {
     bool (*ok)(double);
     std::string_view text;
 };
-constexpr Allowed kPositive{[](double v) { return v > 0; }, "> 0"};
-constexpr Allowed kNonNegative{[](double v) { return v >= 0; }, ">= 0"};
+// The physical ranges (docs/stack-format.md, "Ranges", says why each bound is where it is). They
+// keep every number inside the domain the estimators are written for: relative dielectric indices
+// within [1/5, 5] (the TIR and FGD tables of models/ cover it), roughnesses whose α² and GGX peak
+// 1/(πα²) are normal floats, optical depths whose attenuation is still above float's smallest
+// normal number, and HG phase functions whose 1 − g² survives float rounding.
+constexpr double kEtaDielectricMin = 1, kEtaDielectricMax = 5;
+constexpr double kEtaConductorMin = 0.01, kEtaConductorMax = 10, kKConductorMax = 10;
+constexpr double kAlphaRoughMin = 1e-4;
+constexpr double kTauMax = 100;
+constexpr double kGMax = 0.99;
+constexpr std::size_t kMaxLayers = 100;
+
+constexpr Allowed kDielectricEta{
+    [](double v) { return v >= kEtaDielectricMin && v <= kEtaDielectricMax; }, "[1, 5]"};
+constexpr Allowed kConductorEta{
+    [](double v) { return v >= kEtaConductorMin && v <= kEtaConductorMax; }, "[0.01, 10]"};
+constexpr Allowed kConductorK{[](double v) { return v >= 0 && v <= kKConductorMax; }, "[0, 10]"};
+constexpr Allowed kAlpha{[](double v) { return v == 0 || (v >= kAlphaRoughMin && v <= 1); },
+                         "0 (smooth) or [0.0001, 1]"};
+constexpr Allowed kOpticalDepth{[](double v) { return v >= 0 && v <= kTauMax; }, "[0, 100]"};
 constexpr Allowed kUnit{[](double v) { return v >= 0 && v <= 1; }, "[0, 1]"};
-constexpr Allowed kOpenUnitBall{[](double v) { return v > -1 && v < 1; }, "(-1, 1), i.e. |g| < 1"};
+constexpr Allowed kHgG{[](double v) { return v >= -kGMax && v <= kGMax; }, "[-0.99, 0.99]"};
 
 class Reader {
   public:
@@ -199,7 +245,7 @@ class Reader {
             if (s.name.empty()) s.name = "stack";
         }
         if (j.contains("ambient_eta"))
-            s.ambient_eta = number(j["ambient_eta"], "/ambient_eta", kPositive,
+            s.ambient_eta = number(j["ambient_eta"], "/ambient_eta", kDielectricEta,
                                    "absolute refractive index of the ambient medium");
 
         const json& layers = required(j, "", "layers", "an array of layers, top to bottom");
@@ -210,6 +256,9 @@ class Reader {
             fail("/layers",
                  "the stack has no layers; give at least one, the last being the base, e.g. "
                  "{\"interface\": {\"type\": \"lambertian\", \"albedo\": 0.8}}");
+        if (layers.size() > kMaxLayers)
+            fail("/layers", fmt::format("the stack has {} layers; allowed: at most {}",
+                                        layers.size(), kMaxLayers));
         for (std::size_t i = 0; i < layers.size(); ++i)
             s.layers.push_back(layer(layers[i], child("/layers", i), i, layers.size()));
         return s;
@@ -256,7 +305,7 @@ class Reader {
                  fmt::format("got {}; allowed: a finite number {} ({})", x, allowed.text, meaning));
         if (!allowed.ok(x))
             fail(pointer, fmt::format("got {}; allowed: {} ({})", show(v), allowed.text, meaning));
-        return x;
+        return x + 0.0;  // −0 becomes +0 (the same number, printed without a sign)
     }
 
     /// A number (broadcast to the three channels) or an array of exactly three numbers.
@@ -322,29 +371,29 @@ class Reader {
         if (name == "dielectric") {
             out.type = InterfaceType::Dielectric;
             check_keys(j, pointer, kDielectricKeys, "a dielectric interface");
-            const json& eta =
-                required(j, pointer, "eta", "absolute refractive index of what lies below, > 0");
+            const json& eta = required(j, pointer, "eta",
+                                       "absolute refractive index of what lies below, in [1, 5]");
             if (eta.is_array())
                 fail(child(pointer, "eta"),
                      fmt::format("a dielectric's eta must be a single number, got {}: {}; one "
                                  "refraction path serves all channels, so RGB (dispersive) "
                                  "indices are not supported",
                                  type_phrase(eta), show(eta)));
-            out.eta = number(eta, child(pointer, "eta"), kPositive,
+            out.eta = number(eta, child(pointer, "eta"), kDielectricEta,
                              "absolute refractive index of what lies below");
             out.alpha = alpha(j, pointer, "dielectric");
         } else if (name == "conductor") {
             out.type = InterfaceType::Conductor;
             check_keys(j, pointer, kConductorKeys, "a conductor interface");
-            out.eta_rgb =
-                rgb(required(j, pointer, "eta",
-                             "real part of the absolute complex "
-                             "index, > 0, number or [R, G, B]"),
-                    child(pointer, "eta"), kPositive, "real part of the absolute complex index");
+            out.eta_rgb = rgb(required(j, pointer, "eta",
+                                       "real part of the absolute complex "
+                                       "index, in [0.01, 10], number or [R, G, B]"),
+                              child(pointer, "eta"), kConductorEta,
+                              "real part of the absolute complex index");
             out.k = rgb(required(j, pointer, "k",
-                                 "extinction coefficient, >= 0, number or "
+                                 "extinction coefficient, in [0, 10], number or "
                                  "[R, G, B]"),
-                        child(pointer, "k"), kNonNegative,
+                        child(pointer, "k"), kConductorK,
                         "extinction coefficient, imaginary part of the absolute index");
             out.alpha = alpha(j, pointer, "conductor");
         } else if (name == "lambertian") {
@@ -362,7 +411,7 @@ class Reader {
     double alpha(const json& j, const std::string& pointer, std::string_view type) const {
         const json& v = required(j, pointer, "alpha",
                                  fmt::format("a {} needs an explicit {}", type, kAlphaHint));
-        return number(v, child(pointer, "alpha"), kUnit, "GGX roughness, 0 = smooth");
+        return number(v, child(pointer, "alpha"), kAlpha, "GGX roughness, 0 = smooth");
     }
 
     MediumSpec medium(const json& j, const std::string& pointer) const {
@@ -371,14 +420,13 @@ class Reader {
         check_keys(j, pointer, kMediumKeys, "a medium");
         MediumSpec out;
         if (j.contains("tau_a"))
-            out.tau_a = rgb(j["tau_a"], child(pointer, "tau_a"), kNonNegative,
+            out.tau_a = rgb(j["tau_a"], child(pointer, "tau_a"), kOpticalDepth,
                             "absorption normal optical depth, dimensionless");
         if (j.contains("tau_s"))
-            out.tau_s = rgb(j["tau_s"], child(pointer, "tau_s"), kNonNegative,
+            out.tau_s = rgb(j["tau_s"], child(pointer, "tau_s"), kOpticalDepth,
                             "scattering normal optical depth, dimensionless");
         if (j.contains("g"))
-            out.g =
-                rgb(j["g"], child(pointer, "g"), kOpenUnitBall, "Henyey-Greenstein mean cosine");
+            out.g = rgb(j["g"], child(pointer, "g"), kHgG, "Henyey-Greenstein mean cosine");
         return out;
     }
 
@@ -394,15 +442,19 @@ class PathTracker {
   public:
     explicit PathTracker(const std::string& where) : where_(where) {}
 
-    bool operator()(int, json::parse_event_t event, json& parsed) {
+    bool operator()(int depth, json::parse_event_t event, json& parsed) {
         switch (event) {
             case json::parse_event_t::object_start:
-                element_starts();
-                frames_.push_back({true, {}, {}, 0});
-                break;
             case json::parse_event_t::array_start:
+                // A stack file nests five levels deep (stack, layers, layer, interface, RGB
+                // array); far deeper is not a stack, and would only make messages unreadable.
+                if (depth >= kMaxDepth)
+                    throw InputError(where_, pending_pointer(),
+                                     fmt::format("JSON nested more than {} levels deep; a stack "
+                                                 "file needs five",
+                                                 kMaxDepth));
                 element_starts();
-                frames_.push_back({false, {}, {}, 0});
+                frames_.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
                 break;
             case json::parse_event_t::object_end:
             case json::parse_event_t::array_end:
@@ -440,6 +492,7 @@ class PathTracker {
     }
 
   private:
+    static constexpr int kMaxDepth = 32;
     struct Frame {
         bool is_object;
         std::set<std::string> keys;
@@ -473,9 +526,11 @@ json parse_text(const std::string& text, const std::string& where) {
                                      near.empty() ? "" : fmt::format(" (near {})", near)));
     } catch (const json::out_of_range& e) {
         // 406: a number literal beyond the range of a double, e.g. 1e999 (it would be infinite).
+        const std::string at = tracker.pending_pointer();
         throw InputError(
-            where, tracker.pending_pointer(),
-            fmt::format("{}: not a finite number; allowed: finite numbers", parser_message(e)));
+            where, at,
+            fmt::format("{}: not a finite number; allowed: finite numbers{}", parser_message(e),
+                        at.empty() ? " (the whole file is this number)" : ""));
     } catch (const json::exception& e) {
         throw InputError(where, "", fmt::format("malformed JSON: {}", parser_message(e)));
     }
@@ -515,7 +570,11 @@ Stack load_stack(const std::filesystem::path& path) {
     if (in.bad())
         throw InputError(where, "",
                          fmt::format("cannot read the stack file: {}", std::strerror(errno)));
-    return stack_from_json(parse_text(text.str(), where), where);
+    return parse_stack(text.str(), where);
+}
+
+Stack parse_stack(const std::string& text, const std::string& where) {
+    return stack_from_json(parse_text(text, where), where);
 }
 
 nlohmann::json stack_to_json(const Stack& stack) {

@@ -27,7 +27,7 @@ struct InterfaceSpec {
     /// Conductor: absolute complex index eta_rgb + i·k (RGB).
     Rgbd eta_rgb{1.0};
     Rgbd k{0.0};
-    /// GGX roughness α ∈ [0, 1] of dielectric and conductor interfaces; 0 = smooth.
+    /// GGX roughness α ∈ {0} ∪ [1e-4, 1] of dielectric and conductor interfaces; 0 = smooth.
     double alpha = 0.0;
     /// Lambertian albedo ∈ [0, 1] (RGB).
     Rgbd albedo{0.0};
@@ -75,10 +75,17 @@ struct Stack {
 /// the JSON pointer of the field, the value and what is allowed, for: unknown keys (with the
 /// allowed keys and the closest one), missing required keys (`layers`, `interface`, `type`, and
 /// every key of an interface type, `alpha` included), wrong types, RGB arrays of the wrong length,
-/// NaN/inf, eta ≤ 0 (or an RGB dielectric eta), alpha outside [0, 1], optical depths < 0, |g| ≥ 1,
-/// albedo outside [0, 1], k < 0, an unknown interface type, an opaque interface that is not last, a
-/// medium under the last interface, an empty or missing `layers`, an empty name.
+/// NaN/inf, an RGB dielectric eta, any number outside its physical range (docs/stack-format.md,
+/// "Ranges": dielectric and ambient eta in [1, 5]; conductor eta in [0.01, 10], k in [0, 10]; alpha
+/// 0 or in [1e-4, 1]; tau_a, tau_s in [0, 100]; g in [-0.99, 0.99]; albedo in [0, 1]), an unknown
+/// interface type, an opaque interface that is not last, a medium under the last interface, an
+/// empty or missing `layers` or more than 100 layers, an empty name. Every stack it returns lies
+/// in those ranges: the estimators of lamina are written (and fuzzed, tests/fuzz) for them.
 Stack stack_from_json(const nlohmann::json& j, const std::string& where);
+
+/// Parses the text of a stack file (what load_stack reads); `where` names it in messages. The same
+/// InputErrors as load_stack, also for JSON nested deeper than 32 levels.
+Stack parse_stack(const std::string& text, const std::string& where);
 
 /// Reads and parses a stack file. InputError also on a missing or unreadable file, malformed JSON
 /// (with line and column), duplicate keys, and numbers that overflow a double (1e999).

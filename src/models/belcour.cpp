@@ -29,14 +29,17 @@ double variance_of(double alpha, bool quadratic) {
     return p / (1 - p);
 }
 double alpha_of(double sigma, bool quadratic) {
-    if (sigma <= 0) return 0;
-    const double s = sigma / (1 + sigma);
+    if (!(sigma > 0)) return 0;
+    const double s = 1 / (1 + 1 / sigma);  // σ/(1 + σ), also for σ = ∞ (→ 1)
     return quadratic ? std::sqrt(s) : std::pow(s, 1 / 1.1);
 }
 // Henyey–Greenstein lobe variance (Belcour 2018, §5.3 and code): σ_HG(g) = ((1 − g)/g)^0.8 / (1 +
 // g).
+// Infinite as g → 0⁺ (a subnormal g gives ∞): capped at the variance of the roughest lobe,
+// σ(kAlphaMax), which α(σ) maps to the same clamped roughness; an infinite variance would reach
+// the adding sums as ∞ · 0.
 double variance_hg(double g) {
-    return std::pow((1 - g) / g, 0.8) / (1 + g);
+    return std::min(std::pow((1 - g) / g, 0.8) / (1 + g), variance_of(kAlphaMax, false));
 }
 
 double mean(const Rgbd& x) {
@@ -190,7 +193,12 @@ void precompute_variances(std::vector<BelcourOperator>& ops, bool q) {
 
 double ggx_lobe_shape(double alpha, const Vec3d& wi, const Vec3d& wo, const Vec3d& h) {
     if (alpha <= 0) return 0;
-    const GGX<double> ggx{alpha};
+    // Interfaces within rounding of index matching give accumulated lobes of roughness 1e-17 or
+    // less, whose peak 1/(πα²) overflows (found by the fuzz test). Below the smallest roughness a
+    // stack file may hold, 1e-4, a lobe is a mirror for every purpose: it is evaluated with that
+    // roughness (the same energy, a finite peak).
+    constexpr double kAlphaMin = 1e-4;
+    const GGX<double> ggx{std::max(alpha, kAlphaMin)};
     return ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
 }
 
@@ -216,13 +224,13 @@ class BelcourModel final : public Model {
                     return;
                 case InterfaceType::Dielectric:
                     op.kind = BelcourOperator::Dielectric;
-                    op.n12 = s.eta / above;
+                    op.n12 = model_relative_eta(s.eta / above);
                     op.eta = Rgbd(op.n12);
                     break;
                 case InterfaceType::Conductor:
                     op.kind = BelcourOperator::Conductor;
-                    op.eta = s.eta_rgb / above;
-                    op.k = s.k / above;
+                    op.eta = model_relative_eta(s.eta_rgb / above);
+                    op.k = model_relative_k(s.k / above);
                     op.n12 = op.eta.mean();
                     break;
             }

@@ -38,6 +38,12 @@ double k_node(int i) {
     return FgdTable::kKMax * sqr(double(i) / (FgdTable::kNk - 1));
 }
 
+/// x limited to [lo, hi] for a table coordinate, NaN going to lo: an index computed from NaN would
+/// be undefined behaviour and read outside the table.
+double axis(double x, double lo, double hi) {
+    return x >= lo ? (x <= hi ? x : hi) : lo;
+}
+
 /// Calls visit(x = wi·wm, weight·G2/G1) for each node of the n_r × n_phi visible-normal rule.
 template <typename Visit>
 void visible_normal_rule(double c, double alpha, int n_r, int n_phi, Visit&& visit) {
@@ -122,10 +128,12 @@ double fresnel_complex_fast(double cos_theta, double eta, double k) {
     const double a = safe_sqrt(0.5 * (a2_plus_b2 + t0));
     const double t2 = 2 * cos_theta * a;
     if (t1 + t2 <= 0) return 1;  // grazing onto an index-matched interface: the limit c → 0
-    const double rs = (t1 - t2) / (t1 + t2);
+    // t1 − t2 and t3 − t4 are sums of squares (physics/fresnel.h, fresnel_conductor): clamped at 0
+    // against the rounding that makes them slightly negative near η = 1, κ = 0.
+    const double rs = max0(t1 - t2) / (t1 + t2);
     const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
     const double t4 = t2 * sin2;
-    const double rp = rs * (t3 - t4) / (t3 + t4);
+    const double rp = rs * max0(t3 - t4) / (t3 + t4);
     return 0.5 * (rp + rs);
 }
 
@@ -143,10 +151,11 @@ Rgbd fresnel_complex_rgb(double cos_theta, const Rgbd& eta, const Rgbd& k) {
         const double t1 = a2_plus_b2 + cos2;
         const double a = std::sqrt(std::max(0.5 * (a2_plus_b2 + t0), 0.0));
         const double t2 = 2 * cos_theta * a;
-        const double rs = (t1 - t2) / std::max(t1 + t2, 1e-300);
+        // Non-negative numerators (sums of squares; see fresnel_complex_fast), clamped at 0.
+        const double rs = std::max(t1 - t2, 0.0) / std::max(t1 + t2, 1e-300);
         const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
         const double t4 = t2 * sin2;
-        const double rp = rs * (t3 - t4) / std::max(t3 + t4, 1e-300);
+        const double rp = rs * std::max(t3 - t4, 0.0) / std::max(t3 + t4, 1e-300);
         out[c] = t1 + t2 > 0 ? 0.5 * (rp + rs) : 1.0;
     }
     return {out[0], out[1], out[2]};
@@ -176,9 +185,9 @@ const FgdTable& FgdTable::get() {
 }
 
 FgdTable::Index FgdTable::locate(double eta, double k) {
-    const double fe = (clamp(std::log2(eta), kLog2EtaMin, kLog2EtaMax) - kLog2EtaMin) /
+    const double fe = (axis(std::log2(eta), kLog2EtaMin, kLog2EtaMax) - kLog2EtaMin) /
                       (kLog2EtaMax - kLog2EtaMin) * (kNeta - 1);
-    const double fk = std::sqrt(clamp(k, 0.0, kKMax) / kKMax) * (kNk - 1);
+    const double fk = std::sqrt(axis(k, 0.0, kKMax) / kKMax) * (kNk - 1);
     Index at;
     at.eta = eta;
     at.k = k;
@@ -196,8 +205,8 @@ double FgdTable::operator()(double c, double alpha, double eta, double k) const 
 Rgbd FgdTable::rgb(double c, double alpha, const std::array<Index, 3>& at) const {
     const Rgbd eta(at[0].eta, at[1].eta, at[2].eta), k(at[0].k, at[1].k, at[2].k);
     if (alpha <= 0) return fresnel_complex_rgb(c, eta, k);
-    const double fc = std::sqrt(clamp(c, 0.0, 1.0)) * (kNc - 1);
-    const double fa = std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1);
+    const double fc = std::sqrt(axis(c, 0.0, 1.0)) * (kNc - 1);
+    const double fa = std::sqrt(axis(alpha, 0.0, 1.0)) * (kNalpha - 1);
     const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2);
     const double tc = fc - ic, ta = fa - ia;
     Rgbd out(0.0);
@@ -223,8 +232,8 @@ Rgbd FgdTable::rgb(double c, double alpha, const std::array<Index, 3>& at) const
 
 double FgdTable::operator()(double c, double alpha, const Index& at) const {
     if (alpha <= 0) return fresnel_any(c, at.eta, at.k);  // the smooth limit is exact Fresnel
-    const double fc = std::sqrt(clamp(c, 0.0, 1.0)) * (kNc - 1);
-    const double fa = std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1);
+    const double fc = std::sqrt(axis(c, 0.0, 1.0)) * (kNc - 1);
+    const double fa = std::sqrt(axis(alpha, 0.0, 1.0)) * (kNalpha - 1);
     const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2);
     const double tc = fc - ic, ta = fa - ia, te = at.te, tk = at.tk;
     double sum = 0;

@@ -194,7 +194,10 @@ class Lamina1 final : public Model {
         const Rgbd a_o = attenuation(wo_in.z);
         // First order: the base's lobe at the refracted directions, entering and leaving through
         // the coat's directional transmittance; 1/η0² compresses the solid angle.
-        const Rgbd fb = base_lobe(in, wi.z, wo.z, wo_in);
+        // A direction refracted onto the horizon (an index-matched coat at grazing light, where
+        // √(1 − sin²θ) rounds to 0) carries no first order: T is 0 there and the lobe 0/0.
+        const Rgbd fb =
+            in.wi_in.z > 0 && wo_in.z > 0 ? base_lobe(in, wi.z, wo.z, wo_in) : Rgbd(0.0);
         f += fb * (in.a * a_o) * (in.T * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
         if (series_on_) {
             f += in.X * X_at(wo.z) * K_ * (kInvPi<double> * inv_eta0_ * inv_eta0_);
@@ -641,11 +644,15 @@ double Lamina1::pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) 
                 pdf += m.p[1] * wo.z * kInvPi<double>;
             } else {
                 // Drawn inside the coat: dω'/dω = μo/(η0² μo') (Snell's law of solid angles).
+                // (A wo refracted onto the horizon, wo' = 0 by rounding, is never drawn: density
+                // 0.)
                 const Vec3d wo_in = refract_in(wo, inv_eta0_);
-                const Vec3d h = normalize(m.wi_in + wo_in);
-                const double pdf_in =
-                    GGX<double>{m.alpha_base}.D_visible(m.wi_in, h) / (4 * std::abs(dot(wo_in, h)));
-                pdf += m.p[1] * pdf_in * wo.z / (sqr(eta0_) * wo_in.z);
+                if (wo_in.z > 0) {
+                    const Vec3d h = normalize(m.wi_in + wo_in);
+                    const double pdf_in = GGX<double>{m.alpha_base}.D_visible(m.wi_in, h) /
+                                          (4 * std::abs(dot(wo_in, h)));
+                    pdf += m.p[1] * pdf_in * wo.z / (sqr(eta0_) * wo_in.z);
+                }
             }
         }
         if (m.p[2] > 0) pdf += m.p[2] * wo.z * kInvPi<double>;

@@ -45,7 +45,7 @@ bool coated_stack(const Stack& stack, CoatedStack& out, std::string& why) {
         return false;
     }
     out = CoatedStack{};
-    out.eta0 = coat.interface.eta / stack.ambient_eta;
+    out.eta0 = model_relative_eta(coat.interface.eta / stack.ambient_eta);
     out.alpha0 = coat.interface.alpha;
     if (coat.has_medium) {
         out.tau_a = coat.medium.tau_a;
@@ -58,10 +58,10 @@ bool coated_stack(const Stack& stack, CoatedStack& out, std::string& why) {
     out.albedo = base.albedo;
     const double eta_coat = coat.interface.eta;
     if (base.type == InterfaceType::Conductor) {
-        out.base_eta = base.eta_rgb / eta_coat;
-        out.base_k = base.k / eta_coat;
+        out.base_eta = model_relative_eta(base.eta_rgb / eta_coat);
+        out.base_k = model_relative_k(base.k / eta_coat);
     } else if (base.type == InterfaceType::Dielectric) {
-        out.base_eta = Rgbd(base.eta / eta_coat);
+        out.base_eta = Rgbd(model_relative_eta(base.eta / eta_coat));
     }
     return true;
 }

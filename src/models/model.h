@@ -123,7 +123,28 @@ struct CoatedStack {
     Rgbd albedo{0.0};
 };
 
-/// Extracts the coated shape, or explains (in `why`) why the stack has another shape.
+/// The relative indices the analytic models compute with: the real part η of an index relative to
+/// the medium above in [1e-3, 1e3], the extinction κ in [0, 1e3] (NaN goes to the lower bound).
+/// Every stack a file may hold (docs/stack-format.md, "Ranges") lies well inside (relative η in
+/// [0.002, 10], κ ≤ 10): this changes nothing for them. It keeps squares, Jacobians and table
+/// coordinates finite for stacks built in code with absurd indices (η = 1e308 or 1e-320).
+inline constexpr double kRelativeEtaMin = 1e-3, kRelativeEtaMax = 1e3, kRelativeKMax = 1e3;
+inline double model_relative_eta(double eta) {
+    return eta >= kRelativeEtaMin ? (eta <= kRelativeEtaMax ? eta : kRelativeEtaMax)
+                                  : kRelativeEtaMin;
+}
+inline double model_relative_k(double k) {
+    return k >= 0 ? (k <= kRelativeKMax ? k : kRelativeKMax) : 0.0;
+}
+inline Rgbd model_relative_eta(const Rgbd& eta) {
+    return {model_relative_eta(eta[0]), model_relative_eta(eta[1]), model_relative_eta(eta[2])};
+}
+inline Rgbd model_relative_k(const Rgbd& k) {
+    return {model_relative_k(k[0]), model_relative_k(k[1]), model_relative_k(k[2])};
+}
+
+/// Extracts the coated shape, or explains (in `why`) why the stack has another shape. The
+/// relative indices are those of model_relative_eta / model_relative_k.
 bool coated_stack(const Stack& stack, CoatedStack& out, std::string& why);
 
 /// exp of each channel.

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -416,10 +417,16 @@ std::unique_ptr<IncidentEvaluator> ProductionCoat::prepare(const Vec3d& wi) cons
 }  // namespace
 
 double openpbr_average_fresnel_fit(double eta) {
+    // The fit holds over the relative indices a stack file may give (docs/stack-format.md,
+    // "Ranges": [1/5, 5]); past η ≈ 6 it exceeds 1 and past 13.2 its denominator changes sign (a
+    // NaN for stacks built in code with absurd indices, found by tests/fuzz): η is kept in
+    // [1/5, 5] and the average in [0, 1].
+    eta = std::clamp(eta, 0.2, 5.0);
     if (eta < 1) return 1 - eta * eta * (1 - openpbr_average_fresnel_fit(1 / eta));
     // OpenPBR 1.1, footnote avg_fresnel (d'Eon 2021): ln((10893η − 1438.2)/(−774.4η² + 10212η +
     // 1)).
-    return std::log((10893 * eta - 1438.2) / (-774.4 * eta * eta + 10212 * eta + 1));
+    return std::clamp(std::log((10893 * eta - 1438.2) / (-774.4 * eta * eta + 10212 * eta + 1)),
+                      0.0, 1.0);
 }
 
 double kulla_conty_average_fresnel_fit(double eta) {

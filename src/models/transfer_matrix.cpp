@@ -283,14 +283,14 @@ class TmModel final : public Model {
                     return;
                 case InterfaceType::Dielectric:
                     k.kind = TmComponent::Dielectric;
-                    k.eta = s.eta / above;
+                    k.eta = model_relative_eta(s.eta / above);  // model.h: finite for any stack
                     k.eta_rgb = Rgbd(k.eta);
                     k.fgd_index.fill(FgdTable::locate(k.eta, 0.0));
                     break;
                 case InterfaceType::Conductor:
                     k.kind = TmComponent::Conductor;
-                    k.eta_rgb = s.eta_rgb / above;
-                    k.k = s.k / above;
+                    k.eta_rgb = model_relative_eta(s.eta_rgb / above);
+                    k.k = model_relative_k(s.k / above);
                     k.eta = k.eta_rgb.mean();
                     for (int c = 0; c < 3; ++c)
                         k.fgd_index[c] = FgdTable::locate(k.eta_rgb[c], k.k[c]);

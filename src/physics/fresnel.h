@@ -112,10 +112,13 @@ inline T fresnel_conductor(T cos_theta_i, T eta, T k) {
     const T a = L::sqrt(L::max(L::constant(0.5) * (a2_plus_b2 + t0), zero));
     const T t1 = a2_plus_b2 + cos2;
     const T t2 = two * cos_theta_i * a;
-    const T r_s = (t1 - t2) / (t1 + t2);
+    // The numerators are sums of squares, t1 − t2 = (a − cos θ)² + b² and t3 − t4 =
+    // (a cos θ − sin²θ)² + b² cos²θ, so never negative; near an index-matched interface (η ≈ 1,
+    // k ≈ 0) rounding leaves them at −1e-17 or so: clamped at 0, or R would be negative.
+    const T r_s = L::max(t1 - t2, zero) / (t1 + t2);
     const T t3 = cos2 * a2_plus_b2 + sin2 * sin2;
     const T t4 = t2 * sin2;
-    const T r_p = L::select(L::less(zero, t3 + t4), r_s * (t3 - t4) / (t3 + t4), r_s);
+    const T r_p = L::select(L::less(zero, t3 + t4), r_s * L::max(t3 - t4, zero) / (t3 + t4), r_s);
     return (r_s + r_p) / two;
 }
 

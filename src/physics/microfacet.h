@@ -57,6 +57,9 @@ struct GGX {
         const T cos2 = sqr(w.z);
         if (cos2 == 0) return std::numeric_limits<T>::infinity();
         const T alpha2_tan2 = sqr(alpha) * (sqr(w.x) + sqr(w.y)) / cos2;
+        // Within a few ulps of grazing (cos² subnormal) α² tan²θ overflows: Λ is infinite there
+        // too (inf/inf below would give NaN).
+        if (alpha2_tan2 > std::numeric_limits<T>::max()) return std::numeric_limits<T>::infinity();
         // (sqrt(1+x) − 1)/2 = x / (2 (sqrt(1+x) + 1)): no cancellation for small α.
         return alpha2_tan2 / (T(2) * (std::sqrt(T(1) + alpha2_tan2) + T(1)));
     }

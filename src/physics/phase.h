@@ -36,6 +36,10 @@ LAMINA_LANE_BEGIN
 template <typename T, typename L = Lane<T>>
 inline T hg_phase(T cos_theta, T g) {
     const T one = L::constant(1), two = L::constant(2);
+    // The dot product of two unit vectors in float can exceed 1 by rounding (1.00006 was seen);
+    // with |g| near 1 the denominator (1 − g)² − 2g(cos θ − 1) then turns negative and the phase
+    // infinite or NaN (found by the fuzz test): cos θ is clamped to [−1, 1].
+    cos_theta = L::min(L::max(cos_theta, L::constant(-1)), one);
     const T denom = one + g * g - two * g * cos_theta;
     return (one - g * g) / (L::constant(4) * L::constant(kPi<double>) * denom *
                             L::sqrt(L::max(denom, L::constant(0))));

@@ -86,8 +86,11 @@ bool is_black(const Rgbd& w) {
     return w[0] == 0 && w[1] == 0 && w[2] == 0;
 }
 
+// A channel without extinction along a horizontal direction (an infinite path) has optical depth
+// 0 · ∞ = NaN: its transmittance is 1 (found by the fuzz test).
 Rgbd exp_neg(const Rgbd& x) {
-    return {std::exp(-x[0]), std::exp(-x[1]), std::exp(-x[2])};
+    auto t = [](double depth) { return std::isnan(depth) ? 1.0 : std::exp(-depth); };
+    return {t(x[0]), t(x[1]), t(x[2])};
 }
 
 // The probability that the walk, with flux weight W (per channel, ≥ 0) just after a vertex, is
@@ -396,7 +399,8 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
             double mix = 0;
             Rgbd tr;
             for (int k = 0; k < 3; ++k) {
-                tr[k] = std::exp(-m.tau_t[k] * to_boundary);
+                // τ = 0 along a horizontal path (to_boundary = ∞): 0 · ∞ would be NaN.
+                tr[k] = m.tau_t[k] > 0 ? std::exp(-m.tau_t[k] * to_boundary) : 1.0;
                 mix += p[k] * tr[k];
             }
             for (int k = 0; k < 3; ++k)
@@ -547,7 +551,9 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 const double p1 =
                     ws.prev_pdf * survival_proxy(conn->inner, ws.prev_depth / std::abs(d.z));
                 const double p2 = it.dielectric.pdf(wo, wi_local);
-                return p1 / (p1 + p2);
+                // Both densities vanish when strategy 2 cannot make this path (p2 = 0) and the
+                // survival proxy underflows (a deep, dense medium): strategy 1 alone, weight 1.
+                return p1 + p2 > 0 ? p1 / (p1 + p2) : 1.0;
             }
         };
         // Next event at a non-delta interface: into region k (up) and, for a dielectric, region

@@ -104,7 +104,9 @@ struct MediumWalk {
                 float mix = 0;
                 Rgbf transmittance;
                 for (int k = 0; k < 3; ++k) {
-                    transmittance[k] = std::exp(-m.tau_t[k] * to_boundary);
+                    // A clear channel along a horizontal path (to_boundary = ∞): 0 · ∞ would be
+                    // NaN (found by the fuzz test); its transmittance is 1.
+                    transmittance[k] = m.tau_t[k] > 0 ? std::exp(-m.tau_t[k] * to_boundary) : 1.f;
                     mix += p[k] * transmittance[k];
                 }
                 for (int k = 0; k < 3; ++k)

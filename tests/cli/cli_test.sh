@@ -34,7 +34,36 @@ trap 'rm -rf "$tmp" /tmp/lamina-cli-out.$$' EXIT
 
 check version 0 "$lamina" --version
 check help 0 "$lamina" --help
-check no-subcommand 106 "$lamina"
+check_says no-subcommand 1 "lamina: command line: a subcommand is required, one of: validate," "$lamina"
+# CLI11's own errors exit like lamina's: one "lamina: command line: OPTION: ..." line, exit code 1.
+check_says cli11-unknown-subcommand 1 "lamina: command line: unknown subcommand 'frobnicate'; known: validate" \
+    "$lamina" frobnicate
+check_says cli11-unknown-option 1 "lamina: command line: --bogus: unknown option; see \`lamina simulate --help\`" \
+    "$lamina" simulate "$src/examples/plastic.json" --bogus --out "$tmp/never"
+check_says cli11-unknown-option-first 1 "lamina: command line: --bogus: unknown option" \
+    "$lamina" simulate --bogus
+check_says cli11-missing-value 1 "lamina: command line: --model: expects a value (text) after it" \
+    "$lamina" eval --model
+check_says cli11-not-a-number 1 "lamina: command line: --theta-o: 'abc' is not a number" \
+    "$lamina" eval --model ww09 --stack "$src/examples/plastic.json" --theta-i 30 --theta-o abc --phi-o 0
+check_says cli11-negative-count 1 "lamina: command line: --samples: '-5' is not allowed: expected a whole number >= 1" \
+    "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --samples -5
+check_says cli11-zero-seed 1 "lamina: command line: --seed: '0' is not allowed: expected a whole number >= 1" \
+    "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --seed 0
+check_says cli11-fraction 1 "lamina: command line: --seed: '1.5' is not a whole number" \
+    "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --seed 1.5
+check_says cli11-range 1 "lamina: command line: --size: '5' is not allowed: expected a whole number in [8, 8192]" \
+    "$lamina" render "$src/examples/plastic.json" --size 5 --out "$tmp/never.png"
+check_says cli11-required 1 "lamina: command line: --stack: required; see \`lamina eval --help\`" \
+    "$lamina" eval --model ww09
+check_says cli11-extra 1 "lamina: command line: b.json: unexpected argument" \
+    "$lamina" simulate a.json b.json --out "$tmp/never"
+check_says particles-negative 1 "lamina: command line: --particles: '-5' is not allowed" \
+    "$lamina" simulate "$src/examples/plastic.json" --particles -5 --out "$tmp/never"
+check_says theta-not-a-number 1 "lamina: command line: --theta-i: 'abc' is not a number" \
+    "$lamina" simulate "$src/examples/plastic.json" --theta-i abc --out "$tmp/never"
+check no-output-on-error 1 test -e "$tmp/never"
+check help-still-works 0 "$lamina" eval --help
 
 # validate: every example is valid and described on one line.
 for example in "$src"/examples/*.json; do
@@ -45,7 +74,7 @@ check_says validate-describes 0 "plastic: air | dielectric η=1.5 α=0.2 | mediu
     "$lamina" validate "$src/examples/plastic.json"
 check_says validate-slab 0 "transmits" "$lamina" validate "$src/examples/slab.json"
 check_says validate-scattering 0 "τs=0.5 g=0.3" "$lamina" validate "$src/examples/milky-coat.json"
-check validate-no-file 106 "$lamina" validate
+check_says validate-no-file 1 "lamina: command line: STACK: required" "$lamina" validate
 
 # validate: each kind of bad input fails and the message names the field.
 bad() {  # bad NAME FIELD_TEXT JSON: validate must fail and say FIELD_TEXT
@@ -71,22 +100,22 @@ bad rgb-length '/layers/0/interface/albedo: expected a number or an array of 3 n
     '{"layers": [{"interface": {"type": "lambertian", "albedo": [0.8, 0.2]}}]}'
 bad overflow '/layers/0/medium/tau_a/1: number overflow parsing '"'"'1e999'"'" \
     "{\"layers\": [{\"interface\": $coat, \"medium\": {\"tau_a\": [0, 1e999, 0]}}, $base]}"
-bad eta '/layers/0/interface/eta: got -1.5; allowed: > 0' \
+bad eta '/layers/0/interface/eta: got -1.5; allowed: [1, 5]' \
     '{"layers": [{"interface": {"type": "dielectric", "eta": -1.5, "alpha": 0.1}}]}'
 bad eta-rgb '/layers/0/interface/eta: a dielectric'"'"'s eta must be a single number' \
     '{"layers": [{"interface": {"type": "dielectric", "eta": [1.5, 1.5, 1.5], "alpha": 0.1}}]}'
-bad ambient-eta '/ambient_eta: got 0; allowed: > 0' "{\"ambient_eta\": 0, \"layers\": [$base]}"
-bad alpha '/layers/0/interface/alpha: got 1.5; allowed: [0, 1]' \
+bad ambient-eta '/ambient_eta: got 0; allowed: [1, 5]' "{\"ambient_eta\": 0, \"layers\": [$base]}"
+bad alpha '/layers/0/interface/alpha: got 1.5; allowed: 0 (smooth) or [0.0001, 1]' \
     '{"layers": [{"interface": {"type": "dielectric", "eta": 1.5, "alpha": 1.5}}]}'
 bad alpha-missing '/layers/0/interface/alpha: missing required key "alpha"' \
     '{"layers": [{"interface": {"type": "conductor", "eta": 0.2, "k": 3}}]}'
-bad tau '/layers/0/medium/tau_s: got -0.5; allowed: >= 0' \
+bad tau '/layers/0/medium/tau_s: got -0.5; allowed: [0, 100]' \
     "{\"layers\": [{\"interface\": $coat, \"medium\": {\"tau_s\": -0.5}}, $base]}"
-bad g '/layers/0/medium/g: got 1; allowed: (-1, 1)' \
+bad g '/layers/0/medium/g: got 1; allowed: [-0.99, 0.99]' \
     "{\"layers\": [{\"interface\": $coat, \"medium\": {\"g\": 1}}, $base]}"
 bad albedo '/layers/0/interface/albedo/0: got 1.2; allowed: [0, 1]' \
     '{"layers": [{"interface": {"type": "lambertian", "albedo": [1.2, 0.2, 0.1]}}]}'
-bad k '/layers/0/interface/k/2: got -3; allowed: >= 0' \
+bad k '/layers/0/interface/k/2: got -3; allowed: [0, 10]' \
     '{"layers": [{"interface": {"type": "conductor", "eta": 0.2, "k": [3, 3, -3], "alpha": 0}}]}'
 bad interface-type '/layers/0/interface/type: unknown interface type "metal"' \
     '{"layers": [{"interface": {"type": "metal", "eta": 0.2, "k": 3, "alpha": 0}}]}'

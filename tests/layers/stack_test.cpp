@@ -379,13 +379,60 @@ TEST(StackReject, NonFiniteNumbers) {
                     {"/layers/0/medium/g/2", "nan", "finite"});
 }
 
-TEST(StackReject, EtaNotPositive) {
+TEST(StackReject, EtaOutsideItsRange) {
+    // Dielectric and ambient: [1, 5]; conductor: [0.01, 10] (docs/stack-format.md, "Ranges").
     expect_mentions(error_of(with(plastic(), "/layers/0/interface/eta", 0)),
-                    {"bad.json", "/layers/0/interface/eta", "got 0", "> 0"});
+                    {"bad.json", "/layers/0/interface/eta", "got 0", "[1, 5]"});
+    expect_mentions(error_of(with(plastic(), "/layers/0/interface/eta", 1e308)),
+                    {"/layers/0/interface/eta", "got 1e+308", "[1, 5]"});
+    expect_mentions(error_of(with(plastic(), "/layers/0/interface/eta", 0.99)),
+                    {"/layers/0/interface/eta", "got 0.99", "[1, 5]"});
     expect_mentions(error_of(with(paint(), "/layers/1/interface/eta/2", -1.4)),
-                    {"/layers/1/interface/eta/2", "got -1.4", "> 0"});
+                    {"/layers/1/interface/eta/2", "got -1.4", "[0.01, 10]"});
+    expect_mentions(error_of(with(paint(), "/layers/1/interface/eta/0", 1e-320)),
+                    {"/layers/1/interface/eta/0", "got 1e-320", "[0.01, 10]"});
     expect_mentions(error_of(with(plastic(), "/ambient_eta", -1)),
-                    {"/ambient_eta", "got -1", "> 0"});
+                    {"/ambient_eta", "got -1", "[1, 5]"});
+    expect_mentions(error_of(with(plastic(), "/ambient_eta", 1e-320)),
+                    {"/ambient_eta", "got 1e-320", "[1, 5]"});
+    expect_mentions(error_of(with(plastic(), "/ambient_eta", 5.000000000000001)),
+                    {"/ambient_eta", "got 5.000000000000001", "[1, 5]"});
+}
+
+TEST(StackParse, AcceptsTheBoundsOfEveryRange) {
+    auto accepted = [](const json& j) {
+        EXPECT_NO_THROW(stack_from_json(j, "ok.json")) << j.dump();
+    };
+    for (double eta : {1.0, 5.0}) {
+        accepted(with(plastic(), "/layers/0/interface/eta", eta));
+        accepted(with(plastic(), "/ambient_eta", eta));
+    }
+    for (double eta : {0.01, 10.0})
+        accepted(with(paint(), "/layers/1/interface/eta", eta));
+    for (double k : {0.0, 10.0})
+        accepted(with(paint(), "/layers/1/interface/k", k));
+    for (double alpha : {0.0, 1e-4, 1.0})
+        accepted(with(plastic(), "/layers/0/interface/alpha", alpha));
+    for (double tau : {0.0, 5e-324, 100.0}) {
+        accepted(with(plastic(), "/layers/0/medium/tau_a", tau));
+        accepted(with(plastic(), "/layers/0/medium/tau_s", tau));
+    }
+    for (double g : {-0.99, 0.0, 5e-324, 0.99})
+        accepted(with(plastic(), "/layers/0/medium/g", g));
+    // A hundred layers: 99 coats over a base.
+    json many = plastic();
+    json coat = many["layers"][0];
+    while (many["layers"].size() < 100)
+        many["layers"].insert(many["layers"].begin(), coat);
+    accepted(many);
+    many["layers"].insert(many["layers"].begin(), coat);
+    expect_mentions(error_of(many), {"/layers", "101 layers", "at most 100"});
+}
+
+TEST(StackParse, NegativeZeroIsReadAsZero) {
+    const Stack s = stack_from_json(with(plastic(), "/layers/0/interface/alpha", -0.0), "z.json");
+    EXPECT_EQ(s.layers[0].interface.alpha, 0.0);
+    EXPECT_FALSE(std::signbit(s.layers[0].interface.alpha));
 }
 
 TEST(StackReject, DielectricEtaMustBeScalar) {
@@ -394,25 +441,34 @@ TEST(StackReject, DielectricEtaMustBeScalar) {
                      "one refraction path serves all channels"});
 }
 
-TEST(StackReject, AlphaOutsideUnitInterval) {
-    expect_mentions(error_of(with(plastic(), "/layers/0/interface/alpha", 1.5)),
-                    {"bad.json", "/layers/0/interface/alpha", "got 1.5", "[0, 1]"});
+TEST(StackReject, AlphaOutsideItsRange) {
+    expect_mentions(
+        error_of(with(plastic(), "/layers/0/interface/alpha", 1.5)),
+        {"bad.json", "/layers/0/interface/alpha", "got 1.5", "0 (smooth) or [0.0001, 1]"});
     expect_mentions(error_of(with(paint(), "/layers/1/interface/alpha", -0.1)),
-                    {"/layers/1/interface/alpha", "got -0.1", "[0, 1]"});
+                    {"/layers/1/interface/alpha", "got -0.1", "[0.0001, 1]"});
+    // Rougher than a mirror but smoother than any surface geometric optics describes.
+    expect_mentions(error_of(with(plastic(), "/layers/0/interface/alpha", 1e-300)),
+                    {"/layers/0/interface/alpha", "got 1e-300", "0 (smooth) or [0.0001, 1]"});
 }
 
-TEST(StackReject, NegativeOpticalDepths) {
-    expect_mentions(error_of(with(plastic(), "/layers/0/medium/tau_a/2", -0.9)),
-                    {"bad.json", "/layers/0/medium/tau_a/2", "got -0.9", ">= 0", "optical depth"});
+TEST(StackReject, OpticalDepthsOutsideTheirRange) {
+    expect_mentions(
+        error_of(with(plastic(), "/layers/0/medium/tau_a/2", -0.9)),
+        {"bad.json", "/layers/0/medium/tau_a/2", "got -0.9", "[0, 100]", "optical depth"});
     expect_mentions(error_of(with(plastic(), "/layers/0/medium/tau_s", -1)),
-                    {"/layers/0/medium/tau_s", "got -1", ">= 0"});
+                    {"/layers/0/medium/tau_s", "got -1", "[0, 100]"});
+    expect_mentions(error_of(with(plastic(), "/layers/0/medium/tau_s", 1e308)),
+                    {"/layers/0/medium/tau_s", "got 1e+308", "[0, 100]"});
 }
 
-TEST(StackReject, AnisotropyOutsideOpenUnitInterval) {
+TEST(StackReject, AnisotropyOutsideItsRange) {
     expect_mentions(error_of(with(plastic(), "/layers/0/medium/g", 1)),
-                    {"bad.json", "/layers/0/medium/g", "got 1", "(-1, 1)"});
+                    {"bad.json", "/layers/0/medium/g", "got 1", "[-0.99, 0.99]"});
     expect_mentions(error_of(with(plastic(), "/layers/0/medium/g", {0, -1, 0})),
-                    {"/layers/0/medium/g/1", "got -1", "|g| < 1"});
+                    {"/layers/0/medium/g/1", "got -1", "[-0.99, 0.99]"});
+    expect_mentions(error_of(with(plastic(), "/layers/0/medium/g", 0.995)),
+                    {"/layers/0/medium/g", "got 0.995", "[-0.99, 0.99]"});
 }
 
 TEST(StackReject, AlbedoOutsideUnitInterval) {
@@ -422,9 +478,25 @@ TEST(StackReject, AlbedoOutsideUnitInterval) {
                     {"/layers/1/interface/albedo/0", "got -0.1"});
 }
 
-TEST(StackReject, NegativeExtinction) {
+TEST(StackReject, ExtinctionOutsideItsRange) {
     expect_mentions(error_of(with(paint(), "/layers/1/interface/k", {1, -2, 0})),
-                    {"bad.json", "/layers/1/interface/k/1", "got -2", ">= 0"});
+                    {"bad.json", "/layers/1/interface/k/1", "got -2", "[0, 10]"});
+    expect_mentions(error_of(with(paint(), "/layers/1/interface/k", 1e308)),
+                    {"/layers/1/interface/k", "got 1e+308", "[0, 10]"});
+}
+
+TEST(StackReject, DeeplyNestedJsonIsRefusedWithoutCrashing) {
+    // 10^5 nested arrays where a number belongs: refused while parsing (depth) ...
+    const std::string deep(100000, '[');
+    expect_mentions(
+        load_error_of("{\"ambient_eta\": " + deep + std::string(100000, ']') + ", \"layers\": []}"),
+        {"/ambient_eta/0/0", "nested more than 32 levels"});
+    // ... and, for JSON parsed elsewhere (study configurations), shown without recursion.
+    json nested = 1;
+    for (int i = 0; i < 100000; ++i)
+        nested = json::array({std::move(nested)});
+    expect_mentions(error_of(with(plastic(), "/ambient_eta", nested)),
+                    {"/ambient_eta", "expected a number", "[[[[...]]]]"});
 }
 
 TEST(StackReject, UnknownInterfaceType) {

@@ -117,9 +117,9 @@ PY
 #    metrics.csv as the uninterrupted run.
 "$lamina" study "${tiny[@]}" --out "$tmp/b" >/dev/null 2>&1 &
 pid=$!
-for _ in $(seq 1 600); do
+for _ in $(seq 1 3000); do
     if [ -n "$(find "$tmp/b/cache" -name '*.bin' 2>/dev/null | head -1)" ]; then break; fi
-    sleep 0.05
+    sleep 0.01
 done
 kill -9 "$pid" 2>/dev/null
 wait "$pid" 2>/dev/null
