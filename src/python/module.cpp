@@ -390,6 +390,8 @@ void run_study_py(py::list configs_in, py::dict settings, py::list externals,
                          "add kernel='scalar'");
     s.quiet = settings["quiet"].cast<bool>();
     s.tables = parse_tables_format(settings["tables"].cast<std::string>(), "tables");
+    s.transmission_masking = parse_transmission_masking(
+        settings["transmission_masking"].cast<std::string>(), "arguments", "transmission_masking");
     s.registry_models = settings["registry_models"].cast<bool>();
     for (py::handle e : externals) {
         ExternalModel m;
@@ -573,7 +575,8 @@ PYBIND11_MODULE(_lamina, m) {
         "_simulate",
         [](py::handle stack_obj, py::handle theta_i, double particles, std::uint64_t seed,
            int threads, std::pair<int, int> grid, const std::string& kernel,
-           const std::string& microsurface, int max_events, bool progress) {
+           const std::string& microsurface, const std::string& transmission_masking, int max_events,
+           bool progress) {
             SimulationSettings s;
             s.theta_i_deg = incidences_of(theta_i);
             if (!(particles >= 1 && particles <= 1e15 && particles == std::floor(particles)))
@@ -587,6 +590,8 @@ PYBIND11_MODULE(_lamina, m) {
             s.grid = grid_of(grid);
             s.kernel = parse_kernel(kernel, "kernel");
             s.microsurface = parse_microsurface(microsurface, "microsurface");
+            s.transmission_masking = parse_transmission_masking(transmission_masking, "arguments",
+                                                                "transmission_masking");
             s.max_events = max_events;
             PySimulation r{stack_of(stack_obj), {}};
             r.result = simulate_interruptible(r.stack, s, progress);
@@ -594,7 +599,7 @@ PYBIND11_MODULE(_lamina, m) {
         },
         py::arg("stack"), py::arg("theta_i"), py::arg("particles"), py::arg("seed"),
         py::arg("threads"), py::arg("grid"), py::arg("kernel"), py::arg("microsurface"),
-        py::arg("max_events"), py::arg("progress"));
+        py::arg("transmission_masking"), py::arg("max_events"), py::arg("progress"));
 
     m.def(
         "_export",

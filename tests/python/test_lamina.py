@@ -109,6 +109,23 @@ def test_simulate_is_bitwise_the_cli(tmp_path, stack):
     assert r.info["seed"] == 7 and r.info["particles"] == args["particles"]
 
 
+def test_simulate_transmission_masking_is_the_clis(tmp_path):
+    # The slab's rough interfaces refract: smith and pbrt differ there, and each is the CLI's.
+    args = dict(theta_i=[60], particles=100_000, seed=3, grid=(18, 12))
+    tables = {}
+    for masking in ("smith", "pbrt"):
+        cli("simulate", SLAB, "--theta-i", "60", "--particles", args["particles"], "--seed", 3,
+            "--grid", "18x12", "--transmission-masking", masking, "--out", tmp_path / masking)
+        r = lamina.simulate(SLAB, transmission_masking=masking, **args)
+        r.write(tmp_path / ("py-" + masking))
+        assert ((tmp_path / masking / "brdf.csv").read_bytes()
+                == (tmp_path / ("py-" + masking) / "brdf.csv").read_bytes())
+        tables[masking] = r.f
+    assert not np.array_equal(tables["smith"], tables["pbrt"])
+    with pytest.raises(lamina.InputError):
+        lamina.simulate(SLAB, theta_i=[0], particles=1000, transmission_masking="walter")
+
+
 def test_simulate_stops_on_ctrl_c():
     code = ("import lamina, sys\n"
             "print('start', flush=True)\n"

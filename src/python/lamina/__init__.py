@@ -50,7 +50,8 @@ DEFAULT_THETA_I = (0, 15, 30, 45, 60, 70, 80)
 
 
 def simulate(stack, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, threads=0, grid=(90, 90),
-             kernel="simd", microsurface="single", max_events=10000, progress=None):
+             kernel="simd", microsurface="single", max_events=10000, progress=None,
+             transmission_masking="smith"):
     """Runs the goniophotometer (`lamina simulate`) and returns a SimulationResult.
 
     stack: a Stack, a dict in the stack format or a path. theta_i: degrees in [0, 90), one or a
@@ -58,13 +59,15 @@ def simulate(stack, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, threads=0, g
     inputs (for the same kernel on the same machine) and do not depend on `threads`. The GIL is
     released while particles are traced; Ctrl-C stops the run between chunks of particles and
     raises KeyboardInterrupt. progress: draw a progress line on stderr (default: when it is a
-    terminal).
+    terminal). transmission_masking: "smith" (the Smith microsurface's B(1 + Λi, 1 + Λo) for light
+    a rough dielectric refracts, the default) or "pbrt" (1/(1 + Λi + Λo), as pbrt-v4), the CLI's
+    --transmission-masking.
     """
     if progress is None:
         progress = _stderr_is_terminal()
     return _lamina._simulate(stack, theta_i, float(particles), int(seed), int(threads),
                              (int(grid[0]), int(grid[1])), str(kernel), str(microsurface),
-                             int(max_events), bool(progress))
+                             str(transmission_masking), int(max_events), bool(progress))
 
 
 def _stderr_is_terminal():
@@ -197,13 +200,14 @@ def _split_models(models):
 
 
 def _run(configs, models, theta_i, particles, preset, seed, threads, grid, kernel, microsurface,
-         out, figures, quiet, nodes, peak_nodes, tables="half"):
+         out, figures, quiet, nodes, peak_nodes, tables="half", transmission_masking="smith"):
     names, plugins = _split_models(models)
     settings = {
         "particles": int(particles), "preset": preset, "seed": int(seed),
         "theta_i": [float(t) for t in np.atleast_1d(theta_i)], "grid": (int(grid[0]), int(grid[1])),
         "models": names, "threads": int(threads), "kernel": kernel, "microsurface": microsurface,
         "quiet": bool(quiet), "tables": str(tables),
+        "transmission_masking": str(transmission_masking),
         # models=None: every built-in model; a list: exactly the models it names.
         "registry_models": models is None,
     }
@@ -220,7 +224,8 @@ def _run(configs, models, theta_i, particles, preset, seed, threads, grid, kerne
 
 def compare(stack, models=None, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, threads=0,
             grid=(90, 90), kernel="simd", microsurface="single", out=None, figures=False,
-            quiet=True, config_id=None, nodes=4, peak_nodes=32, tables="half"):
+            quiet=True, config_id=None, nodes=4, peak_nodes=32, tables="half",
+            transmission_masking="smith"):
     """`lamina compare` from Python: the reference for one stack and every model on its bins.
 
     models: registry names and Python models (classes or objects with eval(wi, wo); see
@@ -236,12 +241,13 @@ def compare(stack, models=None, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, 
                         else (st.name or "stack"))
     configs = [{"id": cid, "category": "custom", "stack": st}]
     return _run(configs, models, theta_i, particles, "custom", seed, threads, grid, kernel,
-                microsurface, out, figures, quiet, nodes, peak_nodes, tables)
+                microsurface, out, figures, quiet, nodes, peak_nodes, tables, transmission_masking)
 
 
 def study(models=None, preset="quick", only=None, configs=None, theta_i=DEFAULT_THETA_I,
           particles=None, seed=1, threads=0, grid=(90, 90), kernel="simd", microsurface="single",
-          out=None, figures=False, quiet=True, nodes=4, peak_nodes=32, tables="half"):
+          out=None, figures=False, quiet=True, nodes=4, peak_nodes=32, tables="half",
+          transmission_masking="smith"):
     """`lamina study` from Python, with Python models beside the built-in ones.
 
     configs: None for the study's 60 configurations, or a list of {"id", "category", "stack"};
@@ -262,4 +268,4 @@ def study(models=None, preset="quick", only=None, configs=None, theta_i=DEFAULT_
         keep = set(_lamina._filter_configurations(cs, only))
         cs = [c for c in cs if c["id"] in keep]
     return _run(cs, models, theta_i, n, label, seed, threads, grid, kernel, microsurface, out,
-                figures, quiet, nodes, peak_nodes, tables)
+                figures, quiet, nodes, peak_nodes, tables, transmission_masking)
