@@ -71,8 +71,8 @@ EngineFindings compute_engine_findings(const std::vector<MetricRow>& rows,
         Acc& a = acc[{r.model, r.category}];
         if (a.a_sum.empty()) a.a_sum.assign(f.theta_i.size(), 0), a.a_n.assign(f.theta_i.size(), 0);
         a.configs.insert(r.config);
-        if (std::isfinite(r.metrics.misplaced_energy)) {
-            a.e_sum += r.metrics.misplaced_energy;
+        if (std::isfinite(r.metrics.misplaced_floor)) {
+            a.e_sum += r.metrics.misplaced_floor;
             ++a.e_n;
         }
         const auto k =
@@ -125,13 +125,13 @@ EngineFindings compute_engine_findings(const std::vector<MetricRow>& rows,
             const auto it = by_model[base].find(key);
             if (it == by_model[base].end()) continue;
             const MetricRow& rb = *it->second;
-            if (!std::isfinite(rv->metrics.misplaced_energy) ||
-                !std::isfinite(rb.metrics.misplaced_energy))
+            if (!std::isfinite(rv->metrics.misplaced_floor) ||
+                !std::isfinite(rb.metrics.misplaced_floor))
                 continue;
             EngineFindings::Ablation& a = per_category[rv->category];
             a.rows++;
-            a.shipped += rb.metrics.misplaced_energy;
-            a.switched += rv->metrics.misplaced_energy;
+            a.shipped += rb.metrics.misplaced_floor;
+            a.switched += rv->metrics.misplaced_floor;
             if (std::isfinite(rv->metrics.albedo_error) && std::isfinite(rb.metrics.albedo_error)) {
                 a.shipped_albedo += std::abs(rb.metrics.albedo_error);
                 a.switched_albedo += std::abs(rv->metrics.albedo_error);
@@ -211,7 +211,8 @@ std::string engine_findings_markdown(const EngineFindings& f) {
     out("The coats engines ship (`docs/models.md`, \"Production coats\"), on the BRDF of each "
         "category: the mean signed albedo error (model − reference)/reference against θi "
         "(negative: "
-        "the coat is too dark), the lobe error (mean misplaced energy), what each heuristic does "
+        "the coat is too dark), the lobe error (mean misplaced energy with the 5% floor, the "
+        "ranking metric), what each heuristic does "
         "(the model with one flag switched, `NAME:KEY=VALUE`, against the model as shipped on the "
         "same rows; `lamina study --ablations`), and the most accurate production coat.\n\n");
     for (const std::string& c : f.categories) {
@@ -223,7 +224,7 @@ std::string engine_findings_markdown(const EngineFindings& f) {
             out("No production coat supports this category (see \"Not supported\").\n\n");
             continue;
         }
-        out("| model | misplaced energy |");
+        out("| model | misplaced energy (5% floor) |");
         for (double t : f.theta_i)
             out(" albedo error {}° |", t);
         out("\n|---|---|");
@@ -249,7 +250,8 @@ std::string engine_findings_markdown(const EngineFindings& f) {
         for (const auto& a : f.ablations) {
             if (a.category != c) continue;
             if (!any) {
-                out("\nHeuristics and leaves (mean misplaced energy; mean |albedo error|):\n\n"
+                out("\nHeuristics and leaves (mean misplaced energy, 5% floor; mean |albedo "
+                    "error|):\n\n"
                     "| model | switched | as shipped | switched | what it says |\n"
                     "|---|---|---|---|---|\n");
                 any = true;
@@ -274,7 +276,7 @@ nlohmann::json engine_findings_json(const EngineFindings& f) {
             for (double e : cell.albedo_error)
                 ae.push_back(num(e));
             jc["models"][cell.model] = {{"configurations_supported", cell.configurations},
-                                        {"mean_misplaced_energy", num(cell.mean_misplaced)},
+                                        {"mean_misplaced_floor", num(cell.mean_misplaced)},
                                         {"albedo_error_by_theta_i", ae}};
         }
         if (f.best_production.count(c)) {
@@ -288,8 +290,8 @@ nlohmann::json engine_findings_json(const EngineFindings& f) {
                      {"model", a.model},
                      {"flag", a.flag},
                      {"rows", a.rows},
-                     {"shipped_misplaced_energy", num(a.shipped)},
-                     {"switched_misplaced_energy", num(a.switched)},
+                     {"shipped_misplaced_floor", num(a.shipped)},
+                     {"switched_misplaced_floor", num(a.switched)},
                      {"shipped_mean_abs_albedo_error", num(a.shipped_albedo)},
                      {"switched_mean_abs_albedo_error", num(a.switched_albedo)}});
         j["categories"][c] = jc;

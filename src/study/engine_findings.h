@@ -2,8 +2,8 @@
 // The summary's section for engine developers (summary.md "For engine developers", summary.json
 // "engine_developers"): for each production coat (models/registry.h group "production") and
 // category, the albedo error against θi (is the coat too dark or too bright, and where), the
-// lobe error (mean misplaced energy), what each heuristic does (its one-flag ablation
-// "NAME:KEY=VALUE" against the model as shipped, on the same rows), and the most accurate
+// lobe error (mean misplaced_floor, the ranking metric), what each heuristic does (its one-flag
+// ablation "NAME:KEY=VALUE" against the model as shipped, on the same rows), and the most accurate
 // production coat per category. Computed from the metric rows alone (BRDF rows: the production
 // coats have no BTDF); the summary calls it with the rows it already has.
 
@@ -22,7 +22,7 @@ struct EngineFindings {
     struct Cell {
         std::string model, category;
         int configurations = 0;
-        double mean_misplaced = 0;  ///< mean misplaced energy
+        double mean_misplaced = 0;  ///< mean misplaced energy with the 5% floor (misplaced_floor)
         /// Mean signed albedo error (model − reference)/reference at each of theta_i (NaN where
         /// no row).
         std::vector<double> albedo_error;
@@ -31,14 +31,14 @@ struct EngineFindings {
     struct Ablation {
         std::string variant, model, flag, category;
         int rows = 0;
-        double shipped = 0, switched = 0;                ///< mean misplaced energy of each
+        double shipped = 0, switched = 0;                ///< mean misplaced_floor of each
         double shipped_albedo = 0, switched_albedo = 0;  ///< mean |albedo error| of each
     };
     std::vector<double> theta_i;
     std::vector<std::string> categories;
     std::vector<Cell> cells;  ///< categories × production models, in the study's model order
     std::vector<Ablation> ablations;
-    /// Per category: the production coat with the lowest mean misplaced energy, and the model of
+    /// Per category: the production coat with the lowest mean misplaced_floor, and the model of
     /// any family with the lowest (for scale).
     std::map<std::string, std::string> best_production, best_overall;
     std::map<std::string, double> best_production_error, best_overall_error;

@@ -21,6 +21,7 @@ MetricRow row(const std::string& config, const std::string& category, const std:
     r.channel = channel;
     r.supported = supported;
     r.metrics.misplaced_energy = supported ? misplaced : NAN;
+    r.metrics.misplaced_floor = r.metrics.misplaced_energy;  // the ranking metric (reference ≥ 5%)
     r.metrics.albedo_error = supported ? albedo_error : NAN;
     return r;
 }
