@@ -419,7 +419,7 @@ class Lamina1 final : public Model {
     Rgbd inv_one_minus_Er_{0.0};  ///< 1/(1 − Ē_b r̄)
     Rgbd r_bar_{0.0}, E_bar_{0.0}, t_bar_{0.0}, X_bar_{0.0};
 
-    friend class Lamina1Evaluator;
+    friend class SplitIncidentEvaluator<Lamina1>;
 };
 
 void Lamina1::precompute() {
@@ -586,19 +586,8 @@ void Lamina1::precompute() {
     }
 }
 
-class Lamina1Evaluator final : public IncidentEvaluator {
-  public:
-    Lamina1Evaluator(const Lamina1& model, const Vec3d& wi)
-        : model_(model), in_(model.incident(wi)) {}
-    Rgbd eval(const Vec3d& wo) const override { return model_.eval_with(in_, wo); }
-
-  private:
-    const Lamina1& model_;
-    Lamina1::Incident in_;
-};
-
 std::unique_ptr<IncidentEvaluator> Lamina1::prepare(const Vec3d& wi) const {
-    return std::make_unique<Lamina1Evaluator>(*this, wi);
+    return std::make_unique<SplitIncidentEvaluator<Lamina1>>(*this, wi);
 }
 
 Lamina1::Mixture Lamina1::mixture(const Incident& in) const {

@@ -66,6 +66,21 @@ class IncidentEvaluator {
     virtual Rgbd eval(const Vec3d& wo) const = 0;
 };
 
+/// The IncidentEvaluator of a model that splits its evaluation in two, `typename M::Incident
+/// M::incident(wi)` (everything that depends on wi alone) and `Rgbd M::eval_with(incident, wo)`:
+/// the WW family, the production coats and lamina-1 return one from prepare().
+template <typename M>
+class SplitIncidentEvaluator final : public IncidentEvaluator {
+  public:
+    SplitIncidentEvaluator(const M& model, const Vec3d& wi)
+        : model_(model), incident_(model.incident(wi)) {}
+    Rgbd eval(const Vec3d& wo) const override { return model_.eval_with(incident_, wo); }
+
+  private:
+    const M& model_;
+    typename M::Incident incident_;
+};
+
 class Model {
   public:
     virtual ~Model() = default;

@@ -399,19 +399,8 @@ class ProductionCoat final : public Model {
     double K_r_ = 0, r_b_ = 1;
 };
 
-class ProductionEvaluator final : public IncidentEvaluator {
-  public:
-    ProductionEvaluator(const ProductionCoat& model, const Vec3d& wi)
-        : model_(model), incident_(model.incident(wi)) {}
-    Rgbd eval(const Vec3d& wo) const override { return model_.eval_with(incident_, wo); }
-
-  private:
-    const ProductionCoat& model_;
-    ProductionCoat::Incident incident_;
-};
-
 std::unique_ptr<IncidentEvaluator> ProductionCoat::prepare(const Vec3d& wi) const {
-    return std::make_unique<ProductionEvaluator>(*this, wi);
+    return std::make_unique<SplitIncidentEvaluator<ProductionCoat>>(*this, wi);
 }
 
 }  // namespace

@@ -279,19 +279,8 @@ class WWModel final : public Model {
     float base_eta_f_[3] = {1, 1, 1}, base_k_f_[3] = {0, 0, 0};
 };
 
-class WWEvaluator final : public IncidentEvaluator {
-  public:
-    WWEvaluator(const WWModel& model, const Vec3d& wi)
-        : model_(model), incident_(model.incident(wi)) {}
-    Rgbd eval(const Vec3d& wo) const override { return model_.eval_with(incident_, wo); }
-
-  private:
-    const WWModel& model_;
-    WWModel::Incident incident_;
-};
-
 std::unique_ptr<IncidentEvaluator> WWModel::prepare(const Vec3d& wi) const {
-    return std::make_unique<WWEvaluator>(*this, wi);
+    return std::make_unique<SplitIncidentEvaluator<WWModel>>(*this, wi);
 }
 
 }  // namespace
