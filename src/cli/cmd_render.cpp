@@ -23,6 +23,7 @@ namespace {
 struct RenderArgs {
     std::string stack, model = "random-walk", env = "studio", light, out;
     std::string transmission_masking = "smith";
+    std::string microsurface = "single";
     std::vector<std::string> options;
     int size = 512, spp = 64, threads = 0;
     std::uint64_t seed = 1;
@@ -51,14 +52,27 @@ int run_render(const RenderArgs& a) {
     // The reference's refraction masking, a model option of random-walk (validated there).
     parse_transmission_masking(a.transmission_masking);
     std::vector<std::string> options = a.options;
-    const bool given_as_option = std::any_of(options.begin(), options.end(), [](const auto& o) {
-        return o.rfind("transmission-masking=", 0) == 0;
-    });
-    if ((a.compare || a.model == "random-walk") && !given_as_option)
-        options.push_back("transmission-masking=" + a.transmission_masking);
-    else if (a.transmission_masking != "smith")
-        throw InputError("command line", "--transmission-masking",
-                         "applies to the random-walk reference only, not to --model " + a.model);
+    // The reference's flags become its model options unless given as --option already.
+    auto pass_to_reference = [&](const std::string& key, const std::string& value,
+                                 const std::string& fallback, const std::string& flag) {
+        const bool given_as_option =
+            std::any_of(options.begin(), options.end(),
+                        [&](const auto& o) { return o.rfind(key + "=", 0) == 0; });
+        if ((a.compare || a.model == "random-walk") && !given_as_option)
+            options.push_back(key + "=" + value);
+        else if (value != fallback)
+            throw InputError(
+                "command line", flag,
+                "applies to the random-walk reference only, not to --model " + a.model);
+    };
+    pass_to_reference("transmission-masking", a.transmission_masking, "smith",
+                      "--transmission-masking");
+    if (a.microsurface != "single" && a.microsurface != "multiple")
+        throw InputError("command line", "--microsurface",
+                         "'" + a.microsurface +
+                             "' is not a microsurface model: use single or "
+                             "multiple");
+    pass_to_reference("microsurface", a.microsurface, "single", "--microsurface");
 
     if (!a.compare) {
         const auto model = make_model(a.model, stack, options);
@@ -105,6 +119,10 @@ Runner add_render(CLI::App& app) {
     cmd->add_option("--transmission-masking", a->transmission_masking,
                     "The random-walk reference's masking of light refracted by a rough dielectric: "
                     "smith (default, B(1+Λi, 1+Λo)) or pbrt (1/(1+Λi+Λo), as pbrt-v4)");
+    cmd->add_option("--microsurface", a->microsurface,
+                    "The random-walk reference's rough interfaces: single (default, single-"
+                    "scattering microfacet BSDFs) or multiple (the microsurface random walk of "
+                    "Heitz et al. 2016, nothing lost)");
     cmd->add_flag("--compare", a->compare,
                   "Render the reference and every analytic model; --out is then a folder holding "
                   "compare.png, one PNG+EXR per model and errors.csv");

@@ -23,10 +23,12 @@ std::uint64_t query_stream(const Vec3d& wi, const Vec3d& wo) {
 }
 
 RandomWalkModel::RandomWalkModel(const Stack& stack, std::uint64_t samples, std::uint64_t seed,
-                                 TransmissionMasking masking)
-    : walker_(stack, 10'000, masking), samples_(samples), seed_(seed) {
+                                 TransmissionMasking masking,
+                                 RandomWalkStack::Microsurface microsurface)
+    : walker_(stack, 10'000, masking, microsurface), samples_(samples), seed_(seed) {
     if (stack.transmits())
-        flipped_ = std::make_unique<RandomWalkStack>(flipped_stack(stack), 10'000, masking);
+        flipped_ =
+            std::make_unique<RandomWalkStack>(flipped_stack(stack), 10'000, masking, microsurface);
 }
 
 Support RandomWalkModel::support() const {
@@ -62,7 +64,12 @@ std::vector<OptionSpec> random_walk_options() {
              {"smith", "pbrt"},
              "smith",
              "masking of light refracted by a rough dielectric: the Smith microsurface's "
-             "B(1+Λi, 1+Λo), or pbrt-v4's 1/(1+Λi+Λo)"}};
+             "B(1+Λi, 1+Λo), or pbrt-v4's 1/(1+Λi+Λo)"},
+            {"microsurface",
+             {"single", "multiple"},
+             "single",
+             "rough interfaces: single-scattering microfacet BSDFs, or the microsurface random "
+             "walk of Heitz et al. 2016 (multiple scattering, nothing lost)"}};
 }
 
 std::unique_ptr<Model> make_random_walk(const Stack& stack, const ModelOptions& options) {
@@ -70,7 +77,10 @@ std::unique_ptr<Model> make_random_walk(const Stack& stack, const ModelOptions& 
         stack, std::stoull(option_value(options, "samples")),
         std::stoull(option_value(options, "seed")),
         parse_transmission_masking(option_value(options, "transmission-masking"), "model option",
-                                   "transmission-masking"));
+                                   "transmission-masking"),
+        option_value(options, "microsurface") == "multiple"
+            ? RandomWalkStack::Microsurface::Multiple
+            : RandomWalkStack::Microsurface::Single);
 }
 
 }  // namespace lamina

@@ -19,9 +19,12 @@ namespace lamina {
 class RandomWalkModel final : public Model {
   public:
     /// `masking`: the rough dielectrics' refraction masking (physics/microfacet.h); the model
-    /// option `transmission-masking`.
-    RandomWalkModel(const Stack& stack, std::uint64_t samples, std::uint64_t seed,
-                    TransmissionMasking masking = TransmissionMasking::Smith);
+    /// option `transmission-masking`. `microsurface`: single- or multiple-scattering rough
+    /// interfaces (RandomWalkStack::Microsurface); the model option `microsurface`.
+    RandomWalkModel(
+        const Stack& stack, std::uint64_t samples, std::uint64_t seed,
+        TransmissionMasking masking = TransmissionMasking::Smith,
+        RandomWalkStack::Microsurface microsurface = RandomWalkStack::Microsurface::Single);
 
     std::string name() const override { return "random-walk"; }
     Support support() const override;

@@ -3,6 +3,7 @@
 #include "core/check.h"
 #include "core/math.h"
 #include "physics/fresnel.h"
+#include "physics/microsurface_walk.h"
 #include "physics/phase.h"
 
 #include <array>
@@ -111,9 +112,15 @@ bool is_grey(const Rgbd& x) {
 
 }  // namespace
 
-RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events, TransmissionMasking masking)
-    : transmits_(stack.transmits()), max_events_(max_events) {
+RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events, TransmissionMasking masking,
+                                 Microsurface microsurface, int max_microsurface_order)
+    : transmits_(stack.transmits()),
+      max_events_(max_events),
+      microsurface_(microsurface),
+      max_microsurface_order_(max_microsurface_order) {
     LAMINA_CHECK(max_events >= 1);
+    LAMINA_CHECK(max_microsurface_order >= 1);
+    const bool multiple = microsurface == Microsurface::Multiple;
     const int L = int(stack.layers.size());
     eta_.assign(L + 1, 1.0);
     media_.assign(L + 1, Medium{});
@@ -131,12 +138,18 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events, Transmissio
             case InterfaceType::Dielectric:
                 it.dielectric = {spec.eta / eta_above, spec.alpha};
                 it.dielectric.transmission_masking = masking;
+                // Index-matched and rough with multiple scattering: every facet refracts straight
+                // on (F = 0) and the walk leaves below along −wi with all its flux, which is the
+                // smooth index-matched pass-through (the single-scattering one keeps G2/G1).
+                if (multiple && it.dielectric.is_index_matched()) it.dielectric.alpha = 0;
                 it.delta = it.dielectric.is_smooth() || it.dielectric.is_index_matched();
+                it.multiple = multiple && !it.delta;
                 eta_[k + 1] = spec.eta;
                 break;
             case InterfaceType::Conductor:
                 it.conductor = {spec.eta_rgb / eta_above, spec.k / eta_above, spec.alpha};
                 it.delta = it.conductor.is_smooth();
+                it.multiple = multiple && !it.delta;
                 eta_[k + 1] = eta_above;  // no region below an opaque base
                 break;
             case InterfaceType::Lambertian:
@@ -332,32 +345,106 @@ double RandomWalkStack::survival_proxy(int region, double path) const {
 //     pdf_v(ω) · P_v(ω) · pdf_exit(t, wo) / pdf_exit(wo, t) · w₂,
 // P_v the probability that the walk's flight from v reaches the exit unscattered (chain
 // probability of the weight w·k_v(ω), 1 through a non-scattering medium), with the same w₁, w₂.
-template <RandomWalkStack::Mode kMode, typename Kernel, typename Pdf>
+//
+// With multiple-scattering interfaces (docs/rendering.md §1.6) the exit's f (or exit density) and
+// the vertex's kernel (or pdf × chain probability) are one walk's unbiased estimates each,
+// independent of each other, so their product stays unbiased; t is still drawn from the exit's
+// single-scattering sampler (any proposal with a known density will do), and the balance
+// heuristic's densities are the single-scattering ones (`proxy_pdf`, pdf_interface) in both
+// strategies: any weights that sum to one for each path, computed alike by both, keep the
+// combination unbiased (Veach 1997, §9.2.2).
+template <RandomWalkStack::Mode kMode, typename Kernel, typename PdfChain, typename ProxyPdf>
 void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& wo, double depth,
                                            const Rgbd& w, ParticleRng& rng, const Kernel& kernel,
-                                           const Pdf& pdf_v, Rgbd& f) const {
-    const DielectricInterface<double>& exit = interfaces_[conn.exit_interface].dielectric;
+                                           const PdfChain& pdf_chain, const ProxyPdf& proxy_pdf,
+                                           Rgbd& f) const {
+    const Interface& exit_it = interfaces_[conn.exit_interface];
+    const DielectricInterface<double>& exit = exit_it.dielectric;
     const double uc = rng.uniform_double(), u1 = rng.uniform_double(), u2 = rng.uniform_double();
     const auto st = exit.sample<true>(wo, uc, u1, u2);
     if (!st || !st->is_transmission || st->shadowing == 0 || st->pdf <= 0) return;
     const Vec3d omega = -st->wo;
     if (omega.z * conn.towards <= 0) return;
     const double mu = std::abs(omega.z);
-    const double f_exit = exit.eval(st->wo, wo);
-    if (f_exit == 0) return;
-    const Rgbd kv = kernel(omega);
-    if (is_black(kv)) return;
     const Medium& m = media_[conn.inner];
-    const double pv = pdf_v(omega);
-    const double p1 = pv * survival_proxy(conn.inner, depth / mu);
+    const double p1 = proxy_pdf(omega) * survival_proxy(conn.inner, depth / mu);
     const double mis = st->pdf / (st->pdf + p1);
     if constexpr (kMode == Mode::Pdf) {
+        // The exit's density at wo: a dielectric walk carries all its flux, so its exit density
+        // is its kernel f·|cos θo| (flux convention).
+        const double p_exit =
+            exit_it.multiple ? interface_kernel(exit_it, st->wo, wo, rng)[0] : exit.pdf(st->wo, wo);
+        if (p_exit == 0) return;
         const Rgbd pass = m.scatters ? exp_neg(m.tau_t * (depth / mu)) : Rgbd(1.0);
-        f[0] += pv * chain_probability(w * kv, pass) * exit.pdf(st->wo, wo) / st->pdf * mis;
+        f[0] += pdf_chain(omega, pass) * p_exit / st->pdf * mis;
     } else {
+        const double f_exit = exit_it.multiple
+                                  ? interface_kernel(exit_it, st->wo, wo, rng)[0] / std::abs(wo.z)
+                                  : exit.eval(st->wo, wo);
+        if (f_exit == 0) return;
+        const Rgbd kv = kernel(omega);
+        if (is_black(kv)) return;
         const Rgbd tr = m.empty ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
         f += w * kv * tr * (f_exit / st->pdf * mis);
     }
+}
+
+template <typename Visit>
+void RandomWalkStack::visit_microsurface(const Interface& it, const Vec3d& wi, ParticleRng& rng,
+                                         Visit&& visit) const {
+    auto uniform = [&] { return rng.uniform_double(); };
+    if (it.type == InterfaceType::Dielectric) {
+        const GGX<double> ggx = it.dielectric.distribution();
+        const double eta = it.dielectric.eta;
+        walk_rough_dielectric_visiting(ggx, eta, wi, uniform, max_microsurface_order_,
+                                       [&](const MicrosurfaceFacet<double>& facet) {
+                                           visit([&](const Vec3d& wo) {
+                                               MicrosurfaceConnection<double> c;
+                                               c.density = microsurface_dielectric_connect(
+                                                   ggx, eta, facet, wo);
+                                               c.weight = Rgbd(1.0);
+                                               return c;
+                                           });
+                                       });
+    } else {
+        const ConductorInterface<double>& cond = it.conductor;
+        const GGX<double> ggx = cond.distribution();
+        auto fresnel = [&](double c) { return cond.fresnel(c); };
+        walk_rough_conductor_visiting(ggx, fresnel, wi, uniform, max_microsurface_order_,
+                                      [&](const MicrosurfaceFacet<double>& facet) {
+                                          visit([&](const Vec3d& wo) {
+                                              return microsurface_conductor_connect(ggx, fresnel,
+                                                                                    facet, wo);
+                                          });
+                                      });
+    }
+}
+
+Rgbd RandomWalkStack::interface_kernel(const Interface& it, const Vec3d& wi, const Vec3d& wo,
+                                       ParticleRng& rng) const {
+    if (!it.multiple) return eval_interface(it, wi, wo) * std::abs(wo.z);
+    Rgbd k(0.0);
+    visit_microsurface(it, wi, rng, [&](const auto& connect) {
+        const MicrosurfaceConnection<double> c = connect(wo);
+        k += c.weight * c.density;
+    });
+    for (int ch = 0; ch < 3; ++ch)
+        if (!std::isfinite(k[ch])) return Rgbd(0.0);
+    return k;
+}
+
+double RandomWalkStack::interface_pdf_chain(const Interface& it, const Vec3d& wi, const Vec3d& wo,
+                                            const Rgbd& w, const Rgbd& q, ParticleRng& rng) const {
+    if (!it.multiple) {
+        const double p = pdf_interface(it, wi, wo);
+        return p > 0 ? p * chain_probability(w * eval_interface(it, wi, wo), q) : 0.0;
+    }
+    double p = 0;
+    visit_microsurface(it, wi, rng, [&](const auto& connect) {
+        const MicrosurfaceConnection<double> c = connect(wo);
+        if (c.density > 0) p += c.density * chain_probability(w * c.weight, q);
+    });
+    return std::isfinite(p) ? p : 0.0;
 }
 
 // ---- Media (docs/physics.md §4), as the goniophotometer traverses them --------------------------
@@ -448,14 +535,17 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
             }
             if (conn->rough_exit && region == conn->inner) {
                 const Vec3d d_in = d;
+                auto kernel = [&](const Vec3d& om) {
+                    const double ct = dot(d_in, om);
+                    return Rgbd(hg_phase(ct, m.g[0]), hg_phase(ct, m.g[1]), hg_phase(ct, m.g[2]));
+                };
+                auto proxy = [&](const Vec3d& om) { return phase_pdf(dot(d_in, om)); };
                 connect_through_exit<kMode>(
-                    *conn, wo, conn->distance(s), w, rng,
-                    [&](const Vec3d& om) {
-                        const double ct = dot(d_in, om);
-                        return Rgbd(hg_phase(ct, m.g[0]), hg_phase(ct, m.g[1]),
-                                    hg_phase(ct, m.g[2]));
+                    *conn, wo, conn->distance(s), w, rng, kernel,
+                    [&](const Vec3d& om, const Rgbd& pass) {
+                        return proxy(om) * chain_probability(w * kernel(om), pass);
                     },
-                    [&](const Vec3d& om) { return phase_pdf(dot(d_in, om)); }, f);
+                    proxy, f);
             }
         }
         if constexpr (kMode == Mode::Pdf) {
@@ -480,14 +570,17 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
             }
             if (conn->rough_exit && region == conn->inner) {
                 const Vec3d d_in = d;
+                auto kernel = [&](const Vec3d& om) {
+                    const double ct = dot(d_in, om);
+                    return Rgbd(hg_phase(ct, m.g[0]), hg_phase(ct, m.g[1]), hg_phase(ct, m.g[2]));
+                };
+                auto proxy = [&](const Vec3d& om) { return phase_pdf(dot(d_in, om)); };
                 connect_through_exit<kMode>(
-                    *conn, wo, conn->distance(s), w, rng,
-                    [&](const Vec3d& om) {
-                        const double ct = dot(d_in, om);
-                        return Rgbd(hg_phase(ct, m.g[0]), hg_phase(ct, m.g[1]),
-                                    hg_phase(ct, m.g[2]));
+                    *conn, wo, conn->distance(s), w, rng, kernel,
+                    [&](const Vec3d& om, const Rgbd& pass) {
+                        return proxy(om) * chain_probability(w * kernel(om), pass);
                     },
-                    [&](const Vec3d& om) { return phase_pdf(dot(d_in, om)); }, f);
+                    proxy, f);
             }
         }
         int c_phase = c;
@@ -556,10 +649,47 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 return p1 + p2 > 0 ? p1 / (p1 + p2) : 1.0;
             }
         };
+        // Strategy 2 from the vertex interface (eval and pdf), its kernel, exit density × chain
+        // probability, and the balance heuristic's proxy density (single scattering).
+        auto connect_vertex_interface = [&](const Interface& vi) {
+            connect_through_exit<kMode>(
+                *conn, wo, 1.0, w, rng,
+                [&](const Vec3d& om) { return interface_kernel(vi, wi_local, om, rng); },
+                [&](const Vec3d& om, const Rgbd& pass) {
+                    return interface_pdf_chain(vi, wi_local, om, w, pass, rng);
+                },
+                [&](const Vec3d& om) { return pdf_interface(vi, wi_local, om); }, f);
+        };
         // Next event at a non-delta interface: into region k (up) and, for a dielectric, region
         // k + 1 (down); the kernel f·|cos| and the Jacobian's 1/|cos| cancel.
+        // A multiple-scattering interface (docs/rendering.md §1.6): one microsurface walk from
+        // wi_local estimates the kernel towards both connection directions at once.
+        const bool up_ok = conn && conn->valid[k];
+        const bool down_ok = conn && it.type == InterfaceType::Dielectric && conn->valid[k + 1];
         if constexpr (kConnect) {
-            if (!it.delta) {
+            if (it.multiple && (up_ok || down_ok)) {
+                Rgbd k_up(0.0), k_down(0.0);
+                const Vec3d du = up_ok ? conn->dir_up[k] : Vec3d();
+                const Vec3d dd = down_ok ? conn->dir_down[k + 1] : Vec3d();
+                visit_microsurface(it, wi_local, rng, [&](const auto& connect) {
+                    if (up_ok) {
+                        const MicrosurfaceConnection<double> c = connect(du);
+                        k_up += c.weight * c.density;
+                    }
+                    if (down_ok) {
+                        const MicrosurfaceConnection<double> c = connect(dd);
+                        k_down += c.weight * c.density;
+                    }
+                });
+                // The kernel f·|cos| over |cos| of the connection: f.
+                if (up_ok)
+                    f += w * k_up * conn->from_bottom_up(k) *
+                         (conn->scale[k] * exit_mis(k) / std::abs(du.z));
+                if (down_ok)
+                    f += w * k_down * conn->from_top_down(k + 1) *
+                         (conn->scale[k + 1] * exit_mis(k) / std::abs(dd.z));
+            }
+            if (!it.delta && !it.multiple) {
                 if (conn->valid[k]) {
                     const Vec3d& du = conn->dir_up[k];
                     Rgbd fv = eval_interface(it, wi_local, du);
@@ -570,23 +700,43 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                     f += w * Rgbd(it.dielectric.eval(wi_local, dd)) * conn->from_top_down(k + 1) *
                          (conn->scale[k + 1] * exit_mis(k));
                 }
-                // Strategy 2 from the vertex interface emitting into the inner region.
-                if (conn->rough_exit && k == conn->vertex_interface) {
-                    connect_through_exit<kMode>(
-                        *conn, wo, 1.0, w, rng,
-                        [&](const Vec3d& om) {
-                            return eval_interface(it, wi_local, om) * std::abs(om.z);
-                        },
-                        [&](const Vec3d& om) { return pdf_interface(it, wi_local, om); }, f);
-                }
             }
+            // Strategy 2 from the vertex interface emitting into the inner region.
+            if (!it.delta && conn->rough_exit && k == conn->vertex_interface)
+                connect_vertex_interface(it);
         }
         // Exit density at a non-delta interface (docs/rendering.md §1.4): its sampling density of
         // d_r times the chains' probability of reaching the exit from there, times
         // dω_r/dω_e = (η_e/η_r)² cos θ_e / μ_r (1 when r is the exit region). The weight just
         // after the vertex is ∝ w·f (per channel; f·|cos|/pdf with grey |cos|/pdf).
         if constexpr (kMode == Mode::Pdf) {
-            if (!it.delta) {
+            if (it.multiple && (up_ok || down_ok)) {
+                // Σ over the facets of the density of leaving towards d_r right after the facet
+                // times the chains' probability for the weight that exit would carry.
+                double p_up = 0, p_down = 0;
+                const Vec3d du = up_ok ? conn->dir_up[k] : Vec3d();
+                const Vec3d dd = down_ok ? conn->dir_down[k + 1] : Vec3d();
+                const Rgbd q_up = up_ok ? conn->from_bottom_up(k) : Rgbd(0.0);
+                const Rgbd q_down = down_ok ? conn->from_top_down(k + 1) : Rgbd(0.0);
+                visit_microsurface(it, wi_local, rng, [&](const auto& connect) {
+                    if (up_ok) {
+                        const MicrosurfaceConnection<double> c = connect(du);
+                        if (c.density > 0)
+                            p_up += c.density * chain_probability(w * c.weight, q_up);
+                    }
+                    if (down_ok) {
+                        const MicrosurfaceConnection<double> c = connect(dd);
+                        if (c.density > 0)
+                            p_down += c.density * chain_probability(w * c.weight, q_down);
+                    }
+                });
+                const double cos_e = std::abs(wo.z);
+                if (up_ok && std::isfinite(p_up))
+                    f[0] += p_up * conn->scale[k] * cos_e / conn->mu[k] * exit_mis(k);
+                if (down_ok && std::isfinite(p_down))
+                    f[0] += p_down * conn->scale[k + 1] * cos_e / conn->mu[k + 1] * exit_mis(k);
+            }
+            if (!it.delta && !it.multiple) {
                 const double cos_e = std::abs(wo.z);
                 if (conn->valid[k]) {
                     const Vec3d& du = conn->dir_up[k];
@@ -606,35 +756,48 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                                                   conn->from_top_down(k + 1)) *
                                 conn->scale[k + 1] * cos_e / conn->mu[k + 1] * exit_mis(k);
                 }
-                if (conn->rough_exit && k == conn->vertex_interface) {
-                    connect_through_exit<kMode>(
-                        *conn, wo, 1.0, w, rng,
-                        [&](const Vec3d& om) {
-                            return eval_interface(it, wi_local, om) * std::abs(om.z);
-                        },
-                        [&](const Vec3d& om) { return pdf_interface(it, wi_local, om); }, f);
-                }
             }
+            if (!it.delta && conn->rough_exit && k == conn->vertex_interface)
+                connect_vertex_interface(it);
         }
         std::optional<BsdfSample<double>> s;
-        switch (it.type) {
-            case InterfaceType::Dielectric: {
-                const double uc = rng.uniform_double(), u1 = rng.uniform_double(),
-                             u2 = rng.uniform_double();
-                s = it.dielectric.sample<true>(wi_local, uc, u1, u2);
-                break;
+        if (it.multiple) {
+            // The microsurface walk (Heitz et al. 2016) to its exit; a walk given up at the facet
+            // cap or degenerate loses its flux, as the goniophotometer's. The density is the
+            // single-scattering one: only strategy 2's balance heuristic reads it (a proxy).
+            auto uniform = [&] { return rng.uniform_double(); };
+            const std::optional<MicrosurfaceExit<double>> e =
+                it.type == InterfaceType::Dielectric
+                    ? walk_rough_dielectric(it.dielectric.distribution(), it.dielectric.eta,
+                                            wi_local, uniform, max_microsurface_order_)
+                    : walk_rough_conductor(
+                          it.conductor.distribution(),
+                          [&](double c) { return it.conductor.fresnel(c); }, wi_local, uniform,
+                          max_microsurface_order_);
+            if (!e || !e->escaped) return;
+            s = BsdfSample<double>{};
+            s->wo = e->wo;
+            s->weight = e->weight;
+            s->pdf = pdf_interface(it, wi_local, e->wo);
+        } else
+            switch (it.type) {
+                case InterfaceType::Dielectric: {
+                    const double uc = rng.uniform_double(), u1 = rng.uniform_double(),
+                                 u2 = rng.uniform_double();
+                    s = it.dielectric.sample<true>(wi_local, uc, u1, u2);
+                    break;
+                }
+                case InterfaceType::Conductor: {
+                    const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
+                    s = it.conductor.sample<true>(wi_local, u1, u2);
+                    break;
+                }
+                case InterfaceType::Lambertian: {
+                    const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
+                    s = it.lambertian.sample(wi_local, u1, u2);
+                    break;
+                }
             }
-            case InterfaceType::Conductor: {
-                const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
-                s = it.conductor.sample<true>(wi_local, u1, u2);
-                break;
-            }
-            case InterfaceType::Lambertian: {
-                const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
-                s = it.lambertian.sample(wi_local, u1, u2);
-                break;
-            }
-        }
         if (!s) return;  // a numerical degeneracy: the flux is dropped
         w *= s->weight;
         if (!it.delta) ws.delta_only = false;

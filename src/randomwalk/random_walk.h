@@ -74,11 +74,27 @@ struct RandomWalkSample {
 /// The stack compiled for random walks (double precision, relative indices per interface).
 class RandomWalkStack {
   public:
+    /// How the rough interfaces scatter (as the goniophotometer's --microsurface): `Single`, the
+    /// single-scattering microfacet BSDFs (the energy of the paths that meet a second facet is
+    /// lost), or `Multiple`, the microsurface random walk of Heitz et al. 2016
+    /// (physics/microsurface_walk.h): sample() follows the walk to its exit, eval() and pdf()
+    /// connect through the interface's multiple-scattering BSDF and exit density by the walk's
+    /// unbiased stochastic evaluation (docs/rendering.md §1.6).
+    enum class Microsurface { Single, Multiple };
+    /// Facets a microsurface walk may meet before it is given up (its flux is then lost), as the
+    /// goniophotometer's default.
+    static constexpr int kMaxMicrosurfaceOrder = 100;
+
     /// `max_events`: safety cap on events per walk (as the goniophotometer's); ≥ 1.
     /// `masking`: the refraction masking of the rough dielectrics (physics/microfacet.h), as the
-    /// goniophotometer's --transmission-masking.
+    /// goniophotometer's --transmission-masking (single scattering only: the walk has its own).
+    /// `max_microsurface_order` ≥ 1 (Multiple only): 1 keeps only the walk's first order.
     explicit RandomWalkStack(const Stack& stack, int max_events = 10'000,
-                             TransmissionMasking masking = TransmissionMasking::Smith);
+                             TransmissionMasking masking = TransmissionMasking::Smith,
+                             Microsurface microsurface = Microsurface::Single,
+                             int max_microsurface_order = kMaxMicrosurfaceOrder);
+
+    Microsurface microsurface() const { return microsurface_; }
 
     bool transmits() const { return transmits_; }
     /// Absolute indices of the ambient medium (above) and of the half-space below the base.
@@ -137,7 +153,8 @@ class RandomWalkStack {
         DielectricInterface<double> dielectric{1.0, 0.0};
         ConductorInterface<double> conductor{Rgbd(1.0), Rgbd(0.0), 0.0};
         LambertianInterface<double> lambertian{Rgbd(0.0)};
-        bool delta = true;  ///< smooth or index-matched: no density, no connection
+        bool delta = true;      ///< smooth or index-matched: no density, no connection
+        bool multiple = false;  ///< rough, scattering by the microsurface walk
     };
     struct Medium {
         Rgbd tau_s{0.0}, tau_t{0.0}, g{0.0}, single_scattering_albedo{0.0};
@@ -154,13 +171,29 @@ class RandomWalkStack {
     template <Mode kMode>
     bool traverse_medium(int region, WalkState& ws, ParticleRng& rng, const Connection* conn,
                          const Vec3d& wo, Rgbd& f) const;
-    template <Mode kMode, typename Kernel, typename Pdf>
+    template <Mode kMode, typename Kernel, typename PdfChain, typename ProxyPdf>
     void connect_through_exit(const Connection& conn, const Vec3d& wo, double depth, const Rgbd& w,
-                              ParticleRng& rng, const Kernel& kernel, const Pdf& pdf_v,
-                              Rgbd& f) const;
+                              ParticleRng& rng, const Kernel& kernel, const PdfChain& pdf_chain,
+                              const ProxyPdf& proxy_pdf, Rgbd& f) const;
     double survival_proxy(int region, double path) const;
     static Rgbd eval_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo);
     static double pdf_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo);
+    /// One microsurface walk of a multiple-scattering interface from wi, calling
+    /// `visit(connect)` at every facet, where connect(wo) is the facet's next-event estimate
+    /// towards wo (MicrosurfaceConnection: exit density and the exit's flux weight).
+    template <typename Visit>
+    void visit_microsurface(const Interface& it, const Vec3d& wi, ParticleRng& rng,
+                            Visit&& visit) const;
+    /// The interface's kernel f(wi, wo)·|cos θo| (RGB): exact for single scattering, one walk's
+    /// unbiased estimate for multiple scattering.
+    Rgbd interface_kernel(const Interface& it, const Vec3d& wi, const Vec3d& wo,
+                          ParticleRng& rng) const;
+    /// The interface's exit density at wo times the probability that the delta chains `q` carry
+    /// the walk, of flux weight w before the interface, to the stack's exit:
+    /// pdf(wi, wo)·chain_probability(w·weight(wo), q) (docs/rendering.md §1.4), exact for single
+    /// scattering, one walk's unbiased estimate for multiple scattering.
+    double interface_pdf_chain(const Interface& it, const Vec3d& wi, const Vec3d& wo, const Rgbd& w,
+                               const Rgbd& q, ParticleRng& rng) const;
 
     std::vector<Interface> interfaces_;  ///< top to bottom
     std::vector<Medium> media_;          ///< per region 0..L (0 and L empty)
@@ -168,6 +201,8 @@ class RandomWalkStack {
     bool transmits_ = false;
     bool pdf_unbiased_ = true;
     int max_events_;
+    Microsurface microsurface_ = Microsurface::Single;
+    int max_microsurface_order_ = kMaxMicrosurfaceOrder;
 };
 
 }  // namespace lamina

@@ -117,10 +117,11 @@ TEST(RandomWalkPdfStat, SmoothCoatOverLambertianIsTheWhiteSeries) {
 struct PdfCase {
     std::string name;
     Stack stack;
+    RandomWalkStack::Microsurface microsurface = RandomWalkStack::Microsurface::Single;
 };
 
 void expect_sample_matches_pdf(const PdfCase& c, int test_count) {
-    const RandomWalkStack rw(c.stack);
+    const RandomWalkStack rw(c.stack, 10'000, TransmissionMasking::Smith, c.microsurface);
     ASSERT_TRUE(rw.pdf_is_unbiased()) << c.name;
     const Vec3d wi = incident_direction(deg_to_rad(40.0));
     const std::uint64_t walks_per_cell = 3000;
@@ -184,6 +185,31 @@ TEST(RandomWalkPdfStat, SampleHistogramMatchesThePdfAndItsIntegral) {
                      test::make_stack({test::with_medium(test::dielectric_layer(1.4, 0.0),
                                                          Rgbd(0.1), Rgbd(1.0), Rgbd(0.7)),
                                        test::dielectric_layer(1.0, 0.0)})});
+    for (const PdfCase& c : cases)
+        expect_sample_matches_pdf(c, int(cases.size()));
+}
+
+// Multiple-scattering interfaces (docs/rendering.md §1.6): the exit density of the microsurface
+// walks, estimated by the same walks with a connection at every facet, against the histogram of
+// sample()'s exits, which leave through those walks. A rough dielectric alone (both sides), a rough
+// conductor, a rough coat over a Lambertian (the rough exit's two strategies), and a rough coat
+// over a scattering medium with per-channel extinction over a rough conductor (the facets'
+// per-channel Fresnel weights inside the spectral-MIS chain probabilities).
+TEST(RandomWalkPdfStat, MultipleScatteringSampleHistogramMatchesThePdf) {
+    using enum RandomWalkStack::Microsurface;
+    const Rgbd eta(0.2, 0.4, 1.4), k(3.9, 2.4, 1.6);
+    std::vector<PdfCase> cases = {
+        {"ms_rough_dielectric", test::make_stack({test::dielectric_layer(1.5, 0.6)}), Multiple},
+        {"ms_rough_conductor", test::make_stack({test::conductor_layer(eta, k, 0.7)}), Multiple},
+        {"ms_rough_coat_lambertian",
+         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1)),
+                           test::lambertian_layer(Rgbd(0.8, 0.5, 0.2))}),
+         Multiple},
+        {"ms_rough_coat_chromatic_scattering_conductor",
+         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.3), Rgbd(0.0),
+                                             Rgbd(0.3, 0.8, 1.5), Rgbd(0.5)),
+                           test::conductor_layer(eta, k, 0.5)}),
+         Multiple}};
     for (const PdfCase& c : cases)
         expect_sample_matches_pdf(c, int(cases.size()));
 }

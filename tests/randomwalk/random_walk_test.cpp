@@ -98,23 +98,32 @@ void expect_agreement_conservative(const test::TableComparison& r, double alpha 
         << "chi2 = " << r.chi2 << " over " << r.bins << " bins; worst: " << r.worst;
 }
 
+using RwMicrosurface = RandomWalkStack::Microsurface;
+
 SimulationResult simulate_one(const Stack& stack, double theta_i, std::uint64_t particles,
-                              const HemisphereGrid& grid) {
+                              const HemisphereGrid& grid,
+                              RwMicrosurface microsurface = RwMicrosurface::Single) {
     SimulationSettings s;
     s.theta_i_deg = {theta_i};
     s.particles = particles;
     s.grid = grid;
     s.seed = 11;
+    if (microsurface == RwMicrosurface::Multiple) {
+        s.microsurface = Microsurface::Multiple;
+        s.kernel = Kernel::Scalar;  // the goniophotometer's kernel with multiple scattering
+    }
     return simulate(stack, s);
 }
 
 // z-scores of (random walk − goniophotometer) per bin and channel with the combined standard
 // error; the criterion of the goniophotometer's own tests (table_checks.h: Šidák max |z| and χ²).
+// `microsurface`: both sides with single- or with multiple-scattering rough interfaces.
 void expect_tables_agree(const Stack& stack, double theta_i, int p, std::uint64_t walks,
-                         std::uint64_t particles, const std::string& what) {
+                         std::uint64_t particles, const std::string& what,
+                         RwMicrosurface microsurface = RwMicrosurface::Single) {
     const HemisphereGrid grid(9, 9);
-    const RandomWalkStack rw(stack);
-    const SimulationResult ref = simulate_one(stack, theta_i, particles, grid);
+    const RandomWalkStack rw(stack, 10'000, TransmissionMasking::Smith, microsurface);
+    const SimulationResult ref = simulate_one(stack, theta_i, particles, grid, microsurface);
     for (Side side : {Side::Reflection, Side::Transmission}) {
         if (side == Side::Transmission && !stack.transmits()) continue;
         const BinnedWalk b = bin_random_walk(rw, theta_i, grid, side, p, walks, 5);
@@ -364,10 +373,10 @@ TEST(RandomWalkStat, FlippedStackIsTheStackSeenFromBelow) {
 // E[weight · 1_bin(wo)] = ∫_bin f |cos θo| dωo: the histogram of sample weights (non-delta exits)
 // equals the binned eval (both with standard errors), and the delta exits' total equals the
 // ladder's delta-lobe energies.
-TEST(RandomWalkStat, SampleAgreesWithEval) {
-    for (const char* name : {"plastic", "slab", "milky-coat"}) {
-        const Stack stack = example(name);
-        const RandomWalkStack rw(stack);
+void expect_sample_agrees_with_eval(const std::string& name, const Stack& stack,
+                                    RwMicrosurface microsurface) {
+    {
+        const RandomWalkStack rw(stack, 10'000, TransmissionMasking::Smith, microsurface);
         const HemisphereGrid grid(9, 9);
         const double ti = 35;
         const Vec3d wi = incident_direction(deg_to_rad(ti));
@@ -425,6 +434,43 @@ TEST(RandomWalkStat, SampleAgreesWithEval) {
             expect_agreement_conservative(r);
         }
     }
+}
+
+TEST(RandomWalkStat, SampleAgreesWithEval) {
+    for (const char* name : {"plastic", "slab", "milky-coat"})
+        expect_sample_agrees_with_eval(name, example(name), RwMicrosurface::Single);
+}
+
+// ---- Multiple scattering on the microsurfaces (docs/rendering.md §1.6) --------------------------
+// Stacks whose rough interfaces exercise every place the walk meets one: a rough dielectric alone
+// (R and T from both of its sides' facets), a rough conductor, a rough coat over a Lambertian (the
+// rough exit's two strategies, §1.3), and a rough scattering slab (the BTDF through a rough base).
+std::vector<std::pair<std::string, Stack>> multiple_scattering_stacks() {
+    return {
+        {"rough dielectric 1.5 α0.5", test::make_stack({test::dielectric_layer(1.5, 0.5)})},
+        {"rough conductor α0.6",
+         test::make_stack({test::conductor_layer(Rgbd(0.2, 0.4, 1.4), Rgbd(3.9, 2.4, 1.6), 0.6)})},
+        {"rough coat α0.4 over lambertian",
+         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1)),
+                           test::lambertian_layer(Rgbd(0.8, 0.5, 0.2))})},
+        {"rough scattering slab",
+         test::make_stack(
+             {test::with_medium(test::dielectric_layer(1.4, 0.3), Rgbd(0.05), Rgbd(0.5), Rgbd(0.6)),
+              test::dielectric_layer(1.0, 0.5)})},
+    };
+}
+
+TEST(RandomWalkStat, MultipleScatteringAgreesWithTheGoniophotometer) {
+    for (const auto& [name, stack] : multiple_scattering_stacks())
+        for (double ti : {35.0, 75.0})
+            expect_tables_agree(stack, ti, 3, 1000, 2'000'000,
+                                name + " multiple θi=" + std::to_string(ti),
+                                RwMicrosurface::Multiple);
+}
+
+TEST(RandomWalkStat, MultipleScatteringSampleAgreesWithEval) {
+    for (const auto& [name, stack] : multiple_scattering_stacks())
+        expect_sample_agrees_with_eval(name, stack, RwMicrosurface::Multiple);
 }
 
 // ---- Reproducibility ---------------------------------------------------------------------------

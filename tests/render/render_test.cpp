@@ -208,6 +208,45 @@ TEST(RenderStat, WhiteFurnaceNonAbsorbingSlabsAreOne) {
     }
 }
 
+// Multiple scattering on the microsurfaces (docs/rendering.md §1.6): a rough coat (τ = 0) over a
+// white Lambertian and a transparent non-absorbing rough slab lose nothing, so under the uniform
+// environment they render 1 within noise; with single scattering the same spheres are darker by
+// far more than their standard error (the energy the microsurfaces lose). Every pixel is finite.
+TEST(RenderStat, WhiteFurnaceRoughStacksAreOneWithMultipleScattering) {
+    const std::vector<Stack> stacks = {
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.5), Rgbd(0.0)),
+                          test::lambertian_layer(Rgbd(1.0))}),
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.0)),
+                          test::dielectric_layer(1.0, 0.6)})};
+    for (const Stack& stack : stacks)
+        for (const char* microsurface : {"multiple", "single"}) {
+            const auto rw =
+                make_model("random-walk", stack, {std::string("microsurface=") + microsurface});
+            RenderSettings rs = small(32, 16);
+            rs.transparent = stack.transmits();
+            const Rendering r = render_sphere(*rw, Environment::named("uniform"), rs);
+            double sum = 0, sum_sq = 0;
+            int n = 0;
+            for (std::size_t i = 0; i < r.mask.size(); ++i)
+                if (r.mask[i]) {
+                    for (int c = 0; c < 3; ++c)
+                        ASSERT_TRUE(std::isfinite(r.image.pixels[i][c]));
+                    const double v = r.image.pixels[i][1];
+                    sum += v;
+                    sum_sq += v * v;
+                    ++n;
+                }
+            const double mean = sum / n, se = std::sqrt((sum_sq / n - mean * mean) / (n - 1));
+            if (std::string(microsurface) == "multiple") {
+                EXPECT_LT(std::abs(mean - 1), 5 * se)
+                    << stack.layers.size() << ": " << mean << " ± " << se;
+                EXPECT_LT(se, 0.02);
+            } else {
+                EXPECT_GT(1 - mean, 5 * se) << "single: " << mean << " ± " << se;
+            }
+        }
+}
+
 TEST(Render, IdenticalAcrossThreadCounts) {
     const Stack s = load_stack(std::string(LAMINA_SOURCE_DIR) + "/examples/milky-coat.json");
     const auto rw = make_model("random-walk", s);

@@ -1,0 +1,61 @@
+// Speed of the random-walk estimator (docs/performance.md, "The random walk"): one walk's eval
+// (RandomWalkStack::eval_once, what the renderer calls per connection) with single- and with
+// multiple-scattering rough interfaces (docs/rendering.md §1.6), single thread, on a rough clear
+// coat (η 1.5, α 0.3, some absorption) over rough gold (α 0.3) and on a rough dielectric alone.
+#include "core/rng.h"
+#include "core/spherical.h"
+#include "layers/stack.h"
+#include "randomwalk/random_walk.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+
+namespace {
+
+using namespace lamina;
+
+Stack bench_stack(bool coat) {
+    Stack s;
+    Layer top;
+    top.interface.type = InterfaceType::Dielectric;
+    top.interface.eta = 1.5;
+    top.interface.alpha = 0.3;
+    if (!coat) {
+        s.layers = {top};
+        return s;
+    }
+    top.has_medium = true;
+    top.medium.tau_a = Rgbd(0.05, 0.1, 0.2);
+    Layer base;
+    base.interface.type = InterfaceType::Conductor;
+    base.interface.eta_rgb = Rgbd(0.18, 0.42, 1.37);
+    base.interface.k = Rgbd(3.4, 2.35, 1.85);
+    base.interface.alpha = 0.3;
+    s.layers = {top, base};
+    return s;
+}
+
+// range(0): 1 = coat over gold, 0 = rough dielectric alone; range(1): 1 = multiple scattering.
+void BM_RandomWalkEvalOnce(benchmark::State& state) {
+    const RandomWalkStack rw(bench_stack(state.range(0) == 1), 10'000, TransmissionMasking::Smith,
+                             state.range(1) == 1 ? RandomWalkStack::Microsurface::Multiple
+                                                 : RandomWalkStack::Microsurface::Single);
+    const Vec3d wi = incident_direction(0.6), wo = direction_from_angles(0.8, 2.6);
+    std::uint64_t i = 0;
+    Rgbd sum(0.0);
+    for (auto _ : state) {
+        ParticleRng rng(1, 2, i++);
+        sum += rw.eval_once(wi, wo, rng);
+    }
+    benchmark::DoNotOptimize(sum);
+    state.SetItemsProcessed(std::int64_t(i));
+}
+BENCHMARK(BM_RandomWalkEvalOnce)
+    ->ArgNames({"coat", "multiple"})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Args({0, 0})
+    ->Args({0, 1});
+
+}  // namespace
