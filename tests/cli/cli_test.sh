@@ -215,6 +215,17 @@ check render-reproducible 0 cmp "$tmp/r1.exr" "$tmp/r2.exr"
 check render-compare 0 "$lamina" render "$src/examples/metallic-paint.json" --compare --size 24 --spp 2 --out "$tmp/cmp"
 check render-sheet 0 test -s "$tmp/cmp/compare.png"
 check_says render-errors 0 "ww-prime," cat "$tmp/cmp/errors.csv"
+# Multiple scattering on the microsurfaces: reproducible across thread counts too; bad values and
+# other models refused.
+check render-ms1 0 "$lamina" render "$src/examples/frosted-gold.json" --microsurface multiple --size 16 --spp 2 --threads 1 --out "$tmp/ms1.png"
+check render-ms2 0 "$lamina" render "$src/examples/frosted-gold.json" --microsurface multiple --size 16 --spp 2 --threads 2 --out "$tmp/ms2.png"
+check render-ms-reproducible 0 cmp "$tmp/ms1.exr" "$tmp/ms2.exr"
+check_says render-ms-bad 1 "--microsurface: 'lots' is not a microsurface model" \
+    "$lamina" render "$src/examples/plastic.json" --microsurface lots --size 8 --spp 1 --out "$tmp/ms3.png"
+check_says render-ms-model 1 "applies to the random-walk reference only" \
+    "$lamina" render "$src/examples/plastic.json" --model ww-prime --microsurface multiple --size 8 --spp 1 --out "$tmp/ms4.png"
+check_says eval-ms-bad 1 "allowed: single, multiple" \
+    "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 --theta-o 45 --option microsurface=lots
 check_says render-bad-env 1 "unknown environment" \
     "$lamina" render "$src/examples/plastic.json" --env moon --out "$tmp/r3.png"
 check study-render 0 "$lamina" study --only 'plastic-P2-a0.05*' --particles 2e4 --grid 9x9 --theta-i 30 \

@@ -345,3 +345,28 @@ def test_table_from_arrays_round_trips():
     bad[0, 0, 0, 0, 0] = np.nan
     with pytest.raises(lamina.InputError):
         lamina.Table.from_arrays(bad, t.theta_i, t.sides)
+
+
+def test_random_walk_microsurface_option():
+    """microsurface="multiple" is the CLI's --option microsurface=multiple (the same estimate
+    within its standard error) and adds the energy the single-scattering microsurface loses."""
+    gold = ROOT / "examples" / "frosted-gold.json"
+    ti, to, po = np.radians(30.0), np.radians(45.0), np.radians(180.0)
+    wi = [np.sin(ti), 0.0, np.cos(ti)]
+    wo = [np.sin(to) * np.cos(po), np.sin(to) * np.sin(po), np.cos(to)]
+    args = ("eval", "--model", "random-walk", "--stack", gold, "--theta-i", 30, "--theta-o", 45,
+            "--phi-o", 180, "--samples", 16384, "--seed", 3)
+    values = {}
+    for ms in ("single", "multiple"):
+        m = lamina.Model("random-walk", gold, microsurface=ms, samples=16384, seed=3)
+        assert m.options["microsurface"] == ms
+        got = np.asarray(m.eval(wi, wo))
+        out = cli(*args, "--option", f"microsurface={ms}").stdout.split()
+        want, se = np.array(out[:3], float), np.array(out[3:6], float)
+        assert np.all(np.abs(got - want) < 5 * np.sqrt(2) * se + 1e-12), (ms, got, want, se)
+        values[ms] = (want, se)
+    (f1, s1), (f2, s2) = values["single"], values["multiple"]
+    # Red, where gold reflects most and the walk's higher orders add most.
+    assert f2[0] - f1[0] > 4 * np.hypot(s1[0], s2[0]), (f1, f2)
+    with pytest.raises(lamina.InputError):
+        lamina.Model("random-walk", gold, microsurface="many")

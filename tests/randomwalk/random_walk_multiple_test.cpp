@@ -129,8 +129,8 @@ Albedo hemispherical_albedo(const RandomWalkStack& rw, const Vec3d& wi, Side sid
             const double st = std::sqrt(std::max(0.0, 1 - z * z));
             const Vec3d wo(st * std::cos(phi), st * std::sin(phi),
                            side == Side::Reflection ? z : -z);
-            f[k] = 2 * kPi<double> * z *
-                   rw.eval(wi, wo, walks, seed, 2 * std::uint64_t(i) + k).f[1];
+            f[k] =
+                2 * kPi<double> * z * rw.eval(wi, wo, walks, seed, 2 * std::uint64_t(i) + k).f[1];
         }
         sum += 0.5 * (f[0] + f[1]);
         var += 0.25 * sqr(f[0] - f[1]);
