@@ -274,7 +274,8 @@ Runner add_study(CLI::App& app) {
             for (const StudyConfiguration& c : configs) {
                 const std::string csv =
                     write_comparison(c.stack, env, rs, out / "configs" / c.id / "renders", 0.0,
-                                     {"transmission-masking=" + a->transmission_masking});
+                                     {"transmission-masking=" + a->transmission_masking,
+                                      "microsurface=" + a->microsurface});
                 std::stringstream lines(csv);
                 std::string line;
                 std::getline(lines, line);  // header

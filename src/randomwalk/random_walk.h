@@ -35,6 +35,11 @@
 // ∫ p dω = P(sample returns a non-delta exit)). The renderer keeps a proxy density in its MIS
 // weights (docs/rendering.md §2 says why).
 //
+// Rough interfaces scatter once (Microsurface::Single, the default) or on their whole
+// microsurface (Microsurface::Multiple, Heitz et al. 2016): then sample() follows the microsurface
+// walk and every connection through such an interface uses one walk's unbiased estimate of its
+// kernel or exit density (docs/rendering.md §1.6), so eval() and pdf() keep their expectations.
+//
 // Thread safety: const methods only; each call owns its random-number generator.
 
 #include "core/rgb.h"
