@@ -369,6 +369,57 @@ TEST(RandomWalkStat, FlippedStackIsTheStackSeenFromBelow) {
     }
 }
 
+// The multiple-scattering BSDF of Heitz et al. 2016 is reciprocal (their §5), and so must the
+// random walk through it be: BRDFs f(wi, wo) = f(wo, wi), and a slab's BTDF with the generalized
+// reciprocity above — light from below through the flipped stack, which checks the η² of the
+// microsurface walks' refraction from both sides without the goniophotometer.
+TEST(RandomWalkStat, MultipleScatteringIsReciprocal) {
+    const std::vector<Stack> brdf_stacks = {
+        test::make_stack({test::dielectric_layer(1.5, 0.6)}),
+        test::make_stack({test::conductor_layer(Rgbd(0.2, 0.4, 1.4), Rgbd(3.9, 2.4, 1.6), 0.6)}),
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1)),
+                          test::conductor_layer(Rgbd(0.2), Rgbd(3.0), 0.5)})};
+    std::uint64_t stream = 0;
+    for (const Stack& s : brdf_stacks) {
+        const RandomWalkStack rw(s, 10'000, TransmissionMasking::Smith, RwMicrosurface::Multiple);
+        for (const auto& [a, b] : std::vector<std::pair<Vec3d, Vec3d>>{
+                 {direction_from_angles(0.3, 0.0), direction_from_angles(1.1, 2.0)},
+                 {direction_from_angles(1.3, 0.5), direction_from_angles(0.2, 3.0)}}) {
+            const RandomWalkEstimate ab = rw.eval(a, b, 40000, 9, ++stream);
+            const RandomWalkEstimate ba = rw.eval(b, a, 40000, 9, ++stream);
+            for (int c = 0; c < 3; ++c) {
+                const double se = std::hypot(ab.se[c], ba.se[c]);
+                ASSERT_GT(se, 0);
+                EXPECT_LT(std::abs(ab.f[c] - ba.f[c]), 4.6 * se)  // Šidák, 36 tests at 1e-4
+                    << s.layers.size() << " layers ch " << c << ": " << ab.f[c] << " ± " << ab.se[c]
+                    << " vs " << ba.f[c] << " ± " << ba.se[c];
+            }
+        }
+    }
+    const Stack slab =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1)),
+                          test::dielectric_layer(1.33, 0.5)});
+    const RandomWalkStack rw(slab, 10'000, TransmissionMasking::Smith, RwMicrosurface::Multiple);
+    const RandomWalkStack below(flipped_stack(slab), 10'000, TransmissionMasking::Smith,
+                                RwMicrosurface::Multiple);
+    const double ratio2 = sqr(rw.eta_top() / rw.eta_bottom());
+    auto flip = [](const Vec3d& w) { return Vec3d(w.x, w.y, -w.z); };
+    for (const auto& [wi, wo] : std::vector<std::pair<Vec3d, Vec3d>>{
+             {direction_from_angles(0.3, 0.0), direction_from_angles(0.5, 2.0, Side::Transmission)},
+             {direction_from_angles(1.1, 0.0),
+              direction_from_angles(0.2, 3.0, Side::Transmission)}}) {
+        const RandomWalkEstimate a = rw.eval(wi, wo, 40000, 13, ++stream);
+        const RandomWalkEstimate b = below.eval(flip(wo), flip(wi), 40000, 13, ++stream);
+        for (int c = 0; c < 3; ++c) {
+            const double se = std::hypot(a.se[c] * ratio2, b.se[c]);
+            ASSERT_GT(se, 0);
+            EXPECT_LT(std::abs(a.f[c] * ratio2 - b.f[c]), 4.6 * se)
+                << "slab ch " << c << ": " << a.f[c] * ratio2 << " ± " << a.se[c] * ratio2 << " vs "
+                << b.f[c] << " ± " << b.se[c];
+        }
+    }
+}
+
 // ---- sample() against eval(): the walk's exits, binned, are the bin averages of f --------------
 // E[weight · 1_bin(wo)] = ∫_bin f |cos θo| dωo: the histogram of sample weights (non-delta exits)
 // equals the binned eval (both with standard errors), and the delta exits' total equals the
