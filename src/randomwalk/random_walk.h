@@ -137,6 +137,9 @@ class RandomWalkStack {
     /// per-channel Fresnel, an absorbing non-scattering medium with per-channel τ): then the
     /// spectral-MIS channel probabilities make the exit probability a non-linear function of the
     /// flux weights and pdf() is an approximation (docs/rendering.md §1.4). False only then.
+    /// Multiple-scattering interfaces do not change it: each facet's exit enters the chain
+    /// probability with its own weight (docs/rendering.md §1.6); the facet cap truncates sample,
+    /// eval and pdf alike.
     bool pdf_is_unbiased() const { return pdf_unbiased_; }
 
     /// The delta lobes of the stack for incidence wi (paths made only of smooth events and
