@@ -2,6 +2,8 @@
 
 #include "core/math.h"
 #include "core/rng.h"
+#include "models/coat_transmittance.h"
+#include "models/fgd_table.h"
 #include "models/table_cache.h"
 #include "physics/microsurface_walk.h"
 
@@ -15,7 +17,7 @@ namespace {
 
 using Table = MultipleScatteringAlbedo;
 
-constexpr const char* kCodeVersion = "ms-albedo-v1";
+constexpr const char* kCodeVersion = "ms-albedo-v2";
 constexpr std::uint64_t kSeed = 0x6d73616c62656431ull;  // fixed: the table is deterministic
 constexpr int kMaxOrder = 100;                          // the goniophotometer's facet cap
 
@@ -36,10 +38,10 @@ Vec3d incident(double mu) {
 }
 
 std::size_t dielectric_index(int im, int ia, int ie) {
-    return ((std::size_t(im) * Table::kNalpha + ia) * Table::kNeta + ie) * 2;
+    return (std::size_t(im) * Table::kNalpha + ia) * Table::kNeta + ie;
 }
 std::size_t conductor_index(int im, int ia) {
-    return std::size_t(Table::kNmu) * Table::kNalpha * Table::kNeta * 2 +
+    return std::size_t(Table::kNmu) * Table::kNalpha * Table::kNeta +
            std::size_t(im) * Table::kNalpha + ia;
 }
 
@@ -87,26 +89,27 @@ double Table::walk_conductor(double mu, double alpha, int walks, unsigned stream
 }
 
 MultipleScatteringAlbedo::MultipleScatteringAlbedo() {
-    const TableKey key{
-        "ms-albedo",
-        fmt::format("{} mu{}:{} a{} e{}:{}:{} walks{} order{} seed{}", kCodeVersion, kNmu, kMuMin,
-                    kNalpha, kNeta, kLog2EtaMin, kLog2EtaMax, kWalks, kMaxOrder, kSeed),
-        {std::uint32_t(kNmu * kNalpha * kNeta * 2 + kNmu * kNalpha)}};
+    const TableKey key{"ms-albedo",
+                       fmt::format("{} mu{}:{} a{} e{}:{}:{} walks{}:{} order{} seed{}",
+                                   kCodeVersion, kNmu, kMuMin, kNalpha, kNeta, kLog2EtaMin,
+                                   kLog2EtaMax, kWalksSplit, kWalksConductor, kMaxOrder, kSeed),
+                       {std::uint32_t(kNmu * kNalpha * kNeta + kNmu * kNalpha)}};
     values_ = cached_table(key, [] {
-        std::vector<float> v(std::size_t(kNmu) * kNalpha * kNeta * 2 + kNmu * kNalpha);
+        std::vector<float> v(std::size_t(kNmu) * kNalpha * kNeta + kNmu * kNalpha);
         // One stream per node: each node's walks are the same whatever the thread count.
 #pragma omp parallel for schedule(dynamic) collapse(2)
         for (int im = 0; im < kNmu; ++im)
             for (int ia = 0; ia < kNalpha; ++ia) {
                 for (int ie = 0; ie < kNeta; ++ie) {
                     const unsigned stream = unsigned(dielectric_index(im, ia, ie));
-                    const Dielectric d =
-                        walk_dielectric(mu_node(im), alpha_node(ia), eta_node(ie), kWalks, stream);
-                    v[dielectric_index(im, ia, ie)] = float(d.reflected);
-                    v[dielectric_index(im, ia, ie) + 1] = float(d.transmitted);
+                    const Dielectric d = walk_dielectric(mu_node(im), alpha_node(ia), eta_node(ie),
+                                                         kWalksSplit, stream);
+                    const double total = d.reflected + d.transmitted;
+                    v[dielectric_index(im, ia, ie)] = float(total > 0 ? d.reflected / total : 0);
                 }
-                v[conductor_index(im, ia)] = float(walk_conductor(
-                    mu_node(im), alpha_node(ia), kWalks, unsigned(conductor_index(im, ia))));
+                v[conductor_index(im, ia)] =
+                    float(walk_conductor(mu_node(im), alpha_node(ia), kWalksConductor,
+                                         unsigned(conductor_index(im, ia))));
             }
         return v;
     });
@@ -127,14 +130,18 @@ Table::Dielectric MultipleScatteringAlbedo::dielectric(double mu, double alpha, 
     locate((clamp(std::log2(eta), kLog2EtaMin, kLog2EtaMax) - kLog2EtaMin) /
                (kLog2EtaMax - kLog2EtaMin) * (kNeta - 1),
            kNeta, ie, te);
+    double split = 0;
     for (int dm = 0; dm < 2; ++dm)
         for (int da = 0; da < 2; ++da)
-            for (int de = 0; de < 2; ++de) {
-                const double w = (dm ? tm : 1 - tm) * (da ? ta : 1 - ta) * (de ? te : 1 - te);
-                const std::size_t i = dielectric_index(im + dm, ia + da, ie + de);
-                out.reflected += w * values_[i];
-                out.transmitted += w * values_[i + 1];
-            }
+            for (int de = 0; de < 2; ++de)
+                split += (dm ? tm : 1 - tm) * (da ? ta : 1 - ta) * (de ? te : 1 - te) *
+                         values_[dielectric_index(im + dm, ia + da, ie + de)];
+    // What single scattering loses, from its own tables (the walk's orders ≥ 2 carry exactly it).
+    const double lost = std::max(
+        0.0, 1 - FgdTable::get()(mu, alpha, eta, 0.0) -
+                 CoatTransmittanceTable::get(RefractionMasking::SmithBeta)(mu, alpha, eta));
+    out.reflected = split * lost;
+    out.transmitted = (1 - split) * lost;
     return out;
 }
 

@@ -15,12 +15,17 @@
 // single scattering loses (docs/physics.md, "lost to the microsurface").
 //
 // lamina computes the table itself by the walk (the very code of the goniophotometer's
-// --microsurface multiple), 2^13 walks per node from lamina's counter-based generator (fixed
-// seed: the table is the same on every machine up to the rounding of the math library), and caches
-// it on disk as the FGD table (models/table_cache.h). Its Monte-Carlo standard error is ≤ 0.0056
-// (absolute albedo) per node. Axes: μ = s² (17 nodes, the first at 10⁻³), α = s² (17, α = 0 gives
-// 0 exactly: a smooth interface has one order), log2 η ∈ [−2, 2] (13, η = 1 a node); arguments
-// outside are clamped; multilinear interpolation.
+// --microsurface multiple), from lamina's counter-based generator with a fixed seed (the same on
+// every machine up to the rounding of the math library), and caches it on disk as the FGD table
+// (models/table_cache.h). For the dielectric it stores only how the orders ≥ 2 split, s = ΔR /
+// (ΔR + ΔT) (2^12 walks per node); their total is what single scattering loses, taken from the
+// single-scattering tables, L = 1 − FGD(μ, α, η) − T(μ, α, η) (models/fgd_table.h,
+// models/coat_transmittance.h with the Smith masking): ΔR = s L, ΔT = (1 − s) L, so that a rough
+// dielectric with its orders ≥ 2 conserves energy by construction. The conductor's ΔE is stored
+// itself (2^13 walks per node, standard error ≤ 0.0056). Axes: μ = s² (17 nodes, the first at
+// 10⁻³), α = s² (17, α = 0 gives 0 exactly: a smooth interface has one order), log2 η ∈ [−2, 2]
+// (25, η = 1 a node; the split changes fast near η = 1, where total internal reflection begins);
+// arguments outside are clamped; multilinear interpolation.
 
 #include <vector>
 
@@ -40,18 +45,19 @@ class MultipleScatteringAlbedo {
     /// Orders ≥ 2 of a rough white conductor (ΔE). μ ∈ [0, 1], α ∈ [0, 1].
     double conductor(double mu, double alpha) const;
 
-    /// The walk's estimates at one node with `walks` walks (no table): what the table holds and
-    /// what the tests check it against.
+    /// The walk's estimates of ΔR and ΔT at one node with `walks` walks (no table): what the
+    /// table's split comes from and what the tests check it against.
     static Dielectric walk_dielectric(double mu, double alpha, double eta, int walks,
                                       unsigned stream);
     static double walk_conductor(double mu, double alpha, int walks, unsigned stream);
 
-    static constexpr int kNmu = 17, kNalpha = 17, kNeta = 13, kWalks = 1 << 13;
+    static constexpr int kNmu = 17, kNalpha = 17, kNeta = 25;
+    static constexpr int kWalksSplit = 1 << 12, kWalksConductor = 1 << 13;
     static constexpr double kLog2EtaMin = -2, kLog2EtaMax = 2, kMuMin = 1e-3;
 
   private:
     MultipleScatteringAlbedo();
-    // [μ][α][η][ΔR, ΔT] then [μ][α] ΔE.
+    // [μ][α][η] s, then [μ][α] ΔE.
     std::vector<float> values_;
 };
 

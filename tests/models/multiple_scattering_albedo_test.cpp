@@ -87,14 +87,16 @@ TEST(MultipleScatteringAlbedo, TableInterpolatesTheWalk) {
     // interpolation's error (the orders ≥ 2 vary slowly: ≤ 0.01 between nodes measured).
     constexpr int kWalks = 1 << 15;
     unsigned stream = 990;
-    for (const Case c : {Case{0.37, 0.45, 1.5}, Case{0.12, 0.7, 1 / 1.5}, Case{0.8, 0.25, 1.8}}) {
+    for (const Case c : {Case{0.37, 0.45, 1.5}, Case{0.12, 0.7, 1 / 1.5}, Case{0.8, 0.25, 1.8},
+                         Case{0.2, 0.7, 1 / 1.2}, Case{0.5, 0.7, 1 / 1.2}}) {
         const auto t = table.dielectric(c.mu, c.alpha, c.eta);
         const auto w =
             MultipleScatteringAlbedo::walk_dielectric(c.mu, c.alpha, c.eta, kWalks, stream++);
         const double tol_r = 4 * binomial_se(w.reflected, kWalks) +
-                             4 * binomial_se(w.reflected, MultipleScatteringAlbedo::kWalks) + 0.01;
+                             4 * binomial_se(w.reflected, MultipleScatteringAlbedo::kWalksSplit) +
+                             0.01;
         const double tol_t = 4 * binomial_se(w.transmitted, kWalks) +
-                             4 * binomial_se(w.transmitted, MultipleScatteringAlbedo::kWalks) +
+                             4 * binomial_se(w.transmitted, MultipleScatteringAlbedo::kWalksSplit) +
                              0.01;
         EXPECT_NEAR(t.reflected, w.reflected, tol_r) << c.mu << " " << c.alpha << " " << c.eta;
         EXPECT_NEAR(t.transmitted, w.transmitted, tol_t) << c.mu << " " << c.alpha << " " << c.eta;
@@ -102,7 +104,7 @@ TEST(MultipleScatteringAlbedo, TableInterpolatesTheWalk) {
         const double wc = MultipleScatteringAlbedo::walk_conductor(c.mu, c.alpha, kWalks, stream++);
         EXPECT_NEAR(tc, wc,
                     4 * binomial_se(wc, kWalks) +
-                        4 * binomial_se(wc, MultipleScatteringAlbedo::kWalks) + 0.01);
+                        4 * binomial_se(wc, MultipleScatteringAlbedo::kWalksConductor) + 0.01);
     }
 }
 
