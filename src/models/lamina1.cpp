@@ -142,9 +142,10 @@ class Lamina1 final : public Model {
         Rgbd a{1.0};   ///< exp(−τ/μi')
         Rgbd X{0.0};   ///< X(μi) = T(μi) a(μi') Y(μi')
         double lambda0 = 0, k_top = 0, k_bottom = 1;
-        Vec3d wi_mean;     ///< the mean direction of the light the coat transmits (slabs)
-        Rgbd a_mean{1.0};  ///< exp(−τ/μ̄')
-        double dR = 0;     ///< ΔR(μi) of the coat (multiple scattering)
+        Vec3d wi_mean;      ///< the mean direction of the light the coat transmits (slabs)
+        Rgbd a_mean{1.0};   ///< exp(−τ/μ̄')
+        double dR = 0;      ///< ΔR(μi) of the coat (multiple scattering)
+        double T_pair = 0;  ///< √(T(μi) T_exit(μi)): the first order's reciprocal coat factor
     };
 
     Incident incident(const Vec3d& wi) const {
@@ -154,11 +155,14 @@ class Lamina1 final : public Model {
         in.ok = true;
         in.wi_in = refract_in(wi, inv_eta0_);
         in.T = T_top_(wi.z);
+        in.T_pair = in.T;
         in.a = attenuation(in.wi_in.z);
         if (series_on_) in.X = X_at(wi.z);
         if (alpha0_ > 0) in.lambda0 = GGX<double>{alpha0_}.lambda(wi);
         if (top_ms_) in.dR = dR_top_(wi.z);
         in.k_top = spread_factor(wi.z, in.wi_in.z, eta0_);
+        if (inside_exit_)
+            in.T_pair = std::sqrt(in.T * exit_transmittance(wi.z, in.wi_in.z, in.k_top));
         if (support_.btdf) {
             in.wi_mean = in.wi_in;
             in.a_mean = in.a;
@@ -203,7 +207,7 @@ class Lamina1 final : public Model {
             if (top_ms_) f += Rgbd(in.dR * dR_top_(wo.z) * kInvPi<double> / dR_top_bar_);
         }
         const Vec3d wo_in = refract_in(wo, inv_eta0_);
-        const double T_o = T_top_(wo.z);
+        double T_o = T_top_(wo.z);
         const Rgbd a_o = attenuation(wo_in.z);
         // First order: the base's lobe at the refracted directions, entering and leaving through
         // the coat's directional transmittance; 1/η0² compresses the solid angle.
@@ -211,7 +215,17 @@ class Lamina1 final : public Model {
         // √(1 − sin²θ) rounds to 0) carries no first order: T is 0 there and the lobe 0/0.
         const Rgbd fb =
             in.wi_in.z > 0 && wo_in.z > 0 ? base_lobe(in, wi.z, wo.z, wo_in) : Rgbd(0.0);
-        f += fb * (in.a * a_o) * (in.T * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
+        // The coat enters with T(μi) and leaves with T_exit(μo); made reciprocal as the product
+        // √(T T_exit)(μi) √(T T_exit)(μo), exact at the mirror pair (μo = μi) where the narrow
+        // first order is.
+        if (inside_exit_ && fb.max() > 0)
+            T_o = std::sqrt(T_o *
+                            exit_transmittance(wo.z, wo_in.z, spread_factor(wo.z, wo_in.z, eta0_)));
+        Rgbd rounds(1.0);
+        if (mirror_series_ && fb.max() > 0)
+            rounds = mirror_series_curve_(in.wi_in.z) * mirror_series_curve_(wo_in.z);
+        f += fb * (in.a * a_o) * rounds *
+             (in.T_pair * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
         if (series_on_) {
             f += in.X * X_at(wo.z) * K_ * (kInvPi<double> * inv_eta0_ * inv_eta0_);
         }
@@ -303,6 +317,8 @@ class Lamina1 final : public Model {
             Rgbd a_once = in.a_mean * a_v;
             for (int c = 0; c < 3; ++c)
                 a_once[c] = std::sqrt(a_once[c]);
+            if (mirror_series_)
+                a_once *= mirror_series_curve_(in.wi_mean.z) * mirror_series_curve_(v_in->z);
             f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
         }
         if (series_btdf_)
@@ -323,6 +339,18 @@ class Lamina1 final : public Model {
         if (base_ms_)
             f += F_ms_ * (dE_base_(in.wi_in.z) * dE_base_(wo_in.z) * kInvPi<double> / dE_base_bar_);
         return f;
+    }
+
+    /// The coat's transmittance for the first order leaving a non-Lambertian base towards the
+    /// outside cosine μ (inside μ_in, spread factor k): T_in(μ_in) where the base lobe is narrower
+    /// than the coat's refraction spread α0 k/2 (the light meets the coat along one direction
+    /// and leaves with that direction's transmittance from inside), T(μ) where it is wider (the
+    /// radiance inside is locally uniform, and the light reaching μ outside is T(μ) by
+    /// reciprocity), weighted by u = α1² / (α1² + (α0 k/2)²).
+    double exit_transmittance(double mu, double mu_in, double k) const {
+        const double spread2 = sqr(0.5 * alpha0_ * k),
+                     u = spread2 > 0 ? sqr(alpha1_) / (sqr(alpha1_) + spread2) : 1.0;
+        return u * T_top_(mu) + (1 - u) * T_top_in_(mu_in);
     }
 
     /// α_e² = α1² + (α0 k_i/2)² + (α0 k_o/2)²: a deflection of the light by ε turns the mirror
@@ -439,6 +467,10 @@ class Lamina1 final : public Model {
     /// Multiple scattering: the coat's ΔR from outside and its hemispherical 2∫ΔR μ dμ; the base's
     /// ΔE (conductor: white, times F_ms; dielectric: ΔR, F_ms = 1) and its average.
     bool top_ms_ = false, base_ms_ = false;
+    bool inside_exit_ = false;  ///< exit_transmittance in the first order (see Lamina1Choices)
+    bool mirror_series_ = false;
+    /// √(1/(1 − a² R_in E_b (1 − u))) over inside cosines: the first order's round trips.
+    CosineCurve<Rgbd> mirror_series_curve_;
     CosineCurve<double> dR_top_, dE_base_;
     double dR_top_bar_ = 1, dE_base_bar_ = 1;
     Rgbd F_ms_{1.0};
@@ -447,6 +479,8 @@ class Lamina1 final : public Model {
 };
 
 void Lamina1::precompute() {
+    inside_exit_ = ch_.inside_exit && alpha0_ > 0 && ch_.directional_transmittance &&
+                   coat_.base_type != InterfaceType::Lambertian;
     const auto& table = CoatTransmittanceTable::get(ch_.masking);
     const auto& fgd = FgdTable::get();
     const MultipleScatteringAlbedo* ms =
@@ -521,7 +555,10 @@ void Lamina1::precompute() {
         double R = R_in(mu);
         if (alpha0_ > 0 && mu > mu_crit) {
             const double mu_out = safe_sqrt(1 - (1 - mu * mu) * sqr(eta0_));
-            R = std::max(0.0, R + T_top_in_(mu) - T_top_(mu_out));
+            const double T_exit =
+                inside_exit_ ? exit_transmittance(mu_out, mu, spread_factor(mu_out, mu, eta0_))
+                             : T_top_(mu_out);
+            R = std::max(0.0, R + T_top_in_(mu) - T_exit);
         }
         return a * a * R;
     };
@@ -572,6 +609,25 @@ void Lamina1::precompute() {
                  (coat_.base_type == InterfaceType::Lambertian || !ch_.series_lambertian_only ||
                   alpha1_ >= alpha0_);
     series_btdf_ = series_on_ && !ch_.series_lambertian_only;
+    // Where the uniform series is off (a base smoother than the rough coat), the light the coat's
+    // bottom returns meets a base that keeps its direction: it stays in the first order's lobe,
+    // which each round trip multiplies by a² R_in E_b — the smooth stack's delta series (docs/
+    // physics.md §6.5 of the study), over the part (1 − u) of the light the base does not spread.
+    mirror_series_ = ch_.inter_reflection && inside_exit_ && !series_on_;
+    if (mirror_series_) {
+        mirror_series_curve_.fill([&](double mu) {
+            const double mu_in = std::max(mu, mu_crit + 1e-9);
+            const double mu_out = safe_sqrt(1 - (1 - mu_in * mu_in) * sqr(eta0_));
+            const double spread2 = sqr(0.5 * alpha0_ * spread_factor(mu_out, mu_in, eta0_));
+            const double u = spread2 > 0 ? sqr(alpha1_) / (sqr(alpha1_) + spread2) : 1.0;
+            const Rgbd a = attenuation(mu_in);
+            const Rgbd round_trip = a * a * base_albedo(mu_in) * (R_in(mu_in) * (1 - u));
+            Rgbd S(1.0);
+            for (int c = 0; c < 3; ++c)
+                S[c] = 1 / std::sqrt(std::max(1e-6, 1 - round_trip[c]));  // √ of 1/(1 − ·)
+            return S;
+        });
+    }
     if (!series_on_) return;
     // Y(μ') = ∫ f_b(w', w'') μ'' g(μ'') dω'': what the base's first reflection of light arriving
     // at inside cosine μ' sends back down after one reflection at the coat's bottom.
@@ -828,6 +884,12 @@ std::vector<OptionSpec> lamina1_option_specs() {
          "angular",
          "base lobe widened by the coat's refraction spread: angle-dependent deflection, its "
          "normal-incidence value, or not widened"},
+        {"exit-transmittance",
+         {"inside", "outside"},
+         d.inside_exit ? "inside" : "outside",
+         "the first order leaves a non-Lambertian base through the coat with the inside "
+         "transmittance of its direction where the base lobe is narrower than the coat's spread, "
+         "or always with the outside transmittance T(mu_o)"},
         {"microsurface",
          {"single", "multiple"},
          d.multiple_scattering ? "multiple" : "single",
@@ -846,6 +908,7 @@ Lamina1Choices lamina1_choices(const ModelOptions& o) {
     c.eta2_factor = option_value(o, "eta2") == "on";
     c.mean_shift = option_value(o, "transmitted-direction") == "mean";
     c.multiple_scattering = option_value(o, "microsurface") == "multiple";
+    c.inside_exit = option_value(o, "exit-transmittance") == "inside";
     const std::string& s = option_value(o, "spread");
     c.spread = s == "normal" ? Lamina1Choices::Spread::Normal
                : s == "off"  ? Lamina1Choices::Spread::Off

@@ -52,6 +52,11 @@ struct Lamina1Choices {
     /// gain ΔR (ΔE F_ms for a conductor), and the coat's outer reflection and the base's lobe gain
     /// the separable energy-compensation lobes ΔR(μi) ΔR(μo)/(π ΔR̄) (docs/models.md).
     bool multiple_scattering = false;
+    /// The first order leaves a conductor or dielectric base through the coat with the coat's
+    /// transmittance *from inside* along the base lobe's direction, T_in(μo'), where that lobe is
+    /// narrower than the coat's refraction spread (true), or with the outside transmittance T(μo)
+    /// (false), exact only for locally uniform radiance inside (a Lambertian base always uses it).
+    bool inside_exit = true;
 };
 
 std::vector<OptionSpec> lamina1_option_specs();
