@@ -5,6 +5,7 @@
 #include "models/table_cache.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
+#include "physics/smith_masking.h"
 
 #include <fmt/format.h>
 
@@ -18,7 +19,7 @@ constexpr int kTableNr = 32;    // Gauss–Legendre nodes in r on Heitz's disk
 constexpr int kTableNphi = 32;  // midpoint nodes in φ over the half disk (mirrored)
 constexpr double kCMin = 1e-4;
 constexpr double kAlphaMin = 1e-5;
-constexpr const char* kCodeVersion = "coat-t-v2";
+constexpr const char* kCodeVersion = "coat-t-v3";
 
 using T = CoatTransmittanceTable;
 
@@ -33,11 +34,6 @@ double eta_node(int i) {
 }
 double smooth_weight(double alpha) {
     return std::exp(-alpha / 0.03);
-}
-
-/// Euler's Beta function B(a, b) = Γ(a)Γ(b)/Γ(a + b) for a, b ≥ 1 (finite Λ).
-double beta_function(double a, double b) {
-    return std::exp(std::lgamma(a) + std::lgamma(b) - std::lgamma(a + b));
 }
 
 double integrate(double c, double alpha, double eta, RefractionMasking masking, int n_r,
@@ -88,8 +84,10 @@ const char* masking_name(RefractionMasking m) {
 }  // namespace
 
 double refraction_escape(RefractionMasking masking, double lambda_i, double lambda_t) {
-    if (masking == RefractionMasking::Walter) return (1 + lambda_i) / (1 + lambda_i + lambda_t);
-    return (1 + lambda_i) * beta_function(1 + lambda_i, 1 + lambda_t);
+    // The escape fractions of physics/smith_masking.h, from the Smith roots r = 1 + 2Λ.
+    const double r_i = 1 + 2 * lambda_i, r_t = 1 + 2 * lambda_t;
+    if (masking == RefractionMasking::Walter) return smith_reflection_escape(r_i, r_t);
+    return smith_refraction_escape(r_i, r_t);
 }
 
 double CoatTransmittanceTable::direct(double c, double alpha, double eta, RefractionMasking masking,

@@ -3,6 +3,7 @@
 #include "core/math.h"
 #include "models/factories.h"
 #include "models/fgd_table.h"
+#include "models/multiple_scattering_albedo.h"
 #include "models/quadrature.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
@@ -18,10 +19,16 @@ namespace lamina {
 
 namespace {
 
-constexpr int kNmu = 65;    // nodes of the per-material curves over a cosine, μ = s²
-constexpr int kNx = 33;     // nodes of X(μ), μ = s²
-constexpr int kYnr = 6;     // visible-normal rules of Y and X: Gauss–Legendre in r ...
-constexpr int kYnphi = 8;   // ... × midpoint in φ over the half disk
+constexpr int kNmu = 65;   // nodes of the per-material curves over a cosine, μ = s²
+constexpr int kNx = 33;    // nodes of X(μ), μ = s²
+constexpr int kYnr = 6;    // visible-normal rules of Y and X: Gauss–Legendre in r ...
+constexpr int kYnphi = 8;  // ... × midpoint in φ over the half disk
+// The rule of Y and X: their integrands step at the coat's critical angle (total internal
+// reflection returns everything beyond it), which a 6-node rule in r places on one heavy node:
+// Y = 0.27 instead of 0.17 at normal incidence on α1 = 0.4 under an η0 = 1.2 smooth coat (the
+// series then gave the stack 7% more light than the goniophotometer). 24 × 16 nodes bring the
+// stack's albedo within 0.5% of the goniophotometer's there.
+constexpr int kBaseNr = 24, kBaseNphi = 16;
 constexpr int kGauss = 24;  // Gauss–Legendre nodes per piece of the hemispherical integrals
 
 /// A curve over a cosine μ ∈ [0, 1] on nodes μ = s² (dense at grazing), linear in s.
@@ -135,8 +142,10 @@ class Lamina1 final : public Model {
         Rgbd a{1.0};   ///< exp(−τ/μi')
         Rgbd X{0.0};   ///< X(μi) = T(μi) a(μi') Y(μi')
         double lambda0 = 0, k_top = 0, k_bottom = 1;
-        Vec3d wi_mean;     ///< the mean direction of the light the coat transmits (slabs)
-        Rgbd a_mean{1.0};  ///< exp(−τ/μ̄')
+        Vec3d wi_mean;      ///< the mean direction of the light the coat transmits (slabs)
+        Rgbd a_mean{1.0};   ///< exp(−τ/μ̄')
+        double dR = 0;      ///< ΔR(μi) of the coat (multiple scattering)
+        double T_pair = 0;  ///< √(T(μi) T_exit(μi)): the first order's reciprocal coat factor
     };
 
     Incident incident(const Vec3d& wi) const {
@@ -146,10 +155,14 @@ class Lamina1 final : public Model {
         in.ok = true;
         in.wi_in = refract_in(wi, inv_eta0_);
         in.T = T_top_(wi.z);
+        in.T_pair = in.T;
         in.a = attenuation(in.wi_in.z);
         if (series_on_) in.X = X_at(wi.z);
         if (alpha0_ > 0) in.lambda0 = GGX<double>{alpha0_}.lambda(wi);
+        if (top_ms_) in.dR = dR_top_(wi.z);
         in.k_top = spread_factor(wi.z, in.wi_in.z, eta0_);
+        if (inside_exit_)
+            in.T_pair = std::sqrt(in.T * exit_transmittance(wi.z, in.wi_in.z, in.k_top));
         if (support_.btdf) {
             in.wi_mean = in.wi_in;
             in.a_mean = in.a;
@@ -188,9 +201,13 @@ class Lamina1 final : public Model {
             const Vec3d h = normalize(wi + wo);
             const double G = 1 / (1 + in.lambda0 + ggx0.lambda(wo));
             f = Rgbd(fresnel_dielectric(dot(wi, h), eta0_) * ggx0.D(h) * G / (4 * wi.z * wo.z));
+            // Its orders ≥ 2 as a separable lobe of albedo ΔR(μi), reciprocal by construction
+            // (the energy-compensation form of Kulla & Conty 2017, "Revisiting physically based
+            // shading at Imageworks", SIGGRAPH course, with the walk's ΔR in place of 1 − E).
+            if (top_ms_) f += Rgbd(in.dR * dR_top_(wo.z) * kInvPi<double> / dR_top_bar_);
         }
         const Vec3d wo_in = refract_in(wo, inv_eta0_);
-        const double T_o = T_top_(wo.z);
+        double T_o = T_top_(wo.z);
         const Rgbd a_o = attenuation(wo_in.z);
         // First order: the base's lobe at the refracted directions, entering and leaving through
         // the coat's directional transmittance; 1/η0² compresses the solid angle.
@@ -198,7 +215,17 @@ class Lamina1 final : public Model {
         // √(1 − sin²θ) rounds to 0) carries no first order: T is 0 there and the lobe 0/0.
         const Rgbd fb =
             in.wi_in.z > 0 && wo_in.z > 0 ? base_lobe(in, wi.z, wo.z, wo_in) : Rgbd(0.0);
-        f += fb * (in.a * a_o) * (in.T * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
+        // The coat enters with T(μi) and leaves with T_exit(μo); made reciprocal as the product
+        // √(T T_exit)(μi) √(T T_exit)(μo), exact at the mirror pair (μo = μi) where the narrow
+        // first order is.
+        if (inside_exit_ && fb.max() > 0)
+            T_o = std::sqrt(T_o *
+                            exit_transmittance(wo.z, wo_in.z, spread_factor(wo.z, wo_in.z, eta0_)));
+        Rgbd rounds(1.0);
+        if (mirror_series_ && fb.max() > 0)
+            rounds = mirror_series_curve_(in.wi_in.z) * mirror_series_curve_(wo_in.z);
+        f += fb * (in.a * a_o) * rounds *
+             (in.T_pair * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
         if (series_on_) {
             f += in.X * X_at(wo.z) * K_ * (kInvPi<double> * inv_eta0_ * inv_eta0_);
         }
@@ -290,6 +317,8 @@ class Lamina1 final : public Model {
             Rgbd a_once = in.a_mean * a_v;
             for (int c = 0; c < 3; ++c)
                 a_once[c] = std::sqrt(a_once[c]);
+            if (mirror_series_)
+                a_once *= mirror_series_curve_(in.wi_mean.z) * mirror_series_curve_(v_in->z);
             f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
         }
         if (series_btdf_)
@@ -305,7 +334,23 @@ class Lamina1 final : public Model {
         const GGX<double> ggx{alpha};
         const Vec3d h = normalize(in.wi_in + wo_in);
         const double G = ggx.G2(in.wi_in, wo_in);
-        return base_fresnel(dot(in.wi_in, h)) * (ggx.D(h) * G / (4 * in.wi_in.z * wo_in.z));
+        Rgbd f = base_fresnel(dot(in.wi_in, h)) * (ggx.D(h) * G / (4 * in.wi_in.z * wo_in.z));
+        // The base's orders ≥ 2 (of its own roughness α1), separable as the coat's.
+        if (base_ms_)
+            f += F_ms_ * (dE_base_(in.wi_in.z) * dE_base_(wo_in.z) * kInvPi<double> / dE_base_bar_);
+        return f;
+    }
+
+    /// The coat's transmittance for the first order leaving a non-Lambertian base towards the
+    /// outside cosine μ (inside μ_in, spread factor k): T_in(μ_in) where the base lobe is narrower
+    /// than the coat's refraction spread α0 k/2 (the light meets the coat along one direction
+    /// and leaves with that direction's transmittance from inside), T(μ) where it is wider (the
+    /// radiance inside is locally uniform, and the light reaching μ outside is T(μ) by
+    /// reciprocity), weighted by u = α1² / (α1² + (α0 k/2)²).
+    double exit_transmittance(double mu, double mu_in, double k) const {
+        const double spread2 = sqr(0.5 * alpha0_ * k),
+                     u = spread2 > 0 ? sqr(alpha1_) / (sqr(alpha1_) + spread2) : 1.0;
+        return u * T_top_(mu) + (1 - u) * T_top_in_(mu_in);
     }
 
     /// α_e² = α1² + (α0 k_i/2)² + (α0 k_o/2)²: a deflection of the light by ε turns the mirror
@@ -376,11 +421,12 @@ class Lamina1 final : public Model {
 
     /// The base's directional albedo seen from inside the coat, at inside cosine μ.
     Rgbd base_albedo(double mu) const {
+        const Rgbd ms = base_ms_ ? F_ms_ * dE_base_(mu) : Rgbd(0.0);
         switch (coat_.base_type) {
             case InterfaceType::Conductor:
-                return FgdTable::get().rgb(mu, alpha1_, base_fgd_);
+                return FgdTable::get().rgb(mu, alpha1_, base_fgd_) + ms;
             case InterfaceType::Dielectric:
-                return Rgbd(FgdTable::get()(mu, alpha1_, eta_b_, 0.0));
+                return Rgbd(FgdTable::get()(mu, alpha1_, eta_b_, 0.0)) + ms;
             case InterfaceType::Lambertian:
                 break;
         }
@@ -418,20 +464,35 @@ class Lamina1 final : public Model {
     Rgbd K_{0.0};                 ///< the separable term's normalization
     Rgbd inv_one_minus_Er_{0.0};  ///< 1/(1 − Ē_b r̄)
     Rgbd r_bar_{0.0}, E_bar_{0.0}, t_bar_{0.0}, X_bar_{0.0};
+    /// Multiple scattering: the coat's ΔR from outside and its hemispherical 2∫ΔR μ dμ; the base's
+    /// ΔE (conductor: white, times F_ms; dielectric: ΔR, F_ms = 1) and its average.
+    bool top_ms_ = false, base_ms_ = false;
+    bool inside_exit_ = false;  ///< exit_transmittance in the first order (see Lamina1Choices)
+    bool mirror_series_ = false;
+    /// √(1/(1 − a² R_in E_b (1 − u))) over inside cosines: the first order's round trips.
+    CosineCurve<Rgbd> mirror_series_curve_;
+    CosineCurve<double> dR_top_, dE_base_;
+    double dR_top_bar_ = 1, dE_base_bar_ = 1;
+    Rgbd F_ms_{1.0};
 
     friend class SplitIncidentEvaluator<Lamina1>;
 };
 
 void Lamina1::precompute() {
+    inside_exit_ = ch_.inside_exit && alpha0_ > 0 && ch_.directional_transmittance &&
+                   coat_.base_type != InterfaceType::Lambertian;
     const auto& table = CoatTransmittanceTable::get(ch_.masking);
     const auto& fgd = FgdTable::get();
+    const MultipleScatteringAlbedo* ms =
+        ch_.multiple_scattering ? &MultipleScatteringAlbedo::get() : nullptr;
     auto transmittance = [&](double mu, double alpha, double eta) {
-        return ch_.directional_transmittance ? table(mu, alpha, eta)
-                                             : 1 - fresnel_dielectric(mu, eta);
+        const double t =
+            ch_.directional_transmittance ? table(mu, alpha, eta) : 1 - fresnel_dielectric(mu, eta);
+        return ms ? t + ms->dielectric(mu, alpha, eta).transmitted : t;
     };
     auto setup = [&](Transmittance& t, double alpha, double eta) {
         t.eta = eta;
-        t.exact = alpha == 0 || !ch_.directional_transmittance;
+        t.exact = alpha == 0 || (!ch_.directional_transmittance && !ms);
         if (!t.exact) t.curve.fill([&](double mu) { return transmittance(mu, alpha, eta); });
     };
     setup(T_top_, alpha0_, eta0_);
@@ -444,7 +505,41 @@ void Lamina1::precompute() {
     // The coat's bottom seen from inside: R_in(μ) = FGD(μ, α0, 1/η0) (total internal reflection
     // included), and g(μ) = a(μ)² R_in(μ) for a return trip base → coat → base.
     const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
-    auto R_in = [&](double mu) { return fgd(mu, alpha0_, inv_eta0_, 0.0); };
+    auto R_in = [&](double mu) {
+        const double r = fgd(mu, alpha0_, inv_eta0_, 0.0);
+        return ms ? r + ms->dielectric(mu, alpha0_, inv_eta0_).reflected : r;
+    };
+    // Multiple scattering's separable lobes: the coat's from outside, the base's from inside.
+    top_ms_ = ms && alpha0_ > 0;
+    if (top_ms_) {
+        dR_top_.fill([&](double mu) { return ms->dielectric(mu, alpha0_, eta0_).reflected; });
+        dR_top_bar_ = integrate01<double>([&](double mu) { return dR_top_(mu) * 2 * mu; }, 0.0);
+        top_ms_ = dR_top_bar_ > 0;
+    }
+    base_ms_ = ms && alpha1_ > 0 && coat_.base_type != InterfaceType::Lambertian;
+    if (base_ms_) {
+        if (coat_.base_type == InterfaceType::Conductor) {
+            dE_base_.fill([&](double mu) { return ms->conductor(mu, alpha1_); });
+        } else {
+            dE_base_.fill([&](double mu) { return ms->dielectric(mu, alpha1_, eta_b_).reflected; });
+        }
+        dE_base_bar_ = integrate01<double>([&](double mu) { return dE_base_(mu) * 2 * mu; }, 0.0);
+        base_ms_ = dE_base_bar_ > 0;
+        if (base_ms_ && coat_.base_type == InterfaceType::Conductor) {
+            // Each further facet multiplies by the conductor's Fresnel factor: with its
+            // hemispherical average F̄ and the white surface's E_avg = 1 − ΔĒ, the orders ≥ 2
+            // carry ΔE(μ) F̄² E_avg / (1 − F̄ (1 − E_avg)) (Kulla & Conty 2017, the F_ms factor:
+            // one more bounce F̄, then escape E_avg or another bounce, summed).
+            const Rgbd F_avg = integrate01<Rgbd>(
+                [&](double mu) {
+                    return fresnel_complex_rgb(mu, coat_.base_eta, coat_.base_k) * (2 * mu);
+                },
+                0.0);
+            const double E_avg = 1 - dE_base_bar_;
+            for (int c = 0; c < 3; ++c)
+                F_ms_[c] = sqr(F_avg[c]) * E_avg / (1 - F_avg[c] * (1 - E_avg));
+        }
+    }
     r_bar_ = integrate01<Rgbd>(
         [&](double mu) { return attenuation(mu) * attenuation(mu) * (2 * mu * R_in(mu)); },
         mu_crit);
@@ -460,7 +555,10 @@ void Lamina1::precompute() {
         double R = R_in(mu);
         if (alpha0_ > 0 && mu > mu_crit) {
             const double mu_out = safe_sqrt(1 - (1 - mu * mu) * sqr(eta0_));
-            R = std::max(0.0, R + T_top_in_(mu) - T_top_(mu_out));
+            const double T_exit =
+                inside_exit_ ? exit_transmittance(mu_out, mu, spread_factor(mu_out, mu, eta0_))
+                             : T_top_(mu_out);
+            R = std::max(0.0, R + T_top_in_(mu) - T_exit);
         }
         return a * a * R;
     };
@@ -511,10 +609,35 @@ void Lamina1::precompute() {
                  (coat_.base_type == InterfaceType::Lambertian || !ch_.series_lambertian_only ||
                   alpha1_ >= alpha0_);
     series_btdf_ = series_on_ && !ch_.series_lambertian_only;
+    // Where the uniform series is off (a base smoother than the rough coat), the light the coat's
+    // bottom returns meets a base that keeps its direction: it stays in the first order's lobe,
+    // which each round trip multiplies by a² R_in E_b — the smooth stack's delta series (docs/
+    // physics.md §6.5 of the study), over the part (1 − u) of the light the base does not spread.
+    mirror_series_ = ch_.inter_reflection && inside_exit_ && !series_on_;
+    if (mirror_series_) {
+        mirror_series_curve_.fill([&](double mu) {
+            const double mu_in = std::max(mu, mu_crit + 1e-9);
+            const double mu_out = safe_sqrt(1 - (1 - mu_in * mu_in) * sqr(eta0_));
+            const double spread2 = sqr(0.5 * alpha0_ * spread_factor(mu_out, mu_in, eta0_));
+            const double u = spread2 > 0 ? sqr(alpha1_) / (sqr(alpha1_) + spread2) : 1.0;
+            const Rgbd a = attenuation(mu_in);
+            const Rgbd round_trip = a * a * base_albedo(mu_in) * (R_in(mu_in) * (1 - u));
+            Rgbd S(1.0);
+            for (int c = 0; c < 3; ++c)
+                S[c] = 1 / std::sqrt(std::max(1e-6, 1 - round_trip[c]));  // √ of 1/(1 − ·)
+            return S;
+        });
+    }
     if (!series_on_) return;
     // Y(μ') = ∫ f_b(w', w'') μ'' g(μ'') dω'': what the base's first reflection of light arriving
     // at inside cosine μ' sends back down after one reflection at the coat's bottom.
-    static const QuadratureRule qr = gauss_legendre(kYnr);
+    static const QuadratureRule qr = gauss_legendre(kBaseNr);
+    // The base's separable multiple-scattering lobe sends F_ms ΔE(μ') ∫ ΔE g 2μ'' dμ'' / ΔĒ.
+    const Rgbd Y_ms =
+        base_ms_ ? integrate01<Rgbd>([&](double mu) { return g(mu) * (dE_base_(mu) * 2 * mu); },
+                                     mu_crit) *
+                       (1 / dE_base_bar_)
+                 : Rgbd(0.0);
     auto Y = [&](double mu) -> Rgbd {
         if (coat_.base_type == InterfaceType::Lambertian) return coat_.albedo * r_bar_;
         if (smooth_base) return base_fresnel(mu) * g(mu);
@@ -522,18 +645,19 @@ void Lamina1::precompute() {
         const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
         const double lambda_w = ggx.lambda(w);
         Rgbd sum(0.0);
-        for (int a = 0; a < kYnr; ++a) {
+        for (int a = 0; a < kBaseNr; ++a) {
             const double r = qr.x[a], w_r = qr.w[a] * 2 * r;
-            for (int b = 0; b < kYnphi; ++b) {
+            for (int b = 0; b < kBaseNphi; ++b) {
                 const Vec3d wm =
-                    ggx.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi - 0.25);
+                    ggx.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kBaseNphi - 0.25);
                 const Vec3d w2 = reflect(w, wm);
                 if (w2.z <= 0) continue;
                 // Visible-normal weight: f_b μ'' dω'' = D_w F G2/G1 dwm (Heitz 2018, §2).
                 const double escape = (1 + lambda_w) / (1 + lambda_w + ggx.lambda(w2));
-                sum += base_fresnel(dot(w, wm)) * g(w2.z) * (w_r / kYnphi * escape);
+                sum += base_fresnel(dot(w, wm)) * g(w2.z) * (w_r / kBaseNphi * escape);
             }
         }
+        if (base_ms_) sum += F_ms_ * Y_ms * dE_base_(mu);
         return sum;
     };
     x_exact_ = coat_.base_type == InterfaceType::Lambertian &&
@@ -553,24 +677,31 @@ void Lamina1::precompute() {
         SplitCurve<17> Y_curve;
         Y_curve.fill(mu_crit, Y);
         const GGX<double> ggx0{alpha0_};
+        // The coat's orders ≥ 2 transmit ΔT(μ) more, spread over the inside directions: taken
+        // as cosine-distributed, they return the hemispherical average of a Y.
+        const Rgbd Y_spread =
+            ms ? integrate01<Rgbd>(
+                     [&](double mu) { return Y_curve(mu) * attenuation(mu) * (2 * mu); }, mu_crit)
+               : Rgbd(0.0);
         X_.fill([&](double mu) {
             const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
             const double lambda_w = ggx0.lambda(w);
             Rgbd sum(0.0);
-            for (int a = 0; a < kYnr; ++a) {
+            for (int a = 0; a < kBaseNr; ++a) {
                 const double r = qr.x[a], w_r = qr.w[a] * 2 * r;
-                for (int b = 0; b < kYnphi; ++b) {
+                for (int b = 0; b < kBaseNphi; ++b) {
                     const Vec3d wm =
-                        ggx0.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi - 0.25);
+                        ggx0.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kBaseNphi - 0.25);
                     const double F = fresnel_dielectric(dot(w, wm), eta0_);
                     const auto wt = refract(w, wm, eta0_);
                     if (!wt || wt->z >= 0) continue;
                     const double escape =
                         refraction_escape(ch_.masking, lambda_w, ggx0.lambda(*wt));
-                    sum +=
-                        Y_curve(-wt->z) * attenuation(-wt->z) * ((1 - F) * escape * w_r / kYnphi);
+                    sum += Y_curve(-wt->z) * attenuation(-wt->z) *
+                           ((1 - F) * escape * w_r / kBaseNphi);
                 }
             }
+            if (ms) sum += Y_spread * ms->dielectric(mu, alpha0_, eta0_).transmitted;
             return sum;
         });
     }
@@ -606,6 +737,7 @@ Lamina1::Mixture Lamina1::mixture(const Incident& in) const {
         if (m.alpha_base > 0) m.p[1] = in.T * a * E_b;
     }
     if (series_on_) m.p[2] = (in.X * K_ * X_bar_).mean();
+    m.p[2] += in.dR;  // the coat's separable multiple-scattering lobe, also cosine-distributed
     if (support_.btdf) {
         m.beta = transmission_roughness(in.k_top, in.k_bottom);
         if (m.beta > 0) m.p[3] = in.T * a * std::max(0.0, 1 - E_b);
@@ -752,6 +884,17 @@ std::vector<OptionSpec> lamina1_option_specs() {
          "angular",
          "base lobe widened by the coat's refraction spread: angle-dependent deflection, its "
          "normal-incidence value, or not widened"},
+        {"exit-transmittance",
+         {"inside", "outside"},
+         d.inside_exit ? "inside" : "outside",
+         "the first order leaves a non-Lambertian base through the coat with the inside "
+         "transmittance of its direction where the base lobe is narrower than the coat's spread, "
+         "or always with the outside transmittance T(mu_o)"},
+        {"microsurface",
+         {"single", "multiple"},
+         d.multiple_scattering ? "multiple" : "single",
+         "rough interfaces: single scattering (the masked energy lost, as --microsurface single) "
+         "or with their orders >= 2 restored (as --microsurface multiple)"},
     };
 }
 
@@ -764,6 +907,8 @@ Lamina1Choices lamina1_choices(const ModelOptions& o) {
     c.series_lambertian_only = option_value(o, "inter-reflection") == "auto";
     c.eta2_factor = option_value(o, "eta2") == "on";
     c.mean_shift = option_value(o, "transmitted-direction") == "mean";
+    c.multiple_scattering = option_value(o, "microsurface") == "multiple";
+    c.inside_exit = option_value(o, "exit-transmittance") == "inside";
     const std::string& s = option_value(o, "spread");
     c.spread = s == "normal" ? Lamina1Choices::Spread::Normal
                : s == "off"  ? Lamina1Choices::Spread::Off

@@ -45,6 +45,18 @@ struct Lamina1Choices {
     /// The base lobe widened by the coat's refraction spread: with the angle-dependent deflection
     /// factor (Spread::Angular), its normal-incidence value 1 − 1/η (Normal), or not (Off).
     enum class Spread { Angular, Normal, Off } spread = Spread::Angular;
+    /// The rough interfaces' scattering orders ≥ 2 (models/multiple_scattering_albedo.h): off
+    /// (single scattering: the energy the microsurfaces mask is lost, as in the goniophotometer's
+    /// --microsurface single) or restored (as in --microsurface multiple): the coat's and the
+    /// slab bottom's transmittances gain ΔT, the coat's inside reflectance and the base's albedo
+    /// gain ΔR (ΔE F_ms for a conductor), and the coat's outer reflection and the base's lobe gain
+    /// the separable energy-compensation lobes ΔR(μi) ΔR(μo)/(π ΔR̄) (docs/models.md).
+    bool multiple_scattering = false;
+    /// The first order leaves a conductor or dielectric base through the coat with the coat's
+    /// transmittance *from inside* along the base lobe's direction, T_in(μo'), where that lobe is
+    /// narrower than the coat's refraction spread (true), or with the outside transmittance T(μo)
+    /// (false), exact only for locally uniform radiance inside (a Lambertian base always uses it).
+    bool inside_exit = true;
 };
 
 std::vector<OptionSpec> lamina1_option_specs();

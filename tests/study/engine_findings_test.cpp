@@ -96,6 +96,35 @@ TEST(EngineFindings, MarkdownReadsAsFindings) {
         -0.1, 1e-12);
 }
 
+// The section ranks by misplaced_floor, the summary's ranking metric, not by misplaced_energy:
+// where the reference holds little light the two disagree (misplaced_energy explodes), and the
+// ranking must follow the floored one.
+TEST(EngineFindings, RanksByTheFlooredMetric) {
+    std::vector<MetricRow> r;
+    for (double t : {0.0, 80.0})
+        for (int c = 0; c < 3; ++c) {
+            // openpbr: small relative error everywhere, but at 80° on a dim reference the
+            // floored metric is large (0.4) while misplaced_energy is small (0.05).
+            MetricRow a = row("p1", "plastic", "openpbr", t, c, true, 0.05, 0.0);
+            a.metrics.misplaced_floor = t == 0 ? 0.1 : 0.4;
+            // filament: misplaced_energy explodes (3.0) on the dim reference, the floored
+            // metric stays at 0.15.
+            MetricRow b = row("p1", "plastic", "filament", t, c, true, t == 0 ? 0.1 : 3.0, 0.0);
+            b.metrics.misplaced_floor = 0.15;
+            r.push_back(a);
+            r.push_back(b);
+        }
+    const EngineFindings f = compute_engine_findings(r, {"openpbr", "filament"});
+    ASSERT_FALSE(f.empty());
+    // Means: openpbr (0.1 + 0.4)/2 = 0.25 floored, 0.05 energy; filament 0.15 floored, 1.55.
+    EXPECT_EQ(f.best_production.at("plastic"), "filament");
+    EXPECT_EQ(f.best_overall.at("plastic"), "filament");
+    for (const auto& c : f.cells) {
+        if (c.model == "openpbr") EXPECT_NEAR(c.mean_misplaced, 0.25, 1e-12);
+        if (c.model == "filament") EXPECT_NEAR(c.mean_misplaced, 0.15, 1e-12);
+    }
+}
+
 TEST(EngineFindings, EmptyWithoutProductionCoats) {
     std::vector<MetricRow> r = {row("p1", "plastic", "ww-prime", 0, 0, true, 0.1, 0.0)};
     const EngineFindings f = compute_engine_findings(r, {"ww-prime"});
