@@ -279,9 +279,10 @@ TEST(Lamina1, MultipleScatteringWhiteFurnace) {
                 EXPECT_NEAR(a.mean(), 1.0, 0.02)
                     << "eta0=" << eta << " a0=" << alpha << " ti=" << ti;
                 // Single scattering loses energy there.
-                if (alpha >= 0.3 && ti >= 70)
+                if (alpha >= 0.3 && ti >= 70) {
                     EXPECT_LT(model_albedo(*single, wi, Side::Reflection, o).mean(),
                               a.mean() - 0.01);
+                }
             }
         }
 }

@@ -120,8 +120,12 @@ TEST(EngineFindings, RanksByTheFlooredMetric) {
     EXPECT_EQ(f.best_production.at("plastic"), "filament");
     EXPECT_EQ(f.best_overall.at("plastic"), "filament");
     for (const auto& c : f.cells) {
-        if (c.model == "openpbr") EXPECT_NEAR(c.mean_misplaced, 0.25, 1e-12);
-        if (c.model == "filament") EXPECT_NEAR(c.mean_misplaced, 0.15, 1e-12);
+        if (c.model == "openpbr") {
+            EXPECT_NEAR(c.mean_misplaced, 0.25, 1e-12);
+        }
+        if (c.model == "filament") {
+            EXPECT_NEAR(c.mean_misplaced, 0.15, 1e-12);
+        }
     }
 }
 
