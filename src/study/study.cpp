@@ -1,5 +1,7 @@
 #include "study/study.h"
 
+#include "model_source_digest.h"
+
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hash.h"
@@ -45,8 +47,9 @@ struct ConfigResult {
 
 // ---- The digests of a configuration's inputs ---------------------------------------------------
 
-// Everything a model's binned table depends on: the model (name, options, lamina's version), the
-// stack, the incidences, the grid and the binning rule.
+// Everything a model's binned table depends on: the model (name, options, lamina's version and
+// the digest of the models' code, so that an edited model is binned again), the stack, the
+// incidences, the grid and the binning rule.
 std::string model_key(const std::string& name, const StudyConfiguration& config,
                       const StudySettings& s) {
     // A model from elsewhere (a table file, a Python plugin) may change without its name
@@ -58,9 +61,9 @@ std::string model_key(const std::string& name, const StudyConfiguration& config,
     const ModelSpec spec = parse_model_spec(name, "--models");
     const BinnedOptions b;
     return fmt::format(
-        "lamina {} | model {} | options {} | stack {} | theta_i {} | grid {} | binned {} {} {} {} "
-        "{}",
-        kVersion, name,
+        "lamina {} code {} | model {} | options {} | stack {} | theta_i {} | grid {} | binned {} {} "
+        "{} {} {}",
+        kVersion, kModelSourceDigest, name,
         nlohmann::json(resolve_options(*spec.entry, spec.assignments, "--models")).dump(),
         stack_to_json(config.stack).dump(), fmt::join(s.theta_i_deg, ","), s.grid.to_string(),
         b.rel_tol, b.abs_tol, b.max_depth, b.peak_depth, b.eval_budget);
