@@ -656,8 +656,8 @@ void Lamina1::precompute() {
     series_btdf_ = series_on_ && !ch_.series_lambertian_only;
     // Where the uniform series is off (a base smoother than the rough coat), the light the coat's
     // bottom returns meets a base that keeps its direction: it stays in the first order's lobe,
-    // which each round trip multiplies by a² R_in E_b — the smooth stack's delta series (docs/
-    // physics.md §6.5 of the study), over the part (1 − u) of the light the base does not spread.
+    // which each round trip multiplies by a² R_in E_b, summed as the smooth stack's delta series
+    // is (docs/physics.md §6.5 of the study), over the part (1 − u) the base does not spread.
     mirror_series_ = ch_.inter_reflection && inside_exit_ && !series_on_;
     if (mirror_series_) {
         mirror_series_curve_.fill([&](double mu) {
