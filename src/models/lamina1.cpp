@@ -29,6 +29,7 @@ constexpr int kYnphi = 8;  // ... × midpoint in φ over the half disk
 // series then gave the stack 7% more light than the goniophotometer). 24 × 16 nodes bring the
 // stack's albedo within 0.5% of the goniophotometer's there.
 constexpr int kBaseNr = 24, kBaseNphi = 16;
+constexpr int kNormNr = 12, kNormNphi = 8;  // the base lobe's normalization N (its rule)
 constexpr int kGauss = 24;  // Gauss–Legendre nodes per piece of the hemispherical integrals
 
 /// A curve over a cosine μ ∈ [0, 1] on nodes μ = s² (dense at grazing), linear in s.
@@ -146,6 +147,7 @@ class Lamina1 final : public Model {
         Rgbd a_mean{1.0};   ///< exp(−τ/μ̄')
         double dR = 0;      ///< ΔR(μi) of the coat (multiple scattering)
         double T_pair = 0;  ///< √(T(μi) T_exit(μi)): the first order's reciprocal coat factor
+        double lobe_norm = 1;  ///< 1/√N(μi'): the widened base lobe's normalization
     };
 
     Incident incident(const Vec3d& wi) const {
@@ -160,6 +162,7 @@ class Lamina1 final : public Model {
         if (series_on_) in.X = X_at(wi.z);
         if (alpha0_ > 0) in.lambda0 = GGX<double>{alpha0_}.lambda(wi);
         if (top_ms_) in.dR = dR_top_(wi.z);
+        if (lobe_norm_on_) in.lobe_norm = lobe_norm_(in.wi_in.z);
         in.k_top = spread_factor(wi.z, in.wi_in.z, eta0_);
         if (inside_exit_)
             in.T_pair = std::sqrt(in.T * exit_transmittance(wi.z, in.wi_in.z, in.k_top));
@@ -335,6 +338,7 @@ class Lamina1 final : public Model {
         const Vec3d h = normalize(in.wi_in + wo_in);
         const double G = ggx.G2(in.wi_in, wo_in);
         Rgbd f = base_fresnel(dot(in.wi_in, h)) * (ggx.D(h) * G / (4 * in.wi_in.z * wo_in.z));
+        if (lobe_norm_on_) f *= in.lobe_norm * lobe_norm_(wo_in.z);
         // The base's orders ≥ 2 (of its own roughness α1), separable as the coat's.
         if (base_ms_)
             f += F_ms_ * (dE_base_(in.wi_in.z) * dE_base_(wo_in.z) * kInvPi<double> / dE_base_bar_);
@@ -469,6 +473,10 @@ class Lamina1 final : public Model {
     bool top_ms_ = false, base_ms_ = false;
     bool inside_exit_ = false;  ///< exit_transmittance in the first order (see Lamina1Choices)
     bool mirror_series_ = false;
+    bool lobe_norm_on_ = false;
+    /// 1/√N(μ'): N is the energy of the base lobe whose width follows wo (α_e(k_i, k_o)) over that
+    /// of the lobe of fixed width α_e(k_i, k_i), over the exit cone, at inside cosine μ'.
+    CosineCurve<double, kNx> lobe_norm_;
     /// √(1/(1 − a² R_in E_b (1 − u))) over inside cosines: the first order's round trips.
     CosineCurve<Rgbd> mirror_series_curve_;
     CosineCurve<double> dR_top_, dE_base_;
@@ -483,6 +491,43 @@ void Lamina1::precompute() {
                    coat_.base_type != InterfaceType::Lambertian;
     const auto& table = CoatTransmittanceTable::get(ch_.masking);
     const auto& fgd = FgdTable::get();
+    // The base lobe's width follows wo through k_o, so the lobe is not normalized: its energy over
+    // the exit cone exceeds that of the lobe of fixed width α_e(k_i, k_i) by N(μi') (up to 2×
+    // in the tails under rough, low-index coats). Divided out reciprocally, by √N(μi') √N(μo').
+    // N by the fixed lobe's visible normals (Heitz 2018), the varying lobe weighted by its ratio.
+    lobe_norm_on_ = ch_.lobe_normalization && alpha0_ > 0 &&
+                    coat_.base_type != InterfaceType::Lambertian &&
+                    ch_.spread == Lamina1Choices::Spread::Angular;
+    if (lobe_norm_on_) {
+        static const QuadratureRule qn = gauss_legendre(kNormNr);
+        const double mu_crit_in = std::sqrt(1 - sqr(inv_eta0_));
+        lobe_norm_.fill([&](double mu) {
+            const double mu_in = std::max(mu, mu_crit_in + 1e-6);
+            const Vec3d w(safe_sqrt(1 - mu_in * mu_in), 0, mu_in);
+            const double mu_out_i = safe_sqrt(1 - (1 - mu_in * mu_in) * sqr(eta0_));
+            const double k_i = spread_factor(mu_out_i, mu_in, eta0_);
+            const double alpha_f = effective_alpha(k_i, k_i);
+            if (alpha_f <= 0) return 1.0;
+            const GGX<double> fixed{alpha_f};
+            double sum_fixed = 0, sum_var = 0;
+            for (int a = 0; a < kNormNr; ++a)
+                for (int b = 0; b < kNormNphi; ++b) {
+                    const double r = qn.x[a], w_r = qn.w[a] * 2 * r / kNormNphi;
+                    const Vec3d wm =
+                        fixed.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kNormNphi - 0.25);
+                    const Vec3d wo = reflect(w, wm);
+                    if (wo.z <= mu_crit_in) continue;  // beyond the exit cone (or below)
+                    const double mu_out = safe_sqrt(1 - (1 - wo.z * wo.z) * sqr(eta0_));
+                    const GGX<double> var{effective_alpha(k_i, spread_factor(mu_out, wo.z, eta0_))};
+                    const double g_fixed = fixed.G2(w, wo) / fixed.G1(w);
+                    sum_fixed += w_r * g_fixed;
+                    // f_var / f_fixed = D_var G2_var / (D_fixed G2_fixed) at the same half vector.
+                    sum_var +=
+                        w_r * g_fixed * var.D(wm) * var.G2(w, wo) / (fixed.D(wm) * fixed.G2(w, wo));
+                }
+            return sum_fixed > 0 && sum_var > 0 ? std::sqrt(sum_fixed / sum_var) : 1.0;
+        });
+    }
     const MultipleScatteringAlbedo* ms =
         ch_.multiple_scattering ? &MultipleScatteringAlbedo::get() : nullptr;
     auto transmittance = [&](double mu, double alpha, double eta) {
@@ -611,8 +656,8 @@ void Lamina1::precompute() {
     series_btdf_ = series_on_ && !ch_.series_lambertian_only;
     // Where the uniform series is off (a base smoother than the rough coat), the light the coat's
     // bottom returns meets a base that keeps its direction: it stays in the first order's lobe,
-    // which each round trip multiplies by a² R_in E_b — the smooth stack's delta series (docs/
-    // physics.md §6.5 of the study), over the part (1 − u) of the light the base does not spread.
+    // which each round trip multiplies by a² R_in E_b, summed as the smooth stack's delta series
+    // is (docs/physics.md §6.5 of the study), over the part (1 − u) the base does not spread.
     mirror_series_ = ch_.inter_reflection && inside_exit_ && !series_on_;
     if (mirror_series_) {
         mirror_series_curve_.fill([&](double mu) {
@@ -890,6 +935,11 @@ std::vector<OptionSpec> lamina1_option_specs() {
          "the first order leaves a non-Lambertian base through the coat with the inside "
          "transmittance of its direction where the base lobe is narrower than the coat's spread, "
          "or always with the outside transmittance T(mu_o)"},
+        {"lobe-normalization",
+         {"on", "off"},
+         on_off(d.lobe_normalization),
+         "the widened base lobe (width following wo) divided by its excess energy sqrt(N(mu_i') "
+         "N(mu_o')), or not"},
         {"microsurface",
          {"single", "multiple"},
          d.multiple_scattering ? "multiple" : "single",
@@ -909,6 +959,7 @@ Lamina1Choices lamina1_choices(const ModelOptions& o) {
     c.mean_shift = option_value(o, "transmitted-direction") == "mean";
     c.multiple_scattering = option_value(o, "microsurface") == "multiple";
     c.inside_exit = option_value(o, "exit-transmittance") == "inside";
+    c.lobe_normalization = option_value(o, "lobe-normalization") == "on";
     const std::string& s = option_value(o, "spread");
     c.spread = s == "normal" ? Lamina1Choices::Spread::Normal
                : s == "off"  ? Lamina1Choices::Spread::Off

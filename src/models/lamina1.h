@@ -57,6 +57,9 @@ struct Lamina1Choices {
     /// narrower than the coat's refraction spread (true), or with the outside transmittance T(μo)
     /// (false), exact only for locally uniform radiance inside (a Lambertian base always uses it).
     bool inside_exit = true;
+    /// The base lobe whose width follows wo through the coat's spread is divided by its excess
+    /// energy over the fixed-width lobe, √N(μi') √N(μo') (reciprocal; docs/models.md).
+    bool lobe_normalization = true;
 };
 
 std::vector<OptionSpec> lamina1_option_specs();

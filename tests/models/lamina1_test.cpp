@@ -243,13 +243,13 @@ TEST(Lamina1, AlbedoAtMostOne) {
                         if (model->support().btdf)
                             a += model_albedo(*model, wi, Side::Transmission, o);
                         // Measured excess, reported (docs/models.md, lamina-1's known errors):
-                        // a smooth conductor under a rough low-index coat gets a base lobe whose
-                        // width follows wo (α_e(k_i, k_o)), which is not normalized; single
-                        // scattering's loss hides it, multiple scattering shows it: 7.2% at
-                        // η0 = 1.2, α0 = 0.7, normal incidence, 1.8% at η0 = 1.5, α0 = 0.3.
-                        const bool known_excess =
-                            !options.empty() && bname == "mirror" && alpha >= 0.3 && ti == 0.0;
-                        EXPECT_LE(a.max(), 1.0 + 1e-3 + 6.3e-3 + (known_excess ? 0.075 : 0.0))
+                        // under the roughest low-index coat over a smooth near-perfect mirror the
+                        // round trips of the narrow first order (exit-transmittance=inside) keep
+                        // 3.7% too much with multiple scattering (η0 = 1.2, α0 = 0.7, normal
+                        // incidence; 7.8% before the base lobe's normalization).
+                        const bool known_excess = !options.empty() && bname == "mirror" &&
+                                                  eta < 1.3 && alpha >= 0.7 && ti == 0.0;
+                        EXPECT_LE(a.max(), 1.0 + 1e-3 + 6.3e-3 + (known_excess ? 0.035 : 0.0))
                             << bname << " eta0=" << eta << " a0=" << alpha << " ti=" << ti
                             << (options.empty() ? "" : " multiple");
                     }
