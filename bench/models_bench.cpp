@@ -54,7 +54,8 @@ struct Pairs {
     }
 };
 
-/// The typical coated gold, or the slab for a model that only represents slabs (none now; kept for models that only represent slabs).
+/// The typical coated gold, or the slab for a model that only represents slabs (none now; kept for
+/// models that only represent slabs).
 Stack bench_stack(const std::string& name) {
     const Stack coated_gold = typical_stack(false);
     return make_model(name, coated_gold)->support().brdf ? coated_gold : typical_stack(true);
@@ -104,15 +105,22 @@ void BM_BinnedTable(benchmark::State& state, const std::string& name, bool slab)
 
 /// lamina-1's per-material precomputation (its curves over cosines, hemispherical albedos and the
 /// inter-reflection normalization; the process-wide tables already loaded): the whole constructor.
-void BM_Lamina1Construct(benchmark::State& state, bool slab) {
+void BM_Lamina1Construct(benchmark::State& state, bool slab, bool multiple) {
     warm_tables();
     const Stack stack = typical_stack(slab);
+    const std::vector<std::string> options =
+        multiple ? std::vector<std::string>{"microsurface=multiple"} : std::vector<std::string>{};
+    make_model("lamina-1", stack, options);  // loads the multiple-scattering table once
     for (auto _ : state)
-        benchmark::DoNotOptimize(make_model("lamina-1", stack));
-    state.SetLabel(slab ? "rough slab" : "rough coat over rough gold");
+        benchmark::DoNotOptimize(make_model("lamina-1", stack, options));
+    state.SetLabel(std::string(slab ? "rough slab" : "rough coat over rough gold") +
+                   (multiple ? ", microsurface=multiple" : ""));
 }
-BENCHMARK_CAPTURE(BM_Lamina1Construct, coated_gold, false)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Lamina1Construct, slab, true)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Lamina1Construct, coated_gold, false, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Lamina1Construct, slab, true, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Lamina1Construct, coated_gold_multiple, false, true)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Lamina1Construct, slab_multiple, true, true)->Unit(benchmark::kMicrosecond);
 
 const int registered = [] {
     for (const auto& e : model_registry()) {

@@ -24,11 +24,12 @@ constexpr int kNx = 33;    // nodes of X(μ), μ = s²
 constexpr int kYnr = 6;    // visible-normal rules of Y and X: Gauss–Legendre in r ...
 constexpr int kYnphi = 8;  // ... × midpoint in φ over the half disk
 // The rule of Y and X: their integrands step at the coat's critical angle (total internal
-// reflection returns everything beyond it), which a 6-node rule in r places on one heavy node:
-// Y = 0.27 instead of 0.17 at normal incidence on α1 = 0.4 under an η0 = 1.2 smooth coat (the
-// series then gave the stack 7% more light than the goniophotometer). 24 × 16 nodes bring the
-// stack's albedo within 0.5% of the goniophotometer's there.
-constexpr int kBaseNr = 24, kBaseNphi = 16;
+// reflection returns everything beyond it). A plain 6 × 8 rule in r put that step on one heavy
+// node (Y = 0.27 instead of 0.17 at normal incidence on α1 = 0.4 under an η0 = 1.2 smooth coat,
+// and the stack 7% more light than the goniophotometer); 24 × 16 nodes still moved by 2% from one
+// rule to the next. The rule splits the r axis of each φ node at the step instead
+// (integrate_visible_split): 6 Gauss–Legendre nodes on each side, 8 in φ.
+constexpr int kSplitNr = 6, kSplitNphi = 8, kSplitBisections = 14;
 constexpr int kNormNr = 12, kNormNphi = 8;  // the base lobe's normalization N (its rule)
 constexpr int kGauss = 24;  // Gauss–Legendre nodes per piece of the hemispherical integrals
 
@@ -87,6 +88,45 @@ V integrate01(F&& f, double split) {
         if (split > 0) sum += f(split * q.x[i]) * (q.w[i] * split);
         const double t = q.x[i], d = 1 - split;
         if (d > 0) sum += f(split + d * t * t) * (q.w[i] * 2 * d * t);
+    }
+    return sum;
+}
+
+/// ∫ f(wm) over the visible normals wm of w (Heitz 2018, "Sampling the GGX distribution of
+/// visible normals", JCGT 7(4): u1 = r², u2 over the half disk, its mirror image giving the
+/// same integrand for w in the xz plane), an integrand that steps where outgoing_z(wm) crosses
+/// z_split: per φ node the r axis is split at the crossing (bisection; outgoing_z is monotonic
+/// along r for the reflections and refractions used here) and each piece gets Gauss–Legendre.
+template <typename V, typename Out, typename F>
+V integrate_visible_split(const GGX<double>& ggx, const Vec3d& w, double z_split, Out&& outgoing_z,
+                          F&& f) {
+    static const QuadratureRule q = gauss_legendre(kSplitNr);
+    constexpr double kRMax = 1 - 1e-9;
+    V sum{};
+    for (int b = 0; b < kSplitNphi; ++b) {
+        const double u2 = 0.5 * (b + 0.5) / kSplitNphi - 0.25;
+        auto side = [&](double r) {
+            return outgoing_z(ggx.sample_visible_normal(w, r * r, u2)) > z_split;
+        };
+        double r_split = kRMax;
+        const bool first = side(0);
+        if (first != side(kRMax)) {
+            double lo = 0, hi = kRMax;
+            for (int it = 0; it < kSplitBisections; ++it) {
+                const double mid = 0.5 * (lo + hi);
+                (side(mid) == first ? lo : hi) = mid;
+            }
+            r_split = 0.5 * (lo + hi);
+        }
+        for (int piece = 0; piece < 2; ++piece) {
+            const double start = piece ? r_split : 0, length = piece ? kRMax - r_split : r_split;
+            if (length <= 0) continue;
+            for (int i = 0; i < kSplitNr; ++i) {
+                const double r = start + length * q.x[i];
+                sum += f(ggx.sample_visible_normal(w, r * r, u2)) *
+                       (q.w[i] * length * 2 * r / kSplitNphi);
+            }
+        }
     }
     return sum;
 }
@@ -676,7 +716,6 @@ void Lamina1::precompute() {
     if (!series_on_) return;
     // Y(μ') = ∫ f_b(w', w'') μ'' g(μ'') dω'': what the base's first reflection of light arriving
     // at inside cosine μ' sends back down after one reflection at the coat's bottom.
-    static const QuadratureRule qr = gauss_legendre(kBaseNr);
     // The base's separable multiple-scattering lobe sends F_ms ΔE(μ') ∫ ΔE g 2μ'' dμ'' / ΔĒ.
     const Rgbd Y_ms =
         base_ms_ ? integrate01<Rgbd>([&](double mu) { return g(mu) * (dE_base_(mu) * 2 * mu); },
@@ -689,19 +728,15 @@ void Lamina1::precompute() {
         const GGX<double> ggx{alpha1_};
         const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
         const double lambda_w = ggx.lambda(w);
-        Rgbd sum(0.0);
-        for (int a = 0; a < kBaseNr; ++a) {
-            const double r = qr.x[a], w_r = qr.w[a] * 2 * r;
-            for (int b = 0; b < kBaseNphi; ++b) {
-                const Vec3d wm =
-                    ggx.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kBaseNphi - 0.25);
+        // Visible-normal weight: f_b μ'' dω'' = D_w F G2/G1 dwm (Heitz 2018, §2).
+        Rgbd sum = integrate_visible_split<Rgbd>(
+            ggx, w, mu_crit, [&](const Vec3d& wm) { return reflect(w, wm).z; },
+            [&](const Vec3d& wm) {
                 const Vec3d w2 = reflect(w, wm);
-                if (w2.z <= 0) continue;
-                // Visible-normal weight: f_b μ'' dω'' = D_w F G2/G1 dwm (Heitz 2018, §2).
+                if (w2.z <= 0) return Rgbd(0.0);
                 const double escape = (1 + lambda_w) / (1 + lambda_w + ggx.lambda(w2));
-                sum += base_fresnel(dot(w, wm)) * g(w2.z) * (w_r / kBaseNphi * escape);
-            }
-        }
+                return base_fresnel(dot(w, wm)) * g(w2.z) * escape;
+            });
         if (base_ms_) sum += F_ms_ * Y_ms * dE_base_(mu);
         return sum;
     };
@@ -731,21 +766,20 @@ void Lamina1::precompute() {
         X_.fill([&](double mu) {
             const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
             const double lambda_w = ggx0.lambda(w);
-            Rgbd sum(0.0);
-            for (int a = 0; a < kBaseNr; ++a) {
-                const double r = qr.x[a], w_r = qr.w[a] * 2 * r;
-                for (int b = 0; b < kBaseNphi; ++b) {
-                    const Vec3d wm =
-                        ggx0.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kBaseNphi - 0.25);
-                    const double F = fresnel_dielectric(dot(w, wm), eta0_);
+            // The refracted direction's inside cosine −wt.z; Y_curve steps at μc.
+            auto inside_z = [&](const Vec3d& wm) {
+                const auto wt = refract(w, wm, eta0_);
+                return wt ? -wt->z : 0.0;
+            };
+            Rgbd sum =
+                integrate_visible_split<Rgbd>(ggx0, w, mu_crit, inside_z, [&](const Vec3d& wm) {
                     const auto wt = refract(w, wm, eta0_);
-                    if (!wt || wt->z >= 0) continue;
+                    if (!wt || wt->z >= 0) return Rgbd(0.0);
+                    const double F = fresnel_dielectric(dot(w, wm), eta0_);
                     const double escape =
                         refraction_escape(ch_.masking, lambda_w, ggx0.lambda(*wt));
-                    sum += Y_curve(-wt->z) * attenuation(-wt->z) *
-                           ((1 - F) * escape * w_r / kBaseNphi);
-                }
-            }
+                    return Y_curve(-wt->z) * attenuation(-wt->z) * ((1 - F) * escape);
+                });
             if (ms) sum += Y_spread * ms->dielectric(mu, alpha0_, eta0_).transmitted;
             return sum;
         });
