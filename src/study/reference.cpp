@@ -3,6 +3,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hash.h"
+#include "core/packed_array.h"
 #include "lamina/version.h"
 
 #include <fmt/format.h>
@@ -18,7 +19,10 @@ namespace lamina {
 
 namespace {
 
-constexpr const char* kMagic = "lamina-reference-piece v1\n";
+// v2 packs the float32 data (core/packed_array.h: lossless, about half the bytes); v1 pieces, the
+// data stored raw, are still read.
+constexpr const char* kMagic = "lamina-reference-piece v2\n";
+constexpr const char* kMagicV1 = "lamina-reference-piece v1\n";
 
 // A rough dielectric interface somewhere in the stack: its refraction masking shapes the table.
 bool has_rough_dielectric(const Stack& stack) {
@@ -62,8 +66,8 @@ LobeMetrics metrics_from_json(const nlohmann::json& j) {
     return m;
 }
 
-// Layout: magic line, one line of JSON (key, budget, floor, sizes), then float32 data:
-// for each side present, f then se, bins × 3 channels.
+// Layout: magic line, one line of JSON (key, budget, floor, sizes), then float32 data, packed
+// (v1: raw) as [block, θ bin, φ bin, channel]: for each side present, f then se.
 std::string serialize(const ReferenceKey& key, const ReferencePiece& p) {
     nlohmann::json meta;
     meta["key"] = key.canonical();
@@ -89,15 +93,14 @@ std::string serialize(const ReferenceKey& key, const ReferencePiece& p) {
             for (const Rgbd& x : *v)
                 for (int c = 0; c < 3; ++c)
                     data.push_back(float(x[c]));
-    const std::size_t offset = out.size();
-    out.resize(offset + data.size() * sizeof(float));
-    std::memcpy(out.data() + offset, data.data(), data.size() * sizeof(float));
-    return out;
+    return out +
+           pack_elements(data.data(), data.size(), sizeof(float), std::size_t(key.grid.n_phi()), 3);
 }
 
 bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePiece& p) {
     const std::size_t magic_len = std::strlen(kMagic);
-    if (bytes.compare(0, magic_len, kMagic) != 0) return false;
+    const bool packed = bytes.compare(0, magic_len, kMagic) == 0;
+    if (!packed && bytes.compare(0, magic_len, kMagicV1) != 0) return false;
     const std::size_t eol = bytes.find('\n', magic_len);
     if (eol == std::string::npos) return false;
     nlohmann::json meta;
@@ -124,9 +127,18 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
     const std::size_t sides = p.has_transmission ? 2 : 1;
     const std::size_t n = key.grid.size();
     const std::size_t expected = sides * 2 * n * 3 * sizeof(float);
-    if (bytes.size() != eol + 1 + expected) return false;
     std::vector<float> data(expected / sizeof(float));
-    std::memcpy(data.data(), bytes.data() + eol + 1, expected);
+    if (packed) {
+        try {
+            unpack_elements(std::string_view(bytes).substr(eol + 1), data.data(), data.size(),
+                            sizeof(float), std::size_t(key.grid.n_phi()), 3, key.file_name());
+        } catch (const InputError&) {
+            return false;  // damaged: computed again
+        }
+    } else {
+        if (bytes.size() != eol + 1 + expected) return false;
+        std::memcpy(data.data(), bytes.data() + eol + 1, expected);
+    }
     std::size_t at = 0;
     for (std::size_t side = 0; side < sides; ++side)
         for (auto* v : {&p.f[side], &p.se[side]}) {
