@@ -135,6 +135,22 @@ for f in configs/plastic-P1-a0.05/tables.lza configs/slab-a0.1-a1.3-clear/refere
     cmp -s "$tmp/a/$f" "$tmp/old/$f" && ok || fail "upgraded $f differs"
 done
 
+# 2f. `lamina export --study` reads the packed tables: its .npz holds the study's float32 table.
+"$lamina" export --study "$tmp/full" --config slab-a0.1-a1.3-clear --source bel-prime \
+    --out "$tmp/bel.npz" >/dev/null 2>&1 && ok || fail "export --study"
+"$py" - "$tmp" "$src/src/python/lamina/arrays.py" <<'PY' && ok || fail "export --study's table"
+import importlib.util, json, sys
+import numpy as np
+spec = importlib.util.spec_from_file_location("arrays", sys.argv[2])
+arrays = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(arrays)
+d = f"{sys.argv[1]}/full/configs/slab-a0.1-a1.3-clear"
+t = arrays.read_array(f"{d}/tables.lza")
+k = json.load(open(f"{d}/config.json"))["sources"].index("bel-prime")
+f = np.load(f"{sys.argv[1]}/bel.npz")["f"]
+assert f.shape == t[k].shape and np.array_equal(f, t[k]), (f.shape, t[k].shape)
+PY
+
 # 3. Killed part-way (kill -9 as soon as the first piece is stored), then resumed: the same
 #    metrics.csv as the uninterrupted run.
 "$lamina" study "${tiny[@]}" --out "$tmp/b" >/dev/null 2>&1 &
