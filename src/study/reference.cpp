@@ -21,7 +21,7 @@ namespace {
 
 // v2 packs the data (core/packed_array.h): f as float32, losslessly (the metrics are computed from
 // it), and its standard errors as float16 — an estimate whose own relative uncertainty is of order
-// 1/√(particles in the bin), far above float16's 2⁻¹¹ —, a third of v1's bytes; v1 pieces, f and
+// 1/√(particles in the bin), far above float16's 2⁻¹¹ —: 40% of v1's bytes; v1 pieces, f and
 // se stored raw as float32, are still read.
 constexpr const char* kMagic = "lamina-reference-piece v2\n";
 constexpr const char* kMagicV1 = "lamina-reference-piece v1\n";
