@@ -3,7 +3,7 @@
 
     figures.py STUDY_DIR [--formats png,pdf,svg] [--only GLOB[,GLOB...]] [--jobs N] [--force]
 
-Reads study.json, metrics.csv and configs/<id>/{config.json, tables.npy, reference_se.npy}
+Reads study.json, metrics.csv and configs/<id>/{config.json, tables.lza, reference_se.lza}
 (docs/formats.md) and writes STUDY_DIR/figures/:
 
   slices/<id>-R.<fmt> (and -T for slabs)  incident-plane slices: rows = incidences, columns = RGB
@@ -42,6 +42,22 @@ except ImportError as e:  # pragma: no cover - reported by `lamina figures`
           file=sys.stderr)
     sys.exit(3)
 
+
+def load_array_reader():
+    """read_array of lamina's packed arrays (src/python/lamina/arrays.py, numpy only, the one
+    reader of the format in Python). `lamina figures` passes its embedded copy in
+    $LAMINA_ARRAYS_PY; run from the repository, the script reads the file."""
+    text = os.environ.get("LAMINA_ARRAYS_PY")
+    if not text:
+        here = os.path.dirname(os.path.abspath(__file__)) if "__file__" in globals() else ""
+        with open(os.path.join(here, "..", "src", "python", "lamina", "arrays.py")) as f:
+            text = f.read()
+    namespace = {}
+    exec(compile(text, "lamina/arrays.py", "exec"), namespace)
+    return namespace["read_array"]
+
+
+read_array = load_array_reader()
 
 
 def read_palette():
@@ -103,7 +119,7 @@ def save(fig, path_stem, formats, tight=True):
 def omega_perp(n_theta, n_phi):
     """Ω⊥ of the folded grid's bins (docs/formats.md), shape [n_theta, 1]: Δφ (sin²θ1 − sin²θ0).
     It mirrors lamina's one formula (HemisphereGrid::projected_solid_angle, src/core/grid.cpp);
-    the study's CLI test checks that the albedo it gives from tables.npy is metrics.csv's
+    the study's CLI test checks that the albedo it gives from tables.lza is metrics.csv's
     albedo_ref, which lamina computes with its own."""
     edges = np.radians(np.linspace(0, 90, n_theta + 1))
     s2 = np.sin(edges) ** 2
@@ -159,9 +175,9 @@ class Study:
         d = os.path.join(self.root, "configs", cid)
         with open(os.path.join(d, "config.json")) as f:
             cfg = json.load(f)
-        tables = np.load(os.path.join(d, "tables.npy"), mmap_mode="r")
-        se_path = os.path.join(d, "reference_se.npy")
-        se = np.load(se_path, mmap_mode="r") if os.path.exists(se_path) else None
+        tables = read_array(table_path(d, "tables"))
+        se_path = table_path(d, "reference_se")
+        se = read_array(se_path) if os.path.exists(se_path) else None
         return cfg, tables, se
 
 
@@ -401,13 +417,20 @@ def file_digest(path):
     return _FILE_DIGESTS[path]
 
 
+def table_path(d, stem):
+    """configs/<id>/<stem>.lza, or .npy from a study written before packed arrays."""
+    packed, npy = os.path.join(d, stem + ".lza"), os.path.join(d, stem + ".npy")
+    return npy if not os.path.exists(packed) and os.path.exists(npy) else packed
+
+
 def config_files(study, cid):
     d = os.path.join(study.root, "configs", cid)
-    return [os.path.join(d, n) for n in ("config.json", "tables.npy", "reference_se.npy")]
+    return [os.path.join(d, "config.json"), table_path(d, "tables"),
+            table_path(d, "reference_se")]
 
 
 def has_tables(study, cid):
-    return os.path.exists(os.path.join(study.root, "configs", cid, "tables.npy"))
+    return os.path.exists(table_path(os.path.join(study.root, "configs", cid), "tables"))
 
 
 def plan(study, ids, formats, script_id):
@@ -516,7 +539,7 @@ def main():
         os.replace(tmp, stamp_path)
     skipped = [c for c in ids if not has_tables(study, c)]
     if skipped:
-        print(f"figures: {len(skipped)} configurations without tables.npy (--tables none): "
+        print(f"figures: {len(skipped)} configurations without tables (--tables none): "
               "no slices or albedo curves for them", file=sys.stderr)
     print(f"figures: {len(done)} drawn, {len(tasks) - len(todo)} unchanged, {len(formats)} "
           f"format(s), {time.time() - t0:.1f} s -> {fig_dir}", file=sys.stderr)

@@ -82,11 +82,37 @@
     return bytes.buffer;
   }
 
-  function decode(raw) {
+  // A packed array (docs/formats.md, "Packed arrays"): deflate, then byte planes of the
+  // differences along n of each channel's run, laid out [outer, channels, n]. Returns the
+  // elements (2 or 4 bytes each) in their order [outer, n, channels], as an ArrayBuffer.
+  async function unpack(b64, width, n, channels) {
+    const stream = new Blob([bytesOf(b64)]).stream().pipeThrough(new DecompressionStream("deflate"));
+    const planes = new Uint8Array(await new Response(stream).arrayBuffer());
+    const count = planes.length / width;
+    const out = width === 2 ? new Uint16Array(count) : new Uint32Array(count);
+    const row = n * channels;
+    for (let o = 0; o < count; o += row)
+      for (let c = 0; c < channels; ++c) {
+        let x = 0;
+        for (let k = 0; k < n; ++k) {
+          const i = o + c * n + k;
+          let d = 0;
+          for (let b = 0; b < width; ++b) d += planes[b * count + i] * 2 ** (8 * b);
+          x = width === 2 ? (x + d) & 0xffff : (x + d) >>> 0;  // modulo 2^16 or 2^32
+          out[o + k * channels + c] = x;
+        }
+      }
+    return out.buffer;
+  }
+
+  async function decode(raw) {
     const h = raw.hemi;
+    const T = nTheta();
+    // Studies' data written before packing held the raw bytes.
+    const array = (b64, width, n) => raw.packed ? unpack(b64, width, n, 3) : Promise.resolve(bytesOf(b64));
     // 16-bit codes of log10 f (docs/explorer.md, "Data"): 0 is zero, 65535 not supported.
-    const logDecode = (b64, lo, hi) => {
-      const codes = new Uint16Array(bytesOf(b64));
+    const logDecode = async (b64, lo, hi) => {
+      const codes = new Uint16Array(await array(b64, 2, h.n_phi));
       const out = new Float32Array(codes.length);
       const step = (hi - lo) / 65533;
       for (let k = 0; k < codes.length; ++k) {
@@ -95,14 +121,14 @@
       }
       return out;
     };
-    const hemi = logDecode(h.codes, h.lo, h.hi);
-    const hemiSe = h.se_codes ? logDecode(h.se_codes, h.se_lo, h.se_hi) : null;
+    const hemi = await logDecode(h.codes, h.lo, h.hi);
+    const hemiSe = h.se_codes ? await logDecode(h.se_codes, h.se_lo, h.se_hi) : null;
     return {
       raw,
       sources: raw.sources,
       sides: raw.sides,
-      slice: new Float32Array(bytesOf(raw.slice)),
-      sliceSe: raw.slice_se ? new Float32Array(bytesOf(raw.slice_se)) : null,
+      slice: new Float32Array(await array(raw.slice, 4, 2 * T)),
+      sliceSe: raw.slice_se ? new Float32Array(await array(raw.slice_se, 4, 2 * T)) : null,
       hemi,
       hemiSe,
       hemiShape: h,
@@ -115,9 +141,7 @@
       const done = () => {
         const raw = window.LAMINA_DATA && window.LAMINA_DATA[id];
         if (!raw) { reject(new Error("explorer/data/" + id + ".js did not define the configuration")); return; }
-        const d = decode(raw);
-        decoded.set(id, d);
-        resolve(d);
+        decode(raw).then((d) => { decoded.set(id, d); resolve(d); }, reject);
       };
       if (window.LAMINA_DATA && window.LAMINA_DATA[id]) { done(); return; }
       const s = document.createElement("script");

@@ -5,6 +5,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/npy.h"
+#include "core/packed_array.h"
 #include "export/brdf_source.h"
 #include "export/merl.h"
 #include "export/npz.h"
@@ -72,7 +73,7 @@ BinnedTable study_table(const ExportArgs& a) {
         const auto sides = cfg.at("sides").get<std::vector<std::string>>();
         const HemisphereGrid grid(study.at("grid").at("n_theta").get<int>(),
                                   study.at("grid").at("n_phi").get<int>());
-        const NpyFloat32 t = read_npy_float32(dir / "tables.npy");
+        const NpyFloat32 t = read_study_array(dir, "tables");
         const std::vector<std::size_t> want = {sources.size(),
                                                theta_i.size(),
                                                sides.size(),
@@ -80,7 +81,7 @@ BinnedTable study_table(const ExportArgs& a) {
                                                std::size_t(grid.n_phi()),
                                                3};
         if (t.shape != want)
-            throw InputError((dir / "tables.npy").string(), "shape",
+            throw InputError(study_array_path(dir, "tables").string(), "shape",
                              "does not match config.json and study.json");
         BinnedTable table = BinnedTable::zeros(grid, theta_i, true, sides.size() == 2);
         for (std::size_t i = 0; i < theta_i.size(); ++i)

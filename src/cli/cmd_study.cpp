@@ -67,7 +67,7 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
                     "A Python model, [NAME=]FILE.py defining MODEL (a class with a vectorized "
                     "eval(wi, wo), docs/python.md), binned by lamina's quadrature; repeatable");
     cmd->add_option("--tables", a.tables,
-                    "configs/ID/tables.npy: full (float32), half (float16, half the size) or "
+                    "configs/ID/tables.lza (compressed): full (float32), half (float16) or "
                     "none (metrics and summary only: no explorer page, slices or albedo figures)")
         ->capture_default_str();
     cmd->add_option("--formats", a.formats, "Figure formats, comma-separated: png, pdf, svg")

@@ -1,7 +1,7 @@
 #pragma once
 // Files embedded in the binary at build time (assets.cpp.in): the explorer page's HTML, JS and CSS
-// (web/), the vendored Plotly bundle (node_modules, installed by `make deps`) and the figure
-// script.
+// (web/), the vendored Plotly bundle (node_modules, installed by `make deps`), the figure
+// script and its reader of packed arrays.
 
 #include <string_view>
 
@@ -15,5 +15,7 @@ std::string_view model_colors_json();
 /// Empty when node_modules/plotly.js-dist-min was absent when the build was configured.
 std::string_view plotly_js();
 std::string_view figures_py();
+/// src/python/lamina/arrays.py: the Python reader of packed arrays, which the figure script runs.
+std::string_view arrays_py();
 
 }  // namespace lamina::assets

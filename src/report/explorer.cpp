@@ -4,7 +4,7 @@
 #include "core/error.h"
 #include "core/grid.h"
 #include "core/hash.h"
-#include "core/npy.h"
+#include "core/packed_array.h"
 #include "lamina/version.h"
 #include "report/assets.h"
 
@@ -191,7 +191,7 @@ std::vector<int> merged_edges(int n, int k) {
 }
 
 // A table whose last three axes are θ bin, φ bin, channel, seen as consecutive blocks of
-// T × P × 3 floats: block (s·I + i)·D + d of tables.npy, block i·D + d of reference_se.npy.
+// T × P × 3 floats: block (s·I + i)·D + d of tables.lza, block i·D + d of reference_se.lza.
 struct BinBlocks {
     const std::vector<float>& data;
     std::size_t T, P;
@@ -293,18 +293,18 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     const auto sides = field<std::vector<std::string>>(cfg, "sides", cfg_path);
     const std::size_t S = sources.size(), I = theta_i.size(), D = sides.size(), T = n_theta,
                       P = n_phi;
-    const NpyFloat32 tab = read_npy_float32(dir / "tables.npy");
+    const NpyFloat32 tab = read_study_array(dir, "tables");
     if (tab.shape != std::vector<std::size_t>{S, I, D, T, P, 3})
-        throw InputError((dir / "tables.npy").string(), "shape",
+        throw InputError(study_array_path(dir, "tables").string(), "shape",
                          fmt::format("[{}]: expected [sources {}, incidences {}, sides {}, θ {}, φ "
                                      "{}, 3] from config.json and study.json",
                                      fmt::format("{}", fmt::join(tab.shape, ", ")), S, I, D, T, P));
     NpyFloat32 se;
-    const bool has_se = fs::exists(dir / "reference_se.npy");
+    const bool has_se = has_study_array(dir, "reference_se");
     if (has_se) {
-        se = read_npy_float32(dir / "reference_se.npy");
+        se = read_study_array(dir, "reference_se");
         if (se.shape != std::vector<std::size_t>{I, D, T, P, 3})
-            throw InputError((dir / "reference_se.npy").string(), "shape",
+            throw InputError(study_array_path(dir, "reference_se").string(), "shape",
                              fmt::format("expected [{}, {}, {}, {}, 3]", I, D, T, P));
     }
     const BinBlocks f{tab.data, T, P}, f_se{se.data, T, P};
@@ -400,13 +400,20 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     }
     entry["render_errors"] = render_errors;
 
+    // Every array packed (core/packed_array.h: lossless, deflate; the page inflates it with the
+    // browser's DecompressionStream), then base64.
+    const std::size_t X = 2 * T;
+    auto packed = [](const auto& v, std::size_t n) {
+        const std::string p = pack_elements(v.data(), v.size(), sizeof(v[0]), n, 3);
+        return base64(p.data(), p.size());
+    };
     json data = {
         {"id", id},
         {"sources", sources},
         {"sides", sides},
-        {"slice", base64(slice.data(), slice.size() * sizeof(float))},
-        {"slice_se",
-         has_se ? json(base64(slice_se.data(), slice_se.size() * sizeof(float))) : json(nullptr)},
+        {"packed", true},
+        {"slice", packed(slice, X)},
+        {"slice_se", has_se ? json(packed(slice_se, X)) : json(nullptr)},
         {"hemi",
          {{"n_theta", T2},
           {"n_phi", P2},
@@ -414,12 +421,10 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
           {"phi_edges", phi_edges},
           {"lo", codec.lo},
           {"hi", codec.hi},
-          {"codes", base64(codes.data(), codes.size() * sizeof(std::uint16_t))},
+          {"codes", packed(codes, P2)},
           {"se_lo", se_codec.lo},
           {"se_hi", se_codec.hi},
-          {"se_codes", has_se
-                           ? json(base64(se_codes.data(), se_codes.size() * sizeof(std::uint16_t)))
-                           : json(nullptr)}}},
+          {"se_codes", has_se ? json(packed(se_codes, P2)) : json(nullptr)}}},
     };
     ConfigData out;
     out.script = fmt::format("(window.LAMINA_DATA = window.LAMINA_DATA || {{}})[{}] = {};\n",
@@ -447,10 +452,10 @@ std::string plotly_bundle() {
 // renderings' names and errors.csv), its index entry, the study's axes and this lamina.
 std::string inputs_digest(const fs::path& dir, const json& entry,
                           const std::vector<double>& theta_i, int n_theta, int n_phi) {
-    std::uint64_t h = fnv1a(fmt::format("explorer data v1 | lamina {} | {} | {} | {}x{}", kVersion,
+    std::uint64_t h = fnv1a(fmt::format("explorer data v2 | lamina {} | {} | {} | {}x{}", kVersion,
                                         entry.dump(), fmt::join(theta_i, ","), n_theta, n_phi));
-    for (const char* name :
-         {"config.json", "tables.npy", "reference_se.npy", "renders/errors.csv"}) {
+    for (const char* name : {"config.json", "tables.lza", "reference_se.lza", "tables.npy",
+                             "reference_se.npy", "renders/errors.csv"}) {
         std::ifstream in(dir / name, std::ios::binary);
         std::stringstream ss;
         if (in) ss << in.rdbuf();

@@ -1,8 +1,8 @@
 #pragma once
 // The explorer page of a study directory (docs/explorer.md): DIR/index.html and DIR/explorer/,
 // one page that works from file:// with no network and no server. It reads what `lamina study`
-// wrote (docs/formats.md: study.json, metrics.csv, configs/<id>/{config.json, tables.npy,
-// reference_se.npy}) and nothing else, so it can be regenerated at any time.
+// wrote (docs/formats.md: study.json, metrics.csv, configs/<id>/{config.json, tables.lza,
+// reference_se.lza}) and nothing else, so it can be regenerated at any time.
 
 #include <cstdint>
 #include <filesystem>

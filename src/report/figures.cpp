@@ -69,6 +69,8 @@ void write_figures(const fs::path& study_dir, const FigureOptions& options) {
     if (options.force) command += " --force";
     // The palette the explorer page uses too (web/model-colors.json, embedded).
     ::setenv("LAMINA_MODEL_COLORS", std::string(assets::model_colors_json()).c_str(), 1);
+    // The reader of the tables' packed arrays (src/python/lamina/arrays.py, embedded).
+    ::setenv("LAMINA_ARRAYS_PY", std::string(assets::arrays_py()).c_str(), 1);
     std::FILE* pipe = ::popen(command.c_str(), "w");
     if (!pipe) throw InputError(python, "", "cannot start the figure script's interpreter");
     // An interpreter that exits before reading the script must not kill lamina with SIGPIPE.

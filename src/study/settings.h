@@ -16,10 +16,10 @@
 
 namespace lamina {
 
-/// How the study stores configs/<id>/tables.npy and reference_se.npy (docs/formats.md): float32,
-/// float16 (half the size; 11 significant bits, values below 6.1·10⁻⁵ 1/sr lose relative
-/// precision, below 6·10⁻⁸ become 0, above 65504 are clamped to it), or not at all (metrics and
-/// summary only: no slices, albedo figures or explorer page).
+/// How the study stores configs/<id>/tables.lza and reference_se.lza (packed arrays,
+/// docs/formats.md): float32, float16 (half the size; 11 significant bits, values below 6.1·10⁻⁵
+/// 1/sr lose relative precision, below 6·10⁻⁸ become 0, above 65504 are clamped to it), or not at
+/// all (metrics and summary only: no slices, albedo figures or explorer page).
 enum class TablesFormat { Full, Half, None };
 const char* tables_format_name(TablesFormat format);
 /// "full", "half" or "none"; InputError naming `option` otherwise.
@@ -53,7 +53,7 @@ struct StudySettings {
     Microsurface microsurface = Microsurface::Single;  ///< the reference's rough interfaces
     /// The reference's refraction masking on single-scattering rough dielectrics.
     TransmissionMasking transmission_masking = TransmissionMasking::Smith;
-    TablesFormat tables = TablesFormat::Half;  ///< configs/<id>/tables.npy
+    TablesFormat tables = TablesFormat::Half;  ///< configs/<id>/tables.lza
     /// Ignore what an earlier run left (model tables, metrics, outputs) and compute it again; the
     /// reference pieces, keyed by everything they depend on, are still reused.
     bool recompute = false;

@@ -5,7 +5,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hash.h"
-#include "core/npy.h"
+#include "core/packed_array.h"
 #include "core/progress.h"
 #include "lamina/version.h"
 #include "models/binned.h"
@@ -131,9 +131,11 @@ MetricRow row_from_json(const nlohmann::json& j, const StudyConfiguration& c,
     return r;
 }
 
+// A packed array (core/packed_array.h) of float16 or float32 values.
 std::string tables_bytes(TablesFormat format, const std::vector<float>& data,
-                         const std::vector<std::size_t>& shape) {
-    return format == TablesFormat::Half ? npy_float16(data, shape) : npy_float32(data, shape);
+                         const std::vector<std::size_t>& shape,
+                         const std::vector<std::string>& axes) {
+    return packed_array_file(data, shape, format == TablesFormat::Half, axes);
 }
 
 // ---- One configuration
@@ -181,8 +183,8 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
         s.recompute ? nlohmann::json() : read_state(state_path(out_dir, config.id));
     const bool outputs_there = std::filesystem::exists(config_dir / "config.json") &&
                                (s.tables == TablesFormat::None ||
-                                (std::filesystem::exists(config_dir / "tables.npy") &&
-                                 std::filesystem::exists(config_dir / "reference_se.npy")));
+                                (std::filesystem::exists(config_dir / "tables.lza") &&
+                                 std::filesystem::exists(config_dir / "reference_se.lza")));
     ConfigResult result;
     if (state.is_object() && state.value("outputs", "") == digest_hex(outputs_digest) &&
         outputs_there) {
@@ -232,7 +234,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
                     std::ifstream in(config_dir / "config.json");
                     const nlohmann::json cj = nlohmann::json::parse(in);
                     old_sources = cj.at("sources").get<std::vector<std::string>>();
-                    NpyFloat32 t = read_npy_float32(config_dir / "tables.npy");
+                    NpyFloat32 t = read_study_array(config_dir, "tables");
                     if (t.shape == std::vector<std::size_t>{
                                        old_sources.size(), n_inc, std::size_t(n_sides),
                                        std::size_t(grid.n_theta()), std::size_t(grid.n_phi()), 3})
@@ -339,7 +341,8 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     for (const ModelOutcome& m : models)
         result.rows.insert(result.rows.end(), m.rows.begin(), m.rows.end());
 
-    // 3. configs/<id>/: config.json, tables.npy, reference_se.npy (each rewritten only if changed).
+    // 3. configs/<id>/: config.json, tables.lza, reference_se.lza (each rewritten only if changed;
+    //    the .npy tables of a study written before packed arrays are removed).
     const std::size_t n_sources = 1 + models.size();
     nlohmann::json albedo;
     nlohmann::json supported = nlohmann::json::object();
@@ -404,7 +407,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
         cj["tables"] = nullptr;
     else
         cj["tables"] = {
-            {"file", "tables.npy"},
+            {"file", "tables.lza"},
             {"dtype", s.tables == TablesFormat::Half ? "float16" : "float32"},
             {"shape", shape},
             {"axes", {"source", "incidence", "side", "theta_bin", "phi_bin", "channel"}}};
@@ -412,17 +415,20 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     {
         StagedOutput out(config_dir);
         if (s.tables != TablesFormat::None) {
-            wrote |= out.add_if_changed("tables.npy", tables_bytes(s.tables, tables, shape));
+            const std::vector<std::string> axes = {"source",    "incidence", "side",
+                                                   "theta_bin", "phi_bin",   "channel"};
+            wrote |= out.add_if_changed("tables.lza", tables_bytes(s.tables, tables, shape, axes));
             wrote |= out.add_if_changed(
-                "reference_se.npy",
+                "reference_se.lza",
                 tables_bytes(s.tables, ses,
-                             std::vector<std::size_t>(shape.begin() + 1, shape.end())));
+                             std::vector<std::size_t>(shape.begin() + 1, shape.end()),
+                             std::vector<std::string>(axes.begin() + 1, axes.end())));
         }
         wrote |= out.add_if_changed("config.json", cj.dump(1) + "\n");
         out.commit();
     }
-    if (s.tables == TablesFormat::None)
-        for (const char* name : {"tables.npy", "reference_se.npy"}) {
+    for (const char* name : {"tables.npy", "reference_se.npy", "tables.lza", "reference_se.lza"})
+        if (s.tables == TablesFormat::None || std::string_view(name).ends_with(".npy")) {
             std::error_code ec;
             wrote |= std::filesystem::remove(config_dir / name, ec);
         }

@@ -5,7 +5,35 @@
 const fs = require("fs");
 const os = require("os");
 const path = require("path");
+const zlib = require("zlib");
 const { chromium } = require("playwright-core");
+
+// A packed array (docs/formats.md, "Packed arrays") decoded here independently of the page:
+// {shape, values} with float16 or float32 values as numbers.
+function readPacked(file) {
+  const data = fs.readFileSync(file);
+  const eol = data.indexOf(10, 15);
+  const h = JSON.parse(data.subarray(15, eol).toString());
+  const planes = zlib.inflateSync(data.subarray(eol + 1));
+  const width = h.dtype === "float16" ? 2 : 4, count = planes.length / width;
+  const [n, channels] = h.shape.slice(-2);
+  const bits = new Array(count);
+  for (let o = 0; o < count; o += n * channels)
+    for (let c = 0; c < channels; ++c)
+      for (let k = 0, x = 0; k < n; ++k) {
+        let d = 0;
+        for (let b = 0; b < width; ++b) d += planes[b * count + o + c * n + k] * 2 ** (8 * b);
+        x = (x + d) % 2 ** (8 * width);
+        bits[o + k * channels + c] = x;
+      }
+  const half = (u) => {
+    const e = (u >> 10) & 31, m = u & 1023, s = u >> 15 ? -1 : 1;
+    return e === 0 ? s * m * 2 ** -24 : e === 31 ? (m ? NaN : s * Infinity) : s * (1 + m / 1024) * 2 ** (e - 15);
+  };
+  const view = new DataView(new ArrayBuffer(4));
+  const single = (u) => { view.setUint32(0, u); return view.getFloat32(0); };
+  return { shape: h.shape, values: bits.map(width === 2 ? half : single) };
+}
 
 const [studyDir, shot] = process.argv.slice(2);
 const CHROMIUM = process.env.LAMINA_CHROMIUM || "/usr/bin/chromium";
@@ -43,6 +71,17 @@ async function main() {
     check(expected.some((v) => v > 0), `${shown} loses energy to its rough coat (test premise)`);
     check(lost !== null && lost.length === expected.length && lost.every((v, i) => Math.abs(v - expected[i]) <= 1e-12 * Math.max(1, expected[i])),
       `the albedo view draws the reference's microsurface loss (${lost} against config.json's ${expected})`);
+    // The slice draws exactly the reference's values of tables.lza (the page inflates the
+    // explorer's packed data): the incidence shown, side R, red channel, along the incident plane.
+    const tab = readPacked(path.resolve(studyDir, "configs", shown, "tables.lza"));
+    const [, , D, T, P] = tab.shape;
+    const inc = await page.evaluate(() => window.LAMINA_EXPLORER.state.incidence);
+    const at = (t, p) => tab.values[((inc * D + 0) * T * P + t * P + p) * 3];
+    const want = [];
+    for (let x = 0; x < 2 * T; ++x) want.push(x < T ? at(T - 1 - x, 0) : at(x - T, P - 1));
+    const drawn = await page.evaluate(() => Array.from(document.getElementById("slice").data.find((t) => t.name === "reference").y));
+    check(drawn.length === want.length && drawn.every((v, x) => v === want[x]) && want.some((v) => v > 0),
+      `the slice's reference is tables.lza's, bit for bit (${drawn.slice(0, 4)}… against ${want.slice(0, 4)}…)`);
     const info = await page.evaluate(() => document.getElementById("study-info").textContent);
     check(info.includes("single-scattering microsurfaces"), `the header names the reference's microsurface model (${info})`);
     const cells = await page.evaluate(() => (document.getElementById("leaderboard").data[0] || {}).z);

@@ -4,6 +4,7 @@
 #include "report/explorer.h"
 #include "core/error.h"
 #include "core/npy.h"
+#include "core/packed_array.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -92,10 +93,25 @@ TEST(Explorer, MissingStudyNamesStudyJson) {
     EXPECT_FALSE(fs::exists(d / "index.html"));
 }
 
+// A study's float32 table as a packed array (what lamina writes) or as .npy (older studies).
+void write_table(const fs::path& stem, const std::vector<std::size_t>& shape,
+                 const std::vector<float>& values, bool packed) {
+    if (packed) {
+        fs::create_directories(stem.parent_path());
+        std::ofstream(fs::path(stem.string() + ".lza"), std::ios::binary)
+            << packed_array_file(values, shape, /*half=*/false);
+    } else {
+        write_npy(fs::path(stem.string() + ".npy"), shape, values);
+    }
+}
+
 // One configuration, reference + one model, one incidence, a 2 × 2 grid, f = 1/π everywhere for
-// the reference (albedo exactly 1: Σ Ω⊥ over the hemisphere is π) and 2/π for the model.
-TEST(Explorer, WritesPageDataAndAlbedos) {
-    const fs::path d = fresh_dir("tiny");
+// the reference (albedo exactly 1: Σ Ω⊥ over the hemisphere is π) and 2/π for the model; the
+// tables packed (.lza) and, as older studies hold them, .npy.
+class ExplorerTables : public ::testing::TestWithParam<bool> {};
+
+TEST_P(ExplorerTables, WritesPageDataAndAlbedos) {
+    const fs::path d = fresh_dir(GetParam() ? "tiny-lza" : "tiny-npy");
     write_text(d / "study.json", R"({"theta_i": [30], "grid": {"n_theta": 2, "n_phi": 2},
         "models": ["ww09"], "preset": "test",
         "configurations": [{"id": "c1", "category": "plastic",
@@ -105,8 +121,9 @@ TEST(Explorer, WritesPageDataAndAlbedos) {
     std::vector<float> tables(2 * 2 * 2 * 3);
     for (std::size_t k = 0; k < tables.size(); ++k)
         tables[k] = float((k < 12 ? 1 : 2) / M_PI);
-    write_npy(d / "configs/c1/tables.npy", {2, 1, 1, 2, 2, 3}, tables);
-    write_npy(d / "configs/c1/reference_se.npy", {1, 1, 2, 2, 3}, std::vector<float>(12, 0.01f));
+    write_table(d / "configs/c1/tables", {2, 1, 1, 2, 2, 3}, tables, GetParam());
+    write_table(d / "configs/c1/reference_se", {1, 1, 2, 2, 3}, std::vector<float>(12, 0.01f),
+                GetParam());
     write_text(d / "metrics.csv",
                "config,category,model,theta_i,side,channel,misplaced_energy,misplaced_floor,"
                "albedo_ref,albedo_model,albedo_error,rmse,log_rmse,noise_floor,"
@@ -144,19 +161,25 @@ TEST(Explorer, WritesPageDataAndAlbedos) {
         EXPECT_EQ(e.path().filename().string().rfind(".staging", 0), std::string::npos) << e.path();
 }
 
-TEST(Explorer, TableShapeMismatchNamesTheFile) {
-    const fs::path d = fresh_dir("shape");
+TEST_P(ExplorerTables, TableShapeMismatchNamesTheFile) {
+    const fs::path d = fresh_dir(GetParam() ? "shape-lza" : "shape-npy");
     write_text(d / "study.json", R"({"theta_i": [0, 30], "grid": {"n_theta": 2, "n_phi": 2},
         "configurations": [{"id": "c1", "category": "x", "sides": ["R"]}]})");
     write_text(d / "configs/c1/config.json", R"({"sources": ["reference"], "sides": ["R"]})");
-    write_npy(d / "configs/c1/tables.npy", {1, 1, 1, 2, 2, 3}, std::vector<float>(12, 1.0f));
+    write_table(d / "configs/c1/tables", {1, 1, 1, 2, 2, 3}, std::vector<float>(12, 1.0f),
+                GetParam());
     try {
         write_explorer(d);
         FAIL() << "a table of the wrong shape was accepted";
     } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("tables.npy"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(GetParam() ? "tables.lza" : "tables.npy"),
+                  std::string::npos)
+            << e.what();
     }
 }
+
+INSTANTIATE_TEST_SUITE_P(Formats, ExplorerTables, ::testing::Values(true, false),
+                         [](const auto& info) { return info.param ? "packed" : "npy"; });
 
 }  // namespace
 }  // namespace lamina

@@ -17,8 +17,8 @@ tiny=(--only 'plastic-P1-a0.05,slab-a0.1-a1.3-clear' --models ww-prime,bel-prime
 # 1. A tiny study runs end to end and writes the documented files.
 if "$lamina" study "${tiny[@]}" --out "$tmp/a" >"$tmp/a.log" 2>&1; then ok; else fail "study run"; cat "$tmp/a.log"; fi
 for f in study.json metrics.csv summary.md summary.json \
-         configs/plastic-P1-a0.05/config.json configs/plastic-P1-a0.05/tables.npy \
-         configs/plastic-P1-a0.05/reference_se.npy configs/slab-a0.1-a1.3-clear/tables.npy; do
+         configs/plastic-P1-a0.05/config.json configs/plastic-P1-a0.05/tables.lza \
+         configs/plastic-P1-a0.05/reference_se.lza configs/slab-a0.1-a1.3-clear/tables.lza; do
     [ -s "$tmp/a/$f" ] && ok || fail "missing $f"
 done
 head -1 "$tmp/a/metrics.csv" | grep -qx \
@@ -56,8 +56,8 @@ three=(--only 'plastic-P1-a0.05,slab-a0.1-a1.3-clear' --models ww-prime,bel-prim
 grep -qF 'Work: 0 reference pieces simulated, 2 model tables computed (4 reused), 2 configurations written' "$tmp/a3.log" \
     && ok || { fail "adding a model:"; grep Work "$tmp/a3.log"; }
 "$lamina" study "${three[@]}" --no-figures --out "$tmp/f" >/dev/null 2>&1 && ok || fail "fresh three-model study"
-for f in metrics.csv summary.json configs/plastic-P1-a0.05/tables.npy configs/slab-a0.1-a1.3-clear/tables.npy \
-         configs/slab-a0.1-a1.3-clear/config.json configs/slab-a0.1-a1.3-clear/reference_se.npy; do
+for f in metrics.csv summary.json configs/plastic-P1-a0.05/tables.lza configs/slab-a0.1-a1.3-clear/tables.lza \
+         configs/slab-a0.1-a1.3-clear/config.json configs/slab-a0.1-a1.3-clear/reference_se.lza; do
     cmp -s "$tmp/a/$f" "$tmp/f/$f" && ok || fail "incremental $f differs from a fresh study's"
 done
 # Back to two models: nothing is computed, and the metrics are those of the first run.
@@ -81,7 +81,8 @@ cmp -s "$tmp/g/metrics.csv" "$tmp/a.metrics" && ok || fail "metrics after adding
 "$lamina" study "${tiny[@]}" --tables none --no-figures --out "$tmp/none" >/dev/null 2>&1 && ok || fail "--tables none"
 cmp -s "$tmp/full/metrics.csv" "$tmp/a.metrics" && ok || fail "metrics depend on --tables"
 cmp -s "$tmp/none/metrics.csv" "$tmp/a.metrics" && ok || fail "metrics depend on --tables none"
-[ ! -e "$tmp/none/configs/plastic-P1-a0.05/tables.npy" ] && ok || fail "--tables none wrote tables"
+[ ! -e "$tmp/none/configs/plastic-P1-a0.05/tables.lza" ] && ok || fail "--tables none wrote tables"
+[ -z "$(find "$tmp/a/configs" -name '*.npy')" ] && ok || fail "a study wrote .npy tables"
 # Debian's interpreter, the one with numpy and matplotlib (as `lamina figures` chooses it).
 py=python3
 [ -x /usr/bin/python3 ] && py=/usr/bin/python3
@@ -93,8 +94,8 @@ spec = importlib.util.spec_from_file_location("figures", script)
 figures = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(figures)
 cid = "slab-a0.1-a1.3-clear"
-half = np.load(f"{tmp}/a/configs/{cid}/tables.npy")
-full = np.load(f"{tmp}/full/configs/{cid}/tables.npy")
+half = figures.read_array(f"{tmp}/a/configs/{cid}/tables.lza")
+full = figures.read_array(f"{tmp}/full/configs/{cid}/tables.lza")
 assert half.dtype == np.float16 and full.dtype == np.float32, (half.dtype, full.dtype)
 assert json.load(open(f"{tmp}/a/configs/{cid}/config.json"))["tables"]["dtype"] == "float16"
 ok = np.isfinite(full)
@@ -111,6 +112,43 @@ for r in csv.DictReader(open(f"{tmp}/full/metrics.csv")):
     assert abs(albedo - float(r["albedo_ref"])) <= 1e-6 * float(r["albedo_ref"]), (r, albedo)
     n += 1
 assert n >= 6, n
+PY
+
+# 2e. A study written before packed arrays (configs/<id>/*.npy) is read and upgraded: the models
+#     are reused from its .npy tables, which give way to .lza files equal to a fresh study's.
+cp -r "$tmp/a" "$tmp/old"
+"$py" - "$tmp/old" "$src/src/python/lamina/arrays.py" <<'PY' && ok || fail "writing an old-style study"
+import glob, importlib.util, os, sys
+import numpy as np
+spec = importlib.util.spec_from_file_location("arrays", sys.argv[2])
+arrays = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(arrays)
+for f in glob.glob(f"{sys.argv[1]}/configs/*/*.lza"):
+    np.save(f[:-4] + ".npy", arrays.read_array(f))
+    os.remove(f)
+PY
+"$lamina" study "${tiny[@]}" --no-figures --out "$tmp/old" >"$tmp/old.log" 2>&1 && ok || fail "upgrade run"
+grep -qF 'Work: 0 reference pieces simulated, 0 model tables computed (4 reused), 2 configurations written' "$tmp/old.log" \
+    && ok || { fail "upgrading an old study:"; grep Work "$tmp/old.log"; }
+[ -z "$(find "$tmp/old/configs" -name '*.npy')" ] && ok || fail "the .npy tables stayed"
+for f in configs/plastic-P1-a0.05/tables.lza configs/slab-a0.1-a1.3-clear/reference_se.lza; do
+    cmp -s "$tmp/a/$f" "$tmp/old/$f" && ok || fail "upgraded $f differs"
+done
+
+# 2f. `lamina export --study` reads the packed tables: its .npz holds the study's float32 table.
+"$lamina" export --study "$tmp/full" --config slab-a0.1-a1.3-clear --source bel-prime \
+    --out "$tmp/bel.npz" >/dev/null 2>&1 && ok || fail "export --study"
+"$py" - "$tmp" "$src/src/python/lamina/arrays.py" <<'PY' && ok || fail "export --study's table"
+import importlib.util, json, sys
+import numpy as np
+spec = importlib.util.spec_from_file_location("arrays", sys.argv[2])
+arrays = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(arrays)
+d = f"{sys.argv[1]}/full/configs/slab-a0.1-a1.3-clear"
+t = arrays.read_array(f"{d}/tables.lza")
+k = json.load(open(f"{d}/config.json"))["sources"].index("bel-prime")
+f = np.load(f"{sys.argv[1]}/bel.npz")["f"]
+assert f.shape == t[k].shape and np.array_equal(f, t[k]), (f.shape, t[k].shape)
 PY
 
 # 3. Killed part-way (kill -9 as soon as the first piece is stored), then resumed: the same
@@ -138,7 +176,7 @@ cmp -s "$tmp/a/metrics.csv" "$tmp/b/metrics.csv" && ok || fail "metrics after co
 # 5. compare on one stack file.
 "$lamina" compare "$src/examples/metallic-paint.json" --theta-i 30 --particles 2e4 --grid 18x18 \
     --models ww-prime,bel18-symmetric --out "$tmp/c" >/dev/null 2>&1 && ok || fail "compare"
-[ -s "$tmp/c/configs/metallic-paint/tables.npy" ] && ok || fail "compare tables"
+[ -s "$tmp/c/configs/metallic-paint/tables.lza" ] && ok || fail "compare tables"
 [ "$(wc -l <"$tmp/c/metrics.csv")" -eq 7 ] && ok || fail "compare rows"
 
 # 6. Bad arguments: a clear message and a non-zero exit.

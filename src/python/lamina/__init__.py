@@ -28,6 +28,7 @@ from ._lamina import (  # noqa: F401  (re-exported)
     models,
 )
 from . import _lamina
+from .arrays import read_array
 from .plugins import bin_model, input_error, model_name
 
 __all__ = [
@@ -37,6 +38,7 @@ __all__ = [
     "Stack",
     "Table",
     "bin_model",
+    "read_array",
     "compare",
     "export",
     "Study",
@@ -130,8 +132,9 @@ class Study:
     .info: study.json; .metrics: metrics.csv as a numpy structured array (empty fields are NaN),
     or a pandas DataFrame when pandas is installed and load_study(..., pandas=True);
     .configs: the configuration ids; .config(id): its config.json; .tables(id): {source: array
-    [incidence, side, theta bin, phi bin, channel]} (float32; NaN on a side a model does not
-    support); .reference_se(id): the reference's standard errors, same axes.
+    [incidence, side, theta bin, phi bin, channel]} (float16 or float32 as stored, --tables; NaN
+    on a side a model does not support); .reference_se(id): the reference's standard errors, same
+    axes.
     """
 
     def __init__(self, path, pandas=None):
@@ -160,11 +163,21 @@ class Study:
 
     def tables(self, config_id):
         cfg = self.config(config_id)
-        t = np.load(self._dir(config_id) / "tables.npy")
+        t = self._array(config_id, "tables")
         return {name: t[k] for k, name in enumerate(cfg["sources"])}
 
     def reference_se(self, config_id):
-        return np.load(self._dir(config_id) / "reference_se.npy")
+        return self._array(config_id, "reference_se")
+
+    def _array(self, config_id, stem):
+        # configs/<id>/<stem>.lza (a packed array), or .npy from a study written before them.
+        d = self._dir(config_id)
+        if not (d / f"{stem}.lza").exists() and (d / f"{stem}.npy").exists():
+            return np.load(d / f"{stem}.npy")
+        if not (d / f"{stem}.lza").exists():
+            raise InputError(str(d / f"{stem}.lza"), "tables",
+                             "missing (a study run with --tables none has no tables)")
+        return read_array(d / f"{stem}.lza")
 
     def _dir(self, config_id):
         if config_id not in self.configs:
@@ -231,7 +244,7 @@ def compare(stack, models=None, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, 
     models: registry names and Python models (classes or objects with eval(wi, wo); see
     lamina.plugins), default every built-in model. Writes the study directory `out` (metrics,
     summary, explorer, and figures when figures=True) and returns it as a lamina.Study.
-    tables: how configs/<id>/tables.npy is stored, "half" (float16), "full" or "none" (the CLI's
+    tables: how configs/<id>/tables.lza is stored, "half" (float16), "full" or "none" (the CLI's
     --tables).
     """
     if out is None:

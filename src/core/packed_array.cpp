@@ -1,0 +1,201 @@
+#include "core/packed_array.h"
+
+#include "core/check.h"
+#include "core/error.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <zlib.h>
+#include <nlohmann/json.hpp>
+
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+
+namespace lamina {
+
+static_assert(std::endian::native == std::endian::little, "packed arrays assume little-endian");
+
+namespace {
+
+constexpr std::string_view kMagic = "lamina-array 1\n";
+
+// Steps 1–3 on unsigned integers of one width: [outer, n, channels] → [outer, channels, n],
+// differences along n (modulo 2^bits), byte planes.
+template <class U>
+std::string transform(const U* v, std::size_t count, std::size_t n, std::size_t channels) {
+    const std::size_t row = n * channels, outer = count / row;
+    std::vector<U> d(count);
+    for (std::size_t o = 0; o < outer; ++o)
+        for (std::size_t c = 0; c < channels; ++c) {
+            const U* src = v + o * row + c;
+            U* dst = d.data() + o * row + c * n;
+            U previous = 0;
+            for (std::size_t k = 0; k < n; ++k) {
+                const U x = src[k * channels];
+                dst[k] = U(x - previous);
+                previous = x;
+            }
+        }
+    std::string planes(count * sizeof(U), '\0');
+    for (std::size_t b = 0; b < sizeof(U); ++b)
+        for (std::size_t i = 0; i < count; ++i)
+            planes[b * count + i] = char((d[i] >> (8 * b)) & 0xff);
+    return planes;
+}
+
+template <class U>
+void untransform(const std::string& planes, U* v, std::size_t count, std::size_t n,
+                 std::size_t channels) {
+    const std::size_t row = n * channels, outer = count / row;
+    std::vector<U> d(count, 0);
+    for (std::size_t b = 0; b < sizeof(U); ++b)
+        for (std::size_t i = 0; i < count; ++i)
+            d[i] |= U(U(static_cast<unsigned char>(planes[b * count + i])) << (8 * b));
+    for (std::size_t o = 0; o < outer; ++o)
+        for (std::size_t c = 0; c < channels; ++c) {
+            const U* src = d.data() + o * row + c * n;
+            U* dst = v + o * row + c;
+            U x = 0;
+            for (std::size_t k = 0; k < n; ++k) {
+                x = U(x + src[k]);
+                dst[k * channels] = x;
+            }
+        }
+}
+
+std::size_t element_count(const std::vector<std::size_t>& shape) {
+    return std::accumulate(shape.begin(), shape.end(), std::size_t(1), std::multiplies<>());
+}
+
+}  // namespace
+
+std::string pack_elements(const void* elements, std::size_t count, std::size_t width, std::size_t n,
+                          std::size_t channels) {
+    LAMINA_CHECK((width == 2 || width == 4) && n >= 1 && channels >= 1 &&
+                 count % (n * channels) == 0);
+    const std::string planes =
+        width == 2 ? transform(static_cast<const std::uint16_t*>(elements), count, n, channels)
+                   : transform(static_cast<const std::uint32_t*>(elements), count, n, channels);
+    uLongf size = compressBound(uLong(planes.size()));
+    std::string out(size, '\0');
+    const int rc =
+        compress2(reinterpret_cast<Bytef*>(out.data()), &size,
+                  reinterpret_cast<const Bytef*>(planes.data()), uLong(planes.size()), 6);
+    LAMINA_CHECK(rc == Z_OK);
+    out.resize(size);
+    return out;
+}
+
+void unpack_elements(std::string_view packed, void* out, std::size_t count, std::size_t width,
+                     std::size_t n, std::size_t channels, const std::string& where) {
+    if (!((width == 2 || width == 4) && n >= 1 && channels >= 1 && count % (n * channels) == 0))
+        throw InputError(where, "shape", "not a packed array's layout");
+    std::string planes(count * width, '\0');
+    uLongf size = uLongf(planes.size());
+    const int rc = uncompress(reinterpret_cast<Bytef*>(planes.data()), &size,
+                              reinterpret_cast<const Bytef*>(packed.data()), uLong(packed.size()));
+    if (rc != Z_OK || size != planes.size())
+        throw InputError(where, "data",
+                         rc == Z_BUF_ERROR || (rc == Z_OK && size != planes.size())
+                             ? fmt::format("the packed data does not hold the {} values of the "
+                                           "header's shape",
+                                           count)
+                             : fmt::format("not a zlib stream (zlib: {})", zError(rc)));
+    if (width == 2)
+        untransform(planes, static_cast<std::uint16_t*>(out), count, n, channels);
+    else
+        untransform(planes, static_cast<std::uint32_t*>(out), count, n, channels);
+}
+
+std::string packed_array_file(const std::vector<float>& data, const std::vector<std::size_t>& shape,
+                              bool half, const std::vector<std::string>& axes) {
+    LAMINA_CHECK(shape.size() >= 2 && element_count(shape) == data.size());
+    nlohmann::json header;
+    header["dtype"] = half ? "float16" : "float32";
+    header["shape"] = shape;
+    if (!axes.empty()) header["axes"] = axes;
+    header["packing"] =
+        "channels before the second-last axis, differences along it, byte planes, "
+        "deflate (docs/formats.md)";
+    const std::size_t n = shape[shape.size() - 2], channels = shape.back();
+    std::string packed;
+    if (half) {
+        std::vector<std::uint16_t> bits(data.size());
+        for (std::size_t i = 0; i < data.size(); ++i)
+            bits[i] = float_to_half(data[i]);
+        packed = pack_elements(bits.data(), bits.size(), 2, n, channels);
+    } else {
+        packed = pack_elements(data.data(), data.size(), 4, n, channels);
+    }
+    return std::string(kMagic) + header.dump() + "\n" + packed;
+}
+
+NpyFloat32 parse_packed_array(std::string_view bytes, const std::string& where) {
+    if (bytes.substr(0, kMagic.size()) != kMagic)
+        throw InputError(where, "", "not a lamina packed array (no 'lamina-array 1' line)");
+    const std::size_t eol = bytes.find('\n', kMagic.size());
+    if (eol == std::string_view::npos) throw InputError(where, "header", "truncated");
+    NpyFloat32 a;
+    try {
+        const nlohmann::json h =
+            nlohmann::json::parse(bytes.substr(kMagic.size(), eol - kMagic.size()));
+        const std::string dtype = h.at("dtype").get<std::string>();
+        if (dtype != "float16" && dtype != "float32")
+            throw InputError(where, "dtype",
+                             fmt::format("'{}': expected float16 or float32", dtype));
+        a.half = dtype == "float16";
+        a.shape = h.at("shape").get<std::vector<std::size_t>>();
+    } catch (const nlohmann::json::exception& e) {
+        throw InputError(where, "header", fmt::format("malformed: {}", e.what()));
+    }
+    if (a.shape.size() < 2)
+        throw InputError(where, "shape", "expected at least 2 axes (…, n, channels)");
+    std::size_t count = 1;
+    for (std::size_t d : a.shape) {
+        if (d == 0 || count > (std::size_t(1) << 34) / d)
+            throw InputError(where, "shape",
+                             fmt::format("[{}]: each axis in [1, ...], at most 2^34 values",
+                                         fmt::join(a.shape, ", ")));
+        count *= d;
+    }
+    const std::size_t n = a.shape[a.shape.size() - 2], channels = a.shape.back();
+    const std::string_view packed = bytes.substr(eol + 1);
+    a.data.resize(count);
+    if (a.half) {
+        std::vector<std::uint16_t> bits(count);
+        unpack_elements(packed, bits.data(), count, 2, n, channels, where);
+        for (std::size_t i = 0; i < count; ++i)
+            a.data[i] = half_to_float(bits[i]);
+    } else {
+        unpack_elements(packed, a.data.data(), count, 4, n, channels, where);
+    }
+    return a;
+}
+
+NpyFloat32 read_packed_array(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path.string(), "", "cannot read the file");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return parse_packed_array(ss.str(), path.string());
+}
+
+std::filesystem::path study_array_path(const std::filesystem::path& dir, const std::string& stem) {
+    const std::filesystem::path packed = dir / (stem + ".lza"), npy = dir / (stem + ".npy");
+    return !std::filesystem::exists(packed) && std::filesystem::exists(npy) ? npy : packed;
+}
+
+NpyFloat32 read_study_array(const std::filesystem::path& dir, const std::string& stem) {
+    const std::filesystem::path path = study_array_path(dir, stem);
+    return path.extension() == ".npy" ? read_npy_float32(path) : read_packed_array(path);
+}
+
+bool has_study_array(const std::filesystem::path& dir, const std::string& stem) {
+    return std::filesystem::exists(dir / (stem + ".lza")) ||
+           std::filesystem::exists(dir / (stem + ".npy"));
+}
+
+}  // namespace lamina
