@@ -83,12 +83,24 @@ struct MicrosurfaceHit {
 /// and always going down, the next height follows from C1(h') = C1(h) / (1 − u)^(1/Λ(wr)), with
 /// the signed Λ of a direction of travel: Λ(wr) going up, −1 − Λ(−wr) going down (their GGX Λ
 /// evaluated with cot θ < 0). The powers are taken as exponentials of logarithms,
-/// C1(h') = exp(ln C1(h) − ln(1 − u)/Λ). Straight up (wr.z > 0.9999) nothing masks the ray;
-/// straight down (wr.z < −0.9999, Λ → −1) C1(h') = u C1(h); a horizontal ray (|wr.z| < 1e-4)
-/// meets the surface where it is. A branch-free lane template (core/lane.h).
+/// C1(h') = exp(ln C1(h) − ln(1 − u)/Λ), and the escape test in logarithms. Straight up (wr.z >
+/// 0.9999) nothing masks the ray; straight down (wr.z < −0.9999, Λ → −1) C1(h') = u C1(h); a
+/// horizontal ray (|wr.z| < 1e-4) meets the surface where it is. A branch-free lane template
+/// (core/lane.h).
 template <typename T, typename L = Lane<T>>
 inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(T alpha, const LaneVec3<T>& wr,
                                                                      T h, T u) {
+    return microsurface_next_height<T, L>(alpha, wr, h, u, L::negate(L::less(u, u)), false);
+}
+
+/// The same for the lanes of `walking` only (the heights of other lanes are not computed when
+/// every walking lane escapes); `at_top`: every lane is above all facets (h ≥ 1, C1 = 1, so
+/// ln C1 = 0 exactly), as at a walk's first step.
+template <typename T, typename L = Lane<T>>
+inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(T alpha, const LaneVec3<T>& wr,
+                                                                     T h, T u,
+                                                                     typename L::Mask walking,
+                                                                     bool at_top) {
     const T zero = L::constant(0), one = L::constant(1);
     const T c = microsurface_height_cdf<T, L>(h);
     const auto straight_up = L::less(L::constant(0.9999), wr.z);
@@ -98,15 +110,17 @@ inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(T alpha, co
     const T lambda = ggx_lambda<T, L>(alpha * alpha, wr.x, wr.y, wr.z);
     const T lambda_signed = L::select(up, lambda, zero - one - lambda);
     // ln C1(h), C1 kept above 1e-30: C1 = 0 (the lowest height) would give 0 · ∞ for a tiny Λ.
-    const T log_c = L::log(L::max(c, L::constant(1e-30)));
-    const T escape_probability = L::exp(lambda_signed * log_c);
-    const auto escapes_masked = L::both(up, L::negate(L::less(u, one - escape_probability)));
-    const T c_next = L::exp(log_c - L::log1p(zero - u) / lambda_signed);
+    // Going up, u ≥ 1 − C1^Λ ⟺ ln(1 − u) ≤ Λ ln C1: the escape test needs no power.
+    const T log_c = at_top ? zero : L::log(L::max(c, L::constant(1e-30)));
+    const T log_1mu = L::log1p(zero - u);
+    const auto escapes_masked = L::both(up, L::negate(L::less(lambda_signed * log_c, log_1mu)));
+    const auto escapes = L::either(
+        straight_up, L::both(L::negate(L::either(straight_down, horizontal)), escapes_masked));
+    if (L::none(L::both(walking, L::negate(escapes)))) return {h, escapes};
+    const T c_next = L::exp(log_c - log_1mu / lambda_signed);
     const T h_next =
         L::select(straight_down, microsurface_height_cdf_inverse<T, L>(u * c),
                   L::select(horizontal, h, microsurface_height_cdf_inverse<T, L>(c_next)));
-    const auto escapes = L::either(
-        straight_up, L::both(L::negate(L::either(straight_down, horizontal)), escapes_masked));
     return {h_next, escapes};
 }
 
@@ -155,11 +169,13 @@ inline MicrosurfaceWalkLanes<T, typename L::Mask> microsurface_walk(
     LaneVec3<T> wr = {zero - wi.x, zero - wi.y, zero - wi.z};  // the direction of travel
     T h = side * L::constant(2);  // above every facet (C1 = 1) on its own side
     const T cap = L::constant(double(max_order));
+    bool first = true;  // every lane above all facets
     while (true) {
         // The next facet, in the frame of the side the particle is on.
         const T u = uniform();
         const MicrosurfaceHit<T, typename L::Mask> hit = microsurface_next_height<T, L>(
-            alpha, {side * wr.x, side * wr.y, side * wr.z}, side * h, u);
+            alpha, {side * wr.x, side * wr.y, side * wr.z}, side * h, u, walking, first);
+        first = false;
         const auto escapes = L::both(walking, hit.escapes);
         r.escaped = L::either(r.escaped, escapes);
         walking = L::both(walking, L::negate(hit.escapes));
