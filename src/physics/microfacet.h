@@ -116,7 +116,7 @@ struct GGX {
 
     /// Smith Λ(w) for GGX: Heitz 2014, "Understanding the masking-shadowing function in
     /// microfacet-based BRDFs", JCGT 3(2), Eq. 72: Λ = (−1 + sqrt(1 + α² tan²θ)) / 2.
-    /// Symmetric in w.z; infinite at grazing (w.z = 0).
+    /// Symmetric in w.z; infinite at grazing (w.z = 0). The lane template ggx_lambda.
     T lambda(const Vec3<T>& w) const { return ggx_lambda(sqr(alpha), w.x, w.y, w.z); }
 
     /// Smith masking G1(w) = 1 / (1 + Λ(w)) (Heitz 2014, Eq. 43).
@@ -197,7 +197,8 @@ struct GGX {
     /// warp w to the hemisphere configuration (α = 1), sample a spherical cap z ∈ (−wh.z, 1], take
     /// the halfway direction of the cap point and wh, warp back. The construction holds for every
     /// w, below the horizon included (the "complete" of their title: the cap then covers less than
-    /// a hemisphere). For w.z ≥ 0 it is sample_visible_normal_caps.
+    /// a hemisphere). For w.z ≥ 0 it is sample_visible_normal_caps. The lane template
+    /// ggx_sample_visible_normal_complete.
     Vec3<T> sample_visible_normal_complete(const Vec3<T>& w, T u1, T u2) const {
         const LaneVec3<T> wm = ggx_sample_visible_normal_complete(alpha, {w.x, w.y, w.z}, u1, u2);
         return {wm.x, wm.y, wm.z};

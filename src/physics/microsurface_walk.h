@@ -23,6 +23,12 @@
 // (above: wi.z > 0; from below a dielectric: wi.z < 0). Directions of travel are written `wr`.
 // Heights below the surface are seen from there with heights and directions negated (the
 // microsurface is point-symmetric, microfacet.h).
+//
+// One walk for both particle kernels: microsurface_walk is a branch-free lane template
+// (core/lane.h) that walks a set of lanes under a mask until each has left. The scalar kernel
+// runs it at one lane through walk_rough_dielectric / walk_rough_conductor; the SIMD kernel
+// (simulator/kernel_simd.cpp) on its vectors. The lane test (tests/simulator/kernel_simd_test.cpp)
+// compares the two particle by particle from the same random numbers.
 
 #include "core/lane.h"
 #include "core/lane_vec.h"
