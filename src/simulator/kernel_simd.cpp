@@ -1332,6 +1332,35 @@ void HenyeyGreensteinForTest(const float* g, const float* x, std::size_t n, floa
     }
 }
 
+void GgxLanesForTest(float alpha, const float* w, const float* u1, const float* u2, std::size_t n,
+                     float* lambda, float* wm) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in[5][kMaxLanes], out[4][kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            const bool real = base + l < n;
+            for (int i = 0; i < 3; ++i)
+                in[i][l] = real ? w[3 * (base + l) + i] : (i == 2 ? 1.f : 0.f);
+            in[3][l] = real ? u1[base + l] : 0.f;
+            in[4][l] = real ? u2[base + l] : 0.f;
+        }
+        const V3 wv = {hn::Load(df, in[0]), hn::Load(df, in[1]), hn::Load(df, in[2])};
+        const VF a = hn::Set(df, alpha);
+        hn::Store(ggx_lambda<VF, VecLane>(hn::Mul(a, a), wv.x, wv.y, wv.z), df, out[0]);
+        const V3 m = ggx_sample_visible_normal_complete<VF, VecLane>(a, wv, hn::Load(df, in[3]),
+                                                                     hn::Load(df, in[4]));
+        hn::Store(m.x, df, out[1]);
+        hn::Store(m.y, df, out[2]);
+        hn::Store(m.z, df, out[3]);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l) {
+            lambda[base + l] = out[0][l];
+            for (int i = 0; i < 3; ++i)
+                wm[3 * (base + l) + i] = out[1 + i][l];
+        }
+    }
+}
+
 void MicrosurfaceWalkForTest(const float* wi, std::size_t n, float alpha, bool dielectric,
                              const float* eta, const float* k, int max_order, std::uint64_t seed,
                              float* wo, float* weight, int* order, int* outcome) {
@@ -1414,6 +1443,7 @@ HWY_EXPORT(FresnelDielectricForTest);
 HWY_EXPORT(FresnelConductorForTest);
 HWY_EXPORT(HenyeyGreensteinForTest);
 HWY_EXPORT(MicrosurfaceWalkForTest);
+HWY_EXPORT(GgxLanesForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -1497,6 +1527,16 @@ void simd_henyey_greenstein(const std::vector<float>& g, const std::vector<float
     cos_theta.resize(g.size());
     HWY_DYNAMIC_DISPATCH(HenyeyGreensteinForTest)
     (g.data(), x.data(), g.size(), phase.data(), cos_theta.data());
+}
+
+void simd_ggx_lanes(float alpha, const std::vector<float>& w, const std::vector<float>& u1,
+                    const std::vector<float>& u2, std::vector<float>& lambda,
+                    std::vector<float>& wm) {
+    select_simd_target();
+    lambda.resize(u1.size());
+    wm.resize(3 * u1.size());
+    HWY_DYNAMIC_DISPATCH(GgxLanesForTest)
+    (alpha, w.data(), u1.data(), u2.data(), u1.size(), lambda.data(), wm.data());
 }
 
 SimdWalkResult simd_microsurface_walk(const std::vector<float>& wi, float alpha, bool dielectric,

@@ -40,6 +40,12 @@ std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, f
 void simd_henyey_greenstein(const std::vector<float>& g, const std::vector<float>& x,
                             std::vector<float>& phase, std::vector<float>& cos_theta);
 
+/// For tests: physics/microfacet.h ggx_lambda(alpha², w) and ggx_sample_visible_normal_complete
+/// (alpha, w, u1, u2) on the dispatched instruction set's vectors; w, wm: 3 floats per entry.
+void simd_ggx_lanes(float alpha, const std::vector<float>& w, const std::vector<float>& u1,
+                    const std::vector<float>& u2, std::vector<float>& lambda,
+                    std::vector<float>& wm);
+
 /// For tests: where microsurface walks left the microsurface (physics/microsurface_walk.h
 /// microsurface_walk on the dispatched instruction set's vectors). Particle p arrives from
 /// wi[3p..3p+2] and draws from ParticleRng(seed, 0, p) as the kernel's lanes draw; a dielectric
