@@ -227,7 +227,6 @@ struct MicrosurfaceDielectricFacet {
     template <typename M>
     void operator()(const LaneVec3<T>& w, const LaneVec3<T>& wm, T cos_w_m, M above, M walking,
                     LaneVec3<T>& wr_new, M& crosses, T* /*weight*/) const {
-        (void)walking;
         const FresnelDielectric<T> fr = fresnel_dielectric_full<T, L>(
             cos_w_m, L::select(above, eta, inv_eta), L::select(above, inv_eta, eta));
         const T uc = uniform();
@@ -235,6 +234,9 @@ struct MicrosurfaceDielectricFacet {
         const T two_cos = cos_w_m + cos_w_m;
         const LaneVec3<T> reflected = {two_cos * wm.x - w.x, two_cos * wm.y - w.y,
                                        two_cos * wm.z - w.z};
+        crosses = L::negate(reflects);
+        wr_new = reflected;
+        if (L::none(L::both(walking, crosses))) return;  // no lane refracts
         // Snell about wm (fresnel.h refract, from the side wm points to): the reflectance is 1
         // under total internal reflection, so refracting lanes have cos θt > 0.
         const T along = cos_w_m * fr.inv_eta - fr.cos_theta_t;
@@ -243,7 +245,6 @@ struct MicrosurfaceDielectricFacet {
             {L::mul_add(w.x, neg_inv_eta, wm.x * along), L::mul_add(w.y, neg_inv_eta, wm.y * along),
              L::mul_add(w.z, neg_inv_eta, wm.z * along)});
         wr_new = lane_select<T, L>(reflects, reflected, refracted);
-        crosses = L::negate(reflects);
     }
 };
 
