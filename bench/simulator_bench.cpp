@@ -70,12 +70,29 @@ void BM_SimulateMetallicPaint(benchmark::State& state) {
     run(state, bench_metallic_paint());
 }
 
-// Multiple scattering on the microsurfaces (Heitz et al. 2016 walk): the scalar kernel only.
+// A rough slab: a rough coat (α 0.3) over an absorbing medium and a rough exit (η 1 below, α 0.5),
+// reflection and transmission, total internal reflection inside.
+Stack bench_rough_slab() {
+    Layer exit_face;
+    exit_face.interface.type = InterfaceType::Dielectric;
+    exit_face.interface.eta = 1.0;  // the index below: air
+    exit_face.interface.alpha = 0.5;
+    Layer top = coat(0.3, Rgbd(0.1, 0.0, 0.9));
+    return {"bench rough slab", 1.0, {top, exit_face}};
+}
+void BM_SimulateRoughSlab(benchmark::State& state) {
+    run(state, bench_rough_slab());
+}
+
+// Multiple scattering on the microsurfaces (Heitz et al. 2016 walk), both kernels.
 void BM_SimulatePlasticMultiple(benchmark::State& state) {
     run(state, bench_plastic(), Microsurface::Multiple);
 }
 void BM_SimulateMetallicPaintMultiple(benchmark::State& state) {
     run(state, bench_metallic_paint(), Microsurface::Multiple);
+}
+void BM_SimulateRoughSlabMultiple(benchmark::State& state) {
+    run(state, bench_rough_slab(), Microsurface::Multiple);
 }
 
 BENCHMARK(BM_SimulatePlastic)
@@ -89,12 +106,22 @@ BENCHMARK(BM_SimulateMetallicPaint)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_SimulatePlasticMultiple)
-    ->ArgsProduct({{1, 2}, {0}})
+    ->ArgsProduct({{1, 2}, {0, 1}})
     ->ArgNames({"threads", "simd"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_SimulateMetallicPaintMultiple)
-    ->ArgsProduct({{1, 2}, {0}})
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "simd"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_SimulateRoughSlab)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "simd"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_SimulateRoughSlabMultiple)
+    ->ArgsProduct({{1, 2}, {0, 1}})
     ->ArgNames({"threads", "simd"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

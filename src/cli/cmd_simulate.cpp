@@ -52,8 +52,7 @@ Runner add_simulate(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--microsurface", a->microsurface,
                     "Rough interfaces: single (single scattering, the masked energy reported as "
-                    "lost_microsurface) or multiple (Heitz et al. 2016 random walk; needs "
-                    "--kernel scalar)")
+                    "lost_microsurface) or multiple (Heitz et al. 2016 random walk)")
         ->capture_default_str();
     cmd->add_option("--transmission-masking", a->transmission_masking,
                     "Masking of light refracted by a rough dielectric (single scattering): smith "

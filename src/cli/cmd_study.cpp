@@ -56,8 +56,7 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
         ->capture_default_str();
     cmd->add_option("--microsurface", a.microsurface,
                     "Rough interfaces of the reference: single (single scattering, the masked "
-                    "energy reported as lost) or multiple (Heitz et al. 2016 random walk; needs "
-                    "--kernel scalar)")
+                    "energy reported as lost) or multiple (Heitz et al. 2016 random walk)")
         ->capture_default_str();
     cmd->add_option("--model-table", a.model_tables,
                     "A model evaluated elsewhere, as NAME=FILE.csv in the brdf.csv format (lamina "
@@ -147,10 +146,6 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
     s.kernel = parse_kernel(a.kernel);
     s.microsurface = parse_microsurface(a.microsurface);
     s.transmission_masking = parse_transmission_masking(a.transmission_masking);
-    if (s.microsurface == Microsurface::Multiple && s.kernel == Kernel::Simd)
-        throw InputError("command line", "--microsurface",
-                         "multiple scattering on the microsurfaces runs on the scalar kernel only: "
-                         "add --kernel scalar");
     s.theta_i_deg = parse_incidences(a.theta_i, "--theta-i");
     s.tables = parse_tables_format(a.tables);
     figure_options(a);  // validates --formats before any work

@@ -10,6 +10,13 @@
 //   L::log/log1p/exp lane-wise, the C library's (scalar) or Highway's (vectors: ≤ 4 ulp)
 //   L::select(m,a,b) a where the mask m holds, else b
 //   L::less(a, b)    the mask a < b
+//   L::abs(x)        |x|
+//   L::mul_add(a, b, c), L::neg_mul_add(a, b, c)   a·b + c and c − a·b (vectors: fused)
+//   L::inv_sqrt(x)   1/√x (vectors: the hardware estimate refined by a Newton step, ≤ 2^-22)
+//   L::cos_sin_2pi(u, c, s)   cos and sin of 2πu, u ∈ [0, 1) (an azimuth)
+//   L::both(m, n), L::either(m, n), L::negate(m), L::none(m)   mask logic; none: no lane holds
+//
+// LaneVec3<T> (core/lane_vec.h) holds a direction as three lane values.
 //
 // Lane headers. Vector code must be compiled once per instruction set, inside Highway's target
 // regions, so a header of lane templates (core/beta_function.h, physics/smith_masking.h) is
@@ -48,6 +55,19 @@ struct Lane<T> {
     static T exp(T x) { return std::exp(x); }
     static T select(bool m, T a, T b) { return m ? a : b; }
     static bool less(T a, T b) { return a < b; }
+    static T abs(T x) { return std::abs(x); }
+    static T mul_add(T a, T b, T c) { return a * b + c; }
+    static T neg_mul_add(T a, T b, T c) { return c - a * b; }
+    static T inv_sqrt(T x) { return T(1) / std::sqrt(x); }
+    static void cos_sin_2pi(T u, T& c, T& s) {
+        const T phi = T(2) * T(3.14159265358979323846) * u;
+        c = std::cos(phi);
+        s = std::sin(phi);
+    }
+    static bool both(bool m, bool n) { return m && n; }
+    static bool either(bool m, bool n) { return m || n; }
+    static bool negate(bool m) { return !m; }
+    static bool none(bool m) { return !m; }
     /// The largest argument the lane's special functions take without overflow in their
     /// intermediate products (core/beta_function.h).
     static constexpr double kBetaArgumentMax = sizeof(T) == 4 ? 1e7 : 1e15;

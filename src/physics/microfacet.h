@@ -1,4 +1,3 @@
-#pragma once
 // The GGX (Trowbridge–Reitz) microfacet distribution as a value type.
 //
 // Local frame, z = macro-surface normal. α is the GGX roughness itself (no remapping), isotropic,
@@ -9,6 +8,7 @@
 
 #include "core/beta_function.h"
 #include "core/lane.h"
+#include "core/lane_vec.h"
 #include "core/math.h"
 #include "core/vec.h"
 #include "physics/smith_masking.h"
@@ -16,6 +16,70 @@
 #include <cmath>
 #include <limits>
 #include <string>
+
+// A lane header (core/lane.h): its lane templates are included once as an ordinary header and
+// once per SIMD target; the GGX type below them only once.
+#ifndef LAMINA_LANE_TARGET
+#ifndef LAMINA_PHYSICS_MICROFACET_LANES_H
+#define LAMINA_PHYSICS_MICROFACET_LANES_H
+#define LAMINA_PHYSICS_MICROFACET_BODY
+#endif
+#elif defined(LAMINA_PHYSICS_MICROFACET_TARGET) == defined(HWY_TARGET_TOGGLE)
+#ifdef LAMINA_PHYSICS_MICROFACET_TARGET
+#undef LAMINA_PHYSICS_MICROFACET_TARGET
+#else
+#define LAMINA_PHYSICS_MICROFACET_TARGET
+#endif
+#define LAMINA_PHYSICS_MICROFACET_BODY
+#endif
+
+#ifdef LAMINA_PHYSICS_MICROFACET_BODY
+#undef LAMINA_PHYSICS_MICROFACET_BODY
+
+LAMINA_LANE_BEGIN
+
+/// Smith Λ(w) for GGX of squared roughness alpha2, w = (x, y, z) a unit direction: Heitz 2014,
+/// "Understanding the masking-shadowing function in microfacet-based BRDFs", JCGT 3(2), Eq. 72:
+/// Λ = (−1 + √(1 + α² tan²θ)) / 2, written x/(2(√(1 + x) + 1)) with x = α² tan²θ (no
+/// cancellation for small α). Symmetric in z; +∞ at grazing (z = 0) and wherever α² tan²θ
+/// overflows (within a few ulps of grazing, where the formula would give ∞/∞). A branch-free lane
+/// template (core/lane.h): GGX::lambda and the SIMD kernel's microsurface walk evaluate it.
+template <typename T, typename L = Lane<T>>
+inline T ggx_lambda(T alpha2, T x, T y, T z) {
+    const T alpha2_tan2 = alpha2 * (x * x + y * y) / (z * z);
+    const T lambda =
+        alpha2_tan2 / (L::constant(2) * (L::sqrt(L::constant(1) + alpha2_tan2) + L::constant(1)));
+    // An infinite α² tan²θ, and NaN (0/0 at z = 0 with α = 0), fail the comparison: Λ = ∞.
+    const T infinity = L::constant(HUGE_VAL);
+    return L::select(L::less(alpha2_tan2, infinity), lambda, infinity);
+}
+
+/// A normal drawn from the distribution of GGX normals visible from the direction w (unit, any
+/// side: below the horizon too, see GGX::D_visible_complete) by the spherical caps of Dupuy &
+/// Benyoub 2023, "Sound and complete sampling of visible GGX normals with spherical caps", CGF
+/// 42(8), Listing 3, from two uniform numbers in [0, 1): warp w to the hemisphere configuration
+/// (α = 1), sample the spherical cap z ∈ (−wh.z, 1], take the halfway direction of the cap point
+/// and wh, warp back. A branch-free lane template (core/lane.h):
+/// GGX::sample_visible_normal_complete and the SIMD kernel evaluate it.
+template <typename T, typename L = Lane<T>>
+inline LaneVec3<T> ggx_sample_visible_normal_complete(T alpha, const LaneVec3<T>& w, T u1, T u2) {
+    const T one = L::constant(1);
+    const LaneVec3<T> wh = lane_normalize<T, L>({alpha * w.x, alpha * w.y, w.z});
+    T cos_phi, sin_phi;
+    L::cos_sin_2pi(u1, cos_phi, sin_phi);
+    const T z = (one - u2) * (one + wh.z) - wh.z;
+    const T sin_theta = L::sqrt(L::max(L::neg_mul_add(z, z, one), L::constant(0)));
+    const LaneVec3<T> h = {L::mul_add(sin_theta, cos_phi, wh.x),
+                           L::mul_add(sin_theta, sin_phi, wh.y), z + wh.z};
+    return lane_normalize<T, L>({alpha * h.x, alpha * h.y, L::max(h.z, L::constant(0))});
+}
+
+LAMINA_LANE_END
+
+#endif  // LAMINA_PHYSICS_MICROFACET_BODY
+
+#if !defined(LAMINA_LANE_TARGET) && !defined(LAMINA_PHYSICS_MICROFACET_H)
+#define LAMINA_PHYSICS_MICROFACET_H
 
 namespace lamina {
 
@@ -52,17 +116,8 @@ struct GGX {
 
     /// Smith Λ(w) for GGX: Heitz 2014, "Understanding the masking-shadowing function in
     /// microfacet-based BRDFs", JCGT 3(2), Eq. 72: Λ = (−1 + sqrt(1 + α² tan²θ)) / 2.
-    /// Symmetric in w.z; infinite at grazing (w.z = 0).
-    T lambda(const Vec3<T>& w) const {
-        const T cos2 = sqr(w.z);
-        if (cos2 == 0) return std::numeric_limits<T>::infinity();
-        const T alpha2_tan2 = sqr(alpha) * (sqr(w.x) + sqr(w.y)) / cos2;
-        // Within a few ulps of grazing (cos² subnormal) α² tan²θ overflows: Λ is infinite there
-        // too (inf/inf below would give NaN).
-        if (alpha2_tan2 > std::numeric_limits<T>::max()) return std::numeric_limits<T>::infinity();
-        // (sqrt(1+x) − 1)/2 = x / (2 (sqrt(1+x) + 1)): no cancellation for small α.
-        return alpha2_tan2 / (T(2) * (std::sqrt(T(1) + alpha2_tan2) + T(1)));
-    }
+    /// Symmetric in w.z; infinite at grazing (w.z = 0). The lane template ggx_lambda.
+    T lambda(const Vec3<T>& w) const { return ggx_lambda(sqr(alpha), w.x, w.y, w.z); }
 
     /// Smith masking G1(w) = 1 / (1 + Λ(w)) (Heitz 2014, Eq. 43).
     T G1(const Vec3<T>& w) const { return T(1) / (T(1) + lambda(w)); }
@@ -142,15 +197,11 @@ struct GGX {
     /// warp w to the hemisphere configuration (α = 1), sample a spherical cap z ∈ (−wh.z, 1], take
     /// the halfway direction of the cap point and wh, warp back. The construction holds for every
     /// w, below the horizon included (the "complete" of their title: the cap then covers less than
-    /// a hemisphere). For w.z ≥ 0 it is sample_visible_normal_caps.
+    /// a hemisphere). For w.z ≥ 0 it is sample_visible_normal_caps. The lane template
+    /// ggx_sample_visible_normal_complete.
     Vec3<T> sample_visible_normal_complete(const Vec3<T>& w, T u1, T u2) const {
-        const Vec3<T> wh = normalize(Vec3<T>(alpha * w.x, alpha * w.y, w.z));
-        const T phi = T(2) * kPi<T> * u1;
-        const T z = (T(1) - u2) * (T(1) + wh.z) - wh.z;
-        const T sin_theta = safe_sqrt(T(1) - sqr(z));
-        const Vec3<T> c(sin_theta * std::cos(phi), sin_theta * std::sin(phi), z);
-        const Vec3<T> h = c + wh;
-        return normalize(Vec3<T>(alpha * h.x, alpha * h.y, max0(h.z)));
+        const LaneVec3<T> wm = ggx_sample_visible_normal_complete(alpha, {w.x, w.y, w.z}, u1, u2);
+        return {wm.x, wm.y, wm.z};
     }
 
     /// √(1 + α² tan²θ) = 1 + 2Λ(w): the quantity from which G1 and G2 follow without cancellation.
@@ -165,3 +216,5 @@ struct GGX {
 };
 
 }  // namespace lamina
+
+#endif  // LAMINA_PHYSICS_MICROFACET_H

@@ -1,4 +1,3 @@
-#pragma once
 // Multiple scattering on a rough GGX interface: the microsurface random walk of Heitz, Hanika,
 // d'Eon & Dachsbacher 2016, "Multiple-scattering microfacet BSDFs with the Smith model", ACM TOG
 // 35(4) (SIGGRAPH 2016), for dielectric and conductor microsurfaces.
@@ -24,7 +23,15 @@
 // (above: wi.z > 0; from below a dielectric: wi.z < 0). Directions of travel are written `wr`.
 // Heights below the surface are seen from there with heights and directions negated (the
 // microsurface is point-symmetric, microfacet.h).
+//
+// One walk for both particle kernels: microsurface_walk is a branch-free lane template
+// (core/lane.h) that walks a set of lanes under a mask until each has left. The scalar kernel
+// runs it at one lane through walk_rough_dielectric / walk_rough_conductor; the SIMD kernel
+// (simulator/kernel_simd.cpp) on its vectors. The lane test (tests/simulator/kernel_simd_test.cpp)
+// compares the two particle by particle from the same random numbers.
 
+#include "core/lane.h"
+#include "core/lane_vec.h"
 #include "core/math.h"
 #include "core/rgb.h"
 #include "core/vec.h"
@@ -35,42 +42,239 @@
 #include <limits>
 #include <optional>
 
-namespace lamina {
+// A lane header (core/lane.h): the walk is written once, as lane templates, included once as an
+// ordinary header and once per SIMD target (the SIMD kernel runs the walk on its lanes); the
+// scalar entry points below them only once.
+#ifndef LAMINA_LANE_TARGET
+#ifndef LAMINA_PHYSICS_MICROSURFACE_WALK_LANES_H
+#define LAMINA_PHYSICS_MICROSURFACE_WALK_LANES_H
+#define LAMINA_PHYSICS_MICROSURFACE_WALK_BODY
+#endif
+#elif defined(LAMINA_PHYSICS_MICROSURFACE_WALK_TARGET) == defined(HWY_TARGET_TOGGLE)
+#ifdef LAMINA_PHYSICS_MICROSURFACE_WALK_TARGET
+#undef LAMINA_PHYSICS_MICROSURFACE_WALK_TARGET
+#else
+#define LAMINA_PHYSICS_MICROSURFACE_WALK_TARGET
+#endif
+#define LAMINA_PHYSICS_MICROSURFACE_WALK_BODY
+#endif
+
+#ifdef LAMINA_PHYSICS_MICROSURFACE_WALK_BODY
+#undef LAMINA_PHYSICS_MICROSURFACE_WALK_BODY
+
+LAMINA_LANE_BEGIN
 
 /// CDF C1 of the microsurface's heights, uniform on [−1, 1] (Heitz et al. 2016), and its
 /// inverse on [0, 1].
-template <typename T>
+template <typename T, typename L = Lane<T>>
 inline T microsurface_height_cdf(T h) {
-    return clamp((h + T(1)) * T(0.5), T(0), T(1));
+    return L::min(L::max((h + L::constant(1)) * L::constant(0.5), L::constant(0)), L::constant(1));
 }
-template <typename T>
+template <typename T, typename L = Lane<T>>
 inline T microsurface_height_cdf_inverse(T u) {
-    return clamp(T(2) * u - T(1), T(-1), T(1));
+    return L::min(L::max(L::constant(2) * u - L::constant(1), L::constant(-1)), L::constant(1));
 }
 
-/// Smith Λ for a direction of travel wr: GGX::lambda(wr) going up (wr.z > 0), −1 − Λ(−wr) going
-/// down (Heitz et al. 2016: their GGX Λ evaluated with cot θ < 0).
-template <typename T>
-inline T smith_lambda_signed(const GGX<T>& ggx, const Vec3<T>& wr) {
-    return wr.z >= 0 ? ggx.lambda(wr) : T(-1) - ggx.lambda(wr);
+/// The next intersection of a ray with the microsurface: its height, unless the ray escapes.
+template <typename T, typename M>
+struct MicrosurfaceHit {
+    T height;
+    M escapes;
+};
+
+/// The height of the next intersection of a ray leaving height h along the direction of travel
+/// wr (unit) with the microsurface of GGX roughness alpha, or an escape (upwards only), from one
+/// uniform number u ∈ [0, 1). Heitz et al. 2016 (the height-dependent masking G1(wr, h) =
+/// C1(h)^Λ(wr) and its inverse): a ray going up escapes with probability C1(h)^Λ(wr); otherwise,
+/// and always going down, the next height follows from C1(h') = C1(h) / (1 − u)^(1/Λ(wr)), with
+/// the signed Λ of a direction of travel: Λ(wr) going up, −1 − Λ(−wr) going down (their GGX Λ
+/// evaluated with cot θ < 0). The powers are taken as exponentials of logarithms,
+/// C1(h') = exp(ln C1(h) − ln(1 − u)/Λ), and the escape test in logarithms. Straight up (wr.z >
+/// 0.9999) nothing masks the ray; straight down (wr.z < −0.9999, Λ → −1) C1(h') = u C1(h); a
+/// horizontal ray (|wr.z| < 1e-4) meets the surface where it is. A branch-free lane template
+/// (core/lane.h).
+template <typename T, typename L = Lane<T>>
+inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(T alpha, const LaneVec3<T>& wr,
+                                                                     T h, T u) {
+    return microsurface_next_height<T, L>(alpha, wr, h, u, L::negate(L::less(u, u)), false);
 }
 
-/// The height of the next intersection of a ray leaving height h along wr with the microsurface,
-/// or +∞ when the ray escapes it (upwards only), from one uniform number u ∈ [0, 1).
-/// Heitz et al. 2016 (the height-dependent masking G1(wr, h) = C1(h)^Λ(wr) and its inverse): a
-/// ray going up escapes with probability C1(h)^Λ(wr); otherwise, and always going down, the next
-/// height follows from C1(h') = C1(h) / (1 − u)^(1/Λ(wr)).
-template <typename T>
-inline T microsurface_next_height(const GGX<T>& ggx, const Vec3<T>& wr, T h, T u) {
-    constexpr T kInfinity = std::numeric_limits<T>::infinity();
-    if (wr.z > T(0.9999)) return kInfinity;  // straight up: nothing can mask it
-    const T c = microsurface_height_cdf(h);
-    if (wr.z < T(-0.9999)) return microsurface_height_cdf_inverse(u * c);  // Λ → −1
-    if (std::abs(wr.z) < T(1e-4)) return h;  // horizontal: meets the surface where it is
-    const T lambda = smith_lambda_signed(ggx, wr);
-    if (wr.z > 0 && u >= T(1) - std::pow(c, lambda)) return kInfinity;
-    return microsurface_height_cdf_inverse(c / std::pow(T(1) - u, T(1) / lambda));
+/// The same for the lanes of `walking` only (the heights of other lanes are not computed when
+/// every walking lane escapes); `at_top`: every lane is above all facets (h ≥ 1, C1 = 1, so
+/// ln C1 = 0 exactly), as at a walk's first step.
+template <typename T, typename L = Lane<T>>
+inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(T alpha, const LaneVec3<T>& wr,
+                                                                     T h, T u,
+                                                                     typename L::Mask walking,
+                                                                     bool at_top) {
+    const T zero = L::constant(0), one = L::constant(1);
+    const T c = microsurface_height_cdf<T, L>(h);
+    const auto straight_up = L::less(L::constant(0.9999), wr.z);
+    const auto straight_down = L::less(wr.z, L::constant(-0.9999));
+    const auto horizontal = L::less(L::abs(wr.z), L::constant(1e-4));
+    const auto up = L::less(zero, wr.z);
+    const T lambda = ggx_lambda<T, L>(alpha * alpha, wr.x, wr.y, wr.z);
+    const T lambda_signed = L::select(up, lambda, zero - one - lambda);
+    // ln C1(h), C1 kept above 1e-30: C1 = 0 (the lowest height) would give 0 · ∞ for a tiny Λ.
+    // Going up, u ≥ 1 − C1^Λ ⟺ ln(1 − u) ≤ Λ ln C1: the escape test needs no power.
+    const T log_c = at_top ? zero : L::log(L::max(c, L::constant(1e-30)));
+    const T log_1mu = L::log1p(zero - u);
+    const auto escapes_masked = L::both(up, L::negate(L::less(lambda_signed * log_c, log_1mu)));
+    const auto escapes = L::either(
+        straight_up, L::both(L::negate(L::either(straight_down, horizontal)), escapes_masked));
+    if (L::none(L::both(walking, L::negate(escapes)))) return {h, escapes};
+    const T c_next = L::exp(log_c - log_1mu / lambda_signed);
+    const T h_next =
+        L::select(straight_down, microsurface_height_cdf_inverse<T, L>(u * c),
+                  L::select(horizontal, h, microsurface_height_cdf_inverse<T, L>(c_next)));
+    return {h_next, escapes};
 }
+
+/// Where the walks of a set of lanes left the microsurface. Per lane one of: `escaped` (wo is the
+/// direction of travel out of the microsurface, weight the flux factor it carries: a conductor's
+/// Fresnel factors, 1 for a dielectric), `capped` (given up past its facet cap: it would meet one
+/// more facet; its flux is lost to the microsurface), `degenerate` (a numerical degeneracy:
+/// grazing arrival, a facet not facing the ray after rounding; lost and counted), or none of
+/// them for lanes outside the walking mask. `order` counts the facets met (the scattering order).
+template <typename T, typename M>
+struct MicrosurfaceWalkLanes {
+    LaneVec3<T> wo;
+    T weight[3];
+    T order;
+    M escaped, capped, degenerate;
+};
+
+/// The microsurface walk of Heitz et al. 2016 on the lanes of `walking`, each arriving from wi
+/// (pointing away from the surface, unit) on a rough interface of GGX roughness alpha > 0, written
+/// once for every lane type: while some lane walks, every lane draws its numbers (`uniform()`
+/// returns a lane of uniform numbers in [0, 1); the draws of a lane that walks follow the same
+/// sequence whatever the other lanes do: one for the height, then two for the visible normal and
+/// those of `scatter`), lanes that walk find their next height (microsurface_next_height) and
+/// either escape, stop at the cap of max_order facets, or meet a facet drawn from the normals
+/// visible from their direction (the complete distribution: below the horizon too) and scatter
+/// off it. `scatter(w, wm, cos_w_m, above, walking, wr_new, crosses, weight)` turns the arriving
+/// w (away from the surface), the facet normal wm (unit, on the particle's side, w·wm > 0) into
+/// the new direction of travel, the mask of lanes that crossed to the other side, and multiplies
+/// the flux weights of the walking lanes. Heights and directions below the surface are seen from
+/// there negated (the microsurface is point-symmetric, microfacet.h). `two_sided`: light may
+/// arrive from below (a dielectric); otherwise a lane with wi.z ≤ 0 is degenerate.
+template <typename T, typename L, typename Scatter, typename Uniform>
+inline MicrosurfaceWalkLanes<T, typename L::Mask> microsurface_walk(
+    T alpha, const LaneVec3<T>& wi, typename L::Mask walking, bool two_sided, Scatter&& scatter,
+    Uniform&& uniform, int max_order) {
+    const T zero = L::constant(0), one = L::constant(1);
+    MicrosurfaceWalkLanes<T, typename L::Mask> r;
+    r.weight[0] = r.weight[1] = r.weight[2] = one;
+    r.order = zero;
+    const auto arrives = two_sided ? L::less(zero, L::abs(wi.z)) : L::less(zero, wi.z);
+    r.degenerate = L::both(walking, L::negate(arrives));
+    walking = L::both(walking, arrives);
+    r.escaped = r.capped = L::both(walking, L::negate(walking));  // no lane
+    auto above = L::less(zero, wi.z);  // on the side the interface's normal points to
+    T side = L::select(above, one, zero - one);
+    LaneVec3<T> wr = {zero - wi.x, zero - wi.y, zero - wi.z};  // the direction of travel
+    T h = side * L::constant(2);  // above every facet (C1 = 1) on its own side
+    const T cap = L::constant(double(max_order));
+    bool first = true;  // every lane above all facets
+    while (true) {
+        // The next facet, in the frame of the side the particle is on.
+        const T u = uniform();
+        const MicrosurfaceHit<T, typename L::Mask> hit = microsurface_next_height<T, L>(
+            alpha, {side * wr.x, side * wr.y, side * wr.z}, side * h, u, walking, first);
+        first = false;
+        const auto escapes = L::both(walking, hit.escapes);
+        r.escaped = L::either(r.escaped, escapes);
+        walking = L::both(walking, L::negate(hit.escapes));
+        const auto capped = L::both(walking, L::negate(L::less(r.order, cap)));
+        r.capped = L::either(r.capped, capped);
+        walking = L::both(walking, L::negate(capped));
+        if (L::none(walking)) break;
+        h = L::select(walking, side * hit.height, h);
+        r.order = L::select(walking, r.order + one, r.order);
+        // A facet visible from the arriving direction (below the horizon after a first bounce).
+        const LaneVec3<T> w = {zero - wr.x, zero - wr.y, zero - wr.z};
+        const T u1 = uniform(), u2 = uniform();
+        const LaneVec3<T> wm_side = ggx_sample_visible_normal_complete<T, L>(
+            alpha, {side * w.x, side * w.y, side * w.z}, u1, u2);
+        const LaneVec3<T> wm = {side * wm_side.x, side * wm_side.y, side * wm_side.z};
+        const T cos_w_m = lane_dot<T, L>(w, wm);
+        const auto facing = L::less(zero, cos_w_m);  // false: rounding at grazing (or NaN)
+        r.degenerate = L::either(r.degenerate, L::both(walking, L::negate(facing)));
+        walking = L::both(walking, facing);
+        if (L::none(walking)) break;
+        LaneVec3<T> wr_new;
+        auto crosses = L::negate(walking);
+        scatter(w, wm, cos_w_m, above, walking, wr_new, crosses, r.weight);
+        const auto finite = L::less(L::abs(wr_new.z), L::constant(HUGE_VAL));
+        r.degenerate = L::either(r.degenerate, L::both(walking, L::negate(finite)));
+        walking = L::both(walking, finite);
+        wr = lane_select<T, L>(walking, wr_new, wr);
+        const auto flips = L::both(walking, crosses);
+        side = L::select(flips, zero - side, side);
+        above = L::less(zero, side);
+    }
+    r.wo = wr;
+    return r;
+}
+
+/// The dielectric facet of the walk (Heitz et al. 2016, their dielectric phase function): it
+/// reflects with its exact Fresnel probability (fresnel_dielectric_full, one uniform number drawn
+/// per step) and refracts otherwise; eta = η below / η above, inv_eta = 1/eta.
+template <typename T, typename L, typename Uniform>
+struct MicrosurfaceDielectricFacet {
+    T eta, inv_eta;
+    Uniform& uniform;
+    template <typename M>
+    void operator()(const LaneVec3<T>& w, const LaneVec3<T>& wm, T cos_w_m, M above, M walking,
+                    LaneVec3<T>& wr_new, M& crosses, T* /*weight*/) const {
+        const FresnelDielectric<T> fr = fresnel_dielectric_full<T, L>(
+            cos_w_m, L::select(above, eta, inv_eta), L::select(above, inv_eta, eta));
+        const T uc = uniform();
+        const auto reflects = L::less(uc, fr.reflectance);
+        const T two_cos = cos_w_m + cos_w_m;
+        const LaneVec3<T> reflected = {two_cos * wm.x - w.x, two_cos * wm.y - w.y,
+                                       two_cos * wm.z - w.z};
+        crosses = L::negate(reflects);
+        wr_new = reflected;
+        if (L::none(L::both(walking, crosses))) return;  // no lane refracts
+        // Snell about wm (fresnel.h refract, from the side wm points to): the reflectance is 1
+        // under total internal reflection, so refracting lanes have cos θt > 0.
+        const T along = cos_w_m * fr.inv_eta - fr.cos_theta_t;
+        const T neg_inv_eta = L::constant(0) - fr.inv_eta;
+        const LaneVec3<T> refracted = lane_normalize<T, L>(
+            {L::mul_add(w.x, neg_inv_eta, wm.x * along), L::mul_add(w.y, neg_inv_eta, wm.y * along),
+             L::mul_add(w.z, neg_inv_eta, wm.z * along)});
+        wr_new = lane_select<T, L>(reflects, reflected, refracted);
+    }
+};
+
+/// The conductor facet of the walk (Heitz et al. 2016, their conductor phase function): a mirror
+/// that multiplies the flux by its Fresnel factors, `fresnel(cos_w_m, factors)` filling the three
+/// channels' (fresnel_conductor); no number drawn.
+template <typename T, typename L, typename Fresnel>
+struct MicrosurfaceConductorFacet {
+    const Fresnel& fresnel;
+    template <typename M>
+    void operator()(const LaneVec3<T>& w, const LaneVec3<T>& wm, T cos_w_m, M /*above*/, M walking,
+                    LaneVec3<T>& wr_new, M& crosses, T* weight) const {
+        T factors[3];
+        fresnel(cos_w_m, factors);
+        for (int c = 0; c < 3; ++c)
+            weight[c] = L::select(walking, weight[c] * factors[c], weight[c]);
+        const T two_cos = cos_w_m + cos_w_m;
+        wr_new = {two_cos * wm.x - w.x, two_cos * wm.y - w.y, two_cos * wm.z - w.z};
+        crosses = L::both(walking, L::negate(walking));  // no lane
+    }
+};
+
+LAMINA_LANE_END
+
+#endif  // LAMINA_PHYSICS_MICROSURFACE_WALK_BODY
+
+#if !defined(LAMINA_LANE_TARGET) && !defined(LAMINA_PHYSICS_MICROSURFACE_WALK_H)
+#define LAMINA_PHYSICS_MICROSURFACE_WALK_H
+
+namespace lamina {
 
 /// Where a walk left the microsurface: direction (pointing away from it), the flux weight it
 /// carries (RGB: a conductor's Fresnel factors; 1 for a dielectric) and the number of facets it
@@ -84,55 +288,34 @@ struct MicrosurfaceExit {
     bool escaped = true;
 };
 
+/// The scalar instantiation of microsurface_walk (one lane, bool masks) as an optional exit.
+template <typename T>
+std::optional<MicrosurfaceExit<T>> microsurface_exit(const MicrosurfaceWalkLanes<T, bool>& r) {
+    if (r.degenerate) return std::nullopt;
+    MicrosurfaceExit<T> exit;
+    exit.wo = {r.wo.x, r.wo.y, r.wo.z};
+    exit.weight = {r.weight[0], r.weight[1], r.weight[2]};
+    exit.order = int(r.order);
+    exit.escaped = !r.capped;
+    return exit;
+}
+
 /// The microsurface walk of a particle arriving from wi on a rough dielectric interface of
 /// relative index eta (below / above) and roughness ggx.alpha > 0, light from either side. Each
 /// facet reflects with its exact Fresnel probability and refracts otherwise (Heitz et al. 2016,
 /// the random walk with their dielectric phase function). `uniform()` returns uniform
 /// numbers in [0, 1). A walk that, after max_order facets, would meet one more is given up
 /// (escaped = false: the caller books its flux as lost to the microsurface); a numerical
-/// degeneracy returns nothing (the caller counts it).
+/// degeneracy returns nothing (the caller counts it). The lane template microsurface_walk at one
+/// lane: the SIMD kernel runs the same lines on its vectors.
 template <typename T, typename Uniform>
 std::optional<MicrosurfaceExit<T>> walk_rough_dielectric(const GGX<T>& ggx, T eta,
                                                          const Vec3<T>& wi, Uniform&& uniform,
                                                          int max_order) {
-    if (wi.z == 0) return std::nullopt;
-    bool outside = wi.z > 0;       // on the side the interface's normal points to
-    Vec3<T> wr = -wi;              // direction of travel
-    T h = outside ? T(2) : T(-2);  // above every facet (C1 = 1) on its own side
-    MicrosurfaceExit<T> exit;
-    while (true) {
-        // The next facet, in the frame of the side the particle is on.
-        const T u = uniform();
-        h = outside ? microsurface_next_height(ggx, wr, h, u)
-                    : -microsurface_next_height(ggx, -wr, -h, u);
-        if (!std::isfinite(h)) {
-            exit.wo = wr;
-            return exit;
-        }
-        if (exit.order == max_order) {
-            exit.escaped = false;
-            return exit;
-        }
-        ++exit.order;
-        // A facet visible from the arriving direction (below the horizon after a first bounce).
-        const Vec3<T> w = -wr;
-        const T u1 = uniform(), u2 = uniform();
-        const Vec3<T> wm = outside ? ggx.sample_visible_normal_complete(w, u1, u2)
-                                   : -ggx.sample_visible_normal_complete(-w, u1, u2);
-        const T cos_w_m = dot(w, wm);
-        if (!(cos_w_m > 0)) return std::nullopt;  // degenerate facet (rounding at grazing)
-        const T eta_crossed = outside ? eta : T(1) / eta;
-        const T F = fresnel_dielectric(cos_w_m, eta_crossed);
-        if (uniform() < F) {
-            wr = reflect(w, wm);
-        } else {
-            const std::optional<Vec3<T>> wt = refract(w, wm, eta_crossed);
-            if (!wt) return std::nullopt;  // unreachable: F = 1 under total reflection
-            wr = normalize(*wt);
-            outside = !outside;
-        }
-        if (!std::isfinite(wr.z)) return std::nullopt;
-    }
+    auto draw = [&] { return T(uniform()); };
+    const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw)> facet{eta, T(1) / eta, draw};
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.alpha, {wi.x, wi.y, wi.z}, true,
+                                                           true, facet, draw, max_order));
 }
 
 /// The microsurface walk of a particle arriving from wi (wi.z > 0) on a rough conductor; each
@@ -143,29 +326,14 @@ template <typename T, typename Fresnel, typename Uniform>
 std::optional<MicrosurfaceExit<T>> walk_rough_conductor(const GGX<T>& ggx, const Fresnel& fresnel,
                                                         const Vec3<T>& wi, Uniform&& uniform,
                                                         int max_order) {
-    if (wi.z <= 0) return std::nullopt;
-    Vec3<T> wr = -wi;
-    T h = T(2);
-    MicrosurfaceExit<T> exit;
-    while (true) {
-        h = microsurface_next_height(ggx, wr, h, uniform());
-        if (!std::isfinite(h)) {
-            exit.wo = wr;
-            return exit;
-        }
-        if (exit.order == max_order) {
-            exit.escaped = false;
-            return exit;
-        }
-        ++exit.order;
-        const Vec3<T> w = -wr;
-        const T u1 = uniform(), u2 = uniform();
-        const Vec3<T> wm = ggx.sample_visible_normal_complete(w, u1, u2);
-        const T cos_w_m = dot(w, wm);
-        if (!(cos_w_m > 0)) return std::nullopt;
-        exit.weight *= fresnel(cos_w_m);
-        wr = reflect(w, wm);
-    }
+    auto draw = [&] { return T(uniform()); };
+    auto factors = [&](T cos_w_m, T* out) {
+        const Rgb<T> f = fresnel(cos_w_m);
+        out[0] = f[0], out[1] = f[1], out[2] = f[2];
+    };
+    const MicrosurfaceConductorFacet<T, Lane<T>, decltype(factors)> facet{factors};
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.alpha, {wi.x, wi.y, wi.z}, true,
+                                                           false, facet, draw, max_order));
 }
 
 // ---- Evaluating the walk: phase functions, height masking and next-event estimation -------------
@@ -412,3 +580,5 @@ Rgb<T> eval_rough_conductor_multiple(const GGX<T>& ggx, const Fresnel& fresnel, 
 }
 
 }  // namespace lamina
+
+#endif  // LAMINA_PHYSICS_MICROSURFACE_WALK_H

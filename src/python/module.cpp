@@ -384,10 +384,6 @@ void run_study_py(py::list configs_in, py::dict settings, py::list externals,
     s.kernel = parse_kernel(settings["kernel"].cast<std::string>(), "kernel");
     s.microsurface =
         parse_microsurface(settings["microsurface"].cast<std::string>(), "microsurface");
-    if (s.microsurface == Microsurface::Multiple && s.kernel == Kernel::Simd)
-        throw InputError("arguments", "microsurface",
-                         "multiple scattering on the microsurfaces runs on the scalar kernel only: "
-                         "add kernel='scalar'");
     s.quiet = settings["quiet"].cast<bool>();
     s.tables = parse_tables_format(settings["tables"].cast<std::string>(), "tables");
     s.transmission_masking = parse_transmission_masking(

@@ -39,10 +39,6 @@ void validate_settings(const SimulationSettings& s) {
         throw InputError("command line", "--threads",
                          fmt::format("{} is not allowed: use ≥ 1, or 0 for all cores", s.threads));
     if (s.max_events < 1) throw InputError("command line", "--max-events", "must be ≥ 1");
-    if (s.microsurface == Microsurface::Multiple && s.kernel == Kernel::Simd)
-        throw InputError("command line", "--microsurface",
-                         "multiple scattering on the microsurfaces runs on the scalar kernel only: "
-                         "add --kernel scalar");
     if (s.max_microsurface_order < 1)
         throw InputError("settings", "max_microsurface_order", "must be ≥ 1");
 }

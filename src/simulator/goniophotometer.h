@@ -44,7 +44,7 @@ Kernel parse_kernel(const std::string& text, const std::string& option = "--kern
 /// How a rough interface treats the light its first facet does not let escape: `single`
 /// (docs/physics.md §3: single-scattering microfacet theory, the energy is lost to the microsurface
 /// and reported as lost_microsurface) or `multiple` (the microsurface random walk of Heitz et al.
-/// 2016, physics/microsurface_walk.h: nothing is lost; scalar kernel only).
+/// 2016, physics/microsurface_walk.h: nothing is lost; both kernels).
 enum class Microsurface { Single, Multiple };
 const char* microsurface_name(Microsurface microsurface);
 /// "single" | "multiple" (InputError naming `option` otherwise).

@@ -10,7 +10,14 @@
 // parameters broadcast; no lane-dependent branches. What a lane does per step is exactly what
 // trace_particle does per loop (same samplers, same weights, same budget bookkeeping, same event
 // count), so the two kernels estimate the same tables (tests/simulator: every exact-solution test
-// runs on both, and a two-sample chi-square test compares them).
+// runs on both, and a two-sample chi-square test compares them). Where the physics is written as
+// lane templates (core/lane.h: Fresnel factors, Smith masking, visible normals, Henyey–Greenstein,
+// the microsurface walk) both kernels instantiate the same lines.
+//
+// Multiple scattering on the microsurfaces (physics/microsurface_walk.h). At a rough interface
+// the lanes of the event walk from facet to facet together: while any of them walks, every lane of
+// the vector draws its numbers, and the event ends when each has escaped, met its facet cap or a
+// degeneracy. The event counts once, as in trace_particle.
 //
 // Random numbers. Each lane draws from the particle's own PCG32 generator (O'Neill 2014), seeded
 // as in core/rng.h from one Philox4x32-10 evaluation (Salmon et al. 2011) keyed by (seed, stream,
@@ -63,7 +70,10 @@
     }                   \
     HWY_AFTER_NAMESPACE();
 #define LAMINA_LANE_TARGET
+#include "core/lane_vec.h"
 #include "physics/fresnel.h"
+#include "physics/microfacet.h"
+#include "physics/microsurface_walk.h"
 #include "physics/phase.h"
 #include "physics/smith_masking.h"
 #undef LAMINA_LANE_TARGET
@@ -214,9 +224,7 @@ struct LaneRng {
 
 // ---- Vector geometry ---------------------------------------------------------------------------
 
-struct V3 {
-    VF x, y, z;
-};
+using V3 = LaneVec3<VF>;  // core/lane.h
 
 HWY_INLINE VF Dot(const V3& a, const V3& b) {
     return hn::MulAdd(a.x, b.x, hn::MulAdd(a.y, b.y, hn::Mul(a.z, b.z)));
@@ -229,10 +237,6 @@ HWY_INLINE VF InvSqrt(VF x) {
     const VF y = hn::ApproximateReciprocalSqrt(x);
     const VF half_x_y2 = hn::Mul(hn::Mul(hn::Set(df, 0.5f), x), hn::Mul(y, y));
     return hn::Mul(y, hn::Sub(hn::Set(df, 1.5f), half_x_y2));
-}
-HWY_INLINE V3 Normalize(const V3& a) {
-    const VF inv = InvSqrt(Dot(a, a));
-    return {hn::Mul(a.x, inv), hn::Mul(a.y, inv), hn::Mul(a.z, inv)};
 }
 HWY_INLINE V3 Select(MF m, const V3& a, const V3& b) {
     return {hn::IfThenElse(m, a.x, b.x), hn::IfThenElse(m, a.y, b.y), hn::IfThenElse(m, a.z, b.z)};
@@ -276,23 +280,6 @@ HWY_INLINE void CosSin2Pi(VF u, VF& c, VF& s) {
     s = hn::IfThenElse(sin_negative, hn::Neg(s_abs), s_abs);
 }
 
-// GGX visible normals by spherical caps: microfacet.h sample_visible_normal_caps (Dupuy & Benyoub
-// 2023, Listing 3), w below the surface through −w.
-HWY_INLINE V3 SampleVisibleNormalCaps(const V3& wi, float alpha, VF u1, VF u2) {
-    const DF df;
-    const VF a = hn::Set(df, alpha), one = hn::Set(df, 1.f);
-    const VF sign = hn::IfThenElse(hn::Lt(wi.z, hn::Zero(df)), hn::Set(df, -1.f), one);
-    const V3 wh = Normalize(
-        {hn::Mul(hn::Mul(a, sign), wi.x), hn::Mul(hn::Mul(a, sign), wi.y), hn::Mul(sign, wi.z)});
-    VF cos_phi, sin_phi;
-    CosSin2Pi(u1, cos_phi, sin_phi);
-    const VF z = hn::Sub(hn::Mul(hn::Sub(one, u2), hn::Add(one, wh.z)), wh.z);
-    const VF sin_theta = SafeSqrt(hn::NegMulAdd(z, z, one));
-    const V3 h = {hn::MulAdd(sin_theta, cos_phi, wh.x), hn::MulAdd(sin_theta, sin_phi, wh.y),
-                  hn::Add(z, wh.z)};
-    return Normalize({hn::Mul(a, h.x), hn::Mul(a, h.y), hn::ZeroIfNegative(h.z)});
-}
-
 // |cos θ| · √(1 + α² tan²θ) = √(cos²θ + α² sin²θ) = |cos θ| (1 + 2Λ) (microfacet.h smith_root;
 // Heitz 2014, Eq. 72), without a division; zero at grazing, where 1 + 2Λ is infinite.
 HWY_INLINE VF SmithRootTimesCos(const V3& w, float alpha) {
@@ -334,8 +321,28 @@ struct VecLane {
     static HWY_INLINE VF exp(VF x) { return hn::Exp(DF(), x); }
     static HWY_INLINE VF select(MF m, VF a, VF b) { return hn::IfThenElse(m, a, b); }
     static HWY_INLINE MF less(VF a, VF b) { return hn::Lt(a, b); }
+    static HWY_INLINE VF abs(VF x) { return hn::Abs(x); }
+    static HWY_INLINE VF mul_add(VF a, VF b, VF c) { return hn::MulAdd(a, b, c); }
+    static HWY_INLINE VF neg_mul_add(VF a, VF b, VF c) { return hn::NegMulAdd(a, b, c); }
+    static HWY_INLINE VF inv_sqrt(VF x) { return InvSqrt(x); }
+    static HWY_INLINE void cos_sin_2pi(VF u, VF& c, VF& s) { CosSin2Pi(u, c, s); }
+    static HWY_INLINE MF both(MF m, MF n) { return hn::And(m, n); }
+    static HWY_INLINE MF either(MF m, MF n) { return hn::Or(m, n); }
+    static HWY_INLINE MF negate(MF m) { return hn::Not(m); }
+    static HWY_INLINE bool none(MF m) { return hn::AllFalse(DF(), m); }
     static constexpr double kBetaArgumentMax = Lane<float>::kBetaArgumentMax;
 };
+
+// GGX visible normals by spherical caps: microfacet.h sample_visible_normal_caps (Dupuy & Benyoub
+// 2023, Listing 3; ggx_sample_visible_normal_complete, the same template), w below the surface
+// through −w.
+HWY_INLINE V3 SampleVisibleNormalCaps(const V3& wi, float alpha, VF u1, VF u2) {
+    const DF df;
+    const VF sign = hn::IfThenElse(hn::Lt(wi.z, hn::Zero(df)), hn::Set(df, -1.f), hn::Set(df, 1.f));
+    return ggx_sample_visible_normal_complete<VF, VecLane>(
+        hn::Set(df, alpha), {hn::Mul(sign, wi.x), hn::Mul(sign, wi.y), hn::Mul(sign, wi.z)}, u1,
+        u2);
+}
 
 // The refraction escape G2/G1 = (1 + Λi) B(1 + Λi, 1 + Λo) of the Smith masking
 // (microfacet.h smith_refraction_escape, the same template), from s = |z| r (SmithRootTimesCos).
@@ -507,6 +514,51 @@ HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, Lan
         v.Keep(ok, kLossMicro, shadowing);
     }
     v.d = Select(ok, wo, v.d);
+}
+
+// A rough interface with multiple scattering on its microsurface (physics/microsurface_walk.h
+// microsurface_walk, the template the scalar kernel instantiates at one lane): the lanes of m walk
+// from facet to facet, every lane of the vector drawing its numbers while any walks, until each
+// has escaped (its new direction; a conductor's exit carries its Fresnel factors, the rest
+// absorbed by the base), met its facet cap (its flux lost to the microsurface) or a degeneracy
+// (lost and counted, as a failed sample), as trace_particle books the walk.
+template <typename Facet>
+HWY_INLINE void MicrosurfaceWalkEvent(float alpha, bool two_sided, const Facet& facet, MF m,
+                                      LaneVectors& v, LaneRng& rng, int max_order, MF& degenerate) {
+    const DF df;
+    const VF zero = hn::Zero(df);
+    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
+    auto draw = [&] { return rng.Uniform(); };
+    const MicrosurfaceWalkLanes<VF, MF> walk = microsurface_walk<VF, VecLane>(
+        hn::Set(df, alpha), wi, m, two_sided, facet, draw, max_order);
+    degenerate = hn::Or(degenerate, walk.degenerate);
+    if (!two_sided) v.Keep(walk.escaped, kLossBase, walk.weight);
+    v.Keep(walk.capped, kLossMicro, zero);
+    v.d = Select(walk.escaped, walk.wo, v.d);
+}
+
+HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
+                                    LaneRng& rng, int max_order, MF& degenerate) {
+    const DF df;
+    auto draw = [&] { return rng.Uniform(); };
+    const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw)> facet{
+        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), draw};
+    MicrosurfaceWalkEvent(iface.alpha, true, facet, m, v, rng, max_order, degenerate);
+}
+
+HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v,
+                                   LaneRng& rng, int max_order, MF& degenerate) {
+    auto fresnel = [&](VF cos_w_m, VF* factors) {
+        for (int c = 0; c < 3; ++c) {
+            // Channels with the same index share the computation.
+            const bool same =
+                c > 0 && iface.eta[c] == iface.eta[c - 1] && iface.k[c] == iface.k[c - 1];
+            factors[c] =
+                same ? factors[c - 1] : FresnelConductor(cos_w_m, iface.eta[c], iface.k[c]);
+        }
+    };
+    const MicrosurfaceConductorFacet<VF, VecLane, decltype(fresnel)> facet{fresnel};
+    MicrosurfaceWalkEvent(iface.alpha, false, facet, m, v, rng, max_order, degenerate);
 }
 
 // Lambertian (lambertian.h sample): cosine-distributed on wi's side, weight = albedo. The disk
@@ -856,11 +908,21 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         const bool dielectric = layer.type == InterfaceType::Dielectric;
         switch (layer.type) {
             case InterfaceType::Dielectric: {
+                if (stack.multiple_scattering && !layer.dielectric.is_smooth()) {
+                    DielectricWalkEvent(layer.dielectric, going, v, rng,
+                                        stack.max_microsurface_order, degenerate_event);
+                    break;
+                }
                 const VF uc = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
                 DielectricEvent(layer.dielectric, going, v, uc, u1, u2, degenerate_event);
                 break;
             }
             case InterfaceType::Conductor: {
+                if (stack.multiple_scattering && !layer.conductor.is_smooth()) {
+                    ConductorWalkEvent(layer.conductor, going, v, rng, stack.max_microsurface_order,
+                                       degenerate_event);
+                    break;
+                }
                 const VF u1 = rng.Uniform(), u2 = rng.Uniform();
                 ConductorEvent(layer.conductor, going, v, u1, u2, degenerate_event);
                 break;
@@ -1270,6 +1332,102 @@ void HenyeyGreensteinForTest(const float* g, const float* x, std::size_t n, floa
     }
 }
 
+void GgxLanesForTest(float alpha, const float* w, const float* u1, const float* u2, std::size_t n,
+                     float* lambda, float* wm) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in[5][kMaxLanes], out[4][kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            const bool real = base + l < n;
+            for (int i = 0; i < 3; ++i)
+                in[i][l] = real ? w[3 * (base + l) + i] : (i == 2 ? 1.f : 0.f);
+            in[3][l] = real ? u1[base + l] : 0.f;
+            in[4][l] = real ? u2[base + l] : 0.f;
+        }
+        const V3 wv = {hn::Load(df, in[0]), hn::Load(df, in[1]), hn::Load(df, in[2])};
+        const VF a = hn::Set(df, alpha);
+        hn::Store(ggx_lambda<VF, VecLane>(hn::Mul(a, a), wv.x, wv.y, wv.z), df, out[0]);
+        const V3 m = ggx_sample_visible_normal_complete<VF, VecLane>(a, wv, hn::Load(df, in[3]),
+                                                                     hn::Load(df, in[4]));
+        hn::Store(m.x, df, out[1]);
+        hn::Store(m.y, df, out[2]);
+        hn::Store(m.z, df, out[3]);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l) {
+            lambda[base + l] = out[0][l];
+            for (int i = 0; i < 3; ++i)
+                wm[3 * (base + l) + i] = out[1 + i][l];
+        }
+    }
+}
+
+void MicrosurfaceWalkForTest(const float* wi, std::size_t n, float alpha, bool dielectric,
+                             const float* eta, const float* k, int max_order, std::uint64_t seed,
+                             float* wo, float* weight, int* order, int* outcome) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    std::vector<std::uint64_t> state(n), inc(n);
+    SeedParticles(seed, 0, 0, n, state.data(), inc.data());
+    DielectricInterface<float> di_face;
+    di_face.eta = eta[0];
+    di_face.alpha = alpha;
+    ConductorInterface<float> co_face;
+    co_face.eta = Rgbf(eta[0], eta[1], eta[2]);
+    co_face.k = Rgbf(k[0], k[1], k[2]);
+    co_face.alpha = alpha;
+    HWY_ALIGN float in[3][kMaxLanes], out[7][kMaxLanes];
+    HWY_ALIGN std::int32_t why[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        LaneRng rng;
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            const bool real = base + l < n;
+            rng.state[l] = real ? state[base + l] : 0;
+            rng.inc[l] = real ? inc[base + l] : 1;
+            for (int i = 0; i < 3; ++i)
+                in[i][l] = real ? wi[3 * (base + l) + i] : (i == 2 ? 1.f : 0.f);
+        }
+        rng.SyncIn();
+        const MF m = hn::FirstN(df, std::min(n_lanes, n - base));
+        auto draw = [&] { return rng.Uniform(); };
+        const V3 wi_v = {hn::Load(df, in[0]), hn::Load(df, in[1]), hn::Load(df, in[2])};
+        MicrosurfaceWalkLanes<VF, MF> r;
+        if (dielectric) {
+            const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw)> facet{
+                hn::Set(df, di_face.eta), hn::Set(df, di_face.inv_eta()), draw};
+            r = microsurface_walk<VF, VecLane>(hn::Set(df, alpha), wi_v, m, true, facet, draw,
+                                               max_order);
+        } else {
+            auto fresnel = [&](VF cos_w_m, VF* factors) {
+                for (int c = 0; c < 3; ++c)
+                    factors[c] = FresnelConductor(cos_w_m, co_face.eta[c], co_face.k[c]);
+            };
+            const MicrosurfaceConductorFacet<VF, VecLane, decltype(fresnel)> facet{fresnel};
+            r = microsurface_walk<VF, VecLane>(hn::Set(df, alpha), wi_v, m, false, facet, draw,
+                                               max_order);
+        }
+        hn::Store(r.wo.x, df, out[0]);
+        hn::Store(r.wo.y, df, out[1]);
+        hn::Store(r.wo.z, df, out[2]);
+        for (int c = 0; c < 3; ++c)
+            hn::Store(r.weight[c], df, out[3 + c]);
+        hn::Store(r.order, df, out[6]);
+        const DI di;
+        const VI outcome_v = hn::IfThenElse(
+            hn::RebindMask(di, r.degenerate), hn::Set(di, 2),
+            hn::IfThenElse(hn::RebindMask(di, r.capped), hn::Set(di, 1), hn::Zero(di)));
+        hn::Store(outcome_v, di, why);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l) {
+            const std::size_t p = base + l;
+            for (int i = 0; i < 3; ++i) {
+                wo[3 * p + i] = out[i][l];
+                weight[3 * p + i] = out[3 + i][l];
+            }
+            order[p] = int(out[6][l]);
+            outcome[p] = why[l];
+        }
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace lamina
 HWY_AFTER_NAMESPACE();
@@ -1284,6 +1442,8 @@ HWY_EXPORT(SmithRefractionEscapeForTest);
 HWY_EXPORT(FresnelDielectricForTest);
 HWY_EXPORT(FresnelConductorForTest);
 HWY_EXPORT(HenyeyGreensteinForTest);
+HWY_EXPORT(MicrosurfaceWalkForTest);
+HWY_EXPORT(GgxLanesForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -1367,6 +1527,32 @@ void simd_henyey_greenstein(const std::vector<float>& g, const std::vector<float
     cos_theta.resize(g.size());
     HWY_DYNAMIC_DISPATCH(HenyeyGreensteinForTest)
     (g.data(), x.data(), g.size(), phase.data(), cos_theta.data());
+}
+
+void simd_ggx_lanes(float alpha, const std::vector<float>& w, const std::vector<float>& u1,
+                    const std::vector<float>& u2, std::vector<float>& lambda,
+                    std::vector<float>& wm) {
+    select_simd_target();
+    lambda.resize(u1.size());
+    wm.resize(3 * u1.size());
+    HWY_DYNAMIC_DISPATCH(GgxLanesForTest)
+    (alpha, w.data(), u1.data(), u2.data(), u1.size(), lambda.data(), wm.data());
+}
+
+SimdWalkResult simd_microsurface_walk(const std::vector<float>& wi, float alpha, bool dielectric,
+                                      const float eta[3], const float k[3], int max_order,
+                                      std::uint64_t seed) {
+    select_simd_target();
+    const std::size_t n = wi.size() / 3;
+    SimdWalkResult r;
+    r.wo.resize(3 * n);
+    r.weight.resize(3 * n);
+    r.order.resize(n);
+    r.outcome.resize(n);
+    HWY_DYNAMIC_DISPATCH(MicrosurfaceWalkForTest)
+    (wi.data(), n, alpha, dielectric, eta, k, max_order, seed, r.wo.data(), r.weight.data(),
+     r.order.data(), r.outcome.data());
+    return r;
 }
 
 }  // namespace lamina

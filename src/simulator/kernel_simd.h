@@ -40,6 +40,26 @@ std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, f
 void simd_henyey_greenstein(const std::vector<float>& g, const std::vector<float>& x,
                             std::vector<float>& phase, std::vector<float>& cos_theta);
 
+/// For tests: physics/microfacet.h ggx_lambda(alpha², w) and ggx_sample_visible_normal_complete
+/// (alpha, w, u1, u2) on the dispatched instruction set's vectors; w, wm: 3 floats per entry.
+void simd_ggx_lanes(float alpha, const std::vector<float>& w, const std::vector<float>& u1,
+                    const std::vector<float>& u2, std::vector<float>& lambda,
+                    std::vector<float>& wm);
+
+/// For tests: where microsurface walks left the microsurface (physics/microsurface_walk.h
+/// microsurface_walk on the dispatched instruction set's vectors). Particle p arrives from
+/// wi[3p..3p+2] and draws from ParticleRng(seed, 0, p) as the kernel's lanes draw; a dielectric
+/// of relative index eta[0] (dielectric = true) or a conductor of index eta + i k per channel.
+/// Per particle: wo (3 floats, the direction of travel out), weight (3), order, and outcome
+/// (0 escaped, 1 stopped at the facet cap, 2 degenerate).
+struct SimdWalkResult {
+    std::vector<float> wo, weight;
+    std::vector<int> order, outcome;
+};
+SimdWalkResult simd_microsurface_walk(const std::vector<float>& wi, float alpha, bool dielectric,
+                                      const float eta[3], const float k[3], int max_order,
+                                      std::uint64_t seed);
+
 /// Applies LAMINA_SIMD_TARGET (an instruction set name as simd_target_name prints it, e.g. AVX2 or
 /// SSE4), which caps the dispatch at that set: the way to reproduce another machine's tables, or to
 /// test every compiled set on one machine. Once per process; InputError for an unknown or

@@ -163,6 +163,11 @@ check simulate-multiple 0 "$lamina" simulate "$src/examples/frosted-gold.json" -
     --particles 2e4 --grid 9x9 --kernel scalar --microsurface multiple --out "$tmp/ms"
 check_says simulate-multiple-json 0 '"microsurface": "multiple"' cat "$tmp/ms/result.json"
 check_says simulate-multiple-lost 0 "60,r" awk -F, '$1 == 60 && $7 == 0 {print $1 "," $2}' "$tmp/ms/energy.csv"
+# ... and on the SIMD kernel (the default), the same walk.
+check simulate-multiple-simd 0 "$lamina" simulate "$src/examples/frosted-gold.json" --theta-i 60 \
+    --particles 2e4 --grid 9x9 --microsurface multiple --out "$tmp/ms-simd"
+check_says simulate-multiple-simd-json 0 '"microsurface": "multiple"' cat "$tmp/ms-simd/result.json"
+check_says simulate-multiple-simd-lost 0 "60,r" awk -F, '$1 == 60 && $7 == 0 {print $1 "," $2}' "$tmp/ms-simd/energy.csv"
 
 # The refraction masking of rough dielectrics: result.json names it (smith by default), and the
 # pbrt form keeps more of the light a rough slab transmits (B(1 + Λi, 1 + Λo) < 1/(1 + Λi + Λo)).
@@ -185,8 +190,6 @@ check_says simulate-zero-particles 1 "--particles: '0' is not allowed" \
     "$lamina" simulate "$src/examples/plastic.json" --particles 0 --out "$tmp/bad1"
 check_says simulate-bad-grid 1 "--grid: '90by90' is not a grid" \
     "$lamina" simulate "$src/examples/plastic.json" --grid 90by90 --out "$tmp/bad1"
-check_says simulate-multiple-simd 1 "--microsurface: multiple scattering on the microsurfaces runs on the scalar kernel only" \
-    "$lamina" simulate "$src/examples/plastic.json" --microsurface multiple --out "$tmp/bad1"
 check_says simulate-bad-microsurface 1 "--microsurface: 'many' is not a microsurface model" \
     "$lamina" simulate "$src/examples/plastic.json" --microsurface many --kernel scalar --out "$tmp/bad1"
 check_says simulate-bad-stack 1 "no-such.json" \

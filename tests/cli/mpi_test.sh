@@ -61,6 +61,19 @@ for stack in plastic slab; do
         grep -q '"processes": 1' "$one/result.json" && ok || fail "$stack $n: processes 1"
     done
 done
+# The same with multiple scattering on the microsurfaces (the SIMD kernel's walk), on a rough slab
+# and a rough conductor under a coat.
+for stack in slab frosted-gold; do
+    args=("$src/examples/$stack.json" --theta-i 0,60 --particles 50001 --grid 18x18 --seed 7
+          --microsurface multiple)
+    one=$tmp/ms-$stack-one
+    "$lamina" simulate "${args[@]}" --threads 2 --out "$one" >"$one.log" 2>&1 \
+        || { fail "one-process simulate multiple $stack"; cat "$one.log"; }
+    out=$tmp/ms-$stack-two
+    mpi "$lamina" simulate "${args[@]}" --threads 1 --out "$out" >"$out.log" 2>&1 && ok \
+        || { fail "mpirun simulate multiple $stack"; cat "$out.log"; }
+    same_files "simulate multiple $stack" "$one" "$out" brdf.csv energy.csv
+done
 # The transmitting stack has a transmission lobe in its table.
 grep -q ',T,' "$tmp/sim-slab-50001-one/brdf.csv" && ok || fail "slab: no transmission rows"
 

@@ -109,6 +109,19 @@ def test_simulate_is_bitwise_the_cli(tmp_path, stack):
     assert r.info["seed"] == 7 and r.info["particles"] == args["particles"]
 
 
+def test_simulate_multiple_scattering_is_the_clis(tmp_path):
+    # The microsurface walk on the default (SIMD) kernel: the CLI's bits, nothing lost on the
+    # microsurfaces of the slab.
+    args = dict(theta_i=[0, 60], particles=100_000, seed=5, grid=(18, 12))
+    cli("simulate", SLAB, "--theta-i", "0,60", "--particles", args["particles"], "--seed", 5,
+        "--grid", "18x12", "--microsurface", "multiple", "--out", tmp_path / "cli")
+    r = lamina.simulate(SLAB, microsurface="multiple", **args)
+    r.write(tmp_path / "py")
+    for name in ("brdf.csv", "energy.csv"):
+        assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "py" / name).read_bytes()
+    assert np.all(r.energy["lost_microsurface"] == 0)
+
+
 def test_simulate_transmission_masking_is_the_clis(tmp_path):
     # The slab's rough interfaces refract: smith and pbrt differ there, and each is the CLI's.
     args = dict(theta_i=[60], particles=100_000, seed=3, grid=(18, 12))

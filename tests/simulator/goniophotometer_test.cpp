@@ -461,29 +461,42 @@ TEST(AddingDoublingReference, ConservesEnergy) {
 }
 
 // Reproducibility: the same stack, grid, N and seed give bitwise-identical output for any thread
-// count; a different seed gives different output.
+// count, with either microsurface model (the walk draws a lane's numbers whatever the other lanes
+// do, in the block's fixed order); a different seed gives different output.
 TEST_P(Goniophotometer, BitwiseIdenticalAcrossThreadCounts) {
-    const Stack stack =
+    const std::vector<Stack> stacks = {
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.1, 0.0, 0.9),
                                             Rgbd(0.3), Rgbd(0.2)),
-                          test::lambertian_layer(Rgbd(0.8))});
-    SimulationSettings s = settings({0, 60}, 50'000, HemisphereGrid(30, 30));
-    s.threads = 1;
-    const auto one = simulate(stack, s);
-    s.threads = 2;
-    const auto two = simulate(stack, s);
-    s.threads = 3;
-    const auto three = simulate(stack, s);
-    for (std::size_t i = 0; i < 2; ++i) {
-        EXPECT_EQ(one.table.lobe(i, Side::Reflection).f, two.table.lobe(i, Side::Reflection).f);
-        EXPECT_EQ(one.table.lobe(i, Side::Reflection).se, two.table.lobe(i, Side::Reflection).se);
-        EXPECT_EQ(one.table.lobe(i, Side::Reflection).f, three.table.lobe(i, Side::Reflection).f);
-        EXPECT_EQ(one.incidences[i].budget.term, two.incidences[i].budget.term);
-        EXPECT_EQ(one.incidences[i].budget.term, three.incidences[i].budget.term);
-    }
-    s.seed = 8;
-    const auto other = simulate(stack, s);
-    EXPECT_NE(one.table.lobe(0, Side::Reflection).f, other.table.lobe(0, Side::Reflection).f);
+                          test::lambertian_layer(Rgbd(0.8))}),
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1)),
+                          test::conductor_layer(Rgbd(0.2, 1.0, 1.45), Rgbd(3.0, 2.0, 0.01), 0.6)}),
+    };
+    for (const Stack& stack : stacks)
+        for (const Microsurface microsurface : {Microsurface::Single, Microsurface::Multiple}) {
+            SCOPED_TRACE(microsurface_name(microsurface));
+            SimulationSettings s = settings({0, 60}, 50'000, HemisphereGrid(30, 30));
+            s.microsurface = microsurface;
+            s.threads = 1;
+            const auto one = simulate(stack, s);
+            s.threads = 2;
+            const auto two = simulate(stack, s);
+            s.threads = 3;
+            const auto three = simulate(stack, s);
+            for (std::size_t i = 0; i < 2; ++i) {
+                EXPECT_EQ(one.table.lobe(i, Side::Reflection).f,
+                          two.table.lobe(i, Side::Reflection).f);
+                EXPECT_EQ(one.table.lobe(i, Side::Reflection).se,
+                          two.table.lobe(i, Side::Reflection).se);
+                EXPECT_EQ(one.table.lobe(i, Side::Reflection).f,
+                          three.table.lobe(i, Side::Reflection).f);
+                EXPECT_EQ(one.incidences[i].budget.term, two.incidences[i].budget.term);
+                EXPECT_EQ(one.incidences[i].budget.term, three.incidences[i].budget.term);
+            }
+            s.seed = 8;
+            const auto other = simulate(stack, s);
+            EXPECT_NE(one.table.lobe(0, Side::Reflection).f,
+                      other.table.lobe(0, Side::Reflection).f);
+        }
 }
 
 TEST_P(Goniophotometer, RejectsBadSettings) {
@@ -497,10 +510,19 @@ TEST_P(Goniophotometer, RejectsBadSettings) {
     EXPECT_THROW(validate_settings(s), InputError);
 }
 
-// ---- Multiple scattering on the microsurfaces (physics/microsurface_walk.h, scalar kernel) -----
+// ---- Multiple scattering on the microsurfaces (physics/microsurface_walk.h, both kernels) -----
+
+// The walk is one lane template (microsurface_walk.h) run by both kernels: every test below runs
+// on each (the kernel under test is the suite's parameter, set by the fixture).
+class MicrosurfaceWalkStat : public ::testing::TestWithParam<Kernel> {
+  protected:
+    void SetUp() override { g_kernel = GetParam(); }
+};
+INSTANTIATE_TEST_SUITE_P(Kernels, MicrosurfaceWalkStat,
+                         ::testing::Values(Kernel::Scalar, Kernel::Simd), kernel_test_name);
 
 void multiple_scattering(SimulationSettings& s) {
-    s.kernel = Kernel::Scalar;
+    s.kernel = g_kernel;
     s.microsurface = Microsurface::Multiple;
 }
 void first_order_only(SimulationSettings& s) {
@@ -525,8 +547,7 @@ void first_order_table(SimulationSettings& s) {
 // check_single_rough_dielectric). This tests the walk's height sampling, its visible normals and
 // its Fresnel choices against closed forms. (At the dense side's θi = 50°, Λi ≈ 0.03, the two
 // transmission forms differ by 4 % at grazing exits: the test tells them apart.)
-TEST(MicrosurfaceWalkStat, FirstOrderIsTheSingleScatteringInterface) {
-    g_kernel = Kernel::Scalar;
+TEST_P(MicrosurfaceWalkStat, FirstOrderIsTheSingleScatteringInterface) {
     {
         SCOPED_TRACE("dielectric from above");
         check_single_rough_dielectric(1.0, 1.5, 0.3, 40, first_order_table);
@@ -557,8 +578,7 @@ TEST(MicrosurfaceWalkStat, FirstOrderIsTheSingleScatteringInterface) {
 // The multiple-scattering BSDF is reciprocal (Heitz et al. 2016 prove it for the walk): the
 // tabulated BRDF of a very rough dielectric and of a very rough conductor, where the higher orders
 // carry 10–20 % of the energy at these angles, and of a rough coat over a Lambertian.
-TEST(MicrosurfaceWalkStat, TabulatedReciprocity) {
-    g_kernel = Kernel::Scalar;
+TEST_P(MicrosurfaceWalkStat, TabulatedReciprocity) {
     {
         SCOPED_TRACE("rough dielectric");
         expect_tabulated_reciprocity(test::make_stack({test::dielectric_layer(1.5, 0.8)}),
@@ -584,7 +604,7 @@ TEST(MicrosurfaceWalkStat, TabulatedReciprocity) {
 // absorbing R + T = 1 exactly (each particle's flux stays 1), where single scattering loses a
 // positive fraction (GoniophotometerStat.WhiteFurnace). The higher orders also change where the
 // energy goes: a very rough dielectric reflects more than its first order.
-TEST(MicrosurfaceWalkStat, WhiteFurnaceLosesNothing) {
+TEST_P(MicrosurfaceWalkStat, WhiteFurnaceLosesNothing) {
     const std::vector<Stack> stacks = {
         test::make_stack({test::dielectric_layer(1.5, 0.3), test::dielectric_layer(1.0, 0.5)}),
         test::make_stack({test::dielectric_layer(1.5, 0.5), test::lambertian_layer(Rgbd(1.0))}),
@@ -611,7 +631,7 @@ TEST(MicrosurfaceWalkStat, WhiteFurnaceLosesNothing) {
 // A very rough dielectric: the higher orders add reflection (light that single scattering loses
 // after a first facet sends it back down into the microsurface, then up again). R with multiple
 // scattering exceeds R of the first order by more than the noise.
-TEST(MicrosurfaceWalkStat, HigherOrdersAddReflection) {
+TEST_P(MicrosurfaceWalkStat, HigherOrdersAddReflection) {
     const Stack stack = test::make_stack({test::dielectric_layer(1.5, 0.9)});
     SimulationSettings s = settings({60}, 400'000, HemisphereGrid(9, 9));
     first_order_only(s);
@@ -625,13 +645,15 @@ TEST(MicrosurfaceWalkStat, HigherOrdersAddReflection) {
     EXPECT_GT(b1[BudgetTerm::LostMicrosurface][0], 0.05);
 }
 
-TEST(MicrosurfaceWalk, NeedsTheScalarKernel) {
+TEST(MicrosurfaceWalk, RunsOnBothKernels) {
     SimulationSettings s;
     s.microsurface = Microsurface::Multiple;
     s.kernel = Kernel::Simd;
-    EXPECT_THROW(validate_settings(s), InputError);
+    EXPECT_NO_THROW(validate_settings(s));
     s.kernel = Kernel::Scalar;
     EXPECT_NO_THROW(validate_settings(s));
+    s.max_microsurface_order = 0;
+    EXPECT_THROW(validate_settings(s), InputError);
     EXPECT_EQ(parse_microsurface("multiple"), Microsurface::Multiple);
     EXPECT_THROW(parse_microsurface("heitz"), InputError);
 }

@@ -7,6 +7,7 @@
 #include "core/rng.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
+#include "physics/microsurface_walk.h"
 #include "physics/phase.h"
 #include "simulator/goniophotometer.h"
 #include "support/chi2.h"
@@ -198,6 +199,197 @@ TEST(KernelSimd, HenyeyGreensteinLanes) {
     EXPECT_LE(worst_cos, 2e-6) << simd_target_name();
 }
 
+// The lane test of the walk's GGX pieces (physics/microfacet.h ggx_lambda and
+// ggx_sample_visible_normal_complete, one template each): on the dispatched instruction set's
+// vectors against the scalar float instantiation (GGX<float>::lambda and
+// sample_visible_normal_complete, which call them), for α from 1e-3 to 1, random directions on
+// both hemispheres and the edges (both normals, grazing at cos θ = 1e-3 and exactly, both sides),
+// uniforms including 0 and 1 − 2^-24. Λ: a square root and two divisions, ≤ 1 ulp each on both, so
+// within 8 float ulps relative; ∞ exactly where the scalar one is (grazing). The normal: two
+// normalizations by the refined reciprocal square root (2^-22 relative each) against the exact
+// one, the Cephes azimuth (≤ 2 ulp) against the C library's, fused multiply-adds: within 4e-6 per
+// component, plus 2^-23 / sin θ from the cap point's sin θ = √(1 − z²) (a 2-ulp difference in
+// 1 − z², grown near the cap's pole). Where the cap of visible normals shrinks to a point (w below
+// the horizon with 1 + wh.z < 0.1, wh: w in the hemisphere configuration) the halfway vector
+// h = c + wh cancels and the float construction itself, scalar and vector alike, loses its digits
+// (at α = 10^-3 nothing is left): there only a finite unit normal in the upper hemisphere is
+// required, and the difference is printed.
+TEST(KernelSimd, GgxLanes) {
+    ParticleRng rng(22, 0, 0);
+    for (const float alpha : {1e-3f, 0.05f, 0.3f, 1.f}) {
+        std::vector<float> w = {0,     0,          1, 0,      0, -1, 0.9999995f, 0,
+                                1e-3f, 0.9999995f, 0, -1e-3f, 1, 0,  0};
+        std::vector<float> u1 = {0.f, 0.5f, 1 - 0x1p-24f, 0.25f, 0.75f};
+        std::vector<float> u2 = {0.f, 1 - 0x1p-24f, 0.5f, 0.f, 0.3f};
+        for (int k = 0; k < 4000; ++k) {
+            const float z = 2 * rng.uniform_float() - 1;
+            const float phi = 2 * kPi<float> * rng.uniform_float();
+            const float r = std::sqrt(std::max(0.f, 1 - z * z));
+            w.insert(w.end(), {r * std::cos(phi), r * std::sin(phi), z});
+            u1.push_back(rng.uniform_float());
+            u2.push_back(rng.uniform_float());
+        }
+        std::vector<float> lambda, wm;
+        simd_ggx_lanes(alpha, w, u1, u2, lambda, wm);
+        const GGX<float> ggx{alpha};
+        double worst_lambda = 0, worst_wm = 0, worst_wm_horizon = 0;
+        for (std::size_t j = 0; j < u1.size(); ++j) {
+            const Vec3f wj(w[3 * j], w[3 * j + 1], w[3 * j + 2]);
+            const float l_scalar = ggx.lambda(wj);
+            if (std::isinf(l_scalar)) {
+                EXPECT_TRUE(std::isinf(lambda[j])) << alpha << ' ' << j;
+            } else {
+                ASSERT_TRUE(std::isfinite(lambda[j])) << alpha << ' ' << j;
+                worst_lambda =
+                    std::max(worst_lambda, std::abs(double(lambda[j]) - l_scalar) /
+                                               std::max(double(l_scalar), 1e-30) / 0x1p-24);
+            }
+            const Vec3f m = ggx.sample_visible_normal_complete(wj, u1[j], u2[j]);
+            // Straight down (w = −z) no facet is visible (A(w) = |cos θ| Λ = 0): outside the
+            // sampler's domain, NaN on both (the walk never asks: such a ray escapes first).
+            if (wj.z == -1) continue;
+            const float m_scalar[3] = {m.x, m.y, m.z};
+            // The cap's extent 1 + wh.z (wh: w in the hemisphere configuration, in double).
+            const double ax = double(alpha) * wj.x, ay = double(alpha) * wj.y;
+            const double extent = 1 + wj.z / std::sqrt(ax * ax + ay * ay + double(wj.z) * wj.z);
+            const bool near_horizon = extent < 0.1;
+            // sin θ = √(1 − z²) of the cap point: a rounding of 2 ulp in 1 − z² moves it by
+            // 2^-23 / sin θ, unbounded at the cap's pole (z → 1, u2 → 0).
+            const double z_cap = (1 - double(u2[j])) * extent - (extent - 1);
+            const double sin_cap = std::sqrt(std::max(1 - z_cap * z_cap, 1e-12));
+            const double tolerance = 4e-6 + 0x1p-23 / sin_cap;
+            double norm2 = 0;
+            for (int i = 0; i < 3; ++i) {
+                ASSERT_TRUE(std::isfinite(wm[3 * j + i])) << alpha << ' ' << j;
+                norm2 += double(wm[3 * j + i]) * wm[3 * j + i];
+                const double d = std::abs(double(wm[3 * j + i]) - m_scalar[i]);
+                if (near_horizon)
+                    worst_wm_horizon = std::max(worst_wm_horizon, d);
+                else
+                    worst_wm = std::max(worst_wm, d / tolerance);
+            }
+            EXPECT_NEAR(norm2, 1.0, 1e-5) << alpha << ' ' << j;  // a unit normal everywhere
+            EXPECT_GE(wm[3 * j + 2], 0.f) << alpha << ' ' << j;  // in the upper hemisphere
+        }
+        EXPECT_LE(worst_lambda, 8.0) << "α " << alpha << " on " << simd_target_name();
+        EXPECT_LE(worst_wm, 1.0) << "α " << alpha << " on " << simd_target_name();
+        std::printf(
+            "[ lanes    ] %s α %g: Λ ≤ %.2g ulp, |Δwm| ≤ %.2g of its bound (%.2g where "
+            "1 + wh.z < 0.1)\n",
+            simd_target_name(), alpha, worst_lambda, worst_wm, worst_wm_horizon);
+    }
+}
+
+// The lane test of the microsurface walk (physics/microsurface_walk.h microsurface_walk, one
+// template): on the dispatched instruction set's vectors (ctest runs this on every compiled set
+// through LAMINA_SIMD_TARGET) against the scalar instantiation the scalar kernel runs, particle by
+// particle from the same random numbers (ParticleRng(seed, 0, p); a lane draws the scalar walk's
+// sequence while it walks, whatever the other lanes do). Rough dielectrics from both sides (η
+// above and below 1, α from 0.01 to 1), rough conductors (gold-like, k = 0 with η < 1: total
+// reflection), random directions and the edges: normal incidence, grazing (cos θ = 1e-3), exactly
+// grazing and, for a conductor, from below (both degenerate), and a facet cap of 2 besides 100.
+// The two evaluate the same operations but round differently (Highway's log, exp and log1p ≤ 4
+// ulp, the refined reciprocal square root 2^-22, the Cephes azimuth ≤ 2 ulp, fused multiply-adds):
+// a walk's discrete choices (escape, Fresnel reflection, the cap) flip only where a uniform number
+// lies within ~1e-6 of its threshold, a few times in 10^5 walks of a few facets, so at most 1 in
+// 10^3 walks may end differently (a different formula or draw order would change most); walks
+// that end alike have equal facet counts and leave along directions, with Fresnel weights, that
+// differ by a few 1e-7 per facet except near a facet's critical angle: there the refracted cosine
+// and the Fresnel factor have square-root singularities, cos θt = √(1 − sin²θt), and a rounding
+// difference of 4 ulp in sin²θt becomes √(4 · 2^-24) ≈ 5e-4 (as the Fresnel lane test notes), so
+// directions agree within 1e-3 absolute and weights within 1e-3 relative.
+TEST(KernelSimd, MicrosurfaceWalkLanes) {
+    struct Case {
+        bool dielectric;
+        float alpha, eta[3], k[3];
+        int max_order;
+    };
+    const Case cases[] = {
+        {true, 0.3f, {1.5f, 1.5f, 1.5f}, {0, 0, 0}, 100},
+        {true, 1.0f, {1.5f, 1.5f, 1.5f}, {0, 0, 0}, 100},
+        {true, 0.6f, {1 / 1.5f, 1 / 1.5f, 1 / 1.5f}, {0, 0, 0}, 100},
+        {true, 0.01f, {1.33f, 1.33f, 1.33f}, {0, 0, 0}, 100},
+        {true, 0.9f, {1.5f, 1.5f, 1.5f}, {0, 0, 0}, 2},
+        {false, 0.5f, {0.143f, 0.374f, 1.44f}, {3.98f, 2.38f, 1.80f}, 100},
+        {false, 1.0f, {1 / 1.5f, 1 / 1.5f, 1 / 1.5f}, {0, 0, 0}, 100},
+        {false, 0.8f, {2.9f, 2.9f, 2.9f}, {3.1f, 3.1f, 3.1f}, 2},
+    };
+    ParticleRng dir_rng(21, 0, 0);
+    int case_index = 0;
+    for (const Case& cs : cases) {
+        SCOPED_TRACE("case " + std::to_string(case_index));
+        const std::uint64_t seed = 1000 + std::uint64_t(case_index++);
+        std::vector<float> wi = {0, 0, 1, 0.9999995f, 0, 1e-3f, 1, 0, 0, 0, 0, -1};
+        const int n = 20000;
+        for (int p = 0; p < n; ++p) {
+            const float z =
+                cs.dielectric ? 2 * dir_rng.uniform_float() - 1 : dir_rng.uniform_float();
+            const float phi = 2 * kPi<float> * dir_rng.uniform_float();
+            const float r = std::sqrt(std::max(0.f, 1 - z * z));
+            wi.insert(wi.end(), {r * std::cos(phi), r * std::sin(phi), z});
+        }
+        const std::size_t count = wi.size() / 3;
+        const SimdWalkResult lanes =
+            simd_microsurface_walk(wi, cs.alpha, cs.dielectric, cs.eta, cs.k, cs.max_order, seed);
+        const GGX<float> ggx{cs.alpha};
+        std::size_t differ = 0, escaped = 0, capped = 0, degenerate = 0;
+        double worst_wo = 0, worst_weight = 0;
+        for (std::size_t p = 0; p < count; ++p) {
+            ParticleRng rng(seed, 0, p);
+            auto uniform = [&] { return rng.uniform_float(); };
+            const Vec3f w(wi[3 * p], wi[3 * p + 1], wi[3 * p + 2]);
+            const std::optional<MicrosurfaceExit<float>> scalar =
+                cs.dielectric ? walk_rough_dielectric(ggx, cs.eta[0], w, uniform, cs.max_order)
+                              : walk_rough_conductor(
+                                    ggx,
+                                    [&](float c) {
+                                        return Rgbf(fresnel_conductor(c, cs.eta[0], cs.k[0]),
+                                                    fresnel_conductor(c, cs.eta[1], cs.k[1]),
+                                                    fresnel_conductor(c, cs.eta[2], cs.k[2]));
+                                    },
+                                    w, uniform, cs.max_order);
+            const int outcome = !scalar ? 2 : scalar->escaped ? 0 : 1;
+            if (p < 4) {  // the edges: the degenerate arrivals must be degenerate on both
+                const bool must_degenerate = w.z == 0 || (!cs.dielectric && w.z < 0);
+                if (must_degenerate) {
+                    EXPECT_EQ(outcome, 2) << "edge " << p;
+                    EXPECT_EQ(lanes.outcome[p], 2) << "edge " << p;
+                }
+            }
+            (outcome == 0 ? escaped : outcome == 1 ? capped : degenerate) += 1;
+            if (outcome != lanes.outcome[p] || (scalar && scalar->order != lanes.order[p])) {
+                ++differ;
+                continue;
+            }
+            if (outcome != 0) continue;
+            const float wo_scalar[3] = {scalar->wo.x, scalar->wo.y, scalar->wo.z};
+            for (int i = 0; i < 3; ++i) {
+                ASSERT_TRUE(std::isfinite(lanes.wo[3 * p + i]) &&
+                            std::isfinite(lanes.weight[3 * p + i]))
+                    << p;
+                worst_wo = std::max(worst_wo,
+                                    std::abs(double(lanes.wo[3 * p + i]) - double(wo_scalar[i])));
+                const double ws = scalar->weight[i];
+                if (ws > 0)
+                    worst_weight =
+                        std::max(worst_weight, std::abs(lanes.weight[3 * p + i] / ws - 1));
+            }
+        }
+        EXPECT_LE(double(differ), 1e-3 * double(count))
+            << differ << " of " << count << " walks end differently on " << simd_target_name();
+        EXPECT_LE(worst_wo, 1e-3) << simd_target_name();
+        EXPECT_LE(worst_weight, 1e-3) << simd_target_name();
+        if (cs.max_order == 2) {
+            EXPECT_GT(capped, 0u);  // the cap is exercised
+        }
+        std::printf(
+            "[ lanes    ] %s case %d: %zu escaped, %zu capped, %zu degenerate; %zu differ, "
+            "|Δwo| ≤ %.2g, |Δweight| ≤ %.2g\n",
+            simd_target_name(), case_index - 1, escaped, capped, degenerate, differ, worst_wo,
+            worst_weight);
+    }
+}
+
 // cos and sin of 2πu against double precision for every 2^-18 step of u and around every octant
 // boundary, within 2 float ulps of 1.
 TEST(KernelSimd, AzimuthCosineAndSine) {
@@ -223,19 +415,22 @@ TEST(KernelSimd, AzimuthCosineAndSine) {
 // distribution. Per bin and channel z = (f_a − f_b)/√(se_a² + se_b²) is standard normal when both
 // come from the same distribution (central limit: bins with at least ~100 expected exits); Σ z²
 // over the bins of one channel is χ² with as many degrees of freedom. Each channel is one test at
-// the Šidák-corrected level of the suite (1 % overall for the 24 tests below).
-constexpr int kTwoSampleTests = 30;
+// the Šidák-corrected level of the suite (1 % overall for the 57 channel tests below).
+constexpr int kTwoSampleTests = 57;
 
-// `scalar_tweak` adjusts the scalar run's settings (the SIMD run keeps the defaults).
+// `scalar_tweak` adjusts the scalar run's settings (the SIMD run keeps the defaults);
+// `both_tweak` those of both runs.
 void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
                               std::uint64_t particles,
-                              const std::function<void(SimulationSettings&)>& scalar_tweak = {}) {
+                              const std::function<void(SimulationSettings&)>& scalar_tweak = {},
+                              const std::function<void(SimulationSettings&)>& both_tweak = {}) {
     SimulationSettings s;
     s.theta_i_deg = std::move(theta_i);
     s.particles = particles;
     s.grid = HemisphereGrid(18, 18);
     s.kernel = Kernel::Scalar;
     s.seed = 11;
+    if (both_tweak) both_tweak(s);
     SimulationSettings scalar = s;
     if (scalar_tweak) scalar_tweak(scalar);
     const SimulationResult a = simulate(stack, scalar);
@@ -315,6 +510,34 @@ TEST(KernelSimdStat, WalkFirstOrderIsTheSmithMaskedInterface) {
                                  s.microsurface = Microsurface::Multiple;
                                  s.max_microsurface_order = 1;
                              });
+}
+
+// Multiple scattering on the microsurfaces (the walk, one template) on both kernels: the benchmark
+// plastic, a very rough slab (reflection and transmission, walks from both sides, total internal
+// reflection on facets inside) and a rough conductor under a rough coat (the conductor walk).
+void multiple(SimulationSettings& s) {
+    s.microsurface = Microsurface::Multiple;
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarMultiplePlastic) {
+    expect_same_distribution(
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.1, 0.0, 0.9)),
+                          test::lambertian_layer(Rgbd(0.8, 0.5, 1.0))}),
+        {0, 60}, 1'000'000, {}, multiple);
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarMultipleRoughSlab) {
+    expect_same_distribution(
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.7), Rgbd(0.1, 0.0, 0.9)),
+                          test::dielectric_layer(1.0, 0.5)}),
+        {10, 70}, 1'000'000, {}, multiple);
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarMultipleRoughConductor) {
+    expect_same_distribution(
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.3), Rgbd(0.1)),
+                          test::conductor_layer(Rgbd(0.2, 1.0, 1.45), Rgbd(3.0, 2.0, 0.01), 0.8)}),
+        {30, 75}, 1'000'000, {}, multiple);
 }
 
 TEST(KernelSimdStat, SameTablesAsScalarScatteringMediumSpectral) {

@@ -193,8 +193,6 @@ expect_error "--theta-i: 95 is outside" study --theta-i 95 --out "$tmp/x"
 echo '{"configurations": [{"id": "a b", "stack": {}}]}' >"$tmp/bad.json"
 expect_error "/configurations/0/id" study --configs "$tmp/bad.json" --out "$tmp/x"
 
-expect_error "--microsurface: multiple scattering on the microsurfaces runs on the scalar kernel" \
-    study --microsurface multiple --only 'plastic-P1-a0.05' --out "$tmp/x"
 expect_error "--microsurface: 'double' is not a microsurface model" \
     study --microsurface double --kernel scalar --only 'plastic-P1-a0.05' --out "$tmp/x"
 
@@ -204,7 +202,7 @@ expect_error "--transmission-masking: 'walter' is not a transmission masking" \
 # 7. A multiple-scattering reference: its own cache pieces (the key says so), nothing lost to the
 #    microsurfaces in the budgets, and study.json and summary.json say which reference it is.
 ms=(--only 'plastic-P1-a0.05' --models ww-prime --theta-i 60 --particles 2e4 --grid 18x18
-    --no-figures --kernel scalar)
+    --no-figures)
 "$lamina" study "${ms[@]}" --out "$tmp/m" >/dev/null 2>&1 && ok || fail "single-scattering study"
 "$lamina" study "${ms[@]}" --microsurface multiple --out "$tmp/m" >/dev/null 2>&1 \
     && ok || fail "multiple-scattering study"
