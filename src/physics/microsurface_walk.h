@@ -41,6 +41,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <type_traits>
 
 // A lane header (core/lane.h): the walk is written once, as lane templates, included once as an
 // ordinary header and once per SIMD target (the SIMD kernel runs the walk on its lanes); the
@@ -157,11 +158,19 @@ struct MicrosurfaceWalkLanes {
 /// the new direction of travel, the mask of lanes that crossed to the other side, and multiplies
 /// the flux weights of the walking lanes. Heights and directions below the surface are seen from
 /// there negated (the microsurface is point-symmetric, microfacet.h). `two_sided`: light may
-/// arrive from below (a dielectric); otherwise a lane with wi.z ≤ 0 is degenerate.
-template <typename T, typename L, typename Scatter, typename Uniform>
+/// arrive from below (a dielectric); otherwise a lane with wi.z ≤ 0 is degenerate. `visit(h, w,
+/// above, walking, weight, order)`, if given, sees every facet before the lanes scatter off it:
+/// its height (the interface's frame), the arriving w, the side, the walking lanes, their flux
+/// weights so far and the facet's order (next-event estimation; it draws nothing).
+struct MicrosurfaceNoVisit {
+    template <typename... A>
+    void operator()(A&&...) const {}
+};
+template <typename T, typename L, typename Scatter, typename Uniform,
+          typename Visit = MicrosurfaceNoVisit>
 inline MicrosurfaceWalkLanes<T, typename L::Mask> microsurface_walk(
     T alpha, const LaneVec3<T>& wi, typename L::Mask walking, bool two_sided, Scatter&& scatter,
-    Uniform&& uniform, int max_order) {
+    Uniform&& uniform, int max_order, Visit&& visit = Visit{}) {
     const T zero = L::constant(0), one = L::constant(1);
     MicrosurfaceWalkLanes<T, typename L::Mask> r;
     r.weight[0] = r.weight[1] = r.weight[2] = one;
@@ -193,6 +202,7 @@ inline MicrosurfaceWalkLanes<T, typename L::Mask> microsurface_walk(
         r.order = L::select(walking, r.order + one, r.order);
         // A facet visible from the arriving direction (below the horizon after a first bounce).
         const LaneVec3<T> w = {zero - wr.x, zero - wr.y, zero - wr.z};
+        visit(h, w, above, walking, static_cast<const T*>(r.weight), r.order);
         const T u1 = uniform(), u2 = uniform();
         const LaneVec3<T> wm_side = ggx_sample_visible_normal_complete<T, L>(
             alpha, {side * w.x, side * w.y, side * w.z}, u1, u2);
@@ -467,50 +477,28 @@ inline MicrosurfaceConnection<T> microsurface_conductor_connect(const GGX<T>& gg
 }
 
 /// walk_rough_dielectric with a visitor: `visit(const MicrosurfaceFacet<T>&)` is called at every
-/// facet before the particle scatters off it, with the same random numbers in the same order as
-/// walk_rough_dielectric (one walk of either is the same walk). Returns the same exit.
+/// facet before the particle scatters off it. The same walk (microsurface_walk at one lane, the
+/// same random numbers in the same order): returns the same exit.
+template <typename T, typename Visit>
+struct MicrosurfaceFacetVisitor {
+    Visit& visit;
+    void operator()(T h, const LaneVec3<T>& w, bool above, bool walking, const T* weight,
+                    T order) const {
+        if (walking)
+            visit(MicrosurfaceFacet<T>{h, Vec3<T>(w.x, w.y, w.z), above,
+                                       Rgb<T>(weight[0], weight[1], weight[2]), int(order)});
+    }
+};
 template <typename T, typename Uniform, typename Visit>
 std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_visiting(const GGX<T>& ggx, T eta,
                                                                   const Vec3<T>& wi,
                                                                   Uniform&& uniform, int max_order,
                                                                   Visit&& visit) {
-    if (wi.z == 0) return std::nullopt;
-    bool outside = wi.z > 0;
-    Vec3<T> wr = -wi;
-    T h = outside ? T(2) : T(-2);
-    MicrosurfaceExit<T> exit;
-    while (true) {
-        const T u = uniform();
-        h = outside ? microsurface_next_height(ggx, wr, h, u)
-                    : -microsurface_next_height(ggx, -wr, -h, u);
-        if (!std::isfinite(h)) {
-            exit.wo = wr;
-            return exit;
-        }
-        if (exit.order == max_order) {
-            exit.escaped = false;
-            return exit;
-        }
-        ++exit.order;
-        const Vec3<T> w = -wr;
-        visit(MicrosurfaceFacet<T>{h, w, outside, exit.weight, exit.order});
-        const T u1 = uniform(), u2 = uniform();
-        const Vec3<T> wm = outside ? ggx.sample_visible_normal_complete(w, u1, u2)
-                                   : -ggx.sample_visible_normal_complete(-w, u1, u2);
-        const T cos_w_m = dot(w, wm);
-        if (!(cos_w_m > 0)) return std::nullopt;
-        const T eta_crossed = outside ? eta : T(1) / eta;
-        const T F = fresnel_dielectric(cos_w_m, eta_crossed);
-        if (uniform() < F) {
-            wr = reflect(w, wm);
-        } else {
-            const std::optional<Vec3<T>> wt = refract(w, wm, eta_crossed);
-            if (!wt) return std::nullopt;
-            wr = normalize(*wt);
-            outside = !outside;
-        }
-        if (!std::isfinite(wr.z)) return std::nullopt;
-    }
+    auto draw = [&] { return T(uniform()); };
+    const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw)> facet{eta, T(1) / eta, draw};
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(
+        ggx.alpha, {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
+        MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
 }
 
 /// walk_rough_conductor with a visitor, as walk_rough_dielectric_visiting.
@@ -520,30 +508,15 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor_visiting(const GGX<T>& g
                                                                  const Vec3<T>& wi,
                                                                  Uniform&& uniform, int max_order,
                                                                  Visit&& visit) {
-    if (wi.z <= 0) return std::nullopt;
-    Vec3<T> wr = -wi;
-    T h = T(2);
-    MicrosurfaceExit<T> exit;
-    while (true) {
-        h = microsurface_next_height(ggx, wr, h, uniform());
-        if (!std::isfinite(h)) {
-            exit.wo = wr;
-            return exit;
-        }
-        if (exit.order == max_order) {
-            exit.escaped = false;
-            return exit;
-        }
-        ++exit.order;
-        const Vec3<T> w = -wr;
-        visit(MicrosurfaceFacet<T>{h, w, true, exit.weight, exit.order});
-        const T u1 = uniform(), u2 = uniform();
-        const Vec3<T> wm = ggx.sample_visible_normal_complete(w, u1, u2);
-        const T cos_w_m = dot(w, wm);
-        if (!(cos_w_m > 0)) return std::nullopt;
-        exit.weight *= fresnel(cos_w_m);
-        wr = reflect(w, wm);
-    }
+    auto draw = [&] { return T(uniform()); };
+    auto factors = [&](T cos_w_m, T* out) {
+        const Rgb<T> f = fresnel(cos_w_m);
+        out[0] = f[0], out[1] = f[1], out[2] = f[2];
+    };
+    const MicrosurfaceConductorFacet<T, Lane<T>, decltype(factors)> facet{factors};
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(
+        ggx.alpha, {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
+        MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
 }
 
 /// One walk's unbiased estimate of the multiple-scattering rough dielectric's f(wi, wo)·|cos θo|
