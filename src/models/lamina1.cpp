@@ -293,8 +293,12 @@ class Lamina1 final : public Model {
         const double T = 1 - F;
         Rgbd series(1.0);
         if (ch_.inter_reflection)
-            for (int c = 0; c < 3; ++c)
-                series[c] = 1 / (1 - F * Rb[c] * a[c] * a[c]);
+            for (int c = 0; c < 3; ++c) {
+                // F R_b a² = 1 only where nothing enters (F = 1: wi exactly grazing), and the
+                // lobes' T factor is 0 there: no series (not 0·∞).
+                const double round_trip = F * Rb[c] * a[c] * a[c];
+                series[c] = round_trip < 1 ? 1 / (1 - round_trip) : 0.0;
+            }
         out.push_back({wr, Rb * a * a * series * (T * T)});
         if (support_.btdf) {
             const double sin_t = std::hypot(wi.x, wi.y) * inv_eta0_ * eta_s_;
@@ -448,7 +452,7 @@ class Lamina1 final : public Model {
     Rgbd attenuation(double mu) const {
         if (!has_absorption_) return Rgbd(1.0);
         if (mu <= 0) return Rgbd(0.0);
-        return exp_rgb(coat_.tau_a * (-1 / mu));
+        return beer_lambert(coat_.tau_a, 1 / mu);
     }
 
     Rgbd base_fresnel(double c) const {

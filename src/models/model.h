@@ -167,4 +167,14 @@ inline Rgbd exp_rgb(const Rgbd& x) {
     return {std::exp(x[0]), std::exp(x[1]), std::exp(x[2])};
 }
 
+/// The Beer–Lambert transmittance exp(−τ·path) of each channel, for a path length path = Σ 1/μ ≥ 0
+/// in units of the medium's thickness (+∞ along the horizon or past total internal reflection): 1
+/// where τ = 0 whatever the path (never 0·∞), 0 where τ > 0 and the path is infinite.
+inline Rgbd beer_lambert(const Rgbd& tau, double path) {
+    Rgbd t;
+    for (int c = 0; c < 3; ++c)
+        t[c] = tau[c] > 0 ? std::exp(-tau[c] * path) : 1.0;
+    return t;
+}
+
 }  // namespace lamina

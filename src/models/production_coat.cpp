@@ -323,10 +323,10 @@ class ProductionCoat final : public Model {
         if (has_tau_) {
             switch (r_.tint) {
                 case CoatRecipe::Tint::TwoWay:
-                    s *= exp_rgb(tau_ * -(1 / in.mu_t_i + 1 / refracted_cos(mu_o)));
+                    s *= beer_lambert(tau_, 1 / in.mu_t_i + 1 / refracted_cos(mu_o));
                     break;
                 case CoatRecipe::Tint::ViewOnly:
-                    s *= exp_rgb(tau_ * (-2 / refracted_cos(mu_o)));
+                    s *= beer_lambert(tau_, 2 / refracted_cos(mu_o));
                     break;
                 case CoatRecipe::Tint::Constant:
                     s *= exp_rgb(tau_ * -2.0);
@@ -338,7 +338,7 @@ class ProductionCoat final : public Model {
             const double K_s = fresnel_dielectric(mu_o, eta0_);
             const double K = K_s + (K_r_ - K_s) * r_b_;
             for (int c = 0; c < 3; ++c)
-                s[c] *= (1 - K) / (1 - E_b_[c] * K);
+                s[c] *= coat_darkening(K, E_b_[c]);
         } else {
             s *= darkening_;
         }
@@ -377,7 +377,15 @@ class ProductionCoat final : public Model {
             E_b_ = albedo_;
         }
         for (int c = 0; c < 3; ++c)
-            darkening_[c] = (1 - K) / (1 - E_b_[c] * K);
+            darkening_[c] = coat_darkening(K, E_b_[c]);
+    }
+
+    /// The darkening (1 − K)/(1 − E_b K) (OpenPBR 1.1, "Coat darkening"): 0 where the coat
+    /// reflects everything (K = 1: a coat less dense than the ambient medium past its critical
+    /// angle), never 0/0 with a perfect base (E_b = 1).
+    static double coat_darkening(double K, double E_b) {
+        if (!(K < 1)) return 0.0;
+        return (1 - K) / (1 - E_b * K);
     }
 
     CoatRecipe r_;

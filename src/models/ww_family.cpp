@@ -175,7 +175,7 @@ class WWModel final : public Model {
     Rgbd attenuation(double mu) const {
         if (!has_absorption_) return Rgbd(1.0);
         if (gray_tau_) return Rgbd(std::exp(-coat_.tau_a[0] / mu));
-        return exp_rgb(coat_.tau_a * (-1 / mu));
+        return beer_lambert(coat_.tau_a, 1 / mu);
     }
 
     /// f_base with Λ of its incident direction cached.
@@ -204,7 +204,7 @@ class WWModel final : public Model {
     /// Beer–Lambert along both refracted paths: a = exp(−τ (1/μi' + 1/μo')).
     Rgbd absorption(double mu_i, double mu_o) const {
         if (!has_absorption_) return Rgbd(1.0);
-        return exp_rgb(coat_.tau_a * -(1 / mu_i + 1 / mu_o));
+        return beer_lambert(coat_.tau_a, 1 / mu_i + 1 / mu_o);
     }
 
     Rgbd base_fresnel(double cos_theta) const {
