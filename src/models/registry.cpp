@@ -39,6 +39,11 @@ const std::vector<ModelEntry>& model_registry() {
          "(conductor base: plugin tm2, exact top; slab: tm2_dielectric, transmitted lobe)",
          "bases: conductor, dielectric; media: absorbing; sides: R, T (slab)", tm2_options,
          make_tm2, false, "successors"},
+        {"tm6",
+         "Randrianandrasana et al. 2021 transfer matrices with HG media (plugin tm6): primary, "
+         "forward- and back-scattered lobes, exact top, lobes normalized by their GGX albedo",
+         "bases: conductor; media: absorbing, scattering (HG); sides: R", tm6_options, make_tm6,
+         false, "successors"},
         {"lamina-1",
          "lamina-1: exact top reflection, first order through the coat's directional "
          "transmittance, inter-reflection series, lobe widened by the coat's refraction spread",
