@@ -134,8 +134,7 @@ std::vector<float> compute_ggx_albedo() {
 double GgxAlbedoTable::direct(double c, double alpha, int n_r, int n_phi) {
     if (alpha <= 0) return 1.0;
     double sum = 0;
-    visible_normal_rule(std::max(c, kCMin), alpha, n_r, n_phi,
-                        [&](double, double w) { sum += w; });
+    visible_normal_rule(std::max(c, kCMin), alpha, n_r, n_phi, [&](double, double w) { sum += w; });
     return sum;
 }
 

@@ -101,7 +101,9 @@ struct Matrix2 {
     /// Reflectance over an opaque base of reflectance rb (rb = 0: nothing below); the
     /// denominator m11 (1 − r′ r_b) is kept ≥ 1e−9 m11, as Belcour's adding keeps 1 − R R ≥ 1e−9
     /// (two perfect mirrors facing).
-    T reflectance_over(const T& rb) const { return up_over(rb) / max_of(down_over(rb), m11 * 1e-9); }
+    T reflectance_over(const T& rb) const {
+        return up_over(rb) / max_of(down_over(rb), m11 * 1e-9);
+    }
 };
 
 /// The six-flux matrix [[P, 0, 0], [A, S, X], [B, X, S]] of transfer_matrix.h: state (primary,
@@ -381,10 +383,11 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
                 }
             g_T_next = first_order(k, x.p, x.c_above, x.c_below, g_T, g_next_r, 1.0, ch);
             if constexpr (kSix) {
-                const bool medium_below = i + 1 < n_used && comps[i + 1].kind == TmComponent::Medium;
+                const bool medium_below =
+                    i + 1 < n_used && comps[i + 1].kind == TmComponent::Medium;
                 const double g_between = medium_below ? f[i + 1].s.gt : 1.0;
-                g_sT_next = first_order(k, x.s, x.c_above, x.c_below, g_sT, g_next_r, g_between,
-                                        ch);
+                g_sT_next =
+                    first_order(k, x.s, x.c_above, x.c_below, g_sT, g_next_r, g_between, ch);
                 E = E * M::interface(energy_matrix(x.p), energy_matrix(x.s));
                 G = G * M::interface(asymmetry_matrix(x.p, weight), asymmetry_matrix(x.s, weight));
                 R = E.reflectances_over(Rgbd(0.0));
@@ -550,9 +553,10 @@ class TmModel final : public Model {
         if (tm_lobe_count(comps_, ch_.six_flux) == 0) {
             support_.reason =
                 ch_.six_flux
-                    ? fmt::format("{} needs at most {} lobes (one per interface, two more per "
-                                  "component from the first scattering medium down)",
-                                  name_, int(TmLobes::kMaxLobes))
+                    ? fmt::format(
+                          "{} needs at most {} lobes (one per interface, two more per "
+                          "component from the first scattering medium down)",
+                          name_, int(TmLobes::kMaxLobes))
                     : fmt::format("{} needs 1 to {} interfaces", name_, int(TmLobes::kMaxLobes));
             return;
         }
@@ -835,7 +839,8 @@ TmChoices tm_choices(const ModelOptions& o) {
     c.tir = option_value(o, "tir") == "on";
     c.per_channel_g = option_value(o, "asymmetry") == "per-channel";
     c.ratio_mean_g = option_value(o, "asymmetry") == "ratio-mean";
-    if (o.count("normalization")) c.albedo_normalized = option_value(o, "normalization") == "albedo";
+    if (o.count("normalization"))
+        c.albedo_normalized = option_value(o, "normalization") == "albedo";
     if (o.count("backscatter")) c.backscatter_fit = option_value(o, "backscatter") == "fit";
     return c;
 }
