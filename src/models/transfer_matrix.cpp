@@ -18,13 +18,28 @@ double tm_hg_from_ggx(double alpha) {
     return clamp(-0.085 + 1.085 / (1 + std::pow(a / 0.5, 1.3)), 0.0, 1.0);
 }
 
-double tm_ggx_from_hg(double g) {
-    const double gc = std::max(clamp(g, -1.0, 1.0), 0.2);
+namespace {
+
+double ggx_from_hg_unclamped_g(double gc) {
     return clamp(0.5 * std::pow(1.085 / (gc + 0.085) - 1, 1 / 1.3), 1e-4, 1.0);
 }
 
+/// g′ = √(1 − (1 − g²) η^0.75) with η^0.75 given (one pow per interface, not per call).
+double hg_refract_pow(double g, double eta_pow) {
+    return std::min(safe_sqrt(1 - (1 - g * g) * eta_pow), 1.0);
+}
+
+}  // namespace
+
+double tm_ggx_from_hg(double g) {
+    // g ≤ 0.2 (most scattered lobes) is one value: computed once.
+    static const double alpha_at_floor = ggx_from_hg_unclamped_g(0.2);
+    if (!(g > 0.2)) return alpha_at_floor;
+    return ggx_from_hg_unclamped_g(std::min(g, 1.0));
+}
+
 double tm_hg_refract(double g, double eta) {
-    return std::min(safe_sqrt(1 - (1 - g * g) * std::pow(eta, 0.75)), 1.0);
+    return hg_refract_pow(g, std::pow(eta, 0.75));
 }
 
 double tm_backscatter_fit(double g) {
@@ -42,9 +57,13 @@ TmTwoStream tm_two_stream(const Rgbd& a, const Rgbd& b) {
     TmTwoStream out;
     for (int c = 0; c < 3; ++c) {
         const double gamma = safe_sqrt(a[c] * a[c] - b[c] * b[c]);
-        // sinh(γ)/γ, → 1 as γ → 0 (a lossless scatterer: γ = 0 exactly).
-        const double sinhc = gamma > 1e-8 ? std::sinh(gamma) / gamma : 1.0;
-        const double den = std::cosh(gamma) + a[c] * sinhc;
+        // sinh γ and cosh γ from one expm1 (m = e^γ − 1: sinh = m (m + 2) / (2 (m + 1)), exact to
+        // rounding for small γ); sinh(γ)/γ → 1 as γ → 0 (a lossless scatterer: γ = 0 exactly).
+        const double m = std::expm1(gamma);
+        const double sinh_g = m * (m + 2) / (2 * (m + 1));
+        const double cosh_g = sinh_g + 1 / (m + 1);
+        const double sinhc = gamma > 1e-8 ? sinh_g / gamma : 1.0;
+        const double den = cosh_g + a[c] * sinhc;
         out.t[c] = 1 / den;
         out.r[c] = b[c] * sinhc / den;
     }
@@ -112,23 +131,30 @@ struct Matrix2 {
 template <typename T>
 struct Matrix6 {
     Matrix2<T> P, A, B, S, X;
+    /// False while A = B = X = 0 (an interface, or a stack without a medium yet): the product
+    /// then skips the zero blocks.
+    bool coupled = false;
     static Matrix6 identity() {
         const auto z = Matrix2<T>::zero();
-        return {Matrix2<T>::identity(), z, z, Matrix2<T>::identity(), z};
+        return {Matrix2<T>::identity(), z, z, Matrix2<T>::identity(), z, false};
     }
     static Matrix6 interface(const Matrix2<T>& primary, const Matrix2<T>& secondary) {
         const auto z = Matrix2<T>::zero();
-        return {primary, z, z, secondary, z};
+        return {primary, z, z, secondary, z, false};
     }
     /// A medium: unscattered block `primary`, two-stream matrix `total` acting on each family's
     /// total flux (the primary flux counting in the forward family's).
     static Matrix6 medium(const Matrix2<T>& primary, const Matrix2<T>& total) {
         const Matrix2<T> same = total.diagonal(), swapped = total.off_diagonal();
-        return {primary, same - primary, swapped, same, swapped};
+        return {primary, same - primary, swapped, same, swapped, true};
     }
     Matrix6 operator*(const Matrix6& n) const {
-        return {P * n.P, A * n.P + S * n.A + X * n.B, B * n.P + X * n.A + S * n.B,
-                S * n.S + X * n.X, S * n.X + X * n.S};
+        if (!n.coupled)  // n.A = n.B = n.X = 0
+            return {P * n.P, A * n.P, B * n.P, S * n.S, X * n.S, coupled};
+        if (!coupled)  // A = B = X = 0
+            return {P * n.P, S * n.A, S * n.B, S * n.S, S * n.X, true};
+        return {P * n.P,           A * n.P + S * n.A + X * n.B, B * n.P + X * n.A + S * n.B,
+                S * n.S + X * n.X, S * n.X + X * n.S,           true};
     }
     /// Primary, forward and backward reflectances for unit primary flux down on top, none
     /// scattered, and an opaque base reflecting every family with rb (0: nothing below): the
@@ -155,7 +181,6 @@ struct FluxFactors {
 struct Factors {
     FluxFactors p, s;
     double c_above = 1, c_below = 1;
-    bool skip = false;    ///< an index-matched dielectric: no component at all
     bool opaque = false;  ///< conductor, or a dielectric that reflects the mean direction totally
 };
 
@@ -237,12 +262,13 @@ void medium_factors(const TmComponent& k, double c, const TmChoices& ch, Factors
 /// The first-order asymmetries of one dielectric interface's transmissions and its TIR steps,
 /// for a flux arriving with asymmetry g_down and coming back (after the next interface's
 /// reflection, and the medium between, both ways) with g_back before refraction up
-/// (tm2.cpp/tm6.cpp outgoing_lobes). Returns the asymmetry transmitted down.
-double first_order(const TmComponent& k, FluxFactors& x, double c_above, double c_below,
-                   double g_down, double g_next, double g_between, const TmChoices& ch) {
-    const double g_T_next = tm_hg_refract(g_down, 1 / k.eta) * x.gt;
+/// (tm2.cpp/tm6.cpp outgoing_lobes); eta_pow = η^0.75. Returns the asymmetry transmitted down.
+double first_order(const TmComponent& k, double eta_pow, FluxFactors& x, double c_above,
+                   double c_below, double g_down, double g_next, double g_between,
+                   const TmChoices& ch) {
+    const double g_T_next = hg_refract_pow(g_down, 1 / eta_pow) * x.gt;
     const double g_TR = g_T_next * g_between * g_next * g_between;
-    const double g_TRT = tm_hg_refract(g_TR, k.eta) * x.gtp;
+    const double g_TRT = hg_refract_pow(g_TR, eta_pow) * x.gtp;
     x.gt = g_down != 0 ? g_T_next / g_down : 0.0;
     x.gtp = g_TR != 0 ? g_TRT / g_TR : 0.0;
     if (ch.tir) {
@@ -268,73 +294,64 @@ double first_order(const TmComponent& k, FluxFactors& x, double c_above, double 
     return g_T_next;
 }
 
+/// The transfer factors of the dielectric interface k for light arriving at cosine c (tm.h
+/// dielectric_transfer_factors): FGD energies, the asymmetries of the reflections (g_r) and of
+/// the rough transmissions; x.opaque where the mean direction is totally reflected. Returns the
+/// cosine below.
+double dielectric_factors(const TmComponent& k, double c, double g_r, const TmChoices& ch,
+                          Factors& x) {
+    const FgdTable& fgd = FgdTable::get();
+    x.p.gr = x.p.grp = g_r;
+    x.c_above = c;
+    const double r = std::abs(k.eta - 1) < 1e-3 ? 0.0 : fgd(c, k.alpha, k.fgd_index[0]);
+    x.p.r = x.p.rp = Rgbd(r);
+    const double sin2_t = (1 - c * c) / sqr(k.eta);
+    if (sin2_t >= 1) {  // the mean direction is totally reflected: nothing goes on
+        x.opaque = true;
+        x.s = x.p;
+        return c;
+    }
+    const double ct = std::max(std::sqrt(1 - sin2_t), 1e-6);
+    // Rough transmission as a GGX lobe of roughness ½ s α (tm.h: "fake rough transmissions
+    // scaling factors"), s from the mean directions above and below.
+    const double s_down = std::abs(c / (k.eta * ct) - 1);
+    const double s_up = std::abs(1 - k.eta * ct / c);
+    x.p.gt = tm_hg_from_ggx(0.5 * s_down * k.alpha);
+    x.p.gtp = tm_hg_from_ggx(0.5 * s_up * k.alpha);
+    if (ch.upward_fgd) x.p.rp = Rgbd(fgd(ct, k.alpha, 1 / k.eta, 0.0));
+    x.p.t = Rgbd(1.0) - x.p.r;
+    x.p.tp = Rgbd(1.0) - x.p.rp;
+    x.s = x.p;  // the scattered flux meets the same interface (its g chain differs)
+    x.c_below = ct;
+    return ct;
+}
+
+/// An absorbing layer (two fluxes): r = r′ = 0, t = t′ = exp(−τa/μ) along the mean direction, its
+/// asymmetry unchanged (g = 1, the primary-flux block of the released tm6 medium).
+void absorbing_factors(const TmComponent& k, double c, Factors& x) {
+    const Rgbd path = k.tau_a * (1 / c);
+    for (int i = 0; i < 3; ++i)
+        x.p.t[i] = x.p.tp[i] = std::exp(-std::min(path[i], kMaxOpticalPath));
+    x.c_above = x.c_below = c;
+}
+
+bool index_matched(const TmComponent& k) {
+    return k.kind == TmComponent::Dielectric && std::abs(k.eta - 1) < 1e-5;
+}
+
 template <bool kSix>
 TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmChoices& ch) {
-    const FgdTable& fgd = FgdTable::get();
     TmLobes out;
     const int n = int(comps.size());
-    std::array<Factors, 2 * TmLobes::kMaxLobes> f{};
+    // The reflections' asymmetries g(α) of every interface (the first-order chain looks one
+    // interface ahead).
+    std::array<double, 2 * TmLobes::kMaxLobes> g_r{};
+    for (int i = 0; i < n; ++i)
+        if (comps[i].kind != TmComponent::Medium) g_r[i] = tm_hg_from_ggx(comps[i].alpha);
 
-    // 1. Transfer factors along the refracted mean direction (tm.h dielectric_transfer_factors,
-    //    conductor_transfer_factors, medium_transfer_factors).
-    double c = std::max(c0, 1e-6);
-    int n_used = n;
-    for (int i = 0; i < n; ++i) {
-        const TmComponent& k = comps[i];
-        Factors& x = f[i];
-        if (k.kind == TmComponent::Dielectric) {
-            if (std::abs(k.eta - 1) < 1e-5) {
-                x.skip = true;
-                continue;
-            }
-            x.p.gr = x.p.grp = tm_hg_from_ggx(k.alpha);
-            x.c_above = c;
-            const double r = std::abs(k.eta - 1) < 1e-3 ? 0.0 : fgd(c, k.alpha, k.fgd_index[0]);
-            x.p.r = x.p.rp = Rgbd(r);
-            const double sin2_t = (1 - c * c) / sqr(k.eta);
-            if (sin2_t >= 1) {  // the mean direction is totally reflected: nothing goes on
-                x.opaque = true;
-                x.s = x.p;
-                n_used = i + 1;
-                break;
-            }
-            const double ct = std::max(std::sqrt(1 - sin2_t), 1e-6);
-            // Rough transmission as a GGX lobe of roughness ½ s α (tm.h: "fake rough
-            // transmissions scaling factors"), s from the mean directions above and below.
-            const double s_down = std::abs(c / (k.eta * ct) - 1);
-            const double s_up = std::abs(1 - k.eta * ct / c);
-            x.p.gt = tm_hg_from_ggx(0.5 * s_down * k.alpha);
-            x.p.gtp = tm_hg_from_ggx(0.5 * s_up * k.alpha);
-            if (ch.upward_fgd) x.p.rp = Rgbd(fgd(ct, k.alpha, 1 / k.eta, 0.0));
-            x.p.t = Rgbd(1.0) - x.p.r;
-            x.p.tp = Rgbd(1.0) - x.p.rp;
-            x.s = x.p;  // the scattered flux meets the same interface (its g chain differs)
-            x.c_below = ct;
-            c = ct;
-        } else if (k.kind == TmComponent::Medium) {
-            if (kSix) {
-                medium_factors(k, c, ch, x);
-                continue;
-            }
-            // An absorbing layer: r = r′ = 0, t = t′ = exp(−τa/μ) along the mean direction, its
-            // asymmetry unchanged (g = 1, the primary-flux block of the released tm6 medium).
-            const Rgbd path = k.tau_a * (1 / c);
-            for (int ch3 = 0; ch3 < 3; ++ch3)
-                x.p.t[ch3] = x.p.tp[ch3] = std::exp(-std::min(path[ch3], kMaxOpticalPath));
-            x.c_above = x.c_below = c;
-        } else {
-            x.p.r = fgd.rgb(c, k.alpha, k.fgd_index);
-            x.p.gr = tm_hg_from_ggx(k.alpha);
-            x.s = x.p;
-            x.c_above = c;
-            x.opaque = true;
-            n_used = i + 1;
-            break;
-        }
-    }
-
-    // 2. First-order asymmetries, TIR, matrix products and the lobes each component adds
-    //    (tm2.cpp / tm2_dielectric.cpp / tm6.cpp outgoing_lobes).
+    // One pass, top to bottom: each component's transfer factors along the refracted mean
+    // direction (tm.h *_transfer_factors), its first-order asymmetries and TIR, the matrix
+    // products and the lobes it adds (tm2.cpp / tm2_dielectric.cpp / tm6.cpp outgoing_lobes).
     using M = std::conditional_t<kSix, Matrix6<Rgbd>, Matrix2<Rgbd>>;
     constexpr int kFamilies = kSix ? 3 : 1;
     M E = M::identity();
@@ -345,49 +362,66 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
     // The weights of the asymmetry matrices: the released tm2's RGB means, or each channel's own.
     const bool mean_weights = !ch.per_channel_g && !ch.ratio_mean_g;
     const auto weight = [&](const Rgbd& x) { return mean_weights ? Rgbd(x.mean()) : x; };
+    double c = std::max(c0, 1e-6);
     double g_T = 1;   // asymmetry of the primary light transmitted down to the current component
     double g_sT = 1;  // the same for the scattered light (six fluxes)
     bool smooth = true;
     bool opaque_end = false;
-    for (int i = 0; i < n_used; ++i) {
+    Factors medium_below;  // six fluxes: the medium under an interface, computed there
+    bool have_medium_below = false;
+    for (int i = 0; i < n; ++i) {
         const TmComponent& k = comps[i];
-        Factors x = f[i];
-        if (x.skip) continue;
-        if (k.kind == TmComponent::Medium) {
-            if constexpr (kSix) {
-                E = E * M::medium(energy_matrix(x.p), energy_matrix(x.s));
-                G = G * M::medium(asymmetry_matrix(x.p, weight), asymmetry_matrix(x.s, weight));
-            } else {
-                E = E * energy_matrix(x.p);
-                G = G * asymmetry_matrix(x.p, weight);
-                continue;
-            }
-        }
+        if (index_matched(k)) continue;  // no component at all
+        Factors x;
         std::array<Rgbd, kFamilies> R, Rg;
         double g_T_next = g_T, g_sT_next = g_sT;
         if (k.kind == TmComponent::Medium) {
             if constexpr (kSix) {
+                if (have_medium_below)
+                    x = medium_below;
+                else
+                    medium_factors(k, c, ch, x);
+                have_medium_below = false;
+                E = E * M::medium(energy_matrix(x.p), energy_matrix(x.s));
+                G = G * M::medium(asymmetry_matrix(x.p, weight), asymmetry_matrix(x.s, weight));
                 R = E.reflectances_over(Rgbd(0.0));
                 Rg = G.reflectances_over(Rgbd(0.0));
+            } else {
+                absorbing_factors(k, c, x);
+                E = E * energy_matrix(x.p);
+                G = G * asymmetry_matrix(x.p, weight);
+                continue;
             }
+        } else if (k.kind == TmComponent::Dielectric) {
+            c = dielectric_factors(k, c, g_r[i], ch, x);
+        } else {
+            x.p.r = FgdTable::get().rgb(c, k.alpha, k.fgd_index);
+            x.p.gr = g_r[i];
+            x.s = x.p;
+            x.c_above = c;
+            x.opaque = true;
+        }
+        if (k.kind == TmComponent::Medium) {
+            // its lobes (six fluxes) below
         } else if (!x.opaque) {
             smooth = smooth && k.alpha <= 0;
             // The asymmetry of the light refracted down, reflected by the next interface (through
             // the medium between, the scattered light's only) and refracted back up, to first
             // order; the factors' g are the ratios of these.
             double g_next_r = 1.0;  // the slab's last interface: nothing below reflects
-            for (int j = i + 1; j < n_used; ++j)
-                if (!f[j].skip && comps[j].kind != TmComponent::Medium) {
-                    g_next_r = f[j].p.gr;
+            for (int j = i + 1; j < n; ++j)
+                if (!index_matched(comps[j]) && comps[j].kind != TmComponent::Medium) {
+                    g_next_r = g_r[j];
                     break;
                 }
-            g_T_next = first_order(k, x.p, x.c_above, x.c_below, g_T, g_next_r, 1.0, ch);
+            const double eta_pow = std::pow(k.eta, 0.75);
+            g_T_next = first_order(k, eta_pow, x.p, x.c_above, x.c_below, g_T, g_next_r, 1.0, ch);
             if constexpr (kSix) {
-                const bool medium_below =
-                    i + 1 < n_used && comps[i + 1].kind == TmComponent::Medium;
-                const double g_between = medium_below ? f[i + 1].s.gt : 1.0;
-                g_sT_next =
-                    first_order(k, x.s, x.c_above, x.c_below, g_sT, g_next_r, g_between, ch);
+                have_medium_below = i + 1 < n && comps[i + 1].kind == TmComponent::Medium;
+                if (have_medium_below) medium_factors(comps[i + 1], c, ch, medium_below);
+                const double g_between = have_medium_below ? medium_below.s.gt : 1.0;
+                g_sT_next = first_order(k, eta_pow, x.s, x.c_above, x.c_below, g_sT, g_next_r,
+                                        g_between, ch);
                 E = E * M::interface(energy_matrix(x.p), energy_matrix(x.s));
                 G = G * M::interface(asymmetry_matrix(x.p, weight), asymmetry_matrix(x.s, weight));
                 R = E.reflectances_over(Rgbd(0.0));
@@ -446,6 +480,10 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
         lobe.scale = lobe.energy;
         if (!ch.albedo_normalized || lobe.delta) continue;
         const GgxAlbedoTable& albedo = GgxAlbedoTable::get();
+        if (!ch.per_channel_g) {
+            lobe.scale = lobe.scale * (1 / std::max(albedo(c0, lobe.alpha), 1e-3));
+            continue;
+        }
         for (int i = 0; i < 3; ++i)
             lobe.scale[i] /= std::max(albedo(c0, lobe.alpha_rgb[i]), 1e-3);
     }
@@ -595,6 +633,15 @@ class TmModel final : public Model {
         const Vec3d wi_back = retro_incidence(wi);
         const Vec3d h_back = normalize(wi_back + wo);
         Rgbd f(0.0);
+        // Lobes of one roughness and incidence share their shape (six fluxes: most scattered
+        // lobes are at α = 1): a few shapes are kept.
+        struct Shape {
+            double alpha;
+            bool back;
+            double value;
+        };
+        std::array<Shape, 4> shapes;
+        int n_shapes = 0;
         for (int k = 0; k < st.n_lobes; ++k) {
             const TmLobes::Lobe& l = st.lobes[k];
             if (l.component == 0 && l.family == TmLobes::Primary && ch_.exact_top) {
@@ -602,10 +649,21 @@ class TmModel final : public Model {
                 continue;
             }
             if (l.delta) continue;
-            if (l.family == TmLobes::Backward)
-                f += lobe_value(l, wi_back, wo, h_back);
-            else
-                f += lobe_value(l, wi, wo, h);
+            const bool back = l.family == TmLobes::Backward;
+            if (ch_.per_channel_g) {
+                f += back ? lobe_value(l, wi_back, wo, h_back) : lobe_value(l, wi, wo, h);
+                continue;
+            }
+            double shape = -1;
+            for (int s = 0; s < n_shapes; ++s)
+                if (shapes[s].alpha == l.alpha && shapes[s].back == back) shape = shapes[s].value;
+            if (shape < 0) {
+                shape = back ? ggx_lobe_shape(l.alpha, wi_back, wo, h_back)
+                             : ggx_lobe_shape(l.alpha, wi, wo, h);
+                shapes[n_shapes % 4] = {l.alpha, back, shape};
+                n_shapes = std::min(n_shapes + 1, 4);
+            }
+            f += l.scale * shape;
         }
         return f;
     }
