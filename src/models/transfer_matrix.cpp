@@ -347,7 +347,8 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
     // interface ahead).
     std::array<double, 2 * TmLobes::kMaxLobes> g_r{};
     for (int i = 0; i < n; ++i)
-        if (comps[i].kind != TmComponent::Medium) g_r[i] = tm_hg_from_ggx(comps[i].alpha);
+        if (comps[i].kind != TmComponent::Medium)
+            g_r[i] = comps[i].g_reflect >= 0 ? comps[i].g_reflect : tm_hg_from_ggx(comps[i].alpha);
 
     // One pass, top to bottom: each component's transfer factors along the refracted mean
     // direction (tm.h *_transfer_factors), its first-order asymmetries and TIR, the matrix
@@ -414,7 +415,7 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
                     g_next_r = g_r[j];
                     break;
                 }
-            const double eta_pow = std::pow(k.eta, 0.75);
+            const double eta_pow = k.eta_pow >= 0 ? k.eta_pow : std::pow(k.eta, 0.75);
             g_T_next = first_order(k, eta_pow, x.p, x.c_above, x.c_below, g_T, g_next_r, 1.0, ch);
             if constexpr (kSix) {
                 have_medium_below = i + 1 < n && comps[i + 1].kind == TmComponent::Medium;
@@ -475,13 +476,18 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
     }
     // 3. What multiplies each lobe's shape (the released tm6: its energy over the shape's albedo
     //    at μi, tm6.cpp eval, "single-scattering albedo normalization").
+    double last_alpha = -1, last_inv_albedo = 1;  // most scattered lobes share α = 1
     for (int l = 0; l < out.n_lobes; ++l) {
         TmLobes::Lobe& lobe = out.lobes[l];
         lobe.scale = lobe.energy;
         if (!ch.albedo_normalized || lobe.delta) continue;
         const GgxAlbedoTable& albedo = GgxAlbedoTable::get();
         if (!ch.per_channel_g) {
-            lobe.scale = lobe.scale * (1 / std::max(albedo(c0, lobe.alpha), 1e-3));
+            if (lobe.alpha != last_alpha) {
+                last_alpha = lobe.alpha;
+                last_inv_albedo = 1 / std::max(albedo(c0, lobe.alpha), 1e-3);
+            }
+            lobe.scale = lobe.scale * last_inv_albedo;
             continue;
         }
         for (int i = 0; i < 3; ++i)
@@ -562,6 +568,8 @@ class TmModel final : public Model {
                         k.fgd_index[c] = FgdTable::locate(k.eta_rgb[c], k.k[c]);
                     break;
             }
+            k.g_reflect = tm_hg_from_ggx(k.alpha);
+            k.eta_pow = std::pow(k.eta, 0.75);
             comps_.push_back(k);
             if (stack.layers[i].has_medium && !stack.layers[i].medium.is_empty()) {
                 const MediumSpec& m = stack.layers[i].medium;

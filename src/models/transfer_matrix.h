@@ -125,6 +125,9 @@ struct TmComponent {
     Rgbd tau_s{0.0};   ///< medium: scattering optical depth (normal)
     Rgbd g{0.0};       ///< medium: HG asymmetry
     std::array<FgdTable::Index, 3> fgd_index{};
+    /// Per-stack constants the model fills in once (negative: computed per call): an interface's
+    /// reflection asymmetry g(α) and a dielectric's η^0.75.
+    double g_reflect = -1, eta_pow = -1;
 };
 
 /// The lobes for one incident cosine.
