@@ -12,6 +12,7 @@
 #include "models/fgd_table.h"
 #include "models/registry.h"
 #include "physics/dielectric.h"
+#include "physics/microfacet.h"
 #include "physics/phase.h"
 #include "test_stacks.h"
 
@@ -450,6 +451,56 @@ TEST(Tm6, AlbedoIsTheSumOfTheLobeEnergies) {
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(albedo[c], sum[c], 6e-3) << ti << " " << c;
     }
+}
+
+// The BRDF from its lobes, by hand: the exact top reflection (Walter et al. 2007) plus, for every
+// other lobe, energy/E(μi, α) · D G2/(4 μi μo) at its α (E from the direct integral), the
+// backward lobes at the incidence (−wi.x, −wi.y, wi.z) so that they peak at wi.
+TEST(Tm6Golden, EvalIsTheNormalizedSumOfItsLobes) {
+    const double eta = 1.5, a0 = 0.15, a_b = 0.25;
+    const InterfaceSpec gold = test::gold(a_b);
+    const auto model = make_model("tm6", coated(eta, a0, gold, Rgbd(0.05), Rgbd(0.8), 0.4));
+    TmComponent top, medium, base;
+    top.kind = TmComponent::Dielectric;
+    top.eta = eta;
+    top.alpha = a0;
+    top.fgd_index.fill(FgdTable::locate(eta, 0.0));
+    medium.kind = TmComponent::Medium;
+    medium.tau_a = Rgbd(0.05);
+    medium.tau_s = Rgbd(0.8);
+    medium.g = Rgbd(0.4);
+    base.kind = TmComponent::Conductor;
+    base.alpha = a_b;
+    for (int c = 0; c < 3; ++c)
+        base.fgd_index[c] = FgdTable::locate(gold.eta_rgb[c] / eta, gold.k[c] / eta);
+    TmChoices ch;
+    ch.ratio_mean_g = ch.albedo_normalized = ch.scattering = ch.six_flux = true;
+    const DielectricInterface<double> exact_top{eta, a0};
+    const GgxAlbedoTable& albedo = GgxAlbedoTable::get();
+    int backward = 0;
+    for (double ti : {20.0, 55.0})
+        for (double to : {15.0, 50.0, 75.0})
+            for (double po : {0.0, 60.0, 180.0}) {
+                const Vec3d wi = dir(ti, 0), wo = dir(to, po);
+                const TmLobes st = tm_lobes({top, medium, base}, wi.z, ch);
+                Rgbd want(exact_top.eval(wi, wo));
+                for (int l = 1; l < st.n_lobes; ++l) {
+                    const TmLobes::Lobe& lobe = st.lobes[l];
+                    const bool back = lobe.family == TmLobes::Backward;
+                    backward += back;
+                    const Vec3d w = back ? Vec3d(-wi.x, -wi.y, wi.z) : wi;
+                    const Vec3d h = normalize(w + wo);
+                    const GGX<double> ggx{lobe.alpha};
+                    const double shape = ggx.D(h) * ggx.G2(w, wo) / (4 * w.z * wo.z);
+                    want += lobe.energy * (shape / albedo(wi.z, lobe.alpha));
+                    EXPECT_NEAR(albedo(wi.z, lobe.alpha), GgxAlbedoTable::direct(wi.z, lobe.alpha),
+                                4e-3);
+                }
+                const Rgbd got = model->eval(wi, wo);
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_NEAR(got[c], want[c], 1e-12 * want[c]) << ti << " " << to << " " << po;
+            }
+    EXPECT_GT(backward, 0);
 }
 
 std::vector<std::string> split(const std::string& s) {
