@@ -42,6 +42,14 @@ Stack typical_stack(bool slab) {
     return s;
 }
 
+/// The typical coated gold with a scattering coat (τs 0.5, g 0.3): the six-flux path of tm6.
+Stack milky_stack() {
+    Stack s = typical_stack(false);
+    s.layers[0].medium.tau_s = Rgbd(0.5);
+    s.layers[0].medium.g = Rgbd(0.3);
+    return s;
+}
+
 struct Pairs {
     std::vector<Vec3d> wi, wo;
     Pairs() {
@@ -93,6 +101,39 @@ void BM_ModelPreparedEval(benchmark::State& state, const std::string& name) {
     state.SetItemsProcessed(state.iterations());
 }
 
+/// The same three measurements for a model on the milky coat (tm6's scattering media).
+void BM_MilkyEval(benchmark::State& state, const std::string& name) {
+    warm_tables();
+    const auto model = make_model(name, milky_stack());
+    static const Pairs pairs;
+    std::size_t n = 0;
+    for (auto _ : state) {
+        const std::size_t i = n++ & 4095;
+        benchmark::DoNotOptimize(model->eval(pairs.wi[i], pairs.wo[i]));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+
+void BM_MilkyPreparedEval(benchmark::State& state, const std::string& name) {
+    warm_tables();
+    const auto model = make_model(name, milky_stack());
+    static const Pairs pairs;
+    const auto ev = model->prepare(pairs.wi[0]);
+    std::size_t n = 0;
+    for (auto _ : state)
+        benchmark::DoNotOptimize(ev->eval(pairs.wo[n++ & 4095]));
+    state.SetItemsProcessed(state.iterations());
+}
+
+void BM_MilkyBinnedTable(benchmark::State& state, const std::string& name) {
+    warm_tables();
+    const auto model = make_model(name, milky_stack());
+    const HemisphereGrid grid(90, 90);
+    for (auto _ : state)
+        benchmark::DoNotOptimize(bin_model(*model, grid, {0, 15, 30, 45, 60, 70, 80}));
+    state.counters["threads"] = omp_get_max_threads();
+}
+
 /// One binned table: 7 incidences, 90x90 grid, both sides where supported.
 void BM_BinnedTable(benchmark::State& state, const std::string& name, bool slab) {
     warm_tables();
@@ -132,6 +173,18 @@ const int registered = [] {
         benchmark::RegisterBenchmark(
             ("BM_BinnedTable/" + e.name + (gold ? "/coated-gold" : "/slab-both-sides")).c_str(),
             BM_BinnedTable, e.name, false)
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+    }
+    for (const char* name : {"tm6", "bel-prime"}) {
+        benchmark::RegisterBenchmark(("BM_ModelEval/" + std::string(name) + "/milky-gold").c_str(),
+                                     BM_MilkyEval, std::string(name));
+        benchmark::RegisterBenchmark(
+            ("BM_ModelPreparedEval/" + std::string(name) + "/milky-gold").c_str(),
+            BM_MilkyPreparedEval, std::string(name));
+        benchmark::RegisterBenchmark(
+            ("BM_BinnedTable/" + std::string(name) + "/milky-gold").c_str(), BM_MilkyBinnedTable,
+            std::string(name))
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
     }

@@ -28,6 +28,9 @@ std::vector<OptionSpec> bel_prime_options();
 // tm2.cpp: the transfer-matrix model (Randrianandrasana, Callet & Lucas 2021)
 std::unique_ptr<Model> make_tm2(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> tm2_options();
+// tm6.cpp: the same with Henyey–Greenstein media (the released plugin tm6)
+std::unique_ptr<Model> make_tm6(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> tm6_options();
 // lamina1.cpp: lamina's own layered model (docs/models.md, "lamina-1")
 std::unique_ptr<Model> make_lamina1(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> lamina1_options();

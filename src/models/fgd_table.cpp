@@ -115,7 +115,55 @@ std::vector<float> compute_fgd() {
     return v;
 }
 
+std::vector<float> compute_ggx_albedo() {
+    using T = FgdTable;
+    std::vector<float> v(std::size_t(T::kNc) * T::kNalpha);
+#pragma omp parallel for schedule(dynamic) collapse(2)
+    for (int ic = 0; ic < T::kNc; ++ic)
+        for (int ia = 0; ia < T::kNalpha; ++ia) {
+            double sum = 0;
+            visible_normal_rule(c_node(ic), alpha_node(ia), kTableNr, kTableNphi,
+                                [&](double, double w) { sum += w; });
+            v[std::size_t(ic) * T::kNalpha + ia] = float(sum);
+        }
+    return v;
+}
+
 }  // namespace
+
+double GgxAlbedoTable::direct(double c, double alpha, int n_r, int n_phi) {
+    if (alpha <= 0) return 1.0;
+    double sum = 0;
+    visible_normal_rule(std::max(c, kCMin), alpha, n_r, n_phi, [&](double, double w) { sum += w; });
+    return sum;
+}
+
+GgxAlbedoTable::GgxAlbedoTable() {
+    using T = FgdTable;
+    const TableKey key{"ggx-albedo",
+                       fmt::format("ggx-albedo-v1 c{} a{} nr{} nphi{} cmin{} amin{}", T::kNc,
+                                   T::kNalpha, kTableNr, kTableNphi, kCMin, kAlphaMin),
+                       {T::kNc, T::kNalpha}};
+    values_ = cached_table(key, compute_ggx_albedo);
+}
+
+const GgxAlbedoTable& GgxAlbedoTable::get() {
+    static const GgxAlbedoTable table;
+    return table;
+}
+
+double GgxAlbedoTable::operator()(double c, double alpha) const {
+    if (alpha <= 0) return 1.0;
+    using T = FgdTable;
+    const double fc = std::sqrt(axis(c, 0.0, 1.0)) * (T::kNc - 1);
+    const double fa = std::sqrt(axis(alpha, 0.0, 1.0)) * (T::kNalpha - 1);
+    const int ic = std::min(int(fc), T::kNc - 2), ia = std::min(int(fa), T::kNalpha - 2);
+    const double tc = fc - ic, ta = fa - ia;
+    const float* row = values_.data() + std::size_t(ic) * T::kNalpha + ia;
+    const double v0 = (1 - ta) * row[0] + ta * row[1];
+    const double v1 = (1 - ta) * row[T::kNalpha] + ta * row[T::kNalpha + 1];
+    return clamp((1 - tc) * v0 + tc * v1, 0.0, 1.0);
+}
 
 double fresnel_complex_fast(double cos_theta, double eta, double k) {
     cos_theta = clamp(cos_theta, 0.0, 1.0);

@@ -58,6 +58,27 @@ class FgdTable {
     std::vector<float> values_;
 };
 
+/// E(c, α): the directional albedo of a GGX reflection lobe without its Fresnel factor (F = 1),
+///
+///     E = ∫ D_α(h) G2_α(wi, wo) / (4 μi μo) μo dωo,   μi = c,
+///
+/// the energy the lobe shape of belcour.h's ggx_lobe_shape reflects: what the released tm6 divides
+/// its lobes by so that each reflects exactly its energy (its "GD" table; lamina computes its own
+/// by FgdTable's visible-normal rule with F = 1, same c and α axes, cached on disk as FGD).
+/// E ≤ 1, E = 1 for α = 0; bilinear interpolation in (√c, √α).
+class GgxAlbedoTable {
+  public:
+    static const GgxAlbedoTable& get();
+    /// c ∈ [0, 1], α ∈ [0, 1] (clamped).
+    double operator()(double c, double alpha) const;
+    /// The same integral by an n_r × n_phi rule, no table: the reference of the tests.
+    static double direct(double c, double alpha, int n_r = 96, int n_phi = 128);
+
+  private:
+    GgxAlbedoTable();
+    std::vector<float> values_;
+};
+
 /// Unpolarized Fresnel reflectance for a complex relative index η + iκ with light arriving from
 /// the real (dielectric) side at cos_theta ∈ [0, 1]: the closed form in a², b² (Pharr, Jakob &
 /// Humphreys, PBR 3rd ed., §8.2.1, FrConductor; after Born & Wolf §14.2). With κ = 0 and η < 1 it
