@@ -194,8 +194,11 @@ class Lamina1 final : public Model {
         Incident in;
         in.wi = wi;
         if (!support_.brdf || wi.z <= 0) return in;
-        in.ok = true;
         in.wi_in = refract_in(wi, inv_eta0_);
+        // Light exactly at grazing into an index-matched coat stays on the horizon (cos θi' = 0
+        // by rounding): nothing enters, and the spread factor k = |1 − μ/(η μ')| would be 0/0.
+        if (!(in.wi_in.z > 0)) return in;
+        in.ok = true;
         in.T = T_top_(wi.z);
         in.T_pair = in.T;
         in.a = attenuation(in.wi_in.z);

@@ -8,6 +8,7 @@
 #include "physics/bsdf.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
+#include "physics/smith_masking.h"
 
 #include <cmath>
 #include <optional>
@@ -75,7 +76,7 @@ struct ConductorInterface {
                 s.shadowing = ggx.G1(s.wo);
             } else {
                 const T r_i = ggx.smith_root(wi), r_o = ggx.smith_root(s.wo);
-                s.shadowing = (T(1) + r_i) / (r_i + r_o);
+                s.shadowing = smith_reflection_escape(r_i, r_o);
             }
             if constexpr (kWithPdf) s.pdf = ggx.pdf_visible_normal(wi, wm) / (T(4) * dot(s.wo, wm));
         }
