@@ -15,6 +15,7 @@
 #include "physics/dielectric.h"
 #include "physics/microfacet.h"
 #include "test_stacks.h"
+#include "tm_by_hand.h"
 
 #include <gtest/gtest.h>
 
@@ -23,32 +24,14 @@
 namespace lamina {
 namespace {
 
+using test::alpha_of_g;
 using test::coated;
+using test::fresnel_by_hand;
+using test::g_of_alpha;
+using test::g_refracted;
 
 Vec3d dir(double theta_deg, double phi_deg) {
     return direction_from_angles(deg_to_rad(theta_deg), deg_to_rad(phi_deg));
-}
-
-/// Unpolarized Fresnel reflectance of a smooth dielectric, relative index eta, from the s and p
-/// amplitudes (Born & Wolf §1.5), written here independently of physics/fresnel.h.
-double fresnel_by_hand(double cos_i, double eta) {
-    const double sin2_t = (1 - cos_i * cos_i) / (eta * eta);
-    if (sin2_t >= 1) return 1;
-    const double cos_t = std::sqrt(1 - sin2_t);
-    const double rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    const double rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    return 0.5 * (rs * rs + rp * rp);
-}
-
-// The paper's GGX ↔ HG mapping, written here from the released code's formulas.
-double g_of_alpha(double a) {
-    return a <= 0 ? 1.0 : std::clamp(-0.085 + 1.085 / (1 + std::pow(a / 0.5, 1.3)), 0.0, 1.0);
-}
-double alpha_of_g(double g) {
-    return std::clamp(0.5 * std::pow(1.085 / (std::max(g, 0.2) + 0.085) - 1, 1 / 1.3), 1e-4, 1.0);
-}
-double g_refracted(double g, double eta) {
-    return std::min(std::sqrt(std::max(1 - (1 - g * g) * std::pow(eta, 0.75), 0.0)), 1.0);
 }
 
 TEST(TmMapping, RoundTripsAndLimits) {
