@@ -77,9 +77,9 @@ void warm_tables() {
 
 /// Model::eval(wi, wo) for random pairs (the forward Belcour variants redo their lobe statistics
 /// per call here).
-void BM_ModelEval(benchmark::State& state, const std::string& name) {
+void BM_ModelEval(benchmark::State& state, const std::string& name, const Stack& stack) {
     warm_tables();
-    const auto model = make_model(name, bench_stack(name));
+    const auto model = make_model(name, stack);
     static const Pairs pairs;
     std::size_t n = 0;
     for (auto _ : state) {
@@ -90,9 +90,9 @@ void BM_ModelEval(benchmark::State& state, const std::string& name) {
 }
 
 /// The prepared per-incidence evaluator (what the binned tables and the study use).
-void BM_ModelPreparedEval(benchmark::State& state, const std::string& name) {
+void BM_ModelPreparedEval(benchmark::State& state, const std::string& name, const Stack& stack) {
     warm_tables();
-    const auto model = make_model(name, bench_stack(name));
+    const auto model = make_model(name, stack);
     static const Pairs pairs;
     const auto ev = model->prepare(pairs.wi[0]);
     std::size_t n = 0;
@@ -101,43 +101,10 @@ void BM_ModelPreparedEval(benchmark::State& state, const std::string& name) {
     state.SetItemsProcessed(state.iterations());
 }
 
-/// The same three measurements for a model on the milky coat (tm6's scattering media).
-void BM_MilkyEval(benchmark::State& state, const std::string& name) {
+/// One binned table: 7 incidences, 90x90 grid, both sides where supported, on `stack`.
+void BM_StackBinnedTable(benchmark::State& state, const std::string& name, const Stack& stack) {
     warm_tables();
-    const auto model = make_model(name, milky_stack());
-    static const Pairs pairs;
-    std::size_t n = 0;
-    for (auto _ : state) {
-        const std::size_t i = n++ & 4095;
-        benchmark::DoNotOptimize(model->eval(pairs.wi[i], pairs.wo[i]));
-    }
-    state.SetItemsProcessed(state.iterations());
-}
-
-void BM_MilkyPreparedEval(benchmark::State& state, const std::string& name) {
-    warm_tables();
-    const auto model = make_model(name, milky_stack());
-    static const Pairs pairs;
-    const auto ev = model->prepare(pairs.wi[0]);
-    std::size_t n = 0;
-    for (auto _ : state)
-        benchmark::DoNotOptimize(ev->eval(pairs.wo[n++ & 4095]));
-    state.SetItemsProcessed(state.iterations());
-}
-
-void BM_MilkyBinnedTable(benchmark::State& state, const std::string& name) {
-    warm_tables();
-    const auto model = make_model(name, milky_stack());
-    const HemisphereGrid grid(90, 90);
-    for (auto _ : state)
-        benchmark::DoNotOptimize(bin_model(*model, grid, {0, 15, 30, 45, 60, 70, 80}));
-    state.counters["threads"] = omp_get_max_threads();
-}
-
-/// One binned table: 7 incidences, 90x90 grid, both sides where supported.
-void BM_BinnedTable(benchmark::State& state, const std::string& name, bool slab) {
-    warm_tables();
-    const auto model = make_model(name, slab ? typical_stack(true) : bench_stack(name));
+    const auto model = make_model(name, stack);
     const HemisphereGrid grid(90, 90);
     for (auto _ : state)
         benchmark::DoNotOptimize(bin_model(*model, grid, {0, 15, 30, 45, 60, 70, 80}));
@@ -166,32 +133,34 @@ BENCHMARK_CAPTURE(BM_Lamina1Construct, slab_multiple, true, true)->Unit(benchmar
 const int registered = [] {
     for (const auto& e : model_registry()) {
         if (e.stochastic) continue;  // binning 8100 noisy queries is not a model benchmark
-        benchmark::RegisterBenchmark(("BM_ModelEval/" + e.name).c_str(), BM_ModelEval, e.name);
+        benchmark::RegisterBenchmark(("BM_ModelEval/" + e.name).c_str(), BM_ModelEval, e.name,
+                                     bench_stack(e.name));
         benchmark::RegisterBenchmark(("BM_ModelPreparedEval/" + e.name).c_str(),
-                                     BM_ModelPreparedEval, e.name);
+                                     BM_ModelPreparedEval, e.name, bench_stack(e.name));
         const bool gold = make_model(e.name, typical_stack(false))->support().brdf;
         benchmark::RegisterBenchmark(
             ("BM_BinnedTable/" + e.name + (gold ? "/coated-gold" : "/slab-both-sides")).c_str(),
-            BM_BinnedTable, e.name, false)
+            BM_StackBinnedTable, e.name, bench_stack(e.name))
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
     }
+    // The same three measurements on the milky coat (tm6's scattering media).
     for (const char* name : {"tm6", "bel-prime"}) {
         benchmark::RegisterBenchmark(("BM_ModelEval/" + std::string(name) + "/milky-gold").c_str(),
-                                     BM_MilkyEval, std::string(name));
+                                     BM_ModelEval, std::string(name), milky_stack());
         benchmark::RegisterBenchmark(
             ("BM_ModelPreparedEval/" + std::string(name) + "/milky-gold").c_str(),
-            BM_MilkyPreparedEval, std::string(name));
+            BM_ModelPreparedEval, std::string(name), milky_stack());
         benchmark::RegisterBenchmark(
-            ("BM_BinnedTable/" + std::string(name) + "/milky-gold").c_str(), BM_MilkyBinnedTable,
-            std::string(name))
+            ("BM_BinnedTable/" + std::string(name) + "/milky-gold").c_str(), BM_StackBinnedTable,
+            std::string(name), milky_stack())
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
     }
     for (const char* name : {"bel-prime", "tm2"})
         benchmark::RegisterBenchmark(
-            ("BM_BinnedTable/" + std::string(name) + "/slab-both-sides").c_str(), BM_BinnedTable,
-            std::string(name), true)
+            ("BM_BinnedTable/" + std::string(name) + "/slab-both-sides").c_str(),
+            BM_StackBinnedTable, std::string(name), typical_stack(true))
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
     return 0;
