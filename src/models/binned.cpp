@@ -42,9 +42,11 @@ class RectIntegrator {
     /// of weight fraction a then adds at most a·τ to the error, so the sum stays within τ).
     Rgbd average(double t0, double t1, double p0, double p1) {
         evals_ = 0;
-        const Rgbd coarse = rule(t0, t1, p0, p1).second;
+        const std::pair<Rgbd, Rgbd> whole = rule(t0, t1, p0, p1);
+        const Rgbd coarse = whole.second;
         tol_ = o_.rel_tol * max_abs(coarse) + o_.abs_tol;
-        const Rgbd first = rect(t0, t1, p0, p1, 0, 0);
+        // The top level reuses the coarse rule's nodes: the same values, not evaluated twice.
+        const Rgbd first = rect(t0, t1, p0, p1, 0, 0, &whole);
         // A narrow lobe missed by the coarse nodes made τ far too strict: redo with the real size.
         if (max_abs(first) > 10 * max_abs(coarse)) {
             evals_ = 0;
@@ -109,8 +111,9 @@ class RectIntegrator {
         }
     }
 
-    Rgbd rect(double t0, double t1, double p0, double p1, int depth, int peak_depth) {
-        const auto [i2, i3] = rule(t0, t1, p0, p1);
+    Rgbd rect(double t0, double t1, double p0, double p1, int depth, int peak_depth,
+              const std::pair<Rgbd, Rgbd>* known = nullptr) {
+        const auto [i2, i3] = known ? *known : rule(t0, t1, p0, p1);
         bool split_t = false, split_phi = false;
         if (peak_depth < o_.peak_depth) peak_split(t0, t1, p0, p1, split_t, split_phi);
         const bool forced = split_t || split_phi;
