@@ -4,6 +4,7 @@
 #include "cli/options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/incidences.h"
 #include "core/npy.h"
 #include "core/packed_array.h"
 #include "export/brdf_source.h"
@@ -179,10 +180,10 @@ int run_export(const ExportArgs& a) {
             const Support s = model->support();
             if (!s.brdf && !s.btdf)
                 throw InputError(a.stack, "--model", "not supported: " + s.reason);
-            table =
-                bin_model(*model, HemisphereGrid::parse(a.grid),
-                          parse_incidences(a.theta_i.empty() ? "0,15,30,45,60,70,80" : a.theta_i,
-                                           "--theta-i"));
+            table = bin_model(
+                *model, HemisphereGrid::parse(a.grid),
+                parse_incidences(a.theta_i.empty() ? default_incidences_text() : a.theta_i,
+                                 "--theta-i"));
         }
         const std::size_t n_inc = table.theta_i_deg.size(),
                           n_sides = table.has_transmission ? 2 : 1;
@@ -259,7 +260,8 @@ Runner add_export(CLI::App& app) {
     cmd->add_option("--format", a->format, "bsdf, merl or npz (default: from --out's extension)");
     cmd->add_option("--theta-i", a->theta_i,
                     "Incidences (degrees): a model's .bsdf nodes (default 0..88 by 4) or .npz "
-                    "bins (default 0,15,30,45,60,70,80)");
+                    "bins (default " +
+                        default_incidences_text() + ")");
     cmd->add_option("--grid", a->grid, "Bins of a model's .npz, NTHETAxNPHI")
         ->capture_default_str();
     cmd->add_option("--resolution", a->resolution, ".bsdf: sample-grid nodes a side")

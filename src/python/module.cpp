@@ -10,6 +10,7 @@
 // whose integer sums add up exactly: simulator/goniophotometer.h).
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/incidences.h"
 #include "core/progress.h"
 #include "core/spherical.h"
 #include "core/table.h"
@@ -436,6 +437,7 @@ PYBIND11_MODULE(_lamina, m) {
         "what is allowed).",
         PyExc_ValueError, nullptr);
     m.attr("InputError") = py::handle(g_input_error);
+    m.attr("DEFAULT_THETA_I") = py::cast(default_incidences_deg());
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
@@ -747,8 +749,7 @@ PYBIND11_MODULE(_lamina, m) {
                 py::gil_scoped_release release;
                 return bin_model(*m.model, g, thetas);
             },
-            py::arg("theta_i") = std::vector<double>{0, 15, 30, 45, 60, 70, 80},
-            py::arg("grid") = std::make_pair(90, 90),
+            py::arg("theta_i") = default_incidences_deg(), py::arg("grid") = std::make_pair(90, 90),
             "Cos-weighted bin averages on the goniophotometer's bins (lamina eval --binned)")
         .def(
             "albedo",

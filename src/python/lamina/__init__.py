@@ -48,7 +48,8 @@ __all__ = [
     "study",
 ]
 
-DEFAULT_THETA_I = (0, 15, 30, 45, 60, 70, 80)
+# The incidences lamina uses when none are given (one owner: src/core/incidences.h).
+DEFAULT_THETA_I = tuple(_lamina.DEFAULT_THETA_I)
 
 
 def simulate(stack, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, threads=0, grid=(90, 90),
