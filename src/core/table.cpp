@@ -1,6 +1,7 @@
 #include "core/table.h"
 
 #include "core/error.h"
+#include "core/incidences.h"
 
 #include <fmt/format.h>
 
@@ -110,7 +111,7 @@ BinnedTable BinnedTable::from_csv(const std::string& text, const std::string& wh
               int(std::lround(phi_lo / 180.0 * n_phi)),
               Rgbd(num(6), num(7), num(8)),
               Rgbd(num(9), num(10), num(11))};
-        if (!(r.theta_i >= 0 && r.theta_i < 90))
+        if (!incidence_in_range(r.theta_i))
             throw InputError(where, fmt::format("line {}, column 1", line_no),
                              fmt::format("theta_i {} is outside [0, 90) degrees", r.theta_i));
         // The edges must be the grid's (to rounding): a bin of another layout is refused.

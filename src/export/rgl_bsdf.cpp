@@ -1,6 +1,7 @@
 #include "export/rgl_bsdf.h"
 
 #include "core/error.h"
+#include "core/incidences.h"
 #include "core/math.h"
 #include "core/spherical.h"
 #include "export/bilinear_warp.h"
@@ -73,7 +74,7 @@ TensorFile rgl_bsdf(const BrdfSource& brdf, const RglOptions& o) {
         for (int k = 0; k <= 22; ++k)
             thetas.push_back(4.0 * k);
     for (std::size_t k = 0; k < thetas.size(); ++k)
-        if (!(thetas[k] >= 0 && thetas[k] < 90) || (k > 0 && !(thetas[k] > thetas[k - 1])))
+        if (!incidence_in_range(thetas[k]) || (k > 0 && !(thetas[k] > thetas[k - 1])))
             throw InputError("command line", "--theta-i",
                              "incidences must increase strictly within [0, 90) degrees");
     const int nd = o.ndf_resolution, nv = o.vndf_resolution, ns = o.resolution;
