@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace lamina {
 
@@ -287,7 +288,74 @@ class Ddb22 final : public Model {
         return {mirror_direction(wi), Vec3d{0, 0, 1}};
     }
 
+    // Importance sampling: a two-lobe mixture. The direct lobe (rough coats only: a smooth coat's
+    // is a delta lobe, left out here as model.h says) by the visible normals of GGX α0 seen from
+    // wi (Heitz 2018, JCGT 7(4)), wo its mirror about them; the indirect lobe by the visible
+    // normals of GGX β seen from the lobe's own incidence (the normal, or wi with
+    // indirect-lobe=mirror). Each lobe is chosen with its share of the energy, the direct lobe's
+    // being the coat's FGD(μi, α0, η0). A draw leaving below the surface is a failed sample.
+    bool has_sampling() const override { return support_.brdf; }
+
+    std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override {
+        if (!support_.brdf || !(wi.z > 0)) return std::nullopt;
+        const Incident in = incident(wi);
+        const double p_dir = direct_probability(in);
+        Vec3d wo;
+        if (u.x < p_dir) {
+            const GGX<double> ggx{alpha0_};
+            wo = reflect(wi, ggx.sample_visible_normal(wi, u.y, u.z));
+        } else {
+            const Vec3d from = indirect_incidence(wi);
+            const GGX<double> ggx{sampled_beta()};
+            wo = reflect(from, ggx.sample_visible_normal(from, u.y, u.z));
+        }
+        if (!(wo.z > 0)) return std::nullopt;
+        const double density = pdf_with(in, p_dir, wo);
+        if (!(density > 0)) return std::nullopt;
+        return ModelSample{wo, eval_with(in, wo) * (wo.z / density), density};
+    }
+
+    double pdf(const Vec3d& wi, const Vec3d& wo) const override {
+        if (!support_.brdf || !(wi.z > 0) || !(wo.z > 0)) return 0.0;
+        const Incident in = incident(wi);
+        return pdf_with(in, direct_probability(in), wo);
+    }
+
   private:
+    /// The direct lobe's share of the energy (0 for a smooth coat).
+    double direct_probability(const Incident& in) const {
+        if (!(alpha0_ > 0)) return 0.0;
+        const double e_dir = FgdTable::get()(std::min(in.wi.z, 1.0), alpha0_, eta0_, 0.0);
+        const double sum = e_dir + in.e_ind.mean();
+        return sum > 0 ? e_dir / sum : 1.0;
+    }
+    Vec3d indirect_incidence(const Vec3d& wi) const {
+        return ch_.lobe_at_normal ? Vec3d{0, 0, 1} : wi;
+    }
+    /// β for the sampler (kept ≥ the smallest roughness a stack file may hold, 1e-4: the visible
+    /// normals of α = 0 are not a density).
+    double sampled_beta() const { return std::max(beta_, 1e-4); }
+
+    /// Density of the mixture at wo (solid angle): p D_w(h)/(4 |w·h|) per lobe, the reflection
+    /// Jacobian of Walter et al. 2007, Eq. 14.
+    double pdf_with(const Incident& in, double p_dir, const Vec3d& wo) const {
+        double density = 0;
+        if (p_dir > 0) {
+            const GGX<double> ggx{alpha0_};
+            const Vec3d h = normalize(in.wi + wo);
+            const double c = dot(in.wi, h);
+            if (c > 0) density += p_dir * ggx.D_visible(in.wi, h) / (4 * c);
+        }
+        if (p_dir < 1) {
+            const Vec3d from = indirect_incidence(in.wi);
+            const GGX<double> ggx{sampled_beta()};
+            const Vec3d h = normalize(from + wo);
+            const double c = dot(from, h);
+            if (c > 0) density += (1 - p_dir) * ggx.D_visible(from, h) / (4 * c);
+        }
+        return density;
+    }
+
     Ddb22Choices ch_;
     Ddb22Stack s_;
     Support support_;

@@ -11,11 +11,13 @@
 #include "core/spherical.h"
 #include "models/binned.h"
 #include "models/registry.h"
+#include "support/chi2.h"
 #include "test_stacks.h"
 #include "tm_by_hand.h"
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -374,7 +376,70 @@ TEST(Ddb22Support, RefusesWithAReason) {
     const auto ok = make_model("ddb22", coated(1.5, 0.1, test::lambertian(Rgbd(0.5))));
     EXPECT_TRUE(ok->support().brdf);
     EXPECT_FALSE(ok->support().btdf);
-    EXPECT_FALSE(ok->has_sampling());
+    EXPECT_TRUE(ok->has_sampling());
+    EXPECT_FALSE(make_model("ddb22", coated(1.5, 0.1, test::gold(0.2)))->has_sampling());
+}
+
+std::vector<std::pair<std::string, Stack>> sampled_stacks() {
+    return {
+        {"rough-plastic", coated(1.5, 0.2, test::lambertian(Rgbd(0.8)), Rgbd(0.1, 0.0, 0.9))},
+        {"glossy-white", coated(1.5, 0.05, test::lambertian(Rgbd(1.0)))},
+        {"smooth-coat", coated(2.0, 0.0, test::lambertian(Rgbd(0.5)))},
+        {"rough-low-index", coated(0.8, 0.5, test::lambertian(Rgbd(0.6)))},
+    };
+}
+
+// The sampler draws from its own pdf (chi-square, tests/support/chi2.h), for both lobe frames:
+// one test per stack, incidence and flag, Šidák-corrected over the suite.
+TEST(Ddb22SamplingStat, ChiSquare) {
+    const std::vector<double> incidences = {30.0, 75.0};
+    const std::vector<std::string> variants = {"ddb22", "ddb22:indirect-lobe=mirror"};
+    const auto stacks = sampled_stacks();
+    const int count = int(stacks.size() * incidences.size() * variants.size());
+    for (const auto& variant : variants)
+        for (const auto& [what, stack] : stacks) {
+            const auto model = make_model(variant, stack);
+            for (double ti : incidences) {
+                const Vec3d wi = dir(ti, 0);
+                test::Chi2Options o;
+                o.name = fmt::format("ddb22-{}-{}-{}", what, ti, variant.size());
+                o.sample_count = 200'000;
+                o.test_count = count;
+                const auto r = test::run_chi2(
+                    o,
+                    [&](const std::array<double, 3>& u) {
+                        const auto s = model->sample(wi, Vec3d(u[0], u[1], u[2]));
+                        if (!s) return test::Chi2Draw::none();
+                        return test::Chi2Draw::direction(s->wo);
+                    },
+                    [&](const Vec3d& wo) { return model->pdf(wi, wo); });
+                EXPECT_TRUE(r.passed) << variant << " " << what << " " << ti << ": " << r.message;
+            }
+        }
+}
+
+// The sample's weight is eval·cos θo/pdf, and pdf is what sample reports.
+TEST(Ddb22Sampling, WeightIsEvalOverPdf) {
+    ParticleRng rng(22, 0, 0);
+    for (const auto& [what, stack] : sampled_stacks()) {
+        const auto model = make_model("ddb22", stack);
+        const Vec3d wi = dir(40, 0);
+        int drawn = 0;
+        for (int n = 0; n < 200; ++n) {
+            const Vec3d u(rng.uniform_double(), rng.uniform_double(), rng.uniform_double());
+            const auto s = model->sample(wi, u);
+            if (!s) continue;
+            ++drawn;
+            EXPECT_NEAR(s->pdf, model->pdf(wi, s->wo), 1e-12 * s->pdf) << what;
+            const Rgbd want = model->eval(wi, s->wo) * (s->wo.z / s->pdf);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(s->weight[c], want[c], 1e-12 * want[c] + 1e-300) << what;
+        }
+        // A visible normal of the indirect lobe tilted past 45° from the normal sends wo below
+        // the surface (a failed draw): a fraction β²/(1 + β²) of its draws, ~0.35 for the
+        // white base's β ≈ 0.75 (measured: 142 of 200 mixture draws succeed).
+        EXPECT_GT(drawn, 120) << what;
+    }
 }
 
 }  // namespace
