@@ -436,8 +436,8 @@ TEST(Ddb22Sampling, WeightIsEvalOverPdf) {
                 EXPECT_NEAR(s->weight[c], want[c], 1e-12 * want[c] + 1e-300) << what;
         }
         // A visible normal of the indirect lobe tilted past 45° from the normal sends wo below
-        // the surface (a failed draw): a fraction β²/(1 + β²) of its draws, ~0.35 for the
-        // white base's β ≈ 0.75 (measured: 142 of 200 mixture draws succeed).
+        // the surface (a failed draw): a fraction β²/(1 + β²) of its draws, 0.27 for the
+        // β ≈ 0.6 of these coats (measured: 142 of 200 mixture draws succeed).
         EXPECT_GT(drawn, 120) << what;
     }
 }
