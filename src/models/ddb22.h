@@ -20,11 +20,17 @@
 // inside reflectance (the FGD table at 1/η0, with total internal reflection), a = exp(−τ_a/μ')
 // along the macro refraction. β is the roughness whose unit lobe has the projected variance of
 // the exiting light's directions (GgxNormalLobeTable), A(β) that lobe's albedo, so the indirect
-// lobe reflects exactly E_ind. Each choice is a flag (Ddb22Choices).
+// lobe reflects exactly E_ind. Each choice is a flag (Ddb22Choices). Several coats over the
+// Lambertian (lamina's reading of the paper's Lambertian interface in Belcour 2018's adding): the
+// direct lobes are Bel''s, and T01, T10, R10 become the coats' energies from Bel18's adding, down
+// from the top and up from the base (Ddb22Stack).
 
+#include "models/belcour.h"
 #include "models/model.h"
 
 #include <array>
+#include <string>
+#include <vector>
 
 namespace lamina {
 
@@ -76,17 +82,29 @@ Ddb22Choices ddb22_choices(const ModelOptions& options);
 
 /// What the model computes once per stack (exposed for the tests): the per-channel series factor
 /// K = ρ T̄/(1 − ρ r̄), the hemispherical integrals T̄ and r̄, the projected variance of the
-/// exiting light V_exit and the indirect lobe's roughness β.
+/// exiting light V_exit and the indirect lobe's roughness β; the top interface and the base.
 struct Ddb22Stack {
     Rgbd K{0.0}, T_bar{0.0}, r_bar{0.0};
     double v_exit = 0, beta = 0;
-    CoatedStack coat;
+    double eta0 = 1.5, alpha0 = 0;  ///< the top coat: relative index to the ambient, roughness
+    Rgbd tau_base{0.0};             ///< absorption of the medium right above the Lambertian
+    Rgbd albedo{0.0};               ///< the Lambertian's ρ
+    /// Two or more coats (lamina's reading of the paper's Lambertian interface in Bel18's adding,
+    /// docs/models.md): the coats as operators of Belcour's adding scheme, top down without the
+    /// medium above the base (`down`), and the same seen from the base, bottom up (`up`). Empty for
+    /// one coat, whose energies come from the coat tables directly.
+    std::vector<BelcourOperator> down, up;
+    bool layered() const { return !down.empty(); }
 };
 
-/// Fills `out` for a stack ddb22 supports, or explains (in `why`) why it does not: the coated shape
-/// (model.h, coated_stack) with a Lambertian base, no scattering medium, η0 within the coat tables'
-/// [0.25, 4].
+/// Fills `out` for a stack ddb22 supports, or explains (in `why`) why it does not: one or more
+/// dielectric coats (each relative index within the coat tables' [0.25, 4], at most 8) with
+/// absorbing media over a Lambertian base.
 bool ddb22_stack(const Stack& stack, const Ddb22Choices& choices, Ddb22Stack& out,
                  std::string& why);
+
+/// The light of incidence μ ∈ (0, 1] that reaches the base (RGB, after the medium above it): the
+/// coat's T01(μ) a(μ') for one coat, Bel18's transmitted energy of the coats for several.
+Rgbd ddb22_transmittance_down(const Ddb22Stack& s, double mu);
 
 }  // namespace lamina

@@ -95,8 +95,8 @@ const std::vector<ModelEntry>& model_registry() {
         {"ddb22",
          "de Dinechin & Belcour 2022 as lamina reads it: exact coat reflection + one GGX lobe with "
          "the energy and projected variance of the light the Lambertian returns",
-         "bases: lambertian; media: absorbing; sides: R", ddb22_options, make_ddb22, false,
-         "successors"},
+         "bases: lambertian (under 1-8 coats); media: absorbing; sides: R", ddb22_options,
+         make_ddb22, false, "successors"},
     };
     return entries;
 }
