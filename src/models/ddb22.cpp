@@ -127,10 +127,6 @@ double critical_cosine(double eta) {
     return eta < 1 ? std::sqrt(1 - eta * eta) : 0.0;
 }
 
-}  // namespace
-
-namespace {
-
 /// Belcour's adding as Bel18 forward runs it (models/belcour.h): μ-dependent statistics, TIR
 /// below the top interface, the author's transmission variances, the power mapping.
 const BelcourChoices kAdding{};
