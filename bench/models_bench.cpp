@@ -50,6 +50,29 @@ Stack milky_stack() {
     return s;
 }
 
+/// The typical coat over a Lambertian (albedo 0.8): the plastic of the WW family, lamina-1 and
+/// ddb22.
+Stack plastic_stack() {
+    Stack s = typical_stack(false);
+    s.layers[1].interface = InterfaceSpec{};
+    s.layers[1].interface.type = InterfaceType::Lambertian;
+    s.layers[1].interface.albedo = Rgbd(0.8);
+    return s;
+}
+
+/// A rough clear coat (η 1.4, α 0.3) over the plastic's coat raised to η 1.6: ddb22's layered
+/// path (Bel18's adding for the coats).
+Stack layered_plastic_stack() {
+    Stack s = plastic_stack();
+    s.layers[0].interface.eta = 1.6;
+    Layer top;
+    top.interface.type = InterfaceType::Dielectric;
+    top.interface.eta = 1.4;
+    top.interface.alpha = 0.3;
+    s.layers.insert(s.layers.begin(), top);
+    return s;
+}
+
 struct Pairs {
     std::vector<Vec3d> wi, wo;
     Pairs() {
@@ -62,11 +85,19 @@ struct Pairs {
     }
 };
 
-/// The typical coated gold, or the slab for a model that only represents slabs (none now; kept for
-/// models that only represent slabs).
+/// The typical coated gold, else the slab for a model that only represents slabs (none now), else
+/// the plastic for a model with a Lambertian base only (ddb22).
 Stack bench_stack(const std::string& name) {
     const Stack coated_gold = typical_stack(false);
-    return make_model(name, coated_gold)->support().brdf ? coated_gold : typical_stack(true);
+    if (make_model(name, coated_gold)->support().brdf) return coated_gold;
+    const Stack slab = typical_stack(true);
+    return make_model(name, slab)->support().brdf ? slab : plastic_stack();
+}
+
+/// The name of the stack bench_stack gives a model.
+std::string bench_stack_name(const std::string& name) {
+    if (make_model(name, typical_stack(false))->support().brdf) return "coated-gold";
+    return make_model(name, typical_stack(true))->support().brdf ? "slab-both-sides" : "plastic";
 }
 
 void warm_tables() {
@@ -130,6 +161,17 @@ BENCHMARK_CAPTURE(BM_Lamina1Construct, coated_gold_multiple, false, true)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Lamina1Construct, slab_multiple, true, true)->Unit(benchmark::kMicrosecond);
 
+/// ddb22's per-material precomputation (the hemispherical integrals over the coat tables and the
+/// exiting light's variance; the process-wide tables already loaded): the whole constructor.
+void BM_Ddb22Construct(benchmark::State& state) {
+    warm_tables();
+    const Stack stack = plastic_stack();
+    for (auto _ : state)
+        benchmark::DoNotOptimize(make_model("ddb22", stack));
+    state.SetLabel("rough absorbing coat over a Lambertian");
+}
+BENCHMARK(BM_Ddb22Construct)->Unit(benchmark::kMicrosecond);
+
 const int registered = [] {
     for (const auto& e : model_registry()) {
         if (e.stochastic) continue;  // binning 8100 noisy queries is not a model benchmark
@@ -137,9 +179,8 @@ const int registered = [] {
                                      bench_stack(e.name));
         benchmark::RegisterBenchmark(("BM_ModelPreparedEval/" + e.name).c_str(),
                                      BM_ModelPreparedEval, e.name, bench_stack(e.name));
-        const bool gold = make_model(e.name, typical_stack(false))->support().brdf;
         benchmark::RegisterBenchmark(
-            ("BM_BinnedTable/" + e.name + (gold ? "/coated-gold" : "/slab-both-sides")).c_str(),
+            ("BM_BinnedTable/" + e.name + "/" + bench_stack_name(e.name)).c_str(),
             BM_StackBinnedTable, e.name, bench_stack(e.name))
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
@@ -154,6 +195,27 @@ const int registered = [] {
         benchmark::RegisterBenchmark(
             ("BM_BinnedTable/" + std::string(name) + "/milky-gold").c_str(), BM_StackBinnedTable,
             std::string(name), milky_stack())
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+    }
+    // ddb22 with two coats (the only model here that represents them over a Lambertian).
+    benchmark::RegisterBenchmark("BM_ModelEval/ddb22/layered-plastic", BM_ModelEval,
+                                 std::string("ddb22"), layered_plastic_stack());
+    benchmark::RegisterBenchmark("BM_ModelPreparedEval/ddb22/layered-plastic", BM_ModelPreparedEval,
+                                 std::string("ddb22"), layered_plastic_stack());
+    benchmark::RegisterBenchmark("BM_BinnedTable/ddb22/layered-plastic", BM_StackBinnedTable,
+                                 std::string("ddb22"), layered_plastic_stack())
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    // The plastic, side by side: ddb22 against the models that also represent it.
+    for (const char* name : {"ww-prime", "lamina-1"}) {
+        benchmark::RegisterBenchmark(("BM_ModelEval/" + std::string(name) + "/plastic").c_str(),
+                                     BM_ModelEval, std::string(name), plastic_stack());
+        benchmark::RegisterBenchmark(
+            ("BM_ModelPreparedEval/" + std::string(name) + "/plastic").c_str(),
+            BM_ModelPreparedEval, std::string(name), plastic_stack());
+        benchmark::RegisterBenchmark(("BM_BinnedTable/" + std::string(name) + "/plastic").c_str(),
+                                     BM_StackBinnedTable, std::string(name), plastic_stack())
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
     }

@@ -12,34 +12,35 @@
 
 namespace lamina {
 
+// Roughness ↔ variance (Belcour 2018, §5.1 and the author's code): σ(α) = α^1.1 / (1 − α^1.1),
+// α(σ) = (σ / (1 + σ))^(1/1.1); α clamped below 1 (σ(1) is infinite). The quadratic alternative
+// σ = α²/(1 − α²) is lamina's ablation (the exponent of a slope variance).
+double belcour_variance_of_alpha(double alpha, bool quadratic) {
+    const double a = std::min(alpha, kBelcourAlphaMax);
+    if (a <= 0) return 0;
+    const double p = quadratic ? a * a : std::pow(a, 1.1);
+    return p / (1 - p);
+}
+double belcour_alpha_of_variance(double sigma, bool quadratic) {
+    if (!(sigma > 0)) return 0;
+    const double s = 1 / (1 + 1 / sigma);  // σ/(1 + σ), also for σ = ∞ (→ 1)
+    return quadratic ? std::sqrt(s) : std::pow(s, 1 / 1.1);
+}
+
 namespace {
 
 const char* on_off(bool b) {
     return b ? "on" : "off";
 }
 
-// Roughness ↔ variance (Belcour 2018, §5.1 and the author's code): σ(α) = α^1.1 / (1 − α^1.1),
-// α(σ) = (σ / (1 + σ))^(1/1.1); α clamped below 1 (σ(1) is infinite). The quadratic alternative
-// σ = α²/(1 − α²) is lamina's ablation (the exponent of a slope variance).
-constexpr double kAlphaMax = 0.999;
-double variance_of(double alpha, bool quadratic) {
-    const double a = std::min(alpha, kAlphaMax);
-    if (a <= 0) return 0;
-    const double p = quadratic ? a * a : std::pow(a, 1.1);
-    return p / (1 - p);
-}
-double alpha_of(double sigma, bool quadratic) {
-    if (!(sigma > 0)) return 0;
-    const double s = 1 / (1 + 1 / sigma);  // σ/(1 + σ), also for σ = ∞ (→ 1)
-    return quadratic ? std::sqrt(s) : std::pow(s, 1 / 1.1);
-}
 // Henyey–Greenstein lobe variance (Belcour 2018, §5.3 and code): σ_HG(g) = ((1 − g)/g)^0.8 / (1 +
 // g).
 // Infinite as g → 0⁺ (a subnormal g gives ∞): capped at the variance of the roughest lobe,
-// σ(kAlphaMax), which α(σ) maps to the same clamped roughness; an infinite variance would reach
-// the adding sums as ∞ · 0.
+// σ(kBelcourAlphaMax), which α(σ) maps to the same clamped roughness; an infinite variance would
+// reach the adding sums as ∞ · 0.
 double variance_hg(double g) {
-    return std::min(std::pow((1 - g) / g, 0.8) / (1 + g), variance_of(kAlphaMax, false));
+    return std::min(std::pow((1 - g) / g, 0.8) / (1 + g),
+                    belcour_variance_of_alpha(kBelcourAlphaMax, false));
 }
 
 double mean(const Rgbd& x) {
@@ -67,10 +68,11 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         const bool is_interface = op.kind != BelcourOperator::Medium;
         if (is_interface) {
             const bool pre = op.precomputed && op.precomputed_quadratic == q;
-            sR12 = pre ? op.sigma_r : variance_of(op.alpha, q);
+            sR12 = pre ? op.sigma_r : belcour_variance_of_alpha(op.alpha, q);
             // Roughness the lobe sees: what was accumulated above plus this interface's own
             // (nothing above: α itself, α(σ(α)) = α).
-            alpha_eff = pre && sT0i == 0 ? op.alpha_clamped : alpha_of(sT0i + sR12, q);
+            alpha_eff =
+                pre && sT0i == 0 ? op.alpha_clamped : belcour_alpha_of_variance(sT0i + sR12, q);
             if (op.kind == BelcourOperator::Dielectric) {
                 // Snell's law on the mean direction; TIR: no transmission.
                 const double sin2_t = (1 - c * c) / sqr(op.n12);
@@ -84,14 +86,18 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
                     if (ch.sigma_t_paper) {
                         // Belcour 2018, Eq. 10 as lamina reads it: the first-order deflection of
                         // a refracted ray by a microfacet tilt, |1 − η_i cos θi / (η_t cos θt)|/2.
-                        sT12 = variance_of(op.alpha * 0.5 * std::abs(1 - c / (op.n12 * ct)), q);
-                        sT21 = variance_of(op.alpha * 0.5 * std::abs(1 - op.n12 * ct / c), q);
+                        sT12 = belcour_variance_of_alpha(
+                            op.alpha * 0.5 * std::abs(1 - c / (op.n12 * ct)), q);
+                        sT21 = belcour_variance_of_alpha(
+                            op.alpha * 0.5 * std::abs(1 - op.n12 * ct / c), q);
                     } else {
                         // The author's code (docs/models.md): angle-independent scalings.
                         sT12 = pre ? op.sigma_t12
-                                   : variance_of(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
+                                   : belcour_variance_of_alpha(
+                                         op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
                         sT21 = pre ? op.sigma_t21
-                                   : variance_of(op.alpha * 0.5 * std::abs(1 - op.n12), q);
+                                   : belcour_variance_of_alpha(
+                                         op.alpha * 0.5 * std::abs(1 - op.n12), q);
                     }
                 }
             } else {
@@ -127,7 +133,8 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
             const double sigma_k = sTi0 + J0i * (sT0i + sR12 + rr * (sR12 + sRi0));
             const bool only_own = op.precomputed && op.precomputed_quadratic == q &&
                                   sigma_k == sR12;  // nothing accumulated: α itself
-            out.lobes[out.n_lobes++] = {E, only_own ? op.alpha_clamped : alpha_of(sigma_k, q)};
+            out.lobes[out.n_lobes++] = {
+                E, only_own ? op.alpha_clamped : belcour_alpha_of_variance(sigma_k, q)};
             const double w_old = mean(R0i), w_new = mean(E);
             if (w_old + w_new > 0) sR0i = (w_old * sR0i + w_new * sigma_k) / (w_old + w_new);
         }
@@ -170,7 +177,7 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
     if (last_was_dielectric && last_transmits) {
         out.transmits = true;
         out.transmitted = T0i;
-        out.alpha_t = alpha_of(sT0i, q);
+        out.alpha_t = belcour_alpha_of_variance(sT0i, q);
         out.cos_t = c;
     }
     return out;
@@ -180,10 +187,10 @@ void precompute_variances(std::vector<BelcourOperator>& ops, bool q) {
     for (BelcourOperator& op : ops) {
         op.precomputed = true;
         op.precomputed_quadratic = q;
-        op.alpha_clamped = alpha_of(variance_of(op.alpha, q), q);
-        op.sigma_r = variance_of(op.alpha, q);
-        op.sigma_t12 = variance_of(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
-        op.sigma_t21 = variance_of(op.alpha * 0.5 * std::abs(1 - op.n12), q);
+        op.alpha_clamped = belcour_alpha_of_variance(belcour_variance_of_alpha(op.alpha, q), q);
+        op.sigma_r = belcour_variance_of_alpha(op.alpha, q);
+        op.sigma_t12 = belcour_variance_of_alpha(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
+        op.sigma_t21 = belcour_variance_of_alpha(op.alpha * 0.5 * std::abs(1 - op.n12), q);
         for (int i = 0; i < 3; ++i)
             op.fgd_index[i] = op.kind == BelcourOperator::Conductor
                                   ? FgdTable::locate(op.eta[i], op.k[i])

@@ -77,6 +77,13 @@ std::vector<OptionSpec> belcour_option_specs(const BelcourChoices& defaults);
 /// Choices named by validated options (the variant-fixed ones, exact_top and btdf, from `base`).
 BelcourChoices belcour_choices(const ModelOptions& options, BelcourChoices base);
 
+/// Belcour 2018's roughness ↔ variance mapping (§5.1 and the author's code): σ(α) = α^1.1/(1 −
+/// α^1.1) with α clamped at kBelcourAlphaMax (σ(1) is infinite), and its inverse α(σ) = (σ/(1 +
+/// σ))^(1/1.1) (0 for σ ≤ 0 or NaN, → 1 as σ → ∞). quadratic: lamina's ablation σ = α²/(1 − α²).
+inline constexpr double kBelcourAlphaMax = 0.999;
+double belcour_variance_of_alpha(double alpha, bool quadratic);
+double belcour_alpha_of_variance(double sigma, bool quadratic);
+
 /// GGX reflection lobe shape D G2 / (4 μi μo) with the energy factored out (Belcour 2018, Eq. 1;
 /// the lobe of every statistical model): wi, wo above the surface, h = normalize(wi + wo); 0 for
 /// α ≤ 0 (a smooth lobe is a delta lobe).

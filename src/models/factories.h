@@ -31,6 +31,9 @@ std::vector<OptionSpec> tm2_options();
 // tm6.cpp: the same with Henyey–Greenstein media (the released plugin tm6)
 std::unique_ptr<Model> make_tm6(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> tm6_options();
+// ddb22.cpp: lamina's reading of de Dinechin & Belcour 2022 (a rough coat over a Lambertian)
+std::unique_ptr<Model> make_ddb22(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> ddb22_options();
 // lamina1.cpp: lamina's own layered model (docs/models.md, "lamina-1")
 std::unique_ptr<Model> make_lamina1(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> lamina1_options();

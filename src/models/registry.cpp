@@ -85,13 +85,18 @@ const std::vector<ModelEntry>& model_registry() {
          "Kulla & Conty 2017 layering: base x (1 - E(mu_i))(1 - E(mu_o))/(1 - E_avg), reciprocal",
          "bases: lambertian, conductor; media: absorbing; sides: R", kulla_conty_options,
          make_kulla_conty, false, "production"},
-        // Last: the registry-wide fuzz draws each model's options in this order, so a model added
-        // at the end leaves the draws of the others as they were.
+        // Last (tm6, then ddb22): the registry-wide fuzz draws each model's options in this order,
+        // so a model added at the end leaves the draws of the others as they were.
         {"tm6",
          "Randrianandrasana et al. 2021 transfer matrices with HG media (plugin tm6): primary, "
          "forward- and back-scattered lobes, exact top, lobes normalized by their GGX albedo",
          "bases: conductor; media: absorbing, scattering (HG); sides: R", tm6_options, make_tm6,
          false, "successors"},
+        {"ddb22",
+         "de Dinechin & Belcour 2022 as lamina reads it: exact coat reflection + one GGX lobe with "
+         "the energy and projected variance of the light the Lambertian returns",
+         "bases: lambertian (under 1-8 coats); media: absorbing; sides: R", ddb22_options,
+         make_ddb22, false, "successors"},
     };
     return entries;
 }
