@@ -213,7 +213,7 @@ class Lamina1 final : public Model {
         if (top_ms_) in.dR = dR_top_(wi.z);
         if (lobe_norm_on_) in.lobe_norm = lobe_norm_(in.wi_in.z);
         if (scatters_) {
-            if (base_paths_) in.E_b = E_b_curve_(in.wi_in.z);
+            if (base_paths_) in.E_b = mirror_albedo(in.wi_in.z);
             if (orders_on_) {
                 in.orders = orders_(wi.z) * orders_norm_;
                 if (support_.btdf) in.orders_t = orders_t_(wi.z) * orders_t_norm_;
@@ -317,7 +317,7 @@ class Lamina1 final : public Model {
         const double cos_back = -dxy - zz, cos_mirror = -dxy + zz;
         Rgbd f(0.0);
         double p_back = 0, p_mirror = 0;
-        const Rgbd E_o = base_paths_ ? E_b_curve_(mu_o) : Rgbd(0.0);
+        const Rgbd E_o = base_paths_ ? mirror_albedo(mu_o) : Rgbd(0.0);
         for (int c = 0; c < 3; ++c) {
             if (c == 0 || !g_uniform_) {
                 if (back_on_) p_back = hg_phase(cos_back, coat_.g[c]);
@@ -527,6 +527,12 @@ class Lamina1 final : public Model {
         return coat_.albedo;
     }
 
+    /// The albedo of the mirror that stands for a conductor or dielectric base in the scattered
+    /// light's paths: its Fresnel reflectance when smooth (exact), else its directional albedo.
+    Rgbd mirror_albedo(double mu) const {
+        return alpha1_ == 0 ? base_fresnel(mu) : base_albedo(mu);
+    }
+
     /// The base's directional albedo seen from inside the coat, at inside cosine μ.
     Rgbd base_albedo(double mu) const {
         const Rgbd ms = base_ms_ ? F_ms_ * dE_base_(mu) : Rgbd(0.0);
@@ -591,8 +597,6 @@ class Lamina1 final : public Model {
     Rgbd tau_t_{0.0}, omega_{0.0};
     bool scatters_ = false, g_uniform_ = true, single_on_ = false, base_paths_ = false;
     bool orders_on_ = false, back_on_ = false;
-    /// The base's albedo over inside cosines (the once-scattered mirror paths).
-    CosineCurve<Rgbd, kNx> E_b_curve_;
     /// E_ms(μ), E_ms,T(μ): the energy of the scattered remainder leaving through the top and the
     /// bottom per unit flux arriving at μ; their lobes' normalizations 1/(π Ē_ms), 1/(π T̄_b).
     CosineCurve<Rgbd, kNx> orders_, orders_t_;
@@ -883,7 +887,6 @@ void Lamina1::precompute_scattering() {
     base_paths_ = ch_.medium_base_paths && !lambertian;
     back_on_ = ch_.medium_single;
     orders_on_ = ch_.medium_orders;
-    if (base_paths_) E_b_curve_.fill([&](double mu) { return base_albedo(std::max(mu, 1e-6)); });
 
     // The energies, by the azimuth-averaged adding of coat bottom, medium and base on 6 + 6
     // inside cosines (split at the critical cosine, where the coat's bottom steps): a unit flux
@@ -911,7 +914,7 @@ void Lamina1::precompute_scattering() {
         }
         returned[j] = R;
         if (support_.btdf) bottom[j] = T_bot_in_(mu);
-        E_nodes[j] = lambertian ? coat_.albedo : base_albedo(mu);
+        E_nodes[j] = lambertian ? coat_.albedo : mirror_albedo(mu);
         a_nodes[j] = attenuation(mu);
     }
     const FluxMatrix I = FluxMatrix::identity(n), r = FluxMatrix::diagonal(returned);

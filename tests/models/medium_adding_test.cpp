@@ -80,8 +80,7 @@ TEST(MediumAdding, AttenuationSlope) {
                 const double mu2 = mu1 + d;
                 const double a1 = std::exp(-tau / mu1), a2 = std::exp(-tau / mu2);
                 const double expect = d > 1e-6 ? (a1 - a2) / (mu1 - mu2)
-                                               : tau * std::exp(-tau / (mu1 + d / 2)) /
-                                                     (mu1 * mu2);
+                                               : tau * std::exp(-tau / (mu1 + d / 2)) / (mu1 * mu2);
                 EXPECT_NEAR(attenuation_slope(mu1, mu2, a1, a2, tau), expect,
                             1e-9 * std::abs(expect) + 1e-300)
                     << tau << " " << mu1 << " " << d;
