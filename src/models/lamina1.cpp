@@ -398,6 +398,24 @@ class Lamina1 final : public Model {
     Mixture mixture(const Incident& in) const;
     double pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) const;
 
+    /// The slab medium's once-scattered light leaving through the bottom, exact for the slab:
+    /// scattered at depth t from the entering direction −wi' into the leaving one (v' turned
+    /// down), ϖ p(Θ) (a(μv') − a(μi'))/(μv' − μi') per unit flux inside (the depth integral of
+    /// the two Beer–Lambert factors), entering with T(μi), leaving as broad light with the
+    /// bottom's T_b(μv)/η_s².
+    [[gnu::noinline]] Rgbd single_transmission(const Incident& in, const Vec3d& v_in,
+                                               const Rgbd& a_v, double T_b) const {
+        const Vec3d& wi_in = in.wi_in;
+        const double cos_forward = -(wi_in.x * v_in.x + wi_in.y * v_in.y) + wi_in.z * v_in.z;
+        Rgbd f(0.0);
+        double p = 0;
+        for (int c = 0; c < 3; ++c) {
+            if (c == 0 || !g_uniform_) p = hg_phase(cos_forward, coat_.g[c]);
+            f[c] = omega_[c] * p * attenuation_slope(v_in.z, wi_in.z, a_v[c], in.a[c], tau_t_[c]);
+        }
+        return f * (in.T * T_b / (eta_s_ * eta_s_));
+    }
+
     /// The BTDF of a slab: the mirrored transmission lobe through both interfaces, and the
     /// diffuse light of the inter-reflections leaving through the bottom.
     Rgbd eval_btdf(const Incident& in, const Vec3d& wo) const {
@@ -430,6 +448,7 @@ class Lamina1 final : public Model {
             f += in.X * inv_one_minus_Er_ * (T_b * kInvPi<double> / (eta_s_ * eta_s_));
         // The scattered light that leaves through the bottom, as uniform radiance below it.
         if (orders_on_) f += in.orders_t * T_b;
+        if (scatters_ && back_on_) f += single_transmission(in, *v_in, a_v, T_b);
         return f;
     }
 
@@ -603,7 +622,7 @@ class Lamina1 final : public Model {
     Rgbd orders_norm_{0.0};
     double orders_t_norm_ = 0;
     /// The explicit single scattering's energy at μ (the sampler's mixture weight).
-    CosineCurve<Rgbd, kNx> single_energy_;
+    CosineCurve<Rgbd, kNx> single_energy_, single_energy_t_;
 
     friend class SplitIncidentEvaluator<Lamina1>;
 };
@@ -901,7 +920,7 @@ void Lamina1::precompute_scattering() {
     const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
     const CosineNodes nodes = split_cosine_nodes(6, mu_crit);
     const int n = nodes.size();
-    std::vector<double> exit(n, 0.0), returned(n, 0.0), bottom(n, 0.0);
+    std::vector<double> exit(n, 0.0), returned(n, 0.0), bottom(n, 0.0), bottom_single(n, 0.0);
     std::vector<Rgbd> E_nodes(n), a_nodes(n);
     for (int j = 0; j < n; ++j) {
         const double mu = nodes.mu[j];
@@ -913,12 +932,17 @@ void Lamina1::precompute_scattering() {
             R = alpha0_ > 0 ? std::max(0.0, R + T_top_in_(mu) - exit[j]) : R;
         }
         returned[j] = R;
-        if (support_.btdf) bottom[j] = T_bot_in_(mu);
+        if (support_.btdf) {
+            bottom[j] = T_bot_in_(mu);
+            // The once-scattered light's exit: T_b at the cosine it leaves with below.
+            const double s2 = sqr(eta_s_) * (1 - mu * mu);
+            bottom_single[j] = s2 < 1 ? T_bot_(std::sqrt(1 - s2)) : 0.0;
+        }
         E_nodes[j] = lambertian ? coat_.albedo : mirror_albedo(mu);
         a_nodes[j] = attenuation(mu);
     }
     const FluxMatrix I = FluxMatrix::identity(n), r = FluxMatrix::diagonal(returned);
-    std::array<std::vector<double>, 3> top_left{}, bottom_left{}, single_left{};
+    std::array<std::vector<double>, 3> top_left{}, bottom_left{}, single_left{}, single_bottom{};
     for (int c = 0; c < 3; ++c) {
         // Channels with the same medium and base share the computation.
         int same = -1;
@@ -933,6 +957,7 @@ void Lamina1::precompute_scattering() {
             top_left[c] = top_left[same];
             bottom_left[c] = bottom_left[same];
             single_left[c] = single_left[same];
+            single_bottom[c] = single_bottom[same];
             continue;
         }
         const AzimuthalPhase phase = azimuthal_hg(nodes, coat_.g[c]);
@@ -967,9 +992,23 @@ void Lamina1::precompute_scattering() {
         if (support_.btdf) {
             const std::vector<double> bot = row_times(bottom, G * M),
                                       bot0 = row_times(bottom, D * M0);
+            // The explicit once-scattered transmission (single_transmission), first exit.
+            std::vector<double> bot1(n, 0.0);
+            if (ch_.medium_single) {
+                FluxMatrix ST(n);
+                for (int j = 0; j < n; ++j)
+                    for (int k = 0; k < n; ++k)
+                        ST(j, k) =
+                            2 * kPi<double> * nodes.w[j] * nodes.mu[j] * omega_[c] *
+                            phase.same(j, k) *
+                            attenuation_slope(nodes.mu[j], nodes.mu[k], a[j], a[k], tau_t_[c]);
+                bot1 = row_times(bottom_single, ST);
+            }
             bottom_left[c].resize(n);
-            for (int k = 0; k < n; ++k)
-                bottom_left[c][k] = std::max(0.0, bot[k] - bot0[k]);
+            for (int k = 0; k < n; ++k) {
+                bottom_left[c][k] = std::max(0.0, bot[k] - bot0[k] - bot1[k]);
+                single_bottom[c].push_back(bot1[k]);
+            }
         }
     }
     // Linear in μ' between the nodes, flat beyond the first and the last.
@@ -993,6 +1032,9 @@ void Lamina1::precompute_scattering() {
     };
     auto inside_cos = [&](double mu) { return safe_sqrt(1 - (1 - mu * mu) * sqr(inv_eta0_)); };
     single_energy_.fill([&](double mu) { return at(single_left, inside_cos(mu)) * T_top_(mu); });
+    if (support_.btdf && ch_.medium_single)
+        single_energy_t_.fill(
+            [&](double mu) { return at(single_bottom, inside_cos(mu)) * T_top_(mu); });
     if (!orders_on_) return;
     orders_.fill([&](double mu) { return at(top_left, inside_cos(mu)) * T_top_(mu); });
     const Rgbd orders_bar =
@@ -1039,6 +1081,7 @@ Lamina1::Mixture Lamina1::mixture(const Incident& in) const {
         if (m.beta > 0) m.p[3] = in.T * a * std::max(0.0, 1 - E_b);
         if (series_btdf_) m.p[4] = (in.X * inv_one_minus_Er_).mean() * 0.5;
         if (orders_on_) m.p[4] += orders_t_(in.wi.z).mean();
+        if (scatters_ && back_on_) m.p[4] += single_energy_t_(in.wi.z).mean();
     }
     double total = 0;
     for (double p : m.p)
