@@ -549,7 +549,7 @@ class Lamina1 final : public Model {
     /// The albedo of the mirror that stands for a conductor or dielectric base in the scattered
     /// light's paths: its Fresnel reflectance when smooth (exact), else its directional albedo.
     Rgbd mirror_albedo(double mu) const {
-        return alpha1_ == 0 ? base_fresnel(mu) : base_albedo(mu);
+        return alpha1_ == 0 ? base_fresnel(mu) : mirror_albedo_curve_(mu);
     }
 
     /// The base's directional albedo seen from inside the coat, at inside cosine μ.
@@ -621,6 +621,9 @@ class Lamina1 final : public Model {
     CosineCurve<Rgbd, kNx> orders_, orders_t_;
     Rgbd orders_norm_{0.0};
     double orders_t_norm_ = 0;
+    /// A rough base's directional albedo over inside cosines (mirror_albedo; one lookup instead
+    /// of the FGD table's three).
+    CosineCurve<Rgbd, kNmu> mirror_albedo_curve_;
     /// The explicit single scattering's energy at μ (the sampler's mixture weight).
     CosineCurve<Rgbd, kNx> single_energy_, single_energy_t_;
 
@@ -905,6 +908,8 @@ void Lamina1::precompute_scattering() {
     single_on_ = ch_.medium_single || (ch_.medium_base_paths && !lambertian);
     base_paths_ = ch_.medium_base_paths && !lambertian;
     back_on_ = ch_.medium_single;
+    if (!lambertian && alpha1_ > 0)
+        mirror_albedo_curve_.fill([&](double mu) { return base_albedo(std::max(mu, 1e-6)); });
     orders_on_ = ch_.medium_orders;
 
     // The energies, by the azimuth-averaged adding of coat bottom, medium and base on 6 + 6
