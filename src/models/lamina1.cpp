@@ -947,6 +947,7 @@ void Lamina1::precompute_scattering() {
         a_nodes[j] = attenuation(mu);
     }
     const FluxMatrix I = FluxMatrix::identity(n), r = FluxMatrix::diagonal(returned);
+    AzimuthalPhase phase;
     std::array<std::vector<double>, 3> top_left{}, bottom_left{}, single_left{}, single_bottom{};
     for (int c = 0; c < 3; ++c) {
         // Channels with the same medium and base share the computation.
@@ -965,7 +966,8 @@ void Lamina1::precompute_scattering() {
             single_bottom[c] = single_bottom[same];
             continue;
         }
-        const AzimuthalPhase phase = azimuthal_hg(nodes, coat_.g[c]);
+        // The phase matrices depend on g alone: computed once for channels of equal g.
+        if (c == 0 || coat_.g[c] != coat_.g[c - 1]) phase = azimuthal_hg(nodes, coat_.g[c]);
         const SlabMatrices slab = hg_slab(nodes, phase, tau_t_[c], omega_[c]);
         FluxMatrix B(n);
         std::vector<double> E(n), a(n);
