@@ -292,8 +292,7 @@ class Lamina1 final : public Model {
         return f;
     }
 
-    /// The scattering medium's terms (out of line: the absorbing path's code, and so its
-    /// rounding under FMA contraction, stays what it was without them).
+    /// The scattering medium's reflected terms (out of line: absorbing stacks pay one branch).
     [[gnu::noinline]] Rgbd scattered(const Incident& in, const Vec3d& wo, const Vec3d& wo_in,
                                      const Rgbd& a_o) const {
         Rgbd f(0.0);

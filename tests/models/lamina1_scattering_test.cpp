@@ -113,6 +113,44 @@ TEST(Lamina1Scattering, SingleScatteringIsTheDepthIntegral) {
     }
 }
 
+// The slab's once-scattered transmission (medium-orders=off) against the same kind of depth
+// quadrature: a smooth coat (η0 = 1.5) over a smooth bottom into air, so that the unscattered
+// light is a delta lobe and the BTDF is the single scattering alone,
+//   f_T = (1 − F(μi; η0)) (1 − F(μv; η0)) ϖ/(μi'μv') ∫₀^τ p(Θ) e^{−t/μi' − (τ−t)/μv'} dt / η0²
+// (v: wo mirrored up, v' its refraction into the coat, Θ between −wi' and v' turned down).
+TEST(Lamina1Scattering, SingleTransmissionIsTheDepthIntegral) {
+    const double eta0 = 1.5, tau_s = 1.2, tau_a = 0.1, tau = tau_s + tau_a;
+    const QuadratureRule q = gauss_legendre(64);
+    ParticleRng rng(27, 0, 0);
+    for (double g : kG) {
+        const auto model =
+            make_model("lamina-1", milky(eta0, 0.0, test::dielectric(1.0, 0.0), tau_a, tau_s, g),
+                       {"medium-orders=off"});
+        ASSERT_TRUE(model->support().btdf);
+        for (int n = 0; n < 40; ++n) {
+            const Vec3d wi = random_dir(rng), v = random_dir(rng);
+            const Vec3d wo(v.x, v.y, -v.z);
+            auto inside = [&](const Vec3d& w) {
+                const double s2 = (1 - w.z * w.z) / sqr(eta0);
+                return Vec3d(w.x / eta0, w.y / eta0, std::sqrt(1 - s2));
+            };
+            const Vec3d i = inside(wi), o = inside(v);
+            const double p = hg_phase(dot(Vec3d(-i.x, -i.y, -i.z), Vec3d(o.x, o.y, -o.z)), g);
+            double integral = 0;
+            for (std::size_t m = 0; m < q.x.size(); ++m) {
+                const double t = tau * q.x[m];
+                integral += tau * q.w[m] * std::exp(-t / i.z - (tau - t) / o.z);
+            }
+            const double expect = (1 - fresnel_dielectric(wi.z, eta0)) *
+                                  (1 - fresnel_dielectric(v.z, eta0)) * tau_s / tau * p * integral /
+                                  (i.z * o.z * sqr(eta0));
+            const Rgbd f = model->eval(wi, wo);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(f[c], expect, 1e-10 * expect) << "g=" << g;
+        }
+    }
+}
+
 // Without its single scattering and remainder the scattering model is the absorbing model at
 // the extinction τt: the unscattered light is attenuated by τa + τs (exactly, same code).
 TEST(Lamina1Scattering, UnscatteredLightIsAttenuatedByExtinction) {
