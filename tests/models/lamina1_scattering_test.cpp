@@ -210,19 +210,22 @@ TEST(Lamina1Scattering, AlbedoAtMostOne) {
         {"slab", test::dielectric(1.0, 0.2)},
     };
     const std::vector<std::pair<double, double>> media = {{0.0, 0.5}, {0.0, 5.0}, {0.5, 1.0}};
-    for (const auto& [bname, base] : bases)
-        for (const auto& [tau_a, tau_s] : media)
-            for (double g : kG)
-                for (double alpha0 : {0.0, 0.3}) {
-                    const auto model =
-                        make_model("lamina-1", milky(1.5, alpha0, base, tau_a, tau_s, g));
-                    for (double ti : {0.0, 70.0}) {
-                        const Rgbd a = albedo(*model, incident_direction(deg_to_rad(ti)));
-                        EXPECT_LE(a.max(), 1.0 + 1e-3 + 6.3e-3 + 2e-3)
-                            << bname << " tau_a=" << tau_a << " tau_s=" << tau_s << " g=" << g
-                            << " a0=" << alpha0 << " ti=" << ti;
+    for (const std::vector<std::string>& options :
+         {std::vector<std::string>{}, std::vector<std::string>{"microsurface=multiple"}})
+        for (const auto& [bname, base] : bases)
+            for (const auto& [tau_a, tau_s] : media)
+                for (double g : kG)
+                    for (double alpha0 : {0.0, 0.3}) {
+                        const auto model = make_model(
+                            "lamina-1", milky(1.5, alpha0, base, tau_a, tau_s, g), options);
+                        for (double ti : {0.0, 70.0}) {
+                            const Rgbd a = albedo(*model, incident_direction(deg_to_rad(ti)));
+                            EXPECT_LE(a.max(), 1.0 + 1e-3 + 6.3e-3 + 2e-3)
+                                << bname << " tau_a=" << tau_a << " tau_s=" << tau_s << " g=" << g
+                                << " a0=" << alpha0 << " ti=" << ti
+                                << (options.empty() ? "" : " ms");
+                        }
                     }
-                }
 }
 
 std::vector<std::pair<std::string, Stack>> scattering_stacks(double g) {
@@ -238,17 +241,19 @@ std::vector<std::pair<std::string, Stack>> scattering_stacks(double g) {
 // remainder is separable in E_ms(μi) E_ms(μo). To rounding on random pairs, every g.
 TEST(Lamina1Scattering, BrdfIsReciprocal) {
     ParticleRng rng(24, 0, 0);
-    for (double g : kG)
-        for (const auto& [what, stack] : scattering_stacks(g)) {
-            const auto model = make_model("lamina-1", stack);
-            for (int n = 0; n < 100; ++n) {
-                const Vec3d a = random_dir(rng), b = random_dir(rng);
-                const Rgbd fab = model->eval(a, b), fba = model->eval(b, a);
-                for (int c = 0; c < 3; ++c)
-                    EXPECT_NEAR(fab[c], fba[c], 1e-12 * std::max(fab[c], 1.0))
-                        << what << " g=" << g;
+    for (const std::vector<std::string>& options :
+         {std::vector<std::string>{}, std::vector<std::string>{"microsurface=multiple"}})
+        for (double g : kG)
+            for (const auto& [what, stack] : scattering_stacks(g)) {
+                const auto model = make_model("lamina-1", stack, options);
+                for (int n = 0; n < 100; ++n) {
+                    const Vec3d a = random_dir(rng), b = random_dir(rng);
+                    const Rgbd fab = model->eval(a, b), fba = model->eval(b, a);
+                    for (int c = 0; c < 3; ++c)
+                        EXPECT_NEAR(fab[c], fba[c], 1e-12 * std::max(fab[c], 1.0))
+                            << what << " g=" << g;
+                }
             }
-        }
 }
 
 TEST(Lamina1Scattering, PreparedEvaluatorEqualsEval) {
