@@ -1245,17 +1245,18 @@ std::vector<OptionSpec> lamina1_option_specs() {
          {"on", "off"},
          on_off(d.medium_single),
          "scattering media: the exact single scattering of the medium between the refractions "
-         "(closed form), or not"},
+         "(closed form; a slab's transmission too), or left to the remainder lobe"},
         {"medium-base-paths",
          {"mirror", "off"},
          d.medium_base_paths ? "mirror" : "off",
          "scattering media over a conductor or dielectric base: the once-scattered light that "
-         "also meets the base, the base taken as a mirror of its albedo (closed form), or not"},
+         "also meets the base, the base taken as a mirror of its albedo (closed form), or left "
+         "to the remainder lobe"},
         {"medium-orders",
          {"adding", "off"},
          d.medium_orders ? "adding" : "off",
          "scattering media: the rest of the scattered light (orders >= 2, its round trips) as a "
-         "separable lobe with the energy of an azimuth-averaged adding-doubling, or not"},
+         "separable lobe with the energy of an azimuth-averaged adding-doubling, or dropped"},
         {"microsurface",
          {"single", "multiple"},
          d.multiple_scattering ? "multiple" : "single",
