@@ -76,6 +76,10 @@ struct Lamina1Choices {
     /// round trips between coat and base, the once-scattered light over a Lambertian base) as a
     /// separable lobe whose energy is the azimuth-averaged adding–doubling's (medium_adding.h).
     bool medium_orders = true;
+    /// ... the part of that rest a slab transmits shaped like twice-scattered light (the
+    /// once-scattered closed form with HG(g²): two HG scatterings have the mean cosine g²) and
+    /// normalized to the adding's energy (true), or as uniform radiance below the bottom (false).
+    bool medium_transmitted_twice = true;
 };
 
 std::vector<OptionSpec> lamina1_option_specs();
