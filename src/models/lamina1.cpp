@@ -960,6 +960,7 @@ void Lamina1::precompute_scattering() {
     }
     const FluxMatrix I = FluxMatrix::identity(n), r = FluxMatrix::diagonal(returned);
     AzimuthalPhase phase;
+    std::vector<double> twice_phase;
     std::array<std::vector<double>, 3> top_left{}, bottom_left{}, single_left{}, single_bottom{},
         twice_bottom{};
     for (int c = 0; c < 3; ++c) {
@@ -1031,18 +1032,22 @@ void Lamina1::precompute_scattering() {
                 // the bottom's exit (split at its critical cosine), 32 azimuths (φ = π t²): the
                 // adding's 12 cosines under-resolve the forward peak of HG(g²) (≈ 3% low at
                 // g = 0.9), and this energy is what normalizes the lobe.
-                static const QuadratureRule qm = gauss_legendre(24), qp = gauss_legendre(32);
+                static const QuadratureRule qm = gauss_legendre(12), qp = gauss_legendre(16);
                 const double mu_crit_b = eta_s_ > 1 ? std::sqrt(1 - 1 / sqr(eta_s_)) : 0.0;
-                auto shape_energy = [&](double mu_k) {
-                    const double s_k = safe_sqrt(1 - mu_k * mu_k), a_k = attenuation(mu_k)[c];
-                    double e = 0;
-                    for (int piece = 0; piece < 2; ++piece)
-                        for (std::size_t m = 0; m < qm.x.size(); ++m) {
-                            const double width = 0.5 * (1 - mu_crit_b);
-                            const double mu = mu_crit_b + width * (piece + qm.x[m]);
-                            const double s2 = sqr(eta_s_) * (1 - mu * mu);
-                            if (s2 >= 1) continue;
-                            const double s_m = safe_sqrt(1 - mu * mu);
+                const int nm = 2 * int(qm.x.size());
+                auto exit_cos = [&](int m) {
+                    const double width = 0.5 * (1 - mu_crit_b);
+                    return mu_crit_b + width * ((m >= nm / 2) + qm.x[m % (nm / 2)]);
+                };
+                // The azimuthal average of HG(g²) between the rule's cosines and the incidences
+                // (the nodes and μ' = 1): it depends on g alone, computed once for equal g.
+                if (c == 0 || g_twice_[c] != g_twice_[c - 1]) {
+                    twice_phase.assign(std::size_t(n + 1) * nm, 0.0);
+                    for (int k = 0; k <= n; ++k) {
+                        const double mu_k = k < n ? nodes.mu[k] : 1.0,
+                                     s_k = safe_sqrt(1 - mu_k * mu_k);
+                        for (int m = 0; m < nm; ++m) {
+                            const double mu = exit_cos(m), s_m = safe_sqrt(1 - mu * mu);
                             double p0 = 0;
                             for (std::size_t b = 0; b < qp.x.size(); ++b) {
                                 const double t = qp.x[b];
@@ -1051,18 +1056,30 @@ void Lamina1::precompute_scattering() {
                                     hg_phase(mu * mu_k + s_m * s_k * std::cos(kPi<double> * t * t),
                                              g_twice_[c]);
                             }
-                            e += width * qm.w[m] * 2 * kPi<double> * mu * omega_[c] * p0 *
-                                 attenuation_slope(mu, mu_k, attenuation(mu)[c], a_k, tau_t_[c]) *
-                                 T_bot_(std::sqrt(1 - s2));
+                            twice_phase[std::size_t(k) * nm + m] = p0;
                         }
+                    }
+                }
+                auto shape_energy = [&](int k) {
+                    const double mu_k = k < n ? nodes.mu[k] : 1.0, a_k = attenuation(mu_k)[c];
+                    const double width = 0.5 * (1 - mu_crit_b);
+                    double e = 0;
+                    for (int m = 0; m < nm; ++m) {
+                        const double mu = exit_cos(m), s2 = sqr(eta_s_) * (1 - mu * mu);
+                        if (s2 >= 1) continue;
+                        e += width * qm.w[m % (nm / 2)] * 2 * kPi<double> * mu * omega_[c] *
+                             twice_phase[std::size_t(k) * nm + m] *
+                             attenuation_slope(mu, mu_k, attenuation(mu)[c], a_k, tau_t_[c]) *
+                             T_bot_(std::sqrt(1 - s2));
+                    }
                     return e;
                 };
                 // On the nodes, and at μ' = 1 (normal incidence, beyond the last node: the
                 // shape's energy changes by 4% there at g = 0.9).
                 twice_bottom[c].assign(n + 1, 0.0);
                 for (int k = 0; k < n; ++k)
-                    twice_bottom[c][k] = shape_energy(nodes.mu[k]);
-                twice_bottom[c][n] = shape_energy(1.0);
+                    twice_bottom[c][k] = shape_energy(k);
+                twice_bottom[c][n] = shape_energy(n);
             }
             bottom_left[c].resize(n);
             for (int k = 0; k < n; ++k) {
