@@ -1060,18 +1060,23 @@ void Lamina1::precompute_scattering() {
                         }
                     }
                 }
+                // The rule's weights with the exit and the attenuation at its cosines.
+                std::vector<double> exit_weight(nm, 0.0), a_exit(nm, 0.0);
+                for (int m = 0; m < nm; ++m) {
+                    const double mu = exit_cos(m), s2 = sqr(eta_s_) * (1 - mu * mu);
+                    a_exit[m] = std::exp(-tau_t_[c] / mu);
+                    if (s2 < 1)
+                        exit_weight[m] = 0.5 * (1 - mu_crit_b) * qm.w[m % (nm / 2)] * 2 *
+                                         kPi<double> * mu * omega_[c] * T_bot_(std::sqrt(1 - s2));
+                }
                 auto shape_energy = [&](int k) {
-                    const double mu_k = k < n ? nodes.mu[k] : 1.0, a_k = attenuation(mu_k)[c];
-                    const double width = 0.5 * (1 - mu_crit_b);
+                    const double mu_k = k < n ? nodes.mu[k] : 1.0,
+                                 a_k = std::exp(-tau_t_[c] / mu_k);
                     double e = 0;
-                    for (int m = 0; m < nm; ++m) {
-                        const double mu = exit_cos(m), s2 = sqr(eta_s_) * (1 - mu * mu);
-                        if (s2 >= 1) continue;
-                        e += width * qm.w[m % (nm / 2)] * 2 * kPi<double> * mu * omega_[c] *
-                             twice_phase[std::size_t(k) * nm + m] *
-                             attenuation_slope(mu, mu_k, attenuation(mu)[c], a_k, tau_t_[c]) *
-                             T_bot_(std::sqrt(1 - s2));
-                    }
+                    for (int m = 0; m < nm; ++m)
+                        if (exit_weight[m] > 0)
+                            e += exit_weight[m] * twice_phase[std::size_t(k) * nm + m] *
+                                 attenuation_slope(exit_cos(m), mu_k, a_exit[m], a_k, tau_t_[c]);
                     return e;
                 };
                 // On the nodes, and at μ' = 1 (normal incidence, beyond the last node: the
