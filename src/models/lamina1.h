@@ -1,6 +1,7 @@
 #pragma once
 // lamina-1: lamina's own layered BSDF for a dielectric coat over a base (docs/models.md,
-// "lamina-1", has the derivation). For a coat (η0, α0) with an absorbing medium (τ) over a
+// "lamina-1", has the derivation). For a coat (η0, α0) with an absorbing or Henyey–Greenstein
+// scattering medium (τa, τs, g; the unscattered light attenuated by τt = τa + τs) over a
 // Lambertian, conductor or dielectric base (α1):
 //
 //   f_R = f_top                                       exact Walter reflection of the coat
@@ -13,7 +14,11 @@
 // the refracted mean directions, α_e and β: the base lobe widened by the coat's refraction
 // spread, X: the light the coat's bottom sends back to the base after the first order, Ē_b and r̄
 // the base's and the coat bottom's hemispherical albedos, K the normalization that gives the
-// separable term the energy of the geometric series. Each approximation is a flag (Lamina1Choices).
+// separable term the energy of the geometric series. A scattering medium adds its exact single
+// scattering f_ss (and, over a conductor or dielectric base, the once-scattered paths that meet
+// the base) and a separable lobe carrying the rest of the scattered light, its energy from an
+// azimuth-averaged adding–doubling of coat bottom, medium and base (models/medium_adding.h).
+// Each approximation is a flag (Lamina1Choices).
 
 #include "models/coat_transmittance.h"
 #include "models/model.h"
@@ -60,6 +65,21 @@ struct Lamina1Choices {
     /// The base lobe whose width follows wo through the coat's spread is divided by its excess
     /// energy over the fixed-width lobe, √N(μi') √N(μo') (reciprocal; docs/models.md).
     bool lobe_normalization = true;
+    /// Scattering (Henyey–Greenstein) coat media (docs/models.md, lamina-1, "Scattering media"):
+    /// the exact single scattering of the medium between the two refractions (first order in
+    /// τs, closed form) ...
+    bool medium_single = true;
+    /// ... the once-scattered light that also meets a conductor or dielectric base (scattered
+    /// then mirrored, mirrored then scattered; the base as a mirror of its directional albedo) ...
+    bool medium_base_paths = true;
+    /// ... and everything else the scattering sends back (orders ≥ 2, the scattered light's
+    /// round trips between coat and base, the once-scattered light over a Lambertian base) as a
+    /// separable lobe whose energy is the azimuth-averaged adding–doubling's (medium_adding.h).
+    bool medium_orders = true;
+    /// ... the part of that rest a slab transmits shaped like twice-scattered light (the
+    /// once-scattered closed form with HG(g²): two HG scatterings have the mean cosine g²) and
+    /// normalized to the adding's energy (true), or as uniform radiance below the bottom (false).
+    bool medium_transmitted_twice = true;
 };
 
 std::vector<OptionSpec> lamina1_option_specs();

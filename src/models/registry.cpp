@@ -42,7 +42,8 @@ const std::vector<ModelEntry>& model_registry() {
         {"lamina-1",
          "lamina-1: exact top reflection, first order through the coat's directional "
          "transmittance, inter-reflection series, lobe widened by the coat's refraction spread",
-         "bases: lambertian, conductor, dielectric; media: absorbing; sides: R, T (slab)",
+         "bases: lambertian, conductor, dielectric; media: absorbing, scattering (HG); sides: R, "
+         "T (slab)",
          lamina1_options, make_lamina1, false, "lamina"},
         {"random-walk",
          "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "
