@@ -60,6 +60,16 @@ struct Lamina1Choices {
     /// The base lobe whose width follows wo through the coat's spread is divided by its excess
     /// energy over the fixed-width lobe, √N(μi') √N(μo') (reciprocal; docs/models.md).
     bool lobe_normalization = true;
+    /// The slab's first-order transmission: the bottom interface's own Walter BTDF at the mean
+    /// inside direction, widened by the coat's spread and carrying the light's exact first-order
+    /// energy (true), or the mirrored GGX lobe q weighted by T_b,in at the exit (false).
+    bool btdf_bottom_lobe = true;
+    /// The slab's later orders in transmission: the light inside the coat as two populations,
+    /// within the exit cone and beyond it (trapped by a smooth coat's total internal reflection),
+    /// each taken as uniform radiance after the first return, summed over every round trip by a
+    /// 2 × 2 geometric series and let out through the bottom's own transmittance (true); or the
+    /// uniform series of inter-reflection=on (false). Single scattering only.
+    bool btdf_populations = false;
 };
 
 std::vector<OptionSpec> lamina1_option_specs();
