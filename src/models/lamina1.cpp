@@ -37,7 +37,7 @@ constexpr int kGauss = 24;  // Gauss–Legendre nodes per piece of the hemispher
 // later orders), and the split visible-normal rule of their integrals (r nodes per piece, φ
 // nodes, bisections).
 constexpr int kNfirst = 17, kNslab = 17;
-constexpr int kSlabNr = 4, kSlabNphi = 4, kSlabBisections = 8;
+constexpr int kSlabNr = 4, kSlabNphi = 8, kSlabBisections = 8;
 
 /// A curve over a cosine μ ∈ [0, 1] on nodes μ = s² (dense at grazing), linear in s.
 template <typename V, int kN = kNmu>
@@ -76,6 +76,37 @@ struct SplitCurve {
         const double a = lower ? 0 : split, b = lower ? split : 1;
         const auto& v = lower ? below : above;
         const double x = b > a ? clamp((mu - a) / (b - a), 0.0, 1.0) * (kN - 1) : 0;
+        const int i = std::min(int(x), kN - 2);
+        const double t = x - i;
+        return v[i] * (1 - t) + v[i + 1] * t;
+    }
+};
+
+/// A curve over an inside cosine with a square-root edge at the critical cosine μc (a nearly
+/// smooth interface's transmittance from inside, which rises as √(μ − μc) above it): linear on
+/// nodes uniform in [0, μc) and, above, in t with μ = μc + (1 − μc) t² (as integrate01 below).
+template <int kN>
+struct EdgeCurve {
+    double split = 0;
+    std::array<double, kN> below{}, above{};
+    template <typename F>
+    void fill(double mu_split, F&& f) {
+        split = clamp(mu_split, 0.0, 1.0);
+        for (int i = 0; i < kN; ++i) {
+            const double t = double(i) / (kN - 1);
+            below[i] = f(std::min(split * t, std::nextafter(split, 0.0)));
+            above[i] = f(split + (1 - split) * t * t);
+        }
+    }
+    double operator()(double mu) const {
+        const bool lower = mu < split;
+        double x = 0;
+        if (lower)
+            x = split > 0 ? clamp(mu / split, 0.0, 1.0) : 0.0;
+        else
+            x = split < 1 ? std::sqrt(clamp((mu - split) / (1 - split), 0.0, 1.0)) : 0.0;
+        const auto& v = lower ? below : above;
+        x *= kN - 1;
         const int i = std::min(int(x), kN - 2);
         const double t = x - i;
         return v[i] * (1 - t) + v[i + 1] * t;
@@ -936,7 +967,7 @@ void Lamina1::precompute_slab() {
     };
     // T_b,in(μ) of the bottom's own roughness, directly: the table's interpolation across the
     // steep edge just inside the critical cone (nearly smooth bottoms) is 1.5% low at α1 = 0.02.
-    SplitCurve<(kNslab + 1) / 2, double> T_b_in;
+    EdgeCurve<kNslab> T_b_in;
     T_b_in.fill(mu_crit_b, [&](double mu) {
         return bottom_transmittance(alpha1_, Vec3d(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-6)));
     });
@@ -1038,10 +1069,6 @@ void Lamina1::precompute_slab() {
             ms ? integrate01<Rgbd>([&](double mu) { return entering(mu).v[0] * (2 * mu); },
                                    mu_crit_b)
                : Rgbd(0.0);
-        // The rule splits where its integrand steps: at the bottom's critical cosine where T_b,in
-        // (and with it the bottom's reflection) jumps there (nearly smooth bottoms), else nowhere.
-        const double jump = std::abs(T_b_in(mu_crit_b) - T_b_in(std::nextafter(mu_crit_b, 0.0)));
-        const double entry_split = jump > 1e-3 ? mu_crit_b : -1.0;
         auto entry_at = [&](double mu) {
             const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
             const double lambda_w = ggx0.lambda(w);
@@ -1053,7 +1080,7 @@ void Lamina1::precompute_slab() {
             // direction for the lobe's centre (item 5 of docs/models.md).
             Multi<Rgbd, 4> sum =
                 integrate_visible_split<Multi<Rgbd, 4>, kSlabNr, kSlabNphi, kSlabBisections>(
-                    ggx0, w, entry_split, inside_z, [&](const Vec3d& wm) {
+                    ggx0, w, mu_crit_b, inside_z, [&](const Vec3d& wm) {
                         Multi<Rgbd, 4> out;
                         const auto wt = refract(w, wm, eta0_);
                         if (!wt || wt->z >= 0) return out;
