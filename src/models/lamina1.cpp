@@ -259,6 +259,8 @@ class Lamina1 final : public Model {
         double alpha_b = 0;    ///< the slab bottom's roughness widened by the coat's spread
         Rgbd first_T{0.0};  ///< E_1(μi)/T_lobe(μi): the first order over the bottom lobe's energy
         Rgbd first_E{0.0};  ///< E_1(μi): the first order's transmitted energy
+        double u_bottom = 1;  ///< the first order's share in the bottom's lobe (btdf-lobe)
+        Rgbd first_M{0.0};    ///< E_1(μi)/Q_m(μi): over the mirrored lobe's energy (shared)
         /// Φ_p(μi)/(π A_p η_s²) for the populations p = inside, beyond the exit cone (v[0], v[1])
         /// and the energy Σ_p Φ_p T_p they transmit (v[2]): the slab's later orders.
         Multi<Rgbd, 3> trapped{};
@@ -306,10 +308,14 @@ class Lamina1 final : public Model {
                 // direction, of roughness α_b, scaled to carry the light's first-order energy
                 // E_1(μi).
                 in.alpha_b = bottom_roughness(in.k_top, in.k_bottom);
-                const Multi<Rgbd, 2> first = first_order_(wi.z);
+                const Multi<Rgbd, 3> first = first_order_(wi.z);
                 const Multi<Rgbd, 2> smooth = first_order_smooth(wi.z, in.wi_in.z);
                 in.first_T = first.v[0] + smooth.v[0];
                 in.first_E = first.v[1] + smooth.v[1];
+                in.first_M = first.v[2] + smooth.v[0];
+                // btdf-lobe=shared: the bottom's share of the spread's variance.
+                if (ch_.btdf_lobe_shared && in.alpha_b > 0)
+                    in.u_bottom = sqr(alpha1_) / sqr(in.alpha_b);
             }
             if (populations_) in.trapped = trapped_(wi.z);
         }
@@ -424,6 +430,7 @@ class Lamina1 final : public Model {
         std::array<double, 5> p{};
         Vec3d wi_in, wi_mean;
         double alpha_base = 0, beta = 0;
+        bool bottom_sampled = false;  ///< the transmission lobe drawn as the bottom's (btdf-lobe)
     };
     Mixture mixture(const Incident& in) const;
     double pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) const;
@@ -440,11 +447,12 @@ class Lamina1 final : public Model {
         const Rgbd a_v = has_absorption_ ? attenuation(v_in->z) : Rgbd(1.0);
         Rgbd f(0.0);
         const double beta = transmission_roughness(in.k_top, in.k_bottom);
-        if (bottom_lobe_) {
+        if (bottom_lobe_ && in.alpha_b > 0 && in.u_bottom > 0) {
             // The bottom's Walter BTDF (Eq. 21) from the mean inside direction: with a smooth coat
             // the first order is exactly T(μi) a(μi') f_t,bottom(wi', wo).
-            if (in.alpha_b > 0) f += in.first_T * bottom_btdf(in.alpha_b).eval(in.wi_mean, wo);
-        } else if (beta > 0) {
+            f += in.first_T * (in.u_bottom * bottom_btdf(in.alpha_b).eval(in.wi_mean, wo));
+        }
+        if ((!bottom_lobe_ || in.u_bottom < 1) && beta > 0) {
             const GGX<double> ggx{beta};
             const Vec3d h = normalize(in.wi_mean + *v_in);
             const double q = ggx.D(h) * ggx.G2(in.wi_mean, *v_in) / (4 * in.wi_mean.z * v_in->z);
@@ -458,7 +466,16 @@ class Lamina1 final : public Model {
                 a_once[c] = std::sqrt(a_once[c]);
             if (mirror_series_ && !populations_)
                 a_once *= mirror_series_curve_(in.wi_mean.z) * mirror_series_curve_(v_in->z);
-            f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
+            if (bottom_lobe_) {
+                // btdf-lobe=shared: the mirrored lobe's share 1 − u of the first order, carrying
+                // E_1 over its energy Q_m (the medium's attenuation is in E_1).
+                Rgbd rounds(1.0);
+                if (mirror_series_ && !populations_)
+                    rounds = mirror_series_curve_(in.wi_mean.z) * mirror_series_curve_(v_in->z);
+                f += in.first_M * rounds * ((1 - in.u_bottom) * T_b_in * q / (eta_s_ * eta_s_));
+            } else {
+                f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
+            }
         }
         if (populations_) {
             // The later orders: uniform radiance in each population leaves through the bottom as
@@ -655,7 +672,7 @@ class Lamina1 final : public Model {
     /// E_1(μ), the energy it transmits per unit flux arriving at outside cosine μ.
     bool bottom_lobe_ = false;
     /// E_1(μ)/T_lobe(μ) and E_1(μ) (v[0], v[1]) over outside cosines.
-    CosineCurve<Multi<Rgbd, 2>, kNfirst> first_order_;
+    CosineCurve<Multi<Rgbd, 3>, kNfirst> first_order_;
     /// The slab's later orders as two populations of inside light (Lamina1Choices::
     /// btdf_populations): Incident::trapped over outside cosines, and T_{below→p}(μ), the light
     /// arriving from below at μ that the bottom lets into population p.
@@ -1121,16 +1138,36 @@ void Lamina1::precompute_slab() {
         // totally; the lobe is divided by it and carries E_1.
         first_order_.fill([&](double mu) {
             const Incident in = incident(Vec3d(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4)));
-            Multi<Rgbd, 2> r;
+            Multi<Rgbd, 3> r;
             r.v[1] = entry(mu).v[0];
             const double mu_in = in.ok ? in.wi_in.z : 0.0;
             if (in.ok && in.alpha_b > 0) {
                 const double T_lobe = bottom_transmittance(in.alpha_b, in.wi_mean);
                 if (T_lobe > 0) r.v[0] = r.v[1] * (1 / T_lobe);
             }
+            // btdf-lobe=shared: Q_m = ∫_cone T_b,in(μv') q(w̄i', v'; β) μv' dωv', the mirrored
+            // lobe's energy (as eval_btdf weights it), by the visible normals of β at w̄i', split
+            // where the mirrored direction leaves the exit cone.
+            const double beta = in.ok ? transmission_roughness(in.k_top, in.k_bottom) : 0.0;
+            if (ch_.btdf_lobe_shared && beta > 0) {
+                const GGX<double> ggx{beta};
+                const Vec3d& w = in.wi_mean;
+                const double lambda_w = ggx.lambda(w);
+                const double Q_m =
+                    integrate_visible_split<double, kSlabNr, kSlabNphi, kSlabBisections>(
+                        ggx, w, mu_crit_b, [&](const Vec3d& wm) { return reflect(w, wm).z; },
+                        [&](const Vec3d& wm) {
+                            const Vec3d v_in = reflect(w, wm);
+                            if (v_in.z <= mu_crit_b) return 0.0;
+                            return T_bot_in_(v_in.z) * (1 + lambda_w) /
+                                   (1 + lambda_w + ggx.lambda(v_in));
+                        });
+                if (Q_m > 0) r.v[2] = r.v[1] * (1 / Q_m);
+            }
             const Multi<Rgbd, 2> smooth = first_order_smooth(mu, mu_in);
             r.v[0] = r.v[0] - smooth.v[0];
             r.v[1] = r.v[1] - smooth.v[1];
+            r.v[2] = r.v[2] - smooth.v[0];
             return r;
         });
     }
@@ -1238,7 +1275,8 @@ Lamina1::Mixture Lamina1::mixture(const Incident& in) const {
     if (series_on_) m.p[2] = (in.X * K_ * X_bar_).mean();
     m.p[2] += in.dR;  // the coat's separable multiple-scattering lobe, also cosine-distributed
     if (support_.btdf) {
-        m.beta = bottom_lobe_ ? in.alpha_b : transmission_roughness(in.k_top, in.k_bottom);
+        m.bottom_sampled = bottom_lobe_ && in.u_bottom >= 0.5;
+        m.beta = m.bottom_sampled ? in.alpha_b : transmission_roughness(in.k_top, in.k_bottom);
         if (m.beta > 0)
             m.p[3] = bottom_lobe_ ? in.first_E.mean() : in.T * a * std::max(0.0, 1 - E_b);
         if (populations_)
@@ -1282,7 +1320,7 @@ double Lamina1::pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) 
         if (m.p[2] > 0) pdf += m.p[2] * wo.z * kInvPi<double>;
         return pdf;
     }
-    if (m.p[3] > 0 && bottom_lobe_) {
+    if (m.p[3] > 0 && m.bottom_sampled) {
         // Refracted through the visible normals of α_b at the mean inside direction (Walter et
         // al. 2007, Eq. 17: dωm/dωo = η_o² |wo·wm| / (η_i wi·wm + η_o wo·wm)², η_o/η_i = η_b).
         const DielectricInterface<double> bottom = bottom_btdf(m.beta);
@@ -1338,7 +1376,7 @@ std::optional<ModelSample> Lamina1::sample(const Vec3d& wi, const Vec3d& u) cons
             break;
         case 3: {
             const Vec3d wm = GGX<double>{m.beta}.sample_visible_normal(m.wi_mean, u.y, u.z);
-            if (bottom_lobe_) {
+            if (m.bottom_sampled) {
                 const auto wt = refract(m.wi_mean, wm, eta_b_);
                 if (!wt || wt->z >= 0) return std::nullopt;  // totally reflected by the facet
                 wo = *wt;
@@ -1414,13 +1452,15 @@ std::vector<OptionSpec> lamina1_option_specs() {
          "the widened base lobe (width following wo) divided by its excess energy sqrt(N(mu_i') "
          "N(mu_o')), or not"},
         {"btdf-lobe",
-         {"bottom", "mirrored"},
-         d.btdf_bottom_lobe ? "bottom" : "mirrored",
+         {"shared", "bottom", "mirrored"},
+         !d.btdf_bottom_lobe  ? "mirrored"
+         : d.btdf_lobe_shared ? "shared"
+                              : "bottom",
          "slab BTDF first order: the bottom's own Walter BTDF at the mean inside direction with "
-         "the first-order energy, or the mirrored GGX lobe weighted by the bottom's transmittance "
-         "at the exit"},
+         "the first-order energy (bottom), the mirrored GGX lobe weighted by the bottom's "
+         "transmittance at the exit (mirrored), or each for its share of the spread (shared)"},
         {"btdf-series",
-         {"populations", "uniform"},
+         {"uniform", "populations"},
          d.btdf_populations ? "populations" : "uniform",
          "slab BTDF later orders: the light inside and beyond the exit cone as two uniform "
          "populations summed over every round trip and let out through the bottom's "
@@ -1445,7 +1485,8 @@ Lamina1Choices lamina1_choices(const ModelOptions& o) {
     c.multiple_scattering = option_value(o, "microsurface") == "multiple";
     c.inside_exit = option_value(o, "exit-transmittance") == "inside";
     c.lobe_normalization = option_value(o, "lobe-normalization") == "on";
-    c.btdf_bottom_lobe = option_value(o, "btdf-lobe") == "bottom";
+    c.btdf_bottom_lobe = option_value(o, "btdf-lobe") != "mirrored";
+    c.btdf_lobe_shared = option_value(o, "btdf-lobe") == "shared";
     c.btdf_populations = option_value(o, "btdf-series") == "populations";
     const std::string& s = option_value(o, "spread");
     c.spread = s == "normal" ? Lamina1Choices::Spread::Normal
