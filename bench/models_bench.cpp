@@ -132,6 +132,22 @@ void BM_ModelPreparedEval(benchmark::State& state, const std::string& name, cons
     state.SetItemsProcessed(state.iterations());
 }
 
+/// The same through a slab (lamina-1's BTDF): the outgoing directions mirrored below.
+void BM_ModelPreparedEvalTransmission(benchmark::State& state, const std::string& name,
+                                      const Stack& stack) {
+    warm_tables();
+    const auto model = make_model(name, stack);
+    static const Pairs pairs;
+    std::vector<Vec3d> below;
+    for (const Vec3d& w : pairs.wo)
+        below.emplace_back(w.x, w.y, -w.z);
+    const auto ev = model->prepare(pairs.wi[0]);
+    std::size_t n = 0;
+    for (auto _ : state)
+        benchmark::DoNotOptimize(ev->eval(below[n++ & 4095]));
+    state.SetItemsProcessed(state.iterations());
+}
+
 /// One binned table: 7 incidences, 90x90 grid, both sides where supported, on `stack`.
 void BM_StackBinnedTable(benchmark::State& state, const std::string& name, const Stack& stack) {
     warm_tables();
@@ -229,6 +245,10 @@ const int registered = [] {
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
     }
+    for (const char* name : {"lamina-1", "bel-prime", "tm2"})
+        benchmark::RegisterBenchmark(
+            ("BM_ModelPreparedEvalTransmission/" + std::string(name) + "/slab").c_str(),
+            BM_ModelPreparedEvalTransmission, std::string(name), typical_stack(true));
     for (const char* name : {"bel-prime", "tm2"})
         benchmark::RegisterBenchmark(
             ("BM_BinnedTable/" + std::string(name) + "/slab-both-sides").c_str(),

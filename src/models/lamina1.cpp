@@ -6,6 +6,7 @@
 #include "models/medium_adding.h"
 #include "models/multiple_scattering_albedo.h"
 #include "models/quadrature.h"
+#include "physics/dielectric.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
 #include "physics/phase.h"
@@ -34,6 +35,11 @@ constexpr int kYnphi = 8;  // ... × midpoint in φ over the half disk
 constexpr int kSplitNr = 6, kSplitNphi = 8, kSplitBisections = 14;
 constexpr int kNormNr = 12, kNormNphi = 8;  // the base lobe's normalization N (its rule)
 constexpr int kGauss = 24;  // Gauss–Legendre nodes per piece of the hemispherical integrals
+// The slab's transmission curves (precompute_slab): nodes over a cosine (the first order, the
+// later orders), and the split visible-normal rule of their integrals (r nodes per piece, φ
+// nodes, bisections).
+constexpr int kNfirst = 17, kNslab = 17;
+constexpr int kSlabNr = 4, kSlabNphi = 8, kSlabBisections = 8;
 
 /// A curve over a cosine μ ∈ [0, 1] on nodes μ = s² (dense at grazing), linear in s.
 template <typename V, int kN = kNmu>
@@ -54,10 +60,10 @@ struct CosineCurve {
 
 /// A curve over an inside cosine with a jump at the critical cosine μc (total internal reflection
 /// at a smooth coat): linear on nodes uniform in [0, μc) and in [μc, 1], each piece on its own.
-template <int kN>
+template <int kN, typename V = Rgbd>
 struct SplitCurve {
     double split = 0;
-    std::array<Rgbd, kN> below{}, above{};
+    std::array<V, kN> below{}, above{};
     template <typename F>
     void fill(double mu_split, F&& f) {
         split = clamp(mu_split, 0.0, 1.0);
@@ -67,11 +73,42 @@ struct SplitCurve {
             above[i] = f(split + (1 - split) * t);
         }
     }
-    Rgbd operator()(double mu) const {
+    V operator()(double mu) const {
         const bool lower = mu < split;
         const double a = lower ? 0 : split, b = lower ? split : 1;
         const auto& v = lower ? below : above;
         const double x = b > a ? clamp((mu - a) / (b - a), 0.0, 1.0) * (kN - 1) : 0;
+        const int i = std::min(int(x), kN - 2);
+        const double t = x - i;
+        return v[i] * (1 - t) + v[i + 1] * t;
+    }
+};
+
+/// A curve over an inside cosine with a square-root edge at the critical cosine μc (a nearly
+/// smooth interface's transmittance from inside, which rises as √(μ − μc) above it): linear on
+/// nodes uniform in [0, μc) and, above, in t with μ = μc + (1 − μc) t² (as integrate01 below).
+template <int kN>
+struct EdgeCurve {
+    double split = 0;
+    std::array<double, kN> below{}, above{};
+    template <typename F>
+    void fill(double mu_split, F&& f) {
+        split = clamp(mu_split, 0.0, 1.0);
+        for (int i = 0; i < kN; ++i) {
+            const double t = double(i) / (kN - 1);
+            below[i] = f(std::min(split * t, std::nextafter(split, 0.0)));
+            above[i] = f(split + (1 - split) * t * t);
+        }
+    }
+    double operator()(double mu) const {
+        const bool lower = mu < split;
+        double x = 0;
+        if (lower)
+            x = split > 0 ? clamp(mu / split, 0.0, 1.0) : 0.0;
+        else
+            x = split < 1 ? std::sqrt(clamp((mu - split) / (1 - split), 0.0, 1.0)) : 0.0;
+        const auto& v = lower ? below : above;
+        x *= kN - 1;
         const int i = std::min(int(x), kN - 2);
         const double t = x - i;
         return v[i] * (1 - t) + v[i + 1] * t;
@@ -99,14 +136,15 @@ V integrate01(F&& f, double split) {
 /// same integrand for w in the xz plane), an integrand that steps where outgoing_z(wm) crosses
 /// z_split: per φ node the r axis is split at the crossing (bisection; outgoing_z is monotonic
 /// along r for the reflections and refractions used here) and each piece gets Gauss–Legendre.
-template <typename V, typename Out, typename F>
+template <typename V, int kNr = kSplitNr, int kNphi = kSplitNphi,
+          int kBisections = kSplitBisections, typename Out, typename F>
 V integrate_visible_split(const GGX<double>& ggx, const Vec3d& w, double z_split, Out&& outgoing_z,
                           F&& f) {
-    static const QuadratureRule q = gauss_legendre(kSplitNr);
+    static const QuadratureRule q = gauss_legendre(kNr);
     constexpr double kRMax = 1 - 1e-9;
     V sum{};
-    for (int b = 0; b < kSplitNphi; ++b) {
-        const double u2 = 0.5 * (b + 0.5) / kSplitNphi - 0.25;
+    for (int b = 0; b < kNphi; ++b) {
+        const double u2 = 0.5 * (b + 0.5) / kNphi - 0.25;
         auto side = [&](double r) {
             return outgoing_z(ggx.sample_visible_normal(w, r * r, u2)) > z_split;
         };
@@ -114,7 +152,7 @@ V integrate_visible_split(const GGX<double>& ggx, const Vec3d& w, double z_split
         const bool first = side(0);
         if (first != side(kRMax)) {
             double lo = 0, hi = kRMax;
-            for (int it = 0; it < kSplitBisections; ++it) {
+            for (int it = 0; it < kBisections; ++it) {
                 const double mid = 0.5 * (lo + hi);
                 (side(mid) == first ? lo : hi) = mid;
             }
@@ -123,13 +161,42 @@ V integrate_visible_split(const GGX<double>& ggx, const Vec3d& w, double z_split
         for (int piece = 0; piece < 2; ++piece) {
             const double start = piece ? r_split : 0, length = piece ? kRMax - r_split : r_split;
             if (length <= 0) continue;
-            for (int i = 0; i < kSplitNr; ++i) {
+            for (int i = 0; i < kNr; ++i) {
                 const double r = start + length * q.x[i];
-                sum += f(ggx.sample_visible_normal(w, r * r, u2)) *
-                       (q.w[i] * length * 2 * r / kSplitNphi);
+                sum +=
+                    f(ggx.sample_visible_normal(w, r * r, u2)) * (q.w[i] * length * 2 * r / kNphi);
             }
         }
     }
+    return sum;
+}
+
+/// N values of type T integrated and tabulated together (the curves above take it as V).
+template <typename T, int N>
+struct Multi {
+    std::array<T, N> v{};
+    Multi& operator+=(const Multi& o) {
+        for (int i = 0; i < N; ++i)
+            v[i] += o.v[i];
+        return *this;
+    }
+    Multi operator+(const Multi& o) const { return Multi(*this) += o; }
+    Multi operator*(double s) const {
+        Multi r;
+        for (int i = 0; i < N; ++i)
+            r.v[i] = v[i] * s;
+        return r;
+    }
+};
+
+/// ∫_lo^hi f(μ) dμ by Gauss–Legendre (kGauss nodes).
+template <typename V, typename F>
+V integrate_range(F&& f, double lo, double hi) {
+    static const QuadratureRule q = gauss_legendre(kGauss);
+    V sum{};
+    if (!(hi > lo)) return sum;
+    for (int i = 0; i < kGauss; ++i)
+        sum += f(lo + (hi - lo) * q.x[i]) * (q.w[i] * (hi - lo));
     return sum;
 }
 
@@ -173,6 +240,7 @@ class Lamina1 final : public Model {
                 base_fgd_[c] = FgdTable::locate(coat_.base_eta[c], coat_.base_k[c]);
         precompute();
         if (scatters_) precompute_scattering();
+        precompute_slab();
     }
 
     std::string name() const override { return "lamina-1"; }
@@ -195,6 +263,14 @@ class Lamina1 final : public Model {
         Rgbd orders{0.0};      ///< E_ms(μi)/(π Ē_ms): the scattered remainder's separable lobe
         Rgbd orders_t{0.0};    ///< E_ms,T(μi)/(π T̄_b): its transmitted part (slabs)
         Rgbd twice{0.0};       ///< that part's normalization as twice-scattered light
+        double alpha_b = 0;    ///< the slab bottom's roughness widened by the coat's spread
+        Rgbd first_T{0.0};  ///< E_1(μi)/T_lobe(μi): the first order over the bottom lobe's energy
+        Rgbd first_E{0.0};  ///< E_1(μi): the first order's transmitted energy
+        double u_bottom = 1;  ///< the first order's share in the bottom's lobe (btdf-lobe)
+        Rgbd first_M{0.0};    ///< E_1(μi)/Q_m(μi): over the mirrored lobe's energy (shared)
+        /// Φ_p(μi)/(π A_p η_s²) for the populations p = inside, beyond the exit cone (v[0], v[1])
+        /// and the energy Σ_p Φ_p T_p they transmit (v[2]): the slab's later orders.
+        Multi<Rgbd, 3> trapped{};
     };
 
     Incident incident(const Vec3d& wi) const {
@@ -242,6 +318,21 @@ class Lamina1 final : public Model {
             // and a lobe whose width followed wo would no longer be normalized.
             const double s2 = sqr(eta_s_) * (1 - sqr(in.wi_mean.z));
             in.k_bottom = s2 < 1 ? spread_factor(std::sqrt(1 - s2), in.wi_mean.z, eta_s_) : 1.0;
+            if (bottom_lobe_) {
+                // The first order leaves through the bottom's own BTDF at the mean inside
+                // direction, of roughness α_b, scaled to carry the light's first-order energy
+                // E_1(μi).
+                in.alpha_b = bottom_roughness(in.k_top, in.k_bottom);
+                const Multi<Rgbd, 3> first = first_order_(wi.z);
+                const Multi<Rgbd, 2> smooth = first_order_smooth(wi.z, in.wi_in.z);
+                in.first_T = first.v[0] + smooth.v[0];
+                in.first_E = first.v[1] + smooth.v[1];
+                in.first_M = first.v[2] + smooth.v[0];
+                // btdf-lobe=shared: the bottom's share of the spread's variance.
+                if (ch_.btdf_lobe_shared && in.alpha_b > 0)
+                    in.u_bottom = sqr(alpha1_) / sqr(in.alpha_b);
+            }
+            if (populations_) in.trapped = trapped_(wi.z);
         }
         return in;
     }
@@ -395,6 +486,7 @@ class Lamina1 final : public Model {
         std::array<double, 5> p{};
         Vec3d wi_in, wi_mean;
         double alpha_base = 0, beta = 0;
+        bool bottom_sampled = false;  ///< the transmission lobe drawn as the bottom's (btdf-lobe)
     };
     Mixture mixture(const Incident& in) const;
     double pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) const;
@@ -433,7 +525,12 @@ class Lamina1 final : public Model {
         const Rgbd a_v = has_absorption_ ? attenuation(v_in->z) : Rgbd(1.0);
         Rgbd f(0.0);
         const double beta = transmission_roughness(in.k_top, in.k_bottom);
-        if (beta > 0) {
+        if (bottom_lobe_ && in.alpha_b > 0 && in.u_bottom > 0) {
+            // The bottom's Walter BTDF (Eq. 21) from the mean inside direction: with a smooth coat
+            // the first order is exactly T(μi) a(μi') f_t,bottom(wi', wo).
+            f += in.first_T * (in.u_bottom * bottom_btdf(in.alpha_b).eval(in.wi_mean, wo));
+        }
+        if ((!bottom_lobe_ || in.u_bottom < 1) && beta > 0) {
             const GGX<double> ggx{beta};
             const Vec3d h = normalize(in.wi_mean + *v_in);
             const double q = ggx.D(h) * ggx.G2(in.wi_mean, *v_in) / (4 * in.wi_mean.z * v_in->z);
@@ -445,12 +542,27 @@ class Lamina1 final : public Model {
             Rgbd a_once = in.a_mean * a_v;
             for (int c = 0; c < 3; ++c)
                 a_once[c] = std::sqrt(a_once[c]);
-            if (mirror_series_)
+            if (mirror_series_ && !populations_)
                 a_once *= mirror_series_curve_(in.wi_mean.z) * mirror_series_curve_(v_in->z);
-            f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
+            if (bottom_lobe_) {
+                // btdf-lobe=shared: the mirrored lobe's share 1 − u of the first order, carrying
+                // E_1 over its energy Q_m (the medium's attenuation is in E_1).
+                Rgbd rounds(1.0);
+                if (mirror_series_ && !populations_)
+                    rounds = mirror_series_curve_(in.wi_mean.z) * mirror_series_curve_(v_in->z);
+                f += in.first_M * rounds * ((1 - in.u_bottom) * T_b_in * q / (eta_s_ * eta_s_));
+            } else {
+                f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
+            }
         }
-        if (series_btdf_)
+        if (populations_) {
+            // The later orders: uniform radiance in each population leaves through the bottom as
+            // the light from below at wo enters into it (reciprocity), T_{below→p}(μv)/η_s².
+            const Multi<double, 2> enter = enter_below_(v.z);
+            f += in.trapped.v[0] * enter.v[0] + in.trapped.v[1] * enter.v[1];
+        } else if (series_btdf_) {
             f += in.X * inv_one_minus_Er_ * (T_b * kInvPi<double> / (eta_s_ * eta_s_));
+        }
         // The scattered light that leaves through the bottom, as uniform radiance below it.
         if (orders_on_ && !twice_on_) f += in.orders_t * T_b;
         if (scatters_ && back_on_)
@@ -499,6 +611,32 @@ class Lamina1 final : public Model {
     double transmission_roughness(double k_top, double k_bottom) const {
         if (ch_.spread == Lamina1Choices::Spread::Off) return std::max(alpha0_, alpha1_);
         return 0.5 * std::sqrt(sqr(alpha0_ * k_top) + sqr(alpha1_ * k_bottom));
+    }
+
+    /// α_b² = α1² + (α0 k_top/k_bottom)²: the coat turns the light inside by α0 k_top (per unit
+    /// slope), which a bottom facet of slope s matches with k_bottom s (item 5 of docs/models.md).
+    double bottom_roughness(double k_top, double k_bottom) const {
+        if (ch_.spread == Lamina1Choices::Spread::Off) return std::max(alpha0_, alpha1_);
+        return std::sqrt(sqr(alpha1_) + sqr(alpha0_ * k_top / k_bottom));
+    }
+
+    /// The smooth slab's E_1/T_lobe = (1 − F(μ)) a(μ') and E_1 = (1 − F(μ)) a(μ') (1 − F_b(μ')):
+    /// first_order_ holds the residual from them (it vanishes with α0 and α1, and the smooth
+    /// slab's steep edge at grazing incidence is not interpolated).
+    Multi<Rgbd, 2> first_order_smooth(double mu, double mu_in) const {
+        Multi<Rgbd, 2> r;
+        r.v[0] = attenuation(mu_in) * (1 - fresnel_dielectric(mu, eta0_));
+        r.v[1] = r.v[0] * (1 - fresnel_dielectric(mu_in, eta_b_));
+        return r;
+    }
+
+    /// The slab bottom as a single rough interface seen from inside the coat (wi inside, up).
+    DielectricInterface<double> bottom_btdf(double alpha) const {
+        DielectricInterface<double> d{eta_b_, alpha};
+        d.transmission_masking = ch_.masking == RefractionMasking::Walter
+                                     ? TransmissionMasking::Pbrt
+                                     : TransmissionMasking::Smith;
+        return d;
     }
 
     double spread_factor(double mu, double mu_in, double eta) const {
@@ -575,6 +713,7 @@ class Lamina1 final : public Model {
 
     void precompute();
     void precompute_scattering();
+    void precompute_slab();
 
     Lamina1Choices ch_;
     CoatedStack coat_;
@@ -636,6 +775,17 @@ class Lamina1 final : public Model {
     CosineCurve<Rgbd, kNmu> mirror_albedo_curve_;
     /// The explicit single scattering's energy at μ (the sampler's mixture weight).
     CosineCurve<Rgbd, kNx> single_energy_, single_energy_t_;
+    /// The slab's first order through the bottom's BTDF (Lamina1Choices::btdf_bottom_lobe):
+    /// E_1(μ), the energy it transmits per unit flux arriving at outside cosine μ.
+    bool bottom_lobe_ = false;
+    /// E_1(μ)/T_lobe(μ) and E_1(μ) (v[0], v[1]) over outside cosines.
+    CosineCurve<Multi<Rgbd, 3>, kNfirst> first_order_;
+    /// The slab's later orders as two populations of inside light (Lamina1Choices::
+    /// btdf_populations): Incident::trapped over outside cosines, and T_{below→p}(μ), the light
+    /// arriving from below at μ that the bottom lets into population p.
+    bool populations_ = false;
+    CosineCurve<Multi<Rgbd, 3>, kNslab> trapped_;
+    CosineCurve<Multi<double, 2>, kNslab> enter_below_;
 
     friend class SplitIncidentEvaluator<Lamina1>;
 };
@@ -779,7 +929,8 @@ void Lamina1::precompute() {
     // (by k δ per facet tilt δ, item 4 of docs/models.md), so its mean lies beyond the macro
     // refraction — near grazing, beyond a slab's exit cone. By the coat's visible-normal rule.
     mean_shift_ = support_.btdf && alpha0_ > 0 && ch_.directional_transmittance && ch_.mean_shift;
-    if (mean_shift_) {
+    // (With btdf-lobe=bottom, precompute_slab computes it by its own rule, with the first order.)
+    if (mean_shift_ && !ch_.btdf_bottom_lobe) {
         static const QuadratureRule q = gauss_legendre(kYnr);
         const GGX<double> ggx0{alpha0_};
         mu_mean_.fill([&](double mu) {
@@ -1146,6 +1297,305 @@ void Lamina1::precompute_scattering() {
     }
 }
 
+void Lamina1::precompute_slab() {
+    bottom_lobe_ = support_.btdf && ch_.btdf_bottom_lobe;
+    populations_ = support_.btdf && ch_.btdf_populations && ch_.inter_reflection &&
+                   !ch_.multiple_scattering && !(alpha0_ == 0 && alpha1_ == 0);
+    if (!bottom_lobe_ && !populations_) return;
+    const MultipleScatteringAlbedo* ms =
+        ch_.multiple_scattering ? &MultipleScatteringAlbedo::get() : nullptr;
+    // Inside directions fall into two populations: 0 within the coat's exit cone (μ ≥ μc), 1
+    // beyond it, where a smooth coat reflects everything back.
+    const double mu_c = std::sqrt(1 - sqr(inv_eta0_));
+    const double mu_crit_b = eta_b_ < 1 ? std::sqrt(1 - sqr(eta_b_)) : 0.0;
+    auto population = [&](double mu) { return mu >= mu_c ? 0 : 1; };
+    // The bottom's transmittance from inside at w for roughness α (Walter et al. 2007, Eq. 21
+    // integrated over its visible normals, weight (1 − F) G_t/G1), the rule split where the
+    // facets start to reflect totally.
+    auto bottom_transmittance = [&](double alpha, const Vec3d& w) {
+        if (alpha == 0) return 1 - fresnel_dielectric(w.z, eta_b_);
+        const GGX<double> ggx{alpha};
+        const double lambda_w = ggx.lambda(w);
+        return integrate_visible_split<double, kSlabNr, kSlabNphi, kSlabBisections>(
+            ggx, w, mu_crit_b, [&](const Vec3d& wm) { return dot(w, wm); },
+            [&](const Vec3d& wm) {
+                const auto wt = refract(w, wm, eta_b_);
+                if (!wt || wt->z >= 0) return 0.0;
+                return (1 - fresnel_dielectric(dot(w, wm), eta_b_)) *
+                       refraction_escape(ch_.masking, lambda_w, ggx.lambda(*wt));
+            });
+    };
+    // T_b,in(μ) of the bottom's own roughness, directly: the table's interpolation across the
+    // steep edge just inside the critical cone (nearly smooth bottoms) is 1.5% low at α1 = 0.02.
+    EdgeCurve<kNslab> T_b_in;
+    T_b_in.fill(mu_crit_b, [&](double mu) {
+        return bottom_transmittance(alpha1_, Vec3d(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-6)));
+    });
+    using Rule2 = Multi<Rgbd, 2>;
+    using Rule4 = Multi<Rgbd, 4>;
+
+    // ρ_r(μ): the coat's reflection of light inside going up at μ into population r, times the
+    // attenuation of the crossing down. From inside the coat is an interface of relative index
+    // 1/η0 (total internal reflection beyond μc); rough: its visible normals (Heitz 2018), weight
+    // F G2/G1, the reflected direction split at μc.
+    SplitCurve<(kNslab + 1) / 2, Rule2> rho;
+    auto rho_at = [&](double mu) {
+        Rule2 r;
+        if (alpha0_ == 0) {
+            r.v[population(mu)] = attenuation(mu) * fresnel_dielectric(mu, inv_eta0_);
+            return r;
+        }
+        const GGX<double> ggx0{alpha0_};
+        const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+        const double lambda_w = ggx0.lambda(w);
+        return integrate_visible_split<Rule2, kSlabNr, kSlabNphi, kSlabBisections>(
+            ggx0, w, mu_c, [&](const Vec3d& wm) { return reflect(w, wm).z; },
+            [&](const Vec3d& wm) {
+                Rule2 out;
+                const Vec3d w2 = reflect(w, wm);
+                if (w2.z <= 0) return out;
+                const double escape = (1 + lambda_w) / (1 + lambda_w + ggx0.lambda(w2));
+                out.v[population(w2.z)] =
+                    attenuation(w2.z) * (fresnel_dielectric(dot(w, wm), inv_eta0_) * escape);
+                return out;
+            });
+    };
+    if (populations_) rho.fill(mu_c, [&](double mu) { return rho_at(std::max(mu, 1e-6)); });
+
+    // The bottom seen from inside, light going down at μ: its reflection into population q times
+    // the attenuation of the crossing up (v[0], v[1]), and that light after the coat's return,
+    // arriving down in population r (v[2 + r]): Σ ∫ R(μ → w'') ρ_r(μ_w'').
+    SplitCurve<(kNslab + 1) / 2, Rule4> bottom;
+    if (populations_)
+        bottom.fill(mu_crit_b, [&](double mu_in) {
+            const double mu = std::max(mu_in, 1e-6);
+            Rule4 r;
+            if (alpha1_ == 0) {
+                const Rgbd R = attenuation(mu) * fresnel_dielectric(mu, eta_b_);
+                const Rule2 back = rho(mu);
+                r.v[population(mu)] = R;
+                r.v[2] = R * back.v[0];
+                r.v[3] = R * back.v[1];
+                return r;
+            }
+            const GGX<double> ggx1{alpha1_};
+            const Vec3d w(safe_sqrt(1 - mu * mu), 0, mu);
+            const double lambda_w = ggx1.lambda(w);
+            return integrate_visible_split<Rule4, kSlabNr, kSlabNphi, kSlabBisections>(
+                ggx1, w, mu_c, [&](const Vec3d& wm) { return reflect(w, wm).z; },
+                [&](const Vec3d& wm) {
+                    Rule4 out;
+                    const Vec3d w2 = reflect(w, wm);
+                    if (w2.z <= 0) return out;
+                    const double escape = (1 + lambda_w) / (1 + lambda_w + ggx1.lambda(w2));
+                    const Rgbd R =
+                        attenuation(w2.z) * (fresnel_dielectric(dot(w, wm), eta_b_) * escape);
+                    const Rule2 back = rho(w2.z);
+                    out.v[population(w2.z)] = R;
+                    out.v[2] = R * back.v[0];
+                    out.v[3] = R * back.v[1];
+                    return out;
+                });
+        });
+
+    // The light the coat lets in at outside cosine μ, per unit flux, by its own inside direction
+    // w' (the coat's transmitted light t(μ → w'), as in X): E_1(μ) = ∫ t a T_b,in dω' leaves
+    // through the bottom at once (the first order, v[0]); D_r(μ) = ∫ t a (R ρ_r)(μ_w') dω'
+    // comes back down in population r after one reflection at the bottom and one at the coat
+    // (v[1 + r]). T_b,in and the bottom's curve step at the bottom's critical cosine: the rule
+    // splits there.
+    auto entering = [&](double mu_in) {
+        Multi<Rgbd, 3> r;
+        const Rgbd a = attenuation(mu_in);
+        r.v[0] = a * (ms ? T_bot_in_(mu_in) : T_b_in(mu_in));
+        if (populations_) {
+            const Rule4 b = bottom(mu_in);
+            r.v[1] = a * b.v[2];
+            r.v[2] = a * b.v[3];
+        }
+        return r;
+    };
+    CosineCurve<Multi<Rgbd, 3>, kNfirst> entry;
+    if (alpha0_ == 0 || !ch_.directional_transmittance) {
+        entry.fill([&](double mu) {
+            const double mu_in = refract_in(Vec3d(safe_sqrt(1 - mu * mu), 0, mu), inv_eta0_).z;
+            return entering(mu_in) * T_top_(mu);
+        });
+    } else {
+        const GGX<double> ggx0{alpha0_};
+        // The coat's orders ≥ 2 (multiple scattering) transmit ΔT(μ) more, taken as cosine-
+        // distributed inside, as in X.
+        const Rgbd once_spread =
+            ms ? integrate01<Rgbd>([&](double mu) { return entering(mu).v[0] * (2 * mu); },
+                                   mu_crit_b)
+               : Rgbd(0.0);
+        auto entry_at = [&](double mu) {
+            const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+            const double lambda_w = ggx0.lambda(w);
+            auto inside_z = [&](const Vec3d& wm) {
+                const auto wt = refract(w, wm, eta0_);
+                return wt ? -wt->z : 0.0;
+            };
+            // v[3] (x, z, ·): the (1 − F)-weighted inside direction, the transmitted light's mean
+            // direction for the lobe's centre (item 5 of docs/models.md).
+            Multi<Rgbd, 4> sum =
+                integrate_visible_split<Multi<Rgbd, 4>, kSlabNr, kSlabNphi, kSlabBisections>(
+                    ggx0, w, mu_crit_b, inside_z, [&](const Vec3d& wm) {
+                        Multi<Rgbd, 4> out;
+                        const auto wt = refract(w, wm, eta0_);
+                        if (!wt || wt->z >= 0) return out;
+                        const double F = fresnel_dielectric(dot(w, wm), eta0_);
+                        const double escape =
+                            refraction_escape(ch_.masking, lambda_w, ggx0.lambda(*wt));
+                        const Multi<Rgbd, 3> e = entering(-wt->z) * ((1 - F) * escape);
+                        for (int i = 0; i < 3; ++i)
+                            out.v[i] = e.v[i];
+                        out.v[3] = Rgbd(wt->x, -wt->z, 0.0) * (1 - F);
+                        return out;
+                    });
+            if (ms) sum.v[0] += once_spread * ms->dielectric(mu, alpha0_, eta0_).transmitted;
+            return sum;
+        };
+        // The mean direction's curve has twice the nodes (its odd ones interpolated).
+        static_assert(2 * (kNfirst - 1) == kNx - 1, "the mean direction shares the nodes");
+        for (int i = 0; i < kNfirst; ++i) {
+            const double mu = sqr(double(i) / (kNfirst - 1));
+            const Multi<Rgbd, 4> e = entry_at(mu);
+            for (int k = 0; k < 3; ++k)
+                entry.v[i].v[k] = e.v[k];
+            if (mean_shift_) {
+                // Stored as the shift from the macro refraction, as in precompute.
+                const double len = std::hypot(e.v[3][0], e.v[3][1]);
+                const double mu_in =
+                    refract_in(Vec3d(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4)), inv_eta0_).z;
+                mu_mean_.v[2 * i] = (len > 0 ? e.v[3][1] / len : mu_in) - mu_in;
+                if (i > 0)
+                    mu_mean_.v[2 * i - 1] = 0.5 * (mu_mean_.v[2 * i - 2] + mu_mean_.v[2 * i]);
+            }
+        }
+    }
+
+    if (bottom_lobe_) {
+        // T_lobe(μ): the energy of the bottom's lobe of roughness α_b at the mean inside direction
+        // (both depend on wi only), by its visible normals, split where the facets reflect
+        // totally; the lobe is divided by it and carries E_1.
+        first_order_.fill([&](double mu) {
+            const Incident in = incident(Vec3d(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4)));
+            Multi<Rgbd, 3> r;
+            r.v[1] = entry(mu).v[0];
+            const double mu_in = in.ok ? in.wi_in.z : 0.0;
+            if (in.ok && in.alpha_b > 0) {
+                const double T_lobe = bottom_transmittance(in.alpha_b, in.wi_mean);
+                if (T_lobe > 0) r.v[0] = r.v[1] * (1 / T_lobe);
+            }
+            // btdf-lobe=shared: Q_m = ∫_cone T_b,in(μv') q(w̄i', v'; β) μv' dωv', the mirrored
+            // lobe's energy (as eval_btdf weights it), by the visible normals of β at w̄i', split
+            // where the mirrored direction leaves the exit cone.
+            const double beta = in.ok ? transmission_roughness(in.k_top, in.k_bottom) : 0.0;
+            if (ch_.btdf_lobe_shared && beta > 0) {
+                const GGX<double> ggx{beta};
+                const Vec3d& w = in.wi_mean;
+                const double lambda_w = ggx.lambda(w);
+                const double Q_m =
+                    integrate_visible_split<double, kSlabNr, kSlabNphi, kSlabBisections>(
+                        ggx, w, mu_crit_b, [&](const Vec3d& wm) { return reflect(w, wm).z; },
+                        [&](const Vec3d& wm) {
+                            const Vec3d v_in = reflect(w, wm);
+                            if (v_in.z <= mu_crit_b) return 0.0;
+                            return T_bot_in_(v_in.z) * (1 + lambda_w) /
+                                   (1 + lambda_w + ggx.lambda(v_in));
+                        });
+                if (Q_m > 0) r.v[2] = r.v[1] * (1 / Q_m);
+            }
+            const Multi<Rgbd, 2> smooth = first_order_smooth(mu, mu_in);
+            r.v[0] = r.v[0] - smooth.v[0];
+            r.v[1] = r.v[1] - smooth.v[1];
+            r.v[2] = r.v[2] - smooth.v[0];
+            return r;
+        });
+    }
+    if (!populations_) return;
+
+    // T_{below→p}(μ): light arriving from below at μ that the bottom lets into population p. From
+    // below the bottom is an interface of relative index η_s (into the denser coat); rough: its
+    // visible normals, weight (1 − F) G_t/G1, the refracted direction split at μc.
+    enter_below_.fill([&](double mu_out) {
+        const double mu = std::max(mu_out, 1e-4);
+        Multi<double, 2> r;
+        if (alpha1_ == 0) {
+            const double mu_in = safe_sqrt(1 - (1 - mu * mu) / sqr(eta_s_));
+            r.v[population(mu_in)] = 1 - fresnel_dielectric(mu, eta_s_);
+            return r;
+        }
+        const GGX<double> ggx1{alpha1_};
+        const Vec3d w(safe_sqrt(1 - mu * mu), 0, mu);
+        const double lambda_w = ggx1.lambda(w);
+        auto inside_z = [&](const Vec3d& wm) {
+            const auto wt = refract(w, wm, eta_s_);
+            return wt ? -wt->z : 0.0;
+        };
+        return integrate_visible_split<Multi<double, 2>, kSlabNr, kSlabNphi, kSlabBisections>(
+            ggx1, w, mu_c, inside_z, [&](const Vec3d& wm) {
+                Multi<double, 2> out;
+                const auto wt = refract(w, wm, eta_s_);
+                if (!wt || wt->z >= 0) return out;
+                out.v[population(-wt->z)] =
+                    (1 - fresnel_dielectric(dot(w, wm), eta_s_)) *
+                    refraction_escape(ch_.masking, lambda_w, ggx1.lambda(*wt));
+                return out;
+            });
+    });
+
+    // After the first return the light is taken as uniform radiance within each population
+    // (A_p = ∫_p 2μ dμ): the bottom reflects population p into q with R_pq, the coat returns q
+    // into r with ρ_qr, and the bottom lets p out with T_p = (2/(A_p η_s²)) ∫ T_{below→p} μ dμ
+    // (reciprocity of the bottom's BTDF). With M = ρ R, the light arriving down summed over every
+    // round trip is Φ = (1 − M)⁻¹ D.
+    const double A[2] = {1 - sqr(mu_c), sqr(mu_c)};
+    const double range[2][2] = {{mu_c, 1.0}, {0.0, mu_c}};
+    double T_out[2] = {0, 0};
+    Rgbd R_pq[2][2], rho_qr[2][2];
+    for (int p = 0; p < 2; ++p) {
+        const double lo = range[p][0], hi = range[p][1];
+        if (!(A[p] > 0)) continue;
+        const Rule4 Rb = integrate_range<Rule4>(
+            [&](double mu) { return bottom(std::min(mu, std::nextafter(hi, 0.0))) * (2 * mu); }, lo,
+            hi);
+        const Rule2 rh = integrate_range<Rule2>(
+            [&](double mu) { return rho(std::min(mu, std::nextafter(hi, 0.0))) * (2 * mu); }, lo,
+            hi);
+        for (int q = 0; q < 2; ++q) {
+            R_pq[p][q] = Rb.v[q] * (1 / A[p]);
+            rho_qr[p][q] = rh.v[q] * (1 / A[p]);
+        }
+        T_out[p] =
+            integrate01<double>([&](double mu) { return enter_below_(mu).v[p] * (2 * mu); }, 0.0) /
+            (A[p] * sqr(eta_s_));
+    }
+    trapped_.fill([&](double mu) {
+        const Multi<Rgbd, 3> e = entry(mu);
+        Multi<Rgbd, 3> r;
+        for (int c = 0; c < 3; ++c) {
+            // M_rp = Σ_q ρ_qr R_pq; Φ = (1 − M)⁻¹ D by the 2 × 2 inverse.
+            double M[2][2];
+            for (int rr = 0; rr < 2; ++rr)
+                for (int p = 0; p < 2; ++p)
+                    M[rr][p] = rho_qr[0][rr][c] * R_pq[p][0][c] + rho_qr[1][rr][c] * R_pq[p][1][c];
+            const double a = 1 - M[0][0], b = -M[0][1], cc = -M[1][0], d = 1 - M[1][1];
+            const double det = a * d - b * cc;
+            if (!(det > 0)) continue;
+            const double D0 = e.v[1][c], D1 = e.v[2][c];
+            const double phi[2] = {(d * D0 - b * D1) / det, (a * D1 - cc * D0) / det};
+            for (int p = 0; p < 2; ++p) {
+                if (!(A[p] > 0)) continue;
+                r.v[p][c] = phi[p] * kInvPi<double> / (A[p] * sqr(eta_s_));
+                r.v[2][c] += phi[p] * T_out[p];
+            }
+        }
+        return r;
+    });
+}
+
 std::unique_ptr<IncidentEvaluator> Lamina1::prepare(const Vec3d& wi) const {
     return std::make_unique<SplitIncidentEvaluator<Lamina1>>(*this, wi);
 }
@@ -1174,9 +1624,14 @@ Lamina1::Mixture Lamina1::mixture(const Incident& in) const {
         if (orders_on_) m.p[2] += orders_(in.wi.z).mean();
     }
     if (support_.btdf) {
-        m.beta = transmission_roughness(in.k_top, in.k_bottom);
-        if (m.beta > 0) m.p[3] = in.T * a * std::max(0.0, 1 - E_b);
-        if (series_btdf_) m.p[4] = (in.X * inv_one_minus_Er_).mean() * 0.5;
+        m.bottom_sampled = bottom_lobe_ && in.u_bottom >= 0.5;
+        m.beta = m.bottom_sampled ? in.alpha_b : transmission_roughness(in.k_top, in.k_bottom);
+        if (m.beta > 0)
+            m.p[3] = bottom_lobe_ ? in.first_E.mean() : in.T * a * std::max(0.0, 1 - E_b);
+        if (populations_)
+            m.p[4] = in.trapped.v[2].mean();
+        else if (series_btdf_)
+            m.p[4] = (in.X * inv_one_minus_Er_).mean() * 0.5;
         if (orders_on_) m.p[4] += orders_t_(in.wi.z).mean();
         if (scatters_ && back_on_) m.p[4] += single_energy_t_(in.wi.z).mean();
     }
@@ -1216,7 +1671,16 @@ double Lamina1::pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) 
         if (m.p[2] > 0) pdf += m.p[2] * wo.z * kInvPi<double>;
         return pdf;
     }
-    if (m.p[3] > 0) {
+    if (m.p[3] > 0 && m.bottom_sampled) {
+        // Refracted through the visible normals of α_b at the mean inside direction (Walter et
+        // al. 2007, Eq. 17: dωm/dωo = η_o² |wo·wm| / (η_i wi·wm + η_o wo·wm)², η_o/η_i = η_b).
+        const DielectricInterface<double> bottom = bottom_btdf(m.beta);
+        if (const auto wm = bottom.half_vector(m.wi_mean, wo)) {
+            const double jacobian = sqr(eta_b_) * std::abs(dot(wo, *wm)) /
+                                    sqr(dot(m.wi_mean, *wm) + eta_b_ * dot(wo, *wm));
+            pdf += m.p[3] * GGX<double>{m.beta}.D_visible(m.wi_mean, *wm) * jacobian;
+        }
+    } else if (m.p[3] > 0) {
         const Vec3d v(wo.x, wo.y, -wo.z);
         if (const auto v_in = refract_in_checked(v, 1 / eta_s_)) {
             const Vec3d h = normalize(m.wi_mean + *v_in);
@@ -1263,6 +1727,12 @@ std::optional<ModelSample> Lamina1::sample(const Vec3d& wi, const Vec3d& u) cons
             break;
         case 3: {
             const Vec3d wm = GGX<double>{m.beta}.sample_visible_normal(m.wi_mean, u.y, u.z);
+            if (m.bottom_sampled) {
+                const auto wt = refract(m.wi_mean, wm, eta_b_);
+                if (!wt || wt->z >= 0) return std::nullopt;  // totally reflected by the facet
+                wo = *wt;
+                break;
+            }
             const Vec3d v_in = reflect(m.wi_mean, wm);
             const double s2 = sqr(eta_s_) * (1 - sqr(v_in.z));
             if (v_in.z <= 0 || s2 >= 1) return std::nullopt;
@@ -1354,6 +1824,20 @@ std::vector<OptionSpec> lamina1_option_specs() {
          "scattering slabs: the transmitted rest of the scattered light shaped like "
          "twice-scattered "
          "light (the once-scattered form with HG(g^2)), or as uniform radiance below the bottom"},
+        {"btdf-lobe",
+         {"shared", "bottom", "mirrored"},
+         !d.btdf_bottom_lobe  ? "mirrored"
+         : d.btdf_lobe_shared ? "shared"
+                              : "bottom",
+         "slab BTDF first order: the bottom's own Walter BTDF at the mean inside direction with "
+         "the first-order energy (bottom), the mirrored GGX lobe weighted by the bottom's "
+         "transmittance at the exit (mirrored), or each for its share of the spread (shared)"},
+        {"btdf-series",
+         {"uniform", "populations"},
+         d.btdf_populations ? "populations" : "uniform",
+         "slab BTDF later orders: the light inside and beyond the exit cone as two uniform "
+         "populations summed over every round trip and let out through the bottom's "
+         "transmittance, or the uniform series of inter-reflection=on"},
         {"microsurface",
          {"single", "multiple"},
          d.multiple_scattering ? "multiple" : "single",
@@ -1378,6 +1862,9 @@ Lamina1Choices lamina1_choices(const ModelOptions& o) {
     c.medium_base_paths = option_value(o, "medium-base-paths") == "mirror";
     c.medium_orders = option_value(o, "medium-orders") == "adding";
     c.medium_transmitted_twice = option_value(o, "medium-transmitted") == "twice";
+    c.btdf_bottom_lobe = option_value(o, "btdf-lobe") != "mirrored";
+    c.btdf_lobe_shared = option_value(o, "btdf-lobe") == "shared";
+    c.btdf_populations = option_value(o, "btdf-series") == "populations";
     const std::string& s = option_value(o, "spread");
     c.spread = s == "normal" ? Lamina1Choices::Spread::Normal
                : s == "off"  ? Lamina1Choices::Spread::Off

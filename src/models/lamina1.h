@@ -7,14 +7,16 @@
 //   f_R = f_top                                       exact Walter reflection of the coat
 //       + T(μi) T(μo) a(μi') a(μo') f_b(wi', wo'; α_e) / η0²     first order through the coat
 //       + K X(μi) X(μo) / (π η0²)                    inter-reflections (separable, reciprocal)
-//   f_T = T(μi) a(μi') T_b,in(μv') a(μv') q(wi', v'; β) / η_s² + X(μi) T_b(μv) / (π η_s² (1 − Ē_b
-//   r̄))
+//   f_T = E_1(μi) f_t,b(w̄i', wo; α_b) / T_b,in(μ̄i'; α_b)   first order through the slab's bottom
+//       [+ Σ_p Φ_p(μi) T_{below→p}(μo) / (π A_p η_s²)]   later orders (btdf-series=populations)
 //
 // T: the coat's directional transmittance (models/coat_transmittance.h), a: Beer–Lambert along
 // the refracted mean directions, α_e and β: the base lobe widened by the coat's refraction
 // spread, X: the light the coat's bottom sends back to the base after the first order, Ē_b and r̄
 // the base's and the coat bottom's hemispherical albedos, K the normalization that gives the
-// separable term the energy of the geometric series. A scattering medium adds its exact single
+// separable term the energy of the geometric series; E_1: the slab's exact first-order
+// transmission, f_t,b the bottom's Walter BTDF from the coat's mean transmitted direction w̄i',
+// α_b its roughness widened by the coat's spread. A scattering medium adds its exact single
 // scattering f_ss (and, over a conductor or dielectric base, the once-scattered paths that meet
 // the base) and a separable lobe carrying the rest of the scattered light, its energy from an
 // azimuth-averaged adding–doubling of coat bottom, medium and base (models/medium_adding.h).
@@ -80,6 +82,20 @@ struct Lamina1Choices {
     /// once-scattered closed form with HG(g²): two HG scatterings have the mean cosine g²) and
     /// normalized to the adding's energy (true), or as uniform radiance below the bottom (false).
     bool medium_transmitted_twice = true;
+    /// The slab's first-order transmission: the bottom interface's own Walter BTDF at the mean
+    /// inside direction, widened by the coat's spread and carrying the light's exact first-order
+    /// energy (true), or the mirrored GGX lobe q weighted by T_b,in at the exit (false).
+    bool btdf_bottom_lobe = true;
+    /// With btdf_bottom_lobe: the first order split between the bottom's BTDF, for the bottom's
+    /// share of the spread's variance u = α1²/α_b², and the mirrored lobe (the coat's spread,
+    /// made inside the coat and carried through the bottom's flat refraction), for 1 − u.
+    bool btdf_lobe_shared = true;
+    /// The slab's later orders in transmission: the light inside the coat as two populations,
+    /// within the exit cone and beyond it (trapped by a smooth coat's total internal reflection),
+    /// each taken as uniform radiance after the first return, summed over every round trip by a
+    /// 2 × 2 geometric series and let out through the bottom's own transmittance (true); or the
+    /// uniform series of inter-reflection=on (false). Single scattering only.
+    bool btdf_populations = false;
 };
 
 std::vector<OptionSpec> lamina1_option_specs();
