@@ -4,8 +4,8 @@
 // scattering event, `d_out` after. cos_theta = d_in·d_out; g ∈ (−1, 1) is the mean cosine
 // (g > 0 forward scattering). The phase function is normalized over the sphere (1/sr).
 
-#include "core/frame.h"
 #include "core/lane.h"
+#include "core/lane_vec.h"
 #include "core/math.h"
 #include "core/vec.h"
 
@@ -56,14 +56,27 @@ inline T sample_hg_cos_theta(T g, T u) {
     return L::select(tiny, one - two * u, inverted);
 }
 
-/// Propagation direction after scattering d_in (unit) with HG(g), from two uniforms in [0, 1).
+/// Propagation direction after scattering d_in (unit) with HG(g), from two uniforms in [0, 1):
+/// cos θ by sample_hg_cos_theta, the azimuth 2πu2, about d_in in the frame of Duff et al. 2017
+/// (core/lane_vec.h). A branch-free lane template (core/lane.h): sample_hg and the SIMD kernel
+/// evaluate these lines.
+template <typename T, typename L = Lane<T>>
+inline LaneVec3<T> sample_hg_direction(const LaneVec3<T>& d_in, T g, T u1, T u2) {
+    const T cos_theta = sample_hg_cos_theta<T, L>(g, u1);
+    const T sin_theta =
+        L::sqrt(L::max(L::neg_mul_add(cos_theta, cos_theta, L::constant(1)), L::constant(0)));
+    T cos_phi, sin_phi;
+    L::cos_sin_2pi(u2, cos_phi, sin_phi);
+    LaneVec3<T> s, t;
+    lane_orthonormal_basis<T, L>(d_in, s, t);
+    return lane_to_world<T, L>(s, t, d_in, {sin_theta * cos_phi, sin_theta * sin_phi, cos_theta});
+}
+
+/// The same on one direction.
 template <typename T>
 inline Vec3<T> sample_hg(const Vec3<T>& d_in, T g, T u1, T u2) {
-    const T cos_theta = sample_hg_cos_theta(g, u1);
-    const T sin_theta = safe_sqrt(T(1) - sqr(cos_theta));
-    const T phi = T(2) * kPi<T> * u2;
-    const Frame<T> frame = Frame<T>::from_normal(d_in);
-    return frame.to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta});
+    const LaneVec3<T> d = sample_hg_direction<T>({d_in.x, d_in.y, d_in.z}, g, u1, u2);
+    return {d.x, d.y, d.z};
 }
 
 /// Inverse of sample_hg_cos_theta: the u that produces cos_theta.

@@ -3,6 +3,7 @@
 #include "core/check.h"
 #include "core/math.h"
 #include "physics/fresnel.h"
+#include "physics/medium.h"
 #include "physics/microsurface_walk.h"
 #include "physics/phase.h"
 
@@ -463,48 +464,23 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
     Rgbd& w = ws.w;
     const Medium& m = media_[region];
     if (!m.scatters) {
-        const double inv_mu = 1 / std::abs(d.z);
-        w *= exp_neg(m.tau_t * inv_mu);
+        double transmittance[3];
+        beer_lambert_transmittance<double>(m.tau_t, 1 / std::abs(d.z), transmittance);
+        w *= Rgbd(transmittance[0], transmittance[1], transmittance[2]);
         return d.z > 0;
     }
     double s = d.z < 0 ? 0 : 1;
+    auto uniform = [&] { return rng.uniform_double(); };
     while (true) {
-        const double mu = std::abs(d.z);
-        const double to_boundary = (d.z < 0 ? 1 - s : s) / mu;
-        const double total = w[0] + w[1] + w[2];
-        if (total <= 0) return d.z > 0;
-        const double p[3] = {w[0] / total, w[1] / total, w[2] / total};
-        const double uc = rng.uniform_double();
-        const int c = uc < p[0] ? 0 : (uc < p[0] + p[1] ? 1 : 2);
-        const double sigma_c = m.tau_t[c];
-        const double u = rng.uniform_double();
-        const double flight = sigma_c > 0 ? -std::log1p(-u) / sigma_c : INFINITY;
-        if (m.uniform_tau_t) {
-            if (flight >= to_boundary) return d.z > 0;
-            w *= m.single_scattering_albedo;
-        } else if (flight >= to_boundary) {
-            double mix = 0;
-            Rgbd tr;
-            for (int k = 0; k < 3; ++k) {
-                // τ = 0 along a horizontal path (to_boundary = ∞): 0 · ∞ would be NaN.
-                tr[k] = m.tau_t[k] > 0 ? std::exp(-m.tau_t[k] * to_boundary) : 1.0;
-                mix += p[k] * tr[k];
-            }
-            for (int k = 0; k < 3; ++k)
-                w[k] *= tr[k] / mix;
-            return d.z > 0;
-        } else {
-            double mix = 0;
-            Rgbd num;
-            for (int k = 0; k < 3; ++k) {
-                const double e = std::exp(-m.tau_t[k] * flight);
-                num[k] = m.tau_s[k] * e;
-                mix += p[k] * m.tau_t[k] * e;
-            }
-            for (int k = 0; k < 3; ++k)
-                w[k] *= num[k] / mix;
-        }
-        s = clamp(s - d.z * flight, 0.0, 1.0);
+        // The free flight (physics/medium.h, as the goniophotometer's kernels).
+        const LaneVec3<double> dl = {d.x, d.y, d.z};
+        const double wl[3] = {w[0], w[1], w[2]};
+        const MediumFlightLanes<double, bool> flight =
+            medium_free_flight<double>(m, dl, wl, s, uniform);
+        const double* p = flight.p;
+        w *= Rgbd(flight.factor[0], flight.factor[1], flight.factor[2]);
+        if (flight.leaves) return d.z > 0;
+        s = flight.depth;
         ws.delta_only = false;
         // The phase-sampling density: the mixture Σ p_k HG_k when g differs per channel.
         auto phase_pdf = [&](double cos_theta) {
@@ -583,24 +559,13 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
                     proxy, f);
             }
         }
-        int c_phase = c;
-        if (!m.uniform_g) {
-            const double up = rng.uniform_double();
-            c_phase = up < p[0] ? 0 : (up < p[0] + p[1] ? 1 : 2);
-        }
-        const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
-        const Vec3d d_new = sample_hg(d, m.g[c_phase], u1, u2);
+        // The scattering event (physics/medium.h).
+        LaneVec3<double> d_scattered;
+        double phase[3];
+        medium_scatter<double>(m, dl, p, true, uniform, d_scattered, phase);
+        const Vec3d d_new(d_scattered.x, d_scattered.y, d_scattered.z);
         const double cos_theta = dot(d, d_new);
-        if (!m.uniform_g) {
-            double mix = 0;
-            Rgbd ph;
-            for (int k = 0; k < 3; ++k) {
-                ph[k] = hg_phase(cos_theta, m.g[k]);
-                mix += p[k] * ph[k];
-            }
-            for (int k = 0; k < 3; ++k)
-                w[k] *= ph[k] / mix;
-        }
+        w *= Rgbd(phase[0], phase[1], phase[2]);
         // The walk's own strategy for the same paths (strategy 1, weighted at the exit). Only
         // meaningful while connecting (conn is null for sample()).
         ws.prev_mis =

@@ -186,8 +186,8 @@ std::string ReferenceKey::canonical() const {
     return fmt::format(
         "lamina {} | code {} | config {} | stack {} | theta_i {} | particles {} | seed {} | "
         "grid {} | kernel {}{}{}",
-        kVersion, kReferenceSourceDigest, config_id, stack_to_json(stack).dump(), theta_i_deg, particles, seed,
-        grid.to_string(), kernel_description(kernel),
+        kVersion, kReferenceSourceDigest, config_id, stack_to_json(stack).dump(), theta_i_deg,
+        particles, seed, grid.to_string(), kernel_description(kernel),
         microsurface == Microsurface::Multiple ? " | microsurface multiple" : "",
         microsurface == Microsurface::Single &&
                 transmission_masking == TransmissionMasking::Smith && has_rough_dielectric(stack)
