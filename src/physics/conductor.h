@@ -45,7 +45,7 @@ LAMINA_LANE_BEGIN
 /// is degenerate. A branch-free lane template (core/lane.h): the scalar and the SIMD particle
 /// kernels evaluate these lines.
 template <typename T, typename L = Lane<T>, typename Fresnel>
-inline InterfaceEventLanes<T, typename L::Mask> conductor_event(
+LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> conductor_event(
     T alpha, bool smooth, bool uncorrelated, const LaneVec3<T>& wi, T u1, T u2,
     typename L::Mask active, const Fresnel& fresnel, T* fresnel_factors) {
     const T zero = L::constant(0), one = L::constant(1);

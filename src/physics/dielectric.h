@@ -84,10 +84,9 @@ struct InterfaceEventLanes {
 /// eta = η_below / η_above, inv_eta = 1/eta, alpha the GGX roughness. A branch-free lane template
 /// (core/lane.h): the scalar and the SIMD particle kernels evaluate these lines.
 template <typename T, typename L = Lane<T>>
-inline InterfaceEventLanes<T, typename L::Mask> dielectric_event(T eta, T inv_eta, T alpha,
-                                                                 DielectricEventShape shape,
-                                                                 const LaneVec3<T>& wi, T uc, T u1,
-                                                                 T u2, typename L::Mask active) {
+LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> dielectric_event(
+    T eta, T inv_eta, T alpha, DielectricEventShape shape, const LaneVec3<T>& wi, T uc, T u1, T u2,
+    typename L::Mask active) {
     const T zero = L::constant(0), one = L::constant(1);
     InterfaceEventLanes<T, typename L::Mask> e;
     e.degenerate = L::both(active, L::negate(L::less(zero, L::abs(wi.z))));

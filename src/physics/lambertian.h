@@ -39,7 +39,7 @@ LAMINA_LANE_BEGIN
 /// lane with wi_z = 0 belongs to neither side (the caller treats it as degenerate). A branch-free
 /// lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate these lines.
 template <typename T, typename L = Lane<T>>
-inline LaneVec3<T> lambertian_event(T wi_z, T u1, T u2) {
+LAMINA_LANE_INLINE LaneVec3<T> lambertian_event(T wi_z, T u1, T u2) {
     const T zero = L::constant(0);
     T cos_phi, sin_phi;
     L::cos_sin_2pi(u2, cos_phi, sin_phi);

@@ -54,7 +54,7 @@ LAMINA_LANE_BEGIN
 /// extinction transmits 1, also along a horizontal path (inv_mu = ∞, where 0 · ∞ would be NaN:
 /// found by the fuzz test); channels with equal τ share the exponential.
 template <typename T, typename L = Lane<T>, typename Tau>
-inline void beer_lambert_transmittance(const Tau& tau, T inv_mu, T out[3]) {
+LAMINA_LANE_INLINE void beer_lambert_transmittance(const Tau& tau, T inv_mu, T out[3]) {
     for (int c = 0; c < 3; ++c) {
         if (c > 0 && tau[c] == tau[c - 1]) {
             out[c] = out[c - 1];  // a grey pair of channels
@@ -82,9 +82,10 @@ struct MediumFlightLanes {
 /// density is every channel's own and the factors are 1 (leaving) and the single-scattering
 /// albedo τs/τt (scattering). `uniform()` returns a lane of uniform numbers in [0, 1).
 template <typename T, typename L = Lane<T>, typename Medium, typename Uniform>
-inline MediumFlightLanes<T, typename L::Mask> medium_free_flight(const Medium& med,
-                                                                 const LaneVec3<T>& d, const T w[3],
-                                                                 T depth, Uniform&& uniform) {
+LAMINA_LANE_INLINE MediumFlightLanes<T, typename L::Mask> medium_free_flight(const Medium& med,
+                                                                             const LaneVec3<T>& d,
+                                                                             const T w[3], T depth,
+                                                                             Uniform&& uniform) {
     const T zero = L::constant(0), one = L::constant(1), infinity = L::constant(HUGE_VAL);
     MediumFlightLanes<T, typename L::Mask> r;
     const T mu = L::abs(d.z);
@@ -140,9 +141,9 @@ inline MediumFlightLanes<T, typename L::Mask> medium_free_flight(const Medium& m
 /// HG_c / Σ_k p_k HG_k at the new direction (factor[c]; 1 otherwise). Draws nothing when no lane
 /// scatters (returns false); true otherwise.
 template <typename T, typename L = Lane<T>, typename Medium, typename Uniform>
-inline bool medium_scatter(const Medium& med, const LaneVec3<T>& d, const T p[3],
-                           typename L::Mask scatters, Uniform&& uniform, LaneVec3<T>& d_new,
-                           T factor[3]) {
+LAMINA_LANE_INLINE bool medium_scatter(const Medium& med, const LaneVec3<T>& d, const T p[3],
+                                       typename L::Mask scatters, Uniform&& uniform,
+                                       LaneVec3<T>& d_new, T factor[3]) {
     const T zero = L::constant(0), one = L::constant(1);
     factor[0] = factor[1] = factor[2] = one;
     if (L::none(scatters)) return false;

@@ -36,14 +36,14 @@ LAMINA_LANE_BEGIN
 /// (found by the fuzz test): clamped at 1. Also the refraction escape under
 /// TransmissionMasking::Pbrt. Any lane type (core/lane.h).
 template <typename T, typename L = Lane<T>>
-inline T smith_reflection_escape_scaled(T z_i, T s_i, T z_o, T s_o) {
+LAMINA_LANE_INLINE T smith_reflection_escape_scaled(T z_i, T s_i, T z_o, T s_o) {
     return L::min((z_i + s_i) * z_o / L::mul_add(s_i, z_o, s_o * z_i), L::constant(1));
 }
 
 /// The same from the Smith roots r = √(1 + α² tan²θ) = 1 + 2Λ (GGX::smith_root) themselves:
 /// (1 + r_i)/(r_i + r_o).
 template <typename T, typename L = Lane<T>>
-inline T smith_reflection_escape(T r_i, T r_o) {
+LAMINA_LANE_INLINE T smith_reflection_escape(T r_i, T r_o) {
     return smith_reflection_escape_scaled<T, L>(L::constant(1), r_i, L::constant(1), r_o);
 }
 
@@ -62,7 +62,7 @@ inline T smith_reflection_escape(T r_i, T r_o) {
 /// (core/lane.h). Accuracy: core/beta_function.h. Zero for a grazing wo (r_o = ∞) to the
 /// precision of T; one for r_o = 1 (wo along the normal: nothing masks it).
 template <typename T, typename L = Lane<T>>
-inline T smith_refraction_escape(T r_i, T r_o) {
+LAMINA_LANE_INLINE T smith_refraction_escape(T r_i, T r_o) {
     const T half = L::constant(0.5), one = L::constant(1);
     const T one_plus_lambda_i = L::min(half * (one + r_i), L::constant(L::kBetaArgumentMax));
     const T one_plus_lambda_o = half * (one + r_o);
