@@ -94,10 +94,12 @@ LAMINA_LANE_INLINE MediumFlightLanes<T, typename L::Mask> medium_free_flight(con
         L::select(L::less(zero, mu), L::select(down, one - depth, depth) / mu, infinity);
     const T total = w[0] + w[1] + w[2];
     const auto has_flux = L::less(zero, total);
-    const T inv_total = one / L::select(has_flux, total, one);
-    r.p[0] = w[0] * inv_total;
-    r.p[1] = w[1] * inv_total;
-    r.p[2] = w[2] * inv_total;
+    // Quotients, not products with a reciprocal: a flux of subnormal size (a base of albedo
+    // 5e-324, found by the fuzz test) has an infinite reciprocal.
+    const T safe_total = L::select(has_flux, total, one);
+    r.p[0] = w[0] / safe_total;
+    r.p[1] = w[1] / safe_total;
+    r.p[2] = w[2] / safe_total;
     const T p01 = r.p[0] + r.p[1];
     const T u_channel = uniform();
     const auto first = L::less(u_channel, r.p[0]), second = L::less(u_channel, p01);
@@ -126,11 +128,11 @@ LAMINA_LANE_INLINE MediumFlightLanes<T, typename L::Mask> medium_free_flight(con
         mix = L::mul_add(r.p[c], e[c], mix);
         mix_scatter = L::mul_add(r.p[c] * tau_t, e[c], mix_scatter);
     }
-    const T inv_mix = one / L::select(L::both(L::less(zero, mix), has_flux), mix, one);
-    const T inv_mix_scatter = one / L::select(L::less(zero, mix_scatter), mix_scatter, one);
+    const T safe_mix = L::select(L::both(L::less(zero, mix), has_flux), mix, one);
+    const T safe_mix_scatter = L::select(L::less(zero, mix_scatter), mix_scatter, one);
     for (int c = 0; c < 3; ++c)
-        r.factor[c] = L::select(r.leaves, L::select(has_flux, e[c] * inv_mix, one),
-                                L::constant(med.tau_s[c]) * e[c] * inv_mix_scatter);
+        r.factor[c] = L::select(r.leaves, L::select(has_flux, e[c] / safe_mix, one),
+                                L::constant(med.tau_s[c]) * e[c] / safe_mix_scatter);
     return r;
 }
 
@@ -163,9 +165,9 @@ LAMINA_LANE_INLINE bool medium_scatter(const Medium& med, const LaneVec3<T>& d, 
         phase[c] = hg_phase<T, L>(cos_theta, L::constant(med.g[c]));
         mix = L::mul_add(p[c], phase[c], mix);
     }
-    const T inv = one / L::select(L::less(zero, mix), mix, one);
+    const T safe_mix = L::select(L::less(zero, mix), mix, one);
     for (int c = 0; c < 3; ++c)
-        factor[c] = phase[c] * inv;
+        factor[c] = phase[c] / safe_mix;
     return true;
 }
 

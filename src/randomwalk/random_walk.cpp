@@ -121,63 +121,25 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events, Transmissio
       max_microsurface_order_(max_microsurface_order) {
     LAMINA_CHECK(max_events >= 1);
     LAMINA_CHECK(max_microsurface_order >= 1);
-    const bool multiple = microsurface == Microsurface::Multiple;
-    const int L = int(stack.layers.size());
+    const CompiledStack<double> compiled = compile_stack<double>(
+        stack, {masking, microsurface == Microsurface::Multiple, max_microsurface_order});
+    const int L = int(compiled.layers.size());
+    interfaces_ = compiled.layers;
     eta_.assign(L + 1, 1.0);
     media_.assign(L + 1, Medium{});
-    eta_[0] = stack.ambient_eta;
+    eta_[0] = compiled.eta_above;
     // For pdf_is_unbiased(): per-channel extinction in a scattering medium, and per-channel
     // weights of delta events that are not flights through one.
     bool chromatic_scatterer = false, chromatic_weight = false;
     for (int k = 0; k < L; ++k) {
-        const Layer& layer = stack.layers[k];
-        const InterfaceSpec& spec = layer.interface;
-        const double eta_above = stack.eta_above(k);
-        Interface it;
-        it.type = spec.type;
-        switch (spec.type) {
-            case InterfaceType::Dielectric:
-                it.dielectric = {spec.eta / eta_above, spec.alpha};
-                it.dielectric.transmission_masking = masking;
-                // Index-matched and rough with multiple scattering: every facet refracts straight
-                // on (F = 0) and the walk leaves below along −wi with all its flux, which is the
-                // smooth index-matched pass-through (the single-scattering one keeps G2/G1).
-                if (multiple && it.dielectric.is_index_matched()) it.dielectric.alpha = 0;
-                it.delta = it.dielectric.is_smooth() || it.dielectric.is_index_matched();
-                it.multiple = multiple && !it.delta;
-                eta_[k + 1] = spec.eta;
-                break;
-            case InterfaceType::Conductor:
-                it.conductor = {spec.eta_rgb / eta_above, spec.k / eta_above, spec.alpha};
-                it.delta = it.conductor.is_smooth();
-                it.multiple = multiple && !it.delta;
-                eta_[k + 1] = eta_above;  // no region below an opaque base
-                break;
-            case InterfaceType::Lambertian:
-                it.lambertian = {spec.albedo};
-                it.delta = false;
-                eta_[k + 1] = eta_above;
-                break;
-        }
-        if (spec.type == InterfaceType::Conductor && it.delta &&
-            !(is_grey(spec.eta_rgb) && is_grey(spec.k)))
+        const Interface& it = interfaces_[k];
+        eta_[k + 1] = it.eta_below;
+        if (it.type == InterfaceType::Conductor && it.delta &&
+            !(is_grey(it.conductor.eta) && is_grey(it.conductor.k)))
             chromatic_weight = true;
-        interfaces_.push_back(it);
-        if (layer.has_medium) {
-            const MediumSpec& m = layer.medium;
-            Medium& md = media_[k + 1];
-            md.tau_s = m.tau_s;
-            md.tau_t = m.tau_t();
-            md.g = m.g;
-            md.scatters = m.scatters();
-            md.empty = m.is_empty();
-            md.uniform_tau_t = md.tau_t[0] == md.tau_t[1] && md.tau_t[1] == md.tau_t[2];
-            md.uniform_g = m.g[0] == m.g[1] && m.g[1] == m.g[2];
-            for (int c = 0; c < 3; ++c)
-                md.single_scattering_albedo[c] = md.tau_t[c] > 0 ? m.tau_s[c] / md.tau_t[c] : 0.0;
-            if (md.scatters && !md.uniform_tau_t) chromatic_scatterer = true;
-            if (!md.scatters && !md.uniform_tau_t) chromatic_weight = true;
-        }
+        const Medium& md = media_[k + 1] = it.medium;
+        if (md.scatters && !md.uniform_tau_t) chromatic_scatterer = true;
+        if (!md.scatters && !md.is_empty() && !md.uniform_tau_t) chromatic_weight = true;
     }
     pdf_unbiased_ = !(chromatic_scatterer && chromatic_weight);
 }
@@ -240,7 +202,7 @@ static void build_connection(const std::vector<double>& eta, const auto& interfa
         c.dir_up[r] = Vec3d(h.x, h.y, c.mu[r]);
         c.dir_down[r] = Vec3d(h.x, h.y, -c.mu[r]);
         if (r == exit_region) (top ? c.dir_up[r] : c.dir_down[r]) = wo;
-        const bool opaque_flight = probability ? media[r].scatters : !media[r].empty;
+        const bool opaque_flight = probability ? media[r].scatters : !media[r].is_empty();
         c.t[r] = opaque_flight ? exp_neg(media[r].tau_t / c.mu[r]) : Rgbd(1.0);
         c.scale[r] = sqr(ratio);
     }
@@ -385,7 +347,7 @@ void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& 
         if (f_exit == 0) return;
         const Rgbd kv = kernel(omega);
         if (is_black(kv)) return;
-        const Rgbd tr = m.empty ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
+        const Rgbd tr = m.is_empty() ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
         f += w * kv * tr * (f_exit / st->pdf * mis);
     }
 }
@@ -779,7 +741,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 return;
             }
             bool up = true;
-            if (!media_[k].empty) up = traverse_medium<kMode>(k, ws, rng, conn, wo, f);
+            if (!media_[k].is_empty()) up = traverse_medium<kMode>(k, ws, rng, conn, wo, f);
             if (is_black(w)) return;
             if (up) --k;
         } else {
@@ -788,7 +750,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 return;
             }
             bool up = false;
-            if (!media_[k + 1].empty) up = traverse_medium<kMode>(k + 1, ws, rng, conn, wo, f);
+            if (!media_[k + 1].is_empty()) up = traverse_medium<kMode>(k + 1, ws, rng, conn, wo, f);
             if (is_black(w)) return;
             if (!up) ++k;
         }

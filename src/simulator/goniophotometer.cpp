@@ -6,11 +6,11 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "layers/compiled_stack.h"
 #include "physics/medium.h"
 #include "physics/microsurface_walk.h"
 #include "simulator/kernel_simd.h"
 #include "simulator/tally.h"
-#include "simulator/trace_stack.h"
 
 #include <fmt/format.h>
 #include <omp.h>
@@ -53,7 +53,7 @@ bool is_black(const Rgbf& w) {
 // physics/medium.h at one lane. Depth s ∈ [0, 1] across the layer (0 at its top). Returns true if
 // the particle leaves through the top.
 struct MediumWalk {
-    const TraceMedium& m;
+    const CompiledMedium<float>& m;
     ParticleRng& rng;
     PathLosses& losses;
 
@@ -105,7 +105,7 @@ struct MediumWalk {
 // docs/physics.md §3: at an interface the particle (arriving along −wi) draws an outgoing direction
 // from the interface's BSDF sampler; its flux is multiplied by the sample weight and the parts
 // that do not continue are booked (absorbed by the base, lost to the microsurface).
-void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const Vec3f& wi,
+void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& grid, const Vec3f& wi,
                     ParticleRng& rng, int max_events, Tally& tally, BlockBudget& block) {
     const int n_layers = int(stack.layers.size());
     Vec3f d = -wi;  // propagation direction
@@ -119,7 +119,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
             break;
         }
         ++events;
-        const TraceLayer& layer = stack.layers[k];
+        const CompiledLayer<float>& layer = stack.layers[k];
         const Vec3f wi_local = -d;
         // Applies a sample (taken by reference: no copy of the optional in the hot loop).
         // weight = fresnel_weight (absorbed by an opaque base) · shadowing (lost on the
@@ -164,7 +164,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
         auto uniform = [&] { return rng.uniform_float(); };
         switch (layer.type) {
             case InterfaceType::Dielectric: {
-                if (stack.multiple_scattering && !layer.dielectric.is_smooth()) {
+                if (layer.multiple) {
                     apply_walk(
                         walk_rough_dielectric(layer.dielectric.distribution(), layer.dielectric.eta,
                                               wi_local, uniform, stack.max_microsurface_order),
@@ -177,7 +177,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
                 break;
             }
             case InterfaceType::Conductor: {
-                if (stack.multiple_scattering && !layer.conductor.is_smooth()) {
+                if (layer.multiple) {
                     const ConductorInterface<float>& cond = layer.conductor;
                     apply_walk(walk_rough_conductor(
                                    cond.distribution(), [&](float c) { return cond.fresnel(c); },
@@ -213,7 +213,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
                 break;
             }
             // Up through the medium below interface k − 1.
-            const TraceMedium& m = stack.layers[k - 1].medium;
+            const CompiledMedium<float>& m = stack.layers[k - 1].medium;
             bool up = true;
             if (!m.is_empty()) {
                 MediumWalk walk{m, rng, losses};
@@ -227,7 +227,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
                 block.escape_transmitted(w);
                 break;
             }
-            const TraceMedium& m = layer.medium;
+            const CompiledMedium<float>& m = layer.medium;
             bool up = false;
             if (!m.is_empty()) {
                 MediumWalk walk{m, rng, losses};
@@ -301,9 +301,9 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
                              const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);
     const auto start = std::chrono::steady_clock::now();
-    TraceStack trace(stack, settings.transmission_masking);
-    trace.multiple_scattering = settings.microsurface == Microsurface::Multiple;
-    trace.max_microsurface_order = settings.max_microsurface_order;
+    const CompiledStack<float> trace = compile_stack<float>(
+        stack, {settings.transmission_masking, settings.microsurface == Microsurface::Multiple,
+                settings.max_microsurface_order});
     const HemisphereGrid& grid = settings.grid;
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
     if (settings.kernel == Kernel::Simd) select_simd_target();

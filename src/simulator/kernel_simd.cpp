@@ -480,7 +480,8 @@ HWY_INLINE void LambertianEvent(const LambertianInterface<float>& iface, MF m, L
 // One scattering-medium step for the lanes in m (inside layer `layer`'s medium): a free flight,
 // then either the crossing to the next interface or a scattering event. The lanes draw their
 // numbers as the template asks for them (every lane draws while any needs them).
-HWY_INLINE void ScatteringStep(const TraceMedium& med, MF m, LaneVectors& v, LaneRng& rng) {
+HWY_INLINE void ScatteringStep(const CompiledMedium<float>& med, MF m, LaneVectors& v,
+                               LaneRng& rng) {
     const DF df;
     const DI di;
     auto uniform = [&] { return rng.Uniform(); };
@@ -638,7 +639,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     const DF df;
     const DI di;
     const std::size_t n_lanes = hn::Lanes(df);
-    const TraceStack& stack = *job.stack;
+    const CompiledStack<float>& stack = *job.stack;
     const HemisphereGrid& grid = *job.grid;
     const int n_layers = int(stack.layers.size());
     const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
@@ -687,11 +688,11 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         v.events =
             hn::IfThenElse(hn::RebindMask(di, going), hn::Add(v.events, hn::Set(di, 1)), v.events);
         MF degenerate_event = hn::FirstN(df, 0);  // all false
-        const TraceLayer& layer = stack.layers[group];
+        const CompiledLayer<float>& layer = stack.layers[group];
         const bool dielectric = layer.type == InterfaceType::Dielectric;
         switch (layer.type) {
             case InterfaceType::Dielectric: {
-                if (stack.multiple_scattering && !layer.dielectric.is_smooth()) {
+                if (layer.multiple) {
                     DielectricWalkEvent(layer.dielectric, going, v, rng,
                                         stack.max_microsurface_order, degenerate_event);
                     break;
@@ -701,7 +702,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
                 break;
             }
             case InterfaceType::Conductor: {
-                if (stack.multiple_scattering && !layer.conductor.is_smooth()) {
+                if (layer.multiple) {
                     ConductorWalkEvent(layer.conductor, going, v, rng, stack.max_microsurface_order,
                                        degenerate_event);
                     break;
@@ -745,7 +746,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             const int medium_layer = side == 0 ? group - 1 : group;
             const int k_next = side == 0 ? group - 1 : group + 1;
             if (hn::AllFalse(df, moving)) continue;
-            const TraceMedium& med = stack.layers[medium_layer].medium;
+            const CompiledMedium<float>& med = stack.layers[medium_layer].medium;
             if (med.scatters) {
                 // Enters the medium: its free flights are later steps.
                 const auto mi = hn::RebindMask(di, moving);
@@ -1187,9 +1188,10 @@ void InterfaceEventsForTest(int kind, const float* params, const std::int32_t* f
     }
 }
 
-void MediumStepForTest(const TraceMedium& med, const float* d, const float* w, const float* depth,
-                       const float* u, std::size_t n, std::int32_t* leaves, float* factor,
-                       float* depth_out, float* d_out, float* phase, std::int32_t* draws) {
+void MediumStepForTest(const CompiledMedium<float>& med, const float* d, const float* w,
+                       const float* depth, const float* u, std::size_t n, std::int32_t* leaves,
+                       float* factor, float* depth_out, float* d_out, float* phase,
+                       std::int32_t* draws) {
     const DF df;
     LaneIo io{df};
     io.n = n;
@@ -1442,7 +1444,7 @@ SimdEventResult simd_interface_events(int kind, const std::vector<float>& params
     return r;
 }
 
-SimdMediumResult simd_medium_step(const TraceMedium& medium, const std::vector<float>& d,
+SimdMediumResult simd_medium_step(const CompiledMedium<float>& medium, const std::vector<float>& d,
                                   const std::vector<float>& w, const std::vector<float>& depth,
                                   const std::vector<float>& u) {
     select_simd_target();

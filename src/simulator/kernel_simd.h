@@ -86,7 +86,7 @@ struct SimdMediumResult {
     std::vector<std::int32_t> leaves, draws;
     std::vector<float> factor, depth, d, phase;
 };
-SimdMediumResult simd_medium_step(const TraceMedium& medium, const std::vector<float>& d,
+SimdMediumResult simd_medium_step(const CompiledMedium<float>& medium, const std::vector<float>& d,
                                   const std::vector<float>& w, const std::vector<float>& depth,
                                   const std::vector<float>& u);
 

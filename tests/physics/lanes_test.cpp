@@ -16,12 +16,12 @@
 // in 10^3 lanes may choose differently (a different formula or draw order would change most).
 // The bounds on the continuous results are stated with each test.
 #include "core/rng.h"
+#include "layers/compiled_stack.h"
 #include "physics/conductor.h"
 #include "physics/dielectric.h"
 #include "physics/lambertian.h"
 #include "physics/medium.h"
 #include "simulator/kernel_simd.h"
-#include "simulator/trace_stack.h"
 
 #include <gtest/gtest.h>
 
@@ -298,8 +298,8 @@ TEST(KernelSimdLanes, LambertianEvent) {
 // bounded as stated in the loop, from the HG lane test's bound.
 TEST(KernelSimdLanes, MediumStep) {
     ParticleRng rng(34, 0, 0);
-    TraceMedium grey, chromatic, clear, equal_g;
-    auto finish = [](TraceMedium& m) {
+    CompiledMedium<float> grey, chromatic, clear, equal_g;
+    auto finish = [](CompiledMedium<float>& m) {
         m.tau_t = m.tau_a + m.tau_s;
         m.scatters = true;
         m.absorbs = m.tau_a.max() > 0;
@@ -313,7 +313,7 @@ TEST(KernelSimdLanes, MediumStep) {
     chromatic.g = Rgbf(0.999f, -0.999f, 0.3f);
     clear.tau_a = Rgbf(0.f), clear.tau_s = Rgbf(0.f, 1.f, 4.f), clear.g = Rgbf(0.f, 0.5f, -0.5f);
     equal_g.tau_a = Rgbf(0.5f, 0.f, 0.f), equal_g.tau_s = Rgbf(1.f), equal_g.g = Rgbf(-0.7f);
-    for (TraceMedium* m : {&grey, &chromatic, &clear, &equal_g})
+    for (CompiledMedium<float>* m : {&grey, &chromatic, &clear, &equal_g})
         finish(*m);
     const char* names[] = {"grey", "chromatic", "clear channel", "equal g"};
     std::vector<float> d = directions(rng, 6000, true);
@@ -326,7 +326,7 @@ TEST(KernelSimdLanes, MediumStep) {
     }
     const std::vector<float> u = uniforms(rng, n, 5);
     int index = 0;
-    for (const TraceMedium* m : {&grey, &chromatic, &clear, &equal_g}) {
+    for (const CompiledMedium<float>* m : {&grey, &chromatic, &clear, &equal_g}) {
         const SimdMediumResult lanes = simd_medium_step(*m, d, w, depth, u);
         std::size_t differ = 0, scattered = 0;
         double worst_factor = 0, worst_d = 0, worst_pole = 0, worst_phase = 0;
