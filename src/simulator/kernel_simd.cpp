@@ -511,8 +511,7 @@ HWY_INLINE void ScatteringStep(const CompiledMedium<float>& med, MF m, LaneVecto
     v.in_medium = hn::IfThenElseZero(hn::Not(leave_i), v.in_medium);
 }
 
-// ---- Binning: first guesses on vectors, the grid's rule per exit
-// ---------------------------------
+// ---- Binning: first guesses on vectors, the grid's rule per exit ------------------------------
 
 // A first guess of acos(x), x ∈ [−1, 1], within 10^-4 rad: Abramowitz & Stegun 1964, Eq. 4.4.45
 // (|ε| ≤ 5·10^-5 on [0, 1]) with acos(−x) = π − acos(x). Only a guess: HemisphereGrid::bin_of
