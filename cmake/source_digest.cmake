@@ -1,7 +1,9 @@
-# Writes OUT, a header defining lamina::kModelSourceDigest: the SHA-256 of the files listed in
-# LIST (one path per line), names and contents. Run at build time (src/study/CMakeLists.txt) so
-# that any edit of a model's code changes the study's model keys; OUT is rewritten only when the
-# digest changes, so nothing else rebuilds.
+# Writes OUT, a header defining lamina::NAME (a string): the SHA-256 of the files listed in LIST
+# (one path per line), names and contents, truncated to 16 hex digits. Run at build time
+# (src/study/CMakeLists.txt) so that any edit of the code a table depends on changes the study's
+# keys (kModelSourceDigest: the models' code; kReferenceSourceDigest: the reference's, the particle
+# kernels included); WHAT describes the files. OUT is rewritten only when the digest changes, so
+# nothing else rebuilds.
 file(STRINGS "${LIST}" files)
 set(all "")
 foreach(f IN LISTS files)
@@ -11,7 +13,7 @@ foreach(f IN LISTS files)
 endforeach()
 string(SHA256 digest "${all}")
 string(SUBSTRING "${digest}" 0 16 digest)
-set(text "#pragma once\n// Generated at build time by cmake/source_digest.cmake: the digest of the models' code\n// (src/core, src/physics, src/layers, src/randomwalk, src/models).\nnamespace lamina {\ninline constexpr const char* kModelSourceDigest = \"${digest}\";\n}  // namespace lamina\n")
+set(text "#pragma once\n// Generated at build time by cmake/source_digest.cmake: the digest of ${WHAT}.\nnamespace lamina {\ninline constexpr const char* ${NAME} = \"${digest}\";\n}  // namespace lamina\n")
 if(EXISTS "${OUT}")
   file(READ "${OUT}" old)
   if(old STREQUAL text)

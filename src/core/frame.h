@@ -1,6 +1,7 @@
 #pragma once
 // Orthonormal frames: local shading frames about any normal (e.g. a microfacet normal wm).
 
+#include "core/lane_vec.h"
 #include "core/vec.h"
 
 #include <cmath>
@@ -14,13 +15,11 @@ struct Frame {
     Vec3<T> s, t, n;
 
     /// Branchless construction from a unit normal: Duff et al. 2017, "Building an Orthonormal
-    /// Basis, Revisited", JCGT 6(1), Listing 3.
+    /// Basis, Revisited", JCGT 6(1), Listing 3 (the lane template lane_orthonormal_basis).
     static Frame from_normal(const Vec3<T>& n) {
-        const T sign = std::copysign(T(1), n.z);
-        const T a = T(-1) / (sign + n.z);
-        const T b = n.x * n.y * a;
-        return {Vec3<T>(T(1) + sign * n.x * n.x * a, sign * b, -sign * n.x),
-                Vec3<T>(b, sign + n.y * n.y * a, -n.y), n};
+        LaneVec3<T> s, t;
+        lane_orthonormal_basis<T>({n.x, n.y, n.z}, s, t);
+        return {Vec3<T>(s.x, s.y, s.z), Vec3<T>(t.x, t.y, t.z), n};
     }
 
     Vec3<T> to_local(const Vec3<T>& v) const { return {dot(v, s), dot(v, t), dot(v, n)}; }

@@ -20,7 +20,8 @@ std::vector<int> make_guess(const std::vector<double>& edges, double x_min) {
     int b = 0;  // x decreases with c, so the bin only moves forward: one pass
     for (int c = 0; c <= kGuessResolution; ++c) {
         const double x = x_min + (1.0 - x_min) * (kGuessResolution - c) / kGuessResolution;
-        while (b < n - 1 && x < edges[b + 1]) ++b;  // x at a cell's top: the smallest bin
+        while (b < n - 1 && x < edges[b + 1])
+            ++b;  // x at a cell's top: the smallest bin
         guess[c] = b;
     }
     return guess;
@@ -28,9 +29,11 @@ std::vector<int> make_guess(const std::vector<double>& edges, double x_min) {
 }  // namespace
 
 HemisphereGrid::HemisphereGrid(int n_theta, int n_phi) : n_theta_(n_theta), n_phi_(n_phi) {
-    for (int t = 0; t <= n_theta_; ++t) cos_theta_edge_.push_back(std::cos(theta_lo(t)));
+    for (int t = 0; t <= n_theta_; ++t)
+        cos_theta_edge_.push_back(std::cos(theta_lo(t)));
     cos_theta_edge_.back() = 0.0;
-    for (int p = 0; p <= n_phi_; ++p) cos_phi_edge_.push_back(std::cos(phi_lo(p)));
+    for (int p = 0; p <= n_phi_; ++p)
+        cos_phi_edge_.push_back(std::cos(phi_lo(p)));
     cos_phi_edge_.back() = -1.0;
     theta_guess_ = make_guess(cos_theta_edge_, 0.0);
     phi_guess_ = make_guess(cos_phi_edge_, -1.0);
@@ -42,22 +45,22 @@ double HemisphereGrid::projected_solid_angle(int t, int p) const {
 
 int HemisphereGrid::theta_bin(double cos_theta) const {
     cos_theta = clamp(cos_theta, 0.0, 1.0);
-    int b = theta_guess_[int((1.0 - cos_theta) * kGuessResolution)];
-    // Bin b holds cos_theta_edge_[b] ≥ cos θ > cos_theta_edge_[b + 1]; the guess never overshoots.
-    while (b < n_theta_ - 1 && cos_theta <= cos_theta_edge_[b + 1]) ++b;
-    return b;
+    // The guess never overshoots: refine_bin only steps forward.
+    return refine_bin(cos_theta, theta_guess_[int((1.0 - cos_theta) * kGuessResolution)],
+                      cos_theta_edge_);
 }
 
 int HemisphereGrid::phi_bin(double x, double y) const {
     const double r = std::sqrt(x * x + y * y);
     if (r == 0) return 0;
     const double cos_phi = clamp(x / r, -1.0, 1.0);  // folded: φ and −φ share a bin
-    int b = phi_guess_[int((1.0 - cos_phi) * 0.5 * kGuessResolution)];
-    while (b < n_phi_ - 1 && cos_phi <= cos_phi_edge_[b + 1]) ++b;
-    return b;
+    return refine_bin(cos_phi, phi_guess_[int((1.0 - cos_phi) * 0.5 * kGuessResolution)],
+                      cos_phi_edge_);
 }
 
-std::string HemisphereGrid::to_string() const { return fmt::format("{}x{}", n_theta_, n_phi_); }
+std::string HemisphereGrid::to_string() const {
+    return fmt::format("{}x{}", n_theta_, n_phi_);
+}
 
 HemisphereGrid HemisphereGrid::parse(const std::string& text, const std::string& option) {
     const auto x = text.find('x');

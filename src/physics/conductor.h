@@ -1,17 +1,79 @@
-#pragma once
 // A conductor (opaque) interface: smooth (delta mirror) or rough GGX reflection with the exact
 // complex Fresnel factor per RGB channel (Walter et al. 2007, Eq. 20 with conductor Fresnel).
 // Light arrives from above only (wi.z > 0). Relative complex index (eta + i k) per channel, taken
 // against the medium above (docs/physics.md §2). Conventions: physics/bsdf.h.
 
+#include "core/lane.h"
+#include "core/lane_vec.h"
 #include "core/rgb.h"
 #include "physics/bsdf.h"
+#include "physics/dielectric.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
 #include "physics/smith_masking.h"
 
 #include <cmath>
 #include <optional>
+
+// A lane header (core/lane.h): the particle event is a lane template, included once as an
+// ordinary header and once per SIMD target; the interface type below it only once.
+#ifndef LAMINA_LANE_TARGET
+#ifndef LAMINA_PHYSICS_CONDUCTOR_LANES_H
+#define LAMINA_PHYSICS_CONDUCTOR_LANES_H
+#define LAMINA_PHYSICS_CONDUCTOR_BODY
+#endif
+#elif defined(LAMINA_PHYSICS_CONDUCTOR_TARGET) == defined(HWY_TARGET_TOGGLE)
+#ifdef LAMINA_PHYSICS_CONDUCTOR_TARGET
+#undef LAMINA_PHYSICS_CONDUCTOR_TARGET
+#else
+#define LAMINA_PHYSICS_CONDUCTOR_TARGET
+#endif
+#define LAMINA_PHYSICS_CONDUCTOR_BODY
+#endif
+
+#ifdef LAMINA_PHYSICS_CONDUCTOR_BODY
+#undef LAMINA_PHYSICS_CONDUCTOR_BODY
+
+LAMINA_LANE_BEGIN
+
+/// The conductor interface's particle event (ConductorInterface::sample) on the lanes of
+/// `active`, light from above: the mirror direction about a visible microfacet normal drawn from
+/// u1, u2 (Heitz 2018 density, by the spherical caps of Dupuy & Benyoub 2023; the macro normal
+/// when `smooth`), its Fresnel factors `fresnel(cos θ, factors)` (three channels, at the facet
+/// cosine; fresnel_conductor per channel) and, when rough, the escape fraction G2/G1
+/// (ggx_escape_fraction; zero for a reflection below the horizon). A wi at or below the horizon
+/// is degenerate. A branch-free lane template (core/lane.h): the scalar and the SIMD particle
+/// kernels evaluate these lines.
+template <typename T, typename L = Lane<T>, typename Fresnel>
+LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> conductor_event(
+    T alpha, bool smooth, bool uncorrelated, const LaneVec3<T>& wi, T u1, T u2,
+    typename L::Mask active, const Fresnel& fresnel, T* fresnel_factors) {
+    const T zero = L::constant(0), one = L::constant(1);
+    InterfaceEventLanes<T, typename L::Mask> e;
+    e.degenerate = L::both(active, L::negate(L::less(zero, wi.z)));
+    e.reflected = L::both(active, L::negate(e.degenerate));
+    const LaneVec3<T> wm = smooth ? LaneVec3<T>{zero, zero, one}
+                                  : ggx_sample_visible_normal_complete<T, L>(alpha, wi, u1, u2);
+    const T cos_i_m = lane_dot<T, L>(wi, wm);
+    const T two_cos = cos_i_m + cos_i_m;
+    e.wo = {L::mul_add(two_cos, wm.x, zero - wi.x), L::mul_add(two_cos, wm.y, zero - wi.y),
+            L::mul_add(two_cos, wm.z, zero - wi.z)};
+    fresnel(cos_i_m, fresnel_factors);
+    e.shadowing = one;
+    if (!smooth)
+        e.shadowing = L::select(L::less(zero, e.wo.z),
+                                ggx_escape_fraction<T, L>(alpha * alpha, wi, e.wo, e.reflected,
+                                                          e.reflected, uncorrelated, false),
+                                zero);
+    return e;
+}
+
+LAMINA_LANE_END
+
+#endif  // LAMINA_PHYSICS_CONDUCTOR_BODY
+
+#if !defined(LAMINA_LANE_TARGET) && !defined(LAMINA_PHYSICS_CONDUCTOR_H)
+#define LAMINA_PHYSICS_CONDUCTOR_H
 
 namespace lamina {
 
@@ -50,39 +112,32 @@ struct ConductorInterface {
         return distribution().pdf_visible_normal(wi, wm) / (T(4) * dot(wo, wm));
     }
 
-    /// Reflects a particle arriving from wi off a visible microfacet (Heitz 2018 density, drawn as
-    /// in Dupuy & Benyoub 2023); weight
-    /// F(wi·wm)·G2/G1. kWithPdf = false skips the density.
+    /// Reflects a particle arriving from wi: conductor_event at one lane (a visible microfacet
+    /// normal, Heitz 2018 density drawn as in Dupuy & Benyoub 2023; weight F(wi·wm)·G2/G1).
+    /// Nothing unless wi.z > 0. kWithPdf = false skips the density.
     template <bool kWithPdf = true>
     std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T u1, T u2) const {
-        if (wi.z <= 0) return std::nullopt;
+        T factors[3];
+        const auto channel_fresnel = [&](T cos_theta, T* out) {
+            const Rgb<T> f = fresnel(cos_theta);
+            out[0] = f[0], out[1] = f[1], out[2] = f[2];
+        };
+        const InterfaceEventLanes<T, bool> e =
+            conductor_event<T>(alpha, is_smooth(), uncorrelated_shadowing, {wi.x, wi.y, wi.z}, u1,
+                               u2, true, channel_fresnel, factors);
+        if (e.degenerate) return std::nullopt;
         BsdfSample<T> s;
-        if (is_smooth()) {
-            s.wo = Vec3<T>(-wi.x, -wi.y, wi.z);
-            s.is_delta = true;
-            s.fresnel_weight = fresnel(wi.z);
-            s.weight = s.fresnel_weight;
-            return s;
-        }
-        const GGX<T> ggx = distribution();
-        const Vec3<T> wm = ggx.sample_visible_normal_caps(wi, u1, u2);
-        s.wo = reflect(wi, wm);
-        s.fresnel_weight = fresnel(dot(wi, wm));
-        if (s.wo.z <= 0) {
-            s.shadowing = 0;
-        } else {
-            // G2/G1 = (1 + r_i)/(r_i + r_o) with r = 1 + 2Λ (see dielectric.h).
-            if (uncorrelated_shadowing) {
-                s.shadowing = ggx.G1(s.wo);
-            } else {
-                const T r_i = ggx.smith_root(wi), r_o = ggx.smith_root(s.wo);
-                s.shadowing = smith_reflection_escape(r_i, r_o);
-            }
-            if constexpr (kWithPdf) s.pdf = ggx.pdf_visible_normal(wi, wm) / (T(4) * dot(s.wo, wm));
-        }
+        s.wo = {e.wo.x, e.wo.y, e.wo.z};
+        s.is_delta = is_smooth();
+        s.fresnel_weight = {factors[0], factors[1], factors[2]};
+        s.shadowing = e.shadowing;
+        if constexpr (kWithPdf)
+            if (!s.is_delta && s.wo.z > 0) s.pdf = pdf(wi, s.wo);
         s.weight = s.fresnel_weight * s.shadowing;
         return s;
     }
 };
 
 }  // namespace lamina
+
+#endif  // LAMINA_PHYSICS_CONDUCTOR_H

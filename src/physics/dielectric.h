@@ -1,12 +1,13 @@
-#pragma once
 // A dielectric interface between two non-absorbing media: smooth (α = 0, delta reflection and
 // refraction) or rough (GGX, single-scattering microfacet BSDF of Walter et al. 2007, "Microfacet
 // models for refraction through rough surfaces", EGSR). Conventions: physics/bsdf.h.
 //
 // eta = η_below / η_above > 0; eta = 1 is allowed: an index-matched interface is a delta pass-
 // through, smooth or rough (for α > 0 the limit η → 1 of the rough BTDF, a refraction lobe of zero
-// width; see sample_index_matched). α ∈ [0, 1].
+// width; see dielectric_event). α ∈ [0, 1].
 
+#include "core/lane.h"
+#include "core/lane_vec.h"
 #include "core/math.h"
 #include "physics/bsdf.h"
 #include "physics/fresnel.h"
@@ -15,6 +16,137 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+
+#ifndef LAMINA_PHYSICS_DIELECTRIC_SHAPE_H
+#define LAMINA_PHYSICS_DIELECTRIC_SHAPE_H
+namespace lamina {
+/// What is the same on every lane of a dielectric event (dielectric_event): the interface's kind
+/// and options (DielectricInterface). Defined once, outside the lane templates' namespaces.
+struct DielectricEventShape {
+    bool smooth;            ///< α = 0
+    bool index_matched;     ///< η = 1
+    bool uncorrelated;      ///< G1·G1 instead of the height-correlated G2
+    bool smith_refraction;  ///< TransmissionMasking::Smith
+};
+}  // namespace lamina
+#endif
+
+// A lane header (core/lane.h): the particle event is a lane template, included once as an
+// ordinary header and once per SIMD target; the interface type below it only once.
+#ifndef LAMINA_LANE_TARGET
+#ifndef LAMINA_PHYSICS_DIELECTRIC_LANES_H
+#define LAMINA_PHYSICS_DIELECTRIC_LANES_H
+#define LAMINA_PHYSICS_DIELECTRIC_BODY
+#endif
+#elif defined(LAMINA_PHYSICS_DIELECTRIC_TARGET) == defined(HWY_TARGET_TOGGLE)
+#ifdef LAMINA_PHYSICS_DIELECTRIC_TARGET
+#undef LAMINA_PHYSICS_DIELECTRIC_TARGET
+#else
+#define LAMINA_PHYSICS_DIELECTRIC_TARGET
+#endif
+#define LAMINA_PHYSICS_DIELECTRIC_BODY
+#endif
+
+#ifdef LAMINA_PHYSICS_DIELECTRIC_BODY
+#undef LAMINA_PHYSICS_DIELECTRIC_BODY
+
+LAMINA_LANE_BEGIN
+
+/// A particle event at an interface, per lane: the new direction wo (pointing away from the
+/// surface), the fraction `shadowing` of the flux that escapes the microsurface (G2/G1; 1 on a
+/// smooth interface), whether the lane reflected, and the lanes whose sample failed (`degenerate`:
+/// a grazing arrival; nothing else holds for them).
+template <typename T, typename M>
+struct InterfaceEventLanes {
+    LaneVec3<T> wo;
+    T shadowing;
+    M reflected;
+    M degenerate;
+};
+
+/// The dielectric interface's particle event (DielectricInterface::sample) on the lanes of
+/// `active`, each arriving from wi (away from the surface, either side): a visible microfacet
+/// normal drawn from u1, u2 (Heitz 2018, by the spherical caps of Dupuy & Benyoub 2023; the macro
+/// normal when smooth), the Fresnel reflectance at it (fresnel_dielectric_full), reflection if
+/// uc < F and Snell refraction otherwise, both candidates formed and one selected (the Fresnel
+/// choice is a coin flip no branch predictor learns), and the escape fraction G2/G1 of the pair
+/// (ggx_escape_fraction; zero unless a reflection stays on wi's side and a refraction crosses,
+/// the single-scattering microsurface losing the rest). The Fresnel branch probability cancels F
+/// in the weight (Heitz 2018, §2; Walter et al. 2007, Eq. 41 with visible-normal sampling).
+/// Index-matched (η = 1) and rough: F = 0 on every microfacet and Snell's law sends every refracted
+/// ray straight on, so the BTDF of Walter et al. collapses onto a delta lobe at −wi, which eval and
+/// pdf (densities) cannot represent; its weight is the η → 1 limit of the lobe's energy,
+/// E[(1 − F) G2/G1] → G2(wi, −wi)/G1(wi) (every refracted direction tends to −wi; G2 of the
+/// refraction lobe), so the interface is continuous in η; the single-scattering microsurface still
+/// loses 1 − that. (The quotient is ≤ 1 exactly; rounded above it, it booked −6.6e-8 as lost to the
+/// microsurface, found by the fuzz test with seed 99: the escape fractions are clamped at 1.)
+/// Smooth and index-matched: straight through with weight 1. A grazing wi (wi.z = 0) is degenerate.
+/// eta = η_below / η_above, inv_eta = 1/eta, alpha the GGX roughness. A branch-free lane template
+/// (core/lane.h): the scalar and the SIMD particle kernels evaluate these lines.
+template <typename T, typename L = Lane<T>>
+LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> dielectric_event(
+    T eta, T inv_eta, T alpha, DielectricEventShape shape, const LaneVec3<T>& wi, T uc, T u1, T u2,
+    typename L::Mask active) {
+    const T zero = L::constant(0), one = L::constant(1);
+    InterfaceEventLanes<T, typename L::Mask> e;
+    e.degenerate = L::both(active, L::negate(L::less(zero, L::abs(wi.z))));
+    const auto ok = L::both(active, L::negate(e.degenerate));
+    e.shadowing = one;
+    if (shape.index_matched) {
+        e.wo = {zero - wi.x, zero - wi.y, zero - wi.z};
+        e.reflected = L::both(ok, L::negate(ok));  // no lane
+        if (!shape.smooth)
+            e.shadowing = ggx_escape_fraction<T, L>(alpha * alpha, wi, e.wo, e.reflected, ok,
+                                                    shape.uncorrelated, shape.smith_refraction);
+        return e;
+    }
+    // The microfacet normal: drawn for a rough interface, the macro normal for a smooth one (then
+    // the two candidates are the mirror direction and Snell's law, shadowing 1). From below, wi
+    // sees the microsurface through −wi (microfacet.h).
+    LaneVec3<T> wm = {zero, zero, one};
+    if (!shape.smooth) {
+        const T sign = L::select(L::less(wi.z, zero), zero - one, one);
+        wm = ggx_sample_visible_normal_complete<T, L>(
+            alpha, {sign * wi.x, sign * wi.y, sign * wi.z}, u1, u2);
+    }
+    const T cos_i_m = lane_dot<T, L>(wi, wm);  // < 0 when wi is below: seen from the other side
+    const FresnelDielectric<T> fr = fresnel_dielectric_full<T, L>(cos_i_m, eta, inv_eta);
+    const T cos_i = L::min(L::abs(cos_i_m), one);
+    // Mirror about wm (fresnel.h reflect), or Snell about wm (fresnel.h refract) reusing the
+    // refracted cosine: with m = ±wm on wi's side, wt = −wi/η + m (cos θi/η − cos θt) (under total
+    // reflection F = 1 and the refracted candidate is never selected).
+    const T two_cos = cos_i_m + cos_i_m;
+    const LaneVec3<T> reflected = {L::mul_add(two_cos, wm.x, zero - wi.x),
+                                   L::mul_add(two_cos, wm.y, zero - wi.y),
+                                   L::mul_add(two_cos, wm.z, zero - wi.z)};
+    const T along = L::select(L::less(cos_i_m, zero), zero - one, one) *
+                    L::mul_add(cos_i, fr.inv_eta, zero - fr.cos_theta_t);
+    const T neg_inv_eta = zero - fr.inv_eta;
+    const LaneVec3<T> refracted = {L::mul_add(wi.x, neg_inv_eta, wm.x * along),
+                                   L::mul_add(wi.y, neg_inv_eta, wm.y * along),
+                                   L::mul_add(wi.z, neg_inv_eta, wm.z * along)};
+    e.reflected = L::less(uc, fr.reflectance);
+    e.wo = lane_select<T, L>(e.reflected, reflected, refracted);
+    if (!shape.smooth) {
+        // A reflection must stay on wi's side and a refraction cross, else G2 = 0.
+        const auto same_side = L::less(zero, wi.z * e.wo.z);
+        const auto crosses_right = L::either(L::both(same_side, e.reflected),
+                                             L::both(L::negate(same_side), L::negate(e.reflected)));
+        const auto escapes = L::both(L::less(zero, L::abs(e.wo.z)), crosses_right);
+        const T escape =
+            ggx_escape_fraction<T, L>(alpha * alpha, wi, e.wo, e.reflected, L::both(ok, escapes),
+                                      shape.uncorrelated, shape.smith_refraction);
+        e.shadowing = L::select(escapes, escape, zero);
+    }
+    return e;
+}
+
+LAMINA_LANE_END
+
+#endif  // LAMINA_PHYSICS_DIELECTRIC_BODY
+
+#if !defined(LAMINA_LANE_TARGET) && !defined(LAMINA_PHYSICS_DIELECTRIC_H)
+#define LAMINA_PHYSICS_DIELECTRIC_H
 
 namespace lamina {
 
@@ -101,89 +233,37 @@ struct DielectricInterface {
         return (T(1) - F) * pdf_wm * jacobian;
     }
 
-    /// Follows a particle arriving from wi: picks a visible microfacet normal (Heitz 2018, drawn
-    /// with the equivalent spherical-cap construction of Dupuy & Benyoub 2023), reflects with
-    /// probability F and refracts otherwise, and keeps the fraction G2/G1 that escapes the
-    /// microsurface (docs/physics.md §3), with the refraction lobe's G2 of transmission_masking. uc
-    /// picks the Fresnel branch; u1, u2 the normal. kWithPdf = false skips the density (the
-    /// particle tracer only needs the weight).
+    /// Follows a particle arriving from wi: dielectric_event (a visible microfacet normal drawn
+    /// from u1, u2, reflection with probability F picked by uc, refraction otherwise) at one
+    /// lane, keeping the fraction G2/G1 that escapes the microsurface (docs/physics.md §3), with
+    /// the refraction lobe's G2 of transmission_masking. Smooth and index-matched interfaces give
+    /// delta samples. Nothing for a grazing wi. kWithPdf = false skips the density (the particle
+    /// tracer only needs the weight).
     template <bool kWithPdf = true>
     LAMINA_FORCE_INLINE std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T uc, T u1,
                                                             T u2) const {
-        if (wi.z == 0) return std::nullopt;
-        if (is_smooth()) return sample_smooth(wi, uc);
-        if (is_index_matched()) return sample_index_matched(wi);
-        const GGX<T> ggx = distribution();
-        const Vec3<T> wm = ggx.sample_visible_normal_caps(wi, u1, u2);
-        const T cos_i_m = dot(wi, wm);  // < 0 when wi is below: seen from the other side
-        const FresnelDielectric<T> fr = fresnel_dielectric_full(cos_i_m, eta, inv_eta());
-        // Both candidate directions are formed and one is selected: the Fresnel choice is a coin
-        // flip no branch predictor can learn. Snell about wm (fresnel.h refract) reuses the
-        // refracted cosine: with m = ±wm on wi's side, wt = −wi/η + m (cos θi/η − cos θt) (under
-        // total reflection F = 1 and the refracted candidate is never selected).
-        const T sign = cos_i_m < 0 ? T(-1) : T(1);
-        const Vec3<T> reflected = reflect(wi, wm);
-        const Vec3<T> refracted =
-            wi * (-fr.inv_eta) + wm * (sign * (std::abs(cos_i_m) * fr.inv_eta - fr.cos_theta_t));
-        const bool is_reflection = uc < fr.reflectance;
+        const DielectricEventShape shape = event_shape();
+        const InterfaceEventLanes<T, bool> e =
+            dielectric_event<T>(eta, inv_eta(), alpha, shape, {wi.x, wi.y, wi.z}, uc, u1, u2, true);
+        if (e.degenerate) return std::nullopt;
         BsdfSample<T> s;
-        s.wo = is_reflection ? reflected : refracted;
-        s.is_transmission = !is_reflection;
-        // A reflection must stay on wi's side and a refraction cross: otherwise the single-
-        // scattering microsurface loses the energy (G2 = 0 for the pair).
-        const bool escapes = s.wo.z != 0 && (same_hemisphere(wi, s.wo) == is_reflection);
-        // Weight f·|cos θo|/pdf = G2(wi, wo)/G1(wi): the Fresnel branch probability cancels F
-        // (Heitz 2018, §2; Walter Eq. 41 with visible-normal sampling), in terms of the Smith
-        // roots r = √(1 + α²tan²θ) = 1 + 2Λ (Heitz 2014, Eq. 72; microfacet.h).
-        if (uncorrelated_shadowing) {
-            s.shadowing = ggx.G1(s.wo);
-        } else {
-            const T r_i = ggx.smith_root(wi), r_o = ggx.smith_root(s.wo);
-            s.shadowing = is_reflection || transmission_masking == TransmissionMasking::Pbrt
-                              ? smith_reflection_escape(r_i, r_o)
-                              : smith_refraction_escape(r_i, r_o);
-        }
-        if (!escapes) s.shadowing = 0;
+        s.wo = {e.wo.x, e.wo.y, e.wo.z};
+        s.is_delta = shape.smooth || shape.index_matched;
+        s.is_transmission = !e.reflected;
+        s.shadowing = e.shadowing;
         s.weight = Rgb<T>(s.shadowing);
-        if constexpr (kWithPdf) s.pdf = pdf(wi, s.wo);
+        if constexpr (kWithPdf)
+            if (!s.is_delta) s.pdf = pdf(wi, s.wo);
         return s;
     }
 
-  private:
-    /// Rough and η = 1: F = 0 on every microfacet and Snell's law sends every refracted ray
-    /// straight on, so the BTDF of Walter et al. collapses onto a delta lobe at −wi, which eval
-    /// and pdf (densities) cannot represent. Its weight is the η → 1 limit of the lobe's energy,
-    /// E[(1 − F) G2/G1] → G2(wi, −wi)/G1(wi) (every refracted direction tends to −wi; G2 of the
-    /// refraction lobe, transmission_masking's), so the interface is continuous in η; the
-    /// single-scattering microsurface still loses 1 − that.
-    std::optional<BsdfSample<T>> sample_index_matched(const Vec3<T>& wi) const {
-        BsdfSample<T> s;
-        s.wo = -wi;
-        s.is_delta = true;
-        s.is_transmission = true;
-        // A fraction, ≤ 1 exactly; the float quotient can round an ulp above it (found by the
-        // fuzz test, seed 99: −6.6e-8 booked as lost to the microsurface): clamped.
-        s.shadowing = std::min(T(1), masking_shadowing(wi, s.wo) / distribution().G1(wi));
-        s.weight = Rgb<T>(s.shadowing);
-        return s;
-    }
-
-    std::optional<BsdfSample<T>> sample_smooth(const Vec3<T>& wi, T uc) const {
-        const Vec3<T> n(0, 0, 1);
-        const T F = fresnel_dielectric(wi.z, eta);
-        BsdfSample<T> s;
-        s.is_delta = true;
-        s.weight = Rgb<T>(T(1));  // flux: the branch probability equals its Fresnel factor
-        if (uc < F) {
-            s.wo = Vec3<T>(-wi.x, -wi.y, wi.z);
-        } else {
-            const auto wt = refract(wi, n, eta);
-            if (!wt) return std::nullopt;  // unreachable: F = 1 under TIR
-            s.wo = *wt;
-            s.is_transmission = true;
-        }
-        return s;
+    /// The options of dielectric_event.
+    DielectricEventShape event_shape() const {
+        return {is_smooth(), is_index_matched(), uncorrelated_shadowing,
+                transmission_masking == TransmissionMasking::Smith};
     }
 };
 
 }  // namespace lamina
+
+#endif  // LAMINA_PHYSICS_DIELECTRIC_H

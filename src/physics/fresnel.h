@@ -45,7 +45,7 @@ struct FresnelDielectric {
 };
 
 template <typename T, typename L = Lane<T>>
-inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_eta);
+LAMINA_LANE_INLINE FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_eta);
 
 /// Exact unpolarized Fresnel reflectance of a dielectric interface (the mean of the s and p
 /// reflectances; Born & Wolf, Principles of Optics, §1.5.2, Eqs. 21a–b), with the refracted cosine.
@@ -53,14 +53,14 @@ inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_
 /// means the light arrives from the other side, where the relative index is 1/eta.
 /// eta > 0. The reflectance is 1 under total internal reflection (sin θt ≥ 1).
 template <typename T>
-inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta) {
+LAMINA_LANE_INLINE FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta) {
     return fresnel_dielectric_full(cos_theta_i, eta, T(1) / eta);
 }
 
 /// The same with 1/eta supplied (interfaces keep it, saving a division per event). A branch-free
 /// lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate these lines.
 template <typename T, typename L>
-inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_eta) {
+LAMINA_LANE_INLINE FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_eta) {
     const T zero = L::constant(0), one = L::constant(1);
     cos_theta_i = L::min(L::max(cos_theta_i, zero - one), one);
     // From the other side the relative index crossed is 1/η.
@@ -85,7 +85,7 @@ inline FresnelDielectric<T> fresnel_dielectric_full(T cos_theta_i, T eta, T inv_
 /// Exact unpolarized Fresnel reflectance of a dielectric interface; see fresnel_dielectric_full.
 /// Returns 1 under total internal reflection.
 template <typename T>
-inline T fresnel_dielectric(T cos_theta_i, T eta) {
+LAMINA_LANE_INLINE T fresnel_dielectric(T cos_theta_i, T eta) {
     return fresnel_dielectric_full(cos_theta_i, eta).reflectance;
 }
 
@@ -101,7 +101,7 @@ inline T fresnel_dielectric(T cos_theta_i, T eta) {
 /// A branch-free lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate
 /// these lines.
 template <typename T, typename L = Lane<T>>
-inline T fresnel_conductor(T cos_theta_i, T eta, T k) {
+LAMINA_LANE_INLINE T fresnel_conductor(T cos_theta_i, T eta, T k) {
     const T zero = L::constant(0), one = L::constant(1), two = L::constant(2);
     cos_theta_i = L::min(L::max(cos_theta_i, zero), one);
     const T cos2 = cos_theta_i * cos_theta_i;
@@ -125,7 +125,7 @@ inline T fresnel_conductor(T cos_theta_i, T eta, T k) {
 /// The same reflectance evaluated with std::complex, as written in Born & Wolf: an independent
 /// form for tests (slower: complex division and square root).
 template <typename T>
-inline T fresnel_conductor_complex(T cos_theta_i, T eta, T k) {
+LAMINA_LANE_INLINE T fresnel_conductor_complex(T cos_theta_i, T eta, T k) {
     using C = std::complex<T>;
     cos_theta_i = clamp(cos_theta_i, T(0), T(1));
     const C eta_c(eta, k);
@@ -140,7 +140,7 @@ inline T fresnel_conductor_complex(T cos_theta_i, T eta, T k) {
 
 /// Mirror reflection of w (pointing away from the surface) about the unit normal n.
 template <typename T>
-inline Vec3<T> reflect(const Vec3<T>& w, const Vec3<T>& n) {
+LAMINA_LANE_INLINE Vec3<T> reflect(const Vec3<T>& w, const Vec3<T>& n) {
     return n * (T(2) * dot(w, n)) - w;
 }
 
@@ -149,7 +149,7 @@ inline Vec3<T> reflect(const Vec3<T>& w, const Vec3<T>& n) {
 /// Returns the refracted direction, pointing away from the surface on the other side, or nothing
 /// under total internal reflection.
 template <typename T>
-inline std::optional<Vec3<T>> refract(const Vec3<T>& w, Vec3<T> n, T eta) {
+LAMINA_LANE_INLINE std::optional<Vec3<T>> refract(const Vec3<T>& w, Vec3<T> n, T eta) {
     T cos_theta_i = dot(n, w);
     if (cos_theta_i < 0) {  // arriving from the side n points away from
         eta = T(1) / eta;

@@ -45,7 +45,7 @@ LAMINA_LANE_BEGIN
 /// overflows (within a few ulps of grazing, where the formula would give ∞/∞). A branch-free lane
 /// template (core/lane.h): GGX::lambda and the SIMD kernel's microsurface walk evaluate it.
 template <typename T, typename L = Lane<T>>
-inline T ggx_lambda(T alpha2, T x, T y, T z) {
+LAMINA_LANE_INLINE T ggx_lambda(T alpha2, T x, T y, T z) {
     const T alpha2_tan2 = alpha2 * (x * x + y * y) / (z * z);
     const T lambda =
         alpha2_tan2 / (L::constant(2) * (L::sqrt(L::constant(1) + alpha2_tan2) + L::constant(1)));
@@ -62,7 +62,8 @@ inline T ggx_lambda(T alpha2, T x, T y, T z) {
 /// and wh, warp back. A branch-free lane template (core/lane.h):
 /// GGX::sample_visible_normal_complete and the SIMD kernel evaluate it.
 template <typename T, typename L = Lane<T>>
-inline LaneVec3<T> ggx_sample_visible_normal_complete(T alpha, const LaneVec3<T>& w, T u1, T u2) {
+LAMINA_LANE_INLINE LaneVec3<T> ggx_sample_visible_normal_complete(T alpha, const LaneVec3<T>& w,
+                                                                  T u1, T u2) {
     const T one = L::constant(1);
     const LaneVec3<T> wh = lane_normalize<T, L>({alpha * w.x, alpha * w.y, w.z});
     T cos_phi, sin_phi;
@@ -72,6 +73,37 @@ inline LaneVec3<T> ggx_sample_visible_normal_complete(T alpha, const LaneVec3<T>
     const LaneVec3<T> h = {L::mul_add(sin_theta, cos_phi, wh.x),
                            L::mul_add(sin_theta, sin_phi, wh.y), z + wh.z};
     return lane_normalize<T, L>({alpha * h.x, alpha * h.y, L::max(h.z, L::constant(0))});
+}
+
+/// |cos θ| √(1 + α² tan²θ) = √(cos²θ + α² sin²θ) = |cos θ| (1 + 2Λ(w)) (GGX::smith_root; Heitz
+/// 2014, Eq. 72) for GGX of squared roughness alpha2, without a division: zero at grazing, where
+/// 1 + 2Λ is infinite. A branch-free lane template (core/lane.h).
+template <typename T, typename L = Lane<T>>
+LAMINA_LANE_INLINE T ggx_smith_root_times_cos(T alpha2, const LaneVec3<T>& w) {
+    return L::sqrt(L::mul_add(alpha2, L::mul_add(w.x, w.x, w.y * w.y), w.z * w.z));
+}
+
+/// The weight G2(wi, wo)/G1(wi) a particle keeps after one facet of a single-scattering rough
+/// interface sent it from wi to wo (Heitz 2018, §2: visible-normal sampling leaves G2/G1), from
+/// the Smith roots (smith_masking.h): `reflected` lanes (wo on wi's side) escape with
+/// smith_reflection_escape, refracted ones with smith_refraction_escape (`smith_refraction`,
+/// TransmissionMasking::Smith; computed only when some lane of `active` refracts) or, as pbrt-v4,
+/// with the reflection form; `uncorrelated`: G1(wo) = 2/(1 + r_o) = 2|z_o|/(|z_o| + s_o) (Heitz
+/// 2014, Eq. 98). Zero for a grazing wo. A branch-free lane template (core/lane.h): the
+/// interfaces' samplers (dielectric.h, conductor.h) and the SIMD kernel evaluate these lines.
+template <typename T, typename L = Lane<T>>
+LAMINA_LANE_INLINE T ggx_escape_fraction(T alpha2, const LaneVec3<T>& wi, const LaneVec3<T>& wo,
+                                         typename L::Mask reflected, typename L::Mask active,
+                                         bool uncorrelated, bool smith_refraction) {
+    const T z_o = L::abs(wo.z);
+    const T s_o = ggx_smith_root_times_cos<T, L>(alpha2, wo);
+    if (uncorrelated) return L::min((z_o + z_o) / (z_o + s_o), L::constant(1));
+    const T z_i = L::abs(wi.z);
+    const T s_i = ggx_smith_root_times_cos<T, L>(alpha2, wi);
+    const T escape = smith_reflection_escape_scaled<T, L>(z_i, s_i, z_o, s_o);
+    const auto refracts = L::both(active, L::negate(reflected));
+    if (!smith_refraction || L::none(refracts)) return escape;
+    return L::select(refracts, smith_refraction_escape<T, L>(s_i / z_i, s_o / z_o), escape);
 }
 
 LAMINA_LANE_END

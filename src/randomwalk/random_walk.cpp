@@ -3,6 +3,7 @@
 #include "core/check.h"
 #include "core/math.h"
 #include "physics/fresnel.h"
+#include "physics/medium.h"
 #include "physics/microsurface_walk.h"
 #include "physics/phase.h"
 
@@ -120,63 +121,25 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events, Transmissio
       max_microsurface_order_(max_microsurface_order) {
     LAMINA_CHECK(max_events >= 1);
     LAMINA_CHECK(max_microsurface_order >= 1);
-    const bool multiple = microsurface == Microsurface::Multiple;
-    const int L = int(stack.layers.size());
+    const CompiledStack<double> compiled = compile_stack<double>(
+        stack, {masking, microsurface == Microsurface::Multiple, max_microsurface_order});
+    const int L = int(compiled.layers.size());
+    interfaces_ = compiled.layers;
     eta_.assign(L + 1, 1.0);
     media_.assign(L + 1, Medium{});
-    eta_[0] = stack.ambient_eta;
+    eta_[0] = compiled.eta_above;
     // For pdf_is_unbiased(): per-channel extinction in a scattering medium, and per-channel
     // weights of delta events that are not flights through one.
     bool chromatic_scatterer = false, chromatic_weight = false;
     for (int k = 0; k < L; ++k) {
-        const Layer& layer = stack.layers[k];
-        const InterfaceSpec& spec = layer.interface;
-        const double eta_above = stack.eta_above(k);
-        Interface it;
-        it.type = spec.type;
-        switch (spec.type) {
-            case InterfaceType::Dielectric:
-                it.dielectric = {spec.eta / eta_above, spec.alpha};
-                it.dielectric.transmission_masking = masking;
-                // Index-matched and rough with multiple scattering: every facet refracts straight
-                // on (F = 0) and the walk leaves below along −wi with all its flux, which is the
-                // smooth index-matched pass-through (the single-scattering one keeps G2/G1).
-                if (multiple && it.dielectric.is_index_matched()) it.dielectric.alpha = 0;
-                it.delta = it.dielectric.is_smooth() || it.dielectric.is_index_matched();
-                it.multiple = multiple && !it.delta;
-                eta_[k + 1] = spec.eta;
-                break;
-            case InterfaceType::Conductor:
-                it.conductor = {spec.eta_rgb / eta_above, spec.k / eta_above, spec.alpha};
-                it.delta = it.conductor.is_smooth();
-                it.multiple = multiple && !it.delta;
-                eta_[k + 1] = eta_above;  // no region below an opaque base
-                break;
-            case InterfaceType::Lambertian:
-                it.lambertian = {spec.albedo};
-                it.delta = false;
-                eta_[k + 1] = eta_above;
-                break;
-        }
-        if (spec.type == InterfaceType::Conductor && it.delta &&
-            !(is_grey(spec.eta_rgb) && is_grey(spec.k)))
+        const Interface& it = interfaces_[k];
+        eta_[k + 1] = it.eta_below;
+        if (it.type == InterfaceType::Conductor && it.delta &&
+            !(is_grey(it.conductor.eta) && is_grey(it.conductor.k)))
             chromatic_weight = true;
-        interfaces_.push_back(it);
-        if (layer.has_medium) {
-            const MediumSpec& m = layer.medium;
-            Medium& md = media_[k + 1];
-            md.tau_s = m.tau_s;
-            md.tau_t = m.tau_t();
-            md.g = m.g;
-            md.scatters = m.scatters();
-            md.empty = m.is_empty();
-            md.uniform_tau_t = md.tau_t[0] == md.tau_t[1] && md.tau_t[1] == md.tau_t[2];
-            md.uniform_g = m.g[0] == m.g[1] && m.g[1] == m.g[2];
-            for (int c = 0; c < 3; ++c)
-                md.single_scattering_albedo[c] = md.tau_t[c] > 0 ? m.tau_s[c] / md.tau_t[c] : 0.0;
-            if (md.scatters && !md.uniform_tau_t) chromatic_scatterer = true;
-            if (!md.scatters && !md.uniform_tau_t) chromatic_weight = true;
-        }
+        const Medium& md = media_[k + 1] = it.medium;
+        if (md.scatters && !md.uniform_tau_t) chromatic_scatterer = true;
+        if (!md.scatters && !md.is_empty() && !md.uniform_tau_t) chromatic_weight = true;
     }
     pdf_unbiased_ = !(chromatic_scatterer && chromatic_weight);
 }
@@ -239,7 +202,7 @@ static void build_connection(const std::vector<double>& eta, const auto& interfa
         c.dir_up[r] = Vec3d(h.x, h.y, c.mu[r]);
         c.dir_down[r] = Vec3d(h.x, h.y, -c.mu[r]);
         if (r == exit_region) (top ? c.dir_up[r] : c.dir_down[r]) = wo;
-        const bool opaque_flight = probability ? media[r].scatters : !media[r].empty;
+        const bool opaque_flight = probability ? media[r].scatters : !media[r].is_empty();
         c.t[r] = opaque_flight ? exp_neg(media[r].tau_t / c.mu[r]) : Rgbd(1.0);
         c.scale[r] = sqr(ratio);
     }
@@ -384,7 +347,7 @@ void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& 
         if (f_exit == 0) return;
         const Rgbd kv = kernel(omega);
         if (is_black(kv)) return;
-        const Rgbd tr = m.empty ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
+        const Rgbd tr = m.is_empty() ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
         f += w * kv * tr * (f_exit / st->pdf * mis);
     }
 }
@@ -463,48 +426,23 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
     Rgbd& w = ws.w;
     const Medium& m = media_[region];
     if (!m.scatters) {
-        const double inv_mu = 1 / std::abs(d.z);
-        w *= exp_neg(m.tau_t * inv_mu);
+        double transmittance[3];
+        beer_lambert_transmittance<double>(m.tau_t, 1 / std::abs(d.z), transmittance);
+        w *= Rgbd(transmittance[0], transmittance[1], transmittance[2]);
         return d.z > 0;
     }
     double s = d.z < 0 ? 0 : 1;
+    auto uniform = [&] { return rng.uniform_double(); };
     while (true) {
-        const double mu = std::abs(d.z);
-        const double to_boundary = (d.z < 0 ? 1 - s : s) / mu;
-        const double total = w[0] + w[1] + w[2];
-        if (total <= 0) return d.z > 0;
-        const double p[3] = {w[0] / total, w[1] / total, w[2] / total};
-        const double uc = rng.uniform_double();
-        const int c = uc < p[0] ? 0 : (uc < p[0] + p[1] ? 1 : 2);
-        const double sigma_c = m.tau_t[c];
-        const double u = rng.uniform_double();
-        const double flight = sigma_c > 0 ? -std::log1p(-u) / sigma_c : INFINITY;
-        if (m.uniform_tau_t) {
-            if (flight >= to_boundary) return d.z > 0;
-            w *= m.single_scattering_albedo;
-        } else if (flight >= to_boundary) {
-            double mix = 0;
-            Rgbd tr;
-            for (int k = 0; k < 3; ++k) {
-                // τ = 0 along a horizontal path (to_boundary = ∞): 0 · ∞ would be NaN.
-                tr[k] = m.tau_t[k] > 0 ? std::exp(-m.tau_t[k] * to_boundary) : 1.0;
-                mix += p[k] * tr[k];
-            }
-            for (int k = 0; k < 3; ++k)
-                w[k] *= tr[k] / mix;
-            return d.z > 0;
-        } else {
-            double mix = 0;
-            Rgbd num;
-            for (int k = 0; k < 3; ++k) {
-                const double e = std::exp(-m.tau_t[k] * flight);
-                num[k] = m.tau_s[k] * e;
-                mix += p[k] * m.tau_t[k] * e;
-            }
-            for (int k = 0; k < 3; ++k)
-                w[k] *= num[k] / mix;
-        }
-        s = clamp(s - d.z * flight, 0.0, 1.0);
+        // The free flight (physics/medium.h, as the goniophotometer's kernels).
+        const LaneVec3<double> dl = {d.x, d.y, d.z};
+        const double wl[3] = {w[0], w[1], w[2]};
+        const MediumFlightLanes<double, bool> flight =
+            medium_free_flight<double>(m, dl, wl, s, uniform);
+        const double* p = flight.p;
+        w *= Rgbd(flight.factor[0], flight.factor[1], flight.factor[2]);
+        if (flight.leaves) return d.z > 0;
+        s = flight.depth;
         ws.delta_only = false;
         // The phase-sampling density: the mixture Σ p_k HG_k when g differs per channel.
         auto phase_pdf = [&](double cos_theta) {
@@ -583,24 +521,13 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
                     proxy, f);
             }
         }
-        int c_phase = c;
-        if (!m.uniform_g) {
-            const double up = rng.uniform_double();
-            c_phase = up < p[0] ? 0 : (up < p[0] + p[1] ? 1 : 2);
-        }
-        const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
-        const Vec3d d_new = sample_hg(d, m.g[c_phase], u1, u2);
+        // The scattering event (physics/medium.h).
+        LaneVec3<double> d_scattered;
+        double phase[3];
+        medium_scatter<double>(m, dl, p, true, uniform, d_scattered, phase);
+        const Vec3d d_new(d_scattered.x, d_scattered.y, d_scattered.z);
         const double cos_theta = dot(d, d_new);
-        if (!m.uniform_g) {
-            double mix = 0;
-            Rgbd ph;
-            for (int k = 0; k < 3; ++k) {
-                ph[k] = hg_phase(cos_theta, m.g[k]);
-                mix += p[k] * ph[k];
-            }
-            for (int k = 0; k < 3; ++k)
-                w[k] *= ph[k] / mix;
-        }
+        w *= Rgbd(phase[0], phase[1], phase[2]);
         // The walk's own strategy for the same paths (strategy 1, weighted at the exit). Only
         // meaningful while connecting (conn is null for sample()).
         ws.prev_mis =
@@ -814,7 +741,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 return;
             }
             bool up = true;
-            if (!media_[k].empty) up = traverse_medium<kMode>(k, ws, rng, conn, wo, f);
+            if (!media_[k].is_empty()) up = traverse_medium<kMode>(k, ws, rng, conn, wo, f);
             if (is_black(w)) return;
             if (up) --k;
         } else {
@@ -823,7 +750,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 return;
             }
             bool up = false;
-            if (!media_[k + 1].empty) up = traverse_medium<kMode>(k + 1, ws, rng, conn, wo, f);
+            if (!media_[k + 1].is_empty()) up = traverse_medium<kMode>(k + 1, ws, rng, conn, wo, f);
             if (is_black(w)) return;
             if (!up) ++k;
         }

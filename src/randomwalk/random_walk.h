@@ -45,6 +45,7 @@
 #include "core/rgb.h"
 #include "core/rng.h"
 #include "core/vec.h"
+#include "layers/compiled_stack.h"
 #include "layers/stack.h"
 #include "physics/conductor.h"
 #include "physics/dielectric.h"
@@ -156,18 +157,11 @@ class RandomWalkStack {
     struct Connection;
 
   private:
-    struct Interface {
-        InterfaceType type = InterfaceType::Dielectric;
-        DielectricInterface<double> dielectric{1.0, 0.0};
-        ConductorInterface<double> conductor{Rgbd(1.0), Rgbd(0.0), 0.0};
-        LambertianInterface<double> lambertian{Rgbd(0.0)};
-        bool delta = true;      ///< smooth or index-matched: no density, no connection
-        bool multiple = false;  ///< rough, scattering by the microsurface walk
-    };
-    struct Medium {
-        Rgbd tau_s{0.0}, tau_t{0.0}, g{0.0}, single_scattering_albedo{0.0};
-        bool scatters = false, empty = true, uniform_tau_t = true, uniform_g = true;
-    };
+    /// The stack as compile_stack<double> (layers/compiled_stack.h) builds it: `delta` (smooth
+    /// or index-matched: no density, no connection), `multiple` (rough, scattering by the
+    /// microsurface walk).
+    using Interface = CompiledLayer<double>;
+    using Medium = CompiledMedium<double>;
 
     struct WalkState;
     /// What a walk adds up: nothing (sample), f towards wo (eval), the exit density at wo (pdf;
@@ -203,8 +197,8 @@ class RandomWalkStack {
     double interface_pdf_chain(const Interface& it, const Vec3d& wi, const Vec3d& wo, const Rgbd& w,
                                const Rgbd& q, ParticleRng& rng) const;
 
-    std::vector<Interface> interfaces_;  ///< top to bottom
-    std::vector<Medium> media_;          ///< per region 0..L (0 and L empty)
+    std::vector<Interface> interfaces_;  ///< top to bottom (compile_stack's layers)
+    std::vector<Medium> media_;          ///< per region 0..L (0 and L empty): the layers' media
     std::vector<double> eta_;            ///< absolute index per region 0..L
     bool transmits_ = false;
     bool pdf_unbiased_ = true;

@@ -6,11 +6,11 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "layers/compiled_stack.h"
+#include "physics/medium.h"
 #include "physics/microsurface_walk.h"
-#include "physics/phase.h"
 #include "simulator/kernel_simd.h"
 #include "simulator/tally.h"
-#include "simulator/trace_stack.h"
 
 #include <fmt/format.h>
 #include <omp.h>
@@ -50,102 +50,50 @@ bool is_black(const Rgbf& w) {
 }
 
 // ---- Media (docs/physics.md §4) -----------------------------------------------------------------
-// Depth s ∈ [0, 1] across the layer (0 at its top); a direction d with |d.z| = μ crosses the whole
-// layer along a path of optical depth τ/μ. Returns true if the particle leaves through the top.
+// physics/medium.h at one lane. Depth s ∈ [0, 1] across the layer (0 at its top). Returns true if
+// the particle leaves through the top.
 struct MediumWalk {
-    const TraceMedium& m;
+    const CompiledMedium<float>& m;
     ParticleRng& rng;
     PathLosses& losses;
 
     bool traverse(Vec3f& d, Rgbf& w, int& events, int max_events) {
         if (!m.scatters) {
             // Pure absorption: Beer–Lambert along the straight path, no sampling.
-            const float inv_mu = 1.f / std::abs(d.z);
+            float transmittance[3];
+            beer_lambert_transmittance<float>(m.tau_a, 1.f / std::abs(d.z), transmittance);
             const Rgbf before = w;
             for (int c = 0; c < 3; ++c)
-                if (m.tau_a[c] > 0) w[c] *= std::exp(-m.tau_a[c] * inv_mu);
+                w[c] *= transmittance[c];
             losses.add(BudgetTerm::AbsorbedMedium, before - w);
             return d.z > 0;
         }
         return walk(d, w, events, max_events);
     }
 
-    // Scattering: free flights sampled from a mixture of the per-channel exponentials with channel
-    // probabilities ∝ current flux, per-channel weights = channel density / mixture density
-    // (one-sample spectral MIS, balance heuristic: Veach 1997, §9.2.4; Miller, Georgiev & Jarosz
-    // 2019, "A null-scattering path integral formulation of light transport", §6). Unbiased for
-    // every channel whatever the sampling channel.
+    // Scattering: free flights and HG events by one-sample spectral MIS (physics/medium.h).
     bool walk(Vec3f& d, Rgbf& w, int& events, int max_events) {
         float s = d.z < 0 ? 0.f : 1.f;
+        auto uniform = [&] { return rng.uniform_float(); };
         while (true) {
-            const float mu = std::abs(d.z);
-            const float to_boundary = mu > 0 ? (d.z < 0 ? 1.f - s : s) / mu : INFINITY;
-            // Channel probabilities ∝ flux.
-            const float total = w[0] + w[1] + w[2];
-            if (total <= 0) return d.z > 0;
-            const float p[3] = {w[0] / total, w[1] / total, w[2] / total};
-            const float uc = rng.uniform_float();
-            const int c = uc < p[0] ? 0 : (uc < p[0] + p[1] ? 1 : 2);
-            const float sigma_c = m.tau_t[c];
-            const float u = rng.uniform_float();
-            const float flight = sigma_c > 0 ? -std::log1p(-u) / sigma_c : INFINITY;
+            const LaneVec3<float> dl = {d.x, d.y, d.z};
+            const float wl[3] = {w[0], w[1], w[2]};
+            const MediumFlightLanes<float, bool> flight =
+                medium_free_flight<float>(m, dl, wl, s, uniform);
             const Rgbf before = w;
-            if (m.uniform_tau_t) {
-                // One extinction for all channels: the flight pdf is the channels' own, and only
-                // the single-scattering albedo weights a scattering event.
-                if (flight >= to_boundary) return d.z > 0;
-                w *= m.single_scattering_albedo;
-            } else if (flight >= to_boundary) {
-                // Leaves the layer: weight_c = T_c / Σ_k p_k T_k.
-                float mix = 0;
-                Rgbf transmittance;
-                for (int k = 0; k < 3; ++k) {
-                    // A clear channel along a horizontal path (to_boundary = ∞): 0 · ∞ would be
-                    // NaN (found by the fuzz test); its transmittance is 1.
-                    transmittance[k] = m.tau_t[k] > 0 ? std::exp(-m.tau_t[k] * to_boundary) : 1.f;
-                    mix += p[k] * transmittance[k];
-                }
-                for (int k = 0; k < 3; ++k)
-                    w[k] *= transmittance[k] / mix;
+            if (flight.leaves) {
+                for (int c = 0; c < 3; ++c)
+                    w[c] *= flight.factor[c];
                 losses.add(BudgetTerm::AbsorbedMedium, before - w);
                 return d.z > 0;
-            } else {
-                // Scatters at distance `flight`:
-                // weight_c = σs_c e^{−σt_c t} / Σ_k p_k σt_k e^{−σt_k t}.
-                float mix = 0;
-                Rgbf numerator;
-                for (int k = 0; k < 3; ++k) {
-                    const float e = std::exp(-m.tau_t[k] * flight);
-                    numerator[k] = m.tau_s[k] * e;
-                    mix += p[k] * m.tau_t[k] * e;
-                }
-                for (int k = 0; k < 3; ++k)
-                    w[k] *= numerator[k] / mix;
             }
-            s -= d.z * flight;
-            s = clamp(s, 0.f, 1.f);
-            // New direction from HG; per-channel g needs MIS over the channels' phase functions.
-            // The phase channel is drawn afresh (∝ the same p), so the joint density of
-            // (distance, direction) factorizes into the two mixtures used for the weights.
-            int c_phase = c;
-            if (!m.uniform_g) {
-                const float up = rng.uniform_float();
-                c_phase = up < p[0] ? 0 : (up < p[0] + p[1] ? 1 : 2);
-            }
-            const Vec3f d_new =
-                sample_hg(d, m.g[c_phase], rng.uniform_float(), rng.uniform_float());
-            if (!m.uniform_g) {
-                const float cos_theta = dot(d, d_new);
-                float mix_phase = 0;
-                Rgbf phase;
-                for (int k = 0; k < 3; ++k) {
-                    phase[k] = hg_phase(cos_theta, m.g[k]);
-                    mix_phase += p[k] * phase[k];
-                }
-                for (int k = 0; k < 3; ++k)
-                    w[k] *= phase[k] / mix_phase;
-            }
-            d = d_new;
+            s = flight.depth;
+            LaneVec3<float> d_new;
+            float phase[3];
+            medium_scatter<float>(m, dl, flight.p, true, uniform, d_new, phase);
+            for (int c = 0; c < 3; ++c)
+                w[c] *= flight.factor[c] * phase[c];
+            d = {d_new.x, d_new.y, d_new.z};
             losses.add(BudgetTerm::AbsorbedMedium, before - w);
             if (is_black(w)) return d.z > 0;
             if (++events >= max_events) return d.z > 0;  // the caller books the cut-off
@@ -157,7 +105,7 @@ struct MediumWalk {
 // docs/physics.md §3: at an interface the particle (arriving along −wi) draws an outgoing direction
 // from the interface's BSDF sampler; its flux is multiplied by the sample weight and the parts
 // that do not continue are booked (absorbed by the base, lost to the microsurface).
-void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const Vec3f& wi,
+void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& grid, const Vec3f& wi,
                     ParticleRng& rng, int max_events, Tally& tally, BlockBudget& block) {
     const int n_layers = int(stack.layers.size());
     Vec3f d = -wi;  // propagation direction
@@ -171,7 +119,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
             break;
         }
         ++events;
-        const TraceLayer& layer = stack.layers[k];
+        const CompiledLayer<float>& layer = stack.layers[k];
         const Vec3f wi_local = -d;
         // Applies a sample (taken by reference: no copy of the optional in the hot loop).
         // weight = fresnel_weight (absorbed by an opaque base) · shadowing (lost on the
@@ -216,7 +164,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
         auto uniform = [&] { return rng.uniform_float(); };
         switch (layer.type) {
             case InterfaceType::Dielectric: {
-                if (stack.multiple_scattering && !layer.dielectric.is_smooth()) {
+                if (layer.multiple) {
                     apply_walk(
                         walk_rough_dielectric(layer.dielectric.distribution(), layer.dielectric.eta,
                                               wi_local, uniform, stack.max_microsurface_order),
@@ -229,7 +177,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
                 break;
             }
             case InterfaceType::Conductor: {
-                if (stack.multiple_scattering && !layer.conductor.is_smooth()) {
+                if (layer.multiple) {
                     const ConductorInterface<float>& cond = layer.conductor;
                     apply_walk(walk_rough_conductor(
                                    cond.distribution(), [&](float c) { return cond.fresnel(c); },
@@ -265,7 +213,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
                 break;
             }
             // Up through the medium below interface k − 1.
-            const TraceMedium& m = stack.layers[k - 1].medium;
+            const CompiledMedium<float>& m = stack.layers[k - 1].medium;
             bool up = true;
             if (!m.is_empty()) {
                 MediumWalk walk{m, rng, losses};
@@ -279,7 +227,7 @@ void trace_particle(const TraceStack& stack, const HemisphereGrid& grid, const V
                 block.escape_transmitted(w);
                 break;
             }
-            const TraceMedium& m = layer.medium;
+            const CompiledMedium<float>& m = layer.medium;
             bool up = false;
             if (!m.is_empty()) {
                 MediumWalk walk{m, rng, losses};
@@ -353,9 +301,9 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
                              const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);
     const auto start = std::chrono::steady_clock::now();
-    TraceStack trace(stack, settings.transmission_masking);
-    trace.multiple_scattering = settings.microsurface == Microsurface::Multiple;
-    trace.max_microsurface_order = settings.max_microsurface_order;
+    const CompiledStack<float> trace = compile_stack<float>(
+        stack, {settings.transmission_masking, settings.microsurface == Microsurface::Multiple,
+                settings.max_microsurface_order});
     const HemisphereGrid& grid = settings.grid;
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
     if (settings.kernel == Kernel::Simd) select_simd_target();

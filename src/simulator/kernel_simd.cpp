@@ -1,5 +1,13 @@
-// The batched SIMD particle kernel (kernel_simd.h): the physics of trace_particle
-// (goniophotometer.cpp) written once more on SIMD vectors, particles as lanes.
+// The batched SIMD particle kernel (kernel_simd.h): trace_particle (goniophotometer.cpp) on SIMD
+// vectors, particles as lanes. The physics is not here: every event is a lane template of
+// src/physics (core/lane.h) that the scalar kernel instantiates at one lane and this kernel on its
+// vectors — the interface events (dielectric.h dielectric_event, conductor.h conductor_event,
+// lambertian.h lambertian_event, with the Fresnel factors, the Smith masking and the visible
+// normals they use), the microsurface walk (microsurface_walk.h) and the medium step (medium.h:
+// Beer–Lambert, free flights and Henyey–Greenstein scattering by spectral MIS). This file holds
+// the lane management: the lane operations of core/lane.h on Highway vectors (VecLane), the
+// vector random number generator, the queue and refills of lanes, the grouping of lanes by layer,
+// the tallies and the budget sums.
 //
 // Layout. A block's particles run through a fixed set of lanes; a lane whose particle ends (exit,
 // absorption, cut-off) takes the block's next particle, so all lanes stay busy until the block's
@@ -8,11 +16,10 @@
 // lane inside a scattering medium — one free flight with its scattering event. Interfaces are
 // evaluated layer by layer under the mask of the lanes that sit at that layer, with the layer's
 // parameters broadcast; no lane-dependent branches. What a lane does per step is exactly what
-// trace_particle does per loop (same samplers, same weights, same budget bookkeeping, same event
+// trace_particle does per loop (the same templates, the same budget bookkeeping, the same event
 // count), so the two kernels estimate the same tables (tests/simulator: every exact-solution test
-// runs on both, and a two-sample chi-square test compares them). Where the physics is written as
-// lane templates (core/lane.h: Fresnel factors, Smith masking, visible normals, Henyey–Greenstein,
-// the microsurface walk) both kernels instantiate the same lines.
+// runs on both, and a two-sample chi-square test compares them; tests/physics/lanes_test.cpp and
+// tests/simulator/kernel_simd_test.cpp compare each template's instantiations).
 //
 // Multiple scattering on the microsurfaces (physics/microsurface_walk.h). At a rough interface
 // the lanes of the event walk from facet to facet together: while any of them walks, every lane of
@@ -23,8 +30,9 @@
 // as in core/rng.h from one Philox4x32-10 evaluation (Salmon et al. 2011) keyed by (seed, stream,
 // particle index): the very streams of the scalar kernel. Both generators are evaluated here on
 // vectors (Highway has no RNG); tests check them bit for bit against Random123 and pcg-cpp. Every
-// lane draws at every step, used or not: a particle's draws are then not those of the scalar
-// kernel, but each is still a fresh uniform number independent of the particle's past.
+// lane draws whenever some lane of its step needs a number, used or not: a particle's draws are
+// then not those of the scalar kernel, but each is still a fresh uniform number independent of
+// the particle's past.
 //
 // Reproducibility. A block is traced in a fixed order by one thread; exits go to the integer
 // tallies and the budget to the block's double sums in a fixed lane order: the output depends on
@@ -71,7 +79,11 @@
     HWY_AFTER_NAMESPACE();
 #define LAMINA_LANE_TARGET
 #include "core/lane_vec.h"
+#include "physics/conductor.h"
+#include "physics/dielectric.h"
 #include "physics/fresnel.h"
+#include "physics/lambertian.h"
+#include "physics/medium.h"
 #include "physics/microfacet.h"
 #include "physics/microsurface_walk.h"
 #include "physics/phase.h"
@@ -226,9 +238,6 @@ struct LaneRng {
 
 using V3 = LaneVec3<VF>;  // core/lane.h
 
-HWY_INLINE VF Dot(const V3& a, const V3& b) {
-    return hn::MulAdd(a.x, b.x, hn::MulAdd(a.y, b.y, hn::Mul(a.z, b.z)));
-}
 // 1/√x from the hardware estimate refined by one Newton step (y ← y (3 − x y²)/2): ≤ 2^-22
 // relative error whatever the estimate's precision (≥ 12 bits on every target), a fraction of the
 // cost of a square root and a division.
@@ -240,9 +249,6 @@ HWY_INLINE VF InvSqrt(VF x) {
 }
 HWY_INLINE V3 Select(MF m, const V3& a, const V3& b) {
     return {hn::IfThenElse(m, a.x, b.x), hn::IfThenElse(m, a.y, b.y), hn::IfThenElse(m, a.z, b.z)};
-}
-HWY_INLINE VF SafeSqrt(VF x) {
-    return hn::Sqrt(hn::ZeroIfNegative(x));
 }
 
 // cos and sin of 2π u for u ∈ [0, 1) (a uniform azimuth), both at once. 2πu = (π/4)(j + f) with
@@ -280,32 +286,6 @@ HWY_INLINE void CosSin2Pi(VF u, VF& c, VF& s) {
     s = hn::IfThenElse(sin_negative, hn::Neg(s_abs), s_abs);
 }
 
-// |cos θ| · √(1 + α² tan²θ) = √(cos²θ + α² sin²θ) = |cos θ| (1 + 2Λ) (microfacet.h smith_root;
-// Heitz 2014, Eq. 72), without a division; zero at grazing, where 1 + 2Λ is infinite.
-HWY_INLINE VF SmithRootTimesCos(const V3& w, float alpha) {
-    const DF df;
-    const VF xy2 = hn::MulAdd(w.x, w.x, hn::Mul(w.y, w.y));
-    return hn::Sqrt(hn::MulAdd(hn::Set(df, alpha * alpha), xy2, hn::Mul(w.z, w.z)));
-}
-
-// G2/G1 = (1 + r_i)/(r_i + r_o) with r = 1 + 2Λ (dielectric.h, height-correlated), multiplied
-// through by |cos θi| |cos θo| to need one division: (|z_i| + s_i)|z_o| / (s_i|z_o| + s_o|z_i|),
-// s = |z| r. Or G1(wo) = 2/(1 + r_o) = 2|z_o|/(|z_o| + s_o) (uncorrelated option). Zero for a
-// grazing wo, as the scalar form.
-HWY_INLINE VF Shadowing(const V3& wi, const V3& wo, float alpha, bool uncorrelated) {
-    // The ratio is ≤ 1 (Λ ≥ 0); float rounding can give 1 + 1 ulp, which booked a flux of −1e-8 as
-    // lost to the microsurface (found by the fuzz test): clamped at 1.
-    const DF df;
-    const VF one = hn::Set(df, 1.f);
-    const VF z_o = hn::Abs(wo.z);
-    const VF s_o = SmithRootTimesCos(wo, alpha);
-    if (uncorrelated) return hn::Min(hn::Div(hn::Add(z_o, z_o), hn::Add(z_o, s_o)), one);
-    const VF z_i = hn::Abs(wi.z);
-    const VF s_i = SmithRootTimesCos(wi, alpha);
-    return hn::Min(
-        hn::Div(hn::Mul(hn::Add(z_i, s_i), z_o), hn::MulAdd(s_i, z_o, hn::Mul(s_o, z_i))), one);
-}
-
 // The operations of core/lane.h on vectors: the physics templates written over a lane type
 // (core/beta_function.h, physics/microfacet.h smith_refraction_escape) instantiated on lanes.
 // Highway's contrib math functions: Log ≤ 4 ulp, Log1p ≤ 2 ulp, Exp ≤ 1 ulp (hwy/contrib/math).
@@ -322,6 +302,7 @@ struct VecLane {
     static HWY_INLINE VF select(MF m, VF a, VF b) { return hn::IfThenElse(m, a, b); }
     static HWY_INLINE MF less(VF a, VF b) { return hn::Lt(a, b); }
     static HWY_INLINE VF abs(VF x) { return hn::Abs(x); }
+    static HWY_INLINE VF copysign(VF a, VF b) { return hn::CopySign(a, b); }
     static HWY_INLINE VF mul_add(VF a, VF b, VF c) { return hn::MulAdd(a, b, c); }
     static HWY_INLINE VF neg_mul_add(VF a, VF b, VF c) { return hn::NegMulAdd(a, b, c); }
     static HWY_INLINE VF inv_sqrt(VF x) { return InvSqrt(x); }
@@ -332,25 +313,6 @@ struct VecLane {
     static HWY_INLINE bool none(MF m) { return hn::AllFalse(DF(), m); }
     static constexpr double kBetaArgumentMax = Lane<float>::kBetaArgumentMax;
 };
-
-// GGX visible normals by spherical caps: microfacet.h sample_visible_normal_caps (Dupuy & Benyoub
-// 2023, Listing 3; ggx_sample_visible_normal_complete, the same template), w below the surface
-// through −w.
-HWY_INLINE V3 SampleVisibleNormalCaps(const V3& wi, float alpha, VF u1, VF u2) {
-    const DF df;
-    const VF sign = hn::IfThenElse(hn::Lt(wi.z, hn::Zero(df)), hn::Set(df, -1.f), hn::Set(df, 1.f));
-    return ggx_sample_visible_normal_complete<VF, VecLane>(
-        hn::Set(df, alpha), {hn::Mul(sign, wi.x), hn::Mul(sign, wi.y), hn::Mul(sign, wi.z)}, u1,
-        u2);
-}
-
-// The refraction escape G2/G1 = (1 + Λi) B(1 + Λi, 1 + Λo) of the Smith masking
-// (microfacet.h smith_refraction_escape, the same template), from s = |z| r (SmithRootTimesCos).
-HWY_INLINE VF SmithRefractionEscape(const V3& wi, const V3& wo, float alpha) {
-    const VF r_i = hn::Div(SmithRootTimesCos(wi, alpha), hn::Abs(wi.z));
-    const VF r_o = hn::Div(SmithRootTimesCos(wo, alpha), hn::Abs(wo.z));
-    return smith_refraction_escape<VF, VecLane>(r_i, r_o);
-}
 
 // fresnel.h fresnel_conductor (real-arithmetic complex Fresnel, the same template), cos θ in
 // [0, 1].
@@ -415,105 +377,50 @@ HWY_INLINE MF LaneIs(VI v, std::int32_t value) {
 
 // ---- Interface events (goniophotometer.cpp trace_particle, `apply`) ----------------------------
 
-// A rough or smooth dielectric (dielectric.h sample): the particle arrives along d (wi = −d).
+// A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
+// instantiates at one lane): the particle arrives along d (wi = −d).
 HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
                                 VF uc, VF u1, VF u2, MF& degenerate) {
     const DF df;
-    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
-    const MF grazing = hn::And(m, hn::Eq(wi.z, zero));  // sample() returns nothing
-    degenerate = hn::Or(degenerate, grazing);
-    const MF ok = hn::AndNot(grazing, m);
-    V3 wo;
-    VF shadowing = one;
-    if (iface.is_index_matched()) {
-        // Straight through; rough: weight G2(wi, −wi)/G1(wi) = (1 + r)/(2r) (dielectric.h
-        // sample_index_matched, with r = 1 + 2Λ).
-        wo = v.d;
-        if (!iface.is_smooth()) {
-            // G2(wi, −wi)/G1(wi) = Shadowing(wi, −wi): (1 + r)/(2r), or G1 = 2/(1 + r); with the
-            // Smith refraction masking (1 + Λ) B(1 + Λ, 1 + Λ).
-            if (!iface.uncorrelated_shadowing &&
-                iface.transmission_masking == TransmissionMasking::Smith)
-                shadowing = SmithRefractionEscape(wi, v.d, iface.alpha);
-            else
-                shadowing = Shadowing(wi, v.d, iface.alpha, iface.uncorrelated_shadowing);
-        }
-    } else {
-        // The microfacet normal: drawn for a rough interface, the macro normal for a smooth one
-        // (then both branches below reduce to the mirror and Snell's law, shadowing 1).
-        const V3 wm = iface.is_smooth() ? V3{zero, zero, one}
-                                        : SampleVisibleNormalCaps(wi, iface.alpha, u1, u2);
-        const VF cos_i_m = Dot(wi, wm);
-        // fresnel.h fresnel_dielectric_full (the same template): from below, the crossed index
-        // is 1/η.
-        const MF below = hn::Lt(cos_i_m, zero);
-        const FresnelDielectric<VF> fr = fresnel_dielectric_full<VF, VecLane>(
-            cos_i_m, hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()));
-        const VF inv_eta = fr.inv_eta, cos_t = fr.cos_theta_t, reflectance = fr.reflectance;
-        const VF cos_i = hn::Min(hn::Abs(cos_i_m), one);
-        // Both candidates, one selected (dielectric.h): mirror about wm, or Snell about wm.
-        const VF two_cos = hn::Add(cos_i_m, cos_i_m);
-        const V3 reflected = {hn::MulSub(two_cos, wm.x, wi.x), hn::MulSub(two_cos, wm.y, wi.y),
-                              hn::MulSub(two_cos, wm.z, wi.z)};
-        const VF sign = hn::IfThenElse(below, hn::Set(df, -1.f), one);
-        const VF along = hn::Mul(sign, hn::MulSub(cos_i, inv_eta, cos_t));
-        const VF neg_inv_eta = hn::Neg(inv_eta);
-        const V3 refracted = {hn::MulAdd(wi.x, neg_inv_eta, hn::Mul(wm.x, along)),
-                              hn::MulAdd(wi.y, neg_inv_eta, hn::Mul(wm.y, along)),
-                              hn::MulAdd(wi.z, neg_inv_eta, hn::Mul(wm.z, along))};
-        const MF is_reflection = hn::Lt(uc, reflectance);
-        wo = Select(is_reflection, reflected, refracted);
-        if (!iface.is_smooth()) {
-            // A reflection must stay on wi's side and a refraction cross, else G2 = 0.
-            const MF same_side = hn::Gt(hn::Mul(wi.z, wo.z), zero);
-            const MF escapes =
-                hn::AndNot(hn::Eq(wo.z, zero), hn::Not(hn::Xor(same_side, is_reflection)));
-            shadowing = hn::IfThenElseZero(
-                escapes, Shadowing(wi, wo, iface.alpha, iface.uncorrelated_shadowing));
-            // Refracted lanes under the Smith masking: (1 + Λi) B(1 + Λi, 1 + Λo) instead, computed
-            // only when some lane refracts.
-            if (!iface.uncorrelated_shadowing &&
-                iface.transmission_masking == TransmissionMasking::Smith) {
-                const MF refracts = hn::And(ok, hn::AndNot(is_reflection, escapes));
-                if (!hn::AllFalse(df, refracts))
-                    shadowing = hn::IfThenElse(refracts, SmithRefractionEscape(wi, wo, iface.alpha),
-                                               shadowing);
-            }
-        }
-    }
-    v.Keep(ok, kLossMicro, shadowing);
-    v.d = Select(ok, wo, v.d);
+    const InterfaceEventLanes<VF, MF> e = dielectric_event<VF, VecLane>(
+        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), hn::Set(df, iface.alpha),
+        iface.event_shape(), wi, uc, u1, u2, m);
+    degenerate = hn::Or(degenerate, e.degenerate);
+    const MF ok = hn::AndNot(e.degenerate, m);
+    if (!iface.is_smooth()) v.Keep(ok, kLossMicro, e.shadowing);
+    v.d = Select(ok, e.wo, v.d);
 }
 
-// A rough or smooth conductor (conductor.h sample): light from above only.
+// The conductor's Fresnel factors per channel at the facet cosine (fresnel.h fresnel_conductor,
+// the same template); channels with the same index share the computation.
+struct ConductorFresnel {
+    const ConductorInterface<float>& iface;
+    HWY_INLINE void operator()(VF cos_theta, VF* factors) const {
+        for (int c = 0; c < 3; ++c) {
+            const bool same =
+                c > 0 && iface.eta[c] == iface.eta[c - 1] && iface.k[c] == iface.k[c - 1];
+            factors[c] =
+                same ? factors[c - 1] : FresnelConductor(cos_theta, iface.eta[c], iface.k[c]);
+        }
+    }
+};
+
+// A rough or smooth conductor (conductor.h conductor_event, the same template): light from above
+// only.
 HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v, VF u1,
                                VF u2, MF& degenerate) {
     const DF df;
-    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
-    const MF bad = hn::And(m, hn::Le(wi.z, zero));
-    degenerate = hn::Or(degenerate, bad);
-    const MF ok = hn::AndNot(bad, m);
-    const V3 wm =
-        iface.is_smooth() ? V3{zero, zero, one} : SampleVisibleNormalCaps(wi, iface.alpha, u1, u2);
-    const VF cos_i_m = Dot(wi, wm);
-    const VF two_cos = hn::Add(cos_i_m, cos_i_m);
-    const V3 wo = {hn::MulSub(two_cos, wm.x, wi.x), hn::MulSub(two_cos, wm.y, wi.y),
-                   hn::MulSub(two_cos, wm.z, wi.z)};
     VF fresnel[3];
-    for (int c = 0; c < 3; ++c) {
-        // Channels with the same index share the computation.
-        const bool same = c > 0 && iface.eta[c] == iface.eta[c - 1] && iface.k[c] == iface.k[c - 1];
-        fresnel[c] = same ? fresnel[c - 1] : FresnelConductor(cos_i_m, iface.eta[c], iface.k[c]);
-    }
+    const InterfaceEventLanes<VF, MF> e = conductor_event<VF, VecLane>(
+        hn::Set(df, iface.alpha), iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1, u2, m,
+        ConductorFresnel{iface}, fresnel);
+    degenerate = hn::Or(degenerate, e.degenerate);
+    const MF ok = hn::AndNot(e.degenerate, m);
     v.Keep(ok, kLossBase, fresnel);
-    if (!iface.is_smooth()) {
-        const VF shadowing = hn::IfThenElseZero(
-            hn::Gt(wo.z, zero), Shadowing(wi, wo, iface.alpha, iface.uncorrelated_shadowing));
-        v.Keep(ok, kLossMicro, shadowing);
-    }
-    v.d = Select(ok, wo, v.d);
+    if (!iface.is_smooth()) v.Keep(ok, kLossMicro, e.shadowing);
+    v.d = Select(ok, e.wo, v.d);
 }
 
 // A rough interface with multiple scattering on its microsurface (physics/microsurface_walk.h
@@ -548,171 +455,75 @@ HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, MF 
 
 HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v,
                                    LaneRng& rng, int max_order, MF& degenerate) {
-    auto fresnel = [&](VF cos_w_m, VF* factors) {
-        for (int c = 0; c < 3; ++c) {
-            // Channels with the same index share the computation.
-            const bool same =
-                c > 0 && iface.eta[c] == iface.eta[c - 1] && iface.k[c] == iface.k[c - 1];
-            factors[c] =
-                same ? factors[c - 1] : FresnelConductor(cos_w_m, iface.eta[c], iface.k[c]);
-        }
-    };
-    const MicrosurfaceConductorFacet<VF, VecLane, decltype(fresnel)> facet{fresnel};
+    const ConductorFresnel fresnel{iface};
+    const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel> facet{fresnel};
     MicrosurfaceWalkEvent(iface.alpha, false, facet, m, v, rng, max_order, degenerate);
 }
 
-// Lambertian (lambertian.h sample): cosine-distributed on wi's side, weight = albedo. The disk
-// point is drawn by the polar map (r = √u1, φ = 2πu2): the same cosine density as the scalar
-// kernel's concentric map, fewer operations on vectors.
+// Lambertian (lambertian.h lambertian_event, the same template): cosine-distributed on wi's side,
+// weight = albedo.
 HWY_INLINE void LambertianEvent(const LambertianInterface<float>& iface, MF m, LaneVectors& v,
                                 VF u1, VF u2, MF& degenerate) {
     const DF df;
-    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
-    const MF bad = hn::And(m, hn::Eq(v.d.z, zero));
+    const MF bad = hn::And(m, hn::Eq(v.d.z, hn::Zero(df)));
     degenerate = hn::Or(degenerate, bad);
     const MF ok = hn::AndNot(bad, m);
-    VF cos_phi, sin_phi;
-    CosSin2Pi(u2, cos_phi, sin_phi);
-    const VF r = hn::Sqrt(u1);
-    const VF z = SafeSqrt(hn::Sub(one, u1));
-    // wi = −d: the new direction is on wi's side, i.e. against the arriving d.
-    const V3 wo = {hn::Mul(r, cos_phi), hn::Mul(r, sin_phi),
-                   hn::IfThenElse(hn::Gt(v.d.z, zero), hn::Neg(z), z)};
+    const V3 wo = lambertian_event<VF, VecLane>(hn::Neg(v.d.z), u1, u2);
     const VF albedo[3] = {hn::Set(df, iface.albedo[0]), hn::Set(df, iface.albedo[1]),
                           hn::Set(df, iface.albedo[2])};
     v.Keep(ok, kLossBase, albedo);
     v.d = Select(ok, wo, v.d);
 }
 
-// ---- Media (goniophotometer.cpp MediumWalk) -----------------------------------------------------
+// ---- Media (physics/medium.h, the templates the scalar kernel instantiates at one lane) -------
 
-// Henyey–Greenstein direction (phase.h sample_hg), Duff et al. 2017 frame about d.
-HWY_INLINE V3 SampleHg(const V3& d, VF g, VF u1, VF u2) {
-    const DF df;
-    const VF one = hn::Set(df, 1.f);
-    const VF cos_theta = sample_hg_cos_theta<VF, VecLane>(g, u1);  // phase.h, the same template
-    const VF sin_theta = SafeSqrt(hn::NegMulAdd(cos_theta, cos_theta, one));
-    VF cos_phi, sin_phi;
-    CosSin2Pi(u2, cos_phi, sin_phi);
-    const VF lx = hn::Mul(sin_theta, cos_phi), ly = hn::Mul(sin_theta, sin_phi);
-    const VF sign = hn::CopySign(one, d.z);
-    const VF a = hn::Div(hn::Set(df, -1.f), hn::Add(sign, d.z));
-    const VF b = hn::Mul(hn::Mul(d.x, d.y), a);
-    const V3 s_axis = {hn::Add(one, hn::Mul(hn::Mul(sign, hn::Mul(d.x, d.x)), a)), hn::Mul(sign, b),
-                       hn::Neg(hn::Mul(sign, d.x))};
-    const V3 t_axis = {b, hn::MulAdd(hn::Mul(d.y, d.y), a, sign), hn::Neg(d.y)};
-    return {hn::MulAdd(s_axis.x, lx, hn::MulAdd(t_axis.x, ly, hn::Mul(d.x, cos_theta))),
-            hn::MulAdd(s_axis.y, lx, hn::MulAdd(t_axis.y, ly, hn::Mul(d.y, cos_theta))),
-            hn::MulAdd(s_axis.z, lx, hn::MulAdd(t_axis.z, ly, hn::Mul(d.z, cos_theta)))};
-}
-
-// phase.h hg_phase (the same template).
-HWY_INLINE VF HgPhase(VF cos_theta, VF g) {
-    return hg_phase<VF, VecLane>(cos_theta, g);
-}
-
-// One scattering-medium step for the lanes in m (inside layer `layer`'s medium): a free flight by
-// one-sample spectral MIS (balance heuristic over channels ∝ flux; Veach 1997 §9.2.4), then either
-// the crossing to the next interface or a scattering event with HG (per-channel g by the same MIS).
-HWY_INLINE void ScatteringStep(const TraceMedium& med, MF m, LaneVectors& v, VF u_channel,
-                               VF u_flight, VF u_phase, VF u_hg1, VF u_hg2) {
+// One scattering-medium step for the lanes in m (inside layer `layer`'s medium): a free flight,
+// then either the crossing to the next interface or a scattering event. The lanes draw their
+// numbers as the template asks for them (every lane draws while any needs them).
+HWY_INLINE void ScatteringStep(const CompiledMedium<float>& med, MF m, LaneVectors& v,
+                               LaneRng& rng) {
     const DF df;
     const DI di;
-    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
-    const VF mu = hn::Abs(v.d.z);
-    const MF down = hn::Lt(v.d.z, zero);
-    const VF to_boundary = hn::IfThenElse(
-        hn::Gt(mu, zero), hn::Div(hn::IfThenElse(down, hn::Sub(one, v.depth), v.depth), mu),
-        hn::Set(df, HUGE_VALF));
-    const VF total = hn::Add(hn::Add(v.w[0], v.w[1]), v.w[2]);
-    const MF has_flux = hn::Gt(total, zero);
-    const VF inv_total = hn::Div(one, hn::IfThenElse(has_flux, total, one));
-    const VF p[3] = {hn::Mul(v.w[0], inv_total), hn::Mul(v.w[1], inv_total),
-                     hn::Mul(v.w[2], inv_total)};
-    const VF p01 = hn::Add(p[0], p[1]);
-    auto pick = [&](VF u, const float* values) {
-        return hn::IfThenElse(
-            hn::Lt(u, p[0]), hn::Set(df, values[0]),
-            hn::IfThenElse(hn::Lt(u, p01), hn::Set(df, values[1]), hn::Set(df, values[2])));
-    };
-    const float tau_t[3] = {med.tau_t[0], med.tau_t[1], med.tau_t[2]};
-    const VF sigma = pick(u_channel, tau_t);
-    const VF flight = hn::IfThenElse(hn::Gt(sigma, zero),
-                                     hn::Div(hn::Neg(hn::Log1p(df, hn::Neg(u_flight))),
-                                             hn::IfThenElse(hn::Gt(sigma, zero), sigma, one)),
-                                     hn::Set(df, HUGE_VALF));
-    const MF leaves = hn::And(m, hn::Or(hn::Not(has_flux), hn::Ge(flight, to_boundary)));
-    const MF scatters = hn::AndNot(leaves, m);
-
-    // Leaves the layer: weight_c = T_c / Σ_k p_k T_k (arrives at the next interface).
-    // Scatters at `flight`: weight_c = σs_c e^{−σt_c t} / Σ_k p_k σt_k e^{−σt_k t}.
-    const VF t = hn::IfThenElse(leaves, to_boundary, hn::IfThenElseZero(scatters, flight));
-    VF e[3], mix = zero, mix_scatter = zero;
-    for (int c = 0; c < 3; ++c) {
-        // A clear channel along a horizontal path (t = ∞): 0 · ∞ would be NaN; transmittance 1.
-        e[c] = med.tau_t[c] > 0 ? hn::Exp(df, hn::Mul(hn::Set(df, -med.tau_t[c]), t)) : one;
-        mix = hn::MulAdd(p[c], e[c], mix);
-        mix_scatter = hn::MulAdd(hn::Mul(p[c], hn::Set(df, med.tau_t[c])), e[c], mix_scatter);
-    }
-    const MF mix_ok = hn::And(hn::Gt(mix, zero), has_flux);
-    const VF inv_mix = hn::Div(one, hn::IfThenElse(mix_ok, mix, one));
-    const VF inv_mix_s = hn::Div(one, hn::IfThenElse(hn::Gt(mix_scatter, zero), mix_scatter, one));
-    VF factor[3];
-    if (med.uniform_tau_t) {
-        // One extinction for all channels: no spectral MIS; leaving keeps the flux, a scattering
-        // event multiplies it by the single-scattering albedo (as the scalar kernel).
-        for (int c = 0; c < 3; ++c)
-            factor[c] = hn::IfThenElse(leaves, one, hn::Set(df, med.single_scattering_albedo[c]));
-    } else {
+    auto uniform = [&] { return rng.Uniform(); };
+    const MediumFlightLanes<VF, MF> flight =
+        medium_free_flight<VF, VecLane>(med, v.d, v.w, v.depth, uniform);
+    const MF leaves = hn::And(m, flight.leaves);
+    const MF scatters = hn::AndNot(flight.leaves, m);
+    V3 d_new = v.d;
+    VF phase[3];
+    if (medium_scatter<VF, VecLane>(med, v.d, flight.p, scatters, uniform, d_new, phase)) {
+        VF factor[3];
         for (int c = 0; c < 3; ++c)
             factor[c] =
-                hn::IfThenElse(leaves, hn::IfThenElse(has_flux, hn::Mul(e[c], inv_mix), one),
-                               hn::Mul(hn::Mul(hn::Set(df, med.tau_s[c]), e[c]), inv_mix_s));
+                hn::IfThenElse(scatters, hn::Mul(flight.factor[c], phase[c]), flight.factor[c]);
+        v.Keep(m, kLossMedium, factor);
+        v.depth = hn::IfThenElse(scatters, flight.depth, v.depth);
+        v.d = Select(scatters, d_new, v.d);
+        v.events = hn::IfThenElse(hn::RebindMask(di, scatters), hn::Add(v.events, hn::Set(di, 1)),
+                                  v.events);
+    } else {
+        v.Keep(m, kLossMedium, flight.factor);
     }
-    v.Keep(m, kLossMedium, factor);
-
     // Leaving lanes arrive at the interface above (k) or below (k + 1).
     const MI leave_i = hn::RebindMask(di, leaves);
-    v.k = hn::IfThenElse(hn::And(leave_i, hn::RebindMask(di, down)), hn::Add(v.k, hn::Set(di, 1)),
-                         v.k);
+    const MI down = hn::RebindMask(di, hn::Lt(v.d.z, hn::Zero(df)));
+    v.k = hn::IfThenElse(hn::And(leave_i, down), hn::Add(v.k, hn::Set(di, 1)), v.k);
     v.in_medium = hn::IfThenElseZero(hn::Not(leave_i), v.in_medium);
-
-    if (hn::AllFalse(df, scatters)) return;
-    v.depth = hn::IfThenElse(
-        scatters, hn::Min(hn::Max(hn::NegMulAdd(v.d.z, flight, v.depth), zero), one), v.depth);
-    const float g[3] = {med.g[0], med.g[1], med.g[2]};
-    const VF g_lane = med.uniform_g ? hn::Set(df, med.g[0]) : pick(u_phase, g);
-    const V3 d_new = SampleHg(v.d, g_lane, u_hg1, u_hg2);
-    if (!med.uniform_g) {
-        const VF cos_theta = Dot(v.d, d_new);
-        VF phase[3], mix_phase = zero;
-        for (int c = 0; c < 3; ++c) {
-            phase[c] = HgPhase(cos_theta, hn::Set(df, med.g[c]));
-            mix_phase = hn::MulAdd(p[c], phase[c], mix_phase);
-        }
-        const VF inv = hn::Div(one, hn::IfThenElse(hn::Gt(mix_phase, zero), mix_phase, one));
-        VF f[3];
-        for (int c = 0; c < 3; ++c)
-            f[c] = hn::Mul(phase[c], inv);
-        v.Keep(scatters, kLossMedium, f);
-    }
-    v.d = Select(scatters, d_new, v.d);
-    v.events =
-        hn::IfThenElse(hn::RebindMask(di, scatters), hn::Add(v.events, hn::Set(di, 1)), v.events);
 }
 
-// ---- Binning ---------------------------------------------------------------------------------
+// ---- Binning: first guesses on vectors, the grid's rule per exit ------------------------------
 
 // A first guess of acos(x), x ∈ [−1, 1], within 10^-4 rad: Abramowitz & Stegun 1964, Eq. 4.4.45
-// (|ε| ≤ 5·10^-5 on [0, 1]) with acos(−x) = π − acos(x). Only a guess: RefineBin corrects it
-// against the exact edges, so its error only costs refinement steps, never a wrong bin.
+// (|ε| ≤ 5·10^-5 on [0, 1]) with acos(−x) = π − acos(x). Only a guess: HemisphereGrid::bin_of
+// corrects it against the exact edges, so its error only costs refinement steps, never a wrong
+// bin.
 HWY_INLINE VF AcosGuess(VF x) {
     const DF df;
     const VF a = hn::Abs(x);
     VF p = hn::MulAdd(hn::Set(df, -0.0187293f), a, hn::Set(df, 0.0742610f));
     p = hn::MulAdd(p, a, hn::Set(df, -0.2121144f));
     p = hn::MulAdd(p, a, hn::Set(df, 1.5707288f));
-    const VF r = hn::Mul(SafeSqrt(hn::Sub(hn::Set(df, 1.f), a)), p);
+    const VF r = hn::Mul(hn::Sqrt(hn::ZeroIfNegative(hn::Sub(hn::Set(df, 1.f), a))), p);
     return hn::IfThenElse(hn::Lt(x, hn::Zero(df)), hn::Sub(hn::Set(df, kPi<float>), r), r);
 }
 
@@ -730,34 +541,6 @@ HWY_INLINE void BinGuesses(const V3& d, int n_theta, int n_phi, std::int32_t* th
     const VF to_phi_bin = hn::Set(df, float(n_phi) / kPi<float>);
     hn::Store(hn::ConvertTo(di, hn::Mul(AcosGuess(cos_theta), to_theta_bin)), di, theta_guess);
     hn::Store(hn::ConvertTo(di, hn::Mul(AcosGuess(cos_phi), to_phi_bin)), di, phi_guess);
-}
-
-// The bin of x among decreasing edges (HemisphereGrid's rule: bin b holds edge[b] ≥ x >
-// edge[b + 1], the last bin also its lower edge), from any first guess.
-inline int RefineBin(double x, int b, const double* edges, int n) {
-    b = std::clamp(b, 0, n - 1);
-    while (b > 0 && x > edges[b])
-        --b;
-    while (b < n - 1 && x <= edges[b + 1])
-        ++b;
-    return b;
-}
-
-// HemisphereGrid::bin_of, bit for bit (the same double arithmetic and edges), from the guesses;
-// only for the lanes that leave the stack.
-inline std::size_t BinOf(float x, float y, float z, std::int32_t theta_guess,
-                         std::int32_t phi_guess, const HemisphereGrid& grid) {
-    const double cos_theta = std::min(double(std::abs(z)), 1.0);
-    const int b_theta =
-        RefineBin(cos_theta, theta_guess, grid.cos_theta_edges().data(), grid.n_theta());
-    const double xd = x, yd = y;
-    const double r = std::sqrt(xd * xd + yd * yd);
-    int b_phi = 0;
-    if (r != 0) {
-        const double cos_phi = std::clamp(xd / r, -1.0, 1.0);
-        b_phi = RefineBin(cos_phi, phi_guess, grid.cos_phi_edges().data(), grid.n_phi());
-    }
-    return std::size_t(b_theta) * std::size_t(grid.n_phi()) + std::size_t(b_phi);
 }
 
 // ---- The block ----
@@ -855,7 +638,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     const DF df;
     const DI di;
     const std::size_t n_lanes = hn::Lanes(df);
-    const TraceStack& stack = *job.stack;
+    const CompiledStack<float>& stack = *job.stack;
     const HemisphereGrid& grid = *job.grid;
     const int n_layers = int(stack.layers.size());
     const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
@@ -904,11 +687,11 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         v.events =
             hn::IfThenElse(hn::RebindMask(di, going), hn::Add(v.events, hn::Set(di, 1)), v.events);
         MF degenerate_event = hn::FirstN(df, 0);  // all false
-        const TraceLayer& layer = stack.layers[group];
+        const CompiledLayer<float>& layer = stack.layers[group];
         const bool dielectric = layer.type == InterfaceType::Dielectric;
         switch (layer.type) {
             case InterfaceType::Dielectric: {
-                if (stack.multiple_scattering && !layer.dielectric.is_smooth()) {
+                if (layer.multiple) {
                     DielectricWalkEvent(layer.dielectric, going, v, rng,
                                         stack.max_microsurface_order, degenerate_event);
                     break;
@@ -918,7 +701,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
                 break;
             }
             case InterfaceType::Conductor: {
-                if (stack.multiple_scattering && !layer.conductor.is_smooth()) {
+                if (layer.multiple) {
                     ConductorWalkEvent(layer.conductor, going, v, rng, stack.max_microsurface_order,
                                        degenerate_event);
                     break;
@@ -962,7 +745,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             const int medium_layer = side == 0 ? group - 1 : group;
             const int k_next = side == 0 ? group - 1 : group + 1;
             if (hn::AllFalse(df, moving)) continue;
-            const TraceMedium& med = stack.layers[medium_layer].medium;
+            const CompiledMedium<float>& med = stack.layers[medium_layer].medium;
             if (med.scatters) {
                 // Enters the medium: its free flights are later steps.
                 const auto mi = hn::RebindMask(di, moving);
@@ -972,18 +755,10 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
                 continue;
             }
             if (med.absorbs) {
-                // Pure absorption: Beer–Lambert along the straight path.
-                const VF inv_mu = hn::Div(one, hn::Abs(v.d.z));
+                // Pure absorption: Beer–Lambert along the straight path (physics/medium.h).
                 VF transmittance[3];
-                for (int c = 0; c < 3; ++c) {
-                    if (c > 0 && med.tau_a[c] == med.tau_a[c - 1]) {
-                        transmittance[c] = transmittance[c - 1];  // a grey pair of channels
-                        continue;
-                    }
-                    transmittance[c] =
-                        med.tau_a[c] > 0 ? hn::Exp(df, hn::Mul(hn::Set(df, -med.tau_a[c]), inv_mu))
-                                         : one;
-                }
+                beer_lambert_transmittance<VF, VecLane>(med.tau_a, hn::Div(one, hn::Abs(v.d.z)),
+                                                        transmittance);
                 v.Keep(moving, kLossMedium, transmittance);
                 v.End(hn::And(moving, v.Black()), kEnded);
             }
@@ -1035,8 +810,8 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             const std::int32_t why = finish[l];
             if (why != kEnded) {
                 const Rgbf w(w_out[0][l], w_out[1][l], w_out[2][l]);
-                const std::size_t bin = BinOf(d_out[0][l], d_out[1][l], d_out[2][l], theta_guess[l],
-                                              phi_guess[l], grid);
+                const std::size_t bin = grid.bin_of(Vec3f(d_out[0][l], d_out[1][l], d_out[2][l]),
+                                                    theta_guess[l], phi_guess[l]);
                 tally.exit((why == kTransmitted ? grid.size() : 0) + bin, w);
             }
             on_lane(l);
@@ -1203,9 +978,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
 
         if (group_is_medium) {
             // ---- A scattering-medium step ----
-            const VF u0 = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
-            const VF u3 = rng.Uniform(), u4 = rng.Uniform();
-            ScatteringStep(stack.layers[group].medium, going, v, u0, u1, u2, u3, u4);
+            ScatteringStep(stack.layers[group].medium, going, v, rng);
             v.End(hn::And(going, v.Black()), kEnded);
         } else {
             interface_step(v, rng, group, going);
@@ -1323,12 +1096,124 @@ void HenyeyGreensteinForTest(const float* g, const float* x, std::size_t n, floa
             in_x[l] = base + l < n ? x[base + l] : 0.f;
         }
         const VF vg = hn::Load(df, in_g), vx = hn::Load(df, in_x);
-        hn::Store(HgPhase(vx, vg), df, p);
+        hn::Store(hg_phase<VF, VecLane>(vx, vg), df, p);
         hn::Store(sample_hg_cos_theta<VF, VecLane>(vg, vx), df, c);
         for (std::size_t l = 0; l < n_lanes && base + l < n; ++l) {
             phase[base + l] = p[l];
             cos_theta[base + l] = c[l];
         }
+    }
+}
+
+// Lane tests of the interface events and the medium step (tests/physics/lanes_test.cpp): each
+// entry j of the inputs is one lane; the outputs as the header kernel_simd.h describes them.
+struct LaneIo {
+    const DF df;
+    std::size_t base = 0, n = 0;
+    HWY_INLINE VF Load(const float* x, float pad) const {
+        HWY_ALIGN float buf[kMaxLanes];
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            buf[l] = base + l < n ? x[base + l] : pad;
+        return hn::Load(df, buf);
+    }
+    HWY_INLINE V3 Load3(const float* x) const {
+        HWY_ALIGN float buf[3][kMaxLanes];
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            for (int i = 0; i < 3; ++i)
+                buf[i][l] = base + l < n ? x[3 * (base + l) + i] : (i == 2 ? 1.f : 0.f);
+        return {hn::Load(df, buf[0]), hn::Load(df, buf[1]), hn::Load(df, buf[2])};
+    }
+    HWY_INLINE void Store(VF v, float* x) const {
+        HWY_ALIGN float buf[kMaxLanes];
+        hn::Store(v, df, buf);
+        for (std::size_t l = 0; l < hn::Lanes(df) && base + l < n; ++l)
+            x[base + l] = buf[l];
+    }
+    HWY_INLINE void Store3(const V3& v, float* x) const {
+        HWY_ALIGN float buf[3][kMaxLanes];
+        hn::Store(v.x, df, buf[0]);
+        hn::Store(v.y, df, buf[1]);
+        hn::Store(v.z, df, buf[2]);
+        for (std::size_t l = 0; l < hn::Lanes(df) && base + l < n; ++l)
+            for (int i = 0; i < 3; ++i)
+                x[3 * (base + l) + i] = buf[i][l];
+    }
+    HWY_INLINE void StoreMask(MF m, std::int32_t* x) const {
+        const DI di;
+        HWY_ALIGN std::int32_t buf[kMaxLanes];
+        hn::Store(hn::IfThenElseZero(hn::RebindMask(di, m), hn::Set(di, 1)), di, buf);
+        for (std::size_t l = 0; l < hn::Lanes(df) && base + l < n; ++l)
+            x[base + l] = buf[l];
+    }
+    HWY_INLINE MF Active() const { return hn::FirstN(df, std::min(hn::Lanes(df), n - base)); }
+};
+
+void InterfaceEventsForTest(int kind, const float* params, const std::int32_t* flags,
+                            const float* wi, const float* u, std::size_t n, float* wo,
+                            float* shadowing, float* fresnel, std::int32_t* reflected,
+                            std::int32_t* degenerate) {
+    const DF df;
+    LaneIo io{df};
+    io.n = n;
+    for (io.base = 0; io.base < n; io.base += hn::Lanes(df)) {
+        const V3 w = io.Load3(wi);
+        const VF uc = io.Load(u, 0.f), u1 = io.Load(u + n, 0.f), u2 = io.Load(u + 2 * n, 0.f);
+        const MF active = io.Active();
+        InterfaceEventLanes<VF, MF> e;
+        if (kind == 0) {  // dielectric: params eta, alpha; flags the event shape
+            const DielectricEventShape shape{flags[0] != 0, flags[1] != 0, flags[2] != 0,
+                                             flags[3] != 0};
+            e = dielectric_event<VF, VecLane>(hn::Set(df, params[0]), hn::Set(df, 1.f / params[0]),
+                                              hn::Set(df, params[1]), shape, w, uc, u1, u2, active);
+        } else if (kind ==
+                   1) {  // conductor: params alpha, eta[3], k[3]; flags smooth, uncorrelated
+            ConductorInterface<float> iface{Rgbf(params[1], params[2], params[3]),
+                                            Rgbf(params[4], params[5], params[6]), params[0]};
+            VF f[3];
+            e = conductor_event<VF, VecLane>(hn::Set(df, params[0]), flags[0] != 0, flags[1] != 0,
+                                             w, u1, u2, active, ConductorFresnel{iface}, f);
+            for (int c = 0; c < 3; ++c)
+                io.Store(f[c], fresnel + c * n);
+        } else {  // Lambertian
+            e.wo = lambertian_event<VF, VecLane>(w.z, u1, u2);
+            e.shadowing = hn::Set(df, 1.f);
+            e.reflected = active;
+            e.degenerate = hn::And(active, hn::Eq(w.z, hn::Zero(df)));
+        }
+        io.Store3(e.wo, wo);
+        io.Store(e.shadowing, shadowing);
+        io.StoreMask(e.reflected, reflected);
+        io.StoreMask(e.degenerate, degenerate);
+    }
+}
+
+void MediumStepForTest(const CompiledMedium<float>& med, const float* d, const float* w,
+                       const float* depth, const float* u, std::size_t n, std::int32_t* leaves,
+                       float* factor, float* depth_out, float* d_out, float* phase,
+                       std::int32_t* draws) {
+    const DF df;
+    LaneIo io{df};
+    io.n = n;
+    for (io.base = 0; io.base < n; io.base += hn::Lanes(df)) {
+        const V3 dv = io.Load3(d);
+        const VF wv[3] = {io.Load(w, 1.f), io.Load(w + n, 1.f), io.Load(w + 2 * n, 1.f)};
+        int k = 0;  // the uniforms: u[k·n + j] is lane j's k-th draw
+        auto uniform = [&] { return io.Load(u + std::size_t(k++) * n, 0.5f); };
+        const MediumFlightLanes<VF, MF> flight =
+            medium_free_flight<VF, VecLane>(med, dv, wv, io.Load(depth, 0.5f), uniform);
+        const MF scatters = hn::AndNot(flight.leaves, io.Active());
+        V3 d_new = dv;
+        VF ph[3];
+        medium_scatter<VF, VecLane>(med, dv, flight.p, scatters, uniform, d_new, ph);
+        io.StoreMask(flight.leaves, leaves);
+        for (int c = 0; c < 3; ++c) {
+            io.Store(flight.factor[c], factor + c * n);
+            io.Store(ph[c], phase + c * n);
+        }
+        io.Store(flight.depth, depth_out);
+        io.Store3(d_new, d_out);
+        for (std::size_t l = 0; l < hn::Lanes(df) && io.base + l < n; ++l)
+            draws[io.base + l] = k;
     }
 }
 
@@ -1444,6 +1329,8 @@ HWY_EXPORT(FresnelConductorForTest);
 HWY_EXPORT(HenyeyGreensteinForTest);
 HWY_EXPORT(MicrosurfaceWalkForTest);
 HWY_EXPORT(GgxLanesForTest);
+HWY_EXPORT(InterfaceEventsForTest);
+HWY_EXPORT(MediumStepForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -1537,6 +1424,41 @@ void simd_ggx_lanes(float alpha, const std::vector<float>& w, const std::vector<
     wm.resize(3 * u1.size());
     HWY_DYNAMIC_DISPATCH(GgxLanesForTest)
     (alpha, w.data(), u1.data(), u2.data(), u1.size(), lambda.data(), wm.data());
+}
+
+SimdEventResult simd_interface_events(int kind, const std::vector<float>& params,
+                                      const std::vector<std::int32_t>& flags,
+                                      const std::vector<float>& wi, const std::vector<float>& u) {
+    select_simd_target();
+    const std::size_t n = wi.size() / 3;
+    SimdEventResult r;
+    r.wo.resize(3 * n);
+    r.shadowing.resize(n);
+    r.fresnel.assign(3 * n, 1.f);
+    r.reflected.resize(n);
+    r.degenerate.resize(n);
+    HWY_DYNAMIC_DISPATCH(InterfaceEventsForTest)
+    (kind, params.data(), flags.data(), wi.data(), u.data(), n, r.wo.data(), r.shadowing.data(),
+     r.fresnel.data(), r.reflected.data(), r.degenerate.data());
+    return r;
+}
+
+SimdMediumResult simd_medium_step(const CompiledMedium<float>& medium, const std::vector<float>& d,
+                                  const std::vector<float>& w, const std::vector<float>& depth,
+                                  const std::vector<float>& u) {
+    select_simd_target();
+    const std::size_t n = depth.size();
+    SimdMediumResult r;
+    r.leaves.resize(n);
+    r.factor.resize(3 * n);
+    r.depth.resize(n);
+    r.d.resize(3 * n);
+    r.phase.resize(3 * n);
+    r.draws.resize(n);
+    HWY_DYNAMIC_DISPATCH(MediumStepForTest)
+    (medium, d.data(), w.data(), depth.data(), u.data(), n, r.leaves.data(), r.factor.data(),
+     r.depth.data(), r.d.data(), r.phase.data(), r.draws.data());
+    return r;
 }
 
 SimdWalkResult simd_microsurface_walk(const std::vector<float>& wi, float alpha, bool dielectric,

@@ -60,6 +60,36 @@ SimdWalkResult simd_microsurface_walk(const std::vector<float>& wi, float alpha,
                                       const float eta[3], const float k[3], int max_order,
                                       std::uint64_t seed);
 
+/// For tests: the interface events (physics/dielectric.h dielectric_event, conductor.h
+/// conductor_event, lambertian.h lambertian_event) on the dispatched instruction set's vectors,
+/// one lane per particle j arriving from wi[3j..3j+2] with uniforms u[j] (uc), u[n + j] (u1),
+/// u[2n + j] (u2). kind 0: a dielectric, params {eta, alpha}, flags the DielectricEventShape
+/// {smooth, index_matched, uncorrelated, smith_refraction}; kind 1: a conductor, params {alpha,
+/// eta[3], k[3]}, flags {smooth, uncorrelated}; kind 2: a Lambertian (degenerate where wi.z = 0).
+/// Per particle: wo (3), shadowing, the conductor's Fresnel factors (fresnel[c·n + j]; 1
+/// otherwise), reflected and degenerate (0 or 1).
+struct SimdEventResult {
+    std::vector<float> wo, shadowing, fresnel;
+    std::vector<std::int32_t> reflected, degenerate;
+};
+SimdEventResult simd_interface_events(int kind, const std::vector<float>& params,
+                                      const std::vector<std::int32_t>& flags,
+                                      const std::vector<float>& wi, const std::vector<float>& u);
+
+/// For tests: one scattering-medium step (physics/medium.h medium_free_flight, then
+/// medium_scatter for the lanes that scatter) on the dispatched instruction set's vectors, one
+/// lane per particle j travelling along d[3j..3j+2] with flux w[c·n + j] at depth[j], its k-th
+/// draw u[k·n + j] (at most 5). Per particle: leaves (0 or 1), the flight's factors
+/// factor[c·n + j], the scattering depth, the new direction d (3; the old one where no lane
+/// scatters), the phase factors phase[c·n + j] and the number of draws.
+struct SimdMediumResult {
+    std::vector<std::int32_t> leaves, draws;
+    std::vector<float> factor, depth, d, phase;
+};
+SimdMediumResult simd_medium_step(const CompiledMedium<float>& medium, const std::vector<float>& d,
+                                  const std::vector<float>& w, const std::vector<float>& depth,
+                                  const std::vector<float>& u);
+
 /// Applies LAMINA_SIMD_TARGET (an instruction set name as simd_target_name prints it, e.g. AVX2 or
 /// SSE4), which caps the dispatch at that set: the way to reproduce another machine's tables, or to
 /// test every compiled set on one machine. Once per process; InputError for an unknown or

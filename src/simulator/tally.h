@@ -16,8 +16,8 @@
 #include "core/grid.h"
 #include "core/rgb.h"
 #include "core/vec.h"
+#include "layers/compiled_stack.h"
 #include "simulator/goniophotometer.h"
-#include "simulator/trace_stack.h"
 
 #include <array>
 #include <cmath>
@@ -126,7 +126,7 @@ struct Tally {
 /// `tally` (exits, events, degeneracies) and `block` (the budget). Particle p draws its numbers
 /// from ParticleRng(seed, stream, p).
 struct BlockJob {
-    const TraceStack* stack;
+    const CompiledStack<float>* stack;
     const HemisphereGrid* grid;
     Vec3f wi;
     std::uint64_t seed, stream, first, count;

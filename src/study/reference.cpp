@@ -5,6 +5,7 @@
 #include "core/hash.h"
 #include "core/packed_array.h"
 #include "lamina/version.h"
+#include "reference_source_digest.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -183,10 +184,10 @@ std::string read_file(const std::filesystem::path& path) {
 
 std::string ReferenceKey::canonical() const {
     return fmt::format(
-        "lamina {} | config {} | stack {} | theta_i {} | particles {} | seed {} | "
+        "lamina {} | code {} | config {} | stack {} | theta_i {} | particles {} | seed {} | "
         "grid {} | kernel {}{}{}",
-        kVersion, config_id, stack_to_json(stack).dump(), theta_i_deg, particles, seed,
-        grid.to_string(), kernel_description(kernel),
+        kVersion, kReferenceSourceDigest, config_id, stack_to_json(stack).dump(), theta_i_deg,
+        particles, seed, grid.to_string(), kernel_description(kernel),
         microsurface == Microsurface::Multiple ? " | microsurface multiple" : "",
         microsurface == Microsurface::Single &&
                 transmission_masking == TransmissionMasking::Smith && has_rough_dielectric(stack)

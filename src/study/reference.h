@@ -39,7 +39,9 @@ struct ReferenceKey {
     /// reused for `pbrt` only.
     TransmissionMasking transmission_masking = TransmissionMasking::Smith;
 
-    /// A canonical text of every field (and lamina's version) and its 64-bit FNV-1a hash.
+    /// A canonical text of every field, lamina's version and the digest of the reference's code
+    /// (kReferenceSourceDigest: src/core, physics, layers and simulator, so that a kernel whose
+    /// numbers changed is never served a table the old code cached), and its 64-bit FNV-1a hash.
     std::string canonical() const;
     std::string file_name() const;
 };

@@ -1,0 +1,64 @@
+#include "layers/compiled_stack.h"
+
+namespace lamina {
+
+template <typename Real>
+CompiledStack<Real> compile_stack(const Stack& stack, const CompileSettings& settings) {
+    CompiledStack<Real> out;
+    out.eta_above = Real(stack.ambient_eta);
+    out.transmits = stack.transmits();
+    out.multiple_scattering = settings.multiple_scattering;
+    out.max_microsurface_order = settings.max_microsurface_order;
+    const bool multiple = settings.multiple_scattering;
+    for (std::size_t i = 0; i < stack.layers.size(); ++i) {
+        const Layer& layer = stack.layers[i];
+        const InterfaceSpec& spec = layer.interface;
+        // Relative indices against the medium above (docs/physics.md §2), formed in double.
+        const double eta_above = stack.eta_above(i);
+        CompiledLayer<Real> t;
+        t.type = spec.type;
+        switch (spec.type) {
+            case InterfaceType::Dielectric:
+                t.dielectric = {Real(spec.eta / eta_above), Real(spec.alpha)};
+                t.dielectric.transmission_masking = settings.transmission_masking;
+                if (multiple && t.dielectric.is_index_matched()) t.dielectric.alpha = Real(0);
+                t.delta = t.dielectric.is_smooth() || t.dielectric.is_index_matched();
+                t.multiple = multiple && !t.delta;
+                t.eta_below = Real(spec.eta);
+                break;
+            case InterfaceType::Conductor:
+                t.conductor = {Rgb<Real>(spec.eta_rgb / eta_above), Rgb<Real>(spec.k / eta_above),
+                               Real(spec.alpha)};
+                t.delta = t.conductor.is_smooth();
+                t.multiple = multiple && !t.delta;
+                t.eta_below = Real(eta_above);  // no region below an opaque base
+                break;
+            case InterfaceType::Lambertian:
+                t.lambertian = {Rgb<Real>(spec.albedo)};
+                t.eta_below = Real(eta_above);
+                break;
+        }
+        if (layer.has_medium) {
+            const MediumSpec& m = layer.medium;
+            CompiledMedium<Real>& md = t.medium;
+            md.tau_a = Rgb<Real>(m.tau_a);
+            md.tau_s = Rgb<Real>(m.tau_s);
+            md.tau_t = Rgb<Real>(m.tau_t());
+            md.g = Rgb<Real>(m.g);
+            md.absorbs = m.tau_a.max() > 0;
+            md.scatters = m.tau_s.max() > 0;
+            md.uniform_g = m.g[0] == m.g[1] && m.g[1] == m.g[2];
+            md.uniform_tau_t = md.tau_t[0] == md.tau_t[1] && md.tau_t[1] == md.tau_t[2];
+            for (int c = 0; c < 3; ++c)
+                md.single_scattering_albedo[c] =
+                    md.tau_t[c] > 0 ? Real(m.tau_s[c] / m.tau_t()[c]) : Real(0);
+        }
+        out.layers.push_back(t);
+    }
+    return out;
+}
+
+template CompiledStack<float> compile_stack<float>(const Stack&, const CompileSettings&);
+template CompiledStack<double> compile_stack<double>(const Stack&, const CompileSettings&);
+
+}  // namespace lamina
