@@ -232,30 +232,54 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
     // Like for like: the overall ranking above averages each model over the configurations it
     // supports, so a model that skips the hard ones (Belcour's have no Lambertian base) looks
     // better than it is. This one averages the BRDF rows of the configurations whose BRDF every
-    // model supports.
+    // model supports. When no configuration is supported by all (a model made for one category
+    // only, such as ddb22's Lambertian bases), the model supporting the fewest configurations is
+    // left out, then the next, until some configurations are common; the summary names them.
+    auto supports_r = [&](const std::string& m, const std::string& id) {
+        const auto it = per_config.find(id);
+        const bool unsupported_r = f.not_supported.count(m) && f.not_supported.at(m).count(id) &&
+                                   f.not_supported.at(m).at(id).find('R') != std::string::npos;
+        return it != per_config.end() && it->second.count(m) && it->second.at(m).n_mf > 0 &&
+               !unsupported_r;
+    };
+    std::vector<std::string> compared = models;
     std::set<std::string> common;
-    for (const StudyConfiguration& c : configs) {
-        bool all = !models.empty();
-        for (const std::string& m : models) {
-            const auto it = per_config.find(c.id);
-            const bool unsupported_r =
-                f.not_supported.count(m) && f.not_supported.at(m).count(c.id) &&
-                f.not_supported.at(m).at(c.id).find('R') != std::string::npos;
-            if (it == per_config.end() || !it->second.count(m) || it->second.at(m).n_mf == 0 ||
-                unsupported_r)
-                all = false;
+    while (!compared.empty()) {
+        common.clear();
+        for (const StudyConfiguration& c : configs) {
+            bool all = true;
+            for (const std::string& m : compared)
+                all = all && supports_r(m, c.id);
+            if (all) common.insert(c.id);
         }
-        if (all) common.insert(c.id);
+        if (!common.empty() || compared.size() <= 2) break;
+        // The model with the fewest supported BRDFs (the last such in the study's order).
+        std::size_t fewest = 0;
+        int fewest_n = -1;
+        for (std::size_t k = 0; k < compared.size(); ++k) {
+            int n = 0;
+            for (const StudyConfiguration& c : configs)
+                n += supports_r(compared[k], c.id);
+            if (fewest_n < 0 || n <= fewest_n) {
+                fewest_n = n;
+                fewest = k;
+            }
+        }
+        f.common.left_out.push_back(compared[fewest]);
+        compared.erase(compared.begin() + long(fewest));
     }
+    if (common.empty()) f.common.left_out.clear();
     std::map<std::string, Accumulator> acc_common;
     for (const MetricRow& r : rows)
-        if (r.side == 'R' && common.count(r.config)) acc_common[r.model].add(r);
+        if (r.side == 'R' && common.count(r.config) &&
+            std::find(compared.begin(), compared.end(), r.model) != compared.end())
+            acc_common[r.model].add(r);
     for (const StudyConfiguration& c : configs)
         if (common.count(c.id)) f.common.ids.push_back(c.id);
     std::sort(f.common.ids.begin(), f.common.ids.end());
-    for (const std::string& m : models)
+    for (const std::string& m : compared)
         f.common.models[m] = acc_common[m].result();
-    if (!common.empty()) f.common.ranking = rank(models, f.common.models, true);
+    if (!common.empty()) f.common.ranking = rank(compared, f.common.models, true);
 
     // What the reference itself drops to its single-scattering microsurfaces, per category: the
     // mean over configurations, incidences and channels, and the worst.
@@ -384,6 +408,7 @@ void json_common(const StudyFindings& f, nlohmann::json& j) {
     j["common"]["configurations"] = f.common.ids.size();
     j["common"]["ids"] = f.common.ids;
     j["common"]["ranking"] = f.common.ranking;
+    j["common"]["left_out"] = f.common.left_out;
     for (const auto& [m, a] : f.common.models)
         j["common"]["models"][m] = {
             {"mean_misplaced_floor", num(a.mean_misplaced_floor)},
@@ -524,16 +549,29 @@ void md_findings(const StudyFindings& f, Markdown& out) {
                              pct(models.at(ranking[k]).mean_misplaced_floor));
         return t;
     };
-    if (const GroupFindings* all = f.group("all"); all && !all->ranking.empty())
-        out("- **Overall**: {} (mean misplaced energy over the configurations each supports).\n",
-            chain(all->ranking, all->models));
+    if (const GroupFindings* all = f.group("all"); all && !all->ranking.empty()) {
+        std::string t;
+        for (std::size_t k = 0; k < all->ranking.size(); ++k) {
+            const ModelAggregate& a = all->models.at(all->ranking[k]);
+            t += fmt::format("{}{} {}", k ? " < " : "", all->ranking[k],
+                             pct(a.mean_misplaced_floor));
+            if (int(a.configurations_supported) < all->configurations)
+                t += fmt::format(" ({} of {})", a.configurations_supported, all->configurations);
+        }
+        out("- **Overall**: {} (mean misplaced energy over the configurations each supports; "
+            "\"of\": how many).\n",
+            t);
+    }
     if (f.models.size() > 1) {
         if (f.common.ranking.empty())
             out("- **Like for like**: no configuration's BRDF is supported by every model.\n");
         else
-            out("- **Like for like** (the BRDF of the {} configuration{} every model supports): "
-                "{}.\n",
+            out("- **Like for like** (the BRDF of the {} configuration{} every model{} "
+                "supports): {}.\n",
                 f.common.ids.size(), f.common.ids.size() == 1 ? "" : "s",
+                f.common.left_out.empty() ? std::string()
+                                          : fmt::format(" but {} (made for fewer configurations)",
+                                                        fmt::join(f.common.left_out, ", ")),
                 chain(f.common.ranking, f.common.models));
     }
     // Said when it matters (a multiple-scattering reference loses only the rare walk it gives up).

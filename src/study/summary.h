@@ -73,11 +73,14 @@ struct GroupFindings {
     std::vector<std::string> ranking;
 };
 
-/// Like for like: the BRDF rows of the configurations whose BRDF every model supports.
+/// Like for like: the BRDF rows of the configurations whose BRDF every model supports (every
+/// model but `left_out` when no configuration is supported by all).
 struct CommonFindings {
     std::vector<std::string> ids;
     std::vector<std::string> ranking;  ///< by mean misplaced_floor; empty when `ids` is
     std::map<std::string, ModelAggregate> models;
+    /// The models left out so that some configurations are common (fewest supported first).
+    std::vector<std::string> left_out;
 };
 
 /// What the reference loses to its single-scattering microsurfaces over a category (or "all").

@@ -99,6 +99,34 @@ TEST(StudySummary, LikeForLikeRankingUsesOnlyConfigurationsEveryModelSupports) {
         << w.md;
 }
 
+// Three models and no configuration all of them support: "a" and "b" share the paint, "c"
+// supports only the plastic, which "b" does not. The model with the fewest supported BRDFs ("b"
+// and "c" one each: the later in the study's order on a tie) is left out; a and b are then
+// compared on the paint, and the summary names c.
+TEST(StudySummary, LikeForLikeLeavesOutTheModelsMadeForFewerConfigurations) {
+    const StudyConfiguration& plastic = builtin("plastic-P1-a0.05");
+    const StudyConfiguration& paint = builtin("paint-a0.05-a1.3");
+    std::vector<MetricRow> rows;
+    add_rows(rows, plastic, "a", true, 0.5);
+    add_rows(rows, plastic, "b", false, 0);
+    add_rows(rows, plastic, "c", true, 0.05);
+    add_rows(rows, paint, "a", true, 0.1);
+    add_rows(rows, paint, "b", true, 0.2);
+    add_rows(rows, paint, "c", false, 0);
+
+    const Written w = summarize({plastic, paint}, {"a", "b", "c"}, rows);
+    const nlohmann::json& j = w.json;
+    EXPECT_EQ(j["common"]["left_out"], (nlohmann::json{"c"}));
+    EXPECT_EQ(j["common"]["ids"], (nlohmann::json{paint.id}));
+    EXPECT_EQ(j["common"]["ranking"], (nlohmann::json{"a", "b"}));
+    EXPECT_NE(w.md.find("every model but c (made for fewer configurations) supports): a 10.0% < "
+                        "b 20.0%."),
+              std::string::npos)
+        << w.md;
+    // The overall ranking says how many configurations each model's mean covers.
+    EXPECT_NE(w.md.find("c 5.0% (1 of 2)"), std::string::npos) << w.md;
+}
+
 // The reference's own microsurface loss, per category and overall: means over incidences and
 // channels, and the worst with where it is.
 TEST(StudySummary, ReportsTheReferencesMicrosurfaceLoss) {
