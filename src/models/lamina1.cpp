@@ -200,6 +200,13 @@ V integrate_range(F&& f, double lo, double hi) {
     return sum;
 }
 
+/// Each channel clamped at zero (interpolated energies, never negative).
+Rgbd nonnegative(Rgbd v) {
+    for (int c = 0; c < 3; ++c)
+        v[c] = std::max(v[c], 0.0);
+    return v;
+}
+
 /// |1 − μ/(η μ')|: the rate at which a refracted direction turns with the tilt of the facet it
 /// crosses (differentiate Snell's law sin(θ − δ) = η sin(θ' + Δ − δ) in δ at δ = 0, for a facet
 /// tilted by δ in the plane of incidence: dΔ/dδ = 1 − cos θ/(η cos θ')). Belcour 2018, Eq. 10,
@@ -325,14 +332,21 @@ class Lamina1 final : public Model {
                 in.alpha_b = bottom_roughness(in.k_top, in.k_bottom);
                 const Multi<Rgbd, 3> first = first_order_(wi.z);
                 const Multi<Rgbd, 2> smooth = first_order_smooth(wi.z, in.wi_in.z);
-                in.first_T = first.v[0] + smooth.v[0];
-                in.first_E = first.v[1] + smooth.v[1];
-                in.first_M = first.v[2] + smooth.v[0];
+                // Stored as residuals from the smooth slab, the interpolated curves can undershoot
+                // zero by their interpolation error where the energy itself vanishes (grazing
+                // incidence, total internal reflection at the bottom): an energy is ≥ 0.
+                in.first_T = nonnegative(first.v[0] + smooth.v[0]);
+                in.first_E = nonnegative(first.v[1] + smooth.v[1]);
+                in.first_M = nonnegative(first.v[2] + smooth.v[0]);
                 // btdf-lobe=shared: the bottom's share of the spread's variance.
                 if (ch_.btdf_lobe_shared && in.alpha_b > 0)
                     in.u_bottom = sqr(alpha1_) / sqr(in.alpha_b);
             }
-            if (populations_) in.trapped = trapped_(wi.z);
+            if (populations_) {
+                in.trapped = trapped_(wi.z);
+                for (Rgbd& v : in.trapped.v)
+                    v = nonnegative(v);
+            }
         }
         return in;
     }

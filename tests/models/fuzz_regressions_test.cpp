@@ -103,5 +103,35 @@ TEST(FuzzRegressions, RefractionEscapeIsAFraction) {
     }
 }
 
+// Seed 1202, cases 1147 and 150 (the first long run after lamina-1's slab BTDF went through the
+// bottom's own BTDF): the slab's first-order energy E_1(μi) is interpolated as a residual from the
+// smooth slab's, and where E_1 vanishes (grazing incidence, the bottom's total reflection) the
+// interpolation undershot zero by its error: BTDF values of −7e-11 at θi = 90° and of −2e-74 in a
+// channel absorbed to nothing. An energy is ≥ 0; the transmission there is (almost) nothing.
+TEST(FuzzRegressions, Lamina1SlabFirstOrderNeverNegative) {
+    const Stack grazing = parse_stack(
+        R"({"ambient_eta": 4.663436641312639, "layers": [{"interface": {"type": "dielectric",
+        "eta": 4.999999999999999, "alpha": 0.9999999999999999}}, {"interface": {"type":
+        "dielectric", "eta": 2.839203385897703, "alpha": 0.8074603277953867}}]})",
+        "fuzz-1202-1147");
+    const Stack absorbed = parse_stack(
+        R"({"ambient_eta": 4.155068073541906, "layers": [{"interface": {"type": "dielectric",
+        "eta": 4.36374906698391, "alpha": -0}, "medium": {"tau_a": [43.592037184124365,
+        96.90214081526878, 49.71162235065619]}}, {"interface": {"type": "dielectric",
+        "eta": 2.134708249139151, "alpha": 0.8688474796894968}}]})",
+        "fuzz-1202-150");
+    for (const char* lobe : {"btdf-lobe=shared", "btdf-lobe=bottom"})
+        for (const char* series : {"btdf-series=uniform", "btdf-series=populations"}) {
+            const auto g = make_model("lamina-1", grazing, {lobe, series, "inter-reflection=on"});
+            const auto a = make_model("lamina-1", absorbed, {lobe, series, "inter-reflection=on"});
+            for (double theta_i : {90.0, 90.0 - 1e-7, 89.0, 58.76})
+                for (double theta_o : {180.0, 161.7, 120.0, 95.0}) {
+                    expect_good(g->eval(dir(theta_i, 0), dir(theta_o, 0)), lobe);
+                    expect_good(g->prepare(dir(theta_i, 0))->eval(dir(theta_o, 180)), lobe);
+                    expect_good(a->eval(dir(theta_i, 0), dir(theta_o, 0)), lobe);
+                }
+        }
+}
+
 }  // namespace
 }  // namespace lamina
