@@ -99,22 +99,6 @@ namespace {
 
 constexpr int kGauss = 32;  // Gauss–Legendre nodes per piece of the hemispherical integrals
 
-/// ∫₀¹ f(μ) dμ by Gauss–Legendre in two pieces split at a critical cosine (where the coat's
-/// smooth-limit transmittance has a square-root edge); the upper piece in t with μ = split +
-/// (1 − split) t², which makes that edge smooth.
-template <typename V, typename F>
-V integrate_split01(F&& f, double split) {
-    static const QuadratureRule q = gauss_legendre(kGauss);
-    V sum{};
-    split = clamp(split, 0.0, 1.0);
-    for (int i = 0; i < kGauss; ++i) {
-        if (split > 0) sum += f(split * q.x[i]) * (q.w[i] * split);
-        const double t = q.x[i], d = 1 - split;
-        if (d > 0) sum += f(split + d * t * t) * (q.w[i] * 2 * d * t);
-    }
-    return sum;
-}
-
 /// The cosine of the macro refraction of a direction of cosine mu into a medium of relative index
 /// eta (0 past total reflection).
 double refracted_cosine(double mu, double eta) {
@@ -291,14 +275,15 @@ bool ddb22_stack(const Stack& stack, const Ddb22Choices& ch, Ddb22Stack& out, st
         // whose mean direction is totally reflected and drops what the rough facets transmit
         // there, so its upward T would lose that light; its upward R (what returns to the base)
         // is kept.
-        out.T_bar = integrate_split01<Rgbd>(
+        out.T_bar = integrate_split01<kGauss, Rgbd>(
                         [&](double mu) { return ddb22_transmittance_down(out, mu) * (2 * mu); },
                         split_out) *
                     sqr(stack.ambient_eta / eta_base_medium);
     } else {
-        out.T_bar = integrate_split01<Rgbd>([&](double mu) { return up(mu, true); }, split_in);
+        out.T_bar =
+            integrate_split01<kGauss, Rgbd>([&](double mu) { return up(mu, true); }, split_in);
     }
-    out.r_bar = integrate_split01<Rgbd>([&](double mu) { return up(mu, false); }, split_in);
+    out.r_bar = integrate_split01<kGauss, Rgbd>([&](double mu) { return up(mu, false); }, split_in);
     for (int k = 0; k < 3; ++k) {
         const double rho = out.albedo[k];
         // 1 − ρ r̄ > 0: r̄ < 1 whenever anything leaves; kept ≥ 1e-9 (a white base under coats
@@ -312,9 +297,9 @@ bool ddb22_stack(const Stack& stack, const Ddb22Choices& ch, Ddb22Stack& out, st
     // azimuthally symmetric about the normal, so its mean direction is the normal and its
     // projected variance V = ∫ W μ (1 − μ²) dμ / ∫ W μ dμ.
     const auto weight = [&](double mu) { return ddb22_transmittance_down(out, mu).mean() * mu; };
-    const double flux = integrate_split01<double>(weight, split_out);
-    const double moment =
-        integrate_split01<double>([&](double mu) { return weight(mu) * (1 - mu * mu); }, split_out);
+    const double flux = integrate_split01<kGauss, double>(weight, split_out);
+    const double moment = integrate_split01<kGauss, double>(
+        [&](double mu) { return weight(mu) * (1 - mu * mu); }, split_out);
     // Nothing leaves (an opaque absorbing coat): the lobe carries no energy; any width will do.
     out.v_exit = flux > 0 ? moment / flux : 0.5;
     out.beta = ch.matched_variance

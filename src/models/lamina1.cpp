@@ -115,22 +115,6 @@ struct EdgeCurve {
     }
 };
 
-/// ∫₀¹ f(μ) dμ by Gauss–Legendre, in two pieces split at `split` (a critical cosine, where f has
-/// a square-root edge: Fresnel beyond total reflection). The upper piece is integrated in t with
-/// μ = split + (1 − split) t², which makes that edge smooth.
-template <typename V, typename F>
-V integrate01(F&& f, double split) {
-    static const QuadratureRule q = gauss_legendre(kGauss);
-    V sum{};
-    split = clamp(split, 0.0, 1.0);
-    for (int i = 0; i < kGauss; ++i) {
-        if (split > 0) sum += f(split * q.x[i]) * (q.w[i] * split);
-        const double t = q.x[i], d = 1 - split;
-        if (d > 0) sum += f(split + d * t * t) * (q.w[i] * 2 * d * t);
-    }
-    return sum;
-}
-
 /// ∫ f(wm) over the visible normals wm of w (Heitz 2018, "Sampling the GGX distribution of
 /// visible normals", JCGT 7(4): u1 = r², u2 over the half disk, its mirror image giving the
 /// same integrand for w in the xz plane), an integrand that steps where outgoing_z(wm) crosses
@@ -876,7 +860,8 @@ void Lamina1::precompute() {
     top_ms_ = ms && alpha0_ > 0;
     if (top_ms_) {
         dR_top_.fill([&](double mu) { return ms->dielectric(mu, alpha0_, eta0_).reflected; });
-        dR_top_bar_ = integrate01<double>([&](double mu) { return dR_top_(mu) * 2 * mu; }, 0.0);
+        dR_top_bar_ =
+            integrate_split01<kGauss, double>([&](double mu) { return dR_top_(mu) * 2 * mu; }, 0.0);
         top_ms_ = dR_top_bar_ > 0;
     }
     base_ms_ = ms && alpha1_ > 0 && coat_.base_type != InterfaceType::Lambertian;
@@ -886,14 +871,15 @@ void Lamina1::precompute() {
         } else {
             dE_base_.fill([&](double mu) { return ms->dielectric(mu, alpha1_, eta_b_).reflected; });
         }
-        dE_base_bar_ = integrate01<double>([&](double mu) { return dE_base_(mu) * 2 * mu; }, 0.0);
+        dE_base_bar_ = integrate_split01<kGauss, double>(
+            [&](double mu) { return dE_base_(mu) * 2 * mu; }, 0.0);
         base_ms_ = dE_base_bar_ > 0;
         if (base_ms_ && coat_.base_type == InterfaceType::Conductor) {
             // Each further facet multiplies by the conductor's Fresnel factor: with its
             // hemispherical average F̄ and the white surface's E_avg = 1 − ΔĒ, the orders ≥ 2
             // carry ΔE(μ) F̄² E_avg / (1 − F̄ (1 − E_avg)) (Kulla & Conty 2017, the F_ms factor:
             // one more bounce F̄, then escape E_avg or another bounce, summed).
-            const Rgbd F_avg = integrate01<Rgbd>(
+            const Rgbd F_avg = integrate_split01<kGauss, Rgbd>(
                 [&](double mu) {
                     return fresnel_complex_rgb(mu, coat_.base_eta, coat_.base_k) * (2 * mu);
                 },
@@ -903,7 +889,7 @@ void Lamina1::precompute() {
                 F_ms_[c] = sqr(F_avg[c]) * E_avg / (1 - F_avg[c] * (1 - E_avg));
         }
     }
-    r_bar_ = integrate01<Rgbd>(
+    r_bar_ = integrate_split01<kGauss, Rgbd>(
         [&](double mu) { return attenuation(mu) * attenuation(mu) * (2 * mu * R_in(mu)); },
         mu_crit);
     // What the first order does not send out is returned: light inside at μ'' within the exit
@@ -931,10 +917,11 @@ void Lamina1::precompute() {
     g_curve.fill(mu_crit, [&](double mu) { return g_direct(std::max(mu, 1e-6)); });
     auto g = [&](double mu) { return g_curve(mu); };
     const double mu_crit_b = eta_b_ < 1 ? std::sqrt(1 - sqr(eta_b_)) : 0.0;
-    E_bar_ = integrate01<Rgbd>([&](double mu) { return base_albedo(mu) * (2 * mu); }, mu_crit_b);
+    E_bar_ = integrate_split01<kGauss, Rgbd>([&](double mu) { return base_albedo(mu) * (2 * mu); },
+                                             mu_crit_b);
     auto inside_cos = [&](double mu) { return safe_sqrt(1 - (1 - mu * mu) * sqr(inv_eta0_)); };
     t_bar_ =
-        integrate01<Rgbd>(
+        integrate_split01<kGauss, Rgbd>(
             [&](double mu) { return attenuation(inside_cos(mu)) * (2 * mu * T_top_(mu)); }, 0.0) *
         sqr(inv_eta0_);
 
@@ -997,8 +984,8 @@ void Lamina1::precompute() {
     // at inside cosine μ' sends back down after one reflection at the coat's bottom.
     // The base's separable multiple-scattering lobe sends F_ms ΔE(μ') ∫ ΔE g 2μ'' dμ'' / ΔĒ.
     const Rgbd Y_ms =
-        base_ms_ ? integrate01<Rgbd>([&](double mu) { return g(mu) * (dE_base_(mu) * 2 * mu); },
-                                     mu_crit) *
+        base_ms_ ? integrate_split01<kGauss, Rgbd>(
+                       [&](double mu) { return g(mu) * (dE_base_(mu) * 2 * mu); }, mu_crit) *
                        (1 / dE_base_bar_)
                  : Rgbd(0.0);
     auto Y = [&](double mu) -> Rgbd {
@@ -1039,7 +1026,7 @@ void Lamina1::precompute() {
         // The coat's orders ≥ 2 transmit ΔT(μ) more, spread over the inside directions: taken
         // as cosine-distributed, they return the hemispherical average of a Y.
         const Rgbd Y_spread =
-            ms ? integrate01<Rgbd>(
+            ms ? integrate_split01<kGauss, Rgbd>(
                      [&](double mu) { return Y_curve(mu) * attenuation(mu) * (2 * mu); }, mu_crit)
                : Rgbd(0.0);
         X_.fill([&](double mu) {
@@ -1064,8 +1051,8 @@ void Lamina1::precompute() {
         });
     }
     // X̄ = (2/η0²)∫ X(μ) μ dμ: the diffuse exit's normalization.
-    X_bar_ =
-        integrate01<Rgbd>([&](double mu) { return X_at(mu) * (2 * mu); }, 0.0) * sqr(inv_eta0_);
+    X_bar_ = integrate_split01<kGauss, Rgbd>([&](double mu) { return X_at(mu) * (2 * mu); }, 0.0) *
+             sqr(inv_eta0_);
     for (int c = 0; c < 3; ++c) {
         const double one_minus = 1 - E_bar_[c] * r_bar_[c];
         inv_one_minus_Er_[c] = one_minus > 0 ? 1 / one_minus : 0;
@@ -1285,13 +1272,13 @@ void Lamina1::precompute_scattering() {
     if (!orders_on_) return;
     orders_.fill([&](double mu) { return at(top_left, inside_cos(mu)) * T_top_(mu); });
     const Rgbd orders_bar =
-        integrate01<Rgbd>([&](double mu) { return orders_(mu) * (2 * mu); }, 0.0);
+        integrate_split01<kGauss, Rgbd>([&](double mu) { return orders_(mu) * (2 * mu); }, 0.0);
     for (int c = 0; c < 3; ++c)
         orders_norm_[c] = orders_bar[c] > 0 ? kInvPi<double> / orders_bar[c] : 0.0;
     if (support_.btdf) {
         orders_t_.fill([&](double mu) { return at(bottom_left, inside_cos(mu)) * T_top_(mu); });
-        const double T_bar =
-            integrate01<double>([&](double mu) { return T_bot_(mu) * (2 * mu); }, 0.0);
+        const double T_bar = integrate_split01<kGauss, double>(
+            [&](double mu) { return T_bot_(mu) * (2 * mu); }, 0.0);
         orders_t_norm_ = T_bar > 0 ? kInvPi<double> / T_bar : 0.0;
         if (twice_on_)
             twice_.fill([&](double mu) {
@@ -1440,8 +1427,8 @@ void Lamina1::precompute_slab() {
         // The coat's orders ≥ 2 (multiple scattering) transmit ΔT(μ) more, taken as cosine-
         // distributed inside, as in X.
         const Rgbd once_spread =
-            ms ? integrate01<Rgbd>([&](double mu) { return entering(mu).v[0] * (2 * mu); },
-                                   mu_crit_b)
+            ms ? integrate_split01<kGauss, Rgbd>(
+                     [&](double mu) { return entering(mu).v[0] * (2 * mu); }, mu_crit_b)
                : Rgbd(0.0);
         auto entry_at = [&](double mu) {
             const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
@@ -1582,9 +1569,9 @@ void Lamina1::precompute_slab() {
             R_pq[p][q] = Rb.v[q] * (1 / A[p]);
             rho_qr[p][q] = rh.v[q] * (1 / A[p]);
         }
-        T_out[p] =
-            integrate01<double>([&](double mu) { return enter_below_(mu).v[p] * (2 * mu); }, 0.0) /
-            (A[p] * sqr(eta_s_));
+        T_out[p] = integrate_split01<kGauss, double>(
+                       [&](double mu) { return enter_below_(mu).v[p] * (2 * mu); }, 0.0) /
+                   (A[p] * sqr(eta_s_));
     }
     trapped_.fill([&](double mu) {
         const Multi<Rgbd, 3> e = entry(mu);

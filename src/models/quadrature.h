@@ -40,4 +40,21 @@ inline QuadratureRule gauss_legendre(int n) {
     return q;
 }
 
+/// ∫₀¹ f(μ) dμ by kNodes-point Gauss–Legendre in two pieces split at `split` (a critical cosine,
+/// where f has a square-root edge: Fresnel beyond total reflection, a coat's smooth-limit
+/// transmittance). The upper piece is integrated in t with μ = split + (1 − split) t², which makes
+/// that edge smooth. The lower piece is skipped when split = 0, the upper when split = 1.
+template <int kNodes, typename V, typename F>
+V integrate_split01(F&& f, double split) {
+    static const QuadratureRule q = gauss_legendre(kNodes);
+    V sum{};
+    split = clamp(split, 0.0, 1.0);
+    for (int i = 0; i < kNodes; ++i) {
+        if (split > 0) sum += f(split * q.x[i]) * (q.w[i] * split);
+        const double t = q.x[i], d = 1 - split;
+        if (d > 0) sum += f(split + d * t * t) * (q.w[i] * 2 * d * t);
+    }
+    return sum;
+}
+
 }  // namespace lamina
