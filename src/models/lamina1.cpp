@@ -1299,7 +1299,9 @@ void Lamina1::precompute_scattering() {
 }
 
 void Lamina1::precompute_slab() {
-    bottom_lobe_ = support_.btdf && ch_.btdf_bottom_lobe;
+    // An index-matched bottom lets the light straight through (a delta, whatever its roughness):
+    // no BTDF lobe of its own, the first order is the mirrored lobe of the coat's spread.
+    bottom_lobe_ = support_.btdf && ch_.btdf_bottom_lobe && eta_b_ != 1;
     populations_ = support_.btdf && ch_.btdf_populations && ch_.inter_reflection &&
                    !ch_.multiple_scattering && !(alpha0_ == 0 && alpha1_ == 0);
     if (!bottom_lobe_ && !populations_) return;
@@ -1677,9 +1679,11 @@ double Lamina1::pdf_with(const Incident& in, const Mixture& m, const Vec3d& wo) 
         // al. 2007, Eq. 17: dωm/dωo = η_o² |wo·wm| / (η_i wi·wm + η_o wo·wm)², η_o/η_i = η_b).
         const DielectricInterface<double> bottom = bottom_btdf(m.beta);
         if (const auto wm = bottom.half_vector(m.wi_mean, wo)) {
-            const double jacobian = sqr(eta_b_) * std::abs(dot(wo, *wm)) /
-                                    sqr(dot(m.wi_mean, *wm) + eta_b_ * dot(wo, *wm));
-            pdf += m.p[3] * GGX<double>{m.beta}.D_visible(m.wi_mean, *wm) * jacobian;
+            const double denom = sqr(dot(m.wi_mean, *wm) + eta_b_ * dot(wo, *wm));
+            const double jacobian = sqr(eta_b_) * std::abs(dot(wo, *wm)) / denom;
+            // A nearly index-matched bottom straight through: the half vector is rounding noise.
+            if (denom > 0 && std::isfinite(jacobian))
+                pdf += m.p[3] * GGX<double>{m.beta}.D_visible(m.wi_mean, *wm) * jacobian;
         }
     } else if (m.p[3] > 0) {
         const Vec3d v(wo.x, wo.y, -wo.z);

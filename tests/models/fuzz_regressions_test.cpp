@@ -133,5 +133,25 @@ TEST(FuzzRegressions, Lamina1SlabFirstOrderNeverNegative) {
         }
 }
 
+// Seed 1203, case 1707: a rough slab index-matched on both sides (η 1, 1) with
+// btdf-lobe=bottom: straight through, the bottom's refraction half vector wi' + wo is rounding
+// noise and the sampling density came out NaN. An index-matched bottom is a pass-through (a delta
+// whatever its roughness): no lobe of its own, the first order is the coat's mirrored lobe.
+TEST(FuzzRegressions, Lamina1IndexMatchedSlabBottomDensity) {
+    const Stack stack = parse_stack(
+        R"({"layers": [{"interface": {"type": "dielectric", "eta": 1, "alpha": 0.29012388879062523}},
+        {"interface": {"type": "dielectric", "eta": 1, "alpha": 0.6751831488162825}}]})",
+        "fuzz-1203-1707");
+    const Vec3d wi(0.9414427014706656, 0.2077378493526307, 0.2655760263916134);
+    for (const char* lobe : {"btdf-lobe=bottom", "btdf-lobe=shared"}) {
+        const auto model = make_model("lamina-1", stack, {lobe});
+        for (const Vec3d& wo : {Vec3d(-wi.x, -wi.y, -wi.z), Vec3d(0, 0, -1), dir(150, 30)}) {
+            const double pdf = model->pdf(wi, wo);
+            EXPECT_TRUE(std::isfinite(pdf) && pdf >= 0) << lobe << " pdf " << pdf;
+            expect_good(model->eval(wi, wo), lobe);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace lamina
