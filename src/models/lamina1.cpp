@@ -34,6 +34,9 @@ constexpr int kYnphi = 8;  // ... × midpoint in φ over the half disk
 // (integrate_visible_split): 6 Gauss–Legendre nodes on each side, 8 in φ.
 constexpr int kSplitNr = 6, kSplitNphi = 8, kSplitBisections = 14;
 constexpr int kNormNr = 12, kNormNphi = 8;  // the base lobe's normalization N (its rule)
+/// Energies (fractions of the incident light) below this are taken as zero where a lobe is
+/// normalized by them: far below anything a goniophotometer could measure.
+constexpr double kNegligibleEnergy = 1e-12;
 constexpr int kGauss = 24;  // Gauss–Legendre nodes per piece of the hemispherical integrals
 // The slab's transmission curves (precompute_slab): nodes over a cosine (the first order, the
 // later orders), and the split visible-normal rule of their integrals (r nodes per piece, φ
@@ -1274,7 +1277,9 @@ void Lamina1::precompute_scattering() {
     const Rgbd orders_bar =
         integrate_split01<kGauss, Rgbd>([&](double mu) { return orders_(mu) * (2 * mu); }, 0.0);
     for (int c = 0; c < 3; ++c)
-        orders_norm_[c] = orders_bar[c] > 0 ? kInvPi<double> / orders_bar[c] : 0.0;
+        // A remainder below kNegligibleEnergy of the incident light is none (its normalization
+        // would overflow: 1/Ē of a channel whose albedo is 1e-284).
+        orders_norm_[c] = orders_bar[c] > kNegligibleEnergy ? kInvPi<double> / orders_bar[c] : 0.0;
     if (support_.btdf) {
         orders_t_.fill([&](double mu) { return at(bottom_left, inside_cos(mu)) * T_top_(mu); });
         const double T_bar = integrate_split01<kGauss, double>(
@@ -1292,7 +1297,7 @@ void Lamina1::precompute_scattering() {
                 }
                 Rgbd K(0.0);
                 for (int c = 0; c < 3; ++c)
-                    K[c] = shape[c] > 0 ? left[c] / shape[c] : 0.0;
+                    K[c] = shape[c] > kNegligibleEnergy ? left[c] / shape[c] : 0.0;
                 return K;
             });
     }
@@ -1752,7 +1757,11 @@ std::optional<ModelSample> Lamina1::sample(const Vec3d& wi, const Vec3d& u) cons
     if (wo.z == 0 || (wo.z < 0 && !support_.btdf)) return std::nullopt;
     const double pdf = pdf_with(in, m, wo);
     if (!(pdf > 0)) return std::nullopt;
-    return ModelSample{wo, eval_with(in, wo) * (std::abs(wo.z) / pdf), pdf};
+    const Rgbd weight = eval_with(in, wo) * (std::abs(wo.z) / pdf);
+    // A direction drawn where the density underflows (a denormal pdf at the horizon, u at 1):
+    // its weight would overflow; it is rejected, as a direction of zero density is.
+    if (!std::isfinite(weight.max())) return std::nullopt;
+    return ModelSample{wo, weight, pdf};
 }
 
 double Lamina1::pdf(const Vec3d& wi, const Vec3d& wo) const {

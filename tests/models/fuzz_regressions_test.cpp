@@ -153,5 +153,34 @@ TEST(FuzzRegressions, Lamina1IndexMatchedSlabBottomDensity) {
     }
 }
 
+// Seed 1204, case 459: an HG medium over a Lambertian whose green albedo is 4e-284 and whose green
+// channel does not scatter: the scattered remainder's energy underflowed and its lobe's
+// normalization 1/(π Ē) overflowed, NaN at every direction. Case 2343: a denormal scattering
+// coefficient, a direction drawn at u = 1 onto the horizon with a denormal density: an infinite
+// sample weight. Remainders below 1e-12 of the incident light are none; such samples are rejected.
+TEST(FuzzRegressions, Lamina1NegligibleScatteringAndDenormalDensities) {
+    const Stack underflow = parse_stack(
+        R"({"layers": [{"interface": {"type": "dielectric", "eta": 1.000000000004, "alpha": 0.0001},
+        "medium": {"tau_a": 8.538748379669514, "tau_s": [8.651628500632103, 0, 61.12619341219868]}},
+        {"interface": {"type": "lambertian", "albedo": [1, 4.1257808956169206e-284,
+        0.7270220246748208]}}]})",
+        "fuzz-1204-459");
+    const auto a = make_model("lamina-1", underflow, {"inter-reflection=on"});
+    for (double theta_o : {0.0, 30.0, 89.0})
+        expect_good(a->eval(dir(0, 0), dir(theta_o, 0)), "fuzz-1204-459");
+    const Stack denormal = parse_stack(
+        R"({"layers": [{"interface": {"type": "dielectric", "eta": 1.000000000004,
+        "alpha": 0.04148237435507844}, "medium": {"tau_a": 5e-324, "tau_s": 2.2250738585072014e-308}},
+        {"interface": {"type": "dielectric", "eta": 1, "alpha": 0.6235676489022046}}]})",
+        "fuzz-1204-2343");
+    const auto b = make_model("lamina-1", denormal, {"refraction-masking=walter"});
+    const Vec3d wi(0.734908330850755, 0, 0.6781664583611883);
+    for (double u : {0.0, 0.5, 0.9999999999999999})
+        if (const auto smp = b->sample(wi, Vec3d(u, u, u))) {
+            expect_good(smp->weight, "fuzz-1204-2343 weight");
+            EXPECT_TRUE(std::isfinite(smp->pdf) && smp->pdf > 0);
+        }
+}
+
 }  // namespace
 }  // namespace lamina
