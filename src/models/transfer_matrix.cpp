@@ -583,9 +583,13 @@ class TmModel final : public Model {
                 TmComponent med;
                 med.kind = TmComponent::Medium;
                 med.tau_a = m.tau_a;
-                med.tau_s = m.tau_s;
+                // A scattering optical depth below 1e-12 scatters less than 1e-12 of the light:
+                // none (its two-stream solution underflows, 1e-160² is subnormal, to NaN).
+                constexpr double kNegligibleTau = 1e-12;
+                for (int c = 0; c < 3; ++c)
+                    med.tau_s[c] = m.tau_s[c] < kNegligibleTau ? 0.0 : m.tau_s[c];
                 med.g = m.g;
-                ch_.six_flux = ch_.six_flux || m.scatters();
+                ch_.six_flux = ch_.six_flux || med.tau_s.max() > 0;
                 comps_.push_back(med);
             }
         }

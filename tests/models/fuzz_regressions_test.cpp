@@ -182,5 +182,34 @@ TEST(FuzzRegressions, Lamina1NegligibleScatteringAndDenormalDensities) {
         }
 }
 
+// Seed 1205, case 1669: tm6 with a medium of scattering optical depth 1e-160 (and τa 9e-64 in
+// blue) over a lossless conductor, at grazing incidence with upward-fgd=refracted: its two-stream
+// solution underflowed (1e-160² is subnormal) to NaN in blue. A scattering depth below 1e-12
+// scatters less than 1e-12 of the light and is taken as none: the same as τs = 0.
+TEST(FuzzRegressions, Tm6NegligibleScatteringDepth) {
+    const std::string layers =
+        R"("layers": [{"interface": {"type": "dielectric", "eta": 4.999999999999999,
+        "alpha": 0.00010000000099990001}, "medium": {"tau_a": [100, 2.2250738585072014e-308,
+        9.131989052602682e-64], "tau_s": TAU_S}}, {"interface": {"type": "dielectric", "eta": 5,
+        "alpha": 0}}, {"interface": {"type": "conductor", "eta": 0.010000000000000002,
+        "k": [10, 6.840666103672959, 1e-320], "alpha": -0}}])";
+    auto stack_with = [&](const std::string& tau_s) {
+        std::string l = layers;
+        l.replace(l.find("TAU_S"), 5, tau_s);
+        return parse_stack("{\"ambient_eta\": 1.0000000000000002, " + l + "}", "fuzz-1205-1669");
+    };
+    const auto tiny = make_model("tm6", stack_with("1e-160"), {"upward-fgd=refracted"});
+    const auto none = make_model("tm6", stack_with("0"), {"upward-fgd=refracted"});
+    for (double cos_i : {6.123233995736766e-17, 1e-8, 0.5}) {
+        const Vec3d wi(std::sqrt(1 - cos_i * cos_i), 0, cos_i);
+        for (const Vec3d& wo : {Vec3d(-wi.x, 0, wi.z), dir(30, 0), dir(60, 90)}) {
+            const Rgbd f = tiny->eval(wi, wo), g = none->eval(wi, wo);
+            expect_good(f, "tm6");
+            for (int c = 0; c < 3; ++c)
+                EXPECT_EQ(f[c], g[c]);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace lamina
