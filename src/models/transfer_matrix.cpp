@@ -163,7 +163,10 @@ struct Matrix6 {
         const T x = T(1.0) / max_of(P.down_over(rb), P.m11 * 1e-9);
         const T a = S.down_over(rb), b = X.down_over(rb);
         const T pa = A.down_over(rb) * x, pb = B.down_over(rb) * x;
-        const T det_inv = T(1.0) / max_of(a * a - b * b, a * a * 1e-9);
+        // Kept ≥ 1e-9 a² and, where a itself vanishes (a lossless stack over a perfect mirror:
+        // S's down flux over rb = 1 cancels), ≥ (1e-9 S.m11)², the two-flux guard squared.
+        const T det_inv =
+            T(1.0) / max_of(max_of(a * a - b * b, a * a * 1e-9), S.m11 * S.m11 * 1e-18);
         const T y = (b * pb - a * pa) * det_inv, z = (b * pa - a * pb) * det_inv;
         return {P.up_over(rb) * x, A.up_over(rb) * x + S.up_over(rb) * y + X.up_over(rb) * z,
                 B.up_over(rb) * x + X.up_over(rb) * y + S.up_over(rb) * z};

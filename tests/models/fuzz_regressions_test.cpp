@@ -211,5 +211,31 @@ TEST(FuzzRegressions, Tm6NegligibleScatteringDepth) {
     }
 }
 
+// Seed 1207, case 27035: tm6 over a lossless conductor (η 0.01, κ 1e-20: a perfect mirror in
+// green and blue) under five components, one medium scattering in those channels: the six-flux
+// solve's determinant a² − b² was exactly 0 (the scattered family's down flux over rb = 1
+// cancels) and its 1e-9 a² guard with it: NaN. The guard is also ≥ (1e-9 S.m11)², the two-flux
+// guard squared; every channel then equals the red one's value at the mirror (a near-delta top).
+TEST(FuzzRegressions, Tm6SixFluxOverAPerfectMirror) {
+    const Stack stack = parse_stack(
+        R"({"ambient_eta": 1.0000000000000002, "layers": [{"interface": {"type": "dielectric",
+        "eta": 1.4685851099524947, "alpha": 0.0001}, "medium": {"tau_s": 5e-324, "g":
+        [0.9899999999999999, 0.99, 0.06668513281132588]}}, {"interface": {"type": "dielectric",
+        "eta": 1, "alpha": 0.23954889673372903}, "medium": {"tau_a": 1e-300, "tau_s":
+        [99.99999999999999, 5e-324, 85.27842649239021], "g": [-0.99, 1e-320, 0.9899999999999999]}},
+        {"interface": {"type": "dielectric", "eta": 2.6762692101284578, "alpha": 1}, "medium":
+        {"tau_a": [99.99999999999999, 0, 9.872609193467563], "tau_s": [1e-320, 5e-324, 1e-160]}},
+        {"interface": {"type": "dielectric", "eta": 1, "alpha": 0.0001}}, {"interface": {"type":
+        "conductor", "eta": [10, 0.01, 0.010000000000000002], "k": 1e-20, "alpha": 0}}]})",
+        "fuzz-1207-27035");
+    const auto model = make_model("tm6", stack, {"top=lobe", "normalization=none"});
+    for (double cos_i : {6.123233995736766e-17, 1e-8, 0.1})
+        for (double theta_o : {0.0, 45.0, 89.0}) {
+            const Vec3d wi(std::sqrt(1 - cos_i * cos_i), 0, cos_i);
+            expect_good(model->eval(wi, dir(theta_o, 180)), "tm6");
+            expect_good(model->prepare(wi)->eval(dir(theta_o, 180)), "tm6 prepared");
+        }
+}
+
 }  // namespace
 }  // namespace lamina
