@@ -9,6 +9,7 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "model_sampling.h"
 #include "models/binned.h"
 #include "models/registry.h"
 #include "support/chi2.h"
@@ -542,18 +543,8 @@ TEST(Ddb22SamplingStat, ChiSquare) {
             const auto model = make_model(variant, stack);
             for (double ti : incidences) {
                 const Vec3d wi = dir(ti, 0);
-                test::Chi2Options o;
-                o.name = fmt::format("ddb22-{}-{}-{}", what, ti, variant.size());
-                o.sample_count = 200'000;
-                o.test_count = count;
-                const auto r = test::run_chi2(
-                    o,
-                    [&](const std::array<double, 3>& u) {
-                        const auto s = model->sample(wi, Vec3d(u[0], u[1], u[2]));
-                        if (!s) return test::Chi2Draw::none();
-                        return test::Chi2Draw::direction(s->wo);
-                    },
-                    [&](const Vec3d& wo) { return model->pdf(wi, wo); });
+                const auto r = test::model_sampling_chi2(
+                    *model, wi, fmt::format("ddb22-{}-{}-{}", what, ti, variant.size()), count);
                 EXPECT_TRUE(r.passed) << variant << " " << what << " " << ti << ": " << r.message;
             }
         }
@@ -565,17 +556,7 @@ TEST(Ddb22Sampling, WeightIsEvalOverPdf) {
     for (const auto& [what, stack] : sampled_stacks()) {
         const auto model = make_model("ddb22", stack);
         const Vec3d wi = dir(40, 0);
-        int drawn = 0;
-        for (int n = 0; n < 200; ++n) {
-            const Vec3d u(rng.uniform_double(), rng.uniform_double(), rng.uniform_double());
-            const auto s = model->sample(wi, u);
-            if (!s) continue;
-            ++drawn;
-            EXPECT_NEAR(s->pdf, model->pdf(wi, s->wo), 1e-12 * s->pdf) << what;
-            const Rgbd want = model->eval(wi, s->wo) * (s->wo.z / s->pdf);
-            for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(s->weight[c], want[c], 1e-12 * want[c] + 1e-300) << what;
-        }
+        const int drawn = test::expect_sample_weights(*model, wi, rng, 200, what);
         // A visible normal of the indirect lobe tilted past 45° from the normal sends wo below
         // the surface (a failed draw): a fraction β²/(1 + β²) of its draws, 0.27 for the
         // β ≈ 0.6 of these coats (measured: 142 of 200 mixture draws succeed).

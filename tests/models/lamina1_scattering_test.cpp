@@ -5,6 +5,7 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "model_sampling.h"
 #include "models/binned.h"
 #include "models/quadrature.h"
 #include "models/registry.h"
@@ -282,18 +283,8 @@ TEST(Lamina1ScatteringSamplingStat, ChiSquare) {
             const auto model = make_model("lamina-1", stack);
             for (double ti : incidences) {
                 const Vec3d wi = dir(ti, 0);
-                test::Chi2Options o;
-                o.name = fmt::format("lamina1-scattering-{}-{}-{}", what, g, ti);
-                o.sample_count = 200'000;
-                o.test_count = count;
-                const auto r = test::run_chi2(
-                    o,
-                    [&](const std::array<double, 3>& u) {
-                        const auto s = model->sample(wi, Vec3d(u[0], u[1], u[2]));
-                        if (!s) return test::Chi2Draw::none();
-                        return test::Chi2Draw::direction(s->wo);
-                    },
-                    [&](const Vec3d& wo) { return model->pdf(wi, wo); });
+                const auto r = test::model_sampling_chi2(
+                    *model, wi, fmt::format("lamina1-scattering-{}-{}-{}", what, g, ti), count);
                 EXPECT_TRUE(r.passed) << what << " g=" << g << " " << ti << ": " << r.message;
             }
         }
@@ -305,17 +296,7 @@ TEST(Lamina1Scattering, SampleWeightIsEvalOverPdf) {
     for (const auto& [what, stack] : scattering_stacks(0.3)) {
         const auto model = make_model("lamina-1", stack);
         const Vec3d wi = dir(40, 0);
-        int drawn = 0;
-        for (int n = 0; n < 200; ++n) {
-            const Vec3d u(rng.uniform_double(), rng.uniform_double(), rng.uniform_double());
-            const auto s = model->sample(wi, u);
-            if (!s) continue;
-            ++drawn;
-            EXPECT_NEAR(s->pdf, model->pdf(wi, s->wo), 1e-12 * s->pdf);
-            const Rgbd f = model->eval(wi, s->wo);
-            for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(s->weight[c], f[c] * std::abs(s->wo.z) / s->pdf, 1e-9) << what;
-        }
+        const int drawn = test::expect_sample_weights(*model, wi, rng, 200, what);
         EXPECT_GT(drawn, 100) << what;
     }
 }
