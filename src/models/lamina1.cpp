@@ -63,7 +63,10 @@ struct CosineCurve {
 
 /// A curve over an inside cosine with a jump at the critical cosine μc (total internal reflection
 /// at a smooth coat): linear on nodes uniform in [0, μc) and in [μc, 1], each piece on its own.
-template <int kN, typename V = Rgbd>
+/// kSqrtEdge: a square-root edge there instead (a nearly smooth interface's transmittance from
+/// inside, which rises as √(μ − μc) above it): the upper nodes uniform in t with
+/// μ = μc + (1 − μc) t², as integrate_split01 (models/quadrature.h) places its nodes.
+template <int kN, typename V = Rgbd, bool kSqrtEdge = false>
 struct SplitCurve {
     double split = 0;
     std::array<V, kN> below{}, above{};
@@ -73,50 +76,25 @@ struct SplitCurve {
         for (int i = 0; i < kN; ++i) {
             const double t = double(i) / (kN - 1);
             below[i] = f(std::min(split * t, std::nextafter(split, 0.0)));
-            above[i] = f(split + (1 - split) * t);
+            above[i] = f(split + (1 - split) * (kSqrtEdge ? t * t : t));
         }
     }
     V operator()(double mu) const {
         const bool lower = mu < split;
         const double a = lower ? 0 : split, b = lower ? split : 1;
         const auto& v = lower ? below : above;
-        const double x = b > a ? clamp((mu - a) / (b - a), 0.0, 1.0) * (kN - 1) : 0;
-        const int i = std::min(int(x), kN - 2);
-        const double t = x - i;
-        return v[i] * (1 - t) + v[i + 1] * t;
-    }
-};
-
-/// A curve over an inside cosine with a square-root edge at the critical cosine μc (a nearly
-/// smooth interface's transmittance from inside, which rises as √(μ − μc) above it): linear on
-/// nodes uniform in [0, μc) and, above, in t with μ = μc + (1 − μc) t² (as integrate01 below).
-template <int kN>
-struct EdgeCurve {
-    double split = 0;
-    std::array<double, kN> below{}, above{};
-    template <typename F>
-    void fill(double mu_split, F&& f) {
-        split = clamp(mu_split, 0.0, 1.0);
-        for (int i = 0; i < kN; ++i) {
-            const double t = double(i) / (kN - 1);
-            below[i] = f(std::min(split * t, std::nextafter(split, 0.0)));
-            above[i] = f(split + (1 - split) * t * t);
-        }
-    }
-    double operator()(double mu) const {
-        const bool lower = mu < split;
-        double x = 0;
-        if (lower)
-            x = split > 0 ? clamp(mu / split, 0.0, 1.0) : 0.0;
-        else
-            x = split < 1 ? std::sqrt(clamp((mu - split) / (1 - split), 0.0, 1.0)) : 0.0;
-        const auto& v = lower ? below : above;
+        double x = b > a ? clamp((mu - a) / (b - a), 0.0, 1.0) : 0;
+        if (kSqrtEdge && !lower) x = std::sqrt(x);
         x *= kN - 1;
         const int i = std::min(int(x), kN - 2);
         const double t = x - i;
         return v[i] * (1 - t) + v[i + 1] * t;
     }
 };
+
+/// The square-root-edge curve (SplitCurve with kSqrtEdge).
+template <int kN>
+using EdgeCurve = SplitCurve<kN, double, true>;
 
 /// ∫ f(wm) over the visible normals wm of w (Heitz 2018, "Sampling the GGX distribution of
 /// visible normals", JCGT 7(4): u1 = r², u2 over the half disk, its mirror image giving the
