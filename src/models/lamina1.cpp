@@ -6,6 +6,7 @@
 #include "models/medium_adding.h"
 #include "models/multiple_scattering_albedo.h"
 #include "models/quadrature.h"
+#include "models/slope_sum_table.h"
 #include "physics/dielectric.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
@@ -33,7 +34,8 @@ constexpr int kYnphi = 8;  // ... × midpoint in φ over the half disk
 // rule to the next. The rule splits the r axis of each φ node at the step instead
 // (integrate_visible_split): 6 Gauss–Legendre nodes on each side, 8 in φ.
 constexpr int kSplitNr = 6, kSplitNphi = 8, kSplitBisections = 14;
-constexpr int kNormNr = 12, kNormNphi = 8;  // the base lobe's normalization N (its rule)
+constexpr int kNormNr = 8, kNormNphi = 8;  // the base lobe's normalization N (its rule) ...
+constexpr int kNnorm = 17;                 // ... on this many cosines (μ = s²)
 /// Energies (fractions of the incident light) below this are taken as zero where a lobe is
 /// normalized by them: far below anything a goniophotometer could measure.
 constexpr double kNegligibleEnergy = 1e-12;
@@ -179,6 +181,81 @@ Rgbd nonnegative(Rgbd v) {
 double deflection(double mu, double mu_in, double eta) {
     return std::abs(1 - mu / (eta * mu_in));
 }
+
+/// One facet's exact deflection of the refracted light at normal incidence (docs/models.md,
+/// lamina-1, item 4), for the coat's spreads' tails: a facet tilted by δ turns the inside
+/// direction by g(δ) — entering from outside, g = δ − asin(sin δ/η); leaving from inside, the
+/// outside ray turns by ψ = asin(η sin δ) − δ, which the smooth refraction wo → wo' sees inside
+/// as g = asin(sin ψ/η) (nothing beyond total internal reflection, δ ≥ asin(1/η)). Both have
+/// g'(0) = k_n = 1 − 1/η. Tabulated inverse, over g ∈ [0, g_max] (129 nodes): sin δ and cos δ
+/// (both smooth in g: an interpolated cos δ alone would make tan δ grow like √g at 0), and the
+/// weight k_n w(δ)/g'(δ) (the Jacobian of the map, 1 at δ = 0) with w the facet's transmission
+/// 1 − F(cos δ) times the refracted ray's Smith escape 1/(1 + Λ), relative to normal incidence.
+struct FacetDeflection {
+    static constexpr int kN = 129, kFine = 257;
+    double g_max = 0;
+    std::array<double, kN> sin_delta{}, cos_delta{}, weight{};
+
+    void build(bool entering, double eta, double alpha0) {
+        const GGX<double> ggx{alpha0};
+        const double k_n = 1 - 1 / eta;
+        const double delta_max = entering ? 0.5 * kPi<double> : std::asin(1 / eta);
+        const double w0 = 1 - fresnel_dielectric(1.0, eta);
+        // The forward map on a fine δ grid (g is increasing), then inverted node by node.
+        std::array<double, kFine> g{}, sn{}, c{}, wt{};
+        for (int j = 0; j < kFine; ++j) {
+            const double delta = delta_max * j / (kFine - 1);
+            const double sd = std::sin(delta), cd = std::cos(delta);
+            double gj, dg, escape_cos;
+            if (entering) {
+                const double ct = safe_sqrt(1 - sqr(sd / eta));
+                gj = delta - std::asin(std::min(sd / eta, 1.0));
+                dg = 1 - cd / (eta * ct);
+                escape_cos = std::cos(gj);
+            } else {
+                const double x = std::min(eta * sd, 1.0);
+                const double psi = std::asin(x) - delta;
+                gj = std::asin(std::sin(psi) / eta);
+                const double root = safe_sqrt(1 - x * x);
+                dg = root > 0 ? std::cos(psi) * (eta * cd / root - 1) / (eta * std::cos(gj))
+                              : HUGE_VAL;
+                escape_cos = std::cos(psi);
+            }
+            const double F =
+                entering ? fresnel_dielectric(cd, eta) : fresnel_dielectric(cd, 1 / eta);
+            const Vec3d w_ref(safe_sqrt(1 - sqr(escape_cos)), 0, std::max(escape_cos, 1e-9));
+            const double w = (1 - F) / (1 + ggx.lambda(w_ref)) / w0;
+            g[j] = gj;
+            sn[j] = sd;
+            c[j] = cd;
+            wt[j] = j == 0 ? 1.0 : (dg > 0 && std::isfinite(dg) ? k_n * w / dg : 0.0);
+        }
+        g_max = g[kFine - 1];
+        int j = 0;
+        for (int i = 0; i < kN; ++i) {
+            const double gi = g_max * i / (kN - 1);
+            while (j < kFine - 2 && g[j + 1] < gi)
+                ++j;
+            const double span = g[j + 1] - g[j];
+            const double t = span > 0 ? clamp((gi - g[j]) / span, 0.0, 1.0) : 0.0;
+            sin_delta[i] = sn[j] + t * (sn[j + 1] - sn[j]);
+            cos_delta[i] = c[j] + t * (c[j + 1] - c[j]);
+            weight[i] = wt[j] + t * (wt[j + 1] - wt[j]);
+        }
+    }
+
+    /// sin δ, cos δ and the weight at deflection g ≥ 0; false beyond g_max (no facet turns so far).
+    bool lookup(double g, double& sin_d, double& cos_d, double& w) const {
+        if (!(g < g_max)) return false;
+        const double f = g / g_max * (kN - 1);
+        const int i = std::min(int(f), kN - 2);
+        const double t = f - i;
+        sin_d = sin_delta[i] + t * (sin_delta[i + 1] - sin_delta[i]);
+        cos_d = cos_delta[i] + t * (cos_delta[i + 1] - cos_delta[i]);
+        w = weight[i] + t * (weight[i + 1] - weight[i]);
+        return cos_d > 0 && w > 0;
+    }
+};
 
 class Lamina1 final : public Model {
   public:
@@ -558,12 +635,71 @@ class Lamina1 final : public Model {
         const GGX<double> ggx{alpha};
         const Vec3d h = normalize(in.wi_in + wo_in);
         const double G = ggx.G2(in.wi_in, wo_in);
-        Rgbd f = base_fresnel(dot(in.wi_in, h)) * (ggx.D(h) * G / (4 * in.wi_in.z * wo_in.z));
+        const double D = shaped_lobe_
+                             ? first_order_ndf(h, in.k_top, spread_factor(mu_o, wo_in.z, eta0_))
+                             : ggx.D(h);
+        Rgbd f = base_fresnel(dot(in.wi_in, h)) * (D * G / (4 * in.wi_in.z * wo_in.z));
         if (lobe_norm_on_) f *= in.lobe_norm * lobe_norm_(wo_in.z);
         // The base's orders ≥ 2 (of its own roughness α1), separable as the coat's.
         if (base_ms_)
             f += F_ms_ * (dE_base_(in.wi_in.z) * dE_base_(wo_in.z) * kInvPi<double> / dE_base_bar_);
         return f;
+    }
+
+    /// The widened base lobe's normal distribution at the inside half vector h (first-order-lobe
+    /// compressed or sum; docs/models.md, lamina-1, item 4). Its half-vector slope is the sum of
+    /// three independent GGX slopes, the base's (α1) and the coat's two refractions' (α0 k_i/2,
+    /// α0 k_o/2): SlopeSumTable's density, with the same tail as the GGX of α_e and 2/3 to 1 of
+    /// its core. With `compressed`, the part of the density whose tail a coat spread makes
+    /// (its variance share u, as in the btdf-lobe=shared rule) is carried through one facet's
+    /// exact deflection instead of the linear k δ: half entering, half leaving (FacetDeflection;
+    /// the same for wi and wo, so the lobe stays symmetric), the summed slope S ↔ the facet tilt
+    /// δ by S = (k/2) tan δ and the mirror direction's turn 2θh = (k/k_n) g(δ), with the map's
+    /// Jacobian and the facet's transmission. D(h) = P(tan θh)/cos⁴θh. Approximation "the rate
+    /// of the less oblique end": both coat spreads turn the light at k = min(k_i, k_o), not at
+    /// their own ends — the light that reaches an oblique wo from a less oblique wi travelled
+    /// near the lobe's centre, the mirror of the less oblique refraction, where both facets
+    /// met it; the deflection rate at wo itself (k_o, which grows towards grazing exits) would
+    /// widen the lobe's flank tenfold at θo = 60° under α0 = 0.5 (tests/models/lamina1_lobe_test).
+    /// The GGX of α_e keeps k_i and k_o (its masking G2 and the sampling too).
+    double first_order_ndf(const Vec3d& h, double k_i, double k_o) const {
+        // Both refractions turn the light at the rate of the pair's less oblique end (see the
+        // comment above): symmetric, and k_i itself at the mirror pair.
+        const double k_c = std::min(k_i, k_o);
+        k_i = k_o = k_c;
+        const double a_b = alpha1_, a_i = 0.5 * alpha0_ * k_i, a_o = 0.5 * alpha0_ * k_o;
+        const double s2 = sqr(a_b) + sqr(a_i) + sqr(a_o);
+        const double c2 = h.z * h.z;
+        if (!(s2 > 0) || !(c2 > 0)) return 0;
+        const double sigma = std::sqrt(s2);
+        const double coat2 = sqr(a_i) + sqr(a_o);
+        const double x = sqr(a_b) / s2, y = coat2 > 0 ? sqr(a_i) / coat2 : 0.0;
+        const SlopeSumTable& table = SlopeSumTable::get();
+        const SlopeSumTable::Shares at = SlopeSumTable::locate(x, y);
+        auto density = [&](double r) {
+            return s2 * kInvPi<double> / sqr(s2 + r * r) * table.ratio(r / sigma, at);
+        };
+        const double t2 = std::max(0.0, 1 - c2) / c2, t = std::sqrt(t2);
+        if (ch_.first_order_lobe != Lamina1Choices::FirstOrderLobe::Compressed || !(coat2 > 0))
+            return density(t) / sqr(c2);
+        double p = x * density(t);
+        const double theta_h = std::atan(t);
+        const double k_n = 1 - inv_eta0_;
+        const double ks[2] = {k_i, k_o}, shares[2] = {sqr(a_i) / s2, sqr(a_o) / s2};
+        for (int side = 0; side < 2; ++side) {
+            if (!(shares[side] > 0) || !(ks[side] > 0)) continue;
+            const double g = 2 * k_n * theta_h / ks[side];
+            for (const FacetDeflection* map : {&entering_, &leaving_}) {
+                double sin_d, cos_d, w;
+                if (!map->lookup(g, sin_d, cos_d, w)) continue;
+                const double tan_d = sin_d / cos_d;
+                const double S = 0.5 * ks[side] * tan_d;
+                // P(t) t dt = P_S(S) S dS: dS/dt = sec²δ k_n / ((1 + t²) g'(δ)), S/t → 1 at 0.
+                const double s_over_t = t > 1e-12 ? S / t : 1.0;
+                p += 0.5 * shares[side] * density(S) * s_over_t * w / (cos_d * cos_d * (1 + t2));
+            }
+        }
+        return p / sqr(c2);
     }
 
     /// The coat's transmittance for the first order leaving a non-Lambertian base towards the
@@ -729,9 +865,13 @@ class Lamina1 final : public Model {
     bool inside_exit_ = false;  ///< exit_transmittance in the first order (see Lamina1Choices)
     bool mirror_series_ = false;
     bool lobe_norm_on_ = false;
+    /// first-order-lobe compressed or sum: first_order_ndf in place of the GGX of α_e (a coat
+    /// with α0 > 0 over a conductor or dielectric base, the spread on); the facet maps it uses.
+    bool shaped_lobe_ = false;
+    FacetDeflection entering_, leaving_;
     /// 1/√N(μ'): N is the energy of the base lobe whose width follows wo (α_e(k_i, k_o)) over that
     /// of the lobe of fixed width α_e(k_i, k_i), over the exit cone, at inside cosine μ'.
-    CosineCurve<double, kNx> lobe_norm_;
+    CosineCurve<double, kNnorm> lobe_norm_;
     /// √(1/(1 − a² R_in E_b (1 − u))) over inside cosines: the first order's round trips.
     CosineCurve<Rgbd> mirror_series_curve_;
     CosineCurve<double> dR_top_, dE_base_;
@@ -778,6 +918,13 @@ void Lamina1::precompute() {
     // the exit cone exceeds that of the lobe of fixed width α_e(k_i, k_i) by N(μi') (up to 2×
     // in the tails under rough, low-index coats). Divided out reciprocally, by √N(μi') √N(μo').
     // N by the fixed lobe's visible normals (Heitz 2018), the varying lobe weighted by its ratio.
+    shaped_lobe_ = ch_.first_order_lobe != Lamina1Choices::FirstOrderLobe::Ggx && alpha0_ > 0 &&
+                   eta0_ > 1 && coat_.base_type != InterfaceType::Lambertian &&
+                   ch_.spread != Lamina1Choices::Spread::Off;
+    if (shaped_lobe_ && ch_.first_order_lobe == Lamina1Choices::FirstOrderLobe::Compressed) {
+        entering_.build(true, eta0_, alpha0_);
+        leaving_.build(false, eta0_, alpha0_);
+    }
     lobe_norm_on_ = ch_.lobe_normalization && alpha0_ > 0 &&
                     coat_.base_type != InterfaceType::Lambertian &&
                     ch_.spread == Lamina1Choices::Spread::Angular;
@@ -801,12 +948,15 @@ void Lamina1::precompute() {
                     const Vec3d wo = reflect(w, wm);
                     if (wo.z <= mu_crit_in) continue;  // beyond the exit cone (or below)
                     const double mu_out = safe_sqrt(1 - (1 - wo.z * wo.z) * sqr(eta0_));
-                    const GGX<double> var{effective_alpha(k_i, spread_factor(mu_out, wo.z, eta0_))};
+                    const double k_o = spread_factor(mu_out, wo.z, eta0_);
+                    const GGX<double> var{effective_alpha(k_i, k_o)};
                     const double g_fixed = fixed.G2(w, wo) / fixed.G1(w);
                     sum_fixed += w_r * g_fixed;
-                    // f_var / f_fixed = D_var G2_var / (D_fixed G2_fixed) at the same half vector.
+                    // f_var / f_fixed = D_var G2_var / (D_fixed G2_fixed) at the same half vector
+                    // (D_var the shaped lobe's where first-order-lobe shapes it).
+                    const double D_var = shaped_lobe_ ? first_order_ndf(wm, k_i, k_o) : var.D(wm);
                     sum_var +=
-                        w_r * g_fixed * var.D(wm) * var.G2(w, wo) / (fixed.D(wm) * fixed.G2(w, wo));
+                        w_r * g_fixed * D_var * var.G2(w, wo) / (fixed.D(wm) * fixed.G2(w, wo));
                 }
             return sum_fixed > 0 && sum_var > 0 ? std::sqrt(sum_fixed / sum_var) : 1.0;
         });
@@ -1783,6 +1933,14 @@ std::vector<OptionSpec> lamina1_option_specs() {
          "angular",
          "base lobe widened by the coat's refraction spread: angle-dependent deflection, its "
          "normal-incidence value, or not widened"},
+        {"first-order-lobe",
+         {"compressed", "sum", "ggx"},
+         d.first_order_lobe == Lamina1Choices::FirstOrderLobe::Compressed ? "compressed"
+         : d.first_order_lobe == Lamina1Choices::FirstOrderLobe::Sum      ? "sum"
+                                                                          : "ggx",
+         "shape of the widened base lobe: the sum of the base's and the coat's two GGX slope "
+         "spreads with the coat's tails through one facet's exact refraction (compressed), the "
+         "same sum with the linear deflection (sum), or one GGX of the summed variance (ggx)"},
         {"exit-transmittance",
          {"inside", "outside"},
          d.inside_exit ? "inside" : "outside",
@@ -1857,6 +2015,10 @@ Lamina1Choices lamina1_choices(const ModelOptions& o) {
     c.btdf_bottom_lobe = option_value(o, "btdf-lobe") != "mirrored";
     c.btdf_lobe_shared = option_value(o, "btdf-lobe") == "shared";
     c.btdf_populations = option_value(o, "btdf-series") == "populations";
+    const std::string& lobe = option_value(o, "first-order-lobe");
+    c.first_order_lobe = lobe == "sum"   ? Lamina1Choices::FirstOrderLobe::Sum
+                         : lobe == "ggx" ? Lamina1Choices::FirstOrderLobe::Ggx
+                                         : Lamina1Choices::FirstOrderLobe::Compressed;
     const std::string& s = option_value(o, "spread");
     c.spread = s == "normal" ? Lamina1Choices::Spread::Normal
                : s == "off"  ? Lamina1Choices::Spread::Off

@@ -52,6 +52,16 @@ struct Lamina1Choices {
     /// The base lobe widened by the coat's refraction spread: with the angle-dependent deflection
     /// factor (Spread::Angular), its normal-incidence value 1 − 1/η (Normal), or not (Off).
     enum class Spread { Angular, Normal, Off } spread = Spread::Angular;
+    /// The shape of that widened lobe (docs/models.md, lamina-1, item 4): its half-vector slope
+    /// as the sum of the three independent GGX slopes of the base and the coat's two refractions
+    /// (models/slope_sum_table.h), the coat's tails carried through one facet's exact Snell
+    /// deflection and transmission (Compressed); the same sum with the linear deflection (Sum);
+    /// or one GGX lobe of the summed variance (Ggx, the earlier form).
+    enum class FirstOrderLobe {
+        Compressed,
+        Sum,
+        Ggx
+    } first_order_lobe = FirstOrderLobe::Compressed;
     /// The rough interfaces' scattering orders ≥ 2 (models/multiple_scattering_albedo.h): off
     /// (single scattering: the energy the microsurfaces mask is lost, as in the goniophotometer's
     /// --microsurface single) or restored (as in --microsurface multiple): the coat's and the
