@@ -12,15 +12,16 @@
 //
 // T: the coat's directional transmittance (models/coat_transmittance.h), a: Beer–Lambert along
 // the refracted mean directions, α_e and β: the base lobe widened by the coat's refraction
-// spread, X: the light the coat's bottom sends back to the base after the first order, Ē_b and r̄
-// the base's and the coat bottom's hemispherical albedos, K the normalization that gives the
-// separable term the energy of the geometric series; E_1: the slab's exact first-order
-// transmission, f_t,b the bottom's Walter BTDF from the coat's mean transmitted direction w̄i',
-// α_b its roughness widened by the coat's spread. A scattering medium adds its exact single
-// scattering f_ss (and, over a conductor or dielectric base, the once-scattered paths that meet
-// the base) and a separable lobe carrying the rest of the scattered light, its energy from an
-// azimuth-averaged adding–doubling of coat bottom, medium and base (models/medium_adding.h).
-// Each approximation is a flag (Lamina1Choices).
+// spread (its shape the sum of the base's and the coat's GGX spreads, the coat's tails through
+// one facet's exact refraction: first-order-lobe), X: the light the coat's bottom sends back to the
+// base after the first order, Ē_b and r̄ the base's and the coat bottom's hemispherical albedos, K
+// the normalization that gives the separable term the energy of the geometric series; E_1: the
+// slab's exact first-order transmission, f_t,b the bottom's Walter BTDF from the coat's mean
+// transmitted direction w̄i', α_b its roughness widened by the coat's spread. A scattering medium
+// adds its exact single scattering f_ss (and, over a conductor or dielectric base, the
+// once-scattered paths that meet the base) and a separable lobe carrying the rest of the scattered
+// light, its energy from an azimuth-averaged adding–doubling of coat bottom, medium and base
+// (models/medium_adding.h). Each approximation is a flag (Lamina1Choices).
 
 #include "models/coat_transmittance.h"
 #include "models/model.h"
