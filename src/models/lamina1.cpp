@@ -1139,7 +1139,9 @@ void Lamina1::precompute() {
     };
     x_exact_ = coat_.base_type == InterfaceType::Lambertian &&
                (alpha0_ == 0 || !ch_.directional_transmittance);
-    if (x_exact_) {
+    // X (and K, X̄) serve the separable series alone: where it is off (a base smoother than the
+    // coat, inter-reflection=off) they are not computed (X stays 0, never read).
+    if (x_exact_ || !series_on_) {
     } else if (alpha0_ == 0 || !ch_.directional_transmittance) {
         // The light enters along the refracted direction (smooth coat) or is taken to.
         X_.fill([&](double mu) {
