@@ -58,7 +58,11 @@ def visible_normal(rng, w, alpha):
     n = len(w)
     vh = np.stack([alpha * w[:, 0], alpha * w[:, 1], w[:, 2]], -1)
     vh /= np.linalg.norm(vh, axis=-1, keepdims=True)
-    t1 = np.tile([1.0, 0, 0], (n, 1))  # normal incidence: any tangent frame
+    lensq = vh[:, 0] ** 2 + vh[:, 1] ** 2
+    safe = np.sqrt(np.maximum(lensq, 1e-30))
+    t1 = np.where((lensq > 0)[:, None],
+                  np.stack([-vh[:, 1] / safe, vh[:, 0] / safe, np.zeros(n)], -1),
+                  np.array([1.0, 0, 0]))
     t2 = np.cross(vh, t1)
     r = np.sqrt(rng.random(n))
     phi = 2 * np.pi * rng.random(n)
