@@ -117,7 +117,7 @@ Misplaced misplaced(const std::vector<double>& model, const std::vector<double>&
 
 // The shaped lobe places the first order closer to the particles than one GGX lobe of the summed
 // variance, by more than the particles' noise, on coats from α0 0.2 to 0.5 at θi 0° and 45°
-// (docs/models.md measures the idealized shapes: 16–17 % for one GGX against 1–10 %).
+// (docs/models.md measures the idealized shapes: 15–17 % for one GGX against 0.4–9 %).
 TEST(Lamina1LobeStat, ShapedFirstOrderIsCloserToParticles) {
     const long n = 400000;
     std::uint64_t seed = 4100;
