@@ -137,9 +137,8 @@ TEST(Lamina1LobeStat, ShapedFirstOrderIsCloserToParticles) {
                 << "alpha0 " << alpha0 << " theta_i " << theta_i << ": shaped " << a.value
                 << ", ggx " << b.value << ", noise " << a.noise;
             std::printf(
-                "alpha0 %.2f theta_i %2.0f: misplaced shaped %.4f ggx %.4f (noise %.4f); shape "
-                "only "
-                "%.4f %.4f; energy / particles' %.4f %.4f\n",
+                "alpha0 %.2f theta_i %2.0f: misplaced shaped %.4f ggx %.4f (noise %.4f); "
+                "shape only %.4f %.4f; energy / particles' %.4f %.4f\n",
                 alpha0, theta_i, a.value, b.value, a.noise, a.shape, b.shape, a.energy_ratio,
                 b.energy_ratio);
         }
