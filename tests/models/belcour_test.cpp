@@ -21,9 +21,7 @@ namespace {
 
 using test::coated;
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    return direction_from_angles(deg_to_rad(theta_deg), deg_to_rad(phi_deg));
-}
+using test::dir;
 
 /// ∫ D G2 / (4 μi μo) μo dωo: the albedo of a GGX lobe of unit energy (what the height-correlated
 /// shadowing leaves of it), by a dense midpoint rule in (u = sin²θ, φ) (measure ½ du dφ).

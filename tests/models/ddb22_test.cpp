@@ -29,9 +29,7 @@ namespace {
 using test::coated;
 using test::fresnel_by_hand;
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    return direction_from_angles(deg_to_rad(theta_deg), deg_to_rad(phi_deg));
-}
+using test::dir;
 
 // GGX by hand (Walter et al. 2007, Eqs. 33–34; the height-correlated Smith G2 of Heitz 2014,
 // Eq. 99), written from the formulas, not through physics/microfacet.h.

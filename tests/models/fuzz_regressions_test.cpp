@@ -5,6 +5,8 @@
 #include "models/registry.h"
 #include "physics/smith_masking.h"
 
+#include "test_stacks.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,10 +14,7 @@
 namespace lamina {
 namespace {
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    const double t = deg_to_rad(theta_deg), p = deg_to_rad(phi_deg);
-    return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+using test::dir;
 
 void expect_good(const Rgbd& f, const std::string& what) {
     for (int c = 0; c < 3; ++c) {

@@ -20,10 +20,7 @@
 namespace lamina {
 namespace {
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    const double t = deg_to_rad(theta_deg), p = deg_to_rad(phi_deg);
-    return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+using test::dir;
 
 constexpr double kEta0 = 1.5, kEtaBase = 0.2, kKBase = 4.0;  // a bright metal (absolute)
 constexpr int kNtheta = 30, kNphi = 12;                      // 3° rings × 30° sectors (φ ≥ 0)

@@ -25,10 +25,7 @@ namespace {
 
 using test::coated;
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    const double t = deg_to_rad(theta_deg), p = deg_to_rad(phi_deg);
-    return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+using test::dir;
 
 Vec3d random_dir(ParticleRng& rng) {
     return dir(89.5 * rng.uniform_double(), 360 * rng.uniform_double());

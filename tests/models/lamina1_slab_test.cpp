@@ -19,10 +19,7 @@ namespace {
 
 using test::coated;
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    const double t = deg_to_rad(theta_deg), p = deg_to_rad(phi_deg);
-    return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+using test::dir;
 
 // A smooth coat over a rough bottom: the light enters along the refracted direction wi' with
 // the flux fraction (1 − F(μi)) and crosses the medium once, so the first order is exactly

@@ -26,10 +26,7 @@ namespace {
 
 using test::coated;
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    const double t = deg_to_rad(theta_deg), p = deg_to_rad(phi_deg);
-    return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+using test::dir;
 
 Rgbd total_delta(const Model& m, const Vec3d& wi, bool reflection) {
     Rgbd e(0.0);

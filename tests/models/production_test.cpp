@@ -20,10 +20,7 @@ namespace {
 
 using test::coated;
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    const double t = deg_to_rad(theta_deg), p = deg_to_rad(phi_deg);
-    return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+using test::dir;
 
 // --- The sources' equations, restated ------------------------------------------------------
 

@@ -1,10 +1,17 @@
 #pragma once
 // Stacks for the model tests, built in code (the JSON parser lives in another branch).
 
+#include "core/math.h"
 #include "core/rgb.h"
+#include "core/spherical.h"
 #include "layers/stack.h"
 
 namespace lamina::test {
+
+/// The upper-hemisphere direction at polar angle theta_deg and azimuth phi_deg (degrees).
+inline Vec3d dir(double theta_deg, double phi_deg) {
+    return direction_from_angles(deg_to_rad(theta_deg), deg_to_rad(phi_deg));
+}
 
 inline InterfaceSpec lambertian(Rgbd albedo) {
     InterfaceSpec s;

@@ -33,9 +33,7 @@ using test::fresnel_by_hand;
 using test::g_of_alpha;
 using test::g_refracted;
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    return direction_from_angles(deg_to_rad(theta_deg), deg_to_rad(phi_deg));
-}
+using test::dir;
 
 double backscatter_fit_by_hand(double g) {
     return 0.5039 - 0.8254 * g + 0.3226 * g * g;  // g ∈ [0, 0.6]: inside the clamp

@@ -30,9 +30,7 @@ using test::fresnel_by_hand;
 using test::g_of_alpha;
 using test::g_refracted;
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    return direction_from_angles(deg_to_rad(theta_deg), deg_to_rad(phi_deg));
-}
+using test::dir;
 
 TEST(TmMapping, RoundTripsAndLimits) {
     EXPECT_EQ(tm_hg_from_ggx(0.0), 1.0);

@@ -16,9 +16,7 @@ namespace {
 
 using test::coated;
 
-Vec3d dir(double theta_deg, double phi_deg) {
-    return direction_from_angles(deg_to_rad(theta_deg), deg_to_rad(phi_deg));
-}
+using test::dir;
 
 // WW' with a smooth coat (η) over a Lambertian (ρ) and absorption τ between:
 //   f = ρ/(π η²) (1 − F(μi)) (1 − F(μo)) exp(−τ (1/μi' + 1/μo')),  μ' = √(1 − (1 − μ²)/η²),
