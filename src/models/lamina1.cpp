@@ -664,40 +664,33 @@ class Lamina1 final : public Model {
     /// The GGX of α_e keeps k_i and k_o (its masking G2 and the sampling too).
     double first_order_ndf(const Vec3d& h, double k_i, double k_o) const {
         // Both refractions turn the light at the rate of the pair's less oblique end (see the
-        // comment above): symmetric, and k_i itself at the mirror pair.
-        const double k_c = std::min(k_i, k_o);
-        k_i = k_o = k_c;
-        const double a_b = alpha1_, a_i = 0.5 * alpha0_ * k_i, a_o = 0.5 * alpha0_ * k_o;
-        const double s2 = sqr(a_b) + sqr(a_i) + sqr(a_o);
+        // comment above): symmetric, and k_i itself at the mirror pair. The two coat spreads
+        // then have one scale, α0 k/2, and one map each.
+        const double k = std::min(k_i, k_o);
+        const double a_b = alpha1_, a_c = 0.5 * alpha0_ * k;
+        const double s2 = sqr(a_b) + 2 * sqr(a_c);
         const double c2 = h.z * h.z;
         if (!(s2 > 0) || !(c2 > 0)) return 0;
         const double sigma = std::sqrt(s2);
-        const double coat2 = sqr(a_i) + sqr(a_o);
-        const double x = sqr(a_b) / s2, y = coat2 > 0 ? sqr(a_i) / coat2 : 0.0;
+        const double x = sqr(a_b) / s2;  // the base's share; the coat's two halves have y = 1/2
         const SlopeSumTable& table = SlopeSumTable::get();
-        const SlopeSumTable::Shares at = SlopeSumTable::locate(x, y);
+        const SlopeSumTable::Shares at = SlopeSumTable::locate(x, 0.5);
         auto density = [&](double r) {
             return s2 * kInvPi<double> / sqr(s2 + r * r) * table.ratio(r / sigma, at);
         };
         const double t2 = std::max(0.0, 1 - c2) / c2, t = std::sqrt(t2);
-        if (ch_.first_order_lobe != Lamina1Choices::FirstOrderLobe::Compressed || !(coat2 > 0))
+        if (ch_.first_order_lobe != Lamina1Choices::FirstOrderLobe::Compressed || !(a_c > 0))
             return density(t) / sqr(c2);
+        // The coat's share 1 − x, half through the entering facet's map, half the leaving one's.
         double p = x * density(t);
-        const double theta_h = std::atan(t);
-        const double k_n = 1 - inv_eta0_;
-        const double ks[2] = {k_i, k_o}, shares[2] = {sqr(a_i) / s2, sqr(a_o) / s2};
-        for (int side = 0; side < 2; ++side) {
-            if (!(shares[side] > 0) || !(ks[side] > 0)) continue;
-            const double g = 2 * k_n * theta_h / ks[side];
-            for (const FacetDeflection* map : {&entering_, &leaving_}) {
-                double sin_d, cos_d, w;
-                if (!map->lookup(g, sin_d, cos_d, w)) continue;
-                const double tan_d = sin_d / cos_d;
-                const double S = 0.5 * ks[side] * tan_d;
-                // P(t) t dt = P_S(S) S dS: dS/dt = sec²δ k_n / ((1 + t²) g'(δ)), S/t → 1 at 0.
-                const double s_over_t = t > 1e-12 ? S / t : 1.0;
-                p += 0.5 * shares[side] * density(S) * s_over_t * w / (cos_d * cos_d * (1 + t2));
-            }
+        const double g = 2 * (1 - inv_eta0_) * std::atan(t) / k;
+        for (const FacetDeflection* map : {&entering_, &leaving_}) {
+            double sin_d, cos_d, w;
+            if (!map->lookup(g, sin_d, cos_d, w)) continue;
+            const double S = 0.5 * k * sin_d / cos_d;
+            // P(t) t dt = P_S(S) S dS: dS/dt = sec²δ k_n / ((1 + t²) g'(δ)), S/t → 1 at 0.
+            const double s_over_t = t > 1e-12 ? S / t : 1.0;
+            p += 0.5 * (1 - x) * density(S) * s_over_t * w / (cos_d * cos_d * (1 + t2));
         }
         return p / sqr(c2);
     }
