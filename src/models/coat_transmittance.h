@@ -18,8 +18,12 @@
 // over the visible normals (Heitz 2018, "Sampling the GGX distribution of visible normals",
 // JCGT 7(4)), T = ∫ D_wi(wm) (1 − F(wi·wm)) G_t(wi, wt)/G1(wi) dwm, wt the refraction of wi about
 // wm, by a Gauss–Legendre (in r, weight 2r) × midpoint (in φ, half the disk and its mirror image)
-// rule on Heitz's sampling disk. Axes: c = s² (41 nodes), α = s² (33), log2 η ∈ [−2, 2] (41; η = 1
-// is a node); arguments outside are clamped. Multilinear interpolation of the residual from the
+// rule on Heitz's sampling disk. Axes: c in two pieces split at the critical cosine μc(η) =
+// √(1 − η²) of total internal reflection (μc = 0 for η ≥ 1), c = μc (1 − y²) below it (25 nodes
+// uniform in y) and c = μc + (1 − μc) x² above it (41 uniform in x; for η ≥ 1, c = x²), so the
+// smoothed step of total internal reflection lies on one node line at every η and the nodes crowd
+// towards it from both sides; α = s² (33); log2 η ∈ [−2, 2] (41; η = 1 is a node); arguments
+// outside are clamped. Multilinear interpolation of the residual from the
 // smooth limit w(α)(1 − F(c)) (the control variate of the FGD table, for the step of TIR);
 // α = 0 returns 1 − F(c) exactly. Cached on disk like the FGD table (models/table_cache.h).
 
@@ -51,7 +55,9 @@ class CoatTransmittanceTable {
     static double direct(double c, double alpha, double eta, RefractionMasking masking,
                          int n_r = 64, int n_phi = 64);
 
-    static constexpr int kNc = 41, kNalpha = 33, kNeta = 41;
+    /// Nodes of the c axis below the critical cosine μc(η) = √(1 − η²) (η < 1) and above it
+    /// (with μc = 0 where there is no total internal reflection), of α and of log2 η.
+    static constexpr int kNbelow = 33, kNc = 49, kNalpha = 33, kNeta = 41;
     static constexpr double kLog2EtaMin = -2, kLog2EtaMax = 2;
 
   private:

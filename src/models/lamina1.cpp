@@ -7,6 +7,7 @@
 #include "models/multiple_scattering_albedo.h"
 #include "models/quadrature.h"
 #include "models/slope_sum_table.h"
+#include "models/visible_normal_quadrature.h"
 #include "physics/dielectric.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
@@ -25,15 +26,18 @@ namespace {
 
 constexpr int kNmu = 65;   // nodes of the per-material curves over a cosine, μ = s²
 constexpr int kNx = 33;    // nodes of X(μ), μ = s²
-constexpr int kYnr = 6;    // visible-normal rules of Y and X: Gauss–Legendre in r ...
-constexpr int kYnphi = 8;  // ... × midpoint in φ over the half disk
+constexpr int kYnr = 6;    // the rule of the transmitted light's mean direction: Gauss–Legendre
+constexpr int kYnphi = 8;  // in r × midpoint in φ over the half disk
 // The rule of Y and X: their integrands step at the coat's critical angle (total internal
 // reflection returns everything beyond it). A plain 6 × 8 rule in r put that step on one heavy
 // node (Y = 0.27 instead of 0.17 at normal incidence on α1 = 0.4 under an η0 = 1.2 smooth coat,
 // and the stack 7% more light than the goniophotometer); 24 × 16 nodes still moved by 2% from one
-// rule to the next. The rule splits the r axis of each φ node at the step instead
-// (integrate_visible_split): 6 Gauss–Legendre nodes on each side, 8 in φ.
-constexpr int kSplitNr = 6, kSplitNphi = 8, kSplitBisections = 14;
+// rule to the next. The rule splits the radius of each φ node at the step instead (and, for a
+// slab's Y, at its bottom's own total reflection) and integrates it in u = √(1 − r)
+// (integrate_visible_split, models/visible_normal_quadrature.h): 5 Gauss–Legendre nodes per
+// piece, 6 in φ; on the study's slabs, paints and frosted metals its albedos are within 1.0e-3
+// (mean 5e-5) of a 16 × 32 rule, where 6 × 8 nodes in r were within 3.1e-3.
+constexpr int kSplitNr = 5, kSplitNphi = 6, kSplitBisections = 14;
 constexpr int kNormNr = 8, kNormNphi = 8;  // the base lobe's normalization N (its rule) ...
 constexpr int kNnorm = 17;                 // ... on this many cosines (μ = s²)
 /// Energies (fractions of the incident light) below this are taken as zero where a lobe is
@@ -65,9 +69,11 @@ struct CosineCurve {
 
 /// A curve over an inside cosine with a jump at the critical cosine μc (total internal reflection
 /// at a smooth coat): linear on nodes uniform in [0, μc) and in [μc, 1], each piece on its own.
-/// kSqrtEdge: a square-root edge there instead (a nearly smooth interface's transmittance from
-/// inside, which rises as √(μ − μc) above it): the upper nodes uniform in t with
-/// μ = μc + (1 − μc) t², as integrate_split01 (models/quadrature.h) places its nodes.
+/// kSqrtEdge: a square-root edge there instead (a rough interface's transmittance from inside,
+/// which rises as √(μ − μc) above it when nearly smooth, its step smoothed over a width ~α on
+/// both sides): the nodes crowd towards μc from both sides, μ = μc (1 − (1 − t)²) below and
+/// μ = μc + (1 − μc) t² above (t uniform), as integrate_split01 (models/quadrature.h) places its
+/// upper nodes.
 template <int kN, typename V = Rgbd, bool kSqrtEdge = false>
 struct SplitCurve {
     double split = 0;
@@ -77,7 +83,9 @@ struct SplitCurve {
         split = clamp(mu_split, 0.0, 1.0);
         for (int i = 0; i < kN; ++i) {
             const double t = double(i) / (kN - 1);
-            below[i] = f(std::min(split * t, std::nextafter(split, 0.0)));
+            if (split > 0)  // else never read
+                below[i] = f(
+                    std::min(split * (kSqrtEdge ? 1 - sqr(1 - t) : t), std::nextafter(split, 0.0)));
             above[i] = f(split + (1 - split) * (kSqrtEdge ? t * t : t));
         }
     }
@@ -86,7 +94,7 @@ struct SplitCurve {
         const double a = lower ? 0 : split, b = lower ? split : 1;
         const auto& v = lower ? below : above;
         double x = b > a ? clamp((mu - a) / (b - a), 0.0, 1.0) : 0;
-        if (kSqrtEdge && !lower) x = std::sqrt(x);
+        if (kSqrtEdge) x = lower ? 1 - std::sqrt(1 - x) : std::sqrt(x);
         x *= kN - 1;
         const int i = std::min(int(x), kN - 2);
         const double t = x - i;
@@ -97,46 +105,6 @@ struct SplitCurve {
 /// The square-root-edge curve (SplitCurve with kSqrtEdge).
 template <int kN>
 using EdgeCurve = SplitCurve<kN, double, true>;
-
-/// ∫ f(wm) over the visible normals wm of w (Heitz 2018, "Sampling the GGX distribution of
-/// visible normals", JCGT 7(4): u1 = r², u2 over the half disk, its mirror image giving the
-/// same integrand for w in the xz plane), an integrand that steps where outgoing_z(wm) crosses
-/// z_split: per φ node the r axis is split at the crossing (bisection; outgoing_z is monotonic
-/// along r for the reflections and refractions used here) and each piece gets Gauss–Legendre.
-template <typename V, int kNr = kSplitNr, int kNphi = kSplitNphi,
-          int kBisections = kSplitBisections, typename Out, typename F>
-V integrate_visible_split(const GGX<double>& ggx, const Vec3d& w, double z_split, Out&& outgoing_z,
-                          F&& f) {
-    static const QuadratureRule q = gauss_legendre(kNr);
-    constexpr double kRMax = 1 - 1e-9;
-    V sum{};
-    for (int b = 0; b < kNphi; ++b) {
-        const double u2 = 0.5 * (b + 0.5) / kNphi - 0.25;
-        auto side = [&](double r) {
-            return outgoing_z(ggx.sample_visible_normal(w, r * r, u2)) > z_split;
-        };
-        double r_split = kRMax;
-        const bool first = side(0);
-        if (first != side(kRMax)) {
-            double lo = 0, hi = kRMax;
-            for (int it = 0; it < kBisections; ++it) {
-                const double mid = 0.5 * (lo + hi);
-                (side(mid) == first ? lo : hi) = mid;
-            }
-            r_split = 0.5 * (lo + hi);
-        }
-        for (int piece = 0; piece < 2; ++piece) {
-            const double start = piece ? r_split : 0, length = piece ? kRMax - r_split : r_split;
-            if (length <= 0) continue;
-            for (int i = 0; i < kNr; ++i) {
-                const double r = start + length * q.x[i];
-                sum +=
-                    f(ggx.sample_visible_normal(w, r * r, u2)) * (q.w[i] * length * 2 * r / kNphi);
-            }
-        }
-    }
-    return sum;
-}
 
 /// N values of type T integrated and tabulated together (the curves above take it as V).
 template <typename T, int N>
@@ -834,8 +802,11 @@ class Lamina1 final : public Model {
     CosineCurve<double, kNx> mu_mean_;  ///< μ̄'(μ) − μ'(μ): the transmitted light's mean shift
     /// T(μ) of the coat from above and of the bottom from below: exact 1 − F(μ) when smooth (or
     /// with coat-transmittance=fresnel), else the per-material curve resampled from the table.
+    /// T(μ) of one interface from the table (directional-transmittance) or 1 − F(μ) (smooth, or
+    /// coat-transmittance=fresnel), tabulated with its edge at the critical cosine (none: 0) on a
+    /// node, where a nearly smooth interface's T rises steeply.
     struct Transmittance {
-        CosineCurve<double> curve;
+        EdgeCurve<kNmu> curve;
         double eta = 1;
         bool exact = true;
         double operator()(double mu) const {
@@ -964,7 +935,9 @@ void Lamina1::precompute() {
     auto setup = [&](Transmittance& t, double alpha, double eta) {
         t.eta = eta;
         t.exact = alpha == 0 || (!ch_.directional_transmittance && !ms);
-        if (!t.exact) t.curve.fill([&](double mu) { return transmittance(mu, alpha, eta); });
+        if (!t.exact)
+            t.curve.fill(eta < 1 ? std::sqrt(1 - eta * eta) : 0.0,
+                         [&](double mu) { return transmittance(mu, alpha, eta); });
     };
     setup(T_top_, alpha0_, eta0_);
     setup(T_top_in_, alpha0_, inv_eta0_);
@@ -1119,14 +1092,22 @@ void Lamina1::precompute() {
         const Vec3d w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
         const double lambda_w = ggx.lambda(w);
         // Visible-normal weight: f_b μ'' dω'' = D_w F G2/G1 dwm (Heitz 2018, §2).
-        Rgbd sum = integrate_visible_split<Rgbd>(
-            ggx, w, mu_crit, [&](const Vec3d& wm) { return reflect(w, wm).z; },
-            [&](const Vec3d& wm) {
-                const Vec3d w2 = reflect(w, wm);
-                if (w2.z <= 0) return Rgbd(0.0);
-                const double escape = (1 + lambda_w) / (1 + lambda_w + ggx.lambda(w2));
-                return base_fresnel(dot(w, wm)) * g(w2.z) * escape;
-            });
+        auto f_y = [&](const Vec3d& wm) {
+            const Vec3d w2 = reflect(w, wm);
+            if (w2.z <= 0) return Rgbd(0.0);
+            const double escape = (1 + lambda_w) / (1 + lambda_w + ggx.lambda(w2));
+            return base_fresnel(dot(w, wm)) * g(w2.z) * escape;
+        };
+        static const QuadratureRule q = gauss_legendre(kSplitNr);
+        constexpr double kTol = 1.0 / (1 << kSplitBisections);
+        const Crossing coat_edge{[&](const Vec3d& wm) { return reflect(w, wm).z; }, mu_crit};
+        // A slab's bottom reflects totally from facets seen beyond its critical cosine: its
+        // Fresnel factor steps there too (unsplit, 3e-3 of a slab's albedo at α1 = 0.3).
+        Rgbd sum = mu_crit_b > 0 && coat_.base_type == InterfaceType::Dielectric
+                       ? integrate_visible_split<Rgbd>(
+                             ggx, w, f_y, q, kSplitNphi, kTol, coat_edge,
+                             Crossing{[&](const Vec3d& wm) { return dot(w, wm); }, mu_crit_b})
+                       : integrate_visible_split<Rgbd>(ggx, w, f_y, q, kSplitNphi, kTol, coat_edge);
         if (base_ms_) sum += F_ms_ * Y_ms * dE_base_(mu);
         return sum;
     };
@@ -1163,8 +1144,8 @@ void Lamina1::precompute() {
                 const auto wt = refract(w, wm, eta0_);
                 return wt ? -wt->z : 0.0;
             };
-            Rgbd sum =
-                integrate_visible_split<Rgbd>(ggx0, w, mu_crit, inside_z, [&](const Vec3d& wm) {
+            Rgbd sum = integrate_visible_split<Rgbd, kSplitNr, kSplitNphi, kSplitBisections>(
+                ggx0, w, mu_crit, inside_z, [&](const Vec3d& wm) {
                     const auto wt = refract(w, wm, eta0_);
                     if (!wt || wt->z >= 0) return Rgbd(0.0);
                     const double F = fresnel_dielectric(dot(w, wm), eta0_);
@@ -1440,28 +1421,11 @@ void Lamina1::precompute_slab() {
     const double mu_c = std::sqrt(1 - sqr(inv_eta0_));
     const double mu_crit_b = eta_b_ < 1 ? std::sqrt(1 - sqr(eta_b_)) : 0.0;
     auto population = [&](double mu) { return mu >= mu_c ? 0 : 1; };
-    // The bottom's transmittance from inside at w for roughness α (Walter et al. 2007, Eq. 21
-    // integrated over its visible normals, weight (1 − F) G_t/G1), the rule split where the
-    // facets start to reflect totally.
-    auto bottom_transmittance = [&](double alpha, const Vec3d& w) {
-        if (alpha == 0) return 1 - fresnel_dielectric(w.z, eta_b_);
-        const GGX<double> ggx{alpha};
-        const double lambda_w = ggx.lambda(w);
-        return integrate_visible_split<double, kSlabNr, kSlabNphi, kSlabBisections>(
-            ggx, w, mu_crit_b, [&](const Vec3d& wm) { return dot(w, wm); },
-            [&](const Vec3d& wm) {
-                const auto wt = refract(w, wm, eta_b_);
-                if (!wt || wt->z >= 0) return 0.0;
-                return (1 - fresnel_dielectric(dot(w, wm), eta_b_)) *
-                       refraction_escape(ch_.masking, lambda_w, ggx.lambda(*wt));
-            });
-    };
-    // T_b,in(μ) of the bottom's own roughness, directly: the table's interpolation across the
-    // steep edge just inside the critical cone (nearly smooth bottoms) is 1.5% low at α1 = 0.02.
-    EdgeCurve<kNslab> T_b_in;
-    T_b_in.fill(mu_crit_b, [&](double mu) {
-        return bottom_transmittance(alpha1_, Vec3d(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-6)));
-    });
+    // The energy of the bottom's lobe of roughness α at inside cosine μ (its transmittance from
+    // inside): the coat transmittance table (Walter et al. 2007, Eq. 21 over the visible normals),
+    // whose c axis puts the smoothed step of total internal reflection on a node line
+    // (models/coat_transmittance.h).
+    const CoatTransmittanceTable& table = CoatTransmittanceTable::get(ch_.masking);
     using Rule2 = Multi<Rgbd, 2>;
     using Rule4 = Multi<Rgbd, 4>;
 
@@ -1538,7 +1502,7 @@ void Lamina1::precompute_slab() {
     auto entering = [&](double mu_in) {
         Multi<Rgbd, 3> r;
         const Rgbd a = attenuation(mu_in);
-        r.v[0] = a * (ms ? T_bot_in_(mu_in) : T_b_in(mu_in));
+        r.v[0] = a * T_bot_in_(mu_in);
         if (populations_) {
             const Rule4 b = bottom(mu_in);
             r.v[1] = a * b.v[2];
@@ -1616,7 +1580,7 @@ void Lamina1::precompute_slab() {
             r.v[1] = entry(mu).v[0];
             const double mu_in = in.ok ? in.wi_in.z : 0.0;
             if (in.ok && in.alpha_b > 0) {
-                const double T_lobe = bottom_transmittance(in.alpha_b, in.wi_mean);
+                const double T_lobe = table(in.wi_mean.z, in.alpha_b, eta_b_);
                 if (T_lobe > 0) r.v[0] = r.v[1] * (1 / T_lobe);
             }
             // btdf-lobe=shared: Q_m = ∫_cone T_b,in(μv') q(w̄i', v'; β) μv' dωv', the mirrored

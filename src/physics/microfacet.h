@@ -180,9 +180,26 @@ struct GGX {
         return G1(w) * cos_w_wm * D(wm) / std::abs(w.z);
     }
 
-    /// Samples wm ∝ D_w(wm) from two uniform numbers in [0, 1): Heitz 2018, "Sampling the GGX
-    /// distribution of visible normals", JCGT 7(4), Listing 1 (the w.z < 0 case through −w).
-    Vec3<T> sample_visible_normal(Vec3<T> w, T u1, T u2) const {
+    /// Heitz 2018's sampler of visible normals prepared for one direction w (its Sections 3.2
+    /// and 4.1: w in the hemisphere configuration and the basis around it), so that a quadrature
+    /// over many (r, φ) pairs of one w builds the basis once and each φ's cosine and sine once.
+    struct VisibleNormalFrame {
+        T alpha;
+        Vec3<T> vh, t1, t2;
+        T s;  ///< the warp towards the visible half disk, (1 + vh.z)/2
+        /// The visible normal of the point (r cos φ, r sin φ) of the unit disk (Sections 4.2-4.4).
+        Vec3<T> normal(T r, T cos_phi, T sin_phi) const {
+            const T p1 = r * cos_phi;
+            const T p2 = (T(1) - s) * safe_sqrt(T(1) - sqr(p1)) + s * (r * sin_phi);
+            // Section 4.3: reprojection onto the hemisphere.
+            const Vec3<T> nh = t1 * p1 + t2 * p2 + vh * safe_sqrt(T(1) - sqr(p1) - sqr(p2));
+            // Section 3.4: back to the ellipsoid configuration.
+            return normalize(Vec3<T>(alpha * nh.x, alpha * nh.y, max0(nh.z)));
+        }
+    };
+
+    /// The prepared sampler of the normals visible from w (w.z < 0 through −w).
+    VisibleNormalFrame visible_normal_frame(Vec3<T> w) const {
         if (w.z < 0) w = -w;
         // Section 3.2: the view direction in the hemisphere configuration (α = 1).
         const Vec3<T> vh = normalize(Vec3<T>(alpha * w.x, alpha * w.y, w.z));
@@ -190,18 +207,15 @@ struct GGX {
         const T len2 = sqr(vh.x) + sqr(vh.y);
         const Vec3<T> t1 =
             len2 > 0 ? Vec3<T>(-vh.y, vh.x, T(0)) / std::sqrt(len2) : Vec3<T>(T(1), T(0), T(0));
-        const Vec3<T> t2 = cross(vh, t1);
-        // Section 4.2: a point on the projected area, warped towards the visible half disk.
-        const T r = std::sqrt(u1);
+        return {alpha, vh, t1, cross(vh, t1), T(0.5) * (T(1) + vh.z)};
+    }
+
+    /// Samples wm ∝ D_w(wm) from two uniform numbers in [0, 1): Heitz 2018, "Sampling the GGX
+    /// distribution of visible normals", JCGT 7(4), Listing 1 (the w.z < 0 case through −w):
+    /// the disk point r = √u1, φ = 2π u2 (Section 4.2) through visible_normal_frame.
+    Vec3<T> sample_visible_normal(Vec3<T> w, T u1, T u2) const {
         const T phi = T(2) * kPi<T> * u2;
-        const T p1 = r * std::cos(phi);
-        T p2 = r * std::sin(phi);
-        const T s = T(0.5) * (T(1) + vh.z);
-        p2 = (T(1) - s) * safe_sqrt(T(1) - sqr(p1)) + s * p2;
-        // Section 4.3: reprojection onto the hemisphere.
-        const Vec3<T> nh = t1 * p1 + t2 * p2 + vh * safe_sqrt(T(1) - sqr(p1) - sqr(p2));
-        // Section 3.4: back to the ellipsoid configuration.
-        return normalize(Vec3<T>(alpha * nh.x, alpha * nh.y, max0(nh.z)));
+        return visible_normal_frame(w).normal(std::sqrt(u1), std::cos(phi), std::sin(phi));
     }
 
     /// Samples the same density D_w(wm) as sample_visible_normal by the spherical-cap

@@ -102,12 +102,13 @@ SlabOrders trace_slab(double alpha0, double alpha1, double theta_i, long n, std:
 // The first order's energy E_1(μi) = ∫ t(μi → w') T_b,in(μ_w') dω' under rough coats (where the
 // lobe is centred on the mean direction but carries the exact energy), and the later orders of
 // btdf-series=populations (uniform radiance per population after the first return: an
-// approximation, within 0.01 of the incident flux on these stacks), against the particles.
-// Tolerance: 4 standard errors plus the quadrature budget: the binned albedo's 1e-3 and the
-// per-material rules' 2e-3 (first order), and at θi = 70° the coarse visible-normal rule of the
-// per-material curves (4 × 8 nodes per cosine, for the 1 ms budget), 8e-3 from the converged
-// 8 × 16 rule (which passes with 3e-3 there) where the coat spreads the light across the
-// bottom's critical angle.
+// approximation), against the particles. Tolerance: 4 standard errors plus the quadrature budget
+// of the first order (the binned albedo's 1e-3 and the per-material rules' 2e-3: the visible-
+// normal rules in u = √(1 − r), within 1.2e-3 of a 48 × 48 rule on these coats, and the coat
+// transmittance table, within 4e-3 of its direct integral near the critical edge); for the later
+// orders the approximation's 1e-2, and at θi = 70° 8e-3 more, where the coat spreads the light
+// across the bottom's critical angle and the uniform radiance per population misses most (the
+// measured gap there is 0.017 of the incident flux at α0 = α1 = 0.05).
 TEST(Lamina1SlabStat, TransmittedOrdersMatchParticles) {
     BinnedOptions o;
     o.rel_tol = 1e-3;
@@ -128,10 +129,11 @@ TEST(Lamina1SlabStat, TransmittedOrdersMatchParticles) {
                 const Vec3d wi = dir(theta_i, 0);
                 const double E1 = model_albedo(*first, wi, Side::Transmission, o)[1];
                 const double all = model_albedo(*both, wi, Side::Transmission, o)[1];
-                const double rule = theta_i > 60 ? 8e-3 : 0.0;
-                EXPECT_NEAR(E1, mc.first, 4 * mc.first_se + 3e-3 + rule)
+                const double grazing = theta_i > 60 ? 8e-3 : 0.0;
+                EXPECT_NEAR(E1, mc.first, 4 * mc.first_se + 3e-3)
                     << "alpha0 " << alpha0 << " alpha1 " << alpha1 << " theta_i " << theta_i;
-                EXPECT_NEAR(all, mc.first + mc.later, 4 * (mc.first_se + mc.later_se) + 1e-2 + rule)
+                EXPECT_NEAR(all, mc.first + mc.later,
+                            4 * (mc.first_se + mc.later_se) + 1e-2 + grazing)
                     << "alpha0 " << alpha0 << " alpha1 " << alpha1 << " theta_i " << theta_i;
             }
         }
