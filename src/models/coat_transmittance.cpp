@@ -17,7 +17,7 @@ namespace lamina {
 
 namespace {
 
-constexpr int kTableNr = 16;    // Gauss–Legendre nodes in r on Heitz's disk, per piece
+constexpr int kTableNr = 16;    // Gauss–Legendre nodes in u = √(1 − r) per piece
 constexpr int kTableNphi = 32;  // midpoint nodes in φ over the half disk (mirrored)
 constexpr double kCMin = 1e-4;
 constexpr double kAlphaMin = 1e-5;
@@ -70,11 +70,12 @@ double smooth_weight(double alpha) {
     return std::exp(-alpha / 0.03);
 }
 
-/// T by the visible normals of wi, n_r Gauss–Legendre nodes in r on each side of the facets'
-/// total internal reflection (η < 1: w·wm below the critical cosine; the rule splits r there per
-/// φ node, integrate_visible_split; unsplit, 64 nodes across that step at normal incidence were
-/// 1e-2 low at α = 0.3) × n_phi midpoint nodes in φ over the half disk p1 ≥ 0, whose mirror
-/// image (the normal's y → −y) gives the same integrand, wi lying in the xz plane.
+/// T by the visible normals of wi, n_r Gauss–Legendre nodes in u = √(1 − r) on each side of the
+/// facets' total internal reflection (η < 1: w·wm below the critical cosine; the rule splits the
+/// radius there per φ node, integrate_visible_split; unsplit, 32 nodes in r across that step at
+/// normal incidence were 1.4e-2 low at α = 0.3) × n_phi midpoint nodes in φ over the half disk
+/// p1 ≥ 0, whose mirror image (the normal's y → −y) gives the same integrand, wi lying in the xz
+/// plane.
 double integrate(double c, double alpha, double eta, RefractionMasking masking, int n_r,
                  int n_phi) {
     if (alpha <= 0) return 1 - fresnel_dielectric(c, eta);

@@ -800,11 +800,10 @@ class Lamina1 final : public Model {
     std::array<FgdTable::Index, 3> base_fgd_{};
     bool series_on_ = false, series_btdf_ = false, x_exact_ = false, mean_shift_ = false;
     CosineCurve<double, kNx> mu_mean_;  ///< μ̄'(μ) − μ'(μ): the transmitted light's mean shift
-    /// T(μ) of the coat from above and of the bottom from below: exact 1 − F(μ) when smooth (or
-    /// with coat-transmittance=fresnel), else the per-material curve resampled from the table.
-    /// T(μ) of one interface from the table (directional-transmittance) or 1 − F(μ) (smooth, or
-    /// coat-transmittance=fresnel), tabulated with its edge at the critical cosine (none: 0) on a
-    /// node, where a nearly smooth interface's T rises steeply.
+    /// T(μ) of one interface (the coat from above or inside, the bottom from below or inside):
+    /// exact 1 − F(μ) when smooth (or with coat-transmittance=fresnel), else the per-material
+    /// curve resampled from the table with its edge at the critical cosine (none: 0) on a node,
+    /// where a nearly smooth interface's T rises steeply.
     struct Transmittance {
         EdgeCurve<kNmu> curve;
         double eta = 1;

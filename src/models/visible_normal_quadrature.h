@@ -1,9 +1,9 @@
 #pragma once
 // Quadrature over the normals visible from a direction (Heitz 2018, "Sampling the GGX distribution
 // of visible normals", JCGT 7(4)) for integrands that step where the facet's outgoing direction
-// crosses a cosine (total internal reflection, the edge of a coat's exit cone): the r axis of
-// Heitz's sampling disk is split at the step per φ node, each piece integrated by Gauss–Legendre.
-// Used by the per-material curves of lamina-1 and the coat transmittance table.
+// crosses a cosine (total internal reflection, the edge of a coat's exit cone): the radius of
+// Heitz's sampling disk is split at the steps per φ node, each piece integrated by Gauss–Legendre
+// in u = √(1 − r). Used by the per-material curves of lamina-1 and the coat transmittance table.
 
 #include "core/math.h"
 #include "core/vec.h"
@@ -23,13 +23,14 @@ namespace lamina {
 /// a nonlinear function without using derivatives", Advances in Engineering Software 28(3)): the
 /// interpolation is taken only where the last three points admit a monotone quadratic, else a
 /// bisection step, so it never needs many more evaluations than bisection and, on the smooth
-/// crossings of the visible-normal rules, far fewer.
+/// crossings of the visible-normal rules, far fewer. A NaN of h counts as h ≤ 0 and its step
+/// falls back to bisection; at most 100 evaluations (bisection reaches 2^−100 of the bracket).
 template <typename H>
 double bracketed_root(H&& h, double x0, double x1, double h0, double h1, double tol) {
     // a: the newest point; a and b bracket the root; c: the point before.
     double b = x0, a = x1, c = x1, fb = h0, fa = h1, fc = h1;
     double t = 0.5;
-    for (;;) {
+    for (int evaluation = 0; evaluation < 100; ++evaluation) {
         const double xt = a + t * (b - a), ft = h(xt);
         if ((ft > 0) == (fa > 0)) {
             c = a, fc = fa;
@@ -46,8 +47,9 @@ double bracketed_root(H&& h, double x0, double x1, double h0, double h1, double 
                 ? fa / (fb - fa) * fc / (fb - fc) +
                       (c - a) / (b - a) * fa / (fc - fa) * fb / (fc - fb)
                 : 0.5;
-        t = clamp(t, t_lim, 1 - t_lim);
+        t = t == t ? clamp(t, t_lim, 1 - t_lim) : 0.5;
     }
+    return std::abs(fa) < std::abs(fb) ? a : b;
 }
 
 /// A step of an integrand over the visible normals: where outgoing_z(wm) crosses z_split.
