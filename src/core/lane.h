@@ -80,6 +80,8 @@ struct Lane<T> {
     /// The largest argument the lane's special functions take without overflow in their
     /// intermediate products (core/beta_function.h).
     static constexpr double kBetaArgumentMax = sizeof(T) == 4 ? 1e7 : 1e15;
+    /// Whether the lane holds floats (the special functions choose their method by it).
+    static constexpr bool kSinglePrecision = sizeof(T) == 4;
 };
 
 }  // namespace lamina

@@ -312,6 +312,7 @@ struct VecLane {
     static HWY_INLINE MF negate(MF m) { return hn::Not(m); }
     static HWY_INLINE bool none(MF m) { return hn::AllFalse(DF(), m); }
     static constexpr double kBetaArgumentMax = Lane<float>::kBetaArgumentMax;
+    static constexpr bool kSinglePrecision = true;
 };
 
 // fresnel.h fresnel_conductor (real-arithmetic complex Fresnel, the same template), cos θ in
