@@ -121,20 +121,26 @@ HWY_INLINE void MulHiLo32(VU a, VU b, VU& lo, VU& hi) {
     hi = hn::OddEven(hn::BitCast(du, odd), hn::BitCast(du, hn::ShiftRight<32>(even)));
 }
 
-// Philox4x32-10 (Salmon et al. 2011, §4.2; the constants of Random123's philox.h) on lanes.
-HWY_INLINE void Philox4x32(VU c[4], std::uint32_t k0, std::uint32_t k1) {
+// Philox4x32-10 (Salmon et al. 2011, §4.2; the constants of Random123's philox.h) on lanes, for
+// kN counter vectors at once: their rounds interleave, so the multiplications' latencies overlap
+// (one vector's ten rounds are one dependent chain).
+template <int kN>
+HWY_INLINE void Philox4x32(VU (&c)[kN][4], std::uint32_t k0, std::uint32_t k1) {
     const DU du;
     const VU m0 = hn::Set(du, 0xD2511F53u), m1 = hn::Set(du, 0xCD9E8D57u);
     for (int round = 0; round < 10; ++round) {
-        VU lo0, hi0, lo1, hi1;
-        MulHiLo32(m0, c[0], lo0, hi0);
-        MulHiLo32(m1, c[2], lo1, hi1);
-        const VU n0 = hn::Xor(hn::Xor(hi1, c[1]), hn::Set(du, k0));
-        const VU n2 = hn::Xor(hn::Xor(hi0, c[3]), hn::Set(du, k1));
-        c[0] = n0;
-        c[1] = lo1;
-        c[2] = n2;
-        c[3] = lo0;
+        const VU key0 = hn::Set(du, k0), key1 = hn::Set(du, k1);
+        for (int j = 0; j < kN; ++j) {
+            VU lo0, hi0, lo1, hi1;
+            MulHiLo32(m0, c[j][0], lo0, hi0);
+            MulHiLo32(m1, c[j][2], lo1, hi1);
+            const VU n0 = hn::Xor(hn::Xor(hi1, c[j][1]), key0);
+            const VU n2 = hn::Xor(hn::Xor(hi0, c[j][3]), key1);
+            c[j][0] = n0;
+            c[j][1] = lo1;
+            c[j][2] = n2;
+            c[j][3] = lo0;
+        }
         k0 += 0x9E3779B9u;  // the Weyl key schedule
         k1 += 0xBB67AE85u;
     }
@@ -143,30 +149,38 @@ HWY_INLINE void Philox4x32(VU c[4], std::uint32_t k0, std::uint32_t k1) {
 constexpr std::uint64_t kPcgMultiplier = 6364136223846793005ull;
 
 // The PCG32 generator (pcg-cpp's pcg32: 64-bit LCG state, XSH-RR output of the previous state) of
-// particle p, seeded as ParticleRng(seed, stream, p) seeds it.
+// particle p, seeded as ParticleRng(seed, stream, p) seeds it; four vectors of particles at a time.
 void SeedParticles(std::uint64_t seed, std::uint64_t stream, std::uint64_t first,
                    std::uint64_t count, std::uint64_t* state, std::uint64_t* inc) {
+    constexpr int kVectors = 4;
     const DU du;
     const std::size_t n = hn::Lanes(du);
-    HWY_ALIGN std::uint32_t idx_lo[kMaxLanes], idx_hi[kMaxLanes], out[4][kMaxLanes];
-    for (std::uint64_t base = 0; base < count; base += n) {
-        for (std::size_t l = 0; l < n; ++l) {
-            const std::uint64_t p = first + base + l;
-            idx_lo[l] = std::uint32_t(p);
-            idx_hi[l] = std::uint32_t(p >> 32);
+    HWY_ALIGN std::uint32_t idx_lo[kMaxLanes], idx_hi[kMaxLanes], out[kVectors][4][kMaxLanes];
+    for (std::uint64_t base = 0; base < count; base += kVectors * n) {
+        VU c[kVectors][4];
+        for (int j = 0; j < kVectors; ++j) {
+            for (std::size_t l = 0; l < n; ++l) {
+                const std::uint64_t p = first + base + j * n + l;
+                idx_lo[l] = std::uint32_t(p);
+                idx_hi[l] = std::uint32_t(p >> 32);
+            }
+            c[j][0] = hn::Load(du, idx_lo);
+            c[j][1] = hn::Load(du, idx_hi);
+            c[j][2] = hn::Set(du, std::uint32_t(stream));
+            c[j][3] = hn::Set(du, std::uint32_t(stream >> 32));
         }
-        VU c[4] = {hn::Load(du, idx_lo), hn::Load(du, idx_hi), hn::Set(du, std::uint32_t(stream)),
-                   hn::Set(du, std::uint32_t(stream >> 32))};
         Philox4x32(c, std::uint32_t(seed), std::uint32_t(seed >> 32));
-        for (int w = 0; w < 4; ++w)
-            hn::Store(c[w], du, out[w]);
-        for (std::size_t l = 0; l < n && base + l < count; ++l) {
-            const std::uint64_t initstate = (std::uint64_t(out[1][l]) << 32) | out[0][l];
-            const std::uint64_t sequence = (std::uint64_t(out[3][l]) << 32) | out[2][l];
-            const std::uint64_t increment = (sequence << 1) | 1u;
-            state[base + l] = (initstate + increment) * kPcgMultiplier + increment;
-            inc[base + l] = increment;
-        }
+        for (int j = 0; j < kVectors; ++j)
+            for (int w = 0; w < 4; ++w)
+                hn::Store(c[j][w], du, out[j][w]);
+        for (int j = 0; j < kVectors; ++j)
+            for (std::size_t l = 0; l < n && base + j * n + l < count; ++l) {
+                const std::uint64_t initstate = (std::uint64_t(out[j][1][l]) << 32) | out[j][0][l];
+                const std::uint64_t sequence = (std::uint64_t(out[j][3][l]) << 32) | out[j][2][l];
+                const std::uint64_t increment = (sequence << 1) | 1u;
+                state[base + j * n + l] = (initstate + increment) * kPcgMultiplier + increment;
+                inc[base + j * n + l] = increment;
+            }
     }
 }
 
@@ -376,6 +390,17 @@ HWY_INLINE MF LaneIs(VI v, std::int32_t value) {
     return hn::RebindMask(df, hn::Eq(v, hn::Set(di, value)));
 }
 
+// Bit l set where lane l of m holds.
+HWY_INLINE std::uint64_t MaskBits(MF m) {
+    const DF df;
+    std::uint8_t bytes[(kMaxLanes + 7) / 8] = {};
+    hn::StoreMaskBits(df, m, bytes);
+    std::uint64_t bits = 0;
+    for (std::size_t i = 0; i < (hn::Lanes(df) + 7) / 8; ++i)
+        bits |= std::uint64_t(bytes[i]) << (8 * i);
+    return bits;
+}
+
 // ---- Interface events (goniophotometer.cpp trace_particle, `apply`) ----------------------------
 
 // A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
@@ -512,36 +537,86 @@ HWY_INLINE void ScatteringStep(const CompiledMedium<float>& med, MF m, LaneVecto
     v.in_medium = hn::IfThenElseZero(hn::Not(leave_i), v.in_medium);
 }
 
-// ---- Binning: first guesses on vectors, the grid's rule per exit ------------------------------
+// ---- Binning: on vectors where provably the grid's bin, else the grid's rule per exit ---------
 
-// A first guess of acos(x), x ∈ [−1, 1], within 10^-4 rad: Abramowitz & Stegun 1964, Eq. 4.4.45
-// (|ε| ≤ 5·10^-5 on [0, 1]) with acos(−x) = π − acos(x). Only a guess: HemisphereGrid::bin_of
-// corrects it against the exact edges, so its error only costs refinement steps, never a wrong
-// bin.
-HWY_INLINE VF AcosGuess(VF x) {
+// acos(x), x ∈ [−1, 1]: Abramowitz & Stegun 1964, Eq. 4.4.46 (|ε| ≤ 2·10^-8 on [0, 1]) with
+// acos(−x) = π − acos(x). In float its error is that of the rounding, at most 4.3e-7 rad
+// (measured on 4·10^6 points of [−1, 1] against the double acos; the float operations bound it by
+// about 5e-7: ulp-level square root, polynomial and product, π − r rounded once).
+constexpr double kAcosErrorBound = 5e-7;
+HWY_INLINE VF Acos(VF x) {
     const DF df;
     const VF a = hn::Abs(x);
-    VF p = hn::MulAdd(hn::Set(df, -0.0187293f), a, hn::Set(df, 0.0742610f));
-    p = hn::MulAdd(p, a, hn::Set(df, -0.2121144f));
-    p = hn::MulAdd(p, a, hn::Set(df, 1.5707288f));
+    VF p = hn::MulAdd(hn::Set(df, -0.0012624911f), a, hn::Set(df, 0.0066700901f));
+    p = hn::MulAdd(p, a, hn::Set(df, -0.0170881256f));
+    p = hn::MulAdd(p, a, hn::Set(df, 0.0308918810f));
+    p = hn::MulAdd(p, a, hn::Set(df, -0.0501743046f));
+    p = hn::MulAdd(p, a, hn::Set(df, 0.0889789874f));
+    p = hn::MulAdd(p, a, hn::Set(df, -0.2145988016f));
+    p = hn::MulAdd(p, a, hn::Set(df, 1.5707963050f));
     const VF r = hn::Mul(hn::Sqrt(hn::ZeroIfNegative(hn::Sub(hn::Set(df, 1.f), a))), p);
     return hn::IfThenElse(hn::Lt(x, hn::Zero(df)), hn::Sub(hn::Set(df, kPi<float>), r), r);
 }
 
-// Guesses of the θ and φ bins of the lanes' directions (the bins are uniform in angle).
-HWY_INLINE void BinGuesses(const V3& d, int n_theta, int n_phi, std::int32_t* theta_guess,
-                           std::int32_t* phi_guess) {
+// The grid's bins on vectors. HemisphereGrid::bin_of's rule puts x = cos θ (or the folded cos φ,
+// x/r in double) in bin b when edge[b] ≥ x > edge[b + 1], edge[b] = cos(b Δ): the bin of the
+// angle acos(x), floor(acos(x)/Δ) clamped to [0, n − 1], wherever acos(x) is not within the edges'
+// double rounding (~1e-16) of a multiple of Δ. The lanes compute the angle in float, t = Acos(x)/Δ
+// in bins, with an error below η bins; where t − η and t + η fall in the same bin, that bin is
+// bin_of's. The error bound η:
+//   θ: x = min(|z|, 1) is bin_of's own; Acos's kAcosErrorBound, and t's own rounding (n ulps);
+//   φ: x/r in float is within 3 float ulps (2e-7) of bin_of's double x/r, which moves the angle
+//      by 2e-7 / sin φ, and at an inner edge sin φ ≥ sin Δφ; the rest as for θ.
+// Both get a factor of 4 of safety. A lane whose bin is not certain (in practice 1 exit in 10³ on
+// the default grid) or whose r is below 1e-15 (x² + y² subnormal; bin_of's r = 0 is bin 0) takes
+// bin_of itself; tests/simulator/kernel_simd_test.cpp checks the lanes against bin_of at and near
+// every edge of several grids.
+struct VectorBins {
+    int n_theta, n_phi;
+    float to_theta, to_phi;    // bins per radian
+    float eta_theta, eta_phi;  // the error bounds, in bins
+    explicit VectorBins(const HemisphereGrid& grid)
+        : n_theta(grid.n_theta()),
+          n_phi(grid.n_phi()),
+          to_theta(float(grid.n_theta() / (0.5 * kPi<double>))),
+          to_phi(float(grid.n_phi() / kPi<double>)) {
+        const double ulp = 0x1p-23;  // a float's relative spacing, at most
+        const double d_phi = kPi<double> / n_phi;
+        eta_theta = float(4 * (kAcosErrorBound * to_theta + n_theta * ulp));
+        eta_phi = float(
+            4 * ((kAcosErrorBound + 2e-7 / std::sin(std::min(d_phi, kPi<double> / 2))) * to_phi +
+                 n_phi * ulp));
+    }
+};
+
+// The θ and φ bins of the lanes' directions d (unit vectors), stored per lane; bit l of the
+// result is set where lane l's pair is certainly bin_of's (VectorBins says when).
+HWY_INLINE std::uint64_t LaneBins(const VectorBins& g, const V3& d, std::int32_t* theta_bin,
+                                  std::int32_t* phi_bin) {
     const DF df;
     const DI di;
-    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
+    const VF one = hn::Set(df, 1.f);
     const VF cos_theta = hn::Min(hn::Abs(d.z), one);
     const VF r = hn::Sqrt(hn::MulAdd(d.x, d.x, hn::Mul(d.y, d.y)));
-    const VF cos_phi = hn::Min(
-        hn::Max(hn::Div(d.x, hn::IfThenElse(hn::Gt(r, zero), r, one)), hn::Set(df, -1.f)), one);
-    const VF to_theta_bin = hn::Set(df, float(n_theta) / (0.5f * kPi<float>));
-    const VF to_phi_bin = hn::Set(df, float(n_phi) / kPi<float>);
-    hn::Store(hn::ConvertTo(di, hn::Mul(AcosGuess(cos_theta), to_theta_bin)), di, theta_guess);
-    hn::Store(hn::ConvertTo(di, hn::Mul(AcosGuess(cos_phi), to_phi_bin)), di, phi_guess);
+    const MF resolved = hn::Gt(r, hn::Set(df, 1e-15f));
+    const VF cos_phi =
+        hn::Min(hn::Max(hn::Div(d.x, hn::IfThenElse(resolved, r, one)), hn::Set(df, -1.f)), one);
+    // The bin of t − η and whether t + η shares it; truncation is the floor here (t ≥ 0), and
+    // a negative t − η is clamped to bin 0 as floor would be.
+    auto bin = [&](VF t, float eta, int n, std::int32_t* out) {
+        const VI last = hn::Set(di, n - 1);
+        const VI lo =
+            hn::Min(hn::Max(hn::ConvertTo(di, hn::Sub(t, hn::Set(df, eta))), hn::Zero(di)), last);
+        const VI hi =
+            hn::Min(hn::Max(hn::ConvertTo(di, hn::Add(t, hn::Set(df, eta))), hn::Zero(di)), last);
+        hn::Store(lo, di, out);
+        return hn::RebindMask(df, hn::Eq(lo, hi));
+    };
+    const MF theta_known =
+        bin(hn::Mul(Acos(cos_theta), hn::Set(df, g.to_theta)), g.eta_theta, g.n_theta, theta_bin);
+    const MF phi_known =
+        bin(hn::Mul(Acos(cos_phi), hn::Set(df, g.to_phi)), g.eta_phi, g.n_phi, phi_bin);
+    return MaskBits(hn::And(resolved, hn::And(theta_known, phi_known)));
 }
 
 // ---- The block ----
@@ -771,7 +846,8 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     // order; on_lane(l) then runs for every ended lane, in lane order ----
     HWY_ALIGN std::int32_t finish[kMaxLanes];
     HWY_ALIGN float w_out[3][kMaxLanes];
-    HWY_ALIGN std::int32_t theta_guess[kMaxLanes], phi_guess[kMaxLanes];
+    HWY_ALIGN std::int32_t theta_bin[kMaxLanes], phi_bin[kMaxLanes];
+    const VectorBins vector_bins(grid);
     HWY_ALIGN float d_out[3][kMaxLanes];
     auto end_particles = [&](LaneVectors& v, MF ended, auto&& on_lane) {
         const MF reflected = LaneIs(v.finish, kReflected);
@@ -791,28 +867,30 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             hn::Add(v.events_done, hn::IfThenElseZero(hn::RebindMask(di, ended), v.events));
         const MF exits = hn::Or(reflected, transmitted);
         hn::Store(v.finish, di, finish);
+        std::uint64_t known_bins = 0;
         if (!hn::AllFalse(df, exits)) {
-            BinGuesses(v.d, grid.n_theta(), grid.n_phi(), theta_guess, phi_guess);
-            hn::Store(v.d.x, df, d_out[0]);
-            hn::Store(v.d.y, df, d_out[1]);
-            hn::Store(v.d.z, df, d_out[2]);
+            known_bins = LaneBins(vector_bins, v.d, theta_bin, phi_bin);
+            if ((MaskBits(exits) & ~known_bins) != 0) {
+                hn::Store(v.d.x, df, d_out[0]);
+                hn::Store(v.d.y, df, d_out[1]);
+                hn::Store(v.d.z, df, d_out[2]);
+            }
             for (int c = 0; c < 3; ++c)
                 hn::Store(v.w[c], df, w_out[c]);
         }
         // Over the set bits of the mask: which lanes ended is random, a branch per lane would be
         // mispredicted half of the time.
-        std::uint8_t mask_bytes[(kMaxLanes + 7) / 8] = {};
-        hn::StoreMaskBits(df, ended, mask_bytes);
-        std::uint64_t ended_bits = 0;
-        for (std::size_t i = 0; i < (n_lanes + 7) / 8; ++i)
-            ended_bits |= std::uint64_t(mask_bytes[i]) << (8 * i);
-        for (; ended_bits != 0; ended_bits &= ended_bits - 1) {
+        for (std::uint64_t ended_bits = MaskBits(ended); ended_bits != 0;
+             ended_bits &= ended_bits - 1) {
             const std::size_t l = std::size_t(std::countr_zero(ended_bits));
             const std::int32_t why = finish[l];
             if (why != kEnded) {
                 const Rgbf w(w_out[0][l], w_out[1][l], w_out[2][l]);
-                const std::size_t bin = grid.bin_of(Vec3f(d_out[0][l], d_out[1][l], d_out[2][l]),
-                                                    theta_guess[l], phi_guess[l]);
+                const std::size_t bin =
+                    (known_bins >> l & 1) != 0
+                        ? std::size_t(theta_bin[l]) * std::size_t(vector_bins.n_phi) +
+                              std::size_t(phi_bin[l])
+                        : grid.bin_of(Vec3f(d_out[0][l], d_out[1][l], d_out[2][l]));
                 tally.exit((why == kTransmitted ? grid.size() : 0) + bin, w);
             }
             on_lane(l);
@@ -861,12 +939,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             hn::Store(p.k, di, qk);
             hn::Store(p.in_medium, di, qin);
             hn::Store(p.events, di, qevents);
-            std::uint8_t mask_bytes[(kMaxLanes + 7) / 8] = {};
-            hn::StoreMaskBits(df, waits, mask_bytes);
-            std::uint64_t bits = 0;
-            for (std::size_t i = 0; i < (n_lanes + 7) / 8; ++i)
-                bits |= std::uint64_t(mask_bytes[i]) << (8 * i);
-            for (; bits != 0; bits &= bits - 1) {
+            for (std::uint64_t bits = MaskBits(waits); bits != 0; bits &= bits - 1) {
                 const std::size_t l = std::size_t(std::countr_zero(bits));
                 queue.push_back({{qd[0][l], qd[1][l], qd[2][l]},
                                  {qw[0][l], qw[1][l], qw[2][l]},
@@ -1050,6 +1123,26 @@ void SmithRefractionEscapeForTest(const float* r_i, const float* r_o, std::size_
                   res);
         for (std::size_t l = 0; l < n_lanes && base + l < n; ++l)
             out[base + l] = res[l];
+    }
+}
+
+void LaneBinsForTest(const HemisphereGrid& grid, const float* d, std::size_t n,
+                     std::int64_t* bins) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    const VectorBins g(grid);
+    HWY_ALIGN float in[3][kMaxLanes];
+    HWY_ALIGN std::int32_t theta_bin[kMaxLanes], phi_bin[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l)
+            for (int i = 0; i < 3; ++i)
+                in[i][l] = base + l < n ? d[3 * (base + l) + i] : (i == 2 ? 1.f : 0.f);
+        const std::uint64_t known =
+            LaneBins(g, V3{hn::Load(df, in[0]), hn::Load(df, in[1]), hn::Load(df, in[2])},
+                     theta_bin, phi_bin);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l)
+            bins[base + l] =
+                (known >> l & 1) != 0 ? std::int64_t(theta_bin[l]) * g.n_phi + phi_bin[l] : -1;
     }
 }
 
@@ -1325,6 +1418,7 @@ HWY_EXPORT(TraceBlockSimd);
 HWY_EXPORT(PcgDrawsForTest);
 HWY_EXPORT(CosSin2PiForTest);
 HWY_EXPORT(SmithRefractionEscapeForTest);
+HWY_EXPORT(LaneBinsForTest);
 HWY_EXPORT(FresnelDielectricForTest);
 HWY_EXPORT(FresnelConductorForTest);
 HWY_EXPORT(HenyeyGreensteinForTest);
@@ -1380,6 +1474,13 @@ void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::v
     c.resize(u.size());
     s.resize(u.size());
     HWY_DYNAMIC_DISPATCH(CosSin2PiForTest)(u.data(), u.size(), c.data(), s.data());
+}
+
+std::vector<std::int64_t> simd_lane_bins(const HemisphereGrid& grid, const std::vector<float>& d) {
+    select_simd_target();
+    std::vector<std::int64_t> bins(d.size() / 3);
+    HWY_DYNAMIC_DISPATCH(LaneBinsForTest)(grid, d.data(), bins.size(), bins.data());
+    return bins;
 }
 
 std::vector<float> simd_smith_refraction_escape(const std::vector<float>& r_i,

@@ -21,6 +21,10 @@ std::vector<float> simd_particle_uniforms(std::uint64_t seed, std::uint64_t stre
 /// For tests: the kernel's azimuth cos(2πu), sin(2πu) for u in [0, 1).
 void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::vector<float>& s);
 
+/// For tests: the exit bins the SIMD kernel computes on the dispatched instruction set's vectors
+/// (d: 3 floats per unit direction), or −1 where it leaves the bin to HemisphereGrid::bin_of.
+std::vector<std::int64_t> simd_lane_bins(const HemisphereGrid& grid, const std::vector<float>& d);
+
 /// For tests: physics/microfacet.h smith_refraction_escape(r_i[j], r_o[j]) instantiated on the
 /// dispatched instruction set's vectors (the lane test compares it with the scalar instantiation).
 std::vector<float> simd_smith_refraction_escape(const std::vector<float>& r_i,
