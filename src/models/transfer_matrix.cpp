@@ -85,6 +85,30 @@ Rgbd max_of(const Rgbd& a, const Rgbd& b) {
     return {std::max(a[0], b[0]), std::max(a[1], b[1]), std::max(a[2], b[2])};
 }
 
+/// A cumulative reflectance (or transmittance) of a passive stack, per channel in [floor, 1]:
+/// where the transfer matrices lose their precision (a transmission near kTinyT, when the mean
+/// direction meets an interface just short of total reflection) their products can give any
+/// value, 10⁷ or ∞ − ∞ (fuzz seed 1213, a coat whose refracted grazing light meets a lower
+/// interface at its critical angle). A value that is not finite keeps `floor`: the light went
+/// where the components above sent it.
+Rgbd passive_fraction(const Rgbd& x, const Rgbd& floor) {
+    Rgbd out;
+    for (int c = 0; c < 3; ++c)
+        out[c] =
+            std::isfinite(x[c]) ? std::clamp(x[c], floor[c], std::max(floor[c], 1.0)) : floor[c];
+    return out;
+}
+
+/// The g-weighted part of the same: a value that is not finite keeps `floor` (the value above).
+/// Finite values pass: set_asymmetry caps the ratio g at 1, and a g at or below 0.2 takes the
+/// roughness floor.
+Rgbd weighted_fraction(const Rgbd& x, const Rgbd& floor) {
+    Rgbd out;
+    for (int c = 0; c < 3; ++c)
+        out[c] = std::isfinite(x[c]) ? x[c] : floor[c];
+    return out;
+}
+
 Rgbd max_rgb(const Rgbd& x, double lo) {
     return {std::max(x[0], lo), std::max(x[1], lo), std::max(x[2], lo)};
 }
@@ -448,6 +472,8 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
             opaque_end = true;
         }
         for (int fam = 0; fam < kFamilies; ++fam) {
+            R[fam] = passive_fraction(R[fam], e_above[fam]);
+            Rg[fam] = weighted_fraction(Rg[fam], g_above[fam]);
             // Clamped at 0 (as the released tm6 does): where a channel is absorbed the difference
             // is 0 up to rounding (≈ −1e−17 otherwise).
             const Rgbd energy = max_of(R[fam] - e_above[fam], Rgbd(0.0));
@@ -470,8 +496,8 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
     if constexpr (!kSix) {
         if (ch.slab && !opaque_end) {
             out.transmits = true;
-            out.transmitted.energy = max_of(E.transmittance(), Rgbd(0.0));
-            set_asymmetry(out.transmitted, G.transmittance(), ch);
+            out.transmitted.energy = passive_fraction(E.transmittance(), Rgbd(0.0));
+            set_asymmetry(out.transmitted, weighted_fraction(G.transmittance(), Rgbd(0.0)), ch);
             out.transmitted.delta = smooth;
             out.transmitted.scale = out.transmitted.energy;
             out.cos_t = c;

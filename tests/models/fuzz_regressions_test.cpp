@@ -236,5 +236,30 @@ TEST(FuzzRegressions, Tm6SixFluxOverAPerfectMirror) {
         }
 }
 
+// Seed 1213, case 4445: tm2 on twelve dielectric interfaces (η up to 5, a medium of optical depth
+// 60) lit at (or within 1e-8 of) grazing incidence: NaN, and +∞ in transmission. The light the
+// coat refracts meets the η = 1 interface below at its critical angle; its transmission ~1e-12
+// broke the transfer matrices (a lobe of energy 1.8e7 at 89.999°). Cumulative reflectances are now
+// kept within [what the interfaces above reflect, 1] (transfer_matrix.cpp passive_fraction).
+TEST(FuzzRegressions, Tm2TwelveInterfacesAtGrazingIncidence) {
+    const Stack stack = parse_stack(
+        R"({"layers": [{"interface": {"type": "dielectric", "eta": 1, "alpha": 0.0001}, "medium": {"g": -0}}, {"interface": {"type": "dielectric", "eta": 4.6161493848612265, "alpha": 0.2255988002766874}, "medium": {"tau_a": 0, "g": -0}}, {"interface": {"type": "dielectric", "eta": 2.9879134927823867, "alpha": 0.00010000000099990001}, "medium": {"tau_a": 60.03567401669637, "g": [-0.933399695583531, -2.2250738585072014e-308, -0.5849484125376706]}}, {"interface": {"type": "dielectric", "eta": 1.046096150667572, "alpha": 0.0008369377252562437}}, {"interface": {"type": "dielectric", "eta": 1.0000000000000002, "alpha": 0.00010000000099990001}}, {"interface": {"type": "dielectric", "eta": 1.3912453387012282, "alpha": 0.532849251839036}}, {"interface": {"type": "dielectric", "eta": 1, "alpha": 0.0001}}, {"interface": {"type": "dielectric", "eta": 5, "alpha": 0.9999999999999999}, "medium": {"tau_a": -0.0, "g": [-0.35138665763003374, 0.5673215002316124, 9.790366857011927e-08]}}, {"interface": {"type": "dielectric", "eta": 1.000000000004, "alpha": 0.00014024484678585813}}, {"interface": {"type": "dielectric", "eta": 4.999999999999999, "alpha": -0}}, {"interface": {"type": "dielectric", "eta": 4.56308463685104, "alpha": 0}}, {"interface": {"type": "dielectric", "eta": 4.5048449596442754, "alpha": 0}}]})",
+        "fuzz-1213-4445");
+    const auto model =
+        make_model("tm2", stack,
+                   {"top=released", "upward-fgd=same-cosine", "tir=on", "asymmetry=per-channel"});
+    for (double cos_i : {6.123233995736766e-17, 1e-8, 0.1}) {
+        const Vec3d wi(std::sqrt(1 - cos_i * cos_i), 0, cos_i);
+        for (const Vec3d& wo : {Vec3d(-wi.x, 0, wi.z), Vec3d(0, 0, 1), Vec3d(0, 0, -1),
+                                Vec3d(-0.8475671868812198, -0.5306881039954217, 1e-20),
+                                Vec3d(-0.8475671868812198, -0.5306881039954217, -1e-300)}) {
+            expect_good(model->eval(wi, wo), "tm2");
+            expect_good(model->prepare(wi)->eval(wo), "tm2 prepared");
+            const double pdf = model->pdf(wi, wo);
+            EXPECT_TRUE(std::isfinite(pdf) && pdf >= 0) << "pdf " << pdf;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace lamina
