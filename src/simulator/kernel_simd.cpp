@@ -565,8 +565,10 @@ HWY_INLINE VF Acos(VF x) {
 // in bins, with an error below η bins; where t − η and t + η fall in the same bin, that bin is
 // bin_of's. The error bound η:
 //   θ: x = min(|z|, 1) is bin_of's own; Acos's kAcosErrorBound, and t's own rounding (n ulps);
-//   φ: x/r in float is within 3 float ulps (2e-7) of bin_of's double x/r, which moves the angle
-//      by 2e-7 / sin φ, and at an inner edge sin φ ≥ sin Δφ; the rest as for θ.
+//   φ: x/r in float is within 2^-23 ≈ 1.2e-7 of bin_of's double x/r (two roundings in x² + y²,
+//      halved by the square root, one in the square root and one in the quotient; 2e-7 is
+//      used). To land more than η beyond an edge φe the float angle must move the cosine by at
+//      least sin φe · η Δφ, and an inner edge has sin φe ≥ sin Δφ; the rest as for θ.
 // Both get a factor of 4 of safety. A lane whose bin is not certain (in practice 1 exit in 10³ on
 // the default grid) or whose r is below 1e-15 (x² + y² subnormal; bin_of's r = 0 is bin 0) takes
 // bin_of itself; tests/simulator/kernel_simd_test.cpp checks the lanes against bin_of at and near
