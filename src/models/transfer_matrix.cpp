@@ -397,9 +397,20 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
     bool opaque_end = false;
     Factors medium_below;  // six fluxes: the medium under an interface, computed there
     bool have_medium_below = false;
+    // Two fluxes: the product of the downward transmissions along the mean path. Once it is below
+    // kTinyT in every channel the components deeper down return less than kTinyT² of the light,
+    // and the matrices, which divide by these transmissions, would only add rounding noise of any
+    // size (fuzz seed 1213: a medium of optical depth 60 seen at grazing, a lobe of energy 1.8e7):
+    // the stack ends there, as at an opaque component. (Six fluxes: the scattered light is not
+    // bounded by the primary transmission, so the scheme goes on.)
+    Rgbd t_down(1.0);
     for (int i = 0; i < n; ++i) {
         const TmComponent& k = comps[i];
         if (index_matched(k)) continue;  // no component at all
+        if (!kSix && t_down.max() < kTinyT) {
+            opaque_end = true;
+            break;
+        }
         Factors x;
         std::array<Rgbd, kFamilies> R, Rg;
         double g_T_next = g_T, g_sT_next = g_sT;
@@ -416,6 +427,7 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
                 Rg = G.reflectances_over(Rgbd(0.0));
             } else {
                 absorbing_factors(k, c, x);
+                t_down = t_down * x.p.t;
                 E = E * energy_matrix(x.p);
                 G = G * asymmetry_matrix(x.p, weight);
                 continue;
@@ -455,6 +467,7 @@ TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmCho
                 R = E.reflectances_over(Rgbd(0.0));
                 Rg = G.reflectances_over(Rgbd(0.0));
             } else {
+                t_down = t_down * x.p.t;
                 E = E * energy_matrix(x.p);
                 G = G * asymmetry_matrix(x.p, weight);
                 R[0] = E.reflectance_over(Rgbd(0.0));

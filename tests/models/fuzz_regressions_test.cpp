@@ -239,8 +239,11 @@ TEST(FuzzRegressions, Tm6SixFluxOverAPerfectMirror) {
 // Seed 1213, case 4445: tm2 on twelve dielectric interfaces (η up to 5, a medium of optical depth
 // 60) lit at (or within 1e-8 of) grazing incidence: NaN, and +∞ in transmission. The light the
 // coat refracts meets the η = 1 interface below at its critical angle; its transmission ~1e-12
-// broke the transfer matrices (a lobe of energy 1.8e7 at 89.999°). Cumulative reflectances are now
-// kept within [what the interfaces above reflect, 1] (transfer_matrix.cpp passive_fraction).
+// and the depth-60 medium seen at grazing (transmission e^−45 at the path cap) broke the transfer
+// matrices (a lobe of energy 1.8e7 at 89.999°). The two-flux scheme now ends the stack where the
+// downward transmission falls below 1e-12 (transfer_matrix.cpp run_scheme), and cumulative
+// reflectances are kept within [what the interfaces above reflect, 1] (passive_fraction). A
+// clamp alone was finite but not right: it gave 0.146 at 89.995° against the limit 0.0578.
 TEST(FuzzRegressions, Tm2TwelveInterfacesAtGrazingIncidence) {
     const Stack stack = parse_stack(
         R"({"layers": [{"interface": {"type": "dielectric", "eta": 1, "alpha": 0.0001}, "medium": {"g": -0}}, {"interface": {"type": "dielectric", "eta": 4.6161493848612265, "alpha": 0.2255988002766874}, "medium": {"tau_a": 0, "g": -0}}, {"interface": {"type": "dielectric", "eta": 2.9879134927823867, "alpha": 0.00010000000099990001}, "medium": {"tau_a": 60.03567401669637, "g": [-0.933399695583531, -2.2250738585072014e-308, -0.5849484125376706]}}, {"interface": {"type": "dielectric", "eta": 1.046096150667572, "alpha": 0.0008369377252562437}}, {"interface": {"type": "dielectric", "eta": 1.0000000000000002, "alpha": 0.00010000000099990001}}, {"interface": {"type": "dielectric", "eta": 1.3912453387012282, "alpha": 0.532849251839036}}, {"interface": {"type": "dielectric", "eta": 1, "alpha": 0.0001}}, {"interface": {"type": "dielectric", "eta": 5, "alpha": 0.9999999999999999}, "medium": {"tau_a": -0.0, "g": [-0.35138665763003374, 0.5673215002316124, 9.790366857011927e-08]}}, {"interface": {"type": "dielectric", "eta": 1.000000000004, "alpha": 0.00014024484678585813}}, {"interface": {"type": "dielectric", "eta": 4.999999999999999, "alpha": -0}}, {"interface": {"type": "dielectric", "eta": 4.56308463685104, "alpha": 0}}, {"interface": {"type": "dielectric", "eta": 4.5048449596442754, "alpha": 0}}]})",
@@ -259,6 +262,12 @@ TEST(FuzzRegressions, Tm2TwelveInterfacesAtGrazingIncidence) {
             EXPECT_TRUE(std::isfinite(pdf) && pdf >= 0) << "pdf " << pdf;
         }
     }
+    // Toward grazing the value seen from the normal has a limit (0.0578 from 89° on; before the
+    // fix it jumped to 4.8e7 at 89.999°): within 1 % of it at every incidence closer than 89.99°.
+    const double limit = model->eval(dir(89.99, 0), Vec3d(0, 0, 1))[0];
+    for (double theta_i : {89.999, 89.9999, 89.9999999})
+        EXPECT_NEAR(model->eval(dir(theta_i, 0), Vec3d(0, 0, 1))[0], limit, 0.01 * limit)
+            << theta_i;
 }
 
 }  // namespace

@@ -55,10 +55,11 @@ TEST(KernelSimd, RunsOnTheRequestedInstructionSet) {
 // template): its instantiation on the dispatched instruction set's vectors (ctest runs this on
 // every compiled set through LAMINA_SIMD_TARGET) against the scalar float instantiation and the
 // double one, on random roots r = 1 + 2Λ from 1 to 1e4 (log-uniform) and the edges: r = 1 (the
-// normal), huge and infinite r (grazing). The result is in [0, 1]; the float formula's exponent is
-// a sum of terms up to ~50 in size that cancel, so its error is absolute, a few ulp of those terms
-// (core/beta_function.h): vector and scalar float agree to 2e-5, and both are within 2e-5 of the
-// double instantiation at the same arguments (beyond the float bound on 1 + Λ, 1e7, both are
+// normal), huge and infinite r (grazing); both of the float methods run (the Gamma functions for
+// 1 + Λ ≤ 3, r ≤ 5, and Stirling's series beyond). The result is in [0, 1]; the series' exponent
+// is a sum of terms up to ~50 in size that cancel, so its error is absolute, a few ulp of those
+// terms (core/beta_function.h): vector and scalar float agree to 2e-5, and both are within 2e-5 of
+// the double instantiation at the same arguments (beyond the float bound on 1 + Λ, 1e7, both are
 // evaluated at the bound: the double reference is given the bounded arguments).
 TEST(KernelSimd, SmithRefractionEscapeLanes) {
     ParticleRng rng(17, 0, 0);
