@@ -49,20 +49,6 @@ class HemisphereGrid {
                std::size_t(phi_bin(double(w.x), double(w.y)));
     }
 
-    /// The same bin from first guesses of its θ and φ bins (any ints: clamped to the grid), e.g.
-    /// the SIMD kernel's, from an approximate acos on vectors: corrected against the same exact
-    /// edges, so the same bin as bin_of whatever the guesses (a poor guess costs steps only).
-    template <typename T>
-    std::size_t bin_of(const Vec3<T>& w, int theta_guess, int phi_guess) const {
-        const double cos_theta = std::min(double(std::abs(w.z)), 1.0);
-        const int b_theta = refine_bin(cos_theta, theta_guess, cos_theta_edge_);
-        const double x = double(w.x), y = double(w.y);
-        const double r = std::sqrt(x * x + y * y);
-        const int b_phi =
-            r == 0 ? 0 : refine_bin(std::clamp(x / r, -1.0, 1.0), phi_guess, cos_phi_edge_);
-        return std::size_t(b_theta) * std::size_t(n_phi_) + std::size_t(b_phi);
-    }
-
     /// The grid's rule: the bin of x among the decreasing edges (bin b holds edge[b] ≥ x >
     /// edge[b + 1], the last bin also its lower edge), from any first guess b.
     static int refine_bin(double x, int b, const std::vector<double>& edges) {
