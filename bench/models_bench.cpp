@@ -3,11 +3,11 @@
 // all OpenMP threads).
 #include "core/rng.h"
 #include "core/spherical.h"
-#include "models/binned.h"
-#include "models/coat_transmittance.h"
-#include "models/fgd_table.h"
+#include "models/numerics/binned.h"
 #include "models/registry.h"
-#include "models/tir_table.h"
+#include "models/tables/coat_transmittance.h"
+#include "models/tables/fgd_table.h"
+#include "models/tables/tir_table.h"
 
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -103,7 +103,7 @@ std::string bench_stack_name(const std::string& name) {
 void warm_tables() {
     FgdTable::get();
     TirTable::get();
-    CoatTransmittanceTable::get(RefractionMasking::SmithBeta);
+    CoatTransmittanceTable::get(TransmissionMasking::Smith);
 }
 
 /// Model::eval(wi, wo) for random pairs (the forward Belcour variants redo their lobe statistics

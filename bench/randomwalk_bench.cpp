@@ -38,9 +38,9 @@ Stack bench_stack(bool coat) {
 
 // range(0): 1 = coat over gold, 0 = rough dielectric alone; range(1): 1 = multiple scattering.
 void BM_RandomWalkEvalOnce(benchmark::State& state) {
-    const RandomWalkStack rw(bench_stack(state.range(0) == 1), 10'000, TransmissionMasking::Smith,
-                             state.range(1) == 1 ? RandomWalkStack::Microsurface::Multiple
-                                                 : RandomWalkStack::Microsurface::Single);
+    const RandomWalkStack rw(
+        bench_stack(state.range(0) == 1),
+        {.microsurface = state.range(1) == 1 ? Microsurface::Multiple : Microsurface::Single});
     const Vec3d wi = incident_direction(0.6), wo = direction_from_angles(0.8, 2.6);
     std::uint64_t i = 0;
     Rgbd sum(0.0);

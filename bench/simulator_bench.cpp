@@ -44,7 +44,7 @@ Stack bench_metallic_paint() {
 void run(benchmark::State& state, const Stack& stack,
          Microsurface microsurface = Microsurface::Single) {
     SimulationSettings s;
-    s.microsurface = microsurface;
+    s.transport.microsurface = microsurface;
     s.theta_i_deg = {30.0};
     s.particles = 1'000'000;
     s.threads = int(state.range(0));

@@ -8,8 +8,8 @@
 #include "core/math.h"
 #include "core/spherical.h"
 #include "layers/stack.h"
-#include "models/binned.h"
-#include "models/random_walk_model.h"
+#include "models/numerics/binned.h"
+#include "models/random_walk/random_walk_model.h"
 #include "models/registry.h"
 
 #include <fmt/format.h>
@@ -27,7 +27,8 @@ namespace lamina::cli {
 namespace {
 
 struct EvalArgs {
-    std::string model, stack, theta_i, directions, out, grid = "90x90", side = "R";
+    std::string model, stack, theta_i, directions, out, grid = HemisphereGrid{}.to_string(),
+                                                        side = "R";
     double theta_o = std::nan(""), phi_o = std::nan("");
     bool binned = false, pdf = false;
     std::vector<std::string> options;
@@ -210,7 +211,7 @@ Runner add_eval(CLI::App& app) {
                     "CSV of directions: header theta_i,theta_o,phi_o,side");
     cmd->add_flag("--binned", a->binned,
                   "Cos-weighted bin averages in the goniophotometer's brdf.csv format");
-    cmd->add_option("--grid", a->grid, "Bins for --binned, NTHETAxNPHI (default 90x90)");
+    cmd->add_option("--grid", a->grid, "Bins for --binned, NTHETAxNPHI")->capture_default_str();
     cmd->add_option("--out", a->out, "Output CSV (written atomically)");
     cmd->add_option("--samples", a->samples,
                     "random-walk: walks per query (default: its samples option, 1024); a point "

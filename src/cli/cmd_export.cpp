@@ -13,7 +13,7 @@
 #include "export/rgl_bsdf.h"
 #include "lamina/version.h"
 #include "layers/stack.h"
-#include "models/binned.h"
+#include "models/numerics/binned.h"
 #include "models/registry.h"
 
 #include <fmt/format.h>

@@ -1,10 +1,11 @@
 // lamina render: a sphere of a stack rendered with a model or the random-walk reference, or the
 // comparison sheet of every supporting model (docs/rendering.md).
 #include "cli/commands.h"
+#include "cli/settings_options.h"
 #include "core/error.h"
 #include "layers/stack.h"
+#include "models/random_walk/random_walk_model.h"
 #include "models/registry.h"
-#include "physics/microfacet.h"
 #include "render/contact_sheet.h"
 #include "render/renderer.h"
 
@@ -22,8 +23,8 @@ namespace {
 
 struct RenderArgs {
     std::string stack, model = "random-walk", env = "studio", light, out;
-    std::string transmission_masking = "smith";
-    std::string microsurface = "single";
+    /// The random-walk reference's transport (its named settings are its model options).
+    TransportSettings transport;
     std::vector<std::string> options;
     int size = 512, spp = 64, threads = 0;
     std::uint64_t seed = 1;
@@ -49,30 +50,23 @@ int run_render(const RenderArgs& a) {
     s.threads = a.threads;
     s.lobe_alpha = lobe_alpha_for(stack);  // a proposal density only (renderer.h)
     if (a.out.empty()) throw InputError("command line", "--out", "required");
-    // The reference's refraction masking, a model option of random-walk (validated there).
-    parse_transmission_masking(a.transmission_masking);
+    // The reference's transport settings become its model options unless given as --option
+    // already; for another model they are an error unless left at their defaults.
     std::vector<std::string> options = a.options;
-    // The reference's flags become its model options unless given as --option already.
-    auto pass_to_reference = [&](const std::string& key, const std::string& value,
-                                 const std::string& fallback, const std::string& flag) {
-        const bool given_as_option =
-            std::any_of(options.begin(), options.end(),
-                        [&](const auto& o) { return o.rfind(key + "=", 0) == 0; });
-        if ((a.compare || a.model == "random-walk") && !given_as_option)
-            options.push_back(key + "=" + value);
-        else if (value != fallback)
+    const std::vector<std::string> defaults = random_walk_assignments(TransportSettings{});
+    const std::vector<std::string> given = random_walk_assignments(a.transport);
+    for (std::size_t k = 0; k < given.size(); ++k) {
+        const std::string key = given[k].substr(0, given[k].find('='));
+        const bool as_option = std::any_of(options.begin(), options.end(), [&](const auto& o) {
+            return o.rfind(key + "=", 0) == 0;
+        });
+        if ((a.compare || a.model == "random-walk") && !as_option)
+            options.push_back(given[k]);
+        else if (given[k] != defaults[k])
             throw InputError(
-                "command line", flag,
+                "command line", "--" + key,
                 "applies to the random-walk reference only, not to --model " + a.model);
-    };
-    pass_to_reference("transmission-masking", a.transmission_masking, "smith",
-                      "--transmission-masking");
-    if (a.microsurface != "single" && a.microsurface != "multiple")
-        throw InputError("command line", "--microsurface",
-                         "'" + a.microsurface +
-                             "' is not a microsurface model: use single or "
-                             "multiple");
-    pass_to_reference("microsurface", a.microsurface, "single", "--microsurface");
+    }
 
     if (!a.compare) {
         const auto model = make_model(a.model, stack, options);
@@ -116,13 +110,9 @@ Runner add_render(CLI::App& app) {
     cmd->add_option("--threads", a->threads, "Threads (default: all)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--exposure", a->exposure, "Exposure in stops for the PNG (default 0)");
-    cmd->add_option("--transmission-masking", a->transmission_masking,
-                    "The random-walk reference's masking of light refracted by a rough dielectric: "
-                    "smith (default, B(1+Λi, 1+Λo)) or pbrt (1/(1+Λi+Λo), as pbrt-v4)");
-    cmd->add_option("--microsurface", a->microsurface,
-                    "The random-walk reference's rough interfaces: single (default, single-"
-                    "scattering microfacet BSDFs) or multiple (the microsurface random walk of "
-                    "Heitz et al. 2016, nothing lost)");
+    // The reference's transport (layers/transport_settings.h), but the numbers it keeps at their
+    // defaults (random_walk_options).
+    add_settings_options(cmd, a->transport, {"max_microsurface_order", "max_events"});
     cmd->add_flag("--compare", a->compare,
                   "Render the reference and every analytic model; --out is then a folder holding "
                   "compare.png, one PNG+EXR per model and errors.csv");

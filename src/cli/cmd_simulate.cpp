@@ -1,8 +1,9 @@
-// lamina simulate STACK.json --theta-i 0,30,60 --particles 1e7 [--seed S] [--threads T]
-//                 [--grid 90x90] --out DIR
+// lamina simulate STACK.json [--theta-i 0,30,60] [--particles 1e7] [any setting of
+//                 SimulationSettings: --seed, --grid, --kernel, --microsurface, …] --out DIR
 // Under `mpirun -n K` the particles are split over K processes (docs/scaling.md).
 #include "cli/commands.h"
 #include "cli/options.h"
+#include "cli/settings_options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/incidences.h"
@@ -24,10 +25,8 @@ namespace lamina::cli {
 
 namespace {
 struct SimulateArgs {
-    std::string stack, theta_i = default_incidences_text(), particles = "1e6", grid = "90x90", out;
-    std::string kernel = "simd", microsurface = "single", transmission_masking = "smith";
-    std::uint64_t seed = 1;
-    int threads = 0, max_events = 10000;
+    std::string stack, out;
+    SimulationSettings settings;
 };
 }  // namespace
 
@@ -36,44 +35,13 @@ Runner add_simulate(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "simulate", "Trace particles through a stack: the reference BRDF/BTDF (goniophotometer)");
     cmd->add_option("STACK", a->stack, "Stack JSON file")->required();
-    cmd->add_option("--theta-i", a->theta_i, "Incidences in degrees, comma-separated, in [0, 90)")
-        ->capture_default_str();
-    cmd->add_option("--particles,-n", a->particles, "Particles per incidence (1e7-style accepted)")
-        ->capture_default_str();
-    cmd->add_option("--seed", a->seed, "Random seed")->capture_default_str();
-    cmd->add_option("--threads", a->threads, "Threads (0 = all cores)")->capture_default_str();
-    cmd->add_option("--grid", a->grid, "Bins NTHETAxNPHI over θ∈[0°,90°], φ∈[0°,180°] (folded)")
-        ->capture_default_str();
-    cmd->add_option("--max-events", a->max_events, "Safety cap on events per particle")
-        ->capture_default_str();
-    cmd->add_option("--kernel", a->kernel,
-                    "Particle kernel: simd (vectorized, runtime dispatch) or scalar (reference "
-                    "path); tables are reproducible per kernel")
-        ->capture_default_str();
-    cmd->add_option("--microsurface", a->microsurface,
-                    "Rough interfaces: single (single scattering, the masked energy reported as "
-                    "lost_microsurface) or multiple (Heitz et al. 2016 random walk)")
-        ->capture_default_str();
-    cmd->add_option("--transmission-masking", a->transmission_masking,
-                    "Masking of light refracted by a rough dielectric (single scattering): smith "
-                    "(the Smith microsurface's B(1+Λi, 1+Λo)) or pbrt (1/(1+Λi+Λo), as pbrt-v4)")
-        ->capture_default_str();
+    add_settings_options(cmd, a->settings);
     cmd->add_option("--out,-o", a->out, "Output folder")->required();
     return [a] {
         // Under mpirun every process runs this; the particles are split over them
         // (distributed/split_simulation.h) and only the root reads the stack and writes.
         Communicator& world = Communicator::world();
-        SimulationSettings s;
-        s.theta_i_deg = parse_incidences(a->theta_i, "--theta-i");
-        s.particles = parse_count(a->particles, "--particles");
-        s.seed = a->seed;
-        s.threads = a->threads;
-        s.kernel = parse_kernel(a->kernel);
-        s.microsurface = parse_microsurface(a->microsurface);
-        s.transmission_masking = parse_transmission_masking(a->transmission_masking);
-        s.grid = HemisphereGrid::parse(a->grid);
-        s.max_events = a->max_events;
-        validate_settings(s);
+        SimulationSettings s = a->settings;
         if (world.distributed() && s.threads == 0) s.threads = default_threads_per_process(world);
         // The root reads the stack and sends its canonical JSON to the others (no shared file
         // system is assumed); stack_from_json(stack_to_json(s)) == s.

@@ -5,10 +5,12 @@
 #include "cli/commands.h"
 #include "cli/model_plugin.h"
 #include "cli/options.h"
+#include "cli/settings_options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/incidences.h"
 #include "distributed/communicator.h"
+#include "models/random_walk/random_walk_model.h"
 #include "render/contact_sheet.h"
 #include "report/explorer.h"
 #include "report/figures.h"
@@ -27,37 +29,24 @@ namespace lamina::cli {
 namespace {
 
 struct CommonArgs {
-    std::string theta_i = default_incidences_text(), particles, grid = "90x90", models, out;
-    std::string kernel = "simd", microsurface = "single", transmission_masking = "smith",
-                tables = "half", formats = "png";
-    std::uint64_t seed = 1;
-    int threads = 0;
-    bool no_figures = false, recompute = false;
-    bool ablations = false;
+    CLI::App* cmd = nullptr;
+    StudySettings settings;  ///< the options write into it; settings_from completes it
+    std::string models, out, formats = "png";
+    bool no_figures = false;
     std::vector<std::string> model_tables;   ///< NAME=FILE.csv (FILE may hold {id})
     std::vector<std::string> model_plugins;  ///< [NAME=]FILE.py (docs/python.md)
 };
 
 void add_common(CLI::App* cmd, CommonArgs& a) {
-    cmd->add_option("--theta-i", a.theta_i, "Incidences in degrees, comma-separated, in [0, 90)")
-        ->capture_default_str();
-    cmd->add_option("--particles,-n", a.particles,
-                    "Particles per incidence (overrides the preset; 1e7-style accepted)");
+    a.cmd = cmd;
+    // The reference's settings (the goniophotometer's, core/setting.h) and the study's own.
+    add_settings_options(cmd, a.settings.reference);
+    add_settings_options(cmd, a.settings);
     cmd->add_option("--models", a.models,
                     "Models to compare, comma-separated (default: all); NAME:KEY=VALUE adds a "
                     "model's flag");
-    cmd->add_flag("--ablations", a.ablations,
+    cmd->add_flag("--ablations", a.settings.ablations,
                   "Also each production coat with one flag switched (openpbr:darkening=off, ...)");
-    cmd->add_option("--seed", a.seed, "Random seed")->capture_default_str();
-    cmd->add_option("--threads", a.threads, "Threads (0 = all cores)")->capture_default_str();
-    cmd->add_option("--grid", a.grid, "Bins NTHETAxNPHI")->capture_default_str();
-    cmd->add_option("--kernel", a.kernel,
-                    "Particle kernel of the reference: simd (vectorized) or scalar")
-        ->capture_default_str();
-    cmd->add_option("--microsurface", a.microsurface,
-                    "Rough interfaces of the reference: single (single scattering, the masked "
-                    "energy reported as lost) or multiple (Heitz et al. 2016 random walk)")
-        ->capture_default_str();
     cmd->add_option("--model-table", a.model_tables,
                     "A model evaluated elsewhere, as NAME=FILE.csv in the brdf.csv format (lamina "
                     "eval --binned writes it) on the study's grid and incidences; {id} in FILE "
@@ -65,20 +54,11 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
     cmd->add_option("--model-plugin", a.model_plugins,
                     "A Python model, [NAME=]FILE.py defining MODEL (a class with a vectorized "
                     "eval(wi, wo), docs/python.md), binned by lamina's quadrature; repeatable");
-    cmd->add_option("--tables", a.tables,
-                    "configs/ID/tables.lza (compressed): full (float32), half (float16) or "
-                    "none (metrics and summary only: no explorer page, slices or albedo figures)")
-        ->capture_default_str();
     cmd->add_option("--formats", a.formats, "Figure formats, comma-separated: png, pdf, svg")
         ->capture_default_str();
-    cmd->add_flag("--recompute", a.recompute,
+    cmd->add_flag("--recompute", a.settings.recompute,
                   "Recompute the models, metrics and outputs even where their inputs are "
                   "unchanged (the reference pieces are still reused), and redraw every figure");
-    cmd->add_option("--transmission-masking", a.transmission_masking,
-                    "The reference's masking of light refracted by a rough dielectric (single "
-                    "scattering): smith (the Smith microsurface's B(1+Λi, 1+Λo)) or pbrt "
-                    "(1/(1+Λi+Λo), as pbrt-v4)")
-        ->capture_default_str();
     cmd->add_flag("--no-figures", a.no_figures,
                   "Skip the paper figures (the explorer page is always written)");
 }
@@ -131,33 +111,23 @@ FigureOptions figure_options(const CommonArgs& a) {
         }
     if (o.formats.empty())
         throw InputError("command line", "--formats", "no format given; allowed: png, pdf, svg");
-    o.force = a.recompute;
+    o.force = a.settings.recompute;
     return o;
 }
 
 StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
-    StudySettings s;
-    s.particles = preset_particles(preset);  // validates --preset in every case
-    if (!a.particles.empty()) s.particles = parse_count(a.particles, "--particles");
+    StudySettings s = a.settings;
+    const std::uint64_t budget = preset_particles(preset);  // validates --preset in every case
     // A particle count given by hand is not the preset's budget: say so wherever it is shown.
-    s.preset = a.particles.empty() ? preset : "custom";
-    s.seed = a.seed;
-    s.threads = a.threads;
-    s.kernel = parse_kernel(a.kernel);
-    s.microsurface = parse_microsurface(a.microsurface);
-    s.transmission_masking = parse_transmission_masking(a.transmission_masking);
-    s.theta_i_deg = parse_incidences(a.theta_i, "--theta-i");
-    s.tables = parse_tables_format(a.tables);
+    const bool by_hand = a.cmd->count("--particles") > 0;
+    if (!by_hand) s.reference.particles = budget;
+    s.preset = by_hand ? "custom" : preset;
     figure_options(a);  // validates --formats before any work
-    s.recompute = a.recompute;
-    s.grid = HemisphereGrid::parse(a.grid);
     if (!a.models.empty()) {
         std::stringstream ss(a.models);
         for (std::string m; std::getline(ss, m, ',');)
             if (!m.empty()) s.models.push_back(m);
     }
-    s.ablations = a.ablations;
-    if (s.threads < 0) throw InputError("command line", "--threads", "use ≥ 1, or 0 for all cores");
     for (const std::string& assignment : a.model_tables)
         s.external_models.push_back(model_table(assignment));
     for (const std::string& assignment : a.model_plugins)
@@ -247,7 +217,8 @@ Runner add_study(CLI::App& app) {
                 StagedOutput probe(out);  // and the output folder
                 keys = study_reference_keys(configs, s);
             }
-            const int threads = s.threads > 0 ? s.threads : default_threads_per_process(world);
+            const int threads =
+                s.reference.threads > 0 ? s.reference.threads : default_threads_per_process(world);
             const std::size_t computed = share_reference_pieces(
                 world, world.is_root() ? reference_cache_dir(out) : std::filesystem::path(), keys,
                 threads);
@@ -261,16 +232,15 @@ Runner add_study(CLI::App& app) {
             RenderSettings rs;
             rs.size = a->render_size;
             rs.spp = a->render_spp;
-            rs.seed = s.seed;
-            rs.threads = s.threads;
+            rs.seed = s.reference.seed;
+            rs.threads = s.reference.threads;
             rs.progress = !s.quiet;
             const Environment env = Environment::named("studio");
             std::string index = "config,model,rel_rmse,seconds\n";
             for (const StudyConfiguration& c : configs) {
                 const std::string csv =
                     write_comparison(c.stack, env, rs, out / "configs" / c.id / "renders", 0.0,
-                                     {"transmission-masking=" + a->transmission_masking,
-                                      "microsurface=" + a->microsurface});
+                                     random_walk_assignments(s.reference.transport));
                 std::stringstream lines(csv);
                 std::string line;
                 std::getline(lines, line);  // header

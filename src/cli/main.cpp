@@ -50,6 +50,8 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         // CLI11's errors exit like lamina's: one "lamina: command line: ..." line, exit code 1.
         return fail(lamina::cli::input_error_from(e, app).what());
+    } catch (const lamina::InputError& e) {
+        return fail(e.what());  // a setting's value, read as CLI11 parses (cli/settings_options.h)
     }
     try {
         world = &lamina::Communicator::world();

@@ -67,8 +67,8 @@ ExternalModel model_plugin(const std::string& assignment, const StudySettings& s
     m.source = file;
     const char* python_env = std::getenv("LAMINA_PYTHON");
     const std::string python = python_env && *python_env ? python_env : LAMINA_PYTHON_EXECUTABLE;
-    const std::string theta_i = fmt::format("{}", fmt::join(settings.theta_i_deg, ","));
-    const std::string grid = settings.grid.to_string();
+    const std::string theta_i = fmt::format("{}", fmt::join(settings.reference.theta_i_deg, ","));
+    const std::string grid = settings.reference.grid.to_string();
     m.table = [file, python, theta_i, grid](const StudyConfiguration& c) {
         std::string dir_template =
             (std::filesystem::temp_directory_path() / "lamina-plugin-XXXXXX").string();

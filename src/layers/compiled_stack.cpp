@@ -3,13 +3,13 @@
 namespace lamina {
 
 template <typename Real>
-CompiledStack<Real> compile_stack(const Stack& stack, const CompileSettings& settings) {
+CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& settings) {
     CompiledStack<Real> out;
     out.eta_above = Real(stack.ambient_eta);
     out.transmits = stack.transmits();
-    out.multiple_scattering = settings.multiple_scattering;
+    const bool multiple = settings.microsurface == Microsurface::Multiple;
+    out.multiple_scattering = multiple;
     out.max_microsurface_order = settings.max_microsurface_order;
-    const bool multiple = settings.multiple_scattering;
     for (std::size_t i = 0; i < stack.layers.size(); ++i) {
         const Layer& layer = stack.layers[i];
         const InterfaceSpec& spec = layer.interface;
@@ -58,7 +58,7 @@ CompiledStack<Real> compile_stack(const Stack& stack, const CompileSettings& set
     return out;
 }
 
-template CompiledStack<float> compile_stack<float>(const Stack&, const CompileSettings&);
-template CompiledStack<double> compile_stack<double>(const Stack&, const CompileSettings&);
+template CompiledStack<float> compile_stack<float>(const Stack&, const TransportSettings&);
+template CompiledStack<double> compile_stack<double>(const Stack&, const TransportSettings&);
 
 }  // namespace lamina

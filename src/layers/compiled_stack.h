@@ -7,6 +7,7 @@
 
 #include "core/rgb.h"
 #include "layers/stack.h"
+#include "layers/transport_settings.h"
 #include "physics/conductor.h"
 #include "physics/dielectric.h"
 #include "physics/lambertian.h"
@@ -49,33 +50,25 @@ struct CompiledLayer {
     CompiledMedium<Real> medium;  ///< the medium below this interface (empty for the last layer)
 };
 
-/// How the rough interfaces scatter: the refraction masking of every single-scattering rough
-/// dielectric (physics/microfacet.h), and whether the microsurfaces scatter multiply (at most
-/// max_microsurface_order facets, ≥ 1).
-struct CompileSettings {
-    TransmissionMasking transmission_masking = TransmissionMasking::Smith;
-    bool multiple_scattering = false;
-    int max_microsurface_order = 100;
-};
-
 template <typename Real>
 struct CompiledStack {
     std::vector<CompiledLayer<Real>> layers;  ///< top to bottom
     Real eta_above = Real(1);                 ///< the ambient medium's absolute index
     bool transmits = false;  ///< the base is a dielectric: light can leave downwards
-    /// As CompileSettings: a rough interface's layer has `multiple` set when this is.
+    /// Microsurface::Multiple: a rough interface's layer has `multiple` set when this is.
     bool multiple_scattering = false;
-    int max_microsurface_order = 100;
+    int max_microsurface_order = TransportSettings{}.max_microsurface_order;
 };
 
 /// The stack compiled in precision Real (float: the goniophotometer's kernels; double: the random
-/// walk). With multiple scattering an index-matched rough dielectric is the smooth index-matched
-/// pass-through: every facet refracts straight on (F = 0) and the walk leaves below along −wi
-/// with all its flux (the single-scattering one keeps G2/G1).
+/// walk) for the transport `settings` (its microsurface model, order and refraction masking). With
+/// multiple scattering an index-matched rough dielectric is the smooth index-matched pass-through:
+/// every facet refracts straight on (F = 0) and the walk leaves below along −wi with all its flux
+/// (the single-scattering one keeps G2/G1).
 template <typename Real>
-CompiledStack<Real> compile_stack(const Stack& stack, const CompileSettings& settings);
+CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& settings);
 
-extern template CompiledStack<float> compile_stack<float>(const Stack&, const CompileSettings&);
-extern template CompiledStack<double> compile_stack<double>(const Stack&, const CompileSettings&);
+extern template CompiledStack<float> compile_stack<float>(const Stack&, const TransportSettings&);
+extern template CompiledStack<double> compile_stack<double>(const Stack&, const TransportSettings&);
 
 }  // namespace lamina

@@ -1,7 +1,13 @@
 #include "models/registry.h"
 
 #include "core/error.h"
-#include "models/factories.h"
+#include "models/belcour/belcour.h"
+#include "models/ddb22/ddb22.h"
+#include "models/lamina1/lamina1.h"
+#include "models/production/production_coats.h"
+#include "models/random_walk/random_walk_model.h"
+#include "models/transfer_matrix/transfer_matrix.h"
+#include "models/weidlich_wilkie/ww_family.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -10,35 +16,62 @@
 
 namespace lamina {
 
+namespace {
+
+// A variant of a family: the family's options and factory at the variant's name.
+using FamilyOptions = std::vector<OptionSpec> (*)(const std::string& variant);
+using FamilyMake = std::unique_ptr<Model> (*)(const std::string& variant, const Stack& stack,
+                                              const ModelOptions& options);
+ModelEntry variant(std::string name, std::string description, std::string supports,
+                   FamilyOptions options, FamilyMake make, std::string group = "2019") {
+    const std::string n = name;
+    return {std::move(name),
+            std::move(description),
+            std::move(supports),
+            [options, n] { return options(n); },
+            [make, n](const Stack& stack, const ModelOptions& o) { return make(n, stack, o); },
+            false,
+            std::move(group)};
+}
+
+}  // namespace
+
 const std::vector<ModelEntry>& model_registry() {
     static const std::vector<ModelEntry> entries = {
-        {"ww09",
-         "Weidlich & Wilkie, SIGGRAPH Asia 2009 course code: T01 and refraction at h, base at "
-         "outside directions",
-         "bases: lambertian, conductor, dielectric (slab reflection); sides: R", ww09_options,
-         make_ww09},
-        {"ele10",
-         "Elek 2010 (CESCG, Alg. 1): T01 at h, refraction about n, alpha1 <- max(alpha0, alpha1)",
-         "bases: lambertian, conductor, dielectric (slab reflection); sides: R", ele10_options,
-         make_ele10},
-        {"ww-prime",
-         "WW': T01, T10 and refraction at n, 1/eta0^2 compression, alpha1 <- max(alpha0, alpha1)",
-         "bases: lambertian, conductor, dielectric (slab reflection); sides: R", ww_prime_options,
-         make_ww_prime},
-        {"bel18-forward", "Belcour 2018 adding of lobe statistics, cosine mu_i (not reciprocal)",
-         "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R",
-         bel18_forward_options, make_bel18_forward},
-        {"bel18-symmetric", "Belcour 2018 adding of lobe statistics, cosine |wi.h| (reciprocal)",
-         "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R",
-         bel18_symmetric_options, make_bel18_symmetric},
-        {"bel-prime", "Bel': Bel18 forward with the exact top reflection and a slab BTDF lobe",
-         "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R, T (slab)",
-         bel_prime_options, make_bel_prime},
-        {"tm2",
-         "Randrianandrasana et al. 2021 transfer matrices: lobes by energy and HG asymmetry "
-         "(conductor base: plugin tm2, exact top; slab: tm2_dielectric, transmitted lobe)",
-         "bases: conductor, dielectric; media: absorbing; sides: R, T (slab)", tm2_options,
-         make_tm2, false, "successors"},
+        variant(
+            "ww09",
+            "Weidlich & Wilkie, SIGGRAPH Asia 2009 course code: T01 and refraction at h, base at "
+            "outside directions",
+            "bases: lambertian, conductor, dielectric (slab reflection); sides: R", ww_options,
+            make_ww),
+        variant("ele10",
+                "Elek 2010 (CESCG, Alg. 1): T01 at h, refraction about n, alpha1 <- max(alpha0, "
+                "alpha1)",
+                "bases: lambertian, conductor, dielectric (slab reflection); sides: R", ww_options,
+                make_ww),
+        variant("ww-prime",
+                "WW': T01, T10 and refraction at n, 1/eta0^2 compression, alpha1 <- max(alpha0, "
+                "alpha1)",
+                "bases: lambertian, conductor, dielectric (slab reflection); sides: R", ww_options,
+                make_ww),
+        variant("bel18-forward",
+                "Belcour 2018 adding of lobe statistics, cosine mu_i (not reciprocal)",
+                "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R",
+                belcour_options, make_belcour),
+        variant("bel18-symmetric",
+                "Belcour 2018 adding of lobe statistics, cosine |wi.h| (reciprocal)",
+                "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R",
+                belcour_options, make_belcour),
+        variant("bel-prime",
+                "Bel': Bel18 forward with the exact top reflection and a slab BTDF lobe",
+                "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R, T "
+                "(slab)",
+                belcour_options, make_belcour),
+        variant("tm2",
+                "Randrianandrasana et al. 2021 transfer matrices: lobes by energy and HG asymmetry "
+                "(conductor base: plugin tm2, exact top; slab: tm2_dielectric, transmitted lobe)",
+                "bases: conductor, dielectric; media: absorbing; sides: R, T (slab)", tm_options,
+                make_tm, "successors"),
         {"lamina-1",
          "lamina-1: exact top reflection, first order through the coat's directional "
          "transmittance, inter-reflection series, lobe widened by the coat's refraction spread",
@@ -88,11 +121,12 @@ const std::vector<ModelEntry>& model_registry() {
          make_kulla_conty, false, "production"},
         // Last (tm6, then ddb22): the registry-wide fuzz draws each model's options in this order,
         // so a model added at the end leaves the draws of the others as they were.
-        {"tm6",
-         "Randrianandrasana et al. 2021 transfer matrices with HG media (plugin tm6): primary, "
-         "forward- and back-scattered lobes, exact top, lobes normalized by their GGX albedo",
-         "bases: conductor; media: absorbing, scattering (HG); sides: R", tm6_options, make_tm6,
-         false, "successors"},
+        variant("tm6",
+                "Randrianandrasana et al. 2021 transfer matrices with HG media (plugin tm6): "
+                "primary, forward- and back-scattered lobes, exact top, lobes normalized by their "
+                "GGX albedo",
+                "bases: conductor; media: absorbing, scattering (HG); sides: R", tm_options,
+                make_tm, "successors"),
         {"ddb22",
          "de Dinechin & Belcour 2022 as lamina reads it: exact coat reflection + one GGX lobe with "
          "the energy and projected variance of the light the Lambertian returns",

@@ -1,11 +1,12 @@
 #pragma once
 // The one table of analytic models (docs/style.md §12: an explicit registry, like Tungsten's
 // BsdfFactory, no static self-registration). `lamina models`, `lamina eval`, the study and the
-// explorer all find models here. Adding a model = one source file with its factory and options
-// (declared in models/factories.h) + one line in registry.cpp.
+// explorer all find models here. Adding a model = its family's folder (or a new variant of a
+// family: its default choices) + one row in registry.cpp (docs/architecture.md).
 
 #include "models/model.h"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,8 +17,8 @@ struct ModelEntry {
     std::string name;
     std::string description;  ///< one line
     std::string supports;     ///< bases and sides, one line
-    std::vector<OptionSpec> (*options)();
-    std::unique_ptr<Model> (*make)(const Stack& stack, const ModelOptions& options);
+    std::function<std::vector<OptionSpec>()> options;
+    std::function<std::unique_ptr<Model>(const Stack& stack, const ModelOptions& options)> make;
     /// A stochastic estimator (the random walk): its eval is noisy and slow, so the study's
     /// default model list and the analytic-model sweeps leave it out.
     bool stochastic = false;

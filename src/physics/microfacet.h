@@ -12,6 +12,7 @@
 #include "core/math.h"
 #include "core/vec.h"
 #include "physics/smith_masking.h"
+#include "physics/transmission_masking.h"
 
 #include <cmath>
 #include <limits>
@@ -114,23 +115,6 @@ LAMINA_LANE_END
 #define LAMINA_PHYSICS_MICROFACET_H
 
 namespace lamina {
-
-/// How a rough dielectric masks and shadows the light it *refracts* (its reflection lobe always
-/// has the height-correlated 1/(1 + Λi + Λo) of Heitz 2014, Eq. 99).
-enum class TransmissionMasking {
-    /// The Smith microsurface's own height-correlated form for a pair on opposite sides,
-    /// B(1 + Λi, 1 + Λo) (smith_refraction_escape): the default.
-    Smith,
-    /// 1/(1 + Λi + Λo) as for reflection: Walter et al. 2007 with the height-correlated G2, as
-    /// pbrt-v4 uses it; kept for comparisons with those renderers.
-    Pbrt,
-};
-/// "smith" | "pbrt".
-const char* transmission_masking_name(TransmissionMasking masking);
-/// "smith" | "pbrt"; InputError naming `where` (a file or "command line") and `field` otherwise.
-TransmissionMasking parse_transmission_masking(const std::string& text,
-                                               const std::string& where = "command line",
-                                               const std::string& field = "--transmission-masking");
 
 template <typename T>
 struct GGX {

@@ -18,7 +18,7 @@
 #include "export/merl.h"
 #include "export/rgl_bsdf.h"
 #include "layers/stack.h"
-#include "models/binned.h"
+#include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "report/explorer.h"
 #include "report/figures.h"
@@ -53,7 +53,13 @@ PyObject* g_input_error = nullptr;  // lamina.InputError, a subclass of ValueErr
 
 nlohmann::json json_of(py::handle obj) {
     const py::object dumps = py::module_::import("json").attr("dumps");
-    return nlohmann::json::parse(dumps(obj, py::arg("allow_nan") = false).cast<std::string>());
+    // numpy arrays and scalars as lists and numbers; tuples are lists already.
+    const py::cpp_function plain([](py::handle o) -> py::object {
+        if (py::hasattr(o, "tolist")) return o.attr("tolist")();
+        throw py::type_error("not a JSON value: " + py::repr(o).cast<std::string>());
+    });
+    return nlohmann::json::parse(
+        dumps(obj, py::arg("allow_nan") = false, py::arg("default") = plain).cast<std::string>());
 }
 
 py::object python_of(const nlohmann::json& j) {
@@ -374,21 +380,14 @@ void run_study_py(py::list configs_in, py::dict settings, py::list externals,
         sc.parameters = describe_parameters(sc.stack);
         configs.push_back(std::move(sc));
     }
+    // settings: {"reference": the goniophotometer's settings, "study": the study's, "preset",
+    // "models", "quiet", "registry_models"}: read by the settings' own codecs (core/setting.h).
     StudySettings s;
-    s.particles = settings["particles"].cast<std::uint64_t>();
+    settings_from_json(s.reference, json_of(settings["reference"]), "arguments");
+    settings_from_json(s, json_of(settings["study"]), "arguments");
     s.preset = settings["preset"].cast<std::string>();
-    s.seed = settings["seed"].cast<std::uint64_t>();
-    s.theta_i_deg = incidences_of(settings["theta_i"]);
-    s.grid = grid_of(settings["grid"].cast<std::pair<int, int>>());
     s.models = settings["models"].cast<std::vector<std::string>>();
-    s.threads = settings["threads"].cast<int>();
-    s.kernel = parse_kernel(settings["kernel"].cast<std::string>(), "kernel");
-    s.microsurface =
-        parse_microsurface(settings["microsurface"].cast<std::string>(), "microsurface");
     s.quiet = settings["quiet"].cast<bool>();
-    s.tables = parse_tables_format(settings["tables"].cast<std::string>(), "tables");
-    s.transmission_masking = parse_transmission_masking(
-        settings["transmission_masking"].cast<std::string>(), "arguments", "transmission_masking");
     s.registry_models = settings["registry_models"].cast<bool>();
     for (py::handle e : externals) {
         ExternalModel m;
@@ -450,8 +449,10 @@ PYBIND11_MODULE(_lamina, m) {
         }
     });
 
-    m.attr("kernel_description") = py::cpp_function(
-        [](const std::string& k) { return kernel_description(parse_kernel(k, "kernel")); });
+    m.attr("kernel_description") = py::cpp_function([](const std::string& k) {
+        return kernel_description(SettingCodec<Kernel>::from_text(k, {.name = "kernel", .help = ""},
+                                                                  "arguments", "kernel"));
+    });
 
     // ---- Stack ----
     py::class_<Stack>(m, "Stack", "A layer stack (docs/stack-format.md)")
@@ -569,35 +570,20 @@ PYBIND11_MODULE(_lamina, m) {
                                r.result.settings.particles);
         });
 
+    // The goniophotometer's settings and their defaults, by name (core/setting.h): Python's
+    // keyword arguments of simulate, compare and study.
+    m.attr("SIMULATION_SETTINGS") = python_of(settings_to_json(SimulationSettings{}));
     m.def(
         "_simulate",
-        [](py::handle stack_obj, py::handle theta_i, double particles, std::uint64_t seed,
-           int threads, std::pair<int, int> grid, const std::string& kernel,
-           const std::string& microsurface, const std::string& transmission_masking, int max_events,
-           bool progress) {
+        [](py::handle stack_obj, py::dict settings, bool progress) {
             SimulationSettings s;
-            s.theta_i_deg = incidences_of(theta_i);
-            if (!(particles >= 1 && particles <= 1e15 && particles == std::floor(particles)))
-                throw InputError("arguments", "particles",
-                                 fmt::format("{} is not allowed: expected a whole number in "
-                                             "[1, 1e15]",
-                                             particles));
-            s.particles = std::uint64_t(particles);
-            s.seed = seed;
-            s.threads = threads;
-            s.grid = grid_of(grid);
-            s.kernel = parse_kernel(kernel, "kernel");
-            s.microsurface = parse_microsurface(microsurface, "microsurface");
-            s.transmission_masking = parse_transmission_masking(transmission_masking, "arguments",
-                                                                "transmission_masking");
-            s.max_events = max_events;
+            settings_from_json(s, json_of(settings), "arguments");
             PySimulation r{stack_of(stack_obj), {}};
             r.result = simulate_interruptible(r.stack, s, progress);
             return r;
         },
-        py::arg("stack"), py::arg("theta_i"), py::arg("particles"), py::arg("seed"),
-        py::arg("threads"), py::arg("grid"), py::arg("kernel"), py::arg("microsurface"),
-        py::arg("transmission_masking"), py::arg("max_events"), py::arg("progress"));
+        py::arg("stack"), py::arg("settings"), py::arg("progress"));
+    m.def("_preset_particles", &preset_particles, py::arg("preset"));
 
     m.def(
         "_export",
@@ -749,7 +735,8 @@ PYBIND11_MODULE(_lamina, m) {
                 py::gil_scoped_release release;
                 return bin_model(*m.model, g, thetas);
             },
-            py::arg("theta_i") = default_incidences_deg(), py::arg("grid") = std::make_pair(90, 90),
+            py::arg("theta_i") = default_incidences_deg(),
+            py::arg("grid") = std::make_pair(HemisphereGrid{}.n_theta(), HemisphereGrid{}.n_phi()),
             "Cos-weighted bin averages on the goniophotometer's bins (lamina eval --binned)")
         .def(
             "albedo",

@@ -113,16 +113,11 @@ bool is_grey(const Rgbd& x) {
 
 }  // namespace
 
-RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events, TransmissionMasking masking,
-                                 Microsurface microsurface, int max_microsurface_order)
-    : transmits_(stack.transmits()),
-      max_events_(max_events),
-      microsurface_(microsurface),
-      max_microsurface_order_(max_microsurface_order) {
-    LAMINA_CHECK(max_events >= 1);
-    LAMINA_CHECK(max_microsurface_order >= 1);
-    const CompiledStack<double> compiled = compile_stack<double>(
-        stack, {masking, microsurface == Microsurface::Multiple, max_microsurface_order});
+RandomWalkStack::RandomWalkStack(const Stack& stack, const TransportSettings& transport)
+    : transmits_(stack.transmits()), transport_(transport) {
+    LAMINA_CHECK(transport.max_events >= 1);
+    LAMINA_CHECK(transport.max_microsurface_order >= 1);
+    const CompiledStack<double> compiled = compile_stack<double>(stack, transport);
     const int L = int(compiled.layers.size());
     interfaces_ = compiled.layers;
     eta_.assign(L + 1, 1.0);
@@ -359,7 +354,7 @@ void RandomWalkStack::visit_microsurface(const Interface& it, const Vec3d& wi, P
     if (it.type == InterfaceType::Dielectric) {
         const GGX<double> ggx = it.dielectric.distribution();
         const double eta = it.dielectric.eta;
-        walk_rough_dielectric_visiting(ggx, eta, wi, uniform, max_microsurface_order_,
+        walk_rough_dielectric_visiting(ggx, eta, wi, uniform, transport_.max_microsurface_order,
                                        [&](const MicrosurfaceFacet<double>& facet) {
                                            visit([&](const Vec3d& wo) {
                                                MicrosurfaceConnection<double> c;
@@ -373,7 +368,7 @@ void RandomWalkStack::visit_microsurface(const Interface& it, const Vec3d& wi, P
         const ConductorInterface<double>& cond = it.conductor;
         const GGX<double> ggx = cond.distribution();
         auto fresnel = [&](double c) { return cond.fresnel(c); };
-        walk_rough_conductor_visiting(ggx, fresnel, wi, uniform, max_microsurface_order_,
+        walk_rough_conductor_visiting(ggx, fresnel, wi, uniform, transport_.max_microsurface_order,
                                       [&](const MicrosurfaceFacet<double>& facet) {
                                           visit([&](const Vec3d& wo) {
                                               return microsurface_conductor_connect(ggx, fresnel,
@@ -536,7 +531,7 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
         ws.prev_depth = kEstimate ? conn->distance(s) : 0;
         d = d_new;
         if (is_black(w)) return d.z > 0;
-        if (++ws.events >= max_events_) {
+        if (++ws.events >= transport_.max_events) {
             w = Rgbd(0.0);
             return d.z > 0;
         }
@@ -556,7 +551,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
     Vec3d& d = ws.d;
     Rgbd& w = ws.w;
     int k = 0;  // the interface the particle is about to meet
-    while (ws.events++ < max_events_) {
+    while (ws.events++ < transport_.max_events) {
         const Interface& it = interfaces_[k];
         const Vec3d wi_local = -d;
         // Strategy 1's balance-heuristic weight at the exit interface (1 for other paths): the
@@ -696,11 +691,11 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
             const std::optional<MicrosurfaceExit<double>> e =
                 it.type == InterfaceType::Dielectric
                     ? walk_rough_dielectric(it.dielectric.distribution(), it.dielectric.eta,
-                                            wi_local, uniform, max_microsurface_order_)
+                                            wi_local, uniform, transport_.max_microsurface_order)
                     : walk_rough_conductor(
                           it.conductor.distribution(),
                           [&](double c) { return it.conductor.fresnel(c); }, wi_local, uniform,
-                          max_microsurface_order_);
+                          transport_.max_microsurface_order);
             if (!e || !e->escaped) return;
             s = BsdfSample<double>{};
             s->wo = e->wo;

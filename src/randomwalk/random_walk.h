@@ -80,27 +80,16 @@ struct RandomWalkSample {
 /// The stack compiled for random walks (double precision, relative indices per interface).
 class RandomWalkStack {
   public:
-    /// How the rough interfaces scatter (as the goniophotometer's --microsurface): `Single`, the
-    /// single-scattering microfacet BSDFs (the energy of the paths that meet a second facet is
-    /// lost), or `Multiple`, the microsurface random walk of Heitz et al. 2016
-    /// (physics/microsurface_walk.h): sample() follows the walk to its exit, eval() and pdf()
-    /// connect through the interface's multiple-scattering BSDF and exit density by the walk's
-    /// unbiased stochastic evaluation (docs/rendering.md §1.6).
-    enum class Microsurface { Single, Multiple };
-    /// Facets a microsurface walk may meet before it is given up (its flux is then lost), as the
-    /// goniophotometer's default.
-    static constexpr int kMaxMicrosurfaceOrder = 100;
+    /// `transport` (layers/transport_settings.h, as the goniophotometer's): the safety cap on
+    /// events per walk, the refraction masking of the single-scattering rough dielectrics, and how
+    /// the rough interfaces scatter: `Single`, the single-scattering microfacet BSDFs (the energy
+    /// of the paths that meet a second facet is lost), or `Multiple`, the microsurface random walk
+    /// of Heitz et al. 2016 (physics/microsurface_walk.h): sample() follows the walk to its exit,
+    /// eval() and pdf() connect through the interface's multiple-scattering BSDF and exit density
+    /// by the walk's unbiased stochastic evaluation (docs/rendering.md §1.6).
+    explicit RandomWalkStack(const Stack& stack, const TransportSettings& transport = {});
 
-    /// `max_events`: safety cap on events per walk (as the goniophotometer's); ≥ 1.
-    /// `masking`: the refraction masking of the rough dielectrics (physics/microfacet.h), as the
-    /// goniophotometer's --transmission-masking (single scattering only: the walk has its own).
-    /// `max_microsurface_order` ≥ 1 (Multiple only): 1 keeps only the walk's first order.
-    explicit RandomWalkStack(const Stack& stack, int max_events = 10'000,
-                             TransmissionMasking masking = TransmissionMasking::Smith,
-                             Microsurface microsurface = Microsurface::Single,
-                             int max_microsurface_order = kMaxMicrosurfaceOrder);
-
-    Microsurface microsurface() const { return microsurface_; }
+    const TransportSettings& transport() const { return transport_; }
 
     bool transmits() const { return transmits_; }
     /// Absolute indices of the ambient medium (above) and of the half-space below the base.
@@ -202,9 +191,7 @@ class RandomWalkStack {
     std::vector<double> eta_;            ///< absolute index per region 0..L
     bool transmits_ = false;
     bool pdf_unbiased_ = true;
-    int max_events_;
-    Microsurface microsurface_ = Microsurface::Single;
-    int max_microsurface_order_ = kMaxMicrosurfaceOrder;
+    TransportSettings transport_;
 };
 
 }  // namespace lamina

@@ -4,7 +4,7 @@
 #include "core/math.h"
 #include "core/progress.h"
 #include "core/rng.h"
-#include "models/random_walk_model.h"
+#include "models/random_walk/random_walk_model.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
 #include "physics/sampling.h"

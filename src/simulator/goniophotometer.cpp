@@ -28,21 +28,6 @@ Rgbd EnergyBudget::sum() const {
     return s;
 }
 
-void validate_settings(const SimulationSettings& s) {
-    if (s.theta_i_deg.empty())
-        throw InputError("command line", "--theta-i", "at least one incidence is needed");
-    for (double t : s.theta_i_deg)
-        check_incidence(t, "command line", "--theta-i");
-    if (s.particles == 0)
-        throw InputError("command line", "--particles", "the particle count must be > 0");
-    if (s.threads < 0)
-        throw InputError("command line", "--threads",
-                         fmt::format("{} is not allowed: use ≥ 1, or 0 for all cores", s.threads));
-    if (s.max_events < 1) throw InputError("command line", "--max-events", "must be ≥ 1");
-    if (s.max_microsurface_order < 1)
-        throw InputError("settings", "max_microsurface_order", "must be ≥ 1");
-}
-
 namespace {
 
 bool is_black(const Rgbf& w) {
@@ -256,33 +241,8 @@ void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block) {
     }
 }
 
-const char* kernel_name(Kernel kernel) {
-    return kernel == Kernel::Simd ? "simd" : "scalar";
-}
-
 std::string kernel_description(Kernel kernel) {
     return kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name()) : "scalar";
-}
-
-const char* microsurface_name(Microsurface microsurface) {
-    return microsurface == Microsurface::Multiple ? "multiple" : "single";
-}
-
-Microsurface parse_microsurface(const std::string& text, const std::string& option) {
-    if (text == "single") return Microsurface::Single;
-    if (text == "multiple") return Microsurface::Multiple;
-    throw InputError("command line", option,
-                     fmt::format("'{}' is not a microsurface model: use single (single "
-                                 "scattering, the lost energy reported) or multiple (Heitz et al. "
-                                 "2016 random walk, scalar kernel)",
-                                 text));
-}
-
-Kernel parse_kernel(const std::string& text, const std::string& option) {
-    if (text == "scalar") return Kernel::Scalar;
-    if (text == "simd") return Kernel::Simd;
-    throw InputError("command line", option,
-                     fmt::format("'{}' is not a kernel: use scalar or simd", text));
 }
 
 void IncidenceSums::add(const IncidenceSums& o) {
@@ -301,9 +261,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
                              const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);
     const auto start = std::chrono::steady_clock::now();
-    const CompiledStack<float> trace = compile_stack<float>(
-        stack, {settings.transmission_masking, settings.microsurface == Microsurface::Multiple,
-                settings.max_microsurface_order});
+    const CompiledStack<float> trace = compile_stack<float>(stack, settings.transport);
     const HemisphereGrid& grid = settings.grid;
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
     if (settings.kernel == Kernel::Simd) select_simd_target();
@@ -329,7 +287,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
                      incidence_stream(settings.theta_i_deg[inc]),
                      0,
                      0,
-                     settings.max_events};
+                     settings.transport.max_events};
         IncidenceSums total;
         total.bins.resize(2 * grid.size());
 

@@ -14,9 +14,10 @@
 #include "core/grid.h"
 #include "core/incidences.h"
 #include "core/rgb.h"
+#include "core/setting.h"
 #include "core/table.h"
 #include "layers/stack.h"
-#include "physics/microfacet.h"
+#include "layers/transport_settings.h"
 
 #include <array>
 #include <cstdint>
@@ -34,48 +35,60 @@ inline constexpr std::uint64_t kParticlesPerBlock = 4096;
 /// run time to what the CPU offers. Each is bitwise reproducible for any thread or process count on
 /// a given machine; the two agree in distribution (a two-sample chi-square test), not bit for bit.
 enum class Kernel { Scalar, Simd };
-const char* kernel_name(Kernel kernel);
+inline constexpr std::array<EnumName<Kernel>, 2> enum_names(Kernel) {
+    return {{{Kernel::Scalar, "scalar", "one particle at a time, the reference path"},
+             {Kernel::Simd, "simd", "particles as the lanes of SIMD vectors"}}};
+}
+inline const char* enum_noun(Kernel) {
+    return "a particle kernel";
+}
 /// The kernel as it runs on this machine: "scalar", or "simd" with the instruction set dispatched
 /// to (e.g. "simd AVX3"). Tables are bitwise reproducible for equal descriptions.
 std::string kernel_description(Kernel kernel);
-/// "scalar" | "simd" (InputError naming `option` otherwise).
-Kernel parse_kernel(const std::string& text, const std::string& option = "--kernel");
 
-/// How a rough interface treats the light its first facet does not let escape: `single`
-/// (docs/physics.md §3: single-scattering microfacet theory, the energy is lost to the microsurface
-/// and reported as lost_microsurface) or `multiple` (the microsurface random walk of Heitz et al.
-/// 2016, physics/microsurface_walk.h: nothing is lost; both kernels).
-enum class Microsurface { Single, Multiple };
-const char* microsurface_name(Microsurface microsurface);
-/// "single" | "multiple" (InputError naming `option` otherwise).
-Microsurface parse_microsurface(const std::string& text,
-                                const std::string& option = "--microsurface");
-
-/// Facets a microsurface walk may meet before its particle is given up (reported as
-/// lost_microsurface); walks of a few facets are the rule, a hundred is never reached in practice.
-inline constexpr int kMaxMicrosurfaceOrder = 100;
-
+/// The goniophotometer's settings. Each is declared once, in `fields` (core/setting.h): the
+/// command line, result.json, the study's files, the reference's cache key and Python read them
+/// there.
 struct SimulationSettings {
     std::vector<double> theta_i_deg = default_incidences_deg();  ///< each in [0, 90)
     std::uint64_t particles = 1'000'000;                         ///< per incidence, > 0
     std::uint64_t seed = 1;
-    int threads = 0;  ///< 0: all available
-    HemisphereGrid grid{90, 90};
-    /// Safety cap on interface and scattering events per particle; flux still travelling then is
-    /// reported as `cut_off` (docs/physics.md §5: must be ≈ 0).
-    int max_events = 10'000;
-    /// First particle index (a simulation may be split into ranges of particles, e.g. across
-    /// processes; the union of ranges equals one run of all particles, bit for bit).
-    std::uint64_t first_particle = 0;
+    int threads = 0;      ///< 0: all available
+    HemisphereGrid grid;  ///< its default is the study's (core/grid.h)
     Kernel kernel = Kernel::Simd;
-    Microsurface microsurface = Microsurface::Single;
-    /// Facets per microsurface walk (Microsurface::Multiple); 1 keeps only the first order, which
-    /// is the single-scattering interface (a test of the walk).
-    int max_microsurface_order = kMaxMicrosurfaceOrder;
-    /// The single-scattering rough dielectric's refraction masking (physics/microfacet.h): the
-    /// Smith microsurface's B(1 + Λi, 1 + Λo) or pbrt-v4's 1/(1 + Λi + Λo). The microsurface
-    /// walk (Microsurface::Multiple) has its own, which is the Smith one.
-    TransmissionMasking transmission_masking = TransmissionMasking::Smith;
+    /// The physics the particles follow (shared with the random walk).
+    TransportSettings transport;
+    /// First particle index (a simulation may be split into ranges of particles, e.g. across
+    /// processes; the union of ranges equals one run of all particles, bit for bit). Not a
+    /// setting: distributed/split_simulation.h sets it.
+    std::uint64_t first_particle = 0;
+
+    template <typename Self, typename Visit>
+    static void fields(Self& s, Visit&& visit) {
+        using Key = SettingInfo::Key;
+        visit({.name = "theta_i",
+               .help = "Incidences in degrees, comma-separated, in [0, 90)",
+               .key = Key::Fixed},
+              s.theta_i_deg);
+        visit({.name = "particles",
+               .help = "Particles per incidence (1e7-style accepted)",
+               .min = 1,
+               .key = Key::Fixed},
+              s.particles);
+        visit({.name = "seed", .help = "Random seed", .min = 0, .key = Key::Fixed}, s.seed);
+        visit({.name = "threads", .help = "Threads (0 = all cores)", .min = 0, .key = Key::No},
+              s.threads);
+        visit({.name = "grid",
+               .help = "Bins NTHETAxNPHI over θ∈[0°,90°], φ∈[0°,180°] (folded)",
+               .key = Key::Fixed},
+              s.grid);
+        visit({.name = "kernel",
+               .help = "Particle kernel: simd (vectorized, runtime dispatch) or scalar (reference "
+                       "path); tables are reproducible per kernel",
+               .key = Key::Fixed},
+              s.kernel);
+        TransportSettings::fields(s.transport, visit);
+    }
 };
 
 /// Where the flux of an incidence went, per channel; the terms sum to 1 to rounding.
@@ -139,8 +152,8 @@ struct SimulationResult {
     int processes = 1;     ///< processes that shared the particles (distributed/split_simulation.h)
 };
 
-/// Checks settings (InputError naming the option and the allowed range).
-void validate_settings(const SimulationSettings& settings);
+/// Checks what the settings' codecs cannot see alone (InputError naming `where` and the setting).
+void validate_settings(const SimulationSettings& settings, const std::string& where = "settings");
 
 /// Traces particles [first_particle, first_particle + particles) of every incidence and returns
 /// the raw sums. A run split into ranges that start at multiples of kParticlesPerBlock adds up

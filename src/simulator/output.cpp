@@ -37,18 +37,12 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     j["lamina_version"] = kVersion;
     j["kind"] = "goniophotometer";
     j["stack"] = stack_to_json(stack);
-    j["grid"] = {{"n_theta", s.grid.n_theta()},
-                 {"n_phi", s.grid.n_phi()},
-                 {"theta_range_deg", {0, 90}},
-                 {"phi_range_deg", {0, 180}},
-                 {"folded", true}};
-    j["particles"] = s.particles;
-    j["seed"] = s.seed;
+    // Every setting as it was given (core/setting.h), then what ran: the kernel's instruction set,
+    // the bins' ranges, the threads and processes used.
+    j.update(settings_to_json(s));
+    j["kernel_description"] = kernel_description(s.kernel);
+    j["grid"].update({{"theta_range_deg", {0, 90}}, {"phi_range_deg", {0, 180}}, {"folded", true}});
     j["first_particle"] = s.first_particle;
-    j["max_events"] = s.max_events;
-    j["kernel"] = kernel_description(s.kernel);
-    j["microsurface"] = microsurface_name(s.microsurface);
-    j["transmission_masking"] = transmission_masking_name(s.transmission_masking);
     j["threads"] = result.threads_used;
     j["processes"] = result.processes;
     j["seconds"] = result.seconds;

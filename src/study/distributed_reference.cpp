@@ -17,29 +17,15 @@ namespace {
 nlohmann::json key_json(const ReferenceKey& key) {
     return {{"config_id", key.config_id},
             {"stack", stack_to_json(key.stack)},
-            {"theta_i", key.theta_i_deg},
-            {"particles", key.particles},
-            {"seed", key.seed},
-            {"grid", key.grid.to_string()},
-            {"kernel", kernel_name(key.kernel)},
-            {"microsurface", microsurface_name(key.microsurface)},
-            {"transmission_masking", transmission_masking_name(key.transmission_masking)},
+            {"settings", settings_to_json(key.settings)},
             {"canonical", key.canonical()}};
 }
 
 ReferenceKey key_from_json(const nlohmann::json& j) {
-    ReferenceKey key{
-        j.at("config_id").get<std::string>(),
-        stack_from_json(j.at("stack"), "reference work list"),
-        j.at("theta_i").get<double>(),
-        j.at("particles").get<std::uint64_t>(),
-        j.at("seed").get<std::uint64_t>(),
-        HemisphereGrid::parse(j.at("grid").get<std::string>()),
-        parse_kernel(j.at("kernel").get<std::string>(), "reference work list"),
-        parse_microsurface(j.at("microsurface").get<std::string>(), "reference work list")};
-    key.transmission_masking =
-        parse_transmission_masking(j.at("transmission_masking").get<std::string>(),
-                                   "reference work list", "transmission_masking");
+    ReferenceKey key{j.at("config_id").get<std::string>(),
+                     stack_from_json(j.at("stack"), "reference work list"),
+                     {}};
+    settings_from_json(key.settings, j.at("settings"), "reference work list");
     if (key.canonical() != j.at("canonical").get<std::string>())
         throw InputError("reference work list", key.config_id,
                          "this process describes the piece differently from the root: are all "
@@ -58,7 +44,7 @@ std::string with_index(std::uint64_t index, const std::string& bytes) {
 std::uint64_t particles_of(const std::vector<ReferenceKey>& work, int rank, int size) {
     std::uint64_t n = 0;
     for (std::size_t i = std::size_t(rank); i < work.size(); i += std::size_t(size))
-        n += work[i].particles;
+        n += work[i].settings.particles;
     return n;
 }
 
@@ -68,11 +54,8 @@ std::vector<ReferenceKey> study_reference_keys(const std::vector<StudyConfigurat
                                                const StudySettings& s) {
     std::vector<ReferenceKey> keys;
     for (const StudyConfiguration& config : configs)
-        for (double theta_i : s.theta_i_deg) {
-            ReferenceKey key{config.id, config.stack, theta_i,  s.particles,
-                             s.seed,    s.grid,       s.kernel, s.microsurface};
-            key.transmission_masking = s.transmission_masking;
-            keys.push_back(key);
+        for (double theta_i : s.reference.theta_i_deg) {
+            keys.push_back(reference_key(config.id, config.stack, theta_i, s.reference));
         }
     return keys;
 }

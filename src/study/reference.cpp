@@ -76,7 +76,7 @@ std::string serialize(const ReferenceKey& key, const ReferencePiece& p) {
     nlohmann::json meta;
     meta["key"] = key.canonical();
     meta["has_transmission"] = p.has_transmission;
-    meta["bins"] = key.grid.size();
+    meta["bins"] = key.settings.grid.size();
     meta["seconds"] = p.seconds;
     nlohmann::json budget;
     for (int t = 0; t < kBudgetTerms; ++t)
@@ -98,7 +98,7 @@ std::string serialize(const ReferenceKey& key, const ReferencePiece& p) {
                 f.push_back(float(p.f[side][j][c]));
                 se.push_back(float_to_half(float(p.se[side][j][c])));
             }
-    const std::size_t n_phi = std::size_t(key.grid.n_phi());
+    const std::size_t n_phi = std::size_t(key.settings.grid.n_phi());
     const std::string f_packed = pack_elements(f.data(), f.size(), sizeof(float), n_phi, 3);
     meta["f_packed"] = f_packed.size();
     return kMagic + meta.dump() + "\n" + f_packed +
@@ -115,7 +115,7 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
     try {
         meta = nlohmann::json::parse(bytes.substr(magic_len, eol - magic_len));
         if (meta.at("key").get<std::string>() != key.canonical()) return false;
-        if (meta.at("bins").get<std::size_t>() != key.grid.size()) return false;
+        if (meta.at("bins").get<std::size_t>() != key.settings.grid.size()) return false;
         p.has_transmission = meta.at("has_transmission").get<bool>();
         p.seconds = meta.at("seconds").get<double>();
         const auto& budget = meta.at("budget");
@@ -133,7 +133,7 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
         return false;
     }
     const std::size_t sides = p.has_transmission ? 2 : 1;
-    const std::size_t n = key.grid.size();
+    const std::size_t n = key.settings.grid.size();
     const std::size_t expected = sides * 2 * n * 3 * sizeof(float);
     std::vector<float> data(expected / sizeof(float));
     if (packed) {
@@ -145,7 +145,7 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
             const std::size_t f_bytes = meta.at("f_packed").get<std::size_t>();
             const std::string_view rest = std::string_view(bytes).substr(eol + 1);
             if (f_bytes > rest.size()) return false;
-            const std::size_t n_phi = std::size_t(key.grid.n_phi());
+            const std::size_t n_phi = std::size_t(key.settings.grid.n_phi());
             unpack_elements(rest.substr(0, f_bytes), f.data(), values, sizeof(float), n_phi, 3,
                             key.file_name());
             unpack_elements(rest.substr(f_bytes), se.data(), values, sizeof(std::uint16_t), n_phi,
@@ -183,21 +183,35 @@ std::string read_file(const std::filesystem::path& path) {
 }  // namespace
 
 std::string ReferenceKey::canonical() const {
+    const TransportSettings& t = settings.transport;
+    const bool masking_said = t.microsurface == Microsurface::Single &&
+                              t.transmission_masking == TransmissionMasking::Smith &&
+                              has_rough_dielectric(stack);
     return fmt::format(
         "lamina {} | code {} | config {} | stack {} | theta_i {} | particles {} | seed {} | "
         "grid {} | kernel {}{}{}",
-        kVersion, kReferenceSourceDigest, config_id, stack_to_json(stack).dump(), theta_i_deg,
-        particles, seed, grid.to_string(), kernel_description(kernel),
-        microsurface == Microsurface::Multiple ? " | microsurface multiple" : "",
-        microsurface == Microsurface::Single &&
-                transmission_masking == TransmissionMasking::Smith && has_rough_dielectric(stack)
-            ? " | transmission masking smith"
-            : "");
+        kVersion, kReferenceSourceDigest, config_id, stack_to_json(stack).dump(), theta_i_deg(),
+        settings.particles, settings.seed, settings.grid.to_string(),
+        kernel_description(settings.kernel), settings_key_text(settings),
+        masking_said ? " | transmission masking smith" : "");
 }
 
 std::string ReferenceKey::file_name() const {
-    return fmt::format("theta{}-n{}-s{}-{:016x}.bin", theta_i_deg, particles, seed,
-                       fnv1a(canonical()));
+    return fmt::format("theta{}-n{}-s{}-{:016x}.bin", theta_i_deg(), settings.particles,
+                       settings.seed, fnv1a(canonical()));
+}
+
+const char* reference_code_digest() {
+    return kReferenceSourceDigest;
+}
+
+ReferenceKey reference_key(const std::string& config_id, const Stack& stack, double theta_i_deg,
+                           const SimulationSettings& reference) {
+    ReferenceKey key{config_id, stack, reference};
+    key.settings.theta_i_deg = {theta_i_deg};
+    key.settings.threads = 0;
+    key.settings.first_particle = 0;
+    return key;
 }
 
 std::uint64_t second_half_seed(std::uint64_t seed) {
@@ -216,22 +230,17 @@ std::optional<ReferencePiece> load_reference_piece(const std::filesystem::path& 
 std::string compute_reference_piece(const ReferenceKey& key, int threads,
                                     const std::function<void(std::uint64_t)>& on_progress) {
     // Two halves with different seeds; the same stream (the incidence) in each.
-    SimulationSettings s;
-    s.theta_i_deg = {key.theta_i_deg};
-    s.grid = key.grid;
+    const std::uint64_t particles = key.settings.particles;
+    SimulationSettings s = key.settings;
     s.threads = threads;
-    s.particles = (key.particles + 1) / 2;
-    s.seed = key.seed;
-    s.kernel = key.kernel;
-    s.microsurface = key.microsurface;
-    s.transmission_masking = key.transmission_masking;
+    s.particles = (particles + 1) / 2;
     const SimulationResult a = simulate(key.stack, s, on_progress);
     const std::uint64_t n_a = s.particles;
-    s.particles = key.particles - n_a;
-    s.seed = second_half_seed(key.seed);
+    s.particles = particles - n_a;
+    s.seed = second_half_seed(key.settings.seed);
     const SimulationResult b = simulate(key.stack, s, on_progress);
     const std::uint64_t n_b = s.particles;
-    const double wa = double(n_a) / double(key.particles), wb = double(n_b) / double(key.particles);
+    const double wa = double(n_a) / double(particles), wb = double(n_b) / double(particles);
 
     ReferencePiece piece;
     piece.has_transmission = a.table.has_transmission;
@@ -240,15 +249,15 @@ std::string compute_reference_piece(const ReferenceKey& key, int threads,
         const Side sd = side == 0 ? Side::Reflection : Side::Transmission;
         const BinnedLobe& la = a.table.lobe(0, sd);
         const BinnedLobe& lb = b.table.lobe(0, sd);
-        piece.f[side].resize(key.grid.size());
-        piece.se[side].resize(key.grid.size());
-        for (std::size_t j = 0; j < key.grid.size(); ++j)
+        piece.f[side].resize(key.settings.grid.size());
+        piece.se[side].resize(key.settings.grid.size());
+        for (std::size_t j = 0; j < key.settings.grid.size(); ++j)
             for (int c = 0; c < 3; ++c) {
                 piece.f[side][j][c] = wa * la.f[j][c] + wb * lb.f[j][c];
                 piece.se[side][j][c] = std::hypot(wa * la.se[j][c], wb * lb.se[j][c]);
             }
         for (int c = 0; c < 3; ++c)
-            piece.floor[side][c] = noise_floor(key.grid, la.f, lb.f, c);
+            piece.floor[side][c] = noise_floor(key.settings.grid, la.f, lb.f, c);
     }
     const EnergyBudget& ba = a.incidences[0].budget;
     const EnergyBudget& bb = b.incidences[0].budget;

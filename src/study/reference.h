@@ -23,25 +23,23 @@ namespace lamina {
 struct ReferenceKey {
     std::string config_id;
     Stack stack;
-    double theta_i_deg = 0;
-    std::uint64_t particles = 0;  ///< in all, both halves together
-    std::uint64_t seed = 1;
-    HemisphereGrid grid;
-    /// The particle kernel; its description (with the SIMD instruction set) is part of the key,
-    /// since tables are bitwise reproducible per kernel description only.
-    Kernel kernel = Kernel::Simd;
-    /// Single- or multiple-scattering microsurfaces (part of the key when multiple; the text of
-    /// single-scattering keys is what it was before the option existed, so their caches stay).
-    Microsurface microsurface = Microsurface::Single;
-    /// The refraction masking of single-scattering rough dielectrics (physics/microfacet.h).
-    /// Part of the key where it changes the table (single scattering and a rough dielectric in
-    /// the stack) and it is `smith`: caches made before the option, with the pbrt form, are then
-    /// reused for `pbrt` only.
-    TransmissionMasking transmission_masking = TransmissionMasking::Smith;
+    /// The goniophotometer's settings of the piece: one incidence, the particles of both halves
+    /// together, the seed of the first half, the grid, the kernel (its description, with the SIMD
+    /// instruction set, is part of the key, since tables are bitwise reproducible per kernel
+    /// description only) and the transport. The threads are not part of the key.
+    SimulationSettings settings;
+
+    double theta_i_deg() const { return settings.theta_i_deg.front(); }
 
     /// A canonical text of every field, lamina's version and the digest of the reference's code
     /// (kReferenceSourceDigest: src/core, physics, layers and simulator, so that a kernel whose
     /// numbers changed is never served a table the old code cached), and its 64-bit FNV-1a hash.
+    /// The settings a key has always held are written in a fixed form; the others as " | name
+    /// value" where they differ from what the reference did before they existed
+    /// (settings_key_text), so that caches made then stay valid. The refraction masking is
+    /// written only where it changes the table (single scattering, a rough dielectric in the
+    /// stack) and it is `smith`: caches made before the setting, with the pbrt form, are reused
+    /// for `pbrt` only.
     std::string canonical() const;
     std::string file_name() const;
 };
@@ -77,5 +75,12 @@ ReferencePiece store_reference_piece(const std::filesystem::path& cache_dir,
 
 /// The seed of the second half, derived from the study's seed.
 std::uint64_t second_half_seed(std::uint64_t seed);
+
+/// The digest of the reference's code the keys hold (kReferenceSourceDigest).
+const char* reference_code_digest();
+
+/// The key of the incidence `theta_i_deg` of a study's reference with the settings `reference`.
+ReferenceKey reference_key(const std::string& config_id, const Stack& stack, double theta_i_deg,
+                           const SimulationSettings& reference);
 
 }  // namespace lamina

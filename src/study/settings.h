@@ -21,9 +21,14 @@ namespace lamina {
 /// 1/sr lose relative precision, below 6·10⁻⁸ become 0, above 65504 are clamped to it), or not at
 /// all (metrics and summary only: no slices, albedo figures or explorer page).
 enum class TablesFormat { Full, Half, None };
-const char* tables_format_name(TablesFormat format);
-/// "full", "half" or "none"; InputError naming `option` otherwise.
-TablesFormat parse_tables_format(const std::string& text, const std::string& option = "--tables");
+inline constexpr std::array<EnumName<TablesFormat>, 3> enum_names(TablesFormat) {
+    return {{{TablesFormat::Full, "full", "float32"},
+             {TablesFormat::Half, "half", "float16, half the size"},
+             {TablesFormat::None, "none", "metrics and summary only"}}};
+}
+inline const char* enum_noun(TablesFormat) {
+    return "a table format";
+}
 
 /// A model evaluated elsewhere that joins the study as binned tables, like a built-in model: a
 /// `--model-table NAME=FILE.csv` (a renderer's or a fit's values in the brdf.csv format) or a
@@ -40,19 +45,13 @@ struct ExternalModel {
 
 struct StudySettings {
     std::string preset = "quick";
-    std::uint64_t particles = 1'000'000;  ///< per incidence (both halves together)
-    std::uint64_t seed = 1;
-    std::vector<double> theta_i_deg = default_incidences_deg();
-    HemisphereGrid grid{90, 90};
+    /// The reference's settings (the goniophotometer's): incidences, particles per incidence (both
+    /// halves together), seed, threads, grid, kernel and transport.
+    SimulationSettings reference;
     std::vector<std::string> models;  ///< registry names; empty: every model
     /// Also every production model's one-flag ablations (models/registry.h ablation_variants),
     /// "NAME:KEY=VALUE": the summary's engine-developer section says which heuristic helps.
     bool ablations = false;
-    int threads = 0;                                   ///< 0: all cores
-    Kernel kernel = Kernel::Simd;                      ///< the reference's particle kernel
-    Microsurface microsurface = Microsurface::Single;  ///< the reference's rough interfaces
-    /// The reference's refraction masking on single-scattering rough dielectrics.
-    TransmissionMasking transmission_masking = TransmissionMasking::Smith;
     TablesFormat tables = TablesFormat::Half;  ///< configs/<id>/tables.lza
     /// Ignore what an earlier run left (model tables, metrics, outputs) and compute it again; the
     /// reference pieces, keyed by everything they depend on, are still reused.
@@ -60,6 +59,17 @@ struct StudySettings {
     bool quiet = false;                          ///< no per-configuration lines on stdout
     std::vector<ExternalModel> external_models;  ///< compared after the registry's models
     bool registry_models = true;  ///< false: no registry model unless named in `models`
+
+    /// The study's own settings (core/setting.h); the reference's are SimulationSettings'.
+    template <typename Self, typename Visit>
+    static void fields(Self& s, Visit&& visit) {
+        visit({.name = "tables",
+               .help = "configs/ID/tables.lza (compressed): full (float32), half (float16) or "
+                       "none (metrics and summary only: no explorer page, slices or albedo "
+                       "figures)",
+               .key = SettingInfo::Key::No},
+              s.tables);
+    }
 };
 
 /// One row of metrics.csv.

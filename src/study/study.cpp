@@ -8,7 +8,7 @@
 #include "core/packed_array.h"
 #include "core/progress.h"
 #include "lamina/version.h"
-#include "models/binned.h"
+#include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "study/reference.h"
 #include "study/summary.h"
@@ -61,12 +61,14 @@ std::string model_key(const std::string& name, const StudyConfiguration& config,
     const ModelSpec spec = parse_model_spec(name, "--models");
     const BinnedOptions b;
     return fmt::format(
-        "lamina {} code {} | model {} | options {} | stack {} | theta_i {} | grid {} | binned {} {} "
+        "lamina {} code {} | model {} | options {} | stack {} | theta_i {} | grid {} | binned {} "
+        "{} "
         "{} {} {}",
         kVersion, kModelSourceDigest, name,
         nlohmann::json(resolve_options(*spec.entry, spec.assignments, "--models")).dump(),
-        stack_to_json(config.stack).dump(), fmt::join(s.theta_i_deg, ","), s.grid.to_string(),
-        b.rel_tol, b.abs_tol, b.max_depth, b.peak_depth, b.eval_budget);
+        stack_to_json(config.stack).dump(), fmt::join(s.reference.theta_i_deg, ","),
+        s.reference.grid.to_string(), b.rel_tol, b.abs_tol, b.max_depth, b.peak_depth,
+        b.eval_budget);
 }
 
 std::filesystem::path state_path(const std::filesystem::path& out_dir, const std::string& id) {
@@ -156,25 +158,21 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
                                const std::vector<std::string>& model_names,
                                const std::filesystem::path& out_dir, Progress& progress,
                                StudyWork& work) {
-    const std::size_t n_inc = s.theta_i_deg.size();
-    const HemisphereGrid& grid = s.grid;
+    const std::size_t n_inc = s.reference.theta_i_deg.size();
+    const HemisphereGrid& grid = s.reference.grid;
     const std::size_t bins = grid.size();
     const std::filesystem::path config_dir = out_dir / "configs" / config.id;
 
     // 0. The digests of the inputs, and what the last run left.
     std::vector<ReferenceKey> keys;
     std::uint64_t ref_digest = fnv1a("reference");
-    for (double theta_i : s.theta_i_deg) {
-        ReferenceKey key{config.id, config.stack, theta_i,  s.particles,
-                         s.seed,    grid,         s.kernel, s.microsurface};
-        key.transmission_masking = s.transmission_masking;
-        keys.push_back(key);
+    for (double theta_i : s.reference.theta_i_deg) {
+        keys.push_back(reference_key(config.id, config.stack, theta_i, s.reference));
         ref_digest = fnv1a(keys.back().canonical(), ref_digest);
     }
     std::vector<std::string> model_keys;
-    std::uint64_t outputs_digest =
-        fnv1a(fmt::format("{} | reference {} | tables {}", kStateFormat, digest_hex(ref_digest),
-                          tables_format_name(s.tables)));
+    std::uint64_t outputs_digest = fnv1a(fmt::format("{} | reference {} | tables {}", kStateFormat,
+                                                     digest_hex(ref_digest), enum_text(s.tables)));
     for (const std::string& name : model_names) {
         model_keys.push_back(digest_hex(fnv1a(model_key(name, config, s))));
         outputs_digest = fnv1a(" | " + name + " " + model_keys.back(), outputs_digest);
@@ -209,7 +207,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     for (const ReferenceKey& key : keys) {
         bool computed = false;
         pieces.push_back(reference_piece(
-            reference_cache_dir(out_dir), key, s.threads,
+            reference_cache_dir(out_dir), key, s.reference.threads,
             [&](std::uint64_t n) { progress.advance(n); }, &computed));
         work.reference_pieces_computed += computed;
         result.reference_seconds += pieces.back().seconds;
@@ -230,7 +228,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
         if (!old_loaded) {
             old_loaded = true;
             try {
-                if (state.value("tables", "") == tables_format_name(s.tables)) {
+                if (state.value("tables", "") == enum_text(s.tables)) {
                     std::ifstream in(config_dir / "config.json");
                     const nlohmann::json cj = nlohmann::json::parse(in);
                     old_sources = cj.at("sources").get<std::vector<std::string>>();
@@ -287,7 +285,8 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
             // A table from elsewhere (model table, Python plugin), checked against the study.
             table = external->table(config);
             if (table.has_reflection || table.has_transmission)
-                check_external_table(table, grid, s.theta_i_deg, transmits, external->source);
+                check_external_table(table, grid, s.reference.theta_i_deg, transmits,
+                                     external->source);
             m.support.brdf = table.has_reflection;
             m.support.btdf = transmits && table.has_transmission;
             if (!m.support.brdf || (transmits && !m.support.btdf))
@@ -299,7 +298,8 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
         } else {
             const std::unique_ptr<Model> model = make_model(name, config.stack);
             m.support = model->support();
-            if (m.support.brdf || m.support.btdf) table = bin_model(*model, grid, s.theta_i_deg);
+            if (m.support.brdf || m.support.btdf)
+                table = bin_model(*model, grid, s.reference.theta_i_deg);
         }
         m.table.assign(n_inc * block, NAN);
         m.albedo = nlohmann::json::object();
@@ -313,7 +313,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
                         m.rows.push_back({config.id,
                                           config.category,
                                           name,
-                                          s.theta_i_deg[i],
+                                          s.reference.theta_i_deg[i],
                                           side_name[0],
                                           c,
                                           false,
@@ -331,7 +331,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
                     }
                 m.albedo[side_name].push_back(rgb(a));
                 for (int c = 0; c < 3; ++c)
-                    m.rows.push_back({config.id, config.category, name, s.theta_i_deg[i],
+                    m.rows.push_back({config.id, config.category, name, s.reference.theta_i_deg[i],
                                       side_name[0], c, true,
                                       lobe_metrics(grid, pieces[i].f[side], lobe.f, c),
                                       pieces[i].floor[side][c]});
@@ -379,7 +379,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     for (std::size_t i = 0; i < n_inc; ++i) {
         result.lost_microsurface.push_back(pieces[i].budget[BudgetTerm::LostMicrosurface]);
         nlohmann::json e;
-        e["theta_i"] = s.theta_i_deg[i];
+        e["theta_i"] = s.reference.theta_i_deg[i];
         for (int t = 0; t < kBudgetTerms; ++t)
             e[kBudgetTermNames[t]] = rgb(pieces[i].budget.term[t]);
         e["reflected_se"] = rgb(pieces[i].budget.reflected_se);
@@ -398,7 +398,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     cj["parameters"] = config.parameters;
     cj["stack"] = stack_to_json(config.stack);
     cj["sides"] = transmits ? nlohmann::json{"R", "T"} : nlohmann::json{"R"};
-    cj["theta_i"] = s.theta_i_deg;
+    cj["theta_i"] = s.reference.theta_i_deg;
     cj["sources"] = sources;
     cj["supported"] = supported;
     cj["albedo"] = albedo;
@@ -440,7 +440,7 @@ ConfigResult run_configuration(const StudyConfiguration& config, const StudySett
     st["format"] = kStateFormat;
     st["outputs"] = digest_hex(outputs_digest);
     st["reference"] = digest_hex(ref_digest);
-    st["tables"] = tables_format_name(s.tables);
+    st["tables"] = enum_text(s.tables);
     st["reference_seconds"] = result.reference_seconds;
     st["lost_microsurface"] = nlohmann::json::array();
     for (const Rgbd& v : result.lost_microsurface)
@@ -554,28 +554,6 @@ std::filesystem::path reference_cache_dir(const std::filesystem::path& out_dir) 
     return out_dir / "cache" / "reference";
 }
 
-const char* tables_format_name(TablesFormat format) {
-    switch (format) {
-        case TablesFormat::Full:
-            return "full";
-        case TablesFormat::Half:
-            return "half";
-        case TablesFormat::None:
-            return "none";
-    }
-    return "half";
-}
-
-TablesFormat parse_tables_format(const std::string& text, const std::string& option) {
-    if (text == "full") return TablesFormat::Full;
-    if (text == "half") return TablesFormat::Half;
-    if (text == "none") return TablesFormat::None;
-    throw InputError("command line", option,
-                     fmt::format("'{}' is not a table format: use full (float32), half (float16, "
-                                 "half the size) or none (metrics and summary only)",
-                                 text));
-}
-
 std::string describe_work(const StudyWork& w) {
     return fmt::format(
         "{} reference pieces simulated, {} model tables computed ({} reused), {} configurations "
@@ -589,7 +567,8 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
     const std::vector<std::string> model_names = study_models(s);
 
     StagedOutput probe(out_dir);  // the folder must be writable before any work starts
-    Progress progress("study", "particles", configs.size() * s.theta_i_deg.size() * s.particles);
+    Progress progress("study", "particles",
+                      configs.size() * s.reference.theta_i_deg.size() * s.reference.particles);
     StudyResult result;
     ReferenceLoss lost;
     double reference_seconds = 0;
@@ -614,13 +593,11 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
     nlohmann::json sj;
     sj["lamina_version"] = kVersion;
     sj["preset"] = s.preset;
-    sj["particles"] = s.particles;
-    sj["seed"] = s.seed;
-    sj["kernel"] = kernel_description(s.kernel);
-    sj["microsurface"] = microsurface_name(s.microsurface);
-    sj["transmission_masking"] = transmission_masking_name(s.transmission_masking);
-    sj["theta_i"] = s.theta_i_deg;
-    sj["grid"] = {{"n_theta", s.grid.n_theta()}, {"n_phi", s.grid.n_phi()}};
+    // The reference's settings (core/setting.h; threads are not the study's), then the kernel as it
+    // ran here.
+    sj.update(settings_to_json(s.reference));
+    sj.erase("threads");
+    sj["kernel_description"] = kernel_description(s.reference.kernel);
     sj["models"] = model_names;
     // The family of each model (the explorer groups them): its registry group, "ablations" for a
     // production coat with a flag switched, "external" for a model table or a Python model.
@@ -635,7 +612,7 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
         groups[name] = spec.assignments.empty() ? spec.entry->group : std::string("ablations");
     }
     sj["model_groups"] = groups;
-    sj["tables"] = tables_format_name(s.tables);
+    sj.update(settings_to_json(s));
     // The reference's simulation time as stored in its pieces: the same on every re-run.
     sj["reference_seconds"] = reference_seconds;
     nlohmann::json list = nlohmann::json::array();

@@ -174,10 +174,10 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
                                const std::vector<MetricRow>& rows, const ReferenceLoss& lost) {
     StudyFindings f;
     f.preset = s.preset;
-    f.particles = s.particles;
-    f.microsurface = microsurface_name(s.microsurface);
-    f.theta_i = s.theta_i_deg;
-    f.grid = s.grid.to_string();
+    f.particles = s.reference.particles;
+    f.microsurface = enum_text(s.reference.transport.microsurface);
+    f.theta_i = s.reference.theta_i_deg;
+    f.grid = s.reference.grid.to_string();
     f.models = models;
     f.configurations = configs.size();
 
@@ -287,7 +287,7 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
     for (const StudyConfiguration& c : configs) {
         const auto it = lost.find(c.id);
         if (it == lost.end()) continue;
-        for (std::size_t i = 0; i < it->second.size() && i < s.theta_i_deg.size(); ++i)
+        for (std::size_t i = 0; i < it->second.size() && i < s.reference.theta_i_deg.size(); ++i)
             for (int ch = 0; ch < 3; ++ch) {
                 const double v = it->second[i][ch];
                 for (const std::string& g : {c.category, std::string("all")}) {
@@ -295,7 +295,7 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
                     LossFindings& l = f.reference_loss[g];
                     if (n == 0 || v > l.worst) {
                         l.worst = v;
-                        l.worst_at = {c.id, s.theta_i_deg[i], 'R', ch};
+                        l.worst_at = {c.id, s.reference.theta_i_deg[i], 'R', ch};
                     }
                     sum += v;
                     ++n;

@@ -17,7 +17,7 @@ TEST(Incidences, DefaultsAreTheStudysSevenAnglesEverywhere) {
     EXPECT_EQ(default_incidences_deg(), expected);
     EXPECT_EQ(default_incidences_text(), "0,15,30,45,60,70,80");
     EXPECT_EQ(SimulationSettings{}.theta_i_deg, expected);
-    EXPECT_EQ(StudySettings{}.theta_i_deg, expected);
+    EXPECT_EQ(StudySettings{}.reference.theta_i_deg, expected);
 }
 
 TEST(Incidences, RangeIsZeroToNinetyExcluded) {

@@ -9,7 +9,7 @@
 #include "export/npz.h"
 #include "export/rgl_bsdf.h"
 #include "export/tensor_file.h"
-#include "models/binned.h"
+#include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "models/test_stacks.h"
 #include "simulator/goniophotometer.h"

@@ -17,8 +17,8 @@
 #include "core/rng.h"
 #include "core/spherical.h"
 #include "layers/stack.h"
-#include "models/binned.h"
-#include "models/random_walk_model.h"
+#include "models/numerics/binned.h"
+#include "models/random_walk/random_walk_model.h"
 #include "models/registry.h"
 #include "render/renderer.h"
 #include "simulator/goniophotometer.h"
@@ -520,15 +520,15 @@ void check_simulation(Draw& d, const CaseContext& c, const Stack& stack) {
     s.threads = 1;
     s.grid = HemisphereGrid(3, 4);
     s.kernel = d.chance(0.5) ? Kernel::Scalar : Kernel::Simd;
-    s.microsurface = d.chance(0.3) ? Microsurface::Multiple : Microsurface::Single;
+    s.transport.microsurface = d.chance(0.3) ? Microsurface::Multiple : Microsurface::Single;
     try {
         validate_settings(s);
     } catch (const InputError&) {
-        s.microsurface = Microsurface::Single;  // a combination the kernel does not offer
+        s.transport.microsurface = Microsurface::Single;  // a combination the kernel does not offer
     }
     const std::string what =
-        fmt::format("simulation ({} kernel, {} microsurface) of {} = {}", kernel_name(s.kernel),
-                    microsurface_name(s.microsurface), c.where, shorten(c.text));
+        fmt::format("simulation ({} kernel, {} microsurface) of {} = {}", enum_text(s.kernel),
+                    enum_text(s.transport.microsurface), c.where, shorten(c.text));
     const SimulationResult r = simulate(stack, s);
     for (std::size_t i = 0; i < r.table.lobes.size(); ++i)
         for (const BinnedLobe& lobe : r.table.lobes[i])

@@ -3,7 +3,7 @@
 // is shown explicitly instead of hidden.
 #include "core/math.h"
 #include "core/spherical.h"
-#include "models/binned.h"
+#include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "test_stacks.h"
 

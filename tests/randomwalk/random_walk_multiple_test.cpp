@@ -1,4 +1,4 @@
-// The random walk with multiple-scattering rough interfaces (RandomWalkStack::Microsurface::
+// The random walk with multiple-scattering rough interfaces (Microsurface::
 // Multiple, docs/rendering.md §1.6) against independent computations: its first order is the
 // single-scattering Walter BSDF with the height-correlated Smith masking (conductor: G2,
 // dielectric: B(1 + Λi, 1 + Λo)) of physics/dielectric.h and conductor.h; white furnaces
@@ -25,7 +25,7 @@
 namespace lamina {
 namespace {
 
-using enum RandomWalkStack::Microsurface;
+using enum Microsurface;
 
 // ---- The first order of the stochastic evaluation ----------------------------------------------
 // Capped at one facet, a walk's estimate is the first facet's phase function towards wo times the
@@ -58,8 +58,9 @@ TEST(RandomWalkMultiple, FirstOrderIsTheSingleScatteringInterface) {
     }
     int checked = 0;
     for (const Case& c : cases) {
-        const RandomWalkStack single(c.stack, 10'000, TransmissionMasking::Smith, Single);
-        const RandomWalkStack first(c.stack, 10'000, TransmissionMasking::Smith, Multiple, 1);
+        const RandomWalkStack single(c.stack, {.microsurface = Single});
+        const RandomWalkStack first(c.stack,
+                                    {.microsurface = Multiple, .max_microsurface_order = 1});
         for (double ti : {0.4, 1.2})
             for (const Vec3d& wo : wos) {
                 const Vec3d wi = incident_direction(ti);
@@ -168,14 +169,14 @@ TEST(RandomWalkMultipleStat, WhiteFurnaceByQuadratureOfTheEval) {
     for (const Case& c : cases)
         for (double ti : {0.5, 1.3}) {
             const Vec3d wi = incident_direction(ti);
-            const RandomWalkStack multiple(c.stack, 10'000, TransmissionMasking::Smith, Multiple);
+            const RandomWalkStack multiple(c.stack, {.microsurface = Multiple});
             const Albedo a = total_albedo(multiple, wi, 48, 8);
             EXPECT_LT(std::abs(a.mean - 1), 4.5 * a.se)
                 << c.name << " θi " << ti << ": " << a.mean << " ± " << a.se;
             EXPECT_LT(a.se, 0.02) << c.name;  // the test's resolution
             RecordProperty(c.name + " θi " + std::to_string(ti),
                            std::to_string(a.mean) + " ± " + std::to_string(a.se));
-            const RandomWalkStack single(c.stack, 10'000, TransmissionMasking::Smith, Single);
+            const RandomWalkStack single(c.stack, {.microsurface = Single});
             const Albedo s = total_albedo(single, wi, 48, 8);
             EXPECT_GT(1 - s.mean, 5 * s.se)
                 << c.name << " θi " << ti << " single: " << s.mean << " ± " << s.se;
@@ -187,8 +188,8 @@ TEST(RandomWalkMultipleStat, WhiteFurnaceByQuadratureOfTheEval) {
 // that leaves above equals the eval's hemispherical reflectance (binomial SE ⊕ quadrature SE).
 TEST(RandomWalkMultipleStat, WhiteFurnaceOfTheSampleWeights) {
     for (double alpha : {0.3, 1.0}) {
-        const RandomWalkStack rw(test::make_stack({test::dielectric_layer(1.5, alpha)}), 10'000,
-                                 TransmissionMasking::Smith, Multiple);
+        const RandomWalkStack rw(test::make_stack({test::dielectric_layer(1.5, alpha)}),
+                                 {.microsurface = Multiple});
         for (double ti : {0.5, 1.3}) {
             const Vec3d wi = incident_direction(ti);
             const int n = 200000;
@@ -218,8 +219,7 @@ TEST(RandomWalkMultiple, IndexMatchedRoughInterfaceIsAPassThrough) {
         test::make_stack({test::with_medium(test::dielectric_layer(1.0, 0.5), Rgbd(0.0)),
                           test::dielectric_layer(1.0, 0.0)});
     const Vec3d wi = incident_direction(1.0);
-    const auto lobes =
-        RandomWalkStack(stack, 10'000, TransmissionMasking::Smith, Multiple).delta_lobes(wi);
+    const auto lobes = RandomWalkStack(stack, {.microsurface = Multiple}).delta_lobes(wi);
     ASSERT_EQ(lobes.size(), 1u);
     EXPECT_LT(lobes[0].direction.z, 0);
     EXPECT_NEAR(lobes[0].energy[0], 1.0, 1e-12);
@@ -232,7 +232,7 @@ TEST(RandomWalkMultiple, DeterministicForASeedAndFinite) {
     const RandomWalkStack rw(
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1)),
                           test::conductor_layer(Rgbd(0.2, 0.4, 1.4), Rgbd(3.9, 2.4, 1.6), 0.3)}),
-        10'000, TransmissionMasking::Smith, Multiple);
+        {.microsurface = Multiple});
     const Vec3d wi = incident_direction(0.6), wo = direction_from_angles(1.1, 2.0);
     const RandomWalkEstimate a = rw.eval(wi, wo, 500, 1, 7), b = rw.eval(wi, wo, 500, 1, 7);
     EXPECT_EQ(a.f, b.f);

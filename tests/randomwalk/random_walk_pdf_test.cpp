@@ -117,11 +117,11 @@ TEST(RandomWalkPdfStat, SmoothCoatOverLambertianIsTheWhiteSeries) {
 struct PdfCase {
     std::string name;
     Stack stack;
-    RandomWalkStack::Microsurface microsurface = RandomWalkStack::Microsurface::Single;
+    Microsurface microsurface = Microsurface::Single;
 };
 
 void expect_sample_matches_pdf(const PdfCase& c, int test_count) {
-    const RandomWalkStack rw(c.stack, 10'000, TransmissionMasking::Smith, c.microsurface);
+    const RandomWalkStack rw(c.stack, {.microsurface = c.microsurface});
     ASSERT_TRUE(rw.pdf_is_unbiased()) << c.name;
     const Vec3d wi = incident_direction(deg_to_rad(40.0));
     const std::uint64_t walks_per_cell = 3000;
@@ -196,7 +196,7 @@ TEST(RandomWalkPdfStat, SampleHistogramMatchesThePdfAndItsIntegral) {
 // over a scattering medium with per-channel extinction over a rough conductor (the facets'
 // per-channel Fresnel weights inside the spectral-MIS chain probabilities).
 TEST(RandomWalkPdfStat, MultipleScatteringSampleHistogramMatchesThePdf) {
-    using enum RandomWalkStack::Microsurface;
+    using enum Microsurface;
     const Rgbd eta(0.2, 0.4, 1.4), k(3.9, 2.4, 1.6);
     std::vector<PdfCase> cases = {
         {"ms_rough_dielectric", test::make_stack({test::dielectric_layer(1.5, 0.6)}), Multiple},

@@ -98,7 +98,7 @@ void expect_agreement_conservative(const test::TableComparison& r, double alpha 
         << "chi2 = " << r.chi2 << " over " << r.bins << " bins; worst: " << r.worst;
 }
 
-using RwMicrosurface = RandomWalkStack::Microsurface;
+using RwMicrosurface = Microsurface;
 
 SimulationResult simulate_one(const Stack& stack, double theta_i, std::uint64_t particles,
                               const HemisphereGrid& grid,
@@ -109,7 +109,7 @@ SimulationResult simulate_one(const Stack& stack, double theta_i, std::uint64_t 
     s.grid = grid;
     s.seed = 11;
     if (microsurface == RwMicrosurface::Multiple) {
-        s.microsurface = Microsurface::Multiple;
+        s.transport.microsurface = Microsurface::Multiple;
         s.kernel = Kernel::Scalar;  // the goniophotometer's kernel with multiple scattering
     }
     return simulate(stack, s);
@@ -122,7 +122,7 @@ void expect_tables_agree(const Stack& stack, double theta_i, int p, std::uint64_
                          std::uint64_t particles, const std::string& what,
                          RwMicrosurface microsurface = RwMicrosurface::Single) {
     const HemisphereGrid grid(9, 9);
-    const RandomWalkStack rw(stack, 10'000, TransmissionMasking::Smith, microsurface);
+    const RandomWalkStack rw(stack, {.microsurface = microsurface});
     const SimulationResult ref = simulate_one(stack, theta_i, particles, grid, microsurface);
     for (Side side : {Side::Reflection, Side::Transmission}) {
         if (side == Side::Transmission && !stack.transmits()) continue;
@@ -381,7 +381,7 @@ TEST(RandomWalkStat, MultipleScatteringIsReciprocal) {
                           test::conductor_layer(Rgbd(0.2), Rgbd(3.0), 0.5)})};
     std::uint64_t stream = 0;
     for (const Stack& s : brdf_stacks) {
-        const RandomWalkStack rw(s, 10'000, TransmissionMasking::Smith, RwMicrosurface::Multiple);
+        const RandomWalkStack rw(s, {.microsurface = RwMicrosurface::Multiple});
         for (const auto& [a, b] : std::vector<std::pair<Vec3d, Vec3d>>{
                  {direction_from_angles(0.3, 0.0), direction_from_angles(1.1, 2.0)},
                  {direction_from_angles(1.3, 0.5), direction_from_angles(0.2, 3.0)}}) {
@@ -399,9 +399,8 @@ TEST(RandomWalkStat, MultipleScatteringIsReciprocal) {
     const Stack slab =
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1)),
                           test::dielectric_layer(1.33, 0.5)});
-    const RandomWalkStack rw(slab, 10'000, TransmissionMasking::Smith, RwMicrosurface::Multiple);
-    const RandomWalkStack below(flipped_stack(slab), 10'000, TransmissionMasking::Smith,
-                                RwMicrosurface::Multiple);
+    const RandomWalkStack rw(slab, {.microsurface = RwMicrosurface::Multiple});
+    const RandomWalkStack below(flipped_stack(slab), {.microsurface = RwMicrosurface::Multiple});
     const double ratio2 = sqr(rw.eta_top() / rw.eta_bottom());
     auto flip = [](const Vec3d& w) { return Vec3d(w.x, w.y, -w.z); };
     for (const auto& [wi, wo] : std::vector<std::pair<Vec3d, Vec3d>>{
@@ -427,7 +426,7 @@ TEST(RandomWalkStat, MultipleScatteringIsReciprocal) {
 void expect_sample_agrees_with_eval(const std::string& name, const Stack& stack,
                                     RwMicrosurface microsurface) {
     {
-        const RandomWalkStack rw(stack, 10'000, TransmissionMasking::Smith, microsurface);
+        const RandomWalkStack rw(stack, {.microsurface = microsurface});
         const HemisphereGrid grid(9, 9);
         const double ti = 35;
         const Vec3d wi = incident_direction(deg_to_rad(ti));

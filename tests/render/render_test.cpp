@@ -5,7 +5,7 @@
 
 #include "core/math.h"
 
-#include "models/random_walk_model.h"
+#include "models/random_walk/random_walk_model.h"
 #include "models/registry.h"
 #include "render/contact_sheet.h"
 #include "render/image.h"

@@ -45,7 +45,7 @@ class Goniophotometer : public ::testing::TestWithParam<Kernel> {
     void SetUp() override { g_kernel = GetParam(); }
 };
 std::string kernel_test_name(const ::testing::TestParamInfo<Kernel>& info) {
-    return kernel_name(info.param);
+    return enum_text(info.param);
 }
 INSTANTIATE_TEST_SUITE_P(Kernels, GoniophotometerStat,
                          ::testing::Values(Kernel::Scalar, Kernel::Simd), kernel_test_name);
@@ -236,7 +236,7 @@ void check_single_rough_dielectric(double ambient_eta, double eta, double alpha,
     Stack stack = test::make_stack({test::dielectric_layer(eta, alpha)});
     stack.ambient_eta = ambient_eta;
     SimulationSettings s = settings({theta_i}, particles, HemisphereGrid(18, 18));
-    s.transmission_masking = masking;
+    s.transport.transmission_masking = masking;
     if (tweak) tweak(s);
     const HemisphereGrid grid = s.grid;
     const auto r = simulate(stack, s);
@@ -298,7 +298,7 @@ TEST_P(GoniophotometerStat, SingleRoughDielectricFromDenseSide) {
 TEST_P(GoniophotometerStat, SingleRoughDielectricSmithAndPbrtMasking) {
     for (const TransmissionMasking masking :
          {TransmissionMasking::Smith, TransmissionMasking::Pbrt}) {
-        SCOPED_TRACE(transmission_masking_name(masking));
+        SCOPED_TRACE(enum_text(masking));
         if (masking == TransmissionMasking::Pbrt) {
             SCOPED_TRACE("alpha 0.3, 40 degrees");
             check_single_rough_dielectric(1.0, 1.5, 0.3, 40, {}, masking);
@@ -473,9 +473,9 @@ TEST_P(Goniophotometer, BitwiseIdenticalAcrossThreadCounts) {
     };
     for (const Stack& stack : stacks)
         for (const Microsurface microsurface : {Microsurface::Single, Microsurface::Multiple}) {
-            SCOPED_TRACE(microsurface_name(microsurface));
+            SCOPED_TRACE(enum_text(microsurface));
             SimulationSettings s = settings({0, 60}, 50'000, HemisphereGrid(30, 30));
-            s.microsurface = microsurface;
+            s.transport.microsurface = microsurface;
             s.threads = 1;
             const auto one = simulate(stack, s);
             s.threads = 2;
@@ -523,11 +523,11 @@ INSTANTIATE_TEST_SUITE_P(Kernels, MicrosurfaceWalkStat,
 
 void multiple_scattering(SimulationSettings& s) {
     s.kernel = g_kernel;
-    s.microsurface = Microsurface::Multiple;
+    s.transport.microsurface = Microsurface::Multiple;
 }
 void first_order_only(SimulationSettings& s) {
     multiple_scattering(s);
-    s.max_microsurface_order = 1;
+    s.transport.max_microsurface_order = 1;
 }
 
 // The first order on a coarser grid: the walk's first-order exits all carry flux 1 (the
@@ -637,7 +637,7 @@ TEST_P(MicrosurfaceWalkStat, HigherOrdersAddReflection) {
     first_order_only(s);
     const auto first = simulate(stack, s);
     multiple_scattering(s);
-    s.max_microsurface_order = kMaxMicrosurfaceOrder;
+    s.transport.max_microsurface_order = TransportSettings{}.max_microsurface_order;
     const auto all = simulate(stack, s);
     const EnergyBudget &b1 = first.incidences[0].budget, &b = all.incidences[0].budget;
     const double se = std::hypot(b1.reflected_se[0], b.reflected_se[0]);
@@ -647,15 +647,18 @@ TEST_P(MicrosurfaceWalkStat, HigherOrdersAddReflection) {
 
 TEST(MicrosurfaceWalk, RunsOnBothKernels) {
     SimulationSettings s;
-    s.microsurface = Microsurface::Multiple;
+    s.transport.microsurface = Microsurface::Multiple;
     s.kernel = Kernel::Simd;
     EXPECT_NO_THROW(validate_settings(s));
     s.kernel = Kernel::Scalar;
     EXPECT_NO_THROW(validate_settings(s));
-    s.max_microsurface_order = 0;
+    s.transport.max_microsurface_order = 0;
     EXPECT_THROW(validate_settings(s), InputError);
-    EXPECT_EQ(parse_microsurface("multiple"), Microsurface::Multiple);
-    EXPECT_THROW(parse_microsurface("heitz"), InputError);
+    const SettingInfo info{.name = "microsurface", .help = ""};
+    EXPECT_EQ(SettingCodec<Microsurface>::from_text("multiple", info, "test", "microsurface"),
+              Microsurface::Multiple);
+    EXPECT_THROW(SettingCodec<Microsurface>::from_text("heitz", info, "test", "microsurface"),
+                 InputError);
 }
 
 // Fuzz seed 1214, case 2100: particles trapped in a dense scattering layer (τs = 100 under an
@@ -675,11 +678,11 @@ TEST(Goniophotometer, BudgetClosesForLongTrappedPaths) {
         s.threads = 1;
         s.grid = HemisphereGrid(3, 4);
         s.kernel = kernel;
-        s.microsurface = Microsurface::Multiple;
+        s.transport.microsurface = Microsurface::Multiple;
         const SimulationResult r = simulate(stack, s);
         for (const IncidenceStats& st : r.incidences)
             for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(st.budget.sum()[c], 1.0, 1e-10) << kernel_name(kernel);
+                EXPECT_NEAR(st.budget.sum()[c], 1.0, 1e-10) << enum_text(kernel);
     }
 }
 

@@ -589,8 +589,8 @@ TEST(KernelSimdStat, SameTablesAsScalarRoughSlab) {
 TEST(KernelSimdStat, WalkFirstOrderIsTheSmithMaskedInterface) {
     expect_same_distribution(test::make_stack({test::dielectric_layer(1.5, 0.7)}), {75}, 1'000'000,
                              [](SimulationSettings& s) {
-                                 s.microsurface = Microsurface::Multiple;
-                                 s.max_microsurface_order = 1;
+                                 s.transport.microsurface = Microsurface::Multiple;
+                                 s.transport.max_microsurface_order = 1;
                              });
 }
 
@@ -598,7 +598,7 @@ TEST(KernelSimdStat, WalkFirstOrderIsTheSmithMaskedInterface) {
 // plastic, a very rough slab (reflection and transmission, walks from both sides, total internal
 // reflection on facets inside) and a rough conductor under a rough coat (the conductor walk).
 void multiple(SimulationSettings& s) {
-    s.microsurface = Microsurface::Multiple;
+    s.transport.microsurface = Microsurface::Multiple;
 }
 
 TEST(KernelSimdStat, SameTablesAsScalarMultiplePlastic) {

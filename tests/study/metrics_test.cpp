@@ -117,8 +117,12 @@ TEST(StudyMetrics, NoiseFloorOfMisplacedFloorIsHalfTheHalvesDifference) {
 // from what the piece holds, and equals the one computed with the piece.
 TEST(StudyMetrics, OldReferencePiecesGetTheirMisplacedFloorNoise) {
     const Stack stack = test::make_stack({test::lambertian_layer(Rgbd(0.8, 0.3, 0.02))});
-    ReferenceKey key{
-        "old", stack, 30, 4000, 3, HemisphereGrid(6, 6), Kernel::Scalar, Microsurface::Single};
+    SimulationSettings s;
+    s.particles = 4000;
+    s.seed = 3;
+    s.grid = HemisphereGrid(6, 6);
+    s.kernel = Kernel::Scalar;
+    const ReferenceKey key = reference_key("old", stack, 30, s);
     std::string bytes = compute_reference_piece(key, 1, [](std::uint64_t) {});
     const std::size_t eol = bytes.find('\n', bytes.find('\n') + 1);
     std::string meta = bytes.substr(0, eol);
@@ -211,9 +215,12 @@ TEST(StudyReference, CachedPieceIsReusedAndAMismatchIsRecomputed) {
     const std::filesystem::path dir =
         std::filesystem::path(LAMINA_BINARY_DIR) / "test-output" / "reference-cache";
     std::filesystem::remove_all(dir);
-    ReferenceKey key{
-        "lambertian",        test::make_stack({test::lambertian_layer(Rgbd(0.5))}), 30.0, 20'000, 5,
-        HemisphereGrid(9, 9)};
+    SimulationSettings s;
+    s.particles = 20'000;
+    s.seed = 5;
+    s.grid = HemisphereGrid(9, 9);
+    ReferenceKey key =
+        reference_key("lambertian", test::make_stack({test::lambertian_layer(Rgbd(0.5))}), 30, s);
     bool computed = false;
     const ReferencePiece first = reference_piece(dir, key, 0, {}, &computed);
     EXPECT_TRUE(computed);
@@ -228,7 +235,7 @@ TEST(StudyReference, CachedPieceIsReusedAndAMismatchIsRecomputed) {
     EXPECT_TRUE(computed);
     EXPECT_EQ(first.f[0], redone.f[0]);
     // Another seed is another piece.
-    key.seed = 6;
+    key.settings.seed = 6;
     reference_piece(dir, key, 0, {}, &computed);
     EXPECT_TRUE(computed);
 }

@@ -57,7 +57,7 @@ Written summarize(const std::vector<StudyConfiguration>& configs,
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     StudySettings s;
-    s.theta_i_deg = {30};
+    s.reference.theta_i_deg = {30};
     const StudyFindings findings = compute_findings(configs, s, models, rows, lost);
     EXPECT_EQ(write_summary(dir, findings), 2);
     EXPECT_EQ(write_summary(dir, findings), 0);  // unchanged: nothing rewritten

@@ -52,25 +52,45 @@ __all__ = [
 DEFAULT_THETA_I = tuple(_lamina.DEFAULT_THETA_I)
 
 
-def simulate(stack, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, threads=0, grid=(90, 90),
-             kernel="simd", microsurface="single", max_events=10000, progress=None,
-             transmission_masking="smith"):
+# The goniophotometer's settings by name, with their defaults (one owner: the SimulationSettings of
+# src/simulator/goniophotometer.h): simulate, compare and study take any of them as keywords.
+SIMULATION_SETTINGS = dict(_lamina.SIMULATION_SETTINGS)
+
+
+def _reference_settings(settings):
+    """The settings given, checked by name; their values are checked by lamina itself."""
+    for name in settings:
+        if name not in SIMULATION_SETTINGS:
+            raise input_error("arguments", name,
+                              f"is not a setting; the settings are {', '.join(SIMULATION_SETTINGS)}")
+    return dict(settings)
+
+
+def _grid_pair(grid):
+    """(n_theta, n_phi) of a grid given as a pair, "90x90" or {"n_theta", "n_phi"}."""
+    if isinstance(grid, dict):
+        return int(grid["n_theta"]), int(grid["n_phi"])
+    if isinstance(grid, str):
+        n_theta, n_phi = grid.split("x")
+        return int(n_theta), int(n_phi)
+    return int(grid[0]), int(grid[1])
+
+
+def simulate(stack, progress=None, **settings):
     """Runs the goniophotometer (`lamina simulate`) and returns a SimulationResult.
 
-    stack: a Stack, a dict in the stack format or a path. theta_i: degrees in [0, 90), one or a
-    list. particles: per incidence. The tables are bitwise those of `lamina simulate` with the same
-    inputs (for the same kernel on the same machine) and do not depend on `threads`. The GIL is
-    released while particles are traced; Ctrl-C stops the run between chunks of particles and
-    raises KeyboardInterrupt. progress: draw a progress line on stderr (default: when it is a
-    terminal). transmission_masking: "smith" (the Smith microsurface's B(1 + Λi, 1 + Λo) for light
-    a rough dielectric refracts, the default) or "pbrt" (1/(1 + Λi + Λo), as pbrt-v4), the CLI's
-    --transmission-masking.
+    stack: a Stack, a dict in the stack format or a path. settings: any of SIMULATION_SETTINGS by
+    name, as `lamina simulate` takes them (theta_i: degrees in [0, 90), one or a list; particles:
+    per incidence; seed, threads, grid=(n_theta, n_phi), kernel, microsurface,
+    transmission_masking, max_events, ...; docs/python.md); the others keep their defaults. The
+    tables are bitwise those of `lamina simulate` with the same inputs (for the same kernel on the
+    same machine) and do not depend on `threads`. The GIL is released while particles are traced;
+    Ctrl-C stops the run between chunks of particles and raises KeyboardInterrupt. progress: draw a
+    progress line on stderr (default: when it is a terminal).
     """
     if progress is None:
         progress = _stderr_is_terminal()
-    return _lamina._simulate(stack, theta_i, float(particles), int(seed), int(threads),
-                             (int(grid[0]), int(grid[1])), str(kernel), str(microsurface),
-                             str(transmission_masking), int(max_events), bool(progress))
+    return _lamina._simulate(stack, _reference_settings(settings), bool(progress))
 
 
 def _stderr_is_terminal():
@@ -213,40 +233,39 @@ def _split_models(models):
     return names, plugins
 
 
-def _run(configs, models, theta_i, particles, preset, seed, threads, grid, kernel, microsurface,
-         out, figures, quiet, nodes, peak_nodes, tables="half", transmission_masking="smith"):
+def _run(configs, models, preset, out, figures, quiet, nodes, peak_nodes, tables, settings):
     names, plugins = _split_models(models)
-    settings = {
-        "particles": int(particles), "preset": preset, "seed": int(seed),
-        "theta_i": [float(t) for t in np.atleast_1d(theta_i)], "grid": (int(grid[0]), int(grid[1])),
-        "models": names, "threads": int(threads), "kernel": kernel, "microsurface": microsurface,
-        "quiet": bool(quiet), "tables": str(tables),
-        "transmission_masking": str(transmission_masking),
+    reference = _reference_settings(settings)
+    effective = dict(SIMULATION_SETTINGS, **reference)
+    theta_i = [float(t) for t in np.atleast_1d(effective["theta_i"])]
+    grid = _grid_pair(effective["grid"])
+    run = {
+        "reference": reference, "study": {"tables": str(tables)}, "preset": preset,
+        "models": names, "quiet": bool(quiet),
         # models=None: every built-in model; a list: exactly the models it names.
         "registry_models": models is None,
     }
     externals = []
     for p in plugins:
         def table(config_id, stack, p=p):
-            return bin_model(p, stack, settings["theta_i"], settings["grid"], nodes, peak_nodes)
+            return bin_model(p, stack, theta_i, grid, nodes, peak_nodes)
         externals.append((model_name(p), table))
     if not names and not externals and models is not None:
         raise input_error("arguments", "models", "no model to compare")
-    _lamina._run_study(configs, settings, externals, str(out), bool(figures))
+    _lamina._run_study(configs, run, externals, str(out), bool(figures))
     return load_study(out)
 
 
-def compare(stack, models=None, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, threads=0,
-            grid=(90, 90), kernel="simd", microsurface="single", out=None, figures=False,
-            quiet=True, config_id=None, nodes=4, peak_nodes=32, tables="half",
-            transmission_masking="smith"):
+def compare(stack, models=None, out=None, figures=False, quiet=True, config_id=None, nodes=4,
+            peak_nodes=32, tables="half", **settings):
     """`lamina compare` from Python: the reference for one stack and every model on its bins.
 
     models: registry names and Python models (classes or objects with eval(wi, wo); see
-    lamina.plugins), default every built-in model. Writes the study directory `out` (metrics,
-    summary, explorer, and figures when figures=True) and returns it as a lamina.Study.
-    tables: how configs/<id>/tables.lza is stored, "half" (float16), "full" or "none" (the CLI's
-    --tables).
+    lamina.plugins), default every built-in model. settings: the reference's, any of
+    SIMULATION_SETTINGS by name (theta_i, particles, seed, grid, kernel, microsurface, ...).
+    Writes the study directory `out` (metrics, summary, explorer, and figures when figures=True)
+    and returns it as a lamina.Study. tables: how configs/<id>/tables.lza is stored, "half"
+    (float16), "full" or "none" (the CLI's --tables).
     """
     if out is None:
         raise input_error("arguments", "out", "give the output folder (out=...)")
@@ -254,32 +273,33 @@ def compare(stack, models=None, theta_i=DEFAULT_THETA_I, particles=1e6, seed=1, 
     cid = config_id or (Path(os.fspath(stack)).stem if isinstance(stack, (str, os.PathLike))
                         else (st.name or "stack"))
     configs = [{"id": cid, "category": "custom", "stack": st}]
-    return _run(configs, models, theta_i, particles, "custom", seed, threads, grid, kernel,
-                microsurface, out, figures, quiet, nodes, peak_nodes, tables, transmission_masking)
+    return _run(configs, models, "custom", out, figures, quiet, nodes, peak_nodes, tables,
+                settings)
 
 
-def study(models=None, preset="quick", only=None, configs=None, theta_i=DEFAULT_THETA_I,
-          particles=None, seed=1, threads=0, grid=(90, 90), kernel="simd", microsurface="single",
-          out=None, figures=False, quiet=True, nodes=4, peak_nodes=32, tables="half",
-          transmission_masking="smith"):
+def study(models=None, preset="quick", only=None, configs=None, out=None, figures=False,
+          quiet=True, nodes=4, peak_nodes=32, tables="half", **settings):
     """`lamina study` from Python, with Python models beside the built-in ones.
 
     configs: None for the study's 60 configurations, or a list of {"id", "category", "stack"};
-    only: the CLI's --only globs. Returns the study directory `out` as a lamina.Study.
+    only: the CLI's --only globs. settings: the reference's, any of SIMULATION_SETTINGS by name;
+    particles, when given, replaces the preset's budget. Returns the study directory `out` as a
+    lamina.Study.
     """
     if out is None:
         raise input_error("arguments", "out", "give the output folder (out=...)")
-    presets = {"quick": 1_000_000, "standard": 10_000_000, "paper": 160_000_000}
-    if preset not in presets:
-        raise input_error("arguments", "preset",
-                          f"'{preset}' is not a preset: use quick, standard or paper")
-    n = presets[preset] if particles is None else particles
-    label = preset if particles is None else "custom"
+    label = preset
+    if "particles" in settings:
+        _lamina._preset_particles(preset)  # the preset is checked even when not used
+        label = "custom"
+    else:
+        settings = dict(settings, particles=_lamina._preset_particles(preset))
     cs = _lamina._builtin_configurations() if configs is None else [
         {"id": c["id"], "category": c.get("category", "custom"), "stack": Stack(c["stack"])}
         for c in configs]
     if only:
         keep = set(_lamina._filter_configurations(cs, only))
         cs = [c for c in cs if c["id"] in keep]
-    return _run(cs, models, theta_i, n, label, seed, threads, grid, kernel, microsurface, out,
-                figures, quiet, nodes, peak_nodes, tables, transmission_masking)
+    return _run(cs, models, label, out, figures, quiet, nodes, peak_nodes, tables, settings)
+
+

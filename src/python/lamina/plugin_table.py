@@ -36,7 +36,7 @@ def main(argv=None):
     p.add_argument("plugin")
     p.add_argument("--stack", required=True)
     p.add_argument("--theta-i", required=True)
-    p.add_argument("--grid", default="90x90")
+    p.add_argument("--grid", required=True)
     p.add_argument("--nodes", type=int, default=4)
     p.add_argument("--out", required=True)
     a = p.parse_args(argv)

@@ -100,9 +100,10 @@ def _average(model, name, wi, t0, t1, p0, p1, n, lower):
     return np.einsum("bij,bijc->bc", weight, f) / weight.sum(axis=(1, 2))[:, None]
 
 
-def bin_model(obj, stack, theta_i, grid=(90, 90), nodes=4, peak_nodes=32):
+def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32):
     """A Python model on lamina's bins: a lamina.Table (the brdf.csv format), or None when the
-    model supports neither side of this stack."""
+    model supports neither side of this stack. grid: (n_theta, n_phi), default the
+    goniophotometer's."""
     stack = _lamina.Stack(stack)
     model = instantiate(obj, stack)
     name = model_name(obj)
@@ -111,6 +112,9 @@ def bin_model(obj, stack, theta_i, grid=(90, 90), nodes=4, peak_nodes=32):
     if not sides:
         return None
     theta_i = [float(t) for t in np.atleast_1d(theta_i)]
+    if grid is None:
+        default = _lamina.SIMULATION_SETTINGS["grid"]
+        grid = (default["n_theta"], default["n_phi"])
     n_theta, n_phi = int(grid[0]), int(grid[1])
     t_edges = np.linspace(0, np.pi / 2, n_theta + 1)
     p_edges = np.linspace(0, np.pi, n_phi + 1)

@@ -1,0 +1,35 @@
+#pragma once
+// The command line of a settings struct (core/setting.h): one option per setting, --NAME with '-'
+// for '_', its help and its default as the setting declares them. CLI11 hands the option's text to
+// the setting's codec, which writes the member; a bad value is an InputError naming the option.
+
+#include "core/setting.h"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace lamina::cli {
+
+/// Adds the options of every setting of `s` but those named in `skip`. `s` must outlive the
+/// parse (the options write into it); the defaults shown are its values now.
+template <typename S>
+void add_settings_options(CLI::App* cmd, S& s, const std::vector<std::string>& skip = {}) {
+    S::fields(s, [&](const SettingInfo& info, auto& member) {
+        using T = std::decay_t<decltype(member)>;
+        if (std::find(skip.begin(), skip.end(), info.name) != skip.end()) return;
+        const std::string flag = option_name(info.name);
+        CLI::Option* option = cmd->add_option_function<std::string>(
+            flag,
+            [&member, info, flag](const std::string& text) {
+                member = SettingCodec<T>::from_text(text, info, "command line", flag);
+            },
+            info.help);
+        option->default_str(SettingCodec<T>::to_text(member));
+    });
+}
+
+}  // namespace lamina::cli

@@ -1,0 +1,230 @@
+#include "models/numerics/binned.h"
+
+#include "core/math.h"
+#include "core/spherical.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace lamina {
+
+namespace {
+
+// Gauss–Legendre on [0, 1]: 3 points at ½, ½ ± √(3/5)/2, weights 8/18, 5/18 (Abramowitz &
+// Stegun, Table 25.4).
+constexpr double kG3[3] = {0.5 - 0.3872983346207417, 0.5, 0.5 + 0.3872983346207417};
+constexpr double kW3[3] = {5.0 / 18, 8.0 / 18, 5.0 / 18};
+constexpr double kMinDtheta = 1e-9, kMinDphi = 1e-8;
+constexpr double kPoleTheta = 1e-9;
+
+struct Peak {
+    double theta, phi;
+    bool pole;  ///< at the normal: every φ
+};
+
+/// ∫ |cos θ| dω over [θ0, θ1] × [φ0, φ1] (one folded half), the weight of a rectangle.
+double measure(double t0, double t1, double p0, double p1) {
+    return 0.5 * (p1 - p0) * (sqr(std::sin(t1)) - sqr(std::sin(t0)));
+}
+
+// Rectangles live in (θ, φ), where the integrand f·sin θ cos θ is smooth up to both ends of the
+// hemisphere (in u = sin²θ it has square-root edges at the normal and at grazing, which adaptive
+// bisection cannot shake off).
+class RectIntegrator {
+  public:
+    RectIntegrator(const IncidentEvaluator& f, Side side, std::vector<Peak> peaks,
+                   const BinnedOptions& o)
+        : f_(f), transmission_(side == Side::Transmission), peaks_(std::move(peaks)), o_(o) {}
+
+    /// The cos-weighted average over the rectangle. Error control is on this average: every
+    /// sub-rectangle's average must be good to τ = rel_tol·|average| + abs_tol (a sub-rectangle
+    /// of weight fraction a then adds at most a·τ to the error, so the sum stays within τ).
+    Rgbd average(double t0, double t1, double p0, double p1) {
+        evals_ = 0;
+        const std::pair<Rgbd, Rgbd> whole = rule(t0, t1, p0, p1);
+        const Rgbd coarse = whole.second;
+        tol_ = o_.rel_tol * max_abs(coarse) + o_.abs_tol;
+        // The top level reuses the coarse rule's nodes: the same values, not evaluated twice.
+        const Rgbd first = rect(t0, t1, p0, p1, 0, 0, &whole);
+        // A narrow lobe missed by the coarse nodes made τ far too strict: redo with the real size.
+        if (max_abs(first) > 10 * max_abs(coarse)) {
+            evals_ = 0;
+            tol_ = o_.rel_tol * max_abs(first) + o_.abs_tol;
+            return rect(t0, t1, p0, p1, 0, 0);
+        }
+        return first;
+    }
+
+  private:
+    static double max_abs(const Rgbd& v) {
+        return std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+    }
+
+    Rgbd at(double theta, double phi) {
+        ++evals_;
+        const double s = std::sin(theta), z = std::cos(theta);
+        return f_.eval(Vec3d(s * std::cos(phi), s * std::sin(phi), transmission_ ? -z : z));
+    }
+
+    /// Cos-weighted averages by two embedded rules on the same 9 nodes, each normalized by the
+    /// same rule applied to the weight sin θ cos θ (so constants are exact): the 3×3
+    /// Gauss–Legendre product rule (degree 5) and the 5-point degree-3 rule on its centre and
+    /// its 4 axis nodes (weights −1/9 and 5/18: exact for 1, x², y²). Their difference estimates
+    /// the error of the lower one, so keeping the 3×3 value is conservative.
+    std::pair<Rgbd, Rgbd> rule(double t0, double t1, double p0, double p1) {
+        const double dt = t1 - t0, dp = p1 - p0;
+        constexpr double kW5Centre = -1.0 / 9, kW5Axis = 5.0 / 18;
+        Rgbd i3(0.0), i5(0.0);
+        double w3 = 0, w5 = 0;
+        for (int a = 0; a < 3; ++a) {
+            const double theta = t0 + dt * kG3[a];
+            const double w = std::sin(2 * theta);
+            w3 += w * kW3[a];
+            for (int b = 0; b < 3; ++b) {
+                const Rgbd g = at(theta, p0 + dp * kG3[b]) * w;
+                i3 += g * (kW3[a] * kW3[b]);
+                const bool centre = a == 1 && b == 1, axis = (a == 1) != (b == 1);
+                if (centre || axis) {
+                    const double c5 = centre ? kW5Centre : kW5Axis;
+                    i5 += g * c5;
+                    w5 += w * c5;
+                }
+            }
+        }
+        if (w3 <= 0 || w5 <= 0) return {Rgbd(0.0), Rgbd(0.0)};
+        return {i5 / w5, i3 / w3};
+    }
+
+    /// Which coordinates must be split to approach a peak inside the (closed) rectangle.
+    void peak_split(double t0, double t1, double p0, double p1, bool& split_t,
+                    bool& split_phi) const {
+        split_t = split_phi = false;
+        for (const Peak& pk : peaks_) {
+            if (pk.pole) {
+                if (t0 <= kPoleTheta && t1 - t0 > kMinDtheta) split_t = true;
+                continue;
+            }
+            if (pk.theta < t0 || pk.theta > t1 || pk.phi < p0 || pk.phi > p1) continue;
+            if (t1 - t0 > kMinDtheta) split_t = true;
+            if (p1 - p0 > kMinDphi) split_phi = true;
+        }
+    }
+
+    Rgbd rect(double t0, double t1, double p0, double p1, int depth, int peak_depth,
+              const std::pair<Rgbd, Rgbd>* known = nullptr) {
+        const auto [i2, i3] = known ? *known : rule(t0, t1, p0, p1);
+        bool split_t = false, split_phi = false;
+        if (peak_depth < o_.peak_depth) peak_split(t0, t1, p0, p1, split_t, split_phi);
+        const bool forced = split_t || split_phi;
+        if (!forced && depth < o_.max_depth && evals_ < o_.eval_budget && max_abs(i3 - i2) > tol_)
+            split_t = split_phi = true;
+        if (!split_t && !split_phi) return i3;
+        const int nd = forced ? depth : depth + 1;
+        const int np = forced ? peak_depth + 1 : peak_depth;
+        const double tm = 0.5 * (t0 + t1), pm = 0.5 * (p0 + p1);
+        // Children are combined with their exact weights (fractions of ∫ |cos θ| dω).
+        auto part = [&](double a0, double a1, double b0, double b1) {
+            return rect(a0, a1, b0, b1, nd, np) * measure(a0, a1, b0, b1);
+        };
+        Rgbd sum(0.0);
+        if (split_t && split_phi)
+            sum = part(t0, tm, p0, pm) + part(tm, t1, p0, pm) + part(t0, tm, pm, p1) +
+                  part(tm, t1, pm, p1);
+        else if (split_t)
+            sum = part(t0, tm, p0, p1) + part(tm, t1, p0, p1);
+        else
+            sum = part(t0, t1, p0, pm) + part(t0, t1, pm, p1);
+        const double m = measure(t0, t1, p0, p1);
+        return m > 0 ? sum / m : i3;
+    }
+
+    const IncidentEvaluator& f_;
+    bool transmission_;
+    std::vector<Peak> peaks_;
+    BinnedOptions o_;
+    long evals_ = 0;
+    double tol_ = 0;
+};
+
+std::vector<Peak> peaks_on_side(const std::vector<Vec3d>& dirs, Side side) {
+    std::vector<Peak> out;
+    for (const Vec3d& d : dirs) {
+        if ((d.z > 0) != (side == Side::Reflection)) continue;
+        const double theta = theta_of(d);
+        const double phi = std::atan2(std::abs(d.y), d.x);  // folded into [0, π]
+        out.push_back({theta, phi, theta <= kPoleTheta});
+    }
+    return out;
+}
+
+}  // namespace
+
+Rgbd cos_weighted_average(const IncidentEvaluator& f, Side side, double theta0, double theta1,
+                          double phi0, double phi1, const std::vector<Vec3d>& peaks,
+                          const BinnedOptions& options) {
+    RectIntegrator integrator(f, side, peaks_on_side(peaks, side), options);
+    return integrator.average(theta0, theta1, phi0, phi1);
+}
+
+Rgbd model_albedo(const Model& model, const Vec3d& wi, Side side, const BinnedOptions& options) {
+    const auto evaluator = model.prepare(wi);
+    const std::vector<Vec3d> peaks = model.peak_directions(wi);
+    // ∫ f |cos θ| dω over the hemisphere = 2 Σ (rectangle average × its weight) over [0, π/2] ×
+    // [0, π] (symmetry φ ↔ −φ). A fixed 16 × 16 partition first, so that no large rectangle is
+    // accepted on an accidental agreement of its two rules.
+    constexpr int kN = 16;
+    const double dt = kPi<double> / 2 / kN, dp = kPi<double> / kN;
+    Rgbd albedo(0.0);
+    for (int a = 0; a < kN; ++a)
+        for (int b = 0; b < kN; ++b)
+            albedo += cos_weighted_average(*evaluator, side, a * dt, (a + 1) * dt, b * dp,
+                                           (b + 1) * dp, peaks, options) *
+                      (2 * measure(a * dt, (a + 1) * dt, b * dp, (b + 1) * dp));
+    for (const DeltaLobe& d : model.delta_lobes(wi))
+        if ((d.direction.z > 0) == (side == Side::Reflection)) albedo += d.energy;
+    return albedo;
+}
+
+BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
+                      const std::vector<double>& theta_i_deg, const BinnedOptions& options) {
+    const Support support = model.support();
+    BinnedTable table = BinnedTable::zeros(grid, theta_i_deg, support.brdf, support.btdf);
+    const std::size_t n_inc = theta_i_deg.size();
+    std::vector<Vec3d> wi(n_inc);
+    std::vector<std::unique_ptr<IncidentEvaluator>> evaluators(n_inc);
+    std::vector<std::vector<Vec3d>> peaks(n_inc);
+    for (std::size_t i = 0; i < n_inc; ++i) {
+        wi[i] = incident_direction(deg_to_rad(theta_i_deg[i]));
+        evaluators[i] = model.prepare(wi[i]);  // forward variants: lobe statistics, once
+        peaks[i] = model.peak_directions(wi[i]);
+    }
+    std::vector<Side> sides;
+    if (support.brdf) sides.push_back(Side::Reflection);
+    if (support.btdf) sides.push_back(Side::Transmission);
+    const long n_rows = long(n_inc) * long(sides.size()) * grid.n_theta();
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long row = 0; row < n_rows; ++row) {
+        const int t = int(row % grid.n_theta());
+        const long rest = row / grid.n_theta();
+        const Side side = sides[rest % long(sides.size())];
+        const std::size_t i = std::size_t(rest / long(sides.size()));
+        RectIntegrator integrator(*evaluators[i], side, peaks_on_side(peaks[i], side), options);
+        BinnedLobe& lobe = table.lobe(i, side);
+        for (int p = 0; p < grid.n_phi(); ++p)
+            lobe.f[std::size_t(t) * grid.n_phi() + p] = integrator.average(
+                grid.theta_lo(t), grid.theta_hi(t), grid.phi_lo(p), grid.phi_hi(p));
+    }
+    // Delta lobes: energy / Ω⊥ of the bin they hit (docs/physics.md §5).
+    for (std::size_t i = 0; i < n_inc; ++i) {
+        for (const DeltaLobe& d : model.delta_lobes(wi[i])) {
+            const Side side = d.direction.z > 0 ? Side::Reflection : Side::Transmission;
+            if (side == Side::Reflection ? !support.brdf : !support.btdf) continue;
+            const std::size_t j = grid.bin_of(d.direction);
+            table.lobe(i, side).f[j] += d.energy / grid.projected_solid_angle(j);
+        }
+    }
+    return table;
+}
+
+}  // namespace lamina

@@ -1,0 +1,120 @@
+#pragma once
+// The coats that engines ship (docs/models.md, "Production coats"): OpenPBR Surface 1.1, Adobe's
+// openpbr-bsdf, Autodesk Standard Surface, Dassault Enterprise PBR 2025x, Google Filament,
+// glTF KHR_materials_clearcoat, Blender 4.x Principled and Kulla & Conty 2017. Each is a sum of a
+// coat lobe and the base's own lobe evaluated at the *outside* directions, the base scaled by a
+// layering factor — none of them refracts, nor follows light between the interfaces:
+//
+//     f(wi, wo) = f_coat(wi, wo) + A(wi, wo) · T(wi, wo) · Δ(wo) · f_base'(wi, wo)
+//
+//   f_coat  the coat's microfacet reflection: Fresnel (exact or Schlick, at wi·h or at n·wo),
+//           GGX D_α with α = r² (every engine squares its roughness parameter r; lamina's α0
+//           maps to r = √α0) and a visibility term (height-correlated Smith or Kelemen's);
+//   A       the base attenuation: 1 − E_coat(μo) (albedo scaling), its reciprocal forms, or a
+//           Schlick Fresnel at n·wo, wi·h or the larger of the two cosines;
+//   T       the coat tint from τ_a: along both refracted paths, along the view's only, or a
+//           constant e^(−2τ) (the tint matched at normal incidence, two ways);
+//   Δ       OpenPBR's coat darkening (1 − K)/(1 − E_b K);
+//   f_base' the Lambertian ρ/π, or the conductor's GGX lobe with the model's metal Fresnel
+//           (exact, Schlick, F82-tint) and roughness after the model's base-roughening rule.
+//
+// A recipe (CoatRecipe) names one model's choices; its flags switch each heuristic off and swap
+// its leaves (Fresnel, visibility, roughness clamp, metal Fresnel) for lamina's exact ones. The
+// directional albedos E_coat are lamina's FGD table (models/tables/fgd_table.h): no engine's table
+// is copied; the published fits a model ships (OpenPBR's E_F(η), Adobe's average Fresnel,
+// Filament's F0 conversion) are implemented as shipped and cited where used.
+//
+// Represented: a dielectric coat (absorbing, not scattering) over a Lambertian or conductor base
+// (BRDF only). Not supported, with the reason: other shapes, a scattering coat, a dielectric
+// base (slab: the models' bases are opaque), and a coat IOR other than 1.5 for the models whose
+// coat has a fixed IOR (Enterprise PBR, Filament, glTF).
+
+#include "models/model.h"
+
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+struct CoatRecipe {
+    std::string name;
+    enum class Fresnel {
+        Exact,       ///< exact dielectric Fresnel of η0 (physics/fresnel.h)
+        SchlickIor,  ///< Schlick with F0 = ((η0 − 1)/(η0 + 1))²
+        Schlick004,  ///< Schlick with F0 = 0.04 (a fixed IOR 1.5: η0 must be 1.5)
+    } coat_fresnel = Fresnel::Exact;
+    /// The model's coat has no IOR parameter (IOR 1.5): another η0 is not supported.
+    bool coat_ior_fixed = false;
+    /// The coat lobe's Fresnel at n·wo instead of wi·h (glTF's layering Fresnel).
+    bool coat_fresnel_at_n = false;
+    enum class Visibility {
+        Smith,    ///< height-correlated Smith G2 / (4 μi μo) (Heitz 2014, Eq. 99)
+        Kelemen,  ///< 1 / (4 (wi·h)²) (Kelemen & Szirmay-Kalos 2001; Filament's V_Kelemen)
+    } coat_visibility = Visibility::Smith;
+    /// Smallest coat roughness parameter r (Filament clamps r to [0.089, 1]); 0: none.
+    double coat_min_roughness = 0;
+
+    enum class Attenuation {
+        AlbedoView,        ///< 1 − E(μo)
+        AlbedoReciprocal,  ///< (1 − E(μi)) (1 − E(μo))
+        KullaConty,        ///< (1 − E(μi)) (1 − E(μo)) / (1 − E_avg)
+        FresnelView,       ///< 1 − F(μo) in the coat's own Fresnel
+        FresnelHalf,       ///< 1 − F(wi·h)
+        FresnelMax,        ///< 1 − max(F(μi), F(μo))
+    } attenuation = Attenuation::AlbedoView;
+
+    enum class Tint {
+        TwoWay,    ///< exp(−τ (1/μt_i + 1/μt_o)), μt = √(1 − (1 − μ²)/η0²)
+        ViewOnly,  ///< exp(−2τ/μt_o): the normal-incidence two-way tint along the view's path
+        Constant,  ///< exp(−2τ): a model without a view-dependent tint (or none: baked in)
+    } tint = Tint::TwoWay;
+
+    enum class Darkening {
+        None,
+        Spec,   ///< OpenPBR 1.1: K = lerp(F(μo), K_r, r_b), E_F by d'Eon's fit, E_b from FGD
+        Adobe,  ///< openpbr-bsdf: K_s = E_F (Kulla–Conty fit), E_b the average F82 Fresnel
+    } darkening = Darkening::None;
+
+    enum class Roughening {
+        None,
+        OpenPBR,          ///< r' = min(1, r⁴ + 2 r_c⁴)^¼
+        Adobe,            ///< r' = min(1, r⁴ + (1 − 1/η0) r_c⁴)^¼
+        Max,              ///< r' = max(r, r_c) (Filament)
+        StandardSurface,  ///< r' = lerp(r, 1, r_c) (coat_affect_roughness = 1)
+    } roughening = Roughening::None;
+
+    enum class MetalFresnel {
+        Exact,            ///< the conductor's exact Fresnel with η1/η0, κ1/η0
+        Schlick,          ///< Schlick with the exact normal reflectance F0 under the coat
+        F82Tint,          ///< Kutz et al. 2021's F82-tint: F0 and the tint from the exact F(1/7)
+        SchlickFilament,  ///< Schlick with the F0 in air converted by f0ClearCoatToSurface
+    } metal_fresnel = MetalFresnel::Exact;
+
+    /// Standard Surface's coat_affect_color = 1: ρ ← ρ^2 (its default 0 leaves ρ).
+    bool affect_color = false;
+};
+
+/// Flags every production model shares, appended to its own: leaves=shipped|exact swaps the
+/// coat's Fresnel, visibility and roughness clamp and the metal Fresnel for lamina's exact ones.
+OptionSpec leaves_option();
+/// Applies leaves=exact to a recipe.
+void use_exact_leaves(CoatRecipe& recipe);
+
+/// Builds a production coat; never fails (unsupported stacks say why in support()).
+std::unique_ptr<Model> make_production_coat(const Stack& stack, const CoatRecipe& recipe);
+
+/// OpenPBR's hemispherical Fresnel albedo E_F(η) = 2 ∫ F(μ; η) μ dμ by the fit of d'Eon 2021
+/// as the OpenPBR 1.1 specification gives it (footnote "avg_fresnel", accurate to 0.2% for
+/// η ∈ [1, 3]); η < 1 through E_F(η) = 1 − η² (1 − E_F(1/η)).
+double openpbr_average_fresnel_fit(double eta);
+/// Kulla & Conty 2017 (slide 18)'s fit of the same average, as Adobe's openpbr-bsdf ships it
+/// (openpbr_average_fresnel): (η − 1)/(4.08567 + 1.00071 η) for η > 1.
+double kulla_conty_average_fresnel_fit(double eta);
+/// Filament's conversion of an F0 against air to an F0 against a coat of IOR 1.5
+/// (Filament documentation, "Clear coat", f0ClearCoatToSurface; a fit).
+double filament_f0_clear_coat_to_surface(double f0);
+/// Kutz, Hasan & Edmondson 2021 (OpenPBR 1.1, "Metal"): the F82-tint metal Fresnel,
+/// F_Schlick(μ) − b μ (1 − μ)⁶ with b = F_Schlick(μ̄)(1 − tint)/(μ̄ (1 − μ̄)⁶), μ̄ = 1/7.
+double f82_tint_fresnel(double cos_theta, double f0, double tint);
+
+}  // namespace lamina

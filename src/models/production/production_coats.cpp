@@ -1,0 +1,250 @@
+// The production coats as their authors ship them (docs/models.md, "Production coats"): one
+// recipe of models/production/production_coat.h per model, with its flags. Sources, read for the
+// equations (no code copied):
+//   OpenPBR Surface 1.1 specification (Academy Software Foundation), "Coat" (darkening,
+//     view-dependent absorption, roughening) and "Layering" (albedo scaling);
+//   Adobe openpbr-bsdf (impl/openpbr_coating_lobe.h, impl/openpbr_bsdf.h; the reciprocal
+//     coat attenuation is the OPENPBR_RECIPROCAL_COAT_AND_FUZZ switch, off by default);
+//   Autodesk Standard Surface specification, "Coating";
+//   Dassault Systèmes Enterprise PBR 2025x specification, "Clearcoat";
+//   Google Filament documentation, "Clear coat model" and "Clear coat parameterization";
+//   Khronos KHR_materials_clearcoat, "Layering" (and three.js's half-vector Fresnel in the lobe);
+//   Blender 4.x Cycles, the Principled BSDF's coat (kernel/svm/closure.h);
+//   Kulla & Conty 2017, "Revisiting physically based shading at Imageworks" (SIGGRAPH course).
+#include "models/production/production_coats.h"
+#include "models/production/production_coat.h"
+
+namespace lamina {
+
+namespace {
+
+const char* on_off(bool b) {
+    return b ? "on" : "off";
+}
+bool is_on(const ModelOptions& o, const std::string& key) {
+    return option_value(o, key) == "on";
+}
+bool exact_leaves(const ModelOptions& o) {
+    return option_value(o, "leaves") == "exact";
+}
+
+OptionSpec on_off_option(const std::string& key, bool default_on, const std::string& help) {
+    return {key, {"on", "off"}, on_off(default_on), help};
+}
+
+// --- OpenPBR Surface 1.1 (the specification) ------------------------------------------------
+CoatRecipe openpbr_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "openpbr";
+    r.coat_fresnel = CoatRecipe::Fresnel::Exact;
+    r.attenuation = CoatRecipe::Attenuation::AlbedoView;  // Eq. coat_layering_formula
+    r.tint = is_on(o, "view-tint") ? CoatRecipe::Tint::TwoWay : CoatRecipe::Tint::Constant;
+    r.darkening = is_on(o, "darkening") ? CoatRecipe::Darkening::Spec : CoatRecipe::Darkening::None;
+    r.roughening =
+        is_on(o, "roughening") ? CoatRecipe::Roughening::OpenPBR : CoatRecipe::Roughening::None;
+    r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    if (exact_leaves(o)) use_exact_leaves(r);
+    return r;
+}
+
+// --- Adobe openpbr-bsdf --------------------------------------------------------------------
+CoatRecipe adobe_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "openpbr-adobe";
+    r.coat_fresnel = CoatRecipe::Fresnel::Exact;
+    r.attenuation = is_on(o, "reciprocal") ? CoatRecipe::Attenuation::AlbedoReciprocal
+                                           : CoatRecipe::Attenuation::AlbedoView;
+    r.tint = is_on(o, "view-tint") ? CoatRecipe::Tint::TwoWay : CoatRecipe::Tint::Constant;
+    r.darkening =
+        is_on(o, "darkening") ? CoatRecipe::Darkening::Adobe : CoatRecipe::Darkening::None;
+    r.roughening =
+        is_on(o, "roughening") ? CoatRecipe::Roughening::Adobe : CoatRecipe::Roughening::None;
+    r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    if (exact_leaves(o)) use_exact_leaves(r);
+    return r;
+}
+
+// --- Autodesk Standard Surface --------------------------------------------------------------
+CoatRecipe standard_surface_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "standard-surface";
+    r.coat_fresnel = CoatRecipe::Fresnel::Exact;  // coat_IOR, a dielectric GGX closure
+    r.attenuation = CoatRecipe::Attenuation::AlbedoView;
+    r.tint = CoatRecipe::Tint::Constant;  // coat_color multiplies every layer below
+    r.roughening = option_value(o, "affect-roughness") == "1"
+                       ? CoatRecipe::Roughening::StandardSurface
+                       : CoatRecipe::Roughening::None;
+    r.affect_color = option_value(o, "affect-color") == "1";
+    // Gulbrandsen 2014's artist-friendly metal reproduces the exact conductor Fresnel of the
+    // (η, κ) its two colours are derived from (docs/models.md says where it cannot).
+    r.metal_fresnel = CoatRecipe::MetalFresnel::Exact;
+    return r;
+}
+
+// --- Dassault Enterprise PBR 2025x ----------------------------------------------------------
+CoatRecipe enterprise_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "enterprise-pbr";
+    r.coat_fresnel = CoatRecipe::Fresnel::Schlick004;
+    r.coat_ior_fixed = true;
+    r.attenuation = CoatRecipe::Attenuation::FresnelMax;  // 1 − c max(F_c(v·n), F_c(l·n))
+    r.tint = CoatRecipe::Tint::Constant;                  // no coat tint: baked into the base
+    r.metal_fresnel = CoatRecipe::MetalFresnel::Schlick;
+    if (exact_leaves(o)) use_exact_leaves(r);
+    return r;
+}
+
+// --- Google Filament ------------------------------------------------------------------------
+CoatRecipe filament_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "filament";
+    r.coat_fresnel = CoatRecipe::Fresnel::Schlick004;
+    r.coat_ior_fixed = true;
+    r.coat_visibility = CoatRecipe::Visibility::Kelemen;
+    r.coat_min_roughness = 0.089;  // clearCoatRoughness clamped to [0.089, 1]
+    r.attenuation = option_value(o, "attenuation") == "h" ? CoatRecipe::Attenuation::FresnelHalf
+                                                          : CoatRecipe::Attenuation::FresnelView;
+    r.tint = CoatRecipe::Tint::Constant;  // no coat tint: baked into the base
+    r.roughening =
+        is_on(o, "roughening") ? CoatRecipe::Roughening::Max : CoatRecipe::Roughening::None;
+    r.metal_fresnel = is_on(o, "f0-conversion") ? CoatRecipe::MetalFresnel::SchlickFilament
+                                                : CoatRecipe::MetalFresnel::Schlick;
+    if (exact_leaves(o)) use_exact_leaves(r);
+    return r;
+}
+
+// --- glTF KHR_materials_clearcoat -----------------------------------------------------------
+CoatRecipe gltf_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "gltf-clearcoat";
+    r.coat_fresnel = CoatRecipe::Fresnel::Schlick004;
+    r.coat_ior_fixed = true;
+    // mix(material, clearcoat_brdf, clearcoat · F(0.04, N·V)): the layering Fresnel at n·wo
+    // weighs the coat lobe too; three.js evaluates the lobe's own Fresnel at v·h.
+    r.coat_fresnel_at_n = option_value(o, "coat-fresnel") == "n";
+    r.attenuation = CoatRecipe::Attenuation::FresnelView;
+    r.tint = CoatRecipe::Tint::Constant;  // no coat tint: baked into the base
+    r.metal_fresnel = CoatRecipe::MetalFresnel::Schlick;
+    if (exact_leaves(o)) use_exact_leaves(r);
+    return r;
+}
+
+// --- Blender 4.x Principled -----------------------------------------------------------------
+CoatRecipe blender_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "blender-principled";
+    r.coat_fresnel = CoatRecipe::Fresnel::Exact;
+    r.attenuation = CoatRecipe::Attenuation::AlbedoView;
+    r.tint = is_on(o, "view-tint") ? CoatRecipe::Tint::ViewOnly : CoatRecipe::Tint::Constant;
+    r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    if (exact_leaves(o)) use_exact_leaves(r);
+    return r;
+}
+
+// --- Kulla & Conty 2017 ---------------------------------------------------------------------
+CoatRecipe kulla_conty_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "kulla-conty";
+    r.coat_fresnel = CoatRecipe::Fresnel::Exact;
+    r.attenuation = option_value(o, "form") == "reciprocal" ? CoatRecipe::Attenuation::KullaConty
+                                                            : CoatRecipe::Attenuation::AlbedoView;
+    r.tint = CoatRecipe::Tint::TwoWay;  // Beer–Lambert along both refracted paths at n
+    r.metal_fresnel = CoatRecipe::MetalFresnel::Exact;
+    return r;
+}
+
+}  // namespace
+
+std::vector<OptionSpec> openpbr_options() {
+    return {on_off_option("darkening", true,
+                          "coat darkening (1 - K)/(1 - E_b K), K = lerp(F(mu_o), K_r, r_b)"),
+            on_off_option("roughening", true, "base roughening r' = min(1, r^4 + 2 r_c^4)^(1/4)"),
+            on_off_option("view-tint", true,
+                          "coat tint T^(1/mu_t,i + 1/mu_t,o); off: the constant coat_color"),
+            leaves_option()};
+}
+std::unique_ptr<Model> make_openpbr(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, openpbr_recipe(options));
+}
+
+std::vector<OptionSpec> openpbr_adobe_options() {
+    return {on_off_option("reciprocal", false,
+                          "the light side's 1 - E_coat(wi) too (OPENPBR_RECIPROCAL_COAT_AND_FUZZ)"),
+            on_off_option("darkening", true, "coat darkening with K_s = E_F (average Fresnel)"),
+            on_off_option("roughening", true,
+                          "base roughening r' = min(1, r^4 + (1 - 1/eta0) r_c^4)^(1/4)"),
+            on_off_option("view-tint", true,
+                          "coat tint on both passages; off: the constant coat_color"),
+            leaves_option()};
+}
+std::unique_ptr<Model> make_openpbr_adobe(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, adobe_recipe(options));
+}
+
+std::vector<OptionSpec> standard_surface_options() {
+    return {{"affect-roughness",
+             {"0", "1"},
+             "0",
+             "coat_affect_roughness: r <- lerp(r, 1, r_c) for the metal below"},
+            {"affect-color",
+             {"0", "1"},
+             "0",
+             "coat_affect_color: base_color <- base_color^2 (diffuse only)"}};
+}
+std::unique_ptr<Model> make_standard_surface(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, standard_surface_recipe(options));
+}
+
+std::vector<OptionSpec> enterprise_pbr_options() {
+    return {leaves_option()};
+}
+std::unique_ptr<Model> make_enterprise_pbr(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, enterprise_recipe(options));
+}
+
+std::vector<OptionSpec> filament_options() {
+    return {
+        {"attenuation",
+         {"h", "n"},
+         "h",
+         "base attenuation 1 - F_c at l.h (punctual lights) or at n.v (image-based lighting)"},
+        on_off_option("roughening", true, "base roughness at least the coat's"),
+        on_off_option("f0-conversion", true,
+                      "f0ClearCoatToSurface: the metal's F0 in air converted to under the coat"),
+        leaves_option()};
+}
+std::unique_ptr<Model> make_filament(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, filament_recipe(options));
+}
+
+std::vector<OptionSpec> gltf_clearcoat_options() {
+    return {{"coat-fresnel",
+             {"n", "h"},
+             "n",
+             "the coat lobe's Fresnel: the layering F(N.V) of the extension, or F(V.H) (three.js)"},
+            leaves_option()};
+}
+std::unique_ptr<Model> make_gltf_clearcoat(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, gltf_recipe(options));
+}
+
+std::vector<OptionSpec> blender_principled_options() {
+    return {on_off_option("view-tint", true,
+                          "coat tint^(1/mu_t,o) along the view; off: the constant tint"),
+            leaves_option()};
+}
+std::unique_ptr<Model> make_blender_principled(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, blender_recipe(options));
+}
+
+std::vector<OptionSpec> kulla_conty_options() {
+    return {{"form",
+             {"reciprocal", "view"},
+             "reciprocal",
+             "(1 - E(mu_i))(1 - E(mu_o))/(1 - E_avg), or the view-only 1 - E(mu_o)"}};
+}
+std::unique_ptr<Model> make_kulla_conty(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, kulla_conty_recipe(options));
+}
+
+}  // namespace lamina

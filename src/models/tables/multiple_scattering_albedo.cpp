@@ -1,0 +1,162 @@
+#include "models/tables/multiple_scattering_albedo.h"
+
+#include "core/math.h"
+#include "core/rng.h"
+#include "models/tables/coat_transmittance.h"
+#include "models/tables/fgd_table.h"
+#include "models/tables/table_cache.h"
+#include "physics/microsurface_walk.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace lamina {
+
+namespace {
+
+using Table = MultipleScatteringAlbedo;
+
+constexpr const char* kCodeVersion = "ms-albedo-v2";
+constexpr std::uint64_t kSeed = 0x6d73616c62656431ull;  // fixed: the table is deterministic
+constexpr int kMaxOrder = 100;                          // the goniophotometer's facet cap
+
+double mu_node(int i) {
+    return std::max(Table::kMuMin, sqr(double(i) / (Table::kNmu - 1)));
+}
+double alpha_node(int i) {
+    return sqr(double(i) / (Table::kNalpha - 1));
+}
+double eta_node(int i) {
+    return std::exp2(Table::kLog2EtaMin +
+                     (Table::kLog2EtaMax - Table::kLog2EtaMin) * i / (Table::kNeta - 1));
+}
+
+Vec3d incident(double mu) {
+    mu = clamp(mu, Table::kMuMin, 1.0);
+    return {safe_sqrt(1 - mu * mu), 0, mu};
+}
+
+std::size_t dielectric_index(int im, int ia, int ie) {
+    return (std::size_t(im) * Table::kNalpha + ia) * Table::kNeta + ie;
+}
+std::size_t conductor_index(int im, int ia) {
+    return std::size_t(Table::kNmu) * Table::kNalpha * Table::kNeta +
+           std::size_t(im) * Table::kNalpha + ia;
+}
+
+/// Position of x on an axis of n nodes: the cell's first node and the weight of the next.
+void locate(double f, int n, int& i, double& t) {
+    f = clamp(f, 0.0, double(n - 1));
+    i = std::min(int(f), n - 2);
+    t = f - i;
+}
+
+}  // namespace
+
+Table::Dielectric Table::walk_dielectric(double mu, double alpha, double eta, int walks,
+                                         unsigned stream) {
+    Dielectric out;
+    if (alpha <= 0 || walks <= 0) return out;
+    const GGX<double> ggx{alpha};
+    const Vec3d wi = incident(mu);
+    std::uint64_t reflected = 0, transmitted = 0;
+    ParticleRng rng(kSeed, stream, 0);  // one generator per node: its walks in sequence
+    auto uniform = [&] { return rng.uniform_double(); };
+    for (int n = 0; n < walks; ++n) {
+        const auto exit = walk_rough_dielectric(ggx, eta, wi, uniform, kMaxOrder);
+        if (!exit || !exit->escaped || exit->order < 2) continue;
+        (exit->wo.z > 0 ? reflected : transmitted) += 1;
+    }
+    out.reflected = double(reflected) / walks;
+    out.transmitted = double(transmitted) / walks;
+    return out;
+}
+
+double Table::walk_conductor(double mu, double alpha, int walks, unsigned stream) {
+    if (alpha <= 0 || walks <= 0) return 0;
+    const GGX<double> ggx{alpha};
+    const Vec3d wi = incident(mu);
+    auto white = [](double) { return Rgbd(1.0); };
+    std::uint64_t later = 0;
+    ParticleRng rng(kSeed, stream, 0);
+    auto uniform = [&] { return rng.uniform_double(); };
+    for (int n = 0; n < walks; ++n) {
+        const auto exit = walk_rough_conductor(ggx, white, wi, uniform, kMaxOrder);
+        if (exit && exit->escaped && exit->order >= 2) ++later;
+    }
+    return double(later) / walks;
+}
+
+MultipleScatteringAlbedo::MultipleScatteringAlbedo() {
+    const TableKey key{"ms-albedo",
+                       fmt::format("{} mu{}:{} a{} e{}:{}:{} walks{}:{} order{} seed{}",
+                                   kCodeVersion, kNmu, kMuMin, kNalpha, kNeta, kLog2EtaMin,
+                                   kLog2EtaMax, kWalksSplit, kWalksConductor, kMaxOrder, kSeed),
+                       {std::uint32_t(kNmu * kNalpha * kNeta + kNmu * kNalpha)}};
+    values_ = cached_table(key, [] {
+        std::vector<float> v(std::size_t(kNmu) * kNalpha * kNeta + kNmu * kNalpha);
+        // One stream per node: each node's walks are the same whatever the thread count.
+#pragma omp parallel for schedule(dynamic) collapse(2)
+        for (int im = 0; im < kNmu; ++im)
+            for (int ia = 0; ia < kNalpha; ++ia) {
+                for (int ie = 0; ie < kNeta; ++ie) {
+                    const unsigned stream = unsigned(dielectric_index(im, ia, ie));
+                    const Dielectric d = walk_dielectric(mu_node(im), alpha_node(ia), eta_node(ie),
+                                                         kWalksSplit, stream);
+                    const double total = d.reflected + d.transmitted;
+                    v[dielectric_index(im, ia, ie)] = float(total > 0 ? d.reflected / total : 0);
+                }
+                v[conductor_index(im, ia)] =
+                    float(walk_conductor(mu_node(im), alpha_node(ia), kWalksConductor,
+                                         unsigned(conductor_index(im, ia))));
+            }
+        return v;
+    });
+}
+
+const MultipleScatteringAlbedo& MultipleScatteringAlbedo::get() {
+    static const MultipleScatteringAlbedo table;
+    return table;
+}
+
+Table::Dielectric MultipleScatteringAlbedo::dielectric(double mu, double alpha, double eta) const {
+    Dielectric out;
+    if (!(alpha > 0) || !(eta > 0)) return out;
+    int im, ia, ie;
+    double tm, ta, te;
+    locate(std::sqrt(clamp(mu, 0.0, 1.0)) * (kNmu - 1), kNmu, im, tm);
+    locate(std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1), kNalpha, ia, ta);
+    locate((clamp(std::log2(eta), kLog2EtaMin, kLog2EtaMax) - kLog2EtaMin) /
+               (kLog2EtaMax - kLog2EtaMin) * (kNeta - 1),
+           kNeta, ie, te);
+    double split = 0;
+    for (int dm = 0; dm < 2; ++dm)
+        for (int da = 0; da < 2; ++da)
+            for (int de = 0; de < 2; ++de)
+                split += (dm ? tm : 1 - tm) * (da ? ta : 1 - ta) * (de ? te : 1 - te) *
+                         values_[dielectric_index(im + dm, ia + da, ie + de)];
+    // What single scattering loses, from its own tables (the walk's orders ≥ 2 carry exactly it).
+    const double lost =
+        std::max(0.0, 1 - FgdTable::get()(mu, alpha, eta, 0.0) -
+                          CoatTransmittanceTable::get(TransmissionMasking::Smith)(mu, alpha, eta));
+    out.reflected = split * lost;
+    out.transmitted = (1 - split) * lost;
+    return out;
+}
+
+double MultipleScatteringAlbedo::conductor(double mu, double alpha) const {
+    if (!(alpha > 0)) return 0;
+    int im, ia;
+    double tm, ta;
+    locate(std::sqrt(clamp(mu, 0.0, 1.0)) * (kNmu - 1), kNmu, im, tm);
+    locate(std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1), kNalpha, ia, ta);
+    double sum = 0;
+    for (int dm = 0; dm < 2; ++dm)
+        for (int da = 0; da < 2; ++da)
+            sum += (dm ? tm : 1 - tm) * (da ? ta : 1 - ta) *
+                   values_[conductor_index(im + dm, ia + da)];
+    return sum;
+}
+
+}  // namespace lamina

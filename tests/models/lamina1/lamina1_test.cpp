@@ -1,0 +1,422 @@
+// lamina-1 (docs/models.md, "lamina-1"): its exact limits against closed forms, its reciprocity
+// and energy, its sampler (chi-square), and its coat transmittance table against independent
+// integrals.
+#include "core/math.h"
+#include "core/rng.h"
+#include "core/spherical.h"
+#include "models/model_sampling.h"
+#include "models/numerics/binned.h"
+#include "models/registry.h"
+#include "models/tables/coat_transmittance.h"
+#include "models/test_stacks.h"
+#include "physics/conductor.h"
+#include "physics/fresnel.h"
+#include "physics/microfacet.h"
+#include "support/chi2.h"
+#include "support/closed_forms.h"
+
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace lamina {
+namespace {
+
+using test::coated;
+
+using test::dir;
+
+Rgbd total_delta(const Model& m, const Vec3d& wi, bool reflection) {
+    Rgbd e(0.0);
+    for (const DeltaLobe& d : m.delta_lobes(wi))
+        if ((d.direction.z > 0) == reflection) e += d.energy;
+    return e;
+}
+
+// A smooth coat over a black base reflects the Fresnel mirror lobe F(μi) and nothing else.
+TEST(Lamina1, SmoothCoatOverBlackIsTheFresnelMirror) {
+    for (const InterfaceSpec& base :
+         {test::lambertian(Rgbd(0.0)), test::conductor(Rgbd(1.5), Rgbd(0.0), 0.3)}) {
+        // A conductor of the coat's own index with κ = 0 is index-matched: it reflects nothing.
+        const auto model = make_model("lamina-1", coated(1.5, 0.0, base));
+        for (double ti : {0.0, 30.0, 60.0, 85.0}) {
+            const Vec3d wi = dir(ti, 0);
+            const auto lobes = model->delta_lobes(wi);
+            ASSERT_GE(lobes.size(), 1u);
+            EXPECT_NEAR(lobes[0].energy[0], fresnel_dielectric(wi.z, 1.5), 1e-15);
+            EXPECT_NEAR(lobes[0].direction.x, -wi.x, 1e-15);
+            for (double to : {0.0, 40.0, 80.0})
+                for (double po : {0.0, 90.0, 180.0}) {
+                    const Rgbd f = model->eval(wi, dir(to, po));
+                    EXPECT_LT(f.max(), 1e-12) << ti << " " << to << " " << po;
+                }
+        }
+    }
+}
+
+// An index-matched smooth coat (η0 = 1) without absorption is no coat: the base alone, i.e. the
+// Walter conductor BRDF (physics/conductor.h) and ρ/π.
+TEST(Lamina1, IndexMatchedCoatIsTheBaseAlone) {
+    const InterfaceSpec gold = test::gold(0.3);
+    const auto model = make_model("lamina-1", coated(1.0, 0.0, gold));
+    const ConductorInterface<double> bare{gold.eta_rgb, gold.k, 0.3};
+    const auto lambert = make_model("lamina-1", coated(1.0, 0.0, test::lambertian(Rgbd(0.7))));
+    ParticleRng rng(11, 0, 0);
+    for (int n = 0; n < 200; ++n) {
+        const Vec3d wi = dir(89 * rng.uniform_double(), 0);
+        const Vec3d wo = dir(89 * rng.uniform_double(), 360 * rng.uniform_double());
+        const Rgbd f = model->eval(wi, wo), ref = bare.eval(wi, wo);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(f[c], ref[c], 1e-9 * std::max(1.0, ref[c]));
+        EXPECT_NEAR(lambert->eval(wi, wo)[1], 0.7 / kPi<double>, 1e-12);
+    }
+}
+
+// A smooth coat over a Lambertian with absorption: the exact series of docs/physics.md §6.3
+// (test/support/closed_forms.h), all orders, and the mirror lobe F(μi). The model's only
+// approximations vanish here (the light enters and leaves along the refracted directions, the
+// base re-diffuses it exactly); what remains is the Gauss rule of r̄ (24 nodes on each side of
+// the critical cosine) and of the normalization integral, accurate to far below 1e-9.
+TEST(Lamina1, SmoothCoatedLambertianIsTheExactSeries) {
+    const Rgbd tau(0.1, 0.0, 0.9), rho(0.8, 0.5, 0.2);
+    const auto model = make_model("lamina-1", coated(1.5, 0.0, test::lambertian(rho), tau));
+    const test::CoatedLambertianSeries exact(1.5, tau, rho);
+    for (double ti : {0.0, 20.0, 45.0, 70.0, 85.0}) {
+        const Vec3d wi = dir(ti, 0);
+        EXPECT_NEAR(total_delta(*model, wi, true)[0], exact.specular(wi.z), 1e-15);
+        for (double to : {0.0, 33.0, 60.0, 88.0}) {
+            const Vec3d wo = dir(to, 123);
+            const Rgbd f = model->eval(wi, wo), g = exact.diffuse(wi.z, wo.z);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(f[c], g[c], 1e-6 * g[c]) << ti << " " << to << " " << c;
+        }
+    }
+}
+
+// Smooth coat over a smooth conductor: one mirror lobe of energy R − F with
+// R = F + (1 − F)² Rc a² / (1 − F Rc a²) (docs/physics.md §6.5), Rc at the refracted cosine.
+TEST(Lamina1, SmoothCoatOverSmoothConductorIsTheExactSeries) {
+    const InterfaceSpec gold = test::gold(0.0);
+    const Rgbd tau(0.2, 0.05, 0.0);
+    const auto model = make_model("lamina-1", coated(1.5, 0.0, gold, tau));
+    for (double ti : {0.0, 30.0, 60.0, 80.0}) {
+        const Vec3d wi = dir(ti, 0);
+        const double F = fresnel_dielectric(wi.z, 1.5);
+        const double mu_t = std::sqrt(1 - (1 - wi.z * wi.z) / 2.25);
+        const Rgbd R = total_delta(*model, wi, true);
+        for (int c = 0; c < 3; ++c) {
+            const double Rc = fresnel_conductor(mu_t, gold.eta_rgb[c] / 1.5, gold.k[c] / 1.5);
+            const double a2 = std::exp(-2 * tau[c] / mu_t);
+            const double expected = F + sqr(1 - F) * Rc * a2 / (1 - F * Rc * a2);
+            EXPECT_NEAR(R[c], expected, 1e-7) << ti << " " << c;  // fresnel_complex_rgb: 1e-7
+        }
+    }
+}
+
+// A smooth slab (index η, absorption τ) in air: R = F + (1 − F)² F a²/(1 − F² a²) and
+// T = (1 − F)² a/(1 − F² a²) (docs/physics.md §6.4), both delta lobes; the BTDF lobe leaves along
+// −wi.
+TEST(Lamina1, SmoothSlabIsTheExactSeries) {
+    const Rgbd tau(0.1, 0.0, 0.9);
+    const auto model = make_model("lamina-1", coated(1.5, 0.0, test::dielectric(1.0, 0.0), tau));
+    ASSERT_TRUE(model->support().btdf);
+    for (double ti : {0.0, 30.0, 60.0, 80.0}) {
+        const Vec3d wi = dir(ti, 0);
+        const double F = fresnel_dielectric(wi.z, 1.5);
+        const double mu_t = std::sqrt(1 - (1 - wi.z * wi.z) / 2.25);
+        const Rgbd R = total_delta(*model, wi, true), T = total_delta(*model, wi, false);
+        for (const DeltaLobe& d : model->delta_lobes(wi))
+            if (d.direction.z < 0) {
+                EXPECT_NEAR(d.direction.x, -wi.x, 1e-12);
+                EXPECT_NEAR(d.direction.z, -wi.z, 1e-12);
+            }
+        for (int c = 0; c < 3; ++c) {
+            const double a = std::exp(-tau[c] / mu_t);
+            const double denom = 1 - F * F * a * a;
+            EXPECT_NEAR(R[c], F + sqr(1 - F) * F * a * a / denom, 1e-12) << ti;
+            EXPECT_NEAR(T[c], sqr(1 - F) * a / denom, 1e-12) << ti;
+        }
+        EXPECT_LT(model->eval(wi, dir(40, 200)).max(), 1e-12);
+        EXPECT_LT(model->eval(wi, Vec3d(0.3, 0.1, -std::sqrt(0.9))).max(), 1e-12);
+    }
+}
+
+// Continuity: nearly smooth slabs (α = 10⁻³ on both interfaces) reflect and transmit what the
+// smooth slab does (docs/physics.md §6.4) up to 60°: what separates them is the microsurfaces' loss
+// (< 1e-4 there), the tables' interpolation (< 1e-3 at α = 10⁻³) and the binned quadrature
+// (1e-3 relative); the later orders, spread into the separable lobes (inter-reflection=on; by
+// default a slab gets none), carry F²a² < 1% of the light.
+TEST(Lamina1, NearlySmoothSlabIsTheSmoothSlab) {
+    const Rgbd tau(0.1, 0.0, 0.9);
+    const auto model = make_model("lamina-1", coated(1.5, 1e-3, test::dielectric(1.0, 1e-3), tau),
+                                  {"inter-reflection=on"});
+    BinnedOptions o;
+    o.rel_tol = 1e-3;
+    for (double ti : {0.0, 30.0, 60.0}) {
+        const Vec3d wi = dir(ti, 0);
+        const double F = fresnel_dielectric(wi.z, 1.5);
+        const double mu_t = std::sqrt(1 - (1 - wi.z * wi.z) / 2.25);
+        const Rgbd R = model_albedo(*model, wi, Side::Reflection, o);
+        const Rgbd T = model_albedo(*model, wi, Side::Transmission, o);
+        for (int c = 0; c < 3; ++c) {
+            const double a = std::exp(-tau[c] / mu_t);
+            const double denom = 1 - F * F * a * a;
+            EXPECT_NEAR(R[c], F + sqr(1 - F) * F * a * a / denom, 5e-3) << ti << " " << c;
+            EXPECT_NEAR(T[c], sqr(1 - F) * a / denom, 5e-3) << ti << " " << c;
+        }
+    }
+}
+
+std::vector<std::pair<std::string, Stack>> rough_stacks() {
+    return {
+        {"plastic", coated(1.5, 0.3, test::lambertian(Rgbd(0.8, 0.5, 0.2)), Rgbd(0.1, 0, 0.9))},
+        {"paint", coated(1.5, 0.05, test::gold(0.3), Rgbd(0.1))},
+        {"frosted", coated(1.5, 0.4, test::gold(0.05))},
+        {"slab", coated(1.5, 0.3, test::dielectric(1.0, 0.3), Rgbd(0.1, 0, 0.9))},
+        {"glass on glass", coated(1.3, 0.2, test::dielectric(1.8, 0.1))},
+    };
+}
+
+// Both microsurface options (the default single scattering and multiple).
+const std::vector<std::vector<std::string>> kMicrosurfaces = {{}, {"microsurface=multiple"}};
+
+// Reciprocal by construction: every factor is symmetric in (wi, wo) (T(μi)T(μo), a(μi')a(μo'),
+// the widened lobe's α_e(k_i, k_o), X(μi)X(μo)). Checked to rounding on random pairs.
+TEST(Lamina1, BrdfIsReciprocal) {
+    ParticleRng rng(5, 0, 0);
+    for (const auto& options : kMicrosurfaces)
+        for (const auto& [what, stack] : rough_stacks()) {
+            const auto model = make_model("lamina-1", stack, options);
+            for (int n = 0; n < 300; ++n) {
+                const Vec3d a = dir(89.5 * rng.uniform_double(), 360 * rng.uniform_double());
+                const Vec3d b = dir(89.5 * rng.uniform_double(), 360 * rng.uniform_double());
+                const Rgbd fab = model->eval(a, b), fba = model->eval(b, a);
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_NEAR(fab[c], fba[c], 1e-12 * std::max(fab[c], 1.0)) << what;
+            }
+        }
+}
+
+TEST(Lamina1, PreparedEvaluatorEqualsEval) {
+    ParticleRng rng(6, 0, 0);
+    for (const auto& options : kMicrosurfaces)
+        for (const auto& [what, stack] : rough_stacks()) {
+            const auto model = make_model("lamina-1", stack, options);
+            const Vec3d wi = dir(50, 0);
+            const auto prepared = model->prepare(wi);
+            for (int n = 0; n < 50; ++n) {
+                Vec3d wo = dir(89.5 * rng.uniform_double(), 360 * rng.uniform_double());
+                if (n % 2) wo.z = -wo.z;
+                const Rgbd f = model->eval(wi, wo), g = prepared->eval(wo);
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_EQ(f[c], g[c]) << what;
+            }
+        }
+}
+
+// Energy: nothing absorbs, so R + T ≤ 1 (the single-scattering microsurfaces lose the rest).
+// Coats η0 ∈ {1.2, 1.5, 2}, α0 ∈ {0, 0.05, 0.3, 0.7} over a white Lambertian, a near-perfect
+// smooth and rough mirror and a slab, at incidences up to 85°. Budget: the binned quadrature's
+// 1e-3 and the FGD table's interpolation error (≤ 6.3e-3 for conductors; docs/models.md), which
+// enters through the hemispherical albedos.
+TEST(Lamina1, AlbedoAtMostOne) {
+    BinnedOptions o;
+    o.rel_tol = 1e-3;
+    const std::vector<std::pair<std::string, InterfaceSpec>> bases = {
+        {"white lambertian", test::lambertian(Rgbd(1.0))},
+        {"mirror", test::conductor(Rgbd(0.05), Rgbd(8.0), 0.0)},
+        {"rough mirror", test::conductor(Rgbd(0.05), Rgbd(8.0), 0.4)},
+        {"slab", test::dielectric(1.0, 0.2)},
+    };
+    for (const auto& options : kMicrosurfaces)
+        for (const auto& [bname, base] : bases)
+            for (double eta : {1.2, 1.5, 2.0})
+                for (double alpha : {0.0, 0.05, 0.3, 0.7}) {
+                    const auto model = make_model("lamina-1", coated(eta, alpha, base), options);
+                    for (double ti : {0.0, 60.0, 85.0}) {
+                        const Vec3d wi = incident_direction(deg_to_rad(ti));
+                        Rgbd a = model_albedo(*model, wi, Side::Reflection, o);
+                        if (model->support().btdf)
+                            a += model_albedo(*model, wi, Side::Transmission, o);
+                        // Measured excess, reported (docs/models.md, lamina-1's known errors):
+                        // under the roughest low-index coat over a smooth near-perfect mirror the
+                        // round trips of the narrow first order (exit-transmittance=inside) keep
+                        // 3.7% too much with multiple scattering (η0 = 1.2, α0 = 0.7, normal
+                        // incidence; 7.8% before the base lobe's normalization).
+                        const bool known_excess = !options.empty() && bname == "mirror" &&
+                                                  eta < 1.3 && alpha >= 0.7 && ti == 0.0;
+                        EXPECT_LE(a.max(), 1.0 + 1e-3 + 6.3e-3 + (known_excess ? 0.035 : 0.0))
+                            << bname << " eta0=" << eta << " a0=" << alpha << " ti=" << ti
+                            << (options.empty() ? "" : " multiple");
+                    }
+                }
+}
+
+// White furnace with multiple scattering: a non-absorbing rough coat over a white Lambertian
+// loses nothing, so the albedo is 1 (the goniophotometer's --microsurface multiple reaches it
+// within its standard error). lamina-1 reaches it by construction — the coat's inside
+// reflectance and transmittance then sum to 1, and the series carries the rest — up to the
+// multiple-scattering table's Monte-Carlo error (≤ 0.0056 per node; the inside hemispherical
+// average r̄ enters through 1/(1 − r̄) ≤ 3 here), the transmittance and FGD tables'
+// interpolation and the binned quadrature (1e-3).
+TEST(Lamina1, MultipleScatteringWhiteFurnace) {
+    BinnedOptions o;
+    o.rel_tol = 1e-3;
+    for (double eta : {1.2, 1.5, 2.0})
+        for (double alpha : {0.1, 0.3, 0.7}) {
+            const auto model =
+                make_model("lamina-1", coated(eta, alpha, test::lambertian(Rgbd(1.0))),
+                           {"microsurface=multiple"});
+            const auto single =
+                make_model("lamina-1", coated(eta, alpha, test::lambertian(Rgbd(1.0))));
+            for (double ti : {0.0, 45.0, 70.0, 85.0}) {
+                const Vec3d wi = incident_direction(deg_to_rad(ti));
+                const Rgbd a = model_albedo(*model, wi, Side::Reflection, o);
+                EXPECT_NEAR(a.mean(), 1.0, 0.02)
+                    << "eta0=" << eta << " a0=" << alpha << " ti=" << ti;
+                // Single scattering loses energy there.
+                if (alpha >= 0.3 && ti >= 70) {
+                    EXPECT_LT(model_albedo(*single, wi, Side::Reflection, o).mean(),
+                              a.mean() - 0.01);
+                }
+            }
+        }
+}
+
+TEST(Lamina1, SupportIsExplicit) {
+    const auto milky = make_model(
+        "lamina-1", coated(1.5, 0.1, test::lambertian(Rgbd(0.5)), Rgbd(0.1), Rgbd(0.5), 0.3));
+    EXPECT_TRUE(milky->support().brdf);  // HG media (lamina1_scattering_test.cpp)
+    const auto bare = make_model("lamina-1", test::single(test::gold(0.2)));
+    EXPECT_FALSE(bare->support().brdf);
+    const auto plastic = make_model("lamina-1", coated(1.5, 0.1, test::lambertian(Rgbd(0.5))));
+    EXPECT_TRUE(plastic->support().brdf);
+    EXPECT_FALSE(plastic->support().btdf);
+    EXPECT_TRUE(plastic->has_sampling());
+}
+
+// The coat transmittance's direct integral (visible normals) against an independent solid-angle
+// integral of Walter's BTDF (Eq. 21) with the same masking, on a midpoint grid in (s = sin θo, φ)
+// of the lower hemisphere (in s, not u = sin²θo: at normal incidence the transmitted lobe peaks
+// at u = 0, where a midpoint grid in u was 2.7e-3 low at α = 0.2).
+TEST(CoatTransmittance, DirectIntegralEqualsSolidAngleIntegral) {
+    const int nu = 1200, nphi = 600;
+    for (TransmissionMasking masking : {TransmissionMasking::Smith, TransmissionMasking::Pbrt})
+        for (double alpha : {0.2, 0.5})
+            for (double c : {1.0, 0.9, 0.4})
+                for (double eta : {1.5, 1 / 1.5}) {
+                    const Vec3d wi(std::sqrt(1 - c * c), 0, c);
+                    const GGX<double> ggx{alpha};
+                    double sum = 0;
+                    for (int a = 0; a < nu; ++a)
+                        for (int b = 0; b < nphi; ++b) {
+                            const double s = (a + 0.5) / nu, u = s * s;
+                            const double phi = kPi<double> * (b + 0.5) / nphi;
+                            const Vec3d wo(s * std::cos(phi), s * std::sin(phi), -std::sqrt(1 - u));
+                            // Walter Eq. 16: h = −(wi + η wo), in the upper hemisphere.
+                            Vec3d h = normalize(wi + wo * eta);
+                            if (h.z < 0) h = -h;
+                            if (dot(wi, h) <= 0 || dot(wo, h) >= 0) continue;
+                            const double F = fresnel_dielectric(dot(wi, h), eta);
+                            const double G =
+                                refraction_escape(masking, ggx.lambda(wi), ggx.lambda(wo)) *
+                                ggx.G1(wi);
+                            const double f = std::abs(dot(wi, h) * dot(wo, h)) * eta * eta *
+                                             (1 - F) * ggx.D(h) * G /
+                                             (c * -wo.z * sqr(dot(wi, h) + eta * dot(wo, h)));
+                            sum += f * 2 * s;  // f μo dω = f ½ du dφ = f s ds dφ, two halves in φ
+                        }
+                    const double integral = sum * kPi<double> / (double(nu) * nphi);
+                    EXPECT_NEAR(CoatTransmittanceTable::direct(c, alpha, eta, masking), integral,
+                                1e-3)
+                        << alpha << " " << c << " " << eta;
+                }
+}
+
+// The table against its direct integral at random off-grid points, per region: entering a denser
+// medium (η ∈ [1.1, 2.5]), leaving it (η ∈ [0.4, 0.9], where T has the smoothed step of total
+// internal reflection at the critical cosine), leaving it at nearly matched indices (η ∈ [0.9,
+// 0.999], where that step moves fastest with η: 0.27 off at η = 0.95 on an axis uniform in
+// log2 η), α ∈ [0.02, 0.82]; and within ±0.05 of the critical cosine at α ∈ [0.01, 0.1], the
+// steep edge of a nearly smooth slab's bottom. Bounds: the interpolation error measured at 300
+// points per region (docs/models.md), rounded up.
+TEST(CoatTransmittance, TableMatchesDirectIntegrationOffGrid) {
+    const auto& table = CoatTransmittanceTable::get(TransmissionMasking::Smith);
+    struct Region {
+        double eta_lo, eta_hi, alpha_lo, alpha_hi;
+        bool at_edge;
+        double max_bound, mean_bound;
+    };
+    for (const Region& region : {Region{1.1, 2.5, 0.02, 0.82, false, 5e-3, 4e-4},
+                                 Region{0.4, 0.9, 0.02, 0.82, false, 6e-3, 8e-4},
+                                 Region{0.9, 0.999, 0.02, 0.82, false, 6e-3, 8e-4},
+                                 Region{0.4, 0.95, 0.01, 0.1, true, 8e-3, 2e-3}}) {
+        ParticleRng rng(21, 0, 0);
+        double max_err = 0, sum_err = 0;
+        const int n = 300;
+        for (int i = 0; i < n; ++i) {
+            const double eta =
+                region.eta_lo + (region.eta_hi - region.eta_lo) * rng.uniform_double();
+            const double alpha =
+                region.alpha_lo + (region.alpha_hi - region.alpha_lo) * rng.uniform_double();
+            const double mu_c = std::sqrt(1 - eta * eta);
+            const double c = region.at_edge ? mu_c + 0.1 * (rng.uniform_double() - 0.5)
+                                            : 0.02 + 0.98 * rng.uniform_double();
+            const double err =
+                std::abs(table(c, alpha, eta) -
+                         CoatTransmittanceTable::direct(c, alpha, eta, TransmissionMasking::Smith));
+            max_err = std::max(max_err, err);
+            sum_err += err;
+        }
+        std::printf(
+            "coat transmittance table, eta in [%g, %g], alpha in [%g, %g]%s: max %.2e "
+            "mean %.2e\n",
+            region.eta_lo, region.eta_hi, region.alpha_lo, region.alpha_hi,
+            region.at_edge ? " at the critical edge" : "", max_err, sum_err / n);
+        EXPECT_LT(max_err, region.max_bound);
+        EXPECT_LT(sum_err / n, region.mean_bound);
+    }
+}
+
+TEST(CoatTransmittance, SmoothLimitIsFresnel) {
+    const auto& table = CoatTransmittanceTable::get(TransmissionMasking::Pbrt);
+    for (double c : {0.1, 0.5, 1.0})
+        for (double eta : {1.5, 0.7})
+            EXPECT_EQ(table(c, 0.0, eta), 1 - fresnel_dielectric(c, eta));
+}
+
+// The sampler draws from its own pdf (chi-square, tests/support/chi2.h): one test per stack and
+// incidence, Šidák-corrected over the suite.
+TEST(Lamina1SamplingStat, ChiSquare) {
+    const std::vector<double> incidences = {30.0, 70.0};
+    const auto stacks = rough_stacks();
+    const int count = int(stacks.size() * incidences.size() * kMicrosurfaces.size());
+    for (const auto& options : kMicrosurfaces)
+        for (const auto& [what, stack] : stacks) {
+            const auto model = make_model("lamina-1", stack, options);
+            for (double ti : incidences) {
+                const Vec3d wi = dir(ti, 0);
+                const auto r = test::model_sampling_chi2(
+                    *model, wi,
+                    fmt::format("lamina1-{}-{}{}", what, ti, options.empty() ? "" : "-ms"), count);
+                EXPECT_TRUE(r.passed) << what << " " << ti << ": " << r.message;
+            }
+        }
+}
+
+// The sample's weight is eval·|cos θo|/pdf, and pdf is what sample reports.
+TEST(Lamina1, SampleWeightIsEvalOverPdf) {
+    ParticleRng rng(8, 0, 0);
+    for (const auto& options : kMicrosurfaces)
+        for (const auto& [what, stack] : rough_stacks()) {
+            const auto model = make_model("lamina-1", stack, options);
+            const Vec3d wi = dir(40, 0);
+            const int drawn = test::expect_sample_weights(*model, wi, rng, 200, what);
+            EXPECT_GT(drawn, 100) << what;
+        }
+}
+
+}  // namespace
+}  // namespace lamina
