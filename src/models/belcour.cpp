@@ -29,18 +29,25 @@ double belcour_alpha_of_variance(double sigma, bool quadratic) {
 
 namespace {
 
-const char* on_off(bool b) {
-    return b ? "on" : "off";
+// Henyey–Greenstein lobe variance (Belcour 2018, §5.3 and code): σ_HG(g) = ((1 − g)/g)^0.8 / (1 +
+// g). Infinite as g → 0⁺ (a subnormal g gives ∞) and undefined for g ≤ 0 (reached only through
+// medium-variance=every-medium on an absorbing medium): capped at the variance of the roughest
+// lobe, σ(kBelcourAlphaMax), which α(σ) maps to the same clamped roughness; an infinite variance
+// would reach the adding sums as ∞ · 0.
+double variance_hg(double g) {
+    const double cap = belcour_variance_of_alpha(kBelcourAlphaMax, false);
+    if (!(g > 0)) return cap;
+    return std::min(std::pow((1 - g) / g, 0.8) / (1 + g), cap);
 }
 
-// Henyey–Greenstein lobe variance (Belcour 2018, §5.3 and code): σ_HG(g) = ((1 − g)/g)^0.8 / (1 +
-// g).
-// Infinite as g → 0⁺ (a subnormal g gives ∞): capped at the variance of the roughest lobe,
-// σ(kBelcourAlphaMax), which α(σ) maps to the same clamped roughness; an infinite variance would
-// reach the adding sums as ∞ · 0.
-double variance_hg(double g) {
-    return std::min(std::pow((1 - g) / g, 0.8) / (1 + g),
-                    belcour_variance_of_alpha(kBelcourAlphaMax, false));
+// Belcour 2018, §6, as the author's code applies it ("decoupling approximation"): of the energy
+// going up through the stack above, the fraction τ leaves; the rest is totally internally
+// reflected back down: Ri0 ← min(Ri0 + (1 − τ) Ti0, 1), Ti0 ← τ Ti0 (the code clamps Ri0 to 1).
+void total_internal_reflection(double tau, Rgbd& Ri0, Rgbd& Ti0) {
+    for (int k = 0; k < 3; ++k) {
+        Ri0[k] = std::min(Ri0[k] + (1 - tau) * Ti0[k], 1.0);
+        Ti0[k] *= tau;
+    }
 }
 
 double mean(const Rgbd& x) {
@@ -60,7 +67,12 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
     double c = std::max(c0, 1e-6);
     bool first_interface = true;
     bool last_was_dielectric = false, last_transmits = false;
-    for (const BelcourOperator& op : ops) {
+    // The index ratio η_above/η_below of the interface above the current layer, as light going up
+    // sees it (tir=each-interface); 1: no step (the top, or a medium in between, as the author's
+    // code has it unless tir_across_media).
+    double eta_up = 1;
+    for (std::size_t index = 0; index < ops.size(); ++index) {
+        const BelcourOperator& op = ops[index];
         Rgbd R12(0.0), T12(0.0);
         double sR12 = 0, sT12 = 0, sT21 = 0, J12 = 1, ct = c;
         bool transmits = false;
@@ -111,12 +123,19 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         } else {
             // Medium (docs/models.md "Per medium"): unscattered plus once forward-scattered light,
             // T = (1 + τs L) e^{−(τa+τs) L}, L = 1/c; no reflection; the scattered part widens
-            // the lobe by σ_HG(g) (only when the medium scatters).
+            // the lobe by σ_HG(g) (only when the medium scatters, unless every medium does).
             const double L = 1 / c;
             const Rgbd tau_t = op.tau_a + op.tau_s;
             T12 = (Rgbd(1.0) + op.tau_s * L) * exp_rgb(tau_t * -L);
-            sT12 = sT21 = op.tau_s.max() > 0 ? variance_hg(op.g) : 0.0;
+            sT12 = sT21 =
+                op.tau_s.max() > 0 || ch.medium_variance_every_medium ? variance_hg(op.g) : 0.0;
             transmits = true;
+        }
+        if (is_interface && ch.tir == BelcourTir::EachInterface && eta_up != 1) {
+            // The author's placement: before this interface's sums, for the interface above it,
+            // at the cosine in the layer between and the roughness this interface reads its FGD
+            // at — the spread of the light coming back up (the decoupling approximation).
+            total_internal_reflection(tir_fraction(ch.tir_table, c, alpha_eff, eta_up), Ri0, Ti0);
         }
         const Rgbd R21 = R12, T21 = T12;
         const double sR21 = sR12, J21 = 1 / J12;
@@ -157,15 +176,21 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         sT0i = new_sT0i;
         sRi0 = new_sRi0;
         sTi0 = new_sTi0;
+        const bool medium_below =
+            index + 1 < ops.size() && ops[index + 1].kind == BelcourOperator::Medium;
         if (is_interface && first_interface && op.kind == BelcourOperator::Dielectric &&
-            transmits && ch.tir) {
-            // Belcour 2018, §6: of the energy going up through the top interface, only τ_TIR
-            // leaves; the rest is totally internally reflected.
-            const double tau = TirTable::get()(ct, alpha_eff, 1 / op.n12);
-            Ri0 += Ti0 * (1 - tau);
-            Ti0 *= tau;
+            transmits && ch.tir == BelcourTir::TopInterface &&
+            (ch.tir_across_media || !medium_below)) {
+            // lamina's former placement: right after the top interface, at its refracted cosine
+            // and its own roughness.
+            total_internal_reflection(tir_fraction(ch.tir_table, ct, alpha_eff, 1 / op.n12), Ri0,
+                                      Ti0);
         }
         if (is_interface) first_interface = false;
+        if (op.kind == BelcourOperator::Dielectric)
+            eta_up = 1 / op.n12;
+        else if (op.kind == BelcourOperator::Medium && !ch.tir_across_media)
+            eta_up = 1;
         c = ct;
         J0i *= J12;
         Ji0 *= J21;
@@ -274,7 +299,7 @@ class BelcourModel final : public Model {
         // Build (or load) the tables now, outside any parallel region of the callers: a first
         // use inside one would compute them with a single thread.
         FgdTable::get();
-        if (ch_.tir) TirTable::get();
+        if (ch_.tir != BelcourTir::Off) tir_table_prepare(ch_.tir_table);
         top_ = ops_.front();
     }
 
@@ -401,13 +426,43 @@ std::unique_ptr<IncidentEvaluator> BelcourModel::prepare(const Vec3d& wi) const 
 
 }  // namespace
 
+namespace {
+const char* tir_name(BelcourTir tir) {
+    switch (tir) {
+        case BelcourTir::EachInterface:
+            return "each-interface";
+        case BelcourTir::TopInterface:
+            return "top-interface";
+        case BelcourTir::Off:
+            break;
+    }
+    return "off";
+}
+}  // namespace
+
 std::vector<OptionSpec> belcour_option_specs(const BelcourChoices& d) {
     return {
         {"cosine",
          {"forward", "symmetric"},
          d.symmetric ? "symmetric" : "forward",
          "cosine fed to the adding scheme: mu_i (forward) or |wi.h| (symmetric, reciprocal)"},
-        {"tir", {"on", "off"}, on_off(d.tir), "total internal reflection below the top interface"},
+        {"tir",
+         {"each-interface", "top-interface", "off"},
+         tir_name(d.tir),
+         "total-internal-reflection step: while adding each interface below the top, for the one "
+         "above, at the roughness of the light coming back (the author's code); once below the top "
+         "interface at its own roughness; or none"},
+        {"tir-table",
+         {"lobe-fresnel", "lobe", "microfacet"},
+         tir_definition_name(d.tir_table),
+         "what the step's fraction holds: a flat interface's Fresnel transmittance over the "
+         "light's GGX lobe (the author's table), that lobe's part inside the escape cone, or "
+         "what a rough interface's microfacets refract of collimated light"},
+        {"tir-media",
+         {"skip", "cross"},
+         d.tir_across_media ? "cross" : "skip",
+         "a medium between two interfaces: no step for the interface above it (the author's code) "
+         "or the step across it"},
         {"sigma-t",
          {"code", "paper"},
          d.sigma_t_paper ? "paper" : "code",
@@ -416,14 +471,25 @@ std::vector<OptionSpec> belcour_option_specs(const BelcourChoices& d) {
          {"power", "quadratic"},
          d.quadratic_mapping ? "quadratic" : "power",
          "roughness <-> variance: a^1.1/(1-a^1.1) (Belcour) or a^2/(1-a^2)"},
+        {"medium-variance",
+         {"scattering", "every-medium"},
+         d.medium_variance_every_medium ? "every-medium" : "scattering",
+         "a medium widens the lobes by the HG variance of its g when it scatters, or every medium "
+         "by its g (the author's operator with the stack's g)"},
     };
 }
 
 BelcourChoices belcour_choices(const ModelOptions& o, BelcourChoices c) {
     c.symmetric = option_value(o, "cosine") == "symmetric";
-    c.tir = option_value(o, "tir") == "on";
+    const std::string tir = option_value(o, "tir");
+    c.tir = tir == "each-interface"  ? BelcourTir::EachInterface
+            : tir == "top-interface" ? BelcourTir::TopInterface
+                                     : BelcourTir::Off;
+    c.tir_table = tir_definition_of(option_value(o, "tir-table"));
+    c.tir_across_media = option_value(o, "tir-media") == "cross";
     c.sigma_t_paper = option_value(o, "sigma-t") == "paper";
     c.quadratic_mapping = option_value(o, "variance-mapping") == "quadratic";
+    c.medium_variance_every_medium = option_value(o, "medium-variance") == "every-medium";
     return c;
 }
 

@@ -299,7 +299,9 @@ double first_order(const TmComponent& k, double eta_pow, FluxFactors& x, double 
     x.gt = g_down != 0 ? g_T_next / g_down : 0.0;
     x.gtp = g_TR != 0 ? g_TRT / g_TR : 0.0;
     if (ch.tir) {
-        const TirTable& tir = TirTable::get();
+        auto tir = [&](double c, double alpha, double eta) {
+            return tir_fraction(ch.tir_table, c, alpha, eta);
+        };
         if (k.eta < 1) {
             // Downward TIR (into a lower index), at the roughness of the arriving light.
             const double a = g_down >= 1 ? 0.0 : tm_ggx_from_hg(g_down);
@@ -659,7 +661,7 @@ class TmModel final : public Model {
         support_.btdf = ch_.slab;
         top_ = comps_.front();
         FgdTable::get();
-        if (ch_.tir) TirTable::get();
+        if (ch_.tir) tir_table_prepare(ch_.tir_table);
         if (ch_.albedo_normalized) GgxAlbedoTable::get();
     }
 
@@ -906,6 +908,12 @@ std::vector<OptionSpec> tm_option_specs() {
          d.upward_fgd ? "refracted" : "same-cosine",
          "upward reflectance r': r at the incident cosine (released) or FGD(mu_t, alpha, 1/eta)"},
         {"tir", {"on", "off"}, on_off(d.tir), "the TIR-table steps of the released code"},
+        {"tir-table",
+         {"lobe", "lobe-fresnel", "microfacet"},
+         tir_definition_name(d.tir_table),
+         "the fraction the TIR steps move: the light's GGX lobe outside a flat interface's escape "
+         "cone (the released table), one minus its Fresnel transmittance (Belcour's table), or "
+         "what a rough interface's microfacets reflect totally of collimated light"},
         {"asymmetry",
          {"rgb-mean", "per-channel"},
          d.per_channel_g ? "per-channel" : "rgb-mean",
@@ -949,6 +957,7 @@ TmChoices tm_choices(const ModelOptions& o) {
                             : TmChoices::Top::Released;
     c.upward_fgd = option_value(o, "upward-fgd") == "refracted";
     c.tir = option_value(o, "tir") == "on";
+    c.tir_table = tir_definition_of(option_value(o, "tir-table"));
     c.per_channel_g = option_value(o, "asymmetry") == "per-channel";
     c.ratio_mean_g = option_value(o, "asymmetry") == "ratio-mean";
     if (o.count("normalization"))
