@@ -7,6 +7,7 @@
 // validated options into the struct. A variant of a family is its default choices.
 
 #include "core/check.h"
+#include "core/enum_names.h"
 #include "models/model.h"
 
 #include <functional>
@@ -46,6 +47,16 @@ template <typename Choices>
 ModelOption<Choices> on_off_member(std::string key, bool Choices::*member, std::string help) {
     return member_option<Choices, bool>(std::move(key), member, {{"on", true}, {"off", false}},
                                         std::move(help));
+}
+
+/// An option over a named enum member (core/enum_names.h): its values are the enum's names, in
+/// their order.
+template <typename Choices, typename E>
+ModelOption<Choices> enum_member(std::string key, E Choices::*member, std::string help) {
+    std::vector<std::pair<std::string, E>> values;
+    for (const auto& n : enum_names(E{}))
+        values.emplace_back(n.text, n.value);
+    return member_option<Choices, E>(std::move(key), member, std::move(values), std::move(help));
 }
 
 template <typename Choices>

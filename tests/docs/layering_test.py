@@ -83,7 +83,7 @@ def self_check(rules):
 
 def main():
     root = Path(sys.argv[1])
-    rules = read_rules((root / "docs" / "architecture.md").read_text())
+    rules = read_rules((root / "docs/architecture.md").read_text())
     if "core" not in rules or "models/belcour" not in rules:
         print("FAIL: docs/architecture.md has no tables of what each folder may include")
         return 1

@@ -46,7 +46,8 @@ TEST(ModelsEnergy, AlbedoAtMostOne) {
         // Bel18/Bel' energies come from the FGD table: its interpolation budget for conductors
         // (max 6.3e-3, docs/models.md) adds to the quadrature tolerance (1e-3).
         // Bel18 symmetric is not conservative by construction (Bel18SymmetricCanExceedOne below):
-        // its budget is the measured excess over a wider sweep, 1.24e-2, rounded up.
+        // its budget is the measured excess over a wider sweep, 5.3e-3 (1.24e-2 with lamina's
+        // former TIR step, tir=top-interface tir-table=microfacet), rounded up.
         // The transfer-matrix models (tm*) read the same table; lamina-1's hemispherical albedos
         // and its return of the first order come from the same FGD table (and its coat
         // transmittance table, whose budget is smaller): the same budget.
@@ -94,14 +95,15 @@ TEST(ModelsEnergy, WW09ExceedsOneAtGrazingIncidence) {
 
 // Bel18 symmetric runs the adding scheme at c0 = |wi·h|, a different cosine for every outgoing
 // direction: the lobe energies E_k(c0(wo)) are then not one partition of the incident energy, and
-// nothing bounds ∫ Σ E_k(c0(wo)) lobe_k(wo) μo dωo by 1. Over coats η0 ∈ [1.1, 2], α0 ∈ [0, 0.5]
-// over a near-perfect mirror the excess reaches 1.2% (η0 = 1.2, α0 = 0.1, θi = 60°), mostly
+// nothing bounds ∫ Σ E_k(c0(wo)) lobe_k(wo) μo dωo by 1. Over coats η0 ∈ {1.1, 1.2, 1.5, 2},
+// α0 ∈ {0, 0.05, 0.1, 0.2, 0.3, 0.5} over a near-perfect mirror, θi ∈ {0°, 30°, 60°, 80°}, the
+// excess reaches 0.53% (η0 = 1.2, α0 = 0.1, θi = 60°; 1.24% with lamina's former TIR step), mostly
 // through TIR at the grazing c0 of far-off-specular pairs. Shown, not hidden.
 TEST(ModelsEnergy, Bel18SymmetricCanExceedOne) {
     const auto model = make_model("bel18-symmetric",
                                   coated(1.2, 0.1, test::conductor(Rgbd(0.05), Rgbd(8.0), 0.0)));
     const Rgbd a = model_albedo(*model, incident_direction(deg_to_rad(60.0)), Side::Reflection);
-    EXPECT_GT(a.max(), 1.005);
+    EXPECT_GT(a.max(), 1.003);
     EXPECT_LT(a.max(), 1.02);
 }
 

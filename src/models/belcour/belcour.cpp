@@ -30,13 +30,24 @@ double belcour_alpha_of_variance(double sigma, bool quadratic) {
 namespace {
 
 // Henyey–Greenstein lobe variance (Belcour 2018, §5.3 and code): σ_HG(g) = ((1 − g)/g)^0.8 / (1 +
-// g).
-// Infinite as g → 0⁺ (a subnormal g gives ∞): capped at the variance of the roughest lobe,
-// σ(kBelcourAlphaMax), which α(σ) maps to the same clamped roughness; an infinite variance would
-// reach the adding sums as ∞ · 0.
+// g). Infinite as g → 0⁺ (a subnormal g gives ∞) and undefined for g ≤ 0 (reached only through
+// medium-variance=every-medium on an absorbing medium): capped at the variance of the roughest
+// lobe, σ(kBelcourAlphaMax), which α(σ) maps to the same clamped roughness; an infinite variance
+// would reach the adding sums as ∞ · 0.
 double variance_hg(double g) {
-    return std::min(std::pow((1 - g) / g, 0.8) / (1 + g),
-                    belcour_variance_of_alpha(kBelcourAlphaMax, false));
+    const double cap = belcour_variance_of_alpha(kBelcourAlphaMax, false);
+    if (!(g > 0)) return cap;
+    return std::min(std::pow((1 - g) / g, 0.8) / (1 + g), cap);
+}
+
+// Belcour 2018, §6, as the author's code applies it ("decoupling approximation"): of the energy
+// going up through the stack above, the fraction τ leaves; the rest is totally internally
+// reflected back down: Ri0 ← min(Ri0 + (1 − τ) Ti0, 1), Ti0 ← τ Ti0 (the code clamps Ri0 to 1).
+void total_internal_reflection(double tau, Rgbd& Ri0, Rgbd& Ti0) {
+    for (int k = 0; k < 3; ++k) {
+        Ri0[k] = std::min(Ri0[k] + (1 - tau) * Ti0[k], 1.0);
+        Ti0[k] *= tau;
+    }
 }
 
 double mean(const Rgbd& x) {
@@ -56,7 +67,12 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
     double c = std::max(c0, 1e-6);
     bool first_interface = true;
     bool last_was_dielectric = false, last_transmits = false;
-    for (const BelcourOperator& op : ops) {
+    // The index ratio η_above/η_below of the interface above the current layer, as light going up
+    // sees it (tir=each-interface); 1: no step (the top, or a medium in between, as the author's
+    // code has it unless tir_across_media).
+    double eta_up = 1;
+    for (std::size_t index = 0; index < ops.size(); ++index) {
+        const BelcourOperator& op = ops[index];
         Rgbd R12(0.0), T12(0.0);
         double sR12 = 0, sT12 = 0, sT21 = 0, J12 = 1, ct = c;
         bool transmits = false;
@@ -107,12 +123,19 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         } else {
             // Medium (docs/models.md "Per medium"): unscattered plus once forward-scattered light,
             // T = (1 + τs L) e^{−(τa+τs) L}, L = 1/c; no reflection; the scattered part widens
-            // the lobe by σ_HG(g) (only when the medium scatters).
+            // the lobe by σ_HG(g) (only when the medium scatters, unless every medium does).
             const double L = 1 / c;
             const Rgbd tau_t = op.tau_a + op.tau_s;
             T12 = (Rgbd(1.0) + op.tau_s * L) * exp_rgb(tau_t * -L);
-            sT12 = sT21 = op.tau_s.max() > 0 ? variance_hg(op.g) : 0.0;
+            sT12 = sT21 =
+                op.tau_s.max() > 0 || ch.medium_variance_every_medium ? variance_hg(op.g) : 0.0;
             transmits = true;
+        }
+        if (is_interface && ch.tir == BelcourTir::EachInterface && eta_up != 1) {
+            // The author's placement: before this interface's sums, for the interface above it,
+            // at the cosine in the layer between and the roughness this interface reads its FGD
+            // at — the spread of the light coming back up (the decoupling approximation).
+            total_internal_reflection(tir_fraction(ch.tir_table, c, alpha_eff, eta_up), Ri0, Ti0);
         }
         const Rgbd R21 = R12, T21 = T12;
         const double sR21 = sR12, J21 = 1 / J12;
@@ -153,15 +176,21 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         sT0i = new_sT0i;
         sRi0 = new_sRi0;
         sTi0 = new_sTi0;
+        const bool medium_below =
+            index + 1 < ops.size() && ops[index + 1].kind == BelcourOperator::Medium;
         if (is_interface && first_interface && op.kind == BelcourOperator::Dielectric &&
-            transmits && ch.tir) {
-            // Belcour 2018, §6: of the energy going up through the top interface, only τ_TIR
-            // leaves; the rest is totally internally reflected.
-            const double tau = TirTable::get()(ct, alpha_eff, 1 / op.n12);
-            Ri0 += Ti0 * (1 - tau);
-            Ti0 *= tau;
+            transmits && ch.tir == BelcourTir::TopInterface &&
+            (ch.tir_across_media || !medium_below)) {
+            // lamina's former placement: right after the top interface, at its refracted cosine
+            // and its own roughness.
+            total_internal_reflection(tir_fraction(ch.tir_table, ct, alpha_eff, 1 / op.n12), Ri0,
+                                      Ti0);
         }
         if (is_interface) first_interface = false;
+        if (op.kind == BelcourOperator::Dielectric)
+            eta_up = 1 / op.n12;
+        else if (op.kind == BelcourOperator::Medium && !ch.tir_across_media)
+            eta_up = 1;
         c = ct;
         J0i *= J12;
         Ji0 *= J21;
@@ -270,7 +299,7 @@ class BelcourModel final : public Model {
         // Build (or load) the tables now, outside any parallel region of the callers: a first
         // use inside one would compute them with a single thread.
         FgdTable::get();
-        if (ch_.tir) TirTable::get();
+        if (ch_.tir != BelcourTir::Off) tir_table_prepare(ch_.tir_table);
         top_ = ops_.front();
     }
 
@@ -403,12 +432,30 @@ const ModelOptionTable<BelcourChoices>& belcour_option_table() {
         member_option<C, bool>(
             "cosine", &C::symmetric, {{"forward", false}, {"symmetric", true}},
             "cosine fed to the adding scheme: mu_i (forward) or |wi.h| (symmetric, reciprocal)"),
-        on_off_member<C>("tir", &C::tir, "total internal reflection below the top interface"),
+        enum_member<C>("tir", &C::tir,
+                       "total-internal-reflection step: while adding each interface below the "
+                       "top, for the one above, at the roughness of the light coming back (the "
+                       "author's code); once below the top interface at its own roughness; or "
+                       "none"),
+        enum_member<C>("tir-table", &C::tir_table,
+                       "what the step's fraction holds: a flat interface's Fresnel transmittance "
+                       "over the light's GGX lobe (the author's table), that lobe's part inside "
+                       "the escape cone, or what a rough interface's microfacets refract of "
+                       "collimated light"),
+        member_option<C, bool>("tir-media", &C::tir_across_media,
+                               {{"skip", false}, {"cross", true}},
+                               "a medium between two interfaces: no step for the interface above "
+                               "it (the author's code) or the step across it"),
         member_option<C, bool>("sigma-t", &C::sigma_t_paper, {{"code", false}, {"paper", true}},
                                "transmission variance: the author's code or the paper's Eq. 10"),
         member_option<C, bool>("variance-mapping", &C::quadratic_mapping,
                                {{"power", false}, {"quadratic", true}},
                                "roughness <-> variance: a^1.1/(1-a^1.1) (Belcour) or a^2/(1-a^2)"),
+        member_option<C, bool>("medium-variance", &C::medium_variance_every_medium,
+                               {{"scattering", false}, {"every-medium", true}},
+                               "a medium widens the lobes by the HG variance of its g when it "
+                               "scatters, or every medium by its g (the author's operator with "
+                               "the stack's g)"),
     });
     return table;
 }

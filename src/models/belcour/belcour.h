@@ -9,6 +9,7 @@
 #include "models/model.h"
 #include "models/model_options.h"
 #include "models/tables/fgd_table.h"
+#include "models/tables/tir_table.h"
 
 #include <array>
 #include <string>
@@ -16,11 +17,41 @@
 
 namespace lamina {
 
+/// Where the total-internal-reflection step (the τ_TIR table scales the upward transmission of the
+/// stack above and moves the rest to upward reflection) is applied (docs/models.md, "TIR").
+enum class BelcourTir {
+    /// The author's code: while adding each interface below the top, before its sums, for the
+    /// interface above it (its index ratio seen from below), at the cosine in the layer between and
+    /// the roughness α(σT0i + σR) the interface being added reads its FGD at.
+    EachInterface,
+    /// lamina's former reading: once, right after the top interface, at its refracted cosine and
+    /// its own roughness.
+    TopInterface,
+    Off,
+};
+inline constexpr std::array<EnumName<BelcourTir>, 3> enum_names(BelcourTir) {
+    return {{{BelcourTir::EachInterface, "each-interface", "the author's code"},
+             {BelcourTir::TopInterface, "top-interface", "once below the top interface"},
+             {BelcourTir::Off, "off", "none"}}};
+}
+inline const char* enum_noun(BelcourTir) {
+    return "a TIR step";
+}
+
 struct BelcourChoices {
     /// Cosine fed to the adding scheme: |wi·h| (symmetric, reciprocal) or μi (forward).
     bool symmetric = false;
-    /// Total internal reflection below the top interface (paper §6), from the τ_TIR table.
-    bool tir = true;
+    BelcourTir tir = BelcourTir::EachInterface;
+    /// What τ_TIR holds (tir_table.h): the author's table by default.
+    TirDefinition tir_table = TirDefinition::LobeFresnel;
+    /// A medium between two interfaces keeps the step for the interface above it (lamina's former
+    /// reading) or removes it (false: the author's code, where the interface below a medium sees
+    /// the index ratio 1 of the medium's own layer entry).
+    bool tir_across_media = false;
+    /// Every medium widens the transmitted lobe by σ_HG(g) of its stack's g (true: the author's
+    /// operator read literally), or only a medium that scatters (false: a medium that does not
+    /// scatter has no phase function; the author's operator with g = 1 gives it no variance).
+    bool medium_variance_every_medium = false;
     /// Transmission variances: the author's code (false) or the paper's Eq. 10 (true).
     bool sigma_t_paper = false;
     /// Roughness ↔ variance: the author's σ = α^1.1/(1 − α^1.1) (false) or σ = α²/(1 − α²).

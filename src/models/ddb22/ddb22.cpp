@@ -110,9 +110,18 @@ double critical_cosine(double eta) {
     return eta < 1 ? std::sqrt(1 - eta * eta) : 0.0;
 }
 
-/// Belcour's adding as Bel18 forward runs it (models/belcour/belcour.h): μ-dependent statistics,
-/// TIR below the top interface, the author's transmission variances, the power mapping.
-const BelcourChoices kAdding{};
+/// Belcour's adding (models/belcour/belcour.h) as Bel18 forward runs it — μ-dependent statistics,
+/// the author's transmission variances, the power mapping — but with a TIR step that is exact for
+/// smooth coats: once below the top interface, with the microfacet definition of τ_TIR (no
+/// Fresnel; the author's table counts the top's Fresnel a second time).
+BelcourChoices adding_choices() {
+    BelcourChoices c;
+    c.tir = BelcourTir::TopInterface;
+    c.tir_table = TirDefinition::Microfacet;
+    c.tir_across_media = true;
+    return c;
+}
+const BelcourChoices kAdding = adding_choices();
 
 const CoatTransmittanceTable& coat_table() {
     return CoatTransmittanceTable::get(TransmissionMasking::Smith);
@@ -323,7 +332,7 @@ class Ddb22 final : public Model {
         beta_ = s_.beta;
         albedo_beta_ = GgxNormalLobeTable::get().albedo(beta_);
         if (!ch_.lobe_at_normal) GgxAlbedoTable::get();
-        if (s_.layered()) TirTable::get();
+        if (s_.layered()) tir_table_prepare(kAdding.tir_table);
     }
 
     std::string name() const override { return "ddb22"; }

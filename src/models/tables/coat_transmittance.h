@@ -19,15 +19,11 @@
 // JCGT 7(4)), T = ∫ D_wi(wm) (1 − F(wi·wm)) G_t(wi, wt)/G1(wi) dwm, wt the refraction of wi about
 // wm, by the split visible-normal rule of models/numerics/visible_normal_quadrature.h
 // (Gauss–Legendre in u = √(1 − r) on each side of the facets' total internal reflection × midpoint
-// in φ, half the disk and its mirror image). Axes: c in two pieces split at the critical cosine
-// μc(η) = √(1 − η²) of total internal reflection (μc = 0 for η ≥ 1), c = μc (1 − y²) below it
-// (kNbelow nodes uniform in y) and c = μc + (1 − μc) x² above it (kNc uniform in x; for η ≥ 1, c =
-// x²), so the smoothed step of total internal reflection lies on one node line at every η and the
-// nodes crowd towards it from both sides; α = s² (kNalpha); η in two halves meeting at the node η =
-// 1, uniform in log2 η up to 2^kLog2EtaMax above and uniform in μc(η) down to η = 2^kLog2EtaMin
-// below (kNeta in all); arguments outside are clamped. Multilinear interpolation of the residual
-// from the smooth limit w(α)(1 − F(c)) (the control variate of the FGD table, for the step of TIR),
-// the weight w interpolated in α as the residual is; α = 0 returns 1 − F(c) exactly. Cached on disk
+// in φ, half the disk and its mirror image). Axes and interpolation:
+// models/tables/critical_cosine_axes.h (c in two pieces split at the critical cosine
+// μc(η) = √(1 − η²), α = s², η in two halves meeting at η = 1), the residual from the smooth limit
+// w(α)(1 − F(c)) interpolated (the control variate of the FGD table, for the step of TIR); α = 0
+// returns 1 − F(c) exactly. Cached on disk
 // like the FGD table (models/tables/table_cache.h). Its accuracy by region: docs/models.md,
 // lamina-1.
 

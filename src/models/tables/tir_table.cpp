@@ -2,6 +2,9 @@
 
 #include "core/math.h"
 #include "core/rng.h"
+#include "models/numerics/quadrature.h"
+#include "models/numerics/visible_normal_quadrature.h"
+#include "models/tables/critical_cosine_axes.h"
 #include "models/tables/table_cache.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
@@ -9,6 +12,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace lamina {
@@ -23,11 +27,6 @@ constexpr int kSplit = 16;  // c nodes 0..kSplit cover [0, c_crit], the rest [c_
 /// be undefined behaviour and read outside the table).
 double axis(double x, double lo, double hi) {
     return x >= lo ? (x <= hi ? x : hi) : lo;
-}
-
-/// Critical cosine of relative index η < 1: below it a smooth interface reflects totally.
-double critical_cosine(double eta) {
-    return std::sqrt(std::max(0.0, 1 - eta * eta));
 }
 
 // The c axis is relative to the critical cosine of each η node and dense next to it on both
@@ -138,6 +137,142 @@ double TirTable::operator()(double c, double alpha, double eta) const {
                        values_[(std::size_t(ic + dc) * kNalpha + (ia + da)) * kNeta + ie + de];
     }
     return sum;
+}
+
+// ---- The lobe definitions (LobeFresnel, Lobe) ----
+
+namespace {
+
+constexpr int kLobeNr = 16;    // Gauss–Legendre nodes in u = √(1 − r) per piece
+constexpr int kLobeNphi = 32;  // midpoint nodes in φ over the half disk (mirrored)
+constexpr double kLobeCMin = 1e-4, kLobeAlphaMin = 1e-5;
+constexpr const char* kLobeCodeVersion = "tir-lobe-v1";
+constexpr int kLobeComponents = 2;  // LobeFresnel, Lobe
+
+using L = LobeTirTable;
+
+int component(TirDefinition definition) {
+    return definition == TirDefinition::LobeFresnel ? 0 : 1;
+}
+
+const CriticalCosineAxes& lobe_axes() {
+    static const CriticalCosineAxes a(L::kNbelow, L::kNc, L::kNalpha, L::kNeta, L::kLog2EtaMin,
+                                      L::kLog2EtaMax, kLobeCMin, kLobeAlphaMin);
+    return a;
+}
+
+/// The step limit of the Lobe definition on the side of μc a table piece holds (the lower piece
+/// ends at μc from below).
+double step(bool above) {
+    return above ? 1.0 : 0.0;
+}
+
+/// Both lobe fractions at one point (α > 0, c ≥ kLobeCMin): the lobe of the incidence wi at
+/// cosine c, D G1(wi) G1(wo)/(4 μi μo) μo dωo = D_wi(wm) G1(wo) dωm over the visible normals wm
+/// (Heitz 2018), wo the reflection of wi about wm; the integrals of G1(wo) times 1 − F(μo; η),
+/// times 1{μo > μc}, and alone (μo > 0 only), the rule split where μo crosses 0 and μc.
+std::array<double, kLobeComponents> lobe_fractions(double c, double alpha, double eta, int n_r,
+                                                   int n_phi) {
+    const Vec3d wi(safe_sqrt(1 - c * c), 0, c);
+    const GGX<double> ggx{alpha};
+    const double mu_c = critical_cosine(eta);
+    auto reflected = [&](const Vec3d& wm) { return 2 * dot(wi, wm) * wm - wi; };
+    auto reflected_z = [&](const Vec3d& wm) { return reflected(wm).z; };
+    const QuadratureRule q = gauss_legendre(n_r);
+    const Vec3d sums = integrate_visible_split<Vec3d>(
+        ggx, wi,
+        [&](const Vec3d& wm) {
+            const Vec3d wo = reflected(wm);
+            if (!(wo.z > 0)) return Vec3d(0, 0, 0);
+            const double g1 = ggx.G1(wo);
+            return Vec3d(g1 * (1 - fresnel_dielectric(wo.z, eta)), wo.z > mu_c ? g1 : 0.0, g1);
+        },
+        q, n_phi, 1e-6, Crossing{reflected_z, 0.0}, Crossing{reflected_z, mu_c});
+    return {sums.x / sums.z, sums.y / sums.z};
+}
+
+std::vector<float> compute_lobe() {
+    const CriticalCosineAxes& a = lobe_axes();
+    std::vector<float> v(a.count(kLobeComponents));
+#pragma omp parallel for schedule(dynamic) collapse(2)
+    for (int ic = 0; ic < a.c_count(); ++ic)
+        for (int ia = 0; ia < a.n_alpha; ++ia)
+            for (int ie = 0; ie < a.n_eta; ++ie) {
+                const double alpha = a.alpha_node(ia), eta = a.eta_node(ie);
+                // Without total internal reflection the lower piece is the single cosine c_min:
+                // computed once (ic = 0), copied after the loop.
+                if (ic > 0 && a.below(ic) && critical_cosine(eta) == 0) continue;
+                const double c = a.c_node(ic, eta);
+                const auto f = lobe_fractions(c, alpha, eta, kLobeNr, kLobeNphi);
+                const double w = CriticalCosineAxes::smooth_weight(alpha);
+                v[a.index(ic, ia, ie, kLobeComponents, 0)] =
+                    float(f[0] - w * L::smooth_limit(TirDefinition::LobeFresnel, c, eta));
+                v[a.index(ic, ia, ie, kLobeComponents, 1)] = float(f[1] - w * step(!a.below(ic)));
+            }
+    for (int ic = 1; ic < a.n_below; ++ic)
+        for (int ia = 0; ia < a.n_alpha; ++ia)
+            for (int ie = 0; ie < a.n_eta; ++ie)
+                if (critical_cosine(a.eta_node(ie)) == 0)
+                    for (int k = 0; k < kLobeComponents; ++k)
+                        v[a.index(ic, ia, ie, kLobeComponents, k)] =
+                            v[a.index(0, ia, ie, kLobeComponents, k)];
+    return v;
+}
+
+}  // namespace
+
+double LobeTirTable::smooth_limit(TirDefinition definition, double c, double eta) {
+    if (definition == TirDefinition::LobeFresnel) return 1 - fresnel_dielectric(c, eta);
+    return step(c >= critical_cosine(eta));
+}
+
+double LobeTirTable::direct(TirDefinition definition, double c, double alpha, double eta, int n_r,
+                            int n_phi) {
+    c = clamp(c, 0.0, 1.0);
+    if (alpha <= 0) return smooth_limit(definition, c, eta);
+    return lobe_fractions(std::max(c, kLobeCMin), alpha, eta, n_r, n_phi)[component(definition)];
+}
+
+LobeTirTable::LobeTirTable() {
+    const CriticalCosineAxes& a = lobe_axes();
+    const TableKey key{"tir-lobe",
+                       fmt::format("{} c{}+{} a{} e{}:{}:{} nr{} nphi{} cmin{} amin{}",
+                                   kLobeCodeVersion, kNbelow, kNc, kNalpha, kNeta, kLog2EtaMin,
+                                   kLog2EtaMax, kLobeNr, kLobeNphi, kLobeCMin, kLobeAlphaMin),
+                       {std::uint32_t(a.c_count()), kNalpha, kNeta, kLobeComponents}};
+    values_ = cached_table(key, compute_lobe);
+}
+
+const LobeTirTable& LobeTirTable::get() {
+    static const LobeTirTable table;
+    return table;
+}
+
+double LobeTirTable::operator()(TirDefinition definition, double c, double alpha,
+                                double eta) const {
+    c = clamp(c, 0.0, 1.0);
+    if (alpha <= 0) return smooth_limit(definition, c, eta);
+    if (definition == TirDefinition::Lobe && !(eta < 1)) return 1;  // no total reflection
+    eta = clamp(eta, std::exp2(kLog2EtaMin), std::exp2(kLog2EtaMax));
+    // The limit on the query's side of μc: the lookup's piece (c < μc: the lower one).
+    const double limit = definition == TirDefinition::LobeFresnel
+                             ? smooth_limit(definition, c, eta)
+                             : step(!(c < critical_cosine(eta)));
+    return clamp(lobe_axes().interpolate(values_, kLobeComponents, component(definition), c, alpha,
+                                         eta, limit),
+                 0.0, 1.0);
+}
+
+double tir_fraction(TirDefinition definition, double c, double alpha, double eta) {
+    if (definition == TirDefinition::Microfacet) return TirTable::get()(c, alpha, eta);
+    return LobeTirTable::get()(definition, c, alpha, eta);
+}
+
+void tir_table_prepare(TirDefinition definition) {
+    if (definition == TirDefinition::Microfacet)
+        TirTable::get();
+    else
+        LobeTirTable::get();
 }
 
 }  // namespace lamina

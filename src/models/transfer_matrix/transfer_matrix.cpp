@@ -295,7 +295,9 @@ double first_order(const TmComponent& k, double eta_pow, FluxFactors& x, double 
     x.gt = g_down != 0 ? g_T_next / g_down : 0.0;
     x.gtp = g_TR != 0 ? g_TRT / g_TR : 0.0;
     if (ch.tir) {
-        const TirTable& tir = TirTable::get();
+        auto tir = [&](double c, double alpha, double eta) {
+            return tir_fraction(ch.tir_table, c, alpha, eta);
+        };
         if (k.eta < 1) {
             // Downward TIR (into a lower index), at the roughness of the arriving light.
             const double a = g_down >= 1 ? 0.0 : tm_ggx_from_hg(g_down);
@@ -655,7 +657,7 @@ class TmModel final : public Model {
         support_.btdf = ch_.slab;
         top_ = comps_.front();
         FgdTable::get();
-        if (ch_.tir) TirTable::get();
+        if (ch_.tir) tir_table_prepare(ch_.tir_table);
         if (ch_.albedo_normalized) GgxAlbedoTable::get();
     }
 
@@ -912,6 +914,17 @@ TmOption tir_option() {
                                     "the TIR-table steps of the released code");
 }
 
+TmOption tir_table_option() {
+    return member_option<TmChoices, TirDefinition>(
+        "tir-table", &TmChoices::tir_table,
+        {{"lobe", TirDefinition::Lobe},
+         {"lobe-fresnel", TirDefinition::LobeFresnel},
+         {"microfacet", TirDefinition::Microfacet}},
+        "the fraction the TIR steps move: the light's GGX lobe outside a flat interface's escape "
+        "cone (the released table), one minus its Fresnel transmittance (Belcour's table), or "
+        "what a rough interface's microfacets reflect totally of collimated light");
+}
+
 // The asymmetry weights: one g per lobe from the RGB-mean weights, one per channel, or (tm6) one
 // per lobe as the channel mean of the per-channel ratios.
 TmOption::Value asymmetry(std::string text, bool per_channel, bool ratio_mean) {
@@ -931,6 +944,7 @@ const ModelOptionTable<TmChoices>& tm2_option_table() {
                    "the exact top reflection, or the matrices' FGD-weighted lobe"),
         upward_fgd_option(),
         tir_option(),
+        tir_table_option(),
         {"asymmetry",
          {asymmetry("rgb-mean", false, false), asymmetry("per-channel", true, false)},
          "lobe asymmetry g from RGB-mean weights, one per lobe (released), or per channel"},
@@ -945,6 +959,7 @@ const ModelOptionTable<TmChoices>& tm6_option_table() {
                    "the matrices' lobe"),
         upward_fgd_option(),
         tir_option(),
+        tir_table_option(),
         {"asymmetry",
          {asymmetry("ratio-mean", false, true), asymmetry("rgb-mean", false, false),
           asymmetry("per-channel", true, false)},

@@ -44,6 +44,7 @@
 #include "models/model.h"
 #include "models/model_options.h"
 #include "models/tables/fgd_table.h"
+#include "models/tables/tir_table.h"
 
 #include <array>
 #include <string>
@@ -97,6 +98,9 @@ struct TmChoices {
     bool upward_fgd = false;
     /// The TIR table steps of the released code (energy moved from transmission to reflection).
     bool tir = true;
+    /// What their fraction holds (tir_table.h): the released table is the Lobe definition's
+    /// complement (the part of the light's GGX lobe a flat interface reflects totally).
+    TirDefinition tir_table = TirDefinition::Lobe;
     /// The asymmetry matrices weighted per channel, one g (and GGX roughness) per channel and lobe
     /// (true), or with the released RGB-mean weights, one g per lobe (false).
     bool per_channel_g = false;

@@ -11,6 +11,7 @@
 #include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "models/tables/fgd_table.h"
+#include "models/tables/tir_table.h"
 #include "models/test_stacks.h"
 #include "models/transfer_matrix/tm_by_hand.h"
 #include "physics/conductor.h"
@@ -126,6 +127,59 @@ TEST(TmGolden, CoatOverGoldMatchesTheHandAdding) {
                     EXPECT_NEAR(got[c], want, 1e-10 * want) << ti << " " << to << " " << po;
                 }
             }
+    }
+}
+
+// The same with the TIR step on (the default), as the released code applies it: on the coat's own
+// upward factors, for the light coming back from the base, at the cosine μt below the coat and the
+// roughness α(g_t g_b) of that light (the first-order chain), with the released table's
+// definition (tir-table=lobe: the light's GGX lobe outside the coat's escape cone is totally
+// reflected): τ = τ_Lobe(μt, α(g_t g_b), 1/η), r′ = r + (1 − τ) t, t′ = τ t; the g-weighted
+// factors keep their g (r′_g = g_r r′, t′_g = g_t′ t′). tir-table=microfacet (lamina's former
+// table) differs by more than 1 % at θi 75°.
+TEST(TmGolden, CoatOverGoldTirStepByHand) {
+    const double eta = 1.5, a0 = 0.2, a1 = 0.3;
+    const InterfaceSpec gold = test::gold(a1);
+    const auto model = make_model("tm2", coated(eta, a0, gold));
+    const auto microfacet = make_model("tm2", coated(eta, a0, gold), {"tir-table=microfacet"});
+    const FgdTable& fgd = FgdTable::get();
+    const DielectricInterface<double> top{eta, a0};
+    for (double ti : {10.0, 50.0, 75.0}) {
+        const Vec3d wi = dir(ti, 0);
+        const double mi = wi.z, mt = std::sqrt(1 - (1 - mi * mi) / (eta * eta));
+        const double r = fgd(mi, a0, eta, 0), t = 1 - r;
+        Rgbd rb;
+        for (int c = 0; c < 3; ++c)
+            rb[c] = fgd(mt, a1, gold.eta_rgb[c] / eta, gold.k[c] / eta);
+        const double gr = g_of_alpha(a0), gb = g_of_alpha(a1);
+        const double gt = g_of_alpha(0.5 * std::abs(mi / (eta * mt) - 1) * a0);
+        const double gtp_own = g_of_alpha(0.5 * std::abs(1 - eta * mt / mi) * a0);
+        const double gtp = g_refracted(gt * gb, eta) * gtp_own / (gt * gb);
+        const double tau = tir_fraction(TirDefinition::Lobe, mt, alpha_of_g(gt * gb), 1 / eta);
+        const double rp = r + (1 - tau) * t, tp = tau * t;
+        Rgbd e1;
+        for (int c = 0; c < 3; ++c)
+            e1[c] = t * tp * rb[c] / (1 - rp * rb[c]);
+        const double rg = gr * r, tg = gt * t, tpg = gtp * tp, rpg = gr * rp, rbg = gb * rb.mean();
+        const double Rg = rg + tg * tpg * rbg / (1 - rpg * rbg);
+        const double g1 = std::min((Rg - rg) / e1.mean(), 1.0);
+        const GGX<double> lobe{alpha_of_g(g1)};
+        double max_diff = 0;
+        for (double to : {15.0, 55.0})
+            for (double po : {0.0, 160.0}) {
+                const Vec3d wo = dir(to, po), h = normalize(wi + wo);
+                const double shape = lobe.D(h) * lobe.G2(wi, wo) / (4 * wi.z * wo.z);
+                const Rgbd got = model->eval(wi, wo);
+                for (int c = 0; c < 3; ++c) {
+                    const double want = top.eval(wi, wo) + e1[c] * shape;
+                    EXPECT_NEAR(got[c], want, 1e-10 * want) << ti << " " << to << " " << po;
+                    max_diff =
+                        std::max(max_diff, std::abs(microfacet->eval(wi, wo)[c] / got[c] - 1));
+                }
+            }
+        if (ti == 75.0) {
+            EXPECT_GT(max_diff, 0.01);
+        }
     }
 }
 
@@ -262,7 +316,7 @@ TEST(Tm2, BaseLobeEnergyIsBelPrimesAtBelsRoughness) {
     bb.n12 = bb.eta.mean();
     bb.alpha = ab;
     BelcourChoices bch;
-    bch.tir = false;
+    bch.tir = BelcourTir::Off;
     TmChoices tch;
     tch.tir = false;
     for (double c0 : {1.0, 0.6, 0.2}) {
