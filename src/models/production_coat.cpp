@@ -3,6 +3,7 @@
 #include "core/math.h"
 #include "models/fgd_table.h"
 #include "models/quadrature.h"
+#include "models/uncorrelated_albedo.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
 #include "physics/sampling.h"
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 namespace lamina {
 
@@ -28,6 +30,12 @@ double schlick(double c, double f0) {
 }
 
 constexpr double kF82Cos = 1.0 / 7.0;  // μ̄ of the F82-tint model (OpenPBR 1.1, "Metal")
+/// OpenPBR 1.1's default specular_roughness: the diffuse base leaves it there (its specular_weight
+/// is 0); openpbr-bsdf's darkening still reads it through E_F(1) (docs/models.md).
+constexpr double kOpenPbrDefaultSpecularRoughness = 0.3;
+/// openpbr-bsdf's compensation lobe for the metal's multiple scattering is off below r = 0.04
+/// (openpbr_microfacet_multiple_scattering_lobes.h, "MinRoughnessWithVisibleEnergyLoss").
+constexpr double kMetalMultipleScatteringMinRoughness = 0.04;
 
 class ProductionCoat final : public Model {
   public:
@@ -70,35 +78,19 @@ class ProductionCoat final : public Model {
         // Roughness: every engine's α is its parameter squared, α = r².
         double r_coat = std::sqrt(coat_.alpha0);
         if (r_.coat_min_roughness > 0) r_coat = std::max(r_coat, r_.coat_min_roughness);
-        alpha_coat_ = sqr(r_coat);
+        alpha_coat_ = sqr(lobe_roughness(r_coat));
         eta_index_ = FgdTable::locate(eta0_, 0);
+        // openpbr-bsdf reads its table at the coat's α before its lobe's clamp; at α = 0 it takes
+        // the exact Fresnel factor.
+        if (r_.coat_albedo == CoatRecipe::CoatAlbedo::OpenPbrBsdf && r_coat > 0)
+            coat_grid_ = OpenPbrBsdfEnergyGrid::dielectric(eta0_, sqr(r_coat));
 
         // The base.
         is_metal_ = coat_.base_type == InterfaceType::Conductor;
+        r_coat_ = r_coat;
         if (is_metal_) {
-            const double r_base = std::sqrt(coat_.base_alpha);
-            double r_prime = r_base;
-            switch (r_.roughening) {
-                case CoatRecipe::Roughening::None:
-                    break;
-                case CoatRecipe::Roughening::OpenPBR:  // OpenPBR 1.1, "Roughening"
-                    r_prime =
-                        std::pow(std::min(1.0, sqr(sqr(r_base)) + 2 * sqr(sqr(r_coat))), 0.25);
-                    break;
-                case CoatRecipe::Roughening::Adobe: {  // openpbr-bsdf, openpbr_bsdf.h
-                    const double factor = 1 - (eta0_ >= 1 ? 1 / eta0_ : eta0_);
-                    r_prime =
-                        std::pow(std::min(1.0, sqr(sqr(r_base)) + factor * sqr(sqr(r_coat))), 0.25);
-                    break;
-                }
-                case CoatRecipe::Roughening::Max:  // Filament, base no glossier than the coat
-                    r_prime = std::max(r_base, r_coat);
-                    break;
-                case CoatRecipe::Roughening::StandardSurface:  // coat_affect_roughness = 1
-                    r_prime = r_base + (1 - r_base) * r_coat;
-                    break;
-            }
-            alpha_base_ = sqr(r_prime);
+            const double r_prime = roughened(std::sqrt(coat_.base_alpha));
+            alpha_base_ = sqr(lobe_roughness(r_prime));
             for (int c = 0; c < 3; ++c) {
                 const double e = coat_.base_eta[c], k = coat_.base_k[c];
                 f0_[c] = fresnel_conductor(1.0, e, k);
@@ -118,6 +110,16 @@ class ProductionCoat final : public Model {
                             fresnel_conductor(1.0, e * eta0_, k * eta0_));
                         break;
                 }
+            }
+            // The average of the model's metal Fresnel, 2 ∫ F μ dμ (Gauss–Legendre, exact for
+            // F82-tint's polynomial and Schlick's): openpbr-bsdf's E_b and its compensation lobe.
+            const QuadratureRule q = gauss_legendre(16);
+            for (std::size_t i = 0; i < q.x.size(); ++i)
+                metal_average_ += metal_fresnel(q.x[i]) * (2 * q.w[i] * q.x[i]);
+            if (r_.metal_multiple_scattering && r_prime >= kMetalMultipleScatteringMinRoughness) {
+                ms_grid_ = OpenPbrBsdfEnergyGrid::white(alpha_base_);
+                ms_color_ = metal_average_ * metal_average_ * kInvPi<double>;
+                ms_norm_ = 1 / std::max(ms_grid_->average_complement(), 1e-12);
             }
         } else {
             albedo_ = r_.affect_color ? coat_.albedo * coat_.albedo : coat_.albedo;
@@ -145,6 +147,7 @@ class ProductionCoat final : public Model {
         double F_i = 0;     ///< the coat's Fresnel at μi (its own form)
         double mu_t_i = 1;  ///< refracted cosine
         double lambda_coat = 0, lambda_base = 0;
+        double ms_complement_i = 0;  ///< 1 − E(μi) of the metal's compensation lobe
     };
 
     Incident incident(const Vec3d& wi) const {
@@ -156,6 +159,7 @@ class ProductionCoat final : public Model {
         in.mu_t_i = refracted_cos(wi.z);
         if (alpha_coat_ > 0) in.lambda_coat = GGX<double>{alpha_coat_}.lambda(wi);
         if (is_metal_ && alpha_base_ > 0) in.lambda_base = GGX<double>{alpha_base_}.lambda(wi);
+        if (ms_grid_) in.ms_complement_i = ms_grid_->complement(wi.z);
         return in;
     }
 
@@ -173,19 +177,26 @@ class ProductionCoat final : public Model {
         if (alpha_coat_ > 0) {
             const GGX<double> ggx{alpha_coat_};
             const double F = coat_fresnel(r_.coat_fresnel_at_n ? wo.z : cos_h);
-            if (r_.coat_visibility == CoatRecipe::Visibility::Smith) {
-                const double G = 1 / (1 + in.lambda_coat + ggx.lambda(wo));
-                f_coat = F * ggx.D(h) * G / (4 * wi.z * wo.z);
-            } else {
+            if (r_.coat_visibility == CoatRecipe::Visibility::Kelemen) {
                 f_coat = F * ggx.D(h) / (4 * cos_h * cos_h);
+            } else {
+                const double G = masking_shadowing(r_.coat_visibility, in.lambda_coat, ggx, wo);
+                f_coat = F * ggx.D(h) * G / (4 * wi.z * wo.z);
             }
         }
         Rgbd base(0.0);
         if (is_metal_) {
             if (alpha_base_ <= 0) return Rgbd(f_coat);  // a smooth base: a delta lobe
             const GGX<double> ggx{alpha_base_};
-            const double G = 1 / (1 + in.lambda_base + ggx.lambda(wo));
+            const double G = masking_shadowing(r_.metal_visibility, in.lambda_base, ggx, wo);
             base = metal_fresnel(cos_h) * (ggx.D(h) * G / (4 * wi.z * wo.z));
+            if (ms_grid_) {
+                // openpbr-bsdf's compensation lobe (openpbr_microfacet_multiple_scattering_
+                // lobes.h), clamped as it clamps it to 1/μi.
+                const double shape =
+                    std::min(in.ms_complement_i * ms_grid_->complement(wo.z) * ms_norm_, 1 / wi.z);
+                base += ms_color_ * shape;
+            }
         } else {
             base = albedo_ * kInvPi<double>;
         }
@@ -266,7 +277,46 @@ class ProductionCoat final : public Model {
 
     /// E_coat(μ): the directional albedo of the coat lobe with exact Fresnel and Smith G2
     /// (lamina's FGD table; the models that scale by an albedo all use the exact Fresnel).
-    double coat_albedo(double mu) const { return FgdTable::get()(mu, alpha_coat_, eta_index_); }
+    double coat_albedo(double mu) const {
+        if (coat_grid_) return 1 - coat_grid_->complement(mu);
+        if (r_.coat_albedo == CoatRecipe::CoatAlbedo::OpenPbrBsdf && r_coat_ == 0)
+            return fresnel_dielectric(mu, eta0_);
+        return FgdTable::get()(mu, alpha_coat_, eta_index_);
+    }
+
+    /// The masking-shadowing of a lobe: height-correlated or uncorrelated Smith, Λ(wi) given.
+    static double masking_shadowing(CoatRecipe::Visibility v, double lambda_i,
+                                    const GGX<double>& ggx, const Vec3d& wo) {
+        const double lambda_o = ggx.lambda(wo);
+        if (v == CoatRecipe::Visibility::SmithUncorrelated)
+            return 1 / ((1 + lambda_i) * (1 + lambda_o));  // Heitz 2014, Eq. 98
+        return 1 / (1 + lambda_i + lambda_o);              // Heitz 2014, Eq. 99
+    }
+
+    /// The roughness parameter of a rough lobe after the model's clamp (a smooth one stays 0).
+    double lobe_roughness(double r) const {
+        return r > 0 ? std::max(r, r_.lobe_min_roughness) : 0.0;
+    }
+
+    /// The base's roughness parameter after the model's base-roughening rule.
+    double roughened(double r_base) const {
+        const double r_coat = r_coat_;
+        switch (r_.roughening) {
+            case CoatRecipe::Roughening::None:
+                return r_base;
+            case CoatRecipe::Roughening::OpenPBR:  // OpenPBR 1.1, "Roughening"
+                return std::pow(std::min(1.0, sqr(sqr(r_base)) + 2 * sqr(sqr(r_coat))), 0.25);
+            case CoatRecipe::Roughening::Adobe: {  // openpbr-bsdf, openpbr_bsdf.h
+                const double factor = 1 - (eta0_ >= 1 ? 1 / eta0_ : eta0_);
+                return std::pow(std::min(1.0, sqr(sqr(r_base)) + factor * sqr(sqr(r_coat))), 0.25);
+            }
+            case CoatRecipe::Roughening::Max:  // Filament, base no glossier than the coat
+                return std::max(r_base, r_coat);
+            case CoatRecipe::Roughening::StandardSurface:  // coat_affect_roughness = 1
+                return r_base + (1 - r_base) * r_coat;
+        }
+        return r_base;
+    }
 
     double coat_fresnel(double c) const {
         if (r_.coat_fresnel == CoatRecipe::Fresnel::Exact) return fresnel_dielectric(c, eta0_);
@@ -364,14 +414,19 @@ class ProductionCoat final : public Model {
                 r_b_ = std::sqrt(coat_.base_alpha);
                 return;
             }
-            // Adobe: E_b = the metal's average Fresnel 2∫F μ dμ (its own metal Fresnel; a
-            // Gauss–Legendre rule, exact for F82's polynomial), r_b = the roughened r,
-            // K_s = E_F.
-            const QuadratureRule q = gauss_legendre(16);
-            E_b_ = Rgbd(0.0);
-            for (std::size_t i = 0; i < q.x.size(); ++i)
-                E_b_ += metal_fresnel(q.x[i]) * (2 * q.w[i] * q.x[i]);
-            const double r_b = std::sqrt(alpha_base_);
+            // Adobe: E_b = the metal's average Fresnel 2∫F μ dμ (its own metal Fresnel),
+            // r_b = the roughened r (before the lobe's clamp), K_s = E_F.
+            E_b_ = metal_average_;
+            const double r_b = roughened(std::sqrt(coat_.base_alpha));
+            K = E_F + (K_r_ - E_F) * r_b;
+        } else if (r_.darkening == D::Adobe) {
+            // openpbr-bsdf weighs the base's specularity s, the average Fresnel of its specular
+            // at the relative index the specular weight leaves: 0 gives index 1, where its fit
+            // is E_F(1) = 2.67e-3, not 0. E_b = lerp(ρ, 1, s), r_b = lerp(1, r', s) with r'
+            // the default specular roughness after roughening (openpbr_bsdf.h).
+            const double s = kulla_conty_average_fresnel_fit(1.0);
+            E_b_ = albedo_ * (1 - s) + Rgbd(s);
+            const double r_b = 1 + s * (roughened(kOpenPbrDefaultSpecularRoughness) - 1);
             K = E_F + (K_r_ - E_F) * r_b;
         } else {
             E_b_ = albedo_;
@@ -401,6 +456,14 @@ class ProductionCoat final : public Model {
     Rgbd tau_{0.0};
     bool has_tau_ = false;
     double kc_norm_ = 1;
+    double r_coat_ = 0;  ///< the coat's roughness parameter before the lobe's clamp
+    std::optional<OpenPbrBsdfEnergyGrid> coat_grid_;
+    // The metal: its average Fresnel and openpbr-bsdf's compensation lobe (F_avg²/π, its grid,
+    // 1/(1 − E_avg)).
+    Rgbd metal_average_{0.0};
+    std::optional<OpenPbrBsdfEnergyGrid> ms_grid_;
+    Rgbd ms_color_{0.0};
+    double ms_norm_ = 1;
     // Darkening: Δ for a wo-independent K, else K_r, r_b and E_b for the spec's K(μo).
     Rgbd darkening_{1.0};
     Rgbd E_b_{0.0};
@@ -457,7 +520,11 @@ OptionSpec leaves_option() {
 void use_exact_leaves(CoatRecipe& r) {
     r.coat_fresnel = CoatRecipe::Fresnel::Exact;
     r.coat_visibility = CoatRecipe::Visibility::Smith;
+    r.metal_visibility = CoatRecipe::Visibility::Smith;
     r.coat_min_roughness = 0;
+    r.lobe_min_roughness = 0;
+    r.coat_albedo = CoatRecipe::CoatAlbedo::Fgd;
+    r.metal_multiple_scattering = false;
     r.metal_fresnel = CoatRecipe::MetalFresnel::Exact;
 }
 

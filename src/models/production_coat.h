@@ -48,11 +48,28 @@ struct CoatRecipe {
     /// The coat lobe's Fresnel at n·wo instead of wi·h (glTF's layering Fresnel).
     bool coat_fresnel_at_n = false;
     enum class Visibility {
-        Smith,    ///< height-correlated Smith G2 / (4 μi μo) (Heitz 2014, Eq. 99)
+        Smith,              ///< height-correlated Smith G2 / (4 μi μo) (Heitz 2014, Eq. 99)
+        SmithUncorrelated,  ///< G1(wi) G1(wo) / (4 μi μo) (Heitz 2014, Eq. 98)
         Kelemen,  ///< 1 / (4 (wi·h)²) (Kelemen & Szirmay-Kalos 2001; Filament's V_Kelemen)
     } coat_visibility = Visibility::Smith;
+    /// The metal lobe's masking-shadowing (Smith or SmithUncorrelated).
+    Visibility metal_visibility = Visibility::Smith;
     /// Smallest coat roughness parameter r (Filament clamps r to [0.089, 1]); 0: none.
     double coat_min_roughness = 0;
+    /// Smallest roughness parameter r of a rough lobe, coat or metal (openpbr-bsdf: 0.001); a
+    /// smooth one (r = 0) stays a delta lobe.
+    double lobe_min_roughness = 0;
+
+    /// Where E_coat, the coat lobe's directional albedo, comes from.
+    enum class CoatAlbedo {
+        Fgd,  ///< lamina's FGD table: exact Fresnel, height-correlated Smith (models/fgd_table.h)
+        OpenPbrBsdf,  ///< the uncorrelated lobe's albedo on openpbr-bsdf's grid, read as it reads
+                      ///< it (models/uncorrelated_albedo.h)
+    } coat_albedo = CoatAlbedo::Fgd;
+    /// openpbr-bsdf's compensation lobe for the metal's multiple scattering between microfacets:
+    /// F_avg² (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg)), E the white uncorrelated lobe's albedo
+    /// on its grid, for r ≥ 0.04.
+    bool metal_multiple_scattering = false;
 
     enum class Attenuation {
         AlbedoView,        ///< 1 − E(μo)
@@ -72,7 +89,8 @@ struct CoatRecipe {
     enum class Darkening {
         None,
         Spec,   ///< OpenPBR 1.1: K = lerp(F(μo), K_r, r_b), E_F by d'Eon's fit, E_b from FGD
-        Adobe,  ///< openpbr-bsdf: K_s = E_F (Kulla–Conty fit), E_b the average F82 Fresnel
+        Adobe,  ///< openpbr-bsdf: K_s = E_F (Kulla–Conty fit), E_b the average F82 Fresnel; the
+                ///< diffuse base's specular (weight 0, relative index 1) still counts E_F(1)
     } darkening = Darkening::None;
 
     enum class Roughening {

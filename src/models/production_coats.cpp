@@ -60,6 +60,14 @@ CoatRecipe adobe_recipe(const ModelOptions& o) {
     r.roughening =
         is_on(o, "roughening") ? CoatRecipe::Roughening::Adobe : CoatRecipe::Roughening::None;
     r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    // Its leaves (openpbr_lobe_utils.h, openpbr_eval_aniso_smith_g2): the uncorrelated Smith
+    // masking-shadowing on coat and metal, r ≥ 0.001, E_coat the albedo of that lobe as its table
+    // holds it, and the metal's multiple-scattering compensation lobe.
+    r.coat_visibility = CoatRecipe::Visibility::SmithUncorrelated;
+    r.metal_visibility = CoatRecipe::Visibility::SmithUncorrelated;
+    r.lobe_min_roughness = 0.001;
+    r.coat_albedo = CoatRecipe::CoatAlbedo::OpenPbrBsdf;
+    r.metal_multiple_scattering = is_on(o, "multiple-scattering");
     if (exact_leaves(o)) use_exact_leaves(r);
     return r;
 }
@@ -175,6 +183,9 @@ std::vector<OptionSpec> openpbr_adobe_options() {
                           "base roughening r' = min(1, r^4 + (1 - 1/eta0) r_c^4)^(1/4)"),
             on_off_option("view-tint", true,
                           "coat tint on both passages; off: the constant coat_color"),
+            on_off_option("multiple-scattering", true,
+                          "the metal's compensation lobe for multiple scattering between its "
+                          "microfacets (leaves=exact drops it)"),
             leaves_option()};
 }
 std::unique_ptr<Model> make_openpbr_adobe(const Stack& stack, const ModelOptions& options) {
