@@ -9,20 +9,23 @@
 //
 //   f_coat  the coat's microfacet reflection: Fresnel (exact or Schlick, at wi·h or at n·wo),
 //           GGX D_α with α = r² (every engine squares its roughness parameter r; lamina's α0
-//           maps to r = √α0) and a visibility term (height-correlated Smith or Kelemen's);
+//           maps to r = √α0) and a visibility term (height-correlated or uncorrelated Smith,
+//           or Kelemen's);
 //   A       the base attenuation: 1 − E_coat(μo) (albedo scaling), its reciprocal forms, or a
 //           Schlick Fresnel at n·wo, wi·h or the larger of the two cosines;
 //   T       the coat tint from τ_a: along both refracted paths, along the view's only, or a
 //           constant e^(−2τ) (the tint matched at normal incidence, two ways);
 //   Δ       OpenPBR's coat darkening (1 − K)/(1 − E_b K);
 //   f_base' the Lambertian ρ/π, or the conductor's GGX lobe with the model's metal Fresnel
-//           (exact, Schlick, F82-tint) and roughness after the model's base-roughening rule.
+//           (exact, Schlick, F82-tint) and roughness after the model's base-roughening rule
+//           (with openpbr-bsdf's compensation lobe for its multiple scattering).
 //
 // A recipe (CoatRecipe) names one model's choices; its flags switch each heuristic off and swap
 // its leaves (Fresnel, visibility, roughness clamp, metal Fresnel) for lamina's exact ones. The
-// directional albedos E_coat are lamina's FGD table (models/fgd_table.h): no engine's table is
-// copied; the published fits a model ships (OpenPBR's E_F(η), Adobe's average Fresnel,
-// Filament's F0 conversion) are implemented as shipped and cited where used.
+// directional albedos E_coat are lamina's FGD table (models/fgd_table.h), or for openpbr-bsdf
+// the albedo of its own lobe on its grid (models/uncorrelated_albedo.h, lamina's nodes): no
+// engine's table is copied; the published fits a model ships (OpenPBR's E_F(η), Adobe's average
+// Fresnel, Filament's F0 conversion) are implemented as shipped and cited where used.
 //
 // Represented: a dielectric coat (absorbing, not scattering) over a Lambertian or conductor base
 // (BRDF only). Not supported, with the reason: other shapes, a scattering coat, a dielectric
