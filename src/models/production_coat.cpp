@@ -2,6 +2,7 @@
 
 #include "core/math.h"
 #include "models/fgd_table.h"
+#include "models/filament_dfg.h"
 #include "models/quadrature.h"
 #include "models/uncorrelated_albedo.h"
 #include "physics/fresnel.h"
@@ -90,7 +91,8 @@ class ProductionCoat final : public Model {
         r_coat_ = r_coat;
         if (is_metal_) {
             const double r_prime = roughened(std::sqrt(coat_.base_alpha));
-            alpha_base_ = sqr(lobe_roughness(r_prime));
+            const double r_lobe = std::max(lobe_roughness(r_prime), r_.metal_min_roughness);
+            alpha_base_ = sqr(r_lobe);
             for (int c = 0; c < 3; ++c) {
                 const double e = coat_.base_eta[c], k = coat_.base_k[c];
                 f0_[c] = fresnel_conductor(1.0, e, k);
@@ -111,11 +113,15 @@ class ProductionCoat final : public Model {
                         break;
                 }
             }
+            // Filament's fresnel(): f90 = saturate(dot(f0, 50 · 0.33)), the edge dimmed for an F0
+            // below 2 %.
+            if (r_.metal_f90_from_f0) f90_ = std::min(1.0, 50 * 0.33 * (f0_[0] + f0_[1] + f0_[2]));
             // The average of the model's metal Fresnel, 2 ∫ F μ dμ (Gauss–Legendre, exact for
             // F82-tint's polynomial and Schlick's): openpbr-bsdf's E_b and its compensation lobe.
             const QuadratureRule q = gauss_legendre(16);
             for (std::size_t i = 0; i < q.x.size(); ++i)
                 metal_average_ += metal_fresnel(q.x[i]) * (2 * q.w[i] * q.x[i]);
+            if (r_.metal_energy_compensation) dfg_.emplace(r_lobe);
             if (r_.metal_multiple_scattering && r_prime >= kMetalMultipleScatteringMinRoughness) {
                 ms_grid_ = OpenPbrBsdfEnergyGrid::white(alpha_base_);
                 ms_color_ = metal_average_ * metal_average_ * kInvPi<double>;
@@ -178,10 +184,10 @@ class ProductionCoat final : public Model {
             const GGX<double> ggx{alpha_coat_};
             const double F = coat_fresnel(r_.coat_fresnel_at_n ? wo.z : cos_h);
             if (r_.coat_visibility == CoatRecipe::Visibility::Kelemen) {
-                f_coat = F * ggx.D(h) / (4 * cos_h * cos_h);
+                f_coat = F * ndf(ggx, h) / (4 * cos_h * cos_h);
             } else {
                 const double G = masking_shadowing(r_.coat_visibility, in.lambda_coat, ggx, wo);
-                f_coat = F * ggx.D(h) * G / (4 * wi.z * wo.z);
+                f_coat = F * ndf(ggx, h) * G / (4 * wi.z * wo.z);
             }
         }
         Rgbd base(0.0);
@@ -189,7 +195,13 @@ class ProductionCoat final : public Model {
             if (alpha_base_ <= 0) return Rgbd(f_coat);  // a smooth base: a delta lobe
             const GGX<double> ggx{alpha_base_};
             const double G = masking_shadowing(r_.metal_visibility, in.lambda_base, ggx, wo);
-            base = metal_fresnel(cos_h) * (ggx.D(h) * G / (4 * wi.z * wo.z));
+            base = metal_fresnel(cos_h) * (ndf(ggx, h) * G / (4 * wi.z * wo.z));
+            if (dfg_) {
+                // Filament's energyCompensation, 1 + F0 (1/E(μo) − 1), on the lobe.
+                const double inv_e = 1 / dfg_->albedo(wo.z);
+                for (int c = 0; c < 3; ++c)
+                    base[c] *= 1 + f0_[c] * (inv_e - 1);
+            }
             if (ms_grid_) {
                 // openpbr-bsdf's compensation lobe (openpbr_microfacet_multiple_scattering_
                 // lobes.h), clamped as it clamps it to 1/μi.
@@ -293,6 +305,12 @@ class ProductionCoat final : public Model {
         return 1 / (1 + lambda_i + lambda_o);              // Heitz 2014, Eq. 99
     }
 
+    /// D(h), capped where the model caps it.
+    double ndf(const GGX<double>& ggx, const Vec3d& h) const {
+        const double d = ggx.D(h);
+        return r_.max_ndf > 0 ? std::min(d, r_.max_ndf) : d;
+    }
+
     /// The roughness parameter of a rough lobe after the model's clamp (a smooth one stays 0).
     double lobe_roughness(double r) const {
         return r > 0 ? std::max(r, r_.lobe_min_roughness) : 0.0;
@@ -335,7 +353,8 @@ class ProductionCoat final : public Model {
                     break;
                 case CoatRecipe::MetalFresnel::Schlick:
                 case CoatRecipe::MetalFresnel::SchlickFilament:
-                    F[i] = schlick(c, f0_[i]);
+                    // Schlick 1994, Eq. 15, with the edge value f90 (Filament's F_Schlick).
+                    F[i] = f0_[i] + (f90_ - f0_[i]) * schlick_weight(c);
                     break;
                 case CoatRecipe::MetalFresnel::F82Tint:
                     F[i] = f82_tint_fresnel(c, f0_[i], tint82_[i]);
@@ -452,6 +471,8 @@ class ProductionCoat final : public Model {
     FgdTable::Index eta_index_;
     bool is_metal_ = false;
     Rgbd f0_{0.0}, tint82_{1.0};
+    double f90_ = 1;                         ///< the metal's Schlick edge value
+    std::optional<FilamentDfgTexture> dfg_;  ///< Filament's energy compensation
     Rgbd albedo_{0.0};
     Rgbd tau_{0.0};
     bool has_tau_ = false;
@@ -523,6 +544,10 @@ void use_exact_leaves(CoatRecipe& r) {
     r.metal_visibility = CoatRecipe::Visibility::Smith;
     r.coat_min_roughness = 0;
     r.lobe_min_roughness = 0;
+    r.metal_min_roughness = 0;
+    r.max_ndf = 0;
+    r.metal_energy_compensation = false;
+    r.metal_f90_from_f0 = false;
     r.coat_albedo = CoatRecipe::CoatAlbedo::Fgd;
     r.metal_multiple_scattering = false;
     r.metal_fresnel = CoatRecipe::MetalFresnel::Exact;

@@ -62,6 +62,11 @@ struct CoatRecipe {
     /// Smallest roughness parameter r of a rough lobe, coat or metal (openpbr-bsdf: 0.001); a
     /// smooth one (r = 0) stays a delta lobe.
     double lobe_min_roughness = 0;
+    /// Smallest roughness parameter of the metal, a smooth one included (Filament: 0.045).
+    double metal_min_roughness = 0;
+    /// Largest value of D (Filament caps α/(1 − (n·h)²(1 − α²)) at 453.5, a half-precision
+    /// guard, so D ≤ 453.5²/π in its coat and metal lobes); 0: none.
+    double max_ndf = 0;
 
     /// Where E_coat, the coat lobe's directional albedo, comes from.
     enum class CoatAlbedo {
@@ -69,6 +74,11 @@ struct CoatRecipe {
         OpenPbrBsdf,  ///< the uncorrelated lobe's albedo on openpbr-bsdf's grid, read as it reads
                       ///< it (models/uncorrelated_albedo.h)
     } coat_albedo = CoatAlbedo::Fgd;
+    /// Filament's compensation of the metal lobe for multiple scattering, × (1 + F0 (1/E − 1)),
+    /// E read from its DFG texture at (μo, r) (models/filament_dfg.h).
+    bool metal_energy_compensation = false;
+    /// The metal's Schlick f90 = min(1, 16.5 (F0_r + F0_g + F0_b)) (Filament), not 1.
+    bool metal_f90_from_f0 = false;
     /// openpbr-bsdf's compensation lobe for the metal's multiple scattering between microfacets:
     /// F_avg² (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg)), E the white uncorrelated lobe's albedo
     /// on its grid, for r ≥ 0.04.

@@ -14,6 +14,8 @@
 #include "models/factories.h"
 #include "models/production_coat.h"
 
+#include "core/math.h"
+
 namespace lamina {
 
 namespace {
@@ -109,7 +111,14 @@ CoatRecipe filament_recipe(const ModelOptions& o) {
     r.coat_fresnel = CoatRecipe::Fresnel::Schlick004;
     r.coat_ior_fixed = true;
     r.coat_visibility = CoatRecipe::Visibility::Kelemen;
-    r.coat_min_roughness = 0.089;  // clearCoatRoughness clamped to [0.089, 1]
+    // Its shaders (common_material.fs, surface_shading_lit.fs, surface_brdf.fs), desktop target:
+    // perceptual roughness of coat and metal clamped to [0.045, 1] (0.089 on mobile), D capped,
+    // the metal's f90 from its F0 and its energy compensation from the DFG texture.
+    r.coat_min_roughness = 0.045;
+    r.metal_min_roughness = 0.045;
+    r.max_ndf = 453.5 * 453.5 / kPi<double>;
+    r.metal_f90_from_f0 = true;
+    r.metal_energy_compensation = is_on(o, "energy-compensation");
     r.attenuation = option_value(o, "attenuation") == "h" ? CoatRecipe::Attenuation::FresnelHalf
                                                           : CoatRecipe::Attenuation::FresnelView;
     r.tint = CoatRecipe::Tint::Constant;  // no coat tint: baked into the base
@@ -222,6 +231,9 @@ std::vector<OptionSpec> filament_options() {
         on_off_option("roughening", true, "base roughness at least the coat's"),
         on_off_option("f0-conversion", true,
                       "f0ClearCoatToSurface: the metal's F0 in air converted to under the coat"),
+        on_off_option("energy-compensation", true,
+                      "the metal lobe x (1 + F0 (1/E - 1)), E from the DFG texture (leaves=exact "
+                      "drops it)"),
         leaves_option()};
 }
 std::unique_ptr<Model> make_filament(const Stack& stack, const ModelOptions& options) {
