@@ -122,10 +122,21 @@ class ProductionCoat final : public Model {
             for (std::size_t i = 0; i < q.x.size(); ++i)
                 metal_average_ += metal_fresnel(q.x[i]) * (2 * q.w[i] * q.x[i]);
             if (r_.metal_energy_compensation) dfg_.emplace(r_lobe);
-            if (r_.metal_multiple_scattering && r_prime >= kMetalMultipleScatteringMinRoughness) {
+            using MS = CoatRecipe::MetalMultipleScattering;
+            if (r_.metal_multiple_scattering == MS::OpenPbrBsdf &&
+                r_prime >= kMetalMultipleScatteringMinRoughness) {
                 ms_grid_ = OpenPbrBsdfEnergyGrid::white(alpha_base_);
                 ms_color_ = metal_average_ * metal_average_ * kInvPi<double>;
                 ms_norm_ = 1 / std::max(ms_grid_->average_complement(), 1e-12);
+            } else if (r_.metal_multiple_scattering == MS::EnterpriseApprox) {
+                // dspbr-pt's material kernel (evaluateBaseSpecularGGX), its guards included.
+                ms_roughness_ = r_lobe;
+                const double e_avg = clamp(1 - 0.58 * r_lobe + 0.08 * r_lobe * r_lobe, 0.0, 1.0);
+                for (int c = 0; c < 3; ++c) {
+                    const double f_avg = metal_average_[c];
+                    ms_color_[c] = sqr(f_avg) * e_avg / std::max(1 - f_avg * (1 - e_avg), 1e-5);
+                }
+                ms_norm_ = 1 / std::max(kPi<double> * (1 - e_avg), 1e-6);
             }
         } else {
             albedo_ = r_.affect_color ? coat_.albedo * coat_.albedo : coat_.albedo;
@@ -165,7 +176,7 @@ class ProductionCoat final : public Model {
         in.mu_t_i = refracted_cos(wi.z);
         if (alpha_coat_ > 0) in.lambda_coat = GGX<double>{alpha_coat_}.lambda(wi);
         if (is_metal_ && alpha_base_ > 0) in.lambda_base = GGX<double>{alpha_base_}.lambda(wi);
-        if (ms_grid_) in.ms_complement_i = ms_grid_->complement(wi.z);
+        if (has_ms()) in.ms_complement_i = ms_complement(wi.z);
         return in;
     }
 
@@ -202,11 +213,11 @@ class ProductionCoat final : public Model {
                 for (int c = 0; c < 3; ++c)
                     base[c] *= 1 + f0_[c] * (inv_e - 1);
             }
-            if (ms_grid_) {
-                // openpbr-bsdf's compensation lobe (openpbr_microfacet_multiple_scattering_
-                // lobes.h), clamped as it clamps it to 1/μi.
-                const double shape =
-                    std::min(in.ms_complement_i * ms_grid_->complement(wo.z) * ms_norm_, 1 / wi.z);
+            if (has_ms()) {
+                double shape = in.ms_complement_i * ms_complement(wo.z) * ms_norm_;
+                // openpbr-bsdf clamps its lobe to 1/μi (openpbr_microfacet_multiple_scattering_
+                // lobes.h).
+                if (ms_grid_) shape = std::min(shape, 1 / wi.z);
                 base += ms_color_ * shape;
             }
         } else {
@@ -303,6 +314,18 @@ class ProductionCoat final : public Model {
         if (v == CoatRecipe::Visibility::SmithUncorrelated)
             return 1 / ((1 + lambda_i) * (1 + lambda_o));  // Heitz 2014, Eq. 98
         return 1 / (1 + lambda_i + lambda_o);              // Heitz 2014, Eq. 99
+    }
+
+    /// The metal carries a compensation lobe for its multiple scattering.
+    bool has_ms() const { return ms_grid_.has_value() || ms_roughness_ > 0; }
+
+    /// 1 − E(μ) of the compensation lobe's white albedo.
+    double ms_complement(double mu) const {
+        if (ms_grid_) return ms_grid_->complement(mu);
+        // dspbr-pt's fit E(μ) = 1 − r (1/2 + (1 − μ)⁵/2), clamped to [0, 1].
+        const double e =
+            clamp(1 - ms_roughness_ * (0.5 + 0.5 * std::pow(1 - clamp(mu, 0.0, 1.0), 5)), 0.0, 1.0);
+        return 1 - e;
     }
 
     /// D(h), capped where the model caps it.
@@ -485,6 +508,7 @@ class ProductionCoat final : public Model {
     std::optional<OpenPbrBsdfEnergyGrid> ms_grid_;
     Rgbd ms_color_{0.0};
     double ms_norm_ = 1;
+    double ms_roughness_ = 0;  ///< the metal's r for dspbr-pt's fits (0: not that lobe)
     // Darkening: Δ for a wo-independent K, else K_r, r_b and E_b for the spec's K(μo).
     Rgbd darkening_{1.0};
     Rgbd E_b_{0.0};
@@ -549,7 +573,7 @@ void use_exact_leaves(CoatRecipe& r) {
     r.metal_energy_compensation = false;
     r.metal_f90_from_f0 = false;
     r.coat_albedo = CoatRecipe::CoatAlbedo::Fgd;
-    r.metal_multiple_scattering = false;
+    r.metal_multiple_scattering = CoatRecipe::MetalMultipleScattering::None;
     r.metal_fresnel = CoatRecipe::MetalFresnel::Exact;
 }
 

@@ -79,10 +79,18 @@ struct CoatRecipe {
     bool metal_energy_compensation = false;
     /// The metal's Schlick f90 = min(1, 16.5 (F0_r + F0_g + F0_b)) (Filament), not 1.
     bool metal_f90_from_f0 = false;
-    /// openpbr-bsdf's compensation lobe for the metal's multiple scattering between microfacets:
-    /// F_avg² (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg)), E the white uncorrelated lobe's albedo
-    /// on its grid, for r ≥ 0.04.
-    bool metal_multiple_scattering = false;
+    /// A compensation lobe for the metal's multiple scattering between microfacets, of Kulla &
+    /// Conty 2017's form c (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg)) with E a white lobe's albedo.
+    enum class MetalMultipleScattering {
+        None,
+        /// openpbr-bsdf: c = F_avg², E the white uncorrelated lobe's albedo on its grid, the lobe
+        /// clamped to 1/μi, for r ≥ 0.04.
+        OpenPbrBsdf,
+        /// dspbr-pt (Enterprise PBR): c = F_avg² E_avg/(1 − F_avg (1 − E_avg)) (Kulla & Conty 2017,
+        /// slide 18), E(μ) = 1 − r (1 + (1 − μ)⁵)/2 and E_avg = 1 − 0.58 r + 0.08 r², both
+        /// clamped to [0, 1] (its fits).
+        EnterpriseApprox,
+    } metal_multiple_scattering = MetalMultipleScattering::None;
 
     enum class Attenuation {
         AlbedoView,        ///< 1 − E(μo)

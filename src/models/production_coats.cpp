@@ -69,7 +69,9 @@ CoatRecipe adobe_recipe(const ModelOptions& o) {
     r.metal_visibility = CoatRecipe::Visibility::SmithUncorrelated;
     r.lobe_min_roughness = 0.001;
     r.coat_albedo = CoatRecipe::CoatAlbedo::OpenPbrBsdf;
-    r.metal_multiple_scattering = is_on(o, "multiple-scattering");
+    r.metal_multiple_scattering = is_on(o, "multiple-scattering")
+                                      ? CoatRecipe::MetalMultipleScattering::OpenPbrBsdf
+                                      : CoatRecipe::MetalMultipleScattering::None;
     if (exact_leaves(o)) use_exact_leaves(r);
     return r;
 }
@@ -100,6 +102,12 @@ CoatRecipe enterprise_recipe(const ModelOptions& o) {
     r.attenuation = CoatRecipe::Attenuation::FresnelMax;  // 1 − c max(F_c(v·n), F_c(l·n))
     r.tint = CoatRecipe::Tint::Constant;                  // no coat tint: baked into the base
     r.metal_fresnel = CoatRecipe::MetalFresnel::Schlick;
+    // As Dassault's path tracer dspbr-pt ships it (its material kernel): r ≥ 0.002 on coat and
+    // metal, the metal's multiple-scattering lobe with its fitted albedos.
+    r.lobe_min_roughness = 0.002;
+    r.metal_multiple_scattering = is_on(o, "multiple-scattering")
+                                      ? CoatRecipe::MetalMultipleScattering::EnterpriseApprox
+                                      : CoatRecipe::MetalMultipleScattering::None;
     if (exact_leaves(o)) use_exact_leaves(r);
     return r;
 }
@@ -216,7 +224,10 @@ std::unique_ptr<Model> make_standard_surface(const Stack& stack, const ModelOpti
 }
 
 std::vector<OptionSpec> enterprise_pbr_options() {
-    return {leaves_option()};
+    return {on_off_option("multiple-scattering", true,
+                          "the metal's multiple-scattering lobe (dspbr-pt's Kulla-Conty form with "
+                          "its fitted albedos; leaves=exact drops it)"),
+            leaves_option()};
 }
 std::unique_ptr<Model> make_enterprise_pbr(const Stack& stack, const ModelOptions& options) {
     return make_production_coat(stack, enterprise_recipe(options));

@@ -256,6 +256,58 @@ TEST(ProductionCoatsGolden, FilamentMatchesItsShaders) {
         worst.compensation.rel, worst.compensation.where);
 }
 
+// The data file's Enterprise PBR inputs (dspbr-pt's glTF material) are docs/models.md's mapping:
+// clearcoatRoughnessFactor = √α0; a metal's baseColor its F0 under the coat F(1; η1/η0, κ1/η0),
+// metallic 1, roughness √α1; a diffuse base's baseColor ρ, metallic 0, specularFactor 0.
+TEST(ProductionCoatsGolden, EnterprisePbrInputsFollowTheMapping) {
+    const json data = load("enterprise-pbr.json");
+    for (const json& record : data.at("stacks")) {
+        const json &s = record.at("stack"), &in = record.at("inputs");
+        const std::string id = record.at("id");
+        const double eta0 = s.at("eta0");
+        EXPECT_EQ(eta0, 1.5) << id;
+        EXPECT_NEAR(in.at("clearcoatRoughnessFactor").get<double>(),
+                    std::sqrt(s.at("alpha0").get<double>()), 1e-6)
+            << id;
+        const Rgbd base = rgb(in.at("baseColorFactor"));
+        if (s.at("base") == "lambertian") {
+            EXPECT_EQ(in.at("metallicFactor").get<double>(), 0) << id;
+            EXPECT_EQ(in.at("specularFactor").get<double>(), 0) << id;
+            const Rgbd rho = rgb(s.at("rho"));
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(base[c], rho[c], 1e-6) << id;
+            continue;
+        }
+        EXPECT_EQ(in.at("metallicFactor").get<double>(), 1) << id;
+        EXPECT_NEAR(in.at("roughnessFactor").get<double>(), std::sqrt(s.at("alpha1").get<double>()),
+                    1e-6)
+            << id;
+        const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1"));
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(base[c], conductor_ref(1, eta1[c] / eta0, k1[c] / eta0), 1e-6) << id;
+    }
+}
+
+// `enterprise-pbr` against Dassault's dspbr-pt (its Enterprise PBR material kernel).
+TEST(ProductionCoatsGolden, EnterprisePbrMatchesDspbr) {
+    const json data = load("enterprise-pbr.json");
+    Differences worst;
+    for (const json& record : data.at("stacks")) {
+        const json* compensation =
+            record.contains("compensation") ? &record.at("compensation") : nullptr;
+        keep_worst(worst, compare(data, record, "enterprise-pbr", {}, {"multiple-scattering=off"},
+                                  record.at("values"), compensation,
+                                  [](const Vec3d&, const Vec3d&) { return 1e-3; }));
+    }
+    EXPECT_LE(worst.total.rel, 1e-3) << worst.total.where;
+    EXPECT_LE(worst.compensation.excess, 1) << worst.compensation.where;
+    std::cout << fmt::format(
+        "enterprise-pbr: worst relative difference {:.2e} ({}); without the multiple-scattering "
+        "lobe {:.2e} ({}); of that lobe {:.2e} ({})\n",
+        worst.total.rel, worst.total.where, worst.rest.rel, worst.rest.where,
+        worst.compensation.rel, worst.compensation.where);
+}
+
 // The OpenPBR specification (`openpbr`) against Adobe's code on the same stacks: how far the
 // specification and its best-known implementation are apart (docs/models.md). The largest and
 // the median relative difference over the pairs and channels, per kind of base; the test holds

@@ -489,8 +489,14 @@ TEST(ProductionCoats, EnergyAsMeasured) {
         EXPECT_GT(forward, 1.2) << name;
         EXPECT_LE(forward, 1.33) << name;
     }
-    // Enterprise PBR's 1 − max(F(μi), F(μo)) conserves energy both ways.
-    EXPECT_LE(max_albedo(find_model("enterprise-pbr"), false), 1 + 1e-3);
+    // Enterprise PBR's 1 − max(F(μi), F(μo)) conserves energy both ways; dspbr-pt's
+    // multiple-scattering lobe for the metal adds light with its fitted albedos (measured 1.067:
+    // gold α1 = 0.4 under a smooth coat, θi = 80°).
+    const ModelEntry& enterprise = find_model("enterprise-pbr");
+    EXPECT_LE(max_albedo(enterprise, false, {"multiple-scattering=off"}), 1 + 1e-3);
+    const double enterprise_ms = max_albedo(enterprise, false);
+    EXPECT_GT(enterprise_ms, 1.05);
+    EXPECT_LE(enterprise_ms, 1.075);
     // Filament's base × (1 − Fc(l·h)) does not: at grazing incidence l·h is far from grazing.
     const double filament = max_albedo(find_model("filament"), false);
     EXPECT_GT(filament, 1.3);
