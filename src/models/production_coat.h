@@ -57,7 +57,7 @@ struct CoatRecipe {
     } coat_visibility = Visibility::Smith;
     /// The metal lobe's masking-shadowing (Smith or SmithUncorrelated).
     Visibility metal_visibility = Visibility::Smith;
-    /// Smallest coat roughness parameter r (Filament clamps r to [0.089, 1]); 0: none.
+    /// Smallest coat roughness parameter r, a smooth coat included (Filament: 0.045); 0: none.
     double coat_min_roughness = 0;
     /// Smallest roughness parameter r of a rough lobe, coat or metal (openpbr-bsdf: 0.001); a
     /// smooth one (r = 0) stays a delta lobe.

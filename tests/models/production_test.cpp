@@ -86,7 +86,7 @@ std::vector<const ModelEntry*> production() {
 
 // A smooth clear coat over a black base: all that is left is the top interface's mirror
 // reflection, in the model's own Fresnel (Schlick 0.04 for the coats with a fixed IOR). Filament
-// clamps its coat roughness (r ≥ 0.089): it has no smooth limit as shipped, only with the exact
+// clamps its coat roughness (r ≥ 0.045): it has no smooth limit as shipped, only with the exact
 // leaves.
 TEST(ProductionCoats, SmoothCoatOverBlackBaseIsTheTopReflection) {
     const Stack s = coated(1.5, 0.0, test::lambertian(Rgbd(0.0)));
