@@ -298,8 +298,9 @@ class ProductionCoat final : public Model {
                r_.attenuation == A::KullaConty;
     }
 
-    /// E_coat(μ): the directional albedo of the coat lobe with exact Fresnel and Smith G2
-    /// (lamina's FGD table; the models that scale by an albedo all use the exact Fresnel).
+    /// E_coat(μ): the directional albedo of the coat lobe with exact Fresnel — with Smith G2 from
+    /// lamina's FGD table, or openpbr-bsdf's uncorrelated lobe on its grid (the models that scale
+    /// by an albedo all use the exact Fresnel).
     double coat_albedo(double mu) const {
         if (coat_grid_) return 1 - coat_grid_->complement(mu);
         if (r_.coat_albedo == CoatRecipe::CoatAlbedo::OpenPbrBsdf && r_coat_ == 0)
@@ -502,8 +503,9 @@ class ProductionCoat final : public Model {
     double kc_norm_ = 1;
     double r_coat_ = 0;  ///< the coat's roughness parameter before the lobe's clamp
     std::optional<OpenPbrBsdfEnergyGrid> coat_grid_;
-    // The metal: its average Fresnel and openpbr-bsdf's compensation lobe (F_avg²/π, its grid,
-    // 1/(1 − E_avg)).
+    // The metal: its average Fresnel and its compensation lobe for multiple scattering,
+    // ms_color_ (1 − E(μi)) (1 − E(μo)) ms_norm_ with E from openpbr-bsdf's grid or dspbr-pt's
+    // fits.
     Rgbd metal_average_{0.0};
     std::optional<OpenPbrBsdfEnergyGrid> ms_grid_;
     Rgbd ms_color_{0.0};
