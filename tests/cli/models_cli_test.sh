@@ -75,7 +75,7 @@ if "$lamina" validate "$tmp/gold.json" >/dev/null 2>&1; then
     if cmp -s "$tmp/a1" "$tmp/a2" && grep -q "^[0-9]" "$tmp/a1"; then pass=$((pass + 1)); else
         echo "FAIL spec name: '$(cat "$tmp/a2")' vs '$(cat "$tmp/a1")'"; fails=$((fails + 1)); fi
     check production-bad-flag 1 "$lamina" eval --model filament --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180 --option darkening=off
-    expect_output production-bad-flag-lists "its options: attenuation, roughening, f0-conversion, leaves"
+    expect_output production-bad-flag-lists "its options: attenuation, roughening, f0-conversion, energy-compensation, leaves"
 else
     echo "SKIP the stack-reading checks: 'lamina validate' cannot parse a stack yet (issue 2 not merged)"
 fi

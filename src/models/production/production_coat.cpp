@@ -2,6 +2,8 @@
 
 #include "core/math.h"
 #include "models/numerics/quadrature.h"
+#include "models/production/filament_dfg.h"
+#include "models/production/uncorrelated_albedo.h"
 #include "models/tables/fgd_table.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
@@ -12,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 namespace lamina {
 
@@ -28,6 +31,12 @@ double schlick(double c, double f0) {
 }
 
 constexpr double kF82Cos = 1.0 / 7.0;  // μ̄ of the F82-tint model (OpenPBR 1.1, "Metal")
+/// OpenPBR 1.1's default specular_roughness: the diffuse base leaves it there (its specular_weight
+/// is 0); openpbr-bsdf's darkening still reads it through E_F(1) (docs/models.md).
+constexpr double kOpenPbrDefaultSpecularRoughness = 0.3;
+/// openpbr-bsdf's compensation lobe for the metal's multiple scattering is off below r = 0.04
+/// (openpbr_microfacet_multiple_scattering_lobes.h, "MinRoughnessWithVisibleEnergyLoss").
+constexpr double kMetalMultipleScatteringMinRoughness = 0.04;
 
 class ProductionCoat final : public Model {
   public:
@@ -70,35 +79,20 @@ class ProductionCoat final : public Model {
         // Roughness: every engine's α is its parameter squared, α = r².
         double r_coat = std::sqrt(coat_.alpha0);
         if (r_.coat_min_roughness > 0) r_coat = std::max(r_coat, r_.coat_min_roughness);
-        alpha_coat_ = sqr(r_coat);
+        alpha_coat_ = sqr(lobe_roughness(r_coat));
         eta_index_ = FgdTable::locate(eta0_, 0);
+        // openpbr-bsdf reads its table at the coat's α before its lobe's clamp; at α = 0 it takes
+        // the exact Fresnel factor.
+        if (r_.coat_albedo == CoatRecipe::CoatAlbedo::OpenPbrBsdf && r_coat > 0)
+            coat_grid_ = OpenPbrBsdfEnergyGrid::dielectric(eta0_, sqr(r_coat));
 
         // The base.
         is_metal_ = coat_.base_type == InterfaceType::Conductor;
+        r_coat_ = r_coat;
         if (is_metal_) {
-            const double r_base = std::sqrt(coat_.base_alpha);
-            double r_prime = r_base;
-            switch (r_.roughening) {
-                case CoatRecipe::Roughening::None:
-                    break;
-                case CoatRecipe::Roughening::OpenPBR:  // OpenPBR 1.1, "Roughening"
-                    r_prime =
-                        std::pow(std::min(1.0, sqr(sqr(r_base)) + 2 * sqr(sqr(r_coat))), 0.25);
-                    break;
-                case CoatRecipe::Roughening::Adobe: {  // openpbr-bsdf, openpbr_bsdf.h
-                    const double factor = 1 - (eta0_ >= 1 ? 1 / eta0_ : eta0_);
-                    r_prime =
-                        std::pow(std::min(1.0, sqr(sqr(r_base)) + factor * sqr(sqr(r_coat))), 0.25);
-                    break;
-                }
-                case CoatRecipe::Roughening::Max:  // Filament, base no glossier than the coat
-                    r_prime = std::max(r_base, r_coat);
-                    break;
-                case CoatRecipe::Roughening::StandardSurface:  // coat_affect_roughness = 1
-                    r_prime = r_base + (1 - r_base) * r_coat;
-                    break;
-            }
-            alpha_base_ = sqr(r_prime);
+            const double r_prime = roughened(std::sqrt(coat_.base_alpha));
+            const double r_lobe = std::max(lobe_roughness(r_prime), r_.metal_min_roughness);
+            alpha_base_ = sqr(r_lobe);
             for (int c = 0; c < 3; ++c) {
                 const double e = coat_.base_eta[c], k = coat_.base_k[c];
                 f0_[c] = fresnel_conductor(1.0, e, k);
@@ -118,6 +112,31 @@ class ProductionCoat final : public Model {
                             fresnel_conductor(1.0, e * eta0_, k * eta0_));
                         break;
                 }
+            }
+            // Filament's fresnel(): f90 = saturate(dot(f0, 50 · 0.33)), the edge dimmed for an F0
+            // below 2 %.
+            if (r_.metal_f90_from_f0) f90_ = std::min(1.0, 50 * 0.33 * (f0_[0] + f0_[1] + f0_[2]));
+            // The average of the model's metal Fresnel, 2 ∫ F μ dμ (Gauss–Legendre, exact for
+            // F82-tint's polynomial and Schlick's): openpbr-bsdf's E_b and its compensation lobe.
+            const QuadratureRule q = gauss_legendre(16);
+            for (std::size_t i = 0; i < q.x.size(); ++i)
+                metal_average_ += metal_fresnel(q.x[i]) * (2 * q.w[i] * q.x[i]);
+            if (r_.metal_energy_compensation) dfg_.emplace(r_lobe);
+            using MS = CoatRecipe::MetalMultipleScattering;
+            if (r_.metal_multiple_scattering == MS::OpenPbrBsdf &&
+                r_prime >= kMetalMultipleScatteringMinRoughness) {
+                ms_grid_ = OpenPbrBsdfEnergyGrid::white(alpha_base_);
+                ms_color_ = metal_average_ * metal_average_ * kInvPi<double>;
+                ms_norm_ = 1 / std::max(ms_grid_->average_complement(), 1e-12);
+            } else if (r_.metal_multiple_scattering == MS::EnterpriseApprox) {
+                // dspbr-pt's material kernel (evaluateBaseSpecularGGX), its guards included.
+                ms_roughness_ = r_lobe;
+                const double e_avg = clamp(1 - 0.58 * r_lobe + 0.08 * r_lobe * r_lobe, 0.0, 1.0);
+                for (int c = 0; c < 3; ++c) {
+                    const double f_avg = metal_average_[c];
+                    ms_color_[c] = sqr(f_avg) * e_avg / std::max(1 - f_avg * (1 - e_avg), 1e-5);
+                }
+                ms_norm_ = 1 / std::max(kPi<double> * (1 - e_avg), 1e-6);
             }
         } else {
             albedo_ = r_.affect_color ? coat_.albedo * coat_.albedo : coat_.albedo;
@@ -145,6 +164,7 @@ class ProductionCoat final : public Model {
         double F_i = 0;     ///< the coat's Fresnel at μi (its own form)
         double mu_t_i = 1;  ///< refracted cosine
         double lambda_coat = 0, lambda_base = 0;
+        double ms_complement_i = 0;  ///< 1 − E(μi) of the metal's compensation lobe
     };
 
     Incident incident(const Vec3d& wi) const {
@@ -156,6 +176,7 @@ class ProductionCoat final : public Model {
         in.mu_t_i = refracted_cos(wi.z);
         if (alpha_coat_ > 0) in.lambda_coat = GGX<double>{alpha_coat_}.lambda(wi);
         if (is_metal_ && alpha_base_ > 0) in.lambda_base = GGX<double>{alpha_base_}.lambda(wi);
+        if (has_ms()) in.ms_complement_i = ms_complement(wi.z);
         return in;
     }
 
@@ -173,19 +194,32 @@ class ProductionCoat final : public Model {
         if (alpha_coat_ > 0) {
             const GGX<double> ggx{alpha_coat_};
             const double F = coat_fresnel(r_.coat_fresnel_at_n ? wo.z : cos_h);
-            if (r_.coat_visibility == CoatRecipe::Visibility::Smith) {
-                const double G = 1 / (1 + in.lambda_coat + ggx.lambda(wo));
-                f_coat = F * ggx.D(h) * G / (4 * wi.z * wo.z);
+            if (r_.coat_visibility == CoatRecipe::Visibility::Kelemen) {
+                f_coat = F * ndf(ggx, h) / (4 * cos_h * cos_h);
             } else {
-                f_coat = F * ggx.D(h) / (4 * cos_h * cos_h);
+                const double G = masking_shadowing(r_.coat_visibility, in.lambda_coat, ggx, wo);
+                f_coat = F * ndf(ggx, h) * G / (4 * wi.z * wo.z);
             }
         }
         Rgbd base(0.0);
         if (is_metal_) {
             if (alpha_base_ <= 0) return Rgbd(f_coat);  // a smooth base: a delta lobe
             const GGX<double> ggx{alpha_base_};
-            const double G = 1 / (1 + in.lambda_base + ggx.lambda(wo));
-            base = metal_fresnel(cos_h) * (ggx.D(h) * G / (4 * wi.z * wo.z));
+            const double G = masking_shadowing(r_.metal_visibility, in.lambda_base, ggx, wo);
+            base = metal_fresnel(cos_h) * (ndf(ggx, h) * G / (4 * wi.z * wo.z));
+            if (dfg_) {
+                // Filament's energyCompensation, 1 + F0 (1/E(μo) − 1), on the lobe.
+                const double inv_e = 1 / dfg_->albedo(wo.z);
+                for (int c = 0; c < 3; ++c)
+                    base[c] *= 1 + f0_[c] * (inv_e - 1);
+            }
+            if (has_ms()) {
+                double shape = in.ms_complement_i * ms_complement(wo.z) * ms_norm_;
+                // openpbr-bsdf clamps its lobe to 1/μi (openpbr_microfacet_multiple_scattering_
+                // lobes.h).
+                if (ms_grid_) shape = std::min(shape, 1 / wi.z);
+                base += ms_color_ * shape;
+            }
         } else {
             base = albedo_ * kInvPi<double>;
         }
@@ -264,9 +298,67 @@ class ProductionCoat final : public Model {
                r_.attenuation == A::KullaConty;
     }
 
-    /// E_coat(μ): the directional albedo of the coat lobe with exact Fresnel and Smith G2
-    /// (lamina's FGD table; the models that scale by an albedo all use the exact Fresnel).
-    double coat_albedo(double mu) const { return FgdTable::get()(mu, alpha_coat_, eta_index_); }
+    /// E_coat(μ): the directional albedo of the coat lobe with exact Fresnel — with Smith G2 from
+    /// lamina's FGD table, or openpbr-bsdf's uncorrelated lobe on its grid (the models that scale
+    /// by an albedo all use the exact Fresnel).
+    double coat_albedo(double mu) const {
+        if (coat_grid_) return 1 - coat_grid_->complement(mu);
+        if (r_.coat_albedo == CoatRecipe::CoatAlbedo::OpenPbrBsdf && r_coat_ == 0)
+            return fresnel_dielectric(mu, eta0_);
+        return FgdTable::get()(mu, alpha_coat_, eta_index_);
+    }
+
+    /// The masking-shadowing of a lobe: height-correlated or uncorrelated Smith, Λ(wi) given.
+    static double masking_shadowing(CoatRecipe::Visibility v, double lambda_i,
+                                    const GGX<double>& ggx, const Vec3d& wo) {
+        const double lambda_o = ggx.lambda(wo);
+        if (v == CoatRecipe::Visibility::SmithUncorrelated)
+            return 1 / ((1 + lambda_i) * (1 + lambda_o));  // Heitz 2014, Eq. 98
+        return 1 / (1 + lambda_i + lambda_o);              // Heitz 2014, Eq. 99
+    }
+
+    /// The metal carries a compensation lobe for its multiple scattering.
+    bool has_ms() const { return ms_grid_.has_value() || ms_roughness_ > 0; }
+
+    /// 1 − E(μ) of the compensation lobe's white albedo.
+    double ms_complement(double mu) const {
+        if (ms_grid_) return ms_grid_->complement(mu);
+        // dspbr-pt's fit E(μ) = 1 − r (1/2 + (1 − μ)⁵/2), clamped to [0, 1].
+        const double e =
+            clamp(1 - ms_roughness_ * (0.5 + 0.5 * std::pow(1 - clamp(mu, 0.0, 1.0), 5)), 0.0, 1.0);
+        return 1 - e;
+    }
+
+    /// D(h), capped where the model caps it.
+    double ndf(const GGX<double>& ggx, const Vec3d& h) const {
+        const double d = ggx.D(h);
+        return r_.max_ndf > 0 ? std::min(d, r_.max_ndf) : d;
+    }
+
+    /// The roughness parameter of a rough lobe after the model's clamp (a smooth one stays 0).
+    double lobe_roughness(double r) const {
+        return r > 0 ? std::max(r, r_.lobe_min_roughness) : 0.0;
+    }
+
+    /// The base's roughness parameter after the model's base-roughening rule.
+    double roughened(double r_base) const {
+        const double r_coat = r_coat_;
+        switch (r_.roughening) {
+            case CoatRecipe::Roughening::None:
+                return r_base;
+            case CoatRecipe::Roughening::OpenPBR:  // OpenPBR 1.1, "Roughening"
+                return std::pow(std::min(1.0, sqr(sqr(r_base)) + 2 * sqr(sqr(r_coat))), 0.25);
+            case CoatRecipe::Roughening::Adobe: {  // openpbr-bsdf, openpbr_bsdf.h
+                const double factor = 1 - (eta0_ >= 1 ? 1 / eta0_ : eta0_);
+                return std::pow(std::min(1.0, sqr(sqr(r_base)) + factor * sqr(sqr(r_coat))), 0.25);
+            }
+            case CoatRecipe::Roughening::Max:  // Filament, base no glossier than the coat
+                return std::max(r_base, r_coat);
+            case CoatRecipe::Roughening::StandardSurface:  // coat_affect_roughness = 1
+                return r_base + (1 - r_base) * r_coat;
+        }
+        return r_base;
+    }
 
     double coat_fresnel(double c) const {
         if (r_.coat_fresnel == CoatRecipe::Fresnel::Exact) return fresnel_dielectric(c, eta0_);
@@ -285,7 +377,8 @@ class ProductionCoat final : public Model {
                     break;
                 case CoatRecipe::MetalFresnel::Schlick:
                 case CoatRecipe::MetalFresnel::SchlickFilament:
-                    F[i] = schlick(c, f0_[i]);
+                    // Schlick 1994, Eq. 15, with the edge value f90 (Filament's F_Schlick).
+                    F[i] = f0_[i] + (f90_ - f0_[i]) * schlick_weight(c);
                     break;
                 case CoatRecipe::MetalFresnel::F82Tint:
                     F[i] = f82_tint_fresnel(c, f0_[i], tint82_[i]);
@@ -364,14 +457,19 @@ class ProductionCoat final : public Model {
                 r_b_ = std::sqrt(coat_.base_alpha);
                 return;
             }
-            // Adobe: E_b = the metal's average Fresnel 2∫F μ dμ (its own metal Fresnel; a
-            // Gauss–Legendre rule, exact for F82's polynomial), r_b = the roughened r,
-            // K_s = E_F.
-            const QuadratureRule q = gauss_legendre(16);
-            E_b_ = Rgbd(0.0);
-            for (std::size_t i = 0; i < q.x.size(); ++i)
-                E_b_ += metal_fresnel(q.x[i]) * (2 * q.w[i] * q.x[i]);
-            const double r_b = std::sqrt(alpha_base_);
+            // Adobe: E_b = the metal's average Fresnel 2∫F μ dμ (its own metal Fresnel),
+            // r_b = the roughened r (before the lobe's clamp), K_s = E_F.
+            E_b_ = metal_average_;
+            const double r_b = roughened(std::sqrt(coat_.base_alpha));
+            K = E_F + (K_r_ - E_F) * r_b;
+        } else if (r_.darkening == D::Adobe) {
+            // openpbr-bsdf weighs the base's specularity s, the average Fresnel of its specular
+            // at the relative index the specular weight leaves: 0 gives index 1, where its fit
+            // is E_F(1) = 2.67e-3, not 0. E_b = lerp(ρ, 1, s), r_b = lerp(1, r', s) with r'
+            // the default specular roughness after roughening (openpbr_bsdf.h).
+            const double s = kulla_conty_average_fresnel_fit(1.0);
+            E_b_ = albedo_ * (1 - s) + Rgbd(s);
+            const double r_b = 1 + s * (roughened(kOpenPbrDefaultSpecularRoughness) - 1);
             K = E_F + (K_r_ - E_F) * r_b;
         } else {
             E_b_ = albedo_;
@@ -397,10 +495,22 @@ class ProductionCoat final : public Model {
     FgdTable::Index eta_index_;
     bool is_metal_ = false;
     Rgbd f0_{0.0}, tint82_{1.0};
+    double f90_ = 1;                         ///< the metal's Schlick edge value
+    std::optional<FilamentDfgTexture> dfg_;  ///< Filament's energy compensation
     Rgbd albedo_{0.0};
     Rgbd tau_{0.0};
     bool has_tau_ = false;
     double kc_norm_ = 1;
+    double r_coat_ = 0;  ///< the coat's roughness parameter before the lobe's clamp
+    std::optional<OpenPbrBsdfEnergyGrid> coat_grid_;
+    // The metal: its average Fresnel and its compensation lobe for multiple scattering,
+    // ms_color_ (1 − E(μi)) (1 − E(μo)) ms_norm_ with E from openpbr-bsdf's grid or dspbr-pt's
+    // fits.
+    Rgbd metal_average_{0.0};
+    std::optional<OpenPbrBsdfEnergyGrid> ms_grid_;
+    Rgbd ms_color_{0.0};
+    double ms_norm_ = 1;
+    double ms_roughness_ = 0;  ///< the metal's r for dspbr-pt's fits (0: not that lobe)
     // Darkening: Δ for a wo-independent K, else K_r, r_b and E_b for the spec's K(μo).
     Rgbd darkening_{1.0};
     Rgbd E_b_{0.0};
@@ -457,7 +567,15 @@ OptionSpec leaves_option() {
 void use_exact_leaves(CoatRecipe& r) {
     r.coat_fresnel = CoatRecipe::Fresnel::Exact;
     r.coat_visibility = CoatRecipe::Visibility::Smith;
+    r.metal_visibility = CoatRecipe::Visibility::Smith;
     r.coat_min_roughness = 0;
+    r.lobe_min_roughness = 0;
+    r.metal_min_roughness = 0;
+    r.max_ndf = 0;
+    r.metal_energy_compensation = false;
+    r.metal_f90_from_f0 = false;
+    r.coat_albedo = CoatRecipe::CoatAlbedo::Fgd;
+    r.metal_multiple_scattering = CoatRecipe::MetalMultipleScattering::None;
     r.metal_fresnel = CoatRecipe::MetalFresnel::Exact;
 }
 

@@ -9,20 +9,24 @@
 //
 //   f_coat  the coat's microfacet reflection: Fresnel (exact or Schlick, at wi·h or at n·wo),
 //           GGX D_α with α = r² (every engine squares its roughness parameter r; lamina's α0
-//           maps to r = √α0) and a visibility term (height-correlated Smith or Kelemen's);
+//           maps to r = √α0) and a visibility term (height-correlated or uncorrelated Smith,
+//           or Kelemen's);
 //   A       the base attenuation: 1 − E_coat(μo) (albedo scaling), its reciprocal forms, or a
 //           Schlick Fresnel at n·wo, wi·h or the larger of the two cosines;
 //   T       the coat tint from τ_a: along both refracted paths, along the view's only, or a
 //           constant e^(−2τ) (the tint matched at normal incidence, two ways);
 //   Δ       OpenPBR's coat darkening (1 − K)/(1 − E_b K);
 //   f_base' the Lambertian ρ/π, or the conductor's GGX lobe with the model's metal Fresnel
-//           (exact, Schlick, F82-tint) and roughness after the model's base-roughening rule.
+//           (exact, Schlick, F82-tint) and roughness after the model's base-roughening rule
+//           (with openpbr-bsdf's compensation lobe for its multiple scattering).
 //
 // A recipe (CoatRecipe) names one model's choices; its flags switch each heuristic off and swap
 // its leaves (Fresnel, visibility, roughness clamp, metal Fresnel) for lamina's exact ones. The
-// directional albedos E_coat are lamina's FGD table (models/tables/fgd_table.h): no engine's table
-// is copied; the published fits a model ships (OpenPBR's E_F(η), Adobe's average Fresnel,
-// Filament's F0 conversion) are implemented as shipped and cited where used.
+// directional albedos E_coat are lamina's FGD table (models/tables/fgd_table.h), or for
+// openpbr-bsdf the albedo of its own lobe on its grid (models/production/uncorrelated_albedo.h,
+// lamina's nodes): no engine's table is copied; the published fits a model ships (OpenPBR's E_F(η),
+// Adobe's average Fresnel, Filament's F0 conversion) are implemented as shipped and cited where
+// used.
 //
 // Represented: a dielectric coat (absorbing, not scattering) over a Lambertian or conductor base
 // (BRDF only). Not supported, with the reason: other shapes, a scattering coat, a dielectric
@@ -48,11 +52,47 @@ struct CoatRecipe {
     /// The coat lobe's Fresnel at n·wo instead of wi·h (glTF's layering Fresnel).
     bool coat_fresnel_at_n = false;
     enum class Visibility {
-        Smith,    ///< height-correlated Smith G2 / (4 μi μo) (Heitz 2014, Eq. 99)
+        Smith,              ///< height-correlated Smith G2 / (4 μi μo) (Heitz 2014, Eq. 99)
+        SmithUncorrelated,  ///< G1(wi) G1(wo) / (4 μi μo) (Heitz 2014, Eq. 98)
         Kelemen,  ///< 1 / (4 (wi·h)²) (Kelemen & Szirmay-Kalos 2001; Filament's V_Kelemen)
     } coat_visibility = Visibility::Smith;
-    /// Smallest coat roughness parameter r (Filament clamps r to [0.089, 1]); 0: none.
+    /// The metal lobe's masking-shadowing (Smith or SmithUncorrelated).
+    Visibility metal_visibility = Visibility::Smith;
+    /// Smallest coat roughness parameter r, a smooth coat included (Filament: 0.045); 0: none.
     double coat_min_roughness = 0;
+    /// Smallest roughness parameter r of a rough lobe, coat or metal (openpbr-bsdf: 0.001); a
+    /// smooth one (r = 0) stays a delta lobe.
+    double lobe_min_roughness = 0;
+    /// Smallest roughness parameter of the metal, a smooth one included (Filament: 0.045).
+    double metal_min_roughness = 0;
+    /// Largest value of D (Filament caps α/(1 − (n·h)²(1 − α²)) at 453.5, a half-precision
+    /// guard, so D ≤ 453.5²/π in its coat and metal lobes); 0: none.
+    double max_ndf = 0;
+
+    /// Where E_coat, the coat lobe's directional albedo, comes from.
+    enum class CoatAlbedo {
+        Fgd,          ///< lamina's FGD table: exact Fresnel, height-correlated Smith
+                      ///< (models/tables/fgd_table.h)
+        OpenPbrBsdf,  ///< the uncorrelated lobe's albedo on openpbr-bsdf's grid, read as it reads
+                      ///< it (models/production/uncorrelated_albedo.h)
+    } coat_albedo = CoatAlbedo::Fgd;
+    /// Filament's compensation of the metal lobe for multiple scattering, × (1 + F0 (1/E − 1)),
+    /// E read from its DFG texture at (μo, r) (models/production/filament_dfg.h).
+    bool metal_energy_compensation = false;
+    /// The metal's Schlick f90 = min(1, 16.5 (F0_r + F0_g + F0_b)) (Filament), not 1.
+    bool metal_f90_from_f0 = false;
+    /// A compensation lobe for the metal's multiple scattering between microfacets, of Kulla &
+    /// Conty 2017's form c (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg)) with E a white lobe's albedo.
+    enum class MetalMultipleScattering {
+        None,
+        /// openpbr-bsdf: c = F_avg², E the white uncorrelated lobe's albedo on its grid, the lobe
+        /// clamped to 1/μi, for r ≥ 0.04.
+        OpenPbrBsdf,
+        /// dspbr-pt (Enterprise PBR): c = F_avg² E_avg/(1 − F_avg (1 − E_avg)) (Kulla & Conty 2017,
+        /// slide 18), E(μ) = 1 − r (1 + (1 − μ)⁵)/2 and E_avg = 1 − 0.58 r + 0.08 r², both
+        /// clamped to [0, 1] (its fits).
+        EnterpriseApprox,
+    } metal_multiple_scattering = MetalMultipleScattering::None;
 
     enum class Attenuation {
         AlbedoView,        ///< 1 − E(μo)
@@ -72,7 +112,8 @@ struct CoatRecipe {
     enum class Darkening {
         None,
         Spec,   ///< OpenPBR 1.1: K = lerp(F(μo), K_r, r_b), E_F by d'Eon's fit, E_b from FGD
-        Adobe,  ///< openpbr-bsdf: K_s = E_F (Kulla–Conty fit), E_b the average F82 Fresnel
+        Adobe,  ///< openpbr-bsdf: K_s = E_F (Kulla–Conty fit), E_b the average F82 Fresnel; the
+                ///< diffuse base's specular (weight 0, relative index 1) still counts E_F(1)
     } darkening = Darkening::None;
 
     enum class Roughening {

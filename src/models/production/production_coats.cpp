@@ -14,6 +14,8 @@
 #include "models/production/production_coats.h"
 #include "models/production/production_coat.h"
 
+#include "core/math.h"
+
 namespace lamina {
 
 namespace {
@@ -60,6 +62,16 @@ CoatRecipe adobe_recipe(const ModelOptions& o) {
     r.roughening =
         is_on(o, "roughening") ? CoatRecipe::Roughening::Adobe : CoatRecipe::Roughening::None;
     r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    // Its leaves (openpbr_lobe_utils.h, openpbr_eval_aniso_smith_g2): the uncorrelated Smith
+    // masking-shadowing on coat and metal, r ≥ 0.001, E_coat the albedo of that lobe as its table
+    // holds it, and the metal's multiple-scattering compensation lobe.
+    r.coat_visibility = CoatRecipe::Visibility::SmithUncorrelated;
+    r.metal_visibility = CoatRecipe::Visibility::SmithUncorrelated;
+    r.lobe_min_roughness = 0.001;
+    r.coat_albedo = CoatRecipe::CoatAlbedo::OpenPbrBsdf;
+    r.metal_multiple_scattering = is_on(o, "multiple-scattering")
+                                      ? CoatRecipe::MetalMultipleScattering::OpenPbrBsdf
+                                      : CoatRecipe::MetalMultipleScattering::None;
     if (exact_leaves(o)) use_exact_leaves(r);
     return r;
 }
@@ -90,6 +102,12 @@ CoatRecipe enterprise_recipe(const ModelOptions& o) {
     r.attenuation = CoatRecipe::Attenuation::FresnelMax;  // 1 − c max(F_c(v·n), F_c(l·n))
     r.tint = CoatRecipe::Tint::Constant;                  // no coat tint: baked into the base
     r.metal_fresnel = CoatRecipe::MetalFresnel::Schlick;
+    // As Dassault's path tracer dspbr-pt ships it (its material kernel): r ≥ 0.002 on coat and
+    // metal, the metal's multiple-scattering lobe with its fitted albedos.
+    r.lobe_min_roughness = 0.002;
+    r.metal_multiple_scattering = is_on(o, "multiple-scattering")
+                                      ? CoatRecipe::MetalMultipleScattering::EnterpriseApprox
+                                      : CoatRecipe::MetalMultipleScattering::None;
     if (exact_leaves(o)) use_exact_leaves(r);
     return r;
 }
@@ -101,7 +119,14 @@ CoatRecipe filament_recipe(const ModelOptions& o) {
     r.coat_fresnel = CoatRecipe::Fresnel::Schlick004;
     r.coat_ior_fixed = true;
     r.coat_visibility = CoatRecipe::Visibility::Kelemen;
-    r.coat_min_roughness = 0.089;  // clearCoatRoughness clamped to [0.089, 1]
+    // Its shaders (common_material.fs, surface_shading_lit.fs, surface_brdf.fs), desktop target:
+    // perceptual roughness of coat and metal clamped to [0.045, 1] (0.089 on mobile), D capped,
+    // the metal's f90 from its F0 and its energy compensation from the DFG texture.
+    r.coat_min_roughness = 0.045;
+    r.metal_min_roughness = 0.045;
+    r.max_ndf = 453.5 * 453.5 / kPi<double>;
+    r.metal_f90_from_f0 = true;
+    r.metal_energy_compensation = is_on(o, "energy-compensation");
     r.attenuation = option_value(o, "attenuation") == "h" ? CoatRecipe::Attenuation::FresnelHalf
                                                           : CoatRecipe::Attenuation::FresnelView;
     r.tint = CoatRecipe::Tint::Constant;  // no coat tint: baked into the base
@@ -175,6 +200,9 @@ std::vector<OptionSpec> openpbr_adobe_options() {
                           "base roughening r' = min(1, r^4 + (1 - 1/eta0) r_c^4)^(1/4)"),
             on_off_option("view-tint", true,
                           "coat tint on both passages; off: the constant coat_color"),
+            on_off_option("multiple-scattering", true,
+                          "the metal's compensation lobe for multiple scattering between its "
+                          "microfacets (leaves=exact drops it)"),
             leaves_option()};
 }
 std::unique_ptr<Model> make_openpbr_adobe(const Stack& stack, const ModelOptions& options) {
@@ -196,7 +224,10 @@ std::unique_ptr<Model> make_standard_surface(const Stack& stack, const ModelOpti
 }
 
 std::vector<OptionSpec> enterprise_pbr_options() {
-    return {leaves_option()};
+    return {on_off_option("multiple-scattering", true,
+                          "the metal's multiple-scattering lobe (dspbr-pt's Kulla-Conty form with "
+                          "its fitted albedos; leaves=exact drops it)"),
+            leaves_option()};
 }
 std::unique_ptr<Model> make_enterprise_pbr(const Stack& stack, const ModelOptions& options) {
     return make_production_coat(stack, enterprise_recipe(options));
@@ -211,6 +242,9 @@ std::vector<OptionSpec> filament_options() {
         on_off_option("roughening", true, "base roughness at least the coat's"),
         on_off_option("f0-conversion", true,
                       "f0ClearCoatToSurface: the metal's F0 in air converted to under the coat"),
+        on_off_option("energy-compensation", true,
+                      "the metal lobe x (1 + F0 (1/E - 1)), E from the DFG texture (leaves=exact "
+                      "drops it)"),
         leaves_option()};
 }
 std::unique_ptr<Model> make_filament(const Stack& stack, const ModelOptions& options) {

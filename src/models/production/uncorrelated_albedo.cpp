@@ -1,0 +1,155 @@
+#include "models/production/uncorrelated_albedo.h"
+
+#include "core/math.h"
+#include "models/numerics/quadrature.h"
+#include "models/numerics/visible_normal_quadrature.h"
+#include "physics/fresnel.h"
+#include "physics/microfacet.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lamina {
+
+namespace {
+
+using Grid = OpenPbrBsdfEnergyGrid;
+
+/// The smallest cosine the integrals are taken at: the μ = 0 node is the limit μ → 0.
+constexpr double kMuMin = 1e-6;
+
+/// E over the visible normals of wi: ∫ D_wi(h) F(wi·h) G1(wo) dh (Heitz 2018), the radius split
+/// where wo = reflect(wi, h) crosses the horizon (G1(wo) has a kink there, and wo below it
+/// contributes nothing).
+template <typename Fresnel>
+double albedo(double mu, double alpha, Fresnel&& fresnel, int n_r, int n_phi) {
+    mu = std::max(mu, kMuMin);
+    const Vec3d wi(safe_sqrt(1 - mu * mu), 0, mu);
+    const GGX<double> ggx{alpha};
+    const QuadratureRule q = gauss_legendre(n_r);
+    auto outgoing_z = [&](const Vec3d& h) { return 2 * dot(wi, h) * h.z - wi.z; };
+    auto integrand = [&](const Vec3d& h) {
+        const double cos_h = dot(wi, h);
+        const Vec3d wo = h * (2 * cos_h) - wi;
+        if (wo.z <= 0) return 0.0;
+        return fresnel(cos_h) * ggx.G1(wo);
+    };
+    return integrate_visible_split<double>(ggx, wi, integrand, q, n_phi, 1e-7,
+                                           Crossing{outgoing_z, 0.0});
+}
+
+}  // namespace
+
+double uncorrelated_ggx_albedo(double mu, double alpha, double eta, int n_r, int n_phi) {
+    auto fresnel = [eta](double c) { return eta == 1 ? 0.0 : fresnel_dielectric(c, eta); };
+    if (alpha <= 0) return fresnel(clamp(mu, 0.0, 1.0));
+    const bool tir = eta < 1;
+    return albedo(mu, alpha, fresnel, n_r > 0 ? n_r : (tir ? 96 : 24),
+                  n_phi > 0 ? n_phi : (tir ? 400 : 48));
+}
+
+double uncorrelated_ggx_albedo_white(double mu, double alpha, int n_r, int n_phi) {
+    if (alpha <= 0) return 1;
+    return albedo(
+        mu, alpha, [](double) { return 1.0; }, n_r > 0 ? n_r : 24, n_phi > 0 ? n_phi : 48);
+}
+
+// --- openpbr-bsdf's grid ----------------------------------------------------------------------
+// The axes as openpbr-bsdf's openpbr_microfacet_multiple_scattering_data.h reads them: the η
+// index runs 16 → 31 over η ∈ [1, 2.5] and 15 → 0 over 1/η ∈ [1, 2.5]; r = √α and μ are uniform
+// over the 32 nodes. Indices are clamped to [0, 31]; past η = 2.5 (or below 1/2.5) the complement
+// read at the end node is scaled by 1 − (F0(η) − F0(2.5))/(1 − F0(2.5)).
+
+double Grid::eta_index(double eta) {
+    constexpr int kHalf = kN / 2;
+    const double index = eta < 1 ? (kHalf - 1) - (1 / eta - 1) / (kEtaMax - 1) * (kHalf - 1)
+                                 : kHalf + (eta - 1) / (kEtaMax - 1) * (kHalf - 1);
+    return clamp(index, 0.0, double(kN - 1));
+}
+double Grid::alpha_index(double alpha) {
+    return clamp(std::sqrt(std::max(alpha, 0.0)) * (kN - 1), 0.0, double(kN - 1));
+}
+double Grid::mu_index(double mu) {
+    return clamp(mu * (kN - 1), 0.0, double(kN - 1));
+}
+double Grid::eta_node(int i) {
+    constexpr int kHalf = kN / 2;
+    if (i >= kHalf) return 1 + (kEtaMax - 1) * (i - kHalf) / (kHalf - 1);
+    return 1 / (1 + (kEtaMax - 1) * (kHalf - 1 - i) / (kHalf - 1));
+}
+double Grid::alpha_node(int j) {
+    return sqr(double(j) / (kN - 1));
+}
+
+namespace {
+/// The lower node of a fractional index and the weight of the upper one (the upper node is the
+/// lower one at the end of the axis).
+std::pair<int, double> bracket(double index) {
+    const int i0 = std::min(int(std::floor(index)), Grid::kN - 1);
+    return {i0, index - i0};
+}
+int upper(int i0) {
+    return std::min(i0 + 1, Grid::kN - 1);
+}
+double f0_of(double eta) {
+    return sqr((eta - 1) / (eta + 1));
+}
+}  // namespace
+
+Grid Grid::dielectric(double eta, double alpha) {
+    Grid g;
+    const auto [ie, te] = bracket(eta_index(eta));
+    const auto [ja, ta] = bracket(alpha_index(alpha));
+    g.t_eta_ = te;
+    g.t_alpha_ = ta;
+    const int etas[2] = {ie, upper(ie)}, alphas[2] = {ja, upper(ja)};
+    for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b)
+            for (int k = 0; k < kN; ++k)
+                g.albedo_[(a * 2 + b) * kN + k] = uncorrelated_ggx_albedo(
+                    double(k) / (kN - 1), alpha_node(alphas[b]), eta_node(etas[a]));
+    if (eta > kEtaMax || eta < 1 / kEtaMax) {
+        const double f0_max = f0_of(kEtaMax);
+        g.extrapolation_ = 1 - (f0_of(eta) - f0_max) / (1 - f0_max);
+    }
+    return g;
+}
+
+Grid Grid::white(double alpha) {
+    Grid g;
+    const auto [ja, ta] = bracket(alpha_index(alpha));
+    g.t_alpha_ = ta;
+    const int alphas[2] = {ja, upper(ja)};
+    static const QuadratureRule q = gauss_legendre(32);
+    for (int b = 0; b < 2; ++b) {
+        const double a = alpha_node(alphas[b]);
+        for (int k = 0; k < kN; ++k) {
+            const double e = uncorrelated_ggx_albedo_white(double(k) / (kN - 1), a);
+            // Both η slots hold the white lobe: the η weight is 0.
+            g.albedo_[b * kN + k] = g.albedo_[(2 + b) * kN + k] = e;
+        }
+        double average = 0;
+        for (std::size_t i = 0; i < q.x.size(); ++i)
+            average += 2 * q.w[i] * q.x[i] * uncorrelated_ggx_albedo_white(q.x[i], a);
+        g.average_[b] = average;
+    }
+    return g;
+}
+
+double Grid::complement(double mu) const {
+    const auto [k, tk] = bracket(mu_index(mu));
+    const int k1 = upper(k);
+    auto at = [&](int a, int b) {
+        const double* row = &albedo_[(a * 2 + b) * kN];
+        return std::lerp(1 - row[k], 1 - row[k1], tk);
+    };
+    const double value = std::lerp(std::lerp(at(0, 0), at(0, 1), t_alpha_),
+                                   std::lerp(at(1, 0), at(1, 1), t_alpha_), t_eta_);
+    return extrapolation_ * value;
+}
+
+double Grid::average_complement() const {
+    return std::lerp(1 - average_[0], 1 - average_[1], t_alpha_);
+}
+
+}  // namespace lamina
