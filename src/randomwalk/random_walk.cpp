@@ -466,20 +466,6 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
                               hg_phase(cd, g) * tr_down[ch] * below[ch]);
                 }
             }
-            if (conn->rough_exit && region == conn->inner) {
-                const Vec3d d_in = d;
-                auto kernel = [&](const Vec3d& om) {
-                    const double ct = dot(d_in, om);
-                    return Rgbd(hg_phase(ct, m.g[0]), hg_phase(ct, m.g[1]), hg_phase(ct, m.g[2]));
-                };
-                auto proxy = [&](const Vec3d& om) { return phase_pdf(dot(d_in, om)); };
-                connect_through_exit<kMode>(
-                    *conn, wo, conn->distance(s), w, rng, kernel,
-                    [&](const Vec3d& om, const Rgbd& pass) {
-                        return proxy(om) * chain_probability(w * kernel(om), pass);
-                    },
-                    proxy, f);
-            }
         }
         if constexpr (kMode == Mode::Pdf) {
             // Exit density (docs/rendering.md §1.4): the phase-sampling density of d_r± times the
@@ -501,6 +487,9 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
                     f[0] += phase_pdf(ct) * chain_probability(W, q) * jacobian;
                 }
             }
+        }
+        if constexpr (kEstimate) {
+            // The connection through a rough exit (eval and pdf alike): one walk's estimate.
             if (conn->rough_exit && region == conn->inner) {
                 const Vec3d d_in = d;
                 auto kernel = [&](const Vec3d& om) {

@@ -695,7 +695,7 @@ TEST(StackFuzz, TheExamplesAndTheStudyConfigurationsLieInTheRanges) {
     }
 }
 
-// The cases of the report that opened this work (issue 14), which the file ranges now refuse:
+// The cases of a robustness report on the stack files, which the file ranges now refuse:
 // built in code, past the parser, each model must still return finite, non-negative values (the
 // models clamp relative indices to the domain they compute in; the tables' coordinates are safe).
 TEST(StackFuzz, ModelsStayFiniteForIndicesFarOutsideTheFileRanges) {
