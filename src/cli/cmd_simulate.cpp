@@ -26,6 +26,7 @@ namespace {
 struct SimulateArgs {
     std::string stack, theta_i = default_incidences_text(), particles = "1e6", grid = "90x90", out;
     std::string kernel = "simd", microsurface = "single", transmission_masking = "smith";
+    std::string polarization = "off";
     std::uint64_t seed = 1;
     int threads = 0, max_events = 10000;
 };
@@ -58,6 +59,12 @@ Runner add_simulate(CLI::App& app) {
                     "Masking of light refracted by a rough dielectric (single scattering): smith "
                     "(the Smith microsurface's B(1+Λi, 1+Λo)) or pbrt (1/(1+Λi+Λo), as pbrt-v4)")
         ->capture_default_str();
+    cmd->add_option("--polarization", a->polarization,
+                    "Polarized transport: on (Stokes vectors and Mueller matrices, exact for "
+                    "unpolarized incident light) or off (the unpolarized Fresnel factor at every "
+                    "event)")
+        ->check(CLI::IsMember({"on", "off"}))
+        ->capture_default_str();
     cmd->add_option("--out,-o", a->out, "Output folder")->required();
     return [a] {
         // Under mpirun every process runs this; the particles are split over them
@@ -73,6 +80,7 @@ Runner add_simulate(CLI::App& app) {
         s.transmission_masking = parse_transmission_masking(a->transmission_masking);
         s.grid = HemisphereGrid::parse(a->grid);
         s.max_events = a->max_events;
+        s.polarization = a->polarization == "on";
         validate_settings(s);
         if (world.distributed() && s.threads == 0) s.threads = default_threads_per_process(world);
         // The root reads the stack and sends its canonical JSON to the others (no shared file

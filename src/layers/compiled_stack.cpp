@@ -9,6 +9,7 @@ CompiledStack<Real> compile_stack(const Stack& stack, const CompileSettings& set
     out.transmits = stack.transmits();
     out.multiple_scattering = settings.multiple_scattering;
     out.max_microsurface_order = settings.max_microsurface_order;
+    out.polarization = settings.polarization;
     const bool multiple = settings.multiple_scattering;
     for (std::size_t i = 0; i < stack.layers.size(); ++i) {
         const Layer& layer = stack.layers[i];
@@ -31,6 +32,7 @@ CompiledStack<Real> compile_stack(const Stack& stack, const CompileSettings& set
                                Real(spec.alpha)};
                 t.delta = t.conductor.is_smooth();
                 t.multiple = multiple && !t.delta;
+                if (!t.conductor.is_grey()) out.polarization_channels = 3;
                 t.eta_below = Real(eta_above);  // no region below an opaque base
                 break;
             case InterfaceType::Lambertian:

@@ -56,6 +56,9 @@ struct CompileSettings {
     TransmissionMasking transmission_masking = TransmissionMasking::Smith;
     bool multiple_scattering = false;
     int max_microsurface_order = 100;
+    /// Follow the particles' polarization (docs/physics.md §8): Stokes vectors and Mueller
+    /// matrices instead of the unpolarized Fresnel factors.
+    bool polarization = false;
 };
 
 template <typename Real>
@@ -66,6 +69,12 @@ struct CompiledStack {
     /// As CompileSettings: a rough interface's layer has `multiple` set when this is.
     bool multiple_scattering = false;
     int max_microsurface_order = 100;
+    /// As CompileSettings: the particles carry a polarization state (physics/polarization.h).
+    bool polarization = false;
+    /// Polarization states a particle needs: 1 when every Mueller matrix of the stack is the same
+    /// in all channels (dielectrics, Lambertian bases, grey conductors), 3 when a conductor's
+    /// index differs between channels.
+    int polarization_channels = 1;
 };
 
 /// The stack compiled in precision Real (float: the goniophotometer's kernels; double: the random

@@ -76,7 +76,24 @@ struct SimulationSettings {
     /// Smith microsurface's B(1 + Λi, 1 + Λo) or pbrt-v4's 1/(1 + Λi + Λo). The microsurface
     /// walk (Microsurface::Multiple) has its own, which is the Smith one.
     TransmissionMasking transmission_masking = TransmissionMasking::Smith;
+    /// Follow the particles' polarization (docs/physics.md §8): every event applies its Mueller
+    /// matrix to the particle's Stokes vector instead of the unpolarized Fresnel factors. The
+    /// tables are then those of unpolarized incident light, exact for it.
+    bool polarization = false;
+    /// The incident light's Stokes vector (polarized runs), in the frame of docs/physics.md §8
+    /// (x ⊥ the plane of incidence): 0 unpolarized (1, 0, 0, 0), 1 s-polarized (1, 1, 0, 0),
+    /// 2 linear at +45° (1, 0, 1, 0), 3 circular (1, 0, 0, 1). Each has its own random-number
+    /// streams (incident_stream), so runs with different states are independent.
+    int incident_polarization = 0;
+    /// Tally the Stokes vectors of the exits per bin (IncidenceSums::stokes; polarized runs),
+    /// from which the Mueller tables follow (simulator/mueller.h).
+    bool stokes_tallies = false;
 };
+
+/// Sums per (side · n_bins + bin) of the Stokes tallies: per channel c, at c · 12 + h · 4 + k the
+/// sum of S_k over the exits into the bin's half h (0: y ≥ 0, 1: y < 0, each in its own bin
+/// frame, docs/physics.md §8), at c · 12 + 8 + k the sum of S_k² over both halves.
+inline constexpr int kStokesSums = 36;
 
 /// Where the flux of an incidence went, per channel; the terms sum to 1 to rounding.
 enum class BudgetTerm {
@@ -119,6 +136,9 @@ struct IncidenceSums {
     /// kBudgetTerms + 1), scale 2^56.
     std::array<std::array<Fixed128, 3>, kBudgetTerms + 2> budget{};
     std::uint64_t events = 0, degenerate = 0;
+    /// The Stokes tallies (kStokesSums per entry, as bins; empty unless
+    /// SimulationSettings::stokes_tallies), S_k at scale 2^40 and S_k² at 2^38.
+    std::vector<std::array<Fixed128, kStokesSums>> stokes;
 
     void add(const IncidenceSums& o);
 };
@@ -132,6 +152,8 @@ struct SimulationSums {
 
 struct SimulationResult {
     SimulationSettings settings;
+    /// The raw sums (kept when settings.stokes_tallies: the Mueller tables are built from them).
+    std::vector<IncidenceSums> sums;
     BinnedTable table;  ///< reflection, and transmission when the stack transmits
     std::vector<IncidenceStats> incidences;
     double seconds = 0;

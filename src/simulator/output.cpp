@@ -49,6 +49,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     j["kernel"] = kernel_description(s.kernel);
     j["microsurface"] = microsurface_name(s.microsurface);
     j["transmission_masking"] = transmission_masking_name(s.transmission_masking);
+    j["polarization"] = s.polarization ? "on" : "off";
     j["threads"] = result.threads_used;
     j["processes"] = result.processes;
     j["seconds"] = result.seconds;
