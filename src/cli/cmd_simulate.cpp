@@ -11,14 +11,17 @@
 #include "distributed/split_simulation.h"
 #include "layers/stack.h"
 #include "simulator/goniophotometer.h"
+#include "simulator/mueller.h"
 #include "simulator/output.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <utility>
 
 namespace lamina::cli {
 
@@ -27,6 +30,7 @@ struct SimulateArgs {
     std::string stack, theta_i = default_incidences_text(), particles = "1e6", grid = "90x90", out;
     std::string kernel = "simd", microsurface = "single", transmission_masking = "smith";
     std::string polarization = "off";
+    bool mueller = false;
     std::uint64_t seed = 1;
     int threads = 0, max_events = 10000;
 };
@@ -65,6 +69,10 @@ Runner add_simulate(CLI::App& app) {
                     "event)")
         ->check(CLI::IsMember({"on", "off"}))
         ->capture_default_str();
+    cmd->add_flag("--mueller", a->mueller,
+                  "Also write the 4x4 Mueller BRDF/BTDF per bin with standard errors "
+                  "(mueller.npy, mueller_se.npy; needs --polarization on; four runs: unpolarized, "
+                  "s-polarized, +45° and circular incident light)");
     cmd->add_option("--out,-o", a->out, "Output folder")->required();
     return [a] {
         // Under mpirun every process runs this; the particles are split over them
@@ -117,11 +125,37 @@ Runner add_simulate(CLI::App& app) {
                                                   "particles", mine.count * s.theta_i_deg.size());
             on_progress = [&](std::uint64_t n) { progress->advance(n); };
         }
-        const std::optional<SimulationResult> split = simulate_split(world, stack, s, on_progress);
-        if (!split) return 0;  // not the root: its sums went to the root
-        const SimulationResult& result = *split;
+        if (a->mueller) {
+            if (!s.polarization)
+                throw InputError("command line", "--mueller", "needs --polarization on");
+            s.stokes_tallies = true;
+        }
+        // --mueller: four runs (unpolarized, s-polarized, +45°, circular incident light;
+        // simulator/mueller.h), the first of which gives the tables.
+        std::array<std::optional<SimulationResult>, 4> runs;
+        for (int j = 0; j < (a->mueller ? 4 : 1); ++j) {
+            SimulationSettings run = s;
+            run.incident_polarization = j;
+            if (j > 0 && progress) progress->finish();
+            if (j > 0 && world.is_root())
+                progress = std::make_unique<Progress>(
+                    fmt::format("simulate {} (Mueller run {} of 4)", stack.name, j + 1),
+                    "particles",
+                    particle_range(s.particles, world.rank(), world.size()).count *
+                        s.theta_i_deg.size());
+            runs[std::size_t(j)] = simulate_split(world, stack, run, on_progress);
+        }
+        if (!runs[0]) return 0;  // not the root: its sums went to the root
+        const SimulationResult& result = *runs[0];
         progress->finish();
-        write_simulation(a->out, stack, result);
+        std::vector<std::pair<std::string, std::string>> extra;
+        if (a->mueller) {
+            const MuellerTable mueller =
+                mueller_table({&*runs[0], &*runs[1], &*runs[2], &*runs[3]});
+            extra = {{"mueller.npy", mueller_npy(mueller, false)},
+                     {"mueller_se.npy", mueller_npy(mueller, true)}};
+        }
+        write_simulation(a->out, stack, result, extra);
         for (std::size_t i = 0; i < result.incidences.size(); ++i) {
             const EnergyBudget& b = result.incidences[i].budget;
             fmt::print("θi = {:>4}°  R = {}  T = {}  lost = {}  absorbed = {}\n", s.theta_i_deg[i],
@@ -133,8 +167,9 @@ Runner add_simulate(CLI::App& app) {
             result.processes > 1
                 ? fmt::format("{} processes × {} threads", result.processes, result.threads_used)
                 : fmt::format("{} threads", result.threads_used);
-        fmt::print("{:.3g} particles/s on {}; wrote {}/{{result.json,brdf.csv,energy.csv}}\n",
-                   double(s.particles * s.theta_i_deg.size()) / result.seconds, workers, a->out);
+        fmt::print("{:.3g} particles/s on {}; wrote {}/{{result.json,brdf.csv,energy.csv{}}}\n",
+                   double(s.particles * s.theta_i_deg.size()) / result.seconds, workers, a->out,
+                   a->mueller ? ",mueller.npy,mueller_se.npy" : "");
         return 0;
     };
 }

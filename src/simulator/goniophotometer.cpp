@@ -41,8 +41,8 @@ void validate_settings(const SimulationSettings& s) {
     if (s.max_events < 1) throw InputError("command line", "--max-events", "must be ≥ 1");
     if (s.max_microsurface_order < 1)
         throw InputError("settings", "max_microsurface_order", "must be ≥ 1");
-    if (s.incident_polarization < 0 || s.incident_polarization > 3)
-        throw InputError("settings", "incident_polarization", "must be 0, 1, 2 or 3");
+    if (s.incident_polarization < 0 || s.incident_polarization > 6)
+        throw InputError("settings", "incident_polarization", "must be in [0, 6]");
     if (!s.polarization && (s.incident_polarization != 0 || s.stokes_tallies))
         throw InputError("command line", "--polarization",
                          "polarized incident light and Stokes tallies need --polarization on");
@@ -307,14 +307,16 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
 
 std::uint64_t incidence_stream(double theta_i_deg, int incident_polarization) {
     // The stream is the incidence itself, so a result does not depend on which other incidences
-    // were simulated with it; a polarized incident state other than unpolarized flips the top
-    // bits (the sign and the exponent's top bit of θi), so that runs with different incident
-    // states are independent.
-    return std::bit_cast<std::uint64_t>(theta_i_deg) ^ (std::uint64_t(incident_polarization) << 62);
+    // were simulated with it; a polarized incident state other than unpolarized adds its index
+    // times an odd 64-bit constant (the golden ratio's, as in Random123's key schedule) to the
+    // key, so that runs with different incident states are independent.
+    return std::bit_cast<std::uint64_t>(theta_i_deg) ^
+           (std::uint64_t(incident_polarization) * 0x9E3779B97F4A7C15ull);
 }
 
 // The incident Stokes vectors (S1, S2, S3)/S0 of SimulationSettings::incident_polarization.
-constexpr float kIncidentStokes[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+constexpr float kIncidentStokes[7][3] = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 0, 1},
+                                         {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
 
 }  // namespace
 

@@ -82,8 +82,9 @@ struct SimulationSettings {
     bool polarization = false;
     /// The incident light's Stokes vector (polarized runs), in the frame of docs/physics.md §8
     /// (x ⊥ the plane of incidence): 0 unpolarized (1, 0, 0, 0), 1 s-polarized (1, 1, 0, 0),
-    /// 2 linear at +45° (1, 0, 1, 0), 3 circular (1, 0, 0, 1). Each has its own random-number
-    /// streams (incident_stream), so runs with different states are independent.
+    /// 2 linear at +45° (1, 0, 1, 0), 3 circular (1, 0, 0, 1), and 4–6 their opposites
+    /// (p-polarized (1, −1, 0, 0), linear at −45°, circular the other way). Each state has its own
+    /// random-number streams, so runs with different states are independent.
     int incident_polarization = 0;
     /// Tally the Stokes vectors of the exits per bin (IncidenceSums::stokes; polarized runs),
     /// from which the Mueller tables follow (simulator/mueller.h).

@@ -50,6 +50,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     j["microsurface"] = microsurface_name(s.microsurface);
     j["transmission_masking"] = transmission_masking_name(s.transmission_masking);
     j["polarization"] = s.polarization ? "on" : "off";
+    j["mueller"] = s.stokes_tallies;
     j["threads"] = result.threads_used;
     j["processes"] = result.processes;
     j["seconds"] = result.seconds;
@@ -76,10 +77,13 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
 }
 
 void write_simulation(const std::filesystem::path& dir, const Stack& stack,
-                      const SimulationResult& result) {
+                      const SimulationResult& result,
+                      const std::vector<std::pair<std::string, std::string>>& extra) {
     StagedOutput out(dir);
     out.add("brdf.csv", result.table.to_csv());
     out.add("energy.csv", energy_csv(result));
+    for (const auto& [name, bytes] : extra)
+        out.add(name, bytes);
     out.add("result.json", result_json(stack, result).dump(2) + "\n");
     out.commit();
 }
