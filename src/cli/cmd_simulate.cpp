@@ -162,6 +162,13 @@ Runner add_simulate(CLI::App& app) {
                        format_rgb(b[BudgetTerm::Reflected]), format_rgb(b[BudgetTerm::Transmitted]),
                        format_rgb(b[BudgetTerm::LostMicrosurface]),
                        format_rgb(b[BudgetTerm::AbsorbedMedium] + b[BudgetTerm::AbsorbedBase]));
+            // A thick scattering layer's cost is bounded by --max-events; what it stops is told.
+            if (b[BudgetTerm::CutOff].max() > 0)
+                fmt::print(
+                    "          cut off after --max-events {}: {} ({:.4g} events per "
+                    "particle)\n",
+                    s.max_events, format_rgb(b[BudgetTerm::CutOff]),
+                    result.incidences[i].events_per_particle);
         }
         const std::string workers =
             result.processes > 1

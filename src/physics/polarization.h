@@ -148,6 +148,10 @@ LAMINA_LANE_INLINE DielectricMueller<T> fresnel_dielectric_mueller(T cos_theta_i
     const T u_im = r.eta * L::sqrt(L::max(sin2_theta_t - one, zero));
     const T e1 = r.eta * r.eta;
     r.reflection = reflection_mueller<T, L>(mu, e1, zero, u_re, u_im);
+    // Under total internal reflection R_s = R_p = 1 exactly (only the phase is computed).
+    const auto tir = L::negate(L::less(sin2_theta_t, one));
+    r.reflection.a = L::select(tir, one, r.reflection.a);
+    r.reflection.b = L::select(tir, zero, r.reflection.b);
     const T ds = mu + u_re, dp = L::mul_add(e1, mu, u_re);
     const T mu_u4 = four * mu * u_re;
     const auto regular = L::less(zero, ds * dp);
@@ -296,6 +300,9 @@ LAMINA_LANE_INLINE typename L::Mask polarized_dielectric_choice(PolarizationLane
                                  L::mul_add(flux[1], p_reflect[1], flux[2] * p_reflect[2]));
         p = L::select(has_flux, mix / L::select(has_flux, total, one), p_reflect[0]);
     }
+    // Nothing refracts (total internal reflection, grazing light): reflection for sure, whatever
+    // the mixture's rounding (a P of 1 − 2^-24 would let uc = 1 − 2^-24 refract).
+    p = L::select(L::less(zero, fm.transmission.a), p, one);
     const auto reflects = L::less(uc, p);
     const InterfaceMueller<T> m = {L::select(reflects, fm.reflection.a, fm.transmission.a),
                                    L::select(reflects, fm.reflection.b, fm.transmission.b),

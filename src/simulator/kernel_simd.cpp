@@ -1428,6 +1428,102 @@ void InterfaceEventsForTest(int kind, const float* params, const std::int32_t* f
     }
 }
 
+void FresnelMuellerForTest(int kind, const float* cos_theta, std::size_t n, float eta, float k,
+                           float* out) {
+    const DF df;
+    LaneIo io{df};
+    io.n = n;
+    const std::size_t stride = kind == 0 ? 9 : 4;
+    for (io.base = 0; io.base < n; io.base += hn::Lanes(df)) {
+        const VF c = io.Load(cos_theta, 1.f);
+        VF v[9];
+        if (kind == 0) {
+            const DielectricMueller<VF> m = fresnel_dielectric_mueller<VF, VecLane>(
+                c, hn::Set(df, eta), hn::Set(df, 1.f / eta));
+            const VF all[9] = {m.reflection.a,   m.reflection.b,   m.reflection.c,
+                               m.reflection.d,   m.transmission.a, m.transmission.b,
+                               m.transmission.c, m.transmission.d, m.cos_theta_t};
+            std::copy(all, all + 9, v);
+        } else {
+            const InterfaceMueller<VF> m =
+                fresnel_conductor_mueller<VF, VecLane>(c, hn::Set(df, eta), hn::Set(df, k));
+            v[0] = m.a, v[1] = m.b, v[2] = m.c, v[3] = m.d;
+        }
+        HWY_ALIGN float buf[kMaxLanes];
+        for (std::size_t e = 0; e < stride; ++e) {
+            hn::Store(v[e], df, buf);
+            for (std::size_t l = 0; l < hn::Lanes(df) && io.base + l < n; ++l)
+                out[(io.base + l) * stride + e] = buf[l];
+        }
+    }
+}
+
+void PolarizedEventsForTest(int kind, const float* params, const std::int32_t* flags,
+                            const float* wi, const float* u, const float* x, const float* stokes,
+                            const float* flux, int channels, std::size_t n, float* wo,
+                            float* shadowing, std::int32_t* reflected, std::int32_t* degenerate,
+                            float* x_out, float* stokes_out, float* factor) {
+    const DF df;
+    LaneIo io{df};
+    io.n = n;
+    // Strided per-lane inputs and outputs: element e of lane j at [stride·j + e].
+    auto load = [&](const float* a, std::size_t stride, std::size_t e, float pad) {
+        HWY_ALIGN float buf[kMaxLanes];
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            buf[l] = io.base + l < n ? a[stride * (io.base + l) + e] : pad;
+        return hn::Load(df, buf);
+    };
+    auto store = [&](VF v, float* a, std::size_t stride, std::size_t e) {
+        HWY_ALIGN float buf[kMaxLanes];
+        hn::Store(v, df, buf);
+        for (std::size_t l = 0; l < hn::Lanes(df) && io.base + l < n; ++l)
+            a[stride * (io.base + l) + e] = buf[l];
+    };
+    for (io.base = 0; io.base < n; io.base += hn::Lanes(df)) {
+        const V3 w = io.Load3(wi);
+        const VF uc = io.Load(u, 0.f), u1 = io.Load(u + n, 0.f), u2 = io.Load(u + 2 * n, 0.f);
+        const MF active = io.Active();
+        PolarizationLanes<VF> pol;
+        pol.channels = channels;
+        pol.stokes.x = {load(x, 3, 0, 0.f), load(x, 3, 1, 1.f), load(x, 3, 2, 0.f)};
+        for (int c = 0; c < 3; ++c) {
+            pol.stokes.q[c] = load(stokes, 9, std::size_t(3 * c), 0.f);
+            pol.stokes.u[c] = load(stokes, 9, std::size_t(3 * c + 1), 0.f);
+            pol.stokes.v[c] = load(stokes, 9, std::size_t(3 * c + 2), 0.f);
+        }
+        const VF flux_v[3] = {load(flux, 3, 0, 1.f), load(flux, 3, 1, 1.f), load(flux, 3, 2, 1.f)};
+        pol.flux = flux_v;
+        InterfaceEventLanes<VF, MF> e;
+        if (kind == 0) {
+            const DielectricEventShape shape{flags[0] != 0, flags[1] != 0, flags[2] != 0,
+                                             flags[3] != 0};
+            e = dielectric_event<VF, VecLane, true>(
+                hn::Set(df, params[0]), hn::Set(df, 1.f / params[0]), hn::Set(df, params[1]), shape,
+                w, uc, u1, u2, active, &pol);
+        } else {
+            ConductorInterface<float> iface{Rgbf(params[1], params[2], params[3]),
+                                            Rgbf(params[4], params[5], params[6]), params[0]};
+            VF f[3];
+            e = conductor_event<VF, VecLane>(hn::Set(df, params[0]), flags[0] != 0, flags[1] != 0,
+                                             w, u1, u2, active, ConductorFresnel{iface}, f, &pol,
+                                             ConductorMueller{iface});
+        }
+        io.Store3(e.wo, wo);
+        io.Store(e.shadowing, shadowing);
+        io.StoreMask(e.reflected, reflected);
+        io.StoreMask(e.degenerate, degenerate);
+        store(pol.stokes.x.x, x_out, 3, 0);
+        store(pol.stokes.x.y, x_out, 3, 1);
+        store(pol.stokes.x.z, x_out, 3, 2);
+        for (int c = 0; c < 3; ++c) {
+            store(pol.stokes.q[c], stokes_out, 9, std::size_t(3 * c));
+            store(pol.stokes.u[c], stokes_out, 9, std::size_t(3 * c + 1));
+            store(pol.stokes.v[c], stokes_out, 9, std::size_t(3 * c + 2));
+            store(pol.factor[c], factor, 3, std::size_t(c));
+        }
+    }
+}
+
 void MediumStepForTest(const CompiledMedium<float>& med, const float* d, const float* w,
                        const float* depth, const float* u, std::size_t n, std::int32_t* leaves,
                        float* factor, float* depth_out, float* d_out, float* phase,
@@ -1573,6 +1669,8 @@ HWY_EXPORT(MicrosurfaceWalkForTest);
 HWY_EXPORT(GgxLanesForTest);
 HWY_EXPORT(InterfaceEventsForTest);
 HWY_EXPORT(MediumStepForTest);
+HWY_EXPORT(FresnelMuellerForTest);
+HWY_EXPORT(PolarizedEventsForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -1707,6 +1805,36 @@ SimdMediumResult simd_medium_step(const CompiledMedium<float>& medium, const std
     HWY_DYNAMIC_DISPATCH(MediumStepForTest)
     (medium, d.data(), w.data(), depth.data(), u.data(), n, r.leaves.data(), r.factor.data(),
      r.depth.data(), r.d.data(), r.phase.data(), r.draws.data());
+    return r;
+}
+
+std::vector<float> simd_fresnel_mueller(int kind, const std::vector<float>& cos_theta, float eta,
+                                        float k) {
+    select_simd_target();
+    std::vector<float> out(cos_theta.size() * (kind == 0 ? 9 : 4));
+    HWY_DYNAMIC_DISPATCH(FresnelMuellerForTest)
+    (kind, cos_theta.data(), cos_theta.size(), eta, k, out.data());
+    return out;
+}
+
+SimdPolarizedEventResult simd_polarized_interface_events(
+    int kind, const std::vector<float>& params, const std::vector<std::int32_t>& flags,
+    const std::vector<float>& wi, const std::vector<float>& u, const std::vector<float>& x,
+    const std::vector<float>& stokes, const std::vector<float>& flux, int channels) {
+    select_simd_target();
+    const std::size_t n = wi.size() / 3;
+    SimdPolarizedEventResult r;
+    r.event.wo.resize(3 * n);
+    r.event.shadowing.resize(n);
+    r.event.reflected.resize(n);
+    r.event.degenerate.resize(n);
+    r.x.resize(3 * n);
+    r.stokes.resize(9 * n);
+    r.factor.resize(3 * n);
+    HWY_DYNAMIC_DISPATCH(PolarizedEventsForTest)
+    (kind, params.data(), flags.data(), wi.data(), u.data(), x.data(), stokes.data(), flux.data(),
+     channels, n, r.event.wo.data(), r.event.shadowing.data(), r.event.reflected.data(),
+     r.event.degenerate.data(), r.x.data(), r.stokes.data(), r.factor.data());
     return r;
 }
 

@@ -29,16 +29,18 @@ Stokes stokes_of(C ex, C ey) {
             2 * (ex * std::conj(ey)).real(), -2 * (ex * std::conj(ey)).imag()};
 }
 
-// The Mueller matrix of the Jones matrix diag(a_s, a_p) from the definition: the images of four
-// pure states whose Stokes vectors are independent (x, y, +45°, circular), M = S_out S_in⁻¹ with
-// S_in⁻¹ written out (S_in has columns (1,1,0,0), (1,−1,0,0), (1,0,1,0), (1,0,0,1)).
-Matrix4 mueller_of_jones(C a_s, C a_p) {
+// The Mueller matrix of the Jones matrix J from the definition: the images of four pure states
+// whose Stokes vectors are independent (x, y, +45°, circular), M = S_out S_in⁻¹ with S_in⁻¹
+// written out (S_in has columns (1,1,0,0), (1,−1,0,0), (1,0,1,0), (1,0,0,1)).
+using Jones = std::array<std::array<C, 2>, 2>;
+Matrix4 mueller_of_jones(const Jones& jm) {
     const double r = 1 / std::sqrt(2.0);
     const std::array<std::array<C, 2>, 4> in = {
         {{C(1), C(0)}, {C(0), C(1)}, {C(r), C(r)}, {C(r), C(0, r)}}};
     std::array<Stokes, 4> out;
     for (int j = 0; j < 4; ++j)
-        out[j] = stokes_of(a_s * in[j][0], a_p * in[j][1]);
+        out[j] = stokes_of(jm[0][0] * in[j][0] + jm[0][1] * in[j][1],
+                           jm[1][0] * in[j][0] + jm[1][1] * in[j][1]);
     // S_in⁻¹: e0 = (x + y)/2, e1 = (x − y)/2, e2 = d − e0, e3 = c − e0.
     Matrix4 m{};
     for (int i = 0; i < 4; ++i) {
@@ -46,6 +48,9 @@ Matrix4 mueller_of_jones(C a_s, C a_p) {
         m[i] = {e0, e1, out[2][i] - e0, out[3][i] - e0};
     }
     return m;
+}
+Matrix4 mueller_of_jones(C a_s, C a_p) {
+    return mueller_of_jones(Jones{{{a_s, C(0)}, {C(0), a_p}}});
 }
 
 Matrix4 expand(const InterfaceMueller<double>& m) {
@@ -355,6 +360,28 @@ TEST(Polarization, DegreeOfPolarizationStaysAtMostOne) {
         else
             EXPECT_LE(after, 1.0 + 1e-12);
     }
+}
+
+// The step of the Mueller tables' reciprocity (tests/simulator/mueller_test.cpp) that is pure
+// algebra: the transpose of a Jones matrix has the Mueller matrix P Mᵀ P, P = diag(1, 1, 1, −1), in
+// this header's convention S3 = −2 Im(E_x E_y*) (Jᵀ exchanges the roles of E_x* E_y and E_x E_y*,
+// which flips S3 only), and diag(1, −1) has the Mueller matrix D = diag(1, 1, −1, −1).
+TEST(Polarization, MuellerMatrixOfTheTransposedJonesMatrix) {
+    ParticleRng rng(10, 0, 0);
+    auto z = [&] { return C(rng.uniform_double() - 0.5, rng.uniform_double() - 0.5); };
+    const double p[4] = {1, 1, 1, -1};
+    for (int k = 0; k < 100; ++k) {
+        const Jones j = {{{z(), z()}, {z(), z()}}};
+        const Jones jt = {{{j[0][0], j[1][0]}, {j[0][1], j[1][1]}}};
+        const Matrix4 m = mueller_of_jones(j), mt = mueller_of_jones(jt);
+        Matrix4 expected{};
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b)
+                expected[a][b] = p[a] * p[b] * m[b][a];
+        expect_matrix_near(mt, expected, 1e-14, "transpose");
+    }
+    const Matrix4 d = mueller_of_jones(C(1), C(-1));
+    expect_matrix_near(d, {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, -1, 0}, {0, 0, 0, -1}}}, 1e-15, "D");
 }
 
 // The tabulation frame: x ∝ ẑ × d, horizontal and ⊥ to d; ŷ straight up or down; for light in
