@@ -554,6 +554,100 @@ inline MicrosurfaceConnection<T> microsurface_conductor_connect(const GGX<T>& gg
     return out;
 }
 
+// ---- Polarized next-event estimation (physics/polarization.h)
+// ------------------------------------ A connection from a facet carries the state the particle has
+// when it meets the facet (the polarized visiting walks below keep it in their PolarizationLanes
+// while they visit): turned into the plane of incidence of the connecting facet (w, wm), the
+// branch's Fresnel factor of the unpolarized phase function, F or 1 − F (dielectric) or F
+// (conductor), becomes the state's own fraction a + b q, and the light leaves in the branch's
+// Mueller matrix; the connection's Stokes vector is written in the tabulation frame of wo
+// (stokes_bin_frame).
+
+/// Per channel a Stokes vector (S0..S3) in the tabulation frame of a direction of travel.
+template <typename T>
+struct StokesRgb {
+    T s[3][4] = {};
+};
+
+/// Adds to `out` the Stokes vectors of the light that `state` (one for all channels, or one per
+/// channel) turns into through the branch `m` of a facet of normal wm met from w (unit vectors; wm
+/// on either side), `scale[c]` times the branch's fraction a + b q over its unpolarized a, leaving
+/// along wo; nothing where a = 0. One state serves all channels with the matrix of channel 0.
+template <typename T>
+inline void microsurface_stokes_through(const InterfaceMueller<T>* m, bool per_channel_matrix,
+                                        const Vec3<T>& w, const Vec3<T>& wm, const Vec3<T>& wo,
+                                        StokesLanes<T> state, int channels, const T scale[3],
+                                        StokesRgb<T>& out) {
+    const Vec3<T> n = cross(w, wm);
+    stokes_rotate_frame<T>(state, {-w.x, -w.y, -w.z}, {n.x, n.y, n.z}, channels, true);
+    T ratio[3] = {0, 0, 0};
+    for (int c = 0; c < channels; ++c) {
+        const InterfaceMueller<T>& mc = m[per_channel_matrix ? c : 0];
+        if (!(mc.a > 0)) continue;
+        ratio[c] = stokes_apply<T>(mc, state.q[c], state.u[c], state.v[c], true) / mc.a;
+    }
+    stokes_rotate_frame<T>(state, {wo.x, wo.y, wo.z}, stokes_bin_frame<T>({wo.x, wo.y, wo.z}),
+                           channels, true);
+    for (int c = 0; c < 3; ++c) {
+        const int k = channels == 3 ? c : 0;
+        const T f = scale[c] * ratio[channels == 3 ? c : 0];
+        out.s[c][0] += f;
+        out.s[c][1] += f * state.q[k];
+        out.s[c][2] += f * state.u[k];
+        out.s[c][3] += f * state.v[k];
+    }
+}
+
+/// microsurface_dielectric_connect for a particle in polarization state `state`: the connection's
+/// density (its own, with the state's branch fraction in place of F or 1 − F) times the facet's
+/// weight, as Stokes vectors in wo's tabulation frame, added to `out`.
+template <typename T>
+inline void microsurface_dielectric_connect_polarized(const GGX<T>& ggx, T eta,
+                                                      const MicrosurfaceFacet<T>& facet,
+                                                      const Vec3<T>& wo,
+                                                      const StokesLanes<T>& state, int channels,
+                                                      StokesRgb<T>& out) {
+    const T base = microsurface_dielectric_connect(ggx, eta, facet, wo);
+    if (!(base > 0) || !std::isfinite(base)) return;
+    // The connecting facet as microsurface_dielectric_phase finds it, seen from the particle's
+    // side.
+    const bool refracted = facet.outside != (wo.z > 0);
+    const T eta_side = facet.outside ? eta : T(1) / eta;
+    const Vec3<T> w_side = facet.outside ? facet.w : -facet.w;
+    const Vec3<T> wo_side = facet.outside ? wo : -wo;
+    Vec3<T> wm = refracted ? -(w_side + wo_side * eta_side) : w_side + wo_side;
+    wm = normalize(wm);
+    if (wm.z < 0) wm = -wm;
+    const DielectricMueller<T> fm =
+        fresnel_dielectric_mueller<T>(dot(w_side, wm), eta_side, T(1) / eta_side);
+    const InterfaceMueller<T>& m = refracted ? fm.transmission : fm.reflection;
+    const T scale[3] = {base * facet.weight[0], base * facet.weight[1], base * facet.weight[2]};
+    microsurface_stokes_through(&m, false, facet.w, wm, wo, state, channels, scale, out);
+}
+
+/// microsurface_conductor_connect for a particle in polarization state `state`: the density times
+/// the facet's weight and the state's reflected fraction of the connecting facet (the Mueller
+/// matrices `mueller(cos, m)` fills per channel), as Stokes vectors added to `out`.
+template <typename T, typename Mueller>
+inline void microsurface_conductor_connect_polarized(const GGX<T>& ggx, const Mueller& mueller,
+                                                     const MicrosurfaceFacet<T>& facet,
+                                                     const Vec3<T>& wo, const StokesLanes<T>& state,
+                                                     int channels, StokesRgb<T>& out) {
+    const T escape = microsurface_escape(ggx, wo, facet.h);
+    if (!(escape > 0)) return;
+    T cos_w_m;
+    const T density = microsurface_reflection_density(ggx, facet.w, wo, cos_w_m);
+    if (!(density > 0)) return;
+    InterfaceMueller<T> m[3];
+    mueller(cos_w_m, m);
+    // The unpolarized weight F = a, turned into the state's fraction a + b q by the ratio.
+    T scale[3];
+    for (int c = 0; c < 3; ++c)
+        scale[c] = density * escape * facet.weight[c] * m[c].a;
+    microsurface_stokes_through(m, true, facet.w, normalize(facet.w + wo), wo, state, channels,
+                                scale, out);
+}
+
 /// walk_rough_dielectric with a visitor: `visit(const MicrosurfaceFacet<T>&)` is called at every
 /// facet before the particle scatters off it. The same walk (microsurface_walk at one lane, the
 /// same random numbers in the same order): returns the same exit.
@@ -592,6 +686,34 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor_visiting(const GGX<T>& g
         out[0] = f[0], out[1] = f[1], out[2] = f[2];
     };
     const MicrosurfaceConductorFacet<T, Lane<T>, decltype(factors)> facet{factors};
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(
+        ggx.alpha, {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
+        MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
+}
+
+/// walk_rough_dielectric_polarized with a visitor, as walk_rough_dielectric_visiting; at each call
+/// `pol.stokes` holds the state with which the particle meets the facet.
+template <typename T, typename Uniform, typename Visit>
+std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_polarized_visiting(
+    const GGX<T>& ggx, T eta, const Vec3<T>& wi, Uniform&& uniform, int max_order,
+    PolarizationLanes<T>& pol, Visit&& visit) {
+    auto draw = [&] { return T(uniform()); };
+    const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw), true> facet{eta, T(1) / eta, draw,
+                                                                              &pol};
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(
+        ggx.alpha, {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
+        MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
+}
+
+/// walk_rough_conductor_polarized with a visitor, as walk_rough_dielectric_polarized_visiting.
+template <typename T, typename Mueller, typename Uniform, typename Visit>
+std::optional<MicrosurfaceExit<T>> walk_rough_conductor_polarized_visiting(
+    const GGX<T>& ggx, const Mueller& mueller, const Vec3<T>& wi, Uniform&& uniform, int max_order,
+    PolarizationLanes<T>& pol, Visit&& visit) {
+    auto draw = [&] { return T(uniform()); };
+    const NoMueller unpolarized;
+    const MicrosurfaceConductorFacet<T, Lane<T>, NoMueller, Mueller> facet{unpolarized, &pol,
+                                                                           &mueller};
     return microsurface_exit(microsurface_walk<T, Lane<T>>(
         ggx.alpha, {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
         MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));

@@ -50,6 +50,8 @@
 #include "physics/conductor.h"
 #include "physics/dielectric.h"
 #include "physics/lambertian.h"
+#include "physics/microsurface_walk.h"
+#include "physics/polarization.h"
 
 #include <cstdint>
 #include <optional>
@@ -95,12 +97,19 @@ class RandomWalkStack {
     /// `masking`: the refraction masking of the rough dielectrics (physics/microfacet.h), as the
     /// goniophotometer's --transmission-masking (single scattering only: the walk has its own).
     /// `max_microsurface_order` ≥ 1 (Multiple only): 1 keeps only the walk's first order.
+    /// `polarization`: the walks carry the particle's polarization as the goniophotometer's
+    /// polarized kernels do (docs/physics.md §8; off by default for now): sample() follows it, and
+    /// eval() connects with it — a vertex's light leaves in the Mueller matrix of its facet for the
+    /// walk's state, and the delta chains carry its s and p parts separately (a smooth chain lies
+    /// in one plane of incidence). The estimates are those of unpolarized incident light.
     explicit RandomWalkStack(const Stack& stack, int max_events = 10'000,
                              TransmissionMasking masking = TransmissionMasking::Smith,
                              Microsurface microsurface = Microsurface::Single,
-                             int max_microsurface_order = kMaxMicrosurfaceOrder);
+                             int max_microsurface_order = kMaxMicrosurfaceOrder,
+                             bool polarization = false);
 
     Microsurface microsurface() const { return microsurface_; }
+    bool polarization() const { return polarized_; }
 
     bool transmits() const { return transmits_; }
     /// Absolute indices of the ambient medium (above) and of the half-space below the base.
@@ -194,6 +203,22 @@ class RandomWalkStack {
     /// the walk, of flux weight w before the interface, to the stack's exit:
     /// pdf(wi, wo)·chain_probability(w·weight(wo), q) (docs/rendering.md §1.4), exact for single
     /// scattering, one walk's unbiased estimate for multiple scattering.
+    /// Polarized walks: the Stokes vectors (per unit flux, per channel, f·|cos| units, in the
+    /// tabulation frame of each direction) of the light a non-delta interface, met from wi by a
+    /// particle in polarization state `state` with flux `w`, sends towards the n ≤ 2 directions
+    /// d[j] (away from it): exact for single scattering, one walk's unbiased estimate (a polarized
+    /// visiting walk, shared by the directions) for multiple scattering. `channels`: the states
+    /// in use (0: the stack's).
+    void emission(const Interface& it, const Vec3d& wi, const Vec3d* d, int n,
+                  const StokesLanes<double>& state, const Rgbd& w, ParticleRng& rng,
+                  StokesRgb<double>* out, int channels = 0) const;
+    /// Strategy 2 for a polarized walk (eval): as connect_through_exit, the vertex's light
+    /// `emit(ω, out)` (Stokes vectors per unit flux) crossing the exit interface in the Mueller
+    /// matrix of its facet.
+    template <typename Emit, typename ProxyPdf>
+    void connect_through_exit_polarized(const Connection& conn, const Vec3d& wo, double depth,
+                                        const Rgbd& w, ParticleRng& rng, const Emit& emit,
+                                        const ProxyPdf& proxy_pdf, Rgbd& f) const;
     double interface_pdf_chain(const Interface& it, const Vec3d& wi, const Vec3d& wo, const Rgbd& w,
                                const Rgbd& q, ParticleRng& rng) const;
 
@@ -205,6 +230,8 @@ class RandomWalkStack {
     int max_events_;
     Microsurface microsurface_ = Microsurface::Single;
     int max_microsurface_order_ = kMaxMicrosurfaceOrder;
+    bool polarized_ = false;
+    int channels_ = 1;  ///< polarization states per particle (CompiledStack::polarization_channels)
 };
 
 }  // namespace lamina
