@@ -170,7 +170,7 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, int max_events, Transmissio
         if (md.scatters && !md.uniform_tau_t) chromatic_scatterer = true;
         if (!md.scatters && !md.is_empty() && !md.uniform_tau_t) chromatic_weight = true;
     }
-    pdf_unbiased_ = !(chromatic_scatterer && chromatic_weight);
+    pdf_unbiased_ = !(chromatic_scatterer && chromatic_weight) && !polarization;
 }
 
 // ---- Building the connection: the delta-chain ladder
@@ -734,7 +734,8 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
         const Vec3d d_new(d_scattered.x, d_scattered.y, d_scattered.z);
         const double cos_theta = dot(d, d_new);
         w *= Rgbd(phase[0], phase[1], phase[2]);
-        if (polarized_) stokes_depolarize<double>(ws.stokes, 3, true);  // docs/physics.md §8
+        if (polarized_ && kMode != Mode::Pdf)  // docs/physics.md §8
+            stokes_depolarize<double>(ws.stokes, 3, true);
         // The walk's own strategy for the same paths (strategy 1, weighted at the exit). Only
         // meaningful while connecting (conn is null for sample()).
         ws.prev_mis =
@@ -762,7 +763,9 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
     ws.d = -wi;
     Vec3d& d = ws.d;
     Rgbd& w = ws.w;
-    if (polarized_) {  // unpolarized incident light (docs/physics.md §8)
+    // pdf() estimates the exit density of the unpolarized walk (random_walk.h): its walks are.
+    const bool polarized = polarized_ && kMode != Mode::Pdf;
+    if (polarized) {  // unpolarized incident light (docs/physics.md §8)
         const float unpolarized[3] = {0, 0, 0};
         ws.stokes = stokes_incident<double>({d.x, d.y, d.z}, unpolarized);
     }
@@ -790,7 +793,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
         // Strategy 2 from the vertex interface (eval and pdf), its kernel, exit density × chain
         // probability, and the balance heuristic's proxy density (single scattering).
         auto connect_vertex_interface = [&](const Interface& vi) {
-            if (polarized_ && kConnect) {
+            if (polarized && kConnect) {
                 connect_through_exit_polarized(
                     *conn, wo, 1.0, w, rng,
                     [&](const Vec3d& om, StokesRgb<double>& e) {
@@ -814,7 +817,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
         const bool up_ok = conn && conn->valid[k];
         const bool down_ok = conn && it.type == InterfaceType::Dielectric && conn->valid[k + 1];
         if constexpr (kConnect) {
-            if (polarized_) {
+            if (polarized) {
                 // The vertex's light towards d_r, in the frame of its chain's plane (whose s and
                 // p parts the chains carry apart); f·|cos| over |cos| of the connection.
                 if (!it.delta && (up_ok || down_ok)) {
@@ -858,7 +861,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                     f += w * k_down * conn->from_top_down(k + 1) *
                          (conn->scale[k + 1] * exit_mis(k) / std::abs(dd.z));
             }
-            if (!polarized_ && !it.delta && !it.multiple) {
+            if (!polarized && !it.delta && !it.multiple) {
                 if (conn->valid[k]) {
                     const Vec3d& du = conn->dir_up[k];
                     Rgbd fv = eval_interface(it, wi_local, du);
@@ -948,12 +951,12 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
             auto uniform = [&] { return rng.uniform_double(); };
             const bool dielectric = it.type == InterfaceType::Dielectric;
             const std::optional<MicrosurfaceExit<double>> e =
-                polarized_ ? (dielectric ? walk_rough_dielectric_polarized(
-                                               it.dielectric.distribution(), it.dielectric.eta,
-                                               wi_local, uniform, max_microsurface_order_, pol)
-                                         : walk_rough_conductor_polarized(
-                                               it.conductor.distribution(), mueller, wi_local,
-                                               uniform, max_microsurface_order_, pol))
+                polarized ? (dielectric ? walk_rough_dielectric_polarized(
+                                              it.dielectric.distribution(), it.dielectric.eta,
+                                              wi_local, uniform, max_microsurface_order_, pol)
+                                        : walk_rough_conductor_polarized(
+                                              it.conductor.distribution(), mueller, wi_local,
+                                              uniform, max_microsurface_order_, pol))
                 : dielectric
                     ? walk_rough_dielectric(it.dielectric.distribution(), it.dielectric.eta,
                                             wi_local, uniform, max_microsurface_order_)
@@ -971,7 +974,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 case InterfaceType::Dielectric: {
                     const double uc = rng.uniform_double(), u1 = rng.uniform_double(),
                                  u2 = rng.uniform_double();
-                    if (polarized_) {
+                    if (polarized) {
                         s = it.dielectric.sample_polarized(wi_local, uc, u1, u2, pol);
                         if (s && !s->is_delta) s->pdf = it.dielectric.pdf(wi_local, s->wo);
                     } else {
@@ -981,7 +984,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 }
                 case InterfaceType::Conductor: {
                     const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
-                    if (polarized_) {
+                    if (polarized) {
                         s = it.conductor.sample_polarized(wi_local, u1, u2, pol);
                         if (s && !s->is_delta && s->wo.z > 0)
                             s->pdf = it.conductor.pdf(wi_local, s->wo);
@@ -997,7 +1000,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                     break;
                 }
             }
-        if (polarized_) ws.stokes = pol.stokes;
+        if (polarized) ws.stokes = pol.stokes;
         if (!s) return;  // a numerical degeneracy: the flux is dropped
         w *= s->weight;
         if (!it.delta) ws.delta_only = false;
@@ -1111,7 +1114,7 @@ RandomWalkEstimate RandomWalkStack::eval(const Vec3d& wi, const Vec3d& wo, std::
 double RandomWalkStack::pdf_once(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng) const {
     if (wi.z <= 0 || wo.z == 0 || (wo.z < 0 && !transmits_)) return 0;
     Connection conn;
-    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, true, conn, polarized_);
+    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, true, conn);
     Rgbd p(0.0);
     walk<Mode::Pdf>(wi, wo, rng, &conn, p, nullptr);
     return p[0];
@@ -1123,7 +1126,7 @@ RandomWalkPdf RandomWalkStack::pdf(const Vec3d& wi, const Vec3d& wo, std::uint64
     e.walks = walks;
     if (walks == 0 || wi.z <= 0 || wo.z == 0 || (wo.z < 0 && !transmits_)) return e;
     Connection conn;
-    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, true, conn, polarized_);
+    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, true, conn);
     double sum = 0, sum_sq = 0;
     for (std::uint64_t i = 0; i < walks; ++i) {
         ParticleRng rng(seed, stream, i);

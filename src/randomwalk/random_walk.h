@@ -149,7 +149,10 @@ class RandomWalkStack {
     /// flux weights and pdf() is an approximation (docs/rendering.md §1.4). False only then.
     /// Multiple-scattering interfaces do not change it: each facet's exit enters the chain
     /// probability with its own weight (docs/rendering.md §1.6); the facet cap truncates sample,
-    /// eval and pdf alike.
+    /// eval and pdf alike. Polarized walks: pdf() estimates the exit density of the unpolarized
+    /// walk (its walks and branch probabilities are those of unpolarized light at every event),
+    /// which differs from the polarized sample()'s by polarization's effect on the Fresnel
+    /// choices: a proxy density (the renderer's use), and pdf_is_unbiased() is false.
     bool pdf_is_unbiased() const { return pdf_unbiased_; }
 
     /// The delta lobes of the stack for incidence wi (paths made only of smooth events and

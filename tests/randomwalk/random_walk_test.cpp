@@ -564,8 +564,12 @@ TEST(RandomWalkStat, PolarizedAgreesWithTheGoniophotometer) {
     for (const auto& [name, stack] : polarized_stacks())
         for (const RwMicrosurface ms : {RwMicrosurface::Single, RwMicrosurface::Multiple})
             for (double ti : {35.0, 75.0}) {
-                if (stack.layers.size() == 1 && ms == RwMicrosurface::Single && ti > 35) continue;
-                expect_tables_agree(stack, ti, 3, 1000, 2'000'000,
+                // Grazing incidence on the stacks with a rough base (the others' is the same
+                // code at another angle), to bound the test's time.
+                if (ti > 35 && stack.layers.size() == 2 && stack.layers[1].interface.alpha == 0)
+                    continue;
+                if (ti > 35 && stack.layers.size() == 1 && ms == RwMicrosurface::Single) continue;
+                expect_tables_agree(stack, ti, 3, 1000, 1'000'000,
                                     name + (ms == RwMicrosurface::Multiple ? " multiple" : "") +
                                         " polarized θi=" + std::to_string(ti),
                                     ms, true);
