@@ -113,7 +113,8 @@ inline Layer with_medium(Layer layer, const Rgbd& tau_a, const Rgbd& tau_s = Rgb
 /// every key of an interface type, `alpha` included), wrong types, RGB arrays of the wrong length,
 /// NaN/inf, an RGB dielectric eta, any number outside its physical range (docs/stack-format.md,
 /// "Ranges": dielectric and ambient eta in [1, 5]; conductor eta in [0.01, 10], k in [0, 10]; alpha
-/// 0 or in [1e-4, 1]; tau_a, tau_s in [0, 100]; g in [-0.99, 0.99]; albedo in [0, 1]), an unknown
+/// 0 or in [1e-4, 1]; tau_a in [0, 100], tau_s in [0, 1e4]; g in [-0.99, 0.99]; albedo in [0, 1]),
+/// an unknown
 /// interface type, an opaque interface that is not last, a medium under the last interface, an
 /// empty or missing `layers` or more than 100 layers, an empty name. Every stack it returns lies
 /// in those ranges: the estimators of lamina are written (and fuzzed, tests/fuzz) for them.

@@ -355,7 +355,7 @@ std::string outside_ranges(const Stack& s) {
         if (f.type == InterfaceType::Lambertian && !in(f.albedo, 0, 1)) return "albedo";
         const MediumSpec& m = s.layers[i].medium;
         if (s.layers[i].has_medium &&
-            (!in(m.tau_a, 0, 100) || !in(m.tau_s, 0, 100) || !in(m.g, -0.99, 0.99)))
+            (!in(m.tau_a, 0, 100) || !in(m.tau_s, 0, 1e4) || !in(m.g, -0.99, 0.99)))
             return "medium";
     }
     return "";
