@@ -595,7 +595,8 @@ void bind_export(py::module_& m) {
     m.def(
         "_export",
         [](py::object source, const std::filesystem::path& path, const std::string& format,
-           std::vector<double> theta_i, int resolution, const std::string& description) {
+           std::vector<double> theta_i, std::optional<int> resolution,
+           const std::string& description) {
             // source: a Model or a Table (its reflection side).
             BrdfSource brdf;
             if (py::isinstance<PyModel>(source)) {
@@ -612,7 +613,7 @@ void bind_export(py::module_& m) {
                 if (format == "bsdf") {
                     RglOptions o;
                     o.theta_i_deg = theta_i;
-                    o.resolution = resolution;
+                    if (resolution) o.resolution = *resolution;  // else RglOptions' default
                     o.description = description;
                     const TensorFile file = rgl_bsdf(brdf, o);
                     check_rgl_bsdf(file, path.string());
