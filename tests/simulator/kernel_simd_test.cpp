@@ -590,6 +590,7 @@ void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
     s.grid = HemisphereGrid(18, 18);
     s.kernel = Kernel::Scalar;
     s.seed = 11;
+    apply_physics(ReferencePhysics::Bpb19, s.transport);  // the tweaks name what they add
     if (both_tweak) both_tweak(s);
     SimulationSettings scalar = s;
     if (scalar_tweak) scalar_tweak(scalar);
