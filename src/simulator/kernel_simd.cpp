@@ -415,75 +415,92 @@ struct LaneSums {
     }
 };
 
-// Written once for both: kPolarized = false is the unpolarized kernel, with none of it.
+// One block traced (trace_block_simd), in two phases: every particle's first event on full
+// vectors (FirstEvents), then steps of the lanes with refills from the queue until it is empty
+// (Steps). Written once for both: kPolarized = false is the unpolarized kernel, with none of it.
+// The per-step work, InterfaceStep and EndParticles, is compiled out of line (two call sites
+// each); the pieces they are made of are inlined into them.
 template <bool kPolarized>
-void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
-    const DF df;
-    const DI di;
-    const std::size_t n_lanes = hn::Lanes(df);
-    const CompiledStack<float>& stack = *job.stack;
-    const HemisphereGrid& grid = *job.grid;
-    const int n_layers = int(stack.layers.size());
-    const VF zero = hn::Zero(df), one = hn::Set(df, 1.f);
+class BlockTracer {
+  public:
+    BlockTracer(const BlockJob& job, Tally& tally, Scratch& scratch)
+        : job_(job),
+          tally_(tally),
+          stack_(*job.stack),
+          grid_(*job.grid),
+          n_layers_(int(stack_.layers.size())),
+          n_lanes_(hn::Lanes(DF())),
+          zero_(hn::Zero(DF())),
+          one_(hn::Set(DF(), 1.f)),
+          scratch_(scratch),
+          vector_bins_(grid_),
+          stokes_tallies_(kPolarized && job.stokes_tallies) {
+        sums_.zero();
+    }
 
-    thread_local Scratch scratch;
-    scratch.resize(job.count);
-    SeedParticles(job.seed, job.stream, job.first, job.count, scratch.state.data(),
-                  scratch.inc.data());
+    void Trace(BlockBudget& block) {
+        scratch_.resize(job_.count);
+        SeedParticles(job_.seed, job_.stream, job_.first, job_.count, scratch_.state.data(),
+                      scratch_.inc.data());
+        FirstEvents();
+        Steps();
+        sums_.reduce(block, tally_.sums.events);
+        tally_.sums.degenerate += degenerate_;
+    }
 
-    LaneSums sums;
-    sums.zero();
-    std::uint64_t degenerate = 0;
-    bool left[2] = {false, false};  // some particle was reflected / transmitted in this block
+  private:
+    // ---- Lane bookkeeping ----
 
     // Moves a lane set's float sums into the double ones.
-    auto flush = [&](LaneVectors& v) {
+    HWY_INLINE void Flush(LaneVectors& v) {
         for (int c = 0; c < 3; ++c) {
             for (int t = 0; t < kLossTerms; ++t)
                 if (v.touched[t]) {
-                    sums.add(t, c, v.loss[t][c]);
-                    v.loss[t][c] = zero;
+                    sums_.add(t, c, v.loss[t][c]);
+                    v.loss[t][c] = zero_;
                 }
             for (int e = 0; e < 4; ++e)
-                if (left[e / 2]) {
-                    sums.add(kLossTerms + e, c, v.exit_sum[e][c]);
-                    v.exit_sum[e][c] = zero;
+                if (left_[e / 2]) {
+                    sums_.add(kLossTerms + e, c, v.exit_sum[e][c]);
+                    v.exit_sum[e][c] = zero_;
                 }
         }
-    };
-    auto clear = [&](LaneVectors& v) {
-        v.d = {zero, zero, zero};
-        v.depth = zero;
+    }
+
+    HWY_INLINE void Clear(LaneVectors& v) const {
+        const DF df;
+        const DI di;
+        v.d = {zero_, zero_, zero_};
+        v.depth = zero_;
         for (int c = 0; c < 3; ++c)
-            v.w[c] = zero;
+            v.w[c] = zero_;
         for (auto& term : v.loss)
             for (auto& channel : term)
-                channel = zero;
+                channel = zero_;
         for (auto& term : v.exit_sum)
             for (auto& channel : term)
-                channel = zero;
+                channel = zero_;
         v.k = v.in_medium = v.events = v.events_done = v.live = v.finish = hn::Zero(di);
         if constexpr (kPolarized) {
             v.pol.stokes = stokes_incident<VF, VecLane>(
-                {hn::Set(df, -job.wi.x), hn::Set(df, -job.wi.y), hn::Set(df, -job.wi.z)},
-                job.incident_stokes);
-            v.pol.channels = stack.polarization_channels;
+                {hn::Set(df, -job_.wi.x), hn::Set(df, -job_.wi.y), hn::Set(df, -job_.wi.z)},
+                job_.incident_stokes);
+            v.pol.channels = stack_.polarization_channels;
             v.pol.flux = v.w;
         }
-    };
+    }
 
     // ---- One interface event of the lanes in `going`, all at interface `group` ----
-    auto interface_step = [&](LaneVectors& v, LaneRng& rng, int group, MF going) {
-        v.events =
-            hn::IfThenElse(hn::RebindMask(di, going), hn::Add(v.events, hn::Set(di, 1)), v.events);
-        MF degenerate_event = hn::FirstN(df, 0);  // all false
-        const CompiledLayer<float>& layer = stack.layers[group];
-        const bool dielectric = layer.type == InterfaceType::Dielectric;
+
+    // The layer's event on the lanes of `going`; marks the lanes whose sample failed.
+    HWY_INLINE void Event(const CompiledLayer<float>& layer, LaneVectors& v, LaneRng& rng, MF going,
+                          MF& degenerate_event) const {
         switch (layer.type) {
             case InterfaceType::Dielectric: {
                 if (layer.multiple) {
                     DielectricWalkEvent<kPolarized>(layer.dielectric, going, v, rng,
-                                                    stack.max_microsurface_order, degenerate_event);
+                                                    stack_.max_microsurface_order,
+                                                    degenerate_event);
                     break;
                 }
                 const VF uc = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
@@ -494,7 +511,7 @@ void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
             case InterfaceType::Conductor: {
                 if (layer.multiple) {
                     ConductorWalkEvent<kPolarized>(layer.conductor, going, v, rng,
-                                                   stack.max_microsurface_order, degenerate_event);
+                                                   stack_.max_microsurface_order, degenerate_event);
                     break;
                 }
                 const VF u1 = rng.Uniform(), u2 = rng.Uniform();
@@ -507,27 +524,23 @@ void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
                 break;
             }
         }
-        // A failed sample loses the flux to the microsurface; an exactly grazing new direction is
-        // lost to the microsurface (dielectric) or the base (opaque), as in trace_particle.
-        const MF grazing = hn::AndNot(degenerate_event, hn::And(going, hn::Eq(v.d.z, zero)));
-        const MF lost = hn::Or(degenerate_event, grazing);
-        v.Keep(dielectric ? lost : degenerate_event, kLossMicro, zero);
-        if (!dielectric) v.Keep(grazing, kLossBase, zero);
-        degenerate += hn::CountTrue(df, lost);
-        const MF black = hn::And(going, v.Black());
-        const MF ends = hn::Or(black, lost);
-        v.End(ends, kEnded);
-        const MF continues = hn::AndNot(ends, going);
+    }
 
-        // Exits, then the medium behind: below the interface going down, above it going up.
-        const MF up = hn::Gt(v.d.z, zero);
+    // The lanes of `continues` leave interface `group`: out of the stack at its top or bottom
+    // (reflected, transmitted), else into the medium behind it, below going down and above going
+    // up: a scattering medium's lanes enter it (its free flights are later steps), an absorbing
+    // one's cross it (Beer–Lambert), and both arrive at the next interface.
+    HWY_INLINE void LeaveInterface(LaneVectors& v, int group, MF continues) const {
+        const DF df;
+        const DI di;
+        const MF up = hn::Gt(v.d.z, zero_);
         const MF goes_up = hn::And(continues, up), goes_down = hn::AndNot(up, continues);
         MF moves_up = goes_up, moves_down = goes_down;
         if (group == 0) {
             v.End(goes_up, kReflected);
             moves_up = hn::FirstN(df, 0);
         }
-        if (group == n_layers - 1) {
+        if (group == n_layers_ - 1) {
             v.End(goes_down, kTransmitted);
             moves_down = hn::FirstN(df, 0);
         }
@@ -536,7 +549,7 @@ void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
             const int medium_layer = side == 0 ? group - 1 : group;
             const int k_next = side == 0 ? group - 1 : group + 1;
             if (hn::AllFalse(df, moving)) continue;
-            const CompiledMedium<float>& med = stack.layers[medium_layer].medium;
+            const CompiledMedium<float>& med = stack_.layers[medium_layer].medium;
             if (med.scatters) {
                 // Enters the medium: its free flights are later steps.
                 const auto mi = hn::RebindMask(di, moving);
@@ -548,32 +561,48 @@ void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
             if (med.absorbs) {
                 // Pure absorption: Beer–Lambert along the straight path (physics/medium.h).
                 VF transmittance[3];
-                beer_lambert_transmittance<VF, VecLane>(med.tau_a, hn::Div(one, hn::Abs(v.d.z)),
+                beer_lambert_transmittance<VF, VecLane>(med.tau_a, hn::Div(one_, hn::Abs(v.d.z)),
                                                         transmittance);
                 v.Keep(moving, kLossMedium, transmittance);
                 v.End(hn::And(moving, v.Black()), kEnded);
             }
             v.k = hn::IfThenElse(hn::RebindMask(di, moving), hn::Set(di, k_next), v.k);
         }
-    };
+    }
+
+    void InterfaceStep(LaneVectors& v, LaneRng& rng, int group, MF going) {
+        const DF df;
+        const DI di;
+        v.events =
+            hn::IfThenElse(hn::RebindMask(di, going), hn::Add(v.events, hn::Set(di, 1)), v.events);
+        MF degenerate_event = hn::FirstN(df, 0);  // all false
+        const CompiledLayer<float>& layer = stack_.layers[group];
+        const bool dielectric = layer.type == InterfaceType::Dielectric;
+        Event(layer, v, rng, going, degenerate_event);
+        // A failed sample loses the flux to the microsurface; an exactly grazing new direction is
+        // lost to the microsurface (dielectric) or the base (opaque), as in trace_particle.
+        const MF grazing = hn::AndNot(degenerate_event, hn::And(going, hn::Eq(v.d.z, zero_)));
+        const MF lost = hn::Or(degenerate_event, grazing);
+        v.Keep(dielectric ? lost : degenerate_event, kLossMicro, zero_);
+        if (!dielectric) v.Keep(grazing, kLossBase, zero_);
+        degenerate_ += hn::CountTrue(df, lost);
+        const MF black = hn::And(going, v.Black());
+        const MF ends = hn::Or(black, lost);
+        v.End(ends, kEnded);
+        LeaveInterface(v, group, hn::AndNot(ends, going));
+    }
 
     // ---- Particles that ended in a step: sums on vectors, exits binned and tallied in lane
     // order; on_lane(l) then runs for every ended lane, in lane order ----
-    HWY_ALIGN std::int32_t finish[kMaxLanes];
-    HWY_ALIGN float w_out[3][kMaxLanes];
-    HWY_ALIGN std::int32_t theta_bin[kMaxLanes], phi_bin[kMaxLanes];
-    const VectorBins vector_bins(grid);
-    HWY_ALIGN float d_out[3][kMaxLanes];
-    // Polarized runs with Stokes tallies: the exits' Stokes vectors in their bin frames.
-    [[maybe_unused]] HWY_ALIGN float stokes_out[3][4][kMaxLanes];
-    const bool stokes_tallies = kPolarized && job.stokes_tallies;
-    auto end_particles = [&](LaneVectors& v, MF ended, auto&& on_lane) {
-        const MF reflected = LaneIs(v.finish, kReflected);
-        const MF transmitted = LaneIs(v.finish, kTransmitted);
+
+    // R, R², T, T² of the leaving lanes into the lanes' float sums; the ended particles' events.
+    HWY_INLINE void SumEnded(LaneVectors& v, MF ended, MF reflected, MF transmitted) {
+        const DF df;
+        const DI di;
         for (int side = 0; side < 2; ++side) {
             const MF leaves = side == 0 ? reflected : transmitted;
             if (hn::AllFalse(df, leaves)) continue;
-            left[side] = true;
+            left_[side] = true;
             for (int c = 0; c < 3; ++c) {
                 const VF w_out_c = hn::IfThenElseZero(leaves, v.w[c]);
                 v.exit_sum[2 * side][c] = hn::Add(v.exit_sum[2 * side][c], w_out_c);
@@ -583,56 +612,74 @@ void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
         }
         v.events_done =
             hn::Add(v.events_done, hn::IfThenElseZero(hn::RebindMask(di, ended), v.events));
-        const MF exits = hn::Or(reflected, transmitted);
-        hn::Store(v.finish, di, finish);
-        std::uint64_t known_bins = 0;
-        if (!hn::AllFalse(df, exits)) {
-            known_bins = LaneBins(vector_bins, v.d, theta_bin, phi_bin);
-            if ((MaskBits(exits) & ~known_bins) != 0) {
-                hn::Store(v.d.x, df, d_out[0]);
-                hn::Store(v.d.y, df, d_out[1]);
-                hn::Store(v.d.z, df, d_out[2]);
-            }
-            for (int c = 0; c < 3; ++c)
-                hn::Store(v.w[c], df, w_out[c]);
-            if constexpr (kPolarized)
-                if (stokes_tallies) {
-                    VF stokes[3][4];
-                    stokes_in_bin_frame<VF, VecLane>(v.pol.stokes, v.d, v.w, v.pol.channels, exits,
-                                                     stokes);
-                    for (int c = 0; c < 3; ++c)
-                        for (int k = 0; k < 4; ++k)
-                            hn::Store(stokes[c][k], df, stokes_out[c][k]);
-                    hn::Store(v.d.y, df, d_out[1]);
-                }
+    }
+
+    // The exits' bins (where the lanes are certain of them, else their directions for bin_of),
+    // fluxes and, with Stokes tallies, Stokes vectors into the per-lane arrays; returns the lanes
+    // whose bins are known (bit l for lane l).
+    HWY_INLINE std::uint64_t StageExits(const LaneVectors& v, MF exits) {
+        const DF df;
+        const std::uint64_t known_bins = LaneBins(vector_bins_, v.d, theta_bin_, phi_bin_);
+        if ((MaskBits(exits) & ~known_bins) != 0) {
+            hn::Store(v.d.x, df, d_out_[0]);
+            hn::Store(v.d.y, df, d_out_[1]);
+            hn::Store(v.d.z, df, d_out_[2]);
         }
+        for (int c = 0; c < 3; ++c)
+            hn::Store(v.w[c], df, w_out_[c]);
+        if constexpr (kPolarized)
+            if (stokes_tallies_) {
+                VF stokes[3][4];
+                stokes_in_bin_frame<VF, VecLane>(v.pol.stokes, v.d, v.w, v.pol.channels, exits,
+                                                 stokes);
+                for (int c = 0; c < 3; ++c)
+                    for (int k = 0; k < 4; ++k)
+                        hn::Store(stokes[c][k], df, stokes_out_[c][k]);
+                hn::Store(v.d.y, df, d_out_[1]);
+            }
+        return known_bins;
+    }
+
+    // Lane l's exit (staged by StageExits) into the tallies.
+    HWY_INLINE void TallyExit(std::size_t l, std::int32_t why, std::uint64_t known_bins) {
+        const Rgbf w(w_out_[0][l], w_out_[1][l], w_out_[2][l]);
+        const std::size_t bin = (known_bins >> l & 1) != 0
+                                    ? std::size_t(theta_bin_[l]) * std::size_t(vector_bins_.n_phi) +
+                                          std::size_t(phi_bin_[l])
+                                    : grid_.bin_of(Vec3f(d_out_[0][l], d_out_[1][l], d_out_[2][l]));
+        tally_.exit((why == kTransmitted ? grid_.size() : 0) + bin, w);
+        if constexpr (kPolarized)
+            if (stokes_tallies_) {
+                float s[3][4];
+                for (int c = 0; c < 3; ++c)
+                    for (int k = 0; k < 4; ++k)
+                        s[c][k] = stokes_out_[c][k][l];
+                tally_.exit_stokes((why == kTransmitted ? grid_.size() : 0) + bin,
+                                   d_out_[1][l] < 0 ? 1 : 0, s);
+            }
+    }
+
+    template <typename OnLane>
+    void EndParticles(LaneVectors& v, MF ended, OnLane&& on_lane) {
+        const DF df;
+        const DI di;
+        const MF reflected = LaneIs(v.finish, kReflected);
+        const MF transmitted = LaneIs(v.finish, kTransmitted);
+        SumEnded(v, ended, reflected, transmitted);
+        const MF exits = hn::Or(reflected, transmitted);
+        hn::Store(v.finish, di, finish_);
+        std::uint64_t known_bins = 0;
+        if (!hn::AllFalse(df, exits)) known_bins = StageExits(v, exits);
         // Over the set bits of the mask: which lanes ended is random, a branch per lane would be
         // mispredicted half of the time.
         for (std::uint64_t ended_bits = MaskBits(ended); ended_bits != 0;
              ended_bits &= ended_bits - 1) {
             const std::size_t l = std::size_t(std::countr_zero(ended_bits));
-            const std::int32_t why = finish[l];
-            if (why != kEnded) {
-                const Rgbf w(w_out[0][l], w_out[1][l], w_out[2][l]);
-                const std::size_t bin =
-                    (known_bins >> l & 1) != 0
-                        ? std::size_t(theta_bin[l]) * std::size_t(vector_bins.n_phi) +
-                              std::size_t(phi_bin[l])
-                        : grid.bin_of(Vec3f(d_out[0][l], d_out[1][l], d_out[2][l]));
-                tally.exit((why == kTransmitted ? grid.size() : 0) + bin, w);
-                if constexpr (kPolarized)
-                    if (stokes_tallies) {
-                        float s[3][4];
-                        for (int c = 0; c < 3; ++c)
-                            for (int k = 0; k < 4; ++k)
-                                s[c][k] = stokes_out[c][k][l];
-                        tally.exit_stokes((why == kTransmitted ? grid.size() : 0) + bin,
-                                          d_out[1][l] < 0 ? 1 : 0, s);
-                    }
-            }
+            const std::int32_t why = finish_[l];
+            if (why != kEnded) TallyExit(l, why, known_bins);
             on_lane(l);
         }
-    };
+    }
 
     // ---- First events, on full vectors ----
     // Every particle starts with the same event (interface 0 met from above), so the block's
@@ -640,36 +687,36 @@ void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
     // order. The main loop then hands out particles that are past their first event: the fresh
     // particles of a two-interface stack join the others in phase (at the lower interface)
     // instead of idling for a step.
-    Queue& queue = scratch.queue;
-    queue.clear();
-    [[maybe_unused]] std::vector<WaitingPolarization>& queue_pol = scratch.queue_pol;
-    if constexpr (kPolarized) queue_pol.clear();
-    [[maybe_unused]] PolarizationArrays staged_pol;  // the lanes' states, staged or stored
-    {
+    void FirstEvents() {
+        const DF df;
+        const DI di;
+        Queue& queue = scratch_.queue;
+        queue.clear();
+        if constexpr (kPolarized) scratch_.queue_pol.clear();
         LaneVectors p;
-        clear(p);
+        Clear(p);
         [[maybe_unused]] const StokesLanes<VF> incident = p.pol.stokes;
         LaneRng prng;
         HWY_ALIGN float qd[3][kMaxLanes], qw[3][kMaxLanes], qdepth[kMaxLanes];
         HWY_ALIGN std::int32_t qk[kMaxLanes], qin[kMaxLanes], qevents[kMaxLanes];
         std::uint64_t chunks = 0;
-        for (std::uint64_t base = 0; base < job.count; base += n_lanes) {
-            const std::size_t n = std::size_t(std::min<std::uint64_t>(n_lanes, job.count - base));
-            for (std::size_t l = 0; l < n_lanes; ++l) {
-                prng.state[l] = l < n ? scratch.state[base + l] : 0;
-                prng.inc[l] = l < n ? scratch.inc[base + l] : 1;
+        for (std::uint64_t base = 0; base < job_.count; base += n_lanes_) {
+            const std::size_t n = std::size_t(std::min<std::uint64_t>(n_lanes_, job_.count - base));
+            for (std::size_t l = 0; l < n_lanes_; ++l) {
+                prng.state[l] = l < n ? scratch_.state[base + l] : 0;
+                prng.inc[l] = l < n ? scratch_.inc[base + l] : 1;
             }
             prng.SyncIn();
             const MF going = hn::FirstN(df, n);
-            p.d = {hn::Set(df, -job.wi.x), hn::Set(df, -job.wi.y), hn::Set(df, -job.wi.z)};
+            p.d = {hn::Set(df, -job_.wi.x), hn::Set(df, -job_.wi.y), hn::Set(df, -job_.wi.z)};
             for (int c = 0; c < 3; ++c)
-                p.w[c] = hn::IfThenElseZero(going, one);
+                p.w[c] = hn::IfThenElseZero(going, one_);
             p.k = p.in_medium = p.events = p.finish = hn::Zero(di);
-            p.depth = zero;
+            p.depth = zero_;
             if constexpr (kPolarized) p.pol.stokes = incident;
-            interface_step(p, prng, 0, going);
+            InterfaceStep(p, prng, 0, going);
             const MF ended = hn::RebindMask(df, hn::Ne(p.finish, hn::Zero(di)));
-            if (!hn::AllFalse(df, ended)) end_particles(p, ended, [](std::size_t) {});
+            if (!hn::AllFalse(df, ended)) EndParticles(p, ended, [](std::size_t) {});
             prng.SyncOut();
             const MF waits = hn::AndNot(ended, going);
             hn::Store(p.d.x, df, qd[0]);
@@ -681,10 +728,10 @@ void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
             hn::Store(p.k, di, qk);
             hn::Store(p.in_medium, di, qin);
             hn::Store(p.events, di, qevents);
-            if constexpr (kPolarized) staged_pol.Store(p.pol.stokes);
+            if constexpr (kPolarized) staged_pol_.Store(p.pol.stokes);
             for (std::uint64_t bits = MaskBits(waits); bits != 0; bits &= bits - 1) {
                 const std::size_t l = std::size_t(std::countr_zero(bits));
-                if constexpr (kPolarized) queue_pol.push_back(staged_pol.Lane(l));
+                if constexpr (kPolarized) scratch_.queue_pol.push_back(staged_pol_.Lane(l));
                 queue.push_back({{qd[0][l], qd[1][l], qd[2][l]},
                                  {qw[0][l], qw[1][l], qw[2][l]},
                                  qdepth[l],
@@ -694,83 +741,78 @@ void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
                                  prng.state[l],
                                  prng.inc[l]});
             }
-            if (++chunks % kFlushSteps == 0) flush(p);
+            if (++chunks % kFlushSteps == 0) Flush(p);
         }
-        flush(p);
-        sums.add_events(p.events_done);
+        Flush(p);
+        sums_.add_events(p.events_done);
     }
 
     // ---- The main loop ----
-    LaneRng rng;
-    HWY_ALIGN float sd[3][kMaxLanes], sw[3][kMaxLanes], sdepth[kMaxLanes];
-    HWY_ALIGN std::int32_t sk[kMaxLanes], s_in[kMaxLanes], sevents[kMaxLanes], live[kMaxLanes];
-    std::size_t next = 0;  // the queue's next particle
+
     // Stages the queue's next particle for lane l, or retires the lane when none is left.
-    auto take_particle = [&](std::size_t l) {
-        if (next < queue.size()) {
-            if constexpr (kPolarized) staged_pol.SetLane(l, queue_pol[next]);
-            const Waiting& q = queue[next++];
+    HWY_INLINE void TakeParticle(std::size_t l) {
+        const Queue& queue = scratch_.queue;
+        if (next_ < queue.size()) {
+            if constexpr (kPolarized) staged_pol_.SetLane(l, scratch_.queue_pol[next_]);
+            const Waiting& q = queue[next_++];
             for (int i = 0; i < 3; ++i) {
-                sd[i][l] = q.d[i];
-                sw[i][l] = q.w[i];
+                sd_[i][l] = q.d[i];
+                sw_[i][l] = q.w[i];
             }
-            sdepth[l] = q.depth;
-            sk[l] = q.k;
-            s_in[l] = q.in_medium;
-            sevents[l] = q.events;
-            rng.state[l] = q.state;
-            rng.inc[l] = q.inc;
-            live[l] = 1;
+            sdepth_[l] = q.depth;
+            sk_[l] = q.k;
+            s_in_[l] = q.in_medium;
+            sevents_[l] = q.events;
+            rng_.state[l] = q.state;
+            rng_.inc[l] = q.inc;
+            live_[l] = 1;
         } else {
             for (int i = 0; i < 3; ++i)
-                sw[i][l] = 0.f;
-            sd[2][l] = -1.f;
-            sdepth[l] = 0.f;
-            sk[l] = s_in[l] = sevents[l] = 0;
-            rng.state[l] = 0;
-            rng.inc[l] = 1;
-            live[l] = 0;
+                sw_[i][l] = 0.f;
+            sd_[2][l] = -1.f;
+            sdepth_[l] = 0.f;
+            sk_[l] = s_in_[l] = sevents_[l] = 0;
+            rng_.state[l] = 0;
+            rng_.inc[l] = 1;
+            live_[l] = 0;
         }
-    };
-    LaneVectors v;
-    clear(v);
-    // The staged particles into the lanes of `fresh`.
-    auto restart = [&](MF fresh) {
-        const auto fresh_i = hn::RebindMask(di, fresh);
-        v.d = Select(fresh, V3{hn::Load(df, sd[0]), hn::Load(df, sd[1]), hn::Load(df, sd[2])}, v.d);
-        for (int c = 0; c < 3; ++c)
-            v.w[c] = hn::IfThenElse(fresh, hn::Load(df, sw[c]), v.w[c]);
-        v.depth = hn::IfThenElse(fresh, hn::Load(df, sdepth), v.depth);
-        v.k = hn::IfThenElse(fresh_i, hn::Load(di, sk), v.k);
-        v.in_medium = hn::IfThenElse(fresh_i, hn::Load(di, s_in), v.in_medium);
-        v.events = hn::IfThenElse(fresh_i, hn::Load(di, sevents), v.events);
-        v.live = hn::IfThenElse(fresh_i, hn::Load(di, live), v.live);
-        if constexpr (kPolarized) staged_pol.Load(fresh, v.pol.stokes);
-    };
-    for (std::size_t l = 0; l < n_lanes; ++l)
-        take_particle(l);
-    rng.SyncIn();
-    restart(hn::FirstN(df, n_lanes));
+    }
 
-    int steps_since_flush = 0;
-    while (true) {
-        if (++steps_since_flush == kFlushSteps) {
-            flush(v);
-            steps_since_flush = 0;
-        }
-        v.finish = hn::Zero(di);
-        const MF live_mask = hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di)));
-        if (hn::AllFalse(df, live_mask)) break;
-        // One group of lanes steps: those at one interface, or those inside one scattering
-        // medium, whichever group is largest (ties to the first). The lanes of a two-interface
-        // stack then alternate between its interfaces in phase, so each step runs one
-        // interface's code on nearly full vectors.
+    // The staged particles into the lanes of `fresh`.
+    HWY_INLINE void Restart(LaneVectors& v, MF fresh) const {
+        const DF df;
+        const DI di;
+        const auto fresh_i = hn::RebindMask(di, fresh);
+        v.d = Select(fresh, V3{hn::Load(df, sd_[0]), hn::Load(df, sd_[1]), hn::Load(df, sd_[2])},
+                     v.d);
+        for (int c = 0; c < 3; ++c)
+            v.w[c] = hn::IfThenElse(fresh, hn::Load(df, sw_[c]), v.w[c]);
+        v.depth = hn::IfThenElse(fresh, hn::Load(df, sdepth_), v.depth);
+        v.k = hn::IfThenElse(fresh_i, hn::Load(di, sk_), v.k);
+        v.in_medium = hn::IfThenElse(fresh_i, hn::Load(di, s_in_), v.in_medium);
+        v.events = hn::IfThenElse(fresh_i, hn::Load(di, sevents_), v.events);
+        v.live = hn::IfThenElse(fresh_i, hn::Load(di, live_), v.live);
+        if constexpr (kPolarized) staged_pol_.Load(fresh, v.pol.stokes);
+    }
+
+    // The group of lanes that steps: those at one interface, or those inside one scattering
+    // medium, whichever group is largest (ties to the first). The lanes of a two-interface stack
+    // then alternate between its interfaces in phase, so each step runs one interface's code on
+    // nearly full vectors.
+    struct Group {
+        int layer;
+        bool is_medium;
+        MF lanes;
+    };
+    HWY_INLINE Group PickGroup(const LaneVectors& v, MF live_mask) const {
+        const DF df;
+        const DI di;
         const MF in_med = hn::And(live_mask, hn::RebindMask(df, hn::Ne(v.in_medium, hn::Zero(di))));
         const MF at_interface = hn::AndNot(in_med, live_mask);
         int group = 0;
         bool group_is_medium = false;
         std::size_t group_size = 0;
-        for (int j = 0; j < n_layers; ++j) {
+        for (int j = 0; j < n_layers_; ++j) {
             const std::size_t at_j = hn::CountTrue(df, hn::And(at_interface, LaneIs(v.k, j)));
             if (at_j > group_size) {
                 group = j;
@@ -778,8 +820,8 @@ void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
             }
         }
         if (!hn::AllFalse(df, in_med))
-            for (int j = 0; j < n_layers; ++j) {
-                if (!stack.layers[j].medium.scatters) continue;
+            for (int j = 0; j < n_layers_; ++j) {
+                if (!stack_.layers[j].medium.scatters) continue;
                 const std::size_t in_j = hn::CountTrue(df, hn::And(in_med, LaneIs(v.k, j)));
                 if (in_j > group_size) {
                     group = j;
@@ -787,40 +829,96 @@ void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
                     group_size = in_j;
                 }
             }
-        const MF stepped = hn::And(group_is_medium ? in_med : at_interface, LaneIs(v.k, group));
-
-        // Cut-off (trace_particle: checked before every event).
-        const MF cut =
-            hn::And(stepped, hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job.max_events - 1))));
-        if (!hn::AllFalse(df, cut)) v.Keep(cut, kLossCutOff, zero);
-        v.End(cut, kEnded);
-        const MF going = hn::AndNot(cut, stepped);
-
-        if (group_is_medium) {
-            // ---- A scattering-medium step ----
-            ScatteringStep<kPolarized>(stack.layers[group].medium, going, v, rng);
-            v.End(hn::And(going, v.Black()), kEnded);
-        } else {
-            interface_step(v, rng, group, going);
-        }
-        const MF ended = hn::RebindMask(df, hn::Ne(v.finish, hn::Zero(di)));
-        if (hn::AllFalse(df, ended)) continue;
-        rng.SyncOut();
-        end_particles(v, ended, take_particle);
-        rng.SyncIn();
-        restart(ended);
+        return {group, group_is_medium,
+                hn::And(group_is_medium ? in_med : at_interface, LaneIs(v.k, group))};
     }
-    flush(v);
-    sums.add_events(v.events_done);
-    sums.reduce(block, tally.sums.events);
-    tally.sums.degenerate += degenerate;
-}
+
+    // The queued particles through the lanes, one group's step at a time, until the queue is
+    // empty and every lane retired.
+    void Steps() {
+        const DF df;
+        const DI di;
+        LaneVectors v;
+        Clear(v);
+        for (std::size_t l = 0; l < n_lanes_; ++l)
+            TakeParticle(l);
+        rng_.SyncIn();
+        Restart(v, hn::FirstN(df, n_lanes_));
+
+        int steps_since_flush = 0;
+        while (true) {
+            if (++steps_since_flush == kFlushSteps) {
+                Flush(v);
+                steps_since_flush = 0;
+            }
+            v.finish = hn::Zero(di);
+            const MF live_mask = hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di)));
+            if (hn::AllFalse(df, live_mask)) break;
+            const Group group = PickGroup(v, live_mask);
+
+            // Cut-off (trace_particle: checked before every event).
+            const MF cut =
+                hn::And(group.lanes,
+                        hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job_.max_events - 1))));
+            if (!hn::AllFalse(df, cut)) v.Keep(cut, kLossCutOff, zero_);
+            v.End(cut, kEnded);
+            const MF going = hn::AndNot(cut, group.lanes);
+
+            if (group.is_medium) {
+                // ---- A scattering-medium step ----
+                ScatteringStep<kPolarized>(stack_.layers[group.layer].medium, going, v, rng_);
+                v.End(hn::And(going, v.Black()), kEnded);
+            } else {
+                InterfaceStep(v, rng_, group.layer, going);
+            }
+            const MF ended = hn::RebindMask(df, hn::Ne(v.finish, hn::Zero(di)));
+            if (hn::AllFalse(df, ended)) continue;
+            rng_.SyncOut();
+            EndParticles(v, ended, [this](std::size_t l) { TakeParticle(l); });
+            rng_.SyncIn();
+            Restart(v, ended);
+        }
+        Flush(v);
+        sums_.add_events(v.events_done);
+    }
+
+    const BlockJob& job_;
+    Tally& tally_;
+    const CompiledStack<float>& stack_;
+    const HemisphereGrid& grid_;
+    const int n_layers_;
+    const std::size_t n_lanes_;
+    const VF zero_, one_;
+    Scratch& scratch_;  // the particles' generators and the queue, kept between blocks
+
+    LaneSums sums_;
+    std::uint64_t degenerate_ = 0;
+    bool left_[2] = {false, false};  // some particle was reflected / transmitted in this block
+
+    // The ended lanes, staged by EndParticles.
+    HWY_ALIGN std::int32_t finish_[kMaxLanes];
+    HWY_ALIGN float w_out_[3][kMaxLanes];
+    HWY_ALIGN std::int32_t theta_bin_[kMaxLanes], phi_bin_[kMaxLanes];
+    const VectorBins vector_bins_;
+    HWY_ALIGN float d_out_[3][kMaxLanes];
+    // Polarized runs with Stokes tallies: the exits' Stokes vectors in their bin frames.
+    [[maybe_unused]] HWY_ALIGN float stokes_out_[3][4][kMaxLanes];
+    const bool stokes_tallies_;
+    [[maybe_unused]] PolarizationArrays staged_pol_;  // the lanes' states, staged or stored
+
+    // The main loop's generators, and the particle staged for each lane.
+    LaneRng rng_;
+    HWY_ALIGN float sd_[3][kMaxLanes], sw_[3][kMaxLanes], sdepth_[kMaxLanes];
+    HWY_ALIGN std::int32_t sk_[kMaxLanes], s_in_[kMaxLanes], sevents_[kMaxLanes], live_[kMaxLanes];
+    std::size_t next_ = 0;  // the queue's next particle
+};
 
 void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
+    thread_local Scratch scratch;
     if (job.stack->polarization)
-        TraceBlock<true>(job, tally, block);
+        BlockTracer<true>(job, tally, scratch).Trace(block);
     else
-        TraceBlock<false>(job, tally, block);
+        BlockTracer<false>(job, tally, scratch).Trace(block);
 }
 
 }  // namespace HWY_NAMESPACE
