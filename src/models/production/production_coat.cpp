@@ -2,6 +2,7 @@
 
 #include "core/math.h"
 #include "models/numerics/quadrature.h"
+#include "models/production/cycles_albedo.h"
 #include "models/production/filament_dfg.h"
 #include "models/production/uncorrelated_albedo.h"
 #include "models/tables/fgd_table.h"
@@ -58,6 +59,12 @@ class ProductionCoat final : public Model {
                 r_.name);
             return;
         }
+        if (r_.coat_ior_at_least_one && coat_.eta0 < 1) {
+            support_.reason = fmt::format(
+                "{} clamps its coat IOR to at least 1; this coat's relative index is {}", r_.name,
+                coat_.eta0);
+            return;
+        }
         if (r_.coat_ior_fixed && std::abs(coat_.eta0 - 1.5) > 1e-9) {
             support_.reason = fmt::format(
                 "{}'s coat has a fixed IOR of 1.5 (F0 = 0.04); this coat's relative index is {}",
@@ -85,6 +92,16 @@ class ProductionCoat final : public Model {
         // the exact Fresnel factor.
         if (r_.coat_albedo == CoatRecipe::CoatAlbedo::OpenPbrBsdf && r_coat > 0)
             coat_grid_ = OpenPbrBsdfEnergyGrid::dielectric(eta0_, sqr(r_coat));
+        if (r_.coat_energy_compensation || r_.coat_albedo == CoatRecipe::CoatAlbedo::Cycles) {
+            // Cycles reads its tables at the coat's r, a smooth coat included (its first node).
+            coat_white_.emplace(r_coat);
+            // Cycles' fresnel_dielectric_Fss: Kulla & Conty's fit, 0 at η0 = 1.
+            const double f_ss = eta0_ > 1 ? kulla_conty_average_fresnel_fit(eta0_) : 0.0;
+            coat_fms_ = multiple_scattering_fresnel(f_ss, coat_white_->average());
+            coat_f0_ior_ = sqr((eta0_ - 1) / (eta0_ + 1));
+            if (r_.coat_albedo == CoatRecipe::CoatAlbedo::Cycles && eta0_ > 1)
+                coat_factor_.emplace(r_coat, eta0_);
+        }
 
         // The base.
         is_metal_ = coat_.base_type == InterfaceType::Conductor;
@@ -121,7 +138,14 @@ class ProductionCoat final : public Model {
             const QuadratureRule q = gauss_legendre(16);
             for (std::size_t i = 0; i < q.x.size(); ++i)
                 metal_average_ += metal_fresnel(q.x[i]) * (2 * q.w[i] * q.x[i]);
-            if (r_.metal_energy_compensation) dfg_.emplace(r_lobe);
+            using MEC = CoatRecipe::MetalEnergyCompensation;
+            if (r_.metal_energy_compensation == MEC::Filament) dfg_.emplace(r_lobe);
+            if (r_.metal_energy_compensation == MEC::Cycles) {
+                metal_white_.emplace(r_lobe);
+                for (int c = 0; c < 3; ++c)
+                    metal_fms_[c] = multiple_scattering_fresnel(
+                        f82_tint_average_fresnel(f0_[c], tint82_[c]), metal_white_->average());
+            }
             using MS = CoatRecipe::MetalMultipleScattering;
             if (r_.metal_multiple_scattering == MS::OpenPbrBsdf &&
                 r_prime >= kMetalMultipleScatteringMinRoughness) {
@@ -200,6 +224,7 @@ class ProductionCoat final : public Model {
                 const double G = masking_shadowing(r_.coat_visibility, in.lambda_coat, ggx, wo);
                 f_coat = F * ndf(ggx, h) * G / (4 * wi.z * wo.z);
             }
+            f_coat *= coat_compensation(wo.z);
         }
         Rgbd base(0.0);
         if (is_metal_) {
@@ -212,6 +237,12 @@ class ProductionCoat final : public Model {
                 const double inv_e = 1 / dfg_->albedo(wo.z);
                 for (int c = 0; c < 3; ++c)
                     base[c] *= 1 + f0_[c] * (inv_e - 1);
+            }
+            if (metal_white_) {
+                // Cycles' microfacet_ggx_preserve_energy: 1 + F_ms (1 − E(μo))/E(μo).
+                const double missing = 1 / metal_white_->albedo(wo.z) - 1;
+                for (int c = 0; c < 3; ++c)
+                    base[c] *= 1 + metal_fms_[c] * missing;
             }
             if (has_ms()) {
                 double shape = in.ms_complement_i * ms_complement(wo.z) * ms_norm_;
@@ -234,7 +265,8 @@ class ProductionCoat final : public Model {
         const Vec3d wr = mirror_direction(wi);
         // At the mirror pair h = n: wi·h = μi = μo, and the smooth limit of either visibility
         // term leaves the lobe's energy equal to its Fresnel factor.
-        if (alpha_coat_ == 0) lobes.push_back({wr, Rgbd(coat_fresnel(wi.z))});
+        if (alpha_coat_ == 0)
+            lobes.push_back({wr, Rgbd(coat_fresnel(wi.z) * coat_compensation(wi.z))});
         if (is_metal_ && alpha_base_ == 0) {
             const Incident in = incident(wi);
             lobes.push_back({wr, metal_fresnel(wi.z) * base_scale(in, wi.z, wi.z)});
@@ -303,9 +335,39 @@ class ProductionCoat final : public Model {
     /// by an albedo all use the exact Fresnel).
     double coat_albedo(double mu) const {
         if (coat_grid_) return 1 - coat_grid_->complement(mu);
+        if (r_.coat_albedo == CoatRecipe::CoatAlbedo::Cycles) {
+            // bsdf_microfacet_estimate_albedo times the compensated lobe's weight
+            // E + F_ms (1 − E) (microfacet_ggx_preserve_energy); η0 ≤ 1: the Fresnel factor.
+            const double E = coat_white_->albedo(mu);
+            const double weight = r_.coat_energy_compensation ? E + coat_fms_ * (1 - E) : 1.0;
+            if (!coat_factor_) return weight * fresnel_dielectric(clamp(mu, 0.0, 1.0), eta0_);
+            return weight * (coat_f0_ior_ + (1 - coat_f0_ior_) * coat_factor_->factor(mu));
+        }
         if (r_.coat_albedo == CoatRecipe::CoatAlbedo::OpenPbrBsdf && r_coat_ == 0)
             return fresnel_dielectric(mu, eta0_);
         return FgdTable::get()(mu, alpha_coat_, eta_index_);
+    }
+
+    /// Cycles' compensation of the coat lobe for multiple scattering at μo (1 without it).
+    /// A smooth coat loses nothing: Cycles' table holds E = 1 at its first roughness node to the
+    /// six digits it prints, so the delta lobe is left as it is.
+    double coat_compensation(double mu_o) const {
+        if (!r_.coat_energy_compensation || alpha_coat_ == 0) return 1;
+        return 1 + coat_fms_ * (1 / coat_white_->albedo(mu_o) - 1);
+    }
+
+    /// Kulla & Conty 2017 (slide 18)'s colour of the multiply scattered energy with one Fresnel
+    /// bounce taken out, F_ms = F_ss E_avg/(1 − F_ss (1 − E_avg)), as Cycles scales its lobes
+    /// (microfacet_ggx_preserve_energy).
+    static double multiple_scattering_fresnel(double f_ss, double e_avg) {
+        return f_ss * e_avg / (1 - f_ss * (1 - e_avg));
+    }
+
+    /// The F82-tint Fresnel's average 2 ∫ F μ dμ in closed form, F0 + (1 − F0)/21 − b/126 with b
+    /// its edge term (Cycles' fresnel_f82_Fss).
+    static double f82_tint_average_fresnel(double f0, double tint) {
+        const double b = schlick(kF82Cos, f0) * (1 - tint) / (kF82Cos * std::pow(1 - kF82Cos, 6));
+        return f0 + (1 - f0) / 21 - b / 126;
     }
 
     /// The masking-shadowing of a lobe: height-correlated or uncorrelated Smith, Λ(wi) given.
@@ -394,7 +456,7 @@ class ProductionCoat final : public Model {
         double a = 1;
         switch (r_.attenuation) {
             case A::AlbedoView:
-                a = 1 - coat_albedo(mu_o);
+                a = clamp(1 - coat_albedo(mu_o), 0.0, 1.0);
                 break;
             case A::AlbedoReciprocal:
                 a = (1 - in.E_i) * (1 - coat_albedo(mu_o));
@@ -497,6 +559,12 @@ class ProductionCoat final : public Model {
     Rgbd f0_{0.0}, tint82_{1.0};
     double f90_ = 1;                         ///< the metal's Schlick edge value
     std::optional<FilamentDfgTexture> dfg_;  ///< Filament's energy compensation
+    // Cycles' tables: the coat's white albedo and Fresnel factor, the metal's white albedo, and
+    // their F_ms (the metal's per channel).
+    std::optional<CyclesWhiteAlbedo> coat_white_, metal_white_;
+    std::optional<CyclesFresnelFactor> coat_factor_;
+    double coat_fms_ = 0, coat_f0_ior_ = 0;
+    Rgbd metal_fms_{0.0};
     Rgbd albedo_{0.0};
     Rgbd tau_{0.0};
     bool has_tau_ = false;
@@ -572,7 +640,8 @@ void use_exact_leaves(CoatRecipe& r) {
     r.lobe_min_roughness = 0;
     r.metal_min_roughness = 0;
     r.max_ndf = 0;
-    r.metal_energy_compensation = false;
+    r.metal_energy_compensation = CoatRecipe::MetalEnergyCompensation::None;
+    r.coat_energy_compensation = false;
     r.metal_f90_from_f0 = false;
     r.coat_albedo = CoatRecipe::CoatAlbedo::Fgd;
     r.metal_multiple_scattering = CoatRecipe::MetalMultipleScattering::None;

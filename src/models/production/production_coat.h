@@ -1,7 +1,7 @@
 #pragma once
 // The coats that engines ship (docs/models.md, "Production coats"): OpenPBR Surface 1.1, Adobe's
 // openpbr-bsdf, Autodesk Standard Surface, Dassault Enterprise PBR 2025x, Google Filament,
-// glTF KHR_materials_clearcoat, Blender 4.x Principled and Kulla & Conty 2017. Each is a sum of a
+// glTF KHR_materials_clearcoat, Blender Cycles Principled and Kulla & Conty 2017. Each is a sum of a
 // coat lobe and the base's own lobe evaluated at the *outside* directions, the base scaled by a
 // layering factor — none of them refracts, nor follows light between the interfaces:
 //
@@ -49,6 +49,8 @@ struct CoatRecipe {
     } coat_fresnel = Fresnel::Exact;
     /// The model's coat has no IOR parameter (IOR 1.5): another η0 is not supported.
     bool coat_ior_fixed = false;
+    /// The model clamps its coat IOR to ≥ 1 (Blender): η0 < 1 is not supported.
+    bool coat_ior_at_least_one = false;
     /// The coat lobe's Fresnel at n·wo instead of wi·h (glTF's layering Fresnel).
     bool coat_fresnel_at_n = false;
     enum class Visibility {
@@ -75,10 +77,27 @@ struct CoatRecipe {
                       ///< (models/tables/fgd_table.h)
         OpenPbrBsdf,  ///< the uncorrelated lobe's albedo on openpbr-bsdf's grid, read as it reads
                       ///< it (models/production/uncorrelated_albedo.h)
+        Cycles,       ///< Cycles' estimate of its compensated lobe's albedo,
+                      ///< [E + F_ms (1 − E)] (F0 + (1 − F0) s) on its tables
+                      ///< (models/production/cycles_albedo.h); F(μ; η0) for η0 ≤ 1
     } coat_albedo = CoatAlbedo::Fgd;
-    /// Filament's compensation of the metal lobe for multiple scattering, × (1 + F0 (1/E − 1)),
-    /// E read from its DFG texture at (μo, r) (models/production/filament_dfg.h).
-    bool metal_energy_compensation = false;
+    /// Cycles' compensation of every dielectric microfacet closure for multiple scattering: the
+    /// coat lobe × (1 + F_ms (1 − E(μo))/E(μo)), E the white lobe's albedo on Cycles' table and
+    /// F_ms = F_ss E_avg/(1 − F_ss (1 − E_avg)) with F_ss Kulla & Conty's fit of the coat's
+    /// average Fresnel (kernel/closure/bsdf_microfacet.h, microfacet_ggx_preserve_energy).
+    bool coat_energy_compensation = false;
+    /// A compensation of the metal lobe for multiple scattering, a factor on the lobe that
+    /// depends on μo.
+    enum class MetalEnergyCompensation {
+        None,
+        /// Filament: × (1 + F0 (1/E − 1)), E read from its DFG texture at (μo, r)
+        /// (models/production/filament_dfg.h).
+        Filament,
+        /// Cycles' multiscatter GGX: × (1 + F_ms (1 − E)/E), E and E_avg from its tables,
+        /// F_ms = F_ss E_avg/(1 − F_ss (1 − E_avg)), F_ss the F82-tint average F0 + (1 − F0)/21 −
+        /// b/126.
+        Cycles,
+    } metal_energy_compensation = MetalEnergyCompensation::None;
     /// The metal's Schlick f90 = min(1, 16.5 (F0_r + F0_g + F0_b)) (Filament), not 1.
     bool metal_f90_from_f0 = false;
     /// A compensation lobe for the metal's multiple scattering between microfacets, of Kulla &

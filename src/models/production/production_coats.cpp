@@ -9,7 +9,7 @@
 //   Dassault Systèmes Enterprise PBR 2025x specification, "Clearcoat";
 //   Google Filament documentation, "Clear coat model" and "Clear coat parameterization";
 //   Khronos KHR_materials_clearcoat, "Layering" (and three.js's half-vector Fresnel in the lobe);
-//   Blender 4.x Cycles, the Principled BSDF's coat (kernel/svm/closure.h);
+//   Blender Cycles, the Principled BSDF (kernel/svm/closure.h, kernel/closure/bsdf_microfacet.h);
 //   Kulla & Conty 2017, "Revisiting physically based shading at Imageworks" (SIGGRAPH course).
 #include "models/production/production_coats.h"
 #include "models/production/production_coat.h"
@@ -126,7 +126,9 @@ CoatRecipe filament_recipe(const ModelOptions& o) {
     r.metal_min_roughness = 0.045;
     r.max_ndf = 453.5 * 453.5 / kPi<double>;
     r.metal_f90_from_f0 = true;
-    r.metal_energy_compensation = is_on(o, "energy-compensation");
+    r.metal_energy_compensation = is_on(o, "energy-compensation")
+                                      ? CoatRecipe::MetalEnergyCompensation::Filament
+                                      : CoatRecipe::MetalEnergyCompensation::None;
     r.attenuation = option_value(o, "attenuation") == "h" ? CoatRecipe::Attenuation::FresnelHalf
                                                           : CoatRecipe::Attenuation::FresnelView;
     r.tint = CoatRecipe::Tint::Constant;  // no coat tint: baked into the base
@@ -154,14 +156,23 @@ CoatRecipe gltf_recipe(const ModelOptions& o) {
     return r;
 }
 
-// --- Blender 4.x Principled -----------------------------------------------------------------
+// --- Blender Cycles Principled --------------------------------------------------------------
 CoatRecipe blender_recipe(const ModelOptions& o) {
     CoatRecipe r;
     r.name = "blender-principled";
     r.coat_fresnel = CoatRecipe::Fresnel::Exact;
+    r.coat_ior_at_least_one = true;
     r.attenuation = CoatRecipe::Attenuation::AlbedoView;
     r.tint = is_on(o, "view-tint") ? CoatRecipe::Tint::ViewOnly : CoatRecipe::Tint::Constant;
     r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    // As Cycles ships it (kernel/svm/closure.h, kernel/closure/bsdf_microfacet.h): every
+    // dielectric closure compensated for multiple scattering, the coat's albedo its estimate on
+    // Cycles' tables, the metal with the node's default multiscatter GGX.
+    r.coat_energy_compensation = is_on(o, "energy-compensation");
+    r.coat_albedo = CoatRecipe::CoatAlbedo::Cycles;
+    r.metal_energy_compensation = is_on(o, "energy-compensation")
+                                      ? CoatRecipe::MetalEnergyCompensation::Cycles
+                                      : CoatRecipe::MetalEnergyCompensation::None;
     if (exact_leaves(o)) use_exact_leaves(r);
     return r;
 }
@@ -265,6 +276,9 @@ std::unique_ptr<Model> make_gltf_clearcoat(const Stack& stack, const ModelOption
 std::vector<OptionSpec> blender_principled_options() {
     return {on_off_option("view-tint", true,
                           "coat tint^(1/mu_t,o) along the view; off: the constant tint"),
+            on_off_option("energy-compensation", true,
+                          "Cycles' compensation of the coat and metal lobes for multiple "
+                          "scattering, 1 + F_ms (1 - E)/E (leaves=exact drops it)"),
             leaves_option()};
 }
 std::unique_ptr<Model> make_blender_principled(const Stack& stack, const ModelOptions& options) {

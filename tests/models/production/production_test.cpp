@@ -363,14 +363,36 @@ TEST(ProductionCoats, GltfAgainstTheExtension) {
 // Blender: base × (1 − E_coat(wo)) × tint^(1/μt_o), the tint once along the view, matched at
 // normal incidence: tint = e^(−2τ).
 TEST(ProductionCoats, BlenderAgainstItsClosure) {
-    const Stack s = coated(1.5, 0.0, test::lambertian(kRho), kTau);
+    // A smooth coat over a Lambertian base: the base weighted by 1 − (Cycles' estimate of the
+    // coat's albedo at μo) and by coat_tint^(1/μt_o). The estimate F0 + (1 − F0) s reads the table
+    // of s at Cycles' nodes: μ = m/15, z = k/15 with F0 = z⁴ (η from F0), at the first roughness
+    // node (r = 1e-4, where s is its smooth value ŝ(μ) = (F(μ) − F0)/(1 − F0) to 1e-9), linearly
+    // interpolated in μ and z; the white albedo there is 1 (to 1e-9).
+    const double eta = 1.5;
+    const Stack s = coated(eta, 0.0, test::lambertian(kRho), kTau);
     const Vec3d wi = dir(30, 0), wo = dir(55, 135);
+    auto s_hat = [](double mu, double e) {
+        const double f0 = sqr((e - 1) / (e + 1));
+        return (fresnel_ref(mu, e) - f0) / (1 - f0);
+    };
+    auto eta_of_z = [](double z) {
+        const double q = z * z;  // √F0
+        return (1 + q) / (1 - q);
+    };
+    const double z = std::sqrt((eta - 1) / (eta + 1)) * 15, y = wo.z * 15;
+    const int k = int(z), m = int(y);
+    auto at_z = [&](int kk) {
+        const double e = eta_of_z(kk / 15.0);
+        return std::lerp(s_hat(m / 15.0, e), s_hat((m + 1) / 15.0, e), y - m);
+    };
+    const double factor = std::lerp(at_z(k), at_z(k + 1), z - k);
+    const double f0 = sqr((eta - 1) / (eta + 1));
+    const double albedo = f0 + (1 - f0) * factor;
     Rgbd want;
     for (int c = 0; c < 3; ++c)
-        want[c] = (1 - fresnel_ref(wo.z, 1.5)) *
-                  std::pow(std::exp(-2 * kTau[c]), 1 / refracted_cos(wo.z, 1.5)) * kRho[c] /
-                  kPi<double>;
-    expect_rgb_near(make_model("blender-principled", s)->eval(wi, wo), want, 1e-9, "blender");
+        want[c] = (1 - albedo) * std::pow(std::exp(-2 * kTau[c]), 1 / refracted_cos(wo.z, eta)) *
+                  kRho[c] / kPi<double>;
+    expect_rgb_near(make_model("blender-principled", s)->eval(wi, wo), want, 1e-8, "blender");
 }
 
 // Kulla & Conty: (1 − E(μi))(1 − E(μo))/(1 − E_avg) f_base, E_avg = 2∫E μ dμ (here by a
