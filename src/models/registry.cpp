@@ -112,7 +112,8 @@ const std::vector<ModelEntry>& model_registry() {
          "bases: lambertian, conductor; eta0 = 1.5; sides: R", gltf_clearcoat_options,
          make_gltf_clearcoat, false, "production"},
         {"blender-principled",
-         "Blender 4.x Principled coat: base x (1 - E_coat(wo)) x tint^(1/mu_t,o), view side only",
+         "Blender Cycles Principled coat: compensated coat lobe, base x (1 - Cycles' estimate of "
+         "its albedo at wo) x tint^(1/mu_t,o), compensated F82-tint metal",
          "bases: lambertian, conductor; media: absorbing; sides: R", blender_principled_options,
          make_blender_principled, false, "production"},
         {"kulla-conty",
@@ -132,6 +133,11 @@ const std::vector<ModelEntry>& model_registry() {
          "the energy and projected variance of the light the Lambertian returns",
          "bases: lambertian (under 1-8 coats); media: absorbing; sides: R", ddb22_options,
          make_ddb22, false, "successors"},
+        {"threejs-clearcoat",
+         "three.js MeshPhysicalMaterial clearcoat: Schlick 0.04 (spherical-Gaussian fit) at v.h "
+         "on the lobe, base x (1 - Fc(n.v)), roughness >= 0.045, compensated metal",
+         "bases: lambertian, conductor; eta0 = 1.5; sides: R", threejs_clearcoat_options,
+         make_threejs_clearcoat, false, "production"},
     };
     return entries;
 }

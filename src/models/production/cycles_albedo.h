@@ -3,16 +3,10 @@
 // them for multiple scattering and to layer its Principled BSDF (docs/models.md,
 // "`blender-principled`"), as lamina re-derives them:
 //
-//   E(μ, α)     the directional albedo of a white GGX lobe (F = 1) with the height-correlated
-//               Smith term, ∫ D_wi(h) G2/G1(wi) dh over the visible normals of wi whose
-//               reflection leaves above the horizon (Heitz 2018: visible-normal sampling leaves
-//               the weight G2/G1);
+//   E(μ, α)     the directional albedo of the white GGX lobe with the height-correlated Smith
+//               term (models/production/ggx_albedo.h);
 //   E_avg(α)    its cosine-weighted average 2 ∫ E(μ) μ dμ;
-//   s(μ, α, η)  the mean over the same visible normals of the Fresnel factor's position between
-//               its ends, ŝ(c) = clamp((F(c; η) − F0)/(1 − F0), 0, 1), F the exact dielectric
-//               Fresnel of relative index η > 1 and F0 = ((η − 1)/(η + 1))² (a normal whose
-//               reflection goes below the horizon counts 0). Cycles takes F0 + (1 − F0) s as the
-//               albedo of a rough dielectric's reflection relative to its own lobe.
+//   s(μ, α, η)  the mean Fresnel factor position (ggx_albedo.h, cycles_fresnel_factor).
 //
 // Cycles does not evaluate these integrals: it estimates them once by Monte Carlo (its
 // cycles_precompute tool) on fixed nodes and interpolates them linearly in the node index. The
@@ -29,17 +23,11 @@
 // Only the nodes a lobe reads are computed: 2 × 32 values of E and 2 of E_avg at one r, 2 × 16 × 2
 // values of s at one (r, η).
 
+#include "models/production/ggx_albedo.h"
+
 #include <array>
 
 namespace lamina {
-
-/// E(μ, α) of the white GGX lobe with height-correlated Smith masking. μ ∈ [0, 1] (taken at
-/// μ ≥ 10⁻⁶), α ≥ 0 (α = 0 gives 1). n_r Gauss–Legendre nodes per piece of the visible-normal
-/// radius (split where the reflection crosses the horizon) × n_phi nodes in φ.
-double correlated_ggx_albedo_white(double mu, double alpha, int n_r = 24, int n_phi = 48);
-
-/// s(μ, α, η) above, η > 1; α = 0 gives ŝ(μ).
-double cycles_fresnel_factor(double mu, double alpha, double eta, int n_r = 24, int n_phi = 48);
 
 /// Cycles' tables ggx_E and ggx_Eavg read at one roughness parameter r ∈ [0, 1].
 class CyclesWhiteAlbedo {

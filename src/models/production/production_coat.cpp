@@ -4,6 +4,7 @@
 #include "models/numerics/quadrature.h"
 #include "models/production/cycles_albedo.h"
 #include "models/production/filament_dfg.h"
+#include "models/production/threejs_dfg.h"
 #include "models/production/uncorrelated_albedo.h"
 #include "models/tables/fgd_table.h"
 #include "physics/fresnel.h"
@@ -29,6 +30,12 @@ double schlick_weight(double c) {
 
 double schlick(double c, double f0) {
     return f0 + (1 - f0) * schlick_weight(c);
+}
+
+/// Karis 2013 ("Real shading in Unreal Engine 4", SIGGRAPH course notes)'s spherical-Gaussian fit
+/// of Schlick's weight, 2^((−5.55473 c − 6.98316) c), as three.js's F_Schlick evaluates it.
+double schlick_weight_spherical_gaussian(double c) {
+    return std::exp2((-5.55473 * c - 6.98316) * c);
 }
 
 constexpr double kF82Cos = 1.0 / 7.0;  // μ̄ of the F82-tint model (OpenPBR 1.1, "Metal")
@@ -140,6 +147,7 @@ class ProductionCoat final : public Model {
                 metal_average_ += metal_fresnel(q.x[i]) * (2 * q.w[i] * q.x[i]);
             using MEC = CoatRecipe::MetalEnergyCompensation;
             if (r_.metal_energy_compensation == MEC::Filament) dfg_.emplace(r_lobe);
+            if (r_.metal_energy_compensation == MEC::ThreeJs) threejs_dfg_.emplace(r_lobe);
             if (r_.metal_energy_compensation == MEC::Cycles) {
                 metal_white_.emplace(r_lobe);
                 for (int c = 0; c < 3; ++c)
@@ -235,6 +243,12 @@ class ProductionCoat final : public Model {
             if (dfg_) {
                 // Filament's energyCompensation, 1 + F0 (1/E(μo) − 1), on the lobe.
                 const double inv_e = 1 / dfg_->albedo(wo.z);
+                for (int c = 0; c < 3; ++c)
+                    base[c] *= 1 + f0_[c] * (inv_e - 1);
+            }
+            if (threejs_dfg_) {
+                // three.js's multiScatteringCompensation, 1 + F0 (1/E(μo) − 1), on the lobe.
+                const double inv_e = 1 / threejs_dfg_->albedo(wo.z);
                 for (int c = 0; c < 3; ++c)
                     base[c] *= 1 + f0_[c] * (inv_e - 1);
             }
@@ -424,7 +438,13 @@ class ProductionCoat final : public Model {
 
     double coat_fresnel(double c) const {
         if (r_.coat_fresnel == CoatRecipe::Fresnel::Exact) return fresnel_dielectric(c, eta0_);
-        return schlick(c, coat_f0_);
+        return coat_f0_ + (1 - coat_f0_) * model_schlick_weight(c);
+    }
+
+    /// Schlick's weight in the model's form: (1 − c)⁵ or its spherical-Gaussian fit.
+    double model_schlick_weight(double c) const {
+        return r_.schlick_spherical_gaussian ? schlick_weight_spherical_gaussian(clamp(c, 0.0, 1.0))
+                                             : schlick_weight(c);
     }
 
     /// μt = √(1 − (1 − μ²)/η0²) (OpenPBR 1.1, "View-dependent absorption").
@@ -440,7 +460,7 @@ class ProductionCoat final : public Model {
                 case CoatRecipe::MetalFresnel::Schlick:
                 case CoatRecipe::MetalFresnel::SchlickFilament:
                     // Schlick 1994, Eq. 15, with the edge value f90 (Filament's F_Schlick).
-                    F[i] = f0_[i] + (f90_ - f0_[i]) * schlick_weight(c);
+                    F[i] = f0_[i] + (f90_ - f0_[i]) * model_schlick_weight(c);
                     break;
                 case CoatRecipe::MetalFresnel::F82Tint:
                     F[i] = f82_tint_fresnel(c, f0_[i], tint82_[i]);
@@ -557,8 +577,9 @@ class ProductionCoat final : public Model {
     FgdTable::Index eta_index_;
     bool is_metal_ = false;
     Rgbd f0_{0.0}, tint82_{1.0};
-    double f90_ = 1;                         ///< the metal's Schlick edge value
-    std::optional<FilamentDfgTexture> dfg_;  ///< Filament's energy compensation
+    double f90_ = 1;                                ///< the metal's Schlick edge value
+    std::optional<FilamentDfgTexture> dfg_;         ///< Filament's energy compensation
+    std::optional<ThreeJsDfgTexture> threejs_dfg_;  ///< three.js's energy compensation
     // Cycles' tables: the coat's white albedo and Fresnel factor, the metal's white albedo, and
     // their F_ms (the metal's per channel).
     std::optional<CyclesWhiteAlbedo> coat_white_, metal_white_;
@@ -642,6 +663,7 @@ void use_exact_leaves(CoatRecipe& r) {
     r.max_ndf = 0;
     r.metal_energy_compensation = CoatRecipe::MetalEnergyCompensation::None;
     r.coat_energy_compensation = false;
+    r.schlick_spherical_gaussian = false;
     r.metal_f90_from_f0 = false;
     r.coat_albedo = CoatRecipe::CoatAlbedo::Fgd;
     r.metal_multiple_scattering = CoatRecipe::MetalMultipleScattering::None;

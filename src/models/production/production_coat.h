@@ -1,9 +1,10 @@
 #pragma once
 // The coats that engines ship (docs/models.md, "Production coats"): OpenPBR Surface 1.1, Adobe's
 // openpbr-bsdf, Autodesk Standard Surface, Dassault Enterprise PBR 2025x, Google Filament,
-// glTF KHR_materials_clearcoat, Blender Cycles Principled and Kulla & Conty 2017. Each is a sum of a
-// coat lobe and the base's own lobe evaluated at the *outside* directions, the base scaled by a
-// layering factor — none of them refracts, nor follows light between the interfaces:
+// glTF KHR_materials_clearcoat and three.js's MeshPhysicalMaterial, Blender Cycles Principled and
+// Kulla & Conty 2017. Each is a sum of a coat lobe and the base's own lobe evaluated at the
+// *outside* directions, the base scaled by a layering factor — none of them refracts, nor follows
+// light between the interfaces:
 //
 //     f(wi, wo) = f_coat(wi, wo) + A(wi, wo) · T(wi, wo) · Δ(wo) · f_base'(wi, wo)
 //
@@ -49,6 +50,9 @@ struct CoatRecipe {
     } coat_fresnel = Fresnel::Exact;
     /// The model's coat has no IOR parameter (IOR 1.5): another η0 is not supported.
     bool coat_ior_fixed = false;
+    /// Schlick's weight (1 − c)⁵ replaced by the spherical-Gaussian fit 2^((−5.55473 c − 6.98316)
+    /// c) (Karis 2013, "Real shading in Unreal Engine 4"; three.js's F_Schlick) on coat and metal.
+    bool schlick_spherical_gaussian = false;
     /// The model clamps its coat IOR to ≥ 1 (Blender): η0 < 1 is not supported.
     bool coat_ior_at_least_one = false;
     /// The coat lobe's Fresnel at n·wo instead of wi·h (glTF's layering Fresnel).
@@ -97,6 +101,9 @@ struct CoatRecipe {
         /// F_ms = F_ss E_avg/(1 − F_ss (1 − E_avg)), F_ss the F82-tint average F0 + (1 − F0)/21 −
         /// b/126.
         Cycles,
+        /// three.js: × (1 + F0 (1/E − 1)), E read from its DFG texture at (r, μo)
+        /// (models/production/threejs_dfg.h).
+        ThreeJs,
     } metal_energy_compensation = MetalEnergyCompensation::None;
     /// The metal's Schlick f90 = min(1, 16.5 (F0_r + F0_g + F0_b)) (Filament), not 1.
     bool metal_f90_from_f0 = false;

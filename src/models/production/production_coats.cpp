@@ -156,6 +156,30 @@ CoatRecipe gltf_recipe(const ModelOptions& o) {
     return r;
 }
 
+// --- three.js MeshPhysicalMaterial (glTF's clear coat) ---------------------------------------
+CoatRecipe threejs_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "threejs-clearcoat";
+    // Its shaders (lights_physical_pars_fragment, lights_physical_fragment, meshphysical, common):
+    // Schlick 0.04 in Karis's spherical-Gaussian form at v.h on the coat lobe, the base times
+    // 1 - clearcoat F(n.v), the height-correlated visibility, roughness of coat and base clamped
+    // to >= 0.045, the metal's Schlick with f90 = 1 and its multiple-scattering compensation from
+    // the DFG texture.
+    r.coat_fresnel = CoatRecipe::Fresnel::Schlick004;
+    r.coat_ior_fixed = true;
+    r.schlick_spherical_gaussian = true;
+    r.attenuation = CoatRecipe::Attenuation::FresnelView;
+    r.tint = CoatRecipe::Tint::Constant;  // no coat tint: baked into the base
+    r.coat_min_roughness = 0.045;
+    r.metal_min_roughness = 0.045;
+    r.metal_fresnel = CoatRecipe::MetalFresnel::Schlick;
+    r.metal_energy_compensation = is_on(o, "energy-compensation")
+                                      ? CoatRecipe::MetalEnergyCompensation::ThreeJs
+                                      : CoatRecipe::MetalEnergyCompensation::None;
+    if (exact_leaves(o)) use_exact_leaves(r);
+    return r;
+}
+
 // --- Blender Cycles Principled --------------------------------------------------------------
 CoatRecipe blender_recipe(const ModelOptions& o) {
     CoatRecipe r;
@@ -283,6 +307,17 @@ std::vector<OptionSpec> blender_principled_options() {
 }
 std::unique_ptr<Model> make_blender_principled(const Stack& stack, const ModelOptions& options) {
     return make_production_coat(stack, blender_recipe(options));
+}
+
+std::vector<OptionSpec> threejs_clearcoat_options() {
+    return {
+        on_off_option("energy-compensation", true,
+                      "the metal lobe x (1 + F0 (1/E - 1)), E from the DFG texture (leaves=exact "
+                      "drops it)"),
+        leaves_option()};
+}
+std::unique_ptr<Model> make_threejs_clearcoat(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, threejs_recipe(options));
 }
 
 std::vector<OptionSpec> kulla_conty_options() {

@@ -86,8 +86,8 @@ std::vector<const ModelEntry*> production() {
 
 // A smooth clear coat over a black base: all that is left is the top interface's mirror
 // reflection, in the model's own Fresnel (Schlick 0.04 for the coats with a fixed IOR). Filament
-// clamps its coat roughness (r ≥ 0.045): it has no smooth limit as shipped, only with the exact
-// leaves.
+// and three.js clamp their coat roughness (r ≥ 0.045): they have no smooth limit as shipped, only
+// with the exact leaves.
 TEST(ProductionCoats, SmoothCoatOverBlackBaseIsTheTopReflection) {
     const Stack s = coated(1.5, 0.0, test::lambertian(Rgbd(0.0)));
     for (const ModelEntry* e : production()) {
@@ -100,7 +100,8 @@ TEST(ProductionCoats, SmoothCoatOverBlackBaseIsTheTopReflection) {
                 if (!has_leaves) continue;
                 opts.push_back("leaves=exact");
             }
-            if (e->name == "filament" && opts.empty()) continue;  // clamped: below
+            if ((e->name == "filament" || e->name == "threejs-clearcoat") && opts.empty())
+                continue;  // clamped
             const auto m = make_model(e->name, s, opts);
             ASSERT_TRUE(m->support().brdf) << e->name;
             const bool schlick =
@@ -503,8 +504,8 @@ double max_albedo(const ModelEntry& e, bool transposed, const std::vector<std::s
 // the FGD table's interpolation budget (6.3e-3, docs/models.md).
 TEST(ProductionCoats, EnergyAsMeasured) {
     const double tol = 1e-3 + 6.3e-3;
-    for (const char* name :
-         {"openpbr", "openpbr-adobe", "standard-surface", "gltf-clearcoat", "blender-principled"}) {
+    for (const char* name : {"openpbr", "openpbr-adobe", "standard-surface", "gltf-clearcoat",
+                             "blender-principled", "threejs-clearcoat"}) {
         const ModelEntry& e = find_model(name);
         EXPECT_LE(max_albedo(e, true), 1 + tol) << name << " (per wo)";
         const double forward = max_albedo(e, false);
@@ -561,8 +562,8 @@ TEST(ProductionCoats, ReciprocityAsMeasured) {
              {"openpbr-adobe", {"reciprocal=on"}}})
         for (const Stack& s : stacks)
             EXPECT_LT(reciprocity_error(*make_model(name, s, opts)), 1e-12) << name;
-    for (const char* name :
-         {"openpbr", "openpbr-adobe", "standard-surface", "blender-principled", "gltf-clearcoat"})
+    for (const char* name : {"openpbr", "openpbr-adobe", "standard-surface", "blender-principled",
+                             "gltf-clearcoat", "threejs-clearcoat"})
         EXPECT_GT(reciprocity_error(*make_model(name, stacks[0])), 0.05) << name;
     const double filament_metal = reciprocity_error(*make_model("filament", stacks[1]));
     std::cout << "filament over gold: reciprocity error " << filament_metal << "\n";
@@ -582,8 +583,8 @@ TEST(ProductionCoats, SupportIsExplicit) {
         EXPECT_FALSE(scattering->support().brdf);
         EXPECT_NE(scattering->support().reason.find("scattering"), std::string::npos) << e->name;
         const auto other_ior = make_model(e->name, coated(1.3, 0.1, test::lambertian(kRho)));
-        const bool fixed =
-            e->name == "enterprise-pbr" || e->name == "filament" || e->name == "gltf-clearcoat";
+        const bool fixed = e->name == "enterprise-pbr" || e->name == "filament" ||
+                           e->name == "gltf-clearcoat" || e->name == "threejs-clearcoat";
         EXPECT_EQ(other_ior->support().brdf, !fixed) << e->name;
         if (fixed) {
             EXPECT_NE(other_ior->support().reason.find("fixed IOR"), std::string::npos) << e->name;

@@ -1,7 +1,9 @@
-// Cycles' albedo tables as lamina re-derives them (models/production/cycles_albedo.h): the
-// visible-normal integrals against independent ones over the outgoing solid angle, their limits,
-// and the reading at Cycles' nodes.
+// The GGX albedos engines tabulate (models/production/ggx_albedo.h) against independent integrals
+// over the outgoing solid angle, their limits, and the readings of Cycles' tables
+// (cycles_albedo.h) and three.js's DFG texture (threejs_dfg.h) at their nodes.
+#include "models/production/ggx_albedo.h"
 #include "models/production/cycles_albedo.h"
+#include "models/production/threejs_dfg.h"
 
 #include "core/math.h"
 #include "models/numerics/quadrature.h"
@@ -54,7 +56,7 @@ double by_solid_angle(double mu, double alpha, double eta, bool white, int n_mu 
 
 // The visible-normal integrals against the solid-angle ones at moderate roughness (where a
 // 400 × 400 rule resolves the lobe): within 2e-5.
-TEST(CyclesAlbedo, AgreesWithTheSolidAngleIntegral) {
+TEST(GgxAlbedo, AgreesWithTheSolidAngleIntegral) {
     for (double alpha : {0.1, 0.3, 0.7})
         for (double mu : {0.15, 0.5, 0.95}) {
             EXPECT_NEAR(correlated_ggx_albedo_white(mu, alpha),
@@ -69,7 +71,7 @@ TEST(CyclesAlbedo, AgreesWithTheSolidAngleIntegral) {
 
 // Limits: a smooth lobe reflects all its light and its factor is ŝ(μ) itself; ŝ runs from 0 at
 // normal incidence to 1 at grazing.
-TEST(CyclesAlbedo, Limits) {
+TEST(GgxAlbedo, Limits) {
     for (double mu : {0.05, 0.4, 1.0}) {
         EXPECT_EQ(correlated_ggx_albedo_white(mu, 0), 1);
         const double f0 = 0.04;
@@ -98,6 +100,36 @@ TEST(CyclesAlbedo, ReadsItsNodesAsCyclesDoes) {
     const double r16 = 4 / 15.0, mu16 = 11 / 15.0;
     const CyclesFresnelFactor factor(r16, eta);
     EXPECT_NEAR(factor.factor(mu16), cycles_fresnel_factor(mu16, r16 * r16, eta), 1e-12);
+}
+
+// The Schlick split adds up to the white albedo; at α = 0 it is 1 − w and w of μ itself.
+TEST(GgxAlbedo, SchlickSplitAddsUpToTheAlbedo) {
+    for (double alpha : {0.05, 0.4})
+        for (double mu : {0.1, 0.6}) {
+            const SchlickSplit s = correlated_ggx_schlick_split(mu, alpha);
+            EXPECT_NEAR(s.scale + s.bias, correlated_ggx_albedo_white(mu, alpha), 1e-13);
+            EXPECT_GT(s.bias, 0);
+        }
+    const SchlickSplit smooth = correlated_ggx_schlick_split(0.3, 0);
+    EXPECT_NEAR(smooth.bias, std::pow(0.7, 5), 1e-15);
+    EXPECT_NEAR(smooth.scale + smooth.bias, 1, 1e-15);
+}
+
+// three.js's texture: at a texel centre the reading is that texel, scale and bias each rounded to
+// half precision (11 significant bits: the rounding moves a value by at most 2⁻¹² of itself);
+// half-way between two centres, their mean; past the last centre, the edge texel.
+TEST(ThreeJsDfg, ReadsItsTexelsAsTheGpuDoes) {
+    const int x = 5, y = 9;
+    const double r = ThreeJsDfgTexture::texel_centre(x), mu = ThreeJsDfgTexture::texel_centre(y);
+    const ThreeJsDfgTexture texture(r);
+    const SchlickSplit s = correlated_ggx_schlick_split(mu, r * r);
+    EXPECT_NEAR(texture.albedo(mu), s.scale + s.bias, (s.scale + s.bias) * std::ldexp(1.0, -11));
+    EXPECT_NE(texture.albedo(mu), s.scale + s.bias);  // rounded
+    const double next = ThreeJsDfgTexture::texel_centre(y + 1);
+    EXPECT_NEAR(texture.albedo((mu + next) / 2), (texture.albedo(mu) + texture.albedo(next)) / 2,
+                1e-15);
+    EXPECT_EQ(texture.albedo(1.0), texture.albedo(ThreeJsDfgTexture::texel_centre(15)));
+    EXPECT_EQ(texture.albedo(0.0), texture.albedo(ThreeJsDfgTexture::texel_centre(0)));
 }
 
 }  // namespace
