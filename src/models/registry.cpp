@@ -138,6 +138,11 @@ const std::vector<ModelEntry>& model_registry() {
          "on the lobe, base x (1 - Fc(n.v)), roughness >= 0.045, compensated metal",
          "bases: lambertian, conductor; eta0 = 1.5; sides: R", threejs_clearcoat_options,
          make_threejs_clearcoat, false, "production"},
+        {"openpbr-materialx",
+         "OpenPBR in MaterialX (its graph, GLSL generator): coat throughput 1 - E(wo) by its "
+         "fitted albedo, constant coat_color, darkening with F0, compensated lobes",
+         "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_materialx_options,
+         make_openpbr_materialx, false, "production"},
     };
     return entries;
 }

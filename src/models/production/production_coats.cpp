@@ -76,6 +76,36 @@ CoatRecipe adobe_recipe(const ModelOptions& o) {
     return r;
 }
 
+// --- OpenPBR in MaterialX (its graph, its GLSL generator) --------------------------------------
+CoatRecipe materialx_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "openpbr-materialx";
+    // libraries/bxdf/open_pbr_surface.mtlx as the GLSL generator evaluates it (pbrlib genglsl,
+    // the analytic directional albedo): the coat a dielectric_bsdf layered over the base by its
+    // throughput 1 - E(mu_o), the constant coat_color, the graph's darkening with
+    // Kcoat = 1 - (1 - F0)/eta^2, the specification's roughening, every lobe compensated for
+    // multiple scattering by the fitted albedo, and a diffuse base under its specular layer at
+    // index 1.
+    r.coat_fresnel = CoatRecipe::Fresnel::Exact;
+    r.attenuation = CoatRecipe::Attenuation::AlbedoView;
+    r.coat_albedo = CoatRecipe::CoatAlbedo::MaterialX;
+    r.coat_energy_compensation = is_on(o, "energy-compensation")
+                                     ? CoatRecipe::CoatEnergyCompensation::MaterialX
+                                     : CoatRecipe::CoatEnergyCompensation::None;
+    r.metal_energy_compensation = is_on(o, "energy-compensation")
+                                      ? CoatRecipe::MetalEnergyCompensation::MaterialX
+                                      : CoatRecipe::MetalEnergyCompensation::None;
+    r.tint = CoatRecipe::Tint::Constant;
+    r.darkening =
+        is_on(o, "darkening") ? CoatRecipe::Darkening::MaterialX : CoatRecipe::Darkening::None;
+    r.roughening =
+        is_on(o, "roughening") ? CoatRecipe::Roughening::OpenPBR : CoatRecipe::Roughening::None;
+    r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    r.diffuse_specular_throughput = true;
+    if (exact_leaves(o)) use_exact_leaves(r);
+    return r;
+}
+
 // --- Autodesk Standard Surface --------------------------------------------------------------
 CoatRecipe standard_surface_recipe(const ModelOptions& o) {
     CoatRecipe r;
@@ -192,7 +222,9 @@ CoatRecipe blender_recipe(const ModelOptions& o) {
     // As Cycles ships it (kernel/svm/closure.h, kernel/closure/bsdf_microfacet.h): every
     // dielectric closure compensated for multiple scattering, the coat's albedo its estimate on
     // Cycles' tables, the metal with the node's default multiscatter GGX.
-    r.coat_energy_compensation = is_on(o, "energy-compensation");
+    r.coat_energy_compensation = is_on(o, "energy-compensation")
+                                     ? CoatRecipe::CoatEnergyCompensation::Cycles
+                                     : CoatRecipe::CoatEnergyCompensation::None;
     r.coat_albedo = CoatRecipe::CoatAlbedo::Cycles;
     r.metal_energy_compensation = is_on(o, "energy-compensation")
                                       ? CoatRecipe::MetalEnergyCompensation::Cycles
@@ -318,6 +350,20 @@ std::vector<OptionSpec> threejs_clearcoat_options() {
 }
 std::unique_ptr<Model> make_threejs_clearcoat(const Stack& stack, const ModelOptions& options) {
     return make_production_coat(stack, threejs_recipe(options));
+}
+
+std::vector<OptionSpec> openpbr_materialx_options() {
+    return {
+        on_off_option("darkening", true,
+                      "the graph's coat darkening (1 - K)/(1 - E_b K), K = 1 - (1 - F0)/eta0^2"),
+        on_off_option("roughening", true, "base roughening r' = min(1, r^4 + 2 r_c^4)^(1/4)"),
+        on_off_option("energy-compensation", true,
+                      "coat and metal lobes x (1 + F_ss (1 - E)/E), E by MaterialX's fit "
+                      "(leaves=exact drops it)"),
+        leaves_option()};
+}
+std::unique_ptr<Model> make_openpbr_materialx(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, materialx_recipe(options));
 }
 
 std::vector<OptionSpec> kulla_conty_options() {
