@@ -41,7 +41,8 @@ TEST(ModelRegistry, ListsTheProductionCoats) {
         }
     EXPECT_EQ(names, (std::vector<std::string>{"openpbr", "openpbr-adobe", "standard-surface",
                                                "enterprise-pbr", "filament", "gltf-clearcoat",
-                                               "blender-principled", "kulla-conty"}));
+                                               "blender-principled", "kulla-conty",
+                                               "threejs-clearcoat", "openpbr-materialx"}));
 }
 
 TEST(ModelRegistry, UnknownNameListsTheKnownOnes) {
