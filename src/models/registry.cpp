@@ -4,6 +4,7 @@
 #include "models/belcour/belcour.h"
 #include "models/ddb22/ddb22.h"
 #include "models/lamina1/lamina1.h"
+#include "models/lamina_coat/lamina_coat.h"
 #include "models/production/production_coats.h"
 #include "models/random_walk/random_walk_model.h"
 #include "models/transfer_matrix/transfer_matrix.h"
@@ -159,6 +160,11 @@ const std::vector<ModelEntry>& model_registry() {
          "fitted albedo, constant coat_color, darkening with F0, compensated lobes",
          "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_materialx_options,
          make_openpbr_materialx, false, "production"},
+        {"lamina-coat",
+         "lamina-coat: OpenPBR's structure and cost (coat lobe, attenuated, darkened, roughened "
+         "base) with terms derived from the layering and fitted on the study's reference",
+         "bases: lambertian, conductor; media: absorbing; eta0 in [1.1, 2.6]; sides: R",
+         lamina_coat_options, make_lamina_coat, false, "lamina"},
     };
     return entries;
 }
