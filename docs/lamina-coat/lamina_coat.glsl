@@ -6,8 +6,8 @@
 // read with texelFetch (value = integer / 65535). The constants are docs/lamina-coat/fit.csv.
 
 const float LC_GRAZING = 0.0;      // k_g
-const float LC_ROUGHENING = 0.17;  // k_r
-const float LC_TINT_PATH = 0.0;    // c_tau
+const float LC_ROUGHENING = 0.125;  // k_r
+const float LC_TINT_PATH = 0.1;    // c_tau
 const float LC_PI = 3.14159265358979;
 
 uniform highp usampler2D lamina_coat_table;

@@ -55,7 +55,7 @@ Node eta_node(double eta) {
 
 LaminaCoatFit lamina_coat_fit() {
     // scripts/lamina_coat_fit.py fit on the study's fitting configurations (docs/lamina-coat.md).
-    return {0.0, 0.17, 0.0};
+    return {0.0, 0.125, 0.1};
 }
 
 double lamina_coat_albedo(double mu, double r, double eta) {

@@ -18,6 +18,15 @@ csv = np.loadtxt(sys.argv[2], delimiter=',', comments='#')
 sys.exit(0 if png.shape == csv.shape and (png == csv).all() else 1)
 " "$src/docs/lamina-coat/tables.png" "$src/docs/lamina-coat/tables.csv"; then ok; else fail "tables.png != tables.csv"; fi
 
+# The GLSL's constants are the fit's (docs/lamina-coat/fit.csv); the C++ agrees with the GLSL below.
+for pair in "k_g LC_GRAZING" "c_tau LC_TINT_PATH" "k_r LC_ROUGHENING"; do
+    set -- $pair
+    fitted=$(awk -F, -v k="$1" '$1 == k { print $2 + 0 }' "$src/docs/lamina-coat/fit.csv")
+    shader=$(awk -v k="$2" '$1 == "const" && $3 == k { sub(";", "", $5); print $5 + 0 }' \
+        "$src/docs/lamina-coat/lamina_coat.glsl")
+    if [ -n "$fitted" ] && [ "$fitted" = "$shader" ]; then ok; else fail "$1: fit.csv $fitted, GLSL $shader"; fi
+done
+
 # Stacks: plastics (clear, tinted, rough), metals under smooth and rough coats, another index.
 stacks=(
   '{"layers":[{"interface":{"type":"dielectric","eta":1.5,"alpha":0.1},"medium":{"tau_a":[0.1,0,0.9]}},{"interface":{"type":"lambertian","albedo":[0.8,0.5,0.2]}}]}'
