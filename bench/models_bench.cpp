@@ -3,6 +3,7 @@
 // all OpenMP threads).
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "models/lamina_coat/lamina_coat.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "models/tables/coat_transmittance.h"
@@ -12,6 +13,7 @@
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <vector>
 
 namespace {
@@ -197,6 +199,32 @@ void BM_Ddb22Construct(benchmark::State& state) {
 }
 BENCHMARK(BM_Ddb22Construct)->Unit(benchmark::kMicrosecond);
 
+/// lamina-coat's function itself (lamina_coat_eval, what docs/lamina-coat.md and its GLSL give an
+/// engine), without the Model interface: the cost per evaluation to set beside the production
+/// coats' (the summary's "For engine developers").
+void BM_LaminaCoatFunction(benchmark::State& state, bool conductor) {
+    LaminaCoatMaterial m;
+    m.eta = 1.5;
+    m.alpha_coat = 0.1;
+    m.tau = Rgbd(0.05, 0.1, 0.2);
+    m.conductor = conductor;
+    m.albedo = Rgbd(0.8);
+    m.base_eta = Rgbd(0.18, 0.42, 1.37) / 1.5;
+    m.base_k = Rgbd(3.4, 2.35, 1.85) / 1.5;
+    m.alpha_base = 0.2;
+    const LaminaCoatPrepared p = lamina_coat_prepare(m);
+    static const Pairs pairs;
+    std::size_t n = 0;
+    for (auto _ : state) {
+        const std::size_t i = n++ & 4095;
+        benchmark::DoNotOptimize(lamina_coat_eval(p, pairs.wi[i], pairs.wo[i]));
+    }
+    state.SetItemsProcessed(state.iterations());
+    state.SetLabel(conductor ? "coated gold" : "plastic");
+}
+BENCHMARK_CAPTURE(BM_LaminaCoatFunction, coated_gold, true);
+BENCHMARK_CAPTURE(BM_LaminaCoatFunction, plastic, false);
+
 const int registered = [] {
     for (const auto& e : model_registry()) {
         if (e.stochastic) continue;  // binning 8100 noisy queries is not a model benchmark
@@ -244,6 +272,25 @@ const int registered = [] {
                                      BM_StackBinnedTable, std::string(name), plastic_stack())
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
+    }
+    // The coats engines ship, as shipped and with lamina's exact leaves, beside lamina-coat, on the
+    // plastic and the coated gold (BM_ModelEval: one eval per pair through the Model interface).
+    for (const auto& e : model_registry()) {
+        if (e.group != "production" && e.name != "lamina-coat") continue;
+        for (const bool exact : {false, true}) {
+            const auto options = e.options();
+            if (exact && std::none_of(options.begin(), options.end(),
+                                      [](const OptionSpec& o) { return o.key == "leaves"; }))
+                continue;
+            const std::string spec = exact ? e.name + ":leaves=exact" : e.name;
+            for (const auto& [stack_name, stack] :
+                 {std::pair{std::string("plastic"), plastic_stack()},
+                  std::pair{std::string("coated-gold"), typical_stack(false)}}) {
+                if (!make_model(spec, stack)->support().brdf) continue;
+                benchmark::RegisterBenchmark(("BM_CoatEval/" + spec + "/" + stack_name).c_str(),
+                                             BM_ModelEval, spec, stack);
+            }
+        }
     }
     for (const char* name : {"lamina-1", "bel-prime", "tm2"})
         benchmark::RegisterBenchmark(

@@ -4,6 +4,7 @@
 #include "models/belcour/belcour.h"
 #include "models/ddb22/ddb22.h"
 #include "models/lamina1/lamina1.h"
+#include "models/lamina_coat/lamina_coat.h"
 #include "models/production/production_coats.h"
 #include "models/random_walk/random_walk_model.h"
 #include "models/transfer_matrix/transfer_matrix.h"
@@ -128,15 +129,16 @@ const std::vector<ModelEntry>& model_registry() {
          "bases: lambertian, conductor; eta0 = 1.5; sides: R", gltf_clearcoat_options,
          make_gltf_clearcoat, false, "production"},
         {"blender-principled",
-         "Blender 4.x Principled coat: base x (1 - E_coat(wo)) x tint^(1/mu_t,o), view side only",
+         "Blender Cycles Principled coat: compensated coat lobe, base x (1 - Cycles' estimate of "
+         "its albedo at wo) x tint^(1/mu_t,o), compensated F82-tint metal",
          "bases: lambertian, conductor; media: absorbing; sides: R", blender_principled_options,
          make_blender_principled, false, "production"},
         {"kulla-conty",
          "Kulla & Conty 2017 layering: base x (1 - E(mu_i))(1 - E(mu_o))/(1 - E_avg), reciprocal",
          "bases: lambertian, conductor; media: absorbing; sides: R", kulla_conty_options,
          make_kulla_conty, false, "production"},
-        // Last (tm6, then ddb22): the registry-wide fuzz draws each model's options in this order,
-        // so a model added at the end leaves the draws of the others as they were.
+        // The registry-wide fuzz draws each model's options in this order, so models are added at
+        // the end: the draws of those before them stay as they were.
         variant("tm6",
                 "Randrianandrasana et al. 2021 transfer matrices with HG media (plugin tm6): "
                 "primary, forward- and back-scattered lobes, exact top, lobes normalized by their "
@@ -148,6 +150,21 @@ const std::vector<ModelEntry>& model_registry() {
                 "lobe with the energy and projected variance of the light the Lambertian returns",
                 "bases: lambertian (under 1-8 coats); media: absorbing; sides: R", kDdb22,
                 "successors"),
+        {"threejs-clearcoat",
+         "three.js MeshPhysicalMaterial clearcoat: Schlick 0.04 (spherical-Gaussian fit) at v.h "
+         "on the lobe, base x (1 - Fc(n.v)), roughness >= 0.045, compensated metal",
+         "bases: lambertian, conductor; eta0 = 1.5; sides: R", threejs_clearcoat_options,
+         make_threejs_clearcoat, false, "production"},
+        {"openpbr-materialx",
+         "OpenPBR in MaterialX (its graph, GLSL generator): coat throughput 1 - E(wo) by its "
+         "fitted albedo, constant coat_color, darkening with F0, compensated lobes",
+         "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_materialx_options,
+         make_openpbr_materialx, false, "production"},
+        {"lamina-coat",
+         "lamina-coat: OpenPBR's structure and cost (coat lobe, attenuated, darkened, roughened "
+         "base) with terms derived from the layering and fitted on the study's reference",
+         "bases: lambertian, conductor; media: absorbing; eta0 in [1.1, 2.6]; sides: R",
+         lamina_coat_options, make_lamina_coat, false, "lamina"},
     };
     return entries;
 }

@@ -152,10 +152,62 @@ EngineFindings compute_engine_findings(const std::vector<MetricRow>& rows,
             f.ablations.push_back(a);
         }
     }
+
+    // Each coat against its exact leaves and lamina-coat, on the rows lamina-coat also covers.
+    if (by_model.count("lamina-coat")) {
+        const auto& replacement = by_model["lamina-coat"];
+        for (const std::string& m : production) {
+            if (!by_model.count(m)) continue;
+            const auto exact = by_model.find(m + ":leaves=exact");
+            std::map<std::string, EngineFindings::Replacement> per_category;
+            for (const auto& [key, row] : by_model[m]) {
+                const auto lc = replacement.find(key);
+                if (lc == replacement.end() || !std::isfinite(row->metrics.misplaced_floor) ||
+                    !std::isfinite(lc->second->metrics.misplaced_floor))
+                    continue;
+                EngineFindings::Replacement& r = per_category[row->category];
+                r.rows++;
+                r.shipped += row->metrics.misplaced_floor;
+                r.lamina_coat += lc->second->metrics.misplaced_floor;
+                double e = NAN;
+                if (exact != by_model.end()) {
+                    const auto x = exact->second.find(key);
+                    if (x != exact->second.end()) e = x->second->metrics.misplaced_floor;
+                }
+                r.exact_leaves += e;  // NaN as soon as one row lacks it
+            }
+            for (const std::string& c : f.categories) {
+                auto it = per_category.find(c);
+                if (it == per_category.end()) continue;
+                EngineFindings::Replacement r = it->second;
+                r.model = m;
+                r.category = c;
+                r.shipped /= r.rows;
+                r.exact_leaves /= r.rows;
+                r.lamina_coat /= r.rows;
+                f.replacements.push_back(r);
+            }
+        }
+    }
     return f;
 }
 
 namespace {
+
+/// One sentence of advice for an engine shipping `r.model`, from the three errors.
+std::string replacement_advice(const EngineFindings::Replacement& r) {
+    const double best_of_coat =
+        std::isfinite(r.exact_leaves) ? std::min(r.shipped, r.exact_leaves) : r.shipped;
+    if (r.lamina_coat < 0.5 * r.shipped)
+        return fmt::format("replace it: lamina-coat misplaces {:.0f}% of what it does",
+                           100 * r.lamina_coat / r.shipped);
+    if (r.lamina_coat < best_of_coat)
+        return fmt::format("lamina-coat is better by {:.1f} points",
+                           100 * (best_of_coat - r.lamina_coat));
+    if (std::isfinite(r.exact_leaves) && r.exact_leaves < r.shipped - 0.001)
+        return "keep its layering and take exact leaves";
+    return "keep it here";
+}
 
 /// "too dark at every incidence (−3.1% at 0° to −9.0% at 80°)", "too bright at grazing incidence
 /// (+12% at 80°), too dark at normal incidence (−2% at 0°)", "within ±1% at every incidence".
@@ -260,6 +312,21 @@ std::string engine_findings_markdown(const EngineFindings& f) {
                 pct(a.shipped_albedo), pct(a.switched), pct(a.switched_albedo), switch_effect(a));
         }
         out("\n");
+        bool header = false;
+        for (const auto& r : f.replacements) {
+            if (r.category != c) continue;
+            if (!header) {
+                out("What an engine could ship instead (mean misplaced energy, 5% floor, on the "
+                    "rows lamina-coat covers; the cost per evaluation of each is `make bench`, "
+                    "BM_CoatEval, in docs/lamina-coat.md):\n\n"
+                    "| coat | as shipped | `leaves=exact` | lamina-coat | advice |\n"
+                    "|---|---|---|---|---|\n");
+                header = true;
+            }
+            out("| {} | {} | {} | {} | {} |\n", r.model, pct(r.shipped), pct(r.exact_leaves),
+                pct(r.lamina_coat), replacement_advice(r));
+        }
+        if (header) out("\n");
     }
     return md;
 }
@@ -294,6 +361,14 @@ nlohmann::json engine_findings_json(const EngineFindings& f) {
                      {"switched_misplaced_floor", num(a.switched)},
                      {"shipped_mean_abs_albedo_error", num(a.shipped_albedo)},
                      {"switched_mean_abs_albedo_error", num(a.switched_albedo)}});
+        for (const auto& r : f.replacements)
+            if (r.category == c)
+                jc["replacements"].push_back({{"model", r.model},
+                                              {"rows", r.rows},
+                                              {"shipped_misplaced_floor", num(r.shipped)},
+                                              {"exact_leaves_misplaced_floor", num(r.exact_leaves)},
+                                              {"lamina_coat_misplaced_floor", num(r.lamina_coat)},
+                                              {"advice", replacement_advice(r)}});
         j["categories"][c] = jc;
     }
     return j;

@@ -34,8 +34,17 @@ struct EngineFindings {
         double shipped = 0, switched = 0;                ///< mean misplaced_floor of each
         double shipped_albedo = 0, switched_albedo = 0;  ///< mean |albedo error| of each
     };
+    /// A production coat against what could replace it, on the rows all three cover: as shipped,
+    /// with lamina's exact leaves (its `leaves=exact` variant, NaN where it was not run) and
+    /// lamina-coat (docs/lamina-coat.md).
+    struct Replacement {
+        std::string model, category;
+        int rows = 0;
+        double shipped = 0, exact_leaves = 0, lamina_coat = 0;  ///< mean misplaced_floor
+    };
     std::vector<double> theta_i;
     std::vector<std::string> categories;
+    std::vector<Replacement> replacements;  ///< when lamina-coat ran
     std::vector<Cell> cells;  ///< categories × production models, in the study's model order
     std::vector<Ablation> ablations;
     /// Per category: the production coat with the lowest mean misplaced_floor, and the model of

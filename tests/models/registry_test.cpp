@@ -28,7 +28,7 @@ TEST(ModelRegistry, ListsTheSixModelsOfTheStudyAndTheRandomWalk) {
               (std::vector<std::string>{"ww09", "ele10", "ww-prime", "bel18-forward",
                                         "bel18-symmetric", "bel-prime"}));
     EXPECT_EQ(by_group["successors"], (std::vector<std::string>{"tm2", "tm6", "ddb22"}));
-    EXPECT_EQ(by_group["lamina"], (std::vector<std::string>{"lamina-1"}));
+    EXPECT_EQ(by_group["lamina"], (std::vector<std::string>{"lamina-1", "lamina-coat"}));
     EXPECT_EQ(by_group["reference"], (std::vector<std::string>{"random-walk"}));
 }
 
@@ -41,7 +41,8 @@ TEST(ModelRegistry, ListsTheProductionCoats) {
         }
     EXPECT_EQ(names, (std::vector<std::string>{"openpbr", "openpbr-adobe", "standard-surface",
                                                "enterprise-pbr", "filament", "gltf-clearcoat",
-                                               "blender-principled", "kulla-conty"}));
+                                               "blender-principled", "kulla-conty",
+                                               "threejs-clearcoat", "openpbr-materialx"}));
 }
 
 TEST(ModelRegistry, UnknownNameListsTheKnownOnes) {

@@ -139,3 +139,38 @@ TEST(EngineFindings, EmptyWithoutProductionCoats) {
 
 }  // namespace
 }  // namespace lamina
+
+namespace lamina {
+namespace {
+
+TEST(EngineFindings, SetsEachCoatBesideItsExactLeavesAndLaminaCoat) {
+    std::vector<MetricRow> rs;
+    for (double t : {0.0, 60.0})
+        for (int c = 0; c < 3; ++c) {
+            rs.push_back(row("p1", "plastic", "openpbr", t, c, true, t == 0 ? 0.1 : 0.3, 0));
+            rs.push_back(row("p1", "plastic", "openpbr:leaves=exact", t, c, true, 0.15, 0));
+            rs.push_back(row("p1", "plastic", "lamina-coat", t, c, true, 0.05, 0));
+            rs.push_back(row("p1", "plastic", "filament", t, c, true, 0.06, 0));
+        }
+    const EngineFindings f =
+        compute_engine_findings(rs, {"openpbr", "filament", "openpbr:leaves=exact", "lamina-coat"});
+    ASSERT_EQ(f.replacements.size(), 2u);
+    const auto& openpbr = f.replacements[0];
+    EXPECT_EQ(openpbr.model, "openpbr");
+    EXPECT_EQ(openpbr.rows, 6);
+    EXPECT_NEAR(openpbr.shipped, 0.2, 1e-12);
+    EXPECT_NEAR(openpbr.exact_leaves, 0.15, 1e-12);
+    EXPECT_NEAR(openpbr.lamina_coat, 0.05, 1e-12);
+    EXPECT_TRUE(std::isnan(f.replacements[1].exact_leaves));  // filament:leaves=exact not run
+    const std::string md = engine_findings_markdown(f);
+    EXPECT_NE(md.find("| openpbr | 20.0% | 15.0% | 5.0% | replace it: lamina-coat misplaces 25% "
+                      "of what it does |"),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("| filament | 6.0% | – | 5.0% | lamina-coat is better by 1.0 points |"),
+              std::string::npos)
+        << md;
+}
+
+}  // namespace
+}  // namespace lamina

@@ -2,7 +2,9 @@
 
 #include "core/math.h"
 #include "models/numerics/quadrature.h"
+#include "models/production/cycles_albedo.h"
 #include "models/production/filament_dfg.h"
+#include "models/production/threejs_dfg.h"
 #include "models/production/uncorrelated_albedo.h"
 #include "models/tables/fgd_table.h"
 #include "physics/fresnel.h"
@@ -28,6 +30,12 @@ double schlick_weight(double c) {
 
 double schlick(double c, double f0) {
     return f0 + (1 - f0) * schlick_weight(c);
+}
+
+/// Karis 2013 ("Real shading in Unreal Engine 4", SIGGRAPH course notes)'s spherical-Gaussian fit
+/// of Schlick's weight, 2^((−5.55473 c − 6.98316) c), as three.js's F_Schlick evaluates it.
+double schlick_weight_spherical_gaussian(double c) {
+    return std::exp2((-5.55473 * c - 6.98316) * c);
 }
 
 constexpr double kF82Cos = 1.0 / 7.0;  // μ̄ of the F82-tint model (OpenPBR 1.1, "Metal")
@@ -58,6 +66,12 @@ class ProductionCoat final : public Model {
                 r_.name);
             return;
         }
+        if (r_.coat_ior_at_least_one && coat_.eta0 < 1) {
+            support_.reason = fmt::format(
+                "{} clamps its coat IOR to at least 1; this coat's relative index is {}", r_.name,
+                coat_.eta0);
+            return;
+        }
         if (r_.coat_ior_fixed && std::abs(coat_.eta0 - 1.5) > 1e-9) {
             support_.reason = fmt::format(
                 "{}'s coat has a fixed IOR of 1.5 (F0 = 0.04); this coat's relative index is {}",
@@ -81,10 +95,22 @@ class ProductionCoat final : public Model {
         if (r_.coat_min_roughness > 0) r_coat = std::max(r_coat, r_.coat_min_roughness);
         alpha_coat_ = sqr(lobe_roughness(r_coat));
         eta_index_ = FgdTable::locate(eta0_, 0);
+        coat_f0_ior_ = sqr((eta0_ - 1) / (eta0_ + 1));
         // openpbr-bsdf reads its table at the coat's α before its lobe's clamp; at α = 0 it takes
         // the exact Fresnel factor.
         if (r_.coat_albedo == CoatRecipe::CoatAlbedo::OpenPbrBsdf && r_coat > 0)
             coat_grid_ = OpenPbrBsdfEnergyGrid::dielectric(eta0_, sqr(r_coat));
+        using CEC = CoatRecipe::CoatEnergyCompensation;
+        if (r_.coat_energy_compensation == CEC::Cycles ||
+            r_.coat_albedo == CoatRecipe::CoatAlbedo::Cycles) {
+            // Cycles reads its tables at the coat's r, a smooth coat included (its first node).
+            coat_white_.emplace(r_coat);
+            // Cycles' fresnel_dielectric_Fss: Kulla & Conty's fit, 0 at η0 = 1.
+            const double f_ss = eta0_ > 1 ? kulla_conty_average_fresnel_fit(eta0_) : 0.0;
+            coat_fms_ = multiple_scattering_fresnel(f_ss, coat_white_->average());
+            if (r_.coat_albedo == CoatRecipe::CoatAlbedo::Cycles && eta0_ > 1)
+                coat_factor_.emplace(r_coat, eta0_);
+        }
 
         // The base.
         is_metal_ = coat_.base_type == InterfaceType::Conductor;
@@ -121,7 +147,15 @@ class ProductionCoat final : public Model {
             const QuadratureRule q = gauss_legendre(16);
             for (std::size_t i = 0; i < q.x.size(); ++i)
                 metal_average_ += metal_fresnel(q.x[i]) * (2 * q.w[i] * q.x[i]);
-            if (r_.metal_energy_compensation) dfg_.emplace(r_lobe);
+            using MEC = CoatRecipe::MetalEnergyCompensation;
+            if (r_.metal_energy_compensation == MEC::Filament) dfg_.emplace(r_lobe);
+            if (r_.metal_energy_compensation == MEC::ThreeJs) threejs_dfg_.emplace(r_lobe);
+            if (r_.metal_energy_compensation == MEC::Cycles) {
+                metal_white_.emplace(r_lobe);
+                for (int c = 0; c < 3; ++c)
+                    metal_fms_[c] = multiple_scattering_fresnel(
+                        f82_tint_average_fresnel(f0_[c], tint82_[c]), metal_white_->average());
+            }
             using MS = CoatRecipe::MetalMultipleScattering;
             if (r_.metal_multiple_scattering == MS::OpenPbrBsdf &&
                 r_prime >= kMetalMultipleScatteringMinRoughness) {
@@ -141,6 +175,10 @@ class ProductionCoat final : public Model {
         } else {
             albedo_ = r_.affect_color ? coat_.albedo * coat_.albedo : coat_.albedo;
         }
+        // MaterialX's base specular (weight 0 over a diffuse base) at OpenPBR's default
+        // roughness, roughened by the coat.
+        if (r_.diffuse_specular_throughput)
+            specular_alpha_ = sqr(roughened(kOpenPbrDefaultSpecularRoughness));
         tau_ = coat_.tau_a;
         has_tau_ = tau_.max() > 0;
         if (r_.attenuation == CoatRecipe::Attenuation::KullaConty) {
@@ -200,6 +238,7 @@ class ProductionCoat final : public Model {
                 const double G = masking_shadowing(r_.coat_visibility, in.lambda_coat, ggx, wo);
                 f_coat = F * ndf(ggx, h) * G / (4 * wi.z * wo.z);
             }
+            f_coat *= coat_compensation(wo.z);
         }
         Rgbd base(0.0);
         if (is_metal_) {
@@ -213,6 +252,23 @@ class ProductionCoat final : public Model {
                 for (int c = 0; c < 3; ++c)
                     base[c] *= 1 + f0_[c] * (inv_e - 1);
             }
+            if (threejs_dfg_) {
+                // three.js's multiScatteringCompensation, 1 + F0 (1/E(μo) − 1), on the lobe.
+                const double inv_e = 1 / threejs_dfg_->albedo(wo.z);
+                for (int c = 0; c < 3; ++c)
+                    base[c] *= 1 + f0_[c] * (inv_e - 1);
+            }
+            if (r_.metal_energy_compensation == CoatRecipe::MetalEnergyCompensation::MaterialX) {
+                const double alpha = materialx_alpha(alpha_base_);
+                for (int c = 0; c < 3; ++c)
+                    base[c] *= materialx_compensation(f0_[c], wo.z, alpha);
+            }
+            if (metal_white_) {
+                // Cycles' microfacet_ggx_preserve_energy: 1 + F_ms (1 − E(μo))/E(μo).
+                const double missing = 1 / metal_white_->albedo(wo.z) - 1;
+                for (int c = 0; c < 3; ++c)
+                    base[c] *= 1 + metal_fms_[c] * missing;
+            }
             if (has_ms()) {
                 double shape = in.ms_complement_i * ms_complement(wo.z) * ms_norm_;
                 // openpbr-bsdf clamps its lobe to 1/μi (openpbr_microfacet_multiple_scattering_
@@ -222,6 +278,12 @@ class ProductionCoat final : public Model {
             }
         } else {
             base = albedo_ * kInvPi<double>;
+            if (r_.diffuse_specular_throughput) {
+                // MaterialX's dielectric_bsdf at index 1 (F0 = 0): throughput 1 − B · comp.
+                const double alpha = materialx_alpha(specular_alpha_);
+                base *= 1 - materialx_ggx_albedo_fit(wo.z, alpha).bias *
+                                materialx_compensation(0.0, wo.z, alpha);
+            }
         }
         return Rgbd(f_coat) + base * base_scale(in, wo.z, cos_h);
     }
@@ -234,7 +296,8 @@ class ProductionCoat final : public Model {
         const Vec3d wr = mirror_direction(wi);
         // At the mirror pair h = n: wi·h = μi = μo, and the smooth limit of either visibility
         // term leaves the lobe's energy equal to its Fresnel factor.
-        if (alpha_coat_ == 0) lobes.push_back({wr, Rgbd(coat_fresnel(wi.z))});
+        if (alpha_coat_ == 0)
+            lobes.push_back({wr, Rgbd(coat_fresnel(wi.z) * coat_compensation(wi.z))});
         if (is_metal_ && alpha_base_ == 0) {
             const Incident in = incident(wi);
             lobes.push_back({wr, metal_fresnel(wi.z) * base_scale(in, wi.z, wi.z)});
@@ -303,9 +366,70 @@ class ProductionCoat final : public Model {
     /// by an albedo all use the exact Fresnel).
     double coat_albedo(double mu) const {
         if (coat_grid_) return 1 - coat_grid_->complement(mu);
+        if (r_.coat_albedo == CoatRecipe::CoatAlbedo::MaterialX) {
+            // mx_dielectric_bsdf: (F0 A + B) × its compensation, at α ≥ 1e-8.
+            const double alpha = materialx_alpha(alpha_coat_);
+            const SchlickSplit fit = materialx_ggx_albedo_fit(mu, alpha);
+            return (coat_f0_ior_ * fit.scale + fit.bias) *
+                   materialx_compensation(coat_f0_ior_, mu, alpha);
+        }
+        if (r_.coat_albedo == CoatRecipe::CoatAlbedo::Cycles) {
+            // bsdf_microfacet_estimate_albedo times the compensated lobe's weight
+            // E + F_ms (1 − E) (microfacet_ggx_preserve_energy); η0 ≤ 1: the Fresnel factor.
+            const double E = coat_white_->albedo(mu);
+            const double weight =
+                r_.coat_energy_compensation == CoatRecipe::CoatEnergyCompensation::Cycles
+                    ? E + coat_fms_ * (1 - E)
+                    : 1.0;
+            if (!coat_factor_) return weight * fresnel_dielectric(clamp(mu, 0.0, 1.0), eta0_);
+            return weight * (coat_f0_ior_ + (1 - coat_f0_ior_) * coat_factor_->factor(mu));
+        }
         if (r_.coat_albedo == CoatRecipe::CoatAlbedo::OpenPbrBsdf && r_coat_ == 0)
             return fresnel_dielectric(mu, eta0_);
         return FgdTable::get()(mu, alpha_coat_, eta_index_);
+    }
+
+    /// Cycles' compensation of the coat lobe for multiple scattering at μo (1 without it).
+    /// A smooth coat loses nothing: Cycles' table holds E = 1 at its first roughness node to the
+    /// six digits it prints, so the delta lobe is left as it is.
+    double coat_compensation(double mu_o) const {
+        using CEC = CoatRecipe::CoatEnergyCompensation;
+        switch (r_.coat_energy_compensation) {
+            case CEC::None:
+                return 1;
+            case CEC::Cycles:
+                if (alpha_coat_ == 0) return 1;
+                return 1 + coat_fms_ * (1 / coat_white_->albedo(mu_o) - 1);
+            case CEC::MaterialX:
+                return materialx_compensation(coat_f0_ior_, mu_o, materialx_alpha(alpha_coat_));
+        }
+        return 1;
+    }
+
+    /// MaterialX's α of a lobe: clamped to [1e-8, 1] (mx_dielectric_bsdf's safeAlpha).
+    static double materialx_alpha(double alpha) { return clamp(alpha, 1e-8, 1.0); }
+
+    /// MaterialX's compensation of a lobe of normal reflectance f0 for multiple scattering,
+    /// 1 + F_ss (1 − E)/E with F_ss = f0 + (1 − f0)/21 and E = A + B of its fit at (μ, α)
+    /// (mx_ggx_energy_compensation; Turquin 2019, Eqs. 14 and 16).
+    static double materialx_compensation(double f0, double mu, double alpha) {
+        const SchlickSplit fit = materialx_ggx_albedo_fit(mu, alpha);
+        const double E = fit.scale + fit.bias;
+        return 1 + (f0 + (1 - f0) / 21) * (1 - E) / E;
+    }
+
+    /// Kulla & Conty 2017 (slide 18)'s colour of the multiply scattered energy with one Fresnel
+    /// bounce taken out, F_ms = F_ss E_avg/(1 − F_ss (1 − E_avg)), as Cycles scales its lobes
+    /// (microfacet_ggx_preserve_energy).
+    static double multiple_scattering_fresnel(double f_ss, double e_avg) {
+        return f_ss * e_avg / (1 - f_ss * (1 - e_avg));
+    }
+
+    /// The F82-tint Fresnel's average 2 ∫ F μ dμ in closed form, F0 + (1 − F0)/21 − b/126 with b
+    /// its edge term (Cycles' fresnel_f82_Fss).
+    static double f82_tint_average_fresnel(double f0, double tint) {
+        const double b = schlick(kF82Cos, f0) * (1 - tint) / (kF82Cos * std::pow(1 - kF82Cos, 6));
+        return f0 + (1 - f0) / 21 - b / 126;
     }
 
     /// The masking-shadowing of a lobe: height-correlated or uncorrelated Smith, Λ(wi) given.
@@ -362,7 +486,13 @@ class ProductionCoat final : public Model {
 
     double coat_fresnel(double c) const {
         if (r_.coat_fresnel == CoatRecipe::Fresnel::Exact) return fresnel_dielectric(c, eta0_);
-        return schlick(c, coat_f0_);
+        return coat_f0_ + (1 - coat_f0_) * model_schlick_weight(c);
+    }
+
+    /// Schlick's weight in the model's form: (1 − c)⁵ or its spherical-Gaussian fit.
+    double model_schlick_weight(double c) const {
+        return r_.schlick_spherical_gaussian ? schlick_weight_spherical_gaussian(clamp(c, 0.0, 1.0))
+                                             : schlick_weight(c);
     }
 
     /// μt = √(1 − (1 − μ²)/η0²) (OpenPBR 1.1, "View-dependent absorption").
@@ -378,7 +508,7 @@ class ProductionCoat final : public Model {
                 case CoatRecipe::MetalFresnel::Schlick:
                 case CoatRecipe::MetalFresnel::SchlickFilament:
                     // Schlick 1994, Eq. 15, with the edge value f90 (Filament's F_Schlick).
-                    F[i] = f0_[i] + (f90_ - f0_[i]) * schlick_weight(c);
+                    F[i] = f0_[i] + (f90_ - f0_[i]) * model_schlick_weight(c);
                     break;
                 case CoatRecipe::MetalFresnel::F82Tint:
                     F[i] = f82_tint_fresnel(c, f0_[i], tint82_[i]);
@@ -394,7 +524,7 @@ class ProductionCoat final : public Model {
         double a = 1;
         switch (r_.attenuation) {
             case A::AlbedoView:
-                a = 1 - coat_albedo(mu_o);
+                a = clamp(1 - coat_albedo(mu_o), 0.0, 1.0);
                 break;
             case A::AlbedoReciprocal:
                 a = (1 - in.E_i) * (1 - coat_albedo(mu_o));
@@ -441,6 +571,15 @@ class ProductionCoat final : public Model {
     void setup_darkening() {
         using D = CoatRecipe::Darkening;
         if (r_.darkening == D::None) return;
+        if (r_.darkening == D::MaterialX) {
+            // open_pbr_surface.mtlx: Kcoat = 1 − (1 − F0)/η0², E_base = the base colour (a
+            // metal's F0, a diffuse base's ρ).
+            const double K = 1 - (1 - coat_f0_ior_) / (eta0_ * eta0_);
+            E_b_ = is_metal_ ? f0_ : albedo_;
+            for (int c = 0; c < 3; ++c)
+                darkening_[c] = coat_darkening(K, E_b_[c]);
+            return;
+        }
         // OpenPBR 1.1, "Darkening": Δ = (1 − K)/(1 − E_b K), K_r = 1 − (1 − E_F(η_c))/η_c².
         const double E_F = r_.darkening == D::Spec ? openpbr_average_fresnel_fit(eta0_)
                                                    : kulla_conty_average_fresnel_fit(eta0_);
@@ -495,8 +634,16 @@ class ProductionCoat final : public Model {
     FgdTable::Index eta_index_;
     bool is_metal_ = false;
     Rgbd f0_{0.0}, tint82_{1.0};
-    double f90_ = 1;                         ///< the metal's Schlick edge value
-    std::optional<FilamentDfgTexture> dfg_;  ///< Filament's energy compensation
+    double f90_ = 1;                                ///< the metal's Schlick edge value
+    std::optional<FilamentDfgTexture> dfg_;         ///< Filament's energy compensation
+    std::optional<ThreeJsDfgTexture> threejs_dfg_;  ///< three.js's energy compensation
+    // Cycles' tables: the coat's white albedo and Fresnel factor, the metal's white albedo, and
+    // their F_ms (the metal's per channel).
+    std::optional<CyclesWhiteAlbedo> coat_white_, metal_white_;
+    std::optional<CyclesFresnelFactor> coat_factor_;
+    double coat_fms_ = 0, coat_f0_ior_ = 0;
+    double specular_alpha_ = 0;  ///< MaterialX's base specular over a diffuse base
+    Rgbd metal_fms_{0.0};
     Rgbd albedo_{0.0};
     Rgbd tau_{0.0};
     bool has_tau_ = false;
@@ -542,6 +689,24 @@ double kulla_conty_average_fresnel_fit(double eta) {
     return 0.997118 + 0.1014 * eta - 0.965241 * eta * eta - 0.130607 * eta * eta * eta;
 }
 
+SchlickSplit materialx_ggx_albedo_fit(double mu, double alpha) {
+    // mx_ggx_dir_albedo_analytic: r = c0 + c1 x + c2 y + c3 x y + c4 x² + c5 y² + c6 x² y +
+    // c7 x y² + c8 x² y², x = μ, y = α, four components; A = r.x/r.z, B = r.y/r.w.
+    static constexpr double c[9][4] = {
+        {0.1003, 0.9345, 1.0, 1.0},     {-0.6303, -2.323, -1.765, 0.2281},
+        {9.748, 2.229, 8.263, 15.94},   {-2.038, -3.748, 11.53, -55.83},
+        {29.34, 1.424, 28.96, 13.08},   {-8.245, -0.7684, -7.507, 41.26},
+        {-26.44, 1.436, -36.11, 54.9},  {19.99, 0.2913, 15.86, 300.2},
+        {-5.448, 0.6286, 33.37, -285.1}};
+    const double x = clamp(mu, 1e-8, 1.0), y = alpha, x2 = x * x, y2 = y * y;
+    const double terms[9] = {1, x, y, x * y, x2, y2, x2 * y, x * y2, x2 * y2};
+    double r[4] = {0, 0, 0, 0};
+    for (int k = 0; k < 9; ++k)
+        for (int i = 0; i < 4; ++i)
+            r[i] += c[k][i] * terms[k];
+    return {clamp(r[0] / r[2], 0.0, 1.0), clamp(r[1] / r[3], 0.0, 1.0)};
+}
+
 double filament_f0_clear_coat_to_surface(double f0) {
     // Filament documentation, "Clear coat" (f0ClearCoatToSurface): a fit of the F0 of an
     // interface against IOR 1.5 from its F0 against air.
@@ -572,7 +737,10 @@ void use_exact_leaves(CoatRecipe& r) {
     r.lobe_min_roughness = 0;
     r.metal_min_roughness = 0;
     r.max_ndf = 0;
-    r.metal_energy_compensation = false;
+    r.metal_energy_compensation = CoatRecipe::MetalEnergyCompensation::None;
+    r.coat_energy_compensation = CoatRecipe::CoatEnergyCompensation::None;
+    r.diffuse_specular_throughput = false;
+    r.schlick_spherical_gaussian = false;
     r.metal_f90_from_f0 = false;
     r.coat_albedo = CoatRecipe::CoatAlbedo::Fgd;
     r.metal_multiple_scattering = CoatRecipe::MetalMultipleScattering::None;

@@ -1,9 +1,10 @@
 #pragma once
 // The coats that engines ship (docs/models.md, "Production coats"): OpenPBR Surface 1.1, Adobe's
 // openpbr-bsdf, Autodesk Standard Surface, Dassault Enterprise PBR 2025x, Google Filament,
-// glTF KHR_materials_clearcoat, Blender 4.x Principled and Kulla & Conty 2017. Each is a sum of a
-// coat lobe and the base's own lobe evaluated at the *outside* directions, the base scaled by a
-// layering factor — none of them refracts, nor follows light between the interfaces:
+// glTF KHR_materials_clearcoat and three.js's MeshPhysicalMaterial, Blender Cycles Principled and
+// Kulla & Conty 2017. Each is a sum of a coat lobe and the base's own lobe evaluated at the
+// *outside* directions, the base scaled by a layering factor — none of them refracts, nor follows
+// light between the interfaces:
 //
 //     f(wi, wo) = f_coat(wi, wo) + A(wi, wo) · T(wi, wo) · Δ(wo) · f_base'(wi, wo)
 //
@@ -34,6 +35,7 @@
 // coat has a fixed IOR (Enterprise PBR, Filament, glTF).
 
 #include "models/model.h"
+#include "models/production/ggx_albedo.h"
 
 #include <string>
 #include <vector>
@@ -49,6 +51,11 @@ struct CoatRecipe {
     } coat_fresnel = Fresnel::Exact;
     /// The model's coat has no IOR parameter (IOR 1.5): another η0 is not supported.
     bool coat_ior_fixed = false;
+    /// Schlick's weight (1 − c)⁵ replaced by the spherical-Gaussian fit 2^((−5.55473 c − 6.98316)
+    /// c) (Karis 2013, "Real shading in Unreal Engine 4"; three.js's F_Schlick) on coat and metal.
+    bool schlick_spherical_gaussian = false;
+    /// The model clamps its coat IOR to ≥ 1 (Blender): η0 < 1 is not supported.
+    bool coat_ior_at_least_one = false;
     /// The coat lobe's Fresnel at n·wo instead of wi·h (glTF's layering Fresnel).
     bool coat_fresnel_at_n = false;
     enum class Visibility {
@@ -75,10 +82,42 @@ struct CoatRecipe {
                       ///< (models/tables/fgd_table.h)
         OpenPbrBsdf,  ///< the uncorrelated lobe's albedo on openpbr-bsdf's grid, read as it reads
                       ///< it (models/production/uncorrelated_albedo.h)
+        Cycles,       ///< Cycles' estimate of its compensated lobe's albedo,
+                      ///< [E + F_ms (1 − E)] (F0 + (1 − F0) s) on its tables
+                      ///< (models/production/cycles_albedo.h); F(μ; η0) for η0 ≤ 1
+        MaterialX,    ///< MaterialX's: (F0 A + B) × its compensation, A and B its fit
+                      ///< (materialx_ggx_albedo_fit)
     } coat_albedo = CoatAlbedo::Fgd;
-    /// Filament's compensation of the metal lobe for multiple scattering, × (1 + F0 (1/E − 1)),
-    /// E read from its DFG texture at (μo, r) (models/production/filament_dfg.h).
-    bool metal_energy_compensation = false;
+    /// A compensation of the coat lobe for multiple scattering, a factor that depends on μo.
+    enum class CoatEnergyCompensation {
+        None,
+        /// Cycles' on every dielectric microfacet closure: × (1 + F_ms (1 − E(μo))/E(μo)), E the
+        /// white lobe's albedo on Cycles' table and F_ms = F_ss E_avg/(1 − F_ss (1 − E_avg)) with
+        /// F_ss Kulla & Conty's fit of the coat's average Fresnel (kernel/closure/
+        /// bsdf_microfacet.h, microfacet_ggx_preserve_energy).
+        Cycles,
+        /// MaterialX's (mx_ggx_energy_compensation, after Turquin 2019, Eqs. 14 and 16):
+        /// × (1 + F_ss (1 − E)/E), F_ss = F0 + (1 − F0)/21, E = A + B of its fit at (μo, α).
+        MaterialX,
+    } coat_energy_compensation = CoatEnergyCompensation::None;
+    /// A compensation of the metal lobe for multiple scattering, a factor on the lobe that
+    /// depends on μo.
+    enum class MetalEnergyCompensation {
+        None,
+        /// Filament: × (1 + F0 (1/E − 1)), E read from its DFG texture at (μo, r)
+        /// (models/production/filament_dfg.h).
+        Filament,
+        /// Cycles' multiscatter GGX: × (1 + F_ms (1 − E)/E), E and E_avg from its tables,
+        /// F_ms = F_ss E_avg/(1 − F_ss (1 − E_avg)), F_ss the F82-tint average F0 + (1 − F0)/21 −
+        /// b/126.
+        Cycles,
+        /// three.js: × (1 + F0 (1/E − 1)), E read from its DFG texture at (r, μo)
+        /// (models/production/threejs_dfg.h).
+        ThreeJs,
+        /// MaterialX: × (1 + F_ss (1 − E)/E), F_ss = F0 + (1 − F0)/21 (the F82 tint left out), E
+        /// = A + B of its fit at (μo, α).
+        MaterialX,
+    } metal_energy_compensation = MetalEnergyCompensation::None;
     /// The metal's Schlick f90 = min(1, 16.5 (F0_r + F0_g + F0_b)) (Filament), not 1.
     bool metal_f90_from_f0 = false;
     /// A compensation lobe for the metal's multiple scattering between microfacets, of Kulla &
@@ -114,6 +153,7 @@ struct CoatRecipe {
         Spec,   ///< OpenPBR 1.1: K = lerp(F(μo), K_r, r_b), E_F by d'Eon's fit, E_b from FGD
         Adobe,  ///< openpbr-bsdf: K_s = E_F (Kulla–Conty fit), E_b the average F82 Fresnel; the
                 ///< diffuse base's specular (weight 0, relative index 1) still counts E_F(1)
+        MaterialX,  ///< MaterialX's graph: K = 1 − (1 − F0)/η0² (F0 for E_F), E_b the base colour
     } darkening = Darkening::None;
 
     enum class Roughening {
@@ -133,6 +173,10 @@ struct CoatRecipe {
 
     /// Standard Surface's coat_affect_color = 1: ρ ← ρ^2 (its default 0 leaves ρ).
     bool affect_color = false;
+    /// MaterialX's OpenPBR: the diffuse base under the base's specular layer, whose weight 0 sets
+    /// its index to 1 (no reflection) but whose throughput keeps 1 − B (1 + (1 − E)/(21 E)) of
+    /// its fit at the default specular roughness after roughening.
+    bool diffuse_specular_throughput = false;
 };
 
 /// Flags every production model shares, appended to its own: leaves=shipped|exact swaps the
@@ -154,6 +198,11 @@ double kulla_conty_average_fresnel_fit(double eta);
 /// Filament's conversion of an F0 against air to an F0 against a coat of IOR 1.5
 /// (Filament documentation, "Clear coat", f0ClearCoatToSurface; a fit).
 double filament_f0_clear_coat_to_surface(double f0);
+/// MaterialX's rational fit of the split-sum's scale A and bias B of a GGX lobe with the
+/// height-correlated Smith term (libraries/pbrlib/genglsl/lib/mx_microfacet_specular.glsl,
+/// mx_ggx_dir_albedo_analytic: "rational quadratic fit to Monte Carlo data"), E_F0 = F0 A + B,
+/// at (μ, α) with α the GGX α; A and B clamped to [0, 1].
+SchlickSplit materialx_ggx_albedo_fit(double mu, double alpha);
 /// Kutz, Hasan & Edmondson 2021 (OpenPBR 1.1, "Metal"): the F82-tint metal Fresnel,
 /// F_Schlick(μ) − b μ (1 − μ)⁶ with b = F_Schlick(μ̄)(1 − tint)/(μ̄ (1 − μ̄)⁶), μ̄ = 1/7.
 double f82_tint_fresnel(double cos_theta, double f0, double tint);

@@ -9,7 +9,7 @@
 //   Dassault Systèmes Enterprise PBR 2025x specification, "Clearcoat";
 //   Google Filament documentation, "Clear coat model" and "Clear coat parameterization";
 //   Khronos KHR_materials_clearcoat, "Layering" (and three.js's half-vector Fresnel in the lobe);
-//   Blender 4.x Cycles, the Principled BSDF's coat (kernel/svm/closure.h);
+//   Blender Cycles, the Principled BSDF (kernel/svm/closure.h, kernel/closure/bsdf_microfacet.h);
 //   Kulla & Conty 2017, "Revisiting physically based shading at Imageworks" (SIGGRAPH course).
 #include "models/production/production_coats.h"
 #include "models/production/production_coat.h"
@@ -76,6 +76,36 @@ CoatRecipe adobe_recipe(const ModelOptions& o) {
     return r;
 }
 
+// --- OpenPBR in MaterialX (its graph, its GLSL generator) --------------------------------------
+CoatRecipe materialx_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "openpbr-materialx";
+    // libraries/bxdf/open_pbr_surface.mtlx as the GLSL generator evaluates it (pbrlib genglsl,
+    // the analytic directional albedo): the coat a dielectric_bsdf layered over the base by its
+    // throughput 1 - E(mu_o), the constant coat_color, the graph's darkening with
+    // Kcoat = 1 - (1 - F0)/eta^2, the specification's roughening, every lobe compensated for
+    // multiple scattering by the fitted albedo, and a diffuse base under its specular layer at
+    // index 1.
+    r.coat_fresnel = CoatRecipe::Fresnel::Exact;
+    r.attenuation = CoatRecipe::Attenuation::AlbedoView;
+    r.coat_albedo = CoatRecipe::CoatAlbedo::MaterialX;
+    r.coat_energy_compensation = is_on(o, "energy-compensation")
+                                     ? CoatRecipe::CoatEnergyCompensation::MaterialX
+                                     : CoatRecipe::CoatEnergyCompensation::None;
+    r.metal_energy_compensation = is_on(o, "energy-compensation")
+                                      ? CoatRecipe::MetalEnergyCompensation::MaterialX
+                                      : CoatRecipe::MetalEnergyCompensation::None;
+    r.tint = CoatRecipe::Tint::Constant;
+    r.darkening =
+        is_on(o, "darkening") ? CoatRecipe::Darkening::MaterialX : CoatRecipe::Darkening::None;
+    r.roughening =
+        is_on(o, "roughening") ? CoatRecipe::Roughening::OpenPBR : CoatRecipe::Roughening::None;
+    r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    r.diffuse_specular_throughput = true;
+    if (exact_leaves(o)) use_exact_leaves(r);
+    return r;
+}
+
 // --- Autodesk Standard Surface --------------------------------------------------------------
 CoatRecipe standard_surface_recipe(const ModelOptions& o) {
     CoatRecipe r;
@@ -126,7 +156,9 @@ CoatRecipe filament_recipe(const ModelOptions& o) {
     r.metal_min_roughness = 0.045;
     r.max_ndf = 453.5 * 453.5 / kPi<double>;
     r.metal_f90_from_f0 = true;
-    r.metal_energy_compensation = is_on(o, "energy-compensation");
+    r.metal_energy_compensation = is_on(o, "energy-compensation")
+                                      ? CoatRecipe::MetalEnergyCompensation::Filament
+                                      : CoatRecipe::MetalEnergyCompensation::None;
     r.attenuation = option_value(o, "attenuation") == "h" ? CoatRecipe::Attenuation::FresnelHalf
                                                           : CoatRecipe::Attenuation::FresnelView;
     r.tint = CoatRecipe::Tint::Constant;  // no coat tint: baked into the base
@@ -154,14 +186,49 @@ CoatRecipe gltf_recipe(const ModelOptions& o) {
     return r;
 }
 
-// --- Blender 4.x Principled -----------------------------------------------------------------
+// --- three.js MeshPhysicalMaterial (glTF's clear coat) ---------------------------------------
+CoatRecipe threejs_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "threejs-clearcoat";
+    // Its shaders (lights_physical_pars_fragment, lights_physical_fragment, meshphysical, common):
+    // Schlick 0.04 in Karis's spherical-Gaussian form at v.h on the coat lobe, the base times
+    // 1 - clearcoat F(n.v), the height-correlated visibility, roughness of coat and base clamped
+    // to >= 0.045, the metal's Schlick with f90 = 1 and its multiple-scattering compensation from
+    // the DFG texture.
+    r.coat_fresnel = CoatRecipe::Fresnel::Schlick004;
+    r.coat_ior_fixed = true;
+    r.schlick_spherical_gaussian = true;
+    r.attenuation = CoatRecipe::Attenuation::FresnelView;
+    r.tint = CoatRecipe::Tint::Constant;  // no coat tint: baked into the base
+    r.coat_min_roughness = 0.045;
+    r.metal_min_roughness = 0.045;
+    r.metal_fresnel = CoatRecipe::MetalFresnel::Schlick;
+    r.metal_energy_compensation = is_on(o, "energy-compensation")
+                                      ? CoatRecipe::MetalEnergyCompensation::ThreeJs
+                                      : CoatRecipe::MetalEnergyCompensation::None;
+    if (exact_leaves(o)) use_exact_leaves(r);
+    return r;
+}
+
+// --- Blender Cycles Principled --------------------------------------------------------------
 CoatRecipe blender_recipe(const ModelOptions& o) {
     CoatRecipe r;
     r.name = "blender-principled";
     r.coat_fresnel = CoatRecipe::Fresnel::Exact;
+    r.coat_ior_at_least_one = true;
     r.attenuation = CoatRecipe::Attenuation::AlbedoView;
     r.tint = is_on(o, "view-tint") ? CoatRecipe::Tint::ViewOnly : CoatRecipe::Tint::Constant;
     r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    // As Cycles ships it (kernel/svm/closure.h, kernel/closure/bsdf_microfacet.h): every
+    // dielectric closure compensated for multiple scattering, the coat's albedo its estimate on
+    // Cycles' tables, the metal with the node's default multiscatter GGX.
+    r.coat_energy_compensation = is_on(o, "energy-compensation")
+                                     ? CoatRecipe::CoatEnergyCompensation::Cycles
+                                     : CoatRecipe::CoatEnergyCompensation::None;
+    r.coat_albedo = CoatRecipe::CoatAlbedo::Cycles;
+    r.metal_energy_compensation = is_on(o, "energy-compensation")
+                                      ? CoatRecipe::MetalEnergyCompensation::Cycles
+                                      : CoatRecipe::MetalEnergyCompensation::None;
     if (exact_leaves(o)) use_exact_leaves(r);
     return r;
 }
@@ -265,10 +332,38 @@ std::unique_ptr<Model> make_gltf_clearcoat(const Stack& stack, const ModelOption
 std::vector<OptionSpec> blender_principled_options() {
     return {on_off_option("view-tint", true,
                           "coat tint^(1/mu_t,o) along the view; off: the constant tint"),
+            on_off_option("energy-compensation", true,
+                          "Cycles' compensation of the coat and metal lobes for multiple "
+                          "scattering, 1 + F_ms (1 - E)/E (leaves=exact drops it)"),
             leaves_option()};
 }
 std::unique_ptr<Model> make_blender_principled(const Stack& stack, const ModelOptions& options) {
     return make_production_coat(stack, blender_recipe(options));
+}
+
+std::vector<OptionSpec> threejs_clearcoat_options() {
+    return {
+        on_off_option("energy-compensation", true,
+                      "the metal lobe x (1 + F0 (1/E - 1)), E from the DFG texture (leaves=exact "
+                      "drops it)"),
+        leaves_option()};
+}
+std::unique_ptr<Model> make_threejs_clearcoat(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, threejs_recipe(options));
+}
+
+std::vector<OptionSpec> openpbr_materialx_options() {
+    return {
+        on_off_option("darkening", true,
+                      "the graph's coat darkening (1 - K)/(1 - E_b K), K = 1 - (1 - F0)/eta0^2"),
+        on_off_option("roughening", true, "base roughening r' = min(1, r^4 + 2 r_c^4)^(1/4)"),
+        on_off_option("energy-compensation", true,
+                      "coat and metal lobes x (1 + F_ss (1 - E)/E), E by MaterialX's fit "
+                      "(leaves=exact drops it)"),
+        leaves_option()};
+}
+std::unique_ptr<Model> make_openpbr_materialx(const Stack& stack, const ModelOptions& options) {
+    return make_production_coat(stack, materialx_recipe(options));
 }
 
 std::vector<OptionSpec> kulla_conty_options() {

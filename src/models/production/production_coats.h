@@ -23,6 +23,10 @@ std::unique_ptr<Model> make_gltf_clearcoat(const Stack& stack, const ModelOption
 std::vector<OptionSpec> gltf_clearcoat_options();
 std::unique_ptr<Model> make_blender_principled(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> blender_principled_options();
+std::unique_ptr<Model> make_threejs_clearcoat(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> threejs_clearcoat_options();
+std::unique_ptr<Model> make_openpbr_materialx(const Stack& stack, const ModelOptions& options);
+std::vector<OptionSpec> openpbr_materialx_options();
 std::unique_ptr<Model> make_kulla_conty(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> kulla_conty_options();
 
