@@ -1,6 +1,6 @@
-// Goniophotometer throughput (issue 3): particles per second for the benchmark plastic and the
-// benchmark metallic paint at θi = 30°, on 1 and 2 threads, with events per particle; the second
-// argument picks the kernel (0 scalar, 1 SIMD, issue 8).
+// Goniophotometer throughput: particles per second for the benchmark plastic and the benchmark
+// metallic paint at θi = 30°, on 1 and 2 threads, with events per particle; the second argument
+// picks the kernel (0 scalar, 1 SIMD).
 #include "layers/stack.h"
 #include "simulator/goniophotometer.h"
 #include "simulator/kernel_simd.h"

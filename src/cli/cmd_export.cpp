@@ -11,6 +11,8 @@
 #include "export/merl.h"
 #include "export/npz.h"
 #include "export/rgl_bsdf.h"
+#include "export/rgl_fidelity.h"
+#include "export/rgl_reader.h"
 #include "lamina/version.h"
 #include "layers/stack.h"
 #include "models/numerics/binned.h"
@@ -32,11 +34,13 @@ namespace lamina::cli {
 namespace {
 
 struct ExportArgs {
-    std::string check;  ///< a file to check instead of writing one
+    std::string check;    ///< a file to check instead of writing one
+    bool strict = false;  ///< --check: exit 2 when the figures miss the goals
     std::string simulation, study, config, source = "reference", model, stack, out, format;
     std::string theta_i, grid = "90x90";
     std::vector<std::string> options;
-    int resolution = 32, vndf_resolution = 64, ndf_resolution = 64;
+    int resolution = RglOptions{}.resolution, vndf_resolution = RglOptions{}.vndf_resolution,
+        ndf_resolution = RglOptions{}.ndf_resolution;
 };
 
 std::string read_text(const std::filesystem::path& path) {
@@ -108,18 +112,116 @@ BinnedTable study_table(const ExportArgs& a) {
     }
 }
 
+// The source of an export (or of a check): a binned table (simulate, study) or a model.
+struct Source {
+    BinnedTable table;
+    bool have_table = false;
+    std::shared_ptr<const Model> model;
+    nlohmann::json meta;
+};
+
+bool has_source(const ExportArgs& a) {
+    return !a.simulation.empty() || !a.study.empty() || !a.model.empty();
+}
+
+Source load_source(const ExportArgs& a) {
+    const int sources = int(!a.simulation.empty()) + int(!a.study.empty()) + int(!a.model.empty());
+    if (sources != 1)
+        throw InputError("command line", "--simulation",
+                         "give one source: --simulation DIR, --study DIR --config ID, or --model "
+                         "NAME --stack FILE");
+    Source src;
+    src.meta["lamina_version"] = kVersion;
+    if (!a.simulation.empty()) {
+        const std::filesystem::path dir = a.simulation;
+        src.table = BinnedTable::from_csv(read_text(dir / "brdf.csv"), (dir / "brdf.csv").string());
+        src.have_table = true;
+        src.meta["source"] = "simulation";
+        if (std::filesystem::exists(dir / "result.json"))
+            src.meta["result"] = read_json(dir / "result.json");
+    } else if (!a.study.empty()) {
+        if (a.config.empty()) throw InputError("command line", "--config", "required with --study");
+        src.table = study_table(a);
+        src.have_table = true;
+        src.meta["source"] = {{"study", a.study}, {"config", a.config}, {"source", a.source}};
+    } else {
+        if (a.stack.empty()) throw InputError("command line", "--stack", "required with --model");
+        const ModelEntry& entry = find_model(a.model);
+        const Stack stack = load_stack(a.stack);
+        src.model = entry.make(stack, resolve_options(entry, a.options));
+        src.meta["source"] = {{"model", a.model}, {"stack", stack_to_json(stack)}};
+    }
+    return src;
+}
+
+/// The reflection side of a source as a BRDF.
+BrdfSource brdf_of(const Source& src, const ExportArgs& a) {
+    return src.have_table ? table_brdf(src.table, a.simulation.empty() ? a.source : "reference",
+                                       a.simulation.empty() ? a.study : a.simulation)
+                          : model_brdf(src.model, a.stack);
+}
+
+// The figures of rgl_fidelity.h, as a table: how close a renderer reading the file gets to its
+// source. Returns whether they meet the goals.
+bool print_fidelity(const TensorFile& file, const std::string& path, const BrdfSource& brdf) {
+    using Goals = RglFidelityGoals;
+    const RglReader reader(file, path);
+    const RglFidelityOptions options;
+    const RglFidelity r = rgl_fidelity(reader, brdf, options, path);
+    fmt::print(
+        "\nA renderer reading {} (pbrt-v4, Mitsuba 3) against its source, {}:\n"
+        "directional albedo (luminance; error: the channel where it is largest, goal ≤ {:g}%)\n"
+        "  θi (°)   source     file     error\n",
+        path, brdf.name, 100 * Goals::kAlbedo);
+    for (const RglAlbedoRow& row : r.albedo)
+        fmt::print("  {:6.1f}  {:8.5f}  {:8.5f}  {:6.2f}%{}\n", row.theta_i_deg,
+                   luminance(row.source), luminance(row.file), 100 * row.error,
+                   row.error > Goals::kAlbedo ? "  over the goal" : "");
+    const auto worst = std::max_element(
+        r.albedo.begin(), r.albedo.end(),
+        [](const RglAlbedoRow& x, const RglAlbedoRow& y) { return x.error < y.error; });
+    fmt::print("  worst: {:.2f}% at θi = {:g}°\n", 100 * worst->error, worst->theta_i_deg);
+    fmt::print(
+        "values f at {} random direction pairs (θi, θo ≤ {:g}°, luminance): relative error "
+        "{:.2f}% for half of them, {:.2f}% for {:g}% (goal ≤ {:g}%), {:.2f}% for 99%{}\n",
+        r.value_errors.size(), options.max_theta_deg, 100 * r.value_error(0.5),
+        100 * r.value_error(Goals::kValueQuantile), 100 * Goals::kValueQuantile,
+        100 * Goals::kValue, 100 * r.value_error(0.99),
+        r.pairs_skipped ? fmt::format(" ({} pairs where the source is 0 left out)", r.pairs_skipped)
+                        : "");
+    const bool ok = r.meets_goals();
+    fmt::print("{}: {} the goals\n", path, ok ? "meets" : "misses");
+    return ok;
+}
+
 // --check FILE: reads a .bsdf or MERL .binary as a reader would and describes it (InputError
-// naming the file and what is wrong for a malformed or truncated one).
-int run_check(const std::string& path) {
+// naming the file and what is wrong for a malformed or truncated one); with a source, also how
+// close a renderer reading a .bsdf gets to it.
+int run_check(const ExportArgs& a) {
+    const std::string& path = a.check;
     const std::string bytes = read_text(path);
     if (bytes.rfind("tensor_file", 0) == 0 || std::filesystem::path(path).extension() == ".bsdf") {
         const TensorFile file = parse_tensor_file(bytes, path);
         check_rgl_bsdf(file, path);
         const auto& spectra = file.at("spectra").shape;
-        fmt::print("{}: RGL .bsdf, {} incidences, {} × {} samples, {} wavelengths: \"{}\"\n", path,
-                   spectra[1], spectra[3], spectra[4], spectra[2], file.at("description").data);
-        return 0;
+        fmt::print(
+            "{}: RGL .bsdf ({:.1f} MB), {} incidences, {} × {} samples, {} wavelengths: "
+            "\"{}\"\n",
+            path, double(bytes.size()) / 1e6, spectra[1], spectra[3], spectra[4], spectra[2],
+            file.at("description").data);
+        if (!has_source(a)) {
+            if (a.strict)
+                throw InputError("command line", "--strict",
+                                 "give the file's source (--model NAME --stack FILE, --simulation "
+                                 "DIR or --study DIR --config ID) to check it against");
+            return 0;
+        }
+        const bool ok = print_fidelity(file, path, brdf_of(load_source(a), a));
+        return ok || !a.strict ? 0 : 2;
     }
+    if (has_source(a) || a.strict)
+        throw InputError("command line", "--check",
+                         "a MERL .binary is checked for its structure only: give no source");
     const MerlBrdf merl = parse_merl(bytes, path);
     fmt::print(
         "{}: MERL .binary, 90 × 90 × 180 × RGB, f at normal incidence and exit ({}, {}, {})\n",
@@ -128,13 +230,9 @@ int run_check(const std::string& path) {
 }
 
 int run_export(const ExportArgs& a) {
-    if (!a.check.empty()) return run_check(a.check);
+    if (!a.check.empty()) return run_check(a);
+    if (a.strict) throw InputError("command line", "--strict", "goes with --check FILE");
     if (a.out.empty()) throw InputError("command line", "--out", "give the output file");
-    const int sources = int(!a.simulation.empty()) + int(!a.study.empty()) + int(!a.model.empty());
-    if (sources != 1)
-        throw InputError("command line", "--simulation",
-                         "give one source: --simulation DIR, --study DIR --config ID, or --model "
-                         "NAME --stack FILE");
     std::string format = a.format;
     if (format.empty()) {
         const std::string ext = std::filesystem::path(a.out).extension().string();
@@ -148,31 +246,11 @@ int run_export(const ExportArgs& a) {
         throw InputError("command line", "--format",
                          fmt::format("'{}' is not a format: bsdf, merl or npz", format));
 
-    // The source: a binned table (simulate, study) or a model.
-    BinnedTable table;
-    bool have_table = false;
-    std::shared_ptr<const Model> model;
-    nlohmann::json meta;
-    meta["lamina_version"] = kVersion;
-    if (!a.simulation.empty()) {
-        const std::filesystem::path dir = a.simulation;
-        table = BinnedTable::from_csv(read_text(dir / "brdf.csv"), (dir / "brdf.csv").string());
-        have_table = true;
-        meta["source"] = "simulation";
-        if (std::filesystem::exists(dir / "result.json"))
-            meta["result"] = read_json(dir / "result.json");
-    } else if (!a.study.empty()) {
-        if (a.config.empty()) throw InputError("command line", "--config", "required with --study");
-        table = study_table(a);
-        have_table = true;
-        meta["source"] = {{"study", a.study}, {"config", a.config}, {"source", a.source}};
-    } else {
-        if (a.stack.empty()) throw InputError("command line", "--stack", "required with --model");
-        const ModelEntry& entry = find_model(a.model);
-        const Stack stack = load_stack(a.stack);
-        model = entry.make(stack, resolve_options(entry, a.options));
-        meta["source"] = {{"model", a.model}, {"stack", stack_to_json(stack)}};
-    }
+    Source src = load_source(a);
+    BinnedTable& table = src.table;
+    const bool have_table = src.have_table;
+    const std::shared_ptr<const Model>& model = src.model;
+    nlohmann::json& meta = src.meta;
 
     std::string bytes;
     if (format == "npz") {
@@ -217,10 +295,7 @@ int run_export(const ExportArgs& a) {
                             {"phi_edges.npy", npy_float32(pe, {pe.size()})},
                             {"metadata.json", meta.dump(1) + "\n"}});
     } else {
-        const BrdfSource brdf =
-            have_table ? table_brdf(table, a.simulation.empty() ? a.source : "reference",
-                                    a.simulation.empty() ? a.study : a.simulation)
-                       : model_brdf(model, a.stack);
+        const BrdfSource brdf = brdf_of(src, a);
         if (format == "bsdf") {
             RglOptions o;
             o.resolution = a.resolution;
@@ -258,22 +333,28 @@ Runner add_export(CLI::App& app) {
     cmd->add_option("--stack", a->stack, "The model's stack JSON file");
     cmd->add_option("--option", a->options, "Model flag KEY=VALUE, repeatable");
     cmd->add_option("--format", a->format, "bsdf, merl or npz (default: from --out's extension)");
-    cmd->add_option("--theta-i", a->theta_i,
-                    "Incidences (degrees): a model's .bsdf nodes (default 0..88 by 4) or .npz "
-                    "bins (default " +
-                        default_incidences_text() + ")");
+    cmd->add_option(
+        "--theta-i", a->theta_i,
+        fmt::format("Incidences (degrees): a model's .bsdf nodes (default {:.4g}, "
+                    "denser towards grazing) or .npz bins (default {})",
+                    fmt::join(rgl_default_incidences(), ","), default_incidences_text()));
     cmd->add_option("--grid", a->grid, "Bins of a model's .npz, NTHETAxNPHI")
         ->capture_default_str();
     cmd->add_option("--resolution", a->resolution, ".bsdf: sample-grid nodes a side")
         ->capture_default_str();
-    cmd->add_option("--vndf-resolution", a->vndf_resolution, ".bsdf: VNDF nodes a side")
+    cmd->add_option("--vndf-resolution", a->vndf_resolution,
+                    ".bsdf: warp (vndf) nodes along θ of the half vector")
         ->capture_default_str();
-    cmd->add_option("--ndf-resolution", a->ndf_resolution, ".bsdf: NDF and σ nodes a side")
+    cmd->add_option("--ndf-resolution", a->ndf_resolution, ".bsdf: ndf and sigma nodes along θ")
         ->capture_default_str();
     cmd->add_option("--out,-o", a->out, "Output file");
     cmd->add_option("--check", a->check,
                     "Read a .bsdf or MERL .binary file as a renderer would and describe it (a "
-                    "malformed or truncated file is refused with what is wrong)");
+                    "malformed or truncated file is refused with what is wrong); with the .bsdf's "
+                    "source, report how close a renderer gets to it: directional albedo and "
+                    "values against the goals (docs/formats.md)");
+    cmd->add_flag("--strict", a->strict,
+                  "With --check and a source: exit with status 2 when the figures miss the goals");
     return [a] { return run_export(*a); };
 }
 

@@ -12,14 +12,17 @@
 #include "distributed/split_simulation.h"
 #include "layers/stack.h"
 #include "simulator/goniophotometer.h"
+#include "simulator/mueller.h"
 #include "simulator/output.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <utility>
 
 namespace lamina::cli {
 
@@ -27,6 +30,7 @@ namespace {
 struct SimulateArgs {
     std::string stack, out;
     SimulationSettings settings;
+    bool mueller = false;
 };
 }  // namespace
 
@@ -36,6 +40,10 @@ Runner add_simulate(CLI::App& app) {
         "simulate", "Trace particles through a stack: the reference BRDF/BTDF (goniophotometer)");
     cmd->add_option("STACK", a->stack, "Stack JSON file")->required();
     add_settings_options(cmd, a->settings);
+    cmd->add_flag("--mueller", a->mueller,
+                  "Also write the 4x4 Mueller BRDF/BTDF per bin with standard errors "
+                  "(mueller.npy, mueller_se.npy; needs --polarization on; four runs: unpolarized, "
+                  "s-polarized, +45° and circular incident light)");
     cmd->add_option("--out,-o", a->out, "Output folder")->required();
     return [a] {
         // Under mpirun every process runs this; the particles are split over them
@@ -77,24 +85,58 @@ Runner add_simulate(CLI::App& app) {
                                                   "particles", mine.count * s.theta_i_deg.size());
             on_progress = [&](std::uint64_t n) { progress->advance(n); };
         }
-        const std::optional<SimulationResult> split = simulate_split(world, stack, s, on_progress);
-        if (!split) return 0;  // not the root: its sums went to the root
-        const SimulationResult& result = *split;
+        if (a->mueller) {
+            if (!s.transport.polarization)
+                throw InputError("command line", "--mueller", "needs --polarization on");
+            s.stokes_tallies = true;
+        }
+        // --mueller: four runs (unpolarized, s-polarized, +45°, circular incident light;
+        // simulator/mueller.h), the first of which gives the tables.
+        std::array<std::optional<SimulationResult>, 4> runs;
+        for (int j = 0; j < (a->mueller ? 4 : 1); ++j) {
+            SimulationSettings run = s;
+            run.incident_polarization = j;
+            if (j > 0 && progress) progress->finish();
+            if (j > 0 && world.is_root())
+                progress = std::make_unique<Progress>(
+                    fmt::format("simulate {} (Mueller run {} of 4)", stack.name, j + 1),
+                    "particles",
+                    particle_range(s.particles, world.rank(), world.size()).count *
+                        s.theta_i_deg.size());
+            runs[std::size_t(j)] = simulate_split(world, stack, run, on_progress);
+        }
+        if (!runs[0]) return 0;  // not the root: its sums went to the root
+        const SimulationResult& result = *runs[0];
         progress->finish();
-        write_simulation(a->out, stack, result);
+        std::vector<std::pair<std::string, std::string>> extra;
+        if (a->mueller) {
+            const MuellerTable mueller =
+                mueller_table({&*runs[0], &*runs[1], &*runs[2], &*runs[3]});
+            extra = {{"mueller.npy", mueller_npy(mueller, false)},
+                     {"mueller_se.npy", mueller_npy(mueller, true)}};
+        }
+        write_simulation(a->out, stack, result, extra);
         for (std::size_t i = 0; i < result.incidences.size(); ++i) {
             const EnergyBudget& b = result.incidences[i].budget;
             fmt::print("θi = {:>4}°  R = {}  T = {}  lost = {}  absorbed = {}\n", s.theta_i_deg[i],
                        format_rgb(b[BudgetTerm::Reflected]), format_rgb(b[BudgetTerm::Transmitted]),
                        format_rgb(b[BudgetTerm::LostMicrosurface]),
                        format_rgb(b[BudgetTerm::AbsorbedMedium] + b[BudgetTerm::AbsorbedBase]));
+            // A thick scattering layer's cost is bounded by --max-events; what it stops is told.
+            if (b[BudgetTerm::CutOff].max() > 0)
+                fmt::print(
+                    "          cut off after --max-events {}: {} ({:.4g} events per "
+                    "particle)\n",
+                    s.transport.max_events, format_rgb(b[BudgetTerm::CutOff]),
+                    result.incidences[i].events_per_particle);
         }
         const std::string workers =
             result.processes > 1
                 ? fmt::format("{} processes × {} threads", result.processes, result.threads_used)
                 : fmt::format("{} threads", result.threads_used);
-        fmt::print("{:.3g} particles/s on {}; wrote {}/{{result.json,brdf.csv,energy.csv}}\n",
-                   double(s.particles * s.theta_i_deg.size()) / result.seconds, workers, a->out);
+        fmt::print("{:.3g} particles/s on {}; wrote {}/{{result.json,brdf.csv,energy.csv{}}}\n",
+                   double(s.particles * s.theta_i_deg.size()) / result.seconds, workers, a->out,
+                   a->mueller ? ",mueller.npy,mueller_se.npy" : "");
         return 0;
     };
 }

@@ -41,6 +41,13 @@ LAMINA_LANE_INLINE LaneVec3<T> lane_normalize(const LaneVec3<T>& a) {
     const T inv = L::inv_sqrt(lane_dot<T, L>(a, a));
     return {a.x * inv, a.y * inv, a.z * inv};
 }
+/// a × b.
+template <typename T, typename L = Lane<T>>
+LAMINA_LANE_INLINE LaneVec3<T> lane_cross(const LaneVec3<T>& a, const LaneVec3<T>& b) {
+    return {L::mul_add(a.y, b.z, L::constant(0) - a.z * b.y),
+            L::mul_add(a.z, b.x, L::constant(0) - a.x * b.z),
+            L::mul_add(a.x, b.y, L::constant(0) - a.y * b.x)};
+}
 /// a where the mask m holds, else b.
 template <typename T, typename L = Lane<T>>
 LAMINA_LANE_INLINE LaneVec3<T> lane_select(typename L::Mask m, const LaneVec3<T>& a,

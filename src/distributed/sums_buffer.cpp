@@ -4,15 +4,15 @@
 
 namespace lamina {
 
-std::size_t flat_sums_size(std::size_t bins) {
-    return bins * 6 + std::size_t(kBudgetTerms + 2) * 3 + 2;
+std::size_t flat_sums_size(std::size_t bins, std::size_t stokes) {
+    return bins * 6 + std::size_t(kBudgetTerms + 2) * 3 + 2 + stokes * kStokesSums;
 }
 
 std::vector<Fixed128> flatten_sums(const std::vector<IncidenceSums>& sums) {
     std::vector<Fixed128> flat;
     std::size_t total = 0;
     for (const IncidenceSums& s : sums)
-        total += flat_sums_size(s.bins.size());
+        total += flat_sums_size(s.bins.size(), s.stokes.size());
     flat.reserve(total);
     for (const IncidenceSums& s : sums) {
         for (const auto& bin : s.bins)
@@ -21,6 +21,8 @@ std::vector<Fixed128> flatten_sums(const std::vector<IncidenceSums>& sums) {
             flat.insert(flat.end(), row.begin(), row.end());
         flat.push_back(Fixed128(s.events));
         flat.push_back(Fixed128(s.degenerate));
+        for (const auto& entry : s.stokes)
+            flat.insert(flat.end(), entry.begin(), entry.end());
     }
     return flat;
 }
@@ -28,7 +30,7 @@ std::vector<Fixed128> flatten_sums(const std::vector<IncidenceSums>& sums) {
 void unflatten_sums(const std::vector<Fixed128>& flat, std::vector<IncidenceSums>& sums) {
     std::size_t at = 0;
     for (IncidenceSums& s : sums) {
-        LAMINA_CHECK(at + flat_sums_size(s.bins.size()) <= flat.size());
+        LAMINA_CHECK(at + flat_sums_size(s.bins.size(), s.stokes.size()) <= flat.size());
         for (auto& bin : s.bins)
             for (Fixed128& x : bin)
                 x = flat[at++];
@@ -37,6 +39,9 @@ void unflatten_sums(const std::vector<Fixed128>& flat, std::vector<IncidenceSums
                 x = flat[at++];
         s.events = std::uint64_t(flat[at++]);
         s.degenerate = std::uint64_t(flat[at++]);
+        for (auto& entry : s.stokes)
+            for (Fixed128& x : entry)
+                x = flat[at++];
     }
     LAMINA_CHECK(at == flat.size());
 }

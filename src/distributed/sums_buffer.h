@@ -4,7 +4,8 @@
 // IncidenceSums::add of the sums they hold, so any exact reduction of the arrays is exact.
 //
 // Layout per incidence, in order: bins (6 integers per bin: Σ flux r, g, b, Σ flux² r, g, b),
-// budget rows (3 per row), events, degenerate.
+// budget rows (3 per row), events, degenerate, then the Stokes tallies when there are any
+// (kStokesSums per bin).
 
 #include "simulator/goniophotometer.h"
 
@@ -13,8 +14,9 @@
 
 namespace lamina {
 
-/// Integers per incidence of `bins` bins (both sides together, as IncidenceSums::bins).
-std::size_t flat_sums_size(std::size_t bins);
+/// Integers per incidence of `bins` bins (both sides together, as IncidenceSums::bins), and
+/// `stokes` entries of Stokes tallies (0 or bins).
+std::size_t flat_sums_size(std::size_t bins, std::size_t stokes = 0);
 
 std::vector<Fixed128> flatten_sums(const std::vector<IncidenceSums>& sums);
 

@@ -50,7 +50,7 @@ double BilinearWarp::eval(std::array<double, 2> x) const {
            t * ((1 - s) * v(i, j + 1) + s * v(i + 1, j + 1));
 }
 
-std::array<double, 2> BilinearWarp::invert(std::array<double, 2> x) const {
+BilinearWarp::Masses BilinearWarp::masses(std::array<double, 2> x) const {
     const double dx = 1.0 / (nx_ - 1), dy = 1.0 / (ny_ - 1);
     const double gx = std::clamp(x[0], 0.0, 1.0) * (nx_ - 1),
                  gy = std::clamp(x[1], 0.0, 1.0) * (ny_ - 1);
@@ -59,14 +59,19 @@ std::array<double, 2> BilinearWarp::invert(std::array<double, 2> x) const {
     // Row totals at the patch's edges and at y; M(y) = M_j + ∫ over the partial patch.
     const double r0 = cond(nx_ - 1, j), r1 = cond(nx_ - 1, j + 1);
     const double row = (1 - t) * r0 + t * r1;
-    const double u_y = marg_[j] + dy * t * (r0 + 0.5 * t * (r1 - r0));
+    const double below = marg_[j] + dy * t * (r0 + 0.5 * t * (r1 - r0));
     // p(·, y) between columns i and i+1, and its integral up to x.
     const double c0 = (1 - t) * v(i, j) + t * v(i, j + 1);
     const double c1 = (1 - t) * v(i + 1, j) + t * v(i + 1, j + 1);
-    const double partial =
+    const double left =
         (1 - t) * cond(i, j) + t * cond(i, j + 1) + dx * s * (c0 + 0.5 * s * (c1 - c0));
-    const double u_x = row > 0 ? partial / row : 0;
-    return {std::clamp(u_x, 0.0, 1.0), std::clamp(u_y, 0.0, 1.0)};
+    return {left, row, below};
+}
+
+std::array<double, 2> BilinearWarp::invert(std::array<double, 2> x) const {
+    const Masses m = masses(x);
+    const double u_x = m.row > 0 ? m.left / m.row : 0;
+    return {std::clamp(u_x, 0.0, 1.0), std::clamp(m.below, 0.0, 1.0)};
 }
 
 std::array<double, 2> BilinearWarp::sample(std::array<double, 2> u) const {

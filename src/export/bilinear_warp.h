@@ -24,6 +24,15 @@ class BilinearWarp {
     /// x → u, the inverse of sample (the readers' map).
     std::array<double, 2> invert(std::array<double, 2> x) const;
 
+    /// The three masses invert() is made of, each a fraction of the total: `left` of the row
+    /// through x left of x, that `row` (a density in y), and `below` of the row (u_y). invert(x) is
+    /// (left / row, below). A reader that interpolates between warps (pbrt-v4 and Mitsuba 3
+    /// between incidences) interpolates these masses, not the inverted coordinates.
+    struct Masses {
+        double left, row, below;
+    };
+    Masses masses(std::array<double, 2> x) const;
+
   private:
     double v(int i, int j) const { return values_[std::size_t(j) * nx_ + i]; }
     double cond(int i, int j) const { return cond_[std::size_t(j) * nx_ + i]; }

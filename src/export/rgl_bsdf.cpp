@@ -5,6 +5,7 @@
 #include "core/math.h"
 #include "core/spherical.h"
 #include "export/bilinear_warp.h"
+#include "export/rgl_parameterization.h"
 
 #include <fmt/format.h>
 
@@ -15,43 +16,147 @@ namespace lamina {
 
 namespace {
 
-constexpr double kPiD = kPi<double>;
+using rgl::direction_at;
+using rgl::solid_angle_jacobian;
+using rgl::theta_to_u;
+using rgl::u_to_theta;
 
-double u_to_theta(double u) {
-    return u * u * (kPiD / 2);
-}
-double u_to_phi(double u) {
-    return (2 * u - 1) * kPiD;
-}
-double theta_to_u(double theta) {
-    return std::sqrt(std::max(0.0, theta) / (kPiD / 2));
+// The writer's choices (docs/formats.md, "How lamina writes a .bsdf"), each found by measuring
+// the figures of rgl_fidelity.h over the study's configurations.
+/// P(ωm, ωm) is held at this fraction of its peak at least: it divides S.
+constexpr double kRetroFloor = 1e-4;
+/// ln D changes by at most this between two ndf nodes, so that the readers' linear interpolation
+/// of D is within kMaxLogStep²/8 ≈ 0.8% of a smooth curve; a lobe narrower than that is left to
+/// S, whose nodes gather there.
+constexpr double kMaxLogStep = 0.25;
+/// The warp's density along u_x: these shares uniform, where ln P(ωm, ωm) changes, and where
+/// ln S changes (the rest).
+constexpr double kUniformShare = 0.5, kRetroShare = 0.25;
+/// Samples along u_x for P and for the changes of S, and azimuths of ωm for the latter.
+constexpr int kFine = 4096, kMonitorSamples = 1024, kMonitorAzimuths = 8;
+/// Where ωo falls below the horizon, S takes the value of the direction at this cos θo.
+constexpr double kHorizonCos = 1e-3;
+
+void check_resolution(int n, const char* field, int max) {
+    if (n < 2 || n > max)
+        throw InputError("command line", field, fmt::format("{} is outside [2, {}]", n, max));
 }
 
-Vec3d from_u(double ux, double uy) {
-    return direction_from_angles(u_to_theta(ux), u_to_phi(uy));
-}
-
-/// A float32 table on an nx × ny node grid over [0, 1]², evaluated as the readers do (bilinear).
-struct NodeTable {
-    int nx, ny;
-    std::vector<float> v;
-    double eval(double x, double y) const {
-        const double gx = std::clamp(x, 0.0, 1.0) * (nx - 1),
-                     gy = std::clamp(y, 0.0, 1.0) * (ny - 1);
-        const int i = std::min(int(gx), nx - 2), j = std::min(int(gy), ny - 2);
-        const double s = gx - i, t = gy - j;
-        auto at = [&](int a, int b) { return double(v[std::size_t(b) * nx + a]); };
-        return (1 - t) * ((1 - s) * at(i, j) + s * at(i + 1, j)) +
-               t * ((1 - s) * at(i, j + 1) + s * at(i + 1, j + 1));
+/// P(ωm, ωm) = Y(f(ωm, ωm)) cos²θm, the retro-reflection (for a microfacet BRDF F G D / 4), at
+/// u_x = i/kFine, floored at kRetroFloor of its peak.
+std::vector<double> retro_reflection(const BrdfSource& brdf) {
+    std::vector<double> p(kFine + 1);
+    double peak = 0;
+    for (int i = 0; i <= kFine; ++i) {
+        const double theta = std::min(u_to_theta(double(i) / kFine), kPi<double> / 2 * (1 - 1e-6));
+        const Vec3d m = direction_from_angles(theta, 0.0);
+        p[std::size_t(i)] = std::max(0.0, luminance(brdf.f(m, m))) * sqr(std::cos(theta));
+        peak = std::max(peak, p[std::size_t(i)]);
     }
-};
+    if (!(peak > 0) || !std::isfinite(peak))
+        throw InputError(brdf.name, "f", "the BRDF is zero or not finite at retro-reflection");
+    for (double& x : p)
+        x = std::max(x, kRetroFloor * peak);
+    return p;
+}
 
-void check_resolution(int n, const char* field) {
-    if (n < 2 || n > 512)
-        throw InputError("command line", field, fmt::format("{} is outside [2, 512]", n));
+/// D at nd nodes of u_x: P(ωm, ωm) with its log-slope limited to kMaxLogStep per node (the
+/// largest function below P that obeys it), normalized to ∫ D cos θm dωm = 1.
+std::vector<double> ndf_nodes(const std::vector<double>& retro, int nd) {
+    std::vector<double> d(static_cast<std::size_t>(nd));
+    for (int a = 0; a < nd; ++a)
+        d[std::size_t(a)] = rgl::linear(retro.data(), retro.size(), double(a) / (nd - 1));
+    const double step = std::exp(kMaxLogStep);
+    for (std::size_t a = 1; a < d.size(); ++a)
+        d[a] = std::min(d[a], d[a - 1] * step);
+    for (std::size_t a = d.size() - 1; a-- > 0;)
+        d[a] = std::min(d[a], d[a + 1] * step);
+    constexpr int kQ = 16384;  // midpoint rule; D is linear between nodes
+    double integral = 0;
+    for (int q = 0; q < kQ; ++q) {
+        const double ux = (q + 0.5) / kQ;
+        integral += rgl::linear(d.data(), d.size(), ux) * std::cos(u_to_theta(ux)) *
+                    solid_angle_jacobian(ux);
+    }
+    for (double& x : d)
+        x /= integral / kQ;
+    return d;
+}
+
+/// |Δ ln S| between neighbouring samples of u_x at incidence wi, averaged over kMonitorAzimuths
+/// azimuths of ωm (S ∝ Y(f) cos θo / D; samples whose ωo is below the horizon are skipped).
+std::vector<double> s_changes(const BrdfSource& brdf, const Vec3d& wi,
+                              const std::vector<float>& ndf, std::size_t nd) {
+    std::vector<double> out(kMonitorSamples, 0.0);
+    for (int r = 0; r < kMonitorAzimuths; ++r) {
+        const double uy = (r + 0.5) / (2 * kMonitorAzimuths);  // φm in (−π, 0): symmetric
+        double previous = 0;
+        bool have_previous = false;
+        for (int i = 0; i <= kMonitorSamples; ++i) {
+            const double ux = double(i) / kMonitorSamples;
+            const Vec3d m = direction_at(ux, uy);
+            const double cos_im = dot(wi, m);
+            const Vec3d wo = m * (2 * cos_im) - wi;
+            double ln_s = 0;
+            bool ok = cos_im > 0 && wo.z > kHorizonCos;
+            if (ok) {
+                const double s =
+                    luminance(brdf.f(wi, wo)) * wo.z / rgl::bilinear(ndf.data(), nd, 2, ux, 0.0);
+                ok = s > 0 && std::isfinite(s);
+                if (ok) ln_s = std::log(s);
+            }
+            if (ok && have_previous) out[std::size_t(i - 1)] += std::abs(ln_s - previous);
+            have_previous = ok;
+            previous = ln_s;
+        }
+    }
+    return out;
+}
+
+/// The warp's density at nv nodes of u_x: kUniformShare uniform, kRetroShare by |Δ ln P(ωm, ωm)|
+/// (the cores and edges of narrow lobes), the rest by |Δ ln S| summed over the incidences (in
+/// their order: the same for any thread count). Each share is a density over [0, 1]; a node gets
+/// the mean of the share's density over its half cells.
+std::vector<double> warp_nodes(const std::vector<double>& retro,
+                               const std::vector<double>& s_change, int nv) {
+    std::vector<double> retro_change(kFine);
+    for (int f = 0; f < kFine; ++f)
+        retro_change[std::size_t(f)] =
+            std::abs(std::log(retro[std::size_t(f) + 1] / retro[std::size_t(f)]));
+    auto mean_density = [](const std::vector<double>& change, double lo, double hi) {
+        const std::size_t n = change.size();
+        double total = 0, mass = 0;
+        for (double c : change)
+            total += c;
+        if (!(total > 0)) return 1.0;
+        for (std::size_t f = std::size_t(lo * double(n));
+             f < std::min(n, std::size_t(std::ceil(hi * double(n)))); ++f)
+            mass += change[f];
+        return mass / total / (hi - lo);
+    };
+    std::vector<double> a(static_cast<std::size_t>(nv));
+    for (int i = 0; i < nv; ++i) {
+        const double lo = std::max(0.0, (i - 0.5) / (nv - 1)),
+                     hi = std::min(1.0, (i + 0.5) / (nv - 1));
+        a[std::size_t(i)] = kUniformShare + kRetroShare * mean_density(retro_change, lo, hi) +
+                            (1 - kUniformShare - kRetroShare) * mean_density(s_change, lo, hi);
+    }
+    return a;
 }
 
 }  // namespace
+
+std::vector<double> rgl_default_incidences() {
+    // Every kStep degrees while that is at most kShare of the distance to the horizon, then steps
+    // of kShare of it (S and the readers' interpolation between incidences change faster there),
+    // and kLast last (past it the readers hold the last incidence).
+    constexpr double kStep = 4, kShare = 0.25, kLast = 88;
+    std::vector<double> out;
+    for (double t = 0; t < kLast - 0.5; t += std::min(kStep, kShare * (90 - t)))
+        out.push_back(std::round(t * 100) / 100);
+    out.push_back(kLast);
+    return out;
+}
 
 const std::vector<double>& rgl_wavelengths() {
     static const std::vector<double> w = {400, 450, 500, 550, 600, 650, 700};
@@ -66,132 +171,106 @@ Rgbd rgl_spectral_weights(std::size_t k) {
 }
 
 TensorFile rgl_bsdf(const BrdfSource& brdf, const RglOptions& o) {
-    check_resolution(o.resolution, "--resolution");
-    check_resolution(o.vndf_resolution, "--vndf-resolution");
-    check_resolution(o.ndf_resolution, "--ndf-resolution");
+    check_resolution(o.resolution, "--resolution", 512);
+    check_resolution(o.vndf_resolution, "--vndf-resolution", 8192);
+    check_resolution(o.ndf_resolution, "--ndf-resolution", 8192);
     std::vector<double> thetas = !o.theta_i_deg.empty() ? o.theta_i_deg : brdf.theta_i_deg;
-    if (thetas.empty())
-        for (int k = 0; k <= 22; ++k)
-            thetas.push_back(4.0 * k);
+    if (thetas.empty()) thetas = rgl_default_incidences();
     for (std::size_t k = 0; k < thetas.size(); ++k)
         if (!incidence_in_range(thetas[k]) || (k > 0 && !(thetas[k] > thetas[k - 1])))
             throw InputError("command line", "--theta-i",
                              "incidences must increase strictly within [0, 90) degrees");
-    const int nd = o.ndf_resolution, nv = o.vndf_resolution, ns = o.resolution;
-    const std::size_t n_inc = thetas.size();
+    const std::size_t nd = std::size_t(o.ndf_resolution), nv = std::size_t(o.vndf_resolution),
+                      ns = std::size_t(o.resolution), n_inc = thetas.size(), plane = ns * ns;
 
-    // 1. D from the retro-reflection, D ∝ Y(f(ωm, ωm)) cos²θm, floored (it divides S), then
-    //    normalized to ∫ D cos θm dωm = 1 (by the interpolant the reader has).
-    std::vector<double> d_theta(nd);
-    double d_max = 0;
-    for (int a = 0; a < nd; ++a) {
-        const double theta = std::min(u_to_theta(double(a) / (nd - 1)), kPiD / 2 * (1 - 1e-6));
-        const Vec3d m = direction_from_angles(theta, 0.0);
-        d_theta[a] = std::max(0.0, luminance(brdf.f(m, m))) * sqr(std::cos(theta));
-        d_max = std::max(d_max, d_theta[a]);
-    }
-    if (!(d_max > 0) || !std::isfinite(d_max))
-        throw InputError(brdf.name, "f", "the BRDF is zero or not finite at retro-reflection");
-    for (double& d : d_theta)
-        d = std::max(d, 2e-2 * d_max);  // D divides S: keep it away from 0
-    NodeTable ndf{nd, nd, std::vector<float>(std::size_t(nd) * nd)};
-    auto fill_ndf = [&](double scale) {
-        for (int b = 0; b < nd; ++b)
-            for (int a = 0; a < nd; ++a)
-                ndf.v[std::size_t(b) * nd + a] = float(d_theta[a] * scale);
-    };
-    fill_ndf(1.0);
-    // ∫ D cos θ dω in u: dω = 2π² u sin θ du_x du_y (θ = u²π/2, φ = (2u − 1)π); midpoint rule.
-    constexpr int kQ = 512;
-    auto projected = [&](const Vec3d& w) {
-        double sum = 0;
-        for (int a = 0; a < kQ; ++a) {
-            const double ux = (a + 0.5) / kQ, theta = u_to_theta(ux);
-            const double jac = 2 * kPiD * kPiD * ux * std::sin(theta);
-            for (int b = 0; b < kQ / 2; ++b) {
-                const double uy = (b + 0.5) / (kQ / 2);
-                const Vec3d m = from_u(ux, uy);
-                sum += ndf.eval(ux, uy) * std::max(0.0, dot(w, m)) * jac;
-            }
-        }
-        return sum / (double(kQ) * (kQ / 2));
-    };
-    fill_ndf(1.0 / projected(Vec3d(0, 0, 1)));
+    // 1. D from the retro-reflection, on two equal rows of u_y (isotropic).
+    const std::vector<double> retro = retro_reflection(brdf);
+    const std::vector<double> d = ndf_nodes(retro, int(nd));
+    std::vector<float> ndf(2 * nd);
+    for (std::size_t a = 0; a < nd; ++a)
+        ndf[a] = ndf[nd + a] = float(d[a]);
 
-    // 2. σ(ωi) on the u grid of ωi (isotropic: each row the same).
-    NodeTable sigma{nd, nd, std::vector<float>(std::size_t(nd) * nd)};
-    std::vector<double> sigma_theta(nd);
+    // 2. σ(θi) = cos θi, held past the last incidence (the readers hold S there too, so that f
+    //    stays bounded as θi → 90°).
+    const double theta_last = deg_to_rad(thetas.back());
+    std::vector<float> sigma(2 * nd);
+    for (std::size_t a = 0; a < nd; ++a)
+        sigma[a] = sigma[nd + a] =
+            float(std::cos(std::min(u_to_theta(double(a) / double(nd - 1)), theta_last)));
+
+    // 3. The warp, a density of u_x alone and the same at every incidence, so that s_x ↔ u_x is
+    //    one map: S's features in θm line up across rows of s and across incidences.
+    std::vector<std::vector<double>> changes(n_inc);
 #pragma omp parallel for schedule(dynamic, 1)
-    for (int a = 0; a < nd; ++a)
-        sigma_theta[a] = projected(direction_from_angles(u_to_theta(double(a) / (nd - 1)), 0.0));
-    for (int b = 0; b < nd; ++b)
-        for (int a = 0; a < nd; ++a)
-            sigma.v[std::size_t(b) * nd + a] = float(sigma_theta[a]);
+    for (std::size_t k = 0; k < n_inc; ++k)
+        changes[k] = s_changes(brdf, incident_direction(deg_to_rad(thetas[k])), ndf, nd);
+    std::vector<double> s_change(kMonitorSamples, 0.0);
+    for (const std::vector<double>& c : changes)
+        for (std::size_t f = 0; f < c.size(); ++f)
+            s_change[f] += c[f];
+    const std::vector<double> a = warp_nodes(retro, s_change, int(nv));
+    std::vector<float> vndf_slice(2 * nv);
+    for (std::size_t i = 0; i < nv; ++i)
+        vndf_slice[i] = vndf_slice[nv + i] = float(a[i]);
+    const BilinearWarp warp(std::vector<double>(vndf_slice.begin(), vndf_slice.end()), int(nv), 2);
 
-    // 3. Per incidence: the VNDF warp and the values S at the s nodes.
+    // 4. Per incidence: S at the s nodes, S = 4 f cos θo σ(θi) / D(ωm) (at the nodes a reader
+    //    gives f back to float32 precision), and the density to sample s from.
     const std::size_t nl = rgl_wavelengths().size();
-    std::vector<float> vndf(n_inc * nv * nv), lum(n_inc * ns * ns), rgb(n_inc * 3 * ns * ns),
-        spectra(n_inc * nl * ns * ns);
+    std::vector<float> vndf(n_inc * vndf_slice.size()), lum(n_inc * plane),
+        spectra(n_inc * nl * plane);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::size_t k = 0; k < n_inc; ++k) {
         const double theta_i = deg_to_rad(thetas[k]);
         const Vec3d wi = incident_direction(theta_i);
-        const double sigma_i = sigma.eval(theta_to_u(theta_i), 0.5);
-        std::vector<double> density(std::size_t(nv) * nv);
-        for (int b = 0; b < nv; ++b)
-            for (int a = 0; a < nv; ++a) {
-                const double ux = double(a) / (nv - 1), uy = double(b) / (nv - 1);
-                const Vec3d m = from_u(ux, uy);
-                const double jac = 2 * kPiD * kPiD * ux * std::sin(u_to_theta(ux));
-                density[std::size_t(b) * nv + a] =
-                    ndf.eval(ux, uy) * std::max(0.0, dot(wi, m)) * jac;
-                vndf[(k * nv + b) * nv + a] = float(density[std::size_t(b) * nv + a]);
+        const double sigma_i = rgl::bilinear(sigma.data(), nd, 2, theta_to_u(theta_i), 0.5);
+        std::copy(vndf_slice.begin(), vndf_slice.end(),
+                  vndf.begin() + std::ptrdiff_t(k * vndf_slice.size()));
+        std::vector<Rgbd> s_values(plane);
+        std::vector<double> weights(plane);
+        double weight_max = 0;
+        for (std::size_t j = 0; j < plane; ++j) {
+            const auto u =
+                warp.sample({double(j % ns) / double(ns - 1), double(j / ns) / double(ns - 1)});
+            const Vec3d m = direction_at(u[0], u[1]);
+            const double cos_im = dot(wi, m);
+            const Vec3d wo = m * (2 * cos_im) - wi;
+            // Nodes whose ωo is below the horizon are never evaluated by a reader, but their
+            // neighbours interpolate with them: S of the direction just above the horizon at the
+            // same azimuth (f cos θo → 0 there), the continuous extension.
+            Vec3d out = wo;
+            const double xy = std::hypot(wo.x, wo.y);
+            if (wo.z < kHorizonCos && xy > 0) {
+                const double r = std::sqrt(1 - kHorizonCos * kHorizonCos) / xy;
+                out = Vec3d(wo.x * r, wo.y * r, kHorizonCos);
             }
-        const BilinearWarp warp(density, nv, nv);
-        std::vector<Rgbd> s_values(std::size_t(ns) * ns);
-        double y_max = 0;
-        for (int b = 0; b < ns; ++b)
-            for (int a = 0; a < ns; ++a) {
-                const auto u = warp.sample({double(a) / (ns - 1), double(b) / (ns - 1)});
-                const Vec3d m = from_u(u[0], u[1]);
-                const Vec3d wo = m * (2 * dot(wi, m)) - wi;
-                // Nodes whose ωo falls below the horizon are never evaluated by a reader, but
-                // their neighbours interpolate with them: give them S of the direction just above
-                // the horizon at the same azimuth (f|cos θo| stays finite there for a glossy
-                // lobe), the continuous extension, rather than a jump to 0.
-                Vec3d out = wo;
-                const double xy = std::hypot(wo.x, wo.y);
-                if (wo.z < 1e-3 && xy > 0) {
-                    constexpr double kZ = 1e-3;
-                    const double r = std::sqrt(1 - kZ * kZ) / xy;
-                    out = Vec3d(wo.x * r, wo.y * r, kZ);
-                }
-                const double d = ndf.eval(u[0], u[1]);
-                Rgbd s = brdf.f(wi, out) * (out.z * 4 * sigma_i / d);
-                for (int c = 0; c < 3; ++c)
-                    if (!std::isfinite(s[c]) || s[c] < 0) s[c] = 0;
-                s_values[std::size_t(b) * ns + a] = s;
-                y_max = std::max(y_max, luminance(s));
-            }
-        for (std::size_t j = 0; j < s_values.size(); ++j) {
-            const Rgbd& s = s_values[j];
-            lum[k * ns * ns + j] = float(std::max(luminance(s), 1e-4 * y_max + 1e-12));
+            const double d_m = rgl::bilinear(ndf.data(), nd, 2, u[0], u[1]);
+            Rgbd s = brdf.f(wi, out) * (out.z * 4 * sigma_i / d_m);
             for (int c = 0; c < 3; ++c)
-                rgb[(k * 3 + c) * ns * ns + j] = float(s[c]);
+                if (!std::isfinite(s[c]) || s[c] < 0) s[c] = 0;
+            s_values[j] = s;
+            // Sampling s ∝ Y(f) cos θo / (warp density of ωo) = Y(S) D (ωi·ωm) J / (4σ p) makes
+            // the readers' Sample_f follow f cos θo (the constant 4σ drops out).
+            const double p = warp.eval(u);
+            const double w = wo.z > 0 && cos_im > 0 && p > 0
+                                 ? luminance(s) * d_m * cos_im * solid_angle_jacobian(u[0]) / p
+                                 : 0;
+            weights[j] = std::isfinite(w) ? w : 0;
+            weight_max = std::max(weight_max, weights[j]);
+        }
+        for (std::size_t j = 0; j < plane; ++j) {
+            // Never 0, so that a renderer can sample every direction it evaluates.
+            lum[k * plane + j] = float(std::max(weights[j], 1e-4 * weight_max + 1e-12));
             for (std::size_t l = 0; l < nl; ++l) {
                 const Rgbd w = rgl_spectral_weights(l);
-                spectra[(k * nl + l) * ns * ns + j] =
-                    float(w[0] * s[0] + w[1] * s[1] + w[2] * s[2]);
+                const Rgbd& sj = s_values[j];
+                spectra[(k * nl + l) * plane + j] =
+                    float(w[0] * sj[0] + w[1] * sj[1] + w[2] * sj[2]);
             }
         }
     }
 
-    // 4. Two equal φi slices (isotropic), then the file.
-    auto twice = [](const std::vector<float>& v) {
-        std::vector<float> out(v);
-        out.insert(out.end(), v.begin(), v.end());
-        return out;
-    };
+    // 5. The file: one φi slice (isotropic).
     std::vector<float> theta_rad, wavelengths;
     for (double t : thetas)
         theta_rad.push_back(float(deg_to_rad(t)));
@@ -204,14 +283,12 @@ TensorFile rgl_bsdf(const BrdfSource& brdf, const RglOptions& o) {
     file["description"] = tensor_uint8(description, {description.size()});
     file["jacobian"] = tensor_uint8(std::string(1, '\1'), {1});
     file["theta_i"] = tensor_float32(theta_rad, {n});
-    file["phi_i"] = tensor_float32({float(-kPiD), float(kPiD)}, {2});
-    file["ndf"] = tensor_float32(ndf.v, {std::uint64_t(nd), std::uint64_t(nd)});
-    file["sigma"] = tensor_float32(sigma.v, {std::uint64_t(nd), std::uint64_t(nd)});
-    file["vndf"] = tensor_float32(twice(vndf), {2, n, std::uint64_t(nv), std::uint64_t(nv)});
-    file["luminance"] = tensor_float32(twice(lum), {2, n, std::uint64_t(ns), std::uint64_t(ns)});
-    file["rgb"] = tensor_float32(twice(rgb), {2, n, 3, std::uint64_t(ns), std::uint64_t(ns)});
-    file["spectra"] =
-        tensor_float32(twice(spectra), {2, n, nl, std::uint64_t(ns), std::uint64_t(ns)});
+    file["phi_i"] = tensor_float32({0.0f}, {1});
+    file["ndf"] = tensor_float32(ndf, {2, nd});
+    file["sigma"] = tensor_float32(sigma, {2, nd});
+    file["vndf"] = tensor_float32(vndf, {1, n, 2, nv});
+    file["luminance"] = tensor_float32(lum, {1, n, ns, ns});
+    file["spectra"] = tensor_float32(spectra, {1, n, nl, ns, ns});
     file["wavelengths"] = tensor_float32(wavelengths, {nl});
     return file;
 }

@@ -3,27 +3,46 @@
 // acquisition and rendering", ACM TOG 37(6)), the format of pbrt-v4's `measured` material and
 // Mitsuba 3's `measured` plugin, written from a BRDF (docs/formats.md, "Exports").
 //
-// The format tabulates, for incidences θi (the `theta_i` field, radians):
-//   ndf       D(ωm) on the grid u = (√(θm/(π/2)), (φm + π)/(2π)) ∈ [0, 1]² (bilinear);
-//   sigma     σ(ωi) = ∫ D(ωm) ⟨ωi·ωm⟩ dωm, the projected microfacet area, on the same u grid of ωi;
-//   vndf      per θi, the density in u of the visible normals D(ωm)⟨ωi·ωm⟩/σ(ωi) (φm relative to
-//             φi: isotropic), whose bilinear warp (export/bilinear_warp.h) maps a "sample" point
-//             s ∈ [0, 1]² to a half vector ωm;
-//   rgb, spectra  per θi, the values S on a regular grid of s, such that a reader evaluates
-//             f(ωi, ωo) |cos θo| = S(s) D(ωm) / (4 σ(ωi)),  ωm = (ωi + ωo)/|ωi + ωo|,
-//             s = vndf warp inverted at u(ωm), S bilinear in s and linear in θi and λ;
-//   luminance per θi, a density over s for importance sampling (here Y of S);
+// The format tabulates, for incidences θi (the `theta_i` field, radians), in the coordinates
+// u = (√(θ/(π/2)), (φ + π)/(2π)) of rgl_parameterization.h:
+//   ndf       D(ωm) on a node grid of u (φm relative to φi in isotropic files);
+//   sigma     σ(θi) on a node grid of u(ωi);
+//   vndf      per θi, a density on a node grid of u, whose bilinear warp (bilinear_warp.h) maps a
+//             "sample" point s ∈ [0, 1]² to a half vector ωm;
+//   spectra   per θi and wavelength, the values S on a regular grid of s, such that a reader
+//             evaluates f(ωi, ωo) |cos θo| = S(s) D(ωm) / (4 σ(θi)), ωm = (ωi + ωo)/|ωi + ωo|,
+//             s = the vndf warp inverted at u(ωm), S bilinear in s and linear in θi and λ
+//             (rgl_reader.h evaluates a file as the readers do);
+//   luminance per θi, a density over s the readers sample s from;
 //   description, jacobian (1: the D/(4σ) factor above applies), phi_i, wavelengths.
-// Writing: S at each s node = f(ωi, ωo)|cos θo| 4σ(ωi)/D(ωm) with ωm the warp of s, D and σ the
-// values the reader interpolates from the written tables: at the nodes a reader gives back f
-// exactly (to float32), in between it interpolates. D is estimated from the BRDF's
-// retro-reflection (D ∝ f(ωm, ωm) cos²θm, the microfacet relation at ωi = ωo = ωm; floored at 2%
-// of its peak, since it divides S), so that the samples gather where the lobe is.
+// The format was designed (Dupuy & Jakob 2018) with D the material's microfacet distribution,
+// σ its projected area and vndf the visible normals D⟨ωi·ωm⟩/σ, which makes S smooth for one
+// rough interface. A layered BRDF is a sum of lobes whose ratios change with θi (a coat's
+// near-specular reflection over a diffuse or rough base: at 80° the coat's share is tens of times
+// its share at normal incidence), and no one D makes S smooth at every incidence. lamina writes:
+//   D      the retro-reflection P(ωm, ωm) = Y(f(ωm, ωm)) cos²θm (for a microfacet BRDF F G D/4),
+//          floored at 1e-4 of its peak, its log-slope limited so that the readers' linear
+//          interpolation keeps it, normalized to ∫ D cos θm dωm = 1;
+//   σ      cos θi, held past the last incidence: S = 4 f cos θi cos θo / D changes slowly with θi
+//          (f cos θi cos θo is reciprocal and bounded), and f stays bounded as θi → 90°;
+//   vndf   one density of u_x alone, the same at every incidence, so that s_x ↔ θm is one map:
+//          S's features in θm (a lobe's core, where the coat's lobe gives way to the base's) line
+//          up across the rows of s and across incidences, and the readers' blending of warps
+//          between incidences changes nothing. Half of it is uniform, a quarter follows the changes
+//          of ln P(ωm, ωm) (the nodes gather in a narrow lobe's core and edges), a quarter the
+//          changes of ln S along θm over the incidences;
+//   S      at each s node, f(ωi, ωo)|cos θo| 4σ(θi)/D(ωm), ωm the warp of the node and D, σ the
+//          values a reader interpolates: at the nodes a reader gives back f to float32 precision;
+//   luminance  Y(S) D (ωi·ωm) J / p (p the warp's density, J = dω/du): the readers then sample
+//          ωo in proportion to f cos θo (floored at 1e-4 of its peak: every direction is sampled).
+// The defaults (rgl_default_incidences, RglOptions) are sized so that a renderer gets within the
+// goals of rgl_fidelity.h on the study's configurations (docs/formats.md gives the figures).
 //
 // Only the reflection side: neither pbrt-v4's nor Mitsuba 3's reader takes a BTDF. Isotropic:
-// phi_i holds two equal slices (φi = −π and π). RGB → spectra: lamina is RGB; the spectra are a
-// piecewise-linear upsampling (b below 450 nm, g at 550 nm, r above 650 nm, linear in between:
-// grey stays grey exactly), since pbrt-v4 reads only the spectral data.
+// phi_i holds one slice. RGB → spectra: lamina is RGB; the spectra are a piecewise-linear
+// upsampling (b below 450 nm, g at 550 nm, r above 650 nm, linear in between: grey stays grey
+// exactly), since pbrt-v4 reads only the spectral data; the colour is the spectra at 450, 550 and
+// 650 nm.
 
 #include "export/brdf_source.h"
 #include "export/tensor_file.h"
@@ -34,19 +53,25 @@
 namespace lamina {
 
 struct RglOptions {
-    std::vector<double> theta_i_deg;  ///< the incidences; empty: the source's, or 0..88° by 4°
-    int resolution = 32;              ///< s-grid nodes a side (rgb, spectra, luminance)
-    int vndf_resolution = 64;         ///< u-grid nodes a side of vndf
-    int ndf_resolution = 64;          ///< u-grid nodes a side of ndf and sigma
+    std::vector<double> theta_i_deg;  ///< the incidences; empty: the source's, or the defaults
+    int resolution = 48;              ///< s nodes a side (spectra, luminance), in [2, 512]
+    int vndf_resolution = 512;        ///< warp nodes along θm (u_x), in [2, 8192]
+    int ndf_resolution = 512;         ///< ndf and sigma nodes along θ (u_x), in [2, 8192]
     std::string description;
 };
+
+/// The incidences (degrees) a model's file gets by default: every 4° while that is at most a
+/// quarter of the distance to the horizon, then steps of a quarter of it (rounded to 0.01°), and
+/// 88° last; 26 of them.
+std::vector<double> rgl_default_incidences();
 
 /// The wavelengths (nm) of the spectra field and the RGB weights of each.
 const std::vector<double>& rgl_wavelengths();
 Rgbd rgl_spectral_weights(std::size_t wavelength_index);
 
-/// The tensor file of the BRDF. InputError for options out of range (resolutions in [2, 512],
-/// incidences increasing in [0, 90)).
+/// The tensor file of the BRDF. InputError for options out of range (the resolutions' ranges
+/// above, incidences increasing in [0, 90)). Parallel over incidences (OpenMP); the file does not
+/// depend on the thread count.
 TensorFile rgl_bsdf(const BrdfSource& brdf, const RglOptions& options);
 
 /// Checks the fields and shapes a reader requires (the structure pbrt-v4 and Mitsuba 3 check on

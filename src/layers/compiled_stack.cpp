@@ -10,6 +10,7 @@ CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& s
     const bool multiple = settings.microsurface == Microsurface::Multiple;
     out.multiple_scattering = multiple;
     out.max_microsurface_order = settings.max_microsurface_order;
+    out.polarization = settings.polarization;
     for (std::size_t i = 0; i < stack.layers.size(); ++i) {
         const Layer& layer = stack.layers[i];
         const InterfaceSpec& spec = layer.interface;
@@ -31,6 +32,7 @@ CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& s
                                Real(spec.alpha)};
                 t.delta = t.conductor.is_smooth();
                 t.multiple = multiple && !t.delta;
+                if (!t.conductor.is_grey()) out.polarization_channels = 3;
                 t.eta_below = Real(eta_above);  // no region below an opaque base
                 break;
             case InterfaceType::Lambertian:

@@ -58,6 +58,13 @@ struct CompiledStack {
     /// Microsurface::Multiple: a rough interface's layer has `multiple` set when this is.
     bool multiple_scattering = false;
     int max_microsurface_order = TransportSettings{}.max_microsurface_order;
+    /// TransportSettings::polarization: the particles carry a polarization state
+    /// (physics/polarization.h).
+    bool polarization = false;
+    /// Polarization states a particle needs: 1 when every Mueller matrix of the stack is the same
+    /// in all channels (dielectrics, Lambertian bases, grey conductors), 3 when a conductor's
+    /// index differs between channels.
+    int polarization_channels = 1;
 };
 
 /// The stack compiled in precision Real (float: the goniophotometer's kernels; double: the random

@@ -199,11 +199,12 @@ struct Allowed {
 // keep every number inside the domain the estimators are written for: relative dielectric indices
 // within [1/5, 5] (the TIR and FGD tables of models/ cover it), roughnesses whose α² and GGX peak
 // 1/(πα²) are normal floats, optical depths whose attenuation is still above float's smallest
-// normal number, and HG phase functions whose 1 − g² survives float rounding.
+// normal number (absorption) or whose mean free path is still many float ulps of a layer
+// (scattering), and HG phase functions whose 1 − g² survives float rounding.
 constexpr double kEtaDielectricMin = 1, kEtaDielectricMax = 5;
 constexpr double kEtaConductorMin = 0.01, kEtaConductorMax = 10, kKConductorMax = 10;
 constexpr double kAlphaRoughMin = 1e-4;
-constexpr double kTauMax = 100;
+constexpr double kTauMax = 100, kTauScatteringMax = 1e4;
 constexpr double kGMax = 0.99;
 constexpr std::size_t kMaxLayers = 100;
 
@@ -215,6 +216,8 @@ constexpr Allowed kConductorK{[](double v) { return v >= 0 && v <= kKConductorMa
 constexpr Allowed kAlpha{[](double v) { return v == 0 || (v >= kAlphaRoughMin && v <= 1); },
                          "0 (smooth) or [0.0001, 1]"};
 constexpr Allowed kOpticalDepth{[](double v) { return v >= 0 && v <= kTauMax; }, "[0, 100]"};
+constexpr Allowed kScatteringDepth{[](double v) { return v >= 0 && v <= kTauScatteringMax; },
+                                   "[0, 10000]"};
 constexpr Allowed kUnit{[](double v) { return v >= 0 && v <= 1; }, "[0, 1]"};
 constexpr Allowed kHgG{[](double v) { return v >= -kGMax && v <= kGMax; }, "[-0.99, 0.99]"};
 
@@ -423,7 +426,7 @@ class Reader {
             out.tau_a = rgb(j["tau_a"], child(pointer, "tau_a"), kOpticalDepth,
                             "absorption normal optical depth, dimensionless");
         if (j.contains("tau_s"))
-            out.tau_s = rgb(j["tau_s"], child(pointer, "tau_s"), kOpticalDepth,
+            out.tau_s = rgb(j["tau_s"], child(pointer, "tau_s"), kScatteringDepth,
                             "scattering normal optical depth, dimensionless");
         if (j.contains("g"))
             out.g = rgb(j["g"], child(pointer, "g"), kHgG, "Henyey-Greenstein mean cosine");

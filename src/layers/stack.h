@@ -70,6 +70,42 @@ struct Stack {
     bool operator==(const Stack&) const = default;
 };
 
+/// Stacks built in code (the study's configurations, the tests): an interface of each type, a layer
+/// of an interface, a medium under a layer. Nothing is range-checked here: stack_from_json checks
+/// what a file holds.
+inline InterfaceSpec dielectric_interface(double eta, double alpha) {
+    InterfaceSpec s;
+    s.type = InterfaceType::Dielectric;
+    s.eta = eta;
+    s.alpha = alpha;
+    return s;
+}
+inline InterfaceSpec conductor_interface(const Rgbd& eta, const Rgbd& k, double alpha) {
+    InterfaceSpec s;
+    s.type = InterfaceType::Conductor;
+    s.eta_rgb = eta;
+    s.k = k;
+    s.alpha = alpha;
+    return s;
+}
+inline InterfaceSpec lambertian_interface(const Rgbd& albedo) {
+    InterfaceSpec s;
+    s.type = InterfaceType::Lambertian;
+    s.albedo = albedo;
+    return s;
+}
+inline Layer layer_of(const InterfaceSpec& interface) {
+    Layer l;
+    l.interface = interface;
+    return l;
+}
+inline Layer with_medium(Layer layer, const Rgbd& tau_a, const Rgbd& tau_s = Rgbd(0.0),
+                         const Rgbd& g = Rgbd(0.0)) {
+    layer.has_medium = true;
+    layer.medium = {tau_a, tau_s, g};
+    return layer;
+}
+
 /// Parses and validates a stack from JSON (format: docs/stack-format.md). `where` names the source
 /// (a file) in error messages; `name` defaults to its stem. Throws one InputError naming `where`,
 /// the JSON pointer of the field, the value and what is allowed, for: unknown keys (with the
@@ -77,7 +113,8 @@ struct Stack {
 /// every key of an interface type, `alpha` included), wrong types, RGB arrays of the wrong length,
 /// NaN/inf, an RGB dielectric eta, any number outside its physical range (docs/stack-format.md,
 /// "Ranges": dielectric and ambient eta in [1, 5]; conductor eta in [0.01, 10], k in [0, 10]; alpha
-/// 0 or in [1e-4, 1]; tau_a, tau_s in [0, 100]; g in [-0.99, 0.99]; albedo in [0, 1]), an unknown
+/// 0 or in [1e-4, 1]; tau_a in [0, 100], tau_s in [0, 1e4]; g in [-0.99, 0.99]; albedo in [0, 1]),
+/// an unknown
 /// interface type, an opaque interface that is not last, a medium under the last interface, an
 /// empty or missing `layers` or more than 100 layers, an empty name. Every stack it returns lies
 /// in those ranges: the estimators of lamina are written (and fuzzed, tests/fuzz) for them.

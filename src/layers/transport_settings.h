@@ -40,6 +40,10 @@ struct TransportSettings {
     /// Safety cap on interface and scattering events per particle (or walk); flux still travelling
     /// then is reported as cut_off (docs/physics.md §5: must be ≈ 0).
     int max_events = 10'000;
+    /// Follow the particles' polarization (docs/physics.md §8): every event applies its Mueller
+    /// matrix to the particle's Stokes vector instead of the unpolarized Fresnel factors; the
+    /// tables are those of unpolarized incident light, exact for it.
+    bool polarization = false;
 
     template <typename Self, typename Visit>
     static void fields(Self& s, Visit&& visit) {
@@ -68,6 +72,12 @@ struct TransportSettings {
                .max = 1e9,
                .key_unsaid = "10000"},
               s.max_events);
+        visit(
+            {.name = "polarization",
+             .help = "Polarized light: Stokes vectors through Mueller matrices at every event (on) "
+                     "or the unpolarized Fresnel factors (off)",
+             .key_unsaid = "off"},
+            s.polarization);
     }
 };
 

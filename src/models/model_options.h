@@ -11,6 +11,7 @@
 #include "models/model.h"
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -96,6 +97,18 @@ class ModelOptionTable {
 
   private:
     std::vector<ModelOption<Choices>> options_;
+};
+
+/// A family of models for the registry (models/registry.cpp): its option table, the default
+/// choices of each of its variants (by registry name), and the model built from choices. A
+/// variant's options and factory follow from these three (the variant's defaults, then the
+/// user's flags).
+template <typename Choices>
+struct ModelFamily {
+    const ModelOptionTable<Choices>& (*table)(const std::string& name);
+    Choices (*variant)(const std::string& name);
+    std::unique_ptr<Model> (*make)(const std::string& name, const Stack& stack,
+                                   const Choices& choices);
 };
 
 }  // namespace lamina

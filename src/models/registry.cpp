@@ -18,21 +18,37 @@ namespace lamina {
 
 namespace {
 
-// A variant of a family: the family's options and factory at the variant's name.
-using FamilyOptions = std::vector<OptionSpec> (*)(const std::string& variant);
-using FamilyMake = std::unique_ptr<Model> (*)(const std::string& variant, const Stack& stack,
-                                              const ModelOptions& options);
+// A variant of a family: its options are the family's flags with the variant's defaults, and its
+// factory applies the user's flags to those defaults.
+template <typename Choices>
 ModelEntry variant(std::string name, std::string description, std::string supports,
-                   FamilyOptions options, FamilyMake make, std::string group = "2019") {
+                   ModelFamily<Choices> family, std::string group = "2019") {
     const std::string n = name;
     return {std::move(name),
             std::move(description),
             std::move(supports),
-            [options, n] { return options(n); },
-            [make, n](const Stack& stack, const ModelOptions& o) { return make(n, stack, o); },
+            [family, n] { return family.table(n).specs(family.variant(n)); },
+            [family, n](const Stack& stack, const ModelOptions& o) {
+                return family.make(n, stack, family.table(n).parse(o, family.variant(n)));
+            },
             false,
             std::move(group)};
 }
+
+const ModelFamily<WWChoices> kWeidlichWilkie{
+    [](const std::string&) -> const ModelOptionTable<WWChoices>& { return ww_option_table(); },
+    ww_variant, make_ww_model};
+const ModelFamily<BelcourChoices> kBelcour{
+    [](const std::string&) -> const ModelOptionTable<BelcourChoices>& {
+        return belcour_option_table();
+    },
+    belcour_variant, make_belcour_model};
+const ModelFamily<TmChoices> kTransferMatrix{tm_option_table, tm_variant, make_tm_model};
+const ModelFamily<Ddb22Choices> kDdb22{
+    [](const std::string&) -> const ModelOptionTable<Ddb22Choices>& {
+        return ddb22_option_table();
+    },
+    [](const std::string&) { return Ddb22Choices{}; }, make_ddb22_model};
 
 }  // namespace
 
@@ -42,36 +58,36 @@ const std::vector<ModelEntry>& model_registry() {
             "ww09",
             "Weidlich & Wilkie, SIGGRAPH Asia 2009 course code: T01 and refraction at h, base at "
             "outside directions",
-            "bases: lambertian, conductor, dielectric (slab reflection); sides: R", ww_options,
-            make_ww),
+            "bases: lambertian, conductor, dielectric (slab reflection); sides: R",
+            kWeidlichWilkie),
         variant("ele10",
                 "Elek 2010 (CESCG, Alg. 1): T01 at h, refraction about n, alpha1 <- max(alpha0, "
                 "alpha1)",
-                "bases: lambertian, conductor, dielectric (slab reflection); sides: R", ww_options,
-                make_ww),
+                "bases: lambertian, conductor, dielectric (slab reflection); sides: R",
+                kWeidlichWilkie),
         variant("ww-prime",
                 "WW': T01, T10 and refraction at n, 1/eta0^2 compression, alpha1 <- max(alpha0, "
                 "alpha1)",
-                "bases: lambertian, conductor, dielectric (slab reflection); sides: R", ww_options,
-                make_ww),
+                "bases: lambertian, conductor, dielectric (slab reflection); sides: R",
+                kWeidlichWilkie),
         variant("bel18-forward",
                 "Belcour 2018 adding of lobe statistics, cosine mu_i (not reciprocal)",
                 "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R",
-                belcour_options, make_belcour),
+                kBelcour),
         variant("bel18-symmetric",
                 "Belcour 2018 adding of lobe statistics, cosine |wi.h| (reciprocal)",
                 "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R",
-                belcour_options, make_belcour),
+                kBelcour),
         variant("bel-prime",
                 "Bel': Bel18 forward with the exact top reflection and a slab BTDF lobe",
                 "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R, T "
                 "(slab)",
-                belcour_options, make_belcour),
+                kBelcour),
         variant("tm2",
                 "Randrianandrasana et al. 2021 transfer matrices: lobes by energy and HG asymmetry "
                 "(conductor base: plugin tm2, exact top; slab: tm2_dielectric, transmitted lobe)",
-                "bases: conductor, dielectric; media: absorbing; sides: R, T (slab)", tm_options,
-                make_tm, "successors"),
+                "bases: conductor, dielectric; media: absorbing; sides: R, T (slab)",
+                kTransferMatrix, "successors"),
         {"lamina-1",
          "lamina-1: exact top reflection, first order through the coat's directional "
          "transmittance, inter-reflection series, lobe widened by the coat's refraction spread",
@@ -125,13 +141,13 @@ const std::vector<ModelEntry>& model_registry() {
                 "Randrianandrasana et al. 2021 transfer matrices with HG media (plugin tm6): "
                 "primary, forward- and back-scattered lobes, exact top, lobes normalized by their "
                 "GGX albedo",
-                "bases: conductor; media: absorbing, scattering (HG); sides: R", tm_options,
-                make_tm, "successors"),
-        {"ddb22",
-         "de Dinechin & Belcour 2022 as lamina reads it: exact coat reflection + one GGX lobe with "
-         "the energy and projected variance of the light the Lambertian returns",
-         "bases: lambertian (under 1-8 coats); media: absorbing; sides: R", ddb22_options,
-         make_ddb22, false, "successors"},
+                "bases: conductor; media: absorbing, scattering (HG); sides: R", kTransferMatrix,
+                "successors"),
+        variant("ddb22",
+                "de Dinechin & Belcour 2022 as lamina reads it: exact coat reflection + one GGX "
+                "lobe with the energy and projected variance of the light the Lambertian returns",
+                "bases: lambertian (under 1-8 coats); media: absorbing; sides: R", kDdb22,
+                "successors"),
     };
     return entries;
 }

@@ -10,10 +10,12 @@
 #include "physics/dielectric.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
+#include "physics/polarization.h"
 #include "physics/smith_masking.h"
 
 #include <cmath>
 #include <optional>
+#include <type_traits>
 
 // A lane header (core/lane.h): the particle event is a lane template, included once as an
 // ordinary header and once per SIMD target; the interface type below it only once.
@@ -42,12 +44,21 @@ LAMINA_LANE_BEGIN
 /// when `smooth`), its Fresnel factors `fresnel(cos θ, factors)` (three channels, at the facet
 /// cosine; fresnel_conductor per channel) and, when rough, the escape fraction G2/G1
 /// (ggx_escape_fraction; zero for a reflection below the horizon). A wi at or below the horizon
-/// is degenerate. A branch-free lane template (core/lane.h): the scalar and the SIMD particle
-/// kernels evaluate these lines.
-template <typename T, typename L = Lane<T>, typename Fresnel>
+/// is degenerate.
+/// Polarized (a `mueller` source given, `pol` the state; physics/polarization.h): the particle's
+/// state is turned into the facet's plane of incidence and multiplied by the reflection Mueller
+/// matrices that `mueller(cos θ, m)` fills per channel (fresnel_conductor_mueller; m[0] for all
+/// channels when one state serves them, which needs the same index in every channel); the Fresnel
+/// factors are then the reflected fractions a + b q of the state, returned in fresnel_factors and
+/// pol->factor.
+/// A branch-free lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate
+/// these lines.
+template <typename T, typename L = Lane<T>, typename Fresnel, typename Mueller = NoMueller,
+          bool kPolarized = !std::is_same_v<Mueller, NoMueller>>
 LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> conductor_event(
     T alpha, bool smooth, bool uncorrelated, const LaneVec3<T>& wi, T u1, T u2,
-    typename L::Mask active, const Fresnel& fresnel, T* fresnel_factors) {
+    typename L::Mask active, const Fresnel& fresnel, T* fresnel_factors,
+    PolarizationLanes<T>* pol = nullptr, const Mueller& mueller = {}) {
     const T zero = L::constant(0), one = L::constant(1);
     InterfaceEventLanes<T, typename L::Mask> e;
     e.degenerate = L::both(active, L::negate(L::less(zero, wi.z)));
@@ -58,7 +69,21 @@ LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> conductor_event(
     const T two_cos = cos_i_m + cos_i_m;
     e.wo = {L::mul_add(two_cos, wm.x, zero - wi.x), L::mul_add(two_cos, wm.y, zero - wi.y),
             L::mul_add(two_cos, wm.z, zero - wi.z)};
-    fresnel(cos_i_m, fresnel_factors);
+    if constexpr (kPolarized) {
+        stokes_rotate_frame<T, L>(pol->stokes, {zero - wi.x, zero - wi.y, zero - wi.z},
+                                  lane_cross<T, L>(wi, wm), pol->channels, e.reflected);
+        InterfaceMueller<T> m[3] = {};
+        mueller(cos_i_m, m);
+        StokesLanes<T>& st = pol->stokes;
+        pol->factor[0] = stokes_apply<T, L>(m[0], st.q[0], st.u[0], st.v[0], e.reflected);
+        pol->factor[1] = pol->factor[2] = pol->factor[0];
+        for (int c = 1; c < pol->channels; ++c)
+            pol->factor[c] = stokes_apply<T, L>(m[c], st.q[c], st.u[c], st.v[c], e.reflected);
+        for (int c = 0; c < 3; ++c)
+            fresnel_factors[c] = pol->factor[c];
+    } else {
+        fresnel(cos_i_m, fresnel_factors);
+    }
     e.shadowing = one;
     if (!smooth)
         e.shadowing = L::select(L::less(zero, e.wo.z),
@@ -91,6 +116,19 @@ struct ConductorInterface {
         return {fresnel_conductor(cos_theta, eta[0], k[0]),
                 fresnel_conductor(cos_theta, eta[1], k[1]),
                 fresnel_conductor(cos_theta, eta[2], k[2])};
+    }
+
+    /// Whether every channel has the same complex index (a grey conductor: one polarization
+    /// state serves all channels).
+    bool is_grey() const {
+        return eta[0] == eta[1] && eta[1] == eta[2] && k[0] == k[1] && k[1] == k[2];
+    }
+
+    /// The reflection Mueller matrices (physics/polarization.h) of the three channels at the
+    /// facet cosine cos_theta.
+    void mueller(T cos_theta, InterfaceMueller<T>* m) const {
+        for (int c = 0; c < 3; ++c)
+            m[c] = fresnel_conductor_mueller(cos_theta, eta[c], k[c]);
     }
 
     T masking_shadowing(const Vec3<T>& wi, const Vec3<T>& wo) const {
@@ -133,6 +171,29 @@ struct ConductorInterface {
         s.shadowing = e.shadowing;
         if constexpr (kWithPdf)
             if (!s.is_delta && s.wo.z > 0) s.pdf = pdf(wi, s.wo);
+        s.weight = s.fresnel_weight * s.shadowing;
+        return s;
+    }
+
+    /// sample() following the particle's polarization (physics/polarization.h): conductor_event's
+    /// Mueller matrices, the state updated in `pol`, the Fresnel weight the reflected fraction of
+    /// the state. No density (the particle tracers').
+    std::optional<BsdfSample<T>> sample_polarized(const Vec3<T>& wi, T u1, T u2,
+                                                  PolarizationLanes<T>& pol) const {
+        T factors[3];
+        const NoMueller unpolarized;
+        const auto channel_mueller = [&](T cos_theta, InterfaceMueller<T>* m) {
+            mueller(cos_theta, m);
+        };
+        const InterfaceEventLanes<T, bool> e =
+            conductor_event<T>(alpha, is_smooth(), uncorrelated_shadowing, {wi.x, wi.y, wi.z}, u1,
+                               u2, true, unpolarized, factors, &pol, channel_mueller);
+        if (e.degenerate) return std::nullopt;
+        BsdfSample<T> s;
+        s.wo = {e.wo.x, e.wo.y, e.wo.z};
+        s.is_delta = is_smooth();
+        s.fresnel_weight = {factors[0], factors[1], factors[2]};
+        s.shadowing = e.shadowing;
         s.weight = s.fresnel_weight * s.shadowing;
         return s;
     }

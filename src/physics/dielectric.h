@@ -12,6 +12,7 @@
 #include "physics/bsdf.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
+#include "physics/polarization.h"
 
 #include <algorithm>
 #include <cmath>
@@ -81,17 +82,25 @@ struct InterfaceEventLanes {
 /// loses 1 − that. (The quotient is ≤ 1 exactly; rounded above it, it booked −6.6e-8 as lost to the
 /// microsurface, found by the fuzz test with seed 99: the escape fractions are clamped at 1.)
 /// Smooth and index-matched: straight through with weight 1. A grazing wi (wi.z = 0) is degenerate.
-/// eta = η_below / η_above, inv_eta = 1/eta, alpha the GGX roughness. A branch-free lane template
-/// (core/lane.h): the scalar and the SIMD particle kernels evaluate these lines.
-template <typename T, typename L = Lane<T>>
+/// eta = η_below / η_above, inv_eta = 1/eta, alpha the GGX roughness.
+/// Polarized (kPolarized, `pol` the state; physics/polarization.h): the particle's state is turned
+/// into the facet's plane of incidence, the branch is chosen with the reflected flux fraction of
+/// that state (polarized_dielectric_choice: the same uniform number uc, now against a + b q instead
+/// of F), and the state leaves in the chosen branch's Mueller matrix, its frame the facet's s axis;
+/// pol->factor returns the flux factors (1 unless the channels' states differ). An index-matched
+/// interface leaves the state as it is (its Mueller matrix is the identity).
+/// A branch-free lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate
+/// these lines.
+template <typename T, typename L = Lane<T>, bool kPolarized = false>
 LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> dielectric_event(
     T eta, T inv_eta, T alpha, DielectricEventShape shape, const LaneVec3<T>& wi, T uc, T u1, T u2,
-    typename L::Mask active) {
+    typename L::Mask active, PolarizationLanes<T>* pol = nullptr) {
     const T zero = L::constant(0), one = L::constant(1);
     InterfaceEventLanes<T, typename L::Mask> e;
     e.degenerate = L::both(active, L::negate(L::less(zero, L::abs(wi.z))));
     const auto ok = L::both(active, L::negate(e.degenerate));
     e.shadowing = one;
+    if constexpr (kPolarized) pol->factor[0] = pol->factor[1] = pol->factor[2] = one;
     if (shape.index_matched) {
         e.wo = {zero - wi.x, zero - wi.y, zero - wi.z};
         e.reflected = L::both(ok, L::negate(ok));  // no lane
@@ -110,7 +119,15 @@ LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> dielectric_event(
             alpha, {sign * wi.x, sign * wi.y, sign * wi.z}, u1, u2);
     }
     const T cos_i_m = lane_dot<T, L>(wi, wm);  // < 0 when wi is below: seen from the other side
-    const FresnelDielectric<T> fr = fresnel_dielectric_full<T, L>(cos_i_m, eta, inv_eta);
+    [[maybe_unused]] DielectricMueller<T> fm;
+    const FresnelDielectric<T> fr = [&] {
+        if constexpr (kPolarized) {
+            fm = fresnel_dielectric_mueller<T, L>(cos_i_m, eta, inv_eta);
+            return FresnelDielectric<T>{zero, fm.cos_theta_t, fm.eta, fm.inv_eta};
+        } else {
+            return fresnel_dielectric_full<T, L>(cos_i_m, eta, inv_eta);
+        }
+    }();
     const T cos_i = L::min(L::abs(cos_i_m), one);
     // Mirror about wm (fresnel.h reflect), or Snell about wm (fresnel.h refract) reusing the
     // refracted cosine: with m = ±wm on wi's side, wt = −wi/η + m (cos θi/η − cos θt) (under total
@@ -125,7 +142,14 @@ LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> dielectric_event(
     const LaneVec3<T> refracted = {L::mul_add(wi.x, neg_inv_eta, wm.x * along),
                                    L::mul_add(wi.y, neg_inv_eta, wm.y * along),
                                    L::mul_add(wi.z, neg_inv_eta, wm.z * along)};
-    e.reflected = L::less(uc, fr.reflectance);
+    if constexpr (kPolarized) {
+        // The plane of incidence: its s axis ∝ wi × wm, ⊥ to the travel direction −wi.
+        stokes_rotate_frame<T, L>(pol->stokes, {zero - wi.x, zero - wi.y, zero - wi.z},
+                                  lane_cross<T, L>(wi, wm), pol->channels, ok);
+        e.reflected = polarized_dielectric_choice<T, L>(*pol, fm, uc, ok, pol->flux);
+    } else {
+        e.reflected = L::less(uc, fr.reflectance);
+    }
     e.wo = lane_select<T, L>(e.reflected, reflected, refracted);
     if (!shape.smooth) {
         // A reflection must stay on wi's side and a refraction cross, else G2 = 0.
@@ -254,6 +278,25 @@ struct DielectricInterface {
         s.weight = Rgb<T>(s.shadowing);
         if constexpr (kWithPdf)
             if (!s.is_delta) s.pdf = pdf(wi, s.wo);
+        return s;
+    }
+
+    /// sample() following the particle's polarization (physics/polarization.h): dielectric_event's
+    /// polarized branch choice, the state updated in `pol`; fresnel_weight holds the choice's flux
+    /// factors (1 unless the channels' states differ). No density (the particle tracers').
+    LAMINA_FORCE_INLINE std::optional<BsdfSample<T>> sample_polarized(
+        const Vec3<T>& wi, T uc, T u1, T u2, PolarizationLanes<T>& pol) const {
+        const DielectricEventShape shape = event_shape();
+        const InterfaceEventLanes<T, bool> e = dielectric_event<T, Lane<T>, true>(
+            eta, inv_eta(), alpha, shape, {wi.x, wi.y, wi.z}, uc, u1, u2, true, &pol);
+        if (e.degenerate) return std::nullopt;
+        BsdfSample<T> s;
+        s.wo = {e.wo.x, e.wo.y, e.wo.z};
+        s.is_delta = shape.smooth || shape.index_matched;
+        s.is_transmission = !e.reflected;
+        s.shadowing = e.shadowing;
+        s.fresnel_weight = {pol.factor[0], pol.factor[1], pol.factor[2]};
+        s.weight = s.fresnel_weight * s.shadowing;
         return s;
     }
 

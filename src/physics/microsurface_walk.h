@@ -37,6 +37,7 @@
 #include "core/vec.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
+#include "physics/polarization.h"
 
 #include <cmath>
 #include <limits>
@@ -230,17 +231,43 @@ inline MicrosurfaceWalkLanes<T, typename L::Mask> microsurface_walk(
 /// The dielectric facet of the walk (Heitz et al. 2016, their dielectric phase function): it
 /// reflects with its exact Fresnel probability (fresnel_dielectric_full, one uniform number drawn
 /// per step) and refracts otherwise; eta = η below / η above, inv_eta = 1/eta.
-template <typename T, typename L, typename Uniform>
+/// Polarized (kPolarized, `pol` the state; physics/polarization.h): as dielectric_event, the state
+/// is turned into the facet's plane of incidence and the branch chosen with its reflected flux
+/// fraction (polarized_dielectric_choice); where the channels' states differ, the choice's flux
+/// factors multiply the walk's weights (the particle's flux for the choice's weights is
+/// pol->flux times the weights so far).
+template <typename T, typename L, typename Uniform, bool kPolarized = false>
 struct MicrosurfaceDielectricFacet {
     T eta, inv_eta;
     Uniform& uniform;
+    PolarizationLanes<T>* pol = nullptr;
     template <typename M>
     void operator()(const LaneVec3<T>& w, const LaneVec3<T>& wm, T cos_w_m, M above, M walking,
-                    LaneVec3<T>& wr_new, M& crosses, T* /*weight*/) const {
-        const FresnelDielectric<T> fr = fresnel_dielectric_full<T, L>(
-            cos_w_m, L::select(above, eta, inv_eta), L::select(above, inv_eta, eta));
-        const T uc = uniform();
-        const auto reflects = L::less(uc, fr.reflectance);
+                    LaneVec3<T>& wr_new, M& crosses, T* weight) const {
+        FresnelDielectric<T> fr;
+        M reflects;
+        const T eta_side = L::select(above, eta, inv_eta);
+        const T inv_eta_side = L::select(above, inv_eta, eta);
+        if constexpr (kPolarized) {
+            const DielectricMueller<T> fm =
+                fresnel_dielectric_mueller<T, L>(cos_w_m, eta_side, inv_eta_side);
+            fr = {L::constant(0), fm.cos_theta_t, fm.eta, fm.inv_eta};
+            const T zero = L::constant(0);
+            stokes_rotate_frame<T, L>(pol->stokes, {zero - w.x, zero - w.y, zero - w.z},
+                                      lane_cross<T, L>(w, wm), pol->channels, walking);
+            const T uc = uniform();
+            T flux[3];
+            for (int c = 0; c < 3; ++c)
+                flux[c] = pol->channels == 3 ? pol->flux[c] * weight[c] : weight[c];
+            reflects = polarized_dielectric_choice<T, L>(*pol, fm, uc, walking, flux);
+            if (pol->channels == 3)
+                for (int c = 0; c < 3; ++c)
+                    weight[c] = L::select(walking, weight[c] * pol->factor[c], weight[c]);
+        } else {
+            fr = fresnel_dielectric_full<T, L>(cos_w_m, eta_side, inv_eta_side);
+            const T uc = uniform();
+            reflects = L::less(uc, fr.reflectance);
+        }
         const T two_cos = cos_w_m + cos_w_m;
         const LaneVec3<T> reflected = {two_cos * wm.x - w.x, two_cos * wm.y - w.y,
                                        two_cos * wm.z - w.z};
@@ -261,14 +288,32 @@ struct MicrosurfaceDielectricFacet {
 /// The conductor facet of the walk (Heitz et al. 2016, their conductor phase function): a mirror
 /// that multiplies the flux by its Fresnel factors, `fresnel(cos_w_m, factors)` filling the three
 /// channels' (fresnel_conductor); no number drawn.
-template <typename T, typename L, typename Fresnel>
+/// Polarized (a `mueller` source given, `pol` the state): as conductor_event, the state is turned
+/// into the facet's plane of incidence and multiplied by the reflection Mueller matrices
+/// `mueller(cos, m)` fills per channel; the factors are the reflected fractions of the state.
+template <typename T, typename L, typename Fresnel, typename Mueller = NoMueller>
 struct MicrosurfaceConductorFacet {
     const Fresnel& fresnel;
+    PolarizationLanes<T>* pol = nullptr;
+    const Mueller* mueller = nullptr;
     template <typename M>
     void operator()(const LaneVec3<T>& w, const LaneVec3<T>& wm, T cos_w_m, M /*above*/, M walking,
                     LaneVec3<T>& wr_new, M& crosses, T* weight) const {
         T factors[3];
-        fresnel(cos_w_m, factors);
+        if constexpr (!std::is_same_v<Mueller, NoMueller>) {
+            const T zero = L::constant(0);
+            stokes_rotate_frame<T, L>(pol->stokes, {zero - w.x, zero - w.y, zero - w.z},
+                                      lane_cross<T, L>(w, wm), pol->channels, walking);
+            InterfaceMueller<T> m[3] = {};
+            (*mueller)(cos_w_m, m);
+            StokesLanes<T>& st = pol->stokes;
+            factors[0] = stokes_apply<T, L>(m[0], st.q[0], st.u[0], st.v[0], walking);
+            factors[1] = factors[2] = factors[0];
+            for (int c = 1; c < pol->channels; ++c)
+                factors[c] = stokes_apply<T, L>(m[c], st.q[c], st.u[c], st.v[c], walking);
+        } else {
+            fresnel(cos_w_m, factors);
+        }
         for (int c = 0; c < 3; ++c)
             weight[c] = L::select(walking, weight[c] * factors[c], weight[c]);
         const T two_cos = cos_w_m + cos_w_m;
@@ -342,6 +387,39 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor(const GGX<T>& ggx, const
         out[0] = f[0], out[1] = f[1], out[2] = f[2];
     };
     const MicrosurfaceConductorFacet<T, Lane<T>, decltype(factors)> facet{factors};
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.alpha, {wi.x, wi.y, wi.z}, true,
+                                                           false, facet, draw, max_order));
+}
+
+/// walk_rough_dielectric following the particle's polarization (physics/polarization.h): `pol`
+/// holds its state (in and out: the exit's, in the frame of the last facet met) and its flux per
+/// channel; the exit's weight is 1, or where the channels' states differ the product of the flux
+/// factors of the facets' branch choices (polarized_dielectric_choice).
+template <typename T, typename Uniform>
+std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_polarized(const GGX<T>& ggx, T eta,
+                                                                   const Vec3<T>& wi,
+                                                                   Uniform&& uniform, int max_order,
+                                                                   PolarizationLanes<T>& pol) {
+    auto draw = [&] { return T(uniform()); };
+    const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw), true> facet{eta, T(1) / eta, draw,
+                                                                              &pol};
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.alpha, {wi.x, wi.y, wi.z}, true,
+                                                           true, facet, draw, max_order));
+}
+
+/// walk_rough_conductor following the particle's polarization: `mueller(cos, m)` fills the
+/// reflection Mueller matrices of the three channels (fresnel_conductor_mueller); the exit's
+/// weight is the product of the facets' reflected fractions of the state.
+template <typename T, typename Mueller, typename Uniform>
+std::optional<MicrosurfaceExit<T>> walk_rough_conductor_polarized(const GGX<T>& ggx,
+                                                                  const Mueller& mueller,
+                                                                  const Vec3<T>& wi,
+                                                                  Uniform&& uniform, int max_order,
+                                                                  PolarizationLanes<T>& pol) {
+    auto draw = [&] { return T(uniform()); };
+    const NoMueller unpolarized;
+    const MicrosurfaceConductorFacet<T, Lane<T>, NoMueller, Mueller> facet{unpolarized, &pol,
+                                                                           &mueller};
     return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.alpha, {wi.x, wi.y, wi.z}, true,
                                                            false, facet, draw, max_order));
 }
@@ -476,6 +554,100 @@ inline MicrosurfaceConnection<T> microsurface_conductor_connect(const GGX<T>& gg
     return out;
 }
 
+// ---- Polarized next-event estimation (physics/polarization.h)
+// ------------------------------------ A connection from a facet carries the state the particle has
+// when it meets the facet (the polarized visiting walks below keep it in their PolarizationLanes
+// while they visit): turned into the plane of incidence of the connecting facet (w, wm), the
+// branch's Fresnel factor of the unpolarized phase function, F or 1 − F (dielectric) or F
+// (conductor), becomes the state's own fraction a + b q, and the light leaves in the branch's
+// Mueller matrix; the connection's Stokes vector is written in the tabulation frame of wo
+// (stokes_bin_frame).
+
+/// Per channel a Stokes vector (S0..S3) in the tabulation frame of a direction of travel.
+template <typename T>
+struct StokesRgb {
+    T s[3][4] = {};
+};
+
+/// Adds to `out` the Stokes vectors of the light that `state` (one for all channels, or one per
+/// channel) turns into through the branch `m` of a facet of normal wm met from w (unit vectors; wm
+/// on either side), `scale[c]` times the branch's fraction a + b q over its unpolarized a, leaving
+/// along wo; nothing where a = 0. One state serves all channels with the matrix of channel 0.
+template <typename T>
+inline void microsurface_stokes_through(const InterfaceMueller<T>* m, bool per_channel_matrix,
+                                        const Vec3<T>& w, const Vec3<T>& wm, const Vec3<T>& wo,
+                                        StokesLanes<T> state, int channels, const T scale[3],
+                                        StokesRgb<T>& out) {
+    const Vec3<T> n = cross(w, wm);
+    stokes_rotate_frame<T>(state, {-w.x, -w.y, -w.z}, {n.x, n.y, n.z}, channels, true);
+    T ratio[3] = {0, 0, 0};
+    for (int c = 0; c < channels; ++c) {
+        const InterfaceMueller<T>& mc = m[per_channel_matrix ? c : 0];
+        if (!(mc.a > 0)) continue;
+        ratio[c] = stokes_apply<T>(mc, state.q[c], state.u[c], state.v[c], true) / mc.a;
+    }
+    stokes_rotate_frame<T>(state, {wo.x, wo.y, wo.z}, stokes_bin_frame<T>({wo.x, wo.y, wo.z}),
+                           channels, true);
+    for (int c = 0; c < 3; ++c) {
+        const int k = channels == 3 ? c : 0;
+        const T f = scale[c] * ratio[channels == 3 ? c : 0];
+        out.s[c][0] += f;
+        out.s[c][1] += f * state.q[k];
+        out.s[c][2] += f * state.u[k];
+        out.s[c][3] += f * state.v[k];
+    }
+}
+
+/// microsurface_dielectric_connect for a particle in polarization state `state`: the connection's
+/// density (its own, with the state's branch fraction in place of F or 1 − F) times the facet's
+/// weight, as Stokes vectors in wo's tabulation frame, added to `out`.
+template <typename T>
+inline void microsurface_dielectric_connect_polarized(const GGX<T>& ggx, T eta,
+                                                      const MicrosurfaceFacet<T>& facet,
+                                                      const Vec3<T>& wo,
+                                                      const StokesLanes<T>& state, int channels,
+                                                      StokesRgb<T>& out) {
+    const T base = microsurface_dielectric_connect(ggx, eta, facet, wo);
+    if (!(base > 0) || !std::isfinite(base)) return;
+    // The connecting facet as microsurface_dielectric_phase finds it, seen from the particle's
+    // side.
+    const bool refracted = facet.outside != (wo.z > 0);
+    const T eta_side = facet.outside ? eta : T(1) / eta;
+    const Vec3<T> w_side = facet.outside ? facet.w : -facet.w;
+    const Vec3<T> wo_side = facet.outside ? wo : -wo;
+    Vec3<T> wm = refracted ? -(w_side + wo_side * eta_side) : w_side + wo_side;
+    wm = normalize(wm);
+    if (wm.z < 0) wm = -wm;
+    const DielectricMueller<T> fm =
+        fresnel_dielectric_mueller<T>(dot(w_side, wm), eta_side, T(1) / eta_side);
+    const InterfaceMueller<T>& m = refracted ? fm.transmission : fm.reflection;
+    const T scale[3] = {base * facet.weight[0], base * facet.weight[1], base * facet.weight[2]};
+    microsurface_stokes_through(&m, false, facet.w, wm, wo, state, channels, scale, out);
+}
+
+/// microsurface_conductor_connect for a particle in polarization state `state`: the density times
+/// the facet's weight and the state's reflected fraction of the connecting facet (the Mueller
+/// matrices `mueller(cos, m)` fills per channel), as Stokes vectors added to `out`.
+template <typename T, typename Mueller>
+inline void microsurface_conductor_connect_polarized(const GGX<T>& ggx, const Mueller& mueller,
+                                                     const MicrosurfaceFacet<T>& facet,
+                                                     const Vec3<T>& wo, const StokesLanes<T>& state,
+                                                     int channels, StokesRgb<T>& out) {
+    const T escape = microsurface_escape(ggx, wo, facet.h);
+    if (!(escape > 0)) return;
+    T cos_w_m;
+    const T density = microsurface_reflection_density(ggx, facet.w, wo, cos_w_m);
+    if (!(density > 0)) return;
+    InterfaceMueller<T> m[3];
+    mueller(cos_w_m, m);
+    // The unpolarized weight F = a, turned into the state's fraction a + b q by the ratio.
+    T scale[3];
+    for (int c = 0; c < 3; ++c)
+        scale[c] = density * escape * facet.weight[c] * m[c].a;
+    microsurface_stokes_through(m, true, facet.w, normalize(facet.w + wo), wo, state, channels,
+                                scale, out);
+}
+
 /// walk_rough_dielectric with a visitor: `visit(const MicrosurfaceFacet<T>&)` is called at every
 /// facet before the particle scatters off it. The same walk (microsurface_walk at one lane, the
 /// same random numbers in the same order): returns the same exit.
@@ -514,6 +686,34 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor_visiting(const GGX<T>& g
         out[0] = f[0], out[1] = f[1], out[2] = f[2];
     };
     const MicrosurfaceConductorFacet<T, Lane<T>, decltype(factors)> facet{factors};
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(
+        ggx.alpha, {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
+        MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
+}
+
+/// walk_rough_dielectric_polarized with a visitor, as walk_rough_dielectric_visiting; at each call
+/// `pol.stokes` holds the state with which the particle meets the facet.
+template <typename T, typename Uniform, typename Visit>
+std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_polarized_visiting(
+    const GGX<T>& ggx, T eta, const Vec3<T>& wi, Uniform&& uniform, int max_order,
+    PolarizationLanes<T>& pol, Visit&& visit) {
+    auto draw = [&] { return T(uniform()); };
+    const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw), true> facet{eta, T(1) / eta, draw,
+                                                                              &pol};
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(
+        ggx.alpha, {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
+        MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
+}
+
+/// walk_rough_conductor_polarized with a visitor, as walk_rough_dielectric_polarized_visiting.
+template <typename T, typename Mueller, typename Uniform, typename Visit>
+std::optional<MicrosurfaceExit<T>> walk_rough_conductor_polarized_visiting(
+    const GGX<T>& ggx, const Mueller& mueller, const Vec3<T>& wi, Uniform&& uniform, int max_order,
+    PolarizationLanes<T>& pol, Visit&& visit) {
+    auto draw = [&] { return T(uniform()); };
+    const NoMueller unpolarized;
+    const MicrosurfaceConductorFacet<T, Lane<T>, NoMueller, Mueller> facet{unpolarized, &pol,
+                                                                           &mueller};
     return microsurface_exit(microsurface_walk<T, Lane<T>>(
         ggx.alpha, {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
         MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));

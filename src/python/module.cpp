@@ -239,24 +239,39 @@ Vec3d vec_at(const double* d, py::ssize_t n) {
     return {d[3 * n], d[3 * n + 1], d[3 * n + 2]};
 }
 
-py::array_t<double> model_eval(const PyModel& m, py::handle wi_obj, py::handle wo_obj) {
+// f(wi, wo) for every broadcast pair of directions, `channels` values each (0: a scalar), in
+// parallel without the GIL; f writes the pair's values; pairs with wi below the surface are 0.
+template <typename F>
+py::array_t<double> over_direction_pairs(py::handle wi_obj, py::handle wo_obj, int channels,
+                                         F&& f) {
     std::vector<py::ssize_t> shape;
     auto arrays = broadcast_directions({{"wi", wi_obj}, {"wo", wo_obj}}, shape);
     const double *wi = arrays[0].data(), *wo = arrays[1].data();
     const py::ssize_t n = arrays[0].shape(0);
-    py::array_t<double> out = shaped(shape, 3);
-    double* f = out.mutable_data();
+    py::array_t<double> out = shaped(shape, channels);
+    double* v = out.mutable_data();
+    const int stride = std::max(channels, 1);
     {
         py::gil_scoped_release release;
 #pragma omp parallel for schedule(static)
         for (py::ssize_t k = 0; k < n; ++k) {
-            const Vec3d a = vec_at(wi, k), b = vec_at(wo, k);
-            const Rgbd v = a.z > 0 ? m.model->eval(a, b) : Rgbd(0.0);
-            for (int c = 0; c < 3; ++c)
-                f[3 * k + c] = v[c];
+            const Vec3d a = vec_at(wi, k);
+            if (a.z > 0)
+                f(a, vec_at(wo, k), v + stride * k);
+            else
+                std::fill(v + stride * k, v + stride * (k + 1), 0.0);
         }
     }
     return out;
+}
+
+py::array_t<double> model_eval(const PyModel& m, py::handle wi_obj, py::handle wo_obj) {
+    return over_direction_pairs(wi_obj, wo_obj, 3,
+                                [&](const Vec3d& wi, const Vec3d& wo, double* out) {
+                                    const Rgbd v = m.model->eval(wi, wo);
+                                    for (int c = 0; c < 3; ++c)
+                                        out[c] = v[c];
+                                });
 }
 
 void require_sampling(const PyModel& m) {
@@ -307,21 +322,9 @@ py::tuple model_sample(const PyModel& m, py::handle wi_obj, py::handle u_obj) {
 
 py::array_t<double> model_pdf(const PyModel& m, py::handle wi_obj, py::handle wo_obj) {
     require_sampling(m);
-    std::vector<py::ssize_t> shape;
-    auto arrays = broadcast_directions({{"wi", wi_obj}, {"wo", wo_obj}}, shape);
-    const double *wi = arrays[0].data(), *wo = arrays[1].data();
-    const py::ssize_t n = arrays[0].shape(0);
-    py::array_t<double> out = shaped(shape, 0);
-    double* p = out.mutable_data();
-    {
-        py::gil_scoped_release release;
-#pragma omp parallel for schedule(static)
-        for (py::ssize_t k = 0; k < n; ++k) {
-            const Vec3d a = vec_at(wi, k);
-            p[k] = a.z > 0 ? m.model->pdf(a, vec_at(wo, k)) : 0.0;
-        }
-    }
-    return out;
+    return over_direction_pairs(
+        wi_obj, wo_obj, 0,
+        [&](const Vec3d& wi, const Vec3d& wo, double* out) { *out = m.model->pdf(wi, wo); });
 }
 
 py::dict support_of(const Support& s) {
@@ -422,13 +425,8 @@ void run_study_py(py::list configs_in, py::dict settings, py::list externals,
     }
 }
 
-}  // namespace
-}  // namespace lamina
-
-PYBIND11_MODULE(_lamina, m) {
-    using namespace lamina;
-    m.doc() = "lamina's compiled core (use the lamina package, docs/python.md)";
-
+// lamina.InputError (InputError's file, field and problem), the defaults Python reads.
+void bind_errors(py::module_& m) {
     g_input_error = PyErr_NewExceptionWithDoc(
         "lamina.InputError",
         "Bad input, as the lamina CLI reports it: .file (or 'command line', 'arguments', "
@@ -453,8 +451,10 @@ PYBIND11_MODULE(_lamina, m) {
         return kernel_description(SettingCodec<Kernel>::from_text(k, {.name = "kernel", .help = ""},
                                                                   "arguments", "kernel"));
     });
+}
 
-    // ---- Stack ----
+// lamina.Stack.
+void bind_stack(py::module_& m) {
     py::class_<Stack>(m, "Stack", "A layer stack (docs/stack-format.md)")
         .def(py::init([](py::handle source) { return stack_of(source); }), py::arg("source"),
              "From a dict in the stack format or a path to a stack JSON file; lamina.InputError "
@@ -468,8 +468,10 @@ PYBIND11_MODULE(_lamina, m) {
         .def("describe", [](const Stack& s) { return describe(s); })
         .def("__eq__", [](const Stack& a, const Stack& b) { return a == b; })
         .def("__repr__", [](const Stack& s) { return "<lamina.Stack " + describe(s) + ">"; });
+}
 
-    // ---- Table ----
+// lamina.Table: binned tables (the brdf.csv format) as numpy arrays.
+void bind_table(py::module_& m) {
     py::class_<BinnedTable>(m, "Table",
                             "Binned BRDF/BTDF: cos-weighted bin averages, the brdf.csv format")
         .def_static(
@@ -517,8 +519,10 @@ PYBIND11_MODULE(_lamina, m) {
                                t.theta_i_deg.size(), t.has_transmission ? "R, T" : "R",
                                t.grid.to_string());
         });
+}
 
-    // ---- simulate ----
+// lamina.simulate: the goniophotometer and its settings.
+void bind_simulation(py::module_& m) {
     py::class_<PySimulation>(m, "SimulationResult", "A goniophotometer run (lamina simulate)")
         .def_property_readonly("stack", [](const PySimulation& r) { return r.stack; })
         .def_property_readonly("table", [](const PySimulation& r) { return r.result.table; })
@@ -584,11 +588,15 @@ PYBIND11_MODULE(_lamina, m) {
         },
         py::arg("stack"), py::arg("settings"), py::arg("progress"));
     m.def("_preset_particles", &preset_particles, py::arg("preset"));
+}
 
+// lamina.export: .bsdf, MERL and .npz files.
+void bind_export(py::module_& m) {
     m.def(
         "_export",
         [](py::object source, const std::filesystem::path& path, const std::string& format,
-           std::vector<double> theta_i, int resolution, const std::string& description) {
+           std::vector<double> theta_i, std::optional<int> resolution,
+           const std::string& description) {
             // source: a Model or a Table (its reflection side).
             BrdfSource brdf;
             if (py::isinstance<PyModel>(source)) {
@@ -605,7 +613,7 @@ PYBIND11_MODULE(_lamina, m) {
                 if (format == "bsdf") {
                     RglOptions o;
                     o.theta_i_deg = theta_i;
-                    o.resolution = resolution;
+                    if (resolution) o.resolution = *resolution;  // else RglOptions' default
                     o.description = description;
                     const TensorFile file = rgl_bsdf(brdf, o);
                     check_rgl_bsdf(file, path.string());
@@ -620,6 +628,10 @@ PYBIND11_MODULE(_lamina, m) {
         },
         py::arg("source"), py::arg("path"), py::arg("format"), py::arg("theta_i"),
         py::arg("resolution"), py::arg("description"));
+}
+
+// lamina.study and lamina.compare, with Python models as external tables.
+void bind_study(py::module_& m) {
     m.def("_table_from_arrays", &table_from_arrays, py::arg("f"), py::arg("theta_i"),
           py::arg("sides"));
     m.def("_run_study", &run_study_py, py::arg("configs"), py::arg("settings"),
@@ -648,8 +660,10 @@ PYBIND11_MODULE(_lamina, m) {
             keep.push_back(c.id);
         return keep;
     });
+}
 
-    // ---- models ----
+// lamina.models and lamina.Model: the registry's models, evaluated and sampled.
+void bind_models(py::module_& m) {
     m.def(
         "models",
         [] {
@@ -765,4 +779,20 @@ PYBIND11_MODULE(_lamina, m) {
         .def("__repr__", [](const PyModel& m) {
             return fmt::format("<lamina.Model {} on {}>", m.name, m.stack.name);
         });
+}
+
+}  // namespace
+}  // namespace lamina
+
+// One function per part of the API, in the order the package uses them.
+PYBIND11_MODULE(_lamina, m) {
+    using namespace lamina;
+    m.doc() = "lamina's compiled core (use the lamina package, docs/python.md)";
+    bind_errors(m);
+    bind_stack(m);
+    bind_table(m);
+    bind_simulation(m);
+    bind_export(m);
+    bind_study(m);
+    bind_models(m);
 }

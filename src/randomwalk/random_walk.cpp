@@ -6,6 +6,7 @@
 #include "physics/medium.h"
 #include "physics/microsurface_walk.h"
 #include "physics/phase.h"
+#include "physics/polarization.h"
 
 #include <array>
 #include <cmath>
@@ -37,7 +38,11 @@ struct RandomWalkStack::Connection {
     std::vector<Vec3d> dir_down;  ///< and down
     std::vector<Rgbd> t;          ///< unscattered transmittance of region r's whole medium
     std::vector<double> scale;    ///< (η_e/η_r)²: radiance compression
-    std::vector<Rgbd> up, down;   ///< A_k^↑, A_k^↓
+    std::vector<Rgbd> up, down;   ///< A_k^↑, A_k^↓ (polarized: the mean of the s and p ones)
+    /// Polarized walks: the ladders of s- and p-polarized light ([0] s, [1] p), each chain lying in
+    /// one plane of incidence (the vertical plane of wo), where the two never mix.
+    bool polarized = false;
+    std::vector<Rgbd> up_sp[2], down_sp[2];
 
     /// Throughput of leaving upwards from the bottom of region r (just above interface r).
     Rgbd from_bottom_up(int r) const {
@@ -50,6 +55,26 @@ struct RandomWalkStack::Connection {
         if (!valid[r]) return Rgbd(0.0);
         if (r == L) return Rgbd(top ? 0.0 : 1.0);
         return t[r] * down[r];
+    }
+    /// The same for light polarized along s (x = 0) or p (x = 1) of the chain's plane.
+    Rgbd from_bottom_up(int r, int x) const {
+        if (!valid[r]) return Rgbd(0.0);
+        if (r == 0) return Rgbd(top ? 1.0 : 0.0);
+        return t[r] * up_sp[x][r - 1];
+    }
+    Rgbd from_top_down(int r, int x) const {
+        if (!valid[r]) return Rgbd(0.0);
+        if (r == L) return Rgbd(top ? 0.0 : 1.0);
+        return t[r] * down_sp[x][r];
+    }
+    /// The exit's flux of light with Stokes vectors e (per channel, in the tabulation frame of
+    /// the chain's direction, whose x axis is the chain's s axis) entering the chains with the
+    /// throughputs q_s, q_p: the s and p intensities (S0 ± S1)/2 times their own.
+    static Rgbd through(const StokesRgb<double>& e, const Rgbd& q_s, const Rgbd& q_p) {
+        Rgbd out;
+        for (int c = 0; c < 3; ++c)
+            out[c] = 0.5 * ((e.s[c][0] + e.s[c][1]) * q_s[c] + (e.s[c][0] - e.s[c][1]) * q_p[c]);
+        return out;
     }
 };
 
@@ -118,6 +143,7 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, const TransportSettings& tr
     LAMINA_CHECK(transport.max_events >= 1);
     LAMINA_CHECK(transport.max_microsurface_order >= 1);
     const CompiledStack<double> compiled = compile_stack<double>(stack, transport);
+    channels_ = compiled.polarization_channels;
     const int L = int(compiled.layers.size());
     interfaces_ = compiled.layers;
     eta_.assign(L + 1, 1.0);
@@ -136,7 +162,7 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, const TransportSettings& tr
         if (md.scatters && !md.uniform_tau_t) chromatic_scatterer = true;
         if (!md.scatters && !md.is_empty() && !md.uniform_tau_t) chromatic_weight = true;
     }
-    pdf_unbiased_ = !(chromatic_scatterer && chromatic_weight);
+    pdf_unbiased_ = !(chromatic_scatterer && chromatic_weight) && !transport.polarization;
 }
 
 // ---- Building the connection: the delta-chain ladder
@@ -155,9 +181,14 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, const TransportSettings& tr
 // flip), 1 for a smooth conductor and an index-matched pass-through (always taken; their factors
 // are weights), t_r = 1 through a non-scattering medium (a weight) and, through a scattering one,
 // t_r = e^{−τt_c/μ_r} per channel: the probability that channel c's free flight crosses it.
+//
+// Polarized walks: every chain lies in the vertical plane of wo (smooth interfaces keep the
+// azimuth), where s- and p-polarized light never mix: the ladder is solved for each, with the s or
+// p Fresnel reflectance of every smooth interface (physics/polarization.h: a ± b), and `up`,
+// `down` hold their mean (the throughput of unpolarized light, which a depolarizing vertex emits).
 static void build_connection(const std::vector<double>& eta, const auto& interfaces,
                              const auto& media, const Vec3d& wo, bool top, bool probability,
-                             RandomWalkStack::Connection& c) {
+                             RandomWalkStack::Connection& c, bool polarized = false) {
     const int L = int(interfaces.size());
     c.top = top;
     c.L = L;
@@ -201,66 +232,99 @@ static void build_connection(const std::vector<double>& eta, const auto& interfa
         c.t[r] = opaque_flight ? exp_neg(media[r].tau_t / c.mu[r]) : Rgbd(1.0);
         c.scale[r] = sqr(ratio);
     }
-    // Unknowns x = (A_0^↑ … A_{L−1}^↑, A_0^↓ … A_{L−1}^↓), one system per channel.
-    const int n = 2 * L;
-    for (int ch = 0; ch < 3; ++ch) {
-        std::vector<double> M(std::size_t(n) * n, 0.0), b(n, 0.0);
-        for (int i = 0; i < n; ++i)
-            M[i * n + i] = 1;
-        auto up = [&](int k) { return k; };
-        auto down = [&](int k) { return L + k; };
-        // "Goes up into region k" and "goes down into region k + 1" from interface k.
-        auto add_up = [&](int row, int k, double coeff) {
-            if (coeff == 0 || !c.valid[k]) return;
-            if (k == 0)
-                b[row] += coeff * (top ? 1.0 : 0.0);
-            else
-                M[row * n + up(k - 1)] -= coeff * c.t[k][ch];
-        };
-        auto add_down = [&](int row, int k, double coeff) {
-            if (coeff == 0 || !c.valid[k + 1]) return;
-            if (k + 1 == L)
-                b[row] += coeff * (top ? 0.0 : 1.0);
-            else
-                M[row * n + down(k + 1)] -= coeff * c.t[k + 1][ch];
-        };
-        for (int k = 0; k < L; ++k) {
-            const auto& it = interfaces[k];
-            if (!it.delta) continue;  // rows stay x = 0
-            if (it.type == InterfaceType::Conductor) {
-                if (c.valid[k])
-                    add_up(down(k), k, probability ? 1.0 : it.conductor.fresnel(c.mu[k])[ch]);
-                continue;
-            }
-            const auto& d = it.dielectric;
-            if (d.is_index_matched()) {
-                // A pass-through: T = G2(w, −w)/G1(w) (1 when smooth), R = 0.
-                auto pass = [&](const Vec3d& w) {
-                    return d.is_smooth() || probability
-                               ? 1.0
-                               : d.masking_shadowing(w, -w) / d.distribution().G1(w);
-                };
-                if (c.valid[k + 1]) add_up(up(k), k, pass(-c.dir_up[k + 1]));
-                if (c.valid[k]) add_down(down(k), k, pass(-c.dir_down[k]));
-                continue;
-            }
-            if (c.valid[k + 1]) {  // arriving from below, cosine μ_{k+1}
-                const double F = fresnel_dielectric(-c.mu[k + 1], d.eta);
-                add_up(up(k), k, 1 - F);
-                add_down(up(k), k, F);
-            }
-            if (c.valid[k]) {  // arriving from above, cosine μ_k
-                const double F = fresnel_dielectric(c.mu[k], d.eta);
-                add_up(down(k), k, F);
-                add_down(down(k), k, 1 - F);
-            }
-        }
-        solve_dense(M, b, n);
-        for (int k = 0; k < L; ++k) {
-            c.up[k][ch] = b[up(k)];
-            c.down[k][ch] = b[down(k)];
-        }
+    // Unknowns x = (A_0^↑ … A_{L−1}^↑, A_0^↓ … A_{L−1}^↓), one system per channel (and, polarized,
+    // per polarization: pol 0 s, 1 p; −1 unpolarized).
+    c.polarized = polarized;
+    for (int x = 0; x < 2; ++x) {
+        c.up_sp[x].assign(polarized ? L : 0, Rgbd(0.0));
+        c.down_sp[x].assign(polarized ? L : 0, Rgbd(0.0));
     }
+    // The reflectance of a smooth dielectric (relative index eta) at the cosine mu, for light of
+    // polarization pol, and of a smooth conductor's channel ch.
+    auto dielectric_reflectance = [](double mu, double eta_rel, int pol) {
+        if (pol < 0) return fresnel_dielectric(mu, eta_rel);
+        const InterfaceMueller<double> m =
+            fresnel_dielectric_mueller<double>(mu, eta_rel, 1 / eta_rel).reflection;
+        return pol == 0 ? m.a + m.b : m.a - m.b;
+    };
+    auto conductor_reflectance = [](const auto& conductor, double mu, int ch, int pol) {
+        if (pol < 0) return conductor.fresnel(mu)[ch];
+        const InterfaceMueller<double> m =
+            fresnel_conductor_mueller<double>(mu, conductor.eta[ch], conductor.k[ch]);
+        return pol == 0 ? m.a + m.b : m.a - m.b;
+    };
+    const int n = 2 * L;
+    for (int pol = polarized ? 0 : -1; pol < (polarized ? 2 : 0); ++pol)
+        for (int ch = 0; ch < 3; ++ch) {
+            std::vector<double> M(std::size_t(n) * n, 0.0), b(n, 0.0);
+            for (int i = 0; i < n; ++i)
+                M[i * n + i] = 1;
+            auto up = [&](int k) { return k; };
+            auto down = [&](int k) { return L + k; };
+            // "Goes up into region k" and "goes down into region k + 1" from interface k.
+            auto add_up = [&](int row, int k, double coeff) {
+                if (coeff == 0 || !c.valid[k]) return;
+                if (k == 0)
+                    b[row] += coeff * (top ? 1.0 : 0.0);
+                else
+                    M[row * n + up(k - 1)] -= coeff * c.t[k][ch];
+            };
+            auto add_down = [&](int row, int k, double coeff) {
+                if (coeff == 0 || !c.valid[k + 1]) return;
+                if (k + 1 == L)
+                    b[row] += coeff * (top ? 0.0 : 1.0);
+                else
+                    M[row * n + down(k + 1)] -= coeff * c.t[k + 1][ch];
+            };
+            for (int k = 0; k < L; ++k) {
+                const auto& it = interfaces[k];
+                if (!it.delta) continue;  // rows stay x = 0
+                if (it.type == InterfaceType::Conductor) {
+                    if (c.valid[k])
+                        add_up(down(k), k,
+                               probability ? 1.0
+                                           : conductor_reflectance(it.conductor, c.mu[k], ch, pol));
+                    continue;
+                }
+                const auto& d = it.dielectric;
+                if (d.is_index_matched()) {
+                    // A pass-through: T = G2(w, −w)/G1(w) (1 when smooth), R = 0.
+                    auto pass = [&](const Vec3d& w) {
+                        return d.is_smooth() || probability
+                                   ? 1.0
+                                   : d.masking_shadowing(w, -w) / d.distribution().G1(w);
+                    };
+                    if (c.valid[k + 1]) add_up(up(k), k, pass(-c.dir_up[k + 1]));
+                    if (c.valid[k]) add_down(down(k), k, pass(-c.dir_down[k]));
+                    continue;
+                }
+                if (c.valid[k + 1]) {  // arriving from below, cosine μ_{k+1}
+                    const double F = dielectric_reflectance(-c.mu[k + 1], d.eta, pol);
+                    add_up(up(k), k, 1 - F);
+                    add_down(up(k), k, F);
+                }
+                if (c.valid[k]) {  // arriving from above, cosine μ_k
+                    const double F = dielectric_reflectance(c.mu[k], d.eta, pol);
+                    add_up(down(k), k, F);
+                    add_down(down(k), k, 1 - F);
+                }
+            }
+            solve_dense(M, b, n);
+            for (int k = 0; k < L; ++k) {
+                if (pol < 0) {
+                    c.up[k][ch] = b[up(k)];
+                    c.down[k][ch] = b[down(k)];
+                } else {
+                    c.up_sp[pol][k][ch] = b[up(k)];
+                    c.down_sp[pol][k][ch] = b[down(k)];
+                }
+            }
+        }
+    if (polarized)
+        for (int k = 0; k < L; ++k) {
+            c.up[k] = (c.up_sp[0][k] + c.up_sp[1][k]) * 0.5;
+            c.down[k] = (c.down_sp[0][k] + c.down_sp[1][k]) * 0.5;
+        }
 }
 
 // ---- The second connection strategy through a rough top (docs/rendering.md §1.3) ---------------
@@ -287,6 +351,7 @@ struct RandomWalkStack::WalkState {
     double prev_pdf = 0;    ///< its sampling density of the current direction
     double prev_depth =
         0;  ///< its depth-distance to the exit interface (1 at the vertex interface)
+    StokesLanes<double> stokes;  ///< polarized walks: the particle's state (physics/polarization.h)
 };
 
 double RandomWalkStack::survival_proxy(int region, double path) const {
@@ -405,6 +470,144 @@ double RandomWalkStack::interface_pdf_chain(const Interface& it, const Vec3d& wi
     return std::isfinite(p) ? p : 0.0;
 }
 
+// ---- Polarized connections (docs/physics.md §8) -------------------------------------------------
+void RandomWalkStack::emission(const Interface& it, const Vec3d& wi, const Vec3d* d, int n,
+                               const StokesLanes<double>& state, const Rgbd& w, ParticleRng& rng,
+                               StokesRgb<double>* out, int channels) const {
+    if (channels == 0) channels = channels_;
+    for (int j = 0; j < n; ++j)
+        out[j] = StokesRgb<double>{};
+    if (it.type == InterfaceType::Lambertian) {  // a depolarizer
+        for (int j = 0; j < n; ++j) {
+            const Rgbd f = it.lambertian.eval(wi, d[j]) * std::abs(d[j].z);
+            for (int c = 0; c < 3; ++c)
+                out[j].s[c][0] = f[c];
+        }
+        return;
+    }
+    const auto mueller = [&](double c, InterfaceMueller<double>* m) { it.conductor.mueller(c, m); };
+    if (!it.multiple) {
+        // f·|cos| of the single-scattering BSDF with the state's fraction of its facet's Fresnel
+        // branch (the facet of the pair wi, d: Walter et al. 2007, Eqs. 13 and 16).
+        for (int j = 0; j < n; ++j) {
+            const Rgbd f = eval_interface(it, wi, d[j]) * std::abs(d[j].z);
+            if (is_black(f)) continue;
+            const double scale[3] = {f[0], f[1], f[2]};
+            if (it.type == InterfaceType::Dielectric) {
+                const std::optional<Vec3d> wm = it.dielectric.half_vector(wi, d[j]);
+                if (!wm) continue;
+                const DielectricMueller<double> fm = fresnel_dielectric_mueller<double>(
+                    dot(wi, *wm), it.dielectric.eta, 1 / it.dielectric.eta);
+                const InterfaceMueller<double>& m =
+                    same_hemisphere(wi, d[j]) ? fm.reflection : fm.transmission;
+                microsurface_stokes_through(&m, false, wi, *wm, d[j], state, channels, scale,
+                                            out[j]);
+            } else {
+                const Vec3d wm = normalize(wi + d[j]);
+                InterfaceMueller<double> m[3];
+                mueller(dot(wi, wm), m);
+                microsurface_stokes_through(m, true, wi, wm, d[j], state, channels, scale, out[j]);
+            }
+        }
+        return;
+    }
+    // One polarized visiting walk from wi (its own state, starting from the particle's): every
+    // facet it meets connects towards each d[j] with the state it meets the facet in.
+    auto uniform = [&] { return rng.uniform_double(); };
+    PolarizationLanes<double> pol;
+    const double flux[3] = {w[0], w[1], w[2]};
+    pol.stokes = state;
+    pol.channels = channels;
+    pol.flux = flux;
+    if (it.type == InterfaceType::Dielectric) {
+        const GGX<double> ggx = it.dielectric.distribution();
+        const double eta = it.dielectric.eta;
+        walk_rough_dielectric_polarized_visiting(
+            ggx, eta, wi, uniform, transport_.max_microsurface_order, pol,
+            [&](const MicrosurfaceFacet<double>& facet) {
+                for (int j = 0; j < n; ++j)
+                    microsurface_dielectric_connect_polarized(ggx, eta, facet, d[j], pol.stokes,
+                                                              channels, out[j]);
+            });
+    } else {
+        const GGX<double> ggx = it.conductor.distribution();
+        walk_rough_conductor_polarized_visiting(
+            ggx, mueller, wi, uniform, transport_.max_microsurface_order, pol,
+            [&](const MicrosurfaceFacet<double>& facet) {
+                for (int j = 0; j < n; ++j)
+                    microsurface_conductor_connect_polarized(ggx, mueller, facet, d[j], pol.stokes,
+                                                             channels, out[j]);
+            });
+    }
+    for (int j = 0; j < n; ++j)
+        for (auto& channel : out[j].s)
+            for (double& x : channel)
+                if (!std::isfinite(x)) {
+                    out[j] = StokesRgb<double>{};
+                    break;
+                }
+}
+
+// Strategy 2 (connect_through_exit) for a polarized walk: the vertex's light towards ω as Stokes
+// vectors, and the exit's BTDF for it — single scattering: the unpolarized f_exit with the exit
+// facet's transmission fraction a + b q of the light's state over its a (the facet of the pair
+// t, wo: Walter et al. 2007, Eq. 16); multiple scattering: the exit's polarized emission towards
+// wo for that state (a mixture of the vertex's per-channel states is the partially polarized
+// state S/S0: the exit's response is linear in S).
+template <typename Emit, typename ProxyPdf>
+void RandomWalkStack::connect_through_exit_polarized(const Connection& conn, const Vec3d& wo,
+                                                     double depth, const Rgbd& w, ParticleRng& rng,
+                                                     const Emit& emit, const ProxyPdf& proxy_pdf,
+                                                     Rgbd& f) const {
+    const Interface& exit_it = interfaces_[conn.exit_interface];
+    const DielectricInterface<double>& exit = exit_it.dielectric;
+    const double uc = rng.uniform_double(), u1 = rng.uniform_double(), u2 = rng.uniform_double();
+    const auto st = exit.sample<true>(wo, uc, u1, u2);
+    if (!st || !st->is_transmission || st->shadowing == 0 || st->pdf <= 0) return;
+    const Vec3d omega = -st->wo;
+    if (omega.z * conn.towards <= 0) return;
+    const double mu = std::abs(omega.z);
+    const Medium& m = media_[conn.inner];
+    const double p1 = proxy_pdf(omega) * survival_proxy(conn.inner, depth / mu);
+    const double mis = st->pdf / (st->pdf + p1);
+    StokesRgb<double> e;
+    emit(omega, e);
+    // The light's state per channel, in the tabulation frame of ω.
+    StokesLanes<double> state;
+    state.x = stokes_bin_frame<double>({omega.x, omega.y, omega.z});
+    const double inv_len = 1 / std::sqrt(dot(Vec3d(state.x.x, state.x.y, state.x.z),
+                                             Vec3d(state.x.x, state.x.y, state.x.z)));
+    state.x = {state.x.x * inv_len, state.x.y * inv_len, state.x.z * inv_len};
+    for (int c = 0; c < 3; ++c) {
+        const double s0 = e.s[c][0];
+        state.q[c] = s0 > 0 ? e.s[c][1] / s0 : 0;
+        state.u[c] = s0 > 0 ? e.s[c][2] / s0 : 0;
+        state.v[c] = s0 > 0 ? e.s[c][3] / s0 : 0;
+    }
+    Rgbd through(0.0);  // per unit S0: the exit's f for the light's state
+    if (exit_it.multiple) {
+        StokesRgb<double> out;
+        emission(exit_it, st->wo, &wo, 1, state, w, rng, &out, 3);
+        for (int c = 0; c < 3; ++c)
+            through[c] = out.s[c][0] / std::abs(wo.z);
+    } else {
+        const double f_exit = exit.eval(st->wo, wo);
+        const std::optional<Vec3d> wm = exit.half_vector(st->wo, wo);
+        if (f_exit == 0 || !wm) return;
+        const DielectricMueller<double> fm =
+            fresnel_dielectric_mueller<double>(dot(st->wo, *wm), exit.eta, 1 / exit.eta);
+        if (!(fm.transmission.a > 0)) return;
+        const Vec3d n = cross(st->wo, *wm);
+        stokes_rotate_frame<double>(state, {omega.x, omega.y, omega.z}, {n.x, n.y, n.z}, 3, true);
+        for (int c = 0; c < 3; ++c)
+            through[c] =
+                f_exit * (fm.transmission.a + fm.transmission.b * state.q[c]) / fm.transmission.a;
+    }
+    const Rgbd tr = m.is_empty() ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
+    const Rgbd kv(e.s[0][0], e.s[1][0], e.s[2][0]);
+    f += w * kv * tr * through * (1 / st->pdf * mis);
+}
+
 // ---- Media (docs/physics.md §4), as the goniophotometer traverses them --------------------------
 // Depth s ∈ [0, 1] across the layer (0 at its top). Returns true if the particle leaves through
 // the top. Free flights from a mixture of the channels' exponentials with probabilities ∝ flux and
@@ -466,20 +669,6 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
                               hg_phase(cd, g) * tr_down[ch] * below[ch]);
                 }
             }
-            if (conn->rough_exit && region == conn->inner) {
-                const Vec3d d_in = d;
-                auto kernel = [&](const Vec3d& om) {
-                    const double ct = dot(d_in, om);
-                    return Rgbd(hg_phase(ct, m.g[0]), hg_phase(ct, m.g[1]), hg_phase(ct, m.g[2]));
-                };
-                auto proxy = [&](const Vec3d& om) { return phase_pdf(dot(d_in, om)); };
-                connect_through_exit<kMode>(
-                    *conn, wo, conn->distance(s), w, rng, kernel,
-                    [&](const Vec3d& om, const Rgbd& pass) {
-                        return proxy(om) * chain_probability(w * kernel(om), pass);
-                    },
-                    proxy, f);
-            }
         }
         if constexpr (kMode == Mode::Pdf) {
             // Exit density (docs/rendering.md §1.4): the phase-sampling density of d_r± times the
@@ -501,6 +690,9 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
                     f[0] += phase_pdf(ct) * chain_probability(W, q) * jacobian;
                 }
             }
+        }
+        if constexpr (kEstimate) {
+            // The connection through a rough exit (eval and pdf alike): one walk's estimate.
             if (conn->rough_exit && region == conn->inner) {
                 const Vec3d d_in = d;
                 auto kernel = [&](const Vec3d& om) {
@@ -523,6 +715,8 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
         const Vec3d d_new(d_scattered.x, d_scattered.y, d_scattered.z);
         const double cos_theta = dot(d, d_new);
         w *= Rgbd(phase[0], phase[1], phase[2]);
+        if (transport_.polarization && kMode != Mode::Pdf)  // docs/physics.md §8
+            stokes_depolarize<double>(ws.stokes, 3, true);
         // The walk's own strategy for the same paths (strategy 1, weighted at the exit). Only
         // meaningful while connecting (conn is null for sample()).
         ws.prev_mis =
@@ -550,6 +744,12 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
     ws.d = -wi;
     Vec3d& d = ws.d;
     Rgbd& w = ws.w;
+    // pdf() estimates the exit density of the unpolarized walk (random_walk.h): its walks are.
+    const bool polarized = transport_.polarization && kMode != Mode::Pdf;
+    if (polarized) {  // unpolarized incident light (docs/physics.md §8)
+        const float unpolarized[3] = {0, 0, 0};
+        ws.stokes = stokes_incident<double>({d.x, d.y, d.z}, unpolarized);
+    }
     int k = 0;  // the interface the particle is about to meet
     while (ws.events++ < transport_.max_events) {
         const Interface& it = interfaces_[k];
@@ -574,6 +774,15 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
         // Strategy 2 from the vertex interface (eval and pdf), its kernel, exit density × chain
         // probability, and the balance heuristic's proxy density (single scattering).
         auto connect_vertex_interface = [&](const Interface& vi) {
+            if (polarized && kConnect) {
+                connect_through_exit_polarized(
+                    *conn, wo, 1.0, w, rng,
+                    [&](const Vec3d& om, StokesRgb<double>& e) {
+                        emission(vi, wi_local, &om, 1, ws.stokes, w, rng, &e);
+                    },
+                    [&](const Vec3d& om) { return pdf_interface(vi, wi_local, om); }, f);
+                return;
+            }
             connect_through_exit<kMode>(
                 *conn, wo, 1.0, w, rng,
                 [&](const Vec3d& om) { return interface_kernel(vi, wi_local, om, rng); },
@@ -589,7 +798,29 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
         const bool up_ok = conn && conn->valid[k];
         const bool down_ok = conn && it.type == InterfaceType::Dielectric && conn->valid[k + 1];
         if constexpr (kConnect) {
-            if (it.multiple && (up_ok || down_ok)) {
+            if (polarized) {
+                // The vertex's light towards d_r, in the frame of its chain's plane (whose s and
+                // p parts the chains carry apart); f·|cos| over |cos| of the connection.
+                if (!it.delta && (up_ok || down_ok)) {
+                    Vec3d dirs[2];
+                    int n = 0;
+                    const int iu = up_ok ? n++ : -1, id = down_ok ? n++ : -1;
+                    if (up_ok) dirs[iu] = conn->dir_up[k];
+                    if (down_ok) dirs[id] = conn->dir_down[k + 1];
+                    StokesRgb<double> e[2];
+                    emission(it, wi_local, dirs, n, ws.stokes, w, rng, e);
+                    if (up_ok)
+                        f += w *
+                             Connection::through(e[iu], conn->from_bottom_up(k, 0),
+                                                 conn->from_bottom_up(k, 1)) *
+                             (conn->scale[k] * exit_mis(k) / std::abs(dirs[iu].z));
+                    if (down_ok)
+                        f += w *
+                             Connection::through(e[id], conn->from_top_down(k + 1, 0),
+                                                 conn->from_top_down(k + 1, 1)) *
+                             (conn->scale[k + 1] * exit_mis(k) / std::abs(dirs[id].z));
+                }
+            } else if (it.multiple && (up_ok || down_ok)) {
                 Rgbd k_up(0.0), k_down(0.0);
                 const Vec3d du = up_ok ? conn->dir_up[k] : Vec3d();
                 const Vec3d dd = down_ok ? conn->dir_down[k + 1] : Vec3d();
@@ -611,7 +842,7 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                     f += w * k_down * conn->from_top_down(k + 1) *
                          (conn->scale[k + 1] * exit_mis(k) / std::abs(dd.z));
             }
-            if (!it.delta && !it.multiple) {
+            if (!polarized && !it.delta && !it.multiple) {
                 if (conn->valid[k]) {
                     const Vec3d& du = conn->dir_up[k];
                     Rgbd fv = eval_interface(it, wi_local, du);
@@ -683,13 +914,32 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 connect_vertex_interface(it);
         }
         std::optional<BsdfSample<double>> s;
+        // Polarized walks: the interfaces' polarized events on the walk's state, as the
+        // goniophotometer's (the density, a proxy for strategy 2's weights, stays the
+        // single-scattering unpolarized one).
+        PolarizationLanes<double> pol;
+        const double flux[3] = {w[0], w[1], w[2]};
+        pol.stokes = ws.stokes;
+        pol.channels = channels_;
+        pol.flux = flux;
+        const auto mueller = [&](double c, InterfaceMueller<double>* m) {
+            it.conductor.mueller(c, m);
+        };
         if (it.multiple) {
             // The microsurface walk (Heitz et al. 2016) to its exit; a walk given up at the facet
             // cap or degenerate loses its flux, as the goniophotometer's. The density is the
             // single-scattering one: only strategy 2's balance heuristic reads it (a proxy).
             auto uniform = [&] { return rng.uniform_double(); };
+            const bool dielectric = it.type == InterfaceType::Dielectric;
             const std::optional<MicrosurfaceExit<double>> e =
-                it.type == InterfaceType::Dielectric
+                polarized
+                    ? (dielectric ? walk_rough_dielectric_polarized(
+                                        it.dielectric.distribution(), it.dielectric.eta, wi_local,
+                                        uniform, transport_.max_microsurface_order, pol)
+                                  : walk_rough_conductor_polarized(
+                                        it.conductor.distribution(), mueller, wi_local, uniform,
+                                        transport_.max_microsurface_order, pol))
+                : dielectric
                     ? walk_rough_dielectric(it.dielectric.distribution(), it.dielectric.eta,
                                             wi_local, uniform, transport_.max_microsurface_order)
                     : walk_rough_conductor(
@@ -706,20 +956,33 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                 case InterfaceType::Dielectric: {
                     const double uc = rng.uniform_double(), u1 = rng.uniform_double(),
                                  u2 = rng.uniform_double();
-                    s = it.dielectric.sample<true>(wi_local, uc, u1, u2);
+                    if (polarized) {
+                        s = it.dielectric.sample_polarized(wi_local, uc, u1, u2, pol);
+                        if (s && !s->is_delta) s->pdf = it.dielectric.pdf(wi_local, s->wo);
+                    } else {
+                        s = it.dielectric.sample<true>(wi_local, uc, u1, u2);
+                    }
                     break;
                 }
                 case InterfaceType::Conductor: {
                     const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
-                    s = it.conductor.sample<true>(wi_local, u1, u2);
+                    if (polarized) {
+                        s = it.conductor.sample_polarized(wi_local, u1, u2, pol);
+                        if (s && !s->is_delta && s->wo.z > 0)
+                            s->pdf = it.conductor.pdf(wi_local, s->wo);
+                    } else {
+                        s = it.conductor.sample<true>(wi_local, u1, u2);
+                    }
                     break;
                 }
                 case InterfaceType::Lambertian: {
                     const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
                     s = it.lambertian.sample(wi_local, u1, u2);
+                    stokes_depolarize<double>(pol.stokes, 3, true);
                     break;
                 }
             }
+        if (polarized) ws.stokes = pol.stokes;
         if (!s) return;  // a numerical degeneracy: the flux is dropped
         w *= s->weight;
         if (!it.delta) ws.delta_only = false;
@@ -779,7 +1042,7 @@ double RandomWalkStack::pdf_interface(const Interface& it, const Vec3d& wi, cons
 Rgbd RandomWalkStack::eval_once(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng) const {
     if (wi.z <= 0 || wo.z == 0 || (wo.z < 0 && !transmits_)) return Rgbd(0.0);
     Connection conn;
-    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, false, conn);
+    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, false, conn, transport_.polarization);
     Rgbd f(0.0);
     walk<Mode::Eval>(wi, wo, rng, &conn, f, nullptr);
     return f;
@@ -791,7 +1054,7 @@ std::vector<RandomWalkStack::DeltaExit> RandomWalkStack::delta_lobes(const Vec3d
     // Light entering along −wi at interface 0 from above is A_0^↓ at wi's Snell invariant.
     const Vec3d mirror(-wi.x, -wi.y, wi.z);
     Connection conn;
-    build_connection(eta_, interfaces_, media_, mirror, true, false, conn);
+    build_connection(eta_, interfaces_, media_, mirror, true, false, conn, transport_.polarization);
     if (conn.down[0].max() > 0) out.push_back({mirror, conn.down[0]});
     if (transmits_) {
         const int L = int(interfaces_.size());
@@ -799,7 +1062,8 @@ std::vector<RandomWalkStack::DeltaExit> RandomWalkStack::delta_lobes(const Vec3d
         const double sin2 = sqr(ratio) * (sqr(wi.x) + sqr(wi.y));
         if (sin2 < 1) {
             const Vec3d wt(-wi.x * ratio, -wi.y * ratio, -std::sqrt(1 - sin2));
-            build_connection(eta_, interfaces_, media_, wt, false, false, conn);
+            build_connection(eta_, interfaces_, media_, wt, false, false, conn,
+                             transport_.polarization);
             if (conn.down[0].max() > 0) out.push_back({wt, conn.down[0]});
         }
     }
@@ -812,7 +1076,7 @@ RandomWalkEstimate RandomWalkStack::eval(const Vec3d& wi, const Vec3d& wo, std::
     e.walks = walks;
     if (walks == 0 || wi.z <= 0 || wo.z == 0 || (wo.z < 0 && !transmits_)) return e;
     Connection conn;
-    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, false, conn);
+    build_connection(eta_, interfaces_, media_, wo, wo.z > 0, false, conn, transport_.polarization);
     Rgbd sum(0.0), sum_sq(0.0);
     for (std::uint64_t i = 0; i < walks; ++i) {
         ParticleRng rng(seed, stream, i);

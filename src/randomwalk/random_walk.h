@@ -50,6 +50,8 @@
 #include "physics/conductor.h"
 #include "physics/dielectric.h"
 #include "physics/lambertian.h"
+#include "physics/microsurface_walk.h"
+#include "physics/polarization.h"
 
 #include <cstdint>
 #include <optional>
@@ -86,10 +88,16 @@ class RandomWalkStack {
     /// of the paths that meet a second facet is lost), or `Multiple`, the microsurface random walk
     /// of Heitz et al. 2016 (physics/microsurface_walk.h): sample() follows the walk to its exit,
     /// eval() and pdf() connect through the interface's multiple-scattering BSDF and exit density
-    /// by the walk's unbiased stochastic evaluation (docs/rendering.md §1.6).
+    /// by the walk's unbiased stochastic evaluation (docs/rendering.md §1.6). With polarization,
+    /// the walks carry the particle's polarization as the goniophotometer's polarized kernels do
+    /// (docs/physics.md §8): sample() follows it, and eval() connects with it — a vertex's light
+    /// leaves in the Mueller matrix of its facet for the walk's state, and the delta chains carry
+    /// its s and p parts separately (a smooth chain lies in one plane of incidence). The estimates
+    /// are those of unpolarized incident light.
     explicit RandomWalkStack(const Stack& stack, const TransportSettings& transport = {});
 
     const TransportSettings& transport() const { return transport_; }
+    bool polarization() const { return transport_.polarization; }
 
     bool transmits() const { return transmits_; }
     /// Absolute indices of the ambient medium (above) and of the half-space below the base.
@@ -129,7 +137,10 @@ class RandomWalkStack {
     /// flux weights and pdf() is an approximation (docs/rendering.md §1.4). False only then.
     /// Multiple-scattering interfaces do not change it: each facet's exit enters the chain
     /// probability with its own weight (docs/rendering.md §1.6); the facet cap truncates sample,
-    /// eval and pdf alike.
+    /// eval and pdf alike. Polarized walks: pdf() estimates the exit density of the unpolarized
+    /// walk (its walks and branch probabilities are those of unpolarized light at every event),
+    /// which differs from the polarized sample()'s by polarization's effect on the Fresnel
+    /// choices: a proxy density (the renderer's use), and pdf_is_unbiased() is false.
     bool pdf_is_unbiased() const { return pdf_unbiased_; }
 
     /// The delta lobes of the stack for incidence wi (paths made only of smooth events and
@@ -183,6 +194,22 @@ class RandomWalkStack {
     /// the walk, of flux weight w before the interface, to the stack's exit:
     /// pdf(wi, wo)·chain_probability(w·weight(wo), q) (docs/rendering.md §1.4), exact for single
     /// scattering, one walk's unbiased estimate for multiple scattering.
+    /// Polarized walks: the Stokes vectors (per unit flux, per channel, f·|cos| units, in the
+    /// tabulation frame of each direction) of the light a non-delta interface, met from wi by a
+    /// particle in polarization state `state` with flux `w`, sends towards the n ≤ 2 directions
+    /// d[j] (away from it): exact for single scattering, one walk's unbiased estimate (a polarized
+    /// visiting walk, shared by the directions) for multiple scattering. `channels`: the states
+    /// in use (0: the stack's).
+    void emission(const Interface& it, const Vec3d& wi, const Vec3d* d, int n,
+                  const StokesLanes<double>& state, const Rgbd& w, ParticleRng& rng,
+                  StokesRgb<double>* out, int channels = 0) const;
+    /// Strategy 2 for a polarized walk (eval): as connect_through_exit, the vertex's light
+    /// `emit(ω, out)` (Stokes vectors per unit flux) crossing the exit interface in the Mueller
+    /// matrix of its facet.
+    template <typename Emit, typename ProxyPdf>
+    void connect_through_exit_polarized(const Connection& conn, const Vec3d& wo, double depth,
+                                        const Rgbd& w, ParticleRng& rng, const Emit& emit,
+                                        const ProxyPdf& proxy_pdf, Rgbd& f) const;
     double interface_pdf_chain(const Interface& it, const Vec3d& wi, const Vec3d& wo, const Rgbd& w,
                                const Rgbd& q, ParticleRng& rng) const;
 
@@ -192,6 +219,7 @@ class RandomWalkStack {
     bool transmits_ = false;
     bool pdf_unbiased_ = true;
     TransportSettings transport_;
+    int channels_ = 1;  ///< polarization states per particle (CompiledStack::polarization_channels)
 };
 
 }  // namespace lamina

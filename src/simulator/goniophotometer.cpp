@@ -41,6 +41,9 @@ struct MediumWalk {
     const CompiledMedium<float>& m;
     ParticleRng& rng;
     PathLosses& losses;
+    /// The particle's polarization (polarized runs; else null): a scattering event depolarizes
+    /// (docs/physics.md §8), absorption keeps it.
+    StokesLanes<float>* stokes = nullptr;
 
     bool traverse(Vec3f& d, Rgbf& w, int& events, int max_events) {
         if (!m.scatters) {
@@ -79,6 +82,7 @@ struct MediumWalk {
             for (int c = 0; c < 3; ++c)
                 w[c] *= flight.factor[c] * phase[c];
             d = {d_new.x, d_new.y, d_new.z};
+            if (stokes) stokes_depolarize<float>(*stokes, 3, true);
             losses.add(BudgetTerm::AbsorbedMedium, before - w);
             if (is_black(w)) return d.z > 0;
             if (++events >= max_events) return d.z > 0;  // the caller books the cut-off
@@ -90,14 +94,38 @@ struct MediumWalk {
 // docs/physics.md §3: at an interface the particle (arriving along −wi) draws an outgoing direction
 // from the interface's BSDF sampler; its flux is multiplied by the sample weight and the parts
 // that do not continue are booked (absorbed by the base, lost to the microsurface).
-void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& grid, const Vec3f& wi,
-                    ParticleRng& rng, int max_events, Tally& tally, BlockBudget& block) {
+// Polarized runs (docs/physics.md §8): the particle also carries its Stokes vector per channel
+// divided by its flux, with the frame's x axis (physics/polarization.h at one lane); every event
+// passes it to the interface's polarized event, a Lambertian base and a scattering event
+// depolarize it, and an exit is tallied with its Stokes vector when the job asks for it.
+// Written once for both: kPolarized = false is the unpolarized kernel, with none of it.
+template <bool kPolarized>
+void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& grid,
+                    const BlockJob& job, ParticleRng& rng, Tally& tally, BlockBudget& block) {
     const int n_layers = int(stack.layers.size());
-    Vec3f d = -wi;  // propagation direction
+    const int max_events = job.max_events;
+    Vec3f d = -job.wi;  // propagation direction
     Rgbf w(1.f);
     PathLosses losses;
     int k = 0;  // the interface the particle is about to meet
     int events = 0;
+    [[maybe_unused]] PolarizationLanes<float> pol;
+    [[maybe_unused]] float flux[3];
+    if constexpr (kPolarized) {
+        pol.stokes = stokes_incident<float>({d.x, d.y, d.z}, job.incident_stokes);
+        pol.channels = stack.polarization_channels;
+        pol.flux = flux;
+    }
+    // Where the channels' states differ, a dielectric's branch choice reweights the channels: the
+    // reweighting (zero in expectation per channel) is booked with the base that coloured them.
+    [[maybe_unused]] const bool reweights = kPolarized && pol.channels == 3;
+    [[maybe_unused]] auto exit_stokes = [&](std::size_t index) {
+        if (!job.stokes_tallies) return;
+        float s[3][4];
+        const float wl[3] = {w[0], w[1], w[2]};
+        stokes_in_bin_frame<float>(pol.stokes, {d.x, d.y, d.z}, wl, pol.channels, true, s);
+        tally.exit_stokes(index, d.y < 0 ? 1 : 0, s);
+    };
     while (true) {
         if (events >= max_events) {
             losses.add(BudgetTerm::CutOff, w);
@@ -147,9 +175,19 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
             d = e->wo;
         };
         auto uniform = [&] { return rng.uniform_float(); };
+        if constexpr (kPolarized)
+            for (int c = 0; c < 3; ++c)
+                flux[c] = w[c];
         switch (layer.type) {
             case InterfaceType::Dielectric: {
                 if (layer.multiple) {
+                    if constexpr (kPolarized) {
+                        apply_walk(walk_rough_dielectric_polarized(
+                                       layer.dielectric.distribution(), layer.dielectric.eta,
+                                       wi_local, uniform, stack.max_microsurface_order, pol),
+                                   reweights);
+                        break;
+                    }
                     apply_walk(
                         walk_rough_dielectric(layer.dielectric.distribution(), layer.dielectric.eta,
                                               wi_local, uniform, stack.max_microsurface_order),
@@ -158,12 +196,25 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
                 }
                 const float uc = rng.uniform_float(), u1 = rng.uniform_float(),
                             u2 = rng.uniform_float();
-                apply(layer.dielectric.sample<false>(wi_local, uc, u1, u2), false);
+                if constexpr (kPolarized)
+                    apply(layer.dielectric.sample_polarized(wi_local, uc, u1, u2, pol), reweights);
+                else
+                    apply(layer.dielectric.sample<false>(wi_local, uc, u1, u2), false);
                 break;
             }
             case InterfaceType::Conductor: {
+                const ConductorInterface<float>& cond = layer.conductor;
                 if (layer.multiple) {
-                    const ConductorInterface<float>& cond = layer.conductor;
+                    if constexpr (kPolarized) {
+                        const auto mueller = [&](float c, InterfaceMueller<float>* m) {
+                            cond.mueller(c, m);
+                        };
+                        apply_walk(walk_rough_conductor_polarized(
+                                       cond.distribution(), mueller, wi_local, uniform,
+                                       stack.max_microsurface_order, pol),
+                                   true);
+                        break;
+                    }
                     apply_walk(walk_rough_conductor(
                                    cond.distribution(), [&](float c) { return cond.fresnel(c); },
                                    wi_local, uniform, stack.max_microsurface_order),
@@ -171,12 +222,16 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
                     break;
                 }
                 const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
-                apply(layer.conductor.sample<false>(wi_local, u1, u2), true);
+                if constexpr (kPolarized)
+                    apply(cond.sample_polarized(wi_local, u1, u2, pol), true);
+                else
+                    apply(cond.sample<false>(wi_local, u1, u2), true);
                 break;
             }
             case InterfaceType::Lambertian: {
                 const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
                 apply(layer.lambertian.sample(wi_local, u1, u2), true);
+                if constexpr (kPolarized) stokes_depolarize<float>(pol.stokes, 3, true);
                 break;
             }
         }
@@ -193,7 +248,9 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         }
         if (d.z > 0) {
             if (k == 0) {  // leaves the stack upwards: reflection
-                tally.exit(grid.bin_of(d), w);
+                const std::size_t bin = grid.bin_of(d);
+                tally.exit(bin, w);
+                if constexpr (kPolarized) exit_stokes(bin);
                 block.escape_reflected(w);
                 break;
             }
@@ -201,21 +258,23 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
             const CompiledMedium<float>& m = stack.layers[k - 1].medium;
             bool up = true;
             if (!m.is_empty()) {
-                MediumWalk walk{m, rng, losses};
+                MediumWalk walk{m, rng, losses, kPolarized ? &pol.stokes : nullptr};
                 up = walk.traverse(d, w, events, max_events);
                 if (is_black(w)) break;
             }
             if (up) --k;
         } else {
             if (k == n_layers - 1) {  // leaves through the final dielectric: transmission
-                tally.exit(grid.size() + grid.bin_of(d), w);
+                const std::size_t bin = grid.size() + grid.bin_of(d);
+                tally.exit(bin, w);
+                if constexpr (kPolarized) exit_stokes(bin);
                 block.escape_transmitted(w);
                 break;
             }
             const CompiledMedium<float>& m = layer.medium;
             bool up = false;
             if (!m.is_empty()) {
-                MediumWalk walk{m, rng, losses};
+                MediumWalk walk{m, rng, losses, kPolarized ? &pol.stokes : nullptr};
                 up = walk.traverse(d, w, events, max_events);
                 if (is_black(w)) break;
             }
@@ -226,18 +285,28 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
     tally.sums.events += std::uint64_t(events);
 }
 
-std::uint64_t incidence_stream(double theta_i_deg) {
+std::uint64_t incidence_stream(double theta_i_deg, int incident_polarization) {
     // The stream is the incidence itself, so a result does not depend on which other incidences
-    // were simulated with it.
-    return std::bit_cast<std::uint64_t>(theta_i_deg);
+    // were simulated with it; a polarized incident state other than unpolarized adds its index
+    // times an odd 64-bit constant (the golden ratio's, as in Random123's key schedule) to the
+    // key, so that runs with different incident states are independent.
+    return std::bit_cast<std::uint64_t>(theta_i_deg) ^
+           (std::uint64_t(incident_polarization) * 0x9E3779B97F4A7C15ull);
 }
+
+// The incident Stokes vectors (S1, S2, S3)/S0 of SimulationSettings::incident_polarization.
+constexpr float kIncidentStokes[7][3] = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 0, 1},
+                                         {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
 
 }  // namespace
 
 void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block) {
     for (std::uint64_t p = job.first; p < job.first + job.count; ++p) {
         ParticleRng rng(job.seed, job.stream, p);
-        trace_particle(*job.stack, *job.grid, job.wi, rng, job.max_events, tally, block);
+        if (job.stack->polarization)
+            trace_particle<true>(*job.stack, *job.grid, job, rng, tally, block);
+        else
+            trace_particle<false>(*job.stack, *job.grid, job, rng, tally, block);
     }
 }
 
@@ -253,6 +322,10 @@ void IncidenceSums::add(const IncidenceSums& o) {
     for (std::size_t t = 0; t < budget.size(); ++t)
         for (int c = 0; c < 3; ++c)
             budget[t][c] += o.budget[t][c];
+    LAMINA_CHECK(stokes.size() == o.stokes.size());
+    for (std::size_t i = 0; i < stokes.size(); ++i)
+        for (int k = 0; k < kStokesSums; ++k)
+            stokes[i][std::size_t(k)] += o.stokes[i][std::size_t(k)];
     events += o.events;
     degenerate += o.degenerate;
 }
@@ -284,16 +357,20 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
                      &grid,
                      Vec3f(incident_direction(theta_i)),
                      settings.seed,
-                     incidence_stream(settings.theta_i_deg[inc]),
+                     incidence_stream(settings.theta_i_deg[inc], settings.incident_polarization),
                      0,
                      0,
                      settings.transport.max_events};
+        for (int k = 0; k < 3; ++k)
+            job.incident_stokes[k] = kIncidentStokes[settings.incident_polarization][k];
+        job.stokes_tallies = settings.stokes_tallies;
         IncidenceSums total;
         total.bins.resize(2 * grid.size());
+        if (settings.stokes_tallies) total.stokes.resize(2 * grid.size());
 
 #pragma omp parallel num_threads(threads) firstprivate(job)
         {
-            Tally local(grid.size());
+            Tally local(grid.size(), settings.stokes_tallies);
 #pragma omp for schedule(dynamic, 1)
             for (std::uint64_t b = 0; b < blocks; ++b) {
                 const std::uint64_t lo = b * kBlock, hi = std::min(n, lo + kBlock);
@@ -368,6 +445,7 @@ SimulationResult finalize_simulation(const Stack& stack, const SimulationSetting
         stats.seconds = inc < sums.incidence_seconds.size() ? sums.incidence_seconds[inc] : 0.0;
         result.incidences.push_back(stats);
     }
+    if (settings.stokes_tallies) result.sums = sums.incidences;
     return result;
 }
 

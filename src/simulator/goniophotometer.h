@@ -62,6 +62,16 @@ struct SimulationSettings {
     /// processes; the union of ranges equals one run of all particles, bit for bit). Not a
     /// setting: distributed/split_simulation.h sets it.
     std::uint64_t first_particle = 0;
+    /// The incident light's Stokes vector (polarized runs), in the frame of docs/physics.md §8
+    /// (x ⊥ the plane of incidence): 0 unpolarized (1, 0, 0, 0), 1 s-polarized (1, 1, 0, 0),
+    /// 2 linear at +45° (1, 0, 1, 0), 3 circular (1, 0, 0, 1), and 4–6 their opposites
+    /// (p-polarized (1, −1, 0, 0), linear at −45°, circular the other way). Each state has its own
+    /// random-number streams, so runs with different states are independent. Not a setting: the
+    /// Mueller tables (simulator/mueller.h) set it for each of their runs.
+    int incident_polarization = 0;
+    /// Tally the Stokes vectors of the exits per bin (IncidenceSums::stokes; polarized runs),
+    /// from which the Mueller tables follow (simulator/mueller.h). Not a setting, as above.
+    bool stokes_tallies = false;
 
     template <typename Self, typename Visit>
     static void fields(Self& s, Visit&& visit) {
@@ -90,6 +100,11 @@ struct SimulationSettings {
         TransportSettings::fields(s.transport, visit);
     }
 };
+
+/// Sums per (side · n_bins + bin) of the Stokes tallies: per channel c, at c · 12 + h · 4 + k the
+/// sum of S_k over the exits into the bin's half h (0: y ≥ 0, 1: y < 0, each in its own bin
+/// frame, docs/physics.md §8), at c · 12 + 8 + k the sum of S_k² over both halves.
+inline constexpr int kStokesSums = 36;
 
 /// Where the flux of an incidence went, per channel; the terms sum to 1 to rounding.
 enum class BudgetTerm {
@@ -132,6 +147,9 @@ struct IncidenceSums {
     /// kBudgetTerms + 1), scale 2^56.
     std::array<std::array<Fixed128, 3>, kBudgetTerms + 2> budget{};
     std::uint64_t events = 0, degenerate = 0;
+    /// The Stokes tallies (kStokesSums per entry, as bins; empty unless
+    /// SimulationSettings::stokes_tallies), S_k at scale 2^40 and S_k² at 2^38.
+    std::vector<std::array<Fixed128, kStokesSums>> stokes;
 
     void add(const IncidenceSums& o);
 };
@@ -145,6 +163,8 @@ struct SimulationSums {
 
 struct SimulationResult {
     SimulationSettings settings;
+    /// The raw sums (kept when settings.stokes_tallies: the Mueller tables are built from them).
+    std::vector<IncidenceSums> sums;
     BinnedTable table;  ///< reflection, and transmission when the stack transmits
     std::vector<IncidenceStats> incidences;
     double seconds = 0;

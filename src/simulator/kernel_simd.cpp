@@ -87,6 +87,7 @@
 #include "physics/microfacet.h"
 #include "physics/microsurface_walk.h"
 #include "physics/phase.h"
+#include "physics/polarization.h"
 #include "physics/smith_masking.h"
 #undef LAMINA_LANE_TARGET
 
@@ -358,6 +359,8 @@ struct LaneVectors {
     VI k;               // at an interface: its index; in a medium: its layer
     VI in_medium, events, live, finish;
     bool touched[kLossTerms] = {};  // loss terms some lane may have booked in this block
+    // Polarized runs: the lanes' polarization (physics/polarization.h); pol.flux points at w.
+    PolarizationLanes<VF> pol;
 
     // Multiplies the flux of the lanes in m by `factor` (per channel) and books what is taken
     // under `term`.
@@ -404,16 +407,21 @@ HWY_INLINE std::uint64_t MaskBits(MF m) {
 // ---- Interface events (goniophotometer.cpp trace_particle, `apply`) ----------------------------
 
 // A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
-// instantiates at one lane): the particle arrives along d (wi = −d).
+// instantiates at one lane): the particle arrives along d (wi = −d). Polarized (kPolarized): the
+// event's polarized form on the lanes' states; where the channels' states differ, its reweighting
+// of the channels is booked with the base, as trace_particle does.
+template <bool kPolarized>
 HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
                                 VF uc, VF u1, VF u2, MF& degenerate) {
     const DF df;
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
-    const InterfaceEventLanes<VF, MF> e = dielectric_event<VF, VecLane>(
+    const InterfaceEventLanes<VF, MF> e = dielectric_event<VF, VecLane, kPolarized>(
         hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), hn::Set(df, iface.alpha),
-        iface.event_shape(), wi, uc, u1, u2, m);
+        iface.event_shape(), wi, uc, u1, u2, m, kPolarized ? &v.pol : nullptr);
     degenerate = hn::Or(degenerate, e.degenerate);
     const MF ok = hn::AndNot(e.degenerate, m);
+    if constexpr (kPolarized)
+        if (v.pol.channels == 3) v.Keep(ok, kLossBase, v.pol.factor);
     if (!iface.is_smooth()) v.Keep(ok, kLossMicro, e.shadowing);
     v.d = Select(ok, e.wo, v.d);
 }
@@ -432,16 +440,39 @@ struct ConductorFresnel {
     }
 };
 
+// The conductor's reflection Mueller matrices per channel (polarization.h
+// fresnel_conductor_mueller, the same template); channels with the same index share them.
+struct ConductorMueller {
+    const ConductorInterface<float>& iface;
+    HWY_INLINE void operator()(VF cos_theta, InterfaceMueller<VF>* m) const {
+        const DF df;
+        for (int c = 0; c < 3; ++c) {
+            const bool same =
+                c > 0 && iface.eta[c] == iface.eta[c - 1] && iface.k[c] == iface.k[c - 1];
+            m[c] = same ? m[c - 1]
+                        : fresnel_conductor_mueller<VF, VecLane>(
+                              cos_theta, hn::Set(df, iface.eta[c]), hn::Set(df, iface.k[c]));
+        }
+    }
+};
+
 // A rough or smooth conductor (conductor.h conductor_event, the same template): light from above
-// only.
+// only. Polarized: the Fresnel factors are the reflected fractions of the lanes' states.
+template <bool kPolarized>
 HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v, VF u1,
                                VF u2, MF& degenerate) {
     const DF df;
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     VF fresnel[3];
-    const InterfaceEventLanes<VF, MF> e = conductor_event<VF, VecLane>(
-        hn::Set(df, iface.alpha), iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1, u2, m,
-        ConductorFresnel{iface}, fresnel);
+    InterfaceEventLanes<VF, MF> e;
+    if constexpr (kPolarized)
+        e = conductor_event<VF, VecLane>(
+            hn::Set(df, iface.alpha), iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1, u2,
+            m, ConductorFresnel{iface}, fresnel, &v.pol, ConductorMueller{iface});
+    else
+        e = conductor_event<VF, VecLane>(hn::Set(df, iface.alpha), iface.is_smooth(),
+                                         iface.uncorrelated_shadowing, wi, u1, u2, m,
+                                         ConductorFresnel{iface}, fresnel);
     degenerate = hn::Or(degenerate, e.degenerate);
     const MF ok = hn::AndNot(e.degenerate, m);
     v.Keep(ok, kLossBase, fresnel);
@@ -454,10 +485,12 @@ HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, Lan
 // from facet to facet, every lane of the vector drawing its numbers while any walks, until each
 // has escaped (its new direction; a conductor's exit carries its Fresnel factors, the rest
 // absorbed by the base), met its facet cap (its flux lost to the microsurface) or a degeneracy
-// (lost and counted, as a failed sample), as trace_particle books the walk.
+// (lost and counted, as a failed sample), as trace_particle books the walk. `weighted`: the exit's
+// weight is booked on a dielectric too (polarized, the channels' states differing).
 template <typename Facet>
 HWY_INLINE void MicrosurfaceWalkEvent(float alpha, bool two_sided, const Facet& facet, MF m,
-                                      LaneVectors& v, LaneRng& rng, int max_order, MF& degenerate) {
+                                      LaneVectors& v, LaneRng& rng, int max_order, MF& degenerate,
+                                      bool weighted = false) {
     const DF df;
     const VF zero = hn::Zero(df);
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
@@ -465,29 +498,40 @@ HWY_INLINE void MicrosurfaceWalkEvent(float alpha, bool two_sided, const Facet& 
     const MicrosurfaceWalkLanes<VF, MF> walk = microsurface_walk<VF, VecLane>(
         hn::Set(df, alpha), wi, m, two_sided, facet, draw, max_order);
     degenerate = hn::Or(degenerate, walk.degenerate);
-    if (!two_sided) v.Keep(walk.escaped, kLossBase, walk.weight);
+    if (!two_sided || weighted) v.Keep(walk.escaped, kLossBase, walk.weight);
     v.Keep(walk.capped, kLossMicro, zero);
     v.d = Select(walk.escaped, walk.wo, v.d);
 }
 
+template <bool kPolarized>
 HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
                                     LaneRng& rng, int max_order, MF& degenerate) {
     const DF df;
     auto draw = [&] { return rng.Uniform(); };
-    const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw)> facet{
-        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), draw};
-    MicrosurfaceWalkEvent(iface.alpha, true, facet, m, v, rng, max_order, degenerate);
+    const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw), kPolarized> facet{
+        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), draw, kPolarized ? &v.pol : nullptr};
+    MicrosurfaceWalkEvent(iface.alpha, true, facet, m, v, rng, max_order, degenerate,
+                          kPolarized && v.pol.channels == 3);
 }
 
+template <bool kPolarized>
 HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v,
                                    LaneRng& rng, int max_order, MF& degenerate) {
     const ConductorFresnel fresnel{iface};
-    const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel> facet{fresnel};
-    MicrosurfaceWalkEvent(iface.alpha, false, facet, m, v, rng, max_order, degenerate);
+    if constexpr (kPolarized) {
+        const ConductorMueller mueller{iface};
+        const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel, ConductorMueller> facet{
+            fresnel, &v.pol, &mueller};
+        MicrosurfaceWalkEvent(iface.alpha, false, facet, m, v, rng, max_order, degenerate);
+    } else {
+        const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel> facet{fresnel};
+        MicrosurfaceWalkEvent(iface.alpha, false, facet, m, v, rng, max_order, degenerate);
+    }
 }
 
 // Lambertian (lambertian.h lambertian_event, the same template): cosine-distributed on wi's side,
-// weight = albedo.
+// weight = albedo; it depolarizes (polarized runs).
+template <bool kPolarized>
 HWY_INLINE void LambertianEvent(const LambertianInterface<float>& iface, MF m, LaneVectors& v,
                                 VF u1, VF u2, MF& degenerate) {
     const DF df;
@@ -499,13 +543,15 @@ HWY_INLINE void LambertianEvent(const LambertianInterface<float>& iface, MF m, L
                           hn::Set(df, iface.albedo[2])};
     v.Keep(ok, kLossBase, albedo);
     v.d = Select(ok, wo, v.d);
+    if constexpr (kPolarized) stokes_depolarize<VF, VecLane>(v.pol.stokes, 3, ok);
 }
 
 // ---- Media (physics/medium.h, the templates the scalar kernel instantiates at one lane) -------
 
 // One scattering-medium step for the lanes in m (inside layer `layer`'s medium): a free flight,
-// then either the crossing to the next interface or a scattering event. The lanes draw their
-// numbers as the template asks for them (every lane draws while any needs them).
+// then either the crossing to the next interface or a scattering event (which depolarizes). The
+// lanes draw their numbers as the template asks for them (every lane draws while any needs them).
+template <bool kPolarized>
 HWY_INLINE void ScatteringStep(const CompiledMedium<float>& med, MF m, LaneVectors& v,
                                LaneRng& rng) {
     const DF df;
@@ -525,6 +571,8 @@ HWY_INLINE void ScatteringStep(const CompiledMedium<float>& med, MF m, LaneVecto
         v.Keep(m, kLossMedium, factor);
         v.depth = hn::IfThenElse(scatters, flight.depth, v.depth);
         v.d = Select(scatters, d_new, v.d);
+        // A scattering event depolarizes (docs/physics.md §8).
+        if constexpr (kPolarized) stokes_depolarize<VF, VecLane>(v.pol.stokes, 3, scatters);
         v.events = hn::IfThenElse(hn::RebindMask(di, scatters), hn::Add(v.events, hn::Set(di, 1)),
                                   v.events);
     } else {
@@ -635,14 +683,63 @@ struct Waiting {
     std::uint64_t state, inc;
 };
 using Queue = std::vector<Waiting>;
+// Its polarization (polarized runs), kept beside the queue: the frame's x axis and (q, u, v) per
+// channel.
+struct WaitingPolarization {
+    float x[3], q[3], u[3], v[3];
+};
 
 struct Scratch {
     std::vector<std::uint64_t> state, inc;
     Queue queue;
+    std::vector<WaitingPolarization> queue_pol;
     void resize(std::size_t n) {
         state.resize(n);
         inc.resize(n);
         queue.reserve(n);
+    }
+};
+
+// The lanes' polarization into per-lane arrays and back (the queue's refills).
+struct PolarizationArrays {
+    HWY_ALIGN float x[3][kMaxLanes], q[3][kMaxLanes], u[3][kMaxLanes], v[3][kMaxLanes];
+    HWY_INLINE void Store(const StokesLanes<VF>& s) {
+        const DF df;
+        hn::Store(s.x.x, df, x[0]);
+        hn::Store(s.x.y, df, x[1]);
+        hn::Store(s.x.z, df, x[2]);
+        for (int c = 0; c < 3; ++c) {
+            hn::Store(s.q[c], df, q[c]);
+            hn::Store(s.u[c], df, u[c]);
+            hn::Store(s.v[c], df, v[c]);
+        }
+    }
+    HWY_INLINE void Load(MF m, StokesLanes<VF>& s) const {
+        const DF df;
+        s.x = Select(m, V3{hn::Load(df, x[0]), hn::Load(df, x[1]), hn::Load(df, x[2])}, s.x);
+        for (int c = 0; c < 3; ++c) {
+            s.q[c] = hn::IfThenElse(m, hn::Load(df, q[c]), s.q[c]);
+            s.u[c] = hn::IfThenElse(m, hn::Load(df, u[c]), s.u[c]);
+            s.v[c] = hn::IfThenElse(m, hn::Load(df, v[c]), s.v[c]);
+        }
+    }
+    WaitingPolarization Lane(std::size_t l) const {
+        WaitingPolarization w;
+        for (int i = 0; i < 3; ++i) {
+            w.x[i] = x[i][l];
+            w.q[i] = q[i][l];
+            w.u[i] = u[i][l];
+            w.v[i] = v[i][l];
+        }
+        return w;
+    }
+    void SetLane(std::size_t l, const WaitingPolarization& w) {
+        for (int i = 0; i < 3; ++i) {
+            x[i][l] = w.x[i];
+            q[i][l] = w.q[i];
+            u[i][l] = w.u[i];
+            v[i][l] = w.v[i];
+        }
     }
 };
 
@@ -712,7 +809,9 @@ struct LaneSums {
     }
 };
 
-void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
+// Written once for both: kPolarized = false is the unpolarized kernel, with none of it.
+template <bool kPolarized>
+void TraceBlock(const BlockJob& job, Tally& tally, BlockBudget& block) {
     const DF df;
     const DI di;
     const std::size_t n_lanes = hn::Lanes(df);
@@ -758,6 +857,13 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             for (auto& channel : term)
                 channel = zero;
         v.k = v.in_medium = v.events = v.events_done = v.live = v.finish = hn::Zero(di);
+        if constexpr (kPolarized) {
+            v.pol.stokes = stokes_incident<VF, VecLane>(
+                {hn::Set(df, -job.wi.x), hn::Set(df, -job.wi.y), hn::Set(df, -job.wi.z)},
+                job.incident_stokes);
+            v.pol.channels = stack.polarization_channels;
+            v.pol.flux = v.w;
+        }
     };
 
     // ---- One interface event of the lanes in `going`, all at interface `group` ----
@@ -770,27 +876,28 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         switch (layer.type) {
             case InterfaceType::Dielectric: {
                 if (layer.multiple) {
-                    DielectricWalkEvent(layer.dielectric, going, v, rng,
-                                        stack.max_microsurface_order, degenerate_event);
+                    DielectricWalkEvent<kPolarized>(layer.dielectric, going, v, rng,
+                                                    stack.max_microsurface_order, degenerate_event);
                     break;
                 }
                 const VF uc = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
-                DielectricEvent(layer.dielectric, going, v, uc, u1, u2, degenerate_event);
+                DielectricEvent<kPolarized>(layer.dielectric, going, v, uc, u1, u2,
+                                            degenerate_event);
                 break;
             }
             case InterfaceType::Conductor: {
                 if (layer.multiple) {
-                    ConductorWalkEvent(layer.conductor, going, v, rng, stack.max_microsurface_order,
-                                       degenerate_event);
+                    ConductorWalkEvent<kPolarized>(layer.conductor, going, v, rng,
+                                                   stack.max_microsurface_order, degenerate_event);
                     break;
                 }
                 const VF u1 = rng.Uniform(), u2 = rng.Uniform();
-                ConductorEvent(layer.conductor, going, v, u1, u2, degenerate_event);
+                ConductorEvent<kPolarized>(layer.conductor, going, v, u1, u2, degenerate_event);
                 break;
             }
             case InterfaceType::Lambertian: {
                 const VF u1 = rng.Uniform(), u2 = rng.Uniform();
-                LambertianEvent(layer.lambertian, going, v, u1, u2, degenerate_event);
+                LambertianEvent<kPolarized>(layer.lambertian, going, v, u1, u2, degenerate_event);
                 break;
             }
         }
@@ -851,6 +958,9 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_ALIGN std::int32_t theta_bin[kMaxLanes], phi_bin[kMaxLanes];
     const VectorBins vector_bins(grid);
     HWY_ALIGN float d_out[3][kMaxLanes];
+    // Polarized runs with Stokes tallies: the exits' Stokes vectors in their bin frames.
+    [[maybe_unused]] HWY_ALIGN float stokes_out[3][4][kMaxLanes];
+    const bool stokes_tallies = kPolarized && job.stokes_tallies;
     auto end_particles = [&](LaneVectors& v, MF ended, auto&& on_lane) {
         const MF reflected = LaneIs(v.finish, kReflected);
         const MF transmitted = LaneIs(v.finish, kTransmitted);
@@ -879,6 +989,16 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             }
             for (int c = 0; c < 3; ++c)
                 hn::Store(v.w[c], df, w_out[c]);
+            if constexpr (kPolarized)
+                if (stokes_tallies) {
+                    VF stokes[3][4];
+                    stokes_in_bin_frame<VF, VecLane>(v.pol.stokes, v.d, v.w, v.pol.channels, exits,
+                                                     stokes);
+                    for (int c = 0; c < 3; ++c)
+                        for (int k = 0; k < 4; ++k)
+                            hn::Store(stokes[c][k], df, stokes_out[c][k]);
+                    hn::Store(v.d.y, df, d_out[1]);
+                }
         }
         // Over the set bits of the mask: which lanes ended is random, a branch per lane would be
         // mispredicted half of the time.
@@ -894,6 +1014,15 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
                               std::size_t(phi_bin[l])
                         : grid.bin_of(Vec3f(d_out[0][l], d_out[1][l], d_out[2][l]));
                 tally.exit((why == kTransmitted ? grid.size() : 0) + bin, w);
+                if constexpr (kPolarized)
+                    if (stokes_tallies) {
+                        float s[3][4];
+                        for (int c = 0; c < 3; ++c)
+                            for (int k = 0; k < 4; ++k)
+                                s[c][k] = stokes_out[c][k][l];
+                        tally.exit_stokes((why == kTransmitted ? grid.size() : 0) + bin,
+                                          d_out[1][l] < 0 ? 1 : 0, s);
+                    }
             }
             on_lane(l);
         }
@@ -907,9 +1036,13 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     // instead of idling for a step.
     Queue& queue = scratch.queue;
     queue.clear();
+    [[maybe_unused]] std::vector<WaitingPolarization>& queue_pol = scratch.queue_pol;
+    if constexpr (kPolarized) queue_pol.clear();
+    [[maybe_unused]] PolarizationArrays staged_pol;  // the lanes' states, staged or stored
     {
         LaneVectors p;
         clear(p);
+        [[maybe_unused]] const StokesLanes<VF> incident = p.pol.stokes;
         LaneRng prng;
         HWY_ALIGN float qd[3][kMaxLanes], qw[3][kMaxLanes], qdepth[kMaxLanes];
         HWY_ALIGN std::int32_t qk[kMaxLanes], qin[kMaxLanes], qevents[kMaxLanes];
@@ -927,6 +1060,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
                 p.w[c] = hn::IfThenElseZero(going, one);
             p.k = p.in_medium = p.events = p.finish = hn::Zero(di);
             p.depth = zero;
+            if constexpr (kPolarized) p.pol.stokes = incident;
             interface_step(p, prng, 0, going);
             const MF ended = hn::RebindMask(df, hn::Ne(p.finish, hn::Zero(di)));
             if (!hn::AllFalse(df, ended)) end_particles(p, ended, [](std::size_t) {});
@@ -941,8 +1075,10 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
             hn::Store(p.k, di, qk);
             hn::Store(p.in_medium, di, qin);
             hn::Store(p.events, di, qevents);
+            if constexpr (kPolarized) staged_pol.Store(p.pol.stokes);
             for (std::uint64_t bits = MaskBits(waits); bits != 0; bits &= bits - 1) {
                 const std::size_t l = std::size_t(std::countr_zero(bits));
+                if constexpr (kPolarized) queue_pol.push_back(staged_pol.Lane(l));
                 queue.push_back({{qd[0][l], qd[1][l], qd[2][l]},
                                  {qw[0][l], qw[1][l], qw[2][l]},
                                  qdepth[l],
@@ -966,6 +1102,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     // Stages the queue's next particle for lane l, or retires the lane when none is left.
     auto take_particle = [&](std::size_t l) {
         if (next < queue.size()) {
+            if constexpr (kPolarized) staged_pol.SetLane(l, queue_pol[next]);
             const Waiting& q = queue[next++];
             for (int i = 0; i < 3; ++i) {
                 sd[i][l] = q.d[i];
@@ -1002,6 +1139,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         v.in_medium = hn::IfThenElse(fresh_i, hn::Load(di, s_in), v.in_medium);
         v.events = hn::IfThenElse(fresh_i, hn::Load(di, sevents), v.events);
         v.live = hn::IfThenElse(fresh_i, hn::Load(di, live), v.live);
+        if constexpr (kPolarized) staged_pol.Load(fresh, v.pol.stokes);
     };
     for (std::size_t l = 0; l < n_lanes; ++l)
         take_particle(l);
@@ -1054,7 +1192,7 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
 
         if (group_is_medium) {
             // ---- A scattering-medium step ----
-            ScatteringStep(stack.layers[group].medium, going, v, rng);
+            ScatteringStep<kPolarized>(stack.layers[group].medium, going, v, rng);
             v.End(hn::And(going, v.Black()), kEnded);
         } else {
             interface_step(v, rng, group, going);
@@ -1070,6 +1208,13 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     sums.add_events(v.events_done);
     sums.reduce(block, tally.sums.events);
     tally.sums.degenerate += degenerate;
+}
+
+void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
+    if (job.stack->polarization)
+        TraceBlock<true>(job, tally, block);
+    else
+        TraceBlock<false>(job, tally, block);
 }
 
 std::uint32_t PcgDrawsForTest(std::uint64_t seed, std::uint64_t stream, std::uint64_t first,
@@ -1283,6 +1428,102 @@ void InterfaceEventsForTest(int kind, const float* params, const std::int32_t* f
     }
 }
 
+void FresnelMuellerForTest(int kind, const float* cos_theta, std::size_t n, float eta, float k,
+                           float* out) {
+    const DF df;
+    LaneIo io{df};
+    io.n = n;
+    const std::size_t stride = kind == 0 ? 9 : 4;
+    for (io.base = 0; io.base < n; io.base += hn::Lanes(df)) {
+        const VF c = io.Load(cos_theta, 1.f);
+        VF v[9];
+        if (kind == 0) {
+            const DielectricMueller<VF> m = fresnel_dielectric_mueller<VF, VecLane>(
+                c, hn::Set(df, eta), hn::Set(df, 1.f / eta));
+            const VF all[9] = {m.reflection.a,   m.reflection.b,   m.reflection.c,
+                               m.reflection.d,   m.transmission.a, m.transmission.b,
+                               m.transmission.c, m.transmission.d, m.cos_theta_t};
+            std::copy(all, all + 9, v);
+        } else {
+            const InterfaceMueller<VF> m =
+                fresnel_conductor_mueller<VF, VecLane>(c, hn::Set(df, eta), hn::Set(df, k));
+            v[0] = m.a, v[1] = m.b, v[2] = m.c, v[3] = m.d;
+        }
+        HWY_ALIGN float buf[kMaxLanes];
+        for (std::size_t e = 0; e < stride; ++e) {
+            hn::Store(v[e], df, buf);
+            for (std::size_t l = 0; l < hn::Lanes(df) && io.base + l < n; ++l)
+                out[(io.base + l) * stride + e] = buf[l];
+        }
+    }
+}
+
+void PolarizedEventsForTest(int kind, const float* params, const std::int32_t* flags,
+                            const float* wi, const float* u, const float* x, const float* stokes,
+                            const float* flux, int channels, std::size_t n, float* wo,
+                            float* shadowing, std::int32_t* reflected, std::int32_t* degenerate,
+                            float* x_out, float* stokes_out, float* factor) {
+    const DF df;
+    LaneIo io{df};
+    io.n = n;
+    // Strided per-lane inputs and outputs: element e of lane j at [stride·j + e].
+    auto load = [&](const float* a, std::size_t stride, std::size_t e, float pad) {
+        HWY_ALIGN float buf[kMaxLanes];
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            buf[l] = io.base + l < n ? a[stride * (io.base + l) + e] : pad;
+        return hn::Load(df, buf);
+    };
+    auto store = [&](VF v, float* a, std::size_t stride, std::size_t e) {
+        HWY_ALIGN float buf[kMaxLanes];
+        hn::Store(v, df, buf);
+        for (std::size_t l = 0; l < hn::Lanes(df) && io.base + l < n; ++l)
+            a[stride * (io.base + l) + e] = buf[l];
+    };
+    for (io.base = 0; io.base < n; io.base += hn::Lanes(df)) {
+        const V3 w = io.Load3(wi);
+        const VF uc = io.Load(u, 0.f), u1 = io.Load(u + n, 0.f), u2 = io.Load(u + 2 * n, 0.f);
+        const MF active = io.Active();
+        PolarizationLanes<VF> pol;
+        pol.channels = channels;
+        pol.stokes.x = {load(x, 3, 0, 0.f), load(x, 3, 1, 1.f), load(x, 3, 2, 0.f)};
+        for (int c = 0; c < 3; ++c) {
+            pol.stokes.q[c] = load(stokes, 9, std::size_t(3 * c), 0.f);
+            pol.stokes.u[c] = load(stokes, 9, std::size_t(3 * c + 1), 0.f);
+            pol.stokes.v[c] = load(stokes, 9, std::size_t(3 * c + 2), 0.f);
+        }
+        const VF flux_v[3] = {load(flux, 3, 0, 1.f), load(flux, 3, 1, 1.f), load(flux, 3, 2, 1.f)};
+        pol.flux = flux_v;
+        InterfaceEventLanes<VF, MF> e;
+        if (kind == 0) {
+            const DielectricEventShape shape{flags[0] != 0, flags[1] != 0, flags[2] != 0,
+                                             flags[3] != 0};
+            e = dielectric_event<VF, VecLane, true>(
+                hn::Set(df, params[0]), hn::Set(df, 1.f / params[0]), hn::Set(df, params[1]), shape,
+                w, uc, u1, u2, active, &pol);
+        } else {
+            ConductorInterface<float> iface{Rgbf(params[1], params[2], params[3]),
+                                            Rgbf(params[4], params[5], params[6]), params[0]};
+            VF f[3];
+            e = conductor_event<VF, VecLane>(hn::Set(df, params[0]), flags[0] != 0, flags[1] != 0,
+                                             w, u1, u2, active, ConductorFresnel{iface}, f, &pol,
+                                             ConductorMueller{iface});
+        }
+        io.Store3(e.wo, wo);
+        io.Store(e.shadowing, shadowing);
+        io.StoreMask(e.reflected, reflected);
+        io.StoreMask(e.degenerate, degenerate);
+        store(pol.stokes.x.x, x_out, 3, 0);
+        store(pol.stokes.x.y, x_out, 3, 1);
+        store(pol.stokes.x.z, x_out, 3, 2);
+        for (int c = 0; c < 3; ++c) {
+            store(pol.stokes.q[c], stokes_out, 9, std::size_t(3 * c));
+            store(pol.stokes.u[c], stokes_out, 9, std::size_t(3 * c + 1));
+            store(pol.stokes.v[c], stokes_out, 9, std::size_t(3 * c + 2));
+            store(pol.factor[c], factor, 3, std::size_t(c));
+        }
+    }
+}
+
 void MediumStepForTest(const CompiledMedium<float>& med, const float* d, const float* w,
                        const float* depth, const float* u, std::size_t n, std::int32_t* leaves,
                        float* factor, float* depth_out, float* d_out, float* phase,
@@ -1428,6 +1669,8 @@ HWY_EXPORT(MicrosurfaceWalkForTest);
 HWY_EXPORT(GgxLanesForTest);
 HWY_EXPORT(InterfaceEventsForTest);
 HWY_EXPORT(MediumStepForTest);
+HWY_EXPORT(FresnelMuellerForTest);
+HWY_EXPORT(PolarizedEventsForTest);
 
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
@@ -1562,6 +1805,36 @@ SimdMediumResult simd_medium_step(const CompiledMedium<float>& medium, const std
     HWY_DYNAMIC_DISPATCH(MediumStepForTest)
     (medium, d.data(), w.data(), depth.data(), u.data(), n, r.leaves.data(), r.factor.data(),
      r.depth.data(), r.d.data(), r.phase.data(), r.draws.data());
+    return r;
+}
+
+std::vector<float> simd_fresnel_mueller(int kind, const std::vector<float>& cos_theta, float eta,
+                                        float k) {
+    select_simd_target();
+    std::vector<float> out(cos_theta.size() * (kind == 0 ? 9 : 4));
+    HWY_DYNAMIC_DISPATCH(FresnelMuellerForTest)
+    (kind, cos_theta.data(), cos_theta.size(), eta, k, out.data());
+    return out;
+}
+
+SimdPolarizedEventResult simd_polarized_interface_events(
+    int kind, const std::vector<float>& params, const std::vector<std::int32_t>& flags,
+    const std::vector<float>& wi, const std::vector<float>& u, const std::vector<float>& x,
+    const std::vector<float>& stokes, const std::vector<float>& flux, int channels) {
+    select_simd_target();
+    const std::size_t n = wi.size() / 3;
+    SimdPolarizedEventResult r;
+    r.event.wo.resize(3 * n);
+    r.event.shadowing.resize(n);
+    r.event.reflected.resize(n);
+    r.event.degenerate.resize(n);
+    r.x.resize(3 * n);
+    r.stokes.resize(9 * n);
+    r.factor.resize(3 * n);
+    HWY_DYNAMIC_DISPATCH(PolarizedEventsForTest)
+    (kind, params.data(), flags.data(), wi.data(), u.data(), x.data(), stokes.data(), flux.data(),
+     channels, n, r.event.wo.data(), r.event.shadowing.data(), r.event.reflected.data(),
+     r.event.degenerate.data(), r.x.data(), r.stokes.data(), r.factor.data());
     return r;
 }
 

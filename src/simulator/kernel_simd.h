@@ -94,6 +94,29 @@ SimdMediumResult simd_medium_step(const CompiledMedium<float>& medium, const std
                                   const std::vector<float>& w, const std::vector<float>& depth,
                                   const std::vector<float>& u);
 
+/// For tests: physics/polarization.h fresnel_dielectric_mueller(cos_theta[j], eta, 1/eta) (kind 0:
+/// per entry the reflection's a, b, c, d, the refraction's a, b, c, d and the refracted cosine, 9
+/// floats) or fresnel_conductor_mueller(cos_theta[j], eta, k) (kind 1: a, b, c, d) on the
+/// dispatched instruction set's vectors.
+std::vector<float> simd_fresnel_mueller(int kind, const std::vector<float>& cos_theta, float eta,
+                                        float k);
+
+/// For tests: the polarized interface events (dielectric_event and conductor_event with their
+/// polarization, physics/polarization.h) on the dispatched instruction set's vectors, as
+/// simd_interface_events (kinds 0 and 1, the same params, flags and draws), each lane also with
+/// its state: the frame's x axis x[3j..3j+2], (q, u, v) of channel c at stokes[9j + 3c ..], the
+/// flux flux[3j + c], `channels` states in use. Per particle: the event's results as
+/// simd_interface_events, the state after it (x, stokes in the same layout) and the flux
+/// factors factor[3j + c].
+struct SimdPolarizedEventResult {
+    SimdEventResult event;
+    std::vector<float> x, stokes, factor;
+};
+SimdPolarizedEventResult simd_polarized_interface_events(
+    int kind, const std::vector<float>& params, const std::vector<std::int32_t>& flags,
+    const std::vector<float>& wi, const std::vector<float>& u, const std::vector<float>& x,
+    const std::vector<float>& stokes, const std::vector<float>& flux, int channels);
+
 /// Applies LAMINA_SIMD_TARGET (an instruction set name as simd_target_name prints it, e.g. AVX2 or
 /// SSE4), which caps the dispatch at that set: the way to reproduce another machine's tables, or to
 /// test every compiled set on one machine. Once per process; InputError for an unknown or

@@ -43,6 +43,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     j["kernel_description"] = kernel_description(s.kernel);
     j["grid"].update({{"theta_range_deg", {0, 90}}, {"phi_range_deg", {0, 180}}, {"folded", true}});
     j["first_particle"] = s.first_particle;
+    j["mueller"] = s.stokes_tallies;
     j["threads"] = result.threads_used;
     j["processes"] = result.processes;
     j["seconds"] = result.seconds;
@@ -69,10 +70,13 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
 }
 
 void write_simulation(const std::filesystem::path& dir, const Stack& stack,
-                      const SimulationResult& result) {
+                      const SimulationResult& result,
+                      const std::vector<std::pair<std::string, std::string>>& extra) {
     StagedOutput out(dir);
     out.add("brdf.csv", result.table.to_csv());
     out.add("energy.csv", energy_csv(result));
+    for (const auto& [name, bytes] : extra)
+        out.add(name, bytes);
     out.add("result.json", result_json(stack, result).dump(2) + "\n");
     out.commit();
 }

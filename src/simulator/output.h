@@ -10,6 +10,8 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace lamina {
 
@@ -20,8 +22,10 @@ inline constexpr const char* kEnergyCsvHeader =
 std::string energy_csv(const SimulationResult& result);
 nlohmann::json result_json(const Stack& stack, const SimulationResult& result);
 
-/// Writes the three files into `dir` (created if needed).
+/// Writes the three files into `dir` (created if needed), with `extra` files (name, bytes) staged
+/// and moved into place with them (the Mueller tables, simulator/mueller.h).
 void write_simulation(const std::filesystem::path& dir, const Stack& stack,
-                      const SimulationResult& result);
+                      const SimulationResult& result,
+                      const std::vector<std::pair<std::string, std::string>>& extra = {});
 
 }  // namespace lamina

@@ -85,8 +85,17 @@ struct Tally {
     std::vector<Recent> recent;  // [side · n_bins + bin], since the last widening
     IncidenceSums sums;          // widened sums
     std::uint64_t particles_since_widening = 0;
+    /// The Stokes tallies since the last widening (empty unless requested), as IncidenceSums::
+    /// stokes.
+    std::vector<std::array<std::int64_t, kStokesSums>> stokes_recent;
 
-    explicit Tally(std::size_t n_bins) : recent(2 * n_bins) { sums.bins.resize(2 * n_bins); }
+    explicit Tally(std::size_t n_bins, bool stokes = false) : recent(2 * n_bins) {
+        sums.bins.resize(2 * n_bins);
+        if (stokes) {
+            stokes_recent.resize(2 * n_bins);
+            sums.stokes.resize(2 * n_bins);
+        }
+    }
 
     /// A particle leaving into bin `index` (side · n_bins + bin) with flux `flux`.
     void exit(std::size_t index, const Rgbf& flux) {
@@ -98,7 +107,23 @@ struct Tally {
             acc.sum_sq[c] += std::llrint(x * x * kSqScale);
         }
     }
+    /// The Stokes vectors s[c] = (S0..S3) per channel (in the bin frame) of a particle leaving
+    /// into bin `index` on the bin's half `half` (0: y ≥ 0, 1: y < 0). |S_k| ≤ S0 ≤ 4.
+    void exit_stokes(std::size_t index, int half, const float (&s)[3][4]) {
+        std::array<std::int64_t, kStokesSums>& acc = stokes_recent[index];
+        for (int c = 0; c < 3; ++c)
+            for (int k = 0; k < 4; ++k) {
+                const double x = s[c][k];
+                acc[std::size_t(c * 12 + half * 4 + k)] += std::llrint(x * kSumScale);
+                acc[std::size_t(c * 12 + 8 + k)] += std::llrint(x * x * kSqScale);
+            }
+    }
     void widen() {
+        for (std::size_t i = 0; i < stokes_recent.size(); ++i) {
+            for (int k = 0; k < kStokesSums; ++k)
+                sums.stokes[i][std::size_t(k)] += stokes_recent[i][std::size_t(k)];
+            stokes_recent[i] = {};
+        }
         for (std::size_t i = 0; i < recent.size(); ++i) {
             for (int c = 0; c < 3; ++c) {
                 sums.bins[i][c] += recent[i].sum[c];
@@ -137,6 +162,10 @@ struct BlockJob {
     Vec3f wi;
     std::uint64_t seed, stream, first, count;
     int max_events;
+    /// Polarized runs (CompiledStack::polarization): the incident Stokes vector (S1, S2, S3)/S0 in
+    /// the bin frame of −wi, and whether exits are tallied with their Stokes vectors.
+    float incident_stokes[3] = {0.f, 0.f, 0.f};
+    bool stokes_tallies = false;
 };
 
 void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block);

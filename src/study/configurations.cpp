@@ -40,27 +40,15 @@ Layer coat(double alpha0, const Rgbd& tau_a) {
 }
 
 Layer lambertian(const Rgbd& rho) {
-    Layer l;
-    l.interface.type = InterfaceType::Lambertian;
-    l.interface.albedo = rho;
-    return l;
+    return layer_of(lambertian_interface(rho));
 }
 
 Layer conductor(const Rgbd& eta, const Rgbd& k, double alpha) {
-    Layer l;
-    l.interface.type = InterfaceType::Conductor;
-    l.interface.eta_rgb = eta;
-    l.interface.k = k;
-    l.interface.alpha = alpha;
-    return l;
+    return layer_of(conductor_interface(eta, k, alpha));
 }
 
 Layer dielectric(double eta, double alpha) {
-    Layer l;
-    l.interface.type = InterfaceType::Dielectric;
-    l.interface.eta = eta;
-    l.interface.alpha = alpha;
-    return l;
+    return layer_of(dielectric_interface(eta, alpha));
 }
 
 StudyConfiguration make(std::string id, std::string category, std::vector<Layer> layers) {

@@ -152,315 +152,387 @@ struct ModelOutcome {
     bool reused = false;
 };
 
-// Evaluates one configuration: reference pieces, models, metrics; writes configs/<id>/ — or, when
-// its inputs are those of the last run, reads back what that run found.
-ConfigResult run_configuration(const StudyConfiguration& config, const StudySettings& s,
-                               const std::vector<std::string>& model_names,
-                               const std::filesystem::path& out_dir, Progress& progress,
-                               StudyWork& work) {
-    const std::size_t n_inc = s.reference.theta_i_deg.size();
-    const HemisphereGrid& grid = s.reference.grid;
-    const std::size_t bins = grid.size();
-    const std::filesystem::path config_dir = out_dir / "configs" / config.id;
+// One configuration of a run: reference pieces, models, metrics; writes configs/<id>/ — or, when
+// its inputs are those of the last run, reads back what that run found. Each step is a method,
+// in the order run() calls them.
+class ConfigurationRun {
+  public:
+    ConfigurationRun(const StudyConfiguration& config, const StudySettings& s,
+                     const std::vector<std::string>& model_names,
+                     const std::filesystem::path& out_dir, Progress& progress, StudyWork& work)
+        : config_(config),
+          s_(s),
+          model_names_(model_names),
+          out_dir_(out_dir),
+          progress_(progress),
+          work_(work),
+          n_inc_(s.reference.theta_i_deg.size()),
+          grid_(s.reference.grid),
+          bins_(grid_.size()),
+          config_dir_(out_dir / "configs" / config.id) {}
 
+    ConfigResult run() {
+        digest_inputs();
+        if (read_back()) return result_;
+        simulate_reference();
+        std::vector<ModelOutcome> models;
+        for (std::size_t k = 0; k < model_names_.size(); ++k)
+            models.push_back(model_outcome(k));
+        for (const ModelOutcome& m : models)
+            result_.rows.insert(result_.rows.end(), m.rows.begin(), m.rows.end());
+        write_outputs(models);
+        write_state(models);
+        return result_;
+    }
+
+  private:
     // 0. The digests of the inputs, and what the last run left.
-    std::vector<ReferenceKey> keys;
-    std::uint64_t ref_digest = fnv1a("reference");
-    for (double theta_i : s.reference.theta_i_deg) {
-        keys.push_back(reference_key(config.id, config.stack, theta_i, s.reference));
-        ref_digest = fnv1a(keys.back().canonical(), ref_digest);
+    void digest_inputs() {
+        ref_digest_ = fnv1a("reference");
+        for (double theta_i : s_.reference.theta_i_deg) {
+            keys_.push_back(reference_key(config_.id, config_.stack, theta_i, s_.reference));
+            ref_digest_ = fnv1a(keys_.back().canonical(), ref_digest_);
+        }
+        outputs_digest_ = fnv1a(fmt::format("{} | reference {} | tables {}", kStateFormat,
+                                            digest_hex(ref_digest_), enum_text(s_.tables)));
+        for (const std::string& name : model_names_) {
+            model_keys_.push_back(digest_hex(fnv1a(model_key(name, config_, s_))));
+            outputs_digest_ = fnv1a(" | " + name + " " + model_keys_.back(), outputs_digest_);
+        }
+        state_ = s_.recompute ? nlohmann::json() : read_state(state_path(out_dir_, config_.id));
     }
-    std::vector<std::string> model_keys;
-    std::uint64_t outputs_digest = fnv1a(fmt::format("{} | reference {} | tables {}", kStateFormat,
-                                                     digest_hex(ref_digest), enum_text(s.tables)));
-    for (const std::string& name : model_names) {
-        model_keys.push_back(digest_hex(fnv1a(model_key(name, config, s))));
-        outputs_digest = fnv1a(" | " + name + " " + model_keys.back(), outputs_digest);
-    }
-    const nlohmann::json state =
-        s.recompute ? nlohmann::json() : read_state(state_path(out_dir, config.id));
-    const bool outputs_there = std::filesystem::exists(config_dir / "config.json") &&
-                               (s.tables == TablesFormat::None ||
-                                (std::filesystem::exists(config_dir / "tables.lza") &&
-                                 std::filesystem::exists(config_dir / "reference_se.lza")));
-    ConfigResult result;
-    if (state.is_object() && state.value("outputs", "") == digest_hex(outputs_digest) &&
-        outputs_there) {
+
+    // The last run's results when every input is unchanged and its outputs are there.
+    bool read_back() {
+        const bool outputs_there = std::filesystem::exists(config_dir_ / "config.json") &&
+                                   (s_.tables == TablesFormat::None ||
+                                    (std::filesystem::exists(config_dir_ / "tables.lza") &&
+                                     std::filesystem::exists(config_dir_ / "reference_se.lza")));
+        if (!state_.is_object() || state_.value("outputs", "") != digest_hex(outputs_digest_) ||
+            !outputs_there)
+            return false;
         try {
-            for (const std::string& name : model_names)
-                for (const nlohmann::json& r : state.at("models").at(name).at("rows"))
-                    result.rows.push_back(row_from_json(r, config, name));
-            for (const nlohmann::json& v : state.at("lost_microsurface"))
-                result.lost_microsurface.push_back(
+            for (const std::string& name : model_names_)
+                for (const nlohmann::json& r : state_.at("models").at(name).at("rows"))
+                    result_.rows.push_back(row_from_json(r, config_, name));
+            for (const nlohmann::json& v : state_.at("lost_microsurface"))
+                result_.lost_microsurface.push_back(
                     Rgbd(v.at(0).get<double>(), v.at(1).get<double>(), v.at(2).get<double>()));
-            result.reference_seconds = state.value("reference_seconds", 0.0);
-            work.model_tables_reused += model_names.size();
-            ++work.configurations_unchanged;
-            return result;
+            result_.reference_seconds = state_.value("reference_seconds", 0.0);
+            work_.model_tables_reused += model_names_.size();
+            ++work_.configurations_unchanged;
+            return true;
         } catch (const std::exception&) {
-            result = {};  // a damaged state: recompute below
+            result_ = {};  // a damaged state: recompute
+            return false;
         }
     }
 
     // 1. The reference, one resumable piece per incidence.
-    std::vector<ReferencePiece> pieces;
-    for (const ReferenceKey& key : keys) {
-        bool computed = false;
-        pieces.push_back(reference_piece(
-            reference_cache_dir(out_dir), key, s.reference.threads,
-            [&](std::uint64_t n) { progress.advance(n); }, &computed));
-        work.reference_pieces_computed += computed;
-        result.reference_seconds += pieces.back().seconds;
+    void simulate_reference() {
+        for (const ReferenceKey& key : keys_) {
+            bool computed = false;
+            pieces_.push_back(reference_piece(
+                reference_cache_dir(out_dir_), key, s_.reference.threads,
+                [&](std::uint64_t n) { progress_.advance(n); }, &computed));
+            work_.reference_pieces_computed += computed;
+            result_.reference_seconds += pieces_.back().seconds;
+        }
+        transmits_ = pieces_.front().has_transmission;
+        n_sides_ = transmits_ ? 2 : 1;
+        block_ = std::size_t(n_sides_) * bins_ * 3;
+        same_reference_ =
+            state_.is_object() && state_.value("reference", "") == digest_hex(ref_digest_);
     }
-    const bool transmits = pieces.front().has_transmission;
-    const int n_sides = transmits ? 2 : 1;
-    const std::size_t block = std::size_t(n_sides) * bins * 3;  // one incidence of one source
 
-    // What the last run's tables hold, for the models whose inputs did not change (read once, when
-    // a model needs them; exact in the same format: a float16 or float32 is written back as read).
-    const bool same_reference =
-        state.is_object() && state.value("reference", "") == digest_hex(ref_digest);
-    std::optional<NpyFloat32> old_tables;
-    std::vector<std::string> old_sources;
-    bool old_loaded = false;
-    auto old_table_of = [&](const std::string& name) -> const float* {
-        if (s.tables == TablesFormat::None) return nullptr;
-        if (!old_loaded) {
-            old_loaded = true;
+    // What the last run's tables hold for `name`, for a model whose inputs did not change (read
+    // once, when a model needs them; exact in the same format: a float16 or float32 is written
+    // back as read); null when there is none.
+    const float* old_table_of(const std::string& name) {
+        if (s_.tables == TablesFormat::None) return nullptr;
+        if (!old_loaded_) {
+            old_loaded_ = true;
             try {
-                if (state.value("tables", "") == enum_text(s.tables)) {
-                    std::ifstream in(config_dir / "config.json");
+                if (state_.value("tables", "") == enum_text(s_.tables)) {
+                    std::ifstream in(config_dir_ / "config.json");
                     const nlohmann::json cj = nlohmann::json::parse(in);
-                    old_sources = cj.at("sources").get<std::vector<std::string>>();
-                    NpyFloat32 t = read_study_array(config_dir, "tables");
+                    old_sources_ = cj.at("sources").get<std::vector<std::string>>();
+                    NpyFloat32 t = read_study_array(config_dir_, "tables");
                     if (t.shape == std::vector<std::size_t>{
-                                       old_sources.size(), n_inc, std::size_t(n_sides),
-                                       std::size_t(grid.n_theta()), std::size_t(grid.n_phi()), 3})
-                        old_tables = std::move(t);
+                                       old_sources_.size(), n_inc_, std::size_t(n_sides_),
+                                       std::size_t(grid_.n_theta()), std::size_t(grid_.n_phi()), 3})
+                        old_tables_ = std::move(t);
                 }
             } catch (const std::exception&) {
-                old_tables.reset();
+                old_tables_.reset();
             }
         }
-        if (!old_tables) return nullptr;
-        const auto it = std::find(old_sources.begin(), old_sources.end(), name);
-        if (it == old_sources.end()) return nullptr;
-        return old_tables->data.data() + std::size_t(it - old_sources.begin()) * n_inc * block;
-    };
+        if (!old_tables_) return nullptr;
+        const auto it = std::find(old_sources_.begin(), old_sources_.end(), name);
+        if (it == old_sources_.end()) return nullptr;
+        return old_tables_->data.data() + std::size_t(it - old_sources_.begin()) * n_inc_ * block_;
+    }
 
-    // 2. Every model on the same bins, unless its inputs and the reference are unchanged.
-    std::vector<ModelOutcome> models;
-    for (std::size_t k = 0; k < model_names.size(); ++k) {
-        const std::string& name = model_names[k];
-        ModelOutcome m{name, model_keys[k], {}, {}, {}, {}, false};
-        if (same_reference && state.contains("models") && state["models"].contains(name) &&
-            state["models"][name].value("key", "") == m.key) {
+    // 2. Model k on the same bins, unless its inputs and the reference are unchanged.
+    ModelOutcome model_outcome(std::size_t k) {
+        const std::string& name = model_names_[k];
+        ModelOutcome m{name, model_keys_[k], {}, {}, {}, {}, false};
+        if (same_reference_ && state_.contains("models") && state_["models"].contains(name) &&
+            state_["models"][name].value("key", "") == m.key) {
             try {
-                const nlohmann::json& ms = state["models"][name];
+                const nlohmann::json& ms = state_["models"][name];
                 const float* old = old_table_of(name);
-                if (s.tables == TablesFormat::None || old) {
+                if (s_.tables == TablesFormat::None || old) {
                     for (const nlohmann::json& r : ms.at("rows"))
-                        m.rows.push_back(row_from_json(r, config, name));
+                        m.rows.push_back(row_from_json(r, config_, name));
                     m.support.brdf = ms.at("support").at("R").get<bool>();
                     m.support.btdf = ms.at("support").at("T").get<bool>();
                     m.support.reason = ms.at("support").at("reason").get<std::string>();
                     m.albedo = ms.at("albedo");
-                    if (old) m.table.assign(old, old + n_inc * block);
+                    if (old) m.table.assign(old, old + n_inc_ * block_);
                     m.reused = true;
                 }
             } catch (const std::exception&) {
-                m = ModelOutcome{name, model_keys[k], {}, {}, {}, {}, false};
+                m = ModelOutcome{name, model_keys_[k], {}, {}, {}, {}, false};
             }
         }
         if (m.reused) {
-            ++work.model_tables_reused;
-            models.push_back(std::move(m));
-            continue;
+            ++work_.model_tables_reused;
+            return m;
         }
-        ++work.model_tables_computed;
+        ++work_.model_tables_computed;
+        compare_model(m, model_table(m));
+        return m;
+    }
+
+    // A model's binned table: from elsewhere (a model table, a Python plugin; checked against the
+    // study) or the registry's model on the bins; its support in m.
+    BinnedTable model_table(ModelOutcome& m) {
         BinnedTable table;
-        const auto external = std::find_if(s.external_models.begin(), s.external_models.end(),
-                                           [&](const ExternalModel& e) { return e.name == name; });
-        if (external != s.external_models.end()) {
-            // A table from elsewhere (model table, Python plugin), checked against the study.
-            table = external->table(config);
+        const auto external =
+            std::find_if(s_.external_models.begin(), s_.external_models.end(),
+                         [&](const ExternalModel& e) { return e.name == m.name; });
+        if (external != s_.external_models.end()) {
+            table = external->table(config_);
             if (table.has_reflection || table.has_transmission)
-                check_external_table(table, grid, s.reference.theta_i_deg, transmits,
+                check_external_table(table, grid_, s_.reference.theta_i_deg, transmits_,
                                      external->source);
             m.support.brdf = table.has_reflection;
-            m.support.btdf = transmits && table.has_transmission;
-            if (!m.support.brdf || (transmits && !m.support.btdf))
+            m.support.btdf = transmits_ && table.has_transmission;
+            if (!m.support.brdf || (transmits_ && !m.support.btdf))
                 m.support.reason =
                     table.has_reflection || table.has_transmission
                         ? fmt::format("{} has no {} rows", external->source,
                                       m.support.brdf ? "T" : "R")
-                        : fmt::format("{} has no table for {}", external->source, config.id);
+                        : fmt::format("{} has no table for {}", external->source, config_.id);
         } else {
-            const std::unique_ptr<Model> model = make_model(name, config.stack);
+            const std::unique_ptr<Model> model = make_model(m.name, config_.stack);
             m.support = model->support();
             if (m.support.brdf || m.support.btdf)
-                table = bin_model(*model, grid, s.reference.theta_i_deg);
+                table = bin_model(*model, grid_, s_.reference.theta_i_deg);
         }
-        m.table.assign(n_inc * block, NAN);
+        return table;
+    }
+
+    // The model's table, albedos and metric rows against the reference.
+    void compare_model(ModelOutcome& m, const BinnedTable& table) {
+        m.table.assign(n_inc_ * block_, NAN);
         m.albedo = nlohmann::json::object();
-        for (std::size_t i = 0; i < n_inc; ++i)
-            for (int side = 0; side < n_sides; ++side) {
+        for (std::size_t i = 0; i < n_inc_; ++i)
+            for (int side = 0; side < n_sides_; ++side) {
                 const bool supported = side == 0 ? m.support.brdf : m.support.btdf;
                 const char* side_name = side == 0 ? "R" : "T";
+                const double theta_i = s_.reference.theta_i_deg[i];
                 if (!supported) {
                     m.albedo[side_name].push_back(nullptr);
                     for (int c = 0; c < 3; ++c)
-                        m.rows.push_back({config.id,
-                                          config.category,
-                                          name,
-                                          s.reference.theta_i_deg[i],
+                        m.rows.push_back({config_.id,
+                                          config_.category,
+                                          m.name,
+                                          theta_i,
                                           side_name[0],
                                           c,
                                           false,
                                           {},
-                                          pieces[i].floor[side][c]});
+                                          pieces_[i].floor[side][c]});
                     continue;
                 }
                 const BinnedLobe& lobe =
                     table.lobe(i, side == 0 ? Side::Reflection : Side::Transmission);
                 Rgbd a(0.0);
-                for (std::size_t j = 0; j < bins; ++j)
+                for (std::size_t j = 0; j < bins_; ++j)
                     for (int c = 0; c < 3; ++c) {
-                        m.table[(i * n_sides + side) * bins * 3 + j * 3 + c] = float(lobe.f[j][c]);
-                        a[c] += lobe.f[j][c] * grid.projected_solid_angle(j);
+                        m.table[(i * n_sides_ + side) * bins_ * 3 + j * 3 + c] =
+                            float(lobe.f[j][c]);
+                        a[c] += lobe.f[j][c] * grid_.projected_solid_angle(j);
                     }
                 m.albedo[side_name].push_back(rgb(a));
                 for (int c = 0; c < 3; ++c)
-                    m.rows.push_back({config.id, config.category, name, s.reference.theta_i_deg[i],
-                                      side_name[0], c, true,
-                                      lobe_metrics(grid, pieces[i].f[side], lobe.f, c),
-                                      pieces[i].floor[side][c]});
+                    m.rows.push_back({config_.id, config_.category, m.name, theta_i, side_name[0],
+                                      c, true, lobe_metrics(grid_, pieces_[i].f[side], lobe.f, c),
+                                      pieces_[i].floor[side][c]});
             }
-        models.push_back(std::move(m));
     }
-    for (const ModelOutcome& m : models)
-        result.rows.insert(result.rows.end(), m.rows.begin(), m.rows.end());
 
     // 3. configs/<id>/: config.json, tables.lza, reference_se.lza (each rewritten only if changed;
     //    the .npy tables of a study written before packed arrays are removed).
-    const std::size_t n_sources = 1 + models.size();
-    nlohmann::json albedo;
-    nlohmann::json supported = nlohmann::json::object();
-    nlohmann::json sources = {"reference"};
-    std::vector<float> tables, ses;
-    if (s.tables != TablesFormat::None) {
-        tables.assign(n_sources * n_inc * block, NAN);
-        ses.assign(n_inc * block, 0.0f);
-    }
-    for (std::size_t i = 0; i < n_inc; ++i)
-        for (int side = 0; side < n_sides; ++side) {
-            Rgbd a(0.0);
-            for (std::size_t j = 0; j < bins; ++j)
-                for (int c = 0; c < 3; ++c) {
-                    const std::size_t at = (i * n_sides + side) * bins * 3 + j * 3 + c;
-                    if (!tables.empty()) {
-                        tables[at] = float(pieces[i].f[side][j][c]);
-                        ses[at] = float(pieces[i].se[side][j][c]);
+    void write_outputs(const std::vector<ModelOutcome>& models) {
+        const std::size_t n_sources = 1 + models.size();
+        nlohmann::json albedo;
+        nlohmann::json supported = nlohmann::json::object();
+        nlohmann::json sources = {"reference"};
+        std::vector<float> tables, ses;
+        if (s_.tables != TablesFormat::None) {
+            tables.assign(n_sources * n_inc_ * block_, NAN);
+            ses.assign(n_inc_ * block_, 0.0f);
+        }
+        for (std::size_t i = 0; i < n_inc_; ++i)
+            for (int side = 0; side < n_sides_; ++side) {
+                Rgbd a(0.0);
+                for (std::size_t j = 0; j < bins_; ++j)
+                    for (int c = 0; c < 3; ++c) {
+                        const std::size_t at = (i * n_sides_ + side) * bins_ * 3 + j * 3 + c;
+                        if (!tables.empty()) {
+                            tables[at] = float(pieces_[i].f[side][j][c]);
+                            ses[at] = float(pieces_[i].se[side][j][c]);
+                        }
+                        a[c] += pieces_[i].f[side][j][c] * grid_.projected_solid_angle(j);
                     }
-                    a[c] += pieces[i].f[side][j][c] * grid.projected_solid_angle(j);
-                }
-            albedo["reference"][side == 0 ? "R" : "T"].push_back(rgb(a));
+                albedo["reference"][side == 0 ? "R" : "T"].push_back(rgb(a));
+            }
+        for (std::size_t k = 0; k < models.size(); ++k) {
+            const ModelOutcome& m = models[k];
+            sources.push_back(m.name);
+            supported[m.name] = {
+                {"R", m.support.brdf}, {"T", m.support.btdf}, {"reason", m.support.reason}};
+            albedo[m.name] = m.albedo;
+            if (!tables.empty())
+                std::copy(m.table.begin(), m.table.end(),
+                          tables.begin() + (1 + k) * n_inc_ * block_);
         }
-    for (std::size_t k = 0; k < models.size(); ++k) {
-        const ModelOutcome& m = models[k];
-        sources.push_back(m.name);
-        supported[m.name] = {
-            {"R", m.support.brdf}, {"T", m.support.btdf}, {"reason", m.support.reason}};
-        albedo[m.name] = m.albedo;
-        if (!tables.empty())
-            std::copy(m.table.begin(), m.table.end(), tables.begin() + (1 + k) * n_inc * block);
-    }
-    nlohmann::json energy = nlohmann::json::array();
-    for (std::size_t i = 0; i < n_inc; ++i) {
-        result.lost_microsurface.push_back(pieces[i].budget[BudgetTerm::LostMicrosurface]);
-        nlohmann::json e;
-        e["theta_i"] = s.reference.theta_i_deg[i];
-        for (int t = 0; t < kBudgetTerms; ++t)
-            e[kBudgetTermNames[t]] = rgb(pieces[i].budget.term[t]);
-        e["reflected_se"] = rgb(pieces[i].budget.reflected_se);
-        e["transmitted_se"] = rgb(pieces[i].budget.transmitted_se);
-        energy.push_back(e);
-    }
-    const std::vector<std::size_t> shape = {n_sources,
-                                            n_inc,
-                                            std::size_t(n_sides),
-                                            std::size_t(grid.n_theta()),
-                                            std::size_t(grid.n_phi()),
-                                            3};
-    nlohmann::json cj;
-    cj["id"] = config.id;
-    cj["category"] = config.category;
-    cj["parameters"] = config.parameters;
-    cj["stack"] = stack_to_json(config.stack);
-    cj["sides"] = transmits ? nlohmann::json{"R", "T"} : nlohmann::json{"R"};
-    cj["theta_i"] = s.reference.theta_i_deg;
-    cj["sources"] = sources;
-    cj["supported"] = supported;
-    cj["albedo"] = albedo;
-    cj["energy"] = energy;
-    if (s.tables == TablesFormat::None)
-        cj["tables"] = nullptr;
-    else
-        cj["tables"] = {
-            {"file", "tables.lza"},
-            {"dtype", s.tables == TablesFormat::Half ? "float16" : "float32"},
-            {"shape", shape},
-            {"axes", {"source", "incidence", "side", "theta_bin", "phi_bin", "channel"}}};
-    bool wrote = false;
-    {
-        StagedOutput out(config_dir);
-        if (s.tables != TablesFormat::None) {
-            const std::vector<std::string> axes = {"source",    "incidence", "side",
-                                                   "theta_bin", "phi_bin",   "channel"};
-            wrote |= out.add_if_changed("tables.lza", tables_bytes(s.tables, tables, shape, axes));
-            wrote |= out.add_if_changed(
-                "reference_se.lza",
-                tables_bytes(s.tables, ses,
-                             std::vector<std::size_t>(shape.begin() + 1, shape.end()),
-                             std::vector<std::string>(axes.begin() + 1, axes.end())));
+        const std::vector<std::size_t> shape = {n_sources,
+                                                n_inc_,
+                                                std::size_t(n_sides_),
+                                                std::size_t(grid_.n_theta()),
+                                                std::size_t(grid_.n_phi()),
+                                                3};
+        const nlohmann::json cj = config_json(sources, supported, albedo, shape);
+        bool wrote = false;
+        {
+            StagedOutput out(config_dir_);
+            if (s_.tables != TablesFormat::None) {
+                const std::vector<std::string> axes = {"source",    "incidence", "side",
+                                                       "theta_bin", "phi_bin",   "channel"};
+                wrote |=
+                    out.add_if_changed("tables.lza", tables_bytes(s_.tables, tables, shape, axes));
+                wrote |= out.add_if_changed(
+                    "reference_se.lza",
+                    tables_bytes(s_.tables, ses,
+                                 std::vector<std::size_t>(shape.begin() + 1, shape.end()),
+                                 std::vector<std::string>(axes.begin() + 1, axes.end())));
+            }
+            wrote |= out.add_if_changed("config.json", cj.dump(1) + "\n");
+            out.commit();
         }
-        wrote |= out.add_if_changed("config.json", cj.dump(1) + "\n");
-        out.commit();
+        for (const char* name :
+             {"tables.npy", "reference_se.npy", "tables.lza", "reference_se.lza"})
+            if (s_.tables == TablesFormat::None || std::string_view(name).ends_with(".npy")) {
+                std::error_code ec;
+                wrote |= std::filesystem::remove(config_dir_ / name, ec);
+            }
+        work_.configurations_written += wrote;
+        work_.configurations_unchanged += !wrote;
     }
-    for (const char* name : {"tables.npy", "reference_se.npy", "tables.lza", "reference_se.lza"})
-        if (s.tables == TablesFormat::None || std::string_view(name).ends_with(".npy")) {
-            std::error_code ec;
-            wrote |= std::filesystem::remove(config_dir / name, ec);
+
+    // config.json: the configuration, its sources, what each supports, the albedos, the
+    // reference's energy budget per incidence and the tables' layout.
+    nlohmann::json config_json(const nlohmann::json& sources, const nlohmann::json& supported,
+                               const nlohmann::json& albedo,
+                               const std::vector<std::size_t>& shape) {
+        nlohmann::json energy = nlohmann::json::array();
+        for (std::size_t i = 0; i < n_inc_; ++i) {
+            result_.lost_microsurface.push_back(pieces_[i].budget[BudgetTerm::LostMicrosurface]);
+            nlohmann::json e;
+            e["theta_i"] = s_.reference.theta_i_deg[i];
+            for (int t = 0; t < kBudgetTerms; ++t)
+                e[kBudgetTermNames[t]] = rgb(pieces_[i].budget.term[t]);
+            e["reflected_se"] = rgb(pieces_[i].budget.reflected_se);
+            e["transmitted_se"] = rgb(pieces_[i].budget.transmitted_se);
+            energy.push_back(e);
         }
-    work.configurations_written += wrote;
-    work.configurations_unchanged += !wrote;
+        nlohmann::json cj;
+        cj["id"] = config_.id;
+        cj["category"] = config_.category;
+        cj["parameters"] = config_.parameters;
+        cj["stack"] = stack_to_json(config_.stack);
+        cj["sides"] = transmits_ ? nlohmann::json{"R", "T"} : nlohmann::json{"R"};
+        cj["theta_i"] = s_.reference.theta_i_deg;
+        cj["sources"] = sources;
+        cj["supported"] = supported;
+        cj["albedo"] = albedo;
+        cj["energy"] = energy;
+        if (s_.tables == TablesFormat::None)
+            cj["tables"] = nullptr;
+        else
+            cj["tables"] = {
+                {"file", "tables.lza"},
+                {"dtype", s_.tables == TablesFormat::Half ? "float16" : "float32"},
+                {"shape", shape},
+                {"axes", {"source", "incidence", "side", "theta_bin", "phi_bin", "channel"}}};
+        return cj;
+    }
 
     // 4. What a later run with the same inputs reads back instead of all of the above.
-    nlohmann::json st;
-    st["format"] = kStateFormat;
-    st["outputs"] = digest_hex(outputs_digest);
-    st["reference"] = digest_hex(ref_digest);
-    st["tables"] = enum_text(s.tables);
-    st["reference_seconds"] = result.reference_seconds;
-    st["lost_microsurface"] = nlohmann::json::array();
-    for (const Rgbd& v : result.lost_microsurface)
-        st["lost_microsurface"].push_back(rgb(v));
-    for (const ModelOutcome& m : models) {
-        nlohmann::json rows = nlohmann::json::array();
-        for (const MetricRow& r : m.rows)
-            rows.push_back(row_json(r));
-        st["models"][m.name] = {
-            {"key", m.key},
-            {"support",
-             {{"R", m.support.brdf}, {"T", m.support.btdf}, {"reason", m.support.reason}}},
-            {"albedo", m.albedo},
-            {"rows", rows}};
+    void write_state(const std::vector<ModelOutcome>& models) {
+        nlohmann::json st;
+        st["format"] = kStateFormat;
+        st["outputs"] = digest_hex(outputs_digest_);
+        st["reference"] = digest_hex(ref_digest_);
+        st["tables"] = enum_text(s_.tables);
+        st["reference_seconds"] = result_.reference_seconds;
+        st["lost_microsurface"] = nlohmann::json::array();
+        for (const Rgbd& v : result_.lost_microsurface)
+            st["lost_microsurface"].push_back(rgb(v));
+        for (const ModelOutcome& m : models) {
+            nlohmann::json rows = nlohmann::json::array();
+            for (const MetricRow& r : m.rows)
+                rows.push_back(row_json(r));
+            st["models"][m.name] = {
+                {"key", m.key},
+                {"support",
+                 {{"R", m.support.brdf}, {"T", m.support.btdf}, {"reason", m.support.reason}}},
+                {"albedo", m.albedo},
+                {"rows", rows}};
+        }
+        std::error_code ec;
+        std::filesystem::create_directories(state_path(out_dir_, config_.id).parent_path(), ec);
+        write_file_if_changed(state_path(out_dir_, config_.id), st.dump() + "\n");
     }
-    std::error_code ec;
-    std::filesystem::create_directories(state_path(out_dir, config.id).parent_path(), ec);
-    write_file_if_changed(state_path(out_dir, config.id), st.dump() + "\n");
-    return result;
-}
+
+    const StudyConfiguration& config_;
+    const StudySettings& s_;
+    const std::vector<std::string>& model_names_;
+    const std::filesystem::path& out_dir_;
+    Progress& progress_;
+    StudyWork& work_;
+    const std::size_t n_inc_;
+    const HemisphereGrid& grid_;
+    const std::size_t bins_;
+    const std::filesystem::path config_dir_;
+
+    std::vector<ReferenceKey> keys_;
+    std::uint64_t ref_digest_ = 0, outputs_digest_ = 0;
+    std::vector<std::string> model_keys_;
+    nlohmann::json state_;
+    std::vector<ReferencePiece> pieces_;
+    bool transmits_ = false, same_reference_ = false;
+    int n_sides_ = 1;
+    std::size_t block_ = 0;  ///< one incidence of one source: sides × bins × channels
+    bool old_loaded_ = false;
+    std::optional<NpyFloat32> old_tables_;
+    std::vector<std::string> old_sources_;
+    ConfigResult result_;
+};
 
 }  // namespace
 
@@ -576,7 +648,7 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
         const auto t0 = std::chrono::steady_clock::now();
         const std::size_t written_before = result.work.configurations_written;
         ConfigResult r =
-            run_configuration(configs[k], s, model_names, out_dir, progress, result.work);
+            ConfigurationRun(configs[k], s, model_names, out_dir, progress, result.work).run();
         result.rows.insert(result.rows.end(), r.rows.begin(), r.rows.end());
         lost[configs[k].id] = r.lost_microsurface;
         reference_seconds += r.reference_seconds;

@@ -1,5 +1,5 @@
 #pragma once
-// The study (issue 5; docs/study.md): for every configuration, the reference (the
+// The study (docs/study.md): for every configuration, the reference (the
 // goniophotometer, resumable, as two halves for the noise floor) and every model on the same bins,
 // compared by the study's metrics. Writes the study directory of docs/formats.md.
 

@@ -169,23 +169,19 @@ const GroupFindings* StudyFindings::group(const std::string& name) const {
     return nullptr;
 }
 
-StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
-                               const StudySettings& s, const std::vector<std::string>& models,
-                               const std::vector<MetricRow>& rows, const ReferenceLoss& lost) {
-    StudyFindings f;
-    f.preset = s.preset;
-    f.particles = s.reference.particles;
-    f.microsurface = enum_text(s.reference.transport.microsurface);
-    f.theta_i = s.reference.theta_i_deg;
-    f.grid = s.reference.grid.to_string();
-    f.models = models;
-    f.configurations = configs.size();
+namespace {
 
-    std::map<std::string, const StudyConfiguration*> by_id;
+using PerConfig = std::map<std::string, std::map<std::string, Accumulator>>;
+
+// The rankings of each group: each category's BRDF, then the BTDF of the categories that transmit
+// (a model's reflection and transmission errors are never averaged together: most models have no
+// BTDF), then all; what each model does not support; each configuration's BRDF rows per model.
+void find_groups(const std::vector<StudyConfiguration>& configs,
+                 const std::vector<std::string>& models, const std::vector<MetricRow>& rows,
+                 StudyFindings& f, PerConfig& per_config) {
     std::map<std::string, int> configs_in;
     bool any_transmission = false;
     for (const StudyConfiguration& c : configs) {
-        by_id[c.id] = &c;
         f.category_of[c.id] = c.category;
         if (std::find(f.categories.begin(), f.categories.end(), c.category) == f.categories.end())
             f.categories.push_back(c.category);
@@ -198,15 +194,12 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
         }
     }
 
-    // Groups: each category's BRDF, then the BTDF of the categories that transmit (a model's
-    // reflection and transmission errors are never averaged together: most models have no BTDF).
     std::vector<std::string> group_names = f.categories;
     for (const std::string& c : f.categories)
         if (configs_in.count(c + " BTDF")) group_names.push_back(c + " BTDF");
     group_names.push_back("all");
     if (any_transmission) group_names.push_back("all BTDF");
     std::map<std::string, std::map<std::string, Accumulator>> acc;
-    std::map<std::string, std::map<std::string, Accumulator>> per_config;  // BRDF rows
     for (const MetricRow& r : rows) {
         acc[r.side == 'T' ? r.category + " BTDF" : r.category][r.model].add(r);
         acc[r.side == 'T' ? "all BTDF" : "all"][r.model].add(r);
@@ -228,8 +221,13 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
         gf.ranking = rank(models, gf.models);
         f.groups.push_back(std::move(gf));
     }
+}
 
-    // Like for like: the overall ranking above averages each model over the configurations it
+// Like for like: the ranking of the configurations whose BRDF every model supports.
+void find_common(const std::vector<StudyConfiguration>& configs,
+                 const std::vector<std::string>& models, const std::vector<MetricRow>& rows,
+                 const PerConfig& per_config, StudyFindings& f) {
+    // The overall ranking above averages each model over the configurations it
     // supports, so a model that skips the hard ones (Belcour's have no Lambertian base) looks
     // better than it is. This one averages the BRDF rows of the configurations whose BRDF every
     // model supports. When no configuration is supported by all (a model made for one category
@@ -280,14 +278,18 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
     for (const std::string& m : compared)
         f.common.models[m] = acc_common[m].result();
     if (!common.empty()) f.common.ranking = rank(compared, f.common.models, true);
+}
 
-    // What the reference itself drops to its single-scattering microsurfaces, per category: the
-    // mean over configurations, incidences and channels, and the worst.
+// What the reference itself drops to its single-scattering microsurfaces, per category: the mean
+// over configurations, incidences and channels, and the worst.
+void find_reference_loss(const std::vector<StudyConfiguration>& configs,
+                         const std::vector<double>& theta_i, const ReferenceLoss& lost,
+                         StudyFindings& f) {
     std::map<std::string, std::pair<double, int>> loss_sum;
     for (const StudyConfiguration& c : configs) {
         const auto it = lost.find(c.id);
         if (it == lost.end()) continue;
-        for (std::size_t i = 0; i < it->second.size() && i < s.reference.theta_i_deg.size(); ++i)
+        for (std::size_t i = 0; i < it->second.size() && i < theta_i.size(); ++i)
             for (int ch = 0; ch < 3; ++ch) {
                 const double v = it->second[i][ch];
                 for (const std::string& g : {c.category, std::string("all")}) {
@@ -295,7 +297,7 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
                     LossFindings& l = f.reference_loss[g];
                     if (n == 0 || v > l.worst) {
                         l.worst = v;
-                        l.worst_at = {c.id, s.reference.theta_i_deg[i], 'R', ch};
+                        l.worst_at = {c.id, theta_i[i], 'R', ch};
                     }
                     sum += v;
                     ++n;
@@ -303,8 +305,12 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
                 }
             }
     }
+}
 
-    // Challenging cases: the best supporting model still misplaces > threshold on average.
+// Challenging cases: the best supporting model still misplaces > threshold on average.
+void find_challenging(const std::vector<StudyConfiguration>& configs,
+                      const std::vector<std::string>& models, PerConfig& per_config,
+                      StudyFindings& f) {
     for (const StudyConfiguration& c : configs) {
         ChallengingCase best;
         double best_mf = std::numeric_limits<double>::infinity();
@@ -322,8 +328,15 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
             !(best_mf <= 2 * best.mean_misplaced_floor_noise))
             f.challenging.push_back(best);
     }
+}
 
-    // The approximations assessment.
+// The approximations assessment: each factor's levels, each model's errors at each.
+void find_assessment(const std::vector<StudyConfiguration>& configs,
+                     const std::vector<std::string>& models, const std::vector<MetricRow>& rows,
+                     StudyFindings& f) {
+    std::map<std::string, const StudyConfiguration*> by_id;
+    for (const StudyConfiguration& c : configs)
+        by_id[c.id] = &c;
     const std::vector<Factor> factors = assessment_factors(by_id);
     for (const Factor& factor : factors) {
         std::map<std::string, std::vector<Accumulator>> level_acc;
@@ -343,6 +356,27 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
                 ff.models[m].push_back(a.result());
         f.assessment.push_back(std::move(ff));
     }
+}
+
+}  // namespace
+
+StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
+                               const StudySettings& s, const std::vector<std::string>& models,
+                               const std::vector<MetricRow>& rows, const ReferenceLoss& lost) {
+    StudyFindings f;
+    f.preset = s.preset;
+    f.particles = s.reference.particles;
+    f.microsurface = enum_text(s.reference.transport.microsurface);
+    f.theta_i = s.reference.theta_i_deg;
+    f.grid = s.reference.grid.to_string();
+    f.models = models;
+    f.configurations = configs.size();
+    PerConfig per_config;
+    find_groups(configs, models, rows, f, per_config);
+    find_common(configs, models, rows, per_config, f);
+    find_reference_loss(configs, s.reference.theta_i_deg, lost, f);
+    find_challenging(configs, models, per_config, f);
+    find_assessment(configs, models, rows, f);
     // For engine developers (study/engine_findings.h): computed from the same rows.
     f.engine = compute_engine_findings(rows, models);
     return f;

@@ -4,10 +4,7 @@
 # exit code 1; nothing crashes (exit codes ≥ 128) or prints NaN/inf. Usage: fuzz_cli_test.sh LAMINA
 set -u
 lamina=$1
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fails=0
-pass=0
+. "$(dirname "$0")/../support/script_lib.sh"
 fail() { echo "FAIL $1"; cat "$tmp/out"; fails=$((fails + 1)); }
 
 run() {  # run NAME COMMAND...: exit 0 or 1, no NaN/inf, no negative BSDF value on success
@@ -59,5 +56,4 @@ done <<'STACKS'
 {"layers": [{"interface": {"type": "dielectric", "eta": 1.5, "alpha": 0.2}
 1e999
 STACKS
-echo "$pass passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

@@ -15,12 +15,7 @@ if ! command -v mpirun >/dev/null 2>&1; then
     echo "SKIP: mpirun not found (make deps installs openmpi-bin)"
     exit 77
 fi
-pass=0
-fails=0
-ok() { pass=$((pass + 1)); }
-fail() { echo "FAIL $*"; fails=$((fails + 1)); }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/../support/script_lib.sh"
 # As CI needs: root in a container, more processes than cores. `timeout`: a hang is a failure.
 mpi() { timeout 120 mpirun -n 2 --allow-run-as-root --oversubscribe "$@"; }
 
@@ -130,5 +125,4 @@ expect_error "only simulate and study" validate "$src/examples/plastic.json"
 expect_error "--preset: 'huge' is not a preset" study --preset huge --out "$tmp/x"
 [ ! -e "$tmp/x/brdf.csv" ] && ok || fail "a failed run wrote output"
 
-echo "$pass passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

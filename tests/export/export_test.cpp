@@ -8,15 +8,21 @@
 #include "export/merl.h"
 #include "export/npz.h"
 #include "export/rgl_bsdf.h"
+#include "export/rgl_fidelity.h"
+#include "export/rgl_reader.h"
 #include "export/tensor_file.h"
 #include "models/numerics/binned.h"
+#include "models/numerics/quadrature.h"
 #include "models/registry.h"
 #include "models/test_stacks.h"
 #include "simulator/goniophotometer.h"
+#include "study/configurations.h"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -61,60 +67,84 @@ double bilinear(const float* slice, std::size_t nx, std::size_t ny, double x, do
            t * ((1 - s) * at(i, j + 1) + s * at(i + 1, j + 1));
 }
 
-/// The inverse-CDF map x → u of a bilinear density (one slice, not normalized): u_y = the mass
-/// below y, u_x = the mass left of x on the row through y over that row's mass. Written from the
-/// definition by summing patch integrals (no precomputed tables).
-std::array<double, 3> invert_slice(const float* p, std::size_t nx, std::size_t ny, double x,
-                                   double y) {
-    const double dx = 1.0 / double(nx - 1), dy = 1.0 / double(ny - 1);
-    auto node = [&](std::size_t a, std::size_t b) { return double(p[b * nx + a]); };
-    // ∫₀¹ p(x', y_b) dx' at a node row, and ∫₀^x of the row interpolated at y.
-    auto row_mass = [&](std::size_t b) {
-        double m = 0;
-        for (std::size_t a = 0; a + 1 < nx; ++a)
-            m += 0.5 * dx * (node(a, b) + node(a + 1, b));
-        return m;
-    };
-    double total = 0;
-    for (std::size_t b = 0; b + 1 < ny; ++b)
-        total += 0.5 * dy * (row_mass(b) + row_mass(b + 1));
-    const double gy = std::clamp(y, 0.0, 1.0) * double(ny - 1);
-    const std::size_t j = std::min<std::size_t>(std::size_t(gy), ny - 2);
-    const double t = gy - double(j);
-    double below = 0;
-    for (std::size_t b = 0; b < j; ++b)
-        below += 0.5 * dy * (row_mass(b) + row_mass(b + 1));
-    const double r0 = row_mass(j), r1 = row_mass(j + 1);
-    below += dy * (r0 * t + 0.5 * (r1 - r0) * t * t);
-    const double gx = std::clamp(x, 0.0, 1.0) * double(nx - 1);
-    const std::size_t i = std::min<std::size_t>(std::size_t(gx), nx - 2);
-    const double s = gx - double(i);
-    auto row_at_y = [&](std::size_t a) { return (1 - t) * node(a, j) + t * node(a, j + 1); };
-    double left = 0;
-    for (std::size_t a = 0; a < i; ++a)
-        left += 0.5 * dx * (row_at_y(a) + row_at_y(a + 1));
-    left += dx * (row_at_y(i) * s + 0.5 * (row_at_y(i + 1) - row_at_y(i)) * s * s);
-    const double row = (1 - t) * r0 + t * r1;
-    // (mass left of x on the row, the row's mass, the mass below y), each over the total.
-    return {left / total, row / total, below / total};
-}
+/// The inverse-CDF map x → u of a bilinear density (one slice, not normalized), written from the
+/// definition: u_y = the mass below y, u_x = the mass left of x on the row through y over that
+/// row's mass. `prefix` holds, per node row, the integral from 0 to each node (trapezoids, exact
+/// for a linear row); the row through y is the linear blend of its two node rows.
+struct SliceInverse {
+    std::size_t nx, ny;
+    std::vector<double> prefix;  ///< [row][node]
+    std::vector<double> below;   ///< mass below each node row
+    double total;
+
+    SliceInverse(const float* p, std::size_t nx_, std::size_t ny_) : nx(nx_), ny(ny_) {
+        const double dx = 1.0 / double(nx - 1), dy = 1.0 / double(ny - 1);
+        prefix.assign(nx * ny, 0.0);
+        for (std::size_t b = 0; b < ny; ++b)
+            for (std::size_t a = 1; a < nx; ++a)
+                prefix[b * nx + a] =
+                    prefix[b * nx + a - 1] + 0.5 * dx * (double(p[b * nx + a - 1]) + p[b * nx + a]);
+        below.assign(ny, 0.0);
+        for (std::size_t b = 1; b < ny; ++b)
+            below[b] = below[b - 1] + 0.5 * dy * (row_mass(b - 1) + row_mass(b));
+        total = below[ny - 1];
+        values = p;
+    }
+    double row_mass(std::size_t b) const { return prefix[b * nx + nx - 1]; }
+
+    /// (mass left of x on the row through y, that row's mass, the mass below y), over the total.
+    std::array<double, 3> operator()(double x, double y) const {
+        const double dx = 1.0 / double(nx - 1), dy = 1.0 / double(ny - 1);
+        const double gy = std::clamp(y, 0.0, 1.0) * double(ny - 1);
+        const std::size_t j = std::min<std::size_t>(std::size_t(gy), ny - 2);
+        const double t = gy - double(j);
+        const double r0 = row_mass(j), r1 = row_mass(j + 1);
+        const double mass_below = below[j] + dy * (r0 * t + 0.5 * (r1 - r0) * t * t);
+        const double gx = std::clamp(x, 0.0, 1.0) * double(nx - 1);
+        const std::size_t i = std::min<std::size_t>(std::size_t(gx), nx - 2);
+        const double s = gx - double(i);
+        auto row_at_y = [&](std::size_t a) {
+            return (1 - t) * values[j * nx + a] + t * values[(j + 1) * nx + a];
+        };
+        const double left = (1 - t) * prefix[j * nx + i] + t * prefix[(j + 1) * nx + i] +
+                            dx * (row_at_y(i) * s + 0.5 * (row_at_y(i + 1) - row_at_y(i)) * s * s);
+        return {left / total, ((1 - t) * r0 + t * r1) / total, mass_below / total};
+    }
+
+  private:
+    const float* values;
+};
 
 struct BsdfReader {
-    Array theta_i, ndf, sigma, vndf, rgb;
+    Array theta_i, ndf, sigma, vndf, spectra, wavelengths;
     std::vector<float> theta_nodes;
+    std::vector<SliceInverse> warps;  ///< per incidence, the first φi slice
+    std::size_t channel_at[3];        ///< the wavelengths read as red, green, blue
 
     explicit BsdfReader(const TensorFile& f)
         : theta_i(field(f, "theta_i")),
           ndf(field(f, "ndf")),
           sigma(field(f, "sigma")),
           vndf(field(f, "vndf")),
-          rgb(field(f, "rgb")),
-          theta_nodes(theta_i.v) {}
+          spectra(field(f, "spectra")),
+          wavelengths(field(f, "wavelengths")),
+          theta_nodes(theta_i.v) {
+        const std::size_t vy = vndf.shape[2], vx = vndf.shape[3];
+        for (std::size_t k = 0; k < theta_nodes.size(); ++k)
+            warps.emplace_back(vndf.v.data() + k * vy * vx, vx, vy);
+        // lamina's upsampling puts red, green and blue at 650, 550 and 450 nm (docs/formats.md).
+        const float want[3] = {650, 550, 450};
+        for (int c = 0; c < 3; ++c)
+            channel_at[c] =
+                std::size_t(std::find(wavelengths.v.begin(), wavelengths.v.end(), want[c]) -
+                            wavelengths.v.begin());
+    }
 
     static double theta2u(double theta) { return std::sqrt(theta / (kPiD / 2)); }
     static double phi2u(double phi) { return (phi + kPiD) / (2 * kPiD); }
 
-    /// f(wi, wo) (1/sr): wi parameterizes the tables (Mitsuba 3's convention).
+    /// f(wi, wo) (1/sr): wi parameterizes the tables (Mitsuba 3's convention); both readers divide
+    /// by cos θ of the other direction.
     Rgbd eval(const Vec3d& wi, const Vec3d& wo) const {
         if (wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
         const Vec3d m = normalize(wi + wo);
@@ -123,27 +153,27 @@ struct BsdfReader {
         double uy = phi2u(phi_m - phi_i);
         uy -= std::floor(uy);
         const double ux = theta2u(theta_m);
-        // The VNDF warp of the mixture of the two θi slices around theta_i (slice φi = 0 of the
-        // two equal ones): u_y = Σ w M(y), u_x = Σ w C(x, y) / Σ w R(y).
+        // The warp of the mixture of the two θi slices around theta_i: u_y = Σ w M(y),
+        // u_x = Σ w C(x, y) / Σ w R(y).
         const auto [k, w] = bracket(theta_nodes, theta_i);
-        const std::size_t vy = vndf.shape[2], vx = vndf.shape[3];
         double left = 0, row = 0, below = 0;
-        for (int e = 0; e < 2; ++e) {
+        for (std::size_t e = 0; e < 2 && k + e < warps.size(); ++e) {
             const double we = e == 0 ? 1 - w : w;
             if (we == 0) continue;
-            const auto [l, r, b] = invert_slice(vndf.v.data() + (k + e) * vy * vx, vx, vy, ux, uy);
+            const auto [l, r, b] = warps[k + e](ux, uy);
             left += we * l;
             row += we * r;
             below += we * b;
         }
         const double sx = row > 0 ? left / row : 0, sy = below;
-        const std::size_t ny = rgb.shape[3], nx = rgb.shape[4];
+        const std::size_t nl = spectra.shape[2], ny = spectra.shape[3], nx = spectra.shape[4];
         Rgbd s(0.0);
         for (int c = 0; c < 3; ++c)
-            for (int e = 0; e < 2; ++e) {
+            for (std::size_t e = 0; e < 2 && k + e < warps.size(); ++e) {
                 const double we = e == 0 ? 1 - w : w;
                 if (we == 0) continue;
-                s[c] += we * bilinear(rgb.v.data() + ((k + e) * 3 + c) * ny * nx, nx, ny, sx, sy);
+                s[c] += we * bilinear(spectra.v.data() + ((k + e) * nl + channel_at[c]) * ny * nx,
+                                      nx, ny, sx, sy);
             }
         const double d = bilinear(ndf.v.data(), ndf.shape[1], ndf.shape[0], ux, uy);
         const double sig = bilinear(sigma.v.data(), sigma.shape[1], sigma.shape[0],
@@ -152,6 +182,32 @@ struct BsdfReader {
     }
 };
 
+/// ∫ f(wi, wo) cos θo dωo of any f, over the half vector: dωo = 4 (wi·ωm) dωm with
+/// dωm = sin θm dθm dφm, and θm = (π/2) t⁴ (dθm = 2π t³ dt), which crowds the nodes near ωm = n,
+/// where near-specular lobes sit whatever θi. 8-point Gauss–Legendre on 40 × 40 cells of (t, φm).
+template <typename F>
+Rgbd half_vector_albedo(F&& f, const Vec3d& wi) {
+    static const QuadratureRule q = gauss_legendre(8);
+    constexpr int kCells = 40;
+    Rgbd sum(0.0);
+    for (int a = 0; a < kCells; ++a)
+        for (int ga = 0; ga < 8; ++ga) {
+            const double t = (a + q.x[ga]) / kCells, theta_m = kPiD / 2 * t * t * t * t;
+            const double d_theta = 2 * kPiD * t * t * t / kCells * q.w[ga];
+            for (int b = 0; b < kCells; ++b)
+                for (int gb = 0; gb < 8; ++gb) {
+                    const double phi_m = 2 * kPiD * (b + q.x[gb]) / kCells;
+                    const Vec3d m = direction_from_angles(theta_m, phi_m);
+                    const double c = dot(wi, m);
+                    const Vec3d wo = m * (2 * c) - wi;
+                    if (c <= 0 || wo.z <= 0) continue;
+                    sum += f(wi, wo) * (wo.z * 4 * c * std::sin(theta_m) * d_theta * 2 * kPiD /
+                                        kCells * q.w[gb]);
+                }
+        }
+    return sum;
+}
+
 // ---- sources ---------------------------------------------------------------------------------
 
 std::shared_ptr<const Model> plastic_model() {
@@ -159,6 +215,13 @@ std::shared_ptr<const Model> plastic_model() {
     const Stack stack =
         test::coated(1.5, 0.3, test::lambertian(Rgbd(0.8, 0.4, 0.1)), Rgbd(0.1, 0.0, 0.5));
     return make_model("ww-prime", stack);
+}
+
+/// lamina-1's BRDF of one of the study's configurations.
+BrdfSource study_source(const std::string& id, const std::string& model = "lamina-1") {
+    for (const StudyConfiguration& c : builtin_configurations())
+        if (c.id == id) return model_brdf(make_model(model, c.stack), id);
+    throw std::runtime_error("no configuration " + id);
 }
 
 Vec3d random_direction(std::mt19937_64& rng, double max_theta_deg) {
@@ -186,6 +249,35 @@ std::vector<double> errors(const BsdfReader& reader, const BrdfSource& source, i
     return out;
 }
 
+/// The goals' value figure: pairs uniform in solid angle over θ ≤ 85° (cos θ uniform), sorted
+/// relative errors of Y.
+std::vector<double> goal_errors(const BsdfReader& reader, const BrdfSource& source, int n,
+                                std::uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    const double cos_max = std::cos(deg_to_rad(RglFidelityGoals::kMaxThetaDeg));
+    auto direction = [&] {
+        const double cos_theta = 1 - (1 - cos_max) * u(rng);
+        return direction_from_angles(std::acos(cos_theta), 2 * kPiD * u(rng));
+    };
+    std::vector<double> out;
+    for (int k = 0; k < n; ++k) {
+        const Vec3d wi = direction(), wo = direction();
+        const double want = luminance(source.f(wi, wo));
+        if (want > 0) out.push_back(std::abs(luminance(reader.eval(wi, wo)) / want - 1));
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+/// |a/b − 1| in the worst channel.
+double worst_channel_error(const Rgbd& a, const Rgbd& b) {
+    double e = 0;
+    for (int c = 0; c < 3; ++c)
+        e = std::max(e, std::abs(a[c] / b[c] - 1));
+    return e;
+}
+
 double quantile(const std::vector<double>& sorted, double q) {
     return sorted[std::size_t(q * double(sorted.size() - 1))];
 }
@@ -193,8 +285,6 @@ double quantile(const std::vector<double>& sorted, double q) {
 RglOptions options(int resolution, double dtheta) {
     RglOptions o;
     o.resolution = resolution;
-    o.vndf_resolution = 2 * resolution;
-    o.ndf_resolution = 2 * resolution;
     for (double t = 0; t < 89; t += dtheta)
         o.theta_i_deg.push_back(t);
     return o;
@@ -234,17 +324,27 @@ TEST(RglBsdf, HasTheFieldsTheReadersRequire) {
     const BrdfSource src = model_brdf(plastic_model(), "test");
     const TensorFile f = rgl_bsdf(src, options(8, 20));
     EXPECT_NO_THROW(check_rgl_bsdf(f, "t.bsdf"));
+    // One φi slice (isotropic), five incidences, 8 × 8 sample nodes; tables of θ alone are two
+    // equal rows.
     EXPECT_EQ(f.at("spectra").shape,
-              (std::vector<std::uint64_t>{2, 5, rgl_wavelengths().size(), 8, 8}));
+              (std::vector<std::uint64_t>{1, 5, rgl_wavelengths().size(), 8, 8}));
+    EXPECT_EQ(f.at("ndf").shape, (std::vector<std::uint64_t>{2, 512}));
+    EXPECT_EQ(f.at("vndf").shape, (std::vector<std::uint64_t>{1, 5, 2, 512}));
     EXPECT_EQ(f.at("jacobian").data, std::string(1, '\1'));
-    // The spectra are the RGB values' upsampling: 550 nm is green, 400 nm blue, 700 nm red.
-    const auto rgb = f.at("rgb").floats(), spectra = f.at("spectra").floats();
+    EXPECT_EQ(f.count("rgb"), 0u);
+    // The spectra are a partition of unity over r, g, b: grey stays grey, and 450, 550 and 650 nm
+    // hold b, g and r themselves.
+    const auto spectra = f.at("spectra").floats();
     const std::size_t n = 64, nl = rgl_wavelengths().size();
-    for (std::size_t j = 0; j < n; ++j) {
-        EXPECT_EQ(spectra[3 * n + j], rgb[1 * n + j]);
-        EXPECT_EQ(spectra[0 * n + j], rgb[2 * n + j]);
-        EXPECT_EQ(spectra[(nl - 1) * n + j], rgb[0 * n + j]);
+    for (std::size_t l = 0; l < nl; ++l) {
+        const Rgbd w = rgl_spectral_weights(l);
+        EXPECT_DOUBLE_EQ(w[0] + w[1] + w[2], 1.0);
     }
+    EXPECT_EQ(rgl_spectral_weights(1), Rgbd(0, 0, 1));
+    EXPECT_EQ(rgl_spectral_weights(3), Rgbd(0, 1, 0));
+    EXPECT_EQ(rgl_spectral_weights(5), Rgbd(1, 0, 0));
+    for (std::size_t j = 0; j < n; ++j)
+        EXPECT_GE(spectra[j], 0.f);
     TensorFile missing = f;
     missing.erase("sigma");
     EXPECT_THROW(check_rgl_bsdf(missing, "t.bsdf"), InputError);
@@ -253,14 +353,40 @@ TEST(RglBsdf, HasTheFieldsTheReadersRequire) {
     EXPECT_THROW(check_rgl_bsdf(wrong, "t.bsdf"), InputError);
 }
 
-// The model exported at high resolution and read back: its BRDF within a tolerance that the
-// interpolation explains. Bilinear interpolation (in s, and linear in θi) errs by O(h²): the
-// error must fall by about 4× when the grids are refined 2× (at least 2.5× is asked). At the
-// finer resolution (48 s nodes a side, incidences every 2°) 90% of random pairs with θi, θo ≤ 80°
-// must agree to 2%, and 99% of those with θi, θo ≤ 70° to 5% (measured: 0.74% and 1.0%). Past
-// 70° both directions grazing, with half vectors far from the normal, the warp gives few nodes to
-// a region where S varies fast with θi: there the tail reaches tens of percent (measured p99 over
-// θ ≤ 80°: 33%; docs/formats.md says so).
+TEST(RglBsdf, DefaultIncidencesGetDenserTowardsGrazing) {
+    const std::vector<double> t = rgl_default_incidences();
+    ASSERT_GE(t.size(), 3u);
+    EXPECT_EQ(t.front(), 0.0);
+    EXPECT_EQ(t.back(), 88.0);
+    // Past the goals' 85°, so that every incidence they judge is interpolated, not held.
+    EXPECT_GT(t[t.size() - 2], RglFidelityGoals::kMaxThetaDeg);
+    for (std::size_t k = 1; k < t.size(); ++k) {
+        const double step = t[k] - t[k - 1];
+        EXPECT_LE(step, 4.0 + 1e-9);
+        if (k + 1 < t.size()) {
+            EXPECT_LE(step, 0.25 * (90 - t[k - 1]) + 0.01);
+        }
+    }
+}
+
+// The file's bytes do not depend on the thread count.
+TEST(RglBsdf, FileDoesNotDependOnTheThreadCount) {
+    const BrdfSource src = study_source("paint-a0.05-a1.3");
+    RglOptions o = options(16, 10);
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const std::string one = tensor_file_bytes(rgl_bsdf(src, o));
+    omp_set_num_threads(std::max(2, threads));
+    const std::string many = tensor_file_bytes(rgl_bsdf(src, o));
+    omp_set_num_threads(threads);
+    EXPECT_TRUE(one == many);
+}
+
+// The model exported and read back: its BRDF within a tolerance that the interpolation explains.
+// Bilinear interpolation (in s, and linear in θi) errs by O(h²): the error must fall by about 4×
+// when the grids are refined 2× (at least 2.5× is asked). At the finer resolution (48 s nodes a
+// side, incidences every 2°) 90% of random pairs with θi, θo ≤ 80° must agree to 2%, and 99% of
+// those with θi, θo ≤ 70° to 5%.
 TEST(RglBsdf, ReaderAgreesWithTheModel) {
     const BrdfSource src = model_brdf(plastic_model(), "test");
     const BsdfReader coarse(rgl_bsdf(src, options(24, 4)));
@@ -278,6 +404,108 @@ TEST(RglBsdf, ReaderAgreesWithTheModel) {
     EXPECT_GT(q1 / q2, 2.5);
 }
 
+// The source's albedo by the half-vector quadrature (rgl_fidelity.h) against the model's own
+// sampler, on the study's hardest case for it: a coat of α = 0.001 over a rough metal at 84°,
+// where the whole coat reflection sits within 0.1° of the mirror direction. The Monte-Carlo
+// estimate's standard error is computed; 5 of them are allowed (plus 1e-4 for the quadrature).
+TEST(RglBsdf, SourceAlbedoAgreesWithTheModelsSampler) {
+    for (const StudyConfiguration& c : builtin_configurations()) {
+        if (c.id != "paint-a0.001-a1.3") continue;
+        const std::shared_ptr<const Model> model = make_model("lamina-1", c.stack);
+        ASSERT_TRUE(model->has_sampling());
+        const BrdfSource src = model_brdf(model, c.id);
+        for (double theta : {0.0, 60.0, 84.0}) {
+            const Vec3d wi = incident_direction(deg_to_rad(theta));
+            std::mt19937_64 rng(11);
+            std::uniform_real_distribution<double> u(0, 1);
+            constexpr int kN = 400000;
+            double sum = 0, sum2 = 0;
+            for (int k = 0; k < kN; ++k) {
+                const auto sample = model->sample(wi, Vec3d(u(rng), u(rng), u(rng)));
+                const double y = sample && sample->wo.z > 0 ? luminance(sample->weight) : 0.0;
+                sum += y;
+                sum2 += y * y;
+            }
+            const double mean = sum / kN, se = std::sqrt((sum2 / kN - mean * mean) / kN);
+            const double quad = luminance(directional_albedo(src.f, wi));
+            const double independent = luminance(half_vector_albedo(src.f, wi));
+            std::printf("θi %2.0f: sampler %.5f ± %.5f, source_albedo %.5f, test quadrature %.5f\n",
+                        theta, mean, se, quad, independent);
+            EXPECT_NEAR(quad, mean, 5 * se + 1e-4);
+            EXPECT_NEAR(independent, quad, 2e-4 * quad);
+        }
+    }
+}
+
+// What `lamina export --check` reports (export/rgl_reader.h, rgl_fidelity.h) is what the
+// independent reader finds: the same f at random pairs (to float32 rounding of the interpolation),
+// the same albedo.
+TEST(RglBsdf, CheckReaderAgreesWithTheIndependentReader) {
+    const BrdfSource src = study_source("plastic-P4-a0.05");
+    const TensorFile file = rgl_bsdf(src, options(24, 6));
+    const RglReader check(file, "t.bsdf");
+    const BsdfReader independent(file);
+    std::mt19937_64 rng(5);
+    for (int k = 0; k < 2000; ++k) {
+        const Vec3d wi = random_direction(rng, 89), wo = random_direction(rng, 89);
+        const Rgbd a = check.eval(wi, wo), b = independent.eval(wi, wo);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(a[c], b[c], 1e-5 * (std::abs(b[c]) + 1e-3));
+    }
+    for (double theta : {0.0, 37.0, 71.0, 84.5}) {
+        const Vec3d wi = incident_direction(deg_to_rad(theta));
+        const Rgbd a = directional_albedo(
+            [&](const Vec3d& i, const Vec3d& o) { return check.eval(i, o); }, wi);
+        const Rgbd b = half_vector_albedo(
+            [&](const Vec3d& i, const Vec3d& o) { return independent.eval(i, o); }, wi);
+        EXPECT_LT(worst_channel_error(a, b), 2e-4) << "θi " << theta;
+    }
+}
+
+// The defaults, judged by the independent reader where the previous ones failed (pbrt-v4 made a
+// metallic paint's albedo 32% too high at 80°): the study's metallic paint and plastic with the
+// smoothest coat (α = 0.001: all of the coat's reflection within 0.1° of the mirror direction),
+// at grazing incidences between the file's nodes. Goals (rgl_fidelity.h): albedo within 2% at
+// every θi ≤ 85°, values within 5% for 90% of pairs with θi, θo ≤ 85°.
+TEST(RglBsdf, DefaultsMeetTheGoalsAtGrazingAngles) {
+    using Goals = RglFidelityGoals;
+    for (const char* id : {"paint-a0.001-a1.3", "plastic-P4-a0.05"}) {
+        const BrdfSource src = study_source(id);
+        const BsdfReader reader(rgl_bsdf(src, RglOptions{}));
+        double worst = 0;
+        for (double theta : {0.0, 45.0, 70.0, 74.0, 78.0, 80.0, 83.0, 85.0}) {
+            const Vec3d wi = incident_direction(deg_to_rad(theta));
+            const Rgbd file = half_vector_albedo(
+                [&](const Vec3d& i, const Vec3d& o) { return reader.eval(i, o); }, wi);
+            const double e = worst_channel_error(file, half_vector_albedo(src.f, wi));
+            EXPECT_LE(e, Goals::kAlbedo) << id << " θi " << theta;
+            worst = std::max(worst, e);
+        }
+        const std::vector<double> e = goal_errors(reader, src, 4000, 3);
+        std::printf("%s: worst albedo error %.4f; values p50 %.4f p90 %.4f p99 %.4f\n", id, worst,
+                    quantile(e, 0.5), quantile(e, Goals::kValueQuantile), quantile(e, 0.99));
+        EXPECT_LE(quantile(e, Goals::kValueQuantile), Goals::kValue) << id;
+    }
+}
+
+// Past the last incidence (88°) the readers hold S, and lamina holds σ with it: f stays bounded
+// as θi → 90° (a σ falling to 0 with cos θi would make it grow without bound), and the albedo
+// falls as more of the held lobe passes below the horizon.
+TEST(RglBsdf, BoundedPastTheLastIncidence) {
+    const BrdfSource src = study_source("plastic-P1-a0.05");
+    const BsdfReader reader(rgl_bsdf(src, RglOptions{}));
+    auto albedo = [&](double theta) {
+        return luminance(
+            half_vector_albedo([&](const Vec3d& i, const Vec3d& o) { return reader.eval(i, o); },
+                               incident_direction(deg_to_rad(theta))));
+    };
+    const double a88 = albedo(88), a90 = albedo(89.9);
+    const double s90 = luminance(half_vector_albedo(src.f, incident_direction(deg_to_rad(89.9))));
+    std::printf("albedo at 88°: %.4f; at 89.9°: %.4f, the source %.4f\n", a88, a90, s90);
+    EXPECT_TRUE(std::isfinite(a90));
+    EXPECT_LT(a90, a88);
+}
+
 // A reference table (the goniophotometer's bins, interpolated between bin centres) exported at its
 // incidences: the reader gives back the interpolated table at those incidences.
 TEST(RglBsdf, ReaderAgreesWithAReferenceTable) {
@@ -285,11 +513,11 @@ TEST(RglBsdf, ReaderAgreesWithAReferenceTable) {
         test::coated(1.5, 0.3, test::lambertian(Rgbd(0.8, 0.4, 0.1)), Rgbd(0.1, 0.0, 0.5));
     SimulationSettings s;
     s.theta_i_deg = {0, 30, 60};
-    s.particles = 400'000;
+    s.particles = 2'000'000;  // at 400 000 the bins' own noise (≈5%) dominates the error
     s.grid = HemisphereGrid(30, 30);
     const SimulationResult r = simulate(stack, s);
     const BrdfSource src = table_brdf(r.table, "reference", "test");
-    RglOptions o = options(48, 90);
+    RglOptions o;
     o.theta_i_deg = s.theta_i_deg;
     const BsdfReader reader(rgl_bsdf(src, o));
     const std::vector<double> e = errors(reader, src, 3000, s.theta_i_deg);
@@ -339,6 +567,65 @@ TEST(Npz, IsAStoredZip) {
     EXPECT_EQ(z.substr(0, 4), std::string("PK\x03\x04", 4));
     EXPECT_NE(z.find("PK\x05\x06"), std::string::npos);
     EXPECT_NE(z.find("abc"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace lamina
+
+namespace lamina {
+namespace {
+
+// The defaults on the study's configurations (docs/formats.md, "How close a renderer gets"),
+// judged by the independent reader: every category, the smoothest and roughest coats and bases,
+// with lamina-1 and ww-prime. Albedo within 2% at θi every 10° to 50°, then every degree to 85°
+// (between the file's incidences, where the readers interpolate); values within 5% for 90% of
+// 20 000 pairs with θi, θo ≤ 85°. The clear and tinted slabs whose two interfaces are both
+// near-smooth (α0 = α1 = 0.001) meet the albedo goal only: off the mirror direction their f is
+// small (over half the pairs below 1.5e-3 of a white Lambertian's 1/π) and not a function of the
+// half vector alone, and 10% of the pairs are off by more than 26% (docs/formats.md).
+TEST(RglBsdfStat, DefaultsMeetTheGoalsOnTheStudy) {
+    using Goals = RglFidelityGoals;
+    struct Case {
+        const char* id;
+        const char* model;
+        bool values;
+    };
+    const Case cases[] = {{"plastic-P1-a0.001", "lamina-1", true},
+                          {"plastic-P4-a0.05", "ww-prime", true},
+                          {"plastic-P2-a0.5", "lamina-1", true},
+                          {"paint-a0.001-a1.1", "lamina-1", true},
+                          {"paint-a0.05-a1.5", "ww-prime", true},
+                          {"frosted-a0.1-a1.001", "lamina-1", true},
+                          {"frosted-a0.5-a1.05", "lamina-1", true},
+                          {"slab-a0.001-a1.3-tinted", "lamina-1", true},
+                          {"slab-a0.05-a1.001-clear", "lamina-1", true},
+                          {"slab-a0.5-a1.3-clear", "lamina-1", true},
+                          {"slab-a0.001-a1.001-clear", "lamina-1", false}};
+    std::vector<double> thetas = {0, 10, 20, 30, 40, 50};
+    for (double t = 60; t <= Goals::kMaxThetaDeg; t += 1)
+        thetas.push_back(t);
+    for (const Case& c : cases) {
+        const BrdfSource src = study_source(c.id, c.model);
+        const BsdfReader reader(rgl_bsdf(src, RglOptions{}));
+        std::vector<double> error(thetas.size());
+#pragma omp parallel for schedule(dynamic, 1)
+        for (std::size_t k = 0; k < thetas.size(); ++k) {
+            const Vec3d wi = incident_direction(deg_to_rad(thetas[k]));
+            error[k] = worst_channel_error(
+                half_vector_albedo(
+                    [&](const Vec3d& i, const Vec3d& o) { return reader.eval(i, o); }, wi),
+                half_vector_albedo(src.f, wi));
+        }
+        const auto worst = std::max_element(error.begin(), error.end());
+        const std::vector<double> e = goal_errors(reader, src, 20000, 9);
+        std::printf("%s (%s): worst albedo error %.4f at %g°; values p50 %.4f p90 %.4f p99 %.4f\n",
+                    c.id, c.model, *worst, thetas[std::size_t(worst - error.begin())],
+                    quantile(e, 0.5), quantile(e, Goals::kValueQuantile), quantile(e, 0.99));
+        EXPECT_LE(*worst, Goals::kAlbedo) << c.id;
+        if (c.values) {
+            EXPECT_LE(quantile(e, Goals::kValueQuantile), Goals::kValue) << c.id;
+        }
+    }
 }
 
 }  // namespace

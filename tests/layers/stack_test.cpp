@@ -417,6 +417,7 @@ TEST(StackParse, AcceptsTheBoundsOfEveryRange) {
         accepted(with(plastic(), "/layers/0/medium/tau_a", tau));
         accepted(with(plastic(), "/layers/0/medium/tau_s", tau));
     }
+    accepted(with(plastic(), "/layers/0/medium/tau_s", 1e4));  // a white paint
     for (double g : {-0.99, 0.0, 5e-324, 0.99})
         accepted(with(plastic(), "/layers/0/medium/g", g));
     // A hundred layers: 99 coats over a base.
@@ -457,9 +458,13 @@ TEST(StackReject, OpticalDepthsOutsideTheirRange) {
         error_of(with(plastic(), "/layers/0/medium/tau_a/2", -0.9)),
         {"bad.json", "/layers/0/medium/tau_a/2", "got -0.9", "[0, 100]", "optical depth"});
     expect_mentions(error_of(with(plastic(), "/layers/0/medium/tau_s", -1)),
-                    {"/layers/0/medium/tau_s", "got -1", "[0, 100]"});
+                    {"/layers/0/medium/tau_s", "got -1", "[0, 10000]"});
     expect_mentions(error_of(with(plastic(), "/layers/0/medium/tau_s", 1e308)),
-                    {"/layers/0/medium/tau_s", "got 1e+308", "[0, 100]"});
+                    {"/layers/0/medium/tau_s", "got 1e+308", "[0, 10000]"});
+    expect_mentions(error_of(with(plastic(), "/layers/0/medium/tau_a", 101)),
+                    {"/layers/0/medium/tau_a", "got 101", "[0, 100]"});
+    expect_mentions(error_of(with(plastic(), "/layers/0/medium/tau_s", 10001)),
+                    {"/layers/0/medium/tau_s", "got 10001", "[0, 10000]"});
 }
 
 TEST(StackReject, AnisotropyOutsideItsRange) {

@@ -1,5 +1,5 @@
 #pragma once
-// Stacks for the model tests, built in code (the JSON parser lives in another branch).
+// Stacks for the model tests, built in code on layers/stack.h's builders.
 
 #include "core/math.h"
 #include "core/rgb.h"
@@ -14,25 +14,13 @@ inline Vec3d dir(double theta_deg, double phi_deg) {
 }
 
 inline InterfaceSpec lambertian(Rgbd albedo) {
-    InterfaceSpec s;
-    s.type = InterfaceType::Lambertian;
-    s.albedo = albedo;
-    return s;
+    return lambertian_interface(albedo);
 }
 inline InterfaceSpec dielectric(double eta, double alpha) {
-    InterfaceSpec s;
-    s.type = InterfaceType::Dielectric;
-    s.eta = eta;
-    s.alpha = alpha;
-    return s;
+    return dielectric_interface(eta, alpha);
 }
 inline InterfaceSpec conductor(Rgbd eta, Rgbd k, double alpha) {
-    InterfaceSpec s;
-    s.type = InterfaceType::Conductor;
-    s.eta_rgb = eta;
-    s.k = k;
-    s.alpha = alpha;
-    return s;
+    return conductor_interface(eta, k, alpha);
 }
 /// Gold at (R, G, B) ≈ (650, 550, 450) nm (Johnson & Christy 1972, rounded).
 inline InterfaceSpec gold(double alpha) {
@@ -45,17 +33,9 @@ inline Stack coated(double eta0, double alpha0, const InterfaceSpec& base, Rgbd 
                     Rgbd tau_s = Rgbd(0.0), double g = 0.0) {
     Stack s;
     s.name = "test";
-    Layer coat;
-    coat.interface = dielectric(eta0, alpha0);
-    if (tau_a.max() > 0 || tau_s.max() > 0) {
-        coat.has_medium = true;
-        coat.medium.tau_a = tau_a;
-        coat.medium.tau_s = tau_s;
-        coat.medium.g = Rgbd(g);
-    }
-    Layer b;
-    b.interface = base;
-    s.layers = {coat, b};
+    Layer coat = layer_of(dielectric(eta0, alpha0));
+    if (tau_a.max() > 0 || tau_s.max() > 0) coat = with_medium(coat, tau_a, tau_s, Rgbd(g));
+    s.layers = {coat, layer_of(base)};
     return s;
 }
 
@@ -63,9 +43,7 @@ inline Stack coated(double eta0, double alpha0, const InterfaceSpec& base, Rgbd 
 inline Stack single(const InterfaceSpec& interface) {
     Stack s;
     s.name = "single";
-    Layer l;
-    l.interface = interface;
-    s.layers = {l};
+    s.layers = {layer_of(interface)};
     return s;
 }
 

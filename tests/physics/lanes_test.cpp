@@ -21,6 +21,7 @@
 #include "physics/dielectric.h"
 #include "physics/lambertian.h"
 #include "physics/medium.h"
+#include "physics/polarization.h"
 #include "simulator/kernel_simd.h"
 
 #include <gtest/gtest.h>
@@ -257,6 +258,215 @@ TEST(KernelSimdLanes, ConductorEvent) {
             cs.uncorrelated ? " uncorrelated" : "", ill_conditioned, worst_wo, worst_shadowing,
             worst_fresnel);
     }
+}
+
+// The polarized events (dielectric_event and conductor_event with their polarization,
+// physics/polarization.h): random states (degree of polarization in [0, 1], random frames ⊥ the
+// travel direction), random fluxes, one state for all channels and one per channel, on the cases
+// of the unpolarized tests. The branch choice, the degeneracy and the direction as there; the
+// state after the event is compared as light, not as numbers: both turned into a common frame
+// (x ∝ a × wo, a the coordinate axis least aligned with the scalar's wo), because the facet's s
+// axis, the frame the event leaves the state in, is ill-conditioned where the facet is met near
+// normal incidence (where its choice does not matter). Its error: the float rounding of the
+// rotations and of the Mueller matrix (≤ 1e-5), plus the facet normal's difference (the direction
+// bound `tolerance` of the unpolarized tests) times the state's slope in it (≤ 8), both divided by
+// the branch's intensity factor a + b q (the normalization; the lanes where it is below 1e-3
+// carry less than 1e-3 of the flux and are counted, not compared). The flux factors: relative
+// 1e-5 plus the same normal term.
+double polarized_tolerance(float alpha, const LaneVec3<float>& w, float u1, float u2, double& h) {
+    h = 1;
+    if (alpha == 0) return 1e-6;
+    const float sign = w.z < 0 ? -1.f : 1.f;
+    const double vx = double(alpha) * sign * w.x, vy = double(alpha) * sign * w.y,
+                 vz = double(sign) * w.z;
+    const double len = std::sqrt(vx * vx + vy * vy + vz * vz);
+    const double whx = vx / len, why = vy / len, whz = vz / len;
+    const double z_cap = (1 - double(u2)) * (1 + whz) - whz;
+    const double sin_cap = std::sqrt(std::max(1 - z_cap * z_cap, 1e-12));
+    const double phi = 2 * kPi<double> * double(u1);
+    const double hx = sin_cap * std::cos(phi) + whx, hy = sin_cap * std::sin(phi) + why,
+                 hz = z_cap + whz;
+    h = std::sqrt(hx * hx + hy * hy + hz * hz);
+    return (4e-6 + 0x1p-23 / sin_cap) / h;
+}
+
+// The state turned into the frame a × wo (double; physics/polarization.h stokes_rotate_frame).
+StokesLanes<double> in_common_frame(const float* x, const float* stokes, const LaneVec3<double>& wo,
+                                    int channels) {
+    StokesLanes<double> st;
+    st.x = {x[0], x[1], x[2]};
+    for (int c = 0; c < 3; ++c) {
+        st.q[c] = stokes[3 * c];
+        st.u[c] = stokes[3 * c + 1];
+        st.v[c] = stokes[3 * c + 2];
+    }
+    const double ax = std::abs(wo.x), ay = std::abs(wo.y), az = std::abs(wo.z);
+    const LaneVec3<double> a = ax <= ay && ax <= az   ? LaneVec3<double>{1, 0, 0}
+                               : ay <= ax && ay <= az ? LaneVec3<double>{0, 1, 0}
+                                                      : LaneVec3<double>{0, 0, 1};
+    stokes_rotate_frame<double>(st, wo, lane_cross<double>(a, wo), channels, true);
+    return st;
+}
+
+TEST(KernelSimdLanes, PolarizedEvents) {
+    ParticleRng rng(35, 0, 0);
+    struct Case {
+        int kind;  // 0 dielectric, 1 conductor
+        float alpha, eta[3], k[3];
+    };
+    const Case cases[] = {{0, 0.3f, {1.5f}, {}},
+                          {0, 0.6f, {1 / 1.5f}, {}},
+                          {0, 0.f, {1.5f}, {}},
+                          {0, 1.f, {2.4f}, {}},
+                          {1, 0.5f, {0.143f, 0.374f, 1.44f}, {3.98f, 2.38f, 1.80f}},
+                          {1, 0.f, {0.143f, 0.374f, 1.44f}, {3.98f, 2.38f, 1.80f}},
+                          {1, 0.3f, {2.9f, 2.9f, 2.9f}, {3.1f, 3.1f, 3.1f}}};
+    for (const Case& cs : cases)
+        for (const int channels : {1, 3}) {
+            const std::vector<float> wi = directions(rng, 4000, cs.kind == 0);
+            const std::size_t n = wi.size() / 3;
+            const std::vector<float> u = uniforms(rng, n, 3);
+            std::vector<float> x(3 * n), stokes(9 * n), flux(3 * n);
+            for (std::size_t j = 0; j < n; ++j) {
+                const Vec3d d(-wi[3 * j], -wi[3 * j + 1], -wi[3 * j + 2]);
+                const Vec3d r(rng.uniform_double() - 0.5, rng.uniform_double() - 0.5,
+                              rng.uniform_double() - 0.5);
+                const Vec3d xj = normalize(cross(d, r));
+                x[3 * j] = float(xj.x), x[3 * j + 1] = float(xj.y), x[3 * j + 2] = float(xj.z);
+                for (int c = 0; c < 3; ++c) {
+                    const double dop = rng.uniform_double(), z = 2 * rng.uniform_double() - 1;
+                    const double phi = 2 * kPi<double> * rng.uniform_double(),
+                                 rr = std::sqrt(1 - z * z);
+                    stokes[9 * j + 3 * c] = float(dop * rr * std::cos(phi));
+                    stokes[9 * j + 3 * c + 1] = float(dop * rr * std::sin(phi));
+                    stokes[9 * j + 3 * c + 2] = float(dop * z);
+                    flux[3 * j + c] = 0.05f + rng.uniform_float();
+                }
+            }
+            std::vector<float> params;
+            std::vector<std::int32_t> flags;
+            if (cs.kind == 0) {
+                params = {cs.eta[0], cs.alpha};
+                flags = {cs.alpha == 0, 0, 0, 1};
+            } else {
+                params = {cs.alpha, cs.eta[0], cs.eta[1], cs.eta[2], cs.k[0], cs.k[1], cs.k[2]};
+                flags = {cs.alpha == 0, 0};
+            }
+            const SimdPolarizedEventResult lanes = simd_polarized_interface_events(
+                cs.kind, params, flags, wi, u, x, stokes, flux, channels);
+            const ConductorInterface<float> iface{Rgbf(cs.eta[0], cs.eta[1], cs.eta[2]),
+                                                  Rgbf(cs.k[0], cs.k[1], cs.k[2]), cs.alpha};
+            std::size_t differ = 0, ill_conditioned = 0, dim = 0;
+            double worst_state = 0, worst_factor = 0;
+            for (std::size_t j = 0; j < n; ++j) {
+                const LaneVec3<float> w = {wi[3 * j], wi[3 * j + 1], wi[3 * j + 2]};
+                PolarizationLanes<float> pol;
+                pol.channels = channels;
+                pol.stokes.x = {x[3 * j], x[3 * j + 1], x[3 * j + 2]};
+                for (int c = 0; c < 3; ++c) {
+                    pol.stokes.q[c] = stokes[9 * j + 3 * c];
+                    pol.stokes.u[c] = stokes[9 * j + 3 * c + 1];
+                    pol.stokes.v[c] = stokes[9 * j + 3 * c + 2];
+                }
+                pol.flux = &flux[3 * j];
+                InterfaceEventLanes<float, bool> e;
+                if (cs.kind == 0) {
+                    const DielectricEventShape shape{cs.alpha == 0, false, false, true};
+                    e = dielectric_event<float, Lane<float>, true>(
+                        cs.eta[0], 1 / cs.eta[0], cs.alpha, shape, w, u[j], u[n + j], u[2 * n + j],
+                        true, &pol);
+                } else {
+                    float f[3];
+                    const auto fresnel = [&](float c, float* out) {
+                        const Rgbf r = iface.fresnel(c);
+                        out[0] = r[0], out[1] = r[1], out[2] = r[2];
+                    };
+                    const auto mueller = [&](float c, InterfaceMueller<float>* m) {
+                        iface.mueller(c, m);
+                    };
+                    e = conductor_event<float>(cs.alpha, cs.alpha == 0, false, w, u[n + j],
+                                               u[2 * n + j], true, fresnel, f, &pol, mueller);
+                }
+                ASSERT_EQ(bool(lanes.event.degenerate[j]), e.degenerate) << j;
+                if (e.degenerate) continue;
+                if (bool(lanes.event.reflected[j]) != e.reflected) {
+                    ++differ;
+                    continue;
+                }
+                double h;
+                const double tolerance =
+                    polarized_tolerance(cs.alpha, w, u[n + j], u[2 * n + j], h);
+                if (h < 0.05) {
+                    ++ill_conditioned;
+                    continue;
+                }
+                // The branch's intensity factor a + b q (the smallest over the states): a
+                // conductor's flux factors; for a dielectric, from its facet (the half vector of
+                // wi and wo: Walter et al. 2007, Eqs. 13 and 16) and the incoming state turned
+                // into its plane of incidence, in double.
+                double intensity = 1;
+                if (cs.kind == 1) {
+                    for (int c = 0; c < 3; ++c)
+                        intensity = std::min(intensity, double(pol.factor[c]));
+                } else {
+                    const Vec3d wid(w.x, w.y, w.z), wod(e.wo.x, e.wo.y, e.wo.z);
+                    const double eta_i = w.z > 0 ? 1.0 : cs.eta[0],
+                                 eta_o = e.wo.z > 0 ? 1.0 : cs.eta[0];
+                    Vec3d wm(0, 0, 1);
+                    if (cs.alpha > 0) {
+                        wm = normalize(e.reflected ? wid + wod : -(wid * eta_i + wod * eta_o));
+                        if (wm.z < 0) wm = -wm;
+                    }
+                    const auto fm = fresnel_dielectric_mueller<double>(dot(wid, wm), cs.eta[0],
+                                                                       1.0 / cs.eta[0]);
+                    StokesLanes<double> in;
+                    in.x = {x[3 * j], x[3 * j + 1], x[3 * j + 2]};
+                    for (int c = 0; c < 3; ++c) {
+                        in.q[c] = stokes[9 * j + 3 * c];
+                        in.u[c] = stokes[9 * j + 3 * c + 1];
+                        in.v[c] = stokes[9 * j + 3 * c + 2];
+                    }
+                    const Vec3d n_facet = cross(wid, wm);
+                    stokes_rotate_frame<double>(in, {-wid.x, -wid.y, -wid.z},
+                                                {n_facet.x, n_facet.y, n_facet.z}, channels, true);
+                    const auto& m = e.reflected ? fm.reflection : fm.transmission;
+                    for (int c = 0; c < channels; ++c)
+                        intensity = std::min(intensity, m.a + m.b * in.q[c]);
+                }
+                if (intensity < 1e-3) {
+                    ++dim;
+                    continue;
+                }
+                const LaneVec3<double> wo = {e.wo.x, e.wo.y, e.wo.z};
+                float s_stokes[9], s_x[3] = {pol.stokes.x.x, pol.stokes.x.y, pol.stokes.x.z};
+                for (int c = 0; c < 3; ++c) {
+                    s_stokes[3 * c] = pol.stokes.q[c];
+                    s_stokes[3 * c + 1] = pol.stokes.u[c];
+                    s_stokes[3 * c + 2] = pol.stokes.v[c];
+                }
+                const StokesLanes<double> a = in_common_frame(s_x, s_stokes, wo, channels);
+                const StokesLanes<double> b =
+                    in_common_frame(&lanes.x[3 * j], &lanes.stokes[9 * j], wo, channels);
+                const double bound = (1e-5 + 8 * tolerance) / intensity;
+                for (int c = 0; c < channels; ++c)
+                    worst_state = std::max(
+                        worst_state, std::max({std::abs(a.q[c] - b.q[c]), std::abs(a.u[c] - b.u[c]),
+                                               std::abs(a.v[c] - b.v[c])}) /
+                                         bound);
+                for (int c = 0; c < 3; ++c)
+                    worst_factor = std::max(
+                        worst_factor, std::abs(double(lanes.factor[3 * j + c]) - pol.factor[c]) /
+                                          ((1e-5 + 8 * tolerance) * (1 + pol.factor[c])));
+            }
+            EXPECT_LE(double(differ), 1e-3 * double(n)) << "case " << cs.kind << " α " << cs.alpha;
+            EXPECT_LE(worst_state, 1.0) << "case " << cs.kind << " α " << cs.alpha;
+            EXPECT_LE(worst_factor, 1.0) << "case " << cs.kind << " α " << cs.alpha;
+            std::printf(
+                "[ lanes    ] %s polarized %s α %g η %g, %d state(s): %zu differ, %zu "
+                "ill-conditioned, %zu dim; |Δstate|, |Δfactor| ≤ %.2g, %.2g of their bounds\n",
+                simd_target_name(), cs.kind == 0 ? "dielectric" : "conductor", cs.alpha, cs.eta[0],
+                channels, differ, ill_conditioned, dim, worst_state, worst_factor);
+        }
 }
 
 // The Lambertian event: the polar map's cos and sin of 2πu2 (the vectors' Cephes azimuth, ≤ 2

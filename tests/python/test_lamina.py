@@ -337,6 +337,34 @@ def test_export_check_refuses_truncated_files(tmp_path):
     assert r.returncode == 1 and "truncated" in r.stderr
 
 
+def test_export_check_reports_how_close_a_renderer_gets(tmp_path):
+    cli("export", "--model", "ww-prime", "--stack", PLASTIC, "--out", tmp_path / "ww.bsdf")
+    r = cli("export", "--check", tmp_path / "ww.bsdf", "--model", "ww-prime", "--stack", PLASTIC,
+            "--strict")
+    assert "directional albedo" in r.stdout and "85.0" in r.stdout
+    assert "random direction pairs" in r.stdout and "meets the goals" in r.stdout
+    # Eight sample nodes a side at 20° steps: far from the goals, which --strict turns into exit 2.
+    cli("export", "--model", "ww-prime", "--stack", PLASTIC, "--resolution", 8,
+        "--theta-i", "0,20,40,60,80", "--out", tmp_path / "coarse.bsdf")
+    r = cli("export", "--check", tmp_path / "coarse.bsdf", "--model", "ww-prime", "--stack",
+            PLASTIC, "--strict", check=False)
+    assert r.returncode == 2 and "misses the goals" in r.stdout and "over the goal" in r.stdout
+    r = cli("export", "--check", tmp_path / "coarse.bsdf", "--model", "ww-prime", "--stack",
+            PLASTIC)
+    assert "misses the goals" in r.stdout
+    r = cli("export", "--check", tmp_path / "ww.bsdf", "--strict", check=False)
+    assert r.returncode == 1 and "--strict" in r.stderr
+
+
+def test_export_from_python_takes_the_cli_defaults(tmp_path):
+    cli("export", "--model", "ww-prime", "--stack", PLASTIC, "--out", tmp_path / "cli.bsdf")
+    lamina.export(lamina.Model("ww-prime", PLASTIC), tmp_path / "py.bsdf")
+    describe = [cli("export", "--check", tmp_path / name).stdout for name in ("cli.bsdf", "py.bsdf")]
+    # "NAME: RGL .bsdf (SIZE MB), N incidences, N × N samples, N wavelengths: DESCRIPTION"
+    shapes = [d.split(", ", 1)[1].split(": ")[0] for d in describe]
+    assert shapes[0] == shapes[1] and "incidences" in shapes[0]
+
+
 def test_export_from_python_is_the_cli_file(tmp_path):
     cli("export", "--model", "ww-prime", "--stack", PLASTIC, "--out", tmp_path / "cli.binary")
     lamina.export(lamina.Model("ww-prime", PLASTIC), tmp_path / "py.binary")

@@ -225,5 +225,15 @@ TEST(RandomWalkPdf, ReportsWhenItsEstimateIsNotExact) {
     EXPECT_FALSE(RandomWalkStack(mixed).pdf_is_unbiased());
 }
 
+// Polarized walks: pdf() is the unpolarized walk's exit density (a proxy, random_walk.h), the
+// same estimate bit for bit as without polarization, and says it is not exact.
+TEST(RandomWalkPdf, PolarizedWalksKeepTheUnpolarizedDensity) {
+    const Stack stack = example("frosted-gold");
+    const RandomWalkStack plain(stack), polarized(stack, {.polarization = true});
+    EXPECT_FALSE(polarized.pdf_is_unbiased());
+    const Vec3d wi = incident_direction(0.6), wo = direction_from_angles(0.8, 2.8);
+    EXPECT_EQ(plain.pdf(wi, wo, 200, 3, 0).pdf, polarized.pdf(wi, wo, 200, 3, 0).pdf);
+}
+
 }  // namespace
 }  // namespace lamina

@@ -1,4 +1,4 @@
-// Sphere renderings (render/renderer.h): the proofs of issue 7 — white furnace, black stack,
+// Sphere renderings (render/renderer.h): the proofs of the renderer — white furnace, black stack,
 // WW' equal to the reference where it is exact, identical images across thread counts — and the
 // image files.
 #include "render/renderer.h"

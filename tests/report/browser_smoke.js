@@ -3,10 +3,9 @@
 // the reference and the models. Usage: node browser_smoke.js STUDY_DIR SCREENSHOT
 "use strict";
 const fs = require("fs");
-const os = require("os");
 const path = require("path");
 const zlib = require("zlib");
-const { chromium } = require("playwright-core");
+const { launchChromium } = require("../support/chromium.js");
 
 // A packed array (docs/formats.md, "Packed arrays") decoded here independently of the page:
 // {shape, values} with float16 or float32 values as numbers.
@@ -36,22 +35,14 @@ function readPacked(file) {
 }
 
 const [studyDir, shot] = process.argv.slice(2);
-const CHROMIUM = process.env.LAMINA_CHROMIUM || "/usr/bin/chromium";
 
 async function main() {
-  const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), "lamina-chromium-"));
-  const context = await chromium.launchPersistentContext(userDataDir, {
-    executablePath: CHROMIUM,
-    headless: true,
-    args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-    viewport: { width: 1400, height: 1000 },
-  });
+  const browser = await launchChromium();
   const errors = [];
   let failures = 0;
   const check = (ok, what) => { console.log((ok ? "ok   " : "FAIL ") + what); if (!ok) failures++; };
   try {
-    const page = context.pages()[0] || (await context.newPage());
+    const page = browser.page;
     page.on("console", (m) => { if (m.type() === "error") errors.push("console: " + m.text()); });
     page.on("pageerror", (e) => errors.push("page error: " + e.message));
     await page.route(/^(https?|wss?):/, (route) => { errors.push("network: " + route.request().url()); route.abort(); });
@@ -88,8 +79,7 @@ async function main() {
     check(Array.isArray(cells) && cells.length >= 2, "the leaderboard lists the configurations");
     await page.screenshot({ path: shot, fullPage: true });
   } finally {
-    await context.close();
-    fs.rmSync(userDataDir, { recursive: true, force: true });
+    await browser.close();
   }
   for (const e of errors) console.log("FAIL " + e);
   failures += errors.length;

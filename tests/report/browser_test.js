@@ -7,12 +7,10 @@
 // SCREENSHOT_DIR. Exit code 0 when every check passes.
 "use strict";
 const fs = require("fs");
-const os = require("os");
 const path = require("path");
-const { chromium } = require("playwright-core");
+const { CHROMIUM, launchChromium } = require("../support/chromium.js");
 
 const [studyDir, shotDir] = process.argv.slice(2);
-const CHROMIUM = process.env.LAMINA_CHROMIUM || "/usr/bin/chromium";
 let failures = 0, passes = 0;
 const check = (ok, what) => {
   if (ok) { passes++; console.log("ok   " + what); } else { failures++; console.log("FAIL " + what); }
@@ -24,17 +22,10 @@ async function main() {
     process.exit(1);
   }
   fs.mkdirSync(shotDir, { recursive: true });
-  const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), "lamina-chromium-"));
-  const context = await chromium.launchPersistentContext(userDataDir, {
-    executablePath: CHROMIUM,
-    headless: true,
-    args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-    viewport: { width: 1400, height: 1000 },
-  });
+  const browser = await launchChromium();
   const errors = [];
   try {
-    const page = context.pages()[0] || (await context.newPage());
+    const page = browser.page;
     page.on("console", (m) => { if (m.type() === "error") errors.push("console: " + m.text()); });
     page.on("pageerror", (e) => errors.push("page error: " + e.message));
     // Nothing may leave the machine: the page must work from file:// alone.
@@ -156,8 +147,7 @@ async function main() {
     await page.waitForFunction(() => Number(document.body.dataset.renders || 0) >= 1);
     check((await page.evaluate(() => document.body.dataset.config)) === target, "a reload keeps the configuration (#config=…)");
   } finally {
-    await context.close();
-    fs.rmSync(userDataDir, { recursive: true, force: true });
+    await browser.close();
   }
   for (const e of errors) console.log("FAIL " + e);
   check(errors.length === 0, "no console errors, page errors or network requests");

@@ -5,6 +5,7 @@
 #include "physics/conductor.h"
 #include "physics/dielectric.h"
 #include "physics/fresnel.h"
+#include "simulator/mueller.h"
 #include "support/adding_doubling.h"
 #include "support/closed_forms.h"
 #include "support/quadrature.h"
@@ -67,11 +68,14 @@ void expect_budget_closes(const SimulationResult& r) {
 }
 
 // §6.2: a Lambertian base alone reflects albedo/π in every direction; every particle leaves
-// with flux exactly ρ, so the reflected budget is ρ exactly.
-TEST_P(GoniophotometerStat, LambertianAlone) {
+// with flux exactly ρ, so the reflected budget is ρ exactly. It holds with polarization too (the
+// base depolarizes, and the flux is S0).
+void check_lambertian_alone(bool polarization) {
     const Rgbd albedo(0.8, 0.5, 0.2);
     const Stack stack = test::make_stack({test::lambertian_layer(albedo)});
-    const auto r = simulate(stack, settings({40}, 400'000, HemisphereGrid(9, 9)));
+    SimulationSettings s = settings({40}, 400'000, HemisphereGrid(9, 9));
+    s.transport.polarization = polarization;
+    const auto r = simulate(stack, s);
     expect_agreement(compare_lobe(
         r.table, 0, Side::Reflection, [&](std::size_t) { return albedo * kInvPi<double>; },
         400'000));
@@ -82,19 +86,27 @@ TEST_P(GoniophotometerStat, LambertianAlone) {
     }
     expect_budget_closes(r);
 }
+TEST_P(GoniophotometerStat, LambertianAlone) {
+    check_lambertian_alone(false);
+}
 
 // §6.3: smooth coat (η) over a Lambertian (ρ) with absorption τ between, all orders:
 //   f = ρ/(πη²) (1 − F(μi)) e^{−τ/μi'} (1 − F(μo)) e^{−τ/μo'} / (1 − ρ r),
 //   r = 2∫₀¹ F_inside(μ) e^{−2τ/μ} μ dμ (relative index 1/η, TIR → 1),
 // plus the mirror reflection F(μi) in the bin of the mirror direction. Its albedo is
 //   F(μi) + (1 − F(μi)) e^{−τ/μi'} ρ t / (1 − ρ r), t = 2∫₀¹ (1 − F_inside(μ)) e^{−τ/μ} μ dμ.
-TEST_P(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
+// With polarization the series still holds: light meets the coat unpolarized every time (from
+// outside, and from inside after the depolarizing base), where its reflectance is the mean of the
+// s and p reflectances, and the absorbing medium keeps the state.
+void check_smooth_coat_over_lambertian(bool polarization) {
     const double eta = 1.5, theta_i = 35.0;
     const Rgbd tau(0.1, 0.5, 0.0), rho(0.8, 0.5, 1.0);
     const Stack stack = test::make_stack(
         {test::with_medium(test::dielectric_layer(eta, 0.0), tau), test::lambertian_layer(rho)});
     const HemisphereGrid grid(18, 18);
-    const auto r = simulate(stack, settings({theta_i}, 1'000'000, grid));
+    SimulationSettings s = settings({theta_i}, 1'000'000, grid);
+    s.transport.polarization = polarization;
+    const auto r = simulate(stack, s);
 
     const test::CoatedLambertianSeries series(eta, tau, rho);
     const double mu_i = std::cos(deg_to_rad(theta_i));
@@ -119,6 +131,9 @@ TEST_P(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
     EXPECT_NEAR(b[BudgetTerm::Reflected][2] + b[BudgetTerm::CutOff][2], 1.0, 1e-9);
     EXPECT_LT(b[BudgetTerm::CutOff][2], 1e-9);
     expect_budget_closes(r);
+}
+TEST_P(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
+    check_smooth_coat_over_lambertian(false);
 }
 
 // §6.4: smooth slab of index η and absorption τ in air, with F = F(μi), a = e^{−τ/μi'}:
@@ -443,6 +458,56 @@ TEST_P(GoniophotometerStat, ScatteringSlabAgainstAddingDoubling) {
     expect_budget_closes(r);
 }
 
+// Thick media (docs/stack-format.md, "Ranges"): a white-paint-like layer of τs = 10⁴ (g 0.5, with
+// τa = 10: ω = 0.999) is semi-infinite for light (its diffusion length is ~20 optical depths), so
+// nothing is transmitted, and its R is adding–doubling's (37 doublings: a starting layer of
+// 7e-8, as the other tests'); the cost is bounded (events per particle ≤ --max-events) and what
+// the cap stops is reported as cut_off, here negligible (the absorption leaves ω^(10⁴) = e^−10 of
+// a walk that long). Without absorption (ω = 1) a walk can wander far longer: the cap then stops
+// a reported fraction of the flux (the rest is reflected, R + cut_off = 1, nothing transmitted),
+// and raising --max-events lowers it.
+TEST_P(GoniophotometerStat, ThickScatteringLayer) {
+    const test::AddingDoubling probe(1.0, 1.0, 0.0, 16);
+    const double theta_i = rad_to_deg(std::acos(probe.mu(4)));
+    const double tau_s = 1e4, tau_a = 10, g = 0.5;
+    const Stack absorbing = test::make_stack(
+        {test::with_medium(test::dielectric_layer(1.0, 0.0), Rgbd(tau_a), Rgbd(tau_s), Rgbd(g)),
+         test::dielectric_layer(1.0, 0.0)});
+    const auto r = simulate(absorbing, settings({theta_i}, 40'000, HemisphereGrid(9, 9)));
+    const test::AddingDoubling ad(tau_s + tau_a, tau_s / (tau_s + tau_a), g, 16, 37);
+    const EnergyBudget& b = r.incidences[0].budget;
+    for (int c = 0; c < 3; ++c) {
+        // The reference's own accuracy (as ScatteringSlabAgainstAddingDoubling's) is < 1e-5.
+        EXPECT_LT(std::abs(b[BudgetTerm::Reflected][c] - ad.albedo_reflected(4)),
+                  5 * b.reflected_se[c] + 1e-5)
+            << "R " << b[BudgetTerm::Reflected][c] << " ± " << b.reflected_se[c] << " vs "
+            << ad.albedo_reflected(4);
+        EXPECT_LT(ad.albedo_transmitted(4), 1e-12);
+        EXPECT_EQ(b[BudgetTerm::Transmitted][c], 0.0);
+        EXPECT_LT(b[BudgetTerm::CutOff][c], 1e-4);
+    }
+    EXPECT_LE(r.incidences[0].events_per_particle, 10'000.0);
+    EXPECT_GT(r.incidences[0].events_per_particle, 10.0);
+    expect_budget_closes(r);
+
+    const Stack white = test::make_stack(
+        {test::with_medium(test::dielectric_layer(1.0, 0.0), Rgbd(0.0), Rgbd(tau_s), Rgbd(0.0)),
+         test::dielectric_layer(1.0, 0.0)});
+    SimulationSettings s = settings({theta_i}, 4'000, HemisphereGrid(9, 9));
+    s.transport.max_events = 2'000;
+    const auto capped = simulate(white, s);
+    const EnergyBudget& bw = capped.incidences[0].budget;
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_GT(bw[BudgetTerm::CutOff][c], 0.0);
+        EXPECT_NEAR(bw[BudgetTerm::Reflected][c] + bw[BudgetTerm::CutOff][c], 1.0, 1e-6);
+        EXPECT_EQ(bw[BudgetTerm::Transmitted][c], 0.0);
+    }
+    EXPECT_LE(capped.incidences[0].events_per_particle, 2'000.0);
+    s.transport.max_events = 20'000;
+    const auto longer = simulate(white, s);
+    EXPECT_LT(longer.incidences[0].budget[BudgetTerm::CutOff][0], bw[BudgetTerm::CutOff][0]);
+}
+
 // The reference itself: conservative scattering (ω = 1) must give R + T = 1, and the thin slab
 // limit must match single scattering to first order.
 TEST(AddingDoublingReference, ConservesEnergy) {
@@ -683,6 +748,208 @@ TEST(Goniophotometer, BudgetClosesForLongTrappedPaths) {
         for (const IncidenceStats& st : r.incidences)
             for (int c = 0; c < 3; ++c)
                 EXPECT_NEAR(st.budget.sum()[c], 1.0, 1e-10) << enum_text(kernel);
+    }
+}
+
+// ---- Polarized transport (docs/physics.md §8, both kernels) ------------------------------------
+
+class PolarizationStat : public ::testing::TestWithParam<Kernel> {
+  protected:
+    void SetUp() override { g_kernel = GetParam(); }
+};
+INSTANTIATE_TEST_SUITE_P(Kernels, PolarizationStat, ::testing::Values(Kernel::Scalar, Kernel::Simd),
+                         kernel_test_name);
+
+SimulationSettings polarized(std::vector<double> theta_i, std::uint64_t n, HemisphereGrid grid,
+                             int incident = 0) {
+    SimulationSettings s = settings(std::move(theta_i), n, grid);
+    s.transport.polarization = true;
+    s.incident_polarization = incident;
+    return s;
+}
+
+// A smooth slab (§6.4) with polarization: s and p never mix (every event lies in the plane of
+// incidence), so the exact R and T are the means over s and p of the incoherent series
+// (support/closed_forms.h PolarizedSlab). η = 1.5 at 60° gives R = 0.151872, T = 0.848128, where
+// averaging s and p at every bounce (the unpolarized tracer) gives 0.163768 and 0.836232: the
+// difference is 20 standard errors here. Several indices, angles and absorptions.
+TEST_P(PolarizationStat, SmoothSlabStokesSums) {
+    const double mu60 = 0.5;
+    EXPECT_NEAR(test::PolarizedSlab(mu60, 1.5, 1.0).R, 0.151872, 1e-6);
+    EXPECT_NEAR(test::PolarizedSlab(mu60, 1.5, 1.0).T, 0.848128, 1e-6);
+    struct Case {
+        double eta;
+        Rgbd tau;
+        std::vector<double> theta_i;
+    };
+    for (const Case& k :
+         {Case{1.5, Rgbd(0.0, 0.2, 1.0), {45, 60, 75}}, Case{2.4, Rgbd(0.0, 0.0, 0.3), {30, 70}},
+          Case{1.33, Rgbd(0.0), {56, 85}}}) {
+        const Stack stack =
+            test::make_stack({test::with_medium(test::dielectric_layer(k.eta, 0.0), k.tau),
+                              test::dielectric_layer(1.0, 0.0)});
+        const auto r = simulate(stack, polarized(k.theta_i, 300'000, HemisphereGrid(18, 18)));
+        for (std::size_t i = 0; i < k.theta_i.size(); ++i) {
+            const double mu_i = std::cos(deg_to_rad(k.theta_i[i]));
+            const double mu_t = std::sqrt(1 - (1 - mu_i * mu_i) / (k.eta * k.eta));
+            const EnergyBudget& b = r.incidences[i].budget;
+            for (int c = 0; c < 3; ++c) {
+                const test::PolarizedSlab exact(mu_i, k.eta, std::exp(-k.tau[c] / mu_t));
+                SCOPED_TRACE(::testing::Message() << "η " << k.eta << " θi " << k.theta_i[i]);
+                expect_within_se(b[BudgetTerm::Reflected][c], exact.R, b.reflected_se[c], "R");
+                expect_within_se(b[BudgetTerm::Transmitted][c], exact.T, b.transmitted_se[c], "T");
+            }
+        }
+        expect_budget_closes(r);
+    }
+}
+
+// Brewster's angle (tan θB = η): p-polarized light is not reflected at all (R_p = 0: every
+// particle refracts), s-polarized light is reflected with R_s = ((1 − η²)/(1 + η²))² = 25/169 for
+// η = 1.5, and unpolarized light with R_s/2.
+TEST_P(PolarizationStat, BrewsterAngle) {
+    const Stack stack = test::make_stack({test::dielectric_layer(1.5, 0.0)});
+    const double theta_b = rad_to_deg(std::atan(1.5));
+    const double rs = 25.0 / 169.0;
+    const auto p_light = simulate(stack, polarized({theta_b}, 200'000, HemisphereGrid(9, 9), 4));
+    const auto s_light = simulate(stack, polarized({theta_b}, 200'000, HemisphereGrid(9, 9), 1));
+    const auto unpolarized = simulate(stack, polarized({theta_b}, 200'000, HemisphereGrid(9, 9)));
+    for (int c = 0; c < 3; ++c) {
+        // R_p is zero to the rounding of a − b in float (≤ 1e-7): no particle is reflected.
+        EXPECT_LT(p_light.incidences[0].budget[BudgetTerm::Reflected][c], 1e-6);
+        const EnergyBudget& bs = s_light.incidences[0].budget;
+        expect_within_se(bs[BudgetTerm::Reflected][c], rs, bs.reflected_se[c], "R_s");
+        const EnergyBudget& bu = unpolarized.incidences[0].budget;
+        expect_within_se(bu[BudgetTerm::Reflected][c], rs / 2, bu.reflected_se[c], "R_s/2");
+    }
+}
+
+// A smooth coat (η, absorption a per crossing) over a smooth conductor of per-channel index
+// (η_c + ik_c)/η relative to the coat, with the phases of every reflection (§6.5 polarized):
+// every event lies in the plane of incidence, each acts on the Stokes vector in the block form of
+// physics/polarization.h, so s and p intensities follow their own series
+//     I_x = R_x + (1 − R_x)² Rc_x a² / (1 − R_x Rc_x a²)   (x = s, p; the coat's R_x at μi, the
+//                                                          same inside at μi', Rc_x at μi')
+// and S2 + iS3 is multiplied by the complex series of the events' factors A* B (a Jones matrix
+// diag(A, B) multiplies S2 + iS3 = 2E_x* E_y by A* B):
+//     z = z_R + z_T z_C z_T' a² / (1 − z_R' z_C a²),
+// z_R = r_s* r_p of the coat from outside, z_R' from inside, z_C of the conductor (complex: its
+// phase), z_T, z_T' the flux factors times t_s t_p. For incident light (1, q, u, v): S0 =
+// ((1 + q) I_s + (1 − q) I_p)/2, S1 = ((1 + q) I_s − (1 − q) I_p)/2, S2 + iS3 = z (u + iv), all
+// in the mirror bin. Checked for unpolarized, s-polarized, +45° and circular incident light
+// (incident_polarization 0–3) at 20° and 60°, per channel (the conductor's colour makes the
+// channels' states differ: the per-channel states and the coat's reweighted branch choice).
+TEST_P(PolarizationStat, CoatOverMirrorConductorWithBothPhases) {
+    const double eta = 1.5;
+    const Rgbd tau(0.1, 0.3, 0.0), eta_c(0.143, 0.374, 1.442), k_c(3.983, 2.385, 1.603);
+    const Stack stack = test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), tau),
+                                          test::conductor_layer(eta_c, k_c, 0.0)});
+    const HemisphereGrid grid(18, 18);
+    const std::uint64_t n = 300'000;
+    constexpr double kIncident[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int state = 0; state < 4; ++state) {
+        SimulationSettings s = polarized({20, 60}, n, grid, state);
+        s.stokes_tallies = true;
+        const auto r = simulate(stack, s);
+        for (std::size_t i = 0; i < 2; ++i) {
+            const double mu_i = std::cos(deg_to_rad(r.settings.theta_i_deg[i]));
+            const double mu_t = std::sqrt(1 - (1 - mu_i * mu_i) / (eta * eta));
+            const test::PolarizedFresnel outer(mu_i, eta), inner(mu_t, 1 / eta);
+            const Vec3f wi_f(incident_direction(deg_to_rad(r.settings.theta_i_deg[i])));
+            const std::size_t mirror_bin = grid.bin_of(Vec3f(-wi_f.x, -wi_f.y, wi_f.z));
+            for (int c = 0; c < 3; ++c) {
+                SCOPED_TRACE(::testing::Message() << "state " << state << " θi "
+                                                  << r.settings.theta_i_deg[i] << " channel " << c);
+                const double a = std::exp(-tau[c] / mu_t);
+                const test::PolarizedFresnel cond(mu_t,
+                                                  std::complex<double>(eta_c[c], k_c[c]) / eta);
+                const double is = outer.Rs() + sqr(1 - outer.Rs()) * cond.Rs() * a * a /
+                                                   (1 - inner.Rs() * cond.Rs() * a * a);
+                const double ip = outer.Rp() + sqr(1 - outer.Rp()) * cond.Rp() * a * a /
+                                                   (1 - inner.Rp() * cond.Rp() * a * a);
+                const std::complex<double> z =
+                    outer.reflected_phase() +
+                    outer.transmitted_phase() * cond.reflected_phase() * inner.transmitted_phase() *
+                        a * a / (1.0 - inner.reflected_phase() * cond.reflected_phase() * a * a);
+                const double q = kIncident[state][0];
+                const std::complex<double> w =
+                    z * std::complex<double>(kIncident[state][1], kIncident[state][2]);
+                const double expected[4] = {((1 + q) * is + (1 - q) * ip) / 2,
+                                            ((1 + q) * is - (1 - q) * ip) / 2, w.real(), w.imag()};
+                const BinStokes got = bin_stokes(r.sums[i], mirror_bin, c, n);
+                for (int k = 0; k < 4; ++k) {
+                    const double se =
+                        std::sqrt(std::max(0.0, got.second[k] - sqr(got.upper[k])) / double(n - 1));
+                    expect_within_se(got.upper[k], expected[k], se, "S_k in the mirror bin");
+                    EXPECT_EQ(got.lower[k], 0.0);  // the mirror direction lies in the plane, y = 0
+                }
+                // The reflected budget is S0.
+                expect_within_se(r.incidences[i].budget[BudgetTerm::Reflected][c], expected[0],
+                                 r.incidences[i].budget.reflected_se[c], "R");
+            }
+        }
+        expect_budget_closes(r);
+    }
+}
+
+// Where the depolarizing base makes the unpolarized series exact, polarization must reproduce it.
+TEST_P(PolarizationStat, LambertianAlone) {
+    check_lambertian_alone(true);
+}
+TEST_P(PolarizationStat, SmoothCoatOverLambertianSeries) {
+    check_smooth_coat_over_lambertian(true);
+}
+
+// White furnace, polarized, with multiple scattering on the microsurfaces: every dielectric
+// event keeps the particle's flux (its branch probability is the state's reflected fraction, which
+// cancels it), a white Lambertian base keeps it, so R + T = 1 to rounding and nothing is lost.
+TEST_P(PolarizationStat, WhiteFurnaceLosesNothing) {
+    const std::vector<Stack> stacks = {
+        test::make_stack({test::dielectric_layer(1.5, 0.3), test::dielectric_layer(1.0, 0.5)}),
+        test::make_stack({test::dielectric_layer(1.5, 0.5), test::lambertian_layer(Rgbd(1.0))}),
+        test::make_stack({test::dielectric_layer(1.3, 0.2), test::dielectric_layer(1.7, 0.4),
+                          test::dielectric_layer(1.0, 0.1)}),
+        test::make_stack(
+            {test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.0), Rgbd(0.7), Rgbd(0.3)),
+             test::dielectric_layer(1.0, 0.6)}),
+    };
+    for (const Stack& stack : stacks) {
+        SimulationSettings s = polarized({0, 45, 80}, 100'000, HemisphereGrid(9, 9));
+        s.transport.microsurface = Microsurface::Multiple;
+        const auto r = simulate(stack, s);
+        for (const IncidenceStats& st : r.incidences) {
+            const EnergyBudget& b = st.budget;
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_NEAR(b[BudgetTerm::Reflected][c] + b[BudgetTerm::Transmitted][c], 1.0, 1e-6);
+                EXPECT_EQ(b[BudgetTerm::LostMicrosurface][c], 0.0);
+                EXPECT_EQ(b[BudgetTerm::CutOff][c], 0.0);
+            }
+            EXPECT_EQ(st.degenerate_samples, 0u);
+        }
+    }
+}
+
+// Polarized runs are bitwise reproducible for any thread count too, their Stokes tallies
+// included (a coloured rough conductor under a rough coat: one state per channel).
+TEST_P(Goniophotometer, PolarizedBitwiseIdenticalAcrossThreadCounts) {
+    const Stack stack =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1)),
+                          test::conductor_layer(Rgbd(0.2, 1.0, 1.45), Rgbd(3.0, 2.0, 0.01), 0.6)});
+    for (const Microsurface microsurface : {Microsurface::Single, Microsurface::Multiple}) {
+        SCOPED_TRACE(enum_text(microsurface));
+        SimulationSettings s = polarized({0, 60}, 50'000, HemisphereGrid(30, 30), 2);
+        s.stokes_tallies = true;
+        s.transport.microsurface = microsurface;
+        s.threads = 1;
+        const auto one = simulate(stack, s);
+        s.threads = 3;
+        const auto three = simulate(stack, s);
+        for (std::size_t i = 0; i < 2; ++i) {
+            EXPECT_EQ(one.table.lobe(i, Side::Reflection).f,
+                      three.table.lobe(i, Side::Reflection).f);
+            EXPECT_EQ(one.incidences[i].budget.term, three.incidences[i].budget.term);
+            EXPECT_TRUE(one.sums[i].stokes == three.sums[i].stokes);
+        }
     }
 }
 

@@ -9,6 +9,7 @@
 #include "physics/microfacet.h"
 #include "physics/microsurface_walk.h"
 #include "physics/phase.h"
+#include "physics/polarization.h"
 #include "simulator/goniophotometer.h"
 #include "support/chi2.h"
 #include "support/stacks.h"
@@ -243,6 +244,83 @@ TEST(KernelSimd, FresnelConductorLanes) {
                 worst, std::abs(double(r[j]) - fresnel_conductor(cos_theta[j], ik.eta, ik.k)));
         }
         EXPECT_LE(worst, 8 * 0x1p-24)
+            << "η " << ik.eta << " k " << ik.k << " on " << simd_target_name();
+    }
+}
+
+// The lane test of the polarized Fresnel terms (physics/polarization.h fresnel_dielectric_mueller
+// and fresnel_conductor_mueller, one template each): on the dispatched instruction set's vectors
+// against the scalar float instantiation, for dielectrics from both sides (total internal
+// reflection and the critical angle included) and conductors, random cosines and the edges. The
+// entries are sums of products of the amplitudes' parts divided by |D_s|²|D_p|² (no special
+// functions): the vectors fuse multiply-adds where the scalar code may not, so they agree to
+// 16 float ulps of 1 (entries lie in [−1, 1]; a handful of roundings in each product, doubled by
+// the division). Within 1e-3 of the critical angle (in sin²θt) the refracted cosine's square-root
+// singularity turns 4 ulp of sin²θt into √(4 · 2^-24) ≈ 5e-4 of cos θt, which every entry that
+// depends on it inherits times its slope (≤ 4): 2e-3 there; farther away the same 4 ulp of
+// δ = |1 − sin²θt| move cos θt = √δ by 4 ulp/(2√δ), again times a slope ≤ 4.
+double mueller_lane_bound(double delta) {
+    return 16 * 0x1p-24 + 4 * (4 * 0x1p-24) / (2 * std::sqrt(delta));
+}
+TEST(KernelSimd, FresnelMuellerLanes) {
+    ParticleRng rng(21, 0, 0);
+    for (const float eta : {1.5f, 1 / 1.5f, 1.f, 2.4f}) {
+        std::vector<float> cos_theta = {0.f, -0.f, 1.f, -1.f, 1e-7f, -1e-7f, 0.5f, -0.5f};
+        const float critical = std::sqrt(std::max(0.f, 1 - eta * eta));
+        for (const float d : {-1e-6f, 0.f, 1e-6f})
+            cos_theta.insert(cos_theta.end(), {critical + d, -critical - d});
+        for (int k = 0; k < 4000; ++k)
+            cos_theta.push_back(2 * rng.uniform_float() - 1);
+        const std::vector<float> lanes = simd_fresnel_mueller(0, cos_theta, eta, 0);
+        double worst = 0, worst_critical = 0;
+        for (std::size_t j = 0; j < cos_theta.size(); ++j) {
+            const DielectricMueller<float> m =
+                fresnel_dielectric_mueller(cos_theta[j], eta, 1 / eta);
+            const float scalar[9] = {m.reflection.a,   m.reflection.b,   m.reflection.c,
+                                     m.reflection.d,   m.transmission.a, m.transmission.b,
+                                     m.transmission.c, m.transmission.d, m.cos_theta_t};
+            const double mu = std::abs(double(cos_theta[j]));
+            const double crossed = cos_theta[j] < 0 ? 1 / double(eta) : double(eta);
+            const double delta = std::abs(1 - (1 - mu * mu) / (crossed * crossed));
+            const bool near_critical = delta < 1e-3;
+            for (int e = 0; e < 9; ++e) {
+                ASSERT_TRUE(std::isfinite(lanes[9 * j + e])) << cos_theta[j];
+                const double d = std::abs(double(lanes[9 * j + e]) - scalar[e]);
+                if (near_critical)
+                    worst_critical = std::max(worst_critical, d);
+                else
+                    worst = std::max(worst, d / mueller_lane_bound(delta));
+            }
+        }
+        EXPECT_LE(worst, 1.0) << "η " << eta << " on " << simd_target_name();  // of the bound
+        EXPECT_LE(worst_critical, 2e-3) << "η " << eta << " on " << simd_target_name();
+    }
+    struct Index {
+        float eta, k;
+    };
+    for (const Index ik :
+         {Index{0.143f, 3.983f}, Index{2.9f, 3.1f}, Index{1.5f, 0.01f}, Index{1 / 1.5f, 0.f}}) {
+        std::vector<float> cos_theta = {0.f, 1.f, 1e-7f, 0.5f, 1 - 1e-7f};
+        for (int j = 0; j < 4000; ++j)
+            cos_theta.push_back(rng.uniform_float());
+        const std::vector<float> lanes = simd_fresnel_mueller(1, cos_theta, ik.eta, ik.k);
+        double worst = 0;
+        for (std::size_t j = 0; j < cos_theta.size(); ++j) {
+            const InterfaceMueller<float> m = fresnel_conductor_mueller(cos_theta[j], ik.eta, ik.k);
+            const float scalar[4] = {m.a, m.b, m.c, m.d};
+            const double mu = double(cos_theta[j]);
+            // Without absorption (k = 0) the root u = √(η² − sin²θ) has the critical angle's
+            // singularity as a dielectric's; absorption keeps u away from 0.
+            const double delta =
+                ik.k == 0 ? std::abs(1 - (1 - mu * mu) / (double(ik.eta) * ik.eta)) : 1.0;
+            for (int e = 0; e < 4; ++e) {
+                ASSERT_TRUE(std::isfinite(lanes[4 * j + e])) << cos_theta[j];
+                if (delta >= 1e-3)
+                    worst = std::max(worst, std::abs(double(lanes[4 * j + e]) - scalar[e]) /
+                                                mueller_lane_bound(delta));
+            }
+        }
+        EXPECT_LE(worst, 1.0)  // of the bound
             << "η " << ik.eta << " k " << ik.k << " on " << simd_target_name();
     }
 }
@@ -629,6 +707,42 @@ TEST(KernelSimdStat, SameTablesAsScalarScatteringMediumSpectral) {
                                             Rgbd(0.5, 1.5, 0.8), Rgbd(0.6, -0.2, 0.3)),
                           test::lambertian_layer(Rgbd(0.6))}),
         {45}, 400'000);
+}
+
+// Polarized transport (docs/physics.md §8) on both kernels: a rough slab with multiple scattering
+// (one state for all channels, total internal reflection's retardance inside), a coloured rough
+// conductor under a rough coat (one state per channel: the conductor's Mueller matrices per
+// channel and the coat's reweighted branch choice) and a scattering medium (depolarizing HG
+// events) over a rough slab.
+void polarized_multiple(SimulationSettings& s) {
+    s.transport.polarization = true;
+    s.transport.microsurface = Microsurface::Multiple;
+}
+void polarized_single(SimulationSettings& s) {
+    s.transport.polarization = true;
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarPolarizedRoughSlab) {
+    expect_same_distribution(
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1, 0.0, 0.9)),
+                          test::dielectric_layer(1.0, 0.2)}),
+        {10, 70}, 1'000'000, {}, polarized_multiple);
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarPolarizedGoldUnderCoat) {
+    const Stack stack =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.1), Rgbd(0.1)),
+                          test::conductor_layer(Rgbd(0.2, 1.0, 1.45), Rgbd(3.0, 2.0, 0.01), 0.3)});
+    expect_same_distribution(stack, {30, 75}, 1'000'000, {}, polarized_multiple);
+    expect_same_distribution(stack, {50}, 1'000'000, {}, polarized_single);
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarPolarizedScatteringMedium) {
+    expect_same_distribution(
+        test::make_stack({test::with_medium(test::dielectric_layer(1.3, 0.1), Rgbd(0.05, 0.2, 0.0),
+                                            Rgbd(0.5, 1.5, 0.8), Rgbd(0.6, -0.2, 0.3)),
+                          test::dielectric_layer(1.0, 0.05)}),
+        {45}, 400'000, {}, polarized_single);
 }
 
 }  // namespace

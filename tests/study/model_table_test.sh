@@ -5,12 +5,7 @@
 set -u
 lamina=$1
 src=$2
-pass=0
-fails=0
-ok() { pass=$((pass + 1)); }
-fail() { echo "FAIL $*"; fails=$((fails + 1)); }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/../support/script_lib.sh"
 stack=$src/examples/plastic.json
 common=(--theta-i 0,60 --particles 4e4 --grid 18x18 --no-figures)
 
@@ -70,5 +65,4 @@ if "$lamina" study "${only[@]}" --model-table "mine=$tmp/tables/{id}.csv" --out 
 grep -q '^slab-a0.1-a1.3-clear,slab,mine,0,R,r,,,,,,,,,,false$' "$tmp/st/metrics.csv" \
     && ok || fail "configuration without a table is not supported"
 
-echo "model_table: $pass passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

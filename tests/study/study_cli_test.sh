@@ -4,12 +4,7 @@
 set -u
 lamina=$1
 src=$2
-pass=0
-fails=0
-ok() { pass=$((pass + 1)); }
-fail() { echo "FAIL $*"; fails=$((fails + 1)); }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/../support/script_lib.sh"
 
 tiny=(--only 'plastic-P1-a0.05,slab-a0.1-a1.3-clear' --models ww-prime,bel-prime
       --theta-i 0,60 --particles 4e4 --grid 18x18)
@@ -248,5 +243,4 @@ expect_error "model 'openpbr' has no option 'tint'" study --models openpbr:tint=
 python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['transmission_masking'] == 'pbrt'" \
     "$tmp/m/study.json" && ok || fail "study.json transmission_masking"
 
-echo "$pass passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

@@ -7,8 +7,52 @@
 #include "support/quadrature.h"
 
 #include <cmath>
+#include <complex>
 
 namespace lamina::test {
+
+/// Born & Wolf §1.5.2 (Eqs. 20–21) with a complex relative index n (§14.2), for tests of polarized
+/// transport, written here with std::complex independently of physics/polarization.h: the
+/// amplitude coefficients of light arriving at cos θi ∈ [0, 1] (cos θt the principal root,
+/// Im ≥ 0), the flux factor Re(n cos θt)/cos θi of the refracted beam (real n), the reflectances
+/// R_s = |r_s|², R_p = |r_p|², and the products that act on S2 + iS3 (docs/physics.md §8: a Jones
+/// matrix diag(A, B) multiplies S2 + iS3 = 2 E_x* E_y by A* B).
+struct PolarizedFresnel {
+    std::complex<double> rs, rp, ts, tp;
+    double flux_factor = 0;
+    double Rs() const { return std::norm(rs); }
+    double Rp() const { return std::norm(rp); }
+    std::complex<double> reflected_phase() const { return std::conj(rs) * rp; }
+    std::complex<double> transmitted_phase() const { return flux_factor * std::conj(ts) * tp; }
+
+    PolarizedFresnel(double cos_i, std::complex<double> n) {
+        const double sin2 = 1 - cos_i * cos_i;
+        const std::complex<double> cos_t = std::sqrt(1.0 - sin2 / (n * n));
+        rs = (cos_i - n * cos_t) / (cos_i + n * cos_t);
+        rp = (n * cos_i - cos_t) / (n * cos_i + cos_t);
+        ts = 2 * cos_i / (cos_i + n * cos_t);
+        tp = 2 * cos_i / (n * cos_i + cos_t);
+        flux_factor = (n * cos_t).real() / cos_i;
+    }
+};
+
+/// A smooth parallel stack keeps every event in one plane of incidence, so s- and p-polarized
+/// light never mix: the exact (polarized) reflectance and transmittance of a smooth slab of
+/// relative index η with one crossing's attenuation a, for unpolarized light, are the mean over s
+/// and p of the incoherent geometric series of docs/physics.md §6.4 with that polarization's
+/// Fresnel reflectance R_x at μi (the same at the inside angle):
+///     R = ½ Σ_x [R_x + (1 − R_x)² R_x a² / (1 − R_x² a²)],  T = ½ Σ_x (1 − R_x)² a / (1 − R_x²
+///     a²).
+struct PolarizedSlab {
+    double R = 0, T = 0;
+    PolarizedSlab(double mu_i, double eta, double a) {
+        const PolarizedFresnel f(mu_i, eta);
+        for (const double Rx : {f.Rs(), f.Rp()}) {
+            R += 0.5 * (Rx + (1 - Rx) * (1 - Rx) * Rx * a * a / (1 - Rx * Rx * a * a));
+            T += 0.5 * (1 - Rx) * (1 - Rx) * a / (1 - Rx * Rx * a * a);
+        }
+    }
+};
 
 /// §6.3: a smooth coat (index η) over a Lambertian (ρ) with absorption τ between, all orders of
 /// internal reflection:

@@ -56,6 +56,9 @@ double mean(const Rgbd& x) {
 
 }  // namespace
 
+// Kept in one piece (about 150 lines): Belcour 2018's adding of lobe statistics is one loop over
+// the operators whose steps (paper §4–6 and the author's code: the interface's statistics, the TIR
+// step, the adding sums, the medium) read best in the order the paper gives them.
 BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
                             const BelcourChoices& ch) {
     const FgdTable& fgd = FgdTable::get();
@@ -483,14 +486,9 @@ BelcourChoices belcour_variant(const std::string& variant) {
     return c;
 }
 
-std::vector<OptionSpec> belcour_options(const std::string& variant) {
-    return belcour_option_table().specs(belcour_variant(variant));
-}
-
-std::unique_ptr<Model> make_belcour(const std::string& variant, const Stack& stack,
-                                    const ModelOptions& options) {
-    return std::make_unique<BelcourModel>(
-        variant, stack, belcour_option_table().parse(options, belcour_variant(variant)));
+std::unique_ptr<Model> make_belcour_model(const std::string& name, const Stack& stack,
+                                          const BelcourChoices& choices) {
+    return std::make_unique<BelcourModel>(name, stack, choices);
 }
 
 }  // namespace lamina

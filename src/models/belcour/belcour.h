@@ -122,9 +122,8 @@ double belcour_alpha_of_variance(double sigma, bool quadratic);
 /// α ≤ 0 (a smooth lobe is a delta lobe).
 double ggx_lobe_shape(double alpha, const Vec3d& wi, const Vec3d& wo, const Vec3d& h);
 
-/// The registry's entry points of the variant `variant` (its name appears in support reasons).
-std::vector<OptionSpec> belcour_options(const std::string& variant);
-std::unique_ptr<Model> make_belcour(const std::string& variant, const Stack& stack,
-                                    const ModelOptions& options);
+/// A member of the family with `choices`; `name` appears in support reasons.
+std::unique_ptr<Model> make_belcour_model(const std::string& name, const Stack& stack,
+                                          const BelcourChoices& choices);
 
 }  // namespace lamina

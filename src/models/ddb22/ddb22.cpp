@@ -525,12 +525,9 @@ const ModelOptionTable<Ddb22Choices>& ddb22_option_table() {
     return table;
 }
 
-std::vector<OptionSpec> ddb22_options() {
-    return ddb22_option_table().specs({});
-}
-
-std::unique_ptr<Model> make_ddb22(const Stack& stack, const ModelOptions& options) {
-    return std::make_unique<Ddb22>(stack, ddb22_option_table().parse(options));
+std::unique_ptr<Model> make_ddb22_model(const std::string&, const Stack& stack,
+                                        const Ddb22Choices& choices) {
+    return std::make_unique<Ddb22>(stack, choices);
 }
 
 }  // namespace lamina

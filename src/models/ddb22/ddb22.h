@@ -109,8 +109,8 @@ bool ddb22_stack(const Stack& stack, const Ddb22Choices& choices, Ddb22Stack& ou
 /// coat's T01(μ) a(μ') for one coat, Bel18's transmitted energy of the coats for several.
 Rgbd ddb22_transmittance_down(const Ddb22Stack& s, double mu);
 
-/// The registry's entry points.
-std::vector<OptionSpec> ddb22_options();
-std::unique_ptr<Model> make_ddb22(const Stack& stack, const ModelOptions& options);
+/// The model with `choices` (the registry's; `name` is its registry name).
+std::unique_ptr<Model> make_ddb22_model(const std::string& name, const Stack& stack,
+                                        const Ddb22Choices& choices);
 
 }  // namespace lamina

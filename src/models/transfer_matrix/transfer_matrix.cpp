@@ -364,6 +364,9 @@ bool index_matched(const TmComponent& k) {
     return k.kind == TmComponent::Dielectric && std::abs(k.eta - 1) < 1e-5;
 }
 
+// Kept in one piece (about 170 lines): it is the released code's scheme, one pass over the
+// components with the cumulative matrices, the TIR steps and the lobes in the order that code
+// forms them, and reads best side by side with it (docs/models.md, "Transfer matrices").
 template <bool kSix>
 TmLobes run_scheme(const std::vector<TmComponent>& comps, double c0, const TmChoices& ch) {
     TmLobes out;
@@ -977,11 +980,11 @@ const ModelOptionTable<TmChoices>& tm6_option_table() {
     return table;
 }
 
+}  // namespace
+
 const ModelOptionTable<TmChoices>& tm_option_table(const std::string& variant) {
     return variant == "tm6" ? tm6_option_table() : tm2_option_table();
 }
-
-}  // namespace
 
 TmChoices tm_variant(const std::string& variant) {
     TmChoices c;
@@ -1001,14 +1004,9 @@ TmChoices tm_variant(const std::string& variant) {
     return c;
 }
 
-std::vector<OptionSpec> tm_options(const std::string& variant) {
-    return tm_option_table(variant).specs(tm_variant(variant));
-}
-
-std::unique_ptr<Model> make_tm(const std::string& variant, const Stack& stack,
-                               const ModelOptions& options) {
-    return std::make_unique<TmModel>(variant, stack,
-                                     tm_option_table(variant).parse(options, tm_variant(variant)));
+std::unique_ptr<Model> make_tm_model(const std::string& name, const Stack& stack,
+                                     const TmChoices& choices) {
+    return std::make_unique<TmModel>(name, stack, choices);
 }
 
 }  // namespace lamina

@@ -173,10 +173,11 @@ int tm_lobe_count(const std::vector<TmComponent>& components, bool six_flux);
 
 /// The defaults of a variant: "tm2" or "tm6" (a programming error otherwise).
 TmChoices tm_variant(const std::string& variant);
-/// The registry's entry points of the variant `variant` (tm2 and tm6 have their own flags: tm6's
-/// media scatter, and its released code normalizes lobes and fits the back-scattering).
-std::vector<OptionSpec> tm_options(const std::string& variant);
-std::unique_ptr<Model> make_tm(const std::string& variant, const Stack& stack,
-                               const ModelOptions& options);
+/// The flags of a variant: tm2's, or tm6's (its media scatter, and its released code normalizes
+/// lobes and fits the back-scattering).
+const ModelOptionTable<TmChoices>& tm_option_table(const std::string& variant);
+/// A member of the family with `choices`; `name` appears in support reasons.
+std::unique_ptr<Model> make_tm_model(const std::string& name, const Stack& stack,
+                                     const TmChoices& choices);
 
 }  // namespace lamina

@@ -335,14 +335,9 @@ WWChoices ww_variant(const std::string& variant) {
     return c;
 }
 
-std::vector<OptionSpec> ww_options(const std::string& variant) {
-    return ww_option_table().specs(ww_variant(variant));
-}
-
-std::unique_ptr<Model> make_ww(const std::string& variant, const Stack& stack,
-                               const ModelOptions& options) {
-    return std::make_unique<WWModel>(variant, stack,
-                                     ww_option_table().parse(options, ww_variant(variant)));
+std::unique_ptr<Model> make_ww_model(const std::string& name, const Stack& stack,
+                                     const WWChoices& choices) {
+    return std::make_unique<WWModel>(name, stack, choices);
 }
 
 }  // namespace lamina

@@ -36,9 +36,8 @@ const ModelOptionTable<WWChoices>& ww_option_table();
 /// The defaults of a variant: "ww09", "ele10" or "ww-prime" (a programming error otherwise).
 WWChoices ww_variant(const std::string& variant);
 
-/// The registry's entry points of the variant `variant` (its name appears in support reasons).
-std::vector<OptionSpec> ww_options(const std::string& variant);
-std::unique_ptr<Model> make_ww(const std::string& variant, const Stack& stack,
-                               const ModelOptions& options);
+/// A member of the family with `choices`; `name` appears in support reasons.
+std::unique_ptr<Model> make_ww_model(const std::string& name, const Stack& stack,
+                                     const WWChoices& choices);
 
 }  // namespace lamina

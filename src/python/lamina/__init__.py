@@ -100,12 +100,13 @@ def _stderr_is_terminal():
         return False
 
 
-def export(source, path, format=None, theta_i=None, resolution=32, description=""):
+def export(source, path, format=None, theta_i=None, resolution=None, description=""):
     """Writes a Model, a Table or a SimulationResult (its reflection side) as an RGL .bsdf
     (pbrt-v4, Mitsuba 3) or a MERL .binary file, as `lamina export` does (docs/formats.md).
 
     format: "bsdf" or "merl" (default: from the path's extension). theta_i: a model's .bsdf
-    incidences in degrees (default 0..88 by 4; a table's are its own).
+    incidences in degrees (default: lamina export's, denser towards grazing; a table's are its
+    own). resolution: the .bsdf's sample nodes a side (default: lamina export's).
     """
     path = Path(path)
     if format is None:
@@ -116,7 +117,7 @@ def export(source, path, format=None, theta_i=None, resolution=32, description="
     if isinstance(source, SimulationResult):
         source = source.table
     _lamina._export(source, str(path), format, [float(t) for t in (theta_i or [])],
-                    int(resolution), str(description))
+                    None if resolution is None else int(resolution), str(description))
 
 
 # ---- study directories ------------------------------------------------------------------------

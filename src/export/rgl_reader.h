@@ -1,0 +1,49 @@
+#pragma once
+// An RGL .bsdf file evaluated as pbrt-v4's MeasuredBxDF and Mitsuba 3's `measured` plugin
+// evaluate it (docs/formats.md, "Exports"), so that `lamina export --check` can say how close a
+// renderer gets to the file's source.
+//
+// With ωi the direction that parameterizes the tables (pbrt-v4's wo, Mitsuba 3's wi) and ωo the
+// other, ωm = (ωi + ωo)/|ωi + ωo|:
+//   f(ωi, ωo) |cos θo| = S(s) D(u(ωm)) / (4 σ(u(ωi))),
+// u(ωm) with φm taken relative to φi (isotropic files); s = the inverse of the VNDF warp at u(ωm),
+// the warps of the two incidence nodes around θi blended by interpolating their masses (as the
+// readers' PiecewiseLinear2D / Marginal2D do: bilinear_warp.h, BilinearWarp::masses); S bilinear
+// in s and linear between the two incidences; θi past the last node reads the last node. Both
+// readers divide by |cos θo|, the cosine of the direction that does NOT parameterize the tables.
+//
+// The colour is read from the spectra at 450, 550 and 650 nm, where lamina's upsampling of RGB
+// puts blue, green and red exactly (a spectral renderer interpolates the same values), or from an
+// `rgb` field when there is one. Only isotropic files (one or two φi slices).
+
+#include "core/rgb.h"
+#include "core/vec.h"
+#include "export/bilinear_warp.h"
+#include "export/tensor_file.h"
+
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+class RglReader {
+  public:
+    /// A file check_rgl_bsdf accepts, with at most two φi slices and spectra at 450, 550 and
+    /// 650 nm (or an `rgb` field); InputError naming `where` and the field otherwise.
+    RglReader(const TensorFile& file, const std::string& where);
+
+    /// f(ωi, ωo) in 1/sr, cosine excluded, as a renderer reads it; 0 unless both are above the
+    /// surface. Thread-safe.
+    Rgbd eval(const Vec3d& wi, const Vec3d& wo) const;
+
+    /// The incidence nodes (degrees).
+    std::vector<double> theta_i_deg() const;
+
+  private:
+    std::vector<double> theta_nodes_;       ///< radians
+    std::vector<float> ndf_, sigma_, rgb_;  ///< rgb_: [incidence, channel, s_y, s_x]
+    std::size_t ndf_nx_, ndf_ny_, sigma_nx_, sigma_ny_, s_nx_, s_ny_, vndf_nx_, vndf_ny_;
+    std::vector<BilinearWarp> vndf_;  ///< one per incidence (the first φi slice)
+};
+
+}  // namespace lamina
