@@ -115,6 +115,10 @@ class Bsdf {
     std::optional<Sample> sample(const Vec3& wi, const Vec3& u) const;
     double pdf(const Vec3& wi, const Vec3& wo) const;
 
+    /// The state the GLSL form of eval reads (lamina1/gpu.h documents the layout and what it
+    /// covers), or why this material is not one it covers (the vector then empty).
+    std::vector<float> gpu_state(std::string* why = nullptr) const;
+
   private:
     // Construction (lamina1/coat.h, media.h, slab.h).
     void precompute();

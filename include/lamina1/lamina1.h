@@ -27,6 +27,7 @@
 #include "lamina1/bsdf.h"
 #include "lamina1/coat.h"
 #include "lamina1/eval.h"
+#include "lamina1/gpu.h"
 #include "lamina1/media.h"
 #include "lamina1/sampling.h"
 #include "lamina1/slab.h"

@@ -175,6 +175,16 @@ std::string lamina1_tables_file() {
     return make_tables(lamina1::Masking::Walter, true, true).serialize();
 }
 
+std::vector<float> lamina1_gpu_state(const Stack& stack, const ModelOptions& options,
+                                     std::string& why) {
+    const Lamina1Choices choices = lamina1_option_table().parse(options);
+    lamina1::Layers layers;
+    if (!lamina1_layers(stack, layers, why)) return {};
+    const lamina1::Bsdf bsdf(layers, lamina1_tables(choices.masking, choices.multiple_scattering),
+                             choices);
+    return bsdf.gpu_state(&why);
+}
+
 std::unique_ptr<Model> make_lamina1(const Stack& stack, const ModelOptions& options) {
     return std::make_unique<Lamina1>(stack, lamina1_option_table().parse(options));
 }

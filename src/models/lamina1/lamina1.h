@@ -34,6 +34,11 @@ const lamina1::Tables& lamina1_tables(lamina1::Masking masking, bool multiple);
 /// every table, both maskings, the FGD table as its bins.
 std::string lamina1_tables_file();
 
+/// The state of lamina-1's GLSL form for this stack and these flags (include/lamina1/gpu.h), or
+/// nothing and why (a stack it does not cover).
+std::vector<float> lamina1_gpu_state(const Stack& stack, const ModelOptions& options,
+                                     std::string& why);
+
 /// A stack of the coated shape (coated_stack) as lamina-1's layers; false and why otherwise.
 bool lamina1_layers(const Stack& stack, lamina1::Layers& layers, std::string& why);
 
