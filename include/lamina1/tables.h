@@ -137,6 +137,17 @@ class Tables {
             if (type > 3 || n > (bytes.size() - at) / size) return fail("truncated: " + name);
             const char* data = bytes.data() + at;
             at += n * size;
+            // Each known section has one element type (the reads below copy n elements of it);
+            // a section this reader does not know is skipped.
+            const bool known = name == "axes" || name == "fgd-offset" || name == "fgd-w" ||
+                               name == "fgd-x" || name == "slope-sum" ||
+                               name == "multiple-scattering" || name == "transmittance-smith" ||
+                               name == "transmittance-walter";
+            const std::uint32_t expected = name == "axes"                       ? 3
+                                           : name == "fgd-offset"               ? 2
+                                           : name == "fgd-w" || name == "fgd-x" ? 1
+                                                                                : 0;
+            if (known && type != expected) return fail("element type of " + name);
             if (name == "axes") {
                 axes.assign(data, n);
             } else if (name == "transmittance-smith" || name == "transmittance-walter") {

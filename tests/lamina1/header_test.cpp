@@ -102,6 +102,12 @@ TEST(Lamina1Header, DamagedDataFileIsRefused) {
     other_version[16] = 9;
     EXPECT_FALSE(t.deserialize(other_version, &error));
     EXPECT_NE(error.find("version"), std::string::npos) << error;
+    // A section whose element type is not its own (here the axes' text declared as doubles,
+    // which would read eight bytes an element): refused before anything is read.
+    std::string other_type = bytes;
+    other_type[24 + 24] = 1;  // the first section (axes): its type field after the 24-byte name
+    EXPECT_FALSE(t.deserialize(other_type, &error));
+    EXPECT_EQ(error, "element type of axes") << error;
 }
 
 }  // namespace
