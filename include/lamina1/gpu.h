@@ -3,12 +3,15 @@
 // and scalars eval reads, packed as float32 for a texture; the GLSL is eval_with's reflection
 // line for line (lamina1/eval.h), so every curve is interpolated there as here.
 //
-// Covered: the reflection (wo.z > 0) of a coat, rough or smooth (its delta lobes are not in
+// Covered by eval: the reflection (wo.z > 0) of a coat, rough or smooth (its delta lobes are not in
 // eval), with an absorbing medium, over a Lambertian, conductor or dielectric base, with the
 // default choices or any of spread, first-order-lobe, eta2-factor, inside-exit,
 // lobe-normalization, inter-reflection and directional-transmittance. Not covered (gpu_state
 // says why and returns nothing): scattering media, the multiple-scattering orders and a slab's
-// transmission (the GLSL returns 0 for wo.z < 0).
+// transmission (the GLSL returns 0 for wo.z < 0). Covered by sample and pdf: the same but slabs
+// (their mixture holds the transmission's lobes); the base lobe's weight in the mixture reads the
+// base's mean albedo from a curve (kGpuBaseAlbedo), so the GLSL pdf is the C++ one to that
+// curve's interpolation, and equal to the GLSL sample's own density.
 //
 // Layout (kGpu* below): kGpuScalars scalars, then the curves at fixed offsets, then the generic
 // slope-sum table (lamina1/table_lookups.h, SlopeSumFormat) at kGpuSlopeSum; kGpuSize floats in
@@ -31,10 +34,11 @@ constexpr int kGpuLobeNorm = kGpuX + 3 * kNx;              // 1/√N(μ'): kNnor
 constexpr int kGpuMirrorSeries = kGpuLobeNorm + kNnorm;    // kNmu × RGB
 constexpr int kGpuEntering = kGpuMirrorSeries + 3 * kNmu;  // sin δ, cos δ, weight: 3 × 129
 constexpr int kGpuLeaving = kGpuEntering + 3 * FacetDeflection::kN;
+constexpr int kGpuBaseAlbedo = kGpuLeaving + 3 * FacetDeflection::kN;  // Ē_b(μ'): kNmu
 constexpr int kGpuSlopeSum = 1536;
 constexpr int kGpuSize =
     kGpuSlopeSum + SlopeSumFormat::kNx * SlopeSumFormat::kNy * SlopeSumFormat::kNu;
-static_assert(kGpuLeaving + 3 * FacetDeflection::kN <= kGpuSlopeSum, "the curves overlap");
+static_assert(kGpuBaseAlbedo + kNmu <= kGpuSlopeSum, "the curves overlap");
 
 /// Bits of the flags scalar (index 0).
 enum GpuFlag : unsigned {
@@ -52,6 +56,7 @@ enum GpuFlag : unsigned {
     kGpuTTopInExact = 1u << 11,
     kGpuSpreadNormal = 1u << 12,
     kGpuSpreadOff = 1u << 13,
+    kGpuSampling = 1u << 14,  ///< lamina1_sample and lamina1_pdf cover it (not a slab)
 };
 
 inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
@@ -79,6 +84,7 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     flag(T_top_in_.exact, kGpuTTopInExact);
     flag(ch_.spread == Options::Spread::Normal, kGpuSpreadNormal);
     flag(ch_.spread == Options::Spread::Off, kGpuSpreadOff);
+    flag(!support_.btdf, kGpuSampling);
     v[0] = float(flags);  // exact in float32 (fewer than 2^24)
     v[1] = float(int(layers_.base));
     v[2] = float(eta0_);
@@ -100,6 +106,8 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     v[28] = float(T_top_in_.eta);
     v[29] = float(entering_.g_max);
     v[30] = float(leaving_.g_max);
+    for (int c = 0; c < 3; ++c)
+        v[31 + c] = float(X_bar_[c]);
     for (int i = 0; i < kNmu; ++i) {
         v[kGpuTTop + i] = float(T_top_.curve.below[i]);
         v[kGpuTTop + kNmu + i] = float(T_top_.curve.above[i]);
@@ -108,6 +116,10 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
         for (int c = 0; c < 3; ++c)
             v[kGpuMirrorSeries + 3 * i + c] = float(mirror_series_curve_.v[i][c]);
     }
+    // The sampler's mixture weighs the base lobe by the base's mean albedo at the inside cosine:
+    // a curve over μ' = s² (the FGD lookups it stands for stay in C++).
+    for (int i = 0; i < kNmu; ++i)
+        v[kGpuBaseAlbedo + i] = float(base_albedo(sqr(double(i) / (kNmu - 1))).mean());
     for (int i = 0; i < kNx; ++i)
         for (int c = 0; c < 3; ++c)
             v[kGpuX + 3 * i + c] = float(X_.v[i][c]);

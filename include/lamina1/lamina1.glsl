@@ -4,7 +4,9 @@
 // texture 256 texels wide, `lamina1_state` (no filtering: texelFetch). Conventions as the C++:
 // the local frame, z the macro normal; wi where the light arrives from (wi.z > 0), wo where it
 // leaves to; lamina1_eval returns f in 1/sr, RGB, without the cosine (0 for wo.z <= 0: a slab's
-// transmission is not in this form). Include it after declaring
+// transmission is not in this form). lamina1_sample and lamina1_pdf are Bsdf::sample and pdf
+// (lamina1/sampling.h) for the materials whose state has the sampling flag (not slabs). Include
+// it after declaring
 //   uniform highp sampler2D lamina1_state;
 // lamina's docs/models.md, "lamina-1", derives every term; docs/lamina1.md shows the use.
 
@@ -14,6 +16,7 @@ const int L1_NMU = 65, L1_NX = 33, L1_NNORM = 17, L1_NFACET = 129;
 const int L1_T_TOP = 64, L1_T_TOP_IN = L1_T_TOP + 2 * L1_NMU, L1_X = L1_T_TOP_IN + 2 * L1_NMU;
 const int L1_LOBE_NORM = L1_X + 3 * L1_NX, L1_MIRROR = L1_LOBE_NORM + L1_NNORM;
 const int L1_ENTERING = L1_MIRROR + 3 * L1_NMU, L1_LEAVING = L1_ENTERING + 3 * L1_NFACET;
+const int L1_BASE_ALBEDO = L1_LEAVING + 3 * L1_NFACET;
 const int L1_SLOPE_SUM = 1536, L1_SS_NX = 25, L1_SS_NY = 13, L1_SS_NU = 33;
 
 float l1_at(int i) { return texelFetch(lamina1_state, ivec2(i % 256, i / 256), 0).r; }
@@ -244,4 +247,152 @@ vec3 lamina1_eval(vec3 wi, vec3 wo) {
     f += fb * (a * a_o) * rounds * (T_pair * T_o * eta2);
     if (l1_flag(2)) f += X * l1_x_at(wo.z) * l1_rgb(19) * (L1_INV_PI * inv_eta0 * inv_eta0);
     return f;
+}
+
+// ---- Sampling (lamina1/sampling.h: the mixture of the lobes, each drawn by its own rule) ----
+
+// D_w(wm) = G1(w) max(0, w·wm) D(wm) / cos θ (Heitz 2014, Eq. 38), w above.
+float l1_d_visible(float alpha, vec3 w, vec3 m) {
+    float c = dot(w, m);
+    if (c <= 0.0 || w.z <= 0.0) return 0.0;
+    return c * l1_ggx_d(alpha, m) / ((1.0 + l1_lambda(alpha, w)) * w.z);
+}
+// cos φ and sin φ to float precision: the built-in cos and sin may be coarse (SwiftShader's, the
+// WebGL of headless Chromium, are off by up to 1.9e-4, which near the horizon turns a drawn
+// direction by 2e-3). φ reduced by quarter turns to |r| ≤ π/4, then Taylor to r⁹ (error < 3e-9).
+void l1_cos_sin(float phi, out float c, out float s) {
+    float k = floor(phi / (0.5 * L1_PI) + 0.5);
+    float r = phi - k * (0.5 * L1_PI), r2 = r * r;
+    float sr = r * (1.0 - r2 / 6.0 * (1.0 - r2 / 20.0 * (1.0 - r2 / 42.0 * (1.0 - r2 / 72.0))));
+    float cr = 1.0 - r2 / 2.0 * (1.0 - r2 / 12.0 * (1.0 - r2 / 30.0 * (1.0 - r2 / 56.0)));
+    int q = int(k) & 3;
+    c = q == 0 ? cr : q == 1 ? -sr : q == 2 ? -cr : sr;
+    s = q == 0 ? sr : q == 1 ? cr : q == 2 ? -sr : -cr;
+}
+
+// A visible normal of w from (u1, u2) (Heitz 2018, "Sampling the GGX distribution of visible
+// normals", JCGT 7(4), Listing 1), as GGX::sample_visible_normal.
+vec3 l1_sample_visible_normal(float alpha, vec3 w, float u1, float u2) {
+    vec3 vh = normalize(vec3(alpha * w.x, alpha * w.y, w.z));
+    float len2 = vh.x * vh.x + vh.y * vh.y;
+    vec3 t1 = len2 > 0.0 ? vec3(-vh.y, vh.x, 0.0) / sqrt(len2) : vec3(1.0, 0.0, 0.0);
+    vec3 t2 = cross(vh, t1);
+    float s = 0.5 * (1.0 + vh.z), r = sqrt(u1), cos_phi, sin_phi;
+    l1_cos_sin(2.0 * L1_PI * u2, cos_phi, sin_phi);
+    float p1 = r * cos_phi;
+    float p2 = (1.0 - s) * sqrt(max(1.0 - p1 * p1, 0.0)) + s * (r * sin_phi);
+    vec3 nh = t1 * p1 + t2 * p2 + vh * sqrt(max(1.0 - p1 * p1 - p2 * p2, 0.0));
+    return normalize(vec3(alpha * nh.x, alpha * nh.y, max(nh.z, 0.0)));
+}
+// A cosine-distributed direction (Shirley & Chiu 1997's concentric disk, lifted).
+vec3 l1_sample_cosine(float u1, float u2) {
+    float a = 2.0 * u1 - 1.0, b = 2.0 * u2 - 1.0, x = 0.0, y = 0.0;
+    if (a != 0.0 || b != 0.0) {
+        float r, phi;
+        if (abs(a) > abs(b)) {
+            r = a;
+            phi = (L1_PI / 4.0) * (b / a);
+        } else {
+            r = b;
+            phi = L1_PI / 2.0 - (L1_PI / 4.0) * (a / b);
+        }
+        float c, sn;
+        l1_cos_sin(phi, c, sn);
+        x = r * c;
+        y = r * sn;
+    }
+    return vec3(x, y, sqrt(max(1.0 - x * x - y * y, 0.0)));
+}
+float l1_mean(vec3 v) { return (v.r + v.g + v.b) / 3.0; }
+
+// The mixture at wi (Bsdf::mixture): the lobes' probabilities (top reflection, base lobe,
+// separable series) and the base lobe's roughness; false where nothing can be drawn.
+bool l1_mixture(vec3 wi, out vec3 p, out float alpha_base, out vec3 wi_in) {
+    p = vec3(0.0);
+    alpha_base = 0.0;
+    wi_in = l1_refract_in(wi);
+    if (!l1_flag(14) || wi.z <= 0.0 || !(wi_in.z > 0.0)) return false;
+    float alpha0 = l1_at(4), alpha1 = l1_at(5);
+    float a = l1_mean(l1_attenuation(wi_in.z)), T = l1_transmittance(0, wi.z);
+    if (alpha0 > 0.0) p.x = l1_fresnel_dielectric(wi.z, l1_at(2));
+    float E_b = int(l1_at(1)) == 0 ? l1_mean(l1_rgb(10))
+                                   : l1_cosine_curve(L1_BASE_ALBEDO, L1_NMU, 1, 0, wi_in.z);
+    if (int(l1_at(1)) == 0) {
+        p.y = T * a * E_b;
+    } else {
+        float k = l1_spread_factor(wi.z, wi_in.z);
+        alpha_base = l1_flag(13) ? alpha1 : sqrt(alpha1 * alpha1 + 0.5 * alpha0 * alpha0 * k * k);
+        if (alpha_base > 0.0) p.y = T * a * E_b;
+    }
+    if (l1_flag(2)) p.z = l1_mean(l1_x_at(wi.z) * l1_rgb(19) * l1_rgb(31));
+    float total = p.x + p.y + p.z;
+    if (!(total > 0.0)) return false;
+    p /= total;
+    return true;
+}
+
+float l1_pdf_with(vec3 wi, vec3 p, float alpha_base, vec3 wi_in, vec3 wo) {
+    if (wo.z <= 0.0) return 0.0;
+    float pdf = 0.0;
+    if (p.x > 0.0) {
+        vec3 h = normalize(wi + wo);
+        pdf += p.x * l1_d_visible(l1_at(4), wi, h) / (4.0 * abs(dot(wo, h)));
+    }
+    if (p.y > 0.0) {
+        if (int(l1_at(1)) == 0) {
+            pdf += p.y * wo.z * L1_INV_PI;
+        } else {
+            vec3 wo_in = l1_refract_in(wo);
+            if (wo_in.z > 0.0) {
+                vec3 h = normalize(wi_in + wo_in);
+                float pdf_in = l1_d_visible(alpha_base, wi_in, h) / (4.0 * abs(dot(wo_in, h)));
+                pdf += p.y * pdf_in * wo.z / (l1_sqr(l1_at(2)) * wo_in.z);
+            }
+        }
+    }
+    if (p.z > 0.0) pdf += p.z * wo.z * L1_INV_PI;
+    return pdf;
+}
+
+// The density (solid angle) of lamina1_sample's wo for light from wi.
+float lamina1_pdf(vec3 wi, vec3 wo) {
+    vec3 p, wi_in;
+    float alpha_base;
+    if (!l1_mixture(wi, p, alpha_base, wi_in)) return 0.0;
+    return l1_pdf_with(wi, p, alpha_base, wi_in, wo);
+}
+
+// Draws wo for light from wi from three uniforms in [0, 1): true with wo, its density pdf and
+// the weight f |cos θo| / pdf; false where the draw fails (as Bsdf::sample's nothing).
+bool lamina1_sample(vec3 wi, vec3 u, out vec3 wo, out float pdf, out vec3 weight) {
+    wo = vec3(0.0);
+    pdf = 0.0;
+    weight = vec3(0.0);
+    vec3 p, wi_in;
+    float alpha_base;
+    if (!l1_mixture(wi, p, alpha_base, wi_in)) return false;
+    float eta0 = l1_at(2);
+    if (u.x < p.x) {
+        vec3 m = l1_sample_visible_normal(l1_at(4), wi, u.y, u.z);
+        wo = 2.0 * dot(wi, m) * m - wi;
+    } else if (u.x < p.x + p.y) {
+        if (int(l1_at(1)) == 0) {
+            wo = l1_sample_cosine(u.y, u.z);
+        } else {
+            vec3 m = l1_sample_visible_normal(alpha_base, wi_in, u.y, u.z);
+            vec3 wo_in = 2.0 * dot(wi_in, m) * m - wi_in;
+            float s2 = eta0 * eta0 * (1.0 - wo_in.z * wo_in.z);
+            if (wo_in.z <= 0.0 || s2 >= 1.0) return false;
+            wo = vec3(wo_in.x * eta0, wo_in.y * eta0, sqrt(1.0 - s2));
+        }
+    } else if (p.z > 0.0) {
+        wo = l1_sample_cosine(u.y, u.z);
+    } else {
+        return false;
+    }
+    if (wo.z <= 0.0) return false;
+    pdf = l1_pdf_with(wi, p, alpha_base, wi_in, wo);
+    if (!(pdf > 0.0)) return false;
+    weight = lamina1_eval(wi, wo) * (wo.z / pdf);
+    return true;
 }

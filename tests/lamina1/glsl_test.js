@@ -27,6 +27,43 @@ function direction(thetaDeg, phiDeg) {
   return [Math.sin(t) * Math.cos(p), Math.sin(t) * Math.sin(p), Math.cos(t)];
 }
 
+// The GLSL sampler against the C++ one (sampling.csv: pdf at wo; the sample drawn from u, its
+// validity, direction and density): pdf to PDF_TOL relative (the mixture's base-lobe weight reads
+// an interpolated curve on the GPU, the FGD table in C++), the same lobe and direction (to 1e-4)
+// wherever u is not within 1e-3 of a lobe boundary, and each GLSL sample's density equal to the
+// GLSL pdf at its direction (1e-5: the sampler and pdf agree, as a renderer needs). The directions
+// hold to 1e-4 because the GLSL computes its own cos and sin (SwiftShader's are off by 1.9e-4).
+const PDF_TOL = 1e-3;
+function checkSampling(name, rows, pdfs, samples) {
+  let worstPdf = 0, worstDir = 0, worstSelf = 0, compared = 0, skipped = 0, bad = 0;
+  rows.forEach((r, i) => {
+    const pdf = pdfs[4 * i];
+    worstPdf = Math.max(worstPdf, Math.abs(pdf - +r.pdf) / Math.max(+r.pdf, 1e-30));
+    const ok = pdfs[4 * i + 1] === 1;
+    if (ok) {
+      worstSelf = Math.max(worstSelf, Math.abs(pdfs[4 * i + 2] - pdfs[4 * i + 3]) / pdfs[4 * i + 3]);
+    }
+    if (+r.boundary < 1e-3) {
+      skipped++;
+      return;
+    }
+    if (ok !== (r.valid === "1")) {
+      bad++;
+      return;
+    }
+    if (!ok) return;
+    compared++;
+    for (let c = 0; c < 3; c++) worstDir = Math.max(worstDir, Math.abs(samples[4 * i + c] - +r[`ws${c}`]));
+  });
+  console.log(`${name} sampling: pdf max relative difference ${worstPdf.toExponential(2)}, ` +
+    `${compared} samples' directions within ${worstDir.toExponential(2)} (${skipped} at a lobe ` +
+    `boundary skipped, ${bad} drawn differently), sample pdf vs pdf ${worstSelf.toExponential(2)}`);
+  const fail = !(worstPdf <= PDF_TOL) || !(worstDir <= 1e-4) || bad > 0 || !(worstSelf <= 1e-5) ||
+    compared < rows.length / 2;
+  if (fail) console.log(`FAIL ${name} sampling`);
+  return fail ? 1 : 0;
+}
+
 (async () => {
   const glsl = fs.readFileSync(path.join(root, "include/lamina1/lamina1.glsl"), "utf8");
   const { page, close } = await launchChromium({ width: 64, height: 64 });
@@ -38,7 +75,15 @@ function direction(thetaDeg, phiDeg) {
     const ref = readCsv(path.join(dir, name + ".ref.csv"));
     // wi at φ = 0 (lamina's convention), wo at (θo, φo).
     const pairs = dirs.map((d) => [direction(+d.theta_i, 0), direction(+d.theta_o, +d.phi_o)]);
-    const got = await page.evaluate(({ glsl, state, pairs }) => {
+    const modes = [0];
+    const samplingFile = path.join(dir, name + ".sampling.csv");
+    const sampling = fs.existsSync(samplingFile) ? readCsv(samplingFile) : null;
+    if (sampling) {
+      // wi, wo and u of each pair from the sampling file (the same wi and wo as dirs.csv).
+      sampling.forEach((r, i) => pairs[i].push([+r.u0, +r.u1, +r.u2]));
+      modes.push(1, 2);
+    }
+    const outs = await page.evaluate(({ glsl, state, pairs, modes }) => {
       const gl = document.getElementById("c").getContext("webgl2");
       if (!gl || !gl.getExtension("EXT_color_buffer_float")) return "no WebGL2 float targets";
       const vs = `#version 300 es
@@ -47,13 +92,25 @@ function direction(thetaDeg, phiDeg) {
         precision highp float; precision highp int; precision highp sampler2D;
         uniform highp sampler2D lamina1_state;
         uniform highp sampler2D pairs;
+        uniform int mode;
         out vec4 color;
         ${glsl}
         void main() {
           int i = int(gl_FragCoord.x);
-          vec3 wi = texelFetch(pairs, ivec2(2 * i, 0), 0).xyz;
-          vec3 wo = texelFetch(pairs, ivec2(2 * i + 1, 0), 0).xyz;
-          color = vec4(lamina1_eval(wi, wo), 1.0);
+          vec3 wi = texelFetch(pairs, ivec2(3 * i, 0), 0).xyz;
+          vec3 wo = texelFetch(pairs, ivec2(3 * i + 1, 0), 0).xyz;
+          vec3 u = texelFetch(pairs, ivec2(3 * i + 2, 0), 0).xyz;
+          if (mode == 0) {
+            color = vec4(lamina1_eval(wi, wo), 1.0);
+            return;
+          }
+          vec3 ws, weight;
+          float pdf_s;
+          bool ok = lamina1_sample(wi, u, ws, pdf_s, weight);
+          if (mode == 1)  // the density at wo, and the sample's own density against pdf() there
+            color = vec4(lamina1_pdf(wi, wo), ok ? 1.0 : 0.0, pdf_s, ok ? lamina1_pdf(wi, ws) : 0.0);
+          else
+            color = vec4(ws, weight.g);
         }`;
       const shader = (type, src) => {
         const s = gl.createShader(type);
@@ -86,11 +143,11 @@ function direction(thetaDeg, phiDeg) {
       s.set(state);
       texture(0, 256, rows, gl.R32F, gl.RED, s);
       const n = pairs.length;
-      const d = new Float32Array(n * 8);
-      pairs.forEach(([wi, wo], i) => {
-        d.set([...wi, 0, ...wo, 0], 8 * i);
+      const d = new Float32Array(n * 12);
+      pairs.forEach(([wi, wo, u], i) => {
+        d.set([...wi, 0, ...wo, 0, ...(u || [0, 0, 0]), 0], 12 * i);
       });
-      texture(1, 2 * n, 1, gl.RGBA32F, gl.RGBA, d);
+      texture(1, 3 * n, 1, gl.RGBA32F, gl.RGBA, d);
       gl.uniform1i(gl.getUniformLocation(prog, "lamina1_state"), 0);
       gl.uniform1i(gl.getUniformLocation(prog, "pairs"), 1);
       const target = gl.createTexture();
@@ -107,16 +164,22 @@ function direction(thetaDeg, phiDeg) {
       const loc = gl.getAttribLocation(prog, "p");
       gl.enableVertexAttribArray(loc);
       gl.vertexAttribPointer(loc, 2, gl.FLOAT, false, 0, 0);
-      gl.drawArrays(gl.TRIANGLES, 0, 3);
-      const out = new Float32Array(4 * n);
-      gl.readPixels(0, 0, n, 1, gl.RGBA, gl.FLOAT, out);
-      return Array.from(out);
-    }, { glsl, state, pairs });
-    if (typeof got === "string") {
-      console.log(`FAIL ${name}: ${got}`);
+      const outs = [];
+      for (const mode of modes) {
+        gl.uniform1i(gl.getUniformLocation(prog, "mode"), mode);
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+        const out = new Float32Array(4 * n);
+        gl.readPixels(0, 0, n, 1, gl.RGBA, gl.FLOAT, out);
+        outs.push(Array.from(out));
+      }
+      return outs;
+    }, { glsl, state, pairs, modes });
+    if (typeof outs === "string") {
+      console.log(`FAIL ${name}: ${outs}`);
       failures++;
       continue;
     }
+    const got = outs[0];
     let worst = 0, where = "";
     for (let i = 0; i < ref.length; i++) {
       const r = [+ref[i].f_r, +ref[i].f_g, +ref[i].f_b];
@@ -134,6 +197,7 @@ function direction(thetaDeg, phiDeg) {
       console.log(`FAIL ${name}: above ${TOL}`);
       failures++;
     }
+    if (sampling) failures += checkSampling(name, sampling, outs[1], outs[2]);
   }
   await close();
   process.exit(failures ? 1 : 0);
