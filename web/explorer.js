@@ -363,8 +363,11 @@
     if (STUDY.preset) parts.push("preset " + STUDY.preset);
     if (STUDY.particles) parts.push(Number(STUDY.particles).toExponential(1).replace("e+", "·10^") + " particles per incidence");
     parts.push("grid " + STUDY.grid.n_theta + "×" + STUDY.grid.n_phi);
-    // Which reference: its rough interfaces scatter once (the masked energy is lost) or multiply.
+    // Which reference: exact, the 2019 study's (bpb19) or a mix; its rough interfaces scatter once
+    // (the masked energy is lost) or multiply; light polarized or the Fresnel factors averaged.
+    if (STUDY.physics) parts.push(STUDY.physics === "bpb19" ? "the 2019 reference" : STUDY.physics + " reference");
     if (STUDY.microsurface) parts.push((STUDY.microsurface === "multiple" ? "multiple" : "single") + "-scattering microsurfaces");
+    if (typeof STUDY.polarization === "boolean") parts.push(STUDY.polarization ? "polarized light" : "unpolarized Fresnel factors");
     if (STUDY.lamina_version) parts.push("lamina " + STUDY.lamina_version);
     $("study-info").textContent = parts.join(" · ");
     setOptions($("w-incidence"), THETA_I.map((t, i) => [i, t + "°"]), state.incidence);

@@ -112,6 +112,7 @@ Runner add_render(CLI::App& app) {
     cmd->add_option("--exposure", a->exposure, "Exposure in stops for the PNG (default 0)");
     // The reference's transport (layers/transport_settings.h), but the numbers it keeps at their
     // defaults (random_walk_options).
+    add_physics_option(cmd, a->transport);
     add_settings_options(cmd, a->transport, {"max_microsurface_order", "max_events"});
     cmd->add_flag("--compare", a->compare,
                   "Render the reference and every analytic model; --out is then a folder holding "

@@ -39,6 +39,7 @@ Runner add_simulate(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "simulate", "Trace particles through a stack: the reference BRDF/BTDF (goniophotometer)");
     cmd->add_option("STACK", a->stack, "Stack JSON file")->required();
+    add_physics_option(cmd, a->settings.transport);
     add_settings_options(cmd, a->settings);
     cmd->add_flag("--mueller", a->mueller,
                   "Also write the 4x4 Mueller BRDF/BTDF per bin with standard errors "

@@ -40,6 +40,7 @@ struct CommonArgs {
 void add_common(CLI::App* cmd, CommonArgs& a) {
     a.cmd = cmd;
     // The reference's settings (the goniophotometer's, core/setting.h) and the study's own.
+    add_physics_option(cmd, a.settings.reference.transport);
     add_settings_options(cmd, a.settings.reference);
     add_settings_options(cmd, a.settings);
     cmd->add_option("--models", a.models,
@@ -184,7 +185,9 @@ Runner add_study(CLI::App& app) {
     cmd->add_option("--only", a->only, "Only configurations whose id matches (globs, commas)");
     cmd->add_option("--configs", a->configs, "A JSON list of your own configurations");
     add_common(cmd, *a);
-    cmd->add_option("--out,-o", a->out, "Output folder (default out/study-PRESET)");
+    cmd->add_option(
+        "--out,-o", a->out,
+        "Output folder (default out/study-PRESET, out/study-PRESET-bpb19 for --physics bpb19)");
     cmd->add_flag(
         "--render", a->render,
         "Also render every configuration (reference and models, studio lighting) into "
@@ -201,8 +204,11 @@ Runner add_study(CLI::App& app) {
         Communicator& world = Communicator::world();
         const StudySettings s = settings_from(*a, a->preset);
         std::vector<StudyConfiguration> configs;
+        // The default folder names the preset, and the reference when it is not the exact one.
+        const std::string physics = physics_name(s.reference.transport);
         const std::filesystem::path out =
-            a->out.empty() ? std::filesystem::path("out") / ("study-" + a->preset)
+            a->out.empty() ? std::filesystem::path("out") /
+                                 ("study-" + a->preset + (physics == "exact" ? "" : "-" + physics))
                            : std::filesystem::path(a->out);
         if (world.is_root()) {
             configs =

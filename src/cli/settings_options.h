@@ -4,6 +4,7 @@
 // the setting's codec, which writes the member; a bad value is an InputError naming the option.
 
 #include "core/setting.h"
+#include "layers/transport_settings.h"
 
 #include <CLI/CLI.hpp>
 
@@ -30,6 +31,25 @@ void add_settings_options(CLI::App* cmd, S& s, const std::vector<std::string>& s
             info.help);
         option->default_str(SettingCodec<T>::to_text(member));
     });
+}
+
+/// `--physics exact|bpb19` (layers/transport_settings.h): sets the transport settings it names.
+/// Add it before the transport's own options: CLI11 runs the callbacks in the order the options
+/// were added, so an explicit `--microsurface` or `--polarization` given beside it wins.
+inline void add_physics_option(CLI::App* cmd, TransportSettings& transport) {
+    const SettingInfo info{.name = "physics",
+                           .help =
+                               "The reference: exact (polarization on, microsurface multiple: "
+                               "the defaults) or bpb19 (the 2019 study's: polarization off, "
+                               "microsurface single); --polarization, --microsurface override"};
+    cmd->add_option_function<std::string>(
+        "--physics",
+        [&transport, info](const std::string& text) {
+            apply_physics(
+                SettingCodec<ReferencePhysics>::from_text(text, info, "command line", "--physics"),
+                transport);
+        },
+        info.help);
 }
 
 }  // namespace lamina::cli

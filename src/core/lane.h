@@ -1,7 +1,7 @@
 #pragma once
 // Lane types. A formula written once as a branch-free template over a lane type T runs on one
 // value (T = float or double, masks are bool) and on the lanes of a SIMD vector (the particle
-// kernel instantiates it with Highway vectors, simulator/kernel_simd.cpp, through an operations
+// kernel instantiates it with Highway vectors through VecLane, core/lane_hwy.h, an operations
 // struct of the same shape as Lane<T>). The template reads its arithmetic from the operators
 // (+, −, ·, / are defined for both) and everything else from the operations struct L:
 //
@@ -22,13 +22,33 @@
 // Lane headers. Vector code must be compiled once per instruction set, inside Highway's target
 // regions, so a header of lane templates (core/beta_function.h, physics/smith_masking.h) is
 // included twice over: once as an ordinary header (its templates in namespace lamina, for scalar
-// code), and once per instruction set by the SIMD kernel, which defines LAMINA_LANE_TARGET and
-// LAMINA_LANE_BEGIN/END (simulator/kernel_simd.cpp) to put the same templates into that target's
-// namespace. Such a header has no #pragma once but the guard below (Highway's per-target
-// include guard, keyed on HWY_TARGET_TOGGLE), and holds nothing but lane templates.
+// code), and once per instruction set with LAMINA_LANE_TARGET defined, after core/lane_hwy.h has
+// pointed LAMINA_LANE_BEGIN/END at that target's namespace (core/lane_hwy.h shows how a unit of
+// vector code does it). Such a header holds nothing but lane templates between LAMINA_LANE_BEGIN
+// and LAMINA_LANE_END, and opens with this guard (NAME its path, as LAMINA_CORE_LANE_VEC):
+//
+//   #ifndef LAMINA_LANE_TARGET          // ordinary: once
+//   #ifndef NAME_H
+//   #define NAME_H
+//   #define NAME_BODY
+//   #endif
+//   #elif defined(NAME_TARGET) == defined(HWY_TARGET_TOGGLE)   // per target: Highway's toggle
+//   #ifdef NAME_TARGET
+//   #undef NAME_TARGET
+//   #else
+//   #define NAME_TARGET
+//   #endif
+//   #define NAME_BODY
+//   #endif
+//
+//   #ifdef NAME_BODY
+//   #undef NAME_BODY
+//   …
+//   #endif
 //
 // Scalar instantiations are the readable reference; the lane tests check the vector
-// instantiations against them (tests/simulator/kernel_simd_test.cpp, tests/physics/lanes_test.cpp).
+// instantiations against them (tests/simulator/kernel_simd_test.cpp, tests/physics/lanes_test.cpp,
+// through tests/support/simd_probes.h).
 
 #include <cmath>
 #include <concepts>

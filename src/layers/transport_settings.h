@@ -27,7 +27,7 @@ inline const char* enum_noun(Microsurface) {
 }
 
 struct TransportSettings {
-    Microsurface microsurface = Microsurface::Single;
+    Microsurface microsurface = Microsurface::Multiple;
     /// Facets a microsurface walk (Microsurface::Multiple) may meet before its particle is given up
     /// (reported as lost_microsurface); walks of a few facets are the rule, a hundred is never
     /// reached in practice. 1 keeps only the first order, the single-scattering interface (a test
@@ -43,8 +43,10 @@ struct TransportSettings {
     /// Follow the particles' polarization (docs/physics.md §8): every event applies its Mueller
     /// matrix to the particle's Stokes vector instead of the unpolarized Fresnel factors; the
     /// tables are those of unpolarized incident light, exact for it.
-    bool polarization = false;
+    bool polarization = true;
 
+    // The cache key leaves out the 2019 reference's values (key_unsaid), so a bpb19 reference
+    // keeps the key it had before the other values existed.
     template <typename Self, typename Visit>
     static void fields(Self& s, Visit&& visit) {
         using Key = SettingInfo::Key;
@@ -80,5 +82,34 @@ struct TransportSettings {
             s.polarization);
     }
 };
+
+/// The two references lamina names (docs/physics.md §8). `exact`, the defaults: polarized light
+/// and rough interfaces that scatter on their whole microsurface, nothing rounded off. `bpb19`:
+/// the reference of Bati, Pacanowski and Barla 2019 (unpolarized Fresnel factors at every event,
+/// single scattering on the microsurfaces, the masked energy lost), to reproduce their study.
+enum class ReferencePhysics { Exact, Bpb19 };
+inline constexpr std::array<EnumName<ReferencePhysics>, 2> enum_names(ReferencePhysics) {
+    return {{{ReferencePhysics::Exact, "exact",
+              "polarized light, microsurface multiple scattering (the defaults)"},
+             {ReferencePhysics::Bpb19, "bpb19",
+              "the 2019 study's reference: polarization off, microsurface single"}}};
+}
+inline const char* enum_noun(ReferencePhysics) {
+    return "a reference physics";
+}
+
+/// Sets the settings `physics` names (the others are left as they are).
+inline void apply_physics(ReferencePhysics physics, TransportSettings& t) {
+    const bool exact = physics == ReferencePhysics::Exact;
+    t.polarization = exact;
+    t.microsurface = exact ? Microsurface::Multiple : Microsurface::Single;
+}
+
+/// The named reference `t` is ("exact", "bpb19"), or "custom" for the two mixed.
+inline const char* physics_name(const TransportSettings& t) {
+    if (t.polarization && t.microsurface == Microsurface::Multiple) return "exact";
+    if (!t.polarization && t.microsurface == Microsurface::Single) return "bpb19";
+    return "custom";
+}
 
 }  // namespace lamina

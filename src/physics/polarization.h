@@ -251,23 +251,30 @@ LAMINA_LANE_INLINE void stokes_rotate_frame(StokesLanes<T>& s, const LaneVec3<T>
 }
 
 /// Applies the Mueller matrix (*) m to the state (q, u, v) of the lanes of `active`: returns the
-/// intensity factor a + b q (the flux factor of the event for that state) and replaces the state
-/// by the normalized result, ((b + a q), (c u + d v), (−d u + c v)) / (a + b q), where the factor
-/// is positive (elsewhere the state is kept: no flux continues).
+/// intensity factor a + b q (the flux factor of the event for that state, never negative) and
+/// replaces the state by the normalized result, ((b + a q), (c u + d v), (−d u + c v)) / (a + b q).
+/// A Fresnel matrix keeps the degree of polarization ≤ 1 (a² = b² + c² + d²); in rounding it may
+/// not, and a normalized state is rescaled to degree 1 where it comes out above it, so that no
+/// later event sees a + b q < 0. Where the factor is below 1e-30 (a reflectance that vanishes,
+/// whose normalization would overflow a float) the state is kept: no flux worth following
+/// continues.
 template <typename T, typename L = Lane<T>>
 LAMINA_LANE_INLINE T stokes_apply(const InterfaceMueller<T>& m, T& q, T& u, T& v,
                                   typename L::Mask active) {
     const T zero = L::constant(0), one = L::constant(1);
     const T intensity = L::mul_add(m.b, q, m.a);
-    const auto keeps = L::both(active, L::less(zero, intensity));
+    const auto keeps = L::both(active, L::less(L::constant(1e-30), intensity));
     const T inv = one / L::select(keeps, intensity, one);
-    const T q_new = L::mul_add(m.a, q, m.b) * inv;
-    const T u_new = L::mul_add(m.c, u, m.d * v) * inv;
-    const T v_new = L::mul_add(m.c, v, zero - m.d * u) * inv;
-    q = L::select(keeps, q_new, q);
-    u = L::select(keeps, u_new, u);
-    v = L::select(keeps, v_new, v);
-    return intensity;
+    T q_new = L::mul_add(m.a, q, m.b) * inv;
+    T u_new = L::mul_add(m.c, u, m.d * v) * inv;
+    T v_new = L::mul_add(m.c, v, zero - m.d * u) * inv;
+    const T degree2 = L::mul_add(q_new, q_new, L::mul_add(u_new, u_new, v_new * v_new));
+    const auto above = L::less(one, degree2);
+    const T shrink = L::select(above, L::inv_sqrt(L::select(above, degree2, one)), one);
+    q = L::select(keeps, q_new * shrink, q);
+    u = L::select(keeps, u_new * shrink, u);
+    v = L::select(keeps, v_new * shrink, v);
+    return L::max(intensity, zero);
 }
 
 /// The polarized branch choice at a dielectric facet, the state already in the facet's s/p frame:

@@ -18,6 +18,7 @@
 #include "export/merl.h"
 #include "export/rgl_bsdf.h"
 #include "layers/stack.h"
+#include "layers/transport_settings.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "report/explorer.h"
@@ -577,6 +578,15 @@ void bind_simulation(py::module_& m) {
     // The goniophotometer's settings and their defaults, by name (core/setting.h): Python's
     // keyword arguments of simulate, compare and study.
     m.attr("SIMULATION_SETTINGS") = python_of(settings_to_json(SimulationSettings{}));
+    // The named references (layers/transport_settings.h): the settings each one sets.
+    nlohmann::json physics = nlohmann::json::object();
+    for (const auto& n : enum_names(ReferencePhysics{})) {
+        TransportSettings t;
+        apply_physics(n.value, t);
+        physics[n.text] = {{"polarization", t.polarization},
+                           {"microsurface", enum_text(t.microsurface)}};
+    }
+    m.attr("REFERENCE_PHYSICS") = python_of(physics);
     m.def(
         "_simulate",
         [](py::handle stack_obj, py::dict settings, bool progress) {

@@ -733,11 +733,264 @@ bool RandomWalkStack::traverse_medium(int region, WalkState& ws, ParticleRng& rn
 }
 
 // ---- One walk ----------------------------------------------------------------------------------
+
+// Strategy 1's balance-heuristic weight at the exit interface (1 for other paths): the particle,
+// about to meet interface `at` (it, from wi_local), arrives from the inner region straight from a
+// vertex that strategy 2 connects.
+double RandomWalkStack::exit_mis(const Connection& conn, const WalkState& ws, const Interface& it,
+                                 const Vec3d& wi_local, const Vec3d& wo, int at) const {
+    if (!conn.rough_exit || at != conn.exit_interface || !ws.prev_mis || ws.d.z * conn.towards <= 0)
+        return 1.0;
+    const double p1 = ws.prev_pdf * survival_proxy(conn.inner, ws.prev_depth / std::abs(ws.d.z));
+    const double p2 = it.dielectric.pdf(wo, wi_local);
+    // Both densities vanish when strategy 2 cannot make this path (p2 = 0) and the survival proxy
+    // underflows (a deep, dense medium): strategy 1 alone, weight 1.
+    return p1 + p2 > 0 ? p1 / (p1 + p2) : 1.0;
+}
+
+// Strategy 2 from the vertex interface vi, met from wi_local (eval and pdf): its kernel, exit
+// density × chain probability, and the balance heuristic's proxy density (single scattering).
+template <RandomWalkStack::Mode kMode>
+void RandomWalkStack::connect_from_vertex_interface(const Interface& vi, const Vec3d& wi_local,
+                                                    WalkState& ws, ParticleRng& rng,
+                                                    const Connection& conn, const Vec3d& wo,
+                                                    bool polarized, Rgbd& f) const {
+    const Rgbd& w = ws.w;
+    if (polarized && kMode == Mode::Eval) {
+        connect_through_exit_polarized(
+            conn, wo, 1.0, w, rng,
+            [&](const Vec3d& om, StokesRgb<double>& e) {
+                emission(vi, wi_local, &om, 1, ws.stokes, w, rng, &e);
+            },
+            [&](const Vec3d& om) { return pdf_interface(vi, wi_local, om); }, f);
+        return;
+    }
+    connect_through_exit<kMode>(
+        conn, wo, 1.0, w, rng,
+        [&](const Vec3d& om) { return interface_kernel(vi, wi_local, om, rng); },
+        [&](const Vec3d& om, const Rgbd& pass) {
+            return interface_pdf_chain(vi, wi_local, om, w, pass, rng);
+        },
+        [&](const Vec3d& om) { return pdf_interface(vi, wi_local, om); }, f);
+}
+
+// Next event at a non-delta interface k, met from wi_local (eval): into region k (up) and, for a
+// dielectric, region k + 1 (down); the kernel f·|cos| and the Jacobian's 1/|cos| cancel. A
+// multiple-scattering interface (docs/rendering.md §1.6): one microsurface walk from wi_local
+// estimates the kernel towards both connection directions at once.
+void RandomWalkStack::connect_at_interface(int k, const Vec3d& wi_local, WalkState& ws,
+                                           ParticleRng& rng, const Connection& conn,
+                                           const Vec3d& wo, bool polarized, Rgbd& f) const {
+    const Interface& it = interfaces_[k];
+    const Rgbd& w = ws.w;
+    const bool up_ok = conn.valid[k];
+    const bool down_ok = it.type == InterfaceType::Dielectric && conn.valid[k + 1];
+    auto mis = [&] { return exit_mis(conn, ws, it, wi_local, wo, k); };
+    if (polarized) {
+        // The vertex's light towards d_r, in the frame of its chain's plane (whose s and
+        // p parts the chains carry apart); f·|cos| over |cos| of the connection.
+        if (!it.delta && (up_ok || down_ok)) {
+            Vec3d dirs[2];
+            int n = 0;
+            const int iu = up_ok ? n++ : -1, id = down_ok ? n++ : -1;
+            if (up_ok) dirs[iu] = conn.dir_up[k];
+            if (down_ok) dirs[id] = conn.dir_down[k + 1];
+            StokesRgb<double> e[2];
+            emission(it, wi_local, dirs, n, ws.stokes, w, rng, e);
+            if (up_ok)
+                f += w *
+                     Connection::through(e[iu], conn.from_bottom_up(k, 0),
+                                         conn.from_bottom_up(k, 1)) *
+                     (conn.scale[k] * mis() / std::abs(dirs[iu].z));
+            if (down_ok)
+                f += w *
+                     Connection::through(e[id], conn.from_top_down(k + 1, 0),
+                                         conn.from_top_down(k + 1, 1)) *
+                     (conn.scale[k + 1] * mis() / std::abs(dirs[id].z));
+        }
+    } else if (it.multiple && (up_ok || down_ok)) {
+        Rgbd k_up(0.0), k_down(0.0);
+        const Vec3d du = up_ok ? conn.dir_up[k] : Vec3d();
+        const Vec3d dd = down_ok ? conn.dir_down[k + 1] : Vec3d();
+        visit_microsurface(it, wi_local, rng, [&](const auto& connect) {
+            if (up_ok) {
+                const MicrosurfaceConnection<double> c = connect(du);
+                k_up += c.weight * c.density;
+            }
+            if (down_ok) {
+                const MicrosurfaceConnection<double> c = connect(dd);
+                k_down += c.weight * c.density;
+            }
+        });
+        // The kernel f·|cos| over |cos| of the connection: f.
+        if (up_ok)
+            f += w * k_up * conn.from_bottom_up(k) * (conn.scale[k] * mis() / std::abs(du.z));
+        if (down_ok)
+            f += w * k_down * conn.from_top_down(k + 1) *
+                 (conn.scale[k + 1] * mis() / std::abs(dd.z));
+    }
+    if (!polarized && !it.delta && !it.multiple) {
+        if (conn.valid[k]) {
+            const Vec3d& du = conn.dir_up[k];
+            Rgbd fv = eval_interface(it, wi_local, du);
+            f += w * fv * conn.from_bottom_up(k) * (conn.scale[k] * mis());
+        }
+        if (it.type == InterfaceType::Dielectric && conn.valid[k + 1]) {
+            const Vec3d& dd = conn.dir_down[k + 1];
+            f += w * Rgbd(it.dielectric.eval(wi_local, dd)) * conn.from_top_down(k + 1) *
+                 (conn.scale[k + 1] * mis());
+        }
+    }
+    // Strategy 2 from the vertex interface emitting into the inner region.
+    if (!it.delta && conn.rough_exit && k == conn.vertex_interface)
+        connect_from_vertex_interface<Mode::Eval>(it, wi_local, ws, rng, conn, wo, polarized, f);
+}
+
+// Exit density at a non-delta interface (docs/rendering.md §1.4): its sampling density of
+// d_r times the chains' probability of reaching the exit from there, times
+// dω_r/dω_e = (η_e/η_r)² cos θ_e / μ_r (1 when r is the exit region). The weight just
+// after the vertex is ∝ w·f (per channel; f·|cos|/pdf with grey |cos|/pdf).
+void RandomWalkStack::exit_density_at_interface(int k, const Vec3d& wi_local, WalkState& ws,
+                                                ParticleRng& rng, const Connection& conn,
+                                                const Vec3d& wo, Rgbd& f) const {
+    const Interface& it = interfaces_[k];
+    const Rgbd& w = ws.w;
+    const bool up_ok = conn.valid[k];
+    const bool down_ok = it.type == InterfaceType::Dielectric && conn.valid[k + 1];
+    auto mis = [&] { return exit_mis(conn, ws, it, wi_local, wo, k); };
+    if (it.multiple && (up_ok || down_ok)) {
+        // Σ over the facets of the density of leaving towards d_r right after the facet
+        // times the chains' probability for the weight that exit would carry.
+        double p_up = 0, p_down = 0;
+        const Vec3d du = up_ok ? conn.dir_up[k] : Vec3d();
+        const Vec3d dd = down_ok ? conn.dir_down[k + 1] : Vec3d();
+        const Rgbd q_up = up_ok ? conn.from_bottom_up(k) : Rgbd(0.0);
+        const Rgbd q_down = down_ok ? conn.from_top_down(k + 1) : Rgbd(0.0);
+        visit_microsurface(it, wi_local, rng, [&](const auto& connect) {
+            if (up_ok) {
+                const MicrosurfaceConnection<double> c = connect(du);
+                if (c.density > 0) p_up += c.density * chain_probability(w * c.weight, q_up);
+            }
+            if (down_ok) {
+                const MicrosurfaceConnection<double> c = connect(dd);
+                if (c.density > 0) p_down += c.density * chain_probability(w * c.weight, q_down);
+            }
+        });
+        const double cos_e = std::abs(wo.z);
+        if (up_ok && std::isfinite(p_up)) f[0] += p_up * conn.scale[k] * cos_e / conn.mu[k] * mis();
+        if (down_ok && std::isfinite(p_down))
+            f[0] += p_down * conn.scale[k + 1] * cos_e / conn.mu[k + 1] * mis();
+    }
+    if (!it.delta && !it.multiple) {
+        const double cos_e = std::abs(wo.z);
+        if (conn.valid[k]) {
+            const Vec3d& du = conn.dir_up[k];
+            const double p = pdf_interface(it, wi_local, du);
+            if (p > 0)
+                f[0] += p *
+                        chain_probability(w * eval_interface(it, wi_local, du),
+                                          conn.from_bottom_up(k)) *
+                        conn.scale[k] * cos_e / conn.mu[k] * mis();
+        }
+        if (it.type == InterfaceType::Dielectric && conn.valid[k + 1]) {
+            const Vec3d& dd = conn.dir_down[k + 1];
+            const double p = it.dielectric.pdf(wi_local, dd);
+            if (p > 0)
+                f[0] += p *
+                        chain_probability(w * it.dielectric.eval(wi_local, dd),
+                                          conn.from_top_down(k + 1)) *
+                        conn.scale[k + 1] * cos_e / conn.mu[k + 1] * mis();
+        }
+    }
+    if (!it.delta && conn.rough_exit && k == conn.vertex_interface)
+        connect_from_vertex_interface<Mode::Pdf>(it, wi_local, ws, rng, conn, wo, false, f);
+}
+
+// The interface's event on a particle arriving from wi_local: its sample (direction, weight,
+// density), or none where the sample failed or a microsurface walk was given up (the flux is
+// dropped). Polarized walks: the state ws.stokes after the event.
+std::optional<BsdfSample<double>> RandomWalkStack::sample_interface(const Interface& it,
+                                                                    const Vec3d& wi_local,
+                                                                    WalkState& ws, ParticleRng& rng,
+                                                                    bool polarized) const {
+    const Rgbd& w = ws.w;
+    std::optional<BsdfSample<double>> s;
+    // Polarized walks: the interfaces' polarized events on the walk's state, as the
+    // goniophotometer's (the density, a proxy for strategy 2's weights, stays the
+    // single-scattering unpolarized one).
+    PolarizationLanes<double> pol;
+    const double flux[3] = {w[0], w[1], w[2]};
+    pol.stokes = ws.stokes;
+    pol.channels = channels_;
+    pol.flux = flux;
+    const auto mueller = [&](double c, InterfaceMueller<double>* m) { it.conductor.mueller(c, m); };
+    if (it.multiple) {
+        // The microsurface walk (Heitz et al. 2016) to its exit; a walk given up at the facet
+        // cap or degenerate loses its flux, as the goniophotometer's. The density is the
+        // single-scattering one: only strategy 2's balance heuristic reads it (a proxy).
+        auto uniform = [&] { return rng.uniform_double(); };
+        const bool dielectric = it.type == InterfaceType::Dielectric;
+        const std::optional<MicrosurfaceExit<double>> e =
+            polarized ? (dielectric ? walk_rough_dielectric_polarized(
+                                          it.dielectric.distribution(), it.dielectric.eta, wi_local,
+                                          uniform, transport_.max_microsurface_order, pol)
+                                    : walk_rough_conductor_polarized(
+                                          it.conductor.distribution(), mueller, wi_local, uniform,
+                                          transport_.max_microsurface_order, pol))
+            : dielectric
+                ? walk_rough_dielectric(it.dielectric.distribution(), it.dielectric.eta, wi_local,
+                                        uniform, transport_.max_microsurface_order)
+                : walk_rough_conductor(
+                      it.conductor.distribution(),
+                      [&](double c) { return it.conductor.fresnel(c); }, wi_local, uniform,
+                      transport_.max_microsurface_order);
+        if (!e || !e->escaped) return std::nullopt;
+        s = BsdfSample<double>{};
+        s->wo = e->wo;
+        s->weight = e->weight;
+        s->pdf = pdf_interface(it, wi_local, e->wo);
+    } else
+        switch (it.type) {
+            case InterfaceType::Dielectric: {
+                const double uc = rng.uniform_double(), u1 = rng.uniform_double(),
+                             u2 = rng.uniform_double();
+                if (polarized) {
+                    s = it.dielectric.sample_polarized(wi_local, uc, u1, u2, pol);
+                    if (s && !s->is_delta) s->pdf = it.dielectric.pdf(wi_local, s->wo);
+                } else {
+                    s = it.dielectric.sample<true>(wi_local, uc, u1, u2);
+                }
+                break;
+            }
+            case InterfaceType::Conductor: {
+                const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
+                if (polarized) {
+                    s = it.conductor.sample_polarized(wi_local, u1, u2, pol);
+                    if (s && !s->is_delta && s->wo.z > 0)
+                        s->pdf = it.conductor.pdf(wi_local, s->wo);
+                } else {
+                    s = it.conductor.sample<true>(wi_local, u1, u2);
+                }
+                break;
+            }
+            case InterfaceType::Lambertian: {
+                const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
+                s = it.lambertian.sample(wi_local, u1, u2);
+                stokes_depolarize<double>(pol.stokes, 3, true);
+                break;
+            }
+        }
+    if (polarized) ws.stokes = pol.stokes;
+    return s;
+}
+
+// One walk from wi: at each interface the next events (eval) or exit densities (pdf) towards wo,
+// then the interface's event and the medium behind it, until the particle leaves the stack (its
+// exit into *exit, for sample()), is absorbed, dropped or cut off at max_events.
 template <RandomWalkStack::Mode kMode>
 void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
                            const Connection* conn, Rgbd& f,
                            std::optional<RandomWalkSample>* exit) const {
-    constexpr bool kConnect = kMode == Mode::Eval;
     constexpr bool kEstimate = kMode != Mode::Sample;  // eval and pdf share strategy 2's MIS
     const int L = int(interfaces_.size());
     WalkState ws;
@@ -754,235 +1007,12 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
     while (ws.events++ < transport_.max_events) {
         const Interface& it = interfaces_[k];
         const Vec3d wi_local = -d;
-        // Strategy 1's balance-heuristic weight at the exit interface (1 for other paths): the
-        // particle arrives from the inner region straight from a vertex that strategy 2 connects.
-        auto exit_mis = [&](int at) {
-            if constexpr (!kEstimate)
-                return 1.0;
-            else {
-                if (!conn->rough_exit || at != conn->exit_interface || !ws.prev_mis ||
-                    d.z * conn->towards <= 0)
-                    return 1.0;
-                const double p1 =
-                    ws.prev_pdf * survival_proxy(conn->inner, ws.prev_depth / std::abs(d.z));
-                const double p2 = it.dielectric.pdf(wo, wi_local);
-                // Both densities vanish when strategy 2 cannot make this path (p2 = 0) and the
-                // survival proxy underflows (a deep, dense medium): strategy 1 alone, weight 1.
-                return p1 + p2 > 0 ? p1 / (p1 + p2) : 1.0;
-            }
-        };
-        // Strategy 2 from the vertex interface (eval and pdf), its kernel, exit density × chain
-        // probability, and the balance heuristic's proxy density (single scattering).
-        auto connect_vertex_interface = [&](const Interface& vi) {
-            if (polarized && kConnect) {
-                connect_through_exit_polarized(
-                    *conn, wo, 1.0, w, rng,
-                    [&](const Vec3d& om, StokesRgb<double>& e) {
-                        emission(vi, wi_local, &om, 1, ws.stokes, w, rng, &e);
-                    },
-                    [&](const Vec3d& om) { return pdf_interface(vi, wi_local, om); }, f);
-                return;
-            }
-            connect_through_exit<kMode>(
-                *conn, wo, 1.0, w, rng,
-                [&](const Vec3d& om) { return interface_kernel(vi, wi_local, om, rng); },
-                [&](const Vec3d& om, const Rgbd& pass) {
-                    return interface_pdf_chain(vi, wi_local, om, w, pass, rng);
-                },
-                [&](const Vec3d& om) { return pdf_interface(vi, wi_local, om); }, f);
-        };
-        // Next event at a non-delta interface: into region k (up) and, for a dielectric, region
-        // k + 1 (down); the kernel f·|cos| and the Jacobian's 1/|cos| cancel.
-        // A multiple-scattering interface (docs/rendering.md §1.6): one microsurface walk from
-        // wi_local estimates the kernel towards both connection directions at once.
-        const bool up_ok = conn && conn->valid[k];
-        const bool down_ok = conn && it.type == InterfaceType::Dielectric && conn->valid[k + 1];
-        if constexpr (kConnect) {
-            if (polarized) {
-                // The vertex's light towards d_r, in the frame of its chain's plane (whose s and
-                // p parts the chains carry apart); f·|cos| over |cos| of the connection.
-                if (!it.delta && (up_ok || down_ok)) {
-                    Vec3d dirs[2];
-                    int n = 0;
-                    const int iu = up_ok ? n++ : -1, id = down_ok ? n++ : -1;
-                    if (up_ok) dirs[iu] = conn->dir_up[k];
-                    if (down_ok) dirs[id] = conn->dir_down[k + 1];
-                    StokesRgb<double> e[2];
-                    emission(it, wi_local, dirs, n, ws.stokes, w, rng, e);
-                    if (up_ok)
-                        f += w *
-                             Connection::through(e[iu], conn->from_bottom_up(k, 0),
-                                                 conn->from_bottom_up(k, 1)) *
-                             (conn->scale[k] * exit_mis(k) / std::abs(dirs[iu].z));
-                    if (down_ok)
-                        f += w *
-                             Connection::through(e[id], conn->from_top_down(k + 1, 0),
-                                                 conn->from_top_down(k + 1, 1)) *
-                             (conn->scale[k + 1] * exit_mis(k) / std::abs(dirs[id].z));
-                }
-            } else if (it.multiple && (up_ok || down_ok)) {
-                Rgbd k_up(0.0), k_down(0.0);
-                const Vec3d du = up_ok ? conn->dir_up[k] : Vec3d();
-                const Vec3d dd = down_ok ? conn->dir_down[k + 1] : Vec3d();
-                visit_microsurface(it, wi_local, rng, [&](const auto& connect) {
-                    if (up_ok) {
-                        const MicrosurfaceConnection<double> c = connect(du);
-                        k_up += c.weight * c.density;
-                    }
-                    if (down_ok) {
-                        const MicrosurfaceConnection<double> c = connect(dd);
-                        k_down += c.weight * c.density;
-                    }
-                });
-                // The kernel f·|cos| over |cos| of the connection: f.
-                if (up_ok)
-                    f += w * k_up * conn->from_bottom_up(k) *
-                         (conn->scale[k] * exit_mis(k) / std::abs(du.z));
-                if (down_ok)
-                    f += w * k_down * conn->from_top_down(k + 1) *
-                         (conn->scale[k + 1] * exit_mis(k) / std::abs(dd.z));
-            }
-            if (!polarized && !it.delta && !it.multiple) {
-                if (conn->valid[k]) {
-                    const Vec3d& du = conn->dir_up[k];
-                    Rgbd fv = eval_interface(it, wi_local, du);
-                    f += w * fv * conn->from_bottom_up(k) * (conn->scale[k] * exit_mis(k));
-                }
-                if (it.type == InterfaceType::Dielectric && conn->valid[k + 1]) {
-                    const Vec3d& dd = conn->dir_down[k + 1];
-                    f += w * Rgbd(it.dielectric.eval(wi_local, dd)) * conn->from_top_down(k + 1) *
-                         (conn->scale[k + 1] * exit_mis(k));
-                }
-            }
-            // Strategy 2 from the vertex interface emitting into the inner region.
-            if (!it.delta && conn->rough_exit && k == conn->vertex_interface)
-                connect_vertex_interface(it);
-        }
-        // Exit density at a non-delta interface (docs/rendering.md §1.4): its sampling density of
-        // d_r times the chains' probability of reaching the exit from there, times
-        // dω_r/dω_e = (η_e/η_r)² cos θ_e / μ_r (1 when r is the exit region). The weight just
-        // after the vertex is ∝ w·f (per channel; f·|cos|/pdf with grey |cos|/pdf).
-        if constexpr (kMode == Mode::Pdf) {
-            if (it.multiple && (up_ok || down_ok)) {
-                // Σ over the facets of the density of leaving towards d_r right after the facet
-                // times the chains' probability for the weight that exit would carry.
-                double p_up = 0, p_down = 0;
-                const Vec3d du = up_ok ? conn->dir_up[k] : Vec3d();
-                const Vec3d dd = down_ok ? conn->dir_down[k + 1] : Vec3d();
-                const Rgbd q_up = up_ok ? conn->from_bottom_up(k) : Rgbd(0.0);
-                const Rgbd q_down = down_ok ? conn->from_top_down(k + 1) : Rgbd(0.0);
-                visit_microsurface(it, wi_local, rng, [&](const auto& connect) {
-                    if (up_ok) {
-                        const MicrosurfaceConnection<double> c = connect(du);
-                        if (c.density > 0)
-                            p_up += c.density * chain_probability(w * c.weight, q_up);
-                    }
-                    if (down_ok) {
-                        const MicrosurfaceConnection<double> c = connect(dd);
-                        if (c.density > 0)
-                            p_down += c.density * chain_probability(w * c.weight, q_down);
-                    }
-                });
-                const double cos_e = std::abs(wo.z);
-                if (up_ok && std::isfinite(p_up))
-                    f[0] += p_up * conn->scale[k] * cos_e / conn->mu[k] * exit_mis(k);
-                if (down_ok && std::isfinite(p_down))
-                    f[0] += p_down * conn->scale[k + 1] * cos_e / conn->mu[k + 1] * exit_mis(k);
-            }
-            if (!it.delta && !it.multiple) {
-                const double cos_e = std::abs(wo.z);
-                if (conn->valid[k]) {
-                    const Vec3d& du = conn->dir_up[k];
-                    const double p = pdf_interface(it, wi_local, du);
-                    if (p > 0)
-                        f[0] += p *
-                                chain_probability(w * eval_interface(it, wi_local, du),
-                                                  conn->from_bottom_up(k)) *
-                                conn->scale[k] * cos_e / conn->mu[k] * exit_mis(k);
-                }
-                if (it.type == InterfaceType::Dielectric && conn->valid[k + 1]) {
-                    const Vec3d& dd = conn->dir_down[k + 1];
-                    const double p = it.dielectric.pdf(wi_local, dd);
-                    if (p > 0)
-                        f[0] += p *
-                                chain_probability(w * it.dielectric.eval(wi_local, dd),
-                                                  conn->from_top_down(k + 1)) *
-                                conn->scale[k + 1] * cos_e / conn->mu[k + 1] * exit_mis(k);
-                }
-            }
-            if (!it.delta && conn->rough_exit && k == conn->vertex_interface)
-                connect_vertex_interface(it);
-        }
-        std::optional<BsdfSample<double>> s;
-        // Polarized walks: the interfaces' polarized events on the walk's state, as the
-        // goniophotometer's (the density, a proxy for strategy 2's weights, stays the
-        // single-scattering unpolarized one).
-        PolarizationLanes<double> pol;
-        const double flux[3] = {w[0], w[1], w[2]};
-        pol.stokes = ws.stokes;
-        pol.channels = channels_;
-        pol.flux = flux;
-        const auto mueller = [&](double c, InterfaceMueller<double>* m) {
-            it.conductor.mueller(c, m);
-        };
-        if (it.multiple) {
-            // The microsurface walk (Heitz et al. 2016) to its exit; a walk given up at the facet
-            // cap or degenerate loses its flux, as the goniophotometer's. The density is the
-            // single-scattering one: only strategy 2's balance heuristic reads it (a proxy).
-            auto uniform = [&] { return rng.uniform_double(); };
-            const bool dielectric = it.type == InterfaceType::Dielectric;
-            const std::optional<MicrosurfaceExit<double>> e =
-                polarized
-                    ? (dielectric ? walk_rough_dielectric_polarized(
-                                        it.dielectric.distribution(), it.dielectric.eta, wi_local,
-                                        uniform, transport_.max_microsurface_order, pol)
-                                  : walk_rough_conductor_polarized(
-                                        it.conductor.distribution(), mueller, wi_local, uniform,
-                                        transport_.max_microsurface_order, pol))
-                : dielectric
-                    ? walk_rough_dielectric(it.dielectric.distribution(), it.dielectric.eta,
-                                            wi_local, uniform, transport_.max_microsurface_order)
-                    : walk_rough_conductor(
-                          it.conductor.distribution(),
-                          [&](double c) { return it.conductor.fresnel(c); }, wi_local, uniform,
-                          transport_.max_microsurface_order);
-            if (!e || !e->escaped) return;
-            s = BsdfSample<double>{};
-            s->wo = e->wo;
-            s->weight = e->weight;
-            s->pdf = pdf_interface(it, wi_local, e->wo);
-        } else
-            switch (it.type) {
-                case InterfaceType::Dielectric: {
-                    const double uc = rng.uniform_double(), u1 = rng.uniform_double(),
-                                 u2 = rng.uniform_double();
-                    if (polarized) {
-                        s = it.dielectric.sample_polarized(wi_local, uc, u1, u2, pol);
-                        if (s && !s->is_delta) s->pdf = it.dielectric.pdf(wi_local, s->wo);
-                    } else {
-                        s = it.dielectric.sample<true>(wi_local, uc, u1, u2);
-                    }
-                    break;
-                }
-                case InterfaceType::Conductor: {
-                    const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
-                    if (polarized) {
-                        s = it.conductor.sample_polarized(wi_local, u1, u2, pol);
-                        if (s && !s->is_delta && s->wo.z > 0)
-                            s->pdf = it.conductor.pdf(wi_local, s->wo);
-                    } else {
-                        s = it.conductor.sample<true>(wi_local, u1, u2);
-                    }
-                    break;
-                }
-                case InterfaceType::Lambertian: {
-                    const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
-                    s = it.lambertian.sample(wi_local, u1, u2);
-                    stokes_depolarize<double>(pol.stokes, 3, true);
-                    break;
-                }
-            }
-        if (polarized) ws.stokes = pol.stokes;
+        if constexpr (kMode == Mode::Eval)
+            connect_at_interface(k, wi_local, ws, rng, *conn, wo, polarized, f);
+        if constexpr (kMode == Mode::Pdf)
+            exit_density_at_interface(k, wi_local, ws, rng, *conn, wo, f);
+        const std::optional<BsdfSample<double>> s =
+            sample_interface(it, wi_local, ws, rng, polarized);
         if (!s) return;  // a numerical degeneracy: the flux is dropped
         w *= s->weight;
         if (!it.delta) ws.delta_only = false;

@@ -170,6 +170,23 @@ class RandomWalkStack {
     template <Mode kMode>
     void walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng, const Connection* conn, Rgbd& f,
               std::optional<RandomWalkSample>* exit) const;
+    /// The steps of a walk at interface k, met from wi_local by the walk's state ws: the next
+    /// events towards wo (eval), the exit density at wo (pdf), strategy 1's weight at the exit,
+    /// strategy 2 from the vertex interface, and the interface's event itself.
+    void connect_at_interface(int k, const Vec3d& wi_local, WalkState& ws, ParticleRng& rng,
+                              const Connection& conn, const Vec3d& wo, bool polarized,
+                              Rgbd& f) const;
+    void exit_density_at_interface(int k, const Vec3d& wi_local, WalkState& ws, ParticleRng& rng,
+                                   const Connection& conn, const Vec3d& wo, Rgbd& f) const;
+    double exit_mis(const Connection& conn, const WalkState& ws, const Interface& it,
+                    const Vec3d& wi_local, const Vec3d& wo, int at) const;
+    template <Mode kMode>
+    void connect_from_vertex_interface(const Interface& vi, const Vec3d& wi_local, WalkState& ws,
+                                       ParticleRng& rng, const Connection& conn, const Vec3d& wo,
+                                       bool polarized, Rgbd& f) const;
+    std::optional<BsdfSample<double>> sample_interface(const Interface& it, const Vec3d& wi_local,
+                                                       WalkState& ws, ParticleRng& rng,
+                                                       bool polarized) const;
     template <Mode kMode>
     bool traverse_medium(int region, WalkState& ws, ParticleRng& rng, const Connection* conn,
                          const Vec3d& wo, Rgbd& f) const;

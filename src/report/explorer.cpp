@@ -491,7 +491,7 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
     ExplorerSummary summary;
     json index = {{"study", json::object()}, {"configs", json::array()}};
     for (const char* key : {"preset", "particles", "seed", "lamina_version", "models",
-                            "model_groups", "grid", "microsurface"})
+                            "model_groups", "grid", "microsurface", "polarization", "physics"})
         if (study.contains(key)) index["study"][key] = study[key];
     index["study"]["theta_i"] = theta_i;
     // The page's title: the study folder's name (`out/study-quick/` → study-quick).

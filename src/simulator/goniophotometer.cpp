@@ -90,6 +90,119 @@ struct MediumWalk {
     }
 };
 
+// ---- One interface event ----------------------------------------------------------------------
+// The event of `layer` on a particle arriving along d with flux w: its BSDF sampler (or, with
+// multiple scattering, its microsurface walk) draws the new direction d, and w keeps what
+// continues; the rest is booked in `losses` (absorbed by an opaque base, lost to the microsurface).
+// Polarized runs: pol goes through the event too (pol.flux: the caller's copy of w). Where the
+// channels' states differ, a dielectric's branch choice reweights the channels: the reweighting
+// (zero in expectation per channel) is booked with the base that coloured them.
+template <bool kPolarized>
+inline void interface_event(const CompiledStack<float>& stack, const CompiledLayer<float>& layer,
+                            ParticleRng& rng, Tally& tally, Vec3f& d, Rgbf& w, PathLosses& losses,
+                            [[maybe_unused]] PolarizationLanes<float>& pol) {
+    const Vec3f wi_local = -d;
+    [[maybe_unused]] const bool reweights = kPolarized && pol.channels == 3;
+    // Applies a sample (taken by reference: no copy of the optional in the hot loop).
+    // weight = fresnel_weight (absorbed by an opaque base) · shadowing (lost on the
+    // microsurface); a missing sample is a numerical degeneracy, counted and reported.
+    auto apply = [&](const std::optional<BsdfSample<float>>& s, bool opaque) {
+        if (!s) {
+            ++tally.sums.degenerate;
+            losses.add(BudgetTerm::LostMicrosurface, w);
+            w = Rgbf(0.f);
+            return;
+        }
+        if (opaque) {  // a dielectric's fresnel_weight is 1
+            const Rgbf kept = w * s->fresnel_weight;
+            losses.add(BudgetTerm::AbsorbedBase, w - kept);
+            w = kept;
+        }
+        if (s->shadowing != 1.f) {
+            const Rgbf kept = w * s->shadowing;
+            losses.add(BudgetTerm::LostMicrosurface, w - kept);
+            w = kept;
+        }
+        d = s->wo;
+    };
+    // A rough interface with multiple scattering: the microsurface walk (Heitz et al. 2016)
+    // replaces the single facet; its exit carries the conductor's Fresnel factors. A walk
+    // given up at the facet cap loses its flux to the microsurface; a degenerate one too, and
+    // is counted as a degeneracy.
+    auto apply_walk = [&](const std::optional<MicrosurfaceExit<float>>& e, bool opaque) {
+        if (!e || !e->escaped) {
+            if (!e) ++tally.sums.degenerate;
+            losses.add(BudgetTerm::LostMicrosurface, w);
+            w = Rgbf(0.f);
+            return;
+        }
+        if (opaque) {
+            const Rgbf kept = w * e->weight;
+            losses.add(BudgetTerm::AbsorbedBase, w - kept);
+            w = kept;
+        }
+        d = e->wo;
+    };
+    auto uniform = [&] { return rng.uniform_float(); };
+    switch (layer.type) {
+        case InterfaceType::Dielectric: {
+            if (layer.multiple) {
+                if constexpr (kPolarized) {
+                    apply_walk(walk_rough_dielectric_polarized(
+                                   layer.dielectric.distribution(), layer.dielectric.eta, wi_local,
+                                   uniform, stack.max_microsurface_order, pol),
+                               reweights);
+                    break;
+                }
+                apply_walk(
+                    walk_rough_dielectric(layer.dielectric.distribution(), layer.dielectric.eta,
+                                          wi_local, uniform, stack.max_microsurface_order),
+                    false);
+                break;
+            }
+            const float uc = rng.uniform_float(), u1 = rng.uniform_float(),
+                        u2 = rng.uniform_float();
+            if constexpr (kPolarized)
+                apply(layer.dielectric.sample_polarized(wi_local, uc, u1, u2, pol), reweights);
+            else
+                apply(layer.dielectric.sample<false>(wi_local, uc, u1, u2), false);
+            break;
+        }
+        case InterfaceType::Conductor: {
+            const ConductorInterface<float>& cond = layer.conductor;
+            if (layer.multiple) {
+                if constexpr (kPolarized) {
+                    const auto mueller = [&](float c, InterfaceMueller<float>* m) {
+                        cond.mueller(c, m);
+                    };
+                    apply_walk(
+                        walk_rough_conductor_polarized(cond.distribution(), mueller, wi_local,
+                                                       uniform, stack.max_microsurface_order, pol),
+                        true);
+                    break;
+                }
+                apply_walk(walk_rough_conductor(
+                               cond.distribution(), [&](float c) { return cond.fresnel(c); },
+                               wi_local, uniform, stack.max_microsurface_order),
+                           true);
+                break;
+            }
+            const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
+            if constexpr (kPolarized)
+                apply(cond.sample_polarized(wi_local, u1, u2, pol), true);
+            else
+                apply(cond.sample<false>(wi_local, u1, u2), true);
+            break;
+        }
+        case InterfaceType::Lambertian: {
+            const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
+            apply(layer.lambertian.sample(wi_local, u1, u2), true);
+            if constexpr (kPolarized) stokes_depolarize<float>(pol.stokes, 3, true);
+            break;
+        }
+    }
+}
+
 // ---- One particle ------------------------------------------------------------------------------
 // docs/physics.md §3: at an interface the particle (arriving along −wi) draws an outgoing direction
 // from the interface's BSDF sampler; its flux is multiplied by the sample weight and the parts
@@ -116,9 +229,6 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         pol.channels = stack.polarization_channels;
         pol.flux = flux;
     }
-    // Where the channels' states differ, a dielectric's branch choice reweights the channels: the
-    // reweighting (zero in expectation per channel) is booked with the base that coloured them.
-    [[maybe_unused]] const bool reweights = kPolarized && pol.channels == 3;
     [[maybe_unused]] auto exit_stokes = [&](std::size_t index) {
         if (!job.stokes_tallies) return;
         float s[3][4];
@@ -133,108 +243,10 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         }
         ++events;
         const CompiledLayer<float>& layer = stack.layers[k];
-        const Vec3f wi_local = -d;
-        // Applies a sample (taken by reference: no copy of the optional in the hot loop).
-        // weight = fresnel_weight (absorbed by an opaque base) · shadowing (lost on the
-        // microsurface); a missing sample is a numerical degeneracy, counted and reported.
-        auto apply = [&](const std::optional<BsdfSample<float>>& s, bool opaque) {
-            if (!s) {
-                ++tally.sums.degenerate;
-                losses.add(BudgetTerm::LostMicrosurface, w);
-                w = Rgbf(0.f);
-                return;
-            }
-            if (opaque) {  // a dielectric's fresnel_weight is 1
-                const Rgbf kept = w * s->fresnel_weight;
-                losses.add(BudgetTerm::AbsorbedBase, w - kept);
-                w = kept;
-            }
-            if (s->shadowing != 1.f) {
-                const Rgbf kept = w * s->shadowing;
-                losses.add(BudgetTerm::LostMicrosurface, w - kept);
-                w = kept;
-            }
-            d = s->wo;
-        };
-        // A rough interface with multiple scattering: the microsurface walk (Heitz et al. 2016)
-        // replaces the single facet; its exit carries the conductor's Fresnel factors. A walk
-        // given up at the facet cap loses its flux to the microsurface; a degenerate one too, and
-        // is counted as a degeneracy.
-        auto apply_walk = [&](const std::optional<MicrosurfaceExit<float>>& e, bool opaque) {
-            if (!e || !e->escaped) {
-                if (!e) ++tally.sums.degenerate;
-                losses.add(BudgetTerm::LostMicrosurface, w);
-                w = Rgbf(0.f);
-                return;
-            }
-            if (opaque) {
-                const Rgbf kept = w * e->weight;
-                losses.add(BudgetTerm::AbsorbedBase, w - kept);
-                w = kept;
-            }
-            d = e->wo;
-        };
-        auto uniform = [&] { return rng.uniform_float(); };
         if constexpr (kPolarized)
             for (int c = 0; c < 3; ++c)
                 flux[c] = w[c];
-        switch (layer.type) {
-            case InterfaceType::Dielectric: {
-                if (layer.multiple) {
-                    if constexpr (kPolarized) {
-                        apply_walk(walk_rough_dielectric_polarized(
-                                       layer.dielectric.distribution(), layer.dielectric.eta,
-                                       wi_local, uniform, stack.max_microsurface_order, pol),
-                                   reweights);
-                        break;
-                    }
-                    apply_walk(
-                        walk_rough_dielectric(layer.dielectric.distribution(), layer.dielectric.eta,
-                                              wi_local, uniform, stack.max_microsurface_order),
-                        false);
-                    break;
-                }
-                const float uc = rng.uniform_float(), u1 = rng.uniform_float(),
-                            u2 = rng.uniform_float();
-                if constexpr (kPolarized)
-                    apply(layer.dielectric.sample_polarized(wi_local, uc, u1, u2, pol), reweights);
-                else
-                    apply(layer.dielectric.sample<false>(wi_local, uc, u1, u2), false);
-                break;
-            }
-            case InterfaceType::Conductor: {
-                const ConductorInterface<float>& cond = layer.conductor;
-                if (layer.multiple) {
-                    if constexpr (kPolarized) {
-                        const auto mueller = [&](float c, InterfaceMueller<float>* m) {
-                            cond.mueller(c, m);
-                        };
-                        apply_walk(walk_rough_conductor_polarized(
-                                       cond.distribution(), mueller, wi_local, uniform,
-                                       stack.max_microsurface_order, pol),
-                                   true);
-                        break;
-                    }
-                    apply_walk(walk_rough_conductor(
-                                   cond.distribution(), [&](float c) { return cond.fresnel(c); },
-                                   wi_local, uniform, stack.max_microsurface_order),
-                               true);
-                    break;
-                }
-                const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
-                if constexpr (kPolarized)
-                    apply(cond.sample_polarized(wi_local, u1, u2, pol), true);
-                else
-                    apply(cond.sample<false>(wi_local, u1, u2), true);
-                break;
-            }
-            case InterfaceType::Lambertian: {
-                const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
-                apply(layer.lambertian.sample(wi_local, u1, u2), true);
-                if constexpr (kPolarized) stokes_depolarize<float>(pol.stokes, 3, true);
-                break;
-            }
-        }
+        interface_event<kPolarized>(stack, layer, rng, tally, d, w, losses, pol);
         if (is_black(w)) break;
         if (d.z == 0) {
             // An exactly grazing direction (a sampler at the edge of its domain, probability

@@ -40,6 +40,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     // Every setting as it was given (core/setting.h), then what ran: the kernel's instruction set,
     // the bins' ranges, the threads and processes used.
     j.update(settings_to_json(s));
+    j["physics"] = physics_name(s.transport);  // exact, bpb19 or custom
     j["kernel_description"] = kernel_description(s.kernel);
     j["grid"].update({{"theta_range_deg", {0, 90}}, {"phi_range_deg", {0, 180}}, {"folded", true}});
     j["first_particle"] = s.first_particle;

@@ -669,6 +669,7 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
     // ran here.
     sj.update(settings_to_json(s.reference));
     sj.erase("threads");
+    sj["physics"] = physics_name(s.reference.transport);  // exact, bpb19 or custom
     sj["kernel_description"] = kernel_description(s.reference.kernel);
     sj["models"] = model_names;
     // The family of each model (the explorer groups them): its registry group, "ablations" for a

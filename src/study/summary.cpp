@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.h"
 #include "lamina/version.h"
+#include "layers/transport_settings.h"
 #include "study/engine_findings.h"
 
 #include <fmt/format.h>
@@ -367,6 +368,8 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
     f.preset = s.preset;
     f.particles = s.reference.particles;
     f.microsurface = enum_text(s.reference.transport.microsurface);
+    f.physics = physics_name(s.reference.transport);
+    f.polarization = s.reference.transport.polarization;
     f.theta_i = s.reference.theta_i_deg;
     f.grid = s.reference.grid.to_string();
     f.models = models;
@@ -421,6 +424,8 @@ void json_header(const StudyFindings& f, nlohmann::json& j) {
     j["preset"] = f.preset;
     j["particles"] = f.particles;
     j["microsurface"] = f.microsurface;
+    j["physics"] = f.physics;
+    j["polarization"] = f.polarization;
     j["theta_i"] = f.theta_i;
     j["grid"] = f.grid;
     j["models"] = f.models;
@@ -527,11 +532,17 @@ bool is_total(const std::string& group) {
 
 void md_header(const StudyFindings& f, Markdown& out) {
     out("# lamina study: which layered model, for which material, how wrong\n\n");
+    const char* which = f.physics == "exact"   ? "the exact reference"
+                        : f.physics == "bpb19" ? "the 2019 study's reference (`--physics bpb19`)"
+                                               : "a mixed reference";
     out("Preset `{}`: {:.3g} particles per incidence (two independent halves), incidences {}°, "
-        "{} bins, {} configurations, models {}; the reference's rough interfaces {}. lamina "
-        "{}.\n\n",
+        "{} bins, {} configurations, models {}. Against {}: light {}, and rough interfaces that "
+        "{}. How much of each model's error the exact reference's two corrections account for "
+        "is measured in docs/models.md (\"Against which reference?\"). lamina {}.\n\n",
         f.preset, double(f.particles), fmt::join(f.theta_i, "°, "), f.grid, f.configurations,
-        fmt::join(f.models, ", "),
+        fmt::join(f.models, ", "), which,
+        f.polarization ? "polarized at every event (Stokes vectors through Mueller matrices)"
+                       : "unpolarized at every event (the mean of the s and p Fresnel factors)",
         f.microsurface == "multiple"
             ? "scatter multiply on their microsurfaces (Heitz et al. 2016: nothing is lost there)"
             : "scatter once on their microsurfaces (the masked energy is lost and reported)",

@@ -105,6 +105,8 @@ struct FactorFindings {
 struct StudyFindings {
     // What was run.
     std::string preset, grid, microsurface;
+    std::string physics;        ///< exact, bpb19 or custom (layers/transport_settings.h)
+    bool polarization = false;  ///< the reference's light polarized (docs/physics.md §8)
     std::uint64_t particles = 0;
     std::vector<double> theta_i;
     std::vector<std::string> models, categories;

@@ -177,9 +177,21 @@ check_says simulate-masking-default 0 '"transmission_masking": "smith"' cat "$tm
 check_says simulate-masking-json 0 '"transmission_masking": "pbrt"' cat "$tmp/pbrt/result.json"
 check_says simulate-bad-masking 1 "--transmission-masking: 'walter' is not a transmission masking" \
     "$lamina" simulate "$src/examples/plastic.json" --transmission-masking walter --out "$tmp/bad1"
-# Polarized transport (docs/physics.md §8): off by default, on says so in result.json; --mueller
-# writes the Mueller tables (numpy .npy) and needs --polarization on; a bad value is refused.
-check_says simulate-polarization-default 0 '"polarization": false' cat "$tmp/sim/result.json"
+# Polarized transport (docs/physics.md §8): on by default with multiple scattering on the
+# microsurfaces (the exact reference), which result.json says; --physics bpb19 is the 2019 study's
+# reference and an explicit setting beside it wins; --mueller writes the Mueller tables (numpy
+# .npy) and needs --polarization on; a bad value is refused.
+check_says simulate-polarization-default 0 '"polarization": true' cat "$tmp/sim/result.json"
+check_says simulate-physics-default 0 '"physics": "exact"' cat "$tmp/sim/result.json"
+check simulate-bpb19 0 "$lamina" simulate "$src/examples/plastic.json" --theta-i 30 \
+    --particles 1e4 --grid 9x9 --physics bpb19 --out "$tmp/bpb19"
+check_says simulate-bpb19-json 0 '"microsurface": "single"' cat "$tmp/bpb19/result.json"
+check_says simulate-bpb19-pol 0 '"polarization": false' cat "$tmp/bpb19/result.json"
+check simulate-custom 0 "$lamina" simulate "$src/examples/plastic.json" --theta-i 30 \
+    --particles 1e4 --grid 9x9 --microsurface multiple --physics bpb19 --out "$tmp/custom"
+check_says simulate-custom-json 0 '"physics": "custom"' cat "$tmp/custom/result.json"
+check_says simulate-bad-physics 1 "--physics: 'bpb18' is not a reference physics" \
+    "$lamina" simulate "$src/examples/plastic.json" --physics bpb18 --out "$tmp/bad-physics"
 check simulate-polarized 0 "$lamina" simulate "$src/examples/slab.json" --theta-i 30 \
     --particles 2e4 --grid 9x9 --polarization on --mueller --out "$tmp/pol"
 check_says simulate-polarized-json 0 '"polarization": true' cat "$tmp/pol/result.json"
@@ -188,7 +200,7 @@ for f in mueller.npy mueller_se.npy; do
 done
 check_says simulate-mueller-npy 0 "'shape': (1, 2, 9, 9, 3, 4, 4)" head -c 128 "$tmp/pol/mueller.npy"
 check_says simulate-mueller-needs-polarization 1 "--mueller: needs --polarization on" \
-    "$lamina" simulate "$src/examples/plastic.json" --mueller --out "$tmp/bad-mueller"
+    "$lamina" simulate "$src/examples/plastic.json" --polarization off --mueller --out "$tmp/bad-mueller"
 check_says simulate-bad-polarization 1 "--polarization" \
     "$lamina" simulate "$src/examples/plastic.json" --polarization maybe --out "$tmp/bad-pol"
 check_says render-bad-masking 1 "--transmission-masking: 'walter' is not a transmission masking" \
@@ -240,7 +252,7 @@ check render-ms-reproducible 0 cmp "$tmp/ms1.exr" "$tmp/ms2.exr"
 check_says render-ms-bad 1 "--microsurface: 'lots' is not a microsurface model" \
     "$lamina" render "$src/examples/plastic.json" --microsurface lots --size 8 --spp 1 --out "$tmp/ms3.png"
 check_says render-ms-model 1 "applies to the random-walk reference only" \
-    "$lamina" render "$src/examples/plastic.json" --model ww-prime --microsurface multiple --size 8 --spp 1 --out "$tmp/ms4.png"
+    "$lamina" render "$src/examples/plastic.json" --model ww-prime --microsurface single --size 8 --spp 1 --out "$tmp/ms4.png"
 check_says eval-ms-bad 1 "allowed: single, multiple" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 --theta-o 45 --option microsurface=lots
 check_says render-bad-env 1 "unknown environment" \

@@ -2,7 +2,7 @@
 // dielectric_event, conductor.h conductor_event, lambertian.h lambertian_event, medium.h
 // medium_free_flight and medium_scatter, with phase.h sample_hg_direction): each template
 // instantiated on the dispatched instruction set's vectors (the SIMD kernel's instantiation,
-// through simulator/kernel_simd.h's test entry points; ctest's simd_AVX2 and simd_SSE4 runs repeat
+// through the probes of tests/support/simd_probes.h; ctest's simd_AVX2 and simd_SSE4 runs repeat
 // these tests with LAMINA_SIMD_TARGET, so every compiled instruction set is checked) against its
 // scalar float instantiation (the one the scalar kernel runs), on the same inputs and random
 // numbers: random directions on both sides and the edges (normal incidence, grazing at
@@ -22,7 +22,7 @@
 #include "physics/lambertian.h"
 #include "physics/medium.h"
 #include "physics/polarization.h"
-#include "simulator/kernel_simd.h"
+#include "support/simd_probes.h"
 
 #include <gtest/gtest.h>
 

@@ -58,9 +58,10 @@ TEST(RandomWalkMultiple, FirstOrderIsTheSingleScatteringInterface) {
     }
     int checked = 0;
     for (const Case& c : cases) {
-        const RandomWalkStack single(c.stack, {.microsurface = Single});
-        const RandomWalkStack first(c.stack,
-                                    {.microsurface = Multiple, .max_microsurface_order = 1});
+        const RandomWalkStack single(c.stack, {.microsurface = Single, .polarization = false});
+        const RandomWalkStack first(
+            c.stack,
+            {.microsurface = Multiple, .max_microsurface_order = 1, .polarization = false});
         for (double ti : {0.4, 1.2})
             for (const Vec3d& wo : wos) {
                 const Vec3d wi = incident_direction(ti);
@@ -169,14 +170,15 @@ TEST(RandomWalkMultipleStat, WhiteFurnaceByQuadratureOfTheEval) {
     for (const Case& c : cases)
         for (double ti : {0.5, 1.3}) {
             const Vec3d wi = incident_direction(ti);
-            const RandomWalkStack multiple(c.stack, {.microsurface = Multiple});
+            const RandomWalkStack multiple(c.stack,
+                                           {.microsurface = Multiple, .polarization = false});
             const Albedo a = total_albedo(multiple, wi, 48, 8);
             EXPECT_LT(std::abs(a.mean - 1), 4.5 * a.se)
                 << c.name << " θi " << ti << ": " << a.mean << " ± " << a.se;
             EXPECT_LT(a.se, 0.02) << c.name;  // the test's resolution
             RecordProperty(c.name + " θi " + std::to_string(ti),
                            std::to_string(a.mean) + " ± " + std::to_string(a.se));
-            const RandomWalkStack single(c.stack, {.microsurface = Single});
+            const RandomWalkStack single(c.stack, {.microsurface = Single, .polarization = false});
             const Albedo s = total_albedo(single, wi, 48, 8);
             EXPECT_GT(1 - s.mean, 5 * s.se)
                 << c.name << " θi " << ti << " single: " << s.mean << " ± " << s.se;
@@ -189,7 +191,7 @@ TEST(RandomWalkMultipleStat, WhiteFurnaceByQuadratureOfTheEval) {
 TEST(RandomWalkMultipleStat, WhiteFurnaceOfTheSampleWeights) {
     for (double alpha : {0.3, 1.0}) {
         const RandomWalkStack rw(test::make_stack({test::dielectric_layer(1.5, alpha)}),
-                                 {.microsurface = Multiple});
+                                 {.microsurface = Multiple, .polarization = false});
         for (double ti : {0.5, 1.3}) {
             const Vec3d wi = incident_direction(ti);
             const int n = 200000;
@@ -219,11 +221,12 @@ TEST(RandomWalkMultiple, IndexMatchedRoughInterfaceIsAPassThrough) {
         test::make_stack({test::with_medium(test::dielectric_layer(1.0, 0.5), Rgbd(0.0)),
                           test::dielectric_layer(1.0, 0.0)});
     const Vec3d wi = incident_direction(1.0);
-    const auto lobes = RandomWalkStack(stack, {.microsurface = Multiple}).delta_lobes(wi);
+    const auto lobes =
+        RandomWalkStack(stack, {.microsurface = Multiple, .polarization = false}).delta_lobes(wi);
     ASSERT_EQ(lobes.size(), 1u);
     EXPECT_LT(lobes[0].direction.z, 0);
     EXPECT_NEAR(lobes[0].energy[0], 1.0, 1e-12);
-    const auto single = RandomWalkStack(stack).delta_lobes(wi);
+    const auto single = RandomWalkStack(stack, test::bpb19_transport()).delta_lobes(wi);
     ASSERT_EQ(single.size(), 1u);
     EXPECT_LT(single[0].energy[0], 0.99);
 }
@@ -232,7 +235,7 @@ TEST(RandomWalkMultiple, DeterministicForASeedAndFinite) {
     const RandomWalkStack rw(
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1)),
                           test::conductor_layer(Rgbd(0.2, 0.4, 1.4), Rgbd(3.9, 2.4, 1.6), 0.3)}),
-        {.microsurface = Multiple});
+        {.microsurface = Multiple, .polarization = false});
     const Vec3d wi = incident_direction(0.6), wo = direction_from_angles(1.1, 2.0);
     const RandomWalkEstimate a = rw.eval(wi, wo, 500, 1, 7), b = rw.eval(wi, wo, 500, 1, 7);
     EXPECT_EQ(a.f, b.f);

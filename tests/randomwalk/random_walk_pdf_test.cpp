@@ -39,7 +39,8 @@ TEST(RandomWalkPdf, OneInterfaceIsItsOwnSamplingDensity) {
                                     direction_from_angles(0.4, 3.1, Side::Transmission),
                                     direction_from_angles(1.0, 1.0, Side::Transmission)};
     {
-        const RandomWalkStack rw(test::make_stack({test::dielectric_layer(1.5, 0.3)}));
+        const RandomWalkStack rw(test::make_stack({test::dielectric_layer(1.5, 0.3)}),
+                                 test::bpb19_transport());
         const DielectricInterface<double> d{1.5, 0.3};
         for (const Vec3d& wo : wos) {
             const RandomWalkPdf p = rw.pdf(wi, wo, 64, 1, 1);
@@ -48,7 +49,8 @@ TEST(RandomWalkPdf, OneInterfaceIsItsOwnSamplingDensity) {
         }
     }
     {
-        const RandomWalkStack rw(test::make_stack({test::lambertian_layer(Rgbd(0.2, 0.5, 0.9))}));
+        const RandomWalkStack rw(test::make_stack({test::lambertian_layer(Rgbd(0.2, 0.5, 0.9))}),
+                                 test::bpb19_transport());
         for (const Vec3d& wo : wos) {
             const RandomWalkPdf p = rw.pdf(wi, wo, 64, 1, 1);
             EXPECT_NEAR(p.pdf, std::max(0.0, wo.z) / kPi<double>, 1e-15);
@@ -56,7 +58,8 @@ TEST(RandomWalkPdf, OneInterfaceIsItsOwnSamplingDensity) {
     }
     {
         const Rgbd eta(0.2, 0.4, 1.4), k(3.9, 2.4, 1.6);
-        const RandomWalkStack rw(test::make_stack({test::conductor_layer(eta, k, 0.25)}));
+        const RandomWalkStack rw(test::make_stack({test::conductor_layer(eta, k, 0.25)}),
+                                 test::bpb19_transport());
         const ConductorInterface<double> c{eta, k, 0.25};
         for (const Vec3d& wo : wos) {
             EXPECT_NEAR(rw.pdf(wi, wo, 64, 1, 1).pdf, c.pdf(wi, wo), 1e-12 * c.pdf(wi, wo));
@@ -65,11 +68,13 @@ TEST(RandomWalkPdf, OneInterfaceIsItsOwnSamplingDensity) {
     // Only smooth events: every exit is a delta exit, the density is zero everywhere.
     const RandomWalkStack smooth(
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.2)),
-                          test::dielectric_layer(1.0, 0.0)}));
+                          test::dielectric_layer(1.0, 0.0)}),
+        test::bpb19_transport());
     for (const Vec3d& wo : wos)
         EXPECT_EQ(smooth.pdf(wi, wo, 64, 1, 1).pdf, 0);
     // A black base kills every walk that reaches it.
-    const RandomWalkStack black(test::make_stack({test::lambertian_layer(Rgbd(0.0))}));
+    const RandomWalkStack black(test::make_stack({test::lambertian_layer(Rgbd(0.0))}),
+                                test::bpb19_transport());
     EXPECT_EQ(black.pdf(wi, wos[0], 64, 1, 1).pdf, 0);
 }
 
@@ -86,7 +91,7 @@ TEST(RandomWalkPdfStat, SmoothCoatOverLambertianIsTheWhiteSeries) {
     const Stack stack =
         test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), Rgbd(0.1, 0.6, 0.0)),
                           test::lambertian_layer(Rgbd(0.8, 0.5, 0.2))});
-    const RandomWalkStack rw(stack);
+    const RandomWalkStack rw(stack, test::bpb19_transport());
     ASSERT_TRUE(rw.pdf_is_unbiased());
     const test::CoatedLambertianSeries white(eta, Rgbd(0.0), Rgbd(1.0));
     const int tests = 4 * 3 * 2;
@@ -121,7 +126,7 @@ struct PdfCase {
 };
 
 void expect_sample_matches_pdf(const PdfCase& c, int test_count) {
-    const RandomWalkStack rw(c.stack, {.microsurface = c.microsurface});
+    const RandomWalkStack rw(c.stack, {.microsurface = c.microsurface, .polarization = false});
     ASSERT_TRUE(rw.pdf_is_unbiased()) << c.name;
     const Vec3d wi = incident_direction(deg_to_rad(40.0));
     const std::uint64_t walks_per_cell = 3000;
@@ -217,19 +222,21 @@ TEST(RandomWalkPdfStat, MultipleScatteringSampleHistogramMatchesThePdf) {
 // The exactness condition: a scattering medium with per-channel extinction under a smooth
 // coloured conductor makes the chain probabilities non-linear in the weights.
 TEST(RandomWalkPdf, ReportsWhenItsEstimateIsNotExact) {
-    EXPECT_TRUE(RandomWalkStack(example("milky-coat")).pdf_is_unbiased());
-    EXPECT_TRUE(RandomWalkStack(example("metallic-paint")).pdf_is_unbiased());
+    EXPECT_TRUE(RandomWalkStack(example("milky-coat"), test::bpb19_transport()).pdf_is_unbiased());
+    EXPECT_TRUE(
+        RandomWalkStack(example("metallic-paint"), test::bpb19_transport()).pdf_is_unbiased());
     const Stack mixed = test::make_stack(
         {test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.0), Rgbd(0.2, 0.5, 1.0)),
          test::conductor_layer(Rgbd(0.2, 0.4, 1.4), Rgbd(3.9, 2.4, 1.6), 0.0)});
-    EXPECT_FALSE(RandomWalkStack(mixed).pdf_is_unbiased());
+    EXPECT_FALSE(RandomWalkStack(mixed, test::bpb19_transport()).pdf_is_unbiased());
 }
 
 // Polarized walks: pdf() is the unpolarized walk's exit density (a proxy, random_walk.h), the
 // same estimate bit for bit as without polarization, and says it is not exact.
 TEST(RandomWalkPdf, PolarizedWalksKeepTheUnpolarizedDensity) {
     const Stack stack = example("frosted-gold");
-    const RandomWalkStack plain(stack), polarized(stack, {.polarization = true});
+    const RandomWalkStack plain(stack, test::bpb19_transport()),
+        polarized(stack, {.microsurface = Microsurface::Single, .polarization = true});
     EXPECT_FALSE(polarized.pdf_is_unbiased());
     const Vec3d wi = incident_direction(0.6), wo = direction_from_angles(0.8, 2.8);
     EXPECT_EQ(plain.pdf(wi, wo, 200, 3, 0).pdf, polarized.pdf(wi, wo, 200, 3, 0).pdf);

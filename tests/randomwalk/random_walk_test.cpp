@@ -110,10 +110,9 @@ SimulationResult simulate_one(const Stack& stack, double theta_i, std::uint64_t 
     s.grid = grid;
     s.seed = 11;
     s.transport.polarization = polarization;
-    if (microsurface == RwMicrosurface::Multiple) {
-        s.transport.microsurface = Microsurface::Multiple;
+    s.transport.microsurface = microsurface;
+    if (microsurface == RwMicrosurface::Multiple)
         s.kernel = Kernel::Scalar;  // the goniophotometer's kernel with multiple scattering
-    }
     return simulate(stack, s);
 }
 
@@ -235,7 +234,7 @@ TEST(RandomWalkStat, SmoothCoatOverLambertianSeries) {
     const Rgbd tau(0.1, 0.5, 0.0), rho(0.8, 0.5, 1.0);
     const Stack stack = test::make_stack(
         {test::with_medium(test::dielectric_layer(eta, 0.0), tau), test::lambertian_layer(rho)});
-    const RandomWalkStack rw(stack);
+    const RandomWalkStack rw(stack, test::bpb19_transport());
     const test::CoatedLambertianSeries series(eta, tau, rho);
     int n = 0;
     double worst = 0;
@@ -276,7 +275,8 @@ TEST(RandomWalkGolden, DeltaLobesOfSmoothSlabAndCoatedConductor) {
         {
             const RandomWalkStack rw(
                 test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), Rgbd(tau)),
-                                  test::dielectric_layer(1.0, 0.0)}));
+                                  test::dielectric_layer(1.0, 0.0)}),
+                test::bpb19_transport());
             const auto lobes = rw.delta_lobes(wi);
             ASSERT_EQ(lobes.size(), 2u);
             EXPECT_NEAR(lobes[0].energy[1], F + sqr(1 - F) * F * a * a / (1 - F * F * a * a),
@@ -289,7 +289,8 @@ TEST(RandomWalkGolden, DeltaLobesOfSmoothSlabAndCoatedConductor) {
             const Rgbd ce(0.2, 0.4, 1.4), ck(3.9, 2.4, 1.6);
             const RandomWalkStack rw(
                 test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), Rgbd(tau)),
-                                  test::conductor_layer(ce, ck, 0.0)}));
+                                  test::conductor_layer(ce, ck, 0.0)}),
+                test::bpb19_transport());
             const auto lobes = rw.delta_lobes(wi);
             ASSERT_EQ(lobes.size(), 1u);
             for (int c = 0; c < 3; ++c) {
@@ -312,7 +313,7 @@ TEST(RandomWalkStat, Reciprocity) {
     int tests = 0;
     double worst = 0;
     for (const Stack& s : stacks) {
-        const RandomWalkStack rw(s);
+        const RandomWalkStack rw(s, test::bpb19_transport());
         for (const auto& [a, b] : std::vector<std::pair<Vec3d, Vec3d>>{
                  {direction_from_angles(0.3, 0.0), direction_from_angles(1.1, 2.0)},
                  {direction_from_angles(1.3, 0.5), direction_from_angles(0.2, 3.0)},
@@ -350,7 +351,8 @@ TEST(RandomWalkStat, FlippedStackIsTheStackSeenFromBelow) {
     const Stack twice = flipped_stack(flipped_stack(ball));
     EXPECT_EQ(twice.layers, ball.layers);
     EXPECT_EQ(twice.ambient_eta, ball.ambient_eta);
-    const RandomWalkStack rw(ball), below(flipped_stack(ball));
+    const RandomWalkStack rw(ball, test::bpb19_transport()),
+        below(flipped_stack(ball), test::bpb19_transport());
     EXPECT_EQ(below.eta_top(), 1.33);
     EXPECT_EQ(below.eta_bottom(), 1.0);
     const double ratio2 = sqr(rw.eta_top() / rw.eta_bottom());
@@ -385,7 +387,8 @@ TEST(RandomWalkStat, MultipleScatteringIsReciprocal) {
                           test::conductor_layer(Rgbd(0.2), Rgbd(3.0), 0.5)})};
     std::uint64_t stream = 0;
     for (const Stack& s : brdf_stacks) {
-        const RandomWalkStack rw(s, {.microsurface = RwMicrosurface::Multiple});
+        const RandomWalkStack rw(s,
+                                 {.microsurface = RwMicrosurface::Multiple, .polarization = false});
         for (const auto& [a, b] : std::vector<std::pair<Vec3d, Vec3d>>{
                  {direction_from_angles(0.3, 0.0), direction_from_angles(1.1, 2.0)},
                  {direction_from_angles(1.3, 0.5), direction_from_angles(0.2, 3.0)}}) {
@@ -403,8 +406,10 @@ TEST(RandomWalkStat, MultipleScatteringIsReciprocal) {
     const Stack slab =
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.1)),
                           test::dielectric_layer(1.33, 0.5)});
-    const RandomWalkStack rw(slab, {.microsurface = RwMicrosurface::Multiple});
-    const RandomWalkStack below(flipped_stack(slab), {.microsurface = RwMicrosurface::Multiple});
+    const RandomWalkStack rw(slab,
+                             {.microsurface = RwMicrosurface::Multiple, .polarization = false});
+    const RandomWalkStack below(flipped_stack(slab),
+                                {.microsurface = RwMicrosurface::Multiple, .polarization = false});
     const double ratio2 = sqr(rw.eta_top() / rw.eta_bottom());
     auto flip = [](const Vec3d& w) { return Vec3d(w.x, w.y, -w.z); };
     for (const auto& [wi, wo] : std::vector<std::pair<Vec3d, Vec3d>>{
@@ -586,7 +591,7 @@ TEST(RandomWalkGolden, PolarizedDeltaLobesOfASmoothSlab) {
     const RandomWalkStack rw(
         test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), Rgbd(0.0, tau, 0.0)),
                           test::dielectric_layer(1.0, 0.0)}),
-        {.polarization = true});
+        {.microsurface = Microsurface::Single, .polarization = true});
     for (double ti : {0.0, 40.0, 60.0, 80.0}) {
         const Vec3d wi = incident_direction(deg_to_rad(ti));
         const double mu_t = std::sqrt(1 - (1 - wi.z * wi.z) / (eta * eta));
@@ -605,7 +610,7 @@ TEST(RandomWalkGolden, PolarizedDeltaLobesOfASmoothSlab) {
 
 // ---- Reproducibility ---------------------------------------------------------------------------
 TEST(RandomWalk, DeterministicForASeedAndNoisierWithFewerWalks) {
-    const RandomWalkStack rw(example("milky-coat"));
+    const RandomWalkStack rw(example("milky-coat"), test::bpb19_transport());
     const Vec3d wi = incident_direction(0.5), wo = direction_from_angles(0.9, 2.5);
     const RandomWalkEstimate a = rw.eval(wi, wo, 2000, 1, 7), b = rw.eval(wi, wo, 2000, 1, 7);
     const RandomWalkEstimate c = rw.eval(wi, wo, 2000, 2, 7);
@@ -618,14 +623,16 @@ TEST(RandomWalk, DeterministicForASeedAndNoisierWithFewerWalks) {
 }
 
 TEST(RandomWalk, OpaqueBaseHasNoBtdfAndBlackStackIsBlack) {
-    const RandomWalkStack black(test::make_stack({test::lambertian_layer(Rgbd(0.0))}));
+    const RandomWalkStack black(test::make_stack({test::lambertian_layer(Rgbd(0.0))}),
+                                test::bpb19_transport());
     const Vec3d wi = incident_direction(0.4);
     EXPECT_EQ(black.eval(wi, direction_from_angles(0.3, 1.0), 100, 1, 1).f, Rgbd(0.0));
-    const RandomWalkStack plastic(example("plastic"));
+    const RandomWalkStack plastic(example("plastic"), test::bpb19_transport());
     EXPECT_EQ(plastic.eval(wi, direction_from_angles(0.3, 1.0, Side::Transmission), 100, 1, 1).f,
               Rgbd(0.0));
     // A Lambertian alone: every walk connects once, exactly albedo/π (zero variance).
-    const RandomWalkStack lambert(test::make_stack({test::lambertian_layer(Rgbd(0.25, 0.5, 1.0))}));
+    const RandomWalkStack lambert(test::make_stack({test::lambertian_layer(Rgbd(0.25, 0.5, 1.0))}),
+                                  test::bpb19_transport());
     const RandomWalkEstimate e = lambert.eval(wi, direction_from_angles(1.2, 2.0), 50, 1, 1);
     const Rgbd albedo(0.25, 0.5, 1.0);
     for (int c = 0; c < 3; ++c)

@@ -74,7 +74,8 @@ async function main() {
     check(drawn.length === want.length && drawn.every((v, x) => v === want[x]) && want.some((v) => v > 0),
       `the slice's reference is tables.lza's, bit for bit (${drawn.slice(0, 4)}… against ${want.slice(0, 4)}…)`);
     const info = await page.evaluate(() => document.getElementById("study-info").textContent);
-    check(info.includes("single-scattering microsurfaces"), `the header names the reference's microsurface model (${info})`);
+    check(info.includes("the 2019 reference") && info.includes("single-scattering microsurfaces") && info.includes("unpolarized Fresnel factors"),
+      `the header names the reference (${info})`);
     const cells = await page.evaluate(() => (document.getElementById("leaderboard").data[0] || {}).z);
     check(Array.isArray(cells) && cells.length >= 2, "the leaderboard lists the configurations");
     await page.screenshot({ path: shot, fullPage: true });

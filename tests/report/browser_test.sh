@@ -13,9 +13,11 @@ if [ ! -d "$src/node_modules/playwright-core" ]; then
 fi
 node "$src/tests/report/browser_test.js" "$study" "$build/screenshots"
 
-# And the page of a small real study, end to end: lamina study writes it, Chromium opens it.
+# And the page of a small real study, end to end: lamina study writes it, Chromium opens it. The
+# 2019 reference (--physics bpb19), whose single-scattering microsurfaces lose energy that the
+# albedo view must draw.
 real="$build/report-real-study"
 rm -rf "$real"
 "$lamina" study --only 'plastic-P1-a0.05,slab-a0.1-a1.3-clear' --theta-i 30 --particles 2e4 \
-    --grid 18x18 --no-figures --out "$real" >/dev/null
+    --grid 18x18 --physics bpb19 --no-figures --out "$real" >/dev/null
 node "$src/tests/report/browser_smoke.js" "$real" "$build/screenshots/real-study.png"

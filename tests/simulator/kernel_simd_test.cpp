@@ -2,7 +2,7 @@
 // libraries and closed forms they stand for, and its tables against the scalar kernel's by a
 // two-sample chi-square test. (Every exact-solution test of goniophotometer_test.cpp also runs on
 // it.)
-#include "simulator/kernel_simd.h"
+#include "support/simd_probes.h"
 
 #include "core/rng.h"
 #include "physics/fresnel.h"
@@ -98,10 +98,10 @@ TEST(KernelSimd, SmithRefractionEscapeLanes) {
                 simd_target_name(), worst_scalar, worst_double);
 }
 
-// The exit bins the SIMD kernel computes on vectors (kernel_simd.cpp VectorBins: a float angle
-// with an error bound, certain only where the bound keeps it inside one bin) against the grid's
-// own rule, HemisphereGrid::bin_of, on several grids: every bin the lanes claim is bin_of's, on
-// random directions of both hemispheres and on directions a few float ulps either side of every
+// The exit bins the SIMD kernel computes on vectors (simulator/lane_bins.h VectorBins: a float
+// angle with an error bound, certain only where the bound keeps it inside one bin) against the
+// grid's own rule, HemisphereGrid::bin_of, on several grids: every bin the lanes claim is bin_of's,
+// on random directions of both hemispheres and on directions a few float ulps either side of every
 // θ and φ edge (where a wrong bound would show), the normal, grazing directions and a subnormal
 // azimuthal radius. On the default grid nearly every random exit is binned on the lanes (else the
 // fast path would be dead code; measured 99.8 %).
@@ -590,6 +590,7 @@ void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
     s.grid = HemisphereGrid(18, 18);
     s.kernel = Kernel::Scalar;
     s.seed = 11;
+    apply_physics(ReferencePhysics::Bpb19, s.transport);  // the tweaks name what they add
     if (both_tweak) both_tweak(s);
     SimulationSettings scalar = s;
     if (scalar_tweak) scalar_tweak(scalar);

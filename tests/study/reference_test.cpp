@@ -19,6 +19,7 @@ SimulationSettings small_settings() {
     s.seed = 3;
     s.grid = HemisphereGrid(6, 6);
     s.kernel = Kernel::Scalar;
+    s.transport = test::bpb19_transport();  // the settings the earlier keys were written for
     return s;
 }
 
@@ -50,6 +51,17 @@ TEST(StudyReference, KeyTextOfTheEarlierSettingsIsUnchanged) {
     s.transport.transmission_masking = TransmissionMasking::Smith;
     EXPECT_EQ(reference_key("c", rough, 30, s).canonical(),
               fixed_part(rough) + " | microsurface multiple");
+}
+
+// The exact reference (the defaults) says both of its settings; the 2019 one neither.
+TEST(StudyReference, TheExactReferenceIsSaidAndTheBpb19KeyIsTheEarlierOne) {
+    const Stack stack = test::make_stack({test::lambertian_layer(Rgbd(0.5))});
+    SimulationSettings s = small_settings();
+    s.transport = TransportSettings{};
+    EXPECT_EQ(reference_key("c", stack, 30, s).canonical(),
+              fixed_part(stack) + " | microsurface multiple | polarization on");
+    apply_physics(ReferencePhysics::Bpb19, s.transport);
+    EXPECT_EQ(reference_key("c", stack, 30, s).canonical(), fixed_part(stack));
 }
 
 TEST(StudyReference, LaterSettingsAreSaidOnlyAwayFromTheirEarlierValue) {

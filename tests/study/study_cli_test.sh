@@ -194,11 +194,14 @@ expect_error "--microsurface: 'double' is not a microsurface model" \
 expect_error "--transmission-masking: 'walter' is not a transmission masking" \
     study --transmission-masking walter --only 'plastic-P1-a0.05' --out "$tmp/x"
 
-# 7. A multiple-scattering reference: its own cache pieces (the key says so), nothing lost to the
-#    microsurfaces in the budgets, and study.json and summary.json say which reference it is.
+# 7. The 2019 reference (--physics bpb19) and the same with multiple scattering: each its own
+#    cache pieces (the key says so), nothing lost to the microsurfaces in the budgets of the
+#    second, and study.json and summary.json say which reference it is.
 ms=(--only 'plastic-P1-a0.05' --models ww-prime --theta-i 60 --particles 2e4 --grid 18x18
-    --no-figures)
+    --no-figures --physics bpb19)
 "$lamina" study "${ms[@]}" --out "$tmp/m" >/dev/null 2>&1 && ok || fail "single-scattering study"
+python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['physics'] == 'bpb19'" \
+    "$tmp/m/study.json" && ok || fail "study.json physics bpb19"
 "$lamina" study "${ms[@]}" --microsurface multiple --out "$tmp/m" >/dev/null 2>&1 \
     && ok || fail "multiple-scattering study"
 [ "$(find "$tmp/m/cache" -name '*.bin' | wc -l)" -eq 2 ] && ok || fail "one cache piece per model"
@@ -206,6 +209,7 @@ python3 - "$tmp/m" <<'PY' && ok || fail "multiple-scattering outputs"
 import json, sys
 d = sys.argv[1]
 assert json.load(open(d + "/study.json"))["microsurface"] == "multiple"
+assert json.load(open(d + "/study.json"))["physics"] == "custom"
 assert json.load(open(d + "/summary.json"))["microsurface"] == "multiple"
 for e in json.load(open(d + "/configs/plastic-P1-a0.05/config.json"))["energy"]:
     assert e["lost_microsurface"] == [0, 0, 0], e

@@ -2,6 +2,7 @@
 // Stacks built in code for tests (the JSON parser has its own tests), on layers/stack.h's builders.
 
 #include "layers/stack.h"
+#include "layers/transport_settings.h"
 
 namespace lamina::test {
 
@@ -21,6 +22,14 @@ inline Layer conductor_layer(Rgbd eta, Rgbd k, double alpha) {
 
 inline Stack make_stack(std::vector<Layer> layers, std::string name = "test") {
     return Stack{std::move(name), 1.0, std::move(layers)};
+}
+
+/// The 2019 reference's transport (unpolarized Fresnel factors, single-scattering interfaces):
+/// the one most closed forms in the tests are written for.
+inline TransportSettings bpb19_transport() {
+    TransportSettings t;
+    apply_physics(ReferencePhysics::Bpb19, t);
+    return t;
 }
 
 }  // namespace lamina::test

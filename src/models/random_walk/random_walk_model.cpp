@@ -59,12 +59,27 @@ std::string option_key(const SettingInfo& info) {
     return option_name(info.name).substr(2);
 }
 
-// Calls visit(info, member) for each transport setting that is a named value (an enum).
+// Calls visit(info, member) for each transport setting that takes named values: an enum or an
+// on/off switch.
 template <typename Transport, typename Visit>
 void named_transport_settings(Transport& t, Visit&& visit) {
     TransportSettings::fields(t, [&](const SettingInfo& info, auto& member) {
-        if constexpr (std::is_enum_v<std::decay_t<decltype(member)>>) visit(info, member);
+        using T = std::decay_t<decltype(member)>;
+        if constexpr (std::is_enum_v<T> || std::is_same_v<T, bool>) visit(info, member);
     });
+}
+
+// The values a named setting takes, as text.
+template <typename T>
+std::vector<std::string> named_values(const T& member) {
+    std::vector<std::string> out;
+    if constexpr (std::is_same_v<T, bool>) {
+        out = {SettingCodec<bool>::to_text(true), SettingCodec<bool>::to_text(false)};
+    } else {
+        for (const auto& n : enum_names(member))
+            out.push_back(n.text);
+    }
+    return out;
 }
 
 }  // namespace
@@ -78,10 +93,9 @@ std::vector<OptionSpec> random_walk_options() {
         {"seed", {"1", "2", "3", "4", "5", "6", "7", "8"}, "1", "seed of the walks"}};
     const TransportSettings defaults;
     named_transport_settings(defaults, [&](const SettingInfo& info, const auto& member) {
-        OptionSpec spec{option_key(info), {}, enum_text(member), info.help};
-        for (const auto& n : enum_names(member))
-            spec.values.push_back(n.text);
-        specs.push_back(std::move(spec));
+        using T = std::decay_t<decltype(member)>;
+        specs.push_back(
+            {option_key(info), named_values(member), SettingCodec<T>::to_text(member), info.help});
     });
     return specs;
 }
@@ -89,7 +103,8 @@ std::vector<OptionSpec> random_walk_options() {
 std::vector<std::string> random_walk_assignments(const TransportSettings& transport) {
     std::vector<std::string> out;
     named_transport_settings(transport, [&](const SettingInfo& info, const auto& member) {
-        out.push_back(option_key(info) + "=" + enum_text(member));
+        using T = std::decay_t<decltype(member)>;
+        out.push_back(option_key(info) + "=" + SettingCodec<T>::to_text(member));
     });
     return out;
 }

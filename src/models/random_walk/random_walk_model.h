@@ -56,8 +56,9 @@ std::vector<std::string> random_walk_assignments(const TransportSettings& transp
 std::uint64_t query_stream(const Vec3d& wi, const Vec3d& wo);
 
 /// The registry's entry points. The options are the walks per query (`samples`), their `seed`,
-/// and the transport settings that are named values (every enum of TransportSettings, under its
-/// setting's name with '-' for '_'); the numbers among them keep their defaults.
+/// and the transport settings that take named values (every enum and on/off switch of
+/// TransportSettings, under its setting's name with '-' for '_'); the numbers among them keep
+/// their defaults.
 std::vector<OptionSpec> random_walk_options();
 std::unique_ptr<Model> make_random_walk(const Stack& stack, const ModelOptions& options);
 

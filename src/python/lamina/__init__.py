@@ -57,13 +57,28 @@ DEFAULT_THETA_I = tuple(_lamina.DEFAULT_THETA_I)
 SIMULATION_SETTINGS = dict(_lamina.SIMULATION_SETTINGS)
 
 
+# The named references and the settings each one sets (one owner: ReferencePhysics in
+# src/layers/transport_settings.h): "exact" (the defaults) and "bpb19" (the 2019 study's).
+REFERENCE_PHYSICS = {k: dict(v) for k, v in _lamina.REFERENCE_PHYSICS.items()}
+
+
 def _reference_settings(settings):
-    """The settings given, checked by name; their values are checked by lamina itself."""
+    """The settings given, checked by name; their values are checked by lamina itself.
+    physics="exact"|"bpb19" stands for the settings it names; one given beside it wins."""
+    settings = dict(settings)
+    physics = settings.pop("physics", None)
     for name in settings:
         if name not in SIMULATION_SETTINGS:
             raise input_error("arguments", name,
-                              f"is not a setting; the settings are {', '.join(SIMULATION_SETTINGS)}")
-    return dict(settings)
+                              f"is not a setting; the settings are physics, "
+                              f"{', '.join(SIMULATION_SETTINGS)}")
+    if physics is not None:
+        if physics not in REFERENCE_PHYSICS:
+            raise input_error("arguments", "physics",
+                              f"{physics!r} is not a reference; use one of "
+                              f"{', '.join(REFERENCE_PHYSICS)}")
+        settings = dict(REFERENCE_PHYSICS[physics], **settings)
+    return settings
 
 
 def _grid_pair(grid):
@@ -81,8 +96,9 @@ def simulate(stack, progress=None, **settings):
 
     stack: a Stack, a dict in the stack format or a path. settings: any of SIMULATION_SETTINGS by
     name, as `lamina simulate` takes them (theta_i: degrees in [0, 90), one or a list; particles:
-    per incidence; seed, threads, grid=(n_theta, n_phi), kernel, microsurface,
-    transmission_masking, max_events, ...; docs/python.md); the others keep their defaults. The
+    per incidence; seed, threads, grid=(n_theta, n_phi), kernel, microsurface, polarization,
+    transmission_masking, max_events, ...; docs/python.md), or physics="bpb19" for the 2019
+    study's reference (REFERENCE_PHYSICS); the others keep their defaults. The
     tables are bitwise those of `lamina simulate` with the same inputs (for the same kernel on the
     same machine) and do not depend on `threads`. The GIL is released while particles are traced;
     Ctrl-C stops the run between chunks of particles and raises KeyboardInterrupt. progress: draw a

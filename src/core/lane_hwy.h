@@ -1,0 +1,194 @@
+// Lanes on Highway vectors: the operations struct of core/lane.h for the lanes of a SIMD vector
+// (VecLane), the vector maths it needs that Highway does not provide (a refined 1/√x, cos and sin
+// of 2πu together, acos), and the lane types and small helpers every SIMD translation unit
+// shares. The lane templates instantiated with VecLane are the SIMD particle kernel's physics
+// (simulator/kernel_simd.cpp); the lane tests instantiate them again (tests/support/simd_probes).
+//
+// A per-target header. A translation unit of vector code is compiled once per instruction set:
+// it names itself HWY_TARGET_INCLUDE, includes <hwy/foreach_target.h>, and then includes this
+// header and the lane headers it instantiates between `#define LAMINA_LANE_TARGET` and
+// `#undef LAMINA_LANE_TARGET`:
+//
+//   #define LAMINA_LANE_TARGET
+//   #include "core/lane_hwy.h"
+//   #include "physics/fresnel.h"   // its templates again, in this target's namespace
+//   #undef LAMINA_LANE_TARGET
+//
+// This header points LAMINA_LANE_BEGIN/END at the target's namespace (lamina::HWY_NAMESPACE), so
+// it comes after the unit's ordinary includes: a lane header first met after it would put its
+// scalar templates there.
+
+#ifndef LAMINA_LANE_TARGET
+#error "core/lane_hwy.h is included per SIMD target, with LAMINA_LANE_TARGET defined (see above)"
+#endif
+
+#include "core/lane.h"
+#include "core/math.h"
+
+#include <cstddef>
+#include <cstdint>
+
+#include <hwy/contrib/math/math-inl.h>
+#include <hwy/highway.h>
+
+#undef LAMINA_LANE_BEGIN
+#undef LAMINA_LANE_END
+#define LAMINA_LANE_BEGIN   \
+    HWY_BEFORE_NAMESPACE(); \
+    namespace lamina {      \
+    namespace HWY_NAMESPACE {
+#define LAMINA_LANE_END \
+    }                   \
+    }                   \
+    HWY_AFTER_NAMESPACE();
+
+#include "core/lane_vec.h"
+
+// Highway's per-target include guard: the body once per instruction set.
+#if defined(LAMINA_CORE_LANE_HWY_H) == defined(HWY_TARGET_TOGGLE)
+#ifdef LAMINA_CORE_LANE_HWY_H
+#undef LAMINA_CORE_LANE_HWY_H
+#else
+#define LAMINA_CORE_LANE_HWY_H
+#endif
+
+LAMINA_LANE_BEGIN
+
+namespace hn = hwy::HWY_NAMESPACE;
+
+// Lanes of floats and their integer and mask companions, full vectors of the instruction set.
+using DF = hn::ScalableTag<float>;
+using DI = hn::RebindToSigned<DF>;
+using DU = hn::RebindToUnsigned<DF>;
+using VF = hn::Vec<DF>;
+using VI = hn::Vec<DI>;
+using VU = hn::Vec<DU>;
+using MF = hn::Mask<DF>;
+using MI = hn::Mask<DI>;
+using V3 = LaneVec3<VF>;  // a direction as three vectors (core/lane_vec.h)
+
+/// The most float lanes of any compiled instruction set: the size of a per-lane array.
+constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(float);
+
+/// 1/√x from the hardware estimate refined by one Newton step (y ← y (3 − x y²)/2): ≤ 2^-22
+/// relative error whatever the estimate's precision (≥ 12 bits on every target), a fraction of
+/// the cost of a square root and a division.
+HWY_INLINE VF InvSqrt(VF x) {
+    const DF df;
+    const VF y = hn::ApproximateReciprocalSqrt(x);
+    const VF half_x_y2 = hn::Mul(hn::Mul(hn::Set(df, 0.5f), x), hn::Mul(y, y));
+    return hn::Mul(y, hn::Sub(hn::Set(df, 1.5f), half_x_y2));
+}
+
+/// cos and sin of 2π u for u ∈ [0, 1) (a uniform azimuth), both at once. 2πu = (π/4)(j + f) with
+/// j = ⌊8u⌋ and f = 8u − j, exact in float (u has 24 bits); the octant's angle a ∈ [0, π/4] goes
+/// through the minimax polynomials of the Cephes library's sinf/cosf (Moshier 1992, "Methods and
+/// Programs for Mathematical Functions"; errors below 1 ulp on [−π/4, π/4]), and the octant's
+/// symmetries give cos and sin of the whole angle. One reduction for both instead of two.
+HWY_INLINE void CosSin2Pi(VF u, VF& c, VF& s) {
+    const DF df;
+    const DI di;
+    const VF t = hn::Mul(u, hn::Set(df, 8.f));
+    const VF j_f = hn::Floor(t);
+    const VI j = hn::ConvertTo(di, j_f);
+    const VF f = hn::Sub(t, j_f);
+    const auto odd = hn::RebindMask(df, hn::Ne(hn::And(j, hn::Set(di, 1)), hn::Zero(di)));
+    const VF a = hn::Mul(hn::IfThenElse(odd, hn::Sub(hn::Set(df, 1.f), f), f),
+                         hn::Set(df, 0.25f * kPi<float>));
+    const VF z = hn::Mul(a, a);
+    VF sin_a = hn::MulAdd(z, hn::Set(df, -1.9515295891e-4f), hn::Set(df, 8.3321608736e-3f));
+    sin_a = hn::MulAdd(z, sin_a, hn::Set(df, -1.6666654611e-1f));
+    sin_a = hn::MulAdd(hn::Mul(z, a), sin_a, a);
+    VF cos_a =
+        hn::MulAdd(z, hn::Set(df, 2.443315711809948e-5f), hn::Set(df, -1.388731625493765e-3f));
+    cos_a = hn::MulAdd(z, cos_a, hn::Set(df, 4.166664568298827e-2f));
+    cos_a = hn::MulAdd(hn::Mul(z, z), cos_a, hn::NegMulAdd(hn::Set(df, 0.5f), z, hn::Set(df, 1.f)));
+    // Octants 1, 2, 5, 6 swap sin and cos; cos < 0 in octants 2–5, sin < 0 in octants 4–7.
+    const auto swap = hn::RebindMask(
+        df, hn::Ne(hn::And(hn::Add(j, hn::Set(di, 1)), hn::Set(di, 2)), hn::Zero(di)));
+    const auto cos_negative = hn::RebindMask(
+        df, hn::Ne(hn::And(hn::Add(j, hn::Set(di, 2)), hn::Set(di, 4)), hn::Zero(di)));
+    const auto sin_negative = hn::RebindMask(df, hn::Ne(hn::And(j, hn::Set(di, 4)), hn::Zero(di)));
+    const VF c_abs = hn::IfThenElse(swap, sin_a, cos_a);
+    const VF s_abs = hn::IfThenElse(swap, cos_a, sin_a);
+    c = hn::IfThenElse(cos_negative, hn::Neg(c_abs), c_abs);
+    s = hn::IfThenElse(sin_negative, hn::Neg(s_abs), s_abs);
+}
+
+/// Acos's error bound, radians: Abramowitz & Stegun 1964, Eq. 4.4.46 has |ε| ≤ 2·10^-8 on [0, 1];
+/// in float the error is that of the rounding, at most 4.3e-7 rad (measured on 4·10^6 points of
+/// [−1, 1] against the double acos; the float operations bound it by about 5e-7: ulp-level square
+/// root, polynomial and product, π − r rounded once).
+constexpr double kAcosErrorBound = 5e-7;
+
+/// acos(x), x ∈ [−1, 1]: Abramowitz & Stegun 1964, Eq. 4.4.46, with acos(−x) = π − acos(x);
+/// within kAcosErrorBound.
+HWY_INLINE VF Acos(VF x) {
+    const DF df;
+    const VF a = hn::Abs(x);
+    VF p = hn::MulAdd(hn::Set(df, -0.0012624911f), a, hn::Set(df, 0.0066700901f));
+    p = hn::MulAdd(p, a, hn::Set(df, -0.0170881256f));
+    p = hn::MulAdd(p, a, hn::Set(df, 0.0308918810f));
+    p = hn::MulAdd(p, a, hn::Set(df, -0.0501743046f));
+    p = hn::MulAdd(p, a, hn::Set(df, 0.0889789874f));
+    p = hn::MulAdd(p, a, hn::Set(df, -0.2145988016f));
+    p = hn::MulAdd(p, a, hn::Set(df, 1.5707963050f));
+    const VF r = hn::Mul(hn::Sqrt(hn::ZeroIfNegative(hn::Sub(hn::Set(df, 1.f), a))), p);
+    return hn::IfThenElse(hn::Lt(x, hn::Zero(df)), hn::Sub(hn::Set(df, kPi<float>), r), r);
+}
+
+/// The operations of core/lane.h on vectors: the lane templates (core/beta_function.h, the
+/// physics headers) instantiated on the lanes of VF. Highway's contrib math functions: Log
+/// ≤ 4 ulp, Log1p ≤ 2 ulp, Exp ≤ 1 ulp (hwy/contrib/math).
+struct VecLane {
+    using Value = VF;
+    using Mask = MF;
+    static HWY_INLINE VF constant(double x) { return hn::Set(DF(), float(x)); }
+    static HWY_INLINE VF min(VF a, VF b) { return hn::Min(a, b); }
+    static HWY_INLINE VF max(VF a, VF b) { return hn::Max(a, b); }
+    static HWY_INLINE VF sqrt(VF x) { return hn::Sqrt(x); }
+    static HWY_INLINE VF log(VF x) { return hn::Log(DF(), x); }
+    static HWY_INLINE VF log1p(VF x) { return hn::Log1p(DF(), x); }
+    static HWY_INLINE VF exp(VF x) { return hn::Exp(DF(), x); }
+    static HWY_INLINE VF select(MF m, VF a, VF b) { return hn::IfThenElse(m, a, b); }
+    static HWY_INLINE MF less(VF a, VF b) { return hn::Lt(a, b); }
+    static HWY_INLINE VF abs(VF x) { return hn::Abs(x); }
+    static HWY_INLINE VF copysign(VF a, VF b) { return hn::CopySign(a, b); }
+    static HWY_INLINE VF mul_add(VF a, VF b, VF c) { return hn::MulAdd(a, b, c); }
+    static HWY_INLINE VF neg_mul_add(VF a, VF b, VF c) { return hn::NegMulAdd(a, b, c); }
+    static HWY_INLINE VF inv_sqrt(VF x) { return InvSqrt(x); }
+    static HWY_INLINE void cos_sin_2pi(VF u, VF& c, VF& s) { CosSin2Pi(u, c, s); }
+    static HWY_INLINE MF both(MF m, MF n) { return hn::And(m, n); }
+    static HWY_INLINE MF either(MF m, MF n) { return hn::Or(m, n); }
+    static HWY_INLINE MF negate(MF m) { return hn::Not(m); }
+    static HWY_INLINE bool none(MF m) { return hn::AllFalse(DF(), m); }
+    static constexpr double kBetaArgumentMax = Lane<float>::kBetaArgumentMax;
+    static constexpr bool kSinglePrecision = true;
+};
+
+/// a where the mask m holds, else b (lane_select without the operations struct).
+HWY_INLINE V3 Select(MF m, const V3& a, const V3& b) {
+    return {hn::IfThenElse(m, a.x, b.x), hn::IfThenElse(m, a.y, b.y), hn::IfThenElse(m, a.z, b.z)};
+}
+
+/// The mask of the lanes of v that equal `value`, as a float mask.
+HWY_INLINE MF LaneIs(VI v, std::int32_t value) {
+    const DF df;
+    const DI di;
+    return hn::RebindMask(df, hn::Eq(v, hn::Set(di, value)));
+}
+
+/// Bit l set where lane l of m holds.
+HWY_INLINE std::uint64_t MaskBits(MF m) {
+    const DF df;
+    std::uint8_t bytes[(kMaxLanes + 7) / 8] = {};
+    hn::StoreMaskBits(df, m, bytes);
+    std::uint64_t bits = 0;
+    for (std::size_t i = 0; i < (hn::Lanes(df) + 7) / 8; ++i)
+        bits |= std::uint64_t(bytes[i]) << (8 * i);
+    return bits;
+}
+
+LAMINA_LANE_END
+
+#endif  // LAMINA_CORE_LANE_HWY_H
