@@ -15,6 +15,7 @@
 #include "export/rgl_reader.h"
 #include "lamina/version.h"
 #include "layers/stack.h"
+#include "models/lamina1/lamina1.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
 
@@ -34,8 +35,10 @@ namespace lamina::cli {
 namespace {
 
 struct ExportArgs {
-    std::string check;    ///< a file to check instead of writing one
-    bool strict = false;  ///< --check: exit 2 when the figures miss the goals
+    std::string check;           ///< a file to check instead of writing one
+    std::string lamina1_tables;  ///< lamina-1's data file to write instead of an export
+    std::string lamina1_gpu;     ///< lamina-1's GLSL state of --stack to write instead
+    bool strict = false;         ///< --check: exit 2 when the figures miss the goals
     std::string simulation, study, config, source = "reference", model, stack, out, format;
     std::string theta_i, grid = "90x90";
     std::vector<std::string> options;
@@ -231,6 +234,27 @@ int run_check(const ExportArgs& a) {
 
 int run_export(const ExportArgs& a) {
     if (!a.check.empty()) return run_check(a);
+    if (!a.lamina1_gpu.empty()) {
+        // lamina-1's per-material state for its GLSL form (include/lamina1/gpu.h).
+        if (a.stack.empty()) throw InputError("command line", "--stack", "give the stack file");
+        std::string why;
+        const std::vector<float> state = lamina1_gpu_state(
+            load_stack(a.stack), resolve_options(find_model("lamina-1"), a.options), why);
+        if (state.empty())
+            throw InputError(a.stack, "--lamina1-gpu", "not covered by the GLSL form: " + why);
+        write_file_atomic(a.lamina1_gpu, std::string(reinterpret_cast<const char*>(state.data()),
+                                                     state.size() * sizeof(float)));
+        fmt::print("wrote {} (lamina-1's GLSL state, {} floats)\n", a.lamina1_gpu, state.size());
+        return 0;
+    }
+    if (!a.lamina1_tables.empty()) {
+        // The tables lamina-1's header library reads (include/lamina1/tables.h, docs/lamina1.md).
+        const std::string bytes = lamina1_tables_file();
+        write_file_atomic(a.lamina1_tables, bytes);
+        fmt::print("wrote {} (lamina-1's tables, {:.2f} MB)\n", a.lamina1_tables,
+                   bytes.size() / 1e6);
+        return 0;
+    }
     if (a.strict) throw InputError("command line", "--strict", "goes with --check FILE");
     if (a.out.empty()) throw InputError("command line", "--out", "give the output file");
     std::string format = a.format;
@@ -353,6 +377,12 @@ Runner add_export(CLI::App& app) {
                     "malformed or truncated file is refused with what is wrong); with the .bsdf's "
                     "source, report how close a renderer gets to it: directional albedo and "
                     "values against the goals (docs/formats.md)");
+    cmd->add_option("--lamina1-tables", a->lamina1_tables,
+                    "Write the data file of lamina-1's header library (include/lamina1/, "
+                    "docs/lamina1.md): its generic tables, which a renderer ships beside it");
+    cmd->add_option("--lamina1-gpu", a->lamina1_gpu,
+                    "Write the per-material state of lamina-1's GLSL form for --stack (and "
+                    "--option) as float32 (include/lamina1/gpu.h, docs/lamina1.md)");
     cmd->add_flag("--strict", a->strict,
                   "With --check and a source: exit with status 2 when the figures miss the goals");
     return [a] { return run_export(*a); };

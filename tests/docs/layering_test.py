@@ -100,7 +100,26 @@ def main():
     if bad:
         print(f"FAIL: {len(bad)} include(s) against docs/architecture.md")
         return 1
-    print(f"ok: {len(files)} files of {len(rules)} folders include only what their rows allow")
+    # include/lamina1/, the header library a renderer takes alone: only its own headers (quoted)
+    # and the standard library's (angle brackets, no folder: nothing installed beside it).
+    header_bad = []
+    headers = sorted((root / "include/lamina1").glob("*.h"))
+    for p in headers:
+        for n, line in enumerate(p.read_text(errors="replace").splitlines(), 1):
+            m = re.match(r'\s*#\s*include\s+([<"])([^>"]+)[>"]', line)
+            if not m:
+                continue
+            quoted, inc = m.group(1) == '"', m.group(2)
+            if (quoted and not inc.startswith("lamina1/")) or (not quoted and "/" in inc):
+                header_bad.append(f"include/lamina1/{p.name}:{n}: includes {inc}")
+    for b in header_bad:
+        print(b + ", but lamina-1's headers may include only each other and the standard library")
+    if header_bad or not headers:
+        print("FAIL: include/lamina1/ is not self-contained" if headers else
+              "FAIL: include/lamina1/ has no headers")
+        return 1
+    print(f"ok: {len(files)} files of {len(rules)} folders include only what their rows allow; "
+          f"{len(headers)} headers of include/lamina1/ only each other and the standard library")
     return 0
 
 

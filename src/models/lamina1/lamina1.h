@@ -1,115 +1,22 @@
 #pragma once
-// lamina-1: lamina's own layered BSDF for a dielectric coat over a base (docs/models.md,
-// "lamina-1", has the derivation). For a coat (η0, α0) with an absorbing or Henyey–Greenstein
-// scattering medium (τa, τs, g; the unscattered light attenuated by τt = τa + τs) over a
-// Lambertian, conductor or dielectric base (α1):
-//
-//   f_R = f_top                                       exact Walter reflection of the coat
-//       + T(μi) T(μo) a(μi') a(μo') f_b(wi', wo'; α_e) / η0²     first order through the coat
-//       + K X(μi) X(μo) / (π η0²)                    inter-reflections (separable, reciprocal)
-//   f_T = E_1(μi) f_t,b(w̄i', wo; α_b) / T_b,in(μ̄i'; α_b)   first order through the slab's bottom
-//       [+ Σ_p Φ_p(μi) T_{below→p}(μo) / (π A_p η_s²)]   later orders (btdf-series=populations)
-//
-// T: the coat's directional transmittance (models/tables/coat_transmittance.h), a: Beer–Lambert
-// along the refracted mean directions, α_e and β: the base lobe widened by the coat's refraction
-// spread (its shape the sum of the base's and the coat's GGX spreads, the coat's tails through
-// one facet's exact refraction: first-order-lobe), X: the light the coat's bottom sends back to the
-// base after the first order, Ē_b and r̄ the base's and the coat bottom's hemispherical albedos, K
-// the normalization that gives the separable term the energy of the geometric series; E_1: the
-// slab's exact first-order transmission, f_t,b the bottom's Walter BTDF from the coat's mean
-// transmitted direction w̄i', α_b its roughness widened by the coat's spread. A scattering medium
-// adds its exact single scattering f_ss (and, over a conductor or dielectric base, the
-// once-scattered paths that meet the base) and a separable lobe carrying the rest of the scattered
-// light, its energy from an azimuth-averaged adding–doubling of coat bottom, medium and base
-// (models/numerics/medium_adding.h). Each approximation is a flag (Lamina1Choices).
+// lamina-1 as a lamina Model: the header library include/lamina1/ (lamina-1 itself: the
+// precomputation, eval, sample, pdf) over lamina's own tables, behind the Model interface, and
+// its flags. docs/models.md, "lamina-1", derives the model; include/lamina1/bsdf.h lists its
+// terms; each approximation is a choice of lamina1::Options (include/lamina1/options.h), which
+// is this model's choices struct.
 
+#include "lamina1/options.h"
+#include "lamina1/tables.h"
 #include "models/model.h"
 #include "models/model_options.h"
-#include "models/tables/coat_transmittance.h"
 
 #include <memory>
 #include <vector>
 
 namespace lamina {
 
-struct Lamina1Choices {
-    /// Masking of the refracted rays in the coat's transmittance tables.
-    TransmissionMasking masking = TransmissionMasking::Smith;
-    /// The coat's transmittance: the rough interface's directional transmittance (true) or the
-    /// smooth Fresnel transmittance 1 − F(μ) at the macro normal (false).
-    bool directional_transmittance = true;
-    /// Inter-reflections between base and coat bottom (the separable series term).
-    bool inter_reflection = true;
-    /// "auto": the separable series only where its uniform-radiance assumption can hold, where the
-    /// base re-diffuses the returned light at least as much as the coat spreads it: a Lambertian
-    /// base, or a base at least as rough as the coat (α1 ≥ α0); reflected only (the slab's
-    /// diffuse exit through the bottom only with "on"). With both interfaces smooth the exact
-    /// delta series is summed either way.
-    bool series_lambertian_only = true;
-    /// The slab's transmission lobe centred on the mean direction of the light the rough coat
-    /// transmits (true) or on the macro refraction of wi (false).
-    bool mean_shift = true;
-    /// The 1/η² solid-angle compression of the base term (Hanrahan & Krueger 1993, Eq. 8).
-    bool eta2_factor = true;
-    /// The base lobe widened by the coat's refraction spread: with the angle-dependent deflection
-    /// factor (Spread::Angular), its normal-incidence value 1 − 1/η (Normal), or not (Off).
-    enum class Spread { Angular, Normal, Off } spread = Spread::Angular;
-    /// The shape of that widened lobe (docs/models.md, lamina-1, item 4): its half-vector slope
-    /// as the sum of the three independent GGX slopes of the base and the coat's two refractions
-    /// (models/tables/slope_sum_table.h), the coat's tails carried through one facet's exact Snell
-    /// deflection and transmission (Compressed); the same sum with the linear deflection (Sum);
-    /// or one GGX lobe of the summed variance (Ggx, the earlier form).
-    enum class FirstOrderLobe {
-        Compressed,
-        Sum,
-        Ggx
-    } first_order_lobe = FirstOrderLobe::Compressed;
-    /// The rough interfaces' scattering orders ≥ 2 (models/tables/multiple_scattering_albedo.h):
-    /// off (single scattering: the energy the microsurfaces mask is lost, as in the
-    /// goniophotometer's
-    /// --microsurface single) or restored (as in --microsurface multiple): the coat's and the
-    /// slab bottom's transmittances gain ΔT, the coat's inside reflectance and the base's albedo
-    /// gain ΔR (ΔE F_ms for a conductor), and the coat's outer reflection and the base's lobe gain
-    /// the separable energy-compensation lobes ΔR(μi) ΔR(μo)/(π ΔR̄) (docs/models.md).
-    bool multiple_scattering = false;
-    /// The first order leaves a conductor or dielectric base through the coat with the coat's
-    /// transmittance *from inside* along the base lobe's direction, T_in(μo'), where that lobe is
-    /// narrower than the coat's refraction spread (true), or with the outside transmittance T(μo)
-    /// (false), exact only for locally uniform radiance inside (a Lambertian base always uses it).
-    bool inside_exit = true;
-    /// The base lobe whose width follows wo through the coat's spread is divided by its excess
-    /// energy over the fixed-width lobe, √N(μi') √N(μo') (reciprocal; docs/models.md).
-    bool lobe_normalization = true;
-    /// Scattering (Henyey–Greenstein) coat media (docs/models.md, lamina-1, "Scattering media"):
-    /// the exact single scattering of the medium between the two refractions (first order in
-    /// τs, closed form) ...
-    bool medium_single = true;
-    /// ... the once-scattered light that also meets a conductor or dielectric base (scattered
-    /// then mirrored, mirrored then scattered; the base as a mirror of its directional albedo) ...
-    bool medium_base_paths = true;
-    /// ... and everything else the scattering sends back (orders ≥ 2, the scattered light's
-    /// round trips between coat and base, the once-scattered light over a Lambertian base) as a
-    /// separable lobe whose energy is the azimuth-averaged adding–doubling's (medium_adding.h).
-    bool medium_orders = true;
-    /// ... the part of that rest a slab transmits shaped like twice-scattered light (the
-    /// once-scattered closed form with HG(g²): two HG scatterings have the mean cosine g²) and
-    /// normalized to the adding's energy (true), or as uniform radiance below the bottom (false).
-    bool medium_transmitted_twice = true;
-    /// The slab's first-order transmission: the bottom interface's own Walter BTDF at the mean
-    /// inside direction, widened by the coat's spread and carrying the light's exact first-order
-    /// energy (true), or the mirrored GGX lobe q weighted by T_b,in at the exit (false).
-    bool btdf_bottom_lobe = true;
-    /// With btdf_bottom_lobe: the first order split between the bottom's BTDF, for the bottom's
-    /// share of the spread's variance u = α1²/α_b², and the mirrored lobe (the coat's spread,
-    /// made inside the coat and carried through the bottom's flat refraction), for 1 − u.
-    bool btdf_lobe_shared = true;
-    /// The slab's later orders in transmission: the light inside the coat as two populations,
-    /// within the exit cone and beyond it (trapped by a smooth coat's total internal reflection),
-    /// each taken as uniform radiance after the first return, summed over every round trip by a
-    /// 2 × 2 geometric series and let out through the bottom's own transmittance (true); or the
-    /// uniform series of inter-reflection=on (false). Single scattering only.
-    bool btdf_populations = false;
-};
+/// The model's choices: the header library's options, declared once there.
+using Lamina1Choices = lamina1::Options;
 
 /// The model's flags.
 const ModelOptionTable<Lamina1Choices>& lamina1_option_table();
@@ -117,5 +24,22 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table();
 /// The registry's entry points.
 std::vector<OptionSpec> lamina1_options();
 std::unique_ptr<Model> make_lamina1(const Stack& stack, const ModelOptions& options);
+
+/// lamina's tables (FGD, the transmittance for `masking` and for the Smith masking, the slope
+/// sums and, with `multiple`, the multiple-scattering albedos) as lamina-1 reads them: views of
+/// the process-wide tables, computed or loaded from the cache on first use.
+const lamina1::Tables& lamina1_tables(lamina1::Masking masking, bool multiple);
+
+/// The data file a renderer ships beside the header (include/lamina1/tables.h describes it):
+/// every table, both maskings, the FGD table as its bins.
+std::string lamina1_tables_file();
+
+/// The state of lamina-1's GLSL form for this stack and these flags (include/lamina1/gpu.h), or
+/// nothing and why (a stack it does not cover).
+std::vector<float> lamina1_gpu_state(const Stack& stack, const ModelOptions& options,
+                                     std::string& why);
+
+/// A stack of the coated shape (coated_stack) as lamina-1's layers; false and why otherwise.
+bool lamina1_layers(const Stack& stack, lamina1::Layers& layers, std::string& why);
 
 }  // namespace lamina

@@ -25,9 +25,9 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table() {
     using FirstOrderLobe = L1::FirstOrderLobe;
     using Spread = L1::Spread;
     static const ModelOptionTable<L1> table({
-        member_option<L1, TransmissionMasking>(
+        member_option<L1, lamina1::Masking>(
             "refraction-masking", &L1::masking,
-            {{"smith-beta", TransmissionMasking::Smith}, {"walter", TransmissionMasking::Pbrt}},
+            {{"smith-beta", lamina1::Masking::Smith}, {"walter", lamina1::Masking::Walter}},
             "masking of refracted rays in the coat's transmittance: B(1+Li, 1+Lo) (Smith) or "
             "1/(1+Li+Lo) (Walter)"),
         member_option<L1, bool>(

@@ -19,17 +19,16 @@ namespace {
 
 constexpr int kTableNr = 16;    // Gauss–Legendre nodes in u = √(1 − r) per piece
 constexpr int kTableNphi = 32;  // midpoint nodes in φ over the half disk (mirrored)
-constexpr double kCMin = 1e-4;
-constexpr double kAlphaMin = 1e-5;
+constexpr double kCMin = lamina1::TransmittanceFormat::kCMin;
+constexpr double kAlphaMin = lamina1::TransmittanceFormat::kAlphaMin;
 constexpr const char* kCodeVersion = "coat-t-v6";
 
 using T = CoatTransmittanceTable;
 
-// The c, α, η axes and their interpolation (models/tables/critical_cosine_axes.h).
+// The c, α, η axes and their interpolation (the table's format is lamina-1's header library's,
+// include/lamina1/table_lookups.h, which reads this table too).
 const CriticalCosineAxes& axes() {
-    static const CriticalCosineAxes a(T::kNbelow, T::kNc, T::kNalpha, T::kNeta, T::kLog2EtaMin,
-                                      T::kLog2EtaMax, kCMin, kAlphaMin);
-    return a;
+    return lamina1::TransmittanceFormat::axes();
 }
 
 /// T by the visible normals of wi, n_r Gauss–Legendre nodes in u = √(1 − r) on each side of the
@@ -122,11 +121,7 @@ const CoatTransmittanceTable& CoatTransmittanceTable::get(TransmissionMasking ma
 }
 
 double CoatTransmittanceTable::operator()(double c, double alpha, double eta) const {
-    c = clamp(c, 0.0, 1.0);
-    if (alpha <= 0) return 1 - fresnel_dielectric(c, eta);
-    eta = clamp(eta, std::exp2(kLog2EtaMin), std::exp2(kLog2EtaMax));
-    return clamp(axes().interpolate(values_, 1, 0, c, alpha, eta, 1 - fresnel_dielectric(c, eta)),
-                 0.0, 1.0);
+    return lamina1::TransmittanceFormat::lookup(values_.data(), c, alpha, eta);
 }
 
 }  // namespace lamina

@@ -28,6 +28,7 @@
 // lamina-1.
 
 #include "core/vec.h"
+#include "lamina1/table_lookups.h"
 #include "physics/transmission_masking.h"
 
 #include <vector>
@@ -53,8 +54,15 @@ class CoatTransmittanceTable {
 
     /// Nodes of the c axis below the critical cosine μc(η) = √(1 − η²) (η < 1) and above it
     /// (with μc = 0 where there is no total internal reflection), of α and of log2 η.
-    static constexpr int kNbelow = 33, kNc = 49, kNalpha = 33, kNeta = 41;
-    static constexpr double kLog2EtaMin = -2, kLog2EtaMax = 2;
+    static constexpr int kNbelow = lamina1::TransmittanceFormat::kNbelow,
+                         kNc = lamina1::TransmittanceFormat::kNc,
+                         kNalpha = lamina1::TransmittanceFormat::kNalpha,
+                         kNeta = lamina1::TransmittanceFormat::kNeta;
+    static constexpr double kLog2EtaMin = lamina1::TransmittanceFormat::kLog2EtaMin,
+                            kLog2EtaMax = lamina1::TransmittanceFormat::kLog2EtaMax;
+
+    /// The nodes (the layout of lamina1::TransmittanceFormat; lamina-1 reads them).
+    const std::vector<float>& values() const { return values_; }
 
   private:
     explicit CoatTransmittanceTable(TransmissionMasking masking);

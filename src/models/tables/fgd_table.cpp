@@ -15,27 +15,20 @@ namespace lamina {
 
 namespace {
 
-constexpr int kBins = 64;     // x = wi·wm bins per (c, α)
+constexpr int kBins = lamina1::FgdFormat::kBins;  // x = wi·wm bins per (c, α)
 constexpr int kTableNr = 48;  // Gauss–Legendre nodes in r (weight 2r) on Heitz's disk
 constexpr int kTableNphi = 64;
-constexpr double kCMin = 1e-4;      // c = 0 is evaluated at this cosine (G1 → 0 at grazing)
-constexpr double kAlphaMin = 1e-5;  // α = 0 is evaluated at this roughness (the smooth limit)
+constexpr double kCMin = lamina1::FgdFormat::kCMin;  // c = 0 is evaluated here (G1 → 0 at grazing)
+constexpr double kAlphaMin = lamina1::FgdFormat::kAlphaMin;  // α = 0 here (the smooth limit)
 constexpr const char* kCodeVersion = "fgd-v4";
 
-// c and α are tabulated on squared axes (node = s², s uniform): the shadowing at grazing varies
-// on the scale c ~ α, which needs dense nodes near 0 on both axes.
+// The axes' nodes (lamina1::FgdFormat, the table's format, which lamina-1's header reads).
+using Format = lamina1::FgdFormat;
 double c_node(int i) {
-    return std::max(kCMin, sqr(double(i) / (FgdTable::kNc - 1)));
+    return Format::c_node(i);
 }
 double alpha_node(int i) {
-    return std::max(kAlphaMin, sqr(double(i) / (FgdTable::kNalpha - 1)));
-}
-double eta_node(int i) {
-    return std::exp2(FgdTable::kLog2EtaMin +
-                     (FgdTable::kLog2EtaMax - FgdTable::kLog2EtaMin) * i / (FgdTable::kNeta - 1));
-}
-double k_node(int i) {
-    return FgdTable::kKMax * sqr(double(i) / (FgdTable::kNk - 1));
+    return Format::alpha_node(i);
 }
 
 /// x limited to [lo, hi] for a table coordinate, NaN going to lo: an index computed from NaN would
@@ -64,13 +57,27 @@ void visible_normal_rule(double c, double alpha, int n_r, int n_phi, Visit&& vis
     }
 }
 
-/// Weight of the control variate F(c): 1 for smooth interfaces, fading out by α ≈ 0.1.
-double smooth_weight(double alpha) {
-    return std::exp(-alpha / 0.03);
+double fresnel_any(double x, double eta, double k) {
+    return Format::fresnel(x, eta, k);
 }
 
-double fresnel_any(double x, double eta, double k) {
-    return k == 0 ? fresnel_dielectric(x, eta) : fresnel_complex_fast(x, eta, k);
+/// The bins of x = wi·wm of the (c, α) node (ic, ia): the rule's weights and mean x of each
+/// non-empty bin (FgdFormat::node sums the Fresnel factor over them).
+void node_bins(int ic, int ia, std::vector<double>& w, std::vector<double>& x) {
+    std::array<double, kBins> W{}, X{};
+    visible_normal_rule(c_node(ic), alpha_node(ia), kTableNr, kTableNphi,
+                        [&](double xm, double wm) {
+                            const int b = std::min(kBins - 1, int(xm * kBins));
+                            W[b] += wm;
+                            X[b] += wm * xm;
+                        });
+    w.clear();
+    x.clear();
+    for (int b = 0; b < kBins; ++b)
+        if (W[b] > 0) {
+            w.push_back(W[b]);
+            x.push_back(X[b] / W[b]);
+        }
 }
 
 std::vector<float> compute_fgd() {
@@ -79,37 +86,17 @@ std::vector<float> compute_fgd() {
 #pragma omp parallel for schedule(dynamic) collapse(2)
     for (int ic = 0; ic < T::kNc; ++ic) {
         for (int ia = 0; ia < T::kNalpha; ++ia) {
-            std::array<double, kBins> W{}, X{};
-            visible_normal_rule(c_node(ic), alpha_node(ia), kTableNr, kTableNphi,
-                                [&](double x, double w) {
-                                    const int b = std::min(kBins - 1, int(x * kBins));
-                                    W[b] += w;
-                                    X[b] += w * x;
-                                });
-            int nb = 0;
-            std::array<double, kBins> Wc{}, Xc{};
-            for (int b = 0; b < kBins; ++b)
-                if (W[b] > 0) {
-                    Wc[nb] = W[b];
-                    Xc[nb] = X[b] / W[b];
-                    ++nb;
-                }
-            for (int ie = 0; ie < T::kNeta; ++ie) {
-                const double eta = eta_node(ie);
-                for (int ik = 0; ik < T::kNk; ++ik) {
-                    const double k = k_node(ik);
-                    double sum = 0;
-                    for (int b = 0; b < nb; ++b)
-                        sum += Wc[b] * fresnel_any(Xc[b], eta, k);
-                    // Stored as the residual from w(α)·F(c), the smooth limit (a control variate
-                    // that fades out with roughness): the lookup adds the exact w(α)F(c) back, so
-                    // the step-like kink of F at the critical angle (η < 1) is not interpolated
-                    // where the lobe is narrow enough to keep it.
-                    sum -= smooth_weight(alpha_node(ia)) * fresnel_any(c_node(ic), eta, k);
-                    v[((std::size_t(ic) * T::kNalpha + ia) * T::kNeta + ie) * T::kNk + ik] =
-                        float(sum);
-                }
-            }
+            std::vector<double> w, x;
+            node_bins(ic, ia, w, x);
+            // Stored as the residual from w(α)·F(c), the smooth limit (a control variate that
+            // fades out with roughness): the lookup adds the exact w(α)F(c) back, so the
+            // step-like kink of F at the critical angle (η < 1) is not interpolated where the
+            // lobe is narrow enough to keep it.
+            for (int ie = 0; ie < T::kNeta; ++ie)
+                for (int ik = 0; ik < T::kNk; ++ik)
+                    v[Format::index(ic, ia, ie, ik)] =
+                        Format::node(w.data(), x.data(), int(w.size()), ic, ia,
+                                     Format::eta_node(ie), Format::k_node(ik));
         }
     }
     return v;
@@ -165,50 +152,6 @@ double GgxAlbedoTable::operator()(double c, double alpha) const {
     return clamp((1 - tc) * v0 + tc * v1, 0.0, 1.0);
 }
 
-double fresnel_complex_fast(double cos_theta, double eta, double k) {
-    cos_theta = clamp(cos_theta, 0.0, 1.0);
-    const double cos2 = cos_theta * cos_theta;
-    const double sin2 = 1 - cos2;
-    const double eta2 = eta * eta, k2 = k * k;
-    const double t0 = eta2 - k2 - sin2;
-    const double a2_plus_b2 = std::sqrt(t0 * t0 + 4 * eta2 * k2);
-    const double t1 = a2_plus_b2 + cos2;
-    const double a = safe_sqrt(0.5 * (a2_plus_b2 + t0));
-    const double t2 = 2 * cos_theta * a;
-    if (t1 + t2 <= 0) return 1;  // grazing onto an index-matched interface: the limit c → 0
-    // t1 − t2 and t3 − t4 are sums of squares (physics/fresnel.h, fresnel_conductor): clamped at 0
-    // against the rounding that makes them slightly negative near η = 1, κ = 0.
-    const double rs = max0(t1 - t2) / (t1 + t2);
-    const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
-    const double t4 = t2 * sin2;
-    const double rp = rs * max0(t3 - t4) / (t3 + t4);
-    return 0.5 * (rp + rs);
-}
-
-Rgbd fresnel_complex_rgb(double cos_theta, const Rgbd& eta, const Rgbd& k) {
-    cos_theta = clamp(cos_theta, 0.0, 1.0);
-    const double cos2 = cos_theta * cos_theta;
-    const double sin2 = 1 - cos2;
-    alignas(32) double e[4] = {eta[0], eta[1], eta[2], 1.5}, kk[4] = {k[0], k[1], k[2], 0.0};
-    alignas(32) double out[4];
-    // PBR 3rd ed., §8.2.1 (FrConductor), lane by lane.
-    for (int c = 0; c < 4; ++c) {
-        const double eta2 = e[c] * e[c], k2 = kk[c] * kk[c];
-        const double t0 = eta2 - k2 - sin2;
-        const double a2_plus_b2 = std::sqrt(t0 * t0 + 4 * eta2 * k2);
-        const double t1 = a2_plus_b2 + cos2;
-        const double a = std::sqrt(std::max(0.5 * (a2_plus_b2 + t0), 0.0));
-        const double t2 = 2 * cos_theta * a;
-        // Non-negative numerators (sums of squares; see fresnel_complex_fast), clamped at 0.
-        const double rs = std::max(t1 - t2, 0.0) / std::max(t1 + t2, 1e-300);
-        const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
-        const double t4 = t2 * sin2;
-        const double rp = rs * std::max(t3 - t4, 0.0) / std::max(t3 + t4, 1e-300);
-        out[c] = t1 + t2 > 0 ? 0.5 * (rp + rs) : 1.0;
-    }
-    return {out[0], out[1], out[2]};
-}
-
 double FgdTable::direct(double c, double alpha, double eta, double k, int n_r, int n_phi) {
     if (alpha <= 0) return fresnel_any(c, eta, k);
     double sum = 0;
@@ -233,17 +176,7 @@ const FgdTable& FgdTable::get() {
 }
 
 FgdTable::Index FgdTable::locate(double eta, double k) {
-    const double fe = (axis(std::log2(eta), kLog2EtaMin, kLog2EtaMax) - kLog2EtaMin) /
-                      (kLog2EtaMax - kLog2EtaMin) * (kNeta - 1);
-    const double fk = std::sqrt(axis(k, 0.0, kKMax) / kKMax) * (kNk - 1);
-    Index at;
-    at.eta = eta;
-    at.k = k;
-    at.ie = std::min(int(fe), kNeta - 2);
-    at.ik = std::min(int(fk), kNk - 2);
-    at.te = fe - at.ie;
-    at.tk = fk - at.ik;
-    return at;
+    return Format::locate(eta, k);
 }
 
 double FgdTable::operator()(double c, double alpha, double eta, double k) const {
@@ -251,55 +184,32 @@ double FgdTable::operator()(double c, double alpha, double eta, double k) const 
 }
 
 Rgbd FgdTable::rgb(double c, double alpha, const std::array<Index, 3>& at) const {
-    const Rgbd eta(at[0].eta, at[1].eta, at[2].eta), k(at[0].k, at[1].k, at[2].k);
-    if (alpha <= 0) return fresnel_complex_rgb(c, eta, k);
-    const double fc = std::sqrt(axis(c, 0.0, 1.0)) * (kNc - 1);
-    const double fa = std::sqrt(axis(alpha, 0.0, 1.0)) * (kNalpha - 1);
-    const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2);
-    const double tc = fc - ic, ta = fa - ia;
-    Rgbd out(0.0);
-    for (int dc = 0; dc < 2; ++dc) {
-        const double wc = dc ? tc : 1 - tc;
-        for (int da = 0; da < 2; ++da) {
-            const double wa = wc * (da ? ta : 1 - ta);
-            const float* block = data_ + (std::size_t(ic + dc) * kNalpha + (ia + da)) * kNeta * kNk;
-            for (int i = 0; i < 3; ++i) {
-                const float* row = block + std::size_t(at[i].ie) * kNk + at[i].ik;
-                const double tk = at[i].tk, te = at[i].te;
-                const double v0 = (1 - tk) * row[0] + tk * row[1];
-                const double v1 = (1 - tk) * row[kNk] + tk * row[kNk + 1];
-                out[i] += wa * ((1 - te) * v0 + te * v1);
-            }
-        }
-    }
-    if (alpha < 0.5) out += fresnel_complex_rgb(c, eta, k) * smooth_weight(alpha);
-    for (int i = 0; i < 3; ++i)
-        out[i] = clamp(out[i], 0.0, 1.0);
-    return out;
+    const lamina1::Rgb f = Format::interpolate_rgb(
+        [&](int ic, int ia, int i) { return data_ + Format::index(ic, ia, at[i].ie, at[i].ik); },
+        kNk, c, alpha, at);
+    return {f[0], f[1], f[2]};
 }
 
 double FgdTable::operator()(double c, double alpha, const Index& at) const {
-    if (alpha <= 0) return fresnel_any(c, at.eta, at.k);  // the smooth limit is exact Fresnel
-    const double fc = std::sqrt(axis(c, 0.0, 1.0)) * (kNc - 1);
-    const double fa = std::sqrt(axis(alpha, 0.0, 1.0)) * (kNalpha - 1);
-    const int ic = std::min(int(fc), kNc - 2), ia = std::min(int(fa), kNalpha - 2);
-    const double tc = fc - ic, ta = fa - ia, te = at.te, tk = at.tk;
-    double sum = 0;
-    for (int dc = 0; dc < 2; ++dc) {
-        const double wc = dc ? tc : 1 - tc;
-        for (int da = 0; da < 2; ++da) {
-            const double wa = wc * (da ? ta : 1 - ta);
-            const float* row =
-                data_ + ((std::size_t(ic + dc) * kNalpha + (ia + da)) * kNeta + at.ie) * kNk +
-                at.ik;
-            const double v0 = (1 - tk) * row[0] + tk * row[1];
-            const double v1 = (1 - tk) * row[kNk] + tk * row[kNk + 1];
-            sum += wa * ((1 - te) * v0 + te * v1);
-        }
+    return Format::interpolate(
+        [&](int ic, int ia) { return data_ + Format::index(ic, ia, at.ie, at.ik); }, kNk, c, alpha,
+        at);
+}
+
+lamina1::FgdBins FgdTable::bins() {
+    lamina1::FgdBins out;
+    std::vector<std::vector<double>> w(std::size_t(kNc) * kNalpha), x(w.size());
+#pragma omp parallel for schedule(dynamic) collapse(2)
+    for (int ic = 0; ic < kNc; ++ic)
+        for (int ia = 0; ia < kNalpha; ++ia)
+            node_bins(ic, ia, w[std::size_t(ic) * kNalpha + ia], x[std::size_t(ic) * kNalpha + ia]);
+    out.offset.push_back(0);
+    for (std::size_t i = 0; i < w.size(); ++i) {
+        out.w.insert(out.w.end(), w[i].begin(), w[i].end());
+        out.x.insert(out.x.end(), x[i].begin(), x[i].end());
+        out.offset.push_back(std::uint32_t(out.w.size()));
     }
-    // The control variate w(α)F(c) (see compute_fgd); below 6e-8 beyond α = 0.5, skipped there.
-    if (alpha < 0.5) sum += smooth_weight(alpha) * fresnel_any(c, at.eta, at.k);
-    return clamp(sum, 0.0, 1.0);
+    return out;
 }
 
 }  // namespace lamina

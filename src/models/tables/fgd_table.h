@@ -15,9 +15,12 @@
 // Axes (docs/models.md has the measured accuracy): c = s² (41 nodes, s uniform in [0, 1]),
 // α = s² (33 nodes), log2 η ∈ [−5, 3] (81, η = 1 is a node), κ = 10 s², s ∈ [0, 1] (21); outside,
 // the arguments are clamped. Multilinear interpolation; α = 0 returns the exact Fresnel factor.
+// The axes, the nodes' sum over the bins and the interpolation are the table's format, which
+// lamina-1's header library holds (include/lamina1/table_lookups.h, FgdFormat) and reads.
 // Computed on first use (≈1 s on 2 cores) and cached on disk (models/tables/table_cache.h).
 
 #include "core/rgb.h"
+#include "lamina1/table_lookups.h"
 
 #include <array>
 #include <vector>
@@ -34,11 +37,7 @@ class FgdTable {
 
     /// The (η, κ) part of a lookup, located once per interface (the symmetric Belcour variant
     /// looks the same indices up for every evaluation).
-    struct Index {
-        double eta = 1, k = 0;
-        int ie = 0, ik = 0;
-        double te = 0, tk = 0;
-    };
+    using Index = lamina1::FgdFormat::Index;
     static Index locate(double eta, double k);
     double operator()(double c, double alpha, const Index& at) const;
     /// Three channels at once (a conductor), sharing the (c, α) part of the lookup.
@@ -49,8 +48,17 @@ class FgdTable {
     static double direct(double c, double alpha, double eta, double k, int n_r = 96,
                          int n_phi = 128);
 
-    static constexpr int kNc = 41, kNalpha = 33, kNeta = 81, kNk = 21;
-    static constexpr double kLog2EtaMin = -5, kLog2EtaMax = 3, kKMax = 10;
+    static constexpr int kNc = lamina1::FgdFormat::kNc, kNalpha = lamina1::FgdFormat::kNalpha,
+                         kNeta = lamina1::FgdFormat::kNeta, kNk = lamina1::FgdFormat::kNk;
+    static constexpr double kLog2EtaMin = lamina1::FgdFormat::kLog2EtaMin,
+                            kLog2EtaMax = lamina1::FgdFormat::kLog2EtaMax,
+                            kKMax = lamina1::FgdFormat::kKMax;
+
+    /// The nodes (lamina1::FgdFormat's layout; lamina-1 reads them).
+    const float* data() const { return data_; }
+    /// The bins of x = wi·wm each (c, α) node is summed from (lamina-1's data file holds the
+    /// table as them: lamina1::FgdBins).
+    static lamina1::FgdBins bins();
 
   private:
     FgdTable();
@@ -80,13 +88,19 @@ class GgxAlbedoTable {
 };
 
 /// Unpolarized Fresnel reflectance for a complex relative index η + iκ with light arriving from
-/// the real (dielectric) side at cos_theta ∈ [0, 1]: the closed form in a², b² (Pharr, Jakob &
-/// Humphreys, PBR 3rd ed., §8.2.1, FrConductor; after Born & Wolf §14.2). With κ = 0 and η < 1 it
-/// gives 1 under total internal reflection. Equal to fresnel_conductor, about 4× faster.
-double fresnel_complex_fast(double cos_theta, double eta, double k);
+/// the real (dielectric) side at cos_theta ∈ [0, 1] (lamina1::fresnel_complex, which cites the
+/// closed form). With κ = 0 and η < 1 it gives 1 under total internal reflection. Equal to
+/// physics/fresnel.h's fresnel_conductor, about 4× faster.
+inline double fresnel_complex_fast(double cos_theta, double eta, double k) {
+    return lamina1::fresnel_complex(cos_theta, eta, k);
+}
 
 /// The same for three channels at once (written as one loop over 4 lanes so the compiler
 /// vectorizes it; lamina_models is built with -fno-math-errno for that).
-Rgbd fresnel_complex_rgb(double cos_theta, const Rgbd& eta, const Rgbd& k);
+inline Rgbd fresnel_complex_rgb(double cos_theta, const Rgbd& eta, const Rgbd& k) {
+    const lamina1::Rgb f =
+        lamina1::fresnel_complex_rgb(cos_theta, {eta[0], eta[1], eta[2]}, {k[0], k[1], k[2]});
+    return {f[0], f[1], f[2]};
+}
 
 }  // namespace lamina

@@ -21,35 +21,28 @@ constexpr const char* kCodeVersion = "ms-albedo-v2";
 constexpr std::uint64_t kSeed = 0x6d73616c62656431ull;  // fixed: the table is deterministic
 constexpr int kMaxOrder = 100;                          // the goniophotometer's facet cap
 
+// The axes, the layout and the lookups are the table's format (include/lamina1/table_lookups.h,
+// MultipleScatteringFormat), which lamina-1's header reads too.
+using Format = lamina1::MultipleScatteringFormat;
 double mu_node(int i) {
-    return std::max(Table::kMuMin, sqr(double(i) / (Table::kNmu - 1)));
+    return Format::mu_node(i);
 }
 double alpha_node(int i) {
-    return sqr(double(i) / (Table::kNalpha - 1));
+    return Format::alpha_node(i);
 }
 double eta_node(int i) {
-    return std::exp2(Table::kLog2EtaMin +
-                     (Table::kLog2EtaMax - Table::kLog2EtaMin) * i / (Table::kNeta - 1));
+    return Format::eta_node(i);
 }
-
 Vec3d incident(double mu) {
     mu = clamp(mu, Table::kMuMin, 1.0);
     return {safe_sqrt(1 - mu * mu), 0, mu};
 }
 
 std::size_t dielectric_index(int im, int ia, int ie) {
-    return (std::size_t(im) * Table::kNalpha + ia) * Table::kNeta + ie;
+    return Format::dielectric_index(im, ia, ie);
 }
 std::size_t conductor_index(int im, int ia) {
-    return std::size_t(Table::kNmu) * Table::kNalpha * Table::kNeta +
-           std::size_t(im) * Table::kNalpha + ia;
-}
-
-/// Position of x on an axis of n nodes: the cell's first node and the weight of the next.
-void locate(double f, int n, int& i, double& t) {
-    f = clamp(f, 0.0, double(n - 1));
-    i = std::min(int(f), n - 2);
-    t = f - i;
+    return Format::conductor_index(im, ia);
 }
 
 }  // namespace
@@ -121,42 +114,15 @@ const MultipleScatteringAlbedo& MultipleScatteringAlbedo::get() {
 }
 
 Table::Dielectric MultipleScatteringAlbedo::dielectric(double mu, double alpha, double eta) const {
-    Dielectric out;
-    if (!(alpha > 0) || !(eta > 0)) return out;
-    int im, ia, ie;
-    double tm, ta, te;
-    locate(std::sqrt(clamp(mu, 0.0, 1.0)) * (kNmu - 1), kNmu, im, tm);
-    locate(std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1), kNalpha, ia, ta);
-    locate((clamp(std::log2(eta), kLog2EtaMin, kLog2EtaMax) - kLog2EtaMin) /
-               (kLog2EtaMax - kLog2EtaMin) * (kNeta - 1),
-           kNeta, ie, te);
-    double split = 0;
-    for (int dm = 0; dm < 2; ++dm)
-        for (int da = 0; da < 2; ++da)
-            for (int de = 0; de < 2; ++de)
-                split += (dm ? tm : 1 - tm) * (da ? ta : 1 - ta) * (de ? te : 1 - te) *
-                         values_[dielectric_index(im + dm, ia + da, ie + de)];
+    if (!(alpha > 0) || !(eta > 0)) return {};
     // What single scattering loses, from its own tables (the walk's orders ≥ 2 carry exactly it).
-    const double lost =
-        std::max(0.0, 1 - FgdTable::get()(mu, alpha, eta, 0.0) -
-                          CoatTransmittanceTable::get(TransmissionMasking::Smith)(mu, alpha, eta));
-    out.reflected = split * lost;
-    out.transmitted = (1 - split) * lost;
-    return out;
+    return Format::dielectric(
+        values_.data(), mu, alpha, eta, FgdTable::get()(mu, alpha, eta, 0.0),
+        CoatTransmittanceTable::get(TransmissionMasking::Smith)(mu, alpha, eta));
 }
 
 double MultipleScatteringAlbedo::conductor(double mu, double alpha) const {
-    if (!(alpha > 0)) return 0;
-    int im, ia;
-    double tm, ta;
-    locate(std::sqrt(clamp(mu, 0.0, 1.0)) * (kNmu - 1), kNmu, im, tm);
-    locate(std::sqrt(clamp(alpha, 0.0, 1.0)) * (kNalpha - 1), kNalpha, ia, ta);
-    double sum = 0;
-    for (int dm = 0; dm < 2; ++dm)
-        for (int da = 0; da < 2; ++da)
-            sum += (dm ? tm : 1 - tm) * (da ? ta : 1 - ta) *
-                   values_[conductor_index(im + dm, ia + da)];
-    return sum;
+    return Format::conductor(values_.data(), mu, alpha);
 }
 
 }  // namespace lamina

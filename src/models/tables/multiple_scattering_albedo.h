@@ -27,6 +27,8 @@
 // (25, η = 1 a node; the split changes fast near η = 1, where total internal reflection begins);
 // arguments outside are clamped; multilinear interpolation.
 
+#include "lamina1/table_lookups.h"
+
 #include <vector>
 
 namespace lamina {
@@ -36,10 +38,8 @@ class MultipleScatteringAlbedo {
     /// The process-wide table (computed or loaded once, thread-safe).
     static const MultipleScatteringAlbedo& get();
 
-    struct Dielectric {
-        double reflected = 0;    ///< ΔR
-        double transmitted = 0;  ///< ΔT
-    };
+    /// ΔR and ΔT.
+    using Dielectric = lamina1::MultipleScatteringFormat::Dielectric;
     /// Orders ≥ 2 of a rough dielectric. μ ∈ [0, 1], α ∈ [0, 1], η > 0.
     Dielectric dielectric(double mu, double alpha, double eta) const;
     /// Orders ≥ 2 of a rough white conductor (ΔE). μ ∈ [0, 1], α ∈ [0, 1].
@@ -51,9 +51,16 @@ class MultipleScatteringAlbedo {
                                       unsigned stream);
     static double walk_conductor(double mu, double alpha, int walks, unsigned stream);
 
-    static constexpr int kNmu = 17, kNalpha = 17, kNeta = 25;
+    static constexpr int kNmu = lamina1::MultipleScatteringFormat::kNmu,
+                         kNalpha = lamina1::MultipleScatteringFormat::kNalpha,
+                         kNeta = lamina1::MultipleScatteringFormat::kNeta;
     static constexpr int kWalksSplit = 1 << 12, kWalksConductor = 1 << 13;
-    static constexpr double kLog2EtaMin = -2, kLog2EtaMax = 2, kMuMin = 1e-3;
+    static constexpr double kLog2EtaMin = lamina1::MultipleScatteringFormat::kLog2EtaMin,
+                            kLog2EtaMax = lamina1::MultipleScatteringFormat::kLog2EtaMax,
+                            kMuMin = lamina1::MultipleScatteringFormat::kMuMin;
+
+    /// The nodes (lamina1::MultipleScatteringFormat's layout; lamina-1 reads them).
+    const std::vector<float>& values() const { return values_; }
 
   private:
     MultipleScatteringAlbedo();

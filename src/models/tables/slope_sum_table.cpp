@@ -22,11 +22,6 @@ double phi(double z) {
     return z > 0 ? z * std::cyl_bessel_k(1.0, z) : 1.0;
 }
 
-/// x limited to [lo, hi] for a table coordinate, NaN going to lo.
-double axis(double x, double lo, double hi) {
-    return x >= lo ? (x <= hi ? x : hi) : lo;
-}
-
 /// The GGX slope density of scale σ at radius r.
 double ggx_slope_density(double r, double sigma) {
     return sqr(sigma) * kInvPi<double> / sqr(sqr(sigma) + sqr(r));
@@ -115,33 +110,11 @@ const SlopeSumTable& SlopeSumTable::get() {
 }
 
 SlopeSumTable::Shares SlopeSumTable::locate(double x, double y) {
-    x = axis(x, 0.0, 1.0);
-    y = axis(y, 0.0, 1.0);
-    if (y > 0.5) y = 1 - y;
-    const double fx = std::acos(1 - 2 * x) * kInvPi<double> * (kNx - 1);
-    const double fy = std::sqrt(2 * y) * (kNy - 1);
-    Shares at;
-    at.ix = std::min(int(fx), kNx - 2);
-    at.iy = std::min(int(fy), kNy - 2);
-    at.tx = clamp(fx - at.ix, 0.0, 1.0);
-    at.ty = clamp(fy - at.iy, 0.0, 1.0);
-    return at;
+    return lamina1::SlopeSumFormat::locate(x, y);
 }
 
 double SlopeSumTable::ratio(double rho, const Shares& at) const {
-    rho = axis(rho, 0.0, HUGE_VAL);
-    const double u = std::isfinite(rho) ? rho / (1 + rho) : 1.0;  // ρ = ∞ reads the last node
-    const double fu = u * (kNu - 1);
-    const int iu = std::min(int(fu), kNu - 2);
-    const double tu = fu - iu;
-    double sum = 0;
-    for (int dx = 0; dx < 2; ++dx)
-        for (int dy = 0; dy < 2; ++dy) {
-            const double wxy = (dx ? at.tx : 1 - at.tx) * (dy ? at.ty : 1 - at.ty);
-            const float* row = &values_[(std::size_t(at.ix + dx) * kNy + (at.iy + dy)) * kNu + iu];
-            sum += wxy * ((1 - tu) * row[0] + tu * row[1]);
-        }
-    return sum;
+    return lamina1::SlopeSumFormat::ratio(values_.data(), rho, at);
 }
 
 double SlopeSumTable::density(double r, double a1, double a2, double a3) const {

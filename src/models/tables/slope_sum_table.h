@@ -20,7 +20,11 @@
 // and the radius ρ = r/σ on u = ρ/(1 + ρ) (33 nodes in [0, 1]; R → 1 as ρ → ∞, and R = 1 when
 // one scale holds all the variance). lamina computes it itself (composite Simpson rule in q on
 // [0, 40], 4 001 nodes; std::cyl_bessel_k and std::cyl_bessel_j), well under a second on first
-// use, cached on disk like the FGD table; trilinear interpolation in (s_x, s_y, u).
+// use, cached on disk like the FGD table; trilinear interpolation in (s_x, s_y, u). The axes and
+// the lookup are the table's format, lamina-1's header library's (include/lamina1/
+// table_lookups.h, SlopeSumFormat), which reads the same values.
+
+#include "lamina1/table_lookups.h"
 
 #include <vector>
 
@@ -31,10 +35,7 @@ class SlopeSumTable {
     static const SlopeSumTable& get();
 
     /// The (x, y) part of a lookup, located once for every radius of one lobe.
-    struct Shares {
-        int ix = 0, iy = 0;
-        double tx = 0, ty = 0;
-    };
+    using Shares = lamina1::SlopeSumFormat::Shares;
     /// x, y clamped to [0, 1] (NaN to 0; y folded to [0, 1/2]).
     static Shares locate(double x, double y);
 
@@ -51,7 +52,11 @@ class SlopeSumTable {
     static double direct(double r, double a1, double a2, double a3, int n = 20001,
                          double q_max = 60);
 
-    static constexpr int kNx = 25, kNy = 13, kNu = 33;
+    static constexpr int kNx = lamina1::SlopeSumFormat::kNx, kNy = lamina1::SlopeSumFormat::kNy,
+                         kNu = lamina1::SlopeSumFormat::kNu;
+
+    /// The nodes (lamina1::SlopeSumFormat's layout; lamina-1 reads them).
+    const std::vector<float>& values() const { return values_; }
 
   private:
     SlopeSumTable();

@@ -258,8 +258,8 @@ double LobeTirTable::operator()(TirDefinition definition, double c, double alpha
     const double limit = definition == TirDefinition::LobeFresnel
                              ? smooth_limit(definition, c, eta)
                              : step(!(c < critical_cosine(eta)));
-    return clamp(lobe_axes().interpolate(values_, kLobeComponents, component(definition), c, alpha,
-                                         eta, limit),
+    return clamp(lobe_axes().interpolate(values_.data(), kLobeComponents, component(definition), c,
+                                         alpha, eta, limit),
                  0.0, 1.0);
 }
 

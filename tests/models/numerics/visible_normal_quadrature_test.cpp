@@ -1,7 +1,11 @@
 // The split visible-normal rule (models/numerics/visible_normal_quadrature.h) against the
 // closed-form distribution of GGX normals, and its root finder against a known root.
 #include "models/numerics/visible_normal_quadrature.h"
+
 #include "core/math.h"
+#include "core/vec.h"
+#include "models/numerics/quadrature.h"
+#include "physics/microfacet.h"
 
 #include <gtest/gtest.h>
 

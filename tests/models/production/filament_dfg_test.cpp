@@ -6,8 +6,10 @@
 
 #include "core/math.h"
 #include "core/npy.h"
+#include "core/vec.h"
 #include "models/numerics/quadrature.h"
 #include "models/numerics/visible_normal_quadrature.h"
+#include "physics/microfacet.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
-// The azimuth-averaged adding–doubling of an HG slab (models/numerics/medium_adding.h):
+// The azimuth-averaged adding–doubling of an HG slab (include/lamina1/adding.h, lamina-1's):
 // conservation, its thin limit (the exact single scattering), and its energies against an
 // independent Monte Carlo of the plane-parallel slab (free paths, HG directions) with a fixed seed.
-#include "models/numerics/medium_adding.h"
+#include "lamina1/adding.h"
 
 #include "core/math.h"
 #include "core/rng.h"
@@ -13,6 +13,19 @@
 
 namespace lamina {
 namespace {
+
+using lamina1::attenuation_slope;
+using lamina1::azimuthal_hg;
+using lamina1::AzimuthalPhase;
+using lamina1::CosineNodes;
+using lamina1::FluxMatrix;
+using lamina1::hg_single_mirror_paths;
+using lamina1::hg_single_reflection;
+using lamina1::hg_slab;
+using lamina1::inverse;
+using lamina1::row_times;
+using lamina1::SlabMatrices;
+using lamina1::split_cosine_nodes;
 
 double column_sum(const FluxMatrix& m, int k) {
     double s = 0;

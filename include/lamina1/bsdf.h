@@ -1,0 +1,392 @@
+#pragma once
+// lamina-1's BSDF: the class, the state it precomputes per material and the small helpers every
+// part uses. Its parts are defined beside it: the construction and the coat's curves
+// (lamina1/coat.h), a scattering medium's (lamina1/media.h), a slab's (lamina1/slab.h), the
+// evaluation (lamina1/eval.h) and the sampling (lamina1/sampling.h); lamina1/lamina1.h includes
+// them all. lamina's docs/models.md, "lamina-1", derives every term:
+//
+//   f_R = f_top                                       exact Walter reflection of the coat
+//       + T(μi) T(μo) a(μi') a(μo') f_b(wi', wo'; α_e) / η0²     first order through the coat
+//       + K X(μi) X(μo) / (π η0²)                    inter-reflections (separable, reciprocal)
+//   f_T = E_1(μi) f_t,b(w̄i', wo; α_b) / T_b,in(μ̄i'; α_b)   first order through the slab's bottom
+//       [+ Σ_p Φ_p(μi) T_{below→p}(μo) / (π A_p η_s²)]   later orders (btdf_populations)
+//
+// T: the coat's directional transmittance, a: Beer–Lambert along the refracted mean directions,
+// α_e and β: the base lobe widened by the coat's refraction spread (its shape the sum of the
+// base's and the coat's GGX spreads, the coat's tails through one facet's exact refraction), X:
+// the light the coat's bottom sends back to the base after the first order, K the normalization
+// that gives the separable term the energy of the geometric series; E_1: the slab's exact
+// first-order transmission, f_t,b the bottom's Walter BTDF from the coat's mean transmitted
+// direction w̄i', α_b its roughness widened by the coat's spread. A scattering medium adds its
+// exact single scattering (and, over a conductor or dielectric base, the once-scattered paths that
+// meet the base) and a separable lobe carrying the rest of the scattered light, its energy from an
+// azimuth-averaged adding–doubling (lamina1/adding.h).
+
+#include "lamina1/adding.h"
+#include "lamina1/curves.h"
+#include "lamina1/math.h"
+#include "lamina1/options.h"
+#include "lamina1/physics.h"
+#include "lamina1/tables.h"
+
+#include <array>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace lamina1 {
+
+/// What a material supports: reflection (the coat over any base), transmission (a slab: a
+/// dielectric base), or nothing, and why.
+struct Support {
+    bool brdf = false;
+    bool btdf = false;
+    std::string reason;
+};
+
+/// A drawn direction: wo, the weight eval(wi, wo)·|cos θo|/pdf and the density (solid angle).
+struct Sample {
+    Vec3 wo;
+    Rgb weight;
+    double pdf = 0;
+};
+
+/// A specular lobe of a smooth stack: all the light it carries leaves along `direction`, with
+/// `energy` of the incident flux.
+struct DeltaLobe {
+    Vec3 direction;
+    Rgb energy;
+};
+
+class Bsdf {
+  public:
+    /// A material of these layers with these choices, reading `tables` (which must outlive it).
+    /// Never throws for any layers; support() says whether it models them.
+    Bsdf(const Layers& layers, const Tables& tables, const Options& options = Options());
+
+    const Support& support() const { return support_; }
+    const Layers& layers() const { return layers_; }
+    const Options& options() const { return ch_; }
+
+    /// Everything that depends on wi alone.
+    struct Incident {
+        Vec3 wi, wi_in;  ///< wi and its refraction into the coat about n (pointing up)
+        bool ok = false;
+        double T = 0;  ///< T(μi)
+        Rgb a{1.0};    ///< exp(−τ/μi')
+        Rgb X{0.0};    ///< X(μi) = T(μi) a(μi') Y(μi')
+        double lambda0 = 0, k_top = 0, k_bottom = 1;
+        Vec3 wi_mean;       ///< the mean direction of the light the coat transmits (slabs)
+        Rgb a_mean{1.0};    ///< exp(−τ/μ̄')
+        double dR = 0;      ///< ΔR(μi) of the coat (multiple scattering)
+        double T_pair = 0;  ///< √(T(μi) T_exit(μi)): the first order's reciprocal coat factor
+        double lobe_norm = 1;  ///< 1/√N(μi'): the widened base lobe's normalization
+        Rgb E_b{0.0};          ///< scattering media: the base's albedo E_b(μi') (mirror paths)
+        Rgb orders{0.0};       ///< E_ms(μi)/(π Ē_ms): the scattered remainder's separable lobe
+        Rgb orders_t{0.0};     ///< E_ms,T(μi)/(π T̄_b): its transmitted part (slabs)
+        Rgb twice{0.0};        ///< that part's normalization as twice-scattered light
+        double alpha_b = 0;    ///< the slab bottom's roughness widened by the coat's spread
+        Rgb first_T{0.0};  ///< E_1(μi)/T_lobe(μi): the first order over the bottom lobe's energy
+        Rgb first_E{0.0};  ///< E_1(μi): the first order's transmitted energy
+        double u_bottom = 1;  ///< the first order's share in the bottom's lobe (btdf-lobe)
+        Rgb first_M{0.0};     ///< E_1(μi)/Q_m(μi): over the mirrored lobe's energy (shared)
+        /// Φ_p(μi)/(π A_p η_s²) for the populations p = inside, beyond the exit cone (v[0], v[1])
+        /// and the energy Σ_p Φ_p T_p they transmit (v[2]): the slab's later orders.
+        Multi<Rgb, 3> trapped{};
+    };
+
+    /// The per-incidence part of eval (wi.z > 0): evaluate many wo with eval_with.
+    Incident incident(const Vec3& wi) const;
+
+    /// The BSDF (radiance, 1/sr, cosine excluded; delta lobes excluded), light arriving from wi
+    /// (wi.z > 0) and leaving towards wo (wo.z > 0 reflection, wo.z < 0 a slab's transmission).
+    Rgb eval(const Vec3& wi, const Vec3& wo) const { return eval_with(incident(wi), wo); }
+    Rgb eval_with(const Incident& in, const Vec3& wo) const;
+
+    /// The specular lobes of a smooth coat (none when α0 > 0).
+    std::vector<DeltaLobe> delta_lobes(const Vec3& wi) const;
+    /// Directions where narrow lobes peak (quadratures refine towards them).
+    std::vector<Vec3> peak_directions(const Vec3& wi) const;
+
+    /// Draws wo for light from wi (wi.z > 0) from three uniforms in [0, 1), with the density
+    /// pdf(wi, wo) (solid angle, either side); nothing where the draw fails. Delta lobes are
+    /// not drawn (delta_lobes).
+    std::optional<Sample> sample(const Vec3& wi, const Vec3& u) const;
+    double pdf(const Vec3& wi, const Vec3& wo) const;
+
+    /// The state the GLSL form of eval reads (lamina1/gpu.h documents the layout and what it
+    /// covers), or why this material is not one it covers (the vector then empty).
+    std::vector<float> gpu_state(std::string* why = nullptr) const;
+
+  private:
+    // Construction (lamina1/coat.h, media.h, slab.h).
+    void precompute();
+    void setup_transmittances();
+    void precompute_lobe_normalization();
+    void precompute_multiple_scattering();
+    SplitCurve<33> precompute_albedos();
+    void precompute_mean_direction();
+    void precompute_series(const SplitCurve<33>& g_curve);
+    Rgb returned_light(double mu, const SplitCurve<33>& g_curve, const Rgb& Y_ms) const;
+    void precompute_returned(const SplitCurve<33>& g_curve);
+    void precompute_scattering();
+    struct AddingEnergies;
+    AddingEnergies adding_energies() const;
+    std::vector<double> twice_shape_energy(int c, const CosineNodes& nodes,
+                                           std::vector<double>& twice_phase) const;
+    void precompute_scattering_curves(const AddingEnergies& e);
+    void precompute_slab();
+    struct SlabReflections;
+    SlabReflections slab_reflections() const;
+    CosineCurve<Multi<Rgb, 3>, kNfirst> slab_entry(const SlabReflections& r);
+    void slab_first_order(const CosineCurve<Multi<Rgb, 3>, kNfirst>& entry);
+    void slab_populations(const SlabReflections& r,
+                          const CosineCurve<Multi<Rgb, 3>, kNfirst>& entry);
+
+    // Evaluation (lamina1/eval.h).
+    Rgb scattered(const Incident& in, const Vec3& wo, const Vec3& wo_in, const Rgb& a_o) const;
+    Rgb single_scattering(const Incident& in, const Vec3& wo_in, const Rgb& a_o, double T_o) const;
+    Rgb single_transmission(const Incident& in, const Vec3& v_in, const Rgb& a_v, double T_b,
+                            const Rgb& g, const Rgb& scale) const;
+    Rgb eval_btdf(const Incident& in, const Vec3& wo) const;
+    Rgb base_lobe(const Incident& in, double mu_o, const Vec3& wo_in) const;
+    double first_order_ndf(const Vec3& h, double k_i, double k_o) const;
+
+    // Sampling (lamina1/sampling.h): the mixture for one incidence, lobe probabilities (top
+    // reflection, base lobe, diffuse series; transmission lobe, diffuse transmission) and the
+    // lobes' roughnesses.
+    struct Mixture {
+        std::array<double, 5> p{};
+        Vec3 wi_in, wi_mean;
+        double alpha_base = 0, beta = 0;
+        bool bottom_sampled = false;  ///< the transmission lobe drawn as the bottom's (btdf-lobe)
+    };
+    Mixture mixture(const Incident& in) const;
+    double pdf_with(const Incident& in, const Mixture& m, const Vec3& wo) const;
+
+    /// The coat's transmittance for the first order leaving a non-Lambertian base towards the
+    /// outside cosine μ (inside μ_in, spread factor k): T_in(μ_in) where the base lobe is narrower
+    /// than the coat's refraction spread α0 k/2 (the light meets the coat along one direction
+    /// and leaves with that direction's transmittance from inside), T(μ) where it is wider (the
+    /// radiance inside is locally uniform, and the light reaching μ outside is T(μ) by
+    /// reciprocity), weighted by u = α1² / (α1² + (α0 k/2)²).
+    double exit_transmittance(double mu, double mu_in, double k) const {
+        const double spread2 = sqr(0.5 * alpha0_ * k),
+                     u = spread2 > 0 ? sqr(alpha1_) / (sqr(alpha1_) + spread2) : 1.0;
+        return u * T_top_(mu) + (1 - u) * T_top_in_(mu_in);
+    }
+
+    /// α_e² = α1² + (α0 k_i/2)² + (α0 k_o/2)²: a deflection of the light by ε turns the mirror
+    /// direction by ε, i.e. its half vector by ε/2; independent spreads add in variance (the
+    /// variance adding of Belcour 2018, §5, with GGX's α as the slope scale).
+    double effective_alpha(double k_i, double k_o) const {
+        if (ch_.spread == Options::Spread::Off) return alpha1_;
+        return std::sqrt(sqr(alpha1_) + 0.25 * sqr(alpha0_) * (sqr(k_i) + sqr(k_o)));
+    }
+
+    /// β² = ((α0 k_top)² + (α1 k_bottom)²)/4: the mirrored lobe of a slab's transmission.
+    double transmission_roughness(double k_top, double k_bottom) const {
+        if (ch_.spread == Options::Spread::Off) return std::max(alpha0_, alpha1_);
+        return 0.5 * std::sqrt(sqr(alpha0_ * k_top) + sqr(alpha1_ * k_bottom));
+    }
+
+    /// α_b² = α1² + (α0 k_top/k_bottom)²: the coat turns the light inside by α0 k_top (per unit
+    /// slope), which a bottom facet of slope s matches with k_bottom s (item 5 of lamina-1).
+    double bottom_roughness(double k_top, double k_bottom) const {
+        if (ch_.spread == Options::Spread::Off) return std::max(alpha0_, alpha1_);
+        return std::sqrt(sqr(alpha1_) + sqr(alpha0_ * k_top / k_bottom));
+    }
+
+    /// The smooth slab's E_1/T_lobe = (1 − F(μ)) a(μ') and E_1 = (1 − F(μ)) a(μ') (1 − F_b(μ')):
+    /// first_order_ holds the residual from them (it vanishes with α0 and α1, and the smooth
+    /// slab's steep edge at grazing incidence is not interpolated).
+    Multi<Rgb, 2> first_order_smooth(double mu, double mu_in) const {
+        Multi<Rgb, 2> r;
+        r.v[0] = attenuation(mu_in) * (1 - fresnel_dielectric(mu, eta0_));
+        r.v[1] = r.v[0] * (1 - fresnel_dielectric(mu_in, eta_b_));
+        return r;
+    }
+
+    /// The slab bottom as a single rough interface seen from inside the coat (wi inside, up).
+    RoughDielectric bottom_btdf(double alpha) const {
+        RoughDielectric d{eta_b_, alpha};
+        d.masking = ch_.masking;
+        return d;
+    }
+
+    double spread_factor(double mu, double mu_in, double eta) const {
+        if (ch_.spread == Options::Spread::Normal) return std::abs(1 - 1 / eta);
+        return deflection(mu, mu_in, eta);
+    }
+
+    /// X(μ); exact for a Lambertian base when the light enters along the refracted direction
+    /// (X = T(μ) a(μ') ρ r̄), else the per-material curve.
+    Rgb X_at(double mu) const {
+        if (!x_exact_) return X_(mu);
+        return layers_.albedo * r_bar_ *
+               attenuation(refract_in(Vec3(safe_sqrt(1 - mu * mu), 0, mu), inv_eta0_).z) *
+               T_top_(mu);
+    }
+
+    /// The inside direction (pointing up) whose refraction through a flat interface of relative
+    /// index 1/inv_eta is w (w.z > 0, entering a denser medium: always exists).
+    static Vec3 refract_in(const Vec3& w, double inv_eta) {
+        return {w.x * inv_eta, w.y * inv_eta, safe_sqrt(1 - (1 - w.z * w.z) * sqr(inv_eta))};
+    }
+    static std::optional<Vec3> refract_in_checked(const Vec3& w, double inv_eta) {
+        const double s2 = (1 - w.z * w.z) * sqr(inv_eta);
+        if (s2 >= 1) return std::nullopt;
+        return Vec3(w.x * inv_eta, w.y * inv_eta, std::sqrt(1 - s2));
+    }
+    /// The cosine inside the coat of the outside cosine μ (the macro refraction).
+    double inside_cos(double mu) const { return safe_sqrt(1 - (1 - mu * mu) * sqr(inv_eta0_)); }
+
+    /// The straight-through direction with cosine cos_t below the surface, opposite wi's azimuth.
+    static Vec3 transmitted_direction(const Vec3& wi, double cos_t) {
+        const double s = std::hypot(wi.x, wi.y);
+        const double sin_t = safe_sqrt(1 - cos_t * cos_t);
+        if (s == 0) return {0, 0, -1};
+        return {-sin_t * wi.x / s, -sin_t * wi.y / s, -cos_t};
+    }
+
+    /// Beer–Lambert along one path at inside cosine μ: exp(−τ/μ).
+    Rgb attenuation(double mu) const {
+        if (!has_absorption_) return Rgb(1.0);
+        if (mu <= 0) return Rgb(0.0);
+        return beer_lambert(tau_t_, 1 / mu);
+    }
+
+    Rgb base_fresnel(double c) const {
+        switch (layers_.base) {
+            case Base::Conductor:
+                return fresnel_complex_rgb(c, layers_.base_eta, layers_.base_k);
+            case Base::Dielectric:
+                return Rgb(fresnel_dielectric(c, eta_b_));
+            case Base::Lambertian:
+                break;
+        }
+        return layers_.albedo;
+    }
+
+    /// The albedo of the mirror that stands for a conductor or dielectric base in the scattered
+    /// light's paths: its Fresnel reflectance when smooth (exact), else its directional albedo.
+    Rgb mirror_albedo(double mu) const {
+        return alpha1_ == 0 ? base_fresnel(mu) : mirror_albedo_curve_(mu);
+    }
+
+    /// The base's directional albedo seen from inside the coat, at inside cosine μ.
+    Rgb base_albedo(double mu) const {
+        const Rgb ms = base_ms_ ? F_ms_ * dE_base_(mu) : Rgb(0.0);
+        switch (layers_.base) {
+            case Base::Conductor:
+                return fgd_base_.rgb(mu) + ms;
+            case Base::Dielectric:
+                return Rgb(fgd_base_(mu)) + ms;
+            case Base::Lambertian:
+                break;
+        }
+        return layers_.albedo;
+    }
+
+    /// The coat's reflectance from inside, R_in(μ) = FGD(μ, α0, 1/η0) (total internal reflection
+    /// included), with its orders ≥ 2 under multiple scattering.
+    double inside_reflectance(double mu) const {
+        const double r = fgd_top_in_(mu);
+        return ch_.multiple_scattering
+                   ? r + ms_dielectric(fgd_top_in_, mu, alpha0_, inv_eta0_).reflected
+                   : r;
+    }
+
+    /// The orders ≥ 2 of a rough dielectric interface (α, η), whose FGD `fgd` reads.
+    MultipleScatteringFormat::Dielectric ms_dielectric(const FgdView& fgd, double mu, double alpha,
+                                                       double eta) const {
+        return MultipleScatteringFormat::dielectric(
+            tables_->multiple_scattering(), mu, alpha, eta, fgd(mu),
+            TransmittanceFormat::lookup(tables_->transmittance(Masking::Smith), mu, alpha, eta));
+    }
+
+    const Tables* tables_;
+    Options ch_;
+    Layers layers_;
+    Support support_;
+    double eta0_ = 1.5, inv_eta0_ = 1 / 1.5, alpha0_ = 0, alpha1_ = 0;
+    double eta_b_ = 1, eta_s_ = 1;
+    bool has_absorption_ = false;
+    /// The FGD nodes this material reads: the base (conductor or dielectric), the coat from
+    /// inside (R_in), and for the multiple-scattering table the coat from outside and a slab's
+    /// bottom from below.
+    FgdView fgd_base_, fgd_top_in_, fgd_top_, fgd_bottom_;
+    bool series_on_ = false, series_btdf_ = false, x_exact_ = false, mean_shift_ = false;
+    CosineCurve<double, kNx> mu_mean_;  ///< μ̄'(μ) − μ'(μ): the transmitted light's mean shift
+    /// T(μ) of one interface (the coat from above or inside, the bottom from below or inside):
+    /// exact 1 − F(μ) when smooth (or with coat-transmittance=fresnel), else the per-material
+    /// curve resampled from the table with its edge at the critical cosine (none: 0) on a node,
+    /// where a nearly smooth interface's T rises steeply.
+    struct Transmittance {
+        EdgeCurve<kNmu> curve;
+        double eta = 1;
+        bool exact = true;
+        double operator()(double mu) const {
+            return exact ? 1 - fresnel_dielectric(mu, eta) : curve(mu);
+        }
+    };
+    Transmittance T_top_, T_bot_;
+    /// The bottom's transmittance for light inside the coat (the first-order BTDF's exit) and the
+    /// coat's for light inside it (the first order's consistency with R_in; see precompute).
+    Transmittance T_bot_in_, T_top_in_;
+    /// X(μ): the flux the coat's bottom returns to the base after the first order, per unit flux
+    /// arriving from outside at μ (outside cosines).
+    CosineCurve<Rgb, kNx> X_;
+    Rgb K_{0.0};                 ///< the separable term's normalization
+    Rgb inv_one_minus_Er_{0.0};  ///< 1/(1 − Ē_b r̄)
+    Rgb r_bar_{0.0}, E_bar_{0.0}, t_bar_{0.0}, X_bar_{0.0};
+    /// Multiple scattering: the coat's ΔR from outside and its hemispherical 2∫ΔR μ dμ; the base's
+    /// ΔE (conductor: white, times F_ms; dielectric: ΔR, F_ms = 1) and its average.
+    bool top_ms_ = false, base_ms_ = false;
+    bool inside_exit_ = false;  ///< exit_transmittance in the first order (see Options)
+    bool mirror_series_ = false;
+    bool lobe_norm_on_ = false;
+    /// first-order-lobe compressed or sum: first_order_ndf in place of the GGX of α_e (a coat
+    /// with α0 > 0 over a conductor or dielectric base, the spread on); the facet maps it uses.
+    bool shaped_lobe_ = false;
+    FacetDeflection entering_, leaving_;
+    /// 1/√N(μ'): N is the energy of the base lobe whose width follows wo (α_e(k_i, k_o)) over that
+    /// of the lobe of fixed width α_e(k_i, k_i), over the exit cone, at inside cosine μ'.
+    CosineCurve<double, kNnorm> lobe_norm_;
+    /// √(1/(1 − a² R_in E_b (1 − u))) over inside cosines: the first order's round trips.
+    CosineCurve<Rgb> mirror_series_curve_;
+    CosineCurve<double> dR_top_, dE_base_;
+    double dR_top_bar_ = 1, dE_base_bar_ = 1;
+    Rgb F_ms_{1.0};
+    /// Scattering media (precompute_scattering): τt, ϖ = τs/τt, g equal in the three channels.
+    Rgb tau_t_{0.0}, omega_{0.0};
+    bool scatters_ = false, g_uniform_ = true, single_on_ = false, base_paths_ = false;
+    bool orders_on_ = false, back_on_ = false, twice_on_ = false;
+    Rgb g_twice_{0.0};  ///< g² per channel
+    /// K(μ): the transmitted remainder's energy over that of the twice-scattered shape.
+    CosineCurve<Rgb, kNx> twice_;
+    /// E_ms(μ), E_ms,T(μ): the energy of the scattered remainder leaving through the top and the
+    /// bottom per unit flux arriving at μ; their lobes' normalizations 1/(π Ē_ms), 1/(π T̄_b).
+    CosineCurve<Rgb, kNx> orders_, orders_t_;
+    Rgb orders_norm_{0.0};
+    double orders_t_norm_ = 0;
+    /// A rough base's directional albedo over inside cosines (mirror_albedo; one lookup instead
+    /// of the FGD table's three).
+    CosineCurve<Rgb, kNmu> mirror_albedo_curve_;
+    /// The explicit single scattering's energy at μ (the sampler's mixture weight).
+    CosineCurve<Rgb, kNx> single_energy_, single_energy_t_;
+    /// The slab's first order through the bottom's BTDF (Options::btdf_bottom_lobe).
+    bool bottom_lobe_ = false;
+    /// E_1(μ)/T_lobe(μ), E_1(μ) and E_1(μ)/Q_m(μ) (v[0], v[1], v[2]) over outside cosines, as
+    /// residuals from the smooth slab (first_order_smooth).
+    CosineCurve<Multi<Rgb, 3>, kNfirst> first_order_;
+    /// The slab's later orders as two populations of inside light (Options::btdf_populations):
+    /// Incident::trapped over outside cosines, and T_{below→p}(μ), the light arriving from below
+    /// at μ that the bottom lets into population p.
+    bool populations_ = false;
+    CosineCurve<Multi<Rgb, 3>, kNslab> trapped_;
+    CosineCurve<Multi<double, 2>, kNslab> enter_below_;
+};
+
+}  // namespace lamina1

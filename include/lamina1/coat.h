@@ -1,0 +1,377 @@
+#pragma once
+// lamina-1's construction and the coat's per-material curves: the interfaces' transmittances,
+// the widened base lobe's normalization, the multiple-scattering lobes, the hemispherical albedos
+// and the inter-reflection series (items 1–4 of lamina-1 in lamina's docs/models.md).
+
+#include "lamina1/bsdf.h"
+
+namespace lamina1 {
+
+inline Bsdf::Bsdf(const Layers& layers, const Tables& tables, const Options& options)
+    : tables_(&tables), ch_(options), layers_(layers) {
+    if (!(layers_.eta0 >= 1)) {
+        support_.reason = "lamina-1 needs a coat at least as dense as the ambient medium";
+        return;
+    }
+    if (!tables.complete(ch_.masking, ch_.multiple_scattering)) {
+        support_.reason = "lamina-1's tables lack what these options read";
+        return;
+    }
+    support_.brdf = true;
+    support_.btdf = layers_.base == Base::Dielectric;
+    eta0_ = layers_.eta0;
+    inv_eta0_ = 1 / eta0_;
+    alpha0_ = layers_.alpha0;
+    alpha1_ = layers_.alpha1;
+    // The unscattered light is attenuated by extinction, τt = τa + τs (τa itself, bitwise,
+    // without scattering).
+    tau_t_ = layers_.tau_a + layers_.tau_s;
+    has_absorption_ = tau_t_.max() > 0;
+    scatters_ = layers_.tau_s.max() > 0;
+    if (layers_.base == Base::Dielectric) {
+        eta_b_ = layers_.base_eta[0];  // η_below/η_coat
+        eta_s_ = 1 / eta_b_;           // the coat seen from below: η_coat/η_below
+    }
+    fgd_top_in_ = FgdView(tables, alpha0_, inv_eta0_, 0.0);
+    if (layers_.base == Base::Conductor)
+        fgd_base_ = FgdView(tables, alpha1_, layers_.base_eta, layers_.base_k);
+    if (layers_.base == Base::Dielectric) fgd_base_ = FgdView(tables, alpha1_, eta_b_, 0.0);
+    if (ch_.multiple_scattering) {
+        fgd_top_ = FgdView(tables, alpha0_, eta0_, 0.0);
+        if (support_.btdf) fgd_bottom_ = FgdView(tables, alpha1_, eta_s_, 0.0);
+    }
+    precompute();
+    if (scatters_) precompute_scattering();
+    precompute_slab();
+}
+
+inline void Bsdf::precompute() {
+    inside_exit_ = ch_.inside_exit && alpha0_ > 0 && ch_.directional_transmittance &&
+                   layers_.base != Base::Lambertian;
+    precompute_lobe_normalization();
+    setup_transmittances();
+    precompute_multiple_scattering();
+    const SplitCurve<33> g_curve = precompute_albedos();
+    precompute_mean_direction();
+    precompute_series(g_curve);
+}
+
+/// T(μ) of the coat from outside and inside, and of a slab's bottom from below and inside: the
+/// table (or 1 − F with coat-transmittance=fresnel) resampled per material, with the orders ≥ 2
+/// of multiple scattering.
+inline void Bsdf::setup_transmittances() {
+    const float* table = tables_->transmittance(ch_.masking);
+    const bool ms = ch_.multiple_scattering;
+    auto setup = [&](Transmittance& t, double alpha, double eta, const FgdView& fgd) {
+        t.eta = eta;
+        t.exact = alpha == 0 || (!ch_.directional_transmittance && !ms);
+        if (!t.exact)
+            t.curve.fill(eta < 1 ? std::sqrt(1 - eta * eta) : 0.0, [&](double mu) {
+                const double tr = ch_.directional_transmittance
+                                      ? TransmittanceFormat::lookup(table, mu, alpha, eta)
+                                      : 1 - fresnel_dielectric(mu, eta);
+                return ms ? tr + ms_dielectric(fgd, mu, alpha, eta).transmitted : tr;
+            });
+    };
+    setup(T_top_, alpha0_, eta0_, fgd_top_);
+    setup(T_top_in_, alpha0_, inv_eta0_, fgd_top_in_);
+    if (support_.btdf) {
+        setup(T_bot_, alpha1_, eta_s_, fgd_bottom_);
+        setup(T_bot_in_, alpha1_, eta_b_, fgd_base_);
+    }
+}
+
+/// The base lobe's width follows wo through k_o, so the lobe is not normalized: its energy over
+/// the exit cone exceeds that of the lobe of fixed width α_e(k_i, k_i) by N(μi') (up to 2× in
+/// the tails under rough, low-index coats). Divided out reciprocally, by √N(μi') √N(μo'). N by the
+/// fixed lobe's visible normals (Heitz 2018), the varying lobe weighted by its ratio.
+inline void Bsdf::precompute_lobe_normalization() {
+    shaped_lobe_ = ch_.first_order_lobe != Options::FirstOrderLobe::Ggx && alpha0_ > 0 &&
+                   eta0_ > 1 && layers_.base != Base::Lambertian &&
+                   ch_.spread != Options::Spread::Off;
+    if (shaped_lobe_ && ch_.first_order_lobe == Options::FirstOrderLobe::Compressed) {
+        entering_.build(true, eta0_, alpha0_);
+        leaving_.build(false, eta0_, alpha0_);
+    }
+    lobe_norm_on_ = ch_.lobe_normalization && alpha0_ > 0 && layers_.base != Base::Lambertian &&
+                    ch_.spread == Options::Spread::Angular;
+    if (!lobe_norm_on_) return;
+    static const QuadratureRule qn = gauss_legendre(kNormNr);
+    const double mu_crit_in = std::sqrt(1 - sqr(inv_eta0_));
+    lobe_norm_.fill([&](double mu) {
+        const double mu_in = std::max(mu, mu_crit_in + 1e-6);
+        const Vec3 w(safe_sqrt(1 - mu_in * mu_in), 0, mu_in);
+        const double mu_out_i = safe_sqrt(1 - (1 - mu_in * mu_in) * sqr(eta0_));
+        const double k_i = spread_factor(mu_out_i, mu_in, eta0_);
+        const double alpha_f = effective_alpha(k_i, k_i);
+        if (alpha_f <= 0) return 1.0;
+        const GGX fixed{alpha_f};
+        double sum_fixed = 0, sum_var = 0;
+        for (int a = 0; a < kNormNr; ++a)
+            for (int b = 0; b < kNormNphi; ++b) {
+                const double r = qn.x[a], w_r = qn.w[a] * 2 * r / kNormNphi;
+                const Vec3 wm =
+                    fixed.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kNormNphi - 0.25);
+                const Vec3 wo = reflect(w, wm);
+                if (wo.z <= mu_crit_in) continue;  // beyond the exit cone (or below)
+                const double mu_out = safe_sqrt(1 - (1 - wo.z * wo.z) * sqr(eta0_));
+                const double k_o = spread_factor(mu_out, wo.z, eta0_);
+                const GGX var{effective_alpha(k_i, k_o)};
+                const double g_fixed = fixed.G2(w, wo) / fixed.G1(w);
+                sum_fixed += w_r * g_fixed;
+                // f_var / f_fixed = D_var G2_var / (D_fixed G2_fixed) at the same half vector
+                // (D_var the shaped lobe's where first-order-lobe shapes it).
+                const double D_var = shaped_lobe_ ? first_order_ndf(wm, k_i, k_o) : var.D(wm);
+                sum_var += w_r * g_fixed * D_var * var.G2(w, wo) / (fixed.D(wm) * fixed.G2(w, wo));
+            }
+        return sum_fixed > 0 && sum_var > 0 ? std::sqrt(sum_fixed / sum_var) : 1.0;
+    });
+}
+
+/// Multiple scattering's separable lobes: the coat's from outside, the base's from inside.
+inline void Bsdf::precompute_multiple_scattering() {
+    const bool ms = ch_.multiple_scattering;
+    top_ms_ = ms && alpha0_ > 0;
+    if (top_ms_) {
+        dR_top_.fill(
+            [&](double mu) { return ms_dielectric(fgd_top_, mu, alpha0_, eta0_).reflected; });
+        dR_top_bar_ =
+            integrate_split01<kGauss, double>([&](double mu) { return dR_top_(mu) * 2 * mu; }, 0.0);
+        top_ms_ = dR_top_bar_ > 0;
+    }
+    base_ms_ = ms && alpha1_ > 0 && layers_.base != Base::Lambertian;
+    if (!base_ms_) return;
+    if (layers_.base == Base::Conductor) {
+        dE_base_.fill([&](double mu) {
+            return MultipleScatteringFormat::conductor(tables_->multiple_scattering(), mu, alpha1_);
+        });
+    } else {
+        dE_base_.fill(
+            [&](double mu) { return ms_dielectric(fgd_base_, mu, alpha1_, eta_b_).reflected; });
+    }
+    dE_base_bar_ =
+        integrate_split01<kGauss, double>([&](double mu) { return dE_base_(mu) * 2 * mu; }, 0.0);
+    base_ms_ = dE_base_bar_ > 0;
+    if (base_ms_ && layers_.base == Base::Conductor) {
+        // Each further facet multiplies by the conductor's Fresnel factor: with its hemispherical
+        // average F̄ and the white surface's E_avg = 1 − ΔĒ, the orders ≥ 2 carry ΔE(μ) F̄² E_avg /
+        // (1 − F̄ (1 − E_avg)) (Kulla & Conty 2017, "Revisiting physically based shading at
+        // Imageworks", the F_ms factor: one more bounce F̄, then escape E_avg or another bounce).
+        const Rgb F_avg = integrate_split01<kGauss, Rgb>(
+            [&](double mu) {
+                return fresnel_complex_rgb(mu, layers_.base_eta, layers_.base_k) * (2 * mu);
+            },
+            0.0);
+        const double E_avg = 1 - dE_base_bar_;
+        for (int c = 0; c < 3; ++c)
+            F_ms_[c] = sqr(F_avg[c]) * E_avg / (1 - F_avg[c] * (1 - E_avg));
+    }
+}
+
+/// The hemispherical albedos r̄ (the coat's bottom, with the medium's round trip), Ē_b (the
+/// base) and t̄ (the coat's diffuse exit); returns g(μ) = a(μ)² R_eff(μ), the light a return trip
+/// base → coat → base keeps, tabulated for Y.
+inline SplitCurve<33> Bsdf::precompute_albedos() {
+    // The coat's bottom seen from inside: R_in(μ) = FGD(μ, α0, 1/η0) (total internal reflection
+    // included), and g(μ) = a(μ)² R_in(μ) for a return trip base → coat → base.
+    const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
+    r_bar_ = integrate_split01<kGauss, Rgb>(
+        [&](double mu) {
+            return attenuation(mu) * attenuation(mu) * (2 * mu * inside_reflectance(mu));
+        },
+        mu_crit);
+    // What the first order does not send out is returned: light inside at μ'' within the exit
+    // cone leaves in the first order with the outside transmittance T(μ) (exact for a locally
+    // uniform inside radiance, by reciprocity), so the part returned to the base is
+    // R_eff = 1 − loss − T(μ) = R_in + T_in − T(μ), where R_in + T_in + loss = 1 from inside. For
+    // a smooth coat T_in = T and R_eff = R_in; for a rough one the facets' total internal
+    // reflection makes T_in < T near the critical angle, and R_in alone would count that light
+    // twice. Beyond the cone nothing leaves in the first order and R_eff = R_in.
+    auto g_direct = [&](double mu) {
+        const Rgb a = attenuation(mu);
+        double R = inside_reflectance(mu);
+        if (alpha0_ > 0 && mu > mu_crit) {
+            const double mu_out = safe_sqrt(1 - (1 - mu * mu) * sqr(eta0_));
+            const double T_exit =
+                inside_exit_ ? exit_transmittance(mu_out, mu, spread_factor(mu_out, mu, eta0_))
+                             : T_top_(mu_out);
+            R = std::max(0.0, R + T_top_in_(mu) - T_exit);
+        }
+        return a * a * R;
+    };
+    // Tabulated once (Y's quadrature looks it up at every node); the node μ = 0 is taken at 1e-6,
+    // where an index-matched coat's Fresnel factor is its limit 0 (not the 0/0 of grazing).
+    SplitCurve<33> g_curve;
+    g_curve.fill(mu_crit, [&](double mu) { return g_direct(std::max(mu, 1e-6)); });
+    const double mu_crit_b = eta_b_ < 1 ? std::sqrt(1 - sqr(eta_b_)) : 0.0;
+    E_bar_ = integrate_split01<kGauss, Rgb>([&](double mu) { return base_albedo(mu) * (2 * mu); },
+                                            mu_crit_b);
+    t_bar_ =
+        integrate_split01<kGauss, Rgb>(
+            [&](double mu) { return attenuation(inside_cos(mu)) * (2 * mu * T_top_(mu)); }, 0.0) *
+        sqr(inv_eta0_);
+    return g_curve;
+}
+
+/// The mean direction of the light a rough coat transmits (slab BTDF): the visible facets at
+/// grazing incidence lean towards the light and turn the refracted light away from the normal (by
+/// k δ per facet tilt δ, item 4 of lamina-1), so its mean lies beyond the macro refraction — near
+/// grazing, beyond a slab's exit cone. By the coat's visible-normal rule. (With btdf-lobe=bottom
+/// or shared, slab_entry computes it by its own rule, with the first order.)
+inline void Bsdf::precompute_mean_direction() {
+    mean_shift_ = support_.btdf && alpha0_ > 0 && ch_.directional_transmittance && ch_.mean_shift;
+    if (!mean_shift_ || ch_.btdf_bottom_lobe) return;
+    static const QuadratureRule q = gauss_legendre(kYnr);
+    const GGX ggx0{alpha0_};
+    mu_mean_.fill([&](double mu) {
+        const Vec3 w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+        double x = 0, z = 0;
+        for (int a = 0; a < kYnr; ++a)
+            for (int b = 0; b < kYnphi; ++b) {
+                const double r = q.x[a], w_r = q.w[a] * 2 * r;
+                const Vec3 wm =
+                    ggx0.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kYnphi - 0.25);
+                const auto wt = refract(w, wm, eta0_);
+                if (!wt || wt->z >= 0) continue;
+                const double wgt = (1 - fresnel_dielectric(dot(w, wm), eta0_)) * w_r;
+                x += wgt * wt->x;  // −wt: the inside direction pointing up, in −x
+                z += wgt * -wt->z;
+            }
+        const double len = std::hypot(x, z);
+        // Stored as the shift from the macro refraction (which the lookup adds back exactly): it
+        // vanishes with α0, and so does its interpolation error under narrow lobes.
+        return (len > 0 ? z / len : inside_cos(mu)) - inside_cos(mu);
+    });
+}
+
+/// Which inter-reflections are summed (item 3 of lamina-1): the separable series where the base
+/// re-diffuses the returned light, else the first order's round trips kept in its lobe.
+inline void Bsdf::precompute_series(const SplitCurve<33>& g_curve) {
+    const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
+    const bool smooth_base = layers_.base != Base::Lambertian && alpha1_ == 0;
+    series_on_ =
+        ch_.inter_reflection && !(smooth_base && alpha0_ == 0) &&
+        (layers_.base == Base::Lambertian || !ch_.series_lambertian_only || alpha1_ >= alpha0_);
+    series_btdf_ = series_on_ && !ch_.series_lambertian_only;
+    // Where the uniform series is off (a base smoother than the rough coat), the light the coat's
+    // bottom returns meets a base that keeps its direction: it stays in the first order's lobe,
+    // which each round trip multiplies by a² R_in E_b, summed as the smooth stack's delta series
+    // is (lamina's docs/physics.md §6.5), over the part (1 − u) the base does not spread.
+    mirror_series_ = ch_.inter_reflection && inside_exit_ && !series_on_;
+    if (mirror_series_) {
+        mirror_series_curve_.fill([&](double mu) {
+            const double mu_in = std::max(mu, mu_crit + 1e-9);
+            const double mu_out = safe_sqrt(1 - (1 - mu_in * mu_in) * sqr(eta0_));
+            const double spread2 = sqr(0.5 * alpha0_ * spread_factor(mu_out, mu_in, eta0_));
+            const double u = spread2 > 0 ? sqr(alpha1_) / (sqr(alpha1_) + spread2) : 1.0;
+            const Rgb a = attenuation(mu_in);
+            const Rgb round_trip =
+                a * a * base_albedo(mu_in) * (inside_reflectance(mu_in) * (1 - u));
+            Rgb S(1.0);
+            for (int c = 0; c < 3; ++c)
+                S[c] = 1 / std::sqrt(std::max(1e-6, 1 - round_trip[c]));  // √ of 1/(1 − ·)
+            return S;
+        });
+    }
+    if (!series_on_) return;
+    precompute_returned(g_curve);
+    // X̄ = (2/η0²)∫ X(μ) μ dμ: the diffuse exit's normalization.
+    X_bar_ = integrate_split01<kGauss, Rgb>([&](double mu) { return X_at(mu) * (2 * mu); }, 0.0) *
+             sqr(inv_eta0_);
+    for (int c = 0; c < 3; ++c) {
+        const double one_minus = 1 - E_bar_[c] * r_bar_[c];
+        inv_one_minus_Er_[c] = one_minus > 0 ? 1 / one_minus : 0;
+        // The separable term X(μi)X(μo)K/(πη0²) must leave with the series' energy
+        // X(μi) Ē_b t̄/(1 − Ē_b r̄): ∫ X(μo)/(πη0²) μo dωo = X̄ fixes K.
+        K_[c] = X_bar_[c] > 0 ? E_bar_[c] * t_bar_[c] * inv_one_minus_Er_[c] / X_bar_[c] : 0;
+    }
+}
+
+/// Y(μ') = ∫ f_b(w', w'') μ'' g(μ'') dω'': what the base's first reflection of light arriving at
+/// inside cosine μ' sends back down after one reflection at the coat's bottom. The base's
+/// separable multiple-scattering lobe sends F_ms ΔE(μ') Y_ms, Y_ms = ∫ ΔE g 2μ'' dμ'' / ΔĒ.
+inline Rgb Bsdf::returned_light(double mu, const SplitCurve<33>& g, const Rgb& Y_ms) const {
+    const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
+    const double mu_crit_b = eta_b_ < 1 ? std::sqrt(1 - sqr(eta_b_)) : 0.0;
+    if (layers_.base == Base::Lambertian) return layers_.albedo * r_bar_;
+    if (alpha1_ == 0) return base_fresnel(mu) * g(mu);
+    const GGX ggx{alpha1_};
+    const Vec3 w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+    const double lambda_w = ggx.lambda(w);
+    // Visible-normal weight: f_b μ'' dω'' = D_w F G2/G1 dwm (Heitz 2018, §2).
+    auto f_y = [&](const Vec3& wm) {
+        const Vec3 w2 = reflect(w, wm);
+        if (w2.z <= 0) return Rgb(0.0);
+        const double escape = (1 + lambda_w) / (1 + lambda_w + ggx.lambda(w2));
+        return base_fresnel(dot(w, wm)) * g(w2.z) * escape;
+    };
+    static const QuadratureRule q = gauss_legendre(kSplitNr);
+    constexpr double kTol = 1.0 / (1 << kSplitBisections);
+    const Crossing coat_edge{[&](const Vec3& wm) { return reflect(w, wm).z; }, mu_crit};
+    // A slab's bottom reflects totally from facets seen beyond its critical cosine: its Fresnel
+    // factor steps there too (unsplit, 3e-3 of a slab's albedo at α1 = 0.3).
+    Rgb sum = mu_crit_b > 0 && layers_.base == Base::Dielectric
+                  ? integrate_visible_split<Rgb>(
+                        ggx, w, f_y, q, kSplitNphi, kTol, coat_edge,
+                        Crossing{[&](const Vec3& wm) { return dot(w, wm); }, mu_crit_b})
+                  : integrate_visible_split<Rgb>(ggx, w, f_y, q, kSplitNphi, kTol, coat_edge);
+    if (base_ms_) sum += F_ms_ * Y_ms * dE_base_(mu);
+    return sum;
+}
+
+/// X(μ), the light the coat's bottom returns to the base after the first order (item 3).
+inline void Bsdf::precompute_returned(const SplitCurve<33>& g_curve) {
+    const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
+    const Rgb Y_ms =
+        base_ms_ ? integrate_split01<kGauss, Rgb>(
+                       [&](double mu) { return g_curve(mu) * (dE_base_(mu) * 2 * mu); }, mu_crit) *
+                       (1 / dE_base_bar_)
+                 : Rgb(0.0);
+    auto Y = [&](double mu) { return returned_light(mu, g_curve, Y_ms); };
+    x_exact_ = layers_.base == Base::Lambertian && (alpha0_ == 0 || !ch_.directional_transmittance);
+    // X (and K, X̄) serve the separable series alone.
+    if (x_exact_) return;
+    if (alpha0_ == 0 || !ch_.directional_transmittance) {
+        // The light enters along the refracted direction (smooth coat) or is taken to.
+        X_.fill([&](double mu) {
+            const double mu_in = inside_cos(mu);
+            return Y(mu_in) * attenuation(mu_in) * T_top_(mu);
+        });
+        return;
+    }
+    // A rough coat spreads the entering light over the inside directions, beyond the critical
+    // cone too (light there cannot leave through the first order and is returned): X(μ) =
+    // ∫ t(μ → w') a(μ_w') Y(μ_w') dω' over the coat's transmitted light, by the visible-normal
+    // rule of the coat (weight (1 − F) G_t/G1, as in its transmittance table).
+    SplitCurve<17> Y_curve;
+    Y_curve.fill(mu_crit, Y);
+    const GGX ggx0{alpha0_};
+    // The coat's orders ≥ 2 transmit ΔT(μ) more, spread over the inside directions: taken as
+    // cosine-distributed, they return the hemispherical average of a Y.
+    const bool ms = ch_.multiple_scattering;
+    const Rgb Y_spread =
+        ms ? integrate_split01<kGauss, Rgb>(
+                 [&](double mu) { return Y_curve(mu) * attenuation(mu) * (2 * mu); }, mu_crit)
+           : Rgb(0.0);
+    X_.fill([&](double mu) {
+        const Vec3 w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+        const double lambda_w = ggx0.lambda(w);
+        // The refracted direction's inside cosine −wt.z; Y_curve steps at μc.
+        auto inside_z = [&](const Vec3& wm) {
+            const auto wt = refract(w, wm, eta0_);
+            return wt ? -wt->z : 0.0;
+        };
+        Rgb sum = integrate_visible_split<Rgb, kSplitNr, kSplitNphi, kSplitBisections>(
+            ggx0, w, mu_crit, inside_z, [&](const Vec3& wm) {
+                const auto wt = refract(w, wm, eta0_);
+                if (!wt || wt->z >= 0) return Rgb(0.0);
+                const double F = fresnel_dielectric(dot(w, wm), eta0_);
+                const double escape = refraction_escape(ch_.masking, lambda_w, ggx0.lambda(*wt));
+                return Y_curve(-wt->z) * attenuation(-wt->z) * ((1 - F) * escape);
+            });
+        if (ms) sum += Y_spread * ms_dielectric(fgd_top_, mu, alpha0_, eta0_).transmitted;
+        return sum;
+    });
+}
+
+}  // namespace lamina1

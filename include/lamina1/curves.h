@@ -1,0 +1,209 @@
+#pragma once
+// lamina-1's building blocks: its rules' sizes, the per-material curves over a cosine, and one
+// facet's exact refraction turn (the shaped first-order lobe's tails).
+
+#include "lamina1/math.h"
+#include "lamina1/physics.h"
+#include "lamina1/quadrature.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace lamina1 {
+
+constexpr int kNmu = 65;   // nodes of the per-material curves over a cosine, μ = s²
+constexpr int kNx = 33;    // nodes of X(μ), μ = s²
+constexpr int kYnr = 6;    // the rule of the transmitted light's mean direction: Gauss–Legendre
+constexpr int kYnphi = 8;  // in r × midpoint in φ over the half disk
+// The rule of Y and X: their integrands step at the coat's critical angle (total internal
+// reflection returns everything beyond it). A plain 6 × 8 rule in r put that step on one heavy
+// node (Y = 0.27 instead of 0.17 at normal incidence on α1 = 0.4 under an η0 = 1.2 smooth coat,
+// and the stack 7% more light than the goniophotometer); 24 × 16 nodes still moved by 2% from one
+// rule to the next. The rule splits the radius of each φ node at the step instead (and, for a
+// slab's Y, at its bottom's own total reflection) and integrates it in u = √(1 − r)
+// (integrate_visible_split, lamina1/quadrature.h): 5 Gauss–Legendre nodes
+// per piece, 6 in φ; on the study's slabs, paints and frosted metals its albedos are within 1.0e-3
+// (mean 5e-5) of a 16 × 32 rule, where 6 × 8 nodes in r were within 3.1e-3.
+constexpr int kSplitNr = 5, kSplitNphi = 6, kSplitBisections = 14;
+constexpr int kNormNr = 8, kNormNphi = 8;  // the base lobe's normalization N (its rule) ...
+constexpr int kNnorm = 17;                 // ... on this many cosines (μ = s²)
+/// Energies (fractions of the incident light) below this are taken as zero where a lobe is
+/// normalized by them: far below anything a goniophotometer could measure.
+constexpr double kNegligibleEnergy = 1e-12;
+constexpr int kGauss = 24;  // Gauss–Legendre nodes per piece of the hemispherical integrals
+// The slab's transmission curves (precompute_slab): nodes over a cosine (the first order, the
+// later orders), and the split visible-normal rule of their integrals (r nodes per piece, φ
+// nodes, bisections).
+constexpr int kNfirst = 17, kNslab = 17;
+constexpr int kSlabNr = 4, kSlabNphi = 8, kSlabBisections = 8;
+
+/// A curve over a cosine μ ∈ [0, 1] on nodes μ = s² (dense at grazing), linear in s.
+template <typename V, int kN = kNmu>
+struct CosineCurve {
+    std::array<V, kN> v{};
+    template <typename F>
+    void fill(F&& f) {
+        for (int i = 0; i < kN; ++i)
+            v[i] = f(sqr(double(i) / (kN - 1)));
+    }
+    V operator()(double mu) const {
+        const double s = std::sqrt(clamp(mu, 0.0, 1.0)) * (kN - 1);
+        const int i = std::min(int(s), kN - 2);
+        const double t = s - i;
+        return v[i] * (1 - t) + v[i + 1] * t;
+    }
+};
+
+/// A curve over an inside cosine with a jump at the critical cosine μc (total internal reflection
+/// at a smooth coat): linear on nodes uniform in [0, μc) and in [μc, 1], each piece on its own.
+/// kSqrtEdge: a square-root edge there instead (a rough interface's transmittance from inside,
+/// which rises as √(μ − μc) above it when nearly smooth, its step smoothed over a width ~α on
+/// both sides): the nodes crowd towards μc from both sides, μ = μc (1 − (1 − t)²) below and
+/// μ = μc + (1 − μc) t² above (t uniform), as integrate_split01 (lamina1/quadrature.h)
+/// places its upper nodes.
+template <int kN, typename V = Rgb, bool kSqrtEdge = false>
+struct SplitCurve {
+    double split = 0;
+    std::array<V, kN> below{}, above{};
+    template <typename F>
+    void fill(double mu_split, F&& f) {
+        split = clamp(mu_split, 0.0, 1.0);
+        for (int i = 0; i < kN; ++i) {
+            const double t = double(i) / (kN - 1);
+            if (split > 0)  // else never read
+                below[i] = f(
+                    std::min(split * (kSqrtEdge ? 1 - sqr(1 - t) : t), std::nextafter(split, 0.0)));
+            above[i] = f(split + (1 - split) * (kSqrtEdge ? t * t : t));
+        }
+    }
+    V operator()(double mu) const {
+        const bool lower = mu < split;
+        const double a = lower ? 0 : split, b = lower ? split : 1;
+        const auto& v = lower ? below : above;
+        double x = b > a ? clamp((mu - a) / (b - a), 0.0, 1.0) : 0;
+        if (kSqrtEdge) x = lower ? 1 - std::sqrt(1 - x) : std::sqrt(x);
+        x *= kN - 1;
+        const int i = std::min(int(x), kN - 2);
+        const double t = x - i;
+        return v[i] * (1 - t) + v[i + 1] * t;
+    }
+};
+
+/// The square-root-edge curve (SplitCurve with kSqrtEdge).
+template <int kN>
+using EdgeCurve = SplitCurve<kN, double, true>;
+
+/// N values of type T integrated and tabulated together (the curves above take it as V).
+template <typename T, int N>
+struct Multi {
+    std::array<T, N> v{};
+    Multi& operator+=(const Multi& o) {
+        for (int i = 0; i < N; ++i)
+            v[i] += o.v[i];
+        return *this;
+    }
+    Multi operator+(const Multi& o) const { return Multi(*this) += o; }
+    Multi operator*(double s) const {
+        Multi r;
+        for (int i = 0; i < N; ++i)
+            r.v[i] = v[i] * s;
+        return r;
+    }
+};
+
+/// ∫_lo^hi f(μ) dμ by Gauss–Legendre (kGauss nodes).
+template <typename V, typename F>
+V integrate_range(F&& f, double lo, double hi) {
+    static const QuadratureRule q = gauss_legendre(kGauss);
+    V sum{};
+    if (!(hi > lo)) return sum;
+    for (int i = 0; i < kGauss; ++i)
+        sum += f(lo + (hi - lo) * q.x[i]) * (q.w[i] * (hi - lo));
+    return sum;
+}
+
+/// |1 − μ/(η μ')|: the rate at which a refracted direction turns with the tilt of the facet it
+/// crosses (differentiate Snell's law sin(θ − δ) = η sin(θ' + Δ − δ) in δ at δ = 0, for a facet
+/// tilted by δ in the plane of incidence: dΔ/dδ = 1 − cos θ/(η cos θ')). Belcour 2018, Eq. 10,
+/// is the same first-order deflection. At normal incidence 1 − 1/η.
+inline double deflection(double mu, double mu_in, double eta) {
+    return std::abs(1 - mu / (eta * mu_in));
+}
+
+/// One facet's exact deflection of the refracted light at normal incidence (docs/models.md,
+/// lamina-1, item 4), for the coat's spreads' tails: a facet tilted by δ turns the inside
+/// direction by g(δ) — entering from outside, g = δ − asin(sin δ/η); leaving from inside, the
+/// outside ray turns by ψ = asin(η sin δ) − δ, which the smooth refraction wo → wo' sees inside
+/// as g = asin(sin ψ/η) (nothing beyond total internal reflection, δ ≥ asin(1/η)). Both have
+/// g'(0) = k_n = 1 − 1/η. Tabulated inverse, over g ∈ [0, g_max] (129 nodes): sin δ and cos δ
+/// (both smooth in g: an interpolated cos δ alone would make tan δ grow like √g at 0), and the
+/// weight k_n w(δ)/g'(δ) (the Jacobian of the map, 1 at δ = 0) with w the facet's transmission
+/// 1 − F(cos δ) times the refracted ray's Smith escape 1/(1 + Λ), relative to normal incidence.
+struct FacetDeflection {
+    static constexpr int kN = 129, kFine = 257;
+    double g_max = 0;
+    std::array<double, kN> sin_delta{}, cos_delta{}, weight{};
+
+    void build(bool entering, double eta, double alpha0) {
+        const GGX ggx{alpha0};
+        const double k_n = 1 - 1 / eta;
+        const double delta_max = entering ? 0.5 * kPi : std::asin(1 / eta);
+        const double w0 = 1 - fresnel_dielectric(1.0, eta);
+        // The forward map on a fine δ grid (g is increasing), then inverted node by node.
+        std::array<double, kFine> g{}, sn{}, c{}, wt{};
+        for (int j = 0; j < kFine; ++j) {
+            const double delta = delta_max * j / (kFine - 1);
+            const double sd = std::sin(delta), cd = std::cos(delta);
+            double gj, dg, escape_cos;
+            if (entering) {
+                const double ct = safe_sqrt(1 - sqr(sd / eta));
+                gj = delta - std::asin(std::min(sd / eta, 1.0));
+                dg = 1 - cd / (eta * ct);
+                escape_cos = std::cos(gj);
+            } else {
+                const double x = std::min(eta * sd, 1.0);
+                const double psi = std::asin(x) - delta;
+                gj = std::asin(std::sin(psi) / eta);
+                const double root = safe_sqrt(1 - x * x);
+                dg = root > 0 ? std::cos(psi) * (eta * cd / root - 1) / (eta * std::cos(gj))
+                              : HUGE_VAL;
+                escape_cos = std::cos(psi);
+            }
+            const double F =
+                entering ? fresnel_dielectric(cd, eta) : fresnel_dielectric(cd, 1 / eta);
+            const Vec3 w_ref(safe_sqrt(1 - sqr(escape_cos)), 0, std::max(escape_cos, 1e-9));
+            const double w = (1 - F) / (1 + ggx.lambda(w_ref)) / w0;
+            g[j] = gj;
+            sn[j] = sd;
+            c[j] = cd;
+            wt[j] = j == 0 ? 1.0 : (dg > 0 && std::isfinite(dg) ? k_n * w / dg : 0.0);
+        }
+        g_max = g[kFine - 1];
+        int j = 0;
+        for (int i = 0; i < kN; ++i) {
+            const double gi = g_max * i / (kN - 1);
+            while (j < kFine - 2 && g[j + 1] < gi)
+                ++j;
+            const double span = g[j + 1] - g[j];
+            const double t = span > 0 ? clamp((gi - g[j]) / span, 0.0, 1.0) : 0.0;
+            sin_delta[i] = sn[j] + t * (sn[j + 1] - sn[j]);
+            cos_delta[i] = c[j] + t * (c[j + 1] - c[j]);
+            weight[i] = wt[j] + t * (wt[j + 1] - wt[j]);
+        }
+    }
+
+    /// sin δ, cos δ and the weight at deflection g ≥ 0; false beyond g_max (no facet turns so far).
+    bool lookup(double g, double& sin_d, double& cos_d, double& w) const {
+        if (!(g < g_max)) return false;
+        const double f = g / g_max * (kN - 1);
+        const int i = std::min(int(f), kN - 2);
+        const double t = f - i;
+        sin_d = sin_delta[i] + t * (sin_delta[i + 1] - sin_delta[i]);
+        cos_d = cos_delta[i] + t * (cos_delta[i + 1] - cos_delta[i]);
+        w = weight[i] + t * (weight[i + 1] - weight[i]);
+        return cos_d > 0 && w > 0;
+    }
+};
+
+}  // namespace lamina1

@@ -1,0 +1,398 @@
+// lamina-1's eval in GLSL ES 3.00 (WebGL2): the reflection of lamina1::Bsdf::eval_with
+// (lamina1/eval.h) line for line, in float32, reading the per-material state that
+// Bsdf::gpu_state packs (lamina1/gpu.h documents the layout and what it covers) from an R32F
+// texture 256 texels wide, `lamina1_state` (no filtering: texelFetch). Conventions as the C++:
+// the local frame, z the macro normal; wi where the light arrives from (wi.z > 0), wo where it
+// leaves to; lamina1_eval returns f in 1/sr, RGB, without the cosine (0 for wo.z <= 0: a slab's
+// transmission is not in this form). lamina1_sample and lamina1_pdf are Bsdf::sample and pdf
+// (lamina1/sampling.h) for the materials whose state has the sampling flag (not slabs). Include
+// it after declaring
+//   uniform highp sampler2D lamina1_state;
+// lamina's docs/models.md, "lamina-1", derives every term; docs/lamina1.md shows the use.
+
+const float L1_PI = 3.14159265358979;
+const float L1_INV_PI = 0.318309886183791;
+const int L1_NMU = 65, L1_NX = 33, L1_NNORM = 17, L1_NFACET = 129;
+const int L1_T_TOP = 64, L1_T_TOP_IN = L1_T_TOP + 2 * L1_NMU, L1_X = L1_T_TOP_IN + 2 * L1_NMU;
+const int L1_LOBE_NORM = L1_X + 3 * L1_NX, L1_MIRROR = L1_LOBE_NORM + L1_NNORM;
+const int L1_ENTERING = L1_MIRROR + 3 * L1_NMU, L1_LEAVING = L1_ENTERING + 3 * L1_NFACET;
+const int L1_BASE_ALBEDO = L1_LEAVING + 3 * L1_NFACET;
+const int L1_SLOPE_SUM = 1536, L1_SS_NX = 25, L1_SS_NY = 13, L1_SS_NU = 33;
+
+float l1_at(int i) { return texelFetch(lamina1_state, ivec2(i % 256, i / 256), 0).r; }
+vec3 l1_rgb(int i) { return vec3(l1_at(i), l1_at(i + 1), l1_at(i + 2)); }
+bool l1_flag(int bit) { return ((int(l1_at(0)) >> bit) & 1) == 1; }
+
+float l1_sqr(float x) { return x * x; }
+
+// Exact unpolarized Fresnel reflectance of a dielectric (Born & Wolf §1.5.2, Eqs. 21a–b).
+float l1_fresnel_dielectric(float cos_i, float eta) {
+    cos_i = clamp(cos_i, -1.0, 1.0);
+    bool below = cos_i < 0.0;
+    float e = below ? 1.0 / eta : eta;
+    cos_i = abs(cos_i);
+    float sin2_t = (1.0 - cos_i * cos_i) / (e * e);
+    if (!(sin2_t < 1.0)) return 1.0;
+    float cos_t = sqrt(max(1.0 - sin2_t, 0.0));
+    float rpar = (e * cos_i - cos_t) / (e * cos_i + cos_t);
+    float rper = (cos_i - e * cos_t) / (cos_i + e * cos_t);
+    return 0.5 * (rpar * rpar + rper * rper);
+}
+
+// Fresnel for η + iκ (PBR 3rd ed., §8.2.1, FrConductor), per channel.
+float l1_fresnel_complex(float c, float eta, float k) {
+    c = clamp(c, 0.0, 1.0);
+    float cos2 = c * c, sin2 = 1.0 - cos2, eta2 = eta * eta, k2 = k * k;
+    float t0 = eta2 - k2 - sin2;
+    float a2b2 = sqrt(t0 * t0 + 4.0 * eta2 * k2);
+    float t1 = a2b2 + cos2;
+    float a = sqrt(max(0.5 * (a2b2 + t0), 0.0));
+    float t2 = 2.0 * c * a;
+    if (t1 + t2 <= 0.0) return 1.0;
+    float rs = max(t1 - t2, 0.0) / (t1 + t2);
+    float t3 = cos2 * a2b2 + sin2 * sin2, t4 = t2 * sin2;
+    float rp = rs * max(t3 - t4, 0.0) / (t3 + t4);
+    return 0.5 * (rp + rs);
+}
+
+// GGX (Walter et al. 2007, Eq. 33) and Smith Λ (Heitz 2014, Eq. 72).
+float l1_ggx_d(float alpha, vec3 m) {
+    if (m.z <= 0.0) return 0.0;
+    float a2 = alpha * alpha;
+    float d = m.x * m.x + m.y * m.y + a2 * m.z * m.z;
+    return a2 / (L1_PI * d * d);
+}
+float l1_lambda(float alpha, vec3 w) {
+    float x = alpha * alpha * (w.x * w.x + w.y * w.y) / (w.z * w.z);
+    return x / (2.0 * (sqrt(1.0 + x) + 1.0));
+}
+
+// The per-material curves (lamina1/curves.h): over μ = s² nodes, and the square-root-edge curve.
+float l1_cosine_curve(int base, int n, int stride, int channel, float mu) {
+    float s = sqrt(clamp(mu, 0.0, 1.0)) * float(n - 1);
+    int i = min(int(s), n - 2);
+    float t = s - float(i);
+    return l1_at(base + stride * i + channel) * (1.0 - t) +
+           l1_at(base + stride * (i + 1) + channel) * t;
+}
+vec3 l1_cosine_curve3(int base, int n, float mu) {
+    return vec3(l1_cosine_curve(base, n, 3, 0, mu), l1_cosine_curve(base, n, 3, 1, mu),
+                l1_cosine_curve(base, n, 3, 2, mu));
+}
+float l1_edge_curve(int base, float split, float mu) {
+    bool lower = mu < split;
+    float a = lower ? 0.0 : split, b = lower ? split : 1.0;
+    float x = b > a ? clamp((mu - a) / (b - a), 0.0, 1.0) : 0.0;
+    x = lower ? 1.0 - sqrt(1.0 - x) : sqrt(x);
+    x *= float(L1_NMU - 1);
+    int i = min(int(x), L1_NMU - 2);
+    float t = x - float(i);
+    int at = base + (lower ? 0 : L1_NMU) + i;
+    return l1_at(at) * (1.0 - t) + l1_at(at + 1) * t;
+}
+// T(μ) of the coat from outside (which = 0) or inside (1).
+float l1_transmittance(int which, float mu) {
+    if (l1_flag(which == 0 ? 10 : 11))
+        return 1.0 - l1_fresnel_dielectric(mu, l1_at(which == 0 ? 26 : 28));
+    return l1_edge_curve(which == 0 ? L1_T_TOP : L1_T_TOP_IN, l1_at(which == 0 ? 25 : 27), mu);
+}
+
+vec3 l1_attenuation(float mu) {
+    if (!l1_flag(1)) return vec3(1.0);
+    if (mu <= 0.0) return vec3(0.0);
+    return exp(-l1_rgb(7) / mu);
+}
+vec3 l1_refract_in(vec3 w) {
+    float inv_eta = l1_at(3);
+    return vec3(w.x * inv_eta, w.y * inv_eta,
+                sqrt(max(1.0 - (1.0 - w.z * w.z) * inv_eta * inv_eta, 0.0)));
+}
+float l1_spread_factor(float mu, float mu_in) {
+    float eta = l1_at(2);
+    if (l1_flag(12)) return abs(1.0 - 1.0 / eta);
+    return abs(1.0 - mu / (eta * mu_in));
+}
+float l1_exit_transmittance(float mu, float mu_in, float k) {
+    float alpha0 = l1_at(4), alpha1 = l1_at(5);
+    float spread2 = l1_sqr(0.5 * alpha0 * k);
+    float u = spread2 > 0.0 ? alpha1 * alpha1 / (alpha1 * alpha1 + spread2) : 1.0;
+    return u * l1_transmittance(0, mu) + (1.0 - u) * l1_transmittance(1, mu_in);
+}
+vec3 l1_base_fresnel(float c) {
+    int base = int(l1_at(1));
+    if (base == 1)
+        return vec3(l1_fresnel_complex(c, l1_at(13), l1_at(16)),
+                    l1_fresnel_complex(c, l1_at(14), l1_at(17)),
+                    l1_fresnel_complex(c, l1_at(15), l1_at(18)));
+    if (base == 2) return vec3(l1_fresnel_dielectric(c, l1_at(6)));
+    return l1_rgb(10);
+}
+vec3 l1_x_at(float mu) {
+    if (!l1_flag(3)) return l1_cosine_curve3(L1_X, L1_NX, mu);
+    vec3 w = vec3(sqrt(max(1.0 - mu * mu, 0.0)), 0.0, mu);
+    return l1_rgb(10) * l1_rgb(22) * l1_attenuation(l1_refract_in(w).z) * l1_transmittance(0, mu);
+}
+
+// The slope-sum table's ratio R(ρ; x, 1/2) (lamina1/table_lookups.h, SlopeSumFormat).
+float l1_slope_ratio(float rho, float x) {
+    x = clamp(x, 0.0, 1.0);
+    float fx = acos(1.0 - 2.0 * x) * L1_INV_PI * float(L1_SS_NX - 1);
+    float fy = float(L1_SS_NY - 1);  // y = 1/2: the last node
+    int ix = min(int(fx), L1_SS_NX - 2), iy = min(int(fy), L1_SS_NY - 2);
+    float tx = clamp(fx - float(ix), 0.0, 1.0), ty = clamp(fy - float(iy), 0.0, 1.0);
+    rho = max(rho, 0.0);
+    float u = rho / (1.0 + rho);
+    float fu = u * float(L1_SS_NU - 1);
+    int iu = min(int(fu), L1_SS_NU - 2);
+    float tu = fu - float(iu);
+    float sum = 0.0;
+    for (int dx = 0; dx < 2; ++dx)
+        for (int dy = 0; dy < 2; ++dy) {
+            float wxy = (dx == 1 ? tx : 1.0 - tx) * (dy == 1 ? ty : 1.0 - ty);
+            int row = L1_SLOPE_SUM + ((ix + dx) * L1_SS_NY + (iy + dy)) * L1_SS_NU + iu;
+            sum += wxy * ((1.0 - tu) * l1_at(row) + tu * l1_at(row + 1));
+        }
+    return sum;
+}
+// One facet's deflection map (FacetDeflection::lookup): false beyond g_max.
+bool l1_facet(int base, float g_max, float g, out float sin_d, out float cos_d, out float w) {
+    sin_d = 0.0; cos_d = 1.0; w = 0.0;
+    if (!(g < g_max)) return false;
+    float f = g / g_max * float(L1_NFACET - 1);
+    int i = min(int(f), L1_NFACET - 2);
+    float t = f - float(i);
+    int a = base + 3 * i;
+    sin_d = l1_at(a) + t * (l1_at(a + 3) - l1_at(a));
+    cos_d = l1_at(a + 1) + t * (l1_at(a + 4) - l1_at(a + 1));
+    w = l1_at(a + 2) + t * (l1_at(a + 5) - l1_at(a + 2));
+    return cos_d > 0.0 && w > 0.0;
+}
+float l1_density(float r, float s2, float sigma, float x) {
+    return s2 * L1_INV_PI / l1_sqr(s2 + r * r) * l1_slope_ratio(r / sigma, x);
+}
+// The widened base lobe's NDF (Bsdf::first_order_ndf).
+float l1_first_order_ndf(vec3 h, float k_i, float k_o) {
+    float k = min(k_i, k_o);
+    float a_b = l1_at(5), a_c = 0.5 * l1_at(4) * k;
+    float s2 = a_b * a_b + 2.0 * a_c * a_c;
+    float c2 = h.z * h.z;
+    if (!(s2 > 0.0) || !(c2 > 0.0)) return 0.0;
+    float sigma = sqrt(s2), x = a_b * a_b / s2;
+    float t2 = max(0.0, 1.0 - c2) / c2, t = sqrt(t2);
+    if (!l1_flag(8) || !(a_c > 0.0)) return l1_density(t, s2, sigma, x) / (c2 * c2);
+    float p = x * l1_density(t, s2, sigma, x);
+    float g = 2.0 * (1.0 - l1_at(3)) * atan(t) / k;
+    for (int m = 0; m < 2; ++m) {
+        float sin_d, cos_d, w;
+        if (!l1_facet(m == 0 ? L1_ENTERING : L1_LEAVING, l1_at(m == 0 ? 29 : 30), g, sin_d, cos_d, w))
+            continue;
+        float S = 0.5 * k * sin_d / cos_d;
+        float s_over_t = t > 1e-12 ? S / t : 1.0;
+        p += 0.5 * (1.0 - x) * l1_density(S, s2, sigma, x) * s_over_t * w /
+             (cos_d * cos_d * (1.0 + t2));
+    }
+    return p / (c2 * c2);
+}
+vec3 l1_base_lobe(vec3 wi_in, float k_top, float lobe_norm_i, float mu_o, vec3 wo_in) {
+    if (int(l1_at(1)) == 0) return l1_rgb(10) * L1_INV_PI;
+    float k_o = l1_spread_factor(mu_o, wo_in.z);
+    float alpha1 = l1_at(5), alpha0 = l1_at(4);
+    float alpha = l1_flag(13) ? alpha1
+                              : sqrt(alpha1 * alpha1 + 0.25 * alpha0 * alpha0 * (k_top * k_top + k_o * k_o));
+    if (alpha <= 0.0) return vec3(0.0);
+    vec3 h = normalize(wi_in + wo_in);
+    float G = 1.0 / (1.0 + l1_lambda(alpha, wi_in) + l1_lambda(alpha, wo_in));
+    float D = l1_flag(7) ? l1_first_order_ndf(h, k_top, k_o) : l1_ggx_d(alpha, h);
+    vec3 f = l1_base_fresnel(dot(wi_in, h)) * (D * G / (4.0 * wi_in.z * wo_in.z));
+    if (l1_flag(6)) f *= lobe_norm_i * l1_cosine_curve(L1_LOBE_NORM, L1_NNORM, 1, 0, wo_in.z);
+    return f;
+}
+
+// f(wi, wo): lamina1::Bsdf::eval for wo.z > 0 (Bsdf::incident, then eval_with).
+vec3 lamina1_eval(vec3 wi, vec3 wo) {
+    if (wi.z <= 0.0 || wo.z <= 0.0) return vec3(0.0);
+    float eta0 = l1_at(2), inv_eta0 = l1_at(3), alpha0 = l1_at(4);
+    // Bsdf::incident
+    vec3 wi_in = l1_refract_in(wi);
+    if (!(wi_in.z > 0.0)) return vec3(0.0);
+    float T = l1_transmittance(0, wi.z);
+    vec3 a = l1_attenuation(wi_in.z);
+    vec3 X = l1_flag(2) ? l1_x_at(wi.z) : vec3(0.0);
+    float lambda0 = alpha0 > 0.0 ? l1_lambda(alpha0, wi) : 0.0;
+    float lobe_norm = l1_flag(6) ? l1_cosine_curve(L1_LOBE_NORM, L1_NNORM, 1, 0, wi_in.z) : 1.0;
+    float k_top = l1_spread_factor(wi.z, wi_in.z);
+    float T_pair = T;
+    if (l1_flag(4)) T_pair = sqrt(T * l1_exit_transmittance(wi.z, wi_in.z, k_top));
+    // Bsdf::eval_with
+    vec3 f = vec3(0.0);
+    if (alpha0 > 0.0) {
+        vec3 h = normalize(wi + wo);
+        float G = 1.0 / (1.0 + lambda0 + l1_lambda(alpha0, wo));
+        f = vec3(l1_fresnel_dielectric(dot(wi, h), eta0) * l1_ggx_d(alpha0, h) * G /
+                 (4.0 * wi.z * wo.z));
+    }
+    vec3 wo_in = l1_refract_in(wo);
+    float T_o = l1_transmittance(0, wo.z);
+    vec3 a_o = l1_attenuation(wo_in.z);
+    vec3 fb = wi_in.z > 0.0 && wo_in.z > 0.0 ? l1_base_lobe(wi_in, k_top, lobe_norm, wo.z, wo_in)
+                                            : vec3(0.0);
+    float fb_max = max(fb.r, max(fb.g, fb.b));
+    if (l1_flag(4) && fb_max > 0.0)
+        T_o = sqrt(T_o * l1_exit_transmittance(wo.z, wo_in.z, l1_spread_factor(wo.z, wo_in.z)));
+    vec3 rounds = vec3(1.0);
+    if (l1_flag(5) && fb_max > 0.0)
+        rounds = l1_cosine_curve3(L1_MIRROR, L1_NMU, wi_in.z) *
+                 l1_cosine_curve3(L1_MIRROR, L1_NMU, wo_in.z);
+    float eta2 = l1_flag(9) ? inv_eta0 * inv_eta0 : 1.0;
+    f += fb * (a * a_o) * rounds * (T_pair * T_o * eta2);
+    if (l1_flag(2)) f += X * l1_x_at(wo.z) * l1_rgb(19) * (L1_INV_PI * inv_eta0 * inv_eta0);
+    return f;
+}
+
+// ---- Sampling (lamina1/sampling.h: the mixture of the lobes, each drawn by its own rule) ----
+
+// D_w(wm) = G1(w) max(0, w·wm) D(wm) / cos θ (Heitz 2014, Eq. 38), w above.
+float l1_d_visible(float alpha, vec3 w, vec3 m) {
+    float c = dot(w, m);
+    if (c <= 0.0 || w.z <= 0.0) return 0.0;
+    return c * l1_ggx_d(alpha, m) / ((1.0 + l1_lambda(alpha, w)) * w.z);
+}
+// cos φ and sin φ to float precision: the built-in cos and sin may be coarse (SwiftShader's, the
+// WebGL of headless Chromium, are off by up to 1.9e-4, which near the horizon turns a drawn
+// direction by 2e-3). φ reduced by quarter turns to |r| ≤ π/4, then Taylor to r⁹ (error < 3e-9).
+void l1_cos_sin(float phi, out float c, out float s) {
+    float k = floor(phi / (0.5 * L1_PI) + 0.5);
+    float r = phi - k * (0.5 * L1_PI), r2 = r * r;
+    float sr = r * (1.0 - r2 / 6.0 * (1.0 - r2 / 20.0 * (1.0 - r2 / 42.0 * (1.0 - r2 / 72.0))));
+    float cr = 1.0 - r2 / 2.0 * (1.0 - r2 / 12.0 * (1.0 - r2 / 30.0 * (1.0 - r2 / 56.0)));
+    int q = int(k) & 3;
+    c = q == 0 ? cr : q == 1 ? -sr : q == 2 ? -cr : sr;
+    s = q == 0 ? sr : q == 1 ? cr : q == 2 ? -sr : -cr;
+}
+
+// A visible normal of w from (u1, u2) (Heitz 2018, "Sampling the GGX distribution of visible
+// normals", JCGT 7(4), Listing 1), as GGX::sample_visible_normal.
+vec3 l1_sample_visible_normal(float alpha, vec3 w, float u1, float u2) {
+    vec3 vh = normalize(vec3(alpha * w.x, alpha * w.y, w.z));
+    float len2 = vh.x * vh.x + vh.y * vh.y;
+    vec3 t1 = len2 > 0.0 ? vec3(-vh.y, vh.x, 0.0) / sqrt(len2) : vec3(1.0, 0.0, 0.0);
+    vec3 t2 = cross(vh, t1);
+    float s = 0.5 * (1.0 + vh.z), r = sqrt(u1), cos_phi, sin_phi;
+    l1_cos_sin(2.0 * L1_PI * u2, cos_phi, sin_phi);
+    float p1 = r * cos_phi;
+    float p2 = (1.0 - s) * sqrt(max(1.0 - p1 * p1, 0.0)) + s * (r * sin_phi);
+    vec3 nh = t1 * p1 + t2 * p2 + vh * sqrt(max(1.0 - p1 * p1 - p2 * p2, 0.0));
+    return normalize(vec3(alpha * nh.x, alpha * nh.y, max(nh.z, 0.0)));
+}
+// A cosine-distributed direction (Shirley & Chiu 1997's concentric disk, lifted).
+vec3 l1_sample_cosine(float u1, float u2) {
+    float a = 2.0 * u1 - 1.0, b = 2.0 * u2 - 1.0, x = 0.0, y = 0.0;
+    if (a != 0.0 || b != 0.0) {
+        float r, phi;
+        if (abs(a) > abs(b)) {
+            r = a;
+            phi = (L1_PI / 4.0) * (b / a);
+        } else {
+            r = b;
+            phi = L1_PI / 2.0 - (L1_PI / 4.0) * (a / b);
+        }
+        float c, sn;
+        l1_cos_sin(phi, c, sn);
+        x = r * c;
+        y = r * sn;
+    }
+    return vec3(x, y, sqrt(max(1.0 - x * x - y * y, 0.0)));
+}
+float l1_mean(vec3 v) { return (v.r + v.g + v.b) / 3.0; }
+
+// The mixture at wi (Bsdf::mixture): the lobes' probabilities (top reflection, base lobe,
+// separable series) and the base lobe's roughness; false where nothing can be drawn.
+bool l1_mixture(vec3 wi, out vec3 p, out float alpha_base, out vec3 wi_in) {
+    p = vec3(0.0);
+    alpha_base = 0.0;
+    wi_in = l1_refract_in(wi);
+    if (!l1_flag(14) || wi.z <= 0.0 || !(wi_in.z > 0.0)) return false;
+    float alpha0 = l1_at(4), alpha1 = l1_at(5);
+    float a = l1_mean(l1_attenuation(wi_in.z)), T = l1_transmittance(0, wi.z);
+    if (alpha0 > 0.0) p.x = l1_fresnel_dielectric(wi.z, l1_at(2));
+    float E_b = int(l1_at(1)) == 0 ? l1_mean(l1_rgb(10))
+                                   : l1_cosine_curve(L1_BASE_ALBEDO, L1_NMU, 1, 0, wi_in.z);
+    if (int(l1_at(1)) == 0) {
+        p.y = T * a * E_b;
+    } else {
+        float k = l1_spread_factor(wi.z, wi_in.z);
+        alpha_base = l1_flag(13) ? alpha1 : sqrt(alpha1 * alpha1 + 0.5 * alpha0 * alpha0 * k * k);
+        if (alpha_base > 0.0) p.y = T * a * E_b;
+    }
+    if (l1_flag(2)) p.z = l1_mean(l1_x_at(wi.z) * l1_rgb(19) * l1_rgb(31));
+    float total = p.x + p.y + p.z;
+    if (!(total > 0.0)) return false;
+    p /= total;
+    return true;
+}
+
+float l1_pdf_with(vec3 wi, vec3 p, float alpha_base, vec3 wi_in, vec3 wo) {
+    if (wo.z <= 0.0) return 0.0;
+    float pdf = 0.0;
+    if (p.x > 0.0) {
+        vec3 h = normalize(wi + wo);
+        pdf += p.x * l1_d_visible(l1_at(4), wi, h) / (4.0 * abs(dot(wo, h)));
+    }
+    if (p.y > 0.0) {
+        if (int(l1_at(1)) == 0) {
+            pdf += p.y * wo.z * L1_INV_PI;
+        } else {
+            vec3 wo_in = l1_refract_in(wo);
+            if (wo_in.z > 0.0) {
+                vec3 h = normalize(wi_in + wo_in);
+                float pdf_in = l1_d_visible(alpha_base, wi_in, h) / (4.0 * abs(dot(wo_in, h)));
+                pdf += p.y * pdf_in * wo.z / (l1_sqr(l1_at(2)) * wo_in.z);
+            }
+        }
+    }
+    if (p.z > 0.0) pdf += p.z * wo.z * L1_INV_PI;
+    return pdf;
+}
+
+// The density (solid angle) of lamina1_sample's wo for light from wi.
+float lamina1_pdf(vec3 wi, vec3 wo) {
+    vec3 p, wi_in;
+    float alpha_base;
+    if (!l1_mixture(wi, p, alpha_base, wi_in)) return 0.0;
+    return l1_pdf_with(wi, p, alpha_base, wi_in, wo);
+}
+
+// Draws wo for light from wi from three uniforms in [0, 1): true with wo, its density pdf and
+// the weight f |cos θo| / pdf; false where the draw fails (as Bsdf::sample's nothing).
+bool lamina1_sample(vec3 wi, vec3 u, out vec3 wo, out float pdf, out vec3 weight) {
+    wo = vec3(0.0);
+    pdf = 0.0;
+    weight = vec3(0.0);
+    vec3 p, wi_in;
+    float alpha_base;
+    if (!l1_mixture(wi, p, alpha_base, wi_in)) return false;
+    float eta0 = l1_at(2);
+    if (u.x < p.x) {
+        vec3 m = l1_sample_visible_normal(l1_at(4), wi, u.y, u.z);
+        wo = 2.0 * dot(wi, m) * m - wi;
+    } else if (u.x < p.x + p.y) {
+        if (int(l1_at(1)) == 0) {
+            wo = l1_sample_cosine(u.y, u.z);
+        } else {
+            vec3 m = l1_sample_visible_normal(alpha_base, wi_in, u.y, u.z);
+            vec3 wo_in = 2.0 * dot(wi_in, m) * m - wi_in;
+            float s2 = eta0 * eta0 * (1.0 - wo_in.z * wo_in.z);
+            if (wo_in.z <= 0.0 || s2 >= 1.0) return false;
+            wo = vec3(wo_in.x * eta0, wo_in.y * eta0, sqrt(1.0 - s2));
+        }
+    } else if (p.z > 0.0) {
+        wo = l1_sample_cosine(u.y, u.z);
+    } else {
+        return false;
+    }
+    if (wo.z <= 0.0) return false;
+    pdf = l1_pdf_with(wi, p, alpha_base, wi_in, wo);
+    if (!(pdf > 0.0)) return false;
+    weight = lamina1_eval(wi, wo) * (wo.z / pdf);
+    return true;
+}

@@ -1,0 +1,111 @@
+#pragma once
+// lamina-1's inputs: the layers (one dielectric coat with an optional medium over a Lambertian,
+// conductor or dielectric base) and the model's choices. Every approximation of lamina-1 is one
+// of these choices; the defaults are the model (lamina's docs/models.md, "lamina-1", derives each
+// and measures the others).
+
+#include "lamina1/math.h"
+#include "lamina1/physics.h"
+
+namespace lamina1 {
+
+/// The base under the coat.
+enum class Base { Lambertian, Conductor, Dielectric };
+
+/// The stack: ambient medium | dielectric coat (η0, α0) with an optional homogeneous medium |
+/// base. Indices are relative (lamina's docs/physics.md §2): η0 = η_coat/η_ambient ≥ 1, the base's
+/// η + iκ relative to the coat (a dielectric base, a slab's bottom: η_below/η_coat, the same in
+/// the three channels). Roughnesses are GGX α (no remapping). Optical depths along the normal.
+struct Layers {
+    double eta0 = 1.5;
+    double alpha0 = 0.0;
+    Rgb tau_a{0.0};  ///< the coat medium's absorption optical depth
+    Rgb tau_s{0.0};  ///< its scattering optical depth (Henyey–Greenstein)
+    Rgb g{0.0};      ///< its Henyey–Greenstein asymmetry, (−1, 1)
+    Base base = Base::Lambertian;
+    Rgb base_eta{1.0};    ///< conductor or dielectric base: η relative to the coat
+    Rgb base_k{0.0};      ///< conductor base: κ relative to the coat
+    double alpha1 = 0.0;  ///< the base's roughness (conductor, dielectric)
+    Rgb albedo{0.0};      ///< Lambertian base: its albedo ρ
+};
+
+struct Options {
+    /// Masking of the refracted rays in the coat's transmittance tables.
+    Masking masking = Masking::Smith;
+    /// The coat's transmittance: the rough interface's directional transmittance (true) or the
+    /// smooth Fresnel transmittance 1 − F(μ) at the macro normal (false).
+    bool directional_transmittance = true;
+    /// Inter-reflections between base and coat bottom (the separable series term).
+    bool inter_reflection = true;
+    /// "auto": the separable series only where its uniform-radiance assumption can hold, where the
+    /// base re-diffuses the returned light at least as much as the coat spreads it: a Lambertian
+    /// base, or a base at least as rough as the coat (α1 ≥ α0); reflected only (the slab's
+    /// diffuse exit through the bottom only with "on"). With both interfaces smooth the exact
+    /// delta series is summed either way.
+    bool series_lambertian_only = true;
+    /// The slab's transmission lobe centred on the mean direction of the light the rough coat
+    /// transmits (true) or on the macro refraction of wi (false).
+    bool mean_shift = true;
+    /// The 1/η² solid-angle compression of the base term (Hanrahan & Krueger 1993, Eq. 8).
+    bool eta2_factor = true;
+    /// The base lobe widened by the coat's refraction spread: with the angle-dependent deflection
+    /// factor (Spread::Angular), its normal-incidence value 1 − 1/η (Normal), or not (Off).
+    enum class Spread { Angular, Normal, Off } spread = Spread::Angular;
+    /// The shape of that widened lobe (docs/models.md, lamina-1, item 4): its half-vector slope
+    /// as the sum of the three independent GGX slopes of the base and the coat's two refractions
+    /// (lamina1/table_lookups.h), the coat's tails carried through one facet's exact Snell
+    /// deflection and transmission (Compressed); the same sum with the linear deflection (Sum);
+    /// or one GGX lobe of the summed variance (Ggx, the earlier form).
+    enum class FirstOrderLobe {
+        Compressed,
+        Sum,
+        Ggx
+    } first_order_lobe = FirstOrderLobe::Compressed;
+    /// The rough interfaces' scattering orders ≥ 2 (lamina1/table_lookups.h):
+    /// off (single scattering: the energy the microsurfaces mask is lost, as in the
+    /// goniophotometer's
+    /// --microsurface single) or restored (as in --microsurface multiple): the coat's and the
+    /// slab bottom's transmittances gain ΔT, the coat's inside reflectance and the base's albedo
+    /// gain ΔR (ΔE F_ms for a conductor), and the coat's outer reflection and the base's lobe gain
+    /// the separable energy-compensation lobes ΔR(μi) ΔR(μo)/(π ΔR̄) (docs/models.md).
+    bool multiple_scattering = false;
+    /// The first order leaves a conductor or dielectric base through the coat with the coat's
+    /// transmittance *from inside* along the base lobe's direction, T_in(μo'), where that lobe is
+    /// narrower than the coat's refraction spread (true), or with the outside transmittance T(μo)
+    /// (false), exact only for locally uniform radiance inside (a Lambertian base always uses it).
+    bool inside_exit = true;
+    /// The base lobe whose width follows wo through the coat's spread is divided by its excess
+    /// energy over the fixed-width lobe, √N(μi') √N(μo') (reciprocal; docs/models.md).
+    bool lobe_normalization = true;
+    /// Scattering (Henyey–Greenstein) coat media (docs/models.md, lamina-1, "Scattering media"):
+    /// the exact single scattering of the medium between the two refractions (first order in
+    /// τs, closed form) ...
+    bool medium_single = true;
+    /// ... the once-scattered light that also meets a conductor or dielectric base (scattered
+    /// then mirrored, mirrored then scattered; the base as a mirror of its directional albedo) ...
+    bool medium_base_paths = true;
+    /// ... and everything else the scattering sends back (orders ≥ 2, the scattered light's
+    /// round trips between coat and base, the once-scattered light over a Lambertian base) as a
+    /// separable lobe whose energy is the azimuth-averaged adding–doubling's (lamina1/adding.h).
+    bool medium_orders = true;
+    /// ... the part of that rest a slab transmits shaped like twice-scattered light (the
+    /// once-scattered closed form with HG(g²): two HG scatterings have the mean cosine g²) and
+    /// normalized to the adding's energy (true), or as uniform radiance below the bottom (false).
+    bool medium_transmitted_twice = true;
+    /// The slab's first-order transmission: the bottom interface's own Walter BTDF at the mean
+    /// inside direction, widened by the coat's spread and carrying the light's exact first-order
+    /// energy (true), or the mirrored GGX lobe q weighted by T_b,in at the exit (false).
+    bool btdf_bottom_lobe = true;
+    /// With btdf_bottom_lobe: the first order split between the bottom's BTDF, for the bottom's
+    /// share of the spread's variance u = α1²/α_b², and the mirrored lobe (the coat's spread,
+    /// made inside the coat and carried through the bottom's flat refraction), for 1 − u.
+    bool btdf_lobe_shared = true;
+    /// The slab's later orders in transmission: the light inside the coat as two populations,
+    /// within the exit cone and beyond it (trapped by a smooth coat's total internal reflection),
+    /// each taken as uniform radiance after the first return, summed over every round trip by a
+    /// 2 × 2 geometric series and let out through the bottom's own transmittance (true); or the
+    /// uniform series of inter-reflection=on (false). Single scattering only.
+    bool btdf_populations = false;
+};
+
+}  // namespace lamina1
