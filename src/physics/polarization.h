@@ -265,9 +265,9 @@ LAMINA_LANE_INLINE T stokes_apply(const InterfaceMueller<T>& m, T& q, T& u, T& v
     const T intensity = L::mul_add(m.b, q, m.a);
     const auto keeps = L::both(active, L::less(L::constant(1e-30), intensity));
     const T inv = one / L::select(keeps, intensity, one);
-    T q_new = L::mul_add(m.a, q, m.b) * inv;
-    T u_new = L::mul_add(m.c, u, m.d * v) * inv;
-    T v_new = L::mul_add(m.c, v, zero - m.d * u) * inv;
+    const T q_new = L::mul_add(m.a, q, m.b) * inv;
+    const T u_new = L::mul_add(m.c, u, m.d * v) * inv;
+    const T v_new = L::mul_add(m.c, v, zero - m.d * u) * inv;
     const T degree2 = L::mul_add(q_new, q_new, L::mul_add(u_new, u_new, v_new * v_new));
     const auto above = L::less(one, degree2);
     const T shrink = L::select(above, L::inv_sqrt(L::select(above, degree2, one)), one);

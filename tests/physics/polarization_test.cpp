@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <limits>
 
 namespace lamina {
 namespace {
@@ -360,6 +361,29 @@ TEST(Polarization, DegreeOfPolarizationStaysAtMostOne) {
         else
             EXPECT_LE(after, 1.0 + 1e-12);
     }
+}
+
+// Rounding cannot make a flux negative or a state non-finite: a matrix whose |b| exceeds a by a
+// float ulp (a vanishing s or p reflectance), met by a state already at degree 1 + ulp, returns a
+// factor ≥ 0 and a state of degree ≤ 1; a factor below 1e-30 (whose reciprocal overflows a float)
+// keeps the state. Before this, a fuzzed conductor with k ≈ 0 in one channel gave a bin of −1e4.
+TEST(Polarization, RoundingKeepsTheFluxNonNegativeAndTheStateFinite) {
+    const float ulp = std::numeric_limits<float>::epsilon();
+    const InterfaceMueller<float> brewster{0.1f, -0.1f * (1 + ulp), 0.f, 0.f};
+    float q = 1 + ulp, u = 0.f, v = 0.f;  // a + b q = −a(2 ulp + ulp²) in exact arithmetic
+    EXPECT_GE(stokes_apply<float>(brewster, q, u, v, true), 0.f);
+    float q2 = 0.6f, u2 = 0.6f, v2 = 0.6f;  // degree 1.04: rounded states come back to ≤ 1
+    const InterfaceMueller<float> plain{0.5f, 0.f, 0.5f, 0.f};
+    EXPECT_GT(stokes_apply<float>(plain, q2, u2, v2, true), 0.f);
+    EXPECT_LE(q2 * q2 + u2 * u2 + v2 * v2, 1.f + 4 * ulp);
+    const InterfaceMueller<float> vanishing{1e-40f, 1e-40f, 0.f, 0.f};
+    float q3 = 0.3f, u3 = -0.2f, v3 = 0.1f;
+    const float factor = stokes_apply<float>(vanishing, q3, u3, v3, true);
+    EXPECT_GE(factor, 0.f);
+    EXPECT_LT(factor, 1e-30f);
+    EXPECT_EQ(q3, 0.3f);  // kept
+    EXPECT_EQ(u3, -0.2f);
+    EXPECT_EQ(v3, 0.1f);
 }
 
 // The step of the Mueller tables' reciprocity (tests/simulator/mueller_test.cpp) that is pure
