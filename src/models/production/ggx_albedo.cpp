@@ -13,28 +13,6 @@ namespace lamina {
 
 namespace {
 
-/// The smallest cosine the integrals are taken at.
-constexpr double kMuMin = 1e-6;
-
-/// ∫ f(wi·h) G(wo) over the visible normals h of wi whose reflection wo leaves above the horizon,
-/// the radius split where wo crosses it.
-template <typename Integrand>
-double over_visible_normals(double mu, double alpha, Integrand&& f, int n_r, int n_phi) {
-    mu = std::max(mu, kMuMin);
-    const Vec3d wi(safe_sqrt(1 - mu * mu), 0, mu);
-    const GGX<double> ggx{alpha};
-    const QuadratureRule q = gauss_legendre(n_r);
-    auto outgoing_z = [&](const Vec3d& h) { return 2 * dot(wi, h) * h.z - wi.z; };
-    auto integrand = [&](const Vec3d& h) {
-        const double cos_h = dot(wi, h);
-        const Vec3d wo = h * (2 * cos_h) - wi;
-        if (wo.z <= 0) return 0.0;
-        return f(ggx, wi, wo, cos_h);
-    };
-    return integrate_visible_split<double>(ggx, wi, integrand, q, n_phi, 1e-7,
-                                           Crossing{outgoing_z, 0.0});
-}
-
 /// G2(wi, wo)/G1(wi) = (1 + Λi)/(1 + Λi + Λo): the weight visible-normal sampling leaves.
 double masking_weight(const GGX<double>& ggx, const Vec3d& wi, const Vec3d& wo) {
     const double lambda_i = ggx.lambda(wi);
@@ -45,7 +23,7 @@ double masking_weight(const GGX<double>& ggx, const Vec3d& wi, const Vec3d& wo) 
 
 double correlated_ggx_albedo_white(double mu, double alpha, int n_r, int n_phi) {
     if (alpha <= 0) return 1;
-    return over_visible_normals(
+    return reflection_over_visible_normals(
         mu, alpha,
         [](const GGX<double>& ggx, const Vec3d& wi, const Vec3d& wo, double) {
             return masking_weight(ggx, wi, wo);
@@ -64,13 +42,13 @@ SchlickSplit correlated_ggx_schlick_split(double mu, double alpha, int n_r, int 
         split.scale = 1 - split.bias;
         return split;
     }
-    split.bias = over_visible_normals(
+    split.bias = reflection_over_visible_normals(
         mu, alpha,
         [&](const GGX<double>& ggx, const Vec3d& wi, const Vec3d& wo, double cos_h) {
             return weight(cos_h) * masking_weight(ggx, wi, wo);
         },
         n_r, n_phi);
-    split.scale = over_visible_normals(
+    split.scale = reflection_over_visible_normals(
         mu, alpha,
         [&](const GGX<double>& ggx, const Vec3d& wi, const Vec3d& wo, double cos_h) {
             return (1 - weight(cos_h)) * masking_weight(ggx, wi, wo);
@@ -85,7 +63,7 @@ double cycles_fresnel_factor(double mu, double alpha, double eta, int n_r, int n
         return clamp((fresnel_dielectric(c, eta) - f0) / (1 - f0), 0.0, 1.0);
     };
     if (alpha <= 0) return position(clamp(mu, 0.0, 1.0));
-    return over_visible_normals(
+    return reflection_over_visible_normals(
         mu, alpha,
         [&](const GGX<double>&, const Vec3d&, const Vec3d&, double cos_h) {
             return position(cos_h);

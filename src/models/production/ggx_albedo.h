@@ -9,7 +9,37 @@
 // horizon contributes 0. n_r Gauss–Legendre nodes per piece of the visible-normal radius (split
 // where wo crosses the horizon) × n_phi nodes in φ; μ is taken at ≥ 10⁻⁶.
 
+#include "core/math.h"
+#include "models/numerics/quadrature.h"
+#include "models/numerics/visible_normal_quadrature.h"
+#include "physics/microfacet.h"
+
+#include <algorithm>
+
 namespace lamina {
+
+/// The smallest cosine the integrals are taken at (the μ = 0 node is the limit μ → 0).
+inline constexpr double kAlbedoMuMin = 1e-6;
+
+/// ∫ f(ggx, wi, wo, wi·h) dh over the normals h visible from wi (μ = wi.z) whose reflection wo
+/// leaves above the horizon, the radius split where wo crosses it (the integrand has a kink
+/// there); the albedos below and those of models/production/uncorrelated_albedo.h.
+template <typename Integrand>
+double reflection_over_visible_normals(double mu, double alpha, Integrand&& f, int n_r, int n_phi) {
+    mu = std::max(mu, kAlbedoMuMin);
+    const Vec3d wi(safe_sqrt(1 - mu * mu), 0, mu);
+    const GGX<double> ggx{alpha};
+    const QuadratureRule q = gauss_legendre(n_r);
+    auto outgoing_z = [&](const Vec3d& h) { return 2 * dot(wi, h) * h.z - wi.z; };
+    auto integrand = [&](const Vec3d& h) {
+        const double cos_h = dot(wi, h);
+        const Vec3d wo = h * (2 * cos_h) - wi;
+        if (wo.z <= 0) return 0.0;
+        return f(ggx, wi, wo, cos_h);
+    };
+    return integrate_visible_split<double>(ggx, wi, integrand, q, n_phi, 1e-7,
+                                           Crossing{outgoing_z, 0.0});
+}
 
 /// E(μ, α): the directional albedo of the white lobe (F = 1), ∫ D_wi(h) G2/G1(wi) dh. μ ∈ [0, 1],
 /// α ≥ 0 (α = 0 gives 1).

@@ -1,5 +1,7 @@
 #include "models/production/uncorrelated_albedo.h"
 
+#include "models/production/ggx_albedo.h"
+
 #include "core/math.h"
 #include "models/numerics/quadrature.h"
 #include "models/numerics/visible_normal_quadrature.h"
@@ -15,27 +17,15 @@ namespace {
 
 using Grid = OpenPbrBsdfEnergyGrid;
 
-/// The smallest cosine the integrals are taken at: the μ = 0 node is the limit μ → 0.
-constexpr double kMuMin = 1e-6;
-
-/// E over the visible normals of wi: ∫ D_wi(h) F(wi·h) G1(wo) dh (Heitz 2018), the radius split
-/// where wo = reflect(wi, h) crosses the horizon (G1(wo) has a kink there, and wo below it
-/// contributes nothing).
+/// E over the visible normals of wi: ∫ D_wi(h) F(wi·h) G1(wo) dh (Heitz 2018).
 template <typename Fresnel>
 double albedo(double mu, double alpha, Fresnel&& fresnel, int n_r, int n_phi) {
-    mu = std::max(mu, kMuMin);
-    const Vec3d wi(safe_sqrt(1 - mu * mu), 0, mu);
-    const GGX<double> ggx{alpha};
-    const QuadratureRule q = gauss_legendre(n_r);
-    auto outgoing_z = [&](const Vec3d& h) { return 2 * dot(wi, h) * h.z - wi.z; };
-    auto integrand = [&](const Vec3d& h) {
-        const double cos_h = dot(wi, h);
-        const Vec3d wo = h * (2 * cos_h) - wi;
-        if (wo.z <= 0) return 0.0;
-        return fresnel(cos_h) * ggx.G1(wo);
-    };
-    return integrate_visible_split<double>(ggx, wi, integrand, q, n_phi, 1e-7,
-                                           Crossing{outgoing_z, 0.0});
+    return reflection_over_visible_normals(
+        mu, alpha,
+        [&](const GGX<double>& ggx, const Vec3d&, const Vec3d& wo, double cos_h) {
+            return fresnel(cos_h) * ggx.G1(wo);
+        },
+        n_r, n_phi);
 }
 
 }  // namespace
