@@ -359,6 +359,21 @@ double RandomWalkStack::survival_proxy(int region, double path) const {
     return m.scatters ? std::exp(-m.tau_t.mean() * path) : 1.0;
 }
 
+template <typename ProxyPdf>
+std::optional<RandomWalkStack::ExitDirection> RandomWalkStack::sample_exit_direction(
+    const Connection& conn, const Vec3d& wo, double depth, ParticleRng& rng,
+    const ProxyPdf& proxy_pdf) const {
+    const DielectricInterface<double>& exit = interfaces_[conn.exit_interface].dielectric;
+    const double uc = rng.uniform_double(), u1 = rng.uniform_double(), u2 = rng.uniform_double();
+    const auto st = exit.sample<true>(wo, uc, u1, u2);
+    if (!st || !st->is_transmission || st->shadowing == 0 || st->pdf <= 0) return std::nullopt;
+    const Vec3d omega = -st->wo;
+    if (omega.z * conn.towards <= 0) return std::nullopt;
+    const double mu = std::abs(omega.z);
+    const double p1 = proxy_pdf(omega) * survival_proxy(conn.inner, depth / mu);
+    return ExitDirection{st->wo, st->pdf, omega, mu, st->pdf / (st->pdf + p1)};
+}
+
 // Strategy 2 at a vertex of the inner region that emits `k_v(ω)` (per channel, kernel incl. cos
 // for an interface) with pdf `pdf_v(ω)`, at depth-distance `depth` from the exit (1: the vertex
 // interface). The exit's transmission is sampled from wo (t on the inner side); ω = −t.
@@ -383,32 +398,28 @@ void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& 
                                            Rgbd& f) const {
     const Interface& exit_it = interfaces_[conn.exit_interface];
     const DielectricInterface<double>& exit = exit_it.dielectric;
-    const double uc = rng.uniform_double(), u1 = rng.uniform_double(), u2 = rng.uniform_double();
-    const auto st = exit.sample<true>(wo, uc, u1, u2);
-    if (!st || !st->is_transmission || st->shadowing == 0 || st->pdf <= 0) return;
-    const Vec3d omega = -st->wo;
-    if (omega.z * conn.towards <= 0) return;
-    const double mu = std::abs(omega.z);
+    const std::optional<ExitDirection> ed = sample_exit_direction(conn, wo, depth, rng, proxy_pdf);
+    if (!ed) return;
+    const Vec3d& omega = ed->omega;
+    const double mu = ed->mu, mis = ed->mis;
     const Medium& m = media_[conn.inner];
-    const double p1 = proxy_pdf(omega) * survival_proxy(conn.inner, depth / mu);
-    const double mis = st->pdf / (st->pdf + p1);
     if constexpr (kMode == Mode::Pdf) {
         // The exit's density at wo: a dielectric walk carries all its flux, so its exit density
         // is its kernel f·|cos θo| (flux convention).
         const double p_exit =
-            exit_it.multiple ? interface_kernel(exit_it, st->wo, wo, rng)[0] : exit.pdf(st->wo, wo);
+            exit_it.multiple ? interface_kernel(exit_it, ed->wt, wo, rng)[0] : exit.pdf(ed->wt, wo);
         if (p_exit == 0) return;
         const Rgbd pass = m.scatters ? exp_neg(m.tau_t * (depth / mu)) : Rgbd(1.0);
-        f[0] += pdf_chain(omega, pass) * p_exit / st->pdf * mis;
+        f[0] += pdf_chain(omega, pass) * p_exit / ed->pdf * mis;
     } else {
         const double f_exit = exit_it.multiple
-                                  ? interface_kernel(exit_it, st->wo, wo, rng)[0] / std::abs(wo.z)
-                                  : exit.eval(st->wo, wo);
+                                  ? interface_kernel(exit_it, ed->wt, wo, rng)[0] / std::abs(wo.z)
+                                  : exit.eval(ed->wt, wo);
         if (f_exit == 0) return;
         const Rgbd kv = kernel(omega);
         if (is_black(kv)) return;
         const Rgbd tr = m.is_empty() ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
-        f += w * kv * tr * (f_exit / st->pdf * mis);
+        f += w * kv * tr * (f_exit / ed->pdf * mis);
     }
 }
 
@@ -561,15 +572,11 @@ void RandomWalkStack::connect_through_exit_polarized(const Connection& conn, con
                                                      Rgbd& f) const {
     const Interface& exit_it = interfaces_[conn.exit_interface];
     const DielectricInterface<double>& exit = exit_it.dielectric;
-    const double uc = rng.uniform_double(), u1 = rng.uniform_double(), u2 = rng.uniform_double();
-    const auto st = exit.sample<true>(wo, uc, u1, u2);
-    if (!st || !st->is_transmission || st->shadowing == 0 || st->pdf <= 0) return;
-    const Vec3d omega = -st->wo;
-    if (omega.z * conn.towards <= 0) return;
-    const double mu = std::abs(omega.z);
+    const std::optional<ExitDirection> ed = sample_exit_direction(conn, wo, depth, rng, proxy_pdf);
+    if (!ed) return;
+    const Vec3d& omega = ed->omega;
+    const double mu = ed->mu, mis = ed->mis;
     const Medium& m = media_[conn.inner];
-    const double p1 = proxy_pdf(omega) * survival_proxy(conn.inner, depth / mu);
-    const double mis = st->pdf / (st->pdf + p1);
     StokesRgb<double> e;
     emit(omega, e);
     // The light's state per channel, in the tabulation frame of ω.
@@ -587,17 +594,17 @@ void RandomWalkStack::connect_through_exit_polarized(const Connection& conn, con
     Rgbd through(0.0);  // per unit S0: the exit's f for the light's state
     if (exit_it.multiple) {
         StokesRgb<double> out;
-        emission(exit_it, st->wo, &wo, 1, state, w, rng, &out, 3);
+        emission(exit_it, ed->wt, &wo, 1, state, w, rng, &out, 3);
         for (int c = 0; c < 3; ++c)
             through[c] = out.s[c][0] / std::abs(wo.z);
     } else {
-        const double f_exit = exit.eval(st->wo, wo);
-        const std::optional<Vec3d> wm = exit.half_vector(st->wo, wo);
+        const double f_exit = exit.eval(ed->wt, wo);
+        const std::optional<Vec3d> wm = exit.half_vector(ed->wt, wo);
         if (f_exit == 0 || !wm) return;
         const DielectricMueller<double> fm =
-            fresnel_dielectric_mueller<double>(dot(st->wo, *wm), exit.eta, 1 / exit.eta);
+            fresnel_dielectric_mueller<double>(dot(ed->wt, *wm), exit.eta, 1 / exit.eta);
         if (!(fm.transmission.a > 0)) return;
-        const Vec3d n = cross(st->wo, *wm);
+        const Vec3d n = cross(ed->wt, *wm);
         stokes_rotate_frame<double>(state, {omega.x, omega.y, omega.z}, {n.x, n.y, n.z}, 3, true);
         for (int c = 0; c < 3; ++c)
             through[c] =
@@ -605,7 +612,7 @@ void RandomWalkStack::connect_through_exit_polarized(const Connection& conn, con
     }
     const Rgbd tr = m.is_empty() ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
     const Rgbd kv(e.s[0][0], e.s[1][0], e.s[2][0]);
-    f += w * kv * tr * through * (1 / st->pdf * mis);
+    f += w * kv * tr * through * (1 / ed->pdf * mis);
 }
 
 // ---- Media (docs/physics.md §4), as the goniophotometer traverses them --------------------------

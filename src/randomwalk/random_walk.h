@@ -190,6 +190,20 @@ class RandomWalkStack {
     template <Mode kMode>
     bool traverse_medium(int region, WalkState& ws, ParticleRng& rng, const Connection* conn,
                          const Vec3d& wo, Rgbd& f) const;
+    /// Strategy 2's direction ω into the vertex's region: the exit interface's transmission
+    /// sampled from wo (its single-scattering sampler), with the balance-heuristic weight of that
+    /// strategy against the vertex's proxy density (`proxy_pdf` × the survival to the depth).
+    struct ExitDirection {
+        Vec3d wt;     ///< the sampled transmitted direction at the exit (pointing out of it)
+        double pdf;   ///< its density
+        Vec3d omega;  ///< −wt: the direction from the vertex towards the exit
+        double mu;    ///< |cos θ| of ω
+        double mis;   ///< the balance-heuristic weight
+    };
+    template <typename ProxyPdf>
+    std::optional<ExitDirection> sample_exit_direction(const Connection& conn, const Vec3d& wo,
+                                                       double depth, ParticleRng& rng,
+                                                       const ProxyPdf& proxy_pdf) const;
     template <Mode kMode, typename Kernel, typename PdfChain, typename ProxyPdf>
     void connect_through_exit(const Connection& conn, const Vec3d& wo, double depth, const Rgbd& w,
                               ParticleRng& rng, const Kernel& kernel, const PdfChain& pdf_chain,
