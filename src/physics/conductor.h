@@ -164,14 +164,9 @@ struct ConductorInterface {
             conductor_event<T>(alpha, is_smooth(), uncorrelated_shadowing, {wi.x, wi.y, wi.z}, u1,
                                u2, true, channel_fresnel, factors);
         if (e.degenerate) return std::nullopt;
-        BsdfSample<T> s;
-        s.wo = {e.wo.x, e.wo.y, e.wo.z};
-        s.is_delta = is_smooth();
-        s.fresnel_weight = {factors[0], factors[1], factors[2]};
-        s.shadowing = e.shadowing;
+        BsdfSample<T> s = reflection_sample(e, factors);
         if constexpr (kWithPdf)
             if (!s.is_delta && s.wo.z > 0) s.pdf = pdf(wi, s.wo);
-        s.weight = s.fresnel_weight * s.shadowing;
         return s;
     }
 
@@ -189,6 +184,13 @@ struct ConductorInterface {
             conductor_event<T>(alpha, is_smooth(), uncorrelated_shadowing, {wi.x, wi.y, wi.z}, u1,
                                u2, true, unpolarized, factors, &pol, channel_mueller);
         if (e.degenerate) return std::nullopt;
+        return reflection_sample(e, factors);
+    }
+
+  private:
+    /// The sample of conductor_event's outcome `e` with the channels' Fresnel `factors`.
+    BsdfSample<T> reflection_sample(const InterfaceEventLanes<T, bool>& e,
+                                    const T (&factors)[3]) const {
         BsdfSample<T> s;
         s.wo = {e.wo.x, e.wo.y, e.wo.z};
         s.is_delta = is_smooth();

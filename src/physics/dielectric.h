@@ -221,8 +221,7 @@ struct DielectricInterface {
     /// Radiance BSDF, 1/sr, cosine excluded; zero for smooth and index-matched interfaces (delta
     /// lobes).
     T eval(const Vec3<T>& wi, const Vec3<T>& wo) const {
-        if (is_smooth() || is_index_matched() || wi.z == 0 || wo.z == 0) return T(0);
-        const auto wm = half_vector(wi, wo);
+        const auto wm = rough_half_vector(wi, wo);
         if (!wm) return T(0);
         const GGX<T> ggx = distribution();
         const T F = fresnel_dielectric(dot(wi, *wm), eta);
@@ -241,8 +240,7 @@ struct DielectricInterface {
 
     /// Density of sample(wi, ·) at wo (solid angle); zero for smooth and index-matched interfaces.
     T pdf(const Vec3<T>& wi, const Vec3<T>& wo) const {
-        if (is_smooth() || is_index_matched() || wi.z == 0 || wo.z == 0) return T(0);
-        const auto wm = half_vector(wi, wo);
+        const auto wm = rough_half_vector(wi, wo);
         if (!wm) return T(0);
         const GGX<T> ggx = distribution();
         const T F = fresnel_dielectric(dot(wi, *wm), eta);
@@ -270,11 +268,7 @@ struct DielectricInterface {
         const InterfaceEventLanes<T, bool> e =
             dielectric_event<T>(eta, inv_eta(), alpha, shape, {wi.x, wi.y, wi.z}, uc, u1, u2, true);
         if (e.degenerate) return std::nullopt;
-        BsdfSample<T> s;
-        s.wo = {e.wo.x, e.wo.y, e.wo.z};
-        s.is_delta = shape.smooth || shape.index_matched;
-        s.is_transmission = !e.reflected;
-        s.shadowing = e.shadowing;
+        BsdfSample<T> s = event_sample(e, shape);
         s.weight = Rgb<T>(s.shadowing);
         if constexpr (kWithPdf)
             if (!s.is_delta) s.pdf = pdf(wi, s.wo);
@@ -290,11 +284,7 @@ struct DielectricInterface {
         const InterfaceEventLanes<T, bool> e = dielectric_event<T, Lane<T>, true>(
             eta, inv_eta(), alpha, shape, {wi.x, wi.y, wi.z}, uc, u1, u2, true, &pol);
         if (e.degenerate) return std::nullopt;
-        BsdfSample<T> s;
-        s.wo = {e.wo.x, e.wo.y, e.wo.z};
-        s.is_delta = shape.smooth || shape.index_matched;
-        s.is_transmission = !e.reflected;
-        s.shadowing = e.shadowing;
+        BsdfSample<T> s = event_sample(e, shape);
         s.fresnel_weight = {pol.factor[0], pol.factor[1], pol.factor[2]};
         s.weight = s.fresnel_weight * s.shadowing;
         return s;
@@ -304,6 +294,25 @@ struct DielectricInterface {
     DielectricEventShape event_shape() const {
         return {is_smooth(), is_index_matched(), uncorrelated_shadowing,
                 transmission_masking == TransmissionMasking::Smith};
+    }
+
+  private:
+    /// half_vector() for the rough lobes of eval and pdf: nothing for smooth and index-matched
+    /// interfaces (delta lobes) and for grazing directions.
+    std::optional<Vec3<T>> rough_half_vector(const Vec3<T>& wi, const Vec3<T>& wo) const {
+        if (is_smooth() || is_index_matched() || wi.z == 0 || wo.z == 0) return std::nullopt;
+        return half_vector(wi, wo);
+    }
+
+    /// The sample of dielectric_event's outcome `e` (its weight left to the caller).
+    static BsdfSample<T> event_sample(const InterfaceEventLanes<T, bool>& e,
+                                      const DielectricEventShape& shape) {
+        BsdfSample<T> s;
+        s.wo = {e.wo.x, e.wo.y, e.wo.z};
+        s.is_delta = shape.smooth || shape.index_matched;
+        s.is_transmission = !e.reflected;
+        s.shadowing = e.shadowing;
+        return s;
     }
 };
 
