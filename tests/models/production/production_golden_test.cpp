@@ -127,6 +127,59 @@ void keep_worst(Differences& worst, const Differences& d) {
         }
 }
 
+// The base's inputs every engine below maps alike: a diffuse base's colour is ρ with metallic 0
+// and the named specular factor 0; a metal's colour is its F0 under the coat F(1; η1/η, κ1/η) (η
+// the index above the base, 1 for an engine whose metal sees air), metallic 1, roughness √α1.
+struct BaseInputNames {
+    const char* color;
+    const char* metallic;
+    const char* specular;  // the factor a diffuse base sets to 0
+    const char* roughness;
+};
+
+// Returns false for a diffuse base (nothing more to check on a metal's extra inputs).
+bool expect_base_inputs(const json& s, const json& in, const std::string& id,
+                        const BaseInputNames& names, double eta_above) {
+    const Rgbd base = rgb(in.at(names.color));
+    if (s.at("base") == "lambertian") {
+        EXPECT_EQ(in.at(names.metallic).get<double>(), 0) << id;
+        EXPECT_EQ(in.at(names.specular).get<double>(), 0) << id;
+        const Rgbd rho = rgb(s.at("rho"));
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(base[c], rho[c], 1e-6) << id;
+        return false;
+    }
+    EXPECT_EQ(in.at(names.metallic).get<double>(), 1) << id;
+    EXPECT_NEAR(in.at(names.roughness).get<double>(), std::sqrt(s.at("alpha1").get<double>()), 1e-6)
+        << id;
+    const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1"));
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(base[c], conductor_ref(1, eta1[c] / eta_above, k1[c] / eta_above), 1e-6) << id;
+    return true;
+}
+
+// A metal's F82 tint: F(1/7)/F_Schlick(1/7) of its F0 = F(1; η1/η0, κ1/η0), clamped to [0, 1].
+void expect_f82_tint(const json& s, const json& tint_input, const std::string& id, double eta0) {
+    const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1")), tint = rgb(tint_input);
+    for (int c = 0; c < 3; ++c) {
+        const double f0 = conductor_ref(1, eta1[c] / eta0, k1[c] / eta0);
+        const double schlick_edge = f0 + (1 - f0) * std::pow(6.0 / 7, 5);
+        const double want_tint = std::clamp(
+            conductor_ref(1.0 / 7, eta1[c] / eta0, k1[c] / eta0) / schlick_edge, 0.0, 1.0);
+        EXPECT_NEAR(tint[c], want_tint, 1e-6) << id;
+    }
+}
+
+// A coat's worst differences: in all, without its compensating lobe (`lobe` names it) and of
+// that lobe alone.
+void print_worst(const std::string& label, const Differences& worst, const std::string& lobe) {
+    std::cout << fmt::format(
+        "{}: worst relative difference {:.2e} ({}); without the {} {:.2e} ({}); of that lobe "
+        "{:.2e} ({})\n",
+        label, worst.total.rel, worst.total.where, lobe, worst.rest.rel, worst.rest.where,
+        worst.compensation.rel, worst.compensation.where);
+}
+
 // The data file's OpenPBR inputs are the ones docs/models.md's mapping gives for its stacks:
 // r_c = √α0, coat_color = e^(−2τ); a metal's base_color F0 = F(1; η1/η0, κ1/η0) and its
 // specular_color the F82 tint F(1/7)/F_Schlick(1/7) clamped to [0, 1], specular_roughness √α1;
@@ -143,28 +196,10 @@ void expect_openpbr_inputs_follow_the_mapping(const json& data) {
         const Rgbd tau = rgb(s.at("tau")), coat_color = rgb(in.at("coat_color"));
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(coat_color[c], std::exp(-2 * tau[c]), 1e-6) << id;
-        if (s.at("base") == "lambertian") {
-            EXPECT_EQ(in.at("specular_weight").get<double>(), 0) << id;
-            EXPECT_EQ(in.at("base_metalness").get<double>(), 0) << id;
-            const Rgbd rho = rgb(s.at("rho")), base = rgb(in.at("base_color"));
-            for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(base[c], rho[c], 1e-6) << id;
-            continue;
-        }
-        EXPECT_EQ(in.at("base_metalness").get<double>(), 1) << id;
-        EXPECT_NEAR(in.at("specular_roughness").get<double>(),
-                    std::sqrt(s.at("alpha1").get<double>()), 1e-6)
-            << id;
-        const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1"));
-        const Rgbd f0 = rgb(in.at("base_color")), tint = rgb(in.at("specular_color"));
-        for (int c = 0; c < 3; ++c) {
-            const double want_f0 = conductor_ref(1, eta1[c] / eta0, k1[c] / eta0);
-            const double schlick_edge = want_f0 + (1 - want_f0) * std::pow(6.0 / 7, 5);
-            const double want_tint = std::clamp(
-                conductor_ref(1.0 / 7, eta1[c] / eta0, k1[c] / eta0) / schlick_edge, 0.0, 1.0);
-            EXPECT_NEAR(f0[c], want_f0, 1e-6) << id;
-            EXPECT_NEAR(tint[c], want_tint, 1e-6) << id;
-        }
+        if (expect_base_inputs(
+                s, in, id,
+                {"base_color", "base_metalness", "specular_weight", "specular_roughness"}, eta0))
+            expect_f82_tint(s, in.at("specular_color"), id, eta0);
     }
 }
 TEST(ProductionCoatsGolden, OpenPbrAdobeInputsFollowTheMapping) {
@@ -210,11 +245,7 @@ TEST(ProductionCoatsGolden, OpenPbrAdobeMatchesItsCode) {
         }
         EXPECT_LE(worst.rest.rel, 1e-3) << key << ": " << worst.rest.where;
         EXPECT_LE(worst.compensation.excess, 1) << key << ": " << worst.compensation.where;
-        std::cout << fmt::format(
-            "openpbr-adobe ({}): worst relative difference {:.2e} ({}); without the compensation "
-            "lobe {:.2e} ({}); of that lobe {:.2e} ({})\n",
-            key, worst.total.rel, worst.total.where, worst.rest.rel, worst.rest.where,
-            worst.compensation.rel, worst.compensation.where);
+        print_worst(fmt::format("openpbr-adobe ({})", key), worst, "compensation lobe");
     }
 }
 
@@ -230,21 +261,7 @@ TEST(ProductionCoatsGolden, FilamentInputsFollowTheMapping) {
         EXPECT_NEAR(in.at("clearCoatRoughness").get<double>(),
                     std::sqrt(s.at("alpha0").get<double>()), 1e-6)
             << id;
-        const Rgbd base = rgb(in.at("baseColor"));
-        if (s.at("base") == "lambertian") {
-            EXPECT_EQ(in.at("metallic").get<double>(), 0) << id;
-            EXPECT_EQ(in.at("reflectance").get<double>(), 0) << id;
-            const Rgbd rho = rgb(s.at("rho"));
-            for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(base[c], rho[c], 1e-6) << id;
-            continue;
-        }
-        EXPECT_EQ(in.at("metallic").get<double>(), 1) << id;
-        EXPECT_NEAR(in.at("roughness").get<double>(), std::sqrt(s.at("alpha1").get<double>()), 1e-6)
-            << id;
-        const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1"));
-        for (int c = 0; c < 3; ++c)
-            EXPECT_NEAR(base[c], conductor_ref(1, eta1[c], k1[c]), 1e-6) << id;
+        expect_base_inputs(s, in, id, {"baseColor", "metallic", "reflectance", "roughness"}, 1);
     }
 }
 
@@ -261,11 +278,7 @@ TEST(ProductionCoatsGolden, FilamentMatchesItsShaders) {
     }
     EXPECT_LE(worst.total.rel, 1e-3) << worst.total.where;
     EXPECT_LE(worst.compensation.excess, 1) << worst.compensation.where;
-    std::cout << fmt::format(
-        "filament: worst relative difference {:.2e} ({}); without the energy compensation "
-        "{:.2e} ({}); of the compensation {:.2e} ({})\n",
-        worst.total.rel, worst.total.where, worst.rest.rel, worst.rest.where,
-        worst.compensation.rel, worst.compensation.where);
+    print_worst("filament", worst, "energy compensation");
 }
 
 // The data file's Enterprise PBR inputs (dspbr-pt's glTF material) are docs/models.md's mapping:
@@ -281,22 +294,9 @@ TEST(ProductionCoatsGolden, EnterprisePbrInputsFollowTheMapping) {
         EXPECT_NEAR(in.at("clearcoatRoughnessFactor").get<double>(),
                     std::sqrt(s.at("alpha0").get<double>()), 1e-6)
             << id;
-        const Rgbd base = rgb(in.at("baseColorFactor"));
-        if (s.at("base") == "lambertian") {
-            EXPECT_EQ(in.at("metallicFactor").get<double>(), 0) << id;
-            EXPECT_EQ(in.at("specularFactor").get<double>(), 0) << id;
-            const Rgbd rho = rgb(s.at("rho"));
-            for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(base[c], rho[c], 1e-6) << id;
-            continue;
-        }
-        EXPECT_EQ(in.at("metallicFactor").get<double>(), 1) << id;
-        EXPECT_NEAR(in.at("roughnessFactor").get<double>(), std::sqrt(s.at("alpha1").get<double>()),
-                    1e-6)
-            << id;
-        const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1"));
-        for (int c = 0; c < 3; ++c)
-            EXPECT_NEAR(base[c], conductor_ref(1, eta1[c] / eta0, k1[c] / eta0), 1e-6) << id;
+        expect_base_inputs(
+            s, in, id, {"baseColorFactor", "metallicFactor", "specularFactor", "roughnessFactor"},
+            eta0);
     }
 }
 
@@ -313,11 +313,7 @@ TEST(ProductionCoatsGolden, EnterprisePbrMatchesDspbr) {
     }
     EXPECT_LE(worst.total.rel, 1e-3) << worst.total.where;
     EXPECT_LE(worst.compensation.excess, 1) << worst.compensation.where;
-    std::cout << fmt::format(
-        "enterprise-pbr: worst relative difference {:.2e} ({}); without the multiple-scattering "
-        "lobe {:.2e} ({}); of that lobe {:.2e} ({})\n",
-        worst.total.rel, worst.total.where, worst.rest.rel, worst.rest.where,
-        worst.compensation.rel, worst.compensation.where);
+    print_worst("enterprise-pbr", worst, "multiple-scattering lobe");
 }
 
 // The data file's Principled inputs are docs/models.md's mapping: coat IOR η0, coat roughness
@@ -338,31 +334,10 @@ TEST(ProductionCoatsGolden, BlenderPrincipledInputsFollowTheMapping) {
         const Rgbd tau = rgb(s.at("tau")), tint = rgb(in.at("coat_tint"));
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(tint[c], std::exp(-2 * tau[c]), 1e-6) << id;
-        const Rgbd base = rgb(in.at("base_color"));
-        if (s.at("base") == "lambertian") {
-            EXPECT_EQ(in.at("metallic").get<double>(), 0) << id;
-            EXPECT_EQ(in.at("specular_ior_level").get<double>(), 0) << id;
-            const Rgbd rho = rgb(s.at("rho"));
-            for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(base[c], rho[c], 1e-6) << id;
+        if (!expect_base_inputs(
+                s, in, id, {"base_color", "metallic", "specular_ior_level", "roughness"}, eta0))
             continue;
-        }
-        EXPECT_EQ(in.at("metallic").get<double>(), 1) << id;
-        EXPECT_NEAR(in.at("roughness").get<double>(), std::sqrt(s.at("alpha1").get<double>()), 1e-6)
-            << id;
-        const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1")),
-                   f82 = rgb(in.at("specular_tint"));
-        for (int c = 0; c < 3; ++c) {
-            const double want_f0 = conductor_ref(1, eta1[c] / eta0, k1[c] / eta0);
-            const double schlick_edge = want_f0 + (1 - want_f0) * std::pow(6.0 / 7, 5);
-            EXPECT_NEAR(base[c], want_f0, 1e-6) << id;
-            EXPECT_NEAR(
-                f82[c],
-                std::clamp(conductor_ref(1.0 / 7, eta1[c] / eta0, k1[c] / eta0) / schlick_edge, 0.0,
-                           1.0),
-                1e-6)
-                << id;
-        }
+        expect_f82_tint(s, in.at("specular_tint"), id, eta0);
     }
 }
 
@@ -396,21 +371,8 @@ TEST(ProductionCoatsGolden, ThreeJsInputsFollowTheMapping) {
         EXPECT_NEAR(in.at("clearcoatRoughness").get<double>(),
                     std::sqrt(s.at("alpha0").get<double>()), 1e-6)
             << id;
-        const Rgbd base = rgb(in.at("color"));
-        if (s.at("base") == "lambertian") {
-            EXPECT_EQ(in.at("metalness").get<double>(), 0) << id;
-            EXPECT_EQ(in.at("specularIntensity").get<double>(), 0) << id;
-            const Rgbd rho = rgb(s.at("rho"));
-            for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(base[c], rho[c], 1e-6) << id;
-            continue;
-        }
-        EXPECT_EQ(in.at("metalness").get<double>(), 1) << id;
-        EXPECT_NEAR(in.at("roughness").get<double>(), std::sqrt(s.at("alpha1").get<double>()), 1e-6)
-            << id;
-        const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1"));
-        for (int c = 0; c < 3; ++c)
-            EXPECT_NEAR(base[c], conductor_ref(1, eta1[c] / eta0, k1[c] / eta0), 1e-6) << id;
+        expect_base_inputs(s, in, id, {"color", "metalness", "specularIntensity", "roughness"},
+                           eta0);
     }
 }
 
@@ -445,11 +407,7 @@ TEST(ProductionCoatsGolden, ThreeJsMatchesItsShaders) {
     }
     EXPECT_LE(worst.rest.rel, 1e-3) << worst.rest.where;
     EXPECT_LE(worst.compensation.excess, 1) << worst.compensation.where;
-    std::cout << fmt::format(
-        "threejs-clearcoat: worst relative difference {:.2e} ({}); without the compensation "
-        "{:.2e} ({}); of the compensation {:.2e} ({})\n",
-        worst.total.rel, worst.total.where, worst.rest.rel, worst.rest.where,
-        worst.compensation.rel, worst.compensation.where);
+    print_worst("threejs-clearcoat", worst, "compensation");
 }
 
 // `openpbr-materialx` against MaterialX's OpenPBR graph as its GLSL generator evaluates it.
