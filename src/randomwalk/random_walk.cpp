@@ -400,8 +400,6 @@ void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& 
     const DielectricInterface<double>& exit = exit_it.dielectric;
     const std::optional<ExitDirection> ed = sample_exit_direction(conn, wo, depth, rng, proxy_pdf);
     if (!ed) return;
-    const Vec3d& omega = ed->omega;
-    const double mu = ed->mu, mis = ed->mis;
     const Medium& m = media_[conn.inner];
     if constexpr (kMode == Mode::Pdf) {
         // The exit's density at wo: a dielectric walk carries all its flux, so its exit density
@@ -409,17 +407,17 @@ void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& 
         const double p_exit =
             exit_it.multiple ? interface_kernel(exit_it, ed->wt, wo, rng)[0] : exit.pdf(ed->wt, wo);
         if (p_exit == 0) return;
-        const Rgbd pass = m.scatters ? exp_neg(m.tau_t * (depth / mu)) : Rgbd(1.0);
-        f[0] += pdf_chain(omega, pass) * p_exit / ed->pdf * mis;
+        const Rgbd pass = m.scatters ? exp_neg(m.tau_t * (depth / ed->mu)) : Rgbd(1.0);
+        f[0] += pdf_chain(ed->omega, pass) * p_exit / ed->pdf * ed->mis;
     } else {
         const double f_exit = exit_it.multiple
                                   ? interface_kernel(exit_it, ed->wt, wo, rng)[0] / std::abs(wo.z)
                                   : exit.eval(ed->wt, wo);
         if (f_exit == 0) return;
-        const Rgbd kv = kernel(omega);
+        const Rgbd kv = kernel(ed->omega);
         if (is_black(kv)) return;
-        const Rgbd tr = m.is_empty() ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
-        f += w * kv * tr * (f_exit / ed->pdf * mis);
+        const Rgbd tr = m.is_empty() ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / ed->mu));
+        f += w * kv * tr * (f_exit / ed->pdf * ed->mis);
     }
 }
 
@@ -574,14 +572,12 @@ void RandomWalkStack::connect_through_exit_polarized(const Connection& conn, con
     const DielectricInterface<double>& exit = exit_it.dielectric;
     const std::optional<ExitDirection> ed = sample_exit_direction(conn, wo, depth, rng, proxy_pdf);
     if (!ed) return;
-    const Vec3d& omega = ed->omega;
-    const double mu = ed->mu, mis = ed->mis;
     const Medium& m = media_[conn.inner];
     StokesRgb<double> e;
-    emit(omega, e);
+    emit(ed->omega, e);
     // The light's state per channel, in the tabulation frame of ω.
     StokesLanes<double> state;
-    state.x = stokes_bin_frame<double>({omega.x, omega.y, omega.z});
+    state.x = stokes_bin_frame<double>({ed->omega.x, ed->omega.y, ed->omega.z});
     const double inv_len = 1 / std::sqrt(dot(Vec3d(state.x.x, state.x.y, state.x.z),
                                              Vec3d(state.x.x, state.x.y, state.x.z)));
     state.x = {state.x.x * inv_len, state.x.y * inv_len, state.x.z * inv_len};
@@ -605,14 +601,15 @@ void RandomWalkStack::connect_through_exit_polarized(const Connection& conn, con
             fresnel_dielectric_mueller<double>(dot(ed->wt, *wm), exit.eta, 1 / exit.eta);
         if (!(fm.transmission.a > 0)) return;
         const Vec3d n = cross(ed->wt, *wm);
-        stokes_rotate_frame<double>(state, {omega.x, omega.y, omega.z}, {n.x, n.y, n.z}, 3, true);
+        stokes_rotate_frame<double>(state, {ed->omega.x, ed->omega.y, ed->omega.z}, {n.x, n.y, n.z},
+                                    3, true);
         for (int c = 0; c < 3; ++c)
             through[c] =
                 f_exit * (fm.transmission.a + fm.transmission.b * state.q[c]) / fm.transmission.a;
     }
-    const Rgbd tr = m.is_empty() ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / mu));
+    const Rgbd tr = m.is_empty() ? Rgbd(1.0) : exp_neg(m.tau_t * (depth / ed->mu));
     const Rgbd kv(e.s[0][0], e.s[1][0], e.s[2][0]);
-    f += w * kv * tr * through * (1 / ed->pdf * mis);
+    f += w * kv * tr * through * (1 / ed->pdf * ed->mis);
 }
 
 // ---- Media (docs/physics.md §4), as the goniophotometer traverses them --------------------------

@@ -180,6 +180,40 @@ void print_worst(const std::string& label, const Differences& worst, const std::
         worst.compensation.rel, worst.compensation.where);
 }
 
+// The inputs of an engine whose coat has the fixed index 1.5: its coat roughness input is √α0,
+// and the base as expect_base_inputs says (`metal_under_coat`: the metal's F0 is taken under the
+// coat, η0, rather than against air).
+void expect_fixed_coat_inputs(const std::string& file, const char* coat_roughness,
+                              const BaseInputNames& names, bool metal_under_coat) {
+    for (const json& record : load(file).at("stacks")) {
+        const json &s = record.at("stack"), &in = record.at("inputs");
+        const std::string id = record.at("id");
+        const double eta0 = s.at("eta0");
+        EXPECT_EQ(eta0, 1.5) << id;
+        EXPECT_NEAR(in.at(coat_roughness).get<double>(), std::sqrt(s.at("alpha0").get<double>()),
+                    1e-6)
+            << id;
+        expect_base_inputs(s, in, id, names, metal_under_coat ? eta0 : 1);
+    }
+}
+
+// A coat against its authors' values to 1e-3, its compensating lobe (off with `lobe_off`, named
+// `lobe`) compared on its own where the data file records it.
+void expect_matches_with_compensation(const std::string& file, const std::string& model,
+                                      const std::string& lobe_off, const std::string& lobe) {
+    const json data = load(file);
+    Differences worst;
+    for (const json& record : data.at("stacks")) {
+        const json* compensation =
+            record.contains("compensation") ? &record.at("compensation") : nullptr;
+        keep_worst(worst, compare(data, record, model, {}, {lobe_off}, record.at("values"),
+                                  compensation, [](const Vec3d&, const Vec3d&) { return 1e-3; }));
+    }
+    EXPECT_LE(worst.total.rel, 1e-3) << worst.total.where;
+    EXPECT_LE(worst.compensation.excess, 1) << worst.compensation.where;
+    print_worst(model, worst, lobe);
+}
+
 // The data file's OpenPBR inputs are the ones docs/models.md's mapping gives for its stacks:
 // r_c = √α0, coat_color = e^(−2τ); a metal's base_color F0 = F(1; η1/η0, κ1/η0) and its
 // specular_color the F82 tint F(1/7)/F_Schlick(1/7) clamped to [0, 1], specular_roughness √α1;
@@ -253,67 +287,29 @@ TEST(ProductionCoatsGolden, OpenPbrAdobeMatchesItsCode) {
 // roughness = √α1; a metal's baseColor its F0 against air F(1; η1, κ1), metallic 1; a diffuse
 // base's baseColor ρ, metallic 0, reflectance 0.
 TEST(ProductionCoatsGolden, FilamentInputsFollowTheMapping) {
-    const json data = load("filament.json");
-    for (const json& record : data.at("stacks")) {
-        const json &s = record.at("stack"), &in = record.at("inputs");
-        const std::string id = record.at("id");
-        EXPECT_EQ(s.at("eta0").get<double>(), 1.5) << id;
-        EXPECT_NEAR(in.at("clearCoatRoughness").get<double>(),
-                    std::sqrt(s.at("alpha0").get<double>()), 1e-6)
-            << id;
-        expect_base_inputs(s, in, id, {"baseColor", "metallic", "reflectance", "roughness"}, 1);
-    }
+    expect_fixed_coat_inputs("filament.json", "clearCoatRoughness",
+                             {"baseColor", "metallic", "reflectance", "roughness"}, false);
 }
 
 // `filament` against Filament's shaders (desktop, punctual light), its DFG texture included.
 TEST(ProductionCoatsGolden, FilamentMatchesItsShaders) {
-    const json data = load("filament.json");
-    Differences worst;
-    for (const json& record : data.at("stacks")) {
-        const json* compensation =
-            record.contains("compensation") ? &record.at("compensation") : nullptr;
-        keep_worst(worst, compare(data, record, "filament", {}, {"energy-compensation=off"},
-                                  record.at("values"), compensation,
-                                  [](const Vec3d&, const Vec3d&) { return 1e-3; }));
-    }
-    EXPECT_LE(worst.total.rel, 1e-3) << worst.total.where;
-    EXPECT_LE(worst.compensation.excess, 1) << worst.compensation.where;
-    print_worst("filament", worst, "energy compensation");
+    expect_matches_with_compensation("filament.json", "filament", "energy-compensation=off",
+                                     "energy compensation");
 }
 
 // The data file's Enterprise PBR inputs (dspbr-pt's glTF material) are docs/models.md's mapping:
 // clearcoatRoughnessFactor = √α0; a metal's baseColor its F0 under the coat F(1; η1/η0, κ1/η0),
 // metallic 1, roughness √α1; a diffuse base's baseColor ρ, metallic 0, specularFactor 0.
 TEST(ProductionCoatsGolden, EnterprisePbrInputsFollowTheMapping) {
-    const json data = load("enterprise-pbr.json");
-    for (const json& record : data.at("stacks")) {
-        const json &s = record.at("stack"), &in = record.at("inputs");
-        const std::string id = record.at("id");
-        const double eta0 = s.at("eta0");
-        EXPECT_EQ(eta0, 1.5) << id;
-        EXPECT_NEAR(in.at("clearcoatRoughnessFactor").get<double>(),
-                    std::sqrt(s.at("alpha0").get<double>()), 1e-6)
-            << id;
-        expect_base_inputs(
-            s, in, id, {"baseColorFactor", "metallicFactor", "specularFactor", "roughnessFactor"},
-            eta0);
-    }
+    expect_fixed_coat_inputs(
+        "enterprise-pbr.json", "clearcoatRoughnessFactor",
+        {"baseColorFactor", "metallicFactor", "specularFactor", "roughnessFactor"}, true);
 }
 
 // `enterprise-pbr` against Dassault's dspbr-pt (its Enterprise PBR material kernel).
 TEST(ProductionCoatsGolden, EnterprisePbrMatchesDspbr) {
-    const json data = load("enterprise-pbr.json");
-    Differences worst;
-    for (const json& record : data.at("stacks")) {
-        const json* compensation =
-            record.contains("compensation") ? &record.at("compensation") : nullptr;
-        keep_worst(worst, compare(data, record, "enterprise-pbr", {}, {"multiple-scattering=off"},
-                                  record.at("values"), compensation,
-                                  [](const Vec3d&, const Vec3d&) { return 1e-3; }));
-    }
-    EXPECT_LE(worst.total.rel, 1e-3) << worst.total.where;
-    EXPECT_LE(worst.compensation.excess, 1) << worst.compensation.where;
-    print_worst("enterprise-pbr", worst, "multiple-scattering lobe");
+    expect_matches_with_compensation("enterprise-pbr.json", "enterprise-pbr",
+                                     "multiple-scattering=off", "multiple-scattering lobe");
 }
 
 // The data file's Principled inputs are docs/models.md's mapping: coat IOR η0, coat roughness
@@ -361,19 +357,10 @@ TEST(ProductionCoatsGolden, BlenderPrincipledMatchesCycles) {
 // √α0; a metal's color its F0 under the coat F(1; η1/η0, κ1/η0), metalness 1, roughness √α1; a
 // diffuse base's color ρ, metalness 0, specularIntensity 0.
 TEST(ProductionCoatsGolden, ThreeJsInputsFollowTheMapping) {
-    const json data = load("threejs-clearcoat.json");
-    for (const json& record : data.at("stacks")) {
-        const json &s = record.at("stack"), &in = record.at("inputs");
-        const std::string id = record.at("id");
-        const double eta0 = s.at("eta0");
-        EXPECT_EQ(eta0, 1.5) << id;
-        EXPECT_EQ(in.at("clearcoat").get<double>(), 1) << id;
-        EXPECT_NEAR(in.at("clearcoatRoughness").get<double>(),
-                    std::sqrt(s.at("alpha0").get<double>()), 1e-6)
-            << id;
-        expect_base_inputs(s, in, id, {"color", "metalness", "specularIntensity", "roughness"},
-                           eta0);
-    }
+    expect_fixed_coat_inputs("threejs-clearcoat.json", "clearcoatRoughness",
+                             {"color", "metalness", "specularIntensity", "roughness"}, true);
+    for (const json& record : load("threejs-clearcoat.json").at("stacks"))
+        EXPECT_EQ(record.at("inputs").at("clearcoat").get<double>(), 1) << record.at("id");
 }
 
 /// The largest difference of three.js's DFG texture (E = scale + bias) from the integral it
