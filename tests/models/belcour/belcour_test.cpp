@@ -3,6 +3,7 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "models/model_checks.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "models/tables/fgd_table.h"
@@ -182,14 +183,7 @@ TEST(Bel18, PreparedEvaluatorEqualsEval) {
     const auto model = make_model(
         "bel-prime", coated(1.5, 0.1, test::dielectric(1.2, 0.2), Rgbd(0.1), Rgbd(0.3), 0.7));
     ASSERT_TRUE(model->support().btdf);
-    const Vec3d wi = dir(40, 0);
-    const auto prepared = model->prepare(wi);
-    for (double to : {10.0, 60.0})
-        for (double po : {0.0, 170.0})
-            for (Side side : {Side::Reflection, Side::Transmission}) {
-                const Vec3d wo = direction_from_angles(deg_to_rad(to), deg_to_rad(po), side);
-                EXPECT_EQ(prepared->eval(wo), model->eval(wi, wo));
-            }
+    test::expect_prepared_equals_eval(*model, dir(40, 0));
 }
 
 TEST(Bel18, SupportIsExplicit) {

@@ -8,6 +8,7 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "models/model_checks.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "models/tables/fgd_table.h"
@@ -574,13 +575,7 @@ TEST(Tm6, SupportIsExplicit) {
 TEST(Tm6, PreparedEvaluatorEqualsEval) {
     const auto model =
         make_model("tm6", coated(1.5, 0.1, test::gold(0.2), Rgbd(0.1, 0.3, 0.6), Rgbd(0.7), 0.2));
-    const Vec3d wi = dir(40, 0);
-    const auto prepared = model->prepare(wi);
-    for (double to : {10.0, 40.0, 60.0})
-        for (double po : {0.0, 90.0, 180.0}) {
-            const Vec3d wo = dir(to, po);
-            EXPECT_EQ(prepared->eval(wo), model->eval(wi, wo));
-        }
+    test::expect_prepared_equals_eval(*model, dir(40, 0));
 }
 
 // Any supported stack gives finite values: random stacks of 1–4 interfaces over a conductor with
@@ -636,26 +631,7 @@ TEST(Tm6, RandomStacksGiveFiniteValues) {
 TEST(Tm6, SamplerIsConsistentWithEvalAndPdf) {
     const auto model =
         make_model("tm6", coated(1.5, 0.2, test::gold(0.4), Rgbd(0.05), Rgbd(1.0), 0.4));
-    ASSERT_TRUE(model->has_sampling());
-    const Vec3d wi = dir(35, 0);
-    ParticleRng rng(13, 0, 0);
-    const int n = 100000;
-    double sum = 0, sum2 = 0;
-    for (int i = 0; i < n; ++i) {
-        const Vec3d u(rng.uniform_double(), rng.uniform_double(), rng.uniform_double());
-        const auto s = model->sample(wi, u);
-        const double w = s ? s->weight.mean() : 0.0;
-        if (s && i % 97 == 0) {
-            EXPECT_NEAR(model->pdf(wi, s->wo), s->pdf, 1e-12 * s->pdf);
-        }
-        sum += w;
-        sum2 += w * w;
-    }
-    const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
-    BinnedOptions o;
-    o.rel_tol = 1e-4;
-    const Rgbd albedo = model_albedo(*model, wi, Side::Reflection, o);
-    EXPECT_NEAR(mean, albedo.mean(), 5 * se + 1e-4);
+    test::expect_sampler_matches_albedo(*model, dir(35, 0), 13, 100000, "tm6 over gold");
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "core/rng.h"
 #include "core/spherical.h"
 #include "models/belcour/belcour.h"
+#include "models/model_checks.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "models/tables/fgd_table.h"
@@ -348,14 +349,7 @@ TEST(Tm2, PreparedEvaluatorEqualsEval) {
     const auto model =
         make_model("tm2", coated(1.5, 0.1, test::dielectric(1.2, 0.2), Rgbd(0.1, 0.3, 0.6)));
     ASSERT_TRUE(model->support().btdf);
-    const Vec3d wi = dir(40, 0);
-    const auto prepared = model->prepare(wi);
-    for (double to : {10.0, 60.0})
-        for (double po : {0.0, 170.0})
-            for (Side side : {Side::Reflection, Side::Transmission}) {
-                const Vec3d wo = direction_from_angles(deg_to_rad(to), deg_to_rad(po), side);
-                EXPECT_EQ(prepared->eval(wo), model->eval(wi, wo));
-            }
+    test::expect_prepared_equals_eval(*model, dir(40, 0));
 }
 
 TEST(Tm2, SupportIsExplicit) {
@@ -510,28 +504,8 @@ TEST(Tm2, SamplerIsConsistentWithEvalAndPdf) {
     for (const auto& [name, stack] : std::vector<std::pair<std::string, Stack>>{
              {"coated gold", coated(1.5, 0.2, test::gold(0.4))},
              {"glass sheet", coated(1.5, 0.3, test::dielectric(1.0, 0.2))}}) {
-        const auto model = make_model("tm2", stack);
-        ASSERT_TRUE(model->has_sampling());
-        const Vec3d wi = dir(35, 0);
-        ParticleRng rng(11, 0, 0);
-        const int n = 100000;
-        double sum = 0, sum2 = 0;
-        for (int i = 0; i < n; ++i) {
-            const Vec3d u(rng.uniform_double(), rng.uniform_double(), rng.uniform_double());
-            const auto s = model->sample(wi, u);
-            const double w = s ? s->weight.mean() : 0.0;
-            if (s && i % 97 == 0) {
-                EXPECT_NEAR(model->pdf(wi, s->wo), s->pdf, 1e-12 * s->pdf);
-            }
-            sum += w;
-            sum2 += w * w;
-        }
-        const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
-        BinnedOptions o;
-        o.rel_tol = 1e-4;
-        Rgbd albedo = model_albedo(*model, wi, Side::Reflection, o);
-        if (model->support().btdf) albedo += model_albedo(*model, wi, Side::Transmission, o);
-        EXPECT_NEAR(mean, albedo.mean(), 5 * se + 1e-4) << name;
+        test::expect_sampler_matches_albedo(*make_model("tm2", stack), dir(35, 0), 11, 100000,
+                                            name);
     }
 }
 
