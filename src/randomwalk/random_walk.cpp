@@ -363,7 +363,8 @@ template <typename ProxyPdf>
 std::optional<RandomWalkStack::ExitDirection> RandomWalkStack::sample_exit_direction(
     const Connection& conn, const Vec3d& wo, double depth, ParticleRng& rng,
     const ProxyPdf& proxy_pdf) const {
-    const DielectricInterface<double>& exit = interfaces_[conn.exit_interface].dielectric;
+    const Interface& exit_it = interfaces_[conn.exit_interface];
+    const DielectricInterface<double>& exit = exit_it.dielectric;
     const double uc = rng.uniform_double(), u1 = rng.uniform_double(), u2 = rng.uniform_double();
     const auto st = exit.sample<true>(wo, uc, u1, u2);
     if (!st || !st->is_transmission || st->shadowing == 0 || st->pdf <= 0) return std::nullopt;
@@ -371,7 +372,7 @@ std::optional<RandomWalkStack::ExitDirection> RandomWalkStack::sample_exit_direc
     if (omega.z * conn.towards <= 0) return std::nullopt;
     const double mu = std::abs(omega.z);
     const double p1 = proxy_pdf(omega) * survival_proxy(conn.inner, depth / mu);
-    return ExitDirection{st->wo, st->pdf, omega, mu, st->pdf / (st->pdf + p1)};
+    return ExitDirection{&exit_it, st->wo, st->pdf, omega, mu, st->pdf / (st->pdf + p1)};
 }
 
 // Strategy 2 at a vertex of the inner region that emits `k_v(ω)` (per channel, kernel incl. cos
@@ -396,23 +397,22 @@ void RandomWalkStack::connect_through_exit(const Connection& conn, const Vec3d& 
                                            const Rgbd& w, ParticleRng& rng, const Kernel& kernel,
                                            const PdfChain& pdf_chain, const ProxyPdf& proxy_pdf,
                                            Rgbd& f) const {
-    const Interface& exit_it = interfaces_[conn.exit_interface];
-    const DielectricInterface<double>& exit = exit_it.dielectric;
     const std::optional<ExitDirection> ed = sample_exit_direction(conn, wo, depth, rng, proxy_pdf);
     if (!ed) return;
+    const Interface& exit_it = *ed->exit;
     const Medium& m = media_[conn.inner];
     if constexpr (kMode == Mode::Pdf) {
         // The exit's density at wo: a dielectric walk carries all its flux, so its exit density
         // is its kernel f·|cos θo| (flux convention).
-        const double p_exit =
-            exit_it.multiple ? interface_kernel(exit_it, ed->wt, wo, rng)[0] : exit.pdf(ed->wt, wo);
+        const double p_exit = exit_it.multiple ? interface_kernel(exit_it, ed->wt, wo, rng)[0]
+                                               : exit_it.dielectric.pdf(ed->wt, wo);
         if (p_exit == 0) return;
         const Rgbd pass = m.scatters ? exp_neg(m.tau_t * (depth / ed->mu)) : Rgbd(1.0);
         f[0] += pdf_chain(ed->omega, pass) * p_exit / ed->pdf * ed->mis;
     } else {
         const double f_exit = exit_it.multiple
                                   ? interface_kernel(exit_it, ed->wt, wo, rng)[0] / std::abs(wo.z)
-                                  : exit.eval(ed->wt, wo);
+                                  : exit_it.dielectric.eval(ed->wt, wo);
         if (f_exit == 0) return;
         const Rgbd kv = kernel(ed->omega);
         if (is_black(kv)) return;
@@ -568,10 +568,9 @@ void RandomWalkStack::connect_through_exit_polarized(const Connection& conn, con
                                                      double depth, const Rgbd& w, ParticleRng& rng,
                                                      const Emit& emit, const ProxyPdf& proxy_pdf,
                                                      Rgbd& f) const {
-    const Interface& exit_it = interfaces_[conn.exit_interface];
-    const DielectricInterface<double>& exit = exit_it.dielectric;
     const std::optional<ExitDirection> ed = sample_exit_direction(conn, wo, depth, rng, proxy_pdf);
     if (!ed) return;
+    const Interface& exit_it = *ed->exit;
     const Medium& m = media_[conn.inner];
     StokesRgb<double> e;
     emit(ed->omega, e);
@@ -594,11 +593,11 @@ void RandomWalkStack::connect_through_exit_polarized(const Connection& conn, con
         for (int c = 0; c < 3; ++c)
             through[c] = out.s[c][0] / std::abs(wo.z);
     } else {
-        const double f_exit = exit.eval(ed->wt, wo);
-        const std::optional<Vec3d> wm = exit.half_vector(ed->wt, wo);
+        const double f_exit = exit_it.dielectric.eval(ed->wt, wo);
+        const std::optional<Vec3d> wm = exit_it.dielectric.half_vector(ed->wt, wo);
         if (f_exit == 0 || !wm) return;
-        const DielectricMueller<double> fm =
-            fresnel_dielectric_mueller<double>(dot(ed->wt, *wm), exit.eta, 1 / exit.eta);
+        const DielectricMueller<double> fm = fresnel_dielectric_mueller<double>(
+            dot(ed->wt, *wm), exit_it.dielectric.eta, 1 / exit_it.dielectric.eta);
         if (!(fm.transmission.a > 0)) return;
         const Vec3d n = cross(ed->wt, *wm);
         stokes_rotate_frame<double>(state, {ed->omega.x, ed->omega.y, ed->omega.z}, {n.x, n.y, n.z},

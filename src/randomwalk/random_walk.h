@@ -194,6 +194,7 @@ class RandomWalkStack {
     /// sampled from wo (its single-scattering sampler), with the balance-heuristic weight of that
     /// strategy against the vertex's proxy density (`proxy_pdf` × the survival to the depth).
     struct ExitDirection {
+        const Interface* exit;  ///< the exit interface
         Vec3d wt;     ///< the sampled transmitted direction at the exit (pointing out of it)
         double pdf;   ///< its density
         Vec3d omega;  ///< −wt: the direction from the vertex towards the exit

@@ -70,6 +70,20 @@ void expect_budget_closes(const SimulationResult& r) {
             EXPECT_NEAR(st.budget.sum()[c], 1.0, 1e-6);
 }
 
+// A white furnace with microsurface multiple scattering: every particle is reflected or
+// transmitted (nothing lost in a microsurface, nothing cut off, no degenerate sample).
+void expect_white_furnace_loses_nothing(const SimulationResult& r) {
+    for (const IncidenceStats& st : r.incidences) {
+        const EnergyBudget& b = st.budget;
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_NEAR(b[BudgetTerm::Reflected][c] + b[BudgetTerm::Transmitted][c], 1.0, 1e-6);
+            EXPECT_EQ(b[BudgetTerm::LostMicrosurface][c], 0.0);
+            EXPECT_EQ(b[BudgetTerm::CutOff][c], 0.0);
+        }
+        EXPECT_EQ(st.degenerate_samples, 0u);
+    }
+}
+
 // §6.2: a Lambertian base alone reflects albedo/π in every direction; every particle leaves
 // with flux exactly ρ, so the reflected budget is ρ exactly. It holds with polarization too (the
 // base depolarizes, and the flux is S0).
@@ -683,16 +697,7 @@ TEST_P(MicrosurfaceWalkStat, WhiteFurnaceLosesNothing) {
     for (const Stack& stack : stacks) {
         SimulationSettings s = settings({0, 45, 80}, 100'000, HemisphereGrid(9, 9));
         multiple_scattering(s);
-        const auto r = simulate(stack, s);
-        for (const IncidenceStats& st : r.incidences) {
-            const EnergyBudget& b = st.budget;
-            for (int c = 0; c < 3; ++c) {
-                EXPECT_NEAR(b[BudgetTerm::Reflected][c] + b[BudgetTerm::Transmitted][c], 1.0, 1e-6);
-                EXPECT_EQ(b[BudgetTerm::LostMicrosurface][c], 0.0);
-                EXPECT_EQ(b[BudgetTerm::CutOff][c], 0.0);
-            }
-            EXPECT_EQ(st.degenerate_samples, 0u);
-        }
+        expect_white_furnace_loses_nothing(simulate(stack, s));
     }
 }
 
@@ -928,16 +933,7 @@ TEST_P(PolarizationStat, WhiteFurnaceLosesNothing) {
     for (const Stack& stack : stacks) {
         SimulationSettings s = polarized({0, 45, 80}, 100'000, HemisphereGrid(9, 9));
         s.transport.microsurface = Microsurface::Multiple;
-        const auto r = simulate(stack, s);
-        for (const IncidenceStats& st : r.incidences) {
-            const EnergyBudget& b = st.budget;
-            for (int c = 0; c < 3; ++c) {
-                EXPECT_NEAR(b[BudgetTerm::Reflected][c] + b[BudgetTerm::Transmitted][c], 1.0, 1e-6);
-                EXPECT_EQ(b[BudgetTerm::LostMicrosurface][c], 0.0);
-                EXPECT_EQ(b[BudgetTerm::CutOff][c], 0.0);
-            }
-            EXPECT_EQ(st.degenerate_samples, 0u);
-        }
+        expect_white_furnace_loses_nothing(simulate(stack, s));
     }
 }
 
