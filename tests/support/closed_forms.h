@@ -36,6 +36,17 @@ struct PolarizedFresnel {
     }
 };
 
+/// The unpolarized Fresnel reflectance ½(R_s + R_p) of relative index η + iκ at cos θi (1 under
+/// total internal reflection, where |r_s| = |r_p| = 1).
+inline double fresnel_ref(double cos_i, double eta, double kappa = 0) {
+    const PolarizedFresnel f(cos_i, {eta, kappa});
+    return 0.5 * (f.Rs() + f.Rp());
+}
+/// The same for a conductor (the name the production coats' tests read best with).
+inline double conductor_ref(double cos_i, double eta, double kappa) {
+    return fresnel_ref(cos_i, eta, kappa);
+}
+
 /// A smooth parallel stack keeps every event in one plane of incidence, so s- and p-polarized
 /// light never mix: the exact (polarized) reflectance and transmittance of a smooth slab of
 /// relative index η with one crossing's attenuation a, for unpolarized light, are the mean over s

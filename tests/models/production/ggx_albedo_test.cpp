@@ -7,6 +7,7 @@
 
 #include "core/math.h"
 #include "models/numerics/quadrature.h"
+#include "support/closed_forms.h"
 
 #include <gtest/gtest.h>
 
@@ -15,14 +16,8 @@
 namespace lamina {
 namespace {
 
-/// Exact dielectric Fresnel (Born & Wolf §1.5.2), restated.
-double fresnel_ref(double c, double eta) {
-    const double s2 = (1 - c * c) / (eta * eta);
-    if (s2 >= 1) return 1;
-    const double ct = std::sqrt(1 - s2);
-    const double rs = (c - eta * ct) / (c + eta * ct), rp = (eta * c - ct) / (eta * c + ct);
-    return 0.5 * (rs * rs + rp * rp);
-}
+using test::conductor_ref;
+using test::fresnel_ref;
 
 /// ∫ g(wi·h) D(h) G(wi, wo) / (4 μi) dωo over the outgoing hemisphere with D in Walter et al.
 /// 2007's form (Eq. 33) and Λ in Heitz 2014's (Eq. 72): `white` the height-correlated G2 and

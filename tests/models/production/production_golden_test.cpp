@@ -8,6 +8,7 @@
 #include "models/production/uncorrelated_albedo.h"
 #include "models/registry.h"
 #include "models/test_stacks.h"
+#include "support/closed_forms.h"
 
 #include <gtest/gtest.h>
 
@@ -22,6 +23,9 @@
 
 namespace lamina {
 namespace {
+
+using test::conductor_ref;
+using test::fresnel_ref;
 
 using nlohmann::json;
 
@@ -45,15 +49,6 @@ Stack stack_of(const json& s) {
             ? test::lambertian(rgb(s.at("rho")))
             : test::conductor(rgb(s.at("eta1")), rgb(s.at("kappa1")), s.at("alpha1").get<double>());
     return test::coated(s.at("eta0").get<double>(), s.at("alpha0").get<double>(), base, tau);
-}
-
-/// Exact conductor Fresnel with std::complex (Born & Wolf §14.2), restated here.
-double conductor_ref(double c, double eta, double k) {
-    using C = std::complex<double>;
-    const C n(eta, k);
-    const C ct = std::sqrt(C(1) - (1 - c * c) / (n * n));
-    const C rs = (C(c) - n * ct) / (C(c) + n * ct), rp = (n * c - ct) / (n * c + ct);
-    return 0.5 * (std::norm(rs) + std::norm(rp));
 }
 
 struct Worst {

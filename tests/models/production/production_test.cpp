@@ -9,6 +9,7 @@
 #include "models/production/production_coat.h"
 #include "models/registry.h"
 #include "models/test_stacks.h"
+#include "support/closed_forms.h"
 
 #include <gtest/gtest.h>
 
@@ -20,27 +21,12 @@ namespace lamina {
 namespace {
 
 using test::coated;
-
+using test::conductor_ref;
 using test::dir;
+using test::fresnel_ref;
 
 // --- The sources' equations, restated ------------------------------------------------------
 
-/// Exact dielectric Fresnel (Born & Wolf §1.5.2), light from the ambient side.
-double fresnel_ref(double c, double eta) {
-    const double s2 = (1 - c * c) / (eta * eta);
-    if (s2 >= 1) return 1;
-    const double ct = std::sqrt(1 - s2);
-    const double rs = (c - eta * ct) / (c + eta * ct), rp = (eta * c - ct) / (eta * c + ct);
-    return 0.5 * (rs * rs + rp * rp);
-}
-/// Exact conductor Fresnel with std::complex (Born & Wolf §14.2).
-double conductor_ref(double c, double eta, double k) {
-    using C = std::complex<double>;
-    const C n(eta, k);
-    const C ct = std::sqrt(C(1) - (1 - c * c) / (n * n));
-    const C rs = (C(c) - n * ct) / (C(c) + n * ct), rp = (n * c - ct) / (n * c + ct);
-    return 0.5 * (std::norm(rs) + std::norm(rp));
-}
 double schlick_ref(double c, double f0) {
     return f0 + (1 - f0) * std::pow(1 - c, 5);
 }

@@ -6,6 +6,7 @@
 #include "core/math.h"
 #include "core/vec.h"
 #include "models/numerics/quadrature.h"
+#include "support/closed_forms.h"
 
 #include <gtest/gtest.h>
 
@@ -14,17 +15,10 @@
 namespace lamina {
 namespace {
 
-using Grid = OpenPbrBsdfEnergyGrid;
+using test::conductor_ref;
+using test::fresnel_ref;
 
-/// Exact dielectric Fresnel (Born & Wolf §1.5.2), restated.
-double fresnel_ref(double c, double eta) {
-    if (eta == 1) return 0;
-    const double s2 = (1 - c * c) / (eta * eta);
-    if (s2 >= 1) return 1;
-    const double ct = std::sqrt(1 - s2);
-    const double rs = (c - eta * ct) / (c + eta * ct), rp = (eta * c - ct) / (eta * c + ct);
-    return 0.5 * (rs * rs + rp * rp);
-}
+using Grid = OpenPbrBsdfEnergyGrid;
 
 /// E by the outgoing solid angle: ∫ F(wi·h) D(h) G1(wi) G1(wo) / (4 μi) dωo with D and G1 in the
 /// forms of Walter et al. 2007 (Eq. 33) and Heitz 2014 (Eq. 72, 43); Gauss–Legendre in μo
