@@ -61,6 +61,29 @@ double component_error(const std::vector<float>& a, const LaneVec3<float>& b, st
                      std::abs(double(a[3 * j + 2]) - b.z)});
 }
 
+// The tolerance of a float visible normal sampled from w with u1, u2 (1e-6 on a smooth
+// interface): in double, wh (w on its side in the hemisphere configuration), the cap point c and
+// the halfway vector h = c + wh, whose normalization divides the float rounding by |h| (the cap
+// point near −wh: u2 → 1 with a tiny α): (4e-6 + 2^-23/sin θ_cap)/|h|, with |h| in `h` (1 on a
+// smooth interface).
+double visible_normal_tolerance(float alpha, const LaneVec3<float>& w, float u1, float u2,
+                                double& h) {
+    h = 1;
+    if (alpha == 0) return 1e-6;
+    const float sign = w.z < 0 ? -1.f : 1.f;
+    const double vx = double(alpha) * sign * w.x, vy = double(alpha) * sign * w.y,
+                 vz = double(sign) * w.z;
+    const double len = std::sqrt(vx * vx + vy * vy + vz * vz);
+    const double whx = vx / len, why = vy / len, whz = vz / len;
+    const double z_cap = (1 - double(u2)) * (1 + whz) - whz;
+    const double sin_cap = std::sqrt(std::max(1 - z_cap * z_cap, 1e-12));
+    const double phi = 2 * kPi<double> * double(u1);
+    const double hx = sin_cap * std::cos(phi) + whx, hy = sin_cap * std::sin(phi) + why,
+                 hz = z_cap + whz;
+    h = std::sqrt(hx * hx + hy * hy + hz * hz);
+    return (4e-6 + 0x1p-23 / sin_cap) / h;
+}
+
 // The dielectric event, smooth and rough (α from 10^-3 to 1), η above and below 1 and η = 1, both
 // refraction maskings and the uncorrelated option. Degeneracy (grazing wi) is decided alike on
 // both, exactly. Directions: the visible normal agrees within 4e-6 + 2^-23/sin θc (the GGX lane
@@ -124,21 +147,12 @@ TEST(KernelSimdLanes, DielectricEvent) {
                 // In double: wh (w on its side in the hemisphere configuration), the cap point
                 // c and the halfway vector h = c + wh, whose normalization divides the float
                 // rounding by |h| (the cap point near −wh: u2 → 1 with a tiny α).
-                const double vx = double(cs.alpha) * sign * w.x, vy = double(cs.alpha) * sign * w.y,
-                             vz = double(sign) * w.z;
-                const double len = std::sqrt(vx * vx + vy * vy + vz * vz);
-                const double whx = vx / len, why = vy / len, whz = vz / len;
-                const double z_cap = (1 - double(u[2 * n + j])) * (1 + whz) - whz;
-                const double sin_cap = std::sqrt(std::max(1 - z_cap * z_cap, 1e-12));
-                const double phi = 2 * kPi<double> * double(u[n + j]);
-                const double hx = sin_cap * std::cos(phi) + whx, hy = sin_cap * std::sin(phi) + why,
-                             hz = z_cap + whz;
-                const double h = std::sqrt(hx * hx + hy * hy + hz * hz);
+                double h;
+                tolerance = visible_normal_tolerance(cs.alpha, w, u[n + j], u[2 * n + j], h);
                 if (h < 0.05) {
                     ++ill_conditioned;
                     continue;
                 }
-                tolerance = (4e-6 + 0x1p-23 / sin_cap) / h;
             }
             const double cos_i_m = double(w.x) * wm.x + double(w.y) * wm.y + double(w.z) * wm.z;
             const double eta_crossed = cos_i_m < 0 ? 1 / double(cs.eta) : double(cs.eta);
@@ -217,16 +231,7 @@ TEST(KernelSimdLanes, ConductorEvent) {
             }
             double tolerance = 1e-6, h = 1;
             if (cs.alpha > 0) {
-                const double vx = double(cs.alpha) * w.x, vy = double(cs.alpha) * w.y, vz = w.z;
-                const double len = std::sqrt(vx * vx + vy * vy + vz * vz);
-                const double whx = vx / len, why = vy / len, whz = vz / len;
-                const double z_cap = (1 - double(u[2 * n + j])) * (1 + whz) - whz;
-                const double sin_cap = std::sqrt(std::max(1 - z_cap * z_cap, 1e-12));
-                const double phi = 2 * kPi<double> * double(u[n + j]);
-                const double hx = sin_cap * std::cos(phi) + whx, hy = sin_cap * std::sin(phi) + why,
-                             hz = z_cap + whz;
-                h = std::sqrt(hx * hx + hy * hy + hz * hz);
-                tolerance = (4e-6 + 0x1p-23 / sin_cap) / h;
+                tolerance = visible_normal_tolerance(cs.alpha, w, u[n + j], u[2 * n + j], h);
             }
             if (h < 0.05) {
                 ++ill_conditioned;
@@ -273,22 +278,6 @@ TEST(KernelSimdLanes, ConductorEvent) {
 // the branch's intensity factor a + b q (the normalization; the lanes where it is below 1e-3
 // carry less than 1e-3 of the flux and are counted, not compared). The flux factors: relative
 // 1e-5 plus the same normal term.
-double polarized_tolerance(float alpha, const LaneVec3<float>& w, float u1, float u2, double& h) {
-    h = 1;
-    if (alpha == 0) return 1e-6;
-    const float sign = w.z < 0 ? -1.f : 1.f;
-    const double vx = double(alpha) * sign * w.x, vy = double(alpha) * sign * w.y,
-                 vz = double(sign) * w.z;
-    const double len = std::sqrt(vx * vx + vy * vy + vz * vz);
-    const double whx = vx / len, why = vy / len, whz = vz / len;
-    const double z_cap = (1 - double(u2)) * (1 + whz) - whz;
-    const double sin_cap = std::sqrt(std::max(1 - z_cap * z_cap, 1e-12));
-    const double phi = 2 * kPi<double> * double(u1);
-    const double hx = sin_cap * std::cos(phi) + whx, hy = sin_cap * std::sin(phi) + why,
-                 hz = z_cap + whz;
-    h = std::sqrt(hx * hx + hy * hy + hz * hz);
-    return (4e-6 + 0x1p-23 / sin_cap) / h;
-}
 
 // The state turned into the frame a × wo (double; physics/polarization.h stokes_rotate_frame).
 StokesLanes<double> in_common_frame(const float* x, const float* stokes, const LaneVec3<double>& wo,
@@ -395,7 +384,7 @@ TEST(KernelSimdLanes, PolarizedEvents) {
                 }
                 double h;
                 const double tolerance =
-                    polarized_tolerance(cs.alpha, w, u[n + j], u[2 * n + j], h);
+                    visible_normal_tolerance(cs.alpha, w, u[n + j], u[2 * n + j], h);
                 if (h < 0.05) {
                     ++ill_conditioned;
                     continue;
