@@ -16,23 +16,6 @@ namespace {
 
 using test::coated;
 
-std::vector<std::pair<std::string, Stack>> sweep() {
-    std::vector<std::pair<std::string, Stack>> out;
-    const std::vector<std::pair<std::string, InterfaceSpec>> bases = {
-        {"white lambertian", test::lambertian(Rgbd(1.0))},
-        {"gold a=0.05", test::gold(0.05)},
-        {"gold a=0.4", test::gold(0.4)},
-        {"smooth mirror-ish", test::conductor(Rgbd(0.05), Rgbd(8.0), 0.0)},
-        {"dielectric 1.33 a=0.2", test::dielectric(1.33, 0.2)},
-    };
-    for (const auto& [bname, base] : bases)
-        for (double eta : {1.2, 1.5, 2.0})
-            for (double alpha : {0.0, 0.1, 0.5})
-                out.push_back({fmt::format("eta0={} a0={} base {}", eta, alpha, bname),
-                               coated(eta, alpha, base)});
-    return out;
-}
-
 TEST(ModelsEnergy, AlbedoAtMostOne) {
     BinnedOptions o;
     o.rel_tol = 1e-3;
@@ -56,7 +39,7 @@ TEST(ModelsEnergy, AlbedoAtMostOne) {
         const double tol = entry.name == "bel18-symmetric" ? 2e-2
                            : table_energies                ? 1e-3 + 6.3e-3
                                                            : 1e-3;
-        for (const auto& [what, stack] : sweep()) {
+        for (const auto& [what, stack] : test::energy_sweep(true)) {
             const auto model = entry.make(stack, resolve_options(entry, {}));
             if (!model->support().brdf) continue;
             for (double ti : {0.0, 45.0, 80.0}) {

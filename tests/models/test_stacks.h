@@ -6,6 +6,12 @@
 #include "core/spherical.h"
 #include "layers/stack.h"
 
+#include <fmt/format.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
 namespace lamina::test {
 
 /// The upper-hemisphere direction at polar angle theta_deg and azimuth phi_deg (degrees).
@@ -45,6 +51,26 @@ inline Stack single(const InterfaceSpec& interface) {
     s.name = "single";
     s.layers = {layer_of(interface)};
     return s;
+}
+
+/// The coats the energy tests sweep: indices 1.2, 1.5, 2 and roughness 0, 0.1, 0.5 over a white
+/// Lambertian, gold at α 0.05 and 0.4, a smooth near-mirror conductor and, with
+/// `dielectric_base`, a rough dielectric of index 1.33 (a transmitting stack).
+inline std::vector<std::pair<std::string, Stack>> energy_sweep(bool dielectric_base) {
+    std::vector<std::pair<std::string, InterfaceSpec>> bases = {
+        {"white lambertian", lambertian(Rgbd(1.0))},
+        {"gold a=0.05", gold(0.05)},
+        {"gold a=0.4", gold(0.4)},
+        {"smooth mirror-ish", conductor(Rgbd(0.05), Rgbd(8.0), 0.0)},
+    };
+    if (dielectric_base) bases.push_back({"dielectric 1.33 a=0.2", dielectric(1.33, 0.2)});
+    std::vector<std::pair<std::string, Stack>> out;
+    for (const auto& [bname, base] : bases)
+        for (double eta : {1.2, 1.5, 2.0})
+            for (double alpha : {0.0, 0.1, 0.5})
+                out.push_back({fmt::format("eta0={} a0={} base {}", eta, alpha, bname),
+                               coated(eta, alpha, base)});
+    return out;
 }
 
 }  // namespace lamina::test

@@ -142,6 +142,28 @@ struct Expected {
     std::vector<double> count, variance;
 };
 
+// The expected counts and their variances, n·m and n²·v, from each cell's probability mass m
+// (and its estimate's variance v) as `mass(row, column, cosθ0, cosθ1, φ0, φ1)` gives it, cells in
+// parallel.
+template <typename Mass>
+Expected expected_by_cell(const Chi2Options& o, const Mass& mass) {
+    const int rows = o.cos_theta_bins, cols = o.phi_bins;
+    const double dc = (o.cos_theta_max - o.cos_theta_min) / rows, dp = 2 * kPi<double> / cols;
+    const double n = double(o.sample_count);
+    Expected e{std::vector<double>(std::size_t(rows) * cols, 0.0),
+               std::vector<double>(std::size_t(rows) * cols, 0.0)};
+#pragma omp parallel for schedule(dynamic)
+    for (int r = 0; r < rows; ++r) {
+        for (int c = 0; c < cols; ++c) {
+            const double c0 = o.cos_theta_min + r * dc;
+            const Chi2CellMass m = mass(r, c, c0, c0 + dc, c * dp, (c + 1) * dp);
+            e.count[std::size_t(r) * cols + c] = n * m.mass;
+            e.variance[std::size_t(r) * cols + c] = n * n * m.variance;
+        }
+    }
+    return e;
+}
+
 Chi2Result run_chi2_impl(const Chi2Options& o, const Chi2SampleFn& sample,
                          const std::function<Expected()>& expected_counts) {
     Chi2Result result;
@@ -268,42 +290,15 @@ Chi2Result run_chi2_impl(const Chi2Options& o, const Chi2SampleFn& sample,
 
 Chi2Result run_chi2(const Chi2Options& o, const Chi2SampleFn& sample, const Chi2PdfFn& pdf) {
     return run_chi2_impl(o, sample, [&] {
-        const int rows = o.cos_theta_bins, cols = o.phi_bins;
-        const double dc = (o.cos_theta_max - o.cos_theta_min) / rows, dp = 2 * kPi<double> / cols;
-        Expected e{std::vector<double>(std::size_t(rows) * cols, 0.0),
-                   std::vector<double>(std::size_t(rows) * cols, 0.0)};
-#pragma omp parallel for schedule(dynamic)
-        for (int r = 0; r < rows; ++r) {
-            for (int c = 0; c < cols; ++c) {
-                const double c0 = o.cos_theta_min + r * dc;
-                e.count[std::size_t(r) * cols + c] =
-                    double(o.sample_count) *
-                    integrate_cell(pdf, c0, c0 + dc, c * dp, (c + 1) * dp, o.cell_tolerance);
-            }
-        }
-        return e;
+        return expected_by_cell(o, [&](int, int, double c0, double c1, double p0, double p1) {
+            return Chi2CellMass{integrate_cell(pdf, c0, c1, p0, p1, o.cell_tolerance), 0.0};
+        });
     });
 }
 
 Chi2Result run_chi2_estimated(const Chi2Options& o, const Chi2SampleFn& sample,
                               const Chi2CellMassFn& cell_mass) {
-    return run_chi2_impl(o, sample, [&] {
-        const int rows = o.cos_theta_bins, cols = o.phi_bins;
-        const double dc = (o.cos_theta_max - o.cos_theta_min) / rows, dp = 2 * kPi<double> / cols;
-        const double n = double(o.sample_count);
-        Expected e{std::vector<double>(std::size_t(rows) * cols, 0.0),
-                   std::vector<double>(std::size_t(rows) * cols, 0.0)};
-#pragma omp parallel for schedule(dynamic)
-        for (int r = 0; r < rows; ++r) {
-            for (int c = 0; c < cols; ++c) {
-                const double c0 = o.cos_theta_min + r * dc;
-                const Chi2CellMass m = cell_mass(r, c, c0, c0 + dc, c * dp, (c + 1) * dp);
-                e.count[std::size_t(r) * cols + c] = n * m.mass;
-                e.variance[std::size_t(r) * cols + c] = n * n * m.variance;
-            }
-        }
-        return e;
-    });
+    return run_chi2_impl(o, sample, [&] { return expected_by_cell(o, cell_mass); });
 }
 
 }  // namespace lamina::test

@@ -441,22 +441,6 @@ TEST(ProductionCoats, BaseRougheningRules) {
 
 // --- Energy -----------------------------------------------------------------------------------
 
-std::vector<std::pair<std::string, Stack>> sweep() {
-    std::vector<std::pair<std::string, Stack>> out;
-    const std::vector<std::pair<std::string, InterfaceSpec>> bases = {
-        {"white lambertian", test::lambertian(Rgbd(1.0))},
-        {"gold a=0.05", test::gold(0.05)},
-        {"gold a=0.4", test::gold(0.4)},
-        {"smooth mirror-ish", test::conductor(Rgbd(0.05), Rgbd(8.0), 0.0)},
-    };
-    for (const auto& [bname, base] : bases)
-        for (double eta : {1.2, 1.5, 2.0})
-            for (double alpha : {0.0, 0.1, 0.5})
-                out.push_back({fmt::format("eta0={} a0={} base {}", eta, alpha, bname),
-                               coated(eta, alpha, base)});
-    return out;
-}
-
 /// The model with its arguments swapped: its albedo is the original's ∫ f(wi, wo) μi dωi at wo.
 class Transposed final : public Model {
   public:
@@ -476,7 +460,7 @@ double max_albedo(const ModelEntry& e, bool transposed, const std::vector<std::s
     BinnedOptions o;
     o.rel_tol = 1e-3;
     double worst = 0;
-    for (const auto& [what, stack] : sweep()) {
+    for (const auto& [what, stack] : test::energy_sweep(false)) {
         if (lambertian_only && what.find("lambertian") == std::string::npos) continue;
         std::unique_ptr<Model> m = e.make(stack, resolve_options(e, opts));
         if (!m->support().brdf) continue;
