@@ -87,6 +87,30 @@ TEST(TmGolden, ClearCoatOverBlackBaseIsTheTopReflection) {
             }
 }
 
+// The hand adding's factors for a rough coat (η, α0) over a rough conductor `base` at incidence
+// wi, as the released tm2 defines them (docs/models.md): the coat's r = FGD(μi, α0, η) and
+// t = 1 − r, the base's r_b per channel at the refracted cosine μt, and the asymmetries g_r =
+// g(α0), g_b = g(α1), g_t = g(½ s↓ α0) and the upward g′ from the first-order chain g(½ s↑
+// α0)·g′(g_t g_b, η)/(g_t g_b), s↓ = |μi/(η μt) − 1|, s↑ = |1 − η μt/μi|.
+struct HandAdding {
+    double mt, r, t, gr, gb, gt, gtp;
+    Rgbd rb;
+    HandAdding(double eta, double a0, const InterfaceSpec& base, const Vec3d& wi) {
+        const FgdTable& fgd = FgdTable::get();
+        const double mi = wi.z;
+        mt = std::sqrt(1 - (1 - mi * mi) / (eta * eta));
+        r = fgd(mi, a0, eta, 0);
+        t = 1 - r;
+        for (int c = 0; c < 3; ++c)
+            rb[c] = fgd(mt, base.alpha, base.eta_rgb[c] / eta, base.k[c] / eta);
+        gr = g_of_alpha(a0);
+        gb = g_of_alpha(base.alpha);
+        gt = g_of_alpha(0.5 * std::abs(mi / (eta * mt) - 1) * a0);
+        gtp = g_refracted(gt * gb, eta) * g_of_alpha(0.5 * std::abs(1 - eta * mt / mi) * a0) /
+              (gt * gb);
+    }
+};
+
 // The scheme at a few points, by hand: one rough coat (η, α0) over gold (α1), TIR off. Ray sums
 // (the adding of a two-interface stack) give the total reflectance R = r + t t′ r_b/(1 − r′ r_b)
 // and, for the g-weighted factors, R_g = r_g + t_g t′_g r_bg/(1 − r′_g r_bg); lobe 1 is R − r
@@ -98,22 +122,16 @@ TEST(TmGolden, CoatOverGoldMatchesTheHandAdding) {
     const double eta = 1.5, a0 = 0.2, a1 = 0.3;
     const InterfaceSpec gold = test::gold(a1);
     const auto model = make_model("tm2", coated(eta, a0, gold), {"tir=off"});
-    const FgdTable& fgd = FgdTable::get();
     const DielectricInterface<double> top{eta, a0};
     for (double ti : {10.0, 50.0, 75.0}) {
         const Vec3d wi = dir(ti, 0);
-        const double mi = wi.z, mt = std::sqrt(1 - (1 - mi * mi) / (eta * eta));
-        const double r = fgd(mi, a0, eta, 0), t = 1 - r;
-        Rgbd rb;
-        for (int c = 0; c < 3; ++c)
-            rb[c] = fgd(mt, a1, gold.eta_rgb[c] / eta, gold.k[c] / eta);
+        const HandAdding hand(eta, a0, gold, wi);
+        const double r = hand.r, t = hand.t;
+        const Rgbd rb = hand.rb;
         Rgbd e1;
         for (int c = 0; c < 3; ++c)
             e1[c] = t * t * rb[c] / (1 - r * rb[c]);
-        const double gr = g_of_alpha(a0), gb = g_of_alpha(a1);
-        const double gt = g_of_alpha(0.5 * std::abs(mi / (eta * mt) - 1) * a0);
-        const double gtp_own = g_of_alpha(0.5 * std::abs(1 - eta * mt / mi) * a0);
-        const double gtp = g_refracted(gt * gb, eta) * gtp_own / (gt * gb);
+        const double gr = hand.gr, gb = hand.gb, gt = hand.gt, gtp = hand.gtp;
         const double rg = gr * r, tg = gt * t, tpg = gtp * t, rpg = gr * r, rbg = gb * rb.mean();
         const double Rg = rg + tg * tpg * rbg / (1 - rpg * rbg);
         const double g1 = std::min((Rg - rg) / e1.mean(), 1.0);
@@ -143,19 +161,13 @@ TEST(TmGolden, CoatOverGoldTirStepByHand) {
     const InterfaceSpec gold = test::gold(a1);
     const auto model = make_model("tm2", coated(eta, a0, gold));
     const auto microfacet = make_model("tm2", coated(eta, a0, gold), {"tir-table=microfacet"});
-    const FgdTable& fgd = FgdTable::get();
     const DielectricInterface<double> top{eta, a0};
     for (double ti : {10.0, 50.0, 75.0}) {
         const Vec3d wi = dir(ti, 0);
-        const double mi = wi.z, mt = std::sqrt(1 - (1 - mi * mi) / (eta * eta));
-        const double r = fgd(mi, a0, eta, 0), t = 1 - r;
-        Rgbd rb;
-        for (int c = 0; c < 3; ++c)
-            rb[c] = fgd(mt, a1, gold.eta_rgb[c] / eta, gold.k[c] / eta);
-        const double gr = g_of_alpha(a0), gb = g_of_alpha(a1);
-        const double gt = g_of_alpha(0.5 * std::abs(mi / (eta * mt) - 1) * a0);
-        const double gtp_own = g_of_alpha(0.5 * std::abs(1 - eta * mt / mi) * a0);
-        const double gtp = g_refracted(gt * gb, eta) * gtp_own / (gt * gb);
+        const HandAdding hand(eta, a0, gold, wi);
+        const double mt = hand.mt, r = hand.r, t = hand.t;
+        const Rgbd rb = hand.rb;
+        const double gr = hand.gr, gb = hand.gb, gt = hand.gt, gtp = hand.gtp;
         const double tau = tir_fraction(TirDefinition::Lobe, mt, alpha_of_g(gt * gb), 1 / eta);
         const double rp = r + (1 - tau) * t, tp = tau * t;
         Rgbd e1;
@@ -191,18 +203,13 @@ TEST(TmGolden, PerChannelAsymmetryMatchesTheHandAdding) {
     const InterfaceSpec gold = test::gold(a1);
     const auto model =
         make_model("tm2", coated(eta, a0, gold), {"tir=off", "asymmetry=per-channel"});
-    const FgdTable& fgd = FgdTable::get();
     const DielectricInterface<double> top{eta, a0};
     const Vec3d wi = dir(50, 0), wo = dir(40, 170);
-    const double mi = wi.z, mt = std::sqrt(1 - (1 - mi * mi) / (eta * eta));
-    const double r = fgd(mi, a0, eta, 0), t = 1 - r;
-    const double gr = g_of_alpha(a0), gb = g_of_alpha(a1);
-    const double gt = g_of_alpha(0.5 * std::abs(mi / (eta * mt) - 1) * a0);
-    const double gtp =
-        g_refracted(gt * gb, eta) * g_of_alpha(0.5 * std::abs(1 - eta * mt / mi) * a0) / (gt * gb);
+    const HandAdding hand(eta, a0, gold, wi);
+    const double r = hand.r, t = hand.t, gr = hand.gr, gb = hand.gb, gt = hand.gt, gtp = hand.gtp;
     const Vec3d h = normalize(wi + wo);
     for (int c = 0; c < 3; ++c) {
-        const double rb = fgd(mt, a1, gold.eta_rgb[c] / eta, gold.k[c] / eta);
+        const double rb = hand.rb[c];
         const double e1 = t * t * rb / (1 - r * rb);
         const double Rg = gr * r + gt * t * gtp * t * gb * rb / (1 - gr * r * gb * rb);
         const GGX<double> lobe{alpha_of_g(std::min((Rg - gr * r) / e1, 1.0))};
