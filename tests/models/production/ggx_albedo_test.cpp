@@ -7,6 +7,7 @@
 
 #include "core/math.h"
 #include "models/numerics/quadrature.h"
+#include "models/production/solid_angle_albedo.h"
 #include "support/closed_forms.h"
 
 #include <gtest/gtest.h>
@@ -26,27 +27,13 @@ using test::fresnel_ref;
 /// Gauss–Legendre in μo (n_mu) × midpoint in φo over [0, π], doubled.
 double by_solid_angle(double mu, double alpha, double eta, bool white, int n_mu = 400,
                       int n_phi = 400) {
-    const double a2 = alpha * alpha;
-    auto lambda = [&](double z) { return (-1 + std::sqrt(1 + a2 * (1 - z * z) / (z * z))) / 2; };
     const double f0 = sqr((eta - 1) / (eta + 1));
-    const double s_i = std::sqrt(1 - mu * mu);
-    const QuadratureRule q = gauss_legendre(n_mu);
-    double sum = 0;
-    for (std::size_t i = 0; i < q.x.size(); ++i) {
-        const double mu_o = q.x[i], s_o = std::sqrt(1 - mu_o * mu_o);
-        for (int j = 0; j < n_phi; ++j) {
-            const double phi = kPi<double> * (j + 0.5) / n_phi;
-            const double hx = s_i + s_o * std::cos(phi), hy = s_o * std::sin(phi), hz = mu + mu_o;
-            const double len = std::sqrt(hx * hx + hy * hy + hz * hz);
-            const double cz = hz / len, c_ih = (s_i * hx + mu * hz) / len;
-            const double D = a2 / (kPi<double> * sqr(cz * cz * (a2 - 1) + 1));
-            const double value =
-                white ? D / (1 + lambda(mu) + lambda(mu_o)) / (4 * mu)
-                      : (fresnel_ref(c_ih, eta) - f0) / (1 - f0) * D / (1 + lambda(mu)) / (4 * mu);
-            sum += q.w[i] * (kPi<double> / n_phi) * 2 * value;
-        }
-    }
-    return sum;
+    return test::reflected_hemisphere_integral(
+        mu, alpha, n_mu, n_phi, [&](const test::ReflectedPair& p) {
+            return white ? p.D / (1 + p.lambda_i + p.lambda_o) / (4 * mu)
+                         : (fresnel_ref(p.cos_i_h, eta) - f0) / (1 - f0) * p.D / (1 + p.lambda_i) /
+                               (4 * mu);
+        });
 }
 
 // The visible-normal integrals against the solid-angle ones at moderate roughness (where a

@@ -6,6 +6,7 @@
 #include "core/math.h"
 #include "core/vec.h"
 #include "models/numerics/quadrature.h"
+#include "models/production/solid_angle_albedo.h"
 #include "support/closed_forms.h"
 
 #include <gtest/gtest.h>
@@ -25,26 +26,11 @@ using Grid = OpenPbrBsdfEnergyGrid;
 /// (n_mu) × midpoint in φo (n_phi, over [0, π], doubled: the integrand is even in φo).
 double albedo_by_solid_angle(double mu, double alpha, double eta, bool white, int n_mu = 400,
                              int n_phi = 400) {
-    const double a2 = alpha * alpha;
-    auto lambda = [&](double z) { return (-1 + std::sqrt(1 + a2 * (1 - z * z) / (z * z))) / 2; };
-    const double s_i = std::sqrt(1 - mu * mu);
-    const double g1_i = 1 / (1 + lambda(mu));
-    const QuadratureRule q = gauss_legendre(n_mu);
-    double sum = 0;
-    for (std::size_t i = 0; i < q.x.size(); ++i) {
-        const double mu_o = q.x[i], s_o = std::sqrt(1 - mu_o * mu_o);
-        const double g1_o = 1 / (1 + lambda(mu_o));
-        for (int j = 0; j < n_phi; ++j) {
-            const double phi = kPi<double> * (j + 0.5) / n_phi;
-            const double hx = s_i + s_o * std::cos(phi), hy = s_o * std::sin(phi), hz = mu + mu_o;
-            const double len = std::sqrt(hx * hx + hy * hy + hz * hz);
-            const double cz = hz / len, c_ih = (s_i * hx + mu * hz) / len;
-            const double D = a2 / (kPi<double> * sqr(cz * cz * (a2 - 1) + 1));
-            const double F = white ? 1 : fresnel_ref(c_ih, eta);
-            sum += q.w[i] * (kPi<double> / n_phi) * 2 * F * D * g1_i * g1_o / (4 * mu);
-        }
-    }
-    return sum;
+    return test::reflected_hemisphere_integral(
+        mu, alpha, n_mu, n_phi, [&](const test::ReflectedPair& p) {
+            const double F = white ? 1 : fresnel_ref(p.cos_i_h, eta);
+            return F * p.D / ((1 + p.lambda_i) * (1 + p.lambda_o)) / (4 * mu);
+        });
 }
 
 // The visible-normal integral against the solid-angle one, at moderate roughness (where a
