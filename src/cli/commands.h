@@ -1,6 +1,6 @@
 #pragma once
 // Each subcommand lives in its own cmd_*.cpp and registers itself through one function listed in
-// main.cpp. A command's run function returns the process exit code; InputError escaping it is
+// run.cpp. A command's run function returns the process exit code; InputError escaping it is
 // printed as "lamina: <file>: <field>: <problem>" with exit code 1.
 
 #include <CLI/CLI.hpp>
@@ -10,6 +10,11 @@
 namespace lamina::cli {
 
 using Runner = std::function<int()>;
+
+/// The whole command line: parses argv (argv[0] names the program in --help), runs the subcommand
+/// and returns the exit code (0, or 1 with one "lamina: ..." line on stderr). The executable's
+/// main() and `python3 -m lamina` (the Python module's `cli`) call it.
+int run(int argc, char** argv);
 
 /// Adds the subcommand to `app` and returns what runs it once parsed.
 Runner add_validate(CLI::App& app);

@@ -8,6 +8,7 @@
 // Long computations release the GIL; simulate() checks for Ctrl-C between chunks of particles and
 // raises KeyboardInterrupt, and its result is bitwise the CLI's (chunks start at block boundaries,
 // whose integer sums add up exactly: simulator/goniophotometer.h).
+#include "cli/commands.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/incidences.h"
@@ -40,6 +41,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -791,6 +793,31 @@ void bind_models(py::module_& m) {
         });
 }
 
+// `python3 -m lamina ARGS`: the command-line interface in this process (cli/run.cpp), argv[0] the
+// name --help shows. The GIL is released while it runs; C's stdout is flushed before Python
+// writes again.
+void bind_cli(py::module_& m) {
+    m.def(
+        "cli",
+        [](const std::vector<std::string>& args) {
+            std::vector<std::string> owned = args;
+            std::vector<char*> argv;
+            for (std::string& a : owned)
+                argv.push_back(a.data());
+            argv.push_back(nullptr);
+            int code;
+            {
+                py::gil_scoped_release release;
+                code = cli::run(int(owned.size()), argv.data());
+                std::fflush(stdout);
+                std::fflush(stderr);
+            }
+            return code;
+        },
+        py::arg("argv"),
+        "Runs lamina's command line (argv[0] the program's name) and returns its exit code.");
+}
+
 }  // namespace
 }  // namespace lamina
 
@@ -805,4 +832,5 @@ PYBIND11_MODULE(_lamina, m) {
     bind_export(m);
     bind_study(m);
     bind_models(m);
+    bind_cli(m);
 }

@@ -29,4 +29,7 @@ print("ok")
 PY
 )
 if [ "$out" = ok ]; then ok; else fail "import lamina from the venv: $out"; fi
+# `python3 -m lamina` is the command line, from the installed package.
+out=$(env -u PYTHONPATH "$tmp/venv/bin/python" -m lamina validate "$root/examples/plastic.json" 2>&1)
+case "$out" in plastic:*) ok ;; *) fail "python -m lamina validate: $out" ;; esac
 finish

@@ -432,3 +432,24 @@ def test_random_walk_microsurface_option():
     assert f2[0] - f1[0] > 4 * np.hypot(s1[0], s2[0]), (f1, f2)
     with pytest.raises(lamina.InputError):
         lamina.Model("random-walk", gold, microsurface="many")
+
+
+def run_module(*args):
+    """`python3 -m lamina ARGS` in a child interpreter that imports the package under test."""
+    return subprocess.run([sys.executable, "-m", "lamina", *map(str, args)], capture_output=True,
+                          text=True, env=dict(os.environ))
+
+
+def test_python_m_lamina_runs_the_cli():
+    """`python3 -m lamina` is the command line: the same output and exit codes as the executable."""
+    version = run_module("--version")
+    assert version.returncode == 0 and version.stdout == cli("--version").stdout
+    validate = run_module("validate", PLASTIC)
+    assert validate.returncode == 0 and validate.stdout == cli("validate", PLASTIC).stdout
+    models = run_module("models")
+    assert models.returncode == 0 and models.stdout == cli("models").stdout
+    bad = run_module("simulate", ROOT / "no-such-stack.json", "--out", "unused")
+    assert bad.returncode == 1 and bad.stderr.startswith("lamina: "), bad.stderr
+    assert bad.stderr == cli("simulate", ROOT / "no-such-stack.json", "--out", "unused",
+                             check=False).stderr
+    assert "python3 -m lamina" in run_module("--help").stdout
