@@ -9,6 +9,7 @@
 #include "layers/compiled_stack.h"
 #include "physics/medium.h"
 #include "physics/microsurface_walk.h"
+#include "physics/thin_film_event.h"
 #include "simulator/kernel_simd.h"
 #include "simulator/tally.h"
 
@@ -90,6 +91,102 @@ struct MediumWalk {
     }
 };
 
+// ---- A filmed interface (docs/physics.md §9)
+// ----------------------------------------------------- The film's Mueller matrices
+// (physics/thin_film_event.h) at every facet: a dielectric's single facet or walk through the
+// film's branch choice, a conductor's through conductor_event and the conductor walk with the
+// film's reflection in place of the bare Fresnel terms. A thickness that varies over the surface is
+// drawn first, from the particle's own stream, once per event (a particle's lateral position never
+// matters, docs/physics.md §2). The factors (the film's absorption, the reweighting of the
+// channels) are booked as absorbed at the interface
+// (`apply(sample, true)`), G2/G1 as lost to the microsurface.
+template <bool kPolarized, typename Apply, typename ApplyWalk>
+inline void film_event(const CompiledStack<float>& stack, const CompiledLayer<float>& layer,
+                       ParticleRng& rng, const Vec3f& wi, const Rgbf& w,
+                       [[maybe_unused]] PolarizationLanes<float>& pol, Apply& apply,
+                       ApplyWalk& apply_walk) {
+    const FilmOptics& film = layer.film;
+    const double thickness =
+        film.varies() ? film.thickness_nm(double(rng.uniform_float())) : film.thickness_min_nm;
+    const float flux[3] = {w[0], w[1], w[2]};
+    PolarizationLanes<float>* p = nullptr;
+    if constexpr (kPolarized) p = &pol;
+    auto uniform = [&] { return rng.uniform_float(); };
+    const LaneVec3<float> wl = {wi.x, wi.y, wi.z};
+    if (layer.type == InterfaceType::Dielectric) {
+        const DielectricInterface<float>& di = layer.dielectric;
+        if (layer.multiple) {
+            const MicrosurfaceFilmFacet<decltype(uniform)> facet{film,    di.eta, thickness,
+                                                                 uniform, flux,   p};
+            apply_walk(microsurface_exit(microsurface_walk<float, Lane<float>>(
+                           di.alpha, wl, true, true, facet, uniform, stack.max_microsurface_order)),
+                       true);
+            return;
+        }
+        const float uc = rng.uniform_float(), u1 = rng.uniform_float(), u2 = rng.uniform_float();
+        const FilmEvent e =
+            film_dielectric_event(film, di.eta, di.alpha, di.uncorrelated_shadowing,
+                                  di.transmission_masking == TransmissionMasking::Smith, thickness,
+                                  wl, uc, u1, u2, flux, p);
+        std::optional<BsdfSample<float>> s;
+        if (!e.degenerate) {
+            s.emplace();
+            s->wo = {e.scatter.wo.x, e.scatter.wo.y, e.scatter.wo.z};
+            s->fresnel_weight = {e.scatter.factor[0], e.scatter.factor[1], e.scatter.factor[2]};
+            s->shadowing = e.shadowing;
+        }
+        apply(s, true);
+        return;
+    }
+    // A conductor: the film's reflectance (unpolarized) or reflection Mueller matrices per channel.
+    const ConductorInterface<float>& cond = layer.conductor;
+    const auto reflectance = [&](float cos_theta) {
+        Rgbf r;
+        for (int c = 0; c < 3; ++c)
+            r[c] = float(film.mueller(c, double(cos_theta), true, thickness).reflection.a);
+        return r;
+    };
+    [[maybe_unused]] const auto mueller = [&](float cos_theta, InterfaceMueller<float>* m) {
+        for (int c = 0; c < 3; ++c) {
+            const InterfaceMueller<double> md =
+                film.mueller(c, double(cos_theta), true, thickness).reflection;
+            m[c] = {float(md.a), float(md.b), float(md.c), float(md.d)};
+        }
+    };
+    if (layer.multiple) {
+        if constexpr (kPolarized)
+            apply_walk(walk_rough_conductor_polarized(cond.distribution(), mueller, wi, uniform,
+                                                      stack.max_microsurface_order, pol),
+                       true);
+        else
+            apply_walk(walk_rough_conductor(cond.distribution(), reflectance, wi, uniform,
+                                            stack.max_microsurface_order),
+                       true);
+        return;
+    }
+    const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
+    float factors[3];
+    const auto channel_reflectance = [&](float cos_theta, float* out) {
+        const Rgbf r = reflectance(cos_theta);
+        out[0] = r[0], out[1] = r[1], out[2] = r[2];
+    };
+    InterfaceEventLanes<float, bool> e;
+    if constexpr (kPolarized)
+        e = conductor_event<float>(cond.alpha, cond.is_smooth(), cond.uncorrelated_shadowing, wl,
+                                   u1, u2, true, NoMueller{}, factors, &pol, mueller);
+    else
+        e = conductor_event<float>(cond.alpha, cond.is_smooth(), cond.uncorrelated_shadowing, wl,
+                                   u1, u2, true, channel_reflectance, factors);
+    std::optional<BsdfSample<float>> s;
+    if (!e.degenerate) {
+        s.emplace();
+        s->wo = {e.wo.x, e.wo.y, e.wo.z};
+        s->fresnel_weight = {factors[0], factors[1], factors[2]};
+        s->shadowing = e.shadowing;
+    }
+    apply(s, true);
+}
+
 // ---- One interface event ----------------------------------------------------------------------
 // The event of `layer` on a particle arriving along d with flux w: its BSDF sampler (or, with
 // multiple scattering, its microsurface walk) draws the new direction d, and w keeps what
@@ -144,6 +241,10 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
         d = e->wo;
     };
     auto uniform = [&] { return rng.uniform_float(); };
+    if (layer.has_film) {
+        film_event<kPolarized>(stack, layer, rng, wi_local, w, pol, apply, apply_walk);
+        return;
+    }
     switch (layer.type) {
         case InterfaceType::Dielectric: {
             if (layer.multiple) {
@@ -347,6 +448,11 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
     validate_settings(settings);
     const auto start = std::chrono::steady_clock::now();
     const CompiledStack<float> trace = compile_stack<float>(stack, settings.transport);
+    if (trace.has_film && settings.kernel == Kernel::Simd)
+        throw InputError("command line", "--kernel",
+                         fmt::format("the stack '{}' has a thin film, which the SIMD kernel does "
+                                     "not trace; give --kernel scalar",
+                                     stack.name));
     const HemisphereGrid& grid = settings.grid;
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
     if (settings.kernel == Kernel::Simd) select_simd_target();
