@@ -683,6 +683,20 @@ nlohmann::json stack_to_json(const Stack& stack) {
     return out;
 }
 
+namespace {
+/// " film d=… nm η=…" (and k) of a filmed interface, "" otherwise.
+std::string describe_film(const InterfaceSpec& i) {
+    if (!i.has_film) return "";
+    const FilmSpec& f = i.film;
+    std::string out = f.varies()
+                          ? fmt::format(" film d=[{}, {}] nm", f.thickness_nm, f.thickness_max_nm)
+                          : fmt::format(" film d={} nm", f.thickness_nm);
+    out += fmt::format(" η={}", f.eta);
+    if (f.k > 0) out += fmt::format(" k={}", f.k);
+    return out;
+}
+}  // namespace
+
 std::string describe(const Stack& stack) {
     std::string out = fmt::format("{}: ", stack.name);
     out += stack.ambient_eta == 1.0 ? "air" : fmt::format("ambient η={}", stack.ambient_eta);
@@ -691,25 +705,18 @@ std::string describe(const Stack& stack) {
         const InterfaceSpec& i = layer.interface;
         switch (i.type) {
             case InterfaceType::Dielectric:
-                out += fmt::format(" | dielectric η={} α={}", i.eta, i.alpha);
+                out += fmt::format(" | dielectric η={} α={}", i.eta, i.alpha) + describe_film(i);
                 if (n + 1 == stack.layers.size())
                     out += fmt::format(" (slab: transmits into η={})", i.eta);
                 break;
             case InterfaceType::Conductor:
                 out += fmt::format(" | conductor η={} k={} α={}", show_rgb(i.eta_rgb),
-                                   show_rgb(i.k), i.alpha);
+                                   show_rgb(i.k), i.alpha) +
+                       describe_film(i);
                 break;
             case InterfaceType::Lambertian:
                 out += fmt::format(" | lambertian ρ={}", show_rgb(i.albedo));
                 break;
-        }
-        if (i.has_film) {
-            const FilmSpec& f = i.film;
-            out += f.varies()
-                       ? fmt::format(" film d=[{}, {}] nm", f.thickness_nm, f.thickness_max_nm)
-                       : fmt::format(" film d={} nm", f.thickness_nm);
-            out += fmt::format(" η={}", f.eta);
-            if (f.k > 0) out += fmt::format(" k={}", f.k);
         }
         if (layer.has_medium) {
             const MediumSpec& m = layer.medium;
