@@ -194,7 +194,7 @@ inline void film_event(const CompiledStack<float>& stack, const CompiledLayer<fl
 // Polarized runs: pol goes through the event too (pol.flux: the caller's copy of w). Where the
 // channels' states differ, a dielectric's branch choice reweights the channels: the reweighting
 // (zero in expectation per channel) is booked with the base that coloured them.
-template <bool kPolarized>
+template <bool kPolarized, bool kFilm>
 inline void interface_event(const CompiledStack<float>& stack, const CompiledLayer<float>& layer,
                             ParticleRng& rng, Tally& tally, Vec3f& d, Rgbf& w, PathLosses& losses,
                             [[maybe_unused]] PolarizationLanes<float>& pol) {
@@ -241,9 +241,11 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
         d = e->wo;
     };
     auto uniform = [&] { return rng.uniform_float(); };
-    if (layer.has_film) {
-        film_event<kPolarized>(stack, layer, rng, wi_local, w, pol, apply, apply_walk);
-        return;
+    if constexpr (kFilm) {
+        if (layer.has_film) {
+            film_event<kPolarized>(stack, layer, rng, wi_local, w, pol, apply, apply_walk);
+            return;
+        }
     }
     switch (layer.type) {
         case InterfaceType::Dielectric: {
@@ -312,8 +314,9 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
 // divided by its flux, with the frame's x axis (physics/polarization.h at one lane); every event
 // passes it to the interface's polarized event, a Lambertian base and a scattering event
 // depolarize it, and an exit is tallied with its Stokes vector when the job asks for it.
-// Written once for both: kPolarized = false is the unpolarized kernel, with none of it.
-template <bool kPolarized>
+// Written once for both: kPolarized = false is the unpolarized kernel, with none of it; kFilm
+// = true the instantiation for stacks with a thin film (film_event).
+template <bool kPolarized, bool kFilm>
 void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& grid,
                     const BlockJob& job, ParticleRng& rng, Tally& tally, BlockBudget& block) {
     const int n_layers = int(stack.layers.size());
@@ -347,7 +350,7 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         if constexpr (kPolarized)
             for (int c = 0; c < 3; ++c)
                 flux[c] = w[c];
-        interface_event<kPolarized>(stack, layer, rng, tally, d, w, losses, pol);
+        interface_event<kPolarized, kFilm>(stack, layer, rng, tally, d, w, losses, pol);
         if (is_black(w)) break;
         if (d.z == 0) {
             // An exactly grazing direction (a sampler at the edge of its domain, probability
@@ -416,10 +419,18 @@ constexpr float kIncidentStokes[7][3] = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 
 void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block) {
     for (std::uint64_t p = job.first; p < job.first + job.count; ++p) {
         ParticleRng rng(job.seed, job.stream, p);
-        if (job.stack->polarization)
-            trace_particle<true>(*job.stack, *job.grid, job, rng, tally, block);
-        else
-            trace_particle<false>(*job.stack, *job.grid, job, rng, tally, block);
+        // A stack with a film has its own instantiations: those of the stacks without one are
+        // compiled (inlined, contracted) exactly as before films existed, bit for bit.
+        if (job.stack->has_film) {
+            if (job.stack->polarization)
+                trace_particle<true, true>(*job.stack, *job.grid, job, rng, tally, block);
+            else
+                trace_particle<false, true>(*job.stack, *job.grid, job, rng, tally, block);
+        } else if (job.stack->polarization) {
+            trace_particle<true, false>(*job.stack, *job.grid, job, rng, tally, block);
+        } else {
+            trace_particle<false, false>(*job.stack, *job.grid, job, rng, tally, block);
+        }
     }
 }
 
