@@ -7,11 +7,16 @@
 #include "core/error.h"
 #include "core/math.h"
 #include "models/registry.h"
+#include "physics/conductor.h"
+#include "physics/dielectric.h"
 #include "physics/fresnel.h"
+#include "physics/microfacet.h"
 #include "physics/thin_film.h"
 #include "randomwalk/random_walk.h"
 #include "simulator/goniophotometer.h"
+#include "support/quadrature.h"
 #include "support/stacks.h"
+#include "support/table_checks.h"
 
 #include <gtest/gtest.h>
 
@@ -22,6 +27,8 @@ namespace lamina {
 namespace {
 
 using C = std::complex<double>;
+using test::compare_lobe;
+using test::expect_agreement;
 
 SimulationSettings scalar_settings(std::vector<double> theta_i, std::uint64_t n, bool polarization,
                                    std::uint64_t seed = 11) {
@@ -178,6 +185,92 @@ TEST(ThinFilmStackStat, FilmedSmoothConductor) {
                 }
             }
             expect_budget_closes(r);
+        }
+    }
+}
+
+// Single scattering on a rough filmed interface (one facet: --physics bpb19's microsurface), bin
+// by bin: Walter et al. 2007's BSDF with the film's R and T at the facet in place of the bare
+// Fresnel factors, f_r = R_film(wi·h) D(h) G2 / (4 μi μo) (their Eq. 20) and
+// f_t = |wi·h| |wo·h| η_o² T_film(wi·h) D(h) G2 / (μi |μo| (η_i wi·h + η_o wo·h)²) (Eq. 21), with
+// the Smith refraction masking B(1 + Λi, 1 + Λo) from the C++ library's Beta function. The first
+// facet sees unpolarized light, so polarized tracing gives the same tables. A rough conductor under
+// an oxide film and a rough glass under a high-index film.
+TEST(ThinFilmStackStat, RoughFilmedInterfaceIsWaltersBsdfWithTheFilm) {
+    const double alpha = 0.3, theta_i = 40, d = 130, nf = 2.1;
+    const Vec3d wi = incident_direction(deg_to_rad(theta_i));
+    const GGX<double> ggx{alpha};
+    const Rgbd eta_c(0.143, 0.374, 1.442), k_c(3.983, 2.385, 1.603);
+    const Stack conductor =
+        test::make_stack({with_film(test::conductor_layer(eta_c, k_c, alpha), d, nf)});
+    const Stack glass = test::make_stack({with_film(test::dielectric_layer(1.5, alpha), d, nf)});
+    const DielectricInterface<double> bare{1.5, alpha};
+    for (const bool polarization : {false, true}) {
+        SCOPED_TRACE(polarization ? "polarized" : "unpolarized");
+        SimulationSettings s = scalar_settings({theta_i}, 1'000'000, polarization);
+        // 9 × 9 bins: the polar caps of a finer grid hold a few particles each, too few for the
+        // normal approximation of their z-scores.
+        s.grid = HemisphereGrid(9, 9);
+        s.transport.microsurface = Microsurface::Single;
+        {
+            SCOPED_TRACE("conductor");
+            const SimulationResult r = simulate(conductor, s);
+            expect_agreement(compare_lobe(
+                r.table, 0, Side::Reflection,
+                [&](std::size_t j) {
+                    return test::bin_average(
+                        s.grid, j, Side::Reflection,
+                        [&](const Vec3d& wo) {
+                            if (wo.z <= 0) return Rgbd(0.0);
+                            const Vec3d h = normalize(wi + wo);
+                            const double g = ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
+                            Rgbd f;
+                            for (int c = 0; c < 3; ++c)
+                                f[c] = g * thin_film_mueller(dot(wi, h), C(nf), C(eta_c[c], k_c[c]),
+                                                             d / conductor.wavelengths_nm[c])
+                                               .reflection.a;
+                            return f;
+                        },
+                        12, 1);
+                },
+                double(s.particles)));
+        }
+        SCOPED_TRACE("dielectric");
+        const SimulationResult r = simulate(glass, s);
+        for (const Side side : {Side::Reflection, Side::Transmission}) {
+            SCOPED_TRACE(side == Side::Reflection ? "reflection" : "transmission");
+            expect_agreement(compare_lobe(
+                r.table, 0, side,
+                [&](std::size_t j) {
+                    return test::bin_average(
+                        s.grid, j, side,
+                        [&](const Vec3d& wo) {
+                            const auto h = bare.half_vector(wi, wo);
+                            if (!h || wo.z == 0) return Rgbd(0.0);
+                            const double cos_h = dot(wi, *h);
+                            Rgbd f;
+                            if (side == Side::Reflection) {
+                                const double g = ggx.D(*h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
+                                for (int c = 0; c < 3; ++c)
+                                    f[c] = g * thin_film_mueller(cos_h, C(nf), C(1.5),
+                                                                 d / glass.wavelengths_nm[c])
+                                                   .reflection.a;
+                                return f;
+                            }
+                            const double li = ggx.lambda(wi), lo = ggx.lambda(wo);
+                            const double g2 = std::beta(1 + li, 1 + lo);
+                            const double g =
+                                std::abs(cos_h * dot(wo, *h)) * 1.5 * 1.5 * ggx.D(*h) * g2 /
+                                (std::abs(wi.z * wo.z) * sqr(cos_h + 1.5 * dot(wo, *h)));
+                            for (int c = 0; c < 3; ++c)
+                                f[c] = g * thin_film_mueller(cos_h, C(nf), C(1.5),
+                                                             d / glass.wavelengths_nm[c])
+                                               .transmission.a;
+                            return f;
+                        },
+                        12, 1);
+                },
+                double(s.particles)));
         }
     }
 }
