@@ -454,16 +454,20 @@ void IncidenceSums::add(const IncidenceSums& o) {
     degenerate += o.degenerate;
 }
 
+void validate_kernel_for(const Stack& stack, const SimulationSettings& settings) {
+    if (stack.has_film() && settings.kernel == Kernel::Simd)
+        throw InputError("command line", "--kernel",
+                         fmt::format("the stack '{}' has a thin film, which the SIMD kernel does "
+                                     "not trace; give --kernel scalar",
+                                     stack.name));
+}
+
 SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,
                              const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);
     const auto start = std::chrono::steady_clock::now();
     const CompiledStack<float> trace = compile_stack<float>(stack, settings.transport);
-    if (trace.has_film && settings.kernel == Kernel::Simd)
-        throw InputError("command line", "--kernel",
-                         fmt::format("the stack '{}' has a thin film, which the SIMD kernel does "
-                                     "not trace; give --kernel scalar",
-                                     stack.name));
+    validate_kernel_for(stack, settings);
     const HemisphereGrid& grid = settings.grid;
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
     if (settings.kernel == Kernel::Simd) select_simd_target();

@@ -175,6 +175,10 @@ struct SimulationResult {
 /// Checks what the settings' codecs cannot see alone (InputError naming `where` and the setting).
 void validate_settings(const SimulationSettings& settings, const std::string& where = "settings");
 
+/// Checks that the settings' kernel traces everything the stack holds: a thin film needs the
+/// scalar kernel (InputError naming --kernel otherwise; docs/physics.md §9).
+void validate_kernel_for(const Stack& stack, const SimulationSettings& settings);
+
 /// Traces particles [first_particle, first_particle + particles) of every incidence and returns
 /// the raw sums. A run split into ranges that start at multiples of kParticlesPerBlock adds up
 /// (IncidenceSums::add) to the sums of one run, bit for bit.
