@@ -275,6 +275,47 @@ TEST(ThinFilmStackStat, RoughFilmedInterfaceIsWaltersBsdfWithTheFilm) {
     }
 }
 
+// A film between a coat and a metal: a smooth coat (1.5, absorbing) over a smooth conductor under
+// an oxide film, whose incident medium is the coat. s and p decouple, so with the coat's F_x at μi,
+// the film over the metal seen from inside the coat R_x at μi' (indices relative to the coat,
+// thickness in wavelengths inside it) and a = e^{−τ/μi'}:
+//   R = F_x + (1 − F_x)² R_x a² / (1 − F_x R_x a²)   (§6.5 with the film),
+// averaged over s and p (polarized), or the same series with the averages (unpolarized).
+TEST(ThinFilmStackStat, FilmUnderACoat) {
+    const double eta = 1.5, d = 90, nf = 2.3;
+    const Rgbd tau(0.1, 0.0, 0.2), eta_c(0.143, 0.374, 1.442), k_c(3.983, 2.385, 1.603);
+    const Stack stack =
+        test::make_stack({test::with_medium(test::dielectric_layer(eta, 0.0), tau),
+                          with_film(test::conductor_layer(eta_c, k_c, 0.0), d, nf)});
+    const std::vector<double> angles = {0, 50, 75};
+    for (const bool polarization : {false, true}) {
+        const SimulationResult r = simulate(stack, scalar_settings(angles, 200'000, polarization));
+        for (std::size_t i = 0; i < angles.size(); ++i) {
+            const double mu = std::cos(deg_to_rad(angles[i]));
+            const double mu_t = std::sqrt(1 - (1 - mu * mu) / (eta * eta));
+            const DielectricMueller<double> top = fresnel_dielectric_mueller(mu, eta, 1 / eta);
+            const double Fs = top.reflection.a + top.reflection.b,
+                         Fp = top.reflection.a - top.reflection.b;
+            const EnergyBudget& b = r.incidences[i].budget;
+            for (int c = 0; c < 3; ++c) {
+                const double a = std::exp(-tau[c] / mu_t);
+                const SP film =
+                    intensities(thin_film_mueller(mu_t, C(nf / eta), C(eta_c[c], k_c[c]) / eta,
+                                                  d * eta / stack.wavelengths_nm[c]));
+                auto series = [&](double F, double Rc) {
+                    return F + (1 - F) * (1 - F) * Rc * a * a / (1 - F * Rc * a * a);
+                };
+                const double R = polarization ? (series(Fs, film.Rs) + series(Fp, film.Rp)) / 2
+                                              : series(top.reflection.a, (film.Rs + film.Rp) / 2);
+                expect_within_se(b[BudgetTerm::Reflected][c], R, b.reflected_se[c],
+                                 std::string(polarization ? "polarized" : "unpolarized") + " θ " +
+                                     std::to_string(angles[i]));
+            }
+        }
+        expect_budget_closes(r);
+    }
+}
+
 // A thickness uniform over one period of the film's phase (at normal incidence, λ/(2 η_f)) gives
 // the incoherent slab R12 + T12² R23/(1 − R12 R23) of the boundaries' intensities: all channels at
 // one wavelength so that one range is a period for each.
