@@ -11,7 +11,7 @@
 // geometric series sums to the Airy formulas, separately for s and p (Born & Wolf, "Principles of
 // Optics", 7th ed., §1.6.4, the reflection and transmission coefficients of a homogeneous film;
 // §7.6.1 for the same sum as multiple-beam interference; Heavens 1955, "Optical Properties of Thin
-// Solid Films", ch. 4):
+// Solid Films", the single film):
 //
 //     r = (r12 + r23 e^{2iδ}) / (1 + r12 r23 e^{2iδ}),   t = t12 t23 e^{iδ} / (1 + r12 r23
 //     e^{2iδ}),
@@ -20,7 +20,7 @@
 // transmitted beam in a real exit medium). With real indices R is the Airy reflectance
 // (r12² + r23² + 2 r12 r23 cos 2δ)/(1 + r12² r23² + 2 r12 r23 cos 2δ) that Belcour & Barla 2017,
 // "A Practical Extension to Microfacet Theory for the Modeling of Varying Iridescence" (ACM TOG
-// 36(4)), §3, expand into Fourier terms. η_f cos θ_f is Snell's invariant carried into the film:
+// 36(4)), expand into Fourier terms. η_f cos θ_f is Snell's invariant carried into the film:
 // u_f = √(η_f² − sin²θ1) in units of the incident medium's index, complex for an absorbing film or
 // beyond the film's critical angle (frustrated total reflection: the wave tunnels through a thin
 // enough film), its root taken with Im u_f ≥ 0 so that e^{2iδ} never grows.
