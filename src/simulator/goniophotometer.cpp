@@ -435,7 +435,13 @@ void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block) {
 }
 
 std::string kernel_description(Kernel kernel) {
+    if (kernel == Kernel::Auto) return "auto";
     return kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name()) : "scalar";
+}
+
+Kernel kernel_for(Kernel kernel, const Stack& stack) {
+    if (kernel != Kernel::Auto) return kernel;
+    return stack.has_film() ? Kernel::Scalar : Kernel::Simd;
 }
 
 void IncidenceSums::add(const IncidenceSums& o) {
@@ -458,7 +464,7 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings)
     if (stack.has_film() && settings.kernel == Kernel::Simd)
         throw InputError("command line", "--kernel",
                          fmt::format("the stack '{}' has a thin film, which the SIMD kernel does "
-                                     "not trace; give --kernel scalar",
+                                     "not trace; give --kernel scalar (or auto)",
                                      stack.name));
 }
 
@@ -470,9 +476,9 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
     validate_kernel_for(stack, settings);
     const HemisphereGrid& grid = settings.grid;
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
-    if (settings.kernel == Kernel::Simd) select_simd_target();
-    const auto trace_block =
-        settings.kernel == Kernel::Simd ? trace_block_simd : trace_block_scalar;
+    const Kernel kernel = kernel_for(settings.kernel, stack);
+    if (kernel == Kernel::Simd) select_simd_target();
+    const auto trace_block = kernel == Kernel::Simd ? trace_block_simd : trace_block_scalar;
 
     SimulationSums result;
     result.threads_used = threads;

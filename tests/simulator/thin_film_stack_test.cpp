@@ -421,6 +421,26 @@ TEST(ThinFilmStack, VaryingThicknessIsBitwiseIdenticalAcrossThreads) {
     }
 }
 
+// --kernel auto: the scalar kernel for a stack with a film, the SIMD kernel for one without, bit
+// for bit.
+TEST(ThinFilmStack, AutoKernelPicksScalarForFilms) {
+    const Stack filmed = test::make_stack({with_film(test::dielectric_layer(1.5, 0.2), 100, 1.38)});
+    const Stack bare = test::make_stack({test::dielectric_layer(1.5, 0.2)});
+    for (const Stack& stack : {filmed, bare}) {
+        SimulationSettings s = scalar_settings({30}, 20'000, true);
+        s.kernel = Kernel::Auto;
+        const SimulationResult automatic = simulate(stack, s);
+        s.kernel = stack.has_film() ? Kernel::Scalar : Kernel::Simd;
+        const SimulationResult chosen = simulate(stack, s);
+        EXPECT_EQ(kernel_for(Kernel::Auto, stack), s.kernel);
+        EXPECT_EQ(automatic.table.lobe(0, Side::Reflection).f,
+                  chosen.table.lobe(0, Side::Reflection).f);
+        EXPECT_EQ(automatic.incidences[0].budget.term, chosen.incidences[0].budget.term);
+    }
+    EXPECT_EQ(kernel_for(Kernel::Scalar, bare), Kernel::Scalar);
+    EXPECT_EQ(kernel_for(Kernel::Simd, filmed), Kernel::Simd);  // refused by simulate
+}
+
 // Who does not trace films says so: the SIMD kernel (an InputError naming --kernel), every model
 // (not supported), the random walk.
 TEST(ThinFilmStack, RefusedWhereNotTraced) {
