@@ -59,6 +59,7 @@ Runner add_simulate(CLI::App& app) {
         std::unique_ptr<StagedOutput> probe;
         if (world.is_root()) {
             stack = load_stack(a->stack);
+            validate_kernel_for(stack, s);  // before DIR is made
             stack_text = stack_to_json(stack).dump();
             // Fails now, not after the run, if DIR is not writable.
             probe = std::make_unique<StagedOutput>(a->out);
@@ -67,7 +68,8 @@ Runner add_simulate(CLI::App& app) {
         if (!world.is_root()) stack = stack_from_json(nlohmann::json::parse(stack_text), a->stack);
         // Bitwise identity with a one-process run needs one kernel variant on every process: the
         // SIMD kernel's results depend on the instruction set it dispatches to.
-        const std::vector<std::string> kernels = world.gather(kernel_description(s.kernel));
+        const std::vector<std::string> kernels =
+            world.gather(kernel_description(kernel_for(s.kernel, stack)));
         if (world.is_root())
             for (std::size_t r = 1; r < kernels.size(); ++r)
                 if (kernels[r] != kernels[0])

@@ -22,8 +22,12 @@ CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& s
             case InterfaceType::Dielectric:
                 t.dielectric = {Real(spec.eta / eta_above), Real(spec.alpha)};
                 t.dielectric.transmission_masking = settings.transmission_masking;
-                if (multiple && t.dielectric.is_index_matched()) t.dielectric.alpha = Real(0);
-                t.delta = t.dielectric.is_smooth() || t.dielectric.is_index_matched();
+                // An index-matched interface is a pass-through, unless a film sits on it (a
+                // free-standing film: air | film | air).
+                if (multiple && t.dielectric.is_index_matched() && !spec.has_film)
+                    t.dielectric.alpha = Real(0);
+                t.delta =
+                    t.dielectric.is_smooth() || (t.dielectric.is_index_matched() && !spec.has_film);
                 t.multiple = multiple && !t.delta;
                 t.eta_below = Real(spec.eta);
                 break;
@@ -39,6 +43,21 @@ CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& s
                 t.lambertian = {Rgb<Real>(spec.albedo)};
                 t.eta_below = Real(eta_above);
                 break;
+        }
+        if (spec.has_film) {
+            t.has_film = out.has_film = true;
+            out.polarization_channels = 3;
+            FilmOptics& f = t.film;
+            f.eta_film = {spec.film.eta, spec.film.k};
+            f.eta_above = eta_above;
+            for (int c = 0; c < 3; ++c) {
+                f.eta_below[c] = spec.type == InterfaceType::Conductor
+                                     ? std::complex<double>(spec.eta_rgb[c], spec.k[c])
+                                     : std::complex<double>(spec.eta);
+                f.wavelength_nm[c] = stack.wavelengths_nm[c];
+            }
+            f.thickness_min_nm = spec.film.thickness_nm;
+            f.thickness_max_nm = spec.film.thickness_max_nm;
         }
         if (layer.has_medium) {
             const MediumSpec& m = layer.medium;

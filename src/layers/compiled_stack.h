@@ -12,6 +12,7 @@
 #include "physics/dielectric.h"
 #include "physics/lambertian.h"
 #include "physics/microfacet.h"
+#include "physics/thin_film.h"
 
 #include <vector>
 
@@ -47,6 +48,10 @@ struct CompiledLayer {
     bool multiple = false;
     /// The absolute index of the region below (the one above for an opaque base).
     Real eta_below = Real(1);
+    /// A thin film on the interface (docs/physics.md §9), evaluated in double by the scalar
+    /// kernel's film events (physics/thin_film_event.h).
+    bool has_film = false;
+    FilmOptics film;
     CompiledMedium<Real> medium;  ///< the medium below this interface (empty for the last layer)
 };
 
@@ -63,8 +68,11 @@ struct CompiledStack {
     bool polarization = false;
     /// Polarization states a particle needs: 1 when every Mueller matrix of the stack is the same
     /// in all channels (dielectrics, Lambertian bases, grey conductors), 3 when a conductor's
-    /// index differs between channels.
+    /// index differs between channels, or a thin film's Mueller matrices do (it is traced at a
+    /// different wavelength in each channel).
     int polarization_channels = 1;
+    /// Some interface carries a thin film (traced by the scalar kernel only).
+    bool has_film = false;
 };
 
 /// The stack compiled in precision Real (float: the goniophotometer's kernels; double: the random

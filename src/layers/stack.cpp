@@ -179,11 +179,12 @@ std::string suggestion(std::string_view key, Keys allowed) {
 
 // ---- The validating reader ------------------------------------------------------------------
 
-constexpr std::string_view kStackKeys[] = {"name", "ambient_eta", "layers"};
+constexpr std::string_view kStackKeys[] = {"name", "ambient_eta", "wavelengths_nm", "layers"};
 constexpr std::string_view kLayerKeys[] = {"interface", "medium"};
 constexpr std::string_view kInterfaceTypes[] = {"dielectric", "conductor", "lambertian"};
-constexpr std::string_view kDielectricKeys[] = {"type", "eta", "alpha"};
-constexpr std::string_view kConductorKeys[] = {"type", "eta", "k", "alpha"};
+constexpr std::string_view kDielectricKeys[] = {"type", "eta", "alpha", "film"};
+constexpr std::string_view kConductorKeys[] = {"type", "eta", "k", "alpha", "film"};
+constexpr std::string_view kFilmKeys[] = {"thickness_nm", "eta", "k"};
 constexpr std::string_view kLambertianKeys[] = {"type", "albedo"};
 constexpr std::string_view kMediumKeys[] = {"tau_a", "tau_s", "g"};
 
@@ -207,6 +208,12 @@ constexpr double kAlphaRoughMin = 1e-4;
 constexpr double kTauMax = 100, kTauScatteringMax = 1e4;
 constexpr double kGMax = 0.99;
 constexpr std::size_t kMaxLayers = 100;
+// Films up to 10 µm (beyond a few µm the coherence of broadband light is gone and the period of
+// the fringes in angle falls below any grid; the range still lets the period average be tested);
+// film indices from metals' (η down to 0.01) to high-index oxides; channel wavelengths within the
+// visible range of the CIE 1931 observer.
+constexpr double kFilmThicknessMax = 1e4;
+constexpr double kWavelengthMin = 360, kWavelengthMax = 830;
 
 constexpr Allowed kDielectricEta{
     [](double v) { return v >= kEtaDielectricMin && v <= kEtaDielectricMax; }, "[1, 5]"};
@@ -219,6 +226,12 @@ constexpr Allowed kOpticalDepth{[](double v) { return v >= 0 && v <= kTauMax; },
 constexpr Allowed kScatteringDepth{[](double v) { return v >= 0 && v <= kTauScatteringMax; },
                                    "[0, 10000]"};
 constexpr Allowed kUnit{[](double v) { return v >= 0 && v <= 1; }, "[0, 1]"};
+constexpr Allowed kFilmThickness{[](double v) { return v >= 0 && v <= kFilmThicknessMax; },
+                                 "[0, 10000]"};
+constexpr Allowed kFilmEta{[](double v) { return v >= kEtaConductorMin && v <= kEtaDielectricMax; },
+                           "[0.01, 5]"};
+constexpr Allowed kWavelength{[](double v) { return v >= kWavelengthMin && v <= kWavelengthMax; },
+                              "[360, 830]"};
 constexpr Allowed kHgG{[](double v) { return v >= -kGMax && v <= kGMax; }, "[-0.99, 0.99]"};
 
 class Reader {
@@ -250,6 +263,17 @@ class Reader {
         if (j.contains("ambient_eta"))
             s.ambient_eta = number(j["ambient_eta"], "/ambient_eta", kDielectricEta,
                                    "absolute refractive index of the ambient medium");
+
+        if (j.contains("wavelengths_nm")) {
+            const json& wl = j["wavelengths_nm"];
+            if (!wl.is_array() || wl.size() != 3)
+                fail("/wavelengths_nm",
+                     fmt::format("expected an array of 3 numbers [R, G, B] (the vacuum "
+                                 "wavelengths of the channels in nm), got {}: {}",
+                                 type_phrase(wl), show(wl)));
+            s.wavelengths_nm =
+                rgb(wl, "/wavelengths_nm", kWavelength, "vacuum wavelength of the channel in nm");
+        }
 
         const json& layers = required(j, "", "layers", "an array of layers, top to bottom");
         if (!layers.is_array())
@@ -385,6 +409,7 @@ class Reader {
             out.eta = number(eta, child(pointer, "eta"), kDielectricEta,
                              "absolute refractive index of what lies below");
             out.alpha = alpha(j, pointer, "dielectric");
+            film(j, pointer, out);
         } else if (name == "conductor") {
             out.type = InterfaceType::Conductor;
             check_keys(j, pointer, kConductorKeys, "a conductor interface");
@@ -399,6 +424,7 @@ class Reader {
                         child(pointer, "k"), kConductorK,
                         "extinction coefficient, imaginary part of the absolute index");
             out.alpha = alpha(j, pointer, "conductor");
+            film(j, pointer, out);
         } else if (name == "lambertian") {
             out.type = InterfaceType::Lambertian;
             check_keys(j, pointer, kLambertianKeys, "a lambertian interface");
@@ -415,6 +441,42 @@ class Reader {
         const json& v = required(j, pointer, "alpha",
                                  fmt::format("a {} needs an explicit {}", type, kAlphaHint));
         return number(v, child(pointer, "alpha"), kAlpha, "GGX roughness, 0 = smooth");
+    }
+
+    /// The optional "film" of a dielectric or conductor interface.
+    void film(const json& j, const std::string& pointer, InterfaceSpec& out) const {
+        if (!j.contains("film")) return;
+        const std::string fp = child(pointer, "film");
+        const json& f = j["film"];
+        expect_object(f, fp,
+                      fmt::format("a thin film (an object with keys {})", quoted_list(kFilmKeys)));
+        check_keys(f, fp, kFilmKeys, "a thin film");
+        out.has_film = true;
+        const std::string tp = child(fp, "thickness_nm");
+        const json& t = required(f, fp, "thickness_nm",
+                                 "the film's thickness in nm, in [0, 10000], or a range [min, max] "
+                                 "over which it is uniformly distributed");
+        constexpr std::string_view kMeaning = "film thickness in nm";
+        if (t.is_array()) {
+            if (t.size() != 2)
+                fail(tp, fmt::format("expected a number or a range [min, max] of 2 numbers "
+                                     "({}), got {}: {}",
+                                     kMeaning, type_phrase(t), show(t)));
+            out.film.thickness_nm = number(t[0], child(tp, 0), kFilmThickness, kMeaning);
+            out.film.thickness_max_nm = number(t[1], child(tp, 1), kFilmThickness, kMeaning);
+            if (out.film.thickness_max_nm < out.film.thickness_nm)
+                fail(tp, fmt::format("got the range {}; allowed: [min, max] with min <= max "
+                                     "(a uniform distribution of thickness over it)",
+                                     show(t)));
+        } else {
+            out.film.thickness_nm = number(t, tp, kFilmThickness, kMeaning);
+            out.film.thickness_max_nm = out.film.thickness_nm;
+        }
+        out.film.eta = number(required(f, fp, "eta", "the film's refractive index, in [0.01, 5]"),
+                              child(fp, "eta"), kFilmEta, "real part of the film's absolute index");
+        if (f.contains("k"))
+            out.film.k = number(f["k"], child(fp, "k"), kConductorK,
+                                "extinction coefficient of the film, imaginary part of its index");
     }
 
     MediumSpec medium(const json& j, const std::string& pointer) const {
@@ -599,6 +661,13 @@ nlohmann::json stack_to_json(const Stack& stack) {
                 interface = {{"type", "lambertian"}, {"albedo", rgb_json(i.albedo)}};
                 break;
         }
+        if (i.has_film)
+            interface["film"] = {
+                {"thickness_nm", i.film.varies()
+                                     ? json::array({i.film.thickness_nm, i.film.thickness_max_nm})
+                                     : json(i.film.thickness_nm)},
+                {"eta", i.film.eta},
+                {"k", i.film.k}};
         json l = {{"interface", interface}};
         if (layer.has_medium)
             l["medium"] = {{"tau_a", rgb_json(layer.medium.tau_a)},
@@ -606,8 +675,27 @@ nlohmann::json stack_to_json(const Stack& stack) {
                            {"g", rgb_json(layer.medium.g)}};
         layers.push_back(std::move(l));
     }
-    return {{"name", stack.name}, {"ambient_eta", stack.ambient_eta}, {"layers", layers}};
+    json out = {{"name", stack.name}, {"ambient_eta", stack.ambient_eta}, {"layers", layers}};
+    // Written where it matters or was changed: the canonical form of a stack without a film is
+    // what it has always been.
+    if (stack.has_film() || !(stack.wavelengths_nm == kDefaultChannelWavelengthsNm))
+        out["wavelengths_nm"] = rgb_json(stack.wavelengths_nm);
+    return out;
 }
+
+namespace {
+/// " film d=… nm η=…" (and k) of a filmed interface, "" otherwise.
+std::string describe_film(const InterfaceSpec& i) {
+    if (!i.has_film) return "";
+    const FilmSpec& f = i.film;
+    std::string out = f.varies()
+                          ? fmt::format(" film d=[{}, {}] nm", f.thickness_nm, f.thickness_max_nm)
+                          : fmt::format(" film d={} nm", f.thickness_nm);
+    out += fmt::format(" η={}", f.eta);
+    if (f.k > 0) out += fmt::format(" k={}", f.k);
+    return out;
+}
+}  // namespace
 
 std::string describe(const Stack& stack) {
     std::string out = fmt::format("{}: ", stack.name);
@@ -617,13 +705,14 @@ std::string describe(const Stack& stack) {
         const InterfaceSpec& i = layer.interface;
         switch (i.type) {
             case InterfaceType::Dielectric:
-                out += fmt::format(" | dielectric η={} α={}", i.eta, i.alpha);
+                out += fmt::format(" | dielectric η={} α={}", i.eta, i.alpha) + describe_film(i);
                 if (n + 1 == stack.layers.size())
                     out += fmt::format(" (slab: transmits into η={})", i.eta);
                 break;
             case InterfaceType::Conductor:
                 out += fmt::format(" | conductor η={} k={} α={}", show_rgb(i.eta_rgb),
-                                   show_rgb(i.k), i.alpha);
+                                   show_rgb(i.k), i.alpha) +
+                       describe_film(i);
                 break;
             case InterfaceType::Lambertian:
                 out += fmt::format(" | lambertian ρ={}", show_rgb(i.albedo));
@@ -644,6 +733,7 @@ Stack flipped_stack(const Stack& stack) {
     Stack out;
     out.name = stack.name + " (from below)";
     out.ambient_eta = stack.base().eta;
+    out.wavelengths_nm = stack.wavelengths_nm;
     for (std::size_t j = 0; j < L; ++j) {
         const std::size_t k = L - 1 - j;  // the old interface
         Layer layer;

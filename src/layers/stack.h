@@ -20,6 +20,19 @@ namespace lamina {
 
 enum class InterfaceType { Dielectric, Conductor, Lambertian };
 
+/// A thin film on a dielectric or conductor interface (docs/physics.md §9): a homogeneous layer of
+/// absolute complex index eta + ik, thin enough for the waves inside it to add coherently, whose
+/// thickness is thickness_nm, or uniformly distributed over [thickness_nm, thickness_max_nm] across
+/// the surface when the two differ.
+struct FilmSpec {
+    double thickness_nm = 0.0;      ///< in [0, 10000]; the lower end of a range
+    double thickness_max_nm = 0.0;  ///< ≥ thickness_nm; equal for one thickness
+    double eta = 1.5;               ///< in [0.01, 5]
+    double k = 0.0;                 ///< in [0, 10]
+    bool varies() const { return thickness_max_nm > thickness_nm; }
+    bool operator==(const FilmSpec&) const = default;
+};
+
 struct InterfaceSpec {
     InterfaceType type = InterfaceType::Dielectric;
     /// Dielectric: absolute index of what lies below (scalar: one path serves all channels).
@@ -31,6 +44,9 @@ struct InterfaceSpec {
     double alpha = 0.0;
     /// Lambertian albedo ∈ [0, 1] (RGB).
     Rgbd albedo{0.0};
+    /// A thin film on the interface (dielectric and conductor only).
+    bool has_film = false;
+    FilmSpec film;
 
     bool is_opaque() const { return type != InterfaceType::Dielectric; }
     bool operator==(const InterfaceSpec&) const = default;
@@ -55,10 +71,16 @@ struct Layer {
     bool operator==(const Layer&) const = default;
 };
 
+/// The vacuum wavelengths, in nm, at which the three RGB channels are traced where a wavelength
+/// matters (thin films; docs/physics.md §9): red, green, blue.
+inline constexpr Rgbd kDefaultChannelWavelengthsNm{630.0, 532.0, 465.0};
+
 struct Stack {
     std::string name;
     double ambient_eta = 1.0;
     std::vector<Layer> layers;
+    /// The channels' wavelengths in nm, each in [360, 830] (docs/physics.md §9).
+    Rgbd wavelengths_nm = kDefaultChannelWavelengthsNm;
 
     const InterfaceSpec& base() const { return layers.back().interface; }
     /// True when light can leave through the bottom (the base is a dielectric).
@@ -66,6 +88,12 @@ struct Stack {
     /// Index of the medium just above layer i's interface.
     double eta_above(std::size_t i) const {
         return i == 0 ? ambient_eta : layers[i - 1].interface.eta;
+    }
+    /// Whether some interface carries a thin film.
+    bool has_film() const {
+        for (const Layer& l : layers)
+            if (l.interface.has_film) return true;
+        return false;
     }
     bool operator==(const Stack&) const = default;
 };
@@ -118,6 +146,9 @@ inline Layer with_medium(Layer layer, const Rgbd& tau_a, const Rgbd& tau_s = Rgb
 /// interface type, an opaque interface that is not last, a medium under the last interface, an
 /// empty or missing `layers` or more than 100 layers, an empty name. Every stack it returns lies
 /// in those ranges: the estimators of lamina are written (and fuzzed, tests/fuzz) for them.
+/// A dielectric or conductor may carry a `film` (thickness_nm a number or a range [min, max] in
+/// [0, 10000], eta in [0.01, 5], k in [0, 10]); the stack may give `wavelengths_nm` [R, G, B],
+/// each in [360, 830].
 Stack stack_from_json(const nlohmann::json& j, const std::string& where);
 
 /// Parses the text of a stack file (what load_stack reads); `where` names it in messages. The same

@@ -33,6 +33,10 @@ const std::string& option_value(const ModelOptions& options, const std::string& 
 }
 
 bool coated_stack(const Stack& stack, CoatedStack& out, std::string& why) {
+    if (stack.has_film()) {  // a CoatedStack has no film: reading one would describe another stack
+        why = "thin films are not supported";
+        return false;
+    }
     if (stack.layers.size() != 2) {
         why = fmt::format(
             "needs exactly two interfaces (a dielectric coat over a base), the stack has {}",

@@ -159,7 +159,8 @@ inline Rgbd model_relative_k(const Rgbd& k) {
 }
 
 /// Extracts the coated shape, or explains (in `why`) why the stack has another shape. The
-/// relative indices are those of model_relative_eta / model_relative_k.
+/// relative indices are those of model_relative_eta / model_relative_k. A stack with a thin film
+/// has no coated shape ("thin films are not supported").
 bool coated_stack(const Stack& stack, CoatedStack& out, std::string& why);
 
 /// exp of each channel.

@@ -51,10 +51,40 @@ const ModelFamily<Ddb22Choices> kDdb22{
     },
     [](const std::string&) { return Ddb22Choices{}; }, make_ddb22_model};
 
+/// What every model is for a stack with a thin film (docs/physics.md §9): not supported. No model
+/// of the registry represents films yet (the goniophotometer's scalar kernel traces them), so none
+/// is built for such a stack: a model that ignored the film would return a stack's values that
+/// are not this stack's.
+class FilmNotSupported final : public Model {
+  public:
+    explicit FilmNotSupported(std::string name) : name_(std::move(name)) {}
+    std::string name() const override { return name_; }
+    Support support() const override {
+        return {false, false,
+                "thin films are not supported by this model (the goniophotometer traces them: "
+                "lamina simulate --kernel scalar)"};
+    }
+    Rgbd eval(const Vec3d&, const Vec3d&) const override { return Rgbd(0.0); }
+
+  private:
+    std::string name_;
+};
+
+/// The entries with their factories refusing filmed stacks.
+std::vector<ModelEntry> refusing_films(std::vector<ModelEntry> entries) {
+    for (ModelEntry& e : entries)
+        e.make = [make = std::move(e.make), name = e.name](
+                     const Stack& stack, const ModelOptions& options) -> std::unique_ptr<Model> {
+            if (stack.has_film()) return std::make_unique<FilmNotSupported>(name);
+            return make(stack, options);
+        };
+    return entries;
+}
+
 }  // namespace
 
 const std::vector<ModelEntry>& model_registry() {
-    static const std::vector<ModelEntry> entries = {
+    static const std::vector<ModelEntry> entries = refusing_films({
         variant(
             "ww09",
             "Weidlich & Wilkie, SIGGRAPH Asia 2009 course code: T01 and refraction at h, base at "
@@ -165,7 +195,7 @@ const std::vector<ModelEntry>& model_registry() {
          "base) with terms derived from the layering and fitted on the study's reference",
          "bases: lambertian, conductor; media: absorbing; eta0 in [1.1, 2.6]; sides: R",
          lamina_coat_options, make_lamina_coat, false, "lamina"},
-    };
+    });
     return entries;
 }
 

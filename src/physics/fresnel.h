@@ -122,20 +122,58 @@ LAMINA_LANE_INLINE T fresnel_conductor(T cos_theta_i, T eta, T k) {
     return (r_s + r_p) / two;
 }
 
-/// The same reflectance evaluated with std::complex, as written in Born & Wolf: an independent
-/// form for tests (slower: complex division and square root).
+/// The complex amplitude coefficients of one planar boundary for the s and p components of the
+/// electric field (Born & Wolf §1.5.2, Eqs. 20–21, with the complex index of §14.2; time
+/// dependence e^{−iωt}, an absorbing index n + ik with k > 0), in the frame convention of
+/// docs/physics.md §8 (r_p = −r_s at normal incidence).
+template <typename T>
+struct FresnelAmplitudes {
+    std::complex<T> r_s, r_p, t_s, t_p;
+};
+
+/// The amplitudes of the boundary from medium j into medium k, each given by its complex index
+/// relative to one reference medium (eta_j, eta_k) and its normal wave number in units of the
+/// reference's, u = η cos θ = √(η² − sin²θ_ref) (Snell's invariant η sin θ is the same in every
+/// medium of a stack of parallel boundaries; Im u ≥ 0 for a wave that decays away from the
+/// boundary, so the principal root). With ε = η²:
+///     r_s = (u_j − u_k)/(u_j + u_k),       t_s = 2 u_j/(u_j + u_k),
+///     r_p = (ε_k u_j − ε_j u_k)/(ε_k u_j + ε_j u_k),  t_p = 2 η_j η_k u_j/(ε_k u_j + ε_j u_k),
+/// Born & Wolf's r_⊥, t_⊥, r_∥, t_∥ with n cos θ = u, cos θ = u/η. They obey Stokes' relations
+/// r_kj = −r_jk and t_jk t_kj = 1 − r_jk² (both polarizations), which the Airy sums of a film rest
+/// on (physics/thin_film.h). A boundary seen from the reference medium itself has η_j = 1,
+/// u_j = cos θ. The denominators vanish only at an index-matched grazing boundary (u_j = u_k = 0).
+template <typename T>
+FresnelAmplitudes<T> fresnel_amplitudes(std::complex<T> eta_j, std::complex<T> u_j,
+                                        std::complex<T> eta_k, std::complex<T> u_k) {
+    const std::complex<T> eps_j = eta_j * eta_j, eps_k = eta_k * eta_k;
+    const std::complex<T> ds = u_j + u_k, dp = eps_k * u_j + eps_j * u_k;
+    return {(u_j - u_k) / ds, (eps_k * u_j - eps_j * u_k) / dp, T(2) * u_j / ds,
+            T(2) * eta_j * eta_k * u_j / dp};
+}
+
+/// The normal wave number u = √(η² − sin²θ) of a medium of complex index eta (relative to the
+/// reference medium) for a wave whose Snell invariant is sin²θ = sin2_theta: the root with
+/// Im u ≥ 0 (decaying into an absorbing medium, or evanescent under total internal reflection),
+/// Re u ≥ 0.
+template <typename T>
+std::complex<T> normal_wave_number(std::complex<T> eta, T sin2_theta) {
+    const std::complex<T> e = eta * eta - sin2_theta;
+    // An imaginary part of −0 would put the root of a negative number on the decaying side's
+    // mirror image (std::sqrt follows the sign of zero).
+    return std::sqrt(std::complex<T>(e.real(), e.imag() == T(0) ? T(0) : e.imag()));
+}
+
+/// The same reflectance as fresnel_conductor evaluated with std::complex, as written in Born &
+/// Wolf (fresnel_amplitudes from the dielectric side, η_j = 1, u_j = cos θ): an independent form
+/// for tests (slower: complex division and square root).
 template <typename T>
 LAMINA_LANE_INLINE T fresnel_conductor_complex(T cos_theta_i, T eta, T k) {
     using C = std::complex<T>;
     cos_theta_i = clamp(cos_theta_i, T(0), T(1));
     const C eta_c(eta, k);
-    const T sin2_theta_i = T(1) - sqr(cos_theta_i);
-    const C sin2_theta_t = sin2_theta_i / (eta_c * eta_c);
-    const C cos_theta_t = std::sqrt(C(1) - sin2_theta_t);  // principal root: Im ≥ 0 (decaying)
-    const C r_parallel = (eta_c * cos_theta_i - cos_theta_t) / (eta_c * cos_theta_i + cos_theta_t);
-    const C r_perpendicular =
-        (C(cos_theta_i) - eta_c * cos_theta_t) / (C(cos_theta_i) + eta_c * cos_theta_t);
-    return (std::norm(r_parallel) + std::norm(r_perpendicular)) / T(2);
+    const FresnelAmplitudes<T> a = fresnel_amplitudes<T>(
+        C(1), C(cos_theta_i), eta_c, normal_wave_number(eta_c, T(1) - sqr(cos_theta_i)));
+    return (std::norm(a.r_p) + std::norm(a.r_s)) / T(2);
 }
 
 /// Mirror reflection of w (pointing away from the surface) about the unit normal n.

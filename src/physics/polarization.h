@@ -47,6 +47,7 @@
 #include "core/lane_vec.h"
 
 #include <cmath>
+#include <complex>
 
 // A lane header (core/lane.h): included once as an ordinary header and once per SIMD target.
 #ifndef LAMINA_LANE_TARGET
@@ -75,6 +76,19 @@ template <typename T>
 struct InterfaceMueller {
     T a, b, c, d;
 };
+
+/// The Mueller matrix (*) of a pair of complex amplitudes a_s, a_p (the Jones matrix
+/// diag(a_s, a_p) in the s/p frame) times the flux factor `flux`: a = flux (|a_s|² + |a_p|²)/2,
+/// b = flux (|a_s|² − |a_p|²)/2, c + id = flux a_s a_p*. Reflection has flux 1; a refracted beam
+/// the factor Re(η_t cos θt)/(η_i cos θi) of its real exit medium (Born & Wolf §1.5.2, Eq. 30).
+/// The definition, with std::complex (the films' amplitudes, physics/thin_film.h);
+/// reflection_mueller below is the same for one boundary in real arithmetic, as lane template.
+template <typename T>
+InterfaceMueller<T> mueller_of_amplitudes(std::complex<T> a_s, std::complex<T> a_p, T flux) {
+    const T n_s = std::norm(a_s), n_p = std::norm(a_p);
+    const std::complex<T> x = a_s * std::conj(a_p);
+    return {flux * (n_s + n_p) / T(2), flux * (n_s - n_p) / T(2), flux * x.real(), flux * x.imag()};
+}
 
 /// The reflection Mueller matrix from the complex reflection coefficients of a relative index
 /// whose square is E = e1 + i e2 (e2 ≥ 0), at the incidence cosine mu ∈ [0, 1], given u = a + ib,

@@ -1,6 +1,7 @@
 #include "randomwalk/random_walk.h"
 
 #include "core/check.h"
+#include "core/error.h"
 #include "core/math.h"
 #include "physics/fresnel.h"
 #include "physics/medium.h"
@@ -142,6 +143,10 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, const TransportSettings& tr
     : transmits_(stack.transmits()), transport_(transport) {
     LAMINA_CHECK(transport.max_events >= 1);
     LAMINA_CHECK(transport.max_microsurface_order >= 1);
+    if (stack.has_film())
+        throw InputError(stack.name, "film",
+                         "thin films are not supported by the random walk (the goniophotometer "
+                         "traces them: lamina simulate --kernel scalar)");
     const CompiledStack<double> compiled = compile_stack<double>(stack, transport);
     channels_ = compiled.polarization_channels;
     const int L = int(compiled.layers.size());

@@ -9,6 +9,7 @@
 #include "layers/compiled_stack.h"
 #include "physics/medium.h"
 #include "physics/microsurface_walk.h"
+#include "physics/thin_film_event.h"
 #include "simulator/kernel_simd.h"
 #include "simulator/tally.h"
 
@@ -90,6 +91,102 @@ struct MediumWalk {
     }
 };
 
+// ---- A filmed interface (docs/physics.md §9)
+// ----------------------------------------------------- The film's Mueller matrices
+// (physics/thin_film_event.h) at every facet: a dielectric's single facet or walk through the
+// film's branch choice, a conductor's through conductor_event and the conductor walk with the
+// film's reflection in place of the bare Fresnel terms. A thickness that varies over the surface is
+// drawn first, from the particle's own stream, once per event (a particle's lateral position never
+// matters, docs/physics.md §2). The factors (the film's absorption, the reweighting of the
+// channels) are booked as absorbed at the interface
+// (`apply(sample, true)`), G2/G1 as lost to the microsurface.
+template <bool kPolarized, typename Apply, typename ApplyWalk>
+inline void film_event(const CompiledStack<float>& stack, const CompiledLayer<float>& layer,
+                       ParticleRng& rng, const Vec3f& wi, const Rgbf& w,
+                       [[maybe_unused]] PolarizationLanes<float>& pol, Apply& apply,
+                       ApplyWalk& apply_walk) {
+    const FilmOptics& film = layer.film;
+    const double thickness =
+        film.varies() ? film.thickness_nm(double(rng.uniform_float())) : film.thickness_min_nm;
+    const float flux[3] = {w[0], w[1], w[2]};
+    PolarizationLanes<float>* p = nullptr;
+    if constexpr (kPolarized) p = &pol;
+    auto uniform = [&] { return rng.uniform_float(); };
+    const LaneVec3<float> wl = {wi.x, wi.y, wi.z};
+    if (layer.type == InterfaceType::Dielectric) {
+        const DielectricInterface<float>& di = layer.dielectric;
+        if (layer.multiple) {
+            const MicrosurfaceFilmFacet<decltype(uniform)> facet{film,    di.eta, thickness,
+                                                                 uniform, flux,   p};
+            apply_walk(microsurface_exit(microsurface_walk<float, Lane<float>>(
+                           di.alpha, wl, true, true, facet, uniform, stack.max_microsurface_order)),
+                       true);
+            return;
+        }
+        const float uc = rng.uniform_float(), u1 = rng.uniform_float(), u2 = rng.uniform_float();
+        const FilmEvent e =
+            film_dielectric_event(film, di.eta, di.alpha, di.uncorrelated_shadowing,
+                                  di.transmission_masking == TransmissionMasking::Smith, thickness,
+                                  wl, uc, u1, u2, flux, p);
+        std::optional<BsdfSample<float>> s;
+        if (!e.degenerate) {
+            s.emplace();
+            s->wo = {e.scatter.wo.x, e.scatter.wo.y, e.scatter.wo.z};
+            s->fresnel_weight = {e.scatter.factor[0], e.scatter.factor[1], e.scatter.factor[2]};
+            s->shadowing = e.shadowing;
+        }
+        apply(s, true);
+        return;
+    }
+    // A conductor: the film's reflectance (unpolarized) or reflection Mueller matrices per channel.
+    const ConductorInterface<float>& cond = layer.conductor;
+    const auto reflectance = [&](float cos_theta) {
+        Rgbf r;
+        for (int c = 0; c < 3; ++c)
+            r[c] = float(film.mueller(c, double(cos_theta), true, thickness).reflection.a);
+        return r;
+    };
+    [[maybe_unused]] const auto mueller = [&](float cos_theta, InterfaceMueller<float>* m) {
+        for (int c = 0; c < 3; ++c) {
+            const InterfaceMueller<double> md =
+                film.mueller(c, double(cos_theta), true, thickness).reflection;
+            m[c] = {float(md.a), float(md.b), float(md.c), float(md.d)};
+        }
+    };
+    if (layer.multiple) {
+        if constexpr (kPolarized)
+            apply_walk(walk_rough_conductor_polarized(cond.distribution(), mueller, wi, uniform,
+                                                      stack.max_microsurface_order, pol),
+                       true);
+        else
+            apply_walk(walk_rough_conductor(cond.distribution(), reflectance, wi, uniform,
+                                            stack.max_microsurface_order),
+                       true);
+        return;
+    }
+    const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
+    float factors[3];
+    const auto channel_reflectance = [&](float cos_theta, float* out) {
+        const Rgbf r = reflectance(cos_theta);
+        out[0] = r[0], out[1] = r[1], out[2] = r[2];
+    };
+    InterfaceEventLanes<float, bool> e;
+    if constexpr (kPolarized)
+        e = conductor_event<float>(cond.alpha, cond.is_smooth(), cond.uncorrelated_shadowing, wl,
+                                   u1, u2, true, NoMueller{}, factors, &pol, mueller);
+    else
+        e = conductor_event<float>(cond.alpha, cond.is_smooth(), cond.uncorrelated_shadowing, wl,
+                                   u1, u2, true, channel_reflectance, factors);
+    std::optional<BsdfSample<float>> s;
+    if (!e.degenerate) {
+        s.emplace();
+        s->wo = {e.wo.x, e.wo.y, e.wo.z};
+        s->fresnel_weight = {factors[0], factors[1], factors[2]};
+        s->shadowing = e.shadowing;
+    }
+    apply(s, true);
+}
+
 // ---- One interface event ----------------------------------------------------------------------
 // The event of `layer` on a particle arriving along d with flux w: its BSDF sampler (or, with
 // multiple scattering, its microsurface walk) draws the new direction d, and w keeps what
@@ -97,7 +194,7 @@ struct MediumWalk {
 // Polarized runs: pol goes through the event too (pol.flux: the caller's copy of w). Where the
 // channels' states differ, a dielectric's branch choice reweights the channels: the reweighting
 // (zero in expectation per channel) is booked with the base that coloured them.
-template <bool kPolarized>
+template <bool kPolarized, bool kFilm>
 inline void interface_event(const CompiledStack<float>& stack, const CompiledLayer<float>& layer,
                             ParticleRng& rng, Tally& tally, Vec3f& d, Rgbf& w, PathLosses& losses,
                             [[maybe_unused]] PolarizationLanes<float>& pol) {
@@ -144,6 +241,12 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
         d = e->wo;
     };
     auto uniform = [&] { return rng.uniform_float(); };
+    if constexpr (kFilm) {
+        if (layer.has_film) {
+            film_event<kPolarized>(stack, layer, rng, wi_local, w, pol, apply, apply_walk);
+            return;
+        }
+    }
     switch (layer.type) {
         case InterfaceType::Dielectric: {
             if (layer.multiple) {
@@ -211,8 +314,9 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
 // divided by its flux, with the frame's x axis (physics/polarization.h at one lane); every event
 // passes it to the interface's polarized event, a Lambertian base and a scattering event
 // depolarize it, and an exit is tallied with its Stokes vector when the job asks for it.
-// Written once for both: kPolarized = false is the unpolarized kernel, with none of it.
-template <bool kPolarized>
+// Written once for both: kPolarized = false is the unpolarized kernel, with none of it; kFilm
+// = true the instantiation for stacks with a thin film (film_event).
+template <bool kPolarized, bool kFilm>
 void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& grid,
                     const BlockJob& job, ParticleRng& rng, Tally& tally, BlockBudget& block) {
     const int n_layers = int(stack.layers.size());
@@ -246,7 +350,7 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         if constexpr (kPolarized)
             for (int c = 0; c < 3; ++c)
                 flux[c] = w[c];
-        interface_event<kPolarized>(stack, layer, rng, tally, d, w, losses, pol);
+        interface_event<kPolarized, kFilm>(stack, layer, rng, tally, d, w, losses, pol);
         if (is_black(w)) break;
         if (d.z == 0) {
             // An exactly grazing direction (a sampler at the edge of its domain, probability
@@ -315,15 +419,29 @@ constexpr float kIncidentStokes[7][3] = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 
 void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block) {
     for (std::uint64_t p = job.first; p < job.first + job.count; ++p) {
         ParticleRng rng(job.seed, job.stream, p);
-        if (job.stack->polarization)
-            trace_particle<true>(*job.stack, *job.grid, job, rng, tally, block);
-        else
-            trace_particle<false>(*job.stack, *job.grid, job, rng, tally, block);
+        // A stack with a film has its own instantiations: those of the stacks without one are
+        // compiled (inlined, contracted) exactly as before films existed, bit for bit.
+        if (job.stack->has_film) {
+            if (job.stack->polarization)
+                trace_particle<true, true>(*job.stack, *job.grid, job, rng, tally, block);
+            else
+                trace_particle<false, true>(*job.stack, *job.grid, job, rng, tally, block);
+        } else if (job.stack->polarization) {
+            trace_particle<true, false>(*job.stack, *job.grid, job, rng, tally, block);
+        } else {
+            trace_particle<false, false>(*job.stack, *job.grid, job, rng, tally, block);
+        }
     }
 }
 
 std::string kernel_description(Kernel kernel) {
+    if (kernel == Kernel::Auto) return "auto";
     return kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name()) : "scalar";
+}
+
+Kernel kernel_for(Kernel kernel, const Stack& stack) {
+    if (kernel != Kernel::Auto) return kernel;
+    return stack.has_film() ? Kernel::Scalar : Kernel::Simd;
 }
 
 void IncidenceSums::add(const IncidenceSums& o) {
@@ -342,16 +460,25 @@ void IncidenceSums::add(const IncidenceSums& o) {
     degenerate += o.degenerate;
 }
 
+void validate_kernel_for(const Stack& stack, const SimulationSettings& settings) {
+    if (stack.has_film() && settings.kernel == Kernel::Simd)
+        throw InputError("command line", "--kernel",
+                         fmt::format("the stack '{}' has a thin film, which the SIMD kernel does "
+                                     "not trace; give --kernel scalar (or auto)",
+                                     stack.name));
+}
+
 SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,
                              const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);
     const auto start = std::chrono::steady_clock::now();
     const CompiledStack<float> trace = compile_stack<float>(stack, settings.transport);
+    validate_kernel_for(stack, settings);
     const HemisphereGrid& grid = settings.grid;
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
-    if (settings.kernel == Kernel::Simd) select_simd_target();
-    const auto trace_block =
-        settings.kernel == Kernel::Simd ? trace_block_simd : trace_block_scalar;
+    const Kernel kernel = kernel_for(settings.kernel, stack);
+    if (kernel == Kernel::Simd) select_simd_target();
+    const auto trace_block = kernel == Kernel::Simd ? trace_block_simd : trace_block_scalar;
 
     SimulationSums result;
     result.threads_used = threads;

@@ -34,17 +34,25 @@ inline constexpr std::uint64_t kParticlesPerBlock = 4096;
 /// `simd` traces a batch of particles as the lanes of SIMD vectors (kernel_simd.h), dispatched at
 /// run time to what the CPU offers. Each is bitwise reproducible for any thread or process count on
 /// a given machine; the two agree in distribution (a two-sample chi-square test), not bit for bit.
-enum class Kernel { Scalar, Simd };
-inline constexpr std::array<EnumName<Kernel>, 2> enum_names(Kernel) {
+/// `auto` is `simd`, or `scalar` for a stack the SIMD kernel does not trace (a thin film,
+/// docs/physics.md §9): kernel_for.
+enum class Kernel { Scalar, Simd, Auto };
+inline constexpr std::array<EnumName<Kernel>, 3> enum_names(Kernel) {
     return {{{Kernel::Scalar, "scalar", "one particle at a time, the reference path"},
-             {Kernel::Simd, "simd", "particles as the lanes of SIMD vectors"}}};
+             {Kernel::Simd, "simd", "particles as the lanes of SIMD vectors"},
+             {Kernel::Auto, "auto", "simd, or scalar for a stack with a thin film"}}};
 }
 inline const char* enum_noun(Kernel) {
     return "a particle kernel";
 }
 /// The kernel as it runs on this machine: "scalar", or "simd" with the instruction set dispatched
-/// to (e.g. "simd AVX3"). Tables are bitwise reproducible for equal descriptions.
+/// to (e.g. "simd AVX3"); "auto" for auto, whose kernel depends on the stack (kernel_for). Tables
+/// are bitwise reproducible for equal descriptions of the kernel that ran.
 std::string kernel_description(Kernel kernel);
+
+/// The kernel that traces `stack` under the setting `kernel`: auto is scalar for a stack with a
+/// thin film, simd otherwise; scalar and simd are themselves.
+Kernel kernel_for(Kernel kernel, const Stack& stack);
 
 /// The goniophotometer's settings. Each is declared once, in `fields` (core/setting.h): the
 /// command line, result.json, the study's files, the reference's cache key and Python read them
@@ -93,8 +101,9 @@ struct SimulationSettings {
                .key = Key::Fixed},
               s.grid);
         visit({.name = "kernel",
-               .help = "Particle kernel: simd (vectorized, runtime dispatch) or scalar (reference "
-                       "path); tables are reproducible per kernel",
+               .help = "Particle kernel: simd (vectorized, runtime dispatch), scalar (reference "
+                       "path) or auto (simd, scalar for thin films); tables are reproducible per "
+                       "kernel",
                .key = Key::Fixed},
               s.kernel);
         TransportSettings::fields(s.transport, visit);
@@ -174,6 +183,10 @@ struct SimulationResult {
 
 /// Checks what the settings' codecs cannot see alone (InputError naming `where` and the setting).
 void validate_settings(const SimulationSettings& settings, const std::string& where = "settings");
+
+/// Checks that the settings' kernel traces everything the stack holds: a thin film needs the
+/// scalar kernel, or auto (InputError naming --kernel for simd; docs/physics.md §9).
+void validate_kernel_for(const Stack& stack, const SimulationSettings& settings);
 
 /// Traces particles [first_particle, first_particle + particles) of every incidence and returns
 /// the raw sums. A run split into ranges that start at multiples of kParticlesPerBlock adds up

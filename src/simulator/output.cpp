@@ -41,7 +41,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     // the bins' ranges, the threads and processes used.
     j.update(settings_to_json(s));
     j["physics"] = physics_name(s.transport);  // exact, bpb19 or custom
-    j["kernel_description"] = kernel_description(s.kernel);
+    j["kernel_description"] = kernel_description(kernel_for(s.kernel, stack));
     j["grid"].update({{"theta_range_deg", {0, 90}}, {"phi_range_deg", {0, 180}}, {"folded", true}});
     j["first_particle"] = s.first_particle;
     j["mueller"] = s.stokes_tallies;

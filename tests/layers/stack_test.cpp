@@ -307,9 +307,9 @@ TEST(StackReject, UnknownKeysAtEveryLevelWithSuggestion) {
                     {"bad.json", "/layers/0/interface/alpah", "unknown key \"alpah\"",
                      "did you mean \"alpha\"?", "\"type\", \"eta\", \"alpha\""});
 
-    expect_mentions(
-        error_of(with(plastic(), "/layer", json::array())),
-        {"/layer:", "did you mean \"layers\"?", "\"name\", \"ambient_eta\", \"layers\""});
+    expect_mentions(error_of(with(plastic(), "/layer", json::array())),
+                    {"/layer:", "did you mean \"layers\"?",
+                     "\"name\", \"ambient_eta\", \"wavelengths_nm\", \"layers\""});
     expect_mentions(error_of(with(plastic(), "/layers/0/meduim", json::object())),
                     {"/layers/0/meduim", "did you mean \"medium\"?", "\"interface\", \"medium\""});
     expect_mentions(error_of(with(plastic(), "/layers/0/medium/tau_b", 0.1)),
@@ -583,6 +583,77 @@ TEST(StackLoad, NameDefaultsToTheFileStem) {
     const fs::path path = dir / "blue-glass.json";
     std::ofstream(path) << without(plastic(), "/name").dump(2);
     EXPECT_EQ(load_stack(path).name, "blue-glass");
+}
+
+// ---- Thin films (docs/physics.md §9) --------------------------------------------------------
+
+TEST(StackFilm, ParsesOneThicknessOrARangeAndRoundTrips) {
+    const Stack a = stack_from_json(
+        with(paint(), "/layers/1/interface/film", {{"thickness_nm", 120}, {"eta", 2.2}}), "x");
+    ASSERT_TRUE(a.layers[1].interface.has_film);
+    EXPECT_EQ(a.layers[1].interface.film.thickness_nm, 120);
+    EXPECT_EQ(a.layers[1].interface.film.thickness_max_nm, 120);
+    EXPECT_FALSE(a.layers[1].interface.film.varies());
+    EXPECT_EQ(a.layers[1].interface.film.k, 0.0);  // the default
+    EXPECT_TRUE(a.has_film());
+    EXPECT_EQ(a.wavelengths_nm, kDefaultChannelWavelengthsNm);
+    const Stack b =
+        stack_from_json(with(with(plastic(), "/layers/0/interface/film",
+                                  {{"thickness_nm", {100, 300}}, {"eta", 1.33}, {"k", 0.01}}),
+                             "/wavelengths_nm", {650, 550, 450}),
+                        "x");
+    EXPECT_TRUE(b.layers[0].interface.film.varies());
+    EXPECT_EQ(b.layers[0].interface.film.thickness_max_nm, 300);
+    EXPECT_EQ(b.wavelengths_nm, Rgbd(650, 550, 450));
+    for (const Stack& s : {a, b}) {
+        EXPECT_EQ(stack_from_json(stack_to_json(s), "x"), s);
+        EXPECT_TRUE(stack_to_json(s).contains("wavelengths_nm"));
+    }
+    EXPECT_NE(describe(b).find("film d=[100, 300] nm η=1.33 k=0.01"), std::string::npos)
+        << describe(b);
+    // A stack without a film keeps the canonical form it always had.
+    EXPECT_FALSE(stack_to_json(stack_from_json(plastic(), "x")).contains("wavelengths_nm"));
+}
+
+TEST(StackFilm, RejectsBadFilmsNamingTheField) {
+    auto film = [](json f) { return with(plastic(), "/layers/0/interface/film", std::move(f)); };
+    expect_mentions(error_of(film({{"eta", 1.4}})),
+                    {"bad.json", "/layers/0/interface/film/thickness_nm", "missing"});
+    expect_mentions(error_of(film({{"thickness_nm", -1}, {"eta", 1.4}})),
+                    {"/layers/0/interface/film/thickness_nm", "got -1", "[0, 10000]"});
+    expect_mentions(error_of(film({{"thickness_nm", {300, 100}}, {"eta", 1.4}})),
+                    {"/layers/0/interface/film/thickness_nm", "min <= max"});
+    expect_mentions(error_of(film({{"thickness_nm", {1, 2, 3}}, {"eta", 1.4}})),
+                    {"/layers/0/interface/film/thickness_nm", "[min, max]"});
+    expect_mentions(error_of(film({{"thickness_nm", 100}})),
+                    {"/layers/0/interface/film/eta", "missing"});
+    expect_mentions(error_of(film({{"thickness_nm", 100}, {"eta", 7}})),
+                    {"/layers/0/interface/film/eta", "got 7", "[0.01, 5]"});
+    expect_mentions(error_of(film({{"thickness_nm", 100}, {"eta", 1.4}, {"k", -1}})),
+                    {"/layers/0/interface/film/k", "got -1", "[0, 10]"});
+    expect_mentions(error_of(film({{"thickness_nm", 100}, {"eta", 1.4}, {"thickness", 1}})),
+                    {"/layers/0/interface/film/thickness", "unknown key", "thickness_nm"});
+    expect_mentions(error_of(film(3)), {"/layers/0/interface/film", "a thin film"});
+    // Films on dielectrics and conductors only.
+    expect_mentions(error_of(with(plastic(), "/layers/1/interface/film",
+                                  {{"thickness_nm", 100}, {"eta", 1.4}})),
+                    {"/layers/1/interface/film", "unknown key"});
+    expect_mentions(error_of(with(plastic(), "/wavelengths_nm", {650, 550, 100})),
+                    {"/wavelengths_nm/2", "got 100", "[360, 830]"});
+    expect_mentions(error_of(with(plastic(), "/wavelengths_nm", 550)),
+                    {"/wavelengths_nm", "array of 3"});
+}
+
+TEST(StackFilm, FlippedStackKeepsTheFilmOnItsInterface) {
+    const Stack s = stack_from_json(
+        with(json::parse(R"({"layers": [{"interface": {"type": "dielectric", "eta": 1.5,
+                                                        "alpha": 0}}]})"),
+             "/layers/0/interface/film", {{"thickness_nm", 90}, {"eta", 1.38}}),
+        "x");
+    const Stack f = flipped_stack(s);
+    EXPECT_TRUE(f.layers[0].interface.has_film);
+    EXPECT_EQ(f.layers[0].interface.film, s.layers[0].interface.film);
+    EXPECT_EQ(f.wavelengths_nm, s.wavelengths_nm);
 }
 
 }  // namespace

@@ -1,0 +1,153 @@
+#pragma once
+// A thin film on an interface: the exact reflection and transmission of a homogeneous layer of
+// thickness d and complex index η_f (η_f + ik_f, k_f ≥ 0 absorbing) between an incident medium and
+// an exit medium (a dielectric, or a conductor of complex index), with the waves inside the film
+// added coherently (docs/physics.md §9).
+//
+// Inside the film the partial waves reflected 0, 1, 2, … times between its two boundaries add as
+// amplitudes. With the amplitudes of the boundaries incident | film (r12, t12) and film | exit
+// (r23, t23) of fresnel_amplitudes (physics/fresnel.h), Stokes' relations r21 = −r12,
+// t12 t21 = 1 − r12² and the phase δ = 2π η_f d cos θ_f / λ of one crossing of the film, the
+// geometric series sums to the Airy formulas, separately for s and p (Born & Wolf, "Principles of
+// Optics", 7th ed., §1.6.4, the reflection and transmission coefficients of a homogeneous film;
+// §7.6.1 for the same sum as multiple-beam interference; Heavens 1955, "Optical Properties of Thin
+// Solid Films", the single film):
+//
+//     r = (r12 + r23 e^{2iδ}) / (1 + r12 r23 e^{2iδ}),   t = t12 t23 e^{iδ} / (1 + r12 r23
+//     e^{2iδ}),
+//
+// and the intensities R = |r|², T = Re(η_3 cos θ3)/(η_1 cos θ1) |t|² (the flux factor of the
+// transmitted beam in a real exit medium). With real indices R is the Airy reflectance
+// (r12² + r23² + 2 r12 r23 cos 2δ)/(1 + r12² r23² + 2 r12 r23 cos 2δ) that Belcour & Barla 2017,
+// "A Practical Extension to Microfacet Theory for the Modeling of Varying Iridescence" (ACM TOG
+// 36(4)), expand into Fourier terms. η_f cos θ_f is Snell's invariant carried into the film:
+// u_f = √(η_f² − sin²θ1) in units of the incident medium's index, complex for an absorbing film or
+// beyond the film's critical angle (frustrated total reflection: the wave tunnels through a thin
+// enough film), its root taken with Im u_f ≥ 0 so that e^{2iδ} never grows.
+//
+// A parallel film does not change directions (Snell's invariant crosses it unchanged), so it acts
+// as a modified Fresnel term of the interface it sits on: the Mueller matrices (physics/
+// polarization.h, form (*)) of the film's r and t replace the bare interface's at every smooth or
+// microfacet event.
+
+#include "physics/fresnel.h"
+#include "physics/polarization.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <numbers>
+
+namespace lamina {
+
+/// The film's amplitudes as a whole (r_s, r_p, t_s, t_p: incident medium to exit medium) and the
+/// flux factor of its transmitted beam, Re(u_3)/cos θ1 (0 when the exit medium absorbs, a
+/// conductor, or when the wave is evanescent there: nothing is transmitted).
+template <typename T>
+struct ThinFilmAmplitudes {
+    FresnelAmplitudes<T> film;
+    T transmitted_flux;
+};
+
+/// The Airy sums of the header for light arriving from the incident medium at cos_theta_i ∈ [0, 1]
+/// (clamped) on a film of complex index eta_film over an exit medium of complex index eta_exit,
+/// both relative to the incident medium, the film's thickness given as `thickness_waves` = d η_1/λ
+/// (d in vacuum wavelengths times the incident medium's absolute index, so that the phase of one
+/// crossing is δ = 2π thickness_waves u_f). Thickness 0 gives the bare boundary incident | exit.
+/// At an index-matched grazing boundary, where the amplitudes are 0/0, the grazing limit: total
+/// reflection (r_s = r_p = −1), nothing transmitted.
+template <typename T>
+ThinFilmAmplitudes<T> thin_film_amplitudes(T cos_theta_i, std::complex<T> eta_film,
+                                           std::complex<T> eta_exit, T thickness_waves) {
+    using C = std::complex<T>;
+    const T mu = std::min(std::max(cos_theta_i, T(0)), T(1));
+    const T sin2 = T(1) - mu * mu;
+    const C u1(mu), u3 = normal_wave_number(eta_exit, sin2);
+    // The Airy sums for the film's normal wave number u2.
+    const auto airy = [&](C u2) {
+        const FresnelAmplitudes<T> b12 = fresnel_amplitudes<T>(C(1), u1, eta_film, u2);
+        const FresnelAmplitudes<T> b23 = fresnel_amplitudes<T>(eta_film, u2, eta_exit, u3);
+        // e^{iδ}: |e^{iδ}| = e^{−Im δ} ≤ 1 since Im u2 ≥ 0.
+        const C phase = std::exp(C(0, T(2) * std::numbers::pi_v<T> * thickness_waves) * u2);
+        const C phase2 = phase * phase;
+        const C den_s = T(1) + b12.r_s * b23.r_s * phase2;
+        const C den_p = T(1) + b12.r_p * b23.r_p * phase2;
+        return FresnelAmplitudes<T>{
+            (b12.r_s + b23.r_s * phase2) / den_s, (b12.r_p + b23.r_p * phase2) / den_p,
+            b12.t_s * b23.t_s * phase / den_s, b12.t_p * b23.t_p * phase / den_p};
+    };
+    // The sums are even functions of u2, analytic in u2² = η_f² − sin²θ1, but at the film's
+    // critical angle (u2 → 0: r12 → 1, r23 → −1, e^{2iδ} → 1) they are 0/0, and evaluated at
+    // |u2| they lose ε/|u2| of their precision. Within h = 1e-6 of it in u2² they are taken as the
+    // mean of their values at u2² ± h (the error of the mean is O(h²), of each value O(ε/√h)).
+    const C w = eta_film * eta_film - sin2;
+    constexpr T kNearCritical = T(1e-6);
+    ThinFilmAmplitudes<T> out;
+    if (std::abs(w) < kNearCritical) {
+        const FresnelAmplitudes<T> a = airy(std::sqrt(w + kNearCritical)),
+                                   b = airy(std::sqrt(w - kNearCritical));
+        out.film = {(a.r_s + b.r_s) / T(2), (a.r_p + b.r_p) / T(2), (a.t_s + b.t_s) / T(2),
+                    (a.t_p + b.t_p) / T(2)};
+    } else {
+        out.film = airy(normal_wave_number(eta_film, sin2));
+    }
+    out.transmitted_flux = eta_exit.imag() == T(0) && mu > T(0) ? u3.real() / mu : T(0);
+    const bool finite = std::isfinite(std::norm(out.film.r_s) + std::norm(out.film.r_p) +
+                                      std::norm(out.film.t_s) + std::norm(out.film.t_p));
+    if (!finite) {  // 0/0 at grazing incidence on an index-matched boundary
+        out.film = {C(-1), C(-1), C(0), C(0)};
+        out.transmitted_flux = T(0);
+    }
+    return out;
+}
+
+/// The reflection and transmission Mueller matrices (form (*) of physics/polarization.h, in the s/p
+/// frame of the plane of incidence) of the film of thin_film_amplitudes: reflection
+/// mueller_of_amplitudes(r_s, r_p, 1), transmission mueller_of_amplitudes(t_s, t_p, Re u_3/cos θ1).
+/// Their `a` are the unpolarized reflectance R = (R_s + R_p)/2 and transmittance T; without
+/// absorption (real film and exit indices) R + T = 1 for each polarization, and 1 − R − T is what
+/// an absorbing film or a conductor exit takes.
+template <typename T>
+struct ThinFilmMueller {
+    InterfaceMueller<T> reflection, transmission;
+};
+
+template <typename T>
+ThinFilmMueller<T> thin_film_mueller(T cos_theta_i, std::complex<T> eta_film,
+                                     std::complex<T> eta_exit, T thickness_waves) {
+    const ThinFilmAmplitudes<T> a =
+        thin_film_amplitudes(cos_theta_i, eta_film, eta_exit, thickness_waves);
+    return {mueller_of_amplitudes(a.film.r_s, a.film.r_p, T(1)),
+            mueller_of_amplitudes(a.film.t_s, a.film.t_p, a.transmitted_flux)};
+}
+
+/// A film on one interface of a stack as the particle events see it (physics/thin_film_event.h):
+/// absolute indices, the channels' wavelengths and the thickness or its range. Light arrives from
+/// above (the medium of index eta_above) or, at a dielectric, from below (eta_below, real); the
+/// indices relative to the side of arrival are formed here, in double.
+struct FilmOptics {
+    std::complex<double> eta_film{1.5, 0.0};
+    double eta_above = 1.0;
+    /// The region below: a dielectric's index (real, every channel) or a conductor's per channel.
+    std::complex<double> eta_below[3] = {1.0, 1.0, 1.0};
+    double wavelength_nm[3] = {630.0, 532.0, 465.0};
+    double thickness_min_nm = 0.0, thickness_max_nm = 0.0;
+
+    bool varies() const { return thickness_max_nm > thickness_min_nm; }
+    /// The thickness at the uniform number u ∈ [0, 1): uniform over [min, max].
+    double thickness_nm(double u) const {
+        return thickness_min_nm + (thickness_max_nm - thickness_min_nm) * u;
+    }
+    /// The film's Mueller matrices in channel c for light arriving at the facet cosine cos_theta
+    /// from above (from_above) or from below, the film thickness_nm thick.
+    ThinFilmMueller<double> mueller(int c, double cos_theta, bool from_above,
+                                    double thickness_nm) const {
+        const double eta_i = from_above ? eta_above : eta_below[c].real();
+        const std::complex<double> exit =
+            from_above ? eta_below[c] : std::complex<double>(eta_above);
+        return thin_film_mueller(cos_theta, eta_film / eta_i, exit / eta_i,
+                                 thickness_nm * eta_i / wavelength_nm[c]);
+    }
+};
+
+}  // namespace lamina
