@@ -63,7 +63,7 @@ struct SimulationSettings {
     std::uint64_t seed = 1;
     int threads = 0;      ///< 0: all available
     HemisphereGrid grid;  ///< its default is the study's (core/grid.h)
-    Kernel kernel = Kernel::Simd;
+    Kernel kernel = Kernel::Auto;  ///< auto: SIMD, or scalar for what only it traces (films)
     /// The physics the particles follow (shared with the random walk).
     TransportSettings transport;
     /// First particle index (a simulation may be split into ranges of particles, e.g. across
