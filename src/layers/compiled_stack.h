@@ -65,6 +65,9 @@ struct CompiledStack {
     /// in all channels (dielectrics, Lambertian bases, grey conductors), 3 when a conductor's
     /// index differs between channels.
     int polarization_channels = 1;
+    /// Some rough interface is anisotropic (GgxAnisotropy::on): the tracers take the general
+    /// (anisotropic) instance of the GGX formulas (GGX::lanes) at every interface.
+    bool anisotropic = false;
 };
 
 /// The stack compiled in precision Real (float: the goniophotometer's kernels; double: the random

@@ -36,6 +36,34 @@ ModelEntry variant(std::string name, std::string description, std::string suppor
             std::move(group)};
 }
 
+// A model built for a stack it cannot represent because an interface is anisotropic (no model
+// of lamina's represents anisotropic roughness yet): it supports nothing and says why.
+class AnisotropyNotSupported final : public Model {
+  public:
+    explicit AnisotropyNotSupported(std::string name) : name_(std::move(name)) {}
+    std::string name() const override { return name_; }
+    Support support() const override {
+        return {false, false,
+                "the stack has an anisotropic interface (alpha = [alpha_x, alpha_y]), which this "
+                "model does not represent"};
+    }
+    Rgbd eval(const Vec3d&, const Vec3d&) const override { return Rgbd(0.0); }
+
+  private:
+    std::string name_;
+};
+
+// Every entry of the registry refuses anisotropic stacks (AnisotropyNotSupported).
+std::vector<ModelEntry> refusing_anisotropy(std::vector<ModelEntry> entries) {
+    for (ModelEntry& e : entries)
+        e.make = [make = e.make, name = e.name](const Stack& stack,
+                                                const ModelOptions& options) -> std::unique_ptr<Model> {
+            if (stack.is_anisotropic()) return std::make_unique<AnisotropyNotSupported>(name);
+            return make(stack, options);
+        };
+    return entries;
+}
+
 const ModelFamily<WWChoices> kWeidlichWilkie{
     [](const std::string&) -> const ModelOptionTable<WWChoices>& { return ww_option_table(); },
     ww_variant, make_ww_model};
@@ -54,7 +82,7 @@ const ModelFamily<Ddb22Choices> kDdb22{
 }  // namespace
 
 const std::vector<ModelEntry>& model_registry() {
-    static const std::vector<ModelEntry> entries = {
+    static const std::vector<ModelEntry> entries = refusing_anisotropy({
         variant(
             "ww09",
             "Weidlich & Wilkie, SIGGRAPH Asia 2009 course code: T01 and refraction at h, base at "
@@ -165,7 +193,7 @@ const std::vector<ModelEntry>& model_registry() {
          "base) with terms derived from the layering and fitted on the study's reference",
          "bases: lambertian, conductor; media: absorbing; eta0 in [1.1, 2.6]; sides: R",
          lamina_coat_options, make_lamina_coat, false, "lamina"},
-    };
+    });
     return entries;
 }
 

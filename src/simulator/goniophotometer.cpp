@@ -97,7 +97,9 @@ struct MediumWalk {
 // Polarized runs: pol goes through the event too (pol.flux: the caller's copy of w). Where the
 // channels' states differ, a dielectric's branch choice reweights the channels: the reweighting
 // (zero in expectation per channel) is booked with the base that coloured them.
-template <bool kPolarized>
+// kAnisotropic: the stack has an anisotropic interface (CompiledStack::anisotropic), and every
+// rough interface takes the general instance of the GGX formulas (GGX::lanes).
+template <bool kPolarized, bool kAnisotropic>
 inline void interface_event(const CompiledStack<float>& stack, const CompiledLayer<float>& layer,
                             ParticleRng& rng, Tally& tally, Vec3f& d, Rgbf& w, PathLosses& losses,
                             [[maybe_unused]] PolarizationLanes<float>& pol) {
@@ -148,24 +150,27 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
         case InterfaceType::Dielectric: {
             if (layer.multiple) {
                 if constexpr (kPolarized) {
-                    apply_walk(walk_rough_dielectric_polarized(
+                    apply_walk(walk_rough_dielectric_polarized<kAnisotropic>(
                                    layer.dielectric.distribution(), layer.dielectric.eta, wi_local,
                                    uniform, stack.max_microsurface_order, pol),
                                reweights);
                     break;
                 }
-                apply_walk(
-                    walk_rough_dielectric(layer.dielectric.distribution(), layer.dielectric.eta,
-                                          wi_local, uniform, stack.max_microsurface_order),
-                    false);
+                apply_walk(walk_rough_dielectric<kAnisotropic>(
+                               layer.dielectric.distribution(), layer.dielectric.eta, wi_local,
+                               uniform, stack.max_microsurface_order),
+                           false);
                 break;
             }
             const float uc = rng.uniform_float(), u1 = rng.uniform_float(),
                         u2 = rng.uniform_float();
             if constexpr (kPolarized)
-                apply(layer.dielectric.sample_polarized(wi_local, uc, u1, u2, pol), reweights);
+                apply(layer.dielectric.template sample_polarized<kAnisotropic>(wi_local, uc, u1, u2,
+                                                                               pol),
+                      reweights);
             else
-                apply(layer.dielectric.sample<false>(wi_local, uc, u1, u2), false);
+                apply(layer.dielectric.template sample<false, kAnisotropic>(wi_local, uc, u1, u2),
+                      false);
             break;
         }
         case InterfaceType::Conductor: {
@@ -175,13 +180,13 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
                     const auto mueller = [&](float c, InterfaceMueller<float>* m) {
                         cond.mueller(c, m);
                     };
-                    apply_walk(
-                        walk_rough_conductor_polarized(cond.distribution(), mueller, wi_local,
-                                                       uniform, stack.max_microsurface_order, pol),
-                        true);
+                    apply_walk(walk_rough_conductor_polarized<kAnisotropic>(
+                                   cond.distribution(), mueller, wi_local, uniform,
+                                   stack.max_microsurface_order, pol),
+                               true);
                     break;
                 }
-                apply_walk(walk_rough_conductor(
+                apply_walk(walk_rough_conductor<kAnisotropic>(
                                cond.distribution(), [&](float c) { return cond.fresnel(c); },
                                wi_local, uniform, stack.max_microsurface_order),
                            true);
@@ -189,9 +194,9 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
             }
             const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
             if constexpr (kPolarized)
-                apply(cond.sample_polarized(wi_local, u1, u2, pol), true);
+                apply(cond.template sample_polarized<kAnisotropic>(wi_local, u1, u2, pol), true);
             else
-                apply(cond.sample<false>(wi_local, u1, u2), true);
+                apply(cond.template sample<false, kAnisotropic>(wi_local, u1, u2), true);
             break;
         }
         case InterfaceType::Lambertian: {
@@ -212,7 +217,7 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
 // passes it to the interface's polarized event, a Lambertian base and a scattering event
 // depolarize it, and an exit is tallied with its Stokes vector when the job asks for it.
 // Written once for both: kPolarized = false is the unpolarized kernel, with none of it.
-template <bool kPolarized>
+template <bool kPolarized, bool kAnisotropic>
 void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& grid,
                     const BlockJob& job, ParticleRng& rng, Tally& tally, BlockBudget& block) {
     const int n_layers = int(stack.layers.size());
@@ -246,7 +251,7 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         if constexpr (kPolarized)
             for (int c = 0; c < 3; ++c)
                 flux[c] = w[c];
-        interface_event<kPolarized>(stack, layer, rng, tally, d, w, losses, pol);
+        interface_event<kPolarized, kAnisotropic>(stack, layer, rng, tally, d, w, losses, pol);
         if (is_black(w)) break;
         if (d.z == 0) {
             // An exactly grazing direction (a sampler at the edge of its domain, probability
@@ -315,10 +320,16 @@ constexpr float kIncidentStokes[7][3] = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 
 void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block) {
     for (std::uint64_t p = job.first; p < job.first + job.count; ++p) {
         ParticleRng rng(job.seed, job.stream, p);
-        if (job.stack->polarization)
-            trace_particle<true>(*job.stack, *job.grid, job, rng, tally, block);
-        else
-            trace_particle<false>(*job.stack, *job.grid, job, rng, tally, block);
+        if (job.stack->anisotropic) {
+            if (job.stack->polarization)
+                trace_particle<true, true>(*job.stack, *job.grid, job, rng, tally, block);
+            else
+                trace_particle<false, true>(*job.stack, *job.grid, job, rng, tally, block);
+        } else if (job.stack->polarization) {
+            trace_particle<true, false>(*job.stack, *job.grid, job, rng, tally, block);
+        } else {
+            trace_particle<false, false>(*job.stack, *job.grid, job, rng, tally, block);
+        }
     }
 }
 
@@ -345,6 +356,12 @@ void IncidenceSums::add(const IncidenceSums& o) {
 SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,
                              const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);
+    if (settings.kernel == Kernel::Simd && stack.is_anisotropic())
+        throw InputError(
+            "settings", "kernel",
+            fmt::format("the stack '{}' has an anisotropic interface, which the simd "
+                        "kernel does not trace; use --kernel scalar (kernel=\"scalar\")",
+                        stack.name));
     const auto start = std::chrono::steady_clock::now();
     const CompiledStack<float> trace = compile_stack<float>(stack, settings.transport);
     const HemisphereGrid& grid = settings.grid;
