@@ -239,7 +239,9 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         float s[3][4];
         const float wl[3] = {w[0], w[1], w[2]};
         stokes_in_bin_frame<float>(pol.stokes, {d.x, d.y, d.z}, wl, pol.channels, true, s);
-        tally.exit_stokes(index, d.y < 0 ? 1 : 0, s);
+        // Folded bins count the patch y < 0 as its mirror image (mueller.h); unfolded ones are one
+        // patch each.
+        tally.exit_stokes(index, d.y < 0 && !job.grid->is_unfolded() ? 1 : 0, s);
     };
     while (true) {
         if (events >= max_events) {
@@ -362,9 +364,13 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
             fmt::format("the stack '{}' has an anisotropic interface, which the simd "
                         "kernel does not trace; use --kernel scalar (kernel=\"scalar\")",
                         stack.name));
+    if (settings.kernel == Kernel::Simd && settings.phi_i_deg != 0)
+        throw InputError("settings", "kernel",
+                         "light from phi_i ≠ 0 is tabulated on the unfolded grid, which the simd "
+                         "kernel does not bin; use --kernel scalar (kernel=\"scalar\")");
     const auto start = std::chrono::steady_clock::now();
     const CompiledStack<float> trace = compile_stack<float>(stack, settings.transport);
-    const HemisphereGrid& grid = settings.grid;
+    const HemisphereGrid grid = simulation_grid(stack, settings);
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
     if (settings.kernel == Kernel::Simd) select_simd_target();
     const auto trace_block =
@@ -384,7 +390,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
         const double theta_i = deg_to_rad(settings.theta_i_deg[inc]);
         BlockJob job{&trace,
                      &grid,
-                     Vec3f(incident_direction(theta_i)),
+                     Vec3f(direction_from_angles(theta_i, deg_to_rad(settings.phi_i_deg))),
                      settings.seed,
                      incidence_stream(settings.theta_i_deg[inc], settings.incident_polarization),
                      0,
@@ -427,7 +433,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
 SimulationResult finalize_simulation(const Stack& stack, const SimulationSettings& settings,
                                      const SimulationSums& sums) {
     LAMINA_CHECK(sums.incidences.size() == settings.theta_i_deg.size());
-    const HemisphereGrid& grid = settings.grid;
+    const HemisphereGrid grid = simulation_grid(stack, settings);
     const bool transmits = stack.transmits();
     SimulationResult result;
     result.settings = settings;
@@ -476,6 +482,11 @@ SimulationResult finalize_simulation(const Stack& stack, const SimulationSetting
     }
     if (settings.stokes_tallies) result.sums = sums.incidences;
     return result;
+}
+
+HemisphereGrid simulation_grid(const Stack& stack, const SimulationSettings& settings) {
+    return stack.is_anisotropic() || settings.phi_i_deg != 0 ? settings.grid.unfolded()
+                                                             : settings.grid;
 }
 
 SimulationResult simulate(const Stack& stack, const SimulationSettings& settings,

@@ -51,7 +51,10 @@ std::string kernel_description(Kernel kernel);
 /// there.
 struct SimulationSettings {
     std::vector<double> theta_i_deg = default_incidences_deg();  ///< each in [0, 90)
-    std::uint64_t particles = 1'000'000;                         ///< per incidence, > 0
+    /// The incidence azimuth φi in degrees, [0, 360]: the light comes from (sin θi cos φi,
+    /// sin θi sin φi, cos θi). A non-zero φi unfolds the φ grid (simulation_grid).
+    double phi_i_deg = 0.0;
+    std::uint64_t particles = 1'000'000;  ///< per incidence, > 0
     std::uint64_t seed = 1;
     int threads = 0;      ///< 0: all available
     HemisphereGrid grid;  ///< its default is the study's (core/grid.h)
@@ -80,6 +83,13 @@ struct SimulationSettings {
                .help = "Incidences in degrees, comma-separated, in [0, 90)",
                .key = Key::Fixed},
               s.theta_i_deg);
+        visit({.name = "phi_i",
+               .help = "Incidence azimuth in degrees, in [0, 360] (light from (sin θi cos φi, sin "
+                       "θi sin φi, cos θi)); a non-zero φi unfolds the grid over φ∈[0°,360°)",
+               .min = 0,
+               .max = 360,
+               .key_unsaid = "0"},
+              s.phi_i_deg);
         visit({.name = "particles",
                .help = "Particles per incidence (1e7-style accepted)",
                .min = 1,
@@ -171,6 +181,11 @@ struct SimulationResult {
     int threads_used = 1;  ///< per process
     int processes = 1;     ///< processes that shared the particles (distributed/split_simulation.h)
 };
+
+/// The grid the goniophotometer tabulates a stack on: settings.grid, unfolded over φ ∈ [0°, 360°)
+/// when the stack is anisotropic or the light comes from φi ≠ 0 (no mirror symmetry about the
+/// plane φ = 0 then; core/grid.h). The result's table is on this grid.
+HemisphereGrid simulation_grid(const Stack& stack, const SimulationSettings& settings);
 
 /// Checks what the settings' codecs cannot see alone (InputError naming `where` and the setting).
 void validate_settings(const SimulationSettings& settings, const std::string& where = "settings");
