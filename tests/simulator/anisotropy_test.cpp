@@ -7,8 +7,11 @@
 // tolerances from the tables' standard errors.
 #include "core/error.h"
 #include "core/math.h"
+#include "core/rng.h"
 #include "layers/stack.h"
+#include "physics/conductor.h"
 #include "physics/fresnel.h"
+#include "physics/microsurface_walk.h"
 #include "simulator/goniophotometer.h"
 #include "support/stacks.h"
 
@@ -277,6 +280,101 @@ TEST(AnisotropyStat, SingleConductorMatchesTheAnisotropicMicrofacetBrdf) {
         }
     EXPECT_EQ(outside, 0) << outside << " of " << compared << " bins (worst " << worst << ")";
     EXPECT_GT(compared, 30);
+}
+
+// The rough dielectric of relative index eta with the anisotropic D and Λ of ClosedForm (Walter et
+// al. 2007, Eqs. 20 and 21) and the Smith microsurface's G2: 1/(1 + Λi + Λo) for reflection,
+// B(1 + Λi, 1 + Λo) for refraction (docs/physics.md §3; std::beta).
+double dielectric_closed_form(const ClosedForm& c, double eta, const Vec3d& wi, const Vec3d& wo) {
+    const bool reflect = wo.z > 0;
+    Vec3d m = reflect ? wi + wo : -(wi + wo * eta);
+    m = normalize(m);
+    if (m.z < 0) m = -m;
+    const double ci = dot(wi, m), co = dot(wo, m);
+    if (ci <= 0 || (reflect ? co <= 0 : co >= 0)) return 0;
+    const double F = fresnel_dielectric(ci, eta);
+    const double li = c.lambda(wi), lo = c.lambda(wo);
+    if (reflect) return F * c.D(m) / (1 + li + lo) / (4 * wi.z * wo.z);
+    const double G2 = std::beta(1 + li, 1 + lo);
+    return (1 - F) * c.D(m) * G2 * eta * eta * std::abs(ci * co) /
+           (std::abs(wi.z * wo.z) * sqr(ci + eta * co));
+}
+
+TEST(AnisotropyStat, SingleDielectricMatchesTheAnisotropicMicrofacetBsdf) {
+    const ClosedForm shape{0.2, 0.5, deg_to_rad(-40.0)};
+    const double eta = 1.5;
+    SimulationSettings s = scalar_settings(50, 1'000'000);
+    s.phi_i_deg = 10;
+    s.transport.microsurface = Microsurface::Single;
+    s.transport.polarization = false;
+    const Stack stack = test::make_stack({layer_of(
+        anisotropic(dielectric_interface(eta, shape.alpha_x), shape.alpha_x, shape.alpha_y, -40))});
+    const SimulationResult r = simulate(stack, s);
+    const HemisphereGrid& grid = r.table.grid;
+    const Vec3d wi = direction_from_angles(deg_to_rad(50.0), deg_to_rad(10.0));
+    int compared = 0, outside = 0;
+    double worst = 0;
+    for (Side side : {Side::Reflection, Side::Transmission}) {
+        const BinnedLobe& lobe = r.table.lobe(0, side);
+        for (int t = 0; t < grid.n_theta(); t += 2)
+            for (int p = 0; p < grid.n_phi(); p += 3) {
+                const double s0 = sqr(std::sin(grid.theta_lo(t))),
+                             s1 = sqr(std::sin(grid.theta_hi(t)));
+                constexpr int kNodes = 24;
+                double sum = 0;
+                for (int a = 0; a < kNodes; ++a)
+                    for (int b = 0; b < kNodes; ++b) {
+                        const double u = s0 + (s1 - s0) * (a + 0.5) / kNodes;
+                        const double phi =
+                            grid.phi_lo(p) + (grid.phi_hi(p) - grid.phi_lo(p)) * (b + 0.5) / kNodes;
+                        const double st = std::sqrt(u), ct = std::sqrt(1 - u);
+                        const Vec3d wo = {st * std::cos(phi), st * std::sin(phi),
+                                          side == Side::Reflection ? ct : -ct};
+                        sum += dielectric_closed_form(shape, eta, wi, wo);
+                    }
+                const double expected = sum / (kNodes * kNodes);
+                const std::size_t j = std::size_t(t) * grid.n_phi() + std::size_t(p);
+                if (expected < 1e-3) continue;
+                ++compared;
+                const double z =
+                    std::abs(lobe.f[j][0] - expected) / (lobe.se[j][0] + 5e-3 * expected);
+                worst = std::max(worst, z);
+                if (z > 4.5) ++outside;
+            }
+    }
+    EXPECT_EQ(outside, 0) << outside << " of " << compared << " bins (worst " << worst << ")";
+    EXPECT_GT(compared, 60);
+}
+
+TEST(AnisotropyStat, WalkFirstOrderIsTheSingleScatteringInterface) {
+    // The fraction of anisotropic microsurface walks that leave after their first facet is the
+    // single-scattering interface's escape fraction E[G2/G1] (its first order, docs/physics.md §3),
+    // on a conductor whose facets reflect everything (F = 1).
+    const GGX<double> ggx = GGX<double>::anisotropic(0.3, 0.7, 0.6);
+    const ConductorInterface<double> iface{Rgbd(1.0), Rgbd(0.0), 0.3, false, ggx.anisotropy};
+    const auto white = [](double) { return Rgbd(1.0); };
+    for (double theta : {20.0, 60.0, 80.0}) {
+        for (double phi : {0.0, 1.2}) {
+            const Vec3d wi = direction_from_angles(deg_to_rad(theta), phi);
+            ParticleRng rng(3, std::uint64_t(theta * 10 + phi), 0);
+            auto uniform = [&] { return double(rng.uniform_float()); };
+            constexpr int kN = 200'000;
+            double first = 0, escape = 0, escape2 = 0;
+            for (int n = 0; n < kN; ++n) {
+                const auto e = walk_rough_conductor<true>(ggx, white, wi, uniform, 100);
+                if (e && e->escaped && e->order == 1) first += 1;
+                const auto smp = iface.sample<false, true>(wi, uniform(), uniform());
+                const double g = smp ? smp->shadowing : 0.0;
+                escape += g;
+                escape2 += g * g;
+            }
+            const double p = first / kN, mean = escape / kN;
+            const double se = std::hypot(std::sqrt(p * (1 - p) / kN),
+                                         std::sqrt(std::max(0.0, escape2 / kN - mean * mean) / kN));
+            EXPECT_NEAR(p, mean, 4.5 * se) << theta << " " << phi;
+            EXPECT_LT(p, 1.0);
+        }
+    }
 }
 
 TEST(AnisotropyStat, MultipleScatteringConservesEnergyOnAWhiteConductor) {
