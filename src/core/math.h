@@ -8,9 +8,6 @@
 /// Forces inlining of small hot-path functions the compiler's heuristics would keep out of line
 /// (the particle tracer's interface samplers).
 #define LAMINA_FORCE_INLINE inline __attribute__((always_inline))
-/// The same for a lambda, written after its parameter list: `[&](int x) LAMINA_FORCE_INLINE_LAMBDA
-/// {`.
-#define LAMINA_FORCE_INLINE_LAMBDA __attribute__((always_inline))
 
 namespace lamina {
 

@@ -228,12 +228,6 @@ LAMINA_LANE_END
 
 namespace lamina {
 
-/// f(g), never inlined (GGX::with_lanes says why).
-template <typename F, typename G>
-[[gnu::noinline]] decltype(auto) ggx_call_out_of_line(F& f, const G& g) {
-    return f(g);
-}
-
 template <typename T>
 struct GGX {
     T alpha;  ///< α_x: along the tangent; an isotropic distribution's α
@@ -255,14 +249,10 @@ struct GGX {
         return ggx_lanes<T, Lane<T>, kAnisotropic>(alpha, anisotropy.alpha_y,
                                                    anisotropy.tangent_cos, anisotropy.tangent_sin);
     }
-    /// f(lanes<anisotropy.on>()): a lane template called with the distribution's roughness.
-    /// The anisotropic instance is called out of line (ggx_call_out_of_line), so that the code
-    /// around the isotropic one is compiled as if there were no other (its floating-point
-    /// contractions, and hence isotropic results, are those of the isotropic code alone).
-    template <typename F>
-    LAMINA_FORCE_INLINE decltype(auto) with_lanes(F&& f) const {
-        if (anisotropy.on) return ggx_call_out_of_line(f, lanes<true>());
-        return f(lanes<false>());
+    /// The stretch ggx_stretch of this distribution, applied to (x, y).
+    void stretch(T& x, T& y) const {
+        if (anisotropy.on) return stretch_anisotropic(x, y);
+        ggx_stretch(lanes<false>(), x, y);
     }
 
     /// Normal distribution D(wm), 1/sr: the anisotropic GGX (Heitz 2014, the anisotropic
@@ -279,24 +269,13 @@ struct GGX {
         return alpha2 / (kPi<T> * sqr(denom));
     }
 
-    /// D of an anisotropic distribution (wm.z > 0), multiplied through by α_x² α_y² as the
-    /// isotropic form: α_x α_y / (π (α_y² m_t² + α_x² m_b² + α_x² α_y² m_z²)²) · α_x² α_y².
-    T D_anisotropic(const Vec3<T>& wm) const {
-        const T alpha_y = anisotropy.alpha_y;
-        const T m_t = anisotropy.tangent_cos * wm.x + anisotropy.tangent_sin * wm.y;
-        const T m_b = anisotropy.tangent_cos * wm.y - anisotropy.tangent_sin * wm.x;
-        const T product2 = sqr(alpha * alpha_y);
-        const T denom = sqr(alpha_y * m_t) + sqr(alpha * m_b) + product2 * sqr(wm.z);
-        return alpha * alpha_y * product2 / (kPi<T> * sqr(denom));
-    }
-
     /// Smith Λ(w) for GGX: Heitz 2014, "Understanding the masking-shadowing function in
     /// microfacet-based BRDFs", JCGT 3(2), Eq. 72: Λ = (−1 + sqrt(1 + α(φ)² tan²θ)) / 2, α(φ) the
     /// roughness projected on w's azimuth (ggx_projected_alpha2). Symmetric in w.z; infinite at
     /// grazing (w.z = 0). The lane template ggx_lambda.
     T lambda(const Vec3<T>& w) const {
-        return with_lanes([&](const auto& g)
-                              LAMINA_FORCE_INLINE_LAMBDA { return ggx_lambda(g, w.x, w.y, w.z); });
+        if (anisotropy.on) return lambda_anisotropic(w);
+        return ggx_lambda(lanes<false>(), w.x, w.y, w.z);
     }
 
     /// Smith masking G1(w) = 1 / (1 + Λ(w)) (Heitz 2014, Eq. 43).
@@ -344,8 +323,7 @@ struct GGX {
             const Vec3<T> nh = t1 * p1 + t2 * p2 + vh * safe_sqrt(T(1) - sqr(p1) - sqr(p2));
             // Section 3.4: back to the ellipsoid configuration.
             T x = nh.x, y = nh.y;
-            GGX<T>{alpha, anisotropy}.with_lanes(
-                [&](const auto& g) LAMINA_FORCE_INLINE_LAMBDA { ggx_stretch(g, x, y); });
+            GGX<T>{alpha, anisotropy}.stretch(x, y);
             return normalize(Vec3<T>(x, y, max0(nh.z)));
         }
     };
@@ -356,7 +334,7 @@ struct GGX {
         // Section 3.2: the view direction in the hemisphere configuration (α = 1), stretched in
         // the interface's frame (ggx_stretch: the hemisphere configuration is isotropic).
         T x = w.x, y = w.y;
-        with_lanes([&](const auto& g) LAMINA_FORCE_INLINE_LAMBDA { ggx_stretch(g, x, y); });
+        stretch(x, y);
         const Vec3<T> vh = normalize(Vec3<T>(x, y, w.z));
         // Section 4.1: orthonormal basis around vh.
         const T len2 = sqr(vh.x) + sqr(vh.y);
@@ -401,9 +379,9 @@ struct GGX {
     /// a hemisphere). For w.z ≥ 0 it is sample_visible_normal_caps. The lane template
     /// ggx_sample_visible_normal_complete.
     Vec3<T> sample_visible_normal_complete(const Vec3<T>& w, T u1, T u2) const {
-        const LaneVec3<T> wm = with_lanes([&](const auto& g) LAMINA_FORCE_INLINE_LAMBDA {
-            return ggx_sample_visible_normal_complete(g, LaneVec3<T>{w.x, w.y, w.z}, u1, u2);
-        });
+        if (anisotropy.on) return sample_visible_normal_complete_anisotropic(w, u1, u2);
+        const LaneVec3<T> wm =
+            ggx_sample_visible_normal_complete(lanes<false>(), {w.x, w.y, w.z}, u1, u2);
         return {wm.x, wm.y, wm.z};
     }
 
@@ -412,13 +390,43 @@ struct GGX {
     T smith_root(const Vec3<T>& w) const {
         const T cos2 = sqr(w.z);
         if (cos2 == 0) return std::numeric_limits<T>::infinity();
-        return std::sqrt(T(1) + with_lanes([&](const auto& g) LAMINA_FORCE_INLINE_LAMBDA {
-                                    return ggx_projected_alpha2(g, w.x, w.y);
-                                }) / cos2);
+        if (anisotropy.on) return std::sqrt(T(1) + projected_alpha2_anisotropic(w) / cos2);
+        return std::sqrt(T(1) + ggx_projected_alpha2(lanes<false>(), w.x, w.y) / cos2);
     }
 
     /// Density of sample_visible_normal, with respect to solid angle of wm.
     T pdf_visible_normal(const Vec3<T>& w, const Vec3<T>& wm) const { return D_visible(w, wm); }
+
+  private:
+    /// D of an anisotropic distribution (wm.z > 0), multiplied through by α_x² α_y² as the
+    /// isotropic form: α_x α_y / (π (α_y² m_t² + α_x² m_b² + α_x² α_y² m_z²)²) · α_x² α_y².
+    [[gnu::noinline]] T D_anisotropic(const Vec3<T>& wm) const {
+        const T alpha_y = anisotropy.alpha_y;
+        const T m_t = anisotropy.tangent_cos * wm.x + anisotropy.tangent_sin * wm.y;
+        const T m_b = anisotropy.tangent_cos * wm.y - anisotropy.tangent_sin * wm.x;
+        const T product2 = sqr(alpha * alpha_y);
+        const T denom = sqr(alpha_y * m_t) + sqr(alpha * m_b) + product2 * sqr(wm.z);
+        return alpha * alpha_y * product2 / (kPi<T> * sqr(denom));
+    }
+
+    // The anisotropic instances, out of line: the code around the isotropic instance is then
+    // compiled as if there were no other (its floating-point contractions, hence its results, are
+    // those of the isotropic formulas alone).
+    [[gnu::noinline]] T lambda_anisotropic(const Vec3<T>& w) const {
+        return ggx_lambda(lanes<true>(), w.x, w.y, w.z);
+    }
+    [[gnu::noinline]] T projected_alpha2_anisotropic(const Vec3<T>& w) const {
+        return ggx_projected_alpha2(lanes<true>(), w.x, w.y);
+    }
+    [[gnu::noinline]] void stretch_anisotropic(T& x, T& y) const {
+        ggx_stretch(lanes<true>(), x, y);
+    }
+    [[gnu::noinline]] Vec3<T> sample_visible_normal_complete_anisotropic(const Vec3<T>& w, T u1,
+                                                                         T u2) const {
+        const LaneVec3<T> wm =
+            ggx_sample_visible_normal_complete(lanes<true>(), {w.x, w.y, w.z}, u1, u2);
+        return {wm.x, wm.y, wm.z};
+    }
 };
 
 }  // namespace lamina

@@ -655,8 +655,9 @@ inline void microsurface_conductor_connect_polarized(const GGX<T>& ggx, const Mu
 }
 
 /// walk_rough_dielectric with a visitor: `visit(const MicrosurfaceFacet<T>&)` is called at every
-/// facet before the particle scatters off it. The same walk (microsurface_walk at one lane, the
-/// same random numbers in the same order): returns the same exit.
+/// facet before the particle scatters off it (kAnisotropic as walk_rough_dielectric's). The same
+/// walk (microsurface_walk at one lane, the same random numbers in the same order): returns the
+/// same exit.
 template <typename T, typename Visit>
 struct MicrosurfaceFacetVisitor {
     Visit& visit;
@@ -667,22 +668,20 @@ struct MicrosurfaceFacetVisitor {
                                        Rgb<T>(weight[0], weight[1], weight[2]), int(order)});
     }
 };
-template <typename T, typename Uniform, typename Visit>
+template <bool kAnisotropic = false, typename T, typename Uniform, typename Visit>
 std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_visiting(const GGX<T>& ggx, T eta,
                                                                   const Vec3<T>& wi,
                                                                   Uniform&& uniform, int max_order,
                                                                   Visit&& visit) {
     auto draw = [&] { return T(uniform()); };
     const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw)> facet{eta, T(1) / eta, draw};
-    return ggx.with_lanes([&](const auto& g) LAMINA_FORCE_INLINE_LAMBDA {
-        return microsurface_exit(microsurface_walk<T, Lane<T>>(
-            g, {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
-            MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
-    });
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(
+        ggx.template lanes<kAnisotropic>(), {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
+        MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
 }
 
 /// walk_rough_conductor with a visitor, as walk_rough_dielectric_visiting.
-template <typename T, typename Fresnel, typename Uniform, typename Visit>
+template <bool kAnisotropic = false, typename T, typename Fresnel, typename Uniform, typename Visit>
 std::optional<MicrosurfaceExit<T>> walk_rough_conductor_visiting(const GGX<T>& ggx,
                                                                  const Fresnel& fresnel,
                                                                  const Vec3<T>& wi,
@@ -694,31 +693,27 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor_visiting(const GGX<T>& g
         out[0] = f[0], out[1] = f[1], out[2] = f[2];
     };
     const MicrosurfaceConductorFacet<T, Lane<T>, decltype(factors)> facet{factors};
-    return ggx.with_lanes([&](const auto& g) LAMINA_FORCE_INLINE_LAMBDA {
-        return microsurface_exit(microsurface_walk<T, Lane<T>>(
-            g, {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
-            MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
-    });
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(
+        ggx.template lanes<kAnisotropic>(), {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
+        MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
 }
 
 /// walk_rough_dielectric_polarized with a visitor, as walk_rough_dielectric_visiting; at each call
 /// `pol.stokes` holds the state with which the particle meets the facet.
-template <typename T, typename Uniform, typename Visit>
+template <bool kAnisotropic = false, typename T, typename Uniform, typename Visit>
 std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_polarized_visiting(
     const GGX<T>& ggx, T eta, const Vec3<T>& wi, Uniform&& uniform, int max_order,
     PolarizationLanes<T>& pol, Visit&& visit) {
     auto draw = [&] { return T(uniform()); };
     const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw), true> facet{eta, T(1) / eta, draw,
                                                                               &pol};
-    return ggx.with_lanes([&](const auto& g) LAMINA_FORCE_INLINE_LAMBDA {
-        return microsurface_exit(microsurface_walk<T, Lane<T>>(
-            g, {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
-            MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
-    });
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(
+        ggx.template lanes<kAnisotropic>(), {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
+        MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
 }
 
 /// walk_rough_conductor_polarized with a visitor, as walk_rough_dielectric_polarized_visiting.
-template <typename T, typename Mueller, typename Uniform, typename Visit>
+template <bool kAnisotropic = false, typename T, typename Mueller, typename Uniform, typename Visit>
 std::optional<MicrosurfaceExit<T>> walk_rough_conductor_polarized_visiting(
     const GGX<T>& ggx, const Mueller& mueller, const Vec3<T>& wi, Uniform&& uniform, int max_order,
     PolarizationLanes<T>& pol, Visit&& visit) {
@@ -726,11 +721,9 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor_polarized_visiting(
     const NoMueller unpolarized;
     const MicrosurfaceConductorFacet<T, Lane<T>, NoMueller, Mueller> facet{unpolarized, &pol,
                                                                            &mueller};
-    return ggx.with_lanes([&](const auto& g) LAMINA_FORCE_INLINE_LAMBDA {
-        return microsurface_exit(microsurface_walk<T, Lane<T>>(
-            g, {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
-            MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
-    });
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(
+        ggx.template lanes<kAnisotropic>(), {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
+        MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
 }
 
 /// One walk's unbiased estimate of the multiple-scattering rough dielectric's f(wi, wo)·|cos θo|
