@@ -28,6 +28,14 @@ std::vector<int> make_guess(const std::vector<double>& edges, double x_min) {
 }
 }  // namespace
 
+HemisphereGrid HemisphereGrid::unfolded() const {
+    if (unfolded_) return *this;
+    HemisphereGrid g = *this;
+    g.n_phi_ = 2 * n_phi_;
+    g.unfolded_ = true;
+    return g;
+}
+
 HemisphereGrid::HemisphereGrid(int n_theta, int n_phi) : n_theta_(n_theta), n_phi_(n_phi) {
     for (int t = 0; t <= n_theta_; ++t)
         cos_theta_edge_.push_back(std::cos(theta_lo(t)));
@@ -40,7 +48,9 @@ HemisphereGrid::HemisphereGrid(int n_theta, int n_phi) : n_theta_(n_theta), n_ph
 }
 
 double HemisphereGrid::projected_solid_angle(int t, int p) const {
-    return (phi_hi(p) - phi_lo(p)) * (sqr(std::sin(theta_hi(t))) - sqr(std::sin(theta_lo(t))));
+    const double folded =
+        (phi_hi(p) - phi_lo(p)) * (sqr(std::sin(theta_hi(t))) - sqr(std::sin(theta_lo(t))));
+    return unfolded_ ? folded / 2 : folded;
 }
 
 int HemisphereGrid::theta_bin(double cos_theta) const {
@@ -54,11 +64,13 @@ int HemisphereGrid::phi_bin(double x, double y) const {
     const double r = std::sqrt(x * x + y * y);
     if (r == 0) return 0;
     const double cos_phi = clamp(x / r, -1.0, 1.0);  // folded: φ and −φ share a bin
-    return refine_bin(cos_phi, phi_guess_[int((1.0 - cos_phi) * 0.5 * kGuessResolution)],
-                      cos_phi_edge_);
+    const int folded = refine_bin(
+        cos_phi, phi_guess_[int((1.0 - cos_phi) * 0.5 * kGuessResolution)], cos_phi_edge_);
+    return unfolded_ && y < 0 ? n_phi_ - 1 - folded : folded;
 }
 
 std::string HemisphereGrid::to_string() const {
+    if (unfolded_) return fmt::format("{}x{} unfolded", n_theta_, n_phi_ / 2);
     return fmt::format("{}x{}", n_theta_, n_phi_);
 }
 

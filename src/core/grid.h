@@ -7,6 +7,10 @@
 // plane of incidence, whose light sits at φ = 0). Bin j = theta_bin · n_phi + phi_bin.
 // Its projected solid angle, both folded halves: Ω⊥ = ∫_bin |cos θ| dω = (φ1 − φ0)(sin²θ1 − sin²θ0)
 // (the half-hemisphere's (φ1 − φ0)(sin²θ1 − sin²θ0)/2, counted twice).
+// The unfolded grid (unfolded(): an anisotropic stack, or light from φi ≠ 0, has no mirror
+// symmetry about the plane φ = 0) covers φ ∈ [0°, 360°) in twice as many bins of the same width,
+// each one patch: Ω⊥ = (φ1 − φ0)(sin²θ1 − sin²θ0)/2. Its bins p < n_phi/2 are the folded grid's
+// bins over y ≥ 0; bin n_phi − 1 − p is the mirror image (y < 0) of bin p.
 
 #include "core/math.h"
 #include "core/vec.h"
@@ -21,20 +25,29 @@ namespace lamina {
 
 class HemisphereGrid {
   public:
-    /// n_theta, n_phi ≥ 1 (checked by parse_grid for user input).
+    /// n_theta, n_phi ≥ 1 (checked by parse_grid for user input): the folded grid.
     HemisphereGrid(int n_theta = 90, int n_phi = 90);
 
+    /// The unfolded grid of the same bin width over φ ∈ [0°, 360°) (2 n_phi bins); itself if
+    /// already unfolded.
+    HemisphereGrid unfolded() const;
+    /// Whether φ covers [0°, 360°) (unfolded) or [0°, 180°] with φ and −φ folded.
+    bool is_unfolded() const { return unfolded_; }
+    /// The φ range the bins cover: π (folded) or 2π (unfolded), in radians.
+    double phi_span() const { return unfolded_ ? 2 * kPi<double> : kPi<double>; }
+
     int n_theta() const { return n_theta_; }
+    /// φ bins (2× the folded count when unfolded).
     int n_phi() const { return n_phi_; }
     std::size_t size() const { return std::size_t(n_theta_) * std::size_t(n_phi_); }
 
     /// Bin edges in radians.
     double theta_lo(int t) const { return kPi<double> / 2 * t / n_theta_; }
     double theta_hi(int t) const { return kPi<double> / 2 * (t + 1) / n_theta_; }
-    double phi_lo(int p) const { return kPi<double> * p / n_phi_; }
-    double phi_hi(int p) const { return kPi<double> * (p + 1) / n_phi_; }
+    double phi_lo(int p) const { return phi_span() * p / n_phi_; }
+    double phi_hi(int p) const { return phi_span() * (p + 1) / n_phi_; }
 
-    /// Projected solid angle of bin (t, p), both folded halves (sr).
+    /// Projected solid angle of bin (t, p), both folded halves (sr); one patch when unfolded.
     double projected_solid_angle(int t, int p) const;
     double projected_solid_angle(std::size_t j) const {
         return projected_solid_angle(int(j) / n_phi_, int(j) % n_phi_);
@@ -63,24 +76,28 @@ class HemisphereGrid {
 
     int theta_bin(double cos_theta) const;
     /// The exact edges bin_of compares with (vectorized binning follows the same rule): cos θ
-    /// (decreasing, n_theta + 1, the last 0) and the folded cos φ (decreasing, n_phi + 1, the last
-    /// −1); bin b holds edge[b] ≥ x > edge[b + 1], the last bin also x = its lower edge.
+    /// (decreasing, n_theta + 1, the last 0) and the folded cos φ (decreasing, n_phi + 1 of the
+    /// folded grid, the last −1); bin b holds edge[b] ≥ x > edge[b + 1], the last bin also x = its
+    /// lower edge. Unfolded, a direction with y < 0 takes bin n_phi − 1 − b.
     const std::vector<double>& cos_theta_edges() const { return cos_theta_edge_; }
     const std::vector<double>& cos_phi_edges() const { return cos_phi_edge_; }
     int phi_bin(double x, double y) const;
 
-    /// "90x90"-style description, and its parser (InputError naming `option` on bad text).
+    /// "90x90"-style description (the folded grid's counts; an unfolded grid adds " unfolded"),
+    /// and its parser of the folded form (InputError naming `option` on bad text).
     std::string to_string() const;
     static HemisphereGrid parse(const std::string& text, const std::string& option = "--grid");
 
     bool operator==(const HemisphereGrid& o) const {
-        return n_theta_ == o.n_theta_ && n_phi_ == o.n_phi_;
+        return n_theta_ == o.n_theta_ && n_phi_ == o.n_phi_ && unfolded_ == o.unfolded_;
     }
 
   private:
     int n_theta_, n_phi_;
-    std::vector<double> cos_theta_edge_;        ///< cos of θ edges, decreasing, size n_theta + 1
-    std::vector<double> cos_phi_edge_;          ///< cos of φ edges, decreasing, size n_phi + 1
+    bool unfolded_ = false;
+    std::vector<double> cos_theta_edge_;  ///< cos of θ edges, decreasing, size n_theta + 1
+    std::vector<double>
+        cos_phi_edge_;  ///< cos of the folded φ edges, decreasing, size n_folded + 1
     std::vector<int> theta_guess_, phi_guess_;  ///< first guesses indexed by cos quantized
 };
 

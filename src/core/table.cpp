@@ -93,10 +93,10 @@ BinnedTable BinnedTable::from_csv(const std::string& text, const std::string& wh
                              fmt::format("side '{}' must be R or T", cells[1]));
         const double theta_lo = num(2), theta_hi = num(3), phi_lo = num(4), phi_hi = num(5);
         if (!(theta_lo >= 0 && theta_hi > theta_lo && theta_hi <= 90 && phi_lo >= 0 &&
-              phi_hi > phi_lo && phi_hi <= 180))
+              phi_hi > phi_lo && phi_hi <= 360))
             throw InputError(where, fmt::format("line {}", line_no),
                              "a bin must have 0 ≤ theta_lo < theta_hi ≤ 90 and 0 ≤ phi_lo < "
-                             "phi_hi ≤ 180 (degrees)");
+                             "phi_hi ≤ 360 (degrees; beyond 180 on the unfolded grid only)");
         const int n_theta = int(std::lround(90.0 / (theta_hi - theta_lo)));
         const int n_phi = int(std::lround(180.0 / (phi_hi - phi_lo)));
         if (n_theta > 3600 || n_phi > 3600 ||
@@ -121,13 +121,15 @@ BinnedTable BinnedTable::from_csv(const std::string& text, const std::string& wh
             std::abs(phi_hi - 180.0 * (r.p + 1) / n_phi) > 1e-6)
             throw InputError(where, fmt::format("line {}", line_no),
                              "the bin's edges are not those of a uniform NTHETAxNPHI grid over "
-                             "θ ∈ [0°, 90°], φ ∈ [0°, 180°]");
+                             "θ ∈ [0°, 90°], φ ∈ [0°, 180°] (or [0°, 360°) unfolded)");
         max_t = std::max(max_t, r.t);
         max_p = std::max(max_p, r.p);
         rows.push_back(r);
     }
     if (rows.empty()) throw InputError(where, "", "the table has no rows");
-    const HemisphereGrid grid(n_theta_guess, n_phi_guess);
+    // Bins beyond φ = 180° make the grid the unfolded one (core/grid.h).
+    const HemisphereGrid folded(n_theta_guess, n_phi_guess);
+    const HemisphereGrid grid = max_p >= n_phi_guess ? folded.unfolded() : folded;
     if (max_t + 1 != grid.n_theta() || max_p + 1 != grid.n_phi())
         throw InputError(where, "", "the bins do not form a regular grid");
     std::vector<double> incidences;

@@ -1,5 +1,7 @@
 #include "layers/compiled_stack.h"
 
+#include "core/math.h"
+
 namespace lamina {
 
 template <typename Real>
@@ -18,10 +20,14 @@ CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& s
         const double eta_above = stack.eta_above(i);
         CompiledLayer<Real> t;
         t.type = spec.type;
+        // α_y and the tangent (physics/microfacet.h); `on` only where α_y ≠ α_x in Real.
+        const GgxAnisotropy<Real> anisotropy = GgxAnisotropy<Real>::make(
+            Real(spec.alpha), Real(spec.alpha_b()), deg_to_rad(spec.tangent_deg));
         switch (spec.type) {
             case InterfaceType::Dielectric:
                 t.dielectric = {Real(spec.eta / eta_above), Real(spec.alpha)};
                 t.dielectric.transmission_masking = settings.transmission_masking;
+                t.dielectric.anisotropy = anisotropy;
                 // An index-matched interface is a pass-through, unless a film sits on it (a
                 // free-standing film: air | film | air).
                 if (multiple && t.dielectric.is_index_matched() && !spec.has_film)
@@ -34,6 +40,7 @@ CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& s
             case InterfaceType::Conductor:
                 t.conductor = {Rgb<Real>(spec.eta_rgb / eta_above), Rgb<Real>(spec.k / eta_above),
                                Real(spec.alpha)};
+                t.conductor.anisotropy = anisotropy;
                 t.delta = t.conductor.is_smooth();
                 t.multiple = multiple && !t.delta;
                 if (!t.conductor.is_grey()) out.polarization_channels = 3;
@@ -74,6 +81,8 @@ CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& s
                 md.single_scattering_albedo[c] =
                     md.tau_t[c] > 0 ? Real(m.tau_s[c] / m.tau_t()[c]) : Real(0);
         }
+        if (anisotropy.on && spec.type != InterfaceType::Lambertian && spec.alpha > 0)
+            out.anisotropic = true;
         out.layers.push_back(t);
     }
     return out;

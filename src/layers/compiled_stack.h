@@ -73,6 +73,9 @@ struct CompiledStack {
     int polarization_channels = 1;
     /// Some interface carries a thin film (traced by the scalar kernel only).
     bool has_film = false;
+    /// Some rough interface is anisotropic (GgxAnisotropy::on): the tracers take the general
+    /// (anisotropic) instance of the GGX formulas (GGX::lanes) at every interface.
+    bool anisotropic = false;
 };
 
 /// The stack compiled in precision Real (float: the goniophotometer's kernels; double: the random

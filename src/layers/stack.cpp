@@ -182,14 +182,15 @@ std::string suggestion(std::string_view key, Keys allowed) {
 constexpr std::string_view kStackKeys[] = {"name", "ambient_eta", "wavelengths_nm", "layers"};
 constexpr std::string_view kLayerKeys[] = {"interface", "medium"};
 constexpr std::string_view kInterfaceTypes[] = {"dielectric", "conductor", "lambertian"};
-constexpr std::string_view kDielectricKeys[] = {"type", "eta", "alpha", "film"};
-constexpr std::string_view kConductorKeys[] = {"type", "eta", "k", "alpha", "film"};
+constexpr std::string_view kDielectricKeys[] = {"type", "eta", "alpha", "tangent_deg", "film"};
+constexpr std::string_view kConductorKeys[] = {"type", "eta", "k", "alpha", "tangent_deg", "film"};
 constexpr std::string_view kFilmKeys[] = {"thickness_nm", "eta", "k"};
 constexpr std::string_view kLambertianKeys[] = {"type", "albedo"};
 constexpr std::string_view kMediumKeys[] = {"tau_a", "tau_s", "g"};
 
 constexpr std::string_view kAlphaHint =
-    "GGX roughness, 0 or in [0.0001, 1]; write 0 for a smooth interface";
+    "GGX roughness, 0 or in [0.0001, 1], or [alpha_x, alpha_y] for an anisotropic interface; "
+    "write 0 for a smooth interface";
 
 /// A constraint on one number: the test and how it reads in a message.
 struct Allowed {
@@ -205,6 +206,7 @@ struct Allowed {
 constexpr double kEtaDielectricMin = 1, kEtaDielectricMax = 5;
 constexpr double kEtaConductorMin = 0.01, kEtaConductorMax = 10, kKConductorMax = 10;
 constexpr double kAlphaRoughMin = 1e-4;
+constexpr double kTangentDegMax = 360;
 constexpr double kTauMax = 100, kTauScatteringMax = 1e4;
 constexpr double kGMax = 0.99;
 constexpr std::size_t kMaxLayers = 100;
@@ -222,6 +224,10 @@ constexpr Allowed kConductorEta{
 constexpr Allowed kConductorK{[](double v) { return v >= 0 && v <= kKConductorMax; }, "[0, 10]"};
 constexpr Allowed kAlpha{[](double v) { return v == 0 || (v >= kAlphaRoughMin && v <= 1); },
                          "0 (smooth) or [0.0001, 1]"};
+constexpr Allowed kAlphaRough{[](double v) { return v >= kAlphaRoughMin && v <= 1; },
+                              "[0.0001, 1] (each of an anisotropic [alpha_x, alpha_y])"};
+constexpr Allowed kTangentDeg{[](double v) { return v >= -kTangentDegMax && v <= kTangentDegMax; },
+                              "[-360, 360] degrees"};
 constexpr Allowed kOpticalDepth{[](double v) { return v >= 0 && v <= kTauMax; }, "[0, 100]"};
 constexpr Allowed kScatteringDepth{[](double v) { return v >= 0 && v <= kTauScatteringMax; },
                                    "[0, 10000]"};
@@ -408,7 +414,7 @@ class Reader {
                                  type_phrase(eta), show(eta)));
             out.eta = number(eta, child(pointer, "eta"), kDielectricEta,
                              "absolute refractive index of what lies below");
-            out.alpha = alpha(j, pointer, "dielectric");
+            roughness(j, pointer, "dielectric", out);
             film(j, pointer, out);
         } else if (name == "conductor") {
             out.type = InterfaceType::Conductor;
@@ -423,7 +429,7 @@ class Reader {
                                  "[R, G, B]"),
                         child(pointer, "k"), kConductorK,
                         "extinction coefficient, imaginary part of the absolute index");
-            out.alpha = alpha(j, pointer, "conductor");
+            roughness(j, pointer, "conductor", out);
             film(j, pointer, out);
         } else if (name == "lambertian") {
             out.type = InterfaceType::Lambertian;
@@ -437,10 +443,29 @@ class Reader {
         return out;
     }
 
-    double alpha(const json& j, const std::string& pointer, std::string_view type) const {
+    /// `alpha`: a number, or [alpha_x, alpha_y] (both rough: an anisotropic interface), and the
+    /// optional `tangent_deg`.
+    void roughness(const json& j, const std::string& pointer, std::string_view type,
+                   InterfaceSpec& out) const {
         const json& v = required(j, pointer, "alpha",
                                  fmt::format("a {} needs an explicit {}", type, kAlphaHint));
-        return number(v, child(pointer, "alpha"), kAlpha, "GGX roughness, 0 = smooth");
+        const std::string ap = child(pointer, "alpha");
+        if (v.is_array()) {
+            if (v.size() != 2)
+                fail(ap, fmt::format("expected a number or [alpha_x, alpha_y] (2 numbers), got "
+                                     "an array of {}: {}",
+                                     v.size(), show(v)));
+            out.alpha = number(v[0], child(ap, std::size_t{0}), kAlphaRough,
+                               "GGX roughness along the tangent (alpha_x)");
+            out.alpha_y = number(v[1], child(ap, std::size_t{1}), kAlphaRough,
+                                 "GGX roughness along the bitangent (alpha_y)");
+        } else {
+            out.alpha = number(v, ap, kAlpha, "GGX roughness, 0 = smooth");
+        }
+        if (j.contains("tangent_deg"))
+            out.tangent_deg =
+                number(j["tangent_deg"], child(pointer, "tangent_deg"), kTangentDeg,
+                       "angle of the tangent (the direction of alpha_x) from +x, in degrees");
     }
 
     /// The optional "film" of a dielectric or conductor interface.
@@ -613,6 +638,19 @@ json rgb_json(const Rgbd& v) {
     return json::array({v[0], v[1], v[2]});
 }
 
+/// An interface's `alpha`: the number, or [alpha_x, alpha_y] where α_y was given.
+json alpha_json(const InterfaceSpec& i) {
+    return i.alpha_y < 0 ? json(i.alpha) : json::array({i.alpha, i.alpha_y});
+}
+
+/// "α=0.1", or "α=(0.1, 0.4) ψ=30°" for an interface with its own α_y or tangent.
+std::string show_alpha(const InterfaceSpec& i) {
+    std::string out = i.alpha_y < 0 ? fmt::format("α={}", i.alpha)
+                                    : fmt::format("α=({}, {})", i.alpha, i.alpha_y);
+    if (i.tangent_deg != 0) out += fmt::format(" ψ={}°", i.tangent_deg);
+    return out;
+}
+
 }  // namespace
 
 Stack stack_from_json(const nlohmann::json& j, const std::string& where) {
@@ -649,13 +687,15 @@ nlohmann::json stack_to_json(const Stack& stack) {
         json interface;
         switch (i.type) {
             case InterfaceType::Dielectric:
-                interface = {{"type", "dielectric"}, {"eta", i.eta}, {"alpha", i.alpha}};
+                interface = {{"type", "dielectric"}, {"eta", i.eta}, {"alpha", alpha_json(i)}};
+                if (i.tangent_deg != 0) interface["tangent_deg"] = i.tangent_deg;
                 break;
             case InterfaceType::Conductor:
                 interface = {{"type", "conductor"},
                              {"eta", rgb_json(i.eta_rgb)},
                              {"k", rgb_json(i.k)},
-                             {"alpha", i.alpha}};
+                             {"alpha", alpha_json(i)}};
+                if (i.tangent_deg != 0) interface["tangent_deg"] = i.tangent_deg;
                 break;
             case InterfaceType::Lambertian:
                 interface = {{"type", "lambertian"}, {"albedo", rgb_json(i.albedo)}};
@@ -705,13 +745,14 @@ std::string describe(const Stack& stack) {
         const InterfaceSpec& i = layer.interface;
         switch (i.type) {
             case InterfaceType::Dielectric:
-                out += fmt::format(" | dielectric η={} α={}", i.eta, i.alpha) + describe_film(i);
+                out +=
+                    fmt::format(" | dielectric η={} {}", i.eta, show_alpha(i)) + describe_film(i);
                 if (n + 1 == stack.layers.size())
                     out += fmt::format(" (slab: transmits into η={})", i.eta);
                 break;
             case InterfaceType::Conductor:
-                out += fmt::format(" | conductor η={} k={} α={}", show_rgb(i.eta_rgb),
-                                   show_rgb(i.k), i.alpha) +
+                out += fmt::format(" | conductor η={} k={} {}", show_rgb(i.eta_rgb), show_rgb(i.k),
+                                   show_alpha(i)) +
                        describe_film(i);
                 break;
             case InterfaceType::Lambertian:

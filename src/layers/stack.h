@@ -40,8 +40,15 @@ struct InterfaceSpec {
     /// Conductor: absolute complex index eta_rgb + i·k (RGB).
     Rgbd eta_rgb{1.0};
     Rgbd k{0.0};
-    /// GGX roughness α ∈ {0} ∪ [1e-4, 1] of dielectric and conductor interfaces; 0 = smooth.
+    /// GGX roughness α ∈ {0} ∪ [1e-4, 1] of dielectric and conductor interfaces; 0 = smooth. An
+    /// anisotropic interface's α_x, along its tangent.
     double alpha = 0.0;
+    /// An anisotropic interface's α_y (along its bitangent), in [1e-4, 1] as α; −1: none, α_y = α
+    /// (the stack file's `"alpha": [alpha_x, alpha_y]` sets both; docs/stack-format.md).
+    double alpha_y = -1.0;
+    /// The tangent's angle ψ from +x in degrees, [−360, 360] (`tangent_deg`): α_x lies along
+    /// (cos ψ, sin ψ, 0), so that coat and base may be brushed in different directions.
+    double tangent_deg = 0.0;
     /// Lambertian albedo ∈ [0, 1] (RGB).
     Rgbd albedo{0.0};
     /// A thin film on the interface (dielectric and conductor only).
@@ -49,6 +56,10 @@ struct InterfaceSpec {
     FilmSpec film;
 
     bool is_opaque() const { return type != InterfaceType::Dielectric; }
+    /// α along the bitangent (α itself unless alpha_y is set).
+    double alpha_b() const { return alpha_y < 0 ? alpha : alpha_y; }
+    /// A rough dielectric or conductor with α_y ≠ α_x.
+    bool is_anisotropic() const { return type != InterfaceType::Lambertian && alpha_b() != alpha; }
     bool operator==(const InterfaceSpec&) const = default;
 };
 
@@ -82,6 +93,12 @@ struct Stack {
     /// The channels' wavelengths in nm, each in [360, 830] (docs/physics.md §9).
     Rgbd wavelengths_nm = kDefaultChannelWavelengthsNm;
 
+    /// Some interface is anisotropic (InterfaceSpec::is_anisotropic).
+    bool is_anisotropic() const {
+        for (const Layer& l : layers)
+            if (l.interface.is_anisotropic()) return true;
+        return false;
+    }
     const InterfaceSpec& base() const { return layers.back().interface; }
     /// True when light can leave through the bottom (the base is a dielectric).
     bool transmits() const { return !base().is_opaque(); }
@@ -120,6 +137,14 @@ inline InterfaceSpec lambertian_interface(const Rgbd& albedo) {
     InterfaceSpec s;
     s.type = InterfaceType::Lambertian;
     s.albedo = albedo;
+    return s;
+}
+/// An interface made anisotropic: α_x = alpha_x, α_y = alpha_y, its tangent at tangent_deg.
+inline InterfaceSpec anisotropic(InterfaceSpec s, double alpha_x, double alpha_y,
+                                 double tangent_deg = 0.0) {
+    s.alpha = alpha_x;
+    s.alpha_y = alpha_y;
+    s.tangent_deg = tangent_deg;
     return s;
 }
 inline Layer layer_of(const InterfaceSpec& interface) {
@@ -162,8 +187,9 @@ Stack load_stack(const std::filesystem::path& path);
 /// The same stack seen from below (z flipped), for light that meets a transmitting stack from
 /// its bottom side: the ambient index is the old η below the base, the interfaces come in reverse
 /// order (each with the absolute index of what now lies below it, the old index above it, and the
-/// same roughness), and each medium moves with the region it fills. Isotropic media (HG) and
-/// interfaces are unchanged by the flip. Requires stack.transmits() (every interface a dielectric).
+/// same roughness and tangent: the flip is z → −z, which keeps every azimuth), and each medium
+/// moves with the region it fills. Isotropic media (HG) and interfaces are unchanged by the flip.
+/// Requires stack.transmits() (every interface a dielectric).
 Stack flipped_stack(const Stack& stack);
 
 /// Canonical JSON form (every RGB quantity as a 3-array); stack_from_json(stack_to_json(s)) == s.

@@ -51,31 +51,37 @@ const ModelFamily<Ddb22Choices> kDdb22{
     },
     [](const std::string&) { return Ddb22Choices{}; }, make_ddb22_model};
 
-/// What every model is for a stack with a thin film (docs/physics.md §9): not supported. No model
-/// of the registry represents films yet (the goniophotometer's scalar kernel traces them), so none
-/// is built for such a stack: a model that ignored the film would return a stack's values that
-/// are not this stack's.
-class FilmNotSupported final : public Model {
+/// What every model is for a stack no model of the registry represents yet (docs/physics.md §9
+/// and §3): a thin film, or an anisotropic interface (alpha = [alpha_x, alpha_y]); the
+/// goniophotometer traces both. None is built for such a stack: a model that ignored the film or
+/// the anisotropy would return another stack's values. It supports nothing and says why.
+class StackNotSupported final : public Model {
   public:
-    explicit FilmNotSupported(std::string name) : name_(std::move(name)) {}
+    StackNotSupported(std::string name, std::string reason)
+        : name_(std::move(name)), reason_(std::move(reason)) {}
     std::string name() const override { return name_; }
-    Support support() const override {
-        return {false, false,
-                "thin films are not supported by this model (the goniophotometer traces them: "
-                "lamina simulate --kernel scalar)"};
-    }
+    Support support() const override { return {false, false, reason_}; }
     Rgbd eval(const Vec3d&, const Vec3d&) const override { return Rgbd(0.0); }
 
   private:
-    std::string name_;
+    std::string name_, reason_;
 };
 
-/// The entries with their factories refusing filmed stacks.
-std::vector<ModelEntry> refusing_films(std::vector<ModelEntry> entries) {
+/// The entries with their factories refusing filmed and anisotropic stacks (StackNotSupported).
+std::vector<ModelEntry> refusing_unrepresented(std::vector<ModelEntry> entries) {
     for (ModelEntry& e : entries)
         e.make = [make = std::move(e.make), name = e.name](
                      const Stack& stack, const ModelOptions& options) -> std::unique_ptr<Model> {
-            if (stack.has_film()) return std::make_unique<FilmNotSupported>(name);
+            if (stack.has_film())
+                return std::make_unique<StackNotSupported>(
+                    name,
+                    "thin films are not supported by this model (the goniophotometer traces "
+                    "them: lamina simulate)");
+            if (stack.is_anisotropic())
+                return std::make_unique<StackNotSupported>(
+                    name,
+                    "the stack has an anisotropic interface (alpha = [alpha_x, alpha_y]), which "
+                    "this model does not represent");
             return make(stack, options);
         };
     return entries;
@@ -84,7 +90,7 @@ std::vector<ModelEntry> refusing_films(std::vector<ModelEntry> entries) {
 }  // namespace
 
 const std::vector<ModelEntry>& model_registry() {
-    static const std::vector<ModelEntry> entries = refusing_films({
+    static const std::vector<ModelEntry> entries = refusing_unrepresented({
         variant(
             "ww09",
             "Weidlich & Wilkie, SIGGRAPH Asia 2009 course code: T01 and refraction at h, base at "

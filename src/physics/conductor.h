@@ -39,7 +39,8 @@
 LAMINA_LANE_BEGIN
 
 /// The conductor interface's particle event (ConductorInterface::sample) on the lanes of
-/// `active`, light from above: the mirror direction about a visible microfacet normal drawn from
+/// `active`, light from above, GGX roughness `ggx` (microfacet.h, anisotropic or not): the mirror
+/// direction about a visible microfacet normal drawn from
 /// u1, u2 (Heitz 2018 density, by the spherical caps of Dupuy & Benyoub 2023; the macro normal
 /// when `smooth`), its Fresnel factors `fresnel(cos θ, factors)` (three channels, at the facet
 /// cosine; fresnel_conductor per channel) and, when rough, the escape fraction G2/G1
@@ -54,9 +55,9 @@ LAMINA_LANE_BEGIN
 /// A branch-free lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate
 /// these lines.
 template <typename T, typename L = Lane<T>, typename Fresnel, typename Mueller = NoMueller,
-          bool kPolarized = !std::is_same_v<Mueller, NoMueller>>
+          bool kPolarized = !std::is_same_v<Mueller, NoMueller>, bool kA = false>
 LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> conductor_event(
-    T alpha, bool smooth, bool uncorrelated, const LaneVec3<T>& wi, T u1, T u2,
+    const GgxLanes<T, kA>& ggx, bool smooth, bool uncorrelated, const LaneVec3<T>& wi, T u1, T u2,
     typename L::Mask active, const Fresnel& fresnel, T* fresnel_factors,
     PolarizationLanes<T>* pol = nullptr, const Mueller& mueller = {}) {
     const T zero = L::constant(0), one = L::constant(1);
@@ -64,7 +65,7 @@ LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> conductor_event(
     e.degenerate = L::both(active, L::negate(L::less(zero, wi.z)));
     e.reflected = L::both(active, L::negate(e.degenerate));
     const LaneVec3<T> wm = smooth ? LaneVec3<T>{zero, zero, one}
-                                  : ggx_sample_visible_normal_complete<T, L>(alpha, wi, u1, u2);
+                                  : ggx_sample_visible_normal_complete<T, L>(ggx, wi, u1, u2);
     const T cos_i_m = lane_dot<T, L>(wi, wm);
     const T two_cos = cos_i_m + cos_i_m;
     e.wo = {L::mul_add(two_cos, wm.x, zero - wi.x), L::mul_add(two_cos, wm.y, zero - wi.y),
@@ -86,10 +87,10 @@ LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> conductor_event(
     }
     e.shadowing = one;
     if (!smooth)
-        e.shadowing = L::select(L::less(zero, e.wo.z),
-                                ggx_escape_fraction<T, L>(alpha * alpha, wi, e.wo, e.reflected,
-                                                          e.reflected, uncorrelated, false),
-                                zero);
+        e.shadowing = L::select(
+            L::less(zero, e.wo.z),
+            ggx_escape_fraction<T, L>(ggx, wi, e.wo, e.reflected, e.reflected, uncorrelated, false),
+            zero);
     return e;
 }
 
@@ -106,11 +107,12 @@ template <typename T>
 struct ConductorInterface {
     Rgb<T> eta;
     Rgb<T> k;
-    T alpha;
+    T alpha;  ///< α_x (along the tangent) when anisotropic
     bool uncorrelated_shadowing = false;
+    GgxAnisotropy<T> anisotropy{};  ///< α_y and the tangent (microfacet.h); isotropic by default
 
     bool is_smooth() const { return alpha == 0; }
-    GGX<T> distribution() const { return {alpha}; }
+    GGX<T> distribution() const { return {alpha, anisotropy}; }
 
     Rgb<T> fresnel(T cos_theta) const {
         return {fresnel_conductor(cos_theta, eta[0], k[0]),
@@ -153,16 +155,18 @@ struct ConductorInterface {
     /// Reflects a particle arriving from wi: conductor_event at one lane (a visible microfacet
     /// normal, Heitz 2018 density drawn as in Dupuy & Benyoub 2023; weight F(wi·wm)·G2/G1).
     /// Nothing unless wi.z > 0. kWithPdf = false skips the density.
-    template <bool kWithPdf = true>
+    /// kAnisotropic: the general (anisotropic) roughness, which an anisotropic interface needs;
+    /// false takes the isotropic instance (GGX::lanes).
+    template <bool kWithPdf = true, bool kAnisotropic = false>
     std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T u1, T u2) const {
         T factors[3];
         const auto channel_fresnel = [&](T cos_theta, T* out) {
             const Rgb<T> f = fresnel(cos_theta);
             out[0] = f[0], out[1] = f[1], out[2] = f[2];
         };
-        const InterfaceEventLanes<T, bool> e =
-            conductor_event<T>(alpha, is_smooth(), uncorrelated_shadowing, {wi.x, wi.y, wi.z}, u1,
-                               u2, true, channel_fresnel, factors);
+        const InterfaceEventLanes<T, bool> e = conductor_event<T>(
+            distribution().template lanes<kAnisotropic>(), is_smooth(), uncorrelated_shadowing,
+            {wi.x, wi.y, wi.z}, u1, u2, true, channel_fresnel, factors);
         if (e.degenerate) return std::nullopt;
         BsdfSample<T> s = reflection_sample(e, factors);
         if constexpr (kWithPdf)
@@ -172,7 +176,8 @@ struct ConductorInterface {
 
     /// sample() following the particle's polarization (physics/polarization.h): conductor_event's
     /// Mueller matrices, the state updated in `pol`, the Fresnel weight the reflected fraction of
-    /// the state. No density (the particle tracers').
+    /// the state. No density (the particle tracers'). kAnisotropic as in sample().
+    template <bool kAnisotropic = false>
     std::optional<BsdfSample<T>> sample_polarized(const Vec3<T>& wi, T u1, T u2,
                                                   PolarizationLanes<T>& pol) const {
         T factors[3];
@@ -180,9 +185,9 @@ struct ConductorInterface {
         const auto channel_mueller = [&](T cos_theta, InterfaceMueller<T>* m) {
             mueller(cos_theta, m);
         };
-        const InterfaceEventLanes<T, bool> e =
-            conductor_event<T>(alpha, is_smooth(), uncorrelated_shadowing, {wi.x, wi.y, wi.z}, u1,
-                               u2, true, unpolarized, factors, &pol, channel_mueller);
+        const InterfaceEventLanes<T, bool> e = conductor_event<T>(
+            distribution().template lanes<kAnisotropic>(), is_smooth(), uncorrelated_shadowing,
+            {wi.x, wi.y, wi.z}, u1, u2, true, unpolarized, factors, &pol, channel_mueller);
         if (e.degenerate) return std::nullopt;
         return reflection_sample(e, factors);
     }

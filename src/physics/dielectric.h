@@ -82,7 +82,8 @@ struct InterfaceEventLanes {
 /// loses 1 − that. (The quotient is ≤ 1 exactly; rounded above it, it booked −6.6e-8 as lost to the
 /// microsurface, found by the fuzz test with seed 99: the escape fractions are clamped at 1.)
 /// Smooth and index-matched: straight through with weight 1. A grazing wi (wi.z = 0) is degenerate.
-/// eta = η_below / η_above, inv_eta = 1/eta, alpha the GGX roughness.
+/// eta = η_below / η_above, inv_eta = 1/eta, ggx the GGX roughness (microfacet.h, anisotropic or
+/// not).
 /// Polarized (kPolarized, `pol` the state; physics/polarization.h): the particle's state is turned
 /// into the facet's plane of incidence, the branch is chosen with the reflected flux fraction of
 /// that state (polarized_dielectric_choice: the same uniform number uc, now against a + b q instead
@@ -91,10 +92,10 @@ struct InterfaceEventLanes {
 /// interface leaves the state as it is (its Mueller matrix is the identity).
 /// A branch-free lane template (core/lane.h): the scalar and the SIMD particle kernels evaluate
 /// these lines.
-template <typename T, typename L = Lane<T>, bool kPolarized = false>
+template <typename T, typename L = Lane<T>, bool kPolarized = false, bool kA = false>
 LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> dielectric_event(
-    T eta, T inv_eta, T alpha, DielectricEventShape shape, const LaneVec3<T>& wi, T uc, T u1, T u2,
-    typename L::Mask active, PolarizationLanes<T>* pol = nullptr) {
+    T eta, T inv_eta, const GgxLanes<T, kA>& ggx, DielectricEventShape shape, const LaneVec3<T>& wi,
+    T uc, T u1, T u2, typename L::Mask active, PolarizationLanes<T>* pol = nullptr) {
     const T zero = L::constant(0), one = L::constant(1);
     InterfaceEventLanes<T, typename L::Mask> e;
     e.degenerate = L::both(active, L::negate(L::less(zero, L::abs(wi.z))));
@@ -105,7 +106,7 @@ LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> dielectric_event(
         e.wo = {zero - wi.x, zero - wi.y, zero - wi.z};
         e.reflected = L::both(ok, L::negate(ok));  // no lane
         if (!shape.smooth)
-            e.shadowing = ggx_escape_fraction<T, L>(alpha * alpha, wi, e.wo, e.reflected, ok,
+            e.shadowing = ggx_escape_fraction<T, L>(ggx, wi, e.wo, e.reflected, ok,
                                                     shape.uncorrelated, shape.smith_refraction);
         return e;
     }
@@ -115,8 +116,8 @@ LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> dielectric_event(
     LaneVec3<T> wm = {zero, zero, one};
     if (!shape.smooth) {
         const T sign = L::select(L::less(wi.z, zero), zero - one, one);
-        wm = ggx_sample_visible_normal_complete<T, L>(
-            alpha, {sign * wi.x, sign * wi.y, sign * wi.z}, u1, u2);
+        wm = ggx_sample_visible_normal_complete<T, L>(ggx, {sign * wi.x, sign * wi.y, sign * wi.z},
+                                                      u1, u2);
     }
     const T cos_i_m = lane_dot<T, L>(wi, wm);  // < 0 when wi is below: seen from the other side
     [[maybe_unused]] DielectricMueller<T> fm;
@@ -157,9 +158,8 @@ LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> dielectric_event(
         const auto crosses_right = L::either(L::both(same_side, e.reflected),
                                              L::both(L::negate(same_side), L::negate(e.reflected)));
         const auto escapes = L::both(L::less(zero, L::abs(e.wo.z)), crosses_right);
-        const T escape =
-            ggx_escape_fraction<T, L>(alpha * alpha, wi, e.wo, e.reflected, L::both(ok, escapes),
-                                      shape.uncorrelated, shape.smith_refraction);
+        const T escape = ggx_escape_fraction<T, L>(ggx, wi, e.wo, e.reflected, L::both(ok, escapes),
+                                                   shape.uncorrelated, shape.smith_refraction);
         e.shadowing = L::select(escapes, escape, zero);
     }
     return e;
@@ -183,12 +183,13 @@ struct DielectricInterface {
     /// The masking-shadowing of the refraction lobe (microfacet.h): the Smith microsurface's own
     /// B(1 + Λi, 1 + Λo) by default, or pbrt-v4's 1/(1 + Λi + Λo).
     TransmissionMasking transmission_masking = TransmissionMasking::Smith;
+    GgxAnisotropy<T> anisotropy{};  ///< α_y and the tangent (microfacet.h); isotropic by default
 
     bool is_smooth() const { return alpha == 0; }
     T inv_eta() const { return T(1) / eta; }
     /// η = 1: no reflection (F = 0) and straight-through transmission, a delta lobe for any α.
     bool is_index_matched() const { return eta == T(1); }
-    GGX<T> distribution() const { return {alpha}; }
+    GGX<T> distribution() const { return {alpha, anisotropy}; }
 
     /// η(wo's side) / η(wi's side) — the ratio that appears in the refraction Jacobian.
     T eta_ratio(const Vec3<T>& wi, const Vec3<T>& wo) const {
@@ -260,13 +261,15 @@ struct DielectricInterface {
     /// lane, keeping the fraction G2/G1 that escapes the microsurface (docs/physics.md §3), with
     /// the refraction lobe's G2 of transmission_masking. Smooth and index-matched interfaces give
     /// delta samples. Nothing for a grazing wi. kWithPdf = false skips the density (the particle
-    /// tracer only needs the weight).
-    template <bool kWithPdf = true>
+    /// tracer only needs the weight). kAnisotropic: the general (anisotropic) roughness, which an
+    /// anisotropic interface needs; false takes the isotropic instance (GGX::lanes).
+    template <bool kWithPdf = true, bool kAnisotropic = false>
     LAMINA_FORCE_INLINE std::optional<BsdfSample<T>> sample(const Vec3<T>& wi, T uc, T u1,
                                                             T u2) const {
         const DielectricEventShape shape = event_shape();
         const InterfaceEventLanes<T, bool> e =
-            dielectric_event<T>(eta, inv_eta(), alpha, shape, {wi.x, wi.y, wi.z}, uc, u1, u2, true);
+            dielectric_event<T>(eta, inv_eta(), distribution().template lanes<kAnisotropic>(),
+                                shape, {wi.x, wi.y, wi.z}, uc, u1, u2, true);
         if (e.degenerate) return std::nullopt;
         BsdfSample<T> s = event_sample(e, shape);
         s.weight = Rgb<T>(s.shadowing);
@@ -278,11 +281,14 @@ struct DielectricInterface {
     /// sample() following the particle's polarization (physics/polarization.h): dielectric_event's
     /// polarized branch choice, the state updated in `pol`; fresnel_weight holds the choice's flux
     /// factors (1 unless the channels' states differ). No density (the particle tracers').
+    /// kAnisotropic as in sample().
+    template <bool kAnisotropic = false>
     LAMINA_FORCE_INLINE std::optional<BsdfSample<T>> sample_polarized(
         const Vec3<T>& wi, T uc, T u1, T u2, PolarizationLanes<T>& pol) const {
         const DielectricEventShape shape = event_shape();
         const InterfaceEventLanes<T, bool> e = dielectric_event<T, Lane<T>, true>(
-            eta, inv_eta(), alpha, shape, {wi.x, wi.y, wi.z}, uc, u1, u2, true, &pol);
+            eta, inv_eta(), distribution().template lanes<kAnisotropic>(), shape,
+            {wi.x, wi.y, wi.z}, uc, u1, u2, true, &pol);
         if (e.degenerate) return std::nullopt;
         BsdfSample<T> s = event_sample(e, shape);
         s.fresnel_weight = {pol.factor[0], pol.factor[1], pol.factor[2]};

@@ -85,29 +85,30 @@ struct MicrosurfaceHit {
 };
 
 /// The height of the next intersection of a ray leaving height h along the direction of travel
-/// wr (unit) with the microsurface of GGX roughness alpha, or an escape (upwards only), from one
-/// uniform number u ∈ [0, 1). Heitz et al. 2016 (the height-dependent masking G1(wr, h) =
-/// C1(h)^Λ(wr) and its inverse): a ray going up escapes with probability C1(h)^Λ(wr); otherwise,
-/// and always going down, the next height follows from C1(h') = C1(h) / (1 − u)^(1/Λ(wr)), with
-/// the signed Λ of a direction of travel: Λ(wr) going up, −1 − Λ(−wr) going down (their GGX Λ
-/// evaluated with cot θ < 0). The powers are taken as exponentials of logarithms,
+/// wr (unit) with the microsurface of GGX roughness ggx (anisotropic or not), or an escape (upwards
+/// only), from one uniform number u ∈ [0, 1). Heitz et al. 2016 (the height-dependent masking
+/// G1(wr, h) = C1(h)^Λ(wr) and its inverse): a ray going up escapes with probability C1(h)^Λ(wr);
+/// otherwise, and always going down, the next height follows from C1(h') = C1(h) / (1 −
+/// u)^(1/Λ(wr)), with the signed Λ of a direction of travel: Λ(wr) going up, −1 − Λ(−wr) going down
+/// (their GGX Λ evaluated with cot θ < 0). The powers are taken as exponentials of logarithms,
 /// C1(h') = exp(ln C1(h) − ln(1 − u)/Λ), and the escape test in logarithms. Straight up (wr.z >
 /// 0.9999) nothing masks the ray; straight down (wr.z < −0.9999, Λ → −1) C1(h') = u C1(h); a
 /// horizontal ray (|wr.z| < 1e-4) meets the surface where it is. A branch-free lane template
 /// (core/lane.h).
-template <typename T, typename L = Lane<T>>
-inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(T alpha, const LaneVec3<T>& wr,
-                                                                     T h, T u) {
-    return microsurface_next_height<T, L>(alpha, wr, h, u, L::negate(L::less(u, u)), false);
+template <typename T, typename L = Lane<T>, bool kA>
+inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(const GgxLanes<T, kA>& ggx,
+                                                                     const LaneVec3<T>& wr, T h,
+                                                                     T u) {
+    return microsurface_next_height<T, L>(ggx, wr, h, u, L::negate(L::less(u, u)), false);
 }
 
 /// The same for the lanes of `walking` only (the heights of other lanes are not computed when
 /// every walking lane escapes); `at_top`: every lane is above all facets (h ≥ 1, C1 = 1, so
 /// ln C1 = 0 exactly), as at a walk's first step.
-template <typename T, typename L = Lane<T>>
-inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(T alpha, const LaneVec3<T>& wr,
-                                                                     T h, T u,
-                                                                     typename L::Mask walking,
+template <typename T, typename L = Lane<T>, bool kA>
+inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(const GgxLanes<T, kA>& ggx,
+                                                                     const LaneVec3<T>& wr, T h,
+                                                                     T u, typename L::Mask walking,
                                                                      bool at_top) {
     const T zero = L::constant(0), one = L::constant(1);
     const T c = microsurface_height_cdf<T, L>(h);
@@ -115,7 +116,7 @@ inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(T alpha, co
     const auto straight_down = L::less(wr.z, L::constant(-0.9999));
     const auto horizontal = L::less(L::abs(wr.z), L::constant(1e-4));
     const auto up = L::less(zero, wr.z);
-    const T lambda = ggx_lambda<T, L>(alpha * alpha, wr.x, wr.y, wr.z);
+    const T lambda = ggx_lambda<T, L>(ggx, wr.x, wr.y, wr.z);
     const T lambda_signed = L::select(up, lambda, zero - one - lambda);
     // ln C1(h), C1 kept above 1e-30: C1 = 0 (the lowest height) would give 0 · ∞ for a tiny Λ.
     // Going up, u ≥ 1 − C1^Λ ⟺ ln(1 − u) ≤ Λ ln C1: the escape test needs no power.
@@ -147,7 +148,8 @@ struct MicrosurfaceWalkLanes {
 };
 
 /// The microsurface walk of Heitz et al. 2016 on the lanes of `walking`, each arriving from wi
-/// (pointing away from the surface, unit) on a rough interface of GGX roughness alpha > 0, written
+/// (pointing away from the surface, unit) on a rough interface of GGX roughness ggx (α > 0,
+/// anisotropic or not: the heights' Λ and the visible normals are those of microfacet.h), written
 /// once for every lane type: while some lane walks, every lane draws its numbers (`uniform()`
 /// returns a lane of uniform numbers in [0, 1); the draws of a lane that walks follow the same
 /// sequence whatever the other lanes do: one for the height, then two for the visible normal and
@@ -168,10 +170,10 @@ struct MicrosurfaceNoVisit {
     void operator()(A&&...) const {}
 };
 template <typename T, typename L, typename Scatter, typename Uniform,
-          typename Visit = MicrosurfaceNoVisit>
+          typename Visit = MicrosurfaceNoVisit, bool kA = false>
 inline MicrosurfaceWalkLanes<T, typename L::Mask> microsurface_walk(
-    T alpha, const LaneVec3<T>& wi, typename L::Mask walking, bool two_sided, Scatter&& scatter,
-    Uniform&& uniform, int max_order, Visit&& visit = Visit{}) {
+    const GgxLanes<T, kA>& ggx, const LaneVec3<T>& wi, typename L::Mask walking, bool two_sided,
+    Scatter&& scatter, Uniform&& uniform, int max_order, Visit&& visit = Visit{}) {
     const T zero = L::constant(0), one = L::constant(1);
     MicrosurfaceWalkLanes<T, typename L::Mask> r;
     r.weight[0] = r.weight[1] = r.weight[2] = one;
@@ -190,7 +192,7 @@ inline MicrosurfaceWalkLanes<T, typename L::Mask> microsurface_walk(
         // The next facet, in the frame of the side the particle is on.
         const T u = uniform();
         const MicrosurfaceHit<T, typename L::Mask> hit = microsurface_next_height<T, L>(
-            alpha, {side * wr.x, side * wr.y, side * wr.z}, side * h, u, walking, first);
+            ggx, {side * wr.x, side * wr.y, side * wr.z}, side * h, u, walking, first);
         first = false;
         const auto escapes = L::both(walking, hit.escapes);
         r.escaped = L::either(r.escaped, escapes);
@@ -206,7 +208,7 @@ inline MicrosurfaceWalkLanes<T, typename L::Mask> microsurface_walk(
         visit(h, w, above, walking, static_cast<const T*>(r.weight), r.order);
         const T u1 = uniform(), u2 = uniform();
         const LaneVec3<T> wm_side = ggx_sample_visible_normal_complete<T, L>(
-            alpha, {side * w.x, side * w.y, side * w.z}, u1, u2);
+            ggx, {side * w.x, side * w.y, side * w.z}, u1, u2);
         const LaneVec3<T> wm = {side * wm_side.x, side * wm_side.y, side * wm_side.z};
         const T cos_w_m = lane_dot<T, L>(w, wm);
         const auto facing = L::less(zero, cos_w_m);  // false: rounding at grazing (or NaN)
@@ -363,21 +365,22 @@ std::optional<MicrosurfaceExit<T>> microsurface_exit(const MicrosurfaceWalkLanes
 /// (escaped = false: the caller books its flux as lost to the microsurface); a numerical
 /// degeneracy returns nothing (the caller counts it). The lane template microsurface_walk at one
 /// lane: the SIMD kernel runs the same lines on its vectors.
-template <typename T, typename Uniform>
+template <bool kAnisotropic = false, typename T, typename Uniform>
 std::optional<MicrosurfaceExit<T>> walk_rough_dielectric(const GGX<T>& ggx, T eta,
                                                          const Vec3<T>& wi, Uniform&& uniform,
                                                          int max_order) {
     auto draw = [&] { return T(uniform()); };
     const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw)> facet{eta, T(1) / eta, draw};
-    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.alpha, {wi.x, wi.y, wi.z}, true,
-                                                           true, facet, draw, max_order));
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.template lanes<kAnisotropic>(),
+                                                           {wi.x, wi.y, wi.z}, true, true, facet,
+                                                           draw, max_order));
 }
 
 /// The microsurface walk of a particle arriving from wi (wi.z > 0) on a rough conductor; each
 /// facet multiplies the flux by its Fresnel factor (Heitz et al. 2016, the conductor phase
 /// function). `fresnel(cos)` returns the RGB reflectance at a facet cosine. Given up past
 /// max_order facets and empty on a degeneracy, as walk_rough_dielectric.
-template <typename T, typename Fresnel, typename Uniform>
+template <bool kAnisotropic = false, typename T, typename Fresnel, typename Uniform>
 std::optional<MicrosurfaceExit<T>> walk_rough_conductor(const GGX<T>& ggx, const Fresnel& fresnel,
                                                         const Vec3<T>& wi, Uniform&& uniform,
                                                         int max_order) {
@@ -387,15 +390,16 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor(const GGX<T>& ggx, const
         out[0] = f[0], out[1] = f[1], out[2] = f[2];
     };
     const MicrosurfaceConductorFacet<T, Lane<T>, decltype(factors)> facet{factors};
-    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.alpha, {wi.x, wi.y, wi.z}, true,
-                                                           false, facet, draw, max_order));
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.template lanes<kAnisotropic>(),
+                                                           {wi.x, wi.y, wi.z}, true, false, facet,
+                                                           draw, max_order));
 }
 
 /// walk_rough_dielectric following the particle's polarization (physics/polarization.h): `pol`
 /// holds its state (in and out: the exit's, in the frame of the last facet met) and its flux per
 /// channel; the exit's weight is 1, or where the channels' states differ the product of the flux
 /// factors of the facets' branch choices (polarized_dielectric_choice).
-template <typename T, typename Uniform>
+template <bool kAnisotropic = false, typename T, typename Uniform>
 std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_polarized(const GGX<T>& ggx, T eta,
                                                                    const Vec3<T>& wi,
                                                                    Uniform&& uniform, int max_order,
@@ -403,14 +407,15 @@ std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_polarized(const GGX<T>&
     auto draw = [&] { return T(uniform()); };
     const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw), true> facet{eta, T(1) / eta, draw,
                                                                               &pol};
-    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.alpha, {wi.x, wi.y, wi.z}, true,
-                                                           true, facet, draw, max_order));
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.template lanes<kAnisotropic>(),
+                                                           {wi.x, wi.y, wi.z}, true, true, facet,
+                                                           draw, max_order));
 }
 
 /// walk_rough_conductor following the particle's polarization: `mueller(cos, m)` fills the
 /// reflection Mueller matrices of the three channels (fresnel_conductor_mueller); the exit's
 /// weight is the product of the facets' reflected fractions of the state.
-template <typename T, typename Mueller, typename Uniform>
+template <bool kAnisotropic = false, typename T, typename Mueller, typename Uniform>
 std::optional<MicrosurfaceExit<T>> walk_rough_conductor_polarized(const GGX<T>& ggx,
                                                                   const Mueller& mueller,
                                                                   const Vec3<T>& wi,
@@ -420,8 +425,9 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor_polarized(const GGX<T>& 
     const NoMueller unpolarized;
     const MicrosurfaceConductorFacet<T, Lane<T>, NoMueller, Mueller> facet{unpolarized, &pol,
                                                                            &mueller};
-    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.alpha, {wi.x, wi.y, wi.z}, true,
-                                                           false, facet, draw, max_order));
+    return microsurface_exit(microsurface_walk<T, Lane<T>>(ggx.template lanes<kAnisotropic>(),
+                                                           {wi.x, wi.y, wi.z}, true, false, facet,
+                                                           draw, max_order));
 }
 
 // ---- Evaluating the walk: phase functions, height masking and next-event estimation -------------
@@ -649,8 +655,9 @@ inline void microsurface_conductor_connect_polarized(const GGX<T>& ggx, const Mu
 }
 
 /// walk_rough_dielectric with a visitor: `visit(const MicrosurfaceFacet<T>&)` is called at every
-/// facet before the particle scatters off it. The same walk (microsurface_walk at one lane, the
-/// same random numbers in the same order): returns the same exit.
+/// facet before the particle scatters off it (kAnisotropic as walk_rough_dielectric's). The same
+/// walk (microsurface_walk at one lane, the same random numbers in the same order): returns the
+/// same exit.
 template <typename T, typename Visit>
 struct MicrosurfaceFacetVisitor {
     Visit& visit;
@@ -661,7 +668,7 @@ struct MicrosurfaceFacetVisitor {
                                        Rgb<T>(weight[0], weight[1], weight[2]), int(order)});
     }
 };
-template <typename T, typename Uniform, typename Visit>
+template <bool kAnisotropic = false, typename T, typename Uniform, typename Visit>
 std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_visiting(const GGX<T>& ggx, T eta,
                                                                   const Vec3<T>& wi,
                                                                   Uniform&& uniform, int max_order,
@@ -669,12 +676,12 @@ std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_visiting(const GGX<T>& 
     auto draw = [&] { return T(uniform()); };
     const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw)> facet{eta, T(1) / eta, draw};
     return microsurface_exit(microsurface_walk<T, Lane<T>>(
-        ggx.alpha, {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
+        ggx.template lanes<kAnisotropic>(), {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
         MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
 }
 
 /// walk_rough_conductor with a visitor, as walk_rough_dielectric_visiting.
-template <typename T, typename Fresnel, typename Uniform, typename Visit>
+template <bool kAnisotropic = false, typename T, typename Fresnel, typename Uniform, typename Visit>
 std::optional<MicrosurfaceExit<T>> walk_rough_conductor_visiting(const GGX<T>& ggx,
                                                                  const Fresnel& fresnel,
                                                                  const Vec3<T>& wi,
@@ -687,13 +694,13 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor_visiting(const GGX<T>& g
     };
     const MicrosurfaceConductorFacet<T, Lane<T>, decltype(factors)> facet{factors};
     return microsurface_exit(microsurface_walk<T, Lane<T>>(
-        ggx.alpha, {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
+        ggx.template lanes<kAnisotropic>(), {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
         MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
 }
 
 /// walk_rough_dielectric_polarized with a visitor, as walk_rough_dielectric_visiting; at each call
 /// `pol.stokes` holds the state with which the particle meets the facet.
-template <typename T, typename Uniform, typename Visit>
+template <bool kAnisotropic = false, typename T, typename Uniform, typename Visit>
 std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_polarized_visiting(
     const GGX<T>& ggx, T eta, const Vec3<T>& wi, Uniform&& uniform, int max_order,
     PolarizationLanes<T>& pol, Visit&& visit) {
@@ -701,12 +708,12 @@ std::optional<MicrosurfaceExit<T>> walk_rough_dielectric_polarized_visiting(
     const MicrosurfaceDielectricFacet<T, Lane<T>, decltype(draw), true> facet{eta, T(1) / eta, draw,
                                                                               &pol};
     return microsurface_exit(microsurface_walk<T, Lane<T>>(
-        ggx.alpha, {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
+        ggx.template lanes<kAnisotropic>(), {wi.x, wi.y, wi.z}, true, true, facet, draw, max_order,
         MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
 }
 
 /// walk_rough_conductor_polarized with a visitor, as walk_rough_dielectric_polarized_visiting.
-template <typename T, typename Mueller, typename Uniform, typename Visit>
+template <bool kAnisotropic = false, typename T, typename Mueller, typename Uniform, typename Visit>
 std::optional<MicrosurfaceExit<T>> walk_rough_conductor_polarized_visiting(
     const GGX<T>& ggx, const Mueller& mueller, const Vec3<T>& wi, Uniform&& uniform, int max_order,
     PolarizationLanes<T>& pol, Visit&& visit) {
@@ -715,7 +722,7 @@ std::optional<MicrosurfaceExit<T>> walk_rough_conductor_polarized_visiting(
     const MicrosurfaceConductorFacet<T, Lane<T>, NoMueller, Mueller> facet{unpolarized, &pol,
                                                                            &mueller};
     return microsurface_exit(microsurface_walk<T, Lane<T>>(
-        ggx.alpha, {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
+        ggx.template lanes<kAnisotropic>(), {wi.x, wi.y, wi.z}, true, false, facet, draw, max_order,
         MicrosurfaceFacetVisitor<T, std::remove_reference_t<Visit>>{visit}));
 }
 

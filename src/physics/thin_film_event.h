@@ -154,11 +154,13 @@ inline FilmEvent film_dielectric_event(const FilmOptics& film, float eta, float 
         e.degenerate = true;
         return e;
     }
+    // Isotropic: a stack with a film has no anisotropic interface (validate_kernel_for).
+    const GgxLanes<float, false> ggx = ggx_lanes<float>(alpha, alpha, 1, 0);
     const bool above = wi.z > 0;
     const float sign = above ? 1.f : -1.f;
     const LaneVec3<float> w_side = {sign * wi.x, sign * wi.y, sign * wi.z};
     LaneVec3<float> wm = {0.f, 0.f, 1.f};  // on the particle's side, seen from that side
-    if (alpha > 0) wm = ggx_sample_visible_normal_complete<float>(alpha, w_side, u1, u2);
+    if (alpha > 0) wm = ggx_sample_visible_normal_complete<float>(ggx, w_side, u1, u2);
     const LaneVec3<float> wm_particle = {sign * wm.x, sign * wm.y, sign * wm.z};
     const float cos_w_m = std::min(lane_dot<float>(wi, wm_particle), 1.f);
     if (!(cos_w_m > 0)) {
@@ -171,10 +173,9 @@ inline FilmEvent film_dielectric_event(const FilmOptics& film, float eta, float 
         const LaneVec3<float>& wo = e.scatter.wo;
         const bool same_side = wi.z * wo.z > 0;
         const bool escapes = std::abs(wo.z) > 0 && same_side == e.scatter.reflects;
-        e.shadowing = escapes
-                          ? ggx_escape_fraction<float>(alpha * alpha, wi, wo, e.scatter.reflects,
-                                                       true, uncorrelated, smith_refraction)
-                          : 0.f;
+        e.shadowing = escapes ? ggx_escape_fraction<float>(ggx, wi, wo, e.scatter.reflects, true,
+                                                           uncorrelated, smith_refraction)
+                              : 0.f;
     }
     return e;
 }

@@ -505,7 +505,10 @@ void bind_table(py::module_& m) {
             "theta_edges", [](const BinnedTable& t) { return edges_deg(t.grid.n_theta(), 90); },
             "θ bin edges, degrees")
         .def_property_readonly(
-            "phi_edges", [](const BinnedTable& t) { return edges_deg(t.grid.n_phi(), 180); },
+            "phi_edges",
+            [](const BinnedTable& t) {
+                return edges_deg(t.grid.n_phi(), rad_to_deg(t.grid.phi_span()));
+            },
             "φ bin edges, degrees (folded: each bin covers ±φ)")
         .def_property_readonly(
             "projected_solid_angle",
@@ -540,9 +543,11 @@ void bind_simulation(py::module_& m) {
         .def_property_readonly(
             "theta_edges",
             [](const PySimulation& r) { return edges_deg(r.result.settings.grid.n_theta(), 90); })
-        .def_property_readonly(
-            "phi_edges",
-            [](const PySimulation& r) { return edges_deg(r.result.settings.grid.n_phi(), 180); })
+        .def_property_readonly("phi_edges",
+                               [](const PySimulation& r) {
+                                   return edges_deg(r.result.table.grid.n_phi(),
+                                                    rad_to_deg(r.result.table.grid.phi_span()));
+                               })
         .def_property_readonly(
             "energy",
             [](const PySimulation& r) {

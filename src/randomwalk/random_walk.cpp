@@ -141,6 +141,12 @@ bool is_grey(const Rgbd& x) {
 
 RandomWalkStack::RandomWalkStack(const Stack& stack, const TransportSettings& transport)
     : transmits_(stack.transmits()), transport_(transport) {
+    // The walk's samplers and connections take the isotropic instance of the GGX formulas.
+    if (stack.is_anisotropic())
+        throw InputError(stack.name, "alpha",
+                         "not supported: the random walk does not trace anisotropic interfaces "
+                         "(alpha = [alpha_x, alpha_y]); the goniophotometer does (--kernel "
+                         "scalar)");
     LAMINA_CHECK(transport.max_events >= 1);
     LAMINA_CHECK(transport.max_microsurface_order >= 1);
     if (stack.has_film())

@@ -119,7 +119,8 @@ inline void film_event(const CompiledStack<float>& stack, const CompiledLayer<fl
             const MicrosurfaceFilmFacet<decltype(uniform)> facet{film,    di.eta, thickness,
                                                                  uniform, flux,   p};
             apply_walk(microsurface_exit(microsurface_walk<float, Lane<float>>(
-                           di.alpha, wl, true, true, facet, uniform, stack.max_microsurface_order)),
+                           di.distribution().template lanes<false>(), wl, true, true, facet,
+                           uniform, stack.max_microsurface_order)),
                        true);
             return;
         }
@@ -172,11 +173,13 @@ inline void film_event(const CompiledStack<float>& stack, const CompiledLayer<fl
     };
     InterfaceEventLanes<float, bool> e;
     if constexpr (kPolarized)
-        e = conductor_event<float>(cond.alpha, cond.is_smooth(), cond.uncorrelated_shadowing, wl,
-                                   u1, u2, true, NoMueller{}, factors, &pol, mueller);
+        e = conductor_event<float>(cond.distribution().template lanes<false>(), cond.is_smooth(),
+                                   cond.uncorrelated_shadowing, wl, u1, u2, true, NoMueller{},
+                                   factors, &pol, mueller);
     else
-        e = conductor_event<float>(cond.alpha, cond.is_smooth(), cond.uncorrelated_shadowing, wl,
-                                   u1, u2, true, channel_reflectance, factors);
+        e = conductor_event<float>(cond.distribution().template lanes<false>(), cond.is_smooth(),
+                                   cond.uncorrelated_shadowing, wl, u1, u2, true,
+                                   channel_reflectance, factors);
     std::optional<BsdfSample<float>> s;
     if (!e.degenerate) {
         s.emplace();
@@ -194,7 +197,10 @@ inline void film_event(const CompiledStack<float>& stack, const CompiledLayer<fl
 // Polarized runs: pol goes through the event too (pol.flux: the caller's copy of w). Where the
 // channels' states differ, a dielectric's branch choice reweights the channels: the reweighting
 // (zero in expectation per channel) is booked with the base that coloured them.
-template <bool kPolarized, bool kFilm>
+// kAnisotropic: the stack has an anisotropic interface (CompiledStack::anisotropic), and every
+// rough interface takes the general instance of the GGX formulas (GGX::lanes). kFilm: the stack
+// has a thin film (film_event; never with kAnisotropic: validate_kernel_for refuses the pair).
+template <bool kPolarized, bool kAnisotropic, bool kFilm>
 inline void interface_event(const CompiledStack<float>& stack, const CompiledLayer<float>& layer,
                             ParticleRng& rng, Tally& tally, Vec3f& d, Rgbf& w, PathLosses& losses,
                             [[maybe_unused]] PolarizationLanes<float>& pol) {
@@ -251,24 +257,27 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
         case InterfaceType::Dielectric: {
             if (layer.multiple) {
                 if constexpr (kPolarized) {
-                    apply_walk(walk_rough_dielectric_polarized(
+                    apply_walk(walk_rough_dielectric_polarized<kAnisotropic>(
                                    layer.dielectric.distribution(), layer.dielectric.eta, wi_local,
                                    uniform, stack.max_microsurface_order, pol),
                                reweights);
                     break;
                 }
-                apply_walk(
-                    walk_rough_dielectric(layer.dielectric.distribution(), layer.dielectric.eta,
-                                          wi_local, uniform, stack.max_microsurface_order),
-                    false);
+                apply_walk(walk_rough_dielectric<kAnisotropic>(
+                               layer.dielectric.distribution(), layer.dielectric.eta, wi_local,
+                               uniform, stack.max_microsurface_order),
+                           false);
                 break;
             }
             const float uc = rng.uniform_float(), u1 = rng.uniform_float(),
                         u2 = rng.uniform_float();
             if constexpr (kPolarized)
-                apply(layer.dielectric.sample_polarized(wi_local, uc, u1, u2, pol), reweights);
+                apply(layer.dielectric.template sample_polarized<kAnisotropic>(wi_local, uc, u1, u2,
+                                                                               pol),
+                      reweights);
             else
-                apply(layer.dielectric.sample<false>(wi_local, uc, u1, u2), false);
+                apply(layer.dielectric.template sample<false, kAnisotropic>(wi_local, uc, u1, u2),
+                      false);
             break;
         }
         case InterfaceType::Conductor: {
@@ -278,13 +287,13 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
                     const auto mueller = [&](float c, InterfaceMueller<float>* m) {
                         cond.mueller(c, m);
                     };
-                    apply_walk(
-                        walk_rough_conductor_polarized(cond.distribution(), mueller, wi_local,
-                                                       uniform, stack.max_microsurface_order, pol),
-                        true);
+                    apply_walk(walk_rough_conductor_polarized<kAnisotropic>(
+                                   cond.distribution(), mueller, wi_local, uniform,
+                                   stack.max_microsurface_order, pol),
+                               true);
                     break;
                 }
-                apply_walk(walk_rough_conductor(
+                apply_walk(walk_rough_conductor<kAnisotropic>(
                                cond.distribution(), [&](float c) { return cond.fresnel(c); },
                                wi_local, uniform, stack.max_microsurface_order),
                            true);
@@ -292,9 +301,9 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
             }
             const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
             if constexpr (kPolarized)
-                apply(cond.sample_polarized(wi_local, u1, u2, pol), true);
+                apply(cond.template sample_polarized<kAnisotropic>(wi_local, u1, u2, pol), true);
             else
-                apply(cond.sample<false>(wi_local, u1, u2), true);
+                apply(cond.template sample<false, kAnisotropic>(wi_local, u1, u2), true);
             break;
         }
         case InterfaceType::Lambertian: {
@@ -316,7 +325,7 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
 // depolarize it, and an exit is tallied with its Stokes vector when the job asks for it.
 // Written once for both: kPolarized = false is the unpolarized kernel, with none of it; kFilm
 // = true the instantiation for stacks with a thin film (film_event).
-template <bool kPolarized, bool kFilm>
+template <bool kPolarized, bool kAnisotropic, bool kFilm>
 void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& grid,
                     const BlockJob& job, ParticleRng& rng, Tally& tally, BlockBudget& block) {
     const int n_layers = int(stack.layers.size());
@@ -338,7 +347,9 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         float s[3][4];
         const float wl[3] = {w[0], w[1], w[2]};
         stokes_in_bin_frame<float>(pol.stokes, {d.x, d.y, d.z}, wl, pol.channels, true, s);
-        tally.exit_stokes(index, d.y < 0 ? 1 : 0, s);
+        // Folded bins count the patch y < 0 as its mirror image (mueller.h); unfolded ones are one
+        // patch each.
+        tally.exit_stokes(index, d.y < 0 && !job.grid->is_unfolded() ? 1 : 0, s);
     };
     while (true) {
         if (events >= max_events) {
@@ -350,7 +361,8 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         if constexpr (kPolarized)
             for (int c = 0; c < 3; ++c)
                 flux[c] = w[c];
-        interface_event<kPolarized, kFilm>(stack, layer, rng, tally, d, w, losses, pol);
+        interface_event<kPolarized, kAnisotropic, kFilm>(stack, layer, rng, tally, d, w, losses,
+                                                         pol);
         if (is_black(w)) break;
         if (d.z == 0) {
             // An exactly grazing direction (a sampler at the edge of its domain, probability
@@ -419,17 +431,24 @@ constexpr float kIncidentStokes[7][3] = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 
 void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block) {
     for (std::uint64_t p = job.first; p < job.first + job.count; ++p) {
         ParticleRng rng(job.seed, job.stream, p);
-        // A stack with a film has its own instantiations: those of the stacks without one are
-        // compiled (inlined, contracted) exactly as before films existed, bit for bit.
+        // Stacks with a film or an anisotropic interface have their own instantiations: those of
+        // the other stacks are compiled (inlined, contracted) exactly as before either existed,
+        // bit for bit.
+        const bool pol = job.stack->polarization;
         if (job.stack->has_film) {
-            if (job.stack->polarization)
-                trace_particle<true, true>(*job.stack, *job.grid, job, rng, tally, block);
+            if (pol)
+                trace_particle<true, false, true>(*job.stack, *job.grid, job, rng, tally, block);
             else
-                trace_particle<false, true>(*job.stack, *job.grid, job, rng, tally, block);
-        } else if (job.stack->polarization) {
-            trace_particle<true, false>(*job.stack, *job.grid, job, rng, tally, block);
+                trace_particle<false, false, true>(*job.stack, *job.grid, job, rng, tally, block);
+        } else if (job.stack->anisotropic) {
+            if (pol)
+                trace_particle<true, true, false>(*job.stack, *job.grid, job, rng, tally, block);
+            else
+                trace_particle<false, true, false>(*job.stack, *job.grid, job, rng, tally, block);
+        } else if (pol) {
+            trace_particle<true, false, false>(*job.stack, *job.grid, job, rng, tally, block);
         } else {
-            trace_particle<false, false>(*job.stack, *job.grid, job, rng, tally, block);
+            trace_particle<false, false, false>(*job.stack, *job.grid, job, rng, tally, block);
         }
     }
 }
@@ -439,9 +458,13 @@ std::string kernel_description(Kernel kernel) {
     return kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name()) : "scalar";
 }
 
-Kernel kernel_for(Kernel kernel, const Stack& stack) {
-    if (kernel != Kernel::Auto) return kernel;
-    return stack.has_film() ? Kernel::Scalar : Kernel::Simd;
+bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings) {
+    return stack.has_film() || stack.is_anisotropic() || settings.phi_i_deg != 0;
+}
+
+Kernel kernel_for(const SimulationSettings& settings, const Stack& stack) {
+    if (settings.kernel != Kernel::Auto) return settings.kernel;
+    return needs_scalar_kernel(stack, settings) ? Kernel::Scalar : Kernel::Simd;
 }
 
 void IncidenceSums::add(const IncidenceSums& o) {
@@ -461,11 +484,25 @@ void IncidenceSums::add(const IncidenceSums& o) {
 }
 
 void validate_kernel_for(const Stack& stack, const SimulationSettings& settings) {
-    if (stack.has_film() && settings.kernel == Kernel::Simd)
+    if (stack.has_film() && stack.is_anisotropic())
+        throw InputError(stack.name, "film",
+                         "a thin film on a stack with an anisotropic interface is not traced yet "
+                         "(films and anisotropy each work alone)");
+    if (settings.kernel != Kernel::Simd) return;
+    if (stack.has_film())
         throw InputError("command line", "--kernel",
                          fmt::format("the stack '{}' has a thin film, which the SIMD kernel does "
                                      "not trace; give --kernel scalar (or auto)",
                                      stack.name));
+    if (stack.is_anisotropic())
+        throw InputError("command line", "--kernel",
+                         fmt::format("the stack '{}' has an anisotropic interface, which the SIMD "
+                                     "kernel does not trace; give --kernel scalar (or auto)",
+                                     stack.name));
+    if (settings.phi_i_deg != 0)
+        throw InputError("command line", "--kernel",
+                         "light from phi_i ≠ 0 is tabulated on the unfolded grid, which the SIMD "
+                         "kernel does not bin; give --kernel scalar (or auto)");
 }
 
 SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,
@@ -474,9 +511,9 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
     const auto start = std::chrono::steady_clock::now();
     const CompiledStack<float> trace = compile_stack<float>(stack, settings.transport);
     validate_kernel_for(stack, settings);
-    const HemisphereGrid& grid = settings.grid;
+    const HemisphereGrid grid = simulation_grid(stack, settings);
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
-    const Kernel kernel = kernel_for(settings.kernel, stack);
+    const Kernel kernel = kernel_for(settings, stack);
     if (kernel == Kernel::Simd) select_simd_target();
     const auto trace_block = kernel == Kernel::Simd ? trace_block_simd : trace_block_scalar;
 
@@ -494,7 +531,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
         const double theta_i = deg_to_rad(settings.theta_i_deg[inc]);
         BlockJob job{&trace,
                      &grid,
-                     Vec3f(incident_direction(theta_i)),
+                     Vec3f(direction_from_angles(theta_i, deg_to_rad(settings.phi_i_deg))),
                      settings.seed,
                      incidence_stream(settings.theta_i_deg[inc], settings.incident_polarization),
                      0,
@@ -537,7 +574,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
 SimulationResult finalize_simulation(const Stack& stack, const SimulationSettings& settings,
                                      const SimulationSums& sums) {
     LAMINA_CHECK(sums.incidences.size() == settings.theta_i_deg.size());
-    const HemisphereGrid& grid = settings.grid;
+    const HemisphereGrid grid = simulation_grid(stack, settings);
     const bool transmits = stack.transmits();
     SimulationResult result;
     result.settings = settings;
@@ -586,6 +623,11 @@ SimulationResult finalize_simulation(const Stack& stack, const SimulationSetting
     }
     if (settings.stokes_tallies) result.sums = sums.incidences;
     return result;
+}
+
+HemisphereGrid simulation_grid(const Stack& stack, const SimulationSettings& settings) {
+    return stack.is_anisotropic() || settings.phi_i_deg != 0 ? settings.grid.unfolded()
+                                                             : settings.grid;
 }
 
 SimulationResult simulate(const Stack& stack, const SimulationSettings& settings,

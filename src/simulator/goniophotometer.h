@@ -34,13 +34,14 @@ inline constexpr std::uint64_t kParticlesPerBlock = 4096;
 /// `simd` traces a batch of particles as the lanes of SIMD vectors (kernel_simd.h), dispatched at
 /// run time to what the CPU offers. Each is bitwise reproducible for any thread or process count on
 /// a given machine; the two agree in distribution (a two-sample chi-square test), not bit for bit.
-/// `auto` is `simd`, or `scalar` for a stack the SIMD kernel does not trace (a thin film,
-/// docs/physics.md §9): kernel_for.
+/// `auto` is `simd`, or `scalar` for what the SIMD kernel does not trace (a thin film,
+/// docs/physics.md §9; an anisotropic interface or light from φi ≠ 0, §3 and §5): kernel_for.
 enum class Kernel { Scalar, Simd, Auto };
 inline constexpr std::array<EnumName<Kernel>, 3> enum_names(Kernel) {
     return {{{Kernel::Scalar, "scalar", "one particle at a time, the reference path"},
              {Kernel::Simd, "simd", "particles as the lanes of SIMD vectors"},
-             {Kernel::Auto, "auto", "simd, or scalar for a stack with a thin film"}}};
+             {Kernel::Auto, "auto",
+              "simd, or scalar for a thin film, an anisotropic interface or phi_i != 0"}}};
 }
 inline const char* enum_noun(Kernel) {
     return "a particle kernel";
@@ -50,20 +51,27 @@ inline const char* enum_noun(Kernel) {
 /// are bitwise reproducible for equal descriptions of the kernel that ran.
 std::string kernel_description(Kernel kernel);
 
-/// The kernel that traces `stack` under the setting `kernel`: auto is scalar for a stack with a
-/// thin film, simd otherwise; scalar and simd are themselves.
-Kernel kernel_for(Kernel kernel, const Stack& stack);
+struct SimulationSettings;
+/// Whether only the scalar kernel traces `stack` under `settings` (a thin film, an anisotropic
+/// interface, light from φi ≠ 0).
+bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings);
+/// The kernel that traces `stack` under `settings`: auto is scalar where needs_scalar_kernel,
+/// simd otherwise; scalar and simd are themselves.
+Kernel kernel_for(const SimulationSettings& settings, const Stack& stack);
 
 /// The goniophotometer's settings. Each is declared once, in `fields` (core/setting.h): the
 /// command line, result.json, the study's files, the reference's cache key and Python read them
 /// there.
 struct SimulationSettings {
     std::vector<double> theta_i_deg = default_incidences_deg();  ///< each in [0, 90)
-    std::uint64_t particles = 1'000'000;                         ///< per incidence, > 0
+    /// The incidence azimuth φi in degrees, [0, 360]: the light comes from (sin θi cos φi,
+    /// sin θi sin φi, cos θi). A non-zero φi unfolds the φ grid (simulation_grid).
+    double phi_i_deg = 0.0;
+    std::uint64_t particles = 1'000'000;  ///< per incidence, > 0
     std::uint64_t seed = 1;
-    int threads = 0;      ///< 0: all available
-    HemisphereGrid grid;  ///< its default is the study's (core/grid.h)
-    Kernel kernel = Kernel::Auto;  ///< auto: SIMD, or scalar for what only it traces (films)
+    int threads = 0;               ///< 0: all available
+    HemisphereGrid grid;           ///< its default is the study's (core/grid.h)
+    Kernel kernel = Kernel::Auto;  ///< auto: SIMD, or scalar for what only it traces
     /// The physics the particles follow (shared with the random walk).
     TransportSettings transport;
     /// First particle index (a simulation may be split into ranges of particles, e.g. across
@@ -88,6 +96,13 @@ struct SimulationSettings {
                .help = "Incidences in degrees, comma-separated, in [0, 90)",
                .key = Key::Fixed},
               s.theta_i_deg);
+        visit({.name = "phi_i",
+               .help = "Incidence azimuth in degrees, in [0, 360] (light from (sin θi cos φi, sin "
+                       "θi sin φi, cos θi)); a non-zero φi unfolds the grid over φ∈[0°,360°)",
+               .min = 0,
+               .max = 360,
+               .key_unsaid = "0"},
+              s.phi_i_deg);
         visit({.name = "particles",
                .help = "Particles per incidence (1e7-style accepted)",
                .min = 1,
@@ -181,11 +196,17 @@ struct SimulationResult {
     int processes = 1;     ///< processes that shared the particles (distributed/split_simulation.h)
 };
 
+/// The grid the goniophotometer tabulates a stack on: settings.grid, unfolded over φ ∈ [0°, 360°)
+/// when the stack is anisotropic or the light comes from φi ≠ 0 (no mirror symmetry about the
+/// plane φ = 0 then; core/grid.h). The result's table is on this grid.
+HemisphereGrid simulation_grid(const Stack& stack, const SimulationSettings& settings);
+
 /// Checks what the settings' codecs cannot see alone (InputError naming `where` and the setting).
 void validate_settings(const SimulationSettings& settings, const std::string& where = "settings");
 
-/// Checks that the settings' kernel traces everything the stack holds: a thin film needs the
-/// scalar kernel, or auto (InputError naming --kernel for simd; docs/physics.md §9).
+/// Checks that the settings' kernel traces everything the stack holds: a thin film, an
+/// anisotropic interface and light from φi ≠ 0 need the scalar kernel, or auto (InputError naming
+/// --kernel for simd; docs/physics.md §9); a film with an anisotropic interface is refused.
 void validate_kernel_for(const Stack& stack, const SimulationSettings& settings);
 
 /// Traces particles [first_particle, first_particle + particles) of every incidence and returns

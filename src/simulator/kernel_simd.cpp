@@ -126,6 +126,13 @@ struct LaneVectors {
 
 // ---- Interface events (goniophotometer.cpp trace_particle, `apply`) ----------------------------
 
+// An interface's GGX roughness (physics/microfacet.h) on the vectors' lanes: the isotropic
+// instance (the SIMD kernel traces isotropic stacks; an anisotropic one runs on the scalar kernel,
+// SimulationSettings::kernel).
+HWY_INLINE GgxLanes<VF> VecGgx(const GGX<float>& ggx) {
+    return ggx_lanes<VF, VecLane, false>(ggx.alpha, 0, 1, 0);
+}
+
 // A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
 // instantiates at one lane): the particle arrives along d (wi = −d). Polarized (kPolarized): the
 // event's polarized form on the lanes' states; where the channels' states differ, its reweighting
@@ -136,7 +143,7 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
     const DF df;
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     const InterfaceEventLanes<VF, MF> e = dielectric_event<VF, VecLane, kPolarized>(
-        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), hn::Set(df, iface.alpha),
+        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), VecGgx(iface.distribution()),
         iface.event_shape(), wi, uc, u1, u2, m, kPolarized ? &v.pol : nullptr);
     degenerate = hn::Or(degenerate, e.degenerate);
     const MF ok = hn::AndNot(e.degenerate, m);
@@ -151,16 +158,15 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
 template <bool kPolarized>
 HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v, VF u1,
                                VF u2, MF& degenerate) {
-    const DF df;
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     VF fresnel[3];
     InterfaceEventLanes<VF, MF> e;
     if constexpr (kPolarized)
         e = conductor_event<VF, VecLane>(
-            hn::Set(df, iface.alpha), iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1, u2,
-            m, ConductorFresnel{iface}, fresnel, &v.pol, ConductorMueller{iface});
+            VecGgx(iface.distribution()), iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
+            u2, m, ConductorFresnel{iface}, fresnel, &v.pol, ConductorMueller{iface});
     else
-        e = conductor_event<VF, VecLane>(hn::Set(df, iface.alpha), iface.is_smooth(),
+        e = conductor_event<VF, VecLane>(VecGgx(iface.distribution()), iface.is_smooth(),
                                          iface.uncorrelated_shadowing, wi, u1, u2, m,
                                          ConductorFresnel{iface}, fresnel);
     degenerate = hn::Or(degenerate, e.degenerate);
@@ -178,15 +184,15 @@ HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, Lan
 // (lost and counted, as a failed sample), as trace_particle books the walk. `weighted`: the exit's
 // weight is booked on a dielectric too (polarized, the channels' states differing).
 template <typename Facet>
-HWY_INLINE void MicrosurfaceWalkEvent(float alpha, bool two_sided, const Facet& facet, MF m,
-                                      LaneVectors& v, LaneRng& rng, int max_order, MF& degenerate,
-                                      bool weighted = false) {
+HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, const Facet& facet,
+                                      MF m, LaneVectors& v, LaneRng& rng, int max_order,
+                                      MF& degenerate, bool weighted = false) {
     const DF df;
     const VF zero = hn::Zero(df);
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     auto draw = [&] { return rng.Uniform(); };
-    const MicrosurfaceWalkLanes<VF, MF> walk = microsurface_walk<VF, VecLane>(
-        hn::Set(df, alpha), wi, m, two_sided, facet, draw, max_order);
+    const MicrosurfaceWalkLanes<VF, MF> walk =
+        microsurface_walk<VF, VecLane>(VecGgx(ggx), wi, m, two_sided, facet, draw, max_order);
     degenerate = hn::Or(degenerate, walk.degenerate);
     if (!two_sided || weighted) v.Keep(walk.escaped, kLossBase, walk.weight);
     v.Keep(walk.capped, kLossMicro, zero);
@@ -200,7 +206,7 @@ HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, MF 
     auto draw = [&] { return rng.Uniform(); };
     const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw), kPolarized> facet{
         hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), draw, kPolarized ? &v.pol : nullptr};
-    MicrosurfaceWalkEvent(iface.alpha, true, facet, m, v, rng, max_order, degenerate,
+    MicrosurfaceWalkEvent(iface.distribution(), true, facet, m, v, rng, max_order, degenerate,
                           kPolarized && v.pol.channels == 3);
 }
 
@@ -212,10 +218,10 @@ HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, MF m,
         const ConductorMueller mueller{iface};
         const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel, ConductorMueller> facet{
             fresnel, &v.pol, &mueller};
-        MicrosurfaceWalkEvent(iface.alpha, false, facet, m, v, rng, max_order, degenerate);
+        MicrosurfaceWalkEvent(iface.distribution(), false, facet, m, v, rng, max_order, degenerate);
     } else {
         const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel> facet{fresnel};
-        MicrosurfaceWalkEvent(iface.alpha, false, facet, m, v, rng, max_order, degenerate);
+        MicrosurfaceWalkEvent(iface.distribution(), false, facet, m, v, rng, max_order, degenerate);
     }
 }
 

@@ -41,8 +41,14 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     // the bins' ranges, the threads and processes used.
     j.update(settings_to_json(s));
     j["physics"] = physics_name(s.transport);  // exact, bpb19 or custom
-    j["kernel_description"] = kernel_description(kernel_for(s.kernel, stack));
-    j["grid"].update({{"theta_range_deg", {0, 90}}, {"phi_range_deg", {0, 180}}, {"folded", true}});
+    j["kernel_description"] = kernel_description(kernel_for(s, stack));
+    // The grid of the tables (simulation_grid): "n_phi" stays the setting's (folded) count; an
+    // unfolded table has twice as many φ bins, over [0°, 360°).
+    const bool unfolded = result.table.grid.is_unfolded();
+    j["grid"].update({{"theta_range_deg", {0, 90}},
+                      {"phi_range_deg", {0, unfolded ? 360 : 180}},
+                      {"folded", !unfolded},
+                      {"n_phi_bins", result.table.grid.n_phi()}});
     j["first_particle"] = s.first_particle;
     j["mueller"] = s.stokes_tallies;
     j["threads"] = result.threads_used;

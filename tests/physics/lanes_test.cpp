@@ -120,8 +120,9 @@ TEST(KernelSimdLanes, DielectricEvent) {
         double worst_wo = 0, worst_near_critical = 0, worst_shadowing = 0;
         for (std::size_t j = 0; j < n; ++j) {
             const LaneVec3<float> w = {wi[3 * j], wi[3 * j + 1], wi[3 * j + 2]};
-            const InterfaceEventLanes<float, bool> s = dielectric_event<float>(
-                cs.eta, 1 / cs.eta, cs.alpha, shape, w, u[j], u[n + j], u[2 * n + j], true);
+            const InterfaceEventLanes<float, bool> s =
+                dielectric_event<float>(cs.eta, 1 / cs.eta, ggx_isotropic_lanes<float>(cs.alpha),
+                                        shape, w, u[j], u[n + j], u[2 * n + j], true);
             ASSERT_EQ(bool(lanes.degenerate[j]), s.degenerate) << j;
             if (s.degenerate) {
                 EXPECT_EQ(w.z, 0.f) << j;
@@ -142,8 +143,9 @@ TEST(KernelSimdLanes, DielectricEvent) {
             double tolerance = 1e-6;
             LaneVec3<float> wm = {0, 0, 1};
             if (cs.alpha > 0) {
-                wm = ggx_sample_visible_normal_complete<float>(
-                    cs.alpha, {sign * w.x, sign * w.y, sign * w.z}, u[n + j], u[2 * n + j]);
+                wm = ggx_sample_visible_normal_complete<float>(ggx_isotropic_lanes<float>(cs.alpha),
+                                                               {sign * w.x, sign * w.y, sign * w.z},
+                                                               u[n + j], u[2 * n + j]);
                 // In double: wh (w on its side in the hemisphere configuration), the cap point
                 // c and the halfway vector h = c + wh, whose normalization divides the float
                 // rounding by |h| (the cap point near −wh: u2 → 1 with a tiny α).
@@ -221,9 +223,9 @@ TEST(KernelSimdLanes, ConductorEvent) {
                 const Rgbf r = iface.fresnel(c);
                 out[0] = r[0], out[1] = r[1], out[2] = r[2];
             };
-            const InterfaceEventLanes<float, bool> s =
-                conductor_event<float>(cs.alpha, cs.alpha == 0, cs.uncorrelated, w, u[n + j],
-                                       u[2 * n + j], true, fresnel, f);
+            const InterfaceEventLanes<float, bool> s = conductor_event<float>(
+                ggx_isotropic_lanes<float>(cs.alpha), cs.alpha == 0, cs.uncorrelated, w, u[n + j],
+                u[2 * n + j], true, fresnel, f);
             ASSERT_EQ(bool(lanes.degenerate[j]), s.degenerate) << j;
             if (s.degenerate) {
                 EXPECT_LE(w.z, 0.f) << j;
@@ -362,8 +364,8 @@ TEST(KernelSimdLanes, PolarizedEvents) {
                 if (cs.kind == 0) {
                     const DielectricEventShape shape{cs.alpha == 0, false, false, true};
                     e = dielectric_event<float, Lane<float>, true>(
-                        cs.eta[0], 1 / cs.eta[0], cs.alpha, shape, w, u[j], u[n + j], u[2 * n + j],
-                        true, &pol);
+                        cs.eta[0], 1 / cs.eta[0], ggx_isotropic_lanes<float>(cs.alpha), shape, w,
+                        u[j], u[n + j], u[2 * n + j], true, &pol);
                 } else {
                     float f[3];
                     const auto fresnel = [&](float c, float* out) {
@@ -373,8 +375,9 @@ TEST(KernelSimdLanes, PolarizedEvents) {
                     const auto mueller = [&](float c, InterfaceMueller<float>* m) {
                         iface.mueller(c, m);
                     };
-                    e = conductor_event<float>(cs.alpha, cs.alpha == 0, false, w, u[n + j],
-                                               u[2 * n + j], true, fresnel, f, &pol, mueller);
+                    e = conductor_event<float>(ggx_isotropic_lanes<float>(cs.alpha), cs.alpha == 0,
+                                               false, w, u[n + j], u[2 * n + j], true, fresnel, f,
+                                               &pol, mueller);
                 }
                 ASSERT_EQ(bool(lanes.event.degenerate[j]), e.degenerate) << j;
                 if (e.degenerate) continue;

@@ -432,13 +432,23 @@ TEST(ThinFilmStack, AutoKernelPicksScalarForFilms) {
         const SimulationResult automatic = simulate(stack, s);
         s.kernel = stack.has_film() ? Kernel::Scalar : Kernel::Simd;
         const SimulationResult chosen = simulate(stack, s);
-        EXPECT_EQ(kernel_for(Kernel::Auto, stack), s.kernel);
+        SimulationSettings auto_kernel = s;
+        auto_kernel.kernel = Kernel::Auto;
+        EXPECT_EQ(kernel_for(auto_kernel, stack), s.kernel);
         EXPECT_EQ(automatic.table.lobe(0, Side::Reflection).f,
                   chosen.table.lobe(0, Side::Reflection).f);
         EXPECT_EQ(automatic.incidences[0].budget.term, chosen.incidences[0].budget.term);
     }
-    EXPECT_EQ(kernel_for(Kernel::Scalar, bare), Kernel::Scalar);
-    EXPECT_EQ(kernel_for(Kernel::Simd, filmed), Kernel::Simd);  // refused by simulate
+    SimulationSettings s;
+    s.kernel = Kernel::Scalar;
+    EXPECT_EQ(kernel_for(s, bare), Kernel::Scalar);
+    s.kernel = Kernel::Simd;
+    EXPECT_EQ(kernel_for(s, filmed), Kernel::Simd);  // refused by simulate
+    // Anisotropy and light from φi ≠ 0 need the scalar kernel too.
+    s.kernel = Kernel::Auto;
+    EXPECT_EQ(kernel_for(s, bare), Kernel::Simd);
+    s.phi_i_deg = 30;
+    EXPECT_EQ(kernel_for(s, bare), Kernel::Scalar);
 }
 
 // Who does not trace films says so: the SIMD kernel (an InputError naming --kernel), every model

@@ -218,15 +218,18 @@ void InterfaceEventsForTest(int kind, const float* params, const std::int32_t* f
         if (kind == 0) {  // dielectric: params eta, alpha; flags the event shape
             const DielectricEventShape shape{flags[0] != 0, flags[1] != 0, flags[2] != 0,
                                              flags[3] != 0};
-            e = dielectric_event<VF, VecLane>(hn::Set(df, params[0]), hn::Set(df, 1.f / params[0]),
-                                              hn::Set(df, params[1]), shape, w, uc, u1, u2, active);
+            e = dielectric_event<VF, VecLane>(
+                hn::Set(df, params[0]), hn::Set(df, 1.f / params[0]),
+                ggx_isotropic_lanes<VF, VecLane>(hn::Set(df, params[1])), shape, w, uc, u1, u2,
+                active);
         } else if (kind ==
                    1) {  // conductor: params alpha, eta[3], k[3]; flags smooth, uncorrelated
             ConductorInterface<float> iface{Rgbf(params[1], params[2], params[3]),
                                             Rgbf(params[4], params[5], params[6]), params[0]};
             VF f[3];
-            e = conductor_event<VF, VecLane>(hn::Set(df, params[0]), flags[0] != 0, flags[1] != 0,
-                                             w, u1, u2, active, ConductorFresnel{iface}, f);
+            e = conductor_event<VF, VecLane>(
+                ggx_isotropic_lanes<VF, VecLane>(hn::Set(df, params[0])), flags[0] != 0,
+                flags[1] != 0, w, u1, u2, active, ConductorFresnel{iface}, f);
             for (int c = 0; c < 3; ++c)
                 io.Store(f[c], fresnel + c * n);
         } else {  // Lambertian
@@ -312,15 +315,17 @@ void PolarizedEventsForTest(int kind, const float* params, const std::int32_t* f
             const DielectricEventShape shape{flags[0] != 0, flags[1] != 0, flags[2] != 0,
                                              flags[3] != 0};
             e = dielectric_event<VF, VecLane, true>(
-                hn::Set(df, params[0]), hn::Set(df, 1.f / params[0]), hn::Set(df, params[1]), shape,
-                w, uc, u1, u2, active, &pol);
+                hn::Set(df, params[0]), hn::Set(df, 1.f / params[0]),
+                ggx_isotropic_lanes<VF, VecLane>(hn::Set(df, params[1])), shape, w, uc, u1, u2,
+                active, &pol);
         } else {
             ConductorInterface<float> iface{Rgbf(params[1], params[2], params[3]),
                                             Rgbf(params[4], params[5], params[6]), params[0]};
             VF f[3];
-            e = conductor_event<VF, VecLane>(hn::Set(df, params[0]), flags[0] != 0, flags[1] != 0,
-                                             w, u1, u2, active, ConductorFresnel{iface}, f, &pol,
-                                             ConductorMueller{iface});
+            e = conductor_event<VF, VecLane>(
+                ggx_isotropic_lanes<VF, VecLane>(hn::Set(df, params[0])), flags[0] != 0,
+                flags[1] != 0, w, u1, u2, active, ConductorFresnel{iface}, f, &pol,
+                ConductorMueller{iface});
         }
         io.Store3(e.wo, wo);
         io.Store(e.shadowing, shadowing);
@@ -383,8 +388,9 @@ void GgxLanesForTest(float alpha, const float* w, const float* u1, const float* 
         }
         const V3 wv = {hn::Load(df, in[0]), hn::Load(df, in[1]), hn::Load(df, in[2])};
         const VF a = hn::Set(df, alpha);
-        hn::Store(ggx_lambda<VF, VecLane>(hn::Mul(a, a), wv.x, wv.y, wv.z), df, out[0]);
-        const V3 m = ggx_sample_visible_normal_complete<VF, VecLane>(a, wv, hn::Load(df, in[3]),
+        const GgxLanes<VF> g = ggx_isotropic_lanes<VF, VecLane>(a);
+        hn::Store(ggx_lambda<VF, VecLane>(g, wv.x, wv.y, wv.z), df, out[0]);
+        const V3 m = ggx_sample_visible_normal_complete<VF, VecLane>(g, wv, hn::Load(df, in[3]),
                                                                      hn::Load(df, in[4]));
         hn::Store(m.x, df, out[1]);
         hn::Store(m.y, df, out[2]);
@@ -430,16 +436,16 @@ void MicrosurfaceWalkForTest(const float* wi, std::size_t n, float alpha, bool d
         if (dielectric) {
             const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw)> facet{
                 hn::Set(df, di_face.eta), hn::Set(df, di_face.inv_eta()), draw};
-            r = microsurface_walk<VF, VecLane>(hn::Set(df, alpha), wi_v, m, true, facet, draw,
-                                               max_order);
+            r = microsurface_walk<VF, VecLane>(ggx_isotropic_lanes<VF, VecLane>(hn::Set(df, alpha)),
+                                               wi_v, m, true, facet, draw, max_order);
         } else {
             auto fresnel = [&](VF cos_w_m, VF* factors) {
                 for (int c = 0; c < 3; ++c)
                     factors[c] = FresnelConductor(cos_w_m, co_face.eta[c], co_face.k[c]);
             };
             const MicrosurfaceConductorFacet<VF, VecLane, decltype(fresnel)> facet{fresnel};
-            r = microsurface_walk<VF, VecLane>(hn::Set(df, alpha), wi_v, m, false, facet, draw,
-                                               max_order);
+            r = microsurface_walk<VF, VecLane>(ggx_isotropic_lanes<VF, VecLane>(hn::Set(df, alpha)),
+                                               wi_v, m, false, facet, draw, max_order);
         }
         hn::Store(r.wo.x, df, out[0]);
         hn::Store(r.wo.y, df, out[1]);
