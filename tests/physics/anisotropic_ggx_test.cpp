@@ -19,25 +19,6 @@ namespace {
 
 using test::Chi2Draw;
 
-// ∫ f(wm) dωm over the upper hemisphere, graded towards the pole at the scale of the smaller α
-// (as microfacet_test.cpp's helper), the azimuth cut in `phi_pieces`.
-double integrate_hemisphere(const std::function<double(const Vec3d&)>& f, double alpha, double eps,
-                            int phi_pieces = 8) {
-    std::vector<double> s = {0.0};
-    for (double x = sqr(alpha) / 64; x < 1; x *= 4)
-        s.push_back(x);
-    s.push_back(1.0);
-    double total = 0;
-    for (std::size_t k = 0; k + 1 < s.size(); ++k) {
-        const double c0 = std::max(1 - s[k + 1], std::numeric_limits<double>::min());
-        for (int p = 0; p < phi_pieces; ++p)
-            total += test::integrate_cell(f, c0, 1 - s[k], 2 * kPi<double> * p / phi_pieces,
-                                          2 * kPi<double> * (p + 1) / phi_pieces,
-                                          eps / double(s.size() * phi_pieces));
-    }
-    return total;
-}
-
 struct Aniso {
     double alpha_x, alpha_y, psi;
 };
@@ -84,8 +65,9 @@ TEST(AnisotropicGgx, DistributionMatchesClosedFormAndIsNormalized) {
                     << a.alpha_x << " " << a.alpha_y << " " << c << " " << phi;
             }
         // ∫ D(wm) cos θm dωm = 1 (the projected microfacet area is the macro area).
-        const double total = integrate_hemisphere([&](const Vec3d& wm) { return ggx.D(wm) * wm.z; },
-                                                  std::min(a.alpha_x, a.alpha_y), 1e-10);
+        const double total =
+            test::integrate_hemisphere([&](const Vec3d& wm) { return ggx.D(wm) * wm.z; },
+                                       std::min(a.alpha_x, a.alpha_y), 1e-10, 8);
         EXPECT_NEAR(total, 1, 1e-8) << a.alpha_x << " " << a.alpha_y;
     }
 }
@@ -102,15 +84,15 @@ TEST(AnisotropicGgx, LambdaIsTheProjectedAreaOfTheDistribution) {
             const double lambda = lambda_closed_form(a, w);
             EXPECT_NEAR(ggx.lambda(w), lambda, 1e-12 * (1 + lambda));
             EXPECT_NEAR(ggx.smith_root(w), 1 + 2 * lambda, 1e-12 * (1 + lambda));
-            const double masked = integrate_hemisphere(
+            const double masked = test::integrate_hemisphere(
                 [&](const Vec3d& wm) {
                     return ggx.G1(w) * std::max(0.0, sign * dot(w, wm)) * ggx.D(wm);
                 },
-                std::min(a.alpha_x, a.alpha_y), 1e-10);
+                std::min(a.alpha_x, a.alpha_y), 1e-10, 8);
             EXPECT_NEAR(masked, cos_theta, 1e-8) << a.alpha_x << " " << a.alpha_y << " " << w.z;
-            const double complete =
-                integrate_hemisphere([&](const Vec3d& wm) { return ggx.D_visible_complete(w, wm); },
-                                     std::min(a.alpha_x, a.alpha_y), 1e-10, 64);
+            const double complete = test::integrate_hemisphere(
+                [&](const Vec3d& wm) { return ggx.D_visible_complete(w, wm); },
+                std::min(a.alpha_x, a.alpha_y), 1e-10, 64);
             EXPECT_NEAR(complete, 1, 1e-8) << a.alpha_x << " " << a.alpha_y << " " << w.z;
         }
     }

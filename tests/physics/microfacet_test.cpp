@@ -24,30 +24,6 @@ Vec3d direction_at(double cos_theta, double phi) {
     return test::direction_of(cos_theta, phi);
 }
 
-// ∫ f(wm) dωm over the upper hemisphere, resolving a GGX peak of width α at the pole: the polar
-// range is cut at 1 − cos θm = α²·4^k (graded nodes, the peak's scale is sin²θm ≈ α²), and each
-// band is integrated by the harness's nested adaptive Simpson quadrature to tolerance eps.
-// `phi_pieces` splits the azimuth too, for integrands that vanish on most of a band (normals
-// visible from below the horizon), where Simpson's first nodes could all miss the support.
-double integrate_hemisphere(const std::function<double(const Vec3d&)>& f, double alpha, double eps,
-                            int phi_pieces = 1) {
-    std::vector<double> s = {0.0};
-    for (double x = sqr(alpha) / 64; x < 1; x *= 4)
-        s.push_back(x);
-    s.push_back(1.0);
-    double total = 0;
-    for (std::size_t k = 0; k + 1 < s.size(); ++k) {
-        // D(wm) is defined as 0 on the horizon (wm.z = 0) while its limit is not: the lowest band
-        // starts just above it, so that Simpson's end nodes see the limit (a null set either way).
-        const double c0 = std::max(1 - s[k + 1], std::numeric_limits<double>::min());
-        for (int p = 0; p < phi_pieces; ++p)
-            total += test::integrate_cell(f, c0, 1 - s[k], 2 * kPi<double> * p / phi_pieces,
-                                          2 * kPi<double> * (p + 1) / phi_pieces,
-                                          eps / double(s.size() * phi_pieces));
-    }
-    return total;
-}
-
 TEST(Microfacet, NormalDistributionIsNormalized) {
     // ∫ D(wm) cos θm dωm = 1 (the projected microfacet area equals the macro area, Walter Eq. 4).
     // D depends on θm only; with u = sin²θm, dω = dφ d(cos θm) = dφ du/(2 cos θm), so
@@ -69,8 +45,8 @@ TEST(Microfacet, NormalDistributionIsNormalized) {
         EXPECT_NEAR(total, 1, 1e-9) << "alpha = " << alpha;
         // The same through the 2-D hemisphere quadrature used below (a check of that helper).
         if (alpha >= 0.05) {
-            EXPECT_NEAR(integrate_hemisphere([&](const Vec3d& wm) { return ggx.D(wm) * wm.z; },
-                                             alpha, 1e-10),
+            EXPECT_NEAR(test::integrate_hemisphere(
+                            [&](const Vec3d& wm) { return ggx.D(wm) * wm.z; }, alpha, 1e-10),
                         1, 1e-8)
                 << "alpha = " << alpha;
         }
@@ -90,7 +66,7 @@ TEST(Microfacet, VisibleNormalsAreNormalized) {
     for (double alpha : {0.05, 0.2, 0.5, 1.0}) {
         const GGX<double> ggx{alpha};
         for (const Vec3d& w : kViews) {
-            const double total = integrate_hemisphere(
+            const double total = test::integrate_hemisphere(
                 [&](const Vec3d& wm) { return ggx.D_visible(w, wm); }, alpha, 1e-10);
             EXPECT_NEAR(total, 1, 1e-8) << "alpha = " << alpha << ", w.z = " << w.z;
         }
@@ -105,7 +81,7 @@ TEST(Microfacet, CompleteVisibleNormalsAreNormalized) {
     for (double alpha : {0.05, 0.2, 0.5, 1.0}) {
         const GGX<double> ggx{alpha};
         for (const Vec3d& w : kViews) {
-            const double total = integrate_hemisphere(
+            const double total = test::integrate_hemisphere(
                 [&](const Vec3d& wm) { return ggx.D_visible_complete(w, wm); }, alpha, 1e-10, 64);
             EXPECT_NEAR(total, 1, 1e-8) << "alpha = " << alpha << ", w.z = " << w.z;
         }
@@ -128,15 +104,15 @@ TEST(Microfacet, ProjectedAreas) {
         const GGX<double> ggx{alpha};
         for (const Vec3d& w : kViews) {
             const double sign = w.z < 0 ? -1 : 1, cos_theta = std::abs(w.z);
-            const double is = integrate_hemisphere(
+            const double is = test::integrate_hemisphere(
                 [&](const Vec3d& wm) { return sign * dot(w, wm) * ggx.D(wm); }, alpha, 1e-10);
             EXPECT_NEAR(is, cos_theta, 1e-8) << "alpha = " << alpha << ", w.z = " << w.z;
-            const double visible = integrate_hemisphere(
+            const double visible = test::integrate_hemisphere(
                 [&](const Vec3d& wm) { return std::max(0.0, sign * dot(w, wm)) * ggx.D(wm); },
                 alpha, 1e-10);
             EXPECT_NEAR(visible, cos_theta * (1 + lambda_closed_form(alpha, cos_theta)), 1e-8)
                 << "alpha = " << alpha << ", w.z = " << w.z;
-            const double masked = integrate_hemisphere(
+            const double masked = test::integrate_hemisphere(
                 [&](const Vec3d& wm) {
                     return ggx.G1(w) * std::max(0.0, sign * dot(w, wm)) * ggx.D(wm);
                 },

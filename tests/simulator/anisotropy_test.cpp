@@ -239,6 +239,24 @@ struct ClosedForm {
     }
 };
 
+// ∫_bin f cos θ dω / Ω⊥ by a 24 × 24 midpoint rule in (sin²θ, φ), whose measure is the projected
+// solid angle (d(sin²θ)/2 dφ); `below`: the bin's mirror image under the surface.
+template <typename F>
+double bin_midpoint_average(const HemisphereGrid& grid, int t, int p, bool below, const F& f) {
+    const double s0 = sqr(std::sin(grid.theta_lo(t))), s1 = sqr(std::sin(grid.theta_hi(t)));
+    constexpr int kNodes = 24;
+    double sum = 0;
+    for (int a = 0; a < kNodes; ++a)
+        for (int b = 0; b < kNodes; ++b) {
+            const double u = s0 + (s1 - s0) * (a + 0.5) / kNodes;
+            const double phi =
+                grid.phi_lo(p) + (grid.phi_hi(p) - grid.phi_lo(p)) * (b + 0.5) / kNodes;
+            const double st = std::sqrt(u), ct = std::sqrt(1 - u);
+            sum += f(Vec3d{st * std::cos(phi), st * std::sin(phi), below ? -ct : ct});
+        }
+    return sum / (kNodes * kNodes);
+}
+
 TEST(AnisotropyStat, SingleConductorMatchesTheAnisotropicMicrofacetBrdf) {
     const ClosedForm brdf{0.15, 0.45, deg_to_rad(25.0)};
     SimulationSettings s = scalar_settings(40, 1'000'000);
@@ -254,20 +272,8 @@ TEST(AnisotropyStat, SingleConductorMatchesTheAnisotropicMicrofacetBrdf) {
     double worst = 0;
     for (int t = 0; t < grid.n_theta(); t += 2)
         for (int p = 0; p < grid.n_phi(); p += 3) {
-            // ∫_bin f cos θ dω / Ω⊥ by a 24 × 24 midpoint rule in (sin²θ, φ), whose measure is the
-            // projected solid angle (d(sin²θ)/2 dφ).
-            const double s0 = sqr(std::sin(grid.theta_lo(t))), s1 = sqr(std::sin(grid.theta_hi(t)));
-            constexpr int kNodes = 24;
-            double sum = 0;
-            for (int a = 0; a < kNodes; ++a)
-                for (int b = 0; b < kNodes; ++b) {
-                    const double u = s0 + (s1 - s0) * (a + 0.5) / kNodes;
-                    const double phi =
-                        grid.phi_lo(p) + (grid.phi_hi(p) - grid.phi_lo(p)) * (b + 0.5) / kNodes;
-                    const double st = std::sqrt(u), ct = std::sqrt(1 - u);
-                    sum += brdf.f(wi, {st * std::cos(phi), st * std::sin(phi), ct});
-                }
-            const double expected = sum / (kNodes * kNodes);
+            const double expected = bin_midpoint_average(
+                grid, t, p, false, [&](const Vec3d& wo) { return brdf.f(wi, wo); });
             const std::size_t j = std::size_t(t) * grid.n_phi() + std::size_t(p);
             const double measured = lobe.f[j][0], se = lobe.se[j][0];
             if (expected < 1e-3) continue;
@@ -318,21 +324,9 @@ TEST(AnisotropyStat, SingleDielectricMatchesTheAnisotropicMicrofacetBsdf) {
         const BinnedLobe& lobe = r.table.lobe(0, side);
         for (int t = 0; t < grid.n_theta(); t += 2)
             for (int p = 0; p < grid.n_phi(); p += 3) {
-                const double s0 = sqr(std::sin(grid.theta_lo(t))),
-                             s1 = sqr(std::sin(grid.theta_hi(t)));
-                constexpr int kNodes = 24;
-                double sum = 0;
-                for (int a = 0; a < kNodes; ++a)
-                    for (int b = 0; b < kNodes; ++b) {
-                        const double u = s0 + (s1 - s0) * (a + 0.5) / kNodes;
-                        const double phi =
-                            grid.phi_lo(p) + (grid.phi_hi(p) - grid.phi_lo(p)) * (b + 0.5) / kNodes;
-                        const double st = std::sqrt(u), ct = std::sqrt(1 - u);
-                        const Vec3d wo = {st * std::cos(phi), st * std::sin(phi),
-                                          side == Side::Reflection ? ct : -ct};
-                        sum += dielectric_closed_form(shape, eta, wi, wo);
-                    }
-                const double expected = sum / (kNodes * kNodes);
+                const double expected = bin_midpoint_average(
+                    grid, t, p, side == Side::Transmission,
+                    [&](const Vec3d& wo) { return dielectric_closed_form(shape, eta, wi, wo); });
                 const std::size_t j = std::size_t(t) * grid.n_phi() + std::size_t(p);
                 if (expected < 1e-3) continue;
                 ++compared;

@@ -301,4 +301,22 @@ Chi2Result run_chi2_estimated(const Chi2Options& o, const Chi2SampleFn& sample,
     return run_chi2_impl(o, sample, [&] { return expected_by_cell(o, cell_mass); });
 }
 
+double integrate_hemisphere(const Chi2PdfFn& f, double alpha, double eps, int phi_pieces) {
+    std::vector<double> s = {0.0};
+    for (double x = sqr(alpha) / 64; x < 1; x *= 4)
+        s.push_back(x);
+    s.push_back(1.0);
+    double total = 0;
+    for (std::size_t k = 0; k + 1 < s.size(); ++k) {
+        // D(wm) is defined as 0 on the horizon (wm.z = 0) while its limit is not: the lowest band
+        // starts just above it, so that Simpson's end nodes see the limit (a null set either way).
+        const double c0 = std::max(1 - s[k + 1], std::numeric_limits<double>::min());
+        for (int p = 0; p < phi_pieces; ++p)
+            total += integrate_cell(f, c0, 1 - s[k], 2 * kPi<double> * p / phi_pieces,
+                                    2 * kPi<double> * (p + 1) / phi_pieces,
+                                    eps / double(s.size() * phi_pieces));
+    }
+    return total;
+}
+
 }  // namespace lamina::test

@@ -128,6 +128,13 @@ double adaptive_simpson(const std::function<double(double)>& f, double a, double
 /// ∫ pdf dω over the cell [c0, c1] × [p0, p1] of (cos θ, φ), by nested adaptive Simpson.
 double integrate_cell(const Chi2PdfFn& pdf, double c0, double c1, double p0, double p1, double eps);
 
+/// ∫ f(wm) dωm over the upper hemisphere, resolving a GGX peak of width α at the pole: the polar
+/// range is cut at 1 − cos θm = α²·4^k (graded nodes, the peak's scale is sin²θm ≈ α²), and each
+/// band is integrated by integrate_cell to tolerance eps. `phi_pieces` splits the azimuth too, for
+/// integrands that vanish on most of a band (normals visible from below the horizon) or that are
+/// anisotropic, where Simpson's first nodes could all miss the support.
+double integrate_hemisphere(const Chi2PdfFn& f, double alpha, double eps, int phi_pieces = 1);
+
 /// Direction of (cos θ, φ).
 inline Vec3d direction_of(double cos_theta, double phi) {
     const double s = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
