@@ -20,6 +20,9 @@
 namespace lamina {
 namespace {
 
+using test::expect_budget_closes;
+using test::expect_within_se;
+
 using test::compare_lobe;
 using test::expect_agreement;
 
@@ -58,17 +61,6 @@ INSTANTIATE_TEST_SUITE_P(Kernels, Goniophotometer, ::testing::Values(Kernel::Sca
 
 // Standard error of a budget term from its own estimate; the closed forms are exact, so
 // |estimate − exact| < 5 se holds with probability 1 − 6e-7.
-void expect_within_se(double estimate, double exact, double se, const char* what) {
-    EXPECT_LT(std::abs(estimate - exact), 5 * se + 1e-12)
-        << what << ": estimate " << estimate << " ± " << se << ", exact " << exact;
-}
-
-// Every budget sums to 1 to rounding (docs/physics.md §5).
-void expect_budget_closes(const SimulationResult& r) {
-    for (const IncidenceStats& st : r.incidences)
-        for (int c = 0; c < 3; ++c)
-            EXPECT_NEAR(st.budget.sum()[c], 1.0, 1e-6);
-}
 
 // A white furnace with microsurface multiple scattering: every particle is reflected or
 // transmitted (nothing lost in a microsurface, nothing cut off, no degenerate sample).

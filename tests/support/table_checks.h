@@ -3,6 +3,7 @@
 // table's own standard errors.
 
 #include "core/table.h"
+#include "simulator/goniophotometer.h"
 
 #include <gtest/gtest.h>
 
@@ -78,6 +79,21 @@ inline void expect_agreement(const TableComparison& r, double alpha = 1e-3) {
     EXPECT_LT(r.max_abs_z, z_max) << "worst: " << r.worst;
     EXPECT_LT(std::abs(r.chi2 - r.bins) / std::sqrt(2.0 * r.bins), 5.0)
         << "chi2 = " << r.chi2 << " over " << r.bins << " bins; worst: " << r.worst;
+}
+
+/// |estimate − exact| < 5 se + floor: probability 1 − 6e-7 for an exact closed form (the floor
+/// covers the closed form's own rounding).
+inline void expect_within_se(double estimate, double exact, double se, const std::string& what,
+                             double floor = 1e-12) {
+    EXPECT_LT(std::abs(estimate - exact), 5 * se + floor)
+        << what << ": estimate " << estimate << " ± " << se << ", exact " << exact;
+}
+
+/// Every incidence's energy budget sums to 1 to `tolerance` (docs/physics.md §5).
+inline void expect_budget_closes(const SimulationResult& r, double tolerance = 1e-6) {
+    for (const IncidenceStats& st : r.incidences)
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(st.budget.sum()[c], 1.0, tolerance);
 }
 
 }  // namespace lamina::test
