@@ -145,6 +145,16 @@ TEST_P(GoniophotometerStat, SmoothCoatOverLambertianSeries) {
     check_smooth_coat_over_lambertian(false);
 }
 
+// Light entering a smooth coat of index η at θi: cos θi, the refracted cos θt and the Fresnel
+// reflectance F(μi) of the unpolarized closed forms (docs/physics.md §6).
+struct SmoothEntry {
+    double mu_i, mu_t, F;
+};
+SmoothEntry smooth_coat_entry(double theta_i_deg, double eta) {
+    const double mu_i = std::cos(deg_to_rad(theta_i_deg));
+    return {mu_i, std::sqrt(1 - (1 - mu_i * mu_i) / (eta * eta)), fresnel_dielectric(mu_i, eta)};
+}
+
 // §6.4: smooth slab of index η and absorption τ in air, with F = F(μi), a = e^{−τ/μi'}:
 //   R = F + (1 − F)² F a² / (1 − F² a²),  T = (1 − F)² a / (1 − F² a²).
 // All reflected flux leaves in the mirror bin, all transmitted flux straight through.
@@ -155,9 +165,7 @@ TEST_P(GoniophotometerStat, SmoothSlab) {
                                           test::dielectric_layer(1.0, 0.0)});
     const auto r = simulate(stack, settings({30, 75}, 400'000, HemisphereGrid(18, 18)));
     for (std::size_t i = 0; i < 2; ++i) {
-        const double mu_i = std::cos(deg_to_rad(r.settings.theta_i_deg[i]));
-        const double mu_t = std::sqrt(1 - (1 - mu_i * mu_i) / (eta * eta));
-        const double F = fresnel_dielectric(mu_i, eta);
+        const auto [mu_i, mu_t, F] = smooth_coat_entry(r.settings.theta_i_deg[i], eta);
         const EnergyBudget& b = r.incidences[i].budget;
         for (int c = 0; c < 3; ++c) {
             const double a = std::exp(-tau[c] / mu_t);
@@ -187,9 +195,7 @@ TEST_P(GoniophotometerStat, CoatedSmoothConductor) {
                                           test::conductor_layer(eta_c, k_c, 0.0)});
     const auto r = simulate(stack, settings({20, 60}, 400'000, HemisphereGrid(18, 18)));
     for (std::size_t i = 0; i < 2; ++i) {
-        const double mu_i = std::cos(deg_to_rad(r.settings.theta_i_deg[i]));
-        const double mu_t = std::sqrt(1 - (1 - mu_i * mu_i) / (eta * eta));
-        const double F = fresnel_dielectric(mu_i, eta);
+        const auto [mu_i, mu_t, F] = smooth_coat_entry(r.settings.theta_i_deg[i], eta);
         const EnergyBudget& b = r.incidences[i].budget;
         for (int c = 0; c < 3; ++c) {
             const double a = std::exp(-tau[c] / mu_t);
@@ -367,18 +373,24 @@ TEST_P(GoniophotometerStat, SingleRoughConductor) {
     check_single_rough_conductor();
 }
 
-// §6.7: white furnace: with nothing absorbing, R + T + microsurface loss = 1 for every
-// configuration, nothing is cut off, and the loss is what single scattering loses (> 0 for rough).
-TEST_P(GoniophotometerStat, WhiteFurnace) {
-    const std::vector<Stack> stacks = {
+// The white furnace's stacks: a rough slab, a rough coat over a white Lambertian, three rough
+// interfaces, and a rough coat with a white scattering medium over `scattering_base`.
+std::vector<Stack> white_furnace_stacks(const Layer& scattering_base) {
+    return {
         test::make_stack({test::dielectric_layer(1.5, 0.3), test::dielectric_layer(1.0, 0.5)}),
         test::make_stack({test::dielectric_layer(1.5, 0.5), test::lambertian_layer(Rgbd(1.0))}),
         test::make_stack({test::dielectric_layer(1.3, 0.2), test::dielectric_layer(1.7, 0.4),
                           test::dielectric_layer(1.0, 0.1)}),
         test::make_stack(
             {test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.0), Rgbd(0.7), Rgbd(0.3)),
-             test::lambertian_layer(Rgbd(1.0))}),
+             scattering_base}),
     };
+}
+
+// §6.7: white furnace: with nothing absorbing, R + T + microsurface loss = 1 for every
+// configuration, nothing is cut off, and the loss is what single scattering loses (> 0 for rough).
+TEST_P(GoniophotometerStat, WhiteFurnace) {
+    const std::vector<Stack> stacks = white_furnace_stacks(test::lambertian_layer(Rgbd(1.0)));
     for (const Stack& stack : stacks) {
         const auto r = simulate(stack, settings({0, 45, 80}, 100'000, HemisphereGrid(9, 9)));
         for (const IncidenceStats& st : r.incidences) {
@@ -913,15 +925,7 @@ TEST_P(PolarizationStat, SmoothCoatOverLambertianSeries) {
 // event keeps the particle's flux (its branch probability is the state's reflected fraction, which
 // cancels it), a white Lambertian base keeps it, so R + T = 1 to rounding and nothing is lost.
 TEST_P(PolarizationStat, WhiteFurnaceLosesNothing) {
-    const std::vector<Stack> stacks = {
-        test::make_stack({test::dielectric_layer(1.5, 0.3), test::dielectric_layer(1.0, 0.5)}),
-        test::make_stack({test::dielectric_layer(1.5, 0.5), test::lambertian_layer(Rgbd(1.0))}),
-        test::make_stack({test::dielectric_layer(1.3, 0.2), test::dielectric_layer(1.7, 0.4),
-                          test::dielectric_layer(1.0, 0.1)}),
-        test::make_stack(
-            {test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.0), Rgbd(0.7), Rgbd(0.3)),
-             test::dielectric_layer(1.0, 0.6)}),
-    };
+    const std::vector<Stack> stacks = white_furnace_stacks(test::dielectric_layer(1.0, 0.6));
     for (const Stack& stack : stacks) {
         SimulationSettings s = polarized({0, 45, 80}, 100'000, HemisphereGrid(9, 9));
         s.transport.microsurface = Microsurface::Multiple;
