@@ -28,6 +28,12 @@ RenderSettings small(int size, int spp, int threads = 0) {
     return s;
 }
 
+// A clear coat of index 1.5 and roughness alpha over a grey Lambertian of albedo rho.
+Stack clear_coat_over_lambertian(double alpha, double rho) {
+    return test::make_stack({test::with_medium(test::dielectric_layer(1.5, alpha), Rgbd(0.0)),
+                             test::lambertian_layer(Rgbd(rho))});
+}
+
 // A white Lambertian under a uniform white environment: L = ∫ (1/π) · 1 · cos dω = 1. With the
 // random walk both strategies are exact here (its connection is ρ/π and its sample weight ρ; the
 // MIS weights p/(p + q) and q/(p + q) are ½ each), so every pixel is 1 to rounding.
@@ -49,9 +55,7 @@ TEST(Render, WhiteFurnaceLambertianIsOne) {
 // under the uniform environment it renders 1 within noise: the sphere's mean over n pixels has
 // standard error σ/√n, estimated from the pixels themselves.
 TEST(RenderStat, WhiteFurnaceSmoothCoatOverWhiteIsOne) {
-    const Stack coated =
-        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.0)),
-                          test::lambertian_layer(Rgbd(1.0))});
+    const Stack coated = clear_coat_over_lambertian(0.0, 1.0);
     const auto rw = make_model("random-walk", coated);
     const Rendering r = render_sphere(*rw, Environment::named("uniform"), small(32, 16));
     double sum = 0, sum_sq = 0;
@@ -83,9 +87,7 @@ TEST(Render, BlackStackRendersBlack) {
 // remains): its rendering equals the reference's within noise (here both are exact: the
 // reference's delta lobe is the ladder's F, and its walks below the coat die on the black base).
 TEST(Render, WWPrimeMatchesTheReferenceWhereItIsExact) {
-    const Stack s =
-        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.0)),
-                          test::lambertian_layer(Rgbd(0.0))});
+    const Stack s = clear_coat_over_lambertian(0.0, 0.0);
     const auto ref = make_model("random-walk", s);
     const auto ww = make_model("ww-prime", s);
     ASSERT_TRUE(ww->support().brdf);
@@ -108,9 +110,7 @@ TEST(Render, WWPrimeMatchesTheReferenceWhereItIsExact) {
 // D = Σx² − (Σa² + Σb²)/2 has variance ≈ Σx⁴ + (Σa⁴ + Σb⁴)/4 (Var y² ≤ E y⁴, conservative):
 // |D| must stay below 4 of its standard deviations.
 TEST(RenderStat, WWPrimeMatchesTheRandomWalkOnARoughCoatOverBlack) {
-    const Stack s =
-        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.3), Rgbd(0.0)),
-                          test::lambertian_layer(Rgbd(0.0))});
+    const Stack s = clear_coat_over_lambertian(0.3, 0.0);
     const auto rw = make_model("random-walk", s);
     const auto ww = make_model("ww-prime", s);
     const Environment env = Environment::named("studio");
@@ -214,8 +214,7 @@ TEST(RenderStat, WhiteFurnaceNonAbsorbingSlabsAreOne) {
 // far more than their standard error (the energy the microsurfaces lose). Every pixel is finite.
 TEST(RenderStat, WhiteFurnaceRoughStacksAreOneWithMultipleScattering) {
     const std::vector<Stack> stacks = {
-        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.5), Rgbd(0.0)),
-                          test::lambertian_layer(Rgbd(1.0))}),
+        clear_coat_over_lambertian(0.5, 1.0),
         test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4), Rgbd(0.0)),
                           test::dielectric_layer(1.0, 0.6)})};
     for (const Stack& stack : stacks)
