@@ -24,23 +24,11 @@ Stack typical_stack(bool slab) {
     // A rough clear coat (η 1.5, α 0.1) with some absorption over rough gold (α 0.2), or over a
     // rough dielectric (η 1.33, α 0.2) for the slab.
     Stack s;
-    Layer coat;
-    coat.interface.type = InterfaceType::Dielectric;
-    coat.interface.eta = 1.5;
-    coat.interface.alpha = 0.1;
-    coat.has_medium = true;
-    coat.medium.tau_a = Rgbd(0.05, 0.1, 0.2);
-    Layer base;
-    if (slab) {
-        base.interface.type = InterfaceType::Dielectric;
-        base.interface.eta = 1.33;
-    } else {
-        base.interface.type = InterfaceType::Conductor;
-        base.interface.eta_rgb = Rgbd(0.18, 0.42, 1.37);
-        base.interface.k = Rgbd(3.4, 2.35, 1.85);
-    }
-    base.interface.alpha = 0.2;
-    s.layers = {coat, base};
+    const Layer coat = with_medium(layer_of(dielectric_interface(1.5, 0.1)), Rgbd(0.05, 0.1, 0.2));
+    const InterfaceSpec base =
+        slab ? dielectric_interface(1.33, 0.2)
+             : conductor_interface(Rgbd(0.18, 0.42, 1.37), Rgbd(3.4, 2.35, 1.85), 0.2);
+    s.layers = {coat, layer_of(base)};
     return s;
 }
 

@@ -17,22 +17,13 @@ using namespace lamina;
 
 Stack bench_stack(bool coat) {
     Stack s;
-    Layer top;
-    top.interface.type = InterfaceType::Dielectric;
-    top.interface.eta = 1.5;
-    top.interface.alpha = 0.3;
+    const Layer top = layer_of(dielectric_interface(1.5, 0.3));
     if (!coat) {
         s.layers = {top};
         return s;
     }
-    top.has_medium = true;
-    top.medium.tau_a = Rgbd(0.05, 0.1, 0.2);
-    Layer base;
-    base.interface.type = InterfaceType::Conductor;
-    base.interface.eta_rgb = Rgbd(0.18, 0.42, 1.37);
-    base.interface.k = Rgbd(3.4, 2.35, 1.85);
-    base.interface.alpha = 0.3;
-    s.layers = {top, base};
+    s.layers = {with_medium(top, Rgbd(0.05, 0.1, 0.2)),
+                layer_of(conductor_interface(Rgbd(0.18, 0.42, 1.37), Rgbd(3.4, 2.35, 1.85), 0.3))};
     return s;
 }
 

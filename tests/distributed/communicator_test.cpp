@@ -13,16 +13,8 @@ namespace lamina {
 namespace {
 
 Stack clear_coat_over_lambertian() {
-    Layer coat;
-    coat.interface.type = InterfaceType::Dielectric;
-    coat.interface.eta = 1.5;
-    coat.interface.alpha = 0.3;
-    coat.has_medium = true;
-    coat.medium.tau_a = Rgbd(0.2, 0.0, 0.5);
-    Layer base;
-    base.interface.type = InterfaceType::Lambertian;
-    base.interface.albedo = Rgbd(0.7);
-    return {"test plastic", 1.0, {coat, base}};
+    const Layer coat = with_medium(layer_of(dielectric_interface(1.5, 0.3)), Rgbd(0.2, 0.0, 0.5));
+    return {"test plastic", 1.0, {coat, layer_of(lambertian_interface(Rgbd(0.7)))}};
 }
 
 TEST(Communicator, PlainProcessIsOneRootRank) {
