@@ -138,6 +138,13 @@ Source load_source(const ExportArgs& a) {
     if (!a.simulation.empty()) {
         const std::filesystem::path dir = a.simulation;
         src.table = BinnedTable::from_csv(read_text(dir / "brdf.csv"), (dir / "brdf.csv").string());
+        // The exporters read φ over [0°, 180°] mirrored (an isotropic table): an unfolded one
+        // (an anisotropic stack, light from φi ≠ 0) would be written wrong.
+        if (src.table.grid.is_unfolded())
+            throw InputError((dir / "brdf.csv").string(), "phi_lo",
+                             "an unfolded table (φ over [0°, 360°): an anisotropic stack or "
+                             "phi_i ≠ 0) cannot be exported yet; only folded tables (φ over [0°, "
+                             "180°]) can");
         src.have_table = true;
         src.meta["source"] = "simulation";
         if (std::filesystem::exists(dir / "result.json"))

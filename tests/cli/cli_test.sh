@@ -166,6 +166,11 @@ check simulate-film-auto 0 "$lamina" simulate "$src/examples/coated-lens.json" \
     --theta-i 0,60 --particles 2e4 --grid 9x9 --out "$tmp/film-auto"
 check simulate-film-auto-is-scalar 0 cmp "$tmp/film/brdf.csv" "$tmp/film-auto/brdf.csv"
 check_says simulate-film-auto-ran-scalar 0 '"kernel_description": "scalar"' cat "$tmp/film-auto/result.json"
+check simulate-phi-i 0 "$lamina" simulate "$src/examples/plastic.json" --phi-i 30 --theta-i 40 \
+    --particles 2e4 --grid 9x9 --out "$tmp/phi-i"
+check_says export-unfolded 1 "an unfolded table" \
+    "$lamina" export --simulation "$tmp/phi-i" --out "$tmp/phi-i.bsdf"
+check export-unfolded-writes-nothing 1 test -e "$tmp/phi-i.bsdf"
 check_says eval-film 1 "not supported: thin films are not supported by this model" \
     "$lamina" eval --model ww09 --stack "$src/examples/coated-lens.json" --theta-i 30 --theta-o 30 --phi-o 180
 check_says validate-film 0 "| conductor η=(0.143, 0.374, 1.442) k=(3.983, 2.385, 1.603) α=0.15 film d=[55, 75] nm η=2.4" \
