@@ -259,9 +259,10 @@ class ProductionCoat final : public Model {
                     base[c] *= 1 + f0_[c] * (inv_e - 1);
             }
             if (r_.metal_energy_compensation == CoatRecipe::MetalEnergyCompensation::MaterialX) {
-                const double alpha = materialx_alpha(alpha_base_);
+                const SchlickSplit fit =
+                    materialx_ggx_albedo_fit(wo.z, materialx_alpha(alpha_base_));
                 for (int c = 0; c < 3; ++c)
-                    base[c] *= materialx_compensation(f0_[c], wo.z, alpha);
+                    base[c] *= materialx_compensation(f0_[c], fit);
             }
             if (metal_white_) {
                 // Cycles' microfacet_ggx_preserve_energy: 1 + F_ms (1 − E(μo))/E(μo).
@@ -280,9 +281,9 @@ class ProductionCoat final : public Model {
             base = albedo_ * kInvPi<double>;
             if (r_.diffuse_specular_throughput) {
                 // MaterialX's dielectric_bsdf at index 1 (F0 = 0): throughput 1 − B · comp.
-                const double alpha = materialx_alpha(specular_alpha_);
-                base *= 1 - materialx_ggx_albedo_fit(wo.z, alpha).bias *
-                                materialx_compensation(0.0, wo.z, alpha);
+                const SchlickSplit fit =
+                    materialx_ggx_albedo_fit(wo.z, materialx_alpha(specular_alpha_));
+                base *= 1 - fit.bias * materialx_compensation(0.0, fit);
             }
         }
         return Rgbd(f_coat) + base * base_scale(in, wo.z, cos_h);
@@ -371,7 +372,7 @@ class ProductionCoat final : public Model {
             const double alpha = materialx_alpha(alpha_coat_);
             const SchlickSplit fit = materialx_ggx_albedo_fit(mu, alpha);
             return (coat_f0_ior_ * fit.scale + fit.bias) *
-                   materialx_compensation(coat_f0_ior_, mu, alpha);
+                   materialx_compensation(coat_f0_ior_, fit);
         }
         if (r_.coat_albedo == CoatRecipe::CoatAlbedo::Cycles) {
             // bsdf_microfacet_estimate_albedo times the compensated lobe's weight
@@ -401,7 +402,8 @@ class ProductionCoat final : public Model {
                 if (alpha_coat_ == 0) return 1;
                 return 1 + coat_fms_ * (1 / coat_white_->albedo(mu_o) - 1);
             case CEC::MaterialX:
-                return materialx_compensation(coat_f0_ior_, mu_o, materialx_alpha(alpha_coat_));
+                return materialx_compensation(
+                    coat_f0_ior_, materialx_ggx_albedo_fit(mu_o, materialx_alpha(alpha_coat_)));
         }
         return 1;
     }
@@ -410,10 +412,10 @@ class ProductionCoat final : public Model {
     static double materialx_alpha(double alpha) { return clamp(alpha, 1e-8, 1.0); }
 
     /// MaterialX's compensation of a lobe of normal reflectance f0 for multiple scattering,
-    /// 1 + F_ss (1 − E)/E with F_ss = f0 + (1 − f0)/21 and E = A + B of its fit at (μ, α)
-    /// (mx_ggx_energy_compensation; Turquin 2019, Eqs. 14 and 16).
-    static double materialx_compensation(double f0, double mu, double alpha) {
-        const SchlickSplit fit = materialx_ggx_albedo_fit(mu, alpha);
+    /// 1 + F_ss (1 − E)/E with F_ss = f0 + (1 − f0)/21 and E = A + B of its albedo fit at the
+    /// lobe's (μ, α), `fit` = materialx_ggx_albedo_fit(μ, α) (mx_ggx_energy_compensation;
+    /// Turquin 2019, Eqs. 14 and 16).
+    static double materialx_compensation(double f0, const SchlickSplit& fit) {
         const double E = fit.scale + fit.bias;
         return 1 + (f0 + (1 - f0) / 21) * (1 - E) / E;
     }
