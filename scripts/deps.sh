@@ -13,6 +13,7 @@ packages=(
   python3 python3-numpy python3-matplotlib   # lamina figures (scripts/figures.py)
   python3-dev pybind11-dev python3-pybind11  # the Python module `import lamina` (docs/python.md)
   python3-pytest zlib1g-dev                  # its tests; .npz exports (docs/formats.md)
+  python3-mypy                               # the Python stubs' type check (tests/python)
   chromium fonts-dejavu-core                 # the explorer's browser test (tests/report)
 )
 

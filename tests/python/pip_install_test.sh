@@ -21,6 +21,9 @@ import sys, os
 import lamina
 venv, root = sys.argv[1], sys.argv[2]
 assert os.path.realpath(lamina.__file__).startswith(os.path.realpath(venv)), lamina.__file__
+# The type information ships with the package (PEP 561: py.typed beside the stubs).
+pkg = os.path.dirname(lamina.__file__)
+assert all(os.path.isfile(os.path.join(pkg, n)) for n in ("py.typed", "_lamina.pyi")), os.listdir(pkg)
 s = lamina.Stack(os.path.join(root, "examples", "plastic.json"))
 m = lamina.Model("lamina-1", s)
 f = m.eval([0, 0, 1], [0, 0, 1])

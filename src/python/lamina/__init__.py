@@ -15,6 +15,7 @@ import csv
 import json
 import os
 from pathlib import Path
+from typing import Any, Optional
 
 import numpy as np
 
@@ -91,7 +92,7 @@ def _grid_pair(grid):
     return int(grid[0]), int(grid[1])
 
 
-def simulate(stack, progress=None, **settings):
+def simulate(stack, progress: Optional[bool] = None, **settings: Any) -> SimulationResult:
     """Runs the goniophotometer (`lamina simulate`) and returns a SimulationResult.
 
     stack: a Stack, a dict in the stack format or a path. settings: any of SIMULATION_SETTINGS by
@@ -116,7 +117,8 @@ def _stderr_is_terminal():
         return False
 
 
-def export(source, path, format=None, theta_i=None, resolution=None, description=""):
+def export(source, path, format: Optional[str] = None, theta_i=None, resolution=None,
+           description: str = "") -> None:
     """Writes a Model, a Table or a SimulationResult (its reflection side) as an RGL .bsdf
     (pbrt-v4, Mitsuba 3) or a MERL .binary file, as `lamina export` does (docs/formats.md).
 
@@ -229,7 +231,7 @@ class Study:
                 f"models {', '.join(self.models)}>")
 
 
-def load_study(path, pandas=None) -> Study:
+def load_study(path, pandas: Optional[bool] = None) -> Study:
     """Reads a study directory: metrics, configurations and tables (see Study)."""
     return Study(path, pandas=pandas)
 
@@ -274,7 +276,7 @@ def _run(configs, models, preset, out, figures, quiet, nodes, peak_nodes, tables
 
 
 def compare(stack, models=None, out=None, figures=False, quiet=True, config_id=None, nodes=4,
-            peak_nodes=32, tables="half", **settings):
+            peak_nodes=32, tables="half", **settings: Any) -> Study:
     """`lamina compare` from Python: the reference for one stack and every model on its bins.
 
     models: registry names and Python models (classes or objects with eval(wi, wo); see
@@ -295,7 +297,7 @@ def compare(stack, models=None, out=None, figures=False, quiet=True, config_id=N
 
 
 def study(models=None, preset="quick", only=None, configs=None, out=None, figures=False,
-          quiet=True, nodes=4, peak_nodes=32, tables="half", **settings):
+          quiet=True, nodes=4, peak_nodes=32, tables="half", **settings: Any) -> Study:
     """`lamina study` from Python, with Python models beside the built-in ones.
 
     configs: None for the study's 60 configurations, or a list of {"id", "category", "stack"};
