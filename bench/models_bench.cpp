@@ -3,6 +3,8 @@
 // all OpenMP threads).
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "lamina1/lamina1.h"
+#include "models/lamina1/lamina1.h"
 #include "models/lamina_coat/lamina_coat.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
@@ -212,6 +214,48 @@ void BM_LaminaCoatFunction(benchmark::State& state, bool conductor) {
 }
 BENCHMARK_CAPTURE(BM_LaminaCoatFunction, coated_gold, true);
 BENCHMARK_CAPTURE(BM_LaminaCoatFunction, plastic, false);
+
+/// lamina-1 as a renderer uses it: the header library's Bsdf (include/lamina1/lamina1.h), built
+/// from its Layers, its eval(wi, wo) and sample(wi, u) in the header's own types, without lamina's
+/// Model interface: the cost per evaluation to set beside the production coats' BM_CoatEval and
+/// lamina-coat's function (docs/performance.md, "lamina-1 as a header"). The same materials as
+/// BM_LaminaCoatFunction; the tables are the ones `lamina export --lamina1-tables` writes.
+void BM_Lamina1Header(benchmark::State& state, bool conductor, bool sample) {
+    lamina1::Layers layers;
+    layers.eta0 = 1.5;
+    layers.alpha0 = 0.1;
+    layers.tau_a = {0.05, 0.1, 0.2};
+    if (conductor) {
+        layers.base = lamina1::Base::Conductor;
+        layers.base_eta = {0.18 / 1.5, 0.42 / 1.5, 1.37 / 1.5};
+        layers.base_k = {3.4 / 1.5, 2.35 / 1.5, 1.85 / 1.5};
+        layers.alpha1 = 0.2;
+    } else {
+        layers.albedo = lamina1::Rgb{0.8};
+    }
+    const lamina1::Bsdf bsdf(layers, lamina1_tables(lamina1::Masking::Smith, false));
+    static const Pairs pairs;
+    std::vector<lamina1::Vec3> wi, wo;
+    for (std::size_t i = 0; i < pairs.wi.size(); ++i) {
+        wi.push_back({pairs.wi[i].x, pairs.wi[i].y, pairs.wi[i].z});
+        wo.push_back({pairs.wo[i].x, pairs.wo[i].y, pairs.wo[i].z});
+    }
+    std::size_t n = 0;
+    for (auto _ : state) {
+        const std::size_t i = n++ & 4095;
+        if (sample)
+            benchmark::DoNotOptimize(
+                bsdf.sample(wi[i], {wo[i].x * 0.5 + 0.5, wo[i].y * 0.5 + 0.5, wo[i].z}));
+        else
+            benchmark::DoNotOptimize(bsdf.eval(wi[i], wo[i]));
+    }
+    state.SetItemsProcessed(state.iterations());
+    state.SetLabel(std::string(conductor ? "coated gold" : "plastic") + (sample ? ", sample" : ""));
+}
+BENCHMARK_CAPTURE(BM_Lamina1Header, coated_gold, true, false);
+BENCHMARK_CAPTURE(BM_Lamina1Header, plastic, false, false);
+BENCHMARK_CAPTURE(BM_Lamina1Header, coated_gold_sample, true, true);
+BENCHMARK_CAPTURE(BM_Lamina1Header, plastic_sample, false, true);
 
 const int registered = [] {
     for (const auto& e : model_registry()) {
