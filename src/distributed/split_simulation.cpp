@@ -28,12 +28,7 @@ std::optional<SimulationResult> simulate_split(
         mine.particles = range.count;
         sums = simulate_sums(stack, mine, on_progress);
     } else {  // fewer blocks than ranks: this rank adds zeros
-        sums.incidences.resize(settings.theta_i_deg.size());
-        for (IncidenceSums& s : sums.incidences) {
-            s.bins.resize(2 * settings.grid.size());
-            if (settings.stokes_tallies) s.stokes.resize(2 * settings.grid.size());
-        }
-        sums.incidence_seconds.assign(settings.theta_i_deg.size(), 0.0);
+        sums = zero_sums(stack, settings);
     }
     comm.sum_to_root(sums.incidences);
     if (!comm.is_root()) return std::nullopt;

@@ -142,11 +142,7 @@ SimulationResult simulate_interruptible(const Stack& stack, const SimulationSett
     // costs a set-up (tallies allocated and merged), so chunks double while they take under
     // 0.2 s: Ctrl-C is then seen within about half a second.
     std::uint64_t chunk = kParticlesPerBlock * 16 * std::uint64_t(threads);
-    SimulationSums total;
-    total.incidences.resize(s.theta_i_deg.size());
-    for (IncidenceSums& inc : total.incidences)
-        inc.bins.resize(2 * s.grid.size());
-    total.incidence_seconds.assign(s.theta_i_deg.size(), 0.0);
+    SimulationSums total = zero_sums(stack, s);
     std::unique_ptr<Progress> progress;
     if (show_progress)
         progress = std::make_unique<Progress>(fmt::format("simulate {}", stack.name), "particles",

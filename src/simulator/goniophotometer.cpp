@@ -517,7 +517,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
     if (kernel == Kernel::Simd) select_simd_target();
     const auto trace_block = kernel == Kernel::Simd ? trace_block_simd : trace_block_scalar;
 
-    SimulationSums result;
+    SimulationSums result = zero_sums(stack, settings);
     result.threads_used = threads;
     const std::uint64_t n = settings.particles;
     // Particles per block: the unit of scheduling and of the double-precision budget sums. Blocks
@@ -540,9 +540,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
         for (int k = 0; k < 3; ++k)
             job.incident_stokes[k] = kIncidentStokes[settings.incident_polarization][k];
         job.stokes_tallies = settings.stokes_tallies;
-        IncidenceSums total;
-        total.bins.resize(2 * grid.size());
-        if (settings.stokes_tallies) total.stokes.resize(2 * grid.size());
+        IncidenceSums& total = result.incidences[inc];
 
 #pragma omp parallel num_threads(threads) firstprivate(job)
         {
@@ -562,9 +560,8 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
 #pragma omp critical
             total.add(mine);  // integer sums: the order of merging does not matter
         }
-        result.incidences.push_back(std::move(total));
-        result.incidence_seconds.push_back(
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - inc_start).count());
+        result.incidence_seconds[inc] =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - inc_start).count();
     }
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -628,6 +625,18 @@ SimulationResult finalize_simulation(const Stack& stack, const SimulationSetting
 HemisphereGrid simulation_grid(const Stack& stack, const SimulationSettings& settings) {
     return stack.is_anisotropic() || settings.phi_i_deg != 0 ? settings.grid.unfolded()
                                                              : settings.grid;
+}
+
+SimulationSums zero_sums(const Stack& stack, const SimulationSettings& settings) {
+    const std::size_t n_bins = simulation_grid(stack, settings).size();
+    SimulationSums sums;
+    sums.incidences.resize(settings.theta_i_deg.size());
+    for (IncidenceSums& s : sums.incidences) {
+        s.bins.resize(2 * n_bins);
+        if (settings.stokes_tallies) s.stokes.resize(2 * n_bins);
+    }
+    sums.incidence_seconds.assign(settings.theta_i_deg.size(), 0.0);
+    return sums;
 }
 
 SimulationResult simulate(const Stack& stack, const SimulationSettings& settings,

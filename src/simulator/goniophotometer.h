@@ -201,6 +201,11 @@ struct SimulationResult {
 /// plane φ = 0 then; core/grid.h). The result's table is on this grid.
 HemisphereGrid simulation_grid(const Stack& stack, const SimulationSettings& settings);
 
+/// The zero sums of a run: one IncidenceSums per incidence, its bins (and Stokes tallies when
+/// settings.stokes_tallies) sized for simulation_grid(stack, settings). What a run's chunks,
+/// threads and processes add their sums to (a process with no particles contributes these).
+SimulationSums zero_sums(const Stack& stack, const SimulationSettings& settings);
+
 /// Checks what the settings' codecs cannot see alone (InputError naming `where` and the setting).
 void validate_settings(const SimulationSettings& settings, const std::string& where = "settings");
 

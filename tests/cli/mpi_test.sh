@@ -69,6 +69,20 @@ for stack in slab frosted-gold; do
         || { fail "mpirun simulate multiple $stack"; cat "$out.log"; }
     same_files "simulate multiple $stack" "$one" "$out" brdf.csv energy.csv
 done
+# An anisotropic stack and light from an azimuth: the unfolded grid (twice the φ bins), also on
+# the rank that traces nothing (3000 particles: one block) and with the Mueller tables.
+for n in 50001 3000; do
+    args=("$src/examples/brushed-aluminium-lacquer.json" --theta-i 30 --phi-i 40 --particles "$n"
+          --grid 9x12 --seed 7 --mueller)
+    one=$tmp/aniso-$n-one
+    "$lamina" simulate "${args[@]}" --threads 2 --out "$one" >"$one.log" 2>&1 \
+        || { fail "one-process simulate anisotropic $n"; cat "$one.log"; }
+    out=$tmp/aniso-$n-two
+    mpi "$lamina" simulate "${args[@]}" --threads 1 --out "$out" >"$out.log" 2>&1 && ok \
+        || { fail "mpirun simulate anisotropic $n"; cat "$out.log"; }
+    same_files "simulate anisotropic n=$n" "$one" "$out" brdf.csv energy.csv mueller.npy \
+        mueller_se.npy
+done
 # The transmitting stack has a transmission lobe in its table.
 grep -q ',T,' "$tmp/sim-slab-50001-one/brdf.csv" && ok || fail "slab: no transmission rows"
 
