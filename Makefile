@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build test test-unit bench demo format clean
+.PHONY: all deps configure build test test-unit bench coat-costs demo format clean
 
 all: build
 
@@ -28,6 +28,12 @@ test-unit: build
 bench: deps
 	$(MAKE) build
 	$(BUILD)/lamina_bench
+
+# The production coats' cost per evaluation, which the study's summary quotes
+# (data/coat_costs.json; run on a quiet machine, then rebuild).
+coat-costs: deps
+	$(MAKE) build
+	python3 scripts/coat_costs.py $(BUILD)
 
 demo: deps
 	$(MAKE) build

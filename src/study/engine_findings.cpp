@@ -1,6 +1,7 @@
 #include "study/engine_findings.h"
 
 #include "models/registry.h"
+#include "study/coat_costs.h"
 
 #include <fmt/format.h>
 
@@ -251,6 +252,22 @@ std::string switch_effect(const EngineFindings::Ablation& a) {
                  : fmt::format("`{}` is worse by {}", a.flag, points);
 }
 
+/// The coats of the cost table: the production coats the study ran, then lamina-coat if it ran.
+std::vector<std::string> costed_models(const EngineFindings& f) {
+    std::vector<std::string> models;
+    for (const auto& cell : f.cells)
+        if (std::find(models.begin(), models.end(), cell.model) == models.end())
+            models.push_back(cell.model);
+    if (!f.replacements.empty()) models.push_back("lamina-coat");
+    return models;
+}
+
+std::string ns_text(double ns) {
+    return std::isfinite(ns) ? fmt::format("{:.0f}", ns) : "–";
+}
+
+constexpr const char* kCostStacks[] = {"plastic", "coated-gold"};
+
 }  // namespace
 
 std::string engine_findings_markdown(const EngineFindings& f) {
@@ -328,6 +345,24 @@ std::string engine_findings_markdown(const EngineFindings& f) {
         }
         if (header) out("\n");
     }
+    const CoatCosts& costs = coat_costs();
+    out("### Cost per evaluation\n\n"
+        "Nanoseconds per evaluation f(wi, wo) through lamina's Model interface, each coat as "
+        "shipped and with `leaves=exact`, on random direction pairs; measured side by side in one "
+        "run on {}, {} (`{}`; data/coat_costs.json: a measurement, not part of this study's "
+        "computation). The plastic is a rough clear coat over a Lambertian, the coated gold the "
+        "same coat over rough gold.\n\n"
+        "| coat | plastic, as shipped | plastic, `leaves=exact` | coated gold, as shipped | "
+        "coated gold, `leaves=exact` |\n|---|---|---|---|---|\n",
+        costs.machine, costs.date, costs.command);
+    for (const std::string& m : costed_models(f)) {
+        out("| {} |", m);
+        for (const char* stack : kCostStacks)
+            out(" {} | {} |", ns_text(costs.of(m, stack)),
+                ns_text(costs.of(m + ":leaves=exact", stack)));
+        out("\n");
+    }
+    out("\n");
     return md;
 }
 
@@ -371,6 +406,17 @@ nlohmann::json engine_findings_json(const EngineFindings& f) {
                                               {"advice", replacement_advice(r)}});
         j["categories"][c] = jc;
     }
+    const CoatCosts& costs = coat_costs();
+    nlohmann::json jc = {{"machine", costs.machine},
+                         {"date", costs.date},
+                         {"command", costs.command},
+                         {"ns_per_evaluation", nlohmann::json::object()}};
+    for (const std::string& m : costed_models(f))
+        for (const std::string& spec : {m, m + ":leaves=exact"})
+            for (const char* stack : kCostStacks)
+                if (std::isfinite(costs.of(spec, stack)))
+                    jc["ns_per_evaluation"][spec][stack] = costs.of(spec, stack);
+    j["cost_per_evaluation"] = jc;
     return j;
 }
 

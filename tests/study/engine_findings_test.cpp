@@ -3,6 +3,9 @@
 // that is better, a category no production coat supports.
 #include "study/engine_findings.h"
 
+#include "study/coat_costs.h"
+
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -127,6 +130,28 @@ TEST(EngineFindings, RanksByTheFlooredMetric) {
             EXPECT_NEAR(c.mean_misplaced, 0.15, 1e-12);
         }
     }
+}
+
+TEST(EngineFindings, QuotesTheMeasuredCostOfEachCoat) {
+    // The cost table lists the production coats the study ran, with the measurement's
+    // provenance; its numbers are data/coat_costs.json's (study/coat_costs.h).
+    const EngineFindings f = compute_engine_findings(rows(), kModels);
+    const std::string md = engine_findings_markdown(f);
+    const CoatCosts& costs = coat_costs();
+    EXPECT_NE(md.find("### Cost per evaluation"), std::string::npos) << md;
+    EXPECT_NE(md.find(costs.machine), std::string::npos) << md;
+    EXPECT_NE(md.find(fmt::format(
+                  "| openpbr | {:.0f} | {:.0f} | {:.0f} | {:.0f} |", costs.of("openpbr", "plastic"),
+                  costs.of("openpbr:leaves=exact", "plastic"), costs.of("openpbr", "coated-gold"),
+                  costs.of("openpbr:leaves=exact", "coated-gold"))),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("| filament |"), std::string::npos) << md;
+    EXPECT_EQ(md.find("| ww-prime |"), std::string::npos) << md;  // not a production coat
+    const nlohmann::json j = engine_findings_json(f);
+    EXPECT_EQ(
+        j["cost_per_evaluation"]["ns_per_evaluation"]["filament"]["coated-gold"].get<double>(),
+        costs.of("filament", "coated-gold"));
 }
 
 TEST(EngineFindings, EmptyWithoutProductionCoats) {
