@@ -49,6 +49,7 @@ int run_render(const RenderArgs& a) {
     s.seed = a.seed;
     s.threads = a.threads;
     s.lobe_alpha = lobe_alpha_for(stack);  // a proposal density only (renderer.h)
+    s.brushed = brushed_for(stack);
     if (a.out.empty()) throw InputError("command line", "--out", "required");
     // The reference's transport settings become its model options unless given as --option
     // already; for another model they are an error unless left at their defaults.

@@ -194,6 +194,7 @@ std::string write_comparison(const Stack& stack, const Environment& env,
                              double exposure_ev, const std::vector<std::string>& rw_options) {
     RenderSettings s = settings;
     s.lobe_alpha = lobe_alpha_for(stack);
+    s.brushed = brushed_for(stack);
     s.transparent = false;  // the models render the BRDF only: compare like with like
     std::filesystem::create_directories(dir);
     auto write_pair = [&](const std::string& name, const Image& img) {

@@ -105,7 +105,14 @@ Rendering render_sphere(const Model& model, const Environment& env, const Render
             const double t = -2 * dot(x, d);  // |x + t d| = 1
             if (!(t > 0)) break;              // tangent: no far side
             x = normalize(x + d * t);
-            const Frame<double> inner = Frame<double>::from_normal(-x);
+            // The far side seen from inside, normal −x. Brushed: the outside frame's tangent and
+            // bitangent with the normal turned over, since flipped_stack keeps every azimuth
+            // (z → −z, layers/stack.h); a left-handed frame, which to_local/to_world allow.
+            const Frame<double> inner = [&] {
+                if (!s.brushed) return Frame<double>::from_normal(-x);
+                const Frame<double> outer = shading_frame(x, true);
+                return Frame<double>{outer.s, outer.t, -x};
+            }();
             const Vec3d v = inner.to_local(-d);
             if (v.z <= 0) break;
             if (env.sun) {
@@ -133,7 +140,7 @@ Rendering render_sphere(const Model& model, const Environment& env, const Render
 
     // Radiance towards the camera from the sphere point with normal n, one sample.
     auto shade = [&](const Vec3d& n, ParticleRng& rng) {
-        const Frame<double> frame = Frame<double>::from_normal(n);
+        const Frame<double> frame = shading_frame(n, s.brushed);
         const Vec3d wo = frame.to_local(view);
         if (wo.z <= 1e-9) return Rgbd(0.0);
         Rgbd L(0.0);
@@ -202,6 +209,17 @@ Rendering render_sphere(const Model& model, const Environment& env, const Render
     progress.finish();
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
+}
+
+bool brushed_for(const Stack& stack) {
+    return stack.is_anisotropic();
+}
+
+Frame<double> shading_frame(const Vec3d& n, bool brushed) {
+    const double r = std::hypot(n.x, n.z);
+    if (!brushed || r < 1e-9) return Frame<double>::from_normal(n);
+    const Vec3d tangent(n.z / r, 0, -n.x / r);
+    return {tangent, cross(n, tangent), n};
 }
 
 double lobe_alpha_for(const Stack& stack) {

@@ -24,6 +24,7 @@
 // Reproducible: sample s of pixel p draws from ParticleRng(seed, p, s) (core/rng.h), whatever
 // thread renders it. OpenMP over rows; progress on stderr.
 
+#include "core/frame.h"
 #include "layers/stack.h"
 #include "models/model.h"
 #include "render/environment.h"
@@ -48,6 +49,11 @@ struct RenderSettings {
     /// Render a transmitting stack as a transparent sphere (random walk only); false: the BRDF
     /// only, as the analytic models are rendered (comparison sheets use false).
     bool transparent = true;
+    /// Shading frames whose tangent runs along the sphere's circles of latitude about the image's
+    /// vertical axis (a sphere brushed on a lathe), so that an anisotropic interface's tangent
+    /// (tangent_deg from it) is one smooth field over the sphere; false: any frame about the
+    /// normal, which is all an isotropic stack needs. `brushed_for(stack)` picks it.
+    bool brushed = false;
 };
 
 struct Rendering {
@@ -60,6 +66,15 @@ struct Rendering {
 /// A proposal roughness for `stack`: its top interface's α clamped to [0.02, 1] (0 for a
 /// Lambertian top).
 double lobe_alpha_for(const Stack& stack);
+
+/// Whether `stack` needs the brushed tangent field (RenderSettings::brushed): it is anisotropic.
+bool brushed_for(const Stack& stack);
+
+/// The shading frame at the sphere point with unit normal n: with `brushed`, its first axis is the
+/// tangent of the circle of latitude about the vertical axis y, (n_z, 0, −n_x)/√(n_x² + n_z²),
+/// turning counter-clockwise seen from above; at the poles, and without `brushed`, the branchless
+/// frame of core/frame.h.
+Frame<double> shading_frame(const Vec3d& n, bool brushed);
 
 /// Renders `model` (analytic, or RandomWalkModel through its walker). The model's BRDF must be
 /// supported (support().brdf).

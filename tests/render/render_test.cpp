@@ -246,6 +246,35 @@ TEST(RenderStat, WhiteFurnaceRoughStacksAreOneWithMultipleScattering) {
         }
 }
 
+TEST(Render, BrushedFrameFollowsTheCirclesOfLatitude) {
+    // The brushed shading frame: orthonormal and right-handed about n, its tangent horizontal
+    // (along the circle of latitude about y, so the field is smooth over the sphere: nearby
+    // normals, nearby tangents), the branchless frame at the poles and without brushing.
+    for (double theta = 0.05; theta < 3.1; theta += 0.3)
+        for (double phi = 0; phi < 6.28; phi += 0.4) {
+            // n over the sphere with the pole on y.
+            const Vec3d n(std::sin(theta) * std::cos(phi), std::cos(theta),
+                          std::sin(theta) * std::sin(phi));
+            const Frame<double> f = shading_frame(n, true);
+            EXPECT_NEAR(dot(f.s, f.s), 1, 1e-12);
+            EXPECT_NEAR(dot(f.t, f.t), 1, 1e-12);
+            EXPECT_NEAR(dot(f.s, n), 0, 1e-12);
+            EXPECT_NEAR(dot(f.t, n), 0, 1e-12);
+            EXPECT_NEAR(dot(f.s, f.t), 0, 1e-12);
+            EXPECT_NEAR(length(cross(f.s, f.t) - n), 0, 1e-12);  // right-handed
+            EXPECT_NEAR(f.s.y, 0, 1e-15);                        // along the latitude
+            const Vec3d n2(std::sin(theta) * std::cos(phi + 1e-4), std::cos(theta),
+                           std::sin(theta) * std::sin(phi + 1e-4));
+            EXPECT_LT(length(shading_frame(n2, true).s - f.s), 2e-4);
+        }
+    const Vec3d pole(0, 1, 0), n(0.6, 0, 0.8);
+    EXPECT_EQ(shading_frame(pole, true).s, Frame<double>::from_normal(pole).s);
+    EXPECT_EQ(shading_frame(n, false).s, Frame<double>::from_normal(n).s);
+    EXPECT_TRUE(brushed_for(test::make_stack(
+        {layer_of(anisotropic(conductor_interface(Rgbd(0.2), Rgbd(3.0), 0.1), 0.1, 0.4, 0))})));
+    EXPECT_FALSE(brushed_for(test::make_stack({test::dielectric_layer(1.5, 0.1)})));
+}
+
 TEST(Render, IdenticalAcrossThreadCounts) {
     const Stack s = load_stack(std::string(LAMINA_SOURCE_DIR) + "/examples/milky-coat.json");
     const auto rw = make_model("random-walk", s);
