@@ -413,12 +413,15 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
     tally.sums.events += std::uint64_t(events);
 }
 
-std::uint64_t incidence_stream(double theta_i_deg, int incident_polarization) {
+std::uint64_t incidence_stream(double theta_i_deg, double phi_i_deg, int incident_polarization) {
     // The stream is the incidence itself, so a result does not depend on which other incidences
     // were simulated with it; a polarized incident state other than unpolarized adds its index
     // times an odd 64-bit constant (the golden ratio's, as in Random123's key schedule) to the
-    // key, so that runs with different incident states are independent.
+    // key, so that runs with different incident states are independent. The azimuth's bits enter
+    // rotated by half a word (so that θi = φi does not cancel), and φi = 0 adds nothing: runs at
+    // different φi are independent, and light at φi = 0 keeps the stream it always had.
     return std::bit_cast<std::uint64_t>(theta_i_deg) ^
+           std::rotl(std::bit_cast<std::uint64_t>(phi_i_deg + 0.0), 32) ^
            (std::uint64_t(incident_polarization) * 0x9E3779B97F4A7C15ull);
 }
 
@@ -533,7 +536,8 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
                      &grid,
                      Vec3f(direction_from_angles(theta_i, deg_to_rad(settings.phi_i_deg))),
                      settings.seed,
-                     incidence_stream(settings.theta_i_deg[inc], settings.incident_polarization),
+                     incidence_stream(settings.theta_i_deg[inc], settings.phi_i_deg,
+                                      settings.incident_polarization),
                      0,
                      0,
                      settings.transport.max_events};

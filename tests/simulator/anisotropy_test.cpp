@@ -428,6 +428,23 @@ TEST(AnisotropyStat, UnfoldedTablesAreReciprocal) {
     EXPECT_EQ(compared, 18);
 }
 
+TEST(AnisotropyStat, LightFromAnotherAzimuthDrawsOtherNumbers) {
+    // A smooth interface lit from φi = 0 and φi = 60° with the same seed: the physics is the
+    // same (the reflected energy agrees within its standard errors), the random numbers are not
+    // (the incidence's stream includes φi), so the two estimates differ by noise. On a smooth
+    // interface each particle's fate (reflect if u < F) does not depend on the azimuth, so a
+    // shared stream would give the same estimate to rounding.
+    const Stack stack = test::make_stack({test::dielectric_layer(1.5, 0.0)});
+    SimulationSettings s = scalar_settings(50, 200'000, 6);
+    const double r0 = simulate(stack, s).incidences[0].budget[BudgetTerm::Reflected][0];
+    s.phi_i_deg = 60;
+    const SimulationResult b = simulate(stack, s);
+    const double r60 = b.incidences[0].budget[BudgetTerm::Reflected][0];
+    const double se = b.incidences[0].budget.reflected_se[0];
+    EXPECT_LT(std::abs(r60 - r0), 4.5 * std::sqrt(2.0) * se) << r0 << " " << r60;
+    EXPECT_GT(std::abs(r60 - r0), 0.01 * se) << "the same random numbers at both azimuths";
+}
+
 TEST(AnisotropyStat, MultipleScatteringConservesEnergyOnAWhiteConductor) {
     // The white furnace: a conductor of F ≈ 1 (a tiny real part, a huge k: F > 0.9996 at every
     // angle) with multiple scattering keeps all but what F absorbs; single scattering loses the
