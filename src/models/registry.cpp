@@ -67,17 +67,18 @@ class StackNotSupported final : public Model {
     std::string name_, reason_;
 };
 
-/// The entries with their factories refusing filmed and anisotropic stacks (StackNotSupported).
+/// The entries with their factories refusing filmed stacks, and anisotropic ones unless the entry
+/// represents anisotropy (StackNotSupported).
 std::vector<ModelEntry> refusing_unrepresented(std::vector<ModelEntry> entries) {
     for (ModelEntry& e : entries)
-        e.make = [make = std::move(e.make), name = e.name](
+        e.make = [make = std::move(e.make), name = e.name, anisotropic = e.represents_anisotropy](
                      const Stack& stack, const ModelOptions& options) -> std::unique_ptr<Model> {
             if (stack.has_film())
                 return std::make_unique<StackNotSupported>(
                     name,
                     "thin films are not supported by this model (the goniophotometer traces "
                     "them: lamina simulate)");
-            if (stack.is_anisotropic())
+            if (stack.is_anisotropic() && !anisotropic)
                 return std::make_unique<StackNotSupported>(
                     name,
                     "the stack has an anisotropic interface (alpha = [alpha_x, alpha_y]), which "
@@ -135,7 +136,7 @@ const std::vector<ModelEntry>& model_registry() {
          "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "
          "per-query reference, unbiased",
          "every stack; sides: R, T (slab)", random_walk_options, make_random_walk, true,
-         "reference"},
+         "reference", true},
         // The coats engines ship (production_coats.cpp, docs/models.md "Production coats").
         {"openpbr",
          "OpenPBR Surface 1.1 specification: albedo-scaled coat, coat darkening, base "
