@@ -141,13 +141,13 @@ const std::vector<ModelEntry>& model_registry() {
         {"openpbr",
          "OpenPBR Surface 1.1 specification: albedo-scaled coat, coat darkening, base "
          "roughening, view-dependent tint",
-         "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_options, make_openpbr,
-         false, "production"},
+         "bases: lambertian, conductor; media: absorbing; anisotropic coat and metal; sides: R",
+         openpbr_options, make_openpbr, false, "production", true},
         {"openpbr-adobe",
          "Adobe openpbr-bsdf: OpenPBR with view-only albedo scaling (reciprocal off), average "
          "Fresnel darkening, IOR-scaled roughening",
-         "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_adobe_options,
-         make_openpbr_adobe, false, "production"},
+         "bases: lambertian, conductor; media: absorbing; anisotropic coat and metal; sides: R",
+         openpbr_adobe_options, make_openpbr_adobe, false, "production", true},
         {"standard-surface",
          "Autodesk Standard Surface: coat + coat_color (1 - E_coat(wo)) base, view-only",
          "bases: lambertian, conductor; media: absorbing; sides: R", standard_surface_options,
