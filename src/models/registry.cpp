@@ -51,10 +51,11 @@ const ModelFamily<Ddb22Choices> kDdb22{
     },
     [](const std::string&) { return Ddb22Choices{}; }, make_ddb22_model};
 
-/// What every model is for a stack no model of the registry represents yet (docs/physics.md §9
-/// and §3): a thin film, or an anisotropic interface (alpha = [alpha_x, alpha_y]); the
-/// goniophotometer traces both. None is built for such a stack: a model that ignored the film or
-/// the anisotropy would return another stack's values. It supports nothing and says why.
+/// What a model is for a stack it does not represent (docs/physics.md §9 and §3): a thin film
+/// (no model), or an anisotropic interface (alpha = [alpha_x, alpha_y]) for a model whose entry
+/// does not represent anisotropy; the goniophotometer traces both. Such a model is not built: one
+/// that ignored the film or the anisotropy would return another stack's values. It supports
+/// nothing and says why.
 class StackNotSupported final : public Model {
   public:
     StackNotSupported(std::string name, std::string reason)

@@ -112,7 +112,10 @@ TEST(ProductionAnisotropy, TurnsWithItsTangents) {
 
 // Energy: the albedo ∫ f μo dωo over the whole hemisphere (no mirror symmetry: full azimuth), per
 // incidence and, of the transposed BRDF, per view, at θ ∈ {0°, 45°, 80°} and azimuths across the
-// tangents, over brushed metals and a brushed coat over a Lambertian.
+// tangents, over brushed metals and a brushed coat over a Lambertian. Per view it stays within
+// energy conservation (the quadrature's 1e-3 and the FGD table's 6.3e-3 as in production_test);
+// per incidence the albedo scaling exceeds 1 at grazing light, as the isotropic coats do
+// (production_test, EnergyAsMeasured): bounded by the measured excess.
 TEST(ProductionAnisotropy, EnergyIsBounded) {
     BinnedOptions o;
     o.rel_tol = 1e-3;
@@ -144,8 +147,10 @@ TEST(ProductionAnisotropy, EnergyIsBounded) {
         }
         std::cout << fmt::format("{}: largest albedo per incidence {:.4f}, per view {:.4f}\n", name,
                                  forward, per_view);
+        // Measured: per view 0.9934 (openpbr), 0.9991 (openpbr-adobe); per incidence 1.0511,
+        // 1.0525 (the albedo scaling's excess at grazing wi, as for isotropic coats).
         EXPECT_LE(per_view, 1 + 1e-3 + 6.3e-3) << name;
-        EXPECT_LE(forward, 1.33) << name;
+        EXPECT_LE(forward, 1.06) << name;
     }
 }
 
