@@ -11,6 +11,7 @@
 #include "models/numerics/binned.h"
 #include "models/random_walk/random_walk_model.h"
 #include "models/registry.h"
+#include "simulator/goniophotometer.h"
 
 #include <fmt/format.h>
 
@@ -29,7 +30,7 @@ namespace {
 struct EvalArgs {
     std::string model, stack, theta_i, directions, out, grid = HemisphereGrid{}.to_string(),
                                                         side = "R";
-    double theta_o = std::nan(""), phi_o = std::nan("");
+    double theta_o = std::nan(""), phi_o = std::nan(""), phi_i = 0.0;
     bool binned = false, pdf = false;
     std::vector<std::string> options;
     std::uint64_t samples = 0, seed = 0;  ///< random-walk only; 0: the model's own option
@@ -84,8 +85,14 @@ void require_side(const Model& model, Side side, const std::string& where) {
                                      side == Side::Reflection ? "BRDF" : "BTDF"));
 }
 
-Rgbd eval_at(const Model& model, double theta_i, double theta_o, double phi_o, Side side) {
-    return model.eval(incident_direction(deg_to_rad(theta_i)),
+/// The light's direction at (θi, φi) in degrees, as the goniophotometer's --phi-i.
+Vec3d light_direction(double theta_i, double phi_i) {
+    return direction_from_angles(deg_to_rad(theta_i), deg_to_rad(phi_i));
+}
+
+Rgbd eval_at(const Model& model, double theta_i, double phi_i, double theta_o, double phi_o,
+             Side side) {
+    return model.eval(light_direction(theta_i, phi_i),
                       direction_from_angles(deg_to_rad(theta_o), deg_to_rad(phi_o), side));
 }
 
@@ -96,6 +103,9 @@ int run_eval(const EvalArgs& a) {
     std::vector<std::string> assignments = spec.assignments;
     assignments.insert(assignments.end(), a.options.begin(), a.options.end());
     const ModelOptions options = resolve_options(entry, assignments);
+    if (!(a.phi_i >= 0 && a.phi_i <= 360))  // NaN too
+        throw InputError("command line", "--phi-i",
+                         fmt::format("{} degrees is outside [0, 360]", a.phi_i));
     const int modes = int(a.binned) + int(!a.directions.empty());
     if (modes > 1)
         throw InputError("command line", "--binned",
@@ -106,13 +116,16 @@ int run_eval(const EvalArgs& a) {
     if (a.binned) {
         const std::vector<double> thetas = parse_incidences(
             a.theta_i.empty() ? default_incidences_text() : a.theta_i, "--theta-i");
-        const HemisphereGrid grid = HemisphereGrid::parse(a.grid, "--grid");
+        SimulationSettings binning;  // the goniophotometer's bins for this stack and φi
+        binning.grid = HemisphereGrid::parse(a.grid, "--grid");
+        binning.phi_i_deg = a.phi_i;
         const Stack stack = load_stack(a.stack);
+        const HemisphereGrid grid = simulation_grid(stack, binning);
         const auto model = entry.make(stack, options);
         configure_random_walk(*model, a);
         const Support s = model->support();
         if (!s.brdf && !s.btdf) throw InputError(a.stack, "--model", "not supported: " + s.reason);
-        write_file_atomic(a.out, bin_model(*model, grid, thetas).to_csv());
+        write_file_atomic(a.out, bin_model(*model, grid, thetas, a.phi_i).to_csv());
         return 0;
     }
 
@@ -154,7 +167,7 @@ int run_eval(const EvalArgs& a) {
         std::string out = "theta_i,theta_o,phi_o,side,f_r,f_g,f_b\n";
         for (const Row& r : rows) {
             require_side(*model, r.side, a.stack);
-            const Rgbd f = eval_at(*model, r.ti, r.to, r.po, r.side);
+            const Rgbd f = eval_at(*model, r.ti, a.phi_i, r.to, r.po, r.side);
             fmt::format_to(std::back_inserter(out), "{},{},{},{}\n", r.text, f[0], f[1], f[2]);
         }
         write_file_atomic(a.out, out);
@@ -175,7 +188,7 @@ int run_eval(const EvalArgs& a) {
     const auto model = entry.make(stack, options);
     require_side(*model, side, a.stack);
     if (const RandomWalkModel* rw = configure_random_walk(*model, a)) {
-        const Vec3d wi = incident_direction(deg_to_rad(thetas[0]));
+        const Vec3d wi = light_direction(thetas[0], a.phi_i);
         const Vec3d wo = direction_from_angles(deg_to_rad(a.theta_o), deg_to_rad(a.phi_o), side);
         if (a.pdf) {
             // pdf se: the exit density of the walk's sample() at wo (docs/rendering.md §1.4).
@@ -188,7 +201,7 @@ int run_eval(const EvalArgs& a) {
         fmt::print("{} {} {} {} {} {}\n", e.f[0], e.f[1], e.f[2], e.se[0], e.se[1], e.se[2]);
         return 0;
     }
-    const Rgbd f = eval_at(*model, thetas[0], a.theta_o, a.phi_o, side);
+    const Rgbd f = eval_at(*model, thetas[0], a.phi_i, a.theta_o, a.phi_o, side);
     fmt::print("{} {} {}\n", f[0], f[1], f[2]);
     return 0;
 }
@@ -204,6 +217,10 @@ Runner add_eval(CLI::App& app) {
     cmd->add_option("--theta-i", a->theta_i,
                     "Incidence(s) in degrees, [0, 90); a comma list with --binned (default " +
                         default_incidences_text() + ")");
+    cmd->add_option("--phi-i", a->phi_i,
+                    "Incidence azimuth in degrees, [0, 360] (as simulate's); a non-zero one, or "
+                    "an anisotropic stack, bins on the unfolded grid (phi over [0, 360))")
+        ->capture_default_str();
     cmd->add_option("--theta-o", a->theta_o, "Outgoing polar angle in degrees, [0, 90]");
     cmd->add_option("--phi-o", a->phi_o, "Outgoing azimuth in degrees (mirror at 180)");
     cmd->add_option("--side", a->side, "R (reflection) or T (transmission; θo from -z)");

@@ -51,10 +51,11 @@ const ModelFamily<Ddb22Choices> kDdb22{
     },
     [](const std::string&) { return Ddb22Choices{}; }, make_ddb22_model};
 
-/// What every model is for a stack no model of the registry represents yet (docs/physics.md §9
-/// and §3): a thin film, or an anisotropic interface (alpha = [alpha_x, alpha_y]); the
-/// goniophotometer traces both. None is built for such a stack: a model that ignored the film or
-/// the anisotropy would return another stack's values. It supports nothing and says why.
+/// What a model is for a stack it does not represent (docs/physics.md §9 and §3): a thin film
+/// (no model), or an anisotropic interface (alpha = [alpha_x, alpha_y]) for a model whose entry
+/// does not represent anisotropy; the goniophotometer traces both. Such a model is not built: one
+/// that ignored the film or the anisotropy would return another stack's values. It supports
+/// nothing and says why.
 class StackNotSupported final : public Model {
   public:
     StackNotSupported(std::string name, std::string reason)
@@ -67,17 +68,18 @@ class StackNotSupported final : public Model {
     std::string name_, reason_;
 };
 
-/// The entries with their factories refusing filmed and anisotropic stacks (StackNotSupported).
+/// The entries with their factories refusing filmed stacks, and anisotropic ones unless the entry
+/// represents anisotropy (StackNotSupported).
 std::vector<ModelEntry> refusing_unrepresented(std::vector<ModelEntry> entries) {
     for (ModelEntry& e : entries)
-        e.make = [make = std::move(e.make), name = e.name](
+        e.make = [make = std::move(e.make), name = e.name, anisotropic = e.represents_anisotropy](
                      const Stack& stack, const ModelOptions& options) -> std::unique_ptr<Model> {
             if (stack.has_film())
                 return std::make_unique<StackNotSupported>(
                     name,
                     "thin films are not supported by this model (the goniophotometer traces "
                     "them: lamina simulate)");
-            if (stack.is_anisotropic())
+            if (stack.is_anisotropic() && !anisotropic)
                 return std::make_unique<StackNotSupported>(
                     name,
                     "the stack has an anisotropic interface (alpha = [alpha_x, alpha_y]), which "
@@ -135,18 +137,18 @@ const std::vector<ModelEntry>& model_registry() {
          "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "
          "per-query reference, unbiased",
          "every stack; sides: R, T (slab)", random_walk_options, make_random_walk, true,
-         "reference"},
+         "reference", true},
         // The coats engines ship (production_coats.cpp, docs/models.md "Production coats").
         {"openpbr",
          "OpenPBR Surface 1.1 specification: albedo-scaled coat, coat darkening, base "
          "roughening, view-dependent tint",
-         "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_options, make_openpbr,
-         false, "production"},
+         "bases: lambertian, conductor; media: absorbing; anisotropic coat and metal; sides: R",
+         openpbr_options, make_openpbr, false, "production", true},
         {"openpbr-adobe",
          "Adobe openpbr-bsdf: OpenPBR with view-only albedo scaling (reciprocal off), average "
          "Fresnel darkening, IOR-scaled roughening",
-         "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_adobe_options,
-         make_openpbr_adobe, false, "production"},
+         "bases: lambertian, conductor; media: absorbing; anisotropic coat and metal; sides: R",
+         openpbr_adobe_options, make_openpbr_adobe, false, "production", true},
         {"standard-surface",
          "Autodesk Standard Surface: coat + coat_color (1 - E_coat(wo)) base, view-only",
          "bases: lambertian, conductor; media: absorbing; sides: R", standard_surface_options,

@@ -27,6 +27,10 @@ struct ModelEntry {
     /// "production" (the coats engines ship), "lamina" (lamina's own model) or "reference" (the
     /// stochastic estimator).
     std::string group = "2019";
+    /// The model represents anisotropic interfaces (alpha = [alpha_x, alpha_y], docs/physics.md
+    /// §3): it is built for such a stack and evaluated on the unfolded grid. Otherwise it reports
+    /// the stack as not supported.
+    bool represents_anisotropy = false;
 };
 
 /// The groups of ModelEntry::group, in the order the explorer shows them.

@@ -753,18 +753,26 @@ void bind_models(py::module_& m) {
             py::arg("wi"))
         .def(
             "binned",
-            [](const PyModel& m, py::handle theta_i, std::pair<int, int> grid) {
+            [](const PyModel& m, py::handle theta_i, std::pair<int, int> grid, double phi_i) {
                 const std::vector<double> thetas = incidences_of(theta_i);
-                const HemisphereGrid g = grid_of(grid);
+                if (!(phi_i >= 0 && phi_i <= 360))  // NaN too
+                    throw InputError("arguments", "phi_i",
+                                     fmt::format("{} degrees is outside [0, 360]", phi_i));
+                SimulationSettings binning;  // the goniophotometer's bins for this stack and φi
+                binning.grid = grid_of(grid);
+                binning.phi_i_deg = phi_i;
+                const HemisphereGrid g = simulation_grid(m.stack, binning);
                 const Support s = m.model->support();
                 if (!s.brdf && !s.btdf)
                     throw InputError("arguments", "name", "not supported: " + s.reason);
                 py::gil_scoped_release release;
-                return bin_model(*m.model, g, thetas);
+                return bin_model(*m.model, g, thetas, phi_i);
             },
             py::arg("theta_i") = default_incidences_deg(),
             py::arg("grid") = std::make_pair(HemisphereGrid{}.n_theta(), HemisphereGrid{}.n_phi()),
-            "Cos-weighted bin averages on the goniophotometer's bins (lamina eval --binned)")
+            py::arg("phi_i") = 0.0,
+            "Cos-weighted bin averages on the goniophotometer's bins (lamina eval --binned): "
+            "the unfolded grid (phi over [0, 360)) for an anisotropic stack or phi_i != 0")
         .def(
             "albedo",
             [](const PyModel& m, py::handle theta_i, const std::string& side) {
@@ -776,10 +784,12 @@ void bind_models(py::module_& m) {
                 py::array_t<double> out(std::vector<py::ssize_t>{py::ssize_t(thetas.size()), 3});
                 {
                     py::gil_scoped_release release;
+                    BinnedOptions options;
+                    options.full_azimuth = m.stack.is_anisotropic();
                     for (std::size_t i = 0; i < thetas.size(); ++i) {
-                        const Rgbd a =
-                            model_albedo(*m.model, incident_direction(deg_to_rad(thetas[i])),
-                                         side == "R" ? Side::Reflection : Side::Transmission);
+                        const Rgbd a = model_albedo(
+                            *m.model, incident_direction(deg_to_rad(thetas[i])),
+                            side == "R" ? Side::Reflection : Side::Transmission, options);
                         for (int c = 0; c < 3; ++c)
                             out.mutable_data()[3 * i + c] = a[c];
                     }

@@ -141,12 +141,6 @@ bool is_grey(const Rgbd& x) {
 
 RandomWalkStack::RandomWalkStack(const Stack& stack, const TransportSettings& transport)
     : transmits_(stack.transmits()), transport_(transport) {
-    // The walk's samplers and connections take the isotropic instance of the GGX formulas.
-    if (stack.is_anisotropic())
-        throw InputError(stack.name, "alpha",
-                         "not supported: the random walk does not trace anisotropic interfaces "
-                         "(alpha = [alpha_x, alpha_y]); the goniophotometer does (--kernel "
-                         "scalar)");
     LAMINA_CHECK(transport.max_events >= 1);
     LAMINA_CHECK(transport.max_microsurface_order >= 1);
     if (stack.has_film())
@@ -155,6 +149,7 @@ RandomWalkStack::RandomWalkStack(const Stack& stack, const TransportSettings& tr
                          "traces them: lamina simulate --kernel scalar)");
     const CompiledStack<double> compiled = compile_stack<double>(stack, transport);
     channels_ = compiled.polarization_channels;
+    anisotropic_ = compiled.anisotropic;
     const int L = int(compiled.layers.size());
     interfaces_ = compiled.layers;
     eta_.assign(L + 1, 1.0);
@@ -377,7 +372,8 @@ std::optional<RandomWalkStack::ExitDirection> RandomWalkStack::sample_exit_direc
     const Interface& exit_it = interfaces_[conn.exit_interface];
     const DielectricInterface<double>& exit = exit_it.dielectric;
     const double uc = rng.uniform_double(), u1 = rng.uniform_double(), u2 = rng.uniform_double();
-    const auto st = exit.sample<true>(wo, uc, u1, u2);
+    const auto st = with_roughness(
+        [&](auto aniso) { return exit.sample<true, decltype(aniso)::value>(wo, uc, u1, u2); });
     if (!st || !st->is_transmission || st->shadowing == 0 || st->pdf <= 0) return std::nullopt;
     const Vec3d omega = -st->wo;
     if (omega.z * conn.towards <= 0) return std::nullopt;
@@ -439,27 +435,31 @@ void RandomWalkStack::visit_microsurface(const Interface& it, const Vec3d& wi, P
     if (it.type == InterfaceType::Dielectric) {
         const GGX<double> ggx = it.dielectric.distribution();
         const double eta = it.dielectric.eta;
-        walk_rough_dielectric_visiting(ggx, eta, wi, uniform, transport_.max_microsurface_order,
-                                       [&](const MicrosurfaceFacet<double>& facet) {
-                                           visit([&](const Vec3d& wo) {
-                                               MicrosurfaceConnection<double> c;
-                                               c.density = microsurface_dielectric_connect(
-                                                   ggx, eta, facet, wo);
-                                               c.weight = Rgbd(1.0);
-                                               return c;
-                                           });
-                                       });
+        with_roughness([&](auto aniso) {
+            walk_rough_dielectric_visiting<decltype(aniso)::value>(
+                ggx, eta, wi, uniform, transport_.max_microsurface_order,
+                [&](const MicrosurfaceFacet<double>& facet) {
+                    visit([&](const Vec3d& wo) {
+                        MicrosurfaceConnection<double> c;
+                        c.density = microsurface_dielectric_connect(ggx, eta, facet, wo);
+                        c.weight = Rgbd(1.0);
+                        return c;
+                    });
+                });
+        });
     } else {
         const ConductorInterface<double>& cond = it.conductor;
         const GGX<double> ggx = cond.distribution();
         auto fresnel = [&](double c) { return cond.fresnel(c); };
-        walk_rough_conductor_visiting(ggx, fresnel, wi, uniform, transport_.max_microsurface_order,
-                                      [&](const MicrosurfaceFacet<double>& facet) {
-                                          visit([&](const Vec3d& wo) {
-                                              return microsurface_conductor_connect(ggx, fresnel,
-                                                                                    facet, wo);
-                                          });
-                                      });
+        with_roughness([&](auto aniso) {
+            walk_rough_conductor_visiting<decltype(aniso)::value>(
+                ggx, fresnel, wi, uniform, transport_.max_microsurface_order,
+                [&](const MicrosurfaceFacet<double>& facet) {
+                    visit([&](const Vec3d& wo) {
+                        return microsurface_conductor_connect(ggx, fresnel, facet, wo);
+                    });
+                });
+        });
     }
 }
 
@@ -542,22 +542,26 @@ void RandomWalkStack::emission(const Interface& it, const Vec3d& wi, const Vec3d
     if (it.type == InterfaceType::Dielectric) {
         const GGX<double> ggx = it.dielectric.distribution();
         const double eta = it.dielectric.eta;
-        walk_rough_dielectric_polarized_visiting(
-            ggx, eta, wi, uniform, transport_.max_microsurface_order, pol,
-            [&](const MicrosurfaceFacet<double>& facet) {
-                for (int j = 0; j < n; ++j)
-                    microsurface_dielectric_connect_polarized(ggx, eta, facet, d[j], pol.stokes,
-                                                              channels, out[j]);
-            });
+        with_roughness([&](auto aniso) {
+            walk_rough_dielectric_polarized_visiting<decltype(aniso)::value>(
+                ggx, eta, wi, uniform, transport_.max_microsurface_order, pol,
+                [&](const MicrosurfaceFacet<double>& facet) {
+                    for (int j = 0; j < n; ++j)
+                        microsurface_dielectric_connect_polarized(ggx, eta, facet, d[j], pol.stokes,
+                                                                  channels, out[j]);
+                });
+        });
     } else {
         const GGX<double> ggx = it.conductor.distribution();
-        walk_rough_conductor_polarized_visiting(
-            ggx, mueller, wi, uniform, transport_.max_microsurface_order, pol,
-            [&](const MicrosurfaceFacet<double>& facet) {
-                for (int j = 0; j < n; ++j)
-                    microsurface_conductor_connect_polarized(ggx, mueller, facet, d[j], pol.stokes,
-                                                             channels, out[j]);
-            });
+        with_roughness([&](auto aniso) {
+            walk_rough_conductor_polarized_visiting<decltype(aniso)::value>(
+                ggx, mueller, wi, uniform, transport_.max_microsurface_order, pol,
+                [&](const MicrosurfaceFacet<double>& facet) {
+                    for (int j = 0; j < n; ++j)
+                        microsurface_conductor_connect_polarized(ggx, mueller, facet, d[j],
+                                                                 pol.stokes, channels, out[j]);
+                });
+        });
     }
     for (int j = 0; j < n; ++j)
         for (auto& channel : out[j].s)
@@ -944,20 +948,23 @@ std::optional<BsdfSample<double>> RandomWalkStack::sample_interface(const Interf
         // single-scattering one: only strategy 2's balance heuristic reads it (a proxy).
         auto uniform = [&] { return rng.uniform_double(); };
         const bool dielectric = it.type == InterfaceType::Dielectric;
-        const std::optional<MicrosurfaceExit<double>> e =
-            polarized ? (dielectric ? walk_rough_dielectric_polarized(
+        const std::optional<MicrosurfaceExit<double>> e = with_roughness([&](auto aniso) {
+            constexpr bool kA = decltype(aniso)::value;
+            return polarized    ? (dielectric
+                                       ? walk_rough_dielectric_polarized<kA>(
                                           it.dielectric.distribution(), it.dielectric.eta, wi_local,
                                           uniform, transport_.max_microsurface_order, pol)
-                                    : walk_rough_conductor_polarized(
+                                       : walk_rough_conductor_polarized<kA>(
                                           it.conductor.distribution(), mueller, wi_local, uniform,
                                           transport_.max_microsurface_order, pol))
-            : dielectric
-                ? walk_rough_dielectric(it.dielectric.distribution(), it.dielectric.eta, wi_local,
-                                        uniform, transport_.max_microsurface_order)
-                : walk_rough_conductor(
-                      it.conductor.distribution(),
-                      [&](double c) { return it.conductor.fresnel(c); }, wi_local, uniform,
-                      transport_.max_microsurface_order);
+                   : dielectric ? walk_rough_dielectric<kA>(it.dielectric.distribution(),
+                                                            it.dielectric.eta, wi_local, uniform,
+                                                            transport_.max_microsurface_order)
+                                : walk_rough_conductor<kA>(
+                                      it.conductor.distribution(),
+                                      [&](double c) { return it.conductor.fresnel(c); }, wi_local,
+                                      uniform, transport_.max_microsurface_order);
+        });
         if (!e || !e->escaped) return std::nullopt;
         s = BsdfSample<double>{};
         s->wo = e->wo;
@@ -969,21 +976,32 @@ std::optional<BsdfSample<double>> RandomWalkStack::sample_interface(const Interf
                 const double uc = rng.uniform_double(), u1 = rng.uniform_double(),
                              u2 = rng.uniform_double();
                 if (polarized) {
-                    s = it.dielectric.sample_polarized(wi_local, uc, u1, u2, pol);
+                    s = with_roughness([&](auto aniso) {
+                        return it.dielectric.sample_polarized<decltype(aniso)::value>(wi_local, uc,
+                                                                                      u1, u2, pol);
+                    });
                     if (s && !s->is_delta) s->pdf = it.dielectric.pdf(wi_local, s->wo);
                 } else {
-                    s = it.dielectric.sample<true>(wi_local, uc, u1, u2);
+                    s = with_roughness([&](auto aniso) {
+                        return it.dielectric.sample<true, decltype(aniso)::value>(wi_local, uc, u1,
+                                                                                  u2);
+                    });
                 }
                 break;
             }
             case InterfaceType::Conductor: {
                 const double u1 = rng.uniform_double(), u2 = rng.uniform_double();
                 if (polarized) {
-                    s = it.conductor.sample_polarized(wi_local, u1, u2, pol);
+                    s = with_roughness([&](auto aniso) {
+                        return it.conductor.sample_polarized<decltype(aniso)::value>(wi_local, u1,
+                                                                                     u2, pol);
+                    });
                     if (s && !s->is_delta && s->wo.z > 0)
                         s->pdf = it.conductor.pdf(wi_local, s->wo);
                 } else {
-                    s = it.conductor.sample<true>(wi_local, u1, u2);
+                    s = with_roughness([&](auto aniso) {
+                        return it.conductor.sample<true, decltype(aniso)::value>(wi_local, u1, u2);
+                    });
                 }
                 break;
             }

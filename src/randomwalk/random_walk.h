@@ -55,6 +55,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <type_traits>
 #include <vector>
 
 namespace lamina {
@@ -244,12 +245,23 @@ class RandomWalkStack {
                                         const ProxyPdf& proxy_pdf, Rgbd& f) const;
     double interface_pdf_chain(const Interface& it, const Vec3d& wi, const Vec3d& wo, const Rgbd& w,
                                const Rgbd& q, ParticleRng& rng) const;
+    /// Calls f(std::bool_constant<anisotropic_>{}): the instance of the GGX samplers and
+    /// microsurface walks (GGX::lanes) the stack needs, as the goniophotometer chooses it.
+    template <typename F>
+    decltype(auto) with_roughness(F&& f) const {
+        if (anisotropic_) return f(std::true_type{});
+        return f(std::false_type{});
+    }
 
     std::vector<Interface> interfaces_;  ///< top to bottom (compile_stack's layers)
     std::vector<Medium> media_;          ///< per region 0..L (0 and L empty): the layers' media
     std::vector<double> eta_;            ///< absolute index per region 0..L
     bool transmits_ = false;
     bool pdf_unbiased_ = true;
+    /// Some rough interface is anisotropic (CompiledStack::anisotropic): every sampler and
+    /// microsurface walk takes the general instance of the GGX formulas, as the goniophotometer's
+    /// kernel does; isotropic stacks keep the isotropic instance and their estimates.
+    bool anisotropic_ = false;
     TransportSettings transport_;
     int channels_ = 1;  ///< polarization states per particle (CompiledStack::polarization_channels)
 };

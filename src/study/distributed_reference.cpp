@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/progress.h"
+#include "study/study.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -52,6 +53,7 @@ std::uint64_t particles_of(const std::vector<ReferenceKey>& work, int rank, int 
 
 std::vector<ReferenceKey> study_reference_keys(const std::vector<StudyConfiguration>& configs,
                                                const StudySettings& s) {
+    check_study_supports(configs, s);
     std::vector<ReferenceKey> keys;
     for (const StudyConfiguration& config : configs)
         for (double theta_i : s.reference.theta_i_deg) {

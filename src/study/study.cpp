@@ -634,8 +634,25 @@ std::string describe_work(const StudyWork& w) {
         w.configurations_written, w.configurations_unchanged, w.files_written);
 }
 
+void check_study_supports(const std::vector<StudyConfiguration>& configs, const StudySettings& s) {
+    if (s.reference.phi_i_deg != 0)
+        throw InputError("settings", "--phi-i",
+                         fmt::format("the study compares folded tables (light from phi_i = 0); "
+                                     "phi_i = {} unfolds them: use lamina simulate and lamina "
+                                     "eval --binned --phi-i for one stack",
+                                     s.reference.phi_i_deg));
+    for (const StudyConfiguration& c : configs)
+        if (c.stack.is_anisotropic())
+            throw InputError(
+                "configuration '" + c.id + "'", "alpha",
+                "the stack has an anisotropic interface (alpha = [alpha_x, alpha_y]), whose "
+                "tables are unfolded (phi over [0, 360)); the study compares folded tables "
+                "only: use lamina simulate and lamina eval --binned for this stack");
+}
+
 StudyResult run_study(const std::vector<StudyConfiguration>& configs, const StudySettings& s,
                       const std::filesystem::path& out_dir) {
+    check_study_supports(configs, s);
     const std::vector<std::string> model_names = study_models(s);
 
     StagedOutput probe(out_dir);  // the folder must be writable before any work starts

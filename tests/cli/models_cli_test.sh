@@ -71,6 +71,28 @@ if "$lamina" validate "$tmp/gold.json" >/dev/null 2>&1; then
         echo "FAIL spec name: '$(cat "$tmp/a2")' vs '$(cat "$tmp/a1")'"; fails=$((fails + 1)); fi
     check production-bad-flag 1 "$lamina" eval --model filament --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180 --option darkening=off
     expect_output production-bad-flag-lists "its options: attenuation, roughening, f0-conversion, energy-compensation, leaves"
+    # An anisotropic stack: the models that represent it bin it on the unfolded grid (φ over
+    # [0°, 360°): twice the φ bins), as does φi ≠ 0; the others say why they do not.
+    cat >"$tmp/brushed.json" <<'JSON'
+{"name": "brushed gold", "layers": [
+  {"interface": {"type": "dielectric", "eta": 1.5, "alpha": 0.1}},
+  {"interface": {"type": "conductor", "eta": [0.18, 0.42, 1.37], "k": [3.4, 2.35, 1.85], "alpha": [0.3, 0.05], "tangent_deg": 30}}]}
+JSON
+    check aniso-binned 0 "$lamina" eval --model openpbr-adobe --stack "$tmp/brushed.json" --theta-i 30 --phi-i 45 --binned --grid 9x6 --out "$tmp/ab.csv"
+    if [ "$(wc -l <"$tmp/ab.csv")" -eq $((1 + 9 * 12)) ] && awk -F, 'NR > 1 && $6 > 359 { n++ } END { exit !(n == 9) }' "$tmp/ab.csv"; then
+        pass=$((pass + 1)); else echo "FAIL unfolded binned output"; head -3 "$tmp/ab.csv"; fails=$((fails + 1)); fi
+    check phi-i-binned 0 "$lamina" eval --model bel-prime --stack "$tmp/gold.json" --theta-i 30 --phi-i 90 --binned --grid 9x6 --out "$tmp/pb.csv"
+    [ "$(wc -l <"$tmp/pb.csv")" -eq $((1 + 9 * 12)) ] && pass=$((pass + 1)) || { echo "FAIL phi_i binned"; fails=$((fails + 1)); }
+    check aniso-point 0 "$lamina" eval --model openpbr --stack "$tmp/brushed.json" --theta-i 30 --phi-i 200 --theta-o 45 --phi-o 20
+    expect_output aniso-point-three-numbers "^[0-9.e+-]* [0-9.e+-]* [0-9.e+-]*$"
+    check aniso-not-supported 1 "$lamina" eval --model ww-prime --stack "$tmp/brushed.json" --theta-i 30 --theta-o 45 --phi-o 180
+    expect_output aniso-not-supported-says "not supported: the stack has an anisotropic interface"
+    check phi-i-range 1 "$lamina" eval --model ww09 --stack "$tmp/gold.json" --theta-i 30 --phi-i 400 --theta-o 45 --phi-o 180
+    expect_output phi-i-range-says "phi-i"
+    check phi-i-nan 1 "$lamina" eval --model ww09 --stack "$tmp/gold.json" --theta-i 30 --phi-i nan --theta-o 45 --phi-o 180
+    # The study compares folded tables: an anisotropic stack stops it before any work, naming it.
+    check compare-aniso 1 "$lamina" compare "$tmp/brushed.json" --particles 1000 --theta-i 30 --no-figures --out "$tmp/cmp"
+    expect_output compare-aniso-says "configuration 'brushed'.*anisotropic"
 else
     echo "FAIL validate: 'lamina validate' does not accept the test's stack"; fails=$((fails + 1))
 fi

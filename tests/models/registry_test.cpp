@@ -32,6 +32,27 @@ TEST(ModelRegistry, ListsTheSixModelsOfTheStudyAndTheRandomWalk) {
     EXPECT_EQ(by_group["reference"], (std::vector<std::string>{"random-walk"}));
 }
 
+// An anisotropic stack (docs/physics.md §3) is built only by the models that represent anisotropy;
+// every other one reports it as not supported, saying why, rather than returning an isotropic
+// stack's values.
+TEST(ModelRegistry, OnlyModelsThatRepresentAnisotropyAreBuiltForIt) {
+    Stack brushed = test::coated(1.5, 0.1, anisotropic(test::gold(0.3), 0.3, 0.05, 20.0));
+    ASSERT_TRUE(brushed.is_anisotropic());
+    int represented = 0;
+    for (const auto& e : model_registry()) {
+        const auto model = make_model(e.name, brushed);
+        if (e.represents_anisotropy) {
+            ++represented;
+            EXPECT_TRUE(model->support().brdf) << e.name << ": " << model->support().reason;
+        } else {
+            EXPECT_FALSE(model->support().brdf || model->support().btdf) << e.name;
+            EXPECT_NE(model->support().reason.find("anisotropic"), std::string::npos) << e.name;
+        }
+    }
+    EXPECT_GE(represented, 1);  // the random walk
+    EXPECT_TRUE(find_model("random-walk").represents_anisotropy);
+}
+
 TEST(ModelRegistry, ListsTheProductionCoats) {
     std::vector<std::string> names;
     for (const auto& e : model_registry())

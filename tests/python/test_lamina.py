@@ -308,6 +308,20 @@ def test_binned_is_the_cli_table(tmp_path):
     assert np.array_equal(lamina.Table.from_csv(tmp_path / "t.csv").f, t.f)
 
 
+def test_binned_unfolds_for_an_anisotropic_stack_and_phi_i(tmp_path):
+    # An anisotropic stack, or light from phi_i != 0, is binned on the simulator's unfolded grid
+    # (phi over [0, 360): twice the phi bins), bitwise as `lamina eval --binned --phi-i`.
+    brushed = ROOT / "examples" / "brushed-aluminium-lacquer.json"
+    cli("eval", "--model", "openpbr", "--stack", brushed, "--binned", "--theta-i", "45",
+        "--phi-i", "30", "--grid", "9x6", "--out", tmp_path / "t.csv")
+    t = lamina.Model("openpbr", brushed).binned([45], grid=(9, 6), phi_i=30)
+    assert t.to_csv() == (tmp_path / "t.csv").read_text()
+    assert t.f.shape[-2:] == (12, 3)
+    assert lamina.Model("ww-prime", PLASTIC).binned([45], grid=(9, 6), phi_i=90).f.shape[-2:] == (12, 3)
+    with pytest.raises(lamina.InputError, match="phi_i"):
+        lamina.Model("ww-prime", PLASTIC).binned([45], phi_i=-1)
+
+
 def test_albedo_agrees_with_the_binned_table():
     # Two quadratures of the same integral: the adaptive one over the hemisphere and the sum of
     # bin averages times Ω⊥ (each good to ~1e-4 relative by construction, binned.h).

@@ -1,5 +1,6 @@
 #include "models/numerics/binned.h"
 
+#include "core/check.h"
 #include "core/math.h"
 #include "core/spherical.h"
 
@@ -147,13 +148,21 @@ class RectIntegrator {
     double tol_ = 0;
 };
 
-std::vector<Peak> peaks_on_side(const std::vector<Vec3d>& dirs, Side side) {
+/// The peaks on `side` in the rectangles' coordinates: φ folded into [0, π], or unfolded in
+/// [0, 2π] (a peak at φ = 0 also at 2π, the edge of the last bin).
+std::vector<Peak> peaks_on_side(const std::vector<Vec3d>& dirs, Side side, bool unfolded = false) {
     std::vector<Peak> out;
     for (const Vec3d& d : dirs) {
         if ((d.z > 0) != (side == Side::Reflection)) continue;
         const double theta = theta_of(d);
-        const double phi = std::atan2(std::abs(d.y), d.x);  // folded into [0, π]
-        out.push_back({theta, phi, theta <= kPoleTheta});
+        const bool pole = theta <= kPoleTheta;
+        if (!unfolded) {
+            out.push_back({theta, std::atan2(std::abs(d.y), d.x), pole});
+            continue;
+        }
+        const double phi = phi_of(d);
+        out.push_back({theta, phi, pole});
+        if (phi == 0) out.push_back({theta, 2 * kPi<double>, pole});
     }
     return out;
 }
@@ -171,16 +180,22 @@ Rgbd model_albedo(const Model& model, const Vec3d& wi, Side side, const BinnedOp
     const auto evaluator = model.prepare(wi);
     const std::vector<Vec3d> peaks = model.peak_directions(wi);
     // ∫ f |cos θ| dω over the hemisphere = 2 Σ (rectangle average × its weight) over [0, π/2] ×
-    // [0, π] (symmetry φ ↔ −φ). A fixed 16 × 16 partition first, so that no large rectangle is
-    // accepted on an accidental agreement of its two rules.
+    // [0, π] (symmetry φ ↔ −φ), or Σ over [0, π/2] × [0, 2π) without the symmetry. A fixed
+    // 16 × 16 partition of each half first, so that no large rectangle is accepted on an
+    // accidental agreement of its two rules.
+    const bool full = options.full_azimuth || wi.y != 0;
     constexpr int kN = 16;
+    const int n_phi = full ? 2 * kN : kN;
     const double dt = kPi<double> / 2 / kN, dp = kPi<double> / kN;
+    const double copies = full ? 1 : 2;
+    const std::vector<Peak> side_peaks = peaks_on_side(peaks, side, full);
     Rgbd albedo(0.0);
     for (int a = 0; a < kN; ++a)
-        for (int b = 0; b < kN; ++b)
-            albedo += cos_weighted_average(*evaluator, side, a * dt, (a + 1) * dt, b * dp,
-                                           (b + 1) * dp, peaks, options) *
-                      (2 * measure(a * dt, (a + 1) * dt, b * dp, (b + 1) * dp));
+        for (int b = 0; b < n_phi; ++b) {
+            RectIntegrator integrator(*evaluator, side, side_peaks, options);
+            albedo += integrator.average(a * dt, (a + 1) * dt, b * dp, (b + 1) * dp) *
+                      (copies * measure(a * dt, (a + 1) * dt, b * dp, (b + 1) * dp));
+        }
     for (const DeltaLobe& d : model.delta_lobes(wi))
         if ((d.direction.z > 0) == (side == Side::Reflection)) albedo += d.energy;
     return albedo;
@@ -188,6 +203,13 @@ Rgbd model_albedo(const Model& model, const Vec3d& wi, Side side, const BinnedOp
 
 BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
                       const std::vector<double>& theta_i_deg, const BinnedOptions& options) {
+    return bin_model(model, grid, theta_i_deg, 0.0, options);
+}
+
+BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
+                      const std::vector<double>& theta_i_deg, double phi_i_deg,
+                      const BinnedOptions& options) {
+    LAMINA_CHECK(phi_i_deg == 0 || grid.is_unfolded());
     const Support support = model.support();
     BinnedTable table = BinnedTable::zeros(grid, theta_i_deg, support.brdf, support.btdf);
     const std::size_t n_inc = theta_i_deg.size();
@@ -195,7 +217,7 @@ BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
     std::vector<std::unique_ptr<IncidentEvaluator>> evaluators(n_inc);
     std::vector<std::vector<Vec3d>> peaks(n_inc);
     for (std::size_t i = 0; i < n_inc; ++i) {
-        wi[i] = incident_direction(deg_to_rad(theta_i_deg[i]));
+        wi[i] = direction_from_angles(deg_to_rad(theta_i_deg[i]), deg_to_rad(phi_i_deg));
         evaluators[i] = model.prepare(wi[i]);  // forward variants: lobe statistics, once
         peaks[i] = model.peak_directions(wi[i]);
     }
@@ -209,7 +231,8 @@ BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
         const long rest = row / grid.n_theta();
         const Side side = sides[rest % long(sides.size())];
         const std::size_t i = std::size_t(rest / long(sides.size()));
-        RectIntegrator integrator(*evaluators[i], side, peaks_on_side(peaks[i], side), options);
+        RectIntegrator integrator(*evaluators[i], side,
+                                  peaks_on_side(peaks[i], side, grid.is_unfolded()), options);
         BinnedLobe& lobe = table.lobe(i, side);
         for (int p = 0; p < grid.n_phi(); ++p)
             lobe.f[std::size_t(t) * grid.n_phi() + p] = integrator.average(

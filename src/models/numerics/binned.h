@@ -3,7 +3,11 @@
 // and bin, the cos-weighted average ∫_bin f |cos θ| dω / ∫_bin |cos θ| dω, in exactly the
 // BinnedTable (`brdf.csv`) form of the reference.
 //
-// Quadrature: over one folded half (the stack is isotropic), in (θ, φ) with the weight
+// On the folded grid the light lies in the plane φ = 0 and each bin is averaged over its half
+// y ≥ 0 (an isotropic stack is mirror-symmetric about that plane); on the unfolded grid (an
+// anisotropic stack, or light from φi ≠ 0: core/grid.h) over its one patch of φ ∈ [0°, 360°).
+//
+// Quadrature: over one rectangle of (θ, φ), with the weight
 // sin θ cos θ in the integrand. (The measure is uniform in u = sin²θ, but in u the integrand has
 // square-root edges at the normal and at grazing that adaptive bisection cannot shake off; in θ it
 // is smooth up to both ends.)
@@ -32,11 +36,23 @@ struct BinnedOptions {
     int max_depth = 10;         ///< bisection levels driven by the error estimate
     int peak_depth = 40;        ///< bisection levels towards a peak direction
     long eval_budget = 200000;  ///< evaluations per bin before accepting the current estimate
+    /// model_albedo: integrate φ over [0, 2π) rather than twice [0, π] (which assumes the model
+    /// mirror-symmetric about the plane of wi, i.e. an isotropic stack and wi.y = 0; wi.y ≠ 0
+    /// always takes the full range).
+    bool full_azimuth = false;
 };
 
-/// Bins the sides the model supports (support().brdf → R, .btdf → T). theta_i_deg ∈ [0, 90).
+/// Bins the sides the model supports (support().brdf → R, .btdf → T). theta_i_deg ∈ [0, 90);
+/// the light comes from azimuth φi = 0.
 BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
                       const std::vector<double>& theta_i_deg, const BinnedOptions& options = {});
+
+/// The same with the light from azimuth phi_i_deg ∈ [0, 360] (wi = (sin θi cos φi, sin θi sin φi,
+/// cos θi), as the goniophotometer's --phi-i): the bins the goniophotometer tabulates with that
+/// incidence. A folded grid needs phi_i_deg = 0 (checked); pass the unfolded one otherwise.
+BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
+                      const std::vector<double>& theta_i_deg, double phi_i_deg,
+                      const BinnedOptions& options = {});
 
 /// The cos-weighted average of f over one rectangle [θ0, θ1] × [φ0, φ1] (radians) on `side`, by
 /// the same adaptive rule.

@@ -78,6 +78,21 @@ class ProductionCoat final : public Model {
                 r_.name, coat_.eta0);
             return;
         }
+        const InterfaceSpec &coat_spec = stack.layers[0].interface,
+                            &base_spec = stack.layers[1].interface;
+        if (stack.is_anisotropic()) {
+            if (!r_.anisotropic_roughness) {
+                support_.reason = fmt::format(
+                    "{} has no anisotropic roughness: the stack's anisotropic interface (alpha = "
+                    "[alpha_x, alpha_y]) has no counterpart",
+                    r_.name);
+                return;
+            }
+            // OpenPBR's isotropic α of each interface: the energy terms and the roughening
+            // below read it; the lobes take the interface's anisotropy (lobe_distribution).
+            coat_.alpha0 = openpbr_isotropic_alpha(coat_spec);
+            coat_.base_alpha = openpbr_isotropic_alpha(base_spec);
+        }
         support_.brdf = true;
         eta0_ = coat_.eta0;
         switch (r_.coat_fresnel) {
@@ -94,6 +109,7 @@ class ProductionCoat final : public Model {
         double r_coat = std::sqrt(coat_.alpha0);
         if (r_.coat_min_roughness > 0) r_coat = std::max(r_coat, r_.coat_min_roughness);
         alpha_coat_ = sqr(lobe_roughness(r_coat));
+        coat_ggx_ = lobe_distribution(coat_spec, alpha_coat_);
         eta_index_ = FgdTable::locate(eta0_, 0);
         coat_f0_ior_ = sqr((eta0_ - 1) / (eta0_ + 1));
         // openpbr-bsdf reads its table at the coat's α before its lobe's clamp; at α = 0 it takes
@@ -119,6 +135,7 @@ class ProductionCoat final : public Model {
             const double r_prime = roughened(std::sqrt(coat_.base_alpha));
             const double r_lobe = std::max(lobe_roughness(r_prime), r_.metal_min_roughness);
             alpha_base_ = sqr(r_lobe);
+            base_ggx_ = lobe_distribution(base_spec, alpha_base_);
             for (int c = 0; c < 3; ++c) {
                 const double e = coat_.base_eta[c], k = coat_.base_k[c];
                 f0_[c] = fresnel_conductor(1.0, e, k);
@@ -212,8 +229,8 @@ class ProductionCoat final : public Model {
         in.E_i = uses_albedo() ? coat_albedo(wi.z) : 0;
         in.F_i = coat_fresnel(wi.z);
         in.mu_t_i = refracted_cos(wi.z);
-        if (alpha_coat_ > 0) in.lambda_coat = GGX<double>{alpha_coat_}.lambda(wi);
-        if (is_metal_ && alpha_base_ > 0) in.lambda_base = GGX<double>{alpha_base_}.lambda(wi);
+        if (alpha_coat_ > 0) in.lambda_coat = coat_ggx_.lambda(wi);
+        if (is_metal_ && alpha_base_ > 0) in.lambda_base = base_ggx_.lambda(wi);
         if (has_ms()) in.ms_complement_i = ms_complement(wi.z);
         return in;
     }
@@ -230,7 +247,7 @@ class ProductionCoat final : public Model {
         const double cos_h = dot(wi, h);
         double f_coat = 0;
         if (alpha_coat_ > 0) {
-            const GGX<double> ggx{alpha_coat_};
+            const GGX<double>& ggx = coat_ggx_;
             const double F = coat_fresnel(r_.coat_fresnel_at_n ? wo.z : cos_h);
             if (r_.coat_visibility == CoatRecipe::Visibility::Kelemen) {
                 f_coat = F * ndf(ggx, h) / (4 * cos_h * cos_h);
@@ -243,7 +260,7 @@ class ProductionCoat final : public Model {
         Rgbd base(0.0);
         if (is_metal_) {
             if (alpha_base_ <= 0) return Rgbd(f_coat);  // a smooth base: a delta lobe
-            const GGX<double> ggx{alpha_base_};
+            const GGX<double>& ggx = base_ggx_;
             const double G = masking_shadowing(r_.metal_visibility, in.lambda_base, ggx, wo);
             base = metal_fresnel(cos_h) * (ndf(ggx, h) * G / (4 * wi.z * wo.z));
             if (dfg_) {
@@ -317,11 +334,9 @@ class ProductionCoat final : public Model {
         const double p_c = coat_probability(wi);
         Vec3d wo;
         if (u.z < p_c) {
-            const GGX<double> ggx{alpha_coat_};
-            wo = reflect(wi, ggx.sample_visible_normal(wi, u.x, u.y));
+            wo = reflect(wi, coat_ggx_.sample_visible_normal(wi, u.x, u.y));
         } else if (is_metal_) {
-            const GGX<double> ggx{alpha_base_};
-            wo = reflect(wi, ggx.sample_visible_normal(wi, u.x, u.y));
+            wo = reflect(wi, base_ggx_.sample_visible_normal(wi, u.x, u.y));
         } else {
             wo = sample_cosine_hemisphere(u.x, u.y);
         }
@@ -337,10 +352,10 @@ class ProductionCoat final : public Model {
         const Vec3d h = normalize(wi + wo);
         const double jacobian = 1 / (4 * dot(wo, h));  // dωh/dωo for reflection
         double p = 0;
-        if (p_c > 0) p += p_c * GGX<double>{alpha_coat_}.pdf_visible_normal(wi, h) * jacobian;
+        if (p_c > 0) p += p_c * coat_ggx_.pdf_visible_normal(wi, h) * jacobian;
         if (p_c < 1) {
             if (is_metal_)
-                p += (1 - p_c) * GGX<double>{alpha_base_}.pdf_visible_normal(wi, h) * jacobian;
+                p += (1 - p_c) * base_ggx_.pdf_visible_normal(wi, h) * jacobian;
             else
                 p += (1 - p_c) * pdf_cosine_hemisphere(wo);
         }
@@ -348,6 +363,19 @@ class ProductionCoat final : public Model {
     }
 
   private:
+    /// The lobe of an interface whose isotropic α became `alpha` (the lobe's clamp, the
+    /// roughening): GGX of α for an isotropic interface; for an anisotropic one its α_x, α_y
+    /// scaled by alpha / openpbr_isotropic_alpha (OpenPBR 1.1's α_t, α_b of the new α at the same
+    /// anisotropy), each clamped to the recipe's smallest lobe α as openpbr-bsdf clamps both
+    /// (openpbr_compute_anisotropic_alpha), its tangent the interface's.
+    GGX<double> lobe_distribution(const InterfaceSpec& s, double alpha) const {
+        if (!s.is_anisotropic() || alpha <= 0) return GGX<double>{alpha};
+        const double scale = alpha / openpbr_isotropic_alpha(s), least = sqr(r_.lobe_min_roughness);
+        return GGX<double>::anisotropic(std::max(s.alpha * scale, least),
+                                        std::max(s.alpha_b() * scale, least),
+                                        deg_to_rad(s.tangent_deg));
+    }
+
     int sampled_lobes() const { return int(alpha_coat_ > 0) + int(!is_metal_ || alpha_base_ > 0); }
 
     double coat_probability(const Vec3d& wi) const {
@@ -633,6 +661,9 @@ class ProductionCoat final : public Model {
     double eta0_ = 1.5;
     double coat_f0_ = 0;
     double alpha_coat_ = 0, alpha_base_ = 0;
+    /// The coat's and the metal's lobes: GGX of α_coat_, α_base_, anisotropic where the
+    /// interface is (lobe_distribution).
+    GGX<double> coat_ggx_{0.0}, base_ggx_{0.0};
     FgdTable::Index eta_index_;
     bool is_metal_ = false;
     Rgbd f0_{0.0}, tint82_{1.0};
@@ -689,6 +720,12 @@ double kulla_conty_average_fresnel_fit(double eta) {
     // Kulla & Conty 2017, slide 18, as openpbr-bsdf's openpbr_average_fresnel ships it.
     if (eta > 1) return (eta - 1) / (4.08567 + 1.00071 * eta);
     return 0.997118 + 0.1014 * eta - 0.965241 * eta * eta - 0.130607 * eta * eta * eta;
+}
+
+double openpbr_isotropic_alpha(const InterfaceSpec& interface) {
+    if (!interface.is_anisotropic()) return interface.alpha;
+    // OpenPBR 1.1: α_t² + α_b² = α² (2 / (1 + (1 − a)²)) (1 + (1 − a)²) = 2 α².
+    return std::sqrt(0.5 * (sqr(interface.alpha) + sqr(interface.alpha_b())));
 }
 
 SchlickSplit materialx_ggx_albedo_fit(double mu, double alpha) {

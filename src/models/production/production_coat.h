@@ -30,9 +30,10 @@
 // used.
 //
 // Represented: a dielectric coat (absorbing, not scattering) over a Lambertian or conductor base
-// (BRDF only). Not supported, with the reason: other shapes, a scattering coat, a dielectric
-// base (slab: the models' bases are opaque), and a coat IOR other than 1.5 for the models whose
-// coat has a fixed IOR (Enterprise PBR, Filament, glTF).
+// (BRDF only), anisotropic for the recipes that define anisotropic roughness (OpenPBR's). Not
+// supported, with the reason: other shapes, a scattering coat, a dielectric base (slab: the models'
+// bases are opaque), and a coat IOR other than 1.5 for the models whose coat has a fixed IOR
+// (Enterprise PBR, Filament, glTF).
 
 #include "models/model.h"
 #include "models/production/ggx_albedo.h"
@@ -173,6 +174,13 @@ struct CoatRecipe {
 
     /// Standard Surface's coat_affect_color = 1: ρ ← ρ^2 (its default 0 leaves ρ).
     bool affect_color = false;
+    /// The model defines anisotropic roughness as OpenPBR 1.1 does ("Specular" and "Coat":
+    /// α_t = α √(2 / (1 + (1 − a)²)), α_b = (1 − a) α_t from α = r² and the anisotropy a), so an
+    /// anisotropic interface is represented: its isotropic α is the root mean square
+    /// √((α_x² + α_y²)/2), which the energy terms and the roughening read, and its lobe keeps the
+    /// interface's α_y/α_x and tangent (docs/models.md, "Anisotropic coats"). Otherwise an
+    /// anisotropic stack is not supported.
+    bool anisotropic_roughness = false;
     /// MaterialX's OpenPBR: the diffuse base under the base's specular layer, whose weight 0 sets
     /// its index to 1 (no reflection) but whose throughput keeps 1 − B (1 + (1 − E)/(21 E)) of
     /// its fit at the default specular roughness after roughening.
@@ -184,6 +192,10 @@ struct CoatRecipe {
 OptionSpec leaves_option();
 /// Applies leaves=exact to a recipe.
 void use_exact_leaves(CoatRecipe& recipe);
+
+/// The isotropic α of an interface in OpenPBR 1.1's anisotropy parametrization (the inverse of
+/// its α_t, α_b of α and a): √((α_x² + α_y²)/2); α itself for an isotropic interface.
+double openpbr_isotropic_alpha(const InterfaceSpec& interface);
 
 /// Builds a production coat; never fails (unsupported stacks say why in support()).
 std::unique_ptr<Model> make_production_coat(const Stack& stack, const CoatRecipe& recipe);

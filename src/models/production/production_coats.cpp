@@ -45,6 +45,8 @@ CoatRecipe openpbr_recipe(const ModelOptions& o) {
     r.roughening =
         is_on(o, "roughening") ? CoatRecipe::Roughening::OpenPBR : CoatRecipe::Roughening::None;
     r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    // specular_roughness_anisotropy and coat_roughness_anisotropy ("Specular", "Coat").
+    r.anisotropic_roughness = true;
     if (exact_leaves(o)) use_exact_leaves(r);
     return r;
 }
@@ -68,6 +70,9 @@ CoatRecipe adobe_recipe(const ModelOptions& o) {
     r.coat_visibility = CoatRecipe::Visibility::SmithUncorrelated;
     r.metal_visibility = CoatRecipe::Visibility::SmithUncorrelated;
     r.lobe_min_roughness = 0.001;
+    // Anisotropic α on both lobes, its energy terms at the isotropic α (openpbr_bsdf.h,
+    // openpbr_compute_anisotropic_alpha, openpbr_get_isotropic_alpha).
+    r.anisotropic_roughness = true;
     r.coat_albedo = CoatRecipe::CoatAlbedo::OpenPbrBsdf;
     r.metal_multiple_scattering = is_on(o, "multiple-scattering")
                                       ? CoatRecipe::MetalMultipleScattering::OpenPbrBsdf

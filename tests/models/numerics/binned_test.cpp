@@ -124,6 +124,73 @@ TEST(Binned, DeltaLobeLandsInTheMirrorBin) {
     }
 }
 
+// ---- The unfolded grid (an anisotropic stack, or light from φi ≠ 0: core/grid.h) --------------
+// The largest |a − b| allowed between two bin averages each good to τ = rel_tol·|f| + abs_tol.
+double two_tolerances(double a, double b) {
+    const BinnedOptions o;
+    return o.rel_tol * (std::abs(a) + std::abs(b)) + 2 * o.abs_tol;
+}
+
+// Lit from φi = 0, an isotropic model's unfolded table is its folded one on the half y ≥ 0 (the
+// same rectangles and peaks: bitwise) and the mirror image on y < 0 (mirrored nodes: within the
+// two bins' tolerances); its albedo over the full azimuth is the folded one's.
+TEST(Binned, UnfoldedGridAtPhiZeroIsTheFoldedTableMirrored) {
+    for (const Stack& s : {coated(1.5, 0.3, test::gold(0.3)), coated(1.5, 0.05, test::gold(0.1))}) {
+        const auto model = make_model("bel-prime", s);
+        const HemisphereGrid folded(18, 18), unfolded = folded.unfolded();
+        const BinnedTable a = bin_model(*model, folded, {30});
+        const BinnedTable b = bin_model(*model, unfolded, {30}, 0.0);
+        ASSERT_EQ(b.grid, unfolded);
+        const auto& fa = a.lobe(0, Side::Reflection).f;
+        const auto& fb = b.lobe(0, Side::Reflection).f;
+        const int n = unfolded.n_phi();
+        for (int t = 0; t < folded.n_theta(); ++t)
+            for (int p = 0; p < folded.n_phi(); ++p) {
+                const Rgbd& folded_f = fa[std::size_t(t * folded.n_phi() + p)];
+                const Rgbd& upper = fb[std::size_t(t * n + p)];
+                const Rgbd& lower = fb[std::size_t(t * n + n - 1 - p)];
+                for (int c = 0; c < 3; ++c) {
+                    EXPECT_EQ(upper[c], folded_f[c]) << "bin " << t << "," << p;
+                    EXPECT_NEAR(lower[c], folded_f[c], two_tolerances(lower[c], folded_f[c]))
+                        << "bin " << t << "," << p;
+                }
+            }
+        BinnedOptions full;
+        full.full_azimuth = true;
+        const Vec3d wi = incident_direction(deg_to_rad(30.0));
+        const Rgbd half = model_albedo(*model, wi, Side::Reflection);
+        const Rgbd whole = model_albedo(*model, wi, Side::Reflection, full);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(whole[c], half[c], two_tolerances(whole[c], half[c]));
+    }
+}
+
+// Light from φi = k·Δφ (Δφ the bin width) turns an isotropic model's unfolded table by k bins, the
+// peaks and the delta lobe with it; off the grid's bins the light still gets the same energy.
+TEST(Binned, TurningTheLightTurnsTheUnfoldedTable) {
+    const HemisphereGrid grid = HemisphereGrid(18, 18).unfolded();  // 36 bins of 10°
+    const int n = grid.n_phi(), k = 5;
+    for (const Stack& s : {coated(1.5, 0.2, test::gold(0.25)), test::single(test::gold(0.0))}) {
+        const auto model = make_model("bel-prime", s);
+        const BinnedTable a = bin_model(*model, grid, {40}, 0.0);
+        const BinnedTable b = bin_model(*model, grid, {40}, 10.0 * k);
+        const auto& fa = a.lobe(0, Side::Reflection).f;
+        const auto& fb = b.lobe(0, Side::Reflection).f;
+        for (int t = 0; t < grid.n_theta(); ++t)
+            for (int p = 0; p < n; ++p) {
+                const Rgbd& turned = fb[std::size_t(t * n + (p + k) % n)];
+                const Rgbd& f = fa[std::size_t(t * n + p)];
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_NEAR(turned[c], f[c], two_tolerances(turned[c], f[c]) + 1e-9 * f[c])
+                        << "bin " << t << "," << p;
+            }
+        const BinnedTable off = bin_model(*model, grid, {40}, 123.4);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(off.albedo(0, Side::Reflection)[c], a.albedo(0, Side::Reflection)[c],
+                        2e-4 * a.albedo(0, Side::Reflection)[c]);
+    }
+}
+
 // Output does not depend on the thread count (every bin is computed independently).
 TEST(Binned, DeterministicForAnyThreadCount) {
     const auto model = make_model("bel18-symmetric", coated(1.5, 0.1, test::gold(0.2)));
