@@ -275,6 +275,48 @@ TEST(Render, BrushedFrameFollowsTheCirclesOfLatitude) {
     EXPECT_FALSE(brushed_for(test::make_stack({test::dielectric_layer(1.5, 0.1)})));
 }
 
+TEST(Render, BrushedHighlightRunsAcrossTheBrushing) {
+    // A lacquered metal brushed along the latitudes (tangent 0°: smooth along the circles about
+    // the vertical axis, rough across them), lit by one light placed so that the highlight sits
+    // up and right of the centre (normal (0.4, 0.4, 1)/|·|): the highlight is stretched across the
+    // brushing, about vertically; brushed along the meridians (90°), about horizontally. The spread
+    // of the highlight, as the brightness-weighted variance of the pixel coordinates over the
+    // pixels above a tenth of the peak, says which.
+    const auto spread = [](double tangent_deg) {
+        Layer coat = with_medium(test::dielectric_layer(1.5, 0.02), Rgbd(0.02));
+        const Layer metal = layer_of(
+            anisotropic(conductor_interface(Rgbd(1.66, 0.88, 0.52), Rgbd(9.2, 6.3, 4.8), 0.05),
+                        0.05, 0.4, tangent_deg));
+        const Stack stack = test::make_stack({coat, metal});
+        EXPECT_TRUE(brushed_for(stack));
+        const auto model = make_model("openpbr-adobe", stack);
+        EXPECT_TRUE(model->support().brdf) << model->support().reason;
+        RenderSettings s = small(48, 4);
+        s.brushed = true;
+        s.lobe_alpha = lobe_alpha_for(stack);
+        Environment env = Environment::named("dark");
+        const Vec3d n = normalize(Vec3d(0.4, 0.4, 1)), view(0, 0, 1);
+        env.sun = DirectionalLight{n * (2 * dot(n, view)) - view, Rgbd(1.0)};
+        const Rendering r = render_sphere(*model, env, s);
+        double peak = 0;
+        for (const Rgbf& p : r.image.pixels)
+            peak = std::max(peak, double(p[1]));
+        double w = 0, mx = 0, my = 0, mxx = 0, myy = 0;
+        for (int y = 0; y < 48; ++y)
+            for (int x = 0; x < 48; ++x) {
+                const double v = r.image.at(x, y)[1];
+                if (v < 0.1 * peak) continue;
+                w += v, mx += v * x, my += v * y, mxx += v * x * x, myy += v * y * y;
+            }
+        mx /= w, my /= w;
+        return std::pair{mxx / w - mx * mx, myy / w - my * my};
+    };
+    const auto [x0, y0] = spread(0);
+    EXPECT_GT(y0, 3 * x0) << "brushed along the latitudes: var x " << x0 << ", var y " << y0;
+    const auto [x90, y90] = spread(90);
+    EXPECT_GT(x90, 3 * y90) << "brushed along the meridians: var x " << x90 << ", var y " << y90;
+}
+
 TEST(Render, IdenticalAcrossThreadCounts) {
     const Stack s = load_stack(std::string(LAMINA_SOURCE_DIR) + "/examples/milky-coat.json");
     const auto rw = make_model("random-walk", s);
