@@ -6,6 +6,7 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "layers/colorimetry.h"
 #include "layers/compiled_stack.h"
 #include "physics/medium.h"
 #include "physics/microsurface_walk.h"
@@ -19,6 +20,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 namespace lamina {
 
@@ -315,6 +317,71 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
     }
 }
 
+// ---- A spectral particle (docs/physics.md §10)
+// --------------------------------------------------- Its three wavelengths (tally.h: lattice
+// points t + c · L/3), the channel h whose wavelength its path follows (the hero), and where its
+// exits and losses are tallied. At a dispersive interface (one whose refraction direction depends
+// on the wavelength) the other two channels, whose paths would part from the hero's, are terminated
+// and the hero carries 3 times its flux: the hero is uniformly distributed over the lattice, as
+// each channel is, so its flux times 3 estimates what the three channels did, without bias (the
+// terminated flux is not booked in the budget, which sums to 1 in expectation then).
+struct SpectralParticle {
+    const SpectralTracing& tracing;
+    SpectralTally& tally;
+    SpectralBlock& block;
+    const std::vector<char>& dispersive;  ///< per layer
+    int group;                            ///< t / kSpectralLattice: the wavelength bins' group
+    int hero;
+    bool secondaries = true;  ///< the non-hero channels still travel
+    Rgbf xyz_weight[3], srgb_weight[3];
+
+    /// Before an event at `layer`: terminates the secondaries at a dispersive interface.
+    void before_event(int layer, Rgbf& w) {
+        if (!secondaries || !dispersive[std::size_t(layer)]) return;
+        secondaries = false;
+        for (int c = 0; c < 3; ++c)
+            w[c] = c == hero ? 3.f * w[c] : 0.f;
+    }
+    Rgbf projected(const Rgbf& w, const Rgbf (&weight)[3]) const {
+        return weight[0] * w[0] + weight[1] * w[1] + weight[2] * w[2];
+    }
+    /// An exit into `index` (side · n_bins + bin) with flux w: the wavelength bins, XYZ and sRGB
+    /// (`tally`, `block`: the main sRGB ones).
+    void exit(std::size_t index, bool reflected, const Rgbf& w, Tally& main,
+              BlockBudget& main_block) {
+        const Rgbf xyz = projected(w, xyz_weight), srgb = projected(w, srgb_weight);
+        constexpr float kScale = 1.f / float(kSpectralTallyScale);
+        tally.lambda.exit(index * std::size_t(tracing.bins / 3) + std::size_t(group), w * 0.25f);
+        tally.xyz.exit(index, xyz * kScale);
+        main.exit(index, srgb * kScale);
+        BlockBudget& g = block.groups[std::size_t(group)];
+        if (reflected) {
+            g.escape_reflected(w);
+            block.xyz.escape_reflected(xyz);
+            main_block.escape_reflected(srgb);
+        } else {
+            g.escape_transmitted(w);
+            block.xyz.escape_transmitted(xyz);
+            main_block.escape_transmitted(srgb);
+        }
+    }
+    /// The path's losses, per wavelength group and projected.
+    void flush(const PathLosses& losses, BlockBudget& main_block) {
+        BlockBudget& g = block.groups[std::size_t(group)];
+        for (int t = int(BudgetTerm::AbsorbedMedium); t < kBudgetTerms; ++t)
+            for (int c = 0; c < 3; ++c) {
+                const double lost = losses.term[std::size_t(t)][std::size_t(c)];
+                g.term[std::size_t(t)][std::size_t(c)] += lost;
+                for (int k = 0; k < 3; ++k) {
+                    block.xyz.term[std::size_t(t)][std::size_t(k)] +=
+                        lost * double(xyz_weight[c][k]);
+                    main_block.term[std::size_t(t)][std::size_t(k)] +=
+                        lost * double(srgb_weight[c][k]);
+                }
+            }
+    }
+};
+
 // ---- One particle ------------------------------------------------------------------------------
 // docs/physics.md §3: at an interface the particle (arriving along −wi) draws an outgoing direction
 // from the interface's BSDF sampler; its flux is multiplied by the sample weight and the parts
@@ -324,10 +391,12 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
 // passes it to the interface's polarized event, a Lambertian base and a scattering event
 // depolarize it, and an exit is tallied with its Stokes vector when the job asks for it.
 // Written once for both: kPolarized = false is the unpolarized kernel, with none of it; kFilm
-// = true the instantiation for stacks with a thin film (film_event).
-template <bool kPolarized, bool kAnisotropic, bool kFilm>
+// = true the instantiation for stacks with a thin film (film_event); kSpectral = true the spectral
+// particle `sp` (its exits and losses tallied per wavelength and projected to colour).
+template <bool kPolarized, bool kAnisotropic, bool kFilm, bool kSpectral = false>
 void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& grid,
-                    const BlockJob& job, ParticleRng& rng, Tally& tally, BlockBudget& block) {
+                    const BlockJob& job, ParticleRng& rng, Tally& tally, BlockBudget& block,
+                    [[maybe_unused]] SpectralParticle* sp = nullptr) {
     const int n_layers = int(stack.layers.size());
     const int max_events = job.max_events;
     Vec3f d = -job.wi;  // propagation direction
@@ -358,6 +427,7 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         }
         ++events;
         const CompiledLayer<float>& layer = stack.layers[k];
+        if constexpr (kSpectral) sp->before_event(k, w);
         if constexpr (kPolarized)
             for (int c = 0; c < 3; ++c)
                 flux[c] = w[c];
@@ -377,9 +447,13 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         if (d.z > 0) {
             if (k == 0) {  // leaves the stack upwards: reflection
                 const std::size_t bin = grid.bin_of(d);
-                tally.exit(bin, w);
+                if constexpr (kSpectral) {
+                    sp->exit(bin, true, w, tally, block);
+                } else {
+                    tally.exit(bin, w);
+                    block.escape_reflected(w);
+                }
                 if constexpr (kPolarized) exit_stokes(bin);
-                block.escape_reflected(w);
                 break;
             }
             // Up through the medium below interface k − 1.
@@ -394,9 +468,13 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
         } else {
             if (k == n_layers - 1) {  // leaves through the final dielectric: transmission
                 const std::size_t bin = grid.size() + grid.bin_of(d);
-                tally.exit(bin, w);
+                if constexpr (kSpectral) {
+                    sp->exit(bin, false, w, tally, block);
+                } else {
+                    tally.exit(bin, w);
+                    block.escape_transmitted(w);
+                }
                 if constexpr (kPolarized) exit_stokes(bin);
-                block.escape_transmitted(w);
                 break;
             }
             const CompiledMedium<float>& m = layer.medium;
@@ -409,8 +487,59 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
             if (!up) ++k;
         }
     }
-    losses.flush(block);
+    if constexpr (kSpectral)
+        sp->flush(losses, block);
+    else
+        losses.flush(block);
     tally.sums.events += std::uint64_t(events);
+}
+
+// A spectral run's block (tally.h): each particle draws its hero's lattice point first, from its
+// own stream, and follows the stack compiled at its three wavelengths.
+void trace_block_spectral(const BlockJob& job, Tally& tally, BlockBudget& block) {
+    const SpectralTracing& tr = *job.spectral;
+    const int third = tr.lattice / 3;
+    for (std::uint64_t p = job.first; p < job.first + job.count; ++p) {
+        ParticleRng rng(job.seed, job.stream, p);
+        const int point = std::min(tr.lattice - 1, int(rng.uniform_float() * float(tr.lattice)));
+        const int hero = point / third, t = point % third;
+        const std::size_t at = std::size_t(t) * 3 + std::size_t(hero);
+        const CompiledStack<float>& stack = tr.stacks[at];
+        SpectralParticle sp{tr,
+                            *job.spectral_tally,
+                            *job.spectral_block,
+                            tr.dispersive[at],
+                            t / kSpectralLattice,
+                            hero,
+                            true,
+                            {},
+                            {}};
+        for (int c = 0; c < 3; ++c) {
+            sp.xyz_weight[c] = tr.xyz_weight[std::size_t(t + c * third)];
+            sp.srgb_weight[c] = tr.srgb_weight[std::size_t(t + c * third)];
+        }
+        const bool pol = stack.polarization;
+        if (stack.has_film) {
+            if (pol)
+                trace_particle<true, false, true, true>(stack, *job.grid, job, rng, tally, block,
+                                                        &sp);
+            else
+                trace_particle<false, false, true, true>(stack, *job.grid, job, rng, tally, block,
+                                                         &sp);
+        } else if (stack.anisotropic) {
+            if (pol)
+                trace_particle<true, true, false, true>(stack, *job.grid, job, rng, tally, block,
+                                                        &sp);
+            else
+                trace_particle<false, true, false, true>(stack, *job.grid, job, rng, tally, block,
+                                                         &sp);
+        } else if (pol) {
+            trace_particle<true, false, false, true>(stack, *job.grid, job, rng, tally, block, &sp);
+        } else {
+            trace_particle<false, false, false, true>(stack, *job.grid, job, rng, tally, block,
+                                                      &sp);
+        }
+    }
 }
 
 std::uint64_t incidence_stream(double theta_i_deg, int incident_polarization) {
@@ -422,6 +551,51 @@ std::uint64_t incidence_stream(double theta_i_deg, int incident_polarization) {
            (std::uint64_t(incident_polarization) * 0x9E3779B97F4A7C15ull);
 }
 
+// A spectral run's stacks and colour weights (tally.h; docs/physics.md §10).
+SpectralTracing spectral_tracing(const Stack& stack, const SimulationSettings& settings) {
+    SpectralTracing tr;
+    tr.bins = settings.spectral_bins;
+    tr.lattice = tr.bins * kSpectralLattice;
+    const int third = tr.lattice / 3;
+    const double lo = settings.spectral_min_nm, hi = settings.spectral_max_nm;
+    const double cell = (hi - lo) / tr.lattice;
+    auto lambda = [&](int point) { return lo + (point + 0.5) * cell; };
+    for (int t = 0; t < third; ++t) {
+        const Rgbd wl{lambda(t), lambda(t + third), lambda(t + 2 * third)};
+        // The relative index of each dielectric at the three wavelengths.
+        const Stack at[3] = {stack.at_wavelengths(wl, 0), stack.at_wavelengths(wl, 1),
+                             stack.at_wavelengths(wl, 2)};
+        std::vector<char> dispersive(stack.layers.size(), 0);
+        for (std::size_t i = 0; i < stack.layers.size(); ++i) {
+            if (stack.layers[i].interface.type != InterfaceType::Dielectric) continue;
+            double relative[3];
+            for (int c = 0; c < 3; ++c)
+                relative[c] = at[c].layers[i].interface.eta / at[c].eta_above(i);
+            dispersive[i] = relative[0] != relative[1] || relative[1] != relative[2];
+        }
+        for (int h = 0; h < 3; ++h) {
+            tr.stacks.push_back(compile_stack<float>(at[h], settings.transport));
+            tr.dispersive.push_back(dispersive);
+        }
+    }
+    // XYZ weights: the lattice sum of f · S · (x̄, ȳ, z̄) · cell over ∫ S ȳ dλ on 360–830 nm
+    // (the midpoint rule on 0.1 nm cells), times L/3 for the three uniform channels a particle
+    // carries.
+    double norm_y = 0;
+    constexpr int kCells = 4700;
+    for (int i = 0; i < kCells; ++i)
+        norm_y += d65_xyz_weights(kSpectrumMinNm + (i + 0.5) * 0.1)[1] * 0.1;
+    for (int point = 0; point < tr.lattice; ++point) {
+        const Rgbd xyz = d65_xyz_weights(lambda(point)) * (cell * third / norm_y);
+        const Rgbd srgb = xyz_to_linear_srgb(xyz);
+        // The bound each tally contribution relies on (tally.h).
+        LAMINA_CHECK(std::max(std::abs(srgb.max()), std::abs(srgb.min())) <= 5 && xyz.max() <= 5);
+        tr.xyz_weight.push_back(Rgbf(xyz));
+        tr.srgb_weight.push_back(Rgbf(srgb));
+    }
+    return tr;
+}
+
 // The incident Stokes vectors (S1, S2, S3)/S0 of SimulationSettings::incident_polarization.
 constexpr float kIncidentStokes[7][3] = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 0, 1},
                                          {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
@@ -429,6 +603,10 @@ constexpr float kIncidentStokes[7][3] = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 
 }  // namespace
 
 void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block) {
+    if (job.spectral) {
+        trace_block_spectral(job, tally, block);
+        return;
+    }
     for (std::uint64_t p = job.first; p < job.first + job.count; ++p) {
         ParticleRng rng(job.seed, job.stream, p);
         // Stacks with a film or an anisotropic interface have their own instantiations: those of
@@ -458,8 +636,14 @@ std::string kernel_description(Kernel kernel) {
     return kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name()) : "scalar";
 }
 
+bool is_spectral_run(const Stack& stack, const SimulationSettings& settings) {
+    return settings.spectral == SpectralMode::On ||
+           (settings.spectral == SpectralMode::Auto && stack.is_spectral());
+}
+
 bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings) {
-    return stack.has_film() || stack.is_anisotropic() || settings.phi_i_deg != 0;
+    return stack.has_film() || stack.is_anisotropic() || settings.phi_i_deg != 0 ||
+           is_spectral_run(stack, settings);
 }
 
 Kernel kernel_for(const SimulationSettings& settings, const Stack& stack) {
@@ -481,6 +665,23 @@ void IncidenceSums::add(const IncidenceSums& o) {
             stokes[i][std::size_t(k)] += o.stokes[i][std::size_t(k)];
     events += o.events;
     degenerate += o.degenerate;
+    LAMINA_CHECK(spectral_bins.size() == o.spectral_bins.size() &&
+                 xyz_bins.size() == o.xyz_bins.size() &&
+                 spectral_budget.size() == o.spectral_budget.size());
+    for (std::size_t i = 0; i < spectral_bins.size(); ++i)
+        for (int k = 0; k < 6; ++k)
+            spectral_bins[i][k] += o.spectral_bins[i][k];
+    for (std::size_t i = 0; i < xyz_bins.size(); ++i)
+        for (int k = 0; k < 6; ++k)
+            xyz_bins[i][k] += o.xyz_bins[i][k];
+    auto add_budget = [](auto& into, const auto& from) {
+        for (std::size_t t = 0; t < into.size(); ++t)
+            for (int c = 0; c < 3; ++c)
+                into[t][c] += from[t][c];
+    };
+    for (std::size_t g = 0; g < spectral_budget.size(); ++g)
+        add_budget(spectral_budget[g], o.spectral_budget[g]);
+    add_budget(xyz_budget, o.xyz_budget);
 }
 
 void validate_kernel_for(const Stack& stack, const SimulationSettings& settings) {
@@ -488,6 +689,30 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings)
         throw InputError(stack.name, "film",
                          "a thin film on a stack with an anisotropic interface is not traced yet "
                          "(films and anisotropy each work alone)");
+    if (is_spectral_run(stack, settings)) {
+        if (settings.spectral_bins % 3 != 0)
+            throw InputError("settings", "spectral_bins",
+                             fmt::format("got {}; allowed: a multiple of 3 in [3, 300] (each "
+                                         "particle carries three wavelengths a third of the "
+                                         "range apart)",
+                                         settings.spectral_bins));
+        if (settings.spectral_max_nm - settings.spectral_min_nm < settings.spectral_bins)
+            throw InputError("settings", "spectral_max_nm",
+                             fmt::format("the range [{}, {}] nm is narrower than one nm per "
+                                         "wavelength bin ({} bins); widen it or use fewer bins",
+                                         settings.spectral_min_nm, settings.spectral_max_nm,
+                                         settings.spectral_bins));
+        if (settings.stokes_tallies)
+            throw InputError("settings", "spectral",
+                             "Mueller tables are tabulated per RGB channel; give --spectral off");
+        if (settings.kernel == Kernel::Simd)
+            throw InputError("command line", "--kernel",
+                             fmt::format("a spectral run (stack '{}'{}) is traced by the scalar "
+                                         "kernel only; give --kernel scalar (or auto)",
+                                         stack.name,
+                                         stack.is_spectral() ? ", which has spectral values"
+                                                             : ", --spectral on"));
+    }
     if (settings.kernel != Kernel::Simd) return;
     if (stack.has_film())
         throw InputError("command line", "--kernel",
@@ -516,6 +741,10 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
     const Kernel kernel = kernel_for(settings, stack);
     if (kernel == Kernel::Simd) select_simd_target();
     const auto trace_block = kernel == Kernel::Simd ? trace_block_simd : trace_block_scalar;
+    const bool spectral = is_spectral_run(stack, settings);
+    const SpectralTracing tracing =
+        spectral ? spectral_tracing(stack, settings) : SpectralTracing{};
+    const int groups = settings.spectral_bins / 3;
 
     SimulationSums result;
     result.threads_used = threads;
@@ -540,25 +769,52 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
         for (int k = 0; k < 3; ++k)
             job.incident_stokes[k] = kIncidentStokes[settings.incident_polarization][k];
         job.stokes_tallies = settings.stokes_tallies;
+        if (spectral) job.spectral = &tracing;
         IncidenceSums total;
         total.bins.resize(2 * grid.size());
         if (settings.stokes_tallies) total.stokes.resize(2 * grid.size());
+        if (spectral) {
+            total.spectral_bins.resize(2 * grid.size() * std::size_t(groups));
+            total.xyz_bins.resize(2 * grid.size());
+            total.spectral_budget.resize(std::size_t(groups));
+        }
 
 #pragma omp parallel num_threads(threads) firstprivate(job)
         {
             Tally local(grid.size(), settings.stokes_tallies);
+            std::optional<SpectralTally> local_spectral;
+            if (spectral) {
+                local_spectral.emplace(grid.size(), groups);
+                job.spectral_tally = &*local_spectral;
+            }
 #pragma omp for schedule(dynamic, 1)
             for (std::uint64_t b = 0; b < blocks; ++b) {
                 const std::uint64_t lo = b * kBlock, hi = std::min(n, lo + kBlock);
                 BlockBudget block;
+                std::optional<SpectralBlock> spectral_block;
+                if (spectral) {
+                    spectral_block.emplace(groups);
+                    job.spectral_block = &*spectral_block;
+                }
                 job.first = settings.first_particle + lo;
                 job.count = hi - lo;
                 trace_block(job, local, block);
                 local.add_block(block);
                 local.count_particles(hi - lo);
+                if (spectral) {
+                    spectral_block->add_to(*local_spectral);
+                    local_spectral->lambda.count_particles(hi - lo);
+                    local_spectral->xyz.count_particles(hi - lo);
+                }
                 if (on_progress) on_progress(hi - lo);
             }
-            const IncidenceSums& mine = local.finish();
+            IncidenceSums& mine = local.finish();
+            if (spectral) {
+                mine.spectral_bins = local_spectral->lambda.finish().bins;
+                mine.spectral_budget = local_spectral->lambda.sums.spectral_budget;
+                mine.xyz_bins = local_spectral->xyz.finish().bins;
+                mine.xyz_budget = local_spectral->xyz.sums.budget;
+            }
 #pragma omp critical
             total.add(mine);  // integer sums: the order of merging does not matter
         }
@@ -570,6 +826,102 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
 }
+
+namespace {
+/// The mean and standard error of the per-particle contributions whose sum and sum of squares a
+/// tally entry holds (scales kSumScale, kSqScale), times `scale`.
+std::pair<double, double> tally_estimate(Fixed128 sum, Fixed128 sum_sq, std::uint64_t n,
+                                         double scale) {
+    const double mean = double(sum) / kSumScale / double(n);
+    const double mean_sq = double(sum_sq) / kSqScale / double(n);
+    const double var = std::max(0.0, mean_sq - mean * mean);
+    return {mean * scale, n > 1 ? std::sqrt(var / double(n - 1)) * scale : 0.0};
+}
+
+/// The budget terms and the standard errors of R and T of one channel of a budget's sums, times
+/// `scale`.
+std::array<double, kBudgetTerms + 2> budget_estimate(
+    const std::array<std::array<Fixed128, 3>, kBudgetTerms + 2>& sums, int c, std::uint64_t n,
+    double scale) {
+    std::array<double, kBudgetTerms + 2> out{};
+    const double inv_n = 1.0 / double(n), dn = n > 1 ? double(n - 1) : 1.0;
+    for (int t = 0; t < kBudgetTerms; ++t)
+        out[std::size_t(t)] = double(sums[std::size_t(t)][std::size_t(c)]) / kBudgetScale * inv_n;
+    for (int k = 0; k < 2; ++k) {
+        const double m = out[std::size_t(k == 0 ? BudgetTerm::Reflected : BudgetTerm::Transmitted)];
+        const double m2 =
+            double(sums[std::size_t(kBudgetTerms + k)][std::size_t(c)]) / kBudgetScale * inv_n;
+        out[std::size_t(kBudgetTerms + k)] = std::sqrt(std::max(0.0, m2 - m * m) / dn);
+    }
+    for (double& v : out)
+        v *= scale;
+    return out;
+}
+
+// The spectral tables of a spectral run (SpectralTables), and its sRGB table scaled back
+// (IncidenceSums' spectral fields).
+void finalize_spectral(const SimulationSettings& settings, const SimulationSums& sums,
+                       const HemisphereGrid& grid, bool transmits, SimulationResult& result) {
+    SpectralTables& sp = result.spectral;
+    const int bins = settings.spectral_bins, groups = bins / 3;
+    const std::uint64_t n = settings.particles;
+    for (int l = 0; l <= bins; ++l)
+        sp.bin_edges_nm.push_back(settings.spectral_min_nm +
+                                  (settings.spectral_max_nm - settings.spectral_min_nm) * l / bins);
+    sp.n_directions = grid.size();
+    sp.sides = transmits ? 2 : 1;
+    const std::size_t n_inc = settings.theta_i_deg.size();
+    sp.f.assign(n_inc * std::size_t(sp.sides) * grid.size() * std::size_t(bins), 0.0);
+    sp.se = sp.f;
+    sp.xyz = BinnedTable::zeros(grid, settings.theta_i_deg, true, transmits);
+    // A particle's channel c lies in wavelength bin c · groups + g with probability 1/groups.
+    const double lambda_scale = 4.0 * groups;
+    for (std::size_t inc = 0; inc < n_inc; ++inc) {
+        const IncidenceSums& total = sums.incidences[inc];
+        for (int side = 0; side < sp.sides; ++side) {
+            const Side s = side == 0 ? Side::Reflection : Side::Transmission;
+            BinnedLobe& srgb = result.table.lobe(inc, s);
+            BinnedLobe& xyz = sp.xyz.lobe(inc, s);
+            for (std::size_t j = 0; j < grid.size(); ++j) {
+                const double omega = grid.projected_solid_angle(j);
+                const std::size_t entry = std::size_t(side) * grid.size() + j;
+                for (int c = 0; c < 3; ++c) {
+                    srgb.f[j][c] *= kSpectralTallyScale;
+                    srgb.se[j][c] *= kSpectralTallyScale;
+                    const auto& a = total.xyz_bins[entry];
+                    const auto [m, e] = tally_estimate(a[c], a[3 + c], n, kSpectralTallyScale);
+                    xyz.f[j][c] = m / omega;
+                    xyz.se[j][c] = e / omega;
+                    for (int g = 0; g < groups; ++g) {
+                        const auto& b =
+                            total.spectral_bins[entry * std::size_t(groups) + std::size_t(g)];
+                        const auto [mb, eb] = tally_estimate(b[c], b[3 + c], n, lambda_scale);
+                        const std::size_t at = sp.index(inc, side, j, std::size_t(c * groups + g));
+                        sp.f[at] = mb / omega;
+                        sp.se[at] = eb / omega;
+                    }
+                }
+            }
+        }
+        EnergyBudget xyz_budget;
+        for (int c = 0; c < 3; ++c) {
+            for (int g = 0; g < groups; ++g)
+                sp.budget.emplace_back();  // filled below, in wavelength order
+            const auto e = budget_estimate(total.xyz_budget, c, n, 1.0);
+            for (int t = 0; t < kBudgetTerms; ++t)
+                xyz_budget.term[std::size_t(t)][std::size_t(c)] = e[std::size_t(t)];
+            xyz_budget.reflected_se[std::size_t(c)] = e[kBudgetTerms];
+            xyz_budget.transmitted_se[std::size_t(c)] = e[kBudgetTerms + 1];
+        }
+        sp.xyz_budget.push_back(xyz_budget);
+        const std::size_t first = inc * std::size_t(bins);
+        for (int c = 0; c < 3; ++c)
+            for (int g = 0; g < groups; ++g)
+                sp.budget[first + std::size_t(c * groups + g)] =
+                    budget_estimate(total.spectral_budget[std::size_t(g)], c, n, double(groups));
+    }
+}
+}  // namespace
 
 SimulationResult finalize_simulation(const Stack& stack, const SimulationSettings& settings,
                                      const SimulationSums& sums) {
@@ -622,6 +974,8 @@ SimulationResult finalize_simulation(const Stack& stack, const SimulationSetting
         result.incidences.push_back(stats);
     }
     if (settings.stokes_tallies) result.sums = sums.incidences;
+    if (is_spectral_run(stack, settings))
+        finalize_spectral(settings, sums, grid, transmits, result);
     return result;
 }
 
