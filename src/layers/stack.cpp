@@ -766,8 +766,8 @@ json parse_text(const std::string& text, const std::string& where) {
 /// What a spectral value is, for describe: the named material, or the spectrum's form.
 std::string spectrum_label(const Spectrum& spectrum) {
     const json given = json::parse(spectrum.given);
-    const auto& [key, body] = *given.items().begin();
-    return key == "material" ? body.get<std::string>() : std::string(key);
+    const auto first = given.begin();
+    return first.key() == "material" ? first.value().get<std::string>() : first.key();
 }
 
 /// "0.1" when the three channels agree, else "(0.1, 0, 0.9)".

@@ -498,11 +498,14 @@ void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& gri
 // own stream, and follows the stack compiled at its three wavelengths.
 void trace_block_spectral(const BlockJob& job, Tally& tally, BlockBudget& block) {
     const SpectralTracing& tr = *job.spectral;
-    const int third = tr.lattice / 3;
+    const int third = tr.lattice / 3, groups = tr.bins / 3;
     for (std::uint64_t p = job.first; p < job.first + job.count; ++p) {
         ParticleRng rng(job.seed, job.stream, p);
-        const int point = std::min(tr.lattice - 1, int(rng.uniform_float() * float(tr.lattice)));
-        const int hero = point / third, t = point % third;
+        const int group = int(p % std::uint64_t(groups));
+        constexpr int kPoints = 3 * kSpectralLattice;  // a group's lattice points, all channels
+        const int point = std::min(kPoints - 1, int(rng.uniform_float() * float(kPoints)));
+        const int hero = point / kSpectralLattice;
+        const int t = group * kSpectralLattice + point % kSpectralLattice;
         const std::size_t at = std::size_t(t) * 3 + std::size_t(hero);
         const CompiledStack<float>& stack = tr.stacks[at];
         SpectralParticle sp{tr,
@@ -514,9 +517,10 @@ void trace_block_spectral(const BlockJob& job, Tally& tally, BlockBudget& block)
                             true,
                             {},
                             {}};
+        const float factor = tr.group_factor[std::size_t(group)];
         for (int c = 0; c < 3; ++c) {
-            sp.xyz_weight[c] = tr.xyz_weight[std::size_t(t + c * third)];
-            sp.srgb_weight[c] = tr.srgb_weight[std::size_t(t + c * third)];
+            sp.xyz_weight[c] = tr.xyz_weight[std::size_t(t + c * third)] * factor;
+            sp.srgb_weight[c] = tr.srgb_weight[std::size_t(t + c * third)] * factor;
         }
         const bool pol = stack.polarization;
         if (stack.has_film) {
@@ -588,11 +592,17 @@ SpectralTracing spectral_tracing(const Stack& stack, const SimulationSettings& s
     for (int point = 0; point < tr.lattice; ++point) {
         const Rgbd xyz = d65_xyz_weights(lambda(point)) * (cell * third / norm_y);
         const Rgbd srgb = xyz_to_linear_srgb(xyz);
-        // The bound each tally contribution relies on (tally.h).
+        // The bound each tally contribution relies on (tally.h), with a group factor up to 1.5
+        // (particles >= 2 groups, validate_kernel_for).
         LAMINA_CHECK(std::max(std::abs(srgb.max()), std::abs(srgb.min())) <= 5 && xyz.max() <= 5);
         tr.xyz_weight.push_back(Rgbf(xyz));
         tr.srgb_weight.push_back(Rgbf(srgb));
     }
+    const int groups = tr.bins / 3;
+    for (int g = 0; g < groups; ++g)
+        tr.group_factor.push_back(
+            float(double(settings.particles) /
+                  (groups * double(spectral_group_particles(settings.particles, groups, g)))));
     return tr;
 }
 
@@ -702,6 +712,11 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings)
                                          "wavelength bin ({} bins); widen it or use fewer bins",
                                          settings.spectral_min_nm, settings.spectral_max_nm,
                                          settings.spectral_bins));
+        if (settings.particles < std::uint64_t(2 * (settings.spectral_bins / 3)))
+            throw InputError("settings", "particles",
+                             fmt::format("a spectral run needs at least 2 particles per "
+                                         "wavelength group: {} for {} bins",
+                                         2 * (settings.spectral_bins / 3), settings.spectral_bins));
         if (settings.stokes_tallies)
             throw InputError("settings", "spectral",
                              "Mueller tables are tabulated per RGB channel; give --spectral off");
@@ -874,8 +889,8 @@ void finalize_spectral(const SimulationSettings& settings, const SimulationSums&
     sp.f.assign(n_inc * std::size_t(sp.sides) * grid.size() * std::size_t(bins), 0.0);
     sp.se = sp.f;
     sp.xyz = BinnedTable::zeros(grid, settings.theta_i_deg, true, transmits);
-    // A particle's channel c lies in wavelength bin c · groups + g with probability 1/groups.
-    const double lambda_scale = 4.0 * groups;
+    // Wavelength bin c · groups + g: the mean over the n_g particles of group g of their channel
+    // c (tallied divided by 4).
     for (std::size_t inc = 0; inc < n_inc; ++inc) {
         const IncidenceSums& total = sums.incidences[inc];
         for (int side = 0; side < sp.sides; ++side) {
@@ -895,7 +910,8 @@ void finalize_spectral(const SimulationSettings& settings, const SimulationSums&
                     for (int g = 0; g < groups; ++g) {
                         const auto& b =
                             total.spectral_bins[entry * std::size_t(groups) + std::size_t(g)];
-                        const auto [mb, eb] = tally_estimate(b[c], b[3 + c], n, lambda_scale);
+                        const auto [mb, eb] = tally_estimate(
+                            b[c], b[3 + c], spectral_group_particles(n, groups, g), 4.0);
                         const std::size_t at = sp.index(inc, side, j, std::size_t(c * groups + g));
                         sp.f[at] = mb / omega;
                         sp.se[at] = eb / omega;
@@ -918,7 +934,8 @@ void finalize_spectral(const SimulationSettings& settings, const SimulationSums&
         for (int c = 0; c < 3; ++c)
             for (int g = 0; g < groups; ++g)
                 sp.budget[first + std::size_t(c * groups + g)] =
-                    budget_estimate(total.spectral_budget[std::size_t(g)], c, n, double(groups));
+                    budget_estimate(total.spectral_budget[std::size_t(g)], c,
+                                    spectral_group_particles(n, groups, g), 1.0);
     }
 }
 }  // namespace

@@ -161,13 +161,15 @@ struct Tally {
 // ---- Spectral runs (docs/physics.md §10) ----------------------------------------------------
 // A particle carries three wavelengths: the lattice points t + c · L/3 of the run's lattice of L
 // points (SimulationSettings::spectral_bins · kSpectralLattice), one per channel c, so that
-// channel c's wavelength lies in wavelength bin c · groups + t / kSpectralLattice (groups =
-// spectral_bins / 3). Its exits are tallied three ways: per wavelength bin (the channels' fluxes,
-// divided by 4, at entry (side · n_bins + bin) · groups + t / kSpectralLattice of a Tally over
-// n_bins · groups bins), and projected to CIE XYZ and linear sRGB (Σ_c flux_c · weight(λ_c),
-// divided by kSpectralTallyScale). A flux is at most 3 per channel, 9 for a hero that carries
-// its terminated secondaries (below), and every weight is at most 5 in magnitude (checked when the
-// run is set up), so each contribution stays within the bound of Tally::exit.
+// channel c's wavelength lies in wavelength bin c · groups + g, g = t / kSpectralLattice (groups =
+// spectral_bins / 3). Particle p's group g is p mod groups; its point within the group and its
+// hero channel are drawn from its own stream. Its exits are tallied three ways: per wavelength bin
+// (the channels' fluxes, divided by 4, at entry (side · n_bins + bin) · groups + t /
+// kSpectralLattice of a Tally over n_bins · groups bins), and projected to CIE XYZ and linear sRGB
+// (Σ_c flux_c · weight(λ_c), divided by kSpectralTallyScale). A flux is at most 3 per channel, 9
+// for a hero that carries its terminated secondaries (goniophotometer.cpp), and every weight is at
+// most 5 in magnitude (checked when the run is set up) times a group factor below 1.5, so each
+// contribution, divided by its scale, stays within the bounds of Tally::exit.
 
 /// The stacks and weights of a spectral run.
 struct SpectralTracing {
@@ -183,7 +185,17 @@ struct SpectralTracing {
     /// expectation of Σ_c flux_c · weight(λ_c) over the particles is the projection of the
     /// spectrum.
     std::vector<Rgbf> xyz_weight, srgb_weight;
+    /// Per wavelength group g: N / (groups · n_g), n_g the particles of the run in the group
+    /// (spectral_group_particles), which makes the colour projections' plain mean over all N
+    /// particles the mean of the groups' means.
+    std::vector<float> group_factor;
 };
+
+/// Particle p's wavelength group is p mod groups (the groups are stratified over the particles);
+/// the particles of [0, n) in group g.
+inline std::uint64_t spectral_group_particles(std::uint64_t n, int groups, int g) {
+    return n / std::uint64_t(groups) + (std::uint64_t(g) < n % std::uint64_t(groups) ? 1 : 0);
+}
 
 /// One thread's spectral tallies of one incidence (the sRGB ones are its main Tally).
 struct SpectralTally {
