@@ -517,7 +517,7 @@ class Reader {
             if (eta.is_array())
                 fail(child(pointer, "eta"),
                      fmt::format("a dielectric's eta must be a single number or a spectral value "
-                                 "(an object), got {}: {}; one refraction path serves all RGB "
+                                 "(an object), got {}: {}; one refraction path serves all "
                                  "channels, so RGB indices are not supported (a dispersive index "
                                  "is a spectrum, e.g. {{\"material\": \"BK7\"}})",
                                  type_phrase(eta), show(eta)));
