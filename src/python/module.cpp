@@ -142,10 +142,7 @@ SimulationResult simulate_interruptible(const Stack& stack, const SimulationSett
     // costs a set-up (tallies allocated and merged), so chunks double while they take under
     // 0.2 s: Ctrl-C is then seen within about half a second.
     std::uint64_t chunk = kParticlesPerBlock * 16 * std::uint64_t(threads);
-    SimulationSums total;
-    total.incidences.resize(s.theta_i_deg.size());
-    for (IncidenceSums& inc : total.incidences)
-        inc.bins.resize(2 * s.grid.size());
+    SimulationSums total;  // the first chunk's sums, then each chunk's added
     total.incidence_seconds.assign(s.theta_i_deg.size(), 0.0);
     std::unique_ptr<Progress> progress;
     if (show_progress)
@@ -164,8 +161,9 @@ SimulationResult simulate_interruptible(const Stack& stack, const SimulationSett
                 if (progress) progress->advance(n);
             });
         }
+        if (first == 0) total.incidences = sums.incidences;
         for (std::size_t i = 0; i < total.incidences.size(); ++i) {
-            total.incidences[i].add(sums.incidences[i]);
+            if (first > 0) total.incidences[i].add(sums.incidences[i]);
             total.incidence_seconds[i] += sums.incidence_seconds[i];
         }
         total.threads_used = sums.threads_used;

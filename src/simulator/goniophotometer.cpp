@@ -144,11 +144,6 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings)
                                          "wavelength bin ({} bins); widen it or use fewer bins",
                                          settings.spectral_min_nm, settings.spectral_max_nm,
                                          settings.spectral_bins));
-        if (settings.particles < std::uint64_t(2 * (settings.spectral_bins / 3)))
-            throw InputError("settings", "particles",
-                             fmt::format("a spectral run needs at least 2 particles per "
-                                         "wavelength group: {} for {} bins",
-                                         2 * (settings.spectral_bins / 3), settings.spectral_bins));
         if (settings.stokes_tallies)
             throw InputError("settings", "spectral",
                              "Mueller tables are tabulated per RGB channel; give --spectral off");

@@ -28,10 +28,9 @@ void trace_block_spectral(const BlockJob& job, Tally& tally, BlockBudget& block)
                             true,
                             {},
                             {}};
-        const float factor = tr.group_factor[std::size_t(group)];
         for (int c = 0; c < 3; ++c) {
-            sp.xyz_weight[c] = tr.xyz_weight[std::size_t(t + c * third)] * factor;
-            sp.srgb_weight[c] = tr.srgb_weight[std::size_t(t + c * third)] * factor;
+            sp.xyz_weight[c] = tr.xyz_weight[std::size_t(t + c * third)];
+            sp.srgb_weight[c] = tr.srgb_weight[std::size_t(t + c * third)];
         }
         const bool pol = stack.polarization;
         if (stack.has_film) {
@@ -94,17 +93,11 @@ SpectralTracing spectral_tracing(const Stack& stack, const SimulationSettings& s
     for (int point = 0; point < tr.lattice; ++point) {
         const Rgbd xyz = d65_xyz_weights(lambda(point)) * (cell * third / norm_y);
         const Rgbd srgb = xyz_to_linear_srgb(xyz);
-        // The bound each tally contribution relies on (tally.h), with a group factor up to 1.5
-        // (particles >= 2 groups, validate_kernel_for).
+        // The bound each tally contribution relies on (tally.h).
         LAMINA_CHECK(std::max(std::abs(srgb.max()), std::abs(srgb.min())) <= 5 && xyz.max() <= 5);
         tr.xyz_weight.push_back(Rgbf(xyz));
         tr.srgb_weight.push_back(Rgbf(srgb));
     }
-    const int groups = tr.bins / 3;
-    for (int g = 0; g < groups; ++g)
-        tr.group_factor.push_back(
-            float(double(settings.particles) /
-                  (groups * double(spectral_group_particles(settings.particles, groups, g)))));
     return tr;
 }
 
@@ -113,6 +106,7 @@ namespace {
 /// tally entry holds (scales kSumScale, kSqScale), times `scale`.
 std::pair<double, double> tally_estimate(Fixed128 sum, Fixed128 sum_sq, std::uint64_t n,
                                          double scale) {
+    if (n == 0) return {0.0, 0.0};  // a wavelength group no particle of a tiny run reached
     const double mean = double(sum) / kSumScale / double(n);
     const double mean_sq = double(sum_sq) / kSqScale / double(n);
     const double var = std::max(0.0, mean_sq - mean * mean);
@@ -125,6 +119,7 @@ std::array<double, kBudgetTerms + 2> budget_estimate(
     const std::array<std::array<Fixed128, 3>, kBudgetTerms + 2>& sums, int c, std::uint64_t n,
     double scale) {
     std::array<double, kBudgetTerms + 2> out{};
+    if (n == 0) return out;
     const double inv_n = 1.0 / double(n), dn = n > 1 ? double(n - 1) : 1.0;
     for (int t = 0; t < kBudgetTerms; ++t)
         out[std::size_t(t)] = double(sums[std::size_t(t)][std::size_t(c)]) / kBudgetScale * inv_n;

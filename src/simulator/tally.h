@@ -185,10 +185,6 @@ struct SpectralTracing {
     /// expectation of Σ_c flux_c · weight(λ_c) over the particles is the projection of the
     /// spectrum.
     std::vector<Rgbf> xyz_weight, srgb_weight;
-    /// Per wavelength group g: N / (groups · n_g), n_g the particles of the run in the group
-    /// (spectral_group_particles), which makes the colour projections' plain mean over all N
-    /// particles the mean of the groups' means.
-    std::vector<float> group_factor;
 };
 
 /// Particle p's wavelength group is p mod groups (the groups are stratified over the particles);
