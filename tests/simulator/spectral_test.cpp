@@ -204,6 +204,27 @@ TEST(Spectral, BitwiseIdenticalAcrossThreadCounts) {
         }
 }
 
+// A run split into particle ranges (processes, Python's chunks) adds up to one run, bit for bit:
+// a particle's wavelength group is its global index mod B/3.
+TEST(Spectral, SplitRangesAddUpToOneRun) {
+    const Stack stack = bk7_slab(0.2, 0.0);
+    SimulationSettings s =
+        spectral_settings({30}, 3 * kParticlesPerBlock + 77, HemisphereGrid(6, 6));
+    const SimulationSums whole = simulate_sums(stack, s);
+    SimulationSettings part = s;
+    part.particles = kParticlesPerBlock;
+    SimulationSums sums = simulate_sums(stack, part);
+    part.first_particle = kParticlesPerBlock;
+    part.particles = s.particles - kParticlesPerBlock;
+    sums.incidences[0].add(simulate_sums(stack, part).incidences[0]);
+    const auto a = finalize_simulation(stack, s, whole), b = finalize_simulation(stack, s, sums);
+    EXPECT_EQ(a.spectral.f, b.spectral.f);
+    EXPECT_EQ(a.spectral.se, b.spectral.se);
+    EXPECT_EQ(a.spectral.budget, b.spectral.budget);
+    EXPECT_EQ(a.spectral.xyz.lobe(0, Side::Transmission).f,
+              b.spectral.xyz.lobe(0, Side::Transmission).f);
+}
+
 // A spectral run is the scalar kernel's: auto picks it, simd is refused by name; the bins must be
 // a multiple of 3.
 TEST(Spectral, KernelAndBinsChecked) {
