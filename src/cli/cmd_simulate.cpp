@@ -137,9 +137,17 @@ Runner add_simulate(CLI::App& app) {
             result.processes > 1
                 ? fmt::format("{} processes × {} threads", result.processes, result.threads_used)
                 : fmt::format("{} threads", result.threads_used);
-        fmt::print("{:.3g} particles/s on {}; wrote {}/{{result.json,brdf.csv,energy.csv{}}}\n",
-                   double(s.particles * s.theta_i_deg.size()) / result.seconds, workers, a->out,
-                   a->mueller ? ",mueller.npy,mueller_se.npy" : "");
+        const bool spectral = !result.spectral.bin_edges_nm.empty();
+        if (spectral)
+            fmt::print(
+                "spectral: {} wavelength bins over {}-{} nm; R, T above are linear sRGB "
+                "(D65)\n",
+                s.spectral_bins, s.spectral_min_nm, s.spectral_max_nm);
+        fmt::print(
+            "{:.3g} particles/s on {}; wrote {}/{{result.json,brdf.csv,energy.csv{}{}}}\n",
+            double(s.particles * s.theta_i_deg.size()) / result.seconds, workers, a->out,
+            a->mueller ? ",mueller.npy,mueller_se.npy" : "",
+            spectral ? ",spectral.npy,spectral_se.npy,xyz.npy,xyz_se.npy,spectral_energy.csv" : "");
         return 0;
     };
 }

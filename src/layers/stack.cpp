@@ -183,7 +183,10 @@ constexpr std::string_view kStackKeys[] = {"name", "ambient_eta", "wavelengths_n
 constexpr std::string_view kLayerKeys[] = {"interface", "medium"};
 constexpr std::string_view kInterfaceTypes[] = {"dielectric", "conductor", "lambertian"};
 constexpr std::string_view kDielectricKeys[] = {"type", "eta", "alpha", "tangent_deg", "film"};
-constexpr std::string_view kConductorKeys[] = {"type", "eta", "k", "alpha", "tangent_deg", "film"};
+constexpr std::string_view kConductorKeys[] = {"type",  "eta",         "k",   "material",
+                                               "alpha", "tangent_deg", "film"};
+constexpr std::string_view kSpectrumForms[] = {"spectrum", "sellmeier", "cauchy", "abbe",
+                                               "material"};
 constexpr std::string_view kFilmKeys[] = {"thickness_nm", "eta", "k"};
 constexpr std::string_view kLambertianKeys[] = {"type", "albedo"};
 constexpr std::string_view kMediumKeys[] = {"tau_a", "tau_s", "g"};
@@ -238,6 +241,10 @@ constexpr Allowed kFilmEta{[](double v) { return v >= kEtaConductorMin && v <= k
                            "[0.01, 5]"};
 constexpr Allowed kWavelength{[](double v) { return v >= kWavelengthMin && v <= kWavelengthMax; },
                               "[360, 830]"};
+constexpr Allowed kSampleWavelength{[](double v) { return v >= 100 && v <= 10000; },
+                                    "[100, 10000]"};
+constexpr Allowed kAbbe{[](double v) { return v >= 10 && v <= 120; }, "[10, 120]"};
+constexpr std::size_t kMaxSpectrumSamples = 10000;
 constexpr Allowed kHgG{[](double v) { return v >= -kGMax && v <= kGMax; }, "[-0.99, 0.99]"};
 
 class Reader {
@@ -294,7 +301,9 @@ class Reader {
                                         layers.size(), kMaxLayers));
         for (std::size_t i = 0; i < layers.size(); ++i)
             s.layers.push_back(layer(layers[i], child("/layers", i), i, layers.size()));
-        return s;
+        // The RGB values of the spectra: at the channels' wavelengths, a dielectric's eta at the
+        // green channel's.
+        return s.is_spectral() ? s.at_wavelengths(s.wavelengths_nm, 1) : s;
     }
 
   private:
@@ -355,6 +364,105 @@ class Reader {
         return out;
     }
 
+    /// A spectral value (docs/stack-format.md, "Spectra"): an object with one key, "spectrum"
+    /// ([[λ, value], …]), "sellmeier" ([B1, C1, …]), "cauchy" ([A, B, …]), "abbe" ([n_d, V_d]) or
+    /// "material" (a glass); the last three only where `index` is true (a dielectric's eta). Its
+    /// value at every whole nm of 360–830 must lie in `allowed`.
+    Spectrum spectrum(const json& v, const std::string& pointer, Allowed allowed,
+                      std::string_view meaning, bool index) const {
+        const std::span<const std::string_view> forms(kSpectrumForms, index ? 5 : 1);
+        if (v.size() != 1)
+            fail(pointer, fmt::format("a spectral value is an object with one key, one of {}; "
+                                      "got {}",
+                                      quoted_list(forms), show(v)));
+        const std::string key = v.begin().key();
+        const std::string kp = child(pointer, key);
+        if (std::find(forms.begin(), forms.end(), key) == forms.end())
+            fail(kp, fmt::format("unknown spectral form \"{}\";{} allowed: {}", key,
+                                 suggestion(key, forms), quoted_list(forms)));
+        const json& body = v.begin().value();
+        auto numbers = [&](std::size_t min_count, std::size_t max_count, std::string_view what) {
+            if (!body.is_array() || body.size() < min_count || body.size() > max_count)
+                fail(kp,
+                     fmt::format("expected {}, got {}: {}", what, type_phrase(body), show(body)));
+            std::vector<double> out;
+            for (std::size_t i = 0; i < body.size(); ++i) {
+                if (!body[i].is_number() || !std::isfinite(body[i].get<double>()))
+                    fail(child(kp, i),
+                         fmt::format("expected a finite number, got {}", show(body[i])));
+                out.push_back(body[i].get<double>() + 0.0);
+            }
+            return out;
+        };
+        Spectrum out;
+        if (key == "spectrum") {
+            if (!body.is_array() || body.size() < 2 || body.size() > kMaxSpectrumSamples)
+                fail(kp, fmt::format("expected an array of 2 to {} samples [wavelength_nm, value], "
+                                     "got {}: {}",
+                                     kMaxSpectrumSamples, type_phrase(body), show(body)));
+            std::vector<double> wl, values;
+            for (std::size_t i = 0; i < body.size(); ++i) {
+                const json& sample = body[i];
+                const std::string sp = child(kp, i);
+                if (!sample.is_array() || sample.size() != 2)
+                    fail(sp, fmt::format("expected a sample [wavelength_nm, value], got {}: {}",
+                                         type_phrase(sample), show(sample)));
+                wl.push_back(
+                    number(sample[0], child(sp, 0), kSampleWavelength, "vacuum wavelength in nm"));
+                if (i > 0 && wl[i] <= wl[i - 1])
+                    fail(child(sp, 0), fmt::format("got {} after {}; allowed: wavelengths in "
+                                                   "increasing order",
+                                                   wl[i], wl[i - 1]));
+                values.push_back(number(sample[1], child(sp, 1), allowed, meaning));
+            }
+            out = table_spectrum(std::move(wl), std::move(values));
+        } else if (key == "sellmeier") {
+            std::vector<double> b_c = numbers(2, 8, "[B1, C1, B2, C2, …], 1 to 4 pairs (C in µm²)");
+            if (b_c.size() % 2 != 0)
+                fail(kp,
+                     fmt::format("expected pairs [B1, C1, B2, C2, …], got {} numbers", b_c.size()));
+            out = sellmeier_spectrum(std::move(b_c));
+        } else if (key == "cauchy") {
+            out = cauchy_spectrum(
+                numbers(1, 4, "[A, B, C, D] (B in µm², C in µm⁴, …), 1 to 4 terms"));
+        } else if (key == "abbe") {
+            const std::vector<double> nv = numbers(2, 2, "[n_d, V_d]");
+            number(body[0], child(kp, 0), kDielectricEta, "refractive index at 587.56 nm");
+            number(body[1], child(kp, 1), kAbbe, "Abbe number");
+            out = abbe_spectrum(nv[0], nv[1]);
+        } else {  // a named glass
+            if (!body.is_string() || !is_glass_material(body.get<std::string>()))
+                fail(kp, fmt::format("got {}; allowed: one of {} (data/glass)", show(body),
+                                     glass_material_names()));
+            out = glass_material_eta(body.get<std::string>());
+        }
+        check_spectrum(out, kp, allowed, meaning);
+        out.given = v.dump();
+        return out;
+    }
+
+    /// The spectrum at every whole nm of 360–830 lies in `allowed`.
+    void check_spectrum(const Spectrum& s, const std::string& pointer, Allowed allowed,
+                        std::string_view meaning) const {
+        for (double l = kSpectrumMinNm; l <= kSpectrumMaxNm; l += 1) {
+            const double value = s.at(l);
+            if (!std::isfinite(value) || !allowed.ok(value))
+                fail(pointer, fmt::format("the spectrum is {} at {} nm; allowed: {} ({}) over "
+                                          "360-830 nm",
+                                          value, l, allowed.text, meaning));
+        }
+    }
+
+    /// A number, [R, G, B], or a spectral value (an object: `spectrum`).
+    Rgbd rgb_or_spectrum(const json& v, const std::string& pointer, Allowed allowed,
+                         std::string_view meaning, std::optional<Spectrum>& spectral) const {
+        if (v.is_object()) {
+            spectral = spectrum(v, pointer, allowed, meaning, false);
+            return Rgbd(0.0);  // set from the spectrum (Stack::at_wavelengths)
+        }
+        return rgb(v, pointer, allowed, meaning);
+    }
+
     Layer layer(const json& j, const std::string& pointer, std::size_t index, std::size_t count) {
         expect_object(j, pointer,
                       fmt::format("a layer (an object with keys {})", quoted_list(kLayerKeys)));
@@ -408,34 +516,59 @@ class Reader {
                                        "absolute refractive index of what lies below, in [1, 5]");
             if (eta.is_array())
                 fail(child(pointer, "eta"),
-                     fmt::format("a dielectric's eta must be a single number, got {}: {}; one "
-                                 "refraction path serves all channels, so RGB (dispersive) "
-                                 "indices are not supported",
+                     fmt::format("a dielectric's eta must be a single number or a spectral value "
+                                 "(an object), got {}: {}; one refraction path serves all "
+                                 "channels, so RGB indices are not supported (a dispersive index "
+                                 "is a spectrum, e.g. {{\"material\": \"BK7\"}})",
                                  type_phrase(eta), show(eta)));
-            out.eta = number(eta, child(pointer, "eta"), kDielectricEta,
-                             "absolute refractive index of what lies below");
+            if (eta.is_object())
+                out.eta_spectrum = spectrum(eta, child(pointer, "eta"), kDielectricEta,
+                                            "absolute refractive index of what lies below", true);
+            else
+                out.eta = number(eta, child(pointer, "eta"), kDielectricEta,
+                                 "absolute refractive index of what lies below");
             roughness(j, pointer, "dielectric", out);
             film(j, pointer, out);
         } else if (name == "conductor") {
             out.type = InterfaceType::Conductor;
             check_keys(j, pointer, kConductorKeys, "a conductor interface");
-            out.eta_rgb = rgb(required(j, pointer, "eta",
-                                       "real part of the absolute complex "
-                                       "index, in [0.01, 10], number or [R, G, B]"),
-                              child(pointer, "eta"), kConductorEta,
-                              "real part of the absolute complex index");
-            out.k = rgb(required(j, pointer, "k",
-                                 "extinction coefficient, in [0, 10], number or "
-                                 "[R, G, B]"),
-                        child(pointer, "k"), kConductorK,
-                        "extinction coefficient, imaginary part of the absolute index");
+            if (j.contains("material")) {
+                const json& m = j["material"];
+                const std::string mp = child(pointer, "material");
+                if (!m.is_string() || !is_conductor_material(m.get<std::string>()))
+                    fail(mp, fmt::format("got {}; allowed: one of {} (measured n, k: data/nk)",
+                                         show(m), conductor_material_names()));
+                for (const char* key : {"eta", "k"})
+                    if (j.contains(key))
+                        fail(child(pointer, key),
+                             fmt::format("a conductor gives either \"material\" or \"eta\" and "
+                                         "\"k\", not both (\"{}\" sets them)",
+                                         m.get<std::string>()));
+                out.material = m.get<std::string>();
+                out.eta_spectrum = conductor_material_eta(out.material);
+                out.k_spectrum = conductor_material_k(out.material);
+            } else {
+                out.eta_rgb = rgb_or_spectrum(
+                    required(j, pointer, "eta",
+                             "real part of the absolute complex index, in [0.01, 10], number, "
+                             "[R, G, B] or a spectrum; or give a \"material\""),
+                    child(pointer, "eta"), kConductorEta, "real part of the absolute complex index",
+                    out.eta_spectrum);
+                out.k = rgb_or_spectrum(
+                    required(j, pointer, "k",
+                             "extinction coefficient, in [0, 10], number, [R, G, B] or a "
+                             "spectrum"),
+                    child(pointer, "k"), kConductorK,
+                    "extinction coefficient, imaginary part of the absolute index", out.k_spectrum);
+            }
             roughness(j, pointer, "conductor", out);
             film(j, pointer, out);
         } else if (name == "lambertian") {
             out.type = InterfaceType::Lambertian;
             check_keys(j, pointer, kLambertianKeys, "a lambertian interface");
-            out.albedo = rgb(required(j, pointer, "albedo", "in [0, 1], number or [R, G, B]"),
-                             child(pointer, "albedo"), kUnit, "Lambertian albedo");
+            out.albedo = rgb_or_spectrum(
+                required(j, pointer, "albedo", "in [0, 1], number, [R, G, B] or a spectrum"),
+                child(pointer, "albedo"), kUnit, "Lambertian albedo", out.albedo_spectrum);
         } else {
             fail(tp, fmt::format("unknown interface type \"{}\";{} allowed: {}", name,
                                  suggestion(name, kInterfaceTypes), quoted_list(kInterfaceTypes)));
@@ -510,11 +643,13 @@ class Reader {
         check_keys(j, pointer, kMediumKeys, "a medium");
         MediumSpec out;
         if (j.contains("tau_a"))
-            out.tau_a = rgb(j["tau_a"], child(pointer, "tau_a"), kOpticalDepth,
-                            "absorption normal optical depth, dimensionless");
+            out.tau_a = rgb_or_spectrum(j["tau_a"], child(pointer, "tau_a"), kOpticalDepth,
+                                        "absorption normal optical depth, dimensionless",
+                                        out.tau_a_spectrum);
         if (j.contains("tau_s"))
-            out.tau_s = rgb(j["tau_s"], child(pointer, "tau_s"), kScatteringDepth,
-                            "scattering normal optical depth, dimensionless");
+            out.tau_s = rgb_or_spectrum(j["tau_s"], child(pointer, "tau_s"), kScatteringDepth,
+                                        "scattering normal optical depth, dimensionless",
+                                        out.tau_s_spectrum);
         if (j.contains("g"))
             out.g = rgb(j["g"], child(pointer, "g"), kHgG, "Henyey-Greenstein mean cosine");
         return out;
@@ -628,6 +763,13 @@ json parse_text(const std::string& text, const std::string& where) {
 
 // ---- Describing -----------------------------------------------------------------------------
 
+/// What a spectral value is, for describe: the named material, or the spectrum's form.
+std::string spectrum_label(const Spectrum& spectrum) {
+    const json given = json::parse(spectrum.given);
+    const auto first = given.begin();
+    return first.key() == "material" ? first.value().get<std::string>() : first.key();
+}
+
 /// "0.1" when the three channels agree, else "(0.1, 0, 0.9)".
 std::string show_rgb(const Rgbd& v) {
     if (v[0] == v[1] && v[1] == v[2]) return fmt::format("{}", v[0]);
@@ -681,24 +823,35 @@ Stack parse_stack(const std::string& text, const std::string& where) {
 }
 
 nlohmann::json stack_to_json(const Stack& stack) {
+    // A value given as a spectrum is written as it was given (its RGB values follow from it).
+    auto value = [](const std::optional<Spectrum>& spectrum, const json& plain) {
+        return spectrum ? json::parse(spectrum->given) : plain;
+    };
     json layers = json::array();
     for (const Layer& layer : stack.layers) {
         const InterfaceSpec& i = layer.interface;
         json interface;
         switch (i.type) {
             case InterfaceType::Dielectric:
-                interface = {{"type", "dielectric"}, {"eta", i.eta}, {"alpha", alpha_json(i)}};
-                if (i.tangent_deg != 0) interface["tangent_deg"] = i.tangent_deg;
-                break;
-            case InterfaceType::Conductor:
-                interface = {{"type", "conductor"},
-                             {"eta", rgb_json(i.eta_rgb)},
-                             {"k", rgb_json(i.k)},
+                interface = {{"type", "dielectric"},
+                             {"eta", value(i.eta_spectrum, i.eta)},
                              {"alpha", alpha_json(i)}};
                 if (i.tangent_deg != 0) interface["tangent_deg"] = i.tangent_deg;
                 break;
+            case InterfaceType::Conductor:
+                interface = {{"type", "conductor"}};
+                if (!i.material.empty()) {
+                    interface["material"] = i.material;
+                } else {
+                    interface["eta"] = value(i.eta_spectrum, rgb_json(i.eta_rgb));
+                    interface["k"] = value(i.k_spectrum, rgb_json(i.k));
+                }
+                interface["alpha"] = alpha_json(i);
+                if (i.tangent_deg != 0) interface["tangent_deg"] = i.tangent_deg;
+                break;
             case InterfaceType::Lambertian:
-                interface = {{"type", "lambertian"}, {"albedo", rgb_json(i.albedo)}};
+                interface = {{"type", "lambertian"},
+                             {"albedo", value(i.albedo_spectrum, rgb_json(i.albedo))}};
                 break;
         }
         if (i.has_film)
@@ -710,16 +863,42 @@ nlohmann::json stack_to_json(const Stack& stack) {
                 {"k", i.film.k}};
         json l = {{"interface", interface}};
         if (layer.has_medium)
-            l["medium"] = {{"tau_a", rgb_json(layer.medium.tau_a)},
-                           {"tau_s", rgb_json(layer.medium.tau_s)},
-                           {"g", rgb_json(layer.medium.g)}};
+            l["medium"] = {
+                {"tau_a", value(layer.medium.tau_a_spectrum, rgb_json(layer.medium.tau_a))},
+                {"tau_s", value(layer.medium.tau_s_spectrum, rgb_json(layer.medium.tau_s))},
+                {"g", rgb_json(layer.medium.g)}};
         layers.push_back(std::move(l));
     }
     json out = {{"name", stack.name}, {"ambient_eta", stack.ambient_eta}, {"layers", layers}};
-    // Written where it matters or was changed: the canonical form of a stack without a film is
-    // what it has always been.
-    if (stack.has_film() || !(stack.wavelengths_nm == kDefaultChannelWavelengthsNm))
+    // Written where it matters or was changed: the canonical form of a stack without a film or a
+    // spectrum is what it has always been.
+    if (stack.has_film() || stack.is_spectral() ||
+        !(stack.wavelengths_nm == kDefaultChannelWavelengthsNm))
         out["wavelengths_nm"] = rgb_json(stack.wavelengths_nm);
+    return out;
+}
+
+Stack Stack::at_wavelengths(const Rgbd& wavelengths, int path_channel) const {
+    Stack out = *this;
+    out.wavelengths_nm = wavelengths;
+    auto at = [&](const std::optional<Spectrum>& spectrum, Rgbd& rgb) {
+        if (!spectrum) return;
+        for (std::size_t c = 0; c < 3; ++c)
+            rgb[c] = spectrum->at(wavelengths[c]);
+    };
+    for (Layer& layer : out.layers) {
+        InterfaceSpec& i = layer.interface;
+        if (i.eta_spectrum) {
+            if (i.type == InterfaceType::Dielectric)
+                i.eta = i.eta_spectrum->at(wavelengths[std::size_t(path_channel)]);
+            else
+                at(i.eta_spectrum, i.eta_rgb);
+        }
+        at(i.k_spectrum, i.k);
+        at(i.albedo_spectrum, i.albedo);
+        at(layer.medium.tau_a_spectrum, layer.medium.tau_a);
+        at(layer.medium.tau_s_spectrum, layer.medium.tau_s);
+    }
     return out;
 }
 
@@ -745,24 +924,41 @@ std::string describe(const Stack& stack) {
         const InterfaceSpec& i = layer.interface;
         switch (i.type) {
             case InterfaceType::Dielectric:
-                out +=
-                    fmt::format(" | dielectric η={} {}", i.eta, show_alpha(i)) + describe_film(i);
+                out += fmt::format(" | dielectric η={} {}",
+                                   i.eta_spectrum ? spectrum_label(*i.eta_spectrum)
+                                                  : fmt::format("{}", i.eta),
+                                   show_alpha(i)) +
+                       describe_film(i);
                 if (n + 1 == stack.layers.size())
                     out += fmt::format(" (slab: transmits into η={})", i.eta);
                 break;
             case InterfaceType::Conductor:
-                out += fmt::format(" | conductor η={} k={} {}", show_rgb(i.eta_rgb), show_rgb(i.k),
-                                   show_alpha(i)) +
-                       describe_film(i);
+                if (!i.material.empty())
+                    out += fmt::format(" | conductor {} {}", i.material, show_alpha(i));
+                else
+                    out += fmt::format(
+                        " | conductor η={} k={} {}",
+                        i.eta_spectrum ? spectrum_label(*i.eta_spectrum) : show_rgb(i.eta_rgb),
+                        i.k_spectrum ? spectrum_label(*i.k_spectrum) : show_rgb(i.k),
+                        show_alpha(i));
+                out += describe_film(i);
                 break;
             case InterfaceType::Lambertian:
-                out += fmt::format(" | lambertian ρ={}", show_rgb(i.albedo));
+                out += fmt::format(" | lambertian ρ={}", i.albedo_spectrum
+                                                             ? spectrum_label(*i.albedo_spectrum)
+                                                             : show_rgb(i.albedo));
                 break;
         }
         if (layer.has_medium) {
             const MediumSpec& m = layer.medium;
-            out += fmt::format(" | medium τa={}", show_rgb(m.tau_a));
-            if (m.scatters()) out += fmt::format(" τs={} g={}", show_rgb(m.tau_s), show_rgb(m.g));
+            out +=
+                fmt::format(" | medium τa={}", m.tau_a_spectrum ? spectrum_label(*m.tau_a_spectrum)
+                                                                : show_rgb(m.tau_a));
+            if (m.scatters())
+                out += fmt::format(
+                    " τs={} g={}",
+                    m.tau_s_spectrum ? spectrum_label(*m.tau_s_spectrum) : show_rgb(m.tau_s),
+                    show_rgb(m.g));
         }
     }
     return out;
@@ -780,6 +976,9 @@ Stack flipped_stack(const Stack& stack) {
         Layer layer;
         layer.interface = stack.layers[k].interface;
         layer.interface.eta = stack.eta_above(k);
+        // A dielectric's spectral index moves with its region as the number does.
+        layer.interface.eta_spectrum =
+            k >= 1 ? stack.layers[k - 1].interface.eta_spectrum : std::nullopt;
         if (k >= 1) {  // the old region above interface k is the medium of layer k − 1
             layer.has_medium = stack.layers[k - 1].has_medium;
             layer.medium = stack.layers[k - 1].medium;

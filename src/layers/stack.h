@@ -9,10 +9,12 @@
 // opaque. Opaque interfaces may only be last; the last layer has no medium.
 
 #include "core/rgb.h"
+#include "layers/spectrum.h"
 
 #include <nlohmann/json_fwd.hpp>
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,6 +62,16 @@ struct InterfaceSpec {
     double alpha_b() const { return alpha_y < 0 ? alpha : alpha_y; }
     /// A rough dielectric or conductor with α_y ≠ α_x.
     bool is_anisotropic() const { return type != InterfaceType::Lambertian && alpha_b() != alpha; }
+    /// Spectral values, where the stack file gives them (docs/stack-format.md, "Spectra"): a
+    /// dielectric's eta, a conductor's eta and k, a Lambertian albedo. The RGB fields above then
+    /// hold them at the stack's channel wavelengths (a dielectric's eta at the green channel's),
+    /// which the RGB estimators read (Stack::at_wavelengths).
+    std::optional<Spectrum> eta_spectrum, k_spectrum, albedo_spectrum;
+    /// A conductor's named measured metal (data/nk), which sets eta_spectrum and k_spectrum.
+    std::string material;
+    bool is_spectral() const {
+        return eta_spectrum.has_value() || k_spectrum.has_value() || albedo_spectrum.has_value();
+    }
     bool operator==(const InterfaceSpec&) const = default;
 };
 
@@ -68,10 +80,13 @@ struct MediumSpec {
     Rgbd tau_a{0.0};  ///< absorption optical depth ≥ 0
     Rgbd tau_s{0.0};  ///< scattering optical depth ≥ 0
     Rgbd g{0.0};      ///< Henyey–Greenstein mean cosine, |g| < 1
+    /// Spectral optical depths, where the stack file gives them (as InterfaceSpec's spectra).
+    std::optional<Spectrum> tau_a_spectrum, tau_s_spectrum;
 
     Rgbd tau_t() const { return tau_a + tau_s; }
     bool scatters() const { return tau_s.max() > 0; }
     bool is_empty() const { return tau_a.max() == 0 && tau_s.max() == 0; }
+    bool is_spectral() const { return tau_a_spectrum.has_value() || tau_s_spectrum.has_value(); }
     bool operator==(const MediumSpec&) const = default;
 };
 
@@ -112,6 +127,18 @@ struct Stack {
             if (l.interface.has_film) return true;
         return false;
     }
+    /// Some value is a spectrum (InterfaceSpec::is_spectral, MediumSpec::is_spectral): the
+    /// goniophotometer traces it spectrally by default (docs/physics.md §10).
+    bool is_spectral() const {
+        for (const Layer& l : layers)
+            if (l.interface.is_spectral() || (l.has_medium && l.medium.is_spectral())) return true;
+        return false;
+    }
+    /// The stack at the vacuum wavelengths `wavelengths_nm` of its three channels: every RGB value
+    /// given as a spectrum is that spectrum at the channel's wavelength, and a dielectric's eta
+    /// (one refraction path serves all channels) the spectrum at channel `path_channel`'s.
+    /// Values given as numbers are unchanged.
+    Stack at_wavelengths(const Rgbd& wavelengths_nm, int path_channel) const;
     bool operator==(const Stack&) const = default;
 };
 
@@ -155,7 +182,10 @@ inline Layer layer_of(const InterfaceSpec& interface) {
 inline Layer with_medium(Layer layer, const Rgbd& tau_a, const Rgbd& tau_s = Rgbd(0.0),
                          const Rgbd& g = Rgbd(0.0)) {
     layer.has_medium = true;
-    layer.medium = {tau_a, tau_s, g};
+    layer.medium = MediumSpec{};
+    layer.medium.tau_a = tau_a;
+    layer.medium.tau_s = tau_s;
+    layer.medium.g = g;
     return layer;
 }
 

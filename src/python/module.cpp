@@ -564,6 +564,38 @@ void bind_simulation(py::module_& m) {
             },
             "Energy budget terms, each [incidence, channel] (fractions of the incident flux)")
         .def_property_readonly(
+            "spectral",
+            [](const PySimulation& r) -> py::object {
+                const SpectralTables& sp = r.result.spectral;
+                if (sp.bin_edges_nm.empty()) return py::none();
+                const std::size_t bins = sp.bin_edges_nm.size() - 1,
+                                  n_inc = r.result.settings.theta_i_deg.size(),
+                                  n_theta = std::size_t(r.result.table.grid.n_theta()),
+                                  n_phi = sp.n_directions / n_theta;
+                auto tables = [&](const std::vector<double>& v) {
+                    py::array_t<double> a({n_inc, std::size_t(sp.sides), n_theta, n_phi, bins});
+                    std::copy(v.begin(), v.end(), a.mutable_data());
+                    return a;
+                };
+                py::array_t<double> energy({n_inc, bins, std::size_t(kBudgetTerms + 2)});
+                for (std::size_t i = 0; i < sp.budget.size(); ++i)
+                    std::copy(sp.budget[i].begin(), sp.budget[i].end(),
+                              energy.mutable_data() + i * (kBudgetTerms + 2));
+                py::dict d;
+                d["bin_edges_nm"] = sp.bin_edges_nm;
+                d["f"] = tables(sp.f);
+                d["se"] = tables(sp.se);
+                d["xyz"] = lobes_array(sp.xyz, false);
+                d["xyz_se"] = lobes_array(sp.xyz, true);
+                d["energy"] = energy;
+                return d;
+            },
+            "A spectral run's tables (None for an RGB run; docs/formats.md): bin_edges_nm; f, se "
+            "[incidence, side, θ bin, φ bin, wavelength bin] (the sides of `sides`); xyz, xyz_se "
+            "[..., 3] (CIE 1931 XYZ under D65); energy [incidence, wavelength bin, term] (the "
+            "budget terms, then the standard errors of R and T). f and se above are the linear "
+            "sRGB projection.")
+        .def_property_readonly(
             "info", [](const PySimulation& r) { return python_of(result_json(r.stack, r.result)); },
             "result.json as a dict")
         .def(

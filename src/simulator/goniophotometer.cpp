@@ -11,6 +11,8 @@
 #include "physics/microsurface_walk.h"
 #include "physics/thin_film_event.h"
 #include "simulator/kernel_simd.h"
+#include "simulator/kernel_spectral.h"
+#include "simulator/scalar_particle.h"
 #include "simulator/tally.h"
 
 #include <fmt/format.h>
@@ -19,6 +21,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 namespace lamina {
 
@@ -30,388 +33,6 @@ Rgbd EnergyBudget::sum() const {
 }
 
 namespace {
-
-bool is_black(const Rgbf& w) {
-    return w[0] == 0.f && w[1] == 0.f && w[2] == 0.f;
-}
-
-// ---- Media (docs/physics.md §4) -----------------------------------------------------------------
-// physics/medium.h at one lane. Depth s ∈ [0, 1] across the layer (0 at its top). Returns true if
-// the particle leaves through the top.
-struct MediumWalk {
-    const CompiledMedium<float>& m;
-    ParticleRng& rng;
-    PathLosses& losses;
-    /// The particle's polarization (polarized runs; else null): a scattering event depolarizes
-    /// (docs/physics.md §8), absorption keeps it.
-    StokesLanes<float>* stokes = nullptr;
-
-    bool traverse(Vec3f& d, Rgbf& w, int& events, int max_events) {
-        if (!m.scatters) {
-            // Pure absorption: Beer–Lambert along the straight path, no sampling.
-            float transmittance[3];
-            beer_lambert_transmittance<float>(m.tau_a, 1.f / std::abs(d.z), transmittance);
-            const Rgbf before = w;
-            for (int c = 0; c < 3; ++c)
-                w[c] *= transmittance[c];
-            losses.add(BudgetTerm::AbsorbedMedium, before - w);
-            return d.z > 0;
-        }
-        return walk(d, w, events, max_events);
-    }
-
-    // Scattering: free flights and HG events by one-sample spectral MIS (physics/medium.h).
-    bool walk(Vec3f& d, Rgbf& w, int& events, int max_events) {
-        float s = d.z < 0 ? 0.f : 1.f;
-        auto uniform = [&] { return rng.uniform_float(); };
-        while (true) {
-            const LaneVec3<float> dl = {d.x, d.y, d.z};
-            const float wl[3] = {w[0], w[1], w[2]};
-            const MediumFlightLanes<float, bool> flight =
-                medium_free_flight<float>(m, dl, wl, s, uniform);
-            const Rgbf before = w;
-            if (flight.leaves) {
-                for (int c = 0; c < 3; ++c)
-                    w[c] *= flight.factor[c];
-                losses.add(BudgetTerm::AbsorbedMedium, before - w);
-                return d.z > 0;
-            }
-            s = flight.depth;
-            LaneVec3<float> d_new;
-            float phase[3];
-            medium_scatter<float>(m, dl, flight.p, true, uniform, d_new, phase);
-            for (int c = 0; c < 3; ++c)
-                w[c] *= flight.factor[c] * phase[c];
-            d = {d_new.x, d_new.y, d_new.z};
-            if (stokes) stokes_depolarize<float>(*stokes, 3, true);
-            losses.add(BudgetTerm::AbsorbedMedium, before - w);
-            if (is_black(w)) return d.z > 0;
-            if (++events >= max_events) return d.z > 0;  // the caller books the cut-off
-        }
-    }
-};
-
-// ---- A filmed interface (docs/physics.md §9)
-// ----------------------------------------------------- The film's Mueller matrices
-// (physics/thin_film_event.h) at every facet: a dielectric's single facet or walk through the
-// film's branch choice, a conductor's through conductor_event and the conductor walk with the
-// film's reflection in place of the bare Fresnel terms. A thickness that varies over the surface is
-// drawn first, from the particle's own stream, once per event (a particle's lateral position never
-// matters, docs/physics.md §2). The factors (the film's absorption, the reweighting of the
-// channels) are booked as absorbed at the interface
-// (`apply(sample, true)`), G2/G1 as lost to the microsurface.
-template <bool kPolarized, typename Apply, typename ApplyWalk>
-inline void film_event(const CompiledStack<float>& stack, const CompiledLayer<float>& layer,
-                       ParticleRng& rng, const Vec3f& wi, const Rgbf& w,
-                       [[maybe_unused]] PolarizationLanes<float>& pol, Apply& apply,
-                       ApplyWalk& apply_walk) {
-    const FilmOptics& film = layer.film;
-    const double thickness =
-        film.varies() ? film.thickness_nm(double(rng.uniform_float())) : film.thickness_min_nm;
-    const float flux[3] = {w[0], w[1], w[2]};
-    PolarizationLanes<float>* p = nullptr;
-    if constexpr (kPolarized) p = &pol;
-    auto uniform = [&] { return rng.uniform_float(); };
-    const LaneVec3<float> wl = {wi.x, wi.y, wi.z};
-    if (layer.type == InterfaceType::Dielectric) {
-        const DielectricInterface<float>& di = layer.dielectric;
-        if (layer.multiple) {
-            const MicrosurfaceFilmFacet<decltype(uniform)> facet{film,    di.eta, thickness,
-                                                                 uniform, flux,   p};
-            apply_walk(microsurface_exit(microsurface_walk<float, Lane<float>>(
-                           di.distribution().template lanes<false>(), wl, true, true, facet,
-                           uniform, stack.max_microsurface_order)),
-                       true);
-            return;
-        }
-        const float uc = rng.uniform_float(), u1 = rng.uniform_float(), u2 = rng.uniform_float();
-        const FilmEvent e =
-            film_dielectric_event(film, di.eta, di.alpha, di.uncorrelated_shadowing,
-                                  di.transmission_masking == TransmissionMasking::Smith, thickness,
-                                  wl, uc, u1, u2, flux, p);
-        std::optional<BsdfSample<float>> s;
-        if (!e.degenerate) {
-            s.emplace();
-            s->wo = {e.scatter.wo.x, e.scatter.wo.y, e.scatter.wo.z};
-            s->fresnel_weight = {e.scatter.factor[0], e.scatter.factor[1], e.scatter.factor[2]};
-            s->shadowing = e.shadowing;
-        }
-        apply(s, true);
-        return;
-    }
-    // A conductor: the film's reflectance (unpolarized) or reflection Mueller matrices per channel.
-    const ConductorInterface<float>& cond = layer.conductor;
-    const auto reflectance = [&](float cos_theta) {
-        Rgbf r;
-        for (int c = 0; c < 3; ++c)
-            r[c] = float(film.mueller(c, double(cos_theta), true, thickness).reflection.a);
-        return r;
-    };
-    [[maybe_unused]] const auto mueller = [&](float cos_theta, InterfaceMueller<float>* m) {
-        for (int c = 0; c < 3; ++c) {
-            const InterfaceMueller<double> md =
-                film.mueller(c, double(cos_theta), true, thickness).reflection;
-            m[c] = {float(md.a), float(md.b), float(md.c), float(md.d)};
-        }
-    };
-    if (layer.multiple) {
-        if constexpr (kPolarized)
-            apply_walk(walk_rough_conductor_polarized(cond.distribution(), mueller, wi, uniform,
-                                                      stack.max_microsurface_order, pol),
-                       true);
-        else
-            apply_walk(walk_rough_conductor(cond.distribution(), reflectance, wi, uniform,
-                                            stack.max_microsurface_order),
-                       true);
-        return;
-    }
-    const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
-    float factors[3];
-    const auto channel_reflectance = [&](float cos_theta, float* out) {
-        const Rgbf r = reflectance(cos_theta);
-        out[0] = r[0], out[1] = r[1], out[2] = r[2];
-    };
-    InterfaceEventLanes<float, bool> e;
-    if constexpr (kPolarized)
-        e = conductor_event<float>(cond.distribution().template lanes<false>(), cond.is_smooth(),
-                                   cond.uncorrelated_shadowing, wl, u1, u2, true, NoMueller{},
-                                   factors, &pol, mueller);
-    else
-        e = conductor_event<float>(cond.distribution().template lanes<false>(), cond.is_smooth(),
-                                   cond.uncorrelated_shadowing, wl, u1, u2, true,
-                                   channel_reflectance, factors);
-    std::optional<BsdfSample<float>> s;
-    if (!e.degenerate) {
-        s.emplace();
-        s->wo = {e.wo.x, e.wo.y, e.wo.z};
-        s->fresnel_weight = {factors[0], factors[1], factors[2]};
-        s->shadowing = e.shadowing;
-    }
-    apply(s, true);
-}
-
-// ---- One interface event ----------------------------------------------------------------------
-// The event of `layer` on a particle arriving along d with flux w: its BSDF sampler (or, with
-// multiple scattering, its microsurface walk) draws the new direction d, and w keeps what
-// continues; the rest is booked in `losses` (absorbed by an opaque base, lost to the microsurface).
-// Polarized runs: pol goes through the event too (pol.flux: the caller's copy of w). Where the
-// channels' states differ, a dielectric's branch choice reweights the channels: the reweighting
-// (zero in expectation per channel) is booked with the base that coloured them.
-// kAnisotropic: the stack has an anisotropic interface (CompiledStack::anisotropic), and every
-// rough interface takes the general instance of the GGX formulas (GGX::lanes). kFilm: the stack
-// has a thin film (film_event; never with kAnisotropic: validate_kernel_for refuses the pair).
-template <bool kPolarized, bool kAnisotropic, bool kFilm>
-inline void interface_event(const CompiledStack<float>& stack, const CompiledLayer<float>& layer,
-                            ParticleRng& rng, Tally& tally, Vec3f& d, Rgbf& w, PathLosses& losses,
-                            [[maybe_unused]] PolarizationLanes<float>& pol) {
-    const Vec3f wi_local = -d;
-    [[maybe_unused]] const bool reweights = kPolarized && pol.channels == 3;
-    // Applies a sample (taken by reference: no copy of the optional in the hot loop).
-    // weight = fresnel_weight (absorbed by an opaque base) · shadowing (lost on the
-    // microsurface); a missing sample is a numerical degeneracy, counted and reported.
-    auto apply = [&](const std::optional<BsdfSample<float>>& s, bool opaque) {
-        if (!s) {
-            ++tally.sums.degenerate;
-            losses.add(BudgetTerm::LostMicrosurface, w);
-            w = Rgbf(0.f);
-            return;
-        }
-        if (opaque) {  // a dielectric's fresnel_weight is 1
-            const Rgbf kept = w * s->fresnel_weight;
-            losses.add(BudgetTerm::AbsorbedBase, w - kept);
-            w = kept;
-        }
-        if (s->shadowing != 1.f) {
-            const Rgbf kept = w * s->shadowing;
-            losses.add(BudgetTerm::LostMicrosurface, w - kept);
-            w = kept;
-        }
-        d = s->wo;
-    };
-    // A rough interface with multiple scattering: the microsurface walk (Heitz et al. 2016)
-    // replaces the single facet; its exit carries the conductor's Fresnel factors. A walk
-    // given up at the facet cap loses its flux to the microsurface; a degenerate one too, and
-    // is counted as a degeneracy.
-    auto apply_walk = [&](const std::optional<MicrosurfaceExit<float>>& e, bool opaque) {
-        if (!e || !e->escaped) {
-            if (!e) ++tally.sums.degenerate;
-            losses.add(BudgetTerm::LostMicrosurface, w);
-            w = Rgbf(0.f);
-            return;
-        }
-        if (opaque) {
-            const Rgbf kept = w * e->weight;
-            losses.add(BudgetTerm::AbsorbedBase, w - kept);
-            w = kept;
-        }
-        d = e->wo;
-    };
-    auto uniform = [&] { return rng.uniform_float(); };
-    if constexpr (kFilm) {
-        if (layer.has_film) {
-            film_event<kPolarized>(stack, layer, rng, wi_local, w, pol, apply, apply_walk);
-            return;
-        }
-    }
-    switch (layer.type) {
-        case InterfaceType::Dielectric: {
-            if (layer.multiple) {
-                if constexpr (kPolarized) {
-                    apply_walk(walk_rough_dielectric_polarized<kAnisotropic>(
-                                   layer.dielectric.distribution(), layer.dielectric.eta, wi_local,
-                                   uniform, stack.max_microsurface_order, pol),
-                               reweights);
-                    break;
-                }
-                apply_walk(walk_rough_dielectric<kAnisotropic>(
-                               layer.dielectric.distribution(), layer.dielectric.eta, wi_local,
-                               uniform, stack.max_microsurface_order),
-                           false);
-                break;
-            }
-            const float uc = rng.uniform_float(), u1 = rng.uniform_float(),
-                        u2 = rng.uniform_float();
-            if constexpr (kPolarized)
-                apply(layer.dielectric.template sample_polarized<kAnisotropic>(wi_local, uc, u1, u2,
-                                                                               pol),
-                      reweights);
-            else
-                apply(layer.dielectric.template sample<false, kAnisotropic>(wi_local, uc, u1, u2),
-                      false);
-            break;
-        }
-        case InterfaceType::Conductor: {
-            const ConductorInterface<float>& cond = layer.conductor;
-            if (layer.multiple) {
-                if constexpr (kPolarized) {
-                    const auto mueller = [&](float c, InterfaceMueller<float>* m) {
-                        cond.mueller(c, m);
-                    };
-                    apply_walk(walk_rough_conductor_polarized<kAnisotropic>(
-                                   cond.distribution(), mueller, wi_local, uniform,
-                                   stack.max_microsurface_order, pol),
-                               true);
-                    break;
-                }
-                apply_walk(walk_rough_conductor<kAnisotropic>(
-                               cond.distribution(), [&](float c) { return cond.fresnel(c); },
-                               wi_local, uniform, stack.max_microsurface_order),
-                           true);
-                break;
-            }
-            const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
-            if constexpr (kPolarized)
-                apply(cond.template sample_polarized<kAnisotropic>(wi_local, u1, u2, pol), true);
-            else
-                apply(cond.template sample<false, kAnisotropic>(wi_local, u1, u2), true);
-            break;
-        }
-        case InterfaceType::Lambertian: {
-            const float u1 = rng.uniform_float(), u2 = rng.uniform_float();
-            apply(layer.lambertian.sample(wi_local, u1, u2), true);
-            if constexpr (kPolarized) stokes_depolarize<float>(pol.stokes, 3, true);
-            break;
-        }
-    }
-}
-
-// ---- One particle ------------------------------------------------------------------------------
-// docs/physics.md §3: at an interface the particle (arriving along −wi) draws an outgoing direction
-// from the interface's BSDF sampler; its flux is multiplied by the sample weight and the parts
-// that do not continue are booked (absorbed by the base, lost to the microsurface).
-// Polarized runs (docs/physics.md §8): the particle also carries its Stokes vector per channel
-// divided by its flux, with the frame's x axis (physics/polarization.h at one lane); every event
-// passes it to the interface's polarized event, a Lambertian base and a scattering event
-// depolarize it, and an exit is tallied with its Stokes vector when the job asks for it.
-// Written once for both: kPolarized = false is the unpolarized kernel, with none of it; kFilm
-// = true the instantiation for stacks with a thin film (film_event).
-template <bool kPolarized, bool kAnisotropic, bool kFilm>
-void trace_particle(const CompiledStack<float>& stack, const HemisphereGrid& grid,
-                    const BlockJob& job, ParticleRng& rng, Tally& tally, BlockBudget& block) {
-    const int n_layers = int(stack.layers.size());
-    const int max_events = job.max_events;
-    Vec3f d = -job.wi;  // propagation direction
-    Rgbf w(1.f);
-    PathLosses losses;
-    int k = 0;  // the interface the particle is about to meet
-    int events = 0;
-    [[maybe_unused]] PolarizationLanes<float> pol;
-    [[maybe_unused]] float flux[3];
-    if constexpr (kPolarized) {
-        pol.stokes = stokes_incident<float>({d.x, d.y, d.z}, job.incident_stokes);
-        pol.channels = stack.polarization_channels;
-        pol.flux = flux;
-    }
-    [[maybe_unused]] auto exit_stokes = [&](std::size_t index) {
-        if (!job.stokes_tallies) return;
-        float s[3][4];
-        const float wl[3] = {w[0], w[1], w[2]};
-        stokes_in_bin_frame<float>(pol.stokes, {d.x, d.y, d.z}, wl, pol.channels, true, s);
-        // Folded bins count the patch y < 0 as its mirror image (mueller.h); unfolded ones are one
-        // patch each.
-        tally.exit_stokes(index, d.y < 0 && !job.grid->is_unfolded() ? 1 : 0, s);
-    };
-    while (true) {
-        if (events >= max_events) {
-            losses.add(BudgetTerm::CutOff, w);
-            break;
-        }
-        ++events;
-        const CompiledLayer<float>& layer = stack.layers[k];
-        if constexpr (kPolarized)
-            for (int c = 0; c < 3; ++c)
-                flux[c] = w[c];
-        interface_event<kPolarized, kAnisotropic, kFilm>(stack, layer, rng, tally, d, w, losses,
-                                                         pol);
-        if (is_black(w)) break;
-        if (d.z == 0) {
-            // An exactly grazing direction (a sampler at the edge of its domain, probability
-            // ~2^-24): it belongs to neither hemisphere. Its G2 is zero on a microsurface, and it
-            // is counted and reported as degenerate on any interface.
-            ++tally.sums.degenerate;
-            losses.add(layer.type == InterfaceType::Dielectric ? BudgetTerm::LostMicrosurface
-                                                               : BudgetTerm::AbsorbedBase,
-                       w);
-            break;
-        }
-        if (d.z > 0) {
-            if (k == 0) {  // leaves the stack upwards: reflection
-                const std::size_t bin = grid.bin_of(d);
-                tally.exit(bin, w);
-                if constexpr (kPolarized) exit_stokes(bin);
-                block.escape_reflected(w);
-                break;
-            }
-            // Up through the medium below interface k − 1.
-            const CompiledMedium<float>& m = stack.layers[k - 1].medium;
-            bool up = true;
-            if (!m.is_empty()) {
-                MediumWalk walk{m, rng, losses, kPolarized ? &pol.stokes : nullptr};
-                up = walk.traverse(d, w, events, max_events);
-                if (is_black(w)) break;
-            }
-            if (up) --k;
-        } else {
-            if (k == n_layers - 1) {  // leaves through the final dielectric: transmission
-                const std::size_t bin = grid.size() + grid.bin_of(d);
-                tally.exit(bin, w);
-                if constexpr (kPolarized) exit_stokes(bin);
-                block.escape_transmitted(w);
-                break;
-            }
-            const CompiledMedium<float>& m = layer.medium;
-            bool up = false;
-            if (!m.is_empty()) {
-                MediumWalk walk{m, rng, losses, kPolarized ? &pol.stokes : nullptr};
-                up = walk.traverse(d, w, events, max_events);
-                if (is_black(w)) break;
-            }
-            if (!up) ++k;
-        }
-    }
-    losses.flush(block);
-    tally.sums.events += std::uint64_t(events);
-}
 
 std::uint64_t incidence_stream(double theta_i_deg, double phi_i_deg, int incident_polarization) {
     // The stream is the incidence itself, so a result does not depend on which other incidences
@@ -425,7 +46,6 @@ std::uint64_t incidence_stream(double theta_i_deg, double phi_i_deg, int inciden
            (std::uint64_t(incident_polarization) * 0x9E3779B97F4A7C15ull);
 }
 
-// The incident Stokes vectors (S1, S2, S3)/S0 of SimulationSettings::incident_polarization.
 constexpr float kIncidentStokes[7][3] = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 0, 1},
                                          {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
 
@@ -461,8 +81,14 @@ std::string kernel_description(Kernel kernel) {
     return kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name()) : "scalar";
 }
 
+bool is_spectral_run(const Stack& stack, const SimulationSettings& settings) {
+    return settings.spectral == SpectralMode::On ||
+           (settings.spectral == SpectralMode::Auto && stack.is_spectral());
+}
+
 bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings) {
-    return stack.has_film() || stack.is_anisotropic() || settings.phi_i_deg != 0;
+    return stack.has_film() || stack.is_anisotropic() || settings.phi_i_deg != 0 ||
+           is_spectral_run(stack, settings);
 }
 
 Kernel kernel_for(const SimulationSettings& settings, const Stack& stack) {
@@ -484,6 +110,23 @@ void IncidenceSums::add(const IncidenceSums& o) {
             stokes[i][std::size_t(k)] += o.stokes[i][std::size_t(k)];
     events += o.events;
     degenerate += o.degenerate;
+    LAMINA_CHECK(spectral_bins.size() == o.spectral_bins.size() &&
+                 xyz_bins.size() == o.xyz_bins.size() &&
+                 spectral_budget.size() == o.spectral_budget.size());
+    for (std::size_t i = 0; i < spectral_bins.size(); ++i)
+        for (int k = 0; k < 6; ++k)
+            spectral_bins[i][k] += o.spectral_bins[i][k];
+    for (std::size_t i = 0; i < xyz_bins.size(); ++i)
+        for (int k = 0; k < 6; ++k)
+            xyz_bins[i][k] += o.xyz_bins[i][k];
+    auto add_budget = [](auto& into, const auto& from) {
+        for (std::size_t t = 0; t < into.size(); ++t)
+            for (int c = 0; c < 3; ++c)
+                into[t][c] += from[t][c];
+    };
+    for (std::size_t g = 0; g < spectral_budget.size(); ++g)
+        add_budget(spectral_budget[g], o.spectral_budget[g]);
+    add_budget(xyz_budget, o.xyz_budget);
 }
 
 void validate_kernel_for(const Stack& stack, const SimulationSettings& settings) {
@@ -491,6 +134,30 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings)
         throw InputError(stack.name, "film",
                          "a thin film on a stack with an anisotropic interface is not traced yet "
                          "(films and anisotropy each work alone)");
+    if (is_spectral_run(stack, settings)) {
+        if (settings.spectral_bins % 3 != 0)
+            throw InputError("settings", "spectral_bins",
+                             fmt::format("got {}; allowed: a multiple of 3 in [3, 300] (each "
+                                         "particle carries three wavelengths a third of the "
+                                         "range apart)",
+                                         settings.spectral_bins));
+        if (settings.spectral_max_nm - settings.spectral_min_nm < settings.spectral_bins)
+            throw InputError("settings", "spectral_max_nm",
+                             fmt::format("the range [{}, {}] nm is narrower than one nm per "
+                                         "wavelength bin ({} bins); widen it or use fewer bins",
+                                         settings.spectral_min_nm, settings.spectral_max_nm,
+                                         settings.spectral_bins));
+        if (settings.stokes_tallies)
+            throw InputError("settings", "spectral",
+                             "Mueller tables are tabulated per RGB channel; give --spectral off");
+        if (settings.kernel == Kernel::Simd)
+            throw InputError("command line", "--kernel",
+                             fmt::format("a spectral run (stack '{}'{}) is traced by the scalar "
+                                         "kernel only; give --kernel scalar (or auto)",
+                                         stack.name,
+                                         stack.is_spectral() ? ", which has spectral values"
+                                                             : ", --spectral on"));
+    }
     if (settings.kernel != Kernel::Simd) return;
     if (stack.has_film())
         throw InputError("command line", "--kernel",
@@ -518,7 +185,13 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
     const int threads = settings.threads > 0 ? settings.threads : omp_get_max_threads();
     const Kernel kernel = kernel_for(settings, stack);
     if (kernel == Kernel::Simd) select_simd_target();
-    const auto trace_block = kernel == Kernel::Simd ? trace_block_simd : trace_block_scalar;
+    const bool spectral = is_spectral_run(stack, settings);
+    const auto trace_block = spectral                 ? trace_block_spectral
+                             : kernel == Kernel::Simd ? trace_block_simd
+                                                      : trace_block_scalar;
+    const SpectralTracing tracing =
+        spectral ? spectral_tracing(stack, settings) : SpectralTracing{};
+    const int groups = settings.spectral_bins / 3;
 
     SimulationSums result = zero_sums(stack, settings);
     result.threads_used = threads;
@@ -544,23 +217,45 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
         for (int k = 0; k < 3; ++k)
             job.incident_stokes[k] = kIncidentStokes[settings.incident_polarization][k];
         job.stokes_tallies = settings.stokes_tallies;
+        if (spectral) job.spectral = &tracing;
         IncidenceSums& total = result.incidences[inc];
 
 #pragma omp parallel num_threads(threads) firstprivate(job)
         {
             Tally local(grid.size(), settings.stokes_tallies);
+            std::optional<SpectralTally> local_spectral;
+            if (spectral) {
+                local_spectral.emplace(grid.size(), groups);
+                job.spectral_tally = &*local_spectral;
+            }
 #pragma omp for schedule(dynamic, 1)
             for (std::uint64_t b = 0; b < blocks; ++b) {
                 const std::uint64_t lo = b * kBlock, hi = std::min(n, lo + kBlock);
                 BlockBudget block;
+                std::optional<SpectralBlock> spectral_block;
+                if (spectral) {
+                    spectral_block.emplace(groups);
+                    job.spectral_block = &*spectral_block;
+                }
                 job.first = settings.first_particle + lo;
                 job.count = hi - lo;
                 trace_block(job, local, block);
                 local.add_block(block);
                 local.count_particles(hi - lo);
+                if (spectral) {
+                    spectral_block->add_to(*local_spectral);
+                    local_spectral->lambda.count_particles(hi - lo);
+                    local_spectral->xyz.count_particles(hi - lo);
+                }
                 if (on_progress) on_progress(hi - lo);
             }
-            const IncidenceSums& mine = local.finish();
+            IncidenceSums& mine = local.finish();
+            if (spectral) {
+                mine.spectral_bins = local_spectral->lambda.finish().bins;
+                mine.spectral_budget = local_spectral->lambda.sums.spectral_budget;
+                mine.xyz_bins = local_spectral->xyz.finish().bins;
+                mine.xyz_budget = local_spectral->xyz.sums.budget;
+            }
 #pragma omp critical
             total.add(mine);  // integer sums: the order of merging does not matter
         }
@@ -623,6 +318,8 @@ SimulationResult finalize_simulation(const Stack& stack, const SimulationSetting
         result.incidences.push_back(stats);
     }
     if (settings.stokes_tallies) result.sums = sums.incidences;
+    if (is_spectral_run(stack, settings))
+        finalize_spectral(settings, sums, grid, transmits, result);
     return result;
 }
 
@@ -633,11 +330,18 @@ HemisphereGrid simulation_grid(const Stack& stack, const SimulationSettings& set
 
 SimulationSums zero_sums(const Stack& stack, const SimulationSettings& settings) {
     const std::size_t n_bins = simulation_grid(stack, settings).size();
+    const bool spectral = is_spectral_run(stack, settings);
+    const std::size_t groups = std::size_t(settings.spectral_bins / 3);
     SimulationSums sums;
     sums.incidences.resize(settings.theta_i_deg.size());
     for (IncidenceSums& s : sums.incidences) {
         s.bins.resize(2 * n_bins);
         if (settings.stokes_tallies) s.stokes.resize(2 * n_bins);
+        if (spectral) {
+            s.spectral_bins.resize(2 * n_bins * groups);
+            s.xyz_bins.resize(2 * n_bins);
+            s.spectral_budget.resize(groups);
+        }
     }
     sums.incidence_seconds.assign(settings.theta_i_deg.size(), 0.0);
     return sums;

@@ -35,13 +35,15 @@ inline constexpr std::uint64_t kParticlesPerBlock = 4096;
 /// run time to what the CPU offers. Each is bitwise reproducible for any thread or process count on
 /// a given machine; the two agree in distribution (a two-sample chi-square test), not bit for bit.
 /// `auto` is `simd`, or `scalar` for what the SIMD kernel does not trace (a thin film,
-/// docs/physics.md §9; an anisotropic interface or light from φi ≠ 0, §3 and §5): kernel_for.
+/// docs/physics.md §9; an anisotropic interface or light from φi ≠ 0, §3 and §5; a spectral run,
+/// §10): kernel_for.
 enum class Kernel { Scalar, Simd, Auto };
 inline constexpr std::array<EnumName<Kernel>, 3> enum_names(Kernel) {
     return {{{Kernel::Scalar, "scalar", "one particle at a time, the reference path"},
              {Kernel::Simd, "simd", "particles as the lanes of SIMD vectors"},
              {Kernel::Auto, "auto",
-              "simd, or scalar for a thin film, an anisotropic interface or phi_i != 0"}}};
+              "simd, or scalar for a thin film, an anisotropic interface, phi_i != 0 or a "
+              "spectral run"}}};
 }
 inline const char* enum_noun(Kernel) {
     return "a particle kernel";
@@ -51,9 +53,24 @@ inline const char* enum_noun(Kernel) {
 /// are bitwise reproducible for equal descriptions of the kernel that ran.
 std::string kernel_description(Kernel kernel);
 
+/// Spectral transport (docs/physics.md §10): `on` traces wavelengths, `off` the three RGB
+/// channels (each at one wavelength), `auto` spectral for a stack with a spectral value
+/// (Stack::is_spectral), RGB otherwise.
+enum class SpectralMode { Auto, On, Off };
+inline constexpr std::array<EnumName<SpectralMode>, 3> enum_names(SpectralMode) {
+    return {{{SpectralMode::Auto, "auto", "spectral for a stack with a spectral value, else RGB"},
+             {SpectralMode::On, "on", "trace wavelengths, tabulated in wavelength bins"},
+             {SpectralMode::Off, "off", "the three RGB channels, each at one wavelength"}}};
+}
+inline const char* enum_noun(SpectralMode) {
+    return "a spectral mode";
+}
+
 struct SimulationSettings;
+/// Whether `stack` is traced spectrally under `settings` (SpectralMode).
+bool is_spectral_run(const Stack& stack, const SimulationSettings& settings);
 /// Whether only the scalar kernel traces `stack` under `settings` (a thin film, an anisotropic
-/// interface, light from φi ≠ 0).
+/// interface, light from φi ≠ 0, a spectral run).
 bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings);
 /// The kernel that traces `stack` under `settings`: auto is scalar where needs_scalar_kernel,
 /// simd otherwise; scalar and simd are themselves.
@@ -74,6 +91,12 @@ struct SimulationSettings {
     Kernel kernel = Kernel::Auto;  ///< auto: SIMD, or scalar for what only it traces
     /// The physics the particles follow (shared with the random walk).
     TransportSettings transport;
+    /// Spectral transport (docs/physics.md §10): the mode, the range of vacuum wavelengths traced
+    /// and the number of wavelength bins the tables have over it (a multiple of 3: each particle
+    /// carries three wavelengths a third of the range apart).
+    SpectralMode spectral = SpectralMode::Auto;
+    double spectral_min_nm = 360, spectral_max_nm = 830;
+    int spectral_bins = 30;
     /// First particle index (a simulation may be split into ranges of particles, e.g. across
     /// processes; the union of ranges equals one run of all particles, bit for bit). Not a
     /// setting: distributed/split_simulation.h sets it.
@@ -122,8 +145,36 @@ struct SimulationSettings {
                .key = Key::Fixed},
               s.kernel);
         TransportSettings::fields(s.transport, visit);
+        visit({.name = "spectral",
+               .help = "Spectral transport: on (wavelengths, tabulated in wavelength bins), off "
+                       "(three RGB channels) or auto (on for a stack with a spectral value)",
+               .key_unsaid = "auto"},
+              s.spectral);
+        visit({.name = "spectral_min_nm",
+               .help = "Shortest vacuum wavelength traced in spectral runs, nm",
+               .min = 360,
+               .max = 830,
+               .key_unsaid = "360"},
+              s.spectral_min_nm);
+        visit({.name = "spectral_max_nm",
+               .help = "Longest vacuum wavelength traced in spectral runs, nm",
+               .min = 360,
+               .max = 830,
+               .key_unsaid = "830"},
+              s.spectral_max_nm);
+        visit({.name = "spectral_bins",
+               .help = "Wavelength bins of a spectral run's tables, a multiple of 3",
+               .min = 3,
+               .max = 300,
+               .key_unsaid = "30"},
+              s.spectral_bins);
     }
 };
+
+/// Sample wavelengths per wavelength bin of a spectral run: each particle's hero wavelength is
+/// drawn uniformly from the lattice of spectral_bins · kSpectralLattice points, the middles of
+/// equal cells over the range (docs/physics.md §10).
+inline constexpr int kSpectralLattice = 16;
 
 /// Sums per (side · n_bins + bin) of the Stokes tallies: per channel c, at c · 12 + h · 4 + k the
 /// sum of S_k over the exits into the bin's half h (0: y ≥ 0, 1: y < 0, each in its own bin
@@ -174,6 +225,16 @@ struct IncidenceSums {
     /// The Stokes tallies (kStokesSums per entry, as bins; empty unless
     /// SimulationSettings::stokes_tallies), S_k at scale 2^40 and S_k² at 2^38.
     std::vector<std::array<Fixed128, kStokesSums>> stokes;
+    /// Spectral runs (docs/physics.md §10; empty otherwise). `bins` and `budget` above then hold
+    /// the linear sRGB projection (bins divided by kSpectralTallyScale), and:
+    /// spectral_bins per ((side · n_bins + bin) · spectral_bins / 3 + g): Σ flux (0–2) and Σ flux²
+    /// (3–5) of the wavelength bins c · spectral_bins / 3 + g, c = 0, 1, 2 (divided by 4);
+    /// xyz_bins as bins, the CIE XYZ projection (divided by kSpectralTallyScale);
+    /// spectral_budget[g] as budget, for the wavelength bins c · spectral_bins / 3 + g;
+    /// xyz_budget as budget, for X, Y, Z.
+    std::vector<std::array<Fixed128, 6>> spectral_bins, xyz_bins;
+    std::vector<std::array<std::array<Fixed128, 3>, kBudgetTerms + 2>> spectral_budget;
+    std::array<std::array<Fixed128, 3>, kBudgetTerms + 2> xyz_budget{};
 
     void add(const IncidenceSums& o);
 };
@@ -185,8 +246,40 @@ struct SimulationSums {
     int threads_used = 1;
 };
 
+/// A spectral run's tables (docs/formats.md, "Spectral tables").
+struct SpectralTables {
+    std::vector<double> bin_edges_nm;  ///< spectral_bins + 1 edges over the traced range
+    std::size_t n_directions = 0;      ///< the direction bins of the grid (simulation_grid)
+    int sides = 1;                     ///< 1 (reflection) or 2 (and transmission)
+    /// The cos-weighted bin averages of the BSDF and their standard errors, per
+    /// [incidence][side][direction bin][wavelength bin] (row-major, flattened).
+    std::vector<double> f, se;
+    /// The energy budget per [incidence][wavelength bin]: the terms, then the standard errors of
+    /// R and T (indices kBudgetTerms and kBudgetTerms + 1).
+    std::vector<std::array<double, kBudgetTerms + 2>> budget;
+    /// The CIE 1931 XYZ projection under D65 (channels X, Y, Z; Y = 1 for a white reflector), its
+    /// energy budget per incidence as in IncidenceStats. The linear sRGB projection is the
+    /// result's `table` and `incidences[].budget`.
+    BinnedTable xyz;
+    std::vector<EnergyBudget> xyz_budget;
+
+    std::size_t index(std::size_t incidence, int side, std::size_t direction,
+                      std::size_t lambda) const {
+        const std::size_t n_lambda = bin_edges_nm.size() - 1;
+        return ((incidence * std::size_t(sides) + std::size_t(side)) * n_directions + direction) *
+                   n_lambda +
+               lambda;
+    }
+};
+
+/// Spectral tallies hold their colour projections divided by this (their bound, tally.h).
+inline constexpr double kSpectralTallyScale = 16;
+
 struct SimulationResult {
     SimulationSettings settings;
+    /// A spectral run's tables (empty bin_edges_nm otherwise); `table` is then their linear sRGB
+    /// projection under D65.
+    SpectralTables spectral;
     /// The raw sums (kept when settings.stokes_tallies: the Mueller tables are built from them).
     std::vector<IncidenceSums> sums;
     BinnedTable table;  ///< reflection, and transmission when the stack transmits
@@ -210,8 +303,10 @@ SimulationSums zero_sums(const Stack& stack, const SimulationSettings& settings)
 void validate_settings(const SimulationSettings& settings, const std::string& where = "settings");
 
 /// Checks that the settings' kernel traces everything the stack holds: a thin film, an
-/// anisotropic interface and light from φi ≠ 0 need the scalar kernel, or auto (InputError naming
-/// --kernel for simd; docs/physics.md §9); a film with an anisotropic interface is refused.
+/// anisotropic interface, light from φi ≠ 0 and a spectral run need the scalar kernel, or auto
+/// (InputError naming --kernel for simd; docs/physics.md §9); a film with an anisotropic
+/// interface is refused; a spectral run needs spectral_bins a multiple of 3 and a range of at
+/// least one nm per bin.
 void validate_kernel_for(const Stack& stack, const SimulationSettings& settings);
 
 /// Traces particles [first_particle, first_particle + particles) of every incidence and returns

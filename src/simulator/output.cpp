@@ -1,6 +1,7 @@
 #include "simulator/output.h"
 
 #include "core/atomic_file.h"
+#include "core/npy.h"
 #include "lamina/version.h"
 
 #include <fmt/format.h>
@@ -73,7 +74,70 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
                               {"seconds", st.seconds}});
     }
     j["incidences"] = incidences;
+    if (!result.spectral.bin_edges_nm.empty()) {
+        // A spectral run (docs/physics.md §10): brdf.csv and energy.csv hold its linear sRGB
+        // projection under D65; the wavelength bins and the XYZ budget are here.
+        nlohmann::json xyz = nlohmann::json::array();
+        for (const EnergyBudget& b : result.spectral.xyz_budget) {
+            nlohmann::json budget;
+            for (int t = 0; t < kBudgetTerms; ++t)
+                budget[kBudgetTermNames[t]] = rgb_json(b.term[t]);
+            budget["reflected_se"] = rgb_json(b.reflected_se);
+            budget["transmitted_se"] = rgb_json(b.transmitted_se);
+            xyz.push_back(budget);
+        }
+        j["spectral_tables"] = {{"bin_edges_nm", result.spectral.bin_edges_nm},
+                                {"colour", "linear sRGB (IEC 61966-2-1), illuminant D65"},
+                                {"xyz_energy", xyz}};
+    }
     return j;
+}
+
+std::string spectral_energy_csv(const SimulationResult& result) {
+    const SpectralTables& sp = result.spectral;
+    const std::size_t bins = sp.bin_edges_nm.size() - 1;
+    std::string out = std::string(kSpectralEnergyCsvHeader) + "\n";
+    for (std::size_t i = 0; i < result.settings.theta_i_deg.size(); ++i)
+        for (std::size_t l = 0; l < bins; ++l) {
+            fmt::format_to(std::back_inserter(out), "{},{},{}", result.settings.theta_i_deg[i],
+                           sp.bin_edges_nm[l], sp.bin_edges_nm[l + 1]);
+            for (double v : sp.budget[i * bins + l])
+                fmt::format_to(std::back_inserter(out), ",{}", v);
+            out += "\n";
+        }
+    return out;
+}
+
+std::string spectral_npy(const SimulationResult& result, bool standard_error) {
+    const SpectralTables& sp = result.spectral;
+    const std::size_t bins = sp.bin_edges_nm.size() - 1, n_inc = result.settings.theta_i_deg.size();
+    const std::size_t n_theta = std::size_t(result.table.grid.n_theta());
+    const std::vector<double>& src = standard_error ? sp.se : sp.f;
+    // Both sides always (zeros for an opaque stack), as the other tables.
+    std::vector<float> data(n_inc * 2 * sp.n_directions * bins, 0.f);
+    for (std::size_t i = 0; i < n_inc; ++i)
+        for (int side = 0; side < sp.sides; ++side)
+            for (std::size_t j = 0; j < sp.n_directions; ++j)
+                for (std::size_t l = 0; l < bins; ++l)
+                    data[((i * 2 + std::size_t(side)) * sp.n_directions + j) * bins + l] =
+                        float(src[sp.index(i, side, j, l)]);
+    return npy_float32(data, {n_inc, 2, n_theta, sp.n_directions / n_theta, bins});
+}
+
+std::string xyz_npy(const SimulationResult& result, bool standard_error) {
+    const BinnedTable& t = result.spectral.xyz;
+    const std::size_t n_inc = result.settings.theta_i_deg.size(), n = t.grid.size();
+    const std::size_t n_theta = std::size_t(t.grid.n_theta());
+    std::vector<float> data(n_inc * 2 * n * 3, 0.f);
+    for (std::size_t i = 0; i < n_inc; ++i)
+        for (int side = 0; side < (t.has_transmission ? 2 : 1); ++side) {
+            const BinnedLobe& lobe = t.lobe(i, side == 0 ? Side::Reflection : Side::Transmission);
+            for (std::size_t j = 0; j < n; ++j)
+                for (int c = 0; c < 3; ++c)
+                    data[((i * 2 + std::size_t(side)) * n + j) * 3 + std::size_t(c)] =
+                        float(standard_error ? lobe.se[j][c] : lobe.f[j][c]);
+        }
+    return npy_float32(data, {n_inc, 2, n_theta, n / n_theta, 3});
 }
 
 void write_simulation(const std::filesystem::path& dir, const Stack& stack,
@@ -84,6 +148,13 @@ void write_simulation(const std::filesystem::path& dir, const Stack& stack,
     out.add("energy.csv", energy_csv(result));
     for (const auto& [name, bytes] : extra)
         out.add(name, bytes);
+    if (!result.spectral.bin_edges_nm.empty()) {
+        out.add("spectral.npy", spectral_npy(result, false));
+        out.add("spectral_se.npy", spectral_npy(result, true));
+        out.add("xyz.npy", xyz_npy(result, false));
+        out.add("xyz_se.npy", xyz_npy(result, true));
+        out.add("spectral_energy.csv", spectral_energy_csv(result));
+    }
     out.add("result.json", result_json(stack, result).dump(2) + "\n");
     out.commit();
 }

@@ -58,6 +58,18 @@ struct BlockBudget {
     }
 };
 
+/// Adds a block's budget sums to 128-bit ones (IncidenceSums::budget's layout).
+inline void add_block_budget(const BlockBudget& b,
+                             std::array<std::array<Fixed128, 3>, kBudgetTerms + 2>& into) {
+    for (int t = 0; t < kBudgetTerms; ++t)
+        for (int c = 0; c < 3; ++c)
+            into[t][c] += to_fixed_wide(b.term[t][c]);
+    for (int c = 0; c < 3; ++c) {
+        into[kBudgetTerms][c] += to_fixed_wide(b.reflected_sq[c]);
+        into[kBudgetTerms + 1][c] += to_fixed_wide(b.transmitted_sq[c]);
+    }
+}
+
 /// The flux a particle loses along its path, per budget term, in registers; added to the block's
 /// double sums once, when the particle ends. Summed in double: a particle trapped in a scattering
 /// slab can lose its flux in thousands of small pieces, and a float sum of them drifted by 1.2e-6
@@ -97,9 +109,10 @@ struct Tally {
         }
     }
 
-    /// A particle leaving into bin `index` (side · n_bins + bin) with flux `flux`.
+    /// A particle leaving into bin `index` (side · n_bins + bin) with flux `flux` (for spectral
+    /// runs, their contributions already divided by their scales: goniophotometer.h).
     void exit(std::size_t index, const Rgbf& flux) {
-        LAMINA_DCHECK(flux.max() <= 4.f);
+        LAMINA_DCHECK(flux.max() <= 4.f && flux.min() >= -4.f);
         Recent& acc = recent[index];
         for (int c = 0; c < 3; ++c) {
             const double x = flux[c];
@@ -137,19 +150,68 @@ struct Tally {
         particles_since_widening += n;
         if (particles_since_widening >= kFlushParticles) widen();
     }
-    void add_block(const BlockBudget& b) {
-        for (int t = 0; t < kBudgetTerms; ++t)
-            for (int c = 0; c < 3; ++c)
-                sums.budget[t][c] += to_fixed_wide(b.term[t][c]);
-        for (int c = 0; c < 3; ++c) {
-            sums.budget[kBudgetTerms][c] += to_fixed_wide(b.reflected_sq[c]);
-            sums.budget[kBudgetTerms + 1][c] += to_fixed_wide(b.transmitted_sq[c]);
-        }
-    }
+    void add_block(const BlockBudget& b) { add_block_budget(b, sums.budget); }
     /// The widened sums (widens first).
-    const IncidenceSums& finish() {
+    IncidenceSums& finish() {
         widen();
         return sums;
+    }
+};
+
+// ---- Spectral runs (docs/physics.md §10) ----------------------------------------------------
+// A particle carries three wavelengths: the lattice points t + c · L/3 of the run's lattice of L
+// points (SimulationSettings::spectral_bins · kSpectralLattice), one per channel c, so that
+// channel c's wavelength lies in wavelength bin c · groups + g, g = t / kSpectralLattice (groups =
+// spectral_bins / 3). Particle p's group g is p mod groups; its point within the group and its
+// hero channel are drawn from its own stream. Its exits are tallied three ways: per wavelength bin
+// (the channels' fluxes, divided by 4, at entry (side · n_bins + bin) · groups + t /
+// kSpectralLattice of a Tally over n_bins · groups bins), and projected to CIE XYZ and linear sRGB
+// (Σ_c flux_c · weight(λ_c), divided by kSpectralTallyScale). A flux is at most 3 per channel, 9
+// for a hero that carries its terminated secondaries (goniophotometer.cpp), and every weight is at
+// most 5 in magnitude (checked when the run is set up) times a group factor below 1.5, so each
+// contribution, divided by its scale, stays within the bounds of Tally::exit.
+
+/// The stacks and weights of a spectral run.
+struct SpectralTracing {
+    int bins = 0;     ///< wavelength bins (a multiple of 3)
+    int lattice = 0;  ///< lattice points, bins · kSpectralLattice
+    /// The stack at the wavelengths of the lattice points t, t + L/3, t + 2L/3 with its
+    /// dielectrics' indices at channel h's wavelength (the path the particle follows), at
+    /// t · 3 + h; and per layer, whether its relative index differs between the three wavelengths
+    /// (dispersive: a refraction direction that depends on the wavelength).
+    std::vector<CompiledStack<float>> stacks;
+    std::vector<std::vector<char>> dispersive;
+    /// Per lattice point: its XYZ and linear sRGB weights (colorimetry.h), such that the
+    /// expectation of Σ_c flux_c · weight(λ_c) over the particles is the projection of the
+    /// spectrum.
+    std::vector<Rgbf> xyz_weight, srgb_weight;
+};
+
+/// Particle p's wavelength group is p mod groups (the groups are stratified over the particles);
+/// the particles of [0, n) in group g.
+inline std::uint64_t spectral_group_particles(std::uint64_t n, int groups, int g) {
+    return n / std::uint64_t(groups) + (std::uint64_t(g) < n % std::uint64_t(groups) ? 1 : 0);
+}
+
+/// One thread's spectral tallies of one incidence (the sRGB ones are its main Tally).
+struct SpectralTally {
+    Tally lambda, xyz;
+    SpectralTally(std::size_t n_bins, int groups)
+        : lambda(n_bins * std::size_t(groups)), xyz(n_bins) {
+        lambda.sums.spectral_budget.resize(std::size_t(groups));
+    }
+};
+
+/// The budget sums of one block of a spectral run: per wavelength group, and of XYZ (the sRGB
+/// ones are the block's main BlockBudget).
+struct SpectralBlock {
+    std::vector<BlockBudget> groups;
+    BlockBudget xyz;
+    explicit SpectralBlock(int n_groups) : groups(std::size_t(n_groups)) {}
+    void add_to(SpectralTally& t) const {
+        for (std::size_t g = 0; g < groups.size(); ++g)
+            add_block_budget(groups[g], t.lambda.sums.spectral_budget[g]);
+        add_block_budget(xyz, t.xyz.sums.budget);
     }
 };
 
@@ -166,6 +228,11 @@ struct BlockJob {
     /// the bin frame of −wi, and whether exits are tallied with their Stokes vectors.
     float incident_stokes[3] = {0.f, 0.f, 0.f};
     bool stokes_tallies = false;
+    /// Spectral runs (scalar kernel only): the run's stacks and weights, and this thread's
+    /// spectral tallies and block sums; null otherwise.
+    const SpectralTracing* spectral = nullptr;
+    SpectralTally* spectral_tally = nullptr;
+    SpectralBlock* spectral_block = nullptr;
 };
 
 void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block);

@@ -173,6 +173,23 @@ check_says export-unfolded 1 "an unfolded table" \
 check export-unfolded-writes-nothing 1 test -e "$tmp/phi-i.bsdf"
 check_says eval-film 1 "not supported: thin films are not supported by this model" \
     "$lamina" eval --model ww09 --stack "$src/examples/coated-lens.json" --theta-i 30 --theta-o 30 --phi-o 180
+# Spectral runs (docs/physics.md §10): a spectral stack is traced spectrally on the scalar kernel
+# (auto) and writes its wavelength tables; the SIMD kernel refuses it, writing nothing; its stack
+# reads back from result.json as it was given.
+check simulate-spectral 0 "$lamina" simulate "$src/examples/gold-under-coat.json" --theta-i 0 \
+    --particles 2e4 --grid 9x6 --out "$tmp/spectral"
+for f in spectral.npy spectral_se.npy xyz.npy xyz_se.npy spectral_energy.csv; do
+    check "simulate-spectral-writes-$f" 0 test -s "$tmp/spectral/$f"
+done
+check_says simulate-spectral-material 0 '"material": "Au"' cat "$tmp/spectral/result.json"
+check_says simulate-spectral-simd 1 "is traced by the scalar kernel only; give --kernel scalar" \
+    "$lamina" simulate "$src/examples/dispersive-glass.json" --kernel simd --theta-i 0 \
+    --particles 1000 --out "$tmp/spectral-simd"
+check spectral-simd-writes-nothing 1 test -e "$tmp/spectral-simd"
+check_says simulate-spectral-bins 1 "multiple of 3" "$lamina" simulate "$src/examples/plastic.json" \
+    --spectral on --spectral-bins 10 --theta-i 0 --particles 1000 --out "$tmp/spectral-bins"
+check_says validate-spectral 0 "| dielectric η=BK7 α=0.05" "$lamina" validate \
+    "$src/examples/dispersive-glass.json"
 check_says validate-film 0 "| conductor η=(0.143, 0.374, 1.442) k=(3.983, 2.385, 1.603) α=0.15 film d=[55, 75] nm η=2.4" \
     "$lamina" validate "$src/examples/titania-on-gold.json"
 # Same seed, different thread counts: identical tables.

@@ -84,6 +84,35 @@ TEST(Communicator, FlatSumsAddLikeIncidenceSums) {
     }
 }
 
+// A spectral run's sums (the wavelength bins, XYZ and their budgets) travel with the others.
+TEST(Communicator, SpectralSumsFlattenAndAdd) {
+    std::vector<IncidenceSums> a(1), b(1);
+    for (IncidenceSums* s : {&a[0], &b[0]}) {
+        s->bins.resize(2);
+        s->spectral_bins.resize(6);
+        s->xyz_bins.resize(2);
+        s->spectral_budget.resize(3);
+    }
+    a[0].spectral_bins[5][3] = Fixed128(1) << 100;
+    b[0].spectral_bins[5][3] = 7;
+    a[0].xyz_bins[1][2] = -9;
+    b[0].spectral_budget[2][kBudgetTerms][1] = Fixed128(1) << 80;
+    a[0].xyz_budget[0][2] = 3;
+    std::vector<Fixed128> flat = flatten_sums(a);
+    const std::vector<Fixed128> flat_b = flatten_sums(b);
+    ASSERT_EQ(flat.size(), flat_b.size());
+    add_flat_sums(flat_b.data(), flat.data(), flat.size());
+    std::vector<IncidenceSums> got = b;
+    unflatten_sums(flat, got);
+    IncidenceSums want = a[0];
+    want.add(b[0]);
+    EXPECT_EQ(got[0].spectral_bins, want.spectral_bins);
+    EXPECT_EQ(got[0].xyz_bins, want.xyz_bins);
+    EXPECT_EQ(got[0].spectral_budget, want.spectral_budget);
+    EXPECT_EQ(got[0].xyz_budget, want.xyz_budget);
+    EXPECT_EQ(got[0].spectral_bins[5][3], (Fixed128(1) << 100) + 7);
+}
+
 TEST(Communicator, OneProcessReductionIsTheIdentity) {
     std::vector<IncidenceSums> sums(1);
     sums[0].bins.resize(3);

@@ -224,7 +224,9 @@ TEST(StackRoundTrip, ThroughJsonValueAndText) {
     top.interface.eta = 1.5;
     top.interface.alpha = 0.3;
     top.has_medium = true;
-    top.medium = {Rgbd(0.1, 0.2, 0.3), Rgbd(0.5, 1.0, 2.0), Rgbd(0.3, -0.2, 0.9)};
+    top.medium.tau_a = Rgbd(0.1, 0.2, 0.3);
+    top.medium.tau_s = Rgbd(0.5, 1.0, 2.0);
+    top.medium.g = Rgbd(0.3, -0.2, 0.9);
     Layer middle;
     middle.interface.eta = 1.2;
     middle.interface.alpha = 0.0;

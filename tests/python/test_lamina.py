@@ -123,6 +123,25 @@ def test_light_from_an_azimuth_unfolds_the_grid(tmp_path):
     assert abs((np.argmax(flux) + 0.5) * 15 - 220) <= 15
 
 
+def test_a_spectral_stack_gives_wavelength_tables(tmp_path):
+    # docs/physics.md §10: a stack with a spectral value is traced spectrally (scalar kernel);
+    # the arrays are those the CLI writes to spectral.npy, bit for bit in float32.
+    gold = ROOT / "examples" / "gold-under-coat.json"
+    r = lamina.simulate(gold, theta_i=[0, 45], particles=30_000, grid=(9, 6), threads=1)
+    sp = r.spectral
+    assert len(sp["bin_edges_nm"]) == 31 and sp["bin_edges_nm"][0] == 360
+    assert sp["f"].shape == (2, 1, 9, 6, 30) and sp["xyz"].shape == (2, 1, 9, 6, 3)
+    assert sp["energy"].shape == (2, 30, 8)
+    # Gold reflects red more than blue: the albedo rises with the wavelength across the visible.
+    albedo = sp["energy"][0, :, 0]
+    assert albedo[-3:].mean() > albedo[:3].mean() + 0.3
+    cli("simulate", gold, "--theta-i", "0,45", "--particles", 30_000, "--grid", "9x6",
+        "--out", tmp_path / "cli")
+    assert np.array_equal(np.load(tmp_path / "cli" / "spectral.npy")[:, :1],
+                          sp["f"].astype(np.float32))
+    assert lamina.simulate(PLASTIC, theta_i=[0], particles=1000).spectral is None
+
+
 # ---- simulate: bitwise the CLI's ------------------------------------------------------------------
 
 @pytest.mark.parametrize("stack", [PLASTIC, SLAB])

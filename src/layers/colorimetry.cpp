@@ -1,0 +1,71 @@
+#include "layers/colorimetry.h"
+
+#include "layers/spectral_data.h"
+
+#include <array>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+namespace {
+constexpr double kFirstNm = 360, kStepNm = 5;
+constexpr int kRows = 95;  // 360, 365, …, 830
+
+/// Column `column` of a 5 nm table (the header skipped).
+std::vector<double> column_of(std::string_view text, int column) {
+    std::vector<double> out;
+    std::istringstream in{std::string(text)};
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+        if (line.empty()) continue;
+        std::istringstream cells(line);
+        std::string cell;
+        for (int c = 0; c <= column; ++c)
+            std::getline(cells, cell, ',');
+        out.push_back(std::stod(cell));
+    }
+    return out;
+}
+
+struct Tables {
+    std::array<std::vector<double>, 3> cmf;
+    std::vector<double> d65;
+    Tables() {
+        const std::string_view xyz = spectral_data_file("cie/cie1931_xyz_5nm.csv");
+        for (int k = 0; k < 3; ++k)
+            cmf[std::size_t(k)] = column_of(xyz, k + 1);
+        d65 = column_of(spectral_data_file("cie/d65_5nm.csv"), 1);
+    }
+};
+const Tables& tables() {
+    static const Tables t;
+    return t;
+}
+}  // namespace
+
+Rgbd d65_xyz_weights(double lambda_nm) {
+    const double x = (lambda_nm - kFirstNm) / kStepNm;
+    if (!(x >= 0) || x > kRows - 1) return Rgbd(0.0);
+    const int i = std::min(int(x), kRows - 2);
+    const double t = x - i;
+    const Tables& tab = tables();
+    const double s = tab.d65[std::size_t(i)] * (1 - t) + tab.d65[std::size_t(i + 1)] * t;
+    Rgbd out;
+    for (int k = 0; k < 3; ++k) {
+        const auto& c = tab.cmf[std::size_t(k)];
+        out[std::size_t(k)] = s * (c[std::size_t(i)] * (1 - t) + c[std::size_t(i + 1)] * t);
+    }
+    return out;
+}
+
+Rgbd xyz_to_linear_srgb(const Rgbd& xyz) {
+    return {3.2406 * xyz[0] - 1.5372 * xyz[1] - 0.4986 * xyz[2],
+            -0.9689 * xyz[0] + 1.8758 * xyz[1] + 0.0415 * xyz[2],
+            0.0557 * xyz[0] - 0.2040 * xyz[1] + 1.0570 * xyz[2]};
+}
+
+}  // namespace lamina

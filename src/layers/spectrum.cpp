@@ -1,0 +1,151 @@
+#include "layers/spectrum.h"
+
+#include "core/check.h"
+#include "layers/spectral_data.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace lamina {
+
+double Spectrum::at(double lambda_nm) const {
+    switch (form) {
+        case Form::Table: {
+            if (lambda_nm <= wavelengths_nm.front()) return values.front();
+            if (lambda_nm >= wavelengths_nm.back()) return values.back();
+            const auto hi =
+                std::upper_bound(wavelengths_nm.begin(), wavelengths_nm.end(), lambda_nm);
+            const std::size_t j = std::size_t(hi - wavelengths_nm.begin());
+            const double t =
+                (lambda_nm - wavelengths_nm[j - 1]) / (wavelengths_nm[j] - wavelengths_nm[j - 1]);
+            return values[j - 1] + t * (values[j] - values[j - 1]);
+        }
+        case Form::Sellmeier: {
+            const double l2 = (lambda_nm * 1e-3) * (lambda_nm * 1e-3);
+            double n2 = 1;
+            for (std::size_t i = 0; i + 1 < coefficients.size(); i += 2)
+                n2 += coefficients[i] * l2 / (l2 - coefficients[i + 1]);
+            return std::sqrt(std::max(n2, 0.0));
+        }
+        case Form::Cauchy: {
+            const double inv_l2 = 1.0 / ((lambda_nm * 1e-3) * (lambda_nm * 1e-3));
+            double n = 0, power = 1;
+            for (double c : coefficients) {
+                n += c * power;
+                power *= inv_l2;
+            }
+            return n;
+        }
+    }
+    return 0;
+}
+
+Spectrum table_spectrum(std::vector<double> wavelengths_nm, std::vector<double> values) {
+    LAMINA_CHECK(!wavelengths_nm.empty() && wavelengths_nm.size() == values.size());
+    Spectrum s;
+    s.form = Spectrum::Form::Table;
+    s.wavelengths_nm = std::move(wavelengths_nm);
+    s.values = std::move(values);
+    return s;
+}
+Spectrum sellmeier_spectrum(std::vector<double> b_c) {
+    Spectrum s;
+    s.form = Spectrum::Form::Sellmeier;
+    s.coefficients = std::move(b_c);
+    return s;
+}
+Spectrum cauchy_spectrum(std::vector<double> coefficients) {
+    Spectrum s;
+    s.form = Spectrum::Form::Cauchy;
+    s.coefficients = std::move(coefficients);
+    return s;
+}
+Spectrum abbe_spectrum(double n_d, double v_d) {
+    constexpr double kD = 0.58756, kF = 0.48613, kC = 0.65627;  // µm
+    // n_F − n_C = B (1/λF² − 1/λC²) = (n_d − 1)/V_d; A from n_d.
+    const double b = (n_d - 1) / (v_d * (1 / (kF * kF) - 1 / (kC * kC)));
+    return cauchy_spectrum({n_d - b / (kD * kD), b});
+}
+
+namespace {
+constexpr const char* kMetals[] = {"Ag", "Al", "Au", "Cr", "Cu", "Fe", "Ni", "Pt", "Ti"};
+
+/// Rows of numbers of a CSV text (the header line skipped).
+std::vector<std::vector<std::string>> csv_rows(std::string_view text) {
+    std::vector<std::vector<std::string>> rows;
+    std::istringstream in{std::string(text)};
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+        if (line.empty()) continue;
+        std::vector<std::string> cells;
+        std::istringstream cells_in(line);
+        std::string cell;
+        while (std::getline(cells_in, cell, ','))
+            cells.push_back(cell);
+        rows.push_back(std::move(cells));
+    }
+    return rows;
+}
+
+std::string joined(auto&& names) {
+    std::string out;
+    for (const auto& n : names)
+        out += (out.empty() ? "\"" : ", \"") + std::string(n) + "\"";
+    return out;
+}
+
+std::vector<std::string> glass_names() {
+    std::vector<std::string> out;
+    for (const auto& row : csv_rows(spectral_data_file("glass/sellmeier.csv")))
+        out.push_back(row.at(0));
+    return out;
+}
+
+Spectrum metal_column(const std::string& name, std::size_t column) {
+    const std::string_view text = spectral_data_file("nk/" + name + ".csv");
+    LAMINA_CHECK(!text.empty());
+    std::vector<double> wl, v;
+    for (const auto& row : csv_rows(text)) {
+        wl.push_back(std::stod(row.at(0)));
+        v.push_back(std::stod(row.at(column)));
+    }
+    return table_spectrum(std::move(wl), std::move(v));
+}
+}  // namespace
+
+bool is_conductor_material(const std::string& name) {
+    return std::find(std::begin(kMetals), std::end(kMetals), name) != std::end(kMetals);
+}
+bool is_glass_material(const std::string& name) {
+    const auto names = glass_names();
+    return std::find(names.begin(), names.end(), name) != names.end();
+}
+std::string conductor_material_names() {
+    return joined(kMetals);
+}
+std::string glass_material_names() {
+    return joined(glass_names());
+}
+Spectrum conductor_material_eta(const std::string& name) {
+    return metal_column(name, 1);
+}
+Spectrum conductor_material_k(const std::string& name) {
+    return metal_column(name, 2);
+}
+Spectrum glass_material_eta(const std::string& name) {
+    for (const auto& row : csv_rows(spectral_data_file("glass/sellmeier.csv")))
+        if (row.at(0) == name) {
+            std::vector<double> b_c;
+            for (std::size_t i = 1; i < row.size(); ++i)
+                b_c.push_back(std::stod(row[i]));
+            while (b_c.size() >= 2 && b_c[b_c.size() - 2] == 0 && b_c.back() == 0)
+                b_c.resize(b_c.size() - 2);
+            return sellmeier_spectrum(std::move(b_c));
+        }
+    LAMINA_CHECK(false);
+    return {};
+}
+
+}  // namespace lamina
