@@ -67,12 +67,13 @@ class StackNotSupported final : public Model {
     std::string name_, reason_;
 };
 
-/// The entries with their factories refusing filmed and anisotropic stacks (StackNotSupported).
+/// The entries with their factories refusing anisotropic stacks, and filmed ones unless the entry
+/// represents films (ModelEntry::films), with StackNotSupported.
 std::vector<ModelEntry> refusing_unrepresented(std::vector<ModelEntry> entries) {
     for (ModelEntry& e : entries)
-        e.make = [make = std::move(e.make), name = e.name](
+        e.make = [make = std::move(e.make), name = e.name, films = e.films](
                      const Stack& stack, const ModelOptions& options) -> std::unique_ptr<Model> {
-            if (stack.has_film())
+            if (stack.has_film() && !films)
                 return std::make_unique<StackNotSupported>(
                     name,
                     "thin films are not supported by this model (the goniophotometer traces "
@@ -189,8 +190,9 @@ const std::vector<ModelEntry>& model_registry() {
         {"threejs-clearcoat",
          "three.js MeshPhysicalMaterial clearcoat: Schlick 0.04 (spherical-Gaussian fit) at v.h "
          "on the lobe, base x (1 - Fc(n.v)), roughness >= 0.045, compensated metal",
-         "bases: lambertian, conductor; eta0 = 1.5; sides: R", threejs_clearcoat_options,
-         make_threejs_clearcoat, false, "production"},
+         "bases: lambertian, conductor (with a thin film: KHR_materials_iridescence); eta0 = "
+         "1.5; sides: R",
+         threejs_clearcoat_options, make_threejs_clearcoat, false, "production", true},
         {"openpbr-materialx",
          "OpenPBR in MaterialX (its graph, GLSL generator): coat throughput 1 - E(wo) by its "
          "fitted albedo, constant coat_color, darkening with F0, compensated lobes",

@@ -27,6 +27,10 @@ struct ModelEntry {
     /// "production" (the coats engines ship), "lamina" (lamina's own model) or "reference" (the
     /// stochastic estimator).
     std::string group = "2019";
+    /// The model represents a thin film (InterfaceSpec::film) on the stacks it supports, in its
+    /// own form (docs/models.md, "Thin films"); for every other model the registry builds none
+    /// for a filmed stack.
+    bool films = false;
 };
 
 /// The groups of ModelEntry::group, in the order the explorer shows them.
