@@ -146,8 +146,8 @@ const std::vector<ModelEntry>& model_registry() {
         {"openpbr-adobe",
          "Adobe openpbr-bsdf: OpenPBR with view-only albedo scaling (reciprocal off), average "
          "Fresnel darkening, IOR-scaled roughening",
-         "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_adobe_options,
-         make_openpbr_adobe, false, "production"},
+         "bases: lambertian, conductor (with a thin film); media: absorbing; sides: R",
+         openpbr_adobe_options, make_openpbr_adobe, false, "production", true},
         {"standard-surface",
          "Autodesk Standard Surface: coat + coat_color (1 - E_coat(wo)) base, view-only",
          "bases: lambertian, conductor; media: absorbing; sides: R", standard_surface_options,

@@ -104,6 +104,32 @@ Rgbd film_reflectance_exact(const FilmOptics& film, double cos_theta) {
     });
 }
 
+std::complex<double> gulbrandsen_index(double r, double g) {
+    const double rc = clamp(r, 0.0, 0.99), sr = std::sqrt(rc);
+    const double n_min = (1 - rc) / (1 + rc), n_max = (1 + sr) / (1 - sr);
+    const double n = n_max + (n_min - n_max) * g;
+    const double k2 = (sqr(n + 1) * rc - sqr(n - 1)) / (1 - rc);
+    return {n, std::sqrt(std::max(k2, 0.0))};
+}
+
+Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, const Rgbd& bare) {
+    const double c = clamp(cos_theta, 0.0, 1.0);
+    // Total reflection at the coat | film boundary: openpbr-bsdf reflects everything.
+    const double sin_film = film.eta_above * std::sqrt(1 - c * c) / film.eta_film.real();
+    const double lambda_min =
+        std::min({film.wavelength_nm[0], film.wavelength_nm[1], film.wavelength_nm[2]});
+    const double period = lambda_min / (2 * std::max(std::abs(film.eta_film), 1e-3));
+    return thickness_average(film.thickness_min_nm, film.thickness_max_nm, period, [&](double d) {
+        const double t = clamp((d - 1e-9) / (30 - 1e-9), 0.0, 1.0), presence = t * t * (3 - 2 * t);
+        if (!(presence > 0)) return bare;
+        Rgbd r(1.0);
+        if (sin_film < 1)
+            for (int i = 0; i < 3; ++i)
+                r[i] = film.mueller(i, c, true, d).reflection.a;
+        return bare * (1 - presence) + r * presence;
+    });
+}
+
 Rgbd threejs_iridescence(double outside_ior, double film_ior, double cos_theta_1,
                          double thickness_nm, const Rgbd& base_f0) {
     const double pi = std::numbers::pi;

@@ -47,4 +47,17 @@ Rgbd threejs_iridescence(double outside_ior, double film_ior, double cos_theta_1
 Rgbd threejs_iridescence_range(double outside_ior, double film_ior, double cos_theta_1,
                                double min_nm, double max_nm, const Rgbd& base_f0);
 
+/// Gulbrandsen 2014 ("Artist friendly metallic Fresnel", JCGT 3(4)), Eqs. 3 and 4: the complex
+/// index n + ik whose normal reflectance is r (clamped to [0, 0.99], as openpbr-bsdf clamps it)
+/// with the edge tint g ∈ [0, 1] choosing n between (1 − r)/(1 + r) and (1 + √r)/(1 − √r).
+std::complex<double> gulbrandsen_index(double r, double g);
+
+/// Adobe openpbr-bsdf's film (openpbr_thin_film_iridescence_utils.h, openpbr_reflection_
+/// transmission_coefficient.h): the exact Airy reflectance of `film` at the facet cosine
+/// cos_theta (its eta_above the coat, its eta_below the metal's index as openpbr-bsdf derives
+/// it, gulbrandsen_index of its F0 and F82 tint), total reflection where the film's first
+/// boundary reflects totally (no tunnelling), faded in from the bare metal's reflectance `bare`
+/// over the first 30 nm (smoothstep(1e-9, 30, d)); averaged over the thickness range.
+Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, const Rgbd& bare);
+
 }  // namespace lamina

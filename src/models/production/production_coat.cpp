@@ -60,10 +60,12 @@ class ProductionCoat final : public Model {
                 support_.reason = fmt::format("{} has no thin film under its coat", r_.name);
                 return;
             }
-            if (r_.metal_film == CoatRecipe::MetalFilm::ThreeJs && in.film.k > 0) {
+            if ((r_.metal_film == CoatRecipe::MetalFilm::ThreeJs ||
+                 r_.metal_film == CoatRecipe::MetalFilm::OpenPbrBsdf) &&
+                in.film.k > 0) {
                 support_.reason = fmt::format(
-                    "{}'s iridescence film is transparent (no extinction k); this film's k is {}",
-                    r_.name, in.film.k);
+                    "{}'s thin film is transparent (no extinction k); this film's k is {}", r_.name,
+                    in.film.k);
                 return;
             }
             film_ = stack_film_optics(stack, i);
@@ -159,6 +161,10 @@ class ProductionCoat final : public Model {
                         break;
                 }
             }
+            // openpbr-bsdf's film sees the metal through its F0 and F82 tint (Gulbrandsen's map).
+            if (film_ && r_.metal_film == CoatRecipe::MetalFilm::OpenPbrBsdf)
+                for (int c = 0; c < 3; ++c)
+                    film_->eta_below[c] = gulbrandsen_index(f0_[c], tint82_[c]);
             // Filament's fresnel(): f90 = saturate(dot(f0, 50 · 0.33)), the edge dimmed for an F0
             // below 2 %.
             if (r_.metal_f90_from_f0) f90_ = std::min(1.0, 50 * 0.33 * (f0_[0] + f0_[1] + f0_[2]));
@@ -551,6 +557,8 @@ class ProductionCoat final : public Model {
                 return threejs_iridescence_range(1.0, film_->eta_film.real(), mu_o,
                                                  film_->thickness_min_nm, film_->thickness_max_nm,
                                                  f0_);
+            case CoatRecipe::MetalFilm::OpenPbrBsdf:
+                return openpbr_bsdf_film_reflectance(*film_, cos_h, metal_fresnel(cos_h));
             case CoatRecipe::MetalFilm::Unsupported:
                 break;
         }

@@ -184,6 +184,10 @@ struct CoatRecipe {
         /// the metal's F0, averaged over the thickness range (threejs_iridescence_range); its
         /// thickness 0 turns the film off (the bare metal Fresnel).
         ThreeJs,
+        /// openpbr-bsdf's: the Airy reflectance at wi·h between the coat and the metal's index
+        /// from its F0 and F82 tint by Gulbrandsen's map, at the stack's wavelengths, faded in over
+        /// the first 30 nm (openpbr_bsdf_film_reflectance); the metal's F82-tint Fresnel below.
+        OpenPbrBsdf,
     } metal_film = MetalFilm::Unsupported;
 
     /// Standard Surface's coat_affect_color = 1: ρ ← ρ^2 (its default 0 leaves ρ).

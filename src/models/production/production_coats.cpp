@@ -53,6 +53,8 @@ CoatRecipe openpbr_recipe(const ModelOptions& o) {
 CoatRecipe adobe_recipe(const ModelOptions& o) {
     CoatRecipe r;
     r.name = "openpbr-adobe";
+    // Its thin film (thin_film_weight 1) on the metal under the coat.
+    r.metal_film = CoatRecipe::MetalFilm::OpenPbrBsdf;
     r.coat_fresnel = CoatRecipe::Fresnel::Exact;
     r.attenuation = is_on(o, "reciprocal") ? CoatRecipe::Attenuation::AlbedoReciprocal
                                            : CoatRecipe::Attenuation::AlbedoView;

@@ -86,30 +86,30 @@ TEST(FilmFresnel, RangeIsTheMeanOverTheThickness) {
     }
 }
 
-// three.js turns its iridescence off at thickness 0 (lights_fragment_begin): the model is then
-// the filmless threejs-clearcoat, value for value; with leaves=exact the film of thickness 0 is
-// the bare metal (to rounding).
+// three.js turns its iridescence off at thickness 0 (lights_fragment_begin), openpbr-bsdf fades
+// its film in from 0 (presence 0): each model is then its filmless self, value for value; with
+// leaves=exact the film of thickness 0 is the bare metal (to rounding).
 TEST(FilmFresnel, ThicknessZeroIsTheFilmlessModel) {
     const InterfaceSpec metal = titanium(0.1);
     const Stack bare = test::coated(1.5, 0.09, metal),
                 filmed = test::coated(1.5, 0.09, with_film(metal, 2.5, 0, 0));
-    for (const std::vector<std::string>& o :
-         {std::vector<std::string>{}, std::vector<std::string>{"leaves=exact"}}) {
-        const auto a = make_model("threejs-clearcoat", bare, o),
-                   b = make_model("threejs-clearcoat", filmed, o);
-        ASSERT_TRUE(b->support().brdf) << b->support().reason;
-        for (const auto& [wi, wo] :
-             {std::pair{dir(0, 0), dir(30, 180)}, std::pair{dir(50, 0), dir(45, 170)},
-              std::pair{dir(75, 0), dir(20, 90)}}) {
-            const Rgbd x = a->eval(wi, wo), y = b->eval(wi, wo);
-            for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(y[c], x[c], 1e-12 * std::max(1.0, x[c])) << (o.empty() ? "" : o[0]);
+    for (const char* name : {"threejs-clearcoat", "openpbr-adobe"})
+        for (const std::vector<std::string>& o :
+             {std::vector<std::string>{}, std::vector<std::string>{"leaves=exact"}}) {
+            const auto a = make_model(name, bare, o), b = make_model(name, filmed, o);
+            ASSERT_TRUE(b->support().brdf) << b->support().reason;
+            for (const auto& [wi, wo] :
+                 {std::pair{dir(0, 0), dir(30, 180)}, std::pair{dir(50, 0), dir(45, 170)},
+                  std::pair{dir(75, 0), dir(20, 90)}}) {
+                const Rgbd x = a->eval(wi, wo), y = b->eval(wi, wo);
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_NEAR(y[c], x[c], 1e-12 * std::max(1.0, x[c])) << (o.empty() ? "" : o[0]);
+            }
         }
-    }
 }
 
-// The filmed stacks a model without films refuses, and the ones threejs-clearcoat refuses: a
-// film on the coat, an absorbing film (three.js's film has no k).
+// The filmed stacks a model without films refuses, and the ones the film models refuse: a film on
+// the coat, an absorbing film (three.js's and openpbr-bsdf's films have no k).
 TEST(FilmFresnel, WhoRepresentsWhichFilm) {
     const Stack under = test::coated(1.5, 0.09, with_film(titanium(0.1), 2.5, 60, 60));
     for (const ModelEntry& e : model_registry()) {
@@ -123,6 +123,7 @@ TEST(FilmFresnel, WhoRepresentsWhichFilm) {
     Stack absorbing = under;
     absorbing.layers[1].interface.film.k = 0.5;
     EXPECT_FALSE(make_model("threejs-clearcoat", absorbing)->support().brdf);
+    EXPECT_FALSE(make_model("openpbr-adobe", absorbing)->support().brdf);
     EXPECT_TRUE(make_model("threejs-clearcoat:leaves=exact", absorbing)->support().brdf);
 }
 
@@ -149,12 +150,13 @@ double max_albedo_per_wo(const Model& m) {
 }
 
 // Energy per wo (the production coats' bound, production_test.cpp): the exact film leaf
-// reflects at most what arrives (R ≤ 1 without gain), so leaves=exact stays ≤ 1 within the
+// reflects at most what arrives (R ≤ 1 without gain), so leaves=exact (and openpbr-adobe, whose
+// film is an Airy reflectance too) stays ≤ 1 within the
 // quadrature's 1e-3 and the FGD table's budget (6.3e-3); three.js's film, a colour projection of
 // a spectrum, is not bounded by 1 in every channel: its excess is shown, not hidden.
 TEST(FilmFresnel, EnergyPerView) {
     const double tol = 1e-3 + 6.3e-3;
-    double worst_exact = 0, worst_threejs = 0;
+    double worst_exact = 0, worst_threejs = 0, worst_adobe = 0;
     for (double alpha1 : {0.0, 0.05, 0.3})
         for (const auto& [eta, d] : {std::pair{1.38, 100.0}, std::pair{2.5, 60.0},
                                      std::pair{1.8, 300.0}, std::pair{2.0, 450.0}})
@@ -165,11 +167,15 @@ TEST(FilmFresnel, EnergyPerView) {
                              max_albedo_per_wo(*make_model("threejs-clearcoat:leaves=exact", s)));
                 worst_threejs =
                     std::max(worst_threejs, max_albedo_per_wo(*make_model("threejs-clearcoat", s)));
+                worst_adobe =
+                    std::max(worst_adobe, max_albedo_per_wo(*make_model("openpbr-adobe", s)));
             }
     EXPECT_LE(worst_exact, 1 + tol);
+    EXPECT_LE(worst_adobe, 1 + tol);  // an Airy reflectance too: ≤ 1
     std::cout << fmt::format(
-        "per-wo albedo, most over the sweep: leaves=exact {:.4f}, three.js {:.4f}\n", worst_exact,
-        worst_threejs);
+        "per-wo albedo, most over the sweep: leaves=exact {:.4f}, three.js {:.4f}, openpbr-adobe "
+        "{:.4f}\n",
+        worst_exact, worst_threejs, worst_adobe);
 }
 
 /// One single film of docs/models.md's table: a film in air (or under a coat of index
