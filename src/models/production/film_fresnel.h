@@ -1,7 +1,8 @@
 #pragma once
 // The Fresnel terms of a thin film on a coated metal as the production models evaluate them
 // (docs/models.md, "Thin films"): the exact Airy reflectance of the stack's film (the physics of
-// physics/thin_film.h, at the stack's channel wavelengths) and three.js's iridescence
+// physics/thin_film.h, at the stack's channel wavelengths); Adobe openpbr-bsdf's, the same sum
+// against the metal its F0 and edge tint describe; and three.js's iridescence
 // (KHR_materials_iridescence as three.js evaluates it), Belcour & Barla 2017's Fourier-space Airy
 // sum reduced to two orders on Schlick's Fresnel, integrated against the CIE colour matching
 // functions and returned in linear sRGB.
@@ -42,7 +43,7 @@ Rgbd threejs_iridescence(double outside_ior, double film_ior, double cos_theta_1
                          double thickness_nm, const Rgbd& base_f0);
 
 /// threejs_iridescence averaged over the thickness range [min_nm, max_nm] (the mean of what a
-/// thickness texture uniform over the range shows), by Gauss–Legendre quadrature (12 nodes per
+/// thickness texture uniform over the range shows), by Gauss–Legendre quadrature (32 nodes per
 /// period of the interference, at most 2048 nodes); min_nm = max_nm is one thickness.
 Rgbd threejs_iridescence_range(double outside_ior, double film_ior, double cos_theta_1,
                                double min_nm, double max_nm, const Rgbd& base_f0);
