@@ -33,6 +33,7 @@
     ["alpha0", "α0 (top roughness)"], ["eta0", "η0 (top IOR)"], ["tau", "τa (absorption)"],
     ["tau_s", "τs (scattering)"], ["base", "base"], ["alpha1", "α1 (base roughness)"],
     ["eta1", "η1 (base IOR)"], ["kappa1", "κ1 (base extinction)"], ["rho", "ρ (base albedo)"],
+    ["film_nm", "film thickness (nm)"], ["film_eta", "film η"],
   ];
 
   const configs = INDEX.configs;

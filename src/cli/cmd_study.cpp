@@ -211,8 +211,8 @@ Runner add_study(CLI::App& app) {
                                  ("study-" + a->preset + (physics == "exact" ? "" : "-" + physics))
                            : std::filesystem::path(a->out);
         if (world.is_root()) {
-            configs =
-                a->configs.empty() ? builtin_configurations() : load_configurations(a->configs);
+            configs = a->configs.empty() ? preset_configurations(a->preset)
+                                         : load_configurations(a->configs);
             configs = filter_configurations(std::move(configs), a->only);
             check_model_tables(*a, configs);
         }

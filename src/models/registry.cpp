@@ -68,13 +68,15 @@ class StackNotSupported final : public Model {
     std::string name_, reason_;
 };
 
-/// The entries with their factories refusing filmed stacks, and anisotropic ones unless the entry
-/// represents anisotropy (StackNotSupported).
+/// The entries with their factories refusing filmed stacks unless the entry represents films
+/// (ModelEntry::films), and anisotropic ones unless it represents anisotropy
+/// (ModelEntry::represents_anisotropy), with StackNotSupported.
 std::vector<ModelEntry> refusing_unrepresented(std::vector<ModelEntry> entries) {
     for (ModelEntry& e : entries)
-        e.make = [make = std::move(e.make), name = e.name, anisotropic = e.represents_anisotropy](
+        e.make = [make = std::move(e.make), name = e.name, films = e.films,
+                  anisotropic = e.represents_anisotropy](
                      const Stack& stack, const ModelOptions& options) -> std::unique_ptr<Model> {
-            if (stack.has_film())
+            if (stack.has_film() && !films)
                 return std::make_unique<StackNotSupported>(
                     name,
                     "thin films are not supported by this model (the goniophotometer traces "
@@ -147,7 +149,8 @@ const std::vector<ModelEntry>& model_registry() {
         {"openpbr-adobe",
          "Adobe openpbr-bsdf: OpenPBR with view-only albedo scaling (reciprocal off), average "
          "Fresnel darkening, IOR-scaled roughening",
-         "bases: lambertian, conductor; media: absorbing; anisotropic coat and metal; sides: R",
+         "bases: lambertian, conductor (with a thin film); media: absorbing; anisotropic coat and "
+         "metal; sides: R",
          openpbr_adobe_options, make_openpbr_adobe, false, "production", true},
         {"standard-surface",
          "Autodesk Standard Surface: coat + coat_color (1 - E_coat(wo)) base, view-only",
@@ -191,8 +194,9 @@ const std::vector<ModelEntry>& model_registry() {
         {"threejs-clearcoat",
          "three.js MeshPhysicalMaterial clearcoat: Schlick 0.04 (spherical-Gaussian fit) at v.h "
          "on the lobe, base x (1 - Fc(n.v)), roughness >= 0.045, compensated metal",
-         "bases: lambertian, conductor; eta0 = 1.5; sides: R", threejs_clearcoat_options,
-         make_threejs_clearcoat, false, "production"},
+         "bases: lambertian, conductor (with a thin film: KHR_materials_iridescence); eta0 = "
+         "1.5; sides: R",
+         threejs_clearcoat_options, make_threejs_clearcoat, false, "production", true},
         {"openpbr-materialx",
          "OpenPBR in MaterialX (its graph, GLSL generator): coat throughput 1 - E(wo) by its "
          "fitted albedo, constant coat_color, darkening with F0, compensated lobes",

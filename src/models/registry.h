@@ -31,6 +31,10 @@ struct ModelEntry {
     /// §3): it is built for such a stack and evaluated on the unfolded grid. Otherwise it reports
     /// the stack as not supported.
     bool represents_anisotropy = false;
+    /// The model represents a thin film (InterfaceSpec::film) on the stacks it supports, in its
+    /// own form (docs/models.md, "Thin films"); for every other model the registry builds none
+    /// for a filmed stack.
+    bool films = false;
 };
 
 /// The groups of ModelEntry::group, in the order the explorer shows them.

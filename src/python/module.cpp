@@ -681,17 +681,21 @@ void bind_study(py::module_& m) {
           py::arg("sides"));
     m.def("_run_study", &run_study_py, py::arg("configs"), py::arg("settings"),
           py::arg("externals"), py::arg("out"), py::arg("figures"));
-    m.def("_builtin_configurations", [] {
-        py::list out;
-        for (const StudyConfiguration& c : builtin_configurations()) {
-            py::dict d;
-            d["id"] = c.id;
-            d["category"] = c.category;
-            d["stack"] = c.stack;
-            out.append(d);
-        }
-        return out;
-    });
+    // The configurations a study runs at `preset` (the iridescent category in the larger ones).
+    m.def(
+        "_builtin_configurations",
+        [](const std::string& preset) {
+            py::list out;
+            for (const StudyConfiguration& c : preset_configurations(preset)) {
+                py::dict d;
+                d["id"] = c.id;
+                d["category"] = c.category;
+                d["stack"] = c.stack;
+                out.append(d);
+            }
+            return out;
+        },
+        py::arg("preset") = "quick");
     m.def("_filter_configurations", [](py::list configs, const std::string& pattern) {
         // Filters by id with the CLI's --only rule (globs, commas).
         std::vector<StudyConfiguration> cs;

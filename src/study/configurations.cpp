@@ -81,6 +81,12 @@ std::map<std::string, std::string> describe_parameters(const Stack& stack) {
     }
     if (stack.layers.size() >= 2) {
         const InterfaceSpec& base = stack.base();
+        if (base.has_film) {
+            const FilmSpec& f = base.film;
+            p["film_nm"] = f.varies() ? fmt::format("[{}, {}]", f.thickness_nm, f.thickness_max_nm)
+                                      : num(f.thickness_nm);
+            p["film_eta"] = f.k > 0 ? fmt::format("{} + {}i", f.eta, f.k) : num(f.eta);
+        }
         switch (base.type) {
             case InterfaceType::Lambertian:
                 p["base"] = "lambertian";
@@ -139,6 +145,53 @@ std::vector<StudyConfiguration> builtin_configurations() {
                     fmt::format("slab-a{}-a1{}-{}", a0, alpha1_id(a1), t == 0 ? "clear" : "tinted"),
                     "slab",
                     {coat(a0, t == 0 ? Rgbd(0.0) : Rgbd(0.1, 0.0, 0.9)), dielectric(1.0, a1)}));
+    return out;
+}
+
+std::vector<StudyConfiguration> iridescent_configurations() {
+    // Metals at the channels' wavelengths (630, 532, 465 nm), representative values rounded from
+    // the handbooks' tables.
+    const Rgbd ti_eta(2.74, 2.54, 2.26), ti_k(3.79, 3.43, 3.07);
+    const Rgbd gold_eta(0.143, 0.374, 1.442), gold_k(3.983, 2.385, 1.603);  // the frosted metals'
+    const Rgbd al_eta(1.2, 0.96, 0.65), al_k(7.3, 6.4, 5.4);
+    const Rgbd cu_eta(0.27, 1.12, 1.17), cu_k(3.41, 2.6, 2.4);
+    const Rgbd fe_eta(2.87, 2.95, 2.65), fe_k(3.08, 2.93, 2.81);
+    struct Iridescent {
+        const char* id;
+        double alpha0;
+        Rgbd eta, k;
+        double alpha1, film_eta, film_k, min_nm, max_nm;
+    };
+    const Iridescent list[] = {
+        // Anodized titanium: a 60 nm oxide of index 2.5, first-order interference, glossy and
+        // rough.
+        {"irid-ti-oxide-a0.05-a1.05", 0.05, ti_eta, ti_k, 0.05, 2.5, 0.0, 60, 60},
+        {"irid-ti-oxide-a0.05-a1.3", 0.05, ti_eta, ti_k, 0.3, 2.5, 0.0, 60, 60},
+        // An interference pigment: 300 nm of index 1.8 on gold (higher orders), under a rough
+        // coat.
+        {"irid-gold-film-a0.3-a1.05", 0.3, gold_eta, gold_k, 0.05, 1.8, 0.0, 300, 300},
+        // A protected mirror: MgF2 a quarter wave thick at 532 nm on aluminium, smooth coat.
+        {"irid-al-mgf2-a0.001-a1.2", 0.001, al_eta, al_k, 0.2, 1.38, 0.0, 96.4, 96.4},
+        // A film whose thickness varies over the surface (200–600 nm of 1.5) on copper.
+        {"irid-cu-range-a0.1-a1.1", 0.1, cu_eta, cu_k, 0.1, 1.5, 0.0, 200, 600},
+        // Temper colours: an absorbing 80 nm oxide (2.3 + 0.1i) on iron.
+        {"irid-fe-temper-a0.05-a1.1", 0.05, fe_eta, fe_k, 0.1, 2.3, 0.1, 80, 80},
+    };
+    std::vector<StudyConfiguration> out;
+    for (const Iridescent& c : list) {
+        Layer metal = conductor(c.eta, c.k, c.alpha1);
+        metal.interface.has_film = true;
+        metal.interface.film = {c.min_nm, c.max_nm, c.film_eta, c.film_k};
+        out.push_back(make(c.id, "iridescent", {coat(c.alpha0, Rgbd(0.0)), metal}));
+    }
+    return out;
+}
+
+std::vector<StudyConfiguration> preset_configurations(const std::string& preset) {
+    std::vector<StudyConfiguration> out = builtin_configurations();
+    if (preset != "quick")
+        for (StudyConfiguration& c : iridescent_configurations())
+            out.push_back(std::move(c));
     return out;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // The study's configurations (docs/study.md): 60 two-interface stacks under air — plastics,
-// metallic paints, frosted metals and slabs — built into lamina, plus a user's own list.
+// metallic paints, frosted metals and slabs — built into lamina, the iridescent category of the
+// larger presets, plus a user's own list.
 
 #include "layers/stack.h"
 
@@ -22,6 +23,16 @@ struct StudyConfiguration {
 
 /// The 60 configurations of docs/study.md, in a fixed order.
 std::vector<StudyConfiguration> builtin_configurations();
+
+/// The "iridescent" category (docs/study.md): a clear coat over a metal carrying a thin film
+/// (oxides, protective and interference films; absorbing, of varying thickness, on smooth and
+/// rough metals), traced by the scalar kernel. The standard and paper presets add it to the 60;
+/// the quick one (make demo) leaves it out.
+std::vector<StudyConfiguration> iridescent_configurations();
+
+/// The configurations a study runs by default at `preset`: builtin_configurations(), and
+/// iridescent_configurations() for every preset but "quick".
+std::vector<StudyConfiguration> preset_configurations(const std::string& preset);
 
 /// A user's list: {"configurations": [{"id": ..., "category": ..., "stack": {...}}, ...]}
 /// (`category` optional, default "custom"). InputError naming the file and the JSON pointer.

@@ -211,6 +211,28 @@ TEST(StudyConfigurations, SixtyWithStableUniqueIds) {
     EXPECT_THROW(filter_configurations(configs, "nothing*"), InputError);
 }
 
+// docs/study.md, "The iridescent category": six clear coats over filmed metals, stable ids,
+// valid stacks (the reader's ranges, through its JSON round trip), added by every preset but the
+// quick one.
+TEST(StudyConfigurations, IridescentInTheLargerPresetsOnly) {
+    const auto irid = iridescent_configurations();
+    ASSERT_EQ(irid.size(), 6u);
+    for (const auto& c : irid) {
+        EXPECT_EQ(c.category, "iridescent");
+        ASSERT_EQ(c.stack.layers.size(), 2u);
+        EXPECT_EQ(c.stack.layers[0].interface.eta, 1.5);
+        EXPECT_TRUE(c.stack.layers[1].interface.has_film) << c.id;
+        EXPECT_EQ(stack_from_json(stack_to_json(c.stack), c.id), c.stack) << c.id;
+        EXPECT_TRUE(c.parameters.count("film_nm")) << c.id;
+    }
+    EXPECT_EQ(preset_configurations("quick").size(), 60u);
+    for (const char* preset : {"standard", "paper"}) {
+        const auto all = preset_configurations(preset);
+        ASSERT_EQ(all.size(), 66u);
+        EXPECT_EQ(all.back().id, irid.back().id);
+    }
+}
+
 TEST(StudyReference, CachedPieceIsReusedAndAMismatchIsRecomputed) {
     const std::filesystem::path dir =
         std::filesystem::path(LAMINA_BINARY_DIR) / "test-output" / "reference-cache";

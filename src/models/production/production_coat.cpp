@@ -4,6 +4,7 @@
 #include "models/numerics/quadrature.h"
 #include "models/production/cycles_albedo.h"
 #include "models/production/filament_dfg.h"
+#include "models/production/film_fresnel.h"
 #include "models/production/threejs_dfg.h"
 #include "models/production/uncorrelated_albedo.h"
 #include "models/tables/fgd_table.h"
@@ -32,12 +33,6 @@ double schlick(double c, double f0) {
     return f0 + (1 - f0) * schlick_weight(c);
 }
 
-/// Karis 2013 ("Real shading in Unreal Engine 4", SIGGRAPH course notes)'s spherical-Gaussian fit
-/// of Schlick's weight, 2^((−5.55473 c − 6.98316) c), as three.js's F_Schlick evaluates it.
-double schlick_weight_spherical_gaussian(double c) {
-    return std::exp2((-5.55473 * c - 6.98316) * c);
-}
-
 constexpr double kF82Cos = 1.0 / 7.0;  // μ̄ of the F82-tint model (OpenPBR 1.1, "Metal")
 /// OpenPBR 1.1's default specular_roughness: the diffuse base leaves it there (its specular_weight
 /// is 0); openpbr-bsdf's darkening still reads it through E_F(1) (docs/models.md).
@@ -50,7 +45,34 @@ class ProductionCoat final : public Model {
   public:
     ProductionCoat(const Stack& stack, const CoatRecipe& recipe) : r_(recipe) {
         std::string why;
-        if (!coated_stack(stack, coat_, why)) {
+        // A film under the coat is the recipe's (MetalFilm); the rest of the stack is read
+        // without it.
+        Stack bare = stack;
+        for (std::size_t i = 0; i < bare.layers.size(); ++i) {
+            InterfaceSpec& in = bare.layers[i].interface;
+            if (!in.has_film) continue;
+            if (i + 1 != stack.layers.size() || in.type != InterfaceType::Conductor) {
+                support_.reason =
+                    fmt::format("{} has no thin film but on a metal base under its coat", r_.name);
+                return;
+            }
+            if (r_.metal_film == CoatRecipe::MetalFilm::Unsupported) {
+                support_.reason = fmt::format("{} has no thin film under its coat", r_.name);
+                return;
+            }
+            if ((r_.metal_film == CoatRecipe::MetalFilm::ThreeJs ||
+                 r_.metal_film == CoatRecipe::MetalFilm::OpenPbrBsdf) &&
+                in.film.k > 0) {
+                support_.reason = fmt::format(
+                    "{}'s thin film is transparent (no extinction k); this film's k is {}", r_.name,
+                    in.film.k);
+                return;
+            }
+            film_ = stack_film_optics(stack, i);
+            in.has_film = false;
+            in.film = {};
+        }
+        if (!coated_stack(bare, coat_, why)) {
             support_.reason = fmt::format("{} {}", r_.name, why);
             return;
         }
@@ -156,6 +178,10 @@ class ProductionCoat final : public Model {
                         break;
                 }
             }
+            // openpbr-bsdf's film sees the metal through its F0 and F82 tint (Gulbrandsen's map).
+            if (film_ && r_.metal_film == CoatRecipe::MetalFilm::OpenPbrBsdf)
+                for (int c = 0; c < 3; ++c)
+                    film_->eta_below[c] = gulbrandsen_index(f0_[c], tint82_[c]);
             // Filament's fresnel(): f90 = saturate(dot(f0, 50 · 0.33)), the edge dimmed for an F0
             // below 2 %.
             if (r_.metal_f90_from_f0) f90_ = std::min(1.0, 50 * 0.33 * (f0_[0] + f0_[1] + f0_[2]));
@@ -262,7 +288,7 @@ class ProductionCoat final : public Model {
             if (alpha_base_ <= 0) return Rgbd(f_coat);  // a smooth base: a delta lobe
             const GGX<double>& ggx = base_ggx_;
             const double G = masking_shadowing(r_.metal_visibility, in.lambda_base, ggx, wo);
-            base = metal_fresnel(cos_h) * (ndf(ggx, h) * G / (4 * wi.z * wo.z));
+            base = base_fresnel(cos_h, wo.z) * (ndf(ggx, h) * G / (4 * wi.z * wo.z));
             if (dfg_) {
                 // Filament's energyCompensation, 1 + F0 (1/E(μo) − 1), on the lobe.
                 const double inv_e = 1 / dfg_->albedo(wo.z);
@@ -318,7 +344,7 @@ class ProductionCoat final : public Model {
             lobes.push_back({wr, Rgbd(coat_fresnel(wi.z) * coat_compensation(wi.z))});
         if (is_metal_ && alpha_base_ == 0) {
             const Incident in = incident(wi);
-            lobes.push_back({wr, metal_fresnel(wi.z) * base_scale(in, wi.z, wi.z)});
+            lobes.push_back({wr, base_fresnel(wi.z, wi.z) * base_scale(in, wi.z, wi.z)});
         }
         return lobes;
     }
@@ -548,6 +574,27 @@ class ProductionCoat final : public Model {
         return F;
     }
 
+    /// The Fresnel factor of the metal lobe at cos_h = wi·h for the view cosine mu_o: the metal's
+    /// own (metal_fresnel), or the film's reflectance in the recipe's form (MetalFilm).
+    Rgbd base_fresnel(double cos_h, double mu_o) const {
+        if (!film_) return metal_fresnel(cos_h);
+        switch (r_.metal_film) {
+            case CoatRecipe::MetalFilm::Exact:
+                return film_reflectance_exact(*film_, cos_h);
+            case CoatRecipe::MetalFilm::ThreeJs:
+                // three.js switches its iridescence off at thickness 0 (lights_fragment_begin).
+                if (!(film_->thickness_max_nm > 0)) return metal_fresnel(cos_h);
+                return threejs_iridescence_range(1.0, film_->eta_film.real(), mu_o,
+                                                 film_->thickness_min_nm, film_->thickness_max_nm,
+                                                 f0_);
+            case CoatRecipe::MetalFilm::OpenPbrBsdf:
+                return openpbr_bsdf_film_reflectance(*film_, cos_h, metal_fresnel(cos_h));
+            case CoatRecipe::MetalFilm::Unsupported:
+                break;
+        }
+        return metal_fresnel(cos_h);
+    }
+
     /// A · T · Δ: the base's scale for the pair (in.wi, wo) with cos_h = wi·h.
     Rgbd base_scale(const Incident& in, double mu_o, double cos_h) const {
         using A = CoatRecipe::Attenuation;
@@ -658,6 +705,8 @@ class ProductionCoat final : public Model {
     CoatRecipe r_;
     CoatedStack coat_;
     Support support_;
+    /// The film on the metal base, when the stack has one (MetalFilm).
+    std::optional<FilmOptics> film_;
     double eta0_ = 1.5;
     double coat_f0_ = 0;
     double alpha_coat_ = 0, alpha_base_ = 0;
@@ -784,6 +833,8 @@ void use_exact_leaves(CoatRecipe& r) {
     r.coat_albedo = CoatRecipe::CoatAlbedo::Fgd;
     r.metal_multiple_scattering = CoatRecipe::MetalMultipleScattering::None;
     r.metal_fresnel = CoatRecipe::MetalFresnel::Exact;
+    if (r.metal_film != CoatRecipe::MetalFilm::Unsupported)
+        r.metal_film = CoatRecipe::MetalFilm::Exact;
 }
 
 std::unique_ptr<Model> make_production_coat(const Stack& stack, const CoatRecipe& recipe) {

@@ -30,10 +30,10 @@
 // used.
 //
 // Represented: a dielectric coat (absorbing, not scattering) over a Lambertian or conductor base
-// (BRDF only), anisotropic for the recipes that define anisotropic roughness (OpenPBR's). Not
-// supported, with the reason: other shapes, a scattering coat, a dielectric base (slab: the models'
-// bases are opaque), and a coat IOR other than 1.5 for the models whose coat has a fixed IOR
-// (Enterprise PBR, Filament, glTF).
+// (BRDF only), anisotropic for the recipes that define anisotropic roughness (OpenPBR's), and for a
+// recipe with a MetalFilm a thin film on the conductor. Not supported, with the reason: other
+// shapes, a scattering coat, a dielectric base (slab: the models' bases are opaque), and a coat IOR
+// other than 1.5 for the models whose coat has a fixed IOR (Enterprise PBR, Filament, glTF).
 
 #include "models/model.h"
 #include "models/production/ggx_albedo.h"
@@ -171,6 +171,24 @@ struct CoatRecipe {
         F82Tint,          ///< Kutz et al. 2021's F82-tint: F0 and the tint from the exact F(1/7)
         SchlickFilament,  ///< Schlick with the F0 in air converted by f0ClearCoatToSurface
     } metal_fresnel = MetalFresnel::Exact;
+
+    /// A thin film on the metal base, between the coat and the metal (docs/models.md, "Thin
+    /// films"): its reflectance replaces the metal's Fresnel in the base lobe.
+    enum class MetalFilm {
+        Unsupported,  ///< the model has no film under its coat: a filmed base is not supported
+        /// The film's exact Airy reflectance relative to the coat at wi·h, per channel at the
+        /// stack's wavelength, averaged over the thickness range (models/production/
+        /// film_fresnel.h, film_reflectance_exact).
+        Exact,
+        /// three.js's iridescence Fresnel at n·wo against air (outside IOR 1), the base read from
+        /// the metal's F0, averaged over the thickness range (threejs_iridescence_range); its
+        /// thickness 0 turns the film off (the bare metal Fresnel).
+        ThreeJs,
+        /// openpbr-bsdf's: the Airy reflectance at wi·h between the coat and the metal's index
+        /// from its F0 and F82 tint by Gulbrandsen's map, at the stack's wavelengths, faded in over
+        /// the first 30 nm (openpbr_bsdf_film_reflectance); the metal's F82-tint Fresnel below.
+        OpenPbrBsdf,
+    } metal_film = MetalFilm::Unsupported;
 
     /// Standard Surface's coat_affect_color = 1: ρ ← ρ^2 (its default 0 leaves ρ).
     bool affect_color = false;

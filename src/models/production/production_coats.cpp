@@ -55,6 +55,8 @@ CoatRecipe openpbr_recipe(const ModelOptions& o) {
 CoatRecipe adobe_recipe(const ModelOptions& o) {
     CoatRecipe r;
     r.name = "openpbr-adobe";
+    // Its thin film (thin_film_weight 1) on the metal under the coat.
+    r.metal_film = CoatRecipe::MetalFilm::OpenPbrBsdf;
     r.coat_fresnel = CoatRecipe::Fresnel::Exact;
     r.attenuation = is_on(o, "reciprocal") ? CoatRecipe::Attenuation::AlbedoReciprocal
                                            : CoatRecipe::Attenuation::AlbedoView;
@@ -195,6 +197,9 @@ CoatRecipe gltf_recipe(const ModelOptions& o) {
 CoatRecipe threejs_recipe(const ModelOptions& o) {
     CoatRecipe r;
     r.name = "threejs-clearcoat";
+    // KHR_materials_iridescence on the base (iridescence_fragment, lights_fragment_begin):
+    // evalIridescence at n.v replaces the base's Fresnel in its lobe.
+    r.metal_film = CoatRecipe::MetalFilm::ThreeJs;
     // Its shaders (lights_physical_pars_fragment, lights_physical_fragment, meshphysical, common):
     // Schlick 0.04 in Karis's spherical-Gaussian form at v.h on the coat lobe, the base times
     // 1 - clearcoat F(n.v), the height-correlated visibility, roughness of coat and base clamped

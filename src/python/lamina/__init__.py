@@ -300,7 +300,8 @@ def study(models=None, preset="quick", only=None, configs=None, out=None, figure
           quiet=True, nodes=4, peak_nodes=32, tables="half", **settings: Any) -> Study:
     """`lamina study` from Python, with Python models beside the built-in ones.
 
-    configs: None for the study's 60 configurations, or a list of {"id", "category", "stack"};
+    configs: None for the study's configurations at the preset (the 60, and the iridescent category
+    beyond the quick preset), or a list of {"id", "category", "stack"};
     only: the CLI's --only globs. settings: the reference's, any of SIMULATION_SETTINGS by name;
     particles, when given, replaces the preset's budget. Returns the study directory `out` as a
     lamina.Study.
@@ -313,7 +314,7 @@ def study(models=None, preset="quick", only=None, configs=None, out=None, figure
         label = "custom"
     else:
         settings = dict(settings, particles=_lamina._preset_particles(preset))
-    cs = _lamina._builtin_configurations() if configs is None else [
+    cs = _lamina._builtin_configurations(preset) if configs is None else [
         {"id": c["id"], "category": c.get("category", "custom"), "stack": Stack(c["stack"])}
         for c in configs]
     if only:
