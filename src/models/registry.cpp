@@ -139,19 +139,20 @@ const std::vector<ModelEntry>& model_registry() {
          "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "
          "per-query reference, unbiased",
          "every stack; sides: R, T (slab)", random_walk_options, make_random_walk, true,
-         "reference", true},
+         "reference", /*represents_anisotropy=*/true},
         // The coats engines ship (production_coats.cpp, docs/models.md "Production coats").
         {"openpbr",
          "OpenPBR Surface 1.1 specification: albedo-scaled coat, coat darkening, base "
          "roughening, view-dependent tint",
          "bases: lambertian, conductor; media: absorbing; anisotropic coat and metal; sides: R",
-         openpbr_options, make_openpbr, false, "production", true},
+         openpbr_options, make_openpbr, false, "production", /*represents_anisotropy=*/true},
         {"openpbr-adobe",
          "Adobe openpbr-bsdf: OpenPBR with view-only albedo scaling (reciprocal off), average "
          "Fresnel darkening, IOR-scaled roughening",
          "bases: lambertian, conductor (with a thin film); media: absorbing; anisotropic coat and "
          "metal; sides: R",
-         openpbr_adobe_options, make_openpbr_adobe, false, "production", true},
+         openpbr_adobe_options, make_openpbr_adobe, false, "production",
+         /*represents_anisotropy=*/true, /*films=*/true},
         {"standard-surface",
          "Autodesk Standard Surface: coat + coat_color (1 - E_coat(wo)) base, view-only",
          "bases: lambertian, conductor; media: absorbing; sides: R", standard_surface_options,
@@ -196,7 +197,8 @@ const std::vector<ModelEntry>& model_registry() {
          "on the lobe, base x (1 - Fc(n.v)), roughness >= 0.045, compensated metal",
          "bases: lambertian, conductor (with a thin film: KHR_materials_iridescence); eta0 = "
          "1.5; sides: R",
-         threejs_clearcoat_options, make_threejs_clearcoat, false, "production", true},
+         threejs_clearcoat_options, make_threejs_clearcoat, false, "production",
+         /*represents_anisotropy=*/false, /*films=*/true},
         {"openpbr-materialx",
          "OpenPBR in MaterialX (its graph, GLSL generator): coat throughput 1 - E(wo) by its "
          "fitted albedo, constant coat_color, darkening with F0, compensated lobes",

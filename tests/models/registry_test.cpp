@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 namespace lamina {
@@ -51,6 +52,47 @@ TEST(ModelRegistry, OnlyModelsThatRepresentAnisotropyAreBuiltForIt) {
     }
     EXPECT_GE(represented, 1);  // the random walk
     EXPECT_TRUE(find_model("random-walk").represents_anisotropy);
+}
+
+// A model built for an anisotropic or a filmed stack must read what it claims to represent: its
+// values change when the base's brushing turns by 90° (out of the plane of incidence, where an
+// anisotropic lobe is not symmetric), or when the film's thickness changes. A model that built
+// the stack and ignored the anisotropy or the film would return the same values and fail here,
+// whatever its registry entry says.
+TEST(ModelRegistry, ModelsBuiltForAnisotropyOrFilmsDependOnThem) {
+    const auto brushed = [](double tangent_deg) {
+        return test::coated(1.5, 0.1, anisotropic(test::gold(0.3), 0.3, 0.05, tangent_deg));
+    };
+    const auto filmed = [](double thickness_nm) {
+        InterfaceSpec base = test::gold(0.2);
+        base.has_film = true;
+        base.film.thickness_nm = base.film.thickness_max_nm = thickness_nm;
+        base.film.eta = 1.8;
+        return test::coated(1.5, 0.1, base);
+    };
+    const Vec3d wi = normalize(Vec3d(0.4, 0.3, 0.8)), wo = normalize(Vec3d(-0.2, -0.5, 0.7));
+    int anisotropic_built = 0, filmed_built = 0;
+    for (const auto& e : model_registry()) {
+        if (e.stochastic) continue;  // the random walk: tested against the goniophotometer
+        const auto a = make_model(e.name, brushed(20)), b = make_model(e.name, brushed(110));
+        EXPECT_EQ(a->support().brdf, e.represents_anisotropy) << e.name;
+        if (a->support().brdf) {
+            ++anisotropic_built;
+            EXPECT_GT(std::abs(a->eval(wi, wo)[1] - b->eval(wi, wo)[1]),
+                      1e-3 * std::abs(a->eval(wi, wo)[1]))
+                << e.name << " is built for an anisotropic stack but ignores the brushing";
+        }
+        const auto f = make_model(e.name, filmed(150)), g = make_model(e.name, filmed(400));
+        EXPECT_EQ(f->support().brdf, e.films) << e.name;
+        if (f->support().brdf) {
+            ++filmed_built;
+            EXPECT_GT(std::abs(f->eval(wi, wo)[1] - g->eval(wi, wo)[1]),
+                      1e-3 * std::abs(f->eval(wi, wo)[1]))
+                << e.name << " is built for a filmed stack but ignores the film";
+        }
+    }
+    EXPECT_GE(anisotropic_built, 2);  // the OpenPBR coats
+    EXPECT_GE(filmed_built, 2);       // three.js's and openpbr-bsdf's films
 }
 
 TEST(ModelRegistry, ListsTheProductionCoats) {
