@@ -4,6 +4,22 @@
 
 namespace lamina {
 
+FilmOptics stack_film_optics(const Stack& stack, std::size_t layer) {
+    const InterfaceSpec& spec = stack.layers[layer].interface;
+    FilmOptics f;
+    f.eta_film = {spec.film.eta, spec.film.k};
+    f.eta_above = stack.eta_above(layer);
+    for (int c = 0; c < 3; ++c) {
+        f.eta_below[c] = spec.type == InterfaceType::Conductor
+                             ? std::complex<double>(spec.eta_rgb[c], spec.k[c])
+                             : std::complex<double>(spec.eta);
+        f.wavelength_nm[c] = stack.wavelengths_nm[c];
+    }
+    f.thickness_min_nm = spec.film.thickness_nm;
+    f.thickness_max_nm = spec.film.thickness_max_nm;
+    return f;
+}
+
 template <typename Real>
 CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& settings) {
     CompiledStack<Real> out;
@@ -54,17 +70,7 @@ CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& s
         if (spec.has_film) {
             t.has_film = out.has_film = true;
             out.polarization_channels = 3;
-            FilmOptics& f = t.film;
-            f.eta_film = {spec.film.eta, spec.film.k};
-            f.eta_above = eta_above;
-            for (int c = 0; c < 3; ++c) {
-                f.eta_below[c] = spec.type == InterfaceType::Conductor
-                                     ? std::complex<double>(spec.eta_rgb[c], spec.k[c])
-                                     : std::complex<double>(spec.eta);
-                f.wavelength_nm[c] = stack.wavelengths_nm[c];
-            }
-            f.thickness_min_nm = spec.film.thickness_nm;
-            f.thickness_max_nm = spec.film.thickness_max_nm;
+            t.film = stack_film_optics(stack, i);
         }
         if (layer.has_medium) {
             const MediumSpec& m = layer.medium;

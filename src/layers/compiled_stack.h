@@ -83,6 +83,11 @@ struct CompiledStack {
 /// multiple scattering an index-matched rough dielectric is the smooth index-matched pass-through:
 /// every facet refracts straight on (F = 0) and the walk leaves below along −wi with all its flux
 /// (the single-scattering one keeps G2/G1).
+/// The film of interface `layer` of `stack` as the particle events see it (absolute indices, the
+/// stack's channel wavelengths, the thickness range); the interface must carry a film. The models
+/// that represent films read the same (models/production/film_fresnel.h).
+FilmOptics stack_film_optics(const Stack& stack, std::size_t layer);
+
 template <typename Real>
 CompiledStack<Real> compile_stack(const Stack& stack, const TransportSettings& settings);
 

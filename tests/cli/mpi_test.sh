@@ -56,32 +56,31 @@ for stack in plastic slab; do
         grep -q '"processes": 1' "$one/result.json" && ok || fail "$stack $n: processes 1"
     done
 done
+# one_and_two NAME "FILES" ARGS...: `simulate ARGS` in one process (2 threads) and on 2 ranks
+# (1 thread each); FILES (space-separated) must be byte for byte the same.
+one_and_two() {
+    local name=$1 files=$2
+    shift 2
+    local one=$tmp/$name-one out=$tmp/$name-two
+    "$lamina" simulate "$@" --threads 2 --out "$one" >"$one.log" 2>&1 \
+        || { fail "one-process simulate $name"; cat "$one.log"; }
+    mpi "$lamina" simulate "$@" --threads 1 --out "$out" >"$out.log" 2>&1 && ok \
+        || { fail "mpirun simulate $name"; cat "$out.log"; }
+    # shellcheck disable=SC2086  # FILES is a list
+    same_files "simulate $name" "$one" "$out" $files
+}
 # The same with multiple scattering on the microsurfaces (the SIMD kernel's walk), on a rough slab
 # and a rough conductor under a coat.
 for stack in slab frosted-gold; do
-    args=("$src/examples/$stack.json" --theta-i 0,60 --particles 50001 --grid 18x18 --seed 7
-          --microsurface multiple)
-    one=$tmp/ms-$stack-one
-    "$lamina" simulate "${args[@]}" --threads 2 --out "$one" >"$one.log" 2>&1 \
-        || { fail "one-process simulate multiple $stack"; cat "$one.log"; }
-    out=$tmp/ms-$stack-two
-    mpi "$lamina" simulate "${args[@]}" --threads 1 --out "$out" >"$out.log" 2>&1 && ok \
-        || { fail "mpirun simulate multiple $stack"; cat "$out.log"; }
-    same_files "simulate multiple $stack" "$one" "$out" brdf.csv energy.csv
+    one_and_two "ms-$stack" "brdf.csv energy.csv" "$src/examples/$stack.json" --theta-i 0,60 \
+        --particles 50001 --grid 18x18 --seed 7 --microsurface multiple
 done
 # An anisotropic stack and light from an azimuth: the unfolded grid (twice the φ bins), also on
 # the rank that traces nothing (3000 particles: one block) and with the Mueller tables.
 for n in 50001 3000; do
-    args=("$src/examples/brushed-aluminium-lacquer.json" --theta-i 30 --phi-i 40 --particles "$n"
-          --grid 9x12 --seed 7 --mueller)
-    one=$tmp/aniso-$n-one
-    "$lamina" simulate "${args[@]}" --threads 2 --out "$one" >"$one.log" 2>&1 \
-        || { fail "one-process simulate anisotropic $n"; cat "$one.log"; }
-    out=$tmp/aniso-$n-two
-    mpi "$lamina" simulate "${args[@]}" --threads 1 --out "$out" >"$out.log" 2>&1 && ok \
-        || { fail "mpirun simulate anisotropic $n"; cat "$out.log"; }
-    same_files "simulate anisotropic n=$n" "$one" "$out" brdf.csv energy.csv mueller.npy \
-        mueller_se.npy
+    one_and_two "aniso-$n" "brdf.csv energy.csv mueller.npy mueller_se.npy" \
+        "$src/examples/brushed-aluminium-lacquer.json" --theta-i 30 --phi-i 40 --particles "$n" \
+        --grid 9x12 --seed 7 --mueller
 done
 # The transmitting stack has a transmission lobe in its table.
 grep -q ',T,' "$tmp/sim-slab-50001-one/brdf.csv" && ok || fail "slab: no transmission rows"

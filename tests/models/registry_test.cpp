@@ -71,25 +71,23 @@ TEST(ModelRegistry, ModelsBuiltForAnisotropyOrFilmsDependOnThem) {
         return test::coated(1.5, 0.1, base);
     };
     const Vec3d wi = normalize(Vec3d(0.4, 0.3, 0.8)), wo = normalize(Vec3d(-0.2, -0.5, 0.7));
+    // Whether `name` is built for both stacks as its flag says, and then tells them apart.
+    const auto built_and_depends = [&](const std::string& name, bool flag, const Stack& a,
+                                       const Stack& b, const char* what) {
+        const auto ma = make_model(name, a), mb = make_model(name, b);
+        EXPECT_EQ(ma->support().brdf, flag) << name << " " << what;
+        if (!ma->support().brdf) return 0;
+        const double fa = ma->eval(wi, wo)[1], fb = mb->eval(wi, wo)[1];
+        EXPECT_GT(std::abs(fa - fb), 1e-3 * std::abs(fa))
+            << name << " is built for the " << what << " stack but ignores it";
+        return 1;
+    };
     int anisotropic_built = 0, filmed_built = 0;
     for (const auto& e : model_registry()) {
         if (e.stochastic) continue;  // the random walk: tested against the goniophotometer
-        const auto a = make_model(e.name, brushed(20)), b = make_model(e.name, brushed(110));
-        EXPECT_EQ(a->support().brdf, e.represents_anisotropy) << e.name;
-        if (a->support().brdf) {
-            ++anisotropic_built;
-            EXPECT_GT(std::abs(a->eval(wi, wo)[1] - b->eval(wi, wo)[1]),
-                      1e-3 * std::abs(a->eval(wi, wo)[1]))
-                << e.name << " is built for an anisotropic stack but ignores the brushing";
-        }
-        const auto f = make_model(e.name, filmed(150)), g = make_model(e.name, filmed(400));
-        EXPECT_EQ(f->support().brdf, e.films) << e.name;
-        if (f->support().brdf) {
-            ++filmed_built;
-            EXPECT_GT(std::abs(f->eval(wi, wo)[1] - g->eval(wi, wo)[1]),
-                      1e-3 * std::abs(f->eval(wi, wo)[1]))
-                << e.name << " is built for a filmed stack but ignores the film";
-        }
+        anisotropic_built += built_and_depends(e.name, e.represents_anisotropy, brushed(20),
+                                               brushed(110), "anisotropic");
+        filmed_built += built_and_depends(e.name, e.films, filmed(150), filmed(400), "filmed");
     }
     EXPECT_GE(anisotropic_built, 2);  // the OpenPBR coats
     EXPECT_GE(filmed_built, 2);       // three.js's and openpbr-bsdf's films

@@ -73,23 +73,6 @@ double schlick_weight_spherical_gaussian(double c) {
     return std::exp2((-5.55473 * c - 6.98316) * c);
 }
 
-FilmOptics stack_film_optics(const Stack& stack, std::size_t layer) {
-    const double eta_above = layer == 0 ? stack.ambient_eta : stack.layers[layer - 1].interface.eta;
-    const InterfaceSpec& spec = stack.layers[layer].interface;
-    FilmOptics f;
-    f.eta_film = {spec.film.eta, spec.film.k};
-    f.eta_above = eta_above;
-    for (int c = 0; c < 3; ++c) {
-        f.eta_below[c] = spec.type == InterfaceType::Conductor
-                             ? std::complex<double>(spec.eta_rgb[c], spec.k[c])
-                             : std::complex<double>(spec.eta);
-        f.wavelength_nm[c] = stack.wavelengths_nm[c];
-    }
-    f.thickness_min_nm = spec.film.thickness_nm;
-    f.thickness_max_nm = spec.film.thickness_max_nm;
-    return f;
-}
-
 Rgbd film_reflectance_exact(const FilmOptics& film, double cos_theta) {
     const double c = clamp(cos_theta, 0.0, 1.0);
     const double lambda_min =

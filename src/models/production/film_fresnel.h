@@ -12,6 +12,7 @@
 // reflectance, what a texture of the thickness shows over many pixels.
 
 #include "core/rgb.h"
+#include "layers/compiled_stack.h"
 #include "models/model.h"
 #include "physics/thin_film.h"
 
@@ -24,9 +25,8 @@ namespace lamina {
 /// it; c in [0, 1].
 double schlick_weight_spherical_gaussian(double c);
 
-/// The film of interface `layer` of `stack` as the particle events see it (absolute indices, the
-/// stack's channel wavelengths, the thickness range); the interface must carry a film.
-FilmOptics stack_film_optics(const Stack& stack, std::size_t layer);
+// The film of a stack's interface: layers/compiled_stack.h, stack_film_optics (the same the
+// particle events see).
 
 /// The exact reflectance of `film` for unpolarized light arriving from above at the facet cosine
 /// cos_theta ∈ [0, 1], per channel at its wavelength ((R_s + R_p)/2 of physics/thin_film.h),
