@@ -97,36 +97,24 @@ Kernel kernel_for(const SimulationSettings& settings, const Stack& stack) {
 }
 
 void IncidenceSums::add(const IncidenceSums& o) {
-    LAMINA_CHECK(bins.size() == o.bins.size());
-    for (std::size_t i = 0; i < bins.size(); ++i)
-        for (int k = 0; k < 6; ++k)
-            bins[i][k] += o.bins[i][k];
-    for (std::size_t t = 0; t < budget.size(); ++t)
-        for (int c = 0; c < 3; ++c)
-            budget[t][c] += o.budget[t][c];
-    LAMINA_CHECK(stokes.size() == o.stokes.size());
-    for (std::size_t i = 0; i < stokes.size(); ++i)
-        for (int k = 0; k < kStokesSums; ++k)
-            stokes[i][std::size_t(k)] += o.stokes[i][std::size_t(k)];
+    // Element-wise integer sums of equally sized tallies (bins, Stokes, budgets).
+    const auto add_all = [](auto& into, const auto& from) {
+        LAMINA_CHECK(into.size() == from.size());
+        for (std::size_t i = 0; i < into.size(); ++i)
+            for (std::size_t k = 0; k < into[i].size(); ++k)
+                into[i][k] += from[i][k];
+    };
+    add_all(bins, o.bins);
+    add_all(budget, o.budget);
+    add_all(stokes, o.stokes);
     events += o.events;
     degenerate += o.degenerate;
-    LAMINA_CHECK(spectral_bins.size() == o.spectral_bins.size() &&
-                 xyz_bins.size() == o.xyz_bins.size() &&
-                 spectral_budget.size() == o.spectral_budget.size());
-    for (std::size_t i = 0; i < spectral_bins.size(); ++i)
-        for (int k = 0; k < 6; ++k)
-            spectral_bins[i][k] += o.spectral_bins[i][k];
-    for (std::size_t i = 0; i < xyz_bins.size(); ++i)
-        for (int k = 0; k < 6; ++k)
-            xyz_bins[i][k] += o.xyz_bins[i][k];
-    auto add_budget = [](auto& into, const auto& from) {
-        for (std::size_t t = 0; t < into.size(); ++t)
-            for (int c = 0; c < 3; ++c)
-                into[t][c] += from[t][c];
-    };
+    add_all(spectral_bins, o.spectral_bins);
+    add_all(xyz_bins, o.xyz_bins);
+    LAMINA_CHECK(spectral_budget.size() == o.spectral_budget.size());
     for (std::size_t g = 0; g < spectral_budget.size(); ++g)
-        add_budget(spectral_budget[g], o.spectral_budget[g]);
-    add_budget(xyz_budget, o.xyz_budget);
+        add_all(spectral_budget[g], o.spectral_budget[g]);
+    add_all(xyz_budget, o.xyz_budget);
 }
 
 void validate_kernel_for(const Stack& stack, const SimulationSettings& settings) {

@@ -315,35 +315,38 @@ std::string engine_findings_markdown(const EngineFindings& f) {
                 "(ablations included): {} ({}).\n",
                 f.best_production.at(c), pct(f.best_production_error.at(c)), f.best_overall.at(c),
                 pct(f.best_overall_error.at(c)));
-        bool any = false;
-        for (const auto& a : f.ablations) {
-            if (a.category != c) continue;
-            if (!any) {
-                out("\nHeuristics and leaves (mean misplaced energy, 5% floor; mean |albedo "
-                    "error|):\n\n"
-                    "| model | switched | as shipped | switched | what it says |\n"
-                    "|---|---|---|---|---|\n");
-                any = true;
+        // The rows of `items` in this category under `header`, nothing when there are none.
+        const auto table = [&](const auto& items, const char* header, const auto& row) {
+            bool started = false;
+            for (const auto& item : items) {
+                if (item.category != c) continue;
+                if (!started) out("{}", header);
+                started = true;
+                row(item);
             }
-            out("| {} | `{}` | {}; {} | {}; {} | {} |\n", a.model, a.flag, pct(a.shipped),
-                pct(a.shipped_albedo), pct(a.switched), pct(a.switched_albedo), switch_effect(a));
-        }
+            return started;
+        };
+        table(
+            f.ablations,
+            "\nHeuristics and leaves (mean misplaced energy, 5% floor; mean |albedo error|):\n\n"
+            "| model | switched | as shipped | switched | what it says |\n|---|---|---|---|---|\n",
+            [&](const EngineFindings::Ablation& a) {
+                out("| {} | `{}` | {}; {} | {}; {} | {} |\n", a.model, a.flag, pct(a.shipped),
+                    pct(a.shipped_albedo), pct(a.switched), pct(a.switched_albedo),
+                    switch_effect(a));
+            });
         out("\n");
-        bool header = false;
-        for (const auto& r : f.replacements) {
-            if (r.category != c) continue;
-            if (!header) {
-                out("What an engine could ship instead (mean misplaced energy, 5% floor, on the "
-                    "rows lamina-coat covers; the cost per evaluation of each is `make bench`, "
-                    "BM_CoatEval, in docs/lamina-coat.md):\n\n"
-                    "| coat | as shipped | `leaves=exact` | lamina-coat | advice |\n"
-                    "|---|---|---|---|---|\n");
-                header = true;
-            }
-            out("| {} | {} | {} | {} | {} |\n", r.model, pct(r.shipped), pct(r.exact_leaves),
-                pct(r.lamina_coat), replacement_advice(r));
-        }
-        if (header) out("\n");
+        if (table(f.replacements,
+                  "What an engine could ship instead (mean misplaced energy, 5% floor, on the rows "
+                  "lamina-coat covers; the cost per evaluation of each is below, and `make "
+                  "bench`, BM_CoatEval):\n\n"
+                  "| coat | as shipped | `leaves=exact` | lamina-coat | advice |\n"
+                  "|---|---|---|---|---|\n",
+                  [&](const EngineFindings::Replacement& r) {
+                      out("| {} | {} | {} | {} | {} |\n", r.model, pct(r.shipped),
+                          pct(r.exact_leaves), pct(r.lamina_coat), replacement_advice(r));
+                  }))
+            out("\n");
     }
     const CoatCosts& costs = coat_costs();
     out("### Cost per evaluation\n\n"

@@ -75,12 +75,16 @@ def stub_params(fn):
 def parse_stub():
     """{name: params} for functions, {class: {member: params or "property"}} for classes."""
     tree = ast.parse(STUB.read_text())
-    functions, classes = {}, {}
+    functions, classes, bodies = {}, {}, {}
     for node in tree.body:
         if isinstance(node, ast.FunctionDef):
             functions[node.name] = stub_params(node)
-        elif isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+        elif isinstance(node, ast.ClassDef):
+            # A class's members: its own and those of its bases written in the stub (the stub's
+            # private bases only share declarations; the module's classes have no bases).
             members = {}
+            for base in node.bases:
+                members.update(bodies.get(getattr(base, "id", ""), {}))
             for item in node.body:
                 if isinstance(item, ast.FunctionDef):
                     decorators = {getattr(d, "id", None) for d in item.decorator_list}
@@ -88,7 +92,9 @@ def parse_stub():
                         item)
                 elif isinstance(item, ast.AnnAssign):
                     members[item.target.id] = "attribute"
-            classes[node.name] = members
+            bodies[node.name] = members
+            if not node.name.startswith("_"):
+                classes[node.name] = members
     return functions, classes
 
 
