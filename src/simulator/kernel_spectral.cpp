@@ -32,27 +32,21 @@ void trace_block_spectral(const BlockJob& job, Tally& tally, BlockBudget& block)
             sp.xyz_weight[c] = tr.xyz_weight[std::size_t(t + c * third)];
             sp.srgb_weight[c] = tr.srgb_weight[std::size_t(t + c * third)];
         }
+        // The instance of trace_particle for the stack: polarized or not, anisotropic, filmed.
+        const auto trace = [&]<bool kPolarized, bool kAnisotropic, bool kFilm>() {
+            trace_particle<kPolarized, kAnisotropic, kFilm, true>(stack, *job.grid, job, rng, tally,
+                                                                  block, &sp);
+        };
         const bool pol = stack.polarization;
-        if (stack.has_film) {
-            if (pol)
-                trace_particle<true, false, true, true>(stack, *job.grid, job, rng, tally, block,
-                                                        &sp);
-            else
-                trace_particle<false, false, true, true>(stack, *job.grid, job, rng, tally, block,
-                                                         &sp);
-        } else if (stack.anisotropic) {
-            if (pol)
-                trace_particle<true, true, false, true>(stack, *job.grid, job, rng, tally, block,
-                                                        &sp);
-            else
-                trace_particle<false, true, false, true>(stack, *job.grid, job, rng, tally, block,
-                                                         &sp);
-        } else if (pol) {
-            trace_particle<true, false, false, true>(stack, *job.grid, job, rng, tally, block, &sp);
-        } else {
-            trace_particle<false, false, false, true>(stack, *job.grid, job, rng, tally, block,
-                                                      &sp);
-        }
+        if (stack.has_film)
+            pol ? trace.template operator()<true, false, true>()
+                : trace.template operator()<false, false, true>();
+        else if (stack.anisotropic)
+            pol ? trace.template operator()<true, true, false>()
+                : trace.template operator()<false, true, false>();
+        else
+            pol ? trace.template operator()<true, false, false>()
+                : trace.template operator()<false, false, false>();
     }
 }
 

@@ -19,6 +19,22 @@
 namespace lamina {
 namespace {
 
+/// The mean of the green channel over the pixels entirely on the sphere, and its standard error
+/// (pixels as independent samples).
+std::pair<double, double> sphere_mean(const Rendering& r) {
+    double sum = 0, sum_sq = 0;
+    int n = 0;
+    for (std::size_t i = 0; i < r.mask.size(); ++i)
+        if (r.mask[i]) {
+            const double v = r.image.pixels[i][1];
+            sum += v;
+            sum_sq += v * v;
+            ++n;
+        }
+    const double mean = sum / n;
+    return {mean, std::sqrt((sum_sq / n - mean * mean) / (n - 1))};
+}
+
 RenderSettings small(int size, int spp, int threads = 0) {
     RenderSettings s;
     s.size = size;
@@ -58,16 +74,7 @@ TEST(RenderStat, WhiteFurnaceSmoothCoatOverWhiteIsOne) {
     const Stack coated = clear_coat_over_lambertian(0.0, 1.0);
     const auto rw = make_model("random-walk", coated);
     const Rendering r = render_sphere(*rw, Environment::named("uniform"), small(32, 16));
-    double sum = 0, sum_sq = 0;
-    int n = 0;
-    for (std::size_t i = 0; i < r.mask.size(); ++i)
-        if (r.mask[i]) {
-            const double v = r.image.pixels[i][1];
-            sum += v;
-            sum_sq += v * v;
-            ++n;
-        }
-    const double mean = sum / n, se = std::sqrt((sum_sq / n - mean * mean) / (n - 1));
+    const auto [mean, se] = sphere_mean(r);
     EXPECT_LT(std::abs(mean - 1), 5 * se) << mean << " ± " << se;
     EXPECT_LT(se, 0.02);
 }
@@ -188,16 +195,7 @@ TEST(RenderStat, WhiteFurnaceNonAbsorbingSlabsAreOne) {
             RenderSettings rs = small(32, 16);
             rs.transparent = transparent;
             const Rendering r = render_sphere(*rw, Environment::named("uniform"), rs);
-            double sum = 0, sum_sq = 0;
-            int n = 0;
-            for (std::size_t i = 0; i < r.mask.size(); ++i)
-                if (r.mask[i]) {
-                    const double v = r.image.pixels[i][1];
-                    sum += v;
-                    sum_sq += v * v;
-                    ++n;
-                }
-            const double mean = sum / n, se = std::sqrt((sum_sq / n - mean * mean) / (n - 1));
+            const auto [mean, se] = sphere_mean(r);
             if (transparent) {
                 EXPECT_LT(std::abs(mean - 1), 5 * se) << stack.name << ": " << mean << " ± " << se;
                 EXPECT_LT(se, 0.02);
@@ -224,18 +222,10 @@ TEST(RenderStat, WhiteFurnaceRoughStacksAreOneWithMultipleScattering) {
             RenderSettings rs = small(32, 16);
             rs.transparent = stack.transmits();
             const Rendering r = render_sphere(*rw, Environment::named("uniform"), rs);
-            double sum = 0, sum_sq = 0;
-            int n = 0;
             for (std::size_t i = 0; i < r.mask.size(); ++i)
-                if (r.mask[i]) {
-                    for (int c = 0; c < 3; ++c)
-                        ASSERT_TRUE(std::isfinite(r.image.pixels[i][c]));
-                    const double v = r.image.pixels[i][1];
-                    sum += v;
-                    sum_sq += v * v;
-                    ++n;
-                }
-            const double mean = sum / n, se = std::sqrt((sum_sq / n - mean * mean) / (n - 1));
+                for (int c = 0; c < 3; ++c)
+                    ASSERT_TRUE(!r.mask[i] || std::isfinite(r.image.pixels[i][c]));
+            const auto [mean, se] = sphere_mean(r);
             if (std::string(microsurface) == "multiple") {
                 EXPECT_LT(std::abs(mean - 1), 5 * se)
                     << stack.layers.size() << ": " << mean << " ± " << se;
