@@ -52,4 +52,15 @@ inline void expect_sampler_matches_albedo(const Model& model, const Vec3d& wi, s
     EXPECT_NEAR(mean, albedo.mean(), 5 * se + 1e-4) << label;
 }
 
+/// The model with its directions swapped, f_T(a, b) = f(b, a): its albedo at wo is the light
+/// arriving at wo from every wi, ∫ f(wi, wo) μi dωi (the energy per view direction).
+struct TransposedModel final : Model {
+    const Model& m;
+    explicit TransposedModel(const Model& model) : m(model) {}
+    std::string name() const override { return m.name(); }
+    Support support() const override { return m.support(); }
+    Rgbd eval(const Vec3d& a, const Vec3d& b) const override { return m.eval(b, a); }
+    std::vector<DeltaLobe> delta_lobes(const Vec3d& w) const override { return m.delta_lobes(w); }
+};
+
 }  // namespace lamina::test

@@ -10,6 +10,8 @@
 #include "models/test_stacks.h"
 #include "physics/fresnel.h"
 
+#include "models/model_checks.h"
+
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -130,16 +132,7 @@ TEST(FilmFresnel, WhoRepresentsWhichFilm) {
 
 /// ∫ f(wi, wo) μi dωi at wo (the light arriving at each wo), the most over wo and channels.
 double max_albedo_per_wo(const Model& m) {
-    struct Transposed final : Model {
-        const Model& m;
-        explicit Transposed(const Model& model) : m(model) {}
-        std::string name() const override { return m.name(); }
-        Support support() const override { return m.support(); }
-        Rgbd eval(const Vec3d& a, const Vec3d& b) const override { return m.eval(b, a); }
-        std::vector<DeltaLobe> delta_lobes(const Vec3d& w) const override {
-            return m.delta_lobes(w);
-        }
-    } t(m);
+    const test::TransposedModel t(m);
     BinnedOptions o;
     o.rel_tol = 1e-3;
     double worst = 0;
@@ -191,6 +184,16 @@ struct SingleFilm {
     double documented[3];
 };
 
+// The metals of the single-film tables at the channels' wavelengths (630, 532, 465 nm), n + ik:
+// titanium, gold, copper, aluminium (the iridescent category's values, docs/study.md).
+struct FilmMetals {
+    std::complex<double> ti[3], au[3], cu[3], al[3];
+};
+const FilmMetals kFilmMetals = {{{2.74, 3.79}, {2.54, 3.43}, {2.26, 3.07}},
+                                {{0.18, 3.4}, {0.42, 2.35}, {1.37, 1.85}},
+                                {{0.27, 3.41}, {1.12, 2.6}, {1.17, 2.4}},
+                                {{1.2, 7.3}, {0.96, 6.4}, {0.65, 5.4}}};
+
 // docs/models.md, "Thin films": three.js's film against the exact one on single smooth films, over
 // μ = 0.05 … 1 and the three channels. three.js's reflectance is the sRGB projection of a
 // spectrum (Belcour & Barla's antialiasing), the exact one the reflectance at each channel's
@@ -199,9 +202,8 @@ struct SingleFilm {
 // 0.01): the test keeps the page true.
 TEST(FilmFresnel, ThreeJsAgainstTheExactFilm) {
     using C = std::complex<double>;
-    const C glass(1.52), air(1.0), ti[3] = {{2.74, 3.79}, {2.54, 3.43}, {2.26, 3.07}},
-                                   au[3] = {{0.18, 3.4}, {0.42, 2.35}, {1.37, 1.85}},
-                                   cu[3] = {{0.27, 3.41}, {1.12, 2.6}, {1.17, 2.4}};
+    const C glass(1.52), air(1.0);
+    const auto& [ti, au, cu, al] = kFilmMetals;
     const std::vector<SingleFilm> films = {
         {"MgF2 quarter wave (96.4 nm) on glass",
          1.0,
@@ -260,11 +262,7 @@ TEST(FilmFresnel, ThreeJsAgainstTheExactFilm) {
 // metal's absolute index, the film fully present (thickness ≥ 30 nm). docs/models.md's second
 // table.
 TEST(FilmFresnel, OpenPbrBsdfAgainstTheExactFilm) {
-    using C = std::complex<double>;
-    const C ti[3] = {{2.74, 3.79}, {2.54, 3.43}, {2.26, 3.07}},
-            au[3] = {{0.18, 3.4}, {0.42, 2.35}, {1.37, 1.85}},
-            cu[3] = {{0.27, 3.41}, {1.12, 2.6}, {1.17, 2.4}},
-            al[3] = {{1.2, 7.3}, {0.96, 6.4}, {0.65, 5.4}};
+    const auto& [ti, au, cu, al] = kFilmMetals;
     const std::vector<SingleFilm> films = {
         {"oxide (2.5, 60 nm) on titanium", 1.0, 2.5, 60, {ti[0], ti[1], ti[2]}, {0.09, 0.09, 0.09}},
         {"film (1.8, 300 nm) on gold", 1.0, 1.8, 300, {au[0], au[1], au[2]}, {0.29, 0.29, 0.29}},

@@ -12,6 +12,8 @@
 #include "models/registry.h"
 #include "models/test_stacks.h"
 
+#include "models/model_checks.h"
+
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -130,13 +132,7 @@ TEST(ProductionAnisotropy, EnergyIsBounded) {
         double forward = 0, per_view = 0;
         for (const Stack& s : stacks) {
             const auto m = make_model(name, s);
-            struct Transposed final : Model {
-                const Model& m;
-                explicit Transposed(const Model& model) : m(model) {}
-                std::string name() const override { return m.name(); }
-                Support support() const override { return m.support(); }
-                Rgbd eval(const Vec3d& a, const Vec3d& b) const override { return m.eval(b, a); }
-            } transposed(*m);
+            const test::TransposedModel transposed(*m);
             for (double t : {0.0, 45.0, 80.0})
                 for (double p : {0.0, 75.0, 150.0}) {
                     const Vec3d w = dir(t, p);
