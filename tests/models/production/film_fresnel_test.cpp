@@ -182,6 +182,17 @@ struct SingleFilm {
     /// docs/models.md's largest |three.js − exact| at normal incidence, over μ ≥ 0.5 and over
     /// μ ≥ 0.05, rounded to 0.01.
     double documented[3];
+
+    /// The film as the events see it, at one thickness.
+    FilmOptics optics() const {
+        FilmOptics f;
+        f.eta_film = eta_film;
+        f.eta_above = eta_above;
+        f.thickness_min_nm = f.thickness_max_nm = thickness_nm;
+        for (int c = 0; c < 3; ++c)
+            f.eta_below[c] = below[c];
+        return f;
+    }
 };
 
 // The metals of the single-film tables at the channels' wavelengths (630, 532, 465 nm), n + ik:
@@ -223,17 +234,11 @@ TEST(FilmFresnel, ThreeJsAgainstTheExactFilm) {
          {0.29, 0.29, 0.29}},
     };
     for (const SingleFilm& sf : films) {
-        FilmOptics f;
-        f.eta_film = sf.eta_film;
-        f.eta_above = sf.eta_above;
-        Rgbd f0_air;
-        for (int c = 0; c < 3; ++c) {
-            f.eta_below[c] = sf.below[c];
-            // three.js's base: its F0 against what lies above the film (the mapping's F0).
+        const FilmOptics f = sf.optics();
+        Rgbd f0_air;  // three.js's base: its F0 against what lies above the film (the mapping's F0)
+        for (int c = 0; c < 3; ++c)
             f0_air[c] = fresnel_conductor(1.0, sf.below[c].real() / sf.eta_above,
                                           sf.below[c].imag() / sf.eta_above);
-        }
-        f.thickness_min_nm = f.thickness_max_nm = sf.thickness_nm;
         // The largest |three.js − exact| over the channels: at normal incidence, over μ ≥ 0.5,
         // and over μ ≥ 0.05 (with the μ where it is).
         double normal = 0, above_half = 0, worst = 0, at_mu = 0;
@@ -281,13 +286,9 @@ TEST(FilmFresnel, OpenPbrBsdfAgainstTheExactFilm) {
          {0.22, 0.27, 0.27}},
     };
     for (const SingleFilm& sf : films) {
-        FilmOptics f;
-        f.eta_film = sf.eta_film;
-        f.eta_above = sf.eta_above;
-        f.thickness_min_nm = f.thickness_max_nm = sf.thickness_nm;
+        const FilmOptics f = sf.optics();
         FilmOptics seen = f;
         for (int c = 0; c < 3; ++c) {
-            f.eta_below[c] = sf.below[c];
             const double n = sf.below[c].real() / sf.eta_above,
                          k = sf.below[c].imag() / sf.eta_above;
             const double f0 = fresnel_conductor(1.0, n, k);
