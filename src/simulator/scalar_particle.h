@@ -81,14 +81,13 @@ struct MediumWalk {
     }
 };
 
-// ---- A filmed interface (docs/physics.md §9)
-// ----------------------------------------------------- The film's Mueller matrices
-// (physics/thin_film_event.h) at every facet: a dielectric's single facet or walk through the
-// film's branch choice, a conductor's through conductor_event and the conductor walk with the
-// film's reflection in place of the bare Fresnel terms. A thickness that varies over the surface is
-// drawn first, from the particle's own stream, once per event (a particle's lateral position never
-// matters, docs/physics.md §2). The factors (the film's absorption, the reweighting of the
-// channels) are booked as absorbed at the interface
+// ---- A filmed interface (docs/physics.md §9) --------------------------------------------------
+// The film's Mueller matrices (physics/thin_film_event.h) at every facet: a dielectric's single
+// facet or walk through the film's branch choice, a conductor's through conductor_event and the
+// conductor walk with the film's reflection in place of the bare Fresnel terms. A thickness that
+// varies over the surface is drawn first, from the particle's own stream, once per event (a
+// particle's lateral position never matters, docs/physics.md §2). The factors (the film's
+// absorption, the reweighting of the channels) are booked as absorbed at the interface
 // (`apply(sample, true)`), G2/G1 as lost to the microsurface.
 template <bool kPolarized, typename Apply, typename ApplyWalk>
 inline void film_event(const CompiledStack<float>& stack, const CompiledLayer<float>& layer,
@@ -305,14 +304,16 @@ inline void interface_event(const CompiledStack<float>& stack, const CompiledLay
     }
 }
 
-// ---- A spectral particle (docs/physics.md §10)
-// --------------------------------------------------- Its three wavelengths (tally.h: lattice
-// points t + c · L/3), the channel h whose wavelength its path follows (the hero), and where its
-// exits and losses are tallied. At a dispersive interface (one whose refraction direction depends
-// on the wavelength) the other two channels, whose paths would part from the hero's, are terminated
-// and the hero carries 3 times its flux: the hero is uniformly distributed over the lattice, as
-// each channel is, so its flux times 3 estimates what the three channels did, without bias (the
-// terminated flux is not booked in the budget, which sums to 1 in expectation then).
+// ---- A spectral particle (docs/physics.md §10) -------------------------------------------------
+// Its three wavelengths (tally.h: lattice points t + c · L/3), the channel h whose wavelength its
+// path follows (the hero), and where its exits and losses are tallied. At a dispersive interface
+// (one whose refraction direction depends on the wavelength) the other two channels, whose paths
+// would part from the hero's, are terminated and the hero carries 3 times its flux (hero
+// wavelength sampling's termination of the secondary wavelengths at a dispersive event: Wilkie
+// et al. 2014, "Hero Wavelength Spectral Sampling", EGSR): the
+// hero is uniformly distributed over the lattice, as each channel is, so its flux times 3
+// estimates what the three channels did, without bias (the terminated flux is not booked in the
+// budget, which sums to 1 in expectation then).
 struct SpectralParticle {
     const SpectralTracing& tracing;
     SpectralTally& tally;
