@@ -23,7 +23,8 @@ namespace {
 // factory applies the user's flags to those defaults.
 template <typename Choices>
 ModelEntry variant(std::string name, std::string description, std::string supports,
-                   ModelFamily<Choices> family, std::string group = "2019") {
+                   ModelFamily<Choices> family, std::string group = "2019",
+                   bool represents_anisotropy = false) {
     const std::string n = name;
     return {std::move(name),
             std::move(description),
@@ -33,7 +34,8 @@ ModelEntry variant(std::string name, std::string description, std::string suppor
                 return family.make(n, stack, family.table(n).parse(o, family.variant(n)));
             },
             false,
-            std::move(group)};
+            std::move(group),
+            represents_anisotropy};
 }
 
 const ModelFamily<WWChoices> kWeidlichWilkie{
@@ -99,18 +101,21 @@ const std::vector<ModelEntry>& model_registry() {
             "ww09",
             "Weidlich & Wilkie, SIGGRAPH Asia 2009 course code: T01 and refraction at h, base at "
             "outside directions",
-            "bases: lambertian, conductor, dielectric (slab reflection); sides: R",
-            kWeidlichWilkie),
+            "bases: lambertian, conductor, dielectric (slab reflection); anisotropic coat and "
+            "conductor; sides: R",
+            kWeidlichWilkie, "2019", /*represents_anisotropy=*/true),
         variant("ele10",
                 "Elek 2010 (CESCG, Alg. 1): T01 at h, refraction about n, alpha1 <- max(alpha0, "
                 "alpha1)",
-                "bases: lambertian, conductor, dielectric (slab reflection); sides: R",
-                kWeidlichWilkie),
+                "bases: lambertian, conductor, dielectric (slab reflection); anisotropic coat and "
+                "conductor; sides: R",
+                kWeidlichWilkie, "2019", /*represents_anisotropy=*/true),
         variant("ww-prime",
                 "WW': T01, T10 and refraction at n, 1/eta0^2 compression, alpha1 <- max(alpha0, "
                 "alpha1)",
-                "bases: lambertian, conductor, dielectric (slab reflection); sides: R",
-                kWeidlichWilkie),
+                "bases: lambertian, conductor, dielectric (slab reflection); anisotropic coat and "
+                "conductor; sides: R",
+                kWeidlichWilkie, "2019", /*represents_anisotropy=*/true),
         variant("bel18-forward",
                 "Belcour 2018 adding of lobe statistics, cosine mu_i (not reciprocal)",
                 "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R",

@@ -45,6 +45,15 @@ inline Stack coated(double eta0, double alpha0, const InterfaceSpec& base, Rgbd 
     return s;
 }
 
+/// Brushed gold (α_x = b_x, α_y = b_y at tangent psi1 degrees) under a coat of η 1.5 absorbing
+/// τ = (0.1, 0.2, 0.3) (α_x = c_x, α_y = c_y at psi0); equal α's leave that interface isotropic.
+inline Stack brushed(double c_x, double c_y, double psi0, double b_x, double b_y, double psi1) {
+    Stack s = coated(1.5, c_x, gold(b_x), Rgbd(0.1, 0.2, 0.3));
+    if (c_y != c_x) s.layers[0].interface = anisotropic(s.layers[0].interface, c_x, c_y, psi0);
+    if (b_y != b_x) s.layers[1].interface = anisotropic(s.layers[1].interface, b_x, b_y, psi1);
+    return s;
+}
+
 /// A single interface (ambient over a half-space or a bare conductor).
 inline Stack single(const InterfaceSpec& interface) {
     Stack s;

@@ -15,6 +15,19 @@ namespace lamina {
 
 namespace {
 
+/// An interface's GGX distribution as the stack gives it: α, or α_x, α_y along its tangent.
+GGX<double> interface_distribution(const InterfaceSpec& s) {
+    return s.is_anisotropic()
+               ? GGX<double>::anisotropic(s.alpha, s.alpha_b(), deg_to_rad(s.tangent_deg))
+               : GGX<double>{s.alpha};
+}
+
+/// The root mean square √((α_x² + α_y²)/2) of an interface's roughnesses (α when isotropic): what
+/// "rougher" means between two interfaces whose tangents may differ.
+double rms_alpha(const InterfaceSpec& s) {
+    return s.is_anisotropic() ? std::sqrt((sqr(s.alpha) + sqr(s.alpha_b())) / 2) : s.alpha;
+}
+
 class WWModel final : public Model {
   public:
     WWModel(std::string name, const Stack& stack, const WWChoices& choices)
@@ -28,12 +41,32 @@ class WWModel final : public Model {
             support_.reason = fmt::format("{} has no scattering medium", name_);
             return;
         }
+        const InterfaceSpec &coat_spec = stack.layers[0].interface,
+                            &base_spec = stack.layers[1].interface;
+        if (coat_.base_type == InterfaceType::Dielectric && base_spec.is_anisotropic()) {
+            support_.reason = fmt::format(
+                "{} has no anisotropic dielectric base (a slab's anisotropic bottom interface)",
+                name_);
+            return;
+        }
         support_.brdf = true;
         if (coat_.base_type == InterfaceType::Dielectric)
             support_.reason = fmt::format("{} gives only the slab's reflection (no BTDF)", name_);
-        // Elek 2010, Algorithm 1: the base is at least as rough as the coat.
-        base_alpha_ =
-            choices_.max_roughness ? std::max(coat_.alpha0, coat_.base_alpha) : coat_.base_alpha;
+        // The lobes' distributions: anisotropic where the stack's interfaces are (lamina's
+        // extension of the family: the same terms with the anisotropic D and Λ, each interface in
+        // its own frame). Elek 2010, Algorithm 1: the base is at least as rough as the coat; with
+        // anisotropic interfaces, the rougher by the root mean square of α_x, α_y, whose
+        // distribution (and tangent) the base then takes.
+        coat_ggx_ = interface_distribution(coat_spec);
+        base_ggx_ = interface_distribution(base_spec);
+        coat_.alpha0 = rms_alpha(coat_spec);
+        coat_.base_alpha = rms_alpha(base_spec);
+        base_alpha_ = coat_.base_alpha;
+        if (choices_.max_roughness && coat_.alpha0 > coat_.base_alpha &&
+            coat_.base_type != InterfaceType::Lambertian) {
+            base_alpha_ = coat_.alpha0;
+            base_ggx_ = coat_ggx_;
+        }
         has_absorption_ = coat_.tau_a.max() > 0;
         gray_tau_ = coat_.tau_a.min() == coat_.tau_a.max();
         inv_eta0_ = 1 / coat_.eta0;
@@ -63,14 +96,14 @@ class WWModel final : public Model {
         Incident in;
         in.wi = wi;
         if (!support_.brdf || wi.z <= 0) return in;
-        if (coat_.alpha0 > 0) in.lambda0 = GGX<double>{coat_.alpha0}.lambda(wi);
-        if (base_alpha_ > 0) in.lambda1_out = GGX<double>{base_alpha_}.lambda(wi);
+        if (coat_.alpha0 > 0) in.lambda0 = coat_ggx_.lambda(wi);
+        if (base_alpha_ > 0) in.lambda1_out = base_ggx_.lambda(wi);
         in.T01_n = 1 - fresnel_coat(wi.z);
         if (const auto w = refract_in_n(wi)) {
             in.in_ok = true;
             in.wi_in = *w;
             in.att = attenuation(w->z);
-            if (base_alpha_ > 0) in.lambda1 = GGX<double>{base_alpha_}.lambda(*w);
+            if (base_alpha_ > 0) in.lambda1 = base_ggx_.lambda(*w);
         }
         return in;
     }
@@ -90,9 +123,8 @@ class WWModel final : public Model {
         if (coat_.alpha0 > 0) {
             // Top reflection (docs/models.md; Walter et al. 2007, Eq. 20; height-correlated G2,
             // Heitz 2014, Eq. 99); a delta lobe when smooth.
-            const GGX<double> ggx0{coat_.alpha0};
-            G0 = 1 / (1 + in.lambda0 + ggx0.lambda(wo));
-            f = Rgbd(fresnel_coat(cos_h) * ggx0.D(h) * G0 / (4 * wi.z * wo.z));
+            G0 = 1 / (1 + in.lambda0 + coat_ggx_.lambda(wo));
+            f = Rgbd(fresnel_coat(cos_h) * coat_ggx_.D(h) * G0 / (4 * wi.z * wo.z));
         }
         if (base_is_delta()) return f;
         if (choices_.refract_about_h) {
@@ -129,7 +161,7 @@ class WWModel final : public Model {
             // law of solid angles, η0² μo' dωo' = μo dωo) gives the factor η0² that the 1/η0² of
             // WW' cancels. At the mirror pair h = n, so every variant's T01, T10 and refractions
             // are the normal-incidence ones of wi.
-            const double G0 = coat_.alpha0 > 0 ? GGX<double>{coat_.alpha0}.G2(wi, wr) : 1.0;
+            const double G0 = coat_.alpha0 > 0 ? coat_ggx_.G2(wi, wr) : 1.0;
             const Vec3d n(0, 0, 1);
             const auto in = refract_in(wi, n);
             if (in) {
@@ -180,9 +212,8 @@ class WWModel final : public Model {
         if (base_alpha_ <= 0) return Rgbd(0.0);
         // Walter et al. 2007, Eq. 20, conductor Fresnel per channel.
         const Vec3d h = normalize(wi + wo);
-        const GGX<double> ggx{base_alpha_};
-        const double G = 1 / (1 + lambda_i + ggx.lambda(wo));
-        return base_fresnel(dot(wi, h)) * (ggx.D(h) * G / (4 * wi.z * wo.z));
+        const double G = 1 / (1 + lambda_i + base_ggx_.lambda(wo));
+        return base_fresnel(dot(wi, h)) * (base_ggx_.D(h) * G / (4 * wi.z * wo.z));
     }
 
     bool base_is_delta() const {
@@ -228,8 +259,8 @@ class WWModel final : public Model {
                 // path costs 3× more here).
                 if (base_alpha_ <= 0 || wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
                 const Vec3d h = normalize(wi + wo);
-                const GGX<double> ggx{base_alpha_};
-                return base_fresnel(dot(wi, h)) * (ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z));
+                return base_fresnel(dot(wi, h)) *
+                       (base_ggx_.D(h) * base_ggx_.G2(wi, wo) / (4 * wi.z * wo.z));
             }
             case InterfaceType::Dielectric:
                 return Rgbd(
@@ -268,7 +299,9 @@ class WWModel final : public Model {
     WWChoices choices_;
     CoatedStack coat_;
     Support support_;
-    double base_alpha_ = 0;
+    double base_alpha_ =
+        0;  ///< the base's α (root mean square when anisotropic), after max-roughness
+    GGX<double> coat_ggx_{0.0}, base_ggx_{0.0};
     bool has_absorption_ = false;
     bool gray_tau_ = true;
     double inv_eta0_ = 1, inv_eta0_sq_ = 1;
