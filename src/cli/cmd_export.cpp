@@ -18,6 +18,7 @@
 #include "models/lamina1/lamina1.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
+#include "simulator/goniophotometer.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -43,7 +44,8 @@ struct ExportArgs {
     std::string theta_i, grid = "90x90";
     std::vector<std::string> options;
     int resolution = RglOptions{}.resolution, vndf_resolution = RglOptions{}.vndf_resolution,
-        ndf_resolution = RglOptions{}.ndf_resolution;
+        ndf_resolution = RglOptions{}.ndf_resolution, azimuths = RglOptions{}.azimuths;
+    double phi_i = 0;  ///< a model's .npz: the light's azimuth (degrees)
 };
 
 std::string read_text(const std::filesystem::path& path) {
@@ -120,6 +122,7 @@ struct Source {
     BinnedTable table;
     bool have_table = false;
     std::shared_ptr<const Model> model;
+    std::shared_ptr<const Stack> stack;  ///< the model's
     nlohmann::json meta;
 };
 
@@ -138,13 +141,6 @@ Source load_source(const ExportArgs& a) {
     if (!a.simulation.empty()) {
         const std::filesystem::path dir = a.simulation;
         src.table = BinnedTable::from_csv(read_text(dir / "brdf.csv"), (dir / "brdf.csv").string());
-        // The exporters read φ over [0°, 180°] mirrored (an isotropic table): an unfolded one
-        // (an anisotropic stack, light from φi ≠ 0) would be written wrong.
-        if (src.table.grid.is_unfolded())
-            throw InputError((dir / "brdf.csv").string(), "phi_lo",
-                             "an unfolded table (φ over [0°, 360°): an anisotropic stack or "
-                             "phi_i ≠ 0) cannot be exported yet; only folded tables (φ over [0°, "
-                             "180°]) can");
         src.have_table = true;
         src.meta["source"] = "simulation";
         if (std::filesystem::exists(dir / "result.json"))
@@ -157,9 +153,9 @@ Source load_source(const ExportArgs& a) {
     } else {
         if (a.stack.empty()) throw InputError("command line", "--stack", "required with --model");
         const ModelEntry& entry = find_model(a.model);
-        const Stack stack = load_stack(a.stack);
-        src.model = entry.make(stack, resolve_options(entry, a.options));
-        src.meta["source"] = {{"model", a.model}, {"stack", stack_to_json(stack)}};
+        src.stack = std::make_shared<const Stack>(load_stack(a.stack));
+        src.model = entry.make(*src.stack, resolve_options(entry, a.options));
+        src.meta["source"] = {{"model", a.model}, {"stack", stack_to_json(*src.stack)}};
     }
     return src;
 }
@@ -168,7 +164,7 @@ Source load_source(const ExportArgs& a) {
 BrdfSource brdf_of(const Source& src, const ExportArgs& a) {
     return src.have_table ? table_brdf(src.table, a.simulation.empty() ? a.source : "reference",
                                        a.simulation.empty() ? a.study : a.simulation)
-                          : model_brdf(src.model, a.stack);
+                          : model_brdf(src.model, *src.stack, a.stack);
 }
 
 // The figures of rgl_fidelity.h, as a table: how close a renderer reading the file gets to its
@@ -181,16 +177,18 @@ bool print_fidelity(const TensorFile& file, const std::string& path, const BrdfS
     fmt::print(
         "\nA renderer reading {} (pbrt-v4, Mitsuba 3) against its source, {}:\n"
         "directional albedo (luminance; error: the channel where it is largest, goal ≤ {:g}%)\n"
-        "  θi (°)   source     file     error\n",
-        path, brdf.name, 100 * Goals::kAlbedo);
+        "  θi (°){}   source     file     error\n",
+        path, brdf.name, 100 * Goals::kAlbedo, brdf.isotropic ? "" : "  φi (°)");
     for (const RglAlbedoRow& row : r.albedo)
-        fmt::print("  {:6.1f}  {:8.5f}  {:8.5f}  {:6.2f}%{}\n", row.theta_i_deg,
+        fmt::print("  {:6.1f}{}  {:8.5f}  {:8.5f}  {:6.2f}%{}\n", row.theta_i_deg,
+                   brdf.isotropic ? "" : fmt::format("  {:6.1f}", row.phi_i_deg),
                    luminance(row.source), luminance(row.file), 100 * row.error,
                    row.error > Goals::kAlbedo ? "  over the goal" : "");
     const auto worst = std::max_element(
         r.albedo.begin(), r.albedo.end(),
         [](const RglAlbedoRow& x, const RglAlbedoRow& y) { return x.error < y.error; });
-    fmt::print("  worst: {:.2f}% at θi = {:g}°\n", 100 * worst->error, worst->theta_i_deg);
+    fmt::print("  worst: {:.2f}% at θi = {:g}°{}\n", 100 * worst->error, worst->theta_i_deg,
+               brdf.isotropic ? "" : fmt::format(", φi = {:g}°", worst->phi_i_deg));
     fmt::print(
         "values f at {} random direction pairs (θi, θo ≤ {:g}°, luminance): relative error "
         "{:.2f}% for half of them, {:.2f}% for {:g}% (goal ≤ {:g}%), {:.2f}% for 99%{}\n",
@@ -263,6 +261,9 @@ int run_export(const ExportArgs& a) {
         return 0;
     }
     if (a.strict) throw InputError("command line", "--strict", "goes with --check FILE");
+    if (!(a.phi_i >= 0 && a.phi_i <= 360))  // NaN too
+        throw InputError("command line", "--phi-i",
+                         fmt::format("{} degrees is outside [0, 360]", a.phi_i));
     if (a.out.empty()) throw InputError("command line", "--out", "give the output file");
     std::string format = a.format;
     if (format.empty()) {
@@ -277,6 +278,10 @@ int run_export(const ExportArgs& a) {
         throw InputError("command line", "--format",
                          fmt::format("'{}' is not a format: bsdf, merl or npz", format));
 
+    if (a.phi_i != 0 && format != "npz")
+        throw InputError("command line", "--phi-i",
+                         "goes with --format npz (a .bsdf holds every φi; a MERL file one BRDF "
+                         "of θi alone)");
     Source src = load_source(a);
     BinnedTable& table = src.table;
     const bool have_table = src.have_table;
@@ -289,10 +294,21 @@ int run_export(const ExportArgs& a) {
             const Support s = model->support();
             if (!s.brdf && !s.btdf)
                 throw InputError(a.stack, "--model", "not supported: " + s.reason);
+            // The bins the goniophotometer tabulates for this stack and φi (unfolded for an
+            // anisotropic stack or φi ≠ 0).
+            SimulationSettings binning;
+            binning.grid = HemisphereGrid::parse(a.grid, "--grid");
+            binning.phi_i_deg = a.phi_i;
             table = bin_model(
-                *model, HemisphereGrid::parse(a.grid),
+                *model, simulation_grid(*src.stack, binning),
                 parse_incidences(a.theta_i.empty() ? default_incidences_text() : a.theta_i,
-                                 "--theta-i"));
+                                 "--theta-i"),
+                a.phi_i);
+            meta["phi_i"] = a.phi_i;
+        } else if (a.phi_i != 0) {
+            throw InputError("command line", "--phi-i",
+                             "a table's light azimuth is the one it was simulated with; --phi-i "
+                             "goes with --model");
         }
         const std::size_t n_inc = table.theta_i_deg.size(),
                           n_sides = table.has_transmission ? 2 : 1;
@@ -314,11 +330,12 @@ int run_export(const ExportArgs& a) {
         for (int t = 0; t <= g.n_theta(); ++t)
             te.push_back(float(90.0 * t / g.n_theta()));
         for (int p = 0; p <= g.n_phi(); ++p)
-            pe.push_back(float(180.0 * p / g.n_phi()));
+            pe.push_back(float(rad_to_deg(g.phi_span()) * p / g.n_phi()));
         meta["axes"] = {"incidence", "side", "theta_bin", "phi_bin", "channel"};
         meta["sides"] = n_sides == 2 ? nlohmann::json{"R", "T"} : nlohmann::json{"R"};
         meta["theta_i"] = table.theta_i_deg;
-        meta["grid"] = {{"n_theta", g.n_theta()}, {"n_phi", g.n_phi()}};
+        meta["grid"] = {
+            {"n_theta", g.n_theta()}, {"n_phi", g.n_phi()}, {"unfolded", g.is_unfolded()}};
         bytes = zip_stored({{"f.npy", npy_float32(f, shape)},
                             {"se.npy", npy_float32(se, shape)},
                             {"theta_i.npy", npy_float32(theta_i, {theta_i.size()})},
@@ -332,12 +349,18 @@ int run_export(const ExportArgs& a) {
             o.resolution = a.resolution;
             o.vndf_resolution = a.vndf_resolution;
             o.ndf_resolution = a.ndf_resolution;
+            o.azimuths = a.azimuths;
             if (!a.theta_i.empty()) o.theta_i_deg = parse_incidences(a.theta_i, "--theta-i");
             o.description = fmt::format("lamina {} export: {}", kVersion, meta["source"].dump());
             const TensorFile file = rgl_bsdf(brdf, o);
             check_rgl_bsdf(file, a.out);
             bytes = tensor_file_bytes(file);
         } else {
+            if (!brdf.isotropic)
+                throw InputError(a.stack, "--format",
+                                 "a MERL .binary holds an isotropic BRDF (its half-vector "
+                                 "coordinates drop φi) and this stack is anisotropic: write a "
+                                 ".bsdf or .npz");
             bytes = merl_binary(brdf);
         }
     }
@@ -369,7 +392,14 @@ Runner add_export(CLI::App& app) {
         fmt::format("Incidences (degrees): a model's .bsdf nodes (default {:.4g}, "
                     "denser towards grazing) or .npz bins (default {})",
                     fmt::join(rgl_default_incidences(), ","), default_incidences_text()));
-    cmd->add_option("--grid", a->grid, "Bins of a model's .npz, NTHETAxNPHI")
+    cmd->add_option("--grid", a->grid,
+                    "Bins of a model's .npz, NTHETAxNPHI (φ over [0, 180]; unfolded over [0, "
+                    "360) with twice the bins for an anisotropic stack or --phi-i ≠ 0)")
+        ->capture_default_str();
+    cmd->add_option("--phi-i", a->phi_i, "A model's .npz: the light's azimuth in degrees, [0, 360]")
+        ->capture_default_str();
+    cmd->add_option("--azimuths", a->azimuths,
+                    ".bsdf of an anisotropic stack: φi slices over [−180°, 180°] (intervals)")
         ->capture_default_str();
     cmd->add_option("--resolution", a->resolution, ".bsdf: sample-grid nodes a side")
         ->capture_default_str();

@@ -11,7 +11,8 @@
 
 namespace lamina {
 
-BrdfSource model_brdf(std::shared_ptr<const Model> model, const std::string& where) {
+BrdfSource model_brdf(std::shared_ptr<const Model> model, const Stack& stack,
+                      const std::string& where) {
     const Support s = model->support();
     if (!s.brdf) throw InputError(where, "model", "the BRDF is not supported: " + s.reason);
     for (double t = 0; t < 90; t += 5)
@@ -22,6 +23,7 @@ BrdfSource model_brdf(std::shared_ptr<const Model> model, const std::string& whe
                                          model->name()));
     BrdfSource out;
     out.name = model->name();
+    out.isotropic = !stack.is_anisotropic();
     out.f = [model](const Vec3d& wi, const Vec3d& wo) { return model->eval(wi, wo); };
     return out;
 }
@@ -29,6 +31,12 @@ BrdfSource model_brdf(std::shared_ptr<const Model> model, const std::string& whe
 BrdfSource table_brdf(const BinnedTable& table, const std::string& name, const std::string& where) {
     if (!table.has_reflection || table.theta_i_deg.empty())
         throw InputError(where, "side", "the table has no reflection (R) rows to export");
+    if (table.grid.is_unfolded())
+        throw InputError(where, "phi_lo",
+                         "an unfolded table (φ over [0°, 360°): an anisotropic stack or light "
+                         "from φi ≠ 0) holds the BRDF at one φi; a .bsdf or MERL file needs it "
+                         "at every φi: export the model (--model, --stack) instead, or write the "
+                         "table as .npz");
     BrdfSource out;
     out.name = name;
     out.theta_i_deg = table.theta_i_deg;

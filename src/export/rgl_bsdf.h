@@ -38,6 +38,14 @@
 // The defaults (rgl_default_incidences, RglOptions) are sized so that a renderer gets within the
 // goals of rgl_fidelity.h on the study's configurations (docs/formats.md gives the figures).
 //
+// An anisotropic source (BrdfSource::isotropic false: a brushed stack) gets φi slices: phi_i holds
+// RglOptions::azimuths + 1 values from −π to π (the last slice repeats the first, so that the
+// readers, which interpolate linearly in φi = atan2(ωi.y, ωi.x), have both ends and use no mirror
+// symmetry); D is tabulated over the absolute azimuth of ωm (257 rows of u_y, 1.4° apart, the
+// retro-reflection of each), u_y of the warp is then the absolute φm, and vndf, luminance and
+// spectra hold one slice per (φi, θi). The readers take a file with more than two φi slices as
+// anisotropic and then read ωm's azimuth as it is, not relative to φi.
+//
 // Only the reflection side: neither pbrt-v4's nor Mitsuba 3's reader takes a BTDF. Isotropic:
 // phi_i holds one slice. RGB → spectra: lamina is RGB; the spectra are a piecewise-linear
 // upsampling (b below 450 nm, g at 550 nm, r above 650 nm, linear in between: grey stays grey
@@ -57,6 +65,7 @@ struct RglOptions {
     int resolution = 48;              ///< s nodes a side (spectra, luminance), in [2, 512]
     int vndf_resolution = 512;        ///< warp nodes along θm (u_x), in [2, 8192]
     int ndf_resolution = 512;         ///< ndf and sigma nodes along θ (u_x), in [2, 8192]
+    int azimuths = 24;  ///< an anisotropic source's φi intervals over [−π, π], in [2, 360]
     std::string description;
 };
 
@@ -71,7 +80,7 @@ Rgbd rgl_spectral_weights(std::size_t wavelength_index);
 
 /// The tensor file of the BRDF. InputError for options out of range (the resolutions' ranges
 /// above, incidences increasing in [0, 90)). Parallel over incidences (OpenMP); the file does not
-/// depend on the thread count.
+/// depend on the thread count. An isotropic source's file is the same whatever `azimuths`.
 TensorFile rgl_bsdf(const BrdfSource& brdf, const RglOptions& options);
 
 /// Checks the fields and shapes a reader requires (the structure pbrt-v4 and Mitsuba 3 check on

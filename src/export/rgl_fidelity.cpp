@@ -72,13 +72,18 @@ RglFidelity rgl_fidelity(const RglReader& file, const BrdfSource& source,
         throw InputError(
             where, "theta_i",
             fmt::format("the source has no incidence within {}° of the normal", o.max_theta_deg));
+    const std::vector<double> azimuths =
+        source.isotropic ? std::vector<double>{0} : std::vector<double>{0, 45, 90, 135};
     RglFidelity out;
-    out.albedo.resize(thetas.size());
+    out.albedo.resize(thetas.size() * azimuths.size());
 #pragma omp parallel for schedule(dynamic, 1)
-    for (std::size_t k = 0; k < thetas.size(); ++k) {
-        const Vec3d wi = incident_direction(deg_to_rad(thetas[k]));
+    for (std::size_t k = 0; k < out.albedo.size(); ++k) {
         RglAlbedoRow& r = out.albedo[k];
-        r.theta_i_deg = thetas[k];
+        r.theta_i_deg = thetas[k / azimuths.size()];
+        r.phi_i_deg = azimuths[k % azimuths.size()];
+        const Vec3d wi = source.isotropic ? incident_direction(deg_to_rad(r.theta_i_deg))
+                                          : direction_from_angles(deg_to_rad(r.theta_i_deg),
+                                                                  deg_to_rad(r.phi_i_deg));
         r.source = directional_albedo(source.f, wi);
         r.file = directional_albedo(
             [&file](const Vec3d& i, const Vec3d& o) { return file.eval(i, o); }, wi);

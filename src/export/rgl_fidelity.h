@@ -5,7 +5,9 @@
 //
 //   albedo  for each incidence θi ≤ 85°, the directional albedo of the file as a renderer reads it
 //           (rgl_reader.h) against the source's, |a_file/a_source − 1| in the channel where it is
-//           largest. Goal: ≤ 2% at every incidence.
+//           largest. Goal: ≤ 2% at every incidence. An anisotropic source is lit from φi = 0°,
+//           45°, 90° and 135° at each θi (its BRDF is the same at φi + 180°: every interface's
+//           distribution of normals is symmetric under a half turn).
 //   values  at random direction pairs, ωi and ωo independent and uniform in solid angle over
 //           θ ≤ 85°, |Y_file/Y_source − 1| of the luminance Y of f. Goal: ≤ 5% for 90% of pairs.
 // A source given only at some incidences (a binned table) is compared at those (≤ 85°) alone.
@@ -36,7 +38,7 @@ struct RglFidelityOptions {
 };
 
 struct RglAlbedoRow {
-    double theta_i_deg;
+    double theta_i_deg, phi_i_deg;
     Rgbd source, file;
     double error;  ///< |file/source − 1| in the worst channel (channels where source > 0)
 };

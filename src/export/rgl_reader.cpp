@@ -5,6 +5,8 @@
 #include "export/rgl_bsdf.h"
 #include "export/rgl_parameterization.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -13,10 +15,23 @@ namespace lamina {
 RglReader::RglReader(const TensorFile& file, const std::string& where) {
     check_rgl_bsdf(file, where);
     const TensorField& phi_i = file.at("phi_i");
-    if (phi_i.shape[0] > 2)
-        throw InputError(where, "phi_i",
-                         "an anisotropic file (more than two φi slices): lamina reads isotropic "
-                         "files only");
+    isotropic_ = phi_i.shape[0] <= 2;  // the readers' rule
+    if (isotropic_) {
+        phi_nodes_ = {0.0};
+    } else {
+        for (float p : phi_i.floats())
+            phi_nodes_.push_back(double(p));
+        for (std::size_t k = 1; k < phi_nodes_.size(); ++k)
+            if (!(phi_nodes_[k] > phi_nodes_[k - 1]))
+                throw InputError(where, "phi_i", "the azimuths must increase strictly");
+        const double span = phi_nodes_.back() - phi_nodes_.front();
+        reduction_ = int(std::lround(2 * kPi<double> / span));
+        if (reduction_ != 1 && reduction_ != 2 && reduction_ != 4)
+            throw InputError(where, "phi_i",
+                             fmt::format("an anisotropic file's azimuths span 2π, π or π/2 "
+                                         "(the readers' symmetries); these span {:.4g} rad",
+                                         span));
+    }
     for (float t : file.at("theta_i").floats())
         theta_nodes_.push_back(double(t));
     for (std::size_t k = 1; k < theta_nodes_.size(); ++k)
@@ -29,7 +44,7 @@ RglReader::RglReader(const TensorFile& file, const std::string& where) {
     ndf_ny_ = ndf.shape[0], ndf_nx_ = ndf.shape[1];
     sigma_ny_ = sigma.shape[0], sigma_nx_ = sigma.shape[1];
     s_ny_ = spectra.shape[3], s_nx_ = spectra.shape[4];
-    const std::size_t plane = s_nx_ * s_ny_, n_inc = theta_nodes_.size();
+    const std::size_t plane = s_nx_ * s_ny_, n_slices = phi_nodes_.size() * theta_nodes_.size();
     if (file.count("rgb")) {
         rgb_ = file.at("rgb").floats();
     } else {
@@ -48,8 +63,8 @@ RglReader::RglReader(const TensorFile& file, const std::string& where) {
             at[c] = std::size_t(it - wavelengths.begin());
         }
         const std::size_t nl = wavelengths.size();
-        rgb_.resize(n_inc * 3 * plane);
-        for (std::size_t k = 0; k < n_inc; ++k)
+        rgb_.resize(n_slices * 3 * plane);
+        for (std::size_t k = 0; k < n_slices; ++k)
             for (int c = 0; c < 3; ++c)
                 std::copy_n(v.begin() + std::ptrdiff_t((k * nl + at[c]) * plane), plane,
                             rgb_.begin() + std::ptrdiff_t((k * 3 + std::size_t(c)) * plane));
@@ -57,7 +72,7 @@ RglReader::RglReader(const TensorFile& file, const std::string& where) {
     vndf_ny_ = vndf.shape[2], vndf_nx_ = vndf.shape[3];
     const std::vector<float> v = vndf.floats();
     const std::size_t slice = vndf_nx_ * vndf_ny_;
-    for (std::size_t k = 0; k < theta_nodes_.size(); ++k) {
+    for (std::size_t k = 0; k < n_slices; ++k) {
         std::vector<double> values(v.begin() + std::ptrdiff_t(k * slice),
                                    v.begin() + std::ptrdiff_t((k + 1) * slice));
         double total = 0;
@@ -77,38 +92,54 @@ std::vector<double> RglReader::theta_i_deg() const {
     return out;
 }
 
-Rgbd RglReader::eval(const Vec3d& wi, const Vec3d& wo) const {
+Rgbd RglReader::eval(const Vec3d& wi_in, const Vec3d& wo_in) const {
+    Vec3d wi = wi_in, wo = wo_in;
     if (!(wi.z > 0) || !(wo.z > 0)) return Rgbd(0.0);
+    if (reduction_ >= 2) {
+        // Into the slices' range: ωi.y ≤ 0 (and ωi.x ≤ 0 for a quarter), ωo mirrored with it.
+        if (wi.y >= 0) wi.y = -wi.y, wo.y = -wo.y;
+        if (reduction_ == 4 && wi.x >= 0) wi.x = -wi.x, wo.x = -wo.x;
+    }
     const Vec3d sum = wi + wo;
     if (!(dot(sum, sum) > 0)) return Rgbd(0.0);
     const Vec3d wm = normalize(sum);
     const double theta_i = std::acos(std::min(1.0, wi.z)), phi_i = std::atan2(wi.y, wi.x);
     const double theta_m = std::acos(std::min(1.0, wm.z)), phi_m = std::atan2(wm.y, wm.x);
     const double ux = rgl::theta_to_u(theta_m);
-    double uy = rgl::phi_to_u(phi_m - phi_i);
+    double uy = rgl::phi_to_u(isotropic_ ? phi_m - phi_i : phi_m);
     uy -= std::floor(uy);
 
-    // s: the blended warps' masses at u(ωm), then S at s, each linear in the incidence.
+    // The slices around (φi, θi) and their weights: the readers interpolate the warps' masses
+    // and S multilinearly in the parameters.
     const auto [k, w] = rgl::incidence_weight(theta_nodes_, theta_i);
-    const std::size_t n_inc = theta_nodes_.size();
+    const auto [p, v] =
+        isotropic_ ? rgl::IncidenceWeight{0, 0.0} : rgl::incidence_weight(phi_nodes_, phi_i);
+    const std::size_t n_inc = theta_nodes_.size(), n_phi = phi_nodes_.size();
+    struct Corner {
+        std::size_t slice;
+        double weight;
+    };
+    std::vector<Corner> corners;
+    for (std::size_t b = 0; b < 2 && p + b < n_phi; ++b)
+        for (std::size_t e = 0; e < 2 && k + e < n_inc; ++e) {
+            const double weight = (b == 0 ? 1 - v : v) * (e == 0 ? 1 - w : w);
+            if (weight != 0) corners.push_back({(p + b) * n_inc + k + e, weight});
+        }
+
+    // s: the blended warps' masses at u(ωm), then S at s.
     double left = 0, row = 0, below = 0;
-    for (std::size_t e = 0; e < 2 && k + e < n_inc; ++e) {
-        const double we = e == 0 ? 1 - w : w;
-        if (we == 0) continue;
-        const BilinearWarp::Masses m = vndf_[k + e].masses({ux, uy});
-        left += we * m.left, row += we * m.row, below += we * m.below;
+    for (const Corner& c : corners) {
+        const BilinearWarp::Masses m = vndf_[c.slice].masses({ux, uy});
+        left += c.weight * m.left, row += c.weight * m.row, below += c.weight * m.below;
     }
     const double sx = row > 0 ? std::clamp(left / row, 0.0, 1.0) : 0.0,
                  sy = std::clamp(below, 0.0, 1.0);
     const std::size_t plane = s_nx_ * s_ny_;
     Rgbd s(0.0);
-    for (std::size_t e = 0; e < 2 && k + e < n_inc; ++e) {
-        const double we = e == 0 ? 1 - w : w;
-        if (we == 0) continue;
-        for (int c = 0; c < 3; ++c)
-            s[c] += we * rgl::bilinear(rgb_.data() + ((k + e) * 3 + std::size_t(c)) * plane, s_nx_,
-                                       s_ny_, sx, sy);
-    }
+    for (const Corner& c : corners)
+        for (int ch = 0; ch < 3; ++ch)
+            s[ch] += c.weight * rgl::bilinear(rgb_.data() + (c.slice * 3 + std::size_t(ch)) * plane,
+                                              s_nx_, s_ny_, sx, sy);
     for (int c = 0; c < 3; ++c)
         s[c] = std::max(0.0, s[c]);  // pbrt-v4 clamps the interpolated value
     const double d = rgl::bilinear(ndf_.data(), ndf_nx_, ndf_ny_, ux, uy);

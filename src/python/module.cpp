@@ -648,7 +648,7 @@ void bind_export(py::module_& m) {
                 const PyModel& pm = source.cast<const PyModel&>();
                 auto model = std::shared_ptr<const Model>(
                     find_model(pm.name, "name").make(pm.stack, pm.options));
-                brdf = model_brdf(model, pm.name);
+                brdf = model_brdf(model, pm.stack, pm.name);
             } else {
                 brdf = table_brdf(source.cast<const BinnedTable&>(), "table", "table");
             }

@@ -171,6 +171,14 @@ check simulate-phi-i 0 "$lamina" simulate "$src/examples/plastic.json" --phi-i 3
 check_says export-unfolded 1 "an unfolded table" \
     "$lamina" export --simulation "$tmp/phi-i" --out "$tmp/phi-i.bsdf"
 check export-unfolded-writes-nothing 1 test -e "$tmp/phi-i.bsdf"
+check export-unfolded-npz 0 "$lamina" export --simulation "$tmp/phi-i" --out "$tmp/phi-i.npz"
+check_says export-phi-i-bsdf 1 "goes with --format npz" \
+    "$lamina" export --model openpbr --stack "$src/examples/brushed-aluminium-lacquer.json" \
+    --phi-i 30 --out "$tmp/brushed.bsdf"
+check_says export-anisotropic-merl 1 "holds an isotropic BRDF" \
+    "$lamina" export --model openpbr --stack "$src/examples/brushed-aluminium-lacquer.json" \
+    --out "$tmp/brushed.binary"
+check export-anisotropic-merl-writes-nothing 1 test -e "$tmp/brushed.binary"
 check_says eval-film 1 "not supported: thin films are not supported by this model" \
     "$lamina" eval --model ww09 --stack "$src/examples/coated-lens.json" --theta-i 30 --theta-o 30 --phi-o 180
 # Spectral runs (docs/physics.md §10): a spectral stack is traced spectrally on the scalar kernel

@@ -19,6 +19,7 @@ import lamina
 ROOT = Path(__file__).resolve().parents[2]
 PLASTIC = ROOT / "examples" / "plastic.json"
 SLAB = ROOT / "examples" / "slab.json"
+BRUSHED = ROOT / "examples" / "brushed-aluminium-lacquer.json"
 CLI = os.environ.get("LAMINA_CLI", str(ROOT / "build" / "lamina"))
 
 
@@ -392,6 +393,36 @@ def test_export_npz_of_a_simulation(tmp_path):
     assert np.array_equal(z["se"], se.astype(np.float32))
     assert np.allclose(z["theta_edges"], np.linspace(0, 90, 19))
     assert meta["result"]["particles"] == 50_000
+
+
+def test_export_npz_of_unfolded_tables(tmp_path):
+    # Light from φi = 30° unfolds the grid (φ over [0°, 360°), twice the bins): the .npz holds
+    # the table as brdf.csv has it, with the φ edges of the unfolded grid.
+    cli("simulate", PLASTIC, "--theta-i", "40", "--phi-i", 30, "--particles", 20_000,
+        "--grid", "9x9", "--out", tmp_path / "sim")
+    cli("export", "--simulation", tmp_path / "sim", "--out", tmp_path / "sim.npz")
+    z = np.load(tmp_path / "sim.npz")
+    meta = json.loads(z["metadata.json"])
+    f, se, thetas, sides = read_brdf_csv(tmp_path / "sim" / "brdf.csv")
+    assert z["f"].shape == (1, 1, 9, 18, 3) and meta["grid"]["unfolded"]
+    assert np.array_equal(z["f"], f.astype(np.float32))
+    assert np.allclose(z["phi_edges"], np.linspace(0, 360, 19))
+    # An anisotropic stack's model on the unfolded grid at φi = 60°: the bins `lamina eval
+    # --binned --phi-i` writes.
+    cli("export", "--model", "openpbr", "--stack", BRUSHED, "--theta-i", "20,70", "--phi-i", 60,
+        "--grid", "9x6", "--out", tmp_path / "m.npz")
+    cli("eval", "--model", "openpbr", "--stack", BRUSHED, "--binned", "--theta-i", "20,70",
+        "--phi-i", 60, "--grid", "9x6", "--out", tmp_path / "m.csv")
+    z = np.load(tmp_path / "m.npz")
+    f, _, thetas, _ = read_brdf_csv(tmp_path / "m.csv")
+    meta = json.loads(z["metadata.json"])
+    assert meta["phi_i"] == 60 and meta["grid"]["n_phi"] == 12 and thetas == [20, 70]
+    assert np.array_equal(z["f"], f.astype(np.float32))
+    # A MERL file cannot hold an anisotropic BRDF.
+    r = cli("export", "--model", "openpbr", "--stack", BRUSHED, "--out", tmp_path / "m.binary",
+            check=False)
+    assert r.returncode == 1 and "isotropic" in r.stderr
+    assert not (tmp_path / "m.binary").exists()
 
 
 def test_export_bsdf_and_merl_files(tmp_path):
