@@ -170,7 +170,11 @@ TEST(UnityFgdTexture, TextureAgainstTheIntegral) {
         "HDRP FGD texture against the integral: {:.2e} (sqrt(mu) >= 8/63, r >= 3/63), {:.2e} "
         "(sqrt(mu) < 8/63), {:.2e} (r < 3/63)\n",
         worst, worst_grazing, worst_smooth);
-    EXPECT_GT(worst, 0);
+    // Measured: 5.1e-3, 8.1e-3 and 7.6e-3 (the estimator alone 4.6e-3 on every third texel).
+    EXPECT_GT(worst, 4e-3);
+    EXPECT_LT(worst, 5.5e-3);
+    EXPECT_LT(worst_grazing, 8.5e-3);
+    EXPECT_LT(worst_smooth, 8e-3);
 }
 
 // --- The model's properties ----------------------------------------------------------------
@@ -195,13 +199,24 @@ double max_albedo(bool per_view) {
     return worst;
 }
 
+// StackLit does not conserve energy either way (docs/models.md, measured over the sweep at θ ≤
+// 80°): per view (the light arriving at wo from every wi) the coat lobe keeps the energy F(μo) of
+// the view's Fresnel at every wi and the compensation adds to it, up to 1.483 (η0 = 2, α0 = 0.5,
+// view at 80°); per incidence up to 1.379 (η0 = 2, smooth coat over gold α1 = 0.4, light at 80°).
+// The bounds hold the measured values within the quadrature's 1e-3.
 TEST(UnityStackLit, EnergyAsMeasured) {
     const double per_view = max_albedo(true), forward = max_albedo(false);
     std::cout << fmt::format(
         "unity-stacklit: largest albedo per view {:.4f}, per incidence {:.4f}\n", per_view,
         forward);
+    EXPECT_GT(per_view, 1.47);
+    EXPECT_LT(per_view, 1.49);
+    EXPECT_GT(forward, 1.37);
+    EXPECT_LT(forward, 1.39);
 }
 
+// Not reciprocal: the statistics, the energies and the compensation follow the view alone
+// (measured 0.555 on the plastic, 0.429 on the gold).
 TEST(UnityStackLit, ReciprocityAsMeasured) {
     for (const Stack& s : {coated(1.5, 0.2, test::lambertian(kRho), kTau),
                            coated(1.5, 0.1, test::gold(0.25), kTau)}) {
@@ -216,7 +231,7 @@ TEST(UnityStackLit, ReciprocityAsMeasured) {
                         worst =
                             std::max(worst, std::abs(fab[c] - fba[c]) / std::max(fab[c], fba[c]));
                 }
-        std::cout << "unity-stacklit reciprocity error " << worst << "\n";
+        EXPECT_GT(worst, 0.4);
     }
 }
 
