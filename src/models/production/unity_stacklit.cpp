@@ -126,6 +126,9 @@ class UnityStackLit final : public Model {
             return;
         }
         support_.brdf = true;
+        // The texture is built on the first model that needs it (once per process), not on its
+        // first evaluation.
+        fgd_ = &UnityFgdTexture::get();
         eta0_ = coat_.eta0;
         alpha_coat_ = coat_.alpha0;  // r_c = √α0, α = r_c²
         alpha_coat_lobe_ = std::max(alpha_coat_, kMinAlpha);
@@ -256,7 +259,7 @@ class UnityStackLit final : public Model {
         // GetEnergyCompensationFactor), E read from the FGD texture: the coat's at the view's
         // cosine and its perceptual roughness, the base's at the view's cosine refracted into the
         // coat (Snell, no roughness pull) and the base's roughness after adding.
-        const UnityFgdTexture& fgd = UnityFgdTexture::get();
+        const UnityFgdTexture& fgd = *fgd_;
         const double e_coat = fgd.albedo(mu_clamped, std::sqrt(alpha_coat_));
         const double mu_base =
             std::max(std::sqrt(1 + (mu_clamped * mu_clamped - 1) / (eta0_ * eta0_)), kMinCos);
@@ -325,6 +328,7 @@ class UnityStackLit final : public Model {
     }
 
     Support support_;
+    const UnityFgdTexture* fgd_ = nullptr;
     CoatedStack coat_;
     double eta0_ = 1, alpha_coat_ = 0, alpha_coat_lobe_ = kMinAlpha, coat_f0_ = 0;
     double alpha_base_input_ = 0;
