@@ -213,8 +213,9 @@ const std::vector<ModelEntry>& model_registry() {
         {"unity-stacklit",
          "Unity HDRP StackLit coat: Belcour 2018's adding of energy and variance per view "
          "(Fresnel chain, roughened base), coat and base lobes compensated by HDRP's FGD texture",
-         "bases: lambertian, conductor; media: absorbing; eta0 >= 1; sides: R",
-         unity_stacklit_options, make_unity_stacklit, false, "production"},
+         "bases: lambertian, conductor; media: absorbing; eta0 >= 1; anisotropic metal; sides: R",
+         unity_stacklit_options, make_unity_stacklit, false, "production",
+         /*represents_anisotropy=*/true},
     });
     return entries;
 }

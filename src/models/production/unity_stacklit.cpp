@@ -83,10 +83,12 @@ double schlick(double f0, double c) {
 
 /// What StackLit derives from the view alone (its GetPreLightData).
 struct ViewStatistics {
-    Rgbd coat_energy{0.0};                 ///< E_0: the coat lobe's energy
-    Rgbd base_energy{0.0};                 ///< E_2: the base lobe's energy
-    Rgbd diffuse{1.0};                     ///< T_↑: the diffuse base's energy factor
-    double alpha_base = 0;                 ///< α_b' (clamped to ≥ 1/1024)
+    Rgbd coat_energy{0.0};  ///< E_0: the coat lobe's energy
+    Rgbd base_energy{0.0};  ///< E_2: the base lobe's energy
+    Rgbd diffuse{1.0};      ///< T_↑: the diffuse base's energy factor
+    double alpha_base =
+        0;  ///< α_b' (clamped to ≥ 1/1024); of an anisotropic base, along its tangent
+    double alpha_base_b = 0;  ///< an anisotropic base's α along its bitangent (else alpha_base)
     double perceptual_roughness_base = 0;  ///< √ of α_b' before the clamp (the FGD row)
     double coat_compensation = 1;          ///< c_0
     Rgbd base_compensation{1.0};           ///< c_2
@@ -119,10 +121,10 @@ class UnityStackLit final : public Model {
                 coat_.eta0);
             return;
         }
-        if (stack.is_anisotropic()) {
+        if (stack.layers[0].interface.is_anisotropic()) {
             support_.reason =
-                "unity-stacklit has no anisotropic coat and its base's anisotropy is not mapped: "
-                "the stack's anisotropic interface (alpha = [alpha_x, alpha_y]) has no counterpart";
+                "unity-stacklit has no anisotropic coat (StackLit's anisotropy is the base's): "
+                "the coat's anisotropic roughness (alpha = [alpha_x, alpha_y]) has no counterpart";
             return;
         }
         support_.brdf = true;
@@ -145,8 +147,17 @@ class UnityStackLit final : public Model {
             base_f0_[c] = ior_to_f0(f0_to_ior(std::min(f0_air, 0.999)), eta0_);
         }
         rho_ = is_metal_ ? Rgbd(0.0) : coat_.albedo;
-        const double r_base =
-            is_metal_ ? std::sqrt(coat_.base_alpha) : kDiffuseBasePerceptualRoughness;
+        double alpha_base = coat_.base_alpha;
+        if (const InterfaceSpec& b = stack.layers[1].interface; b.is_anisotropic()) {
+            // StackLit's anisotropic base (Kulla & Conty 2017's parametrization, its
+            // ConvertAnisotropyToRoughness): α_t = α (1 + a), α_b = α (1 − a) along its tangent
+            // and bitangent n × t; so α = (α_x + α_y)/2, a = (α_x − α_y)/(α_x + α_y), the tangent
+            // the interface's.
+            alpha_base = 0.5 * (b.alpha + b.alpha_b());
+            anisotropy_ = (b.alpha - b.alpha_b()) / (b.alpha + b.alpha_b());
+            tangent_rad_ = deg_to_rad(b.tangent_deg);
+        }
+        const double r_base = is_metal_ ? std::sqrt(alpha_base) : kDiffuseBasePerceptualRoughness;
         alpha_base_input_ = r_base * r_base;
     }
 
@@ -253,7 +264,16 @@ class UnityStackLit final : public Model {
         const double s_base = variance_of_alpha(alpha_base_input_);
         const double s_r0m = s_ti0 + j0i * (s_t0i + s_base + m_rr * (s_base + s_ri0));
         v.perceptual_roughness_base = std::sqrt(belcour_alpha_of_variance(s_r0m, false));
-        v.alpha_base = std::max(sqr(v.perceptual_roughness_base), kMinAlpha);
+        v.alpha_base = v.alpha_base_b = std::max(sqr(v.perceptual_roughness_base), kMinAlpha);
+        if (anisotropy_ != 0 && v.perceptual_roughness_base > 0) {
+            // The anisotropy scaled by r/r' (GetModifiedAnisotropy, StackLit's
+            // VLAYERED_ANISOTROPY_SCALAR_ROUGHNESS_CORRECTANISO), then split as the input was.
+            const double a =
+                anisotropy_ * std::sqrt(alpha_base_input_) / v.perceptual_roughness_base;
+            const double alpha = sqr(v.perceptual_roughness_base);
+            v.alpha_base = std::max(alpha * (1 + a), kMinAlpha);
+            v.alpha_base_b = std::max(alpha * (1 - a), kMinAlpha);
+        }
         v.diffuse = Ti0;
         // The energy compensation of each lobe, 1 + F0 (1/E − 1) (Turquin 2019, Eq. 16; StackLit's
         // GetEnergyCompensationFactor), E read from the FGD texture: the coat's at the view's
@@ -275,7 +295,9 @@ class UnityStackLit final : public Model {
         const ViewStatistics v = view(wo.z);
         const Vec3d h = normalize(wi + wo);
         const double coat = ggx_lobe_shape(alpha_coat_lobe_, wi, wo, h);
-        const double base = ggx_lobe_shape(v.alpha_base, wi, wo, h);
+        const double base = anisotropy_ == 0
+                                ? ggx_lobe_shape(v.alpha_base, wi, wo, h)
+                                : base_lobe(v).D(h) * base_lobe(v).G2(wi, wo) / (4 * wi.z * wo.z);
         return v.coat_energy * (v.coat_compensation * coat) +
                v.base_energy * v.base_compensation * base + rho_ * v.diffuse * kInvPi<double>;
     }
@@ -292,8 +314,8 @@ class UnityStackLit final : public Model {
         Vec3d wo;
         if (u.z < p.coat) {
             wo = reflect(wi, GGX<double>{alpha_coat_lobe_}.sample_visible_normal(wi, u.x, u.y));
-        } else if (u.z < p.coat + p.base) {
-            wo = reflect(wi, GGX<double>{p.alpha_base}.sample_visible_normal(wi, u.x, u.y));
+        } else if (u.z < p.coat + p.base_weight) {
+            wo = reflect(wi, p.base.sample_visible_normal(wi, u.x, u.y));
         } else {
             wo = sample_cosine_hemisphere(u.x, u.y);
         }
@@ -310,20 +332,28 @@ class UnityStackLit final : public Model {
         const double jacobian = 1 / (4 * dot(wo, h));  // dωh/dωo for reflection
         double density =
             p.coat * GGX<double>{alpha_coat_lobe_}.pdf_visible_normal(wi, h) * jacobian +
-            p.base * GGX<double>{p.alpha_base}.pdf_visible_normal(wi, h) * jacobian;
-        if (!is_metal_) density += (1 - p.coat - p.base) * pdf_cosine_hemisphere(wo);
+            p.base_weight * p.base.pdf_visible_normal(wi, h) * jacobian;
+        if (!is_metal_) density += (1 - p.coat - p.base_weight) * pdf_cosine_hemisphere(wo);
         return density;
     }
 
   private:
+    /// The base lobe of an anisotropic base, α_t along its tangent, α_b along n × t.
+    GGX<double> base_lobe(const ViewStatistics& v) const {
+        return anisotropy_ == 0
+                   ? GGX<double>{v.alpha_base}
+                   : GGX<double>::anisotropic(v.alpha_base, v.alpha_base_b, tangent_rad_);
+    }
+
     struct Proposal {
-        double coat = 0, base = 0, alpha_base = 0;
+        double coat = 0, base_weight = 0;
+        GGX<double> base{0.0};
     };
     Proposal proposal(const Vec3d& wi) const {
         Proposal p;
         p.coat = clamp(fresnel_dielectric(wi.z, eta0_), 0.1, 0.9);
-        p.base = is_metal_ ? 1 - p.coat : 0.2 * (1 - p.coat);
-        p.alpha_base = view(wi.z).alpha_base;
+        p.base_weight = is_metal_ ? 1 - p.coat : 0.2 * (1 - p.coat);
+        p.base = base_lobe(view(wi.z));
         return p;
     }
 
@@ -332,6 +362,7 @@ class UnityStackLit final : public Model {
     CoatedStack coat_;
     double eta0_ = 1, alpha_coat_ = 0, alpha_coat_lobe_ = kMinAlpha, coat_f0_ = 0;
     double alpha_base_input_ = 0;
+    double anisotropy_ = 0, tangent_rad_ = 0;  ///< StackLit's base anisotropy and its tangent
     bool is_metal_ = false;
     Rgbd base_f0_{0.0}, rho_{0.0};
 };

@@ -16,7 +16,8 @@
 //   T_↑       the energy the adding lets up through the stack (the diffuse base's hacked term).
 //
 // Represented: a clear or absorbing dielectric coat of η0 ≥ 1 over a Lambertian or conductor base,
-// isotropic (StackLit's coat has no anisotropy), BRDF only.
+// the conductor anisotropic too (StackLit's anisotropy is the base's: α_t = α (1 + a), α_b =
+// α (1 − a)); BRDF only.
 
 #include "models/model.h"
 

@@ -47,15 +47,22 @@ Stack stack_of(const json& s) {
         s.at("base") == "lambertian"
             ? test::lambertian(rgb(s.at("rho")))
             : test::conductor(rgb(s.at("eta1")), rgb(s.at("kappa1")), s.at("alpha1").get<double>());
-    return coated(s.at("eta0").get<double>(), s.at("alpha0").get<double>(), base, rgb(s.at("tau")));
+    Stack stack =
+        coated(s.at("eta0").get<double>(), s.at("alpha0").get<double>(), base, rgb(s.at("tau")));
+    if (s.contains("alpha1_xy")) {  // an anisotropic base: [α_x, α_y] at tangent1_deg
+        InterfaceSpec& b = stack.layers[1].interface;
+        b = anisotropic(b, s.at("alpha1_xy").at(0).get<double>(),
+                        s.at("alpha1_xy").at(1).get<double>(), s.at("tangent1_deg").get<double>());
+    }
+    return stack;
 }
 
 // The recorded inputs are docs/models.md's mapping of each stack: coat IOR η0, coat perceptual
 // roughness √α0, thickness 1 with extinction τ; a metal's base colour its F0 against air
 // F(1; η1, κ1), metallic 1, perceptual roughness √α1; a diffuse base's colour ρ, metallic 0,
 // dielectric IOR η0 and StackLit's default perceptual roughness 0.5.
-TEST(UnityStackLit, InputsFollowTheMapping) {
-    for (const json& record : load("unity-stacklit.json").at("stacks")) {
+void expect_inputs_follow_the_mapping(const std::string& file) {
+    for (const json& record : load(file).at("stacks")) {
         const json &s = record.at("stack"), &in = record.at("inputs");
         const std::string id = record.at("id");
         const double eta0 = s.at("eta0");
@@ -85,14 +92,26 @@ TEST(UnityStackLit, InputsFollowTheMapping) {
             const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1"));
             for (int c = 0; c < 3; ++c)
                 EXPECT_NEAR(color[c], test::conductor_ref(1, eta1[c], k1[c]), 1e-12) << id;
+            if (s.contains("alpha1_xy")) {
+                const double ax = s.at("alpha1_xy").at(0), ay = s.at("alpha1_xy").at(1);
+                EXPECT_NEAR(s.at("alpha1").get<double>(), 0.5 * (ax + ay), 1e-12) << id;
+                EXPECT_NEAR(in.at("anisotropy_a").get<double>(), (ax - ay) / (ax + ay), 1e-12)
+                    << id;
+                EXPECT_EQ(in.at("tangent_deg").get<double>(), s.at("tangent1_deg").get<double>())
+                    << id;
+            }
         }
     }
+}
+TEST(UnityStackLit, InputsFollowTheMapping) {
+    expect_inputs_follow_the_mapping("unity-stacklit.json");
+    expect_inputs_follow_the_mapping("unity-stacklit-anisotropic.json");
 }
 
 // `unity-stacklit` against StackLit's code: every recorded pair of every stack to 1e-3 relative,
 // every channel.
-TEST(UnityStackLit, MatchesItsCode) {
-    const json data = load("unity-stacklit.json");
+void expect_matches_its_code(const std::string& file) {
+    const json data = load(file);
     const json& pairs = data.at("pairs");
     double worst = 0;
     std::string where;
@@ -113,8 +132,16 @@ TEST(UnityStackLit, MatchesItsCode) {
             }
         }
     }
-    std::cout << fmt::format("unity-stacklit: worst relative difference {:.2e} ({})\n", worst,
-                             where);
+    std::cout << fmt::format("unity-stacklit ({}): worst relative difference {:.2e} ({})\n", file,
+                             worst, where);
+}
+TEST(UnityStackLit, MatchesItsCode) {
+    expect_matches_its_code("unity-stacklit.json");
+}
+// At anisotropic settings: brushed metals (StackLit's anisotropy a = (α_x − α_y)/(α_x + α_y) of
+// the base at its tangent, α = (α_x + α_y)/2), tangents at 0°–100° from the light's plane.
+TEST(UnityStackLit, MatchesItsCodeWhenAnisotropic) {
+    expect_matches_its_code("unity-stacklit-anisotropic.json");
 }
 
 // --- HDRP's FGD texture ----------------------------------------------------------------------
@@ -241,7 +268,8 @@ TEST(UnityStackLit, Sampling) {
     const std::vector<std::pair<std::string, Stack>> stacks = {
         {"plastic", coated(1.5, 0.2, test::lambertian(kRho), kTau)},
         {"paint", coated(1.5, 0.01, test::gold(0.3), kTau)},
-        {"frosted", coated(1.5, 0.3, test::gold(0.02))}};
+        {"frosted", coated(1.5, 0.3, test::gold(0.02))},
+        {"brushed", coated(1.5, 0.05, anisotropic(test::gold(0.3), 0.3, 0.05, 20.0), kTau)}};
     const int tests = int(stacks.size()) * 2;
     for (const auto& [what, s] : stacks) {
         const auto m = make_model("unity-stacklit", s);
@@ -259,10 +287,11 @@ TEST(UnityStackLit, Sampling) {
 }
 
 TEST(UnityStackLit, NotSupported) {
-    const auto aniso = make_model(
-        "unity-stacklit", coated(1.5, 0.1, anisotropic(test::gold(0.2), 0.3, 0.1, 0.0), kTau));
-    EXPECT_FALSE(aniso->support().brdf);
-    EXPECT_NE(aniso->support().reason.find("anisotropic"), std::string::npos);
+    Stack s = coated(1.5, 0.1, test::gold(0.2), kTau);
+    s.layers[0].interface = anisotropic(s.layers[0].interface, 0.2, 0.05, 0.0);
+    const auto m = make_model("unity-stacklit", s);
+    EXPECT_FALSE(m->support().brdf);
+    EXPECT_NE(m->support().reason.find("anisotropic coat"), std::string::npos);
     const auto below_one = make_model("unity-stacklit", coated(0.8, 0.1, test::lambertian(kRho)));
     EXPECT_FALSE(below_one->support().brdf);
     EXPECT_NE(below_one->support().reason.find("at least 1"), std::string::npos);
