@@ -103,7 +103,7 @@ void expect_inputs_follow_the_mapping(const std::string& file) {
         }
     }
 }
-TEST(UnityStackLit, InputsFollowTheMapping) {
+TEST(UnityStackLitGolden, InputsFollowTheMapping) {
     expect_inputs_follow_the_mapping("unity-stacklit.json");
     expect_inputs_follow_the_mapping("unity-stacklit-anisotropic.json");
 }
@@ -135,12 +135,12 @@ void expect_matches_its_code(const std::string& file) {
     std::cout << fmt::format("unity-stacklit ({}): worst relative difference {:.2e} ({})\n", file,
                              worst, where);
 }
-TEST(UnityStackLit, MatchesItsCode) {
+TEST(UnityStackLitGolden, MatchesItsCode) {
     expect_matches_its_code("unity-stacklit.json");
 }
 // At anisotropic settings: brushed metals (StackLit's anisotropy a = (α_x − α_y)/(α_x + α_y) of
 // the base at its tangent, α = (α_x + α_y)/2), tangents at 0°–100° from the light's plane.
-TEST(UnityStackLit, MatchesItsCodeWhenAnisotropic) {
+TEST(UnityStackLitGolden, MatchesItsCodeWhenAnisotropic) {
     expect_matches_its_code("unity-stacklit-anisotropic.json");
 }
 
