@@ -227,9 +227,10 @@ double max_albedo(bool per_view) {
 }
 
 // StackLit does not conserve energy either way (docs/models.md, measured over the sweep at θ ≤
-// 80°): per view (the light arriving at wo from every wi) the coat lobe keeps the energy F(μo) of
-// the view's Fresnel at every wi and the compensation adds to it, up to 1.483 (η0 = 2, α0 = 0.5,
-// view at 80°); per incidence up to 1.379 (η0 = 2, smooth coat over gold α1 = 0.4, light at 80°).
+// 80°): per view (the light arriving at wo from every wi) up to 1.483 (η0 = 2, α0 = 0.5 over a
+// near-mirror metal, view at 80°: the adding roughens the base lobe at grazing views and its
+// compensation 1 + F0 (1/E − 1) multiplies it by up to 2.5); per incidence up to 1.379 (η0 = 2,
+// smooth coat over gold α1 = 0.4, light at 80°).
 // The bounds hold the measured values within the quadrature's 1e-3.
 TEST(UnityStackLit, EnergyAsMeasured) {
     const double per_view = max_albedo(true), forward = max_albedo(false);
