@@ -194,7 +194,8 @@ class UnityStackLit final : public Model {
                 ctt = std::sqrt(1 - stt * stt);
                 s_r12 = variance_of_alpha(alpha);
                 // Transmission variances: the roughness scaled by ½|1 − cos θi/(η cos θt)| and
-                // ½|1 − η cos θt/cos θi| (Belcour 2018, Eq. 10 as the author's code writes it).
+                // ½|1 − η cos θt/cos θi| (Belcour 2018, Eq. 10 as lamina reads it, bel18's
+                // sigma-t=paper).
                 s_t12 =
                     variance_of_alpha(alpha * 0.5 * std::abs((ctt * eta0_ - cti) / (ctt * eta0_)));
                 s_t21 =
@@ -216,7 +217,7 @@ class UnityStackLit final : public Model {
             const Rgbd& R21 = R12;
             const Rgbd& T21 = T12;
             const double s_r21 = s_r12;
-            // Adding one layer (Belcour 2018, Eqs. 2–5 and the variance's Eqs. 11–14): the
+            // Adding one layer (Belcour 2018, §4–5; docs/models.md, "Belcour 2018", Adding): the
             // series of interreflections 1/(1 − Ri0 R12), a channel whose denominator is 0 left
             // at 0.
             Rgbd m_R0i(0.0), m_Ri0(0.0), m_Rr(0.0), e_T0i(0.0), e_Ti0(0.0);
