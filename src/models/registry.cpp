@@ -6,6 +6,7 @@
 #include "models/lamina1/lamina1.h"
 #include "models/lamina_coat/lamina_coat.h"
 #include "models/production/production_coats.h"
+#include "models/production/unity_stacklit.h"
 #include "models/random_walk/random_walk_model.h"
 #include "models/transfer_matrix/transfer_matrix.h"
 #include "models/weidlich_wilkie/ww_family.h"
@@ -214,6 +215,12 @@ const std::vector<ModelEntry>& model_registry() {
          "base) with terms derived from the layering and fitted on the study's reference",
          "bases: lambertian, conductor; media: absorbing; eta0 in [1.1, 2.6]; sides: R",
          lamina_coat_options, make_lamina_coat, false, "lamina"},
+        {"unity-stacklit",
+         "Unity HDRP StackLit coat: Belcour 2018's adding of energy and variance per view "
+         "(Fresnel chain, roughened base), coat and base lobes compensated by HDRP's FGD texture",
+         "bases: lambertian, conductor; media: absorbing; eta0 >= 1; anisotropic metal; sides: R",
+         unity_stacklit_options, make_unity_stacklit, false, "production",
+         /*represents_anisotropy=*/true},
     });
     return entries;
 }

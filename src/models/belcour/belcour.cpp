@@ -15,8 +15,8 @@ namespace lamina {
 // Roughness ↔ variance (Belcour 2018, §5.1 and the author's code): σ(α) = α^1.1 / (1 − α^1.1),
 // α(σ) = (σ / (1 + σ))^(1/1.1); α clamped below 1 (σ(1) is infinite). The quadratic alternative
 // σ = α²/(1 − α²) is lamina's ablation (the exponent of a slope variance).
-double belcour_variance_of_alpha(double alpha, bool quadratic) {
-    const double a = std::min(alpha, kBelcourAlphaMax);
+double belcour_variance_of_alpha(double alpha, bool quadratic, double alpha_max) {
+    const double a = std::min(alpha, alpha_max);
     if (a <= 0) return 0;
     const double p = quadratic ? a * a : std::pow(a, 1.1);
     return p / (1 - p);

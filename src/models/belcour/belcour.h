@@ -113,8 +113,9 @@ BelcourChoices belcour_variant(const std::string& variant);
 /// Belcour 2018's roughness ↔ variance mapping (§5.1 and the author's code): σ(α) = α^1.1/(1 −
 /// α^1.1) with α clamped at kBelcourAlphaMax (σ(1) is infinite), and its inverse α(σ) = (σ/(1 +
 /// σ))^(1/1.1) (0 for σ ≤ 0 or NaN, → 1 as σ → ∞). quadratic: lamina's ablation σ = α²/(1 − α²).
+/// alpha_max: where α is clamped (Unity's StackLit, RoughnessToLinearVariance: 0.9999).
 inline constexpr double kBelcourAlphaMax = 0.999;
-double belcour_variance_of_alpha(double alpha, bool quadratic);
+double belcour_variance_of_alpha(double alpha, bool quadratic, double alpha_max = kBelcourAlphaMax);
 double belcour_alpha_of_variance(double sigma, bool quadratic);
 
 /// GGX reflection lobe shape D G2 / (4 μi μo) with the energy factored out (Belcour 2018, Eq. 1;

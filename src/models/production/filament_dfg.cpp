@@ -6,13 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 
 namespace lamina {
 
-namespace {
-
-/// The base-2 radical inverse of i (van der Corput), the Hammersley set's second coordinate.
-double radical_inverse(std::uint32_t i) {
+double hammersley_radical_inverse(std::uint32_t i) {
     std::uint32_t bits = (i << 16) | (i >> 16);
     bits = ((bits & 0x55555555u) << 1) | ((bits & 0xAAAAAAAAu) >> 1);
     bits = ((bits & 0x33333333u) << 2) | ((bits & 0xCCCCCCCCu) >> 2);
@@ -21,20 +19,25 @@ double radical_inverse(std::uint32_t i) {
     return bits * 0x1p-32;
 }
 
+namespace {
+
 float to_half_precision(double v) {
     return half_to_float(float_to_half(float(v)));
 }
 
 }  // namespace
 
-double FilamentDfgTexture::estimate(double mu_o, double alpha, int n) {
+double FilamentDfgTexture::estimate(double mu_o, double alpha, int n, HammersleyAzimuth azimuth) {
+    // Unity's IntegrateGGXAndDisneyDiffuseFGD takes n·v at ≥ REAL_EPS (2⁻²⁴).
+    if (azimuth == HammersleyAzimuth::Second) mu_o = std::max(mu_o, 0x1p-24);
     const double sin_o = std::sqrt(std::max(0.0, 1 - mu_o * mu_o));
     const double a2 = alpha * alpha;
     // Filament's u1 = i · (1/n) with 1/n in single precision.
     const float inv_n = 1.0f / float(n);
     double sum = 0;
     for (int i = 0; i < n; ++i) {
-        const double u1 = double(i) * double(inv_n), u2 = radical_inverse(std::uint32_t(i));
+        double u1 = double(i) * double(inv_n), u2 = hammersley_radical_inverse(std::uint32_t(i));
+        if (azimuth == HammersleyAzimuth::Second) std::swap(u1, u2);
         // h from D(h) cos θh: cos²θh = (1 − u2)/(1 + (α² − 1) u2) (Walter et al. 2007, Eq. 35).
         const double phi = 2 * kPi<double> * u1;
         const double cos2 = (1 - u2) / (1 + (alpha + 1) * ((alpha - 1) * u2));

@@ -22,8 +22,17 @@
 //   - bilinear filtering with the texture's edges clamped.
 
 #include <array>
+#include <cstdint>
 
 namespace lamina {
+
+/// The base-2 radical inverse of i (van der Corput), the Hammersley set's second coordinate.
+double hammersley_radical_inverse(std::uint32_t i);
+
+/// Which coordinate of the Hammersley point (i/n, radical inverse of i) the estimators below take
+/// for the azimuth of the sampled normal: Filament's cmgen the first, Unity HDRP's
+/// IntegrateGGXAndDisneyDiffuseFGD the second (the first then draws cos θh).
+enum class HammersleyAzimuth { First, Second };
 
 class FilamentDfgTexture {
   public:
@@ -37,7 +46,10 @@ class FilamentDfgTexture {
     double albedo(double mu_o) const;
 
     /// Filament's estimator of E at one (μo, α) with n points (no texture, no rounding).
-    static double estimate(double mu_o, double alpha, int n = kSamples);
+    /// `azimuth` = Second is Unity HDRP's estimator of the same integral (the Hammersley
+    /// coordinates swapped; μo taken at ≥ 2⁻²⁴ as it takes it).
+    static double estimate(double mu_o, double alpha, int n = kSamples,
+                           HammersleyAzimuth azimuth = HammersleyAzimuth::First);
     /// The perceptual roughness the texture row sampled at coordinate (y + ½)/128 holds.
     static double row_roughness(int y);
 
