@@ -419,11 +419,31 @@ TEST(FilmFresnel, CyclesAgainstTheSpectralFilm) {
         double documented[3];
     };
     const std::vector<Case> cases = {
-        {"MgF2 quarter wave (96.4 nm) on glass", 1.38, 96.4, {false, 1.52, 0, -1}, {0, 0, 0}},
-        {"soap film (1.33, 300 nm) in air", 1.33, 300, {false, 1.0, 0, -1}, {0, 0, 0}},
-        {"film (1.5, 900 nm) on glass of 1.9", 1.5, 900, {false, 1.9, 0, -1}, {0, 0, 0}},
-        {"oxide (2.5, 60 nm) on titanium", 2.5, 60, {true, 2.54, 3.43, -1}, {0, 0, 0}},
-        {"film (1.8, 300 nm) on gold", 1.8, 300, {true, 0.42, 2.35, -1}, {0, 0, 0}},
+        {"MgF2 quarter wave (96.4 nm) on glass",
+         1.38,
+         96.4,
+         {false, 1.52, 0, -1},
+         {7.26e-5, 1.67e-4, 2.35e-4}},
+        {"soap film (1.33, 300 nm) in air",
+         1.33,
+         300,
+         {false, 1.0, 0, -1},
+         {1.59e-4, 1.17e-2, 1.02e-1}},
+        {"film (1.5, 900 nm) on glass of 1.9",
+         1.5,
+         900,
+         {false, 1.9, 0, -1},
+         {6.79e-5, 1.55e-4, 1.85e-4}},
+        {"oxide (2.5, 60 nm) on titanium",
+         2.5,
+         60,
+         {true, 2.54, 3.43, -1},
+         {5.02e-3, 1.52e-2, 2.76e-2}},
+        {"film (1.8, 300 nm) on gold",
+         1.8,
+         300,
+         {true, 0.42, 2.35, -1},
+         {3.86e-4, 2.13e-3, 4.74e-3}},
     };
     for (const Case& k : cases) {
         const C eta_exit(k.substrate.n, k.substrate.k);
@@ -446,8 +466,12 @@ TEST(FilmFresnel, CyclesAgainstTheSpectralFilm) {
                 if (d > worst) worst = d, at_mu = mu;
             }
         }
-        std::cout << fmt::format("| {} | {:.3f} | {:.3f} | {:.3f} (μ = {:.2f}) |\n", k.name, normal,
+        std::cout << fmt::format("| {} | {:.2e} | {:.2e} | {:.2e} (μ = {:.2f}) |\n", k.name, normal,
                                  above_half, worst, at_mu);
+        const double got[3] = {normal, above_half, worst};
+        for (int i = 0; i < 3; ++i)
+            EXPECT_NEAR(got[i], k.documented[i], 0.05 * k.documented[i] + 1e-9)
+                << k.name << " column " << i;
     }
 }
 
@@ -458,16 +482,21 @@ TEST(FilmFresnel, CyclesAgainstTheSpectralFilm) {
 TEST(FilmFresnel, CyclesPrincipledAgainstTheExactFilm) {
     const auto& [ti, au, cu, al] = kFilmMetals;
     const std::vector<SingleFilm> films = {
-        {"oxide (2.5, 60 nm) on titanium", 1.0, 2.5, 60, {ti[0], ti[1], ti[2]}, {0, 0, 0}},
-        {"film (1.8, 300 nm) on gold", 1.0, 1.8, 300, {au[0], au[1], au[2]}, {0, 0, 0}},
-        {"film (1.5, 900 nm) on copper", 1.0, 1.5, 900, {cu[0], cu[1], cu[2]}, {0, 0, 0}},
-        {"MgF2 (1.38, 96.4 nm) on aluminium", 1.0, 1.38, 96.4, {al[0], al[1], al[2]}, {0, 0, 0}},
+        {"oxide (2.5, 60 nm) on titanium", 1.0, 2.5, 60, {ti[0], ti[1], ti[2]}, {0.08, 0.08, 0.08}},
+        {"film (1.8, 300 nm) on gold", 1.0, 1.8, 300, {au[0], au[1], au[2]}, {0.03, 0.09, 0.19}},
+        {"film (1.5, 900 nm) on copper", 1.0, 1.5, 900, {cu[0], cu[1], cu[2]}, {0.13, 0.14, 0.21}},
+        {"MgF2 (1.38, 96.4 nm) on aluminium",
+         1.0,
+         1.38,
+         96.4,
+         {al[0], al[1], al[2]},
+         {0.01, 0.01, 0.07}},
         {"oxide (2.5, 60 nm) on titanium under a coat of 1.5",
          1.5,
          2.5,
          60,
          {ti[0], ti[1], ti[2]},
-         {0, 0, 0}},
+         {0.05, 0.06, 0.10}},
     };
     for (const SingleFilm& sf : films) {
         const FilmOptics f = sf.optics();
@@ -495,6 +524,9 @@ TEST(FilmFresnel, CyclesPrincipledAgainstTheExactFilm) {
         }
         std::cout << fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} (μ = {:.2f}) |\n", sf.name,
                                  normal, above_half, worst, at_mu);
+        EXPECT_NEAR(normal, sf.documented[0], 0.006) << sf.name;
+        EXPECT_NEAR(above_half, sf.documented[1], 0.006) << sf.name;
+        EXPECT_NEAR(worst, sf.documented[2], 0.006) << sf.name;
     }
 }
 
