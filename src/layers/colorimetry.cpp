@@ -2,6 +2,7 @@
 
 #include "layers/spectral_data.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <sstream>
@@ -12,7 +13,7 @@ namespace lamina {
 
 namespace {
 constexpr double kFirstNm = 360, kStepNm = 5;
-constexpr int kRows = 95;  // 360, 365, …, 830
+constexpr int kRows = kCie1931Rows;  // 360, 365, …, 830
 
 /// Column `column` of a 5 nm table (the header skipped).
 std::vector<double> column_of(std::string_view text, int column) {
@@ -60,6 +61,12 @@ Rgbd d65_xyz_weights(double lambda_nm) {
         out[std::size_t(k)] = s * (c[std::size_t(i)] * (1 - t) + c[std::size_t(i + 1)] * t);
     }
     return out;
+}
+
+Rgbd cie1931_cmf_row(int i) {
+    const Tables& tab = tables();
+    const auto row = std::size_t(std::clamp(i, 0, kRows - 1));
+    return {tab.cmf[0][row], tab.cmf[1][row], tab.cmf[2][row]};
 }
 
 Rgbd xyz_to_linear_srgb(const Rgbd& xyz) {

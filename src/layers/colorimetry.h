@@ -12,6 +12,11 @@ namespace lamina {
 /// ∫ f S (x̄, ȳ, z̄) dλ / ∫ S ȳ dλ, so that f = 1 has Y = 1 (CIE 015:2018, §7.1).
 Rgbd d65_xyz_weights(double lambda_nm);
 
+/// The CIE 1931 2° colour-matching functions (x̄, ȳ, z̄) as tabulated (data/cie): row i ∈ [0,
+/// kCie1931Rows) at 360 + 5 i nm.
+inline constexpr int kCie1931Rows = 95;
+Rgbd cie1931_cmf_row(int i);
+
 /// Linear sRGB of XYZ (IEC 61966-2-1:1999, the matrix of its §5.2; D65 white, Y = 1 → (1, 1, 1)).
 Rgbd xyz_to_linear_srgb(const Rgbd& xyz);
 

@@ -179,8 +179,9 @@ const std::vector<ModelEntry>& model_registry() {
         {"blender-principled",
          "Blender Cycles Principled coat: compensated coat lobe, base x (1 - Cycles' estimate of "
          "its albedo at wo) x tint^(1/mu_t,o), compensated F82-tint metal",
-         "bases: lambertian, conductor; media: absorbing; sides: R", blender_principled_options,
-         make_blender_principled, false, "production"},
+         "bases: lambertian, conductor (with a thin film); media: absorbing; sides: R",
+         blender_principled_options, make_blender_principled, false, "production",
+         /*represents_anisotropy=*/false, /*films=*/true},
         {"kulla-conty",
          "Kulla & Conty 2017 layering: base x (1 - E(mu_i))(1 - E(mu_o))/(1 - E_avg), reciprocal",
          "bases: lambertian, conductor; media: absorbing; sides: R", kulla_conty_options,

@@ -1,11 +1,15 @@
 #include "models/production/film_fresnel.h"
 
 #include "core/math.h"
+#include "layers/colorimetry.h"
 #include "models/numerics/quadrature.h"
+#include "models/production/production_coat.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 namespace lamina {
 
@@ -31,6 +35,16 @@ Rgbd thickness_average(double min_nm, double max_nm, double period_nm, F&& f) {
     return sum / double(pieces);
 }
 
+/// XYZ to linear sRGB (Rec. 709 primaries, D65) by the matrix of IEC 61966-2-1 to seven digits,
+/// as three.js's evalSensitivity and Cycles' fallback colour space (util/colorspace.cpp,
+/// get_xyz_to_rec709) carry it (layers/colorimetry.h has the standard's four-digit form).
+template <typename V>
+V xyz_to_srgb_7_digits(const V& xyz) {
+    return {3.2404542 * xyz[0] - 1.5371385 * xyz[1] - 0.4985314 * xyz[2],
+            -0.9692660 * xyz[0] + 1.8760108 * xyz[1] + 0.0415560 * xyz[2],
+            0.0556434 * xyz[0] - 0.2040259 * xyz[1] + 1.0572252 * xyz[2]};
+}
+
 /// Belcour & Barla 2017's sensitivity S(OPD, shift) in linear sRGB: the Fourier transform of the
 /// CIE 1931 colour matching functions at the optical path difference OPD (nm), shifted in phase,
 /// by the paper's fit of each as a sum of Gaussians (their supplemental material; the constants
@@ -52,9 +66,7 @@ Rgbd sensitivity_srgb(double opd_nm, const Rgbd& shift) {
               std::cos(2.2399e+06 * phase + shift[0]) * std::exp(-4.5282e+09 * phase * phase);
     for (double& v : xyz)
         v /= 1.0685e-7;
-    return {3.2404542 * xyz[0] - 1.5371385 * xyz[1] - 0.4985314 * xyz[2],
-            -0.9692660 * xyz[0] + 1.8760108 * xyz[1] + 0.0415560 * xyz[2],
-            0.0556434 * xyz[0] - 0.2040259 * xyz[1] + 1.0572252 * xyz[2]};
+    return xyz_to_srgb_7_digits(Rgbd(xyz[0], xyz[1], xyz[2]));
 }
 
 /// Normal reflectance ((n_t − n_i)/(n_t + n_i))² of a dielectric boundary.
@@ -87,8 +99,8 @@ Rgbd film_reflectance_exact(const FilmOptics& film, double cos_theta) {
     });
 }
 
-std::complex<double> gulbrandsen_index(double r, double g) {
-    const double rc = clamp(r, 0.0, 0.99), sr = std::sqrt(rc);
+std::complex<double> gulbrandsen_index(double r, double g, double r_max) {
+    const double rc = clamp(r, 0.0, r_max), sr = std::sqrt(rc);
     const double n_min = (1 - rc) / (1 + rc), n_max = (1 + sr) / (1 - sr);
     const double n = n_max + (n_min - n_max) * g;
     const double k2 = (sqr(n + 1) * rc - sqr(n - 1)) / (1 - rc);
@@ -164,6 +176,245 @@ Rgbd threejs_iridescence_range(double outside_ior, double film_ior, double cos_t
     const double period = 1 / (2.2399e6 * 1e-9 * 2 * std::max(film_ior, 1e-3));
     return thickness_average(min_nm, max_nm, period, [&](double d) {
         return threejs_iridescence(outside_ior, film_ior, cos_theta_1, d, base_f0);
+    });
+}
+
+namespace {
+
+/// A not-a-knot cubic spline through (x0 + i h, y_i) (de Boor, "A Practical Guide to Splines",
+/// chapter IV: the third derivative continuous at the second and the last but one knot), as
+/// scipy's CubicSpline builds it by default; 0 outside the knots.
+class UniformSpline {
+  public:
+    UniformSpline(double x0, double h, std::vector<double> y) : x0_(x0), h_(h), y_(std::move(y)) {
+        // Second derivatives m_i: m_{i−1} + 4 m_i + m_{i+1} = 6 (y_{i+1} − 2 y_i + y_{i−1})/h²
+        // inside, m_0 − 2 m_1 + m_2 = 0 and its mirror at the end (not-a-knot), by Gaussian
+        // elimination with partial pivoting (n ≈ 100).
+        const int n = int(y_.size());
+        std::vector<std::vector<double>> a(std::size_t(n), std::vector<double>(std::size_t(n + 1)));
+        auto at = [&](int r, int c) -> double& { return a[std::size_t(r)][std::size_t(c)]; };
+        at(0, 0) = 1, at(0, 1) = -2, at(0, 2) = 1;
+        at(n - 1, n - 3) = 1, at(n - 1, n - 2) = -2, at(n - 1, n - 1) = 1;
+        for (int i = 1; i + 1 < n; ++i) {
+            at(i, i - 1) = 1, at(i, i) = 4, at(i, i + 1) = 1;
+            at(i, n) = 6 *
+                       (y_[std::size_t(i + 1)] - 2 * y_[std::size_t(i)] + y_[std::size_t(i - 1)]) /
+                       (h_ * h_);
+        }
+        for (int c = 0; c < n; ++c) {
+            int pivot = c;
+            for (int r = c + 1; r < n; ++r)
+                if (std::abs(at(r, c)) > std::abs(at(pivot, c))) pivot = r;
+            std::swap(a[std::size_t(c)], a[std::size_t(pivot)]);
+            for (int r = c + 1; r < n; ++r) {
+                const double f = at(r, c) / at(c, c);
+                if (f == 0) continue;
+                for (int k = c; k <= n; ++k)
+                    at(r, k) -= f * at(c, k);
+            }
+        }
+        m_.assign(std::size_t(n), 0.0);
+        for (int r = n - 1; r >= 0; --r) {
+            double v = at(r, n);
+            for (int k = r + 1; k < n; ++k)
+                v -= at(r, k) * m_[std::size_t(k)];
+            m_[std::size_t(r)] = v / at(r, r);
+        }
+    }
+    double operator()(double x) const {
+        const double t = (x - x0_) / h_;
+        const int n = int(y_.size());
+        if (!(t >= 0) || t > n - 1) return 0;
+        const int i = std::min(int(t), n - 2);
+        const double b = t - i, a = 1 - b;
+        const auto u = std::size_t(i);
+        return a * y_[u] + b * y_[u + 1] +
+               ((a * a * a - a) * m_[u] + (b * b * b - b) * m_[u + 1]) * h_ * h_ / 6;
+    }
+
+  private:
+    double x0_, h_;
+    std::vector<double> y_, m_;
+};
+
+}  // namespace
+
+CyclesFilmSensitivity::CyclesFilmSensitivity() {
+    // The CIE rows continued by a zero row one step beyond each end.
+    constexpr double kFirstNm = 360, kStepNm = 5;
+    std::array<std::vector<double>, 3> rows;
+    for (auto& r : rows)
+        r.push_back(0.0);
+    for (int i = 0; i < kCie1931Rows; ++i) {
+        const Rgbd v = cie1931_cmf_row(i);
+        for (int c = 0; c < 3; ++c)
+            rows[std::size_t(c)].push_back(v[c]);
+    }
+    for (auto& r : rows)
+        r.push_back(0.0);
+    std::vector<UniformSpline> cmf;
+    for (auto& r : rows)
+        cmf.emplace_back(kFirstNm - kStepNm, kStepNm, r);
+    // The functions of the wavenumber ν (µm⁻¹) on Cycles' grid: x̄(1/ν)/ν² (dλ = dν/ν²).
+    constexpr int kSamples = 1022;
+    const double dnu = std::numbers::pi / 60;
+    std::vector<Rgbd> samples(kSamples, Rgbd(0.0));
+    for (int k = 1; k < kSamples; ++k) {
+        const double nu = k * dnu, lambda_nm = 1000 / nu;
+        for (int c = 0; c < 3; ++c)
+            samples[std::size_t(k)][c] = cmf[std::size_t(c)](lambda_nm) / (nu * nu);
+    }
+    // Their discrete Fourier transform, in linear sRGB, each channel over its DC term.
+    using C = std::complex<double>;
+    std::array<C, 3> dc{};
+    for (int j = 0; j < kSize; ++j) {
+        std::array<C, 3> xyz{};
+        for (int k = 0; k < kSamples; ++k) {
+            // e^(−2πi jk/N) with jk reduced modulo N (exact in integers).
+            const double phase =
+                -2 * std::numbers::pi * double((long(j) * k) % kSamples) / kSamples;
+            const C w(std::cos(phase), std::sin(phase));
+            for (int c = 0; c < 3; ++c)
+                xyz[std::size_t(c)] += samples[std::size_t(k)][c] * w;
+        }
+        const std::array<C, 3> rgb = xyz_to_srgb_7_digits(xyz);
+        if (j == 0)
+            for (int c = 0; c < 3; ++c)
+                dc[std::size_t(c)] = rgb[std::size_t(c)].real();
+        for (int c = 0; c < 3; ++c)
+            table_[c][j] = rgb[std::size_t(c)] / dc[std::size_t(c)];
+    }
+}
+
+const CyclesFilmSensitivity& CyclesFilmSensitivity::get() {
+    static const CyclesFilmSensitivity table;
+    return table;
+}
+
+std::complex<double> CyclesFilmSensitivity::operator()(int channel, double opd_nm) const {
+    // The table spans 2π OPD/60000 nm ∈ [0, 1]: OPD up to 60 µm/2π; beyond, its last entry.
+    const double x = clamp(2 * std::numbers::pi * opd_nm / 60000, 0.0, 1.0) * (kSize - 1);
+    const int i = std::min(int(x), kSize - 1), next = std::min(i + 1, kSize - 1);
+    const double t = x - i;
+    return table_[channel][i] * (1 - t) + table_[channel][next] * t;
+}
+
+namespace {
+
+/// r/|r| (1 for r = 0): the phase of a reflection as a unit phasor, as Cycles forms it
+/// (fresnel_dielectric_polarized's sign, fresnel_conductor_polarized's phasors).
+std::complex<double> phasor(std::complex<double> r) {
+    const double m = std::abs(r);
+    return m > 0 ? r / m : std::complex<double>(1.0);
+}
+
+/// Cycles' iridescence_airy_summation_channel: Belcour & Barla 2017, Eq. 10 to the third order,
+/// R = R12 + R_s + Σ_m 2 C_m Re(e^(imφ) conj(S(m OPD))), C_m = (R_s − T121) r123^m, for one
+/// polarization with the boundaries' reflectances R12, R23 and the round trip's phasor e^(iφ).
+template <typename Sensitivity>
+double airy_summation(const Sensitivity& sensitivity, double R12, double R23, double opd,
+                      std::complex<double> round_trip) {
+    const double T121 = 1 - R12, R123 = R12 * R23, r123 = std::sqrt(R123);
+    const double Rs = T121 * T121 * R23 / (1 - R123);
+    double R = R12 + Rs, Cm = Rs - T121;
+    std::complex<double> power = round_trip;
+    for (int m = 1; m <= 3; ++m) {
+        Cm *= r123;
+        const std::complex<double> S = sensitivity(m * opd);
+        R += Cm * 2 * (power.real() * S.real() + power.imag() * S.imag());
+        power *= round_trip;
+    }
+    return R;
+}
+
+constexpr double kCyclesFilmCutoffNm = 0.1;  // THINFILM_THICKNESS_CUTOFF
+
+}  // namespace
+
+namespace {
+
+template <typename Sensitivity>
+double cycles_film(const Sensitivity& sensitivity, double film_ior, double thickness_nm,
+                   const CyclesFilmSubstrate& substrate, double cos_theta_1) {
+    using C = std::complex<double>;
+    const double c1 = clamp(cos_theta_1, 0.0, 1.0), sin2 = 1 - c1 * c1;
+    // Below 1 nm the film's index goes to the ambient's (1).
+    double eta = film_ior;
+    if (thickness_nm < 1) {
+        const double t = clamp(thickness_nm, 0.0, 1.0);
+        eta = 1 + (film_ior - 1) * t * t * (3 - 2 * t);
+    }
+    // Total reflection at the first boundary (Cycles: at η² − sin²θ1 ≤ 0).
+    if (!(eta * eta - sin2 > 0)) return 1;
+    const C u1(c1), u2(std::sqrt(eta * eta - sin2));
+    const FresnelAmplitudes<double> top = fresnel_amplitudes<double>(C(1), u1, C(eta), u2);
+    // Grazing incidence: the first boundary reflects everything (Cycles returns 1 there too).
+    if (std::norm(top.r_s) == 1 && std::norm(top.r_p) == 1) return 1;
+    // The second boundary, relative to the film (reference medium: the ambient, index 1).
+    const C substrate_eta(substrate.n, substrate.conductor ? substrate.k : 0.0);
+    if (!substrate.conductor && !(substrate.n * substrate.n - sin2 > 0)) return 1;
+    const C u3 = normal_wave_number(substrate_eta, sin2);
+    const FresnelAmplitudes<double> bottom =
+        fresnel_amplitudes<double>(C(eta), u2, substrate_eta, u3);
+    double R23_s = std::norm(bottom.r_s), R23_p = std::norm(bottom.r_p);
+    if (substrate.conductor && substrate.f82 >= 0) {
+        // The F82 model with the normal reflectance of the metal relative to the film and the
+        // value f82 at 82° (Cycles passes the metal's F82 against the ambient).
+        const double n = substrate.n / eta, k = substrate.k / eta;
+        const double f0 = (sqr(n - 1) + k * k) / (sqr(n + 1) + k * k);
+        const double tint = substrate.f82 / f82_tint_fresnel(1.0 / 7, f0, 1.0);
+        R23_s = R23_p = f82_tint_fresnel(u2.real() / eta, f0, tint);
+    }
+    // The round trip's phasor e^(i(φ23 + φ21)), φ21 = φ12 + π.
+    const double opd = 2 * thickness_nm * u2.real();  // 2 η d cos θ2
+    const double R_s = airy_summation(sensitivity, std::norm(top.r_s), R23_s, opd,
+                                      -phasor(bottom.r_s) * phasor(top.r_s));
+    const double R_p = airy_summation(sensitivity, std::norm(top.r_p), R23_p, opd,
+                                      -phasor(bottom.r_p) * phasor(top.r_p));
+    return clamp(0.5 * (R_s + R_p), 0.0, 1.0);
+}
+
+}  // namespace
+
+double cycles_film_reflectance(int channel, double film_ior, double thickness_nm,
+                               const CyclesFilmSubstrate& substrate, double cos_theta_1) {
+    const CyclesFilmSensitivity& table = CyclesFilmSensitivity::get();
+    return cycles_film([&](double opd) { return table(channel, opd); }, film_ior, thickness_nm,
+                       substrate, cos_theta_1);
+}
+
+double cycles_film_reflectance_monochromatic(double wavelength_nm, double film_ior,
+                                             double thickness_nm,
+                                             const CyclesFilmSubstrate& substrate,
+                                             double cos_theta_1) {
+    return cycles_film(
+        [&](double opd) { return std::polar(1.0, -2 * std::numbers::pi * opd / wavelength_nm); },
+        film_ior, thickness_nm, substrate, cos_theta_1);
+}
+
+Rgbd cycles_f82_tint_film(double film_ior, double thickness_nm, const Rgbd& f0, const Rgbd& tint,
+                          double cos_theta) {
+    Rgbd F;
+    for (int c = 0; c < 3; ++c) {
+        if (!(thickness_nm > kCyclesFilmCutoffNm)) {
+            F[c] = f82_tint_fresnel(cos_theta, f0[c], tint[c]);
+            continue;
+        }
+        const double g = f82_tint_fresnel(1.0 / 7, f0[c], tint[c]);
+        const std::complex<double> index = gulbrandsen_index(std::min(f0[c], 0.999), g, 0.999);
+        F[c] = cycles_film_reflectance(c, film_ior, thickness_nm,
+                                       {true, index.real(), index.imag(), g}, cos_theta);
+    }
+    return F;
+}
+
+Rgbd cycles_f82_tint_film_range(double film_ior, double min_nm, double max_nm, const Rgbd& f0,
+                                const Rgbd& tint, double cos_theta) {
+    // The third order's phase 2π · 3 · 2 η d cos θ2/λ has a period in d of at least
+    // λ_min/(6 η), λ_min = 360 nm.
+    const double period = 360 / (6 * std::max(film_ior, 1e-3));
+    return thickness_average(min_nm, max_nm, period, [&](double d) {
+        return cycles_f82_tint_film(film_ior, d, f0, tint, cos_theta);
     });
 }
 

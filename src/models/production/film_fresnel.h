@@ -5,7 +5,9 @@
 // against the metal its F0 and edge tint describe; and three.js's iridescence
 // (KHR_materials_iridescence as three.js evaluates it), Belcour & Barla 2017's Fourier-space Airy
 // sum reduced to two orders on Schlick's Fresnel, integrated against the CIE colour matching
-// functions and returned in linear sRGB.
+// functions and returned in linear sRGB; and Blender Cycles' (its Principled BSDF's thin film),
+// the same Fourier-space sum with the exact phases of both boundaries, three orders, and its
+// sensitivity read from a table of the CIE functions' Fourier transform (CyclesFilmSensitivity).
 //
 // Both return a reflectance per RGB channel in [0, 1] and never throw. A film's thickness range
 // [min, max] (a film uniformly distributed over the surface) is averaged over: the surface's mean
@@ -49,9 +51,10 @@ Rgbd threejs_iridescence_range(double outside_ior, double film_ior, double cos_t
                                double min_nm, double max_nm, const Rgbd& base_f0);
 
 /// Gulbrandsen 2014 ("Artist friendly metallic Fresnel", JCGT 3(4)), Eqs. 3 and 4: the complex
-/// index n + ik whose normal reflectance is r (clamped to [0, 0.99], as openpbr-bsdf clamps it)
-/// with the edge tint g ∈ [0, 1] choosing n between (1 − r)/(1 + r) and (1 + √r)/(1 − √r).
-std::complex<double> gulbrandsen_index(double r, double g);
+/// index n + ik whose normal reflectance is r (clamped to [0, r_max]: 0.99 as openpbr-bsdf clamps
+/// it, 0.999 as Cycles does) with the edge tint g ∈ [0, 1] choosing n between (1 − r)/(1 + r) and
+/// (1 + √r)/(1 − √r).
+std::complex<double> gulbrandsen_index(double r, double g, double r_max = 0.99);
 
 /// Adobe openpbr-bsdf's film (openpbr_thin_film_iridescence_utils.h, openpbr_reflection_
 /// transmission_coefficient.h): the exact Airy reflectance of `film` at the facet cosine
@@ -60,5 +63,67 @@ std::complex<double> gulbrandsen_index(double r, double g);
 /// boundary reflects totally (no tunnelling), faded in from the bare metal's reflectance `bare`
 /// over the first 30 nm (smoothstep(1e-9, 30, d)); averaged over the thickness range.
 Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, const Rgbd& bare);
+
+/// Blender Cycles' table of the spectral sensitivity of its thin film (scene/shader.cpp,
+/// compute_thin_film_table, after Belcour & Barla 2017, §4): per linear-sRGB channel c, the
+/// discrete Fourier transform of the channel's colour-matching function r̄_c(λ) resampled in the
+/// wavenumber ν = 1/λ, S_c[j] = Σ_k r̄_c(1/ν_k)/ν_k² e^(−2πi jk/N) for ν_k = k π/60 µm⁻¹,
+/// k < N = 1022, j < 512, divided by its real DC term (so that a flat spectrum gives 1). lamina
+/// derives it from its own CIE 1931 tables (data/cie, 5 nm rows from 360 to 830 nm, continued by
+/// a zero row 5 nm beyond each end) through a not-a-knot cubic spline in λ, as Cycles' script
+/// (doc/precompute/thin_film_table.py) splines the CIE's 1 nm table, and projects XYZ to linear
+/// sRGB by the IEC 61966-2-1 matrix (Cycles' fallback without a colour-management configuration).
+class CyclesFilmSensitivity {
+  public:
+    static constexpr int kSize = 512;
+    static const CyclesFilmSensitivity& get();
+    /// Entry j ∈ [0, kSize) of channel c (linear sRGB), normalized.
+    std::complex<double> entry(int channel, int j) const { return table_[channel][j]; }
+    /// The kernel's lookup (iridescence_lookup_sensitivity_channel): the entries linearly
+    /// interpolated at x = 2π OPD/60000 nm ∈ [0, 1] (clamped) times 511.
+    std::complex<double> operator()(int channel, double opd_nm) const;
+
+  private:
+    CyclesFilmSensitivity();
+    std::complex<double> table_[3][kSize];
+};
+
+/// Cycles' thin film (kernel/closure/bsdf_util.h, fresnel_iridescence_channel) for light
+/// arriving from a medium of index 1 at cos_theta_1 on a film of index film_ior and thickness
+/// thickness_nm over a substrate: the reflectances and phases of both boundaries (each
+/// polarization) summed to the third order of Belcour & Barla 2017's Eq. 10, each order's phase
+/// integrated against channel c's sensitivity (CyclesFilmSensitivity); the film's index blended
+/// towards 1 below 1 nm (smoothstep), 1 at total reflection on either boundary, the mean of s and
+/// p clamped to [0, 1]. The substrate is a dielectric of index substrate_n (k = 0, f82 < 0), or a
+/// conductor n + ik whose reflectance is the exact one (f82 < 0) or, for f82 ≥ 0, the F82 model
+/// with its normal reflectance relative to the film and the value f82 at 82° (only the phase is
+/// the conductor's), as Cycles' F82-tint metal calls it.
+struct CyclesFilmSubstrate {
+    bool conductor = false;
+    double n = 1.5, k = 0;
+    double f82 = -1;
+};
+double cycles_film_reflectance(int channel, double film_ior, double thickness_nm,
+                               const CyclesFilmSubstrate& substrate, double cos_theta_1);
+/// The same sum with the monochromatic sensitivity e^(−2πi OPD/λ) of the vacuum wavelength
+/// wavelength_nm in place of channel c's table: summed to every order it would be the exact Airy
+/// reflectance of the film at λ (physics/thin_film.h); Cycles' three orders leave out the terms
+/// m ≥ 4 of Eq. 10.
+double cycles_film_reflectance_monochromatic(double wavelength_nm, double film_ior,
+                                             double thickness_nm,
+                                             const CyclesFilmSubstrate& substrate,
+                                             double cos_theta_1);
+
+/// Cycles' F82-tint metal under its thin film (kernel/closure/bsdf_microfacet.h, microfacet_fresnel
+/// with F82_TINT): per channel the metal of normal reflectance f0 and F82 tint `tint` read as
+/// Gulbrandsen's n + ik of r = min(f0, 0.999) and g = its F82-tint reflectance at 1/7, then
+/// cycles_film_reflectance with that conductor and f82 = g. Films of thickness_nm ≤ 0.1 (Cycles'
+/// THINFILM_THICKNESS_CUTOFF) leave the bare F82-tint metal.
+Rgbd cycles_f82_tint_film(double film_ior, double thickness_nm, const Rgbd& f0, const Rgbd& tint,
+                          double cos_theta);
+/// cycles_f82_tint_film averaged over the thickness range [min_nm, max_nm] (Gauss–Legendre, 32
+/// nodes per period of its third order, at most 2048 nodes); min_nm = max_nm is one thickness.
+Rgbd cycles_f82_tint_film_range(double film_ior, double min_nm, double max_nm, const Rgbd& f0,
+                                const Rgbd& tint, double cos_theta);
 
 }  // namespace lamina

@@ -61,7 +61,8 @@ class ProductionCoat final : public Model {
                 return;
             }
             if ((r_.metal_film == CoatRecipe::MetalFilm::ThreeJs ||
-                 r_.metal_film == CoatRecipe::MetalFilm::OpenPbrBsdf) &&
+                 r_.metal_film == CoatRecipe::MetalFilm::OpenPbrBsdf ||
+                 r_.metal_film == CoatRecipe::MetalFilm::Cycles) &&
                 in.film.k > 0) {
                 support_.reason = fmt::format(
                     "{}'s thin film is transparent (no extinction k); this film's k is {}", r_.name,
@@ -589,6 +590,15 @@ class ProductionCoat final : public Model {
                                                  f0_);
             case CoatRecipe::MetalFilm::OpenPbrBsdf:
                 return openpbr_bsdf_film_reflectance(*film_, cos_h, metal_fresnel(cos_h));
+            case CoatRecipe::MetalFilm::Cycles: {
+                // Cycles' film sees an ambient of index 1 above it: relative to the coat, its
+                // index is η_f/η_c and its thickness d η_c (the same optical path in vacuum
+                // wavelengths).
+                const double eta_c = film_->eta_above;
+                return cycles_f82_tint_film_range(
+                    film_->eta_film.real() / eta_c, film_->thickness_min_nm * eta_c,
+                    film_->thickness_max_nm * eta_c, f0_, tint82_, cos_h);
+            }
             case CoatRecipe::MetalFilm::Unsupported:
                 break;
         }

@@ -188,6 +188,11 @@ struct CoatRecipe {
         /// from its F0 and F82 tint by Gulbrandsen's map, at the stack's wavelengths, faded in over
         /// the first 30 nm (openpbr_bsdf_film_reflectance); the metal's F82-tint Fresnel below.
         OpenPbrBsdf,
+        /// Blender Cycles': its Fourier-space Airy sum at wi·h on its F82-tint metal read as
+        /// Gulbrandsen's n + ik (cycles_f82_tint_film_range), the film's index and thickness
+        /// taken relative to the coat (η_f/η_c, d η_c: Cycles' film sees an ambient of index 1);
+        /// a film of at most 0.1 nm (so taken) leaves the bare metal.
+        Cycles,
     } metal_film = MetalFilm::Unsupported;
 
     /// Standard Surface's coat_affect_color = 1: ρ ← ρ^2 (its default 0 leaves ρ).

@@ -224,6 +224,9 @@ CoatRecipe threejs_recipe(const ModelOptions& o) {
 CoatRecipe blender_recipe(const ModelOptions& o) {
     CoatRecipe r;
     r.name = "blender-principled";
+    // The Principled BSDF's thin film on its metal (kernel/svm/closure.h; microfacet_fresnel's
+    // F82-tint case in kernel/closure/bsdf_microfacet.h).
+    r.metal_film = CoatRecipe::MetalFilm::Cycles;
     r.coat_fresnel = CoatRecipe::Fresnel::Exact;
     r.coat_ior_at_least_one = true;
     r.attenuation = CoatRecipe::Attenuation::AlbedoView;
