@@ -63,9 +63,10 @@ double component_error(const std::vector<float>& a, const LaneVec3<float>& b, st
 
 // The tolerance of a float visible normal sampled from w with u1, u2 (1e-6 on a smooth
 // interface): in double, wh (w on its side in the hemisphere configuration), the cap point c and
-// the halfway vector h = c + wh, whose normalization divides the float rounding by |h| (the cap
-// point near −wh: u2 → 1 with a tiny α): (4e-6 + 2^-23/sin θ_cap)/|h|, with |h| in `h` (1 on a
-// smooth interface).
+// the halfway vector h = c + wh, warped back to h' = (α h.x, α h.y, h.z), whose normalization
+// divides the float rounding by |h'| (short when the cap point nears −wh, u2 → 1 with a tiny α,
+// and up to 1/α shorter than |h| for a lying h): (4e-6 + 2^-23/sin θ_cap)/|h'|, with |h| in `h`
+// (1 on a smooth interface).
 double visible_normal_tolerance(float alpha, const LaneVec3<float>& w, float u1, float u2,
                                 double& h) {
     h = 1;
@@ -81,7 +82,8 @@ double visible_normal_tolerance(float alpha, const LaneVec3<float>& w, float u1,
     const double hx = sin_cap * std::cos(phi) + whx, hy = sin_cap * std::sin(phi) + why,
                  hz = z_cap + whz;
     h = std::sqrt(hx * hx + hy * hy + hz * hz);
-    return (4e-6 + 0x1p-23 / sin_cap) / h;
+    const double a2 = double(alpha) * alpha;
+    return (4e-6 + 0x1p-23 / sin_cap) / std::sqrt(a2 * (hx * hx + hy * hy) + hz * hz);
 }
 
 // The dielectric event, smooth and rough (α from 10^-3 to 1), η above and below 1 and η = 1, both

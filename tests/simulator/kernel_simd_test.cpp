@@ -369,11 +369,11 @@ TEST(KernelSimd, HenyeyGreensteinLanes) {
 // normalizations by the refined reciprocal square root (2^-22 relative each) against the exact
 // one, the Cephes azimuth (≤ 2 ulp) against the C library's, fused multiply-adds: within 4e-6 per
 // component, plus 2^-23 / sin θ from the cap point's sin θ = √(1 − z²) (a 2-ulp difference in
-// 1 − z², grown near the cap's pole). Where the cap of visible normals shrinks to a point (w below
-// the horizon with 1 + wh.z < 0.1, wh: w in the hemisphere configuration) the halfway vector
-// h = c + wh cancels and the float construction itself, scalar and vector alike, loses its digits
-// (at α = 10^-3 nothing is left): there only a finite unit normal in the upper hemisphere is
-// required, and the difference is printed.
+// 1 − z², grown near the cap's pole), plus the cancellation of h.z at the cap's rim (below). Where
+// the cap of visible normals shrinks to a point (w below the horizon with 1 + wh.z < 0.1, wh: w in
+// the hemisphere configuration) the halfway vector h = c + wh cancels and the float construction
+// itself, scalar and vector alike, loses its digits (at α = 10^-3 nothing is left): there only a
+// finite unit normal in the upper hemisphere is required, and the difference is printed.
 TEST(KernelSimd, GgxLanes) {
     ParticleRng rng(22, 0, 0);
     for (const float alpha : {1e-3f, 0.05f, 0.3f, 1.f}) {
@@ -417,7 +417,23 @@ TEST(KernelSimd, GgxLanes) {
             // 2^-23 / sin θ, unbounded at the cap's pole (z → 1, u2 → 0).
             const double z_cap = (1 - double(u2[j])) * extent - (extent - 1);
             const double sin_cap = std::sqrt(std::max(1 - z_cap * z_cap, 1e-12));
-            const double tolerance = 4e-6 + 0x1p-23 / sin_cap;
+            // The halfway vector's h.z = z + wh.z cancels to (1 − u2)(1 + wh.z) as u2 → 1 (the
+            // cap point at the cap's rim): z's rounding on either side (2^-24 |z|) and the
+            // vector's 2^-22 in h.x, h.y stay absolute there, and the final normalization divides
+            // them by |h'|, h' = (α h.x, α h.y, h.z) — in exact arithmetic, from double here.
+            const double whz = double(wj.z) / std::sqrt(ax * ax + ay * ay + double(wj.z) * wj.z);
+            const double phi_cap = 2 * kPi<double> * double(u1[j]);
+            const double hz = (1 - double(u2[j])) * (1 + whz),
+                         hx = double(alpha) *
+                              (sin_cap * std::cos(phi_cap) +
+                               ax / std::sqrt(ax * ax + ay * ay + double(wj.z) * wj.z)),
+                         hy = double(alpha) *
+                              (sin_cap * std::sin(phi_cap) +
+                               ay / std::sqrt(ax * ax + ay * ay + double(wj.z) * wj.z));
+            const double h_norm = std::sqrt(hx * hx + hy * hy + hz * hz);
+            const double cancellation =
+                (0x1p-23 * (std::abs(z_cap) + hz) + double(alpha) * 0x1p-21) / h_norm;
+            const double tolerance = 4e-6 + 0x1p-23 / sin_cap + cancellation;
             double norm2 = 0;
             for (int i = 0; i < 3; ++i) {
                 ASSERT_TRUE(std::isfinite(wm[3 * j + i])) << alpha << ' ' << j;
