@@ -356,11 +356,6 @@ int run_export(const ExportArgs& a) {
             check_rgl_bsdf(file, a.out);
             bytes = tensor_file_bytes(file);
         } else {
-            if (!brdf.isotropic)
-                throw InputError(a.stack, "--format",
-                                 "a MERL .binary holds an isotropic BRDF (its half-vector "
-                                 "coordinates drop φi) and this stack is anisotropic: write a "
-                                 ".bsdf or .npz");
             bytes = merl_binary(brdf);
         }
     }

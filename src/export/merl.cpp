@@ -62,6 +62,10 @@ Rgbd MerlBrdf::eval(const Vec3d& wi, const Vec3d& wo) const {
 }
 
 std::string merl_binary(const BrdfSource& brdf) {
+    if (!brdf.isotropic)
+        throw InputError(brdf.name, "--format",
+                         "a MERL .binary holds an isotropic BRDF (its half-vector coordinates "
+                         "drop φh) and this stack is anisotropic: write a .bsdf or .npz");
     std::vector<double> planes(3 * kCount, 0.0);
 #pragma omp parallel for schedule(dynamic, 1)
     for (int ih = 0; ih < kMerlThetaH; ++ih) {

@@ -35,7 +35,8 @@ std::array<double, 3> merl_half_diff(const Vec3d& wi, const Vec3d& wo);
 /// The pair (ωi, ωo) of given half/difference angles with φh = 0.
 std::array<Vec3d, 2> merl_directions(double theta_h, double theta_d, double phi_d);
 
-/// The file's bytes for the BRDF.
+/// The file's bytes for the BRDF. InputError naming the BRDF when it is anisotropic: the format's
+/// half/difference angles drop φh, so it holds isotropic BRDFs only.
 std::string merl_binary(const BrdfSource& brdf);
 /// Parses a file (InputError naming `where` for a wrong size, wrong dimensions, or values that
 /// are not finite).

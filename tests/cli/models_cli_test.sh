@@ -85,7 +85,7 @@ JSON
     [ "$(wc -l <"$tmp/pb.csv")" -eq $((1 + 9 * 12)) ] && pass=$((pass + 1)) || { echo "FAIL phi_i binned"; fails=$((fails + 1)); }
     check aniso-point 0 "$lamina" eval --model openpbr --stack "$tmp/brushed.json" --theta-i 30 --phi-i 200 --theta-o 45 --phi-o 20
     expect_output aniso-point-three-numbers "^[0-9.e+-]* [0-9.e+-]* [0-9.e+-]*$"
-    check aniso-not-supported 1 "$lamina" eval --model ww-prime --stack "$tmp/brushed.json" --theta-i 30 --theta-o 45 --phi-o 180
+    check aniso-not-supported 1 "$lamina" eval --model tm2 --stack "$tmp/brushed.json" --theta-i 30 --theta-o 45 --phi-o 180
     expect_output aniso-not-supported-says "not supported: the stack has an anisotropic interface"
     check phi-i-range 1 "$lamina" eval --model ww09 --stack "$tmp/gold.json" --theta-i 30 --phi-i 400 --theta-o 45 --phi-o 180
     expect_output phi-i-range-says "phi-i"

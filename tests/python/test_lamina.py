@@ -423,6 +423,9 @@ def test_export_npz_of_unfolded_tables(tmp_path):
             check=False)
     assert r.returncode == 1 and "isotropic" in r.stderr
     assert not (tmp_path / "m.binary").exists()
+    with pytest.raises(lamina.InputError, match="isotropic"):
+        lamina.export(lamina.Model("openpbr", BRUSHED), tmp_path / "m.binary")
+    assert not (tmp_path / "m.binary").exists()
 
 
 def test_export_bsdf_and_merl_files(tmp_path):
