@@ -256,5 +256,12 @@ grep -q '^paint-a0.05-a1.3,metallic-paint,openpbr,45,30,R,g,[0-9]' "$tmp/phi/met
 python3 -c "import json,sys; c = json.load(open(sys.argv[1])); \
 assert c['grid'] == '18x18 unfolded' and c['phi_i'] == [30, 30] and c['tables']['shape'][4] == 36" \
     "$tmp/phi/configs/paint-a0.05-a1.3/config.json" && ok || fail "--phi-i config.json"
+# Its tables hold several azimuths' incidences (or one off φ = 0): export --study says it cannot.
+if "$lamina" export --study "$tmp/phi" --config paint-a0.05-a1.3 --out "$tmp/phi.bsdf" >"$tmp/phi-export" 2>&1; then
+    fail "export of an unfolded study configuration accepted"
+else
+    grep -q "config.json: phi_i: 'paint-a0.05-a1.3' is compared on the unfolded grid" "$tmp/phi-export" \
+        && ok || { fail "export message:"; cat "$tmp/phi-export"; }
+fi
 
 finish
