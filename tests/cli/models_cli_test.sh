@@ -94,10 +94,10 @@ JSON
     # metrics.csv gets its phi_i column, and the models that do not represent anisotropy are
     # "not supported" (false rows), not failures.
     check compare-aniso 0 "$lamina" compare "$tmp/brushed.json" --particles 1000 --theta-i 30 --grid 9x6 \
-        --models openpbr,ww-prime --no-figures --out "$tmp/cmp"
+        --models openpbr,bel-prime --no-figures --out "$tmp/cmp"
     if head -1 "$tmp/cmp/metrics.csv" | grep -q '^config,category,model,theta_i,phi_i,side,' &&
         grep -q ',openpbr,30,90,R,r,[0-9]' "$tmp/cmp/metrics.csv" &&
-        grep -q ',ww-prime,30,45,R,g,,,,,,,,,,false$' "$tmp/cmp/metrics.csv"; then
+        grep -q ',bel-prime,30,45,R,g,,,,,,,,,,false$' "$tmp/cmp/metrics.csv"; then
         pass=$((pass + 1)); else echo "FAIL compare-aniso metrics.csv"; head -3 "$tmp/cmp/metrics.csv"; fails=$((fails + 1)); fi
 else
     echo "FAIL validate: 'lamina validate' does not accept the test's stack"; fails=$((fails + 1))

@@ -27,5 +27,5 @@ node "$src/tests/report/browser_smoke.js" "$real" "$build/screenshots/real-study
 brushed="$build/report-brushed-study"
 rm -rf "$brushed"
 "$lamina" study --preset standard --only 'brushed-al-a0.05x.2-a1.05x.3-t90' --theta-i 0,45 \
-    --particles 2e4 --grid 18x18 --models openpbr,ww-prime --no-figures --out "$brushed" >/dev/null
+    --particles 2e4 --grid 18x18 --models openpbr,bel-prime --no-figures --out "$brushed" >/dev/null
 node "$src/tests/report/browser_unfolded.js" "$brushed" "$build/screenshots/brushed-study.png"

@@ -42,7 +42,7 @@ fi
 brushed="$build/figures-brushed"
 rm -rf "$brushed"
 "$lamina" study --preset standard --only 'brushed-gold-a0.001-a1.05x.3-t30' --theta-i 0,45 \
-    --particles 2e4 --grid 18x18 --models openpbr,ww-prime --no-figures --out "$brushed" >/dev/null
+    --particles 2e4 --grid 18x18 --models openpbr,bel-prime --no-figures --out "$brushed" >/dev/null
 ok test $? -eq 0
 out=$("$lamina" figures "$brushed" --formats png 2>&1)
 ok test $? -eq 0

@@ -186,7 +186,7 @@ TEST(StudyUnfolded, TinyBrushedStudyRunsEndToEnd) {
         filter_configurations(brushed_configurations(), "brushed-al-a0.05x.2-a1.05x.3-t90");
     ASSERT_EQ(configs.size(), 1u);
     StudySettings s;
-    s.models = {"openpbr", "ww-prime"};
+    s.models = {"openpbr", "bel-prime"};  // bel-prime: no anisotropy
     s.reference.theta_i_deg = {0, 45};
     s.reference.particles = 20'000;
     s.reference.grid = HemisphereGrid(9, 6);
@@ -197,7 +197,7 @@ TEST(StudyUnfolded, TinyBrushedStudyRunsEndToEnd) {
     std::set<std::pair<double, double>> incidences;
     for (const MetricRow& row : r.rows) {
         incidences.insert({row.theta_i, row.phi_i});
-        if (row.model == "ww-prime") {
+        if (row.model == "bel-prime") {
             EXPECT_FALSE(row.supported);
         } else {
             EXPECT_TRUE(row.supported);
@@ -210,7 +210,7 @@ TEST(StudyUnfolded, TinyBrushedStudyRunsEndToEnd) {
     EXPECT_EQ(r.work.reference_pieces_computed, 4u);
     const std::string csv = read_text(dir / "metrics.csv");
     EXPECT_EQ(csv.rfind("config,category,model,theta_i,phi_i,side,channel,", 0), 0u);
-    EXPECT_NE(csv.find("\nbrushed-al-a0.05x.2-a1.05x.3-t90,brushed,ww-prime,45,90,R,b,,,,,,,,,,"
+    EXPECT_NE(csv.find("\nbrushed-al-a0.05x.2-a1.05x.3-t90,brushed,bel-prime,45,90,R,b,,,,,,,,,,"
                        "false\n"),
               std::string::npos);
     const nlohmann::json cj = nlohmann::json::parse(
@@ -219,16 +219,16 @@ TEST(StudyUnfolded, TinyBrushedStudyRunsEndToEnd) {
     EXPECT_EQ(cj.at("theta_i"), nlohmann::json({0, 45, 45, 45}));
     EXPECT_EQ(cj.at("phi_i"), nlohmann::json({0, 0, 45, 90}));
     EXPECT_EQ(cj.at("tables").at("shape"), nlohmann::json({3, 4, 1, 9, 12, 3}));
-    EXPECT_EQ(cj.at("supported").at("ww-prime").at("R"), false);
+    EXPECT_EQ(cj.at("supported").at("bel-prime").at("R"), false);
     const nlohmann::json sj = nlohmann::json::parse(read_text(dir / "study.json"));
     EXPECT_EQ(sj.at("configurations").at(0).at("grid"), "9x6 unfolded");
     EXPECT_EQ(sj.at("configurations").at(0).at("incidences").size(), 4u);
-    // The summary ranks the category; ww-prime is not supported there, not failing.
+    // The summary ranks the category; bel-prime is not supported there, not failing.
     const GroupFindings* g = r.findings.group("brushed");
     ASSERT_NE(g, nullptr);
     EXPECT_EQ(g->ranking, std::vector<std::string>{"openpbr"});
     EXPECT_EQ(g->models.at("openpbr").rows, 12);
-    EXPECT_EQ(r.findings.not_supported.at("ww-prime").at(configs[0].id), "R");
+    EXPECT_EQ(r.findings.not_supported.at("bel-prime").at(configs[0].id), "R");
     const std::string summary = read_text(dir / "summary.md");
     EXPECT_NE(summary.find("**brushed**"), std::string::npos);
 
