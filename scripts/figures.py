@@ -140,7 +140,21 @@ class Study:
         self.n_phi = int(self.meta["grid"]["n_phi"])
         self.configs = self.meta["configurations"]
         self.models = list(self.meta.get("models") or [])
+        # Each configuration's incidences [(θi, φi)]: an unfolded one's own (study.json
+        # configurations[].incidences: an anisotropic stack, lit from several azimuths, on the
+        # unfolded grid; docs/formats.md), else the study's θi at φi = 0.
+        self.incidences = {c["id"]: [tuple(map(float, x)) for x in c["incidences"]]
+                           if c.get("incidences") else [(t, 0.0) for t in self.theta_i]
+                           for c in self.configs}
+        self._unfolded = {c["id"] for c in self.configs if c.get("incidences")}
         self.metrics = self._read_metrics()
+
+    def unfolded(self, cid):
+        return cid in self._unfolded
+
+    def n_phi_of(self, cid):
+        """The φ bins of a configuration's tables: 2 · n_phi over [0°, 360°) when unfolded."""
+        return 2 * self.n_phi if self.unfolded(cid) else self.n_phi
 
     def _read_metrics(self):
         """{(config, model, side): {'me': [I][3], 'nf': [I][3], 'mf': …, 'nf_mf': …}} with NaN for
@@ -158,10 +172,13 @@ class Study:
             self.has_floored = "misplaced_floor" in (reader.fieldnames or [])
             for row in reader:
                 key = (row["config"], row["model"], row["side"])
-                cell = out.setdefault(key, {k: np.full((len(self.theta_i), 3), np.nan)
+                incs = self.incidences.get(row["config"], [(t, 0.0) for t in self.theta_i])
+                cell = out.setdefault(key, {k: np.full((len(incs), 3), np.nan)
                                             for k, _ in columns})
+                # The phi_i column: only in a study with light off φ = 0.
+                inc = (float(row["theta_i"]), float(row.get("phi_i") or 0))
                 try:
-                    i = self.theta_i.index(float(row["theta_i"]))
+                    i = incs.index(inc)
                 except ValueError:
                     continue
                 c = "rgb".index(row["channel"])
@@ -198,6 +215,17 @@ def pick_incidences(theta_i, wanted=(0, 45, 70)):
     return sorted(out)
 
 
+def plane_bins(n_phi, phi_deg):
+    """The unfolded φ bins (n_phi over [0°, 360°)) the half-plane at azimuth phi_deg runs through:
+    the bin it crosses, or the two it separates when it lies on an edge (equal Ω⊥: their mean is
+    the plane's value), as the explorer takes them."""
+    u = (phi_deg % 360.0) / (360.0 / n_phi)
+    k = round(u)
+    if abs(u - k) < 1e-9:
+        return [(k - 1) % n_phi, k % n_phi]
+    return [int(math.floor(u)) % n_phi]
+
+
 # ---- Per-configuration incident-plane slices ----------------------------------------------------
 
 def slice_figure(study, cid, formats):
@@ -206,7 +234,21 @@ def slice_figure(study, cid, formats):
     T = study.n_theta
     centres = (np.arange(T) + 0.5) * 90.0 / T
     x = np.concatenate([-centres[::-1], centres])  # negative: the light's side (φ bin 0)
-    incs = pick_incidences(study.theta_i)
+    incidences = study.incidences[cid]
+    if study.unfolded(cid):
+        # Lit from several azimuths: the incidence nearest θi = 45° at each, on its own plane of
+        # incidence φ = φi (the light's side) and φi + 180° (the mirror's).
+        P = study.n_phi_of(cid)
+        thetas = sorted({t for t, _ in incidences})
+        t45 = min(thetas, key=lambda t: abs(t - 45))
+        incs = [k for k, (t, _) in enumerate(incidences) if t == t45]
+        bins = {k: (plane_bins(P, incidences[k][1]), plane_bins(P, incidences[k][1] + 180))
+                for k in incs}
+    else:
+        incs = pick_incidences(study.theta_i)
+        bins = {k: ([0], [-1]) for k in incs}
+    label = lambda i: (f"θi = {incidences[i][0]:g}°, φi = {incidences[i][1]:g}°"
+                       if study.unfolded(cid) else f"θi = {incidences[i][0]:g}°")
     # Ablations (NAME:KEY=VALUE) stay in the error matrix; the slices show the models as shipped.
     models = [m for m in cfg["sources"][1:] if ":" not in m]
     for d, side in enumerate(cfg["sides"]):
@@ -220,11 +262,15 @@ def slice_figure(study, cid, formats):
         for r, i in enumerate(incs):
             for c in range(3):
                 ax = axes[r][c]
-                plane = lambda s: np.concatenate([tables[s, i, d, ::-1, 0, c],
-                                                  tables[s, i, d, :, -1, c]])
+                light, mirror = bins[i]
+                # the mean of the plane's bins (one bin folded, or off an edge)
+                half = lambda a, b: np.mean(np.asarray(a[..., b], dtype=np.float64), axis=-1)
+                plane = lambda s: np.concatenate([half(tables[s, i, d, ::-1, :, c], light),
+                                                  half(tables[s, i, d, :, :, c], mirror)])
                 ref = plane(0)
                 if se is not None:
-                    e = np.concatenate([se[i, d, ::-1, 0, c], se[i, d, :, -1, c]])
+                    e = np.concatenate([half(se[i, d, ::-1, :, c], light),
+                                        half(se[i, d, :, :, c], mirror)])
                     lo = np.where(ref - 2 * e > 0, ref - 2 * e, ref * 1e-3)
                     ax.fill_between(x, lo, ref + 2 * e, color="0.75", lw=0,
                                     label="reference ±2·se")
@@ -253,13 +299,14 @@ def slice_figure(study, cid, formats):
                 if r == 0:
                     ax.set_title(f"{CHANNELS[c]} channel", color=["#b8322f", "#2e8540", "#2c5aa0"][c])
                 if c == 0:
-                    ax.set_ylabel(f"θi = {study.theta_i[i]:g}°\n{SIDE_NAME[side]} f (1/sr)")
+                    ax.set_ylabel(f"{label(i)}\n{SIDE_NAME[side]} f (1/sr)")
                 if r == len(incs) - 1:
                     ax.set_xlabel("θo (°), light's side negative")
         handles, labels = axes[0][0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 8), frameon=False,
                    bbox_to_anchor=(0.5, 0.0), columnspacing=0.9, handlelength=1.3)
-        title = f"{cid} — {SIDE_NAME[side]} on the incident plane"
+        title = f"{cid} — {SIDE_NAME[side]} on the incident plane" + (
+            " (φ = φi, and φi + 180° on the mirror's side)" if study.unfolded(cid) else "")
         if ns:
             title += "\nnot supported: " + ", ".join(ns)
         fig.suptitle(title, fontsize=9, y=1 - 0.08 / height, va="top")
@@ -328,7 +375,10 @@ def error_matrix(study, formats, side):
 # ---- Albedo against θi, per category -----------------------------------------------------------
 
 def albedo_figure(study, cat, formats):
-    om = omega_perp(study.n_theta, study.n_phi)
+    # Ω⊥ per bin; an unfolded bin (half the width of φ of 2 · n_phi over [0°, 360°), one patch)
+    # has the folded formula's value for 2 · n_phi bins.
+    oms = {False: omega_perp(study.n_theta, study.n_phi),
+           True: omega_perp(study.n_theta, 2 * study.n_phi)}
     cache = {c["id"]: study.load(c["id"]) for c in study.configs if c["category"] == cat}
     members = [c for c in study.configs if c["category"] == cat]
     ncol = min(5, len(members))
@@ -348,29 +398,36 @@ def albedo_figure(study, cat, formats):
         ax.axis("off")
     for ax, meta in zip(axes.flat, members):
         cfg, tables, se = cache[meta["id"]]
+        unfolded = study.unfolded(meta["id"])
+        om = oms[unfolded]
+        # Against θi at φi = 0° (an unfolded configuration's other azimuths are in its slices).
+        incidences = study.incidences[meta["id"]]
+        ks = [k for k, (_, p) in enumerate(incidences) if p == incidences[0][1]]
+        thetas = [incidences[k][0] for k in ks]
         for d, side in enumerate(cfg["sides"]):
             style = "-" if side == "R" else ":"
             # Σ f Ω⊥ per source and incidence, averaged over RGB.
-            alb = np.nansum(np.asarray(tables[:, :, d]) * om[None, None, :, :, None], axis=(2, 3))
+            alb = np.nansum(np.asarray(tables[:, ks, d]) * om[None, None, :, :, None], axis=(2, 3))
             alb = alb.mean(axis=-1)
             err = None
             if se is not None:
-                v = ((np.asarray(se[:, d]) * om[None, :, :, None]) ** 2).sum(axis=(1, 2))
+                v = ((np.asarray(se[ks, d]) * om[None, :, :, None]) ** 2).sum(axis=(1, 2))
                 err = 2 * np.sqrt(v.mean(axis=-1))
-            ax.errorbar(study.theta_i, alb[0], yerr=err, color="k", lw=1.3, ls=style,
+            ax.errorbar(thetas, alb[0], yerr=err, color="k", lw=1.3, ls=style,
                         capsize=1.5, elinewidth=0.6,
                         label="reference ±2·se" + (" (T dotted)" if side == "T" else ""))
             for k, m in enumerate(cfg["sources"][1:]):
                 if supported(cfg, m, side) and ":" not in m:
-                    ax.plot(study.theta_i, alb[k + 1], color=model_color(m, study.models),
+                    ax.plot(thetas, alb[k + 1], color=model_color(m, study.models),
                             ls=model_dash(m) if side == "R" else ":", lw=0.9, label=m)
         # What the reference loses to its single-scattering microsurfaces (config.json energy):
         # on neither side, so a model that keeps it overshoots the albedo by as much.
         lost = [e.get("lost_microsurface") for e in cfg.get("energy", [])]
-        if lost and len(lost) == len(study.theta_i) and all(lost) and max(map(max, lost)) > 0:
-            ax.plot(study.theta_i, [sum(v) / 3 for v in lost], color="0.55", ls="--", lw=0.8,
+        if lost and len(lost) == len(incidences) and all(lost) and max(map(max, lost)) > 0:
+            ax.plot(thetas, [sum(lost[k]) / 3 for k in ks], color="0.55", ls="--", lw=0.8,
                     marker="x", ms=2.5, label="reference: lost to microsurfaces")
-        ax.set_title(meta["id"], fontsize=6.5)
+        ax.set_title(meta["id"] + (f" (φi = {incidences[0][1]:g}°)" if unfolded else ""),
+                     fontsize=6.5)
         ax.grid(True, lw=0.3, color="0.88")
         ax.set_xticks([0, 30, 60, 90])
     for ax in axes[-1]:

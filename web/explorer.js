@@ -52,7 +52,8 @@
 
   const state = {
     config: configs.length ? configs[0].id : null,
-    incidence: Math.min(2, THETA_I.length - 1),
+    incidence: Math.min(2, THETA_I.length - 1),  // the θi shown: an index into THETA_I
+    phiI: 0,  // the azimuth φi shown, on an unfolded configuration (one lit from several)
     channels: [true, true, true],
     side: "R",
     log: true,
@@ -129,6 +130,8 @@
       sources: raw.sources,
       sides: raw.sides,
       slice: new Float32Array(await array(raw.slice, 4, 2 * T)),
+      // incidences: the slice holds [source, incidence, side, 2T, 3]
+      get nInc() { return this.slice.length / (raw.sources.length * raw.sides.length * 2 * T * 3); },
       sliceSe: raw.slice_se ? new Float32Array(await array(raw.slice_se, 4, 2 * T)) : null,
       hemi,
       hemiSe,
@@ -155,9 +158,32 @@
 
   const nTheta = () => STUDY.grid.n_theta;
 
+  // A configuration's incidences as [θi, φi] pairs, in its tables' order: an unfolded one's own
+  // (index entry `incidences`: an anisotropic stack lit from several azimuths, docs/formats.md),
+  // else the study's θi at φi = 0.
+  const incidencesOf = (cfg) => cfg.incidences || THETA_I.map((t) => [t, 0]);
+  const isUnfolded = (cfg) => Boolean(cfg.incidences);
+  // The azimuths an unfolded configuration is lit from.
+  const azimuthsOf = (cfg) => Array.from(new Set(incidencesOf(cfg).map(([, p]) => p))).sort((a, b) => a - b);
+  // The index of the incidence shown: the widgets' θi at the widgets' φi, or at the first azimuth
+  // the configuration has for that θi (θi = 0 is lit once).
+  function incidenceIndex(cfg) {
+    const t = THETA_I[state.incidence];
+    if (!isUnfolded(cfg)) return state.incidence;
+    const incs = incidencesOf(cfg);
+    let k = incs.findIndex(([a, b]) => a === t && b === state.phiI);
+    if (k < 0) k = incs.findIndex(([a]) => a === t);
+    return k < 0 ? 0 : k;
+  }
+  // "θi = 45°", and ", φi = 90°" on an unfolded configuration.
+  function incidenceText(cfg, k) {
+    const [t, p] = incidencesOf(cfg)[k];
+    return "θi = " + t + "°" + (isUnfolded(cfg) ? ", φi = " + p + "°" : "");
+  }
+
   // f on the incident plane: x from −90° (light's side) to +90° (mirror / straight through).
   function slicePlane(d, source, inc, side, channel) {
-    const T = nTheta(), I = THETA_I.length, D = d.sides.length;
+    const T = nTheta(), I = d.nInc, D = d.sides.length;
     const s = d.sources.indexOf(source), sd = d.sides.indexOf(side);
     const out = new Array(2 * T);
     const base = ((s * I + inc) * D + sd) * 2 * T;
@@ -268,7 +294,14 @@
       box.appendChild(l);
     }
     setOptions($("w-config"), inCategory.map((c) => [c.id, c.id]), cur.id);
-    $("config-desc").textContent = cur.sides.includes("T") ? "BRDF and BTDF (a slab)" : "BRDF (opaque base)";
+    $("config-desc").textContent = (cur.sides.includes("T") ? "BRDF and BTDF (a slab)" : "BRDF (opaque base)") +
+      (isUnfolded(cur) ? " · full hemisphere (φ over 0°–360°), lit from φi = " + azimuthsOf(cur).join("°, ") + "°" : "");
+    // The azimuth of the light: among those of an unfolded configuration; 0° otherwise.
+    const phis = azimuthsOf(cur);
+    if (!phis.includes(state.phiI)) state.phiI = phis[0];
+    setOptions($("w-phi-i"), phis.map((p) => [p, p + "°"]), state.phiI);
+    $("w-phi-i").disabled = phis.length < 2;
+    $("w-phi-i-row").hidden = !isUnfolded(cur);
     // The hemisphere widget: BTDF only where the configuration transmits.
     $("w-side-T").disabled = !cur.sides.includes("T");
     if (!cur.sides.includes(state.side)) state.side = "R";
@@ -389,6 +422,7 @@
     });
     $("w-config").addEventListener("change", () => selectConfig($("w-config").value));
     $("w-incidence").addEventListener("change", () => { state.incidence = Number($("w-incidence").value); render(); });
+    $("w-phi-i").addEventListener("change", () => { state.phiI = Number($("w-phi-i").value); render(); });
     CHANNELS.forEach((c, k) => $("w-ch-" + c.toLowerCase()).addEventListener("change", (e) => {
       state.channels[k] = e.target.checked;
       if (!selectedChannels().length) { state.channels[k] = true; e.target.checked = true; }
@@ -417,7 +451,8 @@
 
   // The state in the address (#config=…&ti=…&side=…): a view can be shared as a link.
   function writeHash() {
-    const h = "config=" + encodeURIComponent(state.config) + "&ti=" + THETA_I[state.incidence] + "&side=" + state.side;
+    const h = "config=" + encodeURIComponent(state.config) + "&ti=" + THETA_I[state.incidence] +
+      (isUnfolded(byId.get(state.config)) ? "&phi=" + state.phiI : "") + "&side=" + state.side;
     if (location.hash.slice(1) !== h) history.replaceState(null, "", "#" + h);
   }
 
@@ -426,6 +461,7 @@
     if (p.get("config") && byId.has(p.get("config"))) state.config = p.get("config");
     const ti = THETA_I.indexOf(Number(p.get("ti")));
     if (p.get("ti") !== null && ti >= 0) state.incidence = ti;
+    if (p.get("phi") !== null && isFinite(Number(p.get("phi")))) state.phiI = Number(p.get("phi"));
     if (p.get("side") === "T" && byId.get(state.config).sides.includes("T")) state.side = "T";
   }
 
@@ -474,7 +510,7 @@
   function drawSlice(d, cfg) {
     const chans = selectedChannels();
     const xs = sliceAngles();
-    const inc = state.incidence, side = state.side;
+    const inc = incidenceIndex(cfg), side = state.side, thetaI = incidencesOf(cfg)[inc][0];
     const traces = [];
     // On a log scale, at most six decades below the highest value drawn (zeros have no place).
     let fmax = 0;
@@ -525,11 +561,12 @@
     // The light's direction (−θi) and the mirror or straight-through direction (+θi), dotted.
     layout.shapes = [];
     chans.forEach((c, k) => {
-      for (const x of [-THETA_I[inc], THETA_I[inc]])
+      for (const x of [-thetaI, thetaI])
         layout.shapes.push({ type: "line", xref: "x" + axisSuffix(k), yref: "y" + axisSuffix(k) + " domain", x0: x, x1: x, y0: 0, y1: 1,
           line: { color: x < 0 ? "#c9a227" : "#999", width: 1, dash: "dot" } });
     });
-    layout.title = { text: cfg.id + " · θi = " + THETA_I[inc] + "° · " + (side === "R" ? "reflection" : "transmission") +
+    layout.title = { text: cfg.id + " · " + incidenceText(cfg, inc) + " · " + (side === "R" ? "reflection" : "transmission") +
+      (isUnfolded(cfg) ? " · the plane φ = φi (negative θo) and φi + 180°" : "") +
       " · dotted: the light's direction (−θi) and the " + (side === "R" ? "mirror" : "straight-through") + " direction",
       font: { size: 13 }, x: 0.01, y: 0.985 };
     layout.margin.t = 46;
@@ -551,7 +588,7 @@
   // For each pixel of the projected disk (x = −sinθ cosφ so that the light is on the left), the
   // index of its (θ, φ) bin in the merged hemisphere table, or −1 outside the disk.
   function isoLookup(h) {
-    const key = h.theta_edges.join() + "|" + h.phi_edges.join();
+    const key = h.theta_edges.join() + "|" + h.phi_edges.join() + "|" + Boolean(h.unfolded);
     if (isoLookupCache && isoLookupCache.key === key) return isoLookupCache;
     const axis = Array.from({ length: ISO_N }, (_, i) => -1 + 2 * i / (ISO_N - 1));
     const idx = new Int32Array(ISO_N * ISO_N);
@@ -565,7 +602,10 @@
         const x = axis[i], y = axis[j], r = Math.hypot(x, y);
         if (r > 1) { idx[j * ISO_N + i] = -1; continue; }
         const theta = Math.asin(Math.min(1, r)) * 180 / Math.PI;
-        const phi = Math.atan2(Math.abs(y), -x) * 180 / Math.PI;
+        // Folded: φ and −φ are one bin. Unfolded (φ over [0°, 360°)): the view from above turned
+        // half a turn, (x, y) = −sinθ (cos φ, sin φ), so that φ = 0 is on the left.
+        const phi = h.unfolded ? (Math.atan2(-y, -x) * 180 / Math.PI + 360) % 360
+          : Math.atan2(Math.abs(y), -x) * 180 / Math.PI;
         idx[j * ISO_N + i] = find(h.theta_edges, theta) * h.n_phi + find(h.phi_edges, phi);
       }
     isoLookupCache = { key, idx, axis };
@@ -575,7 +615,7 @@
   // `source` "se" is the reference's standard error.
   function hemiMap(d, source, inc, side, channel) {
     const h = d.hemiShape, L = isoLookup(h);
-    const I = THETA_I.length, D = d.sides.length;
+    const I = d.nInc, D = d.sides.length;
     const isSe = source === "se";
     const s = isSe ? 0 : d.sources.indexOf(source), sd = d.sides.indexOf(side);
     const base = isSe ? (inc * D + sd) * h.n_theta * h.n_phi : ((s * I + inc) * D + sd) * h.n_theta * h.n_phi;
@@ -643,7 +683,18 @@
     return traces;
   }
 
-  function diskLayout(title) {
+  // `light`: [θi, φi] of an unfolded configuration, whose light is marked where it comes from and
+  // whose plane of incidence is dotted; a folded one has its light on the left.
+  function diskLayout(title, light) {
+    if (light) {
+      const [t, p] = light, r = Math.sin(t * Math.PI / 180), c = Math.cos(p * Math.PI / 180), s = Math.sin(p * Math.PI / 180);
+      const layout = diskLayout(title);
+      layout.shapes[1] = { type: "line", x0: c, x1: -c, y0: s, y1: -s, line: { color: "#bbb", width: 0.7, dash: "dot" } };
+      layout.annotations = [{ x: -r * c, y: -r * s, text: "☀", showarrow: false, font: { size: 14, color: "#c9a227" } },
+        { x: -0.98, y: -0.98, text: "light ☀ at φi = " + p + "°; φ = 0 on the left, 90° at the bottom", showarrow: false,
+          font: { size: 10, color: "#777" }, xanchor: "left" }];
+      return layout;
+    }
     return {
       height: 340, margin: { l: 8, r: 8, t: 34, b: 8 }, title: { text: title, font: { size: 12 } },
       xaxis: { visible: false, range: [-1.04, 1.04], constrain: "domain" },
@@ -656,7 +707,8 @@
   }
 
   function drawIso(d, cfg) {
-    const inc = state.incidence, side = state.side, c = state.isoChannel, m = state.isoModel;
+    const inc = incidenceIndex(cfg), side = state.side, c = state.isoChannel, m = state.isoModel;
+    const light = isUnfolded(cfg) ? incidencesOf(cfg)[inc] : undefined;
     const ref = hemiMap(d, "reference", inc, side, c);
     const supported = isSupported(cfg, m, side);
     const mod = supported ? hemiMap(d, m, inc, side, c) : null;
@@ -667,7 +719,7 @@
     const auto = state.levels.trim() ? null : autoLevels(dmin, dmax);
     const levels = auto ? levelValues(auto) : parseLevels(state.levels);
     const ch = CHANNELS[c];
-    const refLayout = diskLayout("reference · " + ch + " · θi = " + THETA_I[inc] + "°");
+    const refLayout = diskLayout("reference · " + ch + " · " + incidenceText(cfg, inc), light);
     $("iso-levels").textContent = "White contour lines at f = " + levels.map(fmt).join(", ") + " 1/sr" +
       (auto && state.log ? " (every half decade)" : "") + "; reference and model share one colour scale" +
       (state.log ? " (log10 f, four decades)" : "") +
@@ -675,7 +727,7 @@
       (state.diffMode === "sigma" ? "; in units of the reference's standard error, |Δf / se| < 2 is within its noise." : ".");
     Plotly.react($("iso-ref"), isoTraces(ref, levels, auto, dmin, dmax, "reference", false), refLayout, PLOT_CONFIG);
     if (mod) {
-      Plotly.react($("iso-model"), isoTraces(mod, levels, auto, dmin, dmax, m, true), diskLayout(m + " · " + ch), PLOT_CONFIG);
+      Plotly.react($("iso-model"), isoTraces(mod, levels, auto, dmin, dmax, m, true), diskLayout(m + " · " + ch, light), PLOT_CONFIG);
       // Δf in 1/sr, or in units of the reference's standard error (|z| < 2: within the noise).
       const sigma = state.diffMode === "sigma" && d.hemiSe ? hemiMap(d, "se", inc, side, c) : null;
       const diff = mod.map((row, j) => row.map((v, i) => {
@@ -695,7 +747,7 @@
         line: { color: "rgba(40,40,40,0.5)", width: 0.6 },
         colorbar: { title: { text: sigma ? "Δf / se" : "Δf (1/sr)", side: "right" }, thickness: 12, len: 0.9 },
         hovertemplate: sigma ? "(model − reference) / se<br>%{z:.2f}<extra></extra>" : "model − reference<br>Δf %{z:.3g} 1/sr<extra></extra>",
-      }], diskLayout(m + " − reference" + (sigma ? ", in se" : "")), PLOT_CONFIG);
+      }], diskLayout(m + " − reference" + (sigma ? ", in se" : ""), light), PLOT_CONFIG);
     } else {
       const layout = diskLayout(m + " · " + ch);
       layout.annotations.push({ x: 0, y: 0, text: "<b>not supported</b><br>" + (unsupportedReason(cfg, m) || ""),
@@ -712,10 +764,17 @@
   function drawAlbedo(cfg) {
     const chans = selectedChannels(), side = state.side;
     const traces = [];
+    // Against θi at the azimuth shown (θi = 0, lit once, belongs to every azimuth).
+    const incs = incidencesOf(cfg);
+    const phiShown = azimuthsOf(cfg).includes(state.phiI) ? state.phiI : incs[incidenceIndex(cfg)][1];
+    const ks = incs.map((_, k) => k).filter((k) => !isUnfolded(cfg) || incs[k][0] === 0 ||
+      incs[k][1] === phiShown);
+    const THETA_I = ks.map((k) => incs[k][0]);
+    const pick = (arr) => ks.map((k) => arr[k]);
     chans.forEach((c, k) => {
       const ax = { xaxis: "x" + axisSuffix(k), yaxis: "y" + axisSuffix(k) };
-      const ref = cfg.albedo.reference[side].map((v) => (v ? v[c] : null));
-      const se = cfg.albedo_se && cfg.albedo_se[side] ? cfg.albedo_se[side].map((v) => 2 * v[c]) : null;
+      const ref = pick(cfg.albedo.reference[side]).map((v) => (v ? v[c] : null));
+      const se = cfg.albedo_se && cfg.albedo_se[side] ? pick(cfg.albedo_se[side]).map((v) => 2 * v[c]) : null;
       traces.push(Object.assign({ x: THETA_I, y: ref, type: "scatter", mode: "lines+markers", name: "reference (±2·se)",
         legendgroup: "reference", showlegend: k === 0, line: { color: "#000", width: 2 },
         error_y: se ? { type: "data", array: se, visible: true, color: "#555" } : undefined,
@@ -724,20 +783,21 @@
       // energy that no side of the reference holds, and that models which conserve it put back.
       const lost = cfg.budget && cfg.budget.lost_microsurface;
       if (lost && lost.some((v) => v)) {
-        traces.push(Object.assign({ x: THETA_I, y: lost.map((v) => (v ? v[c] : null)), type: "scatter",
+        traces.push(Object.assign({ x: THETA_I, y: pick(lost).map((v) => (v ? v[c] : null)), type: "scatter",
           mode: "lines+markers", name: "reference: lost to microsurfaces", legendgroup: "lost", showlegend: k === 0,
           line: { color: "#888", width: 1.5, dash: "dot" }, marker: { size: 4, symbol: "x" },
           hovertemplate: "reference: lost to microsurfaces<br>θi %{x}°<br>fraction %{y:.4f}<extra></extra>" }, ax));
       }
       for (const m of models) {
         if (!state.shown.has(m) || !isSupported(cfg, m, side) || !cfg.albedo[m]) continue;
-        traces.push(Object.assign({ x: THETA_I, y: cfg.albedo[m][side].map((v) => (v ? v[c] : null)),
+        traces.push(Object.assign({ x: THETA_I, y: pick(cfg.albedo[m][side]).map((v) => (v ? v[c] : null)),
           type: "scatter", mode: "lines+markers", name: m, legendgroup: m, showlegend: k === 0,
           line: { color: modelColor(m), width: 1.5, dash: modelDash(m) }, marker: { size: 5 },
           hovertemplate: m + "<br>θi %{x}°<br>albedo %{y:.4f}<extra></extra>" }, ax));
       }
     });
-    const layout = channelGrid(chans, "θi (°)", (side === "R" ? "reflected" : "transmitted") + " albedo", 330);
+    const layout = channelGrid(chans, "θi (°)" + (isUnfolded(cfg) ? " at φi = " + phiShown + "°" : ""),
+      (side === "R" ? "reflected" : "transmitted") + " albedo", 330);
     chans.forEach((c, k) => {
       layout["yaxis" + axisSuffix(k)].type = "linear";
       Object.assign(layout["xaxis" + axisSuffix(k)], { range: [-3, 90], tickvals: THETA_I });
@@ -753,9 +813,13 @@
     return state.lbAgg === "max" ? Math.max(...v) : v.reduce((a, b) => a + b, 0) / v.length;
   }
 
-  function cellValues(cell, key) {
+  // A configuration's values of one metric over the leaderboard's incidences (θi: at every
+  // azimuth of an unfolded configuration) and the selected channels.
+  function cellValues(cell, key, cfg) {
     if (!cell || !cell[key]) return [];
-    const incs = state.lbIncidence === "all" ? THETA_I.map((_, i) => i) : [Number(state.lbIncidence)];
+    const all = incidencesOf(cfg).map((_, i) => i);
+    const incs = state.lbIncidence === "all" ? all
+      : all.filter((i) => incidencesOf(cfg)[i][0] === THETA_I[Number(state.lbIncidence)]);
     const out = [];
     for (const i of incs) for (const c of selectedChannels()) {
       const v = cell[key][i] ? cell[key][i][c] : null;
@@ -781,7 +845,7 @@
       // relative or floored: each metric has its own).
       const nfKey = NOISE_FLOOR_OF[metric];
       let nf = null;
-      if (nfKey) for (const m of models) if (mm[m] && mm[m][side]) { nf = aggregate(cellValues(mm[m][side], nfKey)); if (nf !== null) break; }
+      if (nfKey) for (const m of models) if (mm[m] && mm[m][side]) { nf = aggregate(cellValues(mm[m][side], nfKey, cfg)); if (nf !== null) break; }
       zr.push(nf !== null && nf > 0 ? Math.log10(nf) : null);
       rr.push(nf);
       tr.push(nfKey ? fmt(nf) : "");
@@ -789,7 +853,7 @@
       for (const m of models) {
         const has = cfg.sides.includes(side);
         const ok = has && isSupported(cfg, m, side);
-        const v = ok && mm[m] ? aggregate(cellValues(mm[m][side], metric)) : null;
+        const v = ok && mm[m] ? aggregate(cellValues(mm[m][side], metric, cfg)) : null;
         zr.push(v !== null && v > 0 ? Math.log10(v) : null);
         rr.push(v);
         const below = nfKey && v !== null && nf !== null && v <= 2 * nf;

@@ -79,6 +79,14 @@ BinnedTable study_table(const ExportArgs& a) {
                              fmt::format("no source '{}'; this configuration has: {}", a.source,
                                          fmt::join(sources, ", ")));
         const std::size_t k = std::size_t(it - sources.begin());
+        if (cfg.contains("phi_i"))
+            throw InputError(
+                (dir / "config.json").string(), "phi_i",
+                fmt::format("'{}' is compared on the unfolded grid ({}) at incidences of several "
+                            "azimuths φi, which one table cannot hold: --study exports folded "
+                            "configurations; simulate the stack at one φi (lamina simulate "
+                            "--phi-i) and export that",
+                            a.config, cfg.value("grid", std::string("unfolded"))));
         const auto theta_i = cfg.at("theta_i").get<std::vector<double>>();
         const auto sides = cfg.at("sides").get<std::vector<std::string>>();
         const HemisphereGrid grid(study.at("grid").at("n_theta").get<int>(),

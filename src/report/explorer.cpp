@@ -71,8 +71,16 @@ std::vector<std::string> split_csv_line(const std::string& line) {
     return out;
 }
 
-// metrics.csv → {config: {model: {side: {metric: [incidence][channel]}}}}, null where empty.
-json read_metrics(const fs::path& path, const std::vector<double>& theta_i) {
+// One incidence of a configuration: θi, and φi (0 on a folded configuration).
+struct Incidence {
+    double theta_i = 0, phi_i = 0;
+};
+using ConfigIncidences = std::map<std::string, std::vector<Incidence>>;
+
+// metrics.csv → {config: {model: {side: {metric: [incidence][channel]}}}}, null where empty. The
+// incidences are the study's θi, or an unfolded configuration's own (θi, φi) (`unfolded`).
+json read_metrics(const fs::path& path, const std::vector<double>& theta_i,
+                  const ConfigIncidences& unfolded) {
     json out = json::object();
     std::ifstream in(path);
     if (!in) return out;  // the page then shows no leaderboard, and says so
@@ -87,6 +95,10 @@ json read_metrics(const fs::path& path, const std::vector<double>& theta_i) {
     const std::size_t c_config = column("config"), c_model = column("model"),
                       c_theta = column("theta_i"), c_side = column("side"),
                       c_channel = column("channel"), c_supported = column("supported");
+    // A study with light off φ = 0 has a phi_i column (docs/formats.md).
+    const std::size_t c_phi =
+        std::size_t(std::find(header.begin(), header.end(), "phi_i") - header.begin());
+    const bool has_phi = c_phi < header.size();
     std::vector<std::pair<const char*, std::size_t>> metrics = {{"me", column("misplaced_energy")},
                                                                 {"nf", column("noise_floor")},
                                                                 {"ae", column("albedo_error")},
@@ -105,16 +117,24 @@ json read_metrics(const fs::path& path, const std::vector<double>& theta_i) {
             throw InputError(path.string(), fmt::format("row {}", row),
                              fmt::format("{} fields, the header has {}", v.size(), header.size()));
         const double t = std::atof(v[c_theta].c_str());
-        std::size_t i = 0;
-        while (i < theta_i.size() && std::abs(theta_i[i] - t) > 1e-6)
-            ++i;
-        if (i == theta_i.size()) continue;  // an incidence study.json does not list
+        const double phi = has_phi ? std::atof(v[c_phi].c_str()) : 0.0;
+        std::size_t i = 0, n = theta_i.size();
+        if (const auto u = unfolded.find(v[c_config]); u != unfolded.end()) {
+            n = u->second.size();
+            while (i < n && (std::abs(u->second[i].theta_i - t) > 1e-6 ||
+                             std::abs(u->second[i].phi_i - phi) > 1e-6))
+                ++i;
+        } else {
+            while (i < n && (std::abs(theta_i[i] - t) > 1e-6 || phi != 0))
+                ++i;
+        }
+        if (i == n) continue;  // an incidence study.json does not list
         const int ch = v[c_channel] == "r" ? 0 : v[c_channel] == "g" ? 1 : 2;
         json& cell = out[v[c_config]][v[c_model]][v[c_side]];
         for (const auto& [key, col] : metrics) {
             if (!cell.contains(key)) cell[key] = json::array();
             json& arr = cell[key];
-            while (arr.size() < theta_i.size())
+            while (arr.size() < n)
                 arr.push_back(json{nullptr, nullptr, nullptr});
             if (v[c_supported] == "true" && !v[col].empty()) {
                 const double x = std::atof(v[col].c_str());
@@ -171,10 +191,12 @@ struct LogCodec {
     }
 };
 
-// Ω⊥ of each θ row's bins on the folded grid of docs/formats.md: the grid's own
-// (HemisphereGrid::projected_solid_angle, the same for every φ bin of a row).
-std::vector<double> omega_perp_rows(std::size_t n_theta, std::size_t n_phi) {
-    const HemisphereGrid grid{int(n_theta), int(n_phi)};
+// Ω⊥ of each θ row's bins on the grid of docs/formats.md with n_phi φ bins, folded or unfolded
+// (2 · the folded count): the grid's own (HemisphereGrid::projected_solid_angle, the same for
+// every φ bin of a row).
+std::vector<double> omega_perp_rows(std::size_t n_theta, std::size_t n_phi, bool unfolded) {
+    const HemisphereGrid folded{int(n_theta), int(unfolded ? n_phi / 2 : n_phi)};
+    const HemisphereGrid grid = unfolded ? folded.unfolded() : folded;
     std::vector<double> rows(n_theta);
     for (std::size_t t = 0; t < n_theta; ++t)
         rows[t] = grid.projected_solid_angle(int(t), 0);
@@ -195,21 +217,52 @@ std::vector<int> merged_edges(int n, int k) {
 struct BinBlocks {
     const std::vector<float>& data;
     std::size_t T, P;
+    bool unfolded = false;  ///< P bins over φ ∈ [0°, 360°)
     std::size_t blocks() const { return data.size() / (T * P * 3); }
     float at(std::size_t block, std::size_t t, std::size_t p, std::size_t c) const {
         return data[((block * T + t) * P + p) * 3 + c];
     }
 };
 
+// The unfolded φ bins the half-plane at azimuth `phi_deg` runs through: the bin it crosses, or
+// the two it separates when it lies on an edge (equal Ω⊥: their mean is the plane's value).
+std::vector<std::size_t> plane_bins(std::size_t P, double phi_deg) {
+    const double width = 360.0 / double(P);
+    const double u = std::fmod(std::fmod(phi_deg, 360.0) + 360.0, 360.0) / width;
+    const double k = std::round(u);
+    if (std::abs(u - k) < 1e-9) return {(std::size_t(k) + P - 1) % P, std::size_t(k) % P};
+    return {std::size_t(std::floor(u)) % P};
+}
+
 // The incident plane of every block at full resolution, [block, 2T, 3]: x < T is the light's
-// side (φ bin 0, θ descending), x >= T the mirror side (the last φ bin, θ ascending).
-std::vector<float> incident_plane(const BinBlocks& b) {
+// side (θ descending), x >= T the mirror side (θ ascending). Folded: φ bin 0 and the last φ bin.
+// Unfolded (`phi_i`: each block's incidence azimuth, blocks = sources × incidences × sides):
+// the half-planes φ = φi and φ = φi + 180°.
+std::vector<float> incident_plane(const BinBlocks& b, const std::vector<double>& phi_i = {},
+                                  std::size_t sides = 1) {
     std::vector<float> out;
     out.reserve(b.blocks() * 2 * b.T * 3);
-    for (std::size_t k = 0; k < b.blocks(); ++k)
+    for (std::size_t k = 0; k < b.blocks(); ++k) {
+        if (!b.unfolded) {
+            for (std::size_t x = 0; x < 2 * b.T; ++x)
+                for (std::size_t c = 0; c < 3; ++c)
+                    out.push_back(x < b.T ? b.at(k, b.T - 1 - x, 0, c)
+                                          : b.at(k, x - b.T, b.P - 1, c));
+            continue;
+        }
+        const double phi = phi_i[(k / sides) % phi_i.size()];
+        const std::vector<std::size_t> light = plane_bins(b.P, phi),
+                                       mirror = plane_bins(b.P, phi + 180);
+        auto mean = [&](const std::vector<std::size_t>& bins, std::size_t t, std::size_t c) {
+            double v = 0;
+            for (std::size_t p : bins)
+                v += b.at(k, t, p, c);
+            return float(v / double(bins.size()));
+        };
         for (std::size_t x = 0; x < 2 * b.T; ++x)
             for (std::size_t c = 0; c < 3; ++c)
-                out.push_back(x < b.T ? b.at(k, b.T - 1 - x, 0, c) : b.at(k, x - b.T, b.P - 1, c));
+                out.push_back(x < b.T ? mean(light, b.T - 1 - x, c) : mean(mirror, x - b.T, c));
+    }
     return out;
 }
 
@@ -220,7 +273,7 @@ std::vector<float> merge_bins(const BinBlocks& b, const std::vector<int>& et,
                               const std::vector<int>& ep, bool quadrature) {
     std::vector<float> out;
     out.reserve(b.blocks() * (et.size() - 1) * (ep.size() - 1) * 3);
-    const std::vector<double> omega = omega_perp_rows(b.T, b.P);
+    const std::vector<double> omega = omega_perp_rows(b.T, b.P, b.unfolded);
     for (std::size_t k = 0; k < b.blocks(); ++k)
         for (std::size_t t2 = 0; t2 + 1 < et.size(); ++t2)
             for (std::size_t p2 = 0; p2 + 1 < ep.size(); ++p2)
@@ -257,7 +310,7 @@ std::vector<std::uint16_t> log_codes(const std::vector<float>& values, LogCodec&
 // error with the bins taken as independent (a slight overestimate: a particle lands in one bin).
 std::vector<std::optional<std::array<double, 3>>> albedos(const BinBlocks& b, bool quadrature) {
     std::vector<std::optional<std::array<double, 3>>> out;
-    const std::vector<double> omega = omega_perp_rows(b.T, b.P);
+    const std::vector<double> omega = omega_perp_rows(b.T, b.P, b.unfolded);
     for (std::size_t k = 0; k < b.blocks(); ++k) {
         std::array<double, 3> a = {0, 0, 0};
         bool finite = false;
@@ -285,14 +338,30 @@ struct ConfigData {
 
 // Reads one configuration and encodes what the page draws (docs/explorer.md, "Data").
 ConfigData encode_configuration(const fs::path& dir, const std::string& id,
-                                const std::vector<double>& theta_i, int n_theta, int n_phi,
+                                const std::vector<double>& study_theta_i, int n_theta, int n_phi,
                                 json& entry) {
     const fs::path cfg_path = dir / "config.json";
     const json cfg = read_json(cfg_path, "the configuration");
     const auto sources = field<std::vector<std::string>>(cfg, "sources", cfg_path);
     const auto sides = field<std::vector<std::string>>(cfg, "sides", cfg_path);
+    // An unfolded configuration (config.json → phi_i, docs/formats.md): its own incidences, on
+    // twice the φ bins over [0°, 360°).
+    const bool unfolded = cfg.contains("phi_i");
+    const std::vector<double> theta_i =
+        unfolded ? field<std::vector<double>>(cfg, "theta_i", cfg_path) : study_theta_i;
+    const std::vector<double> phi_i = unfolded ? field<std::vector<double>>(cfg, "phi_i", cfg_path)
+                                               : std::vector<double>(theta_i.size(), 0.0);
+    if (phi_i.size() != theta_i.size())
+        throw InputError(
+            cfg_path.string(), "/phi_i",
+            fmt::format("{} azimuths for {} incidences (theta_i)", phi_i.size(), theta_i.size()));
+    if (unfolded) {
+        entry["incidences"] = json::array();
+        for (std::size_t i = 0; i < theta_i.size(); ++i)
+            entry["incidences"].push_back({theta_i[i], phi_i[i]});
+    }
     const std::size_t S = sources.size(), I = theta_i.size(), D = sides.size(), T = n_theta,
-                      P = n_phi;
+                      P = unfolded ? 2 * std::size_t(n_phi) : std::size_t(n_phi);
     const NpyFloat32 tab = read_study_array(dir, "tables");
     if (tab.shape != std::vector<std::size_t>{S, I, D, T, P, 3})
         throw InputError(study_array_path(dir, "tables").string(), "shape",
@@ -307,11 +376,13 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
             throw InputError(study_array_path(dir, "reference_se").string(), "shape",
                              fmt::format("expected [{}, {}, {}, {}, 3]", I, D, T, P));
     }
-    const BinBlocks f{tab.data, T, P}, f_se{se.data, T, P};
+    const BinBlocks f{tab.data, T, P, unfolded}, f_se{se.data, T, P, unfolded};
 
-    // 1. The incident-plane slice at full resolution, float32 [source, incidence, side, 2T, 3].
-    const std::vector<float> slice = incident_plane(f);
-    const std::vector<float> slice_se = has_se ? incident_plane(f_se) : std::vector<float>();
+    // 1. The incident-plane slice at full resolution, float32 [source, incidence, side, 2T, 3]
+    //    (unfolded: the plane of each incidence, φ = φi and φi + 180°).
+    const std::vector<float> slice = incident_plane(f, phi_i, D);
+    const std::vector<float> slice_se =
+        has_se ? incident_plane(f_se, phi_i, D) : std::vector<float>();
 
     // 2. Albedos of every source, and the reference's standard error.
     const auto a = albedos(f, false);
@@ -340,7 +411,7 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     for (int e : et)
         theta_edges.push_back(90.0 * e / T);
     for (int e : ep)
-        phi_edges.push_back(180.0 * e / P);
+        phi_edges.push_back((unfolded ? 360.0 : 180.0) * e / double(P));
 
     // Support and reasons: from config.json, else derived from the NaNs of the tables.
     json supported = cfg.value("supported", json::object());
@@ -359,11 +430,12 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
         json budget = json::object();
         for (const char* term : {"lost_microsurface", "absorbed_medium", "absorbed_base"}) {
             json per_incidence = json::array();
-            for (double t : theta_i) {
+            for (std::size_t i = 0; i < theta_i.size(); ++i) {
                 json v = nullptr;
                 for (const json& e : cfg["energy"])
                     if (e.contains("theta_i") && e["theta_i"].is_number() &&
-                        e["theta_i"].get<double>() == t && e.contains(term))
+                        e["theta_i"].get<double>() == theta_i[i] &&
+                        e.value("phi_i", 0.0) == phi_i[i] && e.contains(term))
                         v = e[term];
                 per_incidence.push_back(v);
             }
@@ -426,6 +498,7 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
           {"se_hi", se_codec.hi},
           {"se_codes", has_se ? json(packed(se_codes, P2)) : json(nullptr)}}},
     };
+    if (unfolded) data["hemi"]["unfolded"] = true;  // φ edges over [0°, 360°)
     ConfigData out;
     out.script = fmt::format("(window.LAMINA_DATA = window.LAMINA_DATA || {{}})[{}] = {};\n",
                              json(id).dump(), data.dump());
@@ -509,8 +582,13 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
             stamps = json::object();
         }
     }
+    ConfigIncidences unfolded;
     for (const json& c : configurations) {
         const std::string id = field<std::string>(c, "id", study_path);
+        if (c.contains("incidences") && c["incidences"].is_array())
+            for (const json& inc : c["incidences"])
+                if (inc.is_array() && inc.size() == 2 && inc[0].is_number() && inc[1].is_number())
+                    unfolded[id].push_back({inc[0].get<double>(), inc[1].get<double>()});
         json entry = {{"id", id},
                       {"category", c.value("category", "custom")},
                       {"parameters", c.value("parameters", json::object())}};
@@ -534,7 +612,7 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
         index["configs"].push_back(entry);
         ++summary.configurations;
     }
-    index["metrics"] = read_metrics(study_dir / "metrics.csv", theta_i);
+    index["metrics"] = read_metrics(study_dir / "metrics.csv", theta_i, unfolded);
     index["palette"] = json::parse(assets::model_colors_json());
     const std::string index_js = "window.LAMINA_INDEX = " + index.dump() + ";\n";
     summary.data_bytes += index_js.size();

@@ -24,6 +24,11 @@ std::string alpha1_id(double v) {
     return s.rfind("0.", 0) == 0 ? s.substr(1) : s;
 }
 
+// α, or "α_x×α_y" for an anisotropic interface.
+std::string alpha_text(const InterfaceSpec& s) {
+    return s.is_anisotropic() ? fmt::format("{}×{}", s.alpha, s.alpha_b()) : num(s.alpha);
+}
+
 std::string rgb_text(const Rgbd& v) {
     if (v[0] == v[1] && v[1] == v[2]) return num(v[0]);
     return fmt::format("({}, {}, {})", v[0], v[1], v[2]);
@@ -75,7 +80,8 @@ std::map<std::string, std::string> describe_parameters(const Stack& stack) {
     const Layer& top = stack.layers.front();
     if (top.interface.type == InterfaceType::Dielectric) {
         p["eta0"] = num(top.interface.eta);
-        p["alpha0"] = num(top.interface.alpha);
+        p["alpha0"] = alpha_text(top.interface);
+        if (top.interface.is_anisotropic()) p["tangent0"] = num(top.interface.tangent_deg);
         p["tau"] = rgb_text(top.has_medium ? top.medium.tau_a : Rgbd(0.0));
         if (top.has_medium && top.medium.scatters()) p["tau_s"] = rgb_text(top.medium.tau_s);
     }
@@ -94,13 +100,15 @@ std::map<std::string, std::string> describe_parameters(const Stack& stack) {
                 break;
             case InterfaceType::Conductor:
                 p["base"] = "conductor";
-                p["alpha1"] = num(base.alpha);
+                p["alpha1"] = alpha_text(base);
+                if (base.is_anisotropic()) p["tangent1"] = num(base.tangent_deg);
                 p["eta1"] = rgb_text(base.eta_rgb);
                 p["kappa1"] = rgb_text(base.k);
                 break;
             case InterfaceType::Dielectric:
                 p["base"] = "dielectric";
-                p["alpha1"] = num(base.alpha);
+                p["alpha1"] = alpha_text(base);
+                if (base.is_anisotropic()) p["tangent1"] = num(base.tangent_deg);
                 p["eta1"] = num(base.eta);
                 break;
         }
@@ -187,11 +195,54 @@ std::vector<StudyConfiguration> iridescent_configurations() {
     return out;
 }
 
+std::vector<StudyConfiguration> brushed_configurations() {
+    // The metals at the channels' wavelengths, as the iridescent category's (rounded from the
+    // handbooks' tables); steel as iron.
+    const Rgbd al_eta(1.2, 0.96, 0.65), al_k(7.3, 6.4, 5.4);
+    const Rgbd fe_eta(2.87, 2.95, 2.65), fe_k(3.08, 2.93, 2.81);
+    const Rgbd gold_eta(0.143, 0.374, 1.442), gold_k(3.983, 2.385, 1.603);  // the frosted metals'
+    struct Brushed {
+        const char* id;
+        double alpha0x, alpha0y, coat_tangent;  // the coat (α0x = α0y: isotropic)
+        Rgbd eta, k;
+        double alpha1x, alpha1y, base_tangent;  // the brushed metal: α1x along its tangent
+    };
+    const Brushed list[] = {
+        // Under a smooth clear coat (α0 = 0.001): the metal's lobe, stretched across the
+        // brushing, seen through one smooth refraction; brushed along x, and at 30° to it (lit
+        // from 0°, 45° and 90°: 30°, 15° and 60° from the brushing, no two alike).
+        {"brushed-al-a0.001-a1.05x.3", 0.001, 0.001, 0, al_eta, al_k, 0.05, 0.3, 0},
+        {"brushed-steel-a0.001-a1.1x.5", 0.001, 0.001, 0, fe_eta, fe_k, 0.1, 0.5, 0},
+        {"brushed-gold-a0.001-a1.05x.3-t30", 0.001, 0.001, 0, gold_eta, gold_k, 0.05, 0.3, 30},
+        // Under a rough isotropic coat (α0 = 0.2): the coat's spread over the anisotropic lobe.
+        {"brushed-al-a0.2-a1.05x.3", 0.2, 0.2, 0, al_eta, al_k, 0.05, 0.3, 0},
+        {"brushed-steel-a0.2-a1.1x.5-t30", 0.2, 0.2, 0, fe_eta, fe_k, 0.1, 0.5, 30},
+        // A brushed lacquer (α0 = 0.05 × 0.2, its tangent along x) over brushed aluminium: the
+        // tangents aligned, at 45° and crossed (90°).
+        {"brushed-al-a0.05x.2-a1.05x.3-t0", 0.05, 0.2, 0, al_eta, al_k, 0.05, 0.3, 0},
+        {"brushed-al-a0.05x.2-a1.05x.3-t45", 0.05, 0.2, 0, al_eta, al_k, 0.05, 0.3, 45},
+        {"brushed-al-a0.05x.2-a1.05x.3-t90", 0.05, 0.2, 0, al_eta, al_k, 0.05, 0.3, 90},
+    };
+    std::vector<StudyConfiguration> out;
+    for (const Brushed& b : list) {
+        Layer top = coat(b.alpha0x, Rgbd(0.0));
+        if (b.alpha0y != b.alpha0x)
+            top.interface = anisotropic(top.interface, b.alpha0x, b.alpha0y, b.coat_tangent);
+        Layer metal = conductor(b.eta, b.k, b.alpha1x);
+        metal.interface = anisotropic(metal.interface, b.alpha1x, b.alpha1y, b.base_tangent);
+        out.push_back(make(b.id, "brushed", {top, metal}));
+    }
+    return out;
+}
+
 std::vector<StudyConfiguration> preset_configurations(const std::string& preset) {
     std::vector<StudyConfiguration> out = builtin_configurations();
-    if (preset != "quick")
+    if (preset != "quick") {
         for (StudyConfiguration& c : iridescent_configurations())
             out.push_back(std::move(c));
+        for (StudyConfiguration& c : brushed_configurations())
+            out.push_back(std::move(c));
+    }
     return out;
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // The study's configurations (docs/study.md): 60 two-interface stacks under air — plastics,
-// metallic paints, frosted metals and slabs — built into lamina, the iridescent category of the
-// larger presets, plus a user's own list.
+// metallic paints, frosted metals and slabs — built into lamina, the iridescent and brushed
+// categories of the larger presets, plus a user's own list.
 
 #include "layers/stack.h"
 
@@ -30,8 +30,15 @@ std::vector<StudyConfiguration> builtin_configurations();
 /// the quick one (make demo) leaves it out.
 std::vector<StudyConfiguration> iridescent_configurations();
 
+/// The "brushed" category (docs/study.md): brushed aluminium, steel and gold (anisotropic GGX,
+/// α_x ≠ α_y) under a smooth, a rough and a brushed clear coat, the coat's and the metal's
+/// tangents aligned or turned 45° or 90° against each other. Compared on the unfolded grid, lit
+/// from several azimuths (study_incidences). The standard and paper presets add it; the quick one
+/// leaves it out.
+std::vector<StudyConfiguration> brushed_configurations();
+
 /// The configurations a study runs by default at `preset`: builtin_configurations(), and
-/// iridescent_configurations() for every preset but "quick".
+/// iridescent_configurations() and brushed_configurations() for every preset but "quick".
 std::vector<StudyConfiguration> preset_configurations(const std::string& preset);
 
 /// A user's list: {"configurations": [{"id": ..., "category": ..., "stack": {...}}, ...]}

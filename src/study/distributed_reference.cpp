@@ -53,12 +53,11 @@ std::uint64_t particles_of(const std::vector<ReferenceKey>& work, int rank, int 
 
 std::vector<ReferenceKey> study_reference_keys(const std::vector<StudyConfiguration>& configs,
                                                const StudySettings& s) {
-    check_study_supports(configs, s);
     std::vector<ReferenceKey> keys;
     for (const StudyConfiguration& config : configs)
-        for (double theta_i : s.reference.theta_i_deg) {
-            keys.push_back(reference_key(config.id, config.stack, theta_i, s.reference));
-        }
+        for (const StudyIncidence& inc : study_incidences(config.stack, s.reference))
+            keys.push_back(
+                reference_key(config.id, config.stack, inc.theta_i, s.reference, inc.phi_i));
     return keys;
 }
 

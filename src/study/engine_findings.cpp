@@ -37,7 +37,7 @@ bool is_production(const std::string& name) {
     return e && e->group == "production" && name.find(':') == std::string::npos;
 }
 
-using RowKey = std::tuple<std::string, double, int>;  // config, θi, channel
+using RowKey = std::tuple<std::string, double, double, int>;  // config, θi, φi, channel
 
 }  // namespace
 
@@ -68,7 +68,7 @@ EngineFindings compute_engine_findings(const std::vector<MetricRow>& rows,
     std::map<std::string, std::map<RowKey, const MetricRow*>> by_model;
     for (const MetricRow& r : rows) {
         if (r.side != 'R' || !r.supported) continue;
-        by_model[r.model][{r.config, r.theta_i, r.channel}] = &r;
+        by_model[r.model][{r.config, r.theta_i, r.phi_i, r.channel}] = &r;
         Acc& a = acc[{r.model, r.category}];
         if (a.a_sum.empty()) a.a_sum.assign(f.theta_i.size(), 0), a.a_n.assign(f.theta_i.size(), 0);
         a.configs.insert(r.config);

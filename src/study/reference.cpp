@@ -76,7 +76,7 @@ std::string serialize(const ReferenceKey& key, const ReferencePiece& p) {
     nlohmann::json meta;
     meta["key"] = key.canonical();
     meta["has_transmission"] = p.has_transmission;
-    meta["bins"] = key.settings.grid.size();
+    meta["bins"] = key.grid().size();
     meta["seconds"] = p.seconds;
     nlohmann::json budget;
     for (int t = 0; t < kBudgetTerms; ++t)
@@ -98,7 +98,7 @@ std::string serialize(const ReferenceKey& key, const ReferencePiece& p) {
                 f.push_back(float(p.f[side][j][c]));
                 se.push_back(float_to_half(float(p.se[side][j][c])));
             }
-    const std::size_t n_phi = std::size_t(key.settings.grid.n_phi());
+    const std::size_t n_phi = std::size_t(key.grid().n_phi());
     const std::string f_packed = pack_elements(f.data(), f.size(), sizeof(float), n_phi, 3);
     meta["f_packed"] = f_packed.size();
     return kMagic + meta.dump() + "\n" + f_packed +
@@ -115,7 +115,7 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
     try {
         meta = nlohmann::json::parse(bytes.substr(magic_len, eol - magic_len));
         if (meta.at("key").get<std::string>() != key.canonical()) return false;
-        if (meta.at("bins").get<std::size_t>() != key.settings.grid.size()) return false;
+        if (meta.at("bins").get<std::size_t>() != key.grid().size()) return false;
         p.has_transmission = meta.at("has_transmission").get<bool>();
         p.seconds = meta.at("seconds").get<double>();
         const auto& budget = meta.at("budget");
@@ -133,7 +133,7 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
         return false;
     }
     const std::size_t sides = p.has_transmission ? 2 : 1;
-    const std::size_t n = key.settings.grid.size();
+    const std::size_t n = key.grid().size();
     const std::size_t expected = sides * 2 * n * 3 * sizeof(float);
     std::vector<float> data(expected / sizeof(float));
     if (packed) {
@@ -145,7 +145,7 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
             const std::size_t f_bytes = meta.at("f_packed").get<std::size_t>();
             const std::string_view rest = std::string_view(bytes).substr(eol + 1);
             if (f_bytes > rest.size()) return false;
-            const std::size_t n_phi = std::size_t(key.settings.grid.n_phi());
+            const std::size_t n_phi = std::size_t(key.grid().n_phi());
             unpack_elements(rest.substr(0, f_bytes), f.data(), values, sizeof(float), n_phi, 3,
                             key.file_name());
             unpack_elements(rest.substr(f_bytes), se.data(), values, sizeof(std::uint16_t), n_phi,
@@ -197,7 +197,8 @@ std::string ReferenceKey::canonical() const {
 }
 
 std::string ReferenceKey::file_name() const {
-    return fmt::format("theta{}-n{}-s{}-{:016x}.bin", theta_i_deg(), settings.particles,
+    const std::string phi = phi_i_deg() != 0 ? fmt::format("-phi{}", phi_i_deg()) : "";
+    return fmt::format("theta{}{}-n{}-s{}-{:016x}.bin", theta_i_deg(), phi, settings.particles,
                        settings.seed, fnv1a(canonical()));
 }
 
@@ -211,6 +212,13 @@ ReferenceKey reference_key(const std::string& config_id, const Stack& stack, dou
     key.settings.theta_i_deg = {theta_i_deg};
     key.settings.threads = 0;
     key.settings.first_particle = 0;
+    return key;
+}
+
+ReferenceKey reference_key(const std::string& config_id, const Stack& stack, double theta_i_deg,
+                           const SimulationSettings& reference, double phi_i_deg) {
+    ReferenceKey key = reference_key(config_id, stack, theta_i_deg, reference);
+    key.settings.phi_i_deg = phi_i_deg;  // a Key::Tail setting: said only where it is not 0
     return key;
 }
 
@@ -242,6 +250,7 @@ std::string compute_reference_piece(const ReferenceKey& key, int threads,
     const std::uint64_t n_b = s.particles;
     const double wa = double(n_a) / double(particles), wb = double(n_b) / double(particles);
 
+    const HemisphereGrid grid = key.grid();
     ReferencePiece piece;
     piece.has_transmission = a.table.has_transmission;
     piece.seconds = a.seconds + b.seconds;
@@ -249,15 +258,15 @@ std::string compute_reference_piece(const ReferenceKey& key, int threads,
         const Side sd = side == 0 ? Side::Reflection : Side::Transmission;
         const BinnedLobe& la = a.table.lobe(0, sd);
         const BinnedLobe& lb = b.table.lobe(0, sd);
-        piece.f[side].resize(key.settings.grid.size());
-        piece.se[side].resize(key.settings.grid.size());
-        for (std::size_t j = 0; j < key.settings.grid.size(); ++j)
+        piece.f[side].resize(grid.size());
+        piece.se[side].resize(grid.size());
+        for (std::size_t j = 0; j < grid.size(); ++j)
             for (int c = 0; c < 3; ++c) {
                 piece.f[side][j][c] = wa * la.f[j][c] + wb * lb.f[j][c];
                 piece.se[side][j][c] = std::hypot(wa * la.se[j][c], wb * lb.se[j][c]);
             }
         for (int c = 0; c < 3; ++c)
-            piece.floor[side][c] = noise_floor(key.settings.grid, la.f, lb.f, c);
+            piece.floor[side][c] = noise_floor(grid, la.f, lb.f, c);
     }
     const EnergyBudget& ba = a.incidences[0].budget;
     const EnergyBudget& bb = b.incidences[0].budget;

@@ -30,6 +30,10 @@ struct ReferenceKey {
     SimulationSettings settings;
 
     double theta_i_deg() const { return settings.theta_i_deg.front(); }
+    double phi_i_deg() const { return settings.phi_i_deg; }
+    /// The grid the piece is tabulated on: settings.grid, unfolded for an anisotropic stack or
+    /// φi ≠ 0 (simulation_grid).
+    HemisphereGrid grid() const { return simulation_grid(stack, settings); }
 
     /// A canonical text of every field, lamina's version and the digest of the reference's code
     /// (kReferenceSourceDigest: src/core, physics, layers and simulator, so that a kernel whose
@@ -46,7 +50,8 @@ struct ReferenceKey {
 
 struct ReferencePiece {
     bool has_transmission = false;
-    /// [side][bin]: the average of the halves and its standard error, as stored (float32).
+    /// [side][bin of ReferenceKey::grid()]: the average of the halves and its standard error, as
+    /// stored (float32).
     std::array<std::vector<Rgbd>, 2> f, se;
     EnergyBudget budget;                              ///< average of the halves
     std::array<std::array<LobeMetrics, 3>, 2> floor;  ///< [side][channel]
@@ -79,8 +84,13 @@ std::uint64_t second_half_seed(std::uint64_t seed);
 /// The digest of the reference's code the keys hold (kReferenceSourceDigest).
 const char* reference_code_digest();
 
-/// The key of the incidence `theta_i_deg` of a study's reference with the settings `reference`.
+/// The key of the incidence `theta_i_deg` (at reference.phi_i_deg) of a study's reference with the
+/// settings `reference`.
 ReferenceKey reference_key(const std::string& config_id, const Stack& stack, double theta_i_deg,
                            const SimulationSettings& reference);
+/// The same with the light from azimuth `phi_i_deg` (the key says it only where it is not 0, so
+/// that a piece lit from φi = 0 has the key it always had).
+ReferenceKey reference_key(const std::string& config_id, const Stack& stack, double theta_i_deg,
+                           const SimulationSettings& reference, double phi_i_deg);
 
 }  // namespace lamina

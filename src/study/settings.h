@@ -9,6 +9,7 @@
 #include "study/configurations.h"
 #include "study/metrics.h"
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -72,10 +73,33 @@ struct StudySettings {
     }
 };
 
+/// One incidence of a configuration in the study: θi and the azimuth φi the light comes from
+/// (degrees; wi = (sin θi cos φi, sin θi sin φi, cos θi), as the goniophotometer's --phi-i).
+struct StudyIncidence {
+    double theta_i = 0, phi_i = 0;
+};
+
+/// The azimuths φi an anisotropic configuration is lit from (docs/study.md, "Brushed"): along
+/// the +x axis, diagonally and across it. A configuration's tangents are set against this axis.
+inline constexpr std::array<double, 3> kAnisotropicPhiIDeg = {0, 45, 90};
+
+/// The incidences the study compares a configuration at, in order: for an isotropic stack, each
+/// θi of reference.theta_i_deg at reference.phi_i_deg; for an anisotropic one, each θi at each
+/// azimuth of kAnisotropicPhiIDeg (θi = 0 once: every azimuth is the same light there), θi
+/// first. A configuration whose incidences are all at φi = 0 and whose stack is isotropic is
+/// compared on the folded grid, any other on the unfolded one (study_grid).
+std::vector<StudyIncidence> study_incidences(const Stack& stack,
+                                             const SimulationSettings& reference);
+
+/// The grid the study compares a configuration on: the goniophotometer's (simulation_grid):
+/// reference.grid, unfolded over φ ∈ [0°, 360°) for an anisotropic stack or φi ≠ 0.
+HemisphereGrid study_grid(const Stack& stack, const SimulationSettings& reference);
+
 /// One row of metrics.csv.
 struct MetricRow {
     std::string config, category, model;
     double theta_i = 0;
+    double phi_i = 0;  ///< the incidence's azimuth (metrics.csv's phi_i column, when present)
     char side = 'R';
     int channel = 0;
     bool supported = false;
@@ -83,6 +107,8 @@ struct MetricRow {
     LobeMetrics floor;    ///< the reference's noise floor
 };
 
+/// metrics.csv's header; a study with a row at φi ≠ 0 has a phi_i column after theta_i
+/// (metrics_csv, docs/formats.md).
 inline constexpr const char* kMetricsCsvHeader =
     "config,category,model,theta_i,side,channel,misplaced_energy,misplaced_floor,albedo_ref,"
     "albedo_model,albedo_error,rmse,log_rmse,noise_floor,misplaced_floor_noise,supported";

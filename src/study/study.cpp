@@ -51,7 +51,8 @@ struct ConfigResult {
 // the digest of the models' code, so that an edited model is binned again), the stack, the
 // incidences, the grid and the binning rule.
 std::string model_key(const std::string& name, const StudyConfiguration& config,
-                      const StudySettings& s) {
+                      const StudySettings& s, const std::vector<StudyIncidence>& incidences,
+                      const HemisphereGrid& grid) {
     // A model from elsewhere (a table file, a Python plugin) may change without its name
     // changing: it is evaluated again on every run (a key no earlier run had).
     for (const ExternalModel& e : s.external_models)
@@ -60,15 +61,27 @@ std::string model_key(const std::string& name, const StudyConfiguration& config,
                                std::chrono::system_clock::now().time_since_epoch().count());
     const ModelSpec spec = parse_model_spec(name, "--models");
     const BinnedOptions b;
+    // A folded configuration's key is the one it always had; an unfolded one's names its grid
+    // and its incidences' azimuths.
+    std::string unfolded;
+    if (grid.is_unfolded()) {
+        std::vector<double> theta, phi;
+        for (const StudyIncidence& inc : incidences) {
+            theta.push_back(inc.theta_i);
+            phi.push_back(inc.phi_i);
+        }
+        unfolded = fmt::format(" | incidences {} phi_i {} | grid {}", fmt::join(theta, ","),
+                               fmt::join(phi, ","), grid.to_string());
+    }
     return fmt::format(
         "lamina {} code {} | model {} | options {} | stack {} | theta_i {} | grid {} | binned {} "
         "{} "
-        "{} {} {}",
+        "{} {} {}{}",
         kVersion, kModelSourceDigest, name,
         nlohmann::json(resolve_options(*spec.entry, spec.assignments, "--models")).dump(),
         stack_to_json(config.stack).dump(), fmt::join(s.reference.theta_i_deg, ","),
         s.reference.grid.to_string(), b.rel_tol, b.abs_tol, b.max_depth, b.peak_depth,
-        b.eval_budget);
+        b.eval_budget, unfolded);
 }
 
 std::filesystem::path state_path(const std::filesystem::path& out_dir, const std::string& id) {
@@ -96,19 +109,21 @@ double num_of(const nlohmann::json& v) {
 // A metric row as the state keeps it (every double exactly: JSON numbers round-trip).
 nlohmann::json row_json(const MetricRow& r) {
     const LobeMetrics &m = r.metrics, &f = r.floor;
-    return {r.theta_i,
-            std::string(1, r.side),
-            r.channel,
-            r.supported,
-            num(m.misplaced_energy),
-            num(m.misplaced_floor),
-            num(m.albedo_ref),
-            num(m.albedo_model),
-            num(m.albedo_error),
-            num(m.rmse),
-            num(m.log_rmse),
-            num(f.misplaced_energy),
-            num(f.misplaced_floor)};
+    nlohmann::json j = {r.theta_i,
+                        std::string(1, r.side),
+                        r.channel,
+                        r.supported,
+                        num(m.misplaced_energy),
+                        num(m.misplaced_floor),
+                        num(m.albedo_ref),
+                        num(m.albedo_model),
+                        num(m.albedo_error),
+                        num(m.rmse),
+                        num(m.log_rmse),
+                        num(f.misplaced_energy),
+                        num(f.misplaced_floor)};
+    if (r.phi_i != 0) j.push_back(r.phi_i);  // a 14th field only where the light is off φ = 0
+    return j;
 }
 
 MetricRow row_from_json(const nlohmann::json& j, const StudyConfiguration& c,
@@ -130,6 +145,7 @@ MetricRow row_from_json(const nlohmann::json& j, const StudyConfiguration& c,
     r.metrics.log_rmse = num_of(j.at(10));
     r.floor.misplaced_energy = num_of(j.at(11));
     r.floor.misplaced_floor = num_of(j.at(12));
+    if (j.size() > 13) r.phi_i = j.at(13).get<double>();
     return r;
 }
 
@@ -166,8 +182,9 @@ class ConfigurationRun {
           out_dir_(out_dir),
           progress_(progress),
           work_(work),
-          n_inc_(s.reference.theta_i_deg.size()),
-          grid_(s.reference.grid),
+          incidences_(study_incidences(config.stack, s.reference)),
+          n_inc_(incidences_.size()),
+          grid_(study_grid(config.stack, s.reference)),
           bins_(grid_.size()),
           config_dir_(out_dir / "configs" / config.id) {}
 
@@ -189,14 +206,16 @@ class ConfigurationRun {
     // 0. The digests of the inputs, and what the last run left.
     void digest_inputs() {
         ref_digest_ = fnv1a("reference");
-        for (double theta_i : s_.reference.theta_i_deg) {
-            keys_.push_back(reference_key(config_.id, config_.stack, theta_i, s_.reference));
+        for (const StudyIncidence& inc : incidences_) {
+            keys_.push_back(
+                reference_key(config_.id, config_.stack, inc.theta_i, s_.reference, inc.phi_i));
             ref_digest_ = fnv1a(keys_.back().canonical(), ref_digest_);
         }
         outputs_digest_ = fnv1a(fmt::format("{} | reference {} | tables {}", kStateFormat,
                                             digest_hex(ref_digest_), enum_text(s_.tables)));
         for (const std::string& name : model_names_) {
-            model_keys_.push_back(digest_hex(fnv1a(model_key(name, config_, s_))));
+            model_keys_.push_back(
+                digest_hex(fnv1a(model_key(name, config_, s_, incidences_, grid_))));
             outputs_digest_ = fnv1a(" | " + name + " " + model_keys_.back(), outputs_digest_);
         }
         state_ = s_.recompute ? nlohmann::json() : read_state(state_path(out_dir_, config_.id));
@@ -312,7 +331,14 @@ class ConfigurationRun {
         const auto external =
             std::find_if(s_.external_models.begin(), s_.external_models.end(),
                          [&](const ExternalModel& e) { return e.name == m.name; });
-        if (external != s_.external_models.end()) {
+        if (external != s_.external_models.end() && grid_.is_unfolded()) {
+            // A model table's rows carry θi only (brdf.csv): no table of an unfolded
+            // configuration, whose incidences differ in φi too.
+            m.support.reason = fmt::format(
+                "{}: a model table covers folded configurations only (this one is compared on "
+                "the unfolded grid, lit from several azimuths)",
+                external->source);
+        } else if (external != s_.external_models.end()) {
             table = external->table(config_);
             if (table.has_reflection || table.has_transmission)
                 check_external_table(table, grid_, s_.reference.theta_i_deg, transmits_,
@@ -328,10 +354,38 @@ class ConfigurationRun {
         } else {
             const std::unique_ptr<Model> model = make_model(m.name, config_.stack);
             m.support = model->support();
-            if (m.support.brdf || m.support.btdf)
-                table = bin_model(*model, grid_, s_.reference.theta_i_deg);
+            if (m.support.brdf || m.support.btdf) table = bin_registry_model(*model);
         }
         return table;
+    }
+
+    // The registry's model on the bins of every incidence: as it always was on a folded grid;
+    // on an unfolded one, each azimuth's incidences at once, gathered in the incidences' order.
+    BinnedTable bin_registry_model(const Model& model) const {
+        if (!grid_.is_unfolded()) return bin_model(model, grid_, s_.reference.theta_i_deg);
+        std::vector<double> azimuths;
+        for (const StudyIncidence& inc : incidences_)
+            if (std::find(azimuths.begin(), azimuths.end(), inc.phi_i) == azimuths.end())
+                azimuths.push_back(inc.phi_i);
+        std::vector<double> thetas;
+        for (const StudyIncidence& inc : incidences_)
+            thetas.push_back(inc.theta_i);
+        BinnedTable out;
+        for (double phi : azimuths) {
+            std::vector<double> at_phi;
+            for (const StudyIncidence& inc : incidences_)
+                if (inc.phi_i == phi) at_phi.push_back(inc.theta_i);
+            BinnedTable t = bin_model(model, grid_, at_phi, phi);
+            if (out.lobes.empty()) {
+                out = t;
+                out.theta_i_deg = thetas;
+                out.lobes.assign(incidences_.size(), t.lobes.front());
+            }
+            std::size_t k = 0;
+            for (std::size_t i = 0; i < incidences_.size(); ++i)
+                if (incidences_[i].phi_i == phi) out.lobes[i] = std::move(t.lobes[k++]);
+        }
+        return out;
     }
 
     // The model's table, albedos and metric rows against the reference.
@@ -342,7 +396,7 @@ class ConfigurationRun {
             for (int side = 0; side < n_sides_; ++side) {
                 const bool supported = side == 0 ? m.support.brdf : m.support.btdf;
                 const char* side_name = side == 0 ? "R" : "T";
-                const double theta_i = s_.reference.theta_i_deg[i];
+                const double theta_i = incidences_[i].theta_i, phi_i = incidences_[i].phi_i;
                 if (!supported) {
                     m.albedo[side_name].push_back(nullptr);
                     for (int c = 0; c < 3; ++c)
@@ -350,6 +404,7 @@ class ConfigurationRun {
                                           config_.category,
                                           m.name,
                                           theta_i,
+                                          phi_i,
                                           side_name[0],
                                           c,
                                           false,
@@ -368,8 +423,9 @@ class ConfigurationRun {
                     }
                 m.albedo[side_name].push_back(rgb(a));
                 for (int c = 0; c < 3; ++c)
-                    m.rows.push_back({config_.id, config_.category, m.name, theta_i, side_name[0],
-                                      c, true, lobe_metrics(grid_, pieces_[i].f[side], lobe.f, c),
+                    m.rows.push_back({config_.id, config_.category, m.name, theta_i, phi_i,
+                                      side_name[0], c, true,
+                                      lobe_metrics(grid_, pieces_[i].f[side], lobe.f, c),
                                       pieces_[i].floor[side][c]});
             }
     }
@@ -453,7 +509,8 @@ class ConfigurationRun {
         for (std::size_t i = 0; i < n_inc_; ++i) {
             result_.lost_microsurface.push_back(pieces_[i].budget[BudgetTerm::LostMicrosurface]);
             nlohmann::json e;
-            e["theta_i"] = s_.reference.theta_i_deg[i];
+            e["theta_i"] = incidences_[i].theta_i;
+            if (grid_.is_unfolded()) e["phi_i"] = incidences_[i].phi_i;
             for (int t = 0; t < kBudgetTerms; ++t)
                 e[kBudgetTermNames[t]] = rgb(pieces_[i].budget.term[t]);
             e["reflected_se"] = rgb(pieces_[i].budget.reflected_se);
@@ -466,7 +523,19 @@ class ConfigurationRun {
         cj["parameters"] = config_.parameters;
         cj["stack"] = stack_to_json(config_.stack);
         cj["sides"] = transmits_ ? nlohmann::json{"R", "T"} : nlohmann::json{"R"};
-        cj["theta_i"] = s_.reference.theta_i_deg;
+        if (grid_.is_unfolded()) {
+            // An unfolded configuration's incidences are its own (θi, φi) pairs, on its grid.
+            nlohmann::json theta = nlohmann::json::array(), phi = nlohmann::json::array();
+            for (const StudyIncidence& inc : incidences_) {
+                theta.push_back(inc.theta_i);
+                phi.push_back(inc.phi_i);
+            }
+            cj["theta_i"] = theta;
+            cj["phi_i"] = phi;
+            cj["grid"] = grid_.to_string();
+        } else {
+            cj["theta_i"] = s_.reference.theta_i_deg;
+        }
         cj["sources"] = sources;
         cj["supported"] = supported;
         cj["albedo"] = albedo;
@@ -515,8 +584,9 @@ class ConfigurationRun {
     const std::filesystem::path& out_dir_;
     Progress& progress_;
     StudyWork& work_;
+    const std::vector<StudyIncidence> incidences_;
     const std::size_t n_inc_;
-    const HemisphereGrid& grid_;
+    const HemisphereGrid grid_;  ///< folded, or unfolded (an anisotropic stack, φi ≠ 0)
     const std::size_t bins_;
     const std::filesystem::path config_dir_;
 
@@ -546,11 +616,39 @@ std::uint64_t preset_particles(const std::string& preset) {
                                  preset));
 }
 
+std::vector<StudyIncidence> study_incidences(const Stack& stack,
+                                             const SimulationSettings& reference) {
+    std::vector<StudyIncidence> out;
+    for (double theta_i : reference.theta_i_deg) {
+        if (!stack.is_anisotropic()) {
+            out.push_back({theta_i, reference.phi_i_deg});
+            continue;
+        }
+        for (double phi_i : kAnisotropicPhiIDeg) {
+            out.push_back({theta_i, phi_i});
+            if (theta_i == 0) break;  // the normal: one light whatever its azimuth
+        }
+    }
+    return out;
+}
+
+HemisphereGrid study_grid(const Stack& stack, const SimulationSettings& reference) {
+    return simulation_grid(stack, reference);
+}
+
 std::string metrics_csv(const std::vector<MetricRow>& rows) {
-    std::string out = std::string(kMetricsCsvHeader) + "\n";
+    // The phi_i column only where some light is off φ = 0: a study of folded configurations has
+    // the columns it always had.
+    const bool with_phi =
+        std::any_of(rows.begin(), rows.end(), [](const MetricRow& r) { return r.phi_i != 0; });
+    std::string header = kMetricsCsvHeader;
+    if (with_phi) header.replace(header.find(",side,"), 6, ",phi_i,side,");
+    std::string out = header + "\n";
     for (const MetricRow& r : rows) {
-        fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},", r.config, r.category, r.model,
-                       r.theta_i, r.side, kChannels[r.channel]);
+        fmt::format_to(std::back_inserter(out), "{},{},{},{},", r.config, r.category, r.model,
+                       r.theta_i);
+        if (with_phi) fmt::format_to(std::back_inserter(out), "{},", r.phi_i);
+        fmt::format_to(std::back_inserter(out), "{},{},", r.side, kChannels[r.channel]);
         if (r.supported)
             fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},{},{},true\n",
                            csv_number(r.metrics.misplaced_energy),
@@ -634,30 +732,15 @@ std::string describe_work(const StudyWork& w) {
         w.configurations_written, w.configurations_unchanged, w.files_written);
 }
 
-void check_study_supports(const std::vector<StudyConfiguration>& configs, const StudySettings& s) {
-    if (s.reference.phi_i_deg != 0)
-        throw InputError("settings", "--phi-i",
-                         fmt::format("the study compares folded tables (light from phi_i = 0); "
-                                     "phi_i = {} unfolds them: use lamina simulate and lamina "
-                                     "eval --binned --phi-i for one stack",
-                                     s.reference.phi_i_deg));
-    for (const StudyConfiguration& c : configs)
-        if (c.stack.is_anisotropic())
-            throw InputError(
-                "configuration '" + c.id + "'", "alpha",
-                "the stack has an anisotropic interface (alpha = [alpha_x, alpha_y]), whose "
-                "tables are unfolded (phi over [0, 360)); the study compares folded tables "
-                "only: use lamina simulate and lamina eval --binned for this stack");
-}
-
 StudyResult run_study(const std::vector<StudyConfiguration>& configs, const StudySettings& s,
                       const std::filesystem::path& out_dir) {
-    check_study_supports(configs, s);
     const std::vector<std::string> model_names = study_models(s);
 
     StagedOutput probe(out_dir);  // the folder must be writable before any work starts
-    Progress progress("study", "particles",
-                      configs.size() * s.reference.theta_i_deg.size() * s.reference.particles);
+    std::uint64_t incidences = 0;
+    for (const StudyConfiguration& c : configs)
+        incidences += study_incidences(c.stack, s.reference).size();
+    Progress progress("study", "particles", incidences * s.reference.particles);
     StudyResult result;
     ReferenceLoss lost;
     double reference_seconds = 0;
@@ -706,12 +789,22 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
     // The reference's simulation time as stored in its pieces: the same on every re-run.
     sj["reference_seconds"] = reference_seconds;
     nlohmann::json list = nlohmann::json::array();
-    for (const StudyConfiguration& c : configs)
-        list.push_back(
-            {{"id", c.id},
-             {"category", c.category},
-             {"parameters", c.parameters},
-             {"sides", c.stack.transmits() ? nlohmann::json{"R", "T"} : nlohmann::json{"R"}}});
+    for (const StudyConfiguration& c : configs) {
+        nlohmann::json entry = {
+            {"id", c.id},
+            {"category", c.category},
+            {"parameters", c.parameters},
+            {"sides", c.stack.transmits() ? nlohmann::json{"R", "T"} : nlohmann::json{"R"}}};
+        // An unfolded configuration: its grid and its incidences (config.json has them too).
+        const HemisphereGrid grid = study_grid(c.stack, s.reference);
+        if (grid.is_unfolded()) {
+            entry["grid"] = grid.to_string();
+            entry["incidences"] = nlohmann::json::array();
+            for (const StudyIncidence& inc : study_incidences(c.stack, s.reference))
+                entry["incidences"].push_back({inc.theta_i, inc.phi_i});
+        }
+        list.push_back(entry);
+    }
     sj["configurations"] = list;
     result.work.files_written += write_file_if_changed(out_dir / "study.json", sj.dump(1) + "\n");
     result.work.files_written +=

@@ -46,18 +46,13 @@ struct StudyResult {
     StudyWork work;
 };
 
-/// What the study cannot compare yet: its metrics, figures and explorer read folded tables (φ over
-/// [0°, 180°]), so a configuration with an anisotropic interface, or light from φi ≠ 0 (whose
-/// tables the goniophotometer and the models unfold, core/grid.h), is refused before any work:
-/// InputError naming the configuration and the field. run_study and study_reference_keys call it.
-void check_study_supports(const std::vector<StudyConfiguration>& configs,
-                          const StudySettings& settings);
-
-/// Runs (or resumes) the study into `out_dir`. Incremental: each configuration's outputs carry the
-/// digest of their inputs (the reference pieces' keys, each model's name, options and lamina
-/// version, the stack, incidences, grid and table format; cache/study/<id>.json), and work whose
-/// inputs are unchanged is read back, not redone; a file whose content is unchanged is not
-/// rewritten. Progress with an overall ETA goes to stderr when it is a terminal.
+/// Runs (or resumes) the study into `out_dir`; each configuration at its incidences, on its grid
+/// (study_incidences, study_grid: an anisotropic one, or any under --phi-i ≠ 0, unfolded).
+/// Incremental: each configuration's outputs carry the digest of their inputs (the reference
+/// pieces' keys, each model's name, options and lamina version, the stack, incidences, grid and
+/// table format; cache/study/<id>.json), and work whose inputs are unchanged is read back, not
+/// redone; a file whose content is unchanged is not rewritten. Progress with an overall ETA goes to
+/// stderr when it is a terminal.
 StudyResult run_study(const std::vector<StudyConfiguration>& configs, const StudySettings& settings,
                       const std::filesystem::path& out_dir);
 

@@ -62,7 +62,7 @@ struct Accumulator {
 
     static std::optional<RowPlace> place(const MetricRow* r) {
         if (!r) return std::nullopt;
-        return RowPlace{r->config, r->theta_i, r->side, r->channel};
+        return RowPlace{r->config, r->theta_i, r->side, r->channel, r->phi_i};
     }
 
     ModelAggregate result() const {
@@ -284,13 +284,14 @@ void find_common(const std::vector<StudyConfiguration>& configs,
 // What the reference itself drops to its single-scattering microsurfaces, per category: the mean
 // over configurations, incidences and channels, and the worst.
 void find_reference_loss(const std::vector<StudyConfiguration>& configs,
-                         const std::vector<double>& theta_i, const ReferenceLoss& lost,
+                         const SimulationSettings& reference, const ReferenceLoss& lost,
                          StudyFindings& f) {
     std::map<std::string, std::pair<double, int>> loss_sum;
     for (const StudyConfiguration& c : configs) {
         const auto it = lost.find(c.id);
         if (it == lost.end()) continue;
-        for (std::size_t i = 0; i < it->second.size() && i < theta_i.size(); ++i)
+        const std::vector<StudyIncidence> incidences = study_incidences(c.stack, reference);
+        for (std::size_t i = 0; i < it->second.size() && i < incidences.size(); ++i)
             for (int ch = 0; ch < 3; ++ch) {
                 const double v = it->second[i][ch];
                 for (const std::string& g : {c.category, std::string("all")}) {
@@ -298,7 +299,7 @@ void find_reference_loss(const std::vector<StudyConfiguration>& configs,
                     LossFindings& l = f.reference_loss[g];
                     if (n == 0 || v > l.worst) {
                         l.worst = v;
-                        l.worst_at = {c.id, theta_i[i], 'R', ch};
+                        l.worst_at = {c.id, incidences[i].theta_i, 'R', ch, incidences[i].phi_i};
                     }
                     sum += v;
                     ++n;
@@ -377,7 +378,7 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
     PerConfig per_config;
     find_groups(configs, models, rows, f, per_config);
     find_common(configs, models, rows, per_config, f);
-    find_reference_loss(configs, s.reference.theta_i_deg, lost, f);
+    find_reference_loss(configs, s.reference, lost, f);
     find_challenging(configs, models, per_config, f);
     find_assessment(configs, models, rows, f);
     // For engine developers (study/engine_findings.h): computed from the same rows.
@@ -399,6 +400,7 @@ nlohmann::json num(double v) {
 nlohmann::json place_json(const std::optional<RowPlace>& p, bool with_side = true) {
     if (!p) return nullptr;
     nlohmann::json j = {{"config", p->config}, {"theta_i", p->theta_i}};
+    if (p->phi_i != 0) j["phi_i"] = p->phi_i;
     if (with_side) j["side"] = std::string(1, p->side);
     j["channel"] = kChannels[p->channel];
     return j;
@@ -515,7 +517,9 @@ std::string pct(double v) {
 
 std::string where(const std::optional<RowPlace>& p) {
     if (!p) return "";
-    return fmt::format("{}, θi {}°, {}, {}", p->config, p->theta_i, p->side, kChannels[p->channel]);
+    const std::string phi = p->phi_i != 0 ? fmt::format(", φi {}°", p->phi_i) : "";
+    return fmt::format("{}, θi {}°{}, {}, {}", p->config, p->theta_i, phi, p->side,
+                       kChannels[p->channel]);
 }
 
 struct Markdown {

@@ -48,6 +48,7 @@ struct RowPlace {
     double theta_i = 0;
     char side = 'R';
     int channel = 0;
+    double phi_i = 0;  ///< the light's azimuth (said only where it is not 0)
 };
 
 /// One model over the supported rows of a group (NaN where no row has the value).

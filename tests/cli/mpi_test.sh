@@ -124,6 +124,18 @@ mpi "$lamina" study "${tiny[@]}" --out "$tmp/two/study" >"$tmp/study-again.log" 
     || { fail "resumed mpirun study"; cat "$tmp/study-again.log"; }
 same_files "resumed study" "$tmp/one/study" "$tmp/two/study" metrics.csv
 
+# A brushed configuration (anisotropic: unfolded, lit from φi = 0°, 45°, 90°): its pieces, keyed
+# by φi, spread over the processes like any other; the outputs are one process's, byte for byte.
+brushed=(--preset standard --only 'brushed-gold-a0.001-a1.05x.3-t30' --models openpbr
+         --theta-i 0,45 --particles 2e4 --grid 18x18 --no-figures)
+"$lamina" study "${brushed[@]}" --out "$tmp/one/brushed" >"$tmp/brushed-one.log" 2>&1 \
+    || { fail "one-process brushed study"; cat "$tmp/brushed-one.log"; }
+mpi "$lamina" study "${brushed[@]}" --out "$tmp/two/brushed" >"$tmp/brushed-two.log" 2>&1 \
+    && grep -q 'Reference: 4 pieces computed over 2 processes' "$tmp/brushed-two.log" && ok \
+    || { fail "mpirun brushed study"; cat "$tmp/brushed-two.log"; }
+same_files "brushed study" "$tmp/one/brushed" "$tmp/two/brushed" metrics.csv \
+    configs/brushed-gold-a0.001-a1.05x.3-t30/tables.lza configs/brushed-gold-a0.001-a1.05x.3-t30/config.json
+
 # 3. Errors: rank 0 fails (missing stack) while rank 1 waits for it: a message and a non-zero exit,
 #    no hang; a command that does not run over processes says so.
 expect_error() {  # expect_error TEXT ARGS...

@@ -21,3 +21,11 @@ rm -rf "$real"
 "$lamina" study --only 'plastic-P1-a0.05,slab-a0.1-a1.3-clear' --theta-i 30 --particles 2e4 \
     --grid 18x18 --physics bpb19 --no-figures --out "$real" >/dev/null
 node "$src/tests/report/browser_smoke.js" "$real" "$build/screenshots/real-study.png"
+
+# And a study of one brushed configuration (anisotropic: unfolded tables, lit from φi = 0°, 45°
+# and 90°): the page offers φi and draws each incidence on the full hemisphere.
+brushed="$build/report-brushed-study"
+rm -rf "$brushed"
+"$lamina" study --preset standard --only 'brushed-al-a0.05x.2-a1.05x.3-t90' --theta-i 0,45 \
+    --particles 2e4 --grid 18x18 --models openpbr,bel-prime --no-figures --out "$brushed" >/dev/null
+node "$src/tests/report/browser_unfolded.js" "$brushed" "$build/screenshots/brushed-study.png"

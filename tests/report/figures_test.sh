@@ -37,5 +37,18 @@ if [ "$(id -u)" -ne 0 ]; then  # root writes anywhere: the check means nothing t
     chmod u+w "$study"
     ok test $rc -eq 1
 fi
+# An unfolded configuration (brushed: anisotropic, lit from φi = 0°, 45°, 90°) of a tiny real
+# study: its slices (the plane φ = φi of each azimuth), albedo panel and error-matrix row are drawn.
+brushed="$build/figures-brushed"
+rm -rf "$brushed"
+"$lamina" study --preset standard --only 'brushed-gold-a0.001-a1.05x.3-t30' --theta-i 0,45 \
+    --particles 2e4 --grid 18x18 --models openpbr,bel-prime --no-figures --out "$brushed" >/dev/null
+ok test $? -eq 0
+out=$("$lamina" figures "$brushed" --formats png 2>&1)
+ok test $? -eq 0
+for f in slices/brushed-gold-a0.001-a1.05x.3-t30-R error-matrix-R albedo-brushed; do
+    ok test -s "$brushed/figures/$f.png"
+done
+ok grep -q "3 drawn" <<<"$out"
 echo "$passes passed, $fails failed"
 test "$fails" -eq 0

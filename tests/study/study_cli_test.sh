@@ -246,5 +246,22 @@ expect_error "model 'openpbr' has no option 'tint'" study --models openpbr:tint=
 [ "$(find "$tmp/m/cache" -name '*.bin' | wc -l)" -eq 3 ] && ok || fail "one cache piece per masking"
 python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['transmission_masking'] == 'pbrt'" \
     "$tmp/m/study.json" && ok || fail "study.json transmission_masking"
+# 10. --phi-i lights an isotropic configuration from that azimuth: unfolded, its pieces keyed by φi,
+#     metrics.csv with its phi_i column, config.json with the grid and the incidences.
+"$lamina" study --only 'paint-a0.05-a1.3' --models openpbr --theta-i 0,45 --phi-i 30 \
+    --particles 2e4 --grid 18x18 --no-figures --out "$tmp/phi" >/dev/null 2>&1 && ok || fail "--phi-i study"
+[ "$(find "$tmp/phi/cache" -name 'theta45-phi30-*.bin' | wc -l)" -eq 1 ] && ok || fail "--phi-i piece name"
+grep -q '^paint-a0.05-a1.3,metallic-paint,openpbr,45,30,R,g,[0-9]' "$tmp/phi/metrics.csv" \
+    && ok || fail "--phi-i metrics.csv rows"
+python3 -c "import json,sys; c = json.load(open(sys.argv[1])); \
+assert c['grid'] == '18x18 unfolded' and c['phi_i'] == [30, 30] and c['tables']['shape'][4] == 36" \
+    "$tmp/phi/configs/paint-a0.05-a1.3/config.json" && ok || fail "--phi-i config.json"
+# Its tables hold several azimuths' incidences (or one off φ = 0): export --study says it cannot.
+if "$lamina" export --study "$tmp/phi" --config paint-a0.05-a1.3 --out "$tmp/phi.bsdf" >"$tmp/phi-export" 2>&1; then
+    fail "export of an unfolded study configuration accepted"
+else
+    grep -q "config.json: phi_i: 'paint-a0.05-a1.3' is compared on the unfolded grid" "$tmp/phi-export" \
+        && ok || { fail "export message:"; cat "$tmp/phi-export"; }
+fi
 
 finish

@@ -153,14 +153,17 @@ def _read_metrics(path: Path) -> np.ndarray:
                         [(n, "f8") for n in _METRIC_FLOATS] + [("supported", "?")])
     width = {k: max(1, max(len(r[k]) for r in rows))
              for k in ("config", "category", "model", "side", "channel")}
+    # A study with light off φ = 0 (an anisotropic configuration, --phi-i) has a phi_i column.
+    phi = [("phi_i", "f8")] if "phi_i" in rows[0] else []
     dtype = [("config", f"U{width['config']}"), ("category", f"U{width['category']}"),
-             ("model", f"U{width['model']}"), ("theta_i", "f8"), ("side", f"U{width['side']}"),
-             ("channel", f"U{width['channel']}")]
+             ("model", f"U{width['model']}"), ("theta_i", "f8")] + phi + [
+             ("side", f"U{width['side']}"), ("channel", f"U{width['channel']}")]
     dtype += [(n, "f8") for n in _METRIC_FLOATS[1:]] + [("supported", "?")]
+    floats = _METRIC_FLOATS + ("phi_i",)
     out = np.zeros(len(rows), dtype=dtype)
     for k, r in enumerate(rows):
         out[k] = tuple(
-            (float(r[n]) if r[n] != "" else np.nan) if n in _METRIC_FLOATS
+            (float(r[n]) if r[n] != "" else np.nan) if n in floats
             else (r[n] == "true") if n == "supported" else r[n]
             for n, _ in dtype)
     return out

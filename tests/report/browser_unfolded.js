@@ -1,0 +1,121 @@
+// The explorer page of a small real study of one brushed configuration (an anisotropic stack:
+// unfolded tables, lit from several azimuths; docs/explorer.md) in headless Chromium: it loads with
+// no error, offers the light's azimuth φi, and turning φi draws that incidence — the slice along the
+// plane φ = φi (its reference bit for bit the mean of tables.lza's bins on that plane) and the full
+// hemisphere (φ over 0°–360°). Usage: node browser_unfolded.js STUDY_DIR SCREENSHOT
+"use strict";
+const fs = require("fs");
+const path = require("path");
+const zlib = require("zlib");
+const { launchChromium } = require("../support/chromium.js");
+
+// A packed array (docs/formats.md, "Packed arrays") decoded independently of the page.
+function readPacked(file) {
+  const data = fs.readFileSync(file);
+  const eol = data.indexOf(10, 15);
+  const h = JSON.parse(data.subarray(15, eol).toString());
+  const planes = zlib.inflateSync(data.subarray(eol + 1));
+  const width = h.dtype === "float16" ? 2 : 4, count = planes.length / width;
+  const [n, channels] = h.shape.slice(-2);
+  const bits = new Array(count);
+  for (let o = 0; o < count; o += n * channels)
+    for (let c = 0; c < channels; ++c)
+      for (let k = 0, x = 0; k < n; ++k) {
+        let d = 0;
+        for (let b = 0; b < width; ++b) d += planes[b * count + o + c * n + k] * 2 ** (8 * b);
+        x = (x + d) % 2 ** (8 * width);
+        bits[o + k * channels + c] = x;
+      }
+  const half = (u) => {
+    const e = (u >> 10) & 31, m = u & 1023, s = u >> 15 ? -1 : 1;
+    return e === 0 ? s * m * 2 ** -24 : e === 31 ? (m ? NaN : s * Infinity) : s * (1 + m / 1024) * 2 ** (e - 15);
+  };
+  const view = new DataView(new ArrayBuffer(4));
+  const single = (u) => { view.setUint32(0, u); return view.getFloat32(0); };
+  return { shape: h.shape, values: bits.map(width === 2 ? half : single) };
+}
+
+const [studyDir, shot] = process.argv.slice(2);
+
+async function main() {
+  const browser = await launchChromium();
+  const errors = [];
+  let failures = 0;
+  const check = (ok, what) => { console.log((ok ? "ok   " : "FAIL ") + what); if (!ok) failures++; };
+  try {
+    const page = browser.page;
+    page.on("console", (m) => { if (m.type() === "error") errors.push("console: " + m.text()); });
+    page.on("pageerror", (e) => errors.push("page error: " + e.message));
+    await page.route(/^(https?|wss?):/, (route) => { errors.push("network: " + route.request().url()); route.abort(); });
+    await page.goto("file://" + path.resolve(studyDir, "index.html"));
+    await page.waitForFunction(() => Number(document.body.dataset.renders || 0) > 0, null, { timeout: 20000 });
+    const shown = await page.evaluate(() => document.body.dataset.config);
+    const cfg = JSON.parse(fs.readFileSync(path.resolve(studyDir, "configs", shown, "config.json"), "utf8"));
+    check(Array.isArray(cfg.phi_i) && /unfolded/.test(cfg.grid), `${shown} is unfolded (test premise)`);
+    const options = await page.evaluate(() => {
+      const row = document.getElementById("w-phi-i-row");
+      return { visible: !row.hidden && row.offsetParent !== null,
+        values: Array.from(document.getElementById("w-phi-i").options).map((o) => Number(o.value)) };
+    });
+    check(options.visible, "the light's azimuth φi is offered");
+    check(JSON.stringify(options.values) === JSON.stringify([...new Set(cfg.phi_i)].sort((a, b) => a - b)),
+      `its values are the configuration's azimuths (${options.values})`);
+
+    const tab = readPacked(path.resolve(studyDir, "configs", shown, "tables.lza"));
+    const [, I, D, T, P] = tab.shape;
+    check(P === 2 * JSON.parse(fs.readFileSync(path.resolve(studyDir, "study.json"), "utf8")).grid.n_phi,
+      `tables.lza has the unfolded φ bins (${P})`);
+    // The bins of the half-plane at azimuth a: the one it crosses, or the two it separates.
+    const planeBins = (a) => {
+      const u = (((a % 360) + 360) % 360) / (360 / P), k = Math.round(u);
+      return Math.abs(u - k) < 1e-9 ? [(k + P - 1) % P, k % P] : [Math.floor(u) % P];
+    };
+    let before = await page.evaluate(() => Number(document.body.dataset.renders));
+    for (const phi of [90, 45]) {
+      await page.selectOption("#w-phi-i", String(phi));
+      await page.waitForFunction((n) => Number(document.body.dataset.renders) > n, before, { timeout: 20000 });
+      before = await page.evaluate(() => Number(document.body.dataset.renders));
+      const st = await page.evaluate(() => window.LAMINA_EXPLORER.state);
+      const title = await page.evaluate(() => document.getElementById("slice").layout.title.text);
+      check(title.includes("φi = " + phi + "°"), `the slice shows φi = ${phi}° (${title.split(" · ").slice(0, 2).join(" · ")})`);
+      // Which incidence: the page's θi at this φi.
+      const theta = JSON.parse(fs.readFileSync(path.resolve(studyDir, "study.json"), "utf8")).theta_i[st.incidence];
+      const inc = cfg.theta_i.findIndex((t, k) => t === theta && cfg.phi_i[k] === phi);
+      check(inc >= 0 && inc < I, `the configuration has (θi, φi) = (${theta}°, ${phi}°)`);
+      const at = (t, p) => tab.values[((inc * D + 0) * T * P + t * P + p) * 3];
+      const mean = (bins, t) => { let v = 0; for (const p of bins) v += at(t, p); return Math.fround(v / bins.length); };
+      const light = planeBins(phi), mirror = planeBins(phi + 180);
+      const want = [];
+      for (let x = 0; x < 2 * T; ++x) want.push(x < T ? mean(light, T - 1 - x) : mean(mirror, x - T));
+      const drawn = await page.evaluate(() => Array.from(document.getElementById("slice").data.find((t) => t.name === "reference").y));
+      check(drawn.length === want.length && drawn.every((v, x) => Math.abs(v - want[x]) <= 1e-6 * Math.abs(want[x])) && want.some((v) => v > 0),
+        `the slice's reference is tables.lza's plane φ = ${phi}° (${drawn.slice(T - 2, T + 2)} against ${want.slice(T - 2, T + 2)})`);
+      // The hemisphere: the map covers the whole disk (values below the plane φ = 0 too) and its
+      // brightest pixel lies on the mirror side of the light, in the half-plane φ = φi + 180°.
+      const hemi = await page.evaluate(() => {
+        const t = document.getElementById("iso-ref").data[0];
+        let best = -Infinity, bx = 0, by = 0, below = 0;
+        t.z.forEach((row, j) => row.forEach((v, i) => {
+          if (v === null) return;
+          if (t.y[j] < -0.1) ++below;
+          if (v > best) { best = v; bx = t.x[i]; by = t.y[j]; }
+        }));
+        return { bx, by, below };
+      });
+      check(hemi.below > 100, `the map covers the half-disk below the plane φ = 0 (${hemi.below} pixels)`);
+      // Displayed at (x, y) = −sinθ (cos φ, sin φ): the mirror direction φi + 180° is at +(cos φi, sin φi).
+      const c = Math.cos(phi * Math.PI / 180), s = Math.sin(phi * Math.PI / 180);
+      check(hemi.bx * c + hemi.by * s > 0.2, `the reference's peak is on the mirror side of φi = ${phi}° (${hemi.bx.toFixed(2)}, ${hemi.by.toFixed(2)})`);
+    }
+    const hash = await page.evaluate(() => location.hash);
+    check(hash.includes("phi=45"), `the address keeps φi (${hash})`);
+    await page.screenshot({ path: shot, fullPage: true });
+  } finally {
+    await browser.close();
+  }
+  for (const e of errors) console.log("FAIL " + e);
+  failures += errors.length;
+  console.log(failures ? `${failures} failed` : "0 failed");
+  process.exit(failures ? 1 : 0);
+}
+main().catch((e) => { console.log("FAIL " + e); process.exit(1); });
