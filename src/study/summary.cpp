@@ -570,18 +570,39 @@ void md_findings(const StudyFindings& f, Markdown& out) {
             out("- **{}** ({} configurations): no model supports it.\n", g.name, g.configurations);
             continue;
         }
+        // A model's mean covers the configurations it supports: say so where that is not all of
+        // them, and name the best model that covers all (a mean over an easier subset is not
+        // a recommendation for the category).
+        auto covered = [&](const std::string& m) {
+            return int(g.models.at(m).configurations_supported) >= g.configurations;
+        };
+        auto coverage = [&](const std::string& m) {
+            return covered(m) ? std::string()
+                              : fmt::format(", {} of {}", g.models.at(m).configurations_supported,
+                                            g.configurations);
+        };
         const ModelAggregate& best = g.models.at(rk.front());
-        out("- **{}** ({} configuration{}): use **{}** — mean misplaced energy {} (noise floor "
+        out("- **{}** ({} configuration{}): use **{}**{} — mean misplaced energy {} (noise floor "
             "{}; relative {}), worst {} ({}); mean |albedo error| {}.",
             g.name, g.configurations, g.configurations == 1 ? "" : "s", rk.front(),
+            covered(rk.front()) ? ""
+                                : fmt::format(" (on the {} of {} configurations it supports)",
+                                              best.configurations_supported, g.configurations),
             pct(best.mean_misplaced_floor), pct(best.mean_misplaced_floor_noise),
             pct(best.mean_misplaced_energy), pct(best.worst_misplaced_floor),
             where(best.worst_misplaced_floor_at), pct(best.mean_abs_albedo_error));
+        if (!covered(rk.front()))
+            for (const std::string& m : rk)
+                if (covered(m)) {
+                    out(" Of the models that support all {}: **{}** ({}).", g.configurations, m,
+                        pct(g.models.at(m).mean_misplaced_floor));
+                    break;
+                }
         if (rk.size() > 1) {
             out(" Then ");
             for (std::size_t k = 1; k < rk.size(); ++k)
-                out("{}{} ({})", k > 1 ? ", " : "", rk[k],
-                    pct(g.models.at(rk[k]).mean_misplaced_floor));
+                out("{}{} ({}{})", k > 1 ? ", " : "", rk[k],
+                    pct(g.models.at(rk[k]).mean_misplaced_floor), coverage(rk[k]));
             out(".");
         }
         std::vector<std::string> none;

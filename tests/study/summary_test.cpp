@@ -127,6 +127,27 @@ TEST(StudySummary, LikeForLikeLeavesOutTheModelsMadeForFewerConfigurations) {
     EXPECT_NE(w.md.find("c 5.0% (1 of 2)"), std::string::npos) << w.md;
 }
 
+// A category's best mean may cover only some of its configurations: the finding says on how
+// many, and names the best model that supports them all. Over the plastic and the paint, "b"
+// (paint only, 20%) has the lower mean; "a" (both, 30%) is the best over all of them.
+TEST(StudySummary, FindingsSayWhatAMeanCovers) {
+    StudyConfiguration plastic = builtin("plastic-P1-a0.05"), paint = builtin("paint-a0.05-a1.3");
+    paint.category = plastic.category;
+    std::vector<MetricRow> rows;
+    add_rows(rows, plastic, "a", true, 0.5);
+    add_rows(rows, plastic, "b", false, 0);
+    add_rows(rows, paint, "a", true, 0.1);
+    add_rows(rows, paint, "b", true, 0.2);
+    const Written w = summarize({plastic, paint}, {"a", "b"}, rows);
+    EXPECT_NE(w.md.find("use **b** (on the 1 of 2 configurations it supports) — mean misplaced "
+                        "energy 20.0%"),
+              std::string::npos)
+        << w.md;
+    EXPECT_NE(w.md.find("Of the models that support all 2: **a** (30.0%). Then a (30.0%)."),
+              std::string::npos)
+        << w.md;
+}
+
 // The reference's own microsurface loss, per category and overall: means over incidences and
 // channels, and the worst with where it is.
 TEST(StudySummary, ReportsTheReferencesMicrosurfaceLoss) {
