@@ -301,6 +301,18 @@ RglOptions options(int resolution, double dtheta) {
 
 // ---- tests -----------------------------------------------------------------------------------
 
+/// `lamina export --check`'s reader and the independent one give the same f at random pairs (to
+/// float32 rounding of the interpolation).
+void expect_readers_agree(const RglReader& check, const BsdfReader& independent) {
+    std::mt19937_64 rng(5);
+    for (int k = 0; k < 2000; ++k) {
+        const Vec3d wi = random_direction(rng, 89), wo = random_direction(rng, 89);
+        const Rgbd a = check.eval(wi, wo), b = independent.eval(wi, wo);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(a[c], b[c], 1e-5 * (std::abs(b[c]) + 1e-3));
+    }
+}
+
 TEST(TensorFile, RoundTripsAndRefusesMalformedFiles) {
     TensorFile f;
     f["a"] = tensor_float32({1, 2, 3, 4, 5, 6}, {2, 3});
@@ -459,13 +471,7 @@ TEST(RglBsdf, CheckReaderAgreesWithTheIndependentReader) {
     const TensorFile file = rgl_bsdf(src, options(24, 6));
     const RglReader check(file, "t.bsdf");
     const BsdfReader independent(file);
-    std::mt19937_64 rng(5);
-    for (int k = 0; k < 2000; ++k) {
-        const Vec3d wi = random_direction(rng, 89), wo = random_direction(rng, 89);
-        const Rgbd a = check.eval(wi, wo), b = independent.eval(wi, wo);
-        for (int c = 0; c < 3; ++c)
-            EXPECT_NEAR(a[c], b[c], 1e-5 * (std::abs(b[c]) + 1e-3));
-    }
+    expect_readers_agree(check, independent);
     for (double theta : {0.0, 37.0, 71.0, 84.5}) {
         const Vec3d wi = incident_direction(deg_to_rad(theta));
         const Rgbd a = directional_albedo(
@@ -622,14 +628,7 @@ TEST(RglBsdf, AnisotropicStackMeetsTheGoals) {
                 r.worst_albedo_error(), r.value_error(0.5),
                 r.value_error(RglFidelityGoals::kValueQuantile));
     EXPECT_TRUE(r.meets_goals());
-    const BsdfReader independent(file);
-    std::mt19937_64 rng(5);
-    for (int k = 0; k < 2000; ++k) {
-        const Vec3d wi = random_direction(rng, 89), wo = random_direction(rng, 89);
-        const Rgbd a = reader.eval(wi, wo), b = independent.eval(wi, wo);
-        for (int c = 0; c < 3; ++c)
-            EXPECT_NEAR(a[c], b[c], 1e-5 * (std::abs(b[c]) + 1e-3));
-    }
+    expect_readers_agree(reader, BsdfReader(file));
 }
 
 // Turning the tangent turns the file: the φi slices, D's rows and the s nodes are the same

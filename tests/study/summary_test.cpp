@@ -71,17 +71,24 @@ Written summarize(const std::vector<StudyConfiguration>& configs,
     return w;
 }
 
+/// Model "a" on a plastic (50%) and a paint (10%), model "b" on the paint alone (20%).
+std::vector<MetricRow> a_everywhere_b_on_the_paint(const StudyConfiguration& plastic,
+                                                   const StudyConfiguration& paint) {
+    std::vector<MetricRow> rows;
+    add_rows(rows, plastic, "a", true, 0.5);
+    add_rows(rows, plastic, "b", false, 0);
+    add_rows(rows, paint, "a", true, 0.1);
+    add_rows(rows, paint, "b", true, 0.2);
+    return rows;
+}
+
 // Model "a" supports a plastic (where it misplaces 50%) and a paint (10%); model "b" supports
 // only the paint (20%). Over what each supports, b (20%) ranks before a (30%); like for like, on
 // the paint alone, a (10%) ranks before b (20%).
 TEST(StudySummary, LikeForLikeRankingUsesOnlyConfigurationsEveryModelSupports) {
     const StudyConfiguration& plastic = builtin("plastic-P1-a0.05");
     const StudyConfiguration& paint = builtin("paint-a0.05-a1.3");
-    std::vector<MetricRow> rows;
-    add_rows(rows, plastic, "a", true, 0.5);
-    add_rows(rows, plastic, "b", false, 0);
-    add_rows(rows, paint, "a", true, 0.1);
-    add_rows(rows, paint, "b", true, 0.2);
+    const std::vector<MetricRow> rows = a_everywhere_b_on_the_paint(plastic, paint);
 
     const Written w = summarize({plastic, paint}, {"a", "b"}, rows);
     const nlohmann::json& j = w.json;
@@ -133,11 +140,7 @@ TEST(StudySummary, LikeForLikeLeavesOutTheModelsMadeForFewerConfigurations) {
 TEST(StudySummary, FindingsSayWhatAMeanCovers) {
     StudyConfiguration plastic = builtin("plastic-P1-a0.05"), paint = builtin("paint-a0.05-a1.3");
     paint.category = plastic.category;
-    std::vector<MetricRow> rows;
-    add_rows(rows, plastic, "a", true, 0.5);
-    add_rows(rows, plastic, "b", false, 0);
-    add_rows(rows, paint, "a", true, 0.1);
-    add_rows(rows, paint, "b", true, 0.2);
+    const std::vector<MetricRow> rows = a_everywhere_b_on_the_paint(plastic, paint);
     const Written w = summarize({plastic, paint}, {"a", "b"}, rows);
     EXPECT_NE(w.md.find("use **b** (on the 1 of 2 configurations it supports) — mean misplaced "
                         "energy 20.0%"),
