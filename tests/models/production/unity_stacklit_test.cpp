@@ -15,6 +15,8 @@
 #include "models/test_stacks.h"
 #include "support/closed_forms.h"
 
+#include "models/production/golden_data.h"
+
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -31,15 +33,10 @@ using test::coated;
 using test::dir;
 
 json load(const std::string& name) {
-    const std::string path =
-        std::string(LAMINA_SOURCE_DIR) + "/tests/models/production/data/" + name;
-    std::ifstream in(path);
-    if (!in) throw std::runtime_error("cannot read " + path);
-    return json::parse(in);
+    return test::load_golden(name);
 }
-
 Rgbd rgb(const json& j) {
-    return Rgbd(j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>());
+    return test::golden_rgb(j);
 }
 
 Stack stack_of(const json& s) {
