@@ -150,8 +150,10 @@ const std::vector<ModelEntry>& model_registry() {
         {"openpbr",
          "OpenPBR Surface 1.1 specification: albedo-scaled coat, coat darkening, base "
          "roughening, view-dependent tint",
-         "bases: lambertian, conductor; media: absorbing; anisotropic coat and metal; sides: R",
-         openpbr_options, make_openpbr, false, "production", /*represents_anisotropy=*/true},
+         "bases: lambertian, conductor (with a thin film); media: absorbing; anisotropic coat and "
+         "metal; sides: R",
+         openpbr_options, make_openpbr, false, "production", /*represents_anisotropy=*/true,
+         /*films=*/true},
         {"openpbr-adobe",
          "Adobe openpbr-bsdf: OpenPBR with view-only albedo scaling (reciprocal off), average "
          "Fresnel darkening, IOR-scaled roughening",

@@ -62,7 +62,8 @@ class ProductionCoat final : public Model {
             }
             if ((r_.metal_film == CoatRecipe::MetalFilm::ThreeJs ||
                  r_.metal_film == CoatRecipe::MetalFilm::OpenPbrBsdf ||
-                 r_.metal_film == CoatRecipe::MetalFilm::Cycles) &&
+                 r_.metal_film == CoatRecipe::MetalFilm::Cycles ||
+                 r_.metal_film == CoatRecipe::MetalFilm::OpenPbrSpec) &&
                 in.film.k > 0) {
                 support_.reason = fmt::format(
                     "{}'s thin film is transparent (no extinction k); this film's k is {}", r_.name,
@@ -599,6 +600,11 @@ class ProductionCoat final : public Model {
                     film_->eta_film.real() / eta_c, film_->thickness_min_nm * eta_c,
                     film_->thickness_max_nm * eta_c, f0_, tint82_, cos_h);
             }
+            case CoatRecipe::MetalFilm::OpenPbrSpec:
+                // OpenPBR 1.1, "Thin-film iridescence": the film is incorporated into the metal's
+                // Fresnel factor (no slab of its own); thickness 0 is no film.
+                if (!(film_->thickness_max_nm > 0)) return metal_fresnel(cos_h);
+                return film_reflectance_exact(*film_, cos_h);
             case CoatRecipe::MetalFilm::Unsupported:
                 break;
         }

@@ -193,6 +193,15 @@ struct CoatRecipe {
         /// taken relative to the coat (η_f/η_c, d η_c: Cycles' film sees an ambient of index 1);
         /// a film of at most 0.1 nm (so taken) leaves the bare metal.
         Cycles,
+        /// OpenPBR Surface 1.1's ("Thin-film iridescence"): the film in the metal's Fresnel
+        /// factor, evaluated from first principles at the stack's wavelengths (the
+        /// specification's alternative to Belcour & Barla's model for renderers that sample
+        /// wavelengths), the cases it leaves to the implementation taken exactly: the real
+        /// indices of the coat (or ambient) above and of the metal below (η1 + iκ1, not an
+        /// effective index of its F0 and F82 tint), tunnelling at the film's critical angle
+        /// (film_reflectance_exact). A dielectric film only; thickness 0 (the whole range at 0)
+        /// is no film: the metal's F82-tint Fresnel.
+        OpenPbrSpec,
     } metal_film = MetalFilm::Unsupported;
 
     /// Standard Surface's coat_affect_color = 1: ρ ← ρ^2 (its default 0 leaves ρ).

@@ -2,7 +2,8 @@
 // recipe of models/production/production_coat.h per model, with its flags. Sources, read for the
 // equations (no code copied):
 //   OpenPBR Surface 1.1 specification (Academy Software Foundation), "Coat" (darkening,
-//     view-dependent absorption, roughening) and "Layering" (albedo scaling);
+//     view-dependent absorption, roughening), "Layering" (albedo scaling) and "Thin-film
+//     iridescence";
 //   Adobe openpbr-bsdf (impl/openpbr_coating_lobe.h, impl/openpbr_bsdf.h; the reciprocal
 //     coat attenuation is the OPENPBR_RECIPROCAL_COAT_AND_FUZZ switch, off by default);
 //   Autodesk Standard Surface specification, "Coating";
@@ -45,6 +46,8 @@ CoatRecipe openpbr_recipe(const ModelOptions& o) {
     r.roughening =
         is_on(o, "roughening") ? CoatRecipe::Roughening::OpenPBR : CoatRecipe::Roughening::None;
     r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
+    // thin_film_weight 1 ("Thin-film iridescence"): the film on the metal under the coat.
+    r.metal_film = CoatRecipe::MetalFilm::OpenPbrSpec;
     // specular_roughness_anisotropy and coat_roughness_anisotropy ("Specular", "Coat").
     r.anisotropic_roughness = true;
     if (exact_leaves(o)) use_exact_leaves(r);
