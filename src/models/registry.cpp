@@ -130,6 +130,12 @@ const std::vector<ModelEntry>& model_registry() {
                 "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R, T "
                 "(slab)",
                 kBelcour),
+        variant("wb20",
+                "Weier & Belcour 2020: Bel18 forward with 2x2 lobe covariances, each lobe an "
+                "anisotropic GGX",
+                "bases: conductor, dielectric; media: absorbing, forward-scattering; anisotropic "
+                "interfaces with their tangents; sides: R",
+                kBelcour, "successors", /*represents_anisotropy=*/true),
         variant("tm2",
                 "Randrianandrasana et al. 2021 transfer matrices: lobes by energy and HG asymmetry "
                 "(conductor base: plugin tm2, exact top; slab: tm2_dielectric, transmitted lobe)",
