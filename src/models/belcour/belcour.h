@@ -3,8 +3,10 @@
 // statistical operators", ACM TOG 37(4) (SIGGRAPH): the BRDF is a sum of GGX lobes, one per
 // interface, whose energies and roughnesses come from tracking three statistics of a lobe
 // (energy per RGB, mean cosine, scalar variance) through the stack with an adding–doubling
-// scheme (docs/models.md, "Belcour 2018", "Bel'"; paper §4–6). Bel18 forward, Bel18 symmetric and
-// Bel' are one engine with the choices below; each variant is its defaults (belcour_variant).
+// scheme (docs/models.md, "Belcour 2018", "Bel'"; paper §4–6). Bel18 forward, Bel18 symmetric,
+// Bel' and WB20 (Weier & Belcour 2020, JCGT 9(2): the same scheme with 2×2 lobe covariances for
+// anisotropic interfaces; docs/models.md, "Weier & Belcour 2020") are one engine with the choices
+// below; each variant is its defaults (belcour_variant).
 
 #include "models/model.h"
 #include "models/model_options.h"
