@@ -43,8 +43,8 @@ const ModelFamily<WWChoices> kWeidlichWilkie{
     [](const std::string&) -> const ModelOptionTable<WWChoices>& { return ww_option_table(); },
     ww_variant, make_ww_model};
 const ModelFamily<BelcourChoices> kBelcour{
-    [](const std::string&) -> const ModelOptionTable<BelcourChoices>& {
-        return belcour_option_table();
+    [](const std::string& n) -> const ModelOptionTable<BelcourChoices>& {
+        return n == "wb20" ? wb20_option_table() : belcour_option_table();
     },
     belcour_variant, make_belcour_model};
 const ModelFamily<TmChoices> kTransferMatrix{tm_option_table, tm_variant, make_tm_model};

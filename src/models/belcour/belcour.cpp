@@ -97,7 +97,8 @@ struct CovarianceVariance {
     V t12(const BelcourOperator& op) const { return op.cov_t12; }
     V t21(const BelcourOperator& op) const { return op.cov_t21; }
     V isotropic(double v) const { return {v, v, 0}; }
-    double scalar(const V& v) const { return v.along(dx, dy); }
+    bool mean;  ///< read the mean over azimuths instead (energy-roughness=mean)
+    double scalar(const V& v) const { return mean ? 0.5 * (v.xx + v.yy) : v.along(dx, dy); }
     /// An anisotropic interface reads the roughness along the incident azimuth, never its α.
     bool reads_own_alpha(const V&) const { return false; }
     void set_lobe(BelcourStats::Lobe& lobe, const V& v, double) const {
@@ -288,7 +289,9 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
 
 BelcourStats belcour_adding_anisotropic(const std::vector<BelcourOperator>& ops, double c0,
                                         const BelcourChoices& ch, double dir_x, double dir_y) {
-    return adding_impl(ops, c0, ch, CovarianceVariance{ch.quadratic_mapping, dir_x, dir_y});
+    return adding_impl(
+        ops, c0, ch,
+        CovarianceVariance{ch.quadratic_mapping, dir_x, dir_y, ch.energy_roughness_mean});
 }
 
 void precompute_variances(std::vector<BelcourOperator>& ops, bool q) {
@@ -299,7 +302,7 @@ void precompute_variances(std::vector<BelcourOperator>& ops, bool q) {
         op.sigma_r = belcour_variance_of_alpha(op.alpha, q);
         op.sigma_t12 = belcour_variance_of_alpha(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
         op.sigma_t21 = belcour_variance_of_alpha(op.alpha * 0.5 * std::abs(1 - op.n12), q);
-        const CovarianceVariance cov{q, 1, 0};
+        const CovarianceVariance cov{q, 1, 0, false};
         op.cov_r = cov.of_alpha(op, scale_identity, 0, 0);
         op.cov_t12 = cov.of_alpha(op, scale_t12_code, op.n12, 0);
         op.cov_t21 = cov.of_alpha(op, scale_t21_code, op.n12, 0);
@@ -551,9 +554,11 @@ std::unique_ptr<IncidentEvaluator> BelcourModel::prepare(const Vec3d& wi) const 
 
 }  // namespace
 
-const ModelOptionTable<BelcourChoices>& belcour_option_table() {
+namespace {
+
+std::vector<ModelOption<BelcourChoices>> belcour_options() {
     using C = BelcourChoices;
-    static const ModelOptionTable<C> table({
+    return {
         member_option<C, bool>(
             "cosine", &C::symmetric, {{"forward", false}, {"symmetric", true}},
             "cosine fed to the adding scheme: mu_i (forward) or |wi.h| (symmetric, reciprocal)"),
@@ -581,7 +586,26 @@ const ModelOptionTable<BelcourChoices>& belcour_option_table() {
                                "a medium widens the lobes by the HG variance of its g when it "
                                "scatters, or every medium by its g (the author's operator with "
                                "the stack's g)"),
-    });
+    };
+}
+
+}  // namespace
+
+const ModelOptionTable<BelcourChoices>& belcour_option_table() {
+    static const ModelOptionTable<BelcourChoices> table(belcour_options());
+    return table;
+}
+
+const ModelOptionTable<BelcourChoices>& wb20_option_table() {
+    using C = BelcourChoices;
+    static const ModelOptionTable<C> table([] {
+        std::vector<ModelOption<C>> options = belcour_options();
+        options.push_back(member_option<C, bool>(
+            "energy-roughness", &C::energy_roughness_mean, {{"incident", false}, {"mean", true}},
+            "roughness the FGD and TIR tables read for a covariance: along the incident azimuth "
+            "or its mean over azimuths"));
+        return options;
+    }());
     return table;
 }
 

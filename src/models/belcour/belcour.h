@@ -66,6 +66,9 @@ struct BelcourChoices {
     /// covariance (belcour_adding_anisotropic) and its lobe the anisotropic GGX of its
     /// eigen-decomposition.
     bool anisotropic = false;
+    /// WB20: the FGD and TIR tables read the roughness of the covariance along the incident azimuth
+    /// (false) or of its mean over azimuths, (Σxx + Σyy)/2 (true).
+    bool energy_roughness_mean = false;
 };
 
 /// A lobe's directional variance as a 2×2 covariance in the surface's frame (Weier & Belcour
@@ -153,11 +156,15 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
 /// TIR tables read the roughness of the variance along the incident azimuth (dir_x, dir_y) (unit;
 /// at normal incidence any). Lobe energies and alpha are as belcour_adding's when every interface
 /// is isotropic, up to rounding.
+/// choices.energy_roughness_mean: at (Σxx + Σyy)/2 instead.
 BelcourStats belcour_adding_anisotropic(const std::vector<BelcourOperator>& ops, double c0,
                                         const BelcourChoices& choices, double dir_x, double dir_y);
 
-/// The flags of the engine (the variant-fixed choices, exact_top and btdf, are not flags).
+/// The flags of the engine (the variant-fixed choices, exact_top, btdf and anisotropic, are not
+/// flags).
 const ModelOptionTable<BelcourChoices>& belcour_option_table();
+/// WB20's: the engine's and where the energies read their roughness.
+const ModelOptionTable<BelcourChoices>& wb20_option_table();
 /// The defaults of a variant: "bel18-forward", "bel18-symmetric", "bel-prime" or "wb20" (a
 /// programming error otherwise).
 BelcourChoices belcour_variant(const std::string& variant);

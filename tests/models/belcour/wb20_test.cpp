@@ -88,6 +88,30 @@ TEST(Wb20, BareBrushedConductorIsTheAnisotropicGgx) {
     EXPECT_LT(worst, 1e-9);
 }
 
+// energy-roughness=mean: the energy reads the roughness of the covariance's mean over azimuths,
+// α((σ(α_x) + σ(α_y))/2), whatever the incident azimuth.
+TEST(Wb20, EnergyRoughnessMeanReadsTheAzimuthalMean) {
+    const double ax = 0.1, ay = 0.4, psi = 30;
+    const InterfaceSpec g = test::gold(ax);
+    const Stack s = test::single(anisotropic(g, ax, ay, psi));
+    const ModelEntry& entry = find_model("wb20");
+    const auto model = entry.make(s, resolve_options(entry, {"energy-roughness=mean"}));
+    ASSERT_TRUE(model->support().brdf) << model->support().reason;
+    const GGX<double> ggx = GGX<double>::anisotropic(ax, ay, deg_to_rad(psi));
+    const double alpha_e = belcour_alpha_of_variance(
+        0.5 * (belcour_variance_of_alpha(ax, false) + belcour_variance_of_alpha(ay, false)), false);
+    const FgdTable& fgd = FgdTable::get();
+    for (double pi : {0.0, 75.0}) {
+        const Vec3d wi = dir(40, pi), wo = dir(30, 170);
+        const Vec3d h = normalize(wi + wo);
+        const double shape = ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
+        Rgbd expected;
+        for (int c = 0; c < 3; ++c)
+            expected[c] = fgd(wi.z, alpha_e, g.eta_rgb[c], g.k[c]) * shape;
+        EXPECT_LT(relative_difference(model->eval(wi, wo), expected), 1e-9) << pi;
+    }
+}
+
 // A smooth coat (η 1.5) over a brushed conductor, no TIR step: the coat adds no variance, so the
 // base's lobe has the covariance J (1 + rr) R(ψ) diag(σ(α_x), σ(α_y)) R(ψ)ᵀ, J = η cos θt / cos θi
 // the refraction Jacobian (Belcour 2018, §5.2) and rr = Ri0 R / (1 − Ri0 R) the inter-reflections
