@@ -43,8 +43,8 @@ const ModelFamily<WWChoices> kWeidlichWilkie{
     [](const std::string&) -> const ModelOptionTable<WWChoices>& { return ww_option_table(); },
     ww_variant, make_ww_model};
 const ModelFamily<BelcourChoices> kBelcour{
-    [](const std::string&) -> const ModelOptionTable<BelcourChoices>& {
-        return belcour_option_table();
+    [](const std::string& n) -> const ModelOptionTable<BelcourChoices>& {
+        return n == "wb20" ? wb20_option_table() : belcour_option_table();
     },
     belcour_variant, make_belcour_model};
 const ModelFamily<TmChoices> kTransferMatrix{tm_option_table, tm_variant, make_tm_model};
@@ -130,6 +130,12 @@ const std::vector<ModelEntry>& model_registry() {
                 "bases: conductor, dielectric; media: absorbing, forward-scattering; sides: R, T "
                 "(slab)",
                 kBelcour),
+        variant("wb20",
+                "Weier & Belcour 2020: Bel18 forward with 2x2 lobe covariances, each lobe an "
+                "anisotropic GGX",
+                "bases: conductor, dielectric; media: absorbing, forward-scattering; anisotropic "
+                "interfaces with their tangents; sides: R",
+                kBelcour, "successors", /*represents_anisotropy=*/true),
         variant("tm2",
                 "Randrianandrasana et al. 2021 transfer matrices: lobes by energy and HG asymmetry "
                 "(conductor base: plugin tm2, exact top; slab: tm2_dielectric, transmitted lobe)",

@@ -20,7 +20,7 @@ expect_output() {  # expect_output NAME PATTERN: the last command's output match
 }
 
 check models 0 "$lamina" models --options
-for m in ww09 ele10 ww-prime bel18-forward bel18-symmetric bel-prime tm2; do expect_output "models $m" "^$m "; done
+for m in ww09 ele10 ww-prime bel18-forward bel18-symmetric bel-prime wb20 tm2; do expect_output "models $m" "^$m "; done
 for m in openpbr openpbr-adobe standard-surface enterprise-pbr filament gltf-clearcoat \
     blender-principled kulla-conty; do expect_output "models $m" "^$m "; done
 expect_output "models groups" "^\[production\]"

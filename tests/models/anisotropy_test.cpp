@@ -1,8 +1,8 @@
 // Every deterministic model that represents anisotropy (ModelEntry::represents_anisotropy:
-// OpenPBR's coats, Unity's StackLit (its base), the Weidlich–Wilkie family; docs/models.md) on
-// anisotropic stacks: it reduces to its isotropic form as α_y → α_x, it turns with its interfaces'
-// tangents, and its sampler (where it has one) draws the density it claims. Energy, which differs
-// by model, is tested with each.
+// OpenPBR's coats, Unity's StackLit (its base), the Weidlich–Wilkie family, WB20; docs/models.md)
+// on anisotropic stacks: it reduces to its isotropic form as α_y → α_x, it turns with its
+// interfaces' tangents, and its sampler (where it has one) draws the density it claims. Energy,
+// which differs by model, is tested with each.
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
@@ -61,7 +61,7 @@ double relative_difference(const Rgbd& a, const Rgbd& b) {
 TEST(ModelAnisotropy, TheFamiliesThatRepresentIt) {
     const std::vector<std::string> names = anisotropic_models();
     for (const char* name :
-         {"openpbr", "openpbr-adobe", "unity-stacklit", "ww09", "ele10", "ww-prime"})
+         {"openpbr", "openpbr-adobe", "unity-stacklit", "ww09", "ele10", "ww-prime", "wb20"})
         EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
     EXPECT_FALSE(represents_anisotropic_coat("unity-stacklit"));
     EXPECT_TRUE(represents_anisotropic_coat("openpbr"));

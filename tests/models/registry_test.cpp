@@ -28,7 +28,7 @@ TEST(ModelRegistry, ListsTheSixModelsOfTheStudyAndTheRandomWalk) {
     EXPECT_EQ(by_group["2019"],
               (std::vector<std::string>{"ww09", "ele10", "ww-prime", "bel18-forward",
                                         "bel18-symmetric", "bel-prime"}));
-    EXPECT_EQ(by_group["successors"], (std::vector<std::string>{"tm2", "tm6", "ddb22"}));
+    EXPECT_EQ(by_group["successors"], (std::vector<std::string>{"wb20", "tm2", "tm6", "ddb22"}));
     EXPECT_EQ(by_group["lamina"], (std::vector<std::string>{"lamina-1", "lamina-coat"}));
     EXPECT_EQ(by_group["reference"], (std::vector<std::string>{"random-walk"}));
 }

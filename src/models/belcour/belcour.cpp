@@ -56,17 +56,85 @@ double mean(const Rgbd& x) {
 
 }  // namespace
 
+namespace {
+
+// The variance of the adding scheme as a number (Belcour 2018: one scalar per lobe) or as a 2×2
+// covariance in the surface's frame (Weier & Belcour 2020); the scheme is the same loop for both
+// (adding_impl), which reads the per-operator variances through these.
+struct ScalarVariance {
+    using V = double;
+    bool q;
+    V zero() const { return 0.0; }
+    V of_alpha(const BelcourOperator& op, double (*scale)(double, double, double), double a1,
+               double a2) const {
+        return belcour_variance_of_alpha(scale(op.alpha, a1, a2), q);
+    }
+    V reflection(const BelcourOperator& op) const { return op.sigma_r; }
+    V t12(const BelcourOperator& op) const { return op.sigma_t12; }
+    V t21(const BelcourOperator& op) const { return op.sigma_t21; }
+    V isotropic(double v) const { return v; }
+    double scalar(V v) const { return v; }
+    /// Nothing accumulated above: the interface's own (clamped) α is the roughness it reads.
+    bool reads_own_alpha(V v) const { return v == 0; }
+    void set_lobe(BelcourStats::Lobe& lobe, V v, double alpha) const {
+        lobe.alpha = alpha;
+        lobe.covariance = {v, v, 0};
+    }
+};
+
+struct CovarianceVariance {
+    using V = BelcourCovariance;
+    bool q;
+    double dx, dy;  ///< the incident azimuth (unit), along which the FGD tables read a roughness
+    V zero() const { return {}; }
+    V of_alpha(const BelcourOperator& op, double (*scale)(double, double, double), double a1,
+               double a2) const {
+        return BelcourCovariance::of_axes(belcour_variance_of_alpha(scale(op.alpha, a1, a2), q),
+                                          belcour_variance_of_alpha(scale(op.alpha_b, a1, a2), q),
+                                          op.tangent_cos, op.tangent_sin);
+    }
+    V reflection(const BelcourOperator& op) const { return op.cov_r; }
+    V t12(const BelcourOperator& op) const { return op.cov_t12; }
+    V t21(const BelcourOperator& op) const { return op.cov_t21; }
+    V isotropic(double v) const { return {v, v, 0}; }
+    bool mean;  ///< read the mean over azimuths instead (energy-roughness=mean)
+    double scalar(const V& v) const { return mean ? 0.5 * (v.xx + v.yy) : v.along(dx, dy); }
+    /// An anisotropic interface reads the roughness along the incident azimuth, never its α.
+    bool reads_own_alpha(const V&) const { return false; }
+    void set_lobe(BelcourStats::Lobe& lobe, const V& v, double) const {
+        lobe.covariance = v;
+        lobe.alpha = belcour_alpha_of_variance(std::max(v.xx, v.yy), q);
+    }
+};
+
+double scale_identity(double alpha, double, double) {
+    return alpha;
+}
+// α scalings of the transmission variances (a1, a2 their angle or index terms).
+double scale_paper(double alpha, double ratio, double) {
+    return alpha * 0.5 * std::abs(1 - ratio);  // Belcour 2018, Eq. 10 as lamina reads it
+}
+double scale_t12_code(double alpha, double n12, double) {
+    return alpha * 0.5 * std::abs(n12 - 1) / n12;
+}
+double scale_t21_code(double alpha, double n12, double) {
+    return alpha * 0.5 * std::abs(1 - n12);
+}
+
 // Kept in one piece (about 150 lines): Belcour 2018's adding of lobe statistics is one loop over
 // the operators whose steps (paper §4–6 and the author's code: the interface's statistics, the TIR
 // step, the adding sums, the medium) read best in the order the paper gives them.
-BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
-                            const BelcourChoices& ch) {
+template <typename Var>
+BelcourStats adding_impl(const std::vector<BelcourOperator>& ops, double c0,
+                         const BelcourChoices& ch, const Var& var) {
+    using V = typename Var::V;
     const FgdTable& fgd = FgdTable::get();
     BelcourStats out;
     const bool q = ch.quadratic_mapping;
     // Initial state (docs/models.md "Adding"): nothing reflected, everything transmitted.
     Rgbd R0i(0.0), Ri0(0.0), T0i(1.0), Ti0(1.0);
-    double sR0i = 0, sRi0 = 0, sT0i = 0, sTi0 = 0, J0i = 1, Ji0 = 1;
+    V sR0i = var.zero(), sRi0 = var.zero(), sT0i = var.zero(), sTi0 = var.zero();
+    double J0i = 1, Ji0 = 1;
     double c = std::max(c0, 1e-6);
     bool first_interface = true;
     bool last_was_dielectric = false, last_transmits = false;
@@ -77,17 +145,19 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
     for (std::size_t index = 0; index < ops.size(); ++index) {
         const BelcourOperator& op = ops[index];
         Rgbd R12(0.0), T12(0.0);
-        double sR12 = 0, sT12 = 0, sT21 = 0, J12 = 1, ct = c;
+        V sR12 = var.zero(), sT12 = var.zero(), sT21 = var.zero();
+        double J12 = 1, ct = c;
         bool transmits = false;
         double alpha_eff = 0;
         const bool is_interface = op.kind != BelcourOperator::Medium;
         if (is_interface) {
             const bool pre = op.precomputed && op.precomputed_quadratic == q;
-            sR12 = pre ? op.sigma_r : belcour_variance_of_alpha(op.alpha, q);
+            sR12 = pre ? var.reflection(op) : var.of_alpha(op, scale_identity, 0, 0);
             // Roughness the lobe sees: what was accumulated above plus this interface's own
             // (nothing above: α itself, α(σ(α)) = α).
-            alpha_eff =
-                pre && sT0i == 0 ? op.alpha_clamped : belcour_alpha_of_variance(sT0i + sR12, q);
+            alpha_eff = pre && var.reads_own_alpha(sT0i)
+                            ? op.alpha_clamped
+                            : belcour_alpha_of_variance(var.scalar(sT0i + sR12), q);
             if (op.kind == BelcourOperator::Dielectric) {
                 // Snell's law on the mean direction; TIR: no transmission.
                 const double sin2_t = (1 - c * c) / sqr(op.n12);
@@ -101,18 +171,12 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
                     if (ch.sigma_t_paper) {
                         // Belcour 2018, Eq. 10 as lamina reads it: the first-order deflection of
                         // a refracted ray by a microfacet tilt, |1 − η_i cos θi / (η_t cos θt)|/2.
-                        sT12 = belcour_variance_of_alpha(
-                            op.alpha * 0.5 * std::abs(1 - c / (op.n12 * ct)), q);
-                        sT21 = belcour_variance_of_alpha(
-                            op.alpha * 0.5 * std::abs(1 - op.n12 * ct / c), q);
+                        sT12 = var.of_alpha(op, scale_paper, c / (op.n12 * ct), 0);
+                        sT21 = var.of_alpha(op, scale_paper, op.n12 * ct / c, 0);
                     } else {
                         // The author's code (docs/models.md): angle-independent scalings.
-                        sT12 = pre ? op.sigma_t12
-                                   : belcour_variance_of_alpha(
-                                         op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
-                        sT21 = pre ? op.sigma_t21
-                                   : belcour_variance_of_alpha(
-                                         op.alpha * 0.5 * std::abs(1 - op.n12), q);
+                        sT12 = pre ? var.t12(op) : var.of_alpha(op, scale_t12_code, op.n12, 0);
+                        sT21 = pre ? var.t21(op) : var.of_alpha(op, scale_t21_code, op.n12, 0);
                     }
                 }
             } else {
@@ -130,8 +194,8 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
             const double L = 1 / c;
             const Rgbd tau_t = op.tau_a + op.tau_s;
             T12 = (Rgbd(1.0) + op.tau_s * L) * exp_rgb(tau_t * -L);
-            sT12 = sT21 =
-                op.tau_s.max() > 0 || ch.medium_variance_every_medium ? variance_hg(op.g) : 0.0;
+            sT12 = sT21 = var.isotropic(
+                op.tau_s.max() > 0 || ch.medium_variance_every_medium ? variance_hg(op.g) : 0.0);
             transmits = true;
         }
         if (is_interface && ch.tir == BelcourTir::EachInterface && eta_up != 1) {
@@ -141,7 +205,8 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
             total_internal_reflection(tir_fraction(ch.tir_table, c, alpha_eff, eta_up), Ri0, Ti0);
         }
         const Rgbd R21 = R12, T21 = T12;
-        const double sR21 = sR12, J21 = 1 / J12;
+        const V sR21 = sR12;
+        const double J21 = 1 / J12;
 
         // Adding (docs/models.md): Dn = 1 − Ri0·R12 sums the inter-reflections between this
         // operator and everything above.
@@ -152,11 +217,14 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         const double rr = mean(Ri0 * R12 / Dn);
         if (is_interface && out.n_lobes < BelcourStats::kMaxLobes) {
             // The lobe variance uses J0i before this layer, as the author's code does.
-            const double sigma_k = sTi0 + J0i * (sT0i + sR12 + rr * (sR12 + sRi0));
+            const V sigma_k = sTi0 + J0i * (sT0i + sR12 + rr * (sR12 + sRi0));
             const bool only_own = op.precomputed && op.precomputed_quadratic == q &&
                                   sigma_k == sR12;  // nothing accumulated: α itself
-            out.lobes[out.n_lobes++] = {
-                E, only_own ? op.alpha_clamped : belcour_alpha_of_variance(sigma_k, q)};
+            BelcourStats::Lobe& lobe = out.lobes[out.n_lobes++];
+            lobe.energy = E;
+            var.set_lobe(
+                lobe, sigma_k,
+                only_own ? op.alpha_clamped : belcour_alpha_of_variance(var.scalar(sigma_k), q));
             const double w_old = mean(R0i), w_new = mean(E);
             if (w_old + w_new > 0) sR0i = (w_old * sR0i + w_new * sigma_k) / (w_old + w_new);
         }
@@ -165,14 +233,14 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
         const Rgbd new_T0i = T0i * T12 / Dn;
         const Rgbd new_Ri0 = R21 + through;
         const Rgbd new_Ti0 = T21 * Ti0 / Dn;
-        const double new_sT0i = J12 * sT0i + sT12 + J12 * (sR12 + sRi0) * rr;
+        const V new_sT0i = J12 * sT0i + sT12 + J12 * (sR12 + sRi0) * rr;
         const double norm = mean(new_Ri0);
-        const double new_sRi0 =
+        const V new_sRi0 =
             norm > 0 ? (mean(R21) * sR21 +
                         mean(through) * (sT12 + J12 * (sT21 + sRi0 + rr * (sR12 + sRi0)))) /
                            norm
-                     : 0.0;
-        const double new_sTi0 = Ji0 * sT21 + sTi0 + Ji0 * (sR12 + sRi0) * rr;
+                     : var.zero();
+        const V new_sTi0 = Ji0 * sT21 + sTi0 + Ji0 * (sR12 + sRi0) * rr;
         T0i = new_T0i;
         Ri0 = new_Ri0;
         Ti0 = new_Ti0;
@@ -205,10 +273,25 @@ BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
     if (last_was_dielectric && last_transmits) {
         out.transmits = true;
         out.transmitted = T0i;
-        out.alpha_t = belcour_alpha_of_variance(sT0i, q);
+        out.alpha_t = belcour_alpha_of_variance(var.scalar(sT0i), q);
+        out.covariance_t = BelcourCovariance(sT0i);
         out.cos_t = c;
     }
     return out;
+}
+
+}  // namespace
+
+BelcourStats belcour_adding(const std::vector<BelcourOperator>& ops, double c0,
+                            const BelcourChoices& ch) {
+    return adding_impl(ops, c0, ch, ScalarVariance{ch.quadratic_mapping});
+}
+
+BelcourStats belcour_adding_anisotropic(const std::vector<BelcourOperator>& ops, double c0,
+                                        const BelcourChoices& ch, double dir_x, double dir_y) {
+    return adding_impl(
+        ops, c0, ch,
+        CovarianceVariance{ch.quadratic_mapping, dir_x, dir_y, ch.energy_roughness_mean});
 }
 
 void precompute_variances(std::vector<BelcourOperator>& ops, bool q) {
@@ -219,6 +302,10 @@ void precompute_variances(std::vector<BelcourOperator>& ops, bool q) {
         op.sigma_r = belcour_variance_of_alpha(op.alpha, q);
         op.sigma_t12 = belcour_variance_of_alpha(op.alpha * 0.5 * std::abs(op.n12 - 1) / op.n12, q);
         op.sigma_t21 = belcour_variance_of_alpha(op.alpha * 0.5 * std::abs(1 - op.n12), q);
+        const CovarianceVariance cov{q, 1, 0, false};
+        op.cov_r = cov.of_alpha(op, scale_identity, 0, 0);
+        op.cov_t12 = cov.of_alpha(op, scale_t12_code, op.n12, 0);
+        op.cov_t21 = cov.of_alpha(op, scale_t21_code, op.n12, 0);
         for (int i = 0; i < 3; ++i)
             op.fgd_index[i] = op.kind == BelcourOperator::Conductor
                                   ? FgdTable::locate(op.eta[i], op.k[i])
@@ -237,10 +324,35 @@ double ggx_lobe_shape(double alpha, const Vec3d& wi, const Vec3d& wo, const Vec3
     return ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
 }
 
+BelcourAnisotropicLobe belcour_lobe_of_covariance(const BelcourCovariance& c, bool q) {
+    // Eigen-decomposition of the symmetric 2×2 covariance: λ = m ± r, m the mean of the diagonal,
+    // r = √(((xx − yy)/2)² + xy²); the major axis at ψ = atan2(2 xy, xx − yy)/2.
+    const double m = 0.5 * (c.xx + c.yy), d = 0.5 * (c.xx - c.yy);
+    const double r = std::hypot(d, c.xy);
+    BelcourAnisotropicLobe lobe;
+    lobe.alpha_x = belcour_alpha_of_variance(m + r, q);
+    lobe.alpha_y = belcour_alpha_of_variance(m - r, q);
+    lobe.psi = r > 0 ? 0.5 * std::atan2(c.xy, d) : 0.0;
+    return lobe;
+}
+
 namespace {
 
 double lobe_shape(double alpha, const Vec3d& wi, const Vec3d& wo, const Vec3d& h) {
     return ggx_lobe_shape(alpha, wi, wo, h);
+}
+
+// Weier & Belcour 2020: a lobe as the anisotropic GGX of its covariance, D G2 / (4 μi μo) with
+// the energy factored out; the isotropic lobe (ggx_lobe_shape) when its axes are equal.
+double anisotropic_lobe_shape(const BelcourCovariance& cov, bool q, const Vec3d& wi,
+                              const Vec3d& wo, const Vec3d& h) {
+    const BelcourAnisotropicLobe l = belcour_lobe_of_covariance(cov, q);
+    if (l.alpha_x <= 0) return 0;
+    if (l.alpha_y == l.alpha_x) return ggx_lobe_shape(l.alpha_x, wi, wo, h);
+    constexpr double kAlphaMin = 1e-4;  // as ggx_lobe_shape: a finite peak for a mirror axis
+    const GGX<double> ggx = GGX<double>::anisotropic(std::max(l.alpha_x, kAlphaMin),
+                                                     std::max(l.alpha_y, kAlphaMin), l.psi);
+    return ggx.D(h) * ggx.G2(wi, wo) / (4 * wi.z * wo.z);
 }
 
 class BelcourModel final : public Model {
@@ -253,6 +365,9 @@ class BelcourModel final : public Model {
             const double above = stack.eta_above(i);
             BelcourOperator op;
             op.alpha = s.alpha;
+            op.alpha_b = s.alpha_b();
+            op.tangent_cos = std::cos(deg_to_rad(s.tangent_deg));
+            op.tangent_sin = std::sin(deg_to_rad(s.tangent_deg));
             switch (s.type) {
                 case InterfaceType::Lambertian:
                     support_.reason = fmt::format("{} has no Lambertian base", name_);
@@ -309,17 +424,24 @@ class BelcourModel final : public Model {
     std::string name() const override { return name_; }
     Support support() const override { return support_; }
 
-    BelcourStats stats(double c0) const { return belcour_adding(ops_, c0, ch_); }
+    BelcourStats stats(double c0, const Vec3d& wi) const {
+        if (!ch_.anisotropic) return belcour_adding(ops_, c0, ch_);
+        // The incident azimuth, along which the energies read their roughness (any at normal
+        // incidence, where an anisotropic lobe has no preferred azimuth).
+        const double s = std::hypot(wi.x, wi.y);
+        return s > 0 ? belcour_adding_anisotropic(ops_, c0, ch_, wi.x / s, wi.y / s)
+                     : belcour_adding_anisotropic(ops_, c0, ch_, 1, 0);
+    }
 
     Rgbd eval(const Vec3d& wi, const Vec3d& wo) const override {
         if (!support_.brdf || wi.z <= 0 || wo.z == 0) return Rgbd(0.0);
         if (wo.z > 0) {
             const Vec3d h = normalize(wi + wo);
             const double c0 = ch_.symmetric ? std::abs(dot(wi, h)) : wi.z;
-            return eval_with(stats(c0), wi, wo);
+            return eval_with(stats(c0, wi), wi, wo);
         }
         if (!support_.btdf) return Rgbd(0.0);
-        return eval_with(stats(wi.z), wi, wo);
+        return eval_with(stats(wi.z, wi), wi, wo);
     }
 
     /// Sum of the lobes for precomputed statistics (forward: depend only on wi).
@@ -332,7 +454,10 @@ class BelcourModel final : public Model {
                 f += exact_top(wi, wo, h);
                 continue;
             }
-            f += st.lobes[k].energy * lobe_shape(st.lobes[k].alpha, wi, wo, h);
+            f += st.lobes[k].energy *
+                 (ch_.anisotropic ? anisotropic_lobe_shape(st.lobes[k].covariance,
+                                                           ch_.quadratic_mapping, wi, wo, h)
+                                  : lobe_shape(st.lobes[k].alpha, wi, wo, h));
         }
         return f;
     }
@@ -342,7 +467,7 @@ class BelcourModel final : public Model {
     std::vector<DeltaLobe> delta_lobes(const Vec3d& wi) const override {
         std::vector<DeltaLobe> out;
         if (!support_.brdf || wi.z <= 0) return out;
-        const BelcourStats st = stats(wi.z);  // at the mirror pair |wi·h| = μi: both variants
+        const BelcourStats st = stats(wi.z, wi);  // at the mirror pair |wi·h| = μi: both variants
         const Vec3d wr = mirror_direction(wi);
         for (int k = 0; k < st.n_lobes; ++k) {
             if (k == 0 && ch_.exact_top) {
@@ -360,7 +485,7 @@ class BelcourModel final : public Model {
     std::vector<Vec3d> peak_directions(const Vec3d& wi) const override {
         std::vector<Vec3d> peaks{mirror_direction(wi)};
         if (support_.btdf) {
-            const BelcourStats st = stats(wi.z);
+            const BelcourStats st = stats(wi.z, wi);
             if (st.transmits) peaks.push_back(transmitted_direction(wi, st.cos_t));
         }
         return peaks;
@@ -410,7 +535,7 @@ class BelcourModel final : public Model {
 class BelcourForwardEvaluator final : public IncidentEvaluator {
   public:
     BelcourForwardEvaluator(const BelcourModel& model, const Vec3d& wi)
-        : model_(model), wi_(wi), stats_(model.stats(wi.z)) {}
+        : model_(model), wi_(wi), stats_(model.stats(wi.z, wi)) {}
     Rgbd eval(const Vec3d& wo) const override {
         if (wi_.z <= 0 || wo.z == 0) return Rgbd(0.0);
         return model_.eval_with(stats_, wi_, wo);
@@ -429,9 +554,11 @@ std::unique_ptr<IncidentEvaluator> BelcourModel::prepare(const Vec3d& wi) const 
 
 }  // namespace
 
-const ModelOptionTable<BelcourChoices>& belcour_option_table() {
+namespace {
+
+std::vector<ModelOption<BelcourChoices>> belcour_options() {
     using C = BelcourChoices;
-    static const ModelOptionTable<C> table({
+    return {
         member_option<C, bool>(
             "cosine", &C::symmetric, {{"forward", false}, {"symmetric", true}},
             "cosine fed to the adding scheme: mu_i (forward) or |wi.h| (symmetric, reciprocal)"),
@@ -459,7 +586,26 @@ const ModelOptionTable<BelcourChoices>& belcour_option_table() {
                                "a medium widens the lobes by the HG variance of its g when it "
                                "scatters, or every medium by its g (the author's operator with "
                                "the stack's g)"),
-    });
+    };
+}
+
+}  // namespace
+
+const ModelOptionTable<BelcourChoices>& belcour_option_table() {
+    static const ModelOptionTable<BelcourChoices> table(belcour_options());
+    return table;
+}
+
+const ModelOptionTable<BelcourChoices>& wb20_option_table() {
+    using C = BelcourChoices;
+    static const ModelOptionTable<C> table([] {
+        std::vector<ModelOption<C>> options = belcour_options();
+        options.push_back(member_option<C, bool>(
+            "energy-roughness", &C::energy_roughness_mean, {{"incident", false}, {"mean", true}},
+            "roughness the FGD and TIR tables read for a covariance: along the incident azimuth "
+            "or its mean over azimuths"));
+        return options;
+    }());
     return table;
 }
 
@@ -477,6 +623,10 @@ BelcourChoices belcour_variant(const std::string& variant) {
         // reflection lobe with those statistics.
         c.exact_top = true;
         c.btdf = true;
+    } else if (variant == "wb20") {
+        // Weier & Belcour 2020, "Rendering layered materials with anisotropic interfaces", JCGT
+        // 9(2): Bel18 forward with each variance a 2×2 covariance (docs/models.md, "WB20").
+        c.anisotropic = true;
     } else {
         // Bel18 forward: the adding scheme fed the incident direction's own cosine c0 = μi (as in
         // the author's renderer); the lobe statistics then depend only on wi, so the study
