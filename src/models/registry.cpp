@@ -131,8 +131,8 @@ const std::vector<ModelEntry>& model_registry() {
                 "(slab)",
                 kBelcour),
         variant("wb20",
-                "Weier & Belcour 2020: Bel18 forward with 2x2 lobe covariances, each lobe an "
-                "anisotropic GGX",
+                "after Weier & Belcour 2020: Bel18 forward with 2x2 lobe covariances (Bel18's "
+                "variance map per axis, not the paper's refit), each lobe an anisotropic GGX",
                 "bases: conductor, dielectric; media: absorbing, forward-scattering; anisotropic "
                 "interfaces with their tangents; sides: R",
                 kBelcour, "successors", /*represents_anisotropy=*/true),
