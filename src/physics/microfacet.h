@@ -171,10 +171,14 @@ LAMINA_LANE_INLINE LaneVec3<T> ggx_sample_visible_normal_complete(const GgxLanes
     const LaneVec3<T> wh = lane_normalize<T, L>({wx, wy, w.z});
     T cos_phi, sin_phi;
     L::cos_sin_2pi(u1, cos_phi, sin_phi);
-    const T z = (one - u2) * (one + wh.z) - wh.z;
+    const T cap_height = (one - u2) * (one + wh.z);  // z + wh.z, the halfway vector's height
+    const T z = cap_height - wh.z;
     const T sin_theta = L::sqrt(L::max(L::neg_mul_add(z, z, one), L::constant(0)));
     T hx = L::mul_add(sin_theta, cos_phi, wh.x), hy = L::mul_add(sin_theta, sin_phi, wh.y);
-    const T hz = z + wh.z;
+    // h.z = z + wh.z taken as (1 − u2)(1 + wh.z) itself: the sum cancels at the cap's rim
+    // (u2 → 1), where its rounding could leave it ≤ 0 — a horizontal normal, a failed sample —
+    // for a cap point strictly above −wh.
+    const T hz = cap_height;
     ggx_stretch<T, L>(g, hx, hy);
     return lane_normalize<T, L>({hx, hy, L::max(hz, L::constant(0))});
 }
