@@ -63,16 +63,24 @@ INSTANTIATE_TEST_SUITE_P(Kernels, Goniophotometer, ::testing::Values(Kernel::Sca
 // |estimate − exact| < 5 se holds with probability 1 − 6e-7.
 
 // A white furnace with microsurface multiple scattering: every particle is reflected or
-// transmitted (nothing lost in a microsurface, nothing cut off, no degenerate sample).
+// transmitted (nothing lost in a microsurface, nothing cut off) but for degenerate samples. A walk
+// that meets a facet exactly at grazing — a visible normal drawn at the rim of its cap, u2 within
+// float rounding of 1, about 2^-23 of the facet samples — rounds the facet's cosine to ≤ 0 and
+// loses its particle as a counted degenerate sample: measure zero in exact arithmetic, a few in
+// 10^7 particles in float (seen: one of 3·10^5 on an AMD EPYC). The loss must be exactly those
+// samples, and at most 3 of an incidence's particles (at most a few facets a particle, the mean is
+// below 0.1 per 10^5 particles: 4 or more has a probability below 10^-5).
 void expect_white_furnace_loses_nothing(const SimulationResult& r) {
     for (const IncidenceStats& st : r.incidences) {
         const EnergyBudget& b = st.budget;
+        const double degenerate = double(st.degenerate_samples) / double(r.settings.particles);
         for (int c = 0; c < 3; ++c) {
-            EXPECT_NEAR(b[BudgetTerm::Reflected][c] + b[BudgetTerm::Transmitted][c], 1.0, 1e-6);
-            EXPECT_EQ(b[BudgetTerm::LostMicrosurface][c], 0.0);
+            EXPECT_NEAR(b[BudgetTerm::Reflected][c] + b[BudgetTerm::Transmitted][c],
+                        1.0 - degenerate, 1e-6);
+            EXPECT_NEAR(b[BudgetTerm::LostMicrosurface][c], degenerate, 1e-12);
             EXPECT_EQ(b[BudgetTerm::CutOff][c], 0.0);
         }
-        EXPECT_EQ(st.degenerate_samples, 0u);
+        EXPECT_LE(st.degenerate_samples, 3u);
     }
 }
 
