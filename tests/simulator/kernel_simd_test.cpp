@@ -417,10 +417,11 @@ TEST(KernelSimd, GgxLanes) {
             // 2^-23 / sin θ, unbounded at the cap's pole (z → 1, u2 → 0).
             const double z_cap = (1 - double(u2[j])) * extent - (extent - 1);
             const double sin_cap = std::sqrt(std::max(1 - z_cap * z_cap, 1e-12));
-            // The halfway vector's h.z = z + wh.z cancels to (1 − u2)(1 + wh.z) as u2 → 1 (the
-            // cap point at the cap's rim): z's rounding on either side (2^-24 |z|) and the
-            // vector's 2^-22 in h.x, h.y stay absolute there, and the final normalization divides
-            // them by |h'|, h' = (α h.x, α h.y, h.z) — in exact arithmetic, from double here.
+            // Near the cap's rim (u2 → 1) the halfway vector h' = (α h.x, α h.y, h.z) is short:
+            // the rounding of the cap point (2^-24 |z| on either side; the sampler takes h.z as
+            // (1 − u2)(1 + wh.z), without the cancelling z + wh.z) and the vector's 2^-22 in h.x,
+            // h.y stay absolute, and the final normalization divides them by |h'| — in exact
+            // arithmetic, from double here.
             const double whz = double(wj.z) / std::sqrt(ax * ax + ay * ay + double(wj.z) * wj.z);
             const double phi_cap = 2 * kPi<double> * double(u1[j]);
             const double hz = (1 - double(u2[j])) * (1 + whz),
