@@ -25,6 +25,7 @@ namespace {
 
 using test::brushed;
 using test::dir;
+using test::relative_difference;
 
 /// The registry's deterministic models that represent anisotropy.
 std::vector<std::string> anisotropic_models() {
@@ -47,15 +48,6 @@ std::vector<Vec3d> directions() {
 /// its checks run with the coat isotropic).
 bool represents_anisotropic_coat(const std::string& name) {
     return make_model(name, brushed(0.3, 0.08, 20, 0.1, 0.1, 0))->support().brdf;
-}
-
-double relative_difference(const Rgbd& a, const Rgbd& b) {
-    double worst = 0;
-    for (int c = 0; c < 3; ++c)
-        if (a[c] != b[c])
-            worst =
-                std::max(worst, std::abs(a[c] - b[c]) / std::max(std::abs(a[c]), std::abs(b[c])));
-    return worst;
 }
 
 TEST(ModelAnisotropy, TheFamiliesThatRepresentIt) {

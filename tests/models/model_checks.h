@@ -9,10 +9,21 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
 namespace lamina::test {
+
+/// |a − b| / max(|a|, |b|) in the channel where it is largest (0 where they are equal).
+inline double relative_difference(const Rgbd& a, const Rgbd& b) {
+    double worst = 0;
+    for (int c = 0; c < 3; ++c)
+        if (a[c] != b[c])
+            worst =
+                std::max(worst, std::abs(a[c] - b[c]) / std::max(std::abs(a[c]), std::abs(b[c])));
+    return worst;
+}
 
 /// prepare(wi) evaluates exactly as eval(wi, ·), on both sides, in and out of the incidence plane.
 inline void expect_prepared_equals_eval(const Model& model, const Vec3d& wi) {

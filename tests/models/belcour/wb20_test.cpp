@@ -11,6 +11,8 @@
 #include "models/test_stacks.h"
 #include "physics/microfacet.h"
 
+#include "models/model_checks.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -20,15 +22,7 @@ namespace {
 
 using test::brushed;
 using test::dir;
-
-double relative_difference(const Rgbd& a, const Rgbd& b) {
-    double worst = 0;
-    for (int c = 0; c < 3; ++c)
-        if (a[c] != b[c])
-            worst =
-                std::max(worst, std::abs(a[c] - b[c]) / std::max(std::abs(a[c]), std::abs(b[c])));
-    return worst;
-}
+using test::relative_difference;
 
 // Isotropic interfaces: every covariance is σ I and the energies read α(σ), so wb20 is
 // bel18-forward up to rounding (coats, media, conductor and dielectric bases).
