@@ -5,6 +5,7 @@
 #include "models/production/cycles_albedo.h"
 #include "models/production/filament_dfg.h"
 #include "models/production/film_fresnel.h"
+#include "models/production/lobe_mixture.h"
 #include "models/production/threejs_dfg.h"
 #include "models/production/uncorrelated_albedo.h"
 #include "models/tables/fgd_table.h"
@@ -351,43 +352,20 @@ class ProductionCoat final : public Model {
         return lobes;
     }
 
-    /// Importance sampling: the coat lobe's visible normals (Heitz 2018) with probability p_c,
-    /// else the base (its GGX visible normals, or the cosine for a Lambertian). p_c is the coat's
-    /// Fresnel at μi (clamped to [0.1, 0.9]), 0 when the coat is smooth (a delta lobe, not
-    /// sampled here), 1 when the base is a smooth metal.
+    /// Importance sampling (models/production/lobe_mixture.h): the coat lobe's visible normals with
+    /// probability p_c, else the base (its GGX visible normals, or the cosine for a Lambertian).
+    /// p_c is the coat's Fresnel at μi (clamped to [0.1, 0.9]), 0 when the coat is smooth (a delta
+    /// lobe, not sampled here), 1 when the base is a smooth metal.
     bool has_sampling() const override { return support_.brdf && sampled_lobes() > 0; }
 
     std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override {
         if (!has_sampling() || wi.z <= 0) return std::nullopt;
-        const double p_c = coat_probability(wi);
-        Vec3d wo;
-        if (u.z < p_c) {
-            wo = reflect(wi, coat_ggx_.sample_visible_normal(wi, u.x, u.y));
-        } else if (is_metal_) {
-            wo = reflect(wi, base_ggx_.sample_visible_normal(wi, u.x, u.y));
-        } else {
-            wo = sample_cosine_hemisphere(u.x, u.y);
-        }
-        if (wo.z <= 0) return std::nullopt;
-        const double density = pdf(wi, wo);
-        if (!(density > 0)) return std::nullopt;
-        return ModelSample{wo, eval(wi, wo) * (wo.z / density), density};
+        return sample_lobe_mixture(*this, proposal(wi), wi, u);
     }
 
     double pdf(const Vec3d& wi, const Vec3d& wo) const override {
         if (!has_sampling() || wi.z <= 0 || wo.z <= 0) return 0;
-        const double p_c = coat_probability(wi);
-        const Vec3d h = normalize(wi + wo);
-        const double jacobian = 1 / (4 * dot(wo, h));  // dωh/dωo for reflection
-        double p = 0;
-        if (p_c > 0) p += p_c * coat_ggx_.pdf_visible_normal(wi, h) * jacobian;
-        if (p_c < 1) {
-            if (is_metal_)
-                p += (1 - p_c) * base_ggx_.pdf_visible_normal(wi, h) * jacobian;
-            else
-                p += (1 - p_c) * pdf_cosine_hemisphere(wo);
-        }
-        return p;
+        return proposal(wi).pdf(wi, wo);
     }
 
   private:
@@ -410,6 +388,16 @@ class ProductionCoat final : public Model {
         if (alpha_coat_ <= 0) return 0;
         if (is_metal_ && alpha_base_ <= 0) return 1;
         return clamp(coat_fresnel(wi.z), 0.1, 0.9);
+    }
+
+    /// The sampling mixture: the coat lobe with p_c, the rest to the metal's lobe or the cosine.
+    ReflectionLobeMixture proposal(const Vec3d& wi) const {
+        ReflectionLobeMixture m;
+        m.coat = coat_probability(wi);
+        m.coat_lobe = coat_ggx_;
+        m.base_lobe = base_ggx_;
+        m.diffuse = !is_metal_;
+        return m;
     }
 
     bool uses_albedo() const {

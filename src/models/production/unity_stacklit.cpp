@@ -9,6 +9,7 @@
 #include "core/math.h"
 #include "models/belcour/belcour.h"
 #include "models/production/filament_dfg.h"
+#include "models/production/lobe_mixture.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
 #include "physics/sampling.h"
@@ -303,39 +304,20 @@ class UnityStackLit final : public Model {
                v.base_energy * v.base_compensation * base + rho_ * v.diffuse * kInvPi<double>;
     }
 
-    /// Importance sampling: the coat lobe's visible normals (Heitz 2018) with probability p_c,
-    /// the coat's Fresnel at μi clamped to [0.1, 0.9]; else the base's lobe (GGX visible normals
-    /// at the roughness the base has when viewed along wi) — for a diffuse base one time in five,
-    /// the cosine otherwise.
+    /// Importance sampling (models/production/lobe_mixture.h): the coat lobe's visible normals with
+    /// probability p_c, the coat's Fresnel at μi clamped to [0.1, 0.9]; else the base's lobe (GGX
+    /// visible normals at the roughness the base has when viewed along wi) — for a diffuse base one
+    /// time in five, the cosine otherwise.
     bool has_sampling() const override { return support_.brdf; }
 
     std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override {
         if (!has_sampling() || wi.z <= 0) return std::nullopt;
-        const Proposal p = proposal(wi);
-        Vec3d wo;
-        if (u.z < p.coat) {
-            wo = reflect(wi, GGX<double>{alpha_coat_lobe_}.sample_visible_normal(wi, u.x, u.y));
-        } else if (u.z < p.coat + p.base_weight) {
-            wo = reflect(wi, p.base.sample_visible_normal(wi, u.x, u.y));
-        } else {
-            wo = sample_cosine_hemisphere(u.x, u.y);
-        }
-        if (wo.z <= 0) return std::nullopt;
-        const double density = pdf(wi, wo);
-        if (!(density > 0)) return std::nullopt;
-        return ModelSample{wo, eval(wi, wo) * (wo.z / density), density};
+        return sample_lobe_mixture(*this, proposal(wi), wi, u);
     }
 
     double pdf(const Vec3d& wi, const Vec3d& wo) const override {
         if (!has_sampling() || wi.z <= 0 || wo.z <= 0) return 0;
-        const Proposal p = proposal(wi);
-        const Vec3d h = normalize(wi + wo);
-        const double jacobian = 1 / (4 * dot(wo, h));  // dωh/dωo for reflection
-        double density =
-            p.coat * GGX<double>{alpha_coat_lobe_}.pdf_visible_normal(wi, h) * jacobian +
-            p.base_weight * p.base.pdf_visible_normal(wi, h) * jacobian;
-        if (!is_metal_) density += (1 - p.coat - p.base_weight) * pdf_cosine_hemisphere(wo);
-        return density;
+        return proposal(wi).pdf(wi, wo);
     }
 
   private:
@@ -346,16 +328,14 @@ class UnityStackLit final : public Model {
                    : GGX<double>::anisotropic(v.alpha_base, v.alpha_base_b, tangent_rad_);
     }
 
-    struct Proposal {
-        double coat = 0, base_weight = 0;
-        GGX<double> base{0.0};
-    };
-    Proposal proposal(const Vec3d& wi) const {
-        Proposal p;
-        p.coat = clamp(fresnel_dielectric(wi.z, eta0_), 0.1, 0.9);
-        p.base_weight = is_metal_ ? 1 - p.coat : 0.2 * (1 - p.coat);
-        p.base = base_lobe(view(wi.z));
-        return p;
+    ReflectionLobeMixture proposal(const Vec3d& wi) const {
+        ReflectionLobeMixture m;
+        m.coat = clamp(fresnel_dielectric(wi.z, eta0_), 0.1, 0.9);
+        m.base = is_metal_ ? 1 - m.coat : 0.2 * (1 - m.coat);
+        m.coat_lobe = GGX<double>{alpha_coat_lobe_};
+        m.base_lobe = base_lobe(view(wi.z));
+        m.diffuse = !is_metal_;
+        return m;
     }
 
     Support support_;
