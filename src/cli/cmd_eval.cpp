@@ -2,6 +2,7 @@
 // goniophotometer's bins (docs/models.md, "Evaluating a model").
 #include "cli/commands.h"
 #include "cli/options.h"
+#include "cli/settings_options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/incidences.h"
@@ -11,6 +12,7 @@
 #include "models/numerics/binned.h"
 #include "models/random_walk/random_walk_model.h"
 #include "models/registry.h"
+#include "models/spectral_projection.h"
 #include "simulator/goniophotometer.h"
 
 #include <fmt/format.h>
@@ -32,6 +34,8 @@ struct EvalArgs {
                                                         side = "R";
     double theta_o = std::nan(""), phi_o = std::nan(""), phi_i = 0.0;
     bool binned = false, pdf = false;
+    /// The spectral settings shared with simulate (spectral, spectral_min_nm, spectral_max_nm).
+    SimulationSettings spectral;
     std::vector<std::string> options;
     std::uint64_t samples = 0, seed = 0;  ///< random-walk only; 0: the model's own option
 };
@@ -96,6 +100,30 @@ Rgbd eval_at(const Model& model, double theta_i, double phi_i, double theta_o, d
                       direction_from_angles(deg_to_rad(theta_o), deg_to_rad(phi_o), side));
 }
 
+/// The model eval runs: the registry's, or on a spectral stack (simulate's `--spectral auto`
+/// rule, is_spectral_run) its linear sRGB from per-wavelength models
+/// (models/spectral_projection.h), the colour a spectral run's brdf.csv holds. The random walk
+/// stays in the RGB mode.
+std::unique_ptr<Model> make_eval_model(const ModelEntry& entry, const ModelOptions& options,
+                                       const Stack& stack, const EvalArgs& a) {
+    auto model = entry.make(stack, options);
+    if (!is_spectral_run(stack, a.spectral)) return model;
+    if (dynamic_cast<const RandomWalkModel*>(model.get())) {
+        if (a.spectral.spectral == SpectralMode::On)
+            throw InputError("command line", "--spectral",
+                             "the random walk evaluates the RGB mode (each channel at its "
+                             "wavelength); trace spectra with lamina simulate --spectral on");
+        return model;
+    }
+    const double min_nm = a.spectral.spectral_min_nm, max_nm = a.spectral.spectral_max_nm;
+    if (!(max_nm - min_nm >= 3))
+        throw InputError(
+            "command line", "--spectral-max-nm",
+            fmt::format("the range [{}, {}] nm must be at least 3 nm wide", min_nm, max_nm));
+    return make_spectral_projection([&](const Stack& at) { return entry.make(at, options); }, stack,
+                                    SpectralQuadrature{.min_nm = min_nm, .max_nm = max_nm});
+}
+
 int run_eval(const EvalArgs& a) {
     // NAME or NAME:KEY=VALUE... (the study's ablation names); --option adds to the flags.
     const ModelSpec spec = parse_model_spec(a.model);
@@ -121,7 +149,7 @@ int run_eval(const EvalArgs& a) {
         binning.phi_i_deg = a.phi_i;
         const Stack stack = load_stack(a.stack);
         const HemisphereGrid grid = simulation_grid(stack, binning);
-        const auto model = entry.make(stack, options);
+        const auto model = make_eval_model(entry, options, stack, a);
         configure_random_walk(*model, a);
         const Support s = model->support();
         if (!s.brdf && !s.btdf) throw InputError(a.stack, "--model", "not supported: " + s.reason);
@@ -162,7 +190,7 @@ int run_eval(const EvalArgs& a) {
             rows.push_back(r);
         }
         const Stack stack = load_stack(a.stack);
-        const auto model = entry.make(stack, options);
+        const auto model = make_eval_model(entry, options, stack, a);
         configure_random_walk(*model, a);
         std::string out = "theta_i,theta_o,phi_o,side,f_r,f_g,f_b\n";
         for (const Row& r : rows) {
@@ -185,7 +213,7 @@ int run_eval(const EvalArgs& a) {
     if (!std::isfinite(a.phi_o)) throw InputError("command line", "--phi-o", "must be finite");
     const Side side = parse_side(a.side, "command line", "--side");
     const Stack stack = load_stack(a.stack);
-    const auto model = entry.make(stack, options);
+    const auto model = make_eval_model(entry, options, stack, a);
     require_side(*model, side, a.stack);
     if (const RandomWalkModel* rw = configure_random_walk(*model, a)) {
         const Vec3d wi = light_direction(thetas[0], a.phi_i);
@@ -230,6 +258,7 @@ Runner add_eval(CLI::App& app) {
                   "Cos-weighted bin averages in the goniophotometer's brdf.csv format");
     cmd->add_option("--grid", a->grid, "Bins for --binned, NTHETAxNPHI")->capture_default_str();
     cmd->add_option("--out", a->out, "Output CSV (written atomically)");
+    add_settings_options_only(cmd, a->spectral, {"spectral", "spectral_min_nm", "spectral_max_nm"});
     cmd->add_option("--samples", a->samples,
                     "random-walk: walks per query (default: its samples option, 1024); a point "
                     "evaluation then prints f_r f_g f_b se_r se_g se_b")

@@ -15,21 +15,36 @@
 
 namespace lamina::cli {
 
+/// Adds the option of one setting: --NAME, its help, the codec behind it, its default now.
+template <typename T>
+void add_setting_option(CLI::App* cmd, const SettingInfo& info, T& member) {
+    const std::string flag = option_name(info.name);
+    CLI::Option* option = cmd->add_option_function<std::string>(
+        flag,
+        [&member, info, flag](const std::string& text) {
+            member = SettingCodec<T>::from_text(text, info, "command line", flag);
+        },
+        info.help);
+    option->default_str(SettingCodec<T>::to_text(member));
+}
+
 /// Adds the options of every setting of `s` but those named in `skip`. `s` must outlive the
 /// parse (the options write into it); the defaults shown are its values now.
 template <typename S>
 void add_settings_options(CLI::App* cmd, S& s, const std::vector<std::string>& skip = {}) {
     S::fields(s, [&](const SettingInfo& info, auto& member) {
-        using T = std::decay_t<decltype(member)>;
-        if (std::find(skip.begin(), skip.end(), info.name) != skip.end()) return;
-        const std::string flag = option_name(info.name);
-        CLI::Option* option = cmd->add_option_function<std::string>(
-            flag,
-            [&member, info, flag](const std::string& text) {
-                member = SettingCodec<T>::from_text(text, info, "command line", flag);
-            },
-            info.help);
-        option->default_str(SettingCodec<T>::to_text(member));
+        if (std::find(skip.begin(), skip.end(), info.name) == skip.end())
+            add_setting_option(cmd, info, member);
+    });
+}
+
+/// Adds the options of the settings of `s` named in `only` (a command that shares a few of a
+/// struct's settings, e.g. eval's spectral range with simulate's).
+template <typename S>
+void add_settings_options_only(CLI::App* cmd, S& s, const std::vector<std::string>& only) {
+    S::fields(s, [&](const SettingInfo& info, auto& member) {
+        if (std::find(only.begin(), only.end(), info.name) != only.end())
+            add_setting_option(cmd, info, member);
     });
 }
 

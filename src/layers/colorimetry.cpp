@@ -1,4 +1,5 @@
 #include "layers/colorimetry.h"
+#include "layers/spectrum.h"
 
 #include "layers/spectral_data.h"
 
@@ -61,6 +62,14 @@ Rgbd d65_xyz_weights(double lambda_nm) {
         out[std::size_t(k)] = s * (c[std::size_t(i)] * (1 - t) + c[std::size_t(i + 1)] * t);
     }
     return out;
+}
+
+double d65_y_integral() {
+    double norm_y = 0;
+    constexpr int kCells = int((kSpectrumMaxNm - kSpectrumMinNm) * 10);
+    for (int i = 0; i < kCells; ++i)
+        norm_y += d65_xyz_weights(kSpectrumMinNm + (i + 0.5) * 0.1)[1] * 0.1;
+    return norm_y;
 }
 
 Rgbd cie1931_cmf_row(int i) {

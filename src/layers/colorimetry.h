@@ -12,6 +12,11 @@ namespace lamina {
 /// ∫ f S (x̄, ȳ, z̄) dλ / ∫ S ȳ dλ, so that f = 1 has Y = 1 (CIE 015:2018, §7.1).
 Rgbd d65_xyz_weights(double lambda_nm);
 
+/// ∫ S ȳ dλ over 360–830 nm, the normalization of XYZ above (the midpoint rule on 0.1 nm cells):
+/// what the spectral goniophotometer and the models' spectral projection divide by, whatever
+/// range they trace, so that a narrower range is the colour of that part of the spectrum.
+double d65_y_integral();
+
 /// The CIE 1931 2° colour-matching functions (x̄, ȳ, z̄) as tabulated (data/cie): row i ∈ [0,
 /// kCie1931Rows) at 360 + 5 i nm.
 inline constexpr int kCie1931Rows = 95;

@@ -78,12 +78,8 @@ SpectralTracing spectral_tracing(const Stack& stack, const SimulationSettings& s
         }
     }
     // XYZ weights: the lattice sum of f · S · (x̄, ȳ, z̄) · cell over ∫ S ȳ dλ on 360–830 nm
-    // (the midpoint rule on 0.1 nm cells), times L/3 for the three uniform channels a particle
-    // carries.
-    double norm_y = 0;
-    constexpr int kCells = 4700;
-    for (int i = 0; i < kCells; ++i)
-        norm_y += d65_xyz_weights(kSpectrumMinNm + (i + 0.5) * 0.1)[1] * 0.1;
+    // (d65_y_integral), times L/3 for the three uniform channels a particle carries.
+    const double norm_y = d65_y_integral();
     for (int point = 0; point < tr.lattice; ++point) {
         const Rgbd xyz = d65_xyz_weights(lambda(point)) * (cell * third / norm_y);
         const Rgbd srgb = xyz_to_linear_srgb(xyz);

@@ -196,6 +196,18 @@ check_says simulate-spectral-simd 1 "is traced by the scalar kernel only; give -
 check spectral-simd-writes-nothing 1 test -e "$tmp/spectral-simd"
 check_says simulate-spectral-bins 1 "multiple of 3" "$lamina" simulate "$src/examples/plastic.json" \
     --spectral on --spectral-bins 10 --theta-i 0 --particles 1000 --out "$tmp/spectral-bins"
+# A model on a spectral stack: its linear sRGB from per-wavelength models (--spectral auto, as
+# simulate's); the random walk stays in the RGB mode and says so when asked for spectra.
+check eval-spectral 0 "$lamina" eval --model openpbr --stack "$src/examples/gold-under-coat.json" \
+    --theta-i 30 --theta-o 30 --phi-o 180 --side R
+check eval-spectral-binned 0 "$lamina" eval --model openpbr --binned --theta-i 0 --grid 9x6 \
+    --stack "$src/examples/gold-under-coat.json" --out "$tmp/eval-spectral.csv"
+check_says eval-spectral-random-walk 1 "the random walk evaluates the RGB mode" "$lamina" eval \
+    --model random-walk --stack "$src/examples/gold-under-coat.json" --spectral on --theta-i 30 \
+    --theta-o 30 --phi-o 180 --side R
+check_says eval-spectral-range 1 "at least 3 nm wide" "$lamina" eval --model openpbr \
+    --stack "$src/examples/gold-under-coat.json" --spectral-min-nm 500 --spectral-max-nm 501 \
+    --theta-i 30 --theta-o 30 --phi-o 180 --side R
 check_says validate-spectral 0 "| dielectric η=BK7 α=0.05" "$lamina" validate \
     "$src/examples/dispersive-glass.json"
 check_says validate-film 0 "| conductor η=(0.143, 0.374, 1.442) k=(3.983, 2.385, 1.603) α=0.15 film d=[55, 75] nm η=2.4" \
