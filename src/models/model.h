@@ -112,6 +112,11 @@ class Model {
         return std::nullopt;
     }
     virtual double pdf(const Vec3d& /*wi*/, const Vec3d& /*wo*/) const { return 0.0; }
+    /// Whether eval already returns a colour (linear sRGB) rather than values at the stack's
+    /// channel wavelengths: a shipped film that integrates its spectrum against the CIE functions
+    /// itself (three.js's, Cycles'). On a spectral stack such a model is evaluated once, on the
+    /// stack at its channels' wavelengths, not projected (models/spectral_projection.h).
+    virtual bool integrates_spectrum() const { return false; }
 };
 
 /// Mirror direction of wi about the macro normal.

@@ -145,6 +145,8 @@ class SpectralProjection final : public Model {
 
 std::unique_ptr<Model> make_spectral_projection(const ModelFactory& factory, const Stack& stack,
                                                 const SpectralQuadrature& quadrature) {
+    std::unique_ptr<Model> at_channels = factory(stack);
+    if (at_channels->integrates_spectrum()) return at_channels;
     return std::make_unique<SpectralProjection>(factory, stack, quadrature);
 }
 

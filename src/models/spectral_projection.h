@@ -37,7 +37,9 @@ using ModelFactory = std::function<std::unique_ptr<Model>(const Stack&)>;
 /// value given as numbers means what it means to the spectral goniophotometer; grey values are
 /// the same at every wavelength. Supports what every per-wavelength model supports; samples by
 /// picking one of them uniformly (its pdf the mean of theirs); delta lobes carry their projected
-/// energies. Nothing here throws after construction.
+/// energies. Nothing here throws after construction. A model that integrates the spectrum
+/// itself (Model::integrates_spectrum: a shipped film's colour) is returned as the factory builds
+/// it on `stack`, its channels' wavelengths.
 std::unique_ptr<Model> make_spectral_projection(const ModelFactory& factory, const Stack& stack,
                                                 const SpectralQuadrature& quadrature = {});
 

@@ -10,6 +10,7 @@
 #include "lamina/version.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
+#include "models/spectral_projection.h"
 #include "study/reference.h"
 #include "study/summary.h"
 
@@ -73,6 +74,11 @@ std::string model_key(const std::string& name, const StudyConfiguration& config,
         unfolded = fmt::format(" | incidences {} phi_i {} | grid {}", fmt::join(theta, ","),
                                fmt::join(phi, ","), grid.to_string());
     }
+    // A spectral configuration's models are projected over the reference's range; a key without
+    // it is the one an RGB configuration always had.
+    if (is_spectral_run(config.stack, s.reference))
+        unfolded += fmt::format(" | spectral {}-{} nm", s.reference.spectral_min_nm,
+                                s.reference.spectral_max_nm);
     return fmt::format(
         "lamina {} code {} | model {} | options {} | stack {} | theta_i {} | grid {} | binned {} "
         "{} "
@@ -352,7 +358,15 @@ class ConfigurationRun {
                                       m.support.brdf ? "T" : "R")
                         : fmt::format("{} has no table for {}", external->source, config_.id);
         } else {
-            const std::unique_ptr<Model> model = make_model(m.name, config_.stack);
+            // On a spectral reference (a stack with a spectral value) the model's colour, as
+            // the reference's tables are (models/spectral_projection.h).
+            const std::unique_ptr<Model> model =
+                is_spectral_run(config_.stack, s_.reference)
+                    ? make_spectral_projection(
+                          [&](const Stack& at) { return make_model(m.name, at); }, config_.stack,
+                          SpectralQuadrature{.min_nm = s_.reference.spectral_min_nm,
+                                             .max_nm = s_.reference.spectral_max_nm})
+                    : make_model(m.name, config_.stack);
             m.support = model->support();
             if (m.support.brdf || m.support.btdf) table = bin_registry_model(*model);
         }

@@ -137,5 +137,29 @@ TEST(SpectralProjection, SamplesTheDensityItReports) {
     EXPECT_TRUE(r.passed) << r.message;
 }
 
+TEST(SpectralProjection, AShippedFilmKeepsItsOwnColour) {
+    // three.js's film as shipped integrates the film's spectrum itself: on a spectral stack it is
+    // evaluated once, on the stack at its channels' wavelengths; its exact leaf is projected.
+    const Stack stack = parse_stack(
+        R"({"layers": [{"interface": {"type": "dielectric", "eta": 1.5, "alpha": 0.1}},
+            {"interface": {"type": "conductor", "material": "Ti", "alpha": 0.1,
+                           "film": {"thickness_nm": 60, "eta": 2.5}}}]})",
+        "test");
+    const auto shipped = make_model("threejs-clearcoat", stack);
+    ASSERT_TRUE(shipped->support().brdf) << shipped->support().reason;
+    EXPECT_TRUE(shipped->integrates_spectrum());
+    const auto projected = make_spectral_projection(factory_of("threejs-clearcoat"), stack);
+    const auto exact = make_model("threejs-clearcoat:leaves=exact", stack);
+    EXPECT_FALSE(exact->integrates_spectrum());
+    const auto exact_projected =
+        make_spectral_projection(factory_of("threejs-clearcoat:leaves=exact"), stack);
+    int differ = 0;
+    for (const auto& [wi, wo] : some_directions()) {
+        EXPECT_EQ(projected->eval(wi, wo), shipped->eval(wi, wo));
+        differ += exact_projected->eval(wi, wo) != exact->eval(wi, wo);
+    }
+    EXPECT_GT(differ, 0);
+}
+
 }  // namespace
 }  // namespace lamina

@@ -352,6 +352,13 @@ class ProductionCoat final : public Model {
         return lobes;
     }
 
+    /// three.js's and Cycles' films as shipped give the film's colour (their spectral
+    /// integration), not its value at the stack's wavelengths.
+    bool integrates_spectrum() const override {
+        return film_ && (r_.metal_film == CoatRecipe::MetalFilm::ThreeJs ||
+                         r_.metal_film == CoatRecipe::MetalFilm::Cycles);
+    }
+
     /// Importance sampling (models/production/lobe_mixture.h): the coat lobe's visible normals with
     /// probability p_c, else the base (its GGX visible normals, or the cosine for a Lambertian).
     /// p_c is the coat's Fresnel at μi (clamped to [0.1, 0.9]), 0 when the coat is smooth (a delta
