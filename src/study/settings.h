@@ -63,7 +63,7 @@ struct StudySettings {
     /// Tally the Stokes vectors of the light the reference reflects and transmits for unpolarized
     /// incident light and store them (configs/<id>/reference_stokes.lza, the explorer's
     /// polarization view), where the reference is polarized (transport.polarization, not a
-    /// spectral run); study_reference_key. Off by default: the tallies cost about a quarter of
+    /// spectral run); study_reference_key. Off by default: the tallies cost about a third of
     /// the reference's time (docs/study.md).
     bool reference_stokes = false;
 
@@ -79,7 +79,7 @@ struct StudySettings {
         visit({.name = "reference_stokes",
                .help = "Store the polarized reference's Stokes vectors for unpolarized light "
                        "(configs/ID/reference_stokes.lza: the explorer's degree of polarization; "
-                       "about a quarter more reference time)",
+                       "about a third more reference time)",
                .key = SettingInfo::Key::No},
               s.reference_stokes);
     }
