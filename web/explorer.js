@@ -60,6 +60,7 @@
     shown: new Set(models),
     isoModel: models[0],
     isoChannel: 0,
+    polChannel: 0,
     diffMode: "f",
     levels: "",
     lbMetric: "mf",
@@ -125,6 +126,20 @@
     };
     const hemi = await logDecode(h.codes, h.lo, h.hi);
     const hemiSe = h.se_codes ? await logDecode(h.se_codes, h.se_lo, h.se_hi) : null;
+    // The polarization view's 16-bit codes (docs/explorer.md, "Data"): q / 65534 of [lo, hi],
+    // 65535 where the bin has no light.
+    const linearDecode = async (b64, lo, hi) => {
+      const codes = new Uint16Array(await array(b64, 2, h.n_phi));
+      const out = new Float32Array(codes.length);
+      for (let k = 0; k < codes.length; ++k) out[k] = codes[k] === 65535 ? NaN : lo + (hi - lo) * codes[k] / 65534;
+      return out;
+    };
+    const p = raw.polarization;
+    const pol = p ? {
+      dop: await linearDecode(p.dop, 0, 1),
+      dopSe: await linearDecode(p.dop_se, 0, 1),
+      aolp: await linearDecode(p.aolp, -90, 90),
+    } : null;
     return {
       raw,
       sources: raw.sources,
@@ -136,6 +151,7 @@
       hemi,
       hemiSe,
       hemiShape: h,
+      pol,
     };
   }
 
@@ -436,6 +452,7 @@
     $("w-iso-channel").addEventListener("change", () => { state.isoChannel = Number($("w-iso-channel").value); render(); });
     $("w-levels").addEventListener("change", () => { state.levels = $("w-levels").value; render(); });
     $("w-diff").addEventListener("change", () => { state.diffMode = $("w-diff").value; render(); });
+    $("w-pol-channel").addEventListener("change", () => { state.polChannel = Number($("w-pol-channel").value); render(); });
     $("w-lb-metric").addEventListener("change", () => { state.lbMetric = $("w-lb-metric").value; render(); });
     $("w-lb-incidence").addEventListener("change", () => { state.lbIncidence = $("w-lb-incidence").value; render(); });
     $("w-lb-agg").addEventListener("change", () => { state.lbAgg = $("w-lb-agg").value; render(); });
@@ -759,6 +776,72 @@
     }
   }
 
+  // ---- View 6: polarization of the reference ---------------------------------------------------------
+
+  // A polarization map of the reference (`table`: [incidence, side, θ, φ, channel] on the merged
+  // bins) on the projected disk, as hemiMap.
+  function polMap(d, table, inc, side, channel) {
+    const h = d.hemiShape, L = isoLookup(h);
+    const base = (inc * d.sides.length + d.sides.indexOf(side)) * h.n_theta * h.n_phi;
+    const z = [];
+    for (let j = 0; j < ISO_N; ++j) {
+      const row = new Array(ISO_N);
+      for (let i = 0; i < ISO_N; ++i) {
+        const k = L.idx[j * ISO_N + i];
+        const v = k < 0 ? NaN : table[(base + k) * 3 + channel];
+        row[i] = isFinite(v) ? v : null;
+      }
+      z.push(row);
+    }
+    return z;
+  }
+
+  // A cyclic colour scale for the angle of linear polarization: −90° and +90° are one direction.
+  const AOLP_COLORS = [[0, "#c0392b"], [0.25, "#e6b91e"], [0.5, "#2e8b57"], [0.75, "#2c5aa0"], [1, "#c0392b"]];
+
+  function drawPolarization(d, cfg) {
+    const none = $("pol-none"), maps = $("pol-maps"), note = $("pol-note");
+    const reason = STUDY.polarization === false
+      ? "Not polarized: this study's reference follows unpolarized Fresnel factors (" +
+        (STUDY.physics === "bpb19" ? "--physics bpb19" : "--polarization off") +
+        "), so it says nothing about the polarization of the light it reflects."
+      : !d.pol ? "No polarization data for " + cfg.id + ": the study stored no Stokes vectors of its reference" +
+        " (configs/" + cfg.id + "/reference_stokes.lza: `lamina study --reference-stokes on`, a polarized reference that is not spectral)."
+        : null;
+    document.body.dataset.polarization = reason ? "none" : "drawn";
+    none.hidden = !reason;
+    maps.hidden = Boolean(reason);
+    if (reason) { none.textContent = reason; note.textContent = ""; return; }
+    const inc = incidenceIndex(cfg), side = state.side, c = state.polChannel;
+    $("w-pol-channel").value = String(c);
+    const light = isUnfolded(cfg) ? incidencesOf(cfg)[inc] : undefined;
+    const L = isoLookup(d.hemiShape);
+    const dop = polMap(d, d.pol.dop, inc, side, c), dopSe = polMap(d, d.pol.dopSe, inc, side, c);
+    // The angle where the degree is above twice its standard error (elsewhere it is noise). A
+    // folded bin holds the patch φ ≥ 0 (the lower half of the disk); its mirror image, the upper
+    // half, has the opposite angle (docs/physics.md §8: the mirror flips S2).
+    const aolp = polMap(d, d.pol.aolp, inc, side, c).map((row, j) => row.map((v, i) => {
+      if (v === null || dop[j][i] === null || !(dop[j][i] > 2 * dopSe[j][i])) return null;
+      return !isUnfolded(cfg) && L.axis[j] > 0 ? -v : v;
+    }));
+    const ch = CHANNELS[c], what = side === "R" ? "reflected" : "transmitted";
+    Plotly.react($("pol-dop"), [{
+      type: "heatmap", x: L.axis, y: L.axis, z: dop, zmin: 0, zmax: 1, colorscale: "Viridis", customdata: dopSe,
+      colorbar: { title: { text: "degree", side: "right" }, thickness: 12, len: 0.9 },
+      hovertemplate: "degree of polarization %{z:.3f} ± %{customdata:.3f}<extra></extra>",
+    }], diskLayout("degree of polarization · " + what + " · " + ch + " · " + incidenceText(cfg, inc), light), PLOT_CONFIG);
+    Plotly.react($("pol-aolp"), [{
+      type: "heatmap", x: L.axis, y: L.axis, z: aolp, zmin: -90, zmax: 90, colorscale: AOLP_COLORS,
+      colorbar: { title: { text: "angle (°)", side: "right" }, thickness: 12, len: 0.9, tickvals: [-90, -45, 0, 45, 90] },
+      hovertemplate: "angle of linear polarization %{z:.1f}°<extra></extra>",
+    }], diskLayout("angle of linear polarization · " + ch, light), PLOT_CONFIG);
+    note.textContent = "For unpolarized incident light: the degree of polarization √(S1² + S2² + S3²) / S0 of each bin's " +
+      "Stokes vector (0 unpolarized, 1 fully polarized; ± its standard error on hover, and noise alone gives about that much " +
+      "where the light is unpolarized). The angle of the linear part, ½ atan2(S2, S1), is drawn where the degree exceeds " +
+      "twice its standard error: 0° is polarized horizontally, ⊥ to the vertical plane of the exit direction (s-polarized " +
+      "in the plane of incidence), ±90° in that plane.";
+  }
+
   // ---- View 3: directional albedo against θi -------------------------------------------------------
 
   function drawAlbedo(cfg) {
@@ -996,6 +1079,7 @@
     timed("iso", () => drawIso(d, cfg));
     timed("albedo", () => drawAlbedo(cfg));
     timed("leaderboard", () => drawLeaderboard());
+    timed("polarization", () => drawPolarization(d, cfg));
     drawRenders(cfg);
     document.body.dataset.viewMs = JSON.stringify(times);
     writeHash();

@@ -5,6 +5,7 @@
 #include "core/grid.h"
 #include "core/hash.h"
 #include "core/packed_array.h"
+#include "core/stokes.h"
 #include "lamina/version.h"
 #include "report/assets.h"
 
@@ -331,6 +332,59 @@ std::vector<std::optional<std::array<double, 3>>> albedos(const BinBlocks& b, bo
     return out;
 }
 
+// The polarization view's maps as 16-bit codes, [incidence, side, merged θ bin, merged φ bin,
+// channel] (docs/explorer.md, "Data"): the degree of polarization and its standard error over
+// [0, 1] (code round(65534 · value), 65535 where the bin has no light), the angle of linear
+// polarization over [−90°, 90°] (code round(65534 · (angle + 90°) / 180°)).
+struct Polarization {
+    std::vector<std::uint16_t> dop, dop_se, aolp;
+};
+
+constexpr std::uint16_t kCodeNone = 65535;
+
+std::uint16_t unit_code(double v) {
+    return std::isfinite(v) ? std::uint16_t(std::lround(std::clamp(v, 0.0, 1.0) * 65534.0))
+                            : kCodeNone;
+}
+
+// From configs/<id>/reference_stokes.lza ([quantity (S, se), incidence, side, component, θ, φ,
+// channel], docs/formats.md) and the reference's merged f and se (the first I · D blocks of
+// `merged`, `merged_se`): the Stokes vectors are merged as f is (Ω⊥-weighted averages: the Stokes
+// vectors of incoherent light add), their standard errors in quadrature, then turned into the
+// degree and angle of polarization (core/stokes.h).
+Polarization encode_polarization(const fs::path& dir, std::size_t I, std::size_t D, std::size_t T,
+                                 std::size_t P, bool unfolded, const std::vector<int>& et,
+                                 const std::vector<int>& ep, const std::vector<float>& merged,
+                                 const std::vector<float>& merged_se) {
+    const NpyFloat32 st = read_study_array(dir, "reference_stokes");
+    if (st.shape != std::vector<std::size_t>{2, I, D, 3, T, P, 3})
+        throw InputError(study_array_path(dir, "reference_stokes").string(), "shape",
+                         fmt::format("[{}]: expected [2, incidences {}, sides {}, 3, θ {}, φ {}, "
+                                     "3] from config.json and study.json",
+                                     fmt::join(st.shape, ", "), I, D, T, P));
+    const std::size_t half = st.data.size() / 2;
+    const std::vector<float> values(st.data.begin(), st.data.begin() + std::ptrdiff_t(half));
+    const std::vector<float> errors(st.data.begin() + std::ptrdiff_t(half), st.data.end());
+    const std::vector<float> s = merge_bins(BinBlocks{values, T, P, unfolded}, et, ep, false);
+    const std::vector<float> s_se = merge_bins(BinBlocks{errors, T, P, unfolded}, et, ep, true);
+    const std::size_t cells = (et.size() - 1) * (ep.size() - 1) * 3;  // one block, merged
+    Polarization out;
+    for (std::size_t b = 0; b < I * D; ++b)
+        for (std::size_t x = 0; x < cells; ++x) {
+            std::array<double, 4> v{merged[b * cells + x]}, e{};
+            if (!merged_se.empty()) e[0] = merged_se[b * cells + x];
+            for (std::size_t k = 0; k < 3; ++k) {
+                v[k + 1] = s[(b * 3 + k) * cells + x];
+                e[k + 1] = s_se[(b * 3 + k) * cells + x];
+            }
+            const StokesPolarization p = stokes_polarization(v, e);
+            out.dop.push_back(unit_code(p.dop));
+            out.dop_se.push_back(unit_code(p.dop_se));
+            out.aolp.push_back(unit_code((p.aolp_deg + 90.0) / 180.0));
+        }
+    return out;
+}
+
 struct ConfigData {
     std::string script;      ///< explorer/data/<id>.js
     json albedo, albedo_se;  ///< for the index
@@ -403,10 +457,21 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     const int kt = (int(T) + 44) / 45, kp = (int(P) + 44) / 45;
     const std::vector<int> et = merged_edges(int(T), kt), ep = merged_edges(int(P), kp);
     LogCodec codec, se_codec;
-    const std::vector<std::uint16_t> codes = log_codes(merge_bins(f, et, ep, false), codec);
+    const std::vector<float> merged = merge_bins(f, et, ep, false);
+    const std::vector<float> merged_se =
+        has_se ? merge_bins(f_se, et, ep, true) : std::vector<float>();
+    const std::vector<std::uint16_t> codes = log_codes(merged, codec);
     const std::vector<std::uint16_t> se_codes =
-        has_se ? log_codes(merge_bins(f_se, et, ep, true), se_codec) : std::vector<std::uint16_t>();
+        has_se ? log_codes(merged_se, se_codec) : std::vector<std::uint16_t>();
     const std::size_t T2 = et.size() - 1, P2 = ep.size() - 1;
+
+    // 4. The reference's polarization for unpolarized light (reference_stokes.lza, when the study
+    //    stored it): its degree and the angle of its linear part on the same merged bins.
+    const std::optional<Polarization> polarization =
+        has_study_array(dir, "reference_stokes")
+            ? std::optional(
+                  encode_polarization(dir, I, D, T, P, unfolded, et, ep, merged, merged_se))
+            : std::nullopt;
     std::vector<double> theta_edges, phi_edges;
     for (int e : et)
         theta_edges.push_back(90.0 * e / T);
@@ -499,6 +564,10 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
           {"se_codes", has_se ? json(packed(se_codes, P2)) : json(nullptr)}}},
     };
     if (unfolded) data["hemi"]["unfolded"] = true;  // φ edges over [0°, 360°)
+    if (polarization)
+        data["polarization"] = {{"dop", packed(polarization->dop, P2)},
+                                {"dop_se", packed(polarization->dop_se, P2)},
+                                {"aolp", packed(polarization->aolp, P2)}};
     ConfigData out;
     out.script = fmt::format("(window.LAMINA_DATA = window.LAMINA_DATA || {{}})[{}] = {};\n",
                              json(id).dump(), data.dump());
@@ -528,7 +597,7 @@ std::string inputs_digest(const fs::path& dir, const json& entry,
     std::uint64_t h = fnv1a(fmt::format("explorer data v2 | lamina {} | {} | {} | {}x{}", kVersion,
                                         entry.dump(), fmt::join(theta_i, ","), n_theta, n_phi));
     for (const char* name : {"config.json", "tables.lza", "reference_se.lza", "tables.npy",
-                             "reference_se.npy", "renders/errors.csv"}) {
+                             "reference_se.npy", "reference_stokes.lza", "renders/errors.csv"}) {
         std::ifstream in(dir / name, std::ios::binary);
         std::stringstream ss;
         if (in) ss << in.rdbuf();

@@ -27,6 +27,29 @@ BinStokes bin_stokes(const IncidenceSums& sums, std::size_t entry, int channel, 
     return b;
 }
 
+StokesTerm folded_stokes_term(const BinStokes& b, int i, double sign, std::uint64_t n) {
+    const double dn = n > 1 ? double(n - 1) : 1.0;
+    StokesTerm t;
+    t.mean = b.upper[std::size_t(i)] + sign * b.lower[std::size_t(i)];
+    t.var = std::max(0.0, b.second[std::size_t(i)] - t.mean * t.mean) / dn;
+    return t;
+}
+
+BinStokesVector unpolarized_stokes(const IncidenceSums& sums, std::size_t entry,
+                                   double projected_solid_angle, std::uint64_t n) {
+    BinStokesVector v;
+    for (int c = 0; c < 3; ++c) {
+        const BinStokes b = bin_stokes(sums, entry, c, n);
+        for (int i = 0; i < 4; ++i) {
+            // Column 0: the incident light unpolarized, D_00 = 1.
+            const StokesTerm t = folded_stokes_term(b, i, kMirror[i], n);
+            v.s[std::size_t(i)][c] = t.mean / projected_solid_angle;
+            v.se[std::size_t(i)][c] = std::sqrt(t.var) / projected_solid_angle;
+        }
+    }
+    return v;
+}
+
 MuellerTable mueller_table(const std::array<const SimulationResult*, 4>& runs) {
     const SimulationResult& base = *runs[0];
     const SimulationSettings& s = base.settings;
@@ -45,7 +68,6 @@ MuellerTable mueller_table(const std::array<const SimulationResult*, 4>& runs) {
     t.m.assign(s.theta_i_deg.size() * 2 * n_bins * 3, {});
     t.se.assign(t.m.size(), {});
     const std::uint64_t n = s.particles;
-    const double dn = n > 1 ? double(n - 1) : 1.0;
     for (std::size_t inc = 0; inc < s.theta_i_deg.size(); ++inc)
         for (int side = 0; side < (t.transmits ? 2 : 1); ++side)
             for (std::size_t bin = 0; bin < n_bins; ++bin) {
@@ -59,18 +81,14 @@ MuellerTable mueller_table(const std::array<const SimulationResult*, 4>& runs) {
                     std::array<double, 16>& se = t.se[t.index(inc, side, bin, c)];
                     for (int i = 0; i < 4; ++i)
                         for (int j = 0; j < 4; ++j) {
-                            // Run r's term, folded with the sign of entry (i, j), and its variance.
+                            // Run j's term, folded with the sign of entry (i, j), less run 0's
+                            // for j > 0; the runs are independent.
                             const double sign = kMirror[i] * kMirror[j];
-                            auto term = [&](int r, double& var) {
-                                const double mean = b[r].upper[i] + sign * b[r].lower[i];
-                                var = std::max(0.0, b[r].second[i] - mean * mean) / dn;
-                                return mean;
-                            };
-                            double var = 0, var0 = 0;
-                            double value = term(j, var);
-                            if (j > 0) value -= term(0, var0);
-                            m[std::size_t(4 * i + j)] = value / omega;
-                            se[std::size_t(4 * i + j)] = std::sqrt(var + var0) / omega;
+                            const StokesTerm run = folded_stokes_term(b[j], i, sign, n);
+                            const StokesTerm run0 =
+                                j > 0 ? folded_stokes_term(b[0], i, sign, n) : StokesTerm{};
+                            m[std::size_t(4 * i + j)] = (run.mean - run0.mean) / omega;
+                            se[std::size_t(4 * i + j)] = std::sqrt(run.var + run0.var) / omega;
                         }
                 }
             }

@@ -50,6 +50,26 @@ struct BinStokes {
 };
 BinStokes bin_stokes(const IncidenceSums& sums, std::size_t entry, int channel, std::uint64_t n);
 
+/// One run's term of a Mueller entry (i, j): the mean over the N particles of S_i leaving into the
+/// bin, the exits into the patch y < 0 counted as their mirror images (`sign` = D_ii D_jj), and
+/// the variance of that mean (the per-particle values square to S_i² on either patch).
+struct StokesTerm {
+    double mean = 0, var = 0;
+};
+StokesTerm folded_stokes_term(const BinStokes& b, int i, double sign, std::uint64_t n);
+
+/// The Stokes vector leaving into each bin for unpolarized incident light: the Mueller table's
+/// first column (below), which one run lit unpolarized (incident_polarization 0) with Stokes
+/// tallies gives alone. Per channel, S0..S3 in 1/sr as the tables' f (S0 is f) and their
+/// standard errors, in the bin's tabulation frame (docs/physics.md §8).
+struct BinStokesVector {
+    std::array<Rgbd, 4> s, se;
+};
+/// That vector for entry `entry` (side · n_bins + bin) of `sums`, a bin of projected solid angle
+/// `projected_solid_angle`, from N = `n` particles.
+BinStokesVector unpolarized_stokes(const IncidenceSums& sums, std::size_t entry,
+                                   double projected_solid_angle, std::uint64_t n);
+
 /// The Mueller table from four runs of the same stack and settings with Stokes tallies, run j lit
 /// with incident_polarization j (checked).
 MuellerTable mueller_table(const std::array<const SimulationResult*, 4>& runs);

@@ -19,6 +19,7 @@ nlohmann::json key_json(const ReferenceKey& key) {
     return {{"config_id", key.config_id},
             {"stack", stack_to_json(key.stack)},
             {"settings", settings_to_json(key.settings)},
+            {"stokes_tallies", key.settings.stokes_tallies},  // not a setting: said here
             {"canonical", key.canonical()}};
 }
 
@@ -27,6 +28,7 @@ ReferenceKey key_from_json(const nlohmann::json& j) {
                      stack_from_json(j.at("stack"), "reference work list"),
                      {}};
     settings_from_json(key.settings, j.at("settings"), "reference work list");
+    key.settings.stokes_tallies = j.value("stokes_tallies", false);
     if (key.canonical() != j.at("canonical").get<std::string>())
         throw InputError("reference work list", key.config_id,
                          "this process describes the piece differently from the root: are all "
@@ -56,8 +58,7 @@ std::vector<ReferenceKey> study_reference_keys(const std::vector<StudyConfigurat
     std::vector<ReferenceKey> keys;
     for (const StudyConfiguration& config : configs)
         for (const StudyIncidence& inc : study_incidences(config.stack, s.reference))
-            keys.push_back(
-                reference_key(config.id, config.stack, inc.theta_i, s.reference, inc.phi_i));
+            keys.push_back(study_reference_key(config, inc, s));
     return keys;
 }
 

@@ -6,6 +6,7 @@
 #include "core/packed_array.h"
 #include "lamina/version.h"
 #include "reference_source_digest.h"
+#include "simulator/mueller.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -71,7 +72,9 @@ LobeMetrics metrics_from_json(const nlohmann::json& j) {
 
 // Layout: magic line, one line of JSON (key, budget, floor, sizes), then the data as
 // [block, θ bin, φ bin, channel]. v2: f of each side present (float32, packed; "f_packed" bytes),
-// then se of each side (float16, packed). v1: for each side, f then se, raw float32.
+// then se of each side (float16, packed; "se_packed" bytes where Stokes components follow), then
+// with Stokes components ("stokes_packed" bytes) S1, S2, S3 of each side (float32, packed) and
+// their standard errors (float16, packed). v1: for each side, f then se, raw float32.
 std::string serialize(const ReferenceKey& key, const ReferencePiece& p) {
     nlohmann::json meta;
     meta["key"] = key.canonical();
@@ -100,9 +103,27 @@ std::string serialize(const ReferenceKey& key, const ReferencePiece& p) {
             }
     const std::size_t n_phi = std::size_t(key.grid().n_phi());
     const std::string f_packed = pack_elements(f.data(), f.size(), sizeof(float), n_phi, 3);
+    const std::string se_packed =
+        pack_elements(se.data(), se.size(), sizeof(std::uint16_t), n_phi, 3);
     meta["f_packed"] = f_packed.size();
-    return kMagic + meta.dump() + "\n" + f_packed +
-           pack_elements(se.data(), se.size(), sizeof(std::uint16_t), n_phi, 3);
+    if (p.stokes[0].empty()) return kMagic + meta.dump() + "\n" + f_packed + se_packed;
+    // The Stokes components as [side, component, θ bin, φ bin, channel]: S as float32, their
+    // standard errors as float16, after se.
+    std::vector<float> stokes;
+    std::vector<std::uint16_t> stokes_se;
+    for (int side = 0; side < (p.has_transmission ? 2 : 1); ++side)
+        for (std::size_t k = 0; k < 3; ++k)
+            for (std::size_t j = 0; j < p.stokes[side].size(); ++j)
+                for (int c = 0; c < 3; ++c) {
+                    stokes.push_back(float(p.stokes[side][j][k][c]));
+                    stokes_se.push_back(float_to_half(float(p.stokes_se[side][j][k][c])));
+                }
+    const std::string stokes_packed =
+        pack_elements(stokes.data(), stokes.size(), sizeof(float), n_phi, 3);
+    meta["se_packed"] = se_packed.size();
+    meta["stokes_packed"] = stokes_packed.size();
+    return kMagic + meta.dump() + "\n" + f_packed + se_packed + stokes_packed +
+           pack_elements(stokes_se.data(), stokes_se.size(), sizeof(std::uint16_t), n_phi, 3);
 }
 
 bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePiece& p) {
@@ -145,11 +166,38 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
             const std::size_t f_bytes = meta.at("f_packed").get<std::size_t>();
             const std::string_view rest = std::string_view(bytes).substr(eol + 1);
             if (f_bytes > rest.size()) return false;
+            // A piece with Stokes components says where se ends; one without ends with se.
+            const bool has_stokes = meta.contains("stokes_packed");
+            if (key.settings.stokes_tallies && !has_stokes) return false;  // computed again
+            const std::size_t se_bytes =
+                has_stokes ? meta.at("se_packed").get<std::size_t>() : rest.size() - f_bytes;
+            const std::size_t stokes_bytes =
+                has_stokes ? meta.at("stokes_packed").get<std::size_t>() : 0;
+            if (f_bytes + se_bytes + stokes_bytes > rest.size()) return false;
             const std::size_t n_phi = std::size_t(key.grid().n_phi());
             unpack_elements(rest.substr(0, f_bytes), f.data(), values, sizeof(float), n_phi, 3,
                             key.file_name());
-            unpack_elements(rest.substr(f_bytes), se.data(), values, sizeof(std::uint16_t), n_phi,
-                            3, key.file_name());
+            unpack_elements(rest.substr(f_bytes, se_bytes), se.data(), values,
+                            sizeof(std::uint16_t), n_phi, 3, key.file_name());
+            if (has_stokes) {
+                std::vector<float> stokes(3 * values);
+                std::vector<std::uint16_t> stokes_se(3 * values);
+                unpack_elements(rest.substr(f_bytes + se_bytes, stokes_bytes), stokes.data(),
+                                stokes.size(), sizeof(float), n_phi, 3, key.file_name());
+                unpack_elements(rest.substr(f_bytes + se_bytes + stokes_bytes), stokes_se.data(),
+                                stokes_se.size(), sizeof(std::uint16_t), n_phi, 3, key.file_name());
+                std::size_t at = 0;
+                for (std::size_t side = 0; side < sides; ++side) {
+                    p.stokes[side].assign(n, {});
+                    p.stokes_se[side].assign(n, {});
+                    for (std::size_t k = 0; k < 3; ++k)
+                        for (std::size_t j = 0; j < n; ++j)
+                            for (int c = 0; c < 3; ++c, ++at) {
+                                p.stokes[side][j][k][c] = stokes[at];
+                                p.stokes_se[side][j][k][c] = half_to_float(stokes_se[at]);
+                            }
+                }
+            }
         } catch (const std::exception&) {
             return false;  // damaged: computed again
         }
@@ -159,6 +207,7 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
                 data[(2 * side + 1) * n * 3 + k] = half_to_float(se[side * n * 3 + k]);
             }
     } else {
+        if (key.settings.stokes_tallies) return false;  // v1 pieces have no Stokes components
         if (bytes.size() != eol + 1 + expected) return false;
         std::memcpy(data.data(), bytes.data() + eol + 1, expected);
     }
@@ -267,6 +316,22 @@ std::string compute_reference_piece(const ReferenceKey& key, int threads,
             }
         for (int c = 0; c < 3; ++c)
             piece.floor[side][c] = noise_floor(grid, la.f, lb.f, c);
+        if (!s.stokes_tallies) continue;
+        // The Stokes vectors of the halves (each lit unpolarized), averaged as f.
+        piece.stokes[side].resize(grid.size());
+        piece.stokes_se[side].resize(grid.size());
+        for (std::size_t j = 0; j < grid.size(); ++j) {
+            const std::size_t entry = std::size_t(side) * grid.size() + j;
+            const double omega = grid.projected_solid_angle(j);
+            const BinStokesVector va = unpolarized_stokes(a.sums[0], entry, omega, n_a);
+            const BinStokesVector vb = unpolarized_stokes(b.sums[0], entry, omega, n_b);
+            for (std::size_t k = 0; k < 3; ++k)
+                for (int c = 0; c < 3; ++c) {
+                    piece.stokes[side][j][k][c] = wa * va.s[k + 1][c] + wb * vb.s[k + 1][c];
+                    piece.stokes_se[side][j][k][c] =
+                        std::hypot(wa * va.se[k + 1][c], wb * vb.se[k + 1][c]);
+                }
+        }
     }
     const EnergyBudget& ba = a.incidences[0].budget;
     const EnergyBudget& bb = b.incidences[0].budget;

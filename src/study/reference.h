@@ -26,7 +26,10 @@ struct ReferenceKey {
     /// The goniophotometer's settings of the piece: one incidence, the particles of both halves
     /// together, the seed of the first half, the grid, the kernel (its description, with the SIMD
     /// instruction set, is part of the key, since tables are bitwise reproducible per kernel
-    /// description only) and the transport. The threads are not part of the key.
+    /// description only) and the transport. The threads are not part of the key. With
+    /// settings.stokes_tallies (a polarized reference, not spectral) the piece carries the Stokes
+    /// vectors too (ReferencePiece::stokes): they do not change its tables, so the key's text does
+    /// not say it, and a piece without them is computed again for a key that asks for them.
     SimulationSettings settings;
 
     double theta_i_deg() const { return settings.theta_i_deg.front(); }
@@ -53,6 +56,11 @@ struct ReferencePiece {
     /// [side][bin of ReferenceKey::grid()]: the average of the halves and its standard error, as
     /// stored (float32).
     std::array<std::vector<Rgbd>, 2> f, se;
+    /// [side][bin]: the Stokes components S1, S2, S3 (1/sr, per channel) of the light leaving into
+    /// the bin for unpolarized incident light and their standard errors (simulator/mueller.h
+    /// unpolarized_stokes; the average of the halves, S as float32 and its standard errors as
+    /// float16, as stored); empty unless the key's settings have stokes_tallies.
+    std::array<std::vector<std::array<Rgbd, 3>>, 2> stokes, stokes_se;
     EnergyBudget budget;                              ///< average of the halves
     std::array<std::array<LobeMetrics, 3>, 2> floor;  ///< [side][channel]
     double seconds = 0;

@@ -60,6 +60,12 @@ struct StudySettings {
     bool quiet = false;                          ///< no per-configuration lines on stdout
     std::vector<ExternalModel> external_models;  ///< compared after the registry's models
     bool registry_models = true;  ///< false: no registry model unless named in `models`
+    /// Tally the Stokes vectors of the light the reference reflects and transmits for unpolarized
+    /// incident light and store them (configs/<id>/reference_stokes.lza, the explorer's
+    /// polarization view), where the reference is polarized (transport.polarization, not a
+    /// spectral run); study_reference_key. Off by default: the tallies cost about a third of
+    /// the reference's time (docs/study.md).
+    bool reference_stokes = false;
 
     /// The study's own settings (core/setting.h); the reference's are SimulationSettings'.
     template <typename Self, typename Visit>
@@ -70,6 +76,12 @@ struct StudySettings {
                        "figures)",
                .key = SettingInfo::Key::No},
               s.tables);
+        visit({.name = "reference_stokes",
+               .help = "Store the polarized reference's Stokes vectors for unpolarized light "
+                       "(configs/ID/reference_stokes.lza: the explorer's degree of polarization; "
+                       "about a third more reference time)",
+               .key = SettingInfo::Key::No},
+              s.reference_stokes);
     }
 };
 

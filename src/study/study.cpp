@@ -3,6 +3,7 @@
 #include "model_source_digest.h"
 
 #include "core/atomic_file.h"
+#include "core/check.h"
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/packed_array.h"
@@ -213,12 +214,13 @@ class ConfigurationRun {
     void digest_inputs() {
         ref_digest_ = fnv1a("reference");
         for (const StudyIncidence& inc : incidences_) {
-            keys_.push_back(
-                reference_key(config_.id, config_.stack, inc.theta_i, s_.reference, inc.phi_i));
+            keys_.push_back(study_reference_key(config_, inc, s_));
             ref_digest_ = fnv1a(keys_.back().canonical(), ref_digest_);
         }
-        outputs_digest_ = fnv1a(fmt::format("{} | reference {} | tables {}", kStateFormat,
-                                            digest_hex(ref_digest_), enum_text(s_.tables)));
+        stokes_ = keys_.front().settings.stokes_tallies && s_.tables != TablesFormat::None;
+        outputs_digest_ = fnv1a(fmt::format("{} | reference {} | tables {}{}", kStateFormat,
+                                            digest_hex(ref_digest_), enum_text(s_.tables),
+                                            stokes_ ? " | stokes" : ""));
         for (const std::string& name : model_names_) {
             model_keys_.push_back(
                 digest_hex(fnv1a(model_key(name, config_, s_, incidences_, grid_))));
@@ -229,10 +231,12 @@ class ConfigurationRun {
 
     // The last run's results when every input is unchanged and its outputs are there.
     bool read_back() {
-        const bool outputs_there = std::filesystem::exists(config_dir_ / "config.json") &&
-                                   (s_.tables == TablesFormat::None ||
-                                    (std::filesystem::exists(config_dir_ / "tables.lza") &&
-                                     std::filesystem::exists(config_dir_ / "reference_se.lza")));
+        const bool outputs_there =
+            std::filesystem::exists(config_dir_ / "config.json") &&
+            (s_.tables == TablesFormat::None ||
+             (std::filesystem::exists(config_dir_ / "tables.lza") &&
+              std::filesystem::exists(config_dir_ / "reference_se.lza") &&
+              (!stokes_ || std::filesystem::exists(config_dir_ / "reference_stokes.lza"))));
         if (!state_.is_object() || state_.value("outputs", "") != digest_hex(outputs_digest_) ||
             !outputs_there)
             return false;
@@ -501,17 +505,52 @@ class ConfigurationRun {
                                  std::vector<std::size_t>(shape.begin() + 1, shape.end()),
                                  std::vector<std::string>(axes.begin() + 1, axes.end())));
             }
+            if (stokes_)
+                wrote |= out.add_if_changed(
+                    "reference_stokes.lza",
+                    tables_bytes(s_.tables, stokes_table(), stokes_shape(), kStokesAxes));
             wrote |= out.add_if_changed("config.json", cj.dump(1) + "\n");
             out.commit();
         }
-        for (const char* name :
-             {"tables.npy", "reference_se.npy", "tables.lza", "reference_se.lza"})
-            if (s_.tables == TablesFormat::None || std::string_view(name).ends_with(".npy")) {
+        for (const char* name : {"tables.npy", "reference_se.npy", "tables.lza", "reference_se.lza",
+                                 "reference_stokes.lza"})
+            if (s_.tables == TablesFormat::None || std::string_view(name).ends_with(".npy") ||
+                (!stokes_ && std::string_view(name) == "reference_stokes.lza")) {
                 std::error_code ec;
                 wrote |= std::filesystem::remove(config_dir_ / name, ec);
             }
         work_.configurations_written += wrote;
         work_.configurations_unchanged += !wrote;
+    }
+
+    // reference_stokes.lza: [quantity (S, se), incidence, side, component (S1, S2, S3), θ bin,
+    // φ bin, channel], the reference's Stokes components for unpolarized incident light and their
+    // standard errors (1/sr).
+    static inline const std::vector<std::string> kStokesAxes = {
+        "quantity", "incidence", "side", "component", "theta_bin", "phi_bin", "channel"};
+    std::vector<std::size_t> stokes_shape() const {
+        return {2,
+                n_inc_,
+                std::size_t(n_sides_),
+                3,
+                std::size_t(grid_.n_theta()),
+                std::size_t(grid_.n_phi()),
+                3};
+    }
+    std::vector<float> stokes_table() const {
+        std::vector<float> out;
+        out.reserve(2 * n_inc_ * std::size_t(n_sides_) * 3 * bins_ * 3);
+        for (int q = 0; q < 2; ++q)
+            for (std::size_t i = 0; i < n_inc_; ++i)
+                for (int side = 0; side < n_sides_; ++side) {
+                    const auto& v = q == 0 ? pieces_[i].stokes[side] : pieces_[i].stokes_se[side];
+                    LAMINA_CHECK(v.size() == bins_);
+                    for (std::size_t k = 0; k < 3; ++k)
+                        for (std::size_t j = 0; j < bins_; ++j)
+                            for (int c = 0; c < 3; ++c)
+                                out.push_back(float(v[j][k][c]));
+                }
+        return out;
     }
 
     // config.json: the configuration, its sources, what each supports, the albedos, the
@@ -562,6 +601,11 @@ class ConfigurationRun {
                 {"dtype", s_.tables == TablesFormat::Half ? "float16" : "float32"},
                 {"shape", shape},
                 {"axes", {"source", "incidence", "side", "theta_bin", "phi_bin", "channel"}}};
+        if (stokes_)
+            cj["stokes"] = {{"file", "reference_stokes.lza"},
+                            {"dtype", s_.tables == TablesFormat::Half ? "float16" : "float32"},
+                            {"shape", stokes_shape()},
+                            {"axes", kStokesAxes}};
         return cj;
     }
 
@@ -610,6 +654,7 @@ class ConfigurationRun {
     nlohmann::json state_;
     std::vector<ReferencePiece> pieces_;
     bool transmits_ = false, same_reference_ = false;
+    bool stokes_ = false;  ///< reference_stokes.lza is written (study_reference_key)
     int n_sides_ = 1;
     std::size_t block_ = 0;  ///< one incidence of one source: sides × bins × channels
     bool old_loaded_ = false;
@@ -732,6 +777,15 @@ void check_external_table(const BinnedTable& table, const HemisphereGrid& grid,
                         throw InputError(
                             where, "f",
                             fmt::format("a value at θi = {}° is not finite", theta_i_deg[i]));
+}
+
+ReferenceKey study_reference_key(const StudyConfiguration& config, const StudyIncidence& incidence,
+                                 const StudySettings& s) {
+    ReferenceKey key =
+        reference_key(config.id, config.stack, incidence.theta_i, s.reference, incidence.phi_i);
+    key.settings.stokes_tallies = s.reference_stokes && s.reference.transport.polarization &&
+                                  !is_spectral_run(config.stack, s.reference);
+    return key;
 }
 
 std::filesystem::path reference_cache_dir(const std::filesystem::path& out_dir) {

@@ -4,6 +4,7 @@
 // compared by the study's metrics. Writes the study directory of docs/formats.md.
 
 #include "study/configurations.h"
+#include "study/reference.h"
 #include "study/settings.h"
 #include "study/summary.h"
 
@@ -25,6 +26,12 @@ std::uint64_t preset_particles(const std::string& preset);
 /// models/registry.h). InputError naming --models for a name the registry lacks or a flag it
 /// does not have, and naming --model-table for an external name already taken.
 std::vector<std::string> study_models(const StudySettings& settings);
+
+/// The reference piece of `config` lit at `incidence` in a study with `settings`
+/// (study/reference.h): with Stokes tallies where settings.reference_stokes and the reference is
+/// polarized and not spectral.
+ReferenceKey study_reference_key(const StudyConfiguration& config, const StudyIncidence& incidence,
+                                 const StudySettings& settings);
 
 /// Where a study in `out_dir` keeps its reference pieces (study/reference.h).
 std::filesystem::path reference_cache_dir(const std::filesystem::path& out_dir);

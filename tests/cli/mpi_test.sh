@@ -86,9 +86,10 @@ done
 grep -q ',T,' "$tmp/sim-slab-50001-one/brdf.csv" && ok || fail "slab: no transmission rows"
 
 # 2. study: the reference pieces spread over 2 processes; rank 0 alone writes. Same folder name
-#    in both runs (the explorer data names it).
+#    in both runs (the explorer data names it). With the reference's Stokes vectors, which the
+#    work list must ask the other rank for (reference_stokes.lza, the same bytes).
 tiny=(--only 'plastic-P1-a0.05,slab-a0.1-a1.3-clear' --models ww-prime,bel-prime
-      --theta-i 0,60 --particles 5e4 --grid 18x18 --no-figures)
+      --theta-i 0,60 --particles 5e4 --grid 18x18 --reference-stokes on --no-figures)
 mkdir -p "$tmp/one" "$tmp/two"
 "$lamina" study "${tiny[@]}" --out "$tmp/one/study" >"$tmp/study-one.log" 2>&1 \
     || { fail "one-process study"; cat "$tmp/study-one.log"; }
@@ -98,6 +99,7 @@ grep -q 'Reference: 4 pieces computed over 2 processes' "$tmp/study-two.log" && 
     || fail "study: reference not shared"
 files=$(cd "$tmp/one/study" && find . -type f ! -name study.json ! -path './cache/*' | sort)
 [ -n "$files" ] && ok || fail "study: no files"
+echo "$files" | grep -q 'reference_stokes.lza' && ok || fail "study: no reference_stokes.lza"
 # shellcheck disable=SC2086
 same_files "study" "$tmp/one/study" "$tmp/two/study" $files
 # study.json and the cached pieces differ only in their `seconds` (study.json: `reference_seconds`).

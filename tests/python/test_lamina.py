@@ -379,6 +379,31 @@ def test_load_study_metrics_agree_with_the_tables(tmp_path):
         s.tables("nope")
 
 
+def test_reference_stokes_of_a_polarized_study(tmp_path):
+    # The polarized reference's Stokes components (docs/formats.md): S0 is the reference's f, and
+    # every bin's degree of polarization √(S1² + S2² + S3²)/f is at most 1 (a sum of states of
+    # degree ≤ 1; float16 rounding aside). A study without --reference-stokes on has none.
+    out = tmp_path / "pol"
+    cli("compare", PLASTIC, "--particles", 20_000, "--theta-i", "0,60", "--grid", "18x12",
+        "--models", "ww-prime", "--tables", "full", "--reference-stokes", "on", "--no-figures",
+        "--out", out)
+    s = lamina.load_study(out, pandas=False)
+    st = s.reference_stokes("plastic")
+    assert st.shape == (2, 2, 1, 3, 18, 12, 3)
+    f = s.tables("plastic")["reference"].astype(np.float64)
+    norm = np.sqrt((st[0].astype(np.float64) ** 2).sum(axis=2))
+    lit = f > 0
+    assert np.all(norm[lit] <= f[lit] * (1 + 1e-5))
+    assert np.max(norm[lit] / f[lit]) > 0.1   # the coat polarizes what it reflects
+    assert np.all(st[1] >= 0)
+    assert s.config("plastic")["stokes"]["file"] == "reference_stokes.lza"
+    plain = tmp_path / "plain"
+    cli("compare", PLASTIC, "--particles", 2_000, "--theta-i", "0", "--grid", "18x12",
+        "--models", "ww-prime", "--no-figures", "--out", plain)
+    with pytest.raises(lamina.InputError, match="--reference-stokes on"):
+        lamina.load_study(plain, pandas=False).reference_stokes("plastic")
+
+
 # ---- exports read from numpy ------------------------------------------------------------------
 
 def test_export_npz_of_a_simulation(tmp_path):

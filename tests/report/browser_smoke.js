@@ -49,6 +49,14 @@ async function main() {
     const info = await page.evaluate(() => document.getElementById("study-info").textContent);
     check(info.includes("the 2019 reference") && info.includes("single-scattering microsurfaces") && info.includes("unpolarized Fresnel factors"),
       `the header names the reference (${info})`);
+    // The 2019 reference is not polarized: the polarization view says so and draws no map.
+    const pol = await page.evaluate(() => ({ state: document.body.dataset.polarization,
+      note: document.getElementById("pol-none").hidden ? "" : document.getElementById("pol-none").textContent,
+      maps: document.getElementById("pol-maps").hidden }));
+    check(pol.state === "none" && pol.note.startsWith("Not polarized") && pol.note.includes("--physics bpb19") && pol.maps,
+      `the polarization view says the reference is not polarized (${JSON.stringify(pol)})`);
+    check(!fs.existsSync(path.resolve(studyDir, "configs", shown, "reference_stokes.lza")),
+      "an unpolarized study stores no reference_stokes.lza");
     const cells = await page.evaluate(() => (document.getElementById("leaderboard").data[0] || {}).z);
     check(Array.isArray(cells) && cells.length >= 2, "the leaderboard lists the configurations");
     await page.screenshot({ path: shot, fullPage: true });

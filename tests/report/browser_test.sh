@@ -22,10 +22,21 @@ rm -rf "$real"
     --grid 18x18 --physics bpb19 --no-figures --out "$real" >/dev/null
 node "$src/tests/report/browser_smoke.js" "$real" "$build/screenshots/real-study.png"
 
+# And the same two configurations with the polarized reference (the default, exact physics) and
+# its Stokes vectors stored: the polarization view draws the degree and angle of polarization of
+# reference_stokes.lza.
+polarized="$build/report-polarized-study"
+rm -rf "$polarized"
+"$lamina" study --only 'plastic-P1-a0.05,slab-a0.1-a1.3-clear' --theta-i 60 --particles 2e4 \
+    --grid 18x18 --models ww-prime --reference-stokes on --no-figures --out "$polarized" >/dev/null
+node "$src/tests/report/browser_polarization.js" "$polarized" "$build/screenshots/polarized-study.png"
+
 # And a study of one brushed configuration (anisotropic: unfolded tables, lit from φi = 0°, 45°
-# and 90°): the page offers φi and draws each incidence on the full hemisphere.
+# and 90°): the page offers φi and draws each incidence on the full hemisphere, its polarization
+# too.
 brushed="$build/report-brushed-study"
 rm -rf "$brushed"
 "$lamina" study --preset standard --only 'brushed-al-a0.05x.2-a1.05x.3-t90' --theta-i 0,45 \
-    --particles 2e4 --grid 18x18 --models openpbr,bel-prime --no-figures --out "$brushed" >/dev/null
+    --particles 2e4 --grid 18x18 --models openpbr,bel-prime --reference-stokes on --no-figures \
+    --out "$brushed" >/dev/null
 node "$src/tests/report/browser_unfolded.js" "$brushed" "$build/screenshots/brushed-study.png"

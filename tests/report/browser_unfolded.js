@@ -80,6 +80,29 @@ async function main() {
       // Displayed at (x, y) = −sinθ (cos φ, sin φ): the mirror direction φi + 180° is at +(cos φi, sin φi).
       const c = Math.cos(phi * Math.PI / 180), s = Math.sin(phi * Math.PI / 180);
       check(hemi.bx * c + hemi.by * s > 0.2, `the reference's peak is on the mirror side of φi = ${phi}° (${hemi.bx.toFixed(2)}, ${hemi.by.toFixed(2)})`);
+      // The polarization view (the study stored reference_stokes.lza): on the unfolded disk each
+      // pixel shows its own bin's degree and angle, φ = atan2(−y, −x), no mirror image (red channel).
+      const pol = await page.evaluate(() => {
+        const dop = document.getElementById("pol-dop").data[0], aolp = document.getElementById("pol-aolp").data[0];
+        return { state: document.body.dataset.polarization, x: Array.from(dop.x), y: Array.from(dop.y), dop: dop.z, aolp: aolp.z };
+      });
+      check(pol.state === "drawn", `the polarization view is drawn (${pol.state})`);
+      const stokes = readPacked(path.resolve(studyDir, "configs", shown, "reference_stokes.lza"));
+      const S = (k, t, p) => stokes.values[(((inc * D * 3) + k) * T * P + t * P + p) * 3];
+      let worstDop = 0, worstAngle = 0, compared = 0, angles = 0;
+      pol.dop.forEach((row, j) => row.forEach((v, i) => {
+        const x = pol.x[i], y = pol.y[j], r = Math.hypot(x, y);
+        if (v === null || r > 1) return;
+        const ut = Math.asin(r) * 180 / Math.PI / (90 / T), up = ((Math.atan2(-y, -x) * 180 / Math.PI + 360) % 360) / (360 / P);
+        if (Math.abs(ut - Math.round(ut)) < 0.05 || Math.abs(up - Math.round(up)) < 0.05) return;
+        const t = Math.floor(ut), p = Math.floor(up) % P;
+        worstDop = Math.max(worstDop, Math.abs(v - Math.min(1, Math.hypot(S(0, t, p), S(1, t, p), S(2, t, p)) / at(t, p))));
+        ++compared;
+        const a = pol.aolp[j][i];
+        if (a !== null) { worstAngle = Math.max(worstAngle, Math.abs(a - 0.5 * Math.atan2(S(1, t, p), S(0, t, p)) * 180 / Math.PI)); ++angles; }
+      }));
+      check(compared > 3000 && angles > 100 && worstDop < 1e-4 && worstAngle < 0.01,
+        `every pixel's degree and angle of polarization is its own bin's (${compared} pixels, ${angles} angles; worst ${worstDop}, ${worstAngle}°)`);
     }
     const hash = await page.evaluate(() => location.hash);
     check(hash.includes("phi=45"), `the address keeps φi (${hash})`);

@@ -178,6 +178,35 @@ TEST_P(ExplorerTables, TableShapeMismatchNamesTheFile) {
     }
 }
 
+// The polarization view's data come from configs/<id>/reference_stokes.lza when the study stored
+// it (its values are checked against the files in Chromium, browser_polarization.js): absent
+// without the file, present with it, and a file of the wrong shape is named.
+TEST(Explorer, PolarizationDataFromReferenceStokes) {
+    const fs::path d = fresh_dir("stokes");
+    write_text(d / "study.json", R"({"theta_i": [30], "grid": {"n_theta": 2, "n_phi": 2},
+        "configurations": [{"id": "c1", "category": "x", "sides": ["R"]}]})");
+    write_text(d / "configs/c1/config.json", R"({"sources": ["reference"], "sides": ["R"]})");
+    write_table(d / "configs/c1/tables", {1, 1, 1, 2, 2, 3}, std::vector<float>(12, 0.3f), true);
+    write_explorer(d);
+    EXPECT_EQ(read_text(d / "explorer/data/c1.js").find("\"polarization\""), std::string::npos);
+    std::vector<float> stokes(2 * 1 * 1 * 3 * 2 * 2 * 3, 0.01f);
+    write_table(d / "configs/c1/reference_stokes", {2, 1, 1, 3, 2, 2, 3}, stokes, true);
+    write_explorer(d);
+    const std::string data = read_text(d / "explorer/data/c1.js");
+    for (const char* key : {"\"polarization\"", "\"dop\"", "\"dop_se\"", "\"aolp\""})
+        EXPECT_NE(data.find(key), std::string::npos) << key;
+    write_table(d / "configs/c1/reference_stokes", {2, 1, 1, 3, 2, 1, 3},
+                std::vector<float>(36, 0.01f), true);
+    try {
+        write_explorer(d);
+        FAIL() << "a reference_stokes.lza of the wrong shape was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("reference_stokes.lza"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("shape"), std::string::npos) << e.what();
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Formats, ExplorerTables, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "packed" : "npy"; });
 

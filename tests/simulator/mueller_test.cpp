@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "core/math.h"
 #include "core/spherical.h"
+#include "core/stokes.h"
 #include "support/closed_forms.h"
 #include "support/stacks.h"
 #include "support/table_checks.h"
@@ -182,6 +183,157 @@ TEST_P(MuellerStat, Reciprocity) {
 }
 
 // --mueller needs polarization.
+// ---- The outgoing Stokes vectors of unpolarized light (unpolarized_stokes) -------------------
+
+// One run lit unpolarized with Stokes tallies, as the study's reference runs it.
+SimulationResult unpolarized_run(const Stack& stack, SimulationSettings s) {
+    s.stokes_tallies = true;
+    return simulate(stack, s);
+}
+
+// The polarization (core/stokes.h) of channel c of a bin's vector.
+StokesPolarization polarization_of(const BinStokesVector& v, int c) {
+    return stokes_polarization({v.s[0][c], v.s[1][c], v.s[2][c], v.s[3][c]},
+                               {v.se[0][c], v.se[1][c], v.se[2][c], v.se[3][c]});
+}
+
+class UnpolarizedStokesStat : public MuellerStat {};
+INSTANTIATE_TEST_SUITE_P(Kernels, UnpolarizedStokesStat,
+                         ::testing::Values(Kernel::Scalar, Kernel::Simd), kernel_test_name);
+
+// A smooth dielectric interface (η = 1.5) lit with unpolarized light reflects into the mirror bin
+// only, every particle with the Stokes vector R (1, (R_s − R_p)/(R_s + R_p), 0, 0) of the
+// reflection Mueller matrix's first column (docs/physics.md §8; the bin frame's x axis is the s
+// axis there): degree of polarization (R_s − R_p)/(R_s + R_p), with R_s and R_p from Born & Wolf's
+// amplitudes (support/closed_forms.h), 1 at Brewster's angle atan 1.5 where R_p = 0, and the
+// light s-polarized (S1 > 0). Every particle in the bin carries the same state, so the ratio is
+// exact up to float rounding of the states.
+TEST_P(UnpolarizedStokesStat, SmoothDielectricMirror) {
+    const Stack stack = test::make_stack({test::dielectric_layer(1.5, 0.0)});
+    const double brewster = rad_to_deg(std::atan(1.5));
+    const std::vector<double> theta_i = {32, brewster, 72};  // mirror bins away from bin edges
+    SimulationSettings s = settings(GetParam(), theta_i, 20'000, HemisphereGrid(18, 18));
+    const SimulationResult run = unpolarized_run(stack, s);
+    for (std::size_t inc = 0; inc < theta_i.size(); ++inc) {
+        const double mu_i = std::cos(deg_to_rad(theta_i[inc]));
+        const test::PolarizedFresnel f(mu_i, 1.5);
+        const double expected = (f.Rs() - f.Rp()) / (f.Rs() + f.Rp());
+        const Vec3f wi(incident_direction(deg_to_rad(theta_i[inc])));
+        const std::size_t mirror = s.grid.bin_of(Vec3f(-wi.x, -wi.y, wi.z));
+        const BinStokesVector v =
+            unpolarized_stokes(run.sums[inc], mirror, s.grid.projected_solid_angle(mirror), 20'000);
+        for (int c = 0; c < 3; ++c) {
+            const double f_table = run.table.lobe(inc, Side::Reflection).f[mirror][c];
+            EXPECT_NEAR(v.s[0][c], f_table, 1e-9 * (1 + f_table));  // S0 is the table's f
+            const StokesPolarization p = polarization_of(v, c);
+            EXPECT_NEAR(p.dop, expected, 1e-5) << "θi " << theta_i[inc] << " channel " << c;
+            EXPECT_GT(v.s[1][c], 0.0);
+            EXPECT_NEAR(v.s[2][c], 0.0, 1e-6 * v.s[0][c]);
+            EXPECT_NEAR(v.s[3][c], 0.0, 1e-6 * v.s[0][c]);
+        }
+        if (inc == 1) {
+            EXPECT_NEAR(polarization_of(v, 1).dop, 1.0, 1e-5);  // Brewster's angle
+        }
+    }
+}
+
+// A Lambertian base is an ideal depolarizer (ρ diag(1, 0, 0, 0), docs/physics.md §8): the light
+// it reflects has S1 = S2 = S3 = 0 in every bin, degree 0. Under a smooth coat (η = 1.5, no
+// medium) every exit is that unpolarized light refracted out once (light reflected back inside
+// meets the base again before it leaves), so away from the mirror bin a bin's Stokes vector is
+// the refraction Mueller matrix's first column, ∝ (T_s + T_p, T_s − T_p, 0, 0)/2 at the exit
+// angle, averaged over the bin with the exit density ∝ (T_s + T_p) cos θ sin θ (uniform radiance
+// under the coat): S1/S0 = ∫ (T_s − T_p) cos θ sin θ dθ / ∫ (T_s + T_p) cos θ sin θ dθ over the
+// bin's θ range (negative: p-polarized), within 4 standard errors of the degree (core/stokes.h,
+// an overestimate), and S2, S3 within 4 of theirs.
+TEST_P(UnpolarizedStokesStat, LambertianBase) {
+    SimulationSettings s = settings(GetParam(), {0, 45, 75}, 40'000, HemisphereGrid(9, 9));
+    const SimulationResult bare =
+        unpolarized_run(test::make_stack({test::lambertian_layer(Rgbd(0.8, 0.5, 0.2))}), s);
+    for (std::size_t inc = 0; inc < 3; ++inc)
+        for (std::size_t bin = 0; bin < s.grid.size(); ++bin) {
+            const BinStokesVector v = unpolarized_stokes(
+                bare.sums[inc], bin, s.grid.projected_solid_angle(bin), s.particles);
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_GT(v.s[0][c], 0.0);
+                for (int k = 1; k < 4; ++k)
+                    EXPECT_EQ(v.s[std::size_t(k)][c], 0.0);
+                EXPECT_EQ(polarization_of(v, c).dop, 0.0);
+            }
+        }
+
+    s.particles = 200'000;
+    const SimulationResult coated = unpolarized_run(
+        test::make_stack({test::dielectric_layer(1.5, 0.0), test::lambertian_layer(Rgbd(0.8))}), s);
+    // ∫ g(θ) cos θ sin θ dθ over [a, b], midpoint rule on 2000 steps.
+    auto integral = [](double a, double b, auto g) {
+        const int steps = 2000;
+        double sum = 0;
+        for (int k = 0; k < steps; ++k) {
+            const double t = a + (b - a) * (k + 0.5) / steps;
+            sum += g(std::cos(t)) * std::cos(t) * std::sin(t);
+        }
+        return sum * (b - a) / steps;
+    };
+    int checked = 0;
+    for (std::size_t inc = 0; inc < 3; ++inc) {
+        const Vec3f wi(incident_direction(deg_to_rad(s.theta_i_deg[inc])));
+        const std::size_t mirror = s.grid.bin_of(Vec3f(-wi.x, -wi.y, wi.z));
+        for (std::size_t bin = 0; bin < s.grid.size(); ++bin) {
+            if (bin == mirror) continue;
+            const int row = int(bin) / s.grid.n_phi();
+            const double a = deg_to_rad(10.0 * row), b = deg_to_rad(10.0 * (row + 1));
+            const double s1 = integral(a, b, [](double mu) {
+                const test::PolarizedFresnel f(mu, 1.5);
+                return f.Rp() - f.Rs();  // T_s − T_p
+            });
+            const double s0 = integral(a, b, [](double mu) {
+                const test::PolarizedFresnel f(mu, 1.5);
+                return 2 - f.Rs() - f.Rp();  // T_s + T_p
+            });
+            const BinStokesVector v = unpolarized_stokes(
+                coated.sums[inc], bin, s.grid.projected_solid_angle(bin), s.particles);
+            for (int c = 0; c < 3; ++c) {
+                const StokesPolarization p = polarization_of(v, c);
+                EXPECT_NEAR(v.s[1][c] / v.s[0][c], s1 / s0, 4 * p.dop_se)
+                    << "θi " << s.theta_i_deg[inc] << " bin " << bin << " channel " << c;
+                EXPECT_NEAR(v.s[2][c], 0.0, 4 * v.se[2][c] + 1e-6 * v.s[0][c]);  // float states
+                EXPECT_NEAR(v.s[3][c], 0.0, 4 * v.se[3][c] + 1e-6 * v.s[0][c]);
+                EXPECT_LE(p.dop, 1.0);
+                ++checked;
+            }
+        }
+    }
+    EXPECT_EQ(checked, 3 * (81 - 1) * 3);
+}
+
+// The degree of polarization of every bin is at most 1 (the bin's vector is a sum of states of
+// degree ≤ 1), on rough stacks with every kind of event, reflection and transmission.
+TEST_P(UnpolarizedStokesStat, DegreeAtMostOne) {
+    SimulationSettings s = settings(GetParam(), {0, 45, 80}, 50'000, HemisphereGrid(9, 9));
+    s.transport.microsurface = Microsurface::Multiple;
+    for (const Stack& stack : {rough_coat_over_gold(),
+                               test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.4),
+                                                                   Rgbd(0.0), Rgbd(0.5), Rgbd(0.6)),
+                                                 test::dielectric_layer(1.0, 0.2)})}) {
+        const SimulationResult run = unpolarized_run(stack, s);
+        int polarized = 0;
+        for (std::size_t inc = 0; inc < 3; ++inc)
+            for (std::size_t entry = 0; entry < 2 * s.grid.size(); ++entry) {
+                const BinStokesVector v = unpolarized_stokes(
+                    run.sums[inc], entry, s.grid.projected_solid_angle(entry % s.grid.size()),
+                    s.particles);
+                for (int c = 0; c < 3; ++c) {
+                    const StokesPolarization p = polarization_of(v, c);
+                    if (!(v.s[0][c] > 0)) continue;
+                    EXPECT_LE(p.dop, 1 + 1e-5);
+                    polarized += p.dop > 0.05;
+                }
+            }
+        EXPECT_GT(polarized, 0);  // the stacks polarize: the bound is not met by zeros
+    }
+}
+
 TEST(Mueller, NeedsPolarization) {
     SimulationSettings s = settings(Kernel::Scalar, {30}, 100, HemisphereGrid(9, 9));
     s.transport.polarization = false;

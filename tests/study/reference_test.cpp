@@ -4,11 +4,17 @@
 // value the reference had before the setting existed.
 #include "study/reference.h"
 
+#include "core/math.h"
+#include "core/spherical.h"
 #include "lamina/version.h"
+#include "support/closed_forms.h"
 #include "support/stacks.h"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
 
 namespace lamina {
 namespace {
@@ -76,6 +82,62 @@ TEST(StudyReference, LaterSettingsAreSaidOnlyAwayFromTheirEarlierValue) {
     s.transport.max_events = TransportSettings{}.max_events;
     s.transport.max_microsurface_order = 3;
     EXPECT_EQ(reference_key("c", stack, 30, s).canonical(), before + " | max_microsurface_order 3");
+}
+
+// A piece asked for Stokes vectors (the key's settings.stokes_tallies: a study with
+// --reference-stokes on) carries S1, S2, S3 per side and bin; a piece stored without them is not
+// served to such a key but computed again, and the piece with them serves a key without. One
+// smooth interface of 1.5 lit at 55°: its mirror bin holds light of degree (R_s − R_p)/(R_s + R_p)
+// and its straight-through bin light of degree (T_p − T_s)/(T_s + T_p), p-polarized (S1 < 0),
+// every particle with the same state (Born & Wolf's amplitudes, support/closed_forms.h).
+TEST(StudyReference, PieceCarriesTheStokesVectorsWhenAsked) {
+    const std::filesystem::path dir =
+        std::filesystem::path(LAMINA_BINARY_DIR) / "test-output" / "reference-cache-stokes";
+    std::filesystem::remove_all(dir);
+    SimulationSettings s;
+    s.particles = 20'000;
+    s.seed = 5;
+    s.grid = HemisphereGrid(9, 9);
+    const Stack stack = test::make_stack({test::dielectric_layer(1.5, 0.0)});
+    ReferenceKey plain = reference_key("interface", stack, 55, s);
+    bool computed = false;
+    const ReferencePiece without = reference_piece(dir, plain, 0, {}, &computed);
+    EXPECT_TRUE(computed);
+    EXPECT_TRUE(without.stokes[0].empty());
+    ReferenceKey asked = plain;
+    asked.settings.stokes_tallies = true;
+    EXPECT_EQ(asked.canonical(), plain.canonical());  // the tables are the same
+    EXPECT_FALSE(load_reference_piece(dir, asked).has_value());
+    const ReferencePiece with = reference_piece(dir, asked, 0, {}, &computed);
+    EXPECT_TRUE(computed);
+    EXPECT_EQ(with.f[0], without.f[0]);
+    ASSERT_EQ(with.stokes[0].size(), s.grid.size());
+    ASSERT_EQ(with.stokes[1].size(), s.grid.size());
+    const ReferencePiece again = reference_piece(dir, asked, 0, {}, &computed);
+    EXPECT_FALSE(computed);
+    EXPECT_EQ(again.stokes[1], with.stokes[1]);
+    EXPECT_EQ(again.stokes_se[0], with.stokes_se[0]);
+    reference_piece(dir, plain, 0, {}, &computed);
+    EXPECT_FALSE(computed);
+
+    const double mu_i = std::cos(deg_to_rad(55.0));
+    const test::PolarizedFresnel fresnel(mu_i, 1.5);
+    const double mu_t = std::sqrt(1 - (1 - mu_i * mu_i) / 2.25);
+    const Vec3f wi(incident_direction(deg_to_rad(55.0)));
+    const std::size_t mirror = s.grid.bin_of(Vec3f(-wi.x, -wi.y, wi.z));
+    const std::size_t straight = s.grid.bin_of(Vec3d(-std::sqrt(1 - mu_t * mu_t), 0, -mu_t));
+    const double Rs = fresnel.Rs(), Rp = fresnel.Rp();
+    const double expected[2] = {(Rs - Rp) / (Rs + Rp), (Rp - Rs) / (2 - Rs - Rp)};
+    for (int side = 0; side < 2; ++side) {
+        const std::size_t bin = side == 0 ? mirror : straight;
+        for (int c = 0; c < 3; ++c) {
+            const double f = with.f[side][bin][c];
+            EXPECT_NEAR(with.stokes[side][bin][0][c] / f, expected[side], 1e-5)
+                << "side " << side << " channel " << c;
+            EXPECT_NEAR(with.stokes[side][bin][1][c], 0.0, 1e-6 * f);
+            EXPECT_NEAR(with.stokes[side][bin][2][c], 0.0, 1e-6 * f);
+        }
+    }
 }
 
 }  // namespace

@@ -177,7 +177,9 @@ class Study:
     .configs: the configuration ids; .config(id): its config.json; .tables(id): {source: array
     [incidence, side, theta bin, phi bin, channel]} (float16 or float32 as stored, --tables; NaN
     on a side a model does not support); .reference_se(id): the reference's standard errors, same
-    axes.
+    axes; .reference_stokes(id): the polarized reference's Stokes components S1, S2, S3 for
+    unpolarized light and their standard errors, [2, incidence, side, 3, theta bin, phi bin,
+    channel] (a study run with --reference-stokes on).
     """
 
     def __init__(self, path, pandas=None):
@@ -211,6 +213,14 @@ class Study:
 
     def reference_se(self, config_id):
         return self._array(config_id, "reference_se")
+
+    def reference_stokes(self, config_id):
+        path = self._dir(config_id) / "reference_stokes.lza"
+        if not path.exists():
+            raise InputError(str(path), "reference_stokes",
+                             "missing: the study stores the Stokes vectors of a polarized "
+                             "reference when run with --reference-stokes on")
+        return read_array(path)
 
     def _array(self, config_id, stem):
         # configs/<id>/<stem>.lza (a packed array), or .npy from a study written before them.
