@@ -259,7 +259,6 @@ def _run(configs, models, preset, out, figures, quiet, nodes, peak_nodes, tables
     names, plugins = _split_models(models)
     reference = _reference_settings(settings)
     effective = dict(SIMULATION_SETTINGS, **reference)
-    theta_i = [float(t) for t in np.atleast_1d(effective["theta_i"])]
     grid = _grid_pair(effective["grid"])
     run = {
         "reference": reference, "study": {"tables": str(tables)}, "preset": preset,
@@ -269,8 +268,10 @@ def _run(configs, models, preset, out, figures, quiet, nodes, peak_nodes, tables
     }
     externals = []
     for p in plugins:
-        def table(config_id, stack, p=p):
-            return bin_model(p, stack, theta_i, grid, nodes, peak_nodes)
+        def table(config_id, stack, theta_i, phi_i, p=p):
+            # The configuration's incidences (θi, φi): an anisotropic one is lit from several
+            # azimuths, on the unfolded grid.
+            return bin_model(p, stack, theta_i, grid, nodes, peak_nodes, phi_i)
         externals.append((model_name(p), table))
     if not names and not externals and models is not None:
         raise input_error("arguments", "models", "no model to compare")
