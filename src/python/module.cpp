@@ -656,7 +656,7 @@ void bind_export(py::module_& m) {
         "_export",
         [](py::object source, const std::filesystem::path& path, const std::string& format,
            std::vector<double> theta_i, std::optional<int> resolution,
-           const std::string& description) {
+           const std::string& description, std::optional<int> azimuths) {
             // source: a Model or a Table (its reflection side).
             BrdfSource brdf;
             if (py::isinstance<PyModel>(source)) {
@@ -674,6 +674,7 @@ void bind_export(py::module_& m) {
                     RglOptions o;
                     o.theta_i_deg = theta_i;
                     if (resolution) o.resolution = *resolution;  // else RglOptions' default
+                    if (azimuths) o.azimuths = *azimuths;
                     o.description = description;
                     const TensorFile file = rgl_bsdf(brdf, o);
                     check_rgl_bsdf(file, path.string());
@@ -687,7 +688,7 @@ void bind_export(py::module_& m) {
             }
         },
         py::arg("source"), py::arg("path"), py::arg("format"), py::arg("theta_i"),
-        py::arg("resolution"), py::arg("description"));
+        py::arg("resolution"), py::arg("description"), py::arg("azimuths"));
 }
 
 // lamina.study and lamina.compare, with Python models as external tables.

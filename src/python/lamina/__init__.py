@@ -118,13 +118,15 @@ def _stderr_is_terminal():
 
 
 def export(source, path, format: Optional[str] = None, theta_i=None, resolution=None,
-           description: str = "") -> None:
+           description: str = "", azimuths=None) -> None:
     """Writes a Model, a Table or a SimulationResult (its reflection side) as an RGL .bsdf
     (pbrt-v4, Mitsuba 3) or a MERL .binary file, as `lamina export` does (docs/formats.md).
 
     format: "bsdf" or "merl" (default: from the path's extension). theta_i: a model's .bsdf
     incidences in degrees (default: lamina export's, denser towards grazing; a table's are its
-    own). resolution: the .bsdf's sample nodes a side (default: lamina export's).
+    own). resolution: the .bsdf's sample nodes a side (default: lamina export's). azimuths: the
+    φi intervals of an anisotropic stack's .bsdf over [-180°, 180°] (default: lamina export's
+    --azimuths).
     """
     path = Path(path)
     if format is None:
@@ -135,7 +137,8 @@ def export(source, path, format: Optional[str] = None, theta_i=None, resolution=
     if isinstance(source, SimulationResult):
         source = source.table
     _lamina._export(source, str(path), format, [float(t) for t in (theta_i or [])],
-                    None if resolution is None else int(resolution), str(description))
+                    None if resolution is None else int(resolution), str(description),
+                    None if azimuths is None else int(azimuths))
 
 
 # ---- study directories ------------------------------------------------------------------------

@@ -126,6 +126,7 @@ def _export(
     theta_i: List[float],
     resolution: Optional[int],
     description: str,
+    azimuths: Optional[int],
 ) -> None: ...
 def _table_from_arrays(
     f: _ArrayLike, theta_i: List[float], sides: List[str], unfolded: bool = ...
