@@ -160,12 +160,23 @@ int run_eval(const EvalArgs& a) {
     if (!a.directions.empty()) {
         std::ifstream in(a.directions);
         if (!in) throw InputError(a.directions, "", "cannot read the file");
+        // The light's azimuth is --phi-i's, or each row's in a phi_i column (an anisotropic
+        // stack seen from several azimuths in one batch).
+        constexpr const char* kHeader = "theta_i,theta_o,phi_o,side";
+        constexpr const char* kHeaderPhi = "theta_i,phi_i,theta_o,phi_o,side";
         std::string line;
-        if (!std::getline(in, line) || line != "theta_i,theta_o,phi_o,side")
+        if (std::getline(in, line) && !line.empty() && line.back() == '\r') line.pop_back();
+        const bool with_phi = line == kHeaderPhi;
+        if (line != kHeader && !with_phi)
             throw InputError(a.directions, "line 1",
-                             "expected the header 'theta_i,theta_o,phi_o,side'");
+                             fmt::format("expected the header '{}' or '{}'", kHeader, kHeaderPhi));
+        if (with_phi && a.phi_i != 0)
+            throw InputError(
+                "command line", "--phi-i",
+                fmt::format("{} has a phi_i column: give the azimuths there", a.directions));
+        const std::size_t columns = with_phi ? 5 : 4;
         struct Row {
-            double ti, to, po;
+            double ti, pi, to, po;
             Side side;
             std::string text;
         };
@@ -178,24 +189,29 @@ int run_eval(const EvalArgs& a) {
             for (std::string c; std::getline(ls, c, ',');)
                 cells.push_back(c);
             const std::string where = fmt::format("line {}", n);
-            if (cells.size() != 4)
-                throw InputError(a.directions, where,
-                                 fmt::format("expected 4 columns, found {}", cells.size()));
+            if (cells.size() != columns)
+                throw InputError(
+                    a.directions, where,
+                    fmt::format("expected {} columns, found {}", columns, cells.size()));
+            const std::size_t o = with_phi ? 1 : 0;  // the columns after theta_i
             Row r{parse_number(cells[0], a.directions, where + ", theta_i"),
-                  parse_number(cells[1], a.directions, where + ", theta_o"),
-                  parse_number(cells[2], a.directions, where + ", phi_o"),
-                  parse_side(cells[3], a.directions, where + ", side"), line};
+                  with_phi ? parse_number(cells[1], a.directions, where + ", phi_i") : a.phi_i,
+                  parse_number(cells[1 + o], a.directions, where + ", theta_o"),
+                  parse_number(cells[2 + o], a.directions, where + ", phi_o"),
+                  parse_side(cells[3 + o], a.directions, where + ", side"),
+                  line};
             check_incidence(r.ti, a.directions, where + ", theta_i");
+            check_angle(r.pi, 0, 360, true, a.directions, where + ", phi_i");
             check_angle(r.to, 0, 90, true, a.directions, where + ", theta_o");
             rows.push_back(r);
         }
         const Stack stack = load_stack(a.stack);
         const auto model = make_eval_model(entry, options, stack, a);
         configure_random_walk(*model, a);
-        std::string out = "theta_i,theta_o,phi_o,side,f_r,f_g,f_b\n";
+        std::string out = std::string(with_phi ? kHeaderPhi : kHeader) + ",f_r,f_g,f_b\n";
         for (const Row& r : rows) {
             require_side(*model, r.side, a.stack);
-            const Rgbd f = eval_at(*model, r.ti, a.phi_i, r.to, r.po, r.side);
+            const Rgbd f = eval_at(*model, r.ti, r.pi, r.to, r.po, r.side);
             fmt::format_to(std::back_inserter(out), "{},{},{},{}\n", r.text, f[0], f[1], f[2]);
         }
         write_file_atomic(a.out, out);
@@ -253,7 +269,8 @@ Runner add_eval(CLI::App& app) {
     cmd->add_option("--phi-o", a->phi_o, "Outgoing azimuth in degrees (mirror at 180)");
     cmd->add_option("--side", a->side, "R (reflection) or T (transmission; θo from -z)");
     cmd->add_option("--directions", a->directions,
-                    "CSV of directions: header theta_i,theta_o,phi_o,side");
+                    "CSV of directions: header theta_i,theta_o,phi_o,side (the light at "
+                    "--phi-i) or theta_i,phi_i,theta_o,phi_o,side");
     cmd->add_flag("--binned", a->binned,
                   "Cos-weighted bin averages in the goniophotometer's brdf.csv format");
     cmd->add_option("--grid", a->grid, "Bins for --binned, NTHETAxNPHI")->capture_default_str();

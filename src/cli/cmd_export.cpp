@@ -29,6 +29,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace lamina::cli {
@@ -64,33 +65,51 @@ nlohmann::json read_json(const std::filesystem::path& path) {
     }
 }
 
-// A study configuration's source (the reference or a model) as a binned table.
-BinnedTable study_table(const ExportArgs& a) {
+// A study configuration's source (the reference or a model): its binned table with the azimuth
+// of each incidence, and what a model source needs to be evaluated directly.
+struct StudySource {
+    BinnedTable table;
+    std::vector<double> phi_i_deg;  ///< the light's azimuth per incidence (0 when folded)
+    nlohmann::json stack;           ///< the configuration's (config.json)
+    std::string group;              ///< the source's group in study.json (model_groups)
+    std::string config_path;        ///< config.json, for messages
+};
+
+StudySource study_table(const ExportArgs& a) {
     const std::filesystem::path dir = std::filesystem::path(a.study) / "configs" / a.config;
     const nlohmann::json study = read_json(std::filesystem::path(a.study) / "study.json");
     if (!std::filesystem::is_directory(dir))
         throw InputError(a.study, "--config", fmt::format("no configuration '{}'", a.config));
     const nlohmann::json cfg = read_json(dir / "config.json");
+    StudySource out;
+    out.config_path = (dir / "config.json").string();
     try {
         const auto sources = cfg.at("sources").get<std::vector<std::string>>();
         const auto it = std::find(sources.begin(), sources.end(), a.source);
         if (it == sources.end())
-            throw InputError((dir / "config.json").string(), "--source",
+            throw InputError(out.config_path, "--source",
                              fmt::format("no source '{}'; this configuration has: {}", a.source,
                                          fmt::join(sources, ", ")));
         const std::size_t k = std::size_t(it - sources.begin());
-        if (cfg.contains("phi_i"))
-            throw InputError(
-                (dir / "config.json").string(), "phi_i",
-                fmt::format("'{}' is compared on the unfolded grid ({}) at incidences of several "
-                            "azimuths φi, which one table cannot hold: --study exports folded "
-                            "configurations; simulate the stack at one φi (lamina simulate "
-                            "--phi-i) and export that",
-                            a.config, cfg.value("grid", std::string("unfolded"))));
         const auto theta_i = cfg.at("theta_i").get<std::vector<double>>();
         const auto sides = cfg.at("sides").get<std::vector<std::string>>();
-        const HemisphereGrid grid(study.at("grid").at("n_theta").get<int>(),
-                                  study.at("grid").at("n_phi").get<int>());
+        HemisphereGrid grid(study.at("grid").at("n_theta").get<int>(),
+                            study.at("grid").at("n_phi").get<int>());
+        // An unfolded configuration (docs/formats.md): its incidences' azimuths and its grid.
+        out.phi_i_deg.assign(theta_i.size(), 0.0);
+        if (cfg.contains("phi_i")) {
+            out.phi_i_deg = cfg.at("phi_i").get<std::vector<double>>();
+            grid = grid.unfolded();
+            if (out.phi_i_deg.size() != theta_i.size())
+                throw InputError(out.config_path, "phi_i", "does not match theta_i");
+            if (cfg.value("grid", grid.to_string()) != grid.to_string())
+                throw InputError(out.config_path, "grid",
+                                 fmt::format("'{}' does not match study.json's grid ({})",
+                                             cfg.value("grid", ""), grid.to_string()));
+        }
+        out.stack = cfg.value("stack", nlohmann::json());
+        if (study.contains("model_groups"))
+            out.group = study.at("model_groups").value(a.source, std::string());
         const NpyFloat32 t = read_study_array(dir, "tables");
         const std::vector<std::size_t> want = {sources.size(),
                                                theta_i.size(),
@@ -101,27 +120,36 @@ BinnedTable study_table(const ExportArgs& a) {
         if (t.shape != want)
             throw InputError(study_array_path(dir, "tables").string(), "shape",
                              "does not match config.json and study.json");
-        BinnedTable table = BinnedTable::zeros(grid, theta_i, true, sides.size() == 2);
+        // The reference's standard errors go with it.
+        std::optional<NpyFloat32> se;
+        if (k == 0 && std::filesystem::exists(study_array_path(dir, "reference_se"))) {
+            se = read_study_array(dir, "reference_se");
+            if (std::vector<std::size_t>(want.begin() + 1, want.end()) != se->shape)
+                throw InputError(study_array_path(dir, "reference_se").string(), "shape",
+                                 "does not match config.json and study.json");
+        }
+        BinnedTable& table = out.table;
+        table = BinnedTable::zeros(grid, theta_i, true, sides.size() == 2);
+        const std::size_t source_offset = k * theta_i.size() * sides.size() * grid.size() * 3;
         for (std::size_t i = 0; i < theta_i.size(); ++i)
             for (std::size_t s = 0; s < sides.size(); ++s) {
                 BinnedLobe& lobe = table.lobe(i, s == 0 ? Side::Reflection : Side::Transmission);
+                if (se) lobe.se.assign(grid.size(), Rgbd(0.0));
+                const std::size_t lobe_offset = (i * sides.size() + s) * grid.size() * 3;
                 for (std::size_t j = 0; j < grid.size(); ++j)
-                    for (int c = 0; c < 3; ++c)
-                        lobe.f[j][c] =
-                            t.data[((((k * theta_i.size() + i) * sides.size() + s) * grid.size()) +
-                                    j) *
-                                       3 +
-                                   c];
+                    for (std::size_t c = 0; c < 3; ++c) {
+                        lobe.f[j][int(c)] = t.data[source_offset + lobe_offset + j * 3 + c];
+                        if (se) lobe.se[j][int(c)] = se->data[lobe_offset + j * 3 + c];
+                    }
             }
         for (const auto& lobe : table.lobe(0, Side::Reflection).f)
             if (!std::isfinite(lobe[0]))
                 throw InputError(
-                    (dir / "config.json").string(), "--source",
+                    out.config_path, "--source",
                     fmt::format("'{}' does not support this configuration's BRDF", a.source));
-        return table;
+        return out;
     } catch (const nlohmann::json::exception& e) {
-        throw InputError((dir / "config.json").string(), "",
-                         fmt::format("unexpected: {}", e.what()));
+        throw InputError(out.config_path, "", fmt::format("unexpected: {}", e.what()));
     }
 }
 
@@ -129,8 +157,10 @@ BinnedTable study_table(const ExportArgs& a) {
 struct Source {
     BinnedTable table;
     bool have_table = false;
+    std::vector<double> phi_i_deg;  ///< a table's: the light's azimuth per incidence
     std::shared_ptr<const Model> model;
     std::shared_ptr<const Stack> stack;  ///< the model's
+    StudySource study;                   ///< --study: the configuration's source
     nlohmann::json meta;
 };
 
@@ -151,11 +181,18 @@ Source load_source(const ExportArgs& a) {
         src.table = BinnedTable::from_csv(read_text(dir / "brdf.csv"), (dir / "brdf.csv").string());
         src.have_table = true;
         src.meta["source"] = "simulation";
-        if (std::filesystem::exists(dir / "result.json"))
+        double phi_i = 0;
+        if (std::filesystem::exists(dir / "result.json")) {
             src.meta["result"] = read_json(dir / "result.json");
+            if (src.meta["result"].value("phi_i", nlohmann::json(0.0)).is_number())
+                phi_i = src.meta["result"].value("phi_i", 0.0);
+        }
+        src.phi_i_deg.assign(src.table.theta_i_deg.size(), phi_i);
     } else if (!a.study.empty()) {
         if (a.config.empty()) throw InputError("command line", "--config", "required with --study");
-        src.table = study_table(a);
+        src.study = study_table(a);
+        src.table = src.study.table;
+        src.phi_i_deg = src.study.phi_i_deg;
         src.have_table = true;
         src.meta["source"] = {{"study", a.study}, {"config", a.config}, {"source", a.source}};
     } else {
@@ -168,11 +205,44 @@ Source load_source(const ExportArgs& a) {
     return src;
 }
 
+// A model source of an unfolded study configuration as a BRDF: its table holds the light at the
+// configuration's azimuths only, and a .bsdf or MERL file needs every φi, so the model (its name
+// and flags, as the study ran it) is evaluated on the configuration's stack. The reference and an
+// external model's table cannot be: InputError saying what to write instead.
+BrdfSource unfolded_study_brdf(const StudySource& st, const ExportArgs& a) {
+    std::vector<double> azimuths;
+    for (double phi : st.phi_i_deg)
+        if (std::find(azimuths.begin(), azimuths.end(), phi) == azimuths.end())
+            azimuths.push_back(phi);
+    const std::string held = fmt::format(
+        "'{}' is compared on the unfolded grid ({}), its light from φi = {}° only, "
+        "and a .bsdf or MERL file needs the BRDF at every φi",
+        a.config, st.table.grid.to_string(), fmt::join(azimuths, "°, "));
+    if (a.source == "reference")
+        throw InputError(st.config_path, "--source",
+                         held +
+                             ": write the reference as .npz (every incidence as the study has "
+                             "it), or export one of the study's models (--source MODEL), "
+                             "which is evaluated at every φi");
+    if (st.group == "external")
+        throw InputError(st.config_path, "--source",
+                         held + fmt::format(": '{}' is an external model, known by its table "
+                                            "alone: write it as .npz",
+                                            a.source));
+    if (st.stack.is_null()) throw InputError(st.config_path, "stack", "missing");
+    const Stack stack = stack_from_json(st.stack, st.config_path + ": stack");
+    const std::shared_ptr<const Model> model = make_model(a.source, stack);
+    BrdfSource brdf = model_brdf(model, stack, st.config_path);
+    brdf.name = a.source;
+    return brdf;
+}
+
 /// The reflection side of a source as a BRDF.
 BrdfSource brdf_of(const Source& src, const ExportArgs& a) {
-    return src.have_table ? table_brdf(src.table, a.simulation.empty() ? a.source : "reference",
-                                       a.simulation.empty() ? a.study : a.simulation)
-                          : model_brdf(src.model, *src.stack, a.stack);
+    if (!src.have_table) return model_brdf(src.model, *src.stack, a.stack);
+    if (!a.study.empty() && src.table.grid.is_unfolded()) return unfolded_study_brdf(src.study, a);
+    return table_brdf(src.table, a.simulation.empty() ? a.source : "reference",
+                      a.simulation.empty() ? a.study : a.simulation);
 }
 
 // The figures of rgl_fidelity.h, as a table: how close a renderer reading the file gets to its
@@ -313,6 +383,7 @@ int run_export(const ExportArgs& a) {
                                  "--theta-i"),
                 a.phi_i);
             meta["phi_i"] = a.phi_i;
+            src.phi_i_deg.assign(table.theta_i_deg.size(), a.phi_i);
         } else if (a.phi_i != 0) {
             throw InputError("command line", "--phi-i",
                              "a table's light azimuth is the one it was simulated with; --phi-i "
@@ -334,7 +405,8 @@ int run_export(const ExportArgs& a) {
             }
         const std::vector<std::size_t> shape = {n_inc, n_sides, std::size_t(g.n_theta()),
                                                 std::size_t(g.n_phi()), 3};
-        std::vector<float> theta_i(table.theta_i_deg.begin(), table.theta_i_deg.end()), te, pe;
+        std::vector<float> theta_i(table.theta_i_deg.begin(), table.theta_i_deg.end()),
+            phi_i(src.phi_i_deg.begin(), src.phi_i_deg.end()), te, pe;
         for (int t = 0; t <= g.n_theta(); ++t)
             te.push_back(float(90.0 * t / g.n_theta()));
         for (int p = 0; p <= g.n_phi(); ++p)
@@ -347,6 +419,7 @@ int run_export(const ExportArgs& a) {
         bytes = zip_stored({{"f.npy", npy_float32(f, shape)},
                             {"se.npy", npy_float32(se, shape)},
                             {"theta_i.npy", npy_float32(theta_i, {theta_i.size()})},
+                            {"phi_i.npy", npy_float32(phi_i, {phi_i.size()})},
                             {"theta_edges.npy", npy_float32(te, {te.size()})},
                             {"phi_edges.npy", npy_float32(pe, {pe.size()})},
                             {"metadata.json", meta.dump(1) + "\n"}});

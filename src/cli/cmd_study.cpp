@@ -78,7 +78,8 @@ ExternalModel model_table(const std::string& assignment) {
     if (!per_config && !std::filesystem::is_regular_file(pattern))
         throw InputError(pattern, "--model-table", "cannot read the file");
     m.source = pattern;
-    m.table = [pattern, per_config](const StudyConfiguration& c) {
+    m.table = [pattern, per_config](const StudyConfiguration& c, const std::vector<StudyIncidence>&,
+                                    const HemisphereGrid&) {
         std::string path = pattern;
         for (auto at = path.find("{id}"); at != std::string::npos; at = path.find("{id}"))
             path.replace(at, 4, c.id);
@@ -132,7 +133,7 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
     for (const std::string& assignment : a.model_tables)
         s.external_models.push_back(model_table(assignment));
     for (const std::string& assignment : a.model_plugins)
-        s.external_models.push_back(model_plugin(assignment, s));
+        s.external_models.push_back(model_plugin(assignment));
     return s;
 }
 

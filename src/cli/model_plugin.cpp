@@ -46,12 +46,51 @@ int run_process(const std::vector<std::string>& argv, const std::string& python_
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+// The plugin's table of `c` lit from phi_i at the incidences theta_i (python3 -m
+// lamina.plugin_table), or a table with neither side when the model supports neither.
+BinnedTable plugin_table(const std::string& file, const std::string& python,
+                         const StudyConfiguration& c, const std::vector<double>& theta_i,
+                         double phi_i, const HemisphereGrid& grid) {
+    std::string dir_template =
+        (std::filesystem::temp_directory_path() / "lamina-plugin-XXXXXX").string();
+    if (!mkdtemp(dir_template.data()))
+        throw InputError(file, "--model-plugin", "cannot create a temporary folder");
+    const std::filesystem::path dir = dir_template;
+    struct Cleanup {
+        std::filesystem::path dir;
+        ~Cleanup() {
+            std::error_code ec;
+            std::filesystem::remove_all(dir, ec);
+        }
+    } cleanup{dir};
+    std::ofstream(dir / "stack.json") << stack_to_json(c.stack).dump();
+    const int rc = run_process(
+        {python, "-m", "lamina.plugin_table", file, "--stack", (dir / "stack.json").string(),
+         "--theta-i", fmt::format("{}", fmt::join(theta_i, ",")), "--phi-i",
+         fmt::format("{}", phi_i), "--grid", grid.to_string(), "--out",
+         (dir / "table.csv").string()},
+        LAMINA_PYTHON_DIR);
+    if (rc == 3) {  // the model supports neither side of this stack
+        BinnedTable none;
+        none.has_reflection = false;
+        return none;
+    }
+    if (rc != 0)
+        throw InputError(file, "--model-plugin",
+                         fmt::format("the Python model failed on {} (exit status {}; its "
+                                     "message is above; interpreter: {})",
+                                     c.id, rc, python));
+    std::ifstream in(dir / "table.csv", std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return BinnedTable::from_csv(text.str(), file);
+}
+
 }  // namespace
 #endif
 
-ExternalModel model_plugin(const std::string& assignment, const StudySettings& settings) {
+ExternalModel model_plugin(const std::string& assignment) {
 #ifndef LAMINA_PYTHON_EXECUTABLE
-    (void)settings;
     throw InputError("command line", "--model-plugin",
                      fmt::format("'{}': this lamina was built without the Python module "
                                  "(install python3-dev and pybind11-dev, then rebuild)",
@@ -67,40 +106,16 @@ ExternalModel model_plugin(const std::string& assignment, const StudySettings& s
     m.source = file;
     const char* python_env = std::getenv("LAMINA_PYTHON");
     const std::string python = python_env && *python_env ? python_env : LAMINA_PYTHON_EXECUTABLE;
-    const std::string theta_i = fmt::format("{}", fmt::join(settings.reference.theta_i_deg, ","));
-    const std::string grid = settings.reference.grid.to_string();
-    m.table = [file, python, theta_i, grid](const StudyConfiguration& c) {
-        std::string dir_template =
-            (std::filesystem::temp_directory_path() / "lamina-plugin-XXXXXX").string();
-        if (!mkdtemp(dir_template.data()))
-            throw InputError(file, "--model-plugin", "cannot create a temporary folder");
-        const std::filesystem::path dir = dir_template;
-        struct Cleanup {
-            std::filesystem::path dir;
-            ~Cleanup() {
-                std::error_code ec;
-                std::filesystem::remove_all(dir, ec);
-            }
-        } cleanup{dir};
-        std::ofstream(dir / "stack.json") << stack_to_json(c.stack).dump();
-        const int rc = run_process(
-            {python, "-m", "lamina.plugin_table", file, "--stack", (dir / "stack.json").string(),
-             "--theta-i", theta_i, "--grid", grid, "--out", (dir / "table.csv").string()},
-            LAMINA_PYTHON_DIR);
-        if (rc == 3) {  // the model supports neither side of this stack
-            BinnedTable none;
-            none.has_reflection = false;
-            return none;
-        }
-        if (rc != 0)
-            throw InputError(file, "--model-plugin",
-                             fmt::format("the Python model failed on {} (exit status {}; its "
-                                         "message is above; interpreter: {})",
-                                         c.id, rc, python));
-        std::ifstream in(dir / "table.csv", std::ios::binary);
-        std::ostringstream text;
-        text << in.rdbuf();
-        return BinnedTable::from_csv(text.str(), file);
+    m.unfolded = true;  // the plugin is evaluated at any wi
+    // A brdf.csv row carries θi alone: the model is binned once per light azimuth of the
+    // configuration (once for a folded one), and the tables gathered in the incidences' order.
+    m.table = [file, python](const StudyConfiguration& c,
+                             const std::vector<StudyIncidence>& incidences,
+                             const HemisphereGrid& grid) {
+        return gather_azimuths(incidences, file,
+                               [&](const std::vector<double>& theta_i, double phi_i) {
+                                   return plugin_table(file, python, c, theta_i, phi_i, grid);
+                               });
     };
     return m;
 #endif

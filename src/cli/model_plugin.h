@@ -12,7 +12,9 @@
 namespace lamina::cli {
 
 /// The external model of one `--model-plugin` assignment (InputError naming the option for a
-/// missing file or a build without Python). `settings` gives the grid and incidences.
-ExternalModel model_plugin(const std::string& assignment, const StudySettings& settings);
+/// missing file or a build without Python). Each configuration's table is binned at its
+/// incidences (θi, φi) on its grid, unfolded ones included: the model gets wi and wo in the
+/// stack's frame, over the full azimuth there.
+ExternalModel model_plugin(const std::string& assignment);
 
 }  // namespace lamina::cli

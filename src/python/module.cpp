@@ -334,10 +334,11 @@ py::dict support_of(const Support& s) {
     return d;
 }
 
-/// A table from numpy: f [n_inc, n_sides, n_theta, n_phi, 3] for `sides` ("R", "T"), se = 0.
+/// A table from numpy: f [n_inc, n_sides, n_theta, n_phi, 3] for `sides` ("R", "T"), se = 0;
+/// `unfolded`: the φ bins cover [0°, 360°) (n_phi even: the unfolded grid of n_phi / 2).
 BinnedTable table_from_arrays(py::array_t<double, py::array::c_style | py::array::forcecast> f,
                               const std::vector<double>& theta_i,
-                              const std::vector<std::string>& sides) {
+                              const std::vector<std::string>& sides, bool unfolded) {
     if (f.ndim() != 5 || f.shape(4) != 3 || std::size_t(f.shape(0)) != theta_i.size() ||
         std::size_t(f.shape(1)) != sides.size())
         throw InputError("arguments", "f",
@@ -350,7 +351,12 @@ BinnedTable table_from_arrays(py::array_t<double, py::array::c_style | py::array
     }
     if (sides.size() == 2 && sides[0] != "R")
         throw InputError("arguments", "sides", "use the order ['R', 'T']");
-    const HemisphereGrid grid = grid_of({int(f.shape(2)), int(f.shape(3))});
+    if (unfolded && f.shape(3) % 2 != 0)
+        throw InputError("arguments", "f",
+                         "an unfolded table has an even number of φ bins over [0°, 360°)");
+    const HemisphereGrid grid = unfolded
+                                    ? grid_of({int(f.shape(2)), int(f.shape(3) / 2)}).unfolded()
+                                    : grid_of({int(f.shape(2)), int(f.shape(3))});
     BinnedTable table = BinnedTable::zeros(grid, theta_i, r, t);
     const double* p = f.data();
     for (std::size_t i = 0; i < theta_i.size(); ++i)
@@ -370,7 +376,8 @@ BinnedTable table_from_arrays(py::array_t<double, py::array::c_style | py::array
 }
 
 /// lamina.study / lamina.compare: run_study with Python models as external tables, then the
-/// explorer and the figures. `externals`: [(name, fn(config_id, stack) -> Table | None)].
+/// explorer and the figures. `externals`: [(name, fn(config_id, stack, theta_i, phi_i) -> Table |
+/// None)], theta_i and phi_i the configuration's incidences (degrees, in order).
 void run_study_py(py::list configs_in, py::dict settings, py::list externals,
                   const std::filesystem::path& out, bool figures) {
     std::vector<StudyConfiguration> configs;
@@ -396,9 +403,16 @@ void run_study_py(py::list configs_in, py::dict settings, py::list externals,
         m.name = e[py::int_(0)].cast<std::string>();
         m.source = "Python model '" + m.name + "'";
         py::object fn = py::reinterpret_borrow<py::object>(e[py::int_(1)]);
-        m.table = [fn](const StudyConfiguration& c) {
+        m.unfolded = true;  // a Python model is evaluated at any wi
+        m.table = [fn](const StudyConfiguration& c, const std::vector<StudyIncidence>& incidences,
+                       const HemisphereGrid&) {
             py::gil_scoped_acquire gil;
-            py::object t = fn(c.id, c.stack);
+            std::vector<double> theta_i, phi_i;
+            for (const StudyIncidence& inc : incidences) {
+                theta_i.push_back(inc.theta_i);
+                phi_i.push_back(inc.phi_i);
+            }
+            py::object t = fn(c.id, c.stack, theta_i, phi_i);
             if (t.is_none()) {
                 BinnedTable none;
                 none.has_reflection = false;
@@ -483,9 +497,10 @@ void bind_table(py::module_& m) {
             },
             py::arg("path"))
         .def_static("from_arrays", &table_from_arrays, py::arg("f"), py::arg("theta_i"),
-                    py::arg("sides") = std::vector<std::string>{"R"},
+                    py::arg("sides") = std::vector<std::string>{"R"}, py::arg("unfolded") = false,
                     "A table from f [incidence, side, θ bin, φ bin, 3] (1/sr, cos-weighted bin "
-                    "averages; se = 0), e.g. to write a --model-table CSV with to_csv()")
+                    "averages; se = 0), e.g. to write a --model-table CSV with to_csv(); "
+                    "unfolded: the φ bins cover [0°, 360°) (an anisotropic stack, φi ≠ 0)")
         .def_property_readonly(
             "f", [](const BinnedTable& t) { return lobes_array(t, false); },
             "f [incidence, side, θ bin, φ bin, channel], 1/sr")
@@ -641,7 +656,7 @@ void bind_export(py::module_& m) {
         "_export",
         [](py::object source, const std::filesystem::path& path, const std::string& format,
            std::vector<double> theta_i, std::optional<int> resolution,
-           const std::string& description) {
+           const std::string& description, std::optional<int> azimuths) {
             // source: a Model or a Table (its reflection side).
             BrdfSource brdf;
             if (py::isinstance<PyModel>(source)) {
@@ -659,6 +674,7 @@ void bind_export(py::module_& m) {
                     RglOptions o;
                     o.theta_i_deg = theta_i;
                     if (resolution) o.resolution = *resolution;  // else RglOptions' default
+                    if (azimuths) o.azimuths = *azimuths;
                     o.description = description;
                     const TensorFile file = rgl_bsdf(brdf, o);
                     check_rgl_bsdf(file, path.string());
@@ -672,13 +688,26 @@ void bind_export(py::module_& m) {
             }
         },
         py::arg("source"), py::arg("path"), py::arg("format"), py::arg("theta_i"),
-        py::arg("resolution"), py::arg("description"));
+        py::arg("resolution"), py::arg("description"), py::arg("azimuths"));
 }
 
 // lamina.study and lamina.compare, with Python models as external tables.
 void bind_study(py::module_& m) {
     m.def("_table_from_arrays", &table_from_arrays, py::arg("f"), py::arg("theta_i"),
-          py::arg("sides"));
+          py::arg("sides"), py::arg("unfolded") = false);
+    // Whether the goniophotometer tabulates this stack lit from these azimuths (degrees) on the
+    // unfolded grid (simulation_grid's rule: an anisotropic stack, or some φi ≠ 0).
+    m.def(
+        "_unfolded",
+        [](const Stack& stack, const std::vector<double>& phi_i) {
+            SimulationSettings s;
+            for (double phi : phi_i) {
+                s.phi_i_deg = phi;
+                if (simulation_grid(stack, s).is_unfolded()) return true;
+            }
+            return simulation_grid(stack, s).is_unfolded();
+        },
+        py::arg("stack"), py::arg("phi_i"));
     m.def("_run_study", &run_study_py, py::arg("configs"), py::arg("settings"),
           py::arg("externals"), py::arg("out"), py::arg("figures"));
     // The configurations a study runs at `preset` (the iridescent category in the larger ones).

@@ -31,17 +31,32 @@ inline const char* enum_noun(TablesFormat) {
     return "a table format";
 }
 
+/// One incidence of a configuration in the study: θi and the azimuth φi the light comes from
+/// (degrees; wi = (sin θi cos φi, sin θi sin φi, cos θi), as the goniophotometer's --phi-i).
+struct StudyIncidence {
+    double theta_i = 0, phi_i = 0;
+};
+
 /// A model evaluated elsewhere that joins the study as binned tables, like a built-in model: a
 /// `--model-table NAME=FILE.csv` (a renderer's or a fit's values in the brdf.csv format) or a
-/// Python plugin binned by the Python module. Each table must have the study's grid and
+/// Python model binned by the Python module. Each table must have the configuration's grid and
 /// incidences (checked: InputError naming `source`).
 struct ExternalModel {
     std::string name;
     std::string source;  ///< where the tables come from (a file, a pattern, "python"), for messages
-    /// The table of one configuration: its R side (and T for a slab). A table with neither side
-    /// (has_reflection and has_transmission both false) means the model does not cover the
-    /// configuration (reported as not supported).
-    std::function<BinnedTable(const StudyConfiguration&)> table;
+    /// Whether `table` can answer an unfolded configuration (an anisotropic stack, or light from
+    /// φi ≠ 0: its incidences' azimuths and the unfolded grid): a Python model can, evaluated at
+    /// any wi; a model table cannot (brdf.csv rows carry θi alone), and such a configuration
+    /// reports it not supported.
+    bool unfolded = false;
+    /// The table of one configuration at its incidences (in order) on its grid (study_incidences,
+    /// study_grid): its R side (and T for a slab). A table with neither side (has_reflection and
+    /// has_transmission both false) means the model does not cover the configuration (reported
+    /// as not supported).
+    std::function<BinnedTable(const StudyConfiguration&,
+                              const std::vector<StudyIncidence>& incidences,
+                              const HemisphereGrid& grid)>
+        table;
 };
 
 struct StudySettings {
@@ -83,12 +98,6 @@ struct StudySettings {
                .key = SettingInfo::Key::No},
               s.reference_stokes);
     }
-};
-
-/// One incidence of a configuration in the study: θi and the azimuth φi the light comes from
-/// (degrees; wi = (sin θi cos φi, sin θi sin φi, cos θi), as the goniophotometer's --phi-i).
-struct StudyIncidence {
-    double theta_i = 0, phi_i = 0;
 };
 
 /// The azimuths φi an anisotropic configuration is lit from (docs/study.md, "Brushed"): along

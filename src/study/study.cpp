@@ -341,7 +341,7 @@ class ConfigurationRun {
         const auto external =
             std::find_if(s_.external_models.begin(), s_.external_models.end(),
                          [&](const ExternalModel& e) { return e.name == m.name; });
-        if (external != s_.external_models.end() && grid_.is_unfolded()) {
+        if (external != s_.external_models.end() && grid_.is_unfolded() && !external->unfolded) {
             // A model table's rows carry θi only (brdf.csv): no table of an unfolded
             // configuration, whose incidences differ in φi too.
             m.support.reason = fmt::format(
@@ -349,10 +349,13 @@ class ConfigurationRun {
                 "the unfolded grid, lit from several azimuths)",
                 external->source);
         } else if (external != s_.external_models.end()) {
-            table = external->table(config_);
-            if (table.has_reflection || table.has_transmission)
-                check_external_table(table, grid_, s_.reference.theta_i_deg, transmits_,
-                                     external->source);
+            table = external->table(config_, incidences_, grid_);
+            if (table.has_reflection || table.has_transmission) {
+                std::vector<double> theta_i;
+                for (const StudyIncidence& inc : incidences_)
+                    theta_i.push_back(inc.theta_i);
+                check_external_table(table, grid_, theta_i, transmits_, external->source);
+            }
             m.support.brdf = table.has_reflection;
             m.support.btdf = transmits_ && table.has_transmission;
             if (!m.support.brdf || (transmits_ && !m.support.btdf))
@@ -381,29 +384,10 @@ class ConfigurationRun {
     // on an unfolded one, each azimuth's incidences at once, gathered in the incidences' order.
     BinnedTable bin_registry_model(const Model& model) const {
         if (!grid_.is_unfolded()) return bin_model(model, grid_, s_.reference.theta_i_deg);
-        std::vector<double> azimuths;
-        for (const StudyIncidence& inc : incidences_)
-            if (std::find(azimuths.begin(), azimuths.end(), inc.phi_i) == azimuths.end())
-                azimuths.push_back(inc.phi_i);
-        std::vector<double> thetas;
-        for (const StudyIncidence& inc : incidences_)
-            thetas.push_back(inc.theta_i);
-        BinnedTable out;
-        for (double phi : azimuths) {
-            std::vector<double> at_phi;
-            for (const StudyIncidence& inc : incidences_)
-                if (inc.phi_i == phi) at_phi.push_back(inc.theta_i);
-            BinnedTable t = bin_model(model, grid_, at_phi, phi);
-            if (out.lobes.empty()) {
-                out = t;
-                out.theta_i_deg = thetas;
-                out.lobes.assign(incidences_.size(), t.lobes.front());
-            }
-            std::size_t k = 0;
-            for (std::size_t i = 0; i < incidences_.size(); ++i)
-                if (incidences_[i].phi_i == phi) out.lobes[i] = std::move(t.lobes[k++]);
-        }
-        return out;
+        return gather_azimuths(incidences_, model.name(),
+                               [&](const std::vector<double>& theta_i, double phi_i) {
+                                   return bin_model(model, grid_, theta_i, phi_i);
+                               });
     }
 
     // The model's table, albedos and metric rows against the reference.
@@ -693,6 +677,44 @@ std::vector<StudyIncidence> study_incidences(const Stack& stack,
 
 HemisphereGrid study_grid(const Stack& stack, const SimulationSettings& reference) {
     return simulation_grid(stack, reference);
+}
+
+BinnedTable gather_azimuths(const std::vector<StudyIncidence>& incidences, const std::string& where,
+                            const std::function<BinnedTable(const std::vector<double>& theta_i_deg,
+                                                            double phi_i_deg)>& at_azimuth) {
+    std::vector<double> azimuths, thetas;
+    for (const StudyIncidence& inc : incidences) {
+        if (std::find(azimuths.begin(), azimuths.end(), inc.phi_i) == azimuths.end())
+            azimuths.push_back(inc.phi_i);
+        thetas.push_back(inc.theta_i);
+    }
+    BinnedTable out;
+    for (double phi : azimuths) {
+        std::vector<double> at_phi;
+        for (const StudyIncidence& inc : incidences)
+            if (inc.phi_i == phi) at_phi.push_back(inc.theta_i);
+        BinnedTable t = at_azimuth(at_phi, phi);
+        if (!t.has_reflection && !t.has_transmission) return t;  // no side: not supported
+        if (t.lobes.size() != at_phi.size())
+            throw InputError(where, "theta_i",
+                             fmt::format("{} incidences for the {} at φi = {}°", t.lobes.size(),
+                                         at_phi.size(), phi));
+        if (out.lobes.empty()) {
+            out = t;
+            out.theta_i_deg = thetas;
+            out.lobes.assign(incidences.size(), t.lobes.front());
+        } else if (!(t.grid == out.grid) || t.has_reflection != out.has_reflection ||
+                   t.has_transmission != out.has_transmission) {
+            throw InputError(where, "grid",
+                             fmt::format("the table at φi = {}° has another grid or other sides "
+                                         "than at φi = {}°",
+                                         phi, azimuths.front()));
+        }
+        std::size_t k = 0;
+        for (std::size_t i = 0; i < incidences.size(); ++i)
+            if (incidences[i].phi_i == phi) out.lobes[i] = std::move(t.lobes[k++]);
+    }
+    return out;
 }
 
 std::string metrics_csv(const std::vector<MetricRow>& rows) {

@@ -73,6 +73,16 @@ void check_external_table(const BinnedTable& table, const HemisphereGrid& grid,
                           const std::vector<double>& theta_i_deg, bool transmits,
                           const std::string& where);
 
+/// The table of a configuration's incidences (in order) from tables of one light azimuth each:
+/// `at_azimuth(theta_i_deg, phi_i_deg)` gives the table of the incidences lit from phi_i_deg (their
+/// θi in the incidences' order), called once per distinct azimuth, in order of first appearance
+/// (once for a folded configuration); its lobes are gathered back in the incidences' order. A
+/// table with neither side is returned as it is (not supported). InputError naming `where` when the
+/// tables of two azimuths differ in grid or sides, or one has not as many incidences as asked for.
+BinnedTable gather_azimuths(const std::vector<StudyIncidence>& incidences, const std::string& where,
+                            const std::function<BinnedTable(const std::vector<double>& theta_i_deg,
+                                                            double phi_i_deg)>& at_azimuth);
+
 /// metrics.csv text of the rows.
 std::string metrics_csv(const std::vector<MetricRow>& rows);
 

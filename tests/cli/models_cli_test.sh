@@ -87,6 +87,21 @@ JSON
     expect_output aniso-point-three-numbers "^[0-9.e+-]* [0-9.e+-]* [0-9.e+-]*$"
     check aniso-not-supported 1 "$lamina" eval --model tm2 --stack "$tmp/brushed.json" --theta-i 30 --theta-o 45 --phi-o 180
     expect_output aniso-not-supported-says "not supported: the stack has an anisotropic interface"
+    # A batch with a phi_i column: each row lit from its own azimuth, as --phi-i lights a point
+    # (the brushed stack's value changes with φi at fixed φo − φi, so a dropped column shows).
+    printf 'theta_i,phi_i,theta_o,phi_o,side\n30,200,45,20,R\n30,0,45,180,R\n' >"$tmp/dirs-phi.csv"
+    check batch-phi 0 "$lamina" eval --model openpbr --stack "$tmp/brushed.json" --directions "$tmp/dirs-phi.csv" --out "$tmp/fphi.csv"
+    p1=$("$lamina" eval --model openpbr --stack "$tmp/brushed.json" --theta-i 30 --phi-i 200 --theta-o 45 --phi-o 20 | tr ' ' ',')
+    p2=$("$lamina" eval --model openpbr --stack "$tmp/brushed.json" --theta-i 30 --theta-o 45 --phi-o 180 | tr ' ' ',')
+    if head -1 "$tmp/fphi.csv" | grep -qx 'theta_i,phi_i,theta_o,phi_o,side,f_r,f_g,f_b' &&
+        [ "$(sed -n 2p "$tmp/fphi.csv")" = "30,200,45,20,R,$p1" ] &&
+        [ "$(sed -n 3p "$tmp/fphi.csv")" = "30,0,45,180,R,$p2" ] && [ "$p1" != "$p2" ]; then
+        pass=$((pass + 1)); else echo "FAIL batch with phi_i: $p1 / $p2"; cat "$tmp/fphi.csv"; fails=$((fails + 1)); fi
+    printf 'theta_i,phi_i,theta_o,phi_o,side\n30,400,45,20,R\n' >"$tmp/dirs-bad-phi.csv"
+    check batch-phi-range 1 "$lamina" eval --model openpbr --stack "$tmp/brushed.json" --directions "$tmp/dirs-bad-phi.csv" --out "$tmp/g.csv"
+    expect_output batch-phi-range-says "line 2, phi_i: 400 degrees is outside \[0, 360\]"
+    check batch-phi-twice 1 "$lamina" eval --model openpbr --stack "$tmp/brushed.json" --phi-i 10 --directions "$tmp/dirs-phi.csv" --out "$tmp/g.csv"
+    expect_output batch-phi-twice-says "has a phi_i column"
     check phi-i-range 1 "$lamina" eval --model ww09 --stack "$tmp/gold.json" --theta-i 30 --phi-i 400 --theta-o 45 --phi-o 180
     expect_output phi-i-range-says "phi-i"
     check phi-i-nan 1 "$lamina" eval --model ww09 --stack "$tmp/gold.json" --theta-i 30 --phi-i nan --theta-o 45 --phi-o 180

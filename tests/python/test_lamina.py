@@ -519,6 +519,23 @@ def test_export_from_python_takes_the_cli_defaults(tmp_path):
     assert shapes[0] == shapes[1] and "incidences" in shapes[0]
 
 
+def test_export_from_python_takes_the_azimuths_of_an_anisotropic_stack(tmp_path):
+    # The φi slices of a brushed stack's file: the CLI's --azimuths. The files differ only in
+    # their description text; 4 and 8 intervals give 5 and 9 slices, and each slice holds per
+    # incidence vndf [2, 512], luminance [8, 8] and spectra [7, 8, 8], and its phi_i entry, in
+    # float32 (formats.md).
+    common = dict(theta_i=[0, 40], resolution=8)
+    cli("export", "--model", "openpbr", "--stack", BRUSHED, "--azimuths", 4, "--theta-i", "0,40",
+        "--resolution", 8, "--out", tmp_path / "cli.bsdf")
+    for n in (4, 8):
+        lamina.export(lamina.Model("openpbr", BRUSHED), tmp_path / f"py{n}.bsdf", azimuths=n,
+                      **common)
+    size = {name: (tmp_path / name).stat().st_size for name in ("cli.bsdf", "py4.bsdf", "py8.bsdf")}
+    assert abs(size["cli.bsdf"] - size["py4.bsdf"]) < 1000, size
+    per_slice = (2 * (2 * 512 + 8 * 8 + 7 * 8 * 8) + 1) * 4
+    assert size["py8.bsdf"] - size["py4.bsdf"] == 4 * per_slice, size
+
+
 def test_export_from_python_is_the_cli_file(tmp_path):
     cli("export", "--model", "ww-prime", "--stack", PLASTIC, "--out", tmp_path / "cli.binary")
     lamina.export(lamina.Model("ww-prime", PLASTIC), tmp_path / "py.binary")

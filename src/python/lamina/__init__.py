@@ -118,13 +118,15 @@ def _stderr_is_terminal():
 
 
 def export(source, path, format: Optional[str] = None, theta_i=None, resolution=None,
-           description: str = "") -> None:
+           description: str = "", azimuths=None) -> None:
     """Writes a Model, a Table or a SimulationResult (its reflection side) as an RGL .bsdf
     (pbrt-v4, Mitsuba 3) or a MERL .binary file, as `lamina export` does (docs/formats.md).
 
     format: "bsdf" or "merl" (default: from the path's extension). theta_i: a model's .bsdf
     incidences in degrees (default: lamina export's, denser towards grazing; a table's are its
-    own). resolution: the .bsdf's sample nodes a side (default: lamina export's).
+    own). resolution: the .bsdf's sample nodes a side (default: lamina export's). azimuths: the
+    φi intervals of an anisotropic stack's .bsdf over [-180°, 180°] (default: lamina export's
+    --azimuths).
     """
     path = Path(path)
     if format is None:
@@ -135,7 +137,8 @@ def export(source, path, format: Optional[str] = None, theta_i=None, resolution=
     if isinstance(source, SimulationResult):
         source = source.table
     _lamina._export(source, str(path), format, [float(t) for t in (theta_i or [])],
-                    None if resolution is None else int(resolution), str(description))
+                    None if resolution is None else int(resolution), str(description),
+                    None if azimuths is None else int(azimuths))
 
 
 # ---- study directories ------------------------------------------------------------------------
@@ -269,7 +272,6 @@ def _run(configs, models, preset, out, figures, quiet, nodes, peak_nodes, tables
     names, plugins = _split_models(models)
     reference = _reference_settings(settings)
     effective = dict(SIMULATION_SETTINGS, **reference)
-    theta_i = [float(t) for t in np.atleast_1d(effective["theta_i"])]
     grid = _grid_pair(effective["grid"])
     run = {
         "reference": reference, "study": {"tables": str(tables)}, "preset": preset,
@@ -279,8 +281,10 @@ def _run(configs, models, preset, out, figures, quiet, nodes, peak_nodes, tables
     }
     externals = []
     for p in plugins:
-        def table(config_id, stack, p=p):
-            return bin_model(p, stack, theta_i, grid, nodes, peak_nodes)
+        def table(config_id, stack, theta_i, phi_i, p=p):
+            # The configuration's incidences (θi, φi): an anisotropic one is lit from several
+            # azimuths, on the unfolded grid.
+            return bin_model(p, stack, theta_i, grid, nodes, peak_nodes, phi_i)
         externals.append((model_name(p), table))
     if not names and not externals and models is not None:
         raise input_error("arguments", "models", "no model to compare")

@@ -1,9 +1,12 @@
 """`lamina study|compare --model-plugin NAME=FILE.py` calls this to bin a Python model.
 
-    python3 -m lamina.plugin_table FILE.py --stack STACK.json --theta-i 0,60 --grid 90x90 --out T.csv
+    python3 -m lamina.plugin_table FILE.py --stack STACK.json --theta-i 0,60 [--phi-i 0,45] \
+        --grid 90x90 --out T.csv
 
 FILE.py defines MODEL: a class (called with the lamina.Stack) or an object with a vectorized
-eval(wi, wo), as lamina.plugins describes. Writes the model's binned table (the brdf.csv format)
+eval(wi, wo), as lamina.plugins describes. --phi-i: the light's azimuth per incidence (degrees,
+default 0); the grid is unfolded for an anisotropic stack or an azimuth off 0 (--grid may say
+"90x90 unfolded", as the study names such a grid). Writes the model's binned table (the brdf.csv format)
 to --out; exit status 0 when written, 3 when the model supports neither side of the stack, 1 on
 an error (printed as `lamina: FILE: FIELD: PROBLEM`).
 """
@@ -36,15 +39,18 @@ def main(argv=None):
     p.add_argument("plugin")
     p.add_argument("--stack", required=True)
     p.add_argument("--theta-i", required=True)
+    p.add_argument("--phi-i", default=None)
     p.add_argument("--grid", required=True)
     p.add_argument("--nodes", type=int, default=4)
     p.add_argument("--out", required=True)
     a = p.parse_args(argv)
     try:
         model = load_model(a.plugin)
-        n_theta, n_phi = (int(x) for x in a.grid.split("x"))
-        table = bin_model(model, Stack(a.stack), [float(t) for t in a.theta_i.split(",")],
-                          (n_theta, n_phi), a.nodes)
+        n_theta, n_phi = (int(x) for x in a.grid.split()[0].split("x"))
+        theta_i = [float(t) for t in a.theta_i.split(",")]
+        phi_i = [float(p) for p in a.phi_i.split(",")] if a.phi_i else 0.0
+        table = bin_model(model, Stack(a.stack), theta_i, (n_theta, n_phi), a.nodes,
+                          phi_i=phi_i)
     except InputError as e:
         print(f"lamina: {e}", file=sys.stderr)
         return 1

@@ -13,8 +13,11 @@ A model is a class (instantiated with the stack: ``Model(stack)``) or an object 
 lamina averages it over its bins with its own quadrature, in large batches: each bin gets the
 ``nodes`` x ``nodes`` Gauss-Legendre product rule in (theta, phi) with the weight
 sin(theta) cos(theta) (normalized by the same rule, so that constants are exact), and the bins
-holding a peak direction get ``peak_nodes`` x ``peak_nodes``. The model must be isotropic (the
-bins fold phi and -phi together: it is evaluated on phi in [0, 180] degrees).
+holding a peak direction get ``peak_nodes`` x ``peak_nodes``. The bins are the goniophotometer's:
+for an isotropic stack lit from phi_i = 0 they fold phi and -phi together (the model is evaluated
+on phi in [0, 180] degrees); an anisotropic stack, or light from an azimuth phi_i != 0, gets the
+unfolded grid (phi in [0, 360) degrees), where the model sees wi and wo in the stack's frame over
+the full azimuth (its tangents are in the stack it was made with).
 """
 
 from __future__ import annotations
@@ -100,10 +103,15 @@ def _average(model, name, wi, t0, t1, p0, p1, n, lower):
     return np.einsum("bij,bijc->bc", weight, f) / weight.sum(axis=(1, 2))[:, None]
 
 
-def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32):
+def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32, phi_i=0.0):
     """A Python model on lamina's bins: a lamina.Table (the brdf.csv format), or None when the
     model supports neither side of this stack. grid: (n_theta, n_phi), default the
-    goniophotometer's."""
+    goniophotometer's. phi_i: the light's azimuth in degrees, one for every incidence or one per
+    incidence (wi = (sin θi cos φi, sin θi sin φi, cos θi)). The bins are those the
+    goniophotometer tabulates: folded (φ over [0°, 180°], each bin both halves ±φ) for an
+    isotropic stack lit from φi = 0, unfolded otherwise (an anisotropic stack, or some φi ≠ 0:
+    2 n_phi bins over [0°, 360°), each one patch), where the model gets wo over the full azimuth
+    in the stack's frame."""
     stack = _lamina.Stack(stack)
     model = instantiate(obj, stack)
     name = model_name(obj)
@@ -112,28 +120,39 @@ def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32):
     if not sides:
         return None
     theta_i = [float(t) for t in np.atleast_1d(theta_i)]
+    phi = np.atleast_1d(np.asarray(phi_i, dtype=np.float64))
+    if phi.ndim == 1 and len(phi) == 1:
+        phi = np.full(len(theta_i), phi[0])
+    if phi.ndim != 1 or len(phi) != len(theta_i) or not np.all((phi >= 0) & (phi <= 360)):
+        raise input_error("arguments", "phi_i",
+                          "one azimuth in [0, 360] degrees, or one per incidence")  # NaN too
+    phi_i = [float(p) for p in phi]
     if grid is None:
         default = _lamina.SIMULATION_SETTINGS["grid"]
         grid = (default["n_theta"], default["n_phi"])
-    n_theta, n_phi = int(grid[0]), int(grid[1])
+    unfolded = _lamina._unfolded(stack, phi_i)
+    n_theta = int(grid[0])
+    n_phi = int(grid[1]) * (2 if unfolded else 1)      # φ bins of the table
+    span = 2 * np.pi if unfolded else np.pi
     t_edges = np.linspace(0, np.pi / 2, n_theta + 1)
-    p_edges = np.linspace(0, np.pi, n_phi + 1)
+    p_edges = np.linspace(0, span, n_phi + 1)
     tt, pp = np.meshgrid(np.arange(n_theta), np.arange(n_phi), indexing="ij")
     t0, t1 = t_edges[tt.ravel()], t_edges[tt.ravel() + 1]
     p0, p1 = p_edges[pp.ravel()], p_edges[pp.ravel() + 1]
-    omega = (p1 - p0) * (np.sin(t1) ** 2 - np.sin(t0) ** 2)       # Ω⊥, both folded halves
+    # Ω⊥: both folded halves, or one patch of the unfolded grid.
+    omega = (p1 - p0) * (np.sin(t1) ** 2 - np.sin(t0) ** 2) / (2 if unfolded else 1)
     f = np.zeros((len(theta_i), len(sides), n_theta * n_phi, 3))
 
     def bin_of(d):
         d = np.asarray(d, dtype=np.float64)
         theta = np.arccos(min(1.0, abs(d[2])))
-        phi = np.arctan2(abs(d[1]), d[0])
+        phi = np.arctan2(d[1], d[0]) % (2 * np.pi) if unfolded else np.arctan2(abs(d[1]), d[0])
         return (min(n_theta - 1, int(theta / (np.pi / 2) * n_theta)) * n_phi
-                + min(n_phi - 1, int(phi / np.pi * n_phi)))
+                + min(n_phi - 1, int(phi / span * n_phi)))
 
-    for i, ti in enumerate(theta_i):
-        a = np.radians(ti)
-        wi = np.array([np.sin(a), 0.0, np.cos(a)])
+    for i, (ti, pi) in enumerate(zip(theta_i, phi_i)):
+        a, b = np.radians(ti), np.radians(pi)
+        wi = np.array([np.sin(a) * np.cos(b), np.sin(a) * np.sin(b), np.cos(a)])
         peaks_fn = getattr(model, "peak_directions", None)
         peaks = [np.asarray(p, dtype=np.float64) for p in peaks_fn(wi)] if peaks_fn else \
             [np.array([-wi[0], -wi[1], wi[2]])]
@@ -152,4 +171,4 @@ def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32):
                 j = bin_of(direction)
                 f[i, sides.index(side), j] += np.asarray(energy, dtype=np.float64) / omega[j]
     f = f.reshape(len(theta_i), len(sides), n_theta, n_phi, 3)
-    return _lamina._table_from_arrays(f, theta_i, sides)
+    return _lamina._table_from_arrays(f, theta_i, sides, unfolded)
