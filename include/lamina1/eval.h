@@ -333,7 +333,7 @@ inline double Bsdf::first_order_ndf(const Vec3& h, double k_i, double k_o, bool 
     const double c2 = h.z * h.z;
     // tan θh from the half vector's horizontal length (not from 1 − cos²θh, which rounds to a
     // tangent of 1e-8 at the lobe's peak, where the table's ratio has a slope).
-    const double len = std::hypot(h.x, h.y);
+    const double len = std::sqrt(h.x * h.x + h.y * h.y);  // h is a unit vector
     double s2, x;
     // Anisotropic: 1/(π √det Σ) and ûᵀ Σ⁻¹ û, û the unit azimuth of h's slope.
     double inv_norm = 0, inv_q = 0;
