@@ -366,13 +366,16 @@ inline double Bsdf::first_order_ndf(const Vec3& h, double k_i, double k_o, bool 
         return density(t) / sqr(c2);
     // The coat's share 1 − x, half through the entering facet's map, half the leaving one's.
     double p = x * density(t);
-    const double g = 2 * (1 - inv_eta0_) * std::atan(t) / k;
+    // The maps are read at a tangent of at least 1e-9: their tabulated S/t tends to a limit
+    // 1e-4 from the exact 1 as t → 0, and reading it there keeps the lobe continuous at its peak.
+    const double t_map = std::max(t, 1e-9);
+    const double g = 2 * (1 - inv_eta0_) * std::atan(t_map) / k;
     for (const FacetDeflection* map : {&entering_, &leaving_}) {
         double sin_d, cos_d, w;
         if (!map->lookup(g, sin_d, cos_d, w)) continue;
         const double S = 0.5 * k * sin_d / cos_d;
         // P(t) t dt = P_S(S) S dS: dS/dt = sec²δ k_n / ((1 + t²) g'(δ)), S/t → 1 at 0.
-        const double s_over_t = t > 1e-12 ? S / t : 1.0;
+        const double s_over_t = S / t_map;
         p += 0.5 * (1 - x) * density(S) * s_over_t * w / (cos_d * cos_d * (1 + t2));
     }
     return p / sqr(c2);
