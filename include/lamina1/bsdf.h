@@ -151,7 +151,7 @@ class Bsdf {
                             const Rgb& g, const Rgb& scale) const;
     Rgb eval_btdf(const Incident& in, const Vec3& wo) const;
     Rgb base_lobe(const Incident& in, double mu_o, const Vec3& wo_in) const;
-    double first_order_ndf(const Vec3& h, double k_i, double k_o) const;
+    double first_order_ndf(const Vec3& h, double k_i, double k_o, bool anisotropic) const;
 
     // Sampling (lamina1/sampling.h): the mixture for one incidence, lobe probabilities (top
     // reflection, base lobe, diffuse series; transmission lobe, diffuse transmission) and the
@@ -159,7 +159,8 @@ class Bsdf {
     struct Mixture {
         std::array<double, 5> p{};
         Vec3 wi_in, wi_mean;
-        double alpha_base = 0, beta = 0;
+        GGX base{0.0};  ///< the base lobe's proposal: the widened GGX of k_i on both sides
+        double beta = 0;
         bool bottom_sampled = false;  ///< the transmission lobe drawn as the bottom's (btdf-lobe)
     };
     Mixture mixture(const Incident& in) const;
@@ -183,6 +184,21 @@ class Bsdf {
     double effective_alpha(double k_i, double k_o) const {
         if (ch_.spread == Options::Spread::Off) return alpha1_;
         return std::sqrt(sqr(alpha1_) + 0.25 * sqr(alpha0_) * (sqr(k_i) + sqr(k_o)));
+    }
+
+    /// The widened base lobe as a GGX distribution: of α_e (effective_alpha), or, where an
+    /// interface is anisotropic, of the slope covariance Σ_e = Σ1 + (k_i² + k_o²)/4 Σ0 — each
+    /// axis of the coat's spread scaled as the isotropic α0 is, in the coat's own tangent frame,
+    /// and the coat's and the base's covariances summed however their tangents are turned (the
+    /// 2 × 2 covariances of Weier & Belcour 2020, §3; α_e² is half its trace when both are
+    /// isotropic).
+    GGX widened_ggx(double k_i, double k_o) const {
+        if (!aniso_) return GGX{effective_alpha(k_i, k_o)};
+        SlopeCovariance sigma = sigma1_;
+        if (ch_.spread != Options::Spread::Off)
+            sigma = sigma + sigma0_ * (0.25 * (sqr(k_i) + sqr(k_o)));
+        // Each of Σ0, Σ1 is 0 (a smooth interface) or positive definite, and so is the sum.
+        return sigma.xx + sigma.yy > 0 ? GGX::anisotropic_of(sigma) : GGX{0.0};
     }
 
     /// β² = ((α0 k_top)² + (α1 k_bottom)²)/4: the mirrored lobe of a slab's transmission.
@@ -310,7 +326,15 @@ class Bsdf {
     Options ch_;
     Layers layers_;
     Support support_;
+    /// α0, α1: the interfaces' roughnesses; an anisotropic interface's root mean square
+    /// √((α_x² + α_y²)/2), which every term 1-D in α reads (the tables, the per-material curves).
     double eta0_ = 1.5, inv_eta0_ = 1 / 1.5, alpha0_ = 0, alpha1_ = 0;
+    /// An interface is anisotropic (Layers::alpha0_y, alpha1_y): the coat's reflection, the
+    /// widened base lobe and their sampling use the slope covariances Σ0 and Σ1 (isotropic α² I
+    /// for an isotropic interface of an anisotropic material).
+    bool aniso_ = false;
+    SlopeCovariance sigma0_, sigma1_;
+    GGX coat_ggx_{0.0};  ///< the coat's distribution (exact top reflection, its sampling)
     double eta_b_ = 1, eta_s_ = 1;
     bool has_absorption_ = false;
     /// The FGD nodes this material reads: the base (conductor or dielectric), the coat from

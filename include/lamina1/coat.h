@@ -17,12 +17,46 @@ inline Bsdf::Bsdf(const Layers& layers, const Tables& tables, const Options& opt
         support_.reason = "lamina-1's tables lack what these options read";
         return;
     }
+    const bool coat_aniso = layers_.alpha0_y >= 0;
+    const bool base_aniso = layers_.alpha1_y >= 0 && layers_.base != Base::Lambertian;
+    if ((coat_aniso && !(layers_.alpha0 > 0 && layers_.alpha0_y > 0)) ||
+        (base_aniso && !(layers_.alpha1 > 0 && layers_.alpha1_y > 0))) {
+        support_.reason = "lamina-1 needs both roughnesses of an anisotropic interface above 0";
+        return;
+    }
+    if ((coat_aniso || base_aniso) && ch_.multiple_scattering) {
+        // The orders ≥ 2 are energies of the isotropic tables: at the rms roughness they restore
+        // what an isotropic interface loses, far more than an anisotropic one loses along its
+        // smooth axis (23 % too much light at 80° under a coat of 0.05 × 0.4).
+        support_.reason =
+            "lamina-1 does not represent the multiple-scattering orders (microsurface=multiple) "
+            "of an anisotropic interface";
+        return;
+    }
+    if ((coat_aniso || base_aniso) && layers_.base == Base::Dielectric) {
+        support_.reason =
+            "lamina-1 does not represent a slab with an anisotropic interface (its transmission "
+            "lobes are isotropic)";
+        return;
+    }
     support_.brdf = true;
     support_.btdf = layers_.base == Base::Dielectric;
     eta0_ = layers_.eta0;
     inv_eta0_ = 1 / eta0_;
     alpha0_ = layers_.alpha0;
     alpha1_ = layers_.alpha1;
+    aniso_ = coat_aniso || base_aniso;
+    if (aniso_) {
+        // Each interface's slope covariance; the terms 1-D in α read the root mean square.
+        auto rms = [](double a_x, double a_y) { return std::sqrt(0.5 * (sqr(a_x) + sqr(a_y))); };
+        sigma0_ = coat_aniso ? SlopeCovariance::of_axes(alpha0_, layers_.alpha0_y, layers_.tangent0)
+                             : SlopeCovariance::isotropic(alpha0_);
+        sigma1_ = base_aniso ? SlopeCovariance::of_axes(alpha1_, layers_.alpha1_y, layers_.tangent1)
+                             : SlopeCovariance::isotropic(alpha1_);
+        if (coat_aniso) alpha0_ = rms(alpha0_, layers_.alpha0_y);
+        if (base_aniso) alpha1_ = rms(alpha1_, layers_.alpha1_y);
+    }
+    coat_ggx_ = coat_aniso ? GGX::anisotropic_of(sigma0_) : GGX{alpha0_};
     // The unscattered light is attenuated by extinction, τt = τa + τs (τa itself, bitwise,
     // without scattering).
     tau_t_ = layers_.tau_a + layers_.tau_s;
@@ -121,7 +155,8 @@ inline void Bsdf::precompute_lobe_normalization() {
                 sum_fixed += w_r * g_fixed;
                 // f_var / f_fixed = D_var G2_var / (D_fixed G2_fixed) at the same half vector
                 // (D_var the shaped lobe's where first-order-lobe shapes it).
-                const double D_var = shaped_lobe_ ? first_order_ndf(wm, k_i, k_o) : var.D(wm);
+                const double D_var =
+                    shaped_lobe_ ? first_order_ndf(wm, k_i, k_o, false) : var.D(wm);
                 sum_var += w_r * g_fixed * D_var * var.G2(w, wo) / (fixed.D(wm) * fixed.G2(w, wo));
             }
         return sum_fixed > 0 && sum_var > 0 ? std::sqrt(sum_fixed / sum_var) : 1.0;

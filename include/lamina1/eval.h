@@ -20,7 +20,7 @@ inline Bsdf::Incident Bsdf::incident(const Vec3& wi) const {
     in.T_pair = in.T;
     in.a = attenuation(in.wi_in.z);
     if (series_on_) in.X = X_at(wi.z);
-    if (alpha0_ > 0) in.lambda0 = GGX{alpha0_}.lambda(wi);
+    if (alpha0_ > 0) in.lambda0 = coat_ggx_.lambda(wi);
     if (top_ms_) in.dR = dR_top_(wi.z);
     if (lobe_norm_on_) in.lobe_norm = lobe_norm_(in.wi_in.z);
     if (scatters_) {
@@ -85,7 +85,7 @@ inline Rgb Bsdf::eval_with(const Incident& in, const Vec3& wo) const {
     if (alpha0_ > 0) {
         // The coat's own reflection, exact: Walter et al. 2007, Eq. 20, with the height-
         // correlated G2 (Heitz 2014, Eq. 99).
-        const GGX ggx0{alpha0_};
+        const GGX& ggx0 = coat_ggx_;
         const Vec3 h = normalize(wi + wo);
         const double G = 1 / (1 + in.lambda0 + ggx0.lambda(wo));
         f = Rgb(fresnel_dielectric(dot(wi, h), eta0_) * ggx0.D(h) * G / (4 * wi.z * wo.z));
@@ -289,13 +289,12 @@ inline Rgb Bsdf::eval_btdf(const Incident& in, const Vec3& wo) const {
 /// The base's lobe at the refracted pair (wi', wo'), widened by the coat's refraction spread.
 inline Rgb Bsdf::base_lobe(const Incident& in, double mu_o, const Vec3& wo_in) const {
     if (layers_.base == Base::Lambertian) return layers_.albedo * kInvPi;
-    const double alpha = effective_alpha(in.k_top, spread_factor(mu_o, wo_in.z, eta0_));
-    if (alpha <= 0) return Rgb(0.0);  // a delta lobe (delta_lobes)
-    const GGX ggx{alpha};
+    const double k_o = spread_factor(mu_o, wo_in.z, eta0_);
+    const GGX ggx = widened_ggx(in.k_top, k_o);
+    if (ggx.alpha <= 0) return Rgb(0.0);  // a delta lobe (delta_lobes)
     const Vec3 h = normalize(in.wi_in + wo_in);
     const double G = ggx.G2(in.wi_in, wo_in);
-    const double D =
-        shaped_lobe_ ? first_order_ndf(h, in.k_top, spread_factor(mu_o, wo_in.z, eta0_)) : ggx.D(h);
+    const double D = shaped_lobe_ ? first_order_ndf(h, in.k_top, k_o, aniso_) : ggx.D(h);
     Rgb f = base_fresnel(dot(in.wi_in, h)) * (D * G / (4 * in.wi_in.z * wo_in.z));
     if (lobe_norm_on_) f *= in.lobe_norm * lobe_norm_(wo_in.z);
     // The base's orders ≥ 2 (of its own roughness α1), separable as the coat's.
@@ -319,34 +318,64 @@ inline Rgb Bsdf::base_lobe(const Incident& in, double mu_o, const Vec3& wo_in) c
 /// met it; the deflection rate at wo itself (k_o, which grows towards grazing exits) would
 /// widen the lobe's flank tenfold at θo = 60° under α0 = 0.5 (tests/models/lamina1_lobe_test).
 /// The GGX of α_e keeps k_i and k_o (its masking G2 and the sampling too).
-inline double Bsdf::first_order_ndf(const Vec3& h, double k_i, double k_o) const {
+/// `anisotropic` (an anisotropic interface; false: the isotropic material of the roughnesses'
+/// root mean squares, which the lobe normalization reads): the three slopes have the covariances
+/// Σ1 and (k/2)² Σ0 twice, summed to Σ; the density is the isotropic one stretched by Σ^{1/2}
+/// (exactly the sum's when the three covariances are proportional), the GGX factor of Σ at the
+/// slope and the table's ratio at its Mahalanobis radius, the base's share x = tr Σ1 / tr Σ; the
+/// facet maps act on the slope's length along its own azimuth.
+inline double Bsdf::first_order_ndf(const Vec3& h, double k_i, double k_o, bool anisotropic) const {
     // Both refractions turn the light at the rate of the pair's less oblique end (see the
     // comment above): symmetric, and k_i itself at the mirror pair. The two coat spreads
     // then have one scale, α0 k/2, and one map each.
     const double k = std::min(k_i, k_o);
     const double a_b = alpha1_, a_c = 0.5 * alpha0_ * k;
-    const double s2 = sqr(a_b) + 2 * sqr(a_c);
     const double c2 = h.z * h.z;
+    // tan θh from the half vector's horizontal length (not from 1 − cos²θh, which rounds to a
+    // tangent of 1e-8 at the lobe's peak, where the table's ratio has a slope).
+    const double len = std::sqrt(h.x * h.x + h.y * h.y);  // h is a unit vector
+    double s2, x;
+    // Anisotropic: 1/(π √det Σ) and ûᵀ Σ⁻¹ û, û the unit azimuth of h's slope.
+    double inv_norm = 0, inv_q = 0;
+    if (anisotropic) {
+        const SlopeCovariance total = sigma1_ + sigma0_ * (0.5 * k * k);
+        const double trace = total.xx + total.yy, det = total.determinant();
+        s2 = 0.5 * trace;
+        x = (sigma1_.xx + sigma1_.yy) / trace;
+        const double ux = len > 0 ? h.x / len : 1.0, uy = len > 0 ? h.y / len : 0.0;
+        inv_q = (total.yy * ux * ux - 2 * total.xy * ux * uy + total.xx * uy * uy) / det;
+        inv_norm = kInvPi / std::sqrt(det);
+        if (!(det > 0)) s2 = 0;
+    } else {
+        s2 = sqr(a_b) + 2 * sqr(a_c);
+        x = sqr(a_b) / s2;  // the base's share; the coat's two halves have y = 1/2
+    }
     if (!(s2 > 0) || !(c2 > 0)) return 0;
-    const double sigma = std::sqrt(s2);
-    const double x = sqr(a_b) / s2;  // the base's share; the coat's two halves have y = 1/2
+    const double sigma = std::sqrt(s2), sqrt_inv_q = std::sqrt(inv_q);
     const float* table = tables_->slope_sum();
     const SlopeSumFormat::Shares at = SlopeSumFormat::locate(x, 0.5);
+    // The density of the summed slope at length r along h's azimuth.
     auto density = [&](double r) {
+        if (anisotropic)
+            return inv_norm / sqr(1 + r * r * inv_q) *
+                   SlopeSumFormat::ratio(table, r * sqrt_inv_q, at);
         return s2 * kInvPi / sqr(s2 + r * r) * SlopeSumFormat::ratio(table, r / sigma, at);
     };
-    const double t2 = std::max(0.0, 1 - c2) / c2, t = std::sqrt(t2);
+    const double t = len / std::abs(h.z), t2 = t * t;
     if (ch_.first_order_lobe != Options::FirstOrderLobe::Compressed || !(a_c > 0))
         return density(t) / sqr(c2);
     // The coat's share 1 − x, half through the entering facet's map, half the leaving one's.
     double p = x * density(t);
-    const double g = 2 * (1 - inv_eta0_) * std::atan(t) / k;
+    // The maps are read at a tangent of at least 1e-9: their tabulated S/t tends to a limit
+    // 1e-4 from the exact 1 as t → 0, and reading it there keeps the lobe continuous at its peak.
+    const double t_map = std::max(t, 1e-9);
+    const double g = 2 * (1 - inv_eta0_) * std::atan(t_map) / k;
     for (const FacetDeflection* map : {&entering_, &leaving_}) {
         double sin_d, cos_d, w;
         if (!map->lookup(g, sin_d, cos_d, w)) continue;
         const double S = 0.5 * k * sin_d / cos_d;
         // P(t) t dt = P_S(S) S dS: dS/dt = sec²δ k_n / ((1 + t²) g'(δ)), S/t → 1 at 0.
-        const double s_over_t = t > 1e-12 ? S / t : 1.0;
+        const double s_over_t = S / t_map;
         p += 0.5 * (1 - x) * density(S) * s_over_t * w / (cos_d * cos_d * (1 + t2));
     }
     return p / sqr(c2);

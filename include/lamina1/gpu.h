@@ -7,11 +7,11 @@
 // eval), with an absorbing medium, over a Lambertian, conductor or dielectric base, with the
 // default choices or any of spread, first-order-lobe, eta2-factor, inside-exit,
 // lobe-normalization, inter-reflection and directional-transmittance. Not covered (gpu_state
-// says why and returns nothing): scattering media, the multiple-scattering orders and a slab's
-// transmission (the GLSL returns 0 for wo.z < 0). Covered by sample and pdf: the same but slabs
-// (their mixture holds the transmission's lobes); the base lobe's weight in the mixture reads the
-// base's mean albedo from a curve (kGpuBaseAlbedo), so the GLSL pdf is the C++ one to that
-// curve's interpolation, and equal to the GLSL sample's own density.
+// says why and returns nothing): scattering media, the multiple-scattering orders, anisotropic
+// interfaces and a slab's transmission (the GLSL returns 0 for wo.z < 0). Covered by sample and
+// pdf: the same but slabs (their mixture holds the transmission's lobes); the base lobe's weight in
+// the mixture reads the base's mean albedo from a curve (kGpuBaseAlbedo), so the GLSL pdf is the
+// C++ one to that curve's interpolation, and equal to the GLSL sample's own density.
 //
 // Layout (kGpu* below): kGpuScalars scalars, then the curves at fixed offsets, then the generic
 // slope-sum table (lamina1/table_lookups.h, SlopeSumFormat) at kGpuSlopeSum; kGpuSize floats in
@@ -67,6 +67,7 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     if (!support_.brdf) return refuse("lamina-1 does not model these layers");
     if (scatters_) return refuse("a scattering medium (the GLSL form covers absorbing ones)");
     if (top_ms_ || base_ms_) return refuse("the multiple-scattering orders");
+    if (aniso_) return refuse("an anisotropic interface (the GLSL form is isotropic)");
     std::vector<float> v(kGpuSize, 0.0f);
     unsigned flags = 0;
     auto flag = [&](bool on, unsigned bit) { flags |= on ? bit : 0u; };

@@ -16,17 +16,25 @@ enum class Base { Lambertian, Conductor, Dielectric };
 /// base. Indices are relative (lamina's docs/physics.md §2): η0 = η_coat/η_ambient ≥ 1, the base's
 /// η + iκ relative to the coat (a dielectric base, a slab's bottom: η_below/η_coat, the same in
 /// the three channels). Roughnesses are GGX α (no remapping). Optical depths along the normal.
+/// A rough coat or a rough conductor base may be anisotropic (lamina's docs/physics.md §3): α
+/// along its tangent (alpha0, alpha1: α_x), α_y along its bitangent (alpha0_y, alpha1_y), the
+/// tangent at tangent0, tangent1 radians from +x; each interface has its own tangent. A negative
+/// α_y (the default) is an isotropic interface. docs/lamina1.md says which terms are anisotropic.
 struct Layers {
     double eta0 = 1.5;
     double alpha0 = 0.0;
-    Rgb tau_a{0.0};  ///< the coat medium's absorption optical depth
-    Rgb tau_s{0.0};  ///< its scattering optical depth (Henyey–Greenstein)
-    Rgb g{0.0};      ///< its Henyey–Greenstein asymmetry, (−1, 1)
+    double alpha0_y = -1.0;  ///< the coat's α along its bitangent (negative: alpha0, isotropic)
+    double tangent0 = 0.0;   ///< the coat's tangent, radians from +x (anisotropic coat)
+    Rgb tau_a{0.0};          ///< the coat medium's absorption optical depth
+    Rgb tau_s{0.0};          ///< its scattering optical depth (Henyey–Greenstein)
+    Rgb g{0.0};              ///< its Henyey–Greenstein asymmetry, (−1, 1)
     Base base = Base::Lambertian;
-    Rgb base_eta{1.0};    ///< conductor or dielectric base: η relative to the coat
-    Rgb base_k{0.0};      ///< conductor base: κ relative to the coat
-    double alpha1 = 0.0;  ///< the base's roughness (conductor, dielectric)
-    Rgb albedo{0.0};      ///< Lambertian base: its albedo ρ
+    Rgb base_eta{1.0};       ///< conductor or dielectric base: η relative to the coat
+    Rgb base_k{0.0};         ///< conductor base: κ relative to the coat
+    double alpha1 = 0.0;     ///< the base's roughness (conductor, dielectric)
+    double alpha1_y = -1.0;  ///< a conductor base's α along its bitangent (negative: isotropic)
+    double tangent1 = 0.0;   ///< the base's tangent, radians from +x (anisotropic base)
+    Rgb albedo{0.0};         ///< Lambertian base: its albedo ρ
 };
 
 struct Options {

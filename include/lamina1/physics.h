@@ -158,23 +158,104 @@ inline double refraction_escape(Masking masking, double lambda_i, double lambda_
                     1.0);
 }
 
-/// The GGX (Trowbridge–Reitz) distribution of roughness α > 0 (no remapping), isotropic. A
-/// direction below the surface sees the microsurface through −w.
-struct GGX {
-    double alpha;
+/// A slope covariance: the symmetric 2 × 2 matrix Σ (xx, xy, yy) of an anisotropic GGX
+/// microsurface in the surface's frame (x, y the macro frame's axes). The GGX of α_x along the
+/// tangent t = (cos ψ, sin ψ) and α_y along the bitangent b = (−sin ψ, cos ψ) is the α = 1
+/// microsurface stretched by A = α_x t tᵀ + α_y b bᵀ (lamina's docs/physics.md §3), whose slopes
+/// have the scale matrix Σ = A² = α_x² t tᵀ + α_y² b bᵀ (for an isotropic α, α² I). Independent
+/// slope spreads add as these matrices (Weier & Belcour 2020, "Rendering layered materials with
+/// anisotropic interfaces", JCGT 9(2), §3: a lobe's 2 × 2 covariance), however their tangents
+/// are turned against each other.
+struct SlopeCovariance {
+    double xx = 0, xy = 0, yy = 0;
 
-    /// D(wm), 1/sr: Walter et al. 2007, Eq. 33, as α² / (π (sin²θm + α² cos²θm)²); 0 below.
+    /// α_x along the tangent at tangent_angle radians from +x, α_y along the bitangent.
+    static SlopeCovariance of_axes(double alpha_x, double alpha_y, double tangent_angle) {
+        const double c = std::cos(tangent_angle), s = std::sin(tangent_angle);
+        const double ax2 = sqr(alpha_x), ay2 = sqr(alpha_y);
+        return {ax2 * c * c + ay2 * s * s, (ax2 - ay2) * c * s, ax2 * s * s + ay2 * c * c};
+    }
+    /// The isotropic α: α² I.
+    static SlopeCovariance isotropic(double alpha) { return {sqr(alpha), 0.0, sqr(alpha)}; }
+
+    SlopeCovariance operator+(const SlopeCovariance& o) const {
+        return {xx + o.xx, xy + o.xy, yy + o.yy};
+    }
+    SlopeCovariance operator*(double s) const { return {xx * s, xy * s, yy * s}; }
+    double determinant() const { return xx * yy - xy * xy; }
+    /// The root mean square of the two principal roughnesses, √(tr Σ / 2): the α an isotropic
+    /// quantity (a table 1-D in α) reads for this microsurface; α itself when isotropic.
+    double rms_alpha() const { return std::sqrt(0.5 * (xx + yy)); }
+    /// (x, y) Σ (x, y)ᵀ.
+    double quadratic(double x, double y) const { return xx * x * x + 2 * xy * x * y + yy * y * y; }
+};
+
+/// The stretch from the α = 1 GGX microsurface to one of roughness α, or of slope covariance Σ,
+/// applied to a direction's horizontal part (Heitz 2018, "Sampling the GGX distribution of visible
+/// normals", JCGT 7(4), §3.2: (α_x x, α_y y) in the tangent frame; A (x, y) in the surface's, A =
+/// Σ^{1/2} symmetric).
+struct GgxStretch {
+    double alpha;
+    bool anisotropic = false;
+    double a_xx = 0, a_xy = 0, a_yy = 0;  ///< A (anisotropic only)
+    Vec3 operator()(const Vec3& w) const {
+        if (anisotropic) return {a_xx * w.x + a_xy * w.y, a_xy * w.x + a_yy * w.y, w.z};
+        return {alpha * w.x, alpha * w.y, w.z};
+    }
+};
+
+/// The GGX (Trowbridge–Reitz) distribution of roughness α > 0 (no remapping), isotropic, or
+/// anisotropic of slope covariance Σ (SlopeCovariance; GGX::anisotropic). A direction below the
+/// surface sees the microsurface through −w. The isotropic distribution is computed by the
+/// isotropic formulas themselves: the anisotropic ones are their generalization (equal at
+/// Σ = α² I to rounding) and are read only where `anisotropic` is set.
+struct GGX {
+    double alpha;  ///< the isotropic α; an anisotropic distribution's √(tr Σ / 2)
+    bool anisotropic = false;
+    SlopeCovariance sigma{};  ///< Σ (anisotropic only)
+    /// The stretch A = Σ^{1/2} (symmetric; anisotropic only).
+    double a_xx = 0, a_xy = 0, a_yy = 0;
+
+    /// The distribution of slope covariance Σ (positive definite). The stretch is Σ's symmetric
+    /// square root, (Σ + √det Σ I)/√(tr Σ + 2√det Σ) (the Cayley–Hamilton form for 2 × 2
+    /// matrices): A = α_x t tᵀ + α_y b bᵀ for the Σ of SlopeCovariance::of_axes.
+    static GGX anisotropic_of(const SlopeCovariance& sigma) {
+        GGX g{sigma.rms_alpha()};
+        g.anisotropic = true;
+        g.sigma = sigma;
+        const double s = std::sqrt(std::max(sigma.determinant(), 0.0));
+        const double t = std::sqrt(sigma.xx + sigma.yy + 2 * s);
+        g.a_xx = (sigma.xx + s) / t;
+        g.a_xy = sigma.xy / t;
+        g.a_yy = (sigma.yy + s) / t;
+        return g;
+    }
+
+    /// D(wm), 1/sr: Walter et al. 2007, Eq. 33, as α² / (π (sin²θm + α² cos²θm)²); anisotropic
+    /// (Heitz 2014, the anisotropic distributions of §5) 1/(π √det Σ cos⁴θm (1 + sᵀ Σ⁻¹ s)²), s the
+    /// facet's slope, written det^{3/2} / (π (m_xyᵀ adj(Σ) m_xy + det m_z²)²); 0 below.
     double D(const Vec3& wm) const {
         if (wm.z <= 0) return 0.0;
+        if (anisotropic) {
+            const double det = sigma.determinant();
+            // adj(Σ) = [[yy, −xy], [−xy, xx]]: m_xyᵀ adj(Σ) m_xy = det · m_xyᵀ Σ⁻¹ m_xy.
+            const double q =
+                sigma.yy * sqr(wm.x) - 2 * sigma.xy * wm.x * wm.y + sigma.xx * sqr(wm.y);
+            return det * std::sqrt(det) / (kPi * sqr(q + det * sqr(wm.z)));
+        }
         const double alpha2 = sqr(alpha);
         const double denom = sqr(wm.x) + sqr(wm.y) + alpha2 * sqr(wm.z);
         return alpha2 / (kPi * sqr(denom));
     }
 
     /// Smith Λ(w): Heitz 2014, "Understanding the masking-shadowing function in microfacet-based
-    /// BRDFs", JCGT 3(2), Eq. 72, as x/(2(√(1 + x) + 1)) with x = α² tan²θ; +∞ at grazing.
+    /// BRDFs", JCGT 3(2), Eq. 72, as x/(2(√(1 + x) + 1)) with x = α² tan²θ; +∞ at grazing. An
+    /// anisotropic distribution's α is the roughness projected on w's azimuth (Heitz 2014, §5),
+    /// α(φ)² (w.x² + w.y²) = w_xyᵀ Σ w_xy.
     double lambda(const Vec3& w) const {
-        const double alpha2_tan2 = sqr(alpha) * (w.x * w.x + w.y * w.y) / (w.z * w.z);
+        const double alpha2_tan2 =
+            (anisotropic ? sigma.quadratic(w.x, w.y) : sqr(alpha) * (w.x * w.x + w.y * w.y)) /
+            (w.z * w.z);
         const double value = alpha2_tan2 / (2.0 * (std::sqrt(1.0 + alpha2_tan2) + 1.0));
         return alpha2_tan2 < HUGE_VAL ? value : HUGE_VAL;
     }
@@ -201,10 +282,14 @@ struct GGX {
         return G1(w) * cos_w_wm * D(wm) / std::abs(w.z);
     }
 
+    /// The stretch from the α = 1 microsurface to this one (GgxStretch).
+    GgxStretch stretch() const { return {alpha, anisotropic, a_xx, a_xy, a_yy}; }
+
     /// Heitz 2018's sampler of visible normals prepared for one direction (Heitz 2018, "Sampling
-    /// the GGX distribution of visible normals", JCGT 7(4), §3.2 and §4.1).
+    /// the GGX distribution of visible normals", JCGT 7(4), §3.2 and §4.1), anisotropic by the
+    /// stretch: the α = 1 configuration is isotropic, so its frame may be any about the normal.
     struct VisibleNormalFrame {
-        double alpha;
+        GgxStretch stretch;
         Vec3 vh, t1, t2;
         double s;  ///< the warp towards the visible half disk, (1 + vh.z)/2
         /// The visible normal of the disk point (r cos φ, r sin φ) (§4.2–4.4).
@@ -212,16 +297,17 @@ struct GGX {
             const double p1 = r * cos_phi;
             const double p2 = (1.0 - s) * safe_sqrt(1.0 - sqr(p1)) + s * (r * sin_phi);
             const Vec3 nh = t1 * p1 + t2 * p2 + vh * safe_sqrt(1.0 - sqr(p1) - sqr(p2));
-            return normalize(Vec3(alpha * nh.x, alpha * nh.y, max0(nh.z)));
+            return normalize(stretch(Vec3(nh.x, nh.y, max0(nh.z))));
         }
     };
 
     VisibleNormalFrame visible_normal_frame(Vec3 w) const {
         if (w.z < 0) w = -w;
-        const Vec3 vh = normalize(Vec3(alpha * w.x, alpha * w.y, w.z));
+        const GgxStretch a = stretch();
+        const Vec3 vh = normalize(a(w));
         const double len2 = sqr(vh.x) + sqr(vh.y);
         const Vec3 t1 = len2 > 0 ? Vec3(-vh.y, vh.x, 0.0) / std::sqrt(len2) : Vec3(1.0, 0.0, 0.0);
-        return {alpha, vh, t1, cross(vh, t1), 0.5 * (1.0 + vh.z)};
+        return {a, vh, t1, cross(vh, t1), 0.5 * (1.0 + vh.z)};
     }
 
     /// wm ∝ D_w(wm) from two uniforms in [0, 1) (Heitz 2018, Listing 1).

@@ -20,8 +20,8 @@ inline Bsdf::Mixture Bsdf::mixture(const Incident& in) const {
         m.p[1] = in.T * a * E_b;
     } else {
         // The base lobe is drawn with its incident-side widening on both sides (k_o ≈ k_i).
-        m.alpha_base = effective_alpha(in.k_top, in.k_top);
-        if (m.alpha_base > 0) m.p[1] = in.T * a * E_b;
+        m.base = widened_ggx(in.k_top, in.k_top);
+        if (m.base.alpha > 0) m.p[1] = in.T * a * E_b;
     }
     if (series_on_) m.p[2] = (in.X * K_ * X_bar_).mean();
     m.p[2] += in.dR;  // the coat's separable multiple-scattering lobe, also cosine-distributed
@@ -58,7 +58,7 @@ inline double Bsdf::pdf_with(const Incident& in, const Mixture& m, const Vec3& w
     if (wo.z > 0) {
         if (m.p[0] > 0) {
             const Vec3 h = normalize(in.wi + wo);
-            pdf += m.p[0] * GGX{alpha0_}.D_visible(in.wi, h) / (4 * std::abs(dot(wo, h)));
+            pdf += m.p[0] * coat_ggx_.D_visible(in.wi, h) / (4 * std::abs(dot(wo, h)));
         }
         if (m.p[1] > 0) {
             if (layers_.base == Base::Lambertian) {
@@ -71,7 +71,7 @@ inline double Bsdf::pdf_with(const Incident& in, const Mixture& m, const Vec3& w
                 if (wo_in.z > 0) {
                     const Vec3 h = normalize(m.wi_in + wo_in);
                     const double pdf_in =
-                        GGX{m.alpha_base}.D_visible(m.wi_in, h) / (4 * std::abs(dot(wo_in, h)));
+                        m.base.D_visible(m.wi_in, h) / (4 * std::abs(dot(wo_in, h)));
                     pdf += m.p[1] * pdf_in * wo.z / (sqr(eta0_) * wo_in.z);
                 }
             }
@@ -116,7 +116,7 @@ inline std::optional<Sample> Bsdf::sample(const Vec3& wi, const Vec3& u) const {
     Vec3 wo;
     switch (lobe) {
         case 0: {
-            const Vec3 wm = GGX{alpha0_}.sample_visible_normal(wi, u.y, u.z);
+            const Vec3 wm = coat_ggx_.sample_visible_normal(wi, u.y, u.z);
             wo = reflect(wi, wm);
             if (wo.z <= 0) return std::nullopt;  // shadowed by the coat's microsurface
             break;
@@ -125,7 +125,7 @@ inline std::optional<Sample> Bsdf::sample(const Vec3& wi, const Vec3& u) const {
             if (layers_.base == Base::Lambertian) {
                 wo = sample_cosine_hemisphere(u.y, u.z);
             } else {
-                const Vec3 wm = GGX{m.alpha_base}.sample_visible_normal(m.wi_in, u.y, u.z);
+                const Vec3 wm = m.base.sample_visible_normal(m.wi_in, u.y, u.z);
                 const Vec3 wo_in = reflect(m.wi_in, wm);
                 const double s2 = sqr(eta0_) * (1 - sqr(wo_in.z));
                 if (wo_in.z <= 0 || s2 >= 1) return std::nullopt;  // shadowed, or totally reflected

@@ -2,7 +2,9 @@
 // lamina-1, which includes nothing of lamina) against lamina's own (physics/: lane templates the
 // kernels evaluate), two writings of the same published formulas kept from drifting apart:
 // Fresnel of dielectrics (Born & Wolf) and conductors (also against the std::complex form), GGX's
-// D and Smith Λ, Henyey–Greenstein and Snell's refraction, at 2000 random arguments each.
+// D and Smith Λ (isotropic and anisotropic, with the visible normals), Henyey–Greenstein and
+// Snell's refraction, at 2000 random arguments each.
+#include "core/math.h"
 #include "core/rng.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
@@ -57,6 +59,55 @@ TEST(Lamina1Physics, AgreesWithLaminasPhysics) {
             expect_rel(r1->z, r->z, 1e-12, "refract z");
             expect_rel(r1->x, r->x, 1e-12, "refract x");
         }
+    }
+}
+
+// The anisotropic GGX (lamina1::GGX of a SlopeCovariance, written with the covariance Σ in the
+// surface's frame) against lamina's (physics/microfacet.h: α_x, α_y and the tangent, written as
+// the isotropic formula plus the terms in α_y − α_x): D, Λ, the visible-normal density and the
+// visible normal drawn from the same uniforms (both Heitz 2018's disk, in the same frame); and
+// the covariance of α² I taken as anisotropic against the isotropic distribution.
+TEST(Lamina1Physics, AnisotropicGgxAgreesWithLaminasPhysics) {
+    ParticleRng rng(5, 0, 0);
+    auto u = [&] { return rng.uniform_double(); };
+    auto to1 = [](const Vec3d& w) { return lamina1::Vec3{w.x, w.y, w.z}; };
+    for (int n = 0; n < 2000; ++n) {
+        const double alpha_x = 0.002 + u(), alpha_y = 0.002 + u(), psi = 12.6 * u() - 6.3;
+        const lamina1::GGX a1 =
+            lamina1::GGX::anisotropic_of(lamina1::SlopeCovariance::of_axes(alpha_x, alpha_y, psi));
+        const GGX<double> a = GGX<double>::anisotropic(alpha_x, alpha_y, psi);
+        auto direction = [&] {
+            const double theta = 1.5 * u(), phi = 6.28 * u();
+            return Vec3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                         std::cos(theta));
+        };
+        const Vec3d w = direction(), wm = direction();
+        // The covariance form reads Σ's entries, each rounded to a few ulps, through det Σ and
+        // the quadratic forms, whose cancellations amplify them by up to the condition number
+        // κ = (α_max/α_min)² (up to 2.5e5 here): 1e-12 plus 1e-15 κ.
+        const double kappa = sqr(std::max(alpha_x, alpha_y) / std::min(alpha_x, alpha_y));
+        const double tol = 1e-12 + 1e-15 * kappa;
+        expect_rel(a1.D(to1(wm)), a.D(wm), tol, "anisotropic D");
+        expect_rel(a1.lambda(to1(w)), a.lambda(w), tol, "anisotropic lambda");
+        expect_rel(a1.D_visible(to1(w), to1(wm)), a.D_visible(w, wm), tol, "anisotropic D_w");
+        const double u1 = u(), u2 = u();
+        const lamina1::Vec3 m1 = a1.sample_visible_normal(to1(w), u1, u2);
+        const Vec3d m = a.sample_visible_normal(w, u1, u2);
+        EXPECT_NEAR(m1.x, m.x, tol);
+        EXPECT_NEAR(m1.y, m.y, tol);
+        EXPECT_NEAR(m1.z, m.z, tol);
+
+        // Σ = α² I through the anisotropic formulas is the isotropic distribution.
+        const lamina1::GGX iso{alpha_x};
+        const lamina1::GGX as_aniso =
+            lamina1::GGX::anisotropic_of(lamina1::SlopeCovariance::isotropic(alpha_x));
+        expect_rel(as_aniso.D(to1(wm)), iso.D(to1(wm)), 1e-12, "isotropic D");
+        expect_rel(as_aniso.lambda(to1(w)), iso.lambda(to1(w)), 1e-12, "isotropic lambda");
+        const lamina1::Vec3 n1 = as_aniso.sample_visible_normal(to1(w), u1, u2),
+                            n0 = iso.sample_visible_normal(to1(w), u1, u2);
+        EXPECT_NEAR(n1.x, n0.x, 1e-12);
+        EXPECT_NEAR(n1.y, n0.y, 1e-12);
+        EXPECT_NEAR(n1.z, n0.z, 1e-12);
     }
 }
 

@@ -1,5 +1,6 @@
 // Every deterministic model that represents anisotropy (ModelEntry::represents_anisotropy:
-// OpenPBR's coats, Unity's StackLit (its base), the Weidlich–Wilkie family, WB20; docs/models.md)
+// OpenPBR's coats, Unity's StackLit (its base), the Weidlich–Wilkie family, WB20, lamina-1;
+// docs/models.md)
 // on anisotropic stacks: it reduces to its isotropic form as α_y → α_x, it turns with its
 // interfaces' tangents, and its sampler (where it has one) draws the density it claims. Energy,
 // which differs by model, is tested with each.
@@ -52,8 +53,8 @@ bool represents_anisotropic_coat(const std::string& name) {
 
 TEST(ModelAnisotropy, TheFamiliesThatRepresentIt) {
     const std::vector<std::string> names = anisotropic_models();
-    for (const char* name :
-         {"openpbr", "openpbr-adobe", "unity-stacklit", "ww09", "ele10", "ww-prime", "wb20"})
+    for (const char* name : {"openpbr", "openpbr-adobe", "unity-stacklit", "ww09", "ele10",
+                             "ww-prime", "wb20", "lamina-1"})
         EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
     EXPECT_FALSE(represents_anisotropic_coat("unity-stacklit"));
     EXPECT_TRUE(represents_anisotropic_coat("openpbr"));

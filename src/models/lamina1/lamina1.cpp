@@ -2,6 +2,7 @@
 // lamina's own tables; every formula of the model is the header's.
 #include "models/lamina1/lamina1.h"
 
+#include "core/math.h"
 #include "lamina1/lamina1.h"
 #include "models/tables/coat_transmittance.h"
 #include "models/tables/fgd_table.h"
@@ -149,6 +150,17 @@ bool lamina1_layers(const Stack& stack, lamina1::Layers& layers, std::string& wh
     layers.base_k = to_header(coat.base_k);
     layers.alpha1 = coat.base_alpha;
     layers.albedo = to_header(coat.albedo);
+    // Anisotropic interfaces (alpha = [alpha_x, alpha_y]): α_x is the stack's alpha (above).
+    const InterfaceSpec& top = stack.layers[0].interface;
+    const InterfaceSpec& base = stack.layers[1].interface;
+    if (top.is_anisotropic()) {
+        layers.alpha0_y = top.alpha_b();
+        layers.tangent0 = deg_to_rad(top.tangent_deg);
+    }
+    if (base.is_anisotropic()) {
+        layers.alpha1_y = base.alpha_b();
+        layers.tangent1 = deg_to_rad(base.tangent_deg);
+    }
     return true;
 }
 
