@@ -81,12 +81,22 @@ Side parse_side(const std::string& s, const std::string& where, const std::strin
     throw InputError(where, field, fmt::format("side '{}' must be R or T", s));
 }
 
-void require_side(const Model& model, Side side, const std::string& where) {
+/// The model evaluates `side` of `stack`: refused otherwise, an opaque stack's BTDF under `field`
+/// of `where` (the option or the directions file's line), a model's missing side under --model of
+/// the stack file.
+void require_side(const Model& model, const Stack& stack, Side side, const std::string& stack_file,
+                  const std::string& where, const std::string& field) {
+    if (side == Side::Transmission && !stack.transmits())
+        throw InputError(where, field,
+                         "side T: the stack is opaque (its base is not a dielectric), so it has no "
+                         "BTDF; allowed: R, or T for a slab");
     const Support s = model.support();
     if (side == Side::Reflection ? !s.brdf : !s.btdf)
-        throw InputError(where, "--model",
-                         fmt::format("not supported: {} ({})", s.reason,
-                                     side == Side::Reflection ? "BRDF" : "BTDF"));
+        throw InputError(
+            stack_file, "--model",
+            fmt::format("not supported: {} ({})",
+                        s.reason.empty() ? "this model has no BTDF for this stack" : s.reason,
+                        side == Side::Reflection ? "BRDF" : "BTDF"));
 }
 
 /// The light's direction at (θi, φi) in degrees, as the goniophotometer's --phi-i.
@@ -178,7 +188,7 @@ int run_eval(const EvalArgs& a) {
         struct Row {
             double ti, pi, to, po;
             Side side;
-            std::string text;
+            std::string text, where;
         };
         std::vector<Row> rows;
         for (int n = 2; std::getline(in, line); ++n) {
@@ -199,7 +209,8 @@ int run_eval(const EvalArgs& a) {
                   parse_number(cells[1 + o], a.directions, where + ", theta_o"),
                   parse_number(cells[2 + o], a.directions, where + ", phi_o"),
                   parse_side(cells[3 + o], a.directions, where + ", side"),
-                  line};
+                  line,
+                  where};
             check_incidence(r.ti, a.directions, where + ", theta_i");
             check_angle(r.pi, 0, 360, true, a.directions, where + ", phi_i");
             check_angle(r.to, 0, 90, true, a.directions, where + ", theta_o");
@@ -210,7 +221,7 @@ int run_eval(const EvalArgs& a) {
         configure_random_walk(*model, a);
         std::string out = std::string(with_phi ? kHeaderPhi : kHeader) + ",f_r,f_g,f_b\n";
         for (const Row& r : rows) {
-            require_side(*model, r.side, a.stack);
+            require_side(*model, stack, r.side, a.stack, a.directions, r.where + ", side");
             const Rgbd f = eval_at(*model, r.ti, r.pi, r.to, r.po, r.side);
             fmt::format_to(std::back_inserter(out), "{},{},{},{}\n", r.text, f[0], f[1], f[2]);
         }
@@ -230,7 +241,7 @@ int run_eval(const EvalArgs& a) {
     const Side side = parse_side(a.side, "command line", "--side");
     const Stack stack = load_stack(a.stack);
     const auto model = make_eval_model(entry, options, stack, a);
-    require_side(*model, side, a.stack);
+    require_side(*model, stack, side, a.stack, "command line", "--side");
     if (const RandomWalkModel* rw = configure_random_walk(*model, a)) {
         const Vec3d wi = light_direction(thetas[0], a.phi_i);
         const Vec3d wo = direction_from_angles(deg_to_rad(a.theta_o), deg_to_rad(a.phi_o), side);

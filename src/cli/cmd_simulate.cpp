@@ -59,7 +59,7 @@ Runner add_simulate(CLI::App& app) {
         std::unique_ptr<StagedOutput> probe;
         if (world.is_root()) {
             stack = load_stack(a->stack);
-            validate_kernel_for(stack, s);  // before DIR is made
+            validate_kernel_for(stack, s, a->stack);  // before DIR is made
             stack_text = stack_to_json(stack).dump();
             // Fails now, not after the run, if DIR is not writable.
             probe = std::make_unique<StagedOutput>(a->out);

@@ -14,6 +14,7 @@
 #include "render/contact_sheet.h"
 #include "report/explorer.h"
 #include "report/figures.h"
+#include "simulator/goniophotometer.h"
 #include "study/configurations.h"
 #include "study/distributed_reference.h"
 #include "study/study.h"
@@ -278,6 +279,7 @@ Runner add_compare(CLI::App& app) {
         const StudySettings s = settings_from(*a, "quick");
         StudyConfiguration c;
         c.stack = load_stack(a->stack);
+        validate_kernel_for(c.stack, s.reference, a->stack);  // before DIR is made
         c.id = std::filesystem::path(a->stack).stem().string();
         c.category = "custom";
         c.parameters = describe_parameters(c.stack);

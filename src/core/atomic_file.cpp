@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstring>
@@ -104,11 +105,23 @@ bool StagedOutput::add_if_changed(const std::string& name, std::string_view cont
     return true;
 }
 
+void StagedOutput::remove_unless_staged(const std::string& name) {
+    stale_.push_back(name);
+}
+
 void StagedOutput::commit() {
     for (const auto& name : names_) {
         std::error_code ec;
         fs::rename(staging_ / name, dir_ / name, ec);
         if (ec) throw InputError((dir_ / name).string(), "", "cannot move the file into place");
+    }
+    for (const auto& name : stale_) {
+        if (std::find(names_.begin(), names_.end(), name) != names_.end()) continue;
+        std::error_code ec;
+        fs::remove(dir_ / name, ec);  // absent is fine
+        if (ec && fs::exists(dir_ / name))
+            throw InputError((dir_ / name).string(), "",
+                             "cannot remove this file of an earlier run: " + ec.message());
     }
     committed_ = true;
 }

@@ -37,14 +37,19 @@ class StagedOutput {
     /// Stages it only if the target folder does not already hold exactly `content` under `name`
     /// (which then keeps its modification time). Returns whether it staged.
     bool add_if_changed(const std::string& name, std::string_view content);
-    /// Moves every staged file into the target folder.
+    /// At commit, deletes `name` from the target folder unless this output stages it: a file
+    /// that an earlier run of another kind wrote there (a spectral or Mueller table) and that
+    /// would otherwise lie beside this run's files as if it were one of them.
+    void remove_unless_staged(const std::string& name);
+    /// Moves every staged file into the target folder (and deletes those remove_unless_staged
+    /// named that it did not stage).
     void commit();
 
     const std::filesystem::path& dir() const { return dir_; }
 
   private:
     std::filesystem::path dir_, staging_;
-    std::vector<std::string> names_;
+    std::vector<std::string> names_, stale_;
     bool committed_ = false;
 };
 

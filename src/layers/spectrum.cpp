@@ -41,6 +41,32 @@ double Spectrum::at(double lambda_nm) const {
     return 0;
 }
 
+std::vector<double> Spectrum::turning_points_nm(double lo_nm, double hi_nm) const {
+    if (form != Form::Cauchy) return {};
+    // n(x) = Σ c_k x^k with x = 1/λ² (µm⁻²); n'(x) = c1 + 2 c2 x + 3 c3 x², at most quadratic.
+    const auto c = [&](std::size_t k) { return k < coefficients.size() ? coefficients[k] : 0.0; };
+    const double a = 3 * c(3), b = 2 * c(2), d = c(1);
+    std::vector<double> roots;
+    if (a != 0) {
+        const double disc = b * b - 4 * a * d;
+        if (disc >= 0) {
+            // The stable pair of roots: q = −(b + sign(b) √disc)/2, x = q/a and d/q.
+            const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+            roots.push_back(q / a);
+            if (q != 0) roots.push_back(d / q);
+        }
+    } else if (b != 0) {
+        roots.push_back(-d / b);
+    }
+    std::vector<double> out;
+    for (double x : roots) {
+        if (!(x > 0) || !std::isfinite(x)) continue;
+        const double lambda_nm = 1e3 / std::sqrt(x);
+        if (lambda_nm >= lo_nm && lambda_nm <= hi_nm) out.push_back(lambda_nm);
+    }
+    return out;
+}
+
 Spectrum table_spectrum(std::vector<double> wavelengths_nm, std::vector<double> values) {
     LAMINA_CHECK(!wavelengths_nm.empty() && wavelengths_nm.size() == values.size());
     Spectrum s;

@@ -27,6 +27,11 @@ struct Spectrum {
 
     /// The value at the vacuum wavelength lambda_nm.
     double at(double lambda_nm) const;
+    /// The wavelengths in [lo_nm, hi_nm] where a Cauchy formula turns (its polynomial in 1/λ² has
+    /// a zero derivative there): with the range's ends, where it takes its extreme values over
+    /// the range. Empty for the other forms (a table is linear between its samples; a Sellmeier
+    /// formula is checked for resonances where it is read).
+    std::vector<double> turning_points_nm(double lo_nm, double hi_nm) const;
     bool operator==(const Spectrum&) const = default;
 };
 

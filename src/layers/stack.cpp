@@ -421,6 +421,18 @@ class Reader {
             if (b_c.size() % 2 != 0)
                 fail(kp,
                      fmt::format("expected pairs [B1, C1, B2, C2, …], got {} numbers", b_c.size()));
+            // A resonance inside the visible range (λ² = C) sends n² to ±∞ there, between any
+            // two wavelengths a check could sample; real glasses resonate in the ultraviolet and
+            // the infrared.
+            constexpr double kC_min = kSpectrumMinNm * 1e-3 * kSpectrumMinNm * 1e-3;
+            constexpr double kC_max = kSpectrumMaxNm * 1e-3 * kSpectrumMaxNm * 1e-3;
+            for (std::size_t i = 0; i < b_c.size(); i += 2)
+                if (b_c[i] != 0 && b_c[i + 1] >= kC_min && b_c[i + 1] <= kC_max)
+                    fail(
+                        child(kp, i + 1),
+                        fmt::format("got C = {} µm², a resonance at {:.6g} nm; allowed: C < {:.6g} "
+                                    "or > {:.6g} µm² (resonances outside 360-830 nm), or B = 0",
+                                    b_c[i + 1], std::sqrt(b_c[i + 1]) * 1e3, kC_min, kC_max));
             out = sellmeier_spectrum(std::move(b_c));
         } else if (key == "cauchy") {
             out = cauchy_spectrum(
@@ -444,7 +456,11 @@ class Reader {
     /// The spectrum at every whole nm of 360–830 lies in `allowed`.
     void check_spectrum(const Spectrum& s, const std::string& pointer, Allowed allowed,
                         std::string_view meaning) const {
-        for (double l = kSpectrumMinNm; l <= kSpectrumMaxNm; l += 1) {
+        std::vector<double> wavelengths = s.turning_points_nm(kSpectrumMinNm, kSpectrumMaxNm);
+        for (double l = kSpectrumMinNm; l <= kSpectrumMaxNm; l += 1)
+            wavelengths.push_back(l);
+        std::sort(wavelengths.begin(), wavelengths.end());
+        for (double l : wavelengths) {
             const double value = s.at(l);
             if (!std::isfinite(value) || !allowed.ok(value))
                 fail(pointer, fmt::format("the spectrum is {} at {} nm; allowed: {} ({}) over "

@@ -844,6 +844,16 @@ void bind_models(py::module_& m) {
                 const std::vector<double> thetas = incidences_of(theta_i);
                 if (side != "R" && side != "T")
                     throw InputError("arguments", "side", "must be 'R' or 'T'");
+                // An unsupported side is refused, as binned refuses it (its quadrature of a model
+                // that evaluates to 0 there would be a silent 0).
+                const Support s = m.model->support();
+                if (side == "R" ? !s.brdf : !s.btdf)
+                    throw InputError(
+                        "arguments", "side",
+                        fmt::format(
+                            "not supported: {} ({})",
+                            s.reason.empty() ? "this model has no such side here" : s.reason,
+                            side == "R" ? "BRDF" : "BTDF"));
                 const bool scalar =
                     py::isinstance<py::float_>(theta_i) || py::isinstance<py::int_>(theta_i);
                 py::array_t<double> out(std::vector<py::ssize_t>{py::ssize_t(thetas.size()), 3});

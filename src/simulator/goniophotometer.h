@@ -306,8 +306,10 @@ void validate_settings(const SimulationSettings& settings, const std::string& wh
 /// anisotropic interface, light from φi ≠ 0 and a spectral run need the scalar kernel, or auto
 /// (InputError naming --kernel for simd; docs/physics.md §9); a film with an anisotropic
 /// interface is refused; a spectral run needs spectral_bins a multiple of 3 and a range of at
-/// least one nm per bin.
-void validate_kernel_for(const Stack& stack, const SimulationSettings& settings);
+/// least one nm per bin. A refusal about the stack names `where` (its file; the stack's name when
+/// empty) and the JSON pointer of the field.
+void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
+                         const std::string& where = {});
 
 /// Traces particles [first_particle, first_particle + particles) of every incidence and returns
 /// the raw sums. A run split into ranges that start at multiples of kParticlesPerBlock adds up

@@ -156,6 +156,11 @@ void write_simulation(const std::filesystem::path& dir, const Stack& stack,
         out.add("spectral_energy.csv", spectral_energy_csv(result));
     }
     out.add("result.json", result_json(stack, result).dump(2) + "\n");
+    // The optional tables of another kind of run into the same folder go: what the folder holds
+    // is this run.
+    for (const char* name : {"spectral.npy", "spectral_se.npy", "xyz.npy", "xyz_se.npy",
+                             "spectral_energy.csv", "mueller.npy", "mueller_se.npy"})
+        out.remove_unless_staged(name);
     out.commit();
 }
 

@@ -166,6 +166,30 @@ check simulate-film-auto 0 "$lamina" simulate "$src/examples/coated-lens.json" \
     --theta-i 0,60 --particles 2e4 --grid 9x9 --out "$tmp/film-auto"
 check simulate-film-auto-is-scalar 0 cmp "$tmp/film/brdf.csv" "$tmp/film-auto/brdf.csv"
 check_says simulate-film-auto-ran-scalar 0 '"kernel_description": "scalar"' cat "$tmp/film-auto/result.json"
+# A folder holds one run: a later run of another kind removes the spectral and Mueller tables it
+# does not write (an RGB run's brdf.csv beside an earlier spectral run's spectral.npy read as one).
+check reuse-spectral 0 "$lamina" simulate "$src/examples/gold-under-coat.json" --theta-i 30 \
+    --particles 2000 --grid 5x6 --out "$tmp/reuse"
+check reuse-spectral-wrote 0 test -e "$tmp/reuse/spectral_energy.csv"
+check reuse-mueller 0 "$lamina" simulate "$src/examples/gold-under-coat.json" --theta-i 30 \
+    --particles 2000 --grid 5x6 --spectral off --mueller --out "$tmp/reuse"
+check reuse-mueller-removed-spectral 1 test -e "$tmp/reuse/spectral.npy"
+check reuse-mueller-removed-xyz 1 test -e "$tmp/reuse/xyz_se.npy"
+check reuse-mueller-wrote 0 test -e "$tmp/reuse/mueller_se.npy"
+check reuse-rgb 0 "$lamina" simulate "$src/examples/gold-under-coat.json" --theta-i 30 \
+    --particles 2000 --grid 5x6 --spectral off --out "$tmp/reuse"
+check reuse-rgb-removed-mueller 1 test -e "$tmp/reuse/mueller.npy"
+check reuse-rgb-kept-its-own 0 test -e "$tmp/reuse/brdf.csv"
+# A film beside an anisotropic interface is not traced yet: simulate and compare refuse it naming
+# the file and the film's JSON pointer, before they make the output folder.
+printf '%s\n' '{"name": "n", "layers": [{"interface": {"type": "dielectric", "eta": 1.5, "alpha": 0.1}},
+  {"interface": {"type": "conductor", "eta": 0.2, "k": 3, "alpha": [0.1, 0.3], "film": {"thickness_nm": 300, "eta": 1.5}}}]}' \
+    >"$tmp/film-brushed.json"
+check_says simulate-film-anisotropic 1 "lamina: $tmp/film-brushed.json: /layers/1/interface/film: a thin film on a stack with an anisotropic interface (/layers/1/interface/alpha)" \
+    "$lamina" simulate "$tmp/film-brushed.json" --theta-i 30 --particles 1000 --out "$tmp/film-brushed"
+check_says compare-film-anisotropic 1 "lamina: $tmp/film-brushed.json: /layers/1/interface/film: a thin film" \
+    "$lamina" compare "$tmp/film-brushed.json" --theta-i 30 --particles 1000 --models openpbr --out "$tmp/film-brushed"
+check film-anisotropic-writes-nothing 1 test -e "$tmp/film-brushed"
 check simulate-phi-i 0 "$lamina" simulate "$src/examples/plastic.json" --phi-i 30 --theta-i 40 \
     --particles 2e4 --grid 9x9 --out "$tmp/phi-i"
 check_says export-unfolded 1 "an unfolded table" \

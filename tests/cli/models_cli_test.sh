@@ -52,6 +52,13 @@ if "$lamina" validate "$tmp/gold.json" >/dev/null 2>&1; then
     check not-supported 1 "$lamina" eval --model bel18-forward --stack "$tmp/plastic.json" --theta-i 30 --theta-o 45 --phi-o 180
     expect_output not-supported-says "not supported: bel18-forward has no Lambertian base"
     check no-btdf 1 "$lamina" eval --model ww09 --stack "$tmp/gold.json" --theta-i 30 --theta-o 45 --phi-o 180 --side T
+    # An opaque stack's BTDF is refused with the reason, naming the option or the file's line
+    # (the models leave their support reason empty for a side an opaque stack does not have).
+    expect_output no-btdf-says "lamina: command line: --side: side T: the stack is opaque"
+    printf 'theta_i,theta_o,phi_o,side\n30,45,180,R\n45,0,0,T\n' >"$tmp/dirs-t.csv"
+    check batch-no-btdf 1 "$lamina" eval --model ww-prime --stack "$tmp/plastic.json" --directions "$tmp/dirs-t.csv" --out "$tmp/t.csv"
+    expect_output batch-no-btdf-says "dirs-t.csv: line 3, side: side T: the stack is opaque"
+    check batch-no-btdf-writes-nothing 1 test -e "$tmp/t.csv"
     printf 'theta_i,theta_o,phi_o,side\n30,45,180,R\n0,10,0,R\n' >"$tmp/dirs.csv"
     check batch 0 "$lamina" eval --model ww-prime --stack "$tmp/plastic.json" --directions "$tmp/dirs.csv" --out "$tmp/f.csv"
     if head -1 "$tmp/f.csv" | grep -q '^theta_i,theta_o,phi_o,side,f_r,f_g,f_b$' && [ "$(wc -l <"$tmp/f.csv")" -eq 3 ]; then

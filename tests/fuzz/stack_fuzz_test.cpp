@@ -201,41 +201,169 @@ std::string object(Draw& d, const Mode& m, Fields fields, std::size_t required) 
     return out + "}";
 }
 
-std::string interface_text(Draw& d, const Mode& m, int type) {
+/// Which of the newer stack features a case may draw: a valid stack never holds a film beside an
+/// anisotropic interface (the goniophotometer refuses that pair; a mutant may hold it).
+struct Features {
+    bool film = false, anisotropy = false, spectra = false;
+};
+
+/// Roughness of a rough interface that may be anisotropic: α or [α_x, α_y], the pair's ratio
+/// anywhere from 1 to 10⁴.
+std::string roughness_value(Draw& d, const Mode& m, const Features& features) {
+    if (!features.anisotropy || !d.chance(0.5)) return alpha_value(d, m);
+    if (!m.valid && d.chance(m.p_bad))
+        return d.pick<std::string>({"[0, 0.5]", "[0.5, 0]", "[0.1]", "[0.1, 0.2, 0.3]", "[]",
+                                    "[\"0.1\", 0.2]", "[0.1, null]", "[[0.1], 0.2]",
+                                    fmt::format("[{}, {}]", outside(d, 1e-4, 1), num(0.3))});
+    const double a = inside(d, 1e-4, 1), b = d.chance(0.3) ? inside(d, 1e-4, 1) : a * 1e-3;
+    return d.chance(0.5) ? fmt::format("[{}, {}]", num(a), num(std::max(b, 1e-4)))
+                         : fmt::format("[{}, {}]", num(std::max(b, 1e-4)), num(a));
+}
+
+/// A spectral value in [lo, hi] (docs/stack-format.md, "Spectra"): a measured table, or for a
+/// dielectric's index (`index`) a dispersion formula or a named glass.
+std::string spectrum_value(Draw& d, const Mode& m, double lo, double hi, bool index) {
+    if (!m.valid && d.chance(m.p_bad))
+        return d.pick<std::string>(
+            {"{}", "{\"spectrum\": []}", "{\"spectrum\": [[500, 1]]}",
+             "{\"spectrum\": [[500, 1], [400, 1]]}", "{\"spectrum\": [[500, 1], [500, 1]]}",
+             "{\"spectrum\": [[50, 1], [900, 1]]}", "{\"spectrum\": [[400, 1, 2], [900, 1]]}",
+             fmt::format("{{\"spectrum\": [[400, {}], [700, {}]]}}", outside(d, lo, hi),
+                         num(inside(d, lo, hi))),
+             "{\"sellmeier\": [1.0]}", "{\"sellmeier\": [1, 0.01, 1]}", "{\"cauchy\": []}",
+             "{\"cauchy\": [1.5, 0, 0, 0, 0]}", "{\"cauchy\": [0.5]}", "{\"abbe\": [1.5]}",
+             "{\"abbe\": [1.5, 5]}", "{\"abbe\": [0.5, 50]}", "{\"material\": \"bk7\"}",
+             "{\"material\": 7}", "{\"material\": \"Au\"}", "{\"spectrum\": \"BK7\"}",
+             "{\"cauchy\": [1.5], \"abbe\": [1.5, 50]}", "{\"sellmeier\": [1e300, 1]}",
+             "{\"cauchy\": [1.5, -1e300]}",
+             // A Sellmeier pole between two whole nm inside the visible range.
+             "{\"sellmeier\": [1.25, 0, 1e-6, 0.25050025]}",
+             "{\"sellmeier\": [1.25, 0, -1e-6, 0.25050025]}"});
+    const int forms = index ? 5 : 1;
+    switch (d.below(forms)) {
+        case 1:
+            return d.pick<std::string>({"{\"material\": \"BK7\"}",
+                                        "{\"material\": \"fused_silica\"}",
+                                        "{\"material\": \"water\"}"});
+        case 2:  // n_d in [1, 2.5], any Abbe number: the index stays in [1, 2.9] over 360–830 nm
+            return fmt::format("{{\"abbe\": [{}, {}]}}", num(inside(d, 1, 2.5)),
+                               num(inside(d, 10, 120)));
+        case 3:  // normal dispersion, up to 4 terms: n in [1, 4.1] over 360–830 nm
+            return fmt::format("{{\"cauchy\": [{}, {}, {}, {}]}}", num(inside(d, 1, 4)),
+                               num(inside(d, 0, 0.01)), num(inside(d, 0, 1e-4)),
+                               num(inside(d, 0, 1e-6)));
+        case 4:  // one or two resonances in the ultraviolet (C < 0.1 µm²) and the infrared
+            return fmt::format("{{\"sellmeier\": [{}, {}, {}, {}]}}", num(inside(d, 0.1, 1.5)),
+                               num(inside(d, 0, 0.05)), num(inside(d, 0, 1)),
+                               num(inside(d, 50, 150)));
+        default: {
+            const int n = d.chance(0.1) ? 2 + d.below(2000) : 2 + d.below(6);
+            std::string out = "{\"spectrum\": [";
+            double wl = inside(d, 100, 400);
+            for (int i = 0; i < n; ++i) {
+                out += fmt::format("{}[{}, {}]", i ? ", " : "", num(wl), num(inside(d, lo, hi)));
+                wl = std::nextafter(wl, 1e9) + (d.chance(0.2) ? 0 : 1000 * d.u() / n);
+            }
+            return out + "]}";
+        }
+    }
+}
+
+/// A number, RGB or (with spectra) a spectral value.
+std::string spectral_or_value(Draw& d, const Mode& m, const Features& features, double lo,
+                              double hi, bool rgb, bool index = false) {
+    if (features.spectra && d.chance(0.4)) return spectrum_value(d, m, lo, hi, index);
+    return value(d, m, lo, hi, rgb);
+}
+
+/// The optional film of a dielectric or conductor interface.
+void add_film(Draw& d, const Mode& m, const Features& features, Fields& fields) {
+    if (!features.film || !d.chance(0.5)) return;
+    std::string thickness;
+    if (!m.valid && d.chance(m.p_bad)) {
+        thickness =
+            d.pick<std::string>({"[100, 50]", "[100]", "[1, 2, 3]", "[-1, 10]", "[0, 10001]",
+                                 "-0.001", "10000.000001", "\"100\"", "null", outside(d, 0, 1e4)});
+    } else if (d.chance(0.4)) {
+        const double a = inside(d, 0, 1e4), b = inside(d, 0, 1e4);
+        thickness = fmt::format("[{}, {}]", num(std::min(a, b)),
+                                num(d.chance(0.2) ? std::min(a, b) : std::max(a, b)));
+    } else {
+        thickness = num(d.pick<double>({0.0, 1e-3, 1e4, inside(d, 0, 1e4), inside(d, 50, 1000)}));
+    }
+    Fields film = {{"thickness_nm", thickness}, {"eta", value(d, m, 0.01, 5, false)}};
+    if (d.chance(0.5)) film.push_back({"k", value(d, m, 0, 10, false)});
+    fields.push_back({"film", object(d, m, film, 2)});
+}
+
+std::string interface_text(Draw& d, const Mode& m, int type, const Features& features) {
     const std::vector<std::string> types = {"dielectric", "conductor", "lambertian"};
     std::string type_text = "\"" + types[std::size_t(type)] + "\"";
     if (!m.valid && d.chance(m.p_bad * 0.2))
         type_text = d.pick<std::string>(
             {"\"metal\"", "\"Dielectric\"", "1", "null", "\"\"", "[\"dielectric\"]"});
+    Fields fields;
     switch (type) {
         case 0:
-            return object(d, m,
-                          {{"type", type_text},
-                           {"eta", value(d, m, 1, 5, false)},
-                           {"alpha", alpha_value(d, m)}},
-                          3);
+            fields = {{"type", type_text},
+                      {"eta", spectral_or_value(d, m, features, 1, 5, false, true)},
+                      {"alpha", roughness_value(d, m, features)}};
+            break;
         case 1:
-            return object(d, m,
-                          {{"type", type_text},
-                           {"eta", value(d, m, 0.01, 10, true)},
-                           {"k", value(d, m, 0, 10, true)},
-                           {"alpha", alpha_value(d, m)}},
-                          4);
+            fields = {{"type", type_text}};
+            if (features.spectra && d.chance(0.3)) {
+                fields.push_back(
+                    {"material",
+                     !m.valid && d.chance(m.p_bad)
+                         ? d.pick<std::string>({"\"gold\"", "\"BK7\"", "\"\"", "3"})
+                         : d.pick<std::string>({"\"Ag\"", "\"Al\"", "\"Au\"", "\"Cr\"", "\"Cu\"",
+                                                "\"Fe\"", "\"Ni\"", "\"Pt\"", "\"Ti\""})});
+                if (!m.valid && d.chance(m.p_bad)) fields.push_back({"k", "1"});
+            } else {
+                fields.push_back({"eta", spectral_or_value(d, m, features, 0.01, 10, true)});
+                fields.push_back({"k", spectral_or_value(d, m, features, 0, 10, true)});
+            }
+            fields.push_back({"alpha", roughness_value(d, m, features)});
+            break;
         default:
-            return object(d, m, {{"type", type_text}, {"albedo", value(d, m, 0, 1, true)}}, 2);
+            return object(
+                d, m,
+                {{"type", type_text}, {"albedo", spectral_or_value(d, m, features, 0, 1, true)}},
+                2);
     }
+    const std::size_t required = fields.size();
+    if (features.anisotropy && d.chance(0.5))
+        fields.push_back({"tangent_deg", value(d, m, -360, 360, false)});
+    add_film(d, m, features, fields);
+    return object(d, m, fields, required);
 }
 
-std::string medium_text(Draw& d, const Mode& m) {
+std::string medium_text(Draw& d, const Mode& m, const Features& features) {
     Fields f;
-    if (d.chance(0.7)) f.push_back({"tau_a", value(d, m, 0, 100, true)});
-    if (d.chance(0.5)) f.push_back({"tau_s", value(d, m, 0, 100, true)});
+    if (d.chance(0.7)) f.push_back({"tau_a", spectral_or_value(d, m, features, 0, 100, true)});
+    if (d.chance(0.5))
+        f.push_back(
+            {"tau_s", spectral_or_value(d, m, features, 0, d.chance(0.1) ? 1e4 : 100, true)});
     if (d.chance(0.5)) f.push_back({"g", value(d, m, -0.99, 0.99, true)});
     return object(d, m, f, 0);
 }
 
 /// The text of one stack file.
 std::string stack_text(Draw& d, const Mode& m) {
+    // The newer features: films or anisotropy (both only in a mutant), and spectra with either.
+    Features features;
+    switch (d.below(4)) {
+        case 1:
+            features.film = true;
+            break;
+        case 2:
+            features.anisotropy = true;
+            break;
+        default:
+            break;
+    }
+    if (!m.valid && d.chance(m.p_bad * 0.2)) features.film = features.anisotropy = true;
+    features.spectra = d.chance(0.3);
     int n_layers = 1 + d.below(3);
     if (d.chance(0.15)) n_layers = 4 + d.below(9);
     if (d.chance(0.01)) n_layers = 100;
@@ -245,9 +373,9 @@ std::string stack_text(Draw& d, const Mode& m) {
         const bool last = i + 1 == n_layers;
         int type = last ? d.below(3) : 0;
         if (!m.valid && !last && d.chance(m.p_bad * 0.1)) type = 1 + d.below(2);  // opaque above
-        Fields f = {{"interface", interface_text(d, m, type)}};
+        Fields f = {{"interface", interface_text(d, m, type, features)}};
         if ((!last && d.chance(0.7)) || (!m.valid && last && d.chance(m.p_bad * 0.1)))
-            f.push_back({"medium", medium_text(d, m)});
+            f.push_back({"medium", medium_text(d, m, features)});
         std::string layer = object(d, m, f, 1);
         if (!m.valid && d.chance(m.p_bad * 0.05))
             layer = d.pick<std::string>({"[" + layer + "]", "null", "\"layer\"", "{}",
@@ -266,6 +394,14 @@ std::string stack_text(Draw& d, const Mode& m) {
         top.push_back({"name", name});
     }
     if (d.chance(0.6)) top.push_back({"ambient_eta", value(d, m, 1, 5, false)});
+    if ((features.film || features.spectra) && d.chance(0.4)) {
+        std::string wl = fmt::format("[{}, {}, {}]", num(inside(d, 360, 830)),
+                                     num(inside(d, 360, 830)), num(inside(d, 360, 830)));
+        if (!m.valid && d.chance(m.p_bad))
+            wl = d.pick<std::string>({"[630, 532]", "530", "[630, 532, 359.99]", "[0, 0, 0]",
+                                      "[630, 532, 1e999]", "null", outside(d, 360, 830)});
+        top.push_back({"wavelengths_nm", wl});
+    }
     std::string layers_text = "[" + layers + "]";
     if (!m.valid && d.chance(m.p_bad * 0.05))
         layers_text = d.pick<std::string>({"{" + layers + "}", "null", "3", "[[" + layers + "]]"});
@@ -326,6 +462,9 @@ bool good(const Rgbf& v) {
 bool finite(const Vec3d& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
+bool finite(const Rgbd& v) {
+    return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
 std::string show(const Vec3d& v) {
     return fmt::format("({}, {}, {})", v.x, v.y, v.z);
 }
@@ -343,12 +482,20 @@ bool in(const Rgbd& v, double lo, double hi) {
 /// The ranges of docs/stack-format.md, restated independently of the parser.
 std::string outside_ranges(const Stack& s) {
     if (!in(s.ambient_eta, 1, 5)) return "ambient_eta";
+    if (!in(s.wavelengths_nm, 360, 830)) return "wavelengths_nm";
     if (s.layers.empty() || s.layers.size() > 100) return "layer count";
     for (std::size_t i = 0; i < s.layers.size(); ++i) {
         const InterfaceSpec& f = s.layers[i].interface;
         if (f.is_opaque() && i + 1 != s.layers.size()) return "opaque interface above the base";
         if (f.type != InterfaceType::Lambertian && !(f.alpha == 0 || in(f.alpha, 1e-4, 1)))
             return "alpha";
+        if (f.alpha_y >= 0 && !(in(f.alpha, 1e-4, 1) && in(f.alpha_y, 1e-4, 1))) return "alpha_y";
+        if (!in(f.tangent_deg, -360, 360)) return "tangent_deg";
+        if (f.has_film &&
+            (f.type == InterfaceType::Lambertian || !in(f.film.thickness_nm, 0, 1e4) ||
+             !in(f.film.thickness_max_nm, f.film.thickness_nm, 1e4) || !in(f.film.eta, 0.01, 5) ||
+             !in(f.film.k, 0, 10)))
+            return "film";
         if (f.type == InterfaceType::Dielectric && !in(f.eta, 1, 5)) return "dielectric eta";
         if (f.type == InterfaceType::Conductor && (!in(f.eta_rgb, 0.01, 10) || !in(f.k, 0, 10)))
             return "conductor eta or k";
@@ -522,33 +669,86 @@ void check_simulation(Draw& d, const CaseContext& c, const Stack& stack) {
     s.kernel = d.chance(0.5) ? Kernel::Scalar : Kernel::Simd;
     s.transport.microsurface = d.chance(0.3) ? Microsurface::Multiple : Microsurface::Single;
     s.transport.polarization = d.chance(0.5);
+    if (d.chance(0.3)) s.phi_i_deg = d.pick<double>({360.0, 1e-300, 90.0, 360 * d.u()});
+    s.spectral = d.pick<SpectralMode>({SpectralMode::Auto, SpectralMode::On, SpectralMode::Off});
+    if (d.chance(0.2)) s.transport.max_events = d.pick<int>({1, 2, 100});
     try {
         validate_settings(s);
     } catch (const InputError&) {
         s.transport.microsurface = Microsurface::Single;  // a combination the kernel does not offer
+    }
+    // Films, anisotropy, φi ≠ 0 and spectral runs are the scalar kernel's: the SIMD kernel must
+    // refuse them by name, and a film beside an anisotropic interface is refused by every kernel.
+    try {
+        validate_kernel_for(stack, s);
+    } catch (const InputError& e) {
+        const bool expected = (stack.has_film() && stack.is_anisotropic()) ||
+                              (s.kernel == Kernel::Simd && needs_scalar_kernel(stack, s));
+        FUZZ_EXPECT(expected && !e.problem().empty(), failures,
+                    fmt::format("simulation refused: {}\n{}", e.what(), shorten(c.text)));
+        if (stack.has_film() && stack.is_anisotropic()) return;
+        s.kernel = Kernel::Scalar;
     }
     const std::string what =
         fmt::format("simulation ({} kernel, {} microsurface, polarization {}) of {} = {}",
                     enum_text(s.kernel), enum_text(s.transport.microsurface),
                     s.transport.polarization ? "on" : "off", c.where, shorten(c.text));
     const SimulationResult r = simulate(stack, s);
+    const bool spectral = !r.spectral.bin_edges_nm.empty();
+    // A spectral run: its tables per wavelength bin and their XYZ projection are non-negative;
+    // their linear sRGB projection (`table`, brdf.csv) is an unbiased estimate that may be
+    // negative (the sRGB colour-matching weights are negative over part of the spectrum:
+    // docs/formats.md), and must be finite.
+    for (std::size_t i = 0; i < r.spectral.f.size(); ++i)
+        FUZZ_EXPECT(good(r.spectral.f[i]) && good(r.spectral.se[i]), failures,
+                    fmt::format("{}: spectral table entry {}: f {} se {}", what, i, r.spectral.f[i],
+                                r.spectral.se[i]));
+    for (std::size_t i = 0; i < r.spectral.xyz.lobes.size(); ++i)
+        for (const BinnedLobe& lobe : r.spectral.xyz.lobes[i])
+            for (std::size_t j = 0; j < lobe.f.size(); ++j)
+                FUZZ_EXPECT(good(lobe.f[j]) && good(lobe.se[j]), failures,
+                            fmt::format("{}: XYZ bin {}: f {} se {}", what, j, show(lobe.f[j]),
+                                        show(lobe.se[j])));
+    for (std::size_t g = 0; g < r.spectral.budget.size(); ++g) {
+        double sum = 0;
+        for (int t = 0; t < kBudgetTerms + 2; ++t) {
+            const double term = r.spectral.budget[g][std::size_t(t)];
+            const bool may_be_negative =
+                t == int(BudgetTerm::AbsorbedMedium) || t == int(BudgetTerm::AbsorbedBase);
+            FUZZ_EXPECT(may_be_negative ? std::isfinite(term) : good(term), failures,
+                        fmt::format("{}: spectral budget {} term {} = {}", what, g, t, term));
+            if (t < kBudgetTerms) sum += term;
+        }
+        // Each wavelength bin's budget sums to 1 to rounding, but within its standard error
+        // where an interface disperses (docs/formats.md).
+        bool dispersive = false;
+        for (const Layer& l : stack.layers)
+            dispersive = dispersive || (l.interface.type == InterfaceType::Dielectric &&
+                                        l.interface.eta_spectrum.has_value());
+        FUZZ_EXPECT(dispersive || std::abs(sum - 1) < 1e-6, failures,
+                    fmt::format("{}: spectral budget {} sums to {}", what, g, sum));
+    }
     for (std::size_t i = 0; i < r.table.lobes.size(); ++i)
         for (const BinnedLobe& lobe : r.table.lobes[i])
             for (std::size_t j = 0; j < lobe.f.size(); ++j)
-                FUZZ_EXPECT(good(lobe.f[j]) && good(lobe.se[j]), failures,
+                FUZZ_EXPECT((spectral ? finite(lobe.f[j]) : good(lobe.f[j])) && good(lobe.se[j]),
+                            failures,
                             fmt::format("{}: bin {} of θi = {}: f {} se {}", what, j,
                                         r.table.theta_i_deg[i], show(lobe.f[j]), show(lobe.se[j])));
+    if (spectral) return;  // its sRGB budget sums to 1 within its noise only
     for (std::size_t i = 0; i < r.incidences.size(); ++i) {
         const EnergyBudget& b = r.incidences[i].budget;
         for (int t = 0; t < kBudgetTerms; ++t) {
             // absorbed_medium may be negative: with spectral MIS a particle's weight can grow in
             // one channel, and the column is an unbiased estimate of a non-negative quantity, not
             // a sum of non-negative parts (docs/formats.md). So may absorbed_base with polarized
-            // light, which books there the reweighting of channels whose states differ.
+            // light or a thin film, which books there the reweighting of channels whose states or
+            // film reflectances differ.
             const Rgbd& term = b.term[std::size_t(t)];
             const bool ok =
                 t == int(BudgetTerm::AbsorbedMedium) ||
-                        (t == int(BudgetTerm::AbsorbedBase) && s.transport.polarization)
+                        (t == int(BudgetTerm::AbsorbedBase) &&
+                         (s.transport.polarization || stack.has_film()))
                     ? std::isfinite(term[0]) && std::isfinite(term[1]) && std::isfinite(term[2])
                     : good(term);
             FUZZ_EXPECT(ok, failures,
@@ -697,6 +897,46 @@ TEST(StackFuzz, TheExamplesAndTheStudyConfigurationsLieInTheRanges) {
         EXPECT_EQ(outside_ranges(c.stack), "") << c.id;
         EXPECT_NO_THROW(stack_from_json(stack_to_json(c.stack), c.id)) << c.id;
     }
+}
+
+// A spectrum is checked at every whole nm of 360–830 nm, but used anywhere in between: at the
+// channels' wavelengths_nm and at the spectral kernel's lattice points. Found by a sweep of the
+// spectral stacks: a Sellmeier term with a tiny B resonating between two whole nm passed the
+// check and made a coat of index 67 176 at wavelengths_nm 500.5 (0 just below the resonance). A
+// resonance inside the visible range is refused, and a Cauchy formula is also checked where its
+// polynomial in 1/λ² turns.
+TEST(StackFuzz, SpectraStayInTheirRangesBetweenWholeNanometres) {
+    auto refusal = [](const std::string& eta, const std::string& wavelengths) -> std::string {
+        const std::string text =
+            R"({"wavelengths_nm": )" + wavelengths + R"(, "layers": [{"interface": {"type": )" +
+            R"("dielectric", "eta": )" + eta +
+            R"(, "alpha": 0.1}}, {"interface": {"type": "lambertian", "albedo": 0.5}}]})";
+        try {
+            const Stack s = parse_stack(text, "s.json");
+            return fmt::format("accepted, eta {}", s.layers[0].interface.eta);
+        } catch (const InputError& e) {
+            return e.field() + ": " + e.problem();
+        }
+    };
+    // n² = 2.25 + 1e-6 λ²/(λ² − 0.25050025): within 2e-4 of 1.5 at 500 and 501 nm, ±∞ at 500.5.
+    const std::string pole =
+        refusal(R"({"sellmeier": [1.25, 0, 1e-6, 0.25050025]})", "[630, 500.5, 465]");
+    EXPECT_TRUE(pole.starts_with("/layers/0/interface/eta/sellmeier/3: got C = 0.25050025"))
+        << pole;
+    EXPECT_NE(pole.find("500.5 nm"), std::string::npos) << pole;
+    // The same resonance with B = 0 is no resonance; and one in the infrared (glasses') is fine.
+    EXPECT_TRUE(refusal(R"({"sellmeier": [1.25, 0, 0, 0.25050025]})", "[630, 500.5, 465]")
+                    .starts_with("accepted"));
+    EXPECT_TRUE(refusal(R"({"sellmeier": [1.25, 0, 1, 100]})", "[630, 500.5, 465]")
+                    .starts_with("accepted"));
+    // A Cauchy parabola in x = 1/λ² (µm⁻²), n = 1 − 2e-6 + 0.05 (x − x0)², its minimum x0 halfway
+    // between 500 and 501 nm: n ≥ 1 + 1e-6 at every whole nm, 1 − 2e-6 at x0 (λ ≈ 500.5 nm).
+    const double x0 = (1 / (0.5 * 0.5) + 1 / (0.501 * 0.501)) / 2, k = 0.05;
+    const std::string dip = refusal(
+        fmt::format(R"({{"cauchy": [{}, {}, {}]}})", 1 - 2e-6 + k * x0 * x0, -2 * k * x0, k),
+        "[630, 532, 465]");
+    EXPECT_TRUE(dip.starts_with("/layers/0/interface/eta/cauchy: the spectrum is 0.999998")) << dip;
+    EXPECT_NE(dip.find("at 500.4"), std::string::npos) << dip;
 }
 
 // The cases of a robustness report on the stack files, which the file ranges now refuse:

@@ -352,6 +352,17 @@ def test_albedo_agrees_with_the_binned_table():
     assert m.albedo([20, 40]).shape == (2, 3)
 
 
+def test_albedo_refuses_an_unsupported_side():
+    # It returned zeros: a model that does not represent a thin film (or a side an opaque stack
+    # lacks) evaluates to 0, and its quadrature was a silent 0 albedo.
+    film = lamina.Model("ww-prime", ROOT / "examples" / "coated-lens.json")
+    assert not film.support["brdf"]
+    with pytest.raises(lamina.InputError, match="not supported: thin films"):
+        film.albedo(30)
+    with pytest.raises(lamina.InputError, match="BTDF"):
+        lamina.Model("ww-prime", PLASTIC).albedo(30, "T")
+
+
 # ---- study directories ----------------------------------------------------------------------------
 
 def test_load_study_metrics_agree_with_the_tables(tmp_path):
