@@ -193,15 +193,22 @@ class ConfigurationRun {
           n_inc_(incidences_.size()),
           grid_(study_grid(config.stack, s.reference)),
           bins_(grid_.size()),
-          config_dir_(out_dir / "configs" / config.id) {}
+          config_dir_(out_dir / "configs" / config.id) {
+        for (std::size_t j = 0; j < bins_; ++j)
+            omega_.push_back(grid_.projected_solid_angle(j));
+    }
 
     ConfigResult run() {
         digest_inputs();
         if (read_back()) return result_;
         simulate_reference();
+        // The tables one model after the other (each binned on every thread), then the
+        // comparisons, independent of each other, over the threads.
         std::vector<ModelOutcome> models;
+        std::vector<BinnedTable> tables(model_names_.size());
         for (std::size_t k = 0; k < model_names_.size(); ++k)
-            models.push_back(model_outcome(k));
+            models.push_back(model_outcome(k, tables[k]));
+        compare_models(models, tables);
         for (const ModelOutcome& m : models)
             result_.rows.insert(result_.rows.end(), m.rows.begin(), m.rows.end());
         write_outputs(models);
@@ -302,8 +309,9 @@ class ConfigurationRun {
         return old_tables_->data.data() + std::size_t(it - old_sources_.begin()) * n_inc_ * block_;
     }
 
-    // 2. Model k on the same bins, unless its inputs and the reference are unchanged.
-    ModelOutcome model_outcome(std::size_t k) {
+    // 2. Model k on the same bins (its table in `table`, compared by compare_models), unless its
+    //    inputs and the reference are unchanged.
+    ModelOutcome model_outcome(std::size_t k, BinnedTable& table) {
         const std::string& name = model_names_[k];
         ModelOutcome m{name, model_keys_[k], {}, {}, {}, {}, false};
         if (same_reference_ && state_.contains("models") && state_["models"].contains(name) &&
@@ -330,8 +338,18 @@ class ConfigurationRun {
             return m;
         }
         ++work_.model_tables_computed;
-        compare_model(m, model_table(m));
+        table = model_table(m);
         return m;
+    }
+
+    // The computed models' comparisons, in parallel: each reads the reference and its own table
+    // and writes its own outcome only.
+    void compare_models(std::vector<ModelOutcome>& models, const std::vector<BinnedTable>& tables) {
+        const long n = long(models.size());
+#pragma omp parallel for schedule(dynamic, 1)
+        for (long k = 0; k < n; ++k)
+            if (!models[std::size_t(k)].reused)
+                compare_model(models[std::size_t(k)], tables[std::size_t(k)]);
     }
 
     // A model's binned table: from elsewhere (a model table, a Python plugin; checked against the
@@ -421,7 +439,7 @@ class ConfigurationRun {
                     for (int c = 0; c < 3; ++c) {
                         m.table[(i * n_sides_ + side) * bins_ * 3 + j * 3 + c] =
                             float(lobe.f[j][c]);
-                        a[c] += lobe.f[j][c] * grid_.projected_solid_angle(j);
+                        a[c] += lobe.f[j][c] * omega_[j];
                     }
                 m.albedo[side_name].push_back(rgb(a));
                 for (int c = 0; c < 3; ++c)
@@ -454,7 +472,7 @@ class ConfigurationRun {
                             tables[at] = float(pieces_[i].f[side][j][c]);
                             ses[at] = float(pieces_[i].se[side][j][c]);
                         }
-                        a[c] += pieces_[i].f[side][j][c] * grid_.projected_solid_angle(j);
+                        a[c] += pieces_[i].f[side][j][c] * omega_[j];
                     }
                 albedo["reference"][side == 0 ? "R" : "T"].push_back(rgb(a));
             }
@@ -631,6 +649,7 @@ class ConfigurationRun {
     const HemisphereGrid grid_;  ///< folded, or unfolded (an anisotropic stack, φi ≠ 0)
     const std::size_t bins_;
     const std::filesystem::path config_dir_;
+    std::vector<double> omega_;  ///< each bin's projected solid angle Ω⊥ (sr)
 
     std::vector<ReferenceKey> keys_;
     std::uint64_t ref_digest_ = 0, outputs_digest_ = 0;

@@ -24,9 +24,60 @@ struct Peak {
     bool pole;  ///< at the normal: every φ
 };
 
-/// ∫ |cos θ| dω over [θ0, θ1] × [φ0, φ1] (one folded half), the weight of a rectangle.
+/// ∫ |cos θ| dω over [θ0, θ1] × [φ0, φ1] (one folded half), the weight of a rectangle, from the
+/// sines of its θ edges.
+double measure_of(double sin_t0, double sin_t1, double p0, double p1) {
+    return 0.5 * (p1 - p0) * (sqr(sin_t1) - sqr(sin_t0));
+}
 double measure(double t0, double t1, double p0, double p1) {
-    return 0.5 * (p1 - p0) * (sqr(std::sin(t1)) - sqr(std::sin(t0)));
+    return measure_of(std::sin(t0), std::sin(t1), p0, p1);
+}
+
+// A rectangle's θ range and φ range, each with what the rule needs at its 3 Gauss–Legendre nodes,
+// computed once per range: neighbouring bins of a row share the θ range, of a column the φ range,
+// and the children of a bisected rectangle share theirs in pairs.
+
+/// θ ∈ [lo, hi]: the edges' sines (for the measure), and at the nodes sin θ, cos θ and the weight
+/// sin 2θ.
+struct ThetaRange {
+    double lo, hi, sin_lo, sin_hi;
+    double sin_theta[3], cos_theta[3], weight[3];
+};
+
+ThetaRange theta_range(double lo, double hi, double sin_lo, double sin_hi) {
+    ThetaRange r{lo, hi, sin_lo, sin_hi, {}, {}, {}};
+    const double dt = hi - lo;
+    for (int a = 0; a < 3; ++a) {
+        const double theta = lo + dt * kG3[a];
+        r.weight[a] = std::sin(2 * theta);
+        r.sin_theta[a] = std::sin(theta);
+        r.cos_theta[a] = std::cos(theta);
+    }
+    return r;
+}
+ThetaRange theta_range(double lo, double hi) {
+    return theta_range(lo, hi, std::sin(lo), std::sin(hi));
+}
+
+/// φ ∈ [lo, hi]: cos φ and sin φ at the nodes.
+struct PhiRange {
+    double lo, hi;
+    double cos_phi[3], sin_phi[3];
+};
+
+PhiRange phi_range(double lo, double hi) {
+    PhiRange r{lo, hi, {}, {}};
+    const double dp = hi - lo;
+    for (int b = 0; b < 3; ++b) {
+        const double phi = lo + dp * kG3[b];
+        r.cos_phi[b] = std::cos(phi);
+        r.sin_phi[b] = std::sin(phi);
+    }
+    return r;
+}
+
+double measure(const ThetaRange& t, const PhiRange& p) {
+    return measure_of(t.sin_lo, t.sin_hi, p.lo, p.hi);
 }
 
 // Rectangles live in (θ, φ), where the integrand f·sin θ cos θ is smooth up to both ends of the
@@ -41,18 +92,18 @@ class RectIntegrator {
     /// The cos-weighted average over the rectangle. Error control is on this average: every
     /// sub-rectangle's average must be good to τ = rel_tol·|average| + abs_tol (a sub-rectangle
     /// of weight fraction a then adds at most a·τ to the error, so the sum stays within τ).
-    Rgbd average(double t0, double t1, double p0, double p1) {
+    Rgbd average(const ThetaRange& t, const PhiRange& p) {
         evals_ = 0;
-        const std::pair<Rgbd, Rgbd> whole = rule(t0, t1, p0, p1);
+        const std::pair<Rgbd, Rgbd> whole = rule(t, p);
         const Rgbd coarse = whole.second;
         tol_ = o_.rel_tol * max_abs(coarse) + o_.abs_tol;
         // The top level reuses the coarse rule's nodes: the same values, not evaluated twice.
-        const Rgbd first = rect(t0, t1, p0, p1, 0, 0, &whole);
+        const Rgbd first = rect(t, p, 0, 0, &whole);
         // A narrow lobe missed by the coarse nodes made τ far too strict: redo with the real size.
         if (max_abs(first) > 10 * max_abs(coarse)) {
             evals_ = 0;
             tol_ = o_.rel_tol * max_abs(first) + o_.abs_tol;
-            return rect(t0, t1, p0, p1, 0, 0);
+            return rect(t, p, 0, 0);
         }
         return first;
     }
@@ -62,28 +113,23 @@ class RectIntegrator {
         return std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
     }
 
-    Rgbd at(double theta, double phi) {
-        ++evals_;
-        const double s = std::sin(theta), z = std::cos(theta);
-        return f_.eval(Vec3d(s * std::cos(phi), s * std::sin(phi), transmission_ ? -z : z));
-    }
-
     /// Cos-weighted averages by two embedded rules on the same 9 nodes, each normalized by the
     /// same rule applied to the weight sin θ cos θ (so constants are exact): the 3×3
     /// Gauss–Legendre product rule (degree 5) and the 5-point degree-3 rule on its centre and
     /// its 4 axis nodes (weights −1/9 and 5/18: exact for 1, x², y²). Their difference estimates
     /// the error of the lower one, so keeping the 3×3 value is conservative.
-    std::pair<Rgbd, Rgbd> rule(double t0, double t1, double p0, double p1) {
-        const double dt = t1 - t0, dp = p1 - p0;
+    std::pair<Rgbd, Rgbd> rule(const ThetaRange& t, const PhiRange& p) {
         constexpr double kW5Centre = -1.0 / 9, kW5Axis = 5.0 / 18;
         Rgbd i3(0.0), i5(0.0);
         double w3 = 0, w5 = 0;
+        evals_ += 9;
         for (int a = 0; a < 3; ++a) {
-            const double theta = t0 + dt * kG3[a];
-            const double w = std::sin(2 * theta);
+            const double w = t.weight[a], sin_theta = t.sin_theta[a];
+            const double z = transmission_ ? -t.cos_theta[a] : t.cos_theta[a];
             w3 += w * kW3[a];
             for (int b = 0; b < 3; ++b) {
-                const Rgbd g = at(theta, p0 + dp * kG3[b]) * w;
+                const Rgbd g =
+                    f_.eval(Vec3d(sin_theta * p.cos_phi[b], sin_theta * p.sin_phi[b], z)) * w;
                 i3 += g * (kW3[a] * kW3[b]);
                 const bool centre = a == 1 && b == 1, axis = (a == 1) != (b == 1);
                 if (centre || axis) {
@@ -112,31 +158,39 @@ class RectIntegrator {
         }
     }
 
-    Rgbd rect(double t0, double t1, double p0, double p1, int depth, int peak_depth,
+    Rgbd rect(const ThetaRange& t, const PhiRange& p, int depth, int peak_depth,
               const std::pair<Rgbd, Rgbd>* known = nullptr) {
-        const auto [i2, i3] = known ? *known : rule(t0, t1, p0, p1);
+        const auto [i2, i3] = known ? *known : rule(t, p);
         bool split_t = false, split_phi = false;
-        if (peak_depth < o_.peak_depth) peak_split(t0, t1, p0, p1, split_t, split_phi);
+        if (peak_depth < o_.peak_depth) peak_split(t.lo, t.hi, p.lo, p.hi, split_t, split_phi);
         const bool forced = split_t || split_phi;
         if (!forced && depth < o_.max_depth && evals_ < o_.eval_budget && max_abs(i3 - i2) > tol_)
             split_t = split_phi = true;
         if (!split_t && !split_phi) return i3;
         const int nd = forced ? depth : depth + 1;
         const int np = forced ? peak_depth + 1 : peak_depth;
-        const double tm = 0.5 * (t0 + t1), pm = 0.5 * (p0 + p1);
         // Children are combined with their exact weights (fractions of ∫ |cos θ| dω).
-        auto part = [&](double a0, double a1, double b0, double b1) {
-            return rect(a0, a1, b0, b1, nd, np) * measure(a0, a1, b0, b1);
+        auto part = [&](const ThetaRange& a, const PhiRange& b) {
+            return rect(a, b, nd, np) * measure(a, b);
         };
         Rgbd sum(0.0);
-        if (split_t && split_phi)
-            sum = part(t0, tm, p0, pm) + part(tm, t1, p0, pm) + part(t0, tm, pm, p1) +
-                  part(tm, t1, pm, p1);
-        else if (split_t)
-            sum = part(t0, tm, p0, p1) + part(tm, t1, p0, p1);
-        else
-            sum = part(t0, t1, p0, pm) + part(t0, t1, pm, p1);
-        const double m = measure(t0, t1, p0, p1);
+        if (split_t) {
+            const double tm = 0.5 * (t.lo + t.hi), sin_tm = std::sin(tm);
+            const ThetaRange lower = theta_range(t.lo, tm, t.sin_lo, sin_tm);
+            const ThetaRange upper = theta_range(tm, t.hi, sin_tm, t.sin_hi);
+            if (split_phi) {
+                const double pm = 0.5 * (p.lo + p.hi);
+                const PhiRange left = phi_range(p.lo, pm), right = phi_range(pm, p.hi);
+                sum =
+                    part(lower, left) + part(upper, left) + part(lower, right) + part(upper, right);
+            } else {
+                sum = part(lower, p) + part(upper, p);
+            }
+        } else {
+            const double pm = 0.5 * (p.lo + p.hi);
+            sum = part(t, phi_range(p.lo, pm)) + part(t, phi_range(pm, p.hi));
+        }
+        const double m = measure(t, p);
         return m > 0 ? sum / m : i3;
     }
 
@@ -173,7 +227,7 @@ Rgbd cos_weighted_average(const IncidentEvaluator& f, Side side, double theta0, 
                           double phi0, double phi1, const std::vector<Vec3d>& peaks,
                           const BinnedOptions& options) {
     RectIntegrator integrator(f, side, peaks_on_side(peaks, side), options);
-    return integrator.average(theta0, theta1, phi0, phi1);
+    return integrator.average(theta_range(theta0, theta1), phi_range(phi0, phi1));
 }
 
 Rgbd model_albedo(const Model& model, const Vec3d& wi, Side side, const BinnedOptions& options) {
@@ -193,7 +247,8 @@ Rgbd model_albedo(const Model& model, const Vec3d& wi, Side side, const BinnedOp
     for (int a = 0; a < kN; ++a)
         for (int b = 0; b < n_phi; ++b) {
             RectIntegrator integrator(*evaluator, side, side_peaks, options);
-            albedo += integrator.average(a * dt, (a + 1) * dt, b * dp, (b + 1) * dp) *
+            albedo += integrator.average(theta_range(a * dt, (a + 1) * dt),
+                                         phi_range(b * dp, (b + 1) * dp)) *
                       (copies * measure(a * dt, (a + 1) * dt, b * dp, (b + 1) * dp));
         }
     for (const DeltaLobe& d : model.delta_lobes(wi))
@@ -224,6 +279,9 @@ BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
     std::vector<Side> sides;
     if (support.brdf) sides.push_back(Side::Reflection);
     if (support.btdf) sides.push_back(Side::Transmission);
+    std::vector<PhiRange> columns;
+    for (int p = 0; p < grid.n_phi(); ++p)
+        columns.push_back(phi_range(grid.phi_lo(p), grid.phi_hi(p)));
     const long n_rows = long(n_inc) * long(sides.size()) * grid.n_theta();
 #pragma omp parallel for schedule(dynamic, 1)
     for (long row = 0; row < n_rows; ++row) {
@@ -234,9 +292,10 @@ BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
         RectIntegrator integrator(*evaluators[i], side,
                                   peaks_on_side(peaks[i], side, grid.is_unfolded()), options);
         BinnedLobe& lobe = table.lobe(i, side);
+        const ThetaRange row_range = theta_range(grid.theta_lo(t), grid.theta_hi(t));
         for (int p = 0; p < grid.n_phi(); ++p)
-            lobe.f[std::size_t(t) * grid.n_phi() + p] = integrator.average(
-                grid.theta_lo(t), grid.theta_hi(t), grid.phi_lo(p), grid.phi_hi(p));
+            lobe.f[std::size_t(t) * grid.n_phi() + p] =
+                integrator.average(row_range, columns[std::size_t(p)]);
     }
     // Delta lobes: energy / Ω⊥ of the bin they hit (docs/physics.md §5).
     for (std::size_t i = 0; i < n_inc; ++i) {
