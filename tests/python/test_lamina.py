@@ -534,7 +534,7 @@ def test_export_from_python_takes_the_azimuths_of_an_anisotropic_stack(tmp_path)
     # The φi slices of a brushed stack's file: the CLI's --azimuths. The files differ only in
     # their description text; 4 and 8 intervals give 5 and 9 slices, and each slice holds per
     # incidence vndf [2, 512], luminance [8, 8] and spectra [7, 8, 8], and its phi_i entry, in
-    # float32 (formats.md).
+    # float32 (docs/formats.md).
     common = dict(theta_i=[0, 40], resolution=8)
     cli("export", "--model", "openpbr", "--stack", BRUSHED, "--azimuths", 4, "--theta-i", "0,40",
         "--resolution", 8, "--out", tmp_path / "cli.bsdf")
