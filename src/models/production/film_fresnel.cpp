@@ -4,11 +4,13 @@
 #include "layers/colorimetry.h"
 #include "models/numerics/quadrature.h"
 #include "models/production/production_coat.h"
+#include "physics/thin_film_average.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <vector>
 
 namespace lamina {
@@ -33,6 +35,24 @@ Rgbd thickness_average(double min_nm, double max_nm, double period_nm, F&& f) {
         for (std::size_t i = 0; i < rule.x.size(); ++i)
             sum += f(min_nm + width * (p + rule.x[i])) * rule.w[i];
     return sum / double(pieces);
+}
+
+/// The exact reflectance of `film` for unpolarized light from above at cos_theta, per channel,
+/// averaged over thickness uniform in [min_nm, max_nm] in closed form (physics/
+/// thin_film_average.h); nothing where no closed form holds in some channel (an absorbing film,
+/// an evanescent wave in the film, a range of less than a milliradian of phase).
+std::optional<Rgbd> closed_form_mean(const FilmOptics& film, double cos_theta, double min_nm,
+                                     double max_nm) {
+    const double eta_i = film.eta_above;
+    Rgbd r;
+    for (int c = 0; c < 3; ++c) {
+        const auto m = thin_film_reflectance_mean(
+            cos_theta, film.eta_film / eta_i, film.eta_below[c] / eta_i,
+            min_nm * eta_i / film.wavelength_nm[c], max_nm * eta_i / film.wavelength_nm[c]);
+        if (!m) return std::nullopt;
+        r[c] = (m->first + m->second) / 2;
+    }
+    return r;
 }
 
 /// XYZ to linear sRGB (Rec. 709 primaries, D65) by the matrix of IEC 61966-2-1 to seven digits,
@@ -91,6 +111,10 @@ Rgbd film_reflectance_exact(const FilmOptics& film, double cos_theta) {
         std::min({film.wavelength_nm[0], film.wavelength_nm[1], film.wavelength_nm[2]});
     // The round-trip phase 4π d Re(u_f)/λ with Re(u_f) ≤ |η_f|: a period of at least λ/(2|η_f|).
     const double period = lambda_min / (2 * std::max(std::abs(film.eta_film), 1e-3));
+    if (film.varies())
+        if (const auto closed =
+                closed_form_mean(film, c, film.thickness_min_nm, film.thickness_max_nm))
+            return *closed;
     return thickness_average(film.thickness_min_nm, film.thickness_max_nm, period, [&](double d) {
         Rgbd r;
         for (int i = 0; i < 3; ++i)
@@ -114,15 +138,29 @@ Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, con
     const double lambda_min =
         std::min({film.wavelength_nm[0], film.wavelength_nm[1], film.wavelength_nm[2]});
     const double period = lambda_min / (2 * std::max(std::abs(film.eta_film), 1e-3));
-    return thickness_average(film.thickness_min_nm, film.thickness_max_nm, period, [&](double d) {
-        const double t = clamp((d - 1e-9) / (30 - 1e-9), 0.0, 1.0), presence = t * t * (3 - 2 * t);
+    constexpr double kFadeNm = 30;  // the film is wholly present from 30 nm on
+    const auto at_thickness = [&](double d) {
+        const double t = clamp((d - 1e-9) / (kFadeNm - 1e-9), 0.0, 1.0),
+                     presence = t * t * (3 - 2 * t);
         if (!(presence > 0)) return bare;
         Rgbd r(1.0);
         if (sin_film < 1)
             for (int i = 0; i < 3; ++i)
                 r[i] = film.mueller(i, c, true, d).reflection.a;
         return bare * (1 - presence) + r * presence;
-    });
+    };
+    const double lo = film.thickness_min_nm, hi = film.thickness_max_nm;
+    if (film.varies() && sin_film < 1 && hi > kFadeNm) {
+        // Above the fade the exact film alone, its mean in closed form; below it, numerically.
+        const double split = std::max(lo, kFadeNm);
+        if (const auto closed = closed_form_mean(film, c, split, hi)) {
+            const double w_closed = (hi - split) / (hi - lo);
+            if (!(split > lo)) return *closed;
+            return *closed * w_closed +
+                   thickness_average(lo, split, period, at_thickness) * (1 - w_closed);
+        }
+    }
+    return thickness_average(lo, hi, period, at_thickness);
 }
 
 Rgbd threejs_iridescence(double outside_ior, double film_ior, double cos_theta_1,

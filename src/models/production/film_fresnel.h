@@ -32,8 +32,9 @@ double schlick_weight_spherical_gaussian(double c);
 
 /// The exact reflectance of `film` for unpolarized light arriving from above at the facet cosine
 /// cos_theta ∈ [0, 1], per channel at its wavelength ((R_s + R_p)/2 of physics/thin_film.h),
-/// averaged over the film's thickness range by Gauss–Legendre quadrature (32 nodes per period of
-/// the interference, at most 2048).
+/// averaged over the film's thickness range: in closed form where the film is transparent and its
+/// wave propagates (physics/thin_film_average.h), else by Gauss–Legendre quadrature (32 nodes per
+/// period of the interference, at most 2048).
 Rgbd film_reflectance_exact(const FilmOptics& film, double cos_theta);
 
 /// three.js's evalIridescence (KHR_materials_iridescence; Belcour & Barla 2017, Eqs. 6–10 and
@@ -61,7 +62,8 @@ std::complex<double> gulbrandsen_index(double r, double g, double r_max = 0.99);
 /// cos_theta (its eta_above the coat, its eta_below the metal's index as openpbr-bsdf derives
 /// it, gulbrandsen_index of its F0 and F82 tint), total reflection where the film's first
 /// boundary reflects totally (no tunnelling), faded in from the bare metal's reflectance `bare`
-/// over the first 30 nm (smoothstep(1e-9, 30, d)); averaged over the thickness range.
+/// over the first 30 nm (smoothstep(1e-9, 30, d)); averaged over the thickness range (the part
+/// beyond 30 nm in closed form where film_reflectance_exact's holds).
 Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, const Rgbd& bare);
 
 /// Blender Cycles' table of the spectral sensitivity of its thin film (scene/shader.cpp,
