@@ -1,6 +1,7 @@
 #include "study/configurations.h"
 
 #include "core/error.h"
+#include "layers/spectrum.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -102,6 +103,7 @@ std::map<std::string, std::string> describe_parameters(const Stack& stack) {
                 p["base"] = "conductor";
                 p["alpha1"] = alpha_text(base);
                 if (base.is_anisotropic()) p["tangent1"] = num(base.tangent_deg);
+                if (!base.material.empty()) p["metal"] = base.material;
                 p["eta1"] = rgb_text(base.eta_rgb);
                 p["kappa1"] = rgb_text(base.k);
                 break;
@@ -157,46 +159,49 @@ std::vector<StudyConfiguration> builtin_configurations() {
 }
 
 std::vector<StudyConfiguration> iridescent_configurations() {
-    // Metals at the channels' wavelengths (630, 532, 465 nm), representative values rounded from
-    // the handbooks' tables.
-    const Rgbd ti_eta(2.74, 2.54, 2.26), ti_k(3.79, 3.43, 3.07);
-    const Rgbd gold_eta(0.143, 0.374, 1.442), gold_k(3.983, 2.385, 1.603);  // the frosted metals'
-    const Rgbd al_eta(1.2, 0.96, 0.65), al_k(7.3, 6.4, 5.4);
-    const Rgbd cu_eta(0.27, 1.12, 1.17), cu_k(3.41, 2.6, 2.4);
-    const Rgbd fe_eta(2.87, 2.95, 2.65), fe_k(3.08, 2.93, 2.81);
+    // The metals are the measured ones (data/nk): an interference colour is a spectral quantity,
+    // so the reference traces these stacks over wavelengths and the models are compared by their
+    // colour (docs/study.md, "The iridescent category").
     struct Iridescent {
         const char* id;
         double alpha0;
-        Rgbd eta, k;
+        const char* metal;
         double alpha1, film_eta, film_k, min_nm, max_nm;
     };
     const Iridescent list[] = {
         // Anodized titanium: a 60 nm oxide of index 2.5, first-order interference, glossy and
         // rough.
-        {"irid-ti-oxide-a0.05-a1.05", 0.05, ti_eta, ti_k, 0.05, 2.5, 0.0, 60, 60},
-        {"irid-ti-oxide-a0.05-a1.3", 0.05, ti_eta, ti_k, 0.3, 2.5, 0.0, 60, 60},
+        {"irid-ti-oxide-a0.05-a1.05", 0.05, "Ti", 0.05, 2.5, 0.0, 60, 60},
+        {"irid-ti-oxide-a0.05-a1.3", 0.05, "Ti", 0.3, 2.5, 0.0, 60, 60},
         // An interference pigment: 300 nm of index 1.8 on gold (higher orders), under a rough
         // coat.
-        {"irid-gold-film-a0.3-a1.05", 0.3, gold_eta, gold_k, 0.05, 1.8, 0.0, 300, 300},
+        {"irid-gold-film-a0.3-a1.05", 0.3, "Au", 0.05, 1.8, 0.0, 300, 300},
         // A protected mirror: MgF2 a quarter wave thick at 532 nm on aluminium, smooth coat.
-        {"irid-al-mgf2-a0.001-a1.2", 0.001, al_eta, al_k, 0.2, 1.38, 0.0, 96.4, 96.4},
+        {"irid-al-mgf2-a0.001-a1.2", 0.001, "Al", 0.2, 1.38, 0.0, 96.4, 96.4},
         // A film whose thickness varies over the surface (200–600 nm of 1.5) on copper.
-        {"irid-cu-range-a0.1-a1.1", 0.1, cu_eta, cu_k, 0.1, 1.5, 0.0, 200, 600},
+        {"irid-cu-range-a0.1-a1.1", 0.1, "Cu", 0.1, 1.5, 0.0, 200, 600},
         // Temper colours: an absorbing 80 nm oxide (2.3 + 0.1i) on iron.
-        {"irid-fe-temper-a0.05-a1.1", 0.05, fe_eta, fe_k, 0.1, 2.3, 0.1, 80, 80},
+        {"irid-fe-temper-a0.05-a1.1", 0.05, "Fe", 0.1, 2.3, 0.1, 80, 80},
     };
     std::vector<StudyConfiguration> out;
     for (const Iridescent& c : list) {
-        Layer metal = conductor(c.eta, c.k, c.alpha1);
+        Layer metal = conductor(Rgbd(1.0), Rgbd(1.0), c.alpha1);
+        metal.interface.material = c.metal;
+        metal.interface.eta_spectrum = conductor_material_eta(c.metal);
+        metal.interface.k_spectrum = conductor_material_k(c.metal);
         metal.interface.has_film = true;
         metal.interface.film = {c.min_nm, c.max_nm, c.film_eta, c.film_k};
-        out.push_back(make(c.id, "iridescent", {coat(c.alpha0, Rgbd(0.0)), metal}));
+        StudyConfiguration config = make(c.id, "iridescent", {coat(c.alpha0, Rgbd(0.0)), metal});
+        // The RGB values at the channels' wavelengths, as the stack reader sets them.
+        config.stack = config.stack.at_wavelengths(config.stack.wavelengths_nm, 1);
+        config.parameters = describe_parameters(config.stack);
+        out.push_back(std::move(config));
     }
     return out;
 }
 
 std::vector<StudyConfiguration> brushed_configurations() {
-    // The metals at the channels' wavelengths, as the iridescent category's (rounded from the
+    // The metals at the channels' wavelengths (630, 532, 465 nm; rounded from the
     // handbooks' tables); steel as iron.
     const Rgbd al_eta(1.2, 0.96, 0.65), al_k(7.3, 6.4, 5.4);
     const Rgbd fe_eta(2.87, 2.95, 2.65), fe_k(3.08, 2.93, 2.81);

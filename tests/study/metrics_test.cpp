@@ -222,6 +222,10 @@ TEST(StudyConfigurations, IridescentInTheLargerPresetsOnly) {
         ASSERT_EQ(c.stack.layers.size(), 2u);
         EXPECT_EQ(c.stack.layers[0].interface.eta, 1.5);
         EXPECT_TRUE(c.stack.layers[1].interface.has_film) << c.id;
+        // A measured metal: the reference traces the stack's spectrum.
+        EXPECT_FALSE(c.stack.layers[1].interface.material.empty()) << c.id;
+        EXPECT_TRUE(c.stack.is_spectral()) << c.id;
+        EXPECT_EQ(c.parameters.at("metal"), c.stack.layers[1].interface.material);
         EXPECT_EQ(stack_from_json(stack_to_json(c.stack), c.id), c.stack) << c.id;
         EXPECT_TRUE(c.parameters.count("film_nm")) << c.id;
     }
