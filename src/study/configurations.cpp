@@ -103,9 +103,14 @@ std::map<std::string, std::string> describe_parameters(const Stack& stack) {
                 p["base"] = "conductor";
                 p["alpha1"] = alpha_text(base);
                 if (base.is_anisotropic()) p["tangent1"] = num(base.tangent_deg);
-                if (!base.material.empty()) p["metal"] = base.material;
-                p["eta1"] = rgb_text(base.eta_rgb);
-                p["kappa1"] = rgb_text(base.k);
+                if (!base.material.empty()) {
+                    // A measured metal's index is its spectrum: the widgets show its name.
+                    p["metal"] = base.material;
+                    p["eta1"] = p["kappa1"] = base.material + " (measured)";
+                } else {
+                    p["eta1"] = rgb_text(base.eta_rgb);
+                    p["kappa1"] = rgb_text(base.k);
+                }
                 break;
             case InterfaceType::Dielectric:
                 p["base"] = "dielectric";

@@ -226,6 +226,7 @@ TEST(StudyConfigurations, IridescentInTheLargerPresetsOnly) {
         EXPECT_FALSE(c.stack.layers[1].interface.material.empty()) << c.id;
         EXPECT_TRUE(c.stack.is_spectral()) << c.id;
         EXPECT_EQ(c.parameters.at("metal"), c.stack.layers[1].interface.material);
+        EXPECT_EQ(c.parameters.at("eta1"), c.parameters.at("metal") + " (measured)");
         EXPECT_EQ(stack_from_json(stack_to_json(c.stack), c.id), c.stack) << c.id;
         EXPECT_TRUE(c.parameters.count("film_nm")) << c.id;
     }
