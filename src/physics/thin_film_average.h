@@ -36,11 +36,12 @@
 
 namespace lamina {
 
-/// The mean over a uniform y ∈ [y0, y1] (y1 > y0) of 1/(A + B cos y) for A > |B|.
+/// The mean over a uniform y ∈ [y0, y1] (y1 > y0) of 1/(A + B cos y) for A > |B|, given as
+/// A − B and A + B (both > 0; formed by the caller without cancellation).
 template <typename T>
-T mean_inverse_cosine_sum(T A, T B, T y0, T y1) {
+T mean_inverse_cosine_sum(T a_minus_b, T a_plus_b, T y0, T y1) {
     const T pi = std::numbers::pi_v<T>;
-    const T s = std::sqrt((A - B) * (A + B)), k = std::sqrt((A - B) / (A + B));
+    const T s = std::sqrt(a_minus_b * a_plus_b), k = std::sqrt(a_minus_b / a_plus_b);
     const auto F = [&](T y) {
         // y = 2πn + r with r ∈ [−π, π]: tan(r/2) keeps the sign the floor term expects.
         const T n = std::floor((y + pi) / (2 * pi));
@@ -79,9 +80,12 @@ std::optional<std::pair<T, T>> thin_film_reflectance_mean(T cos_theta_i, std::co
         // |c| < 1: |r12| < 1 for a propagating wave in a distinct film, |r23| ≤ 1.
         if (!(abs_c < T(1))) return T(1);
         const T phase = std::arg(c);
+        // A ∓ B = (1 ∓ |c|)², positive even where |c| is within rounding of 1.
         const T m =
-            mean_inverse_cosine_sum(T(1) + abs_c * abs_c, 2 * abs_c, x0 + phase, x1 + phase);
-        return T(1) - (T(1) - std::norm(r12)) * (T(1) - std::norm(r23)) * m;
+            mean_inverse_cosine_sum((T(1) - abs_c) * (T(1) - abs_c),
+                                    (T(1) + abs_c) * (T(1) + abs_c), x0 + phase, x1 + phase);
+        // In [0, 1] exactly; clamped against rounding near resonance (|c| → 1, where m is large).
+        return std::clamp(T(1) - (T(1) - std::norm(r12)) * (T(1) - std::norm(r23)) * m, T(0), T(1));
     };
     return std::pair<T, T>{mean(b12.r_s, b23.r_s), mean(b12.r_p, b23.r_p)};
 }

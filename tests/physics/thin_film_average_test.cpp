@@ -47,7 +47,8 @@ TEST(ThinFilmAverage, MeanInverseCosineSumAgainstQuadrature) {
         for (int i = 0; i < kSteps; ++i)
             sum += 1 / (k.A + k.B * std::cos(k.y0 + (k.y1 - k.y0) * (i + 0.5) / kSteps));
         const double numeric = sum / kSteps;
-        EXPECT_NEAR(mean_inverse_cosine_sum(k.A, k.B, k.y0, k.y1), numeric, 1e-8 * numeric)
+        EXPECT_NEAR(mean_inverse_cosine_sum(k.A - k.B, k.A + k.B, k.y0, k.y1), numeric,
+                    1e-8 * numeric)
             << k.A << " " << k.B << " [" << k.y0 << ", " << k.y1 << "]";
     }
 }
@@ -107,6 +108,23 @@ TEST(ThinFilmAverage, DeclinesWhereNoClosedFormHolds) {
         thin_film_reflectance_mean(cos60, C(1.2 / 1.5), C(2.0 / 1.5), 0.1, 0.5).has_value());
     EXPECT_FALSE(thin_film_reflectance_mean(1.0, C(1.5), C(2.0), 0.2, 0.2 + 1e-5).has_value());
     EXPECT_FALSE(thin_film_reflectance_mean(1.0, C(1.5), C(2.0), 0.2, 0.2).has_value());
+}
+
+TEST(ThinFilmAverage, FiniteAndBoundedAtExtremes) {
+    // Grazing and normal light, films of index just above the critical value and of index 10,
+    // nearly totally reflecting exits, ranges of 10 µm: a reflectance in [0, 1], never NaN.
+    for (double cos_i : {0.0, 1e-9, 0.5, 1.0})
+        for (C film : {C(1.0005), C(1.5), C(10.0)})
+            for (C exit : {C(1.0), C(0.01, 10.0), C(10.0), C(1e-3, 1e-3)})
+                for (auto [w0, w1] : {std::pair{0.0, 1e-2}, std::pair{0.0, 20.0}}) {
+                    const auto m = thin_film_reflectance_mean(cos_i, film, exit, w0, w1);
+                    if (!m) continue;
+                    for (double r : {m->first, m->second}) {
+                        EXPECT_TRUE(std::isfinite(r)) << cos_i << " " << film << " " << exit;
+                        EXPECT_GE(r, 0.0);
+                        EXPECT_LE(r, 1.0);
+                    }
+                }
 }
 
 }  // namespace
