@@ -224,7 +224,7 @@ struct SingleFilm {
 };
 
 // The metals of the single-film tables at the channels' wavelengths (630, 532, 465 nm), n + ik:
-// titanium, gold, copper, aluminium (the iridescent category's values, docs/study.md).
+// titanium, gold, copper, aluminium (representative handbook values, rounded).
 struct FilmMetals {
     std::complex<double> ti[3], au[3], cu[3], al[3];
 };
