@@ -578,6 +578,11 @@ class ConfigurationRun {
         cj["parameters"] = config_.parameters;
         cj["stack"] = stack_to_json(config_.stack);
         cj["sides"] = transmits_ ? nlohmann::json{"R", "T"} : nlohmann::json{"R"};
+        // A spectral reference's channels are linear sRGB under D65 over its range (tables.lza).
+        if (is_spectral_run(config_.stack, s_.reference))
+            cj["spectral"] = {{"min_nm", s_.reference.spectral_min_nm},
+                              {"max_nm", s_.reference.spectral_max_nm},
+                              {"channels", "linear sRGB (D65)"}};
         if (grid_.is_unfolded()) {
             // An unfolded configuration's incidences are its own (θi, φi) pairs, on its grid.
             nlohmann::json theta = nlohmann::json::array(), phi = nlohmann::json::array();

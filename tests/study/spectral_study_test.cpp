@@ -9,9 +9,11 @@
 #include "models/spectral_projection.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 namespace lamina {
 namespace {
@@ -53,6 +55,13 @@ TEST(StudySpectral, ModelsAreComparedInTheReferencesColour) {
         }
     }
     EXPECT_EQ(rows, 3);
+
+    // config.json says the channels are colour, and over which range.
+    std::ifstream in(dir / "configs" / "gold-spectral" / "config.json");
+    const nlohmann::json cj = nlohmann::json::parse(in);
+    ASSERT_TRUE(cj.contains("spectral"));
+    EXPECT_EQ(cj["spectral"]["min_nm"].get<double>(), s.reference.spectral_min_nm);
+    EXPECT_EQ(cj["spectral"]["max_nm"].get<double>(), s.reference.spectral_max_nm);
 }
 
 }  // namespace
