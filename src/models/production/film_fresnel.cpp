@@ -322,6 +322,13 @@ CyclesFilmSensitivity::CyclesFilmSensitivity() {
         for (int c = 0; c < 3; ++c)
             table_[c][j] = rgb[std::size_t(c)] / dc[std::size_t(c)];
     }
+    for (int c = 0; c < 3; ++c) {
+        running_[c][0] = 0;
+        for (int j = 1; j < kSize; ++j)
+            running_[c][j] = running_[c][j - 1] + (table_[c][j - 1] + table_[c][j]) / 2.0;
+        for (int j = 0; j < kSize; ++j)
+            max_magnitude_[c] = std::max(max_magnitude_[c], std::abs(table_[c][j]));
+    }
 }
 
 const CyclesFilmSensitivity& CyclesFilmSensitivity::get() {
@@ -337,6 +344,23 @@ std::complex<double> CyclesFilmSensitivity::operator()(int channel, double opd_n
     return table_[channel][i] * (1 - t) + table_[channel][next] * t;
 }
 
+std::complex<double> CyclesFilmSensitivity::integral(int channel, double x) const {
+    const std::complex<double>* e = table_[channel];
+    if (x >= kSize - 1)  // beyond the table the lookup holds its last entry
+        return running_[channel][kSize - 1] + (x - (kSize - 1)) * e[kSize - 1];
+    const int i = int(x);
+    const double t = x - i;
+    return running_[channel][i] + t * e[i] + (t * t / 2) * (e[i + 1] - e[i]);
+}
+
+std::complex<double> CyclesFilmSensitivity::mean(int channel, double opd0_nm,
+                                                 double opd1_nm) const {
+    const double to_x = 2 * std::numbers::pi / 60000 * (kSize - 1);
+    const double x0 = std::max(opd0_nm, 0.0) * to_x, x1 = std::max(opd1_nm, 0.0) * to_x;
+    if (!(x1 > x0)) return (*this)(channel, opd1_nm);
+    return (integral(channel, x1) - integral(channel, x0)) / (x1 - x0);
+}
+
 namespace {
 
 /// r/|r| (1 for r = 0): the phase of a reflection as a unit phasor, as Cycles forms it
@@ -349,20 +373,27 @@ std::complex<double> phasor(std::complex<double> r) {
 /// Cycles' iridescence_airy_summation_channel: Belcour & Barla 2017, Eq. 10 to the third order,
 /// R = R12 + R_s + Σ_m 2 C_m Re(e^(imφ) conj(S(m OPD))), C_m = (R_s − T121) r123^m, for one
 /// polarization with the boundaries' reflectances R12, R23 and the round trip's phasor e^(iφ).
+/// The sum R, its DC term R12 + R_s, and the orders' largest swing about it, Σ_m 2|C_m| s_max,
+/// for a sensitivity of magnitude at most s_max (|R − DC| ≤ swing whatever the OPD).
+struct AirySum {
+    double R, dc, swing;
+};
 template <typename Sensitivity>
-double airy_summation(const Sensitivity& sensitivity, double R12, double R23, double opd,
-                      std::complex<double> round_trip) {
+AirySum airy_summation(const Sensitivity& sensitivity, double R12, double R23, double opd,
+                       std::complex<double> round_trip, double s_max) {
     const double T121 = 1 - R12, R123 = R12 * R23, r123 = std::sqrt(R123);
     const double Rs = T121 * T121 * R23 / (1 - R123);
-    double R = R12 + Rs, Cm = Rs - T121;
+    AirySum out{R12 + Rs, R12 + Rs, 0};
+    double Cm = Rs - T121;
     std::complex<double> power = round_trip;
     for (int m = 1; m <= 3; ++m) {
         Cm *= r123;
         const std::complex<double> S = sensitivity(m * opd);
-        R += Cm * 2 * (power.real() * S.real() + power.imag() * S.imag());
+        out.R += Cm * 2 * (power.real() * S.real() + power.imag() * S.imag());
+        out.swing += std::abs(Cm) * 2 * s_max;
         power *= round_trip;
     }
-    return R;
+    return out;
 }
 
 constexpr double kCyclesFilmCutoffNm = 0.1;  // THINFILM_THICKNESS_CUTOFF
@@ -371,10 +402,14 @@ constexpr double kCyclesFilmCutoffNm = 0.1;  // THINFILM_THICKNESS_CUTOFF
 
 namespace {
 
+/// Cycles' film before its final clamp: the mean of the s and p sums, their DC terms' mean and
+/// their swings' mean (AirySum); a total reflection is {1, 1, 0}.
 template <typename Sensitivity>
-double cycles_film(const Sensitivity& sensitivity, double film_ior, double thickness_nm,
-                   const CyclesFilmSubstrate& substrate, double cos_theta_1) {
+AirySum cycles_film_sum(const Sensitivity& sensitivity, double s_max, double film_ior,
+                        double thickness_nm, const CyclesFilmSubstrate& substrate,
+                        double cos_theta_1) {
     using C = std::complex<double>;
+    constexpr AirySum kTotal{1, 1, 0};
     const double c1 = clamp(cos_theta_1, 0.0, 1.0), sin2 = 1 - c1 * c1;
     // Below 1 nm the film's index goes to the ambient's (1).
     double eta = film_ior;
@@ -383,14 +418,14 @@ double cycles_film(const Sensitivity& sensitivity, double film_ior, double thick
         eta = 1 + (film_ior - 1) * t * t * (3 - 2 * t);
     }
     // Total reflection at the first boundary (Cycles: at η² − sin²θ1 ≤ 0).
-    if (!(eta * eta - sin2 > 0)) return 1;
+    if (!(eta * eta - sin2 > 0)) return kTotal;
     const C u1(c1), u2(std::sqrt(eta * eta - sin2));
     const FresnelAmplitudes<double> top = fresnel_amplitudes<double>(C(1), u1, C(eta), u2);
     // Grazing incidence: the first boundary reflects everything (Cycles returns 1 there too).
-    if (std::norm(top.r_s) == 1 && std::norm(top.r_p) == 1) return 1;
+    if (std::norm(top.r_s) == 1 && std::norm(top.r_p) == 1) return kTotal;
     // The second boundary, relative to the film (reference medium: the ambient, index 1).
     const C substrate_eta(substrate.n, substrate.conductor ? substrate.k : 0.0);
-    if (!substrate.conductor && !(substrate.n * substrate.n - sin2 > 0)) return 1;
+    if (!substrate.conductor && !(substrate.n * substrate.n - sin2 > 0)) return kTotal;
     const C u3 = normal_wave_number(substrate_eta, sin2);
     const FresnelAmplitudes<double> bottom =
         fresnel_amplitudes<double>(C(eta), u2, substrate_eta, u3);
@@ -405,11 +440,19 @@ double cycles_film(const Sensitivity& sensitivity, double film_ior, double thick
     }
     // The round trip's phasor e^(i(φ23 + φ21)), φ21 = φ12 + π.
     const double opd = 2 * thickness_nm * u2.real();  // 2 η d cos θ2
-    const double R_s = airy_summation(sensitivity, std::norm(top.r_s), R23_s, opd,
-                                      -phasor(bottom.r_s) * phasor(top.r_s));
-    const double R_p = airy_summation(sensitivity, std::norm(top.r_p), R23_p, opd,
-                                      -phasor(bottom.r_p) * phasor(top.r_p));
-    return clamp(0.5 * (R_s + R_p), 0.0, 1.0);
+    const AirySum R_s = airy_summation(sensitivity, std::norm(top.r_s), R23_s, opd,
+                                       -phasor(bottom.r_s) * phasor(top.r_s), s_max);
+    const AirySum R_p = airy_summation(sensitivity, std::norm(top.r_p), R23_p, opd,
+                                       -phasor(bottom.r_p) * phasor(top.r_p), s_max);
+    return {0.5 * (R_s.R + R_p.R), 0.5 * (R_s.dc + R_p.dc), 0.5 * (R_s.swing + R_p.swing)};
+}
+
+template <typename Sensitivity>
+double cycles_film(const Sensitivity& sensitivity, double film_ior, double thickness_nm,
+                   const CyclesFilmSubstrate& substrate, double cos_theta_1) {
+    return clamp(
+        cycles_film_sum(sensitivity, 1.0, film_ior, thickness_nm, substrate, cos_theta_1).R, 0.0,
+        1.0);
 }
 
 }  // namespace
@@ -430,6 +473,18 @@ double cycles_film_reflectance_monochromatic(double wavelength_nm, double film_i
         film_ior, thickness_nm, substrate, cos_theta_1);
 }
 
+namespace {
+
+/// Cycles' F82-tint metal of channel c as its film sees it: Gulbrandsen's n + ik of
+/// r = min(f0, 0.999) and g = the F82-tint reflectance at 1/7, and f82 = g.
+CyclesFilmSubstrate cycles_f82_tint_substrate(double f0, double tint) {
+    const double g = f82_tint_fresnel(1.0 / 7, f0, tint);
+    const std::complex<double> index = gulbrandsen_index(std::min(f0, 0.999), g, 0.999);
+    return {true, index.real(), index.imag(), g};
+}
+
+}  // namespace
+
 Rgbd cycles_f82_tint_film(double film_ior, double thickness_nm, const Rgbd& f0, const Rgbd& tint,
                           double cos_theta) {
     Rgbd F;
@@ -438,16 +493,31 @@ Rgbd cycles_f82_tint_film(double film_ior, double thickness_nm, const Rgbd& f0, 
             F[c] = f82_tint_fresnel(cos_theta, f0[c], tint[c]);
             continue;
         }
-        const double g = f82_tint_fresnel(1.0 / 7, f0[c], tint[c]);
-        const std::complex<double> index = gulbrandsen_index(std::min(f0[c], 0.999), g, 0.999);
         F[c] = cycles_film_reflectance(c, film_ior, thickness_nm,
-                                       {true, index.real(), index.imag(), g}, cos_theta);
+                                       cycles_f82_tint_substrate(f0[c], tint[c]), cos_theta);
     }
     return F;
 }
 
 Rgbd cycles_f82_tint_film_range(double film_ior, double min_nm, double max_nm, const Rgbd& f0,
                                 const Rgbd& tint, double cos_theta) {
+    if (max_nm > min_nm && min_nm >= 1) {
+        // Every quantity but the OPD is the same at every thickness ≥ 1 nm, and the OPD is
+        // proportional to d: evaluated at max_nm, order m reads the sensitivity's mean over
+        // [m OPD min_nm/max_nm, m OPD].
+        const CyclesFilmSensitivity& table = CyclesFilmSensitivity::get();
+        const double ratio = min_nm / max_nm;
+        Rgbd F;
+        bool exact = true;
+        for (int c = 0; c < 3 && exact; ++c) {
+            const AirySum sum = cycles_film_sum(
+                [&](double opd) { return table.mean(c, opd * ratio, opd); }, table.max_magnitude(c),
+                film_ior, max_nm, cycles_f82_tint_substrate(f0[c], tint[c]), cos_theta);
+            exact = sum.dc - sum.swing >= 0 && sum.dc + sum.swing <= 1;
+            F[c] = sum.R;
+        }
+        if (exact) return F;
+    }
     // The third order's phase 2π · 3 · 2 η d cos θ2/λ has a period in d of at least
     // λ_min/(6 η), λ_min = 360 nm.
     const double period = 360 / (6 * std::max(film_ior, 1e-3));

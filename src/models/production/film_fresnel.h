@@ -84,10 +84,19 @@ class CyclesFilmSensitivity {
     /// The kernel's lookup (iridescence_lookup_sensitivity_channel): the entries linearly
     /// interpolated at x = 2π OPD/60000 nm ∈ [0, 1] (clamped) times 511.
     std::complex<double> operator()(int channel, double opd_nm) const;
+    /// The exact mean of operator() over OPD uniform in [opd0_nm, opd1_nm] (0 ≤ opd0 < opd1):
+    /// the integral of the piecewise-linear lookup from the entries' running trapezoid sums.
+    std::complex<double> mean(int channel, double opd0_nm, double opd1_nm) const;
+    /// The largest |entry| of channel c (the DC entry is 1).
+    double max_magnitude(int channel) const { return max_magnitude_[channel]; }
 
   private:
     CyclesFilmSensitivity();
+    /// ∫ of the lookup from x = 0 to x at channel c (x the lookup's coordinate in entries).
+    std::complex<double> integral(int channel, double x) const;
     std::complex<double> table_[3][kSize];
+    std::complex<double> running_[3][kSize];  ///< ∫ from 0 to entry j (trapezoids)
+    double max_magnitude_[3] = {};
 };
 
 /// Cycles' thin film (kernel/closure/bsdf_util.h, fresnel_iridescence_channel) for light
@@ -123,8 +132,12 @@ double cycles_film_reflectance_monochromatic(double wavelength_nm, double film_i
 /// THINFILM_THICKNESS_CUTOFF) leave the bare F82-tint metal.
 Rgbd cycles_f82_tint_film(double film_ior, double thickness_nm, const Rgbd& f0, const Rgbd& tint,
                           double cos_theta);
-/// cycles_f82_tint_film averaged over the thickness range [min_nm, max_nm] (Gauss–Legendre, 32
-/// nodes per period of its third order, at most 2048 nodes); min_nm = max_nm is one thickness.
+/// cycles_f82_tint_film averaged over the thickness range [min_nm, max_nm]; min_nm = max_nm is one
+/// thickness. The sum is linear in the sensitivity, whose lookup is piecewise linear in the
+/// thickness: its mean is taken exactly (CyclesFilmSensitivity::mean) wherever Cycles' final clamp
+/// to [0, 1] cannot act at any thickness of the range (the orders' largest swing about their DC
+/// term stays inside it) and the range starts above 1 nm (where the film's index blends to 1);
+/// elsewhere by Gauss–Legendre (32 nodes per period of the third order, at most 2048).
 Rgbd cycles_f82_tint_film_range(double film_ior, double min_nm, double max_nm, const Rgbd& f0,
                                 const Rgbd& tint, double cos_theta);
 

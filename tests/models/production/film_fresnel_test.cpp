@@ -223,6 +223,41 @@ struct SingleFilm {
     }
 };
 
+// Cycles' sensitivity lookup is piecewise linear: its mean over an OPD range (running trapezoid
+// sums) against the lookup averaged by a fine midpoint rule, inside the table and past its end.
+TEST(FilmFresnel, CyclesSensitivityMeanIsTheLookupsMean) {
+    const CyclesFilmSensitivity& table = CyclesFilmSensitivity::get();
+    for (int c = 0; c < 3; ++c)
+        for (auto [a, b] : {std::pair{0.0, 5.0}, std::pair{3.3, 3.4}, std::pair{120.0, 2750.0},
+                            std::pair{9000.0, 12000.0}}) {
+            constexpr int kSteps = 400000;
+            std::complex<double> sum = 0;
+            for (int i = 0; i < kSteps; ++i)
+                sum += table(c, a + (b - a) * (i + 0.5) / kSteps);
+            const std::complex<double> want = sum / double(kSteps), got = table.mean(c, a, b);
+            EXPECT_NEAR(got.real(), want.real(), 1e-9) << c << " [" << a << ", " << b << "]";
+            EXPECT_NEAR(got.imag(), want.imag(), 1e-9) << c << " [" << a << ", " << b << "]";
+        }
+}
+
+// Where Cycles' clamp cannot act (a darker metal, not too far from normal light: at μ = 0.2 the
+// orders' bound reaches below 0 and the mean is taken numerically), its film's thickness mean is
+// exact: the sum is linear in the sensitivity's mean. Against a fine midpoint rule, far below the
+// 4e-7 that Gauss–Legendre leaves at the lookup's kinks.
+TEST(FilmFresnel, CyclesRangeMeanIsExactWhereTheClampCannotAct) {
+    const Rgbd f0(0.3, 0.25, 0.2), tint(0.9, 0.95, 1.0);
+    for (double mu : {1.0, 0.6})
+        for (auto [lo, hi] : {std::pair{200.0, 600.0}, std::pair{45.0, 51.0}}) {
+            const Rgbd want = midpoint_mean(lo, hi, 200000, [&](double d) {
+                return cycles_f82_tint_film(1.5, d, f0, tint, mu);
+            });
+            const Rgbd got = cycles_f82_tint_film_range(1.5, lo, hi, f0, tint, mu);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(got[c], want[c], 1e-9)
+                    << "mu " << mu << " [" << lo << ", " << hi << "] channel " << c;
+        }
+}
+
 // The metals of the single-film tables at the channels' wavelengths (630, 532, 465 nm), n + ik:
 // titanium, gold, copper, aluminium (representative handbook values, rounded).
 struct FilmMetals {
