@@ -189,7 +189,7 @@
 
     // The disks.
     const disks = el("colour-disks");
-    while (disks.children.length > sources.length) disks.lastChild.remove();
+    while (disks.children.length > sources.length) { Plotly.purge(disks.lastChild); disks.lastChild.remove(); }
     const means = {};
     sources.forEach((s, n) => {
       let div = disks.children[n];
@@ -275,7 +275,11 @@
   function init() {
     const mode = el("w-colour-mode"), ev = el("w-colour-ev");
     if (!mode || !ev) return;
-    mode.addEventListener("change", () => { settings.mode = mode.value; if (last) draw(...last); });
+    mode.addEventListener("change", () => {
+      settings.mode = mode.value;
+      ev.disabled = settings.mode === "chroma";  // one luminance: no exposure
+      if (last) draw(...last);
+    });
     ev.addEventListener("change", () => {
       const v = Number(ev.value);
       settings.ev = isFinite(v) ? Math.max(-20, Math.min(20, v)) : 0;
