@@ -108,7 +108,9 @@
 
   const el = (id) => document.getElementById(id);
 
-  // The merged bins' projected solid angles (their weights) and cos θo at their centres.
+  // The merged bins' projected solid angles Ω⊥ = ½ (sin²θ1 − sin²θ0) Δφ (lamina's formula,
+  // HemisphereGrid::projected_solid_angle in src/core/grid.cpp, over a merged bin; a folded bin's
+  // mirror half would double every weight alike) and cos θo at their centres.
   function binGeometry(h) {
     const rad = Math.PI / 180, w = [], cosc = [];
     for (let t = 0; t < h.n_theta; ++t) {
