@@ -12,6 +12,8 @@ Reads study.json, metrics.csv and configs/<id>/{config.json, tables.lza, referen
                                           floor (misplaced_floor), log colours, the noise floor as
                                           the first column, models ranked (best first)
   albedo-<category>.<fmt>                 directional albedo against θi, one panel per configuration
+  colour/<id>-R.<fmt> (and -T for slabs)  the colour (sRGB) of f along the incident plane, the
+                                          reference and every model, one panel per incidence
 
 Only the figures whose inputs changed are drawn again (their digests are in figures/.inputs.json;
 --force redraws all), in parallel over the cores (--jobs, default every core).
@@ -228,12 +230,9 @@ def plane_bins(n_phi, phi_deg):
 
 # ---- Per-configuration incident-plane slices ----------------------------------------------------
 
-def slice_figure(study, cid, formats):
-    root = study.root
-    cfg, tables, se = study.load(cid)
-    T = study.n_theta
-    centres = (np.arange(T) + 0.5) * 90.0 / T
-    x = np.concatenate([-centres[::-1], centres])  # negative: the light's side (φ bin 0)
+def plane_incidences(study, cid):
+    """The incidences a configuration's plane figures show, the φ bins of their planes (light's
+    side, mirror side) and their labels."""
     incidences = study.incidences[cid]
     if study.unfolded(cid):
         # Lit from several azimuths: the incidence nearest θi = 45° at each, on its own plane of
@@ -249,6 +248,25 @@ def slice_figure(study, cid, formats):
         bins = {k: ([0], [-1]) for k in incs}
     label = lambda i: (f"θi = {incidences[i][0]:g}°, φi = {incidences[i][1]:g}°"
                        if study.unfolded(cid) else f"θi = {incidences[i][0]:g}°")
+    return incs, bins, label
+
+
+def plane_values(tables, s, i, d, c, bins):
+    """f of source s, incidence i, side d, channel c along the plane of incidence: the light's
+    side (θ descending) then the mirror side, each the mean of its plane's φ bins."""
+    light, mirror = bins
+    half = lambda a, b: np.mean(np.asarray(a[..., b], dtype=np.float64), axis=-1)
+    return np.concatenate([half(tables[s, i, d, ::-1, :, c], light),
+                           half(tables[s, i, d, :, :, c], mirror)])
+
+
+def slice_figure(study, cid, formats):
+    root = study.root
+    cfg, tables, se = study.load(cid)
+    T = study.n_theta
+    centres = (np.arange(T) + 0.5) * 90.0 / T
+    x = np.concatenate([-centres[::-1], centres])  # negative: the light's side (φ bin 0)
+    incs, bins, label = plane_incidences(study, cid)
     # Ablations (NAME:KEY=VALUE) stay in the error matrix; the slices show the models as shipped.
     models = [m for m in cfg["sources"][1:] if ":" not in m]
     for d, side in enumerate(cfg["sides"]):
@@ -265,8 +283,7 @@ def slice_figure(study, cid, formats):
                 light, mirror = bins[i]
                 # the mean of the plane's bins (one bin folded, or off an edge)
                 half = lambda a, b: np.mean(np.asarray(a[..., b], dtype=np.float64), axis=-1)
-                plane = lambda s: np.concatenate([half(tables[s, i, d, ::-1, :, c], light),
-                                                  half(tables[s, i, d, :, :, c], mirror)])
+                plane = lambda s: plane_values(tables, s, i, d, c, bins[i])
                 ref = plane(0)
                 if se is not None:
                     e = np.concatenate([half(se[i, d, ::-1, :, c], light),
@@ -311,6 +328,68 @@ def slice_figure(study, cid, formats):
             title += "\nnot supported: " + ", ".join(ns)
         fig.suptitle(title, fontsize=9, y=1 - 0.08 / height, va="top")
         save(fig, os.path.join(root, "figures", "slices", f"{cid}-{side}"), formats, tight=False)
+    return cid
+
+
+# ---- Per-configuration colour strips ------------------------------------------------------------
+
+def srgb_encode(v):
+    """The sRGB transfer curve (IEC 61966-2-1:1999 §5.2) of linear values in [0, 1]."""
+    return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.power(np.maximum(v, 0.0031308), 1 / 2.4) - 0.055)
+
+
+def shown_srgb(rgb):
+    """The colour shown for linear RGB already times the exposure, [..., 3] → sRGB in [0, 1], as the
+    explorer shows it (docs/explorer.md, "Colour"): negative channels (outside sRGB's gamut) as 0,
+    a value whose largest channel exceeds 1 divided by it (its hue kept), then the transfer curve."""
+    c = np.maximum(np.nan_to_num(rgb, nan=0.0), 0.0)
+    m = c.max(axis=-1, keepdims=True)
+    return srgb_encode(np.where(m > 1, c / np.where(m > 1, m, 1.0), c))
+
+
+def colour_figure(study, cid, formats):
+    """The colour of f along the plane of incidence, reference and models, one panel per incidence
+    (those of the slices), at one exposure per panel: whole stops below the reference's largest
+    channel on the plane (2^−⌈log2 m⌉), so that none of its bins clips."""
+    cfg, tables, _ = study.load(cid)
+    T = study.n_theta
+    incs, bins, label = plane_incidences(study, cid)
+    models = [m for m in cfg["sources"][1:] if ":" not in m]
+    for d, side in enumerate(cfg["sides"]):
+        rows = ["reference"] + [m for m in models if supported(cfg, m, side)]
+        ns = [m for m in models if not supported(cfg, m, side)]
+        panel = 0.32 * len(rows) + 0.75
+        height = panel * len(incs) + 0.75 + (0.17 if ns else 0.0)
+        fig, axes = plt.subplots(len(incs), 1, figsize=(7.0, height), squeeze=False)
+        fig.subplots_adjust(left=1.6 / 7.0, right=1 - 0.15 / 7.0, bottom=0.5 / height,
+                            top=1 - (0.5 + (0.17 if ns else 0.0)) / height, hspace=0.6)
+        for r, i in enumerate(incs):
+            ax = axes[r][0]
+            rgb = np.stack([np.stack([plane_values(tables, cfg["sources"].index(s), i, d, c, bins[i])
+                                      for c in range(3)], axis=-1) for s in rows])  # [row, 2T, 3]
+            m = np.nanmax(rgb[0]) if np.any(rgb[0] > 0) else 1.0
+            k = 2.0 ** -math.ceil(math.log2(m))
+            image = shown_srgb(rgb * k)
+            image[np.isnan(rgb).any(axis=-1)] = 1.0  # a bin without a value: white
+            ax.imshow(image, extent=(-90, 90, len(rows), 0), aspect="auto", interpolation="nearest")
+            ax.set_yticks(np.arange(len(rows)) + 0.5)
+            ax.set_yticklabels(rows, fontsize=7)
+            for tick, s in zip(ax.get_yticklabels(), rows):
+                if s != "reference":
+                    tick.set_color(model_color(s, study.models))
+            ax.set_xlim(-90, 90)
+            ax.set_xticks([-90, -60, -30, 0, 30, 60, 90])
+            ax.tick_params(labelsize=7)
+            ax.set_title(f"{label(i)} · exposure 2^{-math.ceil(math.log2(m)):d} sr", fontsize=8)
+            if r == len(incs) - 1:
+                ax.set_xlabel("θo (°), light's side negative", fontsize=8)
+        title = (f"{cid} — colour of {SIDE_NAME[side]} f on the incident plane (linear RGB × "
+                 "exposure, sRGB)")
+        if ns:
+            title += "\nnot supported: " + ", ".join(ns)
+        fig.suptitle(title, fontsize=9, y=1 - 0.08 / height, va="top")
+        save(fig, os.path.join(study.root, "figures", "colour", f"{cid}-{side}"), formats,
+             tight=False)
     return cid
 
 
@@ -507,6 +586,9 @@ def plan(study, ids, formats, script_id):
         tasks.append((f"slices/{cid}", "slice", cid,
                       sum((outs(f"slices/{cid}-{side}") for side in sides), []),
                       digest("slice", cid, *files)))
+        tasks.append((f"colour/{cid}", "colour", cid,
+                      sum((outs(f"colour/{cid}-{side}") for side in sides), []),
+                      digest("colour", cid, *files)))
     metrics = file_digest(os.path.join(study.root, "metrics.csv"))
     configs = json.dumps(study.configs)
     for side in ["R"] + (["T"] if any("T" in c["sides"] for c in study.configs) else []):
@@ -531,6 +613,8 @@ def draw(task):
     formats = _FORMATS
     if kind == "slice":
         slice_figure(_STUDY, arg, formats)
+    elif kind == "colour":
+        colour_figure(_STUDY, arg, formats)
     elif kind == "matrix":
         error_matrix(_STUDY, formats, arg)
     else:
@@ -580,7 +664,7 @@ def main():
     todo = [t for t in tasks if a.force or stamps.get(t[0]) != t[4]
             or not all(os.path.exists(o) for o in t[3])]
     # The largest first (albedo grids, then matrices), so the pool's last task is a short one.
-    todo.sort(key=lambda t: {"albedo": 0, "matrix": 1, "slice": 2}[t[1]])
+    todo.sort(key=lambda t: {"albedo": 0, "matrix": 1, "slice": 2, "colour": 2}[t[1]])
     if a.jobs > 1 and len(todo) > 1:
         import multiprocessing
         with multiprocessing.get_context("fork").Pool(min(a.jobs, len(todo))) as pool:

@@ -1060,6 +1060,10 @@
 
   let renderSerial = 0;
 
+  // What the views of other files draw with: the page's state and helpers.
+  const VIEW_API = { state, models, nTheta, sliceAngles, slicePlane, isoLookup, ISO_N, diskLayout,
+    incidenceIndex, incidenceText, incidencesOf, isUnfolded, isSupported, modelColor, PLOT_CONFIG };
+
   async function render() {
     const serial = ++renderSerial;
     const cfg = byId.get(state.config);
@@ -1081,6 +1085,8 @@
     timed("leaderboard", () => drawLeaderboard());
     timed("polarization", () => drawPolarization(d, cfg));
     drawRenders(cfg);
+    // Views kept in their own files (web/colour.js), registered in window.LAMINA_VIEWS.
+    for (const v of window.LAMINA_VIEWS || []) timed(v.name, () => v.draw(VIEW_API, d, cfg));
     document.body.dataset.viewMs = JSON.stringify(times);
     writeHash();
     status("");

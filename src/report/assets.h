@@ -9,6 +9,8 @@ namespace lamina::assets {
 
 std::string_view explorer_html();
 std::string_view explorer_js();
+/// web/colour.js: the explorer's colour view and its colour science (sRGB, CIELAB, CIEDE2000).
+std::string_view colour_js();
 std::string_view explorer_css();
 /// web/model-colors.json: the one table of model colours, for the page and the figures.
 std::string_view model_colors_json();

@@ -691,6 +691,7 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
     StagedOutput page_out(study_dir / "explorer");
     page_out.add_if_changed("plotly.min.js", plotly);
     page_out.add_if_changed("explorer.js", assets::explorer_js());
+    page_out.add_if_changed("colour.js", assets::colour_js());
     page_out.add_if_changed("explorer.css", assets::explorer_css());
     StagedOutput root_out(study_dir);
     root_out.add_if_changed("index.html", assets::explorer_html());

@@ -102,6 +102,9 @@ async function main() {
     await page.check("#w-model-ww09");
     await changes("a top-layer parameter (α0)", () => page.selectOption("#w-param-alpha0", "0.3"), ["slice", "iso-ref", "albedo"]);
     check((await page.evaluate(() => document.body.dataset.config)) === "plastic-P2-a0.3", "α0 = 0.3 opens plastic-P2-a0.3");
+    // The colour view on this coloured plastic: known bins against tables.npy, ΔE00 against
+    // published data.
+    await require("./browser_colour.js").checkColour(page, studyDir, check);
     check(await page.evaluate(() => /bel18-forward/.test(document.getElementById("unsupported").textContent)), "an unsupported model is named as such");
     await changes("the category", () => page.selectOption("#w-category", "slab"), ["slice", "albedo"]);
     check((await page.evaluate(() => document.body.dataset.config)) === "slab-a0.1-a1.3-clear", "the slab category opens the slab");

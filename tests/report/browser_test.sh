@@ -40,3 +40,12 @@ rm -rf "$brushed"
     --particles 2e4 --grid 18x18 --models openpbr,bel-prime --reference-stokes on --no-figures \
     --out "$brushed" >/dev/null
 node "$src/tests/report/browser_unfolded.js" "$brushed" "$build/screenshots/brushed-study.png"
+
+# And a study of one iridescent configuration (spectral: the reference traced over 360–830 nm,
+# its tables linear sRGB under D65): the colour view shows the reference's colours as the tables
+# give them.
+spectral="$build/report-spectral-study"
+rm -rf "$spectral"
+"$lamina" study --preset standard --only 'irid-ti-oxide-a0.05-a1.05' --theta-i 0,45 \
+    --particles 2e4 --grid 18x18 --models openpbr --no-figures --out "$spectral" >/dev/null
+node "$src/tests/report/browser_spectral.js" "$spectral" "$build/screenshots/spectral-colour.png"

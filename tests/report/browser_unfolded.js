@@ -8,6 +8,7 @@ const fs = require("fs");
 const path = require("path");
 const { launchChromium } = require("../support/chromium.js");
 const { readPacked } = require("../support/packed_reader.js");
+const { expectedSrgb } = require("./browser_colour.js");
 
 const [studyDir, shot] = process.argv.slice(2);
 
@@ -103,6 +104,31 @@ async function main() {
       }));
       check(compared > 3000 && angles > 100 && worstDop < 1e-4 && worstAngle < 0.01,
         `every pixel's degree and angle of polarization is its own bin's (${compared} pixels, ${angles} angles; worst ${worstDop}, ${worstAngle}°)`);
+      // The colour view on the unfolded disk: each pixel the colour of its own bin (φ = atan2(−y, −x)
+      // over 0°–360°, no mirror image), at the exposure of whole stops below the reference's
+      // largest channel (18 × 36 bins: not merged), to one 8-bit step (16-bit codes).
+      const col = await page.evaluate(() => {
+        const t = document.getElementById("colour-disks").children[0].data[0];
+        return { z: t.z, x0: t.x0, dx: t.dx, k: Number(document.getElementById("colour-view").dataset.exposure) };
+      });
+      let m = 0;
+      for (let t = 0; t < T; ++t) for (let p = 0; p < P; ++p) for (let ch = 0; ch < 3; ++ch)
+        m = Math.max(m, tab.values[((inc * D + 0) * T * P + t * P + p) * 3 + ch]);
+      const k = Math.pow(2, -Math.ceil(Math.log2(m)));
+      let worstColour = 0, colours = 0, opaqueBelow = 0;
+      col.z.forEach((row, j) => row.forEach((v, i) => {
+        const x = col.x0 + i * col.dx, y = col.x0 + j * col.dx, r = Math.hypot(x, y);
+        if (r > 1 || v[3] !== 1) return;
+        if (y < -0.1) ++opaqueBelow;
+        const ut = Math.asin(r) * 180 / Math.PI / (90 / T), up = ((Math.atan2(-y, -x) * 180 / Math.PI + 360) % 360) / (360 / P);
+        if (Math.abs(ut - Math.round(ut)) < 0.05 || Math.abs(up - Math.round(up)) < 0.05) return;
+        const t = Math.floor(ut), p = Math.floor(up) % P;
+        const want = expectedSrgb([0, 1, 2].map((ch) => tab.values[((inc * D + 0) * T * P + t * P + p) * 3 + ch] * k));
+        worstColour = Math.max(worstColour, ...want.map((w, ch) => Math.abs(w - v[ch])));
+        ++colours;
+      }));
+      check(col.k === k && opaqueBelow > 100 && colours > 3000 && worstColour <= 1,
+        `the colour view's reference: every pixel is its own bin's sRGB at exposure ${col.k} (${colours} pixels; worst ${worstColour} step)`);
     }
     const hash = await page.evaluate(() => location.hash);
     check(hash.includes("phi=45"), `the address keeps φi (${hash})`);

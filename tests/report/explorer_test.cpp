@@ -132,8 +132,9 @@ TEST_P(ExplorerTables, WritesPageDataAndAlbedos) {
 
     const ExplorerSummary s = write_explorer(d);
     EXPECT_EQ(s.configurations, 1u);
-    for (const char* f : {"index.html", "explorer/plotly.min.js", "explorer/explorer.js",
-                          "explorer/explorer.css", "explorer/data/index.js", "explorer/data/c1.js"})
+    for (const char* f :
+         {"index.html", "explorer/plotly.min.js", "explorer/explorer.js", "explorer/colour.js",
+          "explorer/explorer.css", "explorer/data/index.js", "explorer/data/c1.js"})
         EXPECT_TRUE(fs::exists(d / f)) << f;
     EXPECT_GT(fs::file_size(d / "explorer/plotly.min.js"), 1000000u);
     EXPECT_NE(read_text(d / "index.html").find("explorer/data/index.js"), std::string::npos);

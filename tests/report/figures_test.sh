@@ -12,11 +12,42 @@ python3 "$src/tests/report/make_fixture.py" "$study" || exit 1
 "$lamina" figures "$study" --formats png,svg --only 'plastic-P1*,slab-*'
 ok test $? -eq 0
 for f in slices/plastic-P1-a0.05-R slices/slab-a0.1-a1.3-clear-R slices/slab-a0.1-a1.3-clear-T \
+         colour/plastic-P1-a0.05-R colour/slab-a0.1-a1.3-clear-R colour/slab-a0.1-a1.3-clear-T \
          error-matrix-R error-matrix-T albedo-plastic albedo-slab albedo-metallic-paint; do
     ok test -s "$study/figures/$f.png"
     ok test -s "$study/figures/$f.svg"
 done
 ok test ! -e "$study/figures/slices/plastic-P2-a0.3-R.png"   # --only
+
+# The colour strips of the coloured plastic: at each incidence, the reference's brightest bin on the
+# incident plane (the mirror side, φ bin n_phi − 1) and its darkest, as computed here from
+# tables.npy (whole stops below the reference's largest channel on the plane, negative channels
+# as 0, the sRGB curve of IEC 61966-2-1), are colours of the PNG, to one 8-bit step.
+"$lamina" figures "$study" --formats png --only 'plastic-P2*' >/dev/null
+ok test -s "$study/figures/colour/plastic-P2-a0.3-R.png"
+colour_check() {
+    "${LAMINA_PYTHON:-/usr/bin/python3}" - "$study" <<'PY'
+import math, sys
+import numpy as np
+import matplotlib.image as mpimg
+root = sys.argv[1]
+tab = np.load(f"{root}/configs/plastic-P2-a0.3/tables.npy").astype(np.float64)
+png = (mpimg.imread(f"{root}/figures/colour/plastic-P2-a0.3-R.png")[..., :3] * 255).round()
+colours = np.unique(png.reshape(-1, 3), axis=0)
+enc = lambda v: 12.92 * v if v <= 0.0031308 else 1.055 * v ** (1 / 2.4) - 0.055
+found = 0
+for i in range(tab.shape[1]):
+    plane = np.concatenate([tab[0, i, 0, ::-1, 0, :], tab[0, i, 0, :, -1, :]])  # [2T, 3]
+    k = 2.0 ** -math.ceil(math.log2(plane.max()))
+    for x in (plane.max(axis=1).argmax(), plane.max(axis=1).argmin()):
+        want = np.array([round(255 * enc(max(0.0, v * k))) for v in plane[x]])
+        near = np.abs(colours - want).max(axis=1).min()
+        print(f"theta_i index {i}, plane bin {x}: sRGB {want}, nearest colour in the figure {near} steps away")
+        found += near <= 1
+sys.exit(0 if found == 2 * tab.shape[1] else 1)
+PY
+}
+ok colour_check
 
 # Errors: each names the file or the option, and exits 1.
 out=$("$lamina" figures "$build/no-such-study" 2>&1); rc=$?
@@ -46,9 +77,10 @@ rm -rf "$brushed"
 ok test $? -eq 0
 out=$("$lamina" figures "$brushed" --formats png 2>&1)
 ok test $? -eq 0
-for f in slices/brushed-gold-a0.001-a1.05x.3-t30-R error-matrix-R albedo-brushed; do
+for f in slices/brushed-gold-a0.001-a1.05x.3-t30-R colour/brushed-gold-a0.001-a1.05x.3-t30-R \
+         error-matrix-R albedo-brushed; do
     ok test -s "$brushed/figures/$f.png"
 done
-ok grep -q "3 drawn" <<<"$out"
+ok grep -q "4 drawn" <<<"$out"
 echo "$passes passed, $fails failed"
 test "$fails" -eq 0
