@@ -584,6 +584,7 @@
     });
     layout.title = { text: cfg.id + " · " + incidenceText(cfg, inc) + " · " + (side === "R" ? "reflection" : "transmission") +
       (isUnfolded(cfg) ? " · the plane φ = φi (negative θo) and φi + 180°" : "") +
+      (cfg.spectral ? " · channels: linear sRGB (D65) of a spectral reference, " + cfg.spectral.min_nm + "–" + cfg.spectral.max_nm + " nm" : "") +
       " · dotted: the light's direction (−θi) and the " + (side === "R" ? "mirror" : "straight-through") + " direction",
       font: { size: 13 }, x: 0.01, y: 0.985 };
     layout.margin.t = 46;

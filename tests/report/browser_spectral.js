@@ -53,6 +53,10 @@ async function main() {
     const models = view.rows.slice(1);
     check(view.meanDe.reference === 0 && models.length > 0 && models.every((s) => view.meanDe[s] > 0),
       `mean ΔE00: the reference against itself 0, the models above (${JSON.stringify(view.meanDe)})`);
+    // The incident-plane view says its channels are colour, over config.json's range.
+    const title = await page.evaluate(() => document.getElementById("slice").layout.title.text);
+    check(cfg.spectral && title.includes("linear sRGB (D65) of a spectral reference, " + cfg.spectral.min_nm + "–" + cfg.spectral.max_nm + " nm"),
+      `the slice's title names the spectral reference's channels (${title})`);
     await (await page.$("#colour-view")).screenshot({ path: shot });
   } finally {
     await browser.close();
