@@ -291,7 +291,7 @@ void main() {
     empty.bins = texture(3, 1, 1, gl.RGBA32F, gl.RGBA, gl.FLOAT, new Float32Array(4));
     empty.coat = texture(2, 1, 1, gl.R16UI, gl.RED_INTEGER, gl.UNSIGNED_SHORT, new Uint16Array(1));
     let coatTable = null;
-    let scene = null, passes = 0, current = 0;
+    let scene = null, passes = 0, current = 0, fence = null;
     const r = {
       size,
       get samples() { return passes; },
@@ -388,6 +388,18 @@ void main() {
           current = 1 - current;
           ++passes;
         }
+        if (fence) gl.deleteSync(fence);
+        fence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
+        gl.flush();
+      },
+      // Whether the passes of the last step are still running (WebGL runs asynchronously: a page
+      // that steps again before they finish only queues work and stops responding).
+      busy() {
+        if (!fence) return false;
+        if (gl.getSyncParameter(fence, gl.SYNC_STATUS) !== gl.SIGNALED) return true;
+        gl.deleteSync(fence);
+        fence = null;
+        return false;
       },
       // Draws the mean so far on the canvas, tone-mapped as lamina render's PNG.
       show(exposure) {
