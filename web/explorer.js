@@ -1093,9 +1093,10 @@
   function liveTable(d, source) {
     const h = d.hemiShape, I = d.nInc, D = d.sides.length, s = d.sources.indexOf(source), sd = d.sides.indexOf("R");
     const n = h.n_theta * h.n_phi, values = new Float32Array(I * n * 3);
-    for (let i = 0; i < I; ++i)
-      values.set(d.hemi.subarray(((s * I + i) * D + sd) * n * 3, ((s * I + i) * D + sd + 1) * n * 3), i * n * 3);
-    return { theta_edges: h.theta_edges, phi_edges: h.phi_edges, theta_i: THETA_I.slice(0, I), values };
+    const order = THETA_I.slice(0, I).map((t, i) => i).sort((a, b) => THETA_I[a] - THETA_I[b]);  // ascending θi
+    order.forEach((i, k) =>
+      values.set(d.hemi.subarray(((s * I + i) * D + sd) * n * 3, ((s * I + i) * D + sd + 1) * n * 3), k * n * 3));
+    return { theta_edges: h.theta_edges, phi_edges: h.phi_edges, theta_i: order.map((i) => THETA_I[i]), values };
   }
   function drawLive(d, cfg, reset) {
     const note = $("live-note"), select = $("w-live-model");
@@ -1117,7 +1118,7 @@
     const l1 = d.raw.lamina1;
     if (l1) choices.push("lamina-1");
     if (coatMaterial(cfg)) choices.push("lamina-coat");
-    if (!d.hemiShape.unfolded)
+    if (!d.hemiShape.unfolded && d.nInc <= 32 && d.hemiShape.n_theta < 64 && d.hemiShape.n_phi < 64)
       for (const s of d.sources) if (s === "reference" || isSupported(cfg, s, "R")) choices.push("table:" + s);
     const keep = select.value;
     setOptions(select, choices.map((c) => [c, c.startsWith("table:") ? c.slice(6) + " (table)" : c + " (GLSL)"]),
@@ -1151,6 +1152,11 @@
       : model === "lamina-coat" ? "lamina-coat in GLSL, its parameters live."
       : model.slice(6) + ": the study's binned table, interpolated linearly over the bins and incidences (a highlight narrower than a bin is spread over it).";
     document.body.dataset.live = model;
+    // Another view's widget redraws the page: the live image restarts only when its scene changed.
+    const key = JSON.stringify([cfg.id, model, env, model === "lamina-1" ? $("w-live-l1").value : "",
+      model === "lamina-coat" ? scene.material : null]);
+    if (key === live.key) return;
+    live.key = key;
     live.pending = scene;
     ++live.frame;
     liveRun();

@@ -8,7 +8,8 @@
 //     --lamina1-gpu` (or `lamina study`) writes, in an R32F texture 256 texels wide;
 //   - "lamina-coat": docs/lamina-coat/lamina_coat.glsl (lamina_coat_eval) on a material of
 //     uniforms (its parameters), with its 32 × 577 R16UI table;
-//   - a binned table (the page data's hemisphere of a source at each of the study's incidences),
+//   - a binned table (the page data's hemisphere of a source at each of the study's incidences, at
+//     most 32, on at most 63 × 63 bins),
 //     interpolated linearly between bin centres in θo and φo and between incidences in θi.
 // The GLSL of lamina-1 and lamina-coat is not restated here: the page loads the shipped files
 // (explorer/glsl.js holds them as strings, window.LAMINA_GLSL).
@@ -62,7 +63,7 @@ uniform vec3 mc_tau, mc_albedo, mc_base_eta, mc_base_k;
 uniform int mc_conductor;
 // MODEL 2: bin edges (degrees) and incidences.
 uniform int n_theta, n_phi, n_inc;
-uniform float theta_edges[64], phi_edges[64], theta_inc[16];
+uniform float theta_edges[64], phi_edges[64], theta_inc[32];
 out vec4 color;
 ${glsl.lamina1}
 ${model === 1 ? glsl.laminaCoat : ""}
@@ -135,7 +136,7 @@ vec3 sp_eval(vec3 wi, vec3 wo) {
   float phi_o = abs(degrees(atan(wi.x * wo.y - wi.y * wo.x, wi.x * wo.x + wi.y * wo.y)));
   if (length(wi.xy) < 1e-6) phi_o = 0.0;
   int k0 = 0;
-  for (int k = 0; k < 16; ++k)
+  for (int k = 0; k < 32; ++k)
     if (k < n_inc && theta_inc[k] <= theta_i) k0 = k;
   int k1 = min(k0 + 1, n_inc - 1);
   float t = k1 > k0 ? clamp((theta_i - theta_inc[k0]) / (theta_inc[k1] - theta_inc[k0]), 0.0, 1.0) : 0.0;

@@ -224,10 +224,12 @@ Lamina1GpuStates lamina1_gpu_states(const Stack& stack, const ModelOptions& opti
     }
     for (double v : {1.2, 1.33, 1.5, 1.8, 2.2}) {
         lamina1::Layers l = layers;
-        const double scale = layers.eta0 / v;  // the base's index relative to the new coat
         l.eta0 = v;
-        l.base_eta = layers.base_eta * scale;
-        l.base_k = layers.base_k * scale;
+        if (layers.base != lamina1::Base::Lambertian) {
+            const double scale = layers.eta0 / v;  // the base's index relative to the new coat
+            l.base_eta = layers.base_eta * scale;
+            l.base_k = layers.base_k * scale;
+        }
         add("eta0", v, l);
     }
     for (double v : {0.0, 0.1, 0.3, 1.0, 3.0}) {
