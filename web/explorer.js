@@ -1143,6 +1143,9 @@
       }
       const k = $("w-live-l1").value, state = l1.all.slice(0, l1.state);
       if (k !== "") state.set(l1.all.subarray(l1.state + Number(k) * l1.head, l1.state + (Number(k) + 1) * l1.head));
+      // The proposal's lobe follows the coat's roughness (lamina render's lobe_alpha_for).
+      const alpha0 = k !== "" && l1.variants[Number(k)][0] === "alpha0" ? l1.variants[Number(k)][1] : Number(cfg.parameters.alpha0);
+      if (Number.isFinite(alpha0)) scene.lobeAlpha = Math.min(Math.max(alpha0, 0.02), 1);
       Object.assign(scene, { model: "lamina-1", state });
     } else if (model === "lamina-coat") Object.assign(scene, { model: "lamina-coat", material: coatMaterial(cfg) });
     else Object.assign(scene, { model: "table", table: liveTable(d, model.slice(6)) });
