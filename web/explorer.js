@@ -1057,6 +1057,158 @@
     }
   }
 
+  // ---- View 5b: live spheres (web/spheres.js; docs/explorer.md, "Live spheres") -------------------------
+
+  const LIVE_SIZE = 192, LIVE_SPP = 256;
+  const live = { renderer: null, why: "", frame: 0, running: -1, visible: false, pending: null };
+  // The lamina-coat material of a configuration's coat (its parameters as the study lists them),
+  // with the widgets' values where the user changed them: null where lamina-coat does not apply
+  // (lamina-coat: one dielectric coat, absorbing only, over a Lambertian or conductor base).
+  // The study's parameters are strings; an anisotropic one ("0.05x0.2") is not a number, and
+  // lamina-coat is isotropic.
+  function coatMaterial(cfg) {
+    const q = cfg.parameters || {}, w = (id) => Number($(id).value), p = {};
+    for (const k of Object.keys(q)) p[k] = k === "base" ? q[k] : Number(q[k]);
+    if (p.tau_s || p.film_nm || (p.base !== "lambertian" && p.base !== "conductor") || !(p.eta0 >= 1.1) ||
+        !Number.isFinite(p.alpha0) || (p.alpha1 !== undefined && !Number.isFinite(p.alpha1))) return null;
+    const eta = w("w-live-eta"), conductor = p.base === "conductor";
+    return {
+      eta, alpha_coat: w("w-live-alpha0"), tau: [w("w-live-tau"), w("w-live-tau"), w("w-live-tau")],
+      conductor, albedo: $("w-live-colour").value.match(/\w\w/g).map((h) => parseInt(h, 16) / 255),
+      base_eta: [(p.eta1 || 1) / eta, (p.eta1 || 1) / eta, (p.eta1 || 1) / eta],
+      base_k: [(p.kappa1 || 0) / eta, (p.kappa1 || 0) / eta, (p.kappa1 || 0) / eta],
+      alpha_base: w("w-live-alpha1"),
+    };
+  }
+  // Sets the live widgets to the configuration's stack.
+  function resetLiveWidgets(cfg) {
+    const p = cfg.parameters || {};
+    $("w-live-alpha0").value = p.alpha0 || 0.1;
+    $("w-live-eta").value = p.eta0 || 1.5;
+    $("w-live-tau").value = p.tau || 0;
+    $("w-live-alpha1").value = p.alpha1 || 0;
+    const g = Math.round(255 * Math.min(1, p.rho === undefined ? 0.8 : p.rho)).toString(16).padStart(2, "0");
+    $("w-live-colour").value = "#" + g + g + g;
+  }
+  // The hemisphere table of `source` at every incidence, for the table path of spheres.js.
+  function liveTable(d, source) {
+    const h = d.hemiShape, I = d.nInc, D = d.sides.length, s = d.sources.indexOf(source), sd = d.sides.indexOf("R");
+    const n = h.n_theta * h.n_phi, values = new Float32Array(I * n * 3);
+    const order = THETA_I.slice(0, I).map((t, i) => i).sort((a, b) => THETA_I[a] - THETA_I[b]);  // ascending θi
+    order.forEach((i, k) =>
+      values.set(d.hemi.subarray(((s * I + i) * D + sd) * n * 3, ((s * I + i) * D + sd + 1) * n * 3), k * n * 3));
+    return { theta_edges: h.theta_edges, phi_edges: h.phi_edges, theta_i: order.map((i) => THETA_I[i]), values };
+  }
+  function drawLive(d, cfg, reset) {
+    const note = $("live-note"), select = $("w-live-model");
+    if (!live.renderer && !live.why) {
+      const r = window.LAMINA_SPHERES ? window.LAMINA_SPHERES.createRenderer($("live-canvas"), LIVE_SIZE, window.LAMINA_GLSL)
+        : { why: "The live spheres' script (explorer/spheres.js) is missing." };
+      if (r.why) live.why = r.why; else live.renderer = r;
+    }
+    if (live.why) {
+      $("live-canvas").hidden = true;
+      note.textContent = live.why;
+      document.body.dataset.live = "unavailable";
+      return;
+    }
+    if (reset) resetLiveWidgets(cfg);
+    // The models this configuration can show: lamina-coat where it applies, and every source the
+    // study has a table of (folded configurations: the tables are interpolated over the bins).
+    const choices = [];
+    const l1 = d.raw.lamina1;
+    if (l1) choices.push("lamina-1");
+    if (coatMaterial(cfg)) choices.push("lamina-coat");
+    if (!d.hemiShape.unfolded && d.nInc <= 32 && d.hemiShape.n_theta < 64 && d.hemiShape.n_phi < 64)
+      for (const s of d.sources) if (s === "reference" || isSupported(cfg, s, "R")) choices.push("table:" + s);
+    const keep = select.value;
+    setOptions(select, choices.map((c) => [c, c.startsWith("table:") ? c.slice(6) + " (table)" : c + " (GLSL)"]),
+      choices.includes(keep) ? keep : choices[0]);
+    if (!choices.length) {
+      $("live-canvas").hidden = true;
+      note.textContent = "No model of this configuration can be rendered live.";
+      document.body.dataset.live = "none";
+      return;
+    }
+    $("live-canvas").hidden = false;
+    const model = select.value, env = $("w-live-env").value;
+    const scene = { env, lobeAlpha: Math.min(Math.max(Number($("w-live-alpha0").value), 0.02), 1) };
+    if (model === "lamina-1") {
+      // The study's states (config.json → lamina1_gpu): the stack's own, or one variant's
+      // per-material part over the stack's slope-sum table.
+      if (!l1.all) l1.all = window.LAMINA_SPHERES.floatsOf(l1.floats);
+      if (reset || $("w-live-l1").dataset.config !== cfg.id) {
+        setOptions($("w-live-l1"), [["", "the configuration's stack"]].concat(l1.variants.map(([p, v], k) =>
+          [String(k), (L1_PARAMS[p] || p) + " = " + v])), "");
+        $("w-live-l1").dataset.config = cfg.id;
+      }
+      const k = $("w-live-l1").value, state = l1.all.slice(0, l1.state);
+      if (k !== "") state.set(l1.all.subarray(l1.state + Number(k) * l1.head, l1.state + (Number(k) + 1) * l1.head));
+      // The proposal's lobe follows the coat's roughness (lamina render's lobe_alpha_for).
+      const alpha0 = k !== "" && l1.variants[Number(k)][0] === "alpha0" ? l1.variants[Number(k)][1] : Number(cfg.parameters.alpha0);
+      if (Number.isFinite(alpha0)) scene.lobeAlpha = Math.min(Math.max(alpha0, 0.02), 1);
+      Object.assign(scene, { model: "lamina-1", state });
+    } else if (model === "lamina-coat") Object.assign(scene, { model: "lamina-coat", material: coatMaterial(cfg) });
+    else Object.assign(scene, { model: "table", table: liveTable(d, model.slice(6)) });
+    $("live-coat").hidden = model !== "lamina-coat";
+    $("live-l1").hidden = model !== "lamina-1";
+    note.textContent = model === "lamina-1" ? "lamina-1 in GLSL (lamina1.glsl) on the state the study computed: the stack's, or one parameter changed at a time."
+      : model === "lamina-coat" ? "lamina-coat in GLSL, its parameters live."
+      : model.slice(6) + ": the study's binned table, interpolated linearly over the bins and incidences (a highlight narrower than a bin is spread over it).";
+    document.body.dataset.live = model;
+    // Another view's widget redraws the page: the live image restarts only when its scene changed.
+    const key = JSON.stringify([cfg.id, model, env, model === "lamina-1" ? $("w-live-l1").value : "",
+      model === "lamina-coat" ? scene.material : null]);
+    if (key === live.key) return;
+    live.key = key;
+    live.pending = scene;
+    ++live.frame;
+    liveRun();
+  }
+  // Compiles and accumulates the pending scene, only while the canvas is on screen: on software
+  // GL a pass costs tens of milliseconds, which the rest of the page should not wait for.
+  function liveRun() {
+    if (!live.visible || !live.renderer) return;
+    if (live.pending) {
+      try {
+        live.renderer.setScene(live.pending);
+      } catch (e) {
+        $("live-note").textContent = "The shader failed: " + e.message;
+        live.pending = null;
+        return;
+      }
+      live.pending = null;
+    }
+    if (live.renderer.samples >= LIVE_SPP) return;
+    const frame = live.frame;
+    if (live.running === frame) return;
+    live.running = frame;
+    // One step at a time, each once the last has finished on the GPU; the passes per step
+    // double while a step takes under 30 ms and halve above 60 ms.
+    let passes = 1, submitted = 0;
+    const tick = () => {
+      if (frame !== live.frame || !live.visible) { live.running = -1; return; }
+      if (live.renderer.busy()) { requestAnimationFrame(tick); return; }
+      const now = performance.now();
+      if (submitted) passes = now - submitted < 30 ? Math.min(2 * passes, 16) : now - submitted > 60 ? Math.max(passes >> 1, 1) : passes;
+      live.renderer.step(Math.min(passes, LIVE_SPP - live.renderer.samples));
+      submitted = performance.now();
+      live.renderer.show(0);
+      $("live-spp").textContent = live.renderer.samples + " spp";
+      document.body.dataset.liveSpp = String(live.renderer.samples);
+      if (live.renderer.samples < LIVE_SPP) requestAnimationFrame(tick); else live.running = -1;
+    };
+    tick();
+  }
+  new IntersectionObserver((entries) => {
+    live.visible = entries.some((e) => e.isIntersecting);
+    liveRun();
+  }).observe($("live-canvas"));
+  const L1_PARAMS = { alpha0: "coat α", eta0: "coat η", tau_a: "coat τa", alpha1: "base α", albedo: "base albedo" };
+  let liveData = null;
+  for (const id of ["w-live-l1", "w-live-model", "w-live-env", "w-live-alpha0", "w-live-eta", "w-live-tau", "w-live-alpha1", "w-live-colour"])
+    $(id).addEventListener("input", () => liveData && drawLive(liveData.d, liveData.cfg, false));
+
   // ---- Rendering ---------------------------------------------------------------------------------------
 
   let renderSerial = 0;
@@ -1086,6 +1238,9 @@
     timed("leaderboard", () => drawLeaderboard());
     timed("polarization", () => drawPolarization(d, cfg));
     drawRenders(cfg);
+    const newConfig = !liveData || liveData.cfg !== cfg;
+    liveData = { d, cfg };
+    drawLive(d, cfg, newConfig);
     // Views kept in their own files (web/colour.js), registered in window.LAMINA_VIEWS.
     for (const v of window.LAMINA_VIEWS || []) timed(v.name, () => v.draw(VIEW_API, d, cfg));
     document.body.dataset.viewMs = JSON.stringify(times);

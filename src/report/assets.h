@@ -12,6 +12,12 @@ std::string_view explorer_js();
 /// web/colour.js: the explorer's colour view and its colour science (sRGB, CIELAB, CIEDE2000).
 std::string_view colour_js();
 std::string_view explorer_css();
+/// The live spheres (web/spheres.js) and the GLSL they load: lamina-1's, lamina-coat's and its
+/// table (docs/explorer.md, "Live spheres").
+std::string_view spheres_js();
+std::string_view lamina1_glsl();
+std::string_view lamina_coat_glsl();
+std::string_view lamina_coat_tables_csv();
 /// web/model-colors.json: the one table of model colours, for the page and the figures.
 std::string_view model_colors_json();
 /// Empty when node_modules/plotly.js-dist-min was absent when the build was configured.

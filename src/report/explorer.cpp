@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <optional>
@@ -567,6 +568,28 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
           {"se_codes", has_se ? json(packed(se_codes, P2)) : json(nullptr)}}},
     };
     if (unfolded) data["hemi"]["unfolded"] = true;  // φ edges over [0°, 360°)
+    // lamina-1's GLSL states for the live spheres (config.json → lamina1_gpu, docs/formats.md):
+    // the file's float32 as base64, with its layout.
+    if (cfg.contains("lamina1_gpu") && cfg["lamina1_gpu"].is_object()) {
+        const json& g = cfg["lamina1_gpu"];
+        const fs::path file = dir / field<std::string>(g, "file", cfg_path);
+        std::ifstream in(file, std::ios::binary);
+        if (!in)
+            throw InputError(file.string(), "", "not found (config.json → lamina1_gpu names it)");
+        const std::string bytes((std::istreambuf_iterator<char>(in)),
+                                std::istreambuf_iterator<char>());
+        const auto n_state = field<std::size_t>(g, "state", cfg_path);
+        const auto head = field<std::size_t>(g, "head", cfg_path);
+        const json variants = field<json>(g, "variants", cfg_path);
+        if (bytes.size() != 4 * (n_state + head * variants.size()))
+            throw InputError(file.string(), "size",
+                             fmt::format("{} bytes: expected 4 × ({} + {} × {}) from config.json",
+                                         bytes.size(), n_state, head, variants.size()));
+        data["lamina1"] = {{"state", n_state},
+                           {"head", head},
+                           {"variants", variants},
+                           {"floats", base64(bytes.data(), bytes.size())}};
+    }
     if (polarization)
         data["polarization"] = {{"dop", packed(polarization->dop, P2)},
                                 {"dop_se", packed(polarization->dop_se, P2)},
@@ -577,6 +600,22 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     out.albedo = albedo;
     out.albedo_se = albedo_se;
     return out;
+}
+
+// The GLSL the live spheres load (web/spheres.js), as strings a file:// page can read:
+// window.LAMINA_GLSL = {lamina1, laminaCoat, laminaCoatTable (the 32 × 577 integers)}.
+std::string glsl_script() {
+    std::vector<int> table;
+    std::istringstream in{std::string(assets::lamina_coat_tables_csv())};
+    for (std::string line; std::getline(in, line);) {
+        if (line.empty() || line[0] == '#') continue;
+        for (const std::string& v : split_csv_line(line))
+            table.push_back(std::stoi(v));
+    }
+    const json glsl = {{"lamina1", std::string(assets::lamina1_glsl())},
+                       {"laminaCoat", std::string(assets::lamina_coat_glsl())},
+                       {"laminaCoatTable", table}};
+    return "window.LAMINA_GLSL = " + glsl.dump() + ";\n";
 }
 
 // Plotly as embedded at build time or, when `make deps` installed it after the build was
@@ -599,8 +638,9 @@ std::string inputs_digest(const fs::path& dir, const json& entry,
                           const std::vector<double>& theta_i, int n_theta, int n_phi) {
     std::uint64_t h = fnv1a(fmt::format("explorer data v2 | lamina {} | {} | {} | {}x{}", kVersion,
                                         entry.dump(), fmt::join(theta_i, ","), n_theta, n_phi));
-    for (const char* name : {"config.json", "tables.lza", "reference_se.lza", "tables.npy",
-                             "reference_se.npy", "reference_stokes.lza", "renders/errors.csv"}) {
+    for (const char* name :
+         {"config.json", "lamina1_gpu.f32", "tables.lza", "reference_se.lza", "tables.npy",
+          "reference_se.npy", "reference_stokes.lza", "renders/errors.csv"}) {
         std::ifstream in(dir / name, std::ios::binary);
         std::stringstream ss;
         if (in) ss << in.rdbuf();
@@ -696,6 +736,8 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
     page_out.add_if_changed("explorer.js", assets::explorer_js());
     page_out.add_if_changed("colour.js", assets::colour_js());
     page_out.add_if_changed("explorer.css", assets::explorer_css());
+    page_out.add_if_changed("spheres.js", assets::spheres_js());
+    page_out.add_if_changed("glsl.js", glsl_script());
     StagedOutput root_out(study_dir);
     root_out.add_if_changed("index.html", assets::explorer_html());
     data_out.commit();

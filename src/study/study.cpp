@@ -9,6 +9,7 @@
 #include "core/packed_array.h"
 #include "core/progress.h"
 #include "lamina/version.h"
+#include "models/lamina1/lamina1.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
 #include "models/spectral_projection.h"
@@ -492,7 +493,25 @@ class ConfigurationRun {
                                                 std::size_t(grid_.n_theta()),
                                                 std::size_t(grid_.n_phi()),
                                                 3};
-        const nlohmann::json cj = config_json(sources, supported, albedo, shape);
+        nlohmann::json cj = config_json(sources, supported, albedo, shape);
+        // lamina-1's GLSL states for the explorer's live spheres (docs/formats.md): the
+        // stack's own, then the per-material part of each variant config.json lists.
+        std::string why;
+        const Lamina1GpuStates gpu = lamina1_gpu_states(config_.stack, {}, why);
+        std::string gpu_bytes;
+        if (!gpu.state.empty()) {
+            nlohmann::json variants = nlohmann::json::array();
+            for (const Lamina1GpuVariant& v : gpu.variants)
+                variants.push_back({v.parameter, v.value});
+            cj["lamina1_gpu"] = {{"file", "lamina1_gpu.f32"},
+                                 {"state", gpu.state.size()},
+                                 {"head", gpu.head},
+                                 {"variants", variants}};
+            gpu_bytes.append(reinterpret_cast<const char*>(gpu.state.data()),
+                             gpu.state.size() * sizeof(float));
+            gpu_bytes.append(reinterpret_cast<const char*>(gpu.heads.data()),
+                             gpu.heads.size() * sizeof(float));
+        }
         bool wrote = false;
         {
             StagedOutput out(config_dir_);
@@ -511,8 +530,13 @@ class ConfigurationRun {
                 wrote |= out.add_if_changed(
                     "reference_stokes.lza",
                     tables_bytes(s_.tables, stokes_table(), stokes_shape(), kStokesAxes));
+            if (!gpu_bytes.empty()) wrote |= out.add_if_changed("lamina1_gpu.f32", gpu_bytes);
             wrote |= out.add_if_changed("config.json", cj.dump(1) + "\n");
             out.commit();
+        }
+        if (gpu_bytes.empty()) {
+            std::error_code ec;
+            wrote |= std::filesystem::remove(config_dir_ / "lamina1_gpu.f32", ec);
         }
         for (const char* name : {"tables.npy", "reference_se.npy", "tables.lza", "reference_se.lza",
                                  "reference_stokes.lza"})

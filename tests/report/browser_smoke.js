@@ -59,7 +59,62 @@ async function main() {
       "an unpolarized study stores no reference_stokes.lza");
     const cells = await page.evaluate(() => (document.getElementById("leaderboard").data[0] || {}).z);
     check(Array.isArray(cells) && cells.length >= 2, "the leaderboard lists the configurations");
+    // The live spheres (docs/explorer.md, "Live spheres"): they start once on screen, offer
+    // lamina-1 (the study's states), lamina-coat (a Lambertian plastic) and the tables, and
+    // each choice changes the image.
+    await page.evaluate(() => document.getElementById("live-canvas").scrollIntoView());
+    const liveImage = async (what) => {
+      await page.waitForFunction(() => Number(document.body.dataset.liveSpp || 0) >= 16, null, { timeout: 60000 });
+      return page.evaluate(() => {
+        const c = document.getElementById("live-canvas"), t = document.createElement("canvas");
+        t.width = c.width; t.height = c.height;
+        const g = t.getContext("2d");
+        g.drawImage(c, 0, 0);
+        const px = g.getImageData(0, 0, c.width, c.height).data;
+        let sum = 0;
+        for (let k = 0; k < px.length; k += 4) sum += px[k] + px[k + 1] + px[k + 2];
+        const centre = 4 * ((c.height >> 1) * c.width + (c.width >> 1));
+        return { mean: sum / (px.length * 0.75), centre: Array.from(px.slice(centre, centre + 3)), corner: Array.from(px.slice(0, 3)) };
+      });
+    };
+    const choose = async (id, value) => {
+      await page.evaluate(([id, value]) => {
+        document.body.dataset.liveSpp = "0";
+        const e = document.getElementById(id);
+        e.value = value;
+        e.dispatchEvent(new Event("input"));
+      }, [id, value]);
+    };
+    const offered = await page.evaluate(() => Array.from(document.getElementById("w-live-model").options).map((o) => o.value));
+    check(["lamina-1", "lamina-coat", "table:reference", "table:lamina-1"].every((m) => offered.includes(m)), `the live view offers lamina-1, lamina-coat and the tables (${offered})`);
+    const l1 = await liveImage();
+    check(l1.centre.join() !== l1.corner.join() && l1.mean > 0, `lamina-1 draws a sphere (${JSON.stringify(l1)})`);
+    const variant = await page.evaluate(() => Array.from(document.getElementById("w-live-l1").options).find((o) => /coat α = 0.5/.test(o.textContent)).value);
+    await choose("w-live-l1", variant);
+    const rough = await liveImage();
+    check(Math.abs(rough.mean - l1.mean) > 0.5, `a rougher coat (α0 = 0.5, the study's state) changes the image (${l1.mean.toFixed(2)} → ${rough.mean.toFixed(2)})`);
+    await choose("w-live-model", "lamina-coat");
+    const coat = await liveImage();
+    await choose("w-live-tau", "3");
+    const dark = await liveImage();
+    check(dark.mean < coat.mean - 0.5, `lamina-coat: an absorbing coat darkens the sphere (${coat.mean.toFixed(2)} → ${dark.mean.toFixed(2)})`);
+    await choose("w-live-model", "table:reference");
+    const ref = await liveImage();
+    check(ref.centre.join() !== ref.corner.join(), `the reference's table draws a sphere (${JSON.stringify(ref)})`);
+    await page.screenshot({ path: shot.replace(/\.png$/, "-live.png") });
+    await page.evaluate(() => window.scrollTo(0, 0));
     await page.screenshot({ path: shot, fullPage: true });
+    // Without WebGL2 the view says so in place of the canvas, with no error.
+    await page.addInitScript(() => {
+      const get = HTMLCanvasElement.prototype.getContext;
+      HTMLCanvasElement.prototype.getContext = function (kind, ...rest) {
+        return kind === "webgl2" ? null : get.call(this, kind, ...rest);
+      };
+    });
+    await page.reload();
+    await page.waitForFunction(() => document.body.dataset.live === "unavailable", null, { timeout: 20000 });
+    const note = await page.evaluate(() => ({ text: document.getElementById("live-note").textContent, hidden: document.getElementById("live-canvas").hidden }));
+    check(/no WebGL2/.test(note.text) && note.hidden, `without WebGL2 the live view says so (${note.text})`);
   } finally {
     await browser.close();
   }

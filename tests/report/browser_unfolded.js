@@ -132,6 +132,11 @@ async function main() {
     }
     const hash = await page.evaluate(() => location.hash);
     check(hash.includes("phi=45"), `the address keeps φi (${hash})`);
+    // An anisotropic stack has no live model: lamina-1's and lamina-coat's GLSL are isotropic and
+    // an unfolded table has no interpolation here. The view says so.
+    const live = await page.evaluate(() => ({ state: document.body.dataset.live,
+      note: document.getElementById("live-note").textContent, hidden: document.getElementById("live-canvas").hidden }));
+    check(live.state === "none" && /No model/.test(live.note) && live.hidden, `the live view has no model to render (${JSON.stringify(live)})`);
     await page.screenshot({ path: shot, fullPage: true });
   } finally {
     await browser.close();

@@ -208,6 +208,49 @@ TEST(Explorer, PolarizationDataFromReferenceStokes) {
     }
 }
 
+// lamina-1's states for the live spheres (config.json → lamina1_gpu, lamina1_gpu.f32) go into the
+// page data as base64 of the file's bytes with their layout; a file of the wrong size or a missing
+// one is refused, naming it. The page's shaders are written beside it (explorer/glsl.js).
+TEST(Explorer, Lamina1StatesForTheLiveSpheres) {
+    const fs::path d = fresh_dir("lamina1-gpu");
+    write_text(d / "study.json", R"({"theta_i": [30], "grid": {"n_theta": 2, "n_phi": 2},
+        "configurations": [{"id": "c1", "category": "x", "sides": ["R"]}]})");
+    const std::string gpu = R"({"file": "lamina1_gpu.f32", "state": 2, "head": 1,
+        "variants": [["alpha0", 0.3]]})";
+    write_text(d / "configs/c1/config.json",
+               R"({"sources": ["reference"], "sides": ["R"], "lamina1_gpu": )" + gpu + "}");
+    write_table(d / "configs/c1/tables", {1, 1, 1, 2, 2, 3}, std::vector<float>(12, 0.3f), true);
+    const float floats[3] = {1.0f, 2.0f, 3.0f};  // state (2 floats), one head (1 float)
+    std::ofstream(d / "configs/c1/lamina1_gpu.f32", std::ios::binary)
+        .write(reinterpret_cast<const char*>(floats), sizeof floats);
+    write_explorer(d);
+    const std::string data = read_text(d / "explorer/data/c1.js");
+    // base64 of the 12 bytes 00 00 80 3f 00 00 00 40 00 00 40 40 (1.0f, 2.0f, 3.0f little-endian)
+    EXPECT_NE(data.find(R"("floats":"AACAPwAAAEAAAEBA")"), std::string::npos)
+        << data.substr(0, 300);
+    EXPECT_NE(data.find(R"("variants":[["alpha0",0.3]])"), std::string::npos);
+    const std::string glsl = read_text(d / "explorer/glsl.js");
+    for (const char* key : {"lamina1_eval", "lamina_coat_eval", "\"laminaCoatTable\":[65535,"})
+        EXPECT_NE(glsl.find(key), std::string::npos) << key;
+    EXPECT_TRUE(fs::exists(d / "explorer/spheres.js"));
+    std::ofstream(d / "configs/c1/lamina1_gpu.f32", std::ios::binary)
+        .write(reinterpret_cast<const char*>(floats), 8);
+    try {
+        write_explorer(d);
+        FAIL() << "a lamina1_gpu.f32 of the wrong size was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("lamina1_gpu.f32"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("8 bytes"), std::string::npos) << e.what();
+    }
+    fs::remove(d / "configs/c1/lamina1_gpu.f32");
+    try {
+        write_explorer(d);
+        FAIL() << "a missing lamina1_gpu.f32 was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("not found"), std::string::npos) << e.what();
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Formats, ExplorerTables, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "packed" : "npy"; });
 

@@ -197,6 +197,63 @@ std::vector<float> lamina1_gpu_state(const Stack& stack, const ModelOptions& opt
     return bsdf.gpu_state(&why);
 }
 
+Lamina1GpuStates lamina1_gpu_states(const Stack& stack, const ModelOptions& options,
+                                    std::string& why) {
+    Lamina1GpuStates out;
+    const Lamina1Choices choices = lamina1_option_table().parse(options);
+    lamina1::Layers layers;
+    if (!lamina1_layers(stack, layers, why)) return out;
+    const lamina1::Tables& tables = lamina1_tables(choices.masking, choices.multiple_scattering);
+    out.state = lamina1::Bsdf(layers, tables, choices).gpu_state(&why);
+    if (out.state.empty()) return out;
+    out.head = lamina1::kGpuSlopeSum;
+    auto add = [&](const char* parameter, double value, const lamina1::Layers& l) {
+        std::string ignored;
+        const std::vector<float> s = lamina1::Bsdf(l, tables, choices).gpu_state(&ignored);
+        if (s.empty()) return;
+        out.variants.push_back({parameter, value});
+        out.heads.insert(out.heads.end(), s.begin(), s.begin() + lamina1::kGpuSlopeSum);
+    };
+    // The values offered: roughnesses from nearly smooth to rough, the indices of common coats,
+    // optical depths over three decades, albedos from dark to white.
+    for (double v : {0.02, 0.05, 0.1, 0.2, 0.3, 0.5}) {
+        lamina1::Layers l = layers;
+        l.alpha0 = v;
+        if (l.alpha0_y >= 0) l.alpha0_y = v;
+        add("alpha0", v, l);
+    }
+    for (double v : {1.2, 1.33, 1.5, 1.8, 2.2}) {
+        lamina1::Layers l = layers;
+        l.eta0 = v;
+        if (layers.base != lamina1::Base::Lambertian) {
+            const double scale = layers.eta0 / v;  // the base's index relative to the new coat
+            l.base_eta = layers.base_eta * scale;
+            l.base_k = layers.base_k * scale;
+        }
+        add("eta0", v, l);
+    }
+    for (double v : {0.0, 0.1, 0.3, 1.0, 3.0}) {
+        lamina1::Layers l = layers;
+        l.tau_a = lamina1::Rgb(v);
+        add("tau_a", v, l);
+    }
+    if (layers.base == lamina1::Base::Lambertian) {
+        for (double v : {0.05, 0.2, 0.5, 0.8, 0.95}) {
+            lamina1::Layers l = layers;
+            l.albedo = lamina1::Rgb(v);
+            add("albedo", v, l);
+        }
+    } else {
+        for (double v : {0.02, 0.05, 0.1, 0.2, 0.4}) {
+            lamina1::Layers l = layers;
+            l.alpha1 = v;
+            if (l.alpha1_y >= 0) l.alpha1_y = v;
+            add("alpha1", v, l);
+        }
+    }
+    return out;
+}
+
 std::unique_ptr<Model> make_lamina1(const Stack& stack, const ModelOptions& options) {
     return std::make_unique<Lamina1>(stack, lamina1_option_table().parse(options));
 }

@@ -39,6 +39,27 @@ std::string lamina1_tables_file();
 std::vector<float> lamina1_gpu_state(const Stack& stack, const ModelOptions& options,
                                      std::string& why);
 
+/// lamina-1's GLSL states for the explorer's live spheres (docs/explorer.md, "Live spheres"): the
+/// stack's own state, and the per-material part of the state (its first lamina1::kGpuSlopeSum
+/// floats; the slope-sum table after them is the same for every material) with one parameter at
+/// a time set to each of a few values, the others the stack's: coat roughness `alpha0`, coat index
+/// `eta0` (a conductor or dielectric base keeps its absolute index), grey coat absorption `tau_a`,
+/// base roughness `alpha1` (conductor and dielectric bases) and grey base albedo `albedo`
+/// (Lambertian base). A value the GLSL form does not cover is left out. Empty `state` and why
+/// where it does not cover the stack itself.
+struct Lamina1GpuVariant {
+    std::string parameter;
+    double value = 0;
+};
+struct Lamina1GpuStates {
+    std::vector<float> state;                 ///< the stack's own, lamina1::kGpuSize floats
+    std::vector<Lamina1GpuVariant> variants;  ///< in the order of `heads`
+    std::vector<float> heads;                 ///< `head` floats per variant
+    std::size_t head = 0;                     ///< lamina1::kGpuSlopeSum
+};
+Lamina1GpuStates lamina1_gpu_states(const Stack& stack, const ModelOptions& options,
+                                    std::string& why);
+
 /// A stack of the coated shape (coated_stack) as lamina-1's layers; false and why otherwise.
 bool lamina1_layers(const Stack& stack, lamina1::Layers& layers, std::string& why);
 
