@@ -410,7 +410,7 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
         throw InputError(
             cfg_path.string(), "/phi_i",
             fmt::format("{} azimuths for {} incidences (theta_i)", phi_i.size(), theta_i.size()));
-    // A spectral reference's channels are linear sRGB under D65 over its range (formats.md).
+    // A spectral reference's channels are linear sRGB under D65 over its range (docs/formats.md).
     if (cfg.contains("spectral") && cfg["spectral"].is_object())
         entry["spectral"] = cfg["spectral"];
     if (unfolded) {
