@@ -87,8 +87,7 @@ bool is_spectral_run(const Stack& stack, const SimulationSettings& settings) {
 }
 
 bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings) {
-    return stack.has_film() || stack.is_anisotropic() || settings.phi_i_deg != 0 ||
-           is_spectral_run(stack, settings);
+    return stack.has_film() || is_spectral_run(stack, settings);
 }
 
 Kernel kernel_for(const SimulationSettings& settings, const Stack& stack) {
@@ -164,15 +163,6 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
                          fmt::format("the stack '{}' has a thin film, which the SIMD kernel does "
                                      "not trace; give --kernel scalar (or auto)",
                                      stack.name));
-    if (stack.is_anisotropic())
-        throw InputError("command line", "--kernel",
-                         fmt::format("the stack '{}' has an anisotropic interface, which the SIMD "
-                                     "kernel does not trace; give --kernel scalar (or auto)",
-                                     stack.name));
-    if (settings.phi_i_deg != 0)
-        throw InputError("command line", "--kernel",
-                         "light from phi_i ≠ 0 is tabulated on the unfolded grid, which the SIMD "
-                         "kernel does not bin; give --kernel scalar (or auto)");
 }
 
 SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,

@@ -126,25 +126,32 @@ struct LaneVectors {
 
 // ---- Interface events (goniophotometer.cpp trace_particle, `apply`) ----------------------------
 
-// An interface's GGX roughness (physics/microfacet.h) on the vectors' lanes: the isotropic
-// instance (the SIMD kernel traces isotropic stacks; an anisotropic one runs on the scalar kernel,
-// SimulationSettings::kernel).
-HWY_INLINE GgxLanes<VF> VecGgx(const GGX<float>& ggx) {
-    return ggx_lanes<VF, VecLane, false>(ggx.alpha, 0, 1, 0);
+// An interface's GGX roughness (physics/microfacet.h) on the vectors' lanes: the very roughness
+// the scalar kernel's events take (GGX::lanes), broadcast. kAnisotropic (the stack has an
+// anisotropic interface, CompiledStack::anisotropic): the general instance, with the interface's
+// α_x, α_y and tangent frame, at every rough interface of the stack, as trace_particle takes it;
+// else the isotropic instance.
+template <bool kAnisotropic>
+HWY_INLINE GgxLanes<VF, kAnisotropic> VecGgx(const GGX<float>& ggx) {
+    const DF df;
+    const auto g = ggx.template lanes<kAnisotropic>();
+    return {hn::Set(df, g.alpha),    hn::Set(df, g.alpha2), hn::Set(df, g.d_alpha),
+            hn::Set(df, g.d_alpha2), hn::Set(df, g.bx),     hn::Set(df, g.by)};
 }
 
 // A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
 // instantiates at one lane): the particle arrives along d (wi = −d). Polarized (kPolarized): the
 // event's polarized form on the lanes' states; where the channels' states differ, its reweighting
 // of the channels is booked with the base, as trace_particle does.
-template <bool kPolarized>
+template <bool kPolarized, bool kAnisotropic>
 HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
                                 VF uc, VF u1, VF u2, MF& degenerate) {
     const DF df;
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     const InterfaceEventLanes<VF, MF> e = dielectric_event<VF, VecLane, kPolarized>(
-        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), VecGgx(iface.distribution()),
-        iface.event_shape(), wi, uc, u1, u2, m, kPolarized ? &v.pol : nullptr);
+        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()),
+        VecGgx<kAnisotropic>(iface.distribution()), iface.event_shape(), wi, uc, u1, u2, m,
+        kPolarized ? &v.pol : nullptr);
     degenerate = hn::Or(degenerate, e.degenerate);
     const MF ok = hn::AndNot(e.degenerate, m);
     if constexpr (kPolarized)
@@ -155,20 +162,21 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
 
 // A rough or smooth conductor (conductor.h conductor_event, the same template): light from above
 // only. Polarized: the Fresnel factors are the reflected fractions of the lanes' states.
-template <bool kPolarized>
+template <bool kPolarized, bool kAnisotropic>
 HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v, VF u1,
                                VF u2, MF& degenerate) {
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     VF fresnel[3];
     InterfaceEventLanes<VF, MF> e;
     if constexpr (kPolarized)
-        e = conductor_event<VF, VecLane>(
-            VecGgx(iface.distribution()), iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
-            u2, m, ConductorFresnel{iface}, fresnel, &v.pol, ConductorMueller{iface});
+        e = conductor_event<VF, VecLane>(VecGgx<kAnisotropic>(iface.distribution()),
+                                         iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
+                                         u2, m, ConductorFresnel{iface}, fresnel, &v.pol,
+                                         ConductorMueller{iface});
     else
-        e = conductor_event<VF, VecLane>(VecGgx(iface.distribution()), iface.is_smooth(),
-                                         iface.uncorrelated_shadowing, wi, u1, u2, m,
-                                         ConductorFresnel{iface}, fresnel);
+        e = conductor_event<VF, VecLane>(VecGgx<kAnisotropic>(iface.distribution()),
+                                         iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
+                                         u2, m, ConductorFresnel{iface}, fresnel);
     degenerate = hn::Or(degenerate, e.degenerate);
     const MF ok = hn::AndNot(e.degenerate, m);
     v.Keep(ok, kLossBase, fresnel);
@@ -183,7 +191,7 @@ HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, Lan
 // absorbed by the base), met its facet cap (its flux lost to the microsurface) or a degeneracy
 // (lost and counted, as a failed sample), as trace_particle books the walk. `weighted`: the exit's
 // weight is booked on a dielectric too (polarized, the channels' states differing).
-template <typename Facet>
+template <bool kAnisotropic, typename Facet>
 HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, const Facet& facet,
                                       MF m, LaneVectors& v, LaneRng& rng, int max_order,
                                       MF& degenerate, bool weighted = false) {
@@ -191,26 +199,26 @@ HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, con
     const VF zero = hn::Zero(df);
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     auto draw = [&] { return rng.Uniform(); };
-    const MicrosurfaceWalkLanes<VF, MF> walk =
-        microsurface_walk<VF, VecLane>(VecGgx(ggx), wi, m, two_sided, facet, draw, max_order);
+    const MicrosurfaceWalkLanes<VF, MF> walk = microsurface_walk<VF, VecLane>(
+        VecGgx<kAnisotropic>(ggx), wi, m, two_sided, facet, draw, max_order);
     degenerate = hn::Or(degenerate, walk.degenerate);
     if (!two_sided || weighted) v.Keep(walk.escaped, kLossBase, walk.weight);
     v.Keep(walk.capped, kLossMicro, zero);
     v.d = Select(walk.escaped, walk.wo, v.d);
 }
 
-template <bool kPolarized>
+template <bool kPolarized, bool kAnisotropic>
 HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
                                     LaneRng& rng, int max_order, MF& degenerate) {
     const DF df;
     auto draw = [&] { return rng.Uniform(); };
     const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw), kPolarized> facet{
         hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), draw, kPolarized ? &v.pol : nullptr};
-    MicrosurfaceWalkEvent(iface.distribution(), true, facet, m, v, rng, max_order, degenerate,
-                          kPolarized && v.pol.channels == 3);
+    MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), true, facet, m, v, rng, max_order,
+                                        degenerate, kPolarized && v.pol.channels == 3);
 }
 
-template <bool kPolarized>
+template <bool kPolarized, bool kAnisotropic>
 HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v,
                                    LaneRng& rng, int max_order, MF& degenerate) {
     const ConductorFresnel fresnel{iface};
@@ -218,10 +226,12 @@ HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, MF m,
         const ConductorMueller mueller{iface};
         const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel, ConductorMueller> facet{
             fresnel, &v.pol, &mueller};
-        MicrosurfaceWalkEvent(iface.distribution(), false, facet, m, v, rng, max_order, degenerate);
+        MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
+                                            max_order, degenerate);
     } else {
         const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel> facet{fresnel};
-        MicrosurfaceWalkEvent(iface.distribution(), false, facet, m, v, rng, max_order, degenerate);
+        MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
+                                            max_order, degenerate);
     }
 }
 
@@ -423,10 +433,11 @@ struct LaneSums {
 
 // One block traced (trace_block_simd), in two phases: every particle's first event on full
 // vectors (FirstEvents), then steps of the lanes with refills from the queue until it is empty
-// (Steps). Written once for both: kPolarized = false is the unpolarized kernel, with none of it.
+// (Steps). Written once for both: kPolarized = false is the unpolarized kernel, with none of it;
+// kAnisotropic = true the general (anisotropic) GGX instance at every rough interface (VecGgx).
 // The per-step work, InterfaceStep and EndParticles, is compiled out of line (two call sites
 // each); the pieces they are made of are inlined into them.
-template <bool kPolarized>
+template <bool kPolarized, bool kAnisotropic>
 class BlockTracer {
   public:
     BlockTracer(const BlockJob& job, Tally& tally, Scratch& scratch)
@@ -504,24 +515,26 @@ class BlockTracer {
         switch (layer.type) {
             case InterfaceType::Dielectric: {
                 if (layer.multiple) {
-                    DielectricWalkEvent<kPolarized>(layer.dielectric, going, v, rng,
-                                                    stack_.max_microsurface_order,
-                                                    degenerate_event);
+                    DielectricWalkEvent<kPolarized, kAnisotropic>(layer.dielectric, going, v, rng,
+                                                                  stack_.max_microsurface_order,
+                                                                  degenerate_event);
                     break;
                 }
                 const VF uc = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
-                DielectricEvent<kPolarized>(layer.dielectric, going, v, uc, u1, u2,
-                                            degenerate_event);
+                DielectricEvent<kPolarized, kAnisotropic>(layer.dielectric, going, v, uc, u1, u2,
+                                                          degenerate_event);
                 break;
             }
             case InterfaceType::Conductor: {
                 if (layer.multiple) {
-                    ConductorWalkEvent<kPolarized>(layer.conductor, going, v, rng,
-                                                   stack_.max_microsurface_order, degenerate_event);
+                    ConductorWalkEvent<kPolarized, kAnisotropic>(layer.conductor, going, v, rng,
+                                                                 stack_.max_microsurface_order,
+                                                                 degenerate_event);
                     break;
                 }
                 const VF u1 = rng.Uniform(), u2 = rng.Uniform();
-                ConductorEvent<kPolarized>(layer.conductor, going, v, u1, u2, degenerate_event);
+                ConductorEvent<kPolarized, kAnisotropic>(layer.conductor, going, v, u1, u2,
+                                                         degenerate_event);
                 break;
             }
             case InterfaceType::Lambertian: {
@@ -660,8 +673,10 @@ class BlockTracer {
                 for (int c = 0; c < 3; ++c)
                     for (int k = 0; k < 4; ++k)
                         s[c][k] = stokes_out_[c][k][l];
+                // Folded bins count the patch y < 0 as its mirror image (mueller.h); unfolded
+                // ones are one patch each (trace_particle's exit_stokes).
                 tally_.exit_stokes((why == kTransmitted ? grid_.size() : 0) + bin,
-                                   d_out_[1][l] < 0 ? 1 : 0, s);
+                                   d_out_[1][l] < 0 && !grid_.is_unfolded() ? 1 : 0, s);
             }
     }
 
@@ -919,12 +934,18 @@ class BlockTracer {
     std::size_t next_ = 0;  // the queue's next particle
 };
 
+// The instance for the stack: polarized or not, isotropic or anisotropic (as trace_particle's).
 void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     thread_local Scratch scratch;
-    if (job.stack->polarization)
-        BlockTracer<true>(job, tally, scratch).Trace(block);
+    const bool polarized = job.stack->polarization, anisotropic = job.stack->anisotropic;
+    if (polarized && anisotropic)
+        BlockTracer<true, true>(job, tally, scratch).Trace(block);
+    else if (polarized)
+        BlockTracer<true, false>(job, tally, scratch).Trace(block);
+    else if (anisotropic)
+        BlockTracer<false, true>(job, tally, scratch).Trace(block);
     else
-        BlockTracer<false>(job, tally, scratch).Trace(block);
+        BlockTracer<false, false>(job, tally, scratch).Trace(block);
 }
 
 }  // namespace HWY_NAMESPACE

@@ -441,11 +441,14 @@ TEST(ThinFilmStack, AutoKernelPicksScalarForFilms) {
     EXPECT_EQ(kernel_for(s, bare), Kernel::Scalar);
     s.kernel = Kernel::Simd;
     EXPECT_EQ(kernel_for(s, filmed), Kernel::Simd);  // refused by simulate
-    // Anisotropy and light from φi ≠ 0 need the scalar kernel too.
+    // Light from φi ≠ 0 and anisotropy do not: both kernels trace them.
     s.kernel = Kernel::Auto;
     EXPECT_EQ(kernel_for(s, bare), Kernel::Simd);
     s.phi_i_deg = 30;
-    EXPECT_EQ(kernel_for(s, bare), Kernel::Scalar);
+    EXPECT_EQ(kernel_for(s, bare), Kernel::Simd);
+    const Stack brushed = test::make_stack(
+        {layer_of(anisotropic(conductor_interface(Rgbd(0.2), Rgbd(3.0), 0.1), 0.1, 0.4, 20))});
+    EXPECT_EQ(kernel_for(s, brushed), Kernel::Simd);
 }
 
 // Who does not trace films says so: the SIMD kernel (an InputError naming --kernel), every model
