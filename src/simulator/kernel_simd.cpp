@@ -161,22 +161,24 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
 }
 
 // A rough or smooth conductor (conductor.h conductor_event, the same template): light from above
-// only. Polarized: the Fresnel factors are the reflected fractions of the lanes' states.
-template <bool kPolarized, bool kAnisotropic>
-HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v, VF u1,
-                               VF u2, MF& degenerate) {
+// only. Polarized: the Fresnel factors are the reflected fractions of the lanes' states. The
+// reflection at a facet comes from `fresnel_of` and `mueller_of` (lane_conductor.h: the bare
+// conductor's; a filmed conductor's, FilmReflection).
+template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
+HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, const Fresnel& fresnel_of,
+                               const Mueller& mueller_of, MF m, LaneVectors& v, VF u1, VF u2,
+                               MF& degenerate) {
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     VF fresnel[3];
     InterfaceEventLanes<VF, MF> e;
     if constexpr (kPolarized)
         e = conductor_event<VF, VecLane>(VecGgx<kAnisotropic>(iface.distribution()),
                                          iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
-                                         u2, m, ConductorFresnel{iface}, fresnel, &v.pol,
-                                         ConductorMueller{iface});
+                                         u2, m, fresnel_of, fresnel, &v.pol, mueller_of);
     else
         e = conductor_event<VF, VecLane>(VecGgx<kAnisotropic>(iface.distribution()),
                                          iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
-                                         u2, m, ConductorFresnel{iface}, fresnel);
+                                         u2, m, fresnel_of, fresnel);
     degenerate = hn::Or(degenerate, e.degenerate);
     const MF ok = hn::AndNot(e.degenerate, m);
     v.Keep(ok, kLossBase, fresnel);
@@ -218,21 +220,89 @@ HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, MF 
                                         degenerate, kPolarized && v.pol.channels == 3);
 }
 
-template <bool kPolarized, bool kAnisotropic>
-HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v,
-                                   LaneRng& rng, int max_order, MF& degenerate) {
-    const ConductorFresnel fresnel{iface};
+template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
+HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, const Fresnel& fresnel,
+                                   const Mueller& mueller, MF m, LaneVectors& v, LaneRng& rng,
+                                   int max_order, MF& degenerate) {
     if constexpr (kPolarized) {
-        const ConductorMueller mueller{iface};
-        const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel, ConductorMueller> facet{
-            fresnel, &v.pol, &mueller};
+        const MicrosurfaceConductorFacet<VF, VecLane, Fresnel, Mueller> facet{fresnel, &v.pol,
+                                                                              &mueller};
         MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
                                             max_order, degenerate);
     } else {
-        const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel> facet{fresnel};
+        const MicrosurfaceConductorFacet<VF, VecLane, Fresnel> facet{fresnel};
         MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
                                             max_order, degenerate);
     }
+}
+
+// ---- A thin film on a conductor (docs/physics.md §9; simulator/scalar_particle.h film_event) ----
+// The film's reflection at each lane's facet cosine and film thickness: FilmOptics::mueller
+// (physics/thin_film.h, in double, the very function the scalar kernel's film_event evaluates),
+// called per lane and channel, as its Airy sums have no lane template. It stands where the bare
+// conductor's ConductorFresnel and ConductorMueller stand in the conductor event and walk.
+struct FilmReflection {
+    const FilmOptics& film;
+    const double* thickness_nm;  // per lane
+    // The reflectance per channel (unpolarized), as film_event's `reflectance`.
+    HWY_NOINLINE void operator()(VF cos_theta, VF* factors) const {
+        const DF df;
+        HWY_ALIGN float cos_l[kMaxLanes], r[3][kMaxLanes];
+        hn::Store(cos_theta, df, cos_l);
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            for (int c = 0; c < 3; ++c)
+                r[c][l] =
+                    float(film.mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection.a);
+        for (int c = 0; c < 3; ++c)
+            factors[c] = hn::Load(df, r[c]);
+    }
+    // The reflection Mueller matrices per channel (polarized), as film_event's `mueller`.
+    HWY_NOINLINE void operator()(VF cos_theta, InterfaceMueller<VF>* m) const {
+        const DF df;
+        HWY_ALIGN float cos_l[kMaxLanes], e[3][4][kMaxLanes];
+        hn::Store(cos_theta, df, cos_l);
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            for (int c = 0; c < 3; ++c) {
+                const auto md = film.mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection;
+                e[c][0][l] = float(md.a);
+                e[c][1][l] = float(md.b);
+                e[c][2][l] = float(md.c);
+                e[c][3][l] = float(md.d);
+            }
+        for (int c = 0; c < 3; ++c)
+            m[c] = {hn::Load(df, e[c][0]), hn::Load(df, e[c][1]), hn::Load(df, e[c][2]),
+                    hn::Load(df, e[c][3])};
+    }
+};
+
+// A filmed conductor's event (film_event's conductor branch): the lanes' thicknesses drawn first
+// where the film's thickness varies (one number per event, from each lane's own stream), then the
+// conductor event or walk with the film's reflection in place of the bare Fresnel terms, booked as
+// the bare conductor's (absorbed by the base, lost to the microsurface). Isotropic: a stack with a
+// film has no anisotropic interface (validate_kernel_for).
+template <bool kPolarized>
+HWY_NOINLINE void FilmConductorEvent(const CompiledLayer<float>& layer, MF m, LaneVectors& v,
+                                     LaneRng& rng, int max_order, MF& degenerate) {
+    const DF df;
+    const FilmOptics& film = layer.film;
+    HWY_ALIGN double thickness[kMaxLanes];
+    if (film.varies()) {
+        HWY_ALIGN float u[kMaxLanes];
+        hn::Store(rng.Uniform(), df, u);
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            thickness[l] = film.thickness_nm(double(u[l]));
+    } else {
+        std::fill(thickness, thickness + hn::Lanes(df), film.thickness_min_nm);
+    }
+    const FilmReflection reflection{film, thickness};
+    if (layer.multiple) {
+        ConductorWalkEvent<kPolarized, false>(layer.conductor, reflection, reflection, m, v, rng,
+                                              max_order, degenerate);
+        return;
+    }
+    const VF u1 = rng.Uniform(), u2 = rng.Uniform();
+    ConductorEvent<kPolarized, false>(layer.conductor, reflection, reflection, m, v, u1, u2,
+                                      degenerate);
 }
 
 // Lambertian (lambertian.h lambertian_event, the same template): cosine-distributed on wi's side,
@@ -526,15 +596,23 @@ class BlockTracer {
                 break;
             }
             case InterfaceType::Conductor: {
+                if constexpr (!kAnisotropic)
+                    if (layer.has_film) {
+                        FilmConductorEvent<kPolarized>(
+                            layer, going, v, rng, stack_.max_microsurface_order, degenerate_event);
+                        break;
+                    }
                 if (layer.multiple) {
-                    ConductorWalkEvent<kPolarized, kAnisotropic>(layer.conductor, going, v, rng,
-                                                                 stack_.max_microsurface_order,
-                                                                 degenerate_event);
+                    ConductorWalkEvent<kPolarized, kAnisotropic>(
+                        layer.conductor, ConductorFresnel{layer.conductor},
+                        ConductorMueller{layer.conductor}, going, v, rng,
+                        stack_.max_microsurface_order, degenerate_event);
                     break;
                 }
                 const VF u1 = rng.Uniform(), u2 = rng.Uniform();
-                ConductorEvent<kPolarized, kAnisotropic>(layer.conductor, going, v, u1, u2,
-                                                         degenerate_event);
+                ConductorEvent<kPolarized, kAnisotropic>(
+                    layer.conductor, ConductorFresnel{layer.conductor},
+                    ConductorMueller{layer.conductor}, going, v, u1, u2, degenerate_event);
                 break;
             }
             case InterfaceType::Lambertian: {

@@ -610,9 +610,9 @@ TEST(KernelSimd, AzimuthCosineAndSine) {
 // distribution. Per bin and channel z = (f_a − f_b)/√(se_a² + se_b²) is standard normal when both
 // come from the same distribution (central limit: bins with at least ~100 expected exits); Σ z²
 // over the bins of one channel is χ² with as many degrees of freedom. Each channel is one test at
-// the Šidák-corrected level of the suite (1 % overall for the 102 channel tests below). The bins
+// the Šidák-corrected level of the suite (1 % overall for the 117 channel tests below). The bins
 // are those of the run's grid (the unfolded one for an anisotropic stack or light from φi ≠ 0).
-constexpr int kTwoSampleTests = 102;
+constexpr int kTwoSampleTests = 117;
 
 // `scalar_tweak` adjusts the scalar run's settings (the SIMD run keeps the defaults);
 // `both_tweak` those of both runs.
@@ -905,6 +905,74 @@ TEST(KernelSimd, AnisotropicTablesBitwiseIdenticalAcrossThreadCounts) {
                 const SimulationResult other = simulate(stack, s);
                 EXPECT_NE(one.table.lobe(0, Side::Reflection).f,
                           other.table.lobe(0, Side::Reflection).f);
+            }
+}
+
+// ---- Thin films on conductors (docs/physics.md §9) ----------------------------------------------
+// The SIMD kernel traces a film on a conductor with the film's reflection (FilmOptics::mueller, in
+// double, per lane) in place of the bare Fresnel terms; a film on a dielectric stays the scalar
+// kernel's. An iridescent metal under a clear coat: an absorbing film whose thickness varies over
+// the surface (one draw per event) on a rough gold, polarized with multiple scattering (the
+// default reference) and unpolarized single scattering; a smooth filmed metal under a rough coat.
+Layer with_conductor_film(Layer layer, double thickness_nm, double thickness_max_nm, double eta,
+                          double k) {
+    layer.interface.has_film = true;
+    layer.interface.film.thickness_nm = thickness_nm;
+    layer.interface.film.thickness_max_nm = thickness_max_nm;
+    layer.interface.film.eta = eta;
+    layer.interface.film.k = k;
+    return layer;
+}
+Stack iridescent_gold(double alpha_metal) {
+    return test::make_stack(
+        {test::with_medium(test::dielectric_layer(1.5, 0.15), Rgbd(0.05)),
+         with_conductor_film(test::conductor_layer(Rgbd(0.143, 0.374, 1.442),
+                                                   Rgbd(3.983, 2.385, 1.603), alpha_metal),
+                             90, 260, 2.3, 0.05)});
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarFilmedConductorUnderCoat) {
+    const Stack rough = iridescent_gold(0.3);
+    ASSERT_TRUE(rough.has_film());
+    expect_same_distribution(rough, {20, 65}, 1'000'000, {},
+                             lit_from(0, Microsurface::Multiple, true));
+    expect_same_distribution(rough, {45}, 1'000'000, {}, lit_from(0, Microsurface::Single, false));
+    expect_same_distribution(iridescent_gold(0.0), {35}, 1'000'000, {},
+                             lit_from(0, Microsurface::Single, true));
+    expect_same_distribution(rough, {50}, 1'000'000, {},
+                             lit_from(70, Microsurface::Multiple, false));
+}
+
+// Reproducibility with films on conductors: bitwise identical tables for 1 and 2 threads.
+TEST(KernelSimd, FilmedConductorTablesBitwiseIdenticalAcrossThreadCounts) {
+    for (const double alpha : {0.0, 0.3})
+        for (const bool polarized : {false, true})
+            for (const Microsurface microsurface : {Microsurface::Single, Microsurface::Multiple}) {
+                SCOPED_TRACE(::testing::Message() << "α " << alpha << " polarized " << polarized
+                                                  << ' ' << enum_text(microsurface));
+                const Stack stack = iridescent_gold(alpha);
+                SimulationSettings s;
+                s.theta_i_deg = {0, 55};
+                s.particles = 20'000;  // five blocks
+                s.grid = HemisphereGrid(18, 18);
+                s.kernel = Kernel::Simd;
+                s.transport.microsurface = microsurface;
+                s.transport.polarization = polarized;
+                s.stokes_tallies = polarized;
+                s.threads = 1;
+                const SimulationResult one = simulate(stack, s);
+                s.threads = 2;
+                const SimulationResult two = simulate(stack, s);
+                for (std::size_t i = 0; i < 2; ++i) {
+                    EXPECT_EQ(one.table.lobe(i, Side::Reflection).f,
+                              two.table.lobe(i, Side::Reflection).f);
+                    EXPECT_EQ(one.table.lobe(i, Side::Reflection).se,
+                              two.table.lobe(i, Side::Reflection).se);
+                    EXPECT_EQ(one.incidences[i].budget.term, two.incidences[i].budget.term);
+                    if (polarized) {
+                        EXPECT_TRUE(one.sums[i].stokes == two.sums[i].stokes);
+                    }
+                }
             }
 }
 
