@@ -4,11 +4,16 @@
 // vectors — the interface events (dielectric.h dielectric_event, conductor.h conductor_event,
 // lambertian.h lambertian_event, with the Fresnel factors, the Smith masking and the visible
 // normals they use), the microsurface walk (microsurface_walk.h) and the medium step (medium.h:
-// Beer–Lambert, free flights and Henyey–Greenstein scattering by spectral MIS). Nor are the lane
-// operations on Highway vectors (VecLane, core/lane_hwy.h), the vector random numbers
-// (simulator/lane_rng.h) and the vector exit bins (simulator/lane_bins.h). This file holds the lane
-// management: the queue and refills of lanes, the grouping of lanes by layer, the events' adapters
-// to the lane state, the tallies and the budget sums.
+// Beer–Lambert, free flights and Henyey–Greenstein scattering by spectral MIS), in their isotropic
+// or general (anisotropic) GGX instance as trace_particle takes them. One piece is evaluated per
+// lane rather than on vectors: a thin film on a conductor, whose reflection (physics/thin_film.h
+// FilmOptics::mueller, in double, the function film_event calls) takes the place of the bare
+// Fresnel terms in the conductor templates (FilmReflection); a film on a dielectric is the scalar
+// kernel's (SimulationSettings::kernel). Nor are the lane operations on Highway vectors (VecLane,
+// core/lane_hwy.h), the vector random numbers (simulator/lane_rng.h) and the vector exit bins
+// (simulator/lane_bins.h). This file holds the lane management: the queue and refills of lanes,
+// the grouping of lanes by layer, the events' adapters to the lane state, the tallies and the
+// budget sums.
 //
 // Layout. A block's particles run through a fixed set of lanes; a lane whose particle ends (exit,
 // absorption, cut-off) takes the block's next particle, so all lanes stay busy until the block's
