@@ -465,8 +465,8 @@ TEST(ThinFilmStack, AutoKernelPicksScalarForFilms) {
     EXPECT_EQ(kernel_for(s, brushed), Kernel::Simd);
 }
 
-// Who does not trace films says so: the SIMD kernel (an InputError naming --kernel), every model
-// (not supported: a film on a glass is on no model's list), the random walk.
+// Who does not trace a film on a glass says so: the SIMD kernel (an InputError naming --kernel),
+// every model (not supported: a film on a glass is on no model's list), the random walk.
 TEST(ThinFilmStack, RefusedWhereNotTraced) {
     const Stack stack =
         test::make_stack({with_film(test::dielectric_layer(1.5, 0.1), 100, 1.38)}, "coated glass");
