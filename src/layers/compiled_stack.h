@@ -71,7 +71,8 @@ struct CompiledStack {
     /// index differs between channels, or a thin film's Mueller matrices do (it is traced at a
     /// different wavelength in each channel).
     int polarization_channels = 1;
-    /// Some interface carries a thin film (traced by the scalar kernel only).
+    /// Some interface carries a thin film (the scalar kernel traces every film, the SIMD kernel
+    /// those on conductors).
     bool has_film = false;
     /// Some rough interface is anisotropic (GgxAnisotropy::on): the tracers take the general
     /// (anisotropic) instance of the GGX formulas (GGX::lanes) at every interface.

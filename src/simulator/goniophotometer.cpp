@@ -86,9 +86,21 @@ bool is_spectral_run(const Stack& stack, const SimulationSettings& settings) {
            (settings.spectral == SpectralMode::Auto && stack.is_spectral());
 }
 
+namespace {
+/// The first dielectric interface carrying a thin film (the SIMD kernel traces films on
+/// conductors only), or the number of layers.
+std::size_t first_dielectric_film(const Stack& stack) {
+    std::size_t i = 0;
+    while (i < stack.layers.size() &&
+           !(stack.layers[i].interface.has_film &&
+             stack.layers[i].interface.type == InterfaceType::Dielectric))
+        ++i;
+    return i;
+}
+}  // namespace
+
 bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings) {
-    return stack.has_film() || stack.is_anisotropic() || settings.phi_i_deg != 0 ||
-           is_spectral_run(stack, settings);
+    return first_dielectric_film(stack) < stack.layers.size() || is_spectral_run(stack, settings);
 }
 
 Kernel kernel_for(const SimulationSettings& settings, const Stack& stack) {
@@ -159,20 +171,13 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
                                                              : ", --spectral on"));
     }
     if (settings.kernel != Kernel::Simd) return;
-    if (stack.has_film())
+    if (const std::size_t film = first_dielectric_film(stack); film < stack.layers.size())
         throw InputError("command line", "--kernel",
-                         fmt::format("the stack '{}' has a thin film, which the SIMD kernel does "
-                                     "not trace; give --kernel scalar (or auto)",
-                                     stack.name));
-    if (stack.is_anisotropic())
-        throw InputError("command line", "--kernel",
-                         fmt::format("the stack '{}' has an anisotropic interface, which the SIMD "
-                                     "kernel does not trace; give --kernel scalar (or auto)",
-                                     stack.name));
-    if (settings.phi_i_deg != 0)
-        throw InputError("command line", "--kernel",
-                         "light from phi_i ≠ 0 is tabulated on the unfolded grid, which the SIMD "
-                         "kernel does not bin; give --kernel scalar (or auto)");
+                         fmt::format("the stack '{}' has a thin film on a dielectric interface "
+                                     "(/layers/{}/interface/film), which the SIMD kernel does not "
+                                     "trace (it traces films on conductors); give --kernel scalar "
+                                     "(or auto)",
+                                     stack.name, film));
 }
 
 SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,

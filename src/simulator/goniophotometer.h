@@ -34,16 +34,15 @@ inline constexpr std::uint64_t kParticlesPerBlock = 4096;
 /// `simd` traces a batch of particles as the lanes of SIMD vectors (kernel_simd.h), dispatched at
 /// run time to what the CPU offers. Each is bitwise reproducible for any thread or process count on
 /// a given machine; the two agree in distribution (a two-sample chi-square test), not bit for bit.
-/// `auto` is `simd`, or `scalar` for what the SIMD kernel does not trace (a thin film,
-/// docs/physics.md §9; an anisotropic interface or light from φi ≠ 0, §3 and §5; a spectral run,
-/// §10): kernel_for.
+/// `auto` is `simd`, or `scalar` for what the SIMD kernel does not trace (a thin film on a
+/// dielectric interface, docs/physics.md §9; a spectral run, §10): kernel_for. Both trace
+/// anisotropic interfaces, light from φi ≠ 0 (§3, §5) and films on conductors.
 enum class Kernel { Scalar, Simd, Auto };
 inline constexpr std::array<EnumName<Kernel>, 3> enum_names(Kernel) {
     return {{{Kernel::Scalar, "scalar", "one particle at a time, the reference path"},
              {Kernel::Simd, "simd", "particles as the lanes of SIMD vectors"},
              {Kernel::Auto, "auto",
-              "simd, or scalar for a thin film, an anisotropic interface, phi_i != 0 or a "
-              "spectral run"}}};
+              "simd, or scalar for a thin film on a dielectric or a spectral run"}}};
 }
 inline const char* enum_noun(Kernel) {
     return "a particle kernel";
@@ -69,8 +68,8 @@ inline const char* enum_noun(SpectralMode) {
 struct SimulationSettings;
 /// Whether `stack` is traced spectrally under `settings` (SpectralMode).
 bool is_spectral_run(const Stack& stack, const SimulationSettings& settings);
-/// Whether only the scalar kernel traces `stack` under `settings` (a thin film, an anisotropic
-/// interface, light from φi ≠ 0, a spectral run).
+/// Whether only the scalar kernel traces `stack` under `settings` (a thin film on a dielectric
+/// interface, a spectral run).
 bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings);
 /// The kernel that traces `stack` under `settings`: auto is scalar where needs_scalar_kernel,
 /// simd otherwise; scalar and simd are themselves.
@@ -140,8 +139,8 @@ struct SimulationSettings {
               s.grid);
         visit({.name = "kernel",
                .help = "Particle kernel: simd (vectorized, runtime dispatch), scalar (reference "
-                       "path) or auto (simd, scalar for thin films); tables are reproducible per "
-                       "kernel",
+                       "path) or auto (simd, scalar for films on dielectrics); tables are "
+                       "reproducible per kernel",
                .key = Key::Fixed},
               s.kernel);
         TransportSettings::fields(s.transport, visit);
@@ -302,12 +301,11 @@ SimulationSums zero_sums(const Stack& stack, const SimulationSettings& settings)
 /// Checks what the settings' codecs cannot see alone (InputError naming `where` and the setting).
 void validate_settings(const SimulationSettings& settings, const std::string& where = "settings");
 
-/// Checks that the settings' kernel traces everything the stack holds: a thin film, an
-/// anisotropic interface, light from φi ≠ 0 and a spectral run need the scalar kernel, or auto
-/// (InputError naming --kernel for simd; docs/physics.md §9); a film with an anisotropic
-/// interface is refused; a spectral run needs spectral_bins a multiple of 3 and a range of at
-/// least one nm per bin. A refusal about the stack names `where` (its file; the stack's name when
-/// empty) and the JSON pointer of the field.
+/// Checks that the settings' kernel traces everything the stack holds: a thin film on a dielectric
+/// interface and a spectral run need the scalar kernel, or auto (InputError naming --kernel for
+/// simd; docs/physics.md §9); a film with an anisotropic interface is refused; a spectral run needs
+/// spectral_bins a multiple of 3 and a range of at least one nm per bin. A refusal about the stack
+/// names `where` (its file; the stack's name when empty) and the JSON pointer of the field.
 void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
                          const std::string& where = {});
 

@@ -4,11 +4,16 @@
 // vectors — the interface events (dielectric.h dielectric_event, conductor.h conductor_event,
 // lambertian.h lambertian_event, with the Fresnel factors, the Smith masking and the visible
 // normals they use), the microsurface walk (microsurface_walk.h) and the medium step (medium.h:
-// Beer–Lambert, free flights and Henyey–Greenstein scattering by spectral MIS). Nor are the lane
-// operations on Highway vectors (VecLane, core/lane_hwy.h), the vector random numbers
-// (simulator/lane_rng.h) and the vector exit bins (simulator/lane_bins.h). This file holds the lane
-// management: the queue and refills of lanes, the grouping of lanes by layer, the events' adapters
-// to the lane state, the tallies and the budget sums.
+// Beer–Lambert, free flights and Henyey–Greenstein scattering by spectral MIS), in their isotropic
+// or general (anisotropic) GGX instance as trace_particle takes them. One piece is evaluated per
+// lane rather than on vectors: a thin film on a conductor, whose reflection (physics/thin_film.h
+// FilmOptics::mueller, in double, the function film_event calls) takes the place of the bare
+// Fresnel terms in the conductor templates (FilmReflection); a film on a dielectric is the scalar
+// kernel's (SimulationSettings::kernel). Nor are the lane operations on Highway vectors (VecLane,
+// core/lane_hwy.h), the vector random numbers (simulator/lane_rng.h) and the vector exit bins
+// (simulator/lane_bins.h). This file holds the lane management: the queue and refills of lanes,
+// the grouping of lanes by layer, the events' adapters to the lane state, the tallies and the
+// budget sums.
 //
 // Layout. A block's particles run through a fixed set of lanes; a lane whose particle ends (exit,
 // absorption, cut-off) takes the block's next particle, so all lanes stay busy until the block's
@@ -126,25 +131,32 @@ struct LaneVectors {
 
 // ---- Interface events (goniophotometer.cpp trace_particle, `apply`) ----------------------------
 
-// An interface's GGX roughness (physics/microfacet.h) on the vectors' lanes: the isotropic
-// instance (the SIMD kernel traces isotropic stacks; an anisotropic one runs on the scalar kernel,
-// SimulationSettings::kernel).
-HWY_INLINE GgxLanes<VF> VecGgx(const GGX<float>& ggx) {
-    return ggx_lanes<VF, VecLane, false>(ggx.alpha, 0, 1, 0);
+// An interface's GGX roughness (physics/microfacet.h) on the vectors' lanes: the very roughness
+// the scalar kernel's events take (GGX::lanes), broadcast. kAnisotropic (the stack has an
+// anisotropic interface, CompiledStack::anisotropic): the general instance, with the interface's
+// α_x, α_y and tangent frame, at every rough interface of the stack, as trace_particle takes it;
+// else the isotropic instance.
+template <bool kAnisotropic>
+HWY_INLINE GgxLanes<VF, kAnisotropic> VecGgx(const GGX<float>& ggx) {
+    const DF df;
+    const auto g = ggx.template lanes<kAnisotropic>();
+    return {hn::Set(df, g.alpha),    hn::Set(df, g.alpha2), hn::Set(df, g.d_alpha),
+            hn::Set(df, g.d_alpha2), hn::Set(df, g.bx),     hn::Set(df, g.by)};
 }
 
 // A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
 // instantiates at one lane): the particle arrives along d (wi = −d). Polarized (kPolarized): the
 // event's polarized form on the lanes' states; where the channels' states differ, its reweighting
 // of the channels is booked with the base, as trace_particle does.
-template <bool kPolarized>
+template <bool kPolarized, bool kAnisotropic>
 HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
                                 VF uc, VF u1, VF u2, MF& degenerate) {
     const DF df;
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     const InterfaceEventLanes<VF, MF> e = dielectric_event<VF, VecLane, kPolarized>(
-        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), VecGgx(iface.distribution()),
-        iface.event_shape(), wi, uc, u1, u2, m, kPolarized ? &v.pol : nullptr);
+        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()),
+        VecGgx<kAnisotropic>(iface.distribution()), iface.event_shape(), wi, uc, u1, u2, m,
+        kPolarized ? &v.pol : nullptr);
     degenerate = hn::Or(degenerate, e.degenerate);
     const MF ok = hn::AndNot(e.degenerate, m);
     if constexpr (kPolarized)
@@ -154,21 +166,24 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, L
 }
 
 // A rough or smooth conductor (conductor.h conductor_event, the same template): light from above
-// only. Polarized: the Fresnel factors are the reflected fractions of the lanes' states.
-template <bool kPolarized>
-HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v, VF u1,
-                               VF u2, MF& degenerate) {
+// only. Polarized: the Fresnel factors are the reflected fractions of the lanes' states. The
+// reflection at a facet comes from `fresnel_of` and `mueller_of` (lane_conductor.h: the bare
+// conductor's; a filmed conductor's, FilmReflection).
+template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
+HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, const Fresnel& fresnel_of,
+                               const Mueller& mueller_of, MF m, LaneVectors& v, VF u1, VF u2,
+                               MF& degenerate) {
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     VF fresnel[3];
     InterfaceEventLanes<VF, MF> e;
     if constexpr (kPolarized)
-        e = conductor_event<VF, VecLane>(
-            VecGgx(iface.distribution()), iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
-            u2, m, ConductorFresnel{iface}, fresnel, &v.pol, ConductorMueller{iface});
+        e = conductor_event<VF, VecLane>(VecGgx<kAnisotropic>(iface.distribution()),
+                                         iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
+                                         u2, m, fresnel_of, fresnel, &v.pol, mueller_of);
     else
-        e = conductor_event<VF, VecLane>(VecGgx(iface.distribution()), iface.is_smooth(),
-                                         iface.uncorrelated_shadowing, wi, u1, u2, m,
-                                         ConductorFresnel{iface}, fresnel);
+        e = conductor_event<VF, VecLane>(VecGgx<kAnisotropic>(iface.distribution()),
+                                         iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
+                                         u2, m, fresnel_of, fresnel);
     degenerate = hn::Or(degenerate, e.degenerate);
     const MF ok = hn::AndNot(e.degenerate, m);
     v.Keep(ok, kLossBase, fresnel);
@@ -183,7 +198,7 @@ HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, MF m, Lan
 // absorbed by the base), met its facet cap (its flux lost to the microsurface) or a degeneracy
 // (lost and counted, as a failed sample), as trace_particle books the walk. `weighted`: the exit's
 // weight is booked on a dielectric too (polarized, the channels' states differing).
-template <typename Facet>
+template <bool kAnisotropic, typename Facet>
 HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, const Facet& facet,
                                       MF m, LaneVectors& v, LaneRng& rng, int max_order,
                                       MF& degenerate, bool weighted = false) {
@@ -191,38 +206,108 @@ HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, con
     const VF zero = hn::Zero(df);
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     auto draw = [&] { return rng.Uniform(); };
-    const MicrosurfaceWalkLanes<VF, MF> walk =
-        microsurface_walk<VF, VecLane>(VecGgx(ggx), wi, m, two_sided, facet, draw, max_order);
+    const MicrosurfaceWalkLanes<VF, MF> walk = microsurface_walk<VF, VecLane>(
+        VecGgx<kAnisotropic>(ggx), wi, m, two_sided, facet, draw, max_order);
     degenerate = hn::Or(degenerate, walk.degenerate);
     if (!two_sided || weighted) v.Keep(walk.escaped, kLossBase, walk.weight);
     v.Keep(walk.capped, kLossMicro, zero);
     v.d = Select(walk.escaped, walk.wo, v.d);
 }
 
-template <bool kPolarized>
+template <bool kPolarized, bool kAnisotropic>
 HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
                                     LaneRng& rng, int max_order, MF& degenerate) {
     const DF df;
     auto draw = [&] { return rng.Uniform(); };
     const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw), kPolarized> facet{
         hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), draw, kPolarized ? &v.pol : nullptr};
-    MicrosurfaceWalkEvent(iface.distribution(), true, facet, m, v, rng, max_order, degenerate,
-                          kPolarized && v.pol.channels == 3);
+    MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), true, facet, m, v, rng, max_order,
+                                        degenerate, kPolarized && v.pol.channels == 3);
 }
 
-template <bool kPolarized>
-HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, MF m, LaneVectors& v,
-                                   LaneRng& rng, int max_order, MF& degenerate) {
-    const ConductorFresnel fresnel{iface};
+template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
+HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, const Fresnel& fresnel,
+                                   const Mueller& mueller, MF m, LaneVectors& v, LaneRng& rng,
+                                   int max_order, MF& degenerate) {
     if constexpr (kPolarized) {
-        const ConductorMueller mueller{iface};
-        const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel, ConductorMueller> facet{
-            fresnel, &v.pol, &mueller};
-        MicrosurfaceWalkEvent(iface.distribution(), false, facet, m, v, rng, max_order, degenerate);
+        const MicrosurfaceConductorFacet<VF, VecLane, Fresnel, Mueller> facet{fresnel, &v.pol,
+                                                                              &mueller};
+        MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
+                                            max_order, degenerate);
     } else {
-        const MicrosurfaceConductorFacet<VF, VecLane, ConductorFresnel> facet{fresnel};
-        MicrosurfaceWalkEvent(iface.distribution(), false, facet, m, v, rng, max_order, degenerate);
+        const MicrosurfaceConductorFacet<VF, VecLane, Fresnel> facet{fresnel};
+        MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
+                                            max_order, degenerate);
     }
+}
+
+// ---- A thin film on a conductor (docs/physics.md §9; simulator/scalar_particle.h film_event) ----
+// The film's reflection at each lane's facet cosine and film thickness: FilmOptics::mueller
+// (physics/thin_film.h, in double, the very function the scalar kernel's film_event evaluates),
+// called per lane and channel, as its Airy sums have no lane template. It stands where the bare
+// conductor's ConductorFresnel and ConductorMueller stand in the conductor event and walk.
+struct FilmReflection {
+    const FilmOptics& film;
+    const double* thickness_nm;  // per lane
+    // The reflectance per channel (unpolarized), as film_event's `reflectance`.
+    HWY_NOINLINE void operator()(VF cos_theta, VF* factors) const {
+        const DF df;
+        HWY_ALIGN float cos_l[kMaxLanes], r[3][kMaxLanes];
+        hn::Store(cos_theta, df, cos_l);
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            for (int c = 0; c < 3; ++c)
+                r[c][l] =
+                    float(film.mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection.a);
+        for (int c = 0; c < 3; ++c)
+            factors[c] = hn::Load(df, r[c]);
+    }
+    // The reflection Mueller matrices per channel (polarized), as film_event's `mueller`.
+    HWY_NOINLINE void operator()(VF cos_theta, InterfaceMueller<VF>* m) const {
+        const DF df;
+        HWY_ALIGN float cos_l[kMaxLanes], e[3][4][kMaxLanes];
+        hn::Store(cos_theta, df, cos_l);
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            for (int c = 0; c < 3; ++c) {
+                const auto md = film.mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection;
+                e[c][0][l] = float(md.a);
+                e[c][1][l] = float(md.b);
+                e[c][2][l] = float(md.c);
+                e[c][3][l] = float(md.d);
+            }
+        for (int c = 0; c < 3; ++c)
+            m[c] = {hn::Load(df, e[c][0]), hn::Load(df, e[c][1]), hn::Load(df, e[c][2]),
+                    hn::Load(df, e[c][3])};
+    }
+};
+
+// A filmed conductor's event (film_event's conductor branch): the lanes' thicknesses drawn first
+// where the film's thickness varies (one number per event, from each lane's own stream), then the
+// conductor event or walk with the film's reflection in place of the bare Fresnel terms, booked as
+// the bare conductor's (absorbed by the base, lost to the microsurface). Isotropic: a stack with a
+// film has no anisotropic interface (validate_kernel_for).
+template <bool kPolarized>
+HWY_NOINLINE void FilmConductorEvent(const CompiledLayer<float>& layer, MF m, LaneVectors& v,
+                                     LaneRng& rng, int max_order, MF& degenerate) {
+    const DF df;
+    const FilmOptics& film = layer.film;
+    HWY_ALIGN double thickness[kMaxLanes];
+    if (film.varies()) {
+        HWY_ALIGN float u[kMaxLanes];
+        hn::Store(rng.Uniform(), df, u);
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            thickness[l] = film.thickness_nm(double(u[l]));
+    } else {
+        std::fill(thickness, thickness + hn::Lanes(df), film.thickness_min_nm);
+    }
+    const FilmReflection reflection{film, thickness};
+    if (layer.multiple) {
+        ConductorWalkEvent<kPolarized, false>(layer.conductor, reflection, reflection, m, v, rng,
+                                              max_order, degenerate);
+        return;
+    }
+    const VF u1 = rng.Uniform(), u2 = rng.Uniform();
+    ConductorEvent<kPolarized, false>(layer.conductor, reflection, reflection, m, v, u1, u2,
+                                      degenerate);
 }
 
 // Lambertian (lambertian.h lambertian_event, the same template): cosine-distributed on wi's side,
@@ -423,10 +508,11 @@ struct LaneSums {
 
 // One block traced (trace_block_simd), in two phases: every particle's first event on full
 // vectors (FirstEvents), then steps of the lanes with refills from the queue until it is empty
-// (Steps). Written once for both: kPolarized = false is the unpolarized kernel, with none of it.
+// (Steps). Written once for both: kPolarized = false is the unpolarized kernel, with none of it;
+// kAnisotropic = true the general (anisotropic) GGX instance at every rough interface (VecGgx).
 // The per-step work, InterfaceStep and EndParticles, is compiled out of line (two call sites
 // each); the pieces they are made of are inlined into them.
-template <bool kPolarized>
+template <bool kPolarized, bool kAnisotropic>
 class BlockTracer {
   public:
     BlockTracer(const BlockJob& job, Tally& tally, Scratch& scratch)
@@ -504,24 +590,34 @@ class BlockTracer {
         switch (layer.type) {
             case InterfaceType::Dielectric: {
                 if (layer.multiple) {
-                    DielectricWalkEvent<kPolarized>(layer.dielectric, going, v, rng,
-                                                    stack_.max_microsurface_order,
-                                                    degenerate_event);
+                    DielectricWalkEvent<kPolarized, kAnisotropic>(layer.dielectric, going, v, rng,
+                                                                  stack_.max_microsurface_order,
+                                                                  degenerate_event);
                     break;
                 }
                 const VF uc = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
-                DielectricEvent<kPolarized>(layer.dielectric, going, v, uc, u1, u2,
-                                            degenerate_event);
+                DielectricEvent<kPolarized, kAnisotropic>(layer.dielectric, going, v, uc, u1, u2,
+                                                          degenerate_event);
                 break;
             }
             case InterfaceType::Conductor: {
+                if constexpr (!kAnisotropic)
+                    if (layer.has_film) {
+                        FilmConductorEvent<kPolarized>(
+                            layer, going, v, rng, stack_.max_microsurface_order, degenerate_event);
+                        break;
+                    }
                 if (layer.multiple) {
-                    ConductorWalkEvent<kPolarized>(layer.conductor, going, v, rng,
-                                                   stack_.max_microsurface_order, degenerate_event);
+                    ConductorWalkEvent<kPolarized, kAnisotropic>(
+                        layer.conductor, ConductorFresnel{layer.conductor},
+                        ConductorMueller{layer.conductor}, going, v, rng,
+                        stack_.max_microsurface_order, degenerate_event);
                     break;
                 }
                 const VF u1 = rng.Uniform(), u2 = rng.Uniform();
-                ConductorEvent<kPolarized>(layer.conductor, going, v, u1, u2, degenerate_event);
+                ConductorEvent<kPolarized, kAnisotropic>(
+                    layer.conductor, ConductorFresnel{layer.conductor},
+                    ConductorMueller{layer.conductor}, going, v, u1, u2, degenerate_event);
                 break;
             }
             case InterfaceType::Lambertian: {
@@ -660,8 +756,10 @@ class BlockTracer {
                 for (int c = 0; c < 3; ++c)
                     for (int k = 0; k < 4; ++k)
                         s[c][k] = stokes_out_[c][k][l];
+                // Folded bins count the patch y < 0 as its mirror image (mueller.h); unfolded
+                // ones are one patch each (trace_particle's exit_stokes).
                 tally_.exit_stokes((why == kTransmitted ? grid_.size() : 0) + bin,
-                                   d_out_[1][l] < 0 ? 1 : 0, s);
+                                   d_out_[1][l] < 0 && !grid_.is_unfolded() ? 1 : 0, s);
             }
     }
 
@@ -919,12 +1017,18 @@ class BlockTracer {
     std::size_t next_ = 0;  // the queue's next particle
 };
 
+// The instance for the stack: polarized or not, isotropic or anisotropic (as trace_particle's).
 void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     thread_local Scratch scratch;
-    if (job.stack->polarization)
-        BlockTracer<true>(job, tally, scratch).Trace(block);
+    const bool polarized = job.stack->polarization, anisotropic = job.stack->anisotropic;
+    if (polarized && anisotropic)
+        BlockTracer<true, true>(job, tally, scratch).Trace(block);
+    else if (polarized)
+        BlockTracer<true, false>(job, tally, scratch).Trace(block);
+    else if (anisotropic)
+        BlockTracer<false, true>(job, tally, scratch).Trace(block);
     else
-        BlockTracer<false>(job, tally, scratch).Trace(block);
+        BlockTracer<false, false>(job, tally, scratch).Trace(block);
 }
 
 }  // namespace HWY_NAMESPACE

@@ -35,22 +35,28 @@ LAMINA_LANE_BEGIN
 // Both get a factor of 4 of safety. A lane whose bin is not certain (in practice 1 exit in 10³ on
 // the default grid) or whose r is below 1e-15 (x² + y² subnormal; bin_of's r = 0 is bin 0) takes
 // bin_of itself; tests/simulator/kernel_simd_test.cpp checks the lanes against bin_of at and near
-// every edge of several grids.
+// every edge of several grids, folded and unfolded.
+// An unfolded grid (core/grid.h) bins the folded cos φ among the folded grid's edges as bin_of does
+// and, for y < 0, takes its mirror bin n_phi − 1 − b: the same rule, the sign of y exact in float.
 struct VectorBins {
-    int n_theta, n_phi;
+    int n_theta, n_phi;        // the grid's bins (n_phi: 2 n_folded when unfolded)
+    int n_folded;              // the φ bins over [0, π] that cos φ is binned among
+    bool unfolded;             // φ over [0, 2π): y < 0 takes the mirror bin
     float to_theta, to_phi;    // bins per radian
     float eta_theta, eta_phi;  // the error bounds, in bins
     explicit VectorBins(const HemisphereGrid& grid)
         : n_theta(grid.n_theta()),
           n_phi(grid.n_phi()),
+          n_folded(grid.is_unfolded() ? grid.n_phi() / 2 : grid.n_phi()),
+          unfolded(grid.is_unfolded()),
           to_theta(float(grid.n_theta() / (0.5 * kPi<double>))),
-          to_phi(float(grid.n_phi() / kPi<double>)) {
+          to_phi(float(n_folded / kPi<double>)) {
         const double ulp = 0x1p-23;  // a float's relative spacing, at most
-        const double d_phi = kPi<double> / n_phi;
+        const double d_phi = kPi<double> / n_folded;
         eta_theta = float(4 * (kAcosErrorBound * to_theta + n_theta * ulp));
         eta_phi = float(
             4 * ((kAcosErrorBound + 2e-7 / std::sin(std::min(d_phi, kPi<double> / 2))) * to_phi +
-                 n_phi * ulp));
+                 n_folded * ulp));
     }
 };
 
@@ -80,7 +86,13 @@ HWY_INLINE std::uint64_t LaneBins(const VectorBins& g, const V3& d, std::int32_t
     const MF theta_known =
         bin(hn::Mul(Acos(cos_theta), hn::Set(df, g.to_theta)), g.eta_theta, g.n_theta, theta_bin);
     const MF phi_known =
-        bin(hn::Mul(Acos(cos_phi), hn::Set(df, g.to_phi)), g.eta_phi, g.n_phi, phi_bin);
+        bin(hn::Mul(Acos(cos_phi), hn::Set(df, g.to_phi)), g.eta_phi, g.n_folded, phi_bin);
+    if (g.unfolded) {
+        const VI folded = hn::Load(di, phi_bin);
+        const VI mirror = hn::Sub(hn::Set(di, g.n_phi - 1), folded);
+        hn::Store(hn::IfThenElse(hn::RebindMask(di, hn::Lt(d.y, hn::Zero(df))), mirror, folded), di,
+                  phi_bin);
+    }
     return MaskBits(hn::And(resolved, hn::And(theta_known, phi_known)));
 }
 

@@ -153,12 +153,12 @@ check_says simulate-energy-header 0 \
 # 2 incidences × 2 sides × 81 bins + header; the slab transmits, so T rows are present.
 check_says simulate-rows 0 "325" sh -c "wc -l <'$tmp/sim/brdf.csv'"
 check_says simulate-has-T 0 "45,T,0,10,0,20" grep -m1 "^45,T," "$tmp/sim/brdf.csv"
-# Thin films: the scalar kernel traces them; the SIMD kernel refuses, writing nothing; the default
-# kernel (auto) picks the scalar one; a model says "not supported".
+# Thin films on dielectrics: the scalar kernel traces them; the SIMD kernel refuses, writing
+# nothing; the default kernel (auto) picks the scalar one; a model says "not supported".
 check simulate-film 0 "$lamina" simulate "$src/examples/coated-lens.json" --kernel scalar \
     --theta-i 0,60 --particles 2e4 --grid 9x9 --out "$tmp/film"
 check_says simulate-film-wavelengths 0 '"wavelengths_nm"' cat "$tmp/film/result.json"
-check_says simulate-film-simd 1 "has a thin film, which the SIMD kernel does not trace; give --kernel scalar" \
+check_says simulate-film-simd 1 "has a thin film on a dielectric interface (/layers/0/interface/film), which the SIMD kernel does not trace (it traces films on conductors); give --kernel scalar" \
     "$lamina" simulate "$src/examples/soap-film.json" --kernel simd --theta-i 0 --particles 1000 \
     --out "$tmp/film-simd"
 check film-simd-writes-nothing 1 test -e "$tmp/film-simd"

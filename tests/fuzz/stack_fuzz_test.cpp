@@ -677,8 +677,9 @@ void check_simulation(Draw& d, const CaseContext& c, const Stack& stack) {
     } catch (const InputError&) {
         s.transport.microsurface = Microsurface::Single;  // a combination the kernel does not offer
     }
-    // Films, anisotropy, φi ≠ 0 and spectral runs are the scalar kernel's: the SIMD kernel must
-    // refuse them by name, and a film beside an anisotropic interface is refused by every kernel.
+    // Films on dielectrics and spectral runs are the scalar kernel's: the SIMD kernel must refuse
+    // them by name (anisotropy, φi ≠ 0 and films on conductors both kernels trace), and a film
+    // beside an anisotropic interface is refused by every kernel.
     try {
         validate_kernel_for(stack, s);
     } catch (const InputError& e) {

@@ -90,18 +90,22 @@ TEST(Anisotropy, UnfoldedGrid) {
     }
 }
 
-TEST(Anisotropy, KernelsAndModelsRefuseWhatTheyCannotTrace) {
+// Both kernels trace an anisotropic stack and light from φi ≠ 0 (kernel_simd_test.cpp compares
+// their tables); auto takes the SIMD kernel for them.
+TEST(Anisotropy, BothKernelsTraceAnisotropyAndAzimuths) {
     const Stack s = parse(conductor_json(R"("alpha": [0.1, 0.4])"));
     SimulationSettings settings;
     settings.theta_i_deg = {30};
     settings.particles = 100;
-    settings.kernel = Kernel::Simd;
-    EXPECT_THROW(simulate(s, settings), InputError);
-    settings.kernel = Kernel::Scalar;
-    EXPECT_NO_THROW(simulate(s, settings));
-    settings.kernel = Kernel::Simd;
-    settings.phi_i_deg = 10;
-    EXPECT_THROW(simulate(parse(conductor_json(R"("alpha": 0.2)")), settings), InputError);
+    for (const Kernel kernel : {Kernel::Simd, Kernel::Scalar}) {
+        settings.kernel = kernel;
+        settings.phi_i_deg = 0;
+        EXPECT_NO_THROW(simulate(s, settings));
+        settings.phi_i_deg = 10;
+        EXPECT_NO_THROW(simulate(parse(conductor_json(R"("alpha": 0.2)")), settings));
+    }
+    settings.kernel = Kernel::Auto;
+    EXPECT_EQ(kernel_for(settings, s), Kernel::Simd);
 }
 
 // ---- Statistical proofs -------------------------------------------------------------------------
@@ -257,9 +261,10 @@ double bin_midpoint_average(const HemisphereGrid& grid, int t, int p, bool below
     return sum / (kNodes * kNodes);
 }
 
-TEST(AnisotropyStat, SingleConductorMatchesTheAnisotropicMicrofacetBrdf) {
+void single_conductor_matches_the_closed_form(Kernel kernel) {
     const ClosedForm brdf{0.15, 0.45, deg_to_rad(25.0)};
     SimulationSettings s = scalar_settings(40, 1'000'000);
+    s.kernel = kernel;
     s.phi_i_deg = 30;
     s.transport.microsurface = Microsurface::Single;
     s.transport.polarization = false;
@@ -306,10 +311,11 @@ double dielectric_closed_form(const ClosedForm& c, double eta, const Vec3d& wi, 
            (std::abs(wi.z * wo.z) * sqr(ci + eta * co));
 }
 
-TEST(AnisotropyStat, SingleDielectricMatchesTheAnisotropicMicrofacetBsdf) {
+void single_dielectric_matches_the_closed_form(Kernel kernel) {
     const ClosedForm shape{0.2, 0.5, deg_to_rad(-40.0)};
     const double eta = 1.5;
     SimulationSettings s = scalar_settings(50, 1'000'000);
+    s.kernel = kernel;
     s.phi_i_deg = 10;
     s.transport.microsurface = Microsurface::Single;
     s.transport.polarization = false;
@@ -338,6 +344,21 @@ TEST(AnisotropyStat, SingleDielectricMatchesTheAnisotropicMicrofacetBsdf) {
     }
     EXPECT_EQ(outside, 0) << outside << " of " << compared << " bins (worst " << worst << ")";
     EXPECT_GT(compared, 60);
+}
+
+// On both kernels (each instantiates the general GGX templates; the SIMD kernel on its vectors).
+TEST(AnisotropyStat, SingleConductorMatchesTheAnisotropicMicrofacetBrdf) {
+    for (const Kernel kernel : {Kernel::Scalar, Kernel::Simd}) {
+        SCOPED_TRACE(enum_text(kernel));
+        single_conductor_matches_the_closed_form(kernel);
+    }
+}
+
+TEST(AnisotropyStat, SingleDielectricMatchesTheAnisotropicMicrofacetBsdf) {
+    for (const Kernel kernel : {Kernel::Scalar, Kernel::Simd}) {
+        SCOPED_TRACE(enum_text(kernel));
+        single_dielectric_matches_the_closed_form(kernel);
+    }
 }
 
 TEST(AnisotropyStat, WalkFirstOrderIsTheSingleScatteringInterface) {

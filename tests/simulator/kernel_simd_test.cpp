@@ -23,6 +23,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <tuple>
 
 namespace lamina {
 namespace {
@@ -104,12 +105,25 @@ TEST(KernelSimd, SmithRefractionEscapeLanes) {
 // on random directions of both hemispheres and on directions a few float ulps either side of every
 // θ and φ edge (where a wrong bound would show), the normal, grazing directions and a subnormal
 // azimuthal radius. On the default grid nearly every random exit is binned on the lanes (else the
-// fast path would be dead code; measured 99.8 %).
+// fast path would be dead code; measured 99.8 %). The unfolded grids (φ over [0°, 360°),
+// core/grid.h) too: the directions below the plane y = 0 take the mirror bins.
 TEST(KernelSimd, LaneBinsAreTheGridsBins) {
     ParticleRng rng(23, 0, 0);
-    for (const auto& [n_theta, n_phi] : std::vector<std::pair<int, int>>{
-             {90, 90}, {30, 20}, {1, 1}, {2, 1}, {7, 3}, {360, 720}, {1000, 500}}) {
-        const HemisphereGrid grid(n_theta, n_phi);
+    for (const auto& [n_theta, n_phi, unfolded] :
+         std::vector<std::tuple<int, int, bool>>{{90, 90, false},
+                                                 {30, 20, false},
+                                                 {1, 1, false},
+                                                 {2, 1, false},
+                                                 {7, 3, false},
+                                                 {360, 720, false},
+                                                 {1000, 500, false},
+                                                 {90, 90, true},
+                                                 {18, 18, true},
+                                                 {1, 1, true},
+                                                 {7, 3, true},
+                                                 {360, 720, true}}) {
+        const HemisphereGrid grid =
+            unfolded ? HemisphereGrid(n_theta, n_phi).unfolded() : HemisphereGrid(n_theta, n_phi);
         std::vector<float> d;
         auto push = [&](double x, double y, double z) {
             d.push_back(float(x));
@@ -147,6 +161,7 @@ TEST(KernelSimd, LaneBinsAreTheGridsBins) {
                 const double y = std::sqrt(std::max(0.0, s * s - double(x) * x));
                 push(x, y, z);
                 push(x, -y, -z);
+                push(x, -y, z);
             }
         }
         push(0, 0, 1);
@@ -154,8 +169,11 @@ TEST(KernelSimd, LaneBinsAreTheGridsBins) {
         push(1, 0, 0);
         push(-1, 0, 0);
         push(0, 1, 0);
+        push(0, -1, 0);
         push(1e-20, 0, 1);
         push(-1e-20, 1e-21, -1);
+        push(-1e-20, -1e-21, 1);
+        push(0.6, -0.0, 0.8);
         const std::vector<std::int64_t> lanes = simd_lane_bins(grid, d);
         ASSERT_EQ(lanes.size(), d.size() / 3);
         int known_random = 0;
@@ -592,8 +610,9 @@ TEST(KernelSimd, AzimuthCosineAndSine) {
 // distribution. Per bin and channel z = (f_a − f_b)/√(se_a² + se_b²) is standard normal when both
 // come from the same distribution (central limit: bins with at least ~100 expected exits); Σ z²
 // over the bins of one channel is χ² with as many degrees of freedom. Each channel is one test at
-// the Šidák-corrected level of the suite (1 % overall for the 57 channel tests below).
-constexpr int kTwoSampleTests = 57;
+// the Šidák-corrected level of the suite (1 % overall for the 117 channel tests below). The bins
+// are those of the run's grid (the unfolded one for an anisotropic stack or light from φi ≠ 0).
+constexpr int kTwoSampleTests = 117;
 
 // `scalar_tweak` adjusts the scalar run's settings (the SIMD run keeps the defaults);
 // `both_tweak` those of both runs.
@@ -616,6 +635,9 @@ void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
     s.seed = 12;
     const SimulationResult b = simulate(stack, s);
     const double level = 1 - std::pow(1 - 0.01, 1.0 / kTwoSampleTests);
+    const HemisphereGrid& grid = a.table.grid;
+    ASSERT_EQ(grid, b.table.grid);
+    ASSERT_EQ(grid, simulation_grid(stack, s));
     for (std::size_t inc = 0; inc < s.theta_i_deg.size(); ++inc) {
         for (const Side side : {Side::Reflection, Side::Transmission}) {
             if (side == Side::Transmission && !a.table.has_transmission) continue;
@@ -624,10 +646,10 @@ void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
             for (int c = 0; c < 3; ++c) {
                 double chi2 = 0;
                 int dof = 0;
-                for (std::size_t j = 0; j < s.grid.size(); ++j) {
+                for (std::size_t j = 0; j < grid.size(); ++j) {
                     // Expected exits ≈ N · f · Ω⊥ (flux fraction, weights of order one).
                     const double exits =
-                        double(particles) * la.f[j][c] * s.grid.projected_solid_angle(j);
+                        double(particles) * la.f[j][c] * grid.projected_solid_angle(j);
                     if (exits < 100) continue;
                     const double se2 = la.se[j][c] * la.se[j][c] + lb.se[j][c] * lb.se[j][c];
                     ASSERT_GT(se2, 0);
@@ -636,9 +658,9 @@ void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
                 }
                 ASSERT_GE(dof, 10) << "too few populated bins to test";
                 const double p = test::gamma_q(dof / 2.0, chi2 / 2.0);
-                EXPECT_GE(p, level)
-                    << "θi " << s.theta_i_deg[inc] << "° side " << int(side) << " channel " << c
-                    << ": χ² = " << chi2 << " for " << dof << " bins";
+                EXPECT_GE(p, level) << "θi " << s.theta_i_deg[inc] << "° φi " << s.phi_i_deg
+                                    << "° side " << int(side) << " channel " << c
+                                    << ": χ² = " << chi2 << " for " << dof << " bins";
             }
             // The budgets too, within 5 combined standard errors.
             const EnergyBudget& ba = a.incidences[inc].budget;
@@ -761,6 +783,197 @@ TEST(KernelSimdStat, SameTablesAsScalarPolarizedScatteringMedium) {
                                             Rgbd(0.5, 1.5, 0.8), Rgbd(0.6, -0.2, 0.3)),
                           test::dielectric_layer(1.0, 0.05)}),
         {45}, 400'000, {}, polarized_single);
+}
+
+// ---- Anisotropic stacks and light from φi ≠ 0 (docs/physics.md §3, §5) -------------------------
+// Both kernels take the general (anisotropic) instance of the GGX templates at every rough
+// interface, each in its own tangent frame, and tabulate on the unfolded grid. Brushed metals
+// (gold's indices: every channel reflects under the coat; α_x ≠ α_y) under a smooth and under a
+// rough coat, the coat brushed too and turned against the base, a brushed rough slab (walks from
+// both sides, transmission), polarized and not, single and multiple scattering on the
+// microsurfaces, lit at φi = 0 and away from it.
+Layer brushed_metal(double alpha_x, double alpha_y, double tangent_deg) {
+    return layer_of(anisotropic(
+        conductor_interface(Rgbd(0.143, 0.374, 1.442), Rgbd(3.983, 2.385, 1.603), alpha_x), alpha_x,
+        alpha_y, tangent_deg));
+}
+Layer brushed_coat(double eta, double alpha_x, double alpha_y, double tangent_deg) {
+    Layer coat = test::dielectric_layer(eta, alpha_x);
+    coat.interface = anisotropic(coat.interface, alpha_x, alpha_y, tangent_deg);
+    return coat;
+}
+std::function<void(SimulationSettings&)> lit_from(double phi_i_deg,
+                                                  Microsurface microsurface = Microsurface::Single,
+                                                  bool polarized = false) {
+    return [=](SimulationSettings& s) {
+        s.phi_i_deg = phi_i_deg;
+        s.transport.microsurface = microsurface;
+        s.transport.polarization = polarized;
+    };
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarBrushedUnderSmoothCoat) {
+    const Stack stack =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.1)),
+                          brushed_metal(0.08, 0.4, 30)});
+    ASSERT_TRUE(stack.is_anisotropic());
+    expect_same_distribution(stack, {30, 70}, 1'000'000, {}, lit_from(0));
+    expect_same_distribution(stack, {50}, 1'000'000, {}, lit_from(130));
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarBrushedUnderTurnedBrushedCoat) {
+    const Stack stack =
+        test::make_stack({test::with_medium(brushed_coat(1.5, 0.05, 0.25, 45), Rgbd(0.1)),
+                          brushed_metal(0.35, 0.1, -20)});
+    expect_same_distribution(stack, {40}, 1'000'000, {}, lit_from(0));
+    expect_same_distribution(stack, {20, 65}, 1'000'000, {}, lit_from(250));
+    expect_same_distribution(stack, {45}, 1'000'000, {}, lit_from(60, Microsurface::Multiple));
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarBrushedRoughSlab) {
+    // Reflection and transmission through two rough dielectrics, the upper one brushed.
+    const Stack stack =
+        test::make_stack({test::with_medium(brushed_coat(1.5, 0.5, 0.15, 70), Rgbd(0.1, 0.0, 0.9)),
+                          test::dielectric_layer(1.0, 0.3)});
+    expect_same_distribution(stack, {25}, 1'000'000, {}, lit_from(0));
+    expect_same_distribution(stack, {60}, 1'000'000, {}, lit_from(30, Microsurface::Multiple));
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarPolarizedBrushedUnderCoat) {
+    // One polarization state per channel (the conductor's Mueller matrices per channel).
+    const Stack stack =
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.1), Rgbd(0.1)),
+                          brushed_metal(0.1, 0.45, 60)});
+    expect_same_distribution(stack, {50}, 1'000'000, {}, lit_from(0, Microsurface::Single, true));
+    expect_same_distribution(stack, {35}, 1'000'000, {}, lit_from(45, Microsurface::Single, true));
+    expect_same_distribution(stack, {70}, 1'000'000, {},
+                             lit_from(200, Microsurface::Multiple, true));
+}
+
+// An isotropic stack lit from φi ≠ 0 (the unfolded grid, the isotropic instance).
+TEST(KernelSimdStat, SameTablesAsScalarIsotropicLitFromAnotherAzimuth) {
+    expect_same_distribution(
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.1, 0.0, 0.9)),
+                          test::lambertian_layer(Rgbd(0.8, 0.5, 1.0))}),
+        {60}, 1'000'000, {}, lit_from(75));
+}
+
+// Reproducibility on anisotropic stacks and light from φi ≠ 0: the SIMD kernel's tables, budgets
+// and Stokes tallies are bitwise identical for 1 and 2 threads (a block's particles take the same
+// lanes in the same order whatever thread traces it), polarized or not, with either microsurface
+// model; another seed gives another table.
+TEST(KernelSimd, AnisotropicTablesBitwiseIdenticalAcrossThreadCounts) {
+    const std::vector<Stack> stacks = {
+        test::make_stack({test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.1)),
+                          brushed_metal(0.08, 0.4, 30)}),
+        test::make_stack({test::with_medium(brushed_coat(1.5, 0.05, 0.25, 45), Rgbd(0.1)),
+                          brushed_metal(0.35, 0.1, -20)}),
+        test::make_stack({test::with_medium(brushed_coat(1.5, 0.5, 0.15, 70), Rgbd(0.1)),
+                          test::dielectric_layer(1.0, 0.3)}),
+    };
+    for (const Stack& stack : stacks)
+        for (const bool polarized : {false, true})
+            for (const Microsurface microsurface : {Microsurface::Single, Microsurface::Multiple}) {
+                SCOPED_TRACE(::testing::Message()
+                             << "polarized " << polarized << ' ' << enum_text(microsurface));
+                SimulationSettings s;
+                s.theta_i_deg = {0, 55};
+                s.phi_i_deg = 35;
+                s.particles = 20'000;  // five blocks
+                s.grid = HemisphereGrid(18, 18);
+                s.kernel = Kernel::Simd;
+                s.transport.microsurface = microsurface;
+                s.transport.polarization = polarized;
+                s.stokes_tallies = polarized;
+                s.threads = 1;
+                const SimulationResult one = simulate(stack, s);
+                s.threads = 2;
+                const SimulationResult two = simulate(stack, s);
+                ASSERT_TRUE(one.table.grid.is_unfolded());
+                for (std::size_t i = 0; i < 2; ++i) {
+                    for (const Side side : {Side::Reflection, Side::Transmission}) {
+                        if (side == Side::Transmission && !one.table.has_transmission) continue;
+                        EXPECT_EQ(one.table.lobe(i, side).f, two.table.lobe(i, side).f);
+                        EXPECT_EQ(one.table.lobe(i, side).se, two.table.lobe(i, side).se);
+                    }
+                    EXPECT_EQ(one.incidences[i].budget.term, two.incidences[i].budget.term);
+                    if (polarized) {
+                        EXPECT_TRUE(one.sums[i].stokes == two.sums[i].stokes);
+                    }
+                }
+                s.seed = 8;
+                const SimulationResult other = simulate(stack, s);
+                EXPECT_NE(one.table.lobe(0, Side::Reflection).f,
+                          other.table.lobe(0, Side::Reflection).f);
+            }
+}
+
+// ---- Thin films on conductors (docs/physics.md §9) ----------------------------------------------
+// The SIMD kernel traces a film on a conductor with the film's reflection (FilmOptics::mueller, in
+// double, per lane) in place of the bare Fresnel terms; a film on a dielectric stays the scalar
+// kernel's. An iridescent metal under a clear coat: an absorbing film whose thickness varies over
+// the surface (one draw per event) on a rough gold, polarized with multiple scattering (the
+// default reference) and unpolarized single scattering; a smooth filmed metal under a rough coat.
+Layer with_conductor_film(Layer layer, double thickness_nm, double thickness_max_nm, double eta,
+                          double k) {
+    layer.interface.has_film = true;
+    layer.interface.film.thickness_nm = thickness_nm;
+    layer.interface.film.thickness_max_nm = thickness_max_nm;
+    layer.interface.film.eta = eta;
+    layer.interface.film.k = k;
+    return layer;
+}
+Stack iridescent_gold(double alpha_metal) {
+    return test::make_stack(
+        {test::with_medium(test::dielectric_layer(1.5, 0.15), Rgbd(0.05)),
+         with_conductor_film(test::conductor_layer(Rgbd(0.143, 0.374, 1.442),
+                                                   Rgbd(3.983, 2.385, 1.603), alpha_metal),
+                             90, 260, 2.3, 0.05)});
+}
+
+TEST(KernelSimdStat, SameTablesAsScalarFilmedConductorUnderCoat) {
+    const Stack rough = iridescent_gold(0.3);
+    ASSERT_TRUE(rough.has_film());
+    expect_same_distribution(rough, {20, 65}, 1'000'000, {},
+                             lit_from(0, Microsurface::Multiple, true));
+    expect_same_distribution(rough, {45}, 1'000'000, {}, lit_from(0, Microsurface::Single, false));
+    expect_same_distribution(iridescent_gold(0.0), {35}, 1'000'000, {},
+                             lit_from(0, Microsurface::Single, true));
+    expect_same_distribution(rough, {50}, 1'000'000, {},
+                             lit_from(70, Microsurface::Multiple, false));
+}
+
+// Reproducibility with films on conductors: bitwise identical tables for 1 and 2 threads.
+TEST(KernelSimd, FilmedConductorTablesBitwiseIdenticalAcrossThreadCounts) {
+    for (const double alpha : {0.0, 0.3})
+        for (const bool polarized : {false, true})
+            for (const Microsurface microsurface : {Microsurface::Single, Microsurface::Multiple}) {
+                SCOPED_TRACE(::testing::Message() << "α " << alpha << " polarized " << polarized
+                                                  << ' ' << enum_text(microsurface));
+                const Stack stack = iridescent_gold(alpha);
+                SimulationSettings s;
+                s.theta_i_deg = {0, 55};
+                s.particles = 20'000;  // five blocks
+                s.grid = HemisphereGrid(18, 18);
+                s.kernel = Kernel::Simd;
+                s.transport.microsurface = microsurface;
+                s.transport.polarization = polarized;
+                s.stokes_tallies = polarized;
+                s.threads = 1;
+                const SimulationResult one = simulate(stack, s);
+                s.threads = 2;
+                const SimulationResult two = simulate(stack, s);
+                for (std::size_t i = 0; i < 2; ++i) {
+                    EXPECT_EQ(one.table.lobe(i, Side::Reflection).f,
+                              two.table.lobe(i, Side::Reflection).f);
+                    EXPECT_EQ(one.table.lobe(i, Side::Reflection).se,
+                              two.table.lobe(i, Side::Reflection).se);
+                    EXPECT_EQ(one.incidences[i].budget.term, two.incidences[i].budget.term);
+                    if (polarized) {
+                        EXPECT_TRUE(one.sums[i].stokes == two.sums[i].stokes);
+                    }
+                }
+            }
 }
 
 }  // namespace

@@ -161,15 +161,20 @@ TEST(ThinFilmStackStat, FilmedSmoothSlab) {
 }
 
 // A smooth conductor under an oxide film: R is the film's reflectance over the metal, the rest
-// absorbed at the base, polarized or not; an absorbing film over a metal too.
+// absorbed at the base, polarized or not; an absorbing film over a metal too. On both kernels (the
+// SIMD kernel traces films on conductors).
 TEST(ThinFilmStackStat, FilmedSmoothConductor) {
     const Rgbd eta_c(2.74, 2.54, 2.26), k_c(3.79, 3.43, 3.07);
     for (const double k_film : {0.0, 0.3}) {
         const Stack stack =
             test::make_stack({with_film(test::conductor_layer(eta_c, k_c, 0.0), 60, 2.5, k_film)});
-        for (const bool polarization : {false, true}) {
-            const SimulationResult r =
-                simulate(stack, scalar_settings({0, 60}, 50'000, polarization));
+        for (const auto& [polarization, kernel] :
+             {std::pair{false, Kernel::Scalar}, std::pair{true, Kernel::Scalar},
+              std::pair{false, Kernel::Simd}, std::pair{true, Kernel::Simd}}) {
+            SCOPED_TRACE(enum_text(kernel));
+            SimulationSettings s = scalar_settings({0, 60}, 50'000, polarization);
+            s.kernel = kernel;
+            const SimulationResult r = simulate(stack, s);
             for (std::size_t i = 0; i < 2; ++i) {
                 const double mu = std::cos(deg_to_rad(r.settings.theta_i_deg[i]));
                 for (int c = 0; c < 3; ++c) {
@@ -209,9 +214,11 @@ TEST(ThinFilmStackStat, RoughFilmedInterfaceIsWaltersBsdfWithTheFilm) {
         // normal approximation of their z-scores.
         s.grid = HemisphereGrid(9, 9);
         s.transport.microsurface = Microsurface::Single;
-        {
-            SCOPED_TRACE("conductor");
-            const SimulationResult r = simulate(conductor, s);
+        for (const Kernel kernel : {Kernel::Scalar, Kernel::Simd}) {
+            SCOPED_TRACE(::testing::Message() << "conductor, " << enum_text(kernel));
+            SimulationSettings sk = s;
+            sk.kernel = kernel;
+            const SimulationResult r = simulate(conductor, sk);
             expect_agreement(compare_lobe(
                 r.table, 0, Side::Reflection,
                 [&](std::size_t j) {
@@ -418,11 +425,18 @@ TEST(ThinFilmStack, VaryingThicknessIsBitwiseIdenticalAcrossThreads) {
     }
 }
 
-// --kernel auto: the scalar kernel for a stack with a film, the SIMD kernel for one without, bit
-// for bit.
+// --kernel auto: the scalar kernel for a stack with a film on a dielectric, the SIMD kernel for
+// one without, bit for bit.
 TEST(ThinFilmStack, AutoKernelPicksScalarForFilms) {
     const Stack filmed = test::make_stack({with_film(test::dielectric_layer(1.5, 0.2), 100, 1.38)});
     const Stack bare = test::make_stack({test::dielectric_layer(1.5, 0.2)});
+    // A film on a conductor: the SIMD kernel's (kernel_simd_test.cpp compares the two kernels).
+    const Stack filmed_metal = test::make_stack(
+        {test::dielectric_layer(1.5, 0.1),
+         with_film(test::conductor_layer(Rgbd(0.2), Rgbd(3.0), 0.2), 80, 2.0, 0.1, 160)});
+    SimulationSettings auto_settings;
+    EXPECT_EQ(kernel_for(auto_settings, filmed_metal), Kernel::Simd);
+    EXPECT_EQ(kernel_for(auto_settings, filmed), Kernel::Scalar);
     for (const Stack& stack : {filmed, bare}) {
         SimulationSettings s = scalar_settings({30}, 20'000, true);
         s.kernel = Kernel::Auto;
@@ -441,15 +455,18 @@ TEST(ThinFilmStack, AutoKernelPicksScalarForFilms) {
     EXPECT_EQ(kernel_for(s, bare), Kernel::Scalar);
     s.kernel = Kernel::Simd;
     EXPECT_EQ(kernel_for(s, filmed), Kernel::Simd);  // refused by simulate
-    // Anisotropy and light from φi ≠ 0 need the scalar kernel too.
+    // Light from φi ≠ 0 and anisotropy do not: both kernels trace them.
     s.kernel = Kernel::Auto;
     EXPECT_EQ(kernel_for(s, bare), Kernel::Simd);
     s.phi_i_deg = 30;
-    EXPECT_EQ(kernel_for(s, bare), Kernel::Scalar);
+    EXPECT_EQ(kernel_for(s, bare), Kernel::Simd);
+    const Stack brushed = test::make_stack(
+        {layer_of(anisotropic(conductor_interface(Rgbd(0.2), Rgbd(3.0), 0.1), 0.1, 0.4, 20))});
+    EXPECT_EQ(kernel_for(s, brushed), Kernel::Simd);
 }
 
-// Who does not trace films says so: the SIMD kernel (an InputError naming --kernel), every model
-// (not supported: a film on a glass is on no model's list), the random walk.
+// Who does not trace a film on a glass says so: the SIMD kernel (an InputError naming --kernel),
+// every model (not supported: a film on a glass is on no model's list), the random walk.
 TEST(ThinFilmStack, RefusedWhereNotTraced) {
     const Stack stack =
         test::make_stack({with_film(test::dielectric_layer(1.5, 0.1), 100, 1.38)}, "coated glass");
