@@ -27,4 +27,31 @@ async function launchChromium(viewport = { width: 1400, height: 1000 }) {
   return { context, page, close };
 }
 
-module.exports = { CHROMIUM, launchChromium };
+// A test of a page that must work from file:// alone: run(page, check) drives the page, check(ok,
+// what) prints "ok" or "FAIL" with what; any console error, page error or network request fails
+// the test too. Prints the count and exits 1 on any failure.
+async function strictPageTest(run) {
+  const browser = await launchChromium();
+  const errors = [];
+  let failures = 0;
+  const check = (ok, what) => { console.log((ok ? "ok   " : "FAIL ") + what); if (!ok) failures++; };
+  try {
+    const page = browser.page;
+    page.on("console", (m) => { if (m.type() === "error") errors.push("console: " + m.text()); });
+    page.on("pageerror", (e) => errors.push("page error: " + e.message));
+    await page.route(/^(https?|wss?):/, (route) => { errors.push("network: " + route.request().url()); route.abort(); });
+    await run(page, check);
+  } finally {
+    await browser.close();
+  }
+  for (const e of errors) console.log("FAIL " + e);
+  failures += errors.length;
+  console.log(failures ? `${failures} failed` : "0 failed");
+  process.exit(failures ? 1 : 0);
+}
+
+function runStrictPageTest(run) {
+  strictPageTest(run).catch((e) => { console.log("FAIL " + e); process.exit(1); });
+}
+
+module.exports = { CHROMIUM, launchChromium, runStrictPageTest };
