@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   librandom123-dev libpcg-cpp-dev libomp-dev libpng-dev libopenexr-dev
   libhwy-dev                                 # the SIMD kernel (Google Highway)
+  libcerf-dev                                # Faddeeva's function: Gaussian integrals (models)
   libopenmpi-dev openmpi-bin                 # mpirun -n K lamina simulate|study (docs/scaling.md)
   python3 python3-numpy python3-matplotlib   # lamina figures (scripts/figures.py)
   python3-dev pybind11-dev python3-pybind11  # the Python module `import lamina` (docs/python.md)

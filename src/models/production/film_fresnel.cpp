@@ -2,6 +2,7 @@
 
 #include "core/math.h"
 #include "layers/colorimetry.h"
+#include "models/numerics/gaussian_fourier.h"
 #include "models/numerics/quadrature.h"
 #include "models/production/production_coat.h"
 #include "physics/thin_film_average.h"
@@ -65,29 +66,110 @@ V xyz_to_srgb_7_digits(const V& xyz) {
             0.0556434 * xyz[0] - 0.2040259 * xyz[1] + 1.0572252 * xyz[2]};
 }
 
-/// Belcour & Barla 2017's sensitivity S(OPD, shift) in linear sRGB: the Fourier transform of the
-/// CIE 1931 colour matching functions at the optical path difference OPD (nm), shifted in phase,
-/// by the paper's fit of each as a sum of Gaussians (their supplemental material; the constants
-/// as three.js's evalSensitivity carries them: the Gaussians' amplitudes, centres and variances
-/// in the spatial frequency of metres, and the normalization 1.0685e-7 that makes the m = 0 term
-/// white), then the XYZ → linear sRGB (Rec. 709 primaries, D65) matrix of IEC 61966-2-1.
-Rgbd sensitivity_srgb(double opd_nm, const Rgbd& shift) {
-    const double two_pi = 2 * std::numbers::pi;
-    const double phase = two_pi * opd_nm * 1e-9;
-    const double val[3] = {5.4856e-13, 4.4201e-13, 5.2481e-13};
-    const double pos[3] = {1.6810e+06, 1.7953e+06, 2.2084e+06};
-    const double var[3] = {4.3278e+09, 9.3046e+09, 6.6121e+09};
-    double xyz[3];
-    for (int i = 0; i < 3; ++i)
-        xyz[i] = val[i] * std::sqrt(two_pi * var[i]) * std::cos(pos[i] * phase + shift[i]) *
-                 std::exp(-phase * phase * var[i]);
-    // X has a second lobe (the blue bump of x̄).
-    xyz[0] += 9.7470e-14 * std::sqrt(two_pi * 4.5282e+09) *
-              std::cos(2.2399e+06 * phase + shift[0]) * std::exp(-4.5282e+09 * phase * phase);
+/// One Gaussian of Belcour & Barla 2017's fit of the CIE 1931 colour matching functions' Fourier
+/// transforms (their supplemental material; the constants as three.js's evalSensitivity carries
+/// them): amplitude, centre and variance in the spatial frequency of metres, and which of X, Y, Z
+/// it belongs to (X has a second lobe, the blue bump of x̄).
+struct SensitivityGaussian {
+    int xyz;
+    double val, pos, var;
+};
+constexpr SensitivityGaussian kSensitivityGaussians[4] = {{0, 5.4856e-13, 1.6810e+06, 4.3278e+09},
+                                                          {1, 4.4201e-13, 1.7953e+06, 9.3046e+09},
+                                                          {2, 5.2481e-13, 2.2084e+06, 6.6121e+09},
+                                                          {0, 9.7470e-14, 2.2399e+06, 4.5282e+09}};
+/// The normalization that makes the m = 0 term white.
+constexpr double kSensitivityNorm = 1.0685e-7;
+
+/// The phase 2π·OPD of an optical path difference in nm, per metre of wavelength⁻¹.
+double sensitivity_phase(double opd_nm) {
+    return 2 * std::numbers::pi * opd_nm * 1e-9;
+}
+
+/// A Gaussian's weight val·√(2π var).
+double sensitivity_weight(const SensitivityGaussian& g) {
+    return g.val * std::sqrt(2 * std::numbers::pi * g.var);
+}
+
+}  // namespace
+
+Rgbd belcour_sensitivity_srgb(double opd_nm, const Rgbd& shift) {
+    const double phase = sensitivity_phase(opd_nm);
+    double xyz[3] = {0, 0, 0};
+    for (const SensitivityGaussian& g : kSensitivityGaussians)
+        xyz[g.xyz] += sensitivity_weight(g) * std::cos(g.pos * phase + shift[g.xyz]) *
+                      std::exp(-phase * phase * g.var);
     for (double& v : xyz)
-        v /= 1.0685e-7;
+        v /= kSensitivityNorm;
     return xyz_to_srgb_7_digits(Rgbd(xyz[0], xyz[1], xyz[2]));
 }
+
+namespace {
+
+/// The mean of belcour_sensitivity_srgb(OPD, shift) over OPD uniform in [opd0_nm, opd1_nm] (0 ≤
+/// opd0 ≤ opd1): each Gaussian-windowed cosine integrated in closed form (models/numerics/
+/// gaussian_fourier.h) — Re[e^{i shift} ∫ e^{−var t²} e^{i pos t} dt] over the phases. Below 1 nm
+/// of OPD, where the difference of the two antiderivatives would lose digits to the division, by
+/// 4-point Gauss–Legendre (exact to ~1e-12 there: the fastest cosine turns by 0.014 rad per nm).
+Rgbd sensitivity_srgb_mean(double opd0_nm, double opd1_nm, const Rgbd& shift) {
+    if (opd1_nm - opd0_nm < 1.0) {
+        static const QuadratureRule rule = gauss_legendre(4);
+        Rgbd sum(0.0);
+        for (std::size_t i = 0; i < rule.x.size(); ++i)
+            sum += belcour_sensitivity_srgb(opd0_nm + (opd1_nm - opd0_nm) * rule.x[i], shift) *
+                   rule.w[i];
+        return sum;
+    }
+    const double t0 = sensitivity_phase(opd0_nm), t1 = sensitivity_phase(opd1_nm);
+    double xyz[3] = {0, 0, 0};
+    for (const SensitivityGaussian& g : kSensitivityGaussians) {
+        const std::complex<double> integral = gaussian_fourier_integral(g.var, g.pos, t0, t1);
+        xyz[g.xyz] +=
+            sensitivity_weight(g) * (std::polar(1.0, shift[g.xyz]) * integral).real() / (t1 - t0);
+    }
+    for (double& v : xyz)
+        v /= kSensitivityNorm;
+    return xyz_to_srgb_7_digits(Rgbd(xyz[0], xyz[1], xyz[2]));
+}
+
+/// sup |S_c| over OPD ≥ 0 of the sensitivity whose X, Y and Z lobes are turned by 0 or π (signs
+/// (+, sY, sZ) after taking the X sign out: |S| is the same for opposite patterns), per linear-sRGB
+/// channel. The maxima of a sampling of OPD over [0, 20000] nm every 0.01 nm (beyond, every window
+/// is below e⁻⁶⁸), rounded up by 0.01 to 0.02 — far more than a sample can miss between two
+/// (h²/8 · max|S''| ≈ 10⁻⁶); tests/models/production/film_fresnel_test.cpp samples them again.
+constexpr double kSensitivitySup[2][2][3] = {{{5.29, 2.90, 1.02}, {4.30, 2.82, 1.33}},
+                                             {{2.22, 1.02, 1.22}, {1.80, 1.00, 0.98}}};
+
+}  // namespace
+
+Rgbd belcour_sensitivity_srgb_bound(double opd0_nm, const Rgbd& shift) {
+    // Each Gaussian's window is largest at the smallest phase, and |cos| ≤ 1.
+    const double phase = sensitivity_phase(opd0_nm);
+    double xyz[3] = {0, 0, 0};
+    for (const SensitivityGaussian& g : kSensitivityGaussians)
+        xyz[g.xyz] += sensitivity_weight(g) * std::exp(-phase * phase * g.var) / kSensitivityNorm;
+    const Rgbd x = xyz_to_srgb_7_digits(Rgbd(xyz[0], 0, 0)),
+               y = xyz_to_srgb_7_digits(Rgbd(0, xyz[1], 0)),
+               z = xyz_to_srgb_7_digits(Rgbd(0, 0, xyz[2]));
+    Rgbd bound;
+    for (int c = 0; c < 3; ++c)
+        bound[c] = std::abs(x[c]) + std::abs(y[c]) + std::abs(z[c]);
+    // Shifts of whole multiples of π (three.js's are): the sampled suprema of their pattern.
+    bool multiples_of_pi = true;
+    int sign[3];
+    for (int k = 0; k < 3; ++k) {
+        multiples_of_pi = multiples_of_pi && std::abs(std::sin(shift[k])) < 1e-9;
+        sign[k] = std::cos(shift[k]) > 0 ? 1 : -1;
+    }
+    if (multiples_of_pi) {
+        const int same_y = sign[1] == sign[0], same_z = sign[2] == sign[0];
+        for (int c = 0; c < 3; ++c)
+            bound[c] = std::min(bound[c], kSensitivitySup[same_y][same_z][c]);
+    }
+    return bound;
+}
+
+namespace {
 
 /// Normal reflectance ((n_t − n_i)/(n_t + n_i))² of a dielectric boundary.
 double normal_reflectance(double eta_t, double eta_i) {
@@ -163,58 +245,217 @@ Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, con
     return thickness_average(lo, hi, period, at_thickness);
 }
 
-Rgbd threejs_iridescence(double outside_ior, double film_ior, double cos_theta_1,
-                         double thickness_nm, const Rgbd& base_f0) {
+namespace {
+
+/// three.js's film fades into the outside medium over its first 0.03 nm of thickness.
+constexpr double kThreejsFadeNm = 0.03;
+
+/// What three.js's evalIridescence computes before the thickness enters, at thickness_nm: the
+/// film's index, the cosine inside it, and per channel the Airy sum's DC term and its first two
+/// orders' coefficients and phases (Belcour & Barla, Eq. 10). Beyond the fade all of it is the
+/// same for every thickness.
+struct ThreejsFilmTerms {
+    bool total_reflection = false;
+    double iridescence_ior = 1, cos_theta_2 = 1;
+    Rgbd dc, c1, c2, phi;
+};
+
+ThreejsFilmTerms threejs_film_terms(double outside_ior, double film_ior, double cos_theta_1,
+                                    double thickness_nm, const Rgbd& base_f0) {
     const double pi = std::numbers::pi;
+    ThreejsFilmTerms out;
     // The film's index goes to the outside's as the thickness goes to 0 (over 0.03 nm).
-    const double t = clamp(thickness_nm / 0.03, 0.0, 1.0);
-    const double iridescence_ior = outside_ior + (film_ior - outside_ior) * t * t * (3 - 2 * t);
+    const double t = clamp(thickness_nm / kThreejsFadeNm, 0.0, 1.0);
+    out.iridescence_ior = outside_ior + (film_ior - outside_ior) * t * t * (3 - 2 * t);
     // Snell's law into the film; total internal reflection reflects everything.
-    const double sin2_theta_2 = sqr(outside_ior / iridescence_ior) * (1 - sqr(cos_theta_1));
+    const double sin2_theta_2 = sqr(outside_ior / out.iridescence_ior) * (1 - sqr(cos_theta_1));
     const double cos2_theta_2 = 1 - sin2_theta_2;
-    if (cos2_theta_2 < 0) return Rgbd(1.0);
-    const double cos_theta_2 = std::sqrt(cos2_theta_2);
+    if (cos2_theta_2 < 0) {
+        out.total_reflection = true;
+        return out;
+    }
+    out.cos_theta_2 = std::sqrt(cos2_theta_2);
     // The first boundary by Schlick's approximation; its phase 0 or π (Belcour & Barla, Eq. 9).
-    const double R12 = schlick_sg(normal_reflectance(iridescence_ior, outside_ior), cos_theta_1);
+    const double R12 =
+        schlick_sg(normal_reflectance(out.iridescence_ior, outside_ior), cos_theta_1);
     const double T121 = 1 - R12;
-    const double phi12 = iridescence_ior < outside_ior ? pi : 0.0;
+    const double phi12 = out.iridescence_ior < outside_ior ? pi : 0.0;
     const double phi21 = pi - phi12;
     // The base read as a dielectric of the index its F0 gives against air (F0 clamped to
     // [0, 0.9999]), Schlick's approximation at the film's cosine, its phase 0 or π.
-    Rgbd R23, phi;
     for (int c = 0; c < 3; ++c) {
         const double s = std::sqrt(clamp(base_f0[c], 0.0, 0.9999));
         const double base_ior = (1 + s) / (1 - s);
-        R23[c] = schlick_sg(normal_reflectance(base_ior, iridescence_ior), cos_theta_2);
-        phi[c] = phi21 + (base_ior < iridescence_ior ? pi : 0.0);
+        const double R23 =
+            schlick_sg(normal_reflectance(base_ior, out.iridescence_ior), out.cos_theta_2);
+        out.phi[c] = phi21 + (base_ior < out.iridescence_ior ? pi : 0.0);
+        // Belcour & Barla, Eq. 10: the DC term and the first two orders of the Airy sum in
+        // Fourier space.
+        const double R123 = clamp(R12 * R23, 1e-5, 0.9999);
+        const double r123 = std::sqrt(R123);
+        const double Rs = sqr(T121) * R23 / (1 - R123);
+        out.dc[c] = R12 + Rs;
+        out.c1[c] = (Rs - T121) * r123;
+        out.c2[c] = out.c1[c] * r123;
     }
-    // Belcour & Barla, Eq. 10: the DC term and the first two orders of the Airy sum in Fourier
-    // space, each order's cosine integrated against the sensitivity.
-    const double opd = 2 * iridescence_ior * thickness_nm * cos_theta_2;
+    return out;
+}
+
+/// The optical path difference 2 η d cos θ2 of one round trip in the film.
+double threejs_opd(const ThreejsFilmTerms& terms, double thickness_nm) {
+    return 2 * terms.iridescence_ior * thickness_nm * terms.cos_theta_2;
+}
+
+}  // namespace
+
+std::optional<Rgbd> threejs_iridescence_range_closed_form(double outside_ior, double film_ior,
+                                                          double cos_theta_1, double min_nm,
+                                                          double max_nm, const Rgbd& base_f0) {
+    if (!(min_nm >= kThreejsFadeNm && max_nm > min_nm)) return std::nullopt;
+    const ThreejsFilmTerms terms =
+        threejs_film_terms(outside_ior, film_ior, cos_theta_1, min_nm, base_f0);
+    if (terms.total_reflection) return Rgbd(1.0);
+    const double opd0 = threejs_opd(terms, min_nm), opd1 = threejs_opd(terms, max_nm);
+    const Rgbd bound1 = belcour_sensitivity_srgb_bound(opd0, terms.phi),
+               bound2 = belcour_sensitivity_srgb_bound(2 * opd0, terms.phi * 2.0);
+    for (int c = 0; c < 3; ++c)
+        if (terms.dc[c] - 2 * std::abs(terms.c1[c]) * bound1[c] -
+                2 * std::abs(terms.c2[c]) * bound2[c] <
+            0)
+            return std::nullopt;
+    const Rgbd s1 = sensitivity_srgb_mean(opd0, opd1, terms.phi),
+               s2 = sensitivity_srgb_mean(2 * opd0, 2 * opd1, terms.phi * 2.0);
+    Rgbd I;
+    for (int c = 0; c < 3; ++c)
+        I[c] = terms.dc[c] + terms.c1[c] * 2 * s1[c] + terms.c2[c] * 2 * s2[c];
+    return I;
+}
+
+namespace {
+
+/// three.js's film before its final clamp at 0 (Belcour & Barla, Eq. 10: each order's cosine
+/// integrated against the sensitivity).
+Rgbd threejs_unclamped(double outside_ior, double film_ior, double cos_theta_1, double thickness_nm,
+                       const Rgbd& base_f0) {
+    const ThreejsFilmTerms terms =
+        threejs_film_terms(outside_ior, film_ior, cos_theta_1, thickness_nm, base_f0);
+    if (terms.total_reflection) return Rgbd(1.0);
+    const double opd = threejs_opd(terms, thickness_nm);
+    const Rgbd s1 = belcour_sensitivity_srgb(opd, terms.phi),
+               s2 = belcour_sensitivity_srgb(2 * opd, terms.phi * 2.0);
     Rgbd I;
     for (int c = 0; c < 3; ++c) {
-        const double R123 = clamp(R12 * R23[c], 1e-5, 0.9999);
-        const double r123 = std::sqrt(R123);
-        const double Rs = sqr(T121) * R23[c] / (1 - R123);
-        I[c] = R12 + Rs;
-        double Cm = Rs - T121;
-        for (int m = 1; m <= 2; ++m) {
-            Cm *= r123;
-            I[c] += Cm * 2 * sensitivity_srgb(m * opd, Rgbd(m * phi[c]))[c];
-        }
-        I[c] = std::max(I[c], 0.0);
+        I[c] = terms.dc[c];
+        I[c] += terms.c1[c] * 2 * s1[c];
+        I[c] += terms.c2[c] * 2 * s2[c];
     }
+    return I;
+}
+
+/// The root of a function of d with a sign change between lo and hi, by bisection to the last
+/// bit.
+template <typename F>
+double bisect(double lo, double hi, F&& negative_at) {
+    const bool negative_lo = negative_at(lo);
+    for (int i = 0; i < 200; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        if (!(mid > lo && mid < hi)) break;
+        (negative_at(mid) == negative_lo ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+/// Where three.js's film over [min_nm, max_nm] jumps or kinks, so that quadrature between them
+/// keeps its order: in the first 0.03 nm the film's index passes each channel's base index (its
+/// phase shift jumps by π) and the index at which light is totally reflected in it, and the fade
+/// ends; anywhere the
+/// clamp at 0 may cut a channel (a kink: the sign changes of the unclamped value, sampled
+/// `per_period` times per period of the interference and bisected).
+std::vector<double> threejs_breakpoints(double outside_ior, double film_ior, double cos_theta_1,
+                                        double min_nm, double max_nm, const Rgbd& base_f0,
+                                        double period_nm) {
+    std::vector<double> breaks;
+    const double fade_hi = std::min(max_nm, kThreejsFadeNm);
+    if (min_nm < fade_hi) {
+        auto ior = [&](double d) {
+            return threejs_film_terms(outside_ior, film_ior, cos_theta_1, d, base_f0)
+                .iridescence_ior;
+        };
+        std::vector<double> jumps = {outside_ior * std::sqrt(std::max(0.0, 1 - sqr(cos_theta_1)))};
+        for (int c = 0; c < 3; ++c) {
+            const double s = std::sqrt(clamp(base_f0[c], 0.0, 0.9999));
+            jumps.push_back((1 + s) / (1 - s));
+        }
+        for (double v : jumps)
+            if ((ior(min_nm) - v) * (ior(fade_hi) - v) < 0)
+                breaks.push_back(bisect(min_nm, fade_hi, [&](double d) { return ior(d) < v; }));
+        // The fade's end, where the index's second derivative jumps (a feature far narrower than
+        // a period).
+        if (max_nm > kThreejsFadeNm) breaks.push_back(kThreejsFadeNm);
+    }
+    constexpr int per_period = 64;
+    const int samples = int(std::clamp(std::ceil((max_nm - min_nm) / period_nm) * per_period,
+                                       double(per_period), 4096.0));
+    Rgbd previous = threejs_unclamped(outside_ior, film_ior, cos_theta_1, min_nm, base_f0);
+    for (int i = 1; i <= samples; ++i) {
+        const double lo = min_nm + (max_nm - min_nm) * (i - 1) / samples,
+                     hi = min_nm + (max_nm - min_nm) * i / samples;
+        const Rgbd next = threejs_unclamped(outside_ior, film_ior, cos_theta_1, hi, base_f0);
+        for (int c = 0; c < 3; ++c)
+            if ((previous[c] < 0) != (next[c] < 0))
+                breaks.push_back(bisect(lo, hi, [&](double d) {
+                    return threejs_unclamped(outside_ior, film_ior, cos_theta_1, d, base_f0)[c] < 0;
+                }));
+        previous = next;
+    }
+    std::sort(breaks.begin(), breaks.end());
+    return breaks;
+}
+
+}  // namespace
+
+Rgbd threejs_iridescence(double outside_ior, double film_ior, double cos_theta_1,
+                         double thickness_nm, const Rgbd& base_f0) {
+    Rgbd I = threejs_unclamped(outside_ior, film_ior, cos_theta_1, thickness_nm, base_f0);
+    for (int c = 0; c < 3; ++c)
+        I[c] = std::max(I[c], 0.0);
     return I;
 }
 
 Rgbd threejs_iridescence_range(double outside_ior, double film_ior, double cos_theta_1,
                                double min_nm, double max_nm, const Rgbd& base_f0) {
-    // The sensitivity's fastest cosine, 2.2399e6 m⁻¹ of optical path 2 η d cos θ2, has a period
-    // in d of at least 1/(2.2399e6 · 1e-9 · 2 η) nm.
-    const double period = 1 / (2.2399e6 * 1e-9 * 2 * std::max(film_ior, 1e-3));
-    return thickness_average(min_nm, max_nm, period, [&](double d) {
-        return threejs_iridescence(outside_ior, film_ior, cos_theta_1, d, base_f0);
-    });
+    if (!(max_nm > min_nm))
+        return threejs_iridescence(outside_ior, film_ior, cos_theta_1, max_nm, base_f0);
+    // Beyond the fade, in closed form where that is exact.
+    const double split = clamp(kThreejsFadeNm, min_nm, max_nm);
+    Rgbd sum(0.0);
+    double rest_lo = min_nm, rest_hi = max_nm;
+    if (max_nm > split)
+        if (const auto closed = threejs_iridescence_range_closed_form(
+                outside_ior, film_ior, cos_theta_1, split, max_nm, base_f0)) {
+            sum += *closed * (max_nm - split);
+            rest_hi = split;
+        }
+    if (rest_hi > rest_lo) {
+        // The rest by quadrature between the film's jumps and kinks. The sensitivity's fastest
+        // cosine, 2.2399e6 m⁻¹ of optical path 2 η d cos θ2, turns in the second order with a
+        // period in d of at least 1/(2 · 2.2399e6 · 1e-9 · 2 η) nm (η at most the larger of the
+        // film's and the outside's index, between which the fade moves it).
+        const double period =
+            1 / (2 * 2.2399e6 * 1e-9 * 2 * std::max({film_ior, outside_ior, 1e-3}));
+        auto at_thickness = [&](double d) {
+            return threejs_iridescence(outside_ior, film_ior, cos_theta_1, d, base_f0);
+        };
+        std::vector<double> edges = threejs_breakpoints(outside_ior, film_ior, cos_theta_1, rest_lo,
+                                                        rest_hi, base_f0, period);
+        edges.insert(edges.begin(), rest_lo);
+        edges.push_back(rest_hi);
+        for (std::size_t i = 0; i + 1 < edges.size(); ++i)
+            if (edges[i + 1] > edges[i])
+                sum += thickness_average(edges[i], edges[i + 1], period, at_thickness) *
+                       (edges[i + 1] - edges[i]);
+    }
+    return sum / (max_nm - min_nm);
 }
 
 namespace {

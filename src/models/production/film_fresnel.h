@@ -19,6 +19,7 @@
 #include "physics/thin_film.h"
 
 #include <cstddef>
+#include <optional>
 
 namespace lamina {
 
@@ -37,19 +38,48 @@ double schlick_weight_spherical_gaussian(double c);
 /// period of the interference, at most 2048).
 Rgbd film_reflectance_exact(const FilmOptics& film, double cos_theta);
 
+/// Belcour & Barla 2017's sensitivity S(OPD, shift) in linear sRGB: the Fourier transform of the
+/// CIE 1931 colour matching functions at the optical path difference OPD (nm, ≥ 0), each of X, Y
+/// and Z turned by its shift, by the paper's fit of each as a sum of Gaussians (their
+/// supplemental material; the constants as three.js's evalSensitivity carries them: amplitudes,
+/// centres and variances in the spatial frequency of metres, and the normalization 1.0685e-7
+/// that makes the m = 0 term white), then the XYZ → linear sRGB (Rec. 709 primaries, D65) matrix
+/// of IEC 61966-2-1 to seven digits.
+Rgbd belcour_sensitivity_srgb(double opd_nm, const Rgbd& shift);
+
+/// A bound on |belcour_sensitivity_srgb(OPD, shift)| per channel for every OPD ≥ opd0_nm ≥ 0:
+/// the Gaussians' windows at opd0_nm through the matrix's magnitudes, and, where every shift is a
+/// whole multiple of π, no more than the supremum over all OPD of that pattern of signs.
+Rgbd belcour_sensitivity_srgb_bound(double opd0_nm, const Rgbd& shift);
+
 /// three.js's evalIridescence (KHR_materials_iridescence; Belcour & Barla 2017, Eqs. 6–10 and
 /// their Gaussian fit of the sensitivity): a film of index film_ior and thickness thickness_nm
 /// between a medium of index outside_ior and a base given by its normal reflectance base_f0 (per
 /// channel, read as a dielectric of index (1 + √F0)/(1 − √F0) against air), lit at cos_theta_1.
-/// The result is linear sRGB, clamped below at 0.
+/// The result is linear sRGB, clamped below at 0. As three.js passes the three channels' phase
+/// shifts (0 or π at the base, per channel) to its sensitivity as one vector, the shift of the R
+/// channel's base turns the X lobes, G's the Y lobe and B's the Z lobe, for every channel.
 Rgbd threejs_iridescence(double outside_ior, double film_ior, double cos_theta_1,
                          double thickness_nm, const Rgbd& base_f0);
 
 /// threejs_iridescence averaged over the thickness range [min_nm, max_nm] (the mean of what a
-/// thickness texture uniform over the range shows), by Gauss–Legendre quadrature (32 nodes per
-/// period of the interference, at most 2048 nodes); min_nm = max_nm is one thickness.
+/// thickness texture uniform over the range shows); min_nm = max_nm is one thickness. Beyond the
+/// film's first 0.03 nm only the sensitivities depend on the thickness, through an optical path
+/// linear in it, so the mean is in closed form (each Gaussian-windowed cosine of the sensitivity
+/// integrated exactly: models/numerics/gaussian_fourier.h) wherever three.js's clamp at 0 cannot
+/// act in the range; elsewhere, and over the first 0.03 nm, by Gauss–Legendre quadrature (32
+/// nodes per period of the interference, at most 2048 nodes).
 Rgbd threejs_iridescence_range(double outside_ior, double film_ior, double cos_theta_1,
                                double min_nm, double max_nm, const Rgbd& base_f0);
+
+/// The mean of threejs_iridescence over thickness uniform in [min_nm, max_nm] in closed form,
+/// where it is exact: 0.03 nm ≤ min_nm < max_nm (beyond three.js's fade of the film's index), and
+/// three.js's clamp at 0 cannot act anywhere in the range (per channel, the DC term exceeds twice
+/// the orders' coefficients times a bound on the sensitivity's magnitude from the range's smallest
+/// optical path on). Nothing elsewhere.
+std::optional<Rgbd> threejs_iridescence_range_closed_form(double outside_ior, double film_ior,
+                                                          double cos_theta_1, double min_nm,
+                                                          double max_nm, const Rgbd& base_f0);
 
 /// Gulbrandsen 2014 ("Artist friendly metallic Fresnel", JCGT 3(4)), Eqs. 3 and 4: the complex
 /// index n + ik whose normal reflectance is r (clamped to [0, r_max]: 0.99 as openpbr-bsdf clamps

@@ -24,6 +24,7 @@
 #include <cmath>
 #include <complex>
 #include <iostream>
+#include <numbers>
 
 namespace lamina {
 namespace {
@@ -101,6 +102,88 @@ TEST(FilmFresnel, RangeIsTheMeanOverTheThickness) {
             EXPECT_NEAR(got_cycles[c], want_cycles[c], 1e-6) << "mu " << mu << " channel " << c;
         }
     }
+}
+
+// The bound on Belcour & Barla's sensitivity that decides where three.js's range mean is in
+// closed form: never below |S| (sampled every 0.005 nm of optical path over 0–20,000 nm, each of
+// the eight patterns of 0/π shifts, and from three starting paths on), and for the patterns within
+// 3 % of the sampled supremum (a bound far looser would send most ranges to quadrature).
+TEST(FilmFresnel, SensitivityBoundHolds) {
+    const double pi = std::numbers::pi;
+    for (int pattern = 0; pattern < 8; ++pattern) {
+        const Rgbd shift(pattern & 1 ? pi : 0.0, pattern & 2 ? pi : 0.0,
+                         pattern & 4 ? 2 * pi : 0.0);
+        for (double opd0 : {0.0, 700.0, 3000.0}) {
+            const Rgbd bound = belcour_sensitivity_srgb_bound(opd0, shift);
+            Rgbd sup(0.0);
+            for (double opd = opd0; opd <= 20000; opd += 0.005) {
+                const Rgbd s = belcour_sensitivity_srgb(opd, shift);
+                for (int c = 0; c < 3; ++c)
+                    sup[c] = std::max(sup[c], std::abs(s[c]));
+            }
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_LE(sup[c], bound[c]) << "pattern " << pattern << " from " << opd0;
+                if (opd0 == 0) {
+                    EXPECT_LE(bound[c], 1.03 * sup[c]) << "pattern " << pattern;
+                }
+            }
+        }
+    }
+}
+
+// three.js's film over a thickness range: where its clamp cannot act the closed form is the mean
+// (a midpoint rule of 400,000 points beyond the fade, to 1e-9), and the range function equals the
+// mean wherever it takes quadrature instead (the clamp possible, a sub-nanometre range, ranges
+// reaching into the first 0.03 nm, where the film's index fades and its phase shifts jump). Bases
+// whose F0 puts some channels' index under the film's and others over it (phase shifts 0 and π in
+// one evaluation) included; grazing light as well. The midpoint rule is only first order across a
+// jump (an error up to h/range times the jump: at most 4 jumps of at most 2, as |I| ≤ 1 + 2·2·|C|
+// with |C| ≤ 1/4 and the clamp), so the fade gets 10⁶ points: the reference's own error there is
+// up to 8·10⁻⁶ over [0.01, 0.02] nm, 6·10⁻¹⁰ over [0, 400] nm.
+TEST(FilmFresnel, ThreejsRangeMeanIsExactWhereTheClampCannotAct) {
+    struct Range {
+        double min_nm, max_nm;
+    };
+    const Range ranges[] = {{100, 400},   {200, 600}, {0.03, 150},
+                            {500, 500.5}, {0, 400},   {0.01, 0.02}};
+    int closed_forms = 0, eligible = 0;
+    for (double film_ior : {1.38, 1.8, 2.5})
+        for (const Rgbd& f0 : {Rgbd(0.9, 0.5, 0.2), Rgbd(0.9, 0.1, 0.04), Rgbd(0.95)})
+            for (double mu : {1.0, 0.02})
+                for (const Range& r : ranges) {
+                    auto film = [&](double d) {
+                        return threejs_iridescence(1.0, film_ior, mu, d, f0);
+                    };
+                    const double fade = std::clamp(0.03, r.min_nm, r.max_nm);
+                    Rgbd want(0.0);
+                    if (fade > r.min_nm)
+                        want += midpoint_mean(r.min_nm, fade, 1000000, film) * (fade - r.min_nm);
+                    if (r.max_nm > fade)
+                        want += midpoint_mean(fade, r.max_nm, 400000, film) * (r.max_nm - fade);
+                    want = want / (r.max_nm - r.min_nm);
+                    const double tolerance = r.max_nm <= 0.03 ? 8e-6 : 1e-9;
+                    const std::string what =
+                        fmt::format("film {} F0 ({}, {}, {}) mu {} [{}, {}]", film_ior, f0[0],
+                                    f0[1], f0[2], mu, r.min_nm, r.max_nm);
+                    const Rgbd got =
+                        threejs_iridescence_range(1.0, film_ior, mu, r.min_nm, r.max_nm, f0);
+                    const auto closed = threejs_iridescence_range_closed_form(
+                        1.0, film_ior, mu, r.min_nm, r.max_nm, f0);
+                    if (closed) ++closed_forms;
+                    if (r.min_nm < 0.03) {
+                        EXPECT_FALSE(closed) << what;
+                    } else {
+                        ++eligible;
+                    }
+                    for (int c = 0; c < 3; ++c) {
+                        EXPECT_NEAR(got[c], want[c], tolerance) << what << " channel " << c;
+                        if (closed) {
+                            EXPECT_NEAR((*closed)[c], want[c], 1e-9) << what << " channel " << c;
+                        }
+                    }
+                }
+    // Most ranges beyond the fade take the closed form (metals' F0 and films of 1.38–2.5).
+    EXPECT_GE(closed_forms, eligible / 2) << closed_forms << " of " << eligible;
 }
 
 // three.js turns its iridescence off at thickness 0 (lights_fragment_begin), openpbr-bsdf fades
