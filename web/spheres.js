@@ -3,7 +3,8 @@
 // under a procedural environment) rendered by a fragment shader that adds one Monte-Carlo sample
 // per pixel per pass to a float accumulation target, with `lamina render`'s light-sampling mixture
 // (cosine, a GGX lobe about the mirror of the view, the cap lights) and its one-sample balance
-// weights. The BRDF is one of:
+// weights, plus a smooth coat's delta lobes exactly (their reflectance times the radiance from the
+// view's mirror direction), as lamina render adds them. The BRDF is one of:
 //   - "lamina-1": include/lamina1/lamina1.glsl (lamina1_eval) on the state `lamina export
 //     --lamina1-gpu` (or `lamina study`) writes, in an R32F texture 256 texels wide;
 //   - "lamina-coat": docs/lamina-coat/lamina_coat.glsl (lamina_coat_eval) on a material of
@@ -120,14 +121,20 @@ vec3 sp_table(int k, float theta_o, float phi_o) {
 }
 #endif
 
+#if MODEL == 1
+LaminaCoatMaterial sp_material() {
+  LaminaCoatMaterial m;
+  m.eta = mc_eta; m.alpha_coat = mc_alpha_coat; m.tau = mc_tau; m.conductor = mc_conductor == 1;
+  m.albedo = mc_albedo; m.base_eta = mc_base_eta; m.base_k = mc_base_k; m.alpha_base = mc_alpha_base;
+  return m;
+}
+#endif
+
 vec3 sp_eval(vec3 wi, vec3 wo) {
 #if MODEL == 0
   return lamina1_eval(wi, wo);
 #elif MODEL == 1
-  LaminaCoatMaterial m;
-  m.eta = mc_eta; m.alpha_coat = mc_alpha_coat; m.tau = mc_tau; m.conductor = mc_conductor == 1;
-  m.albedo = mc_albedo; m.base_eta = mc_base_eta; m.base_k = mc_base_k; m.alpha_base = mc_alpha_base;
-  return lamina_coat_eval(m, wi, wo);
+  return lamina_coat_eval(sp_material(), wi, wo);
 #else
   if (wi.z <= 0.0 || wo.z <= 0.0) return vec3(0.0);
   // The table's frame: the light at φ = 0, wo at φo (folded tables: φo ∈ [0°, 180°]).
@@ -141,6 +148,18 @@ vec3 sp_eval(vec3 wi, vec3 wo) {
   int k1 = min(k0 + 1, n_inc - 1);
   float t = k1 > k0 ? clamp((theta_i - theta_inc[k0]) / (theta_inc[k1] - theta_inc[k0]), 0.0, 1.0) : 0.0;
   return max(mix(sp_table(k0, theta_o, phi_o), sp_table(k1, theta_o, phi_o), t), vec3(0.0));
+#endif
+}
+
+// The delta lobes' reflectance towards the mirror direction of wo (a smooth coat, and a smooth base
+// under it): lamina1_delta, lamina_coat_delta; a binned table holds none (its bins average them).
+vec3 sp_delta(vec3 wo) {
+#if MODEL == 0
+  return lamina1_delta(wo);
+#elif MODEL == 1
+  return lamina_coat_delta(sp_material(), wo);
+#else
+  return vec3(0.0);
 #endif
 }
 
@@ -212,6 +231,10 @@ void main() {
         float p = sp_pdf(d, wi, wo);
         if (p > 0.0) L = sp_eval(wi, wo) * env_radiance(d) * (wi.z / p);
       }
+      // Delta lobes, exactly, as render/renderer.cpp adds them (reciprocity: the lobes seen from
+      // wo): their reflectance times the radiance from the view's mirror direction 2(n·v)n − v.
+      vec3 R = sp_delta(wo);
+      if (R != vec3(0.0)) L += R * env_radiance(2.0 * n.z * n - vec3(0.0, 0.0, 1.0));
     }
   }
   float m = (L.r + L.g + L.b) / 3.0;

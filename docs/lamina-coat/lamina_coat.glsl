@@ -143,3 +143,22 @@ vec3 lamina_coat_eval(LaminaCoatMaterial m, vec3 wi, vec3 wo) {
     }
     return vec3(coat) + base * tint * (t / (eta * eta));
 }
+
+// The delta lobes' reflectance towards the mirror direction of wi (LaminaCoat's delta_lobes in
+// src/models/lamina_coat/lamina_coat.cpp, summed: they share that direction): a smooth coat's
+// Fresnel reflectance F(μi), and a smooth conductor base (α_b = 0: base and coat smooth) seen
+// through it, t(μi)² e^(−2 s τ/μt) F_base(μt). A renderer adds it times the radiance from the
+// mirror direction.
+vec3 lamina_coat_delta(LaminaCoatMaterial m, vec3 wi) {
+    if (wi.z <= 0.0) return vec3(0.0);
+    float r = sqrt(m.alpha_coat), eta = m.eta;
+    vec3 R = vec3(m.alpha_coat == 0.0 ? lc_fresnel_dielectric(wi.z, eta) : 0.0);
+    float alpha_b = sqrt(m.alpha_base * m.alpha_base + LC_ROUGHENING * m.alpha_coat * m.alpha_coat);
+    if (m.conductor && alpha_b <= 0.0) {
+        float mu_t = sqrt(1.0 - (1.0 - wi.z * wi.z) / (eta * eta));
+        float t = lc_transmittance(wi.z, r, eta);
+        R += lc_fresnel_conductor(mu_t, m.base_eta, m.base_k) *
+             exp(-2.0 * m.tau * (1.0 + LC_TINT_PATH * r) / mu_t) * (t * t);
+    }
+    return R;
+}

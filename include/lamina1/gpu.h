@@ -4,9 +4,10 @@
 // line for line (lamina1/eval.h), so every curve is interpolated there as here.
 //
 // Covered by eval: the reflection (wo.z > 0) of a coat, rough or smooth (its delta lobes are not in
-// eval), with an absorbing medium, over a Lambertian, conductor or dielectric base, with the
-// default choices or any of spread, first-order-lobe, eta2-factor, inside-exit,
-// lobe-normalization, inter-reflection and directional-transmittance. Not covered (gpu_state
+// eval: lamina1_delta gives their reflectance at the mirror direction, Bsdf::delta_lobes), with
+// an absorbing medium, over a Lambertian, conductor or dielectric base, with the default choices
+// or any of spread, first-order-lobe, eta2-factor, inside-exit, lobe-normalization,
+// inter-reflection and directional-transmittance. Not covered (gpu_state
 // says why and returns nothing): scattering media, the multiple-scattering orders, anisotropic
 // interfaces and a slab's transmission (the GLSL returns 0 for wo.z < 0). Covered by sample and
 // pdf: the same but slabs (their mixture holds the transmission's lobes); the base lobe's weight in
@@ -56,7 +57,8 @@ enum GpuFlag : unsigned {
     kGpuTTopInExact = 1u << 11,
     kGpuSpreadNormal = 1u << 12,
     kGpuSpreadOff = 1u << 13,
-    kGpuSampling = 1u << 14,  ///< lamina1_sample and lamina1_pdf cover it (not a slab)
+    kGpuSampling = 1u << 14,         ///< lamina1_sample and lamina1_pdf cover it (not a slab)
+    kGpuInterReflection = 1u << 15,  ///< the choice inter-reflection (lamina1_delta's series)
 };
 
 inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
@@ -86,6 +88,7 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     flag(ch_.spread == Options::Spread::Normal, kGpuSpreadNormal);
     flag(ch_.spread == Options::Spread::Off, kGpuSpreadOff);
     flag(!support_.btdf, kGpuSampling);
+    flag(ch_.inter_reflection, kGpuInterReflection);
     v[0] = float(flags);  // exact in float32 (fewer than 2^24)
     v[1] = float(int(layers_.base));
     v[2] = float(eta0_);

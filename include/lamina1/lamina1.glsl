@@ -249,6 +249,30 @@ vec3 lamina1_eval(vec3 wi, vec3 wo) {
     return f;
 }
 
+// The delta lobes' reflectance towards the mirror direction of wi: lamina1::Bsdf::delta_lobes's
+// reflected lobes summed (they share that direction); 0 for a rough coat. A smooth coat reflects
+// its Fresnel reflectance F(μi); over a smooth conductor or dielectric base every order is
+// specular too: R_b a² T² Σ_k (F R_b a²)^k at the inside cosine (the sum with the choice
+// inter-reflection, flag 15, else its first term). A renderer adds it times the radiance from the
+// mirror direction (lamina render does: docs/rendering.md §2).
+vec3 lamina1_delta(vec3 wi) {
+    if (wi.z <= 0.0 || l1_at(4) > 0.0) return vec3(0.0);
+    float F = l1_fresnel_dielectric(wi.z, l1_at(2));
+    if (int(l1_at(1)) == 0 || l1_at(5) > 0.0) return vec3(F);
+    vec3 w_in = l1_refract_in(wi);
+    vec3 a = l1_attenuation(w_in.z);
+    vec3 Rb = l1_base_fresnel(w_in.z);
+    float T = 1.0 - F;
+    vec3 series = vec3(1.0);
+    if (l1_flag(15))
+        for (int c = 0; c < 3; ++c) {
+            // F R_b a² = 1 only where nothing enters (F = 1), where T = 0: no series.
+            float round_trip = F * Rb[c] * a[c] * a[c];
+            series[c] = round_trip < 1.0 ? 1.0 / (1.0 - round_trip) : 0.0;
+        }
+    return vec3(F) + Rb * a * a * series * (T * T);
+}
+
 // ---- Sampling (lamina1/sampling.h: the mixture of the lobes, each drawn by its own rule) ----
 
 // D_w(wm) = G1(w) max(0, w·wm) D(wm) / cos θ (Heitz 2014, Eq. 38), w above.

@@ -3,7 +3,16 @@
 // texture, the directions into an RGBA32F one, one fragment per direction pair evaluates
 // lamina1_eval into an RGBA32F target, and the values read back must equal `lamina eval
 // --directions` (the C++) to TOL relative (float32 arithmetic; docs/lamina1.md).
-// usage: node glsl_test.js REPO_ROOT DIR CASE...   (DIR/CASE.state, CASE.dirs.csv, CASE.ref.csv)
+// lamina1_delta(wi), the delta lobes' reflectance towards the mirror direction, against the closed
+// form of a smooth coat (computed here, independently of lamina): 0 for a rough coat; the Fresnel
+// reflectance F(μi; η0) (Born & Wolf §1.5.2) over a Lambertian or rough base; over a smooth
+// conductor base, the incoherent sum of the two interfaces' reflections,
+// F + R_b a² (1 − F)² / (1 − F R_b a²), with R_b the conductor's Fresnel reflectance for η + iκ
+// relative to the coat at the refracted cosine μt (complex Snell's law) and a = e^(−τ/μt) the
+// coat's transmittance (without inter-reflection, the series' first term: 1 in place of
+// 1/(1 − F R_b a²)), to TOL relative.
+// usage: node glsl_test.js REPO_ROOT DIR CASE...   (DIR/CASE.state, CASE.dirs.csv, CASE.ref.csv,
+// CASE.stack.json, CASE.options)
 "use strict";
 const fs = require("fs");
 const path = require("path");
@@ -25,6 +34,50 @@ function readCsv(file) {
 function direction(thetaDeg, phiDeg) {
   const t = (thetaDeg * Math.PI) / 180, p = (phiDeg * Math.PI) / 180;
   return [Math.sin(t) * Math.cos(p), Math.sin(t) * Math.sin(p), Math.cos(t)];
+}
+
+// Complex numbers as [re, im].
+const cx = {
+  add: (a, b) => [a[0] + b[0], a[1] + b[1]],
+  sub: (a, b) => [a[0] - b[0], a[1] - b[1]],
+  mul: (a, b) => [a[0] * b[0] - a[1] * b[1], a[0] * b[1] + a[1] * b[0]],
+  div: (a, b) => {
+    const d = b[0] * b[0] + b[1] * b[1];
+    return [(a[0] * b[0] + a[1] * b[1]) / d, (a[1] * b[0] - a[0] * b[1]) / d];
+  },
+  sqrt: (a) => {
+    const r = Math.hypot(a[0], a[1]), re = Math.sqrt((r + a[0]) / 2);
+    return [re, re > 0 ? a[1] / (2 * re) : Math.sqrt((r - a[0]) / 2)];
+  },
+  abs2: (a) => a[0] * a[0] + a[1] * a[1],
+};
+// Unpolarized Fresnel reflectance from a medium of index 1 onto index n (complex: n + iκ) at
+// cos θ = c: r_s = (c − n cos θt)/(c + n cos θt), r_p = (n c − cos θt)/(n c + cos θt) =
+// (n² c − n cos θt)/(n² c + n cos θt), with n cos θt = √(n² − sin²θ) (Born & Wolf §1.5.2, §14.2).
+function fresnel(c, n) {
+  const ncos = cx.sqrt(cx.sub(cx.mul(n, n), [1 - c * c, 0])), cc = [c, 0];
+  const rs = cx.div(cx.sub(cc, ncos), cx.add(cc, ncos));
+  const n2c = cx.mul(cx.mul(n, n), cc);
+  const rp = cx.div(cx.sub(n2c, ncos), cx.add(n2c, ncos));
+  return 0.5 * (cx.abs2(rs) + cx.abs2(rp));
+}
+const rgb = (v) => (Array.isArray(v) ? v : [v, v, v]);
+// The closed form of the smooth coat's specular reflection of `stack` at cos θi = mu (RGB).
+function smoothDelta(stack, options, mu) {
+  const coat = stack.layers[0], base = stack.layers[1].interface;
+  const eta0 = coat.interface.eta / (stack.ambient_eta || 1);
+  if (coat.interface.alpha > 0) return [0, 0, 0];
+  const F = fresnel(mu, [eta0, 0]);
+  if (base.type === "lambertian" || base.alpha > 0) return [F, F, F];
+  const muT = Math.sqrt(1 - (1 - mu * mu) / (eta0 * eta0));
+  const tau = rgb(coat.medium ? coat.medium.tau_a : 0), series = !/inter-reflection=off/.test(options);
+  return [0, 1, 2].map((c) => {
+    const Rb = base.type === "conductor"
+      ? fresnel(muT, [rgb(base.eta)[c] / coat.interface.eta, rgb(base.k)[c] / coat.interface.eta])
+      : fresnel(muT, [base.eta / coat.interface.eta, 0]);
+    const a2 = Math.exp(-2 * tau[c] / muT);
+    return F + (Rb * a2 * (1 - F) * (1 - F)) / (series ? 1 - F * Rb * a2 : 1);
+  });
 }
 
 // The GLSL sampler against the C++ one (sampling.csv: pdf at wo; the sample drawn from u, its
@@ -75,7 +128,7 @@ function checkSampling(name, rows, pdfs, samples) {
     const ref = readCsv(path.join(dir, name + ".ref.csv"));
     // wi at φ = 0 (lamina's convention), wo at (θo, φo).
     const pairs = dirs.map((d) => [direction(+d.theta_i, 0), direction(+d.theta_o, +d.phi_o)]);
-    const modes = [0];
+    const modes = [0, 3];
     const samplingFile = path.join(dir, name + ".sampling.csv");
     const sampling = fs.existsSync(samplingFile) ? readCsv(samplingFile) : null;
     if (sampling) {
@@ -100,8 +153,8 @@ function checkSampling(name, rows, pdfs, samples) {
           vec3 wi = texelFetch(pairs, ivec2(3 * i, 0), 0).xyz;
           vec3 wo = texelFetch(pairs, ivec2(3 * i + 1, 0), 0).xyz;
           vec3 u = texelFetch(pairs, ivec2(3 * i + 2, 0), 0).xyz;
-          if (mode == 0) {
-            color = vec4(lamina1_eval(wi, wo), 1.0);
+          if (mode == 0 || mode == 3) {
+            color = vec4(mode == 0 ? lamina1_eval(wi, wo) : lamina1_delta(wi), 1.0);
             return;
           }
           vec3 ws, weight;
@@ -197,7 +250,28 @@ function checkSampling(name, rows, pdfs, samples) {
       console.log(`FAIL ${name}: above ${TOL}`);
       failures++;
     }
-    if (sampling) failures += checkSampling(name, sampling, outs[1], outs[2]);
+    // lamina1_delta against the closed form.
+    const stack = JSON.parse(fs.readFileSync(path.join(dir, name + ".stack.json"), "utf8"));
+    const options = fs.readFileSync(path.join(dir, name + ".options"), "utf8");
+    let worstDelta = 0, whereDelta = "", largest = 0;
+    pairs.forEach(([wi], i) => {
+      const want = smoothDelta(stack, options, wi[2]);
+      for (let c = 0; c < 3; c++) {
+        const g = outs[1][4 * i + c], err = Math.abs(g - want[c]) / Math.max(want[c], 1e-6);
+        largest = Math.max(largest, want[c]);
+        if (!(err <= worstDelta)) {
+          worstDelta = isNaN(err) ? Infinity : err;
+          whereDelta = `θi ${dirs[i].theta_i} ch ${c}: ${g} vs ${want[c]}`;
+        }
+      }
+    });
+    console.log(`${name}: lamina1_delta (largest ${largest.toFixed(4)}) against the closed form, max ` +
+      `relative difference ${worstDelta.toExponential(2)} (${whereDelta})`);
+    if (!(worstDelta <= TOL)) {
+      console.log(`FAIL ${name}: lamina1_delta above ${TOL}`);
+      failures++;
+    }
+    if (sampling) failures += checkSampling(name, sampling, outs[2], outs[3]);
   }
   await close();
   process.exit(failures ? 1 : 0);

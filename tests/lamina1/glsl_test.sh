@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # lamina-1's GLSL form against the C++ in headless Chromium (glsl_test.js): a plastic, a coated
-# rough gold with an absorbing coat, a metallic paint, a slab's reflection and two of the model's
-# other choices; 300 direction pairs each, fixed seed; and a stack the form does not cover refused.
+# rough gold with an absorbing coat, a metallic paint, a slab's reflection, two of the model's
+# other choices and smooth coats (a plastic, a gold with coat and base smooth, with and without
+# inter-reflection); 300 direction pairs each, fixed seed; lamina1_delta against the closed form of
+# a smooth coat's specular reflection (glsl_test.js); and a stack the form does not cover refused.
 # The sampler (not slabs) against the C++ one through the Python module, where it is built
 # (BUILD_DIR/python, for the interpreter PYTHON): the pdf at those pairs and a draw from fixed
 # uniforms at each.
@@ -31,7 +33,10 @@ PY
     if ! "$lamina" eval --model lamina-1 --stack "$stack" "${opts[@]}" \
         --directions "$tmp/$name.dirs.csv" --out "$tmp/$name.ref.csv" > "$tmp/$name.log" 2>&1; then
         fail "eval $name: $(cat "$tmp/$name.log")"; return; fi
-    if [ "$name" != slab ] && [ -n "$build" ] && [ -d "$build/python/lamina" ]; then
+    cp "$stack" "$tmp/$name.stack.json"
+    echo "$@" > "$tmp/$name.options"
+    if [ "$name" != slab ] && [[ "$name" != smooth-* ]] && [ -n "$build" ] &&
+        [ -d "$build/python/lamina" ]; then
         # Per pair: the C++ pdf at (wi, wo) and the draw from u, with whether u0 sits within 1e-3
         # of a lobe boundary (the draws at u0 ± 1e-3 differ from the one at u0).
         if ! PYTHONPATH="$build/python" "$python" - "$tmp/$name" "$stack" "$@" <<'PY' > "$tmp/$name.log" 2>&1
@@ -67,6 +72,21 @@ add_case metallic-paint "$root/examples/metallic-paint.json"
 add_case slab "$root/examples/slab.json"
 add_case gold-ggx-lobe "$root/examples/frosted-gold.json" first-order-lobe=ggx spread=normal
 add_case plastic-fresnel "$root/examples/plastic.json" coat-transmittance=fresnel
+# Smooth coats (delta lobes, lamina1_delta): the plastic's coat smooth; gold with coat and base
+# smooth under an absorbing coat, with the inter-reflection series and without it.
+python3 - "$root/examples" "$tmp" <<'PY' || fail "smooth stacks"
+import json, sys
+plastic = json.load(open(f"{sys.argv[1]}/plastic.json"))
+plastic["layers"][0]["interface"]["alpha"] = 0
+gold = json.load(open(f"{sys.argv[1]}/frosted-gold.json"))
+gold["layers"][0]["interface"]["alpha"] = gold["layers"][1]["interface"]["alpha"] = 0
+gold["layers"][0]["medium"]["tau_a"] = [0.3, 0.1, 0.0]
+json.dump(plastic, open(f"{sys.argv[2]}/smooth-plastic-in.json", "w"))
+json.dump(gold, open(f"{sys.argv[2]}/smooth-gold-in.json", "w"))
+PY
+add_case smooth-plastic "$tmp/smooth-plastic-in.json"
+add_case smooth-gold "$tmp/smooth-gold-in.json"
+add_case smooth-gold-single "$tmp/smooth-gold-in.json" inter-reflection=off
 
 if node "$root/tests/lamina1/glsl_test.js" "$root" "$tmp" "${cases[@]}"; then ok; else fail "GLSL"; fi
 

@@ -84,6 +84,18 @@ async function main(page, check) {
   await choose("w-live-l1", variant);
   const rough = await liveImage();
   check(Math.abs(rough.mean - l1.mean) > 0.5, `a rougher coat (α0 = 0.5, the study's state) changes the image (${l1.mean.toFixed(2)} → ${rough.mean.toFixed(2)})`);
+  // A smooth coat (α0 = 0: a delta lobe, lamina1_delta) renders with its mirror reflection.
+  const smoothVariant = await page.evaluate(() => {
+    const o = Array.from(document.getElementById("w-live-l1").options).find((x) => x.textContent === "coat α = 0");
+    return o ? o.value : null;
+  });
+  check(smoothVariant !== null, "lamina-1 offers a smooth coat (coat α = 0)");
+  if (smoothVariant !== null) {
+    await choose("w-live-l1", smoothVariant);
+    const smooth = await liveImage();
+    check(smooth.centre.join() !== smooth.corner.join() && Math.abs(smooth.mean - rough.mean) > 0.5,
+      `a smooth coat (α0 = 0) draws a sphere unlike α0 = 0.5's (${rough.mean.toFixed(2)} → ${smooth.mean.toFixed(2)})`);
+  }
   await choose("w-live-model", "lamina-coat");
   const coat = await liveImage();
   await choose("w-live-tau", "3");

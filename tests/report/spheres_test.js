@@ -9,6 +9,10 @@
 //   - bias: z = mean(x_G − (x_A + x_B)/2) / (sd/√n) must satisfy |z| < 4 (pixels independent);
 //   - no more spread than the renderer's own noise: δ = |x_G − x_A| − |x_B − x_A| has mean 0 when
 //     G is distributed as B; z = mean(δ)/(sd(δ)/√n) < 4.
+// Smooth coats (α = 0) put part of the image in delta lobes, which both renderers add exactly (their
+// reflectance times the radiance from the view's mirror direction): the same statistics hold.
+// Deliberately wrong variants (a cap light 10% brighter, a smooth coat without its mirror
+// reflection) must be rejected by the same two z tests: the comparison can fail.
 // Plus, with no C++ needed: a binned table of constant f = ρ/π (a Lambertian of albedo ρ) under the
 // uniform environment must render ρ at every pixel (the furnace), mean within 4 se.
 // usage: node spheres_test.js REPO_ROOT DIR   (DIR: CASE.l1gpu and CASE-{1,2}.exr per case)
@@ -37,7 +41,9 @@ const meanSd = (v) => {
   return [m, Math.sqrt(v.reduce((s, x) => s + (x - m) * (x - m), 0) / (v.length - 1))];
 };
 
-function compare(name, sums, passes, A, B) {
+// 1 when G differs from lamina render's A and B beyond Z standard errors (FAIL printed unless
+// `expected`: a wrong variant's rejection).
+function compare(name, sums, passes, A, B, expected) {
   const g = [], a = [], b = [];
   for (let y = 0; y < SIZE; ++y)
     for (let x = 0; x < SIZE; ++x) {
@@ -59,7 +65,7 @@ function compare(name, sums, passes, A, B) {
     `mean (lamina render's own seed-to-seed |B − A| ${(100 * madB).toFixed(2)}%), bias ` +
     `${bias.toExponential(2)} (z ${zBias.toFixed(2)}), spread z ${zSpread.toFixed(2)}`);
   if (!(Math.abs(zBias) < Z) || !(zSpread < Z)) {
-    console.log(`FAIL ${name}: beyond ${Z} standard errors`);
+    console.log(`${expected ? "rejected as it must be" : "FAIL"} ${name}: beyond ${Z} standard errors`);
     return 1;
   }
   return 0;
@@ -76,6 +82,7 @@ function compare(name, sums, passes, A, B) {
     const S = window.LAMINA_SPHERES;
     const r = S.createRenderer(document.getElementById("c"), SIZE, glsl);
     if (r.why) return r.why;
+    if (scene.envDef) S.ENVIRONMENTS[scene.env] = scene.envDef;  // a wrong variant's environment
     if (scene.stateB64) scene.state = S.floatsOf(scene.stateB64);
     if (scene.table) scene.table.values = new Float32Array(scene.table.values);
     try {
@@ -94,16 +101,40 @@ function compare(name, sums, passes, A, B) {
   }, { glsl, scene, SIZE, SPP });
 
   let failures = 0;
+  // A copy of one of spheres.js's environments with cap k's radiance times `scale`.
+  const brighterCap = (env, k, scale) => {
+    const e = JSON.parse(JSON.stringify(ENVIRONMENTS[env]));
+    e.caps[k][2] = e.caps[k][2].map((x) => x * scale);
+    return e;
+  };
+  const ENVIRONMENTS = await page.evaluate(() => window.LAMINA_SPHERES.ENVIRONMENTS);
+  // `wrong`: a deliberately wrong variant of the scene of `tag`, which the comparison must reject
+  // (the test can fail): `env` and `envDef` a changed environment, `coat` changed lamina-coat
+  // parameters.
   const scenes = [
     { name: "lamina-1 plastic, studio", file: "plastic", env: "studio", model: "lamina-1" },
     { name: "lamina-1 plastic, uniform", file: "plastic", env: "uniform", model: "lamina-1" },
     { name: "lamina-1 frosted gold, studio", file: "frosted-gold", env: "studio", model: "lamina-1" },
     { name: "lamina-coat plastic, studio", file: "plastic", env: "studio", model: "lamina-coat" },
+    { name: "lamina-1 plastic, sky", file: "plastic", env: "sky", model: "lamina-1" },
+    { name: "lamina-1 smooth plastic, studio", file: "smooth-plastic", env: "studio", model: "lamina-1" },
+    { name: "lamina-1 smooth plastic, sky", file: "smooth-plastic", env: "sky", model: "lamina-1" },
+    { name: "lamina-coat smooth plastic, studio", file: "smooth-plastic", env: "studio", model: "lamina-coat" },
+    { name: "lamina-1 smooth gold (coat and base), studio", file: "smooth-gold", env: "studio", model: "lamina-1" },
+    { name: "lamina-coat smooth gold (coat and base), studio", file: "smooth-gold", env: "studio",
+      model: "lamina-coat" },
+    { name: "WRONG lamina-1 plastic, studio with the key light 10% brighter", file: "plastic", env: "studio",
+      model: "lamina-1", wrong: { env: "studio-key", envDef: brighterCap("studio", 0, 1.1) } },
+    { name: "WRONG lamina-1 plastic, sky with the sun 10% brighter", file: "plastic", env: "sky",
+      model: "lamina-1", wrong: { env: "sky-sun", envDef: brighterCap("sky", 0, 1.1) } },
+    { name: "WRONG lamina-coat smooth plastic, studio without the mirror reflection (coat α 1e-4)",
+      file: "smooth-plastic", env: "studio", model: "lamina-coat", wrong: { coat: { alpha_coat: 1e-4 } } },
   ];
   for (const s of scenes) {
     const stack = JSON.parse(fs.readFileSync(path.join(dir, s.file + ".json"), "utf8"));
     const tag = `${s.file}-${s.model}-${s.env}`;
     const scene = { model: s.model, env: s.env, lobeAlpha: Math.min(Math.max(stack.layers[0].interface.alpha, 0.02), 1) };
+    if (s.wrong && s.wrong.env) Object.assign(scene, { env: s.wrong.env, envDef: s.wrong.envDef });
     if (s.model === "lamina-1")
       scene.stateB64 = fs.readFileSync(path.join(dir, s.file + ".l1gpu")).toString("base64");
     else {
@@ -115,6 +146,7 @@ function compare(name, sums, passes, A, B) {
         base_eta: rgb(base.eta || 1).map((x) => x / eta), base_k: rgb(base.k || 0).map((x) => x / eta),
         alpha_base: base.alpha || 0,
       };
+      if (s.wrong && s.wrong.coat) Object.assign(scene.material, s.wrong.coat);
     }
     const out = await run(scene);
     if (typeof out === "string") {
@@ -125,7 +157,9 @@ function compare(name, sums, passes, A, B) {
     console.log(`${s.name}: ${(out.seconds / (out.passes - 1) * 1000).toFixed(1)} ms per pass of ` +
       `${SIZE}², ${((SIZE * SIZE * (out.passes - 1)) / out.seconds / 1e6).toFixed(2)} M samples/s (software GL)`);
     const A = readExr(path.join(dir, tag + "-1.exr")).rgb, B = readExr(path.join(dir, tag + "-2.exr")).rgb;
-    failures += compare(s.name, out.sums, out.passes, A, B);
+    const rejected = compare(s.name, out.sums, out.passes, A, B, !!s.wrong);
+    if (s.wrong && !rejected) console.log(`FAIL ${s.name}: not rejected`);
+    failures += s.wrong ? (rejected ? 0 : 1) : rejected;
   }
 
   // The furnace of the table path: a table of constant f = ρ/π on a 10° × 20° grid at three

@@ -214,9 +214,10 @@ Lamina1GpuStates lamina1_gpu_states(const Stack& stack, const ModelOptions& opti
         out.variants.push_back({parameter, value});
         out.heads.insert(out.heads.end(), s.begin(), s.begin() + lamina1::kGpuSlopeSum);
     };
-    // The values offered: roughnesses from nearly smooth to rough, the indices of common coats,
-    // optical depths over three decades, albedos from dark to white.
-    for (double v : {0.02, 0.05, 0.1, 0.2, 0.3, 0.5}) {
+    // The values offered: roughnesses from smooth (a delta lobe: lamina1_delta) through nearly
+    // smooth to rough, the indices of common coats, optical depths over three decades, albedos
+    // from dark to white.
+    for (double v : {0.0, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5}) {
         lamina1::Layers l = layers;
         l.alpha0 = v;
         if (l.alpha0_y >= 0) l.alpha0_y = v;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # ctest `lamina_coat_glsl`: docs/lamina-coat/lamina_coat.glsl in headless Chromium (WebGL2) against
-# `lamina eval --model lamina-coat` (the C++ model) at 96 direction pairs on six stacks, to 1e-4
-# relative; and docs/lamina-coat/tables.png holds the integers of tables.csv.
+# `lamina eval --model lamina-coat` (the C++ model) at 128 direction pairs on eight stacks (two
+# with smooth coats), to 1e-4 relative; lamina_coat_delta against the smooth limits' closed forms
+# (glsl_test.js); and docs/lamina-coat/tables.png holds the integers of tables.csv.
 # Usage: glsl_test.sh LAMINA SRC_DIR [PYTHON (with numpy and Pillow)]
 set -euo pipefail
 lamina=$1 src=$2 python=${3:-python3}
@@ -27,7 +28,8 @@ for pair in "k_g LC_GRAZING" "c_tau LC_TINT_PATH" "k_r LC_ROUGHENING"; do
     if [ -n "$fitted" ] && [ "$fitted" = "$shader" ]; then ok; else fail "$1: fit.csv $fitted, GLSL $shader"; fi
 done
 
-# Stacks: plastics (clear, tinted, rough), metals under smooth and rough coats, another index.
+# Stacks: plastics (clear, tinted, rough), metals under smooth and rough coats, another index;
+# a smooth-coated plastic, and gold with coat and base smooth under an absorbing coat.
 stacks=(
   '{"layers":[{"interface":{"type":"dielectric","eta":1.5,"alpha":0.1},"medium":{"tau_a":[0.1,0,0.9]}},{"interface":{"type":"lambertian","albedo":[0.8,0.5,0.2]}}]}'
   '{"layers":[{"interface":{"type":"dielectric","eta":1.5,"alpha":0.5}},{"interface":{"type":"lambertian","albedo":0.9}}]}'
@@ -35,6 +37,8 @@ stacks=(
   '{"layers":[{"interface":{"type":"dielectric","eta":1.5,"alpha":0.3}},{"interface":{"type":"conductor","eta":[0.143,0.374,1.442],"k":[3.983,2.385,1.603],"alpha":0.05}}]}'
   '{"layers":[{"interface":{"type":"dielectric","eta":1.83,"alpha":0.2},"medium":{"tau_a":[0.3,0.05,0]}},{"interface":{"type":"lambertian","albedo":[0.3,0.6,0.9]}}]}'
   '{"layers":[{"interface":{"type":"dielectric","eta":1.27,"alpha":0.4}},{"interface":{"type":"conductor","eta":[0.2,0.9,1.1],"k":[3.9,2.4,2.2],"alpha":0.12}}]}'
+  '{"layers":[{"interface":{"type":"dielectric","eta":1.5,"alpha":0},"medium":{"tau_a":[0.1,0,0.9]}},{"interface":{"type":"lambertian","albedo":0.8}}]}'
+  '{"layers":[{"interface":{"type":"dielectric","eta":1.5,"alpha":0},"medium":{"tau_a":[0.3,0.1,0]}},{"interface":{"type":"conductor","eta":[0.143,0.374,1.442],"k":[3.983,2.385,1.603],"alpha":0}}]}'
 )
 python3 -c "
 import random
