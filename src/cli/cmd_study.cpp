@@ -151,19 +151,27 @@ void check_model_tables(const CommonArgs& a, const std::vector<StudyConfiguratio
 
 // The explorer page, then the figures (a failure there is a warning: the study itself is done).
 // Without tables (--tables none) there is no page to draw: only the error matrices.
-void write_report(const std::filesystem::path& dir, const CommonArgs& a, const StudySettings& s) {
-    if (s.tables != TablesFormat::None) write_explorer(dir);
+void write_report(const std::filesystem::path& dir, const CommonArgs& a, const StudySettings& s,
+                  StudyTimes& times) {
+    if (s.tables != TablesFormat::None) {
+        PhaseTimer explorer;
+        write_explorer(dir);
+        explorer.add_to(times.explorer);
+    }
     if (a.no_figures) return;
+    PhaseTimer figures;
     try {
         write_figures(dir, figure_options(a));
     } catch (const InputError& e) {
         fmt::print(stderr, "lamina: warning: figures not written: {}\n", e.what());
     }
+    figures.add_to(times.figures);
 }
 
 // What the run did, then the findings (the part of summary.md a reader wants first).
 void print_outcome(const StudyResult& r, const std::filesystem::path& dir, const StudySettings& s) {
-    fmt::print("\nWork: {}\n\n{}", describe_work(r.work), findings_headline(r.findings));
+    fmt::print("\nWork: {}\n{}\n\n{}", describe_work(r.work), describe_times(r.times),
+               findings_headline(r.findings));
     fmt::print("\nReport: {0}/summary.md (metrics: {0}/metrics.csv){1}\n", dir.string(),
                s.tables == TablesFormat::None
                    ? std::string("; no explorer page (--tables none)")
@@ -234,7 +242,7 @@ Runner add_study(CLI::App& app) {
             fmt::print("Reference: {} pieces computed over {} processes × {} threads\n", computed,
                        world.size(), threads);
         }
-        const StudyResult result = run_study(configs, s, out);
+        StudyResult result = run_study(configs, s, out);
         if (a->render) {
             // Renderings of every configuration: reproducible (seed), the same settings for all.
             RenderSettings rs;
@@ -259,7 +267,7 @@ Runner add_study(CLI::App& app) {
             fmt::print("Renderings: {0}/configs/ID/renders/compare.png (errors: {0}/renders.csv)\n",
                        out.string());
         }
-        write_report(out, *a, s);
+        write_report(out, *a, s, result.times);
         print_outcome(result, out, s);
         return 0;
     };
@@ -283,8 +291,8 @@ Runner add_compare(CLI::App& app) {
         c.id = std::filesystem::path(a->stack).stem().string();
         c.category = "custom";
         c.parameters = describe_parameters(c.stack);
-        const StudyResult result = run_study({c}, s, a->out);
-        write_report(a->out, *a, s);
+        StudyResult result = run_study({c}, s, a->out);
+        write_report(a->out, *a, s, result.times);
         print_outcome(result, a->out, s);
         return 0;
     };

@@ -60,10 +60,17 @@ struct ModelSample {
 
 /// A model with everything that depends only on the incident direction already computed (e.g.
 /// the lobe statistics of the forward Belcour variants). eval(wo) == Model::eval(wi, wo).
+/// eval may be called from several threads at once.
 class IncidentEvaluator {
   public:
     virtual ~IncidentEvaluator() = default;
     virtual Rgbd eval(const Vec3d& wo) const = 0;
+
+    /// An evaluator of the same incidence for one thread's run of evaluations (bin_model takes
+    /// one per θ row, whose nodes share their cosines cos θo), or null where this one serves every
+    /// thread as well. It may keep what depends on wo.z alone between calls, and returns the
+    /// same values as this one, bit for bit.
+    virtual std::unique_ptr<IncidentEvaluator> for_one_thread() const { return nullptr; }
 };
 
 /// The IncidentEvaluator of a model that splits its evaluation in two, `typename M::Incident
@@ -79,6 +86,48 @@ class SplitIncidentEvaluator final : public IncidentEvaluator {
   private:
     const M& model_;
     typename M::Incident incident_;
+};
+
+/// The IncidentEvaluator of a split model (as SplitIncidentEvaluator) with a part of its
+/// evaluation that depends on wo.z alone: `typename M::View M::view(double mu_o)` for μo > 0 and
+/// `Rgbd M::eval_in_view(incident, wo, view)`, equal to `eval_with(incident, wo)` bit for bit
+/// when view = view(wo.z) (so neither is inlined: with FMA contraction an inlined copy may round
+/// differently). Its evaluator for one thread keeps the last few views it computed.
+template <typename M>
+class ViewKeepingEvaluator final : public IncidentEvaluator {
+  public:
+    ViewKeepingEvaluator(const M& model, const Vec3d& wi, bool keep_views = false)
+        : model_(model), wi_(wi), incident_(model.incident(wi)), keep_views_(keep_views) {}
+
+    Rgbd eval(const Vec3d& wo) const override {
+        if (!keep_views_ || !(wo.z > 0)) return model_.eval_with(incident_, wo);
+        for (const Kept& kept : kept_)
+            if (kept.filled && kept.mu_o == wo.z)
+                return model_.eval_in_view(incident_, wo, kept.view);
+        Kept& slot = kept_[next_];
+        next_ = (next_ + 1) % kKept;
+        slot = {true, wo.z, model_.view(wo.z)};
+        return model_.eval_in_view(incident_, wo, slot.view);
+    }
+
+    std::unique_ptr<IncidentEvaluator> for_one_thread() const override {
+        return std::make_unique<ViewKeepingEvaluator>(model_, wi_, true);
+    }
+
+  private:
+    /// A rectangle's three cosines and, bisected in θ, its children's six.
+    static constexpr std::size_t kKept = 6;
+    struct Kept {
+        bool filled = false;
+        double mu_o = 0;
+        typename M::View view{};
+    };
+    const M& model_;
+    Vec3d wi_;
+    typename M::Incident incident_;
+    bool keep_views_;
+    mutable Kept kept_[kKept]{};
+    mutable std::size_t next_ = 0;
 };
 
 class Model {

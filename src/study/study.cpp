@@ -183,13 +183,15 @@ class ConfigurationRun {
   public:
     ConfigurationRun(const StudyConfiguration& config, const StudySettings& s,
                      const std::vector<std::string>& model_names,
-                     const std::filesystem::path& out_dir, Progress& progress, StudyWork& work)
+                     const std::filesystem::path& out_dir, Progress& progress, StudyWork& work,
+                     StudyTimes& times)
         : config_(config),
           s_(s),
           model_names_(model_names),
           out_dir_(out_dir),
           progress_(progress),
           work_(work),
+          times_(times),
           incidences_(study_incidences(config.stack, s.reference)),
           n_inc_(incidences_.size()),
           grid_(study_grid(config.stack, s.reference)),
@@ -202,18 +204,31 @@ class ConfigurationRun {
     ConfigResult run() {
         digest_inputs();
         if (read_back()) return result_;
+        PhaseTimer reference;
         simulate_reference();
+        reference.add_to(times_.reference);
         // The tables one model after the other (each binned on every thread), then the
         // comparisons, independent of each other, over the threads.
         std::vector<ModelOutcome> models;
         std::vector<BinnedTable> tables(model_names_.size());
-        for (std::size_t k = 0; k < model_names_.size(); ++k)
+        if (times_.per_model.size() < model_names_.size())
+            for (std::size_t k = times_.per_model.size(); k < model_names_.size(); ++k)
+                times_.per_model.push_back({model_names_[k], {}});
+        for (std::size_t k = 0; k < model_names_.size(); ++k) {
+            PhaseTimer model;
             models.push_back(model_outcome(k, tables[k]));
+            model.add_to(times_.per_model[k].second);
+            model.add_to(times_.models);
+        }
+        PhaseTimer comparisons;
         compare_models(models, tables);
+        comparisons.add_to(times_.comparisons);
         for (const ModelOutcome& m : models)
             result_.rows.insert(result_.rows.end(), m.rows.begin(), m.rows.end());
+        PhaseTimer outputs;
         write_outputs(models);
         write_state(models);
+        outputs.add_to(times_.outputs);
         return result_;
     }
 
@@ -673,6 +688,7 @@ class ConfigurationRun {
     const std::filesystem::path& out_dir_;
     Progress& progress_;
     StudyWork& work_;
+    StudyTimes& times_;
     const std::vector<StudyIncidence> incidences_;
     const std::size_t n_inc_;
     const HemisphereGrid grid_;  ///< folded, or unfolded (an anisotropic stack, φi ≠ 0)
@@ -870,6 +886,29 @@ std::string describe_work(const StudyWork& w) {
         w.configurations_written, w.configurations_unchanged, w.files_written);
 }
 
+std::string describe_times(const StudyTimes& t, std::size_t slowest) {
+    auto span = [](const StudyTimes::Span& s) {
+        return fmt::format("{:.1f} / {:.1f}", s.wall, s.cpu);
+    };
+    std::string out = fmt::format(
+        "Time (wall / CPU s): reference {}, model tables {}, comparisons {}, outputs {}, summary "
+        "{}",
+        span(t.reference), span(t.models), span(t.comparisons), span(t.outputs), span(t.summary));
+    if (t.explorer.wall > 0) out += ", explorer page " + span(t.explorer);
+    if (t.figures.wall > 0) out += ", figures " + span(t.figures);
+    std::vector<std::pair<std::string, StudyTimes::Span>> models = t.per_model;
+    std::stable_sort(models.begin(), models.end(),
+                     [](const auto& a, const auto& b) { return a.second.cpu > b.second.cpu; });
+    if (models.size() > slowest) models.resize(slowest);
+    if (!models.empty()) {
+        out += "; slowest tables";
+        for (std::size_t k = 0; k < models.size(); ++k)
+            out += fmt::format("{} {} {}", k == 0 ? ":" : ",", models[k].first,
+                               span(models[k].second));
+    }
+    return out;
+}
+
 StudyResult run_study(const std::vector<StudyConfiguration>& configs, const StudySettings& s,
                       const std::filesystem::path& out_dir) {
     const std::vector<std::string> model_names = study_models(s);
@@ -885,8 +924,9 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
     for (std::size_t k = 0; k < configs.size(); ++k) {
         const auto t0 = std::chrono::steady_clock::now();
         const std::size_t written_before = result.work.configurations_written;
-        ConfigResult r =
-            ConfigurationRun(configs[k], s, model_names, out_dir, progress, result.work).run();
+        ConfigResult r = ConfigurationRun(configs[k], s, model_names, out_dir, progress,
+                                          result.work, result.times)
+                             .run();
         result.rows.insert(result.rows.end(), r.rows.begin(), r.rows.end());
         lost[configs[k].id] = r.lost_microsurface;
         reference_seconds += r.reference_seconds;
@@ -900,6 +940,7 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
     }
     progress.finish();
 
+    PhaseTimer summary;
     nlohmann::json sj;
     sj["lamina_version"] = kVersion;
     sj["preset"] = s.preset;
@@ -949,6 +990,7 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
         write_file_if_changed(out_dir / "metrics.csv", metrics_csv(result.rows));
     result.findings = compute_findings(configs, s, model_names, result.rows, lost);
     result.work.files_written += write_summary(out_dir, result.findings);
+    summary.add_to(result.times.summary);
     return result;
 }
 

@@ -8,10 +8,13 @@
 #include "study/settings.h"
 #include "study/summary.h"
 
+#include <chrono>
 #include <cstdint>
+#include <ctime>
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lamina {
@@ -47,10 +50,42 @@ struct StudyWork {
     std::size_t files_written = 0;  ///< study.json, metrics.csv, summary.json, summary.md
 };
 
+/// Where a run's time went (describe_times): per phase and per model, the wall time and the
+/// process's CPU time (all threads) in seconds. Measured, not stored: a re-run's are its own.
+struct StudyTimes {
+    struct Span {
+        double wall = 0, cpu = 0;
+    };
+    Span reference;    ///< the reference pieces (simulated or read from the cache)
+    Span models;       ///< the models' binned tables, every model
+    Span comparisons;  ///< the models' metrics and albedos against the reference
+    Span outputs;      ///< configs/<id>/ (tables packed, config.json) and the state
+    Span summary;      ///< study.json, metrics.csv, the findings, summary.md and summary.json
+    Span explorer;     ///< the explorer page (written after run_study, by the command)
+    Span figures;      ///< the figures (likewise)
+    std::vector<std::pair<std::string, Span>> per_model;  ///< the binned tables, in study order
+};
+
+/// Wall and process CPU time (all threads) from construction; add_to adds both to a span.
+class PhaseTimer {
+  public:
+    PhaseTimer() : wall_(std::chrono::steady_clock::now()), cpu_(std::clock()) {}
+    void add_to(StudyTimes::Span& span) const {
+        span.wall +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_).count();
+        span.cpu += double(std::clock() - cpu_) / CLOCKS_PER_SEC;
+    }
+
+  private:
+    std::chrono::steady_clock::time_point wall_;
+    std::clock_t cpu_;
+};
+
 struct StudyResult {
     std::vector<MetricRow> rows;  ///< metrics.csv
     StudyFindings findings;       ///< summary.md, summary.json
     StudyWork work;
+    StudyTimes times;
 };
 
 /// Runs (or resumes) the study into `out_dir`; each configuration at its incidences, on its grid
@@ -66,6 +101,10 @@ StudyResult run_study(const std::vector<StudyConfiguration>& configs, const Stud
 /// One line saying what a run did ("0 reference pieces simulated, 0 model tables computed (420
 /// reused), 0 configurations written (60 unchanged), 0 summary files written").
 std::string describe_work(const StudyWork& work);
+
+/// Where a run's time went, one line per phase and the `slowest` models' tables, each as wall /
+/// CPU seconds ("Time (wall / CPU s): reference 42.0 / 83.1, ...").
+std::string describe_times(const StudyTimes& times, std::size_t slowest = 5);
 
 /// Checks an external model's table against the study's grid and incidences and the stack's sides
 /// (InputError naming `where`, saying what differs).

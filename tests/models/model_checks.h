@@ -25,7 +25,25 @@ inline double relative_difference(const Rgbd& a, const Rgbd& b) {
     return worst;
 }
 
-/// prepare(wi) evaluates exactly as eval(wi, ·), on both sides, in and out of the incidence plane.
+/// prepare(wi)->for_one_thread() (where there is one) evaluates exactly as eval(wi, ·) on a run
+/// like a θ row's (each cosine met again at other azimuths, and again after more cosines than a
+/// row's rectangle has: what the evaluator keeps is reused and replaced), on both sides.
+inline void expect_one_thread_evaluator_equals_eval(const Model& model, const Vec3d& wi) {
+    const auto local = model.prepare(wi)->for_one_thread();
+    if (!local) return;
+    for (int pass = 0; pass < 2; ++pass)
+        for (double theta_o = 2.5; theta_o < 90; theta_o += 7.5)
+            for (double phi_o : {0.0, 45.0, 90.0, 135.0, 180.0})
+                for (Side side : {Side::Reflection, Side::Transmission}) {
+                    const Vec3d wo =
+                        direction_from_angles(deg_to_rad(theta_o), deg_to_rad(phi_o), side);
+                    EXPECT_EQ(local->eval(wo), model.eval(wi, wo))
+                        << model.name() << " at θo = " << theta_o << ", φo = " << phi_o;
+                }
+}
+
+/// prepare(wi) evaluates exactly as eval(wi, ·), on both sides, in and out of the incidence plane,
+/// and so does its evaluator for one thread.
 inline void expect_prepared_equals_eval(const Model& model, const Vec3d& wi) {
     const auto prepared = model.prepare(wi);
     for (double theta_o : {10.0, 40.0, 60.0})
@@ -35,6 +53,7 @@ inline void expect_prepared_equals_eval(const Model& model, const Vec3d& wi) {
                     direction_from_angles(deg_to_rad(theta_o), deg_to_rad(phi_o), side);
                 EXPECT_EQ(prepared->eval(wo), model.eval(wi, wo));
             }
+    expect_one_thread_evaluator_equals_eval(model, wi);
 }
 
 /// The sampler: E[weight] over n samples (seed `seed`) is the albedo of the non-delta lobes on

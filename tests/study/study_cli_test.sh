@@ -29,6 +29,8 @@ grep -q '^slab-a0.1-a1.3-clear,slab,bel-prime,60,T,b,[0-9]' "$tmp/a/metrics.csv"
 grep -q '^## Findings' "$tmp/a/summary.md" && ok || fail "summary findings"
 grep -q '^## Approximations assessment' "$tmp/a/summary.md" && ok || fail "summary assessment"
 grep -q 'Findings' "$tmp/a.log" && ok || fail "findings printed"
+grep -Eq '^Time \(wall / CPU s\): reference [0-9.]+ / [0-9.]+, model tables [0-9.]+ / [0-9.]+,.*; slowest tables: (ww-prime|bel-prime) [0-9.]+ / [0-9.]+, (ww-prime|bel-prime) ' "$tmp/a.log" \
+    && ok || { fail "where the time went:"; grep Time "$tmp/a.log"; }
 
 # 2. Re-running a finished study does no work and rewrites nothing: the counts it reports are 0
 #    and every file keeps its modification time (and content).

@@ -289,7 +289,8 @@ BinnedTable bin_model(const Model& model, const HemisphereGrid& grid,
         const long rest = row / grid.n_theta();
         const Side side = sides[rest % long(sides.size())];
         const std::size_t i = std::size_t(rest / long(sides.size()));
-        RectIntegrator integrator(*evaluators[i], side,
+        const std::unique_ptr<IncidentEvaluator> local = evaluators[i]->for_one_thread();
+        RectIntegrator integrator(local ? *local : *evaluators[i], side,
                                   peaks_on_side(peaks[i], side, grid.is_unfolded()), options);
         BinnedLobe& lobe = table.lobe(i, side);
         const ThetaRange row_range = theta_range(grid.theta_lo(t), grid.theta_hi(t));

@@ -20,7 +20,9 @@
 // peak directions (mirror; refracted for a BTDF) is always bisected towards it, down to a size of
 // ~1e-10 in u: a lobe of α = 0.001 inside one bin is then resolved even though no coarse node sees
 // it. Delta lobes add energy / Ω⊥ to the bin they hit. Parallel over (incidence, side, θ row) with
-// OpenMP; every bin is computed independently, so the output does not depend on the thread count.
+// OpenMP, each row through the incidence's evaluator for one thread where the model has one
+// (IncidentEvaluator::for_one_thread: the same values, bit for bit); every bin is computed
+// independently, so the output does not depend on the thread count.
 
 #include "core/grid.h"
 #include "core/table.h"

@@ -269,7 +269,46 @@ class ProductionCoat final : public Model {
         return eval_with(incident(wi), wo);
     }
 
+    /// What depends on μo = wo.z alone (the terms the recipe uses; ViewKeepingEvaluator keeps
+    /// them for the nodes of a θ row, which share their cosines).
+    struct View {
+        double coat_compensation = 1;  ///< coat_compensation(μo), for a rough coat
+        double coat_albedo = 0;        ///< E_coat(μo), for an attenuation by the albedo
+        double metal_inv_albedo = 1;   ///< 1/E(μo) of Filament's or three.js's DFG texture
+        SchlickSplit metal_fit{}, specular_fit{};  ///< MaterialX's albedo fits at μo
+        double metal_missing = 0;                  ///< 1/E(μo) − 1 of Cycles' white metal albedo
+        double ms_complement = 0;                  ///< ms_complement(μo)
+    };
+
+    // view and eval_in_view are compiled once each (not inlined): with FMA contraction an inlined
+    // copy may round differently, and eval, prepare(wi)->eval and the evaluator for one thread
+    // must agree to the bit.
+    [[gnu::noinline]] View view(double mu_o) const {
+        View v;
+        if (!support_.brdf) return v;
+        if (alpha_coat_ > 0) v.coat_compensation = coat_compensation(mu_o);
+        if (uses_albedo()) v.coat_albedo = coat_albedo(mu_o);
+        if (is_metal_) {
+            if (alpha_base_ <= 0) return v;
+            if (dfg_) v.metal_inv_albedo = 1 / dfg_->albedo(mu_o);
+            if (threejs_dfg_) v.metal_inv_albedo = 1 / threejs_dfg_->albedo(mu_o);
+            if (r_.metal_energy_compensation == CoatRecipe::MetalEnergyCompensation::MaterialX)
+                v.metal_fit = materialx_ggx_albedo_fit(mu_o, materialx_alpha(alpha_base_));
+            if (metal_white_) v.metal_missing = 1 / metal_white_->albedo(mu_o) - 1;
+            if (has_ms()) v.ms_complement = ms_complement(mu_o);
+        } else if (r_.diffuse_specular_throughput) {
+            v.specular_fit = materialx_ggx_albedo_fit(mu_o, materialx_alpha(specular_alpha_));
+        }
+        return v;
+    }
+
     Rgbd eval_with(const Incident& in, const Vec3d& wo) const {
+        if (!support_.brdf || in.wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
+        return eval_in_view(in, wo, view(wo.z));
+    }
+
+    /// eval_with(in, wo), v = view(wo.z).
+    [[gnu::noinline]] Rgbd eval_in_view(const Incident& in, const Vec3d& wo, const View& v) const {
         const Vec3d& wi = in.wi;
         if (!support_.brdf || wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
         const Vec3d h = normalize(wi + wo);
@@ -284,7 +323,7 @@ class ProductionCoat final : public Model {
                 const double G = masking_shadowing(r_.coat_visibility, in.lambda_coat, ggx, wo);
                 f_coat = F * ndf(ggx, h) * G / (4 * wi.z * wo.z);
             }
-            f_coat *= coat_compensation(wo.z);
+            f_coat *= v.coat_compensation;
         }
         Rgbd base(0.0);
         if (is_metal_) {
@@ -292,32 +331,25 @@ class ProductionCoat final : public Model {
             const GGX<double>& ggx = base_ggx_;
             const double G = masking_shadowing(r_.metal_visibility, in.lambda_base, ggx, wo);
             base = base_fresnel(cos_h, wo.z) * (ndf(ggx, h) * G / (4 * wi.z * wo.z));
-            if (dfg_) {
-                // Filament's energyCompensation, 1 + F0 (1/E(μo) − 1), on the lobe.
-                const double inv_e = 1 / dfg_->albedo(wo.z);
-                for (int c = 0; c < 3; ++c)
-                    base[c] *= 1 + f0_[c] * (inv_e - 1);
-            }
-            if (threejs_dfg_) {
-                // three.js's multiScatteringCompensation, 1 + F0 (1/E(μo) − 1), on the lobe.
-                const double inv_e = 1 / threejs_dfg_->albedo(wo.z);
+            if (dfg_ || threejs_dfg_) {
+                // Filament's energyCompensation, three.js's multiScatteringCompensation:
+                // 1 + F0 (1/E(μo) − 1), on the lobe.
+                const double inv_e = v.metal_inv_albedo;
                 for (int c = 0; c < 3; ++c)
                     base[c] *= 1 + f0_[c] * (inv_e - 1);
             }
             if (r_.metal_energy_compensation == CoatRecipe::MetalEnergyCompensation::MaterialX) {
-                const SchlickSplit fit =
-                    materialx_ggx_albedo_fit(wo.z, materialx_alpha(alpha_base_));
                 for (int c = 0; c < 3; ++c)
-                    base[c] *= materialx_compensation(f0_[c], fit);
+                    base[c] *= materialx_compensation(f0_[c], v.metal_fit);
             }
             if (metal_white_) {
                 // Cycles' microfacet_ggx_preserve_energy: 1 + F_ms (1 − E(μo))/E(μo).
-                const double missing = 1 / metal_white_->albedo(wo.z) - 1;
+                const double missing = v.metal_missing;
                 for (int c = 0; c < 3; ++c)
                     base[c] *= 1 + metal_fms_[c] * missing;
             }
             if (has_ms()) {
-                double shape = in.ms_complement_i * ms_complement(wo.z) * ms_norm_;
+                double shape = in.ms_complement_i * v.ms_complement * ms_norm_;
                 // openpbr-bsdf clamps its lobe to 1/μi (openpbr_microfacet_multiple_scattering_
                 // lobes.h).
                 if (ms_grid_) shape = std::min(shape, 1 / wi.z);
@@ -327,12 +359,11 @@ class ProductionCoat final : public Model {
             base = albedo_ * kInvPi<double>;
             if (r_.diffuse_specular_throughput) {
                 // MaterialX's dielectric_bsdf at index 1 (F0 = 0): throughput 1 − B · comp.
-                const SchlickSplit fit =
-                    materialx_ggx_albedo_fit(wo.z, materialx_alpha(specular_alpha_));
+                const SchlickSplit& fit = v.specular_fit;
                 base *= 1 - fit.bias * materialx_compensation(0.0, fit);
             }
         }
-        return Rgbd(f_coat) + base * base_scale(in, wo.z, cos_h);
+        return Rgbd(f_coat) + base * base_scale(in, wo.z, v.coat_albedo, cos_h);
     }
 
     std::unique_ptr<IncidentEvaluator> prepare(const Vec3d& wi) const override;
@@ -347,7 +378,9 @@ class ProductionCoat final : public Model {
             lobes.push_back({wr, Rgbd(coat_fresnel(wi.z) * coat_compensation(wi.z))});
         if (is_metal_ && alpha_base_ == 0) {
             const Incident in = incident(wi);
-            lobes.push_back({wr, base_fresnel(wi.z, wi.z) * base_scale(in, wi.z, wi.z)});
+            lobes.push_back(
+                {wr, base_fresnel(wi.z, wi.z) *
+                         base_scale(in, wi.z, uses_albedo() ? coat_albedo(wi.z) : 0.0, wi.z)});
         }
         return lobes;
     }
@@ -606,19 +639,20 @@ class ProductionCoat final : public Model {
         return metal_fresnel(cos_h);
     }
 
-    /// A · T · Δ: the base's scale for the pair (in.wi, wo) with cos_h = wi·h.
-    Rgbd base_scale(const Incident& in, double mu_o, double cos_h) const {
+    /// A · T · Δ: the base's scale for the pair (in.wi, wo) with cos_h = wi·h and E_o = E_coat(μo)
+    /// (read only by the attenuations by the albedo).
+    Rgbd base_scale(const Incident& in, double mu_o, double E_o, double cos_h) const {
         using A = CoatRecipe::Attenuation;
         double a = 1;
         switch (r_.attenuation) {
             case A::AlbedoView:
-                a = clamp(1 - coat_albedo(mu_o), 0.0, 1.0);
+                a = clamp(1 - E_o, 0.0, 1.0);
                 break;
             case A::AlbedoReciprocal:
-                a = (1 - in.E_i) * (1 - coat_albedo(mu_o));
+                a = (1 - in.E_i) * (1 - E_o);
                 break;
             case A::KullaConty:
-                a = (1 - in.E_i) * (1 - coat_albedo(mu_o)) * kc_norm_;
+                a = (1 - in.E_i) * (1 - E_o) * kc_norm_;
                 break;
             case A::FresnelView:
                 a = 1 - coat_fresnel(mu_o);
@@ -758,7 +792,7 @@ class ProductionCoat final : public Model {
 };
 
 std::unique_ptr<IncidentEvaluator> ProductionCoat::prepare(const Vec3d& wi) const {
-    return std::make_unique<SplitIncidentEvaluator<ProductionCoat>>(*this, wi);
+    return std::make_unique<ViewKeepingEvaluator<ProductionCoat>>(*this, wi);
 }
 
 }  // namespace

@@ -169,7 +169,7 @@ class UnityStackLit final : public Model {
     /// coat's interface, its medium, the base (Belcour 2018, §4–5, the adding equations of the
     /// energy and of the variance, as StackLit writes them), then the FGD reads of
     /// GetPreLightData.
-    ViewStatistics view(double mu_view) const {
+    [[gnu::noinline]] ViewStatistics view(double mu_view) const {
         ViewStatistics v;
         double cti = std::max(mu_view, kMinCos);
         const double mu_clamped = cti;
@@ -294,7 +294,20 @@ class UnityStackLit final : public Model {
 
     Rgbd eval(const Vec3d& wi, const Vec3d& wo) const override {
         if (!support_.brdf || wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
-        const ViewStatistics v = view(wo.z);
+        return eval_in_view(wi, wo, view(wo.z));
+    }
+
+    // The split evaluation (models/model.h, ViewKeepingEvaluator): the view's statistics are
+    // most of an evaluation's cost and depend on wo.z alone.
+    using Incident = Vec3d;
+    using View = ViewStatistics;
+    Incident incident(const Vec3d& wi) const { return wi; }
+    Rgbd eval_with(const Incident& wi, const Vec3d& wo) const { return eval(wi, wo); }
+    // Compiled once (not inlined): with FMA contraction an inlined copy may round differently, and
+    // eval and the evaluator for one thread must agree to the bit (view is not inlined either).
+    [[gnu::noinline]] Rgbd eval_in_view(const Vec3d& wi, const Vec3d& wo,
+                                        const ViewStatistics& v) const {
+        if (!support_.brdf || wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
         const Vec3d h = normalize(wi + wo);
         const double coat = ggx_lobe_shape(alpha_coat_lobe_, wi, wo, h);
         const double base = anisotropy_ == 0
@@ -309,6 +322,8 @@ class UnityStackLit final : public Model {
     /// visible normals at the roughness the base has when viewed along wi) — for a diffuse base one
     /// time in five, the cosine otherwise.
     bool has_sampling() const override { return support_.brdf; }
+
+    std::unique_ptr<IncidentEvaluator> prepare(const Vec3d& wi) const override;
 
     std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override {
         if (!has_sampling() || wi.z <= 0) return std::nullopt;
@@ -347,6 +362,10 @@ class UnityStackLit final : public Model {
     bool is_metal_ = false;
     Rgbd base_f0_{0.0}, rho_{0.0};
 };
+
+std::unique_ptr<IncidentEvaluator> UnityStackLit::prepare(const Vec3d& wi) const {
+    return std::make_unique<ViewKeepingEvaluator<UnityStackLit>>(*this, wi);
+}
 
 }  // namespace
 

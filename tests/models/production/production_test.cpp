@@ -5,6 +5,7 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "models/model_checks.h"
 #include "models/numerics/binned.h"
 #include "models/production/production_coat.h"
 #include "models/registry.h"
@@ -624,6 +625,21 @@ TEST(ProductionCoats, SamplingEstimatesTheAlbedo) {
             }
         }
     }
+}
+
+// The evaluator for one thread (bin_model's, one per θ row) keeps what depends on wo.z alone: the
+// same values as eval, bit for bit, for every production coat on a metal and a Lambertian base,
+// a rough and a smooth coat.
+TEST(ProductionCoats, EvaluatorForOneThreadIsEvalBitForBit) {
+    for (const Stack& s :
+         {coated(1.5, 0.2, test::gold(0.3), kTau), coated(1.5, 0.0, test::gold(0.3), kTau),
+          coated(1.4, 0.3, test::lambertian(kRho), kTau), coated(1.5, 0.05, test::gold(0.0))})
+        for (const ModelEntry* e : production()) {
+            const auto m = make_model(e->name, s);
+            if (!m->support().brdf) continue;
+            for (double theta_i : {0.0, 50.0, 85.0})
+                test::expect_one_thread_evaluator_equals_eval(*m, dir(theta_i, 0));
+        }
 }
 
 // prepare() caches the incident half: the same values as eval.
