@@ -578,8 +578,10 @@ TEST(ProductionCoatsGolden, ThreeJsIridescenceInputsFollowTheMapping) {
 // T121) r123^m, each factor in [0, 1]), so an error ε_S in the sensitivity S (measured on the same
 // GPU, recorded in the data file) moves I by at most 4 ε_S, the metal lobe by 4 ε_S / I of itself,
 // and the value by at most that fraction. The stacks include a film of thickness 0 (three.js turns
-// its iridescence off: the bare metal) and of 0.02 nm (the film's index still blended towards
-// air).
+// its iridescence off: the bare metal), of 0.02 nm (the film's index still blended towards air),
+// and a base whose channels' phase shifts differ (R's index above the film's, G's and B's below:
+// three.js turns each of X, Y, Z by one channel's shift; turning all three by each channel's own
+// shift misses its values by up to 164 %).
 TEST(ProductionCoatsGolden, ThreeJsIridescenceMatchesItsShaders) {
     const json data = load("threejs-iridescence.json");
     const json& pairs = data.at("pairs");
