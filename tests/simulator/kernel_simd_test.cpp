@@ -858,6 +858,38 @@ TEST(KernelSimdStat, SameTablesAsScalarIsotropicLitFromAnotherAzimuth) {
         {60}, 1'000'000, {}, lit_from(75));
 }
 
+// The SIMD kernel traced on 1 and 2 threads at θi = 0° and 55° (light from φi, 20,000 particles:
+// five blocks): tables (both sides), budgets and, polarized, Stokes tallies bitwise identical.
+// Returns the one-thread result and the settings it was traced with.
+std::pair<SimulationResult, SimulationSettings> expect_same_for_1_and_2_threads(
+    const Stack& stack, double phi_i_deg, bool polarized, Microsurface microsurface) {
+    SimulationSettings s;
+    s.theta_i_deg = {0, 55};
+    s.phi_i_deg = phi_i_deg;
+    s.particles = 20'000;
+    s.grid = HemisphereGrid(18, 18);
+    s.kernel = Kernel::Simd;
+    s.transport.microsurface = microsurface;
+    s.transport.polarization = polarized;
+    s.stokes_tallies = polarized;
+    s.threads = 1;
+    SimulationResult one = simulate(stack, s);
+    s.threads = 2;
+    const SimulationResult two = simulate(stack, s);
+    for (std::size_t i = 0; i < 2; ++i) {
+        for (const Side side : {Side::Reflection, Side::Transmission}) {
+            if (side == Side::Transmission && !one.table.has_transmission) continue;
+            EXPECT_EQ(one.table.lobe(i, side).f, two.table.lobe(i, side).f);
+            EXPECT_EQ(one.table.lobe(i, side).se, two.table.lobe(i, side).se);
+        }
+        EXPECT_EQ(one.incidences[i].budget.term, two.incidences[i].budget.term);
+        if (polarized) {
+            EXPECT_TRUE(one.sums[i].stokes == two.sums[i].stokes);
+        }
+    }
+    return {std::move(one), s};
+}
+
 // Reproducibility on anisotropic stacks and light from φi ≠ 0: the SIMD kernel's tables, budgets
 // and Stokes tallies are bitwise identical for 1 and 2 threads (a block's particles take the same
 // lanes in the same order whatever thread traces it), polarized or not, with either microsurface
@@ -876,31 +908,8 @@ TEST(KernelSimd, AnisotropicTablesBitwiseIdenticalAcrossThreadCounts) {
             for (const Microsurface microsurface : {Microsurface::Single, Microsurface::Multiple}) {
                 SCOPED_TRACE(::testing::Message()
                              << "polarized " << polarized << ' ' << enum_text(microsurface));
-                SimulationSettings s;
-                s.theta_i_deg = {0, 55};
-                s.phi_i_deg = 35;
-                s.particles = 20'000;  // five blocks
-                s.grid = HemisphereGrid(18, 18);
-                s.kernel = Kernel::Simd;
-                s.transport.microsurface = microsurface;
-                s.transport.polarization = polarized;
-                s.stokes_tallies = polarized;
-                s.threads = 1;
-                const SimulationResult one = simulate(stack, s);
-                s.threads = 2;
-                const SimulationResult two = simulate(stack, s);
+                auto [one, s] = expect_same_for_1_and_2_threads(stack, 35, polarized, microsurface);
                 ASSERT_TRUE(one.table.grid.is_unfolded());
-                for (std::size_t i = 0; i < 2; ++i) {
-                    for (const Side side : {Side::Reflection, Side::Transmission}) {
-                        if (side == Side::Transmission && !one.table.has_transmission) continue;
-                        EXPECT_EQ(one.table.lobe(i, side).f, two.table.lobe(i, side).f);
-                        EXPECT_EQ(one.table.lobe(i, side).se, two.table.lobe(i, side).se);
-                    }
-                    EXPECT_EQ(one.incidences[i].budget.term, two.incidences[i].budget.term);
-                    if (polarized) {
-                        EXPECT_TRUE(one.sums[i].stokes == two.sums[i].stokes);
-                    }
-                }
                 s.seed = 8;
                 const SimulationResult other = simulate(stack, s);
                 EXPECT_NE(one.table.lobe(0, Side::Reflection).f,
@@ -950,29 +959,7 @@ TEST(KernelSimd, FilmedConductorTablesBitwiseIdenticalAcrossThreadCounts) {
             for (const Microsurface microsurface : {Microsurface::Single, Microsurface::Multiple}) {
                 SCOPED_TRACE(::testing::Message() << "α " << alpha << " polarized " << polarized
                                                   << ' ' << enum_text(microsurface));
-                const Stack stack = iridescent_gold(alpha);
-                SimulationSettings s;
-                s.theta_i_deg = {0, 55};
-                s.particles = 20'000;  // five blocks
-                s.grid = HemisphereGrid(18, 18);
-                s.kernel = Kernel::Simd;
-                s.transport.microsurface = microsurface;
-                s.transport.polarization = polarized;
-                s.stokes_tallies = polarized;
-                s.threads = 1;
-                const SimulationResult one = simulate(stack, s);
-                s.threads = 2;
-                const SimulationResult two = simulate(stack, s);
-                for (std::size_t i = 0; i < 2; ++i) {
-                    EXPECT_EQ(one.table.lobe(i, Side::Reflection).f,
-                              two.table.lobe(i, Side::Reflection).f);
-                    EXPECT_EQ(one.table.lobe(i, Side::Reflection).se,
-                              two.table.lobe(i, Side::Reflection).se);
-                    EXPECT_EQ(one.incidences[i].budget.term, two.incidences[i].budget.term);
-                    if (polarized) {
-                        EXPECT_TRUE(one.sums[i].stokes == two.sums[i].stokes);
-                    }
-                }
+                expect_same_for_1_and_2_threads(iridescent_gold(alpha), 0, polarized, microsurface);
             }
 }
 
