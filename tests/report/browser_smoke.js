@@ -5,19 +5,17 @@
 const fs = require("fs");
 const path = require("path");
 const { runStrictPageTest } = require("../support/chromium.js");
+const { openExplorer } = require("./explorer_page.js");
 const { readPacked } = require("../support/packed_reader.js");
 
 const [studyDir, shot] = process.argv.slice(2);
 
 async function main(page, check) {
-  await page.goto("file://" + path.resolve(studyDir, "index.html"));
-  await page.waitForFunction(() => Number(document.body.dataset.renders || 0) > 0, null, { timeout: 20000 });
+  const { shown, cfg } = await openExplorer(page, studyDir);
   const names = await page.evaluate(() => document.getElementById("slice").data.map((t) => t.name));
   check(names.includes("reference"), "the slice draws the reference");
   check(names.some((n) => n !== "reference" && !/reference/.test(n || "")), "the slice draws a model");
   // The albedo view draws the reference's microsurface loss from the study's config.json.
-  const shown = await page.evaluate(() => document.body.dataset.config);
-  const cfg = JSON.parse(fs.readFileSync(path.resolve(studyDir, "configs", shown, "config.json"), "utf8"));
   const lost = await page.evaluate(() => {
     const t = document.getElementById("albedo").data.find((t) => t.name === "reference: lost to microsurfaces");
     return t ? Array.from(t.y) : null;

@@ -4,20 +4,17 @@
 // incidence equal, to the 8 bits, those computed here from tables.lza; the reference's mean ΔE00
 // against itself is 0 and the model's is not. Usage: node browser_spectral.js STUDY_DIR SCREENSHOT
 "use strict";
-const fs = require("fs");
 const path = require("path");
 const { runStrictPageTest } = require("../support/chromium.js");
+const { openExplorer } = require("./explorer_page.js");
 const { readPacked } = require("../support/packed_reader.js");
 const { expectedSrgb } = require("./browser_colour.js");
 
 const [studyDir, shot] = process.argv.slice(2);
 
 async function main(page, check) {
-  await page.goto("file://" + path.resolve(studyDir, "index.html"));
-  await page.waitForFunction(() => Number(document.body.dataset.renders || 0) > 0, null, { timeout: 20000 });
-  const shown = await page.evaluate(() => document.body.dataset.config);
+  const { shown, cfg } = await openExplorer(page, studyDir);
   const inc = await page.evaluate(() => window.LAMINA_EXPLORER.state.incidence);
-  const cfg = JSON.parse(fs.readFileSync(path.resolve(studyDir, "configs", shown, "config.json"), "utf8"));
   check(cfg.category === "iridescent", `${shown} is of the iridescent category, whose reference is spectral (test premise)`);
   const tab = readPacked(path.resolve(studyDir, "configs", shown, "tables.lza"));
   const [, I, D, T, P] = tab.shape;

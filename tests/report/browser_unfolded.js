@@ -7,16 +7,14 @@
 const fs = require("fs");
 const path = require("path");
 const { runStrictPageTest } = require("../support/chromium.js");
+const { openExplorer } = require("./explorer_page.js");
 const { readPacked } = require("../support/packed_reader.js");
 const { expectedSrgb } = require("./browser_colour.js");
 
 const [studyDir, shot] = process.argv.slice(2);
 
 async function main(page, check) {
-  await page.goto("file://" + path.resolve(studyDir, "index.html"));
-  await page.waitForFunction(() => Number(document.body.dataset.renders || 0) > 0, null, { timeout: 20000 });
-  const shown = await page.evaluate(() => document.body.dataset.config);
-  const cfg = JSON.parse(fs.readFileSync(path.resolve(studyDir, "configs", shown, "config.json"), "utf8"));
+  const { shown, cfg } = await openExplorer(page, studyDir);
   check(Array.isArray(cfg.phi_i) && /unfolded/.test(cfg.grid), `${shown} is unfolded (test premise)`);
   const options = await page.evaluate(() => {
     const row = document.getElementById("w-phi-i-row");
