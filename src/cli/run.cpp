@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "distributed/communicator.h"
 #include "lamina/version.h"
+#include "simulator/kernel_simd.h"
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -18,7 +19,12 @@ namespace lamina::cli {
 
 int run(int argc, char** argv) {
     CLI::App app{"lamina: a lab for layered materials in physically based rendering"};
-    app.set_version_flag("--version", std::string("lamina ") + lamina::kVersion);
+    // The version, and the instruction set the goniophotometer's SIMD kernel takes on this
+    // machine: tables are bitwise reproducible for one instruction set (docs/scaling.md).
+    app.set_version_flag("--version", [] {
+        return fmt::format("lamina {}\nSIMD kernel: {}", lamina::kVersion,
+                           lamina::simd_target_name());
+    });
     app.require_subcommand(1);
 
     // The subcommands, in the order `lamina --help` lists them.

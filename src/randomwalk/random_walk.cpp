@@ -803,7 +803,11 @@ void RandomWalkStack::connect_at_interface(int k, const Vec3d& wi_local, WalkSta
     const Rgbd& w = ws.w;
     const bool up_ok = conn.valid[k];
     const bool down_ok = it.type == InterfaceType::Dielectric && conn.valid[k + 1];
-    auto mis = [&] { return exit_mis(conn, ws, it, wi_local, wo, k); };
+    double mis_weight = -1;  // exit_mis, once per vertex (both connections read it)
+    auto mis = [&] {
+        if (mis_weight < 0) mis_weight = exit_mis(conn, ws, it, wi_local, wo, k);
+        return mis_weight;
+    };
     if (polarized) {
         // The vertex's light towards d_r, in the frame of its chain's plane (whose s and
         // p parts the chains carry apart); f·|cos| over |cos| of the connection.
@@ -875,7 +879,11 @@ void RandomWalkStack::exit_density_at_interface(int k, const Vec3d& wi_local, Wa
     const Rgbd& w = ws.w;
     const bool up_ok = conn.valid[k];
     const bool down_ok = it.type == InterfaceType::Dielectric && conn.valid[k + 1];
-    auto mis = [&] { return exit_mis(conn, ws, it, wi_local, wo, k); };
+    double mis_weight = -1;  // exit_mis, once per vertex (both connections read it)
+    auto mis = [&] {
+        if (mis_weight < 0) mis_weight = exit_mis(conn, ws, it, wi_local, wo, k);
+        return mis_weight;
+    };
     if (it.multiple && (up_ok || down_ok)) {
         // Σ over the facets of the density of leaving towards d_r right after the facet
         // times the chains' probability for the weight that exit would carry.
@@ -924,9 +932,10 @@ void RandomWalkStack::exit_density_at_interface(int k, const Vec3d& wi_local, Wa
         connect_from_vertex_interface<Mode::Pdf>(it, wi_local, ws, rng, conn, wo, false, f);
 }
 
-// The interface's event on a particle arriving from wi_local: its sample (direction, weight,
-// density), or none where the sample failed or a microsurface walk was given up (the flux is
-// dropped). Polarized walks: the state ws.stokes after the event.
+// The interface's event on a particle arriving from wi_local: its sample (direction and weight;
+// the density is sample_density's, computed where it is read), or none where the sample failed or
+// a microsurface walk was given up (the flux is dropped). Polarized walks: the state ws.stokes
+// after the event.
 std::optional<BsdfSample<double>> RandomWalkStack::sample_interface(const Interface& it,
                                                                     const Vec3d& wi_local,
                                                                     WalkState& ws, ParticleRng& rng,
@@ -969,7 +978,6 @@ std::optional<BsdfSample<double>> RandomWalkStack::sample_interface(const Interf
         s = BsdfSample<double>{};
         s->wo = e->wo;
         s->weight = e->weight;
-        s->pdf = pdf_interface(it, wi_local, e->wo);
     } else
         switch (it.type) {
             case InterfaceType::Dielectric: {
@@ -980,11 +988,10 @@ std::optional<BsdfSample<double>> RandomWalkStack::sample_interface(const Interf
                         return it.dielectric.sample_polarized<decltype(aniso)::value>(wi_local, uc,
                                                                                       u1, u2, pol);
                     });
-                    if (s && !s->is_delta) s->pdf = it.dielectric.pdf(wi_local, s->wo);
                 } else {
                     s = with_roughness([&](auto aniso) {
-                        return it.dielectric.sample<true, decltype(aniso)::value>(wi_local, uc, u1,
-                                                                                  u2);
+                        return it.dielectric.sample<false, decltype(aniso)::value>(wi_local, uc, u1,
+                                                                                   u2);
                     });
                 }
                 break;
@@ -996,11 +1003,9 @@ std::optional<BsdfSample<double>> RandomWalkStack::sample_interface(const Interf
                         return it.conductor.sample_polarized<decltype(aniso)::value>(wi_local, u1,
                                                                                      u2, pol);
                     });
-                    if (s && !s->is_delta && s->wo.z > 0)
-                        s->pdf = it.conductor.pdf(wi_local, s->wo);
                 } else {
                     s = with_roughness([&](auto aniso) {
-                        return it.conductor.sample<true, decltype(aniso)::value>(wi_local, u1, u2);
+                        return it.conductor.sample<false, decltype(aniso)::value>(wi_local, u1, u2);
                     });
                 }
                 break;
@@ -1049,10 +1054,13 @@ void RandomWalkStack::walk(const Vec3d& wi, const Vec3d& wo, ParticleRng& rng,
         w *= s->weight;
         if (!it.delta) ws.delta_only = false;
         d = s->wo;
-        if constexpr (kEstimate)
+        if constexpr (kEstimate) {
             ws.prev_mis = conn->rough_exit && k == conn->vertex_interface && !it.delta &&
                           d.z * conn->towards > 0;
-        ws.prev_pdf = s->pdf;
+            // Only strategy 1's weight at the exit reads the density (exit_mis): computed for
+            // the events that weight will meet.
+            ws.prev_pdf = ws.prev_mis ? sample_density(it, wi_local, *s) : 0;
+        }
         ws.prev_depth = 1;
         if (is_black(w) || d.z == 0) return;
         if (d.z > 0) {
@@ -1087,6 +1095,13 @@ Rgbd RandomWalkStack::eval_interface(const Interface& it, const Vec3d& wi, const
             return it.lambertian.eval(wi, wo);
     }
     return Rgbd(0.0);
+}
+
+double RandomWalkStack::sample_density(const Interface& it, const Vec3d& wi,
+                                       const BsdfSample<double>& s) {
+    if (it.multiple) return pdf_interface(it, wi, s.wo);  // the single-scattering proxy
+    if (s.is_delta || (it.type == InterfaceType::Conductor && s.wo.z <= 0)) return 0;
+    return pdf_interface(it, wi, s.wo);
 }
 
 double RandomWalkStack::pdf_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo) {

@@ -213,6 +213,10 @@ class RandomWalkStack {
     double survival_proxy(int region, double path) const;
     static Rgbd eval_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo);
     static double pdf_interface(const Interface& it, const Vec3d& wi, const Vec3d& wo);
+    /// The sampling density of sample_interface's sample s from wi (what the interfaces' samplers
+    /// report; the single-scattering proxy for a multiple-scattering interface); 0 for a delta
+    /// sample.
+    static double sample_density(const Interface& it, const Vec3d& wi, const BsdfSample<double>& s);
     /// One microsurface walk of a multiple-scattering interface from wi, calling
     /// `visit(connect)` at every facet, where connect(wo) is the facet's next-event estimate
     /// towards wo (MicrosurfaceConnection: exit density and the exit's flux weight).

@@ -14,24 +14,24 @@ namespace lamina {
 
 namespace {
 
-std::string num(double v) {
+std::string number_text(double v) {
     return fmt::format("{}", v);
 }
 
 // α1 in ids as in docs/study.md's example `paint-a0.001-a1.3`: "a1" followed by the value without
 // its leading zero.
 std::string alpha1_id(double v) {
-    std::string s = num(v);
+    std::string s = number_text(v);
     return s.rfind("0.", 0) == 0 ? s.substr(1) : s;
 }
 
 // α, or "α_x×α_y" for an anisotropic interface.
 std::string alpha_text(const InterfaceSpec& s) {
-    return s.is_anisotropic() ? fmt::format("{}×{}", s.alpha, s.alpha_b()) : num(s.alpha);
+    return s.is_anisotropic() ? fmt::format("{}×{}", s.alpha, s.alpha_b()) : number_text(s.alpha);
 }
 
 std::string rgb_text(const Rgbd& v) {
-    if (v[0] == v[1] && v[1] == v[2]) return num(v[0]);
+    if (v[0] == v[1] && v[1] == v[2]) return number_text(v[0]);
     return fmt::format("({}, {}, {})", v[0], v[1], v[2]);
 }
 
@@ -80,9 +80,9 @@ std::map<std::string, std::string> describe_parameters(const Stack& stack) {
     if (stack.layers.empty()) return p;
     const Layer& top = stack.layers.front();
     if (top.interface.type == InterfaceType::Dielectric) {
-        p["eta0"] = num(top.interface.eta);
+        p["eta0"] = number_text(top.interface.eta);
         p["alpha0"] = alpha_text(top.interface);
-        if (top.interface.is_anisotropic()) p["tangent0"] = num(top.interface.tangent_deg);
+        if (top.interface.is_anisotropic()) p["tangent0"] = number_text(top.interface.tangent_deg);
         p["tau"] = rgb_text(top.has_medium ? top.medium.tau_a : Rgbd(0.0));
         if (top.has_medium && top.medium.scatters()) p["tau_s"] = rgb_text(top.medium.tau_s);
     }
@@ -91,8 +91,8 @@ std::map<std::string, std::string> describe_parameters(const Stack& stack) {
         if (base.has_film) {
             const FilmSpec& f = base.film;
             p["film_nm"] = f.varies() ? fmt::format("[{}, {}]", f.thickness_nm, f.thickness_max_nm)
-                                      : num(f.thickness_nm);
-            p["film_eta"] = f.k > 0 ? fmt::format("{} + {}i", f.eta, f.k) : num(f.eta);
+                                      : number_text(f.thickness_nm);
+            p["film_eta"] = f.k > 0 ? fmt::format("{} + {}i", f.eta, f.k) : number_text(f.eta);
         }
         switch (base.type) {
             case InterfaceType::Lambertian:
@@ -102,7 +102,7 @@ std::map<std::string, std::string> describe_parameters(const Stack& stack) {
             case InterfaceType::Conductor:
                 p["base"] = "conductor";
                 p["alpha1"] = alpha_text(base);
-                if (base.is_anisotropic()) p["tangent1"] = num(base.tangent_deg);
+                if (base.is_anisotropic()) p["tangent1"] = number_text(base.tangent_deg);
                 if (!base.material.empty()) {
                     // A measured metal's index is its spectrum: the widgets show its name.
                     p["metal"] = base.material;
@@ -115,8 +115,8 @@ std::map<std::string, std::string> describe_parameters(const Stack& stack) {
             case InterfaceType::Dielectric:
                 p["base"] = "dielectric";
                 p["alpha1"] = alpha_text(base);
-                if (base.is_anisotropic()) p["tangent1"] = num(base.tangent_deg);
-                p["eta1"] = num(base.eta);
+                if (base.is_anisotropic()) p["tangent1"] = number_text(base.tangent_deg);
+                p["eta1"] = number_text(base.eta);
                 break;
         }
     }

@@ -2,6 +2,7 @@
 
 #include "models/registry.h"
 #include "study/coat_costs.h"
+#include "study/report_values.h"
 
 #include <fmt/format.h>
 
@@ -14,14 +15,8 @@ namespace lamina {
 
 namespace {
 
-std::string pct(double v) {
-    return std::isfinite(v) ? fmt::format("{:.1f}%", 100 * v) : "–";
-}
 std::string signed_pct(double v) {
     return std::isfinite(v) ? fmt::format("{:+.1f}%", 100 * v) : "–";
-}
-nlohmann::json num(double v) {
-    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
 const ModelEntry* entry_of(const std::string& name) {
@@ -301,7 +296,7 @@ std::string engine_findings_markdown(const EngineFindings& f) {
             out("---|");
         out("\n");
         for (const auto* cell : cells) {
-            out("| {} | {} |", cell->model, pct(cell->mean_misplaced));
+            out("| {} | {} |", cell->model, percent_text(cell->mean_misplaced));
             for (double e : cell->albedo_error)
                 out(" {} |", signed_pct(e));
             out("\n");
@@ -309,12 +304,12 @@ std::string engine_findings_markdown(const EngineFindings& f) {
         out("\n");
         for (const auto* cell : cells)
             out("- **{}**: {}; misplaces {} of the reflected energy.\n", cell->model,
-                albedo_words(f.theta_i, cell->albedo_error), pct(cell->mean_misplaced));
+                albedo_words(f.theta_i, cell->albedo_error), percent_text(cell->mean_misplaced));
         if (f.best_production.count(c))
             out("- Most accurate production coat here: **{}** ({}); best of every model run "
                 "(ablations included): {} ({}).\n",
-                f.best_production.at(c), pct(f.best_production_error.at(c)), f.best_overall.at(c),
-                pct(f.best_overall_error.at(c)));
+                f.best_production.at(c), percent_text(f.best_production_error.at(c)), f.best_overall.at(c),
+                percent_text(f.best_overall_error.at(c)));
         // The rows of `items` in this category under `header`, nothing when there are none.
         const auto table = [&](const auto& items, const char* header, const auto& row) {
             bool started = false;
@@ -331,8 +326,8 @@ std::string engine_findings_markdown(const EngineFindings& f) {
             "\nHeuristics and leaves (mean misplaced energy, 5% floor; mean |albedo error|):\n\n"
             "| model | switched | as shipped | switched | what it says |\n|---|---|---|---|---|\n",
             [&](const EngineFindings::Ablation& a) {
-                out("| {} | `{}` | {}; {} | {}; {} | {} |\n", a.model, a.flag, pct(a.shipped),
-                    pct(a.shipped_albedo), pct(a.switched), pct(a.switched_albedo),
+                out("| {} | `{}` | {}; {} | {}; {} | {} |\n", a.model, a.flag, percent_text(a.shipped),
+                    percent_text(a.shipped_albedo), percent_text(a.switched), percent_text(a.switched_albedo),
                     switch_effect(a));
             });
         out("\n");
@@ -343,8 +338,8 @@ std::string engine_findings_markdown(const EngineFindings& f) {
                   "| coat | as shipped | `leaves=exact` | lamina-coat | advice |\n"
                   "|---|---|---|---|---|\n",
                   [&](const EngineFindings::Replacement& r) {
-                      out("| {} | {} | {} | {} | {} |\n", r.model, pct(r.shipped),
-                          pct(r.exact_leaves), pct(r.lamina_coat), replacement_advice(r));
+                      out("| {} | {} | {} | {} | {} |\n", r.model, percent_text(r.shipped),
+                          percent_text(r.exact_leaves), percent_text(r.lamina_coat), replacement_advice(r));
                   }))
             out("\n");
     }
@@ -379,9 +374,9 @@ nlohmann::json engine_findings_json(const EngineFindings& f) {
             if (cell.category != c || cell.configurations == 0) continue;
             nlohmann::json ae = nlohmann::json::array();
             for (double e : cell.albedo_error)
-                ae.push_back(num(e));
+                ae.push_back(json_number(e));
             jc["models"][cell.model] = {{"configurations_supported", cell.configurations},
-                                        {"mean_misplaced_floor", num(cell.mean_misplaced)},
+                                        {"mean_misplaced_floor", json_number(cell.mean_misplaced)},
                                         {"albedo_error_by_theta_i", ae}};
         }
         if (f.best_production.count(c)) {
@@ -395,17 +390,17 @@ nlohmann::json engine_findings_json(const EngineFindings& f) {
                      {"model", a.model},
                      {"flag", a.flag},
                      {"rows", a.rows},
-                     {"shipped_misplaced_floor", num(a.shipped)},
-                     {"switched_misplaced_floor", num(a.switched)},
-                     {"shipped_mean_abs_albedo_error", num(a.shipped_albedo)},
-                     {"switched_mean_abs_albedo_error", num(a.switched_albedo)}});
+                     {"shipped_misplaced_floor", json_number(a.shipped)},
+                     {"switched_misplaced_floor", json_number(a.switched)},
+                     {"shipped_mean_abs_albedo_error", json_number(a.shipped_albedo)},
+                     {"switched_mean_abs_albedo_error", json_number(a.switched_albedo)}});
         for (const auto& r : f.replacements)
             if (r.category == c)
                 jc["replacements"].push_back({{"model", r.model},
                                               {"rows", r.rows},
-                                              {"shipped_misplaced_floor", num(r.shipped)},
-                                              {"exact_leaves_misplaced_floor", num(r.exact_leaves)},
-                                              {"lamina_coat_misplaced_floor", num(r.lamina_coat)},
+                                              {"shipped_misplaced_floor", json_number(r.shipped)},
+                                              {"exact_leaves_misplaced_floor", json_number(r.exact_leaves)},
+                                              {"lamina_coat_misplaced_floor", json_number(r.lamina_coat)},
                                               {"advice", replacement_advice(r)}});
         j["categories"][c] = jc;
     }

@@ -15,6 +15,7 @@
 #include "models/spectral_projection.h"
 #include "study/reference.h"
 #include "study/summary.h"
+#include "study/report_values.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -31,7 +32,6 @@ namespace lamina {
 
 namespace {
 
-constexpr const char* kChannels[3] = {"r", "g", "b"};
 constexpr const char* kStateFormat = "lamina-study-state v1";
 
 nlohmann::json rgb(const Rgbd& v) {
@@ -107,9 +107,6 @@ nlohmann::json read_state(const std::filesystem::path& path) {
     }
 }
 
-nlohmann::json num(double v) {
-    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
-}
 double num_of(const nlohmann::json& v) {
     return v.is_number() ? v.get<double>() : NAN;
 }
@@ -121,15 +118,15 @@ nlohmann::json row_json(const MetricRow& r) {
                         std::string(1, r.side),
                         r.channel,
                         r.supported,
-                        num(m.misplaced_energy),
-                        num(m.misplaced_floor),
-                        num(m.albedo_ref),
-                        num(m.albedo_model),
-                        num(m.albedo_error),
-                        num(m.rmse),
-                        num(m.log_rmse),
-                        num(f.misplaced_energy),
-                        num(f.misplaced_floor)};
+                        json_number(m.misplaced_energy),
+                        json_number(m.misplaced_floor),
+                        json_number(m.albedo_ref),
+                        json_number(m.albedo_model),
+                        json_number(m.albedo_error),
+                        json_number(m.rmse),
+                        json_number(m.log_rmse),
+                        json_number(f.misplaced_energy),
+                        json_number(f.misplaced_floor)};
     if (r.phi_i != 0) j.push_back(r.phi_i);  // a 14th field only where the light is off φ = 0
     return j;
 }
@@ -793,7 +790,7 @@ std::string metrics_csv(const std::vector<MetricRow>& rows) {
         fmt::format_to(std::back_inserter(out), "{},{},{},{},", r.config, r.category, r.model,
                        r.theta_i);
         if (with_phi) fmt::format_to(std::back_inserter(out), "{},", r.phi_i);
-        fmt::format_to(std::back_inserter(out), "{},{},", r.side, kChannels[r.channel]);
+        fmt::format_to(std::back_inserter(out), "{},{},", r.side, kChannelNames[r.channel]);
         if (r.supported)
             fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},{},{},true\n",
                            csv_number(r.metrics.misplaced_energy),

@@ -4,6 +4,7 @@
 #include "lamina/version.h"
 #include "layers/transport_settings.h"
 #include "study/engine_findings.h"
+#include "study/report_values.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -18,7 +19,6 @@ namespace lamina {
 
 namespace {
 
-constexpr const char* kChannels[3] = {"r", "g", "b"};
 
 // ==== Computing the findings =====================================================================
 
@@ -393,31 +393,28 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
 
 namespace {
 
-nlohmann::json num(double v) {
-    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
-}
 
 nlohmann::json place_json(const std::optional<RowPlace>& p, bool with_side = true) {
     if (!p) return nullptr;
     nlohmann::json j = {{"config", p->config}, {"theta_i", p->theta_i}};
     if (p->phi_i != 0) j["phi_i"] = p->phi_i;
     if (with_side) j["side"] = std::string(1, p->side);
-    j["channel"] = kChannels[p->channel];
+    j["channel"] = kChannelNames[p->channel];
     return j;
 }
 
 nlohmann::json aggregate_json(const ModelAggregate& a) {
-    return {{"mean_misplaced_floor", num(a.mean_misplaced_floor)},
-            {"worst_misplaced_floor", num(a.worst_misplaced_floor)},
+    return {{"mean_misplaced_floor", json_number(a.mean_misplaced_floor)},
+            {"worst_misplaced_floor", json_number(a.worst_misplaced_floor)},
             {"worst_misplaced_floor_at", place_json(a.worst_misplaced_floor_at)},
-            {"mean_misplaced_floor_noise", num(a.mean_misplaced_floor_noise)},
-            {"mean_misplaced_energy", num(a.mean_misplaced_energy)},
-            {"worst_misplaced_energy", num(a.worst_misplaced_energy)},
+            {"mean_misplaced_floor_noise", json_number(a.mean_misplaced_floor_noise)},
+            {"mean_misplaced_energy", json_number(a.mean_misplaced_energy)},
+            {"worst_misplaced_energy", json_number(a.worst_misplaced_energy)},
             {"worst_misplaced_energy_at", place_json(a.worst_misplaced_energy_at)},
-            {"mean_abs_albedo_error", num(a.mean_abs_albedo_error)},
-            {"worst_albedo_error", num(a.worst_albedo_error)},
+            {"mean_abs_albedo_error", json_number(a.mean_abs_albedo_error)},
+            {"worst_albedo_error", json_number(a.worst_albedo_error)},
             {"worst_albedo_error_at", place_json(a.worst_albedo_error_at)},
-            {"mean_noise_floor", num(a.mean_noise_floor)},
+            {"mean_noise_floor", json_number(a.mean_noise_floor)},
             {"configurations_supported", a.configurations_supported}};
 }
 
@@ -452,10 +449,10 @@ void json_common(const StudyFindings& f, nlohmann::json& j) {
     j["common"]["left_out"] = f.common.left_out;
     for (const auto& [m, a] : f.common.models)
         j["common"]["models"][m] = {
-            {"mean_misplaced_floor", num(a.mean_misplaced_floor)},
-            {"mean_misplaced_floor_noise", num(a.mean_misplaced_floor_noise)},
-            {"mean_misplaced_energy", num(a.mean_misplaced_energy)},
-            {"mean_noise_floor", num(a.mean_noise_floor)}};
+            {"mean_misplaced_floor", json_number(a.mean_misplaced_floor)},
+            {"mean_misplaced_floor_noise", json_number(a.mean_misplaced_floor_noise)},
+            {"mean_misplaced_energy", json_number(a.mean_misplaced_energy)},
+            {"mean_noise_floor", json_number(a.mean_noise_floor)}};
 }
 
 void json_loss(const StudyFindings& f, nlohmann::json& j) {
@@ -471,9 +468,9 @@ void json_challenging(const StudyFindings& f, nlohmann::json& j) {
         j["challenging"].push_back(
             {{"config", c.config},
              {"best_model", c.best_model},
-             {"best_mean_misplaced_floor", num(c.best_mean_misplaced_floor)},
-             {"mean_misplaced_floor_noise", num(c.mean_misplaced_floor_noise)},
-             {"best_mean_misplaced_energy", num(c.best_mean_misplaced_energy)}});
+             {"best_mean_misplaced_floor", json_number(c.best_mean_misplaced_floor)},
+             {"mean_misplaced_floor_noise", json_number(c.mean_misplaced_floor_noise)},
+             {"best_mean_misplaced_energy", json_number(c.best_mean_misplaced_energy)}});
 }
 
 void json_assessment(const StudyFindings& f, nlohmann::json& j) {
@@ -484,8 +481,8 @@ void json_assessment(const StudyFindings& f, nlohmann::json& j) {
         fj["levels"] = ff.levels;
         for (const auto& [m, levels] : ff.models)
             for (const ModelAggregate& a : levels) {
-                fj["mean_misplaced_floor"][m].push_back(num(a.mean_misplaced_floor));
-                fj["mean_misplaced_energy"][m].push_back(num(a.mean_misplaced_energy));
+                fj["mean_misplaced_floor"][m].push_back(json_number(a.mean_misplaced_floor));
+                fj["mean_misplaced_energy"][m].push_back(json_number(a.mean_misplaced_energy));
             }
         j["assessment"].push_back(fj);
     }
@@ -510,16 +507,12 @@ constexpr JsonSection kJsonSections[] = {json_header,        json_groups,      j
 
 // ---- summary.md ----
 
-std::string pct(double v) {
-    if (!std::isfinite(v)) return "–";
-    return fmt::format("{:.1f}%", 100 * v);
-}
 
 std::string where(const std::optional<RowPlace>& p) {
     if (!p) return "";
     const std::string phi = p->phi_i != 0 ? fmt::format(", φi {}°", p->phi_i) : "";
     return fmt::format("{}, θi {}°{}, {}, {}", p->config, p->theta_i, phi, p->side,
-                       kChannels[p->channel]);
+                       kChannelNames[p->channel]);
 }
 
 struct Markdown {
@@ -558,7 +551,7 @@ void md_header(const StudyFindings& f, Markdown& out) {
         "Models are ranked by it; the purely relative misplaced energy is shown beside it. "
         "Every number is next to the reference's **noise floor** — what Monte-Carlo noise alone "
         "would show for a perfect model; differences below it mean nothing.\n\n",
-        pct(kMisplacedFloorEnergy));
+        percent_text(kMisplacedFloorEnergy));
 }
 
 void md_findings(const StudyFindings& f, Markdown& out) {
@@ -588,21 +581,21 @@ void md_findings(const StudyFindings& f, Markdown& out) {
             covered(rk.front()) ? ""
                                 : fmt::format(" (on the {} of {} configurations it supports)",
                                               best.configurations_supported, g.configurations),
-            pct(best.mean_misplaced_floor), pct(best.mean_misplaced_floor_noise),
-            pct(best.mean_misplaced_energy), pct(best.worst_misplaced_floor),
-            where(best.worst_misplaced_floor_at), pct(best.mean_abs_albedo_error));
+            percent_text(best.mean_misplaced_floor), percent_text(best.mean_misplaced_floor_noise),
+            percent_text(best.mean_misplaced_energy), percent_text(best.worst_misplaced_floor),
+            where(best.worst_misplaced_floor_at), percent_text(best.mean_abs_albedo_error));
         if (!covered(rk.front()))
             for (const std::string& m : rk)
                 if (covered(m)) {
                     out(" Of the models that support all {}: **{}** ({}).", g.configurations, m,
-                        pct(g.models.at(m).mean_misplaced_floor));
+                        percent_text(g.models.at(m).mean_misplaced_floor));
                     break;
                 }
         if (rk.size() > 1) {
             out(" Then ");
             for (std::size_t k = 1; k < rk.size(); ++k)
                 out("{}{} ({}{})", k > 1 ? ", " : "", rk[k],
-                    pct(g.models.at(rk[k]).mean_misplaced_floor), coverage(rk[k]));
+                    percent_text(g.models.at(rk[k]).mean_misplaced_floor), coverage(rk[k]));
             out(".");
         }
         std::vector<std::string> none;
@@ -616,7 +609,7 @@ void md_findings(const StudyFindings& f, Markdown& out) {
         std::string t;
         for (std::size_t k = 0; k < ranking.size(); ++k)
             t += fmt::format("{}{} {}", k ? " < " : "", ranking[k],
-                             pct(models.at(ranking[k]).mean_misplaced_floor));
+                             percent_text(models.at(ranking[k]).mean_misplaced_floor));
         return t;
     };
     if (const GroupFindings* all = f.group("all"); all && !all->ranking.empty()) {
@@ -624,7 +617,7 @@ void md_findings(const StudyFindings& f, Markdown& out) {
         for (std::size_t k = 0; k < all->ranking.size(); ++k) {
             const ModelAggregate& a = all->models.at(all->ranking[k]);
             t += fmt::format("{}{} {}", k ? " < " : "", all->ranking[k],
-                             pct(a.mean_misplaced_floor));
+                             percent_text(a.mean_misplaced_floor));
             if (int(a.configurations_supported) < all->configurations)
                 t += fmt::format(" ({} of {})", a.configurations_supported, all->configurations);
         }
@@ -650,7 +643,7 @@ void md_findings(const StudyFindings& f, Markdown& out) {
         for (const std::string& c : f.categories)
             if (f.reference_loss.count(c))
                 per_category += fmt::format("{}{} {}", per_category.empty() ? "" : ", ", c,
-                                            pct(f.reference_loss.at(c).mean));
+                                            percent_text(f.reference_loss.at(c).mean));
         const LossFindings& l = f.reference_loss.at("all");
         out("- **What the reference itself drops**: its single-scattering microfacet interfaces "
             "lose, on average over incidences and channels, {} of the incident energy (worst {}: "
@@ -658,15 +651,15 @@ void md_findings(const StudyFindings& f, Markdown& out) {
             "this energy overshoots the reference's albedo by up to that much; where it belongs "
             "(R, T) is what multiple scattering on the microsurfaces would decide. The explorer's "
             "albedo view draws it.\n",
-            per_category, pct(l.worst), l.worst_at.config, l.worst_at.theta_i,
-            kChannels[l.worst_at.channel]);
+            per_category, percent_text(l.worst), l.worst_at.config, l.worst_at.theta_i,
+            kChannelNames[l.worst_at.channel]);
     }
     std::string list;
     for (std::size_t k = 0; k < f.challenging.size(); ++k)
         list += fmt::format("{}`{}`", k ? ", " : "", f.challenging[k].config);
     out("- **Challenging cases** (even the best model misplaces more than {} of the reflected "
         "energy on average, and more than twice the noise floor): {}.\n\n",
-        pct(kChallengingThreshold), list.empty() ? std::string("none") : list);
+        percent_text(kChallengingThreshold), list.empty() ? std::string("none") : list);
 }
 
 void md_tables(const StudyFindings& f, Markdown& out) {
@@ -688,20 +681,20 @@ void md_tables(const StudyFindings& f, Markdown& out) {
     };
     table("Misplaced energy (5% floor, the ranking metric): mean / worst (noise floor)",
           [](const ModelAggregate& a, const GroupFindings&) {
-              return a.rows ? fmt::format("{} / {} ({})", pct(a.mean_misplaced_floor),
-                                          pct(a.worst_misplaced_floor),
-                                          pct(a.mean_misplaced_floor_noise))
+              return a.rows ? fmt::format("{} / {} ({})", percent_text(a.mean_misplaced_floor),
+                                          percent_text(a.worst_misplaced_floor),
+                                          percent_text(a.mean_misplaced_floor_noise))
                             : std::string("not supported");
           });
     table("Misplaced energy (relative to the reference's energy): mean / worst (noise floor)",
           [](const ModelAggregate& a, const GroupFindings&) {
-              return a.rows ? fmt::format("{} / {} ({})", pct(a.mean_misplaced_energy),
-                                          pct(a.worst_misplaced_energy), pct(a.mean_noise_floor))
+              return a.rows ? fmt::format("{} / {} ({})", percent_text(a.mean_misplaced_energy),
+                                          percent_text(a.worst_misplaced_energy), percent_text(a.mean_noise_floor))
                             : std::string("not supported");
           });
     table("Albedo error: mean |error| / worst", [](const ModelAggregate& a, const GroupFindings&) {
         return std::isfinite(a.mean_abs_albedo_error)
-                   ? fmt::format("{} / {:+.1f}%", pct(a.mean_abs_albedo_error),
+                   ? fmt::format("{} / {:+.1f}%", percent_text(a.mean_abs_albedo_error),
                                  100 * a.worst_albedo_error)
                    : std::string("not supported");
     });
@@ -718,8 +711,8 @@ void md_worst(const StudyFindings& f, Markdown& out) {
         for (const GroupFindings& g : f.groups)
             if (!is_total(g.name) && g.models.at(m).rows) {
                 const ModelAggregate& a = g.models.at(m);
-                out("| {} | {} | {} | {} | {} | {} |\n", m, g.name, pct(a.worst_misplaced_floor),
-                    where(a.worst_misplaced_floor_at), pct(a.worst_misplaced_energy),
+                out("| {} | {} | {} | {} | {} | {} |\n", m, g.name, percent_text(a.worst_misplaced_floor),
+                    where(a.worst_misplaced_floor_at), percent_text(a.worst_misplaced_energy),
                     where(a.worst_misplaced_energy_at));
             }
     out("\n");
@@ -729,7 +722,7 @@ void md_challenging(const StudyFindings& f, Markdown& out) {
     out("## Challenging cases\n\nConfigurations where even the best supporting model misplaces "
         "more than {} of the reflected energy (5% floor) on average over incidences and "
         "channels, and more than twice the reference's noise floor.\n\n",
-        pct(kChallengingThreshold));
+        percent_text(kChallengingThreshold));
     if (f.challenging.empty()) {
         out("None.\n\n");
         return;
@@ -738,8 +731,8 @@ void md_challenging(const StudyFindings& f, Markdown& out) {
         "relative |\n|---|---|---|---|---|\n");
     for (const ChallengingCase& c : f.challenging)
         out("| {} | {} | {} | {} | {} |\n", c.config, c.best_model,
-            pct(c.best_mean_misplaced_floor), pct(c.mean_misplaced_floor_noise),
-            pct(c.best_mean_misplaced_energy));
+            percent_text(c.best_mean_misplaced_floor), percent_text(c.mean_misplaced_floor_noise),
+            percent_text(c.best_mean_misplaced_energy));
     out("\n");
 }
 
@@ -758,8 +751,8 @@ void md_assessment(const StudyFindings& f, Markdown& out) {
         for (const std::string& m : f.models) {
             out("| {} |", m);
             for (const ModelAggregate& a : ff.models.at(m))
-                out(" {} |", a.rows ? fmt::format("{} ({})", pct(a.mean_misplaced_floor),
-                                                  pct(a.mean_misplaced_floor_noise))
+                out(" {} |", a.rows ? fmt::format("{} ({})", percent_text(a.mean_misplaced_floor),
+                                                  percent_text(a.mean_misplaced_floor_noise))
                                     : std::string("–"));
             out("\n");
         }

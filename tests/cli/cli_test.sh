@@ -33,6 +33,12 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp" /tmp/lamina-cli-out.$$' EXIT
 
 check version 0 "$lamina" --version
+# --version names the SIMD kernel's instruction set, after LAMINA_SIMD_TARGET's cap; a name that
+# is not one of the build's is refused by name.
+if [ "$(uname -m)" = x86_64 ]; then  # SSE4 is compiled into every x86-64 build
+    check_says version-simd 0 "SIMD kernel: SSE4" env LAMINA_SIMD_TARGET=SSE4 "$lamina" --version
+fi
+check_says version-simd-unknown 1 "LAMINA_SIMD_TARGET" env LAMINA_SIMD_TARGET=MMX "$lamina" --version
 check help 0 "$lamina" --help
 check_says no-subcommand 1 "lamina: command line: a subcommand is required, one of: validate," "$lamina"
 # CLI11's own errors exit like lamina's: one "lamina: command line: OPTION: ..." line, exit code 1.

@@ -502,7 +502,7 @@ TEST(StackReject, DeeplyNestedJsonIsRefusedWithoutCrashing) {
     json nested = 1;
     for (int i = 0; i < 100000; ++i)
         nested = json::array({std::move(nested)});
-    expect_mentions(error_of(with(plastic(), "/ambient_eta", nested)),
+    expect_mentions(error_of(with(plastic(), "/ambient_eta", std::move(nested))),
                     {"/ambient_eta", "expected a number", "[[[[...]]]]"});
 }
 

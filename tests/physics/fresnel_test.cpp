@@ -3,6 +3,7 @@
 
 #include "core/math.h"
 #include "core/rng.h"
+#include "support/chi2.h"
 
 #include <gtest/gtest.h>
 
@@ -152,13 +153,7 @@ TEST(Fresnel, GoldIsAReflectanceAtEveryAngle) {
     EXPECT_GT(fresnel_conductor(1.0, eta[0], k[0]), fresnel_conductor(1.0, eta[2], k[2]));
 }
 
-// Directions on both sides of a tilted normal, for the Snell tests.
-Vec3d random_direction(ParticleRng& rng) {
-    const double z = 1 - 2 * rng.uniform_double(), phi = 2 * kPi<double> * rng.uniform_double();
-    const double r = std::sqrt(std::max(0.0, 1 - z * z));
-    return {r * std::cos(phi), r * std::sin(phi), z};
-}
-
+// Snell's law on random directions on both sides of a tilted normal.
 TEST(Fresnel, RefractObeysSnellAndRoundTrips) {
     // With w on the side n points to, the relative index is η: sin θi = η sin θt; from the other
     // side it is 1/η. The refracted ray lies in the plane of w and n, on the other side, and
@@ -169,7 +164,7 @@ TEST(Fresnel, RefractObeysSnellAndRoundTrips) {
     int refracted = 0, tir = 0;
     for (double eta : {1.5, 1 / 1.5, 2.4}) {
         for (int i = 0; i < 2000; ++i) {
-            const Vec3d w = random_direction(rng);
+            const Vec3d w = test::uniform_sphere_direction(rng);
             const double cos_i = dot(w, n);
             const double rel = cos_i > 0 ? eta : 1 / eta;
             const double sin_i = length(cross(w, n));
@@ -212,7 +207,8 @@ TEST(Fresnel, RefractAtNormalIncidenceGoesStraightThrough) {
 TEST(Fresnel, ReflectIsAnInvolutionAboutTheNormal) {
     ParticleRng rng(12, 0, 0);
     for (int i = 0; i < 1000; ++i) {
-        const Vec3d w = random_direction(rng), n = random_direction(rng);
+        const Vec3d w = test::uniform_sphere_direction(rng),
+                    n = test::uniform_sphere_direction(rng);
         const Vec3d r = reflect(w, n);
         EXPECT_NEAR(length(r), 1, 1e-14);
         EXPECT_NEAR(dot(r, n), dot(w, n), 1e-14);  // same angle to the normal, same side

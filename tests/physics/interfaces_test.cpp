@@ -23,16 +23,12 @@ namespace {
 
 using test::Chi2Draw;
 
-Vec3d direction_at(double cos_theta, double phi) {
-    return test::direction_of(cos_theta, phi);
-}
-
 // Gold-like relative complex index per RGB channel (the usual rendering values for gold).
 const Rgbd kGoldEta(0.143, 0.374, 1.442), kGoldK(3.983, 2.385, 1.603);
 
 // Incidences of docs/physics.md §1 (φi = 0): oblique from above, near grazing, oblique from below.
-const Vec3d kAbove = direction_at(0.6, 0), kGrazing = direction_at(0.1, 0),
-            kBelow = direction_at(-0.8, 0);
+const Vec3d kAbove = test::direction_of(0.6, 0), kGrazing = test::direction_of(0.1, 0),
+            kBelow = test::direction_of(-0.8, 0);
 
 constexpr TransmissionMasking kMaskings[] = {TransmissionMasking::Smith, TransmissionMasking::Pbrt};
 
@@ -173,7 +169,7 @@ TEST(InterfacesStat, SharpLobesChi2) {
     // one cell of the full grid. The grid is zoomed onto |cos θo| ∈ [1 − 16α², 1] for the
     // dielectric's reflection and transmission lobes and the conductor's lobe; everything else
     // (the other lobe, the tails, lost samples) joins the absent bin.
-    const Vec3d wi = direction_at(0.9995, 0.0);
+    const Vec3d wi = test::direction_of(0.9995, 0.0);
     const DielectricInterface<double> d{1.5, 0.05};
     const ConductorInterface<double> c{kGoldEta, kGoldK, 0.05};
     const double band = 16 * sqr(0.05);
@@ -196,7 +192,7 @@ TEST(InterfacesStat, SharpLobesChi2) {
 
 TEST(InterfacesStat, RoughConductorChi2) {
     for (double alpha : {0.05, 0.5}) {
-        for (const Vec3d& wi : {kAbove, direction_at(0.15, 0)}) {
+        for (const Vec3d& wi : {kAbove, test::direction_of(0.15, 0)}) {
             const ConductorInterface<double> iface{kGoldEta, kGoldK, alpha};
             const auto r = test::run_chi2(
                 interface_options("conductor_a" + std::to_string(alpha) + "_" + describe(wi)),
@@ -230,8 +226,8 @@ std::vector<Pair> random_pairs(std::uint64_t seed, int count) {
     ParticleRng rng(seed, 0, 0);
     std::vector<Pair> pairs;
     for (int i = 0; i < count; ++i) {
-        const Vec3d a = direction_at(2 * rng.uniform_double() - 1, 7 * rng.uniform_double());
-        const Vec3d b = direction_at(2 * rng.uniform_double() - 1, 7 * rng.uniform_double());
+        const Vec3d a = test::direction_of(2 * rng.uniform_double() - 1, 7 * rng.uniform_double());
+        const Vec3d b = test::direction_of(2 * rng.uniform_double() - 1, 7 * rng.uniform_double());
         pairs.push_back({a, b});
     }
     return pairs;
@@ -318,7 +314,7 @@ TEST(Interfaces, DielectricSampleWeightMatchesEvalAndPdf) {
                 DielectricInterface<double> d{eta, alpha};
                 d.transmission_masking = masking;
                 const GGX<double> ggx{alpha};
-                for (const Vec3d& wi : {kAbove, kGrazing, kBelow, direction_at(-0.3, 1.0)}) {
+                for (const Vec3d& wi : {kAbove, kGrazing, kBelow, test::direction_of(-0.3, 1.0)}) {
                     int lost = 0, kept = 0, transmitted = 0;
                     for (int i = 0; i < 2000; ++i) {
                         const auto s = d.sample(wi, rng.uniform_double(), rng.uniform_double(),
@@ -502,7 +498,7 @@ TEST(Interfaces, SmoothDielectricSplitsExactlyByFresnel) {
         for (int i = -20; i <= 20; ++i) {
             if (i == 0) continue;
             const double cos_i = i / 20.0;
-            const Vec3d wi = direction_at(cos_i, 0.7);
+            const Vec3d wi = test::direction_of(cos_i, 0.7);
             const double rel = cos_i > 0 ? eta : 1 / eta;  // η_t/η_i seen from wi's side
             const double mu = std::abs(cos_i), sin2_t = (1 - mu * mu) / sqr(rel);
             double F = 1;
@@ -635,7 +631,7 @@ TEST(Interfaces, RoughDielectricEnergyIsWhatG2Keeps) {
                           {1.5, 0.5, kBelow},
                           {1.5, 0.2, kGrazing},
                           {1 / 1.5, 0.2, kBelow},
-                          {1.5, 1.0, direction_at(0.3, 0)}};
+                          {1.5, 1.0, test::direction_of(0.3, 0)}};
     for (const TransmissionMasking masking : kMaskings)
         for (const Case& c : cases) {
             DielectricInterface<double> d{c.eta, c.alpha};

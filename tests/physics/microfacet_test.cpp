@@ -20,10 +20,6 @@ using test::Chi2Draw;
 
 constexpr double kAlphas[] = {0.001, 0.05, 0.2, 0.5, 1.0};
 
-Vec3d direction_at(double cos_theta, double phi) {
-    return test::direction_of(cos_theta, phi);
-}
-
 TEST(Microfacet, NormalDistributionIsNormalized) {
     // ∫ D(wm) cos θm dωm = 1 (the projected microfacet area equals the macro area, Walter Eq. 4).
     // D depends on θm only; with u = sin²θm, dω = dφ d(cos θm) = dφ du/(2 cos θm), so
@@ -57,8 +53,12 @@ TEST(Microfacet, NormalDistributionIsNormalized) {
 }
 
 // Directions of w for the visible-normal tests: normal, oblique, grazing, and below the surface.
-const Vec3d kViews[] = {Vec3d(0, 0, 1),          direction_at(0.7, 0.3),  direction_at(0.2, 2.0),
-                        direction_at(0.01, 4.0), direction_at(-0.5, 1.0), direction_at(-0.02, 5.5)};
+const Vec3d kViews[] = {Vec3d(0, 0, 1),
+                        test::direction_of(0.7, 0.3),
+                        test::direction_of(0.2, 2.0),
+                        test::direction_of(0.01, 4.0),
+                        test::direction_of(-0.5, 1.0),
+                        test::direction_of(-0.02, 5.5)};
 
 TEST(Microfacet, VisibleNormalsAreNormalized) {
     // ∫ D_w(wm) dωm = 1 for every w, including below the surface and grazing (Heitz 2014, Eq. 38
@@ -132,7 +132,7 @@ TEST(Microfacet, LambdaMatchesClosedForm) {
         for (int i = 1; i <= 200; ++i) {
             const double cos_theta = i / 200.0;
             for (double side : {1.0, -1.0}) {
-                const Vec3d w = direction_at(side * cos_theta, 0.1 * i);
+                const Vec3d w = test::direction_of(side * cos_theta, 0.1 * i);
                 const double x = sqr(alpha) * (1 - sqr(cos_theta)) / sqr(cos_theta);
                 const double expected =
                     x > 1e-3 ? lambda_closed_form(alpha, cos_theta)
@@ -156,8 +156,10 @@ TEST(Microfacet, MaskingShadowingBounds) {
     for (double alpha : kAlphas) {
         const GGX<double> ggx{alpha};
         for (int i = 0; i < 2000; ++i) {
-            const Vec3d wi = direction_at(2 * rng.uniform_double() - 1, 7 * rng.uniform_double());
-            const Vec3d wo = direction_at(2 * rng.uniform_double() - 1, 7 * rng.uniform_double());
+            const Vec3d wi =
+                test::direction_of(2 * rng.uniform_double() - 1, 7 * rng.uniform_double());
+            const Vec3d wo =
+                test::direction_of(2 * rng.uniform_double() - 1, 7 * rng.uniform_double());
             const double g2 = ggx.G2(wi, wo);
             EXPECT_LE(g2, std::min(ggx.G1(wi), ggx.G1(wo)) * (1 + 1e-15));
             EXPECT_GE(g2, ggx.G1(wi) * ggx.G1(wo) * (1 - 1e-15));
@@ -179,10 +181,11 @@ TEST(MicrofacetStat, VisibleNormalSamplingChi2) {
         double alpha;
         Vec3d w;
     };
-    const Case cases[] = {{0.05, direction_at(0.7, 0.3)},  {0.2, Vec3d(0, 0, 1)},
-                          {0.2, direction_at(0.02, 2.0)},  {0.5, direction_at(-0.5, 1.0)},
-                          {0.5, direction_at(0.3, 5.0)},   {1.0, direction_at(-0.02, 5.5)},
-                          {0.05, direction_at(-0.05, 1.0)}};
+    const Case cases[] = {
+        {0.05, test::direction_of(0.7, 0.3)},  {0.2, Vec3d(0, 0, 1)},
+        {0.2, test::direction_of(0.02, 2.0)},  {0.5, test::direction_of(-0.5, 1.0)},
+        {0.5, test::direction_of(0.3, 5.0)},   {1.0, test::direction_of(-0.02, 5.5)},
+        {0.05, test::direction_of(-0.05, 1.0)}};
     static_assert(std::size(cases) + 2 + 4 == kVisibleNormalChi2Tests);
     for (const Case& c : cases) {
         const GGX<double> ggx{c.alpha};
@@ -209,10 +212,10 @@ TEST(MicrofacetStat, CompleteVisibleNormalSamplingChi2) {
         double alpha;
         Vec3d w;
     };
-    const Case cases[] = {{0.5, direction_at(-0.5, 1.0)},
-                          {1.0, direction_at(-0.9, 2.0)},
-                          {0.2, direction_at(-0.05, 4.0)},
-                          {0.5, direction_at(0.4, 0.5)}};
+    const Case cases[] = {{0.5, test::direction_of(-0.5, 1.0)},
+                          {1.0, test::direction_of(-0.9, 2.0)},
+                          {0.2, test::direction_of(-0.05, 4.0)},
+                          {0.5, test::direction_of(0.4, 0.5)}};
     static_assert(std::size(cases) + 7 + 2 == kVisibleNormalChi2Tests);
     for (const Case& c : cases) {
         const GGX<double> ggx{c.alpha};
@@ -238,7 +241,7 @@ TEST(MicrofacetStat, SharpVisibleNormalLobeChi2) {
     // P(tan²θm > T) = α²/(α² + T) outside (T ≈ 16α², i.e. ≈ 6 %), which joins the absent bin.
     for (double alpha : {0.05, 0.01}) {
         const GGX<double> ggx{alpha};
-        const Vec3d w = direction_at(0.999, 1.0);
+        const Vec3d w = test::direction_of(0.999, 1.0);
         test::Chi2Options o;
         o.name = "visible_normals_zoomed_a" + std::to_string(alpha);
         o.test_count = kVisibleNormalChi2Tests;

@@ -8,6 +8,7 @@
 #include "core/rng.h"
 #include "core/vec.h"
 #include "physics/fresnel.h"
+#include "support/chi2.h"
 
 #include <gtest/gtest.h>
 
@@ -248,13 +249,8 @@ Vec3d to_vec(const LaneVec3<double>& v) {
 LaneVec3<double> to_lane(const Vec3d& v) {
     return {v.x, v.y, v.z};
 }
-Vec3d random_direction(ParticleRng& rng) {
-    const double z = 2 * rng.uniform_double() - 1, phi = 2 * kPi<double> * rng.uniform_double();
-    const double r = std::sqrt(1 - z * z);
-    return {r * std::cos(phi), r * std::sin(phi), z};
-}
 Vec3d perpendicular(const Vec3d& d, ParticleRng& rng) {
-    return normalize(cross(d, random_direction(rng)));
+    return normalize(cross(d, test::uniform_sphere_direction(rng)));
 }
 
 // A complex field vector E ⊥ d and its Stokes vector in the frame x (y = d × x).
@@ -287,12 +283,12 @@ StokesLanes<double> state_of(const Stokes& s, const Vec3d& x) {
 TEST(Polarization, FrameRotationDescribesTheSameField) {
     ParticleRng rng(6, 0, 0);
     for (int k = 0; k < 500; ++k) {
-        const Vec3d d = random_direction(rng);
+        const Vec3d d = test::uniform_sphere_direction(rng);
         const Vec3d x = perpendicular(d, rng);
         const Field f = random_field(d, x, rng);
         const Stokes before = stokes_in_frame(f, d, x);
         StokesLanes<double> st = state_of(before, x);
-        const Vec3d n = cross(d, random_direction(rng)) * 3.0;  // any length
+        const Vec3d n = cross(d, test::uniform_sphere_direction(rng)) * 3.0;  // any length
         stokes_rotate_frame<double>(st, to_lane(d), to_lane(n), 1, true);
         const Stokes after = stokes_in_frame(f, d, normalize(n));
         EXPECT_NEAR(to_vec(st.x).x, normalize(n).x, 1e-14);
@@ -317,7 +313,7 @@ TEST(Polarization, FacetReflectionMatchesTheMirrorField) {
     ParticleRng rng(7, 0, 0);
     for (int k = 0; k < 500; ++k) {
         const Vec3d m = normalize(Vec3d(rng.uniform_double() - 0.5, rng.uniform_double() - 0.5, 1));
-        Vec3d d = random_direction(rng);
+        Vec3d d = test::uniform_sphere_direction(rng);
         if (dot(d, m) > 0) d = -d;  // arriving at the facet from the side m points to
         const Vec3d d_r = d - m * (2 * dot(d, m));
         const Vec3d x = perpendicular(d, rng);
@@ -413,7 +409,7 @@ TEST(Polarization, MuellerMatrixOfTheTransposedJonesMatrix) {
 TEST(Polarization, BinFrame) {
     ParticleRng rng(9, 0, 0);
     for (int k = 0; k < 100; ++k) {
-        const Vec3d d = random_direction(rng);
+        const Vec3d d = test::uniform_sphere_direction(rng);
         const Vec3d x = to_vec(stokes_bin_frame<double>(to_lane(d)));
         EXPECT_NEAR(dot(x, d), 0.0, 1e-15);
         EXPECT_EQ(x.z, 0.0);

@@ -17,7 +17,6 @@ namespace lamina {
 namespace {
 
 using C = std::complex<double>;
-constexpr double kPi = std::numbers::pi;
 
 // The mean of R_s and R_p over thickness_waves uniform in [w0, w1] by the midpoint rule on
 // 200,000 points (the integrand is smooth and periodic: the rule's error is far below 1e-10).
@@ -41,7 +40,7 @@ TEST(ThinFilmAverage, MeanInverseCosineSumAgainstQuadrature) {
     };
     for (const Case& k : {Case{1.25, 1.0, 0.1, 1.3}, Case{1.25, -1.0, 2.9, 3.5},
                           Case{1.01, 0.2, -7.0, 40.0}, Case{1 + 0.99 * 0.99, 2 * 0.99, 3.0, 9.7},
-                          Case{1.0, 0.0, 0.5, 0.6}, Case{2.0, 1.5, kPi, 3 * kPi}}) {
+                          Case{1.0, 0.0, 0.5, 0.6}, Case{2.0, 1.5, kPi<double>, 3 * kPi<double>}}) {
         constexpr int kSteps = 400000;
         double sum = 0;
         for (int i = 0; i < kSteps; ++i)
@@ -63,10 +62,10 @@ TEST(ThinFilmAverage, EqualsTheAiryReflectanceAveragedNumerically) {
         double w0, w1;
     };
     for (const Case& k : {Case{1.0, C(1.38), C(1.52), 0.05, 0.21},
-                          Case{std::cos(40 * kPi / 180), C(1.45), C(2.0), 0.3, 1.9},
-                          Case{std::cos(60 * kPi / 180), C(1.5), C(0.27, 3.41), 0.3, 0.9},
-                          Case{std::cos(75 * kPi / 180), C(2.5), C(0.18, 3.1), 0.01, 0.02},
-                          Case{std::cos(85 * kPi / 180), C(1.2), C(1.2, 7.3), 0.0, 3.7},
+                          Case{std::cos(40 * kPi<double> / 180), C(1.45), C(2.0), 0.3, 1.9},
+                          Case{std::cos(60 * kPi<double> / 180), C(1.5), C(0.27, 3.41), 0.3, 0.9},
+                          Case{std::cos(75 * kPi<double> / 180), C(2.5), C(0.18, 3.1), 0.01, 0.02},
+                          Case{std::cos(85 * kPi<double> / 180), C(1.2), C(1.2, 7.3), 0.0, 3.7},
                           Case{0.3, C(1.8), C(1.33), 1.1, 1.4}}) {
         const auto closed = thin_film_reflectance_mean(k.cos_i, k.film, k.exit, k.w0, k.w1);
         ASSERT_TRUE(closed.has_value());
@@ -79,7 +78,7 @@ TEST(ThinFilmAverage, EqualsTheAiryReflectanceAveragedNumerically) {
 TEST(ThinFilmAverage, WholePeriodsGiveTheIncoherentSlab) {
     // Over n whole periods of the round-trip phase the mean is the incoherent sum of the two
     // boundaries' intensities, R12 + (1 − R12)² R23 / (1 − R12 R23), whatever the start.
-    const double cos_i = std::cos(35 * kPi / 180), sin2 = 1 - cos_i * cos_i;
+    const double cos_i = std::cos(35 * kPi<double> / 180), sin2 = 1 - cos_i * cos_i;
     const C film(1.6), exit(0.47, 2.4);
     const C u2 = normal_wave_number(film, sin2);
     const double period = 1 / (2 * u2.real());

@@ -19,7 +19,6 @@ namespace lamina {
 namespace {
 
 using C = std::complex<double>;
-constexpr double kPi = std::numbers::pi;
 
 double reflectance(const ThinFilmMueller<double>& m) {
     return m.reflection.a;
@@ -51,7 +50,7 @@ MatrixResult characteristic_matrix(bool s_polarized, double cos_i, C eta_film, C
     };
     const C y1 = admittance(C(1), C(cos_i)), yf = admittance(eta_film, cf),
             y3 = admittance(eta_exit, c3);
-    const C delta = 2 * kPi * thickness_waves * eta_film * cf;
+    const C delta = 2 * kPi<double> * thickness_waves * eta_film * cf;
     const C i(0, 1);
     const C m11 = std::cos(delta), m12 = -i * std::sin(delta) / yf, m21 = -i * yf * std::sin(delta),
             m22 = std::cos(delta);
@@ -129,7 +128,7 @@ TEST(ThinFilm, SoapFilmInAir) {
     // air | 1.33 | air at normal incidence, λ = 550 nm: R = 2R0(1 − cos 2δ)/(1 + R0² − 2R0 cos 2δ).
     const double r0 = std::pow(0.33 / 2.33, 2);
     for (double d_nm : {0.0, 50.0, 103.4, 200.0, 300.0}) {
-        const double two_delta = 4 * kPi * 1.33 * d_nm / 550;
+        const double two_delta = 4 * kPi<double> * 1.33 * d_nm / 550;
         const double expected =
             2 * r0 * (1 - std::cos(two_delta)) / (1 + r0 * r0 - 2 * r0 * std::cos(two_delta));
         EXPECT_NEAR(reflectance(thin_film_mueller(1.0, C(1.33), C(1.0), d_nm / 550)), expected,
@@ -228,7 +227,7 @@ TEST(ThinFilm, PeriodAverageIsTheIncoherentSlab) {
     // Averaged over one period of thickness (δ over [0, π)), the coherent R of each polarization
     // is the incoherent sum R12 + T12² R23 / (1 − R12 R23) of the |r|² series (a lossless film).
     // 1 | 1.45 | 2.0 and 1 | 1.45 | 0.47 + 2.4i at 40°.
-    const double cos_i = std::cos(40 * kPi / 180);
+    const double cos_i = std::cos(40 * kPi<double> / 180);
     struct Case {
         C exit;
         double s, p;

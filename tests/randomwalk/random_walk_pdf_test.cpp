@@ -24,10 +24,6 @@
 namespace lamina {
 namespace {
 
-Stack example(const std::string& name) {
-    return load_stack(std::string(LAMINA_SOURCE_DIR) + "/examples/" + name + ".json");
-}
-
 // ---- (c) Closed forms without noise ------------------------------------------------------------
 // A stack of one rough interface or a Lambertian alone: every walk has exactly one non-delta
 // vertex (the interface itself) and leaves from it, so the estimate is that interface's own
@@ -177,7 +173,8 @@ void expect_sample_matches_pdf(const PdfCase& c, int test_count) {
 }
 
 TEST(RandomWalkPdfStat, SampleHistogramMatchesThePdfAndItsIntegral) {
-    std::vector<PdfCase> cases = {{"plastic", example("plastic")}, {"slab", example("slab")}};
+    std::vector<PdfCase> cases = {{"plastic", test::example("plastic")},
+                                  {"slab", test::example("slab")}};
     // A smooth coat (delta chains, TIR) over a scattering medium with per-channel extinction and
     // g (the spectral-MIS flight probabilities of §1.4) over a coloured Lambertian.
     cases.push_back(
@@ -222,9 +219,10 @@ TEST(RandomWalkPdfStat, MultipleScatteringSampleHistogramMatchesThePdf) {
 // The exactness condition: a scattering medium with per-channel extinction under a smooth
 // coloured conductor makes the chain probabilities non-linear in the weights.
 TEST(RandomWalkPdf, ReportsWhenItsEstimateIsNotExact) {
-    EXPECT_TRUE(RandomWalkStack(example("milky-coat"), test::bpb19_transport()).pdf_is_unbiased());
     EXPECT_TRUE(
-        RandomWalkStack(example("metallic-paint"), test::bpb19_transport()).pdf_is_unbiased());
+        RandomWalkStack(test::example("milky-coat"), test::bpb19_transport()).pdf_is_unbiased());
+    EXPECT_TRUE(RandomWalkStack(test::example("metallic-paint"), test::bpb19_transport())
+                    .pdf_is_unbiased());
     const Stack mixed = test::make_stack(
         {test::with_medium(test::dielectric_layer(1.5, 0.2), Rgbd(0.0), Rgbd(0.2, 0.5, 1.0)),
          test::conductor_layer(Rgbd(0.2, 0.4, 1.4), Rgbd(3.9, 2.4, 1.6), 0.0)});
@@ -234,7 +232,7 @@ TEST(RandomWalkPdf, ReportsWhenItsEstimateIsNotExact) {
 // Polarized walks: pdf() is the unpolarized walk's exit density (a proxy, random_walk.h), the
 // same estimate bit for bit as without polarization, and says it is not exact.
 TEST(RandomWalkPdf, PolarizedWalksKeepTheUnpolarizedDensity) {
-    const Stack stack = example("frosted-gold");
+    const Stack stack = test::example("frosted-gold");
     const RandomWalkStack plain(stack, test::bpb19_transport()),
         polarized(stack, {.microsurface = Microsurface::Single, .polarization = true});
     EXPECT_FALSE(polarized.pdf_is_unbiased());

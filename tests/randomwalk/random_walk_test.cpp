@@ -171,15 +171,11 @@ void expect_tables_agree(const Stack& stack, double theta_i, int p, std::uint64_
     }
 }
 
-Stack example(const std::string& name) {
-    return load_stack(std::string(LAMINA_SOURCE_DIR) + "/examples/" + name + ".json");
-}
-
 // ---- Agreement with the goniophotometer --------------------------------------------------------
 TEST(RandomWalkStat, AgreesWithTheGoniophotometerOnEveryExample) {
     for (const char* name : {"plastic", "metallic-paint", "frosted-gold", "milky-coat", "slab"})
         for (double ti : {35.0, 65.0})
-            expect_tables_agree(example(name), ti, 3, 1500, 4'000'000,
+            expect_tables_agree(test::example(name), ti, 3, 1500, 4'000'000,
                                 std::string(name) + " θi=" + std::to_string(ti));
 }
 
@@ -333,8 +329,8 @@ TEST(RandomWalkGolden, DeltaLobesOfSmoothSlabAndCoatedConductor) {
 
 // ---- Reciprocity: f(wi, wo) = f(wo, wi) within noise, for BRDFs -------------------------------
 TEST(RandomWalkStat, Reciprocity) {
-    std::vector<Stack> stacks = {example("plastic"), example("metallic-paint"),
-                                 example("milky-coat"), example("frosted-gold")};
+    std::vector<Stack> stacks = {test::example("plastic"), test::example("metallic-paint"),
+                                 test::example("milky-coat"), test::example("frosted-gold")};
     stacks.push_back(test::make_stack(
         {test::with_medium(test::dielectric_layer(1.5, 0.0), Rgbd(0.1), Rgbd(1.0), Rgbd(0.6)),
          test::conductor_layer(Rgbd(0.2), Rgbd(3.0), 0.3)}));
@@ -527,7 +523,7 @@ void expect_sample_agrees_with_eval(const std::string& name, const Stack& stack,
 
 TEST(RandomWalkStat, SampleAgreesWithEval) {
     for (const char* name : {"plastic", "slab", "milky-coat"})
-        expect_sample_agrees_with_eval(name, example(name), RwMicrosurface::Single);
+        expect_sample_agrees_with_eval(name, test::example(name), RwMicrosurface::Single);
 }
 
 // ---- Multiple scattering on the microsurfaces (docs/rendering.md §1.6) --------------------------
@@ -639,7 +635,7 @@ TEST(RandomWalkGolden, PolarizedDeltaLobesOfASmoothSlab) {
 
 // ---- Reproducibility ---------------------------------------------------------------------------
 TEST(RandomWalk, DeterministicForASeedAndNoisierWithFewerWalks) {
-    const RandomWalkStack rw(example("milky-coat"), test::bpb19_transport());
+    const RandomWalkStack rw(test::example("milky-coat"), test::bpb19_transport());
     const Vec3d wi = incident_direction(0.5), wo = direction_from_angles(0.9, 2.5);
     const RandomWalkEstimate a = rw.eval(wi, wo, 2000, 1, 7), b = rw.eval(wi, wo, 2000, 1, 7);
     const RandomWalkEstimate c = rw.eval(wi, wo, 2000, 2, 7);
@@ -656,7 +652,7 @@ TEST(RandomWalk, OpaqueBaseHasNoBtdfAndBlackStackIsBlack) {
                                 test::bpb19_transport());
     const Vec3d wi = incident_direction(0.4);
     EXPECT_EQ(black.eval(wi, direction_from_angles(0.3, 1.0), 100, 1, 1).f, Rgbd(0.0));
-    const RandomWalkStack plastic(example("plastic"), test::bpb19_transport());
+    const RandomWalkStack plastic(test::example("plastic"), test::bpb19_transport());
     EXPECT_EQ(plastic.eval(wi, direction_from_angles(0.3, 1.0, Side::Transmission), 100, 1, 1).f,
               Rgbd(0.0));
     // A Lambertian alone: every walk connects once, exactly albedo/π (zero variance).

@@ -54,7 +54,7 @@ Layer with_film(Layer layer, double thickness_nm, double eta, double k = 0.0,
 
 // |estimate − exact| < 5 se (+1e-7, the float kernel's rounding of a budget); budgets close to
 // 1e-5.
-void expect_within_se(double estimate, double exact, double se, const std::string& what) {
+void expect_within_se_of_float(double estimate, double exact, double se, const std::string& what) {
     test::expect_within_se(estimate, exact, se, what, 1e-7);
 }
 void expect_budget_closes(const SimulationResult& r) {
@@ -90,9 +90,10 @@ TEST(ThinFilmStackStat, SmoothFilmedInterface) {
                 const double T = mode == 2 ? sp.Ts : (sp.Ts + sp.Tp) / 2;
                 const std::string what =
                     "mode " + std::to_string(mode) + " θ " + std::to_string(angles[i]);
-                expect_within_se(b[BudgetTerm::Reflected][c], R, b.reflected_se[c], "R " + what);
-                expect_within_se(b[BudgetTerm::Transmitted][c], T, b.transmitted_se[c],
-                                 "T " + what);
+                expect_within_se_of_float(b[BudgetTerm::Reflected][c], R, b.reflected_se[c],
+                                          "R " + what);
+                expect_within_se_of_float(b[BudgetTerm::Transmitted][c], T, b.transmitted_se[c],
+                                          "T " + what);
             }
         }
         expect_budget_closes(r);
@@ -145,9 +146,10 @@ TEST(ThinFilmStackStat, FilmedSmoothSlab) {
                 const double T = polarization ? (Ts + Tp) / 2 : Tu;
                 const std::string what = std::string(polarization ? "polarized" : "unpolarized") +
                                          " θ " + std::to_string(angles[i]);
-                expect_within_se(b[BudgetTerm::Reflected][c], R, b.reflected_se[c], "R " + what);
-                expect_within_se(b[BudgetTerm::Transmitted][c], T, b.transmitted_se[c],
-                                 "T " + what);
+                expect_within_se_of_float(b[BudgetTerm::Reflected][c], R, b.reflected_se[c],
+                                          "R " + what);
+                expect_within_se_of_float(b[BudgetTerm::Transmitted][c], T, b.transmitted_se[c],
+                                          "T " + what);
                 unpolarized_gap =
                     std::max(unpolarized_gap, std::abs((Rs + Rp) / 2 - Ru) / b.reflected_se[c]);
             }
@@ -311,9 +313,9 @@ TEST(ThinFilmStackStat, FilmUnderACoat) {
                 };
                 const double R = polarization ? (series(Fs, film.Rs) + series(Fp, film.Rp)) / 2
                                               : series(top.reflection.a, (film.Rs + film.Rp) / 2);
-                expect_within_se(b[BudgetTerm::Reflected][c], R, b.reflected_se[c],
-                                 std::string(polarization ? "polarized" : "unpolarized") + " θ " +
-                                     std::to_string(angles[i]));
+                expect_within_se_of_float(b[BudgetTerm::Reflected][c], R, b.reflected_se[c],
+                                          std::string(polarization ? "polarized" : "unpolarized") +
+                                              " θ " + std::to_string(angles[i]));
             }
         }
         expect_budget_closes(r);
@@ -333,8 +335,8 @@ TEST(ThinFilmStackStat, ThicknessOverOnePeriodIsTheIncoherentSlab) {
     const double R = R12 + (1 - R12) * (1 - R12) * R23 / (1 - R12 * R23);
     const EnergyBudget& b = r.incidences[0].budget;
     for (int c = 0; c < 3; ++c) {
-        expect_within_se(b[BudgetTerm::Reflected][c], R, b.reflected_se[c], "R");
-        expect_within_se(b[BudgetTerm::Transmitted][c], 1 - R, b.transmitted_se[c], "T");
+        expect_within_se_of_float(b[BudgetTerm::Reflected][c], R, b.reflected_se[c], "R");
+        expect_within_se_of_float(b[BudgetTerm::Transmitted][c], 1 - R, b.transmitted_se[c], "T");
     }
     // Far from the coherent film at the range's lower end (300 nm: R = 0.0957, the slab 0.1272).
     EXPECT_GT(std::abs(thin_film_mueller(1.0, C(nf), C(n3), 300 / lambda).reflection.a - R), 0.02);
@@ -358,9 +360,9 @@ TEST(ThinFilmStackStat, RoughFilmedDielectricWhiteFurnace) {
                 for (int c = 0; c < 3; ++c) {
                     const double total =
                         st.budget[BudgetTerm::Reflected][c] + st.budget[BudgetTerm::Transmitted][c];
-                    expect_within_se(total, 1.0,
-                                     st.budget.reflected_se[c] + st.budget.transmitted_se[c],
-                                     "R + T");
+                    expect_within_se_of_float(
+                        total, 1.0, st.budget.reflected_se[c] + st.budget.transmitted_se[c],
+                        "R + T");
                     EXPECT_NEAR(st.budget[BudgetTerm::LostMicrosurface][c], 0.0, 1e-4);
                     EXPECT_NEAR(st.budget[BudgetTerm::CutOff][c], 0.0, 1e-12);
                 }
@@ -373,7 +375,7 @@ TEST(ThinFilmStackStat, RoughFilmedDielectricWhiteFurnace) {
     const SimulationResult r = simulate(slab, scalar_settings({30, 75}, 100'000, true));
     for (const IncidenceStats& st : r.incidences)
         for (int c = 0; c < 3; ++c)
-            expect_within_se(
+            expect_within_se_of_float(
                 st.budget[BudgetTerm::Reflected][c] + st.budget[BudgetTerm::Transmitted][c], 1.0,
                 st.budget.reflected_se[c] + st.budget.transmitted_se[c], "R + T slab");
 }
@@ -399,10 +401,11 @@ TEST(ThinFilmStackStat, ThicknessZeroIsTheBareStack) {
         for (std::size_t i = 0; i < 2; ++i)
             for (int c = 0; c < 3; ++c) {
                 const EnergyBudget &a = bare.incidences[i].budget, &b = film.incidences[i].budget;
-                expect_within_se(b[BudgetTerm::Reflected][c], a[BudgetTerm::Reflected][c],
-                                 std::hypot(a.reflected_se[c], b.reflected_se[c]), "R");
-                expect_within_se(b[BudgetTerm::Transmitted][c], a[BudgetTerm::Transmitted][c],
-                                 std::hypot(a.transmitted_se[c], b.transmitted_se[c]), "T");
+                expect_within_se_of_float(b[BudgetTerm::Reflected][c], a[BudgetTerm::Reflected][c],
+                                          std::hypot(a.reflected_se[c], b.reflected_se[c]), "R");
+                expect_within_se_of_float(
+                    b[BudgetTerm::Transmitted][c], a[BudgetTerm::Transmitted][c],
+                    std::hypot(a.transmitted_se[c], b.transmitted_se[c]), "T");
             }
     }
 }

@@ -46,6 +46,8 @@
 // On failure both histograms (observed, expected) are written, as text and as one PGM image (left:
 // observed, right: expected, same scale), to <build>/chi2/<name>.{txt,pgm}; the path is printed.
 
+#include "core/math.h"
+#include "core/rng.h"
 #include "core/vec.h"
 
 #include <array>
@@ -139,6 +141,12 @@ double integrate_hemisphere(const Chi2PdfFn& f, double alpha, double eps, int ph
 inline Vec3d direction_of(double cos_theta, double phi) {
     const double s = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
     return {s * std::cos(phi), s * std::sin(phi), cos_theta};
+}
+
+/// A direction uniform on the whole sphere (two of rng's draws).
+inline Vec3d uniform_sphere_direction(ParticleRng& rng) {
+    const double cos_theta = 1 - 2 * rng.uniform_double();
+    return direction_of(cos_theta, 2 * kPi<double> * rng.uniform_double());
 }
 
 }  // namespace lamina::test

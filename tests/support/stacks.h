@@ -24,6 +24,11 @@ inline Stack make_stack(std::vector<Layer> layers, std::string name = "test") {
     return Stack{std::move(name), 1.0, std::move(layers)};
 }
 
+/// examples/<name>.json, a stack lamina ships.
+inline Stack example(const std::string& name) {
+    return load_stack(std::string(LAMINA_SOURCE_DIR) + "/examples/" + name + ".json");
+}
+
 /// The 2019 reference's transport (unpolarized Fresnel factors, single-scattering interfaces):
 /// the one most closed forms in the tests are written for.
 inline TransportSettings bpb19_transport() {

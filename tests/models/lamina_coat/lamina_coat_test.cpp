@@ -103,7 +103,7 @@ TEST(LaminaCoat, IsReciprocal) {
 }
 
 /// ∫ f cos θo dωo (midpoint rule in θo, φo, finer near the mirror) plus the delta lobes.
-Rgbd albedo(const Model& m, const Vec3d& wi) {
+Rgbd albedo_by_midpoints(const Model& m, const Vec3d& wi) {
     Rgbd sum(0.0);
     const int nt = 400, np = 400;
     for (int t = 0; t < nt; ++t) {
@@ -129,7 +129,7 @@ TEST(LaminaCoat, ConservesEnergyAndAWhiteFurnaceReturnsEverything) {
         const auto white =
             make_model("lamina-coat", test::coated(1.5, alpha, test::lambertian(Rgbd(1.0))));
         for (double theta : {0.0, 45.0, 75.0}) {
-            const Rgbd a = albedo(*white, dir(theta, 0));
+            const Rgbd a = albedo_by_midpoints(*white, dir(theta, 0));
             for (int c = 0; c < 3; ++c)
                 EXPECT_NEAR(a[c], 1.0, 3e-3) << alpha << " " << theta;
         }
@@ -139,7 +139,7 @@ TEST(LaminaCoat, ConservesEnergyAndAWhiteFurnaceReturnsEverything) {
                            test::coated(2.0, 0.5, test::conductor(Rgbd(0.05), Rgbd(8.0), 0.1))}) {
         const auto m = make_model("lamina-coat", s);
         for (double theta : {0.0, 45.0, 75.0}) {
-            const Rgbd a = albedo(*m, dir(theta, 0));
+            const Rgbd a = albedo_by_midpoints(*m, dir(theta, 0));
             for (int c = 0; c < 3; ++c)
                 EXPECT_LE(a[c], 1.0 + 1e-3) << theta;
         }

@@ -33,22 +33,16 @@ using test::fresnel_ref;
 
 using nlohmann::json;
 
-json load(const std::string& name) {
-    return test::load_golden(name);
-}
-Rgbd rgb(const json& j) {
-    return test::golden_rgb(j);
-}
-
 /// The lamina stack a record describes: an interface is anisotropic where the record gives its
 /// "alphaK_xy": [alpha_x, alpha_y] and "tangentK_deg" (K = 0 the coat, 1 the base), its
 /// "alphaK" then being OpenPBR's isotropic α (openpbr_isotropic_alpha).
 Stack stack_of(const json& s) {
-    const Rgbd tau = rgb(s.at("tau"));
+    const Rgbd tau = test::golden_rgb(s.at("tau"));
     InterfaceSpec base =
         s.at("base") == "lambertian"
-            ? test::lambertian(rgb(s.at("rho")))
-            : test::conductor(rgb(s.at("eta1")), rgb(s.at("kappa1")), s.at("alpha1").get<double>());
+            ? test::lambertian(test::golden_rgb(s.at("rho")))
+            : test::conductor(test::golden_rgb(s.at("eta1")), test::golden_rgb(s.at("kappa1")),
+                              s.at("alpha1").get<double>());
     if (s.contains("film")) {  // a film on the metal base, of one thickness
         base.has_film = true;
         base.film.thickness_nm = base.film.thickness_max_nm =
@@ -110,8 +104,9 @@ Differences compare(const json& data, const json& record, const std::string& mod
         if (values.at(i).is_null()) continue;
         const json& p = pairs.at(i);
         const Vec3d wi = test::dir(p.at(0), p.at(1)), wo = test::dir(p.at(2), p.at(3));
-        const Rgbd want = rgb(values.at(i)), got = m->eval(wi, wo), got_rest = m_rest->eval(wi, wo);
-        const Rgbd want_ms = compensation ? rgb(compensation->at(i)) : Rgbd(0.0);
+        const Rgbd want = test::golden_rgb(values.at(i)), got = m->eval(wi, wo),
+                   got_rest = m_rest->eval(wi, wo);
+        const Rgbd want_ms = compensation ? test::golden_rgb(compensation->at(i)) : Rgbd(0.0);
         for (int c = 0; c < 3; ++c) {
             const std::string what = fmt::format("{} pair ({}, {}) -> ({}, {}) channel {}",
                                                  record.at("id").get<std::string>(), p.at(0).dump(),
@@ -152,11 +147,11 @@ struct BaseInputNames {
 // Returns false for a diffuse base (nothing more to check on a metal's extra inputs).
 bool expect_base_inputs(const json& s, const json& in, const std::string& id,
                         const BaseInputNames& names, double eta_above) {
-    const Rgbd base = rgb(in.at(names.color));
+    const Rgbd base = test::golden_rgb(in.at(names.color));
     if (s.at("base") == "lambertian") {
         EXPECT_EQ(in.at(names.metallic).get<double>(), 0) << id;
         EXPECT_EQ(in.at(names.specular).get<double>(), 0) << id;
-        const Rgbd rho = rgb(s.at("rho"));
+        const Rgbd rho = test::golden_rgb(s.at("rho"));
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(base[c], rho[c], 1e-6) << id;
         return false;
@@ -164,7 +159,7 @@ bool expect_base_inputs(const json& s, const json& in, const std::string& id,
     EXPECT_EQ(in.at(names.metallic).get<double>(), 1) << id;
     EXPECT_NEAR(in.at(names.roughness).get<double>(), std::sqrt(s.at("alpha1").get<double>()), 1e-6)
         << id;
-    const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1"));
+    const Rgbd eta1 = test::golden_rgb(s.at("eta1")), k1 = test::golden_rgb(s.at("kappa1"));
     for (int c = 0; c < 3; ++c)
         EXPECT_NEAR(base[c], conductor_ref(1, eta1[c] / eta_above, k1[c] / eta_above), 1e-6) << id;
     return true;
@@ -172,7 +167,8 @@ bool expect_base_inputs(const json& s, const json& in, const std::string& id,
 
 // A metal's F82 tint: F(1/7)/F_Schlick(1/7) of its F0 = F(1; η1/η0, κ1/η0), clamped to [0, 1].
 void expect_f82_tint(const json& s, const json& tint_input, const std::string& id, double eta0) {
-    const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1")), tint = rgb(tint_input);
+    const Rgbd eta1 = test::golden_rgb(s.at("eta1")), k1 = test::golden_rgb(s.at("kappa1")),
+               tint = test::golden_rgb(tint_input);
     for (int c = 0; c < 3; ++c) {
         const double f0 = conductor_ref(1, eta1[c] / eta0, k1[c] / eta0);
         const double schlick_edge = f0 + (1 - f0) * std::pow(6.0 / 7, 5);
@@ -197,7 +193,7 @@ void print_worst(const std::string& label, const Differences& worst, const std::
 // coat, η0, rather than against air).
 void expect_fixed_coat_inputs(const std::string& file, const char* coat_roughness,
                               const BaseInputNames& names, bool metal_under_coat) {
-    for (const json& record : load(file).at("stacks")) {
+    for (const json& record : test::load_golden(file).at("stacks")) {
         const json &s = record.at("stack"), &in = record.at("inputs");
         const std::string id = record.at("id");
         const double eta0 = s.at("eta0");
@@ -213,7 +209,7 @@ void expect_fixed_coat_inputs(const std::string& file, const char* coat_roughnes
 // `lobe`) compared on its own where the data file records it.
 void expect_matches_with_compensation(const std::string& file, const std::string& model,
                                       const std::string& lobe_off, const std::string& lobe) {
-    const json data = load(file);
+    const json data = test::load_golden(file);
     Differences worst;
     for (const json& record : data.at("stacks")) {
         const json* compensation =
@@ -239,7 +235,8 @@ void expect_openpbr_inputs_follow_the_mapping(const json& data) {
         EXPECT_NEAR(in.at("coat_roughness").get<double>(), std::sqrt(s.at("alpha0").get<double>()),
                     1e-6)
             << id;
-        const Rgbd tau = rgb(s.at("tau")), coat_color = rgb(in.at("coat_color"));
+        const Rgbd tau = test::golden_rgb(s.at("tau")),
+                   coat_color = test::golden_rgb(in.at("coat_color"));
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(coat_color[c], std::exp(-2 * tau[c]), 1e-6) << id;
         if (expect_base_inputs(
@@ -249,13 +246,13 @@ void expect_openpbr_inputs_follow_the_mapping(const json& data) {
     }
 }
 TEST(ProductionCoatsGolden, OpenPbrAdobeInputsFollowTheMapping) {
-    expect_openpbr_inputs_follow_the_mapping(load("openpbr-adobe.json"));
+    expect_openpbr_inputs_follow_the_mapping(test::load_golden("openpbr-adobe.json"));
 }
 // And at anisotropic settings: an interface's α_x ≥ α_y at tangent ψ is OpenPBR's anisotropy
 // a = 1 − α_y/α_x rotated by ψ (α_t = α √(2/(1 + (1 − a)²)), α_b = (1 − a) α_t of the isotropic
 // α the mapping above checks); an isotropic interface has a = 0.
 TEST(ProductionCoatsGolden, OpenPbrAdobeAnisotropicInputsFollowTheMapping) {
-    const json data = load("openpbr-adobe-anisotropic.json");
+    const json data = test::load_golden("openpbr-adobe-anisotropic.json");
     expect_openpbr_inputs_follow_the_mapping(data);
     for (const json& record : data.at("stacks")) {
         const json &s = record.at("stack"), &in = record.at("inputs");
@@ -277,7 +274,7 @@ TEST(ProductionCoatsGolden, OpenPbrAdobeAnisotropicInputsFollowTheMapping) {
     }
 }
 TEST(ProductionCoatsGolden, OpenPbrMaterialXInputsFollowTheMapping) {
-    expect_openpbr_inputs_follow_the_mapping(load("openpbr-materialx.json"));
+    expect_openpbr_inputs_follow_the_mapping(test::load_golden("openpbr-materialx.json"));
 }
 
 // `openpbr-adobe` against openpbr-bsdf itself: as shipped (the coat's albedo scaling on the view
@@ -289,7 +286,7 @@ TEST(ProductionCoatsGolden, OpenPbrMaterialXInputsFollowTheMapping) {
 void expect_openpbr_adobe_matches(
     const std::string& file,
     const std::vector<std::pair<std::string, std::vector<std::string>>>& variants) {
-    const json data = load(file);
+    const json data = test::load_golden(file);
     for (const auto& [key, options] : variants) {
         std::vector<std::string> ms_off = options;
         ms_off.push_back("multiple-scattering=off");
@@ -368,7 +365,7 @@ TEST(ProductionCoatsGolden, EnterprisePbrMatchesDspbr) {
 // specular tint the F82 tint F(1/7)/F_Schlick(1/7) clamped to [0, 1], roughness √α1, metallic 1; a
 // diffuse base's base colour ρ, metallic 0, specular IOR level 0.
 TEST(ProductionCoatsGolden, BlenderPrincipledInputsFollowTheMapping) {
-    const json data = load("blender-principled.json");
+    const json data = test::load_golden("blender-principled.json");
     for (const json& record : data.at("stacks")) {
         const json &s = record.at("stack"), &in = record.at("inputs");
         const std::string id = record.at("id");
@@ -378,7 +375,7 @@ TEST(ProductionCoatsGolden, BlenderPrincipledInputsFollowTheMapping) {
         EXPECT_NEAR(in.at("coat_roughness").get<double>(), std::sqrt(s.at("alpha0").get<double>()),
                     1e-6)
             << id;
-        const Rgbd tau = rgb(s.at("tau")), tint = rgb(in.at("coat_tint"));
+        const Rgbd tau = test::golden_rgb(s.at("tau")), tint = test::golden_rgb(in.at("coat_tint"));
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(tint[c], std::exp(-2 * tau[c]), 1e-6) << id;
         if (!expect_base_inputs(
@@ -392,7 +389,7 @@ TEST(ProductionCoatsGolden, BlenderPrincipledInputsFollowTheMapping) {
 // tables). lamina computes the tables' nodes itself; they are within 5.3e-5 of Cycles' own
 // (docs/models.md), which the 1e-3 allows.
 TEST(ProductionCoatsGolden, BlenderPrincipledMatchesCycles) {
-    const json data = load("blender-principled.json");
+    const json data = test::load_golden("blender-principled.json");
     Differences worst;
     // The records' metal compensation is not compared apart: the model's flag drops the coat's
     // compensation with the metal's.
@@ -408,7 +405,7 @@ TEST(ProductionCoatsGolden, BlenderPrincipledMatchesCycles) {
 // metal, η0 = 1) with the film relative to the coat: Thin Film IOR η_f/η0, Thin Film Thickness
 // d η0 (docs/models.md, "Thin films").
 TEST(ProductionCoatsGolden, BlenderPrincipledFilmInputsFollowTheMapping) {
-    for (const json& record : load("blender-principled-film.json").at("stacks")) {
+    for (const json& record : test::load_golden("blender-principled-film.json").at("stacks")) {
         const json &s = record.at("stack"), &in = record.at("inputs"), &film = s.at("film");
         const std::string id = record.at("id");
         const double eta0 = s.at("eta0");
@@ -417,7 +414,7 @@ TEST(ProductionCoatsGolden, BlenderPrincipledFilmInputsFollowTheMapping) {
         EXPECT_NEAR(in.at("coat_roughness").get<double>(), std::sqrt(s.at("alpha0").get<double>()),
                     1e-6)
             << id;
-        const Rgbd tau = rgb(s.at("tau")), tint = rgb(in.at("coat_tint"));
+        const Rgbd tau = test::golden_rgb(s.at("tau")), tint = test::golden_rgb(in.at("coat_tint"));
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(tint[c], std::exp(-2 * tau[c]), 1e-6) << id;
         ASSERT_TRUE(expect_base_inputs(
@@ -439,7 +436,7 @@ TEST(ProductionCoatsGolden, BlenderPrincipledFilmInputsFollowTheMapping) {
 // table) lamina differs by no more than the script on the two CIE tables does (the data's
 // difference, up to 1.2e-4 of the DC term, the only one), plus the same 1e-6.
 TEST(ProductionCoatsGolden, CyclesFilmSensitivityMatchesCycles) {
-    const json table = load("blender-principled-film.json").at("thin_film_table");
+    const json table = test::load_golden("blender-principled-film.json").at("thin_film_table");
     const CyclesFilmSensitivity& lamina = CyclesFilmSensitivity::get();
     double worst_script = 0, worst_shipped = 0;
     for (std::size_t r = 0; r < table.at("rows").size(); ++r) {
@@ -478,7 +475,7 @@ TEST(ProductionCoatsGolden, CyclesFilmSensitivityMatchesCycles) {
 // last entry), 0.4 and 0.5 nm (the index blended towards the ambient's below 1 nm of Cycles'
 // thickness) and 0.05 nm (0.075 nm in Cycles, below its 0.1 nm cutoff: the bare metal).
 TEST(ProductionCoatsGolden, BlenderPrincipledFilmMatchesCycles) {
-    const json data = load("blender-principled-film.json");
+    const json data = test::load_golden("blender-principled-film.json");
     const json& pairs = data.at("pairs");
     Worst worst, worst_bare;
     for (const json& record : data.at("stacks")) {
@@ -493,8 +490,8 @@ TEST(ProductionCoatsGolden, BlenderPrincipledFilmMatchesCycles) {
             const json& p = pairs.at(i);
             const Vec3d wi = test::dir(p.at(0), p.at(1)), wo = test::dir(p.at(2), p.at(3));
             const Rgbd got = m->eval(wi, wo), got_bare = m_bare->eval(wi, wo),
-                       want = rgb(record.at("values").at(i)),
-                       want_bare = rgb(record.at("values_without_film").at(i));
+                       want = test::golden_rgb(record.at("values").at(i)),
+                       want_bare = test::golden_rgb(record.at("values_without_film").at(i));
             for (int c = 0; c < 3; ++c) {
                 const std::string what = fmt::format(
                     "{} pair {} channel {}", record.at("id").get<std::string>(), p.dump(), c);
@@ -517,7 +514,7 @@ TEST(ProductionCoatsGolden, BlenderPrincipledFilmMatchesCycles) {
 TEST(ProductionCoatsGolden, ThreeJsInputsFollowTheMapping) {
     expect_fixed_coat_inputs("threejs-clearcoat.json", "clearcoatRoughness",
                              {"color", "metalness", "specularIntensity", "roughness"}, true);
-    for (const json& record : load("threejs-clearcoat.json").at("stacks"))
+    for (const json& record : test::load_golden("threejs-clearcoat.json").at("stacks"))
         EXPECT_EQ(record.at("inputs").at("clearcoat").get<double>(), 1) << record.at("id");
 }
 
@@ -534,7 +531,7 @@ double threejs_table_error(double mu) {
 // to the accuracy of three.js's own texture: an error ΔE in E moves it by ΔE/(E (1 − E)) of
 // itself.
 TEST(ProductionCoatsGolden, ThreeJsMatchesItsShaders) {
-    const json data = load("threejs-clearcoat.json");
+    const json data = test::load_golden("threejs-clearcoat.json");
     Differences worst;
     for (const json& record : data.at("stacks")) {
         const json& s = record.at("stack");
@@ -561,7 +558,7 @@ TEST(ProductionCoatsGolden, ThreeJsMatchesItsShaders) {
 TEST(ProductionCoatsGolden, ThreeJsIridescenceInputsFollowTheMapping) {
     expect_fixed_coat_inputs("threejs-iridescence.json", "clearcoatRoughness",
                              {"color", "metalness", "specularIntensity", "roughness"}, true);
-    for (const json& record : load("threejs-iridescence.json").at("stacks")) {
+    for (const json& record : test::load_golden("threejs-iridescence.json").at("stacks")) {
         const json &in = record.at("inputs"), &film = record.at("stack").at("film");
         EXPECT_EQ(in.at("iridescence").get<double>(), 1) << record.at("id");
         EXPECT_EQ(in.at("iridescenceIOR"), film.at("eta")) << record.at("id");
@@ -583,7 +580,7 @@ TEST(ProductionCoatsGolden, ThreeJsIridescenceInputsFollowTheMapping) {
 // three.js turns each of X, Y, Z by one channel's shift; turning all three by each channel's own
 // shift misses its values by up to 164 %).
 TEST(ProductionCoatsGolden, ThreeJsIridescenceMatchesItsShaders) {
-    const json data = load("threejs-iridescence.json");
+    const json data = test::load_golden("threejs-iridescence.json");
     const json& pairs = data.at("pairs");
     Worst worst;
     for (const json& record : data.at("stacks")) {
@@ -598,11 +595,11 @@ TEST(ProductionCoatsGolden, ThreeJsIridescenceMatchesItsShaders) {
         for (std::size_t i = 0; i < pairs.size(); ++i) {
             const json& p = pairs.at(i);
             const Vec3d wi = test::dir(p.at(0), p.at(1)), wo = test::dir(p.at(2), p.at(3));
-            const Rgbd want = rgb(record.at("values").at(i)), got = m->eval(wi, wo),
+            const Rgbd want = test::golden_rgb(record.at("values").at(i)), got = m->eval(wi, wo),
                        compensation = got - m_rest->eval(wi, wo);
             const double e = dfg.albedo(wo.z);
             const Rgbd film = threejs_iridescence(1.0, in.at("iridescenceIOR"), wo.z, thickness,
-                                                  rgb(in.at("color")));
+                                                  test::golden_rgb(in.at("color")));
             for (int c = 0; c < 3; ++c) {
                 const double gpu =
                     thickness > 0
@@ -634,7 +631,7 @@ TEST(ProductionCoatsGolden, ThreeJsIridescenceMatchesItsShaders) {
 // coat of index 2, MgF2 under a coat of 1.5 (total reflection on the film's first boundary at
 // grazing facets) and a film of thickness 0 (no film).
 TEST(ProductionCoatsGolden, OpenPbrAdobeFilmMatchesItsCode) {
-    const json data = load("openpbr-adobe-film.json");
+    const json data = test::load_golden("openpbr-adobe-film.json");
     const json& pairs = data.at("pairs");
     Worst worst;
     for (const json& record : data.at("stacks")) {
@@ -648,8 +645,9 @@ TEST(ProductionCoatsGolden, OpenPbrAdobeFilmMatchesItsCode) {
         for (std::size_t i = 0; i < pairs.size(); ++i) {
             const json& p = pairs.at(i);
             const Vec3d wi = test::dir(p.at(0), p.at(1)), wo = test::dir(p.at(2), p.at(3));
-            const Rgbd want = rgb(record.at("values").at(i)),
-                       want_change = want - rgb(record.at("values_without_film").at(i)),
+            const Rgbd want = test::golden_rgb(record.at("values").at(i)),
+                       want_change =
+                           want - test::golden_rgb(record.at("values_without_film").at(i)),
                        got_change = m->eval(wi, wo) - m_bare->eval(wi, wo);
             for (int c = 0; c < 3; ++c) {
                 const double diff = std::abs(got_change[c] - want_change[c]);
@@ -669,7 +667,7 @@ TEST(ProductionCoatsGolden, OpenPbrAdobeFilmMatchesItsCode) {
 
 // `openpbr-materialx` against MaterialX's OpenPBR graph as its GLSL generator evaluates it.
 TEST(ProductionCoatsGolden, OpenPbrMaterialXMatchesItsGraph) {
-    const json data = load("openpbr-materialx.json");
+    const json data = test::load_golden("openpbr-materialx.json");
     Differences worst;
     for (const json& record : data.at("stacks"))
         keep_worst(worst, compare(data, record, "openpbr-materialx", {}, {}, record.at("values"),
@@ -686,7 +684,7 @@ TEST(ProductionCoatsGolden, OpenPbrMaterialXMatchesItsGraph) {
 void expect_specification_distance(
     const std::string& file, const std::string& values_key,
     const std::map<std::string, std::pair<double, double>>& measured) {
-    const json data = load(file);
+    const json data = test::load_golden(file);
     const json& pairs = data.at("pairs");
     for (const std::string base : {"lambertian", "conductor"}) {
         std::vector<double> rel;
@@ -699,7 +697,7 @@ void expect_specification_distance(
             for (std::size_t i = 0; i < pairs.size(); ++i) {
                 if (values.at(i).is_null()) continue;
                 const json& p = pairs.at(i);
-                const Rgbd want = rgb(values.at(i)),
+                const Rgbd want = test::golden_rgb(values.at(i)),
                            got = m->eval(test::dir(p.at(0), p.at(1)), test::dir(p.at(2), p.at(3)));
                 for (int c = 0; c < 3; ++c) {
                     rel.push_back(std::abs(got[c] - want[c]) / want[c]);

@@ -32,20 +32,14 @@ using nlohmann::json;
 using test::coated;
 using test::dir;
 
-json load(const std::string& name) {
-    return test::load_golden(name);
-}
-Rgbd rgb(const json& j) {
-    return test::golden_rgb(j);
-}
-
-Stack stack_of(const json& s) {
+Stack stacklit_stack(const json& s) {
     const InterfaceSpec base =
         s.at("base") == "lambertian"
-            ? test::lambertian(rgb(s.at("rho")))
-            : test::conductor(rgb(s.at("eta1")), rgb(s.at("kappa1")), s.at("alpha1").get<double>());
-    Stack stack =
-        coated(s.at("eta0").get<double>(), s.at("alpha0").get<double>(), base, rgb(s.at("tau")));
+            ? test::lambertian(test::golden_rgb(s.at("rho")))
+            : test::conductor(test::golden_rgb(s.at("eta1")), test::golden_rgb(s.at("kappa1")),
+                              s.at("alpha1").get<double>());
+    Stack stack = coated(s.at("eta0").get<double>(), s.at("alpha0").get<double>(), base,
+                         test::golden_rgb(s.at("tau")));
     if (s.contains("alpha1_xy")) {  // an anisotropic base: [α_x, α_y] at tangent1_deg
         InterfaceSpec& b = stack.layers[1].interface;
         b = anisotropic(b, s.at("alpha1_xy").at(0).get<double>(),
@@ -59,7 +53,7 @@ Stack stack_of(const json& s) {
 // F(1; η1, κ1), metallic 1, perceptual roughness √α1; a diffuse base's colour ρ, metallic 0,
 // dielectric IOR η0 and StackLit's default perceptual roughness 0.5.
 void expect_inputs_follow_the_mapping(const std::string& file) {
-    for (const json& record : load(file).at("stacks")) {
+    for (const json& record : test::load_golden(file).at("stacks")) {
         const json &s = record.at("stack"), &in = record.at("inputs");
         const std::string id = record.at("id");
         const double eta0 = s.at("eta0");
@@ -70,15 +64,16 @@ void expect_inputs_follow_the_mapping(const std::string& file) {
         EXPECT_EQ(in.at("coat_thickness").get<double>(), 1) << id;
         EXPECT_EQ(in.at("coat_mask").get<double>(), 1) << id;
         EXPECT_EQ(in.at("lobe_mix").get<double>(), 0) << id;
-        const Rgbd tau = rgb(s.at("tau")), ext = rgb(in.at("coat_extinction")),
-                   color = rgb(in.at("base_color"));
+        const Rgbd tau = test::golden_rgb(s.at("tau")),
+                   ext = test::golden_rgb(in.at("coat_extinction")),
+                   color = test::golden_rgb(in.at("base_color"));
         for (int c = 0; c < 3; ++c)
             EXPECT_EQ(ext[c], tau[c]) << id;
         if (s.at("base") == "lambertian") {
             EXPECT_EQ(in.at("metallic").get<double>(), 0) << id;
             EXPECT_EQ(in.at("dielectric_ior").get<double>(), eta0) << id;
             EXPECT_EQ(in.at("perceptual_roughness_a").get<double>(), 0.5) << id;
-            const Rgbd rho = rgb(s.at("rho"));
+            const Rgbd rho = test::golden_rgb(s.at("rho"));
             for (int c = 0; c < 3; ++c)
                 EXPECT_EQ(color[c], rho[c]) << id;
         } else {
@@ -86,7 +81,7 @@ void expect_inputs_follow_the_mapping(const std::string& file) {
             EXPECT_NEAR(in.at("perceptual_roughness_a").get<double>(),
                         std::sqrt(s.at("alpha1").get<double>()), 1e-12)
                 << id;
-            const Rgbd eta1 = rgb(s.at("eta1")), k1 = rgb(s.at("kappa1"));
+            const Rgbd eta1 = test::golden_rgb(s.at("eta1")), k1 = test::golden_rgb(s.at("kappa1"));
             for (int c = 0; c < 3; ++c)
                 EXPECT_NEAR(color[c], test::conductor_ref(1, eta1[c], k1[c]), 1e-12) << id;
             if (s.contains("alpha1_xy")) {
@@ -108,17 +103,17 @@ TEST(UnityStackLitGolden, InputsFollowTheMapping) {
 // `unity-stacklit` against StackLit's code: every recorded pair of every stack to 1e-3 relative,
 // every channel.
 void expect_matches_its_code(const std::string& file) {
-    const json data = load(file);
+    const json data = test::load_golden(file);
     const json& pairs = data.at("pairs");
     double worst = 0;
     std::string where;
     for (const json& record : data.at("stacks")) {
-        const auto m = make_model("unity-stacklit", stack_of(record.at("stack")));
+        const auto m = make_model("unity-stacklit", stacklit_stack(record.at("stack")));
         ASSERT_TRUE(m->support().brdf) << record.at("id");
         for (std::size_t i = 0; i < pairs.size(); ++i) {
             const json& p = pairs.at(i);
             const Vec3d wi = dir(p.at(0), p.at(1)), wo = dir(p.at(2), p.at(3));
-            const Rgbd want = rgb(record.at("values").at(i)), got = m->eval(wi, wo);
+            const Rgbd want = test::golden_rgb(record.at("values").at(i)), got = m->eval(wi, wo);
             for (int c = 0; c < 3; ++c) {
                 const double rel = std::abs(got[c] - want[c]) / std::abs(want[c]);
                 EXPECT_LE(rel, 1e-3) << record.at("id") << " pair " << i << " channel " << c;
@@ -203,7 +198,7 @@ TEST(UnityFgdTexture, TextureAgainstTheIntegral) {
 
 // --- The model's properties ----------------------------------------------------------------
 
-const Rgbd kRho(0.8, 0.5, 0.2), kTau(0.1, 0.2, 0.3);
+const Rgbd kStackLitRho(0.8, 0.5, 0.2), kStackLitTau(0.1, 0.2, 0.3);
 
 double max_albedo(bool per_view) {
     BinnedOptions o;
@@ -243,8 +238,8 @@ TEST(UnityStackLit, EnergyAsMeasured) {
 // Not reciprocal: the statistics, the energies and the compensation follow the view alone
 // (measured 0.555 on the plastic, 0.429 on the gold).
 TEST(UnityStackLit, ReciprocityAsMeasured) {
-    for (const Stack& s : {coated(1.5, 0.2, test::lambertian(kRho), kTau),
-                           coated(1.5, 0.1, test::gold(0.25), kTau)}) {
+    for (const Stack& s : {coated(1.5, 0.2, test::lambertian(kStackLitRho), kStackLitTau),
+                           coated(1.5, 0.1, test::gold(0.25), kStackLitTau)}) {
         const auto m = make_model("unity-stacklit", s);
         double worst = 0;
         for (double ti : {10.0, 40.0, 70.0})
@@ -264,10 +259,11 @@ TEST(UnityStackLit, ReciprocityAsMeasured) {
 // rough plastic, a nearly smooth coat over a rough metal and a rough coat over a smooth metal.
 TEST(UnityStackLit, Sampling) {
     const std::vector<std::pair<std::string, Stack>> stacks = {
-        {"plastic", coated(1.5, 0.2, test::lambertian(kRho), kTau)},
-        {"paint", coated(1.5, 0.01, test::gold(0.3), kTau)},
+        {"plastic", coated(1.5, 0.2, test::lambertian(kStackLitRho), kStackLitTau)},
+        {"paint", coated(1.5, 0.01, test::gold(0.3), kStackLitTau)},
         {"frosted", coated(1.5, 0.3, test::gold(0.02))},
-        {"brushed", coated(1.5, 0.05, anisotropic(test::gold(0.3), 0.3, 0.05, 20.0), kTau)}};
+        {"brushed",
+         coated(1.5, 0.05, anisotropic(test::gold(0.3), 0.3, 0.05, 20.0), kStackLitTau)}};
     const int tests = int(stacks.size()) * 2;
     for (const auto& [what, s] : stacks) {
         const auto m = make_model("unity-stacklit", s);
@@ -285,12 +281,13 @@ TEST(UnityStackLit, Sampling) {
 }
 
 TEST(UnityStackLit, NotSupported) {
-    Stack s = coated(1.5, 0.1, test::gold(0.2), kTau);
+    Stack s = coated(1.5, 0.1, test::gold(0.2), kStackLitTau);
     s.layers[0].interface = anisotropic(s.layers[0].interface, 0.2, 0.05, 0.0);
     const auto m = make_model("unity-stacklit", s);
     EXPECT_FALSE(m->support().brdf);
     EXPECT_NE(m->support().reason.find("anisotropic coat"), std::string::npos);
-    const auto below_one = make_model("unity-stacklit", coated(0.8, 0.1, test::lambertian(kRho)));
+    const auto below_one =
+        make_model("unity-stacklit", coated(0.8, 0.1, test::lambertian(kStackLitRho)));
     EXPECT_FALSE(below_one->support().brdf);
     EXPECT_NE(below_one->support().reason.find("at least 1"), std::string::npos);
 }
