@@ -308,8 +308,8 @@ std::string engine_findings_markdown(const EngineFindings& f) {
         if (f.best_production.count(c))
             out("- Most accurate production coat here: **{}** ({}); best of every model run "
                 "(ablations included): {} ({}).\n",
-                f.best_production.at(c), percent_text(f.best_production_error.at(c)), f.best_overall.at(c),
-                percent_text(f.best_overall_error.at(c)));
+                f.best_production.at(c), percent_text(f.best_production_error.at(c)),
+                f.best_overall.at(c), percent_text(f.best_overall_error.at(c)));
         // The rows of `items` in this category under `header`, nothing when there are none.
         const auto table = [&](const auto& items, const char* header, const auto& row) {
             bool started = false;
@@ -326,9 +326,9 @@ std::string engine_findings_markdown(const EngineFindings& f) {
             "\nHeuristics and leaves (mean misplaced energy, 5% floor; mean |albedo error|):\n\n"
             "| model | switched | as shipped | switched | what it says |\n|---|---|---|---|---|\n",
             [&](const EngineFindings::Ablation& a) {
-                out("| {} | `{}` | {}; {} | {}; {} | {} |\n", a.model, a.flag, percent_text(a.shipped),
-                    percent_text(a.shipped_albedo), percent_text(a.switched), percent_text(a.switched_albedo),
-                    switch_effect(a));
+                out("| {} | `{}` | {}; {} | {}; {} | {} |\n", a.model, a.flag,
+                    percent_text(a.shipped), percent_text(a.shipped_albedo),
+                    percent_text(a.switched), percent_text(a.switched_albedo), switch_effect(a));
             });
         out("\n");
         if (table(f.replacements,
@@ -339,7 +339,8 @@ std::string engine_findings_markdown(const EngineFindings& f) {
                   "|---|---|---|---|---|\n",
                   [&](const EngineFindings::Replacement& r) {
                       out("| {} | {} | {} | {} | {} |\n", r.model, percent_text(r.shipped),
-                          percent_text(r.exact_leaves), percent_text(r.lamina_coat), replacement_advice(r));
+                          percent_text(r.exact_leaves), percent_text(r.lamina_coat),
+                          replacement_advice(r));
                   }))
             out("\n");
     }
@@ -396,12 +397,13 @@ nlohmann::json engine_findings_json(const EngineFindings& f) {
                      {"switched_mean_abs_albedo_error", json_number(a.switched_albedo)}});
         for (const auto& r : f.replacements)
             if (r.category == c)
-                jc["replacements"].push_back({{"model", r.model},
-                                              {"rows", r.rows},
-                                              {"shipped_misplaced_floor", json_number(r.shipped)},
-                                              {"exact_leaves_misplaced_floor", json_number(r.exact_leaves)},
-                                              {"lamina_coat_misplaced_floor", json_number(r.lamina_coat)},
-                                              {"advice", replacement_advice(r)}});
+                jc["replacements"].push_back(
+                    {{"model", r.model},
+                     {"rows", r.rows},
+                     {"shipped_misplaced_floor", json_number(r.shipped)},
+                     {"exact_leaves_misplaced_floor", json_number(r.exact_leaves)},
+                     {"lamina_coat_misplaced_floor", json_number(r.lamina_coat)},
+                     {"advice", replacement_advice(r)}});
         j["categories"][c] = jc;
     }
     const CoatCosts& costs = coat_costs();

@@ -14,8 +14,8 @@
 #include "models/registry.h"
 #include "models/spectral_projection.h"
 #include "study/reference.h"
-#include "study/summary.h"
 #include "study/report_values.h"
+#include "study/summary.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>

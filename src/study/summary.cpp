@@ -19,7 +19,6 @@ namespace lamina {
 
 namespace {
 
-
 // ==== Computing the findings =====================================================================
 
 // Running sums of one (group, model) over its supported rows.
@@ -393,7 +392,6 @@ StudyFindings compute_findings(const std::vector<StudyConfiguration>& configs,
 
 namespace {
 
-
 nlohmann::json place_json(const std::optional<RowPlace>& p, bool with_side = true) {
     if (!p) return nullptr;
     nlohmann::json j = {{"config", p->config}, {"theta_i", p->theta_i}};
@@ -506,7 +504,6 @@ constexpr JsonSection kJsonSections[] = {json_header,        json_groups,      j
                                          json_not_supported, json_engine};
 
 // ---- summary.md ----
-
 
 std::string where(const std::optional<RowPlace>& p) {
     if (!p) return "";
@@ -689,7 +686,8 @@ void md_tables(const StudyFindings& f, Markdown& out) {
     table("Misplaced energy (relative to the reference's energy): mean / worst (noise floor)",
           [](const ModelAggregate& a, const GroupFindings&) {
               return a.rows ? fmt::format("{} / {} ({})", percent_text(a.mean_misplaced_energy),
-                                          percent_text(a.worst_misplaced_energy), percent_text(a.mean_noise_floor))
+                                          percent_text(a.worst_misplaced_energy),
+                                          percent_text(a.mean_noise_floor))
                             : std::string("not supported");
           });
     table("Albedo error: mean |error| / worst", [](const ModelAggregate& a, const GroupFindings&) {
@@ -711,9 +709,9 @@ void md_worst(const StudyFindings& f, Markdown& out) {
         for (const GroupFindings& g : f.groups)
             if (!is_total(g.name) && g.models.at(m).rows) {
                 const ModelAggregate& a = g.models.at(m);
-                out("| {} | {} | {} | {} | {} | {} |\n", m, g.name, percent_text(a.worst_misplaced_floor),
-                    where(a.worst_misplaced_floor_at), percent_text(a.worst_misplaced_energy),
-                    where(a.worst_misplaced_energy_at));
+                out("| {} | {} | {} | {} | {} | {} |\n", m, g.name,
+                    percent_text(a.worst_misplaced_floor), where(a.worst_misplaced_floor_at),
+                    percent_text(a.worst_misplaced_energy), where(a.worst_misplaced_energy_at));
             }
     out("\n");
 }
