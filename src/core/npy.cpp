@@ -48,10 +48,6 @@ std::string npy_bytes(const char* descr, const void* data, std::size_t bytes,
     return out;
 }
 
-std::size_t element_count(const std::vector<std::size_t>& shape) {
-    return std::accumulate(shape.begin(), shape.end(), std::size_t(1), std::multiplies<>());
-}
-
 }  // namespace
 
 std::string npy_float32(const std::vector<float>& data, const std::vector<std::size_t>& shape) {

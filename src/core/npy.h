@@ -6,10 +6,17 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <numeric>
 #include <string>
 #include <vector>
 
 namespace lamina {
+
+/// The number of elements of an array of this shape (the product of its extents).
+inline std::size_t element_count(const std::vector<std::size_t>& shape) {
+    return std::accumulate(shape.begin(), shape.end(), std::size_t(1), std::multiplies<>());
+}
 
 /// The bytes of a C-ordered float32 array of the given shape (data.size() must equal the product).
 std::string npy_float32(const std::vector<float>& data, const std::vector<std::size_t>& shape);

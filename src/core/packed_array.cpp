@@ -66,10 +66,6 @@ void untransform(const std::string& planes, U* v, std::size_t count, std::size_t
         }
 }
 
-std::size_t element_count(const std::vector<std::size_t>& shape) {
-    return std::accumulate(shape.begin(), shape.end(), std::size_t(1), std::multiplies<>());
-}
-
 }  // namespace
 
 std::string pack_elements(const void* elements, std::size_t count, std::size_t width, std::size_t n,

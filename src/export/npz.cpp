@@ -1,6 +1,7 @@
 #include "export/npz.h"
 
 #include "core/check.h"
+#include "export/bytes.h"
 
 #include <zlib.h>
 
@@ -8,15 +9,6 @@
 #include <cstring>
 
 namespace lamina {
-
-namespace {
-template <typename T>
-void put(std::string& out, T v) {
-    char b[sizeof(T)];
-    std::memcpy(b, &v, sizeof(T));
-    out.append(b, sizeof(T));
-}
-}  // namespace
 
 // The layout of PKWARE's APPNOTE (sections 4.3.7, 4.3.12, 4.3.16): per member a local header and
 // the data, then the central directory and its end record. No ZIP64: members under 4 GiB.
@@ -28,41 +20,41 @@ std::string zip_stored(const std::vector<std::pair<std::string, std::string>>& m
             crc32(0L, reinterpret_cast<const Bytef*>(data.data()), uInt(data.size())));
         const std::uint32_t offset = std::uint32_t(out.size());
         auto common = [&](std::string& s) {
-            put<std::uint16_t>(s, 20);    // version needed: 2.0
-            put<std::uint16_t>(s, 0);     // flags
-            put<std::uint16_t>(s, 0);     // method: stored
-            put<std::uint16_t>(s, 0);     // time
-            put<std::uint16_t>(s, 0x21);  // date: 1980-01-01
-            put<std::uint32_t>(s, crc);
-            put<std::uint32_t>(s, std::uint32_t(data.size()));
-            put<std::uint32_t>(s, std::uint32_t(data.size()));
-            put<std::uint16_t>(s, std::uint16_t(name.size()));
-            put<std::uint16_t>(s, 0);  // extra length
+            append_bytes<std::uint16_t>(s, 20);    // version needed: 2.0
+            append_bytes<std::uint16_t>(s, 0);     // flags
+            append_bytes<std::uint16_t>(s, 0);     // method: stored
+            append_bytes<std::uint16_t>(s, 0);     // time
+            append_bytes<std::uint16_t>(s, 0x21);  // date: 1980-01-01
+            append_bytes<std::uint32_t>(s, crc);
+            append_bytes<std::uint32_t>(s, std::uint32_t(data.size()));
+            append_bytes<std::uint32_t>(s, std::uint32_t(data.size()));
+            append_bytes<std::uint16_t>(s, std::uint16_t(name.size()));
+            append_bytes<std::uint16_t>(s, 0);  // extra length
         };
-        put<std::uint32_t>(out, 0x04034b50);
+        append_bytes<std::uint32_t>(out, 0x04034b50);
         common(out);
         out += name;
         out += data;
-        put<std::uint32_t>(central, 0x02014b50);
-        put<std::uint16_t>(central, 20);  // version made by
+        append_bytes<std::uint32_t>(central, 0x02014b50);
+        append_bytes<std::uint16_t>(central, 20);  // version made by
         common(central);
-        put<std::uint16_t>(central, 0);  // comment length
-        put<std::uint16_t>(central, 0);  // disk
-        put<std::uint16_t>(central, 0);  // internal attributes
-        put<std::uint32_t>(central, 0);  // external attributes
-        put<std::uint32_t>(central, offset);
+        append_bytes<std::uint16_t>(central, 0);  // comment length
+        append_bytes<std::uint16_t>(central, 0);  // disk
+        append_bytes<std::uint16_t>(central, 0);  // internal attributes
+        append_bytes<std::uint32_t>(central, 0);  // external attributes
+        append_bytes<std::uint32_t>(central, offset);
         central += name;
     }
     const std::uint32_t central_offset = std::uint32_t(out.size());
     out += central;
-    put<std::uint32_t>(out, 0x06054b50);
-    put<std::uint16_t>(out, 0);
-    put<std::uint16_t>(out, 0);
-    put<std::uint16_t>(out, std::uint16_t(members.size()));
-    put<std::uint16_t>(out, std::uint16_t(members.size()));
-    put<std::uint32_t>(out, std::uint32_t(central.size()));
-    put<std::uint32_t>(out, central_offset);
-    put<std::uint16_t>(out, 0);
+    append_bytes<std::uint32_t>(out, 0x06054b50);
+    append_bytes<std::uint16_t>(out, 0);
+    append_bytes<std::uint16_t>(out, 0);
+    append_bytes<std::uint16_t>(out, std::uint16_t(members.size()));
+    append_bytes<std::uint16_t>(out, std::uint16_t(members.size()));
+    append_bytes<std::uint32_t>(out, std::uint32_t(central.size()));
+    append_bytes<std::uint32_t>(out, central_offset);
+    append_bytes<std::uint16_t>(out, 0);
     return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include "core/check.h"
 #include "core/error.h"
+#include "export/bytes.h"
 
 #include <fmt/format.h>
 
@@ -17,13 +18,6 @@ static_assert(std::endian::native == std::endian::little, "tensor files are litt
 
 namespace {
 constexpr char kMagic[12] = {'t', 'e', 'n', 's', 'o', 'r', '_', 'f', 'i', 'l', 'e', '\0'};
-
-template <typename T>
-void put(std::string& out, T v) {
-    char b[sizeof(T)];
-    std::memcpy(b, &v, sizeof(T));
-    out.append(b, sizeof(T));
-}
 
 struct Reader {
     const std::string& bytes;
@@ -99,18 +93,18 @@ std::string tensor_file_bytes(const TensorFile& file) {
     auto align = [](std::size_t n) { return (n + 7) / 8 * 8; };
     std::string out;
     out.append(kMagic, 12);
-    put<std::uint8_t>(out, 1);
-    put<std::uint8_t>(out, 0);
-    put<std::uint32_t>(out, std::uint32_t(file.size()));
+    append_bytes<std::uint8_t>(out, 1);
+    append_bytes<std::uint8_t>(out, 0);
+    append_bytes<std::uint32_t>(out, std::uint32_t(file.size()));
     std::size_t offset = align(header);
     for (const auto& [name, field] : file) {
-        put<std::uint16_t>(out, std::uint16_t(name.size()));
+        append_bytes<std::uint16_t>(out, std::uint16_t(name.size()));
         out += name;
-        put<std::uint16_t>(out, std::uint16_t(field.shape.size()));
-        put<std::uint8_t>(out, std::uint8_t(field.type));
-        put<std::uint64_t>(out, offset);
+        append_bytes<std::uint16_t>(out, std::uint16_t(field.shape.size()));
+        append_bytes<std::uint8_t>(out, std::uint8_t(field.type));
+        append_bytes<std::uint64_t>(out, offset);
         for (std::uint64_t s : field.shape)
-            put<std::uint64_t>(out, s);
+            append_bytes<std::uint64_t>(out, s);
         offset = align(offset + field.data.size());
     }
     for (const auto& [name, field] : file) {

@@ -4,6 +4,7 @@
 #include "models/belcour/belcour.h"
 #include "models/numerics/quadrature.h"
 #include "models/tables/coat_transmittance.h"
+#include "models/tables/critical_cosine_axes.h"
 #include "models/tables/fgd_table.h"
 #include "models/tables/tir_table.h"
 #include "physics/fresnel.h"
@@ -102,12 +103,6 @@ constexpr int kGauss = 32;  // Gauss–Legendre nodes per piece of the hemispher
 /// eta (0 past total reflection).
 double refracted_cosine(double mu, double eta) {
     return fresnel_dielectric_full(mu, eta).cos_theta_t;
-}
-
-/// The critical cosine of light arriving from the side where the relative index is eta < 1 (0 when
-/// eta ≥ 1: no total reflection).
-double critical_cosine(double eta) {
-    return eta < 1 ? std::sqrt(1 - eta * eta) : 0.0;
 }
 
 /// Belcour's adding (models/belcour/belcour.h) as Bel18 forward runs it — μ-dependent statistics,

@@ -78,7 +78,7 @@ double f0_to_ior(double f0) {
     return (1 + s) / (1 - s);
 }
 /// Schlick 1994, Eq. 15, with f90 = 1 (HDRP's F_Schlick).
-double schlick(double f0, double c) {
+double f_schlick(double f0, double c) {
     return f0 + (1 - f0) * std::pow(1 - c, 5);
 }
 
@@ -212,7 +212,7 @@ class UnityStackLit final : public Model {
                 // it does not reflect goes to the diffuse lobe
                 // (VLAYERED_DIFFUSE_ENERGY_HACKED_TERM).
                 for (int c = 0; c < 3; ++c)
-                    R12[c] = schlick(base_f0_[c], cti);
+                    R12[c] = f_schlick(base_f0_[c], cti);
                 T12 = Rgbd(1.0) - R12;
             }
             const Rgbd& R21 = R12;

@@ -31,12 +31,6 @@ double alpha_node(int i) {
     return Format::alpha_node(i);
 }
 
-/// x limited to [lo, hi] for a table coordinate, NaN going to lo: an index computed from NaN would
-/// be undefined behaviour and read outside the table.
-double axis(double x, double lo, double hi) {
-    return x >= lo ? (x <= hi ? x : hi) : lo;
-}
-
 /// Calls visit(x = wi·wm, weight·G2/G1) for each node of the n_r × n_phi visible-normal rule.
 template <typename Visit>
 void visible_normal_rule(double c, double alpha, int n_r, int n_phi, Visit&& visit) {
@@ -142,8 +136,8 @@ const GgxAlbedoTable& GgxAlbedoTable::get() {
 double GgxAlbedoTable::operator()(double c, double alpha) const {
     if (alpha <= 0) return 1.0;
     using T = FgdTable;
-    const double fc = std::sqrt(axis(c, 0.0, 1.0)) * (T::kNc - 1);
-    const double fa = std::sqrt(axis(alpha, 0.0, 1.0)) * (T::kNalpha - 1);
+    const double fc = std::sqrt(lamina1::table_axis(c, 0.0, 1.0)) * (T::kNc - 1);
+    const double fa = std::sqrt(lamina1::table_axis(alpha, 0.0, 1.0)) * (T::kNalpha - 1);
     const int ic = std::min(int(fc), T::kNc - 2), ia = std::min(int(fa), T::kNalpha - 2);
     const double tc = fc - ic, ta = fa - ia;
     const float* row = values_.data() + std::size_t(ic) * T::kNalpha + ia;

@@ -23,12 +23,6 @@ constexpr double kCMin = 1e-4, kAlphaMin = 1e-5;
 constexpr const char* kCodeVersion = "tir-v3";
 constexpr int kSplit = 16;  // c nodes 0..kSplit cover [0, c_crit], the rest [c_crit, 1]
 
-/// x limited to [lo, hi] for a table coordinate, NaN going to lo (an index computed from NaN would
-/// be undefined behaviour and read outside the table).
-double axis(double x, double lo, double hi) {
-    return x >= lo ? (x <= hi ? x : hi) : lo;
-}
-
 // The c axis is relative to the critical cosine of each η node and dense next to it on both
 // sides (τ is a smoothed step there, of width ~α): node j ≤ kSplit sits at
 // c_crit (1 − (1 − j/kSplit)²), node j ≥ kSplit at c_crit + (1 − c_crit)((j −
@@ -39,7 +33,7 @@ double c_node(int j, double c_crit) {
 }
 /// Fractional node index of c for the η node whose critical cosine is c_crit.
 double c_index(double c, double c_crit) {
-    c = axis(c, 0.0, 1.0);
+    c = lamina1::table_axis(c, 0.0, 1.0);
     if (c >= c_crit)
         return kSplit + (TirTable::kNc - 1 - kSplit) * std::sqrt((c - c_crit) / (1 - c_crit));
     return kSplit * (1 - std::sqrt(1 - c / c_crit));
@@ -121,8 +115,9 @@ double TirTable::operator()(double c, double alpha, double eta) const {
     if (!(eta < 1)) return 1;  // η ≥ 1 (and NaN): no total internal reflection
     // Smooth interface: the exact step at the critical cosine (the table would blur it).
     if (alpha <= 0) return c > critical_cosine(eta) ? 1.0 : 0.0;
-    const double fa = std::sqrt(axis(alpha, 0.0, 1.0)) * (kNalpha - 1);
-    const double fe = axis(critical_cosine(eta) / max_critical_cosine(), 0.0, 1.0) * (kNeta - 1);
+    const double fa = std::sqrt(lamina1::table_axis(alpha, 0.0, 1.0)) * (kNalpha - 1);
+    const double fe =
+        lamina1::table_axis(critical_cosine(eta) / max_critical_cosine(), 0.0, 1.0) * (kNeta - 1);
     const int ia = std::min(int(fa), kNalpha - 2), ie = std::min(int(fe), kNeta - 2);
     const double ta = fa - ia, te = fe - ie;
     double sum = 0;
