@@ -309,9 +309,7 @@ class Bsdf {
     /// included), with its orders ≥ 2 under multiple scattering.
     double inside_reflectance(double mu) const {
         const double r = fgd_top_in_(mu);
-        return ch_.multiple_scattering
-                   ? r + ms_dielectric(fgd_top_in_, mu, alpha0_, inv_eta0_).reflected
-                   : r;
+        return ms_ ? r + ms_dielectric(fgd_top_in_, mu, alpha0_, inv_eta0_).reflected : r;
     }
 
     /// The orders ≥ 2 of a rough dielectric interface (α, η), whose FGD `fgd` reads.
@@ -368,6 +366,8 @@ class Bsdf {
     /// Multiple scattering: the coat's ΔR from outside and its hemispherical 2∫ΔR μ dμ; the base's
     /// ΔE (conductor: white, times F_ms; dielectric: ΔR, F_ms = 1) and its average.
     bool top_ms_ = false, base_ms_ = false;
+    /// The orders ≥ 2 restored (Options::microsurface, Auto resolved for these layers).
+    bool ms_ = false;
     bool inside_exit_ = false;  ///< exit_transmittance in the first order (see Options)
     bool mirror_series_ = false;
     bool lobe_norm_on_ = false;

@@ -7,12 +7,13 @@
 // eval: lamina1_delta gives their reflectance at the mirror direction, Bsdf::delta_lobes), with
 // an absorbing medium, over a Lambertian, conductor or dielectric base, with the default choices
 // or any of spread, first-order-lobe, eta2-factor, inside-exit, lobe-normalization,
-// inter-reflection and directional-transmittance. Not covered (gpu_state
-// says why and returns nothing): scattering media, the multiple-scattering orders, anisotropic
-// interfaces and a slab's transmission (the GLSL returns 0 for wo.z < 0). Covered by sample and
-// pdf: the same but slabs (their mixture holds the transmission's lobes); the base lobe's weight in
-// the mixture reads the base's mean albedo from a curve (kGpuBaseAlbedo), so the GLSL pdf is the
-// C++ one to that curve's interpolation, and equal to the GLSL sample's own density.
+// inter-reflection and directional-transmittance, with or without the microsurfaces' orders ≥ 2
+// (microsurface). Not covered (gpu_state says why and returns nothing): scattering media,
+// anisotropic interfaces and a slab's transmission (the GLSL returns 0 for wo.z < 0). Covered by
+// sample and pdf: the same but slabs (their mixture holds the transmission's lobes); the base
+// lobe's weight in the mixture reads the base's mean albedo from a curve (kGpuBaseAlbedo), so the
+// GLSL pdf is the C++ one to that curve's interpolation, and equal to the GLSL sample's own
+// density.
 //
 // Layout (kGpu* below): kGpuScalars scalars, then the curves at fixed offsets, then the generic
 // slope-sum table (lamina1/table_lookups.h, SlopeSumFormat) at kGpuSlopeSum; kGpuSize floats in
@@ -36,10 +37,12 @@ constexpr int kGpuMirrorSeries = kGpuLobeNorm + kNnorm;    // kNmu × RGB
 constexpr int kGpuEntering = kGpuMirrorSeries + 3 * kNmu;  // sin δ, cos δ, weight: 3 × 129
 constexpr int kGpuLeaving = kGpuEntering + 3 * FacetDeflection::kN;
 constexpr int kGpuBaseAlbedo = kGpuLeaving + 3 * FacetDeflection::kN;  // Ē_b(μ'): kNmu
-constexpr int kGpuSlopeSum = 1536;
+constexpr int kGpuDRTop = kGpuBaseAlbedo + kNmu;  // the coat's orders ≥ 2, ΔR(μ): kNmu
+constexpr int kGpuDEBase = kGpuDRTop + kNmu;      // the base's, ΔE(μ'): kNmu
+constexpr int kGpuSlopeSum = 1664;
 constexpr int kGpuSize =
     kGpuSlopeSum + SlopeSumFormat::kNx * SlopeSumFormat::kNy * SlopeSumFormat::kNu;
-static_assert(kGpuBaseAlbedo + kNmu <= kGpuSlopeSum, "the curves overlap");
+static_assert(kGpuDEBase + kNmu <= kGpuSlopeSum, "the curves overlap");
 
 /// Bits of the flags scalar (index 0).
 enum GpuFlag : unsigned {
@@ -59,6 +62,8 @@ enum GpuFlag : unsigned {
     kGpuSpreadOff = 1u << 13,
     kGpuSampling = 1u << 14,         ///< lamina1_sample and lamina1_pdf cover it (not a slab)
     kGpuInterReflection = 1u << 15,  ///< the choice inter-reflection (lamina1_delta's series)
+    kGpuTopOrders = 1u << 16,        ///< the coat's orders ≥ 2: ΔR(μi) ΔR(μo)/(π ΔR̄)
+    kGpuBaseOrders = 1u << 17,       ///< the base's: F_ms ΔE(μi') ΔE(μo')/(π ΔĒ)
 };
 
 inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
@@ -68,7 +73,6 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     };
     if (!support_.brdf) return refuse("lamina-1 does not model these layers");
     if (scatters_) return refuse("a scattering medium (the GLSL form covers absorbing ones)");
-    if (top_ms_ || base_ms_) return refuse("the multiple-scattering orders");
     if (aniso_) return refuse("an anisotropic interface (the GLSL form is isotropic)");
     std::vector<float> v(kGpuSize, 0.0f);
     unsigned flags = 0;
@@ -89,6 +93,8 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     flag(ch_.spread == Options::Spread::Off, kGpuSpreadOff);
     flag(!support_.btdf, kGpuSampling);
     flag(ch_.inter_reflection, kGpuInterReflection);
+    flag(top_ms_, kGpuTopOrders);
+    flag(base_ms_, kGpuBaseOrders);
     v[0] = float(flags);  // exact in float32 (fewer than 2^24)
     v[1] = float(int(layers_.base));
     v[2] = float(eta0_);
@@ -110,8 +116,12 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     v[28] = float(T_top_in_.eta);
     v[29] = float(entering_.g_max);
     v[30] = float(leaving_.g_max);
-    for (int c = 0; c < 3; ++c)
+    for (int c = 0; c < 3; ++c) {
         v[31 + c] = float(X_bar_[c]);
+        v[34 + c] = float(F_ms_[c]);
+    }
+    v[37] = float(dR_top_bar_);
+    v[38] = float(dE_base_bar_);
     for (int i = 0; i < kNmu; ++i) {
         v[kGpuTTop + i] = float(T_top_.curve.below[i]);
         v[kGpuTTop + kNmu + i] = float(T_top_.curve.above[i]);
@@ -119,6 +129,8 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
         v[kGpuTTopIn + kNmu + i] = float(T_top_in_.curve.above[i]);
         for (int c = 0; c < 3; ++c)
             v[kGpuMirrorSeries + 3 * i + c] = float(mirror_series_curve_.v[i][c]);
+        if (top_ms_) v[kGpuDRTop + i] = float(dR_top_.v[i]);
+        if (base_ms_) v[kGpuDEBase + i] = float(dE_base_.v[i]);
     }
     // The sampler's mixture weighs the base lobe by the base's mean albedo at the inside cosine:
     // a curve over μ' = s² (the FGD lookups it stands for stay in C++).

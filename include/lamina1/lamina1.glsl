@@ -17,7 +17,8 @@ const int L1_T_TOP = 64, L1_T_TOP_IN = L1_T_TOP + 2 * L1_NMU, L1_X = L1_T_TOP_IN
 const int L1_LOBE_NORM = L1_X + 3 * L1_NX, L1_MIRROR = L1_LOBE_NORM + L1_NNORM;
 const int L1_ENTERING = L1_MIRROR + 3 * L1_NMU, L1_LEAVING = L1_ENTERING + 3 * L1_NFACET;
 const int L1_BASE_ALBEDO = L1_LEAVING + 3 * L1_NFACET;
-const int L1_SLOPE_SUM = 1536, L1_SS_NX = 25, L1_SS_NY = 13, L1_SS_NU = 33;
+const int L1_DR_TOP = L1_BASE_ALBEDO + L1_NMU, L1_DE_BASE = L1_DR_TOP + L1_NMU;
+const int L1_SLOPE_SUM = 1664, L1_SS_NX = 25, L1_SS_NY = 13, L1_SS_NU = 33;
 
 float l1_at(int i) { return texelFetch(lamina1_state, ivec2(i % 256, i / 256), 0).r; }
 vec3 l1_rgb(int i) { return vec3(l1_at(i), l1_at(i + 1), l1_at(i + 2)); }
@@ -205,6 +206,10 @@ vec3 l1_base_lobe(vec3 wi_in, float k_top, float lobe_norm_i, float mu_o, vec3 w
     float D = l1_flag(7) ? l1_first_order_ndf(h, k_top, k_o) : l1_ggx_d(alpha, h);
     vec3 f = l1_base_fresnel(dot(wi_in, h)) * (D * G / (4.0 * wi_in.z * wo_in.z));
     if (l1_flag(6)) f *= lobe_norm_i * l1_cosine_curve(L1_LOBE_NORM, L1_NNORM, 1, 0, wo_in.z);
+    // The base's orders >= 2, separable.
+    if (l1_flag(17))
+        f += l1_rgb(34) * (l1_cosine_curve(L1_DE_BASE, L1_NMU, 1, 0, wi_in.z) *
+                           l1_cosine_curve(L1_DE_BASE, L1_NMU, 1, 0, wo_in.z) * L1_INV_PI / l1_at(38));
     return f;
 }
 
@@ -230,6 +235,10 @@ vec3 lamina1_eval(vec3 wi, vec3 wo) {
         float G = 1.0 / (1.0 + lambda0 + l1_lambda(alpha0, wo));
         f = vec3(l1_fresnel_dielectric(dot(wi, h), eta0) * l1_ggx_d(alpha0, h) * G /
                  (4.0 * wi.z * wo.z));
+        // Its orders >= 2, separable.
+        if (l1_flag(16))
+            f += vec3(l1_cosine_curve(L1_DR_TOP, L1_NMU, 1, 0, wi.z) *
+                      l1_cosine_curve(L1_DR_TOP, L1_NMU, 1, 0, wo.z) * L1_INV_PI / l1_at(37));
     }
     vec3 wo_in = l1_refract_in(wo);
     float T_o = l1_transmittance(0, wo.z);
@@ -349,6 +358,8 @@ bool l1_mixture(vec3 wi, out vec3 p, out float alpha_base, out vec3 wi_in) {
         if (alpha_base > 0.0) p.y = T * a * E_b;
     }
     if (l1_flag(2)) p.z = l1_mean(l1_x_at(wi.z) * l1_rgb(19) * l1_rgb(31));
+    // The coat's separable orders >= 2, also cosine-distributed.
+    if (l1_flag(16)) p.z += l1_cosine_curve(L1_DR_TOP, L1_NMU, 1, 0, wi.z);
     float total = p.x + p.y + p.z;
     if (!(total > 0.0)) return false;
     p /= total;

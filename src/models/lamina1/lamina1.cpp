@@ -58,7 +58,9 @@ class Lamina1 final : public Model {
             support_.reason = fmt::format("lamina-1 {}", why);
             return;
         }
-        bsdf_.emplace(layers, lamina1_tables(choices.masking, choices.multiple_scattering),
+        bsdf_.emplace(layers,
+                      lamina1_tables(choices.masking, choices.microsurface !=
+                                                          lamina1::Options::Microsurface::Single),
                       choices);
         support_.brdf = bsdf_->support().brdf;
         support_.btdf = bsdf_->support().btdf;
@@ -192,8 +194,11 @@ std::vector<float> lamina1_gpu_state(const Stack& stack, const ModelOptions& opt
     const Lamina1Choices choices = lamina1_option_table().parse(options);
     lamina1::Layers layers;
     if (!lamina1_layers(stack, layers, why)) return {};
-    const lamina1::Bsdf bsdf(layers, lamina1_tables(choices.masking, choices.multiple_scattering),
-                             choices);
+    const lamina1::Bsdf bsdf(
+        layers,
+        lamina1_tables(choices.masking,
+                       choices.microsurface != lamina1::Options::Microsurface::Single),
+        choices);
     return bsdf.gpu_state(&why);
 }
 
@@ -203,7 +208,8 @@ Lamina1GpuStates lamina1_gpu_states(const Stack& stack, const ModelOptions& opti
     const Lamina1Choices choices = lamina1_option_table().parse(options);
     lamina1::Layers layers;
     if (!lamina1_layers(stack, layers, why)) return out;
-    const lamina1::Tables& tables = lamina1_tables(choices.masking, choices.multiple_scattering);
+    const lamina1::Tables& tables = lamina1_tables(
+        choices.masking, choices.microsurface != lamina1::Options::Microsurface::Single);
     out.state = lamina1::Bsdf(layers, tables, choices).gpu_state(&why);
     if (out.state.empty()) return out;
     out.head = lamina1::kGpuSlopeSum;

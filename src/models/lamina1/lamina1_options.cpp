@@ -100,10 +100,15 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table() {
             "slab BTDF later orders: the light inside and beyond the exit cone as two uniform "
             "populations summed over every round trip and let out through the bottom's "
             "transmittance, or the uniform series of inter-reflection=on"),
-        member_option<L1, bool>(
-            "microsurface", &L1::multiple_scattering, {{"single", false}, {"multiple", true}},
-            "rough interfaces: single scattering (the masked energy lost, as --microsurface "
-            "single) or with their orders >= 2 restored (as --microsurface multiple)"),
+        member_option<L1, L1::Microsurface>(
+            "microsurface", &L1::microsurface,
+            {{"auto", L1::Microsurface::Auto},
+             {"single", L1::Microsurface::Single},
+             {"multiple", L1::Microsurface::Multiple}},
+            "rough interfaces: with their orders >= 2 restored (multiple, as --microsurface "
+            "multiple; isotropic interfaces only), single scattering (single: the masked energy "
+            "lost, as --microsurface single), or multiple where every interface is isotropic "
+            "(auto)"),
     });
     return table;
 }

@@ -121,9 +121,12 @@ TEST(Lamina1LobeStat, ShapedFirstOrderIsCloserToParticles) {
     for (double alpha0 : {0.2, 0.35, 0.5}) {
         const Stack stack = test::coated(
             kEta0, alpha0, test::conductor(Rgbd(kEtaBase), Rgbd(kKBase), 0.0), Rgbd(0.0));
-        const auto shaped = make_model("lamina-1", stack, {"inter-reflection=off"});
+        // Single scattering: the first order is f minus the coat's Walter reflection alone.
+        const auto shaped =
+            make_model("lamina-1", stack, {"inter-reflection=off", "microsurface=single"});
         const auto ggx =
-            make_model("lamina-1", stack, {"inter-reflection=off", "first-order-lobe=ggx"});
+            make_model("lamina-1", stack,
+                       {"inter-reflection=off", "first-order-lobe=ggx", "microsurface=single"});
         for (double theta_i : {0.0, 45.0}) {
             const Vec3d wi = dir(theta_i, 0);
             std::vector<double> mc, se;

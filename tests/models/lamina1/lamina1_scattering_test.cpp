@@ -209,7 +209,7 @@ TEST(Lamina1Scattering, AlbedoAtMostOne) {
     };
     const std::vector<std::pair<double, double>> media = {{0.0, 0.5}, {0.0, 5.0}, {0.5, 1.0}};
     for (const std::vector<std::string>& options :
-         {std::vector<std::string>{}, std::vector<std::string>{"microsurface=multiple"}})
+         {std::vector<std::string>{}, std::vector<std::string>{"microsurface=single"}})
         for (const auto& [bname, base] : bases)
             for (const auto& [tau_a, tau_s] : media)
                 for (double g : kG)
@@ -221,7 +221,7 @@ TEST(Lamina1Scattering, AlbedoAtMostOne) {
                             EXPECT_LE(a.max(), 1.0 + 1e-3 + 6.3e-3 + 2e-3)
                                 << bname << " tau_a=" << tau_a << " tau_s=" << tau_s << " g=" << g
                                 << " a0=" << alpha0 << " ti=" << ti
-                                << (options.empty() ? "" : " ms");
+                                << (options.empty() ? "" : " single");
                         }
                     }
 }
@@ -240,7 +240,7 @@ std::vector<std::pair<std::string, Stack>> scattering_stacks(double g) {
 TEST(Lamina1Scattering, BrdfIsReciprocal) {
     ParticleRng rng(24, 0, 0);
     for (const std::vector<std::string>& options :
-         {std::vector<std::string>{}, std::vector<std::string>{"microsurface=multiple"}})
+         {std::vector<std::string>{}, std::vector<std::string>{"microsurface=single"}})
         for (double g : kG)
             for (const auto& [what, stack] : scattering_stacks(g)) {
                 const auto model = make_model("lamina-1", stack, options);
