@@ -58,10 +58,7 @@ class Lamina1 final : public Model {
             support_.reason = fmt::format("lamina-1 {}", why);
             return;
         }
-        bsdf_.emplace(layers,
-                      lamina1_tables(choices.masking, choices.microsurface !=
-                                                          lamina1::Options::Microsurface::Single),
-                      choices);
+        bsdf_.emplace(layers, lamina1_tables(choices), choices);
         support_.brdf = bsdf_->support().brdf;
         support_.btdf = bsdf_->support().btdf;
         support_.reason = bsdf_->support().reason;
@@ -185,6 +182,11 @@ const lamina1::Tables& lamina1_tables(lamina1::Masking masking, bool multiple) {
     return t;
 }
 
+const lamina1::Tables& lamina1_tables(const Lamina1Choices& choices) {
+    return lamina1_tables(choices.masking,
+                          choices.microsurface != lamina1::Options::Microsurface::Single);
+}
+
 std::string lamina1_tables_file() {
     return make_tables(lamina1::Masking::Walter, true, true).serialize();
 }
@@ -194,11 +196,7 @@ std::vector<float> lamina1_gpu_state(const Stack& stack, const ModelOptions& opt
     const Lamina1Choices choices = lamina1_option_table().parse(options);
     lamina1::Layers layers;
     if (!lamina1_layers(stack, layers, why)) return {};
-    const lamina1::Bsdf bsdf(
-        layers,
-        lamina1_tables(choices.masking,
-                       choices.microsurface != lamina1::Options::Microsurface::Single),
-        choices);
+    const lamina1::Bsdf bsdf(layers, lamina1_tables(choices), choices);
     return bsdf.gpu_state(&why);
 }
 
@@ -208,8 +206,7 @@ Lamina1GpuStates lamina1_gpu_states(const Stack& stack, const ModelOptions& opti
     const Lamina1Choices choices = lamina1_option_table().parse(options);
     lamina1::Layers layers;
     if (!lamina1_layers(stack, layers, why)) return out;
-    const lamina1::Tables& tables = lamina1_tables(
-        choices.masking, choices.microsurface != lamina1::Options::Microsurface::Single);
+    const lamina1::Tables& tables = lamina1_tables(choices);
     out.state = lamina1::Bsdf(layers, tables, choices).gpu_state(&why);
     if (out.state.empty()) return out;
     out.head = lamina1::kGpuSlopeSum;

@@ -29,6 +29,9 @@ std::unique_ptr<Model> make_lamina1(const Stack& stack, const ModelOptions& opti
 /// sums and, with `multiple`, the multiple-scattering albedos) as lamina-1 reads them: views of
 /// the process-wide tables, computed or loaded from the cache on first use.
 const lamina1::Tables& lamina1_tables(lamina1::Masking masking, bool multiple);
+/// The process-wide tables that `choices` may read (the multiple-scattering table unless the
+/// microsurfaces are single-scattering).
+const lamina1::Tables& lamina1_tables(const Lamina1Choices& choices);
 
 /// The data file a renderer ships beside the header (include/lamina1/tables.h describes it):
 /// every table, both maskings, the FGD table as its bins.
