@@ -59,10 +59,9 @@ TEST(ModelsEnergy, AlbedoAtMostOne) {
 }
 
 // lamina-1's default restores the microsurfaces' orders ≥ 2 as separable lobes whose energies
-// come from a Monte-Carlo table; under rough low-index coats over a near-perfect smooth mirror
-// they return more than arrives (docs/models.md, lamina-1, "Known errors": 1.037 at η0 = 1.2,
-// α0 = 0.7, normal incidence). This bounds that excess over the same sweep at the documented
-// 1.037 plus the quadrature's 1e-3, and fails if it grows.
+// come from a Monte-Carlo table (≤ 0.0056 per node, which the inter-reflection series carries
+// through 1/(1 − r̄) ≤ 3: 0.017), on top of the tables' budget of AlbedoAtMostOne (the quadrature's
+// 1e-3 and the FGD table's 6.3e-3; docs/models.md, lamina-1, "Known errors").
 TEST(ModelsEnergy, Lamina1MultipleScatteringExcess) {
     BinnedOptions o;
     o.rel_tol = 1e-3;
@@ -83,7 +82,7 @@ TEST(ModelsEnergy, Lamina1MultipleScatteringExcess) {
     }
     std::printf("lamina-1 (orders >= 2 restored): largest albedo %.4f (%s)\n", worst,
                 where.c_str());
-    EXPECT_LE(worst, 1.037 + 1e-3) << where;
+    EXPECT_LE(worst, 1.0 + 1e-3 + 6.3e-3 + 0.017) << where;
 }
 
 // Ele10 evaluates the base at the refracted directions without the 1/η0² compression: a narrow
