@@ -206,7 +206,7 @@ vec3 l1_base_lobe(vec3 wi_in, float k_top, float lobe_norm_i, float mu_o, vec3 w
     float D = l1_flag(7) ? l1_first_order_ndf(h, k_top, k_o) : l1_ggx_d(alpha, h);
     vec3 f = l1_base_fresnel(dot(wi_in, h)) * (D * G / (4.0 * wi_in.z * wo_in.z));
     if (l1_flag(6)) f *= lobe_norm_i * l1_cosine_curve(L1_LOBE_NORM, L1_NNORM, 1, 0, wo_in.z);
-    // The base's orders >= 2, separable.
+    // The base's orders >= 2, separable (Kulla & Conty 2017; Bsdf::base_lobe).
     if (l1_flag(17))
         f += l1_rgb(34) * (l1_cosine_curve(L1_DE_BASE, L1_NMU, 1, 0, wi_in.z) *
                            l1_cosine_curve(L1_DE_BASE, L1_NMU, 1, 0, wo_in.z) * L1_INV_PI / l1_at(38));
@@ -235,7 +235,7 @@ vec3 lamina1_eval(vec3 wi, vec3 wo) {
         float G = 1.0 / (1.0 + lambda0 + l1_lambda(alpha0, wo));
         f = vec3(l1_fresnel_dielectric(dot(wi, h), eta0) * l1_ggx_d(alpha0, h) * G /
                  (4.0 * wi.z * wo.z));
-        // Its orders >= 2, separable.
+        // Its orders >= 2, separable (Kulla & Conty 2017; Bsdf::eval_with).
         if (l1_flag(16))
             f += vec3(l1_cosine_curve(L1_DR_TOP, L1_NMU, 1, 0, wi.z) *
                       l1_cosine_curve(L1_DR_TOP, L1_NMU, 1, 0, wo.z) * L1_INV_PI / l1_at(37));
