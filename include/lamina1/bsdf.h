@@ -128,6 +128,7 @@ class Bsdf {
     SplitCurve<33> precompute_albedos();
     void precompute_mean_direction();
     void precompute_series(const SplitCurve<33>& g_curve);
+    Rgb first_order_energy(double mu) const;
     Rgb returned_light(double mu, const SplitCurve<33>& g_curve, const Rgb& Y_ms) const;
     void precompute_returned(const SplitCurve<33>& g_curve);
     void precompute_scattering();
@@ -150,7 +151,17 @@ class Bsdf {
     Rgb single_transmission(const Incident& in, const Vec3& v_in, const Rgb& a_v, double T_b,
                             const Rgb& g, const Rgb& scale) const;
     Rgb eval_btdf(const Incident& in, const Vec3& wo) const;
-    Rgb base_lobe(const Incident& in, double mu_o, const Vec3& wo_in) const;
+    void incident_coat(Incident& in) const;
+    /// Which form of the base lobe: with the base's separable multiple-scattering lobe or not;
+    /// with the interfaces' own slope covariances or, rotation-invariant, their root mean
+    /// square roughnesses (the same where every interface is isotropic).
+    struct LobeForm {
+        bool base_ms = true;
+        bool anisotropic = true;
+    };
+    Rgb first_order(const Incident& in, const Vec3& wo, const Vec3& wo_in, const Rgb& a_o,
+                    LobeForm form) const;
+    Rgb base_lobe(const Incident& in, double mu_o, const Vec3& wo_in, LobeForm form) const;
     double first_order_ndf(const Vec3& h, double k_i, double k_o, bool anisotropic) const;
 
     // Sampling (lamina1/sampling.h): the mixture for one incidence, lobe probabilities (top
@@ -172,6 +183,14 @@ class Bsdf {
     /// and leaves with that direction's transmittance from inside), T(μ) where it is wider (the
     /// radiance inside is locally uniform, and the light reaching μ outside is T(μ) by
     /// reciprocity), weighted by u = α1² / (α1² + (α0 k/2)²).
+    /// The part of the light inside at μ' (within the exit cone) that the first order lets
+    /// out: T_exit along the macro refraction (exit-transmittance=inside), else T(μo).
+    double first_order_exit(double mu_in) const {
+        const double mu_out = safe_sqrt(1 - (1 - mu_in * mu_in) * sqr(eta0_));
+        return inside_exit_ ? exit_transmittance(mu_out, mu_in, spread_factor(mu_out, mu_in, eta0_))
+                            : T_top_(mu_out);
+    }
+
     double exit_transmittance(double mu, double mu_in, double k) const {
         const double spread2 = sqr(0.5 * alpha0_ * k),
                      u = spread2 > 0 ? sqr(alpha1_) / (sqr(alpha1_) + spread2) : 1.0;
@@ -370,6 +389,7 @@ class Bsdf {
     bool ms_ = false;
     bool inside_exit_ = false;  ///< exit_transmittance in the first order (see Options)
     bool mirror_series_ = false;
+    bool balance_ = false;  ///< the first order's balance returned with the series (Options)
     bool lobe_norm_on_ = false;
     /// first-order-lobe compressed or sum: first_order_ndf in place of the GGX of α_e (a coat
     /// with α0 > 0 over a conductor or dielectric base, the spread on); the facet maps it uses.

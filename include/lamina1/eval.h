@@ -15,14 +15,10 @@ inline Bsdf::Incident Bsdf::incident(const Vec3& wi) const {
     // Light exactly at grazing into an index-matched coat stays on the horizon (cos θi' = 0
     // by rounding): nothing enters, and the spread factor k = |1 − μ/(η μ')| would be 0/0.
     if (!(in.wi_in.z > 0)) return in;
-    in.ok = true;
-    in.T = T_top_(wi.z);
-    in.T_pair = in.T;
-    in.a = attenuation(in.wi_in.z);
+    incident_coat(in);
     if (series_on_) in.X = X_at(wi.z);
     if (alpha0_ > 0) in.lambda0 = coat_ggx_.lambda(wi);
     if (top_ms_) in.dR = dR_top_(wi.z);
-    if (lobe_norm_on_) in.lobe_norm = lobe_norm_(in.wi_in.z);
     if (scatters_) {
         if (base_paths_) in.E_b = mirror_albedo(in.wi_in.z);
         if (orders_on_) {
@@ -31,8 +27,6 @@ inline Bsdf::Incident Bsdf::incident(const Vec3& wi) const {
             if (twice_on_) in.twice = twice_(wi.z);
         }
     }
-    in.k_top = spread_factor(wi.z, in.wi_in.z, eta0_);
-    if (inside_exit_) in.T_pair = std::sqrt(in.T * exit_transmittance(wi.z, in.wi_in.z, in.k_top));
     if (support_.btdf) {
         in.wi_mean = in.wi_in;
         in.a_mean = in.a;
@@ -77,6 +71,19 @@ inline Bsdf::Incident Bsdf::incident(const Vec3& wi) const {
     return in;
 }
 
+/// What the coat does to wi for the first order (wi_in set, pointing up): T(μi), the first
+/// order's coat factor T_pair, the attenuation, the spread rate and the lobe's normalization.
+inline void Bsdf::incident_coat(Incident& in) const {
+    const Vec3& wi = in.wi;
+    in.ok = true;
+    in.T = T_top_(wi.z);
+    in.T_pair = in.T;
+    in.a = attenuation(in.wi_in.z);
+    if (lobe_norm_on_) in.lobe_norm = lobe_norm_(in.wi_in.z);
+    in.k_top = spread_factor(wi.z, in.wi_in.z, eta0_);
+    if (inside_exit_) in.T_pair = std::sqrt(in.T * exit_transmittance(wi.z, in.wi_in.z, in.k_top));
+}
+
 inline Rgb Bsdf::eval_with(const Incident& in, const Vec3& wo) const {
     if (!in.ok || wo.z == 0) return Rgb(0.0);
     if (wo.z < 0) return support_.btdf ? eval_btdf(in, wo) : Rgb(0.0);
@@ -95,29 +102,35 @@ inline Rgb Bsdf::eval_with(const Incident& in, const Vec3& wo) const {
         if (top_ms_) f += Rgb(in.dR * dR_top_(wo.z) * kInvPi / dR_top_bar_);
     }
     const Vec3 wo_in = refract_in(wo, inv_eta0_);
-    double T_o = T_top_(wo.z);
     const Rgb a_o = attenuation(wo_in.z);
-    // First order: the base's lobe at the refracted directions, entering and leaving through
-    // the coat's directional transmittance; 1/η0² compresses the solid angle.
-    // A direction refracted onto the horizon (an index-matched coat at grazing light, where
-    // √(1 − sin²θ) rounds to 0) carries no first order: T is 0 there and the lobe 0/0.
-    const Rgb fb = in.wi_in.z > 0 && wo_in.z > 0 ? base_lobe(in, wo.z, wo_in) : Rgb(0.0);
-    // The coat enters with T(μi) and leaves with T_exit(μo); made reciprocal as the product
-    // √(T T_exit)(μi) √(T T_exit)(μo), exact at the mirror pair (μo = μi) where the narrow
-    // first order is.
-    if (inside_exit_ && fb.max() > 0)
-        T_o =
-            std::sqrt(T_o * exit_transmittance(wo.z, wo_in.z, spread_factor(wo.z, wo_in.z, eta0_)));
-    Rgb rounds(1.0);
-    if (mirror_series_ && fb.max() > 0)
-        rounds = mirror_series_curve_(in.wi_in.z) * mirror_series_curve_(wo_in.z);
-    f += fb * (in.a * a_o) * rounds *
-         (in.T_pair * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
+    f += first_order(in, wo, wo_in, a_o, LobeForm{});
     if (series_on_) {
         f += in.X * X_at(wo.z) * K_ * (kInvPi * inv_eta0_ * inv_eta0_);
     }
     if (scatters_) f += scattered(in, wo, wo_in, a_o);
     return f;
+}
+
+/// First order: the base's lobe at the refracted directions, entering and leaving through the
+/// coat's directional transmittance; 1/η0² compresses the solid angle. `base_ms`: with the base's
+/// separable multiple-scattering lobe.
+inline Rgb Bsdf::first_order(const Incident& in, const Vec3& wo, const Vec3& wo_in, const Rgb& a_o,
+                             LobeForm form) const {
+    // A direction refracted onto the horizon (an index-matched coat at grazing light, where
+    // √(1 − sin²θ) rounds to 0) carries no first order: T is 0 there and the lobe 0/0.
+    const Rgb fb = in.wi_in.z > 0 && wo_in.z > 0 ? base_lobe(in, wo.z, wo_in, form) : Rgb(0.0);
+    if (!(fb.max() > 0)) return Rgb(0.0);
+    // The coat enters with T(μi) and leaves with T_exit(μo); made reciprocal as the product
+    // √(T T_exit)(μi) √(T T_exit)(μo), exact at the mirror pair (μo = μi) where the narrow
+    // first order is.
+    double T_o = T_top_(wo.z);
+    if (inside_exit_)
+        T_o =
+            std::sqrt(T_o * exit_transmittance(wo.z, wo_in.z, spread_factor(wo.z, wo_in.z, eta0_)));
+    Rgb rounds(1.0);
+    if (mirror_series_) rounds = mirror_series_curve_(in.wi_in.z) * mirror_series_curve_(wo_in.z);
+    return fb * (in.a * a_o) * rounds *
+           (in.T_pair * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
 }
 
 /// The scattering medium's reflected terms (out of line: absorbing stacks pay one branch).
@@ -287,18 +300,22 @@ inline Rgb Bsdf::eval_btdf(const Incident& in, const Vec3& wo) const {
 }
 
 /// The base's lobe at the refracted pair (wi', wo'), widened by the coat's refraction spread.
-inline Rgb Bsdf::base_lobe(const Incident& in, double mu_o, const Vec3& wo_in) const {
+inline Rgb Bsdf::base_lobe(const Incident& in, double mu_o, const Vec3& wo_in,
+                           LobeForm form) const {
     if (layers_.base == Base::Lambertian) return layers_.albedo * kInvPi;
     const double k_o = spread_factor(mu_o, wo_in.z, eta0_);
-    const GGX ggx = widened_ggx(in.k_top, k_o);
+    const GGX ggx =
+        form.anisotropic ? widened_ggx(in.k_top, k_o) : GGX{effective_alpha(in.k_top, k_o)};
     if (ggx.alpha <= 0) return Rgb(0.0);  // a delta lobe (delta_lobes)
     const Vec3 h = normalize(in.wi_in + wo_in);
     const double G = ggx.G2(in.wi_in, wo_in);
-    const double D = shaped_lobe_ ? first_order_ndf(h, in.k_top, k_o, aniso_) : ggx.D(h);
+    const double D =
+        shaped_lobe_ ? first_order_ndf(h, in.k_top, k_o, aniso_ && form.anisotropic) : ggx.D(h);
     Rgb f = base_fresnel(dot(in.wi_in, h)) * (D * G / (4 * in.wi_in.z * wo_in.z));
     if (lobe_norm_on_) f *= in.lobe_norm * lobe_norm_(wo_in.z);
     // The base's orders ≥ 2 (of its own roughness α1), separable as the coat's.
-    if (base_ms_) f += F_ms_ * (dE_base_(in.wi_in.z) * dE_base_(wo_in.z) * kInvPi / dE_base_bar_);
+    if (base_ms_ && form.base_ms)
+        f += F_ms_ * (dE_base_(in.wi_in.z) * dE_base_(wo_in.z) * kInvPi / dE_base_bar_);
     return f;
 }
 

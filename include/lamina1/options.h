@@ -51,6 +51,13 @@ struct Options {
     /// diffuse exit through the bottom only with "on"). With both interfaces smooth the exact
     /// delta series is summed either way.
     bool series_lambertian_only = true;
+    /// The first order's balance: the series returns what the first order does not let out,
+    /// counted as the light inside within the exit cone times its exit transmittance; the first
+    /// order's lobe (its width, shape, masking and exit factors are approximations) carries a
+    /// different energy. The difference is returned with the series (true), so the light that
+    /// enters leaves in one or the other as it does in the stack; or not (false). A rough coat
+    /// over a conductor or dielectric base, where the series is summed.
+    bool first_order_balance = true;
     /// The slab's transmission lobe centred on the mean direction of the light the rough coat
     /// transmits (true) or on the macro refraction of wi (false).
     bool mean_shift = true;

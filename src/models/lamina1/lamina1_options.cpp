@@ -42,6 +42,10 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table() {
          "inter-reflections between base and coat bottom (geometric series as a separable lobe): "
          "auto: reflected under Lambertian bases and bases at least as rough as the coat; on: "
          "always, transmitted too; off: never (smooth stacks: the exact delta series unless off)"},
+        on_off_member<L1>("first-order-balance", &L1::first_order_balance,
+                          "the energy the first order's lobe does not carry out (against the "
+                          "light inside the exit cone times its exit transmittance) returned "
+                          "with the inter-reflection series, or not"),
         on_off_member<L1>("eta2", &L1::eta2_factor, "the 1/eta0^2 solid-angle compression"),
         member_option<L1, bool>(
             "transmitted-direction", &L1::mean_shift, {{"mean", true}, {"refracted", false}},
