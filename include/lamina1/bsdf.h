@@ -152,10 +152,12 @@ class Bsdf {
                             const Rgb& g, const Rgb& scale) const;
     Rgb eval_btdf(const Incident& in, const Vec3& wo) const;
     void incident_coat(Incident& in) const;
-    /// Which form of the base lobe: with the base's separable multiple-scattering lobe or not;
-    /// with the interfaces' own slope covariances or, rotation-invariant, their root mean
-    /// square roughnesses (the same where every interface is isotropic).
+    /// Which parts of the base lobe: its single-scattering lobe, the base's separable
+    /// multiple-scattering lobe; with the interfaces' own slope covariances or, rotation-
+    /// invariant, their root mean square roughnesses (the same where every interface is
+    /// isotropic).
     struct LobeForm {
+        bool specular = true;
         bool base_ms = true;
         bool anisotropic = true;
     };

@@ -307,12 +307,15 @@ inline Rgb Bsdf::base_lobe(const Incident& in, double mu_o, const Vec3& wo_in,
     const GGX ggx =
         form.anisotropic ? widened_ggx(in.k_top, k_o) : GGX{effective_alpha(in.k_top, k_o)};
     if (ggx.alpha <= 0) return Rgb(0.0);  // a delta lobe (delta_lobes)
-    const Vec3 h = normalize(in.wi_in + wo_in);
-    const double G = ggx.G2(in.wi_in, wo_in);
-    const double D =
-        shaped_lobe_ ? first_order_ndf(h, in.k_top, k_o, aniso_ && form.anisotropic) : ggx.D(h);
-    Rgb f = base_fresnel(dot(in.wi_in, h)) * (D * G / (4 * in.wi_in.z * wo_in.z));
-    if (lobe_norm_on_) f *= in.lobe_norm * lobe_norm_(wo_in.z);
+    Rgb f(0.0);
+    if (form.specular) {
+        const Vec3 h = normalize(in.wi_in + wo_in);
+        const double G = ggx.G2(in.wi_in, wo_in);
+        const double D =
+            shaped_lobe_ ? first_order_ndf(h, in.k_top, k_o, aniso_ && form.anisotropic) : ggx.D(h);
+        f = base_fresnel(dot(in.wi_in, h)) * (D * G / (4 * in.wi_in.z * wo_in.z));
+        if (lobe_norm_on_) f *= in.lobe_norm * lobe_norm_(wo_in.z);
+    }
     // The base's orders ≥ 2 (of its own roughness α1), separable as the coat's.
     if (base_ms_ && form.base_ms)
         f += F_ms_ * (dE_base_(in.wi_in.z) * dE_base_(wo_in.z) * kInvPi / dE_base_bar_);
