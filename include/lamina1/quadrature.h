@@ -116,14 +116,19 @@ Crossing(Out, double) -> Crossing<Out>;
 /// height √(1 − r²) ≈ u √2 is smooth in u at the rim, where in r it has a square-root edge that a
 /// few Gauss–Legendre nodes in r integrate poorly (4 × 8 nodes in r were up to 1e-2 high on the
 /// transmittance of an α = 0.6 coat at normal incidence; in u, 6e-4). Per φ node (n_phi,
-/// midpoint) the u axis is split at each crossing (bracketed_root to r_tol/2 in u; each
-/// outgoing_z is monotonic along r for the reflections and refractions used here) and each piece
-/// gets the Gauss–Legendre rule q_r.
+/// midpoint) the u axis is split at each crossing and each piece gets the Gauss–Legendre rule
+/// q_r. The crossings are found by scanning each outgoing_z over kCrossingScan intervals of u for
+/// sign changes, each then solved by bracketed_root to r_tol/2 in u: a reflection off an oblique
+/// direction is not monotonic along r (towards the rim of the half disk facing away from w the
+/// reflected direction rises and falls), so one crossing may enter and leave the same φ line,
+/// where the ends' signs agree. Without the scan such a gap went unsplit: the slab's mirrored
+/// transmission lobe's energy came out 24 % low (η0 2, θ' = 46°, β 0.27).
 template <typename V, typename Frame, typename F, typename... Out>
 V integrate_visible_split_frame(const Frame& frame, F&& f, const QuadratureRule& q_r, int n_phi,
                                 double r_tol, const Crossing<Out>&... crossings) {
     constexpr double kUMin = 3.1622776601683795e-5;  // r ≤ 1 − 1e-9
     constexpr int kCrossings = sizeof...(Out);
+    constexpr int kCrossingScan = 8;
     // r = 0 (u = 1) is the same normal for every φ.
     const auto normal_0 = frame.normal(0, 1, 0);
     const std::array<double, kCrossings> h_0 = {
@@ -134,7 +139,7 @@ V integrate_visible_split_frame(const Frame& frame, F&& f, const QuadratureRule&
         const double cos_phi = std::cos(phi), sin_phi = std::sin(phi);
         auto normal = [&](double u) { return frame.normal(1 - u * u, cos_phi, sin_phi); };
         // The pieces' ends: kUMin, the crossings found (in increasing u), 1.
-        std::array<double, kCrossings + 2> ends{};
+        std::array<double, kCrossings * kCrossingScan + 2> ends{};
         int n_ends = 0;
         ends[n_ends++] = kUMin;
         int k = 0;
@@ -143,9 +148,16 @@ V integrate_visible_split_frame(const Frame& frame, F&& f, const QuadratureRule&
                 auto h_u = [&](double u) {
                     return crossing.outgoing_z(normal(u)) - crossing.z_split;
                 };
-                const double h_rim = h_u(kUMin);
-                if ((h_0[k] > 0) != (h_rim > 0))
-                    ends[n_ends++] = bracketed_root(h_u, kUMin, 1.0, h_rim, h_0[k], 0.5 * r_tol);
+                double u_prev = kUMin, h_prev = h_u(kUMin);
+                for (int j = 1; j <= kCrossingScan; ++j) {
+                    const double u_j =
+                        j == kCrossingScan ? 1.0 : kUMin + (1 - kUMin) * j / kCrossingScan;
+                    const double h_j = j == kCrossingScan ? h_0[k] : h_u(u_j);
+                    if ((h_prev > 0) != (h_j > 0))
+                        ends[n_ends++] = bracketed_root(h_u, u_prev, u_j, h_prev, h_j, 0.5 * r_tol);
+                    u_prev = u_j;
+                    h_prev = h_j;
+                }
                 ++k;
             }(crossings),
             ...);

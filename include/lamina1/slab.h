@@ -201,19 +201,23 @@ inline void Bsdf::slab_first_order(const CosineCurve<Multi<Rgb, 3>, kNfirst>& en
         }
         // btdf-lobe=shared: Q_m = ∫_cone T_b,in(μv') q(w̄i', v'; β) μv' dωv', the mirrored lobe's
         // energy (as eval_btdf weights it), by the visible normals of β at w̄i', split where the
-        // mirrored direction leaves the exit cone.
+        // mirrored direction leaves the exit cone: twice the φ nodes of the other slab rules, as
+        // that edge crosses some φ lines twice (within 2 % of a 1500 × 3000 solid-angle sum on
+        // five slabs at θi 60°–85°, where 4 × 8 nodes were up to 7 % off).
         const double beta = in.ok ? transmission_roughness(in.k_top, in.k_bottom) : 0.0;
         if (ch_.btdf_lobe_shared && beta > 0) {
             const GGX ggx{beta};
             const Vec3& w = in.wi_mean;
             const double lambda_w = ggx.lambda(w);
-            const double Q_m = integrate_visible_split<double, kSlabNr, kSlabNphi, kSlabBisections>(
-                ggx, w, mu_crit_b, [&](const Vec3& wm) { return reflect(w, wm).z; },
-                [&](const Vec3& wm) {
-                    const Vec3 v_in = reflect(w, wm);
-                    if (v_in.z <= mu_crit_b) return 0.0;
-                    return T_bot_in_(v_in.z) * (1 + lambda_w) / (1 + lambda_w + ggx.lambda(v_in));
-                });
+            const double Q_m =
+                integrate_visible_split<double, kSlabNr, 2 * kSlabNphi, kSlabBisections>(
+                    ggx, w, mu_crit_b, [&](const Vec3& wm) { return reflect(w, wm).z; },
+                    [&](const Vec3& wm) {
+                        const Vec3 v_in = reflect(w, wm);
+                        if (v_in.z <= mu_crit_b) return 0.0;
+                        return T_bot_in_(v_in.z) * (1 + lambda_w) /
+                               (1 + lambda_w + ggx.lambda(v_in));
+                    });
             if (Q_m > 0) r.v[2] = r.v[1] * (1 / Q_m);
         }
         const Multi<Rgb, 2> smooth = first_order_smooth(mu, mu_in);

@@ -5,6 +5,7 @@
 #include "core/math.h"
 #include "core/vec.h"
 #include "models/numerics/quadrature.h"
+#include "physics/fresnel.h"
 #include "physics/microfacet.h"
 
 #include <gtest/gtest.h>
@@ -42,6 +43,40 @@ TEST(VisibleNormalQuadrature, StepsAtCrossingsAreExact) {
             EXPECT_NEAR(band, ggx_cap_fraction(alpha, z1) - ggx_cap_fraction(alpha, z0), 1e-8)
                 << alpha << " " << z0;
         }
+}
+
+// A reflection off an oblique direction is not monotonic along the radius: on the φ lines of the
+// half disk facing away from w the reflected direction's height rises and falls, so a cap of
+// reflected directions can enter and leave one line with the same sign at both ends. The rule
+// scans each line for sign changes: the share of visible normals that reflect w (θ = 46°, GGX
+// α 0.27) into the cap z > 0.866 equals an independent solid-angle sum of the reflection lobe
+// f μo = D G2/(4 μi) over that cap (G2/G1 weighting, 1500 × 3000 midpoint cells), to 2e-3 with
+// 4 × 32 nodes; without the scan the same rule gives it 15 % low.
+TEST(VisibleNormalQuadrature, ReflectedCapCrossingAPhiLineTwice) {
+    const double alpha = 0.272, mu = 0.6939, z_cap = std::sqrt(0.75);
+    const GGX<double> ggx{alpha};
+    const Vec3d w(std::sqrt(1 - mu * mu), 0, mu);
+    const double lambda_w = ggx.lambda(w);
+    const QuadratureRule q = gauss_legendre(4);
+    const double rule = integrate_visible_split<double>(
+        ggx, w,
+        [&](const Vec3d& wm) {
+            const Vec3d wo = reflect(w, wm);
+            return wo.z > z_cap ? (1 + lambda_w) / (1 + lambda_w + ggx.lambda(wo)) : 0.0;
+        },
+        q, 32, 1.0 / 256, Crossing{[&](const Vec3d& wm) { return reflect(w, wm).z; }, z_cap});
+    double sum = 0;
+    const int n = 1500;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < 2 * n; ++j) {
+            const double z = (i + 0.5) / n, s = std::sqrt(1 - z * z);
+            const double phi = 2 * kPi<double> * (j + 0.5) / (2 * n);
+            if (z <= z_cap) continue;
+            const Vec3d wo(s * std::cos(phi), s * std::sin(phi), z);
+            const Vec3d h = normalize(w + wo);
+            sum += ggx.D(h) * ggx.G2(w, wo) / (4 * w.z) * (1.0 / n) * (kPi<double> / n);
+        }
+    EXPECT_NEAR(rule, sum, 2e-3);
 }
 
 // The pieces cover the whole disk at any incidence: the visible normals' density integrates to
