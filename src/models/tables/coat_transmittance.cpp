@@ -21,7 +21,7 @@ constexpr int kTableNr = 16;    // Gauss–Legendre nodes in u = √(1 − r) pe
 constexpr int kTableNphi = 32;  // midpoint nodes in φ over the half disk (mirrored)
 constexpr double kCMin = lamina1::TransmittanceFormat::kCMin;
 constexpr double kAlphaMin = lamina1::TransmittanceFormat::kAlphaMin;
-constexpr const char* kCodeVersion = "coat-t-v6";
+constexpr const char* kCodeVersion = "coat-t-v7";
 
 using T = CoatTransmittanceTable;
 

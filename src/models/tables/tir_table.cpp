@@ -20,7 +20,7 @@ namespace lamina {
 namespace {
 constexpr int kStrata = 32;  // per axis of the sampling square
 constexpr double kCMin = 1e-4, kAlphaMin = 1e-5;
-constexpr const char* kCodeVersion = "tir-v3";
+constexpr const char* kCodeVersion = "tir-v4";
 constexpr int kSplit = 16;  // c nodes 0..kSplit cover [0, c_crit], the rest [c_crit, 1]
 
 // The c axis is relative to the critical cosine of each η node and dense next to it on both
