@@ -289,9 +289,10 @@ inline void Bsdf::precompute_series(const SplitCurve<33>& g_curve) {
     // is then largely lost on the interfaces, as in the 2019 study's reference. With their orders
     // ≥ 2 restored nothing is lost, and each return through the rough coat spreads the light
     // again: the series is summed (a white mirror under a rough coat then keeps 0.985–1.010 of
-    // the light up to 85°; 0.47 without, at 85° under η0 1.2, α0 0.7). In a slab the returned light mostly leaves through a smooth bottom after one more
-    // crossing with its direction kept: the round trips stay in the first order's lobe (measured
-    // on the quick study's slabs: the uniform series there misplaced more light, docs/models.md).
+    // the light up to 85°; 0.47 without, at 85° under η0 1.2, α0 0.7). In a slab the returned light
+    // mostly leaves through a smooth bottom after one more crossing with its direction kept: the
+    // round trips stay in the first order's lobe (measured on the quick study's slabs: the uniform
+    // series there misplaced more light, docs/models.md).
     const bool everywhere = !ch_.series_lambertian_only || (ms_ && layers_.base == Base::Conductor);
     series_on_ = ch_.inter_reflection && !(smooth_base && alpha0_ == 0) &&
                  (layers_.base == Base::Lambertian || everywhere || alpha1_ >= alpha0_);
