@@ -185,18 +185,18 @@ class Bsdf {
     /// and leaves with that direction's transmittance from inside), T(μ) where it is wider (the
     /// radiance inside is locally uniform, and the light reaching μ outside is T(μ) by
     /// reciprocity), weighted by u = α1² / (α1² + (α0 k/2)²).
+    double exit_transmittance(double mu, double mu_in, double k) const {
+        const double spread2 = sqr(0.5 * alpha0_ * k),
+                     u = spread2 > 0 ? sqr(alpha1_) / (sqr(alpha1_) + spread2) : 1.0;
+        return u * T_top_(mu) + (1 - u) * T_top_in_(mu_in);
+    }
+
     /// The part of the light inside at μ' (within the exit cone) that the first order lets
     /// out: T_exit along the macro refraction (exit-transmittance=inside), else T(μo).
     double first_order_exit(double mu_in) const {
         const double mu_out = safe_sqrt(1 - (1 - mu_in * mu_in) * sqr(eta0_));
         return inside_exit_ ? exit_transmittance(mu_out, mu_in, spread_factor(mu_out, mu_in, eta0_))
                             : T_top_(mu_out);
-    }
-
-    double exit_transmittance(double mu, double mu_in, double k) const {
-        const double spread2 = sqr(0.5 * alpha0_ * k),
-                     u = spread2 > 0 ? sqr(alpha1_) / (sqr(alpha1_) + spread2) : 1.0;
-        return u * T_top_(mu) + (1 - u) * T_top_in_(mu_in);
     }
 
     /// α_e² = α1² + (α0 k_i/2)² + (α0 k_o/2)²: a deflection of the light by ε turns the mirror

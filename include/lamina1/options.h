@@ -46,10 +46,11 @@ struct Options {
     /// Inter-reflections between base and coat bottom (the separable series term).
     bool inter_reflection = true;
     /// "auto": the separable series only where its uniform-radiance assumption can hold, where the
-    /// base re-diffuses the returned light at least as much as the coat spreads it: a Lambertian
-    /// base, or a base at least as rough as the coat (α1 ≥ α0); reflected only (the slab's
-    /// diffuse exit through the bottom only with "on"). With both interfaces smooth the exact
-    /// delta series is summed either way.
+    /// returned light is spread again before it leaves: a Lambertian base, a base at least as
+    /// rough as the coat (α1 ≥ α0), and, with the microsurfaces' orders ≥ 2 restored, every
+    /// conductor (the rough coat spreads each return, and nothing is lost on the interfaces);
+    /// reflected only (the slab's diffuse exit through the bottom only with "on"). With both
+    /// interfaces smooth the exact delta series is summed either way.
     bool series_lambertian_only = true;
     /// The first order's balance: the series returns what the first order does not let out,
     /// counted as the light inside within the exit cone times its exit transmittance; the first

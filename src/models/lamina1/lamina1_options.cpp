@@ -40,7 +40,8 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table() {
           {"off", [](L1& c) { c.inter_reflection = c.series_lambertian_only = false; },
            [](const L1& c) { return !c.inter_reflection; }}},
          "inter-reflections between base and coat bottom (geometric series as a separable lobe): "
-         "auto: reflected under Lambertian bases and bases at least as rough as the coat; on: "
+         "auto: reflected under Lambertian bases, bases at least as rough as the coat and, with "
+         "the orders >= 2 restored (microsurface), every conductor; on: "
          "always, transmitted too; off: never (smooth stacks: the exact delta series unless off)"},
         on_off_member<L1>("first-order-balance", &L1::first_order_balance,
                           "the energy the first order's lobe does not carry out (against the "
