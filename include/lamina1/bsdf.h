@@ -125,12 +125,12 @@ class Bsdf {
     void setup_transmittances();
     void precompute_lobe_normalization();
     void precompute_multiple_scattering();
-    SplitCurve<33> precompute_albedos();
+    RgbEdgeCurve<33> precompute_albedos();
     void precompute_mean_direction();
-    void precompute_series(const SplitCurve<33>& g_curve);
+    void precompute_series(const RgbEdgeCurve<33>& g_curve);
     Rgb first_order_energy(double mu) const;
-    Rgb returned_light(double mu, const SplitCurve<33>& g_curve, const Rgb& Y_ms) const;
-    void precompute_returned(const SplitCurve<33>& g_curve);
+    Rgb returned_light(double mu, const RgbEdgeCurve<33>& g_curve, const Rgb& Y_ms) const;
+    void precompute_returned(const RgbEdgeCurve<33>& g_curve);
     void precompute_scattering();
     struct AddingEnergies;
     AddingEnergies adding_energies() const;

@@ -93,6 +93,10 @@ struct SplitCurve {
 /// The square-root-edge curve (SplitCurve with kSqrtEdge).
 template <int kN>
 using EdgeCurve = SplitCurve<kN, double, true>;
+/// The same per channel: the light a return trip keeps, whose Fresnel factors rise from total
+/// reflection as √(μ − μc) just inside the critical cosine.
+template <int kN>
+using RgbEdgeCurve = SplitCurve<kN, Rgb, true>;
 
 /// N values of type T integrated and tabulated together (the curves above take it as V).
 template <typename T, int N>
