@@ -152,7 +152,8 @@ void BM_StackBinnedTable(benchmark::State& state, const std::string& name, const
 
 /// lamina-1's per-material precomputation (its curves over cosines, hemispherical albedos and the
 /// inter-reflection normalization; the process-wide tables already loaded): the whole constructor.
-void BM_Lamina1Construct(benchmark::State& state, bool slab, bool single, bool milky = false) {
+void BM_Lamina1Construct(benchmark::State& state, bool slab, bool single, bool milky = false,
+                         bool series = false) {
     warm_tables();
     Stack stack = typical_stack(slab);
     if (milky) {
@@ -161,16 +162,21 @@ void BM_Lamina1Construct(benchmark::State& state, bool slab, bool single, bool m
         stack.layers[0].medium.g = Rgbd(0.3);
     }
     // The default restores the microsurfaces' orders ≥ 2 (these stacks are isotropic).
-    const std::vector<std::string> options =
-        single ? std::vector<std::string>{"microsurface=single"} : std::vector<std::string>{};
+    std::vector<std::string> options;
+    if (single) options.push_back("microsurface=single");
+    // A slab's inter-reflections as the earlier series (slab-orders=series), against the bins.
+    if (series) options.push_back("slab-orders=series");
     make_model("lamina-1", stack, options);  // loads the multiple-scattering table once
     for (auto _ : state)
         benchmark::DoNotOptimize(make_model("lamina-1", stack, options));
     state.SetLabel(std::string(slab ? "rough slab" : "rough coat over rough gold") +
-                   (milky ? ", HG medium" : "") + (single ? ", microsurface=single" : ""));
+                   (milky ? ", HG medium" : "") + (single ? ", microsurface=single" : "") +
+                   (series ? ", slab-orders=series" : ""));
 }
 BENCHMARK_CAPTURE(BM_Lamina1Construct, coated_gold, false, false)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Lamina1Construct, slab, true, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Lamina1Construct, slab_series, true, false, false, true)
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Lamina1Construct, coated_gold_single, false, true)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Lamina1Construct, slab_single, true, true)->Unit(benchmark::kMicrosecond);

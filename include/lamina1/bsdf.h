@@ -9,7 +9,8 @@
 //       + T(μi) T(μo) a(μi') a(μo') f_b(wi', wo'; α_e) / η0²     first order through the coat
 //       + K X(μi) X(μo) / (π η0²)                    inter-reflections (separable, reciprocal)
 //   f_T = E_1(μi) f_t,b(w̄i', wo; α_b) / T_b,in(μ̄i'; α_b)   first order through the slab's bottom
-//       [+ Σ_p Φ_p(μi) T_{below→p}(μo) / (π A_p η_s²)]   later orders (btdf_populations)
+//       + B(μo)ᵀ W_s s(μi) D C(μi)                    later orders, the inside light in bins
+//   (a slab's reflection: C(μo)ᵀ W (g P₁ g + P₂) C(μi) in place of K X X; lamina1/slab.h)
 //
 // T: the coat's directional transmittance, a: Beer–Lambert along the refracted mean directions,
 // α_e and β: the base lobe widened by the coat's refraction spread (its shape the sum of the
@@ -91,9 +92,11 @@ class Bsdf {
         Rgb first_E{0.0};  ///< E_1(μi): the first order's transmitted energy
         double u_bottom = 1;  ///< the first order's share in the bottom's lobe (btdf-lobe)
         Rgb first_M{0.0};     ///< E_1(μi)/Q_m(μi): over the mirrored lobe's energy (shared)
-        /// Φ_p(μi)/(π A_p η_s²) for the populations p = inside, beyond the exit cone (v[0], v[1])
-        /// and the energy Σ_p Φ_p T_p they transmit (v[2]): the slab's later orders.
-        Multi<Rgb, 3> trapped{};
+        /// slab-orders=bins (lamina1/slab.h, incident_bins): per bin, the reflection's vectors
+        /// g(μi) W P₁ C(μi) and W P₂ C(μi), the light arriving at the bottom (energy and forward
+        /// moment each), and the energies let out (reflected, transmitted: the sampler's
+        /// weights).
+        Multi<Rgb, 6 * kNbins + 2> bins{};
     };
 
     /// The per-incidence part of eval (wi.z > 0): evaluate many wo with eval_with.
@@ -138,12 +141,24 @@ class Bsdf {
                                            std::vector<double>& twice_phase) const;
     void precompute_scattering_curves(const AddingEnergies& e);
     void precompute_slab();
-    struct SlabReflections;
-    SlabReflections slab_reflections() const;
-    CosineCurve<Multi<Rgb, 3>, kNfirst> slab_entry(const SlabReflections& r);
-    void slab_first_order(const CosineCurve<Multi<Rgb, 3>, kNfirst>& entry);
-    void slab_populations(const SlabReflections& r,
-                          const CosineCurve<Multi<Rgb, 3>, kNfirst>& entry);
+    CosineCurve<Rgb, kNfirst> slab_entry();
+    void slab_first_order(const CosineCurve<Rgb, kNfirst>& entry);
+    /// slab-orders=bins (lamina1/slab.h).
+    using BinMoments = Multi<double, 2 * kNbins>;
+    struct Hat {
+        int k0, k1;
+        double w0, w1;
+    };
+    Hat hat_of(double mu) const;
+    void hat_rule(int k, std::array<double, 2 * kBinSub>& mu,
+                  std::array<double, 2 * kBinSub>& weight, double& area) const;
+    BinMoments refracted_into_bins(double alpha, double eta, const FgdView& fgd, double mu) const;
+    void slab_bins();
+    BinMoments coat_entry(double mu) const;
+    BinMoments bottom_exit(double mu) const;
+    void incident_bins(Incident& in) const;
+    Rgb bins_reflection(const Incident& in, const Vec3& wo) const;
+    Rgb bins_transmission(const Incident& in, const Vec3& wo) const;
 
     // Evaluation (lamina1/eval.h).
     Rgb scattered(const Incident& in, const Vec3& wo, const Vec3& wo_in, const Rgb& a_o) const;
@@ -427,12 +442,23 @@ class Bsdf {
     /// E_1(μ)/T_lobe(μ), E_1(μ) and E_1(μ)/Q_m(μ) (v[0], v[1], v[2]) over outside cosines, as
     /// residuals from the smooth slab (first_order_smooth).
     CosineCurve<Multi<Rgb, 3>, kNfirst> first_order_;
-    /// The slab's later orders as two populations of inside light (Options::btdf_populations):
-    /// Incident::trapped over outside cosines, and T_{below→p}(μ), the light arriving from below
-    /// at μ that the bottom lets into population p.
-    bool populations_ = false;
-    CosineCurve<Multi<Rgb, 3>, kNslab> trapped_;
-    CosineCurve<Multi<double, 2>, kNslab> enter_below_;
+    /// slab-orders=bins: the bins' edges over inside cosines (at the interfaces' critical
+    /// cosines, uniform in μ² between them); the light from outside at μ that the coat lets
+    /// into each bin and from below that the bottom lets in, energy (v[k]) and forward moment
+    /// (v[kNbins + k]); Incident::bins over outside cosines.
+    bool bins_ = false;
+    bool bins_ready_ = false;  ///< set once slab_bins has run (incident() is used before)
+    std::array<double, kNbins + 1> bin_edge_{};
+    std::array<int, kNbins> bin_piece_{};    ///< the piece (between critical cosines) of each bin
+    std::array<double, kNbins> bin_area_{};  ///< A_k = ∫ φ_k 2μ dμ
+    SegmentCurve<BinMoments, kBinPer> coat_bins_, bottom_bins_;
+    /// W P₁ and W P₂ per channel and azimuthal order (row-major): the bins' first and later
+    /// reflections (slab_bins), W = 1/(π A_j η0²).
+    std::array<std::array<std::array<double, kNbins * kNbins>, 2>, 3> bins_first_{}, bins_later_{};
+    /// g(μ) = √f(μ) per channel; per incidence, the light arriving at the bottom over
+    /// π A_k η_s² (both orders) and the energies let out (reflected, transmitted).
+    CosineCurve<Rgb, kNslab> bins_g_;
+    CosineCurve<Multi<Rgb, 2 * kNbins + 2>, kNslab> bins_down_;
 };
 
 }  // namespace lamina1

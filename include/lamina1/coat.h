@@ -76,6 +76,11 @@ inline Bsdf::Bsdf(const Layers& layers, const Tables& tables, const Options& opt
         fgd_top_ = FgdView(tables, alpha0_, eta0_, 0.0);
         if (support_.btdf) fgd_bottom_ = FgdView(tables, alpha1_, eta_s_, 0.0);
     }
+    // A slab's later orders in bins (slab-orders=bins) take the place of the separable series
+    // and of the first order's round trips (precompute_series); with both interfaces smooth the
+    // exact delta series is summed instead.
+    bins_ =
+        support_.btdf && ch_.slab_bins && ch_.inter_reflection && !(alpha0_ == 0 && alpha1_ == 0);
     precompute();
     if (scatters_) precompute_scattering();
     precompute_slab();
@@ -297,6 +302,7 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
     // mostly leaves through a smooth bottom after one more crossing with its direction kept: the
     // round trips stay in the first order's lobe (measured on the quick study's slabs: the uniform
     // series there misplaced more light, docs/models.md).
+    if (bins_) return;  // the slab's later orders in bins (lamina1/slab.h)
     const bool everywhere = !ch_.series_lambertian_only || (ms_ && layers_.base == Base::Conductor);
     series_on_ = ch_.inter_reflection && !(smooth_base && alpha0_ == 0) &&
                  (layers_.base == Base::Lambertian || everywhere || alpha1_ >= alpha0_);

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 namespace lamina1 {
 
@@ -37,6 +39,11 @@ constexpr int kGauss = 24;  // Gauss–Legendre nodes per piece of the hemispher
 // nodes, bisections).
 constexpr int kNfirst = 17, kNslab = 17;
 constexpr int kSlabNr = 4, kSlabNphi = 8, kSlabBisections = 8;
+// The slab's inside light in cosine bins (slab-orders=bins): the bins, the nodes per segment of
+// their entry curves (SegmentCurve), and the rule of the interfaces' transfer between bins (r × φ
+// nodes over the whole disk of visible normals, sub-directions per bin).
+constexpr int kNbins = 12, kBinPer = 4;
+constexpr int kBinNr = 12, kBinNphi = 24, kBinSub = 3;
 
 /// A curve over a cosine μ ∈ [0, 1] on nodes μ = s² (dense at grazing), linear in s.
 template <typename V, int kN = kNmu>
@@ -97,6 +104,38 @@ using EdgeCurve = SplitCurve<kN, double, true>;
 /// reflection as √(μ − μc) just inside the critical cosine.
 template <int kN>
 using RgbEdgeCurve = SplitCurve<kN, Rgb, true>;
+
+/// A curve over a cosine μ ∈ [0, 1] in segments between given cuts (where it jumps: the images of
+/// the bins' edges under a smooth refraction), kPer nodes inside each segment at its midpoints
+/// (i + ½)/kPer, linear between them and constant beyond the first and last node of a segment.
+template <typename V, int kPer>
+struct SegmentCurve {
+    std::vector<double> cut;  ///< 0 = cut[0] < … < cut.back() = 1
+    std::vector<V> v;         ///< kPer per segment
+    template <typename F>
+    void fill(std::vector<double> cuts, F&& f) {
+        cut = std::move(cuts);
+        const int n = int(cut.size()) - 1;
+        v.assign(std::size_t(n) * kPer, V{});
+        for (int g = 0; g < n; ++g)
+            for (int i = 0; i < kPer; ++i)
+                v[std::size_t(g) * kPer + i] = f(cut[g] + (cut[g + 1] - cut[g]) * (i + 0.5) / kPer);
+    }
+    V operator()(double mu) const {
+        const int n = int(cut.size()) - 1;
+        const int g = std::clamp(
+            int(std::upper_bound(cut.begin() + 1, cut.end() - 1, mu) - (cut.begin() + 1)), 0,
+            n - 1);
+        const double span = cut[g + 1] - cut[g];
+        const double x = span > 0 ? (mu - cut[g]) / span * kPer - 0.5 : 0.0;
+        const V* seg = v.data() + std::size_t(g) * kPer;
+        if (!(x > 0)) return seg[0];
+        if (x >= kPer - 1) return seg[kPer - 1];
+        const int i = int(x);
+        const double t = x - i;
+        return seg[i] * (1 - t) + seg[i + 1] * t;
+    }
+};
 
 /// N values of type T integrated and tabulated together (the curves above take it as V).
 template <typename T, int N>

@@ -62,11 +62,7 @@ inline Bsdf::Incident Bsdf::incident(const Vec3& wi) const {
             if (ch_.btdf_lobe_shared && in.alpha_b > 0)
                 in.u_bottom = sqr(alpha1_) / sqr(in.alpha_b);
         }
-        if (populations_) {
-            in.trapped = trapped_(wi.z);
-            for (Rgb& v : in.trapped.v)
-                v = nonnegative(v);
-        }
+        if (bins_ready_) incident_bins(in);
     }
     return in;
 }
@@ -107,6 +103,7 @@ inline Rgb Bsdf::eval_with(const Incident& in, const Vec3& wo) const {
     if (series_on_) {
         f += in.X * X_at(wo.z) * K_ * (kInvPi * inv_eta0_ * inv_eta0_);
     }
+    if (bins_) f += bins_reflection(in, wo);
     if (scatters_) f += scattered(in, wo, wo_in, a_o);
     return f;
 }
@@ -271,24 +268,21 @@ inline Rgb Bsdf::eval_btdf(const Incident& in, const Vec3& wo) const {
         Rgb a_once = in.a_mean * a_v;
         for (int c = 0; c < 3; ++c)
             a_once[c] = std::sqrt(a_once[c]);
-        if (mirror_series_ && !populations_)
+        if (mirror_series_)
             a_once *= mirror_series_curve_(in.wi_mean.z) * mirror_series_curve_(v_in->z);
         if (bottom_lobe_) {
             // btdf-lobe=shared: the mirrored lobe's share 1 − u of the first order, carrying
             // E_1 over its energy Q_m (the medium's attenuation is in E_1).
             Rgb rounds(1.0);
-            if (mirror_series_ && !populations_)
+            if (mirror_series_)
                 rounds = mirror_series_curve_(in.wi_mean.z) * mirror_series_curve_(v_in->z);
             f += in.first_M * rounds * ((1 - in.u_bottom) * T_b_in * q / (eta_s_ * eta_s_));
         } else {
             f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
         }
     }
-    if (populations_) {
-        // The later orders: uniform radiance in each population leaves through the bottom as
-        // the light from below at wo enters into it (reciprocity), T_{below→p}(μv)/η_s².
-        const Multi<double, 2> enter = enter_below_(v.z);
-        f += in.trapped.v[0] * enter.v[0] + in.trapped.v[1] * enter.v[1];
+    if (bins_) {
+        f += bins_transmission(in, wo);
     } else if (series_btdf_) {
         f += in.X * inv_one_minus_Er_ * (T_b * kInvPi / (eta_s_ * eta_s_));
     }

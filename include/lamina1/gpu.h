@@ -74,6 +74,7 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     if (!support_.brdf) return refuse("lamina-1 does not model these layers");
     if (scatters_) return refuse("a scattering medium (the GLSL form covers absorbing ones)");
     if (aniso_) return refuse("an anisotropic interface (the GLSL form is isotropic)");
+    if (bins_) return refuse("a slab's later orders in bins (slab-orders=bins)");
     std::vector<float> v(kGpuSize, 0.0f);
     unsigned flags = 0;
     auto flag = [&](bool on, unsigned bit) { flags |= on ? bit : 0u; };

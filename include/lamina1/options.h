@@ -119,12 +119,12 @@ struct Options {
     /// share of the spread's variance u = α1²/α_b², and the mirrored lobe (the coat's spread,
     /// made inside the coat and carried through the bottom's flat refraction), for 1 − u.
     bool btdf_lobe_shared = true;
-    /// The slab's later orders in transmission: the light inside the coat as two populations,
-    /// within the exit cone and beyond it (trapped by a smooth coat's total internal reflection),
-    /// each taken as uniform radiance after the first return, summed over every round trip by a
-    /// 2 × 2 geometric series and let out through the bottom's own transmittance (true); or the
-    /// uniform series of inter-reflection=on (false). Single scattering only.
-    bool btdf_populations = false;
+    /// A slab's inter-reflections, both sides: the light inside carried in cosine bins with its
+    /// azimuthal orders 0 and 1 (the forward moment), through both interfaces' transfer between
+    /// bins, summed over every round trip and let out through each interface by reciprocity
+    /// (true; lamina1/slab.h); or the uniform series and the first order's round trips of
+    /// inter_reflection (false). Nothing with inter_reflection off.
+    bool slab_bins = true;
 };
 
 }  // namespace lamina1

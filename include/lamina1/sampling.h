@@ -24,6 +24,7 @@ inline Bsdf::Mixture Bsdf::mixture(const Incident& in) const {
         if (m.base.alpha > 0) m.p[1] = in.T * a * E_b;
     }
     if (series_on_) m.p[2] = (in.X * K_ * X_bar_).mean();
+    if (bins_) m.p[2] = in.bins.v[6 * kNbins].mean();
     m.p[2] += in.dR;  // the coat's separable multiple-scattering lobe, also cosine-distributed
     // A scattering medium's light: broad (its single scattering) or separable (the rest), both
     // drawn with the cosine lobe.
@@ -36,8 +37,8 @@ inline Bsdf::Mixture Bsdf::mixture(const Incident& in) const {
         m.beta = m.bottom_sampled ? in.alpha_b : transmission_roughness(in.k_top, in.k_bottom);
         if (m.beta > 0)
             m.p[3] = bottom_lobe_ ? in.first_E.mean() : in.T * a * std::max(0.0, 1 - E_b);
-        if (populations_)
-            m.p[4] = in.trapped.v[2].mean();
+        if (bins_)
+            m.p[4] = in.bins.v[6 * kNbins + 1].mean();
         else if (series_btdf_)
             m.p[4] = (in.X * inv_one_minus_Er_).mean() * 0.5;
         if (orders_on_) m.p[4] += orders_t_(in.wi.z).mean();

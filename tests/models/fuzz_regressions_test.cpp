@@ -120,7 +120,7 @@ TEST(FuzzRegressions, Lamina1SlabFirstOrderNeverNegative) {
         "eta": 2.134708249139151, "alpha": 0.8688474796894968}}]})",
         "fuzz-1202-150");
     for (const char* lobe : {"btdf-lobe=shared", "btdf-lobe=bottom"})
-        for (const char* series : {"btdf-series=uniform", "btdf-series=populations"}) {
+        for (const char* series : {"slab-orders=series", "slab-orders=bins"}) {
             const auto g = make_model("lamina-1", grazing, {lobe, series, "inter-reflection=on"});
             const auto a = make_model("lamina-1", absorbed, {lobe, series, "inter-reflection=on"});
             for (double theta_i : {90.0, 90.0 - 1e-7, 89.0, 58.76})

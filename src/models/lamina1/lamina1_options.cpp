@@ -42,7 +42,8 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table() {
          "inter-reflections between base and coat bottom (geometric series as a separable lobe): "
          "auto: reflected under Lambertian bases, bases at least as rough as the coat and, with "
          "the orders >= 2 restored (microsurface), every conductor; on: "
-         "always, transmitted too; off: never (smooth stacks: the exact delta series unless off)"},
+         "always, transmitted too; off: never (smooth stacks: the exact delta series unless off); "
+         "a slab's are slab-orders'"},
         on_off_member<L1>("first-order-balance", &L1::first_order_balance,
                           "the energy the first order's lobe does not carry out (against the "
                           "light inside the exit cone times its exit transmittance) returned "
@@ -101,10 +102,10 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table() {
          "the first-order energy (bottom), the mirrored GGX lobe weighted by the bottom's "
          "transmittance at the exit (mirrored), or each for its share of the spread (shared)"},
         member_option<L1, bool>(
-            "btdf-series", &L1::btdf_populations, {{"uniform", false}, {"populations", true}},
-            "slab BTDF later orders: the light inside and beyond the exit cone as two uniform "
-            "populations summed over every round trip and let out through the bottom's "
-            "transmittance, or the uniform series of inter-reflection=on"),
+            "slab-orders", &L1::slab_bins, {{"bins", true}, {"series", false}},
+            "slab later orders (reflection and transmission): the inside light in cosine bins "
+            "with its forward moment, through both interfaces' transfer between bins, or the "
+            "uniform series of inter-reflection"),
         member_option<L1, L1::Microsurface>(
             "microsurface", &L1::microsurface,
             {{"auto", L1::Microsurface::Auto},

@@ -146,25 +146,31 @@ TEST(Lamina1, SmoothSlabIsTheExactSeries) {
 // Continuity: nearly smooth slabs (α = 10⁻³ on both interfaces) reflect and transmit what the
 // smooth slab does (docs/physics.md §6.4) up to 60°: what separates them is the microsurfaces' loss
 // (< 1e-4 there), the tables' interpolation (< 1e-3 at α = 10⁻³) and the binned quadrature
-// (1e-3 relative); the later orders, spread into the separable lobes (inter-reflection=on; by
-// default a slab gets none), carry F²a² < 1% of the light.
+// (1e-3 relative); the later orders carry F²a² < 1% of the light. With the uniform series
+// (slab-orders=series, inter-reflection=on) 5e-3; with the bins (the default) 8e-3: the first-
+// order lobes against the bins' first exits, whose difference the later transmission takes,
+// move up to 5.5e-3 between reflection and transmission here.
 TEST(Lamina1, NearlySmoothSlabIsTheSmoothSlab) {
     const Rgbd tau(0.1, 0.0, 0.9);
-    const auto model = make_model("lamina-1", coated(1.5, 1e-3, test::dielectric(1.0, 1e-3), tau),
-                                  {"inter-reflection=on"});
-    BinnedOptions o;
-    o.rel_tol = 1e-3;
-    for (double ti : {0.0, 30.0, 60.0}) {
-        const Vec3d wi = dir(ti, 0);
-        const double F = fresnel_dielectric(wi.z, 1.5);
-        const double mu_t = std::sqrt(1 - (1 - wi.z * wi.z) / 2.25);
-        const Rgbd R = model_albedo(*model, wi, Side::Reflection, o);
-        const Rgbd T = model_albedo(*model, wi, Side::Transmission, o);
-        for (int c = 0; c < 3; ++c) {
-            const double a = std::exp(-tau[c] / mu_t);
-            const double denom = 1 - F * F * a * a;
-            EXPECT_NEAR(R[c], F + sqr(1 - F) * F * a * a / denom, 5e-3) << ti << " " << c;
-            EXPECT_NEAR(T[c], sqr(1 - F) * a / denom, 5e-3) << ti << " " << c;
+    const std::vector<std::pair<std::vector<std::string>, double>> variants = {
+        {{}, 8e-3}, {{"slab-orders=series", "inter-reflection=on"}, 5e-3}};
+    for (const auto& [options, budget] : variants) {
+        const auto model =
+            make_model("lamina-1", coated(1.5, 1e-3, test::dielectric(1.0, 1e-3), tau), options);
+        BinnedOptions o;
+        o.rel_tol = 1e-3;
+        for (double ti : {0.0, 30.0, 60.0}) {
+            const Vec3d wi = dir(ti, 0);
+            const double F = fresnel_dielectric(wi.z, 1.5);
+            const double mu_t = std::sqrt(1 - (1 - wi.z * wi.z) / 2.25);
+            const Rgbd R = model_albedo(*model, wi, Side::Reflection, o);
+            const Rgbd T = model_albedo(*model, wi, Side::Transmission, o);
+            for (int c = 0; c < 3; ++c) {
+                const double a = std::exp(-tau[c] / mu_t);
+                const double denom = 1 - F * F * a * a;
+                EXPECT_NEAR(R[c], F + sqr(1 - F) * F * a * a / denom, budget) << ti << " " << c;
+                EXPECT_NEAR(T[c], sqr(1 - F) * a / denom, budget) << ti << " " << c;
+            }
         }
     }
 }
@@ -240,7 +246,10 @@ TEST(Lamina1, AlbedoAtMostOne) {
                         Rgbd a = model_albedo(*model, wi, Side::Reflection, o);
                         if (model->support().btdf)
                             a += model_albedo(*model, wi, Side::Transmission, o);
-                        EXPECT_LE(a.max(), 1.0 + 1e-3 + 6.3e-3)
+                        // A slab's later orders in bins add their energy budget (their largest
+                        // excess measured 8.4e-3, Lamina1Slab.SummedOrdersConserveEnergy).
+                        const double bins = model->support().btdf ? 1e-2 : 0.0;
+                        EXPECT_LE(a.max(), 1.0 + 1e-3 + 6.3e-3 + bins)
                             << bname << " eta0=" << eta << " a0=" << alpha << " ti=" << ti
                             << (options.empty() ? "" : " single");
                     }
