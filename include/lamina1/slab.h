@@ -205,7 +205,7 @@ inline Bsdf::BinMoments Bsdf::refracted_into_bins(double alpha, double eta, cons
     for (int a = 0; a < kBinNr; ++a)
         for (int b = 0; b < kBinNphi; ++b) {
             const double r = q.x[a], w_r = q.w[a] * 2 * r / kBinNphi;
-            const Vec3 wm = ggx.sample_visible_normal(w, r * r, (b + 0.5) / kBinNphi);
+            const Vec3 wm = ggx.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kBinNphi - 0.25);
             const auto wt = refract(w, wm, eta);
             if (!wt || wt->z >= 0) continue;
             const double F = fresnel_dielectric(dot(w, wm), eta);
@@ -332,8 +332,8 @@ inline void Bsdf::slab_bins() {
                     for (int a = 0; a < kBinNr; ++a)
                         for (int b = 0; b < kBinNphi; ++b) {
                             const double r = q.x[a], w_r = q.w[a] * 2 * r / kBinNphi;
-                            const Vec3 wm =
-                                ggx.sample_visible_normal(w, r * r, (b + 0.5) / kBinNphi);
+                            const Vec3 wm = ggx.sample_visible_normal(
+                                w, r * r, 0.5 * (b + 0.5) / kBinNphi - 0.25);
                             const Vec3 w2 = reflect(w, wm);
                             if (w2.z <= 0) continue;
                             const double weight = ws * w_r * fresnel_dielectric(dot(w, wm), eta) *
