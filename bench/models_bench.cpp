@@ -185,6 +185,24 @@ BENCHMARK_CAPTURE(BM_Lamina1Construct, milky_gold, false, false, true)
 BENCHMARK_CAPTURE(BM_Lamina1Construct, milky_slab, true, false, true)
     ->Unit(benchmark::kMicrosecond);
 
+/// lamina-1's reflection of the rough slab, Model::eval(wi, wo) on the random pairs (its incidence
+/// included): the inside light in bins (the default) against slab-orders=series.
+void BM_Lamina1SlabEval(benchmark::State& state, bool series) {
+    warm_tables();
+    const auto model = make_model(
+        "lamina-1", typical_stack(true),
+        series ? std::vector<std::string>{"slab-orders=series"} : std::vector<std::string>{});
+    static const Pairs pairs;
+    std::size_t n = 0;
+    for (auto _ : state) {
+        const std::size_t i = n++ & 4095;
+        benchmark::DoNotOptimize(model->eval(pairs.wi[i], pairs.wo[i]));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK_CAPTURE(BM_Lamina1SlabEval, bins, false);
+BENCHMARK_CAPTURE(BM_Lamina1SlabEval, series, true);
+
 /// ddb22's per-material precomputation (the hemispherical integrals over the coat tables and the
 /// exiting light's variance; the process-wide tables already loaded): the whole constructor.
 void BM_Ddb22Construct(benchmark::State& state) {
