@@ -219,18 +219,17 @@ inline Bsdf::BinMoments Bsdf::refracted_into_bins(double alpha, double eta, cons
     return out;
 }
 
-/// The slab's later orders with the inside light in cosine bins (slab-orders=bins): the flux in
-/// each bin and its forward moment (the azimuthal Fourier orders 0 and 1 of the inside radiance,
-/// about the incident light's horizontal direction; each interface, isotropic, maps each order
-/// of each bin to the same order of every bin) through the coat's and the bottom's transfer from
-/// inside (reflection matrices R_m, m = 0, 1), the medium's attenuation per bin, summed over every
-/// round trip: D = (I − a R_c a R_b)⁻¹ d₁ arriving at the bottom, U = a R_b D at the coat. Each
-/// leaves through its interface by reciprocity of that interface's BTDF: uniform radiance
-/// L_k = Φ_k/(π A_k) in bin k (and its moment) leaves towards wo as L_k C_k(μo)/η² (C_k: the
-/// light from outside at μo that the interface lets into bin k, refracted_into_bins). The first
-/// orders (the bottom's first transmission E_1, the first reflection out through the coat) are
-/// the first-order lobes' own; what those lobes carry against what the bins let out there is
-/// returned to the later orders (as the coat's balance returns it to X).
+/// The slab's inter-reflections with the inside light in cosine bins (slab-orders=bins; lamina's
+/// docs/models.md, lamina-1, item 6): the radiance in each bin's hat and its forward moment (the
+/// azimuthal Fourier orders 0 and 1 about the incident light's horizontal direction; each
+/// isotropic interface maps each order of each bin to the same order of every bin) through the
+/// coat's and the bottom's reflection from inside (R_m, m = 0, 1), the medium's attenuation per
+/// bin, summed over every round trip: D = (I − a R_c a R_b)⁻¹ a R_c P₁ C arriving at the bottom,
+/// P₁ = a R_b a. Radiance L_k = Φ_k/(π A_k) in bin k leaves towards wo as L_k C_k(μo)/η² by
+/// reciprocity of the interface's BTDF (C_k: the light from outside at μo that it lets into bin
+/// k). The first orders (the bottom's first transmission E_1, the first reflection out through
+/// the coat) are the first-order lobes'; the bins keep what those lobes leave out, and the later
+/// transmission takes what is left of the bins' light.
 inline void Bsdf::slab_bins() {
     const double mu_c = std::sqrt(1 - sqr(inv_eta0_));
     const double mu_crit_b = eta_b_ < 1 ? std::sqrt(1 - sqr(eta_b_)) : 0.0;
