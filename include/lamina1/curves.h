@@ -108,11 +108,13 @@ using EdgeCurve = SplitCurve<kN, double, true>;
 template <int kN>
 using RgbEdgeCurve = SplitCurve<kN, Rgb, true>;
 
-/// A curve over a cosine μ ∈ [0, 1] in segments between given cuts (where it jumps: the images of
-/// the bins' edges under a smooth refraction), kPer nodes inside each segment at its midpoints
-/// (i + ½)/kPer, linear between them and constant beyond the first and last node of a segment.
+/// A curve over a cosine μ ∈ [0, 1] in segments between given cuts (where it may jump or bend:
+/// the images of the bins' edges and centres under a smooth refraction), kPer nodes in each
+/// segment from end to end (each end taken just inside it: the one-sided value), linear between
+/// them: continuous within a segment, and across a cut where the function is.
 template <typename V, int kPer>
 struct SegmentCurve {
+    static_assert(kPer >= 2, "a segment has its two ends");
     std::vector<double> cut;  ///< 0 = cut[0] < … < cut.back() = 1
     std::vector<V> v;         ///< kPer per segment
     template <typename F>
@@ -121,8 +123,12 @@ struct SegmentCurve {
         const int n = int(cut.size()) - 1;
         v.assign(std::size_t(n) * kPer, V{});
         for (int g = 0; g < n; ++g)
-            for (int i = 0; i < kPer; ++i)
-                v[std::size_t(g) * kPer + i] = f(cut[g] + (cut[g + 1] - cut[g]) * (i + 0.5) / kPer);
+            for (int i = 0; i < kPer; ++i) {
+                double mu = cut[g] + (cut[g + 1] - cut[g]) * i / (kPer - 1);
+                if (i == 0) mu = std::nextafter(cut[g], cut[g + 1]);
+                if (i == kPer - 1) mu = std::nextafter(cut[g + 1], cut[g]);
+                v[std::size_t(g) * kPer + i] = f(mu);
+            }
     }
     V operator()(double mu) const {
         const int n = int(cut.size()) - 1;
@@ -130,14 +136,14 @@ struct SegmentCurve {
             int(std::upper_bound(cut.begin() + 1, cut.end() - 1, mu) - (cut.begin() + 1)), 0,
             n - 1);
         const double span = cut[g + 1] - cut[g];
-        const double x = span > 0 ? (mu - cut[g]) / span * kPer - 0.5 : 0.0;
+        const double x = span > 0 ? clamp((mu - cut[g]) / span, 0.0, 1.0) * (kPer - 1) : 0.0;
         const V* seg = v.data() + std::size_t(g) * kPer;
-        if (!(x > 0)) return seg[0];
-        if (x >= kPer - 1) return seg[kPer - 1];
-        const int i = int(x);
+        const int i = std::min(int(x), kPer - 2);
         const double t = x - i;
         return seg[i] * (1 - t) + seg[i + 1] * t;
     }
+    /// The outside cosine of node i of segment g (as fill places it).
+    double node(int g, int i) const { return cut[g] + (cut[g + 1] - cut[g]) * i / (kPer - 1); }
 };
 
 /// N values of type T integrated and tabulated together (the curves above take it as V).

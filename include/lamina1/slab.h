@@ -410,8 +410,7 @@ inline void Bsdf::slab_bins() {
         const int n = int(coat_bins_.cut.size()) - 1;
         for (int g = 0; g < n; ++g)
             for (int i = 0; i < kBinPer; ++i) {
-                const double mu = coat_bins_.cut[g] +
-                                  (coat_bins_.cut[g + 1] - coat_bins_.cut[g]) * (i + 0.5) / kBinPer;
+                const double mu = coat_bins_.node(g, i);
                 BinMoments& node = coat_bins_.v[std::size_t(g) * kBinPer + i];
                 double sum = 0;
                 for (int k = 0; k < kNbins; ++k)
