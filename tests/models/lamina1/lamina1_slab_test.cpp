@@ -64,7 +64,7 @@ TEST(Lamina1Slab, SmoothCoatFirstOrderIsTheBottomBtdf) {
 // enters leaves: R + T = 1, with the later orders in bins (the default) and with the uniform
 // series (slab-orders=series, inter-reflection=on). Budgets, measured: the bins' 0.035 (their
 // transfer's rule against the tables, which the matrix balancing meets within 2 %, and the first
-// order's lobes against the bins' first exits: 0.968–1.008 here, the lowest under the α0 = 0.5
+// order's lobes against the bins' first exits: 0.991–1.013 here, the lowest under the α0 = 0.5
 // coat over the nearly smooth bottom at 60°); the series' 0.03, the returned light's visible-
 // normal rule (5 × 6 nodes per piece, up to 0.025 of the incident flux off a 12 × 24 rule under
 // the α0 = 0.5 coat at 58°–62°, where the edge of the coat's spread crosses the bottom's
