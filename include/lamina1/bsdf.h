@@ -442,10 +442,10 @@ class Bsdf {
     /// E_1(μ)/T_lobe(μ), E_1(μ) and E_1(μ)/Q_m(μ) (v[0], v[1], v[2]) over outside cosines, as
     /// residuals from the smooth slab (first_order_smooth).
     CosineCurve<Multi<Rgb, 3>, kNfirst> first_order_;
-    /// slab-orders=bins: the bins' edges over inside cosines (at the interfaces' critical
-    /// cosines, uniform in μ² between them); the light from outside at μ that the coat lets
-    /// into each bin and from below that the bottom lets in, energy (v[k]) and forward moment
-    /// (v[kNbins + k]); Incident::bins over outside cosines.
+    /// slab-orders=bins: the bins' edges over inside cosines (cut at the interfaces' critical
+    /// cosines; in μ² between them, crowding towards the cuts); the light from outside at μ that
+    /// the coat lets into each bin and from below that the bottom lets in, energy (v[k]) and
+    /// forward moment (v[kNbins + k]); Incident::bins over outside cosines.
     bool bins_ = false;
     bool bins_ready_ = false;  ///< set once slab_bins has run (incident() is used before)
     std::array<double, kNbins + 1> bin_edge_{};
