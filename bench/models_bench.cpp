@@ -100,9 +100,10 @@ void warm_tables() {
 
 /// Model::eval(wi, wo) for random pairs (the forward Belcour variants redo their lobe statistics
 /// per call here).
-void BM_ModelEval(benchmark::State& state, const std::string& name, const Stack& stack) {
+void BM_ModelEvalWith(benchmark::State& state, const std::string& name, const Stack& stack,
+                      const std::vector<std::string>& options) {
     warm_tables();
-    const auto model = make_model(name, stack);
+    const auto model = make_model(name, stack, options);
     static const Pairs pairs;
     std::size_t n = 0;
     for (auto _ : state) {
@@ -110,6 +111,9 @@ void BM_ModelEval(benchmark::State& state, const std::string& name, const Stack&
         benchmark::DoNotOptimize(model->eval(pairs.wi[i], pairs.wo[i]));
     }
     state.SetItemsProcessed(state.iterations());
+}
+void BM_ModelEval(benchmark::State& state, const std::string& name, const Stack& stack) {
+    BM_ModelEvalWith(state, name, stack, {});
 }
 
 /// The prepared per-incidence evaluator (what the binned tables and the study use).
@@ -184,24 +188,6 @@ BENCHMARK_CAPTURE(BM_Lamina1Construct, milky_gold, false, false, true)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Lamina1Construct, milky_slab, true, false, true)
     ->Unit(benchmark::kMicrosecond);
-
-/// lamina-1's reflection of the rough slab, Model::eval(wi, wo) on the random pairs (its incidence
-/// included): the inside light in bins (the default) against slab-orders=series.
-void BM_Lamina1SlabEval(benchmark::State& state, bool series) {
-    warm_tables();
-    const auto model = make_model(
-        "lamina-1", typical_stack(true),
-        series ? std::vector<std::string>{"slab-orders=series"} : std::vector<std::string>{});
-    static const Pairs pairs;
-    std::size_t n = 0;
-    for (auto _ : state) {
-        const std::size_t i = n++ & 4095;
-        benchmark::DoNotOptimize(model->eval(pairs.wi[i], pairs.wo[i]));
-    }
-    state.SetItemsProcessed(state.iterations());
-}
-BENCHMARK_CAPTURE(BM_Lamina1SlabEval, bins, false);
-BENCHMARK_CAPTURE(BM_Lamina1SlabEval, series, true);
 
 /// ddb22's per-material precomputation (the hemispherical integrals over the coat tables and the
 /// exiting light's variance; the process-wide tables already loaded): the whole constructor.
@@ -300,6 +286,14 @@ const int registered = [] {
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
     }
+    // lamina-1's reflection of the rough slab (its incidence included): the inside light in bins
+    // (the default) against slab-orders=series.
+    benchmark::RegisterBenchmark("BM_Lamina1SlabEval/bins", BM_ModelEvalWith,
+                                 std::string("lamina-1"), typical_stack(true),
+                                 std::vector<std::string>{});
+    benchmark::RegisterBenchmark("BM_Lamina1SlabEval/series", BM_ModelEvalWith,
+                                 std::string("lamina-1"), typical_stack(true),
+                                 std::vector<std::string>{"slab-orders=series"});
     // The same three measurements on the milky coat (scattering media: tm6's six fluxes,
     // lamina-1's single scattering and adding remainder).
     for (const char* name : {"tm6", "bel-prime", "lamina-1"}) {

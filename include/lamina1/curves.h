@@ -48,6 +48,22 @@ constexpr int kSlabNr = 4, kSlabNphi = 8, kSlabBisections = 8;
 constexpr int kNbins = 12, kBinPer = 4;
 constexpr int kBinNr = 12, kBinNphi = 12, kBinSub = 3;
 
+/// f(wm, weight) over the normals visible from w (w in the xz-plane) by GGX's visible-normal map
+/// (Heitz 2018, "Sampling the GGX distribution of visible normals", JCGT 7(4)), kNr Gauss–Legendre
+/// nodes in u1 = r² times kNphi midpoints in φ over the half disk on one side of the plane of
+/// incidence, which an isotropic interface mirrors; the weights sum to 1. For histograms (the
+/// slab's bins), whose integrands step everywhere: integrate_visible_split where they step once.
+template <int kNr, int kNphi, typename F>
+void for_visible_normals(const GGX& ggx, const Vec3& w, F&& f) {
+    static const QuadratureRule q = gauss_legendre(kNr);
+    for (int a = 0; a < kNr; ++a)
+        for (int b = 0; b < kNphi; ++b) {
+            const double r = q.x[a];
+            f(ggx.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kNphi - 0.25),
+              q.w[a] * 2 * r / kNphi);
+        }
+}
+
 /// A curve over a cosine μ ∈ [0, 1] on nodes μ = s² (dense at grazing), linear in s.
 template <typename V, int kN = kNmu>
 struct CosineCurve {

@@ -199,18 +199,14 @@ inline Bsdf::BinMoments Bsdf::refracted_into_bins(double alpha, double eta, cons
         if (wt && wt->z < 0) deposit(*wt, 1 - fresnel_dielectric(w.z, eta));
         return out;
     }
-    static const QuadratureRule q = gauss_legendre(kBinNr);
     const GGX ggx{alpha};
     const double lambda_w = ggx.lambda(w);
-    for (int a = 0; a < kBinNr; ++a)
-        for (int b = 0; b < kBinNphi; ++b) {
-            const double r = q.x[a], w_r = q.w[a] * 2 * r / kBinNphi;
-            const Vec3 wm = ggx.sample_visible_normal(w, r * r, 0.5 * (b + 0.5) / kBinNphi - 0.25);
-            const auto wt = refract(w, wm, eta);
-            if (!wt || wt->z >= 0) continue;
-            const double F = fresnel_dielectric(dot(w, wm), eta);
-            deposit(*wt, w_r * (1 - F) * refraction_escape(ch_.masking, lambda_w, ggx.lambda(*wt)));
-        }
+    for_visible_normals<kBinNr, kBinNphi>(ggx, w, [&](const Vec3& wm, double w_r) {
+        const auto wt = refract(w, wm, eta);
+        if (!wt || wt->z >= 0) return;
+        const double F = fresnel_dielectric(dot(w, wm), eta);
+        deposit(*wt, w_r * (1 - F) * refraction_escape(ch_.masking, lambda_w, ggx.lambda(*wt)));
+    });
     if (ms_) {
         const double dT = ms_dielectric(fgd, mu, alpha, eta).transmitted;
         for (int k = 0; k < kNbins; ++k)
@@ -306,10 +302,9 @@ inline void Bsdf::slab_bins() {
     };
 
     // The interfaces' reflection from inside between bins, orders m = 0, 1: the flux of bin k
-    // (uniform radiance, kBinSub directions) reflected into bin j; rough: visible normals (weight
+    // (its hat, 2 kBinSub directions) reflected into bin j; rough: visible normals (weight
     // F G2/G1), the orders ≥ 2 (ΔR) cosine-distributed. Then made reciprocal: R_jk A_k = R_kj A_j.
     auto reflection = [&](double alpha, double eta, const FgdView& fgd, FluxMatrix R[2]) {
-        static const QuadratureRule q = gauss_legendre(kBinNr);
         R[0] = FluxMatrix(kNbins);
         R[1] = FluxMatrix(kNbins);
         const GGX ggx{alpha};
@@ -328,18 +323,14 @@ inline void Bsdf::slab_bins() {
                     deposit(mu, ws * fresnel_dielectric(mu, eta), 1.0);
                 } else {
                     const double lambda_w = ggx.lambda(w);
-                    for (int a = 0; a < kBinNr; ++a)
-                        for (int b = 0; b < kBinNphi; ++b) {
-                            const double r = q.x[a], w_r = q.w[a] * 2 * r / kBinNphi;
-                            const Vec3 wm = ggx.sample_visible_normal(
-                                w, r * r, 0.5 * (b + 0.5) / kBinNphi - 0.25);
-                            const Vec3 w2 = reflect(w, wm);
-                            if (w2.z <= 0) continue;
-                            const double weight = ws * w_r * fresnel_dielectric(dot(w, wm), eta) *
-                                                  (1 + lambda_w) / (1 + lambda_w + ggx.lambda(w2));
-                            const double sxy = std::hypot(w2.x, w2.y);
-                            deposit(w2.z, weight, sxy > 0 ? -w2.x / sxy : 1.0);
-                        }
+                    for_visible_normals<kBinNr, kBinNphi>(ggx, w, [&](const Vec3& wm, double w_r) {
+                        const Vec3 w2 = reflect(w, wm);
+                        if (w2.z <= 0) return;
+                        const double weight = ws * w_r * fresnel_dielectric(dot(w, wm), eta) *
+                                              (1 + lambda_w) / (1 + lambda_w + ggx.lambda(w2));
+                        const double sxy = std::hypot(w2.x, w2.y);
+                        deposit(w2.z, weight, sxy > 0 ? -w2.x / sxy : 1.0);
+                    });
                     if (ms_) {
                         const double dR = ms_dielectric(fgd, mu, alpha, eta).reflected;
                         for (int j = 0; j < kNbins; ++j)
