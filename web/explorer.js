@@ -1142,8 +1142,8 @@
           [String(k), (L1_PARAMS[p] || p) + " = " + v])), "");
         $("w-live-l1").dataset.config = cfg.id;
       }
-      const k = $("w-live-l1").value, state = l1.all.slice(0, l1.state);
-      if (k !== "") state.set(l1.all.subarray(l1.state + Number(k) * l1.head, l1.state + (Number(k) + 1) * l1.head));
+      const k = $("w-live-l1").value;
+      const state = window.LAMINA_SPHERES.variantState(l1.all, l1, k === "" ? -1 : Number(k));
       // The proposal's lobe follows the coat's roughness (lamina render's lobe_alpha_for).
       const alpha0 = k !== "" && l1.variants[Number(k)][0] === "alpha0" ? l1.variants[Number(k)][1] : Number(cfg.parameters.alpha0);
       if (Number.isFinite(alpha0)) scene.lobeAlpha = Math.min(Math.max(alpha0, 0.02), 1);

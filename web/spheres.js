@@ -265,6 +265,19 @@ void main() {
     return new Float32Array(bytes.buffer);
   }
 
+  // lamina-1's state for variant k of the page data's states (config.json → lamina1_gpu): the
+  // stack's own state (the first `state` floats of `all`) with the variant's per-material part
+  // (`head` floats, then `tail` floats: a slab's bins, at the state's end) in place; k < 0 or
+  // null: the stack's own.
+  function variantState(all, layout, k) {
+    const state = all.slice(0, layout.state);
+    if (k === null || k < 0) return state;
+    const tail = layout.tail || 0, at = layout.state + k * (layout.head + tail);
+    state.set(all.subarray(at, at + layout.head));
+    if (tail) state.set(all.subarray(at + layout.head, at + layout.head + tail), layout.state - tail);
+    return state;
+  }
+
   // A renderer on `canvas` (size × size pixels), or null with `why` when the browser has no WebGL2
   // float render targets. `glsl` holds the shipped GLSL: {lamina1, laminaCoat, laminaCoatTable}.
   function createRenderer(canvas, size, glsl) {
@@ -458,5 +471,5 @@ void main() {
     return r;
   }
 
-  window.LAMINA_SPHERES = { createRenderer, floatsOf, ENVIRONMENTS };
+  window.LAMINA_SPHERES = { createRenderer, floatsOf, variantState, ENVIRONMENTS };
 })();

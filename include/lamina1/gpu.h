@@ -8,18 +8,18 @@
 // an absorbing medium, over a Lambertian, conductor or dielectric base, with the default choices
 // or any of spread, first-order-lobe, eta2-factor, inside-exit, lobe-normalization,
 // inter-reflection and directional-transmittance, with or without the microsurfaces' orders ≥ 2
-// (microsurface). Not covered (gpu_state says why and returns nothing): scattering media,
-// anisotropic interfaces and a slab's transmission (the GLSL returns 0 for wo.z < 0). Covered by
-// sample and pdf: the same but slabs (their mixture holds the transmission's lobes); the base
-// lobe's weight in the mixture reads the base's mean albedo from a curve (kGpuBaseAlbedo), so the
-// GLSL pdf is the C++ one to that curve's interpolation, and equal to the GLSL sample's own
-// density.
+// (microsurface), a slab's later orders in bins (slab-orders=bins) or as the series. Not covered
+// (gpu_state says why and returns nothing): scattering media, anisotropic interfaces and a slab's
+// transmission (the GLSL returns 0 for wo.z < 0). Covered by sample and pdf: the same but slabs
+// (their mixture holds the transmission's lobes); the base lobe's weight in the mixture reads the
+// base's mean albedo from a curve (kGpuBaseAlbedo), so the GLSL pdf is the C++ one to that curve's
+// interpolation, and equal to the GLSL sample's own density.
 //
 // Layout (kGpu* below): kGpuScalars scalars, then the curves at fixed offsets, then the generic
 // slope-sum table (lamina1/table_lookups.h, SlopeSumFormat) at kGpuSlopeSum; kGpuSize floats in
-// all, which lamina1.glsl reads with texelFetch from an R32F texture kGpuWidth texels wide
-// (index i at (i % kGpuWidth, i / kGpuWidth)). The file `lamina export --lamina1-gpu` writes is
-// these floats, little-endian.
+// all (kGpuBinsEnd for a slab with its bins, which follow the table), which lamina1.glsl reads with
+// texelFetch from an R32F texture kGpuWidth texels wide (index i at (i % kGpuWidth, i /
+// kGpuWidth)). The file `lamina export --lamina1-gpu` writes is these floats, little-endian.
 
 #include "lamina1/bsdf.h"
 
@@ -44,6 +44,21 @@ constexpr int kGpuSize =
     kGpuSlopeSum + SlopeSumFormat::kNx * SlopeSumFormat::kNy * SlopeSumFormat::kNu;
 static_assert(kGpuDEBase + kNmu <= kGpuSlopeSum, "the curves overlap");
 
+// A slab's inside light in bins (slab-orders=bins, lamina1/slab.h), after the slope-sum table in
+// states that have the flag kGpuBinsOn (the others end at kGpuSize): the coat's entry curve
+// C(μ) (coat_bins_: the number of its cuts, the cuts, then kBinPer nodes per segment of 2 kNbins
+// values: each bin's energy, then its forward moment), g(μ) (bins_g_: kNslab × RGB) and W P₁,
+// W P₂ (bins_first_, bins_later_: per channel and azimuthal order, kNbins × kNbins row-major).
+// The curve's segments are padded to the most a slab can have (the cuts are 0, 1 and where a
+// smooth coat refracts each bin's edge and centre).
+constexpr int kGpuBinsMaxCuts = 2 * kNbins + 3;
+constexpr int kGpuBinsCuts = kGpuSize;  ///< n, then n cuts (n ≤ kGpuBinsMaxCuts)
+constexpr int kGpuBinsNodes = kGpuBinsCuts + 1 + kGpuBinsMaxCuts;
+constexpr int kGpuBinsG = kGpuBinsNodes + (kGpuBinsMaxCuts - 1) * kBinPer * 2 * kNbins;
+constexpr int kGpuBinsFirst = kGpuBinsG + 3 * kNslab;
+constexpr int kGpuBinsLater = kGpuBinsFirst + 3 * 2 * kNbins * kNbins;
+constexpr int kGpuBinsEnd = kGpuBinsLater + 3 * 2 * kNbins * kNbins;
+
 /// Bits of the flags scalar (index 0).
 enum GpuFlag : unsigned {
     kGpuRoughCoat = 1u << 0,
@@ -64,6 +79,7 @@ enum GpuFlag : unsigned {
     kGpuInterReflection = 1u << 15,  ///< the choice inter-reflection (lamina1_delta's series)
     kGpuTopOrders = 1u << 16,        ///< the coat's orders ≥ 2: ΔR(μi) ΔR(μo)/(π ΔR̄)
     kGpuBaseOrders = 1u << 17,       ///< the base's: F_ms ΔE(μi') ΔE(μo')/(π ΔĒ)
+    kGpuBinsOn = 1u << 18,           ///< a slab's inside light in bins, from kGpuBinsCuts on
 };
 
 inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
@@ -74,8 +90,9 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     if (!support_.brdf) return refuse("lamina-1 does not model these layers");
     if (scatters_) return refuse("a scattering medium (the GLSL form covers absorbing ones)");
     if (aniso_) return refuse("an anisotropic interface (the GLSL form is isotropic)");
-    if (bins_) return refuse("a slab's later orders in bins (slab-orders=bins)");
-    std::vector<float> v(kGpuSize, 0.0f);
+    if (bins_ && coat_bins_.cut.size() > std::size_t(kGpuBinsMaxCuts))
+        return refuse("more cuts in the bins' entry curve than the layout holds");
+    std::vector<float> v(bins_ ? kGpuBinsEnd : kGpuSize, 0.0f);
     unsigned flags = 0;
     auto flag = [&](bool on, unsigned bit) { flags |= on ? bit : 0u; };
     flag(alpha0_ > 0, kGpuRoughCoat);
@@ -96,6 +113,7 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     flag(ch_.inter_reflection, kGpuInterReflection);
     flag(top_ms_, kGpuTopOrders);
     flag(base_ms_, kGpuBaseOrders);
+    flag(bins_, kGpuBinsOn);
     v[0] = float(flags);  // exact in float32 (fewer than 2^24)
     v[1] = float(int(layers_.base));
     v[2] = float(eta0_);
@@ -152,6 +170,25 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     }
     if (const float* table = tables_->slope_sum())
         std::memcpy(&v[kGpuSlopeSum], table, SlopeSumFormat::size() * sizeof(float));
+    if (bins_) {
+        const std::size_t n = coat_bins_.cut.size();
+        v[kGpuBinsCuts] = float(n);
+        for (std::size_t i = 0; i < n; ++i)
+            v[kGpuBinsCuts + 1 + i] = float(coat_bins_.cut[i]);
+        for (std::size_t i = 0; i < coat_bins_.v.size(); ++i)
+            for (int k = 0; k < 2 * kNbins; ++k)
+                v[kGpuBinsNodes + 2 * kNbins * i + k] = float(coat_bins_.v[i].v[k]);
+        for (int i = 0; i < kNslab; ++i)
+            for (int c = 0; c < 3; ++c)
+                v[kGpuBinsG + 3 * i + c] = float(bins_g_.v[i][c]);
+        for (int c = 0; c < 3; ++c)
+            for (int m = 0; m < 2; ++m)
+                for (int jk = 0; jk < kNbins * kNbins; ++jk) {
+                    const int at = (c * 2 + m) * kNbins * kNbins + jk;
+                    v[kGpuBinsFirst + at] = float(bins_first_[c][m][jk]);
+                    v[kGpuBinsLater + at] = float(bins_later_[c][m][jk]);
+                }
+    }
     return v;
 }
 

@@ -19,6 +19,13 @@ const int L1_ENTERING = L1_MIRROR + 3 * L1_NMU, L1_LEAVING = L1_ENTERING + 3 * L
 const int L1_BASE_ALBEDO = L1_LEAVING + 3 * L1_NFACET;
 const int L1_DR_TOP = L1_BASE_ALBEDO + L1_NMU, L1_DE_BASE = L1_DR_TOP + L1_NMU;
 const int L1_SLOPE_SUM = 1664, L1_SS_NX = 25, L1_SS_NY = 13, L1_SS_NU = 33;
+// A slab's bins (kGpuBins* in lamina1/gpu.h), after the slope-sum table.
+const int L1_NBINS = 12, L1_BIN_PER = 4, L1_NSLAB = 17, L1_BINS_MAX_CUTS = 2 * L1_NBINS + 3;
+const int L1_BINS_CUTS = L1_SLOPE_SUM + L1_SS_NX * L1_SS_NY * L1_SS_NU;
+const int L1_BINS_NODES = L1_BINS_CUTS + 1 + L1_BINS_MAX_CUTS;
+const int L1_BINS_G = L1_BINS_NODES + (L1_BINS_MAX_CUTS - 1) * L1_BIN_PER * 2 * L1_NBINS;
+const int L1_BINS_FIRST = L1_BINS_G + 3 * L1_NSLAB;
+const int L1_BINS_LATER = L1_BINS_FIRST + 6 * L1_NBINS * L1_NBINS;
 
 float l1_at(int i) { return texelFetch(lamina1_state, ivec2(i % 256, i / 256), 0).r; }
 vec3 l1_rgb(int i) { return vec3(l1_at(i), l1_at(i + 1), l1_at(i + 2)); }
@@ -213,6 +220,76 @@ vec3 l1_base_lobe(vec3 wi_in, float k_top, float lobe_norm_i, float mu_o, vec3 w
     return f;
 }
 
+// ---- A slab's inside light in bins (lamina1/slab.h) ----
+
+// The coat's entry curve C(μ) (SegmentCurve::operator()): where in the node array (segment g,
+// node i) and the weight t of node i + 1.
+void l1_bins_at(float mu, out int at, out float t) {
+    int n = int(l1_at(L1_BINS_CUTS));
+    int g = 0;
+    for (int i = 1; i < L1_BINS_MAX_CUTS - 1; ++i)
+        if (i < n - 1 && l1_at(L1_BINS_CUTS + 1 + i) <= mu) g = i;
+    float lo = l1_at(L1_BINS_CUTS + 1 + g), span = l1_at(L1_BINS_CUTS + 2 + g) - lo;
+    float x = span > 0.0 ? clamp((mu - lo) / span, 0.0, 1.0) * float(L1_BIN_PER - 1) : 0.0;
+    int i = min(int(x), L1_BIN_PER - 2);
+    t = x - float(i);
+    at = L1_BINS_NODES + (g * L1_BIN_PER + i) * 2 * L1_NBINS;
+}
+float l1_bins_entry(int at, float t, int k) {
+    return l1_at(at + k) * (1.0 - t) + l1_at(at + 2 * L1_NBINS + k) * t;
+}
+
+// Bsdf::bins_reflection through Bsdf::incident_bins: per channel and azimuthal order m,
+// C_m(μo)ᵀ (g(μo) g(μi) W P₁ + W P₂) C_m(μi), joined in azimuth by the Poisson kernel
+// (binned_exit) at the forward cosine of wo against wi. Without absorption every channel is the
+// first's (as incident_bins, whose vectors carry g(μi) of the first channel then).
+vec3 l1_bins_reflection(vec3 wi, vec3 wo) {
+    int at_i, at_o;
+    float t_i, t_o;
+    l1_bins_at(wi.z, at_i, t_i);
+    l1_bins_at(wo.z, at_o, t_o);
+    float c_i[2 * L1_NBINS], c_o[2 * L1_NBINS];
+    for (int k = 0; k < 2 * L1_NBINS; ++k) {
+        c_i[k] = l1_bins_entry(at_i, t_i, k);
+        c_o[k] = l1_bins_entry(at_o, t_o, k);
+    }
+    vec3 g_i = l1_cosine_curve3(L1_BINS_G, L1_NSLAB, wi.z);
+    vec3 g_o = l1_cosine_curve3(L1_BINS_G, L1_NSLAB, wo.z);
+    // Per channel of the matrices and order m: C_m(μo)ᵀ W P₁ C_m(μi) and C_m(μo)ᵀ W P₂ C_m(μi).
+    int channels = l1_flag(1) ? 3 : 1;
+    vec3 first[2], later[2];
+    for (int mc = 0; mc < 3; ++mc) {
+        if (mc >= channels) break;
+        for (int m = 0; m < 2; ++m) {
+            float x_sum = 0.0, y_sum = 0.0;
+            for (int j = 0; j < L1_NBINS; ++j) {
+                int row = (mc * 2 + m) * L1_NBINS * L1_NBINS + j * L1_NBINS;
+                float x = 0.0, y = 0.0;
+                for (int k = 0; k < L1_NBINS; ++k) {
+                    x += l1_at(L1_BINS_FIRST + row + k) * c_i[m * L1_NBINS + k];
+                    y += l1_at(L1_BINS_LATER + row + k) * c_i[m * L1_NBINS + k];
+                }
+                x_sum += x * c_o[m * L1_NBINS + j];
+                y_sum += y * c_o[m * L1_NBINS + j];
+            }
+            first[m][mc] = x_sum;
+            later[m][mc] = y_sum;
+        }
+    }
+    float si = length(wi.xy), so = length(wo.xy);
+    float c = si > 0.0 && so > 0.0 ? -dot(wi.xy, wo.xy) / (si * so) : 0.0;
+    vec3 f = vec3(0.0);
+    for (int ch = 0; ch < 3; ++ch) {
+        int mc = ch < channels ? ch : 0;
+        float f0 = g_i[mc] * g_o[ch] * first[0][mc] + later[0][mc];
+        float f1 = g_i[mc] * g_o[ch] * first[1][mc] + later[1][mc];
+        if (!(f0 > 0.0)) continue;
+        float rho = clamp(f1 / f0, -0.98, 0.98);
+        f[ch] = f0 * (1.0 - rho * rho) / (1.0 - 2.0 * rho * c + rho * rho);
+    }
+    return f;
+}
+
 // f(wi, wo): lamina1::Bsdf::eval for wo.z > 0 (Bsdf::incident, then eval_with).
 vec3 lamina1_eval(vec3 wi, vec3 wo) {
     if (wi.z <= 0.0 || wo.z <= 0.0) return vec3(0.0);
@@ -255,6 +332,7 @@ vec3 lamina1_eval(vec3 wi, vec3 wo) {
     float eta2 = l1_flag(9) ? inv_eta0 * inv_eta0 : 1.0;
     f += fb * (a * a_o) * rounds * (T_pair * T_o * eta2);
     if (l1_flag(2)) f += X * l1_x_at(wo.z) * l1_rgb(19) * (L1_INV_PI * inv_eta0 * inv_eta0);
+    if (l1_flag(18)) f += l1_bins_reflection(wi, wo);
     return f;
 }
 

@@ -580,13 +580,18 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
                                 std::istreambuf_iterator<char>());
         const auto n_state = field<std::size_t>(g, "state", cfg_path);
         const auto head = field<std::size_t>(g, "head", cfg_path);
+        // A slab's bins at the state's end (`tail`; absent where the study wrote none).
+        const std::size_t tail = g.contains("tail") ? field<std::size_t>(g, "tail", cfg_path) : 0;
         const json variants = field<json>(g, "variants", cfg_path);
-        if (bytes.size() != 4 * (n_state + head * variants.size()))
-            throw InputError(file.string(), "size",
-                             fmt::format("{} bytes: expected 4 × ({} + {} × {}) from config.json",
-                                         bytes.size(), n_state, head, variants.size()));
+        if (tail > n_state || head > n_state - tail ||
+            bytes.size() != 4 * (n_state + (head + tail) * variants.size()))
+            throw InputError(
+                file.string(), "size",
+                fmt::format("{} bytes: expected 4 × ({} + ({} + {}) × {}) from config.json",
+                            bytes.size(), n_state, head, tail, variants.size()));
         data["lamina1"] = {{"state", n_state},
                            {"head", head},
+                           {"tail", tail},
                            {"variants", variants},
                            {"floats", base64(bytes.data(), bytes.size())}};
     }

@@ -518,6 +518,7 @@ class ConfigurationRun {
             cj["lamina1_gpu"] = {{"file", "lamina1_gpu.f32"},
                                  {"state", gpu.state.size()},
                                  {"head", gpu.head},
+                                 {"tail", gpu.tail},
                                  {"variants", variants}};
             gpu_bytes.append(reinterpret_cast<const char*>(gpu.state.data()),
                              gpu.state.size() * sizeof(float));

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # lamina-1's GLSL form against the C++ in headless Chromium (glsl_test.js): a plastic, a coated
-# rough gold with an absorbing coat, a metallic paint, a slab's reflection, two of the model's
-# other choices and smooth coats (a plastic, a gold with coat and base smooth, with and without
-# inter-reflection); 300 direction pairs each, fixed seed; lamina1_delta against the closed form of
+# rough gold with an absorbing coat, a metallic paint, a slab's reflection (its later orders in
+# bins and as the series; a clear, nearly smooth slab), two of the model's other choices and
+# smooth coats (a plastic, a gold with coat and base smooth, with and without inter-reflection); 300 direction pairs each, fixed seed; lamina1_delta against the closed form of
 # a smooth coat's specular reflection (glsl_test.js); and a stack the form does not cover refused.
 # The sampler (not slabs) against the C++ one through the Python module, where it is built
 # (BUILD_DIR/python, for the interpreter PYTHON): the pdf at those pairs and a draw from fixed
@@ -35,7 +35,7 @@ PY
         fail "eval $name: $(cat "$tmp/$name.log")"; return; fi
     cp "$stack" "$tmp/$name.stack.json"
     echo "$@" > "$tmp/$name.options"
-    if [ "$name" != slab ] && [[ "$name" != smooth-* ]] && [ -n "$build" ] &&
+    if [[ "$name" != slab* ]] && [[ "$name" != smooth-* ]] && [ -n "$build" ] &&
         [ -d "$build/python/lamina" ]; then
         # Per pair: the C++ pdf at (wi, wo) and the draw from u, with whether u0 sits within 1e-3
         # of a lobe boundary (the draws at u0 ± 1e-3 differ from the one at u0).
@@ -69,13 +69,14 @@ PY
 add_case plastic "$root/examples/plastic.json"
 add_case frosted-gold "$root/examples/frosted-gold.json"
 add_case metallic-paint "$root/examples/metallic-paint.json"
-# A slab's reflection with its later orders as the uniform series: the bins (slab-orders=bins,
-# the default) are C++ only, and the export refuses them.
-add_case slab "$root/examples/slab.json" slab-orders=series
+# A slab's reflection with its later orders in bins (the default), and as the uniform series.
+add_case slab "$root/examples/slab.json"
+add_case slab-series "$root/examples/slab.json" slab-orders=series
 add_case gold-ggx-lobe "$root/examples/frosted-gold.json" first-order-lobe=ggx spread=normal
 add_case plastic-fresnel "$root/examples/plastic.json" coat-transmittance=fresnel
 # Smooth coats (delta lobes, lamina1_delta): the plastic's coat smooth; gold with coat and base
-# smooth under an absorbing coat, with the inter-reflection series and without it.
+# smooth under an absorbing coat, with the inter-reflection series and without it. And a clear,
+# nearly smooth slab.
 python3 - "$root/examples" "$tmp" <<'PY' || fail "smooth stacks"
 import json, sys
 plastic = json.load(open(f"{sys.argv[1]}/plastic.json"))
@@ -83,9 +84,16 @@ plastic["layers"][0]["interface"]["alpha"] = 0
 gold = json.load(open(f"{sys.argv[1]}/frosted-gold.json"))
 gold["layers"][0]["interface"]["alpha"] = gold["layers"][1]["interface"]["alpha"] = 0
 gold["layers"][0]["medium"]["tau_a"] = [0.3, 0.1, 0.0]
+clear = json.load(open(f"{sys.argv[1]}/slab.json"))
+del clear["layers"][0]["medium"]
+clear["layers"][0]["interface"]["alpha"] = 0.02
+clear["layers"][1]["interface"]["alpha"] = 0.05
+json.dump(clear, open(f"{sys.argv[2]}/slab-clear-in.json", "w"))
 json.dump(plastic, open(f"{sys.argv[2]}/smooth-plastic-in.json", "w"))
 json.dump(gold, open(f"{sys.argv[2]}/smooth-gold-in.json", "w"))
 PY
+# A clear, nearly smooth slab: its bins in one channel, the entry curve's segments crowded.
+add_case slab-clear "$tmp/slab-clear-in.json"
 add_case smooth-plastic "$tmp/smooth-plastic-in.json"
 add_case smooth-gold "$tmp/smooth-gold-in.json"
 add_case smooth-gold-single "$tmp/smooth-gold-in.json" inter-reflection=off

@@ -251,6 +251,33 @@ TEST(Explorer, Lamina1StatesForTheLiveSpheres) {
     }
 }
 
+// A slab's states end with its bins (`tail`): each variant's part is its head then its tail, and
+// the file's size is checked against that layout.
+TEST(Explorer, Lamina1StatesWithASlabsBins) {
+    const fs::path d = fresh_dir("lamina1-gpu-tail");
+    write_text(d / "study.json", R"({"theta_i": [30], "grid": {"n_theta": 2, "n_phi": 2},
+        "configurations": [{"id": "c1", "category": "x", "sides": ["R"]}]})");
+    write_text(d / "configs/c1/config.json",
+               R"({"sources": ["reference"], "sides": ["R"], "lamina1_gpu": {"file":
+        "lamina1_gpu.f32", "state": 3, "head": 1, "tail": 1, "variants": [["alpha0", 0.3]]}})");
+    write_table(d / "configs/c1/tables", {1, 1, 1, 2, 2, 3}, std::vector<float>(12, 0.3f), true);
+    const float floats[5] = {1.0f, 2.0f, 3.0f, 4.0f, 5.0f};  // state (3), head (1) and tail (1)
+    std::ofstream(d / "configs/c1/lamina1_gpu.f32", std::ios::binary)
+        .write(reinterpret_cast<const char*>(floats), sizeof floats);
+    write_explorer(d);
+    const std::string data = read_text(d / "explorer/data/c1.js");
+    EXPECT_NE(data.find(R"("tail":1)"), std::string::npos) << data.substr(0, 300);
+    // Without the tail's float per variant the file is one float short.
+    std::ofstream(d / "configs/c1/lamina1_gpu.f32", std::ios::binary)
+        .write(reinterpret_cast<const char*>(floats), 16);
+    try {
+        write_explorer(d);
+        FAIL() << "a lamina1_gpu.f32 without the variant's tail was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("16 bytes"), std::string::npos) << e.what();
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Formats, ExplorerTables, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "packed" : "npy"; });
 

@@ -115,6 +115,7 @@ function compare(name, sums, passes, A, B, expected) {
     { name: "lamina-1 plastic, studio", file: "plastic", env: "studio", model: "lamina-1" },
     { name: "lamina-1 plastic, uniform", file: "plastic", env: "uniform", model: "lamina-1" },
     { name: "lamina-1 frosted gold, studio", file: "frosted-gold", env: "studio", model: "lamina-1" },
+    { name: "lamina-1 slab (its reflection), studio", file: "slab", env: "studio", model: "lamina-1" },
     { name: "lamina-coat plastic, studio", file: "plastic", env: "studio", model: "lamina-coat" },
     { name: "lamina-1 plastic, sky", file: "plastic", env: "sky", model: "lamina-1" },
     { name: "lamina-1 smooth plastic, studio", file: "smooth-plastic", env: "studio", model: "lamina-1" },
@@ -185,6 +186,32 @@ function compare(name, sums, passes, A, B, expected) {
         failures++;
       }
     }
+  }
+  // A variant's state as the page composes it (variantState, config.json → lamina1_gpu): the
+  // slab's own state with the rougher slab's per-material part (its first HEAD floats and its
+  // bins at the end) in place must be the rougher slab's state, float for float.
+  const HEAD = 1664;  // lamina1::kGpuSlopeSum
+  const slabOwn = fs.readFileSync(path.join(dir, "slab.l1gpu"));
+  const slabRough = fs.readFileSync(path.join(dir, "slab-rough.l1gpu"));
+  const composed = await page.evaluate(({ own, rough, HEAD }) => {
+    const S = window.LAMINA_SPHERES, a = S.floatsOf(own), b = S.floatsOf(rough);
+    const tail = a.length - 12389;  // lamina1::kGpuSize: the bins after it
+    const all = new Float32Array(a.length + HEAD + tail);
+    all.set(a);
+    all.set(b.subarray(0, HEAD), a.length);
+    all.set(b.subarray(b.length - tail), a.length + HEAD);
+    const layout = { state: a.length, head: HEAD, tail };
+    const v = S.variantState(all, layout, 0), own0 = S.variantState(all, layout, -1);
+    let same = v.length === b.length, sameOwn = own0.length === a.length, differ = 0;
+    for (let i = 0; i < b.length; ++i) if (v[i] !== b[i]) same = false;
+    for (let i = 0; i < a.length; ++i) if (own0[i] !== a[i]) sameOwn = false;
+    for (let i = 0; i < a.length; ++i) if (a[i] !== b[i]) ++differ;
+    return { same, sameOwn, tail, differ };
+  }, { own: slabOwn.toString("base64"), rough: slabRough.toString("base64"), HEAD });
+  console.log(`variant state: ${JSON.stringify(composed)}`);
+  if (!(composed.same && composed.sameOwn && composed.tail > 0 && composed.differ > 0)) {
+    console.log("FAIL a variant's state composed as the page does it is not the variant's own state");
+    failures++;
   }
   // No WebGL2: the renderer says why instead of throwing.
   const none = await page.evaluate(() => {

@@ -210,12 +210,15 @@ Lamina1GpuStates lamina1_gpu_states(const Stack& stack, const ModelOptions& opti
     out.state = lamina1::Bsdf(layers, tables, choices).gpu_state(&why);
     if (out.state.empty()) return out;
     out.head = lamina1::kGpuSlopeSum;
+    out.tail = out.state.size() - std::size_t(lamina1::kGpuSize);
     auto add = [&](const char* parameter, double value, const lamina1::Layers& l) {
         std::string ignored;
         const std::vector<float> s = lamina1::Bsdf(l, tables, choices).gpu_state(&ignored);
-        if (s.empty()) return;
+        // A variant of another layout (a slab's bins present or not) cannot share the stack's.
+        if (s.size() != out.state.size()) return;
         out.variants.push_back({parameter, value});
         out.heads.insert(out.heads.end(), s.begin(), s.begin() + lamina1::kGpuSlopeSum);
+        out.heads.insert(out.heads.end(), s.end() - std::ptrdiff_t(out.tail), s.end());
     };
     // The values offered: roughnesses from smooth (a delta lobe: lamina1_delta) through nearly
     // smooth to rough, the indices of common coats, optical depths over three decades, albedos

@@ -44,21 +44,22 @@ std::vector<float> lamina1_gpu_state(const Stack& stack, const ModelOptions& opt
 
 /// lamina-1's GLSL states for the explorer's live spheres (docs/explorer.md, "Live spheres"): the
 /// stack's own state, and the per-material part of the state (its first lamina1::kGpuSlopeSum
-/// floats; the slope-sum table after them is the same for every material) with one parameter at
-/// a time set to each of a few values, the others the stack's: coat roughness `alpha0`, coat index
-/// `eta0` (a conductor or dielectric base keeps its absolute index), grey coat absorption `tau_a`,
-/// base roughness `alpha1` (conductor and dielectric bases) and grey base albedo `albedo`
-/// (Lambertian base). A value the GLSL form does not cover is left out. Empty `state` and why
-/// where it does not cover the stack itself.
+/// floats and, for a slab with its bins, the `tail` floats after the slope-sum table; the table is
+/// the same for every material) with one parameter at a time set to each of a few values, the
+/// others the stack's: coat roughness `alpha0`, coat index `eta0` (a conductor or dielectric base
+/// keeps its absolute index), grey coat absorption `tau_a`, base roughness `alpha1` (conductor and
+/// dielectric bases) and grey base albedo `albedo` (Lambertian base). A value the GLSL form does
+/// not cover is left out. Empty `state` and why where it does not cover the stack itself.
 struct Lamina1GpuVariant {
     std::string parameter;
     double value = 0;
 };
 struct Lamina1GpuStates {
-    std::vector<float> state;                 ///< the stack's own, lamina1::kGpuSize floats
+    std::vector<float> state;                 ///< the stack's own (include/lamina1/gpu.h)
     std::vector<Lamina1GpuVariant> variants;  ///< in the order of `heads`
-    std::vector<float> heads;                 ///< `head` floats per variant
+    std::vector<float> heads;                 ///< `head` then `tail` floats per variant
     std::size_t head = 0;                     ///< lamina1::kGpuSlopeSum
+    std::size_t tail = 0;  ///< the state's last floats: a slab's bins (0 without them)
 };
 Lamina1GpuStates lamina1_gpu_states(const Stack& stack, const ModelOptions& options,
                                     std::string& why);
