@@ -250,15 +250,20 @@ class Bsdf {
         return std::sqrt(sqr(alpha1_) + sqr(alpha0_ * k_top / k_bottom));
     }
 
-    /// The smooth slab's E_1/T_lobe = (1 − F(μ)) a(μ') and E_1 = (1 − F(μ)) a(μ') (1 − F_b(μ')):
-    /// first_order_ holds the residual from them (it vanishes with α0 and α1, and the smooth
-    /// slab's steep edge at grazing incidence is not interpolated).
+    /// The slab under a smooth coat: E_1/T_lobe = (1 − F(μ)) a(μ') and E_1 = (1 − F(μ)) a(μ')
+    /// T_b,in(μ') (v[0], v[1]). first_order_ holds the residual from them: it vanishes with α0, and
+    /// the steep edges at grazing incidence and at the bottom's critical cosine are not
+    /// interpolated.
     Multi<Rgb, 2> first_order_smooth(double mu, double mu_in) const {
         Multi<Rgb, 2> r;
         r.v[0] = attenuation(mu_in) * (1 - fresnel_dielectric(mu, eta0_));
-        r.v[1] = r.v[0] * (1 - fresnel_dielectric(mu_in, eta_b_));
+        r.v[1] = r.v[0] * T_bot_in_(mu_in);
         return r;
     }
+
+    /// A slab over a medium of the coat's own index: its bottom is not there for the light, and
+    /// the stack is the coat's interface alone (delta_lobes, eval_btdf).
+    bool bottom_matched() const { return layers_.base == Base::Dielectric && eta_b_ == 1; }
 
     /// The slab bottom as a single rough interface seen from inside the coat (wi inside, up).
     RoughDielectric bottom_btdf(double alpha) const {
@@ -439,9 +444,11 @@ class Bsdf {
     CosineCurve<Rgb, kNx> single_energy_, single_energy_t_;
     /// The slab's first order through the bottom's BTDF (Options::btdf_bottom_lobe).
     bool bottom_lobe_ = false;
-    /// E_1(μ)/T_lobe(μ), E_1(μ) and E_1(μ)/Q_m(μ) (v[0], v[1], v[2]) over outside cosines, as
-    /// residuals from the smooth slab (first_order_smooth).
-    CosineCurve<Multi<Rgb, 3>, kNfirst> first_order_;
+    /// E_1(μ) and E_1(μ)/Q_m(μ) (v[0], v[1]) over outside cosines, as residuals from the smooth
+    /// slab (first_order_smooth). The bottom lobe's energy T_lobe is looked up per incidence
+    /// (incident): E_1/T_lobe interpolated between the nodes overshot E_1 by 17 % at 85°, where
+    /// T_lobe falls steeply.
+    CosineCurve<Multi<Rgb, 2>, kNfirst> first_order_;
     /// slab-orders=bins: the bins' edges over inside cosines (cut at the interfaces' critical
     /// cosines; in μ² between them, crowding towards the cuts); the light from outside at μ that
     /// the coat lets into each bin and from below that the bottom lets in, energy (v[k]) and

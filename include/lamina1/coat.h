@@ -78,9 +78,10 @@ inline Bsdf::Bsdf(const Layers& layers, const Tables& tables, const Options& opt
     }
     // A slab's later orders in bins (slab-orders=bins) take the place of the separable series
     // and of the first order's round trips (precompute_series); with both interfaces smooth the
-    // exact delta series is summed instead.
-    bins_ =
-        support_.btdf && ch_.slab_bins && ch_.inter_reflection && !(alpha0_ == 0 && alpha1_ == 0);
+    // exact delta series is summed instead; an index-matched bottom has no later orders (the
+    // coat's interface alone: eval_btdf).
+    bins_ = support_.btdf && ch_.slab_bins && ch_.inter_reflection &&
+            !(alpha0_ == 0 && alpha1_ == 0) && !bottom_matched();
     precompute();
     if (scatters_) precompute_scattering();
     precompute_slab();

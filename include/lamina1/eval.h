@@ -50,14 +50,21 @@ inline Bsdf::Incident Bsdf::incident(const Vec3& wi) const {
             // direction, of roughness α_b, scaled to carry the light's first-order energy
             // E_1(μi).
             in.alpha_b = bottom_roughness(in.k_top, in.k_bottom);
-            const Multi<Rgb, 3> first = first_order_(wi.z);
+            const Multi<Rgb, 2> first = first_order_(wi.z);
             const Multi<Rgb, 2> smooth = first_order_smooth(wi.z, in.wi_in.z);
             // Stored as residuals from the smooth slab, the interpolated curves can undershoot
             // zero by their interpolation error where the energy itself vanishes (grazing
             // incidence, total internal reflection at the bottom): an energy is ≥ 0.
-            in.first_T = nonnegative(first.v[0] + smooth.v[0]);
-            in.first_E = nonnegative(first.v[1] + smooth.v[1]);
-            in.first_M = nonnegative(first.v[2] + smooth.v[0]);
+            in.first_E = nonnegative(first.v[0] + smooth.v[1]);
+            in.first_M = nonnegative(first.v[1] + smooth.v[0]);
+            // The bottom lobe carries E_1 over its energy T_lobe at this incidence, by the
+            // transmittance table (Walter et al. 2007, Eq. 21 over the visible normals), whose c
+            // axis puts the smoothed step of total internal reflection on a node line.
+            if (in.alpha_b > 0) {
+                const double T_lobe = TransmittanceFormat::lookup(
+                    tables_->transmittance(ch_.masking), in.wi_mean.z, in.alpha_b, eta_b_);
+                if (T_lobe > 0) in.first_T = in.first_E * (1 / T_lobe);
+            }
             // btdf-lobe=shared: the bottom's share of the spread's variance.
             if (ch_.btdf_lobe_shared && in.alpha_b > 0)
                 in.u_bottom = sqr(alpha1_) / sqr(in.alpha_b);
@@ -177,7 +184,9 @@ inline std::vector<DeltaLobe> Bsdf::delta_lobes(const Vec3& wi) const {
     const Vec3 wr = mirror_direction(wi);
     const double F = fresnel_dielectric(wi.z, eta0_);
     out.push_back({wr, Rgb(F)});
-    if (layers_.base == Base::Lambertian || alpha1_ > 0) return out;
+    // An index-matched bottom is not there for the light, whatever its roughness.
+    const bool matched = bottom_matched();
+    if (layers_.base == Base::Lambertian || (alpha1_ > 0 && !matched)) return out;
     // Both interfaces smooth: every order is specular (docs/physics.md §6.4–6.5 of the study):
     // the series Σ (R_in R_b a²)^k with R_in = F(μi) (Fresnel is the same from both sides).
     const Vec3 w_in = refract_in(wi, inv_eta0_);
@@ -192,7 +201,7 @@ inline std::vector<DeltaLobe> Bsdf::delta_lobes(const Vec3& wi) const {
             const double round_trip = F * Rb[c] * a[c] * a[c];
             series[c] = round_trip < 1 ? 1 / (1 - round_trip) : 0.0;
         }
-    out.push_back({wr, Rb * a * a * series * (T * T)});
+    if (!matched) out.push_back({wr, Rb * a * a * series * (T * T)});
     if (support_.btdf) {
         const double sin_t = std::hypot(wi.x, wi.y) * inv_eta0_ * eta_s_;
         if (sin_t < 1) {
@@ -245,17 +254,31 @@ inline Rgb Bsdf::eval_btdf(const Incident& in, const Vec3& wo) const {
     // v: wo mirrored into the upper hemisphere; v' its refraction into the coat through the
     // bottom (η_s = η_coat/η_below): the straight-through pair has v' = mirror(wi').
     const Vec3 v(wo.x, wo.y, -wo.z);
-    const auto v_in = refract_in_checked(v, 1 / eta_s_);
-    if (!v_in) return Rgb(0.0);
-    const double T_b = T_bot_(v.z), T_b_in = T_bot_in_(v_in->z);
-    const Rgb a_v = has_absorption_ ? attenuation(v_in->z) : Rgb(1.0);
     Rgb f(0.0);
-    const double beta = transmission_roughness(in.k_top, in.k_bottom);
+    if (bottom_matched()) {
+        // The coat's interface alone: its BTDF (Walter et al. 2007, Eq. 21), the light crossing
+        // the layer once along wo, and under multiple scattering its orders ≥ 2, ΔT(μi),
+        // cosine-distributed (as the slab's entry takes them). A smooth coat's is a delta lobe.
+        RoughDielectric top{eta0_, alpha0_};
+        top.masking = ch_.masking;
+        double t = top.eval(in.wi, wo);
+        if (ms_ && alpha0_ > 0)
+            t += ms_dielectric(fgd_top_, in.wi.z, alpha0_, eta0_).transmitted * kInvPi;
+        return attenuation(-wo.z) * t;
+    }
+    // The bottom's own lobe and the bins' light reach every wo: into a denser medium a rough
+    // bottom scatters beyond the cone that refraction maps the inside hemisphere onto.
     if (bottom_lobe_ && in.alpha_b > 0 && in.u_bottom > 0) {
         // The bottom's Walter BTDF (Eq. 21) from the mean inside direction: with a smooth coat
         // the first order is exactly T(μi) a(μi') f_t,bottom(wi', wo).
         f += in.first_T * (in.u_bottom * bottom_btdf(in.alpha_b).eval(in.wi_mean, wo));
     }
+    if (bins_) f += bins_transmission(in, wo);
+    const auto v_in = refract_in_checked(v, 1 / eta_s_);
+    if (!v_in) return f;
+    const double T_b = T_bot_(v.z), T_b_in = T_bot_in_(v_in->z);
+    const Rgb a_v = has_absorption_ ? attenuation(v_in->z) : Rgb(1.0);
+    const double beta = transmission_roughness(in.k_top, in.k_bottom);
     if ((!bottom_lobe_ || in.u_bottom < 1) && beta > 0) {
         const GGX ggx{beta};
         const Vec3 h = normalize(in.wi_mean + *v_in);
@@ -281,11 +304,7 @@ inline Rgb Bsdf::eval_btdf(const Incident& in, const Vec3& wo) const {
             f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
         }
     }
-    if (bins_) {
-        f += bins_transmission(in, wo);
-    } else if (series_btdf_) {
-        f += in.X * inv_one_minus_Er_ * (T_b * kInvPi / (eta_s_ * eta_s_));
-    }
+    if (!bins_ && series_btdf_) f += in.X * inv_one_minus_Er_ * (T_b * kInvPi / (eta_s_ * eta_s_));
     // The scattered light that leaves through the bottom, as uniform radiance below it.
     if (orders_on_ && !twice_on_) f += in.orders_t * T_b;
     if (scatters_ && back_on_) f += single_transmission(in, *v_in, a_v, T_b, layers_.g, Rgb(in.T));

@@ -83,24 +83,16 @@ inline CosineCurve<Rgb, kNfirst> Bsdf::slab_entry() {
     return entry;
 }
 
-/// The first order's curves (btdf-lobe): E_1 over T_lobe(μ), the energy of the bottom's lobe of
-/// roughness α_b at the mean inside direction (both depend on wi only), and with btdf-lobe=shared
-/// over Q_m, the mirrored lobe's, each lobe then carrying E_1.
+/// The first order's curves (btdf-lobe): E_1, and with btdf-lobe=shared E_1 over Q_m, the
+/// mirrored lobe's energy, which that lobe then carries (the bottom's own lobe carries E_1 over its
+/// energy T_lobe, looked up per incidence in incident).
 inline void Bsdf::slab_first_order(const CosineCurve<Rgb, kNfirst>& entry) {
-    const float* table = tables_->transmittance(ch_.masking);
     const double mu_crit_b = eta_b_ < 1 ? std::sqrt(1 - sqr(eta_b_)) : 0.0;
     first_order_.fill([&](double mu) {
         const Incident in = incident(Vec3(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4)));
-        Multi<Rgb, 3> r;
-        r.v[1] = entry(mu);
+        Multi<Rgb, 2> r;
+        r.v[0] = entry(mu);
         const double mu_in = in.ok ? in.wi_in.z : 0.0;
-        if (in.ok && in.alpha_b > 0) {
-            // By the transmittance table (Walter et al. 2007, Eq. 21 over the visible normals),
-            // whose c axis puts the smoothed step of total internal reflection on a node line.
-            const double T_lobe =
-                TransmittanceFormat::lookup(table, in.wi_mean.z, in.alpha_b, eta_b_);
-            if (T_lobe > 0) r.v[0] = r.v[1] * (1 / T_lobe);
-        }
         // btdf-lobe=shared: Q_m = ∫_cone T_b,in(μv') q(w̄i', v'; β) μv' dωv', the mirrored lobe's
         // energy (as eval_btdf weights it), by the visible normals of β at w̄i', split where the
         // mirrored direction leaves the exit cone: twice the φ nodes of the other slab rules, as
@@ -120,12 +112,11 @@ inline void Bsdf::slab_first_order(const CosineCurve<Rgb, kNfirst>& entry) {
                         return T_bot_in_(v_in.z) * (1 + lambda_w) /
                                (1 + lambda_w + ggx.lambda(v_in));
                     });
-            if (Q_m > 0) r.v[2] = r.v[1] * (1 / Q_m);
+            if (Q_m > 0) r.v[1] = r.v[0] * (1 / Q_m);
         }
         const Multi<Rgb, 2> smooth = first_order_smooth(mu, mu_in);
-        r.v[0] = r.v[0] - smooth.v[0];
-        r.v[1] = r.v[1] - smooth.v[1];
-        r.v[2] = r.v[2] - smooth.v[0];
+        r.v[0] = r.v[0] - smooth.v[1];
+        r.v[1] = r.v[1] - smooth.v[0];
         return r;
     });
 }
@@ -339,48 +330,20 @@ inline void Bsdf::slab_bins() {
                 }
             }
     };
-    // Each bin's energy from the per-material curves (the tables, orders ≥ 2 included): the
-    // interface's reflectance from inside R̄_k, flux-averaged over the bin; the rule above gives
-    // where it goes. Scaled to it and made reciprocal (R_jk A_k = R_kj A_j) in turn, until both
-    // hold (a few rounds: the rule is within a few per cent of either).
     auto bin_mean = [&](int k, auto&& f) {
         double sum = 0;
         for (int s = 0; s < kSub; ++s)
             sum += sub_w[k][s] * f(sub_mu[k][s]);
         return sum;
     };
-    auto balance = [&](FluxMatrix R[2], auto&& reflectance) {
-        for (int round = 0; round < 4; ++round) {
-            for (int k = 0; k < kNbins; ++k) {
-                double col = 0;
-                for (int j = 0; j < kNbins; ++j)
-                    col += R[0](j, k);
-                const double f = col > 0 ? bin_mean(k, reflectance) / col : 0.0;
-                for (int j = 0; j < kNbins; ++j) {
-                    R[0](j, k) *= f;
-                    R[1](j, k) *= f;
-                }
-            }
-            for (FluxMatrix* m : {&R[0], &R[1]})
-                for (int j = 0; j < kNbins; ++j)
-                    for (int k = j + 1; k < kNbins; ++k) {
-                        const double sym = 0.5 * ((*m)(j, k) * A[k] + (*m)(k, j) * A[j]);
-                        (*m)(j, k) = sym / A[k];
-                        (*m)(k, j) = sym / A[j];
-                    }
-        }
-    };
-    FluxMatrix Rc[2], Rb[2];
-    reflection(alpha0_, inv_eta0_, fgd_top_in_, Rc);
-    reflection(alpha1_, eta_b_, fgd_base_, Rb);
-    balance(Rc, [&](double mu) { return inside_reflectance(mu); });
-    balance(Rb, [&](double mu) { return base_albedo(mu)[0]; });
-    // The bins' exits likewise: each bin lets out the fraction T̄_k of the interface's
-    // transmittance from inside (T_in), flux-averaged over the bin, and the coat lets in T(μ)
-    // from outside in all (the first orders' own). The entry curves' nodes are scaled to both in
-    // turn (the rule is within a few per cent of either; scaling a column of bins and a row of
-    // outside cosines alternately converges as matrix balancing does), the bottom's to its
-    // exits; the same curves then let the light in and out (reciprocity).
+    // The bins' exits: each bin lets out the fraction T̄_k of the interface's transmittance from
+    // inside (T_in), flux-averaged over the bin, and the coat lets in T(μ) from outside in all
+    // (what the coat's own reflection leaves). The coat's entry curve is scaled to both in turn
+    // (the rule is within a few per cent of either; scaling a column of bins and a row of outside
+    // cosines alternately converges as matrix balancing does), last to the rows: the light that
+    // enters is then T(μ) exactly, and each bin's exit is taken as the curve lets it out. The
+    // bottom's curve is scaled to its exits. The same curves let the light in and out
+    // (reciprocity).
     for (int k = 0; k < kNbins; ++k) {
         tau_c[k] = bin_mean(k, [&](double mu) { return T_top_in_(mu); });
         tau_b[k] = bin_mean(k, [&](double mu) { return T_bot_in_(mu); });
@@ -396,7 +359,7 @@ inline void Bsdf::slab_bins() {
                 node.v[kNbins + k] *= f;
             }
     };
-    for (int round = 0; round < 6; ++round) {
+    for (int round = 0; round < 8; ++round) {
         scale_bins(coat_bins_, eta0_, tau_c);
         const int n = int(coat_bins_.cut.size()) - 1;
         for (int g = 0; g < n; ++g)
@@ -409,8 +372,57 @@ inline void Bsdf::slab_bins() {
                 if (sum > 0) node = node * (T_top_(mu) / sum);
             }
     }
-    scale_bins(coat_bins_, eta0_, tau_c);
     scale_bins(bottom_bins_, eta_s_, tau_b);
+    tau_c.fill(0.0);
+    tau_b.fill(0.0);
+    exit_fractions(coat_bins_, eta0_, tau_c);
+    exit_fractions(bottom_bins_, eta_s_, tau_b);
+
+    // Each bin's reflectance from inside: with the microsurfaces' orders ≥ 2 a clear interface
+    // loses nothing, R̄_k = 1 − T̄_k with the exit just taken (the tables' reflectance and
+    // transmittance, interpolated apart, add up to 1.05 in a bin by the critical cosine of a
+    // nearly smooth coat, which the round trips between the interfaces amplify); with single
+    // scattering the tables' reflectance flux-averaged over the bin, at most 1 − T̄_k. The rule
+    // above gives where it goes; made reciprocal (S_jk = R_jk A_k symmetric) and scaled to R̄_k
+    // as D S D, x_k (S x)_k = R̄_k A_k, by the symmetric form of matrix balancing (x ← √(x R̄ A /
+    // S x), which converges for a nonnegative symmetric S with a positive diagonal): both hold
+    // exactly, so a bin's light is conserved at every bounce.
+    auto balance = [&](FluxMatrix R[2], const std::array<double, kNbins>& tau, auto&& reflectance) {
+        std::array<double, kNbins> target{}, x{};
+        for (int k = 0; k < kNbins; ++k) {
+            const double R_max = std::max(0.0, 1 - tau[k]);
+            target[k] = (ms_ ? R_max : std::min(R_max, bin_mean(k, reflectance))) * A[k];
+            x[k] = 1;
+        }
+        for (FluxMatrix* m : {&R[0], &R[1]})
+            for (int j = 0; j < kNbins; ++j)
+                for (int k = j; k < kNbins; ++k) {
+                    const double sym = 0.5 * ((*m)(j, k) * A[k] + (*m)(k, j) * A[j]);
+                    (*m)(j, k) = (*m)(k, j) = sym;  // S, symmetric
+                }
+        for (int round = 0; round < 500; ++round) {
+            double worst = 0;
+            for (int k = 0; k < kNbins; ++k) {
+                double Sx = 0;
+                for (int j = 0; j < kNbins; ++j)
+                    Sx += R[0](k, j) * x[j];
+                if (!(Sx > 0)) continue;
+                worst =
+                    std::max(worst, std::abs(x[k] * Sx - target[k]) / std::max(target[k], 1e-300));
+                x[k] = std::sqrt(x[k] * target[k] / Sx);
+            }
+            if (worst < 1e-13) break;
+        }
+        for (FluxMatrix* m : {&R[0], &R[1]})
+            for (int j = 0; j < kNbins; ++j)
+                for (int k = 0; k < kNbins; ++k)
+                    (*m)(j, k) *= x[j] * x[k] / A[k];
+    };
+    FluxMatrix Rc[2], Rb[2];
+    reflection(alpha0_, inv_eta0_, fgd_top_in_, Rc);
+    reflection(alpha1_, eta_b_, fgd_base_, Rb);
+    balance(Rc, tau_c, [&](double mu) { return inside_reflectance(mu); });
+    balance(Rb, tau_b, [&](double mu) { return base_albedo(mu)[0]; });
 
     // Per channel and order: the attenuation a of a crossing per bin; the path from the entry
     // (arriving at the bottom) to the coat after the bottom's first reflection, P₁ = a R_b a, and
@@ -463,7 +475,7 @@ inline void Bsdf::slab_bins() {
         entries[i] = coat_entry(mu);
         if (bottom_lobe_)
             E_1s[i] =
-                nonnegative(first_order_.v[i].v[1] + first_order_smooth(mu, inside_cos(mu)).v[1]);
+                nonnegative(first_order_.v[i].v[0] + first_order_smooth(mu, inside_cos(mu)).v[1]);
         E_lobes[i] = first_order_energy(mu);
         for (int c = 0; c < 3; ++c) {
             const std::array<double, kNbins> u1 = times(P1[c][0], entries[i], 0);
@@ -503,8 +515,12 @@ inline void Bsdf::slab_bins() {
             const double extra_T = bottom_lobe_ ? E1_bins - E_1s[i][c] : 0.0;
             const double f_T = extra_T > 0 && E1_bins > 0 ? extra_T / E1_bins : 0.0;
             // What the bins hold beyond what leaves elsewhere, left to the later transmission.
-            const double rest = (E1_bins - (bottom_lobe_ ? E_1s[i][c] : 0.0) - f_T * E1_bins) +
-                                (E_acc - E_lobes[i][c] - E_first) + E_T_later;
+            // Without the bottom's own lobe (an index-matched bottom, or btdf-lobe off) the first
+            // transmission is the mirrored lobe's (eval_btdf), which carries the bins' first
+            // exit E1_bins itself: none of it is left (counted there and here, a matched bottom
+            // transmitted 1.8 of the light).
+            const double first_rest = bottom_lobe_ ? E1_bins - E_1s[i][c] - f_T * E1_bins : 0.0;
+            const double rest = first_rest + (E_acc - E_lobes[i][c] - E_first) + E_T_later;
             const double s = E_T_later > 0 ? std::max(0.0, rest / E_T_later) : 1.0;
             for (int m = 0; m < 2; ++m) {
                 const std::array<double, kNbins> Dm = times(Dop[c][m], C, m);
