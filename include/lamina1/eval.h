@@ -255,16 +255,18 @@ inline Rgb Bsdf::eval_btdf(const Incident& in, const Vec3& wo) const {
     // bottom (η_s = η_coat/η_below): the straight-through pair has v' = mirror(wi').
     const Vec3 v(wo.x, wo.y, -wo.z);
     Rgb f(0.0);
-    if (bottom_matched()) {
-        // The coat's interface alone: its BTDF (Walter et al. 2007, Eq. 21), the light crossing
-        // the layer once along wo, and under multiple scattering its orders ≥ 2, ΔT(μi),
-        // cosine-distributed (as the slab's entry takes them). A smooth coat's is a delta lobe.
+    const bool matched = bottom_matched();
+    if (matched) {
+        // The coat's interface alone (for the unscattered light): its BTDF (Walter et al. 2007,
+        // Eq. 21), the light crossing the layer once along wo, and under multiple scattering its
+        // orders ≥ 2, ΔT(μi), cosine-distributed (as the slab's entry takes them). A smooth
+        // coat's is a delta lobe.
         RoughDielectric top{eta0_, alpha0_};
         top.masking = ch_.masking;
         double t = top.eval(in.wi, wo);
         if (ms_ && alpha0_ > 0)
             t += ms_dielectric(fgd_top_, in.wi.z, alpha0_, eta0_).transmitted * kInvPi;
-        return attenuation(-wo.z) * t;
+        f += attenuation(-wo.z) * t;
     }
     // The bottom's own lobe and the bins' light reach every wo: into a denser medium a rough
     // bottom scatters beyond the cone that refraction maps the inside hemisphere onto.
@@ -279,7 +281,7 @@ inline Rgb Bsdf::eval_btdf(const Incident& in, const Vec3& wo) const {
     const double T_b = T_bot_(v.z), T_b_in = T_bot_in_(v_in->z);
     const Rgb a_v = has_absorption_ ? attenuation(v_in->z) : Rgb(1.0);
     const double beta = transmission_roughness(in.k_top, in.k_bottom);
-    if ((!bottom_lobe_ || in.u_bottom < 1) && beta > 0) {
+    if (!matched && (!bottom_lobe_ || in.u_bottom < 1) && beta > 0) {
         const GGX ggx{beta};
         const Vec3 h = normalize(in.wi_mean + *v_in);
         const double q = ggx.D(h) * ggx.G2(in.wi_mean, *v_in) / (4 * in.wi_mean.z * v_in->z);
@@ -304,7 +306,8 @@ inline Rgb Bsdf::eval_btdf(const Incident& in, const Vec3& wo) const {
             f += a_once * (in.T * T_b_in * q / (eta_s_ * eta_s_));
         }
     }
-    if (!bins_ && series_btdf_) f += in.X * inv_one_minus_Er_ * (T_b * kInvPi / (eta_s_ * eta_s_));
+    if (!bins_ && !matched && series_btdf_)
+        f += in.X * inv_one_minus_Er_ * (T_b * kInvPi / (eta_s_ * eta_s_));
     // The scattered light that leaves through the bottom, as uniform radiance below it.
     if (orders_on_ && !twice_on_) f += in.orders_t * T_b;
     if (scatters_ && back_on_) f += single_transmission(in, *v_in, a_v, T_b, layers_.g, Rgb(in.T));
