@@ -77,11 +77,10 @@ inline Bsdf::AddingEnergies Bsdf::adding_energies() const {
     for (int j = 0; j < n; ++j) {
         const double mu = nodes.mu[j];
         double R = inside_reflectance(mu);
-        if (mu > mu_crit) {
-            exit[j] = T_top_(safe_sqrt(1 - (1 - mu * mu) * sqr(eta0_)));
-            // What the exit does not take is returned (as R_eff in precompute_albedos).
-            R = alpha0_ > 0 ? std::max(0.0, R + T_top_in_(mu) - exit[j]) : R;
-        }
+        if (mu > mu_crit) exit[j] = T_top_(safe_sqrt(1 - (1 - mu * mu) * sqr(eta0_)));
+        // What the exit does not take is returned (as R_eff in precompute_albedos), below the
+        // critical cosine too, where a rough coat's facets let out T_in(μ) that no exit takes.
+        if (alpha0_ > 0) R = std::max(0.0, R + T_top_in_(mu) - exit[j]);
         returned[j] = R;
         if (support_.btdf) {
             bottom[j] = T_bot_in_(mu);
