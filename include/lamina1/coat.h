@@ -83,8 +83,10 @@ inline Bsdf::Bsdf(const Layers& layers, const Tables& tables, const Options& opt
     bins_ = support_.btdf && ch_.slab_bins && ch_.inter_reflection &&
             !(alpha0_ == 0 && alpha1_ == 0) && !bottom_matched();
     precompute();
-    if (scatters_) precompute_scattering();
+    // The slab's bins before the medium's curves: a slab's scattered remainders are weighed by
+    // the bins' entry (precompute_scattering_curves).
     precompute_slab();
+    if (scatters_) precompute_scattering();
 }
 
 inline void Bsdf::precompute() {

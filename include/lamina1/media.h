@@ -18,6 +18,9 @@ struct Bsdf::AddingEnergies {
     CosineNodes nodes;
     std::array<std::vector<double>, 3> top_left{}, bottom_left{}, single_left{}, single_bottom{},
         twice_bottom{};
+    /// The scattered light's whole exits, top and bottom (before the explicit single scattering
+    /// is taken out): what a slab's bins weigh by their entry.
+    std::array<std::vector<double>, 3> top_scattered{}, bottom_scattered{};
 
     /// Linear in μ' between the nodes, flat beyond the first and the last.
     Rgb at(const std::array<std::vector<double>, 3>& v, double mu_in) const {
@@ -107,6 +110,8 @@ inline Bsdf::AddingEnergies Bsdf::adding_energies() const {
         if (same >= 0) {
             e.top_left[c] = e.top_left[same];
             e.bottom_left[c] = e.bottom_left[same];
+            e.top_scattered[c] = e.top_scattered[same];
+            e.bottom_scattered[c] = e.bottom_scattered[same];
             e.single_left[c] = e.single_left[same];
             e.single_bottom[c] = e.single_bottom[same];
             e.twice_bottom[c] = e.twice_bottom[same];
@@ -139,9 +144,12 @@ inline Bsdf::AddingEnergies Bsdf::adding_energies() const {
         if (base_paths_) S = S + hg_single_mirror_paths(nodes, phase, tau_t_[c], omega_[c], E);
         const std::vector<double> single = row_times(exit, S);
         e.top_left[c].resize(n);
+        e.top_scattered[c].resize(n);
         e.single_left[c] = single;
-        for (int k = 0; k < n; ++k)
+        for (int k = 0; k < n; ++k) {
+            e.top_scattered[c][k] = top[k] - top0[k];
             e.top_left[c][k] = std::max(0.0, top[k] - top0[k] - (single_on_ ? single[k] : 0.0));
+        }
         if (!support_.btdf) continue;
         const std::vector<double> bot = row_times(bottom, G * M), bot0 = row_times(bottom, D * M0);
         // The explicit once-scattered transmission (single_transmission), first exit.
@@ -156,7 +164,9 @@ inline Bsdf::AddingEnergies Bsdf::adding_energies() const {
         }
         if (twice_on_) e.twice_bottom[c] = twice_shape_energy(c, nodes, twice_phase);
         e.bottom_left[c].resize(n);
+        e.bottom_scattered[c].resize(n);
         for (int k = 0; k < n; ++k) {
+            e.bottom_scattered[c][k] = bot[k] - bot0[k];
             e.bottom_left[c][k] = std::max(0.0, bot[k] - bot0[k] - bot1[k]);
             e.single_bottom[c].push_back(bot1[k]);
         }
@@ -234,7 +244,29 @@ inline void Bsdf::precompute_scattering_curves(const AddingEnergies& e) {
         single_energy_t_.fill(
             [&](double mu) { return e.at(e.single_bottom, inside_cos(mu)) * T_top_(mu); });
     if (!orders_on_) return;
-    orders_.fill([&](double mu) { return e.at(e.top_left, inside_cos(mu)) * T_top_(mu); });
+    // The remainders per unit flux from outside at μ. The adding takes the light in at the macro
+    // refraction; a slab's bins know where a rough coat sends it (into the trapped cosines, at
+    // grazing incidence), and there the light's unscattered path, which the remainder is the
+    // complement of, is longer: weighed by the bins' entry C_k(μ) (Σ C_k = T(μ)), the scattered
+    // exits at each bin's centre, less the explicit single scattering at the macro refraction
+    // (where eval puts it). At the macro refraction alone, a non-absorbing milky slab under a
+    // coat of α0 0.3 returned 0.74 of the light at 80° (over a smooth bottom).
+    auto remainder = [&](const std::array<std::vector<double>, 3>& left,
+                         const std::array<std::vector<double>, 3>& scattered,
+                         const std::array<std::vector<double>, 3>& single, bool single_out,
+                         double mu) {
+        const double T = T_top_(mu);
+        if (!bins_ready_) return e.at(left, inside_cos(mu)) * T;
+        const BinMoments C = coat_entry(mu);
+        Rgb sum(0.0);
+        for (int k = 0; k < kNbins; ++k)
+            sum += e.at(scattered, 0.5 * (bin_edge_[k] + bin_edge_[k + 1])) * C.v[k];
+        if (single_out) sum = sum - e.at(single, inside_cos(mu)) * T;
+        return nonnegative(sum);
+    };
+    orders_.fill([&](double mu) {
+        return remainder(e.top_left, e.top_scattered, e.single_left, single_on_, mu);
+    });
     const Rgb orders_bar =
         integrate_split01<kGauss, Rgb>([&](double mu) { return orders_(mu) * (2 * mu); }, 0.0);
     for (int c = 0; c < 3; ++c)
@@ -242,14 +274,17 @@ inline void Bsdf::precompute_scattering_curves(const AddingEnergies& e) {
         // would overflow: 1/Ē of a channel whose albedo is 1e-284).
         orders_norm_[c] = orders_bar[c] > kNegligibleEnergy ? kInvPi / orders_bar[c] : 0.0;
     if (!support_.btdf) return;
-    orders_t_.fill([&](double mu) { return e.at(e.bottom_left, inside_cos(mu)) * T_top_(mu); });
+    auto bottom_remainder = [&](double mu) {
+        return remainder(e.bottom_left, e.bottom_scattered, e.single_bottom, true, mu);
+    };
+    orders_t_.fill(bottom_remainder);
     const double T_bar =
         integrate_split01<kGauss, double>([&](double mu) { return T_bot_(mu) * (2 * mu); }, 0.0);
     orders_t_norm_ = T_bar > 0 ? kInvPi / T_bar : 0.0;
     if (!twice_on_) return;
     twice_.fill([&](double mu) {
         const double mu_in = inside_cos(mu);
-        const Rgb left = e.at(e.bottom_left, mu_in);
+        const Rgb left = bottom_remainder(mu) * (1 / std::max(T_top_(mu), 1e-300));
         Rgb shape = e.at(e.twice_bottom, mu_in);
         if (mu_in > nodes.mu[n - 1]) {  // towards the value at μ' = 1
             const double t = (mu_in - nodes.mu[n - 1]) / (1 - nodes.mu[n - 1]);
