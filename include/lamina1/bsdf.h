@@ -444,10 +444,10 @@ class Bsdf {
     CosineCurve<Rgb, kNx> single_energy_, single_energy_t_;
     /// The slab's first order through the bottom's BTDF (Options::btdf_bottom_lobe).
     bool bottom_lobe_ = false;
-    /// E_1(μ) and E_1(μ)/Q_m(μ) (v[0], v[1]) over outside cosines, as residuals from the smooth
-    /// slab (first_order_smooth). The bottom lobe's energy T_lobe is looked up per incidence
-    /// (incident): E_1/T_lobe interpolated between the nodes overshot E_1 by 17 % at 85°, where
-    /// T_lobe falls steeply.
+    /// E_1(μ) and E_1(μ)/Q_m(μ) (v[0], v[1]) over outside cosines, as residuals from the slab
+    /// under a smooth coat (first_order_smooth). The bottom lobe's energy T_lobe is looked up per
+    /// incidence (incident): E_1/T_lobe interpolated between the nodes overshot E_1 by 17 % at 85°,
+    /// where T_lobe falls steeply.
     CosineCurve<Multi<Rgb, 2>, kNfirst> first_order_;
     /// slab-orders=bins: the bins' edges over inside cosines (cut at the interfaces' critical
     /// cosines; in μ² between them, crowding towards the cuts); the light from outside at μ that
