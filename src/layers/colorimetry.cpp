@@ -1,12 +1,11 @@
 #include "layers/colorimetry.h"
 #include "layers/spectrum.h"
 
-#include "layers/spectral_data.h"
+#include "layers/data_files.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -16,20 +15,11 @@ namespace {
 constexpr double kFirstNm = 360, kStepNm = 5;
 constexpr int kRows = kCie1931Rows;  // 360, 365, …, 830
 
-/// Column `column` of a 5 nm table (the header skipped).
-std::vector<double> column_of(std::string_view text, int column) {
+/// Column `column` of a 5 nm table of data/cie.
+std::vector<double> column_of(std::string_view path, std::size_t column) {
     std::vector<double> out;
-    std::istringstream in{std::string(text)};
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line)) {
-        if (line.empty()) continue;
-        std::istringstream cells(line);
-        std::string cell;
-        for (int c = 0; c <= column; ++c)
-            std::getline(cells, cell, ',');
-        out.push_back(std::stod(cell));
-    }
+    for (const auto& row : data_file_rows(path))
+        out.push_back(std::stod(row.at(column)));
     return out;
 }
 
@@ -37,10 +27,9 @@ struct Tables {
     std::array<std::vector<double>, 3> cmf;
     std::vector<double> d65;
     Tables() {
-        const std::string_view xyz = spectral_data_file("cie/cie1931_xyz_5nm.csv");
-        for (int k = 0; k < 3; ++k)
-            cmf[std::size_t(k)] = column_of(xyz, k + 1);
-        d65 = column_of(spectral_data_file("cie/d65_5nm.csv"), 1);
+        for (std::size_t k = 0; k < 3; ++k)
+            cmf[k] = column_of("cie/cie1931_xyz_5nm.csv", k + 1);
+        d65 = column_of("cie/d65_5nm.csv", 1);
     }
 };
 const Tables& tables() {

@@ -1,11 +1,10 @@
 #include "layers/spectrum.h"
 
 #include "core/check.h"
-#include "layers/spectral_data.h"
+#include "layers/data_files.h"
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace lamina {
 
@@ -97,24 +96,6 @@ Spectrum abbe_spectrum(double n_d, double v_d) {
 namespace {
 constexpr const char* kMetals[] = {"Ag", "Al", "Au", "Cr", "Cu", "Fe", "Ni", "Pt", "Ti"};
 
-/// Rows of numbers of a CSV text (the header line skipped).
-std::vector<std::vector<std::string>> csv_rows(std::string_view text) {
-    std::vector<std::vector<std::string>> rows;
-    std::istringstream in{std::string(text)};
-    std::string line;
-    std::getline(in, line);  // header
-    while (std::getline(in, line)) {
-        if (line.empty()) continue;
-        std::vector<std::string> cells;
-        std::istringstream cells_in(line);
-        std::string cell;
-        while (std::getline(cells_in, cell, ','))
-            cells.push_back(cell);
-        rows.push_back(std::move(cells));
-    }
-    return rows;
-}
-
 std::string joined(auto&& names) {
     std::string out;
     for (const auto& n : names)
@@ -124,16 +105,16 @@ std::string joined(auto&& names) {
 
 std::vector<std::string> glass_names() {
     std::vector<std::string> out;
-    for (const auto& row : csv_rows(spectral_data_file("glass/sellmeier.csv")))
+    for (const auto& row : data_file_rows("glass/sellmeier.csv"))
         out.push_back(row.at(0));
     return out;
 }
 
 Spectrum metal_column(const std::string& name, std::size_t column) {
-    const std::string_view text = spectral_data_file("nk/" + name + ".csv");
-    LAMINA_CHECK(!text.empty());
+    const auto rows = data_file_rows("nk/" + name + ".csv");
+    LAMINA_CHECK(!rows.empty());
     std::vector<double> wl, v;
-    for (const auto& row : csv_rows(text)) {
+    for (const auto& row : rows) {
         wl.push_back(std::stod(row.at(0)));
         v.push_back(std::stod(row.at(column)));
     }
@@ -161,7 +142,7 @@ Spectrum conductor_material_k(const std::string& name) {
     return metal_column(name, 2);
 }
 Spectrum glass_material_eta(const std::string& name) {
-    for (const auto& row : csv_rows(spectral_data_file("glass/sellmeier.csv")))
+    for (const auto& row : data_file_rows("glass/sellmeier.csv"))
         if (row.at(0) == name) {
             std::vector<double> b_c;
             for (std::size_t i = 1; i < row.size(); ++i)

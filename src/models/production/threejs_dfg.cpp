@@ -1,25 +1,32 @@
 #include "models/production/threejs_dfg.h"
 
-#include "core/math.h"
-#include "models/production/ggx_albedo.h"
+#include "core/check.h"
+#include "layers/data_files.h"
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace lamina {
 
 namespace {
 
-/// A value rounded to IEEE 754 binary16 (round to nearest, ties to even), as a half-float texel
-/// holds it; the texture's values lie in the normal range of binary16 or are flushed by the same
-/// rule (three.js's values are ≥ 2⁻²⁴).
-double to_half(double x) {
-    if (x == 0) return 0;
-    int e = 0;
-    std::frexp(std::abs(x), &e);  // |x| = m 2^e, m ∈ [½, 1)
-    // binary16: 11 significant bits for normal numbers (e ≥ −13), a fixed step 2⁻²⁴ below.
-    const int exponent = std::max(e - 11, -24);
-    return std::nearbyint(std::ldexp(x, -exponent)) * std::ldexp(1.0, exponent);
+/// three.js's texture (data/production/threejs_dfg.csv): E = scale + bias of each texel, row
+/// by row (μ), the roughness parameter fastest, as its half floats hold them.
+struct ShippedTexture {
+    std::array<double, ThreeJsDfgTexture::kSize * ThreeJsDfgTexture::kSize> albedo{};
+    ShippedTexture() {
+        const auto rows = data_file_rows("production/threejs_dfg.csv");
+        LAMINA_CHECK(rows.size() == albedo.size());
+        for (const auto& row : rows)
+            albedo.at(std::size_t(std::stoi(row.at(0)) * ThreeJsDfgTexture::kSize +
+                                  std::stoi(row.at(1)))) =
+                std::stod(row.at(2)) + std::stod(row.at(3));
+    }
+};
+const ShippedTexture& shipped() {
+    static const ShippedTexture texture;
+    return texture;
 }
 
 /// The GL reading of a coordinate on an axis of n texels with clamped edges: the texel below
@@ -40,13 +47,9 @@ ThreeJsDfgTexture::ThreeJsDfgTexture(double roughness) {
     const Bracket b = texel_bracket(roughness, kSize);
     t_ = b.t;
     const int columns[2] = {b.i0, b.i1};
-    for (int c = 0; c < 2; ++c) {
-        const double alpha = sqr(texel_centre(columns[c]));
-        for (int y = 0; y < kSize; ++y) {
-            const SchlickSplit s = correlated_ggx_schlick_split(texel_centre(y), alpha);
-            albedo_[c * kSize + y] = to_half(s.scale) + to_half(s.bias);
-        }
-    }
+    for (int c = 0; c < 2; ++c)
+        for (int y = 0; y < kSize; ++y)
+            albedo_[c * kSize + y] = shipped().albedo[std::size_t(y * kSize + columns[c])];
 }
 
 double ThreeJsDfgTexture::albedo(double mu_o) const {

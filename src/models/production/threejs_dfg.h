@@ -9,9 +9,10 @@
 // with r the lobe's roughness parameter after three.js's clamp (α = r²). three.js ships the
 // texture as data (DFGLUTData.js: 16 × 16 texels of two half floats, the split-sum's scale and
 // bias, "4096 samples per texel") and reads it with bilinear filtering and clamped edges. lamina
-// reproduces the reading with its own texel values: scale and bias at the texel centres
-// r = (x + ½)/16, μ = (y + ½)/16 (models/production/ggx_albedo.h, correlated_ggx_schlick_split),
-// each rounded to half precision; docs/models.md says how far three.js's own values are from them.
+// reads three.js's own texel values (data/production/threejs_dfg.csv, at r = (x + ½)/16,
+// μ = (y + ½)/16): they are a Monte Carlo estimate, up to 1.47e-2 off the integral they stand for
+// (models/production/ggx_albedo.h, correlated_ggx_schlick_split), which no re-derivation
+// reproduces; tests/models/production/ggx_albedo_test.cpp bounds the difference.
 
 #include <array>
 

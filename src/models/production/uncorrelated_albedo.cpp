@@ -2,14 +2,18 @@
 
 #include "models/production/ggx_albedo.h"
 
+#include "core/check.h"
 #include "core/math.h"
-#include "models/numerics/quadrature.h"
+#include "layers/data_files.h"
 #include "models/numerics/visible_normal_quadrature.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <string_view>
+#include <vector>
 
 namespace lamina {
 
@@ -86,6 +90,35 @@ double f0_of(double eta) {
 }
 }  // namespace
 
+namespace {
+/// openpbr-bsdf's tables of 1 − E (data/production/README.md): the dielectric lobe's
+/// [η][α][μ], the white lobe's [α][μ] and its average's [α], each node unorm16 / 65535 as
+/// openpbr-bsdf decodes it.
+struct ShippedTables {
+    std::vector<double> coat, white, white_average;
+    ShippedTables()
+        : coat(read("production/openpbr_bsdf_coat_energy_complement.csv", 2)),
+          white(read("production/openpbr_bsdf_white_energy_complement.csv", 1)),
+          white_average(read("production/openpbr_bsdf_white_average_energy_complement.csv", 1)) {
+        LAMINA_CHECK(coat.size() == std::size_t(Grid::kN * Grid::kN * Grid::kN) &&
+                     white.size() == std::size_t(Grid::kN * Grid::kN) &&
+                     white_average.size() == std::size_t(Grid::kN));
+    }
+    /// The values of every row after its `keys` index columns, rows in file order.
+    static std::vector<double> read(std::string_view path, std::size_t keys) {
+        std::vector<double> out;
+        for (const auto& row : data_file_rows(path))
+            for (std::size_t c = keys; c < row.size(); ++c)
+                out.push_back(std::stoi(row[c]) / 65535.0);
+        return out;
+    }
+};
+const ShippedTables& shipped() {
+    static const ShippedTables tables;
+    return tables;
+}
+}  // namespace
+
 Grid Grid::dielectric(double eta, double alpha) {
     Grid g;
     const auto [ie, te] = bracket(eta_index(eta));
@@ -96,8 +129,8 @@ Grid Grid::dielectric(double eta, double alpha) {
     for (int a = 0; a < 2; ++a)
         for (int b = 0; b < 2; ++b)
             for (int k = 0; k < kN; ++k)
-                g.albedo_[(a * 2 + b) * kN + k] = uncorrelated_ggx_albedo(
-                    double(k) / (kN - 1), alpha_node(alphas[b]), eta_node(etas[a]));
+                g.complement_[(a * 2 + b) * kN + k] =
+                    shipped().coat[std::size_t((etas[a] * kN + alphas[b]) * kN + k)];
     if (eta > kEtaMax || eta < 1 / kEtaMax) {
         const double f0_max = f0_of(kEtaMax);
         g.extrapolation_ = 1 - (f0_of(eta) - f0_max) / (1 - f0_max);
@@ -110,18 +143,13 @@ Grid Grid::white(double alpha) {
     const auto [ja, ta] = bracket(alpha_index(alpha));
     g.t_alpha_ = ta;
     const int alphas[2] = {ja, upper(ja)};
-    static const QuadratureRule q = gauss_legendre(32);
     for (int b = 0; b < 2; ++b) {
-        const double a = alpha_node(alphas[b]);
         for (int k = 0; k < kN; ++k) {
-            const double e = uncorrelated_ggx_albedo_white(double(k) / (kN - 1), a);
             // Both η slots hold the white lobe: the η weight is 0.
-            g.albedo_[b * kN + k] = g.albedo_[(2 + b) * kN + k] = e;
+            g.complement_[b * kN + k] = g.complement_[(2 + b) * kN + k] =
+                shipped().white[std::size_t(alphas[b] * kN + k)];
         }
-        double average = 0;
-        for (std::size_t i = 0; i < q.x.size(); ++i)
-            average += 2 * q.w[i] * q.x[i] * uncorrelated_ggx_albedo_white(q.x[i], a);
-        g.average_[b] = average;
+        g.average_complement_[b] = shipped().white_average[std::size_t(alphas[b])];
     }
     return g;
 }
@@ -130,8 +158,8 @@ double Grid::complement(double mu) const {
     const auto [k, tk] = bracket(mu_index(mu));
     const int k1 = upper(k);
     auto at = [&](int a, int b) {
-        const double* row = &albedo_[(a * 2 + b) * kN];
-        return std::lerp(1 - row[k], 1 - row[k1], tk);
+        const double* row = &complement_[(a * 2 + b) * kN];
+        return std::lerp(row[k], row[k1], tk);
     };
     const double value = std::lerp(std::lerp(at(0, 0), at(0, 1), t_alpha_),
                                    std::lerp(at(1, 0), at(1, 1), t_alpha_), t_eta_);
@@ -139,7 +167,7 @@ double Grid::complement(double mu) const {
 }
 
 double Grid::average_complement() const {
-    return std::lerp(1 - average_[0], 1 - average_[1], t_alpha_);
+    return std::lerp(average_complement_[0], average_complement_[1], t_alpha_);
 }
 
 }  // namespace lamina

@@ -10,12 +10,13 @@
 // dielectric Fresnel, the "ideal metal" table E with F = 1). lamina computes the integral itself
 // over the visible normals of wi (Heitz 2018): E = ∫ D_wi(h) F(wi·h) G1(wo) dh.
 //
-// OpenPbrBsdfEnergyGrid reproduces how openpbr-bsdf tabulates and reads these albedos — 32 nodes
+// OpenPbrBsdfEnergyGrid reads these albedos as openpbr-bsdf tabulates and reads them — 32 nodes
 // per axis (μ and the roughness r = √α uniform in [0, 1]; the relative index in two halves,
 // [1, 2.5] uniform in η above 1 and uniform in 1/η below), trilinear interpolation in node
 // indices, clamped at the ends, and its extrapolation past η = 2.5 (the complement scaled down
-// linearly in F0) — with lamina's own node values. Only the nodes an (η, α) pair reads are
-// computed: 2 × 2 × 32 for a dielectric, 2 × 32 for the white lobe.
+// linearly in F0) — with the node values openpbr-bsdf ships (data/production, its Monte Carlo
+// estimates of the integrals above as 16-bit integers: within 1.41e-3 of them, which no
+// re-derivation reproduces; tests/models/production/uncorrelated_albedo_test.cpp).
 
 #include <array>
 
@@ -33,7 +34,7 @@ double uncorrelated_ggx_albedo(double mu, double alpha, double eta, int n_r = 0,
 double uncorrelated_ggx_albedo_white(double mu, double alpha, int n_r = 0, int n_phi = 0);
 
 /// openpbr-bsdf's 32-node energy grid, read as openpbr-bsdf reads it, at one (η, α) (or one α for
-/// the white lobe), with lamina's node values.
+/// the white lobe), with openpbr-bsdf's node values.
 class OpenPbrBsdfEnergyGrid {
   public:
     static constexpr int kN = 32;
@@ -47,7 +48,7 @@ class OpenPbrBsdfEnergyGrid {
     /// 1 − E(μ) interpolated as openpbr-bsdf interpolates its table (μ clamped to [0, 1]).
     double complement(double mu) const;
     /// 1 − 2 ∫ E(μ) μ dμ at the α nodes, interpolated in α (the white lobe's "average energy
-    /// complement"); the integral by 32-point Gauss–Legendre in μ over direct values of E.
+    /// complement", openpbr-bsdf's table of it).
     double average_complement() const;
 
     /// The node coordinates openpbr-bsdf uses: the fractional index of η, of α (r = √α) and of μ.
@@ -60,9 +61,9 @@ class OpenPbrBsdfEnergyGrid {
 
   private:
     OpenPbrBsdfEnergyGrid() = default;
-    // E at the two bracketing η nodes × two α nodes × every μ node.
-    std::array<double, 2 * 2 * kN> albedo_{};
-    std::array<double, 2> average_{};
+    // 1 − E at the two bracketing η nodes × two α nodes × every μ node.
+    std::array<double, 2 * 2 * kN> complement_{};
+    std::array<double, 2> average_complement_{};
     double t_eta_ = 0, t_alpha_ = 0;
     double extrapolation_ = 1;  // the scale of the complement past η = 2.5
 };
