@@ -231,6 +231,11 @@ const std::vector<ModelEntry>& model_registry() {
          "bases: lambertian, conductor; media: absorbing; eta0 >= 1; anisotropic metal; sides: R",
          unity_stacklit_options, make_unity_stacklit, false, "production",
          /*represents_anisotropy=*/true},
+        {"standard-surface-materialx",
+         "Standard Surface in MaterialX (its graph, GLSL generator): coat throughput 1 - E(wo) by "
+         "its fitted albedo, constant coat_color, compensated lobes, artistic_ior metal",
+         "bases: lambertian, conductor; media: absorbing; sides: R",
+         standard_surface_materialx_options, make_standard_surface_materialx, false, "production"},
     });
     return entries;
 }

@@ -100,10 +100,11 @@ TEST(ModelRegistry, ListsTheProductionCoats) {
             names.push_back(e.name);
             EXPECT_FALSE(e.stochastic);
         }
-    EXPECT_EQ(names, (std::vector<std::string>{
-                         "openpbr", "openpbr-adobe", "standard-surface", "enterprise-pbr",
-                         "filament", "gltf-clearcoat", "blender-principled", "kulla-conty",
-                         "threejs-clearcoat", "openpbr-materialx", "unity-stacklit"}));
+    EXPECT_EQ(names,
+              (std::vector<std::string>{
+                  "openpbr", "openpbr-adobe", "standard-surface", "enterprise-pbr", "filament",
+                  "gltf-clearcoat", "blender-principled", "kulla-conty", "threejs-clearcoat",
+                  "openpbr-materialx", "unity-stacklit", "standard-surface-materialx"}));
 }
 
 TEST(ModelRegistry, UnknownNameListsTheKnownOnes) {

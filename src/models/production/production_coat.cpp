@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
 #include <optional>
 
 namespace lamina {
@@ -179,6 +180,18 @@ class ProductionCoat final : public Model {
                         f0_[c] = filament_f0_clear_coat_to_surface(
                             fresnel_conductor(1.0, e * eta0_, k * eta0_));
                         break;
+                    case CoatRecipe::MetalFresnel::Artistic: {
+                        // The edge colour g that puts n between Gulbrandsen's bounds at e, as the
+                        // artist would set it, within [0, 1]; then the map back to n + ik.
+                        const double r = std::min(f0_[c], 0.99), sr = std::sqrt(r);
+                        const double n_min = (1 - r) / (1 + r), n_max = (1 + sr) / (1 - sr);
+                        // At F0 = 0 the bounds meet (n = 1 whatever g): g = 0.
+                        const double span = n_max - n_min;
+                        const double g = span > 0 ? clamp((n_max - e) / span, 0.0, 1.0) : 0.0;
+                        artistic_index_[c] = gulbrandsen_index(f0_[c], g);
+                        f0_[c] = metal_fresnel_channel(1.0, c);
+                        break;
+                    }
                 }
             }
             // openpbr-bsdf's film sees the metal through its F0 and F82 tint (Gulbrandsen's map).
@@ -586,22 +599,24 @@ class ProductionCoat final : public Model {
 
     Rgbd metal_fresnel(double c) const {
         Rgbd F;
-        for (int i = 0; i < 3; ++i) {
-            switch (r_.metal_fresnel) {
-                case CoatRecipe::MetalFresnel::Exact:
-                    F[i] = fresnel_conductor(c, coat_.base_eta[i], coat_.base_k[i]);
-                    break;
-                case CoatRecipe::MetalFresnel::Schlick:
-                case CoatRecipe::MetalFresnel::SchlickFilament:
-                    // Schlick 1994, Eq. 15, with the edge value f90 (Filament's F_Schlick).
-                    F[i] = f0_[i] + (f90_ - f0_[i]) * model_schlick_weight(c);
-                    break;
-                case CoatRecipe::MetalFresnel::F82Tint:
-                    F[i] = f82_tint_fresnel(c, f0_[i], tint82_[i]);
-                    break;
-            }
-        }
+        for (int i = 0; i < 3; ++i)
+            F[i] = metal_fresnel_channel(c, i);
         return F;
+    }
+    double metal_fresnel_channel(double c, int i) const {
+        switch (r_.metal_fresnel) {
+            case CoatRecipe::MetalFresnel::Exact:
+                return fresnel_conductor(c, coat_.base_eta[i], coat_.base_k[i]);
+            case CoatRecipe::MetalFresnel::Schlick:
+            case CoatRecipe::MetalFresnel::SchlickFilament:
+                // Schlick 1994, Eq. 15, with the edge value f90 (Filament's F_Schlick).
+                return f0_[i] + (f90_ - f0_[i]) * model_schlick_weight(c);
+            case CoatRecipe::MetalFresnel::F82Tint:
+                return f82_tint_fresnel(c, f0_[i], tint82_[i]);
+            case CoatRecipe::MetalFresnel::Artistic:
+                return fresnel_conductor(c, artistic_index_[i].real(), artistic_index_[i].imag());
+        }
+        return 0;
     }
 
     /// The Fresnel factor of the metal lobe at cos_h = wi·h for the view cosine mu_o: the metal's
@@ -761,9 +776,10 @@ class ProductionCoat final : public Model {
     FgdTable::Index eta_index_;
     bool is_metal_ = false;
     Rgbd f0_{0.0}, tint82_{1.0};
-    double f90_ = 1;                                ///< the metal's Schlick edge value
-    std::optional<FilamentDfgTexture> dfg_;         ///< Filament's energy compensation
-    std::optional<ThreeJsDfgTexture> threejs_dfg_;  ///< three.js's energy compensation
+    std::array<std::complex<double>, 3> artistic_index_{};  ///< MetalFresnel::Artistic's n + ik
+    double f90_ = 1;                                        ///< the metal's Schlick edge value
+    std::optional<FilamentDfgTexture> dfg_;                 ///< Filament's energy compensation
+    std::optional<ThreeJsDfgTexture> threejs_dfg_;          ///< three.js's energy compensation
     // Cycles' tables: the coat's white albedo and Fresnel factor, the metal's white albedo, and
     // their F_ms (the metal's per channel).
     std::optional<CyclesWhiteAlbedo> coat_white_, metal_white_;

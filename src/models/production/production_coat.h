@@ -170,6 +170,11 @@ struct CoatRecipe {
         Schlick,          ///< Schlick with the exact normal reflectance F0 under the coat
         F82Tint,          ///< Kutz et al. 2021's F82-tint: F0 and the tint from the exact F(1/7)
         SchlickFilament,  ///< Schlick with the F0 in air converted by f0ClearCoatToSurface
+        /// The exact Fresnel of the n + ik that Gulbrandsen 2014's map (JCGT 3(4), Eqs. 3 and 4)
+        /// gives for the metal's F0 under the coat (clamped to 0.99) and the edge colour g that
+        /// makes n = η1/η0, clamped to the input's range [0, 1]: MaterialX's artistic_ior read
+        /// from Standard Surface's base_color and specular_color. Inside the range it is Exact.
+        Artistic,
     } metal_fresnel = MetalFresnel::Exact;
 
     /// A thin film on the metal base, between the coat and the metal (docs/models.md, "Thin

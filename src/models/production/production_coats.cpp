@@ -6,7 +6,8 @@
 //     iridescence";
 //   Adobe openpbr-bsdf (impl/openpbr_coating_lobe.h, impl/openpbr_bsdf.h; the reciprocal
 //     coat attenuation is the OPENPBR_RECIPROCAL_COAT_AND_FUZZ switch, off by default);
-//   Autodesk Standard Surface specification, "Coating";
+//   Autodesk Standard Surface specification, "Coating", and its MaterialX graph
+//     (libraries/bxdf/standard_surface.mtlx with pbrlib's genglsl functions);
 //   Dassault Systèmes Enterprise PBR 2025x specification, "Clearcoat";
 //   Google Filament documentation, "Clear coat model" and "Clear coat parameterization";
 //   Khronos KHR_materials_clearcoat, "Layering" (and three.js's half-vector Fresnel in the lobe);
@@ -130,6 +131,32 @@ CoatRecipe standard_surface_recipe(const ModelOptions& o) {
     // Gulbrandsen 2014's artist-friendly metal reproduces the exact conductor Fresnel of the
     // (η, κ) its two colours are derived from (docs/models.md says where it cannot).
     r.metal_fresnel = CoatRecipe::MetalFresnel::Exact;
+    return r;
+}
+
+// --- Standard Surface in MaterialX (its graph, its GLSL generator) -----------------------------
+CoatRecipe standard_surface_materialx_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "standard-surface-materialx";
+    // libraries/bxdf/standard_surface.mtlx as the GLSL generator evaluates it: the coat a
+    // dielectric_bsdf (weight coat, untinted) layered over the base by its throughput
+    // 1 - E(mu_o) from the fitted albedo, the base times coat_attenuation = coat_color, coat and
+    // metal lobes compensated for multiple scattering by that fit, the metal a conductor_bsdf of
+    // the n + ik artistic_ior derives from base_color and specular_color, a diffuse base under a
+    // specular layer of weight 0 (which passes it whole). No darkening; coat_affect_color and
+    // coat_affect_roughness at their default 0.
+    r.coat_fresnel = CoatRecipe::Fresnel::Exact;
+    r.attenuation = CoatRecipe::Attenuation::AlbedoView;
+    r.coat_albedo = CoatRecipe::CoatAlbedo::MaterialX;
+    r.coat_energy_compensation = is_on(o, "energy-compensation")
+                                     ? CoatRecipe::CoatEnergyCompensation::MaterialX
+                                     : CoatRecipe::CoatEnergyCompensation::None;
+    r.metal_energy_compensation = is_on(o, "energy-compensation")
+                                      ? CoatRecipe::MetalEnergyCompensation::MaterialX
+                                      : CoatRecipe::MetalEnergyCompensation::None;
+    r.tint = CoatRecipe::Tint::Constant;
+    r.metal_fresnel = CoatRecipe::MetalFresnel::Artistic;
+    if (exact_leaves(o)) use_exact_leaves(r);
     return r;
 }
 
@@ -304,6 +331,17 @@ std::vector<OptionSpec> standard_surface_options() {
 }
 std::unique_ptr<Model> make_standard_surface(const Stack& stack, const ModelOptions& options) {
     return make_production_coat(stack, standard_surface_recipe(options));
+}
+
+std::vector<OptionSpec> standard_surface_materialx_options() {
+    return {on_off_option("energy-compensation", true,
+                          "coat and metal lobes x (1 + F_ss (1 - E)/E), E by MaterialX's fit "
+                          "(leaves=exact drops it)"),
+            leaves_option()};
+}
+std::unique_ptr<Model> make_standard_surface_materialx(const Stack& stack,
+                                                       const ModelOptions& options) {
+    return make_production_coat(stack, standard_surface_materialx_recipe(options));
 }
 
 std::vector<OptionSpec> enterprise_pbr_options() {

@@ -15,6 +15,9 @@ std::unique_ptr<Model> make_openpbr_adobe(const Stack& stack, const ModelOptions
 std::vector<OptionSpec> openpbr_adobe_options();
 std::unique_ptr<Model> make_standard_surface(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> standard_surface_options();
+std::unique_ptr<Model> make_standard_surface_materialx(const Stack& stack,
+                                                       const ModelOptions& options);
+std::vector<OptionSpec> standard_surface_materialx_options();
 std::unique_ptr<Model> make_enterprise_pbr(const Stack& stack, const ModelOptions& options);
 std::vector<OptionSpec> enterprise_pbr_options();
 std::unique_ptr<Model> make_filament(const Stack& stack, const ModelOptions& options);

@@ -626,12 +626,66 @@ TEST(ProductionCoatsGolden, OpenPbrMaterialXMatchesItsGraph) {
                              worst.total.rel, worst.total.where);
 }
 
-// The OpenPBR specification (`openpbr`) against its two implementations on the same stacks: how
-// far the specification is from Adobe's code and from MaterialX's graph (docs/models.md). The
-// largest and the median relative difference over the pairs and channels, per kind of base; the
-// test holds the measured values to within 10 %.
+// `standard-surface-materialx` against MaterialX's Standard Surface graph as its GLSL generator
+// evaluates it: to 1e-3 at every pair (the metal's n + ik through artistic_ior included: on the
+// metallic paint's green and blue, whose η1/η0 < 1 lies outside the map, its clamp moves the
+// grazing Fresnel).
+TEST(ProductionCoatsGolden, StandardSurfaceMaterialXMatchesItsGraph) {
+    const json data = test::load_golden("standard-surface-materialx.json");
+    Differences worst;
+    for (const json& record : data.at("stacks"))
+        keep_worst(worst,
+                   compare(data, record, "standard-surface-materialx", {}, {}, record.at("values"),
+                           nullptr, [](double, double) { return 1e-3; }));
+    EXPECT_LE(worst.total.rel, 1e-3) << worst.total.where;
+    std::cout << fmt::format("standard-surface-materialx: worst relative difference {:.2e} ({})\n",
+                             worst.total.rel, worst.total.where);
+}
+
+// The data file's Standard Surface inputs are docs/models.md's mapping: coat 1, coat_IOR η0,
+// coat_roughness √α0, coat_color e^(−2τ), base 1; a diffuse base's base_color ρ with metalness
+// and specular 0; a metal's base_color its F0 under the coat, metalness and specular 1,
+// specular_roughness √α1, specular_color the edge colour of Gulbrandsen's map that gives back
+// η1/η0, clamped to [0, 1] (its n = n_max + (n_min − n_max) g, n_min = (1 − r)/(1 + r),
+// n_max = (1 + √r)/(1 − √r), r = F0 ≤ 0.99).
+TEST(ProductionCoatsGolden, StandardSurfaceMaterialXInputsFollowTheMapping) {
+    for (const json& record : test::load_golden("standard-surface-materialx.json").at("stacks")) {
+        const json &s = record.at("stack"), &in = record.at("inputs");
+        const std::string id = record.at("id");
+        const double eta0 = s.at("eta0");
+        EXPECT_EQ(in.at("coat").get<double>(), 1) << id;
+        EXPECT_EQ(in.at("base").get<double>(), 1) << id;
+        EXPECT_NEAR(in.at("coat_IOR").get<double>(), eta0, 1e-9) << id;
+        EXPECT_NEAR(in.at("coat_roughness").get<double>(), std::sqrt(s.at("alpha0").get<double>()),
+                    1e-8)
+            << id;
+        const Rgbd tau = test::golden_rgb(s.at("tau")),
+                   coat_color = test::golden_rgb(in.at("coat_color"));
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(coat_color[c], std::exp(-2 * tau[c]), 1e-8) << id;
+        if (!expect_base_inputs(
+                s, in, id, {"base_color", "metalness", "specular", "specular_roughness"}, eta0))
+            continue;
+        EXPECT_EQ(in.at("specular").get<double>(), 1) << id;
+        const Rgbd eta1 = test::golden_rgb(s.at("eta1")),
+                   g = test::golden_rgb(in.at("specular_color"));
+        for (int c = 0; c < 3; ++c) {
+            const double r = std::min(
+                conductor_ref(1, eta1[c] / eta0, test::golden_rgb(s.at("kappa1"))[c] / eta0), 0.99);
+            const double n_min = (1 - r) / (1 + r), n_max = (1 + std::sqrt(r)) / (1 - std::sqrt(r));
+            EXPECT_NEAR(g[c], std::clamp((n_max - eta1[c] / eta0) / (n_max - n_min), 0.0, 1.0),
+                        1e-7)
+                << id << " channel " << c;
+        }
+    }
+}
+
+// A specification (`openpbr`, `standard-surface`) against its implementations on the same
+// stacks: how far the specification is from the authors' code (docs/models.md). The largest and
+// the median relative difference over the pairs and channels, per kind of base; the test holds
+// the measured values to within 10 %.
 void expect_specification_distance(
-    const std::string& file, const std::string& values_key,
+    const std::string& specification, const std::string& file, const std::string& values_key,
     const std::map<std::string, std::pair<double, double>>& measured) {
     const json data = test::load_golden(file);
     const json& pairs = data.at("pairs");
@@ -640,7 +694,7 @@ void expect_specification_distance(
         std::string where;
         for (const json& record : data.at("stacks")) {
             if (record.at("stack").at("base") != base) continue;
-            const auto m = make_model("openpbr", stack_of(record.at("stack")));
+            const auto m = make_model(specification, stack_of(record.at("stack")));
             const json& values =
                 values_key.empty() ? record.at("values") : record.at("values").at(values_key);
             for (std::size_t i = 0; i < pairs.size(); ++i) {
@@ -660,21 +714,27 @@ void expect_specification_distance(
         std::sort(rel.begin(), rel.end());
         const double largest = rel.back(), median = rel[rel.size() / 2];
         std::cout << fmt::format(
-            "openpbr against {}, {} bases: largest {:.3g} at {}, median {:.3g} ({} values)\n", file,
-            base, largest, where, median, rel.size());
+            "{} against {}, {} bases: largest {:.3g} at {}, median {:.3g} ({} values)\n",
+            specification, file, base, largest, where, median, rel.size());
         EXPECT_NEAR(largest, measured.at(base).first, 0.1 * measured.at(base).first) << base;
         EXPECT_NEAR(median, measured.at(base).second, 0.1 * measured.at(base).second) << base;
     }
 }
 
 TEST(ProductionCoatsGolden, OpenPbrSpecificationAgainstAdobe) {
-    expect_specification_distance("openpbr-adobe.json", "default",
+    expect_specification_distance("openpbr", "openpbr-adobe.json", "default",
                                   {{"lambertian", {0.917, 0.00316}}, {"conductor", {2.07, 0.289}}});
 }
 
 TEST(ProductionCoatsGolden, OpenPbrSpecificationAgainstMaterialX) {
-    expect_specification_distance("openpbr-materialx.json", "",
+    expect_specification_distance("openpbr", "openpbr-materialx.json", "",
                                   {{"lambertian", {0.731, 0.0391}}, {"conductor", {0.642, 0.192}}});
+}
+
+TEST(ProductionCoatsGolden, StandardSurfaceSpecificationAgainstMaterialX) {
+    expect_specification_distance(
+        "standard-surface", "standard-surface-materialx.json", "",
+        {{"lambertian", {0.207, 0.00711}}, {"conductor", {7.51, 0.0186}}});
 }
 
 }  // namespace
