@@ -167,7 +167,7 @@ const std::vector<ModelEntry>& model_registry() {
          "bases: lambertian, conductor (with a thin film); media: absorbing; anisotropic coat and "
          "metal; sides: R",
          openpbr_adobe_options, make_openpbr_adobe, false, "production",
-         /*represents_anisotropy=*/true, /*films=*/true},
+         /*represents_anisotropy=*/true, /*films=*/true, /*specification=*/"openpbr"},
         {"standard-surface",
          "Autodesk Standard Surface: coat + coat_color (1 - E_coat(wo)) base, view-only",
          "bases: lambertian, conductor; media: absorbing; sides: R", standard_surface_options,
@@ -214,12 +214,13 @@ const std::vector<ModelEntry>& model_registry() {
          "bases: lambertian, conductor (with a thin film: KHR_materials_iridescence); eta0 = "
          "1.5; sides: R",
          threejs_clearcoat_options, make_threejs_clearcoat, false, "production",
-         /*represents_anisotropy=*/false, /*films=*/true},
+         /*represents_anisotropy=*/false, /*films=*/true, /*specification=*/"gltf-clearcoat"},
         {"openpbr-materialx",
          "OpenPBR in MaterialX (its graph, GLSL generator): coat throughput 1 - E(wo) by its "
          "fitted albedo, constant coat_color, darkening with F0, compensated lobes",
          "bases: lambertian, conductor; media: absorbing; sides: R", openpbr_materialx_options,
-         make_openpbr_materialx, false, "production"},
+         make_openpbr_materialx, false, "production", /*represents_anisotropy=*/false,
+         /*films=*/false, /*specification=*/"openpbr"},
         {"lamina-coat",
          "lamina-coat: OpenPBR's structure and cost (coat lobe, attenuated, darkened, roughened "
          "base) with terms derived from the layering and fitted on the study's reference",
@@ -235,7 +236,8 @@ const std::vector<ModelEntry>& model_registry() {
          "Standard Surface in MaterialX (its graph, GLSL generator): coat throughput 1 - E(wo) by "
          "its fitted albedo, constant coat_color, compensated lobes, artistic_ior metal",
          "bases: lambertian, conductor; media: absorbing; sides: R",
-         standard_surface_materialx_options, make_standard_surface_materialx, false, "production"},
+         standard_surface_materialx_options, make_standard_surface_materialx, false, "production",
+         /*represents_anisotropy=*/false, /*films=*/false, /*specification=*/"standard-surface"},
     });
     return entries;
 }

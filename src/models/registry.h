@@ -35,6 +35,10 @@ struct ModelEntry {
     /// own form (docs/models.md, "Thin films"); for every other model the registry builds none
     /// for a filmed stack.
     bool films = false;
+    /// A production coat as one implementation ships it: the registry name of the specification
+    /// it implements, which lamina also has (openpbr-adobe and openpbr-materialx: "openpbr");
+    /// the summary sets the two side by side. Empty otherwise.
+    std::string specification = "";
 };
 
 /// The groups of ModelEntry::group, in the order the explorer shows them.

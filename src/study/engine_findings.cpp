@@ -149,6 +149,52 @@ EngineFindings compute_engine_findings(const std::vector<MetricRow>& rows,
         }
     }
 
+    // Each specification beside each of its implementations, row by row.
+    for (const std::string& m : production) {
+        const ModelEntry* e = entry_of(m);
+        if (e->specification.empty() || !by_model.count(m) || !by_model.count(e->specification) ||
+            std::find(models.begin(), models.end(), e->specification) == models.end())
+            continue;
+        const auto& spec_rows = by_model[e->specification];
+        std::map<std::string, EngineFindings::Implementation> per_category;
+        std::map<std::string, int> albedo_rows;
+        for (const auto& [key, row] : by_model[m]) {
+            const auto s = spec_rows.find(key);
+            if (s == spec_rows.end() || !std::isfinite(row->metrics.misplaced_floor) ||
+                !std::isfinite(s->second->metrics.misplaced_floor))
+                continue;
+            const MetricRow& rs = *s->second;
+            EngineFindings::Implementation& d = per_category[row->category];
+            d.rows++;
+            d.implementation_error += row->metrics.misplaced_floor;
+            d.specification_error += rs.metrics.misplaced_floor;
+            if (std::isfinite(row->metrics.albedo_error) &&
+                std::isfinite(rs.metrics.albedo_error)) {
+                d.implementation_albedo += std::abs(row->metrics.albedo_error);
+                d.specification_albedo += std::abs(rs.metrics.albedo_error);
+                d.albedo_difference +=
+                    std::abs(row->metrics.albedo_model - rs.metrics.albedo_model) /
+                    row->metrics.albedo_ref;
+                albedo_rows[row->category]++;
+            }
+        }
+        for (const std::string& c : f.categories) {
+            auto it = per_category.find(c);
+            if (it == per_category.end() || it->second.rows == 0) continue;
+            EngineFindings::Implementation d = it->second;
+            d.specification = e->specification;
+            d.implementation = m;
+            d.category = c;
+            d.implementation_error /= d.rows;
+            d.specification_error /= d.rows;
+            const int n = albedo_rows[c];
+            d.implementation_albedo = n ? d.implementation_albedo / n : NAN;
+            d.specification_albedo = n ? d.specification_albedo / n : NAN;
+            d.albedo_difference = n ? d.albedo_difference / n : NAN;
+            f.implementations.push_back(d);
+        }
+    }
+
     // Each coat against its exact leaves and lamina-coat, on the rows lamina-coat also covers.
     if (by_model.count("lamina-coat")) {
         const auto& replacement = by_model["lamina-coat"];
@@ -278,7 +324,8 @@ std::string engine_findings_markdown(const EngineFindings& f) {
         "the coat is too dark), the lobe error (mean misplaced energy with the 5% floor, the "
         "ranking metric), what each heuristic does "
         "(the model with one flag switched, `NAME:KEY=VALUE`, against the model as shipped on the "
-        "same rows; `lamina study --ablations`), and the most accurate production coat.\n\n");
+        "same rows; `lamina study --ablations`), each specification beside the code that ships it, "
+        "and the most accurate production coat.\n\n");
     for (const std::string& c : f.categories) {
         std::vector<const EngineFindings::Cell*> cells;
         for (const auto& cell : f.cells)
@@ -331,6 +378,19 @@ std::string engine_findings_markdown(const EngineFindings& f) {
                     percent_text(a.switched), percent_text(a.switched_albedo), switch_effect(a));
             });
         out("\n");
+        if (table(f.implementations,
+                  "Specifications and the code that ships them (on the rows both support: mean "
+                  "misplaced energy, 5% floor; mean |albedo error|; and how far apart the two "
+                  "albedos are, mean |a_code − a_specification| / a_reference):\n\n"
+                  "| specification | the code shipping it | the specification's errors | the "
+                  "code's errors | albedos apart |\n|---|---|---|---|---|\n",
+                  [&](const EngineFindings::Implementation& d) {
+                      out("| {} | {} | {}; {} | {}; {} | {} |\n", d.specification, d.implementation,
+                          percent_text(d.specification_error), percent_text(d.specification_albedo),
+                          percent_text(d.implementation_error),
+                          percent_text(d.implementation_albedo), percent_text(d.albedo_difference));
+                  }))
+            out("\n");
         if (table(f.replacements,
                   "What an engine could ship instead (mean misplaced energy, 5% floor, on the rows "
                   "lamina-coat covers; the cost per evaluation of each is below, and `make "
@@ -395,6 +455,17 @@ nlohmann::json engine_findings_json(const EngineFindings& f) {
                      {"switched_misplaced_floor", json_number(a.switched)},
                      {"shipped_mean_abs_albedo_error", json_number(a.shipped_albedo)},
                      {"switched_mean_abs_albedo_error", json_number(a.switched_albedo)}});
+        for (const auto& d : f.implementations)
+            if (d.category == c)
+                jc["implementations"].push_back(
+                    {{"specification", d.specification},
+                     {"implementation", d.implementation},
+                     {"rows", d.rows},
+                     {"specification_misplaced_floor", json_number(d.specification_error)},
+                     {"implementation_misplaced_floor", json_number(d.implementation_error)},
+                     {"specification_mean_abs_albedo_error", json_number(d.specification_albedo)},
+                     {"implementation_mean_abs_albedo_error", json_number(d.implementation_albedo)},
+                     {"mean_albedo_difference", json_number(d.albedo_difference)}});
         for (const auto& r : f.replacements)
             if (r.category == c)
                 jc["replacements"].push_back(

@@ -3,7 +3,8 @@
 // "engine_developers"): for each production coat (models/registry.h group "production") and
 // category, the albedo error against θi (is the coat too dark or too bright, and where), the
 // lobe error (mean misplaced_floor, the ranking metric), what each heuristic does (its one-flag
-// ablation "NAME:KEY=VALUE" against the model as shipped, on the same rows), and the most accurate
+// ablation "NAME:KEY=VALUE" against the model as shipped, on the same rows), each specification
+// beside its shipped implementations (ModelEntry::specification), and the most accurate
 // production coat per category. Computed from the metric rows alone (BRDF rows: the production
 // coats have no BTDF); the summary calls it with the rows it already has.
 
@@ -42,11 +43,23 @@ struct EngineFindings {
         int rows = 0;
         double shipped = 0, exact_leaves = 0, lamina_coat = 0;  ///< mean misplaced_floor
     };
+    /// A specification (openpbr) and one implementation of it (openpbr-adobe), on the rows both
+    /// support: each one's errors against the reference and how far their albedos are apart.
+    struct Implementation {
+        std::string specification, implementation, category;
+        int rows = 0;
+        double specification_error = 0, implementation_error = 0;    ///< mean misplaced_floor
+        double specification_albedo = 0, implementation_albedo = 0;  ///< mean |albedo error|
+        /// mean |a_implementation − a_specification| / a_reference: the two models' albedos
+        /// apart, in units of the reference's
+        double albedo_difference = 0;
+    };
     std::vector<double> theta_i;
     std::vector<std::string> categories;
     std::vector<Replacement> replacements;  ///< when lamina-coat ran
     std::vector<Cell> cells;  ///< categories × production models, in the study's model order
     std::vector<Ablation> ablations;
+    std::vector<Implementation> implementations;  ///< where a specification and its code ran
     /// Per category: the production coat with the lowest mean misplaced_floor, and the model of
     /// any family with the lowest (for scale).
     std::map<std::string, std::string> best_production, best_overall;

@@ -197,5 +197,45 @@ TEST(EngineFindings, SetsEachCoatBesideItsExactLeavesAndLaminaCoat) {
         << md;
 }
 
+// A specification beside the code that ships it (ModelEntry::specification: openpbr-adobe
+// implements openpbr), on the rows both support: each one's errors and how far apart their
+// albedos are, |a_code − a_spec| / a_ref averaged over the rows.
+TEST(EngineFindings, SetsEachSpecificationBesideItsCode) {
+    std::vector<MetricRow> r;
+    for (double t : {0.0, 60.0})
+        for (int c = 0; c < 3; ++c) {
+            MetricRow spec = row("p1", "plastic", "openpbr", t, c, true, 0.2, -0.1);
+            MetricRow code =
+                row("p1", "plastic", "openpbr-adobe", t, c, true, 0.1, t == 0 ? 0.1 : 0.02);
+            spec.metrics.albedo_ref = code.metrics.albedo_ref = 0.5;
+            spec.metrics.albedo_model = 0.45;  // −10 %
+            code.metrics.albedo_model = t == 0 ? 0.55 : 0.51;
+            r.push_back(spec);
+            r.push_back(code);
+            // A row only the code supports does not enter the comparison.
+            r.push_back(row("p2", "plastic", "openpbr", t, c, false, 0, 0));
+            r.push_back(row("p2", "plastic", "openpbr-adobe", t, c, true, 0.9, 0.5));
+        }
+    const EngineFindings f = compute_engine_findings(r, {"openpbr", "openpbr-adobe"});
+    ASSERT_EQ(f.implementations.size(), 1u);
+    const auto& d = f.implementations[0];
+    EXPECT_EQ(d.specification, "openpbr");
+    EXPECT_EQ(d.implementation, "openpbr-adobe");
+    EXPECT_EQ(d.rows, 6);
+    EXPECT_NEAR(d.specification_error, 0.2, 1e-12);
+    EXPECT_NEAR(d.implementation_error, 0.1, 1e-12);
+    EXPECT_NEAR(d.specification_albedo, 0.1, 1e-12);
+    EXPECT_NEAR(d.implementation_albedo, 0.06, 1e-12);
+    EXPECT_NEAR(d.albedo_difference, (0.2 + 0.12) / 2, 1e-12);  // (0.10 + 0.06)/0.5, averaged
+    const std::string md = engine_findings_markdown(f);
+    EXPECT_NE(md.find("| openpbr | openpbr-adobe | 20.0%; 10.0% | 10.0%; 6.0% | 16.0% |"),
+              std::string::npos)
+        << md;
+    const nlohmann::json j = engine_findings_json(f);
+    EXPECT_EQ(j["categories"]["plastic"]["implementations"][0]["implementation"], "openpbr-adobe");
+    // Without the specification in the study there is nothing to set it beside.
+    EXPECT_TRUE(compute_engine_findings(r, {"openpbr-adobe"}).implementations.empty());
+}
+
 }  // namespace
 }  // namespace lamina
