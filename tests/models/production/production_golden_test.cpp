@@ -512,6 +512,33 @@ TEST(ProductionCoatsGolden, ThreeJsMatchesItsShaders) {
                                      "energy-compensation=off", "compensation");
 }
 
+// `gltf-clearcoat` (KHR_materials_clearcoat's layering, as its specification writes it) against
+// Khronos's own reference renderer, the glTF Sample Renderer, lit by one directional light: to 1e-3
+// at every pair (on a smooth coat the pairs within 5° of the mirror are not compared).
+TEST(ProductionCoatsGolden, GltfClearcoatMatchesTheSampleRenderer) {
+    const json data = test::load_golden("gltf-sample-renderer.json");
+    Differences worst;
+    for (const json& record : data.at("stacks"))
+        keep_worst(worst, compare(data, record, "gltf-clearcoat", {}, {}, record.at("values"),
+                                  nullptr, [](double, double) { return 1e-3; }));
+    EXPECT_LE(worst.total.rel, 1e-3) << worst.total.where;
+    std::cout << fmt::format(
+        "gltf-clearcoat against the Sample Renderer: worst relative difference "
+        "{:.2e} ({})\n",
+        worst.total.rel, worst.total.where);
+}
+
+// The Sample Renderer data file's inputs are the glTF mapping: clearcoatFactor 1,
+// clearcoatRoughnessFactor √α0, and the base as for every engine (expect_base_inputs).
+TEST(ProductionCoatsGolden, GltfSampleRendererInputsFollowTheMapping) {
+    expect_fixed_coat_inputs("gltf-sample-renderer.json", "clearcoatRoughnessFactor",
+                             {"baseColorFactor", "metallicFactor",
+                              "KHR_materials_specular.specularFactor", "roughnessFactor"},
+                             true);
+    for (const json& record : test::load_golden("gltf-sample-renderer.json").at("stacks"))
+        EXPECT_EQ(record.at("inputs").at("clearcoatFactor").get<double>(), 1) << record.at("id");
+}
+
 // The iridescence data file's three.js inputs are the threejs-clearcoat mapping with the film's
 // (docs/models.md, "Thin films"): iridescence 1, iridescenceIOR the film's η, the thickness range
 // collapsed on the film's thickness.
