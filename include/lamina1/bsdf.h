@@ -74,9 +74,10 @@ class Bsdf {
     struct Incident {
         Vec3 wi, wi_in;  ///< wi and its refraction into the coat about n (pointing up)
         bool ok = false;
-        double T = 0;  ///< T(μi)
-        Rgb a{1.0};    ///< exp(−τ/μi')
-        Rgb X{0.0};    ///< X(μi) = T(μi) a(μi') Y(μi')
+        double T = 0;      ///< T(μi)
+        Rgb a{1.0};        ///< the coat's Beer–Lambert factor for wi (coat_attenuation)
+        Rgb a_macro{1.0};  ///< exp(−τ/μi') along the macro refraction (the medium's terms)
+        Rgb X{0.0};        ///< X(μi) = T(μi) a(μi') Y(μi')
         double lambda0 = 0, k_top = 0, k_bottom = 1;
         Vec3 wi_mean;       ///< the mean direction of the light the coat transmits (slabs)
         Rgb a_mean{1.0};    ///< exp(−τ/μ̄')
@@ -128,6 +129,7 @@ class Bsdf {
     void setup_transmittances();
     void precompute_lobe_normalization();
     void precompute_multiple_scattering();
+    void precompute_coat_attenuation();
     RgbEdgeCurve<33> precompute_albedos();
     void precompute_mean_direction();
     void precompute_series(const RgbEdgeCurve<33>& g_curve);
@@ -314,6 +316,16 @@ class Bsdf {
         return beer_lambert(tau_t_, 1 / mu);
     }
 
+    /// Beer–Lambert for light crossing the coat between the outside cosine μ and the base, whose
+    /// macro refraction has the inside cosine μ': a rough coat refracts it into a spread of
+    /// inside directions, whose mean of exp(−τ/μ_t) is below exp(−τ/μ') (the paths about the
+    /// macro refraction are longer on average, most at grazing light: 0.62 of it at 70° under
+    /// α0 0.5, τ 0.9), the coat's curve a_coat_ (precompute_coat_attenuation); a smooth coat's
+    /// is the macro refraction's.
+    Rgb coat_attenuation(double mu, double mu_in) const {
+        return a_coat_on_ ? a_coat_(mu) : attenuation(mu_in);
+    }
+
     Rgb base_fresnel(double c) const {
         switch (layers_.base) {
             case Base::Conductor:
@@ -401,8 +413,10 @@ class Bsdf {
     /// X(μ): the flux the coat's bottom returns to the base after the first order, per unit flux
     /// arriving from outside at μ (outside cosines).
     CosineCurve<Rgb, kNx> X_;
-    Rgb K_{0.0};                 ///< the separable term's normalization
-    Rgb inv_one_minus_Er_{0.0};  ///< 1/(1 − Ē_b r̄)
+    bool a_coat_on_ = false;
+    CosineCurve<Rgb, kNmu> a_coat_;  ///< coat_attenuation of a rough absorbing coat
+    Rgb K_{0.0};                     ///< the separable term's normalization
+    Rgb inv_one_minus_Er_{0.0};      ///< 1/(1 − Ē_b r̄)
     Rgb r_bar_{0.0}, E_bar_{0.0}, t_bar_{0.0}, X_bar_{0.0};
     /// Multiple scattering: the coat's ΔR from outside and its hemispherical 2∫ΔR μ dμ; the base's
     /// ΔE (conductor: white, times F_ms; dielectric: ΔR, F_ms = 1) and its average.

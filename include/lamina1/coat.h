@@ -94,6 +94,7 @@ inline void Bsdf::precompute() {
                    layers_.base != Base::Lambertian;
     precompute_lobe_normalization();
     setup_transmittances();
+    precompute_coat_attenuation();
     precompute_multiple_scattering();
     const RgbEdgeCurve<33> g_curve = precompute_albedos();
     precompute_mean_direction();
@@ -213,6 +214,55 @@ inline void Bsdf::precompute_multiple_scattering() {
     }
 }
 
+/// A rough absorbing coat's Beer–Lambert factor for light crossing it from the outside cosine μ,
+/// averaged over the directions the coat transmits it into: ∫ t(μ → w') exp(−τ/μ_w') dω' /
+/// ∫ t(μ → w') dω' by the coat's visible-normal rule (weight (1 − F) G_t/G1, as X(μ) and its
+/// transmittance table), the coat's orders ≥ 2 taken as cosine-distributed inside. By
+/// reciprocity the same factor holds for light leaving towards μ. Over an opaque base without a
+/// scattering medium (Options::coat_path_spread): a slab's first order takes its own directions
+/// through the coat (lamina1/slab.h), and with a medium the adding balances the scattered light's
+/// energy along the macro refractions (lamina1/media.h).
+inline void Bsdf::precompute_coat_attenuation() {
+    a_coat_on_ = ch_.coat_path_spread && alpha0_ > 0 && has_absorption_ && !scatters_ &&
+                 !support_.btdf && ch_.directional_transmittance;
+    if (!a_coat_on_) return;
+    const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
+    const GGX ggx0{alpha0_};
+    const Rgb a_cosine =
+        integrate_split01<kGauss, Rgb>([&](double m) { return attenuation(m) * (2 * m); }, mu_crit);
+    a_coat_.fill([&](double mu) {
+        const Vec3 w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+        const double lambda_w = ggx0.lambda(w);
+        auto inside_z = [&](const Vec3& wm) {
+            const auto wt = refract(w, wm, eta0_);
+            return wt ? -wt->z : 0.0;
+        };
+        // v[0]: the attenuated transmitted light, v[1]: the transmitted light.
+        Multi<Rgb, 2> sum =
+            integrate_visible_split<Multi<Rgb, 2>, kSplitNr, kSplitNphi, kSplitBisections>(
+                ggx0, w, mu_crit, inside_z, [&](const Vec3& wm) {
+                    Multi<Rgb, 2> r;
+                    const auto wt = refract(w, wm, eta0_);
+                    if (!wt || wt->z >= 0) return r;
+                    const double weight =
+                        (1 - fresnel_dielectric(dot(w, wm), eta0_)) *
+                        refraction_escape(ch_.masking, lambda_w, ggx0.lambda(*wt));
+                    r.v[0] = attenuation(-wt->z) * weight;
+                    r.v[1] = Rgb(weight);
+                    return r;
+                });
+        if (ms_) {
+            const double dT = ms_dielectric(fgd_top_, mu, alpha0_, eta0_).transmitted;
+            sum.v[0] += a_cosine * dT;
+            sum.v[1] += Rgb(dT);
+        }
+        Rgb a = attenuation(inside_cos(mu));
+        for (int c = 0; c < 3; ++c)
+            if (sum.v[1][c] > 0) a[c] = sum.v[0][c] / sum.v[1][c];
+        return a;
+    });
+}
+
 /// The hemispherical albedos r̄ (the coat's bottom, with the medium's round trip), Ē_b (the
 /// base) and t̄ (the coat's diffuse exit); returns g(μ) = a(μ)² R_eff(μ), the light a return trip
 /// base → coat → base keeps, tabulated for Y.
@@ -255,7 +305,8 @@ inline RgbEdgeCurve<33> Bsdf::precompute_albedos() {
                                             mu_crit_b);
     t_bar_ =
         integrate_split01<kGauss, Rgb>(
-            [&](double mu) { return attenuation(inside_cos(mu)) * (2 * mu * T_top_(mu)); }, 0.0) *
+            [&](double mu) { return coat_attenuation(mu, inside_cos(mu)) * (2 * mu * T_top_(mu)); },
+            0.0) *
         sqr(inv_eta0_);
     return g_curve;
 }
@@ -376,7 +427,8 @@ inline Rgb Bsdf::first_order_energy(double mu) const {
             if (wo_in.z <= mu_crit) return Rgb(0.0);
             const double density = g1 * fixed.D(wm);
             if (!(density > 0)) return Rgb(0.0);
-            return first_order(in, outside(wo_in), wo_in, attenuation(wo_in.z), kSpecular) *
+            const Vec3 wo = outside(wo_in);
+            return first_order(in, wo, wo_in, coat_attenuation(wo.z, wo_in.z), kSpecular) *
                    (sqr(eta0_) * wo_in.z * 4 * w.z / density);
         });
     if (base_ms_) {
@@ -386,7 +438,7 @@ inline Rgb Bsdf::first_order_energy(double mu) const {
                 if (mu_in <= mu_crit) return Rgb(0.0);
                 const Vec3 wo_in(safe_sqrt(1 - mu_in * mu_in), 0, mu_in);
                 const Vec3 wo = outside(wo_in);
-                return first_order(in, wo, wo_in, attenuation(mu_in), kMultiple) *
+                return first_order(in, wo, wo_in, coat_attenuation(wo.z, mu_in), kMultiple) *
                        (sqr(eta0_) * 2 * kPi * mu_in);
             },
             mu_crit);

@@ -29,7 +29,7 @@ inline Bsdf::Incident Bsdf::incident(const Vec3& wi) const {
     }
     if (support_.btdf) {
         in.wi_mean = in.wi_in;
-        in.a_mean = in.a;
+        in.a_mean = in.a_macro;
         if (mean_shift_) {
             // The transmitted light's mean direction, in wi's plane of incidence.
             const double mu = clamp(in.wi_in.z + mu_mean_(wi.z), 1e-4, 1.0);
@@ -81,7 +81,8 @@ inline void Bsdf::incident_coat(Incident& in) const {
     in.ok = true;
     in.T = T_top_(wi.z);
     in.T_pair = in.T;
-    in.a = attenuation(in.wi_in.z);
+    in.a_macro = attenuation(in.wi_in.z);
+    in.a = a_coat_on_ ? a_coat_(wi.z) : in.a_macro;
     if (lobe_norm_on_) in.lobe_norm = lobe_norm_(in.wi_in.z);
     in.k_top = spread_factor(wi.z, in.wi_in.z, eta0_);
     if (inside_exit_) in.T_pair = std::sqrt(in.T * exit_transmittance(wi.z, in.wi_in.z, in.k_top));
@@ -105,13 +106,14 @@ inline Rgb Bsdf::eval_with(const Incident& in, const Vec3& wo) const {
         if (top_ms_) f += Rgb(in.dR * dR_top_(wo.z) * kInvPi / dR_top_bar_);
     }
     const Vec3 wo_in = refract_in(wo, inv_eta0_);
-    const Rgb a_o = attenuation(wo_in.z);
+    const Rgb a_o = coat_attenuation(wo.z, wo_in.z);
     f += first_order(in, wo, wo_in, a_o, LobeForm{});
     if (series_on_) {
         f += in.X * X_at(wo.z) * K_ * (kInvPi * inv_eta0_ * inv_eta0_);
     }
     if (bins_) f += bins_reflection(in, wo);
-    if (scatters_) f += scattered(in, wo, wo_in, a_o);
+    // The medium's terms take the light along the macro refractions (their depth integrals).
+    if (scatters_) f += scattered(in, wo, wo_in, a_coat_on_ ? attenuation(wo_in.z) : a_o);
     return f;
 }
 
@@ -167,10 +169,10 @@ inline Rgb Bsdf::single_scattering(const Incident& in, const Vec3& wo_in, const 
             if (back_on_) p_back = hg_phase(cos_back, layers_.g[c]);
             if (base_paths_) p_mirror = hg_phase(cos_mirror, layers_.g[c]);
         }
-        double v = p_back * (1 - in.a[c] * a_o[c]) / (mu_i + mu_o);
+        double v = p_back * (1 - in.a_macro[c] * a_o[c]) / (mu_i + mu_o);
         if (base_paths_) {
-            v += p_mirror * attenuation_slope(mu_o, mu_i, a_o[c], in.a[c], tau_t_[c]) *
-                 (E_o[c] * a_o[c] + in.E_b[c] * in.a[c]);
+            v += p_mirror * attenuation_slope(mu_o, mu_i, a_o[c], in.a_macro[c], tau_t_[c]) *
+                 (E_o[c] * a_o[c] + in.E_b[c] * in.a_macro[c]);
         }
         f[c] = omega_[c] * v;
     }
@@ -242,8 +244,8 @@ LAMINA1_NOINLINE inline Rgb Bsdf::single_transmission(const Incident& in, const 
     double p = 0;
     for (int c = 0; c < 3; ++c) {
         if (c == 0 || !g_uniform_) p = hg_phase(cos_forward, g[c]);
-        f[c] = omega_[c] * p * attenuation_slope(v_in.z, wi_in.z, a_v[c], in.a[c], tau_t_[c]) *
-               scale[c];
+        f[c] = omega_[c] * p *
+               attenuation_slope(v_in.z, wi_in.z, a_v[c], in.a_macro[c], tau_t_[c]) * scale[c];
     }
     return f * (T_b / (eta_s_ * eta_s_));
 }

@@ -37,12 +37,13 @@ constexpr int kGpuMirrorSeries = kGpuLobeNorm + kNnorm;    // kNmu × RGB
 constexpr int kGpuEntering = kGpuMirrorSeries + 3 * kNmu;  // sin δ, cos δ, weight: 3 × 129
 constexpr int kGpuLeaving = kGpuEntering + 3 * FacetDeflection::kN;
 constexpr int kGpuBaseAlbedo = kGpuLeaving + 3 * FacetDeflection::kN;  // Ē_b(μ'): kNmu
-constexpr int kGpuDRTop = kGpuBaseAlbedo + kNmu;  // the coat's orders ≥ 2, ΔR(μ): kNmu
-constexpr int kGpuDEBase = kGpuDRTop + kNmu;      // the base's, ΔE(μ'): kNmu
-constexpr int kGpuSlopeSum = 1664;
+constexpr int kGpuDRTop = kGpuBaseAlbedo + kNmu;        // the coat's orders ≥ 2, ΔR(μ): kNmu
+constexpr int kGpuDEBase = kGpuDRTop + kNmu;            // the base's, ΔE(μ'): kNmu
+constexpr int kGpuCoatAttenuation = kGpuDEBase + kNmu;  // a rough coat's a(μ): kNmu × RGB
+constexpr int kGpuSlopeSum = 1808;
 constexpr int kGpuSize =
     kGpuSlopeSum + SlopeSumFormat::kNx * SlopeSumFormat::kNy * SlopeSumFormat::kNu;
-static_assert(kGpuDEBase + kNmu <= kGpuSlopeSum, "the curves overlap");
+static_assert(kGpuCoatAttenuation + 3 * kNmu <= kGpuSlopeSum, "the curves overlap");
 
 // A slab's inside light in bins (slab-orders=bins, lamina1/slab.h), after the slope-sum table in
 // states that have the flag kGpuBinsOn (the others end at kGpuSize): the coat's entry curve
@@ -80,6 +81,7 @@ enum GpuFlag : unsigned {
     kGpuTopOrders = 1u << 16,        ///< the coat's orders ≥ 2: ΔR(μi) ΔR(μo)/(π ΔR̄)
     kGpuBaseOrders = 1u << 17,       ///< the base's: F_ms ΔE(μi') ΔE(μo')/(π ΔĒ)
     kGpuBinsOn = 1u << 18,           ///< a slab's inside light in bins, from kGpuBinsCuts on
+    kGpuCoatSpread = 1u << 19,       ///< a rough absorbing coat's a(μ) (Bsdf::coat_attenuation)
 };
 
 inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
@@ -114,6 +116,7 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     flag(top_ms_, kGpuTopOrders);
     flag(base_ms_, kGpuBaseOrders);
     flag(bins_, kGpuBinsOn);
+    flag(a_coat_on_, kGpuCoatSpread);
     v[0] = float(flags);  // exact in float32 (fewer than 2^24)
     v[1] = float(int(layers_.base));
     v[2] = float(eta0_);
@@ -150,6 +153,9 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
             v[kGpuMirrorSeries + 3 * i + c] = float(mirror_series_curve_.v[i][c]);
         if (top_ms_) v[kGpuDRTop + i] = float(dR_top_.v[i]);
         if (base_ms_) v[kGpuDEBase + i] = float(dE_base_.v[i]);
+        if (a_coat_on_)
+            for (int c = 0; c < 3; ++c)
+                v[kGpuCoatAttenuation + 3 * i + c] = float(a_coat_.v[i][c]);
     }
     // The sampler's mixture weighs the base lobe by the base's mean albedo at the inside cosine:
     // a curve over μ' = s² (the FGD lookups it stands for stay in C++).

@@ -18,7 +18,8 @@ const int L1_LOBE_NORM = L1_X + 3 * L1_NX, L1_MIRROR = L1_LOBE_NORM + L1_NNORM;
 const int L1_ENTERING = L1_MIRROR + 3 * L1_NMU, L1_LEAVING = L1_ENTERING + 3 * L1_NFACET;
 const int L1_BASE_ALBEDO = L1_LEAVING + 3 * L1_NFACET;
 const int L1_DR_TOP = L1_BASE_ALBEDO + L1_NMU, L1_DE_BASE = L1_DR_TOP + L1_NMU;
-const int L1_SLOPE_SUM = 1664, L1_SS_NX = 25, L1_SS_NY = 13, L1_SS_NU = 33;
+const int L1_A_COAT = L1_DE_BASE + L1_NMU;
+const int L1_SLOPE_SUM = 1808, L1_SS_NX = 25, L1_SS_NY = 13, L1_SS_NU = 33;
 // A slab's bins (kGpuBins* in lamina1/gpu.h), after the slope-sum table.
 const int L1_NBINS = 12, L1_BIN_PER = 4, L1_NSLAB = 17, L1_BINS_MAX_CUTS = 2 * L1_NBINS + 3;
 const int L1_BINS_CUTS = L1_SLOPE_SUM + L1_SS_NX * L1_SS_NY * L1_SS_NU;
@@ -109,6 +110,12 @@ vec3 l1_attenuation(float mu) {
     if (!l1_flag(1)) return vec3(1.0);
     if (mu <= 0.0) return vec3(0.0);
     return exp(-l1_rgb(7) / mu);
+}
+// Bsdf::coat_attenuation: a rough absorbing coat's curve over the outside cosine, else the macro
+// refraction's exp(−τ/μ').
+vec3 l1_coat_attenuation(float mu, float mu_in) {
+    if (l1_flag(19)) return l1_cosine_curve3(L1_A_COAT, L1_NMU, mu);
+    return l1_attenuation(mu_in);
 }
 vec3 l1_refract_in(vec3 w) {
     float inv_eta = l1_at(3);
@@ -298,7 +305,7 @@ vec3 lamina1_eval(vec3 wi, vec3 wo) {
     vec3 wi_in = l1_refract_in(wi);
     if (!(wi_in.z > 0.0)) return vec3(0.0);
     float T = l1_transmittance(0, wi.z);
-    vec3 a = l1_attenuation(wi_in.z);
+    vec3 a = l1_coat_attenuation(wi.z, wi_in.z);
     vec3 X = l1_flag(2) ? l1_x_at(wi.z) : vec3(0.0);
     float lambda0 = alpha0 > 0.0 ? l1_lambda(alpha0, wi) : 0.0;
     float lobe_norm = l1_flag(6) ? l1_cosine_curve(L1_LOBE_NORM, L1_NNORM, 1, 0, wi_in.z) : 1.0;
@@ -319,7 +326,7 @@ vec3 lamina1_eval(vec3 wi, vec3 wo) {
     }
     vec3 wo_in = l1_refract_in(wo);
     float T_o = l1_transmittance(0, wo.z);
-    vec3 a_o = l1_attenuation(wo_in.z);
+    vec3 a_o = l1_coat_attenuation(wo.z, wo_in.z);
     vec3 fb = wi_in.z > 0.0 && wo_in.z > 0.0 ? l1_base_lobe(wi_in, k_top, lobe_norm, wo.z, wo_in)
                                             : vec3(0.0);
     float fb_max = max(fb.r, max(fb.g, fb.b));
@@ -424,7 +431,7 @@ bool l1_mixture(vec3 wi, out vec3 p, out float alpha_base, out vec3 wi_in) {
     wi_in = l1_refract_in(wi);
     if (!l1_flag(14) || wi.z <= 0.0 || !(wi_in.z > 0.0)) return false;
     float alpha0 = l1_at(4), alpha1 = l1_at(5);
-    float a = l1_mean(l1_attenuation(wi_in.z)), T = l1_transmittance(0, wi.z);
+    float a = l1_mean(l1_coat_attenuation(wi.z, wi_in.z)), T = l1_transmittance(0, wi.z);
     if (alpha0 > 0.0) p.x = l1_fresnel_dielectric(wi.z, l1_at(2));
     float E_b = int(l1_at(1)) == 0 ? l1_mean(l1_rgb(10))
                                    : l1_cosine_curve(L1_BASE_ALBEDO, L1_NMU, 1, 0, wi_in.z);

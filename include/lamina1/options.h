@@ -125,6 +125,11 @@ struct Options {
     /// (true; lamina1/slab.h); or the uniform series and the first order's round trips of
     /// inter_reflection (false). Nothing with inter_reflection off.
     bool slab_bins = true;
+    /// The Beer–Lambert factor of the light crossing a rough absorbing coat to and from an opaque
+    /// base without a scattering medium: averaged over the directions the coat refracts it into
+    /// (true; Bsdf::coat_attenuation), or along the macro refraction (false; with a scattering
+    /// medium always: the adding balances the scattered light's energy along it).
+    bool coat_path_spread = true;
 };
 
 }  // namespace lamina1

@@ -115,6 +115,11 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table() {
             "multiple; isotropic interfaces only), single scattering (single: the masked energy "
             "lost, as --microsurface single), or multiple where every interface is isotropic "
             "(auto)"),
+        member_option<L1, bool>(
+            "coat-path", &L1::coat_path_spread, {{"spread", true}, {"refracted", false}},
+            "Beer-Lambert through a rough absorbing coat (opaque base, no scattering medium): "
+            "averaged over the directions the coat refracts the light into, or along the macro "
+            "refraction"),
     });
     return table;
 }

@@ -39,14 +39,18 @@ Stack milky(double eta0, double alpha0, const InterfaceSpec& base, double tau_a,
 }
 
 // τs → 0: the scattering terms vanish with τs and the unscattered light's extinction tends to
-// τa, so the model tends to the absorbing one (relative 1e-6 at τs = 1e-9; both sides).
+// τa, so the model tends to the absorbing one (relative 1e-6 at τs = 1e-9; both sides) — with the
+// Beer–Lambert factor along the macro refraction (coat-path=refracted), which a scattering
+// medium always takes (its adding balances the scattered light's energy along it); with the
+// default the absorbing model averages it over a rough coat's spread (Lamina1, below).
 TEST(Lamina1Scattering, VanishingScatteringIsTheAbsorbingModel) {
     ParticleRng rng(21, 0, 0);
     const std::vector<InterfaceSpec> bases = {test::lambertian(Rgbd(0.8, 0.5, 0.2)),
                                               test::gold(0.2), test::dielectric(1.0, 0.3)};
     for (const InterfaceSpec& base : bases)
         for (double alpha0 : {0.0, 0.3}) {
-            const auto absorbing = make_model("lamina-1", milky(1.5, alpha0, base, 0.2, 0, 0));
+            const auto absorbing = make_model("lamina-1", milky(1.5, alpha0, base, 0.2, 0, 0),
+                                              {"coat-path=refracted"});
             const auto scattering =
                 make_model("lamina-1", milky(1.5, alpha0, base, 0.2, 1e-9, 0.5));
             ASSERT_TRUE(scattering->support().brdf);
@@ -150,11 +154,13 @@ TEST(Lamina1Scattering, SingleTransmissionIsTheDepthIntegral) {
 }
 
 // Without its single scattering and remainder the scattering model is the absorbing model at
-// the extinction τt: the unscattered light is attenuated by τa + τs (exactly, same code).
+// the extinction τt: the unscattered light is attenuated by τa + τs (exactly, same code), along
+// the macro refraction as a medium takes it (coat-path=refracted in the absorbing model).
 TEST(Lamina1Scattering, UnscatteredLightIsAttenuatedByExtinction) {
     ParticleRng rng(23, 0, 0);
     for (const InterfaceSpec& base : {test::lambertian(Rgbd(0.7)), test::gold(0.3)}) {
-        const auto absorbing = make_model("lamina-1", milky(1.5, 0.2, base, 0.8, 0, 0));
+        const auto absorbing =
+            make_model("lamina-1", milky(1.5, 0.2, base, 0.8, 0, 0), {"coat-path=refracted"});
         const auto scattering =
             make_model("lamina-1", milky(1.5, 0.2, base, 0.3, 0.5, 0.4),
                        {"medium-single=off", "medium-base-paths=off", "medium-orders=off"});

@@ -1,9 +1,11 @@
 // lamina-1 (docs/models.md, "lamina-1"): its exact limits against closed forms, its reciprocity
 // and energy, its sampler (chi-square), and its coat transmittance table against independent
 // integrals.
+#include "lamina1/lamina1.h"
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/spherical.h"
+#include "models/lamina1/lamina1.h"
 #include "models/model_sampling.h"
 #include "models/numerics/binned.h"
 #include "models/registry.h"
@@ -19,6 +21,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 
 namespace lamina {
@@ -449,6 +452,74 @@ TEST(Lamina1, SampleWeightIsEvalOverPdf) {
             const int drawn = test::expect_sample_weights(*model, wi, rng, 200, what);
             EXPECT_GT(drawn, 100) << what;
         }
+}
+
+// A rough absorbing coat over an opaque base: the first order's Beer–Lambert factor is the mean of
+// exp(−τ/μt) over the directions the coat refracts the light into, each weighted by what it
+// carries ((1 − F) and the refracted ray's escape from the microsurface, as the coat's
+// transmittance), Bsdf::coat_attenuation — against a Monte Carlo estimate over visible normals
+// drawn by lamina's GGX sampler (2·10⁵ draws, fixed seed; 4 standard errors of the ratio
+// estimate, plus the curve's interpolation, 2e-4). It is below the macro refraction's
+// exp(−τ/μ') (longer paths about it: 0.77 of it in blue at 70° here) and equal to it with
+// coat-path=refracted and for a smooth coat.
+TEST(Lamina1, RoughAbsorbingCoatAveragesBeerLambertOverItsRefraction) {
+    lamina1::Layers layers;
+    layers.eta0 = 1.5;
+    layers.alpha0 = 0.3;
+    layers.tau_a = lamina1::Rgb(0.1, 0.4, 0.9);
+    layers.base = lamina1::Base::Lambertian;
+    layers.albedo = lamina1::Rgb(0.8);
+    lamina1::Options single;
+    single.microsurface = lamina1::Options::Microsurface::Single;
+    const lamina1::Bsdf coat(layers, lamina1_tables(lamina1::Masking::Smith, false), single);
+    lamina1::Options refracted = single;
+    refracted.coat_path_spread = false;
+    const lamina1::Bsdf macro(layers, lamina1_tables(lamina1::Masking::Smith, false), refracted);
+    const GGX<double> ggx{layers.alpha0};
+    ParticleRng rng(31, 0, 0);
+    for (double theta : {0.0, 45.0, 70.0}) {
+        const Vec3d wi = dir(theta, 0);
+        const double lambda_i = ggx.lambda(wi);
+        const int n = 200000;
+        double sum_w = 0, sum_w2 = 0;
+        std::array<double, 3> sum_wa{}, sum_wa2{}, sum_w_wa{};
+        for (int k = 0; k < n; ++k) {
+            const Vec3d m =
+                ggx.sample_visible_normal(wi, rng.uniform_double(), rng.uniform_double());
+            const auto wt = refract(wi, m, layers.eta0);
+            if (!wt || wt->z >= 0) continue;
+            const double w =
+                (1 - fresnel_dielectric(dot(wi, m), layers.eta0)) *
+                lamina1::refraction_escape(lamina1::Masking::Smith, lambda_i, ggx.lambda(-*wt));
+            sum_w += w;
+            sum_w2 += w * w;
+            for (int c = 0; c < 3; ++c) {
+                const double wa = w * std::exp(-layers.tau_a[c] / -wt->z);
+                sum_wa[c] += wa;
+                sum_wa2[c] += wa * wa;
+                sum_w_wa[c] += w * wa;
+            }
+        }
+        const lamina1::Rgb a = coat.incident({wi.x, wi.y, wi.z}).a;
+        const lamina1::Rgb a_macro = macro.incident({wi.x, wi.y, wi.z}).a;
+        const double mu_in = std::sqrt(1 - sqr(std::sin(deg_to_rad(theta)) / layers.eta0));
+        for (int c = 0; c < 3; ++c) {
+            const double ratio = sum_wa[c] / sum_w;
+            // The ratio estimator's variance (delta method).
+            const double mw = sum_w / n, ma = sum_wa[c] / n;
+            const double var = (sum_wa2[c] / n - ma * ma - 2 * ratio * (sum_w_wa[c] / n - ma * mw) +
+                                ratio * ratio * (sum_w2 / n - mw * mw)) /
+                               (n * mw * mw);
+            EXPECT_NEAR(a[c], ratio, 4 * std::sqrt(var) + 2e-4) << theta << " channel " << c;
+            EXPECT_NEAR(a_macro[c], std::exp(-layers.tau_a[c] / mu_in), 1e-12);
+            EXPECT_LT(a[c], a_macro[c]) << theta << " channel " << c;
+        }
+    }
+    layers.alpha0 = 0;
+    const lamina1::Bsdf smooth(layers, lamina1_tables(lamina1::Masking::Smith, false), single);
+    const Vec3d wi = dir(60, 0);
+    const double mu_in = std::sqrt(1 - sqr(std::sin(deg_to_rad(60.0)) / layers.eta0));
+    EXPECT_NEAR(smooth.incident({wi.x, wi.y, wi.z}).a[2], std::exp(-0.9 / mu_in), 1e-12);
 }
 
 }  // namespace
