@@ -279,6 +279,30 @@ class Bsdf {
         return deflection(mu, mu_in, eta);
     }
 
+    /// ∫ over the light the rough coat transmits from the outside cosine μ, by the coat's
+    /// visible-normal rule (Heitz 2018), split where the refracted direction's inside cosine
+    /// crosses `split`: each refracted direction wt (pointing down) is passed to f with the
+    /// facet's Fresnel factor F and the refracted ray's escape from the microsurface (G_t/G1,
+    /// refraction_escape), f(wt, F, escape) — the weight (1 − F)·escape of the coat's
+    /// transmittance table. X(μ), a slab's entry and the coat's Beer–Lambert factor read it.
+    template <typename V, int kNr, int kNphi, int kBisections, typename F>
+    V over_coat_transmission(double mu, double split, F&& f) const {
+        const GGX ggx0{alpha0_};
+        const Vec3 w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+        const double lambda_w = ggx0.lambda(w);
+        auto inside_z = [&](const Vec3& wm) {
+            const auto wt = refract(w, wm, eta0_);
+            return wt ? -wt->z : 0.0;
+        };
+        return integrate_visible_split<V, kNr, kNphi, kBisections>(
+            ggx0, w, split, inside_z, [&](const Vec3& wm) {
+                const auto wt = refract(w, wm, eta0_);
+                if (!wt || wt->z >= 0) return V{};
+                return f(*wt, fresnel_dielectric(dot(w, wm), eta0_),
+                         refraction_escape(ch_.masking, lambda_w, ggx0.lambda(*wt)));
+            });
+    }
+
     /// X(μ); exact for a Lambertian base when the light enters along the refracted direction
     /// (X = T(μ) a(μ') ρ r̄), else the per-material curve.
     Rgb X_at(double mu) const {

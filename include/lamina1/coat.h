@@ -227,27 +227,16 @@ inline void Bsdf::precompute_coat_attenuation() {
                  !support_.btdf && ch_.directional_transmittance;
     if (!a_coat_on_) return;
     const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
-    const GGX ggx0{alpha0_};
     const Rgb a_cosine =
         integrate_split01<kGauss, Rgb>([&](double m) { return attenuation(m) * (2 * m); }, mu_crit);
     a_coat_.fill([&](double mu) {
-        const Vec3 w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
-        const double lambda_w = ggx0.lambda(w);
-        auto inside_z = [&](const Vec3& wm) {
-            const auto wt = refract(w, wm, eta0_);
-            return wt ? -wt->z : 0.0;
-        };
         // v[0]: the attenuated transmitted light, v[1]: the transmitted light.
         Multi<Rgb, 2> sum =
-            integrate_visible_split<Multi<Rgb, 2>, kSplitNr, kSplitNphi, kSplitBisections>(
-                ggx0, w, mu_crit, inside_z, [&](const Vec3& wm) {
+            over_coat_transmission<Multi<Rgb, 2>, kSplitNr, kSplitNphi, kSplitBisections>(
+                mu, mu_crit, [&](const Vec3& wt, double F, double escape) {
+                    const double weight = (1 - F) * escape;
                     Multi<Rgb, 2> r;
-                    const auto wt = refract(w, wm, eta0_);
-                    if (!wt || wt->z >= 0) return r;
-                    const double weight =
-                        (1 - fresnel_dielectric(dot(w, wm), eta0_)) *
-                        refraction_escape(ch_.masking, lambda_w, ggx0.lambda(*wt));
-                    r.v[0] = attenuation(-wt->z) * weight;
+                    r.v[0] = attenuation(-wt.z) * weight;
                     r.v[1] = Rgb(weight);
                     return r;
                 });
@@ -507,7 +496,6 @@ inline void Bsdf::precompute_returned(const RgbEdgeCurve<33>& g_curve) {
     // cone too (light there cannot leave through the first order and is returned): X(μ) =
     // ∫ t(μ → w') a(μ_w') Y(μ_w') dω' over the coat's transmitted light, by the visible-normal
     // rule of the coat (weight (1 − F) G_t/G1, as in its transmittance table).
-    const GGX ggx0{alpha0_};
     // The coat's orders ≥ 2 transmit ΔT(μ) more, spread over the inside directions: taken as
     // cosine-distributed, they return the hemispherical average of a Y.
     const bool ms = ms_;
@@ -517,20 +505,10 @@ inline void Bsdf::precompute_returned(const RgbEdgeCurve<33>& g_curve) {
                   : Rgb(0.0);
     };
     auto through_coat = [&](const RgbEdgeCurve<17>& Y_curve, const Rgb& Y_spread, double mu) {
-        const Vec3 w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
-        const double lambda_w = ggx0.lambda(w);
-        // The refracted direction's inside cosine −wt.z; Y_curve steps at μc.
-        auto inside_z = [&](const Vec3& wm) {
-            const auto wt = refract(w, wm, eta0_);
-            return wt ? -wt->z : 0.0;
-        };
-        Rgb sum = integrate_visible_split<Rgb, kSplitNr, kSplitNphi, kSplitBisections>(
-            ggx0, w, mu_crit, inside_z, [&](const Vec3& wm) {
-                const auto wt = refract(w, wm, eta0_);
-                if (!wt || wt->z >= 0) return Rgb(0.0);
-                const double F = fresnel_dielectric(dot(w, wm), eta0_);
-                const double escape = refraction_escape(ch_.masking, lambda_w, ggx0.lambda(*wt));
-                return Y_curve(-wt->z) * attenuation(-wt->z) * ((1 - F) * escape);
+        // Y_curve steps at μc, where the refracted direction's inside cosine crosses it.
+        Rgb sum = over_coat_transmission<Rgb, kSplitNr, kSplitNphi, kSplitBisections>(
+            mu, mu_crit, [&](const Vec3& wt, double F, double escape) {
+                return Y_curve(-wt.z) * attenuation(-wt.z) * ((1 - F) * escape);
             });
         if (ms) sum += Y_spread * ms_dielectric(fgd_top_, mu, alpha0_, eta0_).transmitted;
         return sum;

@@ -33,7 +33,6 @@ inline CosineCurve<Rgb, kNfirst> Bsdf::slab_entry() {
         });
         return entry;
     }
-    const GGX ggx0{alpha0_};
     // The coat's orders ≥ 2 (multiple scattering) transmit ΔT(μ) more, taken as cosine-
     // distributed inside, as in X.
     const bool ms = ms_;
@@ -41,25 +40,14 @@ inline CosineCurve<Rgb, kNfirst> Bsdf::slab_entry() {
                                      [&](double mu) { return entering(mu) * (2 * mu); }, mu_crit_b)
                                : Rgb(0.0);
     auto entry_at = [&](double mu) {
-        const Vec3 w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
-        const double lambda_w = ggx0.lambda(w);
-        auto inside_z = [&](const Vec3& wm) {
-            const auto wt = refract(w, wm, eta0_);
-            return wt ? -wt->z : 0.0;
-        };
         // v[1] (x, z, ·): the (1 − F)-weighted inside direction, the transmitted light's mean
         // direction for the lobe's centre (item 5 of lamina-1).
         Multi<Rgb, 2> sum =
-            integrate_visible_split<Multi<Rgb, 2>, kSlabNr, kSlabNphi, kSlabBisections>(
-                ggx0, w, mu_crit_b, inside_z, [&](const Vec3& wm) {
+            over_coat_transmission<Multi<Rgb, 2>, kSlabNr, kSlabNphi, kSlabBisections>(
+                mu, mu_crit_b, [&](const Vec3& wt, double F, double escape) {
                     Multi<Rgb, 2> out;
-                    const auto wt = refract(w, wm, eta0_);
-                    if (!wt || wt->z >= 0) return out;
-                    const double F = fresnel_dielectric(dot(w, wm), eta0_);
-                    const double escape =
-                        refraction_escape(ch_.masking, lambda_w, ggx0.lambda(*wt));
-                    out.v[0] = entering(-wt->z) * ((1 - F) * escape);
-                    out.v[1] = Rgb(wt->x, -wt->z, 0.0) * (1 - F);
+                    out.v[0] = entering(-wt.z) * ((1 - F) * escape);
+                    out.v[1] = Rgb(wt.x, -wt.z, 0.0) * (1 - F);
                     return out;
                 });
         if (ms) sum.v[0] += once_spread * ms_dielectric(fgd_top_, mu, alpha0_, eta0_).transmitted;
