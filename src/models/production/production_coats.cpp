@@ -87,16 +87,12 @@ CoatRecipe adobe_recipe(const ModelOptions& o) {
     return r;
 }
 
-// --- OpenPBR in MaterialX (its graph, its GLSL generator) --------------------------------------
-CoatRecipe materialx_recipe(const ModelOptions& o) {
-    CoatRecipe r;
-    r.name = "openpbr-materialx";
-    // libraries/bxdf/open_pbr_surface.mtlx as the GLSL generator evaluates it (pbrlib genglsl,
-    // the analytic directional albedo): the coat a dielectric_bsdf layered over the base by its
-    // throughput 1 - E(mu_o), the constant coat_color, the graph's darkening with
-    // Kcoat = 1 - (1 - F0)/eta^2, the specification's roughening, every lobe compensated for
-    // multiple scattering by the fitted albedo, and a diffuse base under its specular layer at
-    // index 1.
+// --- MaterialX's graphs (their GLSL generator) -------------------------------------------------
+// The coat layer both graphs build from pbrlib: a dielectric_bsdf (exact Fresnel) layered over
+// the base by its throughput 1 - E(mu_o) from the generator's fitted albedo, the constant
+// coat_color on the base, and (energy-compensation) the coat and metal lobes compensated for
+// multiple scattering by that fit.
+void materialx_coat_layer(CoatRecipe& r, const ModelOptions& o) {
     r.coat_fresnel = CoatRecipe::Fresnel::Exact;
     r.attenuation = CoatRecipe::Attenuation::AlbedoView;
     r.coat_albedo = CoatRecipe::CoatAlbedo::MaterialX;
@@ -107,6 +103,19 @@ CoatRecipe materialx_recipe(const ModelOptions& o) {
                                       ? CoatRecipe::MetalEnergyCompensation::MaterialX
                                       : CoatRecipe::MetalEnergyCompensation::None;
     r.tint = CoatRecipe::Tint::Constant;
+}
+
+// --- OpenPBR in MaterialX (its graph, its GLSL generator) --------------------------------------
+CoatRecipe materialx_recipe(const ModelOptions& o) {
+    CoatRecipe r;
+    r.name = "openpbr-materialx";
+    // libraries/bxdf/open_pbr_surface.mtlx as the GLSL generator evaluates it (pbrlib genglsl,
+    // the analytic directional albedo): the coat a dielectric_bsdf layered over the base by its
+    // throughput 1 - E(mu_o), the constant coat_color, the graph's darkening with
+    // Kcoat = 1 - (1 - F0)/eta^2, the specification's roughening, every lobe compensated for
+    // multiple scattering by the fitted albedo, and a diffuse base under its specular layer at
+    // index 1.
+    materialx_coat_layer(r, o);
     r.darkening =
         is_on(o, "darkening") ? CoatRecipe::Darkening::MaterialX : CoatRecipe::Darkening::None;
     r.roughening =
@@ -145,16 +154,7 @@ CoatRecipe standard_surface_materialx_recipe(const ModelOptions& o) {
     // the n + ik artistic_ior derives from base_color and specular_color, a diffuse base under a
     // specular layer of weight 0 (which passes it whole). No darkening; coat_affect_color and
     // coat_affect_roughness at their default 0.
-    r.coat_fresnel = CoatRecipe::Fresnel::Exact;
-    r.attenuation = CoatRecipe::Attenuation::AlbedoView;
-    r.coat_albedo = CoatRecipe::CoatAlbedo::MaterialX;
-    r.coat_energy_compensation = is_on(o, "energy-compensation")
-                                     ? CoatRecipe::CoatEnergyCompensation::MaterialX
-                                     : CoatRecipe::CoatEnergyCompensation::None;
-    r.metal_energy_compensation = is_on(o, "energy-compensation")
-                                      ? CoatRecipe::MetalEnergyCompensation::MaterialX
-                                      : CoatRecipe::MetalEnergyCompensation::None;
-    r.tint = CoatRecipe::Tint::Constant;
+    materialx_coat_layer(r, o);
     r.metal_fresnel = CoatRecipe::MetalFresnel::Artistic;
     if (exact_leaves(o)) use_exact_leaves(r);
     return r;
