@@ -22,45 +22,75 @@ namespace {
 
 constexpr std::string_view kMagic = "lamina-array 1\n";
 
+// Scratch memory kept by each thread between calls: the byte planes of one table are megabytes,
+// and a fresh zero-filled buffer per table cost more (the fill and the page faults of a new
+// mapping) than deflating it. A buffer only grows while it is used, and one past kKeptBytes is
+// given back when its use ends, so a large table does not stay held.
+template <class T>
+class Scratch {
+  public:
+    explicit Scratch(std::vector<T>& buffer) : buffer_(buffer) {}
+    Scratch(const Scratch&) = delete;
+    Scratch& operator=(const Scratch&) = delete;
+    ~Scratch() {
+        if (buffer_.size() * sizeof(T) > kKeptBytes) std::vector<T>().swap(buffer_);
+    }
+    /// `count` elements, their values unspecified.
+    T* get(std::size_t count) {
+        if (buffer_.size() < count) buffer_.resize(count);
+        return buffer_.data();
+    }
+
+  private:
+    static constexpr std::size_t kKeptBytes = std::size_t(64) << 20;
+    std::vector<T>& buffer_;
+};
+
 // Steps 1–3 on unsigned integers of one width: [outer, n, channels] → [outer, channels, n],
-// differences along n (modulo 2^bits), byte planes.
+// differences along n (modulo 2^bits), byte planes (`planes`: count · sizeof(U) bytes).
 template <class U>
-std::string transform(const U* v, std::size_t count, std::size_t n, std::size_t channels) {
+void transform(const U* v, std::size_t count, std::size_t n, std::size_t channels,
+               unsigned char* planes) {
     const std::size_t row = n * channels, outer = count / row;
-    std::vector<U> d(count);
+    std::vector<U> run(n);  // one channel's run along n, as differences
     for (std::size_t o = 0; o < outer; ++o)
         for (std::size_t c = 0; c < channels; ++c) {
             const U* src = v + o * row + c;
-            U* dst = d.data() + o * row + c * n;
             U previous = 0;
             for (std::size_t k = 0; k < n; ++k) {
                 const U x = src[k * channels];
-                dst[k] = U(x - previous);
+                run[k] = U(x - previous);
                 previous = x;
             }
+            const std::size_t at = o * row + c * n;
+            for (std::size_t b = 0; b < sizeof(U); ++b) {
+                unsigned char* plane = planes + b * count + at;
+                for (std::size_t k = 0; k < n; ++k)
+                    plane[k] = static_cast<unsigned char>((run[k] >> (8 * b)) & 0xff);
+            }
         }
-    std::string planes(count * sizeof(U), '\0');
-    for (std::size_t b = 0; b < sizeof(U); ++b)
-        for (std::size_t i = 0; i < count; ++i)
-            planes[b * count + i] = char((d[i] >> (8 * b)) & 0xff);
-    return planes;
 }
 
+// The inverse of transform: the byte planes back into v, [outer, n, channels].
 template <class U>
-void untransform(const std::string& planes, U* v, std::size_t count, std::size_t n,
+void untransform(const unsigned char* planes, U* v, std::size_t count, std::size_t n,
                  std::size_t channels) {
     const std::size_t row = n * channels, outer = count / row;
-    std::vector<U> d(count, 0);
-    for (std::size_t b = 0; b < sizeof(U); ++b)
-        for (std::size_t i = 0; i < count; ++i)
-            d[i] |= U(U(static_cast<unsigned char>(planes[b * count + i])) << (8 * b));
+    std::vector<U> run(n);  // one channel's run along n, as differences
     for (std::size_t o = 0; o < outer; ++o)
         for (std::size_t c = 0; c < channels; ++c) {
-            const U* src = d.data() + o * row + c * n;
+            const std::size_t at = o * row + c * n;
+            for (std::size_t k = 0; k < n; ++k)
+                run[k] = U(planes[at + k]);
+            for (std::size_t b = 1; b < sizeof(U); ++b) {
+                const unsigned char* plane = planes + b * count + at;
+                for (std::size_t k = 0; k < n; ++k)
+                    run[k] = U(run[k] | U(U(plane[k]) << (8 * b)));
+            }
             U* dst = v + o * row + c;
             U x = 0;
             for (std::size_t k = 0; k < n; ++k) {
-                x = U(x + src[k]);
+                x = U(x + run[k]);
                 dst[k * channels] = x;
             }
         }
@@ -72,30 +102,35 @@ std::string pack_elements(const void* elements, std::size_t count, std::size_t w
                           std::size_t channels) {
     LAMINA_CHECK((width == 2 || width == 4) && n >= 1 && channels >= 1 &&
                  count % (n * channels) == 0);
-    const std::string planes =
-        width == 2 ? transform(static_cast<const std::uint16_t*>(elements), count, n, channels)
-                   : transform(static_cast<const std::uint32_t*>(elements), count, n, channels);
-    uLongf size = compressBound(uLong(planes.size()));
-    std::string out(size, '\0');
-    const int rc =
-        compress2(reinterpret_cast<Bytef*>(out.data()), &size,
-                  reinterpret_cast<const Bytef*>(planes.data()), uLong(planes.size()), 6);
+    thread_local std::vector<unsigned char> planes_buffer, out_buffer;
+    Scratch planes_scratch(planes_buffer), out_scratch(out_buffer);
+    const std::size_t bytes = count * width;
+    unsigned char* planes = planes_scratch.get(bytes);
+    if (width == 2)
+        transform(static_cast<const std::uint16_t*>(elements), count, n, channels, planes);
+    else
+        transform(static_cast<const std::uint32_t*>(elements), count, n, channels, planes);
+    uLongf size = compressBound(uLong(bytes));
+    unsigned char* out = out_scratch.get(size);
+    const int rc = compress2(out, &size, planes, uLong(bytes), 6);
     LAMINA_CHECK(rc == Z_OK);
-    out.resize(size);
-    return out;
+    return std::string(reinterpret_cast<const char*>(out), size);
 }
 
 void unpack_elements(std::string_view packed, void* out, std::size_t count, std::size_t width,
                      std::size_t n, std::size_t channels, const std::string& where) {
     if (!((width == 2 || width == 4) && n >= 1 && channels >= 1 && count % (n * channels) == 0))
         throw InputError(where, "shape", "not a packed array's layout");
-    std::string planes(count * width, '\0');
-    uLongf size = uLongf(planes.size());
-    const int rc = uncompress(reinterpret_cast<Bytef*>(planes.data()), &size,
-                              reinterpret_cast<const Bytef*>(packed.data()), uLong(packed.size()));
-    if (rc != Z_OK || size != planes.size())
+    thread_local std::vector<unsigned char> planes_buffer;
+    Scratch planes_scratch(planes_buffer);
+    const std::size_t bytes = count * width;
+    unsigned char* planes = planes_scratch.get(bytes);
+    uLongf size = uLongf(bytes);
+    const int rc = uncompress(planes, &size, reinterpret_cast<const Bytef*>(packed.data()),
+                              uLong(packed.size()));
+    if (rc != Z_OK || size != bytes)
         throw InputError(where, "data",
-                         rc == Z_BUF_ERROR || (rc == Z_OK && size != planes.size())
+                         rc == Z_BUF_ERROR || (rc == Z_OK && size != bytes)
                              ? fmt::format("the packed data does not hold the {} values of the "
                                            "header's shape",
                                            count)
@@ -119,10 +154,12 @@ std::string packed_array_file(const std::vector<float>& data, const std::vector<
     const std::size_t n = shape[shape.size() - 2], channels = shape.back();
     std::string packed;
     if (half) {
-        std::vector<std::uint16_t> bits(data.size());
+        thread_local std::vector<std::uint16_t> bits_buffer;
+        Scratch scratch(bits_buffer);
+        std::uint16_t* bits = scratch.get(data.size());
         for (std::size_t i = 0; i < data.size(); ++i)
             bits[i] = float_to_half(data[i]);
-        packed = pack_elements(bits.data(), bits.size(), 2, n, channels);
+        packed = pack_elements(bits, data.size(), 2, n, channels);
     } else {
         packed = pack_elements(data.data(), data.size(), 4, n, channels);
     }
@@ -161,8 +198,10 @@ NpyFloat32 parse_packed_array(std::string_view bytes, const std::string& where) 
     const std::string_view packed = bytes.substr(eol + 1);
     a.data.resize(count);
     if (a.half) {
-        std::vector<std::uint16_t> bits(count);
-        unpack_elements(packed, bits.data(), count, 2, n, channels, where);
+        thread_local std::vector<std::uint16_t> bits_buffer;
+        Scratch scratch(bits_buffer);
+        std::uint16_t* bits = scratch.get(count);
+        unpack_elements(packed, bits, count, 2, n, channels, where);
         for (std::size_t i = 0; i < count; ++i)
             a.data[i] = half_to_float(bits[i]);
     } else {
