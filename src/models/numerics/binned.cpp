@@ -18,6 +18,9 @@ constexpr double kG3[3] = {0.5 - 0.3872983346207417, 0.5, 0.5 + 0.38729833462074
 constexpr double kW3[3] = {5.0 / 18, 8.0 / 18, 5.0 / 18};
 constexpr double kMinDtheta = 1e-9, kMinDphi = 1e-8;
 constexpr double kPoleTheta = 1e-9;
+// Forced levels over which the rectangles next to a peak's are split with it: down to 1/16384 of
+// a 1° bin, ~10⁻⁶ rad, below the width of the sharpest lobe a stack may have (α = 10⁻⁴) at grazing.
+constexpr int kNeighbourDepth = 14;
 
 struct Peak {
     double theta, phi;
@@ -94,16 +97,19 @@ class RectIntegrator {
     /// of weight fraction a then adds at most a·τ to the error, so the sum stays within τ).
     Rgbd average(const ThetaRange& t, const PhiRange& p) {
         evals_ = 0;
+        // The budget per 1° × 2° of (θ, φ), a bin of the default grid: a larger rectangle has
+        // longer discontinuities and more room for peaks.
+        constexpr double kBudgetArea = (kPi<double> / 180) * (kPi<double> / 90);
+        budget_ = std::max(double(o_.eval_budget),
+                           double(o_.eval_budget) * (t.hi - t.lo) * (p.hi - p.lo) / kBudgetArea);
         const std::pair<Rgbd, Rgbd> whole = rule(t, p);
         const Rgbd coarse = whole.second;
-        tol_ = o_.rel_tol * max_abs(coarse) + o_.abs_tol;
         // The top level reuses the coarse rule's nodes: the same values, not evaluated twice.
-        const Rgbd first = rect(t, p, 0, 0, &whole);
+        const Rgbd first = refine(t, p, o_.rel_tol * max_abs(coarse) + o_.abs_tol, &whole);
         // A narrow lobe missed by the coarse nodes made τ far too strict: redo with the real size.
         if (max_abs(first) > 10 * max_abs(coarse)) {
             evals_ = 0;
-            tol_ = o_.rel_tol * max_abs(first) + o_.abs_tol;
-            return rect(t, p, 0, 0);
+            return refine(t, p, o_.rel_tol * max_abs(first) + o_.abs_tol);
         }
         return first;
     }
@@ -143,37 +149,60 @@ class RectIntegrator {
         return {i5 / w5, i3 / w3};
     }
 
-    /// Which coordinates must be split to approach a peak inside the (closed) rectangle.
-    void peak_split(double t0, double t1, double p0, double p1, bool& split_t,
+    /// Which coordinates must be split to approach a peak inside the (closed) rectangle or, for
+    /// the first kNeighbourDepth levels, inside the block of 3 × 3 rectangles of its size around
+    /// it. Without the neighbours a lobe narrower than the node spacing leaks past the edge of the
+    /// rectangle that holds its peak into one whose nodes all miss it: at grazing a sharp lobe is
+    /// narrow in φ and wider in θ (α = 0.001 at 85°: the rectangles along the peak's row missed
+    /// 0.4 % of the light, 3.6 % with rel_tol 10⁻³, against the model's own sampling).
+    void peak_split(double t0, double t1, double p0, double p1, int peak_depth, bool& split_t,
                     bool& split_phi) const {
         split_t = split_phi = false;
+        const double margin = peak_depth < kNeighbourDepth ? 1.0 : 0.0;
+        const double mt = margin * (t1 - t0), mp = margin * (p1 - p0);
         for (const Peak& pk : peaks_) {
             if (pk.pole) {
                 if (t0 <= kPoleTheta && t1 - t0 > kMinDtheta) split_t = true;
                 continue;
             }
-            if (pk.theta < t0 || pk.theta > t1 || pk.phi < p0 || pk.phi > p1) continue;
+            if (pk.theta < t0 - mt || pk.theta > t1 + mt || pk.phi < p0 - mp || pk.phi > p1 + mp)
+                continue;
             if (t1 - t0 > kMinDtheta) split_t = true;
             if (p1 - p0 > kMinDphi) split_phi = true;
         }
     }
 
-    Rgbd rect(const ThetaRange& t, const PhiRange& p, int depth, int peak_depth,
-              const std::pair<Rgbd, Rgbd>* known = nullptr) {
-        const auto [i2, i3] = known ? *known : rule(t, p);
+    /// A sub-rectangle not split (yet): its 3×3 value and its error estimate.
+    struct Cell {
+        ThetaRange t;
+        PhiRange p;
+        int depth, peak_depth;
+        double weight;
+        Rgbd value;
+        double error;           ///< |3×3 − degree-3| (largest channel)
+        double weighted_error;  ///< error × weight: the split order
+    };
+
+    /// Splits the rectangle towards the peaks inside it (forced splits, which do not count as
+    /// depth) and adds its leaves to cells_; `known` is its rule's result when already evaluated.
+    void add_cells(const ThetaRange& t, const PhiRange& p, int depth, int peak_depth,
+                   const std::pair<Rgbd, Rgbd>* known = nullptr) {
         bool split_t = false, split_phi = false;
-        if (peak_depth < o_.peak_depth) peak_split(t.lo, t.hi, p.lo, p.hi, split_t, split_phi);
-        const bool forced = split_t || split_phi;
-        if (!forced && depth < o_.max_depth && evals_ < o_.eval_budget && max_abs(i3 - i2) > tol_)
-            split_t = split_phi = true;
-        if (!split_t && !split_phi) return i3;
-        const int nd = forced ? depth : depth + 1;
-        const int np = forced ? peak_depth + 1 : peak_depth;
-        // Children are combined with their exact weights (fractions of ∫ |cos θ| dω).
-        auto part = [&](const ThetaRange& a, const PhiRange& b) {
-            return rect(a, b, nd, np) * measure(a, b);
-        };
-        Rgbd sum(0.0);
+        if (peak_depth < o_.peak_depth)
+            peak_split(t.lo, t.hi, p.lo, p.hi, peak_depth, split_t, split_phi);
+        if (split_t || split_phi) {
+            split(t, p, split_t, split_phi, depth, peak_depth + 1);
+            return;
+        }
+        const auto [i2, i3] = known ? *known : rule(t, p);
+        const double weight = measure(t, p);
+        const double error = max_abs(i3 - i2);
+        cells_.push_back({t, p, depth, peak_depth, weight, i3, error, weight * error});
+    }
+
+    /// The children of [t] × [p], halved in θ, φ or both, added by add_cells.
+    void split(const ThetaRange& t, const PhiRange& p, bool split_t, bool split_phi, int depth,
+               int peak_depth) {
         if (split_t) {
             const double tm = 0.5 * (t.lo + t.hi), sin_tm = std::sin(tm);
             const ThetaRange lower = theta_range(t.lo, tm, t.sin_lo, sin_tm);
@@ -181,17 +210,64 @@ class RectIntegrator {
             if (split_phi) {
                 const double pm = 0.5 * (p.lo + p.hi);
                 const PhiRange left = phi_range(p.lo, pm), right = phi_range(pm, p.hi);
-                sum =
-                    part(lower, left) + part(upper, left) + part(lower, right) + part(upper, right);
+                add_cells(lower, left, depth, peak_depth);
+                add_cells(upper, left, depth, peak_depth);
+                add_cells(lower, right, depth, peak_depth);
+                add_cells(upper, right, depth, peak_depth);
             } else {
-                sum = part(lower, p) + part(upper, p);
+                add_cells(lower, p, depth, peak_depth);
+                add_cells(upper, p, depth, peak_depth);
             }
         } else {
             const double pm = 0.5 * (p.lo + p.hi);
-            sum = part(t, phi_range(p.lo, pm)) + part(t, phi_range(pm, p.hi));
+            add_cells(t, phi_range(p.lo, pm), depth, peak_depth);
+            add_cells(t, phi_range(pm, p.hi), depth, peak_depth);
         }
-        const double m = measure(t, p);
-        return m > 0 ? sum / m : i3;
+    }
+
+    /// The rectangle's average by adaptive bisection, best first: a leaf whose error estimate
+    /// exceeds tol is bisected in both coordinates (up to max_depth), the one with the largest
+    /// weighted error first, until every leaf is within tol or the evaluation budget is spent.
+    /// Within the budget the leaves are those of depth-first bisection (the criterion is each
+    /// leaf's own); where the budget binds — the integrand jumps along a curve, where the error
+    /// of the cells along it does not shrink as they do — it has been spent evenly along the
+    /// curve, from the largest cells down, rather than on one part of it to max_depth.
+    Rgbd refine(const ThetaRange& t, const PhiRange& p, double tol,
+                const std::pair<Rgbd, Rgbd>* known = nullptr) {
+        cells_.clear();
+        add_cells(t, p, 0, 0, known);
+        const double total_weight = measure(t, p);
+        // A max-heap of the leaves to split by weighted error (ties to the earlier cell, so the
+        // order is fixed), over indices into cells_; a split leaf's weight becomes 0.
+        auto before = [this](std::size_t a, std::size_t b) {
+            const double ea = cells_[a].weighted_error, eb = cells_[b].weighted_error;
+            return ea < eb || (ea == eb && a > b);
+        };
+        heap_.clear();
+        auto push_from = [&](std::size_t first) {
+            for (std::size_t k = first; k < cells_.size(); ++k)
+                if (cells_[k].depth < o_.max_depth && cells_[k].error > tol) {
+                    heap_.push_back(k);
+                    std::push_heap(heap_.begin(), heap_.end(), before);
+                }
+        };
+        push_from(0);
+        while (!heap_.empty() && double(evals_) < budget_) {
+            std::pop_heap(heap_.begin(), heap_.end(), before);
+            const std::size_t k = heap_.back();
+            heap_.pop_back();
+            const Cell cell = cells_[k];
+            cells_[k].weight = 0;  // replaced by its children
+            const std::size_t first = cells_.size();
+            split(cell.t, cell.p, true, true, cell.depth + 1, cell.peak_depth);
+            push_from(first);
+        }
+        if (cells_.size() == 1) return cells_.front().value;
+        // Leaves combined with their exact weights (fractions of ∫ |cos θ| dω), in creation order.
+        Rgbd sum(0.0);
+        for (const Cell& c : cells_)
+            if (c.weight > 0) sum += c.value * c.weight;
+        return total_weight > 0 ? sum / total_weight : cells_.front().value;
     }
 
     const IncidentEvaluator& f_;
@@ -199,7 +275,9 @@ class RectIntegrator {
     std::vector<Peak> peaks_;
     BinnedOptions o_;
     long evals_ = 0;
-    double tol_ = 0;
+    double budget_ = 0;  ///< evaluations for this rectangle (eval_budget scaled to its size)
+    std::vector<Cell> cells_;
+    std::vector<std::size_t> heap_;
 };
 
 /// The peaks on `side` in the rectangles' coordinates: φ folded into [0, π], or unfolded in

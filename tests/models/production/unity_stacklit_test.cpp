@@ -221,8 +221,8 @@ double max_albedo(bool per_view) {
 // StackLit does not conserve energy either way (docs/models.md, measured over the sweep at θ ≤
 // 80°): per view (the light arriving at wo from every wi) up to 1.483 (η0 = 2, α0 = 0.5 over a
 // near-mirror metal, view at 80°: the adding roughens the base lobe at grazing views and its
-// compensation 1 + F0 (1/E − 1) multiplies it by up to 2.5); per incidence up to 1.379 (η0 = 2,
-// smooth coat over gold α1 = 0.4, light at 80°).
+// compensation 1 + F0 (1/E − 1) multiplies it by up to 2.5); per incidence up to 1.418 (η0 = 2,
+// smooth coat over gold α1 = 0.4, light at 80°; the model's own sampling gives 1.4180 ± 0.0005).
 // The bounds hold the measured values within the quadrature's 1e-3.
 TEST(UnityStackLit, EnergyAsMeasured) {
     const double per_view = max_albedo(true), forward = max_albedo(false);
@@ -231,8 +231,8 @@ TEST(UnityStackLit, EnergyAsMeasured) {
         forward);
     EXPECT_GT(per_view, 1.47);
     EXPECT_LT(per_view, 1.49);
-    EXPECT_GT(forward, 1.37);
-    EXPECT_LT(forward, 1.39);
+    EXPECT_GT(forward, 1.41);
+    EXPECT_LT(forward, 1.43);
 }
 
 // Not reciprocal: the statistics, the energies and the compensation follow the view alone
