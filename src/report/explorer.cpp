@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -700,33 +701,63 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
         }
     }
     ConfigIncidences unfolded;
+    // Each configuration's stamp first, then the ones to encode again side by side over the
+    // threads (each reads its own files), then their scripts and index entries in order.
+    struct Item {
+        std::string id, digest;
+        json entry;
+        bool unchanged = false;
+    };
+    std::vector<Item> items;
     for (const json& c : configurations) {
-        const std::string id = field<std::string>(c, "id", study_path);
+        Item item;
+        item.id = field<std::string>(c, "id", study_path);
+        const std::string& id = item.id;
         if (c.contains("incidences") && c["incidences"].is_array())
             for (const json& inc : c["incidences"])
                 if (inc.is_array() && inc.size() == 2 && inc[0].is_number() && inc[1].is_number())
                     unfolded[id].push_back({inc[0].get<double>(), inc[1].get<double>()});
-        json entry = {{"id", id},
+        item.entry = {{"id", id},
                       {"category", c.value("category", "custom")},
                       {"parameters", c.value("parameters", json::object())}};
-        const fs::path dir = study_dir / "configs" / id;
-        const std::string digest = inputs_digest(dir, entry, theta_i, n_theta, n_phi);
+        item.digest =
+            inputs_digest(study_dir / "configs" / id, item.entry, theta_i, n_theta, n_phi);
         const fs::path script = study_dir / "explorer" / "data" / (id + ".js");
         if (stamps.contains(id) && stamps[id].is_object() &&
-            stamps[id].value("digest", "") == digest && stamps[id].contains("entry") &&
+            stamps[id].value("digest", "") == item.digest && stamps[id].contains("entry") &&
             fs::exists(script)) {
-            entry = stamps[id]["entry"];
+            item.entry = stamps[id]["entry"];
+            item.unchanged = true;
             summary.data_bytes += fs::file_size(script);
             ++summary.unchanged;
-        } else {
-            ConfigData d = encode_configuration(dir, id, theta_i, n_theta, n_phi, entry);
-            entry["albedo"] = d.albedo;
-            entry["albedo_se"] = d.albedo_se;
-            summary.data_bytes += d.script.size();
-            data_out.add_if_changed(id + ".js", d.script);
         }
-        new_stamps[id] = {{"digest", digest}, {"entry", entry}};
-        index["configs"].push_back(entry);
+        items.push_back(std::move(item));
+    }
+    std::vector<std::optional<ConfigData>> encoded(items.size());
+    std::vector<std::exception_ptr> failures(items.size());
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long k = 0; k < long(items.size()); ++k) {
+        Item& item = items[std::size_t(k)];
+        if (item.unchanged) continue;
+        try {
+            encoded[std::size_t(k)] = encode_configuration(study_dir / "configs" / item.id, item.id,
+                                                           theta_i, n_theta, n_phi, item.entry);
+        } catch (...) {
+            failures[std::size_t(k)] = std::current_exception();
+        }
+    }
+    for (std::size_t k = 0; k < items.size(); ++k) {
+        if (failures[k]) std::rethrow_exception(failures[k]);
+        Item& item = items[k];
+        if (encoded[k]) {
+            const ConfigData& d = *encoded[k];
+            item.entry["albedo"] = d.albedo;
+            item.entry["albedo_se"] = d.albedo_se;
+            summary.data_bytes += d.script.size();
+            data_out.add_if_changed(item.id + ".js", d.script);
+        }
+        new_stamps[item.id] = {{"digest", item.digest}, {"entry", item.entry}};
+        index["configs"].push_back(item.entry);
         ++summary.configurations;
     }
     index["metrics"] = read_metrics(study_dir / "metrics.csv", theta_i, unfolded);

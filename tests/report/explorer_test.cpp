@@ -7,12 +7,14 @@
 #include "core/packed_array.h"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -160,6 +162,48 @@ TEST_P(ExplorerTables, WritesPageDataAndAlbedos) {
     // No staging folder is left behind.
     for (const auto& e : fs::recursive_directory_iterator(d))
         EXPECT_EQ(e.path().filename().string().rfind(".staging", 0), std::string::npos) << e.path();
+}
+
+// The configurations are encoded side by side over the threads: the page's data are the same for
+// one thread as for three, and the index keeps the study's order.
+TEST(Explorer, PageDataDoNotDependOnTheThreadCount) {
+    std::map<int, std::map<std::string, std::string>> pages;
+    for (int threads : {1, 3}) {
+        const fs::path d = fresh_dir("threads");  // the same folder: its name is the page's title
+        std::string configs;
+        for (int k = 5; k >= 1; --k) {  // listed in reverse: the index must keep this order
+            const std::string id = fmt::format("c{}", k);
+            configs += fmt::format(R"({}{{"id": "{}", "category": "plastic", "sides": ["R"]}})",
+                                   configs.empty() ? "" : ",", id);
+            write_text(d / "configs" / id / "config.json",
+                       R"({"sources": ["reference", "ww09"], "sides": ["R"],
+                           "supported": {"ww09": {"R": true, "T": false, "reason": ""}}})");
+            std::vector<float> tables(2 * 2 * 2 * 3);
+            for (std::size_t j = 0; j < tables.size(); ++j)
+                tables[j] = float((1 + k * (j % 5)) / M_PI);
+            write_table(d / "configs" / id / "tables", {2, 1, 1, 2, 2, 3}, tables, true);
+            write_table(d / "configs" / id / "reference_se", {1, 1, 2, 2, 3},
+                        std::vector<float>(12, 0.01f * float(k)), true);
+        }
+        write_text(d / "study.json", R"({"theta_i": [30], "grid": {"n_theta": 2, "n_phi": 2},
+            "models": ["ww09"], "preset": "test", "configurations": [)" +
+                                         configs + "]}");
+        write_text(d / "metrics.csv",
+                   "config,category,model,theta_i,side,channel,misplaced_energy,misplaced_floor,"
+                   "albedo_ref,albedo_model,albedo_error,rmse,log_rmse,noise_floor,"
+                   "misplaced_floor_noise,supported\n");
+        omp_set_num_threads(threads);
+        write_explorer(d);
+        omp_set_num_threads(omp_get_num_procs());
+        for (const auto& e : fs::directory_iterator(d / "explorer" / "data"))
+            pages[threads][e.path().filename().string()] = read_text(e.path());
+    }
+    EXPECT_EQ(pages[1].size(), 7u);  // five configurations, the index, the stamps
+    for (const auto& [name, text] : pages[1]) {
+        EXPECT_EQ(pages[3][name], text) << name;
+    }
+    const std::string& index = pages[3]["index.js"];
+    EXPECT_LT(index.find(R"("id":"c5")"), index.find(R"("id":"c1")"));
 }
 
 TEST_P(ExplorerTables, TableShapeMismatchNamesTheFile) {
