@@ -102,7 +102,7 @@ void untransform(const unsigned char* planes, U* v, std::size_t count, std::size
 // before it (so matches reach back across chunk edges as they would in one stream) and ended by a
 // sync flush (an empty stored block that realigns to a byte), the last by the final block; the
 // zlib header and the Adler-32 of the whole input go around them. The chunks do not depend on the
-// thread count, so neither do the bytes; the ratio is within 0.1 % of one stream's.
+// thread count, so neither do the bytes; they are about 0.4 % more than one stream's.
 std::string deflate_chunked(const unsigned char* data, std::size_t size) {
     constexpr std::size_t kChunk = std::size_t(1) << 20, kWindow = std::size_t(1) << 15;
     const std::size_t n = std::max<std::size_t>(1, (size + kChunk - 1) / kChunk);
@@ -134,7 +134,7 @@ std::string deflate_chunked(const unsigned char* data, std::size_t size) {
     std::string stream = {char(0x78), char(0x9c)};  // deflate, 32 KiB window, default level
     for (const std::string& part : parts)
         stream += part;
-    const uLong adler = adler32(adler32(0, nullptr, 0), data, uInt(size));
+    const uLong adler = adler32_z(adler32(0, nullptr, 0), data, size);
     for (int shift = 24; shift >= 0; shift -= 8)
         stream += char((adler >> shift) & 0xff);
     return stream;
