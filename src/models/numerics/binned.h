@@ -17,15 +17,15 @@
 // to max_depth), and the 3×3 value of accepted rectangles is kept; the difference estimates the
 // error of the lower-degree rule, so the kept value is conservative. The rectangles are split
 // best first — the largest error times weight next — within an evaluation budget per bin (in
-// proportion to its size in (θ, φ)): within
-// it the accepted rectangles are those of plain recursive bisection; where a model's value jumps
-// along a curve (a cut-off such as total internal reflection inside a bin), the rectangles along
-// the curve keep their error however small they get, and the budget is then spent evenly along
-// it rather than on one end to max_depth. A rectangle that contains one of the model's
-// peak directions (mirror; refracted for a BTDF) is always bisected towards it, down to a size of
-// ~1e-10 in u, and for the first levels so are the rectangles next to it (a sharp lobe at grazing
-// is narrow in φ and wider in θ, and leaks into them): a lobe of α = 0.001 inside one bin is then
-// resolved even though no coarse node sees it. Delta lobes add energy / Ω⊥ to the bin they hit.
+// proportion to its size in (θ, φ)): within it the accepted rectangles are those of plain
+// recursive bisection; where a model's value jumps along a curve (a cut-off such as total
+// internal reflection inside a bin), the rectangles along the curve keep their error however
+// small they get, and the budget is then spent evenly along it rather than on one end to
+// max_depth. A rectangle that contains one of the model's peak directions (mirror; refracted for
+// a BTDF) is always bisected towards it, down to a size of ~1e-10 in u, and for the first levels
+// so are the rectangles next to it (a sharp lobe at grazing is narrow in φ and wider in θ, and
+// leaks into them): a lobe of α = 0.001 inside one bin is then resolved even though no coarse
+// node sees it. Delta lobes add energy / Ω⊥ to the bin they hit.
 // Parallel over (incidence, side, θ row) with OpenMP, each row through the incidence's evaluator
 // for one thread where the model has one (IncidentEvaluator::for_one_thread: the same values, bit
 // for bit); every bin is computed independently, so the output does not depend on the thread count.
