@@ -133,7 +133,7 @@ class Bsdf {
     RgbEdgeCurve<33> precompute_albedos();
     void precompute_mean_direction();
     void precompute_series(const RgbEdgeCurve<33>& g_curve);
-    Rgb first_order_energy(double mu) const;
+    Rgb first_order_energy(double mu, bool of_round_trip = false) const;
     Rgb returned_light(double mu, const RgbEdgeCurve<33>& g_curve, const Rgb& Y_ms) const;
     void precompute_returned(const RgbEdgeCurve<33>& g_curve);
     void precompute_scattering();
@@ -181,6 +181,7 @@ class Bsdf {
     Rgb first_order(const Incident& in, const Vec3& wo, const Vec3& wo_in, const Rgb& a_o,
                     LobeForm form) const;
     Rgb base_lobe(const Incident& in, double mu_o, const Vec3& wo_in, LobeForm form) const;
+    Rgb round_trip(const Incident& in, const Vec3& wo, const Vec3& wo_in, const Rgb& a_o) const;
     double first_order_ndf(const Vec3& h, double k_i, double k_o, bool anisotropic) const;
 
     // Sampling (lamina1/sampling.h): the mixture for one incidence, lobe probabilities (top
@@ -222,6 +223,15 @@ class Bsdf {
     double effective_alpha(double k_i, double k_o) const {
         if (ch_.spread == Options::Spread::Off) return alpha1_;
         return std::sqrt(sqr(alpha1_) + 0.25 * sqr(alpha0_) * (sqr(k_i) + sqr(k_o)));
+    }
+
+    /// The first round trip's lobe width: α_r² = α_e² + α1² + α0². The base reflects the light
+    /// twice (each reflection turns it by twice its facet's tilt, the mirror direction's half
+    /// vector by the tilt: GGX slopes of scale α1) and the coat's bottom once (the same with its
+    /// own facets, scale α0), between the coat's two refractions of α_e; independent spreads
+    /// add in variance, as in effective_alpha.
+    double round_trip_alpha(double k_i, double k_o) const {
+        return std::sqrt(sqr(effective_alpha(k_i, k_o)) + sqr(alpha1_) + sqr(alpha0_));
     }
 
     /// The widened base lobe as a GGX distribution: of α_e (effective_alpha), or, where an
@@ -460,6 +470,11 @@ class Bsdf {
     CosineCurve<double, kNnorm> lobe_norm_;
     /// √(1/(1 − a² R_in E_b (1 − u))) over inside cosines: the first order's round trips.
     CosineCurve<Rgb> mirror_series_curve_;
+    /// The first round trip's lobe (Options::round_trip_lobe, where the series is summed over a
+    /// conductor smoother than the coat; never with the mirror series), and √(a² E_b R_in) over
+    /// inside cosines: what one round trip keeps, split between its two ends.
+    bool round_trip_on_ = false;
+    CosineCurve<Rgb> round_trip_curve_;
     CosineCurve<double> dR_top_, dE_base_;
     double dR_top_bar_ = 1, dE_base_bar_ = 1;
     Rgb F_ms_{1.0};

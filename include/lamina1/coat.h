@@ -374,6 +374,71 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
     balance_ = ch_.first_order_balance && alpha0_ > 0 && ch_.directional_transmittance &&
                layers_.base != Base::Lambertian;
     precompute_returned(g_curve);
+    // The first round trip as a lobe of its own (Options::round_trip_lobe): where the series is
+    // summed over a conductor smoother than the coat (the orders ≥ 2 restored; a rough coat, the
+    // directional transmittance), the returned light leaves near the mirror direction, not as
+    // uniform radiance (docs/models.md, lamina-1, item 3). The lobe keeps √(a² E_b R_in) at each
+    // end; its energy E_r(μ) is taken from the series, X ← X − E_r/G with G = Ē_b t̄/(1 − Ē_b r̄)
+    // the energy the series lets out per unit of X, so that the total is the series' alone.
+    // Where the series holds less than the lobe would carry (E_r > X G: at normal incidence
+    // under a nearly smooth or index-near coat, where the first order's balance leaves little
+    // to return), the lobe is scaled to the series' energy, by √c(μ) at each end, c = X G/E_r
+    // (at the mirror pair, where the lobe is, its energy then scales by c), and E_r is taken
+    // again with the scaled lobe; on every other node of X's, interpolated between.
+    round_trip_on_ = ch_.round_trip_lobe && layers_.base == Base::Conductor && alpha1_ < alpha0_ &&
+                     alpha0_ > 0 && ch_.directional_transmittance;
+    if (round_trip_on_) {
+        round_trip_curve_.fill([&](double mu) {
+            const Rgb a = attenuation(mu);
+            const Rgb kept = a * a * base_albedo(mu) * inside_reflectance(mu);
+            Rgb r;
+            for (int c = 0; c < 3; ++c)
+                r[c] = std::sqrt(std::max(kept[c], 0.0));
+            return r;
+        });
+        Rgb gain(0.0), inv_gain(0.0);
+        for (int c = 0; c < 3; ++c) {
+            const double one_minus = 1 - E_bar_[c] * r_bar_[c];
+            gain[c] = one_minus > 0 ? E_bar_[c] * t_bar_[c] / one_minus : 0.0;
+            inv_gain[c] = gain[c] > 0 ? 1 / gain[c] : 0.0;
+        }
+        const CosineCurve<Rgb, kNx> X_series = X_;
+        CosineCurve<Rgb, (kNx + 1) / 2> share, E_r;
+        E_r.fill([&](double mu) { return first_order_energy(mu, true); });
+        // Scaled until the series holds the lobe's energy: one pass where it does (the study's
+        // frosted metals), up to three more where the lobe is broad and c varies across it.
+        for (int pass = 0; pass < 3; ++pass) {
+            bool over = false;
+            share.fill([&](double mu) {
+                const Rgb E = E_r(mu), held = X_series(mu) * gain;
+                Rgb c(1.0);
+                for (int k = 0; k < 3; ++k)
+                    if (E[k] > held[k] * (1 + 1e-9)) {
+                        c[k] = std::max(held[k], 0.0) / E[k];
+                        over = true;
+                    }
+                return c;
+            });
+            if (!over) break;
+            const CosineCurve<Rgb> unscaled = round_trip_curve_;
+            round_trip_curve_.fill([&](double mu_in) {
+                // The outside cosine whose refraction this is (inside the exit cone; 0 beyond).
+                const double mu = safe_sqrt(1 - (1 - mu_in * mu_in) * sqr(eta0_));
+                Rgb r = unscaled(mu_in);
+                const Rgb c = share(mu);
+                for (int k = 0; k < 3; ++k)
+                    r[k] *= std::sqrt(std::max(c[k], 0.0));
+                return r;
+            });
+            E_r.fill([&](double mu) { return first_order_energy(mu, true); });
+        }
+        X_.fill([&](double mu) {
+            Rgb out = X_series(mu) - E_r(mu) * inv_gain;
+            for (int c = 0; c < 3; ++c)
+                out[c] = std::max(out[c], 0.0);
+            return out;
+        });
+    }
     // X̄ = (2/η0²)∫ X(μ) μ dμ: the diffuse exit's normalization.
     X_bar_ = integrate_split01<kGauss, Rgb>([&](double mu) { return X_at(mu) * (2 * mu); }, 0.0) *
              sqr(inv_eta0_);
@@ -393,15 +458,17 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
 /// 4 μi'/(G1(wi') D(wm)); the base's separable multiple-scattering part, broad, by a 1-D rule.
 /// Like X, a curve in μ alone: under anisotropic interfaces, the lobe of their root mean square
 /// roughnesses (isotropic, so the rule's half disk of visible normals is exact and the balance
-/// turns with the tangents).
-inline Rgb Bsdf::first_order_energy(double mu) const {
+/// turns with the tangents). `of_round_trip`: the same for the first round trip's lobe (GGX of
+/// α_r(k_i, k_i) as the rule's), which has no separable part.
+inline Rgb Bsdf::first_order_energy(double mu, bool of_round_trip) const {
     Incident in;
     in.wi = Vec3(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
     in.wi_in = refract_in(in.wi, inv_eta0_);
     if (!(in.wi_in.z > 0)) return Rgb(0.0);
     incident_coat(in);
     const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
-    const GGX fixed{effective_alpha(in.k_top, in.k_top)};
+    const GGX fixed{of_round_trip ? round_trip_alpha(in.k_top, in.k_top)
+                                  : effective_alpha(in.k_top, in.k_top)};
     if (!(fixed.alpha > 0)) return Rgb(0.0);
     constexpr LobeForm kSpecular{true, false, false}, kMultiple{false, true, false};
     const Vec3 w = in.wi_in;
@@ -417,10 +484,12 @@ inline Rgb Bsdf::first_order_energy(double mu) const {
             const double density = g1 * fixed.D(wm);
             if (!(density > 0)) return Rgb(0.0);
             const Vec3 wo = outside(wo_in);
-            return first_order(in, wo, wo_in, coat_attenuation(wo.z, wo_in.z), kSpecular) *
+            const Rgb a_o = coat_attenuation(wo.z, wo_in.z);
+            return (of_round_trip ? round_trip(in, wo, wo_in, a_o)
+                                  : first_order(in, wo, wo_in, a_o, kSpecular)) *
                    (sqr(eta0_) * wo_in.z * 4 * w.z / density);
         });
-    if (base_ms_) {
+    if (base_ms_ && !of_round_trip) {
         // f_1 of the separable lobe is F_ms ΔE(μi') ΔE(μo')/(π ΔĒ) times the coat's factors.
         const Rgb ms = integrate_split01<kGauss, Rgb>(
             [&](double mu_in) {

@@ -111,6 +111,7 @@ inline Rgb Bsdf::eval_with(const Incident& in, const Vec3& wo) const {
     if (series_on_) {
         f += in.X * X_at(wo.z) * K_ * (kInvPi * inv_eta0_ * inv_eta0_);
     }
+    if (round_trip_on_) f += round_trip(in, wo, wo_in, a_o);
     if (bins_) f += bins_reflection(in, wo);
     // The medium's terms take the light along the macro refractions (their depth integrals).
     if (scatters_) f += scattered(in, wo, wo_in, a_coat_on_ ? attenuation(wo_in.z) : a_o);
@@ -136,6 +137,27 @@ inline Rgb Bsdf::first_order(const Incident& in, const Vec3& wo, const Vec3& wo_
     Rgb rounds(1.0);
     if (mirror_series_) rounds = mirror_series_curve_(in.wi_in.z) * mirror_series_curve_(wo_in.z);
     return fb * (in.a * a_o) * rounds *
+           (in.T_pair * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
+}
+
+/// The first round trip's lobe (Options::round_trip_lobe; docs/models.md, lamina-1, item 3): the
+/// light the first order's exit leaves inside goes back to the coat's bottom, which reflects it
+/// to the base, which sends it out. A Walter lobe of the base at the refracted pair (wi', wo')
+/// with the GGX of α_r (round_trip_alpha: the base's two reflections and the coat bottom's one
+/// widen the first order's α_e), entering and leaving as the first order does (T_pair, T_exit,
+/// a, 1/η0²), times what the round trip keeps, a² E_b R_in, as √ of it at each end: symmetric
+/// in (wi, wo), as the mirror series' factor is.
+inline Rgb Bsdf::round_trip(const Incident& in, const Vec3& wo, const Vec3& wo_in,
+                            const Rgb& a_o) const {
+    if (!(in.wi_in.z > 0 && wo_in.z > 0)) return Rgb(0.0);
+    const double k_o = spread_factor(wo.z, wo_in.z, eta0_);
+    const GGX ggx{round_trip_alpha(in.k_top, k_o)};
+    const Vec3 h = normalize(in.wi_in + wo_in);
+    const Rgb fb = base_fresnel(dot(in.wi_in, h)) *
+                   (ggx.D(h) * ggx.G2(in.wi_in, wo_in) / (4 * in.wi_in.z * wo_in.z));
+    double T_o = T_top_(wo.z);
+    if (inside_exit_) T_o = std::sqrt(T_o * exit_transmittance(wo.z, wo_in.z, k_o));
+    return fb * (in.a * a_o) * round_trip_curve_(in.wi_in.z) * round_trip_curve_(wo_in.z) *
            (in.T_pair * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
 }
 

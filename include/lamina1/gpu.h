@@ -33,7 +33,7 @@ constexpr int kGpuTTop = kGpuScalars;                      // T(μ): below[kNmu]
 constexpr int kGpuTTopIn = kGpuTTop + 2 * kNmu;            // T_in(μ'): the same
 constexpr int kGpuX = kGpuTTopIn + 2 * kNmu;               // X(μ): kNx × RGB
 constexpr int kGpuLobeNorm = kGpuX + 3 * kNx;              // 1/√N(μ'): kNnorm
-constexpr int kGpuMirrorSeries = kGpuLobeNorm + kNnorm;    // kNmu × RGB
+constexpr int kGpuMirrorSeries = kGpuLobeNorm + kNnorm;    // kNmu × RGB (or the round trip's)
 constexpr int kGpuEntering = kGpuMirrorSeries + 3 * kNmu;  // sin δ, cos δ, weight: 3 × 129
 constexpr int kGpuLeaving = kGpuEntering + 3 * FacetDeflection::kN;
 constexpr int kGpuBaseAlbedo = kGpuLeaving + 3 * FacetDeflection::kN;  // Ē_b(μ'): kNmu
@@ -82,6 +82,9 @@ enum GpuFlag : unsigned {
     kGpuBaseOrders = 1u << 17,       ///< the base's: F_ms ΔE(μi') ΔE(μo')/(π ΔĒ)
     kGpuBinsOn = 1u << 18,           ///< a slab's inside light in bins, from kGpuBinsCuts on
     kGpuCoatSpread = 1u << 19,       ///< a rough absorbing coat's a(μ) (Bsdf::coat_attenuation)
+    /// The first round trip's lobe (Bsdf::round_trip), its curve at kGpuMirrorSeries (the mirror
+    /// series is never on with it).
+    kGpuRoundTrip = 1u << 20,
 };
 
 inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
@@ -117,6 +120,7 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     flag(base_ms_, kGpuBaseOrders);
     flag(bins_, kGpuBinsOn);
     flag(a_coat_on_, kGpuCoatSpread);
+    flag(round_trip_on_, kGpuRoundTrip);
     v[0] = float(flags);  // exact in float32 (fewer than 2^24)
     v[1] = float(int(layers_.base));
     v[2] = float(eta0_);
@@ -149,8 +153,9 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
         v[kGpuTTop + kNmu + i] = float(T_top_.curve.above[i]);
         v[kGpuTTopIn + i] = float(T_top_in_.curve.below[i]);
         v[kGpuTTopIn + kNmu + i] = float(T_top_in_.curve.above[i]);
+        const CosineCurve<Rgb>& rounds = round_trip_on_ ? round_trip_curve_ : mirror_series_curve_;
         for (int c = 0; c < 3; ++c)
-            v[kGpuMirrorSeries + 3 * i + c] = float(mirror_series_curve_.v[i][c]);
+            v[kGpuMirrorSeries + 3 * i + c] = float(rounds.v[i][c]);
         if (top_ms_) v[kGpuDRTop + i] = float(dR_top_.v[i]);
         if (base_ms_) v[kGpuDEBase + i] = float(dE_base_.v[i]);
         if (a_coat_on_)

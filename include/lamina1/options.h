@@ -52,6 +52,13 @@ struct Options {
     /// reflected only (the slab's diffuse exit through the bottom only with "on"). With both
     /// interfaces smooth the exact delta series is summed either way.
     bool series_lambertian_only = true;
+    /// The first round trip as a lobe of its own (true) or in the separable series (false), where
+    /// the series is summed over a conductor smoother than the coat (the microsurfaces' orders
+    /// ≥ 2 restored): the light the first order's exit leaves inside meets the coat's bottom,
+    /// whose rough reflection sends it back to the base and out near the mirror direction, a
+    /// lobe widened by that reflection (α_r² = α_e² + α1² + α0²) rather than uniform radiance.
+    /// Its energy is taken from the series, which keeps the total.
+    bool round_trip_lobe = true;
     /// The first order's balance: the series returns what the first order does not let out,
     /// counted as the light inside within the exit cone times its exit transmittance; the first
     /// order's lobe (its width, shape, masking and exit factors are approximations) carries a

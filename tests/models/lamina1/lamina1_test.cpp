@@ -321,6 +321,54 @@ TEST(Lamina1, MultipleScatteringWhiteFurnaceOverAMirror) {
     EXPECT_GT(worst_off, 0.1);
 }
 
+// The first round trip's lobe (round-trip=lobe, the default) takes its energy from the uniform
+// series: over conductors smoother than the coat the albedo is the series' alone's (within the
+// two quadratures' budgets: model_albedo's and the construction's visible-normal rule), while
+// the light near the mirror direction grows and the light far from it shrinks. Where the lobe
+// does not apply (a base as rough as the coat) the two choices are the same model.
+TEST(Lamina1, RoundTripLobeKeepsTheSeriesEnergy) {
+    BinnedOptions o;
+    o.rel_tol = 1e-4;
+    double worst = 0;
+    for (double eta : {1.2, 1.5, 2.0})
+        for (double alpha : {0.1, 0.3, 0.6})
+            for (const InterfaceSpec& base : {test::gold(0.001), test::gold(0.05),
+                                              test::conductor(Rgbd(0.2), Rgbd(3.0), 0.0)}) {
+                const Stack stack = coated(eta, alpha, base);
+                const auto lobe = make_model("lamina-1", stack, {"microsurface=multiple"});
+                const auto series =
+                    make_model("lamina-1", stack, {"microsurface=multiple", "round-trip=series"});
+                for (double ti : {0.0, 45.0, 70.0, 85.0}) {
+                    const Vec3d wi = incident_direction(deg_to_rad(ti));
+                    const Rgbd a = model_albedo(*lobe, wi, Side::Reflection, o);
+                    const Rgbd b = model_albedo(*series, wi, Side::Reflection, o);
+                    for (int c = 0; c < 3; ++c) {
+                        EXPECT_NEAR(a[c], b[c], 2e-3)
+                            << "eta0=" << eta << " a0=" << alpha << " ti=" << ti << " c=" << c;
+                        worst = std::max(worst, std::abs(a[c] - b[c]));
+                    }
+                    // Near the mirror direction the lobe adds, far from it the series loses.
+                    const Vec3d mirror(-wi.x, -wi.y, wi.z);
+                    if (ti < 80) {
+                        EXPECT_GT(lobe->eval(wi, mirror).mean(), series->eval(wi, mirror).mean());
+                        const Vec3d away = dir(60, ti > 0 ? 0 : 90);
+                        EXPECT_LT(lobe->eval(wi, away).mean(), series->eval(wi, away).mean())
+                            << "eta0=" << eta << " a0=" << alpha << " ti=" << ti;
+                    }
+                }
+            }
+    std::printf("round-trip lobe against the series: largest albedo difference %.2e\n", worst);
+    // A base as rough as the coat: the series alone, both ways.
+    const Stack rough = coated(1.5, 0.2, test::gold(0.3));
+    const auto lobe = make_model("lamina-1", rough, {"microsurface=multiple"});
+    const auto series =
+        make_model("lamina-1", rough, {"microsurface=multiple", "round-trip=series"});
+    for (double ti : {0.0, 60.0})
+        for (double to : {10.0, 50.0})
+            EXPECT_EQ(lobe->eval(dir(ti, 0), dir(to, 120)).mean(),
+                      series->eval(dir(ti, 0), dir(to, 120)).mean());
+}
+
 TEST(Lamina1, SupportIsExplicit) {
     const auto milky = make_model(
         "lamina-1", coated(1.5, 0.1, test::lambertian(Rgbd(0.5)), Rgbd(0.1), Rgbd(0.5), 0.3));
