@@ -199,6 +199,16 @@ class Study:
         se = read_array(se_path) if os.path.exists(se_path) else None
         return cfg, tables, se
 
+    def load_albedos(self, cid):
+        """config.json (its per-source albedos: Σ f Ω⊥ of each table, in double, as the study
+        summed them) and the reference's standard errors, without the tables themselves."""
+        d = os.path.join(self.root, "configs", cid)
+        with open(os.path.join(d, "config.json")) as f:
+            cfg = json.load(f)
+        se_path = table_path(d, "reference_se")
+        se = read_array(se_path) if os.path.exists(se_path) else None
+        return cfg, se
+
 
 def supported(cfg, model, side):
     if model not in cfg["sources"]:
@@ -458,7 +468,7 @@ def albedo_figure(study, cat, formats):
     # has the folded formula's value for 2 · n_phi bins.
     oms = {False: omega_perp(study.n_theta, study.n_phi),
            True: omega_perp(study.n_theta, 2 * study.n_phi)}
-    cache = {c["id"]: study.load(c["id"]) for c in study.configs if c["category"] == cat}
+    cache = {c["id"]: study.load_albedos(c["id"]) for c in study.configs if c["category"] == cat}
     members = [c for c in study.configs if c["category"] == cat]
     ncol = min(5, len(members))
     nrow = math.ceil(len(members) / ncol)
@@ -476,7 +486,7 @@ def albedo_figure(study, cat, formats):
     for ax in axes.flat[len(members):]:
         ax.axis("off")
     for ax, meta in zip(axes.flat, members):
-        cfg, tables, se = cache[meta["id"]]
+        cfg, se = cache[meta["id"]]
         unfolded = study.unfolded(meta["id"])
         om = oms[unfolded]
         # Against θi at φi = 0° (an unfolded configuration's other azimuths are in its slices).
@@ -485,9 +495,14 @@ def albedo_figure(study, cat, formats):
         thetas = [incidences[k][0] for k in ks]
         for d, side in enumerate(cfg["sides"]):
             style = "-" if side == "R" else ":"
-            # Σ f Ω⊥ per source and incidence, averaged over RGB.
-            alb = np.nansum(np.asarray(tables[:, ks, d]) * om[None, None, :, :, None], axis=(2, 3))
-            alb = alb.mean(axis=-1)
+            # Σ f Ω⊥ per source and incidence (config.json), averaged over RGB; NaN where a
+            # source does not support the side.
+            def source_albedo(src):
+                per_incidence = (cfg["albedo"].get(src) or {}).get(side) or [None] * len(incidences)
+                return [np.nan if per_incidence[k] is None else float(np.mean(per_incidence[k]))
+                        for k in ks]
+
+            alb = np.array([source_albedo(src) for src in cfg["sources"]])
             err = None
             if se is not None:
                 v = ((np.asarray(se[ks, d]) * om[None, :, :, None]) ** 2).sum(axis=(1, 2))
