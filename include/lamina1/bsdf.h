@@ -470,9 +470,10 @@ class Bsdf {
     CosineCurve<double, kNnorm> lobe_norm_;
     /// √(1/(1 − a² R_in E_b (1 − u))) over inside cosines: the first order's round trips.
     CosineCurve<Rgb> mirror_series_curve_;
-    /// The first round trip's lobe (Options::round_trip_lobe, where the series is summed over a
-    /// conductor smoother than the coat; never with the mirror series), and √(a² E_b R_in) over
-    /// inside cosines: what one round trip keeps, split between its two ends.
+    /// The round trips' lobe (Options::round_trip_lobe, where the series is summed over a
+    /// conductor smoother than the coat; never with the mirror series), and √(k/(1 − k)) over
+    /// inside cosines, k = a² E_b R_in what one round trip keeps: the round trips' sum, split
+    /// between the lobe's two ends (scaled down where the series holds less).
     bool round_trip_on_ = false;
     CosineCurve<Rgb> round_trip_curve_;
     CosineCurve<double> dR_top_, dE_base_;

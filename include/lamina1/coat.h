@@ -374,17 +374,19 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
     balance_ = ch_.first_order_balance && alpha0_ > 0 && ch_.directional_transmittance &&
                layers_.base != Base::Lambertian;
     precompute_returned(g_curve);
-    // The first round trip as a lobe of its own (Options::round_trip_lobe): where the series is
+    // The round trips as a lobe of their own (Options::round_trip_lobe): where the series is
     // summed over a conductor smoother than the coat (the orders ≥ 2 restored; a rough coat, the
     // directional transmittance), the returned light leaves near the mirror direction, not as
-    // uniform radiance (docs/models.md, lamina-1, item 3). The lobe keeps √(a² E_b R_in) at each
-    // end; its energy E_r(μ) is taken from the series, X ← X − E_r/G with G = Ē_b t̄/(1 − Ē_b r̄)
-    // the energy the series lets out per unit of X, so that the total is the series' alone.
-    // Where the series holds less than the lobe would carry (E_r > X G: at normal incidence
-    // under a nearly smooth or index-near coat, where the first order's balance leaves little
-    // to return), the lobe is scaled to the series' energy, by √c(μ) at each end, c = X G/E_r
-    // (at the mirror pair, where the lobe is, its energy then scales by c), and E_r is taken
-    // again with the scaled lobe; on every other node of X's, interpolated between.
+    // uniform radiance (docs/models.md, lamina-1, item 3). One round trip keeps k = a² E_b R_in
+    // of the light; the lobe carries every round trip, Σ kⁿ = k/(1 − k), as its √ at each end
+    // (the later trips at the first one's width). Its energy E_r(μ) is taken from the series:
+    // X ← X − E_r/G, with G = Ē_b t̄/(1 − Ē_b r̄) the energy the series lets out per unit of X,
+    // so that the total is the series' alone. Where the series holds less than the lobe would
+    // carry (E_r > X G: at normal incidence under a nearly smooth or index-near coat, where the
+    // first order's balance leaves little to return; near the critical angle over a bright
+    // metal), the lobe is scaled to the series' energy, by √c(μ) at each end, c = X G/E_r (at
+    // the mirror pair, where the lobe is, its energy then scales by c), and E_r is taken again
+    // with the scaled lobe; on every other node of X's, interpolated between.
     round_trip_on_ = ch_.round_trip_lobe && layers_.base == Base::Conductor && alpha1_ < alpha0_ &&
                      alpha0_ > 0 && ch_.directional_transmittance;
     if (round_trip_on_) {
@@ -392,8 +394,8 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
             const Rgb a = attenuation(mu);
             const Rgb kept = a * a * base_albedo(mu) * inside_reflectance(mu);
             Rgb r;
-            for (int c = 0; c < 3; ++c)
-                r[c] = std::sqrt(std::max(kept[c], 0.0));
+            for (int c = 0; c < 3; ++c)  // Σ_{n≥1} kept^n (a white mirror under TIR: bounded)
+                r[c] = std::sqrt(std::max(kept[c], 0.0) / std::max(1 - kept[c], 1e-3));
             return r;
         });
         Rgb gain(0.0), inv_gain(0.0);
@@ -476,19 +478,25 @@ inline Rgb Bsdf::first_order_energy(double mu, bool of_round_trip) const {
         return Vec3(v.x * eta0_, v.y * eta0_, safe_sqrt(1 - (1 - v.z * v.z) * sqr(eta0_)));
     };
     const double g1 = fixed.G1(w);
-    Rgb sum = integrate_visible_split<Rgb, kSplitNr, kSplitNphi, kSplitBisections>(
-        fixed, w, mu_crit, [&](const Vec3& wm) { return reflect(w, wm).z; },
-        [&](const Vec3& wm) {
-            const Vec3 wo_in = reflect(w, wm);
-            if (wo_in.z <= mu_crit) return Rgb(0.0);
-            const double density = g1 * fixed.D(wm);
-            if (!(density > 0)) return Rgb(0.0);
-            const Vec3 wo = outside(wo_in);
-            const Rgb a_o = coat_attenuation(wo.z, wo_in.z);
-            return (of_round_trip ? round_trip(in, wo, wo_in, a_o)
-                                  : first_order(in, wo, wo_in, a_o, kSpecular)) *
-                   (sqr(eta0_) * wo_in.z * 4 * w.z / density);
-        });
+    auto node = [&](const Vec3& wm) {
+        const Vec3 wo_in = reflect(w, wm);
+        if (wo_in.z <= mu_crit) return Rgb(0.0);
+        const double density = g1 * fixed.D(wm);
+        if (!(density > 0)) return Rgb(0.0);
+        const Vec3 wo = outside(wo_in);
+        const Rgb a_o = coat_attenuation(wo.z, wo_in.z);
+        return (of_round_trip ? round_trip(in, wo, wo_in, a_o)
+                              : first_order(in, wo, wo_in, a_o, kSpecular)) *
+               (sqr(eta0_) * wo_in.z * 4 * w.z / density);
+    };
+    auto height = [&](const Vec3& wm) { return reflect(w, wm).z; };
+    // The round trips' lobe is wider than its rule's GGX where wo is oblique (α_r follows k_o),
+    // and it carries more of the light: twice the nodes in each direction.
+    Rgb sum = of_round_trip
+                  ? integrate_visible_split<Rgb, 2 * kSplitNr, 2 * kSplitNphi, kSplitBisections>(
+                        fixed, w, mu_crit, height, node)
+                  : integrate_visible_split<Rgb, kSplitNr, kSplitNphi, kSplitBisections>(
+                        fixed, w, mu_crit, height, node);
     if (base_ms_ && !of_round_trip) {
         // f_1 of the separable lobe is F_ms ΔE(μi') ΔE(μo')/(π ΔĒ) times the coat's factors.
         const Rgb ms = integrate_split01<kGauss, Rgb>(

@@ -140,13 +140,13 @@ inline Rgb Bsdf::first_order(const Incident& in, const Vec3& wo, const Vec3& wo_
            (in.T_pair * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
 }
 
-/// The first round trip's lobe (Options::round_trip_lobe; docs/models.md, lamina-1, item 3): the
-/// light the first order's exit leaves inside goes back to the coat's bottom, which reflects it
-/// to the base, which sends it out. A Walter lobe of the base at the refracted pair (wi', wo')
-/// with the GGX of α_r (round_trip_alpha: the base's two reflections and the coat bottom's one
-/// widen the first order's α_e), entering and leaving as the first order does (T_pair, T_exit,
-/// a, 1/η0²), times what the round trip keeps, a² E_b R_in, as √ of it at each end: symmetric
-/// in (wi, wo), as the mirror series' factor is.
+/// The round trips' lobe (Options::round_trip_lobe; docs/models.md, lamina-1, item 3): the light
+/// the first order's exit leaves inside goes back to the coat's bottom, which reflects it to the
+/// base, which sends it out, and so on. A Walter lobe of the base at the refracted pair
+/// (wi', wo') with the GGX of α_r (round_trip_alpha: the base's two reflections and the coat
+/// bottom's one widen the first order's α_e), entering and leaving as the first order does
+/// (T_pair, T_exit, a, 1/η0²), times the round trips' sum k/(1 − k), k = a² E_b R_in, as √ of it
+/// at each end: symmetric in (wi, wo), as the mirror series' factor is.
 inline Rgb Bsdf::round_trip(const Incident& in, const Vec3& wo, const Vec3& wo_in,
                             const Rgb& a_o) const {
     if (!(in.wi_in.z > 0 && wo_in.z > 0)) return Rgb(0.0);

@@ -82,7 +82,7 @@ enum GpuFlag : unsigned {
     kGpuBaseOrders = 1u << 17,       ///< the base's: F_ms ΔE(μi') ΔE(μo')/(π ΔĒ)
     kGpuBinsOn = 1u << 18,           ///< a slab's inside light in bins, from kGpuBinsCuts on
     kGpuCoatSpread = 1u << 19,       ///< a rough absorbing coat's a(μ) (Bsdf::coat_attenuation)
-    /// The first round trip's lobe (Bsdf::round_trip), its curve at kGpuMirrorSeries (the mirror
+    /// The round trips' lobe (Bsdf::round_trip), its curve at kGpuMirrorSeries (the mirror
     /// series is never on with it).
     kGpuRoundTrip = 1u << 20,
 };

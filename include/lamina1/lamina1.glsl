@@ -227,8 +227,9 @@ vec3 l1_base_lobe(vec3 wi_in, float k_top, float lobe_norm_i, float mu_o, vec3 w
     return f;
 }
 
-// The first round trip's lobe (Bsdf::round_trip): the base's Walter lobe of α_r² = α_e² + α1² +
-// α0², entering and leaving as the first order, times the curve √(a² E_b R_in) at both ends.
+// The round trips' lobe (Bsdf::round_trip): the base's Walter lobe of α_r² = α_e² + α1² + α0²,
+// entering and leaving as the first order, times the curve √(k/(1 − k)), k = a² E_b R_in, at both
+// ends.
 vec3 l1_round_trip(vec3 wi_in, float k_top, vec3 wo, vec3 wo_in, vec3 a_pair, float T_pair,
                    float eta2) {
     float alpha1 = l1_at(5), alpha0 = l1_at(4);

@@ -52,7 +52,7 @@ struct Options {
     /// reflected only (the slab's diffuse exit through the bottom only with "on"). With both
     /// interfaces smooth the exact delta series is summed either way.
     bool series_lambertian_only = true;
-    /// The first round trip as a lobe of its own (true) or in the separable series (false), where
+    /// The round trips as a lobe of their own (true) or in the separable series (false), where
     /// the series is summed over a conductor smoother than the coat (the microsurfaces' orders
     /// ≥ 2 restored): the light the first order's exit leaves inside meets the coat's bottom,
     /// whose rough reflection sends it back to the base and out near the mirror direction, a
