@@ -8,6 +8,8 @@
 //   f_R = f_top                                       exact Walter reflection of the coat
 //       + T(μi) T(μo) a(μi') a(μo') f_b(wi', wo'; α_e) / η0²     first order through the coat
 //       + K X(μi) X(μo) / (π η0²)                    inter-reflections (separable, reciprocal)
+//       + T a a f_b(wi', wo'; α_r) s(μi') s(μo') / η0²   the round trips over a conductor smoother
+//                                                    than the coat, energy taken from K X X
 //   f_T = E_1(μi) f_t,b(w̄i', wo; α_b) / T_b,in(μ̄i'; α_b)   first order through the slab's bottom
 //       + B(μo)ᵀ W_s s(μi) D C(μi)                    later orders, the inside light in bins
 //   (a slab's reflection: C(μo)ᵀ W (g P₁ g + P₂) C(μi) in place of K X X; lamina1/slab.h)
