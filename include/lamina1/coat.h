@@ -407,8 +407,8 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
         const CosineCurve<Rgb, kNx> X_series = X_;
         CosineCurve<Rgb, (kNx + 1) / 2> share, E_r;
         E_r.fill([&](double mu) { return first_order_energy(mu, true); });
-        // Scaled until the series holds the lobe's energy: one pass where it does (the study's
-        // frosted metals), up to three more where the lobe is broad and c varies across it.
+        // Scaled until the series holds the lobe's energy: no pass where it does, up to three
+        // where the lobe is broad and c varies across it.
         for (int pass = 0; pass < 3; ++pass) {
             bool over = false;
             share.fill([&](double mu) {
@@ -460,8 +460,8 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
 /// 4 μi'/(G1(wi') D(wm)); the base's separable multiple-scattering part, broad, by a 1-D rule.
 /// Like X, a curve in μ alone: under anisotropic interfaces, the lobe of their root mean square
 /// roughnesses (isotropic, so the rule's half disk of visible normals is exact and the balance
-/// turns with the tangents). `of_round_trip`: the same for the first round trip's lobe (GGX of
-/// α_r(k_i, k_i) as the rule's), which has no separable part.
+/// turns with the tangents). `of_round_trip`: the same for the round trips' lobe (GGX of α_r(k_i,
+/// k_i) as the rule's), which has no separable part.
 inline Rgb Bsdf::first_order_energy(double mu, bool of_round_trip) const {
     Incident in;
     in.wi = Vec3(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));

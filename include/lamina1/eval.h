@@ -143,8 +143,9 @@ inline Rgb Bsdf::first_order(const Incident& in, const Vec3& wo, const Vec3& wo_
 /// The round trips' lobe (Options::round_trip_lobe; docs/models.md, lamina-1, item 3): the light
 /// the first order's exit leaves inside goes back to the coat's bottom, which reflects it to the
 /// base, which sends it out, and so on. A Walter lobe of the base at the refracted pair
-/// (wi', wo') with the GGX of α_r (round_trip_alpha: the base's two reflections and the coat
-/// bottom's one widen the first order's α_e), entering and leaving as the first order does
+/// (wi', wo') with the GGX of α_r (Walter et al. 2007, Eq. 20, with the height-correlated G2 of
+/// Heitz 2014, Eq. 99; round_trip_alpha: the base's two reflections and the coat bottom's one
+/// widen the first order's α_e), entering and leaving as the first order does
 /// (T_pair, T_exit, a, 1/η0²), times the round trips' sum k/(1 − k), k = a² E_b R_in, as √ of it
 /// at each end: symmetric in (wi, wo), as the mirror series' factor is.
 inline Rgb Bsdf::round_trip(const Incident& in, const Vec3& wo, const Vec3& wo_in,

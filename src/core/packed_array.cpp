@@ -118,7 +118,9 @@ std::string deflate_chunked(const unsigned char* data, std::size_t size) {
             continue;
         }
         const std::size_t dictionary = std::min(kWindow, begin);
-        if (dictionary > 0) deflateSetDictionary(&z, data + begin - dictionary, uInt(dictionary));
+        if (dictionary > 0 &&
+            deflateSetDictionary(&z, data + begin - dictionary, uInt(dictionary)) != Z_OK)
+            failed[std::size_t(i)] = 1;
         std::string& out = parts[std::size_t(i)];
         out.resize(deflateBound(&z, uLong(end - begin)) + 16);  // + the sync flush's marker
         z.next_in = const_cast<Bytef*>(data + begin);
@@ -126,7 +128,9 @@ std::string deflate_chunked(const unsigned char* data, std::size_t size) {
         z.next_out = reinterpret_cast<Bytef*>(out.data());
         z.avail_out = uInt(out.size());
         const int rc = deflate(&z, last ? Z_FINISH : Z_SYNC_FLUSH);
-        if (rc != (last ? Z_STREAM_END : Z_OK) || z.avail_in != 0) failed[std::size_t(i)] = 1;
+        // A sync flush that filled the buffer may have output left: room must remain.
+        if (rc != (last ? Z_STREAM_END : Z_OK) || z.avail_in != 0 || z.avail_out == 0)
+            failed[std::size_t(i)] = 1;
         out.resize(out.size() - z.avail_out);
         deflateEnd(&z);
     }

@@ -14,6 +14,7 @@
 #include "physics/conductor.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
+#include "simulator/goniophotometer.h"
 #include "support/chi2.h"
 #include "support/closed_forms.h"
 
@@ -368,6 +369,43 @@ TEST(Lamina1, RoundTripLobeKeepsTheSeriesEnergy) {
         for (double to : {10.0, 50.0})
             EXPECT_EQ(lobe->eval(dir(ti, 0), dir(to, 120)).mean(),
                       series->eval(dir(ti, 0), dir(to, 120)).mean());
+}
+
+// Against the particles (the default exact reference: polarized, multiple scattering), on frosted
+// gold at oblique incidence, where the series' uniform light and the reference's forward-leaving
+// round trips differ most: with the round-trip lobe lamina-1 misplaces less of the reflected
+// light than with the series, by more than twice the particles' own noise (Σ se Ω⊥ over the
+// reflected energy, an upper bound of the noise such an L1 sum carries). 30 × 30 bins, 4·10⁶
+// particles per incidence, fixed seed.
+TEST(Lamina1Stat, RoundTripLobeIsCloserToParticlesThanTheSeries) {
+    const Stack stack = coated(1.5, 0.3, test::gold(0.001));
+    SimulationSettings s;
+    s.theta_i_deg = {60.0, 70.0};
+    s.particles = 4'000'000;
+    s.seed = 20261205;
+    s.grid = HemisphereGrid(30, 30);
+    const SimulationResult ref = simulate(stack, s);
+    const auto lobe = make_model("lamina-1", stack);
+    const auto series = make_model("lamina-1", stack, {"round-trip=series"});
+    const BinnedTable t_lobe = bin_model(*lobe, s.grid, s.theta_i_deg);
+    const BinnedTable t_series = bin_model(*series, s.grid, s.theta_i_deg);
+    for (std::size_t i = 0; i < s.theta_i_deg.size(); ++i) {
+        const BinnedLobe& r = ref.table.lobe(i, Side::Reflection);
+        double total = 0, noise = 0, off_lobe = 0, off_series = 0;
+        for (std::size_t j = 0; j < s.grid.size(); ++j) {
+            const double omega = s.grid.projected_solid_angle(j);
+            for (int c = 0; c < 3; ++c) {
+                total += r.f[j][c] * omega;
+                noise += r.se[j][c] * omega;
+                off_lobe += std::abs(t_lobe.lobe(i, Side::Reflection).f[j][c] - r.f[j][c]) * omega;
+                off_series +=
+                    std::abs(t_series.lobe(i, Side::Reflection).f[j][c] - r.f[j][c]) * omega;
+            }
+        }
+        std::printf("θi %.0f°: misplaced %.4f (lobe) against %.4f (series), noise %.4f\n",
+                    s.theta_i_deg[i], off_lobe / total, off_series / total, noise / total);
+        EXPECT_LT(off_lobe, off_series - 2 * noise) << "θi " << s.theta_i_deg[i];
+    }
 }
 
 TEST(Lamina1, SupportIsExplicit) {
