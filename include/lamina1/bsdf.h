@@ -136,6 +136,12 @@ class Bsdf {
     void precompute_mean_direction();
     void precompute_series(const RgbEdgeCurve<33>& g_curve);
     Rgb first_order_energy(double mu, bool of_round_trip = false) const;
+    /// first_order_energy's rule over the visible normals alone, each node's value passed
+    /// through out(value, wo), wo its outside direction (any direction where the value is 0), and
+    /// summed as V (the round trips' solve sums it onto the two nodes of their curve about wo).
+    template <typename V, typename Out>
+    V visible_rule_energy(double mu, bool of_round_trip, Out&& out) const;
+    void precompute_round_trips(const Rgb& gain);
     Rgb returned_light(double mu, const RgbEdgeCurve<33>& g_curve, const Rgb& Y_ms) const;
     void precompute_returned(const RgbEdgeCurve<33>& g_curve);
     void precompute_scattering();
@@ -473,11 +479,11 @@ class Bsdf {
     /// √(1/(1 − a² R_in E_b (1 − u))) over inside cosines: the first order's round trips.
     CosineCurve<Rgb> mirror_series_curve_;
     /// The round trips' lobe (Options::round_trip_lobe, where the series is summed over a
-    /// conductor smoother than the coat; never with the mirror series), and √(k/(1 − k)) over
-    /// inside cosines, k = a² E_b R_in what one round trip keeps: the round trips' sum, split
-    /// between the lobe's two ends (scaled down where the series holds less).
+    /// conductor smoother than the coat; never with the mirror series), and its scale s(μ) over
+    /// outside cosines, on X's nodes, solved so that the lobe carries the series' energy
+    /// (precompute_round_trips).
     bool round_trip_on_ = false;
-    CosineCurve<Rgb> round_trip_curve_;
+    CosineCurve<Rgb, kNx> round_trip_curve_;
     CosineCurve<double> dR_top_, dE_base_;
     double dR_top_bar_ = 1, dE_base_bar_ = 1;
     Rgb F_ms_{1.0};

@@ -377,69 +377,16 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
     // The round trips as a lobe of their own (Options::round_trip_lobe): where the series is
     // summed over a conductor smoother than the coat (the orders ≥ 2 restored; a rough coat, the
     // directional transmittance), the returned light leaves near the mirror direction, not as
-    // uniform radiance (docs/models.md, lamina-1, item 3). One round trip keeps k = a² E_b R_in
-    // of the light; the lobe carries every round trip, Σ kⁿ = k/(1 − k), as its √ at each end
-    // (the later trips at the first one's width). Its energy E_r(μ) is taken from the series:
-    // X ← X − E_r/G, with G = Ē_b t̄/(1 − Ē_b r̄) the energy the series lets out per unit of X,
-    // so that the total is the series' alone. Where the series holds less than the lobe would
-    // carry (E_r > X G: at normal incidence under a nearly smooth or index-near coat, where the
-    // first order's balance leaves little to return; near the critical angle over a bright
-    // metal), the lobe is scaled to the series' energy, by √c(μ) at each end, c = X G/E_r (at
-    // the mirror pair, where the lobe is, its energy then scales by c), and E_r is taken again
-    // with the scaled lobe; on every other node of X's, interpolated between.
+    // uniform radiance (docs/models.md, lamina-1, item 3): the lobe takes the series' energy.
     round_trip_on_ = ch_.round_trip_lobe && layers_.base == Base::Conductor && alpha1_ < alpha0_ &&
                      alpha0_ > 0 && ch_.directional_transmittance;
     if (round_trip_on_) {
-        round_trip_curve_.fill([&](double mu) {
-            const Rgb a = attenuation(mu);
-            const Rgb kept = a * a * base_albedo(mu) * inside_reflectance(mu);
-            Rgb r;
-            for (int c = 0; c < 3; ++c)  // Σ_{n≥1} kept^n (a white mirror under TIR: bounded)
-                r[c] = std::sqrt(std::max(kept[c], 0.0) / std::max(1 - kept[c], 1e-3));
-            return r;
-        });
-        Rgb gain(0.0), inv_gain(0.0);
+        Rgb gain(0.0);
         for (int c = 0; c < 3; ++c) {
             const double one_minus = 1 - E_bar_[c] * r_bar_[c];
             gain[c] = one_minus > 0 ? E_bar_[c] * t_bar_[c] / one_minus : 0.0;
-            inv_gain[c] = gain[c] > 0 ? 1 / gain[c] : 0.0;
         }
-        const CosineCurve<Rgb, kNx> X_series = X_;
-        CosineCurve<Rgb, (kNx + 1) / 2> share, E_r;
-        E_r.fill([&](double mu) { return first_order_energy(mu, true); });
-        // Scaled until the series holds the lobe's energy: no pass where it does, up to three
-        // where the lobe is broad and c varies across it.
-        for (int pass = 0; pass < 3; ++pass) {
-            bool over = false;
-            share.fill([&](double mu) {
-                const Rgb E = E_r(mu), held = X_series(mu) * gain;
-                Rgb c(1.0);
-                for (int k = 0; k < 3; ++k)
-                    if (E[k] > held[k] * (1 + 1e-9)) {
-                        c[k] = std::max(held[k], 0.0) / E[k];
-                        over = true;
-                    }
-                return c;
-            });
-            if (!over) break;
-            const CosineCurve<Rgb> unscaled = round_trip_curve_;
-            round_trip_curve_.fill([&](double mu_in) {
-                // The outside cosine whose refraction this is (inside the exit cone; 0 beyond).
-                const double mu = safe_sqrt(1 - (1 - mu_in * mu_in) * sqr(eta0_));
-                Rgb r = unscaled(mu_in);
-                const Rgb c = share(mu);
-                for (int k = 0; k < 3; ++k)
-                    r[k] *= std::sqrt(std::max(c[k], 0.0));
-                return r;
-            });
-            E_r.fill([&](double mu) { return first_order_energy(mu, true); });
-        }
-        X_.fill([&](double mu) {
-            Rgb out = X_series(mu) - E_r(mu) * inv_gain;
-            for (int c = 0; c < 3; ++c)
-                out[c] = std::max(out[c], 0.0);
-            return out;
-        });
+        precompute_round_trips(gain);
     }
     // X̄ = (2/η0²)∫ X(μ) μ dμ: the diffuse exit's normalization.
     X_bar_ = integrate_split01<kGauss, Rgb>([&](double mu) { return X_at(mu) * (2 * mu); }, 0.0) *
@@ -453,6 +400,118 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
     }
 }
 
+/// The round trips' scale (Options::round_trip_lobe). The series lets out X(μ) G of the light
+/// arriving at outside cosine μ (G = Ē_b t̄/(1 − Ē_b r̄), the energy it lets out per unit of X);
+/// the lobe is to carry that energy instead, with the series' total kept. Its form
+/// s(μi) s(μo) L(wi, wo) (L the lobe of Bsdf::round_trip with a unit scale) is reciprocal
+/// whatever s is. On the nodes μ_i of X's curve, where s has its own, the lobe's energy is
+/// E_i = s_i Σ_j M_ij s_j, M_ij = ∫ L(wi_i, wo) w_j(μo) μo dωo, w_j the curve's interpolation
+/// weights (each node of first_order_energy's rule summed onto the two nodes about its μo).
+/// E_i = X_i G at every node is a symmetric matrix-scaling problem, solved by the damped fixed
+/// point s ← √(s X G / (M s)) (the symmetric form of Sinkhorn's iteration; 20–40 steps to
+/// 10⁻⁹ here). What the lobe carries is then taken from the series, X ← X − E/G; what is left
+/// (where no light reaches the lobe's row: grazing incidence) stays uniform.
+inline void Bsdf::precompute_round_trips(const Rgb& gain) {
+    constexpr int kN = kNx;
+    using Curve = CosineCurve<Rgb, kN>;
+    round_trip_curve_.fill([](double) { return Rgb(1.0); });
+    // One node of the rule, its value shared between the two curve nodes about its μo.
+    struct Share {
+        Curve::Place at;
+        Rgb v;
+        Share operator*(double w) const { return {at, v * w}; }
+    };
+    struct Row {
+        std::array<Rgb, kN> m{};
+        Row& operator+=(const Share& s) {
+            m[s.at.i] += s.v * (1 - s.at.t);
+            m[s.at.i + 1] += s.v * s.at.t;
+            return *this;
+        }
+    };
+    auto share = [](const Rgb& v, const Vec3& wo) { return Share{Curve::locate(wo.z), v}; };
+    std::array<Row, kN> M;
+    for (int i = 0; i < kN; ++i)
+        M[i] = visible_rule_energy<Row>(sqr(double(i) / (kN - 1)), true, share);
+    std::array<Rgb, kN> E;
+    for (int c = 0; c < 3; ++c) {
+        std::array<double, kN> s{}, next{}, target{};
+        auto Ms = [&](int i) {
+            double sum = 0;
+            for (int j = 0; j < kN; ++j)
+                sum += M[i].m[j][c] * s[j];
+            return sum;
+        };
+        for (int i = 0; i < kN; ++i) {
+            target[i] = std::max(X_.v[i][c] * gain[c], 0.0);
+            double row = 0;
+            for (int j = 0; j < kN; ++j)
+                row += M[i].m[j][c];
+            s[i] = row > 0 ? std::sqrt(target[i] / row) : 0.0;
+        }
+        for (int iteration = 0; iteration < 400; ++iteration) {
+            double worst = 0;
+            for (int i = 0; i < kN; ++i) {
+                const double Ms_i = Ms(i);
+                if (target[i] > 0 && Ms_i > 0)
+                    worst = std::max(worst, std::abs(s[i] * Ms_i / target[i] - 1));
+                next[i] = Ms_i > 0 ? std::sqrt(s[i] * target[i] / Ms_i) : 0.0;
+            }
+            s = next;
+            if (worst < 1e-9) break;
+        }
+        for (int i = 0; i < kN; ++i) {
+            round_trip_curve_.v[i][c] = s[i];
+            E[i][c] = s[i] * Ms(i);
+        }
+    }
+    for (int i = 0; i < kN; ++i)
+        for (int c = 0; c < 3; ++c) {
+            const double X = X_.v[i][c], left = X - (gain[c] > 0 ? E[i][c] / gain[c] : 0.0);
+            // What the solve matched (to 10⁻⁹) leaves a remainder of rounding, not light.
+            X_.v[i][c] = left > 1e-6 * X ? left : 0.0;
+        }
+}
+
+template <typename V, typename Out>
+V Bsdf::visible_rule_energy(double mu, bool of_round_trip, Out&& out) const {
+    Incident in;
+    in.wi = Vec3(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+    in.wi_in = refract_in(in.wi, inv_eta0_);
+    if (!(in.wi_in.z > 0)) return V{};
+    incident_coat(in);
+    const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
+    const GGX fixed{of_round_trip ? round_trip_alpha(in.k_top, in.k_top)
+                                  : effective_alpha(in.k_top, in.k_top)};
+    if (!(fixed.alpha > 0)) return V{};
+    constexpr LobeForm kSpecular{true, false, false};
+    const Vec3 w = in.wi_in;
+    auto outside = [&](const Vec3& v) {  // v inside, within the exit cone
+        return Vec3(v.x * eta0_, v.y * eta0_, safe_sqrt(1 - (1 - v.z * v.z) * sqr(eta0_)));
+    };
+    const double g1 = fixed.G1(w);
+    auto node = [&](const Vec3& wm) {
+        const Vec3 wo_in = reflect(w, wm);
+        if (wo_in.z <= mu_crit) return out(Rgb(0.0), wo_in);
+        const double density = g1 * fixed.D(wm);
+        if (!(density > 0)) return out(Rgb(0.0), wo_in);
+        const Vec3 wo = outside(wo_in);
+        const Rgb a_o = coat_attenuation(wo.z, wo_in.z);
+        return out((of_round_trip ? round_trip(in, wo, wo_in, a_o)
+                                  : first_order(in, wo, wo_in, a_o, kSpecular)) *
+                       (sqr(eta0_) * wo_in.z * 4 * w.z / density),
+                   wo);
+    };
+    auto height = [&](const Vec3& wm) { return reflect(w, wm).z; };
+    // The round trips' lobe is wider than its rule's GGX where wo is oblique (α_r follows k_o),
+    // and it carries more of the light: twice the nodes in each direction.
+    return of_round_trip
+               ? integrate_visible_split<V, 2 * kSplitNr, 2 * kSplitNphi, kSplitBisections>(
+                     fixed, w, mu_crit, height, node)
+               : integrate_visible_split<V, kSplitNr, kSplitNphi, kSplitBisections>(
+                     fixed, w, mu_crit, height, node);
+}
+
 /// E_lobe(μ) = ∫ f_1(wi, wo) μo dωo, the energy the first order's lobe carries out for light
 /// arriving at outside cosine μ, over the inside directions (μo dωo = η0² μo' dωo', Snell's law
 /// of solid angles): by the visible normals of the GGX of fixed width α_e(k_i, k_i) at wi', each
@@ -463,41 +522,19 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
 /// turns with the tangents). `of_round_trip`: the same for the round trips' lobe (GGX of α_r(k_i,
 /// k_i) as the rule's), which has no separable part.
 inline Rgb Bsdf::first_order_energy(double mu, bool of_round_trip) const {
-    Incident in;
-    in.wi = Vec3(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
-    in.wi_in = refract_in(in.wi, inv_eta0_);
-    if (!(in.wi_in.z > 0)) return Rgb(0.0);
-    incident_coat(in);
+    Rgb sum =
+        visible_rule_energy<Rgb>(mu, of_round_trip, [](const Rgb& v, const Vec3&) { return v; });
     const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
-    const GGX fixed{of_round_trip ? round_trip_alpha(in.k_top, in.k_top)
-                                  : effective_alpha(in.k_top, in.k_top)};
-    if (!(fixed.alpha > 0)) return Rgb(0.0);
-    constexpr LobeForm kSpecular{true, false, false}, kMultiple{false, true, false};
-    const Vec3 w = in.wi_in;
-    auto outside = [&](const Vec3& v) {  // v inside, within the exit cone
-        return Vec3(v.x * eta0_, v.y * eta0_, safe_sqrt(1 - (1 - v.z * v.z) * sqr(eta0_)));
-    };
-    const double g1 = fixed.G1(w);
-    auto node = [&](const Vec3& wm) {
-        const Vec3 wo_in = reflect(w, wm);
-        if (wo_in.z <= mu_crit) return Rgb(0.0);
-        const double density = g1 * fixed.D(wm);
-        if (!(density > 0)) return Rgb(0.0);
-        const Vec3 wo = outside(wo_in);
-        const Rgb a_o = coat_attenuation(wo.z, wo_in.z);
-        return (of_round_trip ? round_trip(in, wo, wo_in, a_o)
-                              : first_order(in, wo, wo_in, a_o, kSpecular)) *
-               (sqr(eta0_) * wo_in.z * 4 * w.z / density);
-    };
-    auto height = [&](const Vec3& wm) { return reflect(w, wm).z; };
-    // The round trips' lobe is wider than its rule's GGX where wo is oblique (α_r follows k_o),
-    // and it carries more of the light: twice the nodes in each direction.
-    Rgb sum = of_round_trip
-                  ? integrate_visible_split<Rgb, 2 * kSplitNr, 2 * kSplitNphi, kSplitBisections>(
-                        fixed, w, mu_crit, height, node)
-                  : integrate_visible_split<Rgb, kSplitNr, kSplitNphi, kSplitBisections>(
-                        fixed, w, mu_crit, height, node);
     if (base_ms_ && !of_round_trip) {
+        Incident in;
+        in.wi = Vec3(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-4));
+        in.wi_in = refract_in(in.wi, inv_eta0_);
+        if (!(in.wi_in.z > 0)) return Rgb(0.0);
+        incident_coat(in);
+        auto outside = [&](const Vec3& v) {
+            return Vec3(v.x * eta0_, v.y * eta0_, safe_sqrt(1 - (1 - v.z * v.z) * sqr(eta0_)));
+        };
+        constexpr LobeForm kMultiple{false, true, false};
         // f_1 of the separable lobe is F_ms ΔE(μi') ΔE(μo')/(π ΔĒ) times the coat's factors.
         const Rgb ms = integrate_split01<kGauss, Rgb>(
             [&](double mu_in) {

@@ -73,11 +73,19 @@ struct CosineCurve {
         for (int i = 0; i < kN; ++i)
             v[i] = f(sqr(double(i) / (kN - 1)));
     }
-    V operator()(double mu) const {
+    /// Where μ falls: between nodes i and i + 1, t the weight of node i + 1.
+    struct Place {
+        int i;
+        double t;
+    };
+    static Place locate(double mu) {
         const double s = std::sqrt(clamp(mu, 0.0, 1.0)) * (kN - 1);
         const int i = std::min(int(s), kN - 2);
-        const double t = s - i;
-        return v[i] * (1 - t) + v[i + 1] * t;
+        return {i, s - i};
+    }
+    V operator()(double mu) const {
+        const Place p = locate(mu);
+        return v[p.i] * (1 - p.t) + v[p.i + 1] * p.t;
     }
 };
 

@@ -146,8 +146,9 @@ inline Rgb Bsdf::first_order(const Incident& in, const Vec3& wo, const Vec3& wo_
 /// (wi', wo') with the GGX of α_r (Walter et al. 2007, Eq. 20, with the height-correlated G2 of
 /// Heitz 2014, Eq. 99; round_trip_alpha: the base's two reflections and the coat bottom's one
 /// widen the first order's α_e), entering and leaving as the first order does
-/// (T_pair, T_exit, a, 1/η0²), times the round trips' sum k/(1 − k), k = a² E_b R_in, as √ of it
-/// at each end: symmetric in (wi, wo), as the mirror series' factor is.
+/// (T_pair, T_exit, a, 1/η0²), times its scale s(μ) at each end (μi and μo outside; solved at
+/// construction so that the lobe carries the series' energy, precompute_round_trips):
+/// symmetric in (wi, wo).
 inline Rgb Bsdf::round_trip(const Incident& in, const Vec3& wo, const Vec3& wo_in,
                             const Rgb& a_o) const {
     if (!(in.wi_in.z > 0 && wo_in.z > 0)) return Rgb(0.0);
@@ -158,7 +159,7 @@ inline Rgb Bsdf::round_trip(const Incident& in, const Vec3& wo, const Vec3& wo_i
                    (ggx.D(h) * ggx.G2(in.wi_in, wo_in) / (4 * in.wi_in.z * wo_in.z));
     double T_o = T_top_(wo.z);
     if (inside_exit_) T_o = std::sqrt(T_o * exit_transmittance(wo.z, wo_in.z, k_o));
-    return fb * (in.a * a_o) * round_trip_curve_(in.wi_in.z) * round_trip_curve_(wo_in.z) *
+    return fb * (in.a * a_o) * round_trip_curve_(in.wi.z) * round_trip_curve_(wo.z) *
            (in.T_pair * T_o * (ch_.eta2_factor ? inv_eta0_ * inv_eta0_ : 1.0));
 }
 

@@ -82,8 +82,8 @@ enum GpuFlag : unsigned {
     kGpuBaseOrders = 1u << 17,       ///< the base's: F_ms ΔE(μi') ΔE(μo')/(π ΔĒ)
     kGpuBinsOn = 1u << 18,           ///< a slab's inside light in bins, from kGpuBinsCuts on
     kGpuCoatSpread = 1u << 19,       ///< a rough absorbing coat's a(μ) (Bsdf::coat_attenuation)
-    /// The round trips' lobe (Bsdf::round_trip), its curve at kGpuMirrorSeries (the mirror
-    /// series is never on with it).
+    /// The round trips' lobe (Bsdf::round_trip), its curve (kNx nodes over outside cosines) at
+    /// kGpuMirrorSeries (the mirror series is never on with it).
     kGpuRoundTrip = 1u << 20,
 };
 
@@ -153,9 +153,9 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
         v[kGpuTTop + kNmu + i] = float(T_top_.curve.above[i]);
         v[kGpuTTopIn + i] = float(T_top_in_.curve.below[i]);
         v[kGpuTTopIn + kNmu + i] = float(T_top_in_.curve.above[i]);
-        const CosineCurve<Rgb>& rounds = round_trip_on_ ? round_trip_curve_ : mirror_series_curve_;
-        for (int c = 0; c < 3; ++c)
-            v[kGpuMirrorSeries + 3 * i + c] = float(rounds.v[i][c]);
+        if (!round_trip_on_)
+            for (int c = 0; c < 3; ++c)
+                v[kGpuMirrorSeries + 3 * i + c] = float(mirror_series_curve_.v[i][c]);
         if (top_ms_) v[kGpuDRTop + i] = float(dR_top_.v[i]);
         if (base_ms_) v[kGpuDEBase + i] = float(dE_base_.v[i]);
         if (a_coat_on_)
@@ -167,8 +167,10 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     for (int i = 0; i < kNmu; ++i)
         v[kGpuBaseAlbedo + i] = float(base_albedo(sqr(double(i) / (kNmu - 1))).mean());
     for (int i = 0; i < kNx; ++i)
-        for (int c = 0; c < 3; ++c)
+        for (int c = 0; c < 3; ++c) {
             v[kGpuX + 3 * i + c] = float(X_.v[i][c]);
+            if (round_trip_on_) v[kGpuMirrorSeries + 3 * i + c] = float(round_trip_curve_.v[i][c]);
+        }
     for (int i = 0; i < kNnorm; ++i)
         v[kGpuLobeNorm + i] = float(lobe_norm_.v[i]);
     for (int i = 0; i < FacetDeflection::kN; ++i) {

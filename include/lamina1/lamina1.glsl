@@ -228,10 +228,10 @@ vec3 l1_base_lobe(vec3 wi_in, float k_top, float lobe_norm_i, float mu_o, vec3 w
 }
 
 // The round trips' lobe (Bsdf::round_trip): the base's Walter lobe of α_r² = α_e² + α1² + α0²,
-// entering and leaving as the first order, times the curve √(k/(1 − k)), k = a² E_b R_in, at both
-// ends.
-vec3 l1_round_trip(vec3 wi_in, float k_top, vec3 wo, vec3 wo_in, vec3 a_pair, float T_pair,
-                   float eta2) {
+// entering and leaving as the first order, times its scale s(μ) at both ends (outside cosines;
+// solved in C++ so that it carries the series' energy).
+vec3 l1_round_trip(float mu_i, vec3 wi_in, float k_top, vec3 wo, vec3 wo_in, vec3 a_pair,
+                   float T_pair, float eta2) {
     float alpha1 = l1_at(5), alpha0 = l1_at(4);
     float k_o = l1_spread_factor(wo.z, wo_in.z);
     float alpha_e2 = l1_flag(13) ? alpha1 * alpha1
@@ -242,8 +242,8 @@ vec3 l1_round_trip(vec3 wi_in, float k_top, vec3 wo, vec3 wo_in, vec3 a_pair, fl
     vec3 fb = l1_base_fresnel(dot(wi_in, h)) * (l1_ggx_d(alpha, h) * G / (4.0 * wi_in.z * wo_in.z));
     float T_o = l1_transmittance(0, wo.z);
     if (l1_flag(4)) T_o = sqrt(T_o * l1_exit_transmittance(wo.z, wo_in.z, k_o));
-    return fb * a_pair * l1_cosine_curve3(L1_MIRROR, L1_NMU, wi_in.z) *
-           l1_cosine_curve3(L1_MIRROR, L1_NMU, wo_in.z) * (T_pair * T_o * eta2);
+    return fb * a_pair * l1_cosine_curve3(L1_MIRROR, L1_NX, mu_i) *
+           l1_cosine_curve3(L1_MIRROR, L1_NX, wo.z) * (T_pair * T_o * eta2);
 }
 
 // ---- A slab's inside light in bins (lamina1/slab.h) ----
@@ -358,7 +358,7 @@ vec3 lamina1_eval(vec3 wi, vec3 wo) {
     float eta2 = l1_flag(9) ? inv_eta0 * inv_eta0 : 1.0;
     f += fb * (a * a_o) * rounds * (T_pair * T_o * eta2);
     if (l1_flag(2)) f += X * l1_x_at(wo.z) * l1_rgb(19) * (L1_INV_PI * inv_eta0 * inv_eta0);
-    if (l1_flag(20) && wo_in.z > 0.0) f += l1_round_trip(wi_in, k_top, wo, wo_in, a * a_o, T_pair, eta2);
+    if (l1_flag(20) && wo_in.z > 0.0) f += l1_round_trip(wi.z, wi_in, k_top, wo, wo_in, a * a_o, T_pair, eta2);
     if (l1_flag(18)) f += l1_bins_reflection(wi, wo);
     return f;
 }
