@@ -8,8 +8,10 @@
 //   f_R = f_top                                       exact Walter reflection of the coat
 //       + T(μi) T(μo) a(μi') a(μo') f_b(wi', wo'; α_e) / η0²     first order through the coat
 //       + K X(μi) X(μo) / (π η0²)                    inter-reflections (separable, reciprocal)
-//       + T a a f_b(wi', wo'; α_r) s(μi') s(μo') / η0²   the round trips over a conductor smoother
-//                                                    than the coat, energy taken from K X X
+//       + T a a f_b(wi', wo'; α_r) s(μi) s(μo) / η0²   the round trips over a conductor smoother
+//                                                    than the coat, in place of K X X: s solved
+//                                                    so that they carry what the returned light
+//                                                    lets out, followed by its direction
 //   f_T = E_1(μi) f_t,b(w̄i', wo; α_b) / T_b,in(μ̄i'; α_b)   first order through the slab's bottom
 //       + B(μo)ᵀ W_s s(μi) D C(μi)                    later orders, the inside light in bins
 //   (a slab's reflection: C(μo)ᵀ W (g P₁ g + P₂) C(μi) in place of K X X; lamina1/slab.h)
@@ -141,9 +143,14 @@ class Bsdf {
     /// summed as V (the round trips' solve sums it onto the two nodes of their curve about wo).
     template <typename V, typename Out>
     V visible_rule_energy(double mu, bool of_round_trip, Out&& out) const;
-    void precompute_round_trips(const Rgb& gain);
+    void precompute_round_trips(const Rgb& gain, const CosineCurve<Rgb, kNx>& leaving);
     Rgb returned_light(double mu, const RgbEdgeCurve<33>& g_curve, const Rgb& Y_ms) const;
-    void precompute_returned(const RgbEdgeCurve<33>& g_curve);
+    void precompute_returned(const RgbEdgeCurve<33>& g_curve,
+                             CosineCurve<Rgb, kNx>* leaving = nullptr);
+    RgbEdgeCurve<33> returned_escape() const;
+    /// R_eff(μ): of the light going up at inside cosine μ, the part the first order does not let
+    /// out, which is returned (precompute_albedos).
+    double returned_share(double mu) const;
     void precompute_scattering();
     struct AddingEnergies;
     AddingEnergies adding_energies() const;
@@ -480,8 +487,8 @@ class Bsdf {
     CosineCurve<Rgb> mirror_series_curve_;
     /// The round trips' lobe (Options::round_trip_lobe, where the series is summed over a
     /// conductor smoother than the coat; never with the mirror series), and its scale s(μ) over
-    /// outside cosines, on X's nodes, solved so that the lobe carries the series' energy
-    /// (precompute_round_trips).
+    /// outside cosines, on X's nodes, solved so that the lobe carries what the returned light
+    /// lets out (precompute_round_trips, returned_escape).
     bool round_trip_on_ = false;
     CosineCurve<Rgb, kNx> round_trip_curve_;
     CosineCurve<double> dR_top_, dE_base_;

@@ -252,6 +252,13 @@ inline void Bsdf::precompute_coat_attenuation() {
     });
 }
 
+inline double Bsdf::returned_share(double mu) const {
+    const double R_in = inside_reflectance(mu);
+    if (!(alpha0_ > 0)) return R_in;
+    const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
+    return std::max(0.0, R_in + T_top_in_(mu) - (mu > mu_crit ? first_order_exit(mu) : 0.0));
+}
+
 /// The hemispherical albedos r̄ (the coat's bottom, with the medium's round trip), Ē_b (the
 /// base) and t̄ (the coat's diffuse exit); returns g(μ) = a(μ)² R_eff(μ), the light a return trip
 /// base → coat → base keeps, tabulated for Y.
@@ -276,10 +283,7 @@ inline RgbEdgeCurve<33> Bsdf::precompute_albedos() {
     // series, R_eff = R_in + T_in.
     auto g_direct = [&](double mu) {
         const Rgb a = attenuation(mu);
-        double R = inside_reflectance(mu);
-        if (alpha0_ > 0)
-            R = std::max(0.0, R + T_top_in_(mu) - (mu > mu_crit ? first_order_exit(mu) : 0.0));
-        return a * a * R;
+        return a * a * returned_share(mu);
     };
     // Tabulated once (Y's quadrature looks it up at every node); the node μ = 0 is taken at 1e-6,
     // where an index-matched coat's Fresnel factor is its limit 0 (not the 0/0 of grazing). Its
@@ -373,20 +377,22 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
     if (!series_on_) return;
     balance_ = ch_.first_order_balance && alpha0_ > 0 && ch_.directional_transmittance &&
                layers_.base != Base::Lambertian;
-    precompute_returned(g_curve);
     // The round trips as a lobe of their own (Options::round_trip_lobe): where the series is
     // summed over a conductor smoother than the coat (the orders ≥ 2 restored; a rough coat, the
     // directional transmittance), the returned light leaves near the mirror direction, not as
-    // uniform radiance (docs/models.md, lamina-1, item 3): the lobe takes the series' energy.
+    // uniform radiance (docs/models.md, lamina-1, item 3): the lobe takes the light the returned
+    // light lets out, followed by its direction through the round trips (returned_escape).
     round_trip_on_ = ch_.round_trip_lobe && layers_.base == Base::Conductor && alpha1_ < alpha0_ &&
                      alpha0_ > 0 && ch_.directional_transmittance;
+    CosineCurve<Rgb, kNx> leaving;
+    precompute_returned(g_curve, round_trip_on_ ? &leaving : nullptr);
     if (round_trip_on_) {
         Rgb gain(0.0);
         for (int c = 0; c < 3; ++c) {
             const double one_minus = 1 - E_bar_[c] * r_bar_[c];
             gain[c] = one_minus > 0 ? E_bar_[c] * t_bar_[c] / one_minus : 0.0;
         }
-        precompute_round_trips(gain);
+        precompute_round_trips(gain, leaving);
     }
     // X̄ = (2/η0²)∫ X(μ) μ dμ: the diffuse exit's normalization.
     X_bar_ = integrate_split01<kGauss, Rgb>([&](double mu) { return X_at(mu) * (2 * mu); }, 0.0) *
@@ -400,18 +406,18 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
     }
 }
 
-/// The round trips' scale (Options::round_trip_lobe). The series lets out X(μ) G of the light
-/// arriving at outside cosine μ (G = Ē_b t̄/(1 − Ē_b r̄), the energy it lets out per unit of X);
-/// the lobe is to carry that energy instead, with the series' total kept. Its form
-/// s(μi) s(μo) L(wi, wo) (L the lobe of Bsdf::round_trip with a unit scale) is reciprocal
-/// whatever s is. On the nodes μ_i of X's curve, where s has its own, the lobe's energy is
-/// E_i = s_i Σ_j M_ij s_j, M_ij = ∫ L(wi_i, wo) w_j(μo) μo dωo, w_j the curve's interpolation
-/// weights (each node of first_order_energy's rule summed onto the two nodes about its μo).
-/// E_i = X_i G at every node is a symmetric matrix-scaling problem, solved by the damped fixed
-/// point s ← √(s X G / (M s)) (the symmetric form of Sinkhorn's iteration; 20–40 steps to
-/// 10⁻⁹ here). What the lobe carries is then taken from the series, X ← X − E/G; what is left
-/// (where no light reaches the lobe's row: grazing incidence) stays uniform.
-inline void Bsdf::precompute_round_trips(const Rgb& gain) {
+/// The round trips' scale (Options::round_trip_lobe). The lobe carries what the returned light
+/// lets out, L(μ) per unit of light arriving at outside cosine μ (precompute_returned, with its
+/// escape followed by direction: returned_escape). Its form s(μi) s(μo) L(wi, wo) (L the lobe of
+/// Bsdf::round_trip with a unit scale) is reciprocal whatever s is. On the nodes μ_i of X's
+/// curve, where s has its own, the lobe's energy is E_i = s_i Σ_j M_ij s_j, M_ij = ∫ L(wi_i, wo)
+/// w_j(μo) μo dωo, w_j the curve's interpolation weights (each node of first_order_energy's rule
+/// summed onto the two nodes about its μo). E_i = L_i at every node is a symmetric
+/// matrix-scaling problem, solved by the damped fixed point s ← √(s L / (M s)) (the symmetric
+/// form of Sinkhorn's iteration; 20–40 steps to 10⁻⁹ here). What the lobe does not carry (where
+/// no light reaches its row: grazing incidence) stays in the series, as X = (L − E)/G with G =
+/// Ē_b t̄/(1 − Ē_b r̄) the energy the series lets out per unit of X.
+inline void Bsdf::precompute_round_trips(const Rgb& gain, const CosineCurve<Rgb, kNx>& leaving) {
     constexpr int kN = kNx;
     using Curve = CosineCurve<Rgb, kN>;
     round_trip_curve_.fill([](double) { return Rgb(1.0); });
@@ -443,7 +449,7 @@ inline void Bsdf::precompute_round_trips(const Rgb& gain) {
             return sum;
         };
         for (int i = 0; i < kN; ++i) {
-            target[i] = std::max(X_.v[i][c] * gain[c], 0.0);
+            target[i] = std::max(leaving.v[i][c], 0.0);
             double row = 0;
             for (int j = 0; j < kN; ++j)
                 row += M[i].m[j][c];
@@ -467,9 +473,9 @@ inline void Bsdf::precompute_round_trips(const Rgb& gain) {
     }
     for (int i = 0; i < kN; ++i)
         for (int c = 0; c < 3; ++c) {
-            const double X = X_.v[i][c], left = X - (gain[c] > 0 ? E[i][c] / gain[c] : 0.0);
+            const double L = leaving.v[i][c], left = L - E[i][c];
             // What the solve matched (to 10⁻⁹) leaves a remainder of rounding, not light.
-            X_.v[i][c] = left > 1e-6 * X ? left : 0.0;
+            X_.v[i][c] = left > 1e-6 * L && gain[c] > 0 ? left / gain[c] : 0.0;
         }
 }
 
@@ -583,7 +589,8 @@ inline Rgb Bsdf::returned_light(double mu, const RgbEdgeCurve<33>& g, const Rgb&
 }
 
 /// X(μ), the light the coat's bottom returns to the base after the first order (item 3).
-inline void Bsdf::precompute_returned(const RgbEdgeCurve<33>& g_curve) {
+inline void Bsdf::precompute_returned(const RgbEdgeCurve<33>& g_curve,
+                                      CosineCurve<Rgb, kNx>* leaving) {
     const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
     // The base's separable multiple-scattering lobe sends what it receives, averaged over its
     // directions: Y_ms = ∫ ΔE g 2μ'' dμ'' / ΔĒ for a curve g of what the way up keeps.
@@ -630,8 +637,20 @@ inline void Bsdf::precompute_returned(const RgbEdgeCurve<33>& g_curve) {
     RgbEdgeCurve<17> Y_curve;
     Y_curve.fill(mu_crit, Y);
     const Rgb Y_spread = spread(Y_curve);
+    // What X lets out in the end (where the round trips' lobe carries it): Y with the escape
+    // that returned_escape follows in place of what the way up keeps, through the coat as X.
+    RgbEdgeCurve<17> YL_curve;
+    Rgb YL_spread(0.0);
+    if (leaving) {
+        const RgbEdgeCurve<33> escape = returned_escape();
+        const Rgb YL_ms = ms_average(escape);
+        YL_curve.fill(mu_crit, [&](double mu) { return returned_light(mu, escape, YL_ms); });
+        YL_spread = spread(YL_curve);
+    }
     if (!balance_) {
         X_.fill([&](double mu) { return through_coat(Y_curve, Y_spread, mu); });
+        if (leaving)
+            leaving->fill([&](double mu) { return through_coat(YL_curve, YL_spread, mu); });
         return;
     }
     // The first order's balance: the accounting above returns what the first order does not let
@@ -653,13 +672,147 @@ inline void Bsdf::precompute_returned(const RgbEdgeCurve<33>& g_curve) {
     CosineCurve<Rgb, (kNx + 1) / 2> excess;
     excess.fill(
         [&](double mu) { return through_coat(Z_curve, Z_spread, mu) - first_order_energy(mu); });
+    int node = 0;
     X_.fill([&](double mu) {
         const Rgb X = through_coat(Y_curve, Y_spread, mu);
         Rgb out = X + excess(mu) * attenuation(inside_cos(mu));
         for (int c = 0; c < 3; ++c)
             out[c] = std::max(out[c], 0.0);
+        // What X lets out, with the balance: light the first order's lobe does not carry (the
+        // accounting's exit exceeds it) is returned as X is and lets out the same share of
+        // itself; light the lobe carries beyond the accounting (at grazing incidence, where the
+        // coat sends most of what it transmits beyond the exit cone while the lobe stays on the
+        // macro refraction) is taken from what leaves, whole — taken from X it would leave a
+        // share 1 − G of itself too much (docs/models.md, lamina-1, item 3).
+        if (leaving) {
+            const Rgb XL = through_coat(YL_curve, YL_spread, mu), ex = excess(mu);
+            const Rgb a_in = attenuation(inside_cos(mu));
+            for (int c = 0; c < 3; ++c) {
+                const double share = X[c] > 0 ? XL[c] / X[c] : 0.0;
+                leaving->v[node][c] =
+                    std::max(XL[c] + (ex[c] < 0 ? ex[c] : ex[c] * a_in[c] * share), 0.0);
+            }
+        }
+        ++node;
         return out;
     });
+}
+
+/// The light that returned light lets out in the end, followed by its direction (where the
+/// round trips' lobe carries it; docs/models.md, lamina-1, item 3). The series lets out G =
+/// Ē_b t̄/(1 − Ē_b r̄) of it, hemispherical averages as if the light inside were uniform. Over a
+/// metal smoother than the coat it is not: it stays near the direction it came with, spread a
+/// little by each reflection at the coat's bottom, and near the critical angle (grazing light
+/// outside) most of it is reflected back again and again, each time losing 1 − E_b to the metal,
+/// where the averages let it out at the diffuse rate. Here the light is followed on inside
+/// cosines: e(μ), what light arriving at the base going down at μ lets out, solves
+///   e(μ) = E_b(μ) a(μ) [T_in(μ) + R_in(μ) ∫ P(μ → μ'') a(μ'') e(μ'') dμ'']
+/// (the base keeps the direction, being smoother than the coat; T_in and R_in the coat's bottom
+/// seen from inside, with its orders ≥ 2; P the cosine its single-scattering reflection sends
+/// the light to, normalized: Walter et al. 2007, Eq. 20 with the height-correlated G2 of Heitz
+/// 2014, Eq. 99, by its visible normals), a linear system on the curve's nodes. Returned: the
+/// counterpart of g(μ) = a² R_eff (what a return trip keeps, precompute_albedos) — what light
+/// going up at μ from the base lets out in the end: a(μ) times the part of R_eff that the coat's
+/// tilted facets let out at once (T_in beyond the first order's exit), plus the rest reflected
+/// and followed by e.
+inline RgbEdgeCurve<33> Bsdf::returned_escape() const {
+    const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
+    constexpr int kH = 17, kN = 2 * kH;  // nodes below and above the critical cosine
+    SplitCurve<kH, double, true> nodes;
+    nodes.fill(mu_crit, [](double) { return 0.0; });
+    auto index = [](bool lower, int i) { return lower ? i : kH + i; };
+    // P(μ_n → ·), shared between the two nodes about each reflected cosine, rows normalized.
+    std::array<std::array<double, kN>, kN> P{};
+    std::array<double, kN> mu_n{};
+    for (int n = 0; n < kN; ++n) {
+        const bool lower = n < kH;
+        const double mu = std::max(nodes.node(lower ? n : n - kH, lower), 1e-4);
+        mu_n[n] = mu;
+        const Vec3 w(safe_sqrt(1 - mu * mu), 0, mu);
+        const double lambda_w = coat_ggx_.lambda(w);
+        double sum = 0;
+        for_visible_normals<kBinNr, kBinNphi>(coat_ggx_, w, [&](const Vec3& wm, double weight) {
+            const Vec3 r = reflect(w, wm);
+            if (r.z <= 0) return;
+            const double v = fresnel_dielectric(dot(w, wm), inv_eta0_) * weight * (1 + lambda_w) /
+                             (1 + lambda_w + coat_ggx_.lambda(r));
+            const auto p = nodes.locate(r.z);
+            P[n][index(p.lower, p.i)] += v * (1 - p.t);
+            P[n][index(p.lower, p.i + 1)] += v * p.t;
+            sum += v;
+        });
+        if (sum > 0)
+            for (double& x : P[n])
+                x /= sum;
+        else
+            P[n][n] = 1;
+    }
+    // e on the nodes, per channel, by Gaussian elimination with partial pivoting; where the
+    // system is singular (no way out anywhere: a lossless mirror under a coat that lets nothing
+    // out), the light is let out at the series' rate.
+    std::array<Rgb, kN> e{};
+    for (int c = 0; c < 3; ++c) {
+        std::array<std::array<double, kN + 1>, kN> A{};
+        for (int n = 0; n < kN; ++n) {
+            const double mu = mu_n[n];
+            const double d = base_albedo(mu)[c] * attenuation(mu)[c];
+            for (int m = 0; m < kN; ++m)
+                A[n][m] = (n == m ? 1.0 : 0.0) -
+                          d * inside_reflectance(mu) * P[n][m] * attenuation(mu_n[m])[c];
+            A[n][kN] = d * T_top_in_(mu);
+        }
+        bool singular = false;
+        for (int k = 0; k < kN && !singular; ++k) {
+            int pivot = k;
+            for (int n = k + 1; n < kN; ++n)
+                if (std::abs(A[n][k]) > std::abs(A[pivot][k])) pivot = n;
+            std::swap(A[k], A[pivot]);
+            if (!(std::abs(A[k][k]) > 1e-12)) {
+                singular = true;
+                break;
+            }
+            for (int n = k + 1; n < kN; ++n) {
+                const double f = A[n][k] / A[k][k];
+                for (int m = k; m <= kN; ++m)
+                    A[n][m] -= f * A[k][m];
+            }
+        }
+        for (int k = kN - 1; k >= 0 && !singular; --k) {
+            double x = A[k][kN];
+            for (int m = k + 1; m < kN; ++m)
+                x -= A[k][m] * e[m][c];
+            e[k][c] = x / A[k][k];
+        }
+        if (singular) {
+            const double one_minus = 1 - E_bar_[c] * r_bar_[c];
+            const double gain = one_minus > 0 ? E_bar_[c] * t_bar_[c] / one_minus : 0.0;
+            for (int n = 0; n < kN; ++n)
+                e[n][c] = gain;
+        }
+    }
+    // ρ(μ) = ∫ P(μ → μ'') a(μ'') e(μ''): what light the coat's bottom reflects from μ lets out.
+    SplitCurve<kH, Rgb, true> rho;
+    rho.split = nodes.split;
+    for (int n = 0; n < kN; ++n) {
+        Rgb sum(0.0);
+        for (int m = 0; m < kN; ++m)
+            sum += attenuation(mu_n[m]) * e[m] * P[n][m];
+        (n < kH ? rho.below[n] : rho.above[n - kH]) = sum;
+    }
+    RgbEdgeCurve<33> escape;
+    escape.fill(mu_crit, [&](double mu_raw) {
+        const double mu = std::max(mu_raw, 1e-6);  // as g's nodes
+        const Rgb a = attenuation(mu);
+        // The tilted facets' share of R_eff (T_in beyond the first order's exit) leaves at once,
+        // the rest is reflected.
+        const double R_in = inside_reflectance(mu), R_eff = returned_share(mu);
+        const double at_once = std::min(std::max(R_eff - R_in, 0.0), R_eff);
+        Rgb out;
+        for (int c = 0; c < 3; ++c)
+            out[c] = a[c] * (at_once + (R_eff - at_once) * rho(mu)[c]);
+        return out;
+    });
+    return escape;
 }
 
 }  // namespace lamina1

@@ -100,27 +100,41 @@ template <int kN, typename V = Rgb, bool kSqrtEdge = false>
 struct SplitCurve {
     double split = 0;
     std::array<V, kN> below{}, above{};
+    /// The cosine of node i below the split (lower) or above it.
+    double node(int i, bool lower) const {
+        const double t = double(i) / (kN - 1);
+        return lower
+                   ? std::min(split * (kSqrtEdge ? 1 - sqr(1 - t) : t), std::nextafter(split, 0.0))
+                   : split + (1 - split) * (kSqrtEdge ? t * t : t);
+    }
     template <typename F>
     void fill(double mu_split, F&& f) {
         split = clamp(mu_split, 0.0, 1.0);
         for (int i = 0; i < kN; ++i) {
-            const double t = double(i) / (kN - 1);
-            if (split > 0)  // else never read
-                below[i] = f(
-                    std::min(split * (kSqrtEdge ? 1 - sqr(1 - t) : t), std::nextafter(split, 0.0)));
-            above[i] = f(split + (1 - split) * (kSqrtEdge ? t * t : t));
+            if (split > 0) below[i] = f(node(i, true));  // else never read
+            above[i] = f(node(i, false));
         }
     }
-    V operator()(double mu) const {
+    /// Where μ falls: on which side of the split, between nodes i and i + 1 of it, t the weight
+    /// of node i + 1.
+    struct Place {
+        bool lower;
+        int i;
+        double t;
+    };
+    Place locate(double mu) const {
         const bool lower = mu < split;
         const double a = lower ? 0 : split, b = lower ? split : 1;
-        const auto& v = lower ? below : above;
         double x = b > a ? clamp((mu - a) / (b - a), 0.0, 1.0) : 0;
         if (kSqrtEdge) x = lower ? 1 - std::sqrt(1 - x) : std::sqrt(x);
         x *= kN - 1;
         const int i = std::min(int(x), kN - 2);
-        const double t = x - i;
-        return v[i] * (1 - t) + v[i + 1] * t;
+        return {lower, i, x - i};
+    }
+    V operator()(double mu) const {
+        const Place p = locate(mu);
+        const auto& v = p.lower ? below : above;
+        return v[p.i] * (1 - p.t) + v[p.i + 1] * p.t;
     }
 };
 

@@ -48,8 +48,8 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table() {
             "round-trip", &L1::round_trip_lobe, {{"lobe", true}, {"series", false}},
             "the round trips (base, coat bottom, base) over a conductor smoother than the coat, "
             "where the series is summed: a lobe about the mirror direction widened by the coat "
-            "bottom's reflection, its energy taken from the series (lobe), or in the uniform "
-            "series (series)"),
+            "bottom's reflection, carrying what the returned light lets out followed by its "
+            "direction (lobe), or the uniform series with its average escape (series)"),
         on_off_member<L1>("first-order-balance", &L1::first_order_balance,
                           "the energy the first order's lobe does not carry out (against the "
                           "light inside the exit cone times its exit transmittance) returned "

@@ -301,7 +301,7 @@ TEST(Lamina1, MultipleScatteringWhiteFurnace) {
 TEST(Lamina1, MultipleScatteringWhiteFurnaceOverAMirror) {
     BinnedOptions o;
     o.rel_tol = 1e-3;
-    double worst_off = 0;
+    double worst_off = 0, lowest = 2, highest = 0;
     for (double eta : {1.2, 1.5, 2.0})
         for (double alpha : {0.1, 0.3, 0.7})
             for (double alpha1 : {0.0, 0.05, 0.3}) {
@@ -312,55 +312,45 @@ TEST(Lamina1, MultipleScatteringWhiteFurnaceOverAMirror) {
                                             {"microsurface=multiple", "first-order-balance=off"});
                 for (double ti : {0.0, 45.0, 70.0, 85.0}) {
                     const Vec3d wi = incident_direction(deg_to_rad(ti));
-                    EXPECT_NEAR(model_albedo(*model, wi, Side::Reflection, o).mean(), 1.0, 0.02)
+                    const double albedo = model_albedo(*model, wi, Side::Reflection, o).mean();
+                    lowest = std::min(lowest, albedo);
+                    highest = std::max(highest, albedo);
+                    EXPECT_NEAR(albedo, 1.0, 0.02)
                         << "eta0=" << eta << " a0=" << alpha << " a1=" << alpha1 << " ti=" << ti;
                     worst_off = std::max(
                         worst_off,
                         std::abs(model_albedo(*off, wi, Side::Reflection, o).mean() - 1.0));
                 }
             }
+    std::printf("white mirror under rough coats: albedo %.4f to %.4f\n", lowest, highest);
     EXPECT_GT(worst_off, 0.1);
 }
 
-// The round trips' lobe (round-trip=lobe, the default) takes its energy from the uniform series:
-// over conductors smoother than the coat the albedo is the series' alone's, within the two
-// quadratures' budgets (model_albedo's 10⁻⁴ relative and the construction's: the visible-normal
-// rule for the lobe's energy on its scale's nodes, and the interpolation between them; largest at
-// 70°–85° under η0 1.2: 1.3·10⁻³ here), while the light near the mirror direction grows and the
-// light far from it shrinks. Where the lobe does not apply (a base as rough as the coat) the two
-// choices are the same model.
-TEST(Lamina1, RoundTripLobeKeepsTheSeriesEnergy) {
-    BinnedOptions o;
-    o.rel_tol = 1e-4;
-    double worst = 0;
+// The round trips' lobe (round-trip=lobe, the default) puts the returned light near the mirror
+// direction, where the series spreads it uniformly: the ratio of the light at the mirror direction
+// to the light far from it (60° away) is larger with the lobe, under coats whose lobe is narrower
+// than that (α0 ≤ 0.3; under α0 0.6 and η0 2 the lobe, α_r ≈ 0.64, reaches 60° at normal
+// incidence). Where the lobe does not apply (a base as rough as the coat) the two choices are the
+// same model. (Its energy: the white furnace over a mirror above, and against the particles at
+// grazing incidence, Lamina1Stat below.)
+TEST(Lamina1, RoundTripLobeLeavesNearTheMirrorDirection) {
     for (double eta : {1.2, 1.5, 2.0})
-        for (double alpha : {0.1, 0.3, 0.6})
+        for (double alpha : {0.1, 0.3})
             for (const InterfaceSpec& base : {test::gold(0.001), test::gold(0.05),
                                               test::conductor(Rgbd(0.2), Rgbd(3.0), 0.0)}) {
                 const Stack stack = coated(eta, alpha, base);
                 const auto lobe = make_model("lamina-1", stack, {"microsurface=multiple"});
                 const auto series =
                     make_model("lamina-1", stack, {"microsurface=multiple", "round-trip=series"});
-                for (double ti : {0.0, 45.0, 70.0, 85.0}) {
+                for (double ti : {0.0, 45.0, 70.0}) {
+                    // More of the light near the mirror direction than far from it.
                     const Vec3d wi = incident_direction(deg_to_rad(ti));
-                    const Rgbd a = model_albedo(*lobe, wi, Side::Reflection, o);
-                    const Rgbd b = model_albedo(*series, wi, Side::Reflection, o);
-                    for (int c = 0; c < 3; ++c) {
-                        EXPECT_NEAR(a[c], b[c], 2e-3)
-                            << "eta0=" << eta << " a0=" << alpha << " ti=" << ti << " c=" << c;
-                        worst = std::max(worst, std::abs(a[c] - b[c]));
-                    }
-                    // Near the mirror direction the lobe adds, far from it the series loses.
-                    const Vec3d mirror(-wi.x, -wi.y, wi.z);
-                    if (ti < 80) {
-                        EXPECT_GT(lobe->eval(wi, mirror).mean(), series->eval(wi, mirror).mean());
-                        const Vec3d away = dir(60, ti > 0 ? 0 : 90);
-                        EXPECT_LT(lobe->eval(wi, away).mean(), series->eval(wi, away).mean())
-                            << "eta0=" << eta << " a0=" << alpha << " ti=" << ti;
-                    }
+                    const Vec3d mirror(-wi.x, -wi.y, wi.z), away = dir(60, ti > 0 ? 0 : 90);
+                    EXPECT_GT(lobe->eval(wi, mirror).mean() / lobe->eval(wi, away).mean(),
+                              series->eval(wi, mirror).mean() / series->eval(wi, away).mean())
+                        << "eta0=" << eta << " a0=" << alpha << " ti=" << ti;
                 }
             }
-    std::printf("round-trip lobe against the series: largest albedo difference %.2e\n", worst);
     // A base as rough as the coat: the series alone, both ways.
     const Stack rough = coated(1.5, 0.2, test::gold(0.3));
     const auto lobe = make_model("lamina-1", rough, {"microsurface=multiple"});
@@ -406,6 +396,37 @@ TEST(Lamina1Stat, RoundTripLobeIsCloserToParticlesThanTheSeries) {
         std::printf("θi %.0f°: misplaced %.4f (lobe) against %.4f (series), noise %.4f\n",
                     s.theta_i_deg[i], off_lobe / total, off_series / total, noise / total);
         EXPECT_LT(off_lobe, off_series - 2 * noise) << "θi " << s.theta_i_deg[i];
+    }
+}
+
+// The energy at grazing incidence under a nearly smooth coat: light at 80° enters a coat of η 1.5
+// just inside the exit cone (41.0° against 41.8°), and the rough coat sends most of what it
+// transmits beyond the cone, where it stays, reflected round after round between coat and gold,
+// which absorbs a part each time. Against the particles (exact reference, 10⁶ at 80°, fixed
+// seed) lamina-1's albedo is at most half as far off as with the series' average escape, less
+// twice the particles' standard error (measured: 0.542 particles, 0.544 lobe, 0.651 series in
+// green; blue 0.344, 0.351, 0.378; the standard error 4·10⁻⁴).
+TEST(Lamina1Stat, RoundTripEnergyAtGrazingIncidenceFollowsTheTrappedLight) {
+    const Stack stack = coated(1.5, 0.1, test::gold(0.001));
+    SimulationSettings s;
+    s.theta_i_deg = {80.0};
+    s.particles = 1'000'000;
+    s.seed = 20261205;
+    s.grid = HemisphereGrid(30, 30);
+    const SimulationResult ref = simulate(stack, s);
+    const Rgbd R = ref.incidences[0].budget[BudgetTerm::Reflected];
+    const Rgbd se = ref.incidences[0].budget.reflected_se;
+    BinnedOptions o;
+    o.rel_tol = 1e-4;
+    const Vec3d wi = incident_direction(deg_to_rad(80.0));
+    const Rgbd lobe = model_albedo(*make_model("lamina-1", stack), wi, Side::Reflection, o);
+    const Rgbd series = model_albedo(*make_model("lamina-1", stack, {"round-trip=series"}), wi,
+                                     Side::Reflection, o);
+    for (int c = 0; c < 3; ++c) {
+        std::printf("channel %d: particles %.4f ± %.4f, lobe %.4f, series %.4f\n", c, R[c], se[c],
+                    lobe[c], series[c]);
+        EXPECT_LT(std::abs(lobe[c] - R[c]) + 2 * se[c], 0.5 * std::abs(series[c] - R[c]))
+            << "channel " << c;
     }
 }
 
