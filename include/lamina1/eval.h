@@ -147,8 +147,8 @@ inline Rgb Bsdf::first_order(const Incident& in, const Vec3& wo, const Vec3& wo_
 /// Heitz 2014, Eq. 99; round_trip_alpha: the base's two reflections and the coat bottom's one
 /// widen the first order's α_e), entering and leaving as the first order does
 /// (T_pair, T_exit, a, 1/η0²), times its scale s(μ) at each end (μi and μo outside; solved at
-/// construction so that the lobe carries the series' energy, precompute_round_trips):
-/// symmetric in (wi, wo).
+/// construction so that the lobe carries what the returned light lets out,
+/// precompute_round_trips): symmetric in (wi, wo).
 inline Rgb Bsdf::round_trip(const Incident& in, const Vec3& wo, const Vec3& wo_in,
                             const Rgb& a_o) const {
     if (!(in.wi_in.z > 0 && wo_in.z > 0)) return Rgb(0.0);

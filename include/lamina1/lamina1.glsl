@@ -229,7 +229,7 @@ vec3 l1_base_lobe(vec3 wi_in, float k_top, float lobe_norm_i, float mu_o, vec3 w
 
 // The round trips' lobe (Bsdf::round_trip): the base's Walter lobe of α_r² = α_e² + α1² + α0²,
 // entering and leaving as the first order, times its scale s(μ) at both ends (outside cosines;
-// solved in C++ so that it carries the series' energy).
+// solved in C++ so that it carries what the returned light lets out).
 vec3 l1_round_trip(float mu_i, vec3 wi_in, float k_top, vec3 wo, vec3 wo_in, vec3 a_pair,
                    float T_pair, float eta2) {
     float alpha1 = l1_at(5), alpha0 = l1_at(4);
