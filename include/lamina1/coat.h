@@ -413,10 +413,12 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
 /// curve, where s has its own, the lobe's energy is E_i = s_i Σ_j M_ij s_j, M_ij = ∫ L(wi_i, wo)
 /// w_j(μo) μo dωo, w_j the curve's interpolation weights (each node of first_order_energy's rule
 /// summed onto the two nodes about its μo). E_i = L_i at every node is a symmetric
-/// matrix-scaling problem, solved by the damped fixed point s ← √(s L / (M s)) (the symmetric
-/// form of Sinkhorn's iteration; 20–40 steps to 10⁻⁹ here). What the lobe does not carry (where
-/// no light reaches its row: grazing incidence) stays in the series, as X = (L − E)/G with G =
-/// Ē_b t̄/(1 − Ē_b r̄) the energy the series lets out per unit of X.
+/// matrix-scaling problem, solved by the damped fixed point s ← √(s L / (M s)) (Sinkhorn's
+/// iteration, Sinkhorn & Knopp 1967, "Concerning nonnegative matrices and doubly stochastic
+/// matrices", Pacific J. Math. 21(2), in a symmetric form: the square root takes the geometric
+/// mean of the old scale and the one that would match row i alone; 20–40 steps to 10⁻⁹ here). What
+/// the lobe does not carry (where no light reaches its row: grazing incidence) stays in the series,
+/// as X = (L − E)/G with G = Ē_b t̄/(1 − Ē_b r̄) the energy the series lets out per unit of X.
 inline void Bsdf::precompute_round_trips(const Rgb& gain, const CosineCurve<Rgb, kNx>& leaving) {
     constexpr int kN = kNx;
     using Curve = CosineCurve<Rgb, kN>;
@@ -718,8 +720,8 @@ inline void Bsdf::precompute_returned(const RgbEdgeCurve<33>& g_curve,
 inline RgbEdgeCurve<33> Bsdf::returned_escape() const {
     const double mu_crit = std::sqrt(1 - sqr(inv_eta0_));
     constexpr int kH = 17, kN = 2 * kH;  // nodes below and above the critical cosine
-    SplitCurve<kH, double, true> nodes;
-    nodes.fill(mu_crit, [](double) { return 0.0; });
+    SplitCurve<kH, double, true> nodes;  // its nodes' cosines and locate() alone
+    nodes.split = mu_crit;
     auto index = [](bool lower, int i) { return lower ? i : kH + i; };
     // P(μ_n → ·), shared between the two nodes about each reflected cosine, rows normalized.
     std::array<std::array<double, kN>, kN> P{};
@@ -747,48 +749,33 @@ inline RgbEdgeCurve<33> Bsdf::returned_escape() const {
         else
             P[n][n] = 1;
     }
-    // e on the nodes, per channel, by Gaussian elimination with partial pivoting; where the
-    // system is singular (no way out anywhere: a lossless mirror under a coat that lets nothing
-    // out), the light is let out at the series' rate.
+    // e = (I − D R_in P A)⁻¹ D T_in on the nodes, per channel (D = diag(E_b a), A = diag(a));
+    // where the system is singular (no way out anywhere: a lossless mirror under a coat that
+    // lets nothing out; inverse() then gives the zero matrix, whose diagonal a true inverse of
+    // I − M, M ≥ 0, cannot have), the light is let out at the series' rate.
     std::array<Rgb, kN> e{};
     for (int c = 0; c < 3; ++c) {
-        std::array<std::array<double, kN + 1>, kN> A{};
+        FluxMatrix A(kN);
+        std::array<double, kN> b{};
         for (int n = 0; n < kN; ++n) {
             const double mu = mu_n[n];
             const double d = base_albedo(mu)[c] * attenuation(mu)[c];
             for (int m = 0; m < kN; ++m)
-                A[n][m] = (n == m ? 1.0 : 0.0) -
+                A(n, m) = (n == m ? 1.0 : 0.0) -
                           d * inside_reflectance(mu) * P[n][m] * attenuation(mu_n[m])[c];
-            A[n][kN] = d * T_top_in_(mu);
+            b[n] = d * T_top_in_(mu);
         }
-        bool singular = false;
-        for (int k = 0; k < kN && !singular; ++k) {
-            int pivot = k;
-            for (int n = k + 1; n < kN; ++n)
-                if (std::abs(A[n][k]) > std::abs(A[pivot][k])) pivot = n;
-            std::swap(A[k], A[pivot]);
-            if (!(std::abs(A[k][k]) > 1e-12)) {
-                singular = true;
-                break;
-            }
-            for (int n = k + 1; n < kN; ++n) {
-                const double f = A[n][k] / A[k][k];
-                for (int m = k; m <= kN; ++m)
-                    A[n][m] -= f * A[k][m];
-            }
-        }
-        for (int k = kN - 1; k >= 0 && !singular; --k) {
-            double x = A[k][kN];
-            for (int m = k + 1; m < kN; ++m)
-                x -= A[k][m] * e[m][c];
-            e[k][c] = x / A[k][k];
-        }
-        if (singular) {
+        const FluxMatrix inv = inverse(A);
+        if (inv(0, 0) == 0) {
             const double one_minus = 1 - E_bar_[c] * r_bar_[c];
             const double gain = one_minus > 0 ? E_bar_[c] * t_bar_[c] / one_minus : 0.0;
             for (int n = 0; n < kN; ++n)
                 e[n][c] = gain;
+            continue;
         }
+        for (int n = 0; n < kN; ++n)
+            for (int m = 0; m < kN; ++m)
+                e[n][c] += inv(n, m) * b[m];
     }
     // ρ(μ) = ∫ P(μ → μ'') a(μ'') e(μ''): what light the coat's bottom reflects from μ lets out.
     SplitCurve<kH, Rgb, true> rho;
