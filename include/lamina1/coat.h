@@ -68,10 +68,14 @@ inline Bsdf::Bsdf(const Layers& layers, const Tables& tables, const Options& opt
         eta_b_ = layers_.base_eta[0];  // η_below/η_coat
         eta_s_ = 1 / eta_b_;           // the coat seen from below: η_coat/η_below
     }
-    fgd_top_in_ = FgdView(tables, alpha0_, inv_eta0_, 0.0);
+    fgd_top_in_.table = FgdView(tables, alpha0_, inv_eta0_, 0.0);
+    precompute_dense_side(fgd_top_in_, alpha0_, inv_eta0_);
     if (layers_.base == Base::Conductor)
         fgd_base_ = FgdView(tables, alpha1_, layers_.base_eta, layers_.base_k);
-    if (layers_.base == Base::Dielectric) fgd_base_ = FgdView(tables, alpha1_, eta_b_, 0.0);
+    if (layers_.base == Base::Dielectric) {
+        fgd_base_in_.table = FgdView(tables, alpha1_, eta_b_, 0.0);
+        precompute_dense_side(fgd_base_in_, alpha1_, eta_b_);
+    }
     if (ms_) {
         fgd_top_ = FgdView(tables, alpha0_, eta0_, 0.0);
         if (support_.btdf) fgd_bottom_ = FgdView(tables, alpha1_, eta_s_, 0.0);
@@ -101,13 +105,52 @@ inline void Bsdf::precompute() {
     precompute_series(g_curve);
 }
 
+inline void Bsdf::precompute_dense_side(DenseSideFgd& fgd, double alpha, double eta) const {
+    // DenseSideFgd: where the table steps (near μc, under α < 0.2).
+    fgd.weight = eta < 1 && alpha > 0 ? clamp((0.2 - alpha) / 0.1, 0.0, 1.0) : 0.0;
+    if (!(fgd.weight > 0)) return;
+    fgd.transmittance = tables_->transmittance(ch_.masking);
+    fgd.alpha = alpha;
+    fgd.eta = eta;
+    fgd.mu_crit = std::sqrt(1 - eta * eta);
+    fgd.width = std::max(3 * alpha, 0.08);
+    // L(μ) = ∫ D_w(wm) [F (1 − G2/G1(w, wr)) + (1 − F)(1 − G2/G1(w, wt))] dwm over the normals
+    // visible from w (Heitz 2014, Eq. 38; the escapes as the tables take them: the height-
+    // correlated reflection, the refraction's refraction_escape), w on the dense side, wr its
+    // reflection and wt its refraction about wm. F has a kink where the facet cosine w·wm reaches
+    // the critical one (total reflection below it): the rule is split there.
+    const GGX ggx{alpha};
+    const double x_crit = fgd.mu_crit;
+    fgd.loss.fill(x_crit, [&](double mu) {
+        const Vec3 w(safe_sqrt(1 - mu * mu), 0, std::max(mu, 1e-6));
+        const double lambda_w = ggx.lambda(w);
+        auto facet_cosine = [&](const Vec3& wm) { return dot(w, wm); };
+        return integrate_visible_split<double, kSplitNr, kSplitNphi, kSplitBisections>(
+            ggx, w, x_crit, facet_cosine, [&](const Vec3& wm) {
+                const double F = fresnel_dielectric(dot(w, wm), eta);
+                const Vec3 wr = reflect(w, wm);
+                const double escape_r =
+                    wr.z > 0 ? (1 + lambda_w) / (1 + lambda_w + ggx.lambda(wr)) : 0.0;
+                double lost = F * (1 - escape_r);
+                if (F < 1) {
+                    const std::optional<Vec3> wt = refract(w, wm, eta);
+                    const double escape_t =
+                        wt && wt->z < 0 ? refraction_escape(ch_.masking, lambda_w, ggx.lambda(*wt))
+                                        : 0.0;
+                    lost += (1 - F) * (1 - escape_t);
+                }
+                return lost;
+            });
+    });
+}
+
 /// T(μ) of the coat from outside and inside, and of a slab's bottom from below and inside: the
 /// table (or 1 − F with coat-transmittance=fresnel) resampled per material, with the orders ≥ 2
 /// of multiple scattering.
 inline void Bsdf::setup_transmittances() {
     const float* table = tables_->transmittance(ch_.masking);
     const bool ms = ms_;
-    auto setup = [&](Transmittance& t, double alpha, double eta, const FgdView& fgd) {
+    auto setup = [&](Transmittance& t, double alpha, double eta, const auto& fgd) {
         t.eta = eta;
         t.exact = alpha == 0 || (!ch_.directional_transmittance && !ms);
         if (!t.exact)
@@ -122,7 +165,7 @@ inline void Bsdf::setup_transmittances() {
     setup(T_top_in_, alpha0_, inv_eta0_, fgd_top_in_);
     if (support_.btdf) {
         setup(T_bot_, alpha1_, eta_s_, fgd_bottom_);
-        setup(T_bot_in_, alpha1_, eta_b_, fgd_base_);
+        setup(T_bot_in_, alpha1_, eta_b_, fgd_base_in_);
     }
 }
 
@@ -193,7 +236,7 @@ inline void Bsdf::precompute_multiple_scattering() {
         });
     } else {
         dE_base_.fill(
-            [&](double mu) { return ms_dielectric(fgd_base_, mu, alpha1_, eta_b_).reflected; });
+            [&](double mu) { return ms_dielectric(fgd_base_in_, mu, alpha1_, eta_b_).reflected; });
     }
     dE_base_bar_ =
         integrate_split01<kGauss, double>([&](double mu) { return dE_base_(mu) * 2 * mu; }, 0.0);

@@ -16,6 +16,7 @@ namespace lamina1 {
 
 constexpr int kNmu = 65;   // nodes of the per-material curves over a cosine, μ = s²
 constexpr int kNx = 33;    // nodes of X(μ), μ = s²
+constexpr int kNloss = 9;  // nodes on each side of μc of a dense-side interface's loss L(μ)
 constexpr int kYnr = 6;    // the rule of the transmitted light's mean direction: Gauss–Legendre
 constexpr int kYnphi = 8;  // in r × midpoint in φ over the half disk
 // The rule of Y and X: their integrands step at the coat's critical angle (total internal

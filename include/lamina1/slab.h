@@ -283,7 +283,7 @@ inline void Bsdf::slab_bins() {
     // The interfaces' reflection from inside between bins, orders m = 0, 1: the flux of bin k
     // (its hat, 2 kBinSub directions) reflected into bin j; rough: visible normals (weight
     // F G2/G1), the orders ≥ 2 (ΔR) cosine-distributed. Then made reciprocal: R_jk A_k = R_kj A_j.
-    auto reflection = [&](double alpha, double eta, const FgdView& fgd, FluxMatrix R[2]) {
+    auto reflection = [&](double alpha, double eta, const auto& fgd, FluxMatrix R[2]) {
         R[0] = FluxMatrix(kNbins);
         R[1] = FluxMatrix(kNbins);
         const GGX ggx{alpha};
@@ -408,7 +408,7 @@ inline void Bsdf::slab_bins() {
     };
     FluxMatrix Rc[2], Rb[2];
     reflection(alpha0_, inv_eta0_, fgd_top_in_, Rc);
-    reflection(alpha1_, eta_b_, fgd_base_, Rb);
+    reflection(alpha1_, eta_b_, fgd_base_in_, Rb);
     balance(Rc, tau_c, [&](double mu) { return inside_reflectance(mu); });
     balance(Rb, tau_b, [&](double mu) { return base_albedo(mu)[0]; });
 
