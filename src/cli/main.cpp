@@ -1,6 +1,19 @@
 // The `lamina` executable: the command-line interface of cli/run.cpp.
 #include "cli/commands.h"
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
 int main(int argc, char** argv) {
+#ifdef __GLIBC__
+    // A study allocates and frees tables of a few to some tens of MB per model, configuration and
+    // thread. glibc serves blocks that large from fresh mappings, returned on free, so every one
+    // was faulted in and zeroed again: 0.64 M page faults and 5 s of system time on the quick
+    // study. Kept in the heap instead (0.1 M faults, 1.2 s; the peak memory unchanged, 0.35 GB;
+    // docs/performance.md, "The quick study").
+    mallopt(M_MMAP_THRESHOLD, 64 << 20);
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
+#endif
     return lamina::cli::run(argc, argv);
 }
