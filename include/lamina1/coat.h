@@ -130,7 +130,7 @@ inline void Bsdf::precompute_dense_side(DenseSideFgd& fgd, double alpha, double 
                 const double F = fresnel_dielectric(dot(w, wm), eta);
                 const Vec3 wr = reflect(w, wm);
                 const double escape_r =
-                    wr.z > 0 ? (1 + lambda_w) / (1 + lambda_w + ggx.lambda(wr)) : 0.0;
+                    wr.z > 0 ? reflection_escape(lambda_w, ggx.lambda(wr)) : 0.0;
                 double lost = F * (1 - escape_r);
                 if (F < 1) {
                     const std::optional<Vec3> wt = refract(w, wm, eta);
@@ -616,7 +616,7 @@ inline Rgb Bsdf::returned_light(double mu, const RgbEdgeCurve<33>& g, const Rgb&
     auto f_y = [&](const Vec3& wm) {
         const Vec3 w2 = reflect(w, wm);
         if (w2.z <= 0) return Rgb(0.0);
-        const double escape = (1 + lambda_w) / (1 + lambda_w + ggx.lambda(w2));
+        const double escape = reflection_escape(lambda_w, ggx.lambda(w2));
         return base_fresnel(dot(w, wm)) * g(w2.z) * escape;
     };
     static const QuadratureRule q = gauss_legendre(kSplitNr);
@@ -779,8 +779,8 @@ inline RgbEdgeCurve<33> Bsdf::returned_escape() const {
         for_visible_normals<kBinNr, kBinNphi>(coat_ggx_, w, [&](const Vec3& wm, double weight) {
             const Vec3 r = reflect(w, wm);
             if (r.z <= 0) return;
-            const double v = fresnel_dielectric(dot(w, wm), inv_eta0_) * weight * (1 + lambda_w) /
-                             (1 + lambda_w + coat_ggx_.lambda(r));
+            const double v = fresnel_dielectric(dot(w, wm), inv_eta0_) * weight *
+                             reflection_escape(lambda_w, coat_ggx_.lambda(r));
             const auto p = nodes.locate(r.z);
             P[n][index(p.lower, p.i)] += v * (1 - p.t);
             P[n][index(p.lower, p.i + 1)] += v * p.t;

@@ -146,6 +146,13 @@ enum class Masking {
     Walter,
 };
 
+/// G2/G1(wi) of a reflected pair from Λ of both directions: the height-correlated G2 =
+/// 1/(1 + Λi + Λo) (Heitz 2014, Eq. 99) over G1(wi) = 1/(1 + Λi) (Eq. 43), the share of the light
+/// a facet visible from wi reflects that leaves the microsurface at once.
+inline double reflection_escape(double lambda_i, double lambda_o) {
+    return (1 + lambda_i) / (1 + lambda_i + lambda_o);
+}
+
 /// G2/G1(wi) of a refracted pair from Λ of both directions: (1 + Λi) B(1 + Λi, 1 + Λt) (Smith)
 /// or (1 + Λi)/(1 + Λi + Λt) (Walter), written in the Smith roots r = 1 + 2Λ; 1 when α = 0.
 inline double refraction_escape(Masking masking, double lambda_i, double lambda_t) {

@@ -97,8 +97,7 @@ inline void Bsdf::slab_first_order(const CosineCurve<Rgb, kNfirst>& entry) {
                     [&](const Vec3& wm) {
                         const Vec3 v_in = reflect(w, wm);
                         if (v_in.z <= mu_crit_b) return 0.0;
-                        return T_bot_in_(v_in.z) * (1 + lambda_w) /
-                               (1 + lambda_w + ggx.lambda(v_in));
+                        return T_bot_in_(v_in.z) * reflection_escape(lambda_w, ggx.lambda(v_in));
                     });
             if (Q_m > 0) r.v[1] = r.v[0] * (1 / Q_m);
         }
@@ -306,7 +305,7 @@ inline void Bsdf::slab_bins() {
                         const Vec3 w2 = reflect(w, wm);
                         if (w2.z <= 0) return;
                         const double weight = ws * w_r * fresnel_dielectric(dot(w, wm), eta) *
-                                              (1 + lambda_w) / (1 + lambda_w + ggx.lambda(w2));
+                                              reflection_escape(lambda_w, ggx.lambda(w2));
                         const double sxy = std::hypot(w2.x, w2.y);
                         deposit(w2.z, weight, sxy > 0 ? -w2.x / sxy : 1.0);
                     });
