@@ -32,6 +32,7 @@
 #include "lamina1/math.h"
 #include "lamina1/options.h"
 #include "lamina1/physics.h"
+#include "lamina1/polarization.h"
 #include "lamina1/tables.h"
 
 #include <array>
@@ -102,6 +103,8 @@ class Bsdf {
         /// moment each), and the energies let out (reflected, transmitted: the sampler's
         /// weights).
         Multi<Rgb, 6 * kNbins + 2> bins{};
+        /// polarization (lamina1/polarization.h): √k_R(μi) and k_T(μi), 1 where it is off.
+        Rgb pol_R{1.0}, pol_T{1.0};
     };
 
     /// The per-incidence part of eval (wi.z > 0): evaluate many wo with eval_with.
@@ -168,6 +171,7 @@ class Bsdf {
                                            std::vector<double>& twice_phase) const;
     void precompute_scattering_curves(const AddingEnergies& e);
     void precompute_slab();
+    void precompute_polarization();
     CosineCurve<Rgb, kNfirst> slab_entry();
     void slab_first_order(const CosineCurve<Rgb, kNfirst>& entry);
     /// slab-orders=bins (lamina1/slab.h).
@@ -220,6 +224,15 @@ class Bsdf {
         bool bottom_sampled = false;  ///< the transmission lobe drawn as the bottom's (btdf-lobe)
     };
     Mixture mixture(const Incident& in) const;
+    /// A slab's energies at wi per channel, beyond the coat's own reflection: the first order
+    /// reflected (T(μi) a² R_b(μi') T_exit(μi'), first_order_exit) and transmitted
+    /// (E_1, or T a (1 − R_b)), and the later orders' (bins, else the series) reflected and
+    /// transmitted.
+    struct SlabEnergies {
+        Rgb first_reflected{0.0}, later_reflected{0.0}, first_transmitted{0.0},
+            later_transmitted{0.0};
+    };
+    SlabEnergies slab_energies(const Incident& in) const;
     double pdf_with(const Incident& in, const Mixture& m, const Vec3& wo) const;
 
     /// The coat's transmittance for the first order leaving a non-Lambertian base towards the
@@ -568,6 +581,12 @@ class Bsdf {
     /// the coat lets into each bin and from below that the bottom lets in, energy (v[k]) and
     /// forward moment (v[kNbins + k]); Incident::bins over outside cosines.
     bool bins_ = false;
+    /// polarization (precompute_polarization): the slab's series for both polarizations, and
+    /// its ratios on the outside cosine, √k_R(μ) and k_T(μ) (pol_on_: a rough slab's eval reads
+    /// them; a smooth one's delta lobes take the series' ratios at μi themselves).
+    std::optional<SlabPolarization> pol_;
+    bool pol_on_ = false;
+    CosineCurve<Rgb, kNfirst> pol_R_, pol_T_;
     bool bins_ready_ = false;  ///< set once slab_bins has run (incident() is used before)
     std::array<double, kNbins + 1> bin_edge_{};
     std::array<int, kNbins> bin_piece_{};    ///< the piece (between critical cosines) of each bin

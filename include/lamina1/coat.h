@@ -90,6 +90,7 @@ inline Bsdf::Bsdf(const Layers& layers, const Tables& tables, const Options& opt
     // The slab's bins before the medium's curves: a slab's scattered remainders are weighed by
     // the bins' entry (precompute_scattering_curves).
     precompute_slab();
+    precompute_polarization();
     if (scatters_) precompute_scattering();
 }
 

@@ -70,6 +70,10 @@ inline Bsdf::Incident Bsdf::incident(const Vec3& wi) const {
                 in.u_bottom = sqr(alpha1_) / sqr(in.alpha_b);
         }
         if (bins_ready_) incident_bins(in);
+        if (pol_on_) {
+            in.pol_R = pol_R_(wi.z);
+            in.pol_T = pol_T_(wi.z);
+        }
     }
     return in;
 }
@@ -107,12 +111,14 @@ inline Rgb Bsdf::eval_with(const Incident& in, const Vec3& wo) const {
     }
     const Vec3 wo_in = refract_in(wo, inv_eta0_);
     const Rgb a_o = coat_attenuation(wo.z, wo_in.z);
-    f += first_order(in, wo, wo_in, a_o, LobeForm{});
+    // A slab's light beyond the coat's own reflection under polarization (1 where it is off).
+    const Rgb pol = pol_on_ ? in.pol_R * pol_R_(wo.z) : Rgb(1.0);
+    f += first_order(in, wo, wo_in, a_o, LobeForm{}) * pol;
     if (series_on_) {
-        f += in.X * X_at(wo.z) * K_ * (kInvPi * inv_eta0_ * inv_eta0_);
+        f += in.X * X_at(wo.z) * K_ * (kInvPi * inv_eta0_ * inv_eta0_) * pol;
     }
     if (round_trip_on_) f += round_trip(in, wo, wo_in, a_o);
-    if (bins_) f += bins_reflection(in, wo);
+    if (bins_) f += bins_reflection(in, wo) * pol;
     // The medium's terms take the light along the macro refractions (their depth integrals).
     if (scatters_) f += scattered(in, wo, wo_in, a_coat_on_ ? attenuation(wo_in.z) : a_o);
     return f;
@@ -219,6 +225,8 @@ inline std::vector<DeltaLobe> Bsdf::delta_lobes(const Vec3& wi) const {
     const Rgb a = attenuation(w_in.z);
     const Rgb Rb = base_fresnel(w_in.z);
     const double T = 1 - F;
+    // Polarized (lamina1/polarization.h): the series per polarization, what it changes here.
+    const PolarizationChange pol = pol_ ? pol_->change(wi.z) : PolarizationChange{};
     Rgb series(1.0);
     if (ch_.inter_reflection)
         for (int c = 0; c < 3; ++c) {
@@ -227,13 +235,13 @@ inline std::vector<DeltaLobe> Bsdf::delta_lobes(const Vec3& wi) const {
             const double round_trip = F * Rb[c] * a[c] * a[c];
             series[c] = round_trip < 1 ? 1 / (1 - round_trip) : 0.0;
         }
-    if (!matched) out.push_back({wr, Rb * a * a * series * (T * T)});
+    if (!matched) out.push_back({wr, nonnegative(Rb * a * a * series * (T * T) + pol.reflected)});
     if (support_.btdf) {
         const double sin_t = std::hypot(wi.x, wi.y) * inv_eta0_ * eta_s_;
         if (sin_t < 1) {
             const double Tb = 1 - fresnel_dielectric(w_in.z, eta_b_);
-            out.push_back(
-                {transmitted_direction(wi, std::sqrt(1 - sin_t * sin_t)), a * series * (T * Tb)});
+            out.push_back({transmitted_direction(wi, std::sqrt(1 - sin_t * sin_t)),
+                           nonnegative(a * series * (T * Tb) + pol.transmitted)});
         }
     }
     return out;
@@ -303,7 +311,9 @@ inline Rgb Bsdf::eval_btdf(const Incident& in, const Vec3& wo) const {
     }
     if (bins_) f += bins_transmission(in, wo);
     const auto v_in = refract_in_checked(v, 1 / eta_s_);
-    if (!v_in) return f;
+    // The unscattered light under polarization (1 where it is off): everything above, and the
+    // narrow lobe and the series below.
+    if (!v_in) return f * in.pol_T;
     const double T_b = T_bot_(v.z), T_b_in = T_bot_in_(v_in->z);
     const Rgb a_v = has_absorption_ ? attenuation(v_in->z) : Rgb(1.0);
     const double beta = transmission_roughness(in.k_top, in.k_bottom);
@@ -334,6 +344,7 @@ inline Rgb Bsdf::eval_btdf(const Incident& in, const Vec3& wo) const {
     }
     if (!bins_ && !matched && series_btdf_)
         f += in.X * inv_one_minus_Er_ * (T_b * kInvPi / (eta_s_ * eta_s_));
+    f *= in.pol_T;
     // The scattered light that leaves through the bottom, as uniform radiance below it.
     if (orders_on_ && !twice_on_) f += in.orders_t * T_b;
     if (scatters_ && back_on_) f += single_transmission(in, *v_in, a_v, T_b, layers_.g, Rgb(in.T));

@@ -40,10 +40,11 @@ constexpr int kGpuBaseAlbedo = kGpuLeaving + 3 * FacetDeflection::kN;  // Ē_b(�
 constexpr int kGpuDRTop = kGpuBaseAlbedo + kNmu;        // the coat's orders ≥ 2, ΔR(μ): kNmu
 constexpr int kGpuDEBase = kGpuDRTop + kNmu;            // the base's, ΔE(μ'): kNmu
 constexpr int kGpuCoatAttenuation = kGpuDEBase + kNmu;  // a rough coat's a(μ): kNmu × RGB
-constexpr int kGpuSlopeSum = 1808;
+constexpr int kGpuPolarization = kGpuCoatAttenuation + 3 * kNmu;  // a slab's √k_R(μ): kNfirst × RGB
+constexpr int kGpuSlopeSum = 1860;
 constexpr int kGpuSize =
     kGpuSlopeSum + SlopeSumFormat::kNx * SlopeSumFormat::kNy * SlopeSumFormat::kNu;
-static_assert(kGpuCoatAttenuation + 3 * kNmu <= kGpuSlopeSum, "the curves overlap");
+static_assert(kGpuPolarization + 3 * kNfirst <= kGpuSlopeSum, "the curves overlap");
 
 // A slab's inside light in bins (slab-orders=bins, lamina1/slab.h), after the slope-sum table in
 // states that have the flag kGpuBinsOn (the others end at kGpuSize): the coat's entry curve
@@ -85,6 +86,10 @@ enum GpuFlag : unsigned {
     /// The round trips' lobe (Bsdf::round_trip), its curve (kNx nodes over outside cosines) at
     /// kGpuMirrorSeries (the mirror series is never on with it).
     kGpuRoundTrip = 1u << 20,
+    /// A slab's polarization (lamina1/polarization.h): a rough one's reflection beyond the coat's
+    /// own scaled by √k_R(μi) √k_R(μo) (kGpuPolarization); a smooth one's delta series summed per
+    /// polarization (lamina1_delta).
+    kGpuPolarized = 1u << 21,
 };
 
 inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
@@ -121,6 +126,7 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
     flag(bins_, kGpuBinsOn);
     flag(a_coat_on_, kGpuCoatSpread);
     flag(round_trip_on_, kGpuRoundTrip);
+    flag(pol_.has_value(), kGpuPolarized);
     v[0] = float(flags);  // exact in float32 (fewer than 2^24)
     v[1] = float(int(layers_.base));
     v[2] = float(eta0_);
@@ -162,6 +168,10 @@ inline std::vector<float> Bsdf::gpu_state(std::string* why) const {
             for (int c = 0; c < 3; ++c)
                 v[kGpuCoatAttenuation + 3 * i + c] = float(a_coat_.v[i][c]);
     }
+    if (pol_on_)
+        for (int i = 0; i < kNfirst; ++i)
+            for (int c = 0; c < 3; ++c)
+                v[kGpuPolarization + 3 * i + c] = float(pol_R_.v[i][c]);
     // The sampler's mixture weighs the base lobe by the base's mean albedo at the inside cosine:
     // a curve over μ' = s² (the FGD lookups it stands for stay in C++).
     for (int i = 0; i < kNmu; ++i)

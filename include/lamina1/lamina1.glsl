@@ -18,8 +18,8 @@ const int L1_LOBE_NORM = L1_X + 3 * L1_NX, L1_MIRROR = L1_LOBE_NORM + L1_NNORM;
 const int L1_ENTERING = L1_MIRROR + 3 * L1_NMU, L1_LEAVING = L1_ENTERING + 3 * L1_NFACET;
 const int L1_BASE_ALBEDO = L1_LEAVING + 3 * L1_NFACET;
 const int L1_DR_TOP = L1_BASE_ALBEDO + L1_NMU, L1_DE_BASE = L1_DR_TOP + L1_NMU;
-const int L1_A_COAT = L1_DE_BASE + L1_NMU;
-const int L1_SLOPE_SUM = 1808, L1_SS_NX = 25, L1_SS_NY = 13, L1_SS_NU = 33;
+const int L1_A_COAT = L1_DE_BASE + L1_NMU, L1_NFIRST = 17, L1_POL = L1_A_COAT + 3 * L1_NMU;
+const int L1_SLOPE_SUM = 1860, L1_SS_NX = 25, L1_SS_NY = 13, L1_SS_NU = 33;
 // A slab's bins (kGpuBins* in lamina1/gpu.h), after the slope-sum table.
 const int L1_NBINS = 12, L1_BIN_PER = 4, L1_NSLAB = 17, L1_BINS_MAX_CUTS = 2 * L1_NBINS + 3;
 const int L1_BINS_CUTS = L1_SLOPE_SUM + L1_SS_NX * L1_SS_NY * L1_SS_NU;
@@ -34,18 +34,24 @@ bool l1_flag(int bit) { return ((int(l1_at(0)) >> bit) & 1) == 1; }
 
 float l1_sqr(float x) { return x * x; }
 
-// Exact unpolarized Fresnel reflectance of a dielectric (Born & Wolf §1.5.2, Eqs. 21a–b).
-float l1_fresnel_dielectric(float cos_i, float eta) {
+// The s and p reflectances of a dielectric, (R_s, R_p) (Born & Wolf §1.5.2, Eqs. 21a–b).
+vec2 l1_fresnel_sp(float cos_i, float eta) {
     cos_i = clamp(cos_i, -1.0, 1.0);
     bool below = cos_i < 0.0;
     float e = below ? 1.0 / eta : eta;
     cos_i = abs(cos_i);
     float sin2_t = (1.0 - cos_i * cos_i) / (e * e);
-    if (!(sin2_t < 1.0)) return 1.0;
+    if (!(sin2_t < 1.0)) return vec2(1.0);
     float cos_t = sqrt(max(1.0 - sin2_t, 0.0));
     float rpar = (e * cos_i - cos_t) / (e * cos_i + cos_t);
     float rper = (cos_i - e * cos_t) / (cos_i + e * cos_t);
-    return 0.5 * (rpar * rpar + rper * rper);
+    return vec2(rper * rper, rpar * rpar);
+}
+
+// Exact unpolarized Fresnel reflectance of a dielectric: the mean of R_s and R_p.
+float l1_fresnel_dielectric(float cos_i, float eta) {
+    vec2 r = l1_fresnel_sp(cos_i, eta);
+    return 0.5 * (r.x + r.y);
 }
 
 // Fresnel for η + iκ (PBR 3rd ed., §8.2.1, FrConductor), per channel.
@@ -356,10 +362,15 @@ vec3 lamina1_eval(vec3 wi, vec3 wo) {
         rounds = l1_cosine_curve3(L1_MIRROR, L1_NMU, wi_in.z) *
                  l1_cosine_curve3(L1_MIRROR, L1_NMU, wo_in.z);
     float eta2 = l1_flag(9) ? inv_eta0 * inv_eta0 : 1.0;
-    f += fb * (a * a_o) * rounds * (T_pair * T_o * eta2);
-    if (l1_flag(2)) f += X * l1_x_at(wo.z) * l1_rgb(19) * (L1_INV_PI * inv_eta0 * inv_eta0);
+    // A rough slab's light beyond the coat's own reflection under polarization (flag 21).
+    vec3 pol = l1_flag(21) && (alpha0 > 0.0 || l1_at(5) > 0.0)
+                   ? l1_cosine_curve3(L1_POL, L1_NFIRST, wi.z) *
+                         l1_cosine_curve3(L1_POL, L1_NFIRST, wo.z)
+                   : vec3(1.0);
+    f += fb * (a * a_o) * rounds * (T_pair * T_o * eta2) * pol;
+    if (l1_flag(2)) f += X * l1_x_at(wo.z) * l1_rgb(19) * (L1_INV_PI * inv_eta0 * inv_eta0) * pol;
     if (l1_flag(20) && wo_in.z > 0.0) f += l1_round_trip(wi.z, wi_in, k_top, wo, wo_in, a * a_o, T_pair, eta2);
-    if (l1_flag(18)) f += l1_bins_reflection(wi, wo);
+    if (l1_flag(18)) f += l1_bins_reflection(wi, wo) * pol;
     return f;
 }
 
@@ -377,6 +388,19 @@ vec3 lamina1_delta(vec3 wi) {
     vec3 a = l1_attenuation(w_in.z);
     vec3 Rb = l1_base_fresnel(w_in.z);
     float T = 1.0 - F;
+    if (l1_flag(21)) {
+        // Polarized (flag 21): a smooth slab keeps its s and p light apart; the series per
+        // polarization, averaged (lamina1/polarization.h).
+        vec2 F_sp = l1_fresnel_sp(wi.z, l1_at(2)), Rb_sp = l1_fresnel_sp(w_in.z, l1_at(6));
+        vec3 body = vec3(0.0);
+        for (int p = 0; p < 2; ++p)
+            for (int c = 0; c < 3; ++c) {
+                float round_trip = F_sp[p] * Rb_sp[p] * a[c] * a[c];
+                float series = round_trip < 1.0 ? 1.0 / (1.0 - round_trip) : 0.0;
+                body[c] += 0.5 * Rb_sp[p] * a[c] * a[c] * series * l1_sqr(1.0 - F_sp[p]);
+            }
+        return vec3(F) + body;
+    }
     vec3 series = vec3(1.0);
     if (l1_flag(15))
         for (int c = 0; c < 3; ++c) {

@@ -140,6 +140,14 @@ struct Options {
     /// (true; Bsdf::coat_attenuation), or along the macro refraction (false; with a scattering
     /// medium always: the adding balances the scattered light's energy along it).
     bool coat_path_spread = true;
+    /// A slab's light polarized through its interfaces (true: as lamina's default reference,
+    /// --polarization on): its reflection beyond the coat's own and its transmission scaled by
+    /// the ratios of the slab's polarized series to the per-bounce average (lamina1/
+    /// polarization.h), exact for smooth interfaces; or the unpolarized Fresnel factors at every
+    /// event (false: as the 2019 study's reference, --polarization off). Only a slab's
+    /// unscattered light changes (a Lambertian base and a scattering event depolarize, and a
+    /// conductor under a coat changes by under 1 %).
+    bool polarization = true;
 };
 
 }  // namespace lamina1

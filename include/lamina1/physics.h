@@ -16,11 +16,15 @@
 
 namespace lamina1 {
 
-/// Exact unpolarized Fresnel reflectance of a dielectric interface (the mean of the s and p
-/// reflectances; Born & Wolf, Principles of Optics, §1.5.2, Eqs. 21a–b). cos_theta_i ∈ [−1, 1]
-/// (negative: the light arrives from the other side, where the relative index is 1/eta); eta > 0
-/// the relative index beyond / here. 1 under total internal reflection.
-inline double fresnel_dielectric(double cos_theta_i, double eta) {
+/// The amplitude ratios of Fresnel's equations for a dielectric interface (Born & Wolf,
+/// Principles of Optics, §1.5.2, Eqs. 21a–b): r_p = a/b and r_s = c/d, or total internal
+/// reflection. cos_theta_i ∈ [−1, 1] (negative: the light arrives from the other side, where the
+/// relative index is 1/eta); eta > 0 the relative index beyond / here.
+struct FresnelAmplitudes {
+    bool total = false;  ///< total internal reflection: both reflectances 1
+    double a = 0, b = 1, c = 0, d = 1;
+};
+inline FresnelAmplitudes fresnel_amplitudes(double cos_theta_i, double eta) {
     const double inv_eta = 1.0 / eta;
     cos_theta_i = std::min(std::max(cos_theta_i, -1.0), 1.0);
     const bool below = cos_theta_i < 0;
@@ -29,16 +33,40 @@ inline double fresnel_dielectric(double cos_theta_i, double eta) {
     cos_theta_i = below ? -cos_theta_i : cos_theta_i;
     const double sin2_theta_t =
         (1 - cos_theta_i * cos_theta_i) * (inv_eta_crossed * inv_eta_crossed);
-    if (!(sin2_theta_t < 1)) return 1.0;
+    FresnelAmplitudes r;
+    if (!(sin2_theta_t < 1)) {
+        r.total = true;
+        return r;
+    }
     const double cos_theta_t = std::sqrt(std::max(1 - sin2_theta_t, 0.0));
+    r.a = eta_crossed * cos_theta_i - cos_theta_t;
+    r.b = eta_crossed * cos_theta_i + cos_theta_t;
+    r.c = cos_theta_i - eta_crossed * cos_theta_t;
+    r.d = cos_theta_i + eta_crossed * cos_theta_t;
+    return r;
+}
+
+/// Exact unpolarized Fresnel reflectance of a dielectric interface: the mean of the s and p
+/// reflectances of fresnel_amplitudes, (R_s + R_p)/2. 1 under total internal reflection.
+inline double fresnel_dielectric(double cos_theta_i, double eta) {
+    const FresnelAmplitudes r = fresnel_amplitudes(cos_theta_i, eta);
+    if (r.total) return 1.0;
     // r_parallel = a/b, r_perpendicular = c/d; (a²d² + c²b²) / (b²d²) needs a single division.
-    const double a = eta_crossed * cos_theta_i - cos_theta_t,
-                 b = eta_crossed * cos_theta_i + cos_theta_t;
-    const double c = cos_theta_i - eta_crossed * cos_theta_t,
-                 d = cos_theta_i + eta_crossed * cos_theta_t;
-    const double bd = b * d, ad = a * d, cb = c * b;
+    const double bd = r.b * r.d, ad = r.a * r.d, cb = r.c * r.b;
     const double b2d2 = bd * bd;
     return 0 < b2d2 ? (ad * ad + cb * cb) / (b2d2 + b2d2) : 1.0;
+}
+
+/// The s and p reflectances themselves, R_s = (c/d)² and R_p = (a/b)² (both 1 under total
+/// internal reflection, and where a ratio is 0/0: light exactly grazing onto an index-matched
+/// interface).
+struct FresnelSp {
+    double s = 1, p = 1;
+};
+inline FresnelSp fresnel_dielectric_sp(double cos_theta_i, double eta) {
+    const FresnelAmplitudes r = fresnel_amplitudes(cos_theta_i, eta);
+    if (r.total || !(r.b * r.d > 0)) return {};
+    return {sqr(r.c / r.d), sqr(r.a / r.b)};
 }
 
 /// Unpolarized Fresnel reflectance for a complex relative index η + iκ, light from the real side

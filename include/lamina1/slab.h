@@ -18,6 +18,49 @@ inline void Bsdf::precompute_slab() {
     if (bins_) slab_bins();
 }
 
+inline Bsdf::SlabEnergies Bsdf::slab_energies(const Incident& in) const {
+    SlabEnergies e;
+    if (!in.ok || !support_.btdf) return e;
+    const Rgb R_b = base_albedo(in.wi_in.z);
+    e.first_reflected = R_b * in.a * in.a * (in.T * first_order_exit(in.wi_in.z));
+    e.first_transmitted = bottom_lobe_ ? in.first_E : nonnegative(Rgb(1.0) - R_b) * in.a * in.T;
+    if (bins_) {
+        e.later_reflected = in.bins.v[6 * kNbins];
+        e.later_transmitted = in.bins.v[6 * kNbins + 1];
+    } else if (series_on_) {
+        e.later_reflected = in.X * K_ * X_bar_;
+        if (series_btdf_) e.later_transmitted = in.X * inv_one_minus_Er_;
+    }
+    return e;
+}
+
+/// polarization (lamina1/polarization.h): a slab whose bottom is there for the light; its
+/// unscattered light (a scattering event depolarizes: a scattering medium's own terms are left as
+/// they are, and the series attenuates by extinction). Rough: the factors on the outside cosine,
+/// √k_R (the reflection takes it at μi and μo) and k_T, from the series' changes over the slab's
+/// own energies; smooth (both interfaces): the delta lobes take the changes at μi.
+inline void Bsdf::precompute_polarization() {
+    if (!support_.btdf || !ch_.polarization || !ch_.inter_reflection || bottom_matched()) return;
+    pol_.emplace(eta0_, alpha0_, eta_b_, alpha1_, ch_.masking, tau_t_);
+    if (alpha0_ == 0 && alpha1_ == 0) return;
+    for (int i = 0; i < kNfirst; ++i) {
+        const double mu = std::max(sqr(double(i) / (kNfirst - 1)), 1e-4);
+        const SlabEnergies e = slab_energies(incident(Vec3(std::sqrt(1 - mu * mu), 0, mu)));
+        const Rgb R_body = e.first_reflected + e.later_reflected;
+        const Rgb T = e.first_transmitted + e.later_transmitted;
+        const PolarizationChange d = pol_->change(mu);
+        for (int c = 0; c < 3; ++c) {
+            // A change larger than the light it changes (the series and the slab's energies
+            // disagree where both vanish, at grazing incidence) removes that light, no more.
+            pol_R_.v[i][c] = R_body[c] > kNegligibleEnergy
+                                 ? std::sqrt(max0(1 + d.reflected[c] / R_body[c]))
+                                 : 1.0;
+            pol_T_.v[i][c] = T[c] > kNegligibleEnergy ? max0(1 + d.transmitted[c] / T[c]) : 1.0;
+        }
+    }
+    pol_on_ = true;
+}
+
 /// The light the coat lets in at outside cosine μ, per unit flux, by its own inside direction w'
 /// (the coat's transmitted light t(μ → w'), as in X): E_1(μ) = ∫ t a T_b,in dω' leaves through the
 /// bottom at once (the first order). T_b,in steps at the bottom's critical cosine: the rule splits

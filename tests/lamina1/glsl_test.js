@@ -54,15 +54,22 @@ const cx = {
 // Unpolarized Fresnel reflectance from a medium of index 1 onto index n (complex: n + iκ) at
 // cos θ = c: r_s = (c − n cos θt)/(c + n cos θt), r_p = (n c − cos θt)/(n c + cos θt) =
 // (n² c − n cos θt)/(n² c + n cos θt), with n cos θt = √(n² − sin²θ) (Born & Wolf §1.5.2, §14.2).
-function fresnel(c, n) {
+// [R_s, R_p]; fresnel, their mean.
+function fresnelSp(c, n) {
   const ncos = cx.sqrt(cx.sub(cx.mul(n, n), [1 - c * c, 0])), cc = [c, 0];
   const rs = cx.div(cx.sub(cc, ncos), cx.add(cc, ncos));
   const n2c = cx.mul(cx.mul(n, n), cc);
   const rp = cx.div(cx.sub(n2c, ncos), cx.add(n2c, ncos));
-  return 0.5 * (cx.abs2(rs) + cx.abs2(rp));
+  return [cx.abs2(rs), cx.abs2(rp)];
+}
+function fresnel(c, n) {
+  const [s, p] = fresnelSp(c, n);
+  return 0.5 * (s + p);
 }
 const rgb = (v) => (Array.isArray(v) ? v : [v, v, v]);
-// The closed form of the smooth coat's specular reflection of `stack` at cos θi = mu (RGB).
+// The closed form of the smooth coat's specular reflection of `stack` at cos θi = mu (RGB). A
+// smooth slab (a dielectric base) is polarized unless polarization=off: the series per
+// polarization, averaged (the s and p light stay apart between two smooth interfaces).
 function smoothDelta(stack, options, mu) {
   const coat = stack.layers[0], base = stack.layers[1].interface;
   const eta0 = coat.interface.eta / (stack.ambient_eta || 1);
@@ -71,6 +78,16 @@ function smoothDelta(stack, options, mu) {
   if (base.type === "lambertian" || base.alpha > 0) return [F, F, F];
   const muT = Math.sqrt(1 - (1 - mu * mu) / (eta0 * eta0));
   const tau = rgb(coat.medium ? coat.medium.tau_a : 0), series = !/inter-reflection=off/.test(options);
+  if (base.type === "dielectric" && series && !/polarization=off/.test(options)) {
+    const F_sp = fresnelSp(mu, [eta0, 0]), Rb_sp = fresnelSp(muT, [base.eta / coat.interface.eta, 0]);
+    return [0, 1, 2].map((c) => {
+      const a2 = Math.exp(-2 * tau[c] / muT);
+      let R = 0;
+      for (let p = 0; p < 2; p++)
+        R += 0.5 * (F_sp[p] + (Rb_sp[p] * a2 * (1 - F_sp[p]) * (1 - F_sp[p])) / (1 - F_sp[p] * Rb_sp[p] * a2));
+      return R;
+    });
+  }
   return [0, 1, 2].map((c) => {
     const Rb = base.type === "conductor"
       ? fresnel(muT, [rgb(base.eta)[c] / coat.interface.eta, rgb(base.k)[c] / coat.interface.eta])

@@ -89,6 +89,9 @@ del clear["layers"][0]["medium"]
 clear["layers"][0]["interface"]["alpha"] = 0.02
 clear["layers"][1]["interface"]["alpha"] = 0.05
 json.dump(clear, open(f"{sys.argv[2]}/slab-clear-in.json", "w"))
+smooth_slab = json.load(open(f"{sys.argv[1]}/slab.json"))
+smooth_slab["layers"][0]["interface"]["alpha"] = smooth_slab["layers"][1]["interface"]["alpha"] = 0
+json.dump(smooth_slab, open(f"{sys.argv[2]}/smooth-slab-in.json", "w"))
 json.dump(plastic, open(f"{sys.argv[2]}/smooth-plastic-in.json", "w"))
 json.dump(gold, open(f"{sys.argv[2]}/smooth-gold-in.json", "w"))
 PY
@@ -97,6 +100,9 @@ add_case slab-clear "$tmp/slab-clear-in.json"
 add_case smooth-plastic "$tmp/smooth-plastic-in.json"
 add_case smooth-gold "$tmp/smooth-gold-in.json"
 add_case smooth-gold-single "$tmp/smooth-gold-in.json" inter-reflection=off
+# A smooth slab, polarized (the series per polarization) and not.
+add_case smooth-slab "$tmp/smooth-slab-in.json"
+add_case smooth-slab-unpolarized "$tmp/smooth-slab-in.json" polarization=off
 
 if node "$root/tests/lamina1/glsl_test.js" "$root" "$tmp" "${cases[@]}"; then ok; else fail "GLSL"; fi
 

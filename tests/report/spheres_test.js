@@ -190,12 +190,12 @@ function compare(name, sums, passes, A, B, expected) {
   // A variant's state as the page composes it (variantState, config.json → lamina1_gpu): the
   // slab's own state with the rougher slab's per-material part (its first HEAD floats and its
   // bins at the end) in place must be the rougher slab's state, float for float.
-  const HEAD = 1808;  // lamina1::kGpuSlopeSum
+  const HEAD = 1860;  // lamina1::kGpuSlopeSum
   const slabOwn = fs.readFileSync(path.join(dir, "slab.l1gpu"));
   const slabRough = fs.readFileSync(path.join(dir, "slab-rough.l1gpu"));
   const composed = await page.evaluate(({ own, rough, HEAD }) => {
     const S = window.LAMINA_SPHERES, a = S.floatsOf(own), b = S.floatsOf(rough);
-    const tail = a.length - 12533;  // lamina1::kGpuSize: the bins after it
+    const tail = a.length - 12585;  // lamina1::kGpuSize: the bins after it
     const all = new Float32Array(a.length + HEAD + tail);
     all.set(a);
     all.set(b.subarray(0, HEAD), a.length);

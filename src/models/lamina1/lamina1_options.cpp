@@ -126,6 +126,12 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table() {
             "Beer-Lambert through a rough absorbing coat (opaque base, no scattering medium): "
             "averaged over the directions the coat refracts the light into, or along the macro "
             "refraction"),
+        on_off_member<L1>("polarization", &L1::polarization,
+                          "a slab's light polarized through its interfaces, as the default "
+                          "reference (--polarization on): its light beyond the coat's own "
+                          "reflection scaled by the polarized series over the per-bounce "
+                          "average, exact when smooth; or the unpolarized Fresnel factors at "
+                          "every event (off, as --polarization off)"),
     });
     return table;
 }
