@@ -582,8 +582,8 @@ class Bsdf {
     /// forward moment (v[kNbins + k]); Incident::bins over outside cosines.
     bool bins_ = false;
     /// polarization (precompute_polarization): the slab's series for both polarizations, and
-    /// its ratios on the outside cosine, √k_R(μ) and k_T(μ) (pol_on_: a rough slab's eval reads
-    /// them; a smooth one's delta lobes take the series' ratios at μi themselves).
+    /// its factors on the outside cosine, √k_R(μ) and k_T(μ) (pol_on_: a rough slab's eval reads
+    /// them; a smooth one's delta lobes take the series' changes at μi themselves).
     std::optional<SlabPolarization> pol_;
     bool pol_on_ = false;
     CosineCurve<Rgb, kNfirst> pol_R_, pol_T_;
