@@ -130,6 +130,22 @@ std::array<double, 2> fresnel_s_p(double cos_i, double eta) {
             sqr((eta * cos_i - cos_t) / (eta * cos_i + cos_t))};
 }
 
+// The smooth slab's closed form below: {R, T} at cos θi = mu for one channel of optical depth
+// tau (η 1.5 in air), per polarization averaged, or of the mean F (polarized false).
+std::array<double, 2> smooth_slab(double mu, double tau, bool polarized) {
+    const std::array<double, 2> F_sp = fresnel_s_p(mu, 1.5);
+    const double a = std::exp(-tau / std::sqrt(1 - (1 - mu * mu) / 2.25));
+    double R = 0, T = 0;
+    for (double F : polarized ? std::vector<double>{F_sp[0], F_sp[1]}
+                              : std::vector<double>{0.5 * (F_sp[0] + F_sp[1])}) {
+        const double denom = 1 - F * F * a * a;
+        R += F + sqr(1 - F) * F * a * a / denom;
+        T += sqr(1 - F) * a / denom;
+    }
+    const double n = polarized ? 2 : 1;
+    return {R / n, T / n};
+}
+
 // A smooth slab (index η, absorption τ) in air, per polarization (F one of R_s, R_p, the same from
 // both sides at the refracted angle): R = F + (1 − F)² F a²/(1 − F² a²) and T = (1 − F)² a/(1 −
 // F² a²) (docs/physics.md §6.4). Polarized (the default, as the exact reference: a smooth slab
@@ -145,8 +161,6 @@ TEST(Lamina1, SmoothSlabIsTheExactSeries) {
         ASSERT_TRUE(model->support().btdf);
         for (double ti : {0.0, 30.0, 60.0, 80.0}) {
             const Vec3d wi = dir(ti, 0);
-            const std::array<double, 2> F_sp = fresnel_s_p(wi.z, 1.5);
-            const double mu_t = std::sqrt(1 - (1 - wi.z * wi.z) / 2.25);
             const Rgbd R = total_delta(*model, wi, true), T = total_delta(*model, wi, false);
             for (const DeltaLobe& d : model->delta_lobes(wi))
                 if (d.direction.z < 0) {
@@ -154,17 +168,9 @@ TEST(Lamina1, SmoothSlabIsTheExactSeries) {
                     EXPECT_NEAR(d.direction.z, -wi.z, 1e-12);
                 }
             for (int c = 0; c < 3; ++c) {
-                const double a = std::exp(-tau[c] / mu_t);
-                double R_expected = 0, T_expected = 0;
-                for (double F : polarized ? std::vector<double>{F_sp[0], F_sp[1]}
-                                          : std::vector<double>{0.5 * (F_sp[0] + F_sp[1])}) {
-                    const double denom = 1 - F * F * a * a;
-                    R_expected += F + sqr(1 - F) * F * a * a / denom;
-                    T_expected += sqr(1 - F) * a / denom;
-                }
-                const double n = polarized ? 2 : 1;
-                EXPECT_NEAR(R[c], R_expected / n, 1e-12) << ti << " " << polarized;
-                EXPECT_NEAR(T[c], T_expected / n, 1e-12) << ti << " " << polarized;
+                const std::array<double, 2> expected = smooth_slab(wi.z, tau[c], polarized);
+                EXPECT_NEAR(R[c], expected[0], 1e-12) << ti << " " << polarized;
+                EXPECT_NEAR(T[c], expected[1], 1e-12) << ti << " " << polarized;
             }
             EXPECT_LT(model->eval(wi, dir(40, 200)).max(), 1e-12);
             EXPECT_LT(model->eval(wi, Vec3d(0.3, 0.1, -std::sqrt(0.9))).max(), 1e-12);
@@ -198,22 +204,12 @@ TEST(Lamina1, NearlySmoothSlabIsTheSmoothSlab) {
         o.rel_tol = 1e-3;
         for (double ti : {0.0, 30.0, 60.0}) {
             const Vec3d wi = dir(ti, 0);
-            const std::array<double, 2> F_sp = fresnel_s_p(wi.z, 1.5);
-            const double mu_t = std::sqrt(1 - (1 - wi.z * wi.z) / 2.25);
             const Rgbd R = model_albedo(*model, wi, Side::Reflection, o);
             const Rgbd T = model_albedo(*model, wi, Side::Transmission, o);
             for (int c = 0; c < 3; ++c) {
-                const double a = std::exp(-tau[c] / mu_t);
-                double R_expected = 0, T_expected = 0;
-                for (double F : polarized ? std::vector<double>{F_sp[0], F_sp[1]}
-                                          : std::vector<double>{0.5 * (F_sp[0] + F_sp[1])}) {
-                    const double denom = 1 - F * F * a * a;
-                    R_expected += F + sqr(1 - F) * F * a * a / denom;
-                    T_expected += sqr(1 - F) * a / denom;
-                }
-                const double n = polarized ? 2 : 1;
-                EXPECT_NEAR(R[c], R_expected / n, budget) << ti << " " << c << " " << polarized;
-                EXPECT_NEAR(T[c], T_expected / n, budget) << ti << " " << c << " " << polarized;
+                const std::array<double, 2> expected = smooth_slab(wi.z, tau[c], polarized);
+                EXPECT_NEAR(R[c], expected[0], budget) << ti << " " << c << " " << polarized;
+                EXPECT_NEAR(T[c], expected[1], budget) << ti << " " << c << " " << polarized;
             }
         }
     }
