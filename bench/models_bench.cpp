@@ -207,6 +207,35 @@ void BM_Lamina1ConstructFrosted(benchmark::State& state, const char* round_trip)
 BENCHMARK_CAPTURE(BM_Lamina1ConstructFrosted, lobe, "lobe")->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Lamina1ConstructFrosted, series, "series")->Unit(benchmark::kMicrosecond);
 
+/// A nearly smooth slab (η 1.5, α0 0.05 with the typical absorption, over a bottom of α 0.001 into
+/// air), whose polarization (`polarization=on`, the default: both interfaces' Stokes blocks on
+/// the inside cosines and the entry rule on 17 outside ones, lamina1/polarization.h) is built at
+/// construction, against `polarization=off`; and a plastic under the same nearly smooth coat,
+/// whose coat seen from inside near its critical cosine is integrated per material
+/// (Bsdf::DenseSideFgd).
+Stack nearly_smooth(bool slab) {
+    Stack stack = slab ? typical_stack(true) : plastic_stack();
+    stack.layers[0].interface.alpha = 0.05;
+    if (slab) stack.layers[1] = layer_of(dielectric_interface(1.0, 0.001));
+    return stack;
+}
+void BM_Lamina1ConstructNearlySmooth(benchmark::State& state, bool slab, const char* polarization) {
+    warm_tables();
+    const Stack stack = nearly_smooth(slab);
+    const std::vector<std::string> options = {std::string("polarization=") + polarization};
+    make_model("lamina-1", stack, options);
+    for (auto _ : state)
+        benchmark::DoNotOptimize(make_model("lamina-1", stack, options));
+    state.SetLabel(std::string(slab ? "nearly smooth slab" : "plastic under a nearly smooth coat") +
+                   ", polarization=" + polarization);
+}
+BENCHMARK_CAPTURE(BM_Lamina1ConstructNearlySmooth, slab_polarized, true, "on")
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Lamina1ConstructNearlySmooth, slab_unpolarized, true, "off")
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Lamina1ConstructNearlySmooth, plastic, false, "on")
+    ->Unit(benchmark::kMicrosecond);
+
 /// ddb22's per-material precomputation (the hemispherical integrals over the coat tables and the
 /// exiting light's variance; the process-wide tables already loaded): the whole constructor.
 void BM_Ddb22Construct(benchmark::State& state) {
