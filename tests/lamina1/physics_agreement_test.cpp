@@ -1,14 +1,15 @@
 // The header library's scalar physics (include/lamina1/physics.h: what a renderer gets with
 // lamina-1, which includes nothing of lamina) against lamina's own (physics/: lane templates the
 // kernels evaluate), two writings of the same published formulas kept from drifting apart:
-// Fresnel of dielectrics (Born & Wolf) and conductors (also against the std::complex form), GGX's
-// D and Smith Λ (isotropic and anisotropic, with the visible normals), Henyey–Greenstein and
-// Snell's refraction, at 2000 random arguments each.
+// Fresnel of dielectrics (Born & Wolf; R_s and R_p apart too) and conductors (also against the
+// std::complex form), GGX's D and Smith Λ (isotropic and anisotropic, with the visible normals),
+// Henyey–Greenstein and Snell's refraction, at 2000 random arguments each.
 #include "core/math.h"
 #include "core/rng.h"
 #include "physics/fresnel.h"
 #include "physics/microfacet.h"
 #include "physics/phase.h"
+#include "physics/polarization.h"
 
 #include "lamina1/physics.h"
 
@@ -31,6 +32,14 @@ TEST(Lamina1Physics, AgreesWithLaminasPhysics) {
         const double c = 2 * u() - 1, eta = 0.2 + 3 * u(), k = 5 * u() * u();
         expect_rel(lamina1::fresnel_dielectric(c, eta), fresnel_dielectric(c, eta), 1e-12,
                    "fresnel_dielectric");
+        // R_s and R_p apart (lamina-1's slab under polarization) against the reflection Mueller
+        // matrix of lamina's polarized kernels: a = (R_s + R_p)/2, b = (R_s − R_p)/2, to 1e-12 of
+        // a (a − b cancels near Brewster's angle, where R_p → 0).
+        const lamina1::FresnelSp sp = lamina1::fresnel_dielectric_sp(c, eta);
+        const InterfaceMueller<double> m =
+            fresnel_dielectric_mueller<double>(c, eta, 1 / eta).reflection;
+        EXPECT_LE(std::abs(sp.s - (m.a + m.b)), 1e-12 * m.a) << c << " " << eta;
+        EXPECT_LE(std::abs(sp.p - (m.a - m.b)), 1e-12 * m.a) << c << " " << eta;
         const double cp = u();
         expect_rel(lamina1::fresnel_complex(cp, eta, k), fresnel_conductor(cp, eta, k), 1e-12,
                    "fresnel_complex");
