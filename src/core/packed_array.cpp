@@ -113,7 +113,7 @@ std::string deflate_chunked(const unsigned char* data, std::size_t size) {
         const std::size_t begin = std::size_t(i) * kChunk, end = std::min(size, begin + kChunk);
         const bool last = std::size_t(i) + 1 == n;
         z_stream z{};
-        if (deflateInit2(&z, 6, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
+        if (deflateInit2(&z, kPackDeflateLevel, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
             failed[std::size_t(i)] = 1;
             continue;
         }
@@ -135,7 +135,9 @@ std::string deflate_chunked(const unsigned char* data, std::size_t size) {
         deflateEnd(&z);
     }
     LAMINA_CHECK(std::find(failed.begin(), failed.end(), 1) == failed.end());
-    std::string stream = {char(0x78), char(0x9c)};  // deflate, 32 KiB window, default level
+    // RFC 1950 header: deflate, 32 KiB window, FLEVEL 1 ("fast", zlib's levels 2–5), check bits.
+    static_assert(kPackDeflateLevel >= 2 && kPackDeflateLevel <= 5);
+    std::string stream = {char(0x78), char(0x5e)};
     for (const std::string& part : parts)
         stream += part;
     const uLong adler = adler32_z(adler32(0, nullptr, 0), data, size);

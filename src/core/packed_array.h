@@ -30,6 +30,11 @@
 
 namespace lamina {
 
+/// zlib's level for step 4: 3 keeps most of level 6's ratio (the quick study's packed tables are
+/// about 6 % larger) in under half its time, which the study's outputs and the explorer page
+/// spend most of theirs on (docs/performance.md).
+inline constexpr int kPackDeflateLevel = 3;
+
 /// Packs `count` elements of `width` bytes (2 or 4) laid out as [count / (n·channels), n,
 /// channels] (steps 1–4 above). `channels` ≥ 1, `n` ≥ 1, count a multiple of n·channels.
 std::string pack_elements(const void* elements, std::size_t count, std::size_t width, std::size_t n,
