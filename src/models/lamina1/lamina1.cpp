@@ -211,14 +211,15 @@ Lamina1GpuStates lamina1_gpu_states(const Stack& stack, const ModelOptions& opti
     if (out.state.empty()) return out;
     out.head = lamina1::kGpuSlopeSum;
     out.tail = out.state.size() - std::size_t(lamina1::kGpuSize);
+    struct Variant {
+        const char* parameter;
+        double value;
+        lamina1::Layers layers;
+        std::vector<float> state;
+    };
+    std::vector<Variant> variants;
     auto add = [&](const char* parameter, double value, const lamina1::Layers& l) {
-        std::string ignored;
-        const std::vector<float> s = lamina1::Bsdf(l, tables, choices).gpu_state(&ignored);
-        // A variant of another layout (a slab's bins present or not) cannot share the stack's.
-        if (s.size() != out.state.size()) return;
-        out.variants.push_back({parameter, value});
-        out.heads.insert(out.heads.end(), s.begin(), s.begin() + lamina1::kGpuSlopeSum);
-        out.heads.insert(out.heads.end(), s.end() - std::ptrdiff_t(out.tail), s.end());
+        variants.push_back({parameter, value, l, {}});
     };
     // The values offered: roughnesses from smooth (a delta lobe: lamina1_delta) through nearly
     // smooth to rough, the indices of common coats, optical depths over three decades, albedos
@@ -257,6 +258,21 @@ Lamina1GpuStates lamina1_gpu_states(const Stack& stack, const ModelOptions& opti
             if (l.alpha1_y >= 0) l.alpha1_y = v;
             add("alpha1", v, l);
         }
+    }
+    // Each variant is a whole construction (a slab's takes milliseconds): side by side on the
+    // threads, kept in the order above.
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long i = 0; i < long(variants.size()); ++i) {
+        std::string ignored;
+        Variant& v = variants[std::size_t(i)];
+        v.state = lamina1::Bsdf(v.layers, tables, choices).gpu_state(&ignored);
+    }
+    for (const Variant& v : variants) {
+        // A variant of another layout (a slab's bins present or not) cannot share the stack's.
+        if (v.state.size() != out.state.size()) continue;
+        out.variants.push_back({v.parameter, v.value});
+        out.heads.insert(out.heads.end(), v.state.begin(), v.state.begin() + lamina1::kGpuSlopeSum);
+        out.heads.insert(out.heads.end(), v.state.end() - std::ptrdiff_t(out.tail), v.state.end());
     }
     return out;
 }
