@@ -12,11 +12,11 @@ lamina="$build/lamina"
 echo "== The example stacks"
 "$lamina" validate examples/*.json
 echo
-echo "== Their energy budgets: the goniophotometer, 10^6 particles per incidence (out/examples/NAME)"
+echo "== Their energy budgets: the goniophotometer, 2x10^5 particles per incidence (out/examples/NAME)"
 for stack in examples/*.json; do
     name=$(basename "$stack" .json)
     echo "-- $name"
-    "$lamina" simulate "$stack" --theta-i 0,45,80 --particles 1e6 --out "out/examples/$name"
+    "$lamina" simulate "$stack" --theta-i 0,45,80 --particles 2e5 --out "out/examples/$name"
 done
 echo
 echo "== The quick study: 60 configurations x 7 incidences x 10^6 particles, every model"
