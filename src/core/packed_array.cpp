@@ -102,7 +102,8 @@ void untransform(const unsigned char* planes, U* v, std::size_t count, std::size
 // before it (so matches reach back across chunk edges as they would in one stream) and ended by a
 // sync flush (an empty stored block that realigns to a byte), the last by the final block; the
 // zlib header and the Adler-32 of the whole input go around them. The chunks do not depend on the
-// thread count, so neither do the bytes; they are about 0.4 % more than one stream's.
+// thread count, so neither do the bytes; at level 3 they are as large as one stream's (within
+// 0.1 % on the quick study's tables).
 std::string deflate_chunked(const unsigned char* data, std::size_t size) {
     constexpr std::size_t kChunk = std::size_t(1) << 20, kWindow = std::size_t(1) << 15;
     const std::size_t n = std::max<std::size_t>(1, (size + kChunk - 1) / kChunk);
