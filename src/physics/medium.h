@@ -64,6 +64,16 @@ LAMINA_LANE_INLINE void beer_lambert_transmittance(const Tau& tau, T inv_mu, T o
     }
 }
 
+/// beer_lambert_transmittance for optical depths that differ between the lanes (a spectral run's
+/// lanes, each at its own wavelengths): tau[c] a lane value ≥ 0, the same e^{−τ_c/μ}, and 1 where
+/// τ_c = 0 (whatever inv_mu).
+template <typename T, typename L = Lane<T>>
+LAMINA_LANE_INLINE void beer_lambert_transmittance_lanes(const T tau[3], T inv_mu, T out[3]) {
+    for (int c = 0; c < 3; ++c)
+        out[c] = L::select(L::less(L::constant(0), tau[c]),
+                           L::exp((L::constant(0) - tau[c]) * inv_mu), L::constant(1));
+}
+
 /// The first half of a scattering-medium step: a free flight.
 template <typename T, typename M>
 struct MediumFlightLanes {

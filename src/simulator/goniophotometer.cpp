@@ -99,8 +99,22 @@ std::size_t first_dielectric_film(const Stack& stack) {
 }
 }  // namespace
 
+namespace {
+/// The first layer with a scattering medium, or the number of layers.
+std::size_t first_scattering_medium(const Stack& stack) {
+    std::size_t i = 0;
+    while (i < stack.layers.size() &&
+           !(stack.layers[i].has_medium && (stack.layers[i].medium.scatters() ||
+                                            stack.layers[i].medium.tau_s_spectrum.has_value())))
+        ++i;
+    return i;
+}
+}  // namespace
+
 bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings) {
-    return first_dielectric_film(stack) < stack.layers.size() || is_spectral_run(stack, settings);
+    return first_dielectric_film(stack) < stack.layers.size() ||
+           (is_spectral_run(stack, settings) &&
+            first_scattering_medium(stack) < stack.layers.size());
 }
 
 Kernel kernel_for(const SimulationSettings& settings, const Stack& stack) {
@@ -162,13 +176,16 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
         if (settings.stokes_tallies)
             throw InputError("settings", "spectral",
                              "Mueller tables are tabulated per RGB channel; give --spectral off");
-        if (settings.kernel == Kernel::Simd)
-            throw InputError("command line", "--kernel",
-                             fmt::format("a spectral run (stack '{}'{}) is traced by the scalar "
-                                         "kernel only; give --kernel scalar (or auto)",
-                                         stack.name,
-                                         stack.is_spectral() ? ", which has spectral values"
-                                                             : ", --spectral on"));
+        if (const std::size_t med = first_scattering_medium(stack);
+            settings.kernel == Kernel::Simd && med < stack.layers.size())
+            throw InputError(
+                "command line", "--kernel",
+                fmt::format("a spectral run (stack '{}'{}) with a scattering medium "
+                            "(/layers/{}/medium) is traced by the scalar kernel "
+                            "only; give --kernel scalar (or auto)",
+                            stack.name,
+                            stack.is_spectral() ? ", which has spectral values" : ", --spectral on",
+                            med));
     }
     if (settings.kernel != Kernel::Simd) return;
     if (const std::size_t film = first_dielectric_film(stack); film < stack.layers.size())
@@ -191,11 +208,12 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
     const Kernel kernel = kernel_for(settings, stack);
     if (kernel == Kernel::Simd) select_simd_target();
     const bool spectral = is_spectral_run(stack, settings);
-    const auto trace_block = spectral                 ? trace_block_spectral
-                             : kernel == Kernel::Simd ? trace_block_simd
-                                                      : trace_block_scalar;
     const SpectralTracing tracing =
         spectral ? spectral_tracing(stack, settings) : SpectralTracing{};
+    const bool simd = kernel == Kernel::Simd && (!spectral || tracing.lanes_uniform);
+    const auto trace_block = simd       ? trace_block_simd
+                             : spectral ? trace_block_spectral
+                                        : trace_block_scalar;
     const int groups = settings.spectral_bins / 3;
 
     SimulationSums result = zero_sums(stack, settings);

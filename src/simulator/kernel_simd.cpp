@@ -100,6 +100,10 @@ struct LaneVectors {
     VI events_done;     // events of the lane's ended particles
     VI k;               // at an interface: its index; in a medium: its layer
     VI in_medium, events, live, finish;
+    // Spectral runs: the lane's stack (SpectralTracing::stacks' index t · 3 + hero), its hero
+    // channel, its wavelength group and whether its secondary wavelengths still travel
+    // (SpectralParticle).
+    VI at, hero, group, secondaries;
     bool touched[kLossTerms] = {};  // loss terms some lane may have booked in this block
     // Polarized runs: the lanes' polarization (physics/polarization.h); pol.flux points at w.
     PolarizationLanes<VF> pol;
@@ -145,18 +149,17 @@ HWY_INLINE GgxLanes<VF, kAnisotropic> VecGgx(const GGX<float>& ggx) {
 }
 
 // A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
-// instantiates at one lane): the particle arrives along d (wi = −d). Polarized (kPolarized): the
+// instantiates at one lane): the particle arrives along d (wi = −d), the relative index eta (and
+// its inverse) per lane: the interface's, or a spectral lane's. Polarized (kPolarized): the
 // event's polarized form on the lanes' states; where the channels' states differ, its reweighting
 // of the channels is booked with the base, as trace_particle does.
 template <bool kPolarized, bool kAnisotropic>
-HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
-                                VF uc, VF u1, VF u2, MF& degenerate) {
-    const DF df;
+HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, VF eta, VF inv_eta, MF m,
+                                LaneVectors& v, VF uc, VF u1, VF u2, MF& degenerate) {
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     const InterfaceEventLanes<VF, MF> e = dielectric_event<VF, VecLane, kPolarized>(
-        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()),
-        VecGgx<kAnisotropic>(iface.distribution()), iface.event_shape(), wi, uc, u1, u2, m,
-        kPolarized ? &v.pol : nullptr);
+        eta, inv_eta, VecGgx<kAnisotropic>(iface.distribution()), iface.event_shape(), wi, uc, u1,
+        u2, m, kPolarized ? &v.pol : nullptr);
     degenerate = hn::Or(degenerate, e.degenerate);
     const MF ok = hn::AndNot(e.degenerate, m);
     if constexpr (kPolarized)
@@ -215,12 +218,12 @@ HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, con
 }
 
 template <bool kPolarized, bool kAnisotropic>
-HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, MF m, LaneVectors& v,
-                                    LaneRng& rng, int max_order, MF& degenerate) {
-    const DF df;
+HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, VF eta, VF inv_eta,
+                                    MF m, LaneVectors& v, LaneRng& rng, int max_order,
+                                    MF& degenerate) {
     auto draw = [&] { return rng.Uniform(); };
     const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw), kPolarized> facet{
-        hn::Set(df, iface.eta), hn::Set(df, iface.inv_eta()), draw, kPolarized ? &v.pol : nullptr};
+        eta, inv_eta, draw, kPolarized ? &v.pol : nullptr};
     MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), true, facet, m, v, rng, max_order,
                                         degenerate, kPolarized && v.pol.channels == 3);
 }
@@ -247,8 +250,8 @@ HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, const
 // called per lane and channel, as its Airy sums have no lane template. It stands where the bare
 // conductor's ConductorFresnel and ConductorMueller stand in the conductor event and walk.
 struct FilmReflection {
-    const FilmOptics& film;
-    const double* thickness_nm;  // per lane
+    const FilmOptics* const* film;  // per lane: the layer's, or a spectral lane's stack's
+    const double* thickness_nm;     // per lane
     // The reflectance per channel (unpolarized), as film_event's `reflectance`.
     HWY_NOINLINE void operator()(VF cos_theta, VF* factors) const {
         const DF df;
@@ -256,8 +259,8 @@ struct FilmReflection {
         hn::Store(cos_theta, df, cos_l);
         for (std::size_t l = 0; l < hn::Lanes(df); ++l)
             for (int c = 0; c < 3; ++c)
-                r[c][l] =
-                    float(film.mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection.a);
+                r[c][l] = float(
+                    film[l]->mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection.a);
         for (int c = 0; c < 3; ++c)
             factors[c] = hn::Load(df, r[c]);
     }
@@ -268,7 +271,8 @@ struct FilmReflection {
         hn::Store(cos_theta, df, cos_l);
         for (std::size_t l = 0; l < hn::Lanes(df); ++l)
             for (int c = 0; c < 3; ++c) {
-                const auto md = film.mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection;
+                const auto md =
+                    film[l]->mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection;
                 e[c][0][l] = float(md.a);
                 e[c][1][l] = float(md.b);
                 e[c][2][l] = float(md.c);
@@ -283,23 +287,25 @@ struct FilmReflection {
 // A filmed conductor's event (film_event's conductor branch): the lanes' thicknesses drawn first
 // where the film's thickness varies (one number per event, from each lane's own stream), then the
 // conductor event or walk with the film's reflection in place of the bare Fresnel terms, booked as
-// the bare conductor's (absorbed by the base, lost to the microsurface). Isotropic: a stack with a
-// film has no anisotropic interface (validate_kernel_for).
+// the bare conductor's (absorbed by the base, lost to the microsurface). `films`: each lane's film
+// (the layer's, or a spectral lane's stack's: the same thickness distribution, other wavelengths).
+// Isotropic: a stack with a film has no anisotropic interface (validate_kernel_for).
 template <bool kPolarized>
-HWY_NOINLINE void FilmConductorEvent(const CompiledLayer<float>& layer, MF m, LaneVectors& v,
+HWY_NOINLINE void FilmConductorEvent(const CompiledLayer<float>& layer,
+                                     const FilmOptics* const* films, MF m, LaneVectors& v,
                                      LaneRng& rng, int max_order, MF& degenerate) {
     const DF df;
-    const FilmOptics& film = layer.film;
     HWY_ALIGN double thickness[kMaxLanes];
-    if (film.varies()) {
+    if (layer.film.varies()) {
         HWY_ALIGN float u[kMaxLanes];
         hn::Store(rng.Uniform(), df, u);
         for (std::size_t l = 0; l < hn::Lanes(df); ++l)
-            thickness[l] = film.thickness_nm(double(u[l]));
+            thickness[l] = films[l]->thickness_nm(double(u[l]));
     } else {
-        std::fill(thickness, thickness + hn::Lanes(df), film.thickness_min_nm);
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            thickness[l] = films[l]->thickness_min_nm;
     }
-    const FilmReflection reflection{film, thickness};
+    const FilmReflection reflection{films, thickness};
     if (layer.multiple) {
         ConductorWalkEvent<kPolarized, false>(layer.conductor, reflection, reflection, m, v, rng,
                                               max_order, degenerate);
@@ -311,17 +317,16 @@ HWY_NOINLINE void FilmConductorEvent(const CompiledLayer<float>& layer, MF m, La
 }
 
 // Lambertian (lambertian.h lambertian_event, the same template): cosine-distributed on wi's side,
-// weight = albedo; it depolarizes (polarized runs).
+// weight = albedo (per channel and lane: the interface's, or a spectral lane's); it depolarizes
+// (polarized runs).
 template <bool kPolarized>
-HWY_INLINE void LambertianEvent(const LambertianInterface<float>& iface, MF m, LaneVectors& v,
-                                VF u1, VF u2, MF& degenerate) {
+HWY_INLINE void LambertianEvent(const VF albedo[3], MF m, LaneVectors& v, VF u1, VF u2,
+                                MF& degenerate) {
     const DF df;
     const MF bad = hn::And(m, hn::Eq(v.d.z, hn::Zero(df)));
     degenerate = hn::Or(degenerate, bad);
     const MF ok = hn::AndNot(bad, m);
     const V3 wo = lambertian_event<VF, VecLane>(hn::Neg(v.d.z), u1, u2);
-    const VF albedo[3] = {hn::Set(df, iface.albedo[0]), hn::Set(df, iface.albedo[1]),
-                          hn::Set(df, iface.albedo[2])};
     v.Keep(ok, kLossBase, albedo);
     v.d = Select(ok, wo, v.d);
     if constexpr (kPolarized) stokes_depolarize<VF, VecLane>(v.pol.stokes, 3, ok);
@@ -385,11 +390,16 @@ using Queue = std::vector<Waiting>;
 struct WaitingPolarization {
     float x[3], q[3], u[3], v[3];
 };
+// Its spectral lane (spectral runs), kept beside the queue: LaneVectors' at, group, secondaries.
+struct WaitingSpectral {
+    std::int32_t at, group, secondaries;
+};
 
 struct Scratch {
     std::vector<std::uint64_t> state, inc;
     Queue queue;
     std::vector<WaitingPolarization> queue_pol;
+    std::vector<WaitingSpectral> queue_spectral;
     void resize(std::size_t n) {
         state.resize(n);
         inc.resize(n);
@@ -512,13 +522,24 @@ struct LaneSums {
 // kAnisotropic = true the general (anisotropic) GGX instance at every rough interface (VecGgx).
 // The per-step work, InterfaceStep and EndParticles, is compiled out of line (two call sites
 // each); the pieces they are made of are inlined into them.
-template <bool kPolarized, bool kAnisotropic>
+//
+// kSpectral: a spectral run (job.spectral; trace_block_spectral's particles on lanes). Each lane's
+// particle draws its stack (its three wavelengths and hero) first, as trace_block_spectral's does,
+// from its own stream; the lanes branch on SpectralTracing::structure and gather the values that
+// differ between the stacks (SpectralLayerLanes) by their stack index at every event: the
+// dielectric's index, the conductor's, the albedo, the absorption depths, each lane's film. At a
+// dispersive interface a lane's secondary wavelengths end as SpectralParticle::before_event ends
+// them. Exits are tallied per lane as SpectralParticle::exit tallies them, and a particle's
+// losses, kept per lane in double, are booked to its wavelength group and colour projections
+// (SpectralParticle::flush) when it ends — or, for the particles that wait after their first
+// event, then.
+template <bool kPolarized, bool kAnisotropic, bool kSpectral>
 class BlockTracer {
   public:
     BlockTracer(const BlockJob& job, Tally& tally, Scratch& scratch)
         : job_(job),
           tally_(tally),
-          stack_(*job.stack),
+          stack_(kSpectral ? job.spectral->structure : *job.stack),
           grid_(*job.grid),
           n_layers_(int(stack_.layers.size())),
           n_lanes_(hn::Lanes(DF())),
@@ -531,6 +552,11 @@ class BlockTracer {
     }
 
     void Trace(BlockBudget& block) {
+        block_ = &block;
+        if constexpr (kSpectral)
+            for (auto& term : particle_loss_)
+                for (auto& channel : term)
+                    std::fill(std::begin(channel), std::end(channel), 0.0);
         scratch_.resize(job_.count);
         SeedParticles(job_.seed, job_.stream, job_.first, job_.count, scratch_.state.data(),
                       scratch_.inc.data());
@@ -543,12 +569,16 @@ class BlockTracer {
   private:
     // ---- Lane bookkeeping ----
 
-    // Moves a lane set's float sums into the double ones.
+    // Moves a lane set's float sums into the double ones (spectral runs: the losses into each
+    // lane's particle's, particle_loss_).
     HWY_INLINE void Flush(LaneVectors& v) {
         for (int c = 0; c < 3; ++c) {
             for (int t = 0; t < kLossTerms; ++t)
                 if (v.touched[t]) {
-                    sums_.add(t, c, v.loss[t][c]);
+                    if constexpr (kSpectral)
+                        AddToLanes(particle_loss_[t][c], v.loss[t][c]);
+                    else
+                        sums_.add(t, c, v.loss[t][c]);
                     v.loss[t][c] = zero_;
                 }
             for (int e = 0; e < 4; ++e)
@@ -557,6 +587,70 @@ class BlockTracer {
                     v.exit_sum[e][c] = zero_;
                 }
         }
+    }
+
+    // x added to the per-lane doubles at `into`, in double.
+    static HWY_INLINE void AddToLanes(double* into, VF x) {
+        const DD dd;
+        const hn::Half<DF> dfh;
+        const std::size_t half = hn::Lanes(dd);
+        hn::Store(hn::Add(hn::Load(dd, into), hn::PromoteTo(dd, hn::LowerHalf(dfh, x))), dd, into);
+        hn::Store(hn::Add(hn::Load(dd, into + half), hn::PromoteTo(dd, hn::UpperHalf(dfh, x))), dd,
+                  into + half);
+    }
+
+    // ---- Spectral lanes ----
+
+    // A table of SpectralLayerLanes at the lanes' stacks.
+    HWY_INLINE VF Gather(const std::vector<float>& table, VI at) const {
+        return hn::GatherIndex(DF(), table.data(), at);
+    }
+    // The particle of lane l, staged by StageSpectral.
+    HWY_INLINE SpectralParticle LaneParticle(std::size_t l) const {
+        return spectral_particle(job_, std::size_t(at_out_[l]), group_out_[l]);
+    }
+    // The lanes' stacks and groups into at_out_ and group_out_, their float losses into
+    // particle_loss_.
+    HWY_INLINE void StageSpectral(LaneVectors& v) {
+        const DI di;
+        hn::Store(v.at, di, at_out_);
+        hn::Store(v.group, di, group_out_);
+        Flush(v);
+    }
+    // Lane l's particle's losses (staged) booked to its wavelength group and colour projections,
+    // and cleared for the lane's next particle.
+    HWY_INLINE void BookLosses(std::size_t l) {
+        PathLosses losses;
+        bool any = false;
+        for (int t = 0; t < kLossTerms; ++t)
+            for (int c = 0; c < 3; ++c) {
+                double& lost = particle_loss_[t][c][l];
+                losses.term[std::size_t(int(BudgetTerm::AbsorbedMedium) + t)][std::size_t(c)] =
+                    lost;
+                any = any || lost != 0.0;
+                lost = 0.0;
+            }
+        if (any) LaneParticle(l).flush(losses, *block_);
+    }
+    // Before an event at layer `group`: a dispersive interface ends the secondary wavelengths of
+    // the lanes in m that still carry them; the hero carries 3 times its flux
+    // (SpectralParticle::before_event).
+    HWY_INLINE void EndSecondaries(LaneVectors& v, int group, MF m) const {
+        const DF df;
+        const DI di;
+        const VI dispersive = hn::GatherIndex(
+            di, job_.spectral->layer_lanes[std::size_t(group)].dispersive.data(), v.at);
+        const MI ends =
+            hn::And(hn::RebindMask(di, m),
+                    hn::And(hn::Ne(dispersive, hn::Zero(di)), hn::Ne(v.secondaries, hn::Zero(di))));
+        if (hn::AllFalse(di, ends)) return;
+        const MF ends_f = hn::RebindMask(df, ends);
+        for (int c = 0; c < 3; ++c) {
+            const MF hero = hn::RebindMask(df, hn::Eq(v.hero, hn::Set(di, c)));
+            v.w[c] = hn::IfThenElse(
+                ends_f, hn::IfThenElseZero(hero, hn::Mul(hn::Set(df, 3.f), v.w[c])), v.w[c]);
+        }
+        v.secondaries = hn::IfThenElseZero(hn::Not(ends), v.secondaries);
     }
 
     HWY_INLINE void Clear(LaneVectors& v) const {
@@ -573,6 +667,7 @@ class BlockTracer {
             for (auto& channel : term)
                 channel = zero_;
         v.k = v.in_medium = v.events = v.events_done = v.live = v.finish = hn::Zero(di);
+        v.at = v.hero = v.group = v.secondaries = hn::Zero(di);
         if constexpr (kPolarized) {
             v.pol.stokes = stokes_incident<VF, VecLane>(
                 {hn::Set(df, -job_.wi.x), hn::Set(df, -job_.wi.y), hn::Set(df, -job_.wi.z)},
@@ -584,48 +679,95 @@ class BlockTracer {
 
     // ---- One interface event of the lanes in `going`, all at interface `group` ----
 
-    // The layer's event on the lanes of `going`; marks the lanes whose sample failed.
-    HWY_INLINE void Event(const CompiledLayer<float>& layer, LaneVectors& v, LaneRng& rng, MF going,
-                          MF& degenerate_event) const {
+    // The layer's event on the lanes of `going`; marks the lanes whose sample failed. The
+    // layer's values: its own, or (kSpectral) each lane's stack's (SpectralLayerLanes).
+    HWY_INLINE void Event(const CompiledLayer<float>& layer, int group, LaneVectors& v,
+                          LaneRng& rng, MF going, MF& degenerate_event) const {
+        const DF df;
+        [[maybe_unused]] const SpectralLayerLanes* lanes =
+            kSpectral ? &job_.spectral->layer_lanes[std::size_t(group)] : nullptr;
         switch (layer.type) {
             case InterfaceType::Dielectric: {
+                VF eta = hn::Set(df, layer.dielectric.eta);
+                VF inv_eta = hn::Set(df, layer.dielectric.inv_eta());
+                if constexpr (kSpectral) {
+                    eta = Gather(lanes->eta, v.at);
+                    inv_eta = Gather(lanes->inv_eta, v.at);
+                }
                 if (layer.multiple) {
-                    DielectricWalkEvent<kPolarized, kAnisotropic>(layer.dielectric, going, v, rng,
-                                                                  stack_.max_microsurface_order,
-                                                                  degenerate_event);
+                    DielectricWalkEvent<kPolarized, kAnisotropic>(
+                        layer.dielectric, eta, inv_eta, going, v, rng,
+                        stack_.max_microsurface_order, degenerate_event);
                     break;
                 }
                 const VF uc = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
-                DielectricEvent<kPolarized, kAnisotropic>(layer.dielectric, going, v, uc, u1, u2,
-                                                          degenerate_event);
+                DielectricEvent<kPolarized, kAnisotropic>(layer.dielectric, eta, inv_eta, going, v,
+                                                          uc, u1, u2, degenerate_event);
                 break;
             }
             case InterfaceType::Conductor: {
                 if constexpr (!kAnisotropic)
                     if (layer.has_film) {
-                        FilmConductorEvent<kPolarized>(
-                            layer, going, v, rng, stack_.max_microsurface_order, degenerate_event);
+                        HWY_ALIGN const FilmOptics* films[kMaxLanes];
+                        if constexpr (kSpectral) {
+                            HWY_ALIGN std::int32_t at[kMaxLanes];
+                            hn::Store(v.at, DI(), at);
+                            for (std::size_t l = 0; l < n_lanes_; ++l)
+                                films[l] = &job_.spectral->stacks[std::size_t(at[l])]
+                                                .layers[std::size_t(group)]
+                                                .film;
+                        } else {
+                            std::fill(films, films + n_lanes_, &layer.film);
+                        }
+                        FilmConductorEvent<kPolarized>(layer, films, going, v, rng,
+                                                       stack_.max_microsurface_order,
+                                                       degenerate_event);
                         break;
                     }
-                if (layer.multiple) {
-                    ConductorWalkEvent<kPolarized, kAnisotropic>(
-                        layer.conductor, ConductorFresnel{layer.conductor},
-                        ConductorMueller{layer.conductor}, going, v, rng,
-                        stack_.max_microsurface_order, degenerate_event);
-                    break;
+                if constexpr (kSpectral) {
+                    LaneConductorFresnel fresnel;
+                    LaneConductorMueller mueller;
+                    for (int c = 0; c < 3; ++c) {
+                        fresnel.eta[c] = mueller.eta[c] = Gather(lanes->conductor_eta[c], v.at);
+                        fresnel.k[c] = mueller.k[c] = Gather(lanes->conductor_k[c], v.at);
+                    }
+                    ConductorLaneEvent(layer, fresnel, mueller, going, v, rng, degenerate_event);
+                } else {
+                    ConductorLaneEvent(layer, ConductorFresnel{layer.conductor},
+                                       ConductorMueller{layer.conductor}, going, v, rng,
+                                       degenerate_event);
                 }
-                const VF u1 = rng.Uniform(), u2 = rng.Uniform();
-                ConductorEvent<kPolarized, kAnisotropic>(
-                    layer.conductor, ConductorFresnel{layer.conductor},
-                    ConductorMueller{layer.conductor}, going, v, u1, u2, degenerate_event);
                 break;
             }
             case InterfaceType::Lambertian: {
+                VF albedo[3];
+                for (int c = 0; c < 3; ++c)
+                    if constexpr (kSpectral)
+                        albedo[c] = Gather(lanes->albedo[c], v.at);
+                    else
+                        albedo[c] = hn::Set(df, layer.lambertian.albedo[c]);
                 const VF u1 = rng.Uniform(), u2 = rng.Uniform();
-                LambertianEvent<kPolarized>(layer.lambertian, going, v, u1, u2, degenerate_event);
+                LambertianEvent<kPolarized>(albedo, going, v, u1, u2, degenerate_event);
                 break;
             }
         }
+    }
+
+    // A bare conductor's event or walk with the Fresnel factors and Mueller matrices of
+    // `fresnel` and `mueller` (lane_conductor.h).
+    template <typename Fresnel, typename Mueller>
+    HWY_INLINE void ConductorLaneEvent(const CompiledLayer<float>& layer, const Fresnel& fresnel,
+                                       const Mueller& mueller, MF going, LaneVectors& v,
+                                       LaneRng& rng, MF& degenerate_event) const {
+        if (layer.multiple) {
+            ConductorWalkEvent<kPolarized, kAnisotropic>(layer.conductor, fresnel, mueller, going,
+                                                         v, rng, stack_.max_microsurface_order,
+                                                         degenerate_event);
+            return;
+        }
+        const VF u1 = rng.Uniform(), u2 = rng.Uniform();
+        ConductorEvent<kPolarized, kAnisotropic>(layer.conductor, fresnel, mueller, going, v, u1,
+                                                 u2, degenerate_event);
     }
 
     // The lanes of `continues` leave interface `group`: out of the stack at its top or bottom
@@ -661,10 +803,19 @@ class BlockTracer {
                 continue;
             }
             if (med.absorbs) {
-                // Pure absorption: Beer–Lambert along the straight path (physics/medium.h).
+                // Pure absorption: Beer–Lambert along the straight path (physics/medium.h), at
+                // each spectral lane's own depths.
                 VF transmittance[3];
-                beer_lambert_transmittance<VF, VecLane>(med.tau_a, hn::Div(one_, hn::Abs(v.d.z)),
-                                                        transmittance);
+                const VF inv_mu = hn::Div(one_, hn::Abs(v.d.z));
+                if constexpr (kSpectral) {
+                    const SpectralLayerLanes& lanes =
+                        job_.spectral->layer_lanes[std::size_t(medium_layer)];
+                    const VF tau[3] = {Gather(lanes.tau_a[0], v.at), Gather(lanes.tau_a[1], v.at),
+                                       Gather(lanes.tau_a[2], v.at)};
+                    beer_lambert_transmittance_lanes<VF, VecLane>(tau, inv_mu, transmittance);
+                } else {
+                    beer_lambert_transmittance<VF, VecLane>(med.tau_a, inv_mu, transmittance);
+                }
                 v.Keep(moving, kLossMedium, transmittance);
                 v.End(hn::And(moving, v.Black()), kEnded);
             }
@@ -680,7 +831,8 @@ class BlockTracer {
         MF degenerate_event = hn::FirstN(df, 0);  // all false
         const CompiledLayer<float>& layer = stack_.layers[group];
         const bool dielectric = layer.type == InterfaceType::Dielectric;
-        Event(layer, v, rng, going, degenerate_event);
+        if constexpr (kSpectral) EndSecondaries(v, group, going);
+        Event(layer, group, v, rng, going, degenerate_event);
         // A failed sample loses the flux to the microsurface; an exactly grazing new direction is
         // lost to the microsurface (dielectric) or the base (opaque), as in trace_particle.
         const MF grazing = hn::AndNot(degenerate_event, hn::And(going, hn::Eq(v.d.z, zero_)));
@@ -701,7 +853,8 @@ class BlockTracer {
     HWY_INLINE void SumEnded(LaneVectors& v, MF ended, MF reflected, MF transmitted) {
         const DF df;
         const DI di;
-        for (int side = 0; side < 2; ++side) {
+        // Spectral runs: each exit is tallied with its particle's colour weights (TallyExit).
+        for (int side = 0; side < (kSpectral ? 0 : 2); ++side) {
             const MF leaves = side == 0 ? reflected : transmitted;
             if (hn::AllFalse(df, leaves)) continue;
             left_[side] = true;
@@ -749,6 +902,11 @@ class BlockTracer {
                                     ? std::size_t(theta_bin_[l]) * std::size_t(vector_bins_.n_phi) +
                                           std::size_t(phi_bin_[l])
                                     : grid_.bin_of(Vec3f(d_out_[0][l], d_out_[1][l], d_out_[2][l]));
+        if constexpr (kSpectral) {
+            LaneParticle(l).exit((why == kTransmitted ? grid_.size() : 0) + bin, why == kReflected,
+                                 w, tally_, *block_);
+            return;
+        }
         tally_.exit((why == kTransmitted ? grid_.size() : 0) + bin, w);
         if constexpr (kPolarized)
             if (stokes_tallies_) {
@@ -774,6 +932,7 @@ class BlockTracer {
         hn::Store(v.finish, di, finish_);
         std::uint64_t known_bins = 0;
         if (!hn::AllFalse(df, exits)) known_bins = StageExits(v, exits);
+        if constexpr (kSpectral) StageSpectral(v);
         // Over the set bits of the mask: which lanes ended is random, a branch per lane would be
         // mispredicted half of the time.
         for (std::uint64_t ended_bits = MaskBits(ended); ended_bits != 0;
@@ -781,6 +940,7 @@ class BlockTracer {
             const std::size_t l = std::size_t(std::countr_zero(ended_bits));
             const std::int32_t why = finish_[l];
             if (why != kEnded) TallyExit(l, why, known_bins);
+            if constexpr (kSpectral) BookLosses(l);
             on_lane(l);
         }
     }
@@ -797,6 +957,7 @@ class BlockTracer {
         Queue& queue = scratch_.queue;
         queue.clear();
         if constexpr (kPolarized) scratch_.queue_pol.clear();
+        if constexpr (kSpectral) scratch_.queue_spectral.clear();
         LaneVectors p;
         Clear(p);
         [[maybe_unused]] const StokesLanes<VF> incident = p.pol.stokes;
@@ -818,10 +979,19 @@ class BlockTracer {
             p.k = p.in_medium = p.events = p.finish = hn::Zero(di);
             p.depth = zero_;
             if constexpr (kPolarized) p.pol.stokes = incident;
+            if constexpr (kSpectral) DrawStacks(p, prng, base);
             InterfaceStep(p, prng, 0, going);
             const MF ended = hn::RebindMask(df, hn::Ne(p.finish, hn::Zero(di)));
             if (!hn::AllFalse(df, ended)) EndParticles(p, ended, [](std::size_t) {});
             prng.SyncOut();
+            if constexpr (kSpectral) {
+                // The waiting particles' losses of their first event, booked now (the queue does
+                // not carry them).
+                StageSpectral(p);
+                for (std::uint64_t bits = MaskBits(hn::AndNot(ended, going)); bits != 0;
+                     bits &= bits - 1)
+                    BookLosses(std::size_t(std::countr_zero(bits)));
+            }
             const MF waits = hn::AndNot(ended, going);
             hn::Store(p.d.x, df, qd[0]);
             hn::Store(p.d.y, df, qd[1]);
@@ -833,9 +1003,13 @@ class BlockTracer {
             hn::Store(p.in_medium, di, qin);
             hn::Store(p.events, di, qevents);
             if constexpr (kPolarized) staged_pol_.Store(p.pol.stokes);
+            [[maybe_unused]] HWY_ALIGN std::int32_t qsecondaries[kMaxLanes];
+            if constexpr (kSpectral) hn::Store(p.secondaries, di, qsecondaries);
             for (std::uint64_t bits = MaskBits(waits); bits != 0; bits &= bits - 1) {
                 const std::size_t l = std::size_t(std::countr_zero(bits));
                 if constexpr (kPolarized) scratch_.queue_pol.push_back(staged_pol_.Lane(l));
+                if constexpr (kSpectral)
+                    scratch_.queue_spectral.push_back({at_out_[l], group_out_[l], qsecondaries[l]});
                 queue.push_back({{qd[0][l], qd[1][l], qd[2][l]},
                                  {qw[0][l], qw[1][l], qw[2][l]},
                                  qdepth[l],
@@ -851,6 +1025,29 @@ class BlockTracer {
         sums_.add_events(p.events_done);
     }
 
+    // The stacks of the chunk's particles (job.first + base + l in lane l): each draws its
+    // lattice point and hero first from its own stream, as trace_block_spectral's particles do;
+    // its group is its index mod the groups.
+    HWY_INLINE void DrawStacks(LaneVectors& p, LaneRng& prng, std::uint64_t base) const {
+        const DF df;
+        const DI di;
+        const SpectralTracing& tr = *job_.spectral;
+        constexpr int kPoints = 3 * kSpectralLattice;  // a group's lattice points, all channels
+        const std::uint64_t groups = std::uint64_t(tr.bins / 3);
+        HWY_ALIGN std::int32_t group[kMaxLanes];
+        for (std::size_t l = 0; l < n_lanes_; ++l)
+            group[l] = std::int32_t((job_.first + base + l) % groups);
+        const VI point =
+            hn::Min(hn::ConvertTo(di, hn::Mul(prng.Uniform(), hn::Set(df, float(kPoints)))),
+                    hn::Set(di, kPoints - 1));
+        static_assert(kSpectralLattice == 16, "the shifts below divide by kSpectralLattice");
+        p.hero = hn::ShiftRight<4>(point);
+        p.group = hn::Load(di, group);
+        const VI t = hn::Add(hn::ShiftLeft<4>(p.group), hn::And(point, hn::Set(di, 15)));
+        p.at = hn::Add(hn::Mul(t, hn::Set(di, 3)), p.hero);
+        p.secondaries = hn::Set(di, 1);
+    }
+
     // ---- The main loop ----
 
     // Stages the queue's next particle for lane l, or retires the lane when none is left.
@@ -858,6 +1055,13 @@ class BlockTracer {
         const Queue& queue = scratch_.queue;
         if (next_ < queue.size()) {
             if constexpr (kPolarized) staged_pol_.SetLane(l, scratch_.queue_pol[next_]);
+            if constexpr (kSpectral) {
+                const WaitingSpectral& q = scratch_.queue_spectral[next_];
+                s_at_[l] = q.at;
+                s_hero_[l] = q.at % 3;
+                s_group_[l] = q.group;
+                s_secondaries_[l] = q.secondaries;
+            }
             const Waiting& q = queue[next_++];
             for (int i = 0; i < 3; ++i) {
                 sd_[i][l] = q.d[i];
@@ -876,6 +1080,7 @@ class BlockTracer {
             sd_[2][l] = -1.f;
             sdepth_[l] = 0.f;
             sk_[l] = s_in_[l] = sevents_[l] = 0;
+            s_at_[l] = s_hero_[l] = s_group_[l] = s_secondaries_[l] = 0;
             rng_.state[l] = 0;
             rng_.inc[l] = 1;
             live_[l] = 0;
@@ -897,6 +1102,12 @@ class BlockTracer {
         v.events = hn::IfThenElse(fresh_i, hn::Load(di, sevents_), v.events);
         v.live = hn::IfThenElse(fresh_i, hn::Load(di, live_), v.live);
         if constexpr (kPolarized) staged_pol_.Load(fresh, v.pol.stokes);
+        if constexpr (kSpectral) {
+            v.at = hn::IfThenElse(fresh_i, hn::Load(di, s_at_), v.at);
+            v.hero = hn::IfThenElse(fresh_i, hn::Load(di, s_hero_), v.hero);
+            v.group = hn::IfThenElse(fresh_i, hn::Load(di, s_group_), v.group);
+            v.secondaries = hn::IfThenElse(fresh_i, hn::Load(di, s_secondaries_), v.secondaries);
+        }
     }
 
     // The group of lanes that steps: those at one interface, or those inside one scattering
@@ -1015,20 +1226,38 @@ class BlockTracer {
     HWY_ALIGN float sd_[3][kMaxLanes], sw_[3][kMaxLanes], sdepth_[kMaxLanes];
     HWY_ALIGN std::int32_t sk_[kMaxLanes], s_in_[kMaxLanes], sevents_[kMaxLanes], live_[kMaxLanes];
     std::size_t next_ = 0;  // the queue's next particle
+
+    // Spectral runs: the staged lanes' stacks, heroes, groups and secondaries; the ended lanes'
+    // stacks and groups (StageSpectral); each lane's particle's losses (Flush); the block's sums.
+    [[maybe_unused]] HWY_ALIGN std::int32_t s_at_[kMaxLanes], s_hero_[kMaxLanes],
+        s_group_[kMaxLanes], s_secondaries_[kMaxLanes];
+    [[maybe_unused]] HWY_ALIGN std::int32_t at_out_[kMaxLanes], group_out_[kMaxLanes];
+    [[maybe_unused]] HWY_ALIGN double particle_loss_[kLossTerms][3][kMaxLanes];
+    BlockBudget* block_ = nullptr;
 };
 
-// The instance for the stack: polarized or not, isotropic or anisotropic (as trace_particle's).
-void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
+// The instance for the job: spectral or not, and for the stack (the spectral run's structure):
+// polarized or not, isotropic or anisotropic.
+template <bool kSpectral>
+void TraceBlockFor(const CompiledStack<float>& stack, const BlockJob& job, Tally& tally,
+                   BlockBudget& block) {
     thread_local Scratch scratch;
-    const bool polarized = job.stack->polarization, anisotropic = job.stack->anisotropic;
+    const bool polarized = stack.polarization, anisotropic = stack.anisotropic;
     if (polarized && anisotropic)
-        BlockTracer<true, true>(job, tally, scratch).Trace(block);
+        BlockTracer<true, true, kSpectral>(job, tally, scratch).Trace(block);
     else if (polarized)
-        BlockTracer<true, false>(job, tally, scratch).Trace(block);
+        BlockTracer<true, false, kSpectral>(job, tally, scratch).Trace(block);
     else if (anisotropic)
-        BlockTracer<false, true>(job, tally, scratch).Trace(block);
+        BlockTracer<false, true, kSpectral>(job, tally, scratch).Trace(block);
     else
-        BlockTracer<false, false>(job, tally, scratch).Trace(block);
+        BlockTracer<false, false, kSpectral>(job, tally, scratch).Trace(block);
+}
+
+void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
+    if (job.spectral != nullptr)
+        TraceBlockFor<true>(job.spectral->structure, job, tally, block);
+    else
+        TraceBlockFor<false>(*job.stack, job, tally, block);
 }
 
 }  // namespace HWY_NAMESPACE

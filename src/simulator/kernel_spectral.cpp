@@ -7,9 +7,52 @@
 
 namespace lamina {
 
+namespace {
+
+// The SIMD kernel's view of a spectral run (SpectralTracing::layer_lanes, structure,
+// lanes_uniform): the values that differ between the stacks gathered per layer, and whether one
+// stack's branches serve all of them.
+void spectral_lanes(SpectralTracing& tr) {
+    const std::size_t n = tr.stacks.size();
+    const CompiledStack<float>& first = tr.stacks.front();
+    tr.structure = first;
+    tr.lanes_uniform = true;
+    tr.layer_lanes.assign(first.layers.size(), {});
+    for (std::size_t i = 0; i < first.layers.size(); ++i) {
+        SpectralLayerLanes& lanes = tr.layer_lanes[i];
+        CompiledLayer<float>& shared = tr.structure.layers[i];
+        const CompiledLayer<float>& a = first.layers[i];
+        for (std::size_t at = 0; at < n; ++at) {
+            const CompiledStack<float>& stack = tr.stacks[at];
+            const CompiledLayer<float>& l = stack.layers[i];
+            // The branches the kernel takes per layer: the same in every stack, or no lanes.
+            const bool same = l.type == a.type && l.delta == a.delta && l.multiple == a.multiple &&
+                              l.has_film == a.has_film &&
+                              l.dielectric.is_index_matched() == a.dielectric.is_index_matched() &&
+                              !l.medium.scatters;
+            if (!same || (l.has_film && l.type == InterfaceType::Dielectric))
+                tr.lanes_uniform = false;
+            shared.medium.absorbs = shared.medium.absorbs || l.medium.absorbs;
+            tr.structure.polarization_channels =
+                std::max(tr.structure.polarization_channels, stack.polarization_channels);
+            lanes.eta.push_back(l.dielectric.eta);
+            lanes.inv_eta.push_back(l.dielectric.inv_eta());
+            for (int c = 0; c < 3; ++c) {
+                lanes.conductor_eta[std::size_t(c)].push_back(l.conductor.eta[c]);
+                lanes.conductor_k[std::size_t(c)].push_back(l.conductor.k[c]);
+                lanes.albedo[std::size_t(c)].push_back(l.lambertian.albedo[c]);
+                lanes.tau_a[std::size_t(c)].push_back(l.medium.tau_a[c]);
+            }
+            lanes.dispersive.push_back(tr.dispersive[at][i] != 0 ? 1 : 0);
+        }
+    }
+}
+
+}  // namespace
+
 void trace_block_spectral(const BlockJob& job, Tally& tally, BlockBudget& block) {
     const SpectralTracing& tr = *job.spectral;
-    const int third = tr.lattice / 3, groups = tr.bins / 3;
+    const int groups = tr.bins / 3;
     for (std::uint64_t p = job.first; p < job.first + job.count; ++p) {
         ParticleRng rng(job.seed, job.stream, p);
         const int group = int(p % std::uint64_t(groups));
@@ -19,19 +62,7 @@ void trace_block_spectral(const BlockJob& job, Tally& tally, BlockBudget& block)
         const int t = group * kSpectralLattice + point % kSpectralLattice;
         const std::size_t at = std::size_t(t) * 3 + std::size_t(hero);
         const CompiledStack<float>& stack = tr.stacks[at];
-        SpectralParticle sp{tr,
-                            *job.spectral_tally,
-                            *job.spectral_block,
-                            tr.dispersive[at],
-                            t / kSpectralLattice,
-                            hero,
-                            true,
-                            {},
-                            {}};
-        for (int c = 0; c < 3; ++c) {
-            sp.xyz_weight[c] = tr.xyz_weight[std::size_t(t + c * third)];
-            sp.srgb_weight[c] = tr.srgb_weight[std::size_t(t + c * third)];
-        }
+        SpectralParticle sp = spectral_particle(job, at, group);
         // The instance of trace_particle for the stack: polarized or not, anisotropic, filmed.
         const auto trace = [&]<bool kPolarized, bool kAnisotropic, bool kFilm>() {
             trace_particle<kPolarized, kAnisotropic, kFilm, true>(stack, *job.grid, job, rng, tally,
@@ -88,6 +119,7 @@ SpectralTracing spectral_tracing(const Stack& stack, const SimulationSettings& s
         tr.xyz_weight.push_back(Rgbf(xyz));
         tr.srgb_weight.push_back(Rgbf(srgb));
     }
+    spectral_lanes(tr);
     return tr;
 }
 

@@ -56,6 +56,23 @@ struct ConductorMueller {
     }
 };
 
+// The same for indices that differ between the lanes (a spectral run's lanes, each at its own
+// wavelengths): per channel a lane value of η and k.
+struct LaneConductorFresnel {
+    VF eta[3], k[3];
+    HWY_INLINE void operator()(VF cos_theta, VF* factors) const {
+        for (int c = 0; c < 3; ++c)
+            factors[c] = fresnel_conductor<VF, VecLane>(cos_theta, eta[c], k[c]);
+    }
+};
+struct LaneConductorMueller {
+    VF eta[3], k[3];
+    HWY_INLINE void operator()(VF cos_theta, InterfaceMueller<VF>* m) const {
+        for (int c = 0; c < 3; ++c)
+            m[c] = fresnel_conductor_mueller<VF, VecLane>(cos_theta, eta[c], k[c]);
+    }
+};
+
 LAMINA_LANE_END
 
 #endif  // LAMINA_SIMULATOR_LANE_CONDUCTOR_H

@@ -171,6 +171,16 @@ struct Tally {
 // most 5 in magnitude (checked when the run is set up) times a group factor below 1.5, so each
 // contribution, divided by its scale, stays within the bounds of Tally::exit.
 
+/// One layer's values that differ between a spectral run's stacks, per stack (SpectralTracing::
+/// stacks' index t · 3 + h), for the SIMD kernel to gather into its lanes: the dielectric's
+/// relative index and its inverse (the hero's), the conductor's complex index, the Lambertian
+/// albedo and the medium's absorption depth per channel, and whether the layer is dispersive.
+struct SpectralLayerLanes {
+    std::vector<float> eta, inv_eta;
+    std::array<std::vector<float>, 3> conductor_eta, conductor_k, albedo, tau_a;
+    std::vector<std::int32_t> dispersive;
+};
+
 /// The stacks and weights of a spectral run.
 struct SpectralTracing {
     int bins = 0;     ///< wavelength bins (a multiple of 3)
@@ -185,6 +195,15 @@ struct SpectralTracing {
     /// expectation of Σ_c flux_c · weight(λ_c) over the particles is the projection of the
     /// spectrum.
     std::vector<Rgbf> xyz_weight, srgb_weight;
+    /// What the SIMD kernel reads (kernel_simd.cpp): per layer, the values that differ between
+    /// the stacks, indexed as `stacks` (SpectralLayerLanes); and the stack its lanes branch on,
+    /// stacks[0] with every medium absorbing where some stack's does and the most polarization
+    /// states any stack needs. `lanes_uniform`: every stack has the same structure (interface
+    /// types, smooth or index-matched dielectrics, films, no scattering medium), so that one
+    /// stack's branches serve all lanes; else the scalar kernel traces the run.
+    std::vector<SpectralLayerLanes> layer_lanes;
+    CompiledStack<float> structure;
+    bool lanes_uniform = false;
 };
 
 /// Particle p's wavelength group is p mod groups (the groups are stratified over the particles);
@@ -236,5 +255,93 @@ struct BlockJob {
 };
 
 void trace_block_scalar(const BlockJob& job, Tally& tally, BlockBudget& block);
+
+// ---- A spectral particle (docs/physics.md §10) -------------------------------------------------
+// Its three wavelengths (tally.h: lattice points t + c · L/3), the channel h whose wavelength its
+// path follows (the hero), and where its exits and losses are tallied. At a dispersive interface
+// (one whose refraction direction depends on the wavelength) the other two channels, whose paths
+// would part from the hero's, are terminated and the hero carries 3 times its flux (hero
+// wavelength sampling's termination of the secondary wavelengths at a dispersive event: Wilkie
+// et al. 2014, "Hero Wavelength Spectral Sampling", EGSR): the
+// hero is uniformly distributed over the lattice, as each channel is, so its flux times 3
+// estimates what the three channels did, without bias (the terminated flux is not booked in the
+// budget, which sums to 1 in expectation then).
+struct SpectralParticle {
+    const SpectralTracing& tracing;
+    SpectralTally& tally;
+    SpectralBlock& block;
+    const std::vector<char>& dispersive;  ///< per layer
+    int group;                            ///< t / kSpectralLattice: the wavelength bins' group
+    int hero;
+    bool secondaries = true;  ///< the non-hero channels still travel
+    Rgbf xyz_weight[3], srgb_weight[3];
+
+    /// Before an event at `layer`: terminates the secondaries at a dispersive interface.
+    void before_event(int layer, Rgbf& w) {
+        if (!secondaries || !dispersive[std::size_t(layer)]) return;
+        secondaries = false;
+        for (int c = 0; c < 3; ++c)
+            w[c] = c == hero ? 3.f * w[c] : 0.f;
+    }
+    Rgbf projected(const Rgbf& w, const Rgbf (&weight)[3]) const {
+        return weight[0] * w[0] + weight[1] * w[1] + weight[2] * w[2];
+    }
+    /// An exit into `index` (side · n_bins + bin) with flux w: the wavelength bins, XYZ and sRGB
+    /// (`tally`, `block`: the main sRGB ones).
+    void exit(std::size_t index, bool reflected, const Rgbf& w, Tally& main,
+              BlockBudget& main_block) {
+        const Rgbf xyz = projected(w, xyz_weight), srgb = projected(w, srgb_weight);
+        constexpr float kScale = 1.f / float(kSpectralTallyScale);
+        tally.lambda.exit(index * std::size_t(tracing.bins / 3) + std::size_t(group), w * 0.25f);
+        tally.xyz.exit(index, xyz * kScale);
+        main.exit(index, srgb * kScale);
+        BlockBudget& g = block.groups[std::size_t(group)];
+        if (reflected) {
+            g.escape_reflected(w);
+            block.xyz.escape_reflected(xyz);
+            main_block.escape_reflected(srgb);
+        } else {
+            g.escape_transmitted(w);
+            block.xyz.escape_transmitted(xyz);
+            main_block.escape_transmitted(srgb);
+        }
+    }
+    /// The path's losses, per wavelength group and projected.
+    void flush(const PathLosses& losses, BlockBudget& main_block) {
+        BlockBudget& g = block.groups[std::size_t(group)];
+        for (int t = int(BudgetTerm::AbsorbedMedium); t < kBudgetTerms; ++t)
+            for (int c = 0; c < 3; ++c) {
+                const double lost = losses.term[std::size_t(t)][std::size_t(c)];
+                g.term[std::size_t(t)][std::size_t(c)] += lost;
+                for (int k = 0; k < 3; ++k) {
+                    block.xyz.term[std::size_t(t)][std::size_t(k)] +=
+                        lost * double(xyz_weight[c][k]);
+                    main_block.term[std::size_t(t)][std::size_t(k)] +=
+                        lost * double(srgb_weight[c][k]);
+                }
+            }
+    }
+};
+
+/// The spectral particle of stack index `at` (SpectralTracing::stacks: t · 3 + hero) in wavelength
+/// group `group`, tallied into the job's spectral tallies: its channels' colour weights.
+inline SpectralParticle spectral_particle(const BlockJob& job, std::size_t at, int group) {
+    const SpectralTracing& tr = *job.spectral;
+    const int third = tr.lattice / 3, t = int(at / 3);
+    SpectralParticle sp{tr,
+                        *job.spectral_tally,
+                        *job.spectral_block,
+                        tr.dispersive[at],
+                        group,
+                        int(at % 3),
+                        true,
+                        {},
+                        {}};
+    for (int c = 0; c < 3; ++c) {
+        sp.xyz_weight[c] = tr.xyz_weight[std::size_t(t + c * third)];
+        sp.srgb_weight[c] = tr.srgb_weight[std::size_t(t + c * third)];
+    }
+    return sp;
+}
 
 }  // namespace lamina

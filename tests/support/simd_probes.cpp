@@ -140,6 +140,26 @@ void FresnelConductorForTest(const float* cos_theta, std::size_t n, float eta, f
     }
 }
 
+// Per entry j: tau[j] the same in all three channels of lane j (the probe varies it per lane).
+void BeerLambertLanesForTest(const float* tau, const float* inv_mu, std::size_t n, float* out) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float t[kMaxLanes], m[kMaxLanes], r[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            t[l] = base + l < n ? tau[base + l] : 0.f;
+            m[l] = base + l < n ? inv_mu[base + l] : 1.f;
+        }
+        const VF tau_v = hn::Load(df, t);
+        const VF taus[3] = {tau_v, tau_v, tau_v};
+        VF transmittance[3];
+        beer_lambert_transmittance_lanes<VF, VecLane>(taus, hn::Load(df, m), transmittance);
+        hn::Store(transmittance[1], df, r);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l)
+            out[base + l] = r[l];
+    }
+}
+
 void HenyeyGreensteinForTest(const float* g, const float* x, std::size_t n, float* phase,
                              float* cos_theta) {
     const DF df;
@@ -484,6 +504,7 @@ HWY_EXPORT(LaneBinsForTest);
 HWY_EXPORT(FresnelDielectricForTest);
 HWY_EXPORT(FresnelConductorForTest);
 HWY_EXPORT(HenyeyGreensteinForTest);
+HWY_EXPORT(BeerLambertLanesForTest);
 HWY_EXPORT(MicrosurfaceWalkForTest);
 HWY_EXPORT(GgxLanesForTest);
 HWY_EXPORT(InterfaceEventsForTest);
@@ -528,6 +549,15 @@ void simd_fresnel_dielectric(const std::vector<float>& cos_theta, float eta,
     cos_theta_t.resize(cos_theta.size());
     HWY_DYNAMIC_DISPATCH(FresnelDielectricForTest)
     (cos_theta.data(), cos_theta.size(), eta, reflectance.data(), cos_theta_t.data());
+}
+
+std::vector<float> simd_beer_lambert_lanes(const std::vector<float>& tau,
+                                           const std::vector<float>& inv_mu) {
+    select_simd_target();
+    std::vector<float> out(tau.size());
+    HWY_DYNAMIC_DISPATCH(BeerLambertLanesForTest)
+    (tau.data(), inv_mu.data(), tau.size(), out.data());
+    return out;
 }
 
 std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, float eta, float k) {

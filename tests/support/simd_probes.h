@@ -42,6 +42,12 @@ void simd_fresnel_dielectric(const std::vector<float>& cos_theta, float eta,
 /// instruction set's vectors.
 std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, float eta, float k);
 
+/// physics/medium.h beer_lambert_transmittance_lanes with optical depth tau[j] (in every
+/// channel) and inv_mu[j] on the dispatched instruction set's vectors, a depth per lane as a
+/// spectral run's lanes have them.
+std::vector<float> simd_beer_lambert_lanes(const std::vector<float>& tau,
+                                           const std::vector<float>& inv_mu);
+
 /// physics/phase.h hg_phase(x[j], g[j]) and sample_hg_cos_theta(g[j], x[j]) on the
 /// dispatched instruction set's vectors.
 void simd_henyey_greenstein(const std::vector<float>& g, const std::vector<float>& x,
