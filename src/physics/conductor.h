@@ -74,7 +74,7 @@ LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> conductor_event(
         stokes_rotate_frame<T, L>(pol->stokes, {zero - wi.x, zero - wi.y, zero - wi.z},
                                   lane_cross<T, L>(wi, wm), pol->channels, e.reflected);
         InterfaceMueller<T> m[3] = {};
-        mueller(cos_i_m, m);
+        reflection_on_lanes(mueller, cos_i_m, m, e.reflected);
         StokesLanes<T>& st = pol->stokes;
         pol->factor[0] = stokes_apply<T, L>(m[0], st.q[0], st.u[0], st.v[0], e.reflected);
         pol->factor[1] = pol->factor[2] = pol->factor[0];
@@ -83,7 +83,7 @@ LAMINA_LANE_INLINE InterfaceEventLanes<T, typename L::Mask> conductor_event(
         for (int c = 0; c < 3; ++c)
             fresnel_factors[c] = pol->factor[c];
     } else {
-        fresnel(cos_i_m, fresnel_factors);
+        reflection_on_lanes(fresnel, cos_i_m, fresnel_factors, e.reflected);
     }
     e.shadowing = one;
     if (!smooth)

@@ -307,14 +307,14 @@ struct MicrosurfaceConductorFacet {
             stokes_rotate_frame<T, L>(pol->stokes, {zero - w.x, zero - w.y, zero - w.z},
                                       lane_cross<T, L>(w, wm), pol->channels, walking);
             InterfaceMueller<T> m[3] = {};
-            (*mueller)(cos_w_m, m);
+            reflection_on_lanes(*mueller, cos_w_m, m, walking);
             StokesLanes<T>& st = pol->stokes;
             factors[0] = stokes_apply<T, L>(m[0], st.q[0], st.u[0], st.v[0], walking);
             factors[1] = factors[2] = factors[0];
             for (int c = 1; c < pol->channels; ++c)
                 factors[c] = stokes_apply<T, L>(m[c], st.q[c], st.u[c], st.v[c], walking);
         } else {
-            fresnel(cos_w_m, factors);
+            reflection_on_lanes(fresnel, cos_w_m, factors, walking);
         }
         for (int c = 0; c < 3; ++c)
             weight[c] = L::select(walking, weight[c] * factors[c], weight[c]);

@@ -48,6 +48,7 @@
 
 #include <cmath>
 #include <complex>
+#include <type_traits>
 
 // A lane header (core/lane.h): included once as an ordinary header and once per SIMD target.
 #ifndef LAMINA_LANE_TARGET
@@ -225,6 +226,18 @@ struct NoMueller {
     template <typename... A>
     void operator()(A&&...) const {}
 };
+
+/// Calls an interface's reflection source — Fresnel factors `source(cos θ, factors)` or Mueller
+/// matrices `source(cos θ, m)` — for the lanes of `active`: with the mask where the source takes
+/// one (a source evaluated lane by lane, as a thin film's Airy sums, then skips the other lanes,
+/// whose values the events never use), else on every lane.
+template <typename Source, typename T, typename Out, typename M>
+LAMINA_LANE_INLINE void reflection_on_lanes(const Source& source, T cos_theta, Out* out, M active) {
+    if constexpr (std::is_invocable_v<const Source&, T, Out*, M>)
+        source(cos_theta, out, active);
+    else
+        source(cos_theta, out);
+}
 
 /// Unpolarized light (every channel) in the frame x.
 template <typename T, typename L = Lane<T>>

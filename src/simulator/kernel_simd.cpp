@@ -252,24 +252,37 @@ HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, const
 struct FilmReflection {
     const FilmOptics* const* film;  // per lane: the layer's, or a spectral lane's stack's
     const double* thickness_nm;     // per lane
-    // The reflectance per channel (unpolarized), as film_event's `reflectance`.
-    HWY_NOINLINE void operator()(VF cos_theta, VF* factors) const {
+    // The reflectance per channel (unpolarized), as film_event's `reflectance`, on the lanes of
+    // `active` (reflection_on_lanes: the others, whose values no event uses, are not evaluated).
+    HWY_NOINLINE void operator()(VF cos_theta, VF* factors, MF active) const {
         const DF df;
         HWY_ALIGN float cos_l[kMaxLanes], r[3][kMaxLanes];
         hn::Store(cos_theta, df, cos_l);
-        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+        for (int c = 0; c < 3; ++c)
+            std::fill(r[c], r[c] + hn::Lanes(df), 1.f);
+        for (std::uint64_t bits = MaskBits(active); bits != 0; bits &= bits - 1) {
+            const std::size_t l = std::size_t(std::countr_zero(bits));
             for (int c = 0; c < 3; ++c)
                 r[c][l] = float(
                     film[l]->mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection.a);
+        }
         for (int c = 0; c < 3; ++c)
             factors[c] = hn::Load(df, r[c]);
     }
-    // The reflection Mueller matrices per channel (polarized), as film_event's `mueller`.
-    HWY_NOINLINE void operator()(VF cos_theta, InterfaceMueller<VF>* m) const {
+    // The reflection Mueller matrices per channel (polarized), as film_event's `mueller`, on the
+    // lanes of `active` (the others get the identity).
+    HWY_NOINLINE void operator()(VF cos_theta, InterfaceMueller<VF>* m, MF active) const {
         const DF df;
         HWY_ALIGN float cos_l[kMaxLanes], e[3][4][kMaxLanes];
         hn::Store(cos_theta, df, cos_l);
-        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+        for (int c = 0; c < 3; ++c) {
+            std::fill(e[c][0], e[c][0] + hn::Lanes(df), 1.f);
+            std::fill(e[c][1], e[c][1] + hn::Lanes(df), 0.f);
+            std::fill(e[c][2], e[c][2] + hn::Lanes(df), 1.f);
+            std::fill(e[c][3], e[c][3] + hn::Lanes(df), 0.f);
+        }
+        for (std::uint64_t bits = MaskBits(active); bits != 0; bits &= bits - 1) {
+            const std::size_t l = std::size_t(std::countr_zero(bits));
             for (int c = 0; c < 3; ++c) {
                 const auto md =
                     film[l]->mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection;
@@ -278,6 +291,7 @@ struct FilmReflection {
                 e[c][2][l] = float(md.c);
                 e[c][3][l] = float(md.d);
             }
+        }
         for (int c = 0; c < 3; ++c)
             m[c] = {hn::Load(df, e[c][0]), hn::Load(df, e[c][1]), hn::Load(df, e[c][2]),
                     hn::Load(df, e[c][3])};
