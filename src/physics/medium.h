@@ -21,13 +21,15 @@
 //
 // Lane templates (core/lane.h): the scalar kernel (simulator/goniophotometer.cpp), the SIMD kernel
 // (simulator/kernel_simd.cpp) and the random walk (randomwalk/random_walk.cpp) evaluate these
-// lines; the medium's parameters are the same on every lane.
+// lines; the medium's parameters are the same on every lane (CompiledMedium's numbers), or lane
+// values (a spectral run's lanes on the SIMD kernel: each at its own wavelengths, medium_lane).
 
 #include "core/lane.h"
 #include "core/lane_vec.h"
 #include "physics/phase.h"
 
 #include <cmath>
+#include <type_traits>
 
 // A lane header (core/lane.h): included once as an ordinary header and once per SIMD target.
 #ifndef LAMINA_LANE_TARGET
@@ -48,6 +50,16 @@
 #undef LAMINA_PHYSICS_MEDIUM_BODY
 
 LAMINA_LANE_BEGIN
+
+/// A medium's value on the lanes: a number (CompiledMedium's, the same on every lane) broadcast,
+/// or already a lane value (a spectral run's lanes, each at its own wavelengths).
+template <typename T, typename L, typename V>
+LAMINA_LANE_INLINE T medium_lane(const V& v) {
+    if constexpr (std::is_arithmetic_v<V>)
+        return L::constant(double(v));
+    else
+        return v;
+}
 
 /// Beer–Lambert transmittance e^{−τ_c/μ} of the optical depths tau[c] (≥ 0, the same on every
 /// lane) along a straight path across the layer, inv_mu = 1/|d.z|: out[c]. A channel without
@@ -113,9 +125,9 @@ LAMINA_LANE_INLINE MediumFlightLanes<T, typename L::Mask> medium_free_flight(con
     const T p01 = r.p[0] + r.p[1];
     const T u_channel = uniform();
     const auto first = L::less(u_channel, r.p[0]), second = L::less(u_channel, p01);
-    auto pick = [&](double v0, double v1, double v2) {
-        return L::select(first, L::constant(v0),
-                         L::select(second, L::constant(v1), L::constant(v2)));
+    auto pick = [&](const auto& v0, const auto& v1, const auto& v2) {
+        return L::select(first, medium_lane<T, L>(v0),
+                         L::select(second, medium_lane<T, L>(v1), medium_lane<T, L>(v2)));
     };
     const T sigma = pick(med.tau_t[0], med.tau_t[1], med.tau_t[2]);
     const T u_flight = uniform();
@@ -127,14 +139,18 @@ LAMINA_LANE_INLINE MediumFlightLanes<T, typename L::Mask> medium_free_flight(con
     r.depth = L::min(L::max(L::neg_mul_add(d.z, flight, depth), zero), one);
     if (med.uniform_tau_t) {
         for (int c = 0; c < 3; ++c)
-            r.factor[c] = L::select(r.leaves, one, L::constant(med.single_scattering_albedo[c]));
+            r.factor[c] =
+                L::select(r.leaves, one, medium_lane<T, L>(med.single_scattering_albedo[c]));
         return r;
     }
     T e[3], mix = zero, mix_scatter = zero;
     for (int c = 0; c < 3; ++c) {
         // A clear channel along a horizontal path (t = ∞): 0 · ∞ would be NaN; transmittance 1.
-        const T tau_t = L::constant(med.tau_t[c]);
-        e[c] = med.tau_t[c] > 0 ? L::exp((zero - tau_t) * t) : one;
+        const T tau_t = medium_lane<T, L>(med.tau_t[c]);
+        if constexpr (std::is_arithmetic_v<std::remove_cvref_t<decltype(med.tau_t[c])>>)
+            e[c] = med.tau_t[c] > 0 ? L::exp((zero - tau_t) * t) : one;
+        else
+            e[c] = L::select(L::less(zero, tau_t), L::exp((zero - tau_t) * t), one);
         mix = L::mul_add(r.p[c], e[c], mix);
         mix_scatter = L::mul_add(r.p[c] * tau_t, e[c], mix_scatter);
     }
@@ -142,7 +158,7 @@ LAMINA_LANE_INLINE MediumFlightLanes<T, typename L::Mask> medium_free_flight(con
     const T safe_mix_scatter = L::select(L::less(zero, mix_scatter), mix_scatter, one);
     for (int c = 0; c < 3; ++c)
         r.factor[c] = L::select(r.leaves, L::select(has_flux, e[c] / safe_mix, one),
-                                L::constant(med.tau_s[c]) * e[c] / safe_mix_scatter);
+                                medium_lane<T, L>(med.tau_s[c]) * e[c] / safe_mix_scatter);
     return r;
 }
 
@@ -159,12 +175,12 @@ LAMINA_LANE_INLINE bool medium_scatter(const Medium& med, const LaneVec3<T>& d, 
     const T zero = L::constant(0), one = L::constant(1);
     factor[0] = factor[1] = factor[2] = one;
     if (L::none(scatters)) return false;
-    T g = L::constant(med.g[0]);
+    T g = medium_lane<T, L>(med.g[0]);
     if (!med.uniform_g) {
         const T u_phase = uniform();
-        g = L::select(
-            L::less(u_phase, p[0]), g,
-            L::select(L::less(u_phase, p[0] + p[1]), L::constant(med.g[1]), L::constant(med.g[2])));
+        g = L::select(L::less(u_phase, p[0]), g,
+                      L::select(L::less(u_phase, p[0] + p[1]), medium_lane<T, L>(med.g[1]),
+                                medium_lane<T, L>(med.g[2])));
     }
     const T u1 = uniform(), u2 = uniform();
     d_new = sample_hg_direction<T, L>(d, g, u1, u2);
@@ -172,7 +188,7 @@ LAMINA_LANE_INLINE bool medium_scatter(const Medium& med, const LaneVec3<T>& d, 
     const T cos_theta = lane_dot<T, L>(d, d_new);
     T phase[3], mix = zero;
     for (int c = 0; c < 3; ++c) {
-        phase[c] = hg_phase<T, L>(cos_theta, L::constant(med.g[c]));
+        phase[c] = hg_phase<T, L>(cos_theta, medium_lane<T, L>(med.g[c]));
         mix = L::mul_add(p[c], phase[c], mix);
     }
     const T safe_mix = L::select(L::less(zero, mix), mix, one);

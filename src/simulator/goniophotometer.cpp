@@ -99,22 +99,8 @@ std::size_t first_dielectric_film(const Stack& stack) {
 }
 }  // namespace
 
-namespace {
-/// The first layer with a scattering medium, or the number of layers.
-std::size_t first_scattering_medium(const Stack& stack) {
-    std::size_t i = 0;
-    while (i < stack.layers.size() &&
-           !(stack.layers[i].has_medium && (stack.layers[i].medium.scatters() ||
-                                            stack.layers[i].medium.tau_s_spectrum.has_value())))
-        ++i;
-    return i;
-}
-}  // namespace
-
-bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings) {
-    return first_dielectric_film(stack) < stack.layers.size() ||
-           (is_spectral_run(stack, settings) &&
-            first_scattering_medium(stack) < stack.layers.size());
+bool needs_scalar_kernel(const Stack& stack, const SimulationSettings&) {
+    return first_dielectric_film(stack) < stack.layers.size();
 }
 
 Kernel kernel_for(const SimulationSettings& settings, const Stack& stack) {
@@ -176,16 +162,6 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
         if (settings.stokes_tallies)
             throw InputError("settings", "spectral",
                              "Mueller tables are tabulated per RGB channel; give --spectral off");
-        if (const std::size_t med = first_scattering_medium(stack);
-            settings.kernel == Kernel::Simd && med < stack.layers.size())
-            throw InputError(
-                "command line", "--kernel",
-                fmt::format("a spectral run (stack '{}'{}) with a scattering medium "
-                            "(/layers/{}/medium) is traced by the scalar kernel "
-                            "only; give --kernel scalar (or auto)",
-                            stack.name,
-                            stack.is_spectral() ? ", which has spectral values" : ", --spectral on",
-                            med));
     }
     if (settings.kernel != Kernel::Simd) return;
     if (const std::size_t film = first_dielectric_film(stack); film < stack.layers.size())

@@ -35,16 +35,13 @@ inline constexpr std::uint64_t kParticlesPerBlock = 4096;
 /// run time to what the CPU offers. Each is bitwise reproducible for any thread or process count on
 /// a given machine; the two agree in distribution (a two-sample chi-square test), not bit for bit.
 /// `auto` is `simd`, or `scalar` for what the SIMD kernel does not trace (a thin film on a
-/// dielectric interface, docs/physics.md §9; a spectral run with a scattering medium, §10):
-/// kernel_for. Both trace anisotropic interfaces, light from φi ≠ 0 (§3, §5), films on conductors
-/// and spectral runs through absorbing media.
+/// dielectric interface, docs/physics.md §9): kernel_for. Both trace anisotropic interfaces,
+/// light from φi ≠ 0 (§3, §5), films on conductors and spectral runs (§10).
 enum class Kernel { Scalar, Simd, Auto };
 inline constexpr std::array<EnumName<Kernel>, 3> enum_names(Kernel) {
     return {{{Kernel::Scalar, "scalar", "one particle at a time, the reference path"},
              {Kernel::Simd, "simd", "particles as the lanes of SIMD vectors"},
-             {Kernel::Auto, "auto",
-              "simd, or scalar for a thin film on a dielectric or a spectral run with a scattering "
-              "medium"}}};
+             {Kernel::Auto, "auto", "simd, or scalar for a thin film on a dielectric"}}};
 }
 inline const char* enum_noun(Kernel) {
     return "a particle kernel";
@@ -71,10 +68,9 @@ struct SimulationSettings;
 /// Whether `stack` is traced spectrally under `settings` (SpectralMode).
 bool is_spectral_run(const Stack& stack, const SimulationSettings& settings);
 /// Whether only the scalar kernel traces `stack` under `settings` (a thin film on a dielectric
-/// interface; a spectral run with a scattering medium, whose free flights the SIMD kernel draws
-/// with one medium for all lanes). A spectral run on the SIMD kernel whose stacks differ in
-/// structure between wavelengths (a dielectric index-matched to its surroundings at some
-/// wavelengths only, SpectralTracing::lanes_uniform) is handed to the scalar kernel when traced.
+/// interface). A spectral run on the SIMD kernel whose stacks differ in structure between
+/// wavelengths (a dielectric index-matched to its surroundings at some wavelengths only,
+/// SpectralTracing::lanes_uniform) is handed to the scalar kernel when traced.
 bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings);
 /// The kernel that traces `stack` under `settings`: auto is scalar where needs_scalar_kernel,
 /// simd otherwise; scalar and simd are themselves.

@@ -348,12 +348,19 @@ HWY_INLINE void LambertianEvent(const VF albedo[3], MF m, LaneVectors& v, VF u1,
 
 // ---- Media (physics/medium.h, the templates the scalar kernel instantiates at one lane) -------
 
-// One scattering-medium step for the lanes in m (inside layer `layer`'s medium): a free flight,
-// then either the crossing to the next interface or a scattering event (which depolarizes). The
-// lanes draw their numbers as the template asks for them (every lane draws while any needs them).
-template <bool kPolarized>
-HWY_INLINE void ScatteringStep(const CompiledMedium<float>& med, MF m, LaneVectors& v,
-                               LaneRng& rng) {
+// A scattering medium's values on the lanes (a spectral run's: each lane's stack's), in the
+// fields medium.h reads; its flags hold for every lane.
+struct LaneMedium {
+    VF tau_a[3], tau_s[3], tau_t[3], g[3], single_scattering_albedo[3];
+    bool uniform_tau_t, uniform_g;
+};
+
+// One scattering-medium step for the lanes in m (inside layer `layer`'s medium, a CompiledMedium
+// or a LaneMedium): a free flight, then either the crossing to the next interface or a scattering
+// event (which depolarizes). The lanes draw their numbers as the template asks for them (every
+// lane draws while any needs them).
+template <bool kPolarized, typename Medium>
+HWY_INLINE void ScatteringStep(const Medium& med, MF m, LaneVectors& v, LaneRng& rng) {
     const DF df;
     const DI di;
     auto uniform = [&] { return rng.Uniform(); };
@@ -541,7 +548,8 @@ struct LaneSums {
 // particle draws its stack (its three wavelengths and hero) first, as trace_block_spectral's does,
 // from its own stream; the lanes branch on SpectralTracing::structure and gather the values that
 // differ between the stacks (SpectralLayerLanes) by their stack index at every event: the
-// dielectric's index, the conductor's, the albedo, the absorption depths, each lane's film. At a
+// dielectric's index, the conductor's, the albedo, the medium's depths, phase function and
+// single-scattering albedo (LaneMedium), each lane's film. At a
 // dispersive interface a lane's secondary wavelengths end as SpectralParticle::before_event ends
 // them. Exits are tallied per lane as SpectralParticle::exit tallies them, and a particle's
 // losses, kept per lane in double, are booked to its wavelength group and colour projections
@@ -618,6 +626,23 @@ class BlockTracer {
     // A table of SpectralLayerLanes at the lanes' stacks.
     HWY_INLINE VF Gather(const std::vector<float>& table, VI at) const {
         return hn::GatherIndex(DF(), table.data(), at);
+    }
+    // Layer `layer`'s scattering medium at the lanes' stacks, with the flags of `shared`
+    // (SpectralTracing::structure's).
+    HWY_INLINE LaneMedium SpectralMedium(const CompiledMedium<float>& shared, int layer,
+                                         VI at) const {
+        const SpectralLayerLanes& t = job_.spectral->layer_lanes[std::size_t(layer)];
+        LaneMedium med;
+        for (int c = 0; c < 3; ++c) {
+            med.tau_a[c] = Gather(t.tau_a[c], at);
+            med.tau_s[c] = Gather(t.tau_s[c], at);
+            med.tau_t[c] = Gather(t.tau_t[c], at);
+            med.g[c] = Gather(t.g[c], at);
+            med.single_scattering_albedo[c] = Gather(t.single_scattering_albedo[c], at);
+        }
+        med.uniform_tau_t = shared.uniform_tau_t;
+        med.uniform_g = shared.uniform_g;
+        return med;
     }
     // The particle of lane l, staged by StageSpectral.
     HWY_INLINE SpectralParticle LaneParticle(std::size_t l) const {
@@ -1195,7 +1220,12 @@ class BlockTracer {
 
             if (group.is_medium) {
                 // ---- A scattering-medium step ----
-                ScatteringStep<kPolarized>(stack_.layers[group.layer].medium, going, v, rng_);
+                const CompiledMedium<float>& med = stack_.layers[group.layer].medium;
+                if constexpr (kSpectral)
+                    ScatteringStep<kPolarized>(SpectralMedium(med, group.layer, v.at), going, v,
+                                               rng_);
+                else
+                    ScatteringStep<kPolarized>(med, going, v, rng_);
                 v.End(hn::And(going, v.Black()), kEnded);
             } else {
                 InterfaceStep(v, rng_, group.layer, going);

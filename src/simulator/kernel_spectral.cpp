@@ -28,11 +28,17 @@ void spectral_lanes(SpectralTracing& tr) {
             // The branches the kernel takes per layer: the same in every stack, or no lanes.
             const bool same = l.type == a.type && l.delta == a.delta && l.multiple == a.multiple &&
                               l.has_film == a.has_film &&
-                              l.dielectric.is_index_matched() == a.dielectric.is_index_matched() &&
-                              !l.medium.scatters;
+                              l.dielectric.is_index_matched() == a.dielectric.is_index_matched();
             if (!same || (l.has_film && l.type == InterfaceType::Dielectric))
                 tr.lanes_uniform = false;
+            // A lane whose medium neither absorbs nor scatters at its wavelengths is traced
+            // through it by the flags of the others: Beer–Lambert with τa = 0 transmits 1, and
+            // free flights at its own extinction (MIS-weighted, or unweighted with one
+            // extinction) estimate its transmittance without bias.
             shared.medium.absorbs = shared.medium.absorbs || l.medium.absorbs;
+            shared.medium.scatters = shared.medium.scatters || l.medium.scatters;
+            shared.medium.uniform_tau_t = shared.medium.uniform_tau_t && l.medium.uniform_tau_t;
+            shared.medium.uniform_g = shared.medium.uniform_g && l.medium.uniform_g;
             tr.structure.polarization_channels =
                 std::max(tr.structure.polarization_channels, stack.polarization_channels);
             lanes.eta.push_back(l.dielectric.eta);
@@ -42,6 +48,11 @@ void spectral_lanes(SpectralTracing& tr) {
                 lanes.conductor_k[std::size_t(c)].push_back(l.conductor.k[c]);
                 lanes.albedo[std::size_t(c)].push_back(l.lambertian.albedo[c]);
                 lanes.tau_a[std::size_t(c)].push_back(l.medium.tau_a[c]);
+                lanes.tau_s[std::size_t(c)].push_back(l.medium.tau_s[c]);
+                lanes.tau_t[std::size_t(c)].push_back(l.medium.tau_t[c]);
+                lanes.g[std::size_t(c)].push_back(l.medium.g[c]);
+                lanes.single_scattering_albedo[std::size_t(c)].push_back(
+                    l.medium.single_scattering_albedo[c]);
             }
             lanes.dispersive.push_back(tr.dispersive[at][i] != 0 ? 1 : 0);
         }

@@ -174,10 +174,12 @@ struct Tally {
 /// One layer's values that differ between a spectral run's stacks, per stack (SpectralTracing::
 /// stacks' index t · 3 + h), for the SIMD kernel to gather into its lanes: the dielectric's
 /// relative index and its inverse (the hero's), the conductor's complex index, the Lambertian
-/// albedo and the medium's absorption depth per channel, and whether the layer is dispersive.
+/// albedo and the medium's optical depths, phase function and single-scattering albedo per
+/// channel (CompiledMedium's), and whether the layer is dispersive.
 struct SpectralLayerLanes {
     std::vector<float> eta, inv_eta;
-    std::array<std::vector<float>, 3> conductor_eta, conductor_k, albedo, tau_a;
+    std::array<std::vector<float>, 3> conductor_eta, conductor_k, albedo, tau_a, tau_s, tau_t, g,
+        single_scattering_albedo;
     std::vector<std::int32_t> dispersive;
 };
 
@@ -197,10 +199,11 @@ struct SpectralTracing {
     std::vector<Rgbf> xyz_weight, srgb_weight;
     /// What the SIMD kernel reads (kernel_simd.cpp): per layer, the values that differ between
     /// the stacks, indexed as `stacks` (SpectralLayerLanes); and the stack its lanes branch on,
-    /// stacks[0] with every medium absorbing where some stack's does and the most polarization
-    /// states any stack needs. `lanes_uniform`: every stack has the same structure (interface
-    /// types, smooth or index-matched dielectrics, films, no scattering medium), so that one
-    /// stack's branches serve all lanes; else the scalar kernel traces the run.
+    /// stacks[0] with every medium absorbing (scattering) where some stack's does, one extinction
+    /// (one g) for all channels only where every stack's has, and the most polarization states
+    /// any stack needs. `lanes_uniform`: every stack has the same structure (interface types,
+    /// smooth or index-matched dielectrics, films), so that one stack's branches serve all lanes;
+    /// else the scalar kernel traces the run.
     std::vector<SpectralLayerLanes> layer_lanes;
     CompiledStack<float> structure;
     bool lanes_uniform = false;
