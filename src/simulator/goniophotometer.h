@@ -303,8 +303,8 @@ SimulationSums zero_sums(const Stack& stack, const SimulationSettings& settings)
 void validate_settings(const SimulationSettings& settings, const std::string& where = "settings");
 
 /// Checks that the settings' kernel traces everything the stack holds: a thin film on a dielectric
-/// interface and a spectral run need the scalar kernel, or auto (InputError naming --kernel for
-/// simd; docs/physics.md §9); a film with an anisotropic interface is refused; a spectral run needs
+/// interface needs the scalar kernel, or auto (InputError naming --kernel for simd;
+/// docs/physics.md §9); a film with an anisotropic interface is refused; a spectral run needs
 /// spectral_bins a multiple of 3 and a range of at least one nm per bin. A refusal about the stack
 /// names `where` (its file; the stack's name when empty) and the JSON pointer of the field.
 void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,

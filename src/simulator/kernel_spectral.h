@@ -1,6 +1,7 @@
 #pragma once
-// The spectral runs of the scalar kernel (docs/physics.md §10; tally.h says how they are tallied),
-// in a unit of their own (scalar_particle.h says why). Internal to the simulator.
+// The spectral runs of the scalar kernel, in a unit of their own (scalar_particle.h says why), and
+// the stacks and weights both kernels trace them with (docs/physics.md §10; tally.h says how they
+// are tallied). Internal to the simulator.
 
 #include "simulator/goniophotometer.h"
 #include "simulator/tally.h"

@@ -250,8 +250,8 @@ struct BlockJob {
     /// the bin frame of −wi, and whether exits are tallied with their Stokes vectors.
     float incident_stokes[3] = {0.f, 0.f, 0.f};
     bool stokes_tallies = false;
-    /// Spectral runs (scalar kernel only): the run's stacks and weights, and this thread's
-    /// spectral tallies and block sums; null otherwise.
+    /// Spectral runs (either kernel): the run's stacks and weights, and this thread's spectral
+    /// tallies and block sums; null otherwise.
     const SpectralTracing* spectral = nullptr;
     SpectralTally* spectral_tally = nullptr;
     SpectralBlock* spectral_block = nullptr;
