@@ -1,6 +1,7 @@
 // Goniophotometer throughput: particles per second for the benchmark plastic and the benchmark
 // metallic paint at θi = 30°, on 1 and 2 threads, with events per particle; the second argument
-// picks the kernel (0 scalar, 1 SIMD).
+// picks the kernel (0 scalar, 1 SIMD). The spectral plastic's particles carry three wavelengths
+// each (docs/physics.md §10): its wavelength samples per second are three times its items.
 #include "layers/stack.h"
 #include "simulator/goniophotometer.h"
 #include "simulator/kernel_simd.h"
@@ -42,16 +43,18 @@ Stack bench_metallic_paint() {
 }
 
 void run(benchmark::State& state, const Stack& stack,
-         Microsurface microsurface = Microsurface::Single) {
+         Microsurface microsurface = Microsurface::Single, bool spectral = false) {
     SimulationSettings s;
     s.transport.microsurface = microsurface;
+    s.spectral = spectral ? SpectralMode::On : SpectralMode::Off;
     s.theta_i_deg = {30.0};
     s.particles = 1'000'000;
     s.threads = int(state.range(0));
     s.kernel = state.range(1) == 1 ? Kernel::Simd : Kernel::Scalar;
     state.SetLabel((s.kernel == Kernel::Simd ? fmt::format("simd {}", simd_target_name())
                                              : std::string("scalar")) +
-                   (microsurface == Microsurface::Multiple ? " multiple" : ""));
+                   (microsurface == Microsurface::Multiple ? " multiple" : "") +
+                   (spectral ? " spectral" : ""));
     double events = 0;
     for (auto _ : state) {
         const SimulationResult r = simulate(stack, s);
@@ -95,6 +98,18 @@ void BM_SimulateRoughSlabMultiple(benchmark::State& state) {
     run(state, bench_rough_slab(), Microsurface::Multiple);
 }
 
+// The plastic traced spectrally (three wavelengths per particle) with the transport's defaults
+// (polarized, multiple scattering: the exact reference), as BM_SimulatePlasticMultiple traces
+// it in RGB.
+void BM_SimulatePlasticSpectral(benchmark::State& state) {
+    run(state, bench_plastic(), Microsurface::Multiple, true);
+}
+
+BENCHMARK(BM_SimulatePlasticSpectral)
+    ->ArgsProduct({{2}, {0, 1}})
+    ->ArgNames({"threads", "simd"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_SimulatePlastic)
     ->ArgsProduct({{1, 2}, {0, 1}})
     ->ArgNames({"threads", "simd"})
