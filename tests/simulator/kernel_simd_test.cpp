@@ -17,6 +17,7 @@
 #include "support/chi2.h"
 #include "support/stacks.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -646,6 +647,15 @@ TEST(KernelSimd, AzimuthCosineAndSine) {
 // are those of the run's grid (the unfolded one for an anisotropic stack or light from φi ≠ 0).
 constexpr int kTwoSampleTests = 117;
 
+// One test of a suite of n_tests: Σ z² = chi2 over dof bins against χ²(dof) at the Šidák level
+// 1 − 0.99^(1/n_tests).
+void expect_chi2_consistent(double chi2, int dof, int n_tests, const std::string& where) {
+    ASSERT_GE(dof, 10) << "too few populated bins to test: " << where;
+    const double level = 1 - std::pow(1 - 0.01, 1.0 / n_tests);
+    EXPECT_GE(test::gamma_q(dof / 2.0, chi2 / 2.0), level)
+        << where << ": χ² = " << chi2 << " for " << dof << " bins";
+}
+
 // `scalar_tweak` adjusts the scalar run's settings (the SIMD run keeps the defaults);
 // `both_tweak` those of both runs.
 void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
@@ -666,7 +676,6 @@ void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
     s.kernel = Kernel::Simd;
     s.seed = 12;
     const SimulationResult b = simulate(stack, s);
-    const double level = 1 - std::pow(1 - 0.01, 1.0 / kTwoSampleTests);
     const HemisphereGrid& grid = a.table.grid;
     ASSERT_EQ(grid, b.table.grid);
     ASSERT_EQ(grid, simulation_grid(stack, s));
@@ -688,11 +697,9 @@ void expect_same_distribution(const Stack& stack, std::vector<double> theta_i,
                     chi2 += (la.f[j][c] - lb.f[j][c]) * (la.f[j][c] - lb.f[j][c]) / se2;
                     ++dof;
                 }
-                ASSERT_GE(dof, 10) << "too few populated bins to test";
-                const double p = test::gamma_q(dof / 2.0, chi2 / 2.0);
-                EXPECT_GE(p, level) << "θi " << s.theta_i_deg[inc] << "° φi " << s.phi_i_deg
-                                    << "° side " << int(side) << " channel " << c
-                                    << ": χ² = " << chi2 << " for " << dof << " bins";
+                expect_chi2_consistent(chi2, dof, kTwoSampleTests,
+                                       fmt::format("θi {}° φi {}° side {} channel {}",
+                                                   s.theta_i_deg[inc], s.phi_i_deg, int(side), c));
             }
             // The budgets too, within 5 combined standard errors.
             const EnergyBudget& ba = a.incidences[inc].budget;
@@ -1041,7 +1048,6 @@ void expect_same_spectral_distribution(const Stack& stack, std::vector<double> t
     s.kernel = Kernel::Simd;
     s.seed = 12;
     const SimulationResult b = simulate(stack, s);
-    const double level = 1 - std::pow(1 - 0.01, 1.0 / kSpectralTwoSampleTests);
     const HemisphereGrid& grid = a.table.grid;
     const SpectralTables& sa = a.spectral;
     const SpectralTables& sb = b.spectral;
@@ -1062,11 +1068,9 @@ void expect_same_spectral_distribution(const Stack& stack, std::vector<double> t
                     chi2 += (sa.f[at] - sb.f[at]) * (sa.f[at] - sb.f[at]) / se2;
                     ++dof;
                 }
-                ASSERT_GE(dof, 10) << "too few populated bins to test";
-                const double p = test::gamma_q(dof / 2.0, chi2 / 2.0);
-                EXPECT_GE(p, level)
-                    << "θi " << s.theta_i_deg[inc] << "° side " << side << " wavelength bin " << l
-                    << ": χ² = " << chi2 << " for " << dof << " bins";
+                expect_chi2_consistent(
+                    chi2, dof, kSpectralTwoSampleTests,
+                    fmt::format("θi {}° side {} wavelength bin {}", s.theta_i_deg[inc], side, l));
             }
         // The budgets per wavelength bin, within 5 combined standard errors.
         for (std::size_t l = 0; l < bins; ++l) {
@@ -1106,38 +1110,6 @@ TEST(KernelSimdStat, SameSpectralTablesAsScalarScatteringMedium) {
 TEST(KernelSimdStat, SameSpectralTablesAsScalarDispersiveRoughSlab) {
     expect_same_spectral_distribution(parse_stack(kSpectralSlab, "slab"), {10, 65}, 1'000'000,
                                       true);  // 24
-}
-
-// Reproducibility of spectral runs on the SIMD kernel: tables, spectral tables, their budgets
-// and colour projections bitwise identical for 1 and 2 threads (a dispersive coat over gold, a
-// filmed gold, a scattering medium); auto picks the SIMD kernel for a spectral run.
-TEST(KernelSimd, SpectralTablesBitwiseIdenticalAcrossThreadCounts) {
-    for (const Stack& stack : {parse_stack(kSpectralGoldUnderBk7, "gold"), iridescent_gold(0.3),
-                               parse_stack(kSpectralMilky, "milky")})
-        for (const bool exact : {false, true}) {
-            SCOPED_TRACE(::testing::Message() << stack.name << " exact " << exact);
-            SimulationSettings s;
-            s.theta_i_deg = {0, 55};
-            s.particles = 20'000;
-            s.grid = HemisphereGrid(9, 9);
-            s.spectral = SpectralMode::On;
-            EXPECT_EQ(kernel_for(s, stack), Kernel::Simd);
-            apply_physics(exact ? ReferencePhysics::Exact : ReferencePhysics::Bpb19, s.transport);
-            s.threads = 1;
-            const SimulationResult one = simulate(stack, s);
-            s.threads = 2;
-            const SimulationResult two = simulate(stack, s);
-            EXPECT_EQ(one.spectral.f, two.spectral.f);
-            EXPECT_EQ(one.spectral.se, two.spectral.se);
-            EXPECT_EQ(one.spectral.budget, two.spectral.budget);
-            for (std::size_t i = 0; i < 2; ++i) {
-                EXPECT_EQ(one.table.lobe(i, Side::Reflection).f,
-                          two.table.lobe(i, Side::Reflection).f);
-                EXPECT_EQ(one.spectral.xyz.lobe(i, Side::Reflection).f,
-                          two.spectral.xyz.lobe(i, Side::Reflection).f);
-                EXPECT_EQ(one.incidences[i].budget.term, two.incidences[i].budget.term);
-            }
-        }
 }
 
 }  // namespace

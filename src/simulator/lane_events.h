@@ -1,0 +1,348 @@
+// The SIMD kernel's lane state and the adapters of the physics' event templates to it: the
+// state of the lanes' particles (LaneVectors: direction, flux, the losses booked per budget
+// term, polarization and, in spectral runs, each lane's stack), and per interface type and
+// medium the call of the lane template that the scalar kernel instantiates at one lane
+// (physics/dielectric.h, conductor.h, lambertian.h, microsurface_walk.h, medium.h), with the thin
+// film's reflection evaluated lane by lane (FilmReflection). The kernel (simulator/kernel_simd.cpp)
+// manages the lanes around them. A per-target header (core/lane_hwy.h); layers/compiled_stack.h
+// and physics/thin_film.h must already be included as ordinary headers.
+
+#include "core/lane_hwy.h"
+#include "physics/conductor.h"
+#include "physics/dielectric.h"
+#include "physics/lambertian.h"
+#include "physics/medium.h"
+#include "physics/microsurface_walk.h"
+#include "physics/polarization.h"
+#include "simulator/lane_rng.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+
+// Highway's per-target include guard: the body once per instruction set.
+#if defined(LAMINA_SIMULATOR_LANE_EVENTS_H) == defined(HWY_TARGET_TOGGLE)
+#ifdef LAMINA_SIMULATOR_LANE_EVENTS_H
+#undef LAMINA_SIMULATOR_LANE_EVENTS_H
+#else
+#define LAMINA_SIMULATOR_LANE_EVENTS_H
+#endif
+
+LAMINA_LANE_BEGIN
+
+// ---- Lane state ---------------------------------------------------------------------------------
+
+enum LossTerm { kLossMedium = 0, kLossBase = 1, kLossMicro = 2, kLossCutOff = 3, kLossTerms = 4 };
+
+// Why a lane's particle ended this step.
+enum Finish : std::int32_t { kGoesOn = 0, kReflected = 1, kTransmitted = 2, kEnded = 3 };
+
+// The state of the lanes' particles, kept in vectors from step to step.
+struct LaneVectors {
+    V3 d;
+    VF w[3];
+    VF depth;  // inside a scattering medium: 0 at its top, 1 at its bottom
+    // Flux lost per budget term, summed in float over the lane's recent steps (whatever particle
+    // each step belonged to) and moved into double sums every kFlushSteps (8) steps: a few
+    // particles' worth of float additions at most, rounding-level like the particle's own float
+    // arithmetic.
+    VF loss[kLossTerms][3];
+    VF exit_sum[4][3];  // the same for R, R², T, T² of the particles that left
+    VI events_done;     // events of the lane's ended particles
+    VI k;               // at an interface: its index; in a medium: its layer
+    VI in_medium, events, live, finish;
+    // Spectral runs: the lane's stack (SpectralTracing::stacks' index t · 3 + hero), its hero
+    // channel, its wavelength group and whether its secondary wavelengths still travel
+    // (SpectralParticle).
+    VI at, hero, group, secondaries;
+    bool touched[kLossTerms] = {};  // loss terms some lane may have booked in this block
+    // Polarized runs: the lanes' polarization (physics/polarization.h); pol.flux points at w.
+    PolarizationLanes<VF> pol;
+
+    // Multiplies the flux of the lanes in m by `factor` (per channel) and books what is taken
+    // under `term`.
+    HWY_INLINE void Keep(MF m, int term, const VF factor[3]) {
+        touched[term] = true;
+        for (int c = 0; c < 3; ++c) {
+            const VF kept = hn::Mul(w[c], factor[c]);
+            loss[term][c] = hn::Add(loss[term][c], hn::IfThenElseZero(m, hn::Sub(w[c], kept)));
+            w[c] = hn::IfThenElse(m, kept, w[c]);
+        }
+    }
+    HWY_INLINE void Keep(MF m, int term, VF factor) {
+        const VF f[3] = {factor, factor, factor};
+        Keep(m, term, f);
+    }
+    HWY_INLINE MF Black() const {
+        const DF df;
+        const VF zero = hn::Zero(df);
+        return hn::And(hn::And(hn::Eq(w[0], zero), hn::Eq(w[1], zero)), hn::Eq(w[2], zero));
+    }
+    HWY_INLINE void End(MF m, Finish why) {
+        const DI di;
+        finish = hn::IfThenElse(hn::RebindMask(di, m), hn::Set(di, why), finish);
+    }
+};
+
+// ---- Interface events (goniophotometer.cpp trace_particle, `apply`) ----------------------------
+
+// An interface's GGX roughness (physics/microfacet.h) on the vectors' lanes: the very roughness
+// the scalar kernel's events take (GGX::lanes), broadcast. kAnisotropic (the stack has an
+// anisotropic interface, CompiledStack::anisotropic): the general instance, with the interface's
+// α_x, α_y and tangent frame, at every rough interface of the stack, as trace_particle takes it;
+// else the isotropic instance.
+template <bool kAnisotropic>
+HWY_INLINE GgxLanes<VF, kAnisotropic> VecGgx(const GGX<float>& ggx) {
+    const DF df;
+    const auto g = ggx.template lanes<kAnisotropic>();
+    return {hn::Set(df, g.alpha),    hn::Set(df, g.alpha2), hn::Set(df, g.d_alpha),
+            hn::Set(df, g.d_alpha2), hn::Set(df, g.bx),     hn::Set(df, g.by)};
+}
+
+// A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
+// instantiates at one lane): the particle arrives along d (wi = −d), the relative index eta (and
+// its inverse) per lane: the interface's, or a spectral lane's. Polarized (kPolarized): the
+// event's polarized form on the lanes' states; where the channels' states differ, its reweighting
+// of the channels is booked with the base, as trace_particle does.
+template <bool kPolarized, bool kAnisotropic>
+HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, VF eta, VF inv_eta, MF m,
+                                LaneVectors& v, VF uc, VF u1, VF u2, MF& degenerate) {
+    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
+    const InterfaceEventLanes<VF, MF> e = dielectric_event<VF, VecLane, kPolarized>(
+        eta, inv_eta, VecGgx<kAnisotropic>(iface.distribution()), iface.event_shape(), wi, uc, u1,
+        u2, m, kPolarized ? &v.pol : nullptr);
+    degenerate = hn::Or(degenerate, e.degenerate);
+    const MF ok = hn::AndNot(e.degenerate, m);
+    if constexpr (kPolarized)
+        if (v.pol.channels == 3) v.Keep(ok, kLossBase, v.pol.factor);
+    if (!iface.is_smooth()) v.Keep(ok, kLossMicro, e.shadowing);
+    v.d = Select(ok, e.wo, v.d);
+}
+
+// A rough or smooth conductor (conductor.h conductor_event, the same template): light from above
+// only. Polarized: the Fresnel factors are the reflected fractions of the lanes' states. The
+// reflection at a facet comes from `fresnel_of` and `mueller_of` (lane_conductor.h: the bare
+// conductor's; a filmed conductor's, FilmReflection).
+template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
+HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, const Fresnel& fresnel_of,
+                               const Mueller& mueller_of, MF m, LaneVectors& v, VF u1, VF u2,
+                               MF& degenerate) {
+    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
+    VF fresnel[3];
+    InterfaceEventLanes<VF, MF> e;
+    if constexpr (kPolarized)
+        e = conductor_event<VF, VecLane>(VecGgx<kAnisotropic>(iface.distribution()),
+                                         iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
+                                         u2, m, fresnel_of, fresnel, &v.pol, mueller_of);
+    else
+        e = conductor_event<VF, VecLane>(VecGgx<kAnisotropic>(iface.distribution()),
+                                         iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
+                                         u2, m, fresnel_of, fresnel);
+    degenerate = hn::Or(degenerate, e.degenerate);
+    const MF ok = hn::AndNot(e.degenerate, m);
+    v.Keep(ok, kLossBase, fresnel);
+    if (!iface.is_smooth()) v.Keep(ok, kLossMicro, e.shadowing);
+    v.d = Select(ok, e.wo, v.d);
+}
+
+// A rough interface with multiple scattering on its microsurface (physics/microsurface_walk.h
+// microsurface_walk, the template the scalar kernel instantiates at one lane): the lanes of m walk
+// from facet to facet, every lane of the vector drawing its numbers while any walks, until each
+// has escaped (its new direction; a conductor's exit carries its Fresnel factors, the rest
+// absorbed by the base), met its facet cap (its flux lost to the microsurface) or a degeneracy
+// (lost and counted, as a failed sample), as trace_particle books the walk. `weighted`: the exit's
+// weight is booked on a dielectric too (polarized, the channels' states differing).
+template <bool kAnisotropic, typename Facet>
+HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, const Facet& facet,
+                                      MF m, LaneVectors& v, LaneRng& rng, int max_order,
+                                      MF& degenerate, bool weighted = false) {
+    const DF df;
+    const VF zero = hn::Zero(df);
+    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
+    auto draw = [&] { return rng.Uniform(); };
+    const MicrosurfaceWalkLanes<VF, MF> walk = microsurface_walk<VF, VecLane>(
+        VecGgx<kAnisotropic>(ggx), wi, m, two_sided, facet, draw, max_order);
+    degenerate = hn::Or(degenerate, walk.degenerate);
+    if (!two_sided || weighted) v.Keep(walk.escaped, kLossBase, walk.weight);
+    v.Keep(walk.capped, kLossMicro, zero);
+    v.d = Select(walk.escaped, walk.wo, v.d);
+}
+
+template <bool kPolarized, bool kAnisotropic>
+HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, VF eta, VF inv_eta,
+                                    MF m, LaneVectors& v, LaneRng& rng, int max_order,
+                                    MF& degenerate) {
+    auto draw = [&] { return rng.Uniform(); };
+    const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw), kPolarized> facet{
+        eta, inv_eta, draw, kPolarized ? &v.pol : nullptr};
+    MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), true, facet, m, v, rng, max_order,
+                                        degenerate, kPolarized && v.pol.channels == 3);
+}
+
+template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
+HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, const Fresnel& fresnel,
+                                   const Mueller& mueller, MF m, LaneVectors& v, LaneRng& rng,
+                                   int max_order, MF& degenerate) {
+    if constexpr (kPolarized) {
+        const MicrosurfaceConductorFacet<VF, VecLane, Fresnel, Mueller> facet{fresnel, &v.pol,
+                                                                              &mueller};
+        MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
+                                            max_order, degenerate);
+    } else {
+        const MicrosurfaceConductorFacet<VF, VecLane, Fresnel> facet{fresnel};
+        MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
+                                            max_order, degenerate);
+    }
+}
+
+// ---- A thin film on a conductor (docs/physics.md §9; simulator/scalar_particle.h film_event) ----
+// The film's reflection at each lane's facet cosine and film thickness: FilmOptics::mueller
+// (physics/thin_film.h, in double, the very function the scalar kernel's film_event evaluates),
+// called per lane and channel, as its Airy sums have no lane template. It stands where the bare
+// conductor's ConductorFresnel and ConductorMueller stand in the conductor event and walk.
+struct FilmReflection {
+    const FilmOptics* const* film;  // per lane: the layer's, or a spectral lane's stack's
+    const double* thickness_nm;     // per lane
+    // The reflectance per channel (unpolarized), as film_event's `reflectance`, on the lanes of
+    // `active` (reflection_on_lanes: the others, whose values no event uses, are not evaluated).
+    HWY_NOINLINE void operator()(VF cos_theta, VF* factors, MF active) const {
+        const DF df;
+        HWY_ALIGN float cos_l[kMaxLanes], r[3][kMaxLanes];
+        hn::Store(cos_theta, df, cos_l);
+        for (int c = 0; c < 3; ++c)
+            std::fill(r[c], r[c] + hn::Lanes(df), 1.f);
+        for (std::uint64_t bits = MaskBits(active); bits != 0; bits &= bits - 1) {
+            const std::size_t l = std::size_t(std::countr_zero(bits));
+            for (int c = 0; c < 3; ++c)
+                r[c][l] = float(
+                    film[l]->mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection.a);
+        }
+        for (int c = 0; c < 3; ++c)
+            factors[c] = hn::Load(df, r[c]);
+    }
+    // The reflection Mueller matrices per channel (polarized), as film_event's `mueller`, on the
+    // lanes of `active` (the others get the identity).
+    HWY_NOINLINE void operator()(VF cos_theta, InterfaceMueller<VF>* m, MF active) const {
+        const DF df;
+        HWY_ALIGN float cos_l[kMaxLanes], e[3][4][kMaxLanes];
+        hn::Store(cos_theta, df, cos_l);
+        for (int c = 0; c < 3; ++c) {
+            std::fill(e[c][0], e[c][0] + hn::Lanes(df), 1.f);
+            std::fill(e[c][1], e[c][1] + hn::Lanes(df), 0.f);
+            std::fill(e[c][2], e[c][2] + hn::Lanes(df), 1.f);
+            std::fill(e[c][3], e[c][3] + hn::Lanes(df), 0.f);
+        }
+        for (std::uint64_t bits = MaskBits(active); bits != 0; bits &= bits - 1) {
+            const std::size_t l = std::size_t(std::countr_zero(bits));
+            for (int c = 0; c < 3; ++c) {
+                const auto md =
+                    film[l]->mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection;
+                e[c][0][l] = float(md.a);
+                e[c][1][l] = float(md.b);
+                e[c][2][l] = float(md.c);
+                e[c][3][l] = float(md.d);
+            }
+        }
+        for (int c = 0; c < 3; ++c)
+            m[c] = {hn::Load(df, e[c][0]), hn::Load(df, e[c][1]), hn::Load(df, e[c][2]),
+                    hn::Load(df, e[c][3])};
+    }
+};
+
+// A filmed conductor's event (film_event's conductor branch): the lanes' thicknesses drawn first
+// where the film's thickness varies (one number per event, from each lane's own stream), then the
+// conductor event or walk with the film's reflection in place of the bare Fresnel terms, booked as
+// the bare conductor's (absorbed by the base, lost to the microsurface). `films`: each lane's film
+// (the layer's, or a spectral lane's stack's: the same thickness distribution, other wavelengths).
+// Isotropic: a stack with a film has no anisotropic interface (validate_kernel_for).
+template <bool kPolarized>
+HWY_NOINLINE void FilmConductorEvent(const CompiledLayer<float>& layer,
+                                     const FilmOptics* const* films, MF m, LaneVectors& v,
+                                     LaneRng& rng, int max_order, MF& degenerate) {
+    const DF df;
+    HWY_ALIGN double thickness[kMaxLanes];
+    if (layer.film.varies()) {
+        HWY_ALIGN float u[kMaxLanes];
+        hn::Store(rng.Uniform(), df, u);
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            thickness[l] = films[l]->thickness_nm(double(u[l]));
+    } else {
+        for (std::size_t l = 0; l < hn::Lanes(df); ++l)
+            thickness[l] = films[l]->thickness_min_nm;
+    }
+    const FilmReflection reflection{films, thickness};
+    if (layer.multiple) {
+        ConductorWalkEvent<kPolarized, false>(layer.conductor, reflection, reflection, m, v, rng,
+                                              max_order, degenerate);
+        return;
+    }
+    const VF u1 = rng.Uniform(), u2 = rng.Uniform();
+    ConductorEvent<kPolarized, false>(layer.conductor, reflection, reflection, m, v, u1, u2,
+                                      degenerate);
+}
+
+// Lambertian (lambertian.h lambertian_event, the same template): cosine-distributed on wi's side,
+// weight = albedo (per channel and lane: the interface's, or a spectral lane's); it depolarizes
+// (polarized runs).
+template <bool kPolarized>
+HWY_INLINE void LambertianEvent(const VF albedo[3], MF m, LaneVectors& v, VF u1, VF u2,
+                                MF& degenerate) {
+    const DF df;
+    const MF bad = hn::And(m, hn::Eq(v.d.z, hn::Zero(df)));
+    degenerate = hn::Or(degenerate, bad);
+    const MF ok = hn::AndNot(bad, m);
+    const V3 wo = lambertian_event<VF, VecLane>(hn::Neg(v.d.z), u1, u2);
+    v.Keep(ok, kLossBase, albedo);
+    v.d = Select(ok, wo, v.d);
+    if constexpr (kPolarized) stokes_depolarize<VF, VecLane>(v.pol.stokes, 3, ok);
+}
+
+// ---- Media (physics/medium.h, the templates the scalar kernel instantiates at one lane) -------
+
+// A scattering medium's values on the lanes (a spectral run's: each lane's stack's), in the
+// fields medium.h reads; its flags hold for every lane.
+struct LaneMedium {
+    VF tau_a[3], tau_s[3], tau_t[3], g[3], single_scattering_albedo[3];
+    bool uniform_tau_t, uniform_g;
+};
+
+// One scattering-medium step for the lanes in m (inside layer `layer`'s medium, a CompiledMedium
+// or a LaneMedium): a free flight, then either the crossing to the next interface or a scattering
+// event (which depolarizes). The lanes draw their numbers as the template asks for them (every
+// lane draws while any needs them).
+template <bool kPolarized, typename Medium>
+HWY_INLINE void ScatteringStep(const Medium& med, MF m, LaneVectors& v, LaneRng& rng) {
+    const DF df;
+    const DI di;
+    auto uniform = [&] { return rng.Uniform(); };
+    const MediumFlightLanes<VF, MF> flight =
+        medium_free_flight<VF, VecLane>(med, v.d, v.w, v.depth, uniform);
+    const MF leaves = hn::And(m, flight.leaves);
+    const MF scatters = hn::AndNot(flight.leaves, m);
+    V3 d_new = v.d;
+    VF phase[3];
+    if (medium_scatter<VF, VecLane>(med, v.d, flight.p, scatters, uniform, d_new, phase)) {
+        VF factor[3];
+        for (int c = 0; c < 3; ++c)
+            factor[c] =
+                hn::IfThenElse(scatters, hn::Mul(flight.factor[c], phase[c]), flight.factor[c]);
+        v.Keep(m, kLossMedium, factor);
+        v.depth = hn::IfThenElse(scatters, flight.depth, v.depth);
+        v.d = Select(scatters, d_new, v.d);
+        // A scattering event depolarizes (docs/physics.md §8).
+        if constexpr (kPolarized) stokes_depolarize<VF, VecLane>(v.pol.stokes, 3, scatters);
+        v.events = hn::IfThenElse(hn::RebindMask(di, scatters), hn::Add(v.events, hn::Set(di, 1)),
+                                  v.events);
+    } else {
+        v.Keep(m, kLossMedium, flight.factor);
+    }
+    // Leaving lanes arrive at the interface above (k) or below (k + 1).
+    const MI leave_i = hn::RebindMask(di, leaves);
+    const MI down = hn::RebindMask(di, hn::Lt(v.d.z, hn::Zero(df)));
+    v.k = hn::IfThenElse(hn::And(leave_i, down), hn::Add(v.k, hn::Set(di, 1)), v.k);
+    v.in_medium = hn::IfThenElseZero(hn::Not(leave_i), v.in_medium);
+}
+
+LAMINA_LANE_END
+
+#endif  // LAMINA_SIMULATOR_LANE_EVENTS_H
