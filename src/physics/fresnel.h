@@ -4,6 +4,7 @@
 // over the index of the medium it arrives from, for light arriving on the side the normal points
 // to. At an interface of a stack (normal +z pointing up) eta = η_below / η_above.
 
+#include "core/complex_math.h"
 #include "core/lane.h"
 #include "core/math.h"
 #include "core/vec.h"
@@ -146,9 +147,11 @@ template <typename T>
 FresnelAmplitudes<T> fresnel_amplitudes(std::complex<T> eta_j, std::complex<T> u_j,
                                         std::complex<T> eta_k, std::complex<T> u_k) {
     const std::complex<T> eps_j = eta_j * eta_j, eps_k = eta_k * eta_k;
-    const std::complex<T> ds = u_j + u_k, dp = eps_k * u_j + eps_j * u_k;
-    return {(u_j - u_k) / ds, (eps_k * u_j - eps_j * u_k) / dp, T(2) * u_j / ds,
-            T(2) * eta_j * eta_k * u_j / dp};
+    // Each denominator inverted once, for its r and t.
+    const std::complex<T> inv_ds = reciprocal(u_j + u_k),
+                          inv_dp = reciprocal(eps_k * u_j + eps_j * u_k);
+    return {(u_j - u_k) * inv_ds, (eps_k * u_j - eps_j * u_k) * inv_dp, T(2) * u_j * inv_ds,
+            T(2) * eta_j * eta_k * u_j * inv_dp};
 }
 
 /// The normal wave number u = √(η² − sin²θ) of a medium of complex index eta (relative to the
@@ -173,7 +176,7 @@ LAMINA_LANE_INLINE T fresnel_conductor_complex(T cos_theta_i, T eta, T k) {
     const C eta_c(eta, k);
     const FresnelAmplitudes<T> a = fresnel_amplitudes<T>(
         C(1), C(cos_theta_i), eta_c, normal_wave_number(eta_c, T(1) - sqr(cos_theta_i)));
-    return (std::norm(a.r_p) + std::norm(a.r_s)) / T(2);
+    return (squared_modulus(a.r_p) + squared_modulus(a.r_s)) / T(2);
 }
 
 /// Mirror reflection of w (pointing away from the surface) about the unit normal n.

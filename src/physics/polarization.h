@@ -43,6 +43,7 @@
 // incident in the x–z plane x = ŷ: S1 = +1 is s-polarized light (field ⊥ to the plane of
 // incidence), S1 = −1 p-polarized.
 
+#include "core/complex_math.h"
 #include "core/lane.h"
 #include "core/lane_vec.h"
 
@@ -86,7 +87,7 @@ struct InterfaceMueller {
 /// reflection_mueller below is the same for one boundary in real arithmetic, as lane template.
 template <typename T>
 InterfaceMueller<T> mueller_of_amplitudes(std::complex<T> a_s, std::complex<T> a_p, T flux) {
-    const T n_s = std::norm(a_s), n_p = std::norm(a_p);
+    const T n_s = squared_modulus(a_s), n_p = squared_modulus(a_p);
     const std::complex<T> x = a_s * std::conj(a_p);
     return {flux * (n_s + n_p) / T(2), flux * (n_s - n_p) / T(2), flux * x.real(), flux * x.imag()};
 }

@@ -34,8 +34,10 @@
 #include "physics/polarization.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
+#include <cstddef>
 #include <numbers>
 
 namespace lamina {
@@ -56,25 +58,40 @@ struct ThinFilmAmplitudes {
 /// crossing is δ = 2π thickness_waves u_f). Thickness 0 gives the bare boundary incident | exit.
 /// At an index-matched grazing boundary, where the amplitudes are 0/0, the grazing limit: total
 /// reflection (r_s = r_p = −1), nothing transmitted.
-template <typename T>
-ThinFilmAmplitudes<T> thin_film_amplitudes(T cos_theta_i, std::complex<T> eta_film,
-                                           std::complex<T> eta_exit, T thickness_waves) {
+///
+/// N films of the same index (relative to the same incident medium) at once, each over its own
+/// exit medium and with its own thickness in waves (the channels of one film: their wavelengths
+/// and the metal's index at each): the film's normal wave number and its upper boundary's
+/// amplitudes are the same for all and computed once.
+template <typename T, std::size_t N>
+std::array<ThinFilmAmplitudes<T>, N> thin_film_amplitudes(
+    T cos_theta_i, std::complex<T> eta_film, const std::array<std::complex<T>, N>& eta_exit,
+    const std::array<T, N>& thickness_waves) {
     using C = std::complex<T>;
+    using Sums = std::array<FresnelAmplitudes<T>, N>;
     const T mu = std::min(std::max(cos_theta_i, T(0)), T(1));
     const T sin2 = T(1) - mu * mu;
-    const C u1(mu), u3 = normal_wave_number(eta_exit, sin2);
+    const C u1(mu);
+    std::array<C, N> u3;
+    for (std::size_t n = 0; n < N; ++n)
+        u3[n] = normal_wave_number(eta_exit[n], sin2);
     // The Airy sums for the film's normal wave number u2.
     const auto airy = [&](C u2) {
         const FresnelAmplitudes<T> b12 = fresnel_amplitudes<T>(C(1), u1, eta_film, u2);
-        const FresnelAmplitudes<T> b23 = fresnel_amplitudes<T>(eta_film, u2, eta_exit, u3);
-        // e^{iδ}: |e^{iδ}| = e^{−Im δ} ≤ 1 since Im u2 ≥ 0.
-        const C phase = std::exp(C(0, T(2) * std::numbers::pi_v<T> * thickness_waves) * u2);
-        const C phase2 = phase * phase;
-        const C den_s = T(1) + b12.r_s * b23.r_s * phase2;
-        const C den_p = T(1) + b12.r_p * b23.r_p * phase2;
-        return FresnelAmplitudes<T>{
-            (b12.r_s + b23.r_s * phase2) / den_s, (b12.r_p + b23.r_p * phase2) / den_p,
-            b12.t_s * b23.t_s * phase / den_s, b12.t_p * b23.t_p * phase / den_p};
+        Sums sums;
+        for (std::size_t n = 0; n < N; ++n) {
+            const FresnelAmplitudes<T> b23 =
+                fresnel_amplitudes<T>(eta_film, u2, eta_exit[n], u3[n]);
+            // e^{iδ}: |e^{iδ}| = e^{−Im δ} ≤ 1 since Im u2 ≥ 0.
+            const C phase = std::exp(C(0, T(2) * std::numbers::pi_v<T> * thickness_waves[n]) * u2);
+            const C phase2 = phase * phase;
+            const C inv_den_s = reciprocal(T(1) + b12.r_s * b23.r_s * phase2);
+            const C inv_den_p = reciprocal(T(1) + b12.r_p * b23.r_p * phase2);
+            sums[n] = {
+                (b12.r_s + b23.r_s * phase2) * inv_den_s, (b12.r_p + b23.r_p * phase2) * inv_den_p,
+                b12.t_s * b23.t_s * phase * inv_den_s, b12.t_p * b23.t_p * phase * inv_den_p};
+        }
+        return sums;
     };
     // The sums are even functions of u2, analytic in u2² = η_f² − sin²θ1, but at the film's
     // critical angle (u2 → 0: r12 → 1, r23 → −1, e^{2iδ} → 1) they are 0/0, and evaluated at
@@ -82,23 +99,36 @@ ThinFilmAmplitudes<T> thin_film_amplitudes(T cos_theta_i, std::complex<T> eta_fi
     // mean of their values at u2² ± h (the error of the mean is O(h²), of each value O(ε/√h)).
     const C w = eta_film * eta_film - sin2;
     constexpr T kNearCritical = T(1e-6);
-    ThinFilmAmplitudes<T> out;
-    if (std::abs(w) < kNearCritical) {
-        const FresnelAmplitudes<T> a = airy(std::sqrt(w + kNearCritical)),
-                                   b = airy(std::sqrt(w - kNearCritical));
-        out.film = {(a.r_s + b.r_s) / T(2), (a.r_p + b.r_p) / T(2), (a.t_s + b.t_s) / T(2),
-                    (a.t_p + b.t_p) / T(2)};
+    Sums film;
+    if (squared_modulus(w) < kNearCritical * kNearCritical) {
+        const Sums a = airy(std::sqrt(w + kNearCritical)), b = airy(std::sqrt(w - kNearCritical));
+        for (std::size_t n = 0; n < N; ++n)
+            film[n] = {(a[n].r_s + b[n].r_s) / T(2), (a[n].r_p + b[n].r_p) / T(2),
+                       (a[n].t_s + b[n].t_s) / T(2), (a[n].t_p + b[n].t_p) / T(2)};
     } else {
-        out.film = airy(normal_wave_number(eta_film, sin2));
+        film = airy(normal_wave_number(eta_film, sin2));
     }
-    out.transmitted_flux = eta_exit.imag() == T(0) && mu > T(0) ? u3.real() / mu : T(0);
-    const bool finite = std::isfinite(std::norm(out.film.r_s) + std::norm(out.film.r_p) +
-                                      std::norm(out.film.t_s) + std::norm(out.film.t_p));
-    if (!finite) {  // 0/0 at grazing incidence on an index-matched boundary
-        out.film = {C(-1), C(-1), C(0), C(0)};
-        out.transmitted_flux = T(0);
+    std::array<ThinFilmAmplitudes<T>, N> out;
+    for (std::size_t n = 0; n < N; ++n) {
+        out[n].film = film[n];
+        out[n].transmitted_flux =
+            eta_exit[n].imag() == T(0) && mu > T(0) ? u3[n].real() / mu : T(0);
+        const bool finite =
+            std::isfinite(squared_modulus(film[n].r_s) + squared_modulus(film[n].r_p) +
+                          squared_modulus(film[n].t_s) + squared_modulus(film[n].t_p));
+        if (!finite) {  // 0/0 at grazing incidence on an index-matched boundary
+            out[n].film = {C(-1), C(-1), C(0), C(0)};
+            out[n].transmitted_flux = T(0);
+        }
     }
     return out;
+}
+
+/// One film over one exit medium.
+template <typename T>
+ThinFilmAmplitudes<T> thin_film_amplitudes(T cos_theta_i, std::complex<T> eta_film,
+                                           std::complex<T> eta_exit, T thickness_waves) {
+    return thin_film_amplitudes<T, 1>(cos_theta_i, eta_film, {eta_exit}, {thickness_waves})[0];
 }
 
 /// The reflection and transmission Mueller matrices (form (*) of physics/polarization.h, in the s/p
@@ -147,6 +177,25 @@ struct FilmOptics {
             from_above ? eta_below[c] : std::complex<double>(eta_above);
         return thin_film_mueller(cos_theta, eta_film / eta_i, exit / eta_i,
                                  thickness_nm * eta_i / wavelength_nm[c]);
+    }
+    /// The film's reflection Mueller matrices in the three channels for light arriving from above
+    /// at the facet cosine cos_theta, the film thickness_nm thick: mueller(c, cos_theta, true,
+    /// thickness_nm).reflection for c = 0, 1, 2, with what the channels share (the film's index
+    /// relative to the medium above, so its wave number and upper boundary) evaluated once.
+    std::array<InterfaceMueller<double>, 3> reflection_from_above(double cos_theta,
+                                                                  double thickness_nm) const {
+        std::array<std::complex<double>, 3> exit;
+        std::array<double, 3> waves;
+        for (int c = 0; c < 3; ++c) {
+            exit[std::size_t(c)] = eta_below[c] / eta_above;
+            waves[std::size_t(c)] = thickness_nm * eta_above / wavelength_nm[c];
+        }
+        const std::array<ThinFilmAmplitudes<double>, 3> a =
+            thin_film_amplitudes<double, 3>(cos_theta, eta_film / eta_above, exit, waves);
+        std::array<InterfaceMueller<double>, 3> m;
+        for (std::size_t c = 0; c < 3; ++c)
+            m[c] = mueller_of_amplitudes(a[c].film.r_s, a[c].film.r_p, 1.0);
+        return m;
     }
 };
 

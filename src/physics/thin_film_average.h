@@ -85,7 +85,8 @@ std::optional<std::pair<T, T>> thin_film_reflectance_mean(T cos_theta_i, std::co
             mean_inverse_cosine_sum((T(1) - abs_c) * (T(1) - abs_c),
                                     (T(1) + abs_c) * (T(1) + abs_c), x0 + phase, x1 + phase);
         // In [0, 1] exactly; clamped against rounding near resonance (|c| → 1, where m is large).
-        return std::clamp(T(1) - (T(1) - std::norm(r12)) * (T(1) - std::norm(r23)) * m, T(0), T(1));
+        return std::clamp(T(1) - (T(1) - squared_modulus(r12)) * (T(1) - squared_modulus(r23)) * m,
+                          T(0), T(1));
     };
     return std::pair<T, T>{mean(b12.r_s, b23.r_s), mean(b12.r_p, b23.r_p)};
 }

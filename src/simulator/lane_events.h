@@ -196,10 +196,10 @@ HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, const
 }
 
 // ---- A thin film on a conductor (docs/physics.md §9; simulator/scalar_particle.h film_event) ----
-// The film's reflection at each lane's facet cosine and film thickness: FilmOptics::mueller
-// (physics/thin_film.h, in double, the very function the scalar kernel's film_event evaluates),
-// called per lane and channel, as its Airy sums have no lane template. It stands where the bare
-// conductor's ConductorFresnel and ConductorMueller stand in the conductor event and walk.
+// The film's reflection at each lane's facet cosine and film thickness: FilmOptics::
+// reflection_from_above (physics/thin_film.h, in double, what the scalar kernel's film_event
+// evaluates), called per lane and channel, as its Airy sums have no lane template. It stands where
+// the bare conductor's ConductorFresnel and ConductorMueller stand in the conductor event and walk.
 struct FilmReflection {
     const FilmOptics* const* film;  // per lane: the layer's, or a spectral lane's stack's
     const double* thickness_nm;     // per lane
@@ -213,9 +213,9 @@ struct FilmReflection {
             std::fill(r[c], r[c] + hn::Lanes(df), 1.f);
         for (std::uint64_t bits = MaskBits(active); bits != 0; bits &= bits - 1) {
             const std::size_t l = std::size_t(std::countr_zero(bits));
+            const auto md = film[l]->reflection_from_above(double(cos_l[l]), thickness_nm[l]);
             for (int c = 0; c < 3; ++c)
-                r[c][l] = float(
-                    film[l]->mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection.a);
+                r[c][l] = float(md[std::size_t(c)].a);
         }
         for (int c = 0; c < 3; ++c)
             factors[c] = hn::Load(df, r[c]);
@@ -234,13 +234,12 @@ struct FilmReflection {
         }
         for (std::uint64_t bits = MaskBits(active); bits != 0; bits &= bits - 1) {
             const std::size_t l = std::size_t(std::countr_zero(bits));
+            const auto md = film[l]->reflection_from_above(double(cos_l[l]), thickness_nm[l]);
             for (int c = 0; c < 3; ++c) {
-                const auto md =
-                    film[l]->mueller(c, double(cos_l[l]), true, thickness_nm[l]).reflection;
-                e[c][0][l] = float(md.a);
-                e[c][1][l] = float(md.b);
-                e[c][2][l] = float(md.c);
-                e[c][3][l] = float(md.d);
+                e[c][0][l] = float(md[std::size_t(c)].a);
+                e[c][1][l] = float(md[std::size_t(c)].b);
+                e[c][2][l] = float(md[std::size_t(c)].c);
+                e[c][3][l] = float(md[std::size_t(c)].d);
             }
         }
         for (int c = 0; c < 3; ++c)

@@ -131,17 +131,16 @@ inline void film_event(const CompiledStack<float>& stack, const CompiledLayer<fl
     // A conductor: the film's reflectance (unpolarized) or reflection Mueller matrices per channel.
     const ConductorInterface<float>& cond = layer.conductor;
     const auto reflectance = [&](float cos_theta) {
+        const auto md = film.reflection_from_above(double(cos_theta), thickness);
         Rgbf r;
         for (int c = 0; c < 3; ++c)
-            r[c] = float(film.mueller(c, double(cos_theta), true, thickness).reflection.a);
+            r[c] = float(md[std::size_t(c)].a);
         return r;
     };
     [[maybe_unused]] const auto mueller = [&](float cos_theta, InterfaceMueller<float>* m) {
-        for (int c = 0; c < 3; ++c) {
-            const InterfaceMueller<double> md =
-                film.mueller(c, double(cos_theta), true, thickness).reflection;
-            m[c] = {float(md.a), float(md.b), float(md.c), float(md.d)};
-        }
+        const auto md = film.reflection_from_above(double(cos_theta), thickness);
+        for (std::size_t c = 0; c < 3; ++c)
+            m[c] = {float(md[c].a), float(md[c].b), float(md[c].c), float(md[c].d)};
     };
     if (layer.multiple) {
         if constexpr (kPolarized)

@@ -291,6 +291,56 @@ TEST(ThinFilm, MuellerOfAmplitudesIsTheKernelsReflectionMatrix) {
     }
 }
 
+TEST(ThinFilm, ChannelsAtOnceAreEachChannel) {
+    // FilmOptics::reflection_from_above (the channels sharing the film's wave number and upper
+    // boundary) against mueller() channel by channel, and channel by channel against the
+    // characteristic matrix: an oxide on three metals' indices at three wavelengths under a coat,
+    // a film of lower index than the coat (its critical angle at sin θ = 0.8, in and around it),
+    // an absorbing film, and an index-matched film and exit at grazing incidence.
+    struct Case {
+        C film;
+        double above;
+        C below[3];
+        double thickness_nm;
+    };
+    const Case cases[] = {
+        {C(2.5), 1.5, {C(2.7, 3.7), C(2.5, 3.4), C(2.2, 3.0)}, 60},
+        {C(1.2), 1.5, {C(0.2, 3.9), C(0.4, 2.4), C(1.4, 1.6)}, 310},
+        {C(2.3, 0.1), 1.0, {C(2.9, 3.1), C(2.95, 2.9), C(2.65, 2.8)}, 80},
+        {C(1.5), 1.5, {C(1.5), C(1.5), C(1.5)}, 100},
+    };
+    for (const Case& k : cases) {
+        FilmOptics film;
+        film.eta_film = k.film;
+        film.eta_above = k.above;
+        film.thickness_min_nm = film.thickness_max_nm = k.thickness_nm;
+        for (int c = 0; c < 3; ++c)
+            film.eta_below[c] = k.below[c];
+        for (double cos_i : {1.0, 0.83, 0.6 + 1e-9, 0.6, 0.6 - 1e-9, 0.3, 0.02, 0.0}) {
+            const auto m = film.reflection_from_above(cos_i, k.thickness_nm);
+            for (int c = 0; c < 3; ++c) {
+                const InterfaceMueller<double> e =
+                    film.mueller(c, cos_i, true, k.thickness_nm).reflection;
+                const InterfaceMueller<double>& a = m[std::size_t(c)];
+                EXPECT_NEAR(a.a, e.a, 1e-13) << k.film << " " << cos_i << " " << c;
+                EXPECT_NEAR(a.b, e.b, 1e-13) << k.film << " " << cos_i << " " << c;
+                EXPECT_NEAR(a.c, e.c, 1e-13) << k.film << " " << cos_i << " " << c;
+                EXPECT_NEAR(a.d, e.d, 1e-13) << k.film << " " << cos_i << " " << c;
+                // The matrix method is 0/0 at grazing incidence and at the film's critical angle
+                // itself (its p admittance η/cos θ_f infinite).
+                if (cos_i == 0.0 || cos_i == 0.6) continue;
+                const double waves = k.thickness_nm * k.above / film.wavelength_nm[c];
+                const MatrixResult s = characteristic_matrix(true, cos_i, k.film / k.above,
+                                                             k.below[c] / k.above, waves);
+                const MatrixResult p = characteristic_matrix(false, cos_i, k.film / k.above,
+                                                             k.below[c] / k.above, waves);
+                EXPECT_NEAR(a.a + a.b, s.R, 1e-9) << k.film << " " << cos_i << " " << c;
+                EXPECT_NEAR(a.a - a.b, p.R, 1e-9) << k.film << " " << cos_i << " " << c;
+            }
+        }
+    }
+}
+
 TEST(ThinFilm, GrazingIndexMatchedIsFinite) {
     const ThinFilmMueller<double> m = thin_film_mueller(0.0, C(1.0), C(1.0), 0.3);
     EXPECT_TRUE(std::isfinite(m.reflection.a));

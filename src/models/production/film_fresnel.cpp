@@ -198,10 +198,8 @@ Rgbd film_reflectance_exact(const FilmOptics& film, double cos_theta) {
                 closed_form_mean(film, c, film.thickness_min_nm, film.thickness_max_nm))
             return *closed;
     return thickness_average(film.thickness_min_nm, film.thickness_max_nm, period, [&](double d) {
-        Rgbd r;
-        for (int i = 0; i < 3; ++i)
-            r[i] = film.mueller(i, c, true, d).reflection.a;
-        return r;
+        const auto m = film.reflection_from_above(c, d);
+        return Rgbd(m[0].a, m[1].a, m[2].a);
     });
 }
 
@@ -226,9 +224,10 @@ Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, con
                      presence = t * t * (3 - 2 * t);
         if (!(presence > 0)) return bare;
         Rgbd r(1.0);
-        if (sin_film < 1)
-            for (int i = 0; i < 3; ++i)
-                r[i] = film.mueller(i, c, true, d).reflection.a;
+        if (sin_film < 1) {
+            const auto m = film.reflection_from_above(c, d);
+            r = Rgbd(m[0].a, m[1].a, m[2].a);
+        }
         return bare * (1 - presence) + r * presence;
     };
     const double lo = film.thickness_min_nm, hi = film.thickness_max_nm;
