@@ -7,7 +7,7 @@
 // Beer–Lambert, free flights and Henyey–Greenstein scattering by spectral MIS), in their isotropic
 // or general (anisotropic) GGX instance as trace_particle takes them. One piece is evaluated per
 // lane rather than on vectors: a thin film on a conductor, whose reflection (physics/thin_film.h
-// FilmOptics::mueller, in double, the function film_event calls) takes the place of the bare
+// FilmOptics::reflection_from_above, in double, as film_event) takes the place of the bare
 // Fresnel terms in the conductor templates (FilmReflection); a film on a dielectric is the scalar
 // kernel's (SimulationSettings::kernel). Nor are the lane operations on Highway vectors (VecLane,
 // core/lane_hwy.h), the vector random numbers (simulator/lane_rng.h) and the vector exit bins
