@@ -25,12 +25,12 @@ struct Aniso {
 // Strongly and mildly anisotropic, tangents along and across the axes and oblique.
 const Aniso kCases[] = {{0.1, 0.4, 0.0}, {0.5, 0.15, 0.7}, {0.3, 0.6, 2.2}, {0.05, 0.3, -1.1}};
 
-const Vec3d kViews[] = {Vec3d(0, 0, 1),
-                        test::direction_of(0.7, 0.3),
-                        test::direction_of(0.2, 2.0),
-                        test::direction_of(0.05, 4.0),
-                        test::direction_of(-0.5, 1.0),
-                        test::direction_of(-0.1, 5.5)};
+const Vec3d kAnisotropicViews[] = {Vec3d(0, 0, 1),
+                                   test::direction_of(0.7, 0.3),
+                                   test::direction_of(0.2, 2.0),
+                                   test::direction_of(0.05, 4.0),
+                                   test::direction_of(-0.5, 1.0),
+                                   test::direction_of(-0.1, 5.5)};
 
 // The closed forms, written from angles in the tangent frame (independent of the code's forms).
 // D: Heitz 2014, the anisotropic GGX, 1/(π α_x α_y cos⁴θ (1 + tan²θ (cos²φ/α_x² + sin²φ/α_y²))²).
@@ -79,7 +79,7 @@ TEST(AnisotropicGgx, LambdaIsTheProjectedAreaOfTheDistribution) {
     // against it.
     for (const Aniso& a : kCases) {
         const GGX<double> ggx = ggx_of(a);
-        for (const Vec3d& w : kViews) {
+        for (const Vec3d& w : kAnisotropicViews) {
             const double sign = w.z < 0 ? -1 : 1, cos_theta = std::abs(w.z);
             const double lambda = lambda_closed_form(a, w);
             EXPECT_NEAR(ggx.lambda(w), lambda, 1e-12 * (1 + lambda));
@@ -107,7 +107,7 @@ TEST(AnisotropicGgx, EqualRoughnessIsTheIsotropicDistribution) {
         GGX<double> forced = GGX<double>::anisotropic(alpha, alpha, 0.9);
         ASSERT_FALSE(forced.anisotropy.on);
         forced.anisotropy.on = true;
-        for (const Vec3d& w : kViews) {
+        for (const Vec3d& w : kAnisotropicViews) {
             EXPECT_NEAR(forced.lambda(w), iso.lambda(w), 1e-13 * (1 + iso.lambda(w)));
             const Vec3d m = test::direction_of(std::abs(w.z) * 0.5 + 0.5, 1.7);
             EXPECT_NEAR(forced.D(m), iso.D(m), 1e-13 * iso.D(m));
@@ -129,7 +129,7 @@ TEST(AnisotropicGgx, SwappingTheRoughnessesTurnsTheTangentBy90Degrees) {
         const GGX<double> ggx = ggx_of(a);
         const GGX<double> swapped =
             GGX<double>::anisotropic(a.alpha_y, a.alpha_x, a.psi + kPi<double> / 2);
-        for (const Vec3d& w : kViews) {
+        for (const Vec3d& w : kAnisotropicViews) {
             EXPECT_NEAR(swapped.lambda(w), ggx.lambda(w), 1e-12 * (1 + ggx.lambda(w)));
             const Vec3d m = test::direction_of(std::abs(w.z) * 0.5 + 0.5, 2.3);
             EXPECT_NEAR(swapped.D(m), ggx.D(m), 1e-12 * ggx.D(m));
@@ -137,7 +137,7 @@ TEST(AnisotropicGgx, SwappingTheRoughnessesTurnsTheTangentBy90Degrees) {
         // And turning the tangent by 180° changes nothing (D is point-symmetric in the plane).
         const GGX<double> turned =
             GGX<double>::anisotropic(a.alpha_x, a.alpha_y, a.psi + kPi<double>);
-        for (const Vec3d& w : kViews)
+        for (const Vec3d& w : kAnisotropicViews)
             EXPECT_NEAR(turned.lambda(w), ggx.lambda(w), 1e-12 * (1 + ggx.lambda(w)));
     }
 }
