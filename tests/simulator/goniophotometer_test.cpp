@@ -51,13 +51,10 @@ class Goniophotometer : public ::testing::TestWithParam<Kernel> {
   protected:
     void SetUp() override { g_kernel = GetParam(); }
 };
-std::string kernel_test_name(const ::testing::TestParamInfo<Kernel>& info) {
-    return enum_text(info.param);
-}
 INSTANTIATE_TEST_SUITE_P(Kernels, GoniophotometerStat,
-                         ::testing::Values(Kernel::Scalar, Kernel::Simd), kernel_test_name);
+                         ::testing::Values(Kernel::Scalar, Kernel::Simd), test::kernel_test_name);
 INSTANTIATE_TEST_SUITE_P(Kernels, Goniophotometer, ::testing::Values(Kernel::Scalar, Kernel::Simd),
-                         kernel_test_name);
+                         test::kernel_test_name);
 
 // Standard error of a budget term from its own estimate; the closed forms are exact, so
 // |estimate − exact| < 5 se holds with probability 1 − 6e-7.
@@ -613,7 +610,7 @@ class MicrosurfaceWalkStat : public ::testing::TestWithParam<Kernel> {
     void SetUp() override { g_kernel = GetParam(); }
 };
 INSTANTIATE_TEST_SUITE_P(Kernels, MicrosurfaceWalkStat,
-                         ::testing::Values(Kernel::Scalar, Kernel::Simd), kernel_test_name);
+                         ::testing::Values(Kernel::Scalar, Kernel::Simd), test::kernel_test_name);
 
 void multiple_scattering(SimulationSettings& s) {
     s.kernel = g_kernel;
@@ -787,7 +784,7 @@ class PolarizationStat : public ::testing::TestWithParam<Kernel> {
     void SetUp() override { g_kernel = GetParam(); }
 };
 INSTANTIATE_TEST_SUITE_P(Kernels, PolarizationStat, ::testing::Values(Kernel::Scalar, Kernel::Simd),
-                         kernel_test_name);
+                         test::kernel_test_name);
 
 SimulationSettings polarized(std::vector<double> theta_i, std::uint64_t n, HemisphereGrid grid,
                              int incident = 0) {

@@ -19,11 +19,8 @@ namespace lamina {
 namespace {
 
 class MuellerStat : public ::testing::TestWithParam<Kernel> {};
-std::string kernel_test_name(const ::testing::TestParamInfo<Kernel>& info) {
-    return enum_text(info.param);
-}
 INSTANTIATE_TEST_SUITE_P(Kernels, MuellerStat, ::testing::Values(Kernel::Scalar, Kernel::Simd),
-                         kernel_test_name);
+                         test::kernel_test_name);
 
 SimulationSettings settings(Kernel kernel, std::vector<double> theta_i, std::uint64_t n,
                             HemisphereGrid grid) {
@@ -199,7 +196,7 @@ StokesPolarization polarization_of(const BinStokesVector& v, int c) {
 
 class UnpolarizedStokesStat : public MuellerStat {};
 INSTANTIATE_TEST_SUITE_P(Kernels, UnpolarizedStokesStat,
-                         ::testing::Values(Kernel::Scalar, Kernel::Simd), kernel_test_name);
+                         ::testing::Values(Kernel::Scalar, Kernel::Simd), test::kernel_test_name);
 
 // A smooth dielectric interface (η = 1.5) lit with unpolarized light reflects into the mirror bin
 // only, every particle with the Stokes vector R (1, (R_s − R_p)/(R_s + R_p), 0, 0) of the

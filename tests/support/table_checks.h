@@ -89,6 +89,11 @@ inline void expect_within_se(double estimate, double exact, double se, const std
         << what << ": estimate " << estimate << " ± " << se << ", exact " << exact;
 }
 
+/// A kernel-parameterized test's name suffix: the kernel's name (scalar, simd, auto).
+inline std::string kernel_test_name(const ::testing::TestParamInfo<Kernel>& info) {
+    return enum_text(info.param);
+}
+
 /// Every incidence's energy budget sums to 1 to `tolerance` (docs/physics.md §5).
 inline void expect_budget_closes(const SimulationResult& r, double tolerance = 1e-6) {
     for (const IncidenceStats& st : r.incidences)
