@@ -145,6 +145,30 @@ struct MicrosurfaceWalkLanes {
     T weight[3];
     T order;
     M escaped, capped, degenerate;
+    /// Lanes whose walk the caller's `suspend` rule stopped before their next facet (below): wo
+    /// is their direction of travel, h their height (the interface's frame), side ±1 the side
+    /// they are on, order and weight as far as they went; MicrosurfaceWalkResume takes them up.
+    M suspended;
+    T h, side;
+};
+
+/// A walk to take up where microsurface_walk suspended it: on the lanes of `lanes`, at height h
+/// (the interface's frame) on side `side` (+1 above, −1 below), having met `order` facets (the
+/// next one counted) with flux factors `weight`; their direction of travel is the one the walk's
+/// wi is the opposite of. They go on to the facet they had reached, then walk as any lane.
+template <typename T, typename M>
+struct MicrosurfaceWalkResume {
+    M lanes;
+    T h, side, order;
+    T weight[3];
+};
+
+/// microsurface_walk's default `suspend` rule: walks run until every lane has left.
+struct MicrosurfaceNeverSuspend {
+    template <typename M>
+    bool operator()(const M&) const {
+        return false;
+    }
 };
 
 /// The microsurface walk of Heitz et al. 2016 on the lanes of `walking`, each arriving from wi
@@ -165,44 +189,72 @@ struct MicrosurfaceWalkLanes {
 /// above, walking, weight, order)`, if given, sees every facet before the lanes scatter off it:
 /// its height (the interface's frame), the arriving w, the side, the walking lanes, their flux
 /// weights so far and the facet's order (next-event estimation; it draws nothing).
+///
+/// Suspending and resuming (the SIMD kernel: a few lanes still walking would otherwise keep the
+/// whole vector in the walk while the others wait). `suspend(walking)` is asked on every pass but
+/// the first, once the walking lanes have their next facet's height and before they draw it; if
+/// it says so, those lanes stop there as `suspended`, with what resume needs. The lanes of
+/// `resume->lanes` (a subset of `walking`) start there: their first pass draws the height's
+/// number like every lane but keeps their stored height, and they then meet their facet. A lane's
+/// walk suspended and resumed is the walk it would have been with that one extra number drawn.
 struct MicrosurfaceNoVisit {
     template <typename... A>
     void operator()(A&&...) const {}
 };
 template <typename T, typename L, typename Scatter, typename Uniform,
-          typename Visit = MicrosurfaceNoVisit, bool kA = false>
+          typename Visit = MicrosurfaceNoVisit, bool kA = false,
+          typename Suspend = MicrosurfaceNeverSuspend>
 inline MicrosurfaceWalkLanes<T, typename L::Mask> microsurface_walk(
     const GgxLanes<T, kA>& ggx, const LaneVec3<T>& wi, typename L::Mask walking, bool two_sided,
-    Scatter&& scatter, Uniform&& uniform, int max_order, Visit&& visit = Visit{}) {
+    Scatter&& scatter, Uniform&& uniform, int max_order, Visit&& visit = Visit{},
+    const MicrosurfaceWalkResume<T, typename L::Mask>* resume = nullptr,
+    Suspend&& suspend = Suspend{}) {
+    using M = typename L::Mask;
     const T zero = L::constant(0), one = L::constant(1);
-    MicrosurfaceWalkLanes<T, typename L::Mask> r;
-    r.weight[0] = r.weight[1] = r.weight[2] = one;
-    r.order = zero;
-    const auto arrives = two_sided ? L::less(zero, L::abs(wi.z)) : L::less(zero, wi.z);
+    const M no_lane = L::both(walking, L::negate(walking));
+    M resumed = resume ? L::both(walking, resume->lanes) : no_lane;
+    MicrosurfaceWalkLanes<T, M> r;
+    for (int c = 0; c < 3; ++c)
+        r.weight[c] = resume ? L::select(resumed, resume->weight[c], one) : one;
+    r.order = resume ? L::select(resumed, resume->order, zero) : zero;
+    const auto arrives =
+        L::either(resumed, two_sided ? L::less(zero, L::abs(wi.z)) : L::less(zero, wi.z));
     r.degenerate = L::both(walking, L::negate(arrives));
     walking = L::both(walking, arrives);
-    r.escaped = r.capped = L::both(walking, L::negate(walking));  // no lane
-    auto above = L::less(zero, wi.z);  // on the side the interface's normal points to
-    T side = L::select(above, one, zero - one);
+    r.escaped = r.capped = r.suspended = no_lane;
+    // The side the particle is on (+1: the side the interface's normal points to).
+    T side = L::select(L::less(zero, wi.z), one, zero - one);
+    if (resume) side = L::select(resumed, resume->side, side);
+    auto above = L::less(zero, side);
     LaneVec3<T> wr = {zero - wi.x, zero - wi.y, zero - wi.z};  // the direction of travel
     T h = side * L::constant(2);  // above every facet (C1 = 1) on its own side
+    if (resume) h = L::select(resumed, resume->h, h);
     const T cap = L::constant(double(max_order));
-    bool first = true;  // every lane above all facets
+    bool first = true;  // every lane but the resumed ones above all facets
     while (true) {
-        // The next facet, in the frame of the side the particle is on.
+        // The next facet, in the frame of the side the particle is on (a resumed lane has its
+        // own: the number is drawn and not used).
         const T u = uniform();
-        const MicrosurfaceHit<T, typename L::Mask> hit = microsurface_next_height<T, L>(
+        const MicrosurfaceHit<T, M> hit = microsurface_next_height<T, L>(
             ggx, {side * wr.x, side * wr.y, side * wr.z}, side * h, u, walking, first);
-        first = false;
-        const auto escapes = L::both(walking, hit.escapes);
+        const M moves = L::both(walking, L::negate(resumed));
+        const auto escapes = L::both(moves, hit.escapes);
         r.escaped = L::either(r.escaped, escapes);
-        walking = L::both(walking, L::negate(hit.escapes));
-        const auto capped = L::both(walking, L::negate(L::less(r.order, cap)));
+        walking = L::both(walking, L::negate(escapes));
+        const auto capped =
+            L::both(L::both(walking, L::negate(resumed)), L::negate(L::less(r.order, cap)));
         r.capped = L::either(r.capped, capped);
         walking = L::both(walking, L::negate(capped));
         if (L::none(walking)) break;
-        h = L::select(walking, side * hit.height, h);
-        r.order = L::select(walking, r.order + one, r.order);
+        const M arrived = L::both(walking, L::negate(resumed));
+        h = L::select(arrived, side * hit.height, h);
+        r.order = L::select(arrived, r.order + one, r.order);
+        if (!first && suspend(walking)) {
+            r.suspended = walking;
+            break;
+        }
+        first = false;
+        resumed = no_lane;
         // A facet visible from the arriving direction (below the horizon after a first bounce).
         const LaneVec3<T> w = {zero - wr.x, zero - wr.y, zero - wr.z};
         visit(h, w, above, walking, static_cast<const T*>(r.weight), r.order);
@@ -227,6 +279,8 @@ inline MicrosurfaceWalkLanes<T, typename L::Mask> microsurface_walk(
         above = L::less(zero, side);
     }
     r.wo = wr;
+    r.h = h;
+    r.side = side;
     return r;
 }
 

@@ -30,7 +30,12 @@
 // Multiple scattering on the microsurfaces (physics/microsurface_walk.h). At a rough interface
 // the lanes of the event walk from facet to facet together: while any of them walks, every lane of
 // the vector draws its numbers, and the event ends when each has escaped, met its facet cap or a
-// degeneracy. The event counts once, as in trace_particle.
+// degeneracy. In the main loop's steps, once a quarter of the lanes or fewer still walk (after
+// their first facet), their walks are suspended (LaneVectors::mid_walk): they wait at the
+// interface and go on the next time it steps, beside the lanes arriving there, rather than keeping
+// the whole vector in the walk for the few facets more they need (most walks end after one
+// facet; a vector's longest walk is much longer than its average). The event counts once, as in
+// trace_particle, and the cut-off on events never interrupts a suspended walk.
 //
 // Random numbers. Each lane draws from the particle's own generator, the very stream of the scalar
 // kernel (simulator/lane_rng.h). Every lane draws whenever some lane of its step needs a number,
@@ -394,7 +399,10 @@ class BlockTracer {
             for (auto& channel : term)
                 channel = zero_;
         v.k = v.in_medium = v.events = v.events_done = v.live = v.finish = hn::Zero(di);
-        v.at = v.hero = v.group = v.secondaries = hn::Zero(di);
+        v.at = v.hero = v.group = v.secondaries = v.mid_walk = hn::Zero(di);
+        v.walk_h = v.walk_side = v.walk_order = zero_;
+        for (int c = 0; c < 3; ++c)
+            v.walk_weight[c] = zero_;
         if constexpr (kPolarized) {
             v.pol.stokes = stokes_incident<VF, VecLane>(
                 {hn::Set(df, -job_.wi.x), hn::Set(df, -job_.wi.y), hn::Set(df, -job_.wi.z)},
@@ -424,7 +432,7 @@ class BlockTracer {
                 if (layer.multiple) {
                     DielectricWalkEvent<kPolarized, kAnisotropic>(
                         layer.dielectric, eta, inv_eta, going, v, rng,
-                        stack_.max_microsurface_order, degenerate_event);
+                        stack_.max_microsurface_order, degenerate_event, may_suspend_);
                     break;
                 }
                 const VF uc = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
@@ -489,7 +497,7 @@ class BlockTracer {
         if (layer.multiple) {
             ConductorWalkEvent<kPolarized, kAnisotropic>(layer.conductor, fresnel, mueller, going,
                                                          v, rng, stack_.max_microsurface_order,
-                                                         degenerate_event);
+                                                         degenerate_event, may_suspend_);
             return;
         }
         const VF u1 = rng.Uniform(), u2 = rng.Uniform();
@@ -550,27 +558,37 @@ class BlockTracer {
         }
     }
 
+    // The lanes of `going` whose microsurface walks are suspended (lane_events.h
+    // MicrosurfaceWalkEvent): they wait at their interface.
+    HWY_INLINE MF MidWalk(const LaneVectors& v, MF going) const {
+        return hn::And(going, hn::RebindMask(DF(), hn::Ne(v.mid_walk, hn::Zero(DI()))));
+    }
+
     void InterfaceStep(LaneVectors& v, LaneRng& rng, int group, MF going) {
         const DF df;
         const DI di;
-        v.events =
-            hn::IfThenElse(hn::RebindMask(di, going), hn::Add(v.events, hn::Set(di, 1)), v.events);
+        // A suspended walk going on is the same event: counted, and its secondary wavelengths
+        // ended, once.
+        const MF arriving = hn::AndNot(MidWalk(v, going), going);
+        v.events = hn::IfThenElse(hn::RebindMask(di, arriving), hn::Add(v.events, hn::Set(di, 1)),
+                                  v.events);
         MF degenerate_event = hn::FirstN(df, 0);  // all false
         const CompiledLayer<float>& layer = stack_.layers[group];
         const bool dielectric = layer.type == InterfaceType::Dielectric;
-        if constexpr (kSpectral) EndSecondaries(v, group, going);
+        if constexpr (kSpectral) EndSecondaries(v, group, arriving);
         Event(layer, group, v, rng, going, degenerate_event);
+        const MF done = hn::AndNot(MidWalk(v, going), going);  // the lanes whose event is over
         // A failed sample loses the flux to the microsurface; an exactly grazing new direction is
         // lost to the microsurface (dielectric) or the base (opaque), as in trace_particle.
-        const MF grazing = hn::AndNot(degenerate_event, hn::And(going, hn::Eq(v.d.z, zero_)));
+        const MF grazing = hn::AndNot(degenerate_event, hn::And(done, hn::Eq(v.d.z, zero_)));
         const MF lost = hn::Or(degenerate_event, grazing);
         v.Keep(dielectric ? lost : degenerate_event, kLossMicro, zero_);
         if (!dielectric) v.Keep(grazing, kLossBase, zero_);
         degenerate_ += hn::CountTrue(df, lost);
-        const MF black = hn::And(going, v.Black());
+        const MF black = hn::And(done, v.Black());
         const MF ends = hn::Or(black, lost);
         v.End(ends, kEnded);
-        LeaveInterface(v, group, hn::AndNot(ends, going));
+        LeaveInterface(v, group, hn::AndNot(ends, done));
     }
 
     // ---- Particles that ended in a step: sums on vectors, exits binned and tallied in lane
@@ -681,6 +699,7 @@ class BlockTracer {
     void FirstEvents() {
         const DF df;
         const DI di;
+        may_suspend_ = false;
         Queue& queue = scratch_.queue;
         queue.clear();
         if constexpr (kPolarized) scratch_.queue_pol.clear();
@@ -828,6 +847,7 @@ class BlockTracer {
         v.in_medium = hn::IfThenElse(fresh_i, hn::Load(di, s_in_), v.in_medium);
         v.events = hn::IfThenElse(fresh_i, hn::Load(di, sevents_), v.events);
         v.live = hn::IfThenElse(fresh_i, hn::Load(di, live_), v.live);
+        v.mid_walk = hn::IfThenElseZero(hn::Not(fresh_i), v.mid_walk);
         if constexpr (kPolarized) staged_pol_.Load(fresh, v.pol.stokes);
         if constexpr (kSpectral) {
             v.at = hn::IfThenElse(fresh_i, hn::Load(di, s_at_), v.at);
@@ -880,6 +900,7 @@ class BlockTracer {
     void Steps() {
         const DF df;
         const DI di;
+        may_suspend_ = true;
         LaneVectors v;
         Clear(v);
         for (std::size_t l = 0; l < n_lanes_; ++l)
@@ -898,10 +919,12 @@ class BlockTracer {
             if (hn::AllFalse(df, live_mask)) break;
             const Group group = PickGroup(v, live_mask);
 
-            // Cut-off (trace_particle: checked before every event).
-            const MF cut =
+            // Cut-off (trace_particle: checked before every event; a suspended walk is the event
+            // already begun).
+            const MF cut = hn::AndNot(
+                MidWalk(v, group.lanes),
                 hn::And(group.lanes,
-                        hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job_.max_events - 1))));
+                        hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job_.max_events - 1)))));
             if (!hn::AllFalse(df, cut)) v.Keep(cut, kLossCutOff, zero_);
             v.End(cut, kEnded);
             const MF going = hn::AndNot(cut, group.lanes);
@@ -940,6 +963,9 @@ class BlockTracer {
 
     LaneSums sums_;
     std::uint64_t degenerate_ = 0;
+    // Whether microsurface walks may be suspended (the main loop's steps; the first events run
+    // every walk to its end, as their survivors wait in the queue).
+    bool may_suspend_ = false;
     bool left_[2] = {false, false};  // some particle was reflected / transmitted in this block
 
     // The ended lanes, staged by EndParticles.

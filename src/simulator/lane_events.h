@@ -55,6 +55,11 @@ struct LaneVectors {
     // channel, its wavelength group and whether its secondary wavelengths still travel
     // (SpectralParticle).
     VI at, hero, group, secondaries;
+    // Lanes whose microsurface walk is suspended (non-zero), waiting at their interface k to go
+    // on, and where their walks stand (physics/microsurface_walk.h MicrosurfaceWalkResume; their
+    // direction of travel is d).
+    VI mid_walk;
+    VF walk_h, walk_side, walk_order, walk_weight[3];
     bool touched[kLossTerms] = {};  // loss terms some lane may have booked in this block
     // Polarized runs: the lanes' polarization (physics/polarization.h); pol.flux points at w.
     PolarizationLanes<VF> pol;
@@ -152,46 +157,72 @@ HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, const Fre
 // absorbed by the base), met its facet cap (its flux lost to the microsurface) or a degeneracy
 // (lost and counted, as a failed sample), as trace_particle books the walk. `weighted`: the exit's
 // weight is booked on a dielectric too (polarized, the channels' states differing).
+//
+// `may_suspend`: once a quarter of the lanes or fewer are still walking (after their first facet),
+// their walks are suspended before their next facet (v.mid_walk and the walk_ fields, d their
+// direction of travel): they wait at the interface, and go on the next time the kernel steps it
+// (the lanes of m with mid_walk set), beside the lanes that arrive there, instead of holding the
+// vector for the few more facets most of them need. Nothing is booked for a suspended lane.
 template <bool kAnisotropic, typename Facet>
 HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, const Facet& facet,
                                       MF m, LaneVectors& v, LaneRng& rng, int max_order,
-                                      MF& degenerate, bool weighted = false) {
+                                      MF& degenerate, bool may_suspend, bool weighted = false) {
     const DF df;
+    const DI di;
     const VF zero = hn::Zero(df);
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     auto draw = [&] { return rng.Uniform(); };
+    const MF resumed = hn::And(m, hn::RebindMask(df, hn::Ne(v.mid_walk, hn::Zero(di))));
+    const MicrosurfaceWalkResume<VF, MF> resume{
+        resumed,
+        v.walk_h,
+        v.walk_side,
+        v.walk_order,
+        {v.walk_weight[0], v.walk_weight[1], v.walk_weight[2]}};
+    const std::size_t quarter = hn::Lanes(df) / 4;
+    auto suspend = [&](MF walking) { return may_suspend && hn::CountTrue(df, walking) <= quarter; };
     const MicrosurfaceWalkLanes<VF, MF> walk = microsurface_walk<VF, VecLane>(
-        VecGgx<kAnisotropic>(ggx), wi, m, two_sided, facet, draw, max_order);
+        VecGgx<kAnisotropic>(ggx), wi, m, two_sided, facet, draw, max_order, MicrosurfaceNoVisit{},
+        hn::AllFalse(df, resumed) ? nullptr : &resume, suspend);
     degenerate = hn::Or(degenerate, walk.degenerate);
     if (!two_sided || weighted) v.Keep(walk.escaped, kLossBase, walk.weight);
     v.Keep(walk.capped, kLossMicro, zero);
-    v.d = Select(walk.escaped, walk.wo, v.d);
+    v.d = Select(hn::Or(walk.escaped, walk.suspended), walk.wo, v.d);
+    v.mid_walk = hn::IfThenElse(
+        hn::RebindMask(di, m),
+        hn::IfThenElseZero(hn::RebindMask(di, walk.suspended), hn::Set(di, 1)), v.mid_walk);
+    if (hn::AllFalse(df, walk.suspended)) return;
+    v.walk_h = hn::IfThenElse(walk.suspended, walk.h, v.walk_h);
+    v.walk_side = hn::IfThenElse(walk.suspended, walk.side, v.walk_side);
+    v.walk_order = hn::IfThenElse(walk.suspended, walk.order, v.walk_order);
+    for (int c = 0; c < 3; ++c)
+        v.walk_weight[c] = hn::IfThenElse(walk.suspended, walk.weight[c], v.walk_weight[c]);
 }
 
 template <bool kPolarized, bool kAnisotropic>
 HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, VF eta, VF inv_eta,
                                     MF m, LaneVectors& v, LaneRng& rng, int max_order,
-                                    MF& degenerate) {
+                                    MF& degenerate, bool may_suspend) {
     auto draw = [&] { return rng.Uniform(); };
     const MicrosurfaceDielectricFacet<VF, VecLane, decltype(draw), kPolarized> facet{
         eta, inv_eta, draw, kPolarized ? &v.pol : nullptr};
     MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), true, facet, m, v, rng, max_order,
-                                        degenerate, kPolarized && v.pol.channels == 3);
+                                        degenerate, may_suspend, kPolarized && v.pol.channels == 3);
 }
 
 template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
 HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, const Fresnel& fresnel,
                                    const Mueller& mueller, MF m, LaneVectors& v, LaneRng& rng,
-                                   int max_order, MF& degenerate) {
+                                   int max_order, MF& degenerate, bool may_suspend) {
     if constexpr (kPolarized) {
         const MicrosurfaceConductorFacet<VF, VecLane, Fresnel, Mueller> facet{fresnel, &v.pol,
                                                                               &mueller};
         MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
-                                            max_order, degenerate);
+                                            max_order, degenerate, may_suspend);
     } else {
         const MicrosurfaceConductorFacet<VF, VecLane, Fresnel> facet{fresnel};
         MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
-                                            max_order, degenerate);
+                                            max_order, degenerate, may_suspend);
     }
 }
 
@@ -271,8 +302,9 @@ HWY_NOINLINE void FilmConductorEvent(const CompiledLayer<float>& layer,
     }
     const FilmReflection reflection{films, thickness};
     if (layer.multiple) {
+        // Not suspended: the thickness is the event's, drawn above.
         ConductorWalkEvent<kPolarized, false>(layer.conductor, reflection, reflection, m, v, rng,
-                                              max_order, degenerate);
+                                              max_order, degenerate, false);
         return;
     }
     const VF u1 = rng.Uniform(), u2 = rng.Uniform();
