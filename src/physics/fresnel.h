@@ -162,8 +162,8 @@ template <typename T>
 std::complex<T> normal_wave_number(std::complex<T> eta, T sin2_theta) {
     const std::complex<T> e = eta * eta - sin2_theta;
     // An imaginary part of −0 would put the root of a negative number on the decaying side's
-    // mirror image (std::sqrt follows the sign of zero).
-    return std::sqrt(std::complex<T>(e.real(), e.imag() == T(0) ? T(0) : e.imag()));
+    // mirror image (the principal root follows the sign of zero).
+    return principal_sqrt(std::complex<T>(e.real(), e.imag() == T(0) ? T(0) : e.imag()));
 }
 
 /// The same reflectance as fresnel_conductor evaluated with std::complex, as written in Born &

@@ -30,6 +30,7 @@
 // polarization.h, form (*)) of the film's r and t replace the bare interface's at every smooth or
 // microfacet event.
 
+#include "core/complex_math.h"
 #include "physics/fresnel.h"
 #include "physics/polarization.h"
 
@@ -83,7 +84,7 @@ std::array<ThinFilmAmplitudes<T>, N> thin_film_amplitudes(
             const FresnelAmplitudes<T> b23 =
                 fresnel_amplitudes<T>(eta_film, u2, eta_exit[n], u3[n]);
             // e^{iδ}: |e^{iδ}| = e^{−Im δ} ≤ 1 since Im u2 ≥ 0.
-            const C phase = std::exp(C(0, T(2) * std::numbers::pi_v<T> * thickness_waves[n]) * u2);
+            const C phase = exp_i(T(2) * std::numbers::pi_v<T> * thickness_waves[n] * u2);
             const C phase2 = phase * phase;
             const C inv_den_s = reciprocal(T(1) + b12.r_s * b23.r_s * phase2);
             const C inv_den_p = reciprocal(T(1) + b12.r_p * b23.r_p * phase2);
@@ -101,7 +102,8 @@ std::array<ThinFilmAmplitudes<T>, N> thin_film_amplitudes(
     constexpr T kNearCritical = T(1e-6);
     Sums film;
     if (squared_modulus(w) < kNearCritical * kNearCritical) {
-        const Sums a = airy(std::sqrt(w + kNearCritical)), b = airy(std::sqrt(w - kNearCritical));
+        const Sums a = airy(principal_sqrt(w + kNearCritical)),
+                   b = airy(principal_sqrt(w - kNearCritical));
         for (std::size_t n = 0; n < N; ++n)
             film[n] = {(a[n].r_s + b[n].r_s) / T(2), (a[n].r_p + b[n].r_p) / T(2),
                        (a[n].t_s + b[n].t_s) / T(2), (a[n].t_p + b[n].t_p) / T(2)};

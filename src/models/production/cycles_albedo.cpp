@@ -52,15 +52,15 @@ CyclesWhiteAlbedo::CyclesWhiteAlbedo(double r) {
         for (std::size_t n = 0; n < q.x.size(); ++n)
             averages[b] += 2 * q.w[n] * q.x[n] * correlated_ggx_albedo_white(q.x[n], alpha);
     }
-    average_ = std::lerp(averages[0], averages[1], t_r_);
+    average_ = mix(averages[0], averages[1], t_r_);
 }
 
 double CyclesWhiteAlbedo::albedo(double mu) const {
     const auto [k, t] = cycles_bracket(mu, kN);
     const int k1 = next_node(k, kN);
-    auto at = [&](int b) { return std::lerp(albedo_[b * kN + k], albedo_[b * kN + k1], t); };
+    auto at = [&](int b) { return mix(albedo_[b * kN + k], albedo_[b * kN + k1], t); };
     // Cycles interpolates in r first, then in μ: the same bilinear value.
-    return std::lerp(at(0), at(1), t_r_);
+    return mix(at(0), at(1), t_r_);
 }
 
 double CyclesFresnelFactor::unit_node(int i) {
@@ -89,10 +89,9 @@ double CyclesFresnelFactor::factor(double mu) const {
     const int m1 = next_node(m, kN);
     auto at = [&](int a, int b) {
         const double* row = &factor_[(a * 2 + b) * kN];
-        return std::lerp(row[m], row[m1], t);
+        return mix(row[m], row[m1], t);
     };
-    return std::lerp(std::lerp(at(0, 0), at(0, 1), t_r_), std::lerp(at(1, 0), at(1, 1), t_r_),
-                     t_z_);
+    return mix(mix(at(0, 0), at(0, 1), t_r_), mix(at(1, 0), at(1, 1), t_r_), t_z_);
 }
 
 }  // namespace lamina

@@ -77,9 +77,9 @@ double FilamentDfgTexture::albedo(double mu_o) const {
     const int x0 = int(std::floor(tx));
     const double s = tx - x0;
     auto at = [&](int k, int x) { return double(rows_[k * kSize + std::clamp(x, 0, kSize - 1)]); };
-    const double lower = std::lerp(at(0, x0), at(0, x0 + 1), s);
-    const double upper = std::lerp(at(1, x0), at(1, x0 + 1), s);
-    return std::lerp(lower, upper, t_);
+    const double lower = mix(at(0, x0), at(0, x0 + 1), s);
+    const double upper = mix(at(1, x0), at(1, x0 + 1), s);
+    return mix(lower, upper, t_);
 }
 
 }  // namespace lamina

@@ -1,6 +1,7 @@
 #include "models/production/threejs_dfg.h"
 
 #include "core/check.h"
+#include "core/math.h"
 #include "layers/data_files.h"
 
 #include <algorithm>
@@ -54,10 +55,8 @@ ThreeJsDfgTexture::ThreeJsDfgTexture(double roughness) {
 
 double ThreeJsDfgTexture::albedo(double mu_o) const {
     const Bracket b = texel_bracket(mu_o, kSize);
-    auto at = [&](int c) {
-        return std::lerp(albedo_[c * kSize + b.i0], albedo_[c * kSize + b.i1], b.t);
-    };
-    return std::lerp(at(0), at(1), t_);
+    auto at = [&](int c) { return mix(albedo_[c * kSize + b.i0], albedo_[c * kSize + b.i1], b.t); };
+    return mix(at(0), at(1), t_);
 }
 
 }  // namespace lamina

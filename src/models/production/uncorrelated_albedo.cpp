@@ -159,15 +159,15 @@ double Grid::complement(double mu) const {
     const int k1 = upper(k);
     auto at = [&](int a, int b) {
         const double* row = &complement_[(a * 2 + b) * kN];
-        return std::lerp(row[k], row[k1], tk);
+        return mix(row[k], row[k1], tk);
     };
-    const double value = std::lerp(std::lerp(at(0, 0), at(0, 1), t_alpha_),
-                                   std::lerp(at(1, 0), at(1, 1), t_alpha_), t_eta_);
+    const double value =
+        mix(mix(at(0, 0), at(0, 1), t_alpha_), mix(at(1, 0), at(1, 1), t_alpha_), t_eta_);
     return extrapolation_ * value;
 }
 
 double Grid::average_complement() const {
-    return std::lerp(average_complement_[0], average_complement_[1], t_alpha_);
+    return mix(average_complement_[0], average_complement_[1], t_alpha_);
 }
 
 }  // namespace lamina

@@ -48,9 +48,9 @@ double UnityFgdTexture::albedo(double mu, double perceptual_roughness) const {
     const double ty = clamp(perceptual_roughness, 0.0, 1.0) * (kSize - 1);
     const int x0 = std::min(int(tx), kSize - 2), y0 = std::min(int(ty), kSize - 2);
     const double fx = tx - x0, fy = ty - y0;
-    const double lower = std::lerp(texel(x0, y0), texel(x0 + 1, y0), fx);
-    const double upper = std::lerp(texel(x0, y0 + 1), texel(x0 + 1, y0 + 1), fx);
-    return std::lerp(lower, upper, fy);
+    const double lower = mix(texel(x0, y0), texel(x0 + 1, y0), fx);
+    const double upper = mix(texel(x0, y0 + 1), texel(x0 + 1, y0 + 1), fx);
+    return mix(lower, upper, fy);
 }
 
 namespace {
