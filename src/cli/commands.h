@@ -34,5 +34,7 @@ Runner add_figures(CLI::App& app);
 Runner add_render(CLI::App& app);
 /// `lamina export`: .bsdf, MERL .binary or .npz files (cmd_export.cpp).
 Runner add_export(CLI::App& app);
+/// `lamina tables`: the models' tables computed into the cache now (cmd_tables.cpp).
+Runner add_tables(CLI::App& app);
 
 }  // namespace lamina::cli

@@ -43,6 +43,7 @@ int run(int argc, char** argv) {
     add(lamina::cli::add_explorer);
     add(lamina::cli::add_figures);
     add(lamina::cli::add_export);
+    add(lamina::cli::add_tables);
 
     // Under an MPI launcher every process gets here; an error on any of them ends them all
     // (distributed/communicator.h), so that none waits forever for the others.

@@ -124,4 +124,18 @@ JSON
 else
     echo "FAIL validate: 'lamina validate' does not accept the test's stack"; fails=$((fails + 1))
 fi
+
+# `lamina tables` computes every table the models read into the cache; the build ran it for its
+# own folder (<build>/tables), which a lamina built there reads after an empty cache: nothing is
+# computed again, so nothing is written. Without that folder every table is computed and cached.
+check tables 0 env LAMINA_CACHE_DIR="$tmp/cache" "$lamina" tables
+for t in fgd ggx-albedo tir tir-lobe slope-sum coat-t ms-albedo; do expect_output "tables $t" "^$t "; done
+built=$(dirname "$lamina")/tables
+if [ -f "$built/computed.stamp" ]; then
+    expect_output tables-names-the-build "then, read only: .*tables (the build's)"
+    if [ -z "$(ls -A "$tmp/cache" 2>/dev/null)" ]; then pass=$((pass + 1)); else
+        echo "FAIL tables: computed again with the build's folder present:"; ls "$tmp/cache"; fails=$((fails + 1)); fi
+    if [ "$(ls "$built"/*.bin | wc -l)" -eq 8 ]; then pass=$((pass + 1)); else
+        echo "FAIL tables: the build's folder lacks tables:"; ls "$built"; fails=$((fails + 1)); fi
+fi
 finish

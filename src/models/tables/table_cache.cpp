@@ -63,8 +63,18 @@ std::filesystem::path table_cache_path(const TableKey& key) {
     return table_cache_dir() / fmt::format("{}-{:016x}.bin", key.name, key.hash());
 }
 
-std::optional<std::vector<float>> load_cached_table(const TableKey& key) {
-    std::ifstream file(table_cache_path(key), std::ios::binary);
+std::optional<std::filesystem::path> build_table_dir() {
+#ifdef LAMINA_BUILD_TABLE_DIR
+    return std::filesystem::path(LAMINA_BUILD_TABLE_DIR);
+#else
+    return std::nullopt;
+#endif
+}
+
+namespace {
+std::optional<std::vector<float>> load_table_file(const std::filesystem::path& path,
+                                                  const TableKey& key) {
+    std::ifstream file(path, std::ios::binary);
     if (!file) return std::nullopt;
     const std::string in((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
     std::size_t pos = 0;
@@ -91,6 +101,14 @@ std::optional<std::vector<float>> load_cached_table(const TableKey& key) {
     for (const float v : values)
         if (!std::isfinite(v)) return std::nullopt;
     return values;
+}
+}  // namespace
+
+std::optional<std::vector<float>> load_cached_table(const TableKey& key) {
+    if (auto values = load_table_file(table_cache_path(key), key)) return values;
+    if (const auto dir = build_table_dir())
+        return load_table_file(*dir / table_cache_path(key).filename(), key);
+    return std::nullopt;
 }
 
 bool store_cached_table(const TableKey& key, const std::vector<float>& values) {

@@ -8,6 +8,12 @@
 // checksum (u64) of the values. A file that is missing, truncated, or mismatched in any field is
 // recomputed and rewritten (atomically, write_file_atomic) — never trusted. A cache that cannot
 // be written is not an error: the table then lives in memory only.
+//
+// A table missing from the cache is then looked for, read-only and checked the same way, in the
+// folder the build filled when it built lamina (build_table_dir: `lamina tables` run by the
+// build, models/tables/every_table.h), so that a freshly built lamina's first study does not
+// compute them; a lamina built elsewhere (a Python wheel, a moved build folder) finds no folder
+// there and computes them on first use as before.
 
 #include <cstdint>
 #include <filesystem>
@@ -34,7 +40,12 @@ std::filesystem::path table_cache_dir();
 /// The file a table is cached in.
 std::filesystem::path table_cache_path(const TableKey& key);
 
-/// The cached values, or nothing when absent or not exactly matching `key`.
+/// The folder of tables the build computed (`<build>/tables`), where this lamina was built with
+/// one; it may be missing or incomplete, and is only read.
+std::optional<std::filesystem::path> build_table_dir();
+
+/// The cached values, or nothing when absent or not exactly matching `key`: from the cache
+/// folder, else from build_table_dir.
 std::optional<std::vector<float>> load_cached_table(const TableKey& key);
 /// Best effort: returns false (and leaves no partial file) when the cache cannot be written.
 bool store_cached_table(const TableKey& key, const std::vector<float>& values);
