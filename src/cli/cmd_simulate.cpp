@@ -69,7 +69,7 @@ Runner add_simulate(CLI::App& app) {
         // Bitwise identity with a one-process run needs one kernel variant on every process: the
         // SIMD kernel's results depend on the instruction set it dispatches to.
         const std::vector<std::string> kernels =
-            world.gather(kernel_description(kernel_for(s, stack)));
+            world.gather(kernel_description(traced_kernel(s, stack)));
         if (world.is_root())
             for (std::size_t r = 1; r < kernels.size(); ++r)
                 if (kernels[r] != kernels[0])

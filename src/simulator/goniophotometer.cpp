@@ -108,6 +108,19 @@ Kernel kernel_for(const SimulationSettings& settings, const Stack& stack) {
     return needs_scalar_kernel(stack, settings) ? Kernel::Scalar : Kernel::Simd;
 }
 
+namespace {
+// The hand-off of traced_kernel, given the run's spectral tracing (simulate_sums has it).
+Kernel traced_kernel(Kernel kernel, bool spectral, const SpectralTracing& tracing) {
+    return kernel == Kernel::Simd && spectral && !tracing.lanes_uniform ? Kernel::Scalar : kernel;
+}
+}  // namespace
+
+Kernel traced_kernel(const SimulationSettings& settings, const Stack& stack) {
+    const Kernel kernel = kernel_for(settings, stack);
+    if (kernel != Kernel::Simd || !is_spectral_run(stack, settings)) return kernel;
+    return traced_kernel(kernel, true, spectral_tracing(stack, settings));
+}
+
 void IncidenceSums::add(const IncidenceSums& o) {
     // Element-wise integer sums of equally sized tallies (bins, Stokes, budgets).
     const auto add_all = [](auto& into, const auto& from) {
@@ -186,7 +199,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
     const bool spectral = is_spectral_run(stack, settings);
     const SpectralTracing tracing =
         spectral ? spectral_tracing(stack, settings) : SpectralTracing{};
-    const bool simd = kernel == Kernel::Simd && (!spectral || tracing.lanes_uniform);
+    const bool simd = traced_kernel(kernel, spectral, tracing) == Kernel::Simd;
     const auto trace_block = simd       ? trace_block_simd
                              : spectral ? trace_block_spectral
                                         : trace_block_scalar;

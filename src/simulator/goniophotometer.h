@@ -75,6 +75,10 @@ bool needs_scalar_kernel(const Stack& stack, const SimulationSettings& settings)
 /// The kernel that traces `stack` under `settings`: auto is scalar where needs_scalar_kernel,
 /// simd otherwise; scalar and simd are themselves.
 Kernel kernel_for(const SimulationSettings& settings, const Stack& stack);
+/// The kernel that traces the run: kernel_for's, but scalar for a spectral run on the SIMD kernel
+/// whose stacks differ in structure between wavelengths (needs_scalar_kernel). What result.json's
+/// `kernel_description` and the study's reference pieces name.
+Kernel traced_kernel(const SimulationSettings& settings, const Stack& stack);
 
 /// The goniophotometer's settings. Each is declared once, in `fields` (core/setting.h): the
 /// command line, result.json, the study's files, the reference's cache key and Python read them

@@ -42,7 +42,7 @@ nlohmann::json result_json(const Stack& stack, const SimulationResult& result) {
     // the bins' ranges, the threads and processes used.
     j.update(settings_to_json(s));
     j["physics"] = physics_name(s.transport);  // exact, bpb19 or custom
-    j["kernel_description"] = kernel_description(kernel_for(s, stack));
+    j["kernel_description"] = kernel_description(traced_kernel(s, stack));
     // The grid of the tables (simulation_grid): "n_phi" stays the setting's (folded) count; an
     // unfolded table has twice as many φ bins, over [0°, 360°).
     const bool unfolded = result.table.grid.is_unfolded();

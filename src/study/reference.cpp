@@ -241,7 +241,7 @@ std::string ReferenceKey::canonical() const {
         "grid {} | kernel {}{}{}",
         kVersion, kReferenceSourceDigest, config_id, stack_to_json(stack).dump(), theta_i_deg(),
         settings.particles, settings.seed, settings.grid.to_string(),
-        kernel_description(kernel_for(settings, stack)), settings_key_text(settings),
+        kernel_description(traced_kernel(settings, stack)), settings_key_text(settings),
         masking_said ? " | transmission masking smith" : "");
 }
 

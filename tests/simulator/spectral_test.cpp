@@ -3,8 +3,10 @@
 // by a two-sample chi-square test). Suites ending in Stat are the `stat` label.
 #include "core/error.h"
 #include "layers/colorimetry.h"
+#include "layers/stack.h"
 #include "physics/fresnel.h"
 #include "simulator/goniophotometer.h"
+#include "simulator/output.h"
 #include "support/closed_forms.h"
 #include "support/stacks.h"
 #include "support/table_checks.h"
@@ -298,6 +300,30 @@ TEST(Spectral, KernelAndBinsChecked) {
     s.spectral = SpectralMode::Off;
     EXPECT_FALSE(is_spectral_run(stack, s));
     EXPECT_TRUE(simulate(stack, s).spectral.bin_edges_nm.empty());
+}
+
+// A spectral run whose coat is index-matched to the air at some wavelengths only (η = 1 below
+// 500 nm) is handed to the scalar kernel, and result.json names the kernel that traced it; a
+// uniform one stays on the SIMD kernel.
+TEST(Spectral, TheKernelNamedIsTheOneThatTraced) {
+    const Stack matched_in_blue = parse_stack(
+        R"({"layers": [{"interface": {"type": "dielectric", "alpha": 0.1, "eta": {"spectrum":
+            [[360, 1.0], [500, 1.0], [600, 1.5], [830, 1.5]]}}},
+            {"interface": {"type": "lambertian", "albedo": 0.5}}]})",
+        "test");
+    SimulationSettings s = spectral_settings({30}, 2000, HemisphereGrid(3, 3));
+    s.spectral = SpectralMode::Auto;
+    for (const Kernel kernel : {Kernel::Auto, Kernel::Simd}) {
+        s.kernel = kernel;
+        EXPECT_EQ(traced_kernel(s, matched_in_blue), Kernel::Scalar);
+        const SimulationResult r = simulate(matched_in_blue, s);
+        EXPECT_EQ(result_json(matched_in_blue, r)["kernel_description"], "scalar");
+    }
+    s.kernel = Kernel::Auto;
+    const Stack uniform = bk7_slab(0.1, 0.1);
+    EXPECT_EQ(traced_kernel(s, uniform), Kernel::Simd);
+    s.spectral = SpectralMode::Off;  // RGB: the SIMD kernel
+    EXPECT_EQ(traced_kernel(s, matched_in_blue), Kernel::Simd);
 }
 
 }  // namespace
