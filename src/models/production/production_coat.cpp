@@ -35,6 +35,12 @@ double schlick(double c, double f0) {
     return f0 + (1 - f0) * schlick_weight(c);
 }
 
+/// x⁶ in three products (std::pow with a constant exponent is a library call: GCC expands it
+/// only under -funsafe-math-optimizations).
+double pow6(double x) {
+    return sqr(sqr(x) * x);
+}
+
 constexpr double kF82Cos = 1.0 / 7.0;  // μ̄ of the F82-tint model (OpenPBR 1.1, "Metal")
 /// OpenPBR 1.1's default specular_roughness: the diffuse base leaves it there (its specular_weight
 /// is 0); openpbr-bsdf's darkening still reads it through E_F(1) (docs/models.md).
@@ -527,7 +533,7 @@ class ProductionCoat final : public Model {
     /// The F82-tint Fresnel's average 2 ∫ F μ dμ in closed form, F0 + (1 − F0)/21 − b/126 with b
     /// its edge term (Cycles' fresnel_f82_Fss).
     static double f82_tint_average_fresnel(double f0, double tint) {
-        const double b = schlick(kF82Cos, f0) * (1 - tint) / (kF82Cos * std::pow(1 - kF82Cos, 6));
+        const double b = schlick(kF82Cos, f0) * (1 - tint) / (kF82Cos * pow6(1 - kF82Cos));
         return f0 + (1 - f0) / 21 - b / 126;
     }
 
@@ -548,7 +554,7 @@ class ProductionCoat final : public Model {
         if (ms_grid_) return ms_grid_->complement(mu);
         // dspbr-pt's fit E(μ) = 1 − r (1/2 + (1 − μ)⁵/2), clamped to [0, 1].
         const double e =
-            clamp(1 - ms_roughness_ * (0.5 + 0.5 * std::pow(1 - clamp(mu, 0.0, 1.0), 5)), 0.0, 1.0);
+            clamp(1 - ms_roughness_ * (0.5 + 0.5 * schlick_weight(mu)), 0.0, 1.0);
         return 1 - e;
     }
 
@@ -865,9 +871,9 @@ double filament_f0_clear_coat_to_surface(double f0) {
 double f82_tint_fresnel(double cos_theta, double f0, double tint) {
     const double mu = clamp(cos_theta, 0.0, 1.0);
     const double one_minus_bar = 1 - kF82Cos;
-    const double bar6 = std::pow(one_minus_bar, 6);
+    const double bar6 = pow6(one_minus_bar);
     const double b = schlick(kF82Cos, f0) * (1 - tint) / (kF82Cos * bar6);
-    return clamp(schlick(mu, f0) - b * mu * std::pow(1 - mu, 6), 0.0, 1.0);
+    return clamp(schlick(mu, f0) - b * mu * pow6(1 - mu), 0.0, 1.0);
 }
 
 OptionSpec leaves_option() {

@@ -79,7 +79,8 @@ double f0_to_ior(double f0) {
 }
 /// Schlick 1994, Eq. 15, with f90 = 1 (HDRP's F_Schlick).
 double f_schlick(double f0, double c) {
-    return f0 + (1 - f0) * std::pow(1 - c, 5);
+    const double m = 1 - c, m2 = m * m;  // (1 − c)⁵ in products, not a library call
+    return f0 + (1 - f0) * m2 * m2 * m;
 }
 
 /// What StackLit derives from the view alone (its GetPreLightData).
