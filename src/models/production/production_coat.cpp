@@ -553,8 +553,7 @@ class ProductionCoat final : public Model {
     double ms_complement(double mu) const {
         if (ms_grid_) return ms_grid_->complement(mu);
         // dspbr-pt's fit E(μ) = 1 − r (1/2 + (1 − μ)⁵/2), clamped to [0, 1].
-        const double e =
-            clamp(1 - ms_roughness_ * (0.5 + 0.5 * schlick_weight(mu)), 0.0, 1.0);
+        const double e = clamp(1 - ms_roughness_ * (0.5 + 0.5 * schlick_weight(mu)), 0.0, 1.0);
         return 1 - e;
     }
 
