@@ -104,16 +104,17 @@ def model_color(name, models):
     return EXTRA_COLORS[k % len(EXTRA_COLORS)]
 
 
-def save(fig, path_stem, formats, tight=True):
+def save(fig, path_stem, formats, tight=True, box=None):
     """Writes each format, atomically (a temporary file renamed into place). `tight=False` for
     figures laid out by hand: matplotlib's tight boxes measure every tick label again, the bulk of
-    the time for grids of log axes."""
+    the time for grids of log axes. `box`: the bounding box (inches) measured by the caller."""
     os.makedirs(os.path.dirname(path_stem), exist_ok=True)
     # No creation dates: the same study gives byte-identical PDF and SVG files.
     metadata = {"pdf": {"CreationDate": None}, "svg": {"Date": None}, "png": {}}
     for f in formats:
         tmp = f"{path_stem}.tmp-{os.getpid()}.{f}"
-        fig.savefig(tmp, bbox_inches="tight" if tight else None, metadata=metadata[f])
+        bbox = box if box is not None else "tight" if tight else None
+        fig.savefig(tmp, bbox_inches=bbox, metadata=metadata[f])
         os.replace(tmp, f"{path_stem}.{f}")
     plt.close(fig)
 
@@ -437,16 +438,6 @@ def error_matrix(study, formats, side):
     im = ax.imshow(np.ma.masked_invalid(z), aspect="auto", cmap="YlOrRd", norm=norm,
                    interpolation="nearest")
     ax.set_facecolor("0.9")
-    for r in range(len(rows)):
-        for k in range(len(cols)):
-            if ns[r, k]:
-                ax.text(k, r, "n/s", ha="center", va="center", fontsize=5.5, color="0.35")
-            elif np.isfinite(z[r, k]):
-                below = k > 0 and np.isfinite(z[r, 0]) and z[r, k] <= 2 * z[r, 0]
-                v = z[r, k]
-                dark = norm is not None and norm(v) > 0.6
-                ax.text(k, r, f"{v:.2g}" + ("≈" if below else ""), ha="center", va="center",
-                        fontsize=5.5, color="white" if dark else "black")
     ax.set_xticks(range(len(cols)), cols, rotation=35, ha="left")
     ax.xaxis.tick_top()
     ax.set_yticks(range(len(rows)), [c["id"] for c in rows], fontsize=6)
@@ -458,7 +449,21 @@ def error_matrix(study, formats, side):
     cb.set_label(f"{label} (mean over θi and RGB)")
     ax.set_title(f"{SIDE_NAME[side]}: {label}, configurations × models, best first "
                  "(≈: within 2× the noise floor; n/s: not supported)", fontsize=8, pad=6)
-    save(fig, os.path.join(study.root, "figures", f"error-matrix-{side}"), formats)
+    # The tight box of everything outside the cells, measured before the cells' values are
+    # written (they lie inside the axes): measuring the one or two thousand cell texts for
+    # savefig's bbox_inches="tight" cost as much as drawing them.
+    box = fig.get_tightbbox(fig.canvas.get_renderer()).padded(0.1)
+    for r in range(len(rows)):
+        for k in range(len(cols)):
+            if ns[r, k]:
+                ax.text(k, r, "n/s", ha="center", va="center", fontsize=5.5, color="0.35")
+            elif np.isfinite(z[r, k]):
+                below = k > 0 and np.isfinite(z[r, 0]) and z[r, k] <= 2 * z[r, 0]
+                v = z[r, k]
+                dark = norm is not None and norm(v) > 0.6
+                ax.text(k, r, f"{v:.2g}" + ("≈" if below else ""), ha="center", va="center",
+                        fontsize=5.5, color="white" if dark else "black")
+    save(fig, os.path.join(study.root, "figures", f"error-matrix-{side}"), formats, box=box)
 
 
 # ---- Albedo against θi, per category -----------------------------------------------------------
