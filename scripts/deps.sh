@@ -18,7 +18,7 @@ packages=(
   chromium fonts-dejavu-core                 # the explorer's browser test (tests/report)
 )
 
-# One dpkg-query for all of them (one per package took most of a second, on every `make demo`).
+# One dpkg-query for all of them (one per package took over a second on every `make demo`).
 installed=$(dpkg-query -W -f='${Package} ${Status}\n' "${packages[@]}" 2>/dev/null |
   awk '$2 == "install" && $3 == "ok" && $4 == "installed" {print $1}' || true)
 missing=()

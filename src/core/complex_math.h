@@ -31,8 +31,8 @@ inline std::complex<T> reciprocal(std::complex<T> z) {
 /// picks the side, as std::sqrt's). The stable form of Press, Teukolsky, Vetterling & Flannery,
 /// "Numerical Recipes in C", 2nd ed., §5.4, eqs. 5.4.6–5.4.7: w = √((|z| + |Re z|)/2), then
 /// (w, Im z/2w) for Re z ≥ 0 and (|Im z|/2w, ±w) otherwise, with no cancellation on either side.
-/// |z|² is taken as Re² + Im²; where it would lose precision to underflow or overflow (|z| outside
-/// about 1e±146 in double), at zero and for non-finite z, std::sqrt's result.
+/// |z|² is taken as Re² + Im²; where it would lose precision to underflow or overflow (in double,
+/// |z| below about 1e-146 or above about 1e154), at zero and for non-finite z, std::sqrt's result.
 template <typename T>
 inline std::complex<T> principal_sqrt(std::complex<T> z) {
     const T x = z.real(), y = z.imag();

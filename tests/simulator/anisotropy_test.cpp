@@ -110,7 +110,8 @@ TEST(Anisotropy, BothKernelsTraceAnisotropyAndAzimuths) {
 
 // ---- Statistical proofs -------------------------------------------------------------------------
 
-SimulationSettings scalar_settings(double theta_i, std::uint64_t particles, int n = 18) {
+SimulationSettings anisotropic_scalar_settings(double theta_i, std::uint64_t particles,
+                                               int n = 18) {
     SimulationSettings s;
     s.theta_i_deg = {theta_i};
     s.particles = particles;
@@ -153,7 +154,7 @@ TEST(AnisotropyStat, NearlyEqualRoughnessesReproduceTheIsotropicTable) {
     // folded back (the two mirror patches averaged), it is the isotropic table. With exactly equal
     // roughnesses the stack is isotropic and the table is the isotropic one bit for bit.
     for (bool multiple : {false, true}) {
-        SimulationSettings s = scalar_settings(50, 400'000);
+        SimulationSettings s = anisotropic_scalar_settings(50, 400'000);
         s.transport.microsurface = multiple ? Microsurface::Multiple : Microsurface::Single;
         const Stack iso = brushed_conductor(0.3, 0.3, 40);
         ASSERT_FALSE(iso.is_anisotropic());
@@ -184,7 +185,7 @@ TEST(AnisotropyStat, NearlyEqualRoughnessesReproduceTheIsotropicTable) {
 }
 
 TEST(AnisotropyStat, SwappingRoughnessesIsTurningTheTangentBy90Degrees) {
-    SimulationSettings s = scalar_settings(40, 400'000);
+    SimulationSettings s = anisotropic_scalar_settings(40, 400'000);
     const SimulationResult a = simulate(brushed_conductor(0.1, 0.4, 20), s);
     s.seed = 11;
     const SimulationResult b = simulate(brushed_conductor(0.4, 0.1, 110), s);
@@ -205,7 +206,7 @@ TEST(AnisotropyStat, TurningTangentsAndLightTurnsTheTable) {
             anisotropic(conductor_interface(Rgbd(0.2), Rgbd(3.0), 0.1), 0.1, 0.35, -35 + turn));
         return test::make_stack({coat, base});
     };
-    SimulationSettings s = scalar_settings(35, 400'000);
+    SimulationSettings s = anisotropic_scalar_settings(35, 400'000);
     s.phi_i_deg = 20;
     const SimulationResult a = simulate(stack(0), s);
     s.phi_i_deg = 80;
@@ -263,7 +264,7 @@ double bin_midpoint_average(const HemisphereGrid& grid, int t, int p, bool below
 
 void single_conductor_matches_the_closed_form(Kernel kernel) {
     const ClosedForm brdf{0.15, 0.45, deg_to_rad(25.0)};
-    SimulationSettings s = scalar_settings(40, 1'000'000);
+    SimulationSettings s = anisotropic_scalar_settings(40, 1'000'000);
     s.kernel = kernel;
     s.phi_i_deg = 30;
     s.transport.microsurface = Microsurface::Single;
@@ -314,7 +315,7 @@ double dielectric_closed_form(const ClosedForm& c, double eta, const Vec3d& wi, 
 void single_dielectric_matches_the_closed_form(Kernel kernel) {
     const ClosedForm shape{0.2, 0.5, deg_to_rad(-40.0)};
     const double eta = 1.5;
-    SimulationSettings s = scalar_settings(50, 1'000'000);
+    SimulationSettings s = anisotropic_scalar_settings(50, 1'000'000);
     s.kernel = kernel;
     s.phi_i_deg = 10;
     s.transport.microsurface = Microsurface::Single;
@@ -419,7 +420,7 @@ TEST(AnisotropyStat, UnfoldedTablesAreReciprocal) {
     };
     std::vector<SimulationResult> runs;
     for (int a = 0; a < 2; ++a) {
-        SimulationSettings s = scalar_settings(0, 1'000'000);
+        SimulationSettings s = anisotropic_scalar_settings(0, 1'000'000);
         s.theta_i_deg = {thetas[0], thetas[1]};
         s.phi_i_deg = phis[a];
         s.seed = 17 + a;
@@ -456,7 +457,7 @@ TEST(AnisotropyStat, LightFromAnotherAzimuthDrawsOtherNumbers) {
     // interface each particle's fate (reflect if u < F) does not depend on the azimuth, so a
     // shared stream would give the same estimate to rounding.
     const Stack stack = test::make_stack({test::dielectric_layer(1.5, 0.0)});
-    SimulationSettings s = scalar_settings(50, 200'000, 6);
+    SimulationSettings s = anisotropic_scalar_settings(50, 200'000, 6);
     const double r0 = simulate(stack, s).incidences[0].budget[BudgetTerm::Reflected][0];
     s.phi_i_deg = 60;
     const SimulationResult b = simulate(stack, s);
@@ -472,7 +473,7 @@ TEST(AnisotropyStat, MultipleScatteringConservesEnergyOnAWhiteConductor) {
     // masked part. Both anisotropic, unfolded.
     Stack s = test::make_stack(
         {layer_of(anisotropic(conductor_interface(Rgbd(0.01), Rgbd(10.0), 0.2), 0.2, 0.8, 15))});
-    SimulationSettings settings = scalar_settings(60, 200'000);
+    SimulationSettings settings = anisotropic_scalar_settings(60, 200'000);
     settings.transport.polarization = false;
     const SimulationResult multiple = simulate(s, settings);
     const EnergyBudget& b = multiple.incidences[0].budget;
