@@ -410,7 +410,7 @@ int run_export(const ExportArgs& a) {
         for (int t = 0; t <= g.n_theta(); ++t)
             te.push_back(float(90.0 * t / g.n_theta()));
         for (int p = 0; p <= g.n_phi(); ++p)
-            pe.push_back(float(rad_to_deg(g.phi_span()) * p / g.n_phi()));
+            pe.push_back(float(g.phi_span_deg() * p / g.n_phi()));
         meta["axes"] = {"incidence", "side", "theta_bin", "phi_bin", "channel"};
         meta["sides"] = n_sides == 2 ? nlohmann::json{"R", "T"} : nlohmann::json{"R"};
         meta["theta_i"] = table.theta_i_deg;

@@ -35,6 +35,7 @@ class HemisphereGrid {
     bool is_unfolded() const { return unfolded_; }
     /// The φ range the bins cover: π (folded) or 2π (unfolded), in radians.
     double phi_span() const { return unfolded_ ? 2 * kPi<double> : kPi<double>; }
+    double phi_span_deg() const { return unfolded_ ? 360.0 : 180.0; }
 
     int n_theta() const { return n_theta_; }
     /// φ bins (2× the folded count when unfolded).
@@ -46,6 +47,13 @@ class HemisphereGrid {
     double theta_hi(int t) const { return kPi<double> / 2 * (t + 1) / n_theta_; }
     double phi_lo(int p) const { return phi_span() * p / n_phi_; }
     double phi_hi(int p) const { return phi_span() * (p + 1) / n_phi_; }
+    /// Bin edges in degrees, as the tables write them: 90 t / n_θ and 180 p / n_φ (360 unfolded)
+    /// in one rounding, so an edge that is a whole or decimal number of degrees reads as one
+    /// (11, not the 10.999999999999998 of the radians converted).
+    double theta_lo_deg(int t) const { return 90.0 * t / n_theta_; }
+    double theta_hi_deg(int t) const { return 90.0 * (t + 1) / n_theta_; }
+    double phi_lo_deg(int p) const { return phi_span_deg() * p / n_phi_; }
+    double phi_hi_deg(int p) const { return phi_span_deg() * (p + 1) / n_phi_; }
 
     /// Projected solid angle of bin (t, p), both folded halves (sr); one patch when unfolded.
     double projected_solid_angle(int t, int p) const;

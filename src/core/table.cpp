@@ -42,10 +42,9 @@ std::string BinnedTable::to_csv() const {
                     const std::size_t j = std::size_t(t) * grid.n_phi() + p;
                     fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},{},{},{},{},{}\n",
                                    theta_i_deg[i], side == Side::Reflection ? 'R' : 'T',
-                                   rad_to_deg(grid.theta_lo(t)), rad_to_deg(grid.theta_hi(t)),
-                                   rad_to_deg(grid.phi_lo(p)), rad_to_deg(grid.phi_hi(p)),
-                                   l.f[j][0], l.f[j][1], l.f[j][2], l.se[j][0], l.se[j][1],
-                                   l.se[j][2]);
+                                   grid.theta_lo_deg(t), grid.theta_hi_deg(t), grid.phi_lo_deg(p),
+                                   grid.phi_hi_deg(p), l.f[j][0], l.f[j][1], l.f[j][2], l.se[j][0],
+                                   l.se[j][1], l.se[j][2]);
                 }
             }
         }
@@ -111,6 +110,17 @@ BinnedTable BinnedTable::from_csv(const std::string& text, const std::string& wh
               int(std::lround(phi_lo / 180.0 * n_phi)),
               Rgbd(num(6), num(7), num(8)),
               Rgbd(num(9), num(10), num(11))};
+        // A bin average of a BSDF is ≥ 0 and below 10¹² /sr: all of the energy in the smallest
+        // bin of the finest grid read (3600 × 3600, Ω⊥ ≈ 1.7·10⁻¹⁰ sr) is ≈ 6·10⁹. A larger
+        // value is a broken table, and its square would overflow the metrics.
+        for (int c = 0; c < 6; ++c) {
+            const double v = c < 3 ? r.f[c] : r.se[c - 3];
+            if (!(v >= 0 && v <= kMaxBinValue))
+                throw InputError(
+                    where, fmt::format("line {}, column {}", line_no, 7 + c),
+                    fmt::format("{} {} is outside [0, {:g}] (1/sr)",
+                                c < 3 ? "the value" : "the standard error", v, kMaxBinValue));
+        }
         if (!incidence_in_range(r.theta_i))
             throw InputError(where, fmt::format("line {}, column 1", line_no),
                              fmt::format("theta_i {} is outside [0, 90) degrees", r.theta_i));

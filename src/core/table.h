@@ -1,6 +1,6 @@
 #pragma once
-// Binned BRDF/BTDF tables: what the goniophotometer measures and what a model averaged over the same
-// bins produces, in one format (docs/formats.md, `brdf.csv`):
+// Binned BRDF/BTDF tables: what the goniophotometer measures and what a model averaged over the
+// same bins produces, in one format (docs/formats.md, `brdf.csv`):
 //   theta_i,side,theta_lo,theta_hi,phi_lo,phi_hi,f_r,f_g,f_b,se_r,se_g,se_b
 // one row per (incidence, side, θ bin, φ bin); angles in degrees; f is the cos-weighted bin
 // average of the BSDF (1/sr), se its standard error (0 for deterministic models).
@@ -45,11 +45,15 @@ struct BinnedTable {
 
     /// The CSV text of the table (`brdf.csv` format), full round-trip precision.
     std::string to_csv() const;
-    /// Reads a table written by to_csv (InputError naming `where`, the line and the column).
+    /// Reads a table written by to_csv (InputError naming `where`, the line and the column):
+    /// values and standard errors finite, in [0, kMaxBinValue].
     static BinnedTable from_csv(const std::string& text, const std::string& where);
 };
 
 inline constexpr const char* kBrdfCsvHeader =
     "theta_i,side,theta_lo,theta_hi,phi_lo,phi_hi,f_r,f_g,f_b,se_r,se_g,se_b";
+
+/// The largest bin value (1/sr) a table read back may hold (BinnedTable::from_csv).
+inline constexpr double kMaxBinValue = 1e12;
 
 }  // namespace lamina

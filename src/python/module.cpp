@@ -517,9 +517,7 @@ void bind_table(py::module_& m) {
             "θ bin edges, degrees")
         .def_property_readonly(
             "phi_edges",
-            [](const BinnedTable& t) {
-                return edges_deg(t.grid.n_phi(), rad_to_deg(t.grid.phi_span()));
-            },
+            [](const BinnedTable& t) { return edges_deg(t.grid.n_phi(), t.grid.phi_span_deg()); },
             "φ bin edges, degrees (folded: each bin covers ±φ)")
         .def_property_readonly(
             "projected_solid_angle",
@@ -557,7 +555,7 @@ void bind_simulation(py::module_& m) {
         .def_property_readonly("phi_edges",
                                [](const PySimulation& r) {
                                    return edges_deg(r.result.table.grid.n_phi(),
-                                                    rad_to_deg(r.result.table.grid.phi_span()));
+                                                    r.result.table.grid.phi_span_deg());
                                })
         .def_property_readonly(
             "energy",

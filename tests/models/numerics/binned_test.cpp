@@ -10,7 +10,11 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
 
 namespace lamina {
 namespace {
@@ -272,6 +276,35 @@ TEST(Binned, WritesTheBrdfCsvFormat) {
     EXPECT_TRUE(back.has_transmission);
     EXPECT_EQ(back.theta_i_deg, t.theta_i_deg);
     EXPECT_EQ(back.grid, t.grid);
+}
+
+// On a grid whose edges are whole degrees (30 × 30: 3° in θ, 6° in φ; unfolded 6° up to 360°)
+// every edge is written as the whole number, so `phi_hi == 180` selects rows on any such grid.
+TEST(Binned, WritesWholeDegreeEdgesAsWholeNumbers) {
+    const auto model = make_model("bel-prime", coated(1.5, 0.2, test::dielectric(1.3, 0.3)));
+    for (const bool unfolded : {false, true}) {
+        const HemisphereGrid grid =
+            unfolded ? HemisphereGrid(30, 30).unfolded() : HemisphereGrid(30, 30);
+        const BinnedTable t = bin_model(*model, grid, {30}, unfolded ? 40.0 : 0.0);
+        std::istringstream in(t.to_csv());
+        std::string line;
+        std::getline(in, line);
+        int rows = 0, last_phi = 0;
+        while (std::getline(in, line)) {
+            std::vector<std::string> field;
+            std::stringstream ss(line);
+            for (std::string f; std::getline(ss, f, ',');)
+                field.push_back(f);
+            ASSERT_EQ(field.size(), 12u) << line;
+            for (int k = 2; k < 6; ++k)
+                EXPECT_EQ(field[std::size_t(k)].find_first_not_of("0123456789"), std::string::npos)
+                    << "edge '" << field[std::size_t(k)] << "' in " << line;
+            last_phi = std::max(last_phi, std::stoi(field[5]));
+            ++rows;
+        }
+        EXPECT_EQ(rows, 2 * int(grid.size()));  // the slab: R and T
+        EXPECT_EQ(last_phi, unfolded ? 360 : 180);
+    }
 }
 
 }  // namespace
