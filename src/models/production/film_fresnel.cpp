@@ -38,6 +38,37 @@ Rgbd thickness_average(double min_nm, double max_nm, double period_nm, F&& f) {
     return sum / double(pieces);
 }
 
+/// The thickness (nm) past which `film` reflects light from above at cos_theta as an infinitely
+/// thick one, to double precision: the Airy sums hold the film's round trip e^{2iδ}, of modulus
+/// exp(−4π d η_above Im u_f / λ) with u_f the film's normal wave number relative to the medium
+/// above (physics/thin_film.h), and past this thickness it is below 10⁻¹⁶ in every channel.
+/// Infinite where the wave propagates without loss (a transparent film below its critical angle).
+double opaque_thickness_nm(const FilmOptics& film, double cos_theta) {
+    const double im_u =
+        normal_wave_number(film.eta_film / film.eta_above, 1 - cos_theta * cos_theta).imag();
+    const double lambda_max =
+        std::max({film.wavelength_nm[0], film.wavelength_nm[1], film.wavelength_nm[2]});
+    constexpr double kLn1e16 = 36.841361487904734;  // ln 10¹⁶
+    if (!(im_u > 0)) return HUGE_VAL;
+    return kLn1e16 * lambda_max / (4 * std::numbers::pi * film.eta_above * im_u);
+}
+
+/// thickness_average of f over [min_nm, max_nm] where f is constant from opaque_nm on: the
+/// quadrature below it, f(max_nm) times the length above it (a thick absorbing film's range of
+/// micrometres would otherwise take the 2048 nodes at every evaluation).
+template <typename F>
+Rgbd thickness_average_to_opaque(double min_nm, double max_nm, double period_nm, double opaque_nm,
+                                 F&& f) {
+    if (!(max_nm > opaque_nm) || !(max_nm > min_nm))
+        return thickness_average(min_nm, max_nm, period_nm, f);
+    const double split = std::max(min_nm, opaque_nm);
+    const Rgbd thick = f(max_nm);
+    if (!(split > min_nm)) return thick;
+    return (thickness_average(min_nm, split, period_nm, f) * (split - min_nm) +
+            thick * (max_nm - split)) /
+           (max_nm - min_nm);
+}
+
 /// The exact reflectance of `film` for unpolarized light from above at cos_theta, per channel,
 /// averaged over thickness uniform in [min_nm, max_nm] in closed form (physics/
 /// thin_film_average.h); nothing where no closed form holds in some channel (an absorbing film,
@@ -197,10 +228,11 @@ Rgbd film_reflectance_exact(const FilmOptics& film, double cos_theta) {
         if (const auto closed =
                 closed_form_mean(film, c, film.thickness_min_nm, film.thickness_max_nm))
             return *closed;
-    return thickness_average(film.thickness_min_nm, film.thickness_max_nm, period, [&](double d) {
-        const auto m = film.reflection_from_above(c, d);
-        return Rgbd(m[0].a, m[1].a, m[2].a);
-    });
+    return thickness_average_to_opaque(film.thickness_min_nm, film.thickness_max_nm, period,
+                                       opaque_thickness_nm(film, c), [&](double d) {
+                                           const auto m = film.reflection_from_above(c, d);
+                                           return Rgbd(m[0].a, m[1].a, m[2].a);
+                                       });
 }
 
 std::complex<double> gulbrandsen_index(double r, double g, double r_max) {
@@ -241,7 +273,10 @@ Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, con
                    thickness_average(lo, split, period, at_thickness) * (1 - w_closed);
         }
     }
-    return thickness_average(lo, hi, period, at_thickness);
+    // Past the fade, and past where the film is opaque (or totally reflecting), at_thickness is
+    // constant.
+    const double opaque = sin_film < 1 ? std::max(opaque_thickness_nm(film, c), kFadeNm) : kFadeNm;
+    return thickness_average_to_opaque(lo, hi, period, opaque, at_thickness);
 }
 
 namespace {

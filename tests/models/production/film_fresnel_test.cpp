@@ -104,6 +104,44 @@ TEST(FilmFresnel, RangeIsTheMeanOverTheThickness) {
     }
 }
 
+// A film that absorbs (k > 0), or whose wave is evanescent (a film of lower index than the coat,
+// past its critical angle), reflects as an infinitely thick one past a few decay lengths: the
+// range's mean is the quadrature below that thickness and the constant above it. Against the
+// midpoint rule over the whole range, thickness by thickness.
+TEST(FilmFresnel, RangeMeanOfAnOpaqueFilmIsTheMeanOverTheThickness) {
+    struct Case {
+        double eta, k, min_nm, max_nm;
+    };
+    for (const Case& k :
+         {Case{1.85, 1.0, 20, 6000}, Case{2.3, 0.1, 80, 10000}, Case{1.2, 0.0, 10, 3000}}) {
+        InterfaceSpec metal = with_film(titanium(0.2), k.eta, k.min_nm, k.max_nm);
+        metal.film.k = k.k;
+        const FilmOptics f = stack_film_optics(test::coated(1.5, 0.1, metal), 1);
+        const Rgbd bare(0.6, 0.5, 0.4);
+        for (double mu : {1.0, 0.5, 0.1}) {
+            auto one = [&](double d) {
+                FilmOptics at = f;
+                at.thickness_min_nm = at.thickness_max_nm = d;
+                return at;
+            };
+            const Rgbd want = midpoint_mean(k.min_nm, k.max_nm, 400000, [&](double d) {
+                return film_reflectance_exact(one(d), mu);
+            });
+            const Rgbd want_adobe = midpoint_mean(k.min_nm, k.max_nm, 400000, [&](double d) {
+                return openpbr_bsdf_film_reflectance(one(d), mu, bare);
+            });
+            const Rgbd got = film_reflectance_exact(f, mu);
+            const Rgbd got_adobe = openpbr_bsdf_film_reflectance(f, mu, bare);
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_NEAR(got[c], want[c], 1e-7)
+                    << "k " << k.k << " eta " << k.eta << " mu " << mu << " channel " << c;
+                EXPECT_NEAR(got_adobe[c], want_adobe[c], 1e-7)
+                    << "k " << k.k << " eta " << k.eta << " mu " << mu << " channel " << c;
+            }
+        }
+    }
+}
+
 // The bound on Belcour & Barla's sensitivity that decides where three.js's range mean is in
 // closed form: never below |S| (sampled every 0.02 nm of optical path over 0–8,000 nm, each of
 // the eight patterns of 0/π shifts, and from three starting paths on; a sample misses a peak by at
