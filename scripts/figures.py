@@ -628,17 +628,24 @@ def plan(study, ids, formats, script_id):
     return tasks
 
 
+class FigureError(Exception):
+    """A figure that could not be drawn from the study's files: its name and why."""
+
+
 def draw(task):
     name, kind, arg, _, _ = task
     formats = _FORMATS
-    if kind == "slice":
-        slice_figure(_STUDY, arg, formats)
-    elif kind == "colour":
-        colour_figure(_STUDY, arg, formats)
-    elif kind == "matrix":
-        error_matrix(_STUDY, formats, arg)
-    else:
-        albedo_figure(_STUDY, arg, formats)
+    try:
+        if kind == "slice":
+            slice_figure(_STUDY, arg, formats)
+        elif kind == "colour":
+            colour_figure(_STUDY, arg, formats)
+        elif kind == "matrix":
+            error_matrix(_STUDY, formats, arg)
+        else:
+            albedo_figure(_STUDY, arg, formats)
+    except Exception as e:  # a damaged or foreign file: named, not a traceback
+        raise FigureError(f"{name}: {type(e).__name__}: {e}") from None
     return name
 
 
@@ -707,4 +714,12 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except Exception as e:
+        # One line, as lamina's own errors: the study folder is damaged or not one lamina wrote
+        # (a truncated table, a hand-edited study.json, ...).
+        where = sys.argv[1] if len(sys.argv) > 1 else "."
+        what = str(e) if isinstance(e, FigureError) else f"{type(e).__name__}: {e}"
+        sys.exit(f"figures.py: {where}: cannot draw the figures from this study folder "
+                 f"({what}); rerun the study that wrote it")

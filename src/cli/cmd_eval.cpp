@@ -32,7 +32,8 @@ namespace {
 struct EvalArgs {
     std::string model, stack, theta_i, directions, out, grid = HemisphereGrid{}.to_string(),
                                                         side = "R";
-    double theta_o = std::nan(""), phi_o = std::nan(""), phi_i = 0.0;
+    double theta_o = 0.0, phi_o = 0.0, phi_i = 0.0;
+    bool theta_o_given = false, phi_o_given = false;  ///< whether --theta-o / --phi-o were given
     bool binned = false, pdf = false;
     /// The spectral settings shared with simulate (spectral, spectral_min_nm, spectral_max_nm).
     SimulationSettings spectral;
@@ -69,7 +70,7 @@ double parse_number(const std::string& text, const std::string& where, const std
 /// θ in degrees within [lo, hi) or [lo, hi] (closed_hi).
 void check_angle(double v, double lo, double hi, bool closed_hi, const std::string& where,
                  const std::string& field) {
-    if (v < lo || (closed_hi ? v > hi : v >= hi))
+    if (!(v >= lo && (closed_hi ? v <= hi : v < hi)))  // NaN too
         throw InputError(
             where, field,
             fmt::format("{} degrees is outside [{}, {}{}", v, lo, hi, closed_hi ? "]" : ")"));
@@ -150,6 +151,14 @@ int run_eval(const EvalArgs& a) {
                          "--binned and --directions are different modes; use one");
     if ((a.binned || !a.directions.empty()) && a.out.empty())
         throw InputError("command line", "--out", "this mode writes a CSV file: give --out");
+    if (modes == 1 && (a.theta_o_given || a.phi_o_given))
+        throw InputError("command line", a.theta_o_given ? "--theta-o" : "--phi-o",
+                         a.binned ? "--binned covers every outgoing direction: leave it out"
+                                  : "the directions come from the --directions file: leave it out");
+    if (modes == 0 && !a.out.empty())
+        throw InputError("command line", "--out",
+                         "a point evaluation prints its value; --out is for --binned and "
+                         "--directions");
 
     if (a.binned) {
         const std::vector<double> thetas = parse_incidences(
@@ -214,6 +223,7 @@ int run_eval(const EvalArgs& a) {
             check_incidence(r.ti, a.directions, where + ", theta_i");
             check_angle(r.pi, 0, 360, true, a.directions, where + ", phi_i");
             check_angle(r.to, 0, 90, true, a.directions, where + ", theta_o");
+            check_angle(r.po, -360, 360, true, a.directions, where + ", phi_o");
             rows.push_back(r);
         }
         const Stack stack = load_stack(a.stack);
@@ -234,10 +244,10 @@ int run_eval(const EvalArgs& a) {
     if (thetas.size() != 1)
         throw InputError("command line", "--theta-i",
                          "a point evaluation takes one angle (lists are for --binned)");
-    if (std::isnan(a.theta_o)) throw InputError("command line", "--theta-o", "required");
-    if (std::isnan(a.phi_o)) throw InputError("command line", "--phi-o", "required");
+    if (!a.theta_o_given) throw InputError("command line", "--theta-o", "required");
+    if (!a.phi_o_given) throw InputError("command line", "--phi-o", "required");
     check_angle(a.theta_o, 0, 90, true, "command line", "--theta-o");
-    if (!std::isfinite(a.phi_o)) throw InputError("command line", "--phi-o", "must be finite");
+    check_angle(a.phi_o, -360, 360, true, "command line", "--phi-o");
     const Side side = parse_side(a.side, "command line", "--side");
     const Stack stack = load_stack(a.stack);
     const auto model = make_eval_model(entry, options, stack, a);
@@ -276,8 +286,11 @@ Runner add_eval(CLI::App& app) {
                     "Incidence azimuth in degrees, [0, 360] (as simulate's); a non-zero one, or "
                     "an anisotropic stack, bins on the unfolded grid (phi over [0, 360))")
         ->capture_default_str();
-    cmd->add_option("--theta-o", a->theta_o, "Outgoing polar angle in degrees, [0, 90]");
-    cmd->add_option("--phi-o", a->phi_o, "Outgoing azimuth in degrees (mirror at 180)");
+    cmd->add_option("--theta-o", a->theta_o, "Outgoing polar angle in degrees, [0, 90]")
+        ->each([a](const std::string&) { a->theta_o_given = true; });
+    cmd->add_option("--phi-o", a->phi_o,
+                    "Outgoing azimuth in degrees, [-360, 360] (the mirror direction at 180)")
+        ->each([a](const std::string&) { a->phi_o_given = true; });
     cmd->add_option("--side", a->side, "R (reflection) or T (transmission; θo from -z)");
     cmd->add_option("--directions", a->directions,
                     "CSV of directions: header theta_i,theta_o,phi_o,side (the light at "

@@ -7,11 +7,13 @@
 #include "models/random_walk/random_walk_model.h"
 #include "models/registry.h"
 #include "render/contact_sheet.h"
+#include "render/image.h"
 #include "render/renderer.h"
 
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -40,6 +42,10 @@ void write_pair(const std::filesystem::path& png, const Image& img, double ev) {
 }
 
 int run_render(const RenderArgs& a) {
+    if (!(std::abs(a.exposure) <= kMaxExposureStops))  // NaN too
+        throw InputError("command line", "--exposure",
+                         fmt::format("{} stops is outside [-{:g}, {:g}]", a.exposure,
+                                     kMaxExposureStops, kMaxExposureStops));
     const Stack stack = load_stack(a.stack);
     Environment env = Environment::named(a.env);
     if (!a.light.empty()) env.sun = parse_directional_light(a.light);
@@ -73,10 +79,16 @@ int run_render(const RenderArgs& a) {
         const auto model = make_model(a.model, stack, options);
         if (!model->support().brdf)
             throw InputError(a.stack, "--model", "not supported: " + model->support().reason);
-        const Rendering r = render_sphere(*model, env, s);
         std::filesystem::path out = a.out;
         if (out.extension() != ".png") out += ".png";
-        if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
+        // The folder before the rendering, so that an --out that cannot be written fails now.
+        std::error_code ec;
+        if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path(), ec);
+        if (ec)
+            throw InputError(out.string(), "--out",
+                             fmt::format("cannot create its folder {}: {}",
+                                         out.parent_path().string(), ec.message()));
+        const Rendering r = render_sphere(*model, env, s);
         write_pair(out, r.image, a.exposure);
         fmt::print(stderr, "lamina render: {} in {:.1f} s -> {} (+ .exr)\n", a.model, r.seconds,
                    out.string());
@@ -110,7 +122,8 @@ Runner add_render(CLI::App& app) {
     cmd->add_option("--seed", a->seed, "Seed (images are reproducible for a seed)");
     cmd->add_option("--threads", a->threads, "Threads (default: all)")
         ->check(CLI::NonNegativeNumber);
-    cmd->add_option("--exposure", a->exposure, "Exposure in stops for the PNG (default 0)");
+    cmd->add_option("--exposure", a->exposure,
+                    "Exposure in stops for the PNG, [-40, 40] (default 0)");
     // The reference's transport (layers/transport_settings.h), but the numbers it keeps at their
     // defaults (random_walk_options).
     add_physics_option(cmd, a->transport);

@@ -57,6 +57,11 @@ Runner add_simulate(CLI::App& app) {
         Stack stack;
         std::string stack_text;
         std::unique_ptr<StagedOutput> probe;
+        if (a->mueller) {  // before DIR is made, as every check of the run's inputs
+            if (!s.transport.polarization)
+                throw InputError("command line", "--mueller", "needs --polarization on");
+            s.stokes_tallies = true;
+        }
         if (world.is_root()) {
             stack = load_stack(a->stack);
             validate_kernel_for(stack, s, a->stack);  // before DIR is made
@@ -87,11 +92,6 @@ Runner add_simulate(CLI::App& app) {
             progress = std::make_unique<Progress>(fmt::format("simulate {}", stack.name),
                                                   "particles", mine.count * s.theta_i_deg.size());
             on_progress = [&](std::uint64_t n) { progress->advance(n); };
-        }
-        if (a->mueller) {
-            if (!s.transport.polarization)
-                throw InputError("command line", "--mueller", "needs --polarization on");
-            s.stokes_tallies = true;
         }
         // --mueller: four runs (unpolarized, s-polarized, +45°, circular incident light;
         // simulator/mueller.h), the first of which gives the tables.

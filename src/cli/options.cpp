@@ -33,6 +33,9 @@ std::vector<double> parse_angle_list(const std::string& text, const std::string&
                 fmt::format("'{}' is not a number (expected degrees, e.g. 0,30,60)", item));
         out.push_back(v);
     }
+    if (!text.empty() && text.back() == ',')
+        throw InputError("command line", option,
+                         "the list ends with a comma (expected e.g. 0,30,60)");
     if (out.empty())
         throw InputError("command line", option, "expected at least one angle, e.g. 0,30,60");
     return out;
@@ -40,8 +43,7 @@ std::vector<double> parse_angle_list(const std::string& text, const std::string&
 
 std::vector<double> parse_incidences(const std::string& text, const std::string& option) {
     std::vector<double> out = parse_angle_list(text, option);
-    for (double t : out)
-        check_incidence(t, "command line", option);
+    check_incidence_list(out, "command line", option);
     return out;
 }
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <system_error>
@@ -23,16 +24,26 @@ std::string unique_suffix() {
     return fmt::format("{}.{}", ::getpid(), counter++);
 }
 
-void write_all(const fs::path& path, std::string_view content) {
+// Writes `path` (a temporary name) for the file `target`; errors name the target, the file the
+// user asked for.
+void write_all(const fs::path& path, const fs::path& target, std::string_view content) {
     std::FILE* f = std::fopen(path.c_str(), "wb");
-    if (!f) throw InputError(path.string(), "", "cannot open for writing");
+    if (!f) {
+        const int error = errno;
+        std::error_code ec;
+        const fs::path parent = target.parent_path().empty() ? "." : target.parent_path();
+        throw InputError(target.string(), "",
+                         !fs::is_directory(parent, ec)
+                             ? fmt::format("cannot write it: {} is not a folder", parent.string())
+                             : fmt::format("cannot write it: {}", std::strerror(error)));
+    }
     const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
     const bool flushed = std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
     const bool closed = std::fclose(f) == 0;
     if (!ok || !flushed || !closed) {
         std::error_code ec;
         fs::remove(path, ec);
-        throw InputError(path.string(), "", "write failed (disk full or not writable?)");
+        throw InputError(target.string(), "", "write failed (disk full or not writable?)");
     }
 }
 
@@ -41,12 +52,15 @@ void write_all(const fs::path& path, std::string_view content) {
 void write_file_atomic(const fs::path& path, std::string_view content) {
     const fs::path tmp =
         path.parent_path() / fmt::format(".{}.tmp-{}", path.filename().string(), unique_suffix());
-    write_all(tmp, content);
+    write_all(tmp, path, content);
     std::error_code ec;
     fs::rename(tmp, path, ec);
     if (ec) {
         fs::remove(tmp, ec);
-        throw InputError(path.string(), "", "cannot move the finished file into place");
+        throw InputError(path.string(), "",
+                         fs::is_directory(path, ec)
+                             ? "cannot write it: a folder of that name is there"
+                             : "cannot move the finished file into place");
     }
 }
 
@@ -95,7 +109,7 @@ StagedOutput::~StagedOutput() {
 }
 
 void StagedOutput::add(const std::string& name, std::string_view content) {
-    write_all(staging_ / name, content);
+    write_all(staging_ / name, dir_ / name, content);
     names_.push_back(name);
 }
 

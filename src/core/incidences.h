@@ -38,4 +38,18 @@ inline void check_incidence(double theta_i_deg, const std::string& where,
             fmt::format("{} is outside the allowed range [0, 90) degrees", theta_i_deg));
 }
 
+/// Checks a list of incidences in place: each in range (check_incidence), none given twice (a
+/// table holds one block per incidence); −0 becomes 0.
+inline void check_incidence_list(std::vector<double>& theta_i_deg, const std::string& where,
+                                 const std::string& field) {
+    for (std::size_t k = 0; k < theta_i_deg.size(); ++k) {
+        check_incidence(theta_i_deg[k], where, field);
+        theta_i_deg[k] += 0.0;  // −0 + 0 = +0
+        for (std::size_t m = 0; m < k; ++m)
+            if (theta_i_deg[m] == theta_i_deg[k])
+                throw InputError(where, field,
+                                 fmt::format("{} degrees is given twice", theta_i_deg[k]));
+    }
+}
+
 }  // namespace lamina

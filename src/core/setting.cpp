@@ -104,11 +104,13 @@ std::vector<double> SettingCodec<std::vector<double>>::from_text(const std::stri
             setting_detail::fail(
                 where, field,
                 fmt::format("'{}' is not a number (expected degrees, e.g. 0,30,60)", item));
-        check_incidence(v, where, field);
         out.push_back(v);
     }
+    if (!text.empty() && text.back() == ',')
+        setting_detail::fail(where, field, "the list ends with a comma (expected e.g. 0,30,60)");
     if (out.empty())
         setting_detail::fail(where, field, "expected at least one angle, e.g. 0,30,60");
+    check_incidence_list(out, where, field);
     return out;
 }
 
@@ -124,8 +126,8 @@ std::vector<double> SettingCodec<std::vector<double>>::from_json(const nlohmann:
     for (const nlohmann::json& v : j) {
         if (!v.is_number()) setting_detail::fail(where, field, "expected numbers (degrees)");
         out.push_back(v.get<double>());
-        check_incidence(out.back(), where, field);
     }
+    check_incidence_list(out, where, field);
     return out;
 }
 

@@ -676,48 +676,55 @@ class Reader {
 
 // ---- Parsing the text: duplicate keys and number overflow -----------------------------------
 
-/// Follows the parser through the document (nlohmann's parser callback) to know the JSON pointer
-/// of what it is reading. It rejects duplicate keys, which JSON parsers silently resolve to the
-/// last one, and names the field when a number overflows (1e999 is refused by the parser).
+/// Drops nlohmann's "[json.exception.parse_error.101] " prefix.
+std::string parser_message(const json::exception& e) {
+    std::string_view text = e.what();
+    if (const auto end = text.find("] "); text.starts_with("[json.exception.") && end != text.npos)
+        text.remove_prefix(end + 2);
+    return std::string(text);
+}
+
+/// Follows the document event by event (nlohmann's SAX interface) to know the JSON pointer of
+/// what it is reading. It rejects duplicate keys, which JSON parsers silently resolve to the last
+/// one, and names the field when a number overflows (1e999 is refused by the parser). A pass of
+/// its own before the document is built: nlohmann's parser with a callback (3.11) searches the
+/// enclosing array again at the end of each object, quadratic in the array's length (400 000
+/// objects: 27 s); this pass and the plain parse are linear.
 class PathTracker {
   public:
     explicit PathTracker(const std::string& where) : where_(where) {}
 
-    bool operator()(int depth, json::parse_event_t event, json& parsed) {
-        switch (event) {
-            case json::parse_event_t::object_start:
-            case json::parse_event_t::array_start:
-                // A stack file nests five levels deep (stack, layers, layer, interface, RGB
-                // array); far deeper is not a stack, and would only make messages unreadable.
-                if (depth >= kMaxDepth)
-                    throw InputError(where_, pending_pointer(),
-                                     fmt::format("JSON nested more than {} levels deep; a stack "
-                                                 "file needs five",
-                                                 kMaxDepth));
-                element_starts();
-                frames_.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
-                break;
-            case json::parse_event_t::object_end:
-            case json::parse_event_t::array_end:
-                frames_.pop_back();
-                break;
-            case json::parse_event_t::value:
-                element_starts();
-                break;
-            case json::parse_event_t::key: {
-                Frame& f = frames_.back();
-                f.key = parsed.get<std::string>();
-                if (!f.keys.insert(f.key).second)
-                    throw InputError(where_, pending_pointer(),
-                                     fmt::format("duplicate key \"{}\"; each key may appear once "
-                                                 "in an object (a parser would silently keep "
-                                                 "the last one)",
-                                                 f.key));
-                break;
-            }
-        }
+    bool null() { return value(); }
+    bool boolean(bool) { return value(); }
+    bool number_integer(json::number_integer_t) { return value(); }
+    bool number_unsigned(json::number_unsigned_t) { return value(); }
+    bool number_float(json::number_float_t, const json::string_t&) { return value(); }
+    bool string(json::string_t&) { return value(); }
+    bool binary(json::binary_t&) { return value(); }
+    bool start_object(std::size_t) { return starts(true); }
+    bool start_array(std::size_t) { return starts(false); }
+    bool end_object() { return ends(); }
+    bool end_array() { return ends(); }
+    bool key(json::string_t& key) {
+        Frame& f = frames_.back();
+        f.key = key;
+        if (!f.keys.insert(f.key).second)
+            throw InputError(where_, pending_pointer(),
+                             fmt::format("duplicate key \"{}\"; each key may appear once in an "
+                                         "object (a parser would silently keep the last one)",
+                                         f.key));
         return true;
     }
+    /// The parser's error (malformed text, or 406: a number beyond a double's range): kept for
+    /// parse_text, which names the field.
+    bool parse_error(std::size_t, const std::string&, const json::exception& e) {
+        error_id_ = e.id;
+        error_ = parser_message(e);
+        return false;
+    }
+
+    int error_id() const { return error_id_; }
+    const std::string& error() const { return error_; }
 
     /// The pointer of the value being read now (the one after the last key or array element).
     std::string pending_pointer() const {
@@ -740,39 +747,52 @@ class PathTracker {
         std::string key;
         std::size_t count;
     };
+    bool value() {
+        element_starts();
+        return true;
+    }
+    bool starts(bool is_object) {
+        // A stack file nests five levels deep (stack, layers, layer, interface, RGB array); far
+        // deeper is not a stack, and would only make messages unreadable.
+        if (frames_.size() >= std::size_t(kMaxDepth))
+            throw InputError(
+                where_, pending_pointer(),
+                fmt::format("JSON nested more than {} levels deep; a stack file needs five",
+                            kMaxDepth));
+        element_starts();
+        frames_.push_back({is_object, {}, {}, 0});
+        return true;
+    }
+    bool ends() {
+        frames_.pop_back();
+        return true;
+    }
     void element_starts() {
         if (!frames_.empty() && !frames_.back().is_object) ++frames_.back().count;
     }
 
     const std::string& where_;
     std::vector<Frame> frames_;
+    int error_id_ = 0;
+    std::string error_;
 };
-
-/// Drops nlohmann's "[json.exception.parse_error.101] " prefix.
-std::string parser_message(const json::exception& e) {
-    std::string_view text = e.what();
-    if (const auto end = text.find("] "); text.starts_with("[json.exception.") && end != text.npos)
-        text.remove_prefix(end + 2);
-    return std::string(text);
-}
 
 json parse_text(const std::string& text, const std::string& where) {
     PathTracker tracker(where);
-    try {
-        return json::parse(text, std::ref(tracker));
-    } catch (const json::parse_error& e) {
-        const std::string near = tracker.pending_pointer();
-        throw InputError(where, "",
-                         fmt::format("malformed JSON: {}{}", parser_message(e),
-                                     near.empty() ? "" : fmt::format(" (near {})", near)));
-    } catch (const json::out_of_range& e) {
-        // 406: a number literal beyond the range of a double, e.g. 1e999 (it would be infinite).
+    if (!json::sax_parse(text, &tracker)) {
         const std::string at = tracker.pending_pointer();
-        throw InputError(
-            where, at,
-            fmt::format("{}: not a finite number; allowed: finite numbers{}", parser_message(e),
-                        at.empty() ? " (the whole file is this number)" : ""));
-    } catch (const json::exception& e) {
+        if (tracker.error_id() == 406)  // a number literal beyond a double's range, e.g. 1e999
+            throw InputError(
+                where, at,
+                fmt::format("{}: not a finite number; allowed: finite numbers{}", tracker.error(),
+                            at.empty() ? " (the whole file is this number)" : ""));
+        throw InputError(where, "",
+                         fmt::format("malformed JSON: {}{}", tracker.error(),
+                                     at.empty() ? "" : fmt::format(" (near {})", at)));
+    }
+    try {
+        return json::parse(text);
+    } catch (const json::exception& e) {  // not expected: the same text passed the first pass
         throw InputError(where, "", fmt::format("malformed JSON: {}", parser_message(e)));
     }
 }
@@ -826,12 +846,22 @@ Stack load_stack(const std::filesystem::path& path) {
     if (!in)
         throw InputError(where, "",
                          fmt::format("cannot read the stack file: {}", std::strerror(errno)));
-    std::ostringstream text;
-    text << in.rdbuf();
+    // Read up to one byte past the limit: a stack file is a few kilobytes (tabulated spectra
+    // included), and a stream without end (/dev/zero, a pipe) must not be read forever.
+    std::string text;
+    char chunk[1 << 16];
+    while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
+        text.append(chunk, std::size_t(in.gcount()));
+        if (text.size() > kMaxStackFileBytes)
+            throw InputError(where, "",
+                             fmt::format("the file is larger than {} MiB; a stack file is a few "
+                                         "kilobytes",
+                                         kMaxStackFileBytes >> 20));
+    }
     if (in.bad())
         throw InputError(where, "",
                          fmt::format("cannot read the stack file: {}", std::strerror(errno)));
-    return parse_stack(text.str(), where);
+    return parse_stack(text, where);
 }
 
 Stack parse_stack(const std::string& text, const std::string& where) {

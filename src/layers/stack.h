@@ -210,8 +210,12 @@ Stack stack_from_json(const nlohmann::json& j, const std::string& where);
 /// InputErrors as load_stack, also for JSON nested deeper than 32 levels.
 Stack parse_stack(const std::string& text, const std::string& where);
 
-/// Reads and parses a stack file. InputError also on a missing or unreadable file, malformed JSON
-/// (with line and column), duplicate keys, and numbers that overflow a double (1e999).
+/// The largest stack file load_stack reads (16 MiB).
+inline constexpr std::size_t kMaxStackFileBytes = std::size_t(16) << 20;
+
+/// Reads and parses a stack file. InputError also on a missing or unreadable file, one larger
+/// than kMaxStackFileBytes (or without end, as /dev/zero), malformed JSON (with line and column),
+/// duplicate keys, and numbers that overflow a double (1e999).
 Stack load_stack(const std::filesystem::path& path);
 
 /// The same stack seen from below (z flipped), for light that meets a transmitting stack from

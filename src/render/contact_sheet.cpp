@@ -1,5 +1,6 @@
 #include "render/contact_sheet.h"
 
+#include "core/error.h"
 #include "core/math.h"
 
 #include "models/registry.h"
@@ -196,7 +197,12 @@ std::string write_comparison(const Stack& stack, const Environment& env,
     s.lobe_alpha = lobe_alpha_for(stack);
     s.brushed = brushed_for(stack);
     s.transparent = false;  // the models render the BRDF only: compare like with like
-    std::filesystem::create_directories(dir);
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec || !std::filesystem::is_directory(dir, ec))
+        throw InputError(dir.string(), "--out",
+                         fmt::format("cannot create the folder: {}",
+                                     ec ? ec.message() : "a file of that name is there"));
     auto write_pair = [&](const std::string& name, const Image& img) {
         write_png(dir / (name + ".png"), img, exposure_ev);
         write_exr(dir / (name + ".exr"), img);

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -64,10 +65,16 @@ DirectionalLight parse_directional_light(const std::string& text) {
         throw InputError("command line", "--light",
                          "expected x,y,z,E or x,y,z,Er,Eg,Eb (direction towards the light, "
                          "irradiance)");
-    const Vec3d d(v[0], v[1], v[2]);
-    if (length(d) == 0) throw InputError("command line", "--light", "the direction is zero");
+    // The direction scaled by its largest component first: its length then neither overflows
+    // (1e200 components) nor underflows (1e-200).
+    const double largest = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+    if (largest == 0) throw InputError("command line", "--light", "the direction is zero");
+    const Vec3d d = Vec3d(v[0], v[1], v[2]) / largest;
     const Rgbd E = v.size() == 4 ? Rgbd(v[3]) : Rgbd(v[3], v[4], v[5]);
-    if (E.min() < 0) throw InputError("command line", "--light", "irradiance must be ≥ 0");
+    if (E.min() < 0 || E.max() > kMaxLightIrradiance)
+        throw InputError("command line", "--light",
+                         fmt::format("irradiance must be in [0, {:g}] (the image's scale)",
+                                     kMaxLightIrradiance));
     return {normalize(d), E};
 }
 

@@ -43,7 +43,12 @@ struct Environment {
     static Environment named(const std::string& name);
 };
 
-/// Parses "x,y,z,E" (direction towards the light, irradiance E, or E_r,E_g,E_b) for --light.
+/// The largest irradiance --light takes: the environments' radiance is of order 1, and a pixel
+/// of a sharp lobe (f ~ 10⁶ /sr) lit by it stays far inside float's range in the EXR.
+inline constexpr double kMaxLightIrradiance = 1e6;
+
+/// Parses "x,y,z,E" (direction towards the light, irradiance E, or E_r,E_g,E_b) for --light:
+/// finite numbers, a non-zero direction (of any scale), 0 ≤ E ≤ kMaxLightIrradiance.
 DirectionalLight parse_directional_light(const std::string& text);
 
 }  // namespace lamina

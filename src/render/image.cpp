@@ -21,7 +21,9 @@
 namespace lamina {
 
 std::uint8_t tone_map_channel(double linear, double exposure_ev) {
-    const double x = std::max(0.0, linear) * std::exp2(exposure_ev);
+    // Above 10⁶ the fit is past white (its limit is 2.51 / 2.43 > 1); the cap keeps x² finite.
+    // NaN (not ≥ 0) maps to black.
+    const double x = linear >= 0 ? std::min(linear * std::exp2(exposure_ev), 1e6) : 0.0;
     // Narkowicz 2015: (x(2.51x + 0.03)) / (x(2.43x + 0.59) + 0.14), clamped to [0, 1].
     const double y = std::clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
     const double s = y <= 0.0031308 ? 12.92 * y : 1.055 * std::pow(y, 1 / 2.4) - 0.055;

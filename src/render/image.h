@@ -23,7 +23,10 @@ struct Image {
     const Rgbf& at(int x, int y) const { return pixels[std::size_t(y) * width + x]; }
 };
 
-/// 8-bit sRGB of a linear value after exposure and the ACES fit.
+/// The exposures --exposure takes, in stops: ±40 is a factor of 10¹², past any image's range.
+inline constexpr double kMaxExposureStops = 40;
+
+/// 8-bit sRGB of a linear value after exposure and the ACES fit (any input: NaN and ∞ too).
 std::uint8_t tone_map_channel(double linear, double exposure_ev);
 
 /// Writes `image` tone-mapped (exposure_ev) as an 8-bit RGB PNG; an already display-referred

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -256,6 +257,13 @@ std::vector<StudyConfiguration> preset_configurations(const std::string& preset)
     return out;
 }
 
+namespace {
+bool has_control_character(const std::string& text) {
+    return std::any_of(text.begin(), text.end(),
+                       [](char ch) { return (unsigned char)ch < 0x20 || ch == 0x7f; });
+}
+}  // namespace
+
 std::vector<StudyConfiguration> load_configurations(const std::filesystem::path& path) {
     const std::string where = path.string();
     std::ifstream in(path);
@@ -290,10 +298,13 @@ std::vector<StudyConfiguration> load_configurations(const std::filesystem::path&
             throw InputError(where, at + "/id", "a string id is required");
         StudyConfiguration c;
         c.id = item["id"].get<std::string>();
-        if (c.id.empty() || c.id.find_first_of("/\\ \t\n") != std::string::npos || c.id[0] == '.')
+        // An id names a folder, a CSV cell and an --only item; a category a CSV cell and a
+        // heading: neither may hold what would split or end them.
+        if (c.id.empty() || c.id.find_first_of("/\\ ,\"") != std::string::npos ||
+            has_control_character(c.id) || c.id[0] == '.')
             throw InputError(where, at + "/id",
-                             fmt::format("'{}' is not usable as a file name (no spaces, slashes, "
-                                         "or leading dot)",
+                             fmt::format("'{}' is not usable as an id (no spaces, slashes, commas, "
+                                         "quotes, control characters or leading dot)",
                                          c.id));
         if (!ids.insert(c.id).second)
             throw InputError(where, at + "/id", fmt::format("'{}' appears twice", c.id));
@@ -302,6 +313,12 @@ std::vector<StudyConfiguration> load_configurations(const std::filesystem::path&
             if (!item["category"].is_string())
                 throw InputError(where, at + "/category", "must be a string");
             c.category = item["category"].get<std::string>();
+            if (c.category.empty() || c.category.find_first_of(",\"") != std::string::npos ||
+                has_control_character(c.category))
+                throw InputError(where, at + "/category",
+                                 fmt::format("'{}' is not usable as a category (not empty; no "
+                                             "commas, quotes or control characters)",
+                                             c.category));
         }
         if (!item.contains("stack")) throw InputError(where, at + "/stack", "a stack is required");
         try {

@@ -70,6 +70,68 @@ check_says theta-not-a-number 1 "lamina: command line: --theta-i: 'abc' is not a
     "$lamina" simulate "$src/examples/plastic.json" --theta-i abc --out "$tmp/never"
 check no-output-on-error 1 test -e "$tmp/never"
 check help-still-works 0 "$lamina" eval --help
+# Angles and values past their ranges are refused by name, never evaluated into NaN or infinity.
+P="$src/examples/plastic.json"
+check_says eval-phi-o-huge 1 "--phi-o: 1e+308 degrees is outside [-360, 360]" \
+    "$lamina" eval --model ww09 --stack "$P" --theta-i 30 --theta-o 30 --phi-o 1e308
+check_says eval-theta-o-nan 1 "--theta-o: nan degrees is outside [0, 90]" \
+    "$lamina" eval --model ww09 --stack "$P" --theta-i 30 --theta-o nan --phi-o 0
+printf 'theta_i,theta_o,phi_o,side\n30,30,1e308,R\n' >"$tmp/far.csv"
+check_says eval-directions-phi-o 1 "line 2, phi_o: 1e+308 degrees is outside [-360, 360]" \
+    "$lamina" eval --model ww09 --stack "$P" --directions "$tmp/far.csv" --out "$tmp/far-out.csv"
+check eval-directions-writes-nothing 1 test -e "$tmp/far-out.csv"
+check_says eval-binned-theta-o 1 "--theta-o: --binned covers every outgoing direction" \
+    "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --theta-o 30 --out "$tmp/b.csv"
+check_says eval-point-out 1 "--out: a point evaluation prints its value" \
+    "$lamina" eval --model ww09 --stack "$P" --theta-i 30 --theta-o 30 --phi-o 0 --out "$tmp/p.csv"
+check_says render-exposure-nan 1 "--exposure: nan stops is outside [-40, 40]" \
+    "$lamina" render "$P" --size 8 --spp 1 --exposure nan --out "$tmp/never.png"
+check_says render-light-huge 1 "--light: irradiance must be in [0, 1e+06]" \
+    "$lamina" render "$P" --size 8 --spp 1 --light 0,0,1,1e40 --out "$tmp/never.png"
+check no-render-on-error 1 test -e "$tmp/never.png"
+# A far direction is only scaled: the light is the same as from (0, 0, 1), bit for bit.
+check render-light-far 0 "$lamina" render "$P" --size 8 --spp 1 --threads 1 --env dark \
+    --light 0,0,1e200,2 --out "$tmp/far.png"
+check render-light-near 0 "$lamina" render "$P" --size 8 --spp 1 --threads 1 --env dark \
+    --light 0,0,1,2 --out "$tmp/near.png"
+check render-light-scaled 0 cmp "$tmp/far.exr" "$tmp/near.exr"
+# Each incidence once (a table holds one block per incidence), in every command; no empty item.
+check_says simulate-theta-twice 1 "--theta-i: 30 degrees is given twice" \
+    "$lamina" simulate "$P" --theta-i 30,30 --particles 1000 --out "$tmp/twice"
+check simulate-theta-twice-writes-nothing 1 test -e "$tmp/twice"
+check_says eval-theta-twice 1 "--theta-i: 30 degrees is given twice" \
+    "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30,30 --out "$tmp/twice.csv"
+check_says simulate-theta-trailing-comma 1 "--theta-i: the list ends with a comma" \
+    "$lamina" simulate "$P" --theta-i 30, --particles 1000 --out "$tmp/twice"
+# --mueller's refusals come before the output folder is made.
+check_says mueller-unpolarized 1 "--mueller: needs --polarization on" \
+    "$lamina" simulate "$P" --mueller --polarization off --particles 1000 --out "$tmp/mueller-off"
+check mueller-unpolarized-writes-nothing 1 test -e "$tmp/mueller-off"
+check_says mueller-spectral 1 "Mueller tables are tabulated per RGB channel" \
+    "$lamina" simulate "$P" --mueller --spectral on --particles 1000 --out "$tmp/mueller-spectral"
+check mueller-spectral-writes-nothing 1 test -e "$tmp/mueller-spectral"
+# An --out that cannot be written is named, with the reason, before any work.
+: >"$tmp/afile"
+check_says render-out-under-file 1 "x.png: --out: cannot create its folder" \
+    "$lamina" render "$P" --size 8 --spp 1 --out "$tmp/afile/x.png"
+check_says eval-out-under-file 1 "$tmp/afile/x.csv: cannot write it: $tmp/afile is not a folder" \
+    "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --grid 9x9 --out "$tmp/afile/x.csv"
+mkdir -p "$tmp/adir.csv"
+check_says eval-out-is-folder 1 "adir.csv: cannot write it: a folder of that name is there" \
+    "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --grid 9x9 --out "$tmp/adir.csv"
+# A stack file without end, or past 16 MiB, is refused without being read to its end.
+check_says validate-endless 1 "the file is larger than 16 MiB" "$lamina" validate /dev/zero
+# A table read back (--model-table) holds BSDF values: ≥ 0 and below 1e12 (1/sr).
+"$lamina" eval --model ww09 --stack "$P" --binned --grid 9x9 --theta-i 30 --out "$tmp/mt.csv"
+awk -F, 'BEGIN { OFS = "," } NR == 2 { $7 = "1e308" } { print }' "$tmp/mt.csv" >"$tmp/mt-huge.csv"
+check_says model-table-huge 1 "line 2, column 7: the value 1e+308 is outside [0, 1e+12]" \
+    "$lamina" compare "$P" --particles 1000 --theta-i 30 --grid 9x9 --models ww09 \
+    --model-table "fit=$tmp/mt-huge.csv" --out "$tmp/mt-compare"
+# A configuration's id and category become folder names and CSV cells: no commas or quotes.
+printf '{"configurations": [{"id": "a", "category": "x,y", "stack": {"layers": [{"interface": {"type": "lambertian", "albedo": 0.5}}]}}]}' >"$tmp/comma.json"
+check_says configs-category-comma 1 "/configurations/0/category: 'x,y' is not usable as a category" \
+    "$lamina" study --configs "$tmp/comma.json" --particles 1000 --theta-i 30 --grid 9x9 --out "$tmp/comma"
+check configs-category-writes-nothing 1 test -e "$tmp/comma"
 
 # validate: every example is valid and described on one line.
 for example in "$src"/examples/*.json; do

@@ -68,6 +68,15 @@ if [ "$(id -u)" -ne 0 ]; then  # root writes anywhere: the check means nothing t
     chmod u+w "$study"
     ok test $rc -eq 1
 fi
+# A damaged study folder (a hand-edited study.json) is one named error, not a traceback.
+damaged="$build/figures-damaged"
+rm -rf "$damaged"
+cp -r "$study" "$damaged"
+echo '{' >"$damaged/study.json"
+out=$("$lamina" figures "$damaged" 2>&1); rc=$?
+ok test $rc -eq 1
+ok grep -q "cannot draw the figures from this study folder (JSONDecodeError" <<<"$out"
+ok test "$(grep -c Traceback <<<"$out")" -eq 0
 # An unfolded configuration (brushed: anisotropic, lit from φi = 0°, 45°, 90°) of a tiny real
 # study: its slices (the plane φ = φi of each azimuth), albedo panel and error-matrix row are drawn.
 brushed="$build/figures-brushed"
