@@ -3,6 +3,7 @@
 #include "cli/commands.h"
 #include "cli/parse_errors.h"
 #include "core/error.h"
+#include "core/setting.h"
 #include "distributed/communicator.h"
 #include "lamina/version.h"
 #include "simulator/kernel_simd.h"
@@ -76,6 +77,12 @@ int run(int argc, char** argv) {
             return run();
         }
     } catch (const lamina::InputError& e) {
+        // A setting refused by the library (where "settings", the field its snake_case name) is
+        // the command line's option here.
+        if (e.where() == "settings")
+            return fail(
+                lamina::InputError("command line", lamina::option_name(e.field()), e.problem())
+                    .what());
         return fail(e.what());
     } catch (const std::exception& e) {
         return fail(fmt::format("error: {}", e.what()));

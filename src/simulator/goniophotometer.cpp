@@ -166,6 +166,10 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
                                          "particle carries three wavelengths a third of the "
                                          "range apart)",
                                          settings.spectral_bins));
+        if (!(settings.spectral_max_nm > settings.spectral_min_nm))
+            throw InputError("settings", "spectral_max_nm",
+                             fmt::format("{} nm is not above the shortest wavelength ({} nm)",
+                                         settings.spectral_max_nm, settings.spectral_min_nm));
         if (settings.spectral_max_nm - settings.spectral_min_nm < settings.spectral_bins)
             throw InputError("settings", "spectral_max_nm",
                              fmt::format("the range [{}, {}] nm is narrower than one nm per "

@@ -290,6 +290,13 @@ check_says simulate-spectral-scattering-simd 0 '"kernel_description": "simd' \
     --particles 1000 --out '$tmp/spectral-scattering' > /dev/null && cat '$tmp/spectral-scattering/result.json'"
 check_says simulate-spectral-bins 1 "multiple of 3" "$lamina" simulate "$src/examples/plastic.json" \
     --spectral on --spectral-bins 10 --theta-i 0 --particles 1000 --out "$tmp/spectral-bins"
+check_says simulate-spectral-bins-option 1 "command line: --spectral-bins: got 31" \
+    "$lamina" simulate "$src/examples/plastic.json" --spectral on --spectral-bins 31 --theta-i 0 \
+    --particles 1000 --out "$tmp/spectral-bins"
+check_says simulate-spectral-reversed 1 "--spectral-max-nm: 400 nm is not above the shortest wavelength (700 nm)" \
+    "$lamina" simulate "$src/examples/plastic.json" --spectral on --spectral-min-nm 700 \
+    --spectral-max-nm 400 --theta-i 0 --particles 1000 --out "$tmp/spectral-bins"
+check spectral-refusals-write-nothing 1 test -e "$tmp/spectral-bins"
 # A model on a spectral stack: its linear sRGB from per-wavelength models (--spectral auto, as
 # simulate's); the random walk stays in the RGB mode and says so when asked for spectra.
 check eval-spectral 0 "$lamina" eval --model openpbr --stack "$src/examples/gold-under-coat.json" \
