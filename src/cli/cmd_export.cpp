@@ -50,11 +50,7 @@ struct ExportArgs {
 };
 
 std::string read_text(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path.string(), "", "cannot read the file");
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
+    return read_file_bounded(path, kMaxTableFileBytes, "the file");
 }
 
 nlohmann::json read_json(const std::filesystem::path& path) {

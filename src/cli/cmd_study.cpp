@@ -93,9 +93,9 @@ ExternalModel model_table(const std::string& assignment) {
             }
             throw InputError(path, "--model-table", "cannot read the file");
         }
-        std::ostringstream text;
-        text << in.rdbuf();
-        return BinnedTable::from_csv(text.str(), path);
+        in.close();
+        return BinnedTable::from_csv(read_file_bounded(path, kMaxTableFileBytes, "the table"),
+                                     path);
     };
     return m;
 }
@@ -131,10 +131,17 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
         for (std::string m; std::getline(ss, m, ',');)
             if (!m.empty()) s.models.push_back(m);
     }
-    for (const std::string& assignment : a.model_tables)
+    // Their names are cells of metrics.csv and legends.
+    for (const std::string& assignment : a.model_tables) {
         s.external_models.push_back(model_table(assignment));
-    for (const std::string& assignment : a.model_plugins)
+        check_study_label(s.external_models.back().name, "model name", "command line",
+                          "--model-table");
+    }
+    for (const std::string& assignment : a.model_plugins) {
         s.external_models.push_back(model_plugin(assignment));
+        check_study_label(s.external_models.back().name, "model name", "command line",
+                          "--model-plugin");
+    }
     return s;
 }
 

@@ -1,5 +1,6 @@
 #include "cli/model_plugin.h"
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 
 #include <fmt/format.h>
@@ -80,10 +81,8 @@ BinnedTable plugin_table(const std::string& file, const std::string& python,
                          fmt::format("the Python model failed on {} (exit status {}; its "
                                      "message is above; interpreter: {})",
                                      c.id, rc, python));
-    std::ifstream in(dir / "table.csv", std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return BinnedTable::from_csv(text.str(), file);
+    return BinnedTable::from_csv(
+        read_file_bounded(dir / "table.csv", kMaxTableFileBytes, "the Python model's table"), file);
 }
 
 }  // namespace

@@ -64,6 +64,39 @@ void write_file_atomic(const fs::path& path, std::string_view content) {
     }
 }
 
+std::string read_file_bounded(const fs::path& path, std::size_t max_bytes, std::string_view what) {
+    const std::string where = path.string();
+    std::error_code ec;
+    if (!fs::exists(path, ec))
+        throw InputError(where, "", fmt::format("cannot read {}: no such file", what));
+    if (fs::is_directory(path, ec))
+        throw InputError(where, "", fmt::format("cannot read {}: it is a directory", what));
+    constexpr std::size_t kStreamBytes = std::size_t(16) << 20;
+    const std::size_t limit =
+        fs::is_regular_file(path, ec) ? max_bytes : std::min(max_bytes, kStreamBytes);
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f)
+        throw InputError(where, "", fmt::format("cannot read {}: {}", what, std::strerror(errno)));
+    std::string text;
+    std::vector<char> chunk(1 << 16);
+    bool too_large = false;
+    for (std::size_t n; (n = std::fread(chunk.data(), 1, chunk.size(), f)) > 0;) {
+        if (text.size() + n > limit) {
+            too_large = true;
+            break;
+        }
+        text.append(chunk.data(), n);
+    }
+    const bool failed = std::ferror(f) != 0;
+    std::fclose(f);
+    if (too_large)
+        throw InputError(where, "",
+                         fmt::format("{} holds more than {} MiB{}", what, limit >> 20,
+                                     limit < max_bytes ? " (it is not a regular file)" : ""));
+    if (failed) throw InputError(where, "", fmt::format("cannot read {}", what));
+    return text;
+}
+
 bool file_holds(const fs::path& path, std::string_view content) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) != content.size() || ec)

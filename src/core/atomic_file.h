@@ -9,6 +9,16 @@
 
 namespace lamina {
 
+/// The whole content of the file at `path`, read as `what` (named in errors, e.g. "the stack
+/// file"): InputError naming the path when it cannot be read (missing, a folder) or holds more
+/// than max_bytes. A file that is not a regular one (a device such as /dev/zero, a pipe) is read
+/// no further than 16 MiB, so that a stream without end is refused rather than read forever.
+std::string read_file_bounded(const std::filesystem::path& path, std::size_t max_bytes,
+                              std::string_view what);
+
+/// 2 GiB: the largest table (brdf.csv, a .bsdf tensor file) lamina reads.
+inline constexpr std::size_t kMaxTableFileBytes = std::size_t(2) << 30;
+
 /// Writes `content` to `path` atomically. Throws InputError naming the path on failure; the
 /// temporary file is removed and any previous `path` is left untouched.
 void write_file_atomic(const std::filesystem::path& path, std::string_view content);

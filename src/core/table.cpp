@@ -110,16 +110,18 @@ BinnedTable BinnedTable::from_csv(const std::string& text, const std::string& wh
               int(std::lround(phi_lo / 180.0 * n_phi)),
               Rgbd(num(6), num(7), num(8)),
               Rgbd(num(9), num(10), num(11))};
-        // A bin average of a BSDF is ≥ 0 and below 10¹² /sr: all of the energy in the smallest
-        // bin of the finest grid read (3600 × 3600, Ω⊥ ≈ 1.7·10⁻¹⁰ sr) is ≈ 6·10⁹. A larger
-        // value is a broken table, and its square would overflow the metrics.
+        // A bin average of a BSDF is below 10¹² /sr: all of the energy in the smallest bin of
+        // the finest grid read (3600 × 3600, Ω⊥ ≈ 1.7·10⁻¹⁰ sr) is ≈ 6·10⁹. A larger value is a
+        // broken table, and its square would overflow the metrics. Values may be negative: a
+        // spectral run's linear sRGB is (docs/formats.md); standard errors may not.
         for (int c = 0; c < 6; ++c) {
             const double v = c < 3 ? r.f[c] : r.se[c - 3];
-            if (!(v >= 0 && v <= kMaxBinValue))
+            const double lo = c < 3 ? -kMaxBinValue : 0.0;
+            if (!(v >= lo && v <= kMaxBinValue))
                 throw InputError(
                     where, fmt::format("line {}, column {}", line_no, 7 + c),
-                    fmt::format("{} {} is outside [0, {:g}] (1/sr)",
-                                c < 3 ? "the value" : "the standard error", v, kMaxBinValue));
+                    fmt::format("{} {} is outside [{:g}, {:g}] (1/sr)",
+                                c < 3 ? "the value" : "the standard error", v, lo, kMaxBinValue));
         }
         if (!incidence_in_range(r.theta_i))
             throw InputError(where, fmt::format("line {}, column 1", line_no),

@@ -46,7 +46,8 @@ struct BinnedTable {
     /// The CSV text of the table (`brdf.csv` format), full round-trip precision.
     std::string to_csv() const;
     /// Reads a table written by to_csv (InputError naming `where`, the line and the column):
-    /// values and standard errors finite, in [0, kMaxBinValue].
+    /// values finite with |f| ≤ kMaxBinValue (a spectral run's sRGB may be negative), standard
+    /// errors in [0, kMaxBinValue].
     static BinnedTable from_csv(const std::string& text, const std::string& where);
 };
 

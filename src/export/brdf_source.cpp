@@ -60,8 +60,11 @@ BrdfSource table_brdf(const BinnedTable& table, const std::string& name, const s
         const int i1 = std::min(i0 + 1, g.n_theta() - 1), j1 = std::min(j0 + 1, g.n_phi() - 1);
         const double s = x - i0, u = y - j0;
         auto at = [&](int i, int j) { return lobe.f[std::size_t(i) * g.n_phi() + j]; };
-        return (at(i0, j0) * (1 - u) + at(i0, j1) * u) * (1 - s) +
-               (at(i1, j0) * (1 - u) + at(i1, j1) * u) * s;
+        const Rgbd f = (at(i0, j0) * (1 - u) + at(i0, j1) * u) * (1 - s) +
+                       (at(i1, j0) * (1 - u) + at(i1, j1) * u) * s;
+        // A spectral run's linear sRGB may be negative in a bin (docs/formats.md); a BRDF file
+        // holds none.
+        return Rgbd(std::max(f[0], 0.0), std::max(f[1], 0.0), std::max(f[2], 0.0));
     };
     return out;
 }

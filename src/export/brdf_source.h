@@ -32,7 +32,8 @@ BrdfSource model_brdf(std::shared_ptr<const Model> model, const Stack& stack,
 
 /// A binned table's reflection side as a continuous BRDF at its incidences: f(wi, wo) bilinear in
 /// (θo, φo) between the bins' centres (clamped to the edge centres), at the table's incidence
-/// nearest θi. InputError naming `where` when the table has no reflection side, or when it is
+/// nearest θi, negative values (a spectral run's linear sRGB in a bin few particles reached) read
+/// as 0. InputError naming `where` when the table has no reflection side, or when it is
 /// unfolded (an anisotropic stack or light from φi ≠ 0): it holds one φi, and a BRDF file needs
 /// every one.
 BrdfSource table_brdf(const BinnedTable& table, const std::string& name, const std::string& where);

@@ -1,5 +1,6 @@
 #include "export/tensor_file.h"
 
+#include "core/atomic_file.h"
 #include "core/check.h"
 #include "core/error.h"
 #include "export/bytes.h"
@@ -159,11 +160,8 @@ TensorFile parse_tensor_file(const std::string& bytes, const std::string& where)
 }
 
 TensorFile read_tensor_file(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path.string(), "", "cannot read the file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parse_tensor_file(text.str(), path.string());
+    return parse_tensor_file(read_file_bounded(path, kMaxTableFileBytes, "the file"),
+                             path.string());
 }
 
 }  // namespace lamina

@@ -7,6 +7,7 @@
 // default.
 #include "layers/stack.h"
 
+#include "core/atomic_file.h"
 #include "core/check.h"
 #include "core/error.h"
 
@@ -836,32 +837,10 @@ Stack stack_from_json(const nlohmann::json& j, const std::string& where) {
 }
 
 Stack load_stack(const std::filesystem::path& path) {
-    const std::string where = path.string();
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec))
-        throw InputError(where, "", "cannot read the stack file: no such file");
-    if (std::filesystem::is_directory(path, ec))
-        throw InputError(where, "", "cannot read the stack file: it is a directory");
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw InputError(where, "",
-                         fmt::format("cannot read the stack file: {}", std::strerror(errno)));
-    // Read up to one byte past the limit: a stack file is a few kilobytes (tabulated spectra
-    // included), and a stream without end (/dev/zero, a pipe) must not be read forever.
-    std::string text;
-    char chunk[1 << 16];
-    while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
-        text.append(chunk, std::size_t(in.gcount()));
-        if (text.size() > kMaxStackFileBytes)
-            throw InputError(where, "",
-                             fmt::format("the file is larger than {} MiB; a stack file is a few "
-                                         "kilobytes",
-                                         kMaxStackFileBytes >> 20));
-    }
-    if (in.bad())
-        throw InputError(where, "",
-                         fmt::format("cannot read the stack file: {}", std::strerror(errno)));
-    return parse_stack(text, where);
+    // A stack file is a few kilobytes (tabulated spectra included); a stream without end
+    // (/dev/zero, a pipe) must not be read forever.
+    return parse_stack(read_file_bounded(path, kMaxStackFileBytes, "the stack file"),
+                       path.string());
 }
 
 Stack parse_stack(const std::string& text, const std::string& where) {

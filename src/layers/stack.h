@@ -210,7 +210,7 @@ Stack stack_from_json(const nlohmann::json& j, const std::string& where);
 /// InputErrors as load_stack, also for JSON nested deeper than 32 levels.
 Stack parse_stack(const std::string& text, const std::string& where);
 
-/// The largest stack file load_stack reads (16 MiB).
+/// The largest stack file load_stack reads (16 MiB; core/atomic_file.h, read_file_bounded).
 inline constexpr std::size_t kMaxStackFileBytes = std::size_t(16) << 20;
 
 /// Reads and parses a stack file. InputError also on a missing or unreadable file, one larger

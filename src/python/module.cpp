@@ -44,6 +44,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -54,7 +55,36 @@ namespace {
 
 PyObject* g_input_error = nullptr;  // lamina.InputError, a subclass of ValueError
 
-nlohmann::json json_of(py::handle obj) {
+/// Where in `o` (dicts, lists, tuples, numpy values) the first NaN or infinity is, as a JSON
+/// pointer from `at`; empty if nowhere.
+std::string non_finite_at(py::handle o, const std::string& at) {
+    if (py::isinstance<py::float_>(o)) return std::isfinite(o.cast<double>()) ? "" : at;
+    if (py::isinstance<py::dict>(o)) {
+        for (const auto& [key, value] : o.cast<py::dict>())
+            if (std::string r = non_finite_at(value, at + "/" + py::str(key).cast<std::string>());
+                !r.empty())
+                return r;
+        return "";
+    }
+    if (py::isinstance<py::list>(o) || py::isinstance<py::tuple>(o)) {
+        std::size_t i = 0;
+        for (py::handle value : o)
+            if (std::string r = non_finite_at(value, at + "/" + std::to_string(i++)); !r.empty())
+                return r;
+        return "";
+    }
+    if (py::hasattr(o, "tolist") && !py::isinstance<py::str>(o))
+        return non_finite_at(o.attr("tolist")(), at);
+    return "";
+}
+
+/// `obj` as JSON; a NaN or infinity in it is an InputError naming `where` and its place.
+nlohmann::json json_of(py::handle obj, const std::string& where = "arguments") {
+    // A stack dict's place as a JSON pointer (/layers/0/interface/eta); an argument's by its
+    // name (theta_i/0), as the other argument errors.
+    if (const std::string at = non_finite_at(obj, ""); !at.empty())
+        throw InputError(where, where == "arguments" ? at.substr(1) : at,
+                         "not a finite number; allowed: finite numbers");
     const py::object dumps = py::module_::import("json").attr("dumps");
     // numpy arrays and scalars as lists and numbers; tuples are lists already.
     const py::cpp_function plain([](py::handle o) -> py::object {
@@ -72,7 +102,8 @@ py::object python_of(const nlohmann::json& j) {
 /// A Stack, a dict in the stack format (docs/stack-format.md) or a path to a stack file.
 Stack stack_of(py::handle source) {
     if (py::isinstance<Stack>(source)) return source.cast<Stack>();
-    if (py::isinstance<py::dict>(source)) return stack_from_json(json_of(source), "<dict>");
+    if (py::isinstance<py::dict>(source))
+        return stack_from_json(json_of(source, "<dict>"), "<dict>");
     const py::object os = py::module_::import("os");
     if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__"))
         return load_stack(os.attr("fspath")(source).cast<std::string>());
@@ -349,15 +380,23 @@ BinnedTable table_from_arrays(py::array_t<double, py::array::c_style | py::array
         if (side != "R" && side != "T") throw InputError("arguments", "sides", "'R' or 'T'");
         (side == "R" ? r : t) = true;
     }
-    if (sides.size() == 2 && sides[0] != "R")
-        throw InputError("arguments", "sides", "use the order ['R', 'T']");
+    if (sides.size() == 2 && !(sides[0] == "R" && sides[1] == "T"))
+        throw InputError("arguments", "sides", "use ['R'], ['T'] or ['R', 'T'] (in that order)");
+    // As a table read from its CSV: each θi in [0, 90), once on a folded grid (an unfolded table
+    // may hold one θi at several azimuths, the incidences of a brushed configuration).
+    std::vector<double> incidences = theta_i;
+    if (unfolded)
+        for (double t : incidences)
+            check_incidence(t, "arguments", "theta_i");
+    else
+        check_incidence_list(incidences, "arguments", "theta_i");
     if (unfolded && f.shape(3) % 2 != 0)
         throw InputError("arguments", "f",
                          "an unfolded table has an even number of φ bins over [0°, 360°)");
     const HemisphereGrid grid = unfolded
                                     ? grid_of({int(f.shape(2)), int(f.shape(3) / 2)}).unfolded()
                                     : grid_of({int(f.shape(2)), int(f.shape(3))});
-    BinnedTable table = BinnedTable::zeros(grid, theta_i, r, t);
+    BinnedTable table = BinnedTable::zeros(grid, incidences, r, t);
     const double* p = f.data();
     for (std::size_t i = 0; i < theta_i.size(); ++i)
         for (const std::string& side : sides) {
@@ -365,10 +404,11 @@ BinnedTable table_from_arrays(py::array_t<double, py::array::c_style | py::array
             for (std::size_t j = 0; j < grid.size(); ++j)
                 for (int c = 0; c < 3; ++c) {
                     const double v = *p++;
-                    if (!std::isfinite(v))
-                        throw InputError(
-                            "arguments", "f",
-                            fmt::format("a value at θi = {}° is not finite", theta_i[i]));
+                    if (!(std::abs(v) <= kMaxBinValue))  // NaN too; as BinnedTable::from_csv
+                        throw InputError("arguments", "f",
+                                         fmt::format("a value at θi = {}° is {}: allowed finite, "
+                                                     "within ±{:g} (1/sr)",
+                                                     theta_i[i], v, kMaxBinValue));
                     lobe.f[j][c] = v;
                 }
         }
@@ -381,10 +421,16 @@ BinnedTable table_from_arrays(py::array_t<double, py::array::c_style | py::array
 void run_study_py(py::list configs_in, py::dict settings, py::list externals,
                   const std::filesystem::path& out, bool figures) {
     std::vector<StudyConfiguration> configs;
+    std::set<std::string> ids;
     for (py::handle c : configs_in) {
         StudyConfiguration sc;
         sc.id = c["id"].cast<std::string>();
         sc.category = c["category"].cast<std::string>();
+        const std::string at = fmt::format("configs[{}]", configs.size());
+        check_configuration_id(sc.id, "arguments", at + ".id");
+        if (!ids.insert(sc.id).second)
+            throw InputError("arguments", at + ".id", fmt::format("'{}' appears twice", sc.id));
+        check_study_label(sc.category, "category", "arguments", at + ".category");
         sc.stack = stack_of(c["stack"]);
         sc.parameters = describe_parameters(sc.stack);
         configs.push_back(std::move(sc));
@@ -401,6 +447,7 @@ void run_study_py(py::list configs_in, py::dict settings, py::list externals,
     for (py::handle e : externals) {
         ExternalModel m;
         m.name = e[py::int_(0)].cast<std::string>();
+        check_study_label(m.name, "model name", "arguments", "models");
         m.source = "Python model '" + m.name + "'";
         py::object fn = py::reinterpret_borrow<py::object>(e[py::int_(1)]);
         m.unfolded = true;  // a Python model is evaluated at any wi
@@ -490,10 +537,8 @@ void bind_table(py::module_& m) {
         .def_static(
             "from_csv",
             [](const std::filesystem::path& path) {
-                std::ifstream in(path, std::ios::binary);
-                if (!in) throw InputError(path.string(), "", "cannot read the file");
-                std::string text((std::istreambuf_iterator<char>(in)), {});
-                return BinnedTable::from_csv(text, path.string());
+                return BinnedTable::from_csv(
+                    read_file_bounded(path, kMaxTableFileBytes, "the table"), path.string());
             },
             py::arg("path"))
         .def_static("from_arrays", &table_from_arrays, py::arg("f"), py::arg("theta_i"),
@@ -531,7 +576,10 @@ void bind_table(py::module_& m) {
         .def("to_csv", &BinnedTable::to_csv, "The brdf.csv text")
         .def("__repr__", [](const BinnedTable& t) {
             return fmt::format("<lamina.Table {} incidences, sides {}, grid {}>",
-                               t.theta_i_deg.size(), t.has_transmission ? "R, T" : "R",
+                               t.theta_i_deg.size(),
+                               t.has_reflection && t.has_transmission ? "R, T"
+                               : t.has_reflection                     ? "R"
+                                                                      : "T",
                                t.grid.to_string());
         });
 }

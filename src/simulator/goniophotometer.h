@@ -136,7 +136,12 @@ struct SimulationSettings {
                .key = Key::Fixed},
               s.particles);
         visit({.name = "seed", .help = "Random seed", .min = 0, .key = Key::Fixed}, s.seed);
-        visit({.name = "threads", .help = "Threads (0 = all cores)", .min = 0, .key = Key::No},
+        // At most 1024: OpenMP creates them all at once, and 65 536 crashed its runtime.
+        visit({.name = "threads",
+               .help = "Threads (0 = all cores), at most 1024",
+               .min = 0,
+               .max = 1024,
+               .key = Key::No},
               s.threads);
         visit({.name = "grid",
                .help = "Bins NTHETAxNPHI over θ∈[0°,90°], φ∈[0°,180°] (folded)",

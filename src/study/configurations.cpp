@@ -264,6 +264,26 @@ bool has_control_character(const std::string& text) {
 }
 }  // namespace
 
+void check_configuration_id(const std::string& id, const std::string& where,
+                            const std::string& field) {
+    if (id.empty() || id.find_first_of("/\\ ,\"") != std::string::npos ||
+        has_control_character(id) || id[0] == '.')
+        throw InputError(where, field,
+                         fmt::format("'{}' is not usable as an id (no spaces, slashes, commas, "
+                                     "quotes, control characters or leading dot)",
+                                     id));
+}
+
+void check_study_label(const std::string& label, const char* what, const std::string& where,
+                       const std::string& field) {
+    if (label.empty() || label.find_first_of(",\"") != std::string::npos ||
+        has_control_character(label))
+        throw InputError(where, field,
+                         fmt::format("'{}' is not usable as a {} (not empty; no commas, quotes or "
+                                     "control characters)",
+                                     label, what));
+}
+
 std::vector<StudyConfiguration> load_configurations(const std::filesystem::path& path) {
     const std::string where = path.string();
     std::ifstream in(path);
@@ -298,14 +318,7 @@ std::vector<StudyConfiguration> load_configurations(const std::filesystem::path&
             throw InputError(where, at + "/id", "a string id is required");
         StudyConfiguration c;
         c.id = item["id"].get<std::string>();
-        // An id names a folder, a CSV cell and an --only item; a category a CSV cell and a
-        // heading: neither may hold what would split or end them.
-        if (c.id.empty() || c.id.find_first_of("/\\ ,\"") != std::string::npos ||
-            has_control_character(c.id) || c.id[0] == '.')
-            throw InputError(where, at + "/id",
-                             fmt::format("'{}' is not usable as an id (no spaces, slashes, commas, "
-                                         "quotes, control characters or leading dot)",
-                                         c.id));
+        check_configuration_id(c.id, where, at + "/id");
         if (!ids.insert(c.id).second)
             throw InputError(where, at + "/id", fmt::format("'{}' appears twice", c.id));
         c.category = "custom";
@@ -313,12 +326,7 @@ std::vector<StudyConfiguration> load_configurations(const std::filesystem::path&
             if (!item["category"].is_string())
                 throw InputError(where, at + "/category", "must be a string");
             c.category = item["category"].get<std::string>();
-            if (c.category.empty() || c.category.find_first_of(",\"") != std::string::npos ||
-                has_control_character(c.category))
-                throw InputError(where, at + "/category",
-                                 fmt::format("'{}' is not usable as a category (not empty; no "
-                                             "commas, quotes or control characters)",
-                                             c.category));
+            check_study_label(c.category, "category", where, at + "/category");
         }
         if (!item.contains("stack")) throw InputError(where, at + "/stack", "a stack is required");
         try {

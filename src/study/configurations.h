@@ -43,6 +43,15 @@ std::vector<StudyConfiguration> preset_configurations(const std::string& preset)
 
 /// A user's list: {"configurations": [{"id": ..., "category": ..., "stack": {...}}, ...]}
 /// (`category` optional, default "custom"). InputError naming the file and the JSON pointer.
+/// A configuration's id names a folder, a CSV cell and an --only item: InputError unless it is
+/// non-empty without spaces, slashes, commas, quotes, control characters or a leading dot.
+void check_configuration_id(const std::string& id, const std::string& where,
+                            const std::string& field);
+/// A category or a model's name is a CSV cell and a heading: InputError (naming it `what`) unless
+/// it is non-empty without commas, quotes or control characters.
+void check_study_label(const std::string& label, const char* what, const std::string& where,
+                       const std::string& field);
+
 std::vector<StudyConfiguration> load_configurations(const std::filesystem::path& path);
 
 /// Keeps the configurations whose id matches `pattern` (a glob with * and ?; several patterns

@@ -65,6 +65,36 @@ def test_bad_stack_is_an_input_error_naming_the_field():
     assert "[0, 1]" in e.value.problem or "1" in e.value.problem
 
 
+def test_non_finite_numbers_are_named():
+    with pytest.raises(lamina.InputError) as e:
+        lamina.simulate(PLASTIC, theta_i=[30, float("nan")], particles=1000)
+    assert e.value.field == "theta_i/1" and "not a finite number" in e.value.problem
+    bad = json.loads(PLASTIC.read_text())
+    bad["layers"][0]["interface"]["eta"] = float("inf")
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Stack(bad)
+    assert e.value.file == "<dict>" and e.value.field == "/layers/0/interface/eta"
+
+
+def test_study_names_are_checked_before_any_work(tmp_path):
+    # An id names a folder and a CSV cell: "../x" would write beside the study, "a,b" would break
+    # metrics.csv after the whole study had run. Refused before anything is written.
+    plastic = json.loads(PLASTIC.read_text())
+    for config_id, field in (("../x", "configs[0].id"), ("a,b", "configs[0].id")):
+        with pytest.raises(lamina.InputError) as e:
+            lamina.compare(plastic, models=["ww-prime"], config_id=config_id,
+                           out=tmp_path / "c", particles=1000, theta_i=[30], grid=(9, 9))
+        assert e.value.field == field
+        assert "is not usable as an id" in e.value.problem
+    with pytest.raises(lamina.InputError) as e:
+        lamina.study(configs=[{"id": "a", "stack": plastic}, {"id": "a", "stack": plastic}],
+                     models=["ww-prime"], out=tmp_path / "s", particles=1000, theta_i=[30],
+                     grid=(9, 9))
+    assert e.value.field == "configs[1].id" and "appears twice" in e.value.problem
+    assert not (tmp_path / "c").exists() and not (tmp_path / "s").exists()
+    assert not (tmp_path / "x").exists()
+
+
 def test_missing_file_names_the_file(tmp_path):
     with pytest.raises(lamina.InputError) as e:
         lamina.Stack(tmp_path / "nope.json")
@@ -568,6 +598,21 @@ def test_table_from_arrays_round_trips():
     bad[0, 0, 0, 0, 0] = np.nan
     with pytest.raises(lamina.InputError):
         lamina.Table.from_arrays(bad, t.theta_i, t.sides)
+    # The checks of a table read from its CSV: |f| <= 1e12, each θi once in [0, 90), one side once.
+    bad[0, 0, 0, 0, 0] = 1e300
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Table.from_arrays(bad, t.theta_i, t.sides)
+    assert e.value.field == "f"
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Table.from_arrays(t.f, [30, 30], t.sides)
+    assert e.value.field == "theta_i" and "twice" in e.value.problem
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Table.from_arrays(t.f, [0, 95], t.sides)
+    assert e.value.field == "theta_i"
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Table.from_arrays(np.concatenate([t.f, t.f], axis=1), t.theta_i, ["R", "R"])
+    assert e.value.field == "sides"
+    assert "sides T," in repr(lamina.Table.from_arrays(t.f[:, :1], t.theta_i, ["T"]))
 
 
 def test_random_walk_microsurface_option():
