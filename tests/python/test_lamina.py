@@ -560,6 +560,16 @@ def test_export_from_python_takes_the_cli_defaults(tmp_path):
     assert shapes[0] == shapes[1] and "incidences" in shapes[0]
 
 
+def test_export_from_python_takes_one_angle_zero_included(tmp_path):
+    # theta_i=0 is the incidence 0°, not "the default"; one number is a list of one.
+    lamina.export(lamina.Model("ww-prime", PLASTIC), tmp_path / "zero.bsdf", theta_i=0,
+                  resolution=8)
+    lamina.export(lamina.Model("ww-prime", PLASTIC), tmp_path / "one.bsdf", theta_i=[30],
+                  resolution=8)
+    for name in ("zero.bsdf", "one.bsdf"):
+        assert "1 incidences" in cli("export", "--check", tmp_path / name).stdout
+
+
 def test_export_from_python_takes_the_azimuths_of_an_anisotropic_stack(tmp_path):
     # The φi slices of a brushed stack's file: the CLI's --azimuths. The files differ only in
     # their description text; 4 and 8 intervals give 5 and 9 slices, and each slice holds per

@@ -136,7 +136,17 @@ def export(source, path, format: Optional[str] = None, theta_i=None, resolution=
                               "give format='bsdf' or 'merl', or a path ending in .bsdf or .binary")
     if isinstance(source, SimulationResult):
         source = source.table
-    _lamina._export(source, str(path), format, [float(t) for t in (theta_i or [])],
+    # One angle or a list of them; 0 is an incidence, not "the default".
+    if theta_i is None:
+        theta_i = []
+    elif isinstance(theta_i, str) or np.ndim(theta_i) == 0:
+        theta_i = [theta_i]
+    try:
+        theta_i = [float(t) for t in theta_i]
+    except (TypeError, ValueError):
+        raise input_error("arguments", "theta_i",
+                          f"{theta_i!r} is not a list of angles in degrees") from None
+    _lamina._export(source, str(path), format, theta_i,
                     None if resolution is None else int(resolution), str(description),
                     None if azimuths is None else int(azimuths))
 
