@@ -260,6 +260,16 @@ std::vector<py::array_t<double, py::array::c_style | py::array::forcecast>> broa
     return out;
 }
 
+/// One direction argument, checked as broadcast_directions checks each of an array's.
+Vec3d unit_direction(const std::array<double, 3>& w, const char* name) {
+    const double len = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    if (!std::isfinite(len) || std::abs(len - 1) > 1e-6)
+        throw InputError(
+            "arguments", name,
+            fmt::format("({}, {}, {}): directions must be finite unit vectors", w[0], w[1], w[2]));
+    return {w[0], w[1], w[2]};
+}
+
 py::array_t<double> shaped(std::vector<py::ssize_t> shape, py::ssize_t last) {
     if (last > 0) shape.push_back(last);
     return py::array_t<double>(shape);
@@ -846,7 +856,7 @@ void bind_models(py::module_& m) {
             "delta_lobes",
             [](const PyModel& m, std::array<double, 3> wi) {
                 py::list out;
-                for (const DeltaLobe& d : m.model->delta_lobes({wi[0], wi[1], wi[2]}))
+                for (const DeltaLobe& d : m.model->delta_lobes(unit_direction(wi, "wi")))
                     out.append(py::make_tuple(
                         std::array<double, 3>{d.direction.x, d.direction.y, d.direction.z},
                         std::array<double, 3>{d.energy[0], d.energy[1], d.energy[2]}));
@@ -857,7 +867,7 @@ void bind_models(py::module_& m) {
             "peak_directions",
             [](const PyModel& m, std::array<double, 3> wi) {
                 std::vector<std::array<double, 3>> out;
-                for (const Vec3d& d : m.model->peak_directions({wi[0], wi[1], wi[2]}))
+                for (const Vec3d& d : m.model->peak_directions(unit_direction(wi, "wi")))
                     out.push_back({d.x, d.y, d.z});
                 return out;
             },

@@ -65,6 +65,16 @@ def test_bad_stack_is_an_input_error_naming_the_field():
     assert "[0, 1]" in e.value.problem or "1" in e.value.problem
 
 
+def test_single_directions_are_checked():
+    m = lamina.Model("ww-prime", PLASTIC)
+    for bad in ([np.nan, 0, 1], [0, 0, 0], [0, 0, 2]):
+        for method in (m.peak_directions, m.delta_lobes):
+            with pytest.raises(lamina.InputError) as e:
+                method(bad)
+            assert e.value.field == "wi" and "finite unit vectors" in e.value.problem
+    assert len(m.peak_directions([0, 0, 1])) >= 1
+
+
 def test_non_finite_numbers_are_named():
     with pytest.raises(lamina.InputError) as e:
         lamina.simulate(PLASTIC, theta_i=[30, float("nan")], particles=1000)
