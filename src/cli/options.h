@@ -9,10 +9,7 @@
 
 namespace lamina::cli {
 
-/// "0,30,60" → {0, 30, 60} (degrees, each finite; ranges are checked by the consumer).
-std::vector<double> parse_angle_list(const std::string& text, const std::string& option);
-
-/// parse_angle_list, each angle checked to be an incidence in [0, 90) degrees, none twice.
+/// "0,30,60" → {0, 30, 60}: incidences in [0, 90) degrees, each once, as the settings read them.
 std::vector<double> parse_incidences(const std::string& text, const std::string& option);
 
 /// "1e7", "250000", "1.6e8" → an integer count ≥ 1 (must be a whole number ≤ 1e15).

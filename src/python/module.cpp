@@ -226,6 +226,17 @@ std::string option_text(py::handle v) {
     return py::str(v).cast<std::string>();
 }
 
+/// A direction argument (`name`; `which`, "" or "direction 3 " for an array's): a finite unit
+/// vector to 1e-6, or an InputError.
+Vec3d unit_direction(double x, double y, double z, const char* name, const std::string& which) {
+    const double len = std::sqrt(x * x + y * y + z * z);
+    if (!std::isfinite(len) || std::abs(len - 1) > 1e-6)
+        throw InputError(
+            "arguments", name,
+            fmt::format("{}({}, {}, {}): directions must be finite unit vectors", which, x, y, z));
+    return {x, y, z};
+}
+
 /// Directions as an [n, 3] C-contiguous float64 array, broadcast against each other; the shape of
 /// the leading axes comes back in `shape`.
 std::vector<py::array_t<double, py::array::c_style | py::array::forcecast>> broadcast_directions(
@@ -247,27 +258,11 @@ std::vector<py::array_t<double, py::array::c_style | py::array::forcecast>> broa
         shape.assign(a.shape(), a.shape() + a.ndim() - 1);
         out.push_back(np.attr("ascontiguousarray")(a).attr("reshape")(-1, 3));
         const double* d = out.back().data();
-        for (py::ssize_t n = 0; n < out.back().shape(0); ++n) {
-            const double x = d[3 * n], y = d[3 * n + 1], z = d[3 * n + 2];
-            const double len = std::sqrt(x * x + y * y + z * z);
-            if (!std::isfinite(len) || std::abs(len - 1) > 1e-6)
-                throw InputError("arguments", inputs[k].first,
-                                 fmt::format("direction {} is ({}, {}, {}): directions must be "
-                                             "finite unit vectors",
-                                             n, x, y, z));
-        }
+        for (py::ssize_t n = 0; n < out.back().shape(0); ++n)
+            unit_direction(d[3 * n], d[3 * n + 1], d[3 * n + 2], inputs[k].first,
+                           fmt::format("direction {} is ", n));
     }
     return out;
-}
-
-/// One direction argument, checked as broadcast_directions checks each of an array's.
-Vec3d unit_direction(const std::array<double, 3>& w, const char* name) {
-    const double len = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    if (!std::isfinite(len) || std::abs(len - 1) > 1e-6)
-        throw InputError(
-            "arguments", name,
-            fmt::format("({}, {}, {}): directions must be finite unit vectors", w[0], w[1], w[2]));
-    return {w[0], w[1], w[2]};
 }
 
 py::array_t<double> shaped(std::vector<py::ssize_t> shape, py::ssize_t last) {
@@ -856,7 +851,8 @@ void bind_models(py::module_& m) {
             "delta_lobes",
             [](const PyModel& m, std::array<double, 3> wi) {
                 py::list out;
-                for (const DeltaLobe& d : m.model->delta_lobes(unit_direction(wi, "wi")))
+                for (const DeltaLobe& d :
+                     m.model->delta_lobes(unit_direction(wi[0], wi[1], wi[2], "wi", "")))
                     out.append(py::make_tuple(
                         std::array<double, 3>{d.direction.x, d.direction.y, d.direction.z},
                         std::array<double, 3>{d.energy[0], d.energy[1], d.energy[2]}));
@@ -867,7 +863,8 @@ void bind_models(py::module_& m) {
             "peak_directions",
             [](const PyModel& m, std::array<double, 3> wi) {
                 std::vector<std::array<double, 3>> out;
-                for (const Vec3d& d : m.model->peak_directions(unit_direction(wi, "wi")))
+                for (const Vec3d& d :
+                     m.model->peak_directions(unit_direction(wi[0], wi[1], wi[2], "wi", "")))
                     out.push_back({d.x, d.y, d.z});
                 return out;
             },
