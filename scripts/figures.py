@@ -718,8 +718,10 @@ if __name__ == "__main__":
         main()
     except Exception as e:
         # One line, as lamina's own errors: the study folder is damaged or not one lamina wrote
-        # (a truncated table, a hand-edited study.json, ...).
+        # (a truncated table, a hand-edited study.json, ...) — or, where it is intact, a bug
+        # of this script, which the message's exception names.
         where = sys.argv[1] if len(sys.argv) > 1 else "."
         what = str(e) if isinstance(e, FigureError) else f"{type(e).__name__}: {e}"
         sys.exit(f"figures.py: {where}: cannot draw the figures from this study folder "
-                 f"({what}); rerun the study that wrote it")
+                 f"({what}); rerun the study that wrote it, or report this message if the "
+                 f"folder is as lamina wrote it")
