@@ -1,6 +1,7 @@
 #pragma once
-// Output that is never half-written: data goes to a temporary file beside the target and is
-// renamed into place only once complete (rename is atomic within a file system).
+// Files in and out. Output that is never half-written: data goes to a temporary file beside the
+// target and is renamed into place only once complete (rename is atomic within a file system).
+// Input that is never read without bound (read_file_bounded).
 
 #include <filesystem>
 #include <string>
