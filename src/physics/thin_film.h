@@ -52,39 +52,73 @@ struct ThinFilmAmplitudes {
     T transmitted_flux;
 };
 
-/// The Airy sums of the header for light arriving from the incident medium at cos_theta_i ∈ [0, 1]
-/// (clamped) on a film of complex index eta_film over an exit medium of complex index eta_exit,
-/// both relative to the incident medium, the film's thickness given as `thickness_waves` = d η_1/λ
-/// (d in vacuum wavelengths times the incident medium's absolute index, so that the phase of one
-/// crossing is δ = 2π thickness_waves u_f). Thickness 0 gives the bare boundary incident | exit.
-/// At an index-matched grazing boundary, where the amplitudes are 0/0, the grazing limit: total
-/// reflection (r_s = r_p = −1), nothing transmitted.
-///
-/// N films of the same index (relative to the same incident medium) at once, each over its own
-/// exit medium and with its own thickness in waves (the channels of one film: their wavelengths
-/// and the metal's index at each): the film's normal wave number and its upper boundary's
-/// amplitudes are the same for all and computed once.
+/// What the Airy sums of one angle of incidence share over every thickness: the film's normal
+/// wave number u2 and the amplitudes of both boundaries (fresnel_amplitudes), per exit medium, and
+/// the flux factor of the transmitted beam. Within 1e-6 of the film's critical angle in u2² (see
+/// thin_film_amplitudes) there are two sets, at u2² ± 1e-6, whose sums are averaged.
 template <typename T, std::size_t N>
-std::array<ThinFilmAmplitudes<T>, N> thin_film_amplitudes(
-    T cos_theta_i, std::complex<T> eta_film, const std::array<std::complex<T>, N>& eta_exit,
-    const std::array<T, N>& thickness_waves) {
+struct ThinFilmBoundaries {
+    int count = 1;  ///< 1, or 2 near the film's critical angle
+    std::complex<T> u2[2];
+    FresnelAmplitudes<T> upper[2];                 ///< incident | film
+    std::array<FresnelAmplitudes<T>, N> lower[2];  ///< film | exit, per exit medium
+    std::array<T, N> transmitted_flux;
+};
+
+/// The boundaries of thin_film_amplitudes for light arriving at cos_theta_i ∈ [0, 1] (clamped):
+/// computed once per angle, then combined with any thickness.
+template <typename T, std::size_t N>
+ThinFilmBoundaries<T, N> thin_film_boundaries(T cos_theta_i, std::complex<T> eta_film,
+                                              const std::array<std::complex<T>, N>& eta_exit) {
     using C = std::complex<T>;
-    using Sums = std::array<FresnelAmplitudes<T>, N>;
     const T mu = std::min(std::max(cos_theta_i, T(0)), T(1));
     const T sin2 = T(1) - mu * mu;
     const C u1(mu);
     std::array<C, N> u3;
-    for (std::size_t n = 0; n < N; ++n)
+    ThinFilmBoundaries<T, N> b;
+    for (std::size_t n = 0; n < N; ++n) {
         u3[n] = normal_wave_number(eta_exit[n], sin2);
-    // The Airy sums for the film's normal wave number u2.
-    const auto airy = [&](C u2) {
-        const FresnelAmplitudes<T> b12 = fresnel_amplitudes<T>(C(1), u1, eta_film, u2);
+        b.transmitted_flux[n] = eta_exit[n].imag() == T(0) && mu > T(0) ? u3[n].real() / mu : T(0);
+    }
+    // The sums are even functions of u2, analytic in u2² = η_f² − sin²θ1, but at the film's
+    // critical angle (u2 → 0: r12 → 1, r23 → −1, e^{2iδ} → 1) they are 0/0, and evaluated at
+    // |u2| they lose ε/|u2| of their precision. Within h = 1e-6 of it in u2² they are taken as the
+    // mean of their values at u2² ± h (the error of the mean is O(h²), of each value O(ε/√h)).
+    const C w = eta_film * eta_film - sin2;
+    constexpr T kNearCritical = T(1e-6);
+    if (squared_modulus(w) < kNearCritical * kNearCritical) {
+        b.count = 2;
+        b.u2[0] = principal_sqrt(w + kNearCritical);
+        b.u2[1] = principal_sqrt(w - kNearCritical);
+    } else {
+        b.u2[0] = normal_wave_number(eta_film, sin2);
+    }
+    for (int k = 0; k < b.count; ++k) {
+        b.upper[k] = fresnel_amplitudes<T>(C(1), u1, eta_film, b.u2[k]);
+        for (std::size_t n = 0; n < N; ++n)
+            b.lower[k][n] = fresnel_amplitudes<T>(eta_film, b.u2[k], eta_exit[n], u3[n]);
+    }
+    return b;
+}
+
+/// The Airy sums of the header over the boundaries of thin_film_boundaries, the film's thickness
+/// given per exit medium as `thickness_waves` = d η_1/λ (d in vacuum wavelengths times the
+/// incident medium's absolute index, so that the phase of one crossing is δ = 2π
+/// thickness_waves u_f). Thickness 0 gives the bare boundary incident | exit. At an index-matched
+/// grazing boundary, where the amplitudes are 0/0, the grazing limit: total reflection
+/// (r_s = r_p = −1), nothing transmitted.
+template <typename T, std::size_t N>
+std::array<ThinFilmAmplitudes<T>, N> thin_film_amplitudes(const ThinFilmBoundaries<T, N>& b,
+                                                          const std::array<T, N>& thickness_waves) {
+    using C = std::complex<T>;
+    using Sums = std::array<FresnelAmplitudes<T>, N>;
+    const auto airy = [&](int k) {
+        const FresnelAmplitudes<T>& b12 = b.upper[k];
         Sums sums;
         for (std::size_t n = 0; n < N; ++n) {
-            const FresnelAmplitudes<T> b23 =
-                fresnel_amplitudes<T>(eta_film, u2, eta_exit[n], u3[n]);
+            const FresnelAmplitudes<T>& b23 = b.lower[k][n];
             // e^{iδ}: |e^{iδ}| = e^{−Im δ} ≤ 1 since Im u2 ≥ 0.
-            const C phase = exp_i(T(2) * std::numbers::pi_v<T> * thickness_waves[n] * u2);
+            const C phase = exp_i(T(2) * std::numbers::pi_v<T> * thickness_waves[n] * b.u2[k]);
             const C phase2 = phase * phase;
             const C inv_den_s = reciprocal(T(1) + b12.r_s * b23.r_s * phase2);
             const C inv_den_p = reciprocal(T(1) + b12.r_p * b23.r_p * phase2);
@@ -94,27 +128,19 @@ std::array<ThinFilmAmplitudes<T>, N> thin_film_amplitudes(
         }
         return sums;
     };
-    // The sums are even functions of u2, analytic in u2² = η_f² − sin²θ1, but at the film's
-    // critical angle (u2 → 0: r12 → 1, r23 → −1, e^{2iδ} → 1) they are 0/0, and evaluated at
-    // |u2| they lose ε/|u2| of their precision. Within h = 1e-6 of it in u2² they are taken as the
-    // mean of their values at u2² ± h (the error of the mean is O(h²), of each value O(ε/√h)).
-    const C w = eta_film * eta_film - sin2;
-    constexpr T kNearCritical = T(1e-6);
     Sums film;
-    if (squared_modulus(w) < kNearCritical * kNearCritical) {
-        const Sums a = airy(principal_sqrt(w + kNearCritical)),
-                   b = airy(principal_sqrt(w - kNearCritical));
+    if (b.count == 2) {
+        const Sums s0 = airy(0), s1 = airy(1);
         for (std::size_t n = 0; n < N; ++n)
-            film[n] = {(a[n].r_s + b[n].r_s) / T(2), (a[n].r_p + b[n].r_p) / T(2),
-                       (a[n].t_s + b[n].t_s) / T(2), (a[n].t_p + b[n].t_p) / T(2)};
+            film[n] = {(s0[n].r_s + s1[n].r_s) / T(2), (s0[n].r_p + s1[n].r_p) / T(2),
+                       (s0[n].t_s + s1[n].t_s) / T(2), (s0[n].t_p + s1[n].t_p) / T(2)};
     } else {
-        film = airy(normal_wave_number(eta_film, sin2));
+        film = airy(0);
     }
     std::array<ThinFilmAmplitudes<T>, N> out;
     for (std::size_t n = 0; n < N; ++n) {
         out[n].film = film[n];
-        out[n].transmitted_flux =
-            eta_exit[n].imag() == T(0) && mu > T(0) ? u3[n].real() / mu : T(0);
+        out[n].transmitted_flux = b.transmitted_flux[n];
         const bool finite =
             std::isfinite(squared_modulus(film[n].r_s) + squared_modulus(film[n].r_p) +
                           squared_modulus(film[n].t_s) + squared_modulus(film[n].t_p));
@@ -124,6 +150,23 @@ std::array<ThinFilmAmplitudes<T>, N> thin_film_amplitudes(
         }
     }
     return out;
+}
+
+/// The Airy sums of the header for light arriving from the incident medium at cos_theta_i ∈ [0, 1]
+/// (clamped) on a film of complex index eta_film over an exit medium of complex index eta_exit,
+/// both relative to the incident medium, with thickness_waves as above: the boundaries of
+/// thin_film_boundaries combined with the thickness.
+///
+/// N films of the same index (relative to the same incident medium) at once, each over its own
+/// exit medium and with its own thickness in waves (the channels of one film: their wavelengths
+/// and the metal's index at each): the film's normal wave number and its upper boundary's
+/// amplitudes are the same for all and computed once.
+template <typename T, std::size_t N>
+std::array<ThinFilmAmplitudes<T>, N> thin_film_amplitudes(
+    T cos_theta_i, std::complex<T> eta_film, const std::array<std::complex<T>, N>& eta_exit,
+    const std::array<T, N>& thickness_waves) {
+    return thin_film_amplitudes(thin_film_boundaries(cos_theta_i, eta_film, eta_exit),
+                                thickness_waves);
 }
 
 /// One film over one exit medium.
@@ -180,24 +223,36 @@ struct FilmOptics {
         return thin_film_mueller(cos_theta, eta_film / eta_i, exit / eta_i,
                                  thickness_nm * eta_i / wavelength_nm[c]);
     }
+    /// What the film's reflection of light arriving from above at the facet cosine cos_theta
+    /// shares over every thickness (its boundaries in the three channels): prepared once per angle
+    /// for reflection_from_above at many thicknesses.
+    ThinFilmBoundaries<double, 3> boundaries_from_above(double cos_theta) const {
+        std::array<std::complex<double>, 3> exit;
+        for (int c = 0; c < 3; ++c)
+            exit[std::size_t(c)] = eta_below[c] / eta_above;
+        return thin_film_boundaries<double, 3>(cos_theta, eta_film / eta_above, exit);
+    }
+    /// The film's reflection Mueller matrices in the three channels for light arriving from above,
+    /// the film thickness_nm thick, from the boundaries of boundaries_from_above.
+    std::array<InterfaceMueller<double>, 3> reflection_from_above(
+        const ThinFilmBoundaries<double, 3>& boundaries, double thickness_nm) const {
+        std::array<double, 3> waves;
+        for (int c = 0; c < 3; ++c)
+            waves[std::size_t(c)] = thickness_nm * eta_above / wavelength_nm[c];
+        const std::array<ThinFilmAmplitudes<double>, 3> a =
+            thin_film_amplitudes<double, 3>(boundaries, waves);
+        std::array<InterfaceMueller<double>, 3> m;
+        for (std::size_t c = 0; c < 3; ++c)
+            m[c] = mueller_of_amplitudes(a[c].film.r_s, a[c].film.r_p, 1.0);
+        return m;
+    }
     /// The film's reflection Mueller matrices in the three channels for light arriving from above
     /// at the facet cosine cos_theta, the film thickness_nm thick: mueller(c, cos_theta, true,
     /// thickness_nm).reflection for c = 0, 1, 2, with what the channels share (the film's index
     /// relative to the medium above, so its wave number and upper boundary) evaluated once.
     std::array<InterfaceMueller<double>, 3> reflection_from_above(double cos_theta,
                                                                   double thickness_nm) const {
-        std::array<std::complex<double>, 3> exit;
-        std::array<double, 3> waves;
-        for (int c = 0; c < 3; ++c) {
-            exit[std::size_t(c)] = eta_below[c] / eta_above;
-            waves[std::size_t(c)] = thickness_nm * eta_above / wavelength_nm[c];
-        }
-        const std::array<ThinFilmAmplitudes<double>, 3> a =
-            thin_film_amplitudes<double, 3>(cos_theta, eta_film / eta_above, exit, waves);
-        std::array<InterfaceMueller<double>, 3> m;
-        for (std::size_t c = 0; c < 3; ++c)
-            m[c] = mueller_of_amplitudes(a[c].film.r_s, a[c].film.r_p, 1.0);
-        return m;
+        return reflection_from_above(boundaries_from_above(cos_theta), thickness_nm);
     }
 };
 

@@ -228,9 +228,10 @@ Rgbd film_reflectance_exact(const FilmOptics& film, double cos_theta) {
         if (const auto closed =
                 closed_form_mean(film, c, film.thickness_min_nm, film.thickness_max_nm))
             return *closed;
+    const ThinFilmBoundaries<double, 3> boundaries = film.boundaries_from_above(c);
     return thickness_average_to_opaque(film.thickness_min_nm, film.thickness_max_nm, period,
                                        opaque_thickness_nm(film, c), [&](double d) {
-                                           const auto m = film.reflection_from_above(c, d);
+                                           const auto m = film.reflection_from_above(boundaries, d);
                                            return Rgbd(m[0].a, m[1].a, m[2].a);
                                        });
 }
@@ -251,13 +252,14 @@ Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, con
         std::min({film.wavelength_nm[0], film.wavelength_nm[1], film.wavelength_nm[2]});
     const double period = lambda_min / (2 * std::max(std::abs(film.eta_film), 1e-3));
     constexpr double kFadeNm = 30;  // the film is wholly present from 30 nm on
+    const ThinFilmBoundaries<double, 3> boundaries = film.boundaries_from_above(c);
     const auto at_thickness = [&](double d) {
         const double t = clamp((d - 1e-9) / (kFadeNm - 1e-9), 0.0, 1.0),
                      presence = t * t * (3 - 2 * t);
         if (!(presence > 0)) return bare;
         Rgbd r(1.0);
         if (sin_film < 1) {
-            const auto m = film.reflection_from_above(c, d);
+            const auto m = film.reflection_from_above(boundaries, d);
             r = Rgbd(m[0].a, m[1].a, m[2].a);
         }
         return bare * (1 - presence) + r * presence;
