@@ -156,6 +156,27 @@ void check_model_tables(const CommonArgs& a, const std::vector<StudyConfiguratio
                                          assignment, configs.size()));
 }
 
+// Every --model-table file read and checked against its configuration's grid, incidences and
+// sides before any work: a wrong table is refused before the reference is simulated, not after.
+// (They are the first of the settings' external models, in the order given.)
+void check_model_tables_fit(const CommonArgs& a, const StudySettings& s,
+                            const std::vector<StudyConfiguration>& configs) {
+    for (std::size_t k = 0; k < a.model_tables.size(); ++k) {
+        const ExternalModel& e = s.external_models[k];
+        for (const StudyConfiguration& c : configs) {
+            const HemisphereGrid grid = study_grid(c.stack, s.reference);
+            if (grid.is_unfolded()) continue;  // reported not supported by the study
+            const std::vector<StudyIncidence> incidences = study_incidences(c.stack, s.reference);
+            const BinnedTable table = e.table(c, incidences, grid);
+            if (!table.has_reflection && !table.has_transmission) continue;
+            std::vector<double> theta_i;
+            for (const StudyIncidence& inc : incidences)
+                theta_i.push_back(inc.theta_i);
+            check_external_table(table, grid, theta_i, c.stack.transmits(), e.source);
+        }
+    }
+}
+
 // The explorer page, then the figures (a failure there is a warning: the study itself is done).
 // Without tables (--tables none) there is no page to draw: only the error matrices.
 void write_report(const std::filesystem::path& dir, const CommonArgs& a, const StudySettings& s,
@@ -232,6 +253,7 @@ Runner add_study(CLI::App& app) {
                                          : load_configurations(a->configs);
             configs = filter_configurations(std::move(configs), a->only);
             check_model_tables(*a, configs);
+            check_model_tables_fit(*a, s, configs);
         }
         if (world.distributed()) {
             std::vector<ReferenceKey> keys;
@@ -298,6 +320,7 @@ Runner add_compare(CLI::App& app) {
         c.id = std::filesystem::path(a->stack).stem().string();
         c.category = "custom";
         c.parameters = describe_parameters(c.stack);
+        check_model_tables_fit(*a, s, {c});
         StudyResult result = run_study({c}, s, a->out);
         write_report(a->out, *a, s, result.times);
         print_outcome(result, a->out, s);

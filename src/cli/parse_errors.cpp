@@ -137,6 +137,12 @@ InputError input_error_from(const CLI::ParseError& error, const CLI::App& app) {
             return InputError("command line", name,
                               fmt::format("expects a value ({}) after it; {}", expected, help));
         }
+        // "--particles: At Most 1 required but received 2": the option was given twice.
+        constexpr std::string_view kTwice = "At Most 1 required but received ";
+        if (problem.starts_with(kTwice))
+            return InputError("command line", name,
+                              fmt::format("given {} times; it takes one value, given once; {}",
+                                          problem.substr(kTwice.size()), help));
     }
     return InputError("command line", name, fmt::format("{}; {}", lower_first(problem), help));
 }

@@ -50,6 +50,8 @@ check_says cli11-unknown-option-first 1 "lamina: command line: --bogus: unknown 
     "$lamina" simulate --bogus
 check_says cli11-missing-value 1 "lamina: command line: --model: expects a value (text) after it" \
     "$lamina" eval --model
+check_says cli11-given-twice 1 "lamina: command line: --particles: given 2 times; it takes one value, given once" \
+    "$lamina" simulate "$src/examples/plastic.json" --particles 1e3 --particles 2e3 --out "$tmp/never"
 check_says cli11-not-a-number 1 "lamina: command line: --theta-o: 'abc' is not a number" \
     "$lamina" eval --model ww09 --stack "$src/examples/plastic.json" --theta-i 30 --theta-o abc --phi-o 0
 check_says cli11-negative-count 1 "lamina: command line: --samples: '-5' is not allowed: expected a whole number >= 1" \
@@ -135,6 +137,11 @@ awk -F, 'BEGIN { OFS = "," } NR == 2 { $7 = "1e308" } { print }' "$tmp/mt.csv" >
 check_says model-table-huge 1 "line 2, column 7: the value 1e+308 is outside [-1e+12, 1e+12]" \
     "$lamina" compare "$P" --particles 1000 --theta-i 30 --grid 9x9 --models ww09 \
     --model-table "fit=$tmp/mt-huge.csv" --out "$tmp/mt-compare"
+# A model table that does not fit the comparison is refused before the reference is simulated
+# (10¹⁰ particles would take far past the timeout).
+check_says model-table-before-work 1 "the table's incidences are 30 but the study's are 30,45" \
+    timeout 60 "$lamina" compare "$P" --particles 1e10 --theta-i 30,45 --grid 9x9 --models ww09 \
+    --model-table "fit=$tmp/mt.csv" --out "$tmp/mt-compare-early"
 # A configuration's id and category become folder names and CSV cells: no commas or quotes.
 printf '{"configurations": [{"id": "a", "category": "x,y", "stack": {"layers": [{"interface": {"type": "lambertian", "albedo": 0.5}}]}}]}' >"$tmp/comma.json"
 check_says configs-category-comma 1 "/configurations/0/category: 'x,y' is not usable as a category" \

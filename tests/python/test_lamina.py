@@ -428,6 +428,21 @@ def test_load_study_metrics_agree_with_the_tables(tmp_path):
     assert s.reference_se("plastic").shape == (2, 1, 18, 12, 3)
     with pytest.raises(lamina.InputError):
         s.tables("nope")
+    # A damaged study directory: each file named in one InputError, never a bare decoder error.
+    import shutil
+    for name, text in (("study.json", '{"configurations": ['), ("study.json", "[1, 2]"),
+                       ("study.json", '{"configurations": [{"name": "x"}]}'),
+                       ("metrics.csv", "config,model\nplastic"), ("metrics.csv", None),
+                       ("configs/plastic/config.json", '{"sources"')):
+        damaged = tmp_path / "damaged"
+        shutil.rmtree(damaged, ignore_errors=True)
+        shutil.copytree(out, damaged)
+        if text is None:
+            (damaged / name).unlink()
+        else:
+            (damaged / name).write_text(text)
+        with pytest.raises(lamina.InputError, match=name.split("/")[-1]):
+            lamina.load_study(damaged, pandas=False).config("plastic")
 
 
 def test_reference_stokes_of_a_polarized_study(tmp_path):

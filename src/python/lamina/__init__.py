@@ -182,6 +182,18 @@ def _read_metrics(path: Path) -> np.ndarray:
     return out
 
 
+def _read_json_object(path: Path) -> dict:
+    """A JSON object read from path; a damaged or truncated file is an InputError naming it."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            value = json.load(f)
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise input_error(str(path), "", f"not valid JSON ({e}): damaged or truncated?") from None
+    if not isinstance(value, dict):
+        raise input_error(str(path), "", "not a JSON object: damaged, or not lamina's file?")
+    return value
+
+
 class Study:
     """A study directory (`lamina study`, `lamina compare`; docs/formats.md), read from disk.
 
@@ -201,9 +213,16 @@ class Study:
         if not info.is_file():
             raise InputError(str(self.path), "study.json",
                              "not a study directory: no study.json (run lamina study or compare)")
-        with open(info) as f:
-            self.info = json.load(f)
-        self.metrics = _read_metrics(self.path / "metrics.csv")
+        self.info = _read_json_object(info)
+        metrics = self.path / "metrics.csv"
+        if not metrics.is_file():
+            raise input_error(str(metrics), "", "missing: every study directory has one")
+        try:
+            self.metrics = _read_metrics(metrics)
+        except (KeyError, ValueError, TypeError, csv.Error, UnicodeDecodeError) as e:
+            raise input_error(str(metrics), "",
+                              f"not lamina's metrics table ({type(e).__name__}: {e}): "
+                              "damaged or truncated?") from None
         if pandas is None or pandas:
             try:
                 import pandas as pd
@@ -211,13 +230,17 @@ class Study:
             except ImportError:
                 if pandas:
                     raise
-        self.configs = [c["id"] for c in self.info.get("configurations", [])]
-        self.theta_i = list(self.info.get("theta_i", []))
-        self.models = list(self.info.get("models", []))
+        try:
+            self.configs = [str(c["id"]) for c in self.info.get("configurations", [])]
+            self.theta_i = [float(t) for t in self.info.get("theta_i", [])]
+            self.models = [str(m) for m in self.info.get("models", [])]
+        except (KeyError, ValueError, TypeError) as e:
+            raise input_error(str(info), "configurations",
+                              f"not lamina's study description ({type(e).__name__}: {e}): "
+                              "damaged?") from None
 
     def config(self, config_id):
-        with open(self._dir(config_id) / "config.json") as f:
-            return json.load(f)
+        return _read_json_object(self._dir(config_id) / "config.json")
 
     def tables(self, config_id):
         cfg = self.config(config_id)
