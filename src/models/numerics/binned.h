@@ -23,9 +23,13 @@
 // small they get, and the budget is then spent evenly along it rather than on one end to
 // max_depth. A rectangle that contains one of the model's peak directions (mirror; refracted for
 // a BTDF) is always bisected towards it, down to a size of ~1e-10 in u, and for the first levels
-// so are the rectangles next to it (a sharp lobe at grazing is narrow in φ and wider in θ, and
-// leaks into them): a lobe of α = 0.001 inside one bin is then resolved even though no coarse
-// node sees it. Delta lobes add energy / Ω⊥ to the bin they hit.
+// so are the rectangles near it, measured on the sphere (a sharp lobe at grazing is narrow in φ
+// and wider in θ, and leaks into them; one just off the normal spills over the pole into bins of
+// every azimuth): a lobe of α = 0.001 inside one bin is then resolved even though no coarse
+// node sees it. Rectangles are halved across their longer side on the sphere (near the normal a
+// bin is a sliver: in θ alone) or both ways. The embedded rule's estimate is blind to variation
+// along one coordinate alone (on a function of θ alone the two rules agree), which matters only
+// for a lobe's tail in a sliver near the pole. Delta lobes add energy / Ω⊥ to the bin they hit.
 // Parallel over (incidence, side, θ row) with OpenMP, each row through the incidence's evaluator
 // for one thread where the model has one (IncidentEvaluator::for_one_thread: the same values, bit
 // for bit); every bin is computed independently, so the output does not depend on the thread count.

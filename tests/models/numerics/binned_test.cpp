@@ -69,17 +69,29 @@ TEST(BinnedStat, IntegratesToTheModelsOwnAlbedo) {
 // albedo is FGD(μi, α, η, κ) by definition (computed directly, no table; on 512 × 512 nodes, whose
 // value at 85° is within 5·10⁻⁶ of 256 × 256, where 64 × 64 is 3.6·10⁻⁵ off). At 85° the lobe
 // is narrow in φ and wider in θ: it leaks past the rectangles that hold its peak, and without
-// their neighbours bisected with them the table missed 0.7 % of it.
+// their neighbours bisected with them the table missed 0.7 % of it. Just off the normal (θi of
+// 0.001°–0.5°, the lobe 0.06° wide) the lobe spills over the pole into the bins of every azimuth,
+// which the rectangles next to the peak's in (θ, φ) do not reach: the table and model_albedo
+// missed up to 85 % of it there. (model_albedo's 16 × 16 rectangles are checked near the normal
+// only: at 85° and 88° it is 2.7·10⁻⁴ and 5·10⁻⁴ low, within 1e-5 at rel_tol 3·10⁻⁵.)
 TEST(Binned, CapturesSharpLobes) {
     const InterfaceSpec base = test::gold(0.001);
     const auto model = make_model("bel-prime", test::single(base));
-    const BinnedTable t = bin_model(*model, HemisphereGrid(90, 90), {0, 30, 70, 85});
+    const std::vector<double> thetas = {0, 0.001, 0.01, 0.05, 0.1, 0.5, 30, 70, 85};
+    const BinnedTable t = bin_model(*model, HemisphereGrid(90, 90), thetas);
     for (std::size_t i = 0; i < t.theta_i_deg.size(); ++i) {
         const double c = std::cos(deg_to_rad(t.theta_i_deg[i]));
+        const Rgbd albedo =
+            thetas[i] < 1
+                ? model_albedo(*model, incident_direction(deg_to_rad(thetas[i])), Side::Reflection)
+                : Rgbd(0.0);
         for (int ch = 0; ch < 3; ++ch) {
             const double want = FgdTable::direct(c, 0.001, base.eta_rgb[ch], base.k[ch], 512, 512);
             EXPECT_NEAR(t.albedo(i, Side::Reflection)[ch], want, 1e-4 * want)
                 << t.theta_i_deg[i] << " " << ch;
+            if (thetas[i] < 1) {
+                EXPECT_NEAR(albedo[ch], want, 1e-4 * want) << t.theta_i_deg[i] << " " << ch;
+            }
         }
     }
 }
@@ -101,15 +113,17 @@ TEST(Binned, BinAveragesAreGoodTo1e4Relative) {
             const HemisphereGrid grid(90, 90);
             const BinnedTable a = bin_model(*model, grid, {30});
             const BinnedTable b = bin_model(*model, grid, {30}, tight);
-            const auto& fa = a.lobe(0, Side::Reflection).f;
-            const auto& fb = b.lobe(0, Side::Reflection).f;
-            double peak = 0;
-            for (const Rgbd& v : fb)
-                peak = std::max(peak, v.max());
-            for (std::size_t j = 0; j < fa.size(); ++j)
-                for (int c = 0; c < 3; ++c)
-                    ASSERT_NEAR(fa[j][c], fb[j][c], 1e-4 * fb[j][c] + 1e-10 * peak)
-                        << name << " bin " << j;
+            for (std::size_t i = 0; i < 1; ++i) {
+                const auto& fa = a.lobe(i, Side::Reflection).f;
+                const auto& fb = b.lobe(i, Side::Reflection).f;
+                double peak = 0;
+                for (const Rgbd& v : fb)
+                    peak = std::max(peak, v.max());
+                for (std::size_t j = 0; j < fa.size(); ++j)
+                    for (int c = 0; c < 3; ++c)
+                        ASSERT_NEAR(fa[j][c], fb[j][c], 1e-4 * fb[j][c] + 1e-10 * peak)
+                            << name << " θi " << a.theta_i_deg[i] << " bin " << j;
+            }
         }
     }
 }
