@@ -161,7 +161,9 @@
       const done = () => {
         const raw = window.LAMINA_DATA && window.LAMINA_DATA[id];
         if (!raw) { reject(new Error("explorer/data/" + id + ".js did not define the configuration")); return; }
-        decode(raw).then((d) => { decoded.set(id, d); resolve(d); }, reject);
+        decode(raw).then((d) => { decoded.set(id, d); resolve(d); },
+          (e) => reject(new Error("explorer/data/" + id + ".js is damaged (" + e.message +
+            "): write the page again with lamina explorer")));
       };
       if (window.LAMINA_DATA && window.LAMINA_DATA[id]) { done(); return; }
       const s = document.createElement("script");
@@ -738,7 +740,12 @@
     const levels = auto ? levelValues(auto) : parseLevels(state.levels);
     const ch = CHANNELS[c];
     const refLayout = diskLayout("reference · " + ch + " · " + incidenceText(cfg, inc), light);
-    $("iso-levels").textContent = "White contour lines at f = " + levels.map(fmt).join(", ") + " 1/sr" +
+    const given = state.levels.trim() ? state.levels.trim().split(/[,\s]+/).length : 0;
+    $("w-levels").setCustomValidity(given > levels.length ? "numbers" + (state.log ? " above 0 (log scale)" : "") : "");
+    $("iso-levels").textContent = (levels.length ? "White contour lines at f = " + levels.map(fmt).join(", ") + " 1/sr"
+      : "No contour lines: the levels must be numbers" + (state.log ? " above 0 on the log scale" : "")) +
+      (given > levels.length && levels.length ? " (" + (given - levels.length) + " of the levels given ignored: not " +
+        (state.log ? "numbers above 0)" : "numbers)") : "") +
       (auto && state.log ? " (every half decade)" : "") + "; reference and model share one colour scale" +
       (state.log ? " (log10 f, four decades)" : "") +
       ". Difference: red where the model puts too much energy, blue too little" +
@@ -866,7 +873,8 @@
       // What the reference loses to its single-scattering microsurfaces (config.json → energy):
       // energy that no side of the reference holds, and that models which conserve it put back.
       const lost = cfg.budget && cfg.budget.lost_microsurface;
-      if (lost && lost.some((v) => v)) {
+      // Drawn only where some channel lost something (an entry is an RGB triple, or null).
+      if (lost && lost.some((v) => v && v.some((x) => x > 0))) {
         traces.push(Object.assign({ x: THETA_I, y: pick(lost).map((v) => (v ? v[c] : null)), type: "scatter",
           mode: "lines+markers", name: "reference: lost to microsurfaces", legendgroup: "lost", showlegend: k === 0,
           line: { color: "#888", width: 1.5, dash: "dot" }, marker: { size: 4, symbol: "x" },
@@ -1061,34 +1069,59 @@
 
   const LIVE_SIZE = 192, LIVE_SPP = 256;
   const live = { renderer: null, why: "", frame: 0, running: -1, visible: false, pending: null };
+  // A parameter as the study writes it (study/configurations.cpp): a number, or an RGB triple
+  // "(r, g, b)"; null for anything else (a measured metal's name, an anisotropic "αx×αy").
+  function rgbParameter(text) {
+    if (text === undefined) return null;
+    const s = String(text).trim(), m = s.match(/^\((.*)\)$/);
+    const parts = m ? m[1].split(",") : [s];
+    if (parts.length !== 1 && parts.length !== 3) return null;
+    const v = parts.map((x) => (x.trim() === "" ? NaN : Number(x)));
+    if (v.some((x) => !Number.isFinite(x))) return null;
+    return v.length === 1 ? [v[0], v[0], v[0]] : v;
+  }
+  // The coat τa widget: one number (grey) or three, r, g, b, each in [0, 10]; null if it holds
+  // anything else (the widget is then marked invalid and the configuration's τa is used).
+  function liveTau(cfg) {
+    const input = $("w-live-tau"), text = input.value.trim();
+    const v = rgbParameter(text.startsWith("(") ? text : "(" + text + ")");
+    const ok = v && v.every((x) => x >= 0 && x <= 10);
+    input.setCustomValidity(ok ? "" : "one number, or three (r, g, b), each in [0, 10]");
+    return ok ? v : rgbParameter((cfg.parameters || {}).tau) || [0, 0, 0];
+  }
   // The lamina-coat material of a configuration's coat (its parameters as the study lists them),
   // with the widgets' values where the user changed them: null where lamina-coat does not apply
-  // (lamina-coat: one dielectric coat, absorbing only, over a Lambertian or conductor base).
-  // The study's parameters are strings; an anisotropic one ("0.05x0.2") is not a number, and
-  // lamina-coat is isotropic.
+  // (lamina-coat: one dielectric coat, absorbing only, over a Lambertian or conductor base whose
+  // index is given per channel; lamina-coat is isotropic). The study's parameters are strings:
+  // numbers, RGB triples "(r, g, b)", a measured metal's name, an anisotropic "αx×αy".
   function coatMaterial(cfg) {
-    const q = cfg.parameters || {}, w = (id) => Number($(id).value), p = {};
-    for (const k of Object.keys(q)) p[k] = k === "base" ? q[k] : Number(q[k]);
-    if (p.tau_s || p.film_nm || (p.base !== "lambertian" && p.base !== "conductor") || !(p.eta0 >= 1.1) ||
-        !Number.isFinite(p.alpha0) || (p.alpha1 !== undefined && !Number.isFinite(p.alpha1))) return null;
-    const eta = w("w-live-eta"), conductor = p.base === "conductor";
+    const q = cfg.parameters || {}, w = (id) => Number($(id).value), num = (k) => Number(q[k]);
+    const conductor = q.base === "conductor";
+    if (q.layers !== undefined || q.tau_s !== undefined || q.film_nm !== undefined ||
+        (q.base !== "lambertian" && !conductor) || !(num("eta0") >= 1.1) || !Number.isFinite(num("alpha0")) ||
+        (q.alpha1 !== undefined && !Number.isFinite(num("alpha1")))) return null;
+    const eta1 = conductor ? rgbParameter(q.eta1) : [1, 1, 1], kappa1 = conductor ? rgbParameter(q.kappa1) : [0, 0, 0];
+    if (!eta1 || !kappa1) return null;  // a measured metal: its index is a spectrum
+    const eta = w("w-live-eta");
     return {
-      eta, alpha_coat: w("w-live-alpha0"), tau: [w("w-live-tau"), w("w-live-tau"), w("w-live-tau")],
+      eta, alpha_coat: w("w-live-alpha0"), tau: liveTau(cfg),
       conductor, albedo: $("w-live-colour").value.match(/\w\w/g).map((h) => parseInt(h, 16) / 255),
-      base_eta: [(p.eta1 || 1) / eta, (p.eta1 || 1) / eta, (p.eta1 || 1) / eta],
-      base_k: [(p.kappa1 || 0) / eta, (p.kappa1 || 0) / eta, (p.kappa1 || 0) / eta],
+      base_eta: eta1.map((v) => v / eta), base_k: kappa1.map((v) => v / eta),
       alpha_base: w("w-live-alpha1"),
     };
   }
   // Sets the live widgets to the configuration's stack.
   function resetLiveWidgets(cfg) {
-    const p = cfg.parameters || {};
-    $("w-live-alpha0").value = p.alpha0 || 0.1;
-    $("w-live-eta").value = p.eta0 || 1.5;
-    $("w-live-tau").value = p.tau || 0;
-    $("w-live-alpha1").value = p.alpha1 || 0;
-    const g = Math.round(255 * Math.min(1, p.rho === undefined ? 0.8 : p.rho)).toString(16).padStart(2, "0");
-    $("w-live-colour").value = "#" + g + g + g;
+    const p = cfg.parameters || {}, finite = (v, otherwise) => (Number.isFinite(Number(v)) && v !== undefined ? v : otherwise);
+    $("w-live-alpha0").value = finite(p.alpha0, 0.1);
+    $("w-live-eta").value = finite(p.eta0, 1.5);
+    const tau = rgbParameter(p.tau) || [0, 0, 0];
+    $("w-live-tau").value = tau[0] === tau[1] && tau[1] === tau[2] ? String(tau[0]) : tau.join(", ");
+    $("w-live-tau").setCustomValidity("");
+    $("w-live-alpha1").value = finite(p.alpha1, 0);
+    const rho = rgbParameter(p.rho) || [0.8, 0.8, 0.8];
+    $("w-live-colour").value = "#" + rho.map((c) =>
+      Math.round(255 * Math.min(1, Math.max(0, c))).toString(16).padStart(2, "0")).join("");
   }
   // The hemisphere table of `source` at every incidence, for the table path of spheres.js.
   function liveTable(d, source) {
@@ -1156,6 +1189,7 @@
       : model === "lamina-coat" ? "lamina-coat in GLSL, its parameters live."
       : model.slice(6) + ": the study's binned table, interpolated linearly over the bins and incidences (a highlight narrower than a bin is spread over it).";
     document.body.dataset.live = model;
+    document.body.dataset.liveMaterial = model === "lamina-coat" ? JSON.stringify(scene.material) : "";
     // Another view's widget redraws the page: the live image restarts only when its scene changed.
     const key = JSON.stringify([cfg.id, model, env, model === "lamina-1" ? $("w-live-l1").value : "",
       model === "lamina-coat" ? scene.material : null]);
@@ -1225,11 +1259,17 @@
     try {
       d = await loadConfig(cfg.id);
     } catch (e) {
-      status(e.message);
-      console.error(e.message);
+      if (serial !== renderSerial) return;
+      // The views still hold the configuration shown before: hidden, with the reason in their place.
+      status("");
+      $("load-error").textContent = "Cannot show " + cfg.id + ": " + e.message;
+      document.body.dataset.loadError = cfg.id;
+      console.warn(e.message);
       return;
     }
     if (serial !== renderSerial) return;  // a later change superseded this one
+    delete document.body.dataset.loadError;
+    $("load-error").textContent = "";
     const t0 = performance.now(), times = {};
     const timed = (name, f) => { const t = performance.now(); f(); times[name] = Math.round(performance.now() - t); };
     timed("slice", () => drawSlice(d, cfg));

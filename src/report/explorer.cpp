@@ -421,6 +421,11 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     }
     const std::size_t S = sources.size(), I = theta_i.size(), D = sides.size(), T = n_theta,
                       P = unfolded ? 2 * std::size_t(n_phi) : std::size_t(n_phi);
+    // config.json's "tables" is null in a study run with --tables none: nothing to draw.
+    if (cfg.contains("tables") && cfg["tables"].is_null())
+        throw InputError(cfg_path.string(), "tables",
+                         "none: the study was run with --tables none, which keeps no tables for "
+                         "the page to draw (run it again with --tables half or full)");
     const NpyFloat32 tab = read_study_array(dir, "tables");
     if (tab.shape != std::vector<std::size_t>{S, I, D, T, P, 3})
         throw InputError(study_array_path(dir, "tables").string(), "shape",

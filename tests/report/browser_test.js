@@ -149,6 +149,66 @@ async function main() {
     await page.reload();
     await page.waitForFunction(() => Number(document.body.dataset.renders || 0) >= 1);
     check((await page.evaluate(() => document.body.dataset.config)) === target, "a reload keeps the configuration (#config=…)");
+
+    // The live lamina-coat sphere takes the configuration's RGB parameters as the study writes
+    // them ("(0.8, 0.2, 0.1)"), not only grey ones: base colour, coat τa, the conductor's η and κ.
+    const liveMaterial = async (id) => {
+      const n = await renders();
+      await page.evaluate((id) => window.LAMINA_EXPLORER.selectConfig(id), id);
+      await waitRender(n);
+      const offered = await page.evaluate(() => Array.from(document.getElementById("w-live-model").options).map((o) => o.value));
+      if (!offered.includes("lamina-coat")) return { offered };
+      await page.evaluate(() => {
+        const e = document.getElementById("w-live-model");
+        e.value = "lamina-coat";
+        e.dispatchEvent(new Event("input"));
+      });
+      return page.evaluate(() => ({ material: JSON.parse(document.body.dataset.liveMaterial || "null"),
+        colour: document.getElementById("w-live-colour").value, tau: document.getElementById("w-live-tau").value }));
+    };
+    const near = (a, b) => Array.isArray(a) && a.length === b.length && a.every((v, k) => Math.abs(v - b[k]) < 2e-3);
+    const p2 = await liveMaterial("plastic-P2-a0.3");
+    check(p2.material && p2.colour === "#cc331a" && near(p2.material.albedo, [0.8, 0.2, 0.102]),
+      `lamina-coat's base colour is the configuration's ρ = (0.8, 0.2, 0.1) (${JSON.stringify(p2)})`);
+    const paint = await liveMaterial("paint-a0.05-a1.3");
+    check(paint.material && near(paint.material.base_k, [1 / 1.5, 0.01 / 1.5, 0.01 / 1.5]) &&
+      near(paint.material.base_eta, [1.45 / 1.5, 1.45 / 1.5, 1.45 / 1.5]) && near(paint.material.tau, [0.1, 0.1, 0.1]) && paint.tau === "0.1",
+      `lamina-coat's conductor takes κ1 = (1, 0.01, 0.01) per channel and τa 0.1 (${JSON.stringify(paint)})`);
+    await page.evaluate(() => {
+      const e = document.getElementById("w-live-tau");
+      e.value = "0.2, 0, 1";
+      e.dispatchEvent(new Event("input"));
+    });
+    check(near(await page.evaluate(() => JSON.parse(document.body.dataset.liveMaterial).tau), [0.2, 0, 1]),
+      "the τa widget takes three values, r, g, b");
+
+    // A configuration whose data file is missing: its views are hidden and the page says which
+    // file (the views of the configuration shown before must not stay up under the new name);
+    // choosing another configuration shows the views again. (The browser reports the missing
+    // file on its console; those messages are the point here, not failures.)
+    const damaged = fs.mkdtempSync(path.join(require("os").tmpdir(), "lamina-explorer-"));
+    fs.cpSync(studyDir, damaged, { recursive: true });
+    const missing = "slab-a0.1-a1.3-clear";
+    fs.rmSync(path.join(damaged, "explorer", "data", missing + ".js"));
+    const errorsBefore = errors.length;
+    await page.goto("file://" + path.resolve(damaged, "index.html") + "#config=plastic-P1-a0.05");
+    await page.waitForFunction(() => Number(document.body.dataset.renders || 0) >= 1, null, { timeout: 15000 });
+    await page.evaluate((id) => window.LAMINA_EXPLORER.selectConfig(id), missing);
+    await page.waitForFunction((id) => document.body.dataset.loadError === id, missing, { timeout: 10000 });
+    const shown = await page.evaluate(() => ({ text: document.getElementById("load-error").textContent,
+      views: Array.from(document.querySelectorAll("main .view")).map((v) => getComputedStyle(v).display) }));
+    check(shown.text.includes("explorer/data/" + missing + ".js") && shown.views.every((d) => d === "none"),
+      `a missing data file is named and the views are hidden (${JSON.stringify(shown)})`);
+    const n2 = await renders();
+    await page.evaluate(() => window.LAMINA_EXPLORER.selectConfig("plastic-P1-a0.05"));
+    await waitRender(n2);
+    check(await page.evaluate(() => !document.body.dataset.loadError && document.getElementById("load-error").textContent === "" &&
+      Array.from(document.querySelectorAll("main .view")).every((v) => getComputedStyle(v).display !== "none")),
+      "another configuration shows its views again");
+    const expected = errors.splice(errorsBefore);
+    check(expected.every((e) => /ERR_FILE_NOT_FOUND|Failed to load resource/.test(e)),
+      `only the missing file was reported on the console (${expected})`);
+    fs.rmSync(damaged, { recursive: true, force: true });
   } finally {
     await browser.close();
   }

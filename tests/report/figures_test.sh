@@ -77,6 +77,14 @@ out=$("$lamina" figures "$damaged" 2>&1); rc=$?
 ok test $rc -eq 1
 ok grep -q "cannot draw the figures from this study folder (JSONDecodeError" <<<"$out"
 ok test "$(grep -c Traceback <<<"$out")" -eq 0
+# A study run with --tables none keeps no tables: the page says so, by the option.
+notables="$build/explorer-no-tables"
+rm -rf "$notables"
+"$lamina" compare "$src/examples/plastic.json" --particles 2e3 --grid 9x9 --theta-i 30 --models ww09 \
+    --tables none --no-figures --out "$notables" >/dev/null
+out=$("$lamina" explorer "$notables" 2>&1); rc=$?
+ok test $rc -eq 1
+ok grep -q "config.json: tables: none: the study was run with --tables none" <<<"$out"
 # An unfolded configuration (brushed: anisotropic, lit from φi = 0°, 45°, 90°) of a tiny real
 # study: its slices (the plane φ = φi of each azimuth), albedo panel and error-matrix row are drawn.
 brushed="$build/figures-brushed"
