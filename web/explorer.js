@@ -586,6 +586,10 @@
     });
     layout.title = { text: cfg.id + " · " + incidenceText(cfg, inc) + " · " + (side === "R" ? "reflection" : "transmission") +
       (isUnfolded(cfg) ? " · the plane φ = φi (negative θo) and φi + 180°" : "") +
+      // Light along the normal has no azimuth: the study lights it once, and its slice is the
+      // plane of that incidence's φi, whatever the φi widget says.
+      (isUnfolded(cfg) && thetaI === 0 && incidencesOf(cfg)[inc][1] !== state.phiI
+        ? " (normal incidence is lit once, from φi = " + incidencesOf(cfg)[inc][1] + "°: other planes on the iso maps)" : "") +
       (cfg.spectral ? " · channels: linear sRGB (D65) of a spectral reference, " + cfg.spectral.min_nm + "–" + cfg.spectral.max_nm + " nm" : "") +
       " · dotted: the light's direction (−θi) and the " + (side === "R" ? "mirror" : "straight-through") + " direction",
       font: { size: 13 }, x: 0.01, y: 0.985 };

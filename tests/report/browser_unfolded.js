@@ -127,5 +127,19 @@ async function main(page, check) {
     note: document.getElementById("live-note").textContent, hidden: document.getElementById("live-canvas").hidden }));
   check(live.state === "none" && /No model/.test(live.note) && live.hidden, `the live view has no model to render (${JSON.stringify(live)})`);
   await page.screenshot({ path: shot, fullPage: true });
+  // Normal incidence is lit once (from φi = 0°): with the φi widget at 90° the slice says which
+  // plane it shows rather than claiming the widget's.
+  const thetas = JSON.parse(fs.readFileSync(path.resolve(studyDir, "study.json"), "utf8")).theta_i;
+  const normal = thetas.indexOf(0);
+  check(normal >= 0, "the study has θi = 0 (test premise)");
+  let n = await page.evaluate(() => Number(document.body.dataset.renders));
+  await page.selectOption("#w-phi-i", "90");
+  await page.waitForFunction((k) => Number(document.body.dataset.renders) > k, n, { timeout: 20000 });
+  n = await page.evaluate(() => Number(document.body.dataset.renders));
+  await page.selectOption("#w-incidence", String(normal));
+  await page.waitForFunction((k) => Number(document.body.dataset.renders) > k, n, { timeout: 20000 });
+  const title0 = await page.evaluate(() => document.getElementById("slice").layout.title.text);
+  check(title0.includes("θi = 0°, φi = 0°") && title0.includes("normal incidence is lit once, from φi = 0°"),
+    `at θi = 0 the slice names the plane it shows (${title0})`);
 }
 runStrictPageTest(main);
