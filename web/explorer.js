@@ -743,10 +743,18 @@
     const auto = state.levels.trim() ? null : autoLevels(dmin, dmax);
     const levels = auto ? levelValues(auto) : parseLevels(state.levels);
     const ch = CHANNELS[c];
-    const refLayout = diskLayout("reference · " + ch + " · " + incidenceText(cfg, inc), light);
+    const sideName = side === "R" ? "BRDF" : "BTDF";
+    const refLayout = diskLayout("reference · " + sideName + " · channel " + ch + " · " + incidenceText(cfg, inc), light);
+    // A reference with nothing to contour says why rather than leaving a blank disk: no light on
+    // this side (an opaque slab's BTDF), or all of it in a bin or two (a smooth stack's delta lobe).
+    let lit = 0;
+    for (const row of ref) for (const v of row) if (v > 0) ++lit;
+    const emptyNote = lit === 0 ? "The reference has no light on this side (" + sideName + " 0 in every bin). "
+      : lit <= 2 ? "The reference's light falls in " + lit + " bin" + (lit > 1 ? "s" : "") +
+        " (a smooth interface's delta lobe): too few to contour; the slice shows it. " : "";
     const given = state.levels.trim() ? state.levels.trim().split(/[,\s]+/).length : 0;
     $("w-levels").setCustomValidity(given > levels.length ? "numbers" + (state.log ? " above 0 (log scale)" : "") : "");
-    $("iso-levels").textContent = (levels.length ? "White contour lines at f = " + levels.map(fmt).join(", ") + " 1/sr"
+    $("iso-levels").textContent = emptyNote + (levels.length ? "White contour lines at f = " + levels.map(fmt).join(", ") + " 1/sr"
       : "No contour lines: the levels must be numbers" + (state.log ? " above 0 on the log scale" : "")) +
       (given > levels.length && levels.length ? " (" + (given - levels.length) + " of the levels given ignored: not " +
         (state.log ? "numbers above 0)" : "numbers)") : "") +
@@ -756,7 +764,7 @@
       (state.diffMode === "sigma" ? "; in units of the reference's standard error, |Δf / se| < 2 is within its noise." : ".");
     Plotly.react($("iso-ref"), isoTraces(ref, levels, auto, dmin, dmax, "reference", false), refLayout, PLOT_CONFIG);
     if (mod) {
-      Plotly.react($("iso-model"), isoTraces(mod, levels, auto, dmin, dmax, m, true), diskLayout(m + " · " + ch, light), PLOT_CONFIG);
+      Plotly.react($("iso-model"), isoTraces(mod, levels, auto, dmin, dmax, m, true), diskLayout(m + " · " + sideName + " · channel " + ch, light), PLOT_CONFIG);
       // Δf in 1/sr, or in units of the reference's standard error (|z| < 2: within the noise).
       const sigma = state.diffMode === "sigma" && d.hemiSe ? hemiMap(d, "se", inc, side, c) : null;
       const diff = mod.map((row, j) => row.map((v, i) => {
@@ -975,9 +983,13 @@
       rows.push(MEAN); z.push(zr); text.push(tr); hover.push(hr);
     }
     const all = z.flat().filter((v) => v !== null);
-    const zmin = all.length ? Math.min(...all) : -3, zmax = all.length ? Math.max(...all) : 0;
-    const ticks = [];
-    for (let e = Math.floor(zmin); e <= Math.ceil(zmax); ++e) ticks.push(e);
+    let zmin = all.length ? Math.min(...all) : -3, zmax = all.length ? Math.max(...all) : 0;
+    if (!(zmax > zmin)) { zmin -= 0.5; zmax += 0.5; }  // one value (one configuration, one model)
+    // The colour bar's labels: the decades inside [zmin, zmax], or its two ends where fewer than
+    // two decades fall inside (a bar labelled outside its range shows no label at all).
+    let ticks = [];
+    for (let e = Math.ceil(zmin); e <= Math.floor(zmax); ++e) ticks.push(e);
+    if (ticks.length < 2) ticks = [zmin, zmax];
     const cur = rows.indexOf(state.config);
     const trace = {
       type: "heatmap", x: cols, y: rows, z, text, customdata: hover, zmin, zmax,
@@ -985,10 +997,19 @@
       hovertemplate: "%{customdata}<extra></extra>",
       colorbar: { title: { text: "log scale" }, tickvals: ticks, ticktext: ticks.map((e) => fmt(Math.pow(10, e))), thickness: 12 },
     };
+    // Column headers slanted when level ones would run into each other (long model names: the
+    // ablations' "openpbr:darkening=off"), with the top margin to hold them.
+    const longest = Math.max(...cols.map((c) => String(c).length), 1);
+    const width = $("leaderboard").clientWidth || 900;
+    const slanted = longest * 6.5 > (width - 220) / Math.max(cols.length, 1);
+    const top = slanted ? Math.min(280, 40 + 5 * longest) : 70;
+    // At least 90 pixels of grid, so that the colour bar beside a row or two can be read.
+    const gridHeight = Math.max(19 * rows.length, 90);
     const layout = {
-      height: 110 + 19 * rows.length, margin: { l: 200, r: 20, t: 70, b: 10 },
+      height: 40 + top + gridHeight,
+      margin: { l: Math.min(320, Math.max(200, 24 + 6.6 * Math.max(...rows.map((r) => String(r).length)))), r: 20, t: top, b: 10 },
       // Explicit categories and ranges: the grid stays drawn even where every cell is empty.
-      xaxis: { side: "top", tickangle: 0, fixedrange: true, type: "category", categoryorder: "array",
+      xaxis: { side: "top", tickangle: slanted ? -40 : 0, fixedrange: true, type: "category", categoryorder: "array",
         categoryarray: cols, range: [-0.5, cols.length - 0.5] },
       yaxis: { fixedrange: true, tickfont: { size: 11 }, type: "category", categoryorder: "array",
         categoryarray: rows, range: [rows.length - 0.5, -0.5] },
@@ -999,7 +1020,8 @@
         [{ type: "line", xref: "x", x0: 0.5, x1: 0.5, yref: "paper", y0: 0, y1: 1, line: { color: "#333", width: 1.5 } }],
         rows.length > shownConfigs.length ? [{ type: "line", xref: "paper", x0: 0, x1: 1, yref: "y",
           y0: shownConfigs.length - 0.5, y1: shownConfigs.length - 0.5, line: { color: "#333", width: 1.5 } }] : []),
-      annotations: [{ xref: "paper", yref: "paper", x: 0, y: 1, yanchor: "bottom", yshift: 34, showarrow: false, align: "left",
+      // The caption above the column headers (slanted ones reach top − 20 pixels above the grid).
+      annotations: [{ xref: "paper", yref: "paper", x: 0, y: 1, yanchor: "bottom", yshift: slanted ? top - 24 : 34, showarrow: false, align: "left",
         text: (side === "R" ? "BRDF" : "BTDF") + " · " + (state.lbAgg === "max" ? "worst" : "mean") + " over " +
           (state.lbIncidence === "all" ? "all incidences" : "θi = " + THETA_I[Number(state.lbIncidence)] + "°") +
           " and the selected channels · ≈: within 2× the noise floor · n/s: not supported", font: { size: 11, color: "#555" } }],
