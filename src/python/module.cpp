@@ -122,10 +122,7 @@ std::vector<double> incidences_of(py::handle theta_i) {
         for (py::handle t : py::iter(theta_i))
             out.push_back(t.cast<double>());
     if (out.empty()) throw InputError("arguments", "theta_i", "at least one incidence is needed");
-    for (double t : out)
-        if (!(t >= 0 && t < 90))
-            throw InputError("arguments", "theta_i",
-                             fmt::format("{} is outside the allowed range [0, 90) degrees", t));
+    check_incidence_list(out, "arguments", "theta_i");  // in range, each once (as the CLI's)
     return out;
 }
 
@@ -504,10 +501,19 @@ void bind_errors(py::module_& m) {
         try {
             if (p) std::rethrow_exception(p);
         } catch (const InputError& e) {
-            py::object exc = py::handle(g_input_error)(e.what());
-            exc.attr("file") = e.where();
-            exc.attr("field") = e.field();
-            exc.attr("problem") = e.problem();
+            // A check shared with the CLI names its option ("command line", "--only"); from
+            // Python it is the argument of that name ("arguments", "only").
+            const bool option = e.where() == "command line" && e.field().starts_with("--");
+            std::string field = e.field();
+            if (option) {
+                field = field.substr(2);
+                std::replace(field.begin(), field.end(), '-', '_');
+            }
+            const InputError named = option ? InputError("arguments", field, e.problem()) : e;
+            py::object exc = py::handle(g_input_error)(named.what());
+            exc.attr("file") = named.where();
+            exc.attr("field") = named.field();
+            exc.attr("problem") = named.problem();
             PyErr_SetObject(g_input_error, exc.ptr());
         }
     });

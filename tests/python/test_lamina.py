@@ -103,6 +103,20 @@ def test_study_names_are_checked_before_any_work(tmp_path):
     assert e.value.field == "configs[1].id" and "appears twice" in e.value.problem
     assert not (tmp_path / "c").exists() and not (tmp_path / "s").exists()
     assert not (tmp_path / "x").exists()
+    # A check the CLI shares names the Python argument, not the command-line option.
+    with pytest.raises(lamina.InputError) as e:
+        lamina.study(only="nope*", out=tmp_path / "o", particles=1000, theta_i=[30], grid=(9, 9))
+    assert (e.value.file, e.value.field) == ("arguments", "only")
+    assert "matches no configuration" in e.value.problem and "--only" not in str(e.value)
+
+
+def test_incidences_are_given_once():
+    # As on the command line: a table holds one block per incidence.
+    m = lamina.Model("ww-prime", lamina.Stack(PLASTIC))
+    for call in (lambda: m.binned(theta_i=[30, 30], grid=(9, 9)), lambda: m.albedo([0, 0])):
+        with pytest.raises(lamina.InputError) as e:
+            call()
+        assert e.value.field == "theta_i" and "given twice" in e.value.problem
 
 
 def test_missing_file_names_the_file(tmp_path):
@@ -129,7 +143,7 @@ def test_a_thin_film_runs_on_the_scalar_kernel():
     lens = ROOT / "examples" / "coated-lens.json"
     with pytest.raises(lamina.InputError) as e:
         lamina.simulate(lens, theta_i=[0], particles=1000, kernel="simd")
-    assert e.value.field == "--kernel"
+    assert (e.value.file, e.value.field) == ("arguments", "kernel")  # the argument, not --kernel
     r = lamina.simulate(lens, theta_i=[0], particles=20_000, threads=1)
     # MgF2 a quarter wave thick at 550 nm on glass: R = 1.37 %, 1.25 %, 1.49 % in the channels
     # (the Airy sums; standard error 8e-4) where bare glass reflects 4.26 %.
