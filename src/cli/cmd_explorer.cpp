@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <memory>
 
 namespace lamina::cli {
@@ -19,6 +20,14 @@ Runner add_explorer(CLI::App& app) {
         const ExplorerSummary s = write_explorer(*dir);
         fmt::print("{}/index.html: {} configurations, {:.1f} MB of page data\n", *dir,
                    s.configurations, s.data_bytes / 1e6);
+        // The page is written without it (the leaderboard then says no model has a metric), but
+        // a study always has one: say so rather than leave an empty leaderboard unexplained.
+        const std::filesystem::path metrics = std::filesystem::path(*dir) / "metrics.csv";
+        if (!std::filesystem::exists(metrics))
+            fmt::print(stderr,
+                       "lamina: warning: {} is missing: the page's leaderboard is empty (run "
+                       "the study again to write it)\n",
+                       metrics.string());
         return 0;
     };
 }

@@ -77,6 +77,14 @@ out=$("$lamina" figures "$damaged" 2>&1); rc=$?
 ok test $rc -eq 1
 ok grep -q "cannot draw the figures from this study folder (JSONDecodeError" <<<"$out"
 ok test "$(grep -c Traceback <<<"$out")" -eq 0
+# A study folder without metrics.csv: the page is written, and the missing file named.
+nometrics="$build/explorer-no-metrics"
+rm -rf "$nometrics"
+cp -r "$study" "$nometrics"
+rm "$nometrics/metrics.csv"
+out=$("$lamina" explorer "$nometrics" 2>&1); rc=$?
+ok test $rc -eq 0
+ok grep -q "metrics.csv is missing: the page's leaderboard is empty" <<<"$out"
 # A study run with --tables none keeps no tables: the page says so, by the option.
 notables="$build/explorer-no-tables"
 rm -rf "$notables"
