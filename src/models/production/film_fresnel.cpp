@@ -229,8 +229,10 @@ Rgbd film_reflectance_exact(const FilmOptics& film, double cos_theta) {
                 closed_form_mean(film, c, film.thickness_min_nm, film.thickness_max_nm))
             return *closed;
     const ThinFilmBoundaries<double, 3> boundaries = film.boundaries_from_above(c);
-    return thickness_average_to_opaque(film.thickness_min_nm, film.thickness_max_nm, period,
-                                       opaque_thickness_nm(film, c), [&](double d) {
+    // (One thickness needs no opaque thickness: thickness_average takes it at once.)
+    const double opaque = film.varies() ? opaque_thickness_nm(film, c) : HUGE_VAL;
+    return thickness_average_to_opaque(film.thickness_min_nm, film.thickness_max_nm, period, opaque,
+                                       [&](double d) {
                                            const auto m = film.reflection_from_above(boundaries, d);
                                            return Rgbd(m[0].a, m[1].a, m[2].a);
                                        });
@@ -252,7 +254,8 @@ Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, con
         std::min({film.wavelength_nm[0], film.wavelength_nm[1], film.wavelength_nm[2]});
     const double period = lambda_min / (2 * std::max(std::abs(film.eta_film), 1e-3));
     constexpr double kFadeNm = 30;  // the film is wholly present from 30 nm on
-    const ThinFilmBoundaries<double, 3> boundaries = film.boundaries_from_above(c);
+    const ThinFilmBoundaries<double, 3> boundaries =
+        sin_film < 1 ? film.boundaries_from_above(c) : ThinFilmBoundaries<double, 3>{};
     const auto at_thickness = [&](double d) {
         const double t = clamp((d - 1e-9) / (kFadeNm - 1e-9), 0.0, 1.0),
                      presence = t * t * (3 - 2 * t);
@@ -277,7 +280,9 @@ Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, con
     }
     // Past the fade, and past where the film is opaque (or totally reflecting), at_thickness is
     // constant.
-    const double opaque = sin_film < 1 ? std::max(opaque_thickness_nm(film, c), kFadeNm) : kFadeNm;
+    const double opaque = !film.varies() ? HUGE_VAL
+                          : sin_film < 1 ? std::max(opaque_thickness_nm(film, c), kFadeNm)
+                                         : kFadeNm;
     return thickness_average_to_opaque(lo, hi, period, opaque, at_thickness);
 }
 
