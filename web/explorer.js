@@ -1184,7 +1184,10 @@
     setOptions(select, choices.map((c) => [c, c.startsWith("table:") ? c.slice(6) + " (table)" : c + " (GLSL)"]),
       choices.includes(keep) ? keep : choices[0]);
     if (!choices.length) {
+      // Nothing to draw: no canvas, and none of the models' widgets either.
       $("live-canvas").hidden = true;
+      $("live-coat").hidden = true;
+      $("live-l1").hidden = true;
       note.textContent = "No model of this configuration can be rendered live.";
       document.body.dataset.live = "none";
       return;

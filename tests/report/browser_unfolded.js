@@ -124,8 +124,10 @@ async function main(page, check) {
   // An anisotropic stack has no live model: lamina-1's and lamina-coat's GLSL are isotropic and
   // an unfolded table has no interpolation here. The view says so.
   const live = await page.evaluate(() => ({ state: document.body.dataset.live,
-    note: document.getElementById("live-note").textContent, hidden: document.getElementById("live-canvas").hidden }));
-  check(live.state === "none" && /No model/.test(live.note) && live.hidden, `the live view has no model to render (${JSON.stringify(live)})`);
+    note: document.getElementById("live-note").textContent, hidden: document.getElementById("live-canvas").hidden,
+    widgets: document.getElementById("live-coat").hidden && document.getElementById("live-l1").hidden }));
+  check(live.state === "none" && /No model/.test(live.note) && live.hidden && live.widgets,
+    `the live view has no model to render, and shows no model's widgets (${JSON.stringify(live)})`);
   await page.screenshot({ path: shot, fullPage: true });
   // Normal incidence is lit once (from φi = 0°): with the φi widget at 90° the slice says which
   // plane it shows rather than claiming the widget's.
