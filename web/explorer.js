@@ -584,16 +584,27 @@
         layout.shapes.push({ type: "line", xref: "x" + axisSuffix(k), yref: "y" + axisSuffix(k) + " domain", x0: x, x1: x, y0: 0, y1: 1,
           line: { color: x < 0 ? "#c9a227" : "#999", width: 1, dash: "dot" } });
     });
-    layout.title = { text: cfg.id + " · " + incidenceText(cfg, inc) + " · " + (side === "R" ? "reflection" : "transmission") +
-      (isUnfolded(cfg) ? " · the plane φ = φi (negative θo) and φi + 180°" : "") +
-      // Light along the normal has no azimuth: the study lights it once, and its slice is the
-      // plane of that incidence's φi, whatever the φi widget says.
-      (isUnfolded(cfg) && thetaI === 0 && incidencesOf(cfg)[inc][1] !== state.phiI
-        ? " (normal incidence is lit once, from φi = " + incidencesOf(cfg)[inc][1] + "°: other planes on the iso maps)" : "") +
-      (cfg.spectral ? " · channels: linear sRGB (D65) of a spectral reference, " + cfg.spectral.min_nm + "–" + cfg.spectral.max_nm + " nm" : "") +
-      " · dotted: the light's direction (−θi) and the " + (side === "R" ? "mirror" : "straight-through") + " direction",
-      font: { size: 13 }, x: 0.01, y: 0.985 };
-    layout.margin.t = 46;
+    const parts = [cfg.id, incidenceText(cfg, inc), side === "R" ? "reflection" : "transmission"];
+    if (isUnfolded(cfg))
+      parts.push("the plane φ = φi (negative θo) and φi + 180°" +
+        // Light along the normal has no azimuth: the study lights it once, and its slice is the
+        // plane of that incidence's φi, whatever the φi widget says.
+        (thetaI === 0 && incidencesOf(cfg)[inc][1] !== state.phiI
+          ? " (normal incidence is lit once, from φi = " + incidencesOf(cfg)[inc][1] + "°: other planes on the iso maps)" : ""));
+    if (cfg.spectral)
+      parts.push("channels: linear sRGB (D65) of a spectral reference, " + cfg.spectral.min_nm + "–" + cfg.spectral.max_nm + " nm");
+    parts.push("dotted: the light's direction (−θi) and the " + (side === "R" ? "mirror" : "straight-through") + " direction");
+    // Plotly does not wrap a title: the parts go on as many lines as the plot's width needs.
+    const perLine = Math.max(40, Math.floor(($("slice").clientWidth || 1000) / 7.2));
+    const lines = [""];
+    for (const part of parts) {
+      const last = lines.length - 1;
+      if (lines[last] && lines[last].length + 3 + part.length > perLine) lines.push(part);
+      else lines[last] += (lines[last] ? " · " : "") + part;
+    }
+    layout.title = { text: lines.join(" ·<br>"), font: { size: 13 }, x: 0.01, xanchor: "left", y: 1, yref: "container", yanchor: "top",
+      pad: { t: 6 + 17 * (lines.length - 1) } };  // Plotly anchors a title of several lines by its first
+    layout.margin.t = 46 + 22 * (lines.length - 1);
     for (const a of layout.annotations) a.y = 1.0;
     Plotly.react($("slice"), traces, layout, PLOT_CONFIG);
 
