@@ -491,7 +491,8 @@
     const n = channels.length, gap = 0.045;
     const layout = {
       height, margin: { l: 62, r: 12, t: 30, b: 48 }, hovermode: "closest",
-      legend: { orientation: "h", y: -0.2, x: 0 }, annotations: [], plot_bgcolor: "#fff",
+      // The legend 62 pixels below the plots, clear of the x axes' titles at any height.
+      legend: { orientation: "h", x: 0, yanchor: "top", y: -62 / Math.max(height - 78, 100) }, annotations: [], plot_bgcolor: "#fff",
     };
     channels.forEach((c, k) => {
       const sx = k === 0 ? "" : String(k + 1);
@@ -798,8 +799,13 @@
       }], diskLayout(m + " − reference" + (sigma ? ", in se" : ""), light), PLOT_CONFIG);
     } else {
       const layout = diskLayout(m + " · " + ch);
-      layout.annotations.push({ x: 0, y: 0, text: "<b>not supported</b><br>" + (unsupportedReason(cfg, m) || ""),
-        showarrow: false, font: { size: 14, color: "#8a1c1c" } });
+      // The reason on lines that fit the disk (Plotly does not wrap an annotation).
+      const words = String(unsupportedReason(cfg, m) || "").split(" "), reason = [""];
+      for (const w of words)
+        if (reason[reason.length - 1] && reason[reason.length - 1].length + 1 + w.length > 34) reason.push(w);
+        else reason[reason.length - 1] += (reason[reason.length - 1] ? " " : "") + w;
+      layout.annotations.push({ x: 0, y: 0, text: "<b>not supported</b><br>" + reason.join("<br>"),
+        showarrow: false, font: { size: 12, color: "#8a1c1c" } });
       Plotly.react($("iso-model"), [], layout, PLOT_CONFIG);
       const dl = diskLayout(m + " − reference");
       dl.annotations.push({ x: 0, y: 0, text: "<b>not supported</b>", showarrow: false, font: { size: 14, color: "#8a1c1c" } });
@@ -896,8 +902,11 @@
       // What the reference loses to its single-scattering microsurfaces (config.json → energy):
       // energy that no side of the reference holds, and that models which conserve it put back.
       const lost = cfg.budget && cfg.budget.lost_microsurface;
-      // Drawn only where some channel lost something (an entry is an RGB triple, or null).
-      if (lost && lost.some((v) => v && v.some((x) => x > 0))) {
+      // Drawn only where some channel lost something (an entry is an RGB triple, or null); its
+      // note under the plot with it.
+      const lostAny = Boolean(lost && lost.some((v) => v && v.some((x) => x > 0)));
+      $("albedo-lost-note").hidden = !lostAny;
+      if (lostAny) {
         traces.push(Object.assign({ x: THETA_I, y: pick(lost).map((v) => (v ? v[c] : null)), type: "scatter",
           mode: "lines+markers", name: "reference: lost to microsurfaces", legendgroup: "lost", showlegend: k === 0,
           line: { color: "#888", width: 1.5, dash: "dot" }, marker: { size: 4, symbol: "x" },

@@ -21,6 +21,11 @@ async function main(page, check) {
     const what = `${id} ${side}`;
     check(await page.evaluate(() => document.body.dataset.polarization) === "drawn", `${what}: the polarization view is drawn`);
     check(await page.evaluate(() => document.getElementById("pol-none").hidden), `${what}: no "not polarized" note`);
+    // The exact reference follows the microsurfaces' multiple scattering: nothing lost, no
+    // microsurface-loss curve and no note about one.
+    check(await page.evaluate(() => document.getElementById("albedo-lost-note").hidden &&
+      !document.getElementById("albedo").data.some((t) => /lost to microsurfaces/.test(t.name || ""))),
+      `${what}: no microsurface-loss curve or note (the exact reference loses nothing there)`);
     const drawn = await page.evaluate(() => {
       const dop = document.getElementById("pol-dop").data[0], aolp = document.getElementById("pol-aolp").data[0];
       return { x: Array.from(dop.x), y: Array.from(dop.y), dop: dop.z, se: dop.customdata, aolp: aolp.z };

@@ -24,6 +24,7 @@ async function main(page, check) {
   check(expected.some((v) => v > 0), `${shown} loses energy to its rough coat (test premise)`);
   check(lost !== null && lost.length === expected.length && lost.every((v, i) => Math.abs(v - expected[i]) <= 1e-12 * Math.max(1, expected[i])),
     `the albedo view draws the reference's microsurface loss (${lost} against config.json's ${expected})`);
+  check(await page.evaluate(() => !document.getElementById("albedo-lost-note").hidden), "… with its note");
   // The slice draws exactly the reference's values of tables.lza (the page inflates the
   // explorer's packed data): the incidence shown, side R, red channel, along the incident plane.
   const tab = readPacked(path.resolve(studyDir, "configs", shown, "tables.lza"));
