@@ -979,7 +979,8 @@ std::string describe(const Stack& stack) {
             out +=
                 fmt::format(" | medium τa={}", m.tau_a_spectrum ? spectrum_label(*m.tau_a_spectrum)
                                                                 : show_rgb(m.tau_a));
-            if (m.scatters())
+            // A τs spectrum scatters at some wavelength even where the channels' values are 0.
+            if (m.scatters() || m.tau_s_spectrum)
                 out += fmt::format(
                     " τs={} g={}",
                     m.tau_s_spectrum ? spectrum_label(*m.tau_s_spectrum) : show_rgb(m.tau_s),

@@ -157,6 +157,9 @@ check_says validate-describes 0 "plastic: air | dielectric η=1.5 α=0.2 | mediu
     "$lamina" validate "$src/examples/plastic.json"
 check_says validate-slab 0 "transmits" "$lamina" validate "$src/examples/slab.json"
 check_says validate-scattering 0 "τs=0.5 g=0.3" "$lamina" validate "$src/examples/milky-coat.json"
+# A τs spectrum that is 0 at the channels' wavelengths still scatters (at 400 nm): it is described.
+printf '{"layers": [{"interface": {"type": "dielectric", "eta": 1, "alpha": 0}, "medium": {"tau_s": {"spectrum": [[360, 0], [400, 5], [440, 0], [830, 0]]}}}, {"interface": {"type": "lambertian", "albedo": 0}}]}' >"$tmp/ts-spectrum.json"
+check_says validate-scattering-spectrum 0 "medium τa=0 τs=" "$lamina" validate "$tmp/ts-spectrum.json"
 check_says validate-no-file 1 "lamina: command line: STACK: required" "$lamina" validate
 
 # validate: each kind of bad input fails and the message names the field.
