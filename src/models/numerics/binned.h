@@ -28,11 +28,13 @@
 // every azimuth): a lobe of α = 0.001 inside one bin is then resolved even though no coarse
 // node sees it. Rectangles are halved across their longer side on the sphere (near the normal a
 // bin is a sliver: in θ alone) or both ways. The embedded rule's estimate is blind to variation
-// along one coordinate alone (on a function of θ alone the two rules agree), which matters only
-// for a lobe's tail in a sliver near the pole. Delta lobes add energy / Ω⊥ to the bin they hit.
-// Parallel over (incidence, side, θ row) with OpenMP, each row through the incidence's evaluator
-// for one thread where the model has one (IncidentEvaluator::for_one_thread: the same values, bit
-// for bit); every bin is computed independently, so the output does not depend on the thread count.
+// along one coordinate alone (on a function of θ alone the two rules agree): a sharp lobe's bins
+// in the row at the horizon, where masking falls to 0 within about α of 90°, are the ones it
+// leaves off (docs/models.md, "Evaluating a model"). Delta lobes add energy / Ω⊥ to the bin they
+// hit. Parallel over (incidence, side, θ row) with OpenMP, each row through the incidence's
+// evaluator for one thread where the model has one (IncidentEvaluator::for_one_thread: the same
+// values, bit for bit); every bin is computed independently, so the output does not depend on the
+// thread count.
 
 #include "core/grid.h"
 #include "core/table.h"
