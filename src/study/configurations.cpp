@@ -87,6 +87,9 @@ std::map<std::string, std::string> describe_parameters(const Stack& stack) {
         p["tau"] = rgb_text(top.has_medium ? top.medium.tau_a : Rgbd(0.0));
         if (top.has_medium && top.medium.scatters()) p["tau_s"] = rgb_text(top.medium.tau_s);
     }
+    // More than a coat over a base: the parameters above describe the top and the base only,
+    // and the count says so (the explorer's single-coat live model is then not offered).
+    if (stack.layers.size() > 2) p["layers"] = number_text(double(stack.layers.size()));
     if (stack.layers.size() >= 2) {
         const InterfaceSpec& base = stack.base();
         if (base.has_film) {

@@ -181,6 +181,12 @@ async function main() {
     });
     check(near(await page.evaluate(() => JSON.parse(document.body.dataset.liveMaterial).tau), [0.2, 0, 1]),
       "the τa widget takes three values, r, g, b");
+    // A stack of more than a coat over a base (its parameters count the layers) is not one
+    // lamina-coat can draw: not offered.
+    await page.evaluate(() => { window.LAMINA_EXPLORER.configs.find((c) => c.id === "plastic-P2-a0.3").parameters.layers = "3"; });
+    const longer = await liveMaterial("plastic-P2-a0.3");
+    check(Array.isArray(longer.offered) && !longer.offered.includes("lamina-coat"),
+      `a stack of three layers is not offered to lamina-coat (${JSON.stringify(longer)})`);
 
     // A configuration whose data file is missing: its views are hidden and the page says which
     // file (the views of the configuration shown before must not stay up under the new name);

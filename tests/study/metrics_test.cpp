@@ -214,6 +214,19 @@ TEST(StudyConfigurations, SixtyWithStableUniqueIds) {
 // docs/study.md, "The iridescent category": six clear coats over filmed metals, stable ids,
 // valid stacks (the reader's ranges, through its JSON round trip), added by every preset but the
 // quick one.
+// The parameters name the top coat and the base; a stack with more layers says how many, so that
+// nothing reads it as one coat over a base (the explorer's live lamina-coat).
+TEST(StudyConfigurations, ParametersCountTheLayersOfALongerStack) {
+    const Layer base = test::lambertian_layer(Rgbd(0.8));
+    const Stack two = test::make_stack({test::dielectric_layer(1.5, 0.1), base});
+    const Stack three = test::make_stack(
+        {test::dielectric_layer(1.5, 0.1), test::dielectric_layer(1.3, 0.2), base});
+    EXPECT_EQ(describe_parameters(two).count("layers"), 0u);
+    EXPECT_EQ(describe_parameters(three).at("layers"), "3");
+    for (const StudyConfiguration& c : preset_configurations("paper"))
+        EXPECT_EQ(c.parameters.count("layers"), 0u) << c.id;  // the study's stacks are coat + base
+}
+
 TEST(StudyConfigurations, IridescentInTheLargerPresetsOnly) {
     const auto irid = iridescent_configurations();
     ASSERT_EQ(irid.size(), 6u);
