@@ -110,7 +110,12 @@ LAMINA_LANE_INLINE T fresnel_conductor(T cos_theta_i, T eta, T k) {
     const T eta2 = eta * eta, k2 = k * k;
     const T t0 = eta2 - k2 - sin2;
     const T a2_plus_b2 = L::sqrt(t0 * t0 + L::constant(4) * eta2 * k2);
-    const T a = L::sqrt(L::max(L::constant(0.5) * (a2_plus_b2 + t0), zero));
+    // a² = (a² + b² + t0)/2 cancels where t0 < 0 (a metal: η² − k² ≈ −16 for gold, so a² is a
+    // small difference of numbers near 16, 14 float ulps off); there it is evaluated as the equal
+    // 2η²k² / (a² + b² − t0), since (a² + b²)² − t0² = 4η²k².
+    const T a2 = L::select(L::less(t0, zero), two * eta2 * k2 / (a2_plus_b2 - t0),
+                           L::constant(0.5) * (a2_plus_b2 + t0));
+    const T a = L::sqrt(L::max(a2, zero));
     const T t1 = a2_plus_b2 + cos2;
     const T t2 = two * cos_theta_i * a;
     // The numerators are sums of squares, t1 − t2 = (a − cos θ)² + b² and t3 − t4 =

@@ -49,10 +49,16 @@ LAMINA_LANE_INLINE T hg_phase(T cos_theta, T g) {
 /// PBR 4th ed., §11.3.1); uniform when |g| is tiny (|g| < 1e-3). Branch-free.
 template <typename T, typename L = Lane<T>>
 LAMINA_LANE_INLINE T sample_hg_cos_theta(T g, T u) {
-    const T one = L::constant(1), two = L::constant(2);
-    const T s = (one - g * g) / (one + g - two * g * u);
+    const T zero = L::constant(0), one = L::constant(1), two = L::constant(2);
+    // s = (1 − g²) / (1 + g − 2gu), both written without cancellation as |g| → 1 (1 − g² and
+    // 1 + g − 2gu near 0 would be differences of numbers near 1 or 2, 50 to 200 ulps off at
+    // g = 0.99): (1 − g)(1 + g), and (1 − |g|) + 2|g|(1 − u) for g > 0, (1 − |g|) + 2|g|u for
+    // g < 0, sums of non-negative terms.
+    const T a = L::max(g, zero - g);
+    const T s =
+        (one - g) * (one + g) / ((one - a) + two * a * L::select(L::less(zero, g), one - u, u));
     const T inverted = L::min(L::max((one + g * g - s * s) / (two * g), L::constant(-1)), one);
-    const auto tiny = L::less(L::max(g, L::constant(0) - g), L::constant(1e-3));
+    const auto tiny = L::less(a, L::constant(1e-3));
     return L::select(tiny, one - two * u, inverted);
 }
 

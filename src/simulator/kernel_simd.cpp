@@ -1018,6 +1018,11 @@ void TraceBlockSimd(const BlockJob& job, Tally& tally, BlockBudget& block) {
         TraceBlockFor<false>(*job.stack, job, tally, block);
 }
 
+// The instruction set this code was compiled for.
+const char* TargetNameSimd() {
+    return hwy::TargetName(HWY_TARGET);
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace lamina
 HWY_AFTER_NAMESPACE();
@@ -1026,6 +1031,7 @@ HWY_AFTER_NAMESPACE();
 namespace lamina {
 
 HWY_EXPORT(TraceBlockSimd);
+HWY_EXPORT(TargetNameSimd);
 void trace_block_simd(const BlockJob& job, Tally& tally, BlockBudget& block) {
     HWY_DYNAMIC_DISPATCH(TraceBlockSimd)(job, tally, block);
 }
@@ -1042,7 +1048,13 @@ void select_simd_target() {
                 if ((hwy::SupportedTargets() & bit) == 0)
                     throw InputError("environment", "LAMINA_SIMD_TARGET",
                                      fmt::format("this CPU does not support {}", wanted));
-                hwy::DisableTargets(HWY_TARGETS & (bit - 1));
+                // The cap is a mock of the CPU's supported set, and the dispatch is updated to
+                // it. Highway 1.0's DisableTargets does not hold: it leaves enabled the better
+                // sets not compiled here (AVX3_DL on a Zen 4 or Sapphire Rapids CPU, which
+                // dispatches to AVX3), and every SupportedTargets() call resets the dispatch to
+                // the CPU's full set.
+                hwy::SetSupportedTargetsForTest(hwy::SupportedTargets() & ~(bit - 1));
+                hwy::GetChosenTarget().Update(hwy::SupportedTargets());
                 return true;
             }
             names += fmt::format("{}{}", names.empty() ? "" : ", ", hwy::TargetName(bit));
@@ -1056,9 +1068,8 @@ void select_simd_target() {
 
 const char* simd_target_name() {
     select_simd_target();
-    // Dynamic dispatch picks the best target that is both compiled and supported: the lowest bit.
-    const std::int64_t targets = hwy::SupportedTargets() & HWY_TARGETS;
-    return hwy::TargetName(targets & -targets);
+    // The set the dispatch takes, named by the code it runs.
+    return HWY_DYNAMIC_DISPATCH(TargetNameSimd)();
 }
 
 }  // namespace lamina

@@ -205,9 +205,12 @@ TEST(KernelSimd, LaneBinsAreTheGridsBins) {
 // template): on the dispatched instruction set's vectors against the scalar float instantiation,
 // for random cosines on both sides and the edges (normal and grazing incidence from either side,
 // the critical angle, total internal reflection), for η above and below 1 and η = 1. The two
-// evaluate the same operations; the vectors may fuse a multiply-add where the scalar compiler does
-// not (or the reverse), so they agree to 4 float ulps of 1 (the results lie in [0, 1]) away from
-// the critical angle, and total internal reflection gives exactly R = 1 and cos θt = 0.
+// evaluate the same operations, but one may fuse a multiply-add where the other does not (SSE4 has
+// no fused multiply-add): sin²θt = (1 − cos²θi)/η² then differs by up to (1/η² + 3) ulps of 1, and
+// cos θt = √(1 − sin²θt) by that over 2 cos θt (the cancellation near the critical angle); R moves
+// by |dR/d cos θt| times that, |dR_s/dt| = 4ηc|c − ηt|/(c + ηt)³ and |dR_p/dt| = 4ηc|ηc − t|/(ηc +
+// t)³ (c = cos θi, t = cos θt, η the index crossed), plus 4 ulps of 1 of R's own rounding (its
+// values lie in [0, 1]). Total internal reflection gives exactly R = 1 and cos θt = 0.
 TEST(KernelSimd, FresnelDielectricLanes) {
     ParticleRng rng(18, 0, 0);
     for (const float eta : {1.5f, 1 / 1.5f, 1.f, 2.4f, 1 / 2.4f}) {
@@ -220,7 +223,7 @@ TEST(KernelSimd, FresnelDielectricLanes) {
         std::vector<float> r, t;
         simd_fresnel_dielectric(cos_theta, eta, r, t);
         ASSERT_EQ(r.size(), cos_theta.size());
-        double worst = 0;
+        double worst = 0;  // in units of the point's bound
         for (std::size_t j = 0; j < cos_theta.size(); ++j) {
             const FresnelDielectric<float> s = fresnel_dielectric_full(cos_theta[j], eta, 1 / eta);
             ASSERT_TRUE(std::isfinite(r[j]) && std::isfinite(t[j])) << cos_theta[j];
@@ -235,10 +238,18 @@ TEST(KernelSimd, FresnelDielectricLanes) {
                 continue;
             }
             if (tir_scalar) continue;  // both exactly R = 1, cos θt = 0
-            worst = std::max({worst, std::abs(double(r[j]) - s.reflectance),
-                              std::abs(double(t[j]) - s.cos_theta_t)});
+            constexpr double ulp = 0x1p-24;
+            const double n = s.eta, c = std::abs(double(cos_theta[j]));
+            const double ct = s.cos_theta_t;
+            const double bound_t = 4 * ulp + (1 / (n * n) + 3) * ulp / (2 * ct);
+            const double slope = (4 * n * c * std::abs(c - n * ct) / std::pow(c + n * ct, 3) +
+                                  4 * n * c * std::abs(n * c - ct) / std::pow(n * c + ct, 3)) /
+                                 2;
+            const double bound_r = 4 * ulp + slope * bound_t;
+            worst = std::max({worst, std::abs(double(r[j]) - s.reflectance) / bound_r,
+                              std::abs(double(t[j]) - ct) / bound_t});
         }
-        EXPECT_LE(worst, 4 * 0x1p-24) << "η " << eta << " on " << simd_target_name();
+        EXPECT_LE(worst, 1.0) << "η " << eta << " on " << simd_target_name();
     }
 }
 
@@ -246,8 +257,9 @@ TEST(KernelSimd, FresnelDielectricLanes) {
 // template): on the dispatched instruction set's vectors against the scalar float instantiation,
 // for random cosines in [0, 1] and the edges (normal and grazing incidence), gold, a strong
 // absorber, a weak one and k = 0 (where it is the dielectric factor, total reflection included
-// for η < 1): within 8 float ulps of 1 (two divisions and two square roots, each ≤ 1 ulp, the
-// same operations on both; results in [0, 1]).
+// for η < 1): within 8 float ulps of 1 (three divisions and two square roots, each ≤ 1 ulp, the
+// same operations on both, none cancelling — a metal's a² is not taken as a difference; results
+// in [0, 1]).
 TEST(KernelSimd, FresnelConductorLanes) {
     ParticleRng rng(19, 0, 0);
     struct Index {
@@ -383,7 +395,8 @@ TEST(KernelSimd, FresnelMuellerLanes) {
 // cancels (down to (1 − |g|)² = 1e-4 for g = 0.99 in the forward direction), so rounding — fused
 // multiply-adds on one side and not the other — is amplified by κ = (1 + g² + 2|g cos θ|)/denom,
 // and p ∝ denom^{−3/2} by 3/2 of it: relative error ≤ (1 + 1.5 κ) · 8 ulp. The sampled cosine:
-// 2e-6 absolute (its (1 + g² − s²)/(2g) loses up to a few ulp of 1/|g| relative: 1e-3 ≤ |g|).
+// hg_cos_tolerance's first-order bound (s = (1 − g²)/(1 + g − 2gu) and (1 + g² − s²)/(2g) both
+// cancel, by g²/(1 − g²) as g → ±1 and by 1/|g| as g → 0).
 TEST(KernelSimd, HenyeyGreensteinLanes) {
     ParticleRng rng(20, 0, 0);
     std::vector<float> g, x;
@@ -404,10 +417,11 @@ TEST(KernelSimd, HenyeyGreensteinLanes) {
         const double kappa = (1 + gd * gd + 2 * std::abs(gd * xd)) / denom;
         worst_phase = std::max(
             worst_phase, std::abs(double(phase[j]) / p - 1) / ((1 + 1.5 * kappa) * 8 * 0x1p-24));
-        worst_cos = std::max(worst_cos, std::abs(double(cos_theta[j]) - c));
+        worst_cos =
+            std::max(worst_cos, std::abs(double(cos_theta[j]) - c) / hg_cos_tolerance(g[j], x[j]));
     }
     EXPECT_LE(worst_phase, 1.0) << simd_target_name();  // in units of the bound
-    EXPECT_LE(worst_cos, 2e-6) << simd_target_name();
+    EXPECT_LE(worst_cos, 1.0) << simd_target_name();
 }
 
 // The lane test of the walk's GGX pieces (physics/microfacet.h ggx_lambda and

@@ -5,6 +5,8 @@
 
 #include "support/simd_probes.h"
 
+#include "simulator/kernel_simd.h"
+
 #include <algorithm>
 
 #undef HWY_TARGET_INCLUDE
@@ -497,6 +499,9 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace lamina {
 
+// A probe runs on the instruction set the kernel would (LAMINA_SIMD_TARGET applied first).
+#define LAMINA_PROBE_DISPATCH(FUNC) (select_simd_target(), HWY_DYNAMIC_DISPATCH(FUNC))
+
 HWY_EXPORT(PcgDrawsForTest);
 HWY_EXPORT(CosSin2PiForTest);
 HWY_EXPORT(SmithRefractionEscapeForTest);
@@ -516,20 +521,20 @@ std::vector<float> simd_particle_uniforms(std::uint64_t seed, std::uint64_t stre
                                           std::uint64_t first, std::uint64_t n_particles,
                                           std::uint64_t n_draws) {
     std::vector<float> out(n_particles * n_draws);
-    HWY_DYNAMIC_DISPATCH(PcgDrawsForTest)(seed, stream, first, n_particles, n_draws, out.data());
+    LAMINA_PROBE_DISPATCH(PcgDrawsForTest)(seed, stream, first, n_particles, n_draws, out.data());
     return out;
 }
 
 void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::vector<float>& s) {
     c.resize(u.size());
     s.resize(u.size());
-    HWY_DYNAMIC_DISPATCH(CosSin2PiForTest)(u.data(), u.size(), c.data(), s.data());
+    LAMINA_PROBE_DISPATCH(CosSin2PiForTest)(u.data(), u.size(), c.data(), s.data());
 }
 
 std::vector<std::int64_t> simd_lane_bins(const HemisphereGrid& grid, const std::vector<float>& d) {
     select_simd_target();
     std::vector<std::int64_t> bins(d.size() / 3);
-    HWY_DYNAMIC_DISPATCH(LaneBinsForTest)(grid, d.data(), bins.size(), bins.data());
+    LAMINA_PROBE_DISPATCH(LaneBinsForTest)(grid, d.data(), bins.size(), bins.data());
     return bins;
 }
 
@@ -537,7 +542,7 @@ std::vector<float> simd_smith_refraction_escape(const std::vector<float>& r_i,
                                                 const std::vector<float>& r_o) {
     select_simd_target();
     std::vector<float> out(r_i.size());
-    HWY_DYNAMIC_DISPATCH(SmithRefractionEscapeForTest)
+    LAMINA_PROBE_DISPATCH(SmithRefractionEscapeForTest)
     (r_i.data(), r_o.data(), r_i.size(), out.data());
     return out;
 }
@@ -547,7 +552,7 @@ void simd_fresnel_dielectric(const std::vector<float>& cos_theta, float eta,
     select_simd_target();
     reflectance.resize(cos_theta.size());
     cos_theta_t.resize(cos_theta.size());
-    HWY_DYNAMIC_DISPATCH(FresnelDielectricForTest)
+    LAMINA_PROBE_DISPATCH(FresnelDielectricForTest)
     (cos_theta.data(), cos_theta.size(), eta, reflectance.data(), cos_theta_t.data());
 }
 
@@ -555,7 +560,7 @@ std::vector<float> simd_beer_lambert_lanes(const std::vector<float>& tau,
                                            const std::vector<float>& inv_mu) {
     select_simd_target();
     std::vector<float> out(tau.size());
-    HWY_DYNAMIC_DISPATCH(BeerLambertLanesForTest)
+    LAMINA_PROBE_DISPATCH(BeerLambertLanesForTest)
     (tau.data(), inv_mu.data(), tau.size(), out.data());
     return out;
 }
@@ -563,7 +568,7 @@ std::vector<float> simd_beer_lambert_lanes(const std::vector<float>& tau,
 std::vector<float> simd_fresnel_conductor(const std::vector<float>& cos_theta, float eta, float k) {
     select_simd_target();
     std::vector<float> out(cos_theta.size());
-    HWY_DYNAMIC_DISPATCH(FresnelConductorForTest)
+    LAMINA_PROBE_DISPATCH(FresnelConductorForTest)
     (cos_theta.data(), cos_theta.size(), eta, k, out.data());
     return out;
 }
@@ -573,7 +578,7 @@ void simd_henyey_greenstein(const std::vector<float>& g, const std::vector<float
     select_simd_target();
     phase.resize(g.size());
     cos_theta.resize(g.size());
-    HWY_DYNAMIC_DISPATCH(HenyeyGreensteinForTest)
+    LAMINA_PROBE_DISPATCH(HenyeyGreensteinForTest)
     (g.data(), x.data(), g.size(), phase.data(), cos_theta.data());
 }
 
@@ -583,7 +588,7 @@ void simd_ggx_lanes(float alpha, const std::vector<float>& w, const std::vector<
     select_simd_target();
     lambda.resize(u1.size());
     wm.resize(3 * u1.size());
-    HWY_DYNAMIC_DISPATCH(GgxLanesForTest)
+    LAMINA_PROBE_DISPATCH(GgxLanesForTest)
     (alpha, w.data(), u1.data(), u2.data(), u1.size(), lambda.data(), wm.data());
 }
 
@@ -598,7 +603,7 @@ SimdEventResult simd_interface_events(int kind, const std::vector<float>& params
     r.fresnel.assign(3 * n, 1.f);
     r.reflected.resize(n);
     r.degenerate.resize(n);
-    HWY_DYNAMIC_DISPATCH(InterfaceEventsForTest)
+    LAMINA_PROBE_DISPATCH(InterfaceEventsForTest)
     (kind, params.data(), flags.data(), wi.data(), u.data(), n, r.wo.data(), r.shadowing.data(),
      r.fresnel.data(), r.reflected.data(), r.degenerate.data());
     return r;
@@ -616,7 +621,7 @@ SimdMediumResult simd_medium_step(const CompiledMedium<float>& medium, const std
     r.d.resize(3 * n);
     r.phase.resize(3 * n);
     r.draws.resize(n);
-    HWY_DYNAMIC_DISPATCH(MediumStepForTest)
+    LAMINA_PROBE_DISPATCH(MediumStepForTest)
     (medium, d.data(), w.data(), depth.data(), u.data(), n, r.leaves.data(), r.factor.data(),
      r.depth.data(), r.d.data(), r.phase.data(), r.draws.data());
     return r;
@@ -626,7 +631,7 @@ std::vector<float> simd_fresnel_mueller(int kind, const std::vector<float>& cos_
                                         float k) {
     select_simd_target();
     std::vector<float> out(cos_theta.size() * (kind == 0 ? 9 : 4));
-    HWY_DYNAMIC_DISPATCH(FresnelMuellerForTest)
+    LAMINA_PROBE_DISPATCH(FresnelMuellerForTest)
     (kind, cos_theta.data(), cos_theta.size(), eta, k, out.data());
     return out;
 }
@@ -645,7 +650,7 @@ SimdPolarizedEventResult simd_polarized_interface_events(
     r.x.resize(3 * n);
     r.stokes.resize(9 * n);
     r.factor.resize(3 * n);
-    HWY_DYNAMIC_DISPATCH(PolarizedEventsForTest)
+    LAMINA_PROBE_DISPATCH(PolarizedEventsForTest)
     (kind, params.data(), flags.data(), wi.data(), u.data(), x.data(), stokes.data(), flux.data(),
      channels, n, r.event.wo.data(), r.event.shadowing.data(), r.event.reflected.data(),
      r.event.degenerate.data(), r.x.data(), r.stokes.data(), r.factor.data());
@@ -662,7 +667,7 @@ SimdWalkResult simd_microsurface_walk(const std::vector<float>& wi, float alpha,
     r.weight.resize(3 * n);
     r.order.resize(n);
     r.outcome.resize(n);
-    HWY_DYNAMIC_DISPATCH(MicrosurfaceWalkForTest)
+    LAMINA_PROBE_DISPATCH(MicrosurfaceWalkForTest)
     (wi.data(), n, alpha, dielectric, eta, k, max_order, seed, r.wo.data(), r.weight.data(),
      r.order.data(), r.outcome.data());
     return r;

@@ -9,6 +9,8 @@
 #include "layers/compiled_stack.h"
 #include "simulator/kernel_simd.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -125,5 +127,29 @@ SimdPolarizedEventResult simd_polarized_interface_events(
     int kind, const std::vector<float>& params, const std::vector<std::int32_t>& flags,
     const std::vector<float>& wi, const std::vector<float>& u, const std::vector<float>& x,
     const std::vector<float>& stokes, const std::vector<float>& flux, int channels);
+
+/// How far two float evaluations of physics/phase.h sample_hg_cos_theta(g, u) may differ when one
+/// fuses multiply-adds and the other does not (SSE4 has none): twice a first-order bound on the
+/// rounding of one, in double. s = (1 − g)(1 + g) / ((1 − |g|) + 2|g|(1 − u or u)), products and
+/// sums of non-negative terms, carries 8 ulps relative; the cosine's numerator 1 + g² − s² then
+/// loses (1 + g² + s²(1 + 2 · 8)) ulps, divided by 2|g| (its cancellation as g → 0), plus 2 ulps.
+/// Where |g| < 1e-3 the cosine is 1 − 2u: 4 ulps.
+inline double hg_cos_tolerance(float g_float, float u_float) {
+    constexpr double ulp = 0x1p-24;
+    const double g = g_float, u = u_float, a = std::abs(g);
+    if (a < 1e-3) return 4 * ulp;
+    const double s = (1 - g * g) / (1 + g - 2 * g * u);
+    const double numerator_ulps = 1 + g * g + s * s * (1 + 2 * 8);
+    return 2 * (numerator_ulps / (2 * a) + 2) * ulp;
+}
+
+/// hg_cos_tolerance's largest value over u in [0, 1] (65 points, the ends included), for a
+/// sample whose uniform is not known.
+inline double hg_cos_tolerance_max(float g) {
+    double worst = 0;
+    for (int k = 0; k <= 64; ++k)
+        worst = std::max(worst, hg_cos_tolerance(g, std::min(float(k) / 64, 1 - 0x1p-24f)));
+    return worst;
+}
 
 }  // namespace lamina
