@@ -502,14 +502,15 @@ void bind_errors(py::module_& m) {
             if (p) std::rethrow_exception(p);
         } catch (const InputError& e) {
             // A check shared with the CLI names its option ("command line", "--only"); from
-            // Python it is the argument of that name ("arguments", "only").
-            const bool option = e.where() == "command line" && e.field().starts_with("--");
+            // Python it is the argument of that name ("arguments", "only"), and the CLI's other
+            // arguments (a model's "name", its "options") are Python's too.
+            const bool command_line = e.where() == "command line";
             std::string field = e.field();
-            if (option) {
+            if (command_line && field.starts_with("--")) {
                 field = field.substr(2);
                 std::replace(field.begin(), field.end(), '-', '_');
             }
-            const InputError named = option ? InputError("arguments", field, e.problem()) : e;
+            const InputError named = command_line ? InputError("arguments", field, e.problem()) : e;
             py::object exc = py::handle(g_input_error)(named.what());
             exc.attr("file") = named.where();
             exc.attr("field") = named.field();
@@ -829,9 +830,29 @@ void bind_models(py::module_& m) {
         .def(py::init([](const std::string& name, py::handle stack, py::kwargs kwargs) {
                  auto pm = std::make_unique<PyModel>();
                  const ModelEntry& entry = find_model(name, "name");
+                 // A keyword cannot hold a dash: the option round-trip is the keyword round_trip.
+                 const std::vector<OptionSpec> specs = entry.options();
                  std::vector<std::string> assignments;
-                 for (auto [k, v] : kwargs)
-                     assignments.push_back(py::str(k).cast<std::string>() + "=" + option_text(v));
+                 for (auto [k, v] : kwargs) {
+                     const std::string keyword = py::str(k).cast<std::string>();
+                     std::string key = keyword;
+                     std::replace(key.begin(), key.end(), '_', '-');
+                     if (std::none_of(specs.begin(), specs.end(),
+                                      [&](const OptionSpec& o) { return o.key == key; })) {
+                         std::vector<std::string> keywords;
+                         for (const OptionSpec& o : specs) {
+                             keywords.push_back(o.key);
+                             std::replace(keywords.back().begin(), keywords.back().end(), '-', '_');
+                         }
+                         throw InputError(
+                             "arguments", keyword,
+                             fmt::format(
+                                 "model '{}' has no option '{}'; its options: {}", name, keyword,
+                                 keywords.empty() ? "none"
+                                                  : fmt::format("{}", fmt::join(keywords, ", "))));
+                     }
+                     assignments.push_back(key + "=" + option_text(v));
+                 }
                  pm->name = name;
                  pm->stack = stack_of(stack);
                  pm->options = resolve_options(entry, assignments, "options");

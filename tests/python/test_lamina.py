@@ -342,8 +342,23 @@ def test_model_rejects_bad_directions_and_options():
     with pytest.raises(lamina.InputError) as e:
         lamina.Model("ww-prime", PLASTIC, nosuchoption="on")
     assert "nosuchoption" in e.value.problem
-    with pytest.raises(lamina.InputError):
+    assert (e.value.file, e.value.field) == ("arguments", "nosuchoption")
+    with pytest.raises(lamina.InputError) as e:
         lamina.Model("ww10", PLASTIC)
+    assert (e.value.file, e.value.field) == ("arguments", "name")
+
+
+def test_model_options_with_a_dash_are_keywords_with_an_underscore():
+    # lamina-1's round-trip option: round_trip="series" is the CLI's lamina-1:round-trip=series.
+    m = lamina.Model("lamina-1", PLASTIC, round_trip="series")
+    assert m.options["round-trip"] == "series"
+    assert lamina.Model("lamina-1", PLASTIC).options["round-trip"] == "lobe"
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Model("lamina-1", PLASTIC, roundtrip="series")
+    assert "round_trip" in e.value.problem  # the options listed as keywords
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Model("lamina-1", PLASTIC, round_trip="sideways")
+    assert e.value.file == "arguments" and "lobe, series" in e.value.problem
 
 
 def test_model_without_sampler_says_so():
