@@ -395,8 +395,8 @@ TEST(KernelSimd, FresnelMuellerLanes) {
 // cancels (down to (1 − |g|)² = 1e-4 for g = 0.99 in the forward direction), so rounding — fused
 // multiply-adds on one side and not the other — is amplified by κ = (1 + g² + 2|g cos θ|)/denom,
 // and p ∝ denom^{−3/2} by 3/2 of it: relative error ≤ (1 + 1.5 κ) · 8 ulp. The sampled cosine:
-// hg_cos_tolerance's first-order bound (s = (1 − g²)/(1 + g − 2gu) and (1 + g² − s²)/(2g) both
-// cancel, by g²/(1 − g²) as g → ±1 and by 1/|g| as g → 0).
+// hg_cos_tolerance's first-order bound (support/simd_probes.h: s is computed without cancellation,
+// but (1 + g² − s²)/(2g) cancels by 1/|g| as g → 0).
 TEST(KernelSimd, HenyeyGreensteinLanes) {
     ParticleRng rng(20, 0, 0);
     std::vector<float> g, x;
