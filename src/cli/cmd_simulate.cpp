@@ -41,10 +41,12 @@ Runner add_simulate(CLI::App& app) {
     cmd->add_option("STACK", a->stack, "Stack JSON file")->required();
     add_physics_option(cmd, a->settings.transport);
     add_settings_options(cmd, a->settings);
-    cmd->add_flag("--mueller", a->mueller,
-                  "Also write the 4x4 Mueller BRDF/BTDF per bin with standard errors "
-                  "(mueller.npy, mueller_se.npy; needs --polarization on; four runs: unpolarized, "
-                  "s-polarized, +45° and circular incident light)");
+    cmd->add_flag(
+        "--mueller", a->mueller,
+        "Also write the 4x4 Mueller BRDF/BTDF per bin with standard errors "
+        "(mueller.npy, mueller_se.npy; needs --polarization on and an RGB run, --spectral "
+        "off; four runs: unpolarized, "
+        "s-polarized, +45° and circular incident light)");
     cmd->add_option("--out,-o", a->out, "Output folder")->required();
     return [a] {
         // Under mpirun every process runs this; the particles are split over them

@@ -13,7 +13,7 @@
 //   L::abs(x)        |x|
 //   L::copysign(a, b)  |a| with the sign of b (of −0 too)
 //   L::mul_add(a, b, c), L::neg_mul_add(a, b, c)   a·b + c and c − a·b (vectors: fused)
-//   L::inv_sqrt(x)   1/√x (vectors: the hardware estimate refined by a Newton step, ≤ 2^-22)
+//   L::inv_sqrt(x)   1/√x (a square root and a division, correctly rounded)
 //   L::cos_sin_2pi(u, c, s)   cos and sin of 2πu, u ∈ [0, 1) (an azimuth)
 //   L::both(m, n), L::either(m, n), L::negate(m), L::none(m)   mask logic; none: no lane holds
 //

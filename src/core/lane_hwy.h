@@ -70,14 +70,13 @@ using V3 = LaneVec3<VF>;  // a direction as three vectors (core/lane_vec.h)
 /// The most float lanes of any compiled instruction set: the size of a per-lane array.
 constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(float);
 
-/// 1/√x from the hardware estimate refined by one Newton step (y ← y (3 − x y²)/2): ≤ 2^-22
-/// relative error whatever the estimate's precision (≥ 12 bits on every target), a fraction of
-/// the cost of a square root and a division.
+/// 1/√x, a correctly rounded square root and division (each ≤ ½ ulp). Not the hardware's
+/// reciprocal square-root estimate refined by a Newton step: its bits differ between CPU vendors
+/// (Intel's and AMD's rsqrtps), so the same instruction set would trace different tables on
+/// different machines; measured, the exact form costs nothing (docs/performance.md).
 HWY_INLINE VF InvSqrt(VF x) {
     const DF df;
-    const VF y = hn::ApproximateReciprocalSqrt(x);
-    const VF half_x_y2 = hn::Mul(hn::Mul(hn::Set(df, 0.5f), x), hn::Mul(y, y));
-    return hn::Mul(y, hn::Sub(hn::Set(df, 1.5f), half_x_y2));
+    return hn::Div(hn::Set(df, 1.f), hn::Sqrt(x));
 }
 
 /// cos and sin of 2π u for u ∈ [0, 1) (a uniform azimuth), both at once. 2πu = (π/4)(j + f) with

@@ -55,6 +55,19 @@ std::uint32_t PcgDrawsForTest(std::uint64_t seed, std::uint64_t stream, std::uin
     return std::uint32_t(n_lanes);
 }
 
+void InvSqrtForTest(const float* x, std::size_t n, float* out) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    HWY_ALIGN float in[kMaxLanes], y[kMaxLanes];
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        for (std::size_t l = 0; l < n_lanes; ++l)
+            in[l] = base + l < n ? x[base + l] : 1.f;
+        hn::Store(VecLane::inv_sqrt(hn::Load(df, in)), df, y);
+        for (std::size_t l = 0; l < n_lanes && base + l < n; ++l)
+            out[base + l] = y[l];
+    }
+}
+
 void CosSin2PiForTest(const float* u, std::size_t n, float* c, float* s) {
     const DF df;
     const std::size_t n_lanes = hn::Lanes(df);
@@ -504,6 +517,7 @@ namespace lamina {
 
 HWY_EXPORT(PcgDrawsForTest);
 HWY_EXPORT(CosSin2PiForTest);
+HWY_EXPORT(InvSqrtForTest);
 HWY_EXPORT(SmithRefractionEscapeForTest);
 HWY_EXPORT(LaneBinsForTest);
 HWY_EXPORT(FresnelDielectricForTest);
@@ -529,6 +543,12 @@ void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::v
     c.resize(u.size());
     s.resize(u.size());
     LAMINA_PROBE_DISPATCH(CosSin2PiForTest)(u.data(), u.size(), c.data(), s.data());
+}
+
+std::vector<float> simd_inv_sqrt(const std::vector<float>& x) {
+    std::vector<float> out(x.size());
+    LAMINA_PROBE_DISPATCH(InvSqrtForTest)(x.data(), x.size(), out.data());
+    return out;
 }
 
 std::vector<std::int64_t> simd_lane_bins(const HemisphereGrid& grid, const std::vector<float>& d) {

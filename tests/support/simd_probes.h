@@ -23,6 +23,9 @@ std::vector<float> simd_particle_uniforms(std::uint64_t seed, std::uint64_t stre
                                           std::uint64_t first, std::uint64_t n_particles,
                                           std::uint64_t n_draws);
 
+/// the kernel's 1/√x (core/lane_hwy.h VecLane::inv_sqrt) of each x > 0.
+std::vector<float> simd_inv_sqrt(const std::vector<float>& x);
+
 /// the kernel's azimuth cos(2πu), sin(2πu) for u in [0, 1).
 void simd_cos_sin_2pi(const std::vector<float>& u, std::vector<float>& c, std::vector<float>& s);
 
