@@ -45,7 +45,8 @@
 // Reproducibility. A block is traced in a fixed order by one thread; exits go to the integer
 // tallies and the budget to the block's double sums in a fixed lane order: the output depends on
 // the block only, never on the thread count. It may differ between instruction sets (the vector
-// math rounds differently), so it is reproducible for a given kernel and machine.
+// math rounds differently; SSE4 has no fused multiply-add), never between CPUs for one set: every
+// vector operation is IEEE-exact (no hardware estimates, core/lane_hwy.h InvSqrt).
 
 #include "simulator/kernel_simd.h"
 
