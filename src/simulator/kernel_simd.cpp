@@ -46,7 +46,8 @@
 // tallies and the budget to the block's double sums in a fixed lane order: the output depends on
 // the block only, never on the thread count. It may differ between instruction sets (the vector
 // math rounds differently; SSE4 has no fused multiply-add), never between CPUs for one set: every
-// vector operation is IEEE-exact (no hardware estimates, core/lane_hwy.h InvSqrt).
+// vector operation is a fixed sequence of IEEE operations (no hardware estimates, core/lane_hwy.h
+// InvSqrt).
 
 #include "simulator/kernel_simd.h"
 

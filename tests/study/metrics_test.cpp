@@ -211,9 +211,6 @@ TEST(StudyConfigurations, SixtyWithStableUniqueIds) {
     EXPECT_THROW(filter_configurations(configs, "nothing*"), InputError);
 }
 
-// docs/study.md, "The iridescent category": six clear coats over filmed metals, stable ids,
-// valid stacks (the reader's ranges, through its JSON round trip), added by every preset but the
-// quick one.
 // The parameters name the top coat and the base; a stack with more layers says how many, so that
 // nothing reads it as one coat over a base (the explorer's live lamina-coat).
 TEST(StudyConfigurations, ParametersCountTheLayersOfALongerStack) {
@@ -227,6 +224,9 @@ TEST(StudyConfigurations, ParametersCountTheLayersOfALongerStack) {
         EXPECT_EQ(c.parameters.count("layers"), 0u) << c.id;  // the study's stacks are coat + base
 }
 
+// docs/study.md, "The iridescent category": six clear coats over filmed metals, stable ids,
+// valid stacks (the reader's ranges, through its JSON round trip), added by every preset but the
+// quick one.
 TEST(StudyConfigurations, IridescentInTheLargerPresetsOnly) {
     const auto irid = iridescent_configurations();
     ASSERT_EQ(irid.size(), 6u);
