@@ -544,7 +544,7 @@ class Bsdf {
     /// √(1/(1 − a² R_in E_b (1 − u))) over inside cosines: the first order's round trips.
     CosineCurve<Rgb> mirror_series_curve_;
     /// The round trips' lobe (Options::round_trip_lobe, where the series is summed over a
-    /// conductor smoother than the coat; never with the mirror series), and its scale s(μ) over
+    /// conductor no rougher than the coat; never with the mirror series), and its scale s(μ) over
     /// outside cosines, on X's nodes, solved so that the lobe carries what the returned light
     /// lets out (precompute_round_trips, returned_escape).
     bool round_trip_on_ = false;

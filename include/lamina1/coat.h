@@ -426,7 +426,11 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
     // directional transmittance), the returned light leaves near the mirror direction, not as
     // uniform radiance (docs/models.md, lamina-1, item 3): the lobe takes the light the returned
     // light lets out, followed by its direction through the round trips (returned_escape).
-    round_trip_on_ = ch_.round_trip_lobe && layers_.base == Base::Conductor && alpha1_ < alpha0_ &&
+    // A conductor as rough as the coat counts as smoother: the two nearly smooth (α 10⁻³ both,
+    // η0 2.5 over gold) the uniform series lost 4.5 % of the albedo, which the returned light
+    // trapped beyond the critical angle does not lose while it keeps its direction; the lobe is
+    // within 0.1 % of the reference there, and under α 0.05 and 0.2 both it misplaced less light.
+    round_trip_on_ = ch_.round_trip_lobe && layers_.base == Base::Conductor && alpha1_ <= alpha0_ &&
                      alpha0_ > 0 && ch_.directional_transmittance;
     CosineCurve<Rgb, kNx> leaving;
     precompute_returned(g_curve, round_trip_on_ ? &leaving : nullptr);

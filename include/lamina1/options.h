@@ -53,7 +53,7 @@ struct Options {
     /// interfaces smooth the exact delta series is summed either way.
     bool series_lambertian_only = true;
     /// The round trips as a lobe of their own (true) or in the separable series (false), where
-    /// the series is summed over a conductor smoother than the coat (the microsurfaces' orders
+    /// the series is summed over a conductor no rougher than the coat (the microsurfaces' orders
     /// ≥ 2 restored): the light the first order's exit leaves inside meets the coat's bottom,
     /// whose rough reflection sends it back to the base and out near the mirror direction, a
     /// lobe widened by that reflection (α_r² = α_e² + α1² + α0²) rather than uniform radiance.
