@@ -156,7 +156,8 @@ class Bsdf {
     /// summed as V (the round trips' solve sums it onto the two nodes of their curve about wo).
     template <typename V, typename Out>
     V visible_rule_energy(double mu, bool of_round_trip, Out&& out) const;
-    void precompute_round_trips(const Rgb& gain, const CosineCurve<Rgb, kNx>& leaving);
+    void precompute_round_trips(const Rgb& gain, const CosineCurve<Rgb, kNx>& leaving,
+                                double weight);
     Rgb returned_light(double mu, const RgbEdgeCurve<33>& g_curve, const Rgb& Y_ms) const;
     void precompute_returned(const RgbEdgeCurve<33>& g_curve,
                              CosineCurve<Rgb, kNx>* leaving = nullptr);
@@ -544,8 +545,8 @@ class Bsdf {
     /// √(1/(1 − a² R_in E_b (1 − u))) over inside cosines: the first order's round trips.
     CosineCurve<Rgb> mirror_series_curve_;
     /// The round trips' lobe (Options::round_trip_lobe, where the series is summed over a
-    /// conductor no rougher than the coat; never with the mirror series), and its scale s(μ) over
-    /// outside cosines, on X's nodes, solved so that the lobe carries what the returned light
+    /// conductor, its share round_trip_weight; never with the mirror series), and its scale s(μ)
+    /// over outside cosines, on X's nodes, solved so that the lobe carries what the returned light
     /// lets out (precompute_round_trips, returned_escape).
     bool round_trip_on_ = false;
     CosineCurve<Rgb, kNx> round_trip_curve_;

@@ -379,6 +379,21 @@ inline void Bsdf::precompute_mean_direction() {
     });
 }
 
+/// The share of the returned light that the round trips' lobe carries over a conductor (the rest
+/// in the uniform series): what keeps its direction through a round trip. All of it where the
+/// conductor is no rougher than the coat, or than α 0.1; none where it is three times rougher
+/// than that (α1 ≥ 3 max(α0, 0.1)), whose reflections spread the returned light over the inside
+/// directions again; log-linear in α1 between, so that the model is continuous in α1. The bounds
+/// are measured against the exact reference (docs/models.md, lamina-1, item 3: the lobe misplaced
+/// less light up to α1 0.1 over coats of α0 10⁻³–0.05, the series less from α1 0.3, and over
+/// conductors as rough as the coat the series lost up to 5 % of the albedo under η0 2.5).
+inline double round_trip_weight(double alpha0, double alpha1) {
+    const double spread = 3 * std::max(alpha0, 0.1);
+    if (alpha1 <= alpha0) return 1.0;
+    if (alpha1 >= spread) return 0.0;
+    return std::log(spread / alpha1) / std::log(spread / alpha0);
+}
+
 /// Which inter-reflections are summed (item 3 of lamina-1): the separable series where the base
 /// re-diffuses the returned light, else the first order's round trips kept in its lobe.
 inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
@@ -422,16 +437,16 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
     balance_ = ch_.first_order_balance && alpha0_ > 0 && ch_.directional_transmittance &&
                layers_.base != Base::Lambertian;
     // The round trips as a lobe of their own (Options::round_trip_lobe): where the series is
-    // summed over a conductor smoother than the coat (the orders ≥ 2 restored; a rough coat, the
-    // directional transmittance), the returned light leaves near the mirror direction, not as
+    // summed over a conductor (the orders ≥ 2 restored; a rough coat, the directional
+    // transmittance), the returned light leaves near the mirror direction, not as
     // uniform radiance (docs/models.md, lamina-1, item 3): the lobe takes the light the returned
     // light lets out, followed by its direction through the round trips (returned_escape).
-    // A conductor as rough as the coat counts as smoother: the two nearly smooth (α 10⁻³ both,
-    // η0 2.5 over gold) the uniform series lost 4.5 % of the albedo, which the returned light
-    // trapped beyond the critical angle does not lose while it keeps its direction; the lobe is
-    // within 0.1 % of the reference there, and under α 0.05 and 0.2 both it misplaced less light.
-    round_trip_on_ = ch_.round_trip_lobe && layers_.base == Base::Conductor && alpha1_ <= alpha0_ &&
-                     alpha0_ > 0 && ch_.directional_transmittance;
+    // The share of that light the lobe takes (round_trip_weight): all of it over a conductor no
+    // rougher than the coat, none over one much rougher, which spreads the returned light again.
+    const double weight = round_trip_weight(alpha0_, alpha1_);
+    // Under single scattering only where the conductor is smoother than the coat, as before.
+    round_trip_on_ = ch_.round_trip_lobe && layers_.base == Base::Conductor && alpha0_ > 0 &&
+                     ch_.directional_transmittance && (alpha1_ < alpha0_ || (ms_ && weight > 0));
     CosineCurve<Rgb, kNx> leaving;
     precompute_returned(g_curve, round_trip_on_ ? &leaving : nullptr);
     if (round_trip_on_) {
@@ -440,7 +455,7 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
             const double one_minus = 1 - E_bar_[c] * r_bar_[c];
             gain[c] = one_minus > 0 ? E_bar_[c] * t_bar_[c] / one_minus : 0.0;
         }
-        precompute_round_trips(gain, leaving);
+        precompute_round_trips(gain, leaving, weight);
     }
     // X̄ = (2/η0²)∫ X(μ) μ dμ: the diffuse exit's normalization.
     X_bar_ = integrate_split01<kGauss, Rgb>([&](double mu) { return X_at(mu) * (2 * mu); }, 0.0) *
@@ -467,7 +482,8 @@ inline void Bsdf::precompute_series(const RgbEdgeCurve<33>& g_curve) {
 /// mean of the old scale and the one that would match row i alone; 20–40 steps to 10⁻⁹ here). What
 /// the lobe does not carry (where no light reaches its row: grazing incidence) stays in the series,
 /// as X = (L − E)/G with G = Ē_b t̄/(1 − Ē_b r̄) the energy the series lets out per unit of X.
-inline void Bsdf::precompute_round_trips(const Rgb& gain, const CosineCurve<Rgb, kNx>& leaving) {
+inline void Bsdf::precompute_round_trips(const Rgb& gain, const CosineCurve<Rgb, kNx>& leaving,
+                                         double weight) {
     constexpr int kN = kNx;
     using Curve = CosineCurve<Rgb, kN>;
     round_trip_curve_.fill([](double) { return Rgb(1.0); });
@@ -499,7 +515,7 @@ inline void Bsdf::precompute_round_trips(const Rgb& gain, const CosineCurve<Rgb,
             return sum;
         };
         for (int i = 0; i < kN; ++i) {
-            target[i] = std::max(leaving.v[i][c], 0.0);
+            target[i] = weight * std::max(leaving.v[i][c], 0.0);
             double row = 0;
             for (int j = 0; j < kN; ++j)
                 row += M[i].m[j][c];
@@ -521,11 +537,13 @@ inline void Bsdf::precompute_round_trips(const Rgb& gain, const CosineCurve<Rgb,
             E[i][c] = s[i] * Ms(i);
         }
     }
+    // X_ holds the series' own X on entry: its share 1 − weight stays there.
     for (int i = 0; i < kN; ++i)
         for (int c = 0; c < 3; ++c) {
-            const double L = leaving.v[i][c], left = L - E[i][c];
+            const double L = weight * leaving.v[i][c], left = L - E[i][c];
             // What the solve matched (to 10⁻⁹) leaves a remainder of rounding, not light.
-            X_.v[i][c] = left > 1e-6 * L && gain[c] > 0 ? left / gain[c] : 0.0;
+            X_.v[i][c] =
+                (1 - weight) * X_.v[i][c] + (left > 1e-6 * L && gain[c] > 0 ? left / gain[c] : 0.0);
         }
 }
 

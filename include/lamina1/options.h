@@ -53,14 +53,14 @@ struct Options {
     /// interfaces smooth the exact delta series is summed either way.
     bool series_lambertian_only = true;
     /// The round trips as a lobe of their own (true) or in the separable series (false), where
-    /// the series is summed over a conductor no rougher than the coat (the microsurfaces' orders
-    /// ≥ 2 restored): the light the first order's exit leaves inside meets the coat's bottom,
-    /// whose rough reflection sends it back to the base and out near the mirror direction, a
-    /// lobe widened by that reflection (α_r² = α_e² + α1² + α0²) rather than uniform radiance.
-    /// It carries what the returned light lets out, followed by its direction through the round
-    /// trips (near the critical angle most of it stays trapped and the metal absorbs it), and
-    /// the first order's light beyond its accounting is taken from that whole; false keeps the
-    /// series' hemispherical-average escape.
+    /// the series is summed over a conductor (its share round_trip_weight; the microsurfaces'
+    /// orders ≥ 2 restored): the light the first order's exit leaves inside meets the coat's
+    /// bottom, whose rough reflection sends it back to the base and out near the mirror direction,
+    /// a lobe widened by that reflection (α_r² = α_e² + α1² + α0²) rather than uniform radiance. It
+    /// carries what the returned light lets out, followed by its direction through the round trips
+    /// (near the critical angle most of it stays trapped and the metal absorbs it), and the first
+    /// order's light beyond its accounting is taken from that whole; false keeps the series'
+    /// hemispherical-average escape.
     bool round_trip_lobe = true;
     /// The first order's balance: the series returns what the first order does not let out,
     /// counted as the light inside within the exit cone times its exit transmittance; the first

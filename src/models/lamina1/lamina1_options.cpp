@@ -46,7 +46,8 @@ const ModelOptionTable<Lamina1Choices>& lamina1_option_table() {
          "a slab's are slab-orders'"},
         member_option<L1, bool>(
             "round-trip", &L1::round_trip_lobe, {{"lobe", true}, {"series", false}},
-            "the round trips (base, coat bottom, base) over a conductor no rougher than the coat, "
+            "the round trips (base, coat bottom, base) over a conductor (all of them up to the "
+            "coat's roughness, a share up to 3 max(alpha0, 0.1)), "
             "where the series is summed: a lobe about the mirror direction widened by the coat "
             "bottom's reflection, carrying what the returned light lets out followed by its "
             "direction (lobe), or the uniform series with its average escape (series)"),
