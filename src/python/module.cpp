@@ -57,11 +57,31 @@ PyObject* g_input_error = nullptr;  // lamina.InputError, a subclass of ValueErr
 
 /// Where in `o` (dicts, lists, tuples, numpy values) the first NaN or infinity is, as a JSON
 /// pointer from `at`; empty if nowhere.
-std::string non_finite_at(py::handle o, const std::string& at) {
+// How deep an argument may nest: a stack nests five levels (stack, layers, layer, interface, RGB
+// array), as the stack files' reader allows 32; deeper, or a container holding itself, is refused
+// before anything recurses through it.
+constexpr int kMaxArgumentDepth = 32;
+
+std::string non_finite_at(py::handle o, const std::string& at, const std::string& where,
+                          int depth = 0) {
+    if (depth > kMaxArgumentDepth)
+        throw InputError(where, where == "arguments" ? at.substr(1) : at,
+                         fmt::format("nested more than {} levels deep (or containing itself)",
+                                     kMaxArgumentDepth));
     if (py::isinstance<py::float_>(o)) return std::isfinite(o.cast<double>()) ? "" : at;
+    if (py::isinstance<py::int_>(o) && !py::isinstance<py::bool_>(o)) {
+        // An integer beyond a double's range (10**400) is no number lamina can take.
+        const double v = PyLong_AsDouble(o.ptr());
+        if (v == -1.0 && PyErr_Occurred()) {
+            PyErr_Clear();
+            return at;
+        }
+        return "";
+    }
     if (py::isinstance<py::dict>(o)) {
         for (const auto& [key, value] : o.cast<py::dict>())
-            if (std::string r = non_finite_at(value, at + "/" + py::str(key).cast<std::string>());
+            if (std::string r = non_finite_at(value, at + "/" + py::str(key).cast<std::string>(),
+                                              where, depth + 1);
                 !r.empty())
                 return r;
         return "";
@@ -69,12 +89,14 @@ std::string non_finite_at(py::handle o, const std::string& at) {
     if (py::isinstance<py::list>(o) || py::isinstance<py::tuple>(o)) {
         std::size_t i = 0;
         for (py::handle value : o)
-            if (std::string r = non_finite_at(value, at + "/" + std::to_string(i++)); !r.empty())
+            if (std::string r =
+                    non_finite_at(value, at + "/" + std::to_string(i++), where, depth + 1);
+                !r.empty())
                 return r;
         return "";
     }
     if (py::hasattr(o, "tolist") && !py::isinstance<py::str>(o))
-        return non_finite_at(o.attr("tolist")(), at);
+        return non_finite_at(o.attr("tolist")(), at, where, depth + 1);
     return "";
 }
 
@@ -82,7 +104,7 @@ std::string non_finite_at(py::handle o, const std::string& at) {
 nlohmann::json json_of(py::handle obj, const std::string& where = "arguments") {
     // A stack dict's place as a JSON pointer (/layers/0/interface/eta); an argument's by its
     // name (theta_i/0), as the other argument errors.
-    if (const std::string at = non_finite_at(obj, ""); !at.empty())
+    if (const std::string at = non_finite_at(obj, "", where); !at.empty())
         throw InputError(where, where == "arguments" ? at.substr(1) : at,
                          "not a finite number; allowed: finite numbers");
     const py::object dumps = py::module_::import("json").attr("dumps");
@@ -223,14 +245,21 @@ std::string option_text(py::handle v) {
     return py::str(v).cast<std::string>();
 }
 
+/// Cosines closer to the horizon than this are taken on it (z = 0: grazing). The models multiply
+/// and square cosines (4 |cos θi| |cos θo| under a BRDF, a half vector's length), which underflow
+/// to 0 below about 1e-162 and turned such directions' values into NaN; no angle in degrees comes
+/// that close (cos 90° is 6e-17 in double).
+constexpr double kGrazingCosine = 1e-100;
+
 /// A direction argument (`name`; `which`, "" or "direction 3 " for an array's): a finite unit
-/// vector to 1e-6, or an InputError.
+/// vector to 1e-6, or an InputError; within kGrazingCosine of the horizon, on it.
 Vec3d unit_direction(double x, double y, double z, const char* name, const std::string& which) {
     const double len = std::sqrt(x * x + y * y + z * z);
     if (!std::isfinite(len) || std::abs(len - 1) > 1e-6)
         throw InputError(
             "arguments", name,
             fmt::format("{}({}, {}, {}): directions must be finite unit vectors", which, x, y, z));
+    if (std::abs(z) < kGrazingCosine) z = 0;
     return {x, y, z};
 }
 
@@ -271,6 +300,12 @@ Vec3d vec_at(const double* d, py::ssize_t n) {
     return {d[3 * n], d[3 * n + 1], d[3 * n + 2]};
 }
 
+/// Direction n of a checked array (broadcast_directions), on the horizon within kGrazingCosine.
+Vec3d direction_at(const double* d, py::ssize_t n) {
+    const double z = d[3 * n + 2];
+    return {d[3 * n], d[3 * n + 1], std::abs(z) < kGrazingCosine ? 0.0 : z};
+}
+
 // f(wi, wo) for every broadcast pair of directions, `channels` values each (0: a scalar), in
 // parallel without the GIL; f writes the pair's values; pairs with wi below the surface are 0.
 template <typename F>
@@ -287,9 +322,9 @@ py::array_t<double> over_direction_pairs(py::handle wi_obj, py::handle wo_obj, i
         py::gil_scoped_release release;
 #pragma omp parallel for schedule(static)
         for (py::ssize_t k = 0; k < n; ++k) {
-            const Vec3d a = vec_at(wi, k);
+            const Vec3d a = direction_at(wi, k);
             if (a.z > 0)
-                f(a, vec_at(wo, k), v + stride * k);
+                f(a, direction_at(wo, k), v + stride * k);
             else
                 std::fill(v + stride * k, v + stride * (k + 1), 0.0);
         }
@@ -337,7 +372,7 @@ py::tuple model_sample(const PyModel& m, py::handle wi_obj, py::handle u_obj) {
         py::gil_scoped_release release;
 #pragma omp parallel for schedule(static)
         for (py::ssize_t k = 0; k < n; ++k) {
-            const Vec3d a = vec_at(wi, k);
+            const Vec3d a = direction_at(wi, k);
             const std::optional<ModelSample> s =
                 a.z > 0 ? m.model->sample(a, vec_at(ud, k)) : std::nullopt;
             ok[k] = bool(s);

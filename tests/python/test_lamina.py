@@ -86,6 +86,38 @@ def test_non_finite_numbers_are_named():
     assert e.value.file == "<dict>" and e.value.field == "/layers/0/interface/eta"
 
 
+def test_cyclic_deep_and_huge_arguments_are_input_errors():
+    # A container holding itself, or nested far deeper than a stack (five levels), is refused
+    # before anything recurses through it (it crashed the interpreter); an integer beyond a
+    # double's range is no finite number.
+    cyclic = json.loads(PLASTIC.read_text())
+    cyclic["self"] = cyclic
+    deep = 0.5
+    for _ in range(5000):
+        deep = [deep]
+    looped = [30.0]
+    looped.append(looped)
+    for call in (lambda: lamina.Stack(cyclic),
+                 lambda: lamina.Stack({"layers": [{"interface": {"type": "lambertian",
+                                                                 "albedo": deep}}]}),
+                 lambda: lamina.simulate(PLASTIC, theta_i=looped, particles=1000)):
+        with pytest.raises(lamina.InputError) as e:
+            call()
+        assert "nested more than 32 levels deep" in e.value.problem
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Stack({"layers": [{"interface": {"type": "lambertian", "albedo": 10**400}}]})
+    assert e.value.field == "/layers/0/interface/albedo"
+
+
+def test_directions_at_the_horizon_give_finite_values():
+    # Cosines of 1e-170: the models' products of cosines underflow there; such a direction is
+    # taken on the horizon, where a BRDF is 0, not NaN.
+    wi, wo = [1, 0, 1e-170], [-1, 0, 1e-170]
+    for name in ("ww-prime", "lamina-1", "openpbr"):
+        f = lamina.Model(name, PLASTIC).eval(wi, wo)
+        assert np.all(np.isfinite(f)) and np.all(f == 0), name
+
+
 def test_study_names_are_checked_before_any_work(tmp_path):
     # An id names a folder and a CSV cell: "../x" would write beside the study, "a,b" would break
     # metrics.csv after the whole study had run. Refused before anything is written.
