@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include <exception>
+#include <new>
 #include <string>
 #include <utility>
 #include <vector>
@@ -84,6 +85,10 @@ int run(int argc, char** argv) {
                 lamina::InputError("command line", lamina::option_name(e.field()), e.problem())
                     .what());
         return fail(e.what());
+    } catch (const std::bad_alloc&) {
+        return fail(
+            "error: out of memory (a coarser --grid, fewer --threads or fewer incidences "
+            "per run need less)");
     } catch (const std::exception& e) {
         return fail(fmt::format("error: {}", e.what()));
     }

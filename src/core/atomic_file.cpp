@@ -124,6 +124,7 @@ bool write_file_if_changed(const fs::path& path, std::string_view content) {
 
 StagedOutput::StagedOutput(fs::path dir) : dir_(std::move(dir)) {
     std::error_code ec;
+    created_ = !fs::exists(dir_, ec);
     fs::create_directories(dir_, ec);
     if (ec || !fs::is_directory(dir_))
         throw InputError(dir_.string(), "--out",
@@ -139,6 +140,8 @@ StagedOutput::StagedOutput(fs::path dir) : dir_(std::move(dir)) {
 StagedOutput::~StagedOutput() {
     std::error_code ec;
     fs::remove_all(staging_, ec);
+    // A run that failed leaves no folder it made (remove deletes only an empty one).
+    if (created_ && !committed_) fs::remove(dir_, ec);
 }
 
 void StagedOutput::add(const std::string& name, std::string_view content) {

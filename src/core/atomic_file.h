@@ -34,7 +34,8 @@ bool file_holds(const std::filesystem::path& path, std::string_view content);
 
 /// A set of files written together into one folder: every file is staged in a hidden temporary
 /// folder inside the target, and `commit()` renames them all into place. If the object is destroyed
-/// without commit (an error, an exception), nothing staged reaches the target folder.
+/// without commit (an error, an exception), nothing staged reaches the target folder, and a target
+/// folder it created is removed again.
 class StagedOutput {
   public:
     /// Creates `dir` if needed and checks it is writable; throws InputError otherwise.
@@ -62,6 +63,7 @@ class StagedOutput {
     std::filesystem::path dir_, staging_;
     std::vector<std::string> names_, stale_;
     bool committed_ = false;
+    bool created_ = false;  // whether the constructor made the target folder
 };
 
 }  // namespace lamina

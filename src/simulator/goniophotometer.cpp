@@ -17,11 +17,13 @@
 
 #include <fmt/format.h>
 #include <omp.h>
+#include <unistd.h>
 
 #include <bit>
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <vector>
 
 namespace lamina {
 
@@ -190,6 +192,40 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
                                      stack.name, film));
 }
 
+/// Refuses a run whose tallies would not fit in this machine's memory (a bad_alloc inside the
+/// threads' region would abort the process): each thread's Tally (Tally::Recent and its widened
+/// sums per bin and side, Stokes and spectral tallies where asked), and the result's widened sums
+/// per incidence. The 3600 × 3600 grid unfolded needs about 5 GB per thread.
+void check_tally_memory(const HemisphereGrid& grid, const SimulationSettings& settings, int threads,
+                        int spectral_groups) {
+    const double sides_bins = 2.0 * double(grid.size());
+    const double sums = sizeof(std::array<Fixed128, 6>);
+    const double stokes = settings.stokes_tallies
+                              ? sizeof(std::array<Fixed128, kStokesSums>) +
+                                    sizeof(std::array<std::int64_t, kStokesSums>)
+                              : 0.0;
+    // A spectral run's threads keep a Tally per wavelength group and one for XYZ besides.
+    const double tallies_per_thread = 1.0 + (spectral_groups > 0 ? spectral_groups + 1 : 0);
+    const double per_thread =
+        sides_bins * (tallies_per_thread * (sizeof(Tally::Recent) + sums) + stokes);
+    const double per_incidence = sides_bins * (tallies_per_thread * sums + stokes);
+    const double need =
+        double(threads) * per_thread + double(settings.theta_i_deg.size()) * per_incidence;
+    const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page_size <= 0) return;
+    const double have = double(pages) * double(page_size);
+    if (need > have)
+        throw InputError(
+            "settings", "grid",
+            fmt::format("{}: its tallies need about {:.1f} GB ({} threads, {} incidences{}), "
+                        "this machine has {:.1f} GB; allowed: a grid whose tallies fit (a coarser "
+                        "grid, fewer threads or fewer incidences per run)",
+                        grid.to_string(), need / 1e9, threads, settings.theta_i_deg.size(),
+                        spectral_groups > 0 ? fmt::format(", {} wavelength groups", spectral_groups)
+                                            : std::string(),
+                        have / 1e9));
+}
+
 SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,
                              const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);
@@ -208,6 +244,7 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
                              : spectral ? trace_block_spectral
                                         : trace_block_scalar;
     const int groups = settings.spectral_bins / 3;
+    check_tally_memory(grid, settings, threads, spectral ? groups : 0);
 
     SimulationSums result = zero_sums(stack, settings);
     result.threads_used = threads;
@@ -236,14 +273,23 @@ SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& setti
         if (spectral) job.spectral = &tracing;
         IncidenceSums& total = result.incidences[inc];
 
+        // The threads' tallies, allocated here: a bad_alloc inside the threads' region would
+        // abort the process instead of reaching the caller.
+        std::vector<Tally> tallies;
+        std::vector<std::optional<SpectralTally>> spectral_tallies(
+            static_cast<std::size_t>(threads));
+        tallies.reserve(std::size_t(threads));
+        for (int t = 0; t < threads; ++t) {
+            tallies.emplace_back(grid.size(), settings.stokes_tallies);
+            if (spectral) spectral_tallies[std::size_t(t)].emplace(grid.size(), groups);
+        }
+
 #pragma omp parallel num_threads(threads) firstprivate(job)
         {
-            Tally local(grid.size(), settings.stokes_tallies);
-            std::optional<SpectralTally> local_spectral;
-            if (spectral) {
-                local_spectral.emplace(grid.size(), groups);
-                job.spectral_tally = &*local_spectral;
-            }
+            Tally& local = tallies[std::size_t(omp_get_thread_num())];
+            std::optional<SpectralTally>& local_spectral =
+                spectral_tallies[std::size_t(omp_get_thread_num())];
+            if (spectral) job.spectral_tally = &*local_spectral;
 #pragma omp for schedule(dynamic, 1)
             for (std::uint64_t b = 0; b < blocks; ++b) {
                 const std::uint64_t lo = b * kBlock, hi = std::min(n, lo + kBlock);

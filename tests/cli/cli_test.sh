@@ -118,6 +118,12 @@ check mueller-unpolarized-writes-nothing 1 test -e "$tmp/mueller-off"
 check_says mueller-spectral 1 "Mueller tables are tabulated per RGB channel" \
     "$lamina" simulate "$P" --mueller --spectral on --particles 1000 --out "$tmp/mueller-spectral"
 check mueller-spectral-writes-nothing 1 test -e "$tmp/mueller-spectral"
+# Tallies that cannot fit in memory are refused before any work (a bad_alloc among the threads
+# aborted the process), and the folder the run made is gone again.
+check_says grid-beyond-memory 1 "--grid: 3600x3600 unfolded: its tallies need about" \
+    "$lamina" simulate "$P" --theta-i 30 --phi-i 10 --particles 1 --threads 1024 --grid 3600x3600 \
+    --out "$tmp/huge"
+check grid-beyond-memory-writes-nothing 1 test -e "$tmp/huge"
 # An --out that cannot be written is named, with the reason, before any work.
 : >"$tmp/afile"
 check_says render-out-under-file 1 "x.png: --out: cannot create its folder" \
