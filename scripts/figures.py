@@ -37,7 +37,7 @@ try:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.colors import LogNorm
+    from matplotlib.colors import LogNorm, Normalize
     from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
 except ImportError as e:  # pragma: no cover - reported by `lamina figures`
     print(f"figures.py: {e}: install Debian's python3-matplotlib and python3-numpy (make deps)",
@@ -311,12 +311,14 @@ def slice_figure(study, cid, formats):
                                 ls=model_dash(m))
                         if np.any(f > 0):
                             top = max(top, float(np.nanmax(f)))
-                ax.set_yscale("log")
                 positive = ref[ref > 0]
                 lo, hi = 1e-3, 1.0
                 if positive.size:
                     lo, hi = max(positive.min(), top * 1e-5) * 0.5, top * 2
-                    ax.set_ylim(lo, hi)
+                # Limits before the log scale: a side with nothing on it (an opaque slab's
+                # transmission) keeps the default decades instead of a warning.
+                ax.set_ylim(lo, hi)
+                ax.set_yscale("log")
                 # Plain-number ticks: decades on a wide range, 1-2-5 on a short one.
                 ax.yaxis.set_major_locator(LogLocator(10, subs=(1.0,) if hi / lo > 300 else (1.0, 2.0, 5.0)))
                 ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
@@ -433,8 +435,12 @@ def error_matrix(study, formats, side):
             if np.isnan(z[r, 0]):
                 z[r, 0] = np.nanmean(cell[floor_key])
     fig, ax = plt.subplots(figsize=(1.1 + 0.75 * len(cols), 0.8 + 0.16 * len(rows)))
-    finite = z[np.isfinite(z) & (z > 0)]
-    norm = LogNorm(vmin=finite.min(), vmax=finite.max()) if finite.size else None
+    # The scale spans the cells' positive values above 1e-12 (a relative error, numerically 0
+    # below it: a slab that transmits nothing has values of 1e-49, which matplotlib's float32
+    # image rounds to 0 and its log scale then cannot take); none: an empty scale.
+    finite = z[np.isfinite(z) & (z > 1e-12)]
+    norm = (LogNorm(vmin=finite.min(), vmax=finite.max()) if finite.size
+            else Normalize(vmin=0, vmax=1))
     im = ax.imshow(np.ma.masked_invalid(z), aspect="auto", cmap="YlOrRd", norm=norm,
                    interpolation="nearest")
     ax.set_facecolor("0.9")
