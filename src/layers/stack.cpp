@@ -717,7 +717,7 @@ class PathTracker {
         return true;
     }
     /// The parser's error (malformed text, or 406: a number beyond a double's range): kept for
-    /// parse_text, which names the field.
+    /// parse_json_strict, which names the field.
     bool parse_error(std::size_t, const std::string&, const json::exception& e) {
         error_id_ = e.id;
         error_ = parser_message(e);
@@ -778,7 +778,13 @@ class PathTracker {
     std::string error_;
 };
 
-json parse_text(const std::string& text, const std::string& where) {
+}  // namespace
+
+json parse_json_strict(const std::string& text, const std::string& where) {
+    // The parser takes a NUL byte for the end of the text: whatever followed would be ignored.
+    if (const std::size_t nul = text.find('\0'); nul != std::string::npos)
+        throw InputError(where, "",
+                         fmt::format("a NUL byte at offset {}; allowed: JSON text", nul));
     PathTracker tracker(where);
     if (!json::sax_parse(text, &tracker)) {
         const std::string at = tracker.pending_pointer();
@@ -797,6 +803,8 @@ json parse_text(const std::string& text, const std::string& where) {
         throw InputError(where, "", fmt::format("malformed JSON: {}", parser_message(e)));
     }
 }
+
+namespace {
 
 // ---- Describing -----------------------------------------------------------------------------
 
@@ -844,7 +852,7 @@ Stack load_stack(const std::filesystem::path& path) {
 }
 
 Stack parse_stack(const std::string& text, const std::string& where) {
-    return stack_from_json(parse_text(text, where), where);
+    return stack_from_json(parse_json_strict(text, where), where);
 }
 
 nlohmann::json stack_to_json(const Stack& stack) {

@@ -227,6 +227,10 @@ Stack load_stack(const std::filesystem::path& path);
 Stack flipped_stack(const Stack& stack);
 
 /// Canonical JSON form (every RGB quantity as a 3-array); stack_from_json(stack_to_json(s)) == s.
+/// The JSON of a lamina input file (a stack, a study's configurations), strictly: a duplicate key,
+/// a NUL byte, nesting past 32 levels or a number beyond a double's range is an InputError
+/// naming `where` and the place (a JSON pointer).
+nlohmann::json parse_json_strict(const std::string& text, const std::string& where);
 nlohmann::json stack_to_json(const Stack& stack);
 
 /// One line describing the stack, e.g. `red plastic: air | dielectric η=1.5 α=0.05 | medium

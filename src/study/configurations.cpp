@@ -293,12 +293,7 @@ std::vector<StudyConfiguration> load_configurations(const std::filesystem::path&
     if (!in) throw InputError(where, "", "cannot read the configurations file");
     std::stringstream ss;
     ss << in.rdbuf();
-    nlohmann::json j;
-    try {
-        j = nlohmann::json::parse(ss.str());
-    } catch (const nlohmann::json::parse_error& e) {
-        throw InputError(where, "", fmt::format("malformed JSON: {}", e.what()));
-    }
+    const nlohmann::json j = parse_json_strict(ss.str(), where);
     if (!j.is_object() || !j.contains("configurations") || !j["configurations"].is_array())
         throw InputError(where, "/configurations",
                          "expected {\"configurations\": [{\"id\": ..., \"stack\": {...}}, ...]}");

@@ -124,6 +124,16 @@ check_says grid-beyond-memory 1 "--grid: 3600x3600 unfolded: its tallies need ab
     "$lamina" simulate "$P" --theta-i 30 --phi-i 10 --particles 1 --threads 1024 --grid 3600x3600 \
     --out "$tmp/huge"
 check grid-beyond-memory-writes-nothing 1 test -e "$tmp/huge"
+# A NUL byte ended the JSON text for the parser: what followed it was ignored. Refused, in a stack
+# file and in a study's configurations; so is a configuration's duplicate key, as in a stack.
+printf '{"layers":[{"interface":{"type":"lambertian","albedo":0.5}}]}\0garbage{{' >"$tmp/nul.json"
+check_says stack-nul 1 "nul.json: a NUL byte at offset 61" "$lamina" validate "$tmp/nul.json"
+printf '{"configurations":[{"id":"a","id":"b","stack":{"layers":[{"interface":{"type":"lambertian","albedo":0.5}}]}}]}' \
+    >"$tmp/dupkey.json"
+check_says configs-duplicate-key 1 '/configurations/0/id: duplicate key "id"' \
+    "$lamina" study --configs "$tmp/dupkey.json" --particles 1000 --theta-i 30 --grid 6x6 \
+    --models ww09 --out "$tmp/dupkey-study"
+check configs-duplicate-key-writes-nothing 1 test -e "$tmp/dupkey-study"
 # An --out that cannot be written is named, with the reason, before any work.
 : >"$tmp/afile"
 check_says render-out-under-file 1 "x.png: --out: cannot create its folder" \
