@@ -19,7 +19,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -177,8 +176,15 @@ int run_eval(const EvalArgs& a) {
     }
 
     if (!a.directions.empty()) {
-        std::ifstream in(a.directions);
-        if (!in) throw InputError(a.directions, "", "cannot read the file");
+        // Bounded (a stream without end is refused, not read into memory); a NUL byte is no
+        // text.
+        constexpr std::size_t kDirectionsMaxBytes = std::size_t(64) << 20;
+        const std::string text =
+            read_file_bounded(a.directions, kDirectionsMaxBytes, "the directions file");
+        if (const std::size_t nul = text.find('\0'); nul != std::string::npos)
+            throw InputError(a.directions, "",
+                             fmt::format("a NUL byte at offset {}; allowed: CSV text", nul));
+        std::istringstream in(text);
         // The light's azimuth is --phi-i's, or each row's in a phi_i column (an anisotropic
         // stack seen from several azimuths in one batch).
         constexpr const char* kHeader = "theta_i,theta_o,phi_o,side";

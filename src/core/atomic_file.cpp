@@ -50,6 +50,16 @@ void write_all(const fs::path& path, const fs::path& target, std::string_view co
 }  // namespace
 
 void write_file_atomic(const fs::path& path, std::string_view content) {
+    // The finished file is renamed over `path`: a link, pipe or device there would be replaced by
+    // it (a symbolic link's target left as it was, /dev/null made a file).
+    std::error_code status_ec;
+    const fs::file_status status = fs::symlink_status(path, status_ec);
+    if (!status_ec && fs::exists(status) && !fs::is_regular_file(status) &&
+        !fs::is_directory(status))
+        throw InputError(path.string(), "",
+                         "cannot write it: it is not a regular file (a link, pipe or device), "
+                         "which the finished file would replace; allowed: a regular file or a new "
+                         "name");
     const fs::path tmp =
         path.parent_path() / fmt::format(".{}.tmp-{}", path.filename().string(), unique_suffix());
     write_all(tmp, path, content);

@@ -143,6 +143,21 @@ check_says eval-out-under-file 1 "$tmp/afile/x.csv: cannot write it: $tmp/afile 
 mkdir -p "$tmp/adir.csv"
 check_says eval-out-is-folder 1 "adir.csv: cannot write it: a folder of that name is there" \
     "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --grid 9x9 --out "$tmp/adir.csv"
+# A pipe, device or link at --out would be replaced by the finished file: refused.
+mkfifo "$tmp/fifo.csv"
+check_says eval-out-is-fifo 1 "fifo.csv: cannot write it: it is not a regular file" \
+    "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --grid 9x9 --out "$tmp/fifo.csv"
+check eval-out-fifo-kept 0 test -p "$tmp/fifo.csv"
+ln -s "$tmp/elsewhere.csv" "$tmp/link.csv"
+check_says eval-out-is-link 1 "link.csv: cannot write it: it is not a regular file" \
+    "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --grid 9x9 --out "$tmp/link.csv"
+# A directions file without end is refused without being read into memory; one with a NUL byte
+# (whose rows after it were dropped) is no CSV.
+check_says eval-directions-endless 1 "/dev/zero: the directions file holds more than 16 MiB" \
+    "$lamina" eval --model ww09 --stack "$P" --directions /dev/zero --out "$tmp/dz.csv"
+printf 'theta_i,theta_o,phi_o,side\n30,30,180,R\n\0\n' >"$tmp/dnul.csv"
+check_says eval-directions-nul 1 "dnul.csv: a NUL byte at offset" \
+    "$lamina" eval --model ww09 --stack "$P" --directions "$tmp/dnul.csv" --out "$tmp/dnul-out.csv"
 # A stack file without end, or past 16 MiB, is refused without being read to its end.
 check_says validate-endless 1 "/dev/zero: the stack file holds more than 16 MiB" "$lamina" validate /dev/zero
 check_says export-check-endless 1 "/dev/zero: the file holds more than 16 MiB (it is not a regular file)" \
