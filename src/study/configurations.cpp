@@ -269,6 +269,13 @@ bool has_control_character(const std::string& text) {
 
 void check_configuration_id(const std::string& id, const std::string& where,
                             const std::string& field) {
+    // An id names a folder and, with a suffix, cache files: a file name holds 255 bytes.
+    constexpr std::size_t kMaxIdBytes = 128;
+    if (id.size() > kMaxIdBytes)
+        throw InputError(where, field,
+                         fmt::format("'{}…' is {} bytes long; allowed: at most {} (it names the "
+                                     "configuration's folder and cache files)",
+                                     id.substr(0, 40), id.size(), kMaxIdBytes));
     if (id.empty() || id.find_first_of("/\\ ,\"") != std::string::npos ||
         has_control_character(id) || id[0] == '.')
         throw InputError(where, field,

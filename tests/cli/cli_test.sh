@@ -134,6 +134,15 @@ check_says configs-duplicate-key 1 '/configurations/0/id: duplicate key "id"' \
     "$lamina" study --configs "$tmp/dupkey.json" --particles 1000 --theta-i 30 --grid 6x6 \
     --models ww09 --out "$tmp/dupkey-study"
 check configs-duplicate-key-writes-nothing 1 test -e "$tmp/dupkey-study"
+# An id names folders and cache files (a file name holds 255 bytes): a longer one is refused
+# before the reference is simulated.
+long_id=$(printf 'a%.0s' $(seq 1 300))
+printf '{"configurations":[{"id":"%s","stack":{"layers":[{"interface":{"type":"lambertian","albedo":0.5}}]}}]}' \
+    "$long_id" >"$tmp/longid.json"
+check_says configs-long-id 1 "is 300 bytes long; allowed: at most 128" \
+    "$lamina" study --configs "$tmp/longid.json" --particles 1000 --theta-i 30 --grid 6x6 \
+    --models ww09 --out "$tmp/longid-study"
+check configs-long-id-writes-nothing 1 test -e "$tmp/longid-study"
 # An --out that cannot be written is named, with the reason, before any work.
 : >"$tmp/afile"
 check_says render-out-under-file 1 "x.png: --out: cannot create its folder" \
