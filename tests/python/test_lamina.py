@@ -118,6 +118,14 @@ def test_directions_at_the_horizon_give_finite_values():
         assert np.all(np.isfinite(f)) and np.all(f == 0), name
 
 
+def test_one_model_may_be_named_without_a_list(tmp_path):
+    # A string is one model's name (iterated, its letters were taken for models: "unknown model
+    # 'w'").
+    r = lamina.compare(PLASTIC, models="ww-prime", out=tmp_path / "c", particles=1000,
+                       theta_i=[30], grid=(9, 9))
+    assert r.models == ["ww-prime"]
+
+
 def test_study_names_are_checked_before_any_work(tmp_path):
     # An id names a folder and a CSV cell: "../x" would write beside the study, "a,b" would break
     # metrics.csv after the whole study had run. Refused before anything is written.

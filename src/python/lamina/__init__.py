@@ -290,6 +290,8 @@ def load_study(path, pandas: Optional[bool] = None) -> Study:
 def _split_models(models):
     """Registry names and Python models (docs/python.md, "Your own model")."""
     names, plugins = [], []
+    if isinstance(models, str) or hasattr(models, "eval"):
+        models = [models]  # one model, not the letters of its name
     for m in models or []:
         if isinstance(m, str):
             names.append(m)
