@@ -1,5 +1,6 @@
 // The `lamina` executable: the command-line interface of cli/run.cpp.
 #include "cli/commands.h"
+#include "core/atomic_file.h"
 
 #ifdef __GLIBC__
 #include <malloc.h>
@@ -15,5 +16,6 @@ int main(int argc, char** argv) {
     mallopt(M_MMAP_THRESHOLD, 64 << 20);
     mallopt(M_TRIM_THRESHOLD, 256 << 20);
 #endif
+    lamina::remove_staging_on_interrupt();
     return lamina::cli::run(argc, argv);
 }

@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <csignal>
+
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
@@ -18,6 +20,46 @@ namespace fs = std::filesystem;
 namespace lamina {
 
 namespace {
+
+// The staging folders of the live StagedOutputs, and the target folders they created, for the
+// interrupt handler (remove_staging_on_interrupt): fixed slots of plain characters, as a signal
+// handler may read them but not allocate.
+constexpr int kSlots = 16;
+constexpr std::size_t kPathBytes = 4096;
+struct Slot {
+    std::atomic<bool> used{false};
+    char staging[kPathBytes];
+    char created[kPathBytes];  // empty: the folder was there before
+};
+Slot g_slots[kSlots];
+
+int register_staging(const fs::path& staging, const fs::path& created) {
+    const std::string a = staging.string(), b = created.string();
+    if (a.size() >= kPathBytes || b.size() >= kPathBytes) return -1;
+    for (int i = 0; i < kSlots; ++i) {
+        bool expected = false;
+        if (g_slots[i].used.load() || !g_slots[i].used.compare_exchange_strong(expected, true))
+            continue;
+        std::memcpy(g_slots[i].staging, a.c_str(), a.size() + 1);
+        std::memcpy(g_slots[i].created, b.c_str(), b.size() + 1);
+        return i;
+    }
+    return -1;  // more than kSlots at once: not cleaned on an interrupt
+}
+
+// An interrupt (SIGINT, SIGTERM, SIGHUP) while outputs are staged: the staging folders are
+// removed, and the target folders the run created, where empty (rmdir only: async-signal-safe; a
+// staging folder is empty while the run computes, its files are written at the end); then the
+// signal's default action.
+extern "C" void remove_staging_and_reraise(int signal_number) {
+    for (Slot& slot : g_slots) {
+        if (!slot.used.load()) continue;
+        ::rmdir(slot.staging);
+        if (slot.created[0] != '\0') ::rmdir(slot.created);
+    }
+    ::signal(signal_number, SIG_DFL);
+    ::raise(signal_number);
+}
 
 std::string unique_suffix() {
     static std::atomic<unsigned> counter{0};
@@ -145,9 +187,11 @@ StagedOutput::StagedOutput(fs::path dir) : dir_(std::move(dir)) {
     fs::create_directory(staging_, ec);
     if (ec)
         throw InputError(dir_.string(), "--out", "cannot create a staging folder: " + ec.message());
+    slot_ = register_staging(staging_, created_ ? dir_ : fs::path());
 }
 
 StagedOutput::~StagedOutput() {
+    if (slot_ >= 0) g_slots[slot_].used.store(false);
     std::error_code ec;
     fs::remove_all(staging_, ec);
     // A run that failed leaves no folder it made (remove deletes only an empty one).
@@ -184,6 +228,14 @@ void StagedOutput::commit() {
                              "cannot remove this file of an earlier run: " + ec.message());
     }
     committed_ = true;
+}
+
+void remove_staging_on_interrupt() {
+    struct sigaction action {};
+    action.sa_handler = remove_staging_and_reraise;
+    sigemptyset(&action.sa_mask);
+    for (const int signal_number : {SIGINT, SIGTERM, SIGHUP})
+        ::sigaction(signal_number, &action, nullptr);
 }
 
 }  // namespace lamina

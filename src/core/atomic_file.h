@@ -64,6 +64,13 @@ class StagedOutput {
     std::vector<std::string> names_, stale_;
     bool committed_ = false;
     bool created_ = false;  // whether the constructor made the target folder
+    int slot_ = -1;         // its place among the folders an interrupt removes
 };
+
+/// Installs handlers of SIGINT, SIGTERM and SIGHUP that remove the live StagedOutputs' staging
+/// folders and the target folders they created (where empty) before the signal's default action:
+/// an interrupted run leaves nothing behind either (the command line's; Python handles Ctrl-C
+/// itself, between chunks of particles).
+void remove_staging_on_interrupt();
 
 }  // namespace lamina

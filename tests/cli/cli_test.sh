@@ -143,6 +143,14 @@ check_says configs-long-id 1 "is 300 bytes long; allowed: at most 128" \
     "$lamina" study --configs "$tmp/longid.json" --particles 1000 --theta-i 30 --grid 6x6 \
     --models ww09 --out "$tmp/longid-study"
 check configs-long-id-writes-nothing 1 test -e "$tmp/longid-study"
+# An interrupted run (Ctrl-C, a kill) leaves no staging folder, nor the output folder it made.
+timeout -s INT 1 "$lamina" simulate "$src/examples/milky-coat.json" --theta-i 0,20,40,60,80 \
+    --particles 2e6 --threads 1 --kernel scalar --out "$tmp/interrupted" >/dev/null 2>&1
+check interrupted-leaves-nothing 1 test -e "$tmp/interrupted"
+mkdir -p "$tmp/interrupted-kept"
+timeout -s TERM 1 "$lamina" simulate "$src/examples/milky-coat.json" --theta-i 0,20,40,60,80 \
+    --particles 2e6 --threads 1 --kernel scalar --out "$tmp/interrupted-kept" >/dev/null 2>&1
+check interrupted-keeps-its-folder-empty 0 test -z "$(ls -A "$tmp/interrupted-kept")"
 # An --out that cannot be written is named, with the reason, before any work.
 : >"$tmp/afile"
 check_says render-out-under-file 1 "x.png: --out: cannot create its folder" \
