@@ -138,11 +138,22 @@ HemisphereGrid grid_of(const std::pair<int, int>& grid) {
 
 std::vector<double> incidences_of(py::handle theta_i) {
     std::vector<double> out;
-    if (py::isinstance<py::float_>(theta_i) || py::isinstance<py::int_>(theta_i))
-        out.push_back(theta_i.cast<double>());
+    // A number, or numbers; a string is neither (iterated, its characters would not cast).
+    auto number = [](py::handle t, const std::string& at) {
+        if (py::isinstance<py::str>(t) || py::isinstance<py::bytes>(t) ||
+            !(py::isinstance<py::float_>(t) || py::isinstance<py::int_>(t) ||
+              py::hasattr(t, "__float__")))
+            throw InputError("arguments", at,
+                             fmt::format("expected a number of degrees, got {}",
+                                         py::repr(t).cast<std::string>()));
+        return py::float_(py::reinterpret_borrow<py::object>(t)).cast<double>();
+    };
+    if (py::isinstance<py::str>(theta_i) || py::isinstance<py::bytes>(theta_i) ||
+        !py::hasattr(theta_i, "__iter__"))
+        out.push_back(number(theta_i, "theta_i"));
     else
         for (py::handle t : py::iter(theta_i))
-            out.push_back(t.cast<double>());
+            out.push_back(number(t, fmt::format("theta_i/{}", out.size())));
     if (out.empty()) throw InputError("arguments", "theta_i", "at least one incidence is needed");
     check_incidence_list(out, "arguments", "theta_i");  // in range, each once (as the CLI's)
     return out;

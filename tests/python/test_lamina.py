@@ -118,6 +118,15 @@ def test_directions_at_the_horizon_give_finite_values():
         assert np.all(np.isfinite(f)) and np.all(f == 0), name
 
 
+def test_incidences_must_be_numbers():
+    m = lamina.Model("ww-prime", PLASTIC)
+    assert m.albedo(np.float64(45)).shape == (3,)
+    for bad, field in (("30", "theta_i"), (["30"], "theta_i/0"), (None, "theta_i")):
+        with pytest.raises(lamina.InputError) as e:
+            m.albedo(bad)
+        assert e.value.field == field and "expected a number of degrees" in e.value.problem
+
+
 def test_one_model_may_be_named_without_a_list(tmp_path):
     # A string is one model's name (iterated, its letters were taken for models: "unknown model
     # 'w'").
