@@ -28,6 +28,16 @@ bool parse_real(const std::string& text, double& out) {
     return ec == std::errc() && ptr == last && std::isfinite(out);
 }
 
+bool is_integer_text(const std::string& text) {
+    const std::size_t a = text.find_first_not_of(" \t"), b = text.find_last_not_of(" \t");
+    if (a == std::string::npos) return false;
+    std::size_t i = a + ((text[a] == '-' || text[a] == '+') ? 1 : 0);
+    if (i > b) return false;
+    for (; i <= b; ++i)
+        if (text[i] < '0' || text[i] > '9') return false;
+    return true;
+}
+
 void fail(const std::string& where, const std::string& field, std::string problem) {
     throw InputError(where, field, std::move(problem));
 }

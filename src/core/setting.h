@@ -24,6 +24,7 @@
 #include "core/error.h"
 #include "core/grid.h"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <array>
@@ -77,6 +78,8 @@ bool parse_integer(const std::string& text, T& out) {
 }
 [[noreturn]] void fail(const std::string& where, const std::string& field, std::string problem);
 std::string range_text(const SettingInfo& info);
+/// Whether `text` is an integer literal (an optional sign, then digits; blanks around).
+bool is_integer_text(const std::string& text);
 double checked_whole(double v, const std::string& shown, const SettingInfo& info,
                      const std::string& where, const std::string& field);
 }  // namespace setting_detail
@@ -91,7 +94,20 @@ struct SettingCodec<T, std::enable_if_t<std::is_integral_v<T> && !std::is_same_v
     static T from_text(const std::string& text, const SettingInfo& info, const std::string& where,
                        const std::string& field) {
         T exact{};
-        if (setting_detail::parse_integer(text, exact)) return checked(exact, text, info, where, field);
+        if (setting_detail::parse_integer(text, exact))
+            return checked(exact, text, info, where, field);
+        // Integer text beyond the type: its own range, not the decimal notation's 1e15.
+        if (setting_detail::is_integer_text(text)) {
+            constexpr T kMin = std::numeric_limits<T>::min(), kMax = std::numeric_limits<T>::max();
+            const std::string lo =
+                info.min > double(kMin) ? fmt::format("{}", info.min) : std::to_string(kMin);
+            const std::string hi =
+                info.max < double(kMax) ? fmt::format("{}", info.max) : std::to_string(kMax);
+            setting_detail::fail(where, field,
+                                 fmt::format("'{}' is not allowed: expected a whole number in "
+                                             "[{}, {}]",
+                                             text, lo, hi));
+        }
         double v = 0;
         if (!setting_detail::parse_real(text, v))
             setting_detail::fail(where, field, "'" + text + "' is not a number");

@@ -151,6 +151,10 @@ mkdir -p "$tmp/interrupted-kept"
 timeout -s TERM 1 "$lamina" simulate "$src/examples/milky-coat.json" --theta-i 0,20,40,60,80 \
     --particles 2e6 --threads 1 --kernel scalar --out "$tmp/interrupted-kept" >/dev/null 2>&1
 check interrupted-keeps-its-folder-empty 0 test -z "$(ls -A "$tmp/interrupted-kept")"
+# A whole number given as an integer takes its type's whole range, and beyond it says that range
+# (not the 1e15 of the decimal notation, which 2^64 - 1 itself exceeds).
+check_says seed-beyond-uint64 1 "expected a whole number in [0, 18446744073709551615]" \
+    "$lamina" simulate "$P" --seed 18446744073709551616 --particles 100 --theta-i 30 --out "$tmp/seed"
 # An --out that cannot be written is named, with the reason, before any work.
 : >"$tmp/afile"
 check_says render-out-under-file 1 "x.png: --out: cannot create its folder" \
