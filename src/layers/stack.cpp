@@ -784,7 +784,9 @@ json parse_json_strict(const std::string& text, const std::string& where) {
     // The parser takes a NUL byte for the end of the text: whatever followed would be ignored.
     if (const std::size_t nul = text.find('\0'); nul != std::string::npos)
         throw InputError(where, "",
-                         fmt::format("a NUL byte at offset {}; allowed: JSON text", nul));
+                         fmt::format("malformed JSON: a NUL byte at offset {} (JSON text has "
+                                     "none)",
+                                     nul));
     PathTracker tracker(where);
     if (!json::sax_parse(text, &tracker)) {
         const std::string at = tracker.pending_pointer();

@@ -127,7 +127,7 @@ check grid-beyond-memory-writes-nothing 1 test -e "$tmp/huge"
 # A NUL byte ended the JSON text for the parser: what followed it was ignored. Refused, in a stack
 # file and in a study's configurations; so is a configuration's duplicate key, as in a stack.
 printf '{"layers":[{"interface":{"type":"lambertian","albedo":0.5}}]}\0garbage{{' >"$tmp/nul.json"
-check_says stack-nul 1 "nul.json: a NUL byte at offset 61" "$lamina" validate "$tmp/nul.json"
+check_says stack-nul 1 "nul.json: malformed JSON: a NUL byte at offset 61" "$lamina" validate "$tmp/nul.json"
 printf '{"configurations":[{"id":"a","id":"b","stack":{"layers":[{"interface":{"type":"lambertian","albedo":0.5}}]}}]}' \
     >"$tmp/dupkey.json"
 check_says configs-duplicate-key 1 '/configurations/0/id: duplicate key "id"' \
