@@ -381,12 +381,12 @@ inline void Bsdf::precompute_mean_direction() {
 
 /// The share of the returned light that the round trips' lobe carries over a conductor (the rest
 /// in the uniform series): what keeps its direction through a round trip. All of it where the
-/// conductor is no rougher than the coat, or than α 0.1; none where it is three times rougher
-/// than that (α1 ≥ 3 max(α0, 0.1)), whose reflections spread the returned light over the inside
-/// directions again; log-linear in α1 between, so that the model is continuous in α1. The bounds
-/// are measured against the exact reference (docs/models.md, lamina-1, item 3: the lobe misplaced
-/// less light up to α1 0.1 over coats of α0 10⁻³–0.05, the series less from α1 0.3, and over
-/// conductors as rough as the coat the series lost up to 5 % of the albedo under η0 2.5).
+/// conductor is no rougher than the coat (α1 ≤ α0); none where it is rougher than 3 max(α0, 0.1),
+/// whose reflections spread the returned light over the inside directions again; log-linear in α1
+/// between, so that the model is continuous in α1. The bounds are measured against the exact
+/// reference (docs/models.md, lamina-1, item 3: the lobe alone misplaced less light up to α1 0.1
+/// over coats of α0 10⁻³–0.05, the series alone less from α1 0.3, and over conductors as rough as
+/// the coat the series lost up to 5 % of the albedo under η0 2.5).
 inline double round_trip_weight(double alpha0, double alpha1) {
     const double spread = 3 * std::max(alpha0, 0.1);
     if (alpha1 <= alpha0) return 1.0;

@@ -195,7 +195,7 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
 /// Refuses a run whose tallies would not fit in this machine's memory (a bad_alloc inside the
 /// threads' region would abort the process): each thread's Tally (Tally::Recent and its widened
 /// sums per bin and side, Stokes and spectral tallies where asked), and the result's widened sums
-/// per incidence. The 3600 × 3600 grid unfolded needs about 5 GB per thread.
+/// per incidence. The 3600 × 3600 grid unfolded needs about 7.5 GB per thread.
 void check_tally_memory(const HemisphereGrid& grid, const SimulationSettings& settings, int threads,
                         int spectral_groups) {
     const double sides_bins = 2.0 * double(grid.size());
