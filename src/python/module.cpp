@@ -55,13 +55,14 @@ namespace {
 
 PyObject* g_input_error = nullptr;  // lamina.InputError, a subclass of ValueError
 
-/// Where in `o` (dicts, lists, tuples, numpy values) the first NaN or infinity is, as a JSON
-/// pointer from `at`; empty if nowhere.
 // How deep an argument may nest: a stack nests five levels (stack, layers, layer, interface, RGB
 // array), as the stack files' reader allows 32; deeper, or a container holding itself, is refused
 // before anything recurses through it.
 constexpr int kMaxArgumentDepth = 32;
 
+/// Where in `o` (dicts, lists, tuples, numpy values) the first NaN or infinity (or an integer
+/// beyond a double) is, as a JSON pointer from `at`; empty if nowhere. Past kMaxArgumentDepth an
+/// InputError naming `where`.
 std::string non_finite_at(py::handle o, const std::string& at, const std::string& where,
                           int depth = 0) {
     if (depth > kMaxArgumentDepth)
