@@ -67,9 +67,9 @@ class IncidentEvaluator {
     virtual Rgbd eval(const Vec3d& wo) const = 0;
 
     /// An evaluator of the same incidence for one thread's run of evaluations (bin_model takes
-    /// one per θ row, whose nodes share their cosines cos θo), or null where this one serves every
-    /// thread as well. It may keep what depends on wo.z alone between calls, and returns the
-    /// same values as this one, bit for bit.
+    /// one per block of θ rows, whose nodes come a line of one cos θo at a time), or null where
+    /// this one serves every thread as well. It may keep what depends on wo.z alone between calls,
+    /// and returns the same values as this one, bit for bit.
     virtual std::unique_ptr<IncidentEvaluator> for_one_thread() const { return nullptr; }
 };
 

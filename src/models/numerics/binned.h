@@ -11,6 +11,11 @@
 // sin θ cos θ in the integrand. (The measure is uniform in u = sin²θ, but in u the integrand has
 // square-root edges at the normal and at grazing that adaptive bisection cannot shake off; in θ it
 // is smooth up to both ends.)
+// bin_model first evaluates the model on the lattice of half-bin steps, whose nodes neighbouring
+// bins share (about 4 evaluations per bin), and takes a bin's 5 × 5-node rule where it agrees with
+// the bin's own Simpson rule well within τ (below) and no peak direction is near (binned.cpp, "The
+// shared-node pass": the rules, and the margin that covers jumps and kinks); every other bin, and
+// every rectangle of cos_weighted_average and model_albedo, gets the adaptive rule.
 // Each rectangle gets the 3×3 Gauss–Legendre product rule and the degree-3 rule embedded in its
 // centre and axis nodes (9 evaluations); if they differ by more than the bin's tolerance
 // τ = rel_tol·|bin average| + abs_tol (largest channel), it is bisected in both coordinates (up
@@ -31,10 +36,10 @@
 // along one coordinate alone (on a function of θ alone the two rules agree): a sharp lobe's bins
 // in the row at the horizon, where masking falls to 0 within about α of 90°, are the ones it
 // leaves off (docs/models.md, "Evaluating a model"). Delta lobes add energy / Ω⊥ to the bin they
-// hit. Parallel over (incidence, side, θ row) with OpenMP, each row through the incidence's
-// evaluator for one thread where the model has one (IncidentEvaluator::for_one_thread: the same
-// values, bit for bit); every bin is computed independently, so the output does not depend on the
-// thread count.
+// hit. Parallel over (incidence, side, block of θ rows) with OpenMP, each block through the
+// incidence's evaluator for one thread where the model has one (IncidentEvaluator::for_one_thread:
+// the same values, bit for bit); a bin's value depends on the lattice's nodes and its own
+// rectangle alone, so the output does not depend on the thread count.
 
 #include "core/grid.h"
 #include "core/table.h"
