@@ -753,12 +753,15 @@ class PathTracker {
         return true;
     }
     bool starts(bool is_object) {
-        // A stack file nests five levels deep (stack, layers, layer, interface, RGB array); far
-        // deeper is not a stack, and would only make messages unreadable.
+        // lamina's files nest at most ten levels deep (a stack's tabulated spectrum, its deepest
+        // value, sits seven deep: stack, layers, layer, interface or medium, value, samples,
+        // sample; a study's configurations file adds three); far deeper is no lamina file, and
+        // would only make messages unreadable.
         if (frames_.size() >= std::size_t(kMaxDepth))
             throw InputError(
                 where_, pending_pointer(),
-                fmt::format("JSON nested more than {} levels deep; a stack file needs five",
+                fmt::format("JSON nested more than {} levels deep; lamina's files need at most "
+                            "ten",
                             kMaxDepth));
         element_starts();
         frames_.push_back({is_object, {}, {}, 0});

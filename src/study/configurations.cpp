@@ -1,5 +1,6 @@
 #include "study/configurations.h"
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "layers/spectrum.h"
 
@@ -7,7 +8,6 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -296,11 +296,8 @@ void check_study_label(const std::string& label, const char* what, const std::st
 
 std::vector<StudyConfiguration> load_configurations(const std::filesystem::path& path) {
     const std::string where = path.string();
-    std::ifstream in(path);
-    if (!in) throw InputError(where, "", "cannot read the configurations file");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const nlohmann::json j = parse_json_strict(ss.str(), where);
+    const nlohmann::json j = parse_json_strict(
+        read_file_bounded(path, kMaxConfigurationsFileBytes, "the configurations file"), where);
     if (!j.is_object() || !j.contains("configurations") || !j["configurations"].is_array())
         throw InputError(where, "/configurations",
                          "expected {\"configurations\": [{\"id\": ..., \"stack\": {...}}, ...]}");

@@ -41,8 +41,6 @@ std::vector<StudyConfiguration> brushed_configurations();
 /// iridescent_configurations() and brushed_configurations() for every preset but "quick".
 std::vector<StudyConfiguration> preset_configurations(const std::string& preset);
 
-/// A user's list: {"configurations": [{"id": ..., "category": ..., "stack": {...}}, ...]}
-/// (`category` optional, default "custom"). InputError naming the file and the JSON pointer.
 /// A configuration's id names a folder, a CSV cell and an --only item: InputError unless it is
 /// non-empty without spaces, slashes, commas, quotes, control characters or a leading dot.
 void check_configuration_id(const std::string& id, const std::string& where,
@@ -52,6 +50,14 @@ void check_configuration_id(const std::string& id, const std::string& where,
 void check_study_label(const std::string& label, const char* what, const std::string& where,
                        const std::string& field);
 
+/// The largest configurations file load_configurations reads (64 MiB: four full-size stack
+/// files' worth; core/atomic_file.h, read_file_bounded).
+inline constexpr std::size_t kMaxConfigurationsFileBytes = std::size_t(64) << 20;
+
+/// A user's list: {"configurations": [{"id": ..., "category": ..., "stack": {...}}, ...]}
+/// (`category` optional, default "custom"), read as stack files are (parse_json_strict).
+/// InputError naming the file and the JSON pointer, also for a file that cannot be read or holds
+/// more than kMaxConfigurationsFileBytes.
 std::vector<StudyConfiguration> load_configurations(const std::filesystem::path& path);
 
 /// Keeps the configurations whose id matches `pattern` (a glob with * and ?; several patterns

@@ -143,6 +143,13 @@ check_says configs-long-id 1 "is 300 bytes long; allowed: at most 128" \
     "$lamina" study --configs "$tmp/longid.json" --particles 1000 --theta-i 30 --grid 6x6 \
     --models ww09 --out "$tmp/longid-study"
 check configs-long-id-writes-nothing 1 test -e "$tmp/longid-study"
+# The configurations file is read as a stack file is: bounded, and a stream without end refused.
+check_says configs-stream-refused 1 "the configurations file holds more than 16 MiB (it is not a regular file)" \
+    "$lamina" study --configs /dev/zero --particles 1000 --theta-i 30 --grid 6x6 --models ww09 \
+    --out "$tmp/zero-study"
+check_says configs-folder-refused 1 "cannot read the configurations file: it is a directory" \
+    "$lamina" study --configs "$tmp" --particles 1000 --theta-i 30 --grid 6x6 --models ww09 \
+    --out "$tmp/folder-study"
 # An interrupted run (Ctrl-C, a kill) leaves no staging folder, nor the output folder it made.
 timeout -s INT 1 "$lamina" simulate "$src/examples/milky-coat.json" --theta-i 0,20,40,60,80 \
     --particles 2e6 --threads 1 --kernel scalar --out "$tmp/interrupted" >/dev/null 2>&1
