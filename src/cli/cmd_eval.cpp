@@ -33,6 +33,7 @@ struct EvalArgs {
                                                         side = "R";
     double theta_o = 0.0, phi_o = 0.0, phi_i = 0.0;
     bool theta_o_given = false, phi_o_given = false;  ///< whether --theta-o / --phi-o were given
+    bool side_given = false, grid_given = false;      ///< whether --side / --grid were given
     bool binned = false, pdf = false;
     /// The spectral settings shared with simulate (spectral, spectral_min_nm, spectral_max_nm).
     SimulationSettings spectral;
@@ -154,6 +155,14 @@ int run_eval(const EvalArgs& a) {
         throw InputError("command line", a.theta_o_given ? "--theta-o" : "--phi-o",
                          a.binned ? "--binned covers every outgoing direction: leave it out"
                                   : "the directions come from the --directions file: leave it out");
+    // An option the mode has no use for is refused rather than ignored: the user meant something.
+    if (modes == 1 && a.side_given)
+        throw InputError("command line", "--side",
+                         a.binned ? "--binned tabulates every side the model supports: leave it out"
+                                  : "the directions file gives each row's side: leave it out");
+    if (!a.binned && a.grid_given)
+        throw InputError("command line", "--grid",
+                         "the bins are for --binned; a point or a directions file has none");
     if (modes == 0 && !a.out.empty())
         throw InputError("command line", "--out",
                          "a point evaluation prints its value; --out is for --binned and "
@@ -297,13 +306,16 @@ Runner add_eval(CLI::App& app) {
     cmd->add_option("--phi-o", a->phi_o,
                     "Outgoing azimuth in degrees, [-360, 360] (the mirror direction at 180)")
         ->each([a](const std::string&) { a->phi_o_given = true; });
-    cmd->add_option("--side", a->side, "R (reflection) or T (transmission; θo from -z)");
+    cmd->add_option("--side", a->side, "R (reflection) or T (transmission; θo from -z)")
+        ->each([a](const std::string&) { a->side_given = true; });
     cmd->add_option("--directions", a->directions,
                     "CSV of directions: header theta_i,theta_o,phi_o,side (the light at "
                     "--phi-i) or theta_i,phi_i,theta_o,phi_o,side");
     cmd->add_flag("--binned", a->binned,
                   "Cos-weighted bin averages in the goniophotometer's brdf.csv format");
-    cmd->add_option("--grid", a->grid, "Bins for --binned, NTHETAxNPHI")->capture_default_str();
+    cmd->add_option("--grid", a->grid, "Bins for --binned, NTHETAxNPHI")
+        ->capture_default_str()
+        ->each([a](const std::string&) { a->grid_given = true; });
     cmd->add_option("--out", a->out, "Output CSV (written atomically)");
     add_settings_options_only(cmd, a->spectral, {"spectral", "spectral_min_nm", "spectral_max_nm"});
     cmd->add_option("--samples", a->samples,

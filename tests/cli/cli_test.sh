@@ -86,6 +86,13 @@ check_says eval-binned-theta-o 1 "--theta-o: --binned covers every outgoing dire
     "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --theta-o 30 --out "$tmp/b.csv"
 check_says eval-point-out 1 "--out: a point evaluation prints its value" \
     "$lamina" eval --model ww09 --stack "$P" --theta-i 30 --theta-o 30 --phi-o 0 --out "$tmp/p.csv"
+# An option the mode has no use for is refused, not ignored.
+check_says eval-binned-side 1 "--side: --binned tabulates every side the model supports" \
+    "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --side T --out "$tmp/b.csv"
+check_says eval-directions-side 1 "--side: the directions file gives each row's side" \
+    "$lamina" eval --model ww09 --stack "$P" --directions "$tmp/far.csv" --side R --out "$tmp/d.csv"
+check_says eval-point-grid 1 "--grid: the bins are for --binned" \
+    "$lamina" eval --model ww09 --stack "$P" --theta-i 30 --theta-o 30 --phi-o 0 --grid 9x9
 check_says render-exposure-nan 1 "--exposure: nan stops is outside [-40, 40]" \
     "$lamina" render "$P" --size 8 --spp 1 --exposure nan --out "$tmp/never.png"
 check_says render-light-huge 1 "--light: irradiance must be in [0, 1e+06]" \
