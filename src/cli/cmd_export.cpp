@@ -43,6 +43,7 @@ struct ExportArgs {
     bool strict = false;         ///< --check: exit 2 when the figures miss the goals
     std::string simulation, study, config, source = "reference", model, stack, out, format;
     std::string theta_i, grid = "90x90";
+    bool grid_given = false;  ///< whether --grid was given
     std::vector<std::string> options;
     int resolution = RglOptions{}.resolution, vndf_resolution = RglOptions{}.vndf_resolution,
         ndf_resolution = RglOptions{}.ndf_resolution, azimuths = RglOptions{}.azimuths;
@@ -316,6 +317,14 @@ int run_export(const ExportArgs& a) {
     if (!a.lamina1_gpu.empty()) {
         // lamina-1's per-material state for its GLSL form (include/lamina1/gpu.h).
         if (a.stack.empty()) throw InputError("command line", "--stack", "give the stack file");
+        if (has_source(a) || !a.out.empty())
+            throw InputError("command line",
+                             !a.model.empty()        ? "--model"
+                             : !a.simulation.empty() ? "--simulation"
+                             : !a.study.empty()      ? "--study"
+                                                     : "--out",
+                             "--lamina1-gpu writes lamina-1's state of --stack (with its "
+                             "--option flags) to its own file: leave this out");
         std::string why;
         const std::vector<float> state = lamina1_gpu_state(
             load_stack(a.stack), resolve_options(find_model("lamina-1"), a.options), why);
@@ -359,6 +368,18 @@ int run_export(const ExportArgs& a) {
     Source src = load_source(a);
     BinnedTable& table = src.table;
     const bool have_table = src.have_table;
+    // An option the export has no use for is refused, not ignored.
+    if (a.grid_given && (format != "npz" || have_table))
+        throw InputError("command line", "--grid",
+                         format != "npz" ? "the bins of a model's .npz; a .bsdf or MERL file "
+                                           "samples the BRDF its own way"
+                                         : "a table's bins are the ones it was computed on; "
+                                           "--grid goes with --model");
+    if (!a.theta_i.empty() && (format == "merl" || (format == "npz" && have_table)))
+        throw InputError("command line", "--theta-i",
+                         format == "merl" ? "a MERL file samples θi its own way"
+                                          : "a table's incidences are the ones it was computed "
+                                            "at; --theta-i goes with --model");
     const std::shared_ptr<const Model>& model = src.model;
     nlohmann::json& meta = src.meta;
 
@@ -467,7 +488,8 @@ Runner add_export(CLI::App& app) {
     cmd->add_option("--grid", a->grid,
                     "Bins of a model's .npz, NTHETAxNPHI (φ over [0, 180]; unfolded over [0, "
                     "360) with twice the bins for an anisotropic stack or --phi-i ≠ 0)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->each([a](const std::string&) { a->grid_given = true; });
     cmd->add_option("--phi-i", a->phi_i, "A model's .npz: the light's azimuth in degrees, [0, 360]")
         ->capture_default_str();
     cmd->add_option("--azimuths", a->azimuths,

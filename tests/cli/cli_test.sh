@@ -348,6 +348,16 @@ check_says export-unfolded 1 "an unfolded table" \
     "$lamina" export --simulation "$tmp/phi-i" --out "$tmp/phi-i.bsdf"
 check export-unfolded-writes-nothing 1 test -e "$tmp/phi-i.bsdf"
 check export-unfolded-npz 0 "$lamina" export --simulation "$tmp/phi-i" --out "$tmp/phi-i.npz"
+# An option the export has no use for is refused, not ignored.
+check_says export-table-grid 1 "--grid: a table's bins are the ones it was computed on" \
+    "$lamina" export --simulation "$tmp/phi-i" --grid 18x18 --out "$tmp/never.npz"
+check_says export-table-theta-i 1 "--theta-i: a table's incidences are the ones it was computed at" \
+    "$lamina" export --simulation "$tmp/phi-i" --theta-i 10 --out "$tmp/never.npz"
+check_says export-bsdf-grid 1 "--grid: the bins of a model's .npz" \
+    "$lamina" export --model ww09 --stack "$src/examples/plastic.json" --grid 9x9 --out "$tmp/never.bsdf"
+check_says export-gpu-model 1 "--model: --lamina1-gpu writes lamina-1's state of --stack" \
+    "$lamina" export --lamina1-gpu "$tmp/never.bin" --stack "$src/examples/plastic.json" --model ww-prime
+check export-refusals-write-nothing 1 test -e "$tmp/never.npz" -o -e "$tmp/never.bsdf" -o -e "$tmp/never.bin"
 check_says export-phi-i-bsdf 1 "goes with --format npz" \
     "$lamina" export --model openpbr --stack "$src/examples/brushed-aluminium-lacquer.json" \
     --phi-i 30 --out "$tmp/brushed.bsdf"
