@@ -15,6 +15,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <map>
 
 namespace lamina {
 
@@ -267,6 +268,7 @@ ModelOptions resolve_options(const ModelEntry& entry, const std::vector<std::str
     ModelOptions out;
     for (const auto& s : specs)
         out[s.key] = s.default_value;
+    std::map<std::string, std::string> given;  // key → the value first given
     for (const auto& a : assignments) {
         const auto eq = a.find('=');
         if (eq == std::string::npos || eq == 0)
@@ -287,6 +289,12 @@ ModelOptions resolve_options(const ModelEntry& entry, const std::vector<std::str
             throw InputError("command line", field,
                              fmt::format("option '{}' of model '{}' cannot be '{}'; allowed: {}",
                                          key, entry.name, value, fmt::join(spec->values, ", ")));
+        // A key given twice (in a spec and an --option, or two --option) has no one meaning.
+        if (const auto [at, first] = given.emplace(key, value); !first)
+            throw InputError("command line", field,
+                             fmt::format("option '{}' of model '{}' given twice ({}, then {}); "
+                                         "give it once",
+                                         key, entry.name, at->second, value));
         out[key] = value;
     }
     return out;

@@ -51,8 +51,8 @@ const std::vector<ModelEntry>& model_registry();
 const ModelEntry& find_model(const std::string& name, const std::string& field = "--model");
 
 /// Validates `key=value` assignments against the model's options and fills in the defaults.
-/// InputError naming `field` for a malformed assignment, an unknown key (listing the known ones)
-/// or a value outside the allowed ones.
+/// InputError naming `field` for a malformed assignment, an unknown key (listing the known ones),
+/// a value outside the allowed ones or a key given twice.
 ModelOptions resolve_options(const ModelEntry& entry, const std::vector<std::string>& assignments,
                              const std::string& field = "--option");
 

@@ -86,6 +86,9 @@ check_says eval-binned-theta-o 1 "--theta-o: --binned covers every outgoing dire
     "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --theta-o 30 --out "$tmp/b.csv"
 check_says eval-point-out 1 "--out: a point evaluation prints its value" \
     "$lamina" eval --model ww09 --stack "$P" --theta-i 30 --theta-o 30 --phi-o 0 --out "$tmp/p.csv"
+check_says eval-option-twice 1 "option 'refraction-normal' of model 'ww09' given twice (n, then h)" \
+    "$lamina" eval --model ww09:refraction-normal=n --option refraction-normal=h --stack "$P" \
+    --theta-i 30 --theta-o 30 --phi-o 0
 # An option the mode has no use for is refused, not ignored.
 check_says eval-binned-side 1 "--side: --binned tabulates every side the model supports" \
     "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --side T --out "$tmp/b.csv"

@@ -126,6 +126,19 @@ TEST(ModelRegistry, OptionsAreValidated) {
     EXPECT_THROW(resolve_options(ww, {"tir=on"}), InputError);
     EXPECT_EQ(resolve_options(find_model("bel18-symmetric"), {}).at("cosine"), "symmetric");
     EXPECT_EQ(resolve_options(find_model("bel-prime"), {}).at("cosine"), "forward");
+    // A key given twice (a spec's flag and an --option, or two of either) has no one meaning.
+    try {
+        resolve_options(ww, {"refraction-normal=n", "refraction-normal=h"});
+        ADD_FAILURE() << "a key given twice was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("'refraction-normal' of model 'ww09' given twice (n, "
+                                             "then h)"),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_THROW(make_model("ww09:refraction-normal=n", test::single(test::gold(0.3)),
+                            {"refraction-normal=n"}),
+                 InputError);
 }
 
 }  // namespace
