@@ -319,9 +319,11 @@ Runner add_eval(CLI::App& app) {
     cmd->add_option("--out", a->out, "Output CSV (written atomically)");
     add_settings_options_only(cmd, a->spectral, {"spectral", "spectral_min_nm", "spectral_max_nm"});
     cmd->add_option("--samples", a->samples,
-                    "random-walk: walks per query (default: its samples option, 1024); a point "
-                    "evaluation then prints f_r f_g f_b se_r se_g se_b")
-        ->check(CLI::Range(1.0, 1.8e19));  // ≥ 1 (as a double: "-3" must not wrap around)
+                    "random-walk: walks per query, at least 2 (default: its samples option, "
+                    "1024); a point evaluation then prints f_r f_g f_b se_r se_g se_b")
+        // ≥ 2: one walk has no standard error (it printed 0). As a double: "-3" must not wrap
+        // around.
+        ->check(CLI::Range(2.0, 1.8e19));
     cmd->add_flag("--pdf", a->pdf,
                   "random-walk, one point: print the exit density of its sampling at wo and its "
                   "standard error (pdf se, 1/sr) instead of f");

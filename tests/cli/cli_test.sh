@@ -54,7 +54,11 @@ check_says cli11-given-twice 1 "lamina: command line: --particles: given 2 times
     "$lamina" simulate "$src/examples/plastic.json" --particles 1e3 --particles 2e3 --out "$tmp/never"
 check_says cli11-not-a-number 1 "lamina: command line: --theta-o: 'abc' is not a number" \
     "$lamina" eval --model ww09 --stack "$src/examples/plastic.json" --theta-i 30 --theta-o abc --phi-o 0
-check_says cli11-negative-count 1 "lamina: command line: --samples: '-5' is not allowed: expected a whole number >= 1" \
+# One walk has no standard error (it printed 0).
+check_says eval-one-walk 1 "--samples: '1' is not allowed: expected a whole number >= 2" \
+    "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 \
+    --theta-o 30 --phi-o 0 --samples 1
+check_says cli11-negative-count 1 "lamina: command line: --samples: '-5' is not allowed: expected a whole number >= 2" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --samples -5
 check_says cli11-zero-seed 1 "lamina: command line: --seed: '0' is not allowed: expected a whole number >= 1" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --seed 0
