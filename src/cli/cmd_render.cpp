@@ -9,6 +9,7 @@
 #include "render/contact_sheet.h"
 #include "render/image.h"
 #include "render/renderer.h"
+#include "simulator/goniophotometer.h"
 
 #include <fmt/format.h>
 
@@ -121,7 +122,7 @@ Runner add_render(CLI::App& app) {
         ->check(CLI::Range(1, 1 << 20));
     cmd->add_option("--seed", a->seed, "Seed (images are reproducible for a seed)");
     cmd->add_option("--threads", a->threads, "Threads (default: all), at most 1024")
-        ->check(CLI::Range(0, 1024));  // as simulate's: OpenMP creates them all at once
+        ->check(CLI::Range(0, kMaxThreads));  // as simulate's: OpenMP creates them all at once
     cmd->add_option("--exposure", a->exposure,
                     "Exposure in stops for the PNG, [-40, 40] (default 0)");
     // The reference's transport (layers/transport_settings.h), but the numbers it keeps at their

@@ -1,6 +1,9 @@
 // The `lamina` executable: the command-line interface of cli/run.cpp.
 #include "cli/commands.h"
 #include "core/atomic_file.h"
+#include "simulator/goniophotometer.h"
+
+#include <fmt/format.h>
 
 #ifdef __GLIBC__
 #include <malloc.h>
@@ -17,5 +20,10 @@ int main(int argc, char** argv) {
     mallopt(M_TRIM_THRESHOLD, 256 << 20);
 #endif
     lamina::remove_staging_on_interrupt();
+    if (const int asked = lamina::cap_openmp_threads())
+        fmt::print(stderr,
+                   "lamina: warning: OpenMP asked for {} threads (OMP_NUM_THREADS); "
+                   "running at most {}\n",
+                   asked, lamina::kMaxThreads);
     return lamina::cli::run(argc, argv);
 }

@@ -1038,6 +1038,7 @@ void bind_cli(py::module_& m) {
 PYBIND11_MODULE(_lamina, m) {
     using namespace lamina;
     m.doc() = "lamina's compiled core (use the lamina package, docs/python.md)";
+    cap_openmp_threads();  // OMP_NUM_THREADS past kMaxThreads crashed OpenMP's runtime
     bind_errors(m);
     bind_stack(m);
     bind_table(m);

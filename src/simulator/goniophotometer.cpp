@@ -226,6 +226,13 @@ void check_tally_memory(const HemisphereGrid& grid, const SimulationSettings& se
                         have / 1e9));
 }
 
+int cap_openmp_threads() {
+    const int asked = omp_get_max_threads();
+    if (asked <= kMaxThreads) return 0;
+    omp_set_num_threads(kMaxThreads);
+    return asked;
+}
+
 SimulationSums simulate_sums(const Stack& stack, const SimulationSettings& settings,
                              const std::function<void(std::uint64_t)>& on_progress) {
     validate_settings(settings);

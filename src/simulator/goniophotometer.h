@@ -80,6 +80,15 @@ Kernel kernel_for(const SimulationSettings& settings, const Stack& stack);
 /// `kernel_description` and the study's reference pieces name.
 Kernel traced_kernel(const SimulationSettings& settings, const Stack& stack);
 
+/// The most threads lamina runs: OpenMP creates a team's threads all at once, and 65 536 crashed
+/// its runtime (a segmentation fault from OMP_NUM_THREADS=100000 alone).
+inline constexpr int kMaxThreads = 1024;
+
+/// Caps OpenMP's default team size (OMP_NUM_THREADS, or the cores) at kMaxThreads; returns the
+/// size asked for when it capped it, 0 otherwise. Called once at start by the CLI and the Python
+/// module, before any parallel region.
+int cap_openmp_threads();
+
 /// The goniophotometer's settings. Each is declared once, in `fields` (core/setting.h): the
 /// command line, result.json, the study's files, the reference's cache key and Python read them
 /// there.
@@ -136,11 +145,10 @@ struct SimulationSettings {
                .key = Key::Fixed},
               s.particles);
         visit({.name = "seed", .help = "Random seed", .min = 0, .key = Key::Fixed}, s.seed);
-        // At most 1024: OpenMP creates them all at once, and 65 536 crashed its runtime.
         visit({.name = "threads",
                .help = "Threads (0 = all cores), at most 1024",
                .min = 0,
-               .max = 1024,
+               .max = kMaxThreads,
                .key = Key::No},
               s.threads);
         visit({.name = "grid",

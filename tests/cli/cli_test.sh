@@ -54,6 +54,14 @@ check_says cli11-given-twice 1 "lamina: command line: --particles: given 2 times
     "$lamina" simulate "$src/examples/plastic.json" --particles 1e3 --particles 2e3 --out "$tmp/never"
 check_says cli11-not-a-number 1 "lamina: command line: --theta-o: 'abc' is not a number" \
     "$lamina" eval --model ww09 --stack "$src/examples/plastic.json" --theta-i 30 --theta-o abc --phi-o 0
+# OMP_NUM_THREADS far past the 1024 threads lamina runs crashed OpenMP's runtime (a segmentation
+# fault); it is capped, with a warning, and the tables are those of any other thread count.
+check_says omp-threads-capped 0 "OpenMP asked for 100000 threads (OMP_NUM_THREADS); running at most 1024" \
+    env OMP_NUM_THREADS=100000 "$lamina" simulate "$src/examples/plastic.json" --particles 1e3 \
+    --theta-i 0 --grid 9x9 --out "$tmp/omp-many"
+check omp-threads-one 0 env OMP_NUM_THREADS=1 "$lamina" simulate "$src/examples/plastic.json" \
+    --particles 1e3 --theta-i 0 --grid 9x9 --out "$tmp/omp-one"
+check omp-threads-same-table 0 cmp "$tmp/omp-many/brdf.csv" "$tmp/omp-one/brdf.csv"
 # One walk has no standard error (it printed 0).
 check_says eval-one-walk 1 "--samples: '1' is not allowed: expected a whole number >= 2" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 \

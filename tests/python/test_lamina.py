@@ -772,3 +772,19 @@ def test_python_m_lamina_runs_the_cli():
     assert bad.stderr == cli("simulate", ROOT / "no-such-stack.json", "--out", "unused",
                              check=False).stderr
     assert "python3 -m lamina" in run_module("--help").stdout
+
+
+def test_omp_num_threads_past_the_cap_runs_capped():
+    # OMP_NUM_THREADS=100000 crashed OpenMP's runtime (a segmentation fault); the module caps
+    # OpenMP's default at lamina's 1024 threads when it loads, and the tables are any thread
+    # count's.
+    code = ("import sys, lamina; r = lamina.simulate(sys.argv[1], theta_i=[30], particles=1000, "
+            "grid=(9, 9)); print(r.f.tobytes().hex())")
+    runs = []
+    for threads in ("100000", "1"):
+        env = dict(os.environ, OMP_NUM_THREADS=threads)
+        r = subprocess.run([sys.executable, "-c", code, str(PLASTIC)], env=env,
+                           capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+        runs.append(r.stdout)
+    assert runs[0] == runs[1]
