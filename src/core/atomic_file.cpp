@@ -174,19 +174,18 @@ bool write_file_if_changed(const fs::path& path, std::string_view content) {
     return true;
 }
 
-StagedOutput::StagedOutput(fs::path dir) : dir_(std::move(dir)) {
+StagedOutput::StagedOutput(fs::path dir, std::string field) : dir_(std::move(dir)) {
     std::error_code ec;
     created_ = !fs::exists(dir_, ec);
     fs::create_directories(dir_, ec);
     if (ec || !fs::is_directory(dir_))
-        throw InputError(dir_.string(), "--out",
-                         "cannot create the output folder: " + ec.message());
+        throw InputError(dir_.string(), field, "cannot create the output folder: " + ec.message());
     if (::access(dir_.c_str(), W_OK) != 0)
-        throw InputError(dir_.string(), "--out", "the output folder is not writable");
+        throw InputError(dir_.string(), field, "the output folder is not writable");
     staging_ = dir_ / fmt::format(".staging-{}", unique_suffix());
     fs::create_directory(staging_, ec);
     if (ec)
-        throw InputError(dir_.string(), "--out", "cannot create a staging folder: " + ec.message());
+        throw InputError(dir_.string(), field, "cannot create a staging folder: " + ec.message());
     slot_ = register_staging(staging_, created_ ? dir_ : fs::path());
 }
 

@@ -38,8 +38,9 @@ bool file_holds(const std::filesystem::path& path, std::string_view content);
 /// folder it created is removed again.
 class StagedOutput {
   public:
-    /// Creates `dir` if needed and checks it is writable; throws InputError otherwise.
-    explicit StagedOutput(std::filesystem::path dir);
+    /// Creates `dir` if needed and checks it is writable; throws InputError otherwise, naming
+    /// `field` (the option or argument that gave the folder).
+    explicit StagedOutput(std::filesystem::path dir, std::string field = "--out");
     ~StagedOutput();
     StagedOutput(const StagedOutput&) = delete;
     StagedOutput& operator=(const StagedOutput&) = delete;

@@ -169,8 +169,8 @@ HemisphereGrid SettingCodec<HemisphereGrid>::from_json(const nlohmann::json& j,
         setting_detail::fail(where, field,
                              "expected \"NTHETAxNPHI\", [n_theta, n_phi] or {\"n_theta\": "
                              "n_theta, \"n_phi\": n_phi}");
-    return from_text(fmt::format("{}x{}", n_theta.get<long long>(), n_phi.get<long long>()), info,
-                     where, field);
+    // Each count as JSON wrote it: one past a 64-bit integer's range is shown as given.
+    return from_text(fmt::format("{}x{}", n_theta.dump(), n_phi.dump()), info, where, field);
 }
 
 }  // namespace lamina

@@ -721,7 +721,7 @@ void bind_simulation(py::module_& m) {
         .def(
             "write",
             [](const PySimulation& r, const std::filesystem::path& dir) {
-                write_simulation(dir, r.stack, r.result);
+                write_simulation(dir, r.stack, r.result, {}, "dir");
             },
             py::arg("dir"), "Writes DIR/{brdf.csv,energy.csv,result.json} as lamina simulate does")
         .def("__repr__", [](const PySimulation& r) {

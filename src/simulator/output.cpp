@@ -142,8 +142,9 @@ std::string xyz_npy(const SimulationResult& result, bool standard_error) {
 
 void write_simulation(const std::filesystem::path& dir, const Stack& stack,
                       const SimulationResult& result,
-                      const std::vector<std::pair<std::string, std::string>>& extra) {
-    StagedOutput out(dir);
+                      const std::vector<std::pair<std::string, std::string>>& extra,
+                      const std::string& field) {
+    StagedOutput out(dir, field);
     out.add("brdf.csv", result.table.to_csv());
     out.add("energy.csv", energy_csv(result));
     for (const auto& [name, bytes] : extra)

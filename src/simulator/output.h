@@ -35,9 +35,11 @@ std::string xyz_npy(const SimulationResult& result, bool standard_error);
 nlohmann::json result_json(const Stack& stack, const SimulationResult& result);
 
 /// Writes the three files into `dir` (created if needed), with `extra` files (name, bytes) staged
-/// and moved into place with them (the Mueller tables, simulator/mueller.h).
+/// and moved into place with them (the Mueller tables, simulator/mueller.h). An InputError about
+/// the folder names `field`, what gave it (the CLI's --out, Python's dir).
 void write_simulation(const std::filesystem::path& dir, const Stack& stack,
                       const SimulationResult& result,
-                      const std::vector<std::pair<std::string, std::string>>& extra = {});
+                      const std::vector<std::pair<std::string, std::string>>& extra = {},
+                      const std::string& field = "--out");
 
 }  // namespace lamina

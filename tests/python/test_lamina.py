@@ -788,3 +788,16 @@ def test_omp_num_threads_past_the_cap_runs_capped():
         assert r.returncode == 0, r.stderr
         runs.append(r.stdout)
     assert runs[0] == runs[1]
+
+
+def test_a_bad_grid_and_a_bad_folder_are_named_as_python_gave_them(tmp_path):
+    # A count past a 64-bit integer was shown wrapped around (-9223372036854775808).
+    with pytest.raises(lamina.InputError) as e:
+        lamina.simulate(PLASTIC, theta_i=[30], particles=100, grid=(2**63, 1))
+    assert "'9223372036854775808x1' is not a grid" in e.value.problem
+    # write()'s folder is its argument dir, not the CLI's --out.
+    r = lamina.simulate(PLASTIC, theta_i=[30], particles=100, grid=(9, 9))
+    (tmp_path / "a-file").write_text("not a folder")
+    with pytest.raises(lamina.InputError) as e:
+        r.write(tmp_path / "a-file" / "out")
+    assert e.value.field == "dir" and "cannot create the output folder" in e.value.problem
