@@ -397,10 +397,27 @@ void check_rgl_bsdf(const TensorFile& file, const std::string& where) {
                     rgb.shape[3] == lum.shape[2] && rgb.shape[4] == lum.shape[3],
                 "rgb", "expected [phi_i, theta_i, 3, n, n] matching luminance");
     }
-    for (const char* name : {"theta_i", "phi_i", "ndf", "sigma", "vndf", "luminance", "spectra"})
+    for (const char* name :
+         {"theta_i", "phi_i", "wavelengths", "ndf", "sigma", "vndf", "luminance", "spectra"})
         for (float v : file.at(name).floats())
             if (!std::isfinite(v))
                 throw InputError(where, name, "holds a value that is not finite");
+    if (file.count("rgb"))
+        for (float v : file.at("rgb").floats())
+            if (!std::isfinite(v))
+                throw InputError(where, "rgb", "holds a value that is not finite");
+    // The incidences are polar angles of the upper hemisphere (radians), the wavelengths the
+    // nodes a renderer interpolates the spectra between.
+    for (float v : ti.floats())
+        if (!(v >= 0 && v <= float(kPi<double> / 2)))
+            throw InputError(
+                where, "theta_i",
+                fmt::format("{} rad is outside [0, π/2] (an incidence's polar angle)", v));
+    const std::vector<float> wavelengths = wl.floats();
+    for (std::size_t k = 0; k < wavelengths.size(); ++k)
+        if (!(wavelengths[k] > 0) || (k > 0 && !(wavelengths[k] > wavelengths[k - 1])))
+            throw InputError(where, "wavelengths",
+                             "the wavelengths must be positive and increase strictly");
 }
 
 }  // namespace lamina

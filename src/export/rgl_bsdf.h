@@ -84,7 +84,8 @@ Rgbd rgl_spectral_weights(std::size_t wavelength_index);
 TensorFile rgl_bsdf(const BrdfSource& brdf, const RglOptions& options);
 
 /// Checks the fields and shapes a reader requires (the structure pbrt-v4 and Mitsuba 3 check on
-/// loading), InputError naming `where` and the field otherwise.
+/// loading) and their values (every one finite, the incidences in [0, π/2], the wavelengths
+/// positive and increasing), InputError naming `where` and the field otherwise.
 void check_rgl_bsdf(const TensorFile& file, const std::string& where);
 
 }  // namespace lamina

@@ -373,6 +373,25 @@ TEST(RglBsdf, HasTheFieldsTheReadersRequire) {
     TensorFile wrong = f;
     wrong["vndf"] = tensor_float32(std::vector<float>(8, 1.f), {2, 2, 2});
     EXPECT_THROW(check_rgl_bsdf(wrong, "t.bsdf"), InputError);
+    // Values a renderer cannot use: a wavelength that is NaN or out of order, an incidence below
+    // the horizon or negative — each refused naming its field.
+    auto field_refused = [&](const std::string& name, std::size_t at, float value) {
+        TensorFile damaged = f;
+        std::vector<float> v = damaged.at(name).floats();
+        v.at(at) = value;
+        damaged[name] = tensor_float32(v, damaged.at(name).shape);
+        try {
+            check_rgl_bsdf(damaged, "t.bsdf");
+        } catch (const InputError& e) {
+            return e.field() == name;
+        }
+        return false;
+    };
+    EXPECT_TRUE(field_refused("wavelengths", 2, std::nanf("")));
+    EXPECT_TRUE(field_refused("wavelengths", 2, 1.f));  // below its predecessor
+    EXPECT_TRUE(field_refused("theta_i", 0, -0.1f));
+    EXPECT_TRUE(field_refused("theta_i", 4, 2.f));
+    EXPECT_FALSE(field_refused("theta_i", 0, 0.f));  // the normal is an incidence
 }
 
 TEST(RglBsdf, DefaultIncidencesGetDenserTowardsGrazing) {
