@@ -96,7 +96,9 @@ TEST(Binned, CapturesSharpLobes) {
 // Each bin is good to 1e-4 relative: the default tables against ones computed with a tolerance
 // 100× tighter and deeper refinement, for a rough, a glossy (α = 0.05) and a sharp (α = 0.001)
 // configuration, on the 90 × 90 grid (bins below 1e-6 of the lobe's peak bin are compared in
-// absolute terms).
+// absolute terms). The tighter run refines with the same adaptive rule and shares its blindness to
+// bends along θ alone: the check independent of it is the composite rule of
+// SharedNodesSettleSmoothBinsAtFewerEvaluationsWithinTheTolerance below.
 TEST(Binned, BinAveragesAreGoodTo1e4Relative) {
     BinnedOptions tight;
     tight.rel_tol = 1e-6;
