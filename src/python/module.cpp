@@ -1038,7 +1038,16 @@ void bind_cli(py::module_& m) {
 PYBIND11_MODULE(_lamina, m) {
     using namespace lamina;
     m.doc() = "lamina's compiled core (use the lamina package, docs/python.md)";
-    cap_openmp_threads();  // OMP_NUM_THREADS past kMaxThreads crashed OpenMP's runtime
+    // OMP_NUM_THREADS past kMaxThreads crashed OpenMP's runtime: capped, as the CLI does, with a
+    // warning.
+    if (const int asked = cap_openmp_threads())
+        PyErr_WarnEx(
+            PyExc_RuntimeWarning,
+            fmt::format("lamina: OpenMP asked for {} threads (OMP_NUM_THREADS); running at "
+                        "most {}",
+                        asked, kMaxThreads)
+                .c_str(),
+            1);
     bind_errors(m);
     bind_stack(m);
     bind_table(m);

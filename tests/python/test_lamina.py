@@ -786,6 +786,7 @@ def test_omp_num_threads_past_the_cap_runs_capped():
         r = subprocess.run([sys.executable, "-c", code, str(PLASTIC)], env=env,
                            capture_output=True, text=True, timeout=300)
         assert r.returncode == 0, r.stderr
+        assert ("running at most 1024" in r.stderr) == (threads == "100000"), r.stderr
         runs.append(r.stdout)
     assert runs[0] == runs[1]
 

@@ -360,7 +360,8 @@ std::vector<Peak> peaks_on_side(const std::vector<Vec3d>& dirs, Side side, bool 
 // evaluations: on the lattice of half-bin steps in θ and φ a bin owns about 4 nodes, against the
 // 9 interior nodes of its own 3×3 Gauss–Legendre rule. Two embedded product rules on it, per
 // coordinate, in units of the bin's width:
-//   - Simpson's rule on the bin's own nodes 0, ½, 1 (weights 1/6, 4/6, 1/6; degree 3);
+//   - Simpson's rule on the bin's own nodes 0, ½, 1 (weights 1/6, 4/6, 1/6; degree 3;
+//     Abramowitz & Stegun, 25.4.5);
 //   - the interpolatory rule on the 5 nodes −½ … 3/2 (half a bin into each neighbour), weights
 //     −1/180, 17/90, 19/30, 17/90, −1/180 (solved from the moments ∫₀¹ xᵏ dx = 1/(k + 1),
 //     k = 0…4; degree 5 by its symmetry about the bin's centre, as the 3×3 Gauss–Legendre rule).
