@@ -95,16 +95,30 @@ using VD = hn::Vec<DD>;
 using VL = hn::Vec<DL>;
 
 // A particle past its first event, waiting for a lane.
-struct Waiting {
-    float d[3], w[3], depth;
-    std::int32_t k, in_medium, events;
-    std::uint64_t state, inc;
-};
-using Queue = std::vector<Waiting>;
-// Its polarization (polarized runs), kept beside the queue: the frame's x axis and (q, u, v) per
-// channel.
-struct WaitingPolarization {
-    float x[3], q[3], u[3], v[3];
+// The queue of particles past their first event (FirstEvents), one array per field: the
+// waiting lanes' fields are compressed into it on vectors, and the main loop's fresh lanes expand
+// them out of it on vectors (in lane order: the queue's order is the particles' order).
+// Floats: the direction (3), the flux (3), the optical depth, then (polarized runs) the
+// polarization frame's x axis and (q, u, v) per channel (12); integers: the next interface, in
+// medium, the events so far; and the generator. Every array has kMaxLanes entries to spare, for
+// stores of whole vectors.
+constexpr int kQueueFloats = 7, kQueuePolarizationFloats = 12, kQueueInts = 3;
+struct QueueArrays {
+    std::vector<float> f[kQueueFloats + kQueuePolarizationFloats];
+    std::vector<std::int32_t> i[kQueueInts];
+    std::vector<std::uint64_t> state, inc;
+    std::size_t size = 0;
+    void reserve(std::size_t n, bool polarized) {
+        const std::size_t padded = n + kMaxLanes;
+        for (int a = 0; a < kQueueFloats + (polarized ? kQueuePolarizationFloats : 0); ++a)
+            if (f[a].size() < padded) f[a].resize(padded);
+        for (auto& a : i)
+            if (a.size() < padded) a.resize(padded);
+        if (state.size() < padded) {
+            state.resize(padded);
+            inc.resize(padded);
+        }
+    }
 };
 // Its spectral lane (spectral runs), kept beside the queue: LaneVectors' at, group, secondaries.
 struct WaitingSpectral {
@@ -113,56 +127,12 @@ struct WaitingSpectral {
 
 struct Scratch {
     std::vector<std::uint64_t> state, inc;
-    Queue queue;
-    std::vector<WaitingPolarization> queue_pol;
+    QueueArrays queue;
     std::vector<WaitingSpectral> queue_spectral;
-    void resize(std::size_t n) {
+    void resize(std::size_t n, bool polarized) {
         state.resize(n);
         inc.resize(n);
-        queue.reserve(n);
-    }
-};
-
-// The lanes' polarization into per-lane arrays and back (the queue's refills).
-struct PolarizationArrays {
-    HWY_ALIGN float x[3][kMaxLanes], q[3][kMaxLanes], u[3][kMaxLanes], v[3][kMaxLanes];
-    HWY_INLINE void Store(const StokesLanes<VF>& s) {
-        const DF df;
-        hn::Store(s.x.x, df, x[0]);
-        hn::Store(s.x.y, df, x[1]);
-        hn::Store(s.x.z, df, x[2]);
-        for (int c = 0; c < 3; ++c) {
-            hn::Store(s.q[c], df, q[c]);
-            hn::Store(s.u[c], df, u[c]);
-            hn::Store(s.v[c], df, v[c]);
-        }
-    }
-    HWY_INLINE void Load(MF m, StokesLanes<VF>& s) const {
-        const DF df;
-        s.x = Select(m, V3{hn::Load(df, x[0]), hn::Load(df, x[1]), hn::Load(df, x[2])}, s.x);
-        for (int c = 0; c < 3; ++c) {
-            s.q[c] = hn::IfThenElse(m, hn::Load(df, q[c]), s.q[c]);
-            s.u[c] = hn::IfThenElse(m, hn::Load(df, u[c]), s.u[c]);
-            s.v[c] = hn::IfThenElse(m, hn::Load(df, v[c]), s.v[c]);
-        }
-    }
-    WaitingPolarization Lane(std::size_t l) const {
-        WaitingPolarization w;
-        for (int i = 0; i < 3; ++i) {
-            w.x[i] = x[i][l];
-            w.q[i] = q[i][l];
-            w.u[i] = u[i][l];
-            w.v[i] = v[i][l];
-        }
-        return w;
-    }
-    void SetLane(std::size_t l, const WaitingPolarization& w) {
-        for (int i = 0; i < 3; ++i) {
-            x[i][l] = w.x[i];
-            q[i][l] = w.q[i];
-            u[i][l] = w.u[i];
-            v[i][l] = w.v[i];
-        }
+        queue.reserve(n, polarized);
     }
 };
 
@@ -274,7 +244,7 @@ class BlockTracer {
             for (auto& term : particle_loss_)
                 for (auto& channel : term)
                     std::fill(std::begin(channel), std::end(channel), 0.0);
-        scratch_.resize(job_.count);
+        scratch_.resize(job_.count, kPolarized);
         SeedParticles(job_.seed, job_.stream, job_.first, job_.count, scratch_.state.data(),
                       scratch_.inc.data());
         FirstEvents();
@@ -702,16 +672,13 @@ class BlockTracer {
         const DF df;
         const DI di;
         may_suspend_ = false;
-        Queue& queue = scratch_.queue;
-        queue.clear();
-        if constexpr (kPolarized) scratch_.queue_pol.clear();
+        QueueArrays& queue = scratch_.queue;
+        queue.size = 0;
         if constexpr (kSpectral) scratch_.queue_spectral.clear();
         LaneVectors p;
         Clear(p);
         [[maybe_unused]] const StokesLanes<VF> incident = p.pol.stokes;
         LaneRng prng;
-        HWY_ALIGN float qd[3][kMaxLanes], qw[3][kMaxLanes], qdepth[kMaxLanes];
-        HWY_ALIGN std::int32_t qk[kMaxLanes], qin[kMaxLanes], qevents[kMaxLanes];
         std::uint64_t chunks = 0;
         for (std::uint64_t base = 0; base < job_.count; base += n_lanes_) {
             const std::size_t n = std::size_t(std::min<std::uint64_t>(n_lanes_, job_.count - base));
@@ -741,32 +708,19 @@ class BlockTracer {
                     BookLosses(std::size_t(std::countr_zero(bits)));
             }
             const MF waits = hn::AndNot(ended, going);
-            hn::Store(p.d.x, df, qd[0]);
-            hn::Store(p.d.y, df, qd[1]);
-            hn::Store(p.d.z, df, qd[2]);
-            for (int c = 0; c < 3; ++c)
-                hn::Store(p.w[c], df, qw[c]);
-            hn::Store(p.depth, df, qdepth);
-            hn::Store(p.k, di, qk);
-            hn::Store(p.in_medium, di, qin);
-            hn::Store(p.events, di, qevents);
-            if constexpr (kPolarized) staged_pol_.Store(p.pol.stokes);
+            Enqueue(p, waits);
             [[maybe_unused]] HWY_ALIGN std::int32_t qsecondaries[kMaxLanes];
             if constexpr (kSpectral) hn::Store(p.secondaries, di, qsecondaries);
+            std::size_t j = queue.size;
             for (std::uint64_t bits = MaskBits(waits); bits != 0; bits &= bits - 1) {
                 const std::size_t l = std::size_t(std::countr_zero(bits));
-                if constexpr (kPolarized) scratch_.queue_pol.push_back(staged_pol_.Lane(l));
                 if constexpr (kSpectral)
                     scratch_.queue_spectral.push_back({at_out_[l], group_out_[l], qsecondaries[l]});
-                queue.push_back({{qd[0][l], qd[1][l], qd[2][l]},
-                                 {qw[0][l], qw[1][l], qw[2][l]},
-                                 qdepth[l],
-                                 qk[l],
-                                 qin[l],
-                                 qevents[l],
-                                 prng.state[l],
-                                 prng.inc[l]});
+                queue.state[j] = prng.state[l];
+                queue.inc[j] = prng.inc[l];
+                ++j;
             }
+            queue.size = j;
             if (++chunks % kFlushSteps == 0) Flush(p);
         }
         Flush(p);
@@ -798,11 +752,69 @@ class BlockTracer {
 
     // ---- The main loop ----
 
-    // Stages the queue's next particle for lane l, or retires the lane when none is left.
+    // The lanes of `waits` to the end of the queue (their generators apart): their fields
+    // compressed into the queue's arrays, in lane order.
+    HWY_INLINE void Enqueue(const LaneVectors& p, MF waits) {
+        const DF df;
+        const DI di;
+        QueueArrays& q = scratch_.queue;
+        const std::size_t at = q.size;
+        const auto waits_i = hn::RebindMask(di, waits);
+        // With 16 lanes or more compressed in registers and stored whole (the arrays' spare
+        // entries take the rest; the form of compress that stores to memory is microcoded on AMD
+        // Zen 4); with fewer stored, then copied lane by lane (Highway's compress then copies a
+        // table of permutations onto the stack at every call).
+        [[maybe_unused]] HWY_ALIGN float lanes_f[kVectorCompress ? 1 : kQueuedFloats][kMaxLanes];
+        [[maybe_unused]] HWY_ALIGN std::int32_t lanes_i[kQueueInts][kMaxLanes];
+        auto put = [&](VF x, int a) {
+            if constexpr (kVectorCompress)
+                hn::StoreU(hn::Compress(x, waits), df, q.f[a].data() + at);
+            else
+                hn::Store(x, df, lanes_f[a]);
+        };
+        auto put_i = [&](VI x, int a) {
+            if constexpr (kVectorCompress)
+                hn::StoreU(hn::Compress(x, waits_i), di, q.i[a].data() + at);
+            else
+                hn::Store(x, di, lanes_i[a]);
+        };
+        put(p.d.x, 0);
+        put(p.d.y, 1);
+        put(p.d.z, 2);
+        for (int c = 0; c < 3; ++c)
+            put(p.w[c], 3 + c);
+        put(p.depth, 6);
+        put_i(p.k, 0);
+        put_i(p.in_medium, 1);
+        put_i(p.events, 2);
+        if constexpr (kPolarized) {
+            const StokesLanes<VF>& s = p.pol.stokes;
+            put(s.x.x, 7);
+            put(s.x.y, 8);
+            put(s.x.z, 9);
+            for (int c = 0; c < 3; ++c) {
+                put(s.q[c], 10 + c);
+                put(s.u[c], 13 + c);
+                put(s.v[c], 16 + c);
+            }
+        }
+        if constexpr (!kVectorCompress) {
+            std::size_t j = at;
+            for (std::uint64_t bits = MaskBits(waits); bits != 0; bits &= bits - 1, ++j) {
+                const std::size_t l = std::size_t(std::countr_zero(bits));
+                for (int a = 0; a < kQueuedFloats; ++a)
+                    q.f[a][j] = lanes_f[a][l];
+                for (int a = 0; a < kQueueInts; ++a)
+                    q.i[a][j] = lanes_i[a][l];
+            }
+        }
+    }
+
+    // Gives lane l the queue's next particle (its generator and spectral lane here, the rest in
+    // Restart), or retires the lane when none is left.
     HWY_INLINE void TakeParticle(std::size_t l) {
-        const Queue& queue = scratch_.queue;
-        if (next_ < queue.size()) {
-            if constexpr (kPolarized) staged_pol_.SetLane(l, scratch_.queue_pol[next_]);
+        const QueueArrays& queue = scratch_.queue;
+        if (next_ < queue.size) {
             if constexpr (kSpectral) {
                 const WaitingSpectral& q = scratch_.queue_spectral[next_];
                 s_at_[l] = q.at;
@@ -810,53 +822,77 @@ class BlockTracer {
                 s_group_[l] = q.group;
                 s_secondaries_[l] = q.secondaries;
             }
-            const Waiting& q = queue[next_++];
-            for (int i = 0; i < 3; ++i) {
-                sd_[i][l] = q.d[i];
-                sw_[i][l] = q.w[i];
-            }
-            sdepth_[l] = q.depth;
-            sk_[l] = q.k;
-            s_in_[l] = q.in_medium;
-            sevents_[l] = q.events;
-            rng_.state[l] = q.state;
-            rng_.inc[l] = q.inc;
-            live_[l] = 1;
+            rng_.state[l] = queue.state[next_];
+            rng_.inc[l] = queue.inc[next_];
+            taking_ |= std::uint64_t(1) << l;
+            ++next_;
         } else {
-            for (int i = 0; i < 3; ++i)
-                sw_[i][l] = 0.f;
-            sd_[2][l] = -1.f;
-            sdepth_[l] = 0.f;
-            sk_[l] = s_in_[l] = sevents_[l] = 0;
             s_at_[l] = s_hero_[l] = s_group_[l] = s_secondaries_[l] = 0;
             rng_.state[l] = 0;
             rng_.inc[l] = 1;
-            live_[l] = 0;
         }
     }
 
-    // The staged particles into the lanes of `fresh`.
-    HWY_INLINE void Restart(LaneVectors& v, MF fresh) const {
+    // The particles TakeParticle gave since the last restart into the lanes of `fresh`, expanded
+    // from the queue in lane order; the lanes of `fresh` it retired get no flux and are not live.
+    HWY_INLINE void Restart(LaneVectors& v, MF fresh) {
         const DF df;
         const DI di;
+        const QueueArrays& q = scratch_.queue;
+        std::uint8_t bytes[8];
+        for (int b = 0; b < 8; ++b)
+            bytes[b] = std::uint8_t(taking_ >> (8 * b));
+        const MF taking = hn::LoadMaskBits(df, bytes);
+        const auto taking_i = hn::RebindMask(di, taking);
         const auto fresh_i = hn::RebindMask(di, fresh);
-        v.d = Select(fresh, V3{hn::Load(df, sd_[0]), hn::Load(df, sd_[1]), hn::Load(df, sd_[2])},
-                     v.d);
+        // Lane l of `taking` gets the queue's entry taken_from_ + (its rank among them): a
+        // permutation of the next whole vector of entries (an expand, which AVX-512 has as one
+        // instruction; its form that loads from memory is microcoded on AMD Zen 4).
+        HWY_ALIGN std::int32_t rank[kMaxLanes];
+        std::int32_t taken = 0;
+        for (std::size_t l = 0; l < n_lanes_; ++l) {
+            rank[l] = std::min(taken, std::int32_t(n_lanes_) - 1);
+            taken += std::int32_t(taking_ >> l & 1);
+        }
+        const VI rank_v = hn::Load(di, rank);
+        const auto to_f = hn::IndicesFromVec(df, rank_v);
+        const auto to_i = hn::IndicesFromVec(di, rank_v);
+        const std::size_t at = taken_from_;
+        auto take = [&](int a) {
+            return hn::IfThenElseZero(
+                taking, hn::TableLookupLanes(hn::LoadU(df, q.f[a].data() + at), to_f));
+        };
+        auto take_i = [&](int a) {
+            return hn::IfThenElseZero(
+                taking_i, hn::TableLookupLanes(hn::LoadU(di, q.i[a].data() + at), to_i));
+        };
+        v.d = Select(fresh,
+                     V3{take(0), take(1), hn::IfThenElse(taking, take(2), hn::Set(df, -1.f))}, v.d);
         for (int c = 0; c < 3; ++c)
-            v.w[c] = hn::IfThenElse(fresh, hn::Load(df, sw_[c]), v.w[c]);
-        v.depth = hn::IfThenElse(fresh, hn::Load(df, sdepth_), v.depth);
-        v.k = hn::IfThenElse(fresh_i, hn::Load(di, sk_), v.k);
-        v.in_medium = hn::IfThenElse(fresh_i, hn::Load(di, s_in_), v.in_medium);
-        v.events = hn::IfThenElse(fresh_i, hn::Load(di, sevents_), v.events);
-        v.live = hn::IfThenElse(fresh_i, hn::Load(di, live_), v.live);
+            v.w[c] = hn::IfThenElse(fresh, take(3 + c), v.w[c]);
+        v.depth = hn::IfThenElse(fresh, take(6), v.depth);
+        v.k = hn::IfThenElse(fresh_i, take_i(0), v.k);
+        v.in_medium = hn::IfThenElse(fresh_i, take_i(1), v.in_medium);
+        v.events = hn::IfThenElse(fresh_i, take_i(2), v.events);
+        v.live = hn::IfThenElse(fresh_i, hn::IfThenElseZero(taking_i, hn::Set(di, 1)), v.live);
         v.mid_walk = hn::IfThenElseZero(hn::Not(fresh_i), v.mid_walk);
-        if constexpr (kPolarized) staged_pol_.Load(fresh, v.pol.stokes);
+        if constexpr (kPolarized) {
+            StokesLanes<VF>& s = v.pol.stokes;
+            s.x = Select(fresh, V3{take(7), take(8), take(9)}, s.x);
+            for (int c = 0; c < 3; ++c) {
+                s.q[c] = hn::IfThenElse(fresh, take(10 + c), s.q[c]);
+                s.u[c] = hn::IfThenElse(fresh, take(13 + c), s.u[c]);
+                s.v[c] = hn::IfThenElse(fresh, take(16 + c), s.v[c]);
+            }
+        }
         if constexpr (kSpectral) {
             v.at = hn::IfThenElse(fresh_i, hn::Load(di, s_at_), v.at);
             v.hero = hn::IfThenElse(fresh_i, hn::Load(di, s_hero_), v.hero);
             v.group = hn::IfThenElse(fresh_i, hn::Load(di, s_group_), v.group);
             v.secondaries = hn::IfThenElse(fresh_i, hn::Load(di, s_secondaries_), v.secondaries);
         }
+        taking_ = 0;
+        taken_from_ = next_;
     }
 
     // The group of lanes that steps: those at one interface, or those inside one scattering
@@ -979,13 +1015,18 @@ class BlockTracer {
     // Polarized runs with Stokes tallies: the exits' Stokes vectors in their bin frames.
     [[maybe_unused]] HWY_ALIGN float stokes_out_[3][4][kMaxLanes];
     const bool stokes_tallies_;
-    [[maybe_unused]] PolarizationArrays staged_pol_;  // the lanes' states, staged or stored
 
     // The main loop's generators, and the particle staged for each lane.
     LaneRng rng_;
-    HWY_ALIGN float sd_[3][kMaxLanes], sw_[3][kMaxLanes], sdepth_[kMaxLanes];
-    HWY_ALIGN std::int32_t sk_[kMaxLanes], s_in_[kMaxLanes], sevents_[kMaxLanes], live_[kMaxLanes];
-    std::size_t next_ = 0;  // the queue's next particle
+    // Compress (Enqueue) on vectors where they hold 16 lanes or more: AVX-512 has it as one
+    // instruction; with fewer lanes Highway builds it from a table of permutations, which it copies
+    // onto the stack at every call (the AVX2 kernel ran 23 % slower), and the lanes are copied one
+    // by one instead.
+    static constexpr bool kVectorCompress = hn::MaxLanes(DF()) >= 16;
+    static constexpr int kQueuedFloats = kQueueFloats + (kPolarized ? kQueuePolarizationFloats : 0);
+    std::size_t next_ = 0;        // the queue's next particle
+    std::size_t taken_from_ = 0;  // the first particle given since the last restart
+    std::uint64_t taking_ = 0;    // the lanes given one since (bit l for lane l)
 
     // Spectral runs: the staged lanes' stacks, heroes, groups and secondaries; the ended lanes'
     // stacks and groups (StageSpectral); each lane's particle's losses (Flush); the block's sums.
