@@ -94,7 +94,6 @@ using DL = hn::RebindToSigned<DD>;
 using VD = hn::Vec<DD>;
 using VL = hn::Vec<DL>;
 
-// A particle past its first event, waiting for a lane.
 // The queue of particles past their first event (FirstEvents), one array per field: the
 // waiting lanes' fields are compressed into it on vectors, and the main loop's fresh lanes expand
 // them out of it on vectors (in lane order: the queue's order is the particles' order).
@@ -760,10 +759,9 @@ class BlockTracer {
         QueueArrays& q = scratch_.queue;
         const std::size_t at = q.size;
         const auto waits_i = hn::RebindMask(di, waits);
-        // With 16 lanes or more compressed in registers and stored whole (the arrays' spare
-        // entries take the rest; the form of compress that stores to memory is microcoded on AMD
-        // Zen 4); with fewer stored, then copied lane by lane (Highway's compress then copies a
-        // table of permutations onto the stack at every call).
+        // Compressed in registers and stored whole (the arrays' spare entries take the rest; the
+        // form of compress that stores to memory is slow on AMD Zen 4), or stored and copied lane
+        // by lane (kVectorCompress).
         [[maybe_unused]] HWY_ALIGN float lanes_f[kVectorCompress ? 1 : kQueuedFloats][kMaxLanes];
         [[maybe_unused]] HWY_ALIGN std::int32_t lanes_i[kQueueInts][kMaxLanes];
         auto put = [&](VF x, int a) {
@@ -847,7 +845,8 @@ class BlockTracer {
         const auto fresh_i = hn::RebindMask(di, fresh);
         // Lane l of `taking` gets the queue's entry taken_from_ + (its rank among them): a
         // permutation of the next whole vector of entries (an expand, which AVX-512 has as one
-        // instruction; its form that loads from memory is microcoded on AMD Zen 4).
+        // instruction; its form that loads from memory is slow on AMD Zen 4: with it and the
+        // compress that stores, the kernel ran 12 % slower than with one record per particle).
         HWY_ALIGN std::int32_t rank[kMaxLanes];
         std::int32_t taken = 0;
         for (std::size_t l = 0; l < n_lanes_; ++l) {
@@ -1016,14 +1015,15 @@ class BlockTracer {
     [[maybe_unused]] HWY_ALIGN float stokes_out_[3][4][kMaxLanes];
     const bool stokes_tallies_;
 
-    // The main loop's generators, and the particle staged for each lane.
+    // The main loop's generators.
     LaneRng rng_;
     // Compress (Enqueue) on vectors where they hold 16 lanes or more: AVX-512 has it as one
-    // instruction; with fewer lanes Highway builds it from a table of permutations, which it copies
-    // onto the stack at every call (the AVX2 kernel ran 23 % slower), and the lanes are copied one
-    // by one instead.
+    // instruction; with fewer lanes Highway 1.0 builds it from a table of permutations, which it
+    // copies onto the stack at every call (the AVX2 kernel ran 23 % slower with it), and the lanes
+    // are copied one by one instead.
     static constexpr bool kVectorCompress = hn::MaxLanes(DF()) >= 16;
     static constexpr int kQueuedFloats = kQueueFloats + (kPolarized ? kQueuePolarizationFloats : 0);
+    // The queue's reading position.
     std::size_t next_ = 0;        // the queue's next particle
     std::size_t taken_from_ = 0;  // the first particle given since the last restart
     std::uint64_t taking_ = 0;    // the lanes given one since (bit l for lane l)
