@@ -121,7 +121,8 @@ Runner add_render(CLI::App& app) {
     cmd->add_option("--spp", a->spp, "Samples per pixel (default 64)")
         ->check(CLI::Range(1, 1 << 20));
     cmd->add_option("--seed", a->seed, "Seed (images are reproducible for a seed)");
-    cmd->add_option("--threads", a->threads, "Threads (default: all), at most 1024")
+    cmd->add_option("--threads", a->threads,
+                    fmt::format("Threads (default: all), at most {}", kMaxThreads))
         ->check(CLI::Range(0, kMaxThreads));  // as simulate's: OpenMP creates them all at once
     cmd->add_option("--exposure", a->exposure,
                     "Exposure in stops for the PNG, [-40, 40] (default 0)");

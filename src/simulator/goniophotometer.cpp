@@ -22,7 +22,9 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace lamina {
@@ -192,6 +194,40 @@ void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
                                      stack.name, film));
 }
 
+/// The memory a run may still take, in bytes: the least of the physical memory, the kernel's
+/// estimate of what it can give without swapping (MemAvailable, /proc/meminfo: free memory and the
+/// reclaimable caches) and the limit of this process's control group (cgroup v2 memory.max less
+/// memory.current), those that can be read; 0 when none can. Tallies are zeroed when they are
+/// made, so a run past it would be killed by the system (Linux grants the allocation first).
+double memory_available_bytes() {
+    double have = 0;
+    auto take = [&have](double bytes) {
+        if (bytes > 0 && (have == 0 || bytes < have)) have = bytes;
+    };
+    const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
+    if (pages > 0 && page_size > 0) take(double(pages) * double(page_size));
+    if (std::ifstream meminfo("/proc/meminfo"); meminfo) {
+        std::string key, unit;
+        double kib = 0;
+        while (meminfo >> key >> kib) {
+            std::getline(meminfo, unit);
+            if (key == "MemAvailable:") {
+                take(kib * 1024.0);
+                break;
+            }
+        }
+    }
+    // A number, or "max" (no limit), which the extraction fails on.
+    auto read_number = [](const char* path) {
+        double value = 0;
+        std::ifstream in(path);
+        return in >> value ? value : 0.0;
+    };
+    if (const double limit = read_number("/sys/fs/cgroup/memory.max"); limit > 0)
+        take(limit - read_number("/sys/fs/cgroup/memory.current"));
+    return have;
+}
+
 /// Refuses a run whose tallies would not fit in this machine's memory (a bad_alloc inside the
 /// threads' region would abort the process): each thread's Tally (Tally::Recent and its widened
 /// sums per bin and side, Stokes and spectral tallies where asked), and the result's widened sums
@@ -211,15 +247,14 @@ void check_tally_memory(const HemisphereGrid& grid, const SimulationSettings& se
     const double per_incidence = sides_bins * (tallies_per_thread * sums + stokes);
     const double need =
         double(threads) * per_thread + double(settings.theta_i_deg.size()) * per_incidence;
-    const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
-    if (pages <= 0 || page_size <= 0) return;
-    const double have = double(pages) * double(page_size);
+    const double have = memory_available_bytes();
+    if (!(have > 0)) return;
     if (need > have)
         throw InputError(
             "settings", "grid",
             fmt::format("{}: its tallies need about {:.1f} GB ({} threads, {} incidences{}), "
-                        "this machine has {:.1f} GB; allowed: a grid whose tallies fit (a coarser "
-                        "grid, fewer threads or fewer incidences per run)",
+                        "this machine has {:.1f} GB available; allowed: a grid whose tallies fit "
+                        "(a coarser grid, fewer threads or fewer incidences per run)",
                         grid.to_string(), need / 1e9, threads, settings.theta_i_deg.size(),
                         spectral_groups > 0 ? fmt::format(", {} wavelength groups", spectral_groups)
                                             : std::string(),
