@@ -23,11 +23,13 @@ namespace {
 
 // The staging folders of the live StagedOutputs, and the target folders they created, for the
 // interrupt handler (remove_staging_on_interrupt): fixed slots of plain characters, as a signal
-// handler may read them but not allocate.
+// handler may read them but not allocate. A slot is claimed (`used`), filled, then published
+// (`ready`); the handler reads the published ones only, so it never sees a path half copied.
 constexpr int kSlots = 16;
 constexpr std::size_t kPathBytes = 4096;
 struct Slot {
     std::atomic<bool> used{false};
+    std::atomic<bool> ready{false};
     char staging[kPathBytes];
     char created[kPathBytes];  // empty: the folder was there before
 };
@@ -42,6 +44,7 @@ int register_staging(const fs::path& staging, const fs::path& created) {
             continue;
         std::memcpy(g_slots[i].staging, a.c_str(), a.size() + 1);
         std::memcpy(g_slots[i].created, b.c_str(), b.size() + 1);
+        g_slots[i].ready.store(true);
         return i;
     }
     return -1;  // more than kSlots at once: not cleaned on an interrupt
@@ -53,7 +56,7 @@ int register_staging(const fs::path& staging, const fs::path& created) {
 // signal's default action.
 extern "C" void remove_staging_and_reraise(int signal_number) {
     for (Slot& slot : g_slots) {
-        if (!slot.used.load()) continue;
+        if (!slot.ready.load()) continue;
         ::rmdir(slot.staging);
         if (slot.created[0] != '\0') ::rmdir(slot.created);
     }
@@ -190,7 +193,10 @@ StagedOutput::StagedOutput(fs::path dir, std::string field) : dir_(std::move(dir
 }
 
 StagedOutput::~StagedOutput() {
-    if (slot_ >= 0) g_slots[slot_].used.store(false);
+    if (slot_ >= 0) {
+        g_slots[slot_].ready.store(false);
+        g_slots[slot_].used.store(false);
+    }
     std::error_code ec;
     fs::remove_all(staging_, ec);
     // A run that failed leaves no folder it made (remove deletes only an empty one).
