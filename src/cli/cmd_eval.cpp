@@ -58,11 +58,11 @@ RandomWalkModel* configure_random_walk(Model& model, const EvalArgs& a) {
     return rw;
 }
 
+/// A decimal number, as every other number lamina reads (setting_detail::parse_real: no hex
+/// floats, which strtod would take).
 double parse_number(const std::string& text, const std::string& where, const std::string& field) {
-    const char* begin = text.c_str();
-    char* end = nullptr;
-    const double v = std::strtod(begin, &end);
-    if (text.empty() || end != begin + text.size() || !std::isfinite(v))
+    double v = 0;
+    if (!setting_detail::parse_real(text, v) || text.find_first_of(" \t") != std::string::npos)
         throw InputError(where, field, fmt::format("'{}' is not a finite number", text));
     return v;
 }
@@ -301,10 +301,17 @@ Runner add_eval(CLI::App& app) {
                     "Incidence azimuth in degrees, [0, 360] (as simulate's); a non-zero one, or "
                     "an anisotropic stack, bins on the unfolded grid (phi over [0, 360))")
         ->capture_default_str();
+    // Decimal numbers only, as --theta-i and the --directions file (CLI11 alone takes hex too).
+    auto decimal = [](const std::string& text) -> std::string {
+        double v = 0;
+        return setting_detail::parse_real(text, v) ? "" : "'" + text + "' is not a number";
+    };
     cmd->add_option("--theta-o", a->theta_o, "Outgoing polar angle in degrees, [0, 90]")
+        ->check(decimal)
         ->each([a](const std::string&) { a->theta_o_given = true; });
     cmd->add_option("--phi-o", a->phi_o,
                     "Outgoing azimuth in degrees, [-360, 360] (the mirror direction at 180)")
+        ->check(decimal)
         ->each([a](const std::string&) { a->phi_o_given = true; });
     cmd->add_option("--side", a->side, "R (reflection) or T (transmission; θo from -z)")
         ->each([a](const std::string&) { a->side_given = true; });

@@ -179,10 +179,23 @@ Source load_source(const ExportArgs& a) {
         src.have_table = true;
         src.meta["source"] = "simulation";
         double phi_i = 0;
-        if (std::filesystem::exists(dir / "result.json")) {
-            src.meta["result"] = read_json(dir / "result.json");
-            if (src.meta["result"].value("phi_i", nlohmann::json(0.0)).is_number())
-                phi_i = src.meta["result"].value("phi_i", 0.0);
+        if (const std::filesystem::path path = dir / "result.json"; std::filesystem::exists(path)) {
+            nlohmann::json result = read_json(path);
+            if (!result.is_object())
+                throw InputError(path.string(), "",
+                                 "not a simulation's result.json: a JSON object is expected "
+                                 "(the one `lamina simulate` writes beside brdf.csv)");
+            // The light's azimuth places the table on the hemisphere: a value that is not one is
+            // refused rather than read as 0.
+            if (const auto it = result.find("phi_i"); it != result.end()) {
+                if (!it->is_number() || !(it->get<double>() >= 0 && it->get<double>() <= 360))
+                    throw InputError(path.string(), "/phi_i",
+                                     fmt::format("{}: the light's azimuth in degrees is expected; "
+                                                 "allowed: a number in [0, 360]",
+                                                 it->dump()));
+                phi_i = it->get<double>();
+            }
+            src.meta["result"] = std::move(result);
         }
         src.phi_i_deg.assign(src.table.theta_i_deg.size(), phi_i);
     } else if (!a.study.empty()) {
@@ -285,7 +298,9 @@ int run_check(const ExportArgs& a) {
     const std::string bytes = read_text(path);
     if (bytes.rfind("tensor_file", 0) == 0 || std::filesystem::path(path).extension() == ".bsdf") {
         const TensorFile file = parse_tensor_file(bytes, path);
-        check_rgl_bsdf(file, path);
+        // Read as a renderer's reader reads it (RglReader: check_rgl_bsdf, then the incidences'
+        // and azimuths' order and symmetry, the distributions' signs), with or without a source.
+        const RglReader reader(file, path);
         const auto& spectra = file.at("spectra").shape;
         fmt::print(
             "{}: RGL .bsdf ({:.1f} MB), {} incidences, {} × {} samples, {} wavelengths: "
@@ -337,6 +352,15 @@ int run_export(const ExportArgs& a) {
     }
     if (!a.lamina1_tables.empty()) {
         // The tables lamina-1's header library reads (include/lamina1/tables.h, docs/lamina1.md).
+        if (has_source(a) || !a.out.empty() || !a.stack.empty())
+            throw InputError("command line",
+                             !a.model.empty()        ? "--model"
+                             : !a.simulation.empty() ? "--simulation"
+                             : !a.study.empty()      ? "--study"
+                             : !a.out.empty()        ? "--out"
+                                                     : "--stack",
+                             "--lamina1-tables writes lamina-1's tables, the same for every "
+                             "material, to its own file: leave this out");
         const std::string bytes = lamina1_tables_file();
         write_file_atomic(a.lamina1_tables, bytes);
         fmt::print("wrote {} (lamina-1's tables, {:.2f} MB)\n", a.lamina1_tables,

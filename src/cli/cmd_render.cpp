@@ -2,6 +2,7 @@
 // comparison sheet of every supporting model (docs/rendering.md).
 #include "cli/commands.h"
 #include "cli/settings_options.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "layers/stack.h"
 #include "models/random_walk/random_walk_model.h"
@@ -14,6 +15,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -34,13 +36,6 @@ struct RenderArgs {
     double exposure = 0;
     bool compare = false;
 };
-
-void write_pair(const std::filesystem::path& png, const Image& img, double ev) {
-    write_png(png, img, ev);
-    std::filesystem::path exr = png;
-    exr.replace_extension(".exr");
-    write_exr(exr, img);
-}
 
 int run_render(const RenderArgs& a) {
     if (!(std::abs(a.exposure) <= kMaxExposureStops))  // NaN too
@@ -80,18 +75,26 @@ int run_render(const RenderArgs& a) {
         const auto model = make_model(a.model, stack, options);
         if (!model->support().brdf)
             throw InputError(a.stack, "--model", "not supported: " + model->support().reason);
+        // --out NAME, NAME.png or NAME.exr (any case): NAME.png and NAME.exr.
         std::filesystem::path out = a.out;
-        if (out.extension() != ".png") out += ".png";
-        // The folder before the rendering, so that an --out that cannot be written fails now.
-        std::error_code ec;
-        if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path(), ec);
-        if (ec)
-            throw InputError(out.string(), "--out",
-                             fmt::format("cannot create its folder {}: {}",
-                                         out.parent_path().string(), ec.message()));
+        std::string extension = out.extension().string();
+        std::transform(extension.begin(), extension.end(), extension.begin(),
+                       [](unsigned char c) { return char(std::tolower(c)); });
+        if (extension == ".png" || extension == ".exr") out.replace_extension();
+        const std::string name = out.filename().string();
+        if (name.empty() || name == "." || name == "..")
+            throw InputError(a.out, "--out",
+                             "a file name is expected (NAME, NAME.png or NAME.exr), not a folder; "
+                             "a folder is --compare's");
+        // The folder before the rendering, so that an --out that cannot be written fails now; both
+        // files are staged and moved into place together (nothing half-written, no folder left
+        // behind by a failed or interrupted run).
+        StagedOutput staged(out.has_parent_path() ? out.parent_path() : ".", "--out");
         const Rendering r = render_sphere(*model, env, s);
-        write_pair(out, r.image, a.exposure);
-        fmt::print(stderr, "lamina render: {} in {:.1f} s -> {} (+ .exr)\n", a.model, r.seconds,
+        write_png(staged.stage_path(name + ".png"), r.image, a.exposure);
+        write_exr(staged.stage_path(name + ".exr"), r.image);
+        staged.commit();
+        fmt::print(stderr, "lamina render: {} in {:.1f} s -> {}.png (+ .exr)\n", a.model, r.seconds,
                    out.string());
         return 0;
     }
@@ -133,7 +136,9 @@ Runner add_render(CLI::App& app) {
     cmd->add_flag("--compare", a->compare,
                   "Render the reference and every analytic model; --out is then a folder holding "
                   "compare.png, one PNG+EXR per model and errors.csv");
-    cmd->add_option("--out", a->out, "Output PNG (an EXR is written next to it), or a folder")
+    cmd->add_option("--out", a->out,
+                    "Output image NAME, NAME.png or NAME.exr: NAME.png and NAME.exr are written "
+                    "(with --compare: a folder)")
         ->required();
     return [a] { return run_render(*a); };
 }

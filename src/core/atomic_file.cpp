@@ -31,11 +31,12 @@ struct Slot {
     std::atomic<bool> used{false};
     std::atomic<bool> ready{false};
     char staging[kPathBytes];
-    char created[kPathBytes];  // empty: the folder was there before
+    char created[kPathBytes];  // the deepest folder the run made; empty: it made none
+    int created_levels = 0;    // how many folders it made: `created` and its parents
 };
 Slot g_slots[kSlots];
 
-int register_staging(const fs::path& staging, const fs::path& created) {
+int register_staging(const fs::path& staging, const fs::path& created, int created_levels) {
     const std::string a = staging.string(), b = created.string();
     if (a.size() >= kPathBytes || b.size() >= kPathBytes) return -1;
     for (int i = 0; i < kSlots; ++i) {
@@ -44,6 +45,7 @@ int register_staging(const fs::path& staging, const fs::path& created) {
             continue;
         std::memcpy(g_slots[i].staging, a.c_str(), a.size() + 1);
         std::memcpy(g_slots[i].created, b.c_str(), b.size() + 1);
+        g_slots[i].created_levels = created_levels;
         g_slots[i].ready.store(true);
         return i;
     }
@@ -51,14 +53,29 @@ int register_staging(const fs::path& staging, const fs::path& created) {
 }
 
 // An interrupt (SIGINT, SIGTERM, SIGHUP) while outputs are staged: the staging folders are
-// removed, and the target folders the run created, where empty (rmdir only: async-signal-safe; a
-// staging folder is empty while the run computes, its files are written at the end); then the
-// signal's default action.
+// removed, and the folders the run created, deepest first, where empty (rmdir only:
+// async-signal-safe; a staging folder is empty while the run computes, its files are written at
+// the end); then the signal's default action.
 extern "C" void remove_staging_and_reraise(int signal_number) {
     for (Slot& slot : g_slots) {
         if (!slot.ready.load()) continue;
         ::rmdir(slot.staging);
-        if (slot.created[0] != '\0') ::rmdir(slot.created);
+        // Each parent is the path cut at its last '/' (the folders were recorded normalized).
+        char path[kPathBytes];
+        std::size_t length = 0;
+        while (length + 1 < kPathBytes && slot.created[length] != '\0') {
+            path[length] = slot.created[length];
+            ++length;
+        }
+        path[length] = '\0';
+        for (int level = 0; level < slot.created_levels && length > 0; ++level) {
+            if (::rmdir(path) != 0) break;
+            while (length > 0 && path[length - 1] != '/')
+                --length;
+            while (length > 0 && path[length - 1] == '/')
+                --length;
+            path[length] = '\0';
+        }
     }
     ::signal(signal_number, SIG_DFL);
     ::raise(signal_number);
@@ -179,7 +196,17 @@ bool write_file_if_changed(const fs::path& path, std::string_view content) {
 
 StagedOutput::StagedOutput(fs::path dir, std::string field) : dir_(std::move(dir)) {
     std::error_code ec;
-    created_ = !fs::exists(dir_, ec);
+    // The folders create_directories will make, deepest first: the target and those of its
+    // parents that are not there.
+    for (fs::path p = dir_.lexically_normal(); !p.empty() && !fs::exists(p, ec);) {
+        if (!p.has_filename()) {  // a trailing separator: the folder is its parent path
+            p = p.parent_path();
+            continue;
+        }
+        created_.push_back(p);
+        if (!p.has_parent_path() || p.parent_path() == p) break;
+        p = p.parent_path();
+    }
     fs::create_directories(dir_, ec);
     if (ec || !fs::is_directory(dir_))
         throw InputError(dir_.string(), field, "cannot create the output folder: " + ec.message());
@@ -189,7 +216,8 @@ StagedOutput::StagedOutput(fs::path dir, std::string field) : dir_(std::move(dir
     fs::create_directory(staging_, ec);
     if (ec)
         throw InputError(dir_.string(), field, "cannot create a staging folder: " + ec.message());
-    slot_ = register_staging(staging_, created_ ? dir_ : fs::path());
+    slot_ = register_staging(staging_, created_.empty() ? fs::path() : created_.front(),
+                             int(created_.size()));
 }
 
 StagedOutput::~StagedOutput() {
@@ -200,7 +228,14 @@ StagedOutput::~StagedOutput() {
     std::error_code ec;
     fs::remove_all(staging_, ec);
     // A run that failed leaves no folder it made (remove deletes only an empty one).
-    if (created_ && !committed_) fs::remove(dir_, ec);
+    if (!committed_)
+        for (const fs::path& made : created_)
+            if (!fs::remove(made, ec)) break;
+}
+
+fs::path StagedOutput::stage_path(const std::string& name) {
+    names_.push_back(name);
+    return staging_ / name;
 }
 
 void StagedOutput::add(const std::string& name, std::string_view content) {

@@ -47,6 +47,9 @@ class StagedOutput {
 
     /// Stages one file (name relative to the target folder).
     void add(const std::string& name, std::string_view content);
+    /// Where to write the file `name` that a writer of its own writes to a path (a PNG or EXR
+    /// library): a path in the staging folder, moved into place at commit as add()'s files.
+    std::filesystem::path stage_path(const std::string& name);
     /// Stages it only if the target folder does not already hold exactly `content` under `name`
     /// (which then keeps its modification time). Returns whether it staged.
     bool add_if_changed(const std::string& name, std::string_view content);
@@ -64,14 +67,14 @@ class StagedOutput {
     std::filesystem::path dir_, staging_;
     std::vector<std::string> names_, stale_;
     bool committed_ = false;
-    bool created_ = false;  // whether the constructor made the target folder
-    int slot_ = -1;         // its place among the folders an interrupt removes
+    std::vector<std::filesystem::path> created_;  // the folders the constructor made, deepest first
+    int slot_ = -1;  // its place among the folders an interrupt removes
 };
 
 /// Installs handlers of SIGINT, SIGTERM and SIGHUP that remove the live StagedOutputs' staging
-/// folders and the target folders they created (where empty) before the signal's default action:
-/// an interrupted run leaves nothing behind either (the command line's; Python handles Ctrl-C
-/// itself, between chunks of particles).
+/// folders and the folders they created (the target and its parents, where empty) before the
+/// signal's default action: an interrupted run leaves nothing behind either (the command line's;
+/// Python handles Ctrl-C itself, between chunks of particles).
 void remove_staging_on_interrupt();
 
 }  // namespace lamina

@@ -406,6 +406,15 @@ void check_rgl_bsdf(const TensorFile& file, const std::string& where) {
         for (float v : file.at("rgb").floats())
             if (!std::isfinite(v))
                 throw InputError(where, "rgb", "holds a value that is not finite");
+    // The microfacets' distribution and projected area: densities, so never negative, and not
+    // zero everywhere (a reader normalizes by them).
+    for (const char* name : {"ndf", "sigma"}) {
+        const std::vector<float> values = file.at(name).floats();
+        if (std::any_of(values.begin(), values.end(), [](float v) { return v < 0; }))
+            throw InputError(where, name, "holds a negative value (a density is never negative)");
+        if (std::none_of(values.begin(), values.end(), [](float v) { return v > 0; }))
+            throw InputError(where, name, "is zero everywhere (a reader normalizes by it)");
+    }
     // The incidences are polar angles of the upper hemisphere (radians), the wavelengths the
     // nodes a renderer interpolates the spectra between.
     for (float v : ti.floats())

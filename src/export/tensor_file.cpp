@@ -12,6 +12,8 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 namespace lamina {
 
@@ -126,6 +128,7 @@ TensorFile parse_tensor_file(const std::string& bytes, const std::string& where)
                          fmt::format("tensor file version {}.{}: only 1.0 is known", major, minor));
     const auto n_fields = r.get<std::uint32_t>("field count");
     TensorFile out;
+    std::vector<std::pair<std::string, std::uint64_t>> offsets;  // checked against the header's end
     for (std::uint32_t k = 0; k < n_fields; ++k) {
         const auto name_length = r.get<std::uint16_t>("field name");
         if (bytes.size() - r.at < name_length)
@@ -153,9 +156,17 @@ TensorFile parse_tensor_file(const std::string& bytes, const std::string& where)
                                          "end of the file ({} bytes): truncated?",
                                          size, offset, bytes.size()));
         f.data = bytes.substr(offset, size);
+        if (size > 0) offsets.emplace_back(name, offset);
         if (!out.emplace(name, std::move(f)).second)
             throw InputError(where, name, "the field appears twice");
     }
+    // A field's data follows the header: an offset into it would read the header as numbers.
+    for (const auto& [name, offset] : offsets)
+        if (offset < r.at)
+            throw InputError(where, name,
+                             fmt::format("the field's data starts at offset {}, inside the header "
+                                         "(which ends at {})",
+                                         offset, r.at));
     return out;
 }
 

@@ -302,6 +302,7 @@ class Reader {
                                         layers.size(), kMaxLayers));
         for (std::size_t i = 0; i < layers.size(); ++i)
             s.layers.push_back(layer(layers[i], child("/layers", i), i, layers.size()));
+        check_no_film_with_anisotropy(s, where_);
         // The RGB values of the spectra: at the channels' wavelengths, a dielectric's eta at the
         // green channel's.
         return s.is_spectral() ? s.at_wavelengths(s.wavelengths_nm, 1) : s;
@@ -844,6 +845,23 @@ std::string show_alpha(const InterfaceSpec& i) {
 }
 
 }  // namespace
+
+void check_no_film_with_anisotropy(const Stack& stack, const std::string& where) {
+    if (!stack.has_film() || !stack.is_anisotropic()) return;
+    // The file's pointers of the first film and the first anisotropic interface.
+    std::size_t film = 0, anisotropic = 0;
+    while (!stack.layers[film].interface.has_film)
+        ++film;
+    while (!stack.layers[anisotropic].interface.is_anisotropic())
+        ++anisotropic;
+    throw InputError(where.empty() ? stack.name : where,
+                     fmt::format("/layers/{}/interface/film", film),
+                     fmt::format("a thin film on a stack with an anisotropic interface "
+                                 "(/layers/{}/interface/alpha) is not traced yet (films and "
+                                 "anisotropy each work alone); remove the film or make the "
+                                 "roughness one number",
+                                 anisotropic));
+}
 
 Stack stack_from_json(const nlohmann::json& j, const std::string& where) {
     return Reader(where).stack(j);

@@ -202,9 +202,15 @@ inline Layer with_medium(Layer layer, const Rgbd& tau_a, const Rgbd& tau_s = Rgb
 /// empty or missing `layers` or more than 100 layers, an empty name. Every stack it returns lies
 /// in those ranges: the estimators of lamina are written (and fuzzed, tests/fuzz) for them.
 /// A dielectric or conductor may carry a `film` (thickness_nm a number or a range [min, max] in
-/// [0, 10000], eta in [0.01, 5], k in [0, 10]); the stack may give `wavelengths_nm` [R, G, B],
+/// [0, 10000], eta in [0.01, 5], k in [0, 10]; not in a stack with an anisotropic interface,
+/// check_no_film_with_anisotropy); the stack may give `wavelengths_nm` [R, G, B],
 /// each in [360, 830].
 Stack stack_from_json(const nlohmann::json& j, const std::string& where);
+
+/// A stack may not yet carry a thin film beside an anisotropic interface (neither the
+/// goniophotometer nor a model traces both at once): InputError naming `where`, the first film's
+/// pointer and the anisotropic interface's. stack_from_json refuses such a stack with it.
+void check_no_film_with_anisotropy(const Stack& stack, const std::string& where);
 
 /// Parses the text of a stack file (what load_stack reads); `where` names it in messages. The same
 /// InputErrors as load_stack, also for JSON nested deeper than 32 levels.

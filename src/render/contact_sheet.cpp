@@ -1,5 +1,6 @@
 #include "render/contact_sheet.h"
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/math.h"
 
@@ -197,15 +198,13 @@ std::string write_comparison(const Stack& stack, const Environment& env,
     s.lobe_alpha = lobe_alpha_for(stack);
     s.brushed = brushed_for(stack);
     s.transparent = false;  // the models render the BRDF only: compare like with like
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec || !std::filesystem::is_directory(dir, ec))
-        throw InputError(dir.string(), "--out",
-                         fmt::format("cannot create the folder: {}",
-                                     ec ? ec.message() : "a file of that name is there"));
+    // Every file is staged and moved into place at the end: an interrupted or failed comparison
+    // leaves no half set of images (nor a folder it made), and the images of models that do not
+    // support this stack, left by an earlier comparison in the same folder, are removed.
+    StagedOutput out(dir, "--out");
     auto write_pair = [&](const std::string& name, const Image& img) {
-        write_png(dir / (name + ".png"), img, exposure_ev);
-        write_exr(dir / (name + ".exr"), img);
+        write_png(out.stage_path(name + ".png"), img, exposure_ev);
+        write_exr(out.stage_path(name + ".exr"), img);
     };
     std::vector<SheetEntry> entries;
     const auto reference = make_model("random-walk", stack, rw_options);
@@ -220,6 +219,8 @@ std::string write_comparison(const Stack& stack, const Environment& env,
         if (!model->support().brdf) {
             entries.push_back({e.name, Image(), false, model->support().reason});
             summary += fmt::format("{},not supported,\n", e.name);
+            out.remove_unless_staged(e.name + ".png");
+            out.remove_unless_staged(e.name + ".exr");
             continue;
         }
         const Rendering r = render_sphere(*model, env, s);
@@ -228,11 +229,10 @@ std::string write_comparison(const Stack& stack, const Environment& env,
                                relative_rmse(r.image, ref.image, ref.mask), r.seconds);
         entries.push_back({e.name, r.image, true, ""});
     }
-    write_png(dir / "compare.png", contact_sheet(entries, ref.mask, exposure_ev), 0, false);
-    if (std::FILE* f = std::fopen((dir / "errors.csv").c_str(), "w")) {
-        std::fputs(summary.c_str(), f);
-        std::fclose(f);
-    }
+    write_png(out.stage_path("compare.png"), contact_sheet(entries, ref.mask, exposure_ev), 0,
+              false);
+    out.add("errors.csv", summary);
+    out.commit();
     return summary;
 }
 

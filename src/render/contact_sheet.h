@@ -38,7 +38,9 @@ Image contact_sheet(const std::vector<SheetEntry>& entries, const std::vector<ch
 /// Renders the random-walk reference and every analytic model of the registry for `stack` with
 /// the same settings (the proposal lobe of the light-sampling mixture from the stack,
 /// lobe_alpha_for) and writes, into `dir`: one PNG + EXR per model, errors.csv
-/// (model,rel_rmse,seconds; "not supported" rows) and compare.png. Returns the errors.csv text.
+/// (model,rel_rmse,seconds; "not supported" rows) and compare.png, all staged and moved into place
+/// at the end (StagedOutput); the images an earlier comparison left there of models that do not
+/// support this stack are removed. Returns the errors.csv text.
 std::string write_comparison(const Stack& stack, const Environment& env,
                              const RenderSettings& settings, const std::filesystem::path& dir,
                              double exposure_ev, const std::vector<std::string>& rw_options = {});

@@ -148,21 +148,7 @@ void IncidenceSums::add(const IncidenceSums& o) {
 
 void validate_kernel_for(const Stack& stack, const SimulationSettings& settings,
                          const std::string& where) {
-    if (stack.has_film() && stack.is_anisotropic()) {
-        // The file's pointers of the first film and the first anisotropic interface.
-        std::size_t film = 0, anisotropic = 0;
-        while (!stack.layers[film].interface.has_film)
-            ++film;
-        while (!stack.layers[anisotropic].interface.is_anisotropic())
-            ++anisotropic;
-        throw InputError(where.empty() ? stack.name : where,
-                         fmt::format("/layers/{}/interface/film", film),
-                         fmt::format("a thin film on a stack with an anisotropic interface "
-                                     "(/layers/{}/interface/alpha) is not traced yet (films and "
-                                     "anisotropy each work alone); remove the film or make the "
-                                     "roughness one number",
-                                     anisotropic));
-    }
+    check_no_film_with_anisotropy(stack, where);
     if (is_spectral_run(stack, settings)) {
         if (settings.spectral_bins % 3 != 0)
             throw InputError("settings", "spectral_bins",

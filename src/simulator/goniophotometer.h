@@ -139,9 +139,11 @@ struct SimulationSettings {
                .max = 360,
                .key_unsaid = "0"},
               s.phi_i_deg);
+        // At most 10^15 (exact in a double; years of any machine's time), however written.
         visit({.name = "particles",
                .help = "Particles per incidence (1e7-style accepted)",
                .min = 1,
+               .max = 1e15,
                .key = Key::Fixed},
               s.particles);
         visit({.name = "seed", .help = "Random seed", .min = 0, .key = Key::Fixed}, s.seed);

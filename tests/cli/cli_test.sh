@@ -88,7 +88,7 @@ check help-still-works 0 "$lamina" eval --help
 P="$src/examples/plastic.json"
 check_says eval-phi-o-huge 1 "--phi-o: 1e+308 degrees is outside [-360, 360]" \
     "$lamina" eval --model ww09 --stack "$P" --theta-i 30 --theta-o 30 --phi-o 1e308
-check_says eval-theta-o-nan 1 "--theta-o: nan degrees is outside [0, 90]" \
+check_says eval-theta-o-nan 1 "--theta-o: 'nan' is not a number" \
     "$lamina" eval --model ww09 --stack "$P" --theta-i 30 --theta-o nan --phi-o 0
 printf 'theta_i,theta_o,phi_o,side\n30,30,1e308,R\n' >"$tmp/far.csv"
 check_says eval-directions-phi-o 1 "line 2, phi_o: 1e+308 degrees is outside [-360, 360]" \
@@ -172,21 +172,43 @@ check_says configs-stream-refused 1 "the configurations file holds more than 16 
 check_says configs-folder-refused 1 "cannot read the configurations file: it is a directory" \
     "$lamina" study --configs "$tmp" --particles 1000 --theta-i 30 --grid 6x6 --models ww09 \
     --out "$tmp/folder-study"
-# An interrupted run (Ctrl-C, a kill) leaves no staging folder, nor the output folder it made.
+# An interrupted run (Ctrl-C, a kill) leaves no staging folder, nor the output folder it made, nor
+# the parents of it that it made.
 timeout -s INT 1 "$lamina" simulate "$src/examples/milky-coat.json" --theta-i 0,20,40,60,80 \
-    --particles 2e6 --threads 1 --kernel scalar --out "$tmp/interrupted" >/dev/null 2>&1
+    --particles 2e6 --threads 1 --kernel scalar --out "$tmp/interrupted/a/b" >/dev/null 2>&1
 check interrupted-leaves-nothing 1 test -e "$tmp/interrupted"
+timeout -s TERM 2 "$lamina" render "$src/examples/plastic.json" --compare --size 256 --spp 256 \
+    --threads 1 --out "$tmp/interrupted-compare/sheet" >/dev/null 2>&1
+check interrupted-compare-leaves-nothing 1 test -e "$tmp/interrupted-compare"
 mkdir -p "$tmp/interrupted-kept"
 timeout -s TERM 1 "$lamina" simulate "$src/examples/milky-coat.json" --theta-i 0,20,40,60,80 \
     --particles 2e6 --threads 1 --kernel scalar --out "$tmp/interrupted-kept" >/dev/null 2>&1
 check interrupted-keeps-its-folder-empty 0 test -z "$(ls -A "$tmp/interrupted-kept")"
+# The particle count is at most 10^15 however it is written.
+check_says particles-beyond-limit 1 "expected a whole number in [1, 1000000000000000]" \
+    "$lamina" simulate "$P" --particles 9223372036854775808 --theta-i 30 --out "$tmp/many"
+# Control characters from the input (a NUL or a line break in a key) are escaped: one whole line.
+printf '%s' '{"layers\u0000": [], "layers": [{"interface": {"type": "lambertian", "albedo": 1}}]}' \
+    >"$tmp/nul-key.json"
+check_says nul-key-escaped 1 'unknown key "layers\u0000" in the stack; did you mean "layers"?' \
+    "$lamina" validate "$tmp/nul-key.json"
+printf '%s' '{"alp\nha": 1, "layers": [{"interface": {"type": "lambertian", "albedo": 1}}]}' \
+    >"$tmp/newline-key.json"
+check_says newline-key-escaped 1 '/alp\nha: unknown key "alp\nha" in the stack' \
+    "$lamina" validate "$tmp/newline-key.json"
+# A film beside an anisotropic interface is refused by the stack format itself.
+printf '%s' '{"layers": [{"interface": {"type": "dielectric", "eta": 1.5, "alpha": [0.1, 0.2],
+  "film": {"thickness_nm": 100, "eta": 1.4}}}, {"interface": {"type": "lambertian", "albedo": 1}}]}' \
+    >"$tmp/film-aniso.json"
+check_says validate-film-anisotropic 1 "/layers/0/interface/film: a thin film on a stack with an anisotropic interface" \
+    "$lamina" validate "$tmp/film-aniso.json"
 # A whole number given as an integer takes its type's whole range, and beyond it says that range
 # (not the 1e15 of the decimal notation, which 2^64 - 1 itself exceeds).
 check_says seed-beyond-uint64 1 "expected a whole number in [0, 18446744073709551615]" \
     "$lamina" simulate "$P" --seed 18446744073709551616 --particles 100 --theta-i 30 --out "$tmp/seed"
 # An --out that cannot be written is named, with the reason, before any work.
 : >"$tmp/afile"
-check_says render-out-under-file 1 "x.png: --out: cannot create its folder" \
+check_says render-out-under-file 1 "afile: --out: cannot create the output folder" \
     "$lamina" render "$P" --size 8 --spp 1 --out "$tmp/afile/x.png"
 check_says eval-out-under-file 1 "$tmp/afile/x.csv: cannot write it: $tmp/afile is not a folder" \
     "$lamina" eval --model ww09 --stack "$P" --binned --theta-i 30 --grid 9x9 --out "$tmp/afile/x.csv"
@@ -363,6 +385,16 @@ check_says export-unfolded 1 "an unfolded table" \
     "$lamina" export --simulation "$tmp/phi-i" --out "$tmp/phi-i.bsdf"
 check export-unfolded-writes-nothing 1 test -e "$tmp/phi-i.bsdf"
 check export-unfolded-npz 0 "$lamina" export --simulation "$tmp/phi-i" --out "$tmp/phi-i.npz"
+# A result.json that is not a simulation's (not an object; an azimuth that is not one) is refused.
+mkdir -p "$tmp/bad-result" && cp "$tmp/phi-i/brdf.csv" "$tmp/bad-result/"
+echo '[]' >"$tmp/bad-result/result.json"
+check_says export-result-not-object 1 "result.json: not a simulation's result.json" \
+    "$lamina" export --simulation "$tmp/bad-result" --out "$tmp/never.npz"
+echo '{"phi_i": "x"}' >"$tmp/bad-result/result.json"
+check_says export-result-phi-i 1 'result.json: /phi_i: "x": the light'"'"'s azimuth in degrees' \
+    "$lamina" export --simulation "$tmp/bad-result" --out "$tmp/never.npz"
+check_says export-lamina1-tables-out 1 "--out: --lamina1-tables writes lamina-1's tables" \
+    "$lamina" export --lamina1-tables "$tmp/never.bin" --out "$tmp/never.npz"
 # An option the export has no use for is refused, not ignored.
 check_says export-table-grid 1 "--grid: a table's bins are the ones it was computed on" \
     "$lamina" export --simulation "$tmp/phi-i" --grid 18x18 --out "$tmp/never.npz"
@@ -519,6 +551,16 @@ check render-reproducible 0 cmp "$tmp/r1.exr" "$tmp/r2.exr"
 check render-compare 0 "$lamina" render "$src/examples/metallic-paint.json" --compare --size 24 --spp 2 --out "$tmp/cmp"
 check render-sheet 0 test -s "$tmp/cmp/compare.png"
 check_says render-errors 0 "ww-prime," cat "$tmp/cmp/errors.csv"
+# A second comparison into the same folder removes the images of the models that do not support
+# its stack (a clear coat over glass: ww09 reflects only).
+check render-compare-first-ww09 0 test -e "$tmp/cmp/ww09.png"
+check render-compare-again 0 "$lamina" render "$src/examples/coated-lens.json" --compare --size 8 --spp 1 --out "$tmp/cmp"
+check_says render-compare-again-errors 0 "ww09,not supported" cat "$tmp/cmp/errors.csv"
+check render-compare-stale-removed 1 test -e "$tmp/cmp/ww09.png"
+# --out NAME.exr (any case) writes NAME.png and NAME.exr.
+check render-out-exr 0 "$lamina" render "$src/examples/plastic.json" --size 8 --spp 1 --out "$tmp/named.EXR"
+check render-out-exr-png 0 test -e "$tmp/named.png"
+check render-out-exr-exr 0 test -e "$tmp/named.exr"
 # Multiple scattering on the microsurfaces: reproducible across thread counts too; bad values and
 # other models refused.
 check render-ms1 0 "$lamina" render "$src/examples/frosted-gold.json" --microsurface multiple --size 16 --spp 2 --threads 1 --out "$tmp/ms1.png"
