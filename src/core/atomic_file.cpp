@@ -254,6 +254,14 @@ void StagedOutput::remove_unless_staged(const std::string& name) {
 }
 
 void StagedOutput::commit() {
+    // A folder in the place of a file would fail its rename after the files before it had moved:
+    // checked for every file first, so that a failed commit moves none.
+    for (const auto& name : names_) {
+        std::error_code ec;
+        if (fs::is_directory(dir_ / name, ec))
+            throw InputError((dir_ / name).string(), "",
+                             "cannot write it: a folder of that name is there");
+    }
     for (const auto& name : names_) {
         std::error_code ec;
         fs::rename(staging_ / name, dir_ / name, ec);

@@ -424,6 +424,10 @@ BinnedTable table_from_arrays(py::array_t<double, py::array::c_style | py::array
         throw InputError("arguments", "f",
                          "expected f of shape [incidence, side, θ bin, φ bin, 3] matching theta_i "
                          "and sides");
+    // As a table read from its CSV, which has at least one row.
+    if (theta_i.empty())
+        throw InputError("arguments", "theta_i", "at least one incidence is needed");
+    if (sides.empty()) throw InputError("arguments", "sides", "at least one side, 'R' or 'T'");
     bool r = false, t = false;
     for (const std::string& side : sides) {
         if (side != "R" && side != "T") throw InputError("arguments", "sides", "'R' or 'T'");
@@ -521,7 +525,8 @@ void run_study_py(py::list configs_in, py::dict settings, py::list externals,
     {
         py::gil_scoped_release release;
         run_study(configs, s, out);
-        write_explorer(out);
+        // Without tables (tables="none") there is no page to draw, as on the command line.
+        if (s.tables != TablesFormat::None) write_explorer(out);
         if (figures) {
             try {
                 write_figures(out);
@@ -558,10 +563,16 @@ void bind_errors(py::module_& m) {
                 std::replace(field.begin(), field.end(), '-', '_');
             }
             const InputError named = command_line ? InputError("arguments", field, e.problem()) : e;
-            py::object exc = py::handle(g_input_error)(named.what());
-            exc.attr("file") = named.where();
-            exc.attr("field") = named.field();
-            exc.attr("problem") = named.problem();
+            // A message may quote bytes of the input that are not UTF-8 (a stack file in
+            // Latin-1): they are written as \xNN escapes rather than failing the conversion.
+            auto text = [](const std::string& bytes) {
+                return py::reinterpret_steal<py::str>(PyUnicode_DecodeUTF8(
+                    bytes.data(), Py_ssize_t(bytes.size()), "backslashreplace"));
+            };
+            py::object exc = py::handle(g_input_error)(text(named.what()));
+            exc.attr("file") = text(named.where());
+            exc.attr("field") = text(named.field());
+            exc.attr("problem") = text(named.problem());
             PyErr_SetObject(g_input_error, exc.ptr());
         }
     });

@@ -802,3 +802,69 @@ def test_a_bad_grid_and_a_bad_folder_are_named_as_python_gave_them(tmp_path):
     with pytest.raises(lamina.InputError) as e:
         r.write(tmp_path / "a-file" / "out")
     assert e.value.field == "dir" and "cannot create the output folder" in e.value.problem
+
+
+def test_a_damaged_study_folder_is_named_with_file_and_field(tmp_path):
+    # Every error of a study read from disk carries .file, .field and .problem, as the CLI's do
+    # (some were built positionally: a tuple for a message and no attributes).
+    with pytest.raises(lamina.InputError) as e:
+        lamina.load_study(tmp_path / "nowhere")
+    assert e.value.field == "study.json" and "not a study directory" in e.value.problem
+    r = lamina.compare(PLASTIC, models="ww-prime", out=tmp_path / "c", particles=1000,
+                       theta_i=[30], grid=(9, 9))
+    with pytest.raises(lamina.InputError) as e:
+        r.config("nope")
+    assert e.value.field == "configurations" and "no configuration 'nope'" in e.value.problem
+    # config.json naming fewer sources than tables.lza holds: refused, not silently cut.
+    cfg_path = tmp_path / "c" / "configs" / "plastic" / "config.json"
+    cfg = json.loads(cfg_path.read_text())
+    assert len(r.tables("plastic")) == len(cfg["sources"])
+    cfg_path.write_text(json.dumps(dict(cfg, sources=cfg["sources"][:1])))
+    with pytest.raises(lamina.InputError) as e:
+        r.tables("plastic")
+    assert e.value.field == "sources"
+    # A damaged packed array: one InputError naming the file, whatever the damage.
+    lza = tmp_path / "c" / "configs" / "plastic" / "tables.lza"
+    data = lza.read_bytes()
+    for damaged in (data[: len(data) // 2], data.replace(b'"shape"', b'"shap"'),
+                    data[:15] + b"[" + data[16:]):  # the header's JSON broken
+        lza.write_bytes(damaged)
+        with pytest.raises(lamina.InputError) as e:
+            lamina.read_array(lza)
+        assert e.value.file == str(lza)
+
+
+def test_compare_without_tables_writes_no_page(tmp_path):
+    # tables="none" keeps no tables for the explorer page to draw: the study is written without it,
+    # as `lamina compare --tables none` does (it failed at the page).
+    r = lamina.compare(PLASTIC, models="ww-prime", out=tmp_path / "c", particles=1000,
+                       theta_i=[30], grid=(9, 9), tables="none")
+    assert r.configs == ["plastic"]
+    assert not (tmp_path / "c" / "index.html").exists()
+
+
+def test_a_message_quoting_bytes_that_are_not_utf8_is_an_input_error(tmp_path):
+    # A stack file in Latin-1: the parser's message quotes the byte; it reached Python as a
+    # UnicodeDecodeError instead of the InputError naming the file.
+    path = tmp_path / "latin1.json"
+    path.write_bytes(PLASTIC.read_text().replace('"plastic"', '"pl\xe9stic"').encode("latin-1"))
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Stack(path)
+    assert e.value.file == str(path) and "\\xe9" in e.value.problem
+
+
+def test_zero_incidences_are_refused_as_a_csv_is(tmp_path):
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Table.from_arrays(np.zeros((0, 1, 3, 3, 3)), [], ["R"])
+    assert e.value.field == "theta_i"
+
+
+def test_a_failed_write_moves_no_file(tmp_path):
+    # A folder where result.json goes failed the last rename, after brdf.csv and energy.csv had
+    # moved into place: now nothing moves.
+    r = lamina.simulate(PLASTIC, theta_i=[0], particles=500, threads=1, grid=(3, 3))
+    (tmp_path / "out" / "result.json").mkdir(parents=True)
+    with pytest.raises(lamina.InputError) as e:
+        r.write(tmp_path / "out")
+    assert "a folder of that name is there" in e.value.problem
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["result.json"]

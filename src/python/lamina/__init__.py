@@ -29,7 +29,7 @@ from ._lamina import (  # noqa: F401  (re-exported)
     models,
 )
 from . import _lamina
-from .arrays import read_array
+from . import arrays as _arrays
 from .plugins import bin_model, input_error, model_name
 
 __all__ = [
@@ -182,6 +182,19 @@ def _read_metrics(path: Path) -> np.ndarray:
     return out
 
 
+def read_array(path):
+    """Reads a packed-array file (.lza; docs/formats.md) into a numpy array, a .npy path with
+    numpy.load; a missing, damaged or truncated file is an InputError naming it."""
+    try:
+        return _arrays.read_array(path)
+    except _arrays.ArrayError as e:
+        raise input_error(e.where, "", e.problem) from None
+    except OSError as e:
+        raise input_error(str(path), "", f"cannot read it: {e.strerror or e}") from None
+    except ValueError as e:  # numpy.load of a damaged .npy
+        raise input_error(str(path), "", f"not a readable array ({e}): damaged?") from None
+
+
 def _read_json_object(path: Path) -> dict:
     """A JSON object read from path; a damaged or truncated file is an InputError naming it."""
     try:
@@ -189,6 +202,8 @@ def _read_json_object(path: Path) -> dict:
             value = json.load(f)
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise input_error(str(path), "", f"not valid JSON ({e}): damaged or truncated?") from None
+    except OSError as e:
+        raise input_error(str(path), "", f"cannot read it: {e.strerror or e}") from None
     if not isinstance(value, dict):
         raise input_error(str(path), "", "not a JSON object: damaged, or not lamina's file?")
     return value
@@ -211,7 +226,7 @@ class Study:
         self.path = Path(path)
         info = self.path / "study.json"
         if not info.is_file():
-            raise InputError(str(self.path), "study.json",
+            raise input_error(str(self.path), "study.json",
                              "not a study directory: no study.json (run lamina study or compare)")
         self.info = _read_json_object(info)
         metrics = self.path / "metrics.csv"
@@ -245,7 +260,15 @@ class Study:
     def tables(self, config_id):
         cfg = self.config(config_id)
         t = self._array(config_id, "tables")
-        return {name: t[k] for k, name in enumerate(cfg["sources"])}
+        sources = cfg.get("sources")
+        path = str(self._dir(config_id) / "config.json")
+        if not isinstance(sources, list) or not all(isinstance(s, str) for s in sources):
+            raise input_error(path, "sources", "missing or not a list of names: damaged?")
+        if len(sources) != t.shape[0]:
+            raise input_error(path, "sources",
+                              f"{len(sources)} names for the {t.shape[0]} tables of tables.lza: "
+                              "the folder mixes two runs, or is damaged")
+        return {name: t[k] for k, name in enumerate(sources)}
 
     def reference_se(self, config_id):
         return self._array(config_id, "reference_se")
@@ -253,7 +276,7 @@ class Study:
     def reference_stokes(self, config_id):
         path = self._dir(config_id) / "reference_stokes.lza"
         if not path.exists():
-            raise InputError(str(path), "reference_stokes",
+            raise input_error(str(path), "reference_stokes",
                              "missing: the study stores the Stokes vectors of a polarized "
                              "reference when run with --reference-stokes on")
         return read_array(path)
@@ -262,15 +285,15 @@ class Study:
         # configs/<id>/<stem>.lza (a packed array), or .npy from a study written before them.
         d = self._dir(config_id)
         if not (d / f"{stem}.lza").exists() and (d / f"{stem}.npy").exists():
-            return np.load(d / f"{stem}.npy")
+            return read_array(d / f"{stem}.npy")
         if not (d / f"{stem}.lza").exists():
-            raise InputError(str(d / f"{stem}.lza"), "tables",
-                             "missing (a study run with --tables none has no tables)")
+            raise input_error(str(d / f"{stem}.lza"), "tables",
+                              "missing (a study run with --tables none has no tables)")
         return read_array(d / f"{stem}.lza")
 
     def _dir(self, config_id):
         if config_id not in self.configs:
-            raise InputError(str(self.path), "configurations",
+            raise input_error(str(self.path), "configurations",
                              f"no configuration '{config_id}'; the study has: "
                              + ", ".join(self.configs))
         return self.path / "configs" / config_id

@@ -14,24 +14,52 @@ _MAGIC = b"lamina-array 1\n"
 _DTYPES = {"float16": (np.float16, np.uint16), "float32": (np.float32, np.uint32)}
 
 
+class ArrayError(ValueError):
+    """A file that is not a readable packed array: `where` names it, `problem` says why."""
+
+    def __init__(self, where, problem):
+        super().__init__(f"{where}: {problem}")
+        self.where, self.problem = where, problem
+
+
 def unpack_array(data, where="packed array"):
-    """The numpy array (float16 or float32, C order) held by the bytes of a packed-array file."""
+    """The numpy array (float16 or float32, C order) held by the bytes of a packed-array file.
+
+    ArrayError (a ValueError) naming `where` for bytes that are not one: damaged or truncated.
+    """
+    try:
+        return _unpack(data, where)
+    except ArrayError:
+        raise
+    except (ValueError, KeyError, IndexError, TypeError, AttributeError, OverflowError,
+            zlib.error) as e:
+        raise ArrayError(where, f"not a readable lamina packed array ({type(e).__name__}: {e}): "
+                                "damaged or truncated?") from None
+
+
+def _unpack(data, where):
     if not data.startswith(_MAGIC):
-        raise ValueError(f"{where}: not a lamina packed array (no 'lamina-array 1' line)")
+        raise ArrayError(where, "not a lamina packed array (no 'lamina-array 1' line)")
     eol = data.index(b"\n", len(_MAGIC))
     header = json.loads(data[len(_MAGIC):eol])
-    if header.get("dtype") not in _DTYPES:
-        raise ValueError(f"{where}: dtype {header.get('dtype')!r}, expected float16 or float32")
+    if not isinstance(header, dict) or header.get("dtype") not in _DTYPES:
+        dtype = header.get("dtype") if isinstance(header, dict) else None
+        raise ArrayError(where, f"dtype {dtype!r}, expected float16 or float32")
     float_type, uint_type = _DTYPES[header["dtype"]]
-    shape = [int(d) for d in header["shape"]]
+    shape = header.get("shape")
+    if (not isinstance(shape, list) or len(shape) < 2
+            or not all(isinstance(d, int) and not isinstance(d, bool) and d >= 0 for d in shape)):
+        raise ArrayError(where, f"shape {shape!r}: expected a list of at least two sizes")
     width = np.dtype(uint_type).itemsize
-    # Byte planes (low byte first) back into unsigned integers.
-    planes = np.frombuffer(zlib.decompress(data[eol + 1:]), np.uint8)
-    count = int(np.prod(shape))
-    if planes.size != count * width:
-        raise ValueError(f"{where}: {planes.size} bytes unpacked, the shape {shape} needs "
-                         f"{count * width}")
-    planes = planes.reshape(width, count)
+    count = int(np.prod(shape, dtype=np.int64)) if shape else 0
+    # Byte planes (low byte first) back into unsigned integers; no more bytes inflated than the
+    # shape needs (a damaged header must not make a small file expand without bound).
+    inflate = zlib.decompressobj()
+    planes = inflate.decompress(data[eol + 1:], count * width + 1)
+    if len(planes) != count * width or not inflate.eof:
+        raise ArrayError(where, f"the data does not hold the {count * width} bytes the shape "
+                                f"{shape} needs: damaged or truncated?")
+    planes = np.frombuffer(planes, np.uint8).reshape(width, count)
     bits = np.zeros(count, uint_type)
     for b in range(width):
         bits |= planes[b].astype(uint_type) << uint_type(8 * b)

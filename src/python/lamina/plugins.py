@@ -120,6 +120,8 @@ def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32, phi_i=0.0)
     if not sides:
         return None
     theta_i = [float(t) for t in np.atleast_1d(theta_i)]
+    if not theta_i:
+        raise input_error("arguments", "theta_i", "at least one incidence is needed")
     phi = np.atleast_1d(np.asarray(phi_i, dtype=np.float64))
     if phi.ndim == 1 and len(phi) == 1:
         phi = np.full(len(theta_i), phi[0])
