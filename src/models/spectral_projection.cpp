@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <algorithm>
 #include <array>
+#include <memory>
 #include <vector>
 
 namespace lamina {
@@ -77,6 +78,16 @@ class SpectralProjection final : public Model {
         return sum;
     }
 
+    /// The members' own prepared evaluators (what depends on wi alone computed once per member,
+    /// e.g. lamina-1's incident statistics), summed in eval's order: the same values bit for bit.
+    std::unique_ptr<IncidentEvaluator> prepare(const Vec3d& wi) const override {
+        std::vector<std::unique_ptr<IncidentEvaluator>> prepared;
+        prepared.reserve(members_.size());
+        for (const Member& m : members_)
+            prepared.push_back(m.model->prepare(wi));
+        return std::make_unique<Evaluator>(members_, std::move(prepared));
+    }
+
     std::vector<DeltaLobe> delta_lobes(const Vec3d& wi) const override {
         // The lobes of every wavelength, projected; lobes along one direction merged.
         std::vector<DeltaLobe> out;
@@ -135,6 +146,46 @@ class SpectralProjection final : public Model {
             return weights[0] * f[0] + weights[1] * f[1] + weights[2] * f[2];
         }
     };
+    class Evaluator final : public IncidentEvaluator {
+      public:
+        Evaluator(const std::vector<Member>& members,
+                  std::vector<std::unique_ptr<IncidentEvaluator>> prepared)
+            : members_(members), prepared_(std::move(prepared)) {}
+        Rgbd eval(const Vec3d& wo) const override {
+            Rgbd sum(0.0);
+            for (std::size_t i = 0; i < members_.size(); ++i)
+                sum = sum + members_[i].project(prepared_[i]->eval(wo));
+            return sum;
+        }
+        /// Each member's evaluator for one thread where it has one (keeping what depends on
+        /// wo.z alone), else a forwarding one to the shared evaluator.
+        std::unique_ptr<IncidentEvaluator> for_one_thread() const override {
+            std::vector<std::unique_ptr<IncidentEvaluator>> own;
+            own.reserve(prepared_.size());
+            bool any = false;
+            for (const auto& p : prepared_) {
+                std::unique_ptr<IncidentEvaluator> one = p->for_one_thread();
+                any = any || one != nullptr;
+                own.push_back(one ? std::move(one) : std::make_unique<Shared>(*p));
+            }
+            if (!any) return nullptr;
+            return std::make_unique<Evaluator>(members_, std::move(own));
+        }
+
+      private:
+        /// A member evaluator that serves every thread, used through a reference.
+        class Shared final : public IncidentEvaluator {
+          public:
+            explicit Shared(const IncidentEvaluator& e) : e_(e) {}
+            Rgbd eval(const Vec3d& wo) const override { return e_.eval(wo); }
+
+          private:
+            const IncidentEvaluator& e_;
+        };
+        const std::vector<Member>& members_;
+        std::vector<std::unique_ptr<IncidentEvaluator>> prepared_;
+    };
+
     std::vector<Member> members_;
     std::string name_;
     Support support_;

@@ -126,6 +126,44 @@ TEST(SpectralProjection, ADispersiveCoatGetsOneModelPerWavelength) {
     }
 }
 
+// The binned tables evaluate a model through prepare(wi) (and an evaluator for one thread of
+// it): the projection prepares its members, so that what depends on wi alone is computed once per
+// member rather than at every node, and must give eval's values bit for bit — on a dispersive
+// coat (one member per wavelength) and a filmed metal (three wavelengths per member), for models
+// whose evaluators keep incident statistics (lamina-1, the production coats, the Belcour family).
+TEST(SpectralProjection, PreparedEvaluatorsAreEvalBitForBit) {
+    const Stack dispersive = coated_gold(R"({"abbe": [1.5, 30]})");
+    const Stack filmed = parse_stack(
+        R"({"layers": [{"interface": {"type": "dielectric", "eta": 1.5, "alpha": 0.05}},
+            {"interface": {"type": "conductor", "material": "Ti", "alpha": 0.3,
+                           "film": {"thickness_nm": 60, "eta": 2.5}}}]})",
+        "test");
+    struct Case {
+        const Stack& stack;
+        const char* model;
+    };
+    const Case cases[] = {{dispersive, "lamina-1"},
+                          {dispersive, "bel-prime"},
+                          {dispersive, "openpbr"},
+                          {filmed, "openpbr"},
+                          {filmed, "openpbr-adobe"}};
+    for (const Case& c : cases) {
+        const auto projected = make_spectral_projection(factory_of(c.model), c.stack);
+        ASSERT_TRUE(projected->support().brdf) << c.model;
+        for (const auto& [wi, wo] : some_directions()) {
+            const auto prepared = projected->prepare(wi);
+            const auto one_thread = prepared->for_one_thread();
+            const Rgbd want = projected->eval(wi, wo);
+            for (int c2 = 0; c2 < 3; ++c2) {
+                EXPECT_EQ(prepared->eval(wo)[c2], want[c2]) << c.model;
+                if (one_thread) {
+                    EXPECT_EQ(one_thread->eval(wo)[c2], want[c2]) << c.model;
+                }
+            }
+        }
+    }
+}
+
 TEST(SpectralProjection, SamplesTheDensityItReports) {
     const Stack stack = coated_gold("1.5");
     const auto projected = make_spectral_projection(factory_of("openpbr"), stack);
