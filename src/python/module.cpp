@@ -826,7 +826,8 @@ void bind_study(py::module_& m) {
         py::arg("stack"), py::arg("phi_i"));
     m.def("_run_study", &run_study_py, py::arg("configs"), py::arg("settings"),
           py::arg("externals"), py::arg("out"), py::arg("figures"));
-    // The configurations a study runs at `preset` (the iridescent category in the larger ones).
+    // The configurations a study runs at `preset` (the iridescent, brushed and dispersive
+    // categories in the larger ones).
     m.def(
         "_builtin_configurations",
         [](const std::string& preset) {

@@ -249,12 +249,52 @@ std::vector<StudyConfiguration> brushed_configurations() {
     return out;
 }
 
+std::vector<StudyConfiguration> dispersive_configurations() {
+    // A dense flint (the catalogue's SF11: n_d = 1.78472, V_d = 25.68, Schott; rounded), whose
+    // index falls from about 1.84 at 400 nm to 1.77 at 700 nm, as the two-term Cauchy formula
+    // through n_d with that Abbe number: the slab category's shape (a glass over air, reflection
+    // and transmission), with the index a spectrum. Read through the stack reader, so that the
+    // stack is the one a file with these lines gives.
+    struct Dispersive {
+        const char* id;
+        double alpha0, alpha1;
+    };
+    const Dispersive list[] = {
+        // Smooth faces: the transmitted lobe is narrow, and its direction depends on the
+        // wavelength (a prism's colour fringes, blurred by the exit's roughness).
+        {"disp-flint-a0.001-a1.05", 0.001, 0.05},
+        // Rough faces: the colours mix over broad lobes; what is left is the index's spectrum
+        // in the Fresnel factors and the total internal reflection's cone.
+        {"disp-flint-a0.1-a1.3", 0.1, 0.3},
+    };
+    std::vector<StudyConfiguration> out;
+    for (const Dispersive& d : list) {
+        const nlohmann::json stack = {
+            {"name", d.id},
+            {"layers",
+             {{{"interface",
+                {{"type", "dielectric"}, {"eta", {{"abbe", {1.785, 25.7}}}}, {"alpha", d.alpha0}}},
+               {"medium", {{"tau_a", 0}}}},
+              {{"interface", {{"type", "dielectric"}, {"eta", 1.0}, {"alpha", d.alpha1}}}}}}};
+        StudyConfiguration config;
+        config.id = d.id;
+        config.category = "dispersive";
+        config.stack = stack_from_json(stack, d.id);
+        config.parameters = describe_parameters(config.stack);
+        config.parameters["eta0"] = "flint (n_d 1.785, V_d 25.7)";
+        out.push_back(std::move(config));
+    }
+    return out;
+}
+
 std::vector<StudyConfiguration> preset_configurations(const std::string& preset) {
     std::vector<StudyConfiguration> out = builtin_configurations();
     if (preset != "quick") {
         for (StudyConfiguration& c : iridescent_configurations())
             out.push_back(std::move(c));
         for (StudyConfiguration& c : brushed_configurations())
+            out.push_back(std::move(c));
+        for (StudyConfiguration& c : dispersive_configurations())
             out.push_back(std::move(c));
     }
     return out;

@@ -1,7 +1,7 @@
 #pragma once
 // The study's configurations (docs/study.md): 60 two-interface stacks under air — plastics,
-// metallic paints, frosted metals and slabs — built into lamina, the iridescent and brushed
-// categories of the larger presets, plus a user's own list.
+// metallic paints, frosted metals and slabs — built into lamina, the iridescent, brushed and
+// dispersive categories of the larger presets, plus a user's own list.
 
 #include "layers/stack.h"
 
@@ -37,8 +37,15 @@ std::vector<StudyConfiguration> iridescent_configurations();
 /// leaves it out.
 std::vector<StudyConfiguration> brushed_configurations();
 
+/// The "dispersive" category (docs/study.md): the slab category's glass over air with a dense
+/// flint's index as a spectrum (n_d 1.785, Abbe number 25.7), smooth and rough; traced over
+/// wavelengths, as the iridescent category. The standard and paper presets add it; the quick one
+/// leaves it out.
+std::vector<StudyConfiguration> dispersive_configurations();
+
 /// The configurations a study runs by default at `preset`: builtin_configurations(), and
-/// iridescent_configurations() and brushed_configurations() for every preset but "quick".
+/// iridescent_configurations(), brushed_configurations() and dispersive_configurations() for every
+/// preset but "quick".
 std::vector<StudyConfiguration> preset_configurations(const std::string& preset);
 
 /// A configuration's id names a folder, a CSV cell and an --only item: InputError unless it is

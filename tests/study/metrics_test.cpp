@@ -246,8 +246,41 @@ TEST(StudyConfigurations, IridescentInTheLargerPresetsOnly) {
     EXPECT_EQ(preset_configurations("quick").size(), 60u);
     for (const char* preset : {"standard", "paper"}) {
         const auto all = preset_configurations(preset);
-        ASSERT_EQ(all.size(), 74u);  // and the brushed category's eight (unfolded_test.cpp)
+        ASSERT_EQ(all.size(), 76u);  // the brushed category's eight (unfolded_test.cpp), the
+                                     // dispersive category's two (below)
         EXPECT_EQ(all[65].id, irid.back().id);
+    }
+}
+
+// docs/study.md, "The dispersive category": the slab's glass over air with a dense flint's index as
+// a spectrum, smooth and rough, last in the larger presets. The index is the two-term Cauchy
+// formula through n_d = 1.785 at the helium d line with V_d = 25.7 (ISO 7944), checked here
+// against its own definition: (n_d − 1)/(n_F − n_C) at 587.56, 486.13 and 656.27 nm.
+TEST(StudyConfigurations, DispersiveInTheLargerPresetsOnly) {
+    const auto disp = dispersive_configurations();
+    ASSERT_EQ(disp.size(), 2u);
+    for (const auto& c : disp) {
+        EXPECT_EQ(c.category, "dispersive");
+        ASSERT_EQ(c.stack.layers.size(), 2u);
+        const InterfaceSpec& glass = c.stack.layers[0].interface;
+        ASSERT_TRUE(glass.eta_spectrum.has_value()) << c.id;
+        EXPECT_TRUE(c.stack.is_spectral()) << c.id;
+        const Spectrum& n = *glass.eta_spectrum;
+        EXPECT_NEAR(n.at(587.56), 1.785, 1e-9) << c.id;
+        EXPECT_NEAR((n.at(587.56) - 1) / (n.at(486.13) - n.at(656.27)), 25.7, 1e-6) << c.id;
+        EXPECT_GT(n.at(400), n.at(700));
+        // The slab's exit: back to air.
+        EXPECT_EQ(c.stack.layers[1].interface.type, InterfaceType::Dielectric);
+        EXPECT_EQ(c.stack.layers[1].interface.eta, 1.0);
+        EXPECT_TRUE(c.stack.transmits());
+        EXPECT_EQ(stack_from_json(stack_to_json(c.stack), c.id), c.stack) << c.id;
+    }
+    EXPECT_EQ(filter_configurations(preset_configurations("quick"), "*").size(), 60u);
+    for (const char* preset : {"standard", "paper"}) {
+        const auto all = preset_configurations(preset);
+        ASSERT_EQ(all.size(), 76u);
+        EXPECT_EQ(all[74].id, disp.front().id);
+        EXPECT_EQ(all.back().id, disp.back().id);
     }
 }
 
