@@ -137,11 +137,28 @@ HemisphereGrid grid_of(const std::pair<int, int>& grid) {
     return HemisphereGrid::parse(fmt::format("{}x{}", grid.first, grid.second), "grid");
 }
 
+/// Whether `x` is one value rather than a sequence of them: not iterable (a Python or numpy
+/// number), or a numpy array of no dimension (which has __iter__ but cannot be iterated); a string
+/// is one value too.
+bool is_one_value(py::handle x) {
+    if (py::isinstance<py::str>(x) || py::isinstance<py::bytes>(x)) return true;
+    if (!py::hasattr(x, "__iter__")) return true;
+    return py::hasattr(x, "ndim") && py::int_(x.attr("ndim")).cast<int>() == 0;
+}
+
+/// Whether `x` is a truth value (Python's or numpy's), which is not a number of degrees.
+bool is_truth_value(py::handle x) {
+    if (py::isinstance<py::bool_>(x)) return true;
+    return py::hasattr(x, "dtype") &&
+           py::str(x.attr("dtype").attr("kind")).cast<std::string>() == "b";
+}
+
 std::vector<double> incidences_of(py::handle theta_i) {
     std::vector<double> out;
-    // A number, or numbers; a string is neither (iterated, its characters would not cast).
+    // A number, or numbers; a string is neither (iterated, its characters would not cast), nor a
+    // truth value.
     auto number = [](py::handle t, const std::string& at) {
-        if (py::isinstance<py::str>(t) || py::isinstance<py::bytes>(t) ||
+        if (py::isinstance<py::str>(t) || py::isinstance<py::bytes>(t) || is_truth_value(t) ||
             !(py::isinstance<py::float_>(t) || py::isinstance<py::int_>(t) ||
               py::hasattr(t, "__float__")))
             throw InputError("arguments", at,
@@ -149,8 +166,7 @@ std::vector<double> incidences_of(py::handle theta_i) {
                                          py::repr(t).cast<std::string>()));
         return py::float_(py::reinterpret_borrow<py::object>(t)).cast<double>();
     };
-    if (py::isinstance<py::str>(theta_i) || py::isinstance<py::bytes>(theta_i) ||
-        !py::hasattr(theta_i, "__iter__"))
+    if (is_one_value(theta_i))
         out.push_back(number(theta_i, "theta_i"));
     else
         for (py::handle t : py::iter(theta_i))
@@ -993,8 +1009,8 @@ void bind_models(py::module_& m) {
                             "not supported: {} ({})",
                             s.reason.empty() ? "this model has no such side here" : s.reason,
                             side == "R" ? "BRDF" : "BTDF"));
-                const bool scalar =
-                    py::isinstance<py::float_>(theta_i) || py::isinstance<py::int_>(theta_i);
+                // One incidence (a Python or numpy number, a 0-d array): one RGB value.
+                const bool scalar = is_one_value(theta_i);
                 py::array_t<double> out(std::vector<py::ssize_t>{py::ssize_t(thetas.size()), 3});
                 {
                     py::gil_scoped_release release;

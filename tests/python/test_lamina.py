@@ -868,3 +868,19 @@ def test_a_failed_write_moves_no_file(tmp_path):
         r.write(tmp_path / "out")
     assert "a folder of that name is there" in e.value.problem
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["result.json"]
+
+
+def test_one_incidence_is_one_value_whatever_its_type():
+    # A numpy scalar or a 0-d array is one incidence (one RGB albedo), as a Python float; it was a
+    # [1, 3] array for float32 and int64 and an error for a 0-d array. A truth value is no angle.
+    m = lamina.Model("lamina-1", PLASTIC)
+    want = m.albedo(30.0)
+    for one in (np.float64(30), np.float32(30), np.int64(30), np.array(30.0), 30):
+        got = m.albedo(one)
+        assert got.shape == (3,)
+        np.testing.assert_array_equal(got, want)
+    assert m.albedo([30]).shape == (1, 3)
+    for truth in (True, np.bool_(False), [True]):
+        with pytest.raises(lamina.InputError) as e:
+            m.albedo(truth)
+        assert e.value.field.startswith("theta_i") and "expected a number" in e.value.problem
