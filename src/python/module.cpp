@@ -153,24 +153,30 @@ bool is_truth_value(py::handle x) {
            py::str(x.attr("dtype").attr("kind")).cast<std::string>() == "b";
 }
 
-std::vector<double> incidences_of(py::handle theta_i) {
+/// A number of degrees from Python (numpy's numbers too); a string or a truth value is not one.
+double degrees_of(py::handle t, const std::string& at) {
+    if (py::isinstance<py::str>(t) || py::isinstance<py::bytes>(t) || is_truth_value(t) ||
+        !(py::isinstance<py::float_>(t) || py::isinstance<py::int_>(t) ||
+          py::hasattr(t, "__float__")))
+        throw InputError(
+            "arguments", at,
+            fmt::format("expected a number of degrees, got {}", py::repr(t).cast<std::string>()));
+    return py::float_(py::reinterpret_borrow<py::object>(t)).cast<double>();
+}
+
+/// One number of degrees, or a sequence of them (`at`/0, `at`/1, ... in messages), unchecked.
+std::vector<double> degrees_list(py::handle x, const std::string& at) {
     std::vector<double> out;
-    // A number, or numbers; a string is neither (iterated, its characters would not cast), nor a
-    // truth value.
-    auto number = [](py::handle t, const std::string& at) {
-        if (py::isinstance<py::str>(t) || py::isinstance<py::bytes>(t) || is_truth_value(t) ||
-            !(py::isinstance<py::float_>(t) || py::isinstance<py::int_>(t) ||
-              py::hasattr(t, "__float__")))
-            throw InputError("arguments", at,
-                             fmt::format("expected a number of degrees, got {}",
-                                         py::repr(t).cast<std::string>()));
-        return py::float_(py::reinterpret_borrow<py::object>(t)).cast<double>();
-    };
-    if (is_one_value(theta_i))
-        out.push_back(number(theta_i, "theta_i"));
+    if (is_one_value(x))
+        out.push_back(degrees_of(x, at));
     else
-        for (py::handle t : py::iter(theta_i))
-            out.push_back(number(t, fmt::format("theta_i/{}", out.size())));
+        for (py::handle t : py::iter(x))
+            out.push_back(degrees_of(t, fmt::format("{}/{}", at, out.size())));
+    return out;
+}
+
+std::vector<double> incidences_of(py::handle theta_i) {
+    std::vector<double> out = degrees_list(theta_i, "theta_i");
     if (out.empty()) throw InputError("arguments", "theta_i", "at least one incidence is needed");
     check_incidence_list(out, "arguments", "theta_i");  // in range, each once (as the CLI's)
     return out;
@@ -433,8 +439,9 @@ py::dict support_of(const Support& s) {
 /// A table from numpy: f [n_inc, n_sides, n_theta, n_phi, 3] for `sides` ("R", "T"), se = 0;
 /// `unfolded`: the φ bins cover [0°, 360°) (n_phi even: the unfolded grid of n_phi / 2).
 BinnedTable table_from_arrays(py::array_t<double, py::array::c_style | py::array::forcecast> f,
-                              const std::vector<double>& theta_i,
-                              const std::vector<std::string>& sides, bool unfolded) {
+                              py::handle theta_i_arg, const std::vector<std::string>& sides,
+                              bool unfolded) {
+    const std::vector<double> theta_i = degrees_list(theta_i_arg, "theta_i");
     if (f.ndim() != 5 || f.shape(4) != 3 || std::size_t(f.shape(0)) != theta_i.size() ||
         std::size_t(f.shape(1)) != sides.size())
         throw InputError("arguments", "f",
@@ -973,8 +980,10 @@ void bind_models(py::module_& m) {
             py::arg("wi"))
         .def(
             "binned",
-            [](const PyModel& m, py::handle theta_i, std::pair<int, int> grid, double phi_i) {
+            [](const PyModel& m, py::handle theta_i, std::pair<int, int> grid,
+               py::handle phi_i_arg) {
                 const std::vector<double> thetas = incidences_of(theta_i);
+                const double phi_i = degrees_of(phi_i_arg, "phi_i");
                 if (!(phi_i >= 0 && phi_i <= 360))  // NaN too
                     throw InputError("arguments", "phi_i",
                                      fmt::format("{} degrees is outside [0, 360]", phi_i));

@@ -222,6 +222,36 @@ def test_phi_i_out_of_range_is_refused():
         assert e.value.field == "phi_i"
 
 
+def test_truth_values_and_bad_node_counts_are_refused(tmp_path):
+    # True would be read as 1 degree or one node; a node count outside [1, MAX] would bin with
+    # no node or allocate without bound (a study of built-in models only checks it too).
+    for kw in ({"theta_i": [True]}, {"phi_i": True}, {"phi_i": np.bool_(False)}):
+        args = {"theta_i": [0, 40], **kw}
+        with pytest.raises(lamina.InputError) as e:
+            lamina.bin_model(Lambert, PLASTIC, grid=(3, 3), **args)
+        assert e.value.field == next(iter(kw)) and "expected" in e.value.problem
+    for field, bad in (("nodes", 0), ("nodes", 2.5), ("nodes", True), ("nodes", 33),
+                       ("peak_nodes", -1), ("peak_nodes", 257)):
+        with pytest.raises(lamina.InputError) as e:
+            lamina.bin_model(Lambert, PLASTIC, [0], grid=(3, 3), **{field: bad})
+        assert e.value.field == field and "an integer in [1, " in e.value.problem
+        with pytest.raises(lamina.InputError) as e:
+            lamina.compare(PLASTIC, models=["ww09"], out=tmp_path / "c", particles=1e3,
+                           **{field: bad})
+        assert e.value.field == field
+    assert not (tmp_path / "c").exists()
+    t = lamina.bin_model(Lambert, PLASTIC, [0], grid=(3, 3), nodes=np.int64(2), peak_nodes=1)
+    np.testing.assert_allclose(t.f[0, 0, :, :, 0], 0.5 / np.pi, rtol=1e-13)
+    m = lamina.Model("ww09", PLASTIC)
+    for bad in (True, np.bool_(False), "3"):
+        with pytest.raises(lamina.InputError) as e:
+            m.binned([30], (3, 3), phi_i=bad)
+        assert e.value.field == "phi_i"
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Table.from_arrays(np.zeros((1, 1, 3, 3, 3)), [True])
+    assert e.value.field == "theta_i/0"
+
+
 class WrappedWB20:
     """lamina's wb20 (anisotropic) called from Python."""
     name = "py-wb20"

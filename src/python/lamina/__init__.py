@@ -30,7 +30,8 @@ from ._lamina import (  # noqa: F401  (re-exported)
 )
 from . import _lamina
 from . import arrays as _arrays
-from .plugins import bin_model, input_error, model_name
+from .plugins import (MAX_NODES, MAX_PEAK_NODES, bin_model, input_error, model_name,
+                      node_count)
 
 __all__ = [
     "InputError",
@@ -327,6 +328,9 @@ def _split_models(models):
 
 
 def _run(configs, models, preset, out, figures, quiet, nodes, peak_nodes, tables, settings):
+    # Checked here too: a study of built-in models only does not reach bin_model.
+    nodes = node_count("nodes", nodes, MAX_NODES)
+    peak_nodes = node_count("peak_nodes", peak_nodes, MAX_PEAK_NODES)
     names, plugins = _split_models(models)
     reference = _reference_settings(settings)
     effective = dict(SIMULATION_SETTINGS, **reference)

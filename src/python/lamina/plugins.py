@@ -38,6 +38,19 @@ def input_error(file, field, problem):
     return e
 
 
+# The most Gauss–Legendre nodes a side of a bin: every bin's nodes are evaluated in one array of
+# bins × nodes² directions, 0.2 GB at 32 on the default grid; peak bins are a few.
+MAX_NODES, MAX_PEAK_NODES = 32, 256
+
+
+def node_count(field, n, most):
+    """A quadrature's nodes a side: an integer in [1, most] (a truth value is not one)."""
+    if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or \
+            not 1 <= n <= most:
+        raise input_error("arguments", field, f"an integer in [1, {most}], got {n!r}")
+    return int(n)
+
+
 def model_name(obj) -> str:
     name = getattr(obj, "name", None)
     if isinstance(name, str) and name:
@@ -112,6 +125,8 @@ def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32, phi_i=0.0)
     isotropic stack lit from φi = 0, unfolded otherwise (an anisotropic stack, or some φi ≠ 0:
     2 n_phi bins over [0°, 360°), each one patch), where the model gets wo over the full azimuth
     in the stack's frame."""
+    nodes = node_count("nodes", nodes, MAX_NODES)
+    peak_nodes = node_count("peak_nodes", peak_nodes, MAX_PEAK_NODES)
     stack = _lamina.Stack(stack)
     model = instantiate(obj, stack)
     name = model_name(obj)
@@ -119,9 +134,13 @@ def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32, phi_i=0.0)
     sides = (["R"] if sup["brdf"] else []) + (["T"] if sup["btdf"] and stack.transmits else [])
     if not sides:
         return None
+    if np.asarray(theta_i).dtype.kind == "b":
+        raise input_error("arguments", "theta_i", f"expected degrees, got {theta_i!r}")
     theta_i = [float(t) for t in np.atleast_1d(theta_i)]
     if not theta_i:
         raise input_error("arguments", "theta_i", "at least one incidence is needed")
+    if np.asarray(phi_i).dtype.kind == "b":
+        raise input_error("arguments", "phi_i", f"expected degrees, got {phi_i!r}")
     phi = np.atleast_1d(np.asarray(phi_i, dtype=np.float64))
     if phi.ndim == 1 and len(phi) == 1:
         phi = np.full(len(theta_i), phi[0])
