@@ -325,17 +325,26 @@ Runner add_eval(CLI::App& app) {
         ->each([a](const std::string&) { a->grid_given = true; });
     cmd->add_option("--out", a->out, "Output CSV (written atomically)");
     add_settings_options_only(cmd, a->spectral, {"spectral", "spectral_min_nm", "spectral_max_nm"});
-    cmd->add_option("--samples", a->samples,
-                    "random-walk: walks per query, at least 2 (default: its samples option, "
-                    "1024); a point evaluation then prints f_r f_g f_b se_r se_g se_b")
-        // ≥ 2: one walk has no standard error (it printed 0). As a double: "-3" must not wrap
-        // around.
-        ->check(CLI::Range(2.0, 1.8e19));
+    // Whole numbers read as the settings' are ("-3" refused, not wrapped; the bounds named);
+    // 0, the default, leaves the model's own option. ≥ 2 samples: one walk has no standard error.
+    auto add_whole = [cmd](const SettingInfo& info, std::uint64_t& member) {
+        cmd->add_option_function<std::string>(
+            option_name(info.name),
+            [&member, info](const std::string& text) {
+                member = SettingCodec<std::uint64_t>::from_text(text, info, "command line",
+                                                                option_name(info.name));
+            },
+            info.help);
+    };
+    add_whole({.name = "samples",
+               .help = "random-walk: walks per query, at least 2 (default: its samples option, "
+                       "1024); a point evaluation then prints f_r f_g f_b se_r se_g se_b",
+               .min = 2},
+              a->samples);
     cmd->add_flag("--pdf", a->pdf,
                   "random-walk, one point: print the exit density of its sampling at wo and its "
                   "standard error (pdf se, 1/sr) instead of f");
-    cmd->add_option("--seed", a->seed, "random-walk: seed of the walks (≥ 1)")
-        ->check(CLI::Range(1.0, 1.8e19));  // ≥ 1 (as a double: "-3" must not wrap around)
+    add_whole({.name = "seed", .help = "random-walk: seed of the walks (≥ 1)", .min = 1}, a->seed);
     cmd->add_option("--option", a->options,
                     "Model flag KEY=VALUE, repeatable (see `lamina models --options`)");
     return [a] { return run_eval(*a); };

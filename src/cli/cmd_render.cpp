@@ -123,7 +123,10 @@ Runner add_render(CLI::App& app) {
         ->check(CLI::Range(8, 8192));
     cmd->add_option("--spp", a->spp, "Samples per pixel (default 64)")
         ->check(CLI::Range(1, 1 << 20));
-    cmd->add_option("--seed", a->seed, "Seed (images are reproducible for a seed)");
+    // Read as simulate's seed is: a whole number in [0, 2^64 − 1] ("-1" refused, not wrapped).
+    add_setting_option(
+        cmd, {.name = "seed", .help = "Seed (images are reproducible for a seed)", .min = 0},
+        a->seed);
     cmd->add_option("--threads", a->threads,
                     fmt::format("Threads (default: all), at most {}", kMaxThreads))
         ->check(CLI::Range(0, kMaxThreads));  // as simulate's: OpenMP creates them all at once

@@ -63,15 +63,21 @@ check omp-threads-one 0 env OMP_NUM_THREADS=1 "$lamina" simulate "$src/examples/
     --particles 1e3 --theta-i 0 --grid 9x9 --out "$tmp/omp-one"
 check omp-threads-same-table 0 cmp "$tmp/omp-many/brdf.csv" "$tmp/omp-one/brdf.csv"
 # One walk has no standard error (it printed 0).
-check_says eval-one-walk 1 "--samples: '1' is not allowed: expected a whole number >= 2" \
+check_says eval-one-walk 1 "--samples: '1' is not allowed: expected a whole number ≥ 2" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 \
     --theta-o 30 --phi-o 0 --samples 1
-check_says cli11-negative-count 1 "lamina: command line: --samples: '-5' is not allowed: expected a whole number >= 2" \
+# Counts and seeds are read as the settings' whole numbers: a negative one is refused (not wrapped
+# modulo 2^64), and one beyond the type names the range.
+check_says cli11-negative-count 1 "lamina: command line: --samples: '-5' is not allowed: expected a whole number in [2, 18446744073709551615]" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --samples -5
-check_says cli11-zero-seed 1 "lamina: command line: --seed: '0' is not allowed: expected a whole number >= 1" \
+check_says eval-seed-beyond-uint64 1 "lamina: command line: --seed: '18446744073709551616' is not allowed: expected a whole number in [1, 18446744073709551615]" \
+    "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --seed 18446744073709551616
+check_says cli11-zero-seed 1 "lamina: command line: --seed: '0' is not allowed: expected a whole number ≥ 1" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --seed 0
-check_says cli11-fraction 1 "lamina: command line: --seed: '1.5' is not a whole number" \
+check_says cli11-fraction 1 "lamina: command line: --seed: '1.5' is not allowed: expected a whole number in [1, 1000000000000000]" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --seed 1.5
+check_says render-negative-seed 1 "lamina: command line: --seed: '-1' is not allowed: expected a whole number in [0, 18446744073709551615]" \
+    "$lamina" render "$src/examples/plastic.json" --seed -1 --out "$tmp/never.png"
 check_says cli11-range 1 "lamina: command line: --size: '5' is not allowed: expected a whole number in [8, 8192]" \
     "$lamina" render "$src/examples/plastic.json" --size 5 --out "$tmp/never.png"
 check_says cli11-required 1 "lamina: command line: --stack: required; see \`lamina eval --help\`" \
