@@ -135,10 +135,11 @@ Runner add_simulate(CLI::App& app) {
                     s.transport.max_events, format_rgb(b[BudgetTerm::CutOff]),
                     result.incidences[i].events_per_particle);
         }
+        const std::string threads =
+            fmt::format("{} thread{}", result.threads_used, result.threads_used == 1 ? "" : "s");
         const std::string workers =
-            result.processes > 1
-                ? fmt::format("{} processes × {} threads", result.processes, result.threads_used)
-                : fmt::format("{} threads", result.threads_used);
+            result.processes > 1 ? fmt::format("{} processes × {}", result.processes, threads)
+                                 : threads;
         const bool spectral = !result.spectral.bin_edges_nm.empty();
         if (spectral)
             fmt::print(
