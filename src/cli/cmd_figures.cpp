@@ -1,5 +1,6 @@
 // lamina figures DIR: paper-ready figures of a study directory (docs/explorer.md).
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "core/error.h"
 #include "report/figures.h"
 
@@ -27,7 +28,8 @@ Runner add_figures(CLI::App& app) {
     cmd->add_flag("--force", a->force,
                   "Redraw every figure (by default only those whose inputs changed)");
     cmd->add_option("--only", a->only,
-                    "Configuration ids (globs, comma-separated) for the per-configuration slices");
+                    "Configuration ids (globs, comma-separated) for the per-configuration slices")
+        ->check(some_patterns());
     cmd->add_option(
         "--python", a->python,
         "Python interpreter with matplotlib (default: $LAMINA_PYTHON, /usr/bin/python3)");

@@ -215,12 +215,14 @@ Runner add_study(CLI::App& app) {
         int render_size = 160, render_spp = 32;
     };
     auto a = std::make_shared<Args>();
-    auto* cmd = app.add_subcommand(
-        "study", "Compare every model with the reference on the study's 60 configurations");
+    auto* cmd = app.add_subcommand("study",
+                                   "Compare every model with the reference on the study's "
+                                   "configurations (60; 76 in the standard and paper presets)");
     cmd->add_option("--preset", a->preset,
                     "Particle budget: quick (10^6 per incidence), standard (10^7), paper (1.6e8)")
         ->capture_default_str();
-    cmd->add_option("--only", a->only, "Only configurations whose id matches (globs, commas)");
+    cmd->add_option("--only", a->only, "Only configurations whose id matches (globs, commas)")
+        ->check(some_patterns());
     cmd->add_option("--configs", a->configs, "A JSON list of your own configurations");
     add_common(cmd, *a);
     cmd->add_option(
@@ -255,7 +257,12 @@ Runner add_study(CLI::App& app) {
             check_model_tables(*a, configs);
             check_model_tables_fit(*a, s, configs);
         }
+        // Under mpirun: the pieces the processes computed before run_study, and their time (the
+        // root's wall and CPU seconds), counted in the Work and Time lines with run_study's.
+        std::size_t computed_before = 0;
+        StudyTimes::Span reference_before;
         if (world.distributed()) {
+            const PhaseTimer timer;
             std::vector<ReferenceKey> keys;
             if (world.is_root()) {
                 study_models(s);          // validates --models before any work
@@ -270,8 +277,13 @@ Runner add_study(CLI::App& app) {
             if (!world.is_root()) return 0;
             fmt::print("Reference: {} pieces computed over {} processes × {} threads\n", computed,
                        world.size(), threads);
+            computed_before = computed;
+            timer.add_to(reference_before);
         }
         StudyResult result = run_study(configs, s, out);
+        result.work.reference_pieces_computed += computed_before;
+        result.times.reference.wall += reference_before.wall;
+        result.times.reference.cpu += reference_before.cpu;
         if (a->render) {
             // Renderings of every configuration: reproducible (seed), the same settings for all.
             RenderSettings rs;

@@ -25,6 +25,18 @@ std::uint64_t parse_count(const std::string& text, const std::string& option) {
     return std::uint64_t(v);
 }
 
+CLI::Validator some_patterns() {
+    return CLI::Validator(
+        [](std::string& text) {
+            return text.find_first_not_of(", ") == std::string::npos
+                       ? std::string("'" + text +
+                                     "' names no configuration: give id globs (plastic-*, "
+                                     "slab-*-clear), or leave --only out for every configuration")
+                       : std::string();
+        },
+        "GLOBS");
+}
+
 std::string format_rgb(const Rgbd& v) {
     return fmt::format("({:.4f}, {:.4f}, {:.4f})", v[0], v[1], v[2]);
 }

@@ -3,6 +3,8 @@
 
 #include "core/rgb.h"
 
+#include <CLI/CLI.hpp>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -17,5 +19,9 @@ std::uint64_t parse_count(const std::string& text, const std::string& option);
 
 /// "(0.1234, 0.5, 1)" for messages.
 std::string format_rgb(const Rgbd& v);
+
+/// The check of an --only option (configuration id globs, commas): given, it names some pattern
+/// (an empty value would silently mean every configuration).
+CLI::Validator some_patterns();
 
 }  // namespace lamina::cli

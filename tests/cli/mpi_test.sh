@@ -97,6 +97,10 @@ mpi "$lamina" study "${tiny[@]}" --out "$tmp/two/study" >"$tmp/study-two.log" 2>
     && ok || { fail "mpirun study"; cat "$tmp/study-two.log"; }
 grep -q 'Reference: 4 pieces computed over 2 processes' "$tmp/study-two.log" && ok \
     || fail "study: reference not shared"
+# What the run did counts the pieces the processes computed, as one process's run counts its own.
+grep -q 'Work: 4 reference pieces simulated' "$tmp/study-one.log" \
+    && grep -q 'Work: 4 reference pieces simulated' "$tmp/study-two.log" && ok \
+    || { fail "study: the Work line misses the shared pieces"; grep Work "$tmp"/study-*.log; }
 files=$(cd "$tmp/one/study" && find . -type f ! -name study.json ! -path './cache/*' | sort)
 [ -n "$files" ] && ok || fail "study: no files"
 echo "$files" | grep -q 'reference_stokes.lza' && ok || fail "study: no reference_stokes.lza"

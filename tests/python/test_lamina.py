@@ -157,6 +157,12 @@ def test_study_names_are_checked_before_any_work(tmp_path):
         lamina.study(only="nope*", out=tmp_path / "o", particles=1000, theta_i=[30], grid=(9, 9))
     assert (e.value.file, e.value.field) == ("arguments", "only")
     assert "matches no configuration" in e.value.problem and "--only" not in str(e.value)
+    # An empty `only` names nothing: it is not every configuration (a whole study by accident).
+    for empty in ("", " , "):
+        with pytest.raises(lamina.InputError) as e:
+            lamina.study(only=empty, out=tmp_path / "o", particles=1000, theta_i=[30])
+        assert e.value.field == "only" and "names no configuration" in e.value.problem
+    assert not (tmp_path / "o").exists()
 
 
 def test_incidences_are_given_once():

@@ -185,6 +185,9 @@ expect_error() {  # expect_error TEXT ARGS...
 }
 expect_error "--preset: 'huge' is not a preset" study --preset huge --out "$tmp/x"
 expect_error "--only: 'nothing' matches no configuration" study --only nothing --out "$tmp/x"
+# Given empty, --only names nothing: not every configuration (a whole study) by accident.
+expect_error "--only: '' names no configuration" study --only '' --out "$tmp/x"
+expect_error "--only: ', ' names no configuration" figures "$tmp/x" --only ', '
 expect_error "unknown model" study --models ww-prime,nope --only 'plastic-P1-a0.05' --out "$tmp/x"
 expect_error "--theta-i: 95 is outside" study --theta-i 95 --out "$tmp/x"
 echo '{"configurations": [{"id": "a b", "stack": {}}]}' >"$tmp/bad.json"

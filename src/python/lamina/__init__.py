@@ -396,6 +396,10 @@ def study(models=None, preset="quick", only=None, configs=None, out=None, figure
     cs = _lamina._builtin_configurations(preset) if configs is None else [
         {"id": c["id"], "category": c.get("category", "custom"), "stack": Stack(c["stack"])}
         for c in configs]
+    if only is not None and not str(only).strip(", "):
+        raise input_error("arguments", "only",
+                          f"{only!r} names no configuration: give id globs (plastic-*, "
+                          "slab-*-clear), or leave it out for every configuration")
     if only:
         keep = set(_lamina._filter_configurations(cs, only))
         cs = [c for c in cs if c["id"] in keep]
