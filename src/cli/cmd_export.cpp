@@ -90,8 +90,11 @@ StudySource study_table(const ExportArgs& a) {
         const std::size_t k = std::size_t(it - sources.begin());
         const auto theta_i = cfg.at("theta_i").get<std::vector<double>>();
         const auto sides = cfg.at("sides").get<std::vector<std::string>>();
-        HemisphereGrid grid(study.at("grid").at("n_theta").get<int>(),
-                            study.at("grid").at("n_phi").get<int>());
+        // Counts in range (they size the table); read wide so that 1e18 is not wrapped.
+        HemisphereGrid grid = HemisphereGrid::checked(
+            study.at("grid").at("n_theta").get<long long>(),
+            study.at("grid").at("n_phi").get<long long>(),
+            (std::filesystem::path(a.study) / "study.json").string(), "/grid");
         // An unfolded configuration (docs/formats.md): its incidences' azimuths and its grid.
         out.phi_i_deg.assign(theta_i.size(), 0.0);
         if (cfg.contains("phi_i")) {
@@ -139,11 +142,40 @@ StudySource study_table(const ExportArgs& a) {
                         if (se) lobe.se[j][int(c)] = se->data[lobe_offset + j * 3 + c];
                     }
             }
+        // A side the source does not support is NaN in every bin (the study's convention), any
+        // other finite in every bin; a standard error finite and ≥ 0. Anything else is damage.
+        for (std::size_t i = 0; i < theta_i.size(); ++i)
+            for (std::size_t s = 0; s < sides.size(); ++s) {
+                const BinnedLobe& lobe =
+                    table.lobe(i, s == 0 ? Side::Reflection : Side::Transmission);
+                const auto finite = [](const Rgbd& v) {
+                    return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+                };
+                const auto n_finite = std::count_if(lobe.f.begin(), lobe.f.end(), finite);
+                if (n_finite != 0 && std::size_t(n_finite) != lobe.f.size())
+                    throw InputError(
+                        study_array_path(dir, "tables").string(), a.source,
+                        fmt::format("{} of {} bins are not finite at θi = {}°, side {} (a "
+                                    "damaged file?)",
+                                    lobe.f.size() - std::size_t(n_finite), lobe.f.size(),
+                                    theta_i[i], sides[s]));
+                for (const Rgbd& v : lobe.se)
+                    for (int c = 0; c < 3; ++c)
+                        if (!(v[c] >= 0 && std::isfinite(v[c])))
+                            throw InputError(
+                                study_array_path(dir, "reference_se").string(), "",
+                                fmt::format("a standard error at θi = {}°, side {} is {}: allowed "
+                                            "finite, ≥ 0 (a damaged file?)",
+                                            theta_i[i], sides[s], v[c]));
+            }
         for (const auto& lobe : table.lobe(0, Side::Reflection).f)
             if (!std::isfinite(lobe[0]))
-                throw InputError(
-                    out.config_path, "--source",
-                    fmt::format("'{}' does not support this configuration's BRDF", a.source));
+                throw k == 0 ? InputError(study_array_path(dir, "tables").string(), a.source,
+                                          "the reference's BRDF is not finite (a damaged file?)")
+                             : InputError(out.config_path, "--source",
+                                          fmt::format("'{}' does not support this "
+                                                      "configuration's BRDF",
+                                                      a.source));
         return out;
     } catch (const nlohmann::json::exception& e) {
         throw InputError(out.config_path, "", fmt::format("unexpected: {}", e.what()));

@@ -82,13 +82,22 @@ HemisphereGrid HemisphereGrid::parse(const std::string& text, const std::string&
         return ec == std::errc() && ptr == s.data() + s.size();
     };
     if (x == std::string::npos || !parse_int(text.substr(0, x), n_theta) ||
-        !parse_int(text.substr(x + 1), n_phi) || n_theta < 1 || n_phi < 1 || n_theta > 3600 ||
-        n_phi > 3600)
+        !parse_int(text.substr(x + 1), n_phi) || n_theta < 1 || n_phi < 1 || n_theta > kMaxCount ||
+        n_phi > kMaxCount)
         throw InputError("command line", option,
                          fmt::format("'{}' is not a grid: expected NTHETAxNPHI with each count in "
-                                     "[1, 3600], e.g. 90x90",
-                                     text));
+                                     "[1, {}], e.g. 90x90",
+                                     text, kMaxCount));
     return HemisphereGrid(n_theta, n_phi);
+}
+
+HemisphereGrid HemisphereGrid::checked(long long n_theta, long long n_phi, const std::string& where,
+                                       const std::string& field) {
+    if (n_theta < 1 || n_phi < 1 || n_theta > kMaxCount || n_phi > kMaxCount)
+        throw InputError(where, field,
+                         fmt::format("{} × {} bins: allowed counts in [1, {}] along θ and φ",
+                                     n_theta, n_phi, kMaxCount));
+    return HemisphereGrid(int(n_theta), int(n_phi));
 }
 
 }  // namespace lamina

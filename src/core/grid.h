@@ -95,6 +95,12 @@ class HemisphereGrid {
     /// and its parser of the folded form (InputError naming `option` on bad text).
     std::string to_string() const;
     static HemisphereGrid parse(const std::string& text, const std::string& option = "--grid");
+    /// The folded grid of counts read from a file (a study's study.json): each in [1,
+    /// kMaxCount], else InputError naming `where` and `field`.
+    static HemisphereGrid checked(long long n_theta, long long n_phi, const std::string& where,
+                                  const std::string& field);
+    /// The most bins along θ or φ a grid may have.
+    static constexpr int kMaxCount = 3600;
 
     bool operator==(const HemisphereGrid& o) const {
         return n_theta_ == o.n_theta_ && n_phi_ == o.n_phi_ && unfolded_ == o.unfolded_;

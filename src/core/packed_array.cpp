@@ -1,5 +1,6 @@
 #include "core/packed_array.h"
 
+#include "core/atomic_file.h"
 #include "core/check.h"
 #include "core/error.h"
 
@@ -258,11 +259,9 @@ NpyFloat32 parse_packed_array(std::string_view bytes, const std::string& where) 
 }
 
 NpyFloat32 read_packed_array(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path.string(), "", "cannot read the file");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return parse_packed_array(ss.str(), path.string());
+    // Bounded as every table lamina reads: a device or a runaway file is refused, not read on.
+    return parse_packed_array(read_file_bounded(path, kMaxTableFileBytes, "the packed array"),
+                              path.string());
 }
 
 std::filesystem::path study_array_path(const std::filesystem::path& dir, const std::string& stem) {

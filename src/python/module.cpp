@@ -504,8 +504,8 @@ void run_study_py(py::list configs_in, py::dict settings, py::list externals,
         sc.category = c["category"].cast<std::string>();
         const std::string at = fmt::format("configs[{}]", configs.size());
         check_configuration_id(sc.id, "arguments", at + ".id");
-        if (!ids.insert(sc.id).second)
-            throw InputError("arguments", at + ".id", fmt::format("'{}' appears twice", sc.id));
+        if (!ids.insert(configuration_id_key(sc.id)).second)
+            throw InputError("arguments", at + ".id", fmt::format("'{}' {}", sc.id, kIdTwice));
         check_study_label(sc.category, "category", "arguments", at + ".category");
         sc.stack = stack_of(c["stack"]);
         sc.parameters = describe_parameters(sc.stack);

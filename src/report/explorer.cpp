@@ -33,20 +33,30 @@ namespace {
 
 // ---- Reading the study directory ------------------------------------------------------------
 
+// The largest JSON file of a study folder read (a configuration's state and stack are tens of
+// kB; the bound keeps a device or a runaway file from being read without end).
+constexpr std::size_t kMaxStudyJsonBytes = std::size_t(256) << 20;
+
 json read_json(const fs::path& path, const char* what) {
-    std::ifstream in(path);
-    if (!in)
+    std::error_code ec;
+    if (!fs::exists(path, ec))
         throw InputError(path.string(), "",
                          fmt::format("cannot read {} (is this a study directory written by `lamina "
                                      "study` or `lamina compare`?)",
                                      what));
-    std::stringstream ss;
-    ss << in.rdbuf();
+    const std::string text = read_file_bounded(path, kMaxStudyJsonBytes, what);
     try {
-        return json::parse(ss.str());
-    } catch (const json::parse_error& e) {
+        return json::parse(text);
+    } catch (const json::exception& e) {
         throw InputError(path.string(), "", fmt::format("malformed JSON: {}", e.what()));
     }
+}
+
+// A file's bytes for a digest: a regular file's (within the tables' bound), else nothing.
+std::string digest_bytes(const fs::path& path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) > kMaxTableFileBytes) return {};
+    return read_file_bounded(path, kMaxTableFileBytes, "the file");
 }
 
 template <class T>
@@ -85,8 +95,9 @@ using ConfigIncidences = std::map<std::string, std::vector<Incidence>>;
 json read_metrics(const fs::path& path, const std::vector<double>& theta_i,
                   const ConfigIncidences& unfolded) {
     json out = json::object();
-    std::ifstream in(path);
-    if (!in) return out;  // the page then shows no leaderboard, and says so
+    std::error_code ec;
+    if (!fs::exists(path, ec)) return out;  // the page then shows no leaderboard, and says so
+    std::istringstream in(read_file_bounded(path, kMaxTableFileBytes, "the metrics table"));
     std::string line;
     std::getline(in, line);
     const std::vector<std::string> header = split_csv_line(line);
@@ -537,7 +548,7 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     }
     entry["renders"] = renders;
     json render_errors = json::object();
-    if (std::ifstream err(dir / "renders" / "errors.csv"); err) {
+    if (std::istringstream err(digest_bytes(dir / "renders" / "errors.csv")); err) {
         std::string line;
         std::getline(err, line);  // model,rel_rmse,seconds
         while (std::getline(err, line)) {
@@ -579,11 +590,10 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
     if (cfg.contains("lamina1_gpu") && cfg["lamina1_gpu"].is_object()) {
         const json& g = cfg["lamina1_gpu"];
         const fs::path file = dir / field<std::string>(g, "file", cfg_path);
-        std::ifstream in(file, std::ios::binary);
-        if (!in)
+        std::error_code ec;
+        if (!fs::exists(file, ec))
             throw InputError(file.string(), "", "not found (config.json → lamina1_gpu names it)");
-        const std::string bytes((std::istreambuf_iterator<char>(in)),
-                                std::istreambuf_iterator<char>());
+        const std::string bytes = read_file_bounded(file, kMaxTableFileBytes, "lamina-1's states");
         const auto n_state = field<std::size_t>(g, "state", cfg_path);
         const auto head = field<std::size_t>(g, "head", cfg_path);
         // A slab's bins at the state's end (`tail`; absent where the study wrote none).
@@ -652,11 +662,10 @@ std::string inputs_digest(const fs::path& dir, const json& entry,
     for (const char* name :
          {"config.json", "lamina1_gpu.f32", "tables.lza", "reference_se.lza", "tables.npy",
           "reference_se.npy", "reference_stokes.lza", "renders/errors.csv"}) {
-        std::ifstream in(dir / name, std::ios::binary);
-        std::stringstream ss;
-        if (in) ss << in.rdbuf();
-        h = fnv1a(fmt::format("| {} {} |", name, bool(in)), h);
-        h = fnv1a(ss.str(), h);
+        std::error_code ec;
+        const bool there = fs::exists(dir / name, ec);
+        h = fnv1a(fmt::format("| {} {} |", name, there), h);
+        h = fnv1a(there ? digest_bytes(dir / name) : std::string(), h);
     }
     std::error_code ec;
     std::vector<std::string> renders;
@@ -677,8 +686,11 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
     const json study = read_json(study_path, "the study's description");
     const auto theta_i = field<std::vector<double>>(study, "theta_i", study_path);
     const json grid = field<json>(study, "grid", study_path);
-    const int n_theta = field<int>(grid, "n_theta", study_path);
-    const int n_phi = field<int>(grid, "n_phi", study_path);
+    // Counts in range (they size every array below); read wide so that 1e18 is not wrapped.
+    const HemisphereGrid checked_grid = HemisphereGrid::checked(
+        field<long long>(grid, "n_theta", study_path), field<long long>(grid, "n_phi", study_path),
+        study_path.string(), "/grid");
+    const int n_theta = checked_grid.n_theta(), n_phi = checked_grid.n_phi();
     const json configurations = field<json>(study, "configurations", study_path);
     const std::string plotly = plotly_bundle();
 
@@ -698,9 +710,9 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
     // page was drawn from is not encoded again: its index entry comes from the stamps.
     const fs::path stamps_path = study_dir / "explorer" / "data" / ".inputs.json";
     json stamps = json::object(), new_stamps = json::object();
-    if (std::ifstream in(stamps_path); in) {
+    if (const std::string text = digest_bytes(stamps_path); !text.empty()) {
         try {
-            stamps = json::parse(in);
+            stamps = json::parse(text);
         } catch (const std::exception&) {
             stamps = json::object();
         }

@@ -301,36 +301,64 @@ std::vector<StudyConfiguration> preset_configurations(const std::string& preset)
 }
 
 namespace {
+// C0 controls, DEL, and the C1 controls U+0080–U+009F (UTF-8: 0xC2 then 0x80–0x9F).
 bool has_control_character(const std::string& text) {
-    return std::any_of(text.begin(), text.end(),
-                       [](char ch) { return (unsigned char)ch < 0x20 || ch == 0x7f; });
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const auto ch = static_cast<unsigned char>(text[i]);
+        if (ch < 0x20 || ch == 0x7f) return true;
+        if (ch == 0xc2 && i + 1 < text.size() && static_cast<unsigned char>(text[i + 1]) >= 0x80 &&
+            static_cast<unsigned char>(text[i + 1]) <= 0x9f)
+            return true;
+    }
+    return false;
 }
+
+// An id or label names files and folders (configs/<id>/, figures/albedo-<category>.png,
+// renders/<model>.png): a file name holds 255 bytes.
+constexpr std::size_t kMaxNameBytes = 128;
 }  // namespace
+
+std::string configuration_id_key(const std::string& id) {
+    std::string key = id;
+    for (char& ch : key)
+        if (ch >= 'A' && ch <= 'Z') ch = char(ch - 'A' + 'a');
+    return key;
+}
 
 void check_configuration_id(const std::string& id, const std::string& where,
                             const std::string& field) {
-    // An id names a folder and, with a suffix, cache files: a file name holds 255 bytes.
-    constexpr std::size_t kMaxIdBytes = 128;
-    if (id.size() > kMaxIdBytes)
+    if (id.size() > kMaxNameBytes)
         throw InputError(where, field,
                          fmt::format("'{}…' is {} bytes long; allowed: at most {} (it names the "
                                      "configuration's folder and cache files)",
-                                     id.substr(0, 40), id.size(), kMaxIdBytes));
+                                     id.substr(0, 40), id.size(), kMaxNameBytes));
     if (id.empty() || id.find_first_of("/\\ ,\"") != std::string::npos ||
         has_control_character(id) || id[0] == '.')
         throw InputError(where, field,
                          fmt::format("'{}' is not usable as an id (no spaces, slashes, commas, "
                                      "quotes, control characters or leading dot)",
                                      id));
+    // The explorer's own data file is explorer/data/index.js beside each configuration's <id>.js.
+    if (configuration_id_key(id) == "index")
+        throw InputError(
+            where, field,
+            fmt::format("'{}' is reserved (the explorer's index); choose another id", id));
 }
 
 void check_study_label(const std::string& label, const char* what, const std::string& where,
                        const std::string& field) {
-    if (label.empty() || label.find_first_of(",\"") != std::string::npos ||
-        has_control_character(label))
+    if (label.size() > kMaxNameBytes)
         throw InputError(where, field,
-                         fmt::format("'{}' is not usable as a {} (not empty; no commas, quotes or "
-                                     "control characters)",
+                         fmt::format("'{}…' is {} bytes long; allowed: at most {} (it names "
+                                     "files: figures, renderings)",
+                                     label.substr(0, 40), label.size(), kMaxNameBytes));
+    if (label.find_first_not_of(' ') == std::string::npos ||
+        label.find_first_of(",\"/\\") != std::string::npos || has_control_character(label) ||
+        label[0] == '.')
+        throw InputError(where, field,
+                         fmt::format("'{}' is not usable as a {} (not blank; no commas, quotes, "
+                                     "slashes, control characters or leading dot: it names "
+                                     "files)",
                                      label, what));
 }
 
@@ -361,8 +389,8 @@ std::vector<StudyConfiguration> load_configurations(const std::filesystem::path&
         StudyConfiguration c;
         c.id = item["id"].get<std::string>();
         check_configuration_id(c.id, where, at + "/id");
-        if (!ids.insert(c.id).second)
-            throw InputError(where, at + "/id", fmt::format("'{}' appears twice", c.id));
+        if (!ids.insert(configuration_id_key(c.id)).second)
+            throw InputError(where, at + "/id", fmt::format("'{}' {}", c.id, kIdTwice));
         c.category = "custom";
         if (item.contains("category")) {
             if (!item["category"].is_string())

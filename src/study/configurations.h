@@ -57,6 +57,14 @@ void check_configuration_id(const std::string& id, const std::string& where,
 void check_study_label(const std::string& label, const char* what, const std::string& where,
                        const std::string& field);
 
+/// What two configuration ids must differ in: their ASCII letters' case aside (ids name folders,
+/// and two ids that differ in case only name one folder on a case-insensitive file system).
+std::string configuration_id_key(const std::string& id);
+/// The message for an id given twice (in that sense).
+inline constexpr const char* kIdTwice =
+    "appears twice (ids that differ only in case count as the same: they name one folder on "
+    "some file systems)";
+
 /// The largest configurations file load_configurations reads (64 MiB: four full-size stack
 /// files' worth; core/atomic_file.h, read_file_bounded).
 inline constexpr std::size_t kMaxConfigurationsFileBytes = std::size_t(64) << 20;

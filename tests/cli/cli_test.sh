@@ -256,6 +256,21 @@ printf '{"configurations": [{"id": "a", "category": "x,y", "stack": {"layers": [
 check_says configs-category-comma 1 "/configurations/0/category: 'x,y' is not usable as a category" \
     "$lamina" study --configs "$tmp/comma.json" --particles 1000 --theta-i 30 --grid 9x9 --out "$tmp/comma"
 check configs-category-writes-nothing 1 test -e "$tmp/comma"
+# A category names the figures' files (albedo-<category>.png): a path in it would write outside
+# the study folder. An id may not be the explorer's `index`, nor differ from another in case only.
+lambert='{"layers": [{"interface": {"type": "lambertian", "albedo": 0.5}}]}'
+for bad in '../../escaped' 'a/b' ' ' '.hidden'; do
+    printf '{"configurations": [{"id": "a", "category": "%s", "stack": %s}]}' "$bad" "$lambert" >"$tmp/cat.json"
+    check_says "configs-category-path '$bad'" 1 "/configurations/0/category: '$bad' is not usable as a category" \
+        "$lamina" study --configs "$tmp/cat.json" --particles 1000 --theta-i 30 --grid 9x9 --out "$tmp/cat"
+done
+printf '{"configurations": [{"id": "Index", "stack": %s}]}' "$lambert" >"$tmp/index.json"
+check_says configs-id-index 1 "/configurations/0/id: 'Index' is reserved" \
+    "$lamina" study --configs "$tmp/index.json" --particles 1000 --theta-i 30 --grid 9x9 --out "$tmp/cat"
+printf '{"configurations": [{"id": "a", "stack": %s}, {"id": "A", "stack": %s}]}' "$lambert" "$lambert" >"$tmp/case.json"
+check_says configs-id-case 1 "/configurations/1/id: 'A' appears twice (ids that differ only in case" \
+    "$lamina" study --configs "$tmp/case.json" --particles 1000 --theta-i 30 --grid 9x9 --out "$tmp/cat"
+check configs-category-path-writes-nothing 1 test -e "$tmp/cat"
 
 # validate: every example is valid and described on one line.
 for example in "$src"/examples/*.json; do

@@ -148,6 +148,91 @@ f = np.load(f"{sys.argv[1]}/bel.npz")["f"]
 assert f.shape == t[k].shape and np.array_equal(f, t[k]), (f.shape, t[k].shape)
 PY
 
+# 2g. A damaged study folder is refused by name, never read without bound or passed on: a grid
+#     out of range (it sized arrays: a crash), a table file that is a device (read without end),
+#     a NaN or negative standard error (copied into the .npz), a table of the wrong shape (Python).
+LAMINA="$lamina" LAMINA_PYTHONPATH="$(dirname "$lamina")/python" \
+    "$py" - "$tmp" "$src/src/python/lamina/arrays.py" <<'PY' && ok || fail "damaged study folders"
+import importlib.util, json, os, shutil, subprocess, sys, zlib
+import numpy as np
+spec = importlib.util.spec_from_file_location("arrays", sys.argv[2])
+arrays = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(arrays)
+tmp, lamina = sys.argv[1], os.environ["LAMINA"]
+cfg = "slab-a0.1-a1.3-clear"
+
+def damaged(tag, change):
+    d = f"{tmp}/damaged-{tag}"
+    shutil.rmtree(d, ignore_errors=True)
+    shutil.copytree(f"{tmp}/full", d, symlinks=True)
+    change(d)
+    return d
+
+def refused(d, text, *commands):
+    for args in commands:
+        r = subprocess.run([lamina, *args(d)], capture_output=True, text=True)
+        assert r.returncode == 1 and text in r.stderr, (args(d), r.returncode, r.stdout, r.stderr)
+
+export = lambda d: ["export", "--study", d, "--config", cfg, "--out", d + ".npz"]
+explorer = lambda d: ["explorer", d]
+
+def set_grid(d):
+    info = json.load(open(f"{d}/study.json"))
+    info["grid"]["n_theta"] = -9
+    json.dump(info, open(f"{d}/study.json", "w"))
+refused(damaged("grid", set_grid), "/grid: -9 × ", export, explorer)
+
+def device(d):
+    os.remove(f"{d}/configs/{cfg}/reference_se.lza")
+    os.symlink("/dev/zero", f"{d}/configs/{cfg}/reference_se.lza")
+refused(damaged("device", device), "not a regular file", export, explorer)
+
+def write_lza(path, a):  # the packed format of docs/formats.md, float32
+    data = open(path, "rb").read()
+    eol = data.index(b"\n", len(b"lamina-array 1\n"))
+    header = json.loads(data[len(b"lamina-array 1\n"):eol])
+    n, c = a.shape[-2:]
+    bits = np.ascontiguousarray(a.astype(np.float32)).view(np.uint32).reshape(-1, n, c)
+    bits = np.ascontiguousarray(bits.swapaxes(-1, -2))
+    diff = bits.copy()
+    diff[..., 1:] = bits[..., 1:] - bits[..., :-1]
+    flat = diff.reshape(-1)
+    planes = np.stack([((flat >> np.uint32(8 * k)) & np.uint32(0xFF)).astype(np.uint8)
+                       for k in range(4)])
+    open(path, "wb").write(b"lamina-array 1\n" + json.dumps(header).encode() + b"\n" +
+                           zlib.compress(planes.tobytes()))
+
+for value, text in ((np.nan, "is nan: allowed finite, ≥ 0"), (-1.0, "is -1: allowed finite, ≥ 0")):
+    def bad_se(d, value=value):
+        p = f"{d}/configs/{cfg}/reference_se.lza"
+        se = arrays.read_array(p).astype(np.float32)
+        se[0, 0, 3, 3, 1] = value
+        write_lza(p, se)
+        assert arrays.read_array(p)[0, 0, 3, 3, 1] == value or np.isnan(value)
+    refused(damaged("se", bad_se), text, export)
+
+package = f"{os.environ['LAMINA_PYTHONPATH']}/lamina"
+if not os.path.isdir(package) or not any(n.startswith("_lamina") for n in os.listdir(package)):
+    sys.exit(0)  # built without the Python module: the CLI's part above is the test
+sys.path.insert(0, os.environ["LAMINA_PYTHONPATH"])
+import lamina as lam
+def one_incidence_less(d):
+    c = json.load(open(f"{d}/configs/{cfg}/config.json"))
+    c["theta_i"] = c["theta_i"][:-1]
+    json.dump(c, open(f"{d}/configs/{cfg}/config.json", "w"))
+st = lam.load_study(damaged("shape", one_incidence_less), pandas=False)
+for read in (st.tables, st.reference_se):
+    try:
+        read(cfg)
+        raise AssertionError(f"{read.__name__} accepted a table of the wrong shape")
+    except lam.InputError as e:
+        assert e.field == "shape" and "does not match config.json and study.json" in e.problem
+# Every column of metrics.csv, the ranking's misplaced_floor included.
+st = lam.load_study(f"{tmp}/full", pandas=False)
+header = open(f"{tmp}/full/metrics.csv").readline().strip().split(",")
+assert list(st.metrics.dtype.names) == header, (st.metrics.dtype.names, header)
+PY
+
 # 3. Killed part-way (kill -9 as soon as the first piece is stored), then resumed: the same
 #    metrics.csv as the uninterrupted run.
 "$lamina" study "${tiny[@]}" --out "$tmp/b" >/dev/null 2>&1 &

@@ -12,6 +12,7 @@ See docs/python.md.
 from __future__ import annotations
 
 import csv
+import io
 import json
 import os
 from pathlib import Path
@@ -154,32 +155,29 @@ def export(source, path, format: Optional[str] = None, theta_i=None, resolution=
 
 # ---- study directories ------------------------------------------------------------------------
 
+_METRIC_TEXT = ("config", "category", "model", "side", "channel")
 _METRIC_FLOATS = ("theta_i", "misplaced_energy", "albedo_ref", "albedo_model", "albedo_error",
                   "rmse", "log_rmse", "noise_floor")
 
 
 def _read_metrics(path: Path) -> np.ndarray:
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
-    if not rows:
-        names = ("config", "category", "model", "side", "channel")
-        return np.zeros(0, dtype=[(n, "U1") for n in names] +
-                        [(n, "f8") for n in _METRIC_FLOATS] + [("supported", "?")])
-    width = {k: max(1, max(len(r[k]) for r in rows))
-             for k in ("config", "category", "model", "side", "channel")}
-    # A study with light off φ = 0 (an anisotropic configuration, --phi-i) has a phi_i column.
-    phi = [("phi_i", "f8")] if "phi_i" in rows[0] else []
-    dtype = [("config", f"U{width['config']}"), ("category", f"U{width['category']}"),
-             ("model", f"U{width['model']}"), ("theta_i", "f8")] + phi + [
-             ("side", f"U{width['side']}"), ("channel", f"U{width['channel']}")]
-    dtype += [(n, "f8") for n in _METRIC_FLOATS[1:]] + [("supported", "?")]
-    floats = _METRIC_FLOATS + ("phi_i",)
+    """metrics.csv as a structured array of every column it has, in its order (text columns as
+    text, `supported` as a truth value, every other one a number: empty is NaN, anything else
+    that is not a number is refused)."""
+    text = _arrays.read_bytes_bounded(path).decode("utf-8")
+    reader = csv.DictReader(io.StringIO(text, newline=""))
+    rows = list(reader)
+    header = reader.fieldnames or list(_METRIC_TEXT + _METRIC_FLOATS + ("supported",))
+    missing = [n for n in _METRIC_TEXT + _METRIC_FLOATS + ("supported",) if n not in header]
+    if missing:
+        raise KeyError(", ".join(missing))
+    width = {n: max([1] + [len(r[n]) for r in rows]) for n in _METRIC_TEXT}
+    dtype = [(n, f"U{width[n]}") if n in _METRIC_TEXT else (n, "?") if n == "supported"
+             else (n, "f8") for n in header]
     out = np.zeros(len(rows), dtype=dtype)
     for k, r in enumerate(rows):
-        out[k] = tuple(
-            (float(r[n]) if r[n] != "" else np.nan) if n in floats
-            else (r[n] == "true") if n == "supported" else r[n]
-            for n, _ in dtype)
+        out[k] = tuple(r[n] if n in _METRIC_TEXT else (r[n] == "true") if n == "supported"
+                       else (float(r[n]) if r[n] != "" else np.nan) for n in header)
     return out
 
 
@@ -196,11 +194,17 @@ def read_array(path):
         raise input_error(str(path), "", f"not a readable array ({e}): damaged?") from None
 
 
+# The largest study description or config.json read (a configuration's state and stack are
+# tens of kB; the bound only keeps a device or a runaway file from being read without end).
+_MAX_JSON_BYTES = 256 << 20
+
+
 def _read_json_object(path: Path) -> dict:
     """A JSON object read from path; a damaged or truncated file is an InputError naming it."""
     try:
-        with open(path, encoding="utf-8") as f:
-            value = json.load(f)
+        value = json.loads(_arrays.read_bytes_bounded(path, _MAX_JSON_BYTES).decode("utf-8"))
+    except _arrays.ArrayError as e:
+        raise input_error(e.where, "", e.problem) from None
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise input_error(str(path), "", f"not valid JSON ({e}): damaged or truncated?") from None
     except OSError as e:
@@ -226,15 +230,17 @@ class Study:
     def __init__(self, path, pandas=None):
         self.path = Path(path)
         info = self.path / "study.json"
-        if not info.is_file():
+        if not info.exists():
             raise input_error(str(self.path), "study.json",
                              "not a study directory: no study.json (run lamina study or compare)")
         self.info = _read_json_object(info)
         metrics = self.path / "metrics.csv"
-        if not metrics.is_file():
+        if not metrics.exists():
             raise input_error(str(metrics), "", "missing: every study directory has one")
         try:
             self.metrics = _read_metrics(metrics)
+        except _arrays.ArrayError as e:
+            raise input_error(e.where, "", e.problem) from None
         except (KeyError, ValueError, TypeError, csv.Error, UnicodeDecodeError) as e:
             raise input_error(str(metrics), "",
                               f"not lamina's metrics table ({type(e).__name__}: {e}): "
@@ -269,10 +275,29 @@ class Study:
             raise input_error(path, "sources",
                               f"{len(sources)} names for the {t.shape[0]} tables of tables.lza: "
                               "the folder mixes two runs, or is damaged")
+        self._check_shape(config_id, cfg, "tables", t.shape[1:])
         return {name: t[k] for k, name in enumerate(sources)}
 
     def reference_se(self, config_id):
-        return self._array(config_id, "reference_se")
+        se = self._array(config_id, "reference_se")
+        self._check_shape(config_id, self.config(config_id), "reference_se", se.shape)
+        return se
+
+    def _check_shape(self, config_id, cfg, stem, shape):
+        """[incidence, side, theta bin, phi bin, 3] as config.json and study.json say (an unfolded
+        configuration, one with phi_i, has twice the phi bins), as lamina's own readers check."""
+        try:
+            grid = self.info["grid"]
+            n_phi = int(grid["n_phi"]) * (2 if "phi_i" in cfg else 1)
+            want = (len(cfg["theta_i"]), len(cfg["sides"]), int(grid["n_theta"]), n_phi, 3)
+        except (KeyError, TypeError, ValueError) as e:
+            raise input_error(str(self._dir(config_id) / "config.json"), "",
+                              f"not lamina's configuration ({type(e).__name__}: {e}): "
+                              "damaged?") from None
+        if tuple(shape) != want:
+            raise input_error(str(self._dir(config_id) / f"{stem}.lza"), "shape",
+                              f"{list(shape)} does not match config.json and study.json "
+                              f"({list(want)}): the folder mixes two runs, or is damaged")
 
     def reference_stokes(self, config_id):
         path = self._dir(config_id) / "reference_stokes.lza"

@@ -6,6 +6,8 @@ runs it inside the figure script, and `lamina.read_array` is this module's read_
 """
 
 import json
+import os
+import stat
 import zlib
 
 import numpy as np
@@ -69,10 +71,28 @@ def _unpack(data, where):
     return np.ascontiguousarray(np.swapaxes(bits, -1, -2)).view(float_type).reshape(shape)
 
 
+# The largest file lamina reads as a table (as the C++ readers: core/atomic_file.h).
+MAX_FILE_BYTES = 2 << 30
+
+
+def read_bytes_bounded(path, limit=MAX_FILE_BYTES):
+    """The bytes of a regular file of at most `limit` bytes; anything else (a device, a pipe, a
+    directory, a larger file) is an ArrayError naming it, read no further than its size says."""
+    path = str(path)
+    info = os.stat(path)  # follows a symbolic link, as open does
+    if not stat.S_ISREG(info.st_mode):
+        raise ArrayError(path, "not a regular file (a device, a pipe or a folder?)")
+    if info.st_size > limit:
+        raise ArrayError(path, f"{info.st_size} bytes; allowed: at most {limit}")
+    with open(path, "rb") as f:
+        return f.read(info.st_size + 1)  # its size, as checked (read(limit) would reserve limit)
+
+
 def read_array(path):
     """Reads a packed-array file (.lza) into a numpy array; a .npy path is read by numpy.load."""
     path = str(path)
+    data = read_bytes_bounded(path)
     if path.endswith(".npy"):
-        return np.load(path)
-    with open(path, "rb") as f:
-        return unpack_array(f.read(), path)
+        import io
+        return np.load(io.BytesIO(data))
+    return unpack_array(data, path)
