@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/incidences.h"
+#include "core/setting.h"
 
 #include <fmt/format.h>
 
@@ -76,16 +77,14 @@ BinnedTable BinnedTable::from_csv(const std::string& text, const std::string& wh
         if (cells.size() != 12)
             throw InputError(where, fmt::format("line {}", line_no),
                              fmt::format("expected 12 columns, found {}", cells.size()));
+        // A decimal number as every number lamina reads (setting_detail::parse_real): no hex
+        // floats, and subnormals are numbers (std::stod refused them as out of range).
         auto num = [&](int c) {
-            try {
-                std::size_t used = 0;
-                const double v = std::stod(cells[c], &used);
-                if (used != cells[c].size() || !std::isfinite(v)) throw std::invalid_argument("");
-                return v;
-            } catch (const std::exception&) {
+            double v = 0;
+            if (!setting_detail::parse_real(cells[c], v))
                 throw InputError(where, fmt::format("line {}, column {}", line_no, c + 1),
-                                 fmt::format("'{}' is not a finite number", cells[c]));
-            }
+                                 fmt::format("'{}' is not a finite decimal number", cells[c]));
+            return v;
         };
         if (cells[1] != "R" && cells[1] != "T")
             throw InputError(where, fmt::format("line {}, column 2", line_no),

@@ -1,5 +1,6 @@
 // Bin averages of the models on the goniophotometer's grid.
 #include "models/numerics/binned.h"
+#include "core/error.h"
 #include "core/math.h"
 #include "core/spherical.h"
 #include "models/registry.h"
@@ -418,6 +419,32 @@ TEST(Binned, WritesTheBrdfCsvFormat) {
     EXPECT_TRUE(back.has_transmission);
     EXPECT_EQ(back.theta_i_deg, t.theta_i_deg);
     EXPECT_EQ(back.grid, t.grid);
+}
+
+// A value is a decimal number: a subnormal one (a model that returns 1e-320) reads back as itself,
+// a hexadecimal one is refused by line and column (std::stod took 0x10 as 16 and refused 1e-320).
+TEST(Binned, ReadsSubnormalValuesAndRefusesHexadecimal) {
+    const auto model = make_model("bel-prime", coated(1.5, 0.2, test::dielectric(1.3, 0.3)));
+    const std::string csv = bin_model(*model, HemisphereGrid(3, 3), {0}).to_csv();
+    // The first data row's f_r (column 7) replaced.
+    const auto with_f = [&](const std::string& value) {
+        const std::size_t row = csv.find('\n') + 1;
+        std::size_t at = row;
+        for (int comma = 0; comma < 6; ++comma)
+            at = csv.find(',', at) + 1;
+        return csv.substr(0, at) + value + csv.substr(csv.find(',', at));
+    };
+    const BinnedTable tiny = BinnedTable::from_csv(with_f("1e-320"), "test");
+    EXPECT_EQ(tiny.lobe(0, Side::Reflection).f[0][0], 1e-320);
+    try {
+        BinnedTable::from_csv(with_f("0x10"), "test");
+        ADD_FAILURE() << "0x10 accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.field(), "line 2, column 7");
+        EXPECT_NE(std::string(e.what()).find("'0x10' is not a finite decimal number"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 // On a grid whose edges are whole degrees (30 × 30: 3° in θ, 6° in φ; unfolded 6° up to 360°)
