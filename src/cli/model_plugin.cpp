@@ -14,6 +14,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <string_view>
 #include <vector>
 
 extern char** environ;
@@ -47,6 +49,9 @@ int run_process(const std::vector<std::string>& argv, const std::string& python_
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+// What lamina.plugin_table writes in place of a table when the model supports neither side.
+constexpr std::string_view kPluginUnsupported = "unsupported\n";
+
 // The plugin's table of `c` lit from phi_i at the incidences theta_i (python3 -m
 // lamina.plugin_table), or a table with neither side when the model supports neither.
 BinnedTable plugin_table(const std::string& file, const std::string& python,
@@ -71,18 +76,33 @@ BinnedTable plugin_table(const std::string& file, const std::string& python,
          fmt::format("{}", phi_i), "--grid", grid.to_string(), "--out",
          (dir / "table.csv").string()},
         LAMINA_PYTHON_DIR);
-    if (rc == 3) {  // the model supports neither side of this stack
-        BinnedTable none;
-        none.has_reflection = false;
-        return none;
-    }
     if (rc != 0)
         throw InputError(file, "--model-plugin",
                          fmt::format("the Python model failed on {} (exit status {}; its "
                                      "message is above; interpreter: {})",
                                      c.id, rc, python));
-    return BinnedTable::from_csv(
-        read_file_bounded(dir / "table.csv", kMaxTableFileBytes, "the Python model's table"), file);
+    // The table, or the line saying the model supports neither side of this stack (written to the
+    // same file, so that no exit status of the plugin's own can be read as it).
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(dir / "table.csv", ec))
+        throw InputError(file, "--model-plugin",
+                         fmt::format("the Python model's process ended on {} without writing its "
+                                     "table (did the model call sys.exit or os._exit?)",
+                                     c.id));
+    const std::string text =
+        read_file_bounded(dir / "table.csv", kMaxTableFileBytes, "the Python model's table");
+    if (text == kPluginUnsupported) {
+        BinnedTable none;
+        none.has_reflection = false;
+        return none;
+    }
+    try {
+        return BinnedTable::from_csv(text, "the table of " + file);
+    } catch (const InputError& e) {
+        throw InputError(file, "--model-plugin",
+                         fmt::format("its binned table on {} is not readable ({}: {})", c.id,
+                                     e.field(), e.problem()));
+    }
 }
 
 }  // namespace

@@ -252,6 +252,66 @@ def test_truth_values_and_bad_node_counts_are_refused(tmp_path):
     assert e.value.field == "theta_i/0"
 
 
+def test_a_python_model_returning_garbage_is_named():
+    # What a model returns besides eval is checked: a NaN or missing direction, a lobe without an
+    # RGB energy, a support answer that is neither a pair nor a dict (a traceback from lamina's
+    # own code before).
+    class Peaks(Lambert):
+        def __init__(self, stack, peaks=None):
+            super().__init__(stack)
+            self.peaks = peaks
+
+        def peak_directions(self, wi):
+            return self.peaks
+
+    class Lobes(Lambert):
+        lobes = None
+
+        def delta_lobes(self, wi):
+            return self.lobes
+
+    class Supports(Lambert):
+        answer = None
+
+        def supports(self, stack):
+            return self.answer
+
+    cases = [(Peaks(None, None), "peak_directions", "expected a list"),
+             (Peaks(None, [[np.nan, 0, 1]]), "peak_directions", "three finite numbers"),
+             (Peaks(None, [[0, 1]]), "peak_directions", "three finite numbers")]
+    for lobes in (None, [([0, 0, 1], [1, 2])], [([0, 0, 1], "x")], [(1, 2, 3)]):
+        m = Lobes(None)
+        m.lobes = lobes
+        cases.append((m, "delta_lobes", ""))
+    for answer in (None, "yes", (True,)):
+        m = Supports(None)
+        m.answer = answer
+        cases.append((m, "supports", "expected (brdf, btdf)"))
+    for model, field, text in cases:
+        with pytest.raises(lamina.InputError) as e:
+            lamina.bin_model(model, PLASTIC, [30], grid=(3, 3))
+        assert e.value.file == f"Python model '{lamina.model_name(model)}'", e.value
+        assert e.value.field == field and text in e.value.problem, e.value
+
+
+def test_a_plugin_that_exits_is_a_failure_not_an_unsupported_model(tmp_path):
+    # The binned table or "unsupported" is written to the output file, so no exit status of the
+    # plugin's own (sys.exit(3) once read as "supports neither side") passes for an answer.
+    from lamina import plugin_table
+    stack = tmp_path / "stack.json"
+    stack.write_text(PLASTIC.read_text())
+    args = ["--stack", str(stack), "--theta-i", "30", "--grid", "3x3"]
+    exits = tmp_path / "exits.py"
+    exits.write_text("import sys\nsys.exit(3)\n")
+    assert plugin_table.main([str(exits), *args, "--out", str(tmp_path / "a.csv")]) == 1
+    assert not (tmp_path / "a.csv").exists()
+    none = tmp_path / "none.py"
+    none.write_text("class M:\n    def supports(self, s): return (False, False)\n"
+                    "    def eval(self, wi, wo): return wo * 0\nMODEL = M()\n")
+    assert plugin_table.main([str(none), *args, "--out", str(tmp_path / "b.csv")]) == 0
+    assert (tmp_path / "b.csv").read_text() == "unsupported\n"
+
+
 class WrappedWB20:
     """lamina's wb20 (anisotropic) called from Python."""
     name = "py-wb20"

@@ -7,8 +7,9 @@ FILE.py defines MODEL: a class (called with the lamina.Stack) or an object with 
 eval(wi, wo), as lamina.plugins describes. --phi-i: the light's azimuth per incidence (degrees,
 default 0); the grid is unfolded for an anisotropic stack or an azimuth off 0 (--grid may say
 "90x90 unfolded", as the study names such a grid). Writes the model's binned table (the brdf.csv format)
-to --out; exit status 0 when written, 3 when the model supports neither side of the stack, 1 on
-an error (printed as `lamina: FILE: FIELD: PROBLEM`).
+to --out, or the line "unsupported" when the model supports neither side of the stack; exit
+status 0 when written, 1 on an error (printed as `lamina: FILE: FIELD: PROBLEM`), including a
+model that calls sys.exit (lamina reads an exit without the file as a failure too: os._exit).
 """
 
 import argparse
@@ -54,9 +55,11 @@ def main(argv=None):
     except InputError as e:
         print(f"lamina: {e}", file=sys.stderr)
         return 1
-    if table is None:
-        return 3
-    Path(a.out).write_text(table.to_csv())
+    except SystemExit as e:
+        print(f"lamina: {a.plugin}: the Python model called sys.exit({e.code!r})",
+              file=sys.stderr)
+        return 1
+    Path(a.out).write_text("unsupported\n" if table is None else table.to_csv())
     return 0
 
 

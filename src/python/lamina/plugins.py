@@ -71,7 +71,7 @@ def instantiate(obj, stack):
     return obj(stack)
 
 
-def support(model, stack):
+def support(model, stack, name=None):
     fn = getattr(model, "supports", None)
     if fn is None:
         return {"brdf": True, "btdf": False, "reason": ""}
@@ -79,8 +79,31 @@ def support(model, stack):
     if isinstance(s, dict):
         return {"brdf": bool(s.get("brdf", False)), "btdf": bool(s.get("btdf", False)),
                 "reason": str(s.get("reason", ""))}
+    if not isinstance(s, (tuple, list)) or len(s) != 2:
+        raise input_error(f"Python model '{name or model_name(model)}'", "supports",
+                          f"returned {s!r}: expected (brdf, btdf) or "
+                          '{"brdf": ..., "btdf": ..., "reason": ...}')
     brdf, btdf = s
     return {"brdf": bool(brdf), "btdf": bool(btdf), "reason": ""}
+
+
+def _directions(name, what, value):
+    """A model's directions (peak_directions, delta_lobes): finite non-zero 3-vectors."""
+    try:
+        d = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        d = None
+    if d is None or d.shape != (3,) or not np.all(np.isfinite(d)) or not np.any(d):
+        raise input_error(f"Python model '{name}'", what,
+                          f"returned the direction {value!r}: expected three finite numbers")
+    return d
+
+
+def _listed(name, what, value):
+    """A model's list (of directions, of lobes): any iterable that is not text."""
+    if value is None or isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        raise input_error(f"Python model '{name}'", what, f"returned {value!r}: expected a list")
+    return list(value)
 
 
 def _gauss(n):
@@ -130,7 +153,7 @@ def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32, phi_i=0.0)
     stack = _lamina.Stack(stack)
     model = instantiate(obj, stack)
     name = model_name(obj)
-    sup = support(model, stack)
+    sup = support(model, stack, name)
     sides = (["R"] if sup["brdf"] else []) + (["T"] if sup["btdf"] and stack.transmits else [])
     if not sides:
         return None
@@ -175,7 +198,8 @@ def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32, phi_i=0.0)
         a, b = np.radians(ti), np.radians(pi)
         wi = np.array([np.sin(a) * np.cos(b), np.sin(a) * np.sin(b), np.cos(a)])
         peaks_fn = getattr(model, "peak_directions", None)
-        peaks = [np.asarray(p, dtype=np.float64) for p in peaks_fn(wi)] if peaks_fn else \
+        peaks = [_directions(name, "peak_directions", p) for p in _listed(
+            name, "peak_directions", peaks_fn(wi))] if peaks_fn else \
             [np.array([-wi[0], -wi[1], wi[2]])]
         for k, side in enumerate(sides):
             lower = side == "T"
@@ -186,10 +210,22 @@ def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32, phi_i=0.0)
                 f[i, k, fine] = _average(model, name, wi, t0[fine], t1[fine], p0[fine],
                                          p1[fine], peak_nodes, lower)
         lobes = getattr(model, "delta_lobes", None)
-        for direction, energy in (lobes(wi) if lobes else []):
+        for lobe in (_listed(name, "delta_lobes", lobes(wi)) if lobes else []):
+            if not isinstance(lobe, (tuple, list)) or len(lobe) != 2:
+                raise input_error(f"Python model '{name}'", "delta_lobes",
+                                  f"returned {lobe!r}: expected (direction, energy) pairs")
+            direction = _directions(name, "delta_lobes", lobe[0])
+            try:
+                energy = np.broadcast_to(np.asarray(lobe[1], dtype=np.float64), (3,))
+            except (TypeError, ValueError):
+                energy = np.array([np.nan])
+            if energy.shape != (3,) or not np.all(np.isfinite(energy)):
+                raise input_error(f"Python model '{name}'", "delta_lobes",
+                                  f"returned the energy {lobe[1]!r}: expected a finite number "
+                                  "or three (RGB)")
             side = "T" if direction[2] < 0 else "R"
             if side in sides:
                 j = bin_of(direction)
-                f[i, sides.index(side), j] += np.asarray(energy, dtype=np.float64) / omega[j]
+                f[i, sides.index(side), j] += energy / omega[j]
     f = f.reshape(len(theta_i), len(sides), n_theta, n_phi, 3)
     return _lamina._table_from_arrays(f, theta_i, sides, unfolded)
