@@ -8,6 +8,7 @@
 #include "core/hash.h"
 #include "core/packed_array.h"
 #include "core/progress.h"
+#include "core/table.h"
 #include "lamina/version.h"
 #include "models/lamina1/lamina1.h"
 #include "models/numerics/binned.h"
@@ -27,6 +28,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 
 namespace lamina {
 
@@ -97,10 +99,12 @@ std::filesystem::path state_path(const std::filesystem::path& out_dir, const std
 }
 
 nlohmann::json read_state(const std::filesystem::path& path) {
-    std::ifstream in(path);
-    if (!in) return nullptr;
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) return nullptr;
     try {
-        nlohmann::json j = nlohmann::json::parse(in);
+        // Bounded: a state is tens of kB, and a device in its place must not be read on.
+        nlohmann::json j = nlohmann::json::parse(
+            read_file_bounded(path, std::size_t(256) << 20, "the study's state"));
         return j.is_object() ? j : nlohmann::json();
     } catch (const std::exception&) {
         return nullptr;  // a damaged state is recomputed, never trusted
@@ -151,6 +155,16 @@ MetricRow row_from_json(const nlohmann::json& j, const StudyConfiguration& c,
     r.floor.misplaced_energy = num_of(j.at(11));
     r.floor.misplaced_floor = num_of(j.at(12));
     if (j.size() > 13) r.phi_i = j.at(13).get<double>();
+    // A state is the study's own file, but read back it is input: a row out of range (an edited
+    // or damaged file) is not trusted, and the caller recomputes the configuration's rows.
+    bool sane = r.theta_i >= 0 && r.theta_i < 90 && (r.side == 'R' || r.side == 'T') &&
+                r.channel >= 0 && r.channel < 3 && r.phi_i >= 0 && r.phi_i <= 360;
+    for (const double v :
+         {r.metrics.misplaced_energy, r.metrics.misplaced_floor, r.metrics.albedo_ref,
+          r.metrics.albedo_model, r.metrics.albedo_error, r.metrics.rmse, r.metrics.log_rmse,
+          r.floor.misplaced_energy, r.floor.misplaced_floor})
+        sane = sane && (std::isnan(v) || std::abs(v) <= kMaxBinValue);  // NaN: null, not computed
+    if (!sane) throw std::runtime_error("a state row out of range");
     return r;
 }
 
@@ -261,9 +275,14 @@ class ConfigurationRun {
             !outputs_there)
             return false;
         try {
-            for (const std::string& name : model_names_)
-                for (const nlohmann::json& r : state_.at("models").at(name).at("rows"))
+            for (const std::string& name : model_names_) {
+                // Every incidence, side and channel (1 or 2 sides): a shorter list is damage.
+                const nlohmann::json& rows = state_.at("models").at(name).at("rows");
+                if (rows.size() != incidences_.size() * 3 && rows.size() != incidences_.size() * 6)
+                    throw std::runtime_error("a state with missing rows");
+                for (const nlohmann::json& r : rows)
                     result_.rows.push_back(row_from_json(r, config_, name));
+            }
             for (const nlohmann::json& v : state_.at("lost_microsurface"))
                 result_.lost_microsurface.push_back(
                     Rgbd(v.at(0).get<double>(), v.at(1).get<double>(), v.at(2).get<double>()));
@@ -333,6 +352,8 @@ class ConfigurationRun {
                 const nlohmann::json& ms = state_["models"][name];
                 const float* old = old_table_of(name);
                 if (s_.tables == TablesFormat::None || old) {
+                    if (ms.at("rows").size() != n_inc_ * std::size_t(n_sides_) * 3)
+                        throw std::runtime_error("a state with missing rows");
                     for (const nlohmann::json& r : ms.at("rows"))
                         m.rows.push_back(row_from_json(r, config_, name));
                     m.support.brdf = ms.at("support").at("R").get<bool>();
