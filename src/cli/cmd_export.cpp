@@ -5,6 +5,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/incidences.h"
+#include "core/json_text.h"
 #include "core/npy.h"
 #include "core/packed_array.h"
 #include "export/brdf_source.h"
@@ -58,7 +59,8 @@ nlohmann::json read_json(const std::filesystem::path& path) {
     try {
         return nlohmann::json::parse(read_text(path));
     } catch (const nlohmann::json::exception& e) {
-        throw InputError(path.string(), "", fmt::format("not valid JSON: {}", e.what()));
+        throw InputError(path.string(), "",
+                         fmt::format("not valid JSON: {}", json_exception_text(e)));
     }
 }
 
@@ -178,7 +180,9 @@ StudySource study_table(const ExportArgs& a) {
                                                       a.source));
         return out;
     } catch (const nlohmann::json::exception& e) {
-        throw InputError(out.config_path, "", fmt::format("unexpected: {}", e.what()));
+        throw InputError(
+            out.config_path, "",
+            fmt::format("not lamina's configuration: {} (damaged?)", json_exception_text(e)));
     }
 }
 

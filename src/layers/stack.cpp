@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/check.h"
 #include "core/error.h"
+#include "core/json_text.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -678,12 +679,9 @@ class Reader {
 
 // ---- Parsing the text: duplicate keys and number overflow -----------------------------------
 
-/// Drops nlohmann's "[json.exception.parse_error.101] " prefix.
+/// nlohmann's message without its "[json.exception.parse_error.101] " prefix.
 std::string parser_message(const json::exception& e) {
-    std::string_view text = e.what();
-    if (const auto end = text.find("] "); text.starts_with("[json.exception.") && end != text.npos)
-        text.remove_prefix(end + 2);
-    return std::string(text);
+    return json_exception_text(e);
 }
 
 /// Follows the document event by event (nlohmann's SAX interface) to know the JSON pointer of

@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "core/grid.h"
 #include "core/hash.h"
+#include "core/json_text.h"
 #include "core/packed_array.h"
 #include "core/stokes.h"
 #include "lamina/version.h"
@@ -48,7 +49,8 @@ json read_json(const fs::path& path, const char* what) {
     try {
         return json::parse(text);
     } catch (const json::exception& e) {
-        throw InputError(path.string(), "", fmt::format("malformed JSON: {}", e.what()));
+        throw InputError(path.string(), "",
+                         fmt::format("malformed JSON: {}", json_exception_text(e)));
     }
 }
 
@@ -65,7 +67,8 @@ T field(const json& j, const std::string& key, const fs::path& file) {
     try {
         return j.at(key).get<T>();
     } catch (const json::exception& e) {
-        throw InputError(file.string(), "/" + key, fmt::format("wrong type: {}", e.what()));
+        throw InputError(file.string(), "/" + key,
+                         fmt::format("wrong type: {}", json_exception_text(e)));
     }
 }
 
@@ -677,7 +680,25 @@ std::string inputs_digest(const fs::path& dir, const json& entry,
 
 }  // namespace
 
+namespace {
+ExplorerSummary write_explorer_unchecked(const fs::path& study_dir);
+}  // namespace
+
 ExplorerSummary write_explorer(const fs::path& study_dir) {
+    // The study's files are read field by field with their names where a value is checked; a
+    // value of the wrong type anywhere else is still the folder's damage, not lamina's error.
+    try {
+        return write_explorer_unchecked(study_dir);
+    } catch (const json::exception& e) {
+        throw InputError(study_dir.string(), "",
+                         fmt::format("a file of this study folder holds a value of the wrong "
+                                     "type ({}): damaged, or written by another program?",
+                                     json_exception_text(e)));
+    }
+}
+
+namespace {
+ExplorerSummary write_explorer_unchecked(const fs::path& study_dir) {
     const fs::path study_path = study_dir / "study.json";
     if (!fs::exists(study_path))
         throw InputError(study_path.string(), "",
@@ -798,5 +819,6 @@ ExplorerSummary write_explorer(const fs::path& study_dir) {
     root_out.commit();
     return summary;
 }
+}  // namespace
 
 }  // namespace lamina

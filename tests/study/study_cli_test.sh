@@ -214,6 +214,18 @@ for value, text in ((np.nan, "is nan: allowed finite, ≥ 0"), (-1.0, "is -1: al
 package = f"{os.environ['LAMINA_PYTHONPATH']}/lamina"
 if not os.path.isdir(package) or not any(n.startswith("_lamina") for n in os.listdir(package)):
     sys.exit(0)  # built without the Python module: the CLI's part above is the test
+def null_category(d):
+    info = json.load(open(f"{d}/study.json"))
+    info["configurations"][0]["category"] = None
+    json.dump(info, open(f"{d}/study.json", "w"))
+refused(damaged("category", null_category), "holds a value of the wrong type", explorer)
+
+def no_sources(d):
+    c = json.load(open(f"{d}/configs/{cfg}/config.json"))
+    del c["sources"]
+    json.dump(c, open(f"{d}/configs/{cfg}/config.json", "w"))
+refused(damaged("sources", no_sources), "not lamina's configuration: key 'sources'", export)
+
 sys.path.insert(0, os.environ["LAMINA_PYTHONPATH"])
 import lamina as lam
 def one_incidence_less(d):
