@@ -28,6 +28,7 @@ import hashlib
 import json
 import math
 import os
+import signal
 import sys
 import time
 
@@ -700,7 +701,11 @@ def main():
     todo.sort(key=lambda t: {"albedo": 0, "matrix": 1, "slice": 2, "colour": 2}[t[1]])
     if a.jobs > 1 and len(todo) > 1:
         import multiprocessing
-        with multiprocessing.get_context("fork").Pool(min(a.jobs, len(todo))) as pool:
+        # Ctrl-C ends the workers silently (the signal's default action, not Python's
+        # KeyboardInterrupt with a traceback in each); this process says it in one line.
+        with multiprocessing.get_context("fork").Pool(
+                min(a.jobs, len(todo)),
+                initializer=signal.signal, initargs=(signal.SIGINT, signal.SIG_DFL)) as pool:
             done = list(pool.imap_unordered(draw, todo))
     else:
         done = [draw(t) for t in todo]
@@ -722,6 +727,8 @@ def main():
 if __name__ == "__main__":
     try:
         main()
+    except KeyboardInterrupt:
+        sys.exit("figures.py: interrupted")
     except Exception as e:
         # One line, as lamina's own errors: the study folder is damaged or not one lamina wrote
         # (a truncated table, a hand-edited study.json, ...) — or, where it is intact, a bug
