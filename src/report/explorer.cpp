@@ -6,6 +6,7 @@
 #include "core/hash.h"
 #include "core/json_text.h"
 #include "core/packed_array.h"
+#include "core/setting.h"
 #include "core/stokes.h"
 #include "lamina/version.h"
 #include "report/assets.h"
@@ -133,8 +134,16 @@ json read_metrics(const fs::path& path, const std::vector<double>& theta_i,
         if (v.size() != header.size())
             throw InputError(path.string(), fmt::format("row {}", row),
                              fmt::format("{} fields, the header has {}", v.size(), header.size()));
-        const double t = std::atof(v[c_theta].c_str());
-        const double phi = has_phi ? std::atof(v[c_phi].c_str()) : 0.0;
+        // A decimal number, as metrics.csv holds (its writer leaves a value not computed empty).
+        const auto number = [&](std::size_t col) {
+            double x = 0;
+            if (!setting_detail::parse_real(v[col], x))
+                throw InputError(path.string(), fmt::format("row {}, {}", row, header[col]),
+                                 fmt::format("'{}' is not a finite number", v[col]));
+            return x;
+        };
+        const double t = number(c_theta);
+        const double phi = has_phi ? number(c_phi) : 0.0;
         std::size_t i = 0, n = theta_i.size();
         if (const auto u = unfolded.find(v[c_config]); u != unfolded.end()) {
             n = u->second.size();
@@ -153,10 +162,7 @@ json read_metrics(const fs::path& path, const std::vector<double>& theta_i,
             json& arr = cell[key];
             while (arr.size() < n)
                 arr.push_back(json{nullptr, nullptr, nullptr});
-            if (v[c_supported] == "true" && !v[col].empty()) {
-                const double x = std::atof(v[col].c_str());
-                if (std::isfinite(x)) arr[i][ch] = x;
-            }
+            if (v[c_supported] == "true" && !v[col].empty()) arr[i][ch] = number(col);
         }
     }
     return out;

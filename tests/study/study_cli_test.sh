@@ -226,6 +226,16 @@ def no_sources(d):
     json.dump(c, open(f"{d}/configs/{cfg}/config.json", "w"))
 refused(damaged("sources", no_sources), "not lamina's configuration: key 'sources'", export)
 
+def metric_not_a_number(d):
+    lines = open(f"{d}/metrics.csv").read().splitlines()
+    header = lines[0].split(",")
+    cells = lines[1].split(",")
+    cells[header.index("misplaced_floor")] = "x"
+    lines[1] = ",".join(cells)
+    open(f"{d}/metrics.csv", "w").write("\n".join(lines) + "\n")
+refused(damaged("metric", metric_not_a_number), "row 2, misplaced_floor: 'x' is not a finite",
+        explorer)
+
 sys.path.insert(0, os.environ["LAMINA_PYTHONPATH"])
 import lamina as lam
 def one_incidence_less(d):
