@@ -8,6 +8,7 @@ src=$(realpath "$2")
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp" || exit 1
+. "$src/tests/docs/quoted_lib.sh"
 
 stack=$src/examples/plastic.json
 commands=(
@@ -36,12 +37,4 @@ for command in "${commands[@]}"; do
     head -n 1 out.txt >>printed.txt
 done
 
-if [ "$(wc -l <quoted.txt)" -ne "${#commands[@]}" ]; then
-    echo "FAIL: docs/robustness.md quotes $(wc -l <quoted.txt) messages, the test has ${#commands[@]} commands"
-    exit 1
-fi
-if ! diff -u quoted.txt printed.txt; then
-    echo "FAIL: the messages docs/robustness.md quotes differ from what lamina prints (above)"
-    exit 1
-fi
-echo "${#commands[@]} quoted messages match"
+same_as_quoted docs/robustness.md "${#commands[@]}"

@@ -9,6 +9,7 @@ src=$(realpath "$2")
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp" || exit 1
+. "$src/tests/docs/quoted_lib.sh"
 
 layer='{"interface":{"type":"dielectric","eta":1.5,"alpha":0}}'
 base='{"interface":{"type":"lambertian","albedo":0.5}}'
@@ -64,12 +65,4 @@ for input in "${inputs[@]}"; do
     head -n 1 out.txt >>printed.txt
 done
 
-if [ "$(wc -l <quoted.txt)" -ne "${#inputs[@]}" ]; then
-    echo "FAIL: docs/stack-format.md quotes $(wc -l <quoted.txt) messages, the test has ${#inputs[@]} inputs"
-    exit 1
-fi
-if ! diff -u quoted.txt printed.txt; then
-    echo "FAIL: the messages docs/stack-format.md quotes differ from what lamina prints (above)"
-    exit 1
-fi
-echo "${#inputs[@]} quoted messages match"
+same_as_quoted docs/stack-format.md "${#inputs[@]}"
