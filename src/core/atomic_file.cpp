@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <system_error>
@@ -79,6 +80,26 @@ extern "C" void remove_staging_and_reraise(int signal_number) {
     }
     ::signal(signal_number, SIG_DFL);
     ::raise(signal_number);
+}
+
+// The staging folders a killed run left in `dir` (SIGKILL: no handler runs): ".staging-PID.N"
+// whose process no longer exists on this machine. A live run's folder, another process's of this
+// machine, is never touched; a reused PID only keeps a dead folder a while longer.
+void remove_dead_staging(const fs::path& dir) {
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (!name.starts_with(".staging-")) continue;
+        long pid = 0;
+        const char* first = name.data() + 9;
+        const auto [ptr, parse] = std::from_chars(first, name.data() + name.size(), pid);
+        if (parse != std::errc() || ptr == first || *ptr != '.' || pid <= 0 || pid == ::getpid())
+            continue;
+        if (::kill(pid_t(pid), 0) != 0 && errno == ESRCH) {
+            std::error_code ignored;
+            fs::remove_all(it->path(), ignored);
+        }
+    }
 }
 
 std::string unique_suffix() {
@@ -212,6 +233,7 @@ StagedOutput::StagedOutput(fs::path dir, std::string field) : dir_(std::move(dir
         throw InputError(dir_.string(), field, "cannot create the output folder: " + ec.message());
     if (::access(dir_.c_str(), W_OK) != 0)
         throw InputError(dir_.string(), field, "the output folder is not writable");
+    remove_dead_staging(dir_);
     staging_ = dir_ / fmt::format(".staging-{}", unique_suffix());
     fs::create_directory(staging_, ec);
     if (ec)

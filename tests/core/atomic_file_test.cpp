@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
 #include <unistd.h>
 #include <filesystem>
 #include <stdexcept>
@@ -32,6 +33,32 @@ TEST(StagedOutput, FailureLeavesNoFolderItMade) {
     }
     EXPECT_FALSE(fs::exists(dir));
     fs::remove_all(dir.parent_path());
+}
+
+// A run killed outright (SIGKILL: no handler) leaves its staging folder; the next run into the
+// folder removes it, and never the staging folder of a process that is alive.
+TEST(StagedOutput, RemovesTheStagingOfADeadProcessOnly) {
+    const fs::path dir = fresh_dir("dead");
+    fs::create_directories(dir);
+    const pid_t child = ::fork();
+    if (child == 0) ::_exit(0);
+    ASSERT_GT(child, 0);
+    ASSERT_EQ(::waitpid(child, nullptr, 0), child);  // reaped: its PID is no process now
+    const fs::path dead = dir / (".staging-" + std::to_string(child) + ".0");
+    const fs::path alive = dir / (".staging-" + std::to_string(::getppid()) + ".0");
+    const fs::path other = dir / ".staging-notapid";
+    for (const fs::path& p : {dead, alive, other})
+        fs::create_directories(p / "inside");
+    {
+        StagedOutput out(dir);
+        out.add("result.json", "{}");
+        out.commit();
+    }
+    EXPECT_FALSE(fs::exists(dead));
+    EXPECT_TRUE(fs::exists(alive / "inside"));
+    EXPECT_TRUE(fs::exists(other / "inside"));
+    EXPECT_TRUE(fs::exists(dir / "result.json"));
+    fs::remove_all(dir);
 }
 
 // A folder that was there before keeps its files, and the failed run's staged files never reach
