@@ -26,7 +26,9 @@ namespace lamina::cli {
 namespace {
 
 // Runs argv (searched on PATH) with PYTHONPATH prepended by `python_path`; returns the exit status.
-int run_process(const std::vector<std::string>& argv, const std::string& python_path) {
+// Until it has ended, an interrupt of lamina ends it too and removes `temp_dir`'s `temp_files`.
+int run_process(const std::vector<std::string>& argv, const std::string& python_path,
+                const std::filesystem::path& temp_dir, const std::vector<std::string>& temp_files) {
     std::vector<std::string> env_strings;
     for (char** e = environ; *e; ++e)
         if (std::string(*e).rfind("PYTHONPATH=", 0) != 0) env_strings.emplace_back(*e);
@@ -44,8 +46,11 @@ int run_process(const std::vector<std::string>& argv, const std::string& python_
     env.push_back(nullptr);
     pid_t pid = 0;
     if (posix_spawnp(&pid, args[0], nullptr, nullptr, args.data(), env.data()) != 0) return -1;
+    const int slot = register_interrupt_child(int(pid), temp_dir, temp_files);
     int status = 0;
-    if (waitpid(pid, &status, 0) < 0) return -1;
+    const pid_t waited = waitpid(pid, &status, 0);
+    unregister_interrupt_child(slot);
+    if (waited < 0) return -1;
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
@@ -75,7 +80,7 @@ BinnedTable plugin_table(const std::string& file, const std::string& python,
          "--theta-i", fmt::format("{}", fmt::join(theta_i, ",")), "--phi-i",
          fmt::format("{}", phi_i), "--grid", grid.to_string(), "--out",
          (dir / "table.csv").string()},
-        LAMINA_PYTHON_DIR);
+        LAMINA_PYTHON_DIR, dir, {"stack.json", "table.csv"});
     if (rc != 0)
         throw InputError(file, "--model-plugin",
                          fmt::format("the Python model failed on {} (exit status {}; its "

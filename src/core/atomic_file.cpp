@@ -53,11 +53,33 @@ int register_staging(const fs::path& staging, const fs::path& created, int creat
     return -1;  // more than kSlots at once: not cleaned on an interrupt
 }
 
+// The child processes of a run (a Python model binning its table) and their temporary folders,
+// for the interrupt handler: each is sent SIGTERM, and its folder's files and the folder removed
+// (kill, unlink and rmdir: async-signal-safe). Published as the staging slots are.
+constexpr int kChildSlots = 16;
+constexpr int kChildFiles = 3;
+struct ChildSlot {
+    std::atomic<bool> used{false};
+    std::atomic<bool> ready{false};
+    pid_t pid = 0;
+    char dir[kPathBytes];
+    char files[kChildFiles][kPathBytes];
+    int n_files = 0;
+};
+ChildSlot g_children[kChildSlots];
+
 // An interrupt (SIGINT, SIGTERM, SIGHUP) while outputs are staged: the staging folders are
 // removed, and the folders the run created, deepest first, where empty (rmdir only:
 // async-signal-safe; a staging folder is empty while the run computes, its files are written at
 // the end); then the signal's default action.
 extern "C" void remove_staging_and_reraise(int signal_number) {
+    for (ChildSlot& child : g_children) {
+        if (!child.ready.load()) continue;
+        ::kill(child.pid, SIGTERM);
+        for (int f = 0; f < child.n_files; ++f)
+            ::unlink(child.files[f]);
+        ::rmdir(child.dir);
+    }
     for (Slot& slot : g_slots) {
         if (!slot.ready.load()) continue;
         ::rmdir(slot.staging);
@@ -298,6 +320,36 @@ void StagedOutput::commit() {
                              "cannot remove this file of an earlier run: " + ec.message());
     }
     committed_ = true;
+}
+
+int register_interrupt_child(int pid, const fs::path& dir, const std::vector<std::string>& files) {
+    const std::string d = dir.string();
+    if (d.size() >= kPathBytes || files.size() > std::size_t(kChildFiles)) return -1;
+    for (const std::string& f : files)
+        if ((dir / f).string().size() >= kPathBytes) return -1;
+    for (int i = 0; i < kChildSlots; ++i) {
+        bool expected = false;
+        if (g_children[i].used.load() ||
+            !g_children[i].used.compare_exchange_strong(expected, true))
+            continue;
+        ChildSlot& slot = g_children[i];
+        slot.pid = pid_t(pid);
+        std::memcpy(slot.dir, d.c_str(), d.size() + 1);
+        slot.n_files = int(files.size());
+        for (std::size_t f = 0; f < files.size(); ++f) {
+            const std::string path = (dir / files[f]).string();
+            std::memcpy(slot.files[f], path.c_str(), path.size() + 1);
+        }
+        slot.ready.store(true);
+        return i;
+    }
+    return -1;  // more than kChildSlots at once: not ended on an interrupt
+}
+
+void unregister_interrupt_child(int slot) {
+    if (slot < 0 || slot >= kChildSlots) return;
+    g_children[slot].ready.store(false);
+    g_children[slot].used.store(false);
 }
 
 void remove_staging_on_interrupt() {

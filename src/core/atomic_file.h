@@ -77,4 +77,12 @@ class StagedOutput {
 /// Python handles Ctrl-C itself, between chunks of particles).
 void remove_staging_on_interrupt();
 
+/// A child process of the run (a Python model binning its table) for the same handler: on an
+/// interrupt it is sent SIGTERM, and its temporary folder `dir`, holding at most the named files,
+/// is removed. Returns a slot for unregister_interrupt_child, called once the child has ended
+/// (−1 when no slot is free: then it is not ended on an interrupt).
+int register_interrupt_child(int pid, const std::filesystem::path& dir,
+                             const std::vector<std::string>& files);
+void unregister_interrupt_child(int slot);
+
 }  // namespace lamina

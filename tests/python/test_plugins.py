@@ -113,6 +113,57 @@ def test_cli_model_plugin(tmp_path):
     assert np.allclose(s.tables("plastic")["lam"], 0.3 / np.pi, rtol=1e-6)
 
 
+def _processes_running(text):
+    """PIDs of the processes whose command line holds `text` (from /proc)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                if text in (entry / "cmdline").read_bytes().decode(errors="replace"):
+                    found.append(int(entry.name))
+            except OSError:
+                pass
+    return found
+
+
+def test_an_interrupted_study_ends_its_python_model_and_removes_its_folder(tmp_path):
+    # SIGTERM to lamina while a Python model bins its table: the model's process is ended with it
+    # and its temporary folder removed (they were left running and behind).
+    import signal
+    import time
+    plugin = tmp_path / "sleepy_plugin.py"
+    plugin.write_text("import time\nimport numpy as np\nclass M:\n"
+                      "    def eval(self, wi, wo):\n        time.sleep(120)\n"
+                      "        return np.zeros((len(wo), 3))\nMODEL = M\n")
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    run = subprocess.Popen([CLI, "compare", str(PLASTIC), "--particles", "1000", "--theta-i", "30",
+                            "--grid", "9x9", "--models", "ww09", "--model-plugin", str(plugin),
+                            "--out", str(tmp_path / "o")],
+                           env=dict(os.environ, TMPDIR=str(temp)), stdout=subprocess.DEVNULL,
+                           stderr=subprocess.PIPE, text=True)
+    model = f"lamina.plugin_table\0{plugin}"  # the model's process (lamina's own names it too)
+    for _ in range(600):
+        if _processes_running(model) or run.poll() is not None:
+            break
+        time.sleep(0.05)
+    if run.poll() is not None:
+        err = run.stderr.read()
+        if "without the Python module" in err:
+            pytest.skip("this lamina was built without the Python module")
+        raise AssertionError(err)
+    assert list(temp.iterdir()), "no temporary folder while the model runs"
+    time.sleep(0.5)  # lamina registers the process once its spawn has returned
+    run.send_signal(signal.SIGTERM)
+    assert run.wait(timeout=30) == -signal.SIGTERM
+    for _ in range(100):  # the model's process ends on its SIGTERM
+        if not _processes_running(model):
+            break
+        time.sleep(0.05)
+    assert not _processes_running(model)
+    assert not list(temp.iterdir())
+
+
 def test_a_bad_python_model_is_refused_with_its_name():
     class Bad:
         name = "bad"
