@@ -287,21 +287,21 @@ inline void Bsdf::slab_bins() {
     // segments between the outer cosines that a smooth interface refracts onto the bins' edges and
     // centres (a smooth or nearly smooth interface's curves bend there).
     auto cuts_of = [&](double eta) {
-        std::vector<double> cuts{0.0, 1.0}, inside(bin_edge_.begin(), bin_edge_.end());
+        std::vector<double> outer{0.0, 1.0}, inside(bin_edge_.begin(), bin_edge_.end());
         for (int k = 0; k < kNbins; ++k)
             inside.push_back(0.5 * (bin_edge_[k] + bin_edge_[k + 1]));
         for (double e : inside) {
             const double s2 = sqr(eta) * (1 - e * e);
             if (s2 < 1) {
                 const double mu = std::sqrt(1 - s2);
-                if (mu > 1e-6 && mu < 1 - 1e-6) cuts.push_back(mu);
+                if (mu > 1e-6 && mu < 1 - 1e-6) outer.push_back(mu);
             }
         }
-        std::sort(cuts.begin(), cuts.end());
-        cuts.erase(std::unique(cuts.begin(), cuts.end(),
-                               [](double x, double y) { return std::abs(x - y) < 1e-9; }),
-                   cuts.end());
-        return cuts;
+        std::sort(outer.begin(), outer.end());
+        outer.erase(std::unique(outer.begin(), outer.end(),
+                                [](double x, double y) { return std::abs(x - y) < 1e-9; }),
+                    outer.end());
+        return outer;
     };
     coat_bins_.fill(cuts_of(eta0_),
                     [&](double mu) { return refracted_into_bins(alpha0_, eta0_, fgd_top_, mu); });
