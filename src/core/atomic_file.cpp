@@ -13,6 +13,7 @@
 #include <charconv>
 #include <cstdio>
 #include <cstring>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -68,7 +69,8 @@ struct ChildSlot {
 };
 ChildSlot g_children[kChildSlots];
 
-// An interrupt (SIGINT, SIGTERM, SIGHUP) while outputs are staged: the staging folders are
+// An interrupt (SIGINT, SIGTERM, SIGHUP) while outputs are staged: the registered child processes
+// are sent SIGTERM and their temporary files and folders removed; the staging folders are
 // removed, and the folders the run created, deepest first, where empty (rmdir only:
 // async-signal-safe; a staging folder is empty while the run computes, its files are written at
 // the end); then the signal's default action.
@@ -111,9 +113,10 @@ void remove_dead_staging(const fs::path& dir) {
     std::error_code ec;
     for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
         const std::string name = it->path().filename().string();
-        if (!name.starts_with(".staging-")) continue;
+        constexpr std::string_view kPrefix = ".staging-";
+        if (!name.starts_with(kPrefix)) continue;
         long pid = 0;
-        const char* first = name.data() + 9;
+        const char* first = name.data() + kPrefix.size();
         const auto [ptr, parse] = std::from_chars(first, name.data() + name.size(), pid);
         if (parse != std::errc() || ptr == first || *ptr != '.' || pid <= 0 || pid == ::getpid())
             continue;

@@ -253,6 +253,19 @@ for read in (st.tables, st.reference_se):
 st = lam.load_study(f"{tmp}/full", pandas=False)
 header = open(f"{tmp}/full/metrics.csv").readline().strip().split(",")
 assert list(st.metrics.dtype.names) == header, (st.metrics.dtype.names, header)
+# A metrics cell that is not a finite number is refused, as explorer refuses it.
+for text in ("x", "inf", "nan"):
+    def bad_metric(d, text=text):
+        lines = open(f"{d}/metrics.csv").read().splitlines()
+        cells = lines[1].split(",")
+        cells[header.index("misplaced_floor")] = text
+        lines[1] = ",".join(cells)
+        open(f"{d}/metrics.csv", "w").write("\n".join(lines) + "\n")
+    try:
+        lam.load_study(damaged("py-metric", bad_metric), pandas=False)
+        raise AssertionError(f"load_study accepted a metric {text!r}")
+    except lam.InputError as e:
+        assert "not lamina's metrics table" in e.problem, e
 PY
 
 # 2h. The incremental state read back is checked: a row edited out of range (1e308, which gave

@@ -174,10 +174,16 @@ def _read_metrics(path: Path) -> np.ndarray:
     width = {n: max([1] + [len(r[n]) for r in rows]) for n in _METRIC_TEXT}
     dtype = [(n, f"U{width[n]}") if n in _METRIC_TEXT else (n, "?") if n == "supported"
              else (n, "f8") for n in header]
+    def number(text):  # a finite number, as lamina writes (explorer refuses the same)
+        x = float(text)
+        if not np.isfinite(x):
+            raise ValueError(f"{text!r} is not a finite number")
+        return x
+
     out = np.zeros(len(rows), dtype=dtype)
     for k, r in enumerate(rows):
         out[k] = tuple(r[n] if n in _METRIC_TEXT else (r[n] == "true") if n == "supported"
-                       else (float(r[n]) if r[n] != "" else np.nan) for n in header)
+                       else (number(r[n]) if r[n] != "" else np.nan) for n in header)
     return out
 
 
