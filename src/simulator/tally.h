@@ -289,6 +289,12 @@ struct SpectralParticle {
     Rgbf projected(const Rgbf& w, const Rgbf (&weight)[3]) const {
         return weight[0] * w[0] + weight[1] * w[1] + weight[2] * w[2];
     }
+    /// Fetches the tally entries an exit into `index` adds to (a hint: nothing changes).
+    void prefetch(std::size_t index) const {
+        __builtin_prefetch(
+            &tally.lambda.recent[index * std::size_t(tracing.bins / 3) + std::size_t(group)], 1);
+        __builtin_prefetch(&tally.xyz.recent[index], 1);
+    }
     /// An exit into `index` (side · n_bins + bin) with flux w: the wavelength bins, XYZ and sRGB
     /// (`tally`, `block`: the main sRGB ones).
     void exit(std::size_t index, bool reflected, const Rgbf& w, Tally& main,
