@@ -15,6 +15,7 @@
 //   L::mul_add(a, b, c), L::neg_mul_add(a, b, c)   a·b + c and c − a·b (vectors: fused)
 //   L::inv_sqrt(x)   1/√x (a square root and a division, correctly rounded)
 //   L::cos_sin_2pi(u, c, s)   cos and sin of 2πu, u ∈ [0, 1) (an azimuth)
+//   L::cos_sin(x, c, s)       cos and sin of x (a phase; double lanes only)
 //   L::both(m, n), L::either(m, n), L::negate(m), L::none(m)   mask logic; none: no lane holds
 //
 // LaneVec3<T> (core/lane_vec.h) holds a direction as three lane values.
@@ -88,6 +89,10 @@ struct Lane<T> {
     static T mul_add(T a, T b, T c) { return a * b + c; }
     static T neg_mul_add(T a, T b, T c) { return c - a * b; }
     static T inv_sqrt(T x) { return T(1) / std::sqrt(x); }
+    static void cos_sin(T x, T& c, T& s) {
+        c = std::cos(x);
+        s = std::sin(x);
+    }
     static void cos_sin_2pi(T u, T& c, T& s) {
         const T phi = T(2) * T(3.14159265358979323846) * u;
         c = std::cos(phi);

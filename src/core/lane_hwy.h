@@ -165,6 +165,40 @@ struct VecLane {
     static constexpr bool kSinglePrecision = true;
 };
 
+// Lanes of doubles, half as many as of floats in a vector of the same width: the few formulas
+// the kernel evaluates in double (a thin film's Airy sums, physics/thin_film_airy.h).
+using DD = hn::ScalableTag<double>;
+using VD = hn::Vec<DD>;
+using MD = hn::Mask<DD>;
+
+/// The operations of core/lane.h on vectors of doubles, for the lane templates evaluated in
+/// double. Highway's contrib math functions: Exp ≤ 1 ulp, Cos and Sin ≤ 3 ulp on
+/// [−39000, 39000] (hwy/contrib/math).
+struct VecLaneD {
+    using Value = VD;
+    using Mask = MD;
+    static HWY_INLINE VD constant(double x) { return hn::Set(DD(), x); }
+    static HWY_INLINE VD min(VD a, VD b) { return hn::Min(a, b); }
+    static HWY_INLINE VD max(VD a, VD b) { return hn::Max(a, b); }
+    static HWY_INLINE VD sqrt(VD x) { return hn::Sqrt(x); }
+    static HWY_INLINE VD exp(VD x) { return hn::Exp(DD(), x); }
+    static HWY_INLINE void cos_sin(VD x, VD& c, VD& s) {
+        c = hn::Cos(DD(), x);
+        s = hn::Sin(DD(), x);
+    }
+    static HWY_INLINE VD select(MD m, VD a, VD b) { return hn::IfThenElse(m, a, b); }
+    static HWY_INLINE MD less(VD a, VD b) { return hn::Lt(a, b); }
+    static HWY_INLINE VD abs(VD x) { return hn::Abs(x); }
+    static HWY_INLINE VD copysign(VD a, VD b) { return hn::CopySign(a, b); }
+    static HWY_INLINE VD mul_add(VD a, VD b, VD c) { return hn::MulAdd(a, b, c); }
+    static HWY_INLINE VD neg_mul_add(VD a, VD b, VD c) { return hn::NegMulAdd(a, b, c); }
+    static HWY_INLINE MD both(MD m, MD n) { return hn::And(m, n); }
+    static HWY_INLINE MD either(MD m, MD n) { return hn::Or(m, n); }
+    static HWY_INLINE MD negate(MD m) { return hn::Not(m); }
+    static HWY_INLINE bool none(MD m) { return hn::AllFalse(DD(), m); }
+    static constexpr bool kSinglePrecision = false;
+};
+
 /// a where the mask m holds, else b (lane_select without the operations struct).
 HWY_INLINE V3 Select(MF m, const V3& a, const V3& b) {
     return {hn::IfThenElse(m, a.x, b.x), hn::IfThenElse(m, a.y, b.y), hn::IfThenElse(m, a.z, b.z)};

@@ -6,6 +6,7 @@
 
 #include "core/complex_math.h"
 #include "core/lane.h"
+#include "core/lane_complex.h"
 #include "core/math.h"
 #include "core/vec.h"
 
@@ -137,6 +138,12 @@ struct FresnelAmplitudes {
     std::complex<T> r_s, r_p, t_s, t_p;
 };
 
+/// The same amplitudes as lane values (the lane template below).
+template <typename T>
+struct LaneFresnelAmplitudes {
+    LaneComplex<T> r_s, r_p, t_s, t_p;
+};
+
 /// The amplitudes of the boundary from medium j into medium k, each given by its complex index
 /// relative to one reference medium (eta_j, eta_k) and its normal wave number in units of the
 /// reference's, u = η cos θ = √(η² − sin²θ_ref) (Snell's invariant η sin θ is the same in every
@@ -148,27 +155,53 @@ struct FresnelAmplitudes {
 /// r_kj = −r_jk and t_jk t_kj = 1 − r_jk² (both polarizations), which the Airy sums of a film rest
 /// on (physics/thin_film.h). A boundary seen from the reference medium itself has η_j = 1,
 /// u_j = cos θ. The denominators vanish only at an index-matched grazing boundary (u_j = u_k = 0).
+template <typename T, typename L>
+LAMINA_LANE_INLINE LaneFresnelAmplitudes<T> fresnel_amplitudes(LaneComplex<T> eta_j,
+                                                               LaneComplex<T> u_j,
+                                                               LaneComplex<T> eta_k,
+                                                               LaneComplex<T> u_k) {
+    const LaneComplex<T> eps_j = eta_j * eta_j, eps_k = eta_k * eta_k;
+    // Each denominator inverted once, for its r and t.
+    const LaneComplex<T> inv_ds = reciprocal<T, L>(u_j + u_k),
+                         inv_dp = reciprocal<T, L>(eps_k * u_j + eps_j * u_k);
+    const T two = L::constant(2);
+    return {(u_j - u_k) * inv_ds, (eps_k * u_j - eps_j * u_k) * inv_dp, (two * u_j) * inv_ds,
+            (((two * eta_j) * eta_k) * u_j) * inv_dp};
+}
+
+/// The lane template above at one lane, on std::complex.
 template <typename T>
 FresnelAmplitudes<T> fresnel_amplitudes(std::complex<T> eta_j, std::complex<T> u_j,
                                         std::complex<T> eta_k, std::complex<T> u_k) {
-    const std::complex<T> eps_j = eta_j * eta_j, eps_k = eta_k * eta_k;
-    // Each denominator inverted once, for its r and t.
-    const std::complex<T> inv_ds = reciprocal(u_j + u_k),
-                          inv_dp = reciprocal(eps_k * u_j + eps_j * u_k);
-    return {(u_j - u_k) * inv_ds, (eps_k * u_j - eps_j * u_k) * inv_dp, T(2) * u_j * inv_ds,
-            T(2) * eta_j * eta_k * u_j * inv_dp};
+    const LaneFresnelAmplitudes<T> a = fresnel_amplitudes<T, Lane<T>>(
+        lane_complex(eta_j), lane_complex(u_j), lane_complex(eta_k), lane_complex(u_k));
+    return {std_complex(a.r_s), std_complex(a.r_p), std_complex(a.t_s), std_complex(a.t_p)};
+}
+
+/// The square of the normal wave number below, η² − sin²θ, with an imaginary part of −0 made +0:
+/// a −0 would put the root of a negative number on the decaying side's mirror image (the
+/// principal root follows the sign of zero; x + 0 is +0 for x = ±0 and x otherwise).
+template <typename T, typename L>
+LAMINA_LANE_INLINE LaneComplex<T> normal_wave_number_square(LaneComplex<T> eta, T sin2_theta) {
+    const LaneComplex<T> e = eta * eta;
+    return {e.re - sin2_theta, e.im + L::constant(0)};
 }
 
 /// The normal wave number u = √(η² − sin²θ) of a medium of complex index eta (relative to the
 /// reference medium) for a wave whose Snell invariant is sin²θ = sin2_theta: the root with
 /// Im u ≥ 0 (decaying into an absorbing medium, or evanescent under total internal reflection),
-/// Re u ≥ 0.
+/// Re u ≥ 0. On lanes: not finite where η² − sin²θ = 0 (core/lane_complex.h's principal_sqrt).
+template <typename T, typename L>
+LAMINA_LANE_INLINE LaneComplex<T> normal_wave_number(LaneComplex<T> eta, T sin2_theta) {
+    return principal_sqrt<T, L>(normal_wave_number_square<T, L>(eta, sin2_theta));
+}
+
+/// The normal wave number on one lane, on std::complex (complex_math.h's principal_sqrt, which
+/// takes any value).
 template <typename T>
 std::complex<T> normal_wave_number(std::complex<T> eta, T sin2_theta) {
-    const std::complex<T> e = eta * eta - sin2_theta;
-    // An imaginary part of −0 would put the root of a negative number on the decaying side's
-    // mirror image (the principal root follows the sign of zero).
-    return principal_sqrt(std::complex<T>(e.real(), e.imag() == T(0) ? T(0) : e.imag()));
+    return principal_sqrt(
+        std_complex(normal_wave_number_square<T, Lane<T>>(lane_complex(eta), sin2_theta)));
 }
 
 /// The same reflectance as fresnel_conductor evaluated with std::complex, as written in Born &

@@ -45,6 +45,7 @@
 
 #include "core/complex_math.h"
 #include "core/lane.h"
+#include "core/lane_complex.h"
 #include "core/lane_vec.h"
 
 #include <cmath>
@@ -83,13 +84,21 @@ struct InterfaceMueller {
 /// diag(a_s, a_p) in the s/p frame) times the flux factor `flux`: a = flux (|a_s|² + |a_p|²)/2,
 /// b = flux (|a_s|² − |a_p|²)/2, c + id = flux a_s a_p*. Reflection has flux 1; a refracted beam
 /// the factor Re(η_t cos θt)/(η_i cos θi) of its real exit medium (Born & Wolf §1.5.2, Eq. 30).
-/// The definition, with std::complex (the films' amplitudes, physics/thin_film.h);
-/// reflection_mueller below is the same for one boundary in real arithmetic, as lane template.
+/// The definition, on complex lane values (the films' amplitudes, physics/thin_film.h);
+/// reflection_mueller below is the same for one boundary in real arithmetic.
+template <typename T, typename L>
+LAMINA_LANE_INLINE InterfaceMueller<T> mueller_of_amplitudes(LaneComplex<T> a_s, LaneComplex<T> a_p,
+                                                             T flux) {
+    const T n_s = squared_modulus(a_s), n_p = squared_modulus(a_p);
+    const LaneComplex<T> x = times_conj(a_s, a_p);
+    const T two = L::constant(2);
+    return {flux * (n_s + n_p) / two, flux * (n_s - n_p) / two, flux * x.re, flux * x.im};
+}
+
+/// The same on one lane, on std::complex.
 template <typename T>
 InterfaceMueller<T> mueller_of_amplitudes(std::complex<T> a_s, std::complex<T> a_p, T flux) {
-    const T n_s = squared_modulus(a_s), n_p = squared_modulus(a_p);
-    const std::complex<T> x = a_s * std::conj(a_p);
-    return {flux * (n_s + n_p) / T(2), flux * (n_s - n_p) / T(2), flux * x.real(), flux * x.imag()};
+    return mueller_of_amplitudes<T, Lane<T>>(lane_complex(a_s), lane_complex(a_p), flux);
 }
 
 /// The reflection Mueller matrix from the complex reflection coefficients of a relative index

@@ -33,6 +33,7 @@
 #include "core/complex_math.h"
 #include "physics/fresnel.h"
 #include "physics/polarization.h"
+#include "physics/thin_film_airy.h"
 
 #include <algorithm>
 #include <array>
@@ -42,6 +43,11 @@
 #include <numbers>
 
 namespace lamina {
+
+template <typename T>
+inline LaneFresnelAmplitudes<T> lane_amplitudes(const FresnelAmplitudes<T>& a) {
+    return {lane_complex(a.r_s), lane_complex(a.r_p), lane_complex(a.t_s), lane_complex(a.t_p)};
+}
 
 /// The film's amplitudes as a whole (r_s, r_p, t_s, t_p: incident medium to exit medium) and the
 /// flux factor of its transmitted beam, Re(u_3)/cos θ1 (0 when the exit medium absorbs, a
@@ -80,13 +86,10 @@ ThinFilmBoundaries<T, N> thin_film_boundaries(T cos_theta_i, std::complex<T> eta
         u3[n] = normal_wave_number(eta_exit[n], sin2);
         b.transmitted_flux[n] = eta_exit[n].imag() == T(0) && mu > T(0) ? u3[n].real() / mu : T(0);
     }
-    // The sums are even functions of u2, analytic in u2² = η_f² − sin²θ1, but at the film's
-    // critical angle (u2 → 0: r12 → 1, r23 → −1, e^{2iδ} → 1) they are 0/0, and evaluated at
-    // |u2| they lose ε/|u2| of their precision. Within h = 1e-6 of it in u2² they are taken as the
-    // mean of their values at u2² ± h (the error of the mean is O(h²), of each value O(ε/√h)).
+    // Near the film's critical angle two sums, at u2² ± h, averaged (thin_film_airy.h).
     const C w = eta_film * eta_film - sin2;
-    constexpr T kNearCritical = T(1e-6);
-    if (squared_modulus(w) < kNearCritical * kNearCritical) {
+    constexpr T kNearCritical = T(kFilmNearCritical);
+    if (near_film_critical<T, Lane<T>>(lane_complex(eta_film), sin2)) {
         b.count = 2;
         b.u2[0] = principal_sqrt(w + kNearCritical);
         b.u2[1] = principal_sqrt(w - kNearCritical);
@@ -116,15 +119,11 @@ std::array<ThinFilmAmplitudes<T>, N> thin_film_amplitudes(const ThinFilmBoundari
         const FresnelAmplitudes<T>& b12 = b.upper[k];
         Sums sums;
         for (std::size_t n = 0; n < N; ++n) {
-            const FresnelAmplitudes<T>& b23 = b.lower[k][n];
-            // e^{iδ}: |e^{iδ}| = e^{−Im δ} ≤ 1 since Im u2 ≥ 0.
-            const C phase = exp_i(T(2) * std::numbers::pi_v<T> * thickness_waves[n] * b.u2[k]);
-            const C phase2 = phase * phase;
-            const C inv_den_s = reciprocal(T(1) + b12.r_s * b23.r_s * phase2);
-            const C inv_den_p = reciprocal(T(1) + b12.r_p * b23.r_p * phase2);
-            sums[n] = {
-                (b12.r_s + b23.r_s * phase2) * inv_den_s, (b12.r_p + b23.r_p * phase2) * inv_den_p,
-                b12.t_s * b23.t_s * phase * inv_den_s, b12.t_p * b23.t_p * phase * inv_den_p};
+            const LaneFresnelAmplitudes<T> a =
+                airy_sums<T, Lane<T>>(lane_amplitudes(b12), lane_amplitudes(b.lower[k][n]),
+                                      lane_complex(b.u2[k]), thickness_waves[n]);
+            sums[n] = {std_complex(a.r_s), std_complex(a.r_p), std_complex(a.t_s),
+                       std_complex(a.t_p)};
         }
         return sums;
     };

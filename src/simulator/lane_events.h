@@ -2,10 +2,10 @@
 // state of the lanes' particles (LaneVectors: direction, flux, the losses booked per budget
 // term, polarization and, in spectral runs, each lane's stack), and per interface type and
 // medium the call of the lane template that the scalar kernel instantiates at one lane
-// (physics/dielectric.h, conductor.h, lambertian.h, microsurface_walk.h, medium.h), with the thin
-// film's reflection evaluated lane by lane (FilmReflection). The kernel (simulator/kernel_simd.cpp)
-// manages the lanes around them. A per-target header (core/lane_hwy.h); layers/compiled_stack.h
-// and physics/thin_film.h must already be included as ordinary headers.
+// (physics/dielectric.h, conductor.h, lambertian.h, microsurface_walk.h, medium.h), with a thin
+// film's reflection in place of a conductor's Fresnel terms (simulator/lane_film.h). The kernel
+// (simulator/kernel_simd.cpp) manages the lanes around them. A per-target header (core/lane_hwy.h);
+// layers/compiled_stack.h and physics/thin_film.h must already be included as ordinary headers.
 
 #include "core/lane_hwy.h"
 #include "physics/conductor.h"
@@ -14,6 +14,7 @@
 #include "physics/medium.h"
 #include "physics/microsurface_walk.h"
 #include "physics/polarization.h"
+#include "simulator/lane_film.h"
 #include "simulator/lane_rng.h"
 
 #include <algorithm>
@@ -225,59 +226,6 @@ HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, const
                                             max_order, degenerate, may_suspend);
     }
 }
-
-// ---- A thin film on a conductor (docs/physics.md §9; simulator/scalar_particle.h film_event) ----
-// The film's reflection at each lane's facet cosine and film thickness: FilmOptics::
-// reflection_from_above (physics/thin_film.h, in double, what the scalar kernel's film_event
-// evaluates), called per lane and channel, as its Airy sums have no lane template. It stands where
-// the bare conductor's ConductorFresnel and ConductorMueller stand in the conductor event and walk.
-struct FilmReflection {
-    const FilmOptics* const* film;  // per lane: the layer's, or a spectral lane's stack's
-    const double* thickness_nm;     // per lane
-    // The reflectance per channel (unpolarized), as film_event's `reflectance`, on the lanes of
-    // `active` (reflection_on_lanes: the others, whose values no event uses, are not evaluated).
-    HWY_NOINLINE void operator()(VF cos_theta, VF* factors, MF active) const {
-        const DF df;
-        HWY_ALIGN float cos_l[kMaxLanes], r[3][kMaxLanes];
-        hn::Store(cos_theta, df, cos_l);
-        for (int c = 0; c < 3; ++c)
-            std::fill(r[c], r[c] + hn::Lanes(df), 1.f);
-        for (std::uint64_t bits = MaskBits(active); bits != 0; bits &= bits - 1) {
-            const std::size_t l = std::size_t(std::countr_zero(bits));
-            const auto md = film[l]->reflection_from_above(double(cos_l[l]), thickness_nm[l]);
-            for (int c = 0; c < 3; ++c)
-                r[c][l] = float(md[std::size_t(c)].a);
-        }
-        for (int c = 0; c < 3; ++c)
-            factors[c] = hn::Load(df, r[c]);
-    }
-    // The reflection Mueller matrices per channel (polarized), as film_event's `mueller`, on the
-    // lanes of `active` (the others get the identity).
-    HWY_NOINLINE void operator()(VF cos_theta, InterfaceMueller<VF>* m, MF active) const {
-        const DF df;
-        HWY_ALIGN float cos_l[kMaxLanes], e[3][4][kMaxLanes];
-        hn::Store(cos_theta, df, cos_l);
-        for (int c = 0; c < 3; ++c) {
-            std::fill(e[c][0], e[c][0] + hn::Lanes(df), 1.f);
-            std::fill(e[c][1], e[c][1] + hn::Lanes(df), 0.f);
-            std::fill(e[c][2], e[c][2] + hn::Lanes(df), 1.f);
-            std::fill(e[c][3], e[c][3] + hn::Lanes(df), 0.f);
-        }
-        for (std::uint64_t bits = MaskBits(active); bits != 0; bits &= bits - 1) {
-            const std::size_t l = std::size_t(std::countr_zero(bits));
-            const auto md = film[l]->reflection_from_above(double(cos_l[l]), thickness_nm[l]);
-            for (int c = 0; c < 3; ++c) {
-                e[c][0][l] = float(md[std::size_t(c)].a);
-                e[c][1][l] = float(md[std::size_t(c)].b);
-                e[c][2][l] = float(md[std::size_t(c)].c);
-                e[c][3][l] = float(md[std::size_t(c)].d);
-            }
-        }
-        for (int c = 0; c < 3; ++c)
-            m[c] = {hn::Load(df, e[c][0]), hn::Load(df, e[c][1]), hn::Load(df, e[c][2]),
-                    hn::Load(df, e[c][3])};
-    }
-};
 
 // A filmed conductor's event (film_event's conductor branch): the lanes' thicknesses drawn first
 // where the film's thickness varies (one number per event, from each lane's own stream), then the

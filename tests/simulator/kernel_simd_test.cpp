@@ -13,6 +13,7 @@
 #include "physics/microsurface_walk.h"
 #include "physics/phase.h"
 #include "physics/polarization.h"
+#include "physics/thin_film.h"
 #include "simulator/goniophotometer.h"
 #include "support/chi2.h"
 #include "support/stacks.h"
@@ -325,6 +326,83 @@ TEST(KernelSimd, BeerLambertLanes) {
 double mueller_lane_bound(double delta) {
     return 16 * 0x1p-24 + 4 * (4 * 0x1p-24) / (2 * std::sqrt(delta));
 }
+// A thin film's reflection on the lanes (simulator/lane_film.h: the Airy sums of
+// physics/thin_film_airy.h on vectors of doubles, the lanes near the film's critical angle and
+// the grazing index-matched ones handed to the scalar FilmOptics) against FilmOptics::
+// reflection_from_above on one lane, each entry's film its own as a spectral run's lanes have
+// them. Both are double evaluations (their difference is ~1e-13 of the entries, the vector's
+// exp, cos and sin within 3 ulp), each rounded to float once: they agree to one float ulp of
+// entries in [−1, 1], 2^-24.
+TEST(KernelSimd, FilmReflectionLanes) {
+    using C = std::complex<double>;
+    auto film = [](C eta_film, double above, C below0, C below1, C below2) {
+        FilmOptics f;
+        f.eta_film = eta_film;
+        f.eta_above = above;
+        f.eta_below[0] = below0;
+        f.eta_below[1] = below1;
+        f.eta_below[2] = below2;
+        f.wavelength_nm[0] = 630;
+        f.wavelength_nm[1] = 532;
+        f.wavelength_nm[2] = 465;
+        return f;
+    };
+    const std::vector<FilmOptics> films = {
+        // An oxide of 2.5 on titanium under a coat of 1.5.
+        film(C(2.5), 1.5, C(2.74, 3.79), C(2.54, 3.43), C(2.26, 3.0)),
+        // MgF2 on aluminium in air.
+        film(C(1.38), 1.0, C(1.2, 7.26), C(0.96, 6.69), C(0.65, 5.6)),
+        // An absorbing oxide on iron under a coat.
+        film(C(2.3, 0.1), 1.5, C(2.9, 2.9), C(2.8, 2.9), C(2.6, 2.8)),
+        // A film of 1.2 under a coat of 1.5: its critical angle at sin²θ = 0.64.
+        film(C(1.2), 1.5, C(0.2, 3.0), C(0.5, 2.3), C(1.2, 1.9)),
+        // A film index-matched to the medium above, on gold: grazing, u2 = 0.
+        film(C(1.0), 1.0, C(0.18, 3.4), C(0.5, 2.2), C(1.3, 1.8)),
+    };
+    ParticleRng rng(23, 0, 0);
+    std::vector<float> cos_theta = {
+        0.f, 1.f, 1e-7f, 0.6f, std::nextafter(0.6f, 0.f), std::nextafter(0.6f, 1.f)};
+    for (int k = 0; k < 6000; ++k)
+        cos_theta.push_back(rng.uniform_float());
+    std::vector<const FilmOptics*> lane_films;
+    std::vector<double> thickness;
+    for (std::size_t j = 0; j < cos_theta.size(); ++j) {
+        lane_films.push_back(&films[(j * 7 + j / 5) % films.size()]);
+        thickness.push_back(j % 11 == 0 ? 0.0 : 800.0 * double(rng.uniform_float()));
+    }
+    // Every other lane skipped in a second pass: the skipped lanes keep the identity.
+    for (const std::uint64_t skip : {std::uint64_t(0), std::uint64_t(0xAAAAAAAAAAAAAAAA)}) {
+        std::size_t n_lanes = 0;
+        const std::vector<float> lanes =
+            simd_film_reflection(lane_films, cos_theta, thickness, skip, n_lanes);
+        double worst = 0;
+        for (std::size_t j = 0; j < cos_theta.size(); ++j) {
+            const float* e = &lanes[15 * j];
+            if ((skip >> (j % n_lanes) & 1) != 0) {
+                for (int c = 0; c < 3; ++c) {
+                    EXPECT_EQ(e[4 * c], 1.f);
+                    EXPECT_EQ(e[4 * c + 1], 0.f);
+                    EXPECT_EQ(e[4 * c + 2], 1.f);
+                    EXPECT_EQ(e[4 * c + 3], 0.f);
+                    EXPECT_EQ(e[12 + c], 1.f);
+                }
+                continue;
+            }
+            const auto m = lane_films[j]->reflection_from_above(double(cos_theta[j]), thickness[j]);
+            for (int c = 0; c < 3; ++c) {
+                const double scalar[4] = {m[std::size_t(c)].a, m[std::size_t(c)].b,
+                                          m[std::size_t(c)].c, m[std::size_t(c)].d};
+                for (int k = 0; k < 4; ++k) {
+                    ASSERT_TRUE(std::isfinite(e[4 * c + k])) << j;
+                    worst = std::max(worst, std::abs(double(e[4 * c + k]) - scalar[k]));
+                }
+                EXPECT_EQ(e[12 + c], e[4 * c]) << j;  // the unpolarized factor is a
+            }
+        }
+        EXPECT_LE(worst, 0x1p-24) << simd_target_name();
+    }
+}
+
 TEST(KernelSimd, FresnelMuellerLanes) {
     ParticleRng rng(21, 0, 0);
     for (const float eta : {1.5f, 1 / 1.5f, 1.f, 2.4f}) {

@@ -5,6 +5,7 @@
 
 #include "support/simd_probes.h"
 
+#include "physics/thin_film.h"
 #include "simulator/kernel_simd.h"
 
 #include <algorithm>
@@ -26,6 +27,7 @@
 #include "physics/polarization.h"
 #include "simulator/lane_bins.h"
 #include "simulator/lane_conductor.h"
+#include "simulator/lane_film.h"
 #include "simulator/lane_rng.h"
 #undef LAMINA_LANE_TARGET
 
@@ -505,6 +507,52 @@ void MicrosurfaceWalkForTest(const float* wi, std::size_t n, float alpha, bool d
     }
 }
 
+// FilmReflection over entries in chunks of a vector's lanes, the lanes of `skip` (bit l of
+// entry l's chunk) left inactive: per entry the polarized a, b, c, d of each channel, then the
+// unpolarized factor of each channel (15 floats).
+std::uint32_t FilmReflectionForTest(const FilmOptics* const* films, const float* cos_theta,
+                                    const double* thickness_nm, std::size_t n, std::uint64_t skip,
+                                    float* out) {
+    const DF df;
+    const std::size_t n_lanes = hn::Lanes(df);
+    for (std::size_t base = 0; base < n; base += n_lanes) {
+        const std::size_t count = std::min(n_lanes, n - base);
+        HWY_ALIGN float c[kMaxLanes] = {};
+        HWY_ALIGN const FilmOptics* f[kMaxLanes];
+        HWY_ALIGN double t[kMaxLanes];
+        HWY_ALIGN std::int32_t on[kMaxLanes];
+        for (std::size_t l = 0; l < n_lanes; ++l) {
+            const std::size_t j = base + std::min(l, count - 1);
+            c[l] = cos_theta[j];
+            f[l] = films[j];
+            t[l] = thickness_nm[j];
+            on[l] = l < count && (skip >> l & 1) == 0 ? 1 : 0;
+        }
+        const MF active = hn::RebindMask(df, hn::Ne(hn::Load(DI(), on), hn::Zero(DI())));
+        const FilmReflection reflection{f, t};
+        InterfaceMueller<VF> m[3];
+        VF factors[3];
+        reflection(hn::Load(df, c), m, active);
+        reflection(hn::Load(df, c), factors, active);
+        HWY_ALIGN float e[3][5][kMaxLanes];
+        for (int ch = 0; ch < 3; ++ch) {
+            hn::Store(m[ch].a, df, e[ch][0]);
+            hn::Store(m[ch].b, df, e[ch][1]);
+            hn::Store(m[ch].c, df, e[ch][2]);
+            hn::Store(m[ch].d, df, e[ch][3]);
+            hn::Store(factors[ch], df, e[ch][4]);
+        }
+        for (std::size_t l = 0; l < count; ++l) {
+            for (int ch = 0; ch < 3; ++ch)
+                for (int k = 0; k < 4; ++k)
+                    out[(base + l) * 15 + std::size_t(ch * 4 + k)] = e[ch][k][l];
+            for (int ch = 0; ch < 3; ++ch)
+                out[(base + l) * 15 + 12 + std::size_t(ch)] = e[ch][4][l];
+        }
+    }
+    return std::uint32_t(n_lanes);
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace lamina
 HWY_AFTER_NAMESPACE();
@@ -528,6 +576,7 @@ HWY_EXPORT(MicrosurfaceWalkForTest);
 HWY_EXPORT(GgxLanesForTest);
 HWY_EXPORT(InterfaceEventsForTest);
 HWY_EXPORT(MediumStepForTest);
+HWY_EXPORT(FilmReflectionForTest);
 HWY_EXPORT(FresnelMuellerForTest);
 HWY_EXPORT(PolarizedEventsForTest);
 
@@ -653,6 +702,17 @@ std::vector<float> simd_fresnel_mueller(int kind, const std::vector<float>& cos_
     std::vector<float> out(cos_theta.size() * (kind == 0 ? 9 : 4));
     LAMINA_PROBE_DISPATCH(FresnelMuellerForTest)
     (kind, cos_theta.data(), cos_theta.size(), eta, k, out.data());
+    return out;
+}
+
+std::vector<float> simd_film_reflection(const std::vector<const FilmOptics*>& films,
+                                        const std::vector<float>& cos_theta,
+                                        const std::vector<double>& thickness_nm, std::uint64_t skip,
+                                        std::size_t& n_lanes) {
+    select_simd_target();
+    std::vector<float> out(cos_theta.size() * 15);
+    n_lanes = LAMINA_PROBE_DISPATCH(FilmReflectionForTest)(
+        films.data(), cos_theta.data(), thickness_nm.data(), cos_theta.size(), skip, out.data());
     return out;
 }
 

@@ -131,6 +131,17 @@ SimdPolarizedEventResult simd_polarized_interface_events(
     const std::vector<float>& wi, const std::vector<float>& u, const std::vector<float>& x,
     const std::vector<float>& stokes, const std::vector<float>& flux, int channels);
 
+/// simulator/lane_film.h FilmReflection (a thin film's reflection, each lane with its own film
+/// and thickness) on the dispatched instruction set's vectors, entry j in lane j mod the lanes,
+/// the lanes whose bit is set in `skip` inactive in every chunk; n_lanes: the vector's lanes.
+/// Per entry (15 floats): the polarized operator's Mueller a, b, c, d of channels 0, 1, 2, then
+/// the unpolarized operator's factor of each channel (inactive lanes: the identity and 1).
+struct FilmOptics;
+std::vector<float> simd_film_reflection(const std::vector<const FilmOptics*>& films,
+                                        const std::vector<float>& cos_theta,
+                                        const std::vector<double>& thickness_nm, std::uint64_t skip,
+                                        std::size_t& n_lanes);
+
 /// How far two float evaluations of physics/phase.h sample_hg_cos_theta(g, u) may differ when one
 /// fuses multiply-adds and the other does not (SSE4 has none): twice a first-order bound on the
 /// rounding of one, in double. s = (1 − g)(1 + g) / ((1 − |g|) + 2|g|(1 − u or u)), products and
