@@ -167,7 +167,7 @@ std::vector<StudyConfiguration> builtin_configurations() {
     return out;
 }
 
-std::vector<StudyConfiguration> iridescent_configurations() {
+std::vector<StudyConfiguration> iridescent_configurations(bool quick_only) {
     // The metals are the measured ones (data/nk): an interference colour is a spectral quantity,
     // so the reference traces these stacks over wavelengths and the models are compared by their
     // colour (docs/study.md, "The iridescent category").
@@ -176,24 +176,26 @@ std::vector<StudyConfiguration> iridescent_configurations() {
         double alpha0;
         const char* metal;
         double alpha1, film_eta, film_k, min_nm, max_nm;
+        bool quick;  // in the quick preset: the category's three cases the others vary
     };
     const Iridescent list[] = {
         // Anodized titanium: a 60 nm oxide of index 2.5, first-order interference, glossy and
         // rough.
-        {"irid-ti-oxide-a0.05-a1.05", 0.05, "Ti", 0.05, 2.5, 0.0, 60, 60},
-        {"irid-ti-oxide-a0.05-a1.3", 0.05, "Ti", 0.3, 2.5, 0.0, 60, 60},
+        {"irid-ti-oxide-a0.05-a1.05", 0.05, "Ti", 0.05, 2.5, 0.0, 60, 60, false},
+        {"irid-ti-oxide-a0.05-a1.3", 0.05, "Ti", 0.3, 2.5, 0.0, 60, 60, true},
         // An interference pigment: 300 nm of index 1.8 on gold (higher orders), under a rough
         // coat.
-        {"irid-gold-film-a0.3-a1.05", 0.3, "Au", 0.05, 1.8, 0.0, 300, 300},
+        {"irid-gold-film-a0.3-a1.05", 0.3, "Au", 0.05, 1.8, 0.0, 300, 300, true},
         // A protected mirror: MgF2 a quarter wave thick at 532 nm on aluminium, smooth coat.
-        {"irid-al-mgf2-a0.001-a1.2", 0.001, "Al", 0.2, 1.38, 0.0, 96.4, 96.4},
+        {"irid-al-mgf2-a0.001-a1.2", 0.001, "Al", 0.2, 1.38, 0.0, 96.4, 96.4, false},
         // A film whose thickness varies over the surface (200–600 nm of 1.5) on copper.
-        {"irid-cu-range-a0.1-a1.1", 0.1, "Cu", 0.1, 1.5, 0.0, 200, 600},
+        {"irid-cu-range-a0.1-a1.1", 0.1, "Cu", 0.1, 1.5, 0.0, 200, 600, false},
         // Temper colours: an absorbing 80 nm oxide (2.3 + 0.1i) on iron.
-        {"irid-fe-temper-a0.05-a1.1", 0.05, "Fe", 0.1, 2.3, 0.1, 80, 80},
+        {"irid-fe-temper-a0.05-a1.1", 0.05, "Fe", 0.1, 2.3, 0.1, 80, 80, true},
     };
     std::vector<StudyConfiguration> out;
     for (const Iridescent& c : list) {
+        if (quick_only && !c.quick) continue;
         Layer metal = conductor(Rgbd(1.0), Rgbd(1.0), c.alpha1);
         metal.interface.material = c.metal;
         metal.interface.eta_spectrum = conductor_material_eta(c.metal);
@@ -289,9 +291,9 @@ std::vector<StudyConfiguration> dispersive_configurations() {
 
 std::vector<StudyConfiguration> preset_configurations(const std::string& preset) {
     std::vector<StudyConfiguration> out = builtin_configurations();
+    for (StudyConfiguration& c : iridescent_configurations(preset == "quick"))
+        out.push_back(std::move(c));
     if (preset != "quick") {
-        for (StudyConfiguration& c : iridescent_configurations())
-            out.push_back(std::move(c));
         for (StudyConfiguration& c : brushed_configurations())
             out.push_back(std::move(c));
         for (StudyConfiguration& c : dispersive_configurations())

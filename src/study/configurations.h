@@ -26,9 +26,10 @@ std::vector<StudyConfiguration> builtin_configurations();
 
 /// The "iridescent" category (docs/study.md): a clear coat over a metal carrying a thin film
 /// (oxides, protective and interference films; absorbing, of varying thickness, on smooth and
-/// rough metals), traced by the scalar kernel. The standard and paper presets add it to the 60;
-/// the quick one (make demo) leaves it out.
-std::vector<StudyConfiguration> iridescent_configurations();
+/// rough metals), traced spectrally. The standard and paper presets add its six configurations to
+/// the 60; the quick one (make demo) three of them (quick_only): a film on a rough metal, an
+/// interference pigment under a rough coat and an absorbing oxide.
+std::vector<StudyConfiguration> iridescent_configurations(bool quick_only = false);
 
 /// The "brushed" category (docs/study.md): brushed aluminium, steel and gold (anisotropic GGX,
 /// α_x ≠ α_y) under a smooth, a rough and a brushed clear coat, the coat's and the metal's
@@ -45,7 +46,7 @@ std::vector<StudyConfiguration> dispersive_configurations();
 
 /// The configurations a study runs by default at `preset`: builtin_configurations(), and
 /// iridescent_configurations(), brushed_configurations() and dispersive_configurations() for every
-/// preset but "quick".
+/// preset but "quick", which adds iridescent_configurations(true) alone.
 std::vector<StudyConfiguration> preset_configurations(const std::string& preset);
 
 /// A configuration's id names a folder, a CSV cell and an --only item: InputError unless it is

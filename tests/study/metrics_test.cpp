@@ -225,9 +225,10 @@ TEST(StudyConfigurations, ParametersCountTheLayersOfALongerStack) {
 }
 
 // docs/study.md, "The iridescent category": six clear coats over filmed metals, stable ids,
-// valid stacks (the reader's ranges, through its JSON round trip), added by every preset but the
-// quick one.
-TEST(StudyConfigurations, IridescentInTheLargerPresetsOnly) {
+// valid stacks (the reader's ranges, through its JSON round trip), added by the larger presets;
+// the quick one adds three of them, after the 60: the film on a rough metal, the interference
+// pigment under a rough coat, the absorbing oxide.
+TEST(StudyConfigurations, IridescentInEveryPresetThreeInTheQuickOne) {
     const auto irid = iridescent_configurations();
     ASSERT_EQ(irid.size(), 6u);
     for (const auto& c : irid) {
@@ -243,7 +244,16 @@ TEST(StudyConfigurations, IridescentInTheLargerPresetsOnly) {
         EXPECT_EQ(stack_from_json(stack_to_json(c.stack), c.id), c.stack) << c.id;
         EXPECT_TRUE(c.parameters.count("film_nm")) << c.id;
     }
-    EXPECT_EQ(preset_configurations("quick").size(), 60u);
+    const auto quick = preset_configurations("quick");
+    ASSERT_EQ(quick.size(), 63u);
+    EXPECT_EQ(quick[59].category, "slab");
+    EXPECT_EQ(quick[60].id, "irid-ti-oxide-a0.05-a1.3");
+    EXPECT_EQ(quick[61].id, "irid-gold-film-a0.3-a1.05");
+    EXPECT_EQ(quick[62].id, "irid-fe-temper-a0.05-a1.1");
+    const auto quick_irid = iridescent_configurations(true);
+    ASSERT_EQ(quick_irid.size(), 3u);
+    for (std::size_t i = 0; i < 3; ++i)
+        EXPECT_EQ(stack_to_json(quick_irid[i].stack), stack_to_json(quick[60 + i].stack));
     for (const char* preset : {"standard", "paper"}) {
         const auto all = preset_configurations(preset);
         ASSERT_EQ(all.size(), 76u);  // the brushed category's eight (unfolded_test.cpp), the
@@ -275,7 +285,9 @@ TEST(StudyConfigurations, DispersiveInTheLargerPresetsOnly) {
         EXPECT_TRUE(c.stack.transmits());
         EXPECT_EQ(stack_from_json(stack_to_json(c.stack), c.id), c.stack) << c.id;
     }
-    EXPECT_EQ(filter_configurations(preset_configurations("quick"), "*").size(), 60u);
+    EXPECT_EQ(filter_configurations(preset_configurations("quick"), "*").size(), 63u);
+    for (const StudyConfiguration& c : preset_configurations("quick"))
+        EXPECT_NE(c.category, "dispersive") << c.id;
     for (const char* preset : {"standard", "paper"}) {
         const auto all = preset_configurations(preset);
         ASSERT_EQ(all.size(), 76u);

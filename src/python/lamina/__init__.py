@@ -410,8 +410,9 @@ def study(models=None, preset="quick", only=None, configs=None, out=None, figure
           quiet=True, nodes=4, peak_nodes=32, tables="half", **settings: Any) -> Study:
     """`lamina study` from Python, with Python models beside the built-in ones.
 
-    configs: None for the study's configurations at the preset (the 60, and the iridescent, brushed
-    and dispersive categories beyond the quick preset), or a list of {"id", "category", "stack"};
+    configs: None for the study's configurations at the preset (the 60 and three iridescent ones
+    at the quick preset; the iridescent, brushed and dispersive categories whole at the larger
+    ones), or a list of {"id", "category", "stack"};
     only: the CLI's --only globs. settings: the reference's, any of SIMULATION_SETTINGS by name;
     particles, when given, replaces the preset's budget. Returns the study directory `out` as a
     lamina.Study.
