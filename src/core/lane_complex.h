@@ -1,6 +1,7 @@
 // Complex numbers as lane values: a real and an imaginary part, each a lane value of core/lane.h
 // (one double, or the lanes of a SIMD vector of doubles), with the arithmetic the wave optics
-// need (the Fresnel amplitudes of physics/fresnel.h, the Airy sums of physics/thin_film.h). The
+// need (the Fresnel amplitudes of physics/fresnel.h, a thin film's Airy sums of
+// physics/thin_film_airy.h). The
 // functions of core/complex_math.h on std::complex are these templates instantiated at one lane.
 //
 // The forms are those of core/complex_math.h: |z|² = Re² + Im², 1/z = z̄/|z|², the principal
@@ -75,7 +76,7 @@ LAMINA_LANE_INLINE LaneComplex<T> times_conj(LaneComplex<T> a, LaneComplex<T> b)
     return {a.re * b.re + a.im * b.im, a.im * b.re - a.re * b.im};
 }
 
-/// 1/z as z̄/|z|² (z = 0: not finite).
+/// 1/z as z̄/|z|² (z = 0: not finite; the imaginary part of 1/x for a real x is +0).
 template <typename T, typename L>
 LAMINA_LANE_INLINE LaneComplex<T> reciprocal(LaneComplex<T> z) {
     const T inv = L::constant(1) / squared_modulus(z);

@@ -239,8 +239,8 @@ struct NoMueller {
 
 /// Calls an interface's reflection source — Fresnel factors `source(cos θ, factors)` or Mueller
 /// matrices `source(cos θ, m)` — for the lanes of `active`: with the mask where the source takes
-/// one (a source evaluated lane by lane, as a thin film's Airy sums, then skips the other lanes,
-/// whose values the events never use), else on every lane.
+/// one (a source that can skip the other lanes, whose values the events never use, as a thin
+/// film's reflection skips vector halves without an active lane), else on every lane.
 template <typename Source, typename T, typename Out, typename M>
 LAMINA_LANE_INLINE void reflection_on_lanes(const Source& source, T cos_theta, Out* out, M active) {
     if constexpr (std::is_invocable_v<const Source&, T, Out*, M>)

@@ -3,7 +3,7 @@
 // boundaries, and, for one channel, the film's reflection Mueller matrix from its indices away
 // from the special cases thin_film.h sorts out. The scalar functions of thin_film.h instantiate
 // them at one lane; the SIMD particle kernel on the lanes of a vector of doubles
-// (simulator/lane_events.h FilmReflection).
+// (simulator/lane_film.h FilmReflection).
 
 #include "core/lane.h"
 #include "core/lane_complex.h"
@@ -59,11 +59,14 @@ LAMINA_LANE_INLINE LaneFresnelAmplitudes<T> airy_sums(const LaneFresnelAmplitude
 /// the mean of their values at u2² ± h (the error of the mean is O(h²), of each value O(ε/√h)).
 inline constexpr double kFilmNearCritical = 1e-6;
 
-/// Where u2² = η_f² − sin²θ1 lies within kFilmNearCritical of 0.
+/// Where u2² = η_f² − sin²θ1 lies within `band` (kFilmNearCritical: thin_film.h's) of 0. The
+/// SIMD kernel takes a wider band and leaves those lanes to thin_film.h, which decides: its sin²θ1
+/// may round otherwise, and at the band's edge the two ways differ by more than a rounding.
 template <typename T, typename L>
-LAMINA_LANE_INLINE typename L::Mask near_film_critical(LaneComplex<T> eta_film, T sin2) {
+LAMINA_LANE_INLINE typename L::Mask near_film_critical(LaneComplex<T> eta_film, T sin2,
+                                                       double band = kFilmNearCritical) {
     return L::less(squared_modulus(normal_wave_number_square<T, L>(eta_film, sin2)),
-                   L::constant(kFilmNearCritical * kFilmNearCritical));
+                   L::constant(band * band));
 }
 
 /// The upper boundary of a film seen from its incident medium (index 1) at the incidence cosine

@@ -5,15 +5,14 @@
 // lambertian.h lambertian_event, with the Fresnel factors, the Smith masking and the visible
 // normals they use), the microsurface walk (microsurface_walk.h) and the medium step (medium.h:
 // Beer–Lambert, free flights and Henyey–Greenstein scattering by spectral MIS), in their isotropic
-// or general (anisotropic) GGX instance as trace_particle takes them. One piece is evaluated per
-// lane rather than on vectors: a thin film on a conductor, whose reflection (physics/thin_film.h
-// FilmOptics::reflection_from_above, in double, as film_event) takes the place of the bare
-// Fresnel terms in the conductor templates (FilmReflection); a film on a dielectric is the scalar
-// kernel's (SimulationSettings::kernel). Nor are the lane operations on Highway vectors (VecLane,
-// core/lane_hwy.h), the vector random numbers (simulator/lane_rng.h) and the vector exit bins
-// (simulator/lane_bins.h). The lane state and the events' adapters to it are
-// simulator/lane_events.h. This file holds the lane management: the queue and refills of lanes,
-// the grouping of lanes by layer, the tallies and the budget sums.
+// or general (anisotropic) GGX instance as trace_particle takes them, and a thin film on a
+// conductor, whose reflection (the Airy sums of physics/thin_film_airy.h, in double, on vectors of
+// doubles: simulator/lane_film.h FilmReflection) takes the place of the bare Fresnel terms in the
+// conductor templates; a film on a dielectric is the scalar kernel's (SimulationSettings::kernel).
+// Nor are the lane operations on Highway vectors (VecLane, core/lane_hwy.h), the vector random
+// numbers (simulator/lane_rng.h) and the vector exit bins (simulator/lane_bins.h). The lane state
+// and the events' adapters to it are simulator/lane_events.h. This file holds the lane management:
+// the queue and refills of lanes, the grouping of lanes by layer, the tallies and the budget sums.
 //
 // Layout. A block's particles run through a fixed set of lanes; a lane whose particle ends (exit,
 // absorption, cut-off) takes the block's next particle, so all lanes stay busy until the block's

@@ -29,8 +29,9 @@ LAMINA_LANE_BEGIN
 // reflection_from_above (physics/thin_film.h, in double, what the scalar kernel's film_event
 // evaluates) gives, here the lane templates of physics/thin_film_airy.h on vectors of doubles
 // (half a float vector at a time: a film's phase and its near-cancelling sums want double). The
-// lanes near the film's critical angle, and those whose sums are not finite (grazing on an
-// index-matched boundary), are evaluated by reflection_from_above itself, which sorts them out. It
+// lanes within twice reflection_from_above's band of the film's critical angle, and those whose
+// sums are not finite (grazing on an index-matched boundary, an exit's normal wave number 0), are
+// evaluated by reflection_from_above itself, which sorts them out. It
 // stands where the bare conductor's ConductorFresnel and ConductorMueller stand in the conductor
 // event and walk.
 struct FilmReflection {
@@ -45,7 +46,7 @@ struct FilmReflection {
         const std::size_t n_lanes = hn::Lanes(df), n_half = hn::Lanes(dd);
         HWY_ALIGN float cos_l[kMaxLanes];
         HWY_ALIGN double mu[kMaxLanes], above[kMaxLanes], eta_film[2][kMaxLanes],
-            eta_below[3][2][kMaxLanes], thickness_over_lambda[3][kMaxLanes];
+            eta_below[3][2][kMaxLanes], thickness[kMaxLanes], lambda[3][kMaxLanes];
         HWY_ALIGN float out[3][4][kMaxLanes];
         hn::Store(cos_theta, df, cos_l);
         const std::uint64_t active_bits = MaskBits(active);
@@ -53,12 +54,13 @@ struct FilmReflection {
             const FilmOptics& f = *film[l];
             mu[l] = std::min(std::max(double(cos_l[l]), 0.0), 1.0);
             above[l] = f.eta_above;
+            thickness[l] = thickness_nm[l];
             eta_film[0][l] = f.eta_film.real();
             eta_film[1][l] = f.eta_film.imag();
             for (int c = 0; c < 3; ++c) {
                 eta_below[c][0][l] = f.eta_below[c].real();
                 eta_below[c][1][l] = f.eta_below[c].imag();
-                thickness_over_lambda[c][l] = thickness_nm[l] / f.wavelength_nm[c];
+                lambda[c][l] = f.wavelength_nm[c];
             }
         }
         std::uint64_t scalar_bits = 0;
@@ -72,12 +74,14 @@ struct FilmReflection {
             const VD eta_above = hn::Load(dd, above + base);
             const LaneComplex<VD> ef{hn::Div(hn::Load(dd, eta_film[0] + base), eta_above),
                                      hn::Div(hn::Load(dd, eta_film[1] + base), eta_above)};
-            MD special = near_film_critical<VD, VecLaneD>(ef, sin2);
+            // Twice thin_film.h's band: the lanes near its edge are left to it.
+            MD special = near_film_critical<VD, VecLaneD>(ef, sin2, 2 * kFilmNearCritical);
+            const VD thickness_above = hn::Mul(hn::Load(dd, thickness + base), eta_above);
             const LaneFilmTop<VD> top = film_top<VD, VecLaneD>(m, sin2, ef);
             for (int c = 0; c < 3; ++c) {
                 const LaneComplex<VD> ex{hn::Div(hn::Load(dd, eta_below[c][0] + base), eta_above),
                                          hn::Div(hn::Load(dd, eta_below[c][1] + base), eta_above)};
-                const VD waves = hn::Mul(hn::Load(dd, thickness_over_lambda[c] + base), eta_above);
+                const VD waves = hn::Div(thickness_above, hn::Load(dd, lambda[c] + base));
                 const InterfaceMueller<VD> r =
                     film_reflection_mueller<VD, VecLaneD>(top, ef, sin2, ex, waves);
                 const VD sum = hn::Add(hn::Add(r.a, r.b), hn::Add(r.c, r.d));

@@ -327,12 +327,16 @@ double mueller_lane_bound(double delta) {
     return 16 * 0x1p-24 + 4 * (4 * 0x1p-24) / (2 * std::sqrt(delta));
 }
 // A thin film's reflection on the lanes (simulator/lane_film.h: the Airy sums of
-// physics/thin_film_airy.h on vectors of doubles, the lanes near the film's critical angle and
-// the grazing index-matched ones handed to the scalar FilmOptics) against FilmOptics::
-// reflection_from_above on one lane, each entry's film its own as a spectral run's lanes have
-// them. Both are double evaluations (their difference is ~1e-13 of the entries, the vector's
-// exp, cos and sin within 3 ulp), each rounded to float once: they agree to one float ulp of
-// entries in [−1, 1], 2^-24.
+// physics/thin_film_airy.h on vectors of doubles) against FilmOptics::reflection_from_above on
+// one lane, each entry's film its own as a spectral run's lanes have them. Both are double
+// evaluations (their difference is ~1e-13 of the entries, the vector's exp, cos and sin within
+// 3 ulp), each rounded to float once: they agree to one float ulp of entries in [−1, 1], 2^-24.
+// The lanes the vectors leave to FilmOptics near the film's critical angle, where FilmOptics
+// averages two sums, equal it exactly; each such case is put in every lane of a vector, so the
+// routing of every lane is seen: a thick film near its critical angle (averaged and direct sums
+// differ there by ~3e-6, far more than an ulp) and a film index-matched to the medium above at
+// grazing (u2 = 0). An exit matched to the medium above at grazing (u3 = 0, where the vector's
+// square root may be 0/0 and the lane is then left to FilmOptics too) is held to the ulp.
 TEST(KernelSimd, FilmReflectionLanes) {
     using C = std::complex<double>;
     auto film = [](C eta_film, double above, C below0, C below1, C below2) {
@@ -356,25 +360,48 @@ TEST(KernelSimd, FilmReflectionLanes) {
         film(C(2.3, 0.1), 1.5, C(2.9, 2.9), C(2.8, 2.9), C(2.6, 2.8)),
         // A film of 1.2 under a coat of 1.5: its critical angle at sin²θ = 0.64.
         film(C(1.2), 1.5, C(0.2, 3.0), C(0.5, 2.3), C(1.2, 1.9)),
-        // A film index-matched to the medium above, on gold: grazing, u2 = 0.
+        // A film index-matched to the medium above, on gold: at grazing u2 = 0.
         film(C(1.0), 1.0, C(0.18, 3.4), C(0.5, 2.2), C(1.3, 1.8)),
+        // A film of 4 under a coat of 5 (its critical angle at sin²θ = 0.64) over 4 + 0.5i.
+        film(C(4.0), 5.0, C(4.0, 0.5), C(4.0, 0.5), C(4.0, 0.5)),
+        // An exit of index 1, k = 0, under a film in air: at grazing u3 = 0.
+        film(C(1.5), 1.0, C(1.0), C(1.0), C(1.0)),
     };
+    constexpr std::size_t kVector = 16;  // a multiple of every instruction set's float lanes
     ParticleRng rng(23, 0, 0);
-    std::vector<float> cos_theta = {
-        0.f, 1.f, 1e-7f, 0.6f, std::nextafter(0.6f, 0.f), std::nextafter(0.6f, 1.f)};
-    for (int k = 0; k < 6000; ++k)
-        cos_theta.push_back(rng.uniform_float());
+    std::vector<float> cos_theta;
     std::vector<const FilmOptics*> lane_films;
     std::vector<double> thickness;
-    for (std::size_t j = 0; j < cos_theta.size(); ++j) {
-        lane_films.push_back(&films[(j * 7 + j / 5) % films.size()]);
+    std::vector<char> routed;  // left to FilmOptics: equal to it exactly
+    for (std::size_t j = 0; j < 6000; ++j) {
+        cos_theta.push_back(j < 3 ? float(j) / 2 : rng.uniform_float());
+        lane_films.push_back(&films[(j * 7 + j / 5) % 5]);
         thickness.push_back(j % 11 == 0 ? 0.0 : 800.0 * double(rng.uniform_float()));
+        routed.push_back(0);
     }
+    auto every_lane = [&](const FilmOptics& f, float cos_i, double d, bool exact) {
+        for (std::size_t l = 0; l < kVector; ++l) {
+            cos_theta.push_back(cos_i);
+            lane_films.push_back(&f);
+            thickness.push_back(d);
+            routed.push_back(exact ? 1 : 0);
+        }
+    };
+    // cos² − 0.36 within 1.5e-6 of 0: all within twice FilmOptics' band of 1e-6, some inside it.
+    for (int k = -20; k <= 20; k += 4) {
+        float c = 0.6f;
+        for (int i = 0; i < std::abs(k); ++i)
+            c = std::nextafter(c, k < 0 ? 0.f : 1.f);
+        every_lane(films[5], c, 10000, true);
+    }
+    every_lane(films[4], 0.f, 300, true);
+    every_lane(films[6], 0.f, 300, false);
     // Every other lane skipped in a second pass: the skipped lanes keep the identity.
     for (const std::uint64_t skip : {std::uint64_t(0), std::uint64_t(0xAAAAAAAAAAAAAAAA)}) {
         std::size_t n_lanes = 0;
         const std::vector<float> lanes =
             simd_film_reflection(lane_films, cos_theta, thickness, skip, n_lanes);
+        ASSERT_EQ(kVector % n_lanes, 0u);
         double worst = 0;
         for (std::size_t j = 0; j < cos_theta.size(); ++j) {
             const float* e = &lanes[15 * j];
@@ -390,11 +417,16 @@ TEST(KernelSimd, FilmReflectionLanes) {
             }
             const auto m = lane_films[j]->reflection_from_above(double(cos_theta[j]), thickness[j]);
             for (int c = 0; c < 3; ++c) {
-                const double scalar[4] = {m[std::size_t(c)].a, m[std::size_t(c)].b,
-                                          m[std::size_t(c)].c, m[std::size_t(c)].d};
+                const float scalar[4] = {float(m[std::size_t(c)].a), float(m[std::size_t(c)].b),
+                                         float(m[std::size_t(c)].c), float(m[std::size_t(c)].d)};
                 for (int k = 0; k < 4; ++k) {
                     ASSERT_TRUE(std::isfinite(e[4 * c + k])) << j;
-                    worst = std::max(worst, std::abs(double(e[4 * c + k]) - scalar[k]));
+                    if (routed[j])
+                        EXPECT_EQ(e[4 * c + k], scalar[k])
+                            << "entry " << j << ", lane " << j % n_lanes << ", cos "
+                            << cos_theta[j];
+                    else
+                        worst = std::max(worst, std::abs(double(e[4 * c + k]) - scalar[k]));
                 }
                 EXPECT_EQ(e[12 + c], e[4 * c]) << j;  // the unpolarized factor is a
             }
