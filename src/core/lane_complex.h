@@ -1,8 +1,8 @@
 // Complex numbers as lane values: a real and an imaginary part, each a lane value of core/lane.h
 // (one double, or the lanes of a SIMD vector of doubles), with the arithmetic the wave optics
 // need (the Fresnel amplitudes of physics/fresnel.h, a thin film's Airy sums of
-// physics/thin_film_airy.h). The
-// functions of core/complex_math.h on std::complex are these templates instantiated at one lane.
+// physics/thin_film_airy.h). The functions of core/complex_math.h on std::complex are these
+// templates instantiated at one lane.
 //
 // The forms are those of core/complex_math.h: |z|² = Re² + Im², 1/z = z̄/|z|², the principal
 // square root of Press, Teukolsky, Vetterling & Flannery ("Numerical Recipes in C", 2nd ed., §5.4,

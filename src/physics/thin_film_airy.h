@@ -36,8 +36,8 @@ LAMINA_LANE_BEGIN
 /// header) of a film whose boundaries incident | film and film | exit have the amplitudes b12 and
 /// b23, its normal wave number u2 (Im u2 ≥ 0) and its thickness in waves (thickness_waves: the
 /// phase of one crossing is δ = 2π thickness_waves u2), for s and p:
-///     r = (r12 + r23 e^{2iδ}) / (1 + r12 r23 e^{2iδ}),   t = t12 t23 e^{iδ} / (1 + r12 r23
-///     e^{2iδ}).
+///     r = (r12 + r23 e^{2iδ}) / (1 + r12 r23 e^{2iδ}),
+///     t = t12 t23 e^{iδ} / (1 + r12 r23 e^{2iδ}).
 template <typename T, typename L>
 LAMINA_LANE_INLINE LaneFresnelAmplitudes<T> airy_sums(const LaneFresnelAmplitudes<T>& b12,
                                                       const LaneFresnelAmplitudes<T>& b23,
