@@ -136,31 +136,39 @@ HWY_INLINE VF Acos(VF x) {
     return hn::IfThenElse(hn::Lt(x, hn::Zero(df)), hn::Sub(hn::Set(df, kPi<float>), r), r);
 }
 
+/// The operations of core/lane.h that every element type's vectors share (Highway's own),
+/// for the descriptor D; VecLane (floats) and VecLaneD (doubles) add their special functions.
+template <class D>
+struct VecLaneOps {
+    using Value = hn::Vec<D>;
+    using Mask = hn::Mask<D>;
+    using V = Value;
+    using M = Mask;
+    static HWY_INLINE V constant(double x) { return hn::Set(D(), hn::TFromD<D>(x)); }
+    static HWY_INLINE V min(V a, V b) { return hn::Min(a, b); }
+    static HWY_INLINE V max(V a, V b) { return hn::Max(a, b); }
+    static HWY_INLINE V sqrt(V x) { return hn::Sqrt(x); }
+    static HWY_INLINE V exp(V x) { return hn::Exp(D(), x); }
+    static HWY_INLINE V select(M m, V a, V b) { return hn::IfThenElse(m, a, b); }
+    static HWY_INLINE M less(V a, V b) { return hn::Lt(a, b); }
+    static HWY_INLINE V abs(V x) { return hn::Abs(x); }
+    static HWY_INLINE V copysign(V a, V b) { return hn::CopySign(a, b); }
+    static HWY_INLINE V mul_add(V a, V b, V c) { return hn::MulAdd(a, b, c); }
+    static HWY_INLINE V neg_mul_add(V a, V b, V c) { return hn::NegMulAdd(a, b, c); }
+    static HWY_INLINE M both(M m, M n) { return hn::And(m, n); }
+    static HWY_INLINE M either(M m, M n) { return hn::Or(m, n); }
+    static HWY_INLINE M negate(M m) { return hn::Not(m); }
+    static HWY_INLINE bool none(M m) { return hn::AllFalse(D(), m); }
+};
+
 /// The operations of core/lane.h on vectors: the lane templates (core/beta_function.h, the
 /// physics headers) instantiated on the lanes of VF. Highway's contrib math functions: Log
 /// ≤ 4 ulp, Log1p ≤ 2 ulp, Exp ≤ 1 ulp (hwy/contrib/math).
-struct VecLane {
-    using Value = VF;
-    using Mask = MF;
-    static HWY_INLINE VF constant(double x) { return hn::Set(DF(), float(x)); }
-    static HWY_INLINE VF min(VF a, VF b) { return hn::Min(a, b); }
-    static HWY_INLINE VF max(VF a, VF b) { return hn::Max(a, b); }
-    static HWY_INLINE VF sqrt(VF x) { return hn::Sqrt(x); }
+struct VecLane : VecLaneOps<DF> {
     static HWY_INLINE VF log(VF x) { return hn::Log(DF(), x); }
     static HWY_INLINE VF log1p(VF x) { return hn::Log1p(DF(), x); }
-    static HWY_INLINE VF exp(VF x) { return hn::Exp(DF(), x); }
-    static HWY_INLINE VF select(MF m, VF a, VF b) { return hn::IfThenElse(m, a, b); }
-    static HWY_INLINE MF less(VF a, VF b) { return hn::Lt(a, b); }
-    static HWY_INLINE VF abs(VF x) { return hn::Abs(x); }
-    static HWY_INLINE VF copysign(VF a, VF b) { return hn::CopySign(a, b); }
-    static HWY_INLINE VF mul_add(VF a, VF b, VF c) { return hn::MulAdd(a, b, c); }
-    static HWY_INLINE VF neg_mul_add(VF a, VF b, VF c) { return hn::NegMulAdd(a, b, c); }
     static HWY_INLINE VF inv_sqrt(VF x) { return InvSqrt(x); }
     static HWY_INLINE void cos_sin_2pi(VF u, VF& c, VF& s) { CosSin2Pi(u, c, s); }
-    static HWY_INLINE MF both(MF m, MF n) { return hn::And(m, n); }
-    static HWY_INLINE MF either(MF m, MF n) { return hn::Or(m, n); }
-    static HWY_INLINE MF negate(MF m) { return hn::Not(m); }
-    static HWY_INLINE bool none(MF m) { return hn::AllFalse(DF(), m); }
     static constexpr double kBetaArgumentMax = Lane<float>::kBetaArgumentMax;
     static constexpr bool kSinglePrecision = true;
 };
@@ -174,28 +182,11 @@ using MD = hn::Mask<DD>;
 /// The operations of core/lane.h on vectors of doubles, for the lane templates evaluated in
 /// double. Highway's contrib math functions: Exp ≤ 1 ulp, Cos and Sin ≤ 3 ulp on
 /// [−39000, 39000] (hwy/contrib/math).
-struct VecLaneD {
-    using Value = VD;
-    using Mask = MD;
-    static HWY_INLINE VD constant(double x) { return hn::Set(DD(), x); }
-    static HWY_INLINE VD min(VD a, VD b) { return hn::Min(a, b); }
-    static HWY_INLINE VD max(VD a, VD b) { return hn::Max(a, b); }
-    static HWY_INLINE VD sqrt(VD x) { return hn::Sqrt(x); }
-    static HWY_INLINE VD exp(VD x) { return hn::Exp(DD(), x); }
+struct VecLaneD : VecLaneOps<DD> {
     static HWY_INLINE void cos_sin(VD x, VD& c, VD& s) {
         c = hn::Cos(DD(), x);
         s = hn::Sin(DD(), x);
     }
-    static HWY_INLINE VD select(MD m, VD a, VD b) { return hn::IfThenElse(m, a, b); }
-    static HWY_INLINE MD less(VD a, VD b) { return hn::Lt(a, b); }
-    static HWY_INLINE VD abs(VD x) { return hn::Abs(x); }
-    static HWY_INLINE VD copysign(VD a, VD b) { return hn::CopySign(a, b); }
-    static HWY_INLINE VD mul_add(VD a, VD b, VD c) { return hn::MulAdd(a, b, c); }
-    static HWY_INLINE VD neg_mul_add(VD a, VD b, VD c) { return hn::NegMulAdd(a, b, c); }
-    static HWY_INLINE MD both(MD m, MD n) { return hn::And(m, n); }
-    static HWY_INLINE MD either(MD m, MD n) { return hn::Or(m, n); }
-    static HWY_INLINE MD negate(MD m) { return hn::Not(m); }
-    static HWY_INLINE bool none(MD m) { return hn::AllFalse(DD(), m); }
     static constexpr bool kSinglePrecision = false;
 };
 
