@@ -328,15 +328,15 @@
   }
 
   // The model families (study.json model_groups, from the registry): the 2019 set, Belcour's
-  // statistical successors, the production coats, their one-flag ablations. A study without the
-  // field puts every model in one group.
+  // statistical successors, the production coats, their one-flag ablations, a film's own model. A
+  // study without the field puts every model in one group.
   const GROUP_NAMES = {
     lamina: "lamina-1", "2019": "2019 study", successors: "statistical successors", production: "production coats",
-    ablations: "production ablations", external: "your models (tables, Python)",
+    films: "thin-film models", ablations: "production ablations", external: "your models (tables, Python)",
     reference: "reference", other: "models",
   };
-  const GROUP_ORDER = ["lamina", "2019", "successors", "production", "ablations", "external",
-    "reference", "other"];
+  const GROUP_ORDER = ["lamina", "2019", "successors", "production", "ablations", "films",
+    "external", "reference", "other"];
   const modelGroup = (m) => (STUDY.model_groups && STUDY.model_groups[m]) || "other";
   const groups = GROUP_ORDER.map((g) => [g, models.filter((m) => modelGroup(m) === g)])
     .filter(([, ms]) => ms.length);

@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "models/belcour/belcour.h"
+#include "models/belcour_barla/belcour_barla.h"
 #include "models/ddb22/ddb22.h"
 #include "models/lamina1/lamina1.h"
 #include "models/lamina_coat/lamina_coat.h"
@@ -239,13 +240,20 @@ const std::vector<ModelEntry>& model_registry() {
          "bases: lambertian, conductor; media: absorbing; sides: R",
          standard_surface_materialx_options, make_standard_surface_materialx, false, "production",
          /*represents_anisotropy=*/false, /*films=*/false, /*specification=*/"standard-surface"},
+        {"bb17",
+         "Belcour & Barla 2017 as their shader ships it: GGX lobe, uncorrelated Smith, film "
+         "Fresnel by the Airy sum's 3 orders on the CIE fit, in CIE 1931 RGB",
+         "bases: conductor under the ambient (no coat), with a thin film (transparent, index >= "
+         "the ambient's); sides: R",
+         belcour_barla_options, make_belcour_barla, false, "films",
+         /*represents_anisotropy=*/false, /*films=*/true},
     });
     return entries;
 }
 
 const std::vector<std::string>& model_groups() {
-    static const std::vector<std::string> groups = {"lamina", "2019", "successors", "production",
-                                                    "reference"};
+    static const std::vector<std::string> groups = {"lamina",     "2019",  "successors",
+                                                    "production", "films", "reference"};
     return groups;
 }
 

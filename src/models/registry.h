@@ -24,8 +24,8 @@ struct ModelEntry {
     bool stochastic = false;
     /// The family a reader compares it within (the explorer's model groups): "2019" (the
     /// models of the 2019 study), "successors" (Belcour 2018's statistical successors),
-    /// "production" (the coats engines ship), "lamina" (lamina's own model) or "reference" (the
-    /// stochastic estimator).
+    /// "production" (the coats engines ship), "films" (a thin film's own model, on one
+    /// interface), "lamina" (lamina's own model) or "reference" (the stochastic estimator).
     std::string group = "2019";
     /// The model represents anisotropic interfaces (alpha = [alpha_x, alpha_y], docs/physics.md
     /// §3): it is built for such a stack and evaluated on the unfolded grid. Otherwise it reports

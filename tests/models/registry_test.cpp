@@ -63,12 +63,13 @@ TEST(ModelRegistry, ModelsBuiltForAnisotropyOrFilmsDependOnThem) {
     const auto brushed = [](double tangent_deg) {
         return test::coated(1.5, 0.1, anisotropic(test::gold(0.3), 0.3, 0.05, tangent_deg));
     };
-    const auto filmed = [](double thickness_nm) {
+    // A film's own model (group "films") has no coat: its filmed stack is the bare metal.
+    const auto filmed = [](double thickness_nm, bool coated) {
         InterfaceSpec base = test::gold(0.2);
         base.has_film = true;
         base.film.thickness_nm = base.film.thickness_max_nm = thickness_nm;
         base.film.eta = 1.8;
-        return test::coated(1.5, 0.1, base);
+        return coated ? test::coated(1.5, 0.1, base) : test::single(base);
     };
     const Vec3d wi = normalize(Vec3d(0.4, 0.3, 0.8)), wo = normalize(Vec3d(-0.2, -0.5, 0.7));
     // Whether `name` is built for both stacks as its flag says, and then tells them apart.
@@ -87,10 +88,12 @@ TEST(ModelRegistry, ModelsBuiltForAnisotropyOrFilmsDependOnThem) {
         if (e.stochastic) continue;  // the random walk: tested against the goniophotometer
         anisotropic_built += built_and_depends(e.name, e.represents_anisotropy, brushed(20),
                                                brushed(110), "anisotropic");
-        filmed_built += built_and_depends(e.name, e.films, filmed(150), filmed(400), "filmed");
+        const bool coated = e.group != "films";
+        filmed_built +=
+            built_and_depends(e.name, e.films, filmed(150, coated), filmed(400, coated), "filmed");
     }
     EXPECT_GE(anisotropic_built, 2);  // the OpenPBR coats
-    EXPECT_GE(filmed_built, 4);       // three.js's, openpbr-bsdf's, Cycles' and OpenPBR's films
+    EXPECT_GE(filmed_built, 5);  // three.js's, openpbr-bsdf's, Cycles', OpenPBR's and bb17's films
 }
 
 TEST(ModelRegistry, ListsTheProductionCoats) {

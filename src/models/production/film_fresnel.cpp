@@ -122,17 +122,35 @@ double sensitivity_weight(const SensitivityGaussian& g) {
     return g.val * std::sqrt(2 * std::numbers::pi * g.var);
 }
 
+/// The fit as complex values: G_j(OPD) = Σ_{g of j} w_g e^(i pos_g t) e^(−var_g t²) / norm, t the
+/// phase 2π OPD, j ∈ {X, Y, Z}; the sensitivity turned by a shift ψ is Re(e^(iψ) G_j).
+std::array<std::complex<double>, 3> sensitivity_xyz(double opd_nm) {
+    const double phase = sensitivity_phase(opd_nm);
+    std::array<std::complex<double>, 3> xyz{};
+    for (const SensitivityGaussian& g : kSensitivityGaussians)
+        xyz[std::size_t(g.xyz)] += sensitivity_weight(g) * std::exp(-phase * phase * g.var) *
+                                   std::polar(1.0, g.pos * phase) / kSensitivityNorm;
+    return xyz;
+}
+
+/// XYZ to CIE 1931 RGB (the CIE's primaries at 700, 546.1 and 435.8 nm, equal-energy white E): the
+/// inverse of the CIE's RGB → XYZ matrix, to seven digits as Belcour & Barla's shader carries it
+/// (its XYZ_TO_RGB).
+template <typename V>
+V xyz_to_cie_rgb_7_digits(const V& xyz) {
+    return {2.3706743 * xyz[0] - 0.9000405 * xyz[1] - 0.4706338 * xyz[2],
+            -0.5138850 * xyz[0] + 1.4253036 * xyz[1] + 0.0885814 * xyz[2],
+            0.0052982 * xyz[0] - 0.0146949 * xyz[1] + 1.0093968 * xyz[2]};
+}
+
 }  // namespace
 
 Rgbd belcour_sensitivity_srgb(double opd_nm, const Rgbd& shift) {
-    const double phase = sensitivity_phase(opd_nm);
-    double xyz[3] = {0, 0, 0};
-    for (const SensitivityGaussian& g : kSensitivityGaussians)
-        xyz[g.xyz] += sensitivity_weight(g) * std::cos(g.pos * phase + shift[g.xyz]) *
-                      std::exp(-phase * phase * g.var);
-    for (double& v : xyz)
-        v /= kSensitivityNorm;
-    return xyz_to_srgb_7_digits(Rgbd(xyz[0], xyz[1], xyz[2]));
+    const std::array<std::complex<double>, 3> g = sensitivity_xyz(opd_nm);
+    Rgbd xyz;
+    for (int j = 0; j < 3; ++j)
+        xyz[j] = (std::polar(1.0, shift[j]) * g[std::size_t(j)]).real();
+    return xyz_to_srgb_7_digits(xyz);
 }
 
 namespace {
@@ -652,11 +670,13 @@ std::complex<double> phasor(std::complex<double> r) {
     return m > 0 ? r / m : std::complex<double>(1.0);
 }
 
-/// Cycles' iridescence_airy_summation_channel: Belcour & Barla 2017, Eq. 10 to the third order,
-/// R = R12 + R_s + Σ_m 2 C_m Re(e^(imφ) conj(S(m OPD))), C_m = (R_s − T121) r123^m, for one
-/// polarization with the boundaries' reflectances R12, R23 and the round trip's phasor e^(iφ).
-/// The sum R, its DC term R12 + R_s, and the orders' largest swing about it, Σ_m 2|C_m| s_max,
-/// for a sensitivity of magnitude at most s_max (|R − DC| ≤ swing whatever the OPD).
+/// Belcour & Barla 2017, Eq. 10 to the third order (Cycles' iridescence_airy_summation_channel,
+/// their shader's loop), R = (R12 + R_s) S(0) + Σ_m 2 C_m Re(e^(imφ) conj(S(m OPD))),
+/// C_m = (R_s − T121) r123^m, for one polarization with the boundaries' reflectances R12, R23 and
+/// the round trip's phasor e^(iφ); S(0) is real (1 for a sensitivity normalized to white, as
+/// Cycles' table is). The sum R, its DC term (R12 + R_s) S(0), and the orders' largest swing about
+/// it, Σ_m 2|C_m| s_max, for a sensitivity of magnitude at most s_max (|R − DC| ≤ swing whatever
+/// the OPD).
 struct AirySum {
     double R, dc, swing;
 };
@@ -665,7 +685,8 @@ AirySum airy_summation(const Sensitivity& sensitivity, double R12, double R23, d
                        std::complex<double> round_trip, double s_max) {
     const double T121 = 1 - R12, R123 = R12 * R23, r123 = std::sqrt(R123);
     const double Rs = T121 * T121 * R23 / (1 - R123);
-    AirySum out{R12 + Rs, R12 + Rs, 0};
+    const double dc = (R12 + Rs) * sensitivity(0.0).real();
+    AirySum out{dc, dc, 0};
     double Cm = Rs - T121;
     std::complex<double> power = round_trip;
     for (int m = 1; m <= 3; ++m) {
@@ -753,6 +774,86 @@ double cycles_film_reflectance_monochromatic(double wavelength_nm, double film_i
     return cycles_film(
         [&](double opd) { return std::polar(1.0, -2 * std::numbers::pi * opd / wavelength_nm); },
         film_ior, thickness_nm, substrate, cos_theta_1);
+}
+
+namespace {
+
+/// The Dinc (µm) from which Belcour & Barla's shader takes the film's own index.
+constexpr double kBelcourBarlaBlendEndUm = 0.03;
+
+/// Belcour & Barla's shader before its final clamp, in CIE 1931 RGB channel c (the shader's
+/// Fresnel term, its Airy function; docs/models.md, "Belcour & Barla 2017").
+double belcour_barla_sum(int channel, double film_ior, double dinc_um, double base_eta,
+                         double base_kappa, double cos_theta_1) {
+    using C = std::complex<double>;
+    // The shader's sensitivity in channel c: its XYZ fit projected to CIE RGB (conjugated for
+    // airy_summation's Re(e^(imφ) conj S)).
+    const auto sensitivity = [channel](double opd_nm) {
+        return std::conj(xyz_to_cie_rgb_7_digits(sensitivity_xyz(opd_nm))[std::size_t(channel)]);
+    };
+    // "Force eta_2 -> 1.0 when Dinc -> 0.0": the film's index blends from the ambient's over the
+    // first 0.03 µm of Dinc (smoothstep); the optical path keeps Dinc itself.
+    const double t = clamp(dinc_um / kBelcourBarlaBlendEndUm, 0.0, 1.0);
+    const double eta = 1 + (film_ior - 1) * t * t * (3 - 2 * t);
+    const double c1 = clamp(cos_theta_1, 0.0, 1.0), sin2 = 1 - c1 * c1;
+    // A film of lower index than the ambient would reflect totally at grazing facets, where the
+    // shader leaves the reflectance unset: no value is the shader's there (the model refuses such
+    // films); lamina returns total reflection. At grazing incidence the first boundary reflects
+    // everything: the DC term alone.
+    if (!(eta * eta - sin2 > 0) || c1 == 0) return sensitivity(0.0).real();
+    const C u1(c1), u2(std::sqrt(eta * eta - sin2));
+    const FresnelAmplitudes<double> top = fresnel_amplitudes<double>(C(1), u1, C(eta), u2);
+    // The base's index as the shader's fresnelConductor forms it: η3 (1 + iκ3), so that its
+    // A = η3²(1 − κ3²) − sin²θ and 2η3²κ3 are the real and imaginary parts of η3²(1 + iκ3)² −
+    // sin²θ.
+    const C base(base_eta, base_eta * base_kappa);
+    const FresnelAmplitudes<double> bottom =
+        fresnel_amplitudes<double>(C(eta), u2, base, normal_wave_number(base, sin2));
+    const double opd = dinc_um * 1000 * (u2.real() / eta);  // Dinc cos θ2, nm
+    // φ2 = φ21 + φ23 with φ21 = π − φ12.
+    const auto round_trip = [](C r12, C r23) { return -std::conj(phasor(r12)) * phasor(r23); };
+    const AirySum R_s = airy_summation(sensitivity, std::norm(top.r_s), std::norm(bottom.r_s), opd,
+                                       round_trip(top.r_s, bottom.r_s), 1.0);
+    const AirySum R_p = airy_summation(sensitivity, std::norm(top.r_p), std::norm(bottom.r_p), opd,
+                                       round_trip(top.r_p, bottom.r_p), 1.0);
+    return 0.5 * (R_s.R + R_p.R);
+}
+
+/// The period in Dinc (µm) of the sum's fastest term, the third order's phase 2π·3·Dinc cos θ2/λ,
+/// at its shortest: λ = 360 nm.
+constexpr double kBelcourBarlaPeriodUm = 0.36 / 3;
+
+}  // namespace
+
+double belcour_barla_fresnel(int channel, double film_ior, double dinc_um, double base_eta,
+                             double base_kappa, double cos_theta_1) {
+    return clamp(belcour_barla_sum(channel, film_ior, dinc_um, base_eta, base_kappa, cos_theta_1),
+                 0.0, 1.0);
+}
+
+Rgbd belcour_barla_fresnel(double film_ior, double dinc_um, const Rgbd& base_eta,
+                           const Rgbd& base_kappa, double cos_theta_1) {
+    Rgbd F;
+    for (int c = 0; c < 3; ++c)
+        F[c] = belcour_barla_fresnel(c, film_ior, dinc_um, base_eta[c], base_kappa[c], cos_theta_1);
+    return F;
+}
+
+Rgbd belcour_barla_fresnel_range(double film_ior, double dinc_min_um, double dinc_max_um,
+                                 const Rgbd& base_eta, const Rgbd& base_kappa, double cos_theta_1) {
+    const auto mean = [&](double lo, double hi) {
+        return thickness_average(lo, hi, kBelcourBarlaPeriodUm, [&](double dinc) {
+            return belcour_barla_fresnel(film_ior, dinc, base_eta, base_kappa, cos_theta_1);
+        });
+    };
+    // The film's index stops blending at kBelcourBarlaBlendEndUm, where the term's second
+    // derivative jumps: the quadrature takes the two sides apart.
+    constexpr double end = kBelcourBarlaBlendEndUm;
+    if (dinc_min_um < end && dinc_max_um > end)
+        return (mean(dinc_min_um, end) * (end - dinc_min_um) +
+                mean(end, dinc_max_um) * (dinc_max_um - end)) /
+               (dinc_max_um - dinc_min_um);
+    return mean(dinc_min_um, dinc_max_um);
 }
 
 namespace {

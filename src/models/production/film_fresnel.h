@@ -7,9 +7,11 @@
 // sum reduced to two orders on Schlick's Fresnel, integrated against the CIE colour matching
 // functions and returned in linear sRGB; and Blender Cycles' (its Principled BSDF's thin film),
 // the same Fourier-space sum with the exact phases of both boundaries, three orders, and its
-// sensitivity read from a table of the CIE functions' Fourier transform (CyclesFilmSensitivity).
+// sensitivity read from a table of the CIE functions' Fourier transform (CyclesFilmSensitivity);
+// and Belcour & Barla's own shader, the same sum with the paper's Gaussian fit of that transform,
+// returned in CIE 1931 RGB.
 //
-// Both return a reflectance per RGB channel in [0, 1] and never throw. A film's thickness range
+// Each returns a reflectance per RGB channel in [0, 1] and never throw. A film's thickness range
 // [min, max] (a film uniformly distributed over the surface) is averaged over: the surface's mean
 // reflectance, what a texture of the thickness shows over many pixels.
 
@@ -154,6 +156,31 @@ double cycles_film_reflectance_monochromatic(double wavelength_nm, double film_i
                                              double thickness_nm,
                                              const CyclesFilmSubstrate& substrate,
                                              double cos_theta_1);
+
+/// Belcour & Barla 2017's iridescent Fresnel term as their supplemental BRDF Explorer shader
+/// evaluates it (its Airy function; "A practical extension to microfacet theory for the modeling
+/// of varying iridescence", ACM TOG 36(4), Eqs. 6–10): a film of index film_ior over a base, lit
+/// from a medium of index 1 at the facet cosine cos_theta_1 ∈ [0, 1]; the exact reflectances and
+/// phases of both boundaries, each polarization summed to the third order of Eq. 10 (the sum Cycles
+/// took over), each order's phase integrated against the paper's Gaussian fit of the CIE 1931
+/// functions' Fourier transforms (the one three.js carries), the mean of s and p projected to
+/// **CIE 1931 RGB** (equal-energy white, not sRGB) and clamped to [0, 1]; channel c of that
+/// colour. dinc_um is the shader's Dinc, the film's optical path 2 η_f d at normal incidence in
+/// µm (the sum's OPD is Dinc cos θ2); the film's index blends from 1 over Dinc ∈ [0, 0.03]
+/// (smoothstep). The base's complex index is base_eta·(1 + i base_kappa): the shader's κ3 is Born
+/// & Wolf's attenuation index (relative to η3), not the extinction coefficient k of n + ik.
+/// film_ior ≥ 1 (below, the shader leaves a total reflection's reflectance unset; 1 is returned).
+double belcour_barla_fresnel(int channel, double film_ior, double dinc_um, double base_eta,
+                             double base_kappa, double cos_theta_1);
+/// belcour_barla_fresnel in the three channels, channel c with the base base_eta[c]·(1 + i
+/// base_kappa[c]) (the shader's base is one index: each channel is the shader run on its own).
+Rgbd belcour_barla_fresnel(double film_ior, double dinc_um, const Rgbd& base_eta,
+                           const Rgbd& base_kappa, double cos_theta_1);
+/// belcour_barla_fresnel averaged over Dinc uniform in [dinc_min_um, dinc_max_um] (a thickness
+/// uniform over a range) by Gauss–Legendre quadrature (32 nodes per period of the third order at
+/// 360 nm, at most 2048).
+Rgbd belcour_barla_fresnel_range(double film_ior, double dinc_min_um, double dinc_max_um,
+                                 const Rgbd& base_eta, const Rgbd& base_kappa, double cos_theta_1);
 
 /// Cycles' F82-tint metal under its thin film (kernel/closure/bsdf_microfacet.h, microfacet_fresnel
 /// with F82_TINT): per channel the metal of normal reflectance f0 and F82 tint `tint` read as

@@ -1,0 +1,105 @@
+#include "models/belcour_barla/belcour_barla.h"
+
+#include "core/math.h"
+#include "layers/compiled_stack.h"
+#include "models/production/film_fresnel.h"
+#include "physics/microfacet.h"
+
+#include <fmt/format.h>
+
+#include <optional>
+#include <string>
+
+namespace lamina {
+
+std::vector<OptionSpec> belcour_barla_options() {
+    return {{"kappa3",
+             {"attenuation-index", "extinction"},
+             "attenuation-index",
+             "how the conductor's index eta + i k reaches the shader's base eta3 (1 + i kappa3): "
+             "attenuation-index passes kappa3 = k/eta, the same metal; extinction passes kappa3 = "
+             "k (relative to the ambient), what a user reading kappa3 as the extinction "
+             "coefficient gets: the metal eta + i eta k"}};
+}
+
+namespace {
+
+class BelcourBarla final : public Model {
+  public:
+    BelcourBarla(const Stack& stack, const ModelOptions& options) {
+        support_ = {true, false, "a conductor reflects only: no BTDF"};
+        if (stack.layers.size() != 1 || stack.base().type != InterfaceType::Conductor ||
+            stack.layers[0].has_medium) {
+            support_ = {false, false,
+                        "bb17 represents one conductor interface under the ambient, with or "
+                        "without a thin film (Belcour & Barla's shader has no coat)"};
+            return;
+        }
+        const InterfaceSpec& metal = stack.base();
+        const double eta0 = stack.ambient_eta;
+        alpha_ = metal.alpha;
+        const bool extinction = option_value(options, "kappa3") == "extinction";
+        for (int c = 0; c < 3; ++c) {
+            base_eta_[c] = model_relative_eta(metal.eta_rgb[c] / eta0);
+            base_kappa_[c] =
+                model_relative_k(extinction ? metal.k[c] / eta0 : metal.k[c] / metal.eta_rgb[c]);
+        }
+        if (!metal.has_film) return;
+        const FilmOptics film = stack_film_optics(stack, 0);
+        if (film.eta_film.imag() > 0) {
+            support_ = {false, false,
+                        fmt::format("bb17's thin film is transparent (no extinction k); this "
+                                    "film's k is {}",
+                                    film.eta_film.imag())};
+            return;
+        }
+        if (film.eta_film.real() < eta0) {
+            support_ = {false, false,
+                        fmt::format("bb17's thin film must not be of lower index than the medium "
+                                    "above it ({} < {}): the shader leaves the reflectance of its "
+                                    "total reflection unset",
+                                    film.eta_film.real(), eta0)};
+            return;
+        }
+        film_ior_ = film.eta_film.real() / eta0;
+        // Dinc, the film's optical path at normal incidence 2 η_f d, in µm.
+        dinc_min_um_ = 2 * film.eta_film.real() * film.thickness_min_nm / 1000;
+        dinc_max_um_ = 2 * film.eta_film.real() * film.thickness_max_nm / 1000;
+    }
+
+    std::string name() const override { return "bb17"; }
+    Support support() const override { return support_; }
+    bool integrates_spectrum() const override { return true; }
+
+    Rgbd eval(const Vec3d& wi, const Vec3d& wo) const override {
+        if (!support_.brdf || !(wi.z > 0) || !(wo.z > 0) || !(alpha_ > 0)) return Rgbd(0.0);
+        const Vec3d h = normalize(wi + wo);
+        const GGX<double> ggx{alpha_};
+        return fresnel(dot(h, wi)) * (ggx.D(h) * ggx.G2_uncorrelated(wi, wo) / (4 * wi.z * wo.z));
+    }
+
+    std::vector<DeltaLobe> delta_lobes(const Vec3d& wi) const override {
+        if (!support_.brdf || alpha_ > 0 || !(wi.z > 0)) return {};
+        return {{mirror_direction(wi), fresnel(wi.z)}};
+    }
+
+  private:
+    /// The shader's Fresnel term at the facet cosine, averaged over the film's range.
+    Rgbd fresnel(double cos_theta) const {
+        return belcour_barla_fresnel_range(film_ior_, dinc_min_um_, dinc_max_um_, base_eta_,
+                                           base_kappa_, cos_theta);
+    }
+
+    Support support_;
+    double alpha_ = 0;
+    double film_ior_ = 1, dinc_min_um_ = 0, dinc_max_um_ = 0;  ///< no film: Dinc 0
+    Rgbd base_eta_{1.0}, base_kappa_{0.0};
+};
+
+}  // namespace
+
+std::unique_ptr<Model> make_belcour_barla(const Stack& stack, const ModelOptions& options) {
+    return std::make_unique<BelcourBarla>(stack, options);
+}
+
+}  // namespace lamina
