@@ -19,7 +19,13 @@ std::vector<OptionSpec> belcour_barla_options() {
              "how the conductor's index eta + i k reaches the shader's base eta3 (1 + i kappa3): "
              "attenuation-index passes kappa3 = k/eta, the same metal; extinction passes kappa3 = "
              "k (relative to the ambient), what a user reading kappa3 as the extinction "
-             "coefficient gets: the metal eta + i eta k"}};
+             "coefficient gets: the metal eta + i eta k"},
+            {"primaries",
+             {"cie-rgb", "srgb"},
+             "cie-rgb",
+             "the colour the Fresnel term returns: cie-rgb, the shader's (CIE 1931 RGB, "
+             "equal-energy white); srgb, the same spectrum's linear sRGB over the white a flat "
+             "spectrum gives"}};
 }
 
 namespace {
@@ -39,6 +45,8 @@ class BelcourBarla final : public Model {
         const double eta0 = stack.ambient_eta;
         alpha_ = metal.alpha;
         const bool extinction = option_value(options, "kappa3") == "extinction";
+        primaries_ = option_value(options, "primaries") == "srgb" ? BelcourBarlaPrimaries::Srgb
+                                                                  : BelcourBarlaPrimaries::CieRgb;
         for (int c = 0; c < 3; ++c) {
             base_eta_[c] = model_relative_eta(metal.eta_rgb[c] / eta0);
             base_kappa_[c] =
@@ -87,13 +95,14 @@ class BelcourBarla final : public Model {
     /// The shader's Fresnel term at the facet cosine, averaged over the film's range.
     Rgbd fresnel(double cos_theta) const {
         return belcour_barla_fresnel_range(film_ior_, dinc_min_um_, dinc_max_um_, base_eta_,
-                                           base_kappa_, cos_theta);
+                                           base_kappa_, cos_theta, primaries_);
     }
 
     Support support_;
     double alpha_ = 0;
     double film_ior_ = 1, dinc_min_um_ = 0, dinc_max_um_ = 0;  ///< no film: Dinc 0
     Rgbd base_eta_{1.0}, base_kappa_{0.0};
+    BelcourBarlaPrimaries primaries_ = BelcourBarlaPrimaries::CieRgb;
 };
 
 }  // namespace

@@ -22,7 +22,8 @@
 
 namespace lamina {
 
-/// The options of bb17: `kappa3` (how a stack's conductor κ reaches the shader's κ3).
+/// The options of bb17: `kappa3` (how a stack's conductor κ reaches the shader's κ3) and
+/// `primaries` (the colour its Fresnel term returns: the shader's CIE 1931 RGB, or linear sRGB).
 std::vector<OptionSpec> belcour_barla_options();
 
 /// The model for `stack` (not supported, with the reason, for any other shape).

@@ -784,12 +784,17 @@ constexpr double kBelcourBarlaBlendEndUm = 0.03;
 /// Belcour & Barla's shader before its final clamp, in CIE 1931 RGB channel c (the shader's
 /// Fresnel term, its Airy function; docs/models.md, "Belcour & Barla 2017").
 double belcour_barla_sum(int channel, double film_ior, double dinc_um, double base_eta,
-                         double base_kappa, double cos_theta_1) {
+                         double base_kappa, double cos_theta_1, BelcourBarlaPrimaries primaries) {
     using C = std::complex<double>;
     // The shader's sensitivity in channel c: its XYZ fit projected to CIE RGB (conjugated for
-    // airy_summation's Re(e^(imφ) conj S)).
-    const auto sensitivity = [channel](double opd_nm) {
-        return std::conj(xyz_to_cie_rgb_7_digits(sensitivity_xyz(opd_nm))[std::size_t(channel)]);
+    // airy_summation's Re(e^(imφ) conj S)); or to linear sRGB over the white a flat spectrum gives.
+    const std::size_t c = std::size_t(channel);
+    const double srgb_white = xyz_to_srgb_7_digits(sensitivity_xyz(0.0))[c].real();
+    const auto sensitivity = [c, primaries, srgb_white](double opd_nm) {
+        const std::array<std::complex<double>, 3> xyz = sensitivity_xyz(opd_nm);
+        if (primaries == BelcourBarlaPrimaries::Srgb)
+            return std::conj(xyz_to_srgb_7_digits(xyz)[c] / srgb_white);
+        return std::conj(xyz_to_cie_rgb_7_digits(xyz)[c]);
     };
     // "Force eta_2 -> 1.0 when Dinc -> 0.0": the film's index blends from the ambient's over the
     // first 0.03 µm of Dinc (smoothstep); the optical path keeps Dinc itself.
@@ -826,24 +831,30 @@ constexpr double kBelcourBarlaPeriodUm = 0.36 / 3;
 }  // namespace
 
 double belcour_barla_fresnel(int channel, double film_ior, double dinc_um, double base_eta,
-                             double base_kappa, double cos_theta_1) {
-    return clamp(belcour_barla_sum(channel, film_ior, dinc_um, base_eta, base_kappa, cos_theta_1),
-                 0.0, 1.0);
+                             double base_kappa, double cos_theta_1,
+                             BelcourBarlaPrimaries primaries) {
+    return clamp(
+        belcour_barla_sum(channel, film_ior, dinc_um, base_eta, base_kappa, cos_theta_1, primaries),
+        0.0, 1.0);
 }
 
 Rgbd belcour_barla_fresnel(double film_ior, double dinc_um, const Rgbd& base_eta,
-                           const Rgbd& base_kappa, double cos_theta_1) {
+                           const Rgbd& base_kappa, double cos_theta_1,
+                           BelcourBarlaPrimaries primaries) {
     Rgbd F;
     for (int c = 0; c < 3; ++c)
-        F[c] = belcour_barla_fresnel(c, film_ior, dinc_um, base_eta[c], base_kappa[c], cos_theta_1);
+        F[c] = belcour_barla_fresnel(c, film_ior, dinc_um, base_eta[c], base_kappa[c], cos_theta_1,
+                                     primaries);
     return F;
 }
 
 Rgbd belcour_barla_fresnel_range(double film_ior, double dinc_min_um, double dinc_max_um,
-                                 const Rgbd& base_eta, const Rgbd& base_kappa, double cos_theta_1) {
+                                 const Rgbd& base_eta, const Rgbd& base_kappa, double cos_theta_1,
+                                 BelcourBarlaPrimaries primaries) {
     const auto mean = [&](double lo, double hi) {
         return thickness_average(lo, hi, kBelcourBarlaPeriodUm, [&](double dinc) {
-            return belcour_barla_fresnel(film_ior, dinc, base_eta, base_kappa, cos_theta_1);
+            return belcour_barla_fresnel(film_ior, dinc, base_eta, base_kappa, cos_theta_1,
+                                         primaries);
         });
     };
     // The film's index stops blending at kBelcourBarlaBlendEndUm, where the term's second

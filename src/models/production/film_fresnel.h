@@ -170,17 +170,24 @@ double cycles_film_reflectance_monochromatic(double wavelength_nm, double film_i
 /// (smoothstep). The base's complex index is base_eta·(1 + i base_kappa): the shader's κ3 is Born
 /// & Wolf's attenuation index (relative to η3), not the extinction coefficient k of n + ik.
 /// film_ior ≥ 1 (below, the shader leaves a total reflection's reflectance unset; 1 is returned).
+/// `primaries` Srgb (not the shader's: an ablation) projects the same XYZ to linear sRGB (IEC
+/// 61966-2-1) and divides each channel by what a flat spectrum gives it, so that white stays
+/// white (the fit's XYZ of a flat spectrum is the equal-energy white).
+enum class BelcourBarlaPrimaries { CieRgb, Srgb };
 double belcour_barla_fresnel(int channel, double film_ior, double dinc_um, double base_eta,
-                             double base_kappa, double cos_theta_1);
+                             double base_kappa, double cos_theta_1,
+                             BelcourBarlaPrimaries primaries = BelcourBarlaPrimaries::CieRgb);
 /// belcour_barla_fresnel in the three channels, channel c with the base base_eta[c]·(1 + i
 /// base_kappa[c]) (the shader's base is one index: each channel is the shader run on its own).
 Rgbd belcour_barla_fresnel(double film_ior, double dinc_um, const Rgbd& base_eta,
-                           const Rgbd& base_kappa, double cos_theta_1);
+                           const Rgbd& base_kappa, double cos_theta_1,
+                           BelcourBarlaPrimaries primaries = BelcourBarlaPrimaries::CieRgb);
 /// belcour_barla_fresnel averaged over Dinc uniform in [dinc_min_um, dinc_max_um] (a thickness
 /// uniform over a range) by Gauss–Legendre quadrature (32 nodes per period of the third order at
-/// 360 nm, at most 2048).
+/// 360 nm, at most 2048), the two sides of the index blend's end (Dinc 0.03 µm) apart.
 Rgbd belcour_barla_fresnel_range(double film_ior, double dinc_min_um, double dinc_max_um,
-                                 const Rgbd& base_eta, const Rgbd& base_kappa, double cos_theta_1);
+                                 const Rgbd& base_eta, const Rgbd& base_kappa, double cos_theta_1,
+                                 BelcourBarlaPrimaries primaries = BelcourBarlaPrimaries::CieRgb);
 
 /// Cycles' F82-tint metal under its thin film (kernel/closure/bsdf_microfacet.h, microfacet_fresnel
 /// with F82_TINT): per channel the metal of normal reflectance f0 and F82 tint `tint` read as

@@ -507,6 +507,36 @@ TEST(FilmFresnel, BelcourBarlaAgainstTheExactFilm) {
     }
 }
 
+// A film so thick (Dinc = 200 µm) that the orders' Gaussian windows vanish (e^(−6800) and less)
+// leaves the DC term: per polarization the incoherent sum R12 + T121² R23/(1 − R12 R23) of the two
+// boundaries' reflectances, times the white the fit gives a flat spectrum. In CIE 1931 RGB that
+// white is the fit's XYZ (1.000458, 1.000222, 1.001122: the published constants, val·√(2π var)
+// summed per function over 1.0685e-7) through the XYZ → CIE RGB matrix, (1.0003585, 1.0001802,
+// 1.0011323); in sRGB over white, 1 in every channel.
+TEST(FilmFresnel, BelcourBarlaThickFilmIsTheIncoherentSum) {
+    using C = std::complex<double>;
+    const double film = 1.6, mu = 0.7;
+    const C base(1.9, 2.3 * 1.9);
+    const double sin2 = 1 - mu * mu;
+    const C u2 = normal_wave_number(C(film), sin2);
+    const auto top = fresnel_amplitudes<double>(C(1), C(mu), C(film), u2);
+    const auto bottom =
+        fresnel_amplitudes<double>(C(film), u2, base, normal_wave_number(base, sin2));
+    const auto incoherent = [](C r12, C r23) {
+        const double R12 = std::norm(r12), R23 = std::norm(r23);
+        return R12 + (1 - R12) * (1 - R12) * R23 / (1 - R12 * R23);
+    };
+    const double want = (incoherent(top.r_s, bottom.r_s) + incoherent(top.r_p, bottom.r_p)) / 2;
+    const double cie_white[3] = {1.0003585, 1.0001802, 1.0011323};
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(belcour_barla_fresnel(c, film, 200, 1.9, 2.3, mu), want * cie_white[c], 2e-7)
+            << "channel " << c;
+        EXPECT_NEAR(belcour_barla_fresnel(c, film, 200, 1.9, 2.3, mu, BelcourBarlaPrimaries::Srgb),
+                    want, 1e-12)
+            << "channel " << c;
+    }
+}
+
 // The shader's term over a thickness range (Dinc uniform) against a fine midpoint rule, on ranges
 // across the end of its index blend (0.03 µm) and over several periods, where its clamp to [0, 1]
 // does not act (a kink there costs the quadrature ~1e-6; the test checks it does not).
