@@ -34,8 +34,16 @@ class BelcourBarla final : public Model {
   public:
     BelcourBarla(const Stack& stack, const ModelOptions& options) {
         support_ = {true, false, "a conductor reflects only: no BTDF"};
-        if (stack.layers.size() != 1 || stack.base().type != InterfaceType::Conductor ||
-            stack.layers[0].has_medium) {
+        // The conductor under the ambient: alone, or under a smooth clear interface of the
+        // ambient's own index (no interface at all; the shape the coats take for a bare metal).
+        const auto index_matched = [&](const Layer& l) {
+            return l.interface.type == InterfaceType::Dielectric && !l.interface.is_spectral() &&
+                   l.interface.eta == stack.ambient_eta && l.interface.alpha == 0 &&
+                   !l.interface.has_film && !l.has_medium;
+        };
+        const std::size_t n = stack.layers.size();
+        if (!(n == 1 || (n == 2 && index_matched(stack.layers[0]))) ||
+            stack.base().type != InterfaceType::Conductor) {
             support_ = {false, false,
                         "bb17 represents one conductor interface under the ambient, with or "
                         "without a thin film (Belcour & Barla's shader has no coat)"};
@@ -53,7 +61,7 @@ class BelcourBarla final : public Model {
                 model_relative_k(extinction ? metal.k[c] / eta0 : metal.k[c] / metal.eta_rgb[c]);
         }
         if (!metal.has_film) return;
-        const FilmOptics film = stack_film_optics(stack, 0);
+        const FilmOptics film = stack_film_optics(stack, n - 1);
         if (film.eta_film.imag() > 0) {
             support_ = {false, false,
                         fmt::format("bb17's thin film is transparent (no extinction k); this "

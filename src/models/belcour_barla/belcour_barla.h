@@ -8,8 +8,9 @@
 // D the GGX distribution of roughness α, G1 Smith's masking (uncorrelated: the product), F the
 // shader's iridescent Fresnel term (models/production/film_fresnel.h, belcour_barla_fresnel): the
 // film's Airy sum to the third order, integrated against the CIE functions and returned in CIE 1931
-// RGB. A lamina stack it represents: a conductor (α ≥ 0) under the ambient, with or without a
-// transparent film of index at least the ambient's, thickness one value or a range (averaged over).
+// RGB. A lamina stack it represents: a conductor (α ≥ 0) under the ambient (alone, or under a
+// smooth clear interface of the ambient's index, which is none), with or without a transparent
+// film of index at least the ambient's, thickness one value or a range (averaged over).
 // The shader's outside index is 1: lamina passes the indices relative to the ambient, and Dinc =
 // 2 η_f d (the film's optical path at normal incidence, µm). docs/models.md, "Belcour & Barla
 // 2017".

@@ -151,6 +151,32 @@ TEST(BelcourBarla, RepresentsOneFilmedConductor) {
     EXPECT_FALSE(make_model("bb17", test::single(test::dielectric(1.5, 0.1)))->support().brdf);
 }
 
+// A smooth clear interface of the ambient's own index is no interface: the conductor under it is
+// the bare one (the shape the coats take for a bare metal), value for value. Any other top refuses.
+TEST(BelcourBarla, IndexMatchedTopIsTheBareMetal) {
+    const Rgbd eta(2.74, 2.54, 2.26), k(3.79, 3.43, 3.07);
+    for (double ambient : {1.0, 1.33}) {
+        Stack bare = bare_metal(eta, k, 0.2, 2.5, 60, 90);
+        bare.ambient_eta = ambient;
+        Stack matched = test::coated(ambient, 0, bare.layers[0].interface);
+        matched.ambient_eta = ambient;
+        const auto a = make_model("bb17", bare), b = make_model("bb17", matched);
+        ASSERT_TRUE(b->support().brdf) << b->support().reason;
+        for (double ti : {0.0, 50.0})
+            for (double to : {20.0, 75.0}) {
+                const Vec3d wi = test::dir(ti, 0), wo = test::dir(to, 150);
+                const Rgbd fa = a->eval(wi, wo), fb = b->eval(wi, wo);
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_EQ(fa[c], fb[c]) << ambient << " " << ti << " " << to;
+            }
+        for (auto [eta0, alpha0] : {std::pair{ambient + 0.01, 0.0}, std::pair{ambient, 0.1}}) {
+            Stack other = test::coated(eta0, alpha0, bare.layers[0].interface);
+            other.ambient_eta = ambient;
+            EXPECT_FALSE(make_model("bb17", other)->support().brdf) << eta0 << " " << alpha0;
+        }
+    }
+}
+
 // kappa3=extinction hands the shader κ3 = k: its base is then η(1 + ik), another metal. Without a
 // film the Fresnel term's ratio between two angles is that metal's conductor Fresnel ratio.
 TEST(BelcourBarla, ExtinctionAsKappa3IsAnotherMetal) {
