@@ -243,8 +243,8 @@ const std::vector<ModelEntry>& model_registry() {
         {"bb17",
          "Belcour & Barla 2017 as their shader ships it: GGX lobe, uncorrelated Smith, film "
          "Fresnel by the Airy sum's 3 orders on the CIE fit, in CIE 1931 RGB",
-         "bases: conductor under the ambient (no coat), with a thin film (transparent, index >= "
-         "the ambient's); sides: R",
+         "bases: conductor under the ambient (no coat), with or without a thin film "
+         "(transparent, index >= the ambient's); sides: R",
          belcour_barla_options, make_belcour_barla, false, "films",
          /*represents_anisotropy=*/false, /*films=*/true},
     });

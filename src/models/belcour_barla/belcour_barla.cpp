@@ -60,27 +60,20 @@ class BelcourBarla final : public Model {
             base_kappa_[c] =
                 model_relative_k(extinction ? metal.k[c] / eta0 : metal.k[c] / metal.eta_rgb[c]);
         }
-        if (!metal.has_film) return;
-        const FilmOptics film = stack_film_optics(stack, n - 1);
-        if (film.eta_film.imag() > 0) {
-            support_ = {false, false,
-                        fmt::format("bb17's thin film is transparent (no extinction k); this "
-                                    "film's k is {}",
-                                    film.eta_film.imag())};
-            return;
-        }
-        if (film.eta_film.real() < eta0) {
-            support_ = {false, false,
-                        fmt::format("bb17's thin film must not be of lower index than the medium "
-                                    "above it ({} < {}): the shader leaves the reflectance of its "
-                                    "total reflection unset",
-                                    film.eta_film.real(), eta0)};
-            return;
-        }
-        film_ior_ = film.eta_film.real() / eta0;
-        // Dinc, the film's optical path at normal incidence 2 η_f d, in µm.
-        dinc_min_um_ = 2 * film.eta_film.real() * film.thickness_min_nm / 1000;
-        dinc_max_um_ = 2 * film.eta_film.real() * film.thickness_max_nm / 1000;
+        if (metal.has_film && !read_film(stack_film_optics(stack, n - 1), eta0)) return;
+        // A base without extinction is the shader's dielectric (its fresnelConductor hands κ3 = 0
+        // to fresnelDielectric), whose total reflection below the film's index (or the ambient's)
+        // leaves the reflectance unset, as for a film below the ambient.
+        for (int c = 0; c < 3; ++c)
+            if (base_kappa_[c] == 0 && base_eta_[c] < film_ior_) {
+                support_ = {false, false,
+                            fmt::format("bb17's base without extinction (k = 0) must not be of "
+                                        "lower index than what lies above it ({} < {} relative "
+                                        "to the ambient): the shader leaves the reflectance of "
+                                        "its total reflection unset",
+                                        base_eta_[c], film_ior_)};
+                return;
+            }
     }
 
     std::string name() const override { return "bb17"; }
@@ -100,6 +93,30 @@ class BelcourBarla final : public Model {
     }
 
   private:
+    /// Reads the film into film_ior_ and the Dinc range, or says why it is not represented.
+    bool read_film(const FilmOptics& film, double eta0) {
+        if (film.eta_film.imag() > 0) {
+            support_ = {false, false,
+                        fmt::format("bb17's thin film is transparent (no extinction k); this "
+                                    "film's k is {}",
+                                    film.eta_film.imag())};
+            return false;
+        }
+        if (film.eta_film.real() < eta0) {
+            support_ = {false, false,
+                        fmt::format("bb17's thin film must not be of lower index than the medium "
+                                    "above it ({} < {}): the shader leaves the reflectance of its "
+                                    "total reflection unset",
+                                    film.eta_film.real(), eta0)};
+            return false;
+        }
+        film_ior_ = film.eta_film.real() / eta0;
+        // Dinc, the film's optical path at normal incidence 2 η_f d, in µm.
+        dinc_min_um_ = 2 * film.eta_film.real() * film.thickness_min_nm / 1000;
+        dinc_max_um_ = 2 * film.eta_film.real() * film.thickness_max_nm / 1000;
+        return true;
+    }
+
     /// The shader's Fresnel term at the facet cosine, averaged over the film's range.
     Rgbd fresnel(double cos_theta) const {
         return belcour_barla_fresnel_range(film_ior_, dinc_min_um_, dinc_max_um_, base_eta_,

@@ -23,7 +23,8 @@ constexpr int kNodesPerPeriod = 32;
 constexpr int kMaxNodes = 2048;
 
 /// The mean of f(d) over d uniform in [min_nm, max_nm]: composite Gauss–Legendre on pieces no
-/// longer than period_nm (f is periodic in d with at least that period, smooth within it).
+/// longer than period_nm (f is periodic in d with at least that period, smooth within it). Any
+/// one unit of length serves (the films' thickness in nm, Belcour & Barla's Dinc in µm).
 template <typename F>
 Rgbd thickness_average(double min_nm, double max_nm, double period_nm, F&& f) {
     if (!(max_nm > min_nm)) return f(max_nm);
@@ -781,31 +782,46 @@ namespace {
 /// The Dinc (µm) from which Belcour & Barla's shader takes the film's own index.
 constexpr double kBelcourBarlaBlendEndUm = 0.03;
 
-/// Belcour & Barla's shader before its final clamp, in CIE 1931 RGB channel c (the shader's
-/// Fresnel term, its Airy function; docs/models.md, "Belcour & Barla 2017").
+/// Belcour & Barla's shader before its final clamp, channel c of its colour (CIE 1931 RGB, or
+/// linear sRGB over white for the ablation; the shader's Fresnel term, its Airy function;
+/// docs/models.md, "Belcour & Barla 2017").
 double belcour_barla_sum(int channel, double film_ior, double dinc_um, double base_eta,
                          double base_kappa, double cos_theta_1, BelcourBarlaPrimaries primaries) {
     using C = std::complex<double>;
-    // The shader's sensitivity in channel c: its XYZ fit projected to CIE RGB (conjugated for
-    // airy_summation's Re(e^(imφ) conj S)); or to linear sRGB over the white a flat spectrum gives.
+    // The sensitivity S = M·G of channel c (M the projection, G the fit's XYZ), handed to
+    // airy_summation conjugated (it forms Re(e^(imφ) conj(·))): the shader's Σ M cos(pos t + mφ).
     const std::size_t c = std::size_t(channel);
-    const double srgb_white = xyz_to_srgb_7_digits(sensitivity_xyz(0.0))[c].real();
+    const std::array<std::complex<double>, 3> white_xyz = sensitivity_xyz(0.0);
+    const double srgb_white =
+        primaries == BelcourBarlaPrimaries::Srgb ? xyz_to_srgb_7_digits(white_xyz)[c].real() : 1.0;
     const auto sensitivity = [c, primaries, srgb_white](double opd_nm) {
         const std::array<std::complex<double>, 3> xyz = sensitivity_xyz(opd_nm);
         if (primaries == BelcourBarlaPrimaries::Srgb)
             return std::conj(xyz_to_srgb_7_digits(xyz)[c] / srgb_white);
         return std::conj(xyz_to_cie_rgb_7_digits(xyz)[c]);
     };
+    // A bound on |S| at every OPD for airy_summation's swing: |G_j| ≤ Σ_g w_g e^(−var_g t²) ≤
+    // G_j(0) (the weights are positive), so |S_c| ≤ Σ_j |M_cj| G_j(0).
+    double s_max = 0;
+    for (int j = 0; j < 3; ++j) {
+        Rgbd unit(0.0);
+        unit[j] = 1;
+        const double m_cj = primaries == BelcourBarlaPrimaries::Srgb
+                                ? xyz_to_srgb_7_digits(unit)[channel] / srgb_white
+                                : xyz_to_cie_rgb_7_digits(unit)[channel];
+        s_max += std::abs(m_cj) * white_xyz[std::size_t(j)].real();
+    }
     // "Force eta_2 -> 1.0 when Dinc -> 0.0": the film's index blends from the ambient's over the
     // first 0.03 µm of Dinc (smoothstep); the optical path keeps Dinc itself.
-    const double t = clamp(dinc_um / kBelcourBarlaBlendEndUm, 0.0, 1.0);
-    const double eta = 1 + (film_ior - 1) * t * t * (3 - 2 * t);
+    const double blend = clamp(dinc_um / kBelcourBarlaBlendEndUm, 0.0, 1.0);
+    const double eta = 1 + (film_ior - 1) * blend * blend * (3 - 2 * blend);
     const double c1 = clamp(cos_theta_1, 0.0, 1.0), sin2 = 1 - c1 * c1;
+    const double dc_only = sensitivity(0.0).real();
     // A film of lower index than the ambient would reflect totally at grazing facets, where the
     // shader leaves the reflectance unset: no value is the shader's there (the model refuses such
     // films); lamina returns total reflection. At grazing incidence the first boundary reflects
     // everything: the DC term alone.
-    if (!(eta * eta - sin2 > 0) || c1 == 0) return sensitivity(0.0).real();
+    if (!(eta * eta - sin2 > 0) || c1 == 0) return dc_only;
     const C u1(c1), u2(std::sqrt(eta * eta - sin2));
     const FresnelAmplitudes<double> top = fresnel_amplitudes<double>(C(1), u1, C(eta), u2);
     // The base's index as the shader's fresnelConductor forms it: η3 (1 + iκ3), so that its
@@ -814,14 +830,19 @@ double belcour_barla_sum(int channel, double film_ior, double dinc_um, double ba
     const C base(base_eta, base_eta * base_kappa);
     const FresnelAmplitudes<double> bottom =
         fresnel_amplitudes<double>(C(eta), u2, base, normal_wave_number(base, sin2));
+    // Both boundaries reflecting everything (a facet so near grazing that R12 rounds to 1 over a
+    // totally reflecting base): the sum's R_s is 0/0, its limit the DC term alone.
+    for (const double product :
+         {std::norm(top.r_s) * std::norm(bottom.r_s), std::norm(top.r_p) * std::norm(bottom.r_p)})
+        if (!(product < 1)) return dc_only;
     const double opd = dinc_um * 1000 * (u2.real() / eta);  // Dinc cos θ2, nm
     // φ2 = φ21 + φ23 with φ21 = π − φ12.
     const auto round_trip = [](C r12, C r23) { return -std::conj(phasor(r12)) * phasor(r23); };
-    const AirySum R_s = airy_summation(sensitivity, std::norm(top.r_s), std::norm(bottom.r_s), opd,
-                                       round_trip(top.r_s, bottom.r_s), 1.0);
-    const AirySum R_p = airy_summation(sensitivity, std::norm(top.r_p), std::norm(bottom.r_p), opd,
-                                       round_trip(top.r_p, bottom.r_p), 1.0);
-    return 0.5 * (R_s.R + R_p.R);
+    const AirySum sum_s = airy_summation(sensitivity, std::norm(top.r_s), std::norm(bottom.r_s),
+                                         opd, round_trip(top.r_s, bottom.r_s), s_max);
+    const AirySum sum_p = airy_summation(sensitivity, std::norm(top.r_p), std::norm(bottom.r_p),
+                                         opd, round_trip(top.r_p, bottom.r_p), s_max);
+    return 0.5 * (sum_s.R + sum_p.R);
 }
 
 /// The period in Dinc (µm) of the sum's fastest term, the third order's phase 2π·3·Dinc cos θ2/λ,

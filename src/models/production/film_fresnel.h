@@ -11,7 +11,7 @@
 // and Belcour & Barla's own shader, the same sum with the paper's Gaussian fit of that transform,
 // returned in CIE 1931 RGB.
 //
-// Each returns a reflectance per RGB channel in [0, 1] and never throw. A film's thickness range
+// Each returns a reflectance per RGB channel in [0, 1] and never throws. A film's thickness range
 // [min, max] (a film uniformly distributed over the surface) is averaged over: the surface's mean
 // reflectance, what a texture of the thickness shows over many pixels.
 
@@ -169,7 +169,11 @@ double cycles_film_reflectance_monochromatic(double wavelength_nm, double film_i
 /// µm (the sum's OPD is Dinc cos θ2); the film's index blends from 1 over Dinc ∈ [0, 0.03]
 /// (smoothstep). The base's complex index is base_eta·(1 + i base_kappa): the shader's κ3 is Born
 /// & Wolf's attenuation index (relative to η3), not the extinction coefficient k of n + ik.
-/// film_ior ≥ 1 (below, the shader leaves a total reflection's reflectance unset; 1 is returned).
+/// channel ∈ {0, 1, 2}, film_ior ≥ 1, base_eta > 0, base_kappa ≥ 0 (0: a dielectric base, the
+/// shader's fresnelDielectric). Where the shader leaves the reflectance unset (a total reflection
+/// at either boundary: a film below 1, or a dielectric base below the film at steep facets; the
+/// model refuses such stacks) lamina takes the exact total reflection, and where a facet's first
+/// boundary reflects everything, the DC term alone (the white a flat spectrum gives, clamped).
 /// `primaries` Srgb (not the shader's: an ablation) projects the same XYZ to linear sRGB (IEC
 /// 61966-2-1) and divides each channel by what a flat spectrum gives it, so that white stays
 /// white (the fit's XYZ of a flat spectrum is the equal-energy white).
