@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <vector>
@@ -156,30 +157,38 @@ Rgbd belcour_sensitivity_srgb(double opd_nm, const Rgbd& shift) {
 
 namespace {
 
-/// The mean of belcour_sensitivity_srgb(OPD, shift) over OPD uniform in [opd0_nm, opd1_nm] (0 ≤
-/// opd0 ≤ opd1): each Gaussian-windowed cosine integrated in closed form (models/numerics/
-/// gaussian_fourier.h) — Re[e^{i shift} ∫ e^{−var t²} e^{i pos t} dt] over the phases. Below 1 nm
-/// of OPD, where the difference of the two antiderivatives would lose digits to the division, by
-/// 4-point Gauss–Legendre (exact to ~1e-12 there: the fastest cosine turns by 0.014 rad per nm).
-Rgbd sensitivity_srgb_mean(double opd0_nm, double opd1_nm, const Rgbd& shift) {
+/// The mean of the fit's G (sensitivity_xyz) over OPD uniform in [opd0_nm, opd1_nm] (0 ≤ opd0 ≤
+/// opd1): each Gaussian-windowed phasor integrated in closed form (models/numerics/
+/// gaussian_fourier.h), ∫ e^{−var t²} e^{i pos t} dt over the phases. Below 1 nm of OPD, where the
+/// difference of the two antiderivatives would lose digits to the division, by 4-point
+/// Gauss–Legendre (exact to ~1e-12 there: the fastest phasor turns by 0.014 rad per nm).
+std::array<std::complex<double>, 3> sensitivity_xyz_mean(double opd0_nm, double opd1_nm) {
+    std::array<std::complex<double>, 3> xyz{};
     if (opd1_nm - opd0_nm < 1.0) {
         static const QuadratureRule rule = gauss_legendre(4);
-        Rgbd sum(0.0);
-        for (std::size_t i = 0; i < rule.x.size(); ++i)
-            sum += belcour_sensitivity_srgb(opd0_nm + (opd1_nm - opd0_nm) * rule.x[i], shift) *
-                   rule.w[i];
-        return sum;
+        for (std::size_t i = 0; i < rule.x.size(); ++i) {
+            const auto g = sensitivity_xyz(opd0_nm + (opd1_nm - opd0_nm) * rule.x[i]);
+            for (std::size_t j = 0; j < 3; ++j)
+                xyz[j] += g[j] * rule.w[i];
+        }
+        return xyz;
     }
     const double t0 = sensitivity_phase(opd0_nm), t1 = sensitivity_phase(opd1_nm);
-    double xyz[3] = {0, 0, 0};
-    for (const SensitivityGaussian& g : kSensitivityGaussians) {
-        const std::complex<double> integral = gaussian_fourier_integral(g.var, g.pos, t0, t1);
-        xyz[g.xyz] +=
-            sensitivity_weight(g) * (std::polar(1.0, shift[g.xyz]) * integral).real() / (t1 - t0);
-    }
-    for (double& v : xyz)
-        v /= kSensitivityNorm;
-    return xyz_to_srgb_7_digits(Rgbd(xyz[0], xyz[1], xyz[2]));
+    for (const SensitivityGaussian& g : kSensitivityGaussians)
+        xyz[std::size_t(g.xyz)] += sensitivity_weight(g) *
+                                   gaussian_fourier_integral(g.var, g.pos, t0, t1) / (t1 - t0) /
+                                   kSensitivityNorm;
+    return xyz;
+}
+
+/// The mean of belcour_sensitivity_srgb(OPD, shift) over OPD uniform in [opd0_nm, opd1_nm]:
+/// Re(e^{i shift} ·) of sensitivity_xyz_mean, projected to linear sRGB.
+Rgbd sensitivity_srgb_mean(double opd0_nm, double opd1_nm, const Rgbd& shift) {
+    const std::array<std::complex<double>, 3> g = sensitivity_xyz_mean(opd0_nm, opd1_nm);
+    Rgbd xyz;
+    for (int j = 0; j < 3; ++j)
+        xyz[j] = (std::polar(1.0, shift[j]) * g[std::size_t(j)]).real();
+    return xyz_to_srgb_7_digits(xyz);
 }
 
 /// sup |S_c| over OPD ≥ 0 of the sensitivity whose X, Y and Z lobes are turned by 0 or π (signs
@@ -782,35 +791,32 @@ namespace {
 /// The Dinc (µm) from which Belcour & Barla's shader takes the film's own index.
 constexpr double kBelcourBarlaBlendEndUm = 0.03;
 
+/// airy_summation's bound on the sensitivity where its swing is not read.
+constexpr double kNoBound = std::numeric_limits<double>::quiet_NaN();
+
 /// Belcour & Barla's shader before its final clamp, channel c of its colour (CIE 1931 RGB, or
 /// linear sRGB over white for the ablation; the shader's Fresnel term, its Airy function;
-/// docs/models.md, "Belcour & Barla 2017").
+/// docs/models.md, "Belcour & Barla 2017"): the mean of the s and p sums. xyz_of_opd gives the
+/// fit's G at an OPD (sensitivity_xyz, or a memo of it). The sums' swing is not read: no
+/// closed-form mean over a thickness range is taken (the bound it would need, Σ_j |M_cj| G_j(0),
+/// exceeds the DC term on every film tried, metals and MgF2 on glass alike).
+template <typename XyzOfOpd>
 double belcour_barla_sum(int channel, double film_ior, double dinc_um, double base_eta,
-                         double base_kappa, double cos_theta_1, BelcourBarlaPrimaries primaries) {
+                         double base_kappa, double cos_theta_1, BelcourBarlaPrimaries primaries,
+                         const XyzOfOpd& xyz_of_opd) {
     using C = std::complex<double>;
     // The sensitivity S = M·G of channel c (M the projection, G the fit's XYZ), handed to
     // airy_summation conjugated (it forms Re(e^(imφ) conj(·))): the shader's Σ M cos(pos t + mφ).
     const std::size_t c = std::size_t(channel);
-    const std::array<std::complex<double>, 3> white_xyz = sensitivity_xyz(0.0);
+    const std::array<std::complex<double>, 3> white_xyz = xyz_of_opd(0.0);
     const double srgb_white =
         primaries == BelcourBarlaPrimaries::Srgb ? xyz_to_srgb_7_digits(white_xyz)[c].real() : 1.0;
-    const auto sensitivity = [c, primaries, srgb_white](double opd_nm) {
-        const std::array<std::complex<double>, 3> xyz = sensitivity_xyz(opd_nm);
+    const auto sensitivity = [&](double opd_nm) {
+        const std::array<std::complex<double>, 3> xyz = xyz_of_opd(opd_nm);
         if (primaries == BelcourBarlaPrimaries::Srgb)
             return std::conj(xyz_to_srgb_7_digits(xyz)[c] / srgb_white);
         return std::conj(xyz_to_cie_rgb_7_digits(xyz)[c]);
     };
-    // A bound on |S| at every OPD for airy_summation's swing: |G_j| ≤ Σ_g w_g e^(−var_g t²) ≤
-    // G_j(0) (the weights are positive), so |S_c| ≤ Σ_j |M_cj| G_j(0).
-    double s_max = 0;
-    for (int j = 0; j < 3; ++j) {
-        Rgbd unit(0.0);
-        unit[j] = 1;
-        const double m_cj = primaries == BelcourBarlaPrimaries::Srgb
-                                ? xyz_to_srgb_7_digits(unit)[channel] / srgb_white
-                                : xyz_to_cie_rgb_7_digits(unit)[channel];
-        s_max += std::abs(m_cj) * white_xyz[std::size_t(j)].real();
-    }
     // "Force eta_2 -> 1.0 when Dinc -> 0.0": the film's index blends from the ambient's over the
     // first 0.03 µm of Dinc (smoothstep); the optical path keeps Dinc itself.
     const double blend = clamp(dinc_um / kBelcourBarlaBlendEndUm, 0.0, 1.0);
@@ -839,11 +845,35 @@ double belcour_barla_sum(int channel, double film_ior, double dinc_um, double ba
     // φ2 = φ21 + φ23 with φ21 = π − φ12.
     const auto round_trip = [](C r12, C r23) { return -std::conj(phasor(r12)) * phasor(r23); };
     const AirySum sum_s = airy_summation(sensitivity, std::norm(top.r_s), std::norm(bottom.r_s),
-                                         opd, round_trip(top.r_s, bottom.r_s), s_max);
+                                         opd, round_trip(top.r_s, bottom.r_s), kNoBound);
     const AirySum sum_p = airy_summation(sensitivity, std::norm(top.r_p), std::norm(bottom.r_p),
-                                         opd, round_trip(top.r_p, bottom.r_p), s_max);
+                                         opd, round_trip(top.r_p, bottom.r_p), kNoBound);
     return 0.5 * (sum_s.R + sum_p.R);
 }
+
+/// A function of the OPD remembered at its last four arguments: the three channels of one
+/// evaluation, and each channel's s and p sums, read the fit at the same four OPDs (0 and the
+/// three orders'), bit for bit the same arguments.
+template <typename F>
+class OpdMemo {
+  public:
+    explicit OpdMemo(const F& f) : f_(f) {}
+    std::array<std::complex<double>, 3> operator()(double opd_nm) const {
+        for (int i = 0; i < used_; ++i)
+            if (key_[i] == opd_nm) return value_[i];
+        const int slot = used_ < kSlots ? used_++ : (next_++ % kSlots);
+        key_[slot] = opd_nm;
+        value_[slot] = f_(opd_nm);
+        return value_[slot];
+    }
+
+  private:
+    static constexpr int kSlots = 4;
+    const F& f_;
+    mutable double key_[kSlots] = {};
+    mutable std::array<std::complex<double>, 3> value_[kSlots] = {};
+    mutable int used_ = 0, next_ = 0;
+};
 
 /// The period in Dinc (µm) of the sum's fastest term, the third order's phase 2π·3·Dinc cos θ2/λ,
 /// at its shortest: λ = 360 nm.
@@ -854,24 +884,28 @@ constexpr double kBelcourBarlaPeriodUm = 0.36 / 3;
 double belcour_barla_fresnel(int channel, double film_ior, double dinc_um, double base_eta,
                              double base_kappa, double cos_theta_1,
                              BelcourBarlaPrimaries primaries) {
-    return clamp(
-        belcour_barla_sum(channel, film_ior, dinc_um, base_eta, base_kappa, cos_theta_1, primaries),
-        0.0, 1.0);
+    return clamp(belcour_barla_sum(channel, film_ior, dinc_um, base_eta, base_kappa, cos_theta_1,
+                                   primaries, sensitivity_xyz),
+                 0.0, 1.0);
 }
 
 Rgbd belcour_barla_fresnel(double film_ior, double dinc_um, const Rgbd& base_eta,
                            const Rgbd& base_kappa, double cos_theta_1,
                            BelcourBarlaPrimaries primaries) {
+    const auto fit = [](double opd_nm) { return sensitivity_xyz(opd_nm); };
+    const OpdMemo<decltype(fit)> memo(fit);
     Rgbd F;
     for (int c = 0; c < 3; ++c)
-        F[c] = belcour_barla_fresnel(c, film_ior, dinc_um, base_eta[c], base_kappa[c], cos_theta_1,
-                                     primaries);
+        F[c] = clamp(belcour_barla_sum(c, film_ior, dinc_um, base_eta[c], base_kappa[c],
+                                       cos_theta_1, primaries, memo),
+                     0.0, 1.0);
     return F;
 }
 
 Rgbd belcour_barla_fresnel_range(double film_ior, double dinc_min_um, double dinc_max_um,
                                  const Rgbd& base_eta, const Rgbd& base_kappa, double cos_theta_1,
                                  BelcourBarlaPrimaries primaries) {
+    constexpr double end = kBelcourBarlaBlendEndUm;
     const auto mean = [&](double lo, double hi) {
         return thickness_average(lo, hi, kBelcourBarlaPeriodUm, [&](double dinc) {
             return belcour_barla_fresnel(film_ior, dinc, base_eta, base_kappa, cos_theta_1,
@@ -880,7 +914,6 @@ Rgbd belcour_barla_fresnel_range(double film_ior, double dinc_min_um, double din
     };
     // The film's index stops blending at kBelcourBarlaBlendEndUm, where the term's second
     // derivative jumps: the quadrature takes the two sides apart.
-    constexpr double end = kBelcourBarlaBlendEndUm;
     if (dinc_min_um < end && dinc_max_um > end)
         return (mean(dinc_min_um, end) * (end - dinc_min_um) +
                 mean(end, dinc_max_um) * (dinc_max_um - end)) /

@@ -539,22 +539,30 @@ TEST(FilmFresnel, BelcourBarlaThickFilmIsTheIncoherentSum) {
 
 // The shader's term over a thickness range (Dinc uniform) against a fine midpoint rule, on ranges
 // across the end of its index blend (0.03 µm) and over several periods, where its clamp to [0, 1]
-// does not act (a kink there costs the quadrature ~1e-6; the test checks it does not).
+// does not act (a kink there costs the quadrature ~1e-6; the test checks it does not): an oxide on
+// titanium and MgF2 on glass.
 TEST(FilmFresnel, BelcourBarlaRangeIsTheMeanOverDinc) {
-    const Rgbd eta3(2.74, 2.54, 2.26), kappa3(3.79 / 2.74, 3.43 / 2.54, 3.07 / 2.26);
-    for (auto [mu, lo, hi] : {std::tuple{1.0, 0.0, 0.1}, std::tuple{0.4, 0.0, 0.1},
-                              std::tuple{0.4, 0.6, 3.0}, std::tuple{1.0, 0.2, 0.5}}) {
+    struct Case {
+        double film, mu, lo, hi;
+        Rgbd eta3, kappa3;
+    };
+    const Rgbd ti_eta(2.74, 2.54, 2.26), ti_kappa(3.79 / 2.74, 3.43 / 2.54, 3.07 / 2.26);
+    const Rgbd glass(1.52), none(0.0);
+    for (const Case& k :
+         {Case{2.3, 1.0, 0.0, 0.1, ti_eta, ti_kappa}, Case{2.3, 0.4, 0.0, 0.1, ti_eta, ti_kappa},
+          Case{2.3, 0.4, 0.6, 3.0, ti_eta, ti_kappa}, Case{2.3, 1.0, 0.2, 0.5, ti_eta, ti_kappa},
+          Case{1.38, 1.0, 0.3, 2.0, glass, none}, Case{1.38, 0.5, 0.05, 0.4, glass, none}}) {
         const auto f = [&](double dinc) {
-            const Rgbd F = belcour_barla_fresnel(2.3, dinc, eta3, kappa3, mu);
+            const Rgbd F = belcour_barla_fresnel(k.film, dinc, k.eta3, k.kappa3, k.mu);
             for (int c = 0; c < 3; ++c)
-                EXPECT_TRUE(F[c] > 0 && F[c] < 1) << "clamped at Dinc " << dinc << " mu " << mu;
+                EXPECT_TRUE(F[c] > 0 && F[c] < 1) << "clamped at Dinc " << dinc << " mu " << k.mu;
             return F;
         };
-        const Rgbd want = midpoint_mean(lo, hi, 200000, f);
-        const Rgbd got = belcour_barla_fresnel_range(2.3, lo, hi, eta3, kappa3, mu);
+        const Rgbd want = midpoint_mean(k.lo, k.hi, 200000, f);
+        const Rgbd got = belcour_barla_fresnel_range(k.film, k.lo, k.hi, k.eta3, k.kappa3, k.mu);
         for (int c = 0; c < 3; ++c)
-            EXPECT_NEAR(got[c], want[c], 1e-8)
-                << "mu " << mu << " [" << lo << ", " << hi << "] channel " << c;
+            EXPECT_NEAR(got[c], want[c], 1e-8) << "film " << k.film << " mu " << k.mu << " ["
+                                               << k.lo << ", " << k.hi << "] channel " << c;
     }
 }
 
