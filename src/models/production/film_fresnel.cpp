@@ -89,14 +89,24 @@ std::optional<Rgbd> closed_form_mean(const FilmOptics& film, double cos_theta, d
     return r;
 }
 
+/// A 3 × 3 matrix applied to an XYZ triple (of reals or complex values), row by row.
+using Matrix3 = std::array<std::array<double, 3>, 3>;
+template <typename V>
+V apply_matrix(const Matrix3& m, const V& xyz) {
+    return {m[0][0] * xyz[0] + m[0][1] * xyz[1] + m[0][2] * xyz[2],
+            m[1][0] * xyz[0] + m[1][1] * xyz[1] + m[1][2] * xyz[2],
+            m[2][0] * xyz[0] + m[2][1] * xyz[1] + m[2][2] * xyz[2]};
+}
+
 /// XYZ to linear sRGB (Rec. 709 primaries, D65) by the matrix of IEC 61966-2-1 to seven digits,
 /// as three.js's evalSensitivity and Cycles' fallback colour space (util/colorspace.cpp,
 /// get_xyz_to_rec709) carry it (layers/colorimetry.h has the standard's four-digit form).
+constexpr Matrix3 kXyzToSrgb7 = {{{3.2404542, -1.5371385, -0.4985314},
+                                  {-0.9692660, 1.8760108, 0.0415560},
+                                  {0.0556434, -0.2040259, 1.0572252}}};
 template <typename V>
 V xyz_to_srgb_7_digits(const V& xyz) {
-    return {3.2404542 * xyz[0] - 1.5371385 * xyz[1] - 0.4985314 * xyz[2],
-            -0.9692660 * xyz[0] + 1.8760108 * xyz[1] + 0.0415560 * xyz[2],
-            0.0556434 * xyz[0] - 0.2040259 * xyz[1] + 1.0572252 * xyz[2]};
+    return apply_matrix(kXyzToSrgb7, xyz);
 }
 
 /// One Gaussian of Belcour & Barla 2017's fit of the CIE 1931 colour matching functions' Fourier
@@ -138,11 +148,12 @@ std::array<std::complex<double>, 3> sensitivity_xyz(double opd_nm) {
 /// XYZ to CIE 1931 RGB (the CIE's primaries at 700, 546.1 and 435.8 nm, equal-energy white E): the
 /// inverse of the CIE's RGB → XYZ matrix, to seven digits as Belcour & Barla's shader carries it
 /// (its XYZ_TO_RGB).
+constexpr Matrix3 kXyzToCieRgb7 = {{{2.3706743, -0.9000405, -0.4706338},
+                                    {-0.5138850, 1.4253036, 0.0885814},
+                                    {0.0052982, -0.0146949, 1.0093968}}};
 template <typename V>
 V xyz_to_cie_rgb_7_digits(const V& xyz) {
-    return {2.3706743 * xyz[0] - 0.9000405 * xyz[1] - 0.4706338 * xyz[2],
-            -0.5138850 * xyz[0] + 1.4253036 * xyz[1] + 0.0885814 * xyz[2],
-            0.0052982 * xyz[0] - 0.0146949 * xyz[1] + 1.0093968 * xyz[2]};
+    return apply_matrix(kXyzToCieRgb7, xyz);
 }
 
 }  // namespace

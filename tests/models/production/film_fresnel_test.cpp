@@ -351,6 +351,32 @@ struct SingleFilm {
     }
 };
 
+/// The largest |model − exact| over the channels at normal incidence, over μ ≥ 0.5 and over
+/// μ ≥ 0.05 (μ = 0.05 … 1 in steps of 0.05; the last with the μ where it is), the exact film
+/// being physics/thin_film.h's reflectance at the channels' wavelengths: the three columns of
+/// docs/models.md's single-film tables, printed as the table's row and held to sf.documented
+/// (rounded to 0.01). model(μ) is the film model's RGB reflectance at the facet cosine μ.
+template <typename Model>
+void expect_documented_against_exact(const SingleFilm& sf, const Model& model) {
+    const FilmOptics f = sf.optics();
+    double normal = 0, above_half = 0, worst = 0, at_mu = 0;
+    for (int i = 1; i <= 20; ++i) {
+        const double mu = 0.05 * i;
+        const Rgbd exact = film_reflectance_exact(f, mu), got = model(mu);
+        for (int c = 0; c < 3; ++c) {
+            const double d = std::abs(got[c] - exact[c]);
+            if (i == 20) normal = std::max(normal, d);
+            if (mu >= 0.5 - 1e-9) above_half = std::max(above_half, d);
+            if (d > worst) worst = d, at_mu = mu;
+        }
+    }
+    std::cout << fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} (μ = {:.2f}) |\n", sf.name, normal,
+                             above_half, worst, at_mu);
+    EXPECT_NEAR(normal, sf.documented[0], 0.006) << sf.name;
+    EXPECT_NEAR(above_half, sf.documented[1], 0.006) << sf.name;
+    EXPECT_NEAR(worst, sf.documented[2], 0.006) << sf.name;
+}
+
 // Cycles' sensitivity lookup is piecewise linear: its mean over an OPD range (running trapezoid
 // sums) against the lookup averaged by a fine midpoint rule, inside the table and past its end.
 TEST(FilmFresnel, CyclesSensitivityMeanIsTheLookupsMean) {
@@ -425,30 +451,13 @@ TEST(FilmFresnel, ThreeJsAgainstTheExactFilm) {
          {0.29, 0.29, 0.29}},
     };
     for (const SingleFilm& sf : films) {
-        const FilmOptics f = sf.optics();
         Rgbd f0_air;  // three.js's base: its F0 against what lies above the film (the mapping's F0)
         for (int c = 0; c < 3; ++c)
             f0_air[c] = fresnel_conductor(1.0, sf.below[c].real() / sf.eta_above,
                                           sf.below[c].imag() / sf.eta_above);
-        // The largest |three.js − exact| over the channels: at normal incidence, over μ ≥ 0.5,
-        // and over μ ≥ 0.05 (with the μ where it is).
-        double normal = 0, above_half = 0, worst = 0, at_mu = 0;
-        for (int i = 1; i <= 20; ++i) {
-            const double mu = 0.05 * i;
-            const Rgbd exact = film_reflectance_exact(f, mu),
-                       three = threejs_iridescence(1.0, sf.eta_film, mu, sf.thickness_nm, f0_air);
-            for (int c = 0; c < 3; ++c) {
-                const double d = std::abs(three[c] - exact[c]);
-                if (i == 20) normal = std::max(normal, d);
-                if (mu >= 0.5 - 1e-9) above_half = std::max(above_half, d);
-                if (d > worst) worst = d, at_mu = mu;
-            }
-        }
-        std::cout << fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} (μ = {:.2f}) |\n", sf.name,
-                                 normal, above_half, worst, at_mu);
-        EXPECT_NEAR(normal, sf.documented[0], 0.006) << sf.name;
-        EXPECT_NEAR(above_half, sf.documented[1], 0.006) << sf.name;
-        EXPECT_NEAR(worst, sf.documented[2], 0.006) << sf.name;
+        expect_documented_against_exact(sf, [&](double mu) {
+            return threejs_iridescence(1.0, sf.eta_film, mu, sf.thickness_nm, f0_air);
+        });
     }
 }
 
@@ -479,31 +488,15 @@ TEST(FilmFresnel, BelcourBarlaAgainstTheExactFilm) {
          {0.00, 0.00, 0.05}},
     };
     for (const SingleFilm& sf : films) {
-        const FilmOptics f = sf.optics();
         Rgbd eta3, kappa3;
         for (int c = 0; c < 3; ++c) {
             eta3[c] = sf.below[c].real() / sf.eta_above;
             kappa3[c] = sf.below[c].imag() / sf.below[c].real();
         }
         const double dinc_um = 2 * sf.eta_film * sf.thickness_nm / 1000;
-        double normal = 0, above_half = 0, worst = 0, at_mu = 0;
-        for (int i = 1; i <= 20; ++i) {
-            const double mu = 0.05 * i;
-            const Rgbd exact = film_reflectance_exact(f, mu),
-                       shader = belcour_barla_fresnel(sf.eta_film / sf.eta_above, dinc_um, eta3,
-                                                      kappa3, mu);
-            for (int c = 0; c < 3; ++c) {
-                const double d = std::abs(shader[c] - exact[c]);
-                if (i == 20) normal = std::max(normal, d);
-                if (mu >= 0.5 - 1e-9) above_half = std::max(above_half, d);
-                if (d > worst) worst = d, at_mu = mu;
-            }
-        }
-        std::cout << fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} (μ = {:.2f}) |\n", sf.name,
-                                 normal, above_half, worst, at_mu);
-        EXPECT_NEAR(normal, sf.documented[0], 0.006) << sf.name;
-        EXPECT_NEAR(above_half, sf.documented[1], 0.006) << sf.name;
-        EXPECT_NEAR(worst, sf.documented[2], 0.006) << sf.name;
+        expect_documented_against_exact(sf, [&](double mu) {
+            return belcour_barla_fresnel(sf.eta_film / sf.eta_above, dinc_um, eta3, kappa3, mu);
+        });
     }
 }
 
@@ -591,8 +584,7 @@ TEST(FilmFresnel, OpenPbrBsdfAgainstTheExactFilm) {
          {0.22, 0.27, 0.27}},
     };
     for (const SingleFilm& sf : films) {
-        const FilmOptics f = sf.optics();
-        FilmOptics seen = f;
+        FilmOptics seen = sf.optics();
         for (int c = 0; c < 3; ++c) {
             const double n = sf.below[c].real() / sf.eta_above,
                          k = sf.below[c].imag() / sf.eta_above;
@@ -603,23 +595,8 @@ TEST(FilmFresnel, OpenPbrBsdfAgainstTheExactFilm) {
             // openpbr-bsdf takes Gulbrandsen's n + ik as the metal's absolute index.
             seen.eta_below[c] = gulbrandsen_index(f0, tint);
         }
-        double normal = 0, above_half = 0, worst = 0, at_mu = 0;
-        for (int i = 1; i <= 20; ++i) {
-            const double mu = 0.05 * i;
-            const Rgbd exact = film_reflectance_exact(f, mu),
-                       adobe = openpbr_bsdf_film_reflectance(seen, mu, Rgbd(0.0));
-            for (int c = 0; c < 3; ++c) {
-                const double d = std::abs(adobe[c] - exact[c]);
-                if (i == 20) normal = std::max(normal, d);
-                if (mu >= 0.5 - 1e-9) above_half = std::max(above_half, d);
-                if (d > worst) worst = d, at_mu = mu;
-            }
-        }
-        std::cout << fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} (μ = {:.2f}) |\n", sf.name,
-                                 normal, above_half, worst, at_mu);
-        EXPECT_NEAR(normal, sf.documented[0], 0.006) << sf.name;
-        EXPECT_NEAR(above_half, sf.documented[1], 0.006) << sf.name;
-        EXPECT_NEAR(worst, sf.documented[2], 0.006) << sf.name;
+        expect_documented_against_exact(
+            sf, [&](double mu) { return openpbr_bsdf_film_reflectance(seen, mu, Rgbd(0.0)); });
     }
 }
 
@@ -796,7 +773,6 @@ TEST(FilmFresnel, CyclesPrincipledAgainstTheExactFilm) {
          {0.05, 0.06, 0.10}},
     };
     for (const SingleFilm& sf : films) {
-        const FilmOptics f = sf.optics();
         Rgbd f0, tint;
         for (int c = 0; c < 3; ++c) {
             const double n = sf.below[c].real() / sf.eta_above,
@@ -806,24 +782,10 @@ TEST(FilmFresnel, CyclesPrincipledAgainstTheExactFilm) {
                 fresnel_conductor(1.0 / 7, n, k) / (f0[c] + (1 - f0[c]) * std::pow(1 - 1.0 / 7, 5)),
                 0.0, 1.0);
         }
-        double normal = 0, above_half = 0, worst = 0, at_mu = 0;
-        for (int i = 1; i <= 20; ++i) {
-            const double mu = 0.05 * i;
-            const Rgbd exact = film_reflectance_exact(f, mu),
-                       cycles = cycles_f82_tint_film(sf.eta_film / sf.eta_above,
-                                                     sf.thickness_nm * sf.eta_above, f0, tint, mu);
-            for (int c = 0; c < 3; ++c) {
-                const double d = std::abs(cycles[c] - exact[c]);
-                if (i == 20) normal = std::max(normal, d);
-                if (mu >= 0.5 - 1e-9) above_half = std::max(above_half, d);
-                if (d > worst) worst = d, at_mu = mu;
-            }
-        }
-        std::cout << fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} (μ = {:.2f}) |\n", sf.name,
-                                 normal, above_half, worst, at_mu);
-        EXPECT_NEAR(normal, sf.documented[0], 0.006) << sf.name;
-        EXPECT_NEAR(above_half, sf.documented[1], 0.006) << sf.name;
-        EXPECT_NEAR(worst, sf.documented[2], 0.006) << sf.name;
+        expect_documented_against_exact(sf, [&](double mu) {
+            return cycles_f82_tint_film(sf.eta_film / sf.eta_above, sf.thickness_nm * sf.eta_above,
+                                        f0, tint, mu);
+        });
     }
 }
 
