@@ -720,8 +720,6 @@ AirySum airy_summation(const Sensitivity& sensitivity, double R12, double R23, d
     return out;
 }
 
-constexpr double kCyclesFilmCutoffNm = 0.1;  // THINFILM_THICKNESS_CUTOFF
-
 }  // namespace
 
 namespace {
@@ -958,8 +956,16 @@ Rgbd cycles_f82_tint_film(double film_ior, double thickness_nm, const Rgbd& f0, 
     return F;
 }
 
-Rgbd cycles_f82_tint_film_range(double film_ior, double min_nm, double max_nm, const Rgbd& f0,
-                                const Rgbd& tint, double cos_theta) {
+namespace {
+
+/// Cycles' film over the substrate of each channel averaged over the thickness range [min_nm,
+/// max_nm]: the sensitivity's exact mean where Cycles' final clamp cannot act and the range starts
+/// above the 1 nm of the index blend (cycles_f82_tint_film_range), else Gauss–Legendre of
+/// `at_thickness` (the film at one thickness, the cutoff included).
+template <typename AtThickness>
+Rgbd cycles_film_range(double film_ior, double min_nm, double max_nm,
+                       const std::array<CyclesFilmSubstrate, 3>& substrate, double cos_theta,
+                       AtThickness&& at_thickness) {
     if (max_nm > min_nm && min_nm >= 1) {
         // Every quantity but the OPD is the same at every thickness ≥ 1 nm, and the OPD is
         // proportional to d: evaluated at max_nm, order m reads the sensitivity's mean over
@@ -971,7 +977,7 @@ Rgbd cycles_f82_tint_film_range(double film_ior, double min_nm, double max_nm, c
         for (int c = 0; c < 3 && exact; ++c) {
             const AirySum sum = cycles_film_sum(
                 [&](double opd) { return table.mean(c, opd * ratio, opd); }, table.max_magnitude(c),
-                film_ior, max_nm, cycles_f82_tint_substrate(f0[c], tint[c]), cos_theta);
+                film_ior, max_nm, substrate[std::size_t(c)], cos_theta);
             exact = sum.dc - sum.swing >= 0 && sum.dc + sum.swing <= 1;
             F[c] = sum.R;
         }
@@ -980,9 +986,39 @@ Rgbd cycles_f82_tint_film_range(double film_ior, double min_nm, double max_nm, c
     // The third order's phase 2π · 3 · 2 η d cos θ2/λ has a period in d of at least
     // λ_min/(6 η), λ_min = 360 nm.
     const double period = 360 / (6 * std::max(film_ior, 1e-3));
-    return thickness_average(min_nm, max_nm, period, [&](double d) {
+    return thickness_average(min_nm, max_nm, period, at_thickness);
+}
+
+}  // namespace
+
+Rgbd cycles_f82_tint_film_range(double film_ior, double min_nm, double max_nm, const Rgbd& f0,
+                                const Rgbd& tint, double cos_theta) {
+    std::array<CyclesFilmSubstrate, 3> substrate;
+    for (int c = 0; c < 3; ++c)
+        substrate[std::size_t(c)] = cycles_f82_tint_substrate(f0[c], tint[c]);
+    return cycles_film_range(film_ior, min_nm, max_nm, substrate, cos_theta, [&](double d) {
         return cycles_f82_tint_film(film_ior, d, f0, tint, cos_theta);
     });
+}
+
+Rgbd cycles_dielectric_film(double film_ior, double thickness_nm, double eta, double cos_theta) {
+    // generalized_schlick_fresnel's real-Fresnel case (exponent −η, F0 and F90 the dielectric's
+    // own): mix(F0, 1, (F − F0)/(1 − F0)) = F.
+    if (!(thickness_nm > kCyclesFilmCutoffNm))
+        return Rgbd(fresnel_dielectric(clamp(cos_theta, 0.0, 1.0), eta));
+    const CyclesFilmSubstrate substrate{false, eta, 0.0, -1.0};
+    Rgbd F;
+    for (int c = 0; c < 3; ++c)
+        F[c] = cycles_film_reflectance(c, film_ior, thickness_nm, substrate, cos_theta);
+    return F;
+}
+
+Rgbd cycles_dielectric_film_range(double film_ior, double min_nm, double max_nm, double eta,
+                                  double cos_theta) {
+    const CyclesFilmSubstrate dielectric{false, eta, 0.0, -1.0};
+    return cycles_film_range(
+        film_ior, min_nm, max_nm, {dielectric, dielectric, dielectric}, cos_theta,
+        [&](double d) { return cycles_dielectric_film(film_ior, d, eta, cos_theta); });
 }
 
 }  // namespace lamina

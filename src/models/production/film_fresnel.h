@@ -131,6 +131,10 @@ class CyclesFilmSensitivity {
     double max_magnitude_[3] = {};
 };
 
+/// Cycles' THINFILM_THICKNESS_CUTOFF (kernel/closure/bsdf_util.h): a film of at most this thickness
+/// (nm) is no film.
+inline constexpr double kCyclesFilmCutoffNm = 0.1;
+
 /// Cycles' thin film (kernel/closure/bsdf_util.h, fresnel_iridescence_channel) for light
 /// arriving from a medium of index 1 at cos_theta_1 on a film of index film_ior and thickness
 /// thickness_nm over a substrate: the reflectances and phases of both boundaries (each
@@ -208,5 +212,18 @@ Rgbd cycles_f82_tint_film(double film_ior, double thickness_nm, const Rgbd& f0, 
 /// elsewhere by Gauss–Legendre (32 nodes per period of the third order, at most 2048).
 Rgbd cycles_f82_tint_film_range(double film_ior, double min_nm, double max_nm, const Rgbd& f0,
                                 const Rgbd& tint, double cos_theta);
+
+/// Cycles' film on a dielectric of index eta relative to the ambient (eta > 1), as its Principled
+/// BSDF's specular layer evaluates it (kernel/closure/bsdf_microfacet.h,
+/// generalized_schlick_fresnel with a film, at the node's default specular tint and IOR level,
+/// where its rescaling towards the tinted F0 is the identity): per channel cycles_film_reflectance
+/// over that dielectric. Films of thickness_nm ≤ 0.1 leave the bare dielectric's exact Fresnel
+/// (Cycles' real Fresnel remapped between its own F0 and 1, which is itself).
+Rgbd cycles_dielectric_film(double film_ior, double thickness_nm, double eta, double cos_theta);
+/// cycles_dielectric_film averaged over the thickness range [min_nm, max_nm] as
+/// cycles_f82_tint_film_range averages its metal's (the sensitivity's exact mean where Cycles'
+/// clamp cannot act, else quadrature).
+Rgbd cycles_dielectric_film_range(double film_ior, double min_nm, double max_nm, double eta,
+                                  double cos_theta);
 
 }  // namespace lamina

@@ -24,21 +24,22 @@ inline constexpr double kAlbedoMuMin = 1e-6;
 /// ∫ f(ggx, wi, wo, wi·h) dh over the normals h visible from wi (μ = wi.z) whose reflection wo
 /// leaves above the horizon, the radius split where wo crosses it (the integrand has a kink
 /// there); the albedos below and those of models/production/uncorrelated_albedo.h.
-template <typename Integrand>
-double reflection_over_visible_normals(double mu, double alpha, Integrand&& f, int n_r, int n_phi) {
+/// V the integrand's value (double, or a colour such as Rgbd).
+template <typename V = double, typename Integrand>
+V reflection_over_visible_normals(double mu, double alpha, Integrand&& f, int n_r, int n_phi) {
     mu = std::max(mu, kAlbedoMuMin);
     const Vec3d wi(safe_sqrt(1 - mu * mu), 0, mu);
     const GGX<double> ggx{alpha};
     const QuadratureRule q = gauss_legendre(n_r);
     auto outgoing_z = [&](const Vec3d& h) { return 2 * dot(wi, h) * h.z - wi.z; };
-    auto integrand = [&](const Vec3d& h) {
+    auto integrand = [&](const Vec3d& h) -> V {
         const double cos_h = dot(wi, h);
         const Vec3d wo = h * (2 * cos_h) - wi;
-        if (wo.z <= 0) return 0.0;
+        if (wo.z <= 0) return V{};
         return f(ggx, wi, wo, cos_h);
     };
-    return integrate_visible_split<double>(ggx, wi, integrand, q, n_phi, 1e-7,
-                                           Crossing{outgoing_z, 0.0});
+    return integrate_visible_split<V>(ggx, wi, integrand, q, n_phi, 1e-7,
+                                      Crossing{outgoing_z, 0.0});
 }
 
 /// E(μ, α): the directional albedo of the white lobe (F = 1), ∫ D_wi(h) G2/G1(wi) dh. μ ∈ [0, 1],

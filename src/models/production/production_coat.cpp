@@ -5,6 +5,7 @@
 #include "models/production/cycles_albedo.h"
 #include "models/production/filament_dfg.h"
 #include "models/production/film_fresnel.h"
+#include "models/production/glossy_diffuse_film.h"
 #include "models/production/lobe_mixture.h"
 #include "models/production/threejs_dfg.h"
 #include "models/production/uncorrelated_albedo.h"
@@ -901,9 +902,25 @@ void use_exact_leaves(CoatRecipe& r) {
     r.metal_fresnel = CoatRecipe::MetalFresnel::Exact;
     if (r.metal_film != CoatRecipe::MetalFilm::Unsupported)
         r.metal_film = CoatRecipe::MetalFilm::Exact;
+    if (r.dielectric_film != CoatRecipe::DielectricFilm::Unsupported)
+        r.dielectric_film = CoatRecipe::DielectricFilm::Exact;
 }
 
 std::unique_ptr<Model> make_production_coat(const Stack& stack, const CoatRecipe& recipe) {
+    if (recipe.dielectric_film != CoatRecipe::DielectricFilm::Unsupported &&
+        is_filmed_plastic(stack)) {
+        GlossyDiffuseFilmRecipe glossy;
+        glossy.name = recipe.name;
+        glossy.film = recipe.dielectric_film == CoatRecipe::DielectricFilm::Cycles
+                          ? GlossyDiffuseFilmRecipe::Film::Cycles
+                          : GlossyDiffuseFilmRecipe::Film::Exact;
+        glossy.cycles_compensation =
+            recipe.coat_energy_compensation == CoatRecipe::CoatEnergyCompensation::Cycles;
+        glossy.layering = recipe.coat_albedo == CoatRecipe::CoatAlbedo::Cycles
+                              ? GlossyDiffuseFilmRecipe::Layering::CyclesEstimate
+                              : GlossyDiffuseFilmRecipe::Layering::LobeAlbedo;
+        return make_glossy_diffuse_film(stack, glossy);
+    }
     return std::make_unique<ProductionCoat>(stack, recipe);
 }
 

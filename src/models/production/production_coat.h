@@ -31,9 +31,10 @@
 //
 // Represented: a dielectric coat (absorbing, not scattering) over a Lambertian or conductor base
 // (BRDF only), anisotropic for the recipes that define anisotropic roughness (OpenPBR's), and for a
-// recipe with a MetalFilm a thin film on the conductor. Not supported, with the reason: other
-// shapes, a scattering coat, a dielectric base (slab: the models' bases are opaque), and a coat IOR
-// other than 1.5 for the models whose coat has a fixed IOR (Enterprise PBR, Filament, glTF).
+// recipe with a MetalFilm a thin film on the conductor; for a recipe with a DielectricFilm, a film
+// on a plastic's interface (glossy_diffuse_film.h). Not supported, with the reason: other shapes, a
+// scattering coat, a dielectric base (slab: the models' bases are opaque), and a coat IOR other
+// than 1.5 for the models whose coat has a fixed IOR (Enterprise PBR, Filament, glTF).
 
 #include "models/model.h"
 #include "models/production/ggx_albedo.h"
@@ -208,6 +209,17 @@ struct CoatRecipe {
         /// is no film: the metal's F82-tint Fresnel.
         OpenPbrSpec,
     } metal_film = MetalFilm::Unsupported;
+
+    /// A thin film on a dielectric base's specular layer: a filmed plastic (ambient | film |
+    /// dielectric | Lambertian) is the model's dielectric base without a coat, the film in its
+    /// specular lobe's Fresnel factor (models/production/glossy_diffuse_film.h, which takes the
+    /// layering from coat_albedo: Cycles' estimate, or else the filmed lobe's own albedo, and the
+    /// lobe's compensation from coat_energy_compensation).
+    enum class DielectricFilm {
+        Unsupported,  ///< no film on the model's dielectric base
+        Exact,        ///< the film's exact Airy reflectance (OpenPBR 1.1's open case taken exactly)
+        Cycles,       ///< Cycles' film sum over the dielectric (cycles_dielectric_film)
+    } dielectric_film = DielectricFilm::Unsupported;
 
     /// Standard Surface's coat_affect_color = 1: ρ ← ρ^2 (its default 0 leaves ρ).
     bool affect_color = false;

@@ -49,6 +49,8 @@ CoatRecipe openpbr_recipe(const ModelOptions& o) {
     r.metal_fresnel = CoatRecipe::MetalFresnel::F82Tint;
     // thin_film_weight 1 ("Thin-film iridescence"): the film on the metal under the coat.
     r.metal_film = CoatRecipe::MetalFilm::OpenPbrSpec;
+    // ... and on the dielectric base's specular layer ("Glossy-diffuse"), taken exactly.
+    r.dielectric_film = CoatRecipe::DielectricFilm::Exact;
     // specular_roughness_anisotropy and coat_roughness_anisotropy ("Specular", "Coat").
     r.anisotropic_roughness = true;
     if (exact_leaves(o)) use_exact_leaves(r);
@@ -257,6 +259,9 @@ CoatRecipe blender_recipe(const ModelOptions& o) {
     // The Principled BSDF's thin film on its metal (kernel/svm/closure.h; microfacet_fresnel's
     // F82-tint case in kernel/closure/bsdf_microfacet.h).
     r.metal_film = CoatRecipe::MetalFilm::Cycles;
+    // ... and on the dielectric base's specular layer (the Specular component's generalized
+    // Schlick Fresnel with the film).
+    r.dielectric_film = CoatRecipe::DielectricFilm::Cycles;
     r.coat_fresnel = CoatRecipe::Fresnel::Exact;
     r.coat_ior_at_least_one = true;
     r.attenuation = CoatRecipe::Attenuation::AlbedoView;

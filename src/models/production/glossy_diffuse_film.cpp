@@ -1,0 +1,239 @@
+#include "models/production/glossy_diffuse_film.h"
+
+#include "core/math.h"
+#include "layers/compiled_stack.h"
+#include "models/production/cycles_albedo.h"
+#include "models/production/film_fresnel.h"
+#include "models/production/lobe_mixture.h"
+#include "models/production/production_coat.h"
+#include "physics/microfacet.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <optional>
+
+namespace lamina {
+
+bool is_filmed_plastic(const Stack& stack) {
+    return stack.layers.size() == 2 && stack.layers[0].interface.has_film &&
+           stack.layers[0].interface.type == InterfaceType::Dielectric &&
+           !stack.layers[1].interface.has_film &&
+           stack.layers[1].interface.type == InterfaceType::Lambertian;
+}
+
+namespace {
+
+/// The nodes of the tabulated albedo E_film(μ): μ = k/(kNodes − 1), read by cubic interpolation
+/// (Catmull–Rom on the uniform nodes, the end slopes one-sided).
+constexpr int kNodes = 65;
+
+class GlossyDiffuseFilm final : public Model {
+  public:
+    GlossyDiffuseFilm(const Stack& stack, const GlossyDiffuseFilmRecipe& recipe) : r_(recipe) {
+        if (!is_filmed_plastic(stack)) {
+            support_.reason = fmt::format(
+                "{} has a film on a dielectric base only over a Lambertian (ambient | film | "
+                "dielectric | Lambertian)",
+                r_.name);
+            return;
+        }
+        const InterfaceSpec& top = stack.layers[0].interface;
+        Stack bare = stack;
+        bare.layers[0].interface.has_film = false;
+        bare.layers[0].interface.film = {};
+        CoatedStack shape;
+        std::string why;
+        if (!coated_stack(bare, shape, why)) {
+            support_.reason = fmt::format("{} {}", r_.name, why);
+            return;
+        }
+        if (shape.tau_a.max() > 0 || shape.tau_s.max() > 0) {
+            support_.reason = fmt::format(
+                "{}'s filmed dielectric base has nothing between its specular layer and its "
+                "diffuse (this stack has a medium there)",
+                r_.name);
+            return;
+        }
+        if (top.film.k > 0) {
+            support_.reason =
+                fmt::format("{}'s thin film is transparent (no extinction k); this film's k is {}",
+                            r_.name, top.film.k);
+            return;
+        }
+        if (stack.is_anisotropic()) {
+            support_.reason =
+                fmt::format("{} has no anisotropic filmed dielectric base in lamina", r_.name);
+            return;
+        }
+        if (!(shape.eta0 > 1)) {
+            support_.reason = fmt::format(
+                "{}'s filmed dielectric base is denser than the ambient (relative index > 1); "
+                "this one's is {}",
+                r_.name, shape.eta0);
+            return;
+        }
+        film_ = stack_film_optics(stack, 0);
+        if (r_.film == GlossyDiffuseFilmRecipe::Film::Cycles && film_.varies()) {
+            support_.reason = fmt::format(
+                "{} represents one film thickness on a dielectric base: its diffuse layering "
+                "weight is not linear in the film, so a thickness range has no one value",
+                r_.name);
+            return;
+        }
+        support_.brdf = true;
+        eta0_ = shape.eta0;
+        alpha_ = shape.alpha0;
+        ggx_ = GGX<double>{alpha_};
+        rho_ = shape.albedo;
+        // Cycles' film sees an ambient of index 1: the film's index and thickness relative to the
+        // ambient.
+        cycles_film_ior_ = film_.eta_film.real() / film_.eta_above;
+        cycles_thickness_nm_ = film_.thickness_max_nm * film_.eta_above;
+        if (r_.cycles_compensation) {
+            // bsdf_microfacet_setup_fresnel_generalized_schlick with the real Fresnel (exponent
+            // −η): F_ss = mix(F0, 1, s), s = saturate((F_ss,fit − F0)/(1 − F0)), F_ss,fit
+            // fresnel_dielectric_Fss (Kulla & Conty's fit); the film does not enter it.
+            white_.emplace(std::sqrt(alpha_));
+            const double f0 = sqr((eta0_ - 1) / (eta0_ + 1));
+            const double s =
+                clamp((kulla_conty_average_fresnel_fit(eta0_) - f0) / (1 - f0), 0.0, 1.0);
+            const double f_ss = f0 + (1 - f0) * s;
+            const double e_avg = white_->average();
+            f_ms_ = f_ss * e_avg / (1 - f_ss * (1 - e_avg));
+        }
+        // Without a film (≤ 0.1 nm) Cycles estimates the lobe's albedo from its table of the
+        // rough dielectric's Fresnel factor (bsdf_microfacet_estimate_albedo, GENERALIZED_SCHLICK
+        // with exponent < 0), with one from the film's reflectance at the view's cosine.
+        if (r_.layering == GlossyDiffuseFilmRecipe::Layering::CyclesEstimate &&
+            !(cycles_thickness_nm_ > kCyclesFilmCutoffNm))
+            factor_.emplace(std::sqrt(alpha_), eta0_);
+        if (r_.layering == GlossyDiffuseFilmRecipe::Layering::LobeAlbedo)
+            for (int k = 0; k < kNodes; ++k)
+                albedo_[std::size_t(k)] = filmed_lobe_albedo(double(k) / (kNodes - 1), alpha_,
+                                                             [&](double c) { return film(c); });
+    }
+
+    std::string name() const override { return r_.name; }
+    Support support() const override { return support_; }
+
+    Rgbd eval(const Vec3d& wi, const Vec3d& wo) const override {
+        if (!support_.brdf || wi.z <= 0 || wo.z <= 0) return Rgbd(0.0);
+        Rgbd f(0.0);
+        if (alpha_ > 0) {
+            const Vec3d h = normalize(wi + wo);
+            const double cos_h = dot(wi, h);
+            const double G = 1 / (1 + ggx_.lambda(wi) + ggx_.lambda(wo));  // Heitz 2014, Eq. 99
+            f = film(cos_h) * (ggx_.D(h) * G / (4 * wi.z * wo.z) * compensation(wo.z));
+        }
+        return f + rho_ * layering(wo.z) * kInvPi<double>;
+    }
+
+    std::vector<DeltaLobe> delta_lobes(const Vec3d& wi) const override {
+        if (!support_.brdf || wi.z <= 0 || alpha_ > 0) return {};
+        // A smooth interface: the film's reflectance at μi along the mirror direction (Cycles'
+        // compensation is 1 there: its table holds E = 1 at the first roughness node).
+        return {{mirror_direction(wi), film(wi.z)}};
+    }
+
+    /// Cycles' film gives its colour (its spectral integration), not values at the wavelengths.
+    bool integrates_spectrum() const override {
+        return r_.film == GlossyDiffuseFilmRecipe::Film::Cycles;
+    }
+
+    /// Sampling (models/production/lobe_mixture.h): the lobe's visible normals with probability
+    /// the film's reflectance at μi clamped to [0.1, 0.9] (0 for a smooth interface, whose delta
+    /// lobe is reported apart), the cosine otherwise.
+    bool has_sampling() const override { return support_.brdf; }
+
+    std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override {
+        if (!has_sampling() || wi.z <= 0) return std::nullopt;
+        return sample_lobe_mixture(*this, proposal(wi), wi, u);
+    }
+
+    double pdf(const Vec3d& wi, const Vec3d& wo) const override {
+        if (!has_sampling() || wi.z <= 0 || wo.z <= 0) return 0;
+        return proposal(wi).pdf(wi, wo);
+    }
+
+  private:
+    /// The film's reflectance at the facet cosine c, per channel, in the recipe's form.
+    Rgbd film(double c) const {
+        if (r_.film == GlossyDiffuseFilmRecipe::Film::Cycles)
+            return cycles_dielectric_film(cycles_film_ior_, cycles_thickness_nm_, eta0_, c);
+        return film_reflectance_exact(film_, c);
+    }
+
+    /// c(μo): Cycles' compensation 1 + F_ms (1 − E)/E, or 1.
+    double compensation(double mu_o) const {
+        if (!white_ || alpha_ <= 0) return 1;
+        return 1 + f_ms_ * (1 / white_->albedo(mu_o) - 1);
+    }
+
+    /// L(μo), the diffuse lobe's weight per channel.
+    Rgbd layering(double mu_o) const {
+        if (r_.layering == GlossyDiffuseFilmRecipe::Layering::CyclesEstimate) {
+            // closure_layering_weight: 1 − max over the channels of the specular closure's albedo
+            // relative to the weight above it, bsdf_albedo = its weight w (E + F_ms (1 − E) after
+            // microfacet_ggx_preserve_energy) × bsdf_microfacet_estimate_albedo: with a film the
+            // film's reflectance at the view's cosine, without one its table's Fresnel factor.
+            double w = 1;
+            if (white_ && alpha_ > 0) {
+                const double E = white_->albedo(mu_o);
+                w = E + f_ms_ * (1 - E);
+            }
+            if (factor_) {
+                const double f0 = sqr((eta0_ - 1) / (eta0_ + 1));
+                return Rgbd(clamp(1 - w * (f0 + (1 - f0) * factor_->factor(mu_o)), 0.0, 1.0));
+            }
+            return Rgbd(clamp(1 - (film(mu_o) * w).max(), 0.0, 1.0));
+        }
+        return Rgbd(1.0) - interpolated_albedo(mu_o);
+    }
+
+    /// E_film(μ) from its nodes: Catmull–Rom between the two nodes around μ, the slopes the
+    /// central differences (one-sided at the ends).
+    Rgbd interpolated_albedo(double mu) const {
+        const double x = clamp(mu, 0.0, 1.0) * (kNodes - 1);
+        const int i = std::min(int(x), kNodes - 2);
+        const double t = x - i;
+        const auto node = [&](int k) { return albedo_[std::size_t(std::clamp(k, 0, kNodes - 1))]; };
+        const auto slope = [&](int k) {
+            if (k == 0) return node(1) - node(0);
+            if (k == kNodes - 1) return node(k) - node(k - 1);
+            return (node(k + 1) - node(k - 1)) * 0.5;
+        };
+        const double t2 = t * t, t3 = t2 * t;
+        return node(i) * (2 * t3 - 3 * t2 + 1) + slope(i) * (t3 - 2 * t2 + t) +
+               node(i + 1) * (-2 * t3 + 3 * t2) + slope(i + 1) * (t3 - t2);
+    }
+
+    ReflectionLobeMixture proposal(const Vec3d& wi) const {
+        ReflectionLobeMixture m;
+        m.coat = alpha_ > 0 ? clamp(film(wi.z).max(), 0.1, 0.9) : 0.0;
+        m.coat_lobe = ggx_;
+        m.diffuse = true;
+        return m;
+    }
+
+    GlossyDiffuseFilmRecipe r_;
+    Support support_;
+    FilmOptics film_;
+    double eta0_ = 1.5, alpha_ = 0;
+    GGX<double> ggx_{0.0};
+    Rgbd rho_{0.0};
+    double cycles_film_ior_ = 1.5, cycles_thickness_nm_ = 0;
+    std::optional<CyclesWhiteAlbedo> white_;
+    std::optional<CyclesFresnelFactor> factor_;  ///< Cycles' estimate without a film
+    double f_ms_ = 0;
+    std::array<Rgbd, kNodes> albedo_{};
+};
+
+}  // namespace
+
+std::unique_ptr<Model> make_glossy_diffuse_film(const Stack& stack,
+                                                const GlossyDiffuseFilmRecipe& recipe) {
+    return std::make_unique<GlossyDiffuseFilm>(stack, recipe);
+}
+
+}  // namespace lamina
