@@ -86,6 +86,12 @@ class GlossyDiffuseFilm final : public Model {
         alpha_ = shape.alpha0;
         ggx_ = GGX<double>{alpha_};
         rho_ = shape.albedo;
+        if (r_.darkened_base_color) {
+            const double K =
+                openpbr_internal_reflectance(eta0_, openpbr_average_fresnel_fit(eta0_));
+            for (int c = 0; c < 3; ++c)
+                rho_[c] *= openpbr_coat_darkening(K, rho_[c]);
+        }
         // Cycles' film sees an ambient of index 1: the film's index and thickness relative to the
         // ambient.
         cycles_film_ior_ = film_.eta_film.real() / film_.eta_above;

@@ -17,7 +17,10 @@
 //   transmission). The cases the specification leaves to the implementation are taken exactly, as
 //   for its film on a metal: F_film the film's Airy reflectance (physics/thin_film.h, at the
 //   stack's channel wavelengths, averaged over the thickness range), c = 1, and L = 1 − E_film(μo)
-//   with E_film the directional albedo of the filmed lobe itself.
+//   with E_film the directional albedo of the filmed lobe itself. Its ρ is the base colour the
+//   specification asks for, the Lambertian's darkened by the interface's internal reflections
+//   (GlossyDiffuseFilmRecipe::darkened_base_color): without a film the model is then `openpbr`'s
+//   coat over the diffuse base.
 //
 //   Cycles (kernel/svm/closure.h, the Principled BSDF's specular and diffuse components;
 //   kernel/closure/bsdf_microfacet.h): F_film its Fourier-space film sum over the dielectric
@@ -53,6 +56,12 @@ struct GlossyDiffuseFilmRecipe {
         LobeAlbedo,      ///< L = 1 − E_film(μo), the filmed lobe's own albedo (OpenPBR)
         CyclesEstimate,  ///< L = clamp(1 − max_c w F_film,c(μo), 0, 1) (Cycles)
     } layering = Layering::LobeAlbedo;
+    /// The diffuse's colour is the Lambertian's ρ darkened as OpenPBR darkens a diffuse base under
+    /// a coat of the interface's index (openpbr_coat_darkening with K_r of its E_F fit): OpenPBR
+    /// 1.1 defines base_color as the fraction of the light let into the dielectric that comes
+    /// back out ("Glossy-diffuse"), which a Lambertian ρ under the interface gives by its
+    /// internal reflections. Otherwise the colour is ρ (Cycles' base colour).
+    bool darkened_base_color = false;
 };
 
 /// The stack is a filmed plastic (two interfaces: a dielectric carrying a film over a Lambertian).

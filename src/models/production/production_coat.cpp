@@ -704,7 +704,7 @@ class ProductionCoat final : public Model {
             const double K_s = fresnel_dielectric(mu_o, eta0_);
             const double K = K_s + (K_r_ - K_s) * r_b_;
             for (int c = 0; c < 3; ++c)
-                s[c] *= coat_darkening(K, E_b_[c]);
+                s[c] *= openpbr_coat_darkening(K, E_b_[c]);
         } else {
             s *= darkening_;
         }
@@ -720,13 +720,13 @@ class ProductionCoat final : public Model {
             const double K = 1 - (1 - coat_f0_ior_) / (eta0_ * eta0_);
             E_b_ = is_metal_ ? f0_ : albedo_;
             for (int c = 0; c < 3; ++c)
-                darkening_[c] = coat_darkening(K, E_b_[c]);
+                darkening_[c] = openpbr_coat_darkening(K, E_b_[c]);
             return;
         }
         // OpenPBR 1.1, "Darkening": Δ = (1 − K)/(1 − E_b K), K_r = 1 − (1 − E_F(η_c))/η_c².
         const double E_F = r_.darkening == D::Spec ? openpbr_average_fresnel_fit(eta0_)
                                                    : kulla_conty_average_fresnel_fit(eta0_);
-        K_r_ = 1 - (1 - E_F) / (eta0_ * eta0_);
+        K_r_ = openpbr_internal_reflectance(eta0_, E_F);
         double K = K_r_;  // a diffuse base: r_b = 1 (no specular of its own)
         if (is_metal_) {
             if (r_.darkening == D::Spec) {
@@ -757,17 +757,12 @@ class ProductionCoat final : public Model {
             E_b_ = albedo_;
         }
         for (int c = 0; c < 3; ++c)
-            darkening_[c] = coat_darkening(K, E_b_[c]);
+            darkening_[c] = openpbr_coat_darkening(K, E_b_[c]);
     }
 
     /// The darkening (1 − K)/(1 − E_b K) (OpenPBR 1.1, "Coat darkening"): 0 where the coat
     /// reflects everything (K = 1: a coat less dense than the ambient medium past its critical
     /// angle), never 0/0 with a perfect base (E_b = 1).
-    static double coat_darkening(double K, double E_b) {
-        if (!(K < 1)) return 0.0;
-        return (1 - K) / (1 - E_b * K);
-    }
-
     CoatRecipe r_;
     CoatedStack coat_;
     Support support_;
@@ -862,6 +857,15 @@ SchlickSplit materialx_ggx_albedo_fit(double mu, double alpha) {
     return {clamp(r[0] / r[2], 0.0, 1.0), clamp(r[1] / r[3], 0.0, 1.0)};
 }
 
+double openpbr_internal_reflectance(double eta, double average_fresnel) {
+    return 1 - (1 - average_fresnel) / (eta * eta);
+}
+
+double openpbr_coat_darkening(double K, double E_b) {
+    if (!(K < 1)) return 0.0;
+    return (1 - K) / (1 - E_b * K);
+}
+
 double filament_f0_clear_coat_to_surface(double f0) {
     // Filament documentation, "Clear coat" (f0ClearCoatToSurface): a fit of the F0 of an
     // interface against IOR 1.5 from its F0 against air.
@@ -919,6 +923,7 @@ std::unique_ptr<Model> make_production_coat(const Stack& stack, const CoatRecipe
         glossy.layering = recipe.coat_albedo == CoatRecipe::CoatAlbedo::Cycles
                               ? GlossyDiffuseFilmRecipe::Layering::CyclesEstimate
                               : GlossyDiffuseFilmRecipe::Layering::LobeAlbedo;
+        glossy.darkened_base_color = recipe.darkening == CoatRecipe::Darkening::Spec;
         return make_glossy_diffuse_film(stack, glossy);
     }
     return std::make_unique<ProductionCoat>(stack, recipe);

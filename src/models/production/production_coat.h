@@ -213,8 +213,9 @@ struct CoatRecipe {
     /// A thin film on a dielectric base's specular layer: a filmed plastic (ambient | film |
     /// dielectric | Lambertian) is the model's dielectric base without a coat, the film in its
     /// specular lobe's Fresnel factor (models/production/glossy_diffuse_film.h, which takes the
-    /// layering from coat_albedo: Cycles' estimate, or else the filmed lobe's own albedo, and the
-    /// lobe's compensation from coat_energy_compensation).
+    /// layering from coat_albedo: Cycles' estimate, or else the filmed lobe's own albedo; the
+    /// lobe's compensation from coat_energy_compensation; and, with the specification's
+    /// darkening, the diffuse's colour darkened by it).
     enum class DielectricFilm {
         Unsupported,  ///< no film on the model's dielectric base
         Exact,        ///< the film's exact Airy reflectance (OpenPBR 1.1's open case taken exactly)
@@ -253,6 +254,13 @@ std::unique_ptr<Model> make_production_coat(const Stack& stack, const CoatRecipe
 /// as the OpenPBR 1.1 specification gives it (footnote "avg_fresnel", accurate to 0.2% for
 /// η ∈ [1, 3]); η < 1 through E_F(η) = 1 − η² (1 − E_F(1/η)).
 double openpbr_average_fresnel_fit(double eta);
+/// OpenPBR 1.1 ("Darkening"): the internal reflectance of a rough coat's underside,
+/// K_r = 1 − (1 − E_F)/η², from its average Fresnel E_F (the specification's fit, or a model's
+/// own).
+double openpbr_internal_reflectance(double eta, double average_fresnel);
+/// OpenPBR 1.1 ("Darkening"): the darkening (1 − K)/(1 − E_b K) of a base of albedo E_b under a
+/// coat whose underside reflects K (0 where K ≥ 1).
+double openpbr_coat_darkening(double K, double E_b);
 /// Kulla & Conty 2017 (slide 18)'s fit of the same average, as Adobe's openpbr-bsdf ships it
 /// (openpbr_average_fresnel): (η − 1)/(4.08567 + 1.00071 η) for η > 1.
 double kulla_conty_average_fresnel_fit(double eta);

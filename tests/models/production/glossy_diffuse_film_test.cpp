@@ -3,6 +3,7 @@
 // against the Airy film, lamina's FGD table and the white furnace its albedo scaling promises.
 #include "models/production/glossy_diffuse_film.h"
 #include "core/math.h"
+#include "models/production/production_coat.h"
 #include "models/registry.h"
 #include "models/tables/fgd_table.h"
 #include "models/test_stacks.h"
@@ -120,7 +121,8 @@ TEST(GlossyDiffuseFilm, BlenderPrincipledMatchesCycles) {
 }
 
 // `openpbr` (and any recipe's leaves=exact) at thickness 0 is the glossy-diffuse base with the
-// bare interface: the exact dielectric Fresnel at wi·h in the lobe, and the diffuse weighted by
+// bare interface: the exact dielectric Fresnel at wi·h in the lobe, and the diffuse (openpbr's ρ
+// darkened as its specification darkens a diffuse base, leaves=exact's ρ) weighted by
 // 1 − E(μo) with E the lobe's albedo integrated directly (FgdTable::direct: exact Fresnel,
 // height-correlated Smith, 384 × 512 nodes on another rule), apart from the model's own
 // quadrature and table in μo: the lobe to 1e-12, the whole within 2e-5 of ρ/π (measured 1.5e-5;
@@ -145,8 +147,14 @@ TEST(GlossyDiffuseFilm, OpenPbrAtThicknessZeroIsTheBareGlossyDiffuse) {
                                         (1 + ggx.lambda(wi) + ggx.lambda(wo)) / (4 * wi.z * wo.z);
                     const double E = FgdTable::direct(wo.z, alpha, eta0, 0, 384, 512);
                     const Rgbd got = m->eval(wi, wo);
+                    // openpbr's base colour: ρ under the specification's darkening.
+                    const double K =
+                        openpbr_internal_reflectance(eta0, openpbr_average_fresnel_fit(eta0));
                     for (int c = 0; c < 3; ++c) {
-                        const double want = lobe + rho[c] * kInvPi<double> * (1 - E);
+                        const double color = std::string(name) == "openpbr"
+                                                 ? rho[c] * openpbr_coat_darkening(K, rho[c])
+                                                 : rho[c];
+                        const double want = lobe + color * kInvPi<double> * (1 - E);
                         worst =
                             std::max(worst, std::abs(got[c] - want) / (rho[c] * kInvPi<double>));
                         EXPECT_NEAR(got[c], want, 1e-12 * lobe + 2e-5 * rho[c] * kInvPi<double>)
@@ -157,6 +165,42 @@ TEST(GlossyDiffuseFilm, OpenPbrAtThicknessZeroIsTheBareGlossyDiffuse) {
         }
     std::cout << fmt::format(
         "glossy-diffuse at thickness 0 against the direct albedo: {:.1e} of rho/pi\n", worst);
+}
+
+// Without a film `openpbr`'s glossy-diffuse base is its coat over the diffuse base (the coat's
+// albedo scaling and darkening on ρ are the glossy-diffuse's on its darkened colour), and
+// `blender-principled`'s is its coat's closures: a filmed plastic of thickness 0 against the same
+// plastic without a film: openpbr's to the FGD table's budget, 6.3e-3 of E (its coat reads
+// lamina's FGD table, the glossy-diffuse base integrates its lobe; measured 1.3e-3 of ρ/π), and
+// Cycles' to 1e-12 (the same closures, the same tables).
+TEST(GlossyDiffuseFilm, ThicknessZeroIsTheFilmlessModel) {
+    const Rgbd rho(0.8, 0.5, 0.2);
+    double worst = 0;
+    for (const double eta0 : {1.33, 1.5, 2.2})
+        for (const double alpha : {0.05, 0.3}) {
+            const Stack filmed = filmed_plastic(eta0, alpha, rho, 1.4, 0, 0),
+                        bare = test::coated(eta0, alpha, test::lambertian(rho));
+            for (const char* name : {"openpbr", "blender-principled"}) {
+                const auto a = make_model(name, bare), b = make_model(name, filmed);
+                ASSERT_TRUE(b->support().brdf) << b->support().reason;
+                for (const auto& [wi, wo] :
+                     {std::pair{dir(0, 0), dir(30, 180)}, std::pair{dir(50, 0), dir(45, 170)},
+                      std::pair{dir(75, 0), dir(20, 90)}, std::pair{dir(20, 0), dir(85, 10)}}) {
+                    const Rgbd x = a->eval(wi, wo), y = b->eval(wi, wo);
+                    for (int c = 0; c < 3; ++c) {
+                        const double scale = rho[c] * kInvPi<double>;
+                        if (std::string(name) == "openpbr") {
+                            worst = std::max(worst, std::abs(y[c] - x[c]) / scale);
+                            EXPECT_NEAR(y[c], x[c], 6.3e-3 * scale) << name << " eta0 " << eta0;
+                        } else {
+                            EXPECT_NEAR(y[c], x[c], 1e-12 * std::max(1.0, x[c]))
+                                << name << " eta0 " << eta0 << " alpha " << alpha;
+                        }
+                    }
+                }
+            }
+        }
+    std::cout << fmt::format("openpbr at thickness 0 against its coat: {:.1e} of rho/pi\n", worst);
 }
 
 // `openpbr`'s lobe carries the exact film: with ρ = 0 the model over D G2/(4 μi μo) is the
