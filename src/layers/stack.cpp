@@ -935,23 +935,41 @@ nlohmann::json stack_to_json(const Stack& stack) {
 Stack Stack::at_wavelengths(const Rgbd& wavelengths, int path_channel) const {
     Stack out = *this;
     out.wavelengths_nm = wavelengths;
+    // A value given as RGB numbers stands for the spectrum that takes, at each wavelength, the
+    // number of the channel whose wavelength (this stack's wavelengths_nm) is nearest: at its own
+    // channels' wavelengths it is itself, and channel c at another wavelength reads the number of
+    // its part of the spectrum, not the c-th number.
+    auto nearest_channel = [&](double lambda) {
+        std::size_t best = 0;
+        for (std::size_t c = 1; c < 3; ++c)
+            if (std::abs(wavelengths_nm[c] - lambda) < std::abs(wavelengths_nm[best] - lambda))
+                best = c;
+        return best;
+    };
     auto at = [&](const std::optional<Spectrum>& spectrum, Rgbd& rgb) {
-        if (!spectrum) return;
+        const Rgbd given = rgb;
         for (std::size_t c = 0; c < 3; ++c)
-            rgb[c] = spectrum->at(wavelengths[c]);
+            rgb[c] =
+                spectrum ? spectrum->at(wavelengths[c]) : given[nearest_channel(wavelengths[c])];
     };
     for (Layer& layer : out.layers) {
         InterfaceSpec& i = layer.interface;
-        if (i.eta_spectrum) {
-            if (i.type == InterfaceType::Dielectric)
-                i.eta = i.eta_spectrum->at(wavelengths[std::size_t(path_channel)]);
-            else
+        switch (i.type) {
+            case InterfaceType::Dielectric:
+                if (i.eta_spectrum)
+                    i.eta = i.eta_spectrum->at(wavelengths[std::size_t(path_channel)]);
+                break;
+            case InterfaceType::Conductor:
                 at(i.eta_spectrum, i.eta_rgb);
+                at(i.k_spectrum, i.k);
+                break;
+            case InterfaceType::Lambertian:
+                at(i.albedo_spectrum, i.albedo);
+                break;
         }
-        at(i.k_spectrum, i.k);
-        at(i.albedo_spectrum, i.albedo);
         at(layer.medium.tau_a_spectrum, layer.medium.tau_a);
         at(layer.medium.tau_s_spectrum, layer.medium.tau_s);
+        at(std::nullopt, layer.medium.g);  // the phase function's g: RGB numbers only
     }
     return out;
 }

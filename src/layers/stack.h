@@ -136,8 +136,10 @@ struct Stack {
     }
     /// The stack at the vacuum wavelengths `wavelengths_nm` of its three channels: every RGB value
     /// given as a spectrum is that spectrum at the channel's wavelength, and a dielectric's eta
-    /// (one refraction path serves all channels) the spectrum at channel `path_channel`'s.
-    /// Values given as numbers are unchanged.
+    /// (one refraction path serves all channels) the spectrum at channel `path_channel`'s. An RGB
+    /// value given as numbers is the spectrum that takes the number of the channel whose
+    /// wavelength (this stack's own) is nearest: channel c takes the number nearest its new
+    /// wavelength (docs/stack-format.md, "Spectra").
     Stack at_wavelengths(const Rgbd& wavelengths_nm, int path_channel) const;
     bool operator==(const Stack&) const = default;
 };

@@ -86,6 +86,41 @@ TEST(SpectralStack, ReadsEveryFormAndWritesItBack) {
     EXPECT_DOUBLE_EQ(at.layers[4].interface.eta_rgb[0], conductor_material_eta("Au").at(400));
 }
 
+// An RGB value given as numbers is, at other wavelengths, the number of the channel whose
+// wavelength is nearest (630, 532 and 465 nm by default): a reddish albedo stays reddish when a
+// spectral run reads it at 400, 550 and 700 nm (blue's, green's and red's numbers, in that
+// order), and at the stack's own wavelengths every number is itself; a conductor's RGB index, a
+// medium's optical depths and its g likewise, and a spectrum beside them is read as before.
+TEST(SpectralStack, RgbNumbersAreTheNearestChannelsSpectrum) {
+    const char* text = R"({"name": "s", "layers": [
+        {"interface": {"type": "dielectric", "eta": 1.5, "alpha": 0.1},
+         "medium": {"tau_a": [0.1, 0.2, 0.3], "tau_s": {"spectrum": [[400, 1.0], [700, 0.0]]},
+                    "g": [0.5, 0.0, -0.5]}},
+        {"interface": {"type": "dielectric", "eta": 1.3, "alpha": 0.1}},
+        {"interface": {"type": "lambertian", "albedo": [0.8, 0.5, 0.2]}}]})";
+    const Stack s = parse_stack(text, "s.json");
+    const Stack same = s.at_wavelengths(s.wavelengths_nm, 1);
+    EXPECT_EQ(same, s);
+    const Stack at = s.at_wavelengths(Rgbd(400, 550, 700), 1);
+    EXPECT_EQ(at.layers[2].interface.albedo, Rgbd(0.2, 0.5, 0.8));
+    EXPECT_EQ(at.layers[0].medium.tau_a, Rgbd(0.3, 0.2, 0.1));
+    EXPECT_EQ(at.layers[0].medium.g, Rgbd(-0.5, 0.0, 0.5));
+    EXPECT_NEAR(at.layers[0].medium.tau_s[0], 1.0, 1e-12);
+    EXPECT_NEAR(at.layers[0].medium.tau_s[2], 0.0, 1e-12);
+    // The edges between channels: the midpoints of 465, 532 and 630 nm.
+    const Stack edges = s.at_wavelengths(Rgbd(498, 499, 582), 1);
+    EXPECT_EQ(edges.layers[2].interface.albedo, Rgbd(0.2, 0.5, 0.8));
+    // One wavelength in every channel (a dispersive projection's node): one number.
+    EXPECT_EQ(s.at_wavelengths(Rgbd(520), 1).layers[2].interface.albedo, Rgbd(0.5));
+    // A conductor given as RGB numbers.
+    Stack metal = parse_stack(R"({"name": "m", "layers": [{"interface": {"type": "conductor",
+        "eta": [0.2, 0.4, 1.4], "k": [3.9, 2.4, 1.6], "alpha": 0.1}}]})",
+                              "m.json");
+    const Stack metal_at = metal.at_wavelengths(Rgbd(450, 540, 650), 0);
+    EXPECT_EQ(metal_at.layers[0].interface.eta_rgb, Rgbd(1.4, 0.4, 0.2));
+    EXPECT_EQ(metal_at.layers[0].interface.k, Rgbd(1.6, 2.4, 3.9));
+}
+
 TEST(SpectralStack, RefusesBadSpectraByName) {
     auto error = [](const std::string& interface) {
         try {

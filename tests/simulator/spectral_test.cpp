@@ -234,6 +234,42 @@ TEST(SpectralStat, ConstantSpectrumIsTheWhitePoint) {
 // The tables do not depend on the thread count, bit for bit, on either kernel, with both
 // references: a rough dispersive slab, gold under a coat, a filmed metal (titanium's oxide) and
 // a scattering coat.
+// A coloured albedo given as RGB numbers, traced spectrally: each wavelength bin reflects the
+// number of the channel whose wavelength (630, 532, 465 nm) is nearest its own, so red's 0.8
+// above 581 nm and blue's 0.2 below 498.5 nm (not the first number in the shortest third of the
+// range): exactly, a Lambertian keeping each particle's flux times its albedo. Both kernels; the
+// bins that straddle an edge hold their lattice points' mix.
+TEST(Spectral, RgbAlbedoIsTheNearestChannelsNumber) {
+    const Stack stack = test::make_stack({test::lambertian_layer(Rgbd(0.8, 0.5, 0.2))});
+    for (const Kernel kernel : kKernels) {
+        SCOPED_TRACE(enum_text(kernel));
+        const auto r =
+            simulate(stack, spectral_settings({20}, 30'000, HemisphereGrid(4, 4), 3, kernel));
+        const std::size_t bins = r.spectral.bin_edges_nm.size() - 1;
+        int checked = 0;
+        for (std::size_t l = 0; l < bins; ++l) {
+            double want = 0, low = 1, high = 0;
+            for (const double lambda : bin_lattice(r.spectral, l)) {
+                const double albedo = lambda > 581 ? 0.8 : lambda > 498.5 ? 0.5 : 0.2;
+                want += albedo / kSpectralLattice;
+                low = std::min(low, albedo);
+                high = std::max(high, albedo);
+            }
+            const double got = budget(r, 0, l, int(BudgetTerm::Reflected));
+            if (low == high) {  // every lattice point on one side: exact
+                EXPECT_NEAR(got, low, 1e-6) << "bin " << l;
+                checked += low != 0.5;
+            } else {  // the particles' lattice points sample the mix
+                expect_within_se(got, want, budget(r, 0, l, kBudgetTerms), "straddling bin");
+            }
+        }
+        EXPECT_GT(checked, 20);
+        // Its colour is red's: the sRGB albedo's red above its blue.
+        const EnergyBudget& e = r.incidences[0].budget;
+        EXPECT_GT(e[BudgetTerm::Reflected][0], 2 * e[BudgetTerm::Reflected][2]);
+    }
+}
+
 TEST(Spectral, BitwiseIdenticalAcrossThreadCounts) {
     for (const Stack& stack : {bk7_slab(0.2, 0.4), test::example("gold-under-coat"),
                                test::example("titania-on-gold"), test::example("milky-coat")})
