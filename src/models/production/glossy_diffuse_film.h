@@ -36,7 +36,6 @@
 // absorbs), an anisotropic interface, a base index at or below the ambient's, and for Cycles a
 // thickness range (its layering weight is not linear in the film: a range has no one value).
 
-#include "layers/stack.h"
 #include "models/model.h"
 
 #include <memory>
