@@ -939,18 +939,20 @@ Stack Stack::at_wavelengths(const Rgbd& wavelengths, int path_channel) const {
     // number of the channel whose wavelength (this stack's wavelengths_nm) is nearest: at its own
     // channels' wavelengths it is itself, and channel c at another wavelength reads the number of
     // its part of the spectrum, not the c-th number.
-    auto nearest_channel = [&](double lambda) {
-        std::size_t best = 0;
-        for (std::size_t c = 1; c < 3; ++c)
-            if (std::abs(wavelengths_nm[c] - lambda) < std::abs(wavelengths_nm[best] - lambda))
-                best = c;
+    // Channel c keeps its own number where another channel's wavelength is as near (a stack
+    // whose wavelengths_nm repeat one is itself at its own wavelengths).
+    auto nearest_channel = [&](std::size_t c) {
+        const double lambda = wavelengths[c];
+        std::size_t best = c;
+        for (std::size_t k = 0; k < 3; ++k)
+            if (std::abs(wavelengths_nm[k] - lambda) < std::abs(wavelengths_nm[best] - lambda))
+                best = k;
         return best;
     };
     auto at = [&](const std::optional<Spectrum>& spectrum, Rgbd& rgb) {
         const Rgbd given = rgb;
         for (std::size_t c = 0; c < 3; ++c)
-            rgb[c] =
-                spectrum ? spectrum->at(wavelengths[c]) : given[nearest_channel(wavelengths[c])];
+            rgb[c] = spectrum ? spectrum->at(wavelengths[c]) : given[nearest_channel(c)];
     };
     for (Layer& layer : out.layers) {
         InterfaceSpec& i = layer.interface;

@@ -139,7 +139,9 @@ struct Stack {
     /// (one refraction path serves all channels) the spectrum at channel `path_channel`'s. An RGB
     /// value given as numbers is the spectrum that takes the number of the channel whose
     /// wavelength (this stack's own) is nearest: channel c takes the number nearest its new
-    /// wavelength (docs/stack-format.md, "Spectra").
+    /// wavelength, its own on a tie (docs/stack-format.md, "Spectra"). Called on a stack at its
+    /// own channel wavelengths (as the reader leaves it): the result's numbers are read at the new
+    /// wavelengths, so a second call would read them as that stack's own.
     Stack at_wavelengths(const Rgbd& wavelengths_nm, int path_channel) const;
     bool operator==(const Stack&) const = default;
 };

@@ -33,9 +33,10 @@ struct SpectralQuadrature {
 using ModelFactory = std::function<std::unique_ptr<Model>(const Stack&)>;
 
 /// The model's linear sRGB on `stack`. A model built on three wavelengths holds the c-th third of
-/// the range in channel c, as a spectral particle's channels do (docs/physics.md §10), so an RGB
-/// value given as numbers means what it means to the spectral goniophotometer; grey values are
-/// the same at every wavelength. Supports what every per-wavelength model supports; samples by
+/// the range in channel c, as a spectral particle's channels do (docs/physics.md §10), and reads an
+/// RGB value given as numbers as the spectral goniophotometer does (Stack::at_wavelengths: the
+/// number of the nearest of the stack's channel wavelengths); grey values are the same at every
+/// wavelength. Supports what every per-wavelength model supports; samples by
 /// picking one of them uniformly (its pdf the mean of theirs); delta lobes carry their projected
 /// energies. Nothing here throws after construction. A model that integrates the spectrum
 /// itself (Model::integrates_spectrum: a shipped film's colour) is returned as the factory builds

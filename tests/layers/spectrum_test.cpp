@@ -112,6 +112,12 @@ TEST(SpectralStack, RgbNumbersAreTheNearestChannelsSpectrum) {
     EXPECT_EQ(edges.layers[2].interface.albedo, Rgbd(0.2, 0.5, 0.8));
     // One wavelength in every channel (a dispersive projection's node): one number.
     EXPECT_EQ(s.at_wavelengths(Rgbd(520), 1).layers[2].interface.albedo, Rgbd(0.5));
+    // Channel wavelengths that repeat one: each channel keeps its own number at its own
+    // wavelength.
+    Stack repeated = s;
+    repeated.wavelengths_nm = Rgbd(532, 532, 465);
+    EXPECT_EQ(repeated.at_wavelengths(repeated.wavelengths_nm, 1).layers[2].interface.albedo,
+              Rgbd(0.8, 0.5, 0.2));
     // A conductor given as RGB numbers.
     Stack metal = parse_stack(R"({"name": "m", "layers": [{"interface": {"type": "conductor",
         "eta": [0.2, 0.4, 1.4], "k": [3.9, 2.4, 1.6], "alpha": 0.1}}]})",

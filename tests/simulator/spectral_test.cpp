@@ -231,9 +231,6 @@ TEST(SpectralStat, ConstantSpectrumIsTheWhitePoint) {
     }
 }
 
-// The tables do not depend on the thread count, bit for bit, on either kernel, with both
-// references: a rough dispersive slab, gold under a coat, a filmed metal (titanium's oxide) and
-// a scattering coat.
 // A coloured albedo given as RGB numbers, traced spectrally: each wavelength bin reflects the
 // number of the channel whose wavelength (630, 532, 465 nm) is nearest its own, so red's 0.8
 // above 581 nm and blue's 0.2 below 498.5 nm (not the first number in the shortest third of the
@@ -270,6 +267,9 @@ TEST(Spectral, RgbAlbedoIsTheNearestChannelsNumber) {
     }
 }
 
+// The tables do not depend on the thread count, bit for bit, on either kernel, with both
+// references: a rough dispersive slab, gold under a coat, a filmed metal (titanium's oxide) and
+// a scattering coat.
 TEST(Spectral, BitwiseIdenticalAcrossThreadCounts) {
     for (const Stack& stack : {bk7_slab(0.2, 0.4), test::example("gold-under-coat"),
                                test::example("titania-on-gold"), test::example("milky-coat")})

@@ -62,4 +62,12 @@ class CyclesFresnelFactor {
     double t_r_ = 0, t_z_ = 0;
 };
 
+/// Kulla & Conty 2017 (slide 18)'s colour of the multiply scattered energy with one Fresnel
+/// bounce taken out, F_ms = F_ss E_avg/(1 − F_ss (1 − E_avg)), as Cycles scales its lobes
+/// (kernel/closure/bsdf_microfacet.h, microfacet_ggx_preserve_energy): F_ss the lobe's average
+/// Fresnel, E_avg its white lobe's average albedo.
+inline double cycles_multiple_scattering_fresnel(double f_ss, double e_avg) {
+    return f_ss * e_avg / (1 - f_ss * (1 - e_avg));
+}
+
 }  // namespace lamina

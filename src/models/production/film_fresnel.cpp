@@ -1013,12 +1013,4 @@ Rgbd cycles_dielectric_film(double film_ior, double thickness_nm, double eta, do
     return F;
 }
 
-Rgbd cycles_dielectric_film_range(double film_ior, double min_nm, double max_nm, double eta,
-                                  double cos_theta) {
-    const CyclesFilmSubstrate dielectric{false, eta, 0.0, -1.0};
-    return cycles_film_range(
-        film_ior, min_nm, max_nm, {dielectric, dielectric, dielectric}, cos_theta,
-        [&](double d) { return cycles_dielectric_film(film_ior, d, eta, cos_theta); });
-}
-
 }  // namespace lamina

@@ -220,10 +220,5 @@ Rgbd cycles_f82_tint_film_range(double film_ior, double min_nm, double max_nm, c
 /// over that dielectric. Films of thickness_nm ≤ 0.1 leave the bare dielectric's exact Fresnel
 /// (Cycles' real Fresnel remapped between its own F0 and 1, which is itself).
 Rgbd cycles_dielectric_film(double film_ior, double thickness_nm, double eta, double cos_theta);
-/// cycles_dielectric_film averaged over the thickness range [min_nm, max_nm] as
-/// cycles_f82_tint_film_range averages its metal's (the sensitivity's exact mean where Cycles'
-/// clamp cannot act, else quadrature).
-Rgbd cycles_dielectric_film_range(double film_ior, double min_nm, double max_nm, double eta,
-                                  double cos_theta);
 
 }  // namespace lamina

@@ -2,16 +2,20 @@
 
 #include "core/math.h"
 #include "layers/compiled_stack.h"
+#include "models/numerics/quadrature.h"
 #include "models/production/cycles_albedo.h"
 #include "models/production/film_fresnel.h"
 #include "models/production/lobe_mixture.h"
 #include "models/production/production_coat.h"
+#include "physics/fresnel.h"
 #include "physics/microfacet.h"
 
 #include <fmt/format.h>
 
-#include <array>
+#include <algorithm>
+#include <cmath>
 #include <optional>
+#include <vector>
 
 namespace lamina {
 
@@ -24,9 +28,12 @@ bool is_filmed_plastic(const Stack& stack) {
 
 namespace {
 
-/// The nodes of the tabulated albedo E_film(μ): μ = k/(kNodes − 1), read by cubic interpolation
-/// (Catmull–Rom on the uniform nodes, the end slopes one-sided).
-constexpr int kNodes = 65;
+/// The tabulated albedo E_film(μ) of a rough interface: uniform nodes in μ, 8 per period of the
+/// film's interference (at least 65, at most 1025), read by cubic interpolation (Catmull–Rom, the
+/// end slopes one-sided).
+constexpr int kAlbedoNodesPerPeriod = 8, kAlbedoMinNodes = 65, kAlbedoMaxNodes = 1025;
+/// Gauss–Legendre nodes per period of the interference in the film's hemispherical average.
+constexpr int kAverageNodesPerPeriod = 16;
 
 class GlossyDiffuseFilm final : public Model {
   public:
@@ -68,8 +75,8 @@ class GlossyDiffuseFilm final : public Model {
         }
         if (!(shape.eta0 > 1)) {
             support_.reason = fmt::format(
-                "{}'s filmed dielectric base is denser than the ambient (relative index > 1); "
-                "this one's is {}",
+                "{} represents a filmed dielectric base denser than the ambient only (relative "
+                "index > 1); this one's relative index is {}",
                 r_.name, shape.eta0);
             return;
         }
@@ -85,39 +92,50 @@ class GlossyDiffuseFilm final : public Model {
         eta0_ = shape.eta0;
         alpha_ = shape.alpha0;
         ggx_ = GGX<double>{alpha_};
-        rho_ = shape.albedo;
-        if (r_.darkened_base_color) {
-            const double K =
-                openpbr_internal_reflectance(eta0_, openpbr_average_fresnel_fit(eta0_));
-            for (int c = 0; c < 3; ++c)
-                rho_[c] *= openpbr_coat_darkening(K, rho_[c]);
-        }
+        f0_ = sqr((eta0_ - 1) / (eta0_ + 1));
         // Cycles' film sees an ambient of index 1: the film's index and thickness relative to the
-        // ambient.
+        // ambient (the optical path and every ratio of indices unchanged).
         cycles_film_ior_ = film_.eta_film.real() / film_.eta_above;
         cycles_thickness_nm_ = film_.thickness_max_nm * film_.eta_above;
+        // The periods the film's round-trip phase 4π η_f d cos θ_f/λ runs through over the
+        // facet cosines, at most 2 η_f d/λ (the thickest film, the shortest channel).
+        const double shortest_nm =
+            std::min({film_.wavelength_nm[0], film_.wavelength_nm[1], film_.wavelength_nm[2]});
+        periods_ = 2 * std::abs(film_.eta_film) * film_.thickness_max_nm / shortest_nm;
+        C_ = shape.albedo;
+        if (r_.darkened_base_color) {
+            // The specification's K_r of the interface, with the film's change of its average
+            // reflectance taken exactly (the film only moves light between reflection and
+            // transmission, so the underside's average changes by the same, reciprocally: K_r =
+            // 1 − (1 − E_F)/η0²).
+            const Rgbd E_F = Rgbd(openpbr_average_fresnel_fit(eta0_)) + film_average_change();
+            for (int c = 0; c < 3; ++c)
+                C_[c] *= openpbr_coat_darkening(openpbr_internal_reflectance(eta0_, E_F[c]), C_[c]);
+        }
         if (r_.cycles_compensation) {
             // bsdf_microfacet_setup_fresnel_generalized_schlick with the real Fresnel (exponent
             // −η): F_ss = mix(F0, 1, s), s = saturate((F_ss,fit − F0)/(1 − F0)), F_ss,fit
             // fresnel_dielectric_Fss (Kulla & Conty's fit); the film does not enter it.
             white_.emplace(std::sqrt(alpha_));
-            const double f0 = sqr((eta0_ - 1) / (eta0_ + 1));
             const double s =
-                clamp((kulla_conty_average_fresnel_fit(eta0_) - f0) / (1 - f0), 0.0, 1.0);
-            const double f_ss = f0 + (1 - f0) * s;
-            const double e_avg = white_->average();
-            f_ms_ = f_ss * e_avg / (1 - f_ss * (1 - e_avg));
+                clamp((kulla_conty_average_fresnel_fit(eta0_) - f0_) / (1 - f0_), 0.0, 1.0);
+            f_ms_ = cycles_multiple_scattering_fresnel(f0_ + (1 - f0_) * s, white_->average());
         }
         // Without a film (≤ 0.1 nm) Cycles estimates the lobe's albedo from its table of the
         // rough dielectric's Fresnel factor (bsdf_microfacet_estimate_albedo, GENERALIZED_SCHLICK
-        // with exponent < 0), with one from the film's reflectance at the view's cosine.
+        // with exponent < 0); with one, from the film's reflectance at the view's cosine.
         if (r_.layering == GlossyDiffuseFilmRecipe::Layering::CyclesEstimate &&
             !(cycles_thickness_nm_ > kCyclesFilmCutoffNm))
             factor_.emplace(std::sqrt(alpha_), eta0_);
-        if (r_.layering == GlossyDiffuseFilmRecipe::Layering::LobeAlbedo)
-            for (int k = 0; k < kNodes; ++k)
-                albedo_[std::size_t(k)] = filmed_lobe_albedo(double(k) / (kNodes - 1), alpha_,
+        // A rough interface's E_film(μo) on its nodes; a smooth one's is film(μo) itself.
+        if (r_.layering == GlossyDiffuseFilmRecipe::Layering::LobeAlbedo && alpha_ > 0) {
+            const int n = std::clamp(int(std::ceil(kAlbedoNodesPerPeriod * periods_)) + 1,
+                                     kAlbedoMinNodes, kAlbedoMaxNodes);
+            albedo_.resize(std::size_t(n));
+            for (int k = 0; k < n; ++k)
+                albedo_[std::size_t(k)] = filmed_lobe_albedo(double(k) / (n - 1), alpha_,
                                                              [&](double c) { return film(c); });
+        }
     }
 
     std::string name() const override { return r_.name; }
@@ -132,7 +150,7 @@ class GlossyDiffuseFilm final : public Model {
             const double G = 1 / (1 + ggx_.lambda(wi) + ggx_.lambda(wo));  // Heitz 2014, Eq. 99
             f = film(cos_h) * (ggx_.D(h) * G / (4 * wi.z * wo.z) * compensation(wo.z));
         }
-        return f + rho_ * layering(wo.z) * kInvPi<double>;
+        return f + C_ * layering(wo.z) * kInvPi<double>;
     }
 
     std::vector<DeltaLobe> delta_lobes(const Vec3d& wi) const override {
@@ -142,9 +160,11 @@ class GlossyDiffuseFilm final : public Model {
         return {{mirror_direction(wi), film(wi.z)}};
     }
 
-    /// Cycles' film gives its colour (its spectral integration), not values at the wavelengths.
+    /// Cycles' film gives its colour (its spectral integration), not values at the wavelengths;
+    /// below its cutoff there is no film.
     bool integrates_spectrum() const override {
-        return r_.film == GlossyDiffuseFilmRecipe::Film::Cycles;
+        return r_.film == GlossyDiffuseFilmRecipe::Film::Cycles &&
+               cycles_thickness_nm_ > kCyclesFilmCutoffNm;
     }
 
     /// Sampling (models/production/lobe_mixture.h): the lobe's visible normals with probability
@@ -188,25 +208,41 @@ class GlossyDiffuseFilm final : public Model {
                 const double E = white_->albedo(mu_o);
                 w = E + f_ms_ * (1 - E);
             }
-            if (factor_) {
-                const double f0 = sqr((eta0_ - 1) / (eta0_ + 1));
-                return Rgbd(clamp(1 - w * (f0 + (1 - f0) * factor_->factor(mu_o)), 0.0, 1.0));
-            }
+            if (factor_)
+                return Rgbd(clamp(1 - w * (f0_ + (1 - f0_) * factor_->factor(mu_o)), 0.0, 1.0));
             return Rgbd(clamp(1 - (film(mu_o) * w).max(), 0.0, 1.0));
         }
+        if (alpha_ <= 0) return Rgbd(1.0) - film(mu_o);  // a smooth interface: E = F_film
         return Rgbd(1.0) - interpolated_albedo(mu_o);
+    }
+
+    /// 2 ∫ (F_film,c(μ) − F(μ; η0)) μ dμ: the film's change of the interface's hemispherical
+    /// average reflectance, by composite Gauss–Legendre (kAverageNodesPerPeriod per period of the
+    /// interference).
+    Rgbd film_average_change() const {
+        static const QuadratureRule q = gauss_legendre(kAverageNodesPerPeriod);
+        const int pieces = std::clamp(int(std::ceil(periods_)), 1, 512);
+        Rgbd sum(0.0);
+        for (int p = 0; p < pieces; ++p)
+            for (std::size_t i = 0; i < q.x.size(); ++i) {
+                const double mu = (p + q.x[i]) / pieces;
+                sum +=
+                    (film(mu) - Rgbd(fresnel_dielectric(mu, eta0_))) * (2 * mu * q.w[i] / pieces);
+            }
+        return sum;
     }
 
     /// E_film(μ) from its nodes: Catmull–Rom between the two nodes around μ, the slopes the
     /// central differences (one-sided at the ends).
     Rgbd interpolated_albedo(double mu) const {
-        const double x = clamp(mu, 0.0, 1.0) * (kNodes - 1);
-        const int i = std::min(int(x), kNodes - 2);
+        const int n = int(albedo_.size());
+        const double x = clamp(mu, 0.0, 1.0) * (n - 1);
+        const int i = std::min(int(x), n - 2);
         const double t = x - i;
-        const auto node = [&](int k) { return albedo_[std::size_t(std::clamp(k, 0, kNodes - 1))]; };
+        const auto node = [&](int k) { return albedo_[std::size_t(std::clamp(k, 0, n - 1))]; };
         const auto slope = [&](int k) {
             if (k == 0) return node(1) - node(0);
-            if (k == kNodes - 1) return node(k) - node(k - 1);
+            if (k == n - 1) return node(k) - node(k - 1);
             return (node(k + 1) - node(k - 1)) * 0.5;
         };
         const double t2 = t * t, t3 = t2 * t;
@@ -226,13 +262,15 @@ class GlossyDiffuseFilm final : public Model {
     Support support_;
     FilmOptics film_;
     double eta0_ = 1.5, alpha_ = 0;
+    double f0_ = 0;       ///< the bare interface's normal reflectance ((η0 − 1)/(η0 + 1))²
+    double periods_ = 0;  ///< interference periods over the facet cosines (at most)
     GGX<double> ggx_{0.0};
-    Rgbd rho_{0.0};
+    Rgbd C_{0.0};  ///< the diffuse's colour: ρ, or ρ darkened (darkened_base_color)
     double cycles_film_ior_ = 1.5, cycles_thickness_nm_ = 0;
     std::optional<CyclesWhiteAlbedo> white_;
     std::optional<CyclesFresnelFactor> factor_;  ///< Cycles' estimate without a film
     double f_ms_ = 0;
-    std::array<Rgbd, kNodes> albedo_{};
+    std::vector<Rgbd> albedo_;  ///< E_film on the nodes (a rough interface, LobeAlbedo)
 };
 
 }  // namespace

@@ -7,7 +7,7 @@
 // reflection lobe whose Fresnel factor is the film's, over the diffuse lobe weighted by what the
 // specular layer is taken to leave,
 //
-//     f(wi, wo) = F_film(wi·h) D(h) G2(wi, wo) / (4 μi μo) · c(μo) + ρ/π · L(μo),
+//     f(wi, wo) = F_film(wi·h) D(h) G2(wi, wo) / (4 μi μo) · c(μo) + C/π · L(μo),
 //
 // G2 the height-correlated Smith term (Heitz 2014, JCGT 3(2), Eq. 99). Per engine:
 //
@@ -17,16 +17,17 @@
 //   transmission). The cases the specification leaves to the implementation are taken exactly, as
 //   for its film on a metal: F_film the film's Airy reflectance (physics/thin_film.h, at the
 //   stack's channel wavelengths, averaged over the thickness range), c = 1, and L = 1 − E_film(μo)
-//   with E_film the directional albedo of the filmed lobe itself. Its ρ is the base colour the
-//   specification asks for, the Lambertian's darkened by the interface's internal reflections
-//   (GlossyDiffuseFilmRecipe::darkened_base_color): without a film the model is then `openpbr`'s
-//   coat over the diffuse base.
+//   with E_film the directional albedo of the filmed lobe itself (F_film(μo) for a smooth one).
+//   Its colour C is the base colour the specification asks for, the Lambertian's ρ darkened by the
+//   filmed interface's internal reflections (GlossyDiffuseFilmRecipe::darkened_base_color):
+//   without a film the model is then `openpbr`'s coat over the diffuse base.
 //
 //   Cycles (kernel/svm/closure.h, the Principled BSDF's specular and diffuse components;
-//   kernel/closure/bsdf_microfacet.h): F_film its Fourier-space film sum over the dielectric
-//   (film_fresnel.h, cycles_dielectric_film); c its multiple-scattering compensation 1 + F_ms (1 −
-//   E)/E (microfacet_ggx_preserve_energy, E from its white-lobe tables at μo, F_ms from the bare
-//   dielectric's average Fresnel fit: the film does not enter it); L = clamp(1 − max_c w
+//   kernel/closure/bsdf_microfacet.h), C = ρ: F_film its Fourier-space film sum over the
+//   dielectric (film_fresnel.h, cycles_dielectric_film; the film's index and thickness relative
+//   to the ambient's index, which Cycles takes as 1); c its multiple-scattering compensation 1 +
+//   F_ms (1 − E)/E (microfacet_ggx_preserve_energy, E from its white-lobe tables at μo, F_ms from
+//   the bare dielectric's average Fresnel fit: the film does not enter it); L = clamp(1 − max_c w
 //   F_film,c(μo), 0, 1) (closure_layering_weight), w = E + F_ms (1 − E) the lobe's weight after
 //   compensation (1 without it) and F_film(μo) its albedo estimate, the film at the view's cosine
 //   (Cycles keeps no table for films).
@@ -37,7 +38,9 @@
 // thickness range (its layering weight is not linear in the film: a range has no one value).
 
 #include "models/model.h"
+#include "models/production/ggx_albedo.h"
 
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -56,10 +59,11 @@ struct GlossyDiffuseFilmRecipe {
         CyclesEstimate,  ///< L = clamp(1 − max_c w F_film,c(μo), 0, 1) (Cycles)
     } layering = Layering::LobeAlbedo;
     /// The diffuse's colour is the Lambertian's ρ darkened as OpenPBR darkens a diffuse base under
-    /// a coat of the interface's index (openpbr_coat_darkening with K_r of its E_F fit): OpenPBR
-    /// 1.1 defines base_color as the fraction of the light let into the dielectric that comes
-    /// back out ("Glossy-diffuse"), which a Lambertian ρ under the interface gives by its
-    /// internal reflections. Otherwise the colour is ρ (Cycles' base colour).
+    /// a coat of the interface's index (openpbr_coat_darkening, K_r of the specification's E_F fit
+    /// plus the film's change of the interface's average reflectance, per channel): OpenPBR 1.1
+    /// defines base_color as the fraction of the light let into the dielectric that comes back
+    /// out ("Glossy-diffuse"), which a Lambertian ρ under the interface gives by its internal
+    /// reflections. Otherwise the colour is ρ (Cycles' base colour).
     bool darkened_base_color = false;
 };
 
@@ -77,12 +81,6 @@ std::unique_ptr<Model> make_glossy_diffuse_film(const Stack& stack,
 /// film's reflectance at a facet cosine. alpha = 0 gives film_at(mu).
 template <typename FilmAt>
 Rgbd filmed_lobe_albedo(double mu, double alpha, FilmAt&& film_at);
-
-}  // namespace lamina
-
-#include "models/production/ggx_albedo.h"
-
-namespace lamina {
 
 template <typename FilmAt>
 Rgbd filmed_lobe_albedo(double mu, double alpha, FilmAt&& film_at) {

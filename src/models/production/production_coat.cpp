@@ -156,7 +156,7 @@ class ProductionCoat final : public Model {
             coat_white_.emplace(r_coat);
             // Cycles' fresnel_dielectric_Fss: Kulla & Conty's fit, 0 at η0 = 1.
             const double f_ss = eta0_ > 1 ? kulla_conty_average_fresnel_fit(eta0_) : 0.0;
-            coat_fms_ = multiple_scattering_fresnel(f_ss, coat_white_->average());
+            coat_fms_ = cycles_multiple_scattering_fresnel(f_ss, coat_white_->average());
             if (r_.coat_albedo == CoatRecipe::CoatAlbedo::Cycles && eta0_ > 1)
                 coat_factor_.emplace(r_coat, eta0_);
         }
@@ -219,7 +219,7 @@ class ProductionCoat final : public Model {
             if (r_.metal_energy_compensation == MEC::Cycles) {
                 metal_white_.emplace(r_lobe);
                 for (int c = 0; c < 3; ++c)
-                    metal_fms_[c] = multiple_scattering_fresnel(
+                    metal_fms_[c] = cycles_multiple_scattering_fresnel(
                         f82_tint_average_fresnel(f0_[c], tint82_[c]), metal_white_->average());
             }
             using MS = CoatRecipe::MetalMultipleScattering;
@@ -524,13 +524,6 @@ class ProductionCoat final : public Model {
         return 1 + (f0 + (1 - f0) / 21) * (1 - E) / E;
     }
 
-    /// Kulla & Conty 2017 (slide 18)'s colour of the multiply scattered energy with one Fresnel
-    /// bounce taken out, F_ms = F_ss E_avg/(1 − F_ss (1 − E_avg)), as Cycles scales its lobes
-    /// (microfacet_ggx_preserve_energy).
-    static double multiple_scattering_fresnel(double f_ss, double e_avg) {
-        return f_ss * e_avg / (1 - f_ss * (1 - e_avg));
-    }
-
     /// The F82-tint Fresnel's average 2 ∫ F μ dμ in closed form, F0 + (1 − F0)/21 − b/126 with b
     /// its edge term (Cycles' fresnel_f82_Fss).
     static double f82_tint_average_fresnel(double f0, double tint) {
@@ -717,7 +710,7 @@ class ProductionCoat final : public Model {
         if (r_.darkening == D::MaterialX) {
             // open_pbr_surface.mtlx: Kcoat = 1 − (1 − F0)/η0², E_base = the base colour (a
             // metal's F0, a diffuse base's ρ).
-            const double K = 1 - (1 - coat_f0_ior_) / (eta0_ * eta0_);
+            const double K = openpbr_internal_reflectance(eta0_, coat_f0_ior_);
             E_b_ = is_metal_ ? f0_ : albedo_;
             for (int c = 0; c < 3; ++c)
                 darkening_[c] = openpbr_coat_darkening(K, E_b_[c]);
@@ -760,9 +753,6 @@ class ProductionCoat final : public Model {
             darkening_[c] = openpbr_coat_darkening(K, E_b_[c]);
     }
 
-    /// The darkening (1 − K)/(1 − E_b K) (OpenPBR 1.1, "Coat darkening"): 0 where the coat
-    /// reflects everything (K = 1: a coat less dense than the ambient medium past its critical
-    /// angle), never 0/0 with a perfect base (E_b = 1).
     CoatRecipe r_;
     CoatedStack coat_;
     Support support_;

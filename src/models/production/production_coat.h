@@ -259,7 +259,9 @@ double openpbr_average_fresnel_fit(double eta);
 /// own).
 double openpbr_internal_reflectance(double eta, double average_fresnel);
 /// OpenPBR 1.1 ("Darkening"): the darkening (1 − K)/(1 − E_b K) of a base of albedo E_b under a
-/// coat whose underside reflects K (0 where K ≥ 1).
+/// coat whose underside reflects K: 0 where the coat reflects everything (K ≥ 1: a coat less
+/// dense than the ambient medium past its critical angle), never 0/0 with a perfect base
+/// (E_b = 1).
 double openpbr_coat_darkening(double K, double E_b);
 /// Kulla & Conty 2017 (slide 18)'s fit of the same average, as Adobe's openpbr-bsdf ships it
 /// (openpbr_average_fresnel): (η − 1)/(4.08567 + 1.00071 η) for η > 1.
