@@ -218,10 +218,10 @@ class GlossyDiffuseFilm final : public Model {
 
     /// 2 ∫ (F_film,c(μ) − F(μ; η0)) μ dμ: the film's change of the interface's hemispherical
     /// average reflectance, by composite Gauss–Legendre (kAverageNodesPerPeriod per period of the
-    /// interference).
+    /// interference, over at least 4 pieces).
     Rgbd film_average_change() const {
         static const QuadratureRule q = gauss_legendre(kAverageNodesPerPeriod);
-        const int pieces = std::clamp(int(std::ceil(periods_)), 1, 512);
+        const int pieces = std::clamp(int(std::ceil(periods_)), 4, 512);
         Rgbd sum(0.0);
         for (int p = 0; p < pieces; ++p)
             for (std::size_t i = 0; i < q.x.size(); ++i) {
