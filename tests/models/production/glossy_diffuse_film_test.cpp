@@ -3,6 +3,7 @@
 // against the Airy film, lamina's FGD table and the white furnace its albedo scaling promises.
 #include "models/production/glossy_diffuse_film.h"
 #include "core/math.h"
+#include "models/numerics/quadrature.h"
 #include "models/production/production_coat.h"
 #include "models/registry.h"
 #include "models/tables/fgd_table.h"
@@ -24,6 +25,7 @@
 #include <complex>
 #include <iostream>
 #include <tuple>
+#include <vector>
 
 namespace lamina {
 namespace {
@@ -47,6 +49,30 @@ Stack filmed_plastic(double eta0, double alpha0, const Rgbd& rho, double eta_f, 
 Stack golden_plastic(const json& s, double thickness_nm) {
     return filmed_plastic(s.at("eta0"), s.at("alpha0"), test::golden_rgb(s.at("rho")),
                           s.at("film").at("eta"), thickness_nm, thickness_nm);
+}
+
+/// The direction pairs the point checks use: normal, oblique and grazing light and views.
+std::vector<std::pair<Vec3d, Vec3d>> check_pairs() {
+    return {{dir(0, 0), dir(30, 180)},
+            {dir(50, 0), dir(45, 170)},
+            {dir(75, 0), dir(20, 90)},
+            {dir(20, 0), dir(85, 10)}};
+}
+
+/// ∫ f(w) dω over the upper hemisphere: Gauss–Legendre in μ (n_mu nodes) × midpoint in φ (n_phi),
+/// apart from the models' visible-normal rules.
+template <typename V, typename F>
+V upper_hemisphere_integral(int n_mu, int n_phi, F&& f) {
+    const QuadratureRule q = gauss_legendre(n_mu);
+    V sum{};
+    for (std::size_t i = 0; i < q.x.size(); ++i)
+        for (int j = 0; j < n_phi; ++j) {
+            const double phi = 2 * kPi<double> * (j + 0.5) / n_phi;
+            const double mu = q.x[i], s = std::sqrt(1 - mu * mu);
+            sum += f(Vec3d(s * std::cos(phi), s * std::sin(phi), mu)) *
+                   (q.w[i] * 2 * kPi<double> / n_phi);
+        }
+    return sum;
 }
 
 // The data file's Principled inputs are the mapping of docs/models.md ("A film on a dielectric
@@ -143,9 +169,7 @@ TEST(GlossyDiffuseFilm, OpenPbrAtThicknessZeroIsTheBareGlossyDiffuse) {
                 const auto m = make_model(name, stack, options);
                 ASSERT_TRUE(m->support().brdf) << m->support().reason;
                 const GGX<double> ggx{alpha};
-                for (const auto& [wi, wo] :
-                     {std::pair{dir(0, 0), dir(30, 180)}, std::pair{dir(50, 0), dir(45, 170)},
-                      std::pair{dir(75, 0), dir(20, 90)}, std::pair{dir(20, 0), dir(85, 10)}}) {
+                for (const auto& [wi, wo] : check_pairs()) {
                     const Vec3d h = normalize(wi + wo);
                     const double lobe = test::fresnel_ref(dot(wi, h), eta0) * ggx.D(h) /
                                         (1 + ggx.lambda(wi) + ggx.lambda(wo)) / (4 * wi.z * wo.z);
@@ -187,9 +211,7 @@ TEST(GlossyDiffuseFilm, ThicknessZeroIsTheFilmlessModel) {
             for (const char* name : {"openpbr", "blender-principled"}) {
                 const auto a = make_model(name, bare), b = make_model(name, filmed);
                 ASSERT_TRUE(b->support().brdf) << b->support().reason;
-                for (const auto& [wi, wo] :
-                     {std::pair{dir(0, 0), dir(30, 180)}, std::pair{dir(50, 0), dir(45, 170)},
-                      std::pair{dir(75, 0), dir(20, 90)}, std::pair{dir(20, 0), dir(85, 10)}}) {
+                for (const auto& [wi, wo] : check_pairs()) {
                     const Rgbd x = a->eval(wi, wo), y = b->eval(wi, wo);
                     for (int c = 0; c < 3; ++c) {
                         const double scale = rho[c] * kInvPi<double>;
@@ -300,16 +322,8 @@ TEST(GlossyDiffuseFilm, OpenPbrWhiteBaseConservesEnergy) {
             const Vec3d wo = dir(theta_o, 0);
             // The reflected-hemisphere rule of solid_angle_albedo.h, about wo: the model is
             // reciprocal in its lobe and the diffuse term depends on μo alone.
-            const int n_mu = 384, n_phi = 512;
-            const QuadratureRule q = gauss_legendre(n_mu);
-            Rgbd sum(0.0);
-            for (std::size_t i = 0; i < q.x.size(); ++i)
-                for (int j = 0; j < n_phi; ++j) {
-                    const double phi = 2 * kPi<double> * (j + 0.5) / n_phi;
-                    const double mu = q.x[i], s = std::sqrt(1 - mu * mu);
-                    const Vec3d wi(s * std::cos(phi), s * std::sin(phi), mu);
-                    sum += m->eval(wi, wo) * (q.w[i] * mu * 2 * kPi<double> / n_phi);
-                }
+            const Rgbd sum = upper_hemisphere_integral<Rgbd>(
+                384, 512, [&](const Vec3d& wi) { return m->eval(wi, wo) * wi.z; });
             for (int c = 0; c < 3; ++c) {
                 worst = std::max(worst, std::abs(sum[c] - 1));
                 EXPECT_NEAR(sum[c], 1, 2e-5) << "alpha " << alpha << " theta_o " << theta_o;
@@ -385,17 +399,10 @@ TEST(GlossyDiffuseFilm, SamplingIsConsistent) {
                 const auto r = test::model_sampling_chi2(*m, wi, what, 8, 100'000);
                 EXPECT_TRUE(r.passed) << r.message;
             }
-            // ∫ pdf dωo over the upper hemisphere (Gauss–Legendre in μo × midpoint in φo).
+            // ∫ pdf dωo over the upper hemisphere.
             const Vec3d wi = dir(40, 0);
-            const QuadratureRule q = gauss_legendre(128);
-            double total = 0;
-            for (std::size_t i = 0; i < q.x.size(); ++i)
-                for (int j = 0; j < 256; ++j) {
-                    const double phi = 2 * kPi<double> * (j + 0.5) / 256, mu = q.x[i];
-                    const double s = std::sqrt(1 - mu * mu);
-                    total += m->pdf(wi, Vec3d(s * std::cos(phi), s * std::sin(phi), mu)) * q.w[i] *
-                             2 * kPi<double> / 256;
-                }
+            const double total = upper_hemisphere_integral<double>(
+                128, 256, [&](const Vec3d& wo) { return m->pdf(wi, wo); });
             EXPECT_LE(total, 1 + 1e-3) << name << " alpha " << alpha;
             EXPECT_GT(total, 0.95) << name << " alpha " << alpha;
         }
@@ -414,9 +421,7 @@ TEST(GlossyDiffuseFilm, OnlyTheRelativeIndicesMatter) {
     for (const char* name : {"openpbr", "blender-principled"}) {
         const auto a = make_model(name, immersed), b = make_model(name, in_air);
         ASSERT_TRUE(a->support().brdf) << a->support().reason;
-        for (const auto& [wi, wo] :
-             {std::pair{dir(0, 0), dir(30, 180)}, std::pair{dir(50, 0), dir(45, 170)},
-              std::pair{dir(75, 0), dir(20, 90)}, std::pair{dir(20, 0), dir(85, 10)}}) {
+        for (const auto& [wi, wo] : check_pairs()) {
             const Rgbd x = a->eval(wi, wo), y = b->eval(wi, wo);
             for (int c = 0; c < 3; ++c)
                 EXPECT_NEAR(x[c], y[c], 1e-9 * y[c]) << name;
