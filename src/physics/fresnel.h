@@ -91,6 +91,16 @@ LAMINA_LANE_INLINE T fresnel_dielectric(T cos_theta_i, T eta) {
     return fresnel_dielectric_full(cos_theta_i, eta).reflectance;
 }
 
+/// The unpolarized reflectance of a dielectric interface of relative index eta at normal
+/// incidence, F0 = ((η − 1)/(η + 1))² (Born & Wolf, "Principles of Optics", §1.5.2): where
+/// r_s = −r_p, both polarizations alike. fresnel_dielectric at cos θ = 1 is the same number up to
+/// rounding; this is the form the production models' F0 parametrizations are written in.
+template <typename T>
+constexpr T fresnel_dielectric_normal(T eta) {
+    const T r = (eta - T(1)) / (eta + T(1));
+    return r * r;
+}
+
 /// Exact unpolarized Fresnel reflectance of a conductor with relative complex index
 /// eta + i·k (k ≥ 0), light arriving from the dielectric side with cos_theta_i in [0, 1].
 /// The Fresnel equations with a complex index (Born & Wolf §14.2) written in real arithmetic:

@@ -25,7 +25,13 @@ TEST(Fresnel, NormalIncidence) {
     EXPECT_NEAR(fresnel_dielectric(-1.0, 1.5), 0.04, 1e-16);  // from below: relative index 1/η
     for (double eta : {1.0001, 1.33, 2.4, 0.5}) {
         EXPECT_NEAR(fresnel_dielectric(1.0, eta), sqr((eta - 1) / (eta + 1)), kExact);
+        // The F0 the production models are parametrized by: the same number, and the same from
+        // the dense side.
+        EXPECT_NEAR(fresnel_dielectric_normal(eta), fresnel_dielectric(1.0, eta), kExact);
+        EXPECT_NEAR(fresnel_dielectric_normal(1 / eta), fresnel_dielectric_normal(eta), kExact);
     }
+    EXPECT_NEAR(fresnel_dielectric_normal(1.5), 0.04, 1e-16);
+    EXPECT_EQ(fresnel_dielectric_normal(1.0), 0.0);
 }
 
 TEST(Fresnel, KnownValueAt45Degrees) {

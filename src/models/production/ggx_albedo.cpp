@@ -58,7 +58,7 @@ SchlickSplit correlated_ggx_schlick_split(double mu, double alpha, int n_r, int 
 }
 
 double cycles_fresnel_factor(double mu, double alpha, double eta, int n_r, int n_phi) {
-    const double f0 = sqr((eta - 1) / (eta + 1));
+    const double f0 = fresnel_dielectric_normal(eta);
     auto position = [&](double c) {
         return clamp((fresnel_dielectric(c, eta) - f0) / (1 - f0), 0.0, 1.0);
     };

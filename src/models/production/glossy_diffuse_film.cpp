@@ -92,7 +92,7 @@ class GlossyDiffuseFilm final : public Model {
         eta0_ = shape.eta0;
         alpha_ = shape.alpha0;
         ggx_ = GGX<double>{alpha_};
-        f0_ = sqr((eta0_ - 1) / (eta0_ + 1));
+        f0_ = fresnel_dielectric_normal(eta0_);
         // Cycles' film sees an ambient of index 1: the film's index and thickness relative to the
         // ambient (the optical path and every ratio of indices unchanged).
         cycles_film_ior_ = film_.eta_film.real() / film_.eta_above;

@@ -132,7 +132,7 @@ class ProductionCoat final : public Model {
             case CoatRecipe::Fresnel::Exact:
                 break;
             case CoatRecipe::Fresnel::SchlickIor:
-                coat_f0_ = sqr((eta0_ - 1) / (eta0_ + 1));
+                coat_f0_ = fresnel_dielectric_normal(eta0_);
                 break;
             case CoatRecipe::Fresnel::Schlick004:
                 coat_f0_ = 0.04;
@@ -144,7 +144,7 @@ class ProductionCoat final : public Model {
         alpha_coat_ = sqr(lobe_roughness(r_coat));
         coat_ggx_ = lobe_distribution(coat_spec, alpha_coat_);
         eta_index_ = FgdTable::locate(eta0_, 0);
-        coat_f0_ior_ = sqr((eta0_ - 1) / (eta0_ + 1));
+        coat_f0_ior_ = fresnel_dielectric_normal(eta0_);
         // openpbr-bsdf reads its table at the coat's α before its lobe's clamp; at α = 0 it takes
         // the exact Fresnel factor.
         if (r_.coat_albedo == CoatRecipe::CoatAlbedo::OpenPbrBsdf && r_coat > 0)

@@ -86,7 +86,7 @@ int upper(int i0) {
     return std::min(i0 + 1, Grid::kN - 1);
 }
 double f0_of(double eta) {
-    return sqr((eta - 1) / (eta + 1));
+    return fresnel_dielectric_normal(eta);
 }
 }  // namespace
 
