@@ -35,7 +35,9 @@ constexpr int kAlbedoNodesPerPeriod = 8, kAlbedoMinNodes = 65, kAlbedoMaxNodes =
 /// Gauss–Legendre nodes per period of the interference in the film's hemispherical average.
 constexpr int kAverageNodesPerPeriod = 16;
 
-class GlossyDiffuseFilm final : public Model {
+class GlossyDiffuseFilm final : public LobeMixtureModel<GlossyDiffuseFilm> {
+    friend class LobeMixtureModel<GlossyDiffuseFilm>;
+
   public:
     GlossyDiffuseFilm(const Stack& stack, const GlossyDiffuseFilmRecipe& recipe) : r_(recipe) {
         if (!is_filmed_plastic(stack)) {
@@ -171,16 +173,6 @@ class GlossyDiffuseFilm final : public Model {
     /// the film's reflectance at μi clamped to [0.1, 0.9] (0 for a smooth interface, whose delta
     /// lobe is reported apart), the cosine otherwise.
     bool has_sampling() const override { return support_.brdf; }
-
-    std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override {
-        if (!has_sampling() || wi.z <= 0) return std::nullopt;
-        return sample_lobe_mixture(*this, proposal(wi), wi, u);
-    }
-
-    double pdf(const Vec3d& wi, const Vec3d& wo) const override {
-        if (!has_sampling() || wi.z <= 0 || wo.z <= 0) return 0;
-        return proposal(wi).pdf(wi, wo);
-    }
 
   private:
     /// The film's reflectance at the facet cosine c, per channel, in the recipe's form.

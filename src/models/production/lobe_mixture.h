@@ -61,4 +61,25 @@ inline std::optional<ModelSample> sample_lobe_mixture(const Model& model,
     return ModelSample{wo, model.eval(wi, wo) * (wo.z / density), density};
 }
 
+/// The sampling of a model whose proposal is its lobe mixture (the production coats, StackLit,
+/// the filmed plastic): Derived, a final Model, provides has_sampling() and
+/// proposal(wi), the ReflectionLobeMixture for light arriving along wi; reflection only, light
+/// from above. Derived befriends this class when proposal is private.
+template <class Derived>
+class LobeMixtureModel : public Model {
+  public:
+    std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override {
+        if (!self().has_sampling() || wi.z <= 0) return std::nullopt;
+        return sample_lobe_mixture(*this, self().proposal(wi), wi, u);
+    }
+
+    double pdf(const Vec3d& wi, const Vec3d& wo) const override {
+        if (!self().has_sampling() || wi.z <= 0 || wo.z <= 0) return 0;
+        return self().proposal(wi).pdf(wi, wo);
+    }
+
+  private:
+    const Derived& self() const { return static_cast<const Derived&>(*this); }
+};
+
 }  // namespace lamina

@@ -50,7 +50,9 @@ constexpr double kOpenPbrDefaultSpecularRoughness = 0.3;
 /// (openpbr_microfacet_multiple_scattering_lobes.h, "MinRoughnessWithVisibleEnergyLoss").
 constexpr double kMetalMultipleScatteringMinRoughness = 0.04;
 
-class ProductionCoat final : public Model {
+class ProductionCoat final : public LobeMixtureModel<ProductionCoat> {
+    friend class LobeMixtureModel<ProductionCoat>;
+
   public:
     ProductionCoat(const Stack& stack, const CoatRecipe& recipe) : r_(recipe) {
         std::string why;
@@ -417,16 +419,6 @@ class ProductionCoat final : public Model {
     /// p_c is the coat's Fresnel at μi (clamped to [0.1, 0.9]), 0 when the coat is smooth (a delta
     /// lobe, not sampled here), 1 when the base is a smooth metal.
     bool has_sampling() const override { return support_.brdf && sampled_lobes() > 0; }
-
-    std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override {
-        if (!has_sampling() || wi.z <= 0) return std::nullopt;
-        return sample_lobe_mixture(*this, proposal(wi), wi, u);
-    }
-
-    double pdf(const Vec3d& wi, const Vec3d& wo) const override {
-        if (!has_sampling() || wi.z <= 0 || wo.z <= 0) return 0;
-        return proposal(wi).pdf(wi, wo);
-    }
 
   private:
     /// The lobe of an interface whose isotropic α became `alpha` (the lobe's clamp, the

@@ -96,7 +96,9 @@ struct ViewStatistics {
     Rgbd base_compensation{1.0};           ///< c_2
 };
 
-class UnityStackLit final : public Model {
+class UnityStackLit final : public LobeMixtureModel<UnityStackLit> {
+    friend class LobeMixtureModel<UnityStackLit>;
+
   public:
     explicit UnityStackLit(const Stack& stack) {
         std::string why;
@@ -325,16 +327,6 @@ class UnityStackLit final : public Model {
     bool has_sampling() const override { return support_.brdf; }
 
     std::unique_ptr<IncidentEvaluator> prepare(const Vec3d& wi) const override;
-
-    std::optional<ModelSample> sample(const Vec3d& wi, const Vec3d& u) const override {
-        if (!has_sampling() || wi.z <= 0) return std::nullopt;
-        return sample_lobe_mixture(*this, proposal(wi), wi, u);
-    }
-
-    double pdf(const Vec3d& wi, const Vec3d& wo) const override {
-        if (!has_sampling() || wi.z <= 0 || wo.z <= 0) return 0;
-        return proposal(wi).pdf(wi, wo);
-    }
 
   private:
     /// The base lobe of an anisotropic base, α_t along its tangent, α_b along n × t.
