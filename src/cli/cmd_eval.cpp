@@ -41,10 +41,13 @@ struct EvalArgs {
     std::uint64_t samples = 0, seed = 0;  ///< random-walk only; 0: the model's own option
 };
 
-/// Applies --samples/--seed to a random-walk model; rejects them for the analytic models.
-RandomWalkModel* configure_random_walk(Model& model, const EvalArgs& a) {
+/// Applies --samples/--seed to a random-walk model; rejects them for the analytic models (by the
+/// registry's entry: a stochastic model the registry could not build for the stack, which is not
+/// a RandomWalkModel, is left for the caller's support check to report).
+RandomWalkModel* configure_random_walk(const ModelEntry& entry, Model& model, const EvalArgs& a) {
     auto* rw = dynamic_cast<RandomWalkModel*>(&model);
     if (!rw) {
+        if (entry.stochastic) return nullptr;
         if (a.samples != 0 || a.seed != 0)
             throw InputError("command line", a.samples != 0 ? "--samples" : "--seed",
                              "only the stochastic model random-walk takes a sample count or seed");
@@ -169,6 +172,7 @@ int run_eval(const EvalArgs& a) {
                          "--directions");
 
     if (a.binned) {
+        require_tabulable(entry, "command line", "--model");
         const std::vector<double> thetas = parse_incidences(
             a.theta_i.empty() ? default_incidences_text() : a.theta_i, "--theta-i");
         SimulationSettings binning;  // the goniophotometer's bins for this stack and φi
@@ -177,7 +181,7 @@ int run_eval(const EvalArgs& a) {
         const Stack stack = load_stack(a.stack);
         const HemisphereGrid grid = simulation_grid(stack, binning);
         const auto model = make_eval_model(entry, options, stack, a);
-        configure_random_walk(*model, a);
+        configure_random_walk(entry, *model, a);
         const Support s = model->support();
         if (!s.brdf && !s.btdf) throw InputError(a.stack, "--model", "not supported: " + s.reason);
         write_file_atomic(a.out, bin_model(*model, grid, thetas, a.phi_i).to_csv());
@@ -222,6 +226,7 @@ int run_eval(const EvalArgs& a) {
             std::stringstream ls(line);
             for (std::string c; std::getline(ls, c, ',');)
                 cells.push_back(c);
+            if (line.back() == ',') cells.emplace_back();  // getline drops a last, empty cell
             const std::string where = fmt::format("line {}", n);
             if (cells.size() != columns)
                 throw InputError(
@@ -243,7 +248,7 @@ int run_eval(const EvalArgs& a) {
         }
         const Stack stack = load_stack(a.stack);
         const auto model = make_eval_model(entry, options, stack, a);
-        configure_random_walk(*model, a);
+        configure_random_walk(entry, *model, a);
         std::string out = std::string(with_phi ? kHeaderPhi : kHeader) + ",f_r,f_g,f_b\n";
         for (const Row& r : rows) {
             require_side(*model, stack, r.side, a.stack, a.directions, r.where + ", side");
@@ -267,7 +272,7 @@ int run_eval(const EvalArgs& a) {
     const Stack stack = load_stack(a.stack);
     const auto model = make_eval_model(entry, options, stack, a);
     require_side(*model, stack, side, a.stack, "command line", "--side");
-    if (const RandomWalkModel* rw = configure_random_walk(*model, a)) {
+    if (const RandomWalkModel* rw = configure_random_walk(entry, *model, a)) {
         const Vec3d wi = light_direction(thetas[0], a.phi_i);
         const Vec3d wo = direction_from_angles(deg_to_rad(a.theta_o), deg_to_rad(a.phi_o), side);
         if (a.pdf) {
@@ -326,7 +331,9 @@ Runner add_eval(CLI::App& app) {
     cmd->add_option("--out", a->out, "Output CSV (written atomically)");
     add_settings_options_only(cmd, a->spectral, {"spectral", "spectral_min_nm", "spectral_max_nm"});
     // Whole numbers read as the settings' are ("-3" refused, not wrapped; the bounds named);
-    // 0, the default, leaves the model's own option. ≥ 2 samples: one walk has no standard error.
+    // 0, the default, leaves the model's own option. ≥ 2 samples: one walk has no standard error;
+    // ≤ 1e10: ten billion walks take of the order of an hour for one query (the bound keeps a typo
+    // from running for days).
     auto add_whole = [cmd](const SettingInfo& info, std::uint64_t& member) {
         cmd->add_option_function<std::string>(
             option_name(info.name),
@@ -338,8 +345,10 @@ Runner add_eval(CLI::App& app) {
     };
     add_whole({.name = "samples",
                .help = "random-walk: walks per query, at least 2 (default: its samples option, "
-                       "1024); a point evaluation then prints f_r f_g f_b se_r se_g se_b",
-               .min = 2},
+                       "1024), at most 1e10; a point evaluation then prints f_r f_g f_b se_r "
+                       "se_g se_b",
+               .min = 2,
+               .max = 1e10},
               a->samples);
     cmd->add_flag("--pdf", a->pdf,
                   "random-walk, one point: print the exit density of its sampling at wo and its "

@@ -244,6 +244,7 @@ Source load_source(const ExportArgs& a) {
     } else {
         if (a.stack.empty()) throw InputError("command line", "--stack", "required with --model");
         const ModelEntry& entry = find_model(a.model);
+        require_tabulable(entry, "command line", "--model");
         src.stack = std::make_shared<const Stack>(load_stack(a.stack));
         src.model = entry.make(*src.stack, resolve_options(entry, a.options));
         src.meta["source"] = {{"model", a.model}, {"stack", stack_to_json(*src.stack)}};

@@ -406,6 +406,16 @@ void check_rgl_bsdf(const TensorFile& file, const std::string& where) {
         for (float v : file.at("rgb").floats())
             if (!std::isfinite(v))
                 throw InputError(where, "rgb", "holds a value that is not finite");
+    // The BRDF's values per wavelength and their luminance, which a reader samples by (its
+    // marginal distributions): never negative. The rgb field is linear sRGB, negative outside the
+    // gamut.
+    for (const char* name : {"luminance", "spectra"}) {
+        const std::vector<float> values = file.at(name).floats();
+        if (std::any_of(values.begin(), values.end(), [](float v) { return v < 0; }))
+            throw InputError(where, name,
+                             "holds a negative value (a BRDF value is never negative, and a "
+                             "reader samples by the luminance)");
+    }
     // The microfacets' distribution and projected area: densities, so never negative, and not
     // zero everywhere (a reader normalizes by them).
     for (const char* name : {"ndf", "sigma"}) {

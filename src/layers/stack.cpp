@@ -272,7 +272,12 @@ class Reader {
                                           "(line breaks, tabs)",
                                           show(*name)));
         } else {
+            // The file's name, printed on one line as a given name is: a control character in
+            // it (a line break in a file name) becomes '_'.
             s.name = std::filesystem::path(where_).stem().string();
+            std::replace_if(
+                s.name.begin(), s.name.end(), [](unsigned char c) { return c < 0x20 || c == 0x7f; },
+                '_');
             if (s.name.empty()) s.name = "stack";
         }
         if (j.contains("ambient_eta"))

@@ -270,6 +270,16 @@ const ModelEntry& find_model(const std::string& name, const std::string& field) 
         fmt::format("unknown model '{}'; known models: {}", name, fmt::join(names, ", ")));
 }
 
+void require_tabulable(const ModelEntry& entry, const std::string& file, const std::string& field) {
+    if (!entry.stochastic) return;
+    throw InputError(file, field,
+                     fmt::format("{} is a stochastic estimator, which lamina does not tabulate: "
+                                 "its table is the goniophotometer's (lamina simulate traces the "
+                                 "same transport; export --simulation writes it); evaluate it at "
+                                 "points or with --directions",
+                                 entry.name));
+}
+
 ModelOptions resolve_options(const ModelEntry& entry, const std::vector<std::string>& assignments,
                              const std::string& field) {
     const std::vector<OptionSpec> specs = entry.options();

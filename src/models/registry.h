@@ -50,6 +50,14 @@ const std::vector<ModelEntry>& model_registry();
 /// The entry called `name`; InputError (naming `field`) listing the known names otherwise.
 const ModelEntry& find_model(const std::string& name, const std::string& field = "--model");
 
+/// Refuses a stochastic model (ModelEntry::stochastic) where it would be tabulated (lamina eval
+/// --binned, export, compare, study, the Python module's binned): the adaptive quadrature of
+/// models/numerics/binned.h reads a noisy estimator's scatter as quadrature error and would spend
+/// its whole evaluation budget on every bin (on a coarse grid, without end), and an export grid
+/// would hold noise. The random walk's table is the goniophotometer's, which traces the same
+/// transport: InputError naming `file` and `field`, saying so.
+void require_tabulable(const ModelEntry& entry, const std::string& file, const std::string& field);
+
 /// Validates `key=value` assignments against the model's options and fills in the defaults.
 /// InputError naming `field` for a malformed assignment, an unknown key (listing the known ones),
 /// a value outside the allowed ones or a key given twice.

@@ -982,6 +982,7 @@ void bind_models(py::module_& m) {
             "binned",
             [](const PyModel& m, py::handle theta_i, std::pair<int, int> grid,
                py::handle phi_i_arg) {
+                require_tabulable(find_model(m.name, "name"), "arguments", "name");
                 const std::vector<double> thetas = incidences_of(theta_i);
                 const double phi_i = degrees_of(phi_i_arg, "phi_i");
                 if (!(phi_i >= 0 && phi_i <= 360))  // NaN too

@@ -832,8 +832,8 @@ std::vector<std::string> study_models(const StudySettings& s) {
     if (model_names.empty() && s.registry_models)
         for (const ModelEntry& e : model_registry())
             if (!e.stochastic) model_names.push_back(e.name);
-    for (const std::string& name : model_names)
-        parse_model_spec(name, "--models");  // validates
+    for (const std::string& name : model_names)  // validates
+        require_tabulable(*parse_model_spec(name, "--models").entry, "command line", "--models");
     if (s.ablations) {
         const std::vector<std::string> chosen = model_names;
         for (const std::string& name : chosen) {

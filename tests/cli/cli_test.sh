@@ -63,12 +63,12 @@ check omp-threads-one 0 env OMP_NUM_THREADS=1 "$lamina" simulate "$src/examples/
     --particles 1e3 --theta-i 0 --grid 9x9 --out "$tmp/omp-one"
 check omp-threads-same-table 0 cmp "$tmp/omp-many/brdf.csv" "$tmp/omp-one/brdf.csv"
 # One walk has no standard error (it printed 0).
-check_says eval-one-walk 1 "--samples: '1' is not allowed: expected a whole number ≥ 2" \
+check_says eval-one-walk 1 "--samples: '1' is not allowed: expected a whole number in [2, 10000000000]" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 \
     --theta-o 30 --phi-o 0 --samples 1
 # Counts and seeds are read as the settings' whole numbers: a negative one is refused (not wrapped
 # modulo 2^64), and one beyond the type names the range.
-check_says cli11-negative-count 1 "lamina: command line: --samples: '-5' is not allowed: expected a whole number in [2, 18446744073709551615]" \
+check_says cli11-negative-count 1 "lamina: command line: --samples: '-5' is not allowed: expected a whole number in [2, 10000000000]" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --samples -5
 check_says eval-seed-beyond-uint64 1 "lamina: command line: --seed: '18446744073709551616' is not allowed: expected a whole number in [1, 18446744073709551615]" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --seed 18446744073709551616
@@ -236,6 +236,33 @@ check_says eval-directions-endless 1 "/dev/zero: the directions file holds more 
 printf 'theta_i,theta_o,phi_o,side\n30,30,180,R\n\0\n' >"$tmp/dnul.csv"
 check_says eval-directions-nul 1 "dnul.csv: a NUL byte at offset" \
     "$lamina" eval --model ww09 --stack "$P" --directions "$tmp/dnul.csv" --out "$tmp/dnul-out.csv"
+# A row with a trailing comma has an empty fifth cell: refused, not written with its columns
+# shifted.
+printf 'theta_i,theta_o,phi_o,side\n30,30,180,R,\n' >"$tmp/dcomma.csv"
+check_says eval-directions-trailing-comma 1 "dcomma.csv: line 2: expected 4 columns, found 5" \
+    "$lamina" eval --model ww09 --stack "$P" --directions "$tmp/dcomma.csv" --out "$tmp/dc-out.csv"
+# The random walk is not tabulated by quadrature (its noise would drive the adaptive rule without
+# end): eval --binned, compare, export say so.
+check_says eval-binned-random-walk 1 "--model: random-walk is a stochastic estimator" \
+    "$lamina" eval --model random-walk --stack "$P" --binned --theta-i 30 --grid 1x1 --out "$tmp/rw.csv"
+check_says compare-random-walk 1 "--models: random-walk is a stochastic estimator" \
+    "$lamina" compare "$P" --models random-walk --theta-i 30 --particles 100 --grid 3x4 \
+    --tables none --no-figures --out "$tmp/crw"
+check_says export-random-walk 1 "--model: random-walk is a stochastic estimator" \
+    "$lamina" export --model random-walk --stack "$P" --grid 2x2 --theta-i 30 --out "$tmp/rw.npz"
+# The random walk on a stack it does not represent (a film) says that, whatever else is asked.
+printf 'theta_i,theta_o,phi_o,side\n30,30,180,R\n' >"$tmp/d1.csv"
+check_says eval-random-walk-unsupported 1 "not supported" \
+    "$lamina" eval --model random-walk --stack "$src/examples/filmed-plastic.json" \
+    --directions "$tmp/d1.csv" --out "$tmp/d1-out.csv" --samples 64
+check_says eval-samples-bound 1 "--samples: '18446744073709551615' is not allowed" \
+    "$lamina" eval --model random-walk --stack "$P" --theta-i 30 --theta-o 30 --phi-o 180 \
+    --samples 18446744073709551615
+# A stack's default name is its file's: a line break in the file name is shown as '_'.
+printf '{"layers": [{"interface": {"type": "lambertian", "albedo": 0.5}}]}' >"$tmp/two
+lines.json"
+check_says validate-name-from-file 0 "two_lines" "$lamina" validate "$tmp/two
+lines.json"
 # A stack file without end, or past 16 MiB, is refused without being read to its end.
 check_says validate-endless 1 "/dev/zero: the stack file holds more than 16 MiB" "$lamina" validate /dev/zero
 check_says export-check-endless 1 "/dev/zero: the file holds more than 16 MiB (it is not a regular file)" \

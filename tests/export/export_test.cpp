@@ -392,6 +392,10 @@ TEST(RglBsdf, HasTheFieldsTheReadersRequire) {
     EXPECT_TRUE(field_refused("theta_i", 0, -0.1f));
     EXPECT_TRUE(field_refused("theta_i", 4, 2.f));
     EXPECT_FALSE(field_refused("theta_i", 0, 0.f));  // the normal is an incidence
+    // A BRDF value and the luminance a reader samples by are never negative.
+    EXPECT_TRUE(field_refused("spectra", 7, -1e-3f));
+    EXPECT_TRUE(field_refused("luminance", 7, -1e-3f));
+    EXPECT_FALSE(field_refused("spectra", 7, 0.f));
 }
 
 TEST(RglBsdf, DefaultIncidencesGetDenserTowardsGrazing) {

@@ -757,6 +757,10 @@ def test_random_walk_microsurface_option():
     assert f2[0] - f1[0] > 4 * np.hypot(s1[0], s2[0]), (f1, f2)
     with pytest.raises(lamina.InputError):
         lamina.Model("random-walk", gold, microsurface="many")
+    # Not tabulated: the bins' adaptive quadrature would read its noise as quadrature error.
+    with pytest.raises(lamina.InputError) as e:
+        lamina.Model("random-walk", gold).binned(theta_i=[30], grid=(1, 1))
+    assert e.value.field == "name" and "stochastic estimator" in e.value.problem
 
 
 def run_module(*args):
