@@ -658,8 +658,8 @@ const CyclesFilmSensitivity& CyclesFilmSensitivity::get() {
 }
 
 std::complex<double> CyclesFilmSensitivity::operator()(int channel, double opd_nm) const {
-    // The table spans 2π OPD/60000 nm ∈ [0, 1]: OPD up to 60 µm/2π; beyond, its last entry.
-    const double x = clamp(2 * std::numbers::pi * opd_nm / 60000, 0.0, 1.0) * (kSize - 1);
+    // The table spans kPerNm · OPD ∈ [0, 1]: OPD up to 60 µm/2π; beyond, its last entry.
+    const double x = clamp(kPerNm * opd_nm, 0.0, 1.0) * (kSize - 1);
     const int i = std::min(int(x), kSize - 1), next = std::min(i + 1, kSize - 1);
     const double t = x - i;
     return table_[channel][i] * (1 - t) + table_[channel][next] * t;
@@ -676,7 +676,7 @@ std::complex<double> CyclesFilmSensitivity::integral(int channel, double x) cons
 
 std::complex<double> CyclesFilmSensitivity::mean(int channel, double opd0_nm,
                                                  double opd1_nm) const {
-    const double to_x = 2 * std::numbers::pi / 60000 * (kSize - 1);
+    const double to_x = kPerNm * (kSize - 1);
     const double x0 = std::max(opd0_nm, 0.0) * to_x, x1 = std::max(opd1_nm, 0.0) * to_x;
     if (!(x1 > x0)) return (*this)(channel, opd1_nm);
     return (integral(channel, x1) - integral(channel, x0)) / (x1 - x0);
@@ -959,13 +959,40 @@ Rgbd cycles_f82_tint_film(double film_ior, double thickness_nm, const Rgbd& f0, 
 namespace {
 
 /// Cycles' film over the substrate of each channel averaged over the thickness range [min_nm,
-/// max_nm]: the sensitivity's exact mean where Cycles' final clamp cannot act and the range starts
+/// max_nm]: the sensitivity's exact mean where Cycles' final clamp cannot act and the range lies
 /// above the 1 nm of the index blend (cycles_f82_tint_film_range), else Gauss–Legendre of
-/// `at_thickness` (the film at one thickness, the cutoff included).
+/// `at_thickness` (the film at one thickness, the cutoff included). A range across the cutoff
+/// or 1 nm is its parts' weighted means: no quadrature straddles the cutoff's step, and the exact
+/// mean covers all but the first nanometre (by quadrature alone a range of 10 µm takes thousands
+/// of films per call).
 template <typename AtThickness>
 Rgbd cycles_film_range(double film_ior, double min_nm, double max_nm,
                        const std::array<CyclesFilmSubstrate, 3>& substrate, double cos_theta,
                        AtThickness&& at_thickness) {
+    for (const double split : {kCyclesFilmCutoffNm, 1.0})
+        if (min_nm < split && max_nm > split) {
+            const Rgbd below =
+                cycles_film_range(film_ior, min_nm, split, substrate, cos_theta, at_thickness);
+            const Rgbd above =
+                cycles_film_range(film_ior, split, max_nm, substrate, cos_theta, at_thickness);
+            return (below * (split - min_nm) + above * (max_nm - split)) / (max_nm - min_nm);
+        }
+    // From the thickness at which the first order's OPD, 2 d √(η² − sin²θ1), reaches the lookup's
+    // end, every order reads its last entry: the film no longer changes with d (a range of
+    // micrometres would otherwise take the quadrature's 2048 films at every call).
+    if (const double u2_sq = film_ior * film_ior - (1 - sqr(clamp(cos_theta, 0.0, 1.0)));
+        min_nm >= 1 && u2_sq > 0) {
+        const double saturated_nm = 1 / (CyclesFilmSensitivity::kPerNm * 2 * std::sqrt(u2_sq));
+        if (max_nm > saturated_nm) {
+            const double split = std::max(min_nm, saturated_nm);
+            const Rgbd thick = at_thickness(max_nm);
+            if (!(split > min_nm)) return thick;
+            return (cycles_film_range(film_ior, min_nm, split, substrate, cos_theta, at_thickness) *
+                        (split - min_nm) +
+                    thick * (max_nm - split)) /
+                   (max_nm - min_nm);
+        }
+    }
     if (max_nm > min_nm && min_nm >= 1) {
         // Every quantity but the OPD is the same at every thickness ≥ 1 nm, and the OPD is
         // proportional to d: evaluated at max_nm, order m reads the sensitivity's mean over

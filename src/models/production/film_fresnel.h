@@ -110,11 +110,14 @@ Rgbd openpbr_bsdf_film_reflectance(const FilmOptics& film, double cos_theta, con
 class CyclesFilmSensitivity {
   public:
     static constexpr int kSize = 512;
+    /// The lookup's coordinate per nm of OPD, 2π/60000 nm: it spans OPD ∈ [0, 60000 nm/2π]
+    /// and holds its last entry beyond.
+    static constexpr double kPerNm = 2 * 3.14159265358979323846 / 60000;
     static const CyclesFilmSensitivity& get();
     /// Entry j ∈ [0, kSize) of channel c (linear sRGB), normalized.
     std::complex<double> entry(int channel, int j) const { return table_[channel][j]; }
     /// The kernel's lookup (iridescence_lookup_sensitivity_channel): the entries linearly
-    /// interpolated at x = 2π OPD/60000 nm ∈ [0, 1] (clamped) times 511.
+    /// interpolated at x = kPerNm · OPD ∈ [0, 1] (clamped) times 511.
     std::complex<double> operator()(int channel, double opd_nm) const;
     /// The exact mean of operator() over OPD uniform in [opd0_nm, opd1_nm] (0 ≤ opd0 < opd1):
     /// the integral of the piecewise-linear lookup from the entries' running trapezoid sums.

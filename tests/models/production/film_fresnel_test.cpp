@@ -401,13 +401,36 @@ TEST(FilmFresnel, CyclesSensitivityMeanIsTheLookupsMean) {
 TEST(FilmFresnel, CyclesRangeMeanIsExactWhereTheClampCannotAct) {
     const Rgbd f0(0.3, 0.25, 0.2), tint(0.9, 0.95, 1.0);
     for (double mu : {1.0, 0.6})
-        for (auto [lo, hi] : {std::pair{200.0, 600.0}, std::pair{45.0, 51.0}}) {
-            const Rgbd want = midpoint_mean(lo, hi, 200000, [&](double d) {
+        for (auto [lo, hi] : {std::pair{200.0, 600.0}, std::pair{45.0, 51.0}, std::pair{0.0, 600.0},
+                              std::pair{0.5, 40.0}}) {
+            // From below the 1 nm of the index blend and the 0.1 nm cutoff: the first nanometre
+            // by quadrature on each side of the cutoff's step, the rest exactly. The midpoint
+            // rule's cells (600/240000 nm) have the step on a cell boundary.
+            const Rgbd want = midpoint_mean(lo, hi, 240000, [&](double d) {
                 return cycles_f82_tint_film(1.5, d, f0, tint, mu);
             });
             const Rgbd got = cycles_f82_tint_film_range(1.5, lo, hi, f0, tint, mu);
             for (int c = 0; c < 3; ++c)
                 EXPECT_NEAR(got[c], want[c], 1e-9)
+                    << "mu " << mu << " [" << lo << ", " << hi << "] channel " << c;
+        }
+}
+
+// Where the clamp can act (a bright metal: the mean is Gauss–Legendre's), a range past the
+// thickness at which the first order's OPD reaches the lookup's end (about 2.4 µm at η 2) is the
+// quadrature below it and the film's constant value above. Against a fine midpoint rule (about
+// 0.06 nm steps, 700 per period of the third order): within the 4e-7 that Gauss–Legendre leaves at
+// the lookup's kinks.
+TEST(FilmFresnel, CyclesRangePastTheLookupsEndIsItsLastEntry) {
+    const Rgbd f0(0.95, 0.9, 0.85), tint(1.0, 1.0, 1.0);
+    for (double mu : {1.0, 0.5})
+        for (auto [lo, hi] : {std::pair{200.0, 12000.0}, std::pair{5000.0, 9000.0}}) {
+            const Rgbd want = midpoint_mean(lo, hi, 200000, [&](double d) {
+                return cycles_f82_tint_film(2.0, d, f0, tint, mu);
+            });
+            const Rgbd got = cycles_f82_tint_film_range(2.0, lo, hi, f0, tint, mu);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(got[c], want[c], 4e-7)
                     << "mu " << mu << " [" << lo << ", " << hi << "] channel " << c;
         }
 }
