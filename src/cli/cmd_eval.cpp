@@ -332,8 +332,8 @@ Runner add_eval(CLI::App& app) {
     add_settings_options_only(cmd, a->spectral, {"spectral", "spectral_min_nm", "spectral_max_nm"});
     // Whole numbers read as the settings' are ("-3" refused, not wrapped; the bounds named);
     // 0, the default, leaves the model's own option. ≥ 2 samples: one walk has no standard error;
-    // ≤ 1e10: ten billion walks take of the order of an hour for one query (the bound keeps a typo
-    // from running for days).
+    // ≤ 1e9: a billion walks take about an hour for one query (3 s per million on the benchmark
+    // plastic, one core); the bound keeps a typo from running for days.
     auto add_whole = [cmd](const SettingInfo& info, std::uint64_t& member) {
         cmd->add_option_function<std::string>(
             option_name(info.name),
@@ -345,10 +345,10 @@ Runner add_eval(CLI::App& app) {
     };
     add_whole({.name = "samples",
                .help = "random-walk: walks per query, at least 2 (default: its samples option, "
-                       "1024), at most 1e10; a point evaluation then prints f_r f_g f_b se_r "
+                       "1024), at most 1e9; a point evaluation then prints f_r f_g f_b se_r "
                        "se_g se_b",
                .min = 2,
-               .max = 1e10},
+               .max = 1e9},
               a->samples);
     cmd->add_flag("--pdf", a->pdf,
                   "random-walk, one point: print the exit density of its sampling at wo and its "

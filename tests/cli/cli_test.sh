@@ -63,12 +63,12 @@ check omp-threads-one 0 env OMP_NUM_THREADS=1 "$lamina" simulate "$src/examples/
     --particles 1e3 --theta-i 0 --grid 9x9 --out "$tmp/omp-one"
 check omp-threads-same-table 0 cmp "$tmp/omp-many/brdf.csv" "$tmp/omp-one/brdf.csv"
 # One walk has no standard error (it printed 0).
-check_says eval-one-walk 1 "--samples: '1' is not allowed: expected a whole number in [2, 10000000000]" \
+check_says eval-one-walk 1 "--samples: '1' is not allowed: expected a whole number in [2, 1000000000]" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --theta-i 30 \
     --theta-o 30 --phi-o 0 --samples 1
 # Counts and seeds are read as the settings' whole numbers: a negative one is refused (not wrapped
 # modulo 2^64), and one beyond the type names the range.
-check_says cli11-negative-count 1 "lamina: command line: --samples: '-5' is not allowed: expected a whole number in [2, 10000000000]" \
+check_says cli11-negative-count 1 "lamina: command line: --samples: '-5' is not allowed: expected a whole number in [2, 1000000000]" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --samples -5
 check_says eval-seed-beyond-uint64 1 "lamina: command line: --seed: '18446744073709551616' is not allowed: expected a whole number in [1, 18446744073709551615]" \
     "$lamina" eval --model random-walk --stack "$src/examples/plastic.json" --seed 18446744073709551616
