@@ -724,30 +724,38 @@ AirySum airy_summation(const Sensitivity& sensitivity, double R12, double R23, d
 
 namespace {
 
-/// Cycles' film before its final clamp: the mean of the s and p sums, their DC terms' mean and
-/// their swings' mean (AirySum); a total reflection is {1, 1, 0}.
-template <typename Sensitivity>
-AirySum cycles_film_sum(const Sensitivity& sensitivity, double s_max, double film_ior,
-                        double thickness_nm, const CyclesFilmSubstrate& substrate,
-                        double cos_theta_1) {
+/// What Cycles' film sum takes from the boundaries at one incidence and film index: their
+/// reflectances R12, R23 and the round trip's phasor, per polarization (s, p), and the film's
+/// normal wave number u2 = √(η² − sin²θ1) (the OPD is 2 d u2); or a total reflection. For films of
+/// 1 nm and more (where the index blend is over) nothing here depends on the thickness.
+struct CyclesFilmTerms {
+    bool total = true;
+    double R12[2] = {}, R23[2] = {};
+    std::complex<double> round_trip[2] = {};
+    double u2 = 0;
+};
+
+/// The terms at the film index η = film_ior blended as Cycles blends it below 1 nm of thickness.
+CyclesFilmTerms cycles_film_terms(double film_ior, double thickness_nm,
+                                  const CyclesFilmSubstrate& substrate, double cos_theta_1) {
     using C = std::complex<double>;
-    constexpr AirySum kTotal{1, 1, 0};
+    CyclesFilmTerms t;
     const double c1 = clamp(cos_theta_1, 0.0, 1.0), sin2 = 1 - c1 * c1;
     // Below 1 nm the film's index goes to the ambient's (1).
     double eta = film_ior;
     if (thickness_nm < 1) {
-        const double t = clamp(thickness_nm, 0.0, 1.0);
-        eta = 1 + (film_ior - 1) * t * t * (3 - 2 * t);
+        const double b = clamp(thickness_nm, 0.0, 1.0);
+        eta = 1 + (film_ior - 1) * b * b * (3 - 2 * b);
     }
     // Total reflection at the first boundary (Cycles: at η² − sin²θ1 ≤ 0).
-    if (!(eta * eta - sin2 > 0)) return kTotal;
+    if (!(eta * eta - sin2 > 0)) return t;
     const C u1(c1), u2(std::sqrt(eta * eta - sin2));
     const FresnelAmplitudes<double> top = fresnel_amplitudes<double>(C(1), u1, C(eta), u2);
     // Grazing incidence: the first boundary reflects everything (Cycles returns 1 there too).
-    if (std::norm(top.r_s) == 1 && std::norm(top.r_p) == 1) return kTotal;
+    if (std::norm(top.r_s) == 1 && std::norm(top.r_p) == 1) return t;
     // The second boundary, relative to the film (reference medium: the ambient, index 1).
     const C substrate_eta(substrate.n, substrate.conductor ? substrate.k : 0.0);
-    if (!substrate.conductor && !(substrate.n * substrate.n - sin2 > 0)) return kTotal;
+    if (!substrate.conductor && !(substrate.n * substrate.n - sin2 > 0)) return t;
     const C u3 = normal_wave_number(substrate_eta, sin2);
     const FresnelAmplitudes<double> bottom =
         fresnel_amplitudes<double>(C(eta), u2, substrate_eta, u3);
@@ -761,12 +769,39 @@ AirySum cycles_film_sum(const Sensitivity& sensitivity, double s_max, double fil
         R23_s = R23_p = f82_tint_fresnel(u2.real() / eta, f0, tint);
     }
     // The round trip's phasor e^(i(φ23 + φ21)), φ21 = φ12 + π.
-    const double opd = 2 * thickness_nm * u2.real();  // 2 η d cos θ2
-    const AirySum R_s = airy_summation(sensitivity, std::norm(top.r_s), R23_s, opd,
-                                       -phasor(bottom.r_s) * phasor(top.r_s), s_max);
-    const AirySum R_p = airy_summation(sensitivity, std::norm(top.r_p), R23_p, opd,
-                                       -phasor(bottom.r_p) * phasor(top.r_p), s_max);
+    t.total = false;
+    t.R12[0] = std::norm(top.r_s);
+    t.R12[1] = std::norm(top.r_p);
+    t.R23[0] = R23_s;
+    t.R23[1] = R23_p;
+    t.round_trip[0] = -phasor(bottom.r_s) * phasor(top.r_s);
+    t.round_trip[1] = -phasor(bottom.r_p) * phasor(top.r_p);
+    t.u2 = u2.real();
+    return t;
+}
+
+/// Cycles' film before its final clamp, from its terms at thickness_nm: the mean of the s and p
+/// sums, their DC terms' mean and their swings' mean (AirySum); a total reflection is {1, 1, 0}.
+template <typename Sensitivity>
+AirySum cycles_film_sum(const Sensitivity& sensitivity, double s_max, const CyclesFilmTerms& t,
+                        double thickness_nm) {
+    if (t.total) return {1, 1, 0};
+    const double opd = 2 * thickness_nm * t.u2;  // 2 η d cos θ2
+    const AirySum R_s =
+        airy_summation(sensitivity, t.R12[0], t.R23[0], opd, t.round_trip[0], s_max);
+    const AirySum R_p =
+        airy_summation(sensitivity, t.R12[1], t.R23[1], opd, t.round_trip[1], s_max);
     return {0.5 * (R_s.R + R_p.R), 0.5 * (R_s.dc + R_p.dc), 0.5 * (R_s.swing + R_p.swing)};
+}
+
+/// The same from the film's index, thickness, substrate and incidence.
+template <typename Sensitivity>
+AirySum cycles_film_sum(const Sensitivity& sensitivity, double s_max, double film_ior,
+                        double thickness_nm, const CyclesFilmSubstrate& substrate,
+                        double cos_theta_1) {
+    return cycles_film_sum(sensitivity, s_max,
+                           cycles_film_terms(film_ior, thickness_nm, substrate, cos_theta_1),
+                           thickness_nm);
 }
 
 template <typename Sensitivity>
@@ -993,27 +1028,39 @@ Rgbd cycles_film_range(double film_ior, double min_nm, double max_nm,
                    (max_nm - min_nm);
         }
     }
-    if (max_nm > min_nm && min_nm >= 1) {
-        // Every quantity but the OPD is the same at every thickness ≥ 1 nm, and the OPD is
-        // proportional to d: evaluated at max_nm, order m reads the sensitivity's mean over
-        // [m OPD min_nm/max_nm, m OPD].
-        const CyclesFilmSensitivity& table = CyclesFilmSensitivity::get();
-        const double ratio = min_nm / max_nm;
-        Rgbd F;
-        bool exact = true;
-        for (int c = 0; c < 3 && exact; ++c) {
-            const AirySum sum = cycles_film_sum(
-                [&](double opd) { return table.mean(c, opd * ratio, opd); }, table.max_magnitude(c),
-                film_ior, max_nm, substrate[std::size_t(c)], cos_theta);
-            exact = sum.dc - sum.swing >= 0 && sum.dc + sum.swing <= 1;
-            F[c] = sum.R;
-        }
-        if (exact) return F;
-    }
     // The third order's phase 2π · 3 · 2 η d cos θ2/λ has a period in d of at least
     // λ_min/(6 η), λ_min = 360 nm.
     const double period = 360 / (6 * std::max(film_ior, 1e-3));
-    return thickness_average(min_nm, max_nm, period, at_thickness);
+    if (!(max_nm > min_nm && min_nm >= 1))
+        return thickness_average(min_nm, max_nm, period, at_thickness);
+    // Every quantity but the OPD is the same at every thickness ≥ 1 nm (CyclesFilmTerms), and the
+    // OPD is proportional to d: evaluated at max_nm, order m reads the sensitivity's mean over
+    // [m OPD min_nm/max_nm, m OPD].
+    const CyclesFilmSensitivity& table = CyclesFilmSensitivity::get();
+    CyclesFilmTerms terms[3];
+    for (int c = 0; c < 3; ++c)
+        terms[c] = cycles_film_terms(film_ior, max_nm, substrate[std::size_t(c)], cos_theta);
+    const double ratio = min_nm / max_nm;
+    Rgbd F;
+    bool exact = true;
+    for (int c = 0; c < 3 && exact; ++c) {
+        const AirySum sum =
+            cycles_film_sum([&](double opd) { return table.mean(c, opd * ratio, opd); },
+                            table.max_magnitude(c), terms[c], max_nm);
+        exact = sum.dc - sum.swing >= 0 && sum.dc + sum.swing <= 1;
+        F[c] = sum.R;
+    }
+    if (exact) return F;
+    // Where the clamp can act: the film at each node from the same terms (the film at that
+    // thickness, as at_thickness gives it).
+    return thickness_average(min_nm, max_nm, period, [&](double d) {
+        Rgbd R;
+        for (int c = 0; c < 3; ++c)
+            R[c] = clamp(
+                cycles_film_sum([&](double opd) { return table(c, opd); }, 1.0, terms[c], d).R, 0.0,
+                1.0);
+        return R;
+    });
 }
 
 }  // namespace
