@@ -215,6 +215,29 @@ std::string read_file_bounded(const fs::path& path, std::size_t max_bytes, std::
     return text;
 }
 
+std::string read_regular_file_bounded(const fs::path& path, std::size_t max_bytes,
+                                      std::string_view what) {
+    std::error_code ec;
+    if (fs::exists(path, ec) && !fs::is_directory(path, ec) && !fs::is_regular_file(path, ec))
+        throw InputError(path.string(), "",
+                         fmt::format("cannot read {}: it is not a regular file (a pipe or a "
+                                     "device); lamina reads its own files only from regular ones",
+                                     what));
+    return read_file_bounded(path, max_bytes, what);
+}
+
+std::optional<std::string> read_cache_file(const fs::path& path, std::size_t max_bytes) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec) || ec) return std::nullopt;
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (ec || size > max_bytes) return std::nullopt;
+    try {
+        return read_file_bounded(path, max_bytes, "the cache entry");
+    } catch (const InputError&) {
+        return std::nullopt;
+    }
+}
+
 bool file_holds(const fs::path& path, std::string_view content) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) != content.size() || ec)

@@ -4,6 +4,7 @@
 // Input that is never read without bound (read_file_bounded).
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,6 +17,18 @@ namespace lamina {
 /// no further than 16 MiB, so that a stream without end is refused rather than read forever.
 std::string read_file_bounded(const std::filesystem::path& path, std::size_t max_bytes,
                               std::string_view what);
+
+/// read_file_bounded for a file lamina wrote itself (a study's files, a cache's entries): one that
+/// is not a regular file (a pipe, whose opening would wait for a writer; a device) is refused
+/// before it is opened: InputError naming the path.
+std::string read_regular_file_bounded(const std::filesystem::path& path, std::size_t max_bytes,
+                                      std::string_view what);
+
+/// A cache entry's bytes: the content of the regular file at `path` if it holds at most
+/// max_bytes; nothing otherwise (missing, a folder, a pipe or device — never opened —, larger,
+/// unreadable): the caller recomputes the entry.
+std::optional<std::string> read_cache_file(const std::filesystem::path& path,
+                                           std::size_t max_bytes);
 
 /// 2 GiB: the largest table (brdf.csv, a .bsdf tensor file) lamina reads.
 inline constexpr std::size_t kMaxTableFileBytes = std::size_t(2) << 30;

@@ -103,6 +103,9 @@ std::string header_value(const std::string& header, const std::string& key) {
 
 NpyFloat32 read_npy_float32(const std::filesystem::path& path) {
     const std::string where = path.string();
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))  // a pipe is not opened: it would wait
+        throw InputError(where, "", "cannot read the file: it is not a regular file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(where, "", "cannot read the file");
     char magic[8];

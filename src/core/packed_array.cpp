@@ -260,8 +260,8 @@ NpyFloat32 parse_packed_array(std::string_view bytes, const std::string& where) 
 
 NpyFloat32 read_packed_array(const std::filesystem::path& path) {
     // Bounded as every table lamina reads: a device or a runaway file is refused, not read on.
-    return parse_packed_array(read_file_bounded(path, kMaxTableFileBytes, "the packed array"),
-                              path.string());
+    return parse_packed_array(
+        read_regular_file_bounded(path, kMaxTableFileBytes, "the packed array"), path.string());
 }
 
 std::filesystem::path study_array_path(const std::filesystem::path& dir, const std::string& stem) {

@@ -46,7 +46,7 @@ json read_json(const fs::path& path, const char* what) {
                          fmt::format("cannot read {} (is this a study directory written by `lamina "
                                      "study` or `lamina compare`?)",
                                      what));
-    const std::string text = read_file_bounded(path, kMaxStudyJsonBytes, what);
+    const std::string text = read_regular_file_bounded(path, kMaxStudyJsonBytes, what);
     try {
         return json::parse(text);
     } catch (const json::exception& e) {
@@ -101,7 +101,7 @@ json read_metrics(const fs::path& path, const std::vector<double>& theta_i,
     json out = json::object();
     std::error_code ec;
     if (!fs::exists(path, ec)) return out;  // the page then shows no leaderboard, and says so
-    std::istringstream in(read_file_bounded(path, kMaxTableFileBytes, "the metrics table"));
+    std::istringstream in(read_regular_file_bounded(path, kMaxTableFileBytes, "the metrics table"));
     std::string line;
     std::getline(in, line);
     const std::vector<std::string> header = split_csv_line(line);
@@ -602,7 +602,8 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
         std::error_code ec;
         if (!fs::exists(file, ec))
             throw InputError(file.string(), "", "not found (config.json → lamina1_gpu names it)");
-        const std::string bytes = read_file_bounded(file, kMaxTableFileBytes, "lamina-1's states");
+        const std::string bytes =
+            read_regular_file_bounded(file, kMaxTableFileBytes, "lamina-1's states");
         const auto n_state = field<std::size_t>(g, "state", cfg_path);
         const auto head = field<std::size_t>(g, "head", cfg_path);
         // A slab's bins at the state's end (`tail`; absent where the study wrote none).

@@ -222,11 +222,10 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
     return true;
 }
 
+// A piece's bytes; empty (a damaged piece, recomputed) for anything but a regular file within
+// the tables' bound.
 std::string read_file(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    return read_cache_file(path, kMaxTableFileBytes).value_or(std::string());
 }
 
 }  // namespace

@@ -102,9 +102,10 @@ nlohmann::json read_state(const std::filesystem::path& path) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) return nullptr;
     try {
-        // Bounded: a state is tens of kB, and a device in its place must not be read on.
-        nlohmann::json j = nlohmann::json::parse(
-            read_file_bounded(path, std::size_t(256) << 20, "the study's state"));
+        // Bounded: a state is tens of kB, and a device or a pipe in its place is not read.
+        const std::optional<std::string> text = read_cache_file(path, std::size_t(256) << 20);
+        if (!text) return nullptr;
+        nlohmann::json j = nlohmann::json::parse(*text);
         return j.is_object() ? j : nlohmann::json();
     } catch (const std::exception&) {
         return nullptr;  // a damaged state is recomputed, never trusted
@@ -322,8 +323,8 @@ class ConfigurationRun {
             old_loaded_ = true;
             try {
                 if (state_.value("tables", "") == enum_text(s_.tables)) {
-                    std::ifstream in(config_dir_ / "config.json");
-                    const nlohmann::json cj = nlohmann::json::parse(in);
+                    const nlohmann::json cj = nlohmann::json::parse(read_regular_file_bounded(
+                        config_dir_ / "config.json", kMaxTableFileBytes, "the configuration"));
                     old_sources_ = cj.at("sources").get<std::vector<std::string>>();
                     NpyFloat32 t = read_study_array(config_dir_, "tables");
                     if (t.shape == std::vector<std::size_t>{
@@ -832,8 +833,15 @@ std::vector<std::string> study_models(const StudySettings& s) {
     if (model_names.empty() && s.registry_models)
         for (const ModelEntry& e : model_registry())
             if (!e.stochastic) model_names.push_back(e.name);
-    for (const std::string& name : model_names)  // validates
+    for (std::size_t i = 0; i < model_names.size(); ++i) {  // validates
+        const std::string& name = model_names[i];
         require_tabulable(*parse_model_spec(name, "--models").entry, "command line", "--models");
+        // Two sources of one name would be two rows each in metrics.csv and the rankings.
+        if (std::find(model_names.begin(), model_names.begin() + std::ptrdiff_t(i), name) !=
+            model_names.begin() + std::ptrdiff_t(i))
+            throw InputError("command line", "--models",
+                             fmt::format("'{}' is given twice; allowed: each model once", name));
+    }
     if (s.ablations) {
         const std::vector<std::string> chosen = model_names;
         for (const std::string& name : chosen) {

@@ -74,9 +74,12 @@ std::optional<std::filesystem::path> build_table_dir() {
 namespace {
 std::optional<std::vector<float>> load_table_file(const std::filesystem::path& path,
                                                   const TableKey& key) {
-    std::ifstream file(path, std::ios::binary);
-    if (!file) return std::nullopt;
-    const std::string in((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    // A regular file of the entry's size at most (its header is far below 1 kB): a pipe or a
+    // device in its place is never opened, a larger file never read.
+    const std::optional<std::string> bytes =
+        read_cache_file(path, std::size_t(key.count()) * sizeof(float) + 1024);
+    if (!bytes) return std::nullopt;
+    const std::string& in = *bytes;
     std::size_t pos = 0;
     char magic[8];
     if (in.size() < sizeof(magic) || std::memcmp(in.data(), kMagic, sizeof(magic)) != 0)
