@@ -263,6 +263,13 @@ printf '{"layers": [{"interface": {"type": "lambertian", "albedo": 0.5}}]}' >"$t
 lines.json"
 check_says validate-name-from-file 0 "two_lines" "$lamina" validate "$tmp/two
 lines.json"
+# Two sources of one name are refused; a pipe in place of a study's file is refused by name, not
+# opened (opening it would wait for a writer).
+check_says compare-model-twice 1 "--models: 'ww09' is given twice" \
+    "$lamina" compare "$P" --models ww09,ww09 --theta-i 30 --particles 100 --out "$tmp/cdup"
+mkdir -p "$tmp/fifo-study" && mkfifo "$tmp/fifo-study/study.json"
+check_says explorer-pipe 1 "study.json: cannot read the study's description: it is not a regular file" \
+    timeout 60 "$lamina" explorer "$tmp/fifo-study"
 # A stack file without end, or past 16 MiB, is refused without being read to its end.
 check_says validate-endless 1 "/dev/zero: the stack file holds more than 16 MiB" "$lamina" validate /dev/zero
 check_says export-check-endless 1 "/dev/zero: the file holds more than 16 MiB (it is not a regular file)" \
