@@ -105,6 +105,25 @@ def model_color(name, models):
     return EXTRA_COLORS[k % len(EXTRA_COLORS)]
 
 
+# The temporary files this process is writing: removed when it is stopped (end_on_signal).
+WRITING = set()
+
+
+def end_on_signal(signum, frame):
+    """SIGTERM (lamina stopped, which stops this script) or, in a worker, SIGINT: no half-written
+    file stays behind and no worker goes on drawing. The signal's exit status, without Python's
+    traceback."""
+    import multiprocessing
+    for child in multiprocessing.active_children():
+        child.terminate()
+    for path in list(WRITING):
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+    os._exit(128 + signum)
+
+
 def save(fig, path_stem, formats, tight=True, box=None):
     """Writes each format, atomically (a temporary file renamed into place). `tight=False` for
     figures laid out by hand: matplotlib's tight boxes measure every tick label again, the bulk of
@@ -115,8 +134,10 @@ def save(fig, path_stem, formats, tight=True, box=None):
     for f in formats:
         tmp = f"{path_stem}.tmp-{os.getpid()}.{f}"
         bbox = box if box is not None else "tight" if tight else None
+        WRITING.add(tmp)
         fig.savefig(tmp, bbox_inches=bbox, metadata=metadata[f])
         os.replace(tmp, f"{path_stem}.{f}")
+        WRITING.discard(tmp)
     plt.close(fig)
 
 
@@ -701,11 +722,11 @@ def main():
     todo.sort(key=lambda t: {"albedo": 0, "matrix": 1, "slice": 2, "colour": 2}[t[1]])
     if a.jobs > 1 and len(todo) > 1:
         import multiprocessing
-        # Ctrl-C ends the workers silently (the signal's default action, not Python's
+        # Ctrl-C ends the workers silently, each removing its temporary file (not Python's
         # KeyboardInterrupt with a traceback in each); this process says it in one line.
         with multiprocessing.get_context("fork").Pool(
                 min(a.jobs, len(todo)),
-                initializer=signal.signal, initargs=(signal.SIGINT, signal.SIG_DFL)) as pool:
+                initializer=signal.signal, initargs=(signal.SIGINT, end_on_signal)) as pool:
             done = list(pool.imap_unordered(draw, todo))
     else:
         done = [draw(t) for t in todo]
@@ -713,9 +734,11 @@ def main():
         stamps[t[0]] = t[4]
     if todo:  # nothing drawn, nothing rewritten
         tmp = f"{stamp_path}.tmp-{os.getpid()}"
+        WRITING.add(tmp)
         with open(tmp, "w") as f:
             json.dump(stamps, f, indent=0, sort_keys=True)
         os.replace(tmp, stamp_path)
+        WRITING.discard(tmp)
     skipped = [c for c in ids if not has_tables(study, c)]
     if skipped:
         print(f"figures: {len(skipped)} configurations without tables (--tables none): "
@@ -725,6 +748,7 @@ def main():
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGTERM, end_on_signal)  # the workers inherit it
     try:
         main()
     except KeyboardInterrupt:

@@ -1,17 +1,24 @@
 #include "report/figures.h"
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hash.h"
 #include "report/assets.h"
 
 #include <fmt/format.h>
 
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <string_view>
+#include <vector>
+
+extern char** environ;
 
 namespace fs = std::filesystem;
 
@@ -19,11 +26,48 @@ namespace lamina {
 
 namespace {
 
-std::string shell_quote(const std::string& s) {
-    std::string out = "'";
-    for (char c : s)
-        out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return out + "'";
+/// Runs `argv` (its first word looked up on the PATH) with `input` on its standard input and
+/// returns its exit code: 127 when it cannot be started, −1 when it did not exit (a signal). The
+/// child is registered with the interrupt handler (core/atomic_file.h), so that a lamina stopped
+/// by SIGINT, SIGTERM or SIGHUP stops it too (the figure script then removes its temporary files).
+int run_with_input(const std::vector<std::string>& argv, std::string_view input) {
+    int fds[2];
+    if (::pipe(fds) != 0) return 127;
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, fds[0], 0);
+    posix_spawn_file_actions_addclose(&actions, fds[0]);
+    posix_spawn_file_actions_addclose(&actions, fds[1]);
+    std::vector<char*> args;
+    for (const std::string& a : argv)
+        args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    pid_t pid = 0;
+    const int spawned = ::posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(fds[0]);
+    if (spawned != 0) {
+        ::close(fds[1]);
+        return 127;
+    }
+    const int slot = register_interrupt_child(int(pid), {}, {});
+    // An interpreter that exits before reading the script must not kill lamina with SIGPIPE.
+    const auto previous = std::signal(SIGPIPE, SIG_IGN);
+    for (std::size_t at = 0; at < input.size();) {
+        const ssize_t n = ::write(fds[1], input.data() + at, input.size() - at);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) break;
+        at += std::size_t(n);
+    }
+    ::close(fds[1]);
+    std::signal(SIGPIPE, previous);
+    int status = 0;
+    pid_t waited = 0;
+    while ((waited = ::waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
+    }
+    unregister_interrupt_child(slot);
+    if (waited < 0 || !WIFEXITED(status)) return -1;
+    return WEXITSTATUS(status);
 }
 
 std::string choose_python(const std::string& requested) {
@@ -62,24 +106,21 @@ void write_figures(const fs::path& study_dir, const FigureOptions& options) {
     const std::string_view script = assets::figures_py();
     // The script's digest (it reads itself from stdin, so it cannot hash its own file): part of
     // every figure's inputs, so a new lamina redraws what its script draws differently.
-    std::string command =
-        fmt::format("{} - {} --formats {} --script-id {:016x}", shell_quote(python),
-                    shell_quote(study_dir.string()), formats, fnv1a(script));
-    if (!options.only.empty()) command += " --only " + shell_quote(options.only);
-    if (options.force) command += " --force";
+    std::vector<std::string> argv = {python,
+                                     "-",
+                                     study_dir.string(),
+                                     "--formats",
+                                     formats,
+                                     "--script-id",
+                                     fmt::format("{:016x}", fnv1a(script))};
+    if (!options.only.empty()) argv.insert(argv.end(), {"--only", options.only});
+    if (options.force) argv.push_back("--force");
     // The palette the explorer page uses too (web/model-colors.json, embedded).
     ::setenv("LAMINA_MODEL_COLORS", std::string(assets::model_colors_json()).c_str(), 1);
     // The reader of the tables' packed arrays (src/python/lamina/arrays.py, embedded).
     ::setenv("LAMINA_ARRAYS_PY", std::string(assets::arrays_py()).c_str(), 1);
-    std::FILE* pipe = ::popen(command.c_str(), "w");
-    if (!pipe) throw InputError(python, "", "cannot start the figure script's interpreter");
-    // An interpreter that exits before reading the script must not kill lamina with SIGPIPE.
-    const auto previous = std::signal(SIGPIPE, SIG_IGN);
-    std::fwrite(script.data(), 1, script.size(), pipe);
-    const int status = ::pclose(pipe);
-    std::signal(SIGPIPE, previous);
-    if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    const int code = run_with_input(argv, script);
+    if (code != 0) {
         throw InputError(
             study_dir.string(), "figures",
             code == 127 ? fmt::format("cannot run '{}': install python3 (`make deps`)", python)

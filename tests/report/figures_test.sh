@@ -125,5 +125,22 @@ ok test -s "$opaque/figures/error-matrix-T.png"
 if grep -q "figures not written\|Warning" <<<"$out"; then
     echo "FAIL: the opaque slab's figures: $out"; fails=$((fails + 1))
 fi
+
+# lamina stopped while it draws (SIGTERM, as a supervisor or `timeout` sends it to lamina alone):
+# the figure script and its workers stop with it and leave no temporary file.
+"$lamina" figures "$study" --force &
+pid=$!
+for _ in $(seq 100); do  # until the first figure is on disk (or lamina is done)
+    [ -n "$(find "$study/figures" -newer "$build/figures-opaque.json" -name '*.png' 2>/dev/null)" ] &&
+        break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.05
+done
+kill -TERM "$pid" 2>/dev/null
+wait "$pid"
+sleep 1
+ok test -z "$(ps -eo args | grep -F -- "--script-id" | grep -F -- "$study" || true)"
+ok test -z "$(find "$study/figures" -name '*.tmp-*')"
+
 echo "$passes passed, $fails failed"
 test "$fails" -eq 0
