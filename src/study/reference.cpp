@@ -153,6 +153,30 @@ bool deserialize(const std::string& bytes, const ReferenceKey& key, ReferencePie
     } catch (const std::exception&) {
         return false;
     }
+    // The header's numbers as serialize writes them, else a damaged piece (computed again): the
+    // energy budget finite and of the order of 1 (its terms are unbiased estimates, a few may be
+    // slightly negative; a spectral run's sRGB may leave [0, 1]), standard errors and the noise
+    // floor's energies and norms never negative, every value within the tables' bound (a metric
+    // may be NaN: not defined).
+    auto order_one = [](double x) { return std::abs(x) <= 10; };
+    auto bounded = [](double x, bool nonnegative) {
+        return std::isnan(x) || (std::abs(x) <= kMaxBinValue && !(nonnegative && x < 0));
+    };
+    bool sane = std::isfinite(p.seconds) && p.seconds >= 0;
+    for (int c = 0; c < 3; ++c) {
+        for (int t = 0; t < kBudgetTerms; ++t)
+            sane = sane && order_one(p.budget.term[t][c]);
+        sane = sane && order_one(p.budget.reflected_se[c]) && p.budget.reflected_se[c] >= 0 &&
+               order_one(p.budget.transmitted_se[c]) && p.budget.transmitted_se[c] >= 0;
+        for (int side = 0; side < 2; ++side) {
+            const LobeMetrics& m = p.floor[side][c];
+            sane = sane && bounded(m.misplaced_energy, true) && bounded(m.misplaced_floor, true) &&
+                   bounded(m.albedo_ref, false) && bounded(m.albedo_model, false) &&
+                   bounded(m.albedo_error, false) && bounded(m.rmse, true) &&
+                   bounded(m.log_rmse, true);
+        }
+    }
+    if (!sane) return false;
     const std::size_t sides = p.has_transmission ? 2 : 1;
     const std::size_t n = key.grid().size();
     const std::size_t expected = sides * 2 * n * 3 * sizeof(float);

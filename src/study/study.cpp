@@ -106,7 +106,8 @@ nlohmann::json read_state(const std::filesystem::path& path) {
         const std::optional<std::string> text = read_cache_file(path, std::size_t(256) << 20);
         if (!text) return nullptr;
         nlohmann::json j = nlohmann::json::parse(*text);
-        return j.is_object() ? j : nlohmann::json();
+        // Another format's state (a newer or an edited one) is not read.
+        return j.is_object() && j.value("format", "") == kStateFormat ? j : nlohmann::json();
     } catch (const std::exception&) {
         return nullptr;  // a damaged state is recomputed, never trusted
     }
@@ -165,8 +166,31 @@ MetricRow row_from_json(const nlohmann::json& j, const StudyConfiguration& c,
           r.metrics.albedo_model, r.metrics.albedo_error, r.metrics.rmse, r.metrics.log_rmse,
           r.floor.misplaced_energy, r.floor.misplaced_floor})
         sane = sane && (std::isnan(v) || std::abs(v) <= kMaxBinValue);  // NaN: null, not computed
+    // Misplaced energies, their floors and the errors' norms are never negative.
+    for (const double v : {r.metrics.misplaced_energy, r.metrics.misplaced_floor, r.metrics.rmse,
+                           r.metrics.log_rmse, r.floor.misplaced_energy, r.floor.misplaced_floor})
+        sane = sane && !(v < 0);
     if (!sane) throw std::runtime_error("a state row out of range");
     return r;
+}
+
+// A state's rows of one model, from `first` on, checked to be those a run writes, in its order:
+// per incidence, per side (R, then T where the stack transmits), per channel. Rows at other
+// incidences or sides, or fewer (an edited or damaged file), are not trusted: the caller
+// recomputes the configuration.
+void check_row_sequence(const std::vector<MetricRow>& rows, std::size_t first,
+                        const std::vector<StudyIncidence>& incidences, int sides) {
+    if (rows.size() - first != incidences.size() * std::size_t(sides) * 3)
+        throw std::runtime_error("a state with missing rows");
+    for (std::size_t i = 0; i < incidences.size(); ++i)
+        for (int side = 0; side < sides; ++side)
+            for (int c = 0; c < 3; ++c) {
+                const MetricRow& r =
+                    rows[first + (i * std::size_t(sides) + std::size_t(side)) * 3 + std::size_t(c)];
+                if (r.theta_i != incidences[i].theta_i || r.phi_i != incidences[i].phi_i ||
+                    r.side != (side == 0 ? 'R' : 'T') || r.channel != c)
+                    throw std::runtime_error("a state's rows are not this run's");
+            }
 }
 
 // A packed array (core/packed_array.h) of float16 or float32 values.
@@ -276,17 +300,25 @@ class ConfigurationRun {
             !outputs_there)
             return false;
         try {
+            const int sides = config_.stack.transmits() ? 2 : 1;
             for (const std::string& name : model_names_) {
-                // Every incidence, side and channel (1 or 2 sides): a shorter list is damage.
-                const nlohmann::json& rows = state_.at("models").at(name).at("rows");
-                if (rows.size() != incidences_.size() * 3 && rows.size() != incidences_.size() * 6)
-                    throw std::runtime_error("a state with missing rows");
-                for (const nlohmann::json& r : rows)
+                const std::size_t first = result_.rows.size();
+                for (const nlohmann::json& r : state_.at("models").at(name).at("rows"))
                     result_.rows.push_back(row_from_json(r, config_, name));
+                check_row_sequence(result_.rows, first, incidences_, sides);
             }
-            for (const nlohmann::json& v : state_.at("lost_microsurface"))
-                result_.lost_microsurface.push_back(
-                    Rgbd(v.at(0).get<double>(), v.at(1).get<double>(), v.at(2).get<double>()));
+            // The fractions of the incident energy lost on the microsurfaces, per incidence:
+            // finite and of the order of 1 (a spectral run's sRGB may leave [0, 1]).
+            for (const nlohmann::json& v : state_.at("lost_microsurface")) {
+                const Rgbd lost(v.at(0).get<double>(), v.at(1).get<double>(),
+                                v.at(2).get<double>());
+                for (int c = 0; c < 3; ++c)
+                    if (!(std::abs(lost[c]) <= 10))
+                        throw std::runtime_error("a state's loss out of range");
+                result_.lost_microsurface.push_back(lost);
+            }
+            if (result_.lost_microsurface.size() != incidences_.size())
+                throw std::runtime_error("a state with missing losses");
             result_.reference_seconds = state_.value("reference_seconds", 0.0);
             work_.model_tables_reused += model_names_.size();
             ++work_.configurations_unchanged;
@@ -353,10 +385,9 @@ class ConfigurationRun {
                 const nlohmann::json& ms = state_["models"][name];
                 const float* old = old_table_of(name);
                 if (s_.tables == TablesFormat::None || old) {
-                    if (ms.at("rows").size() != n_inc_ * std::size_t(n_sides_) * 3)
-                        throw std::runtime_error("a state with missing rows");
                     for (const nlohmann::json& r : ms.at("rows"))
                         m.rows.push_back(row_from_json(r, config_, name));
+                    check_row_sequence(m.rows, 0, incidences_, n_sides_);
                     m.support.brdf = ms.at("support").at("R").get<bool>();
                     m.support.btdf = ms.at("support").at("T").get<bool>();
                     m.support.reason = ms.at("support").at("reason").get<std::string>();

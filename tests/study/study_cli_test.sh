@@ -269,17 +269,29 @@ for text in ("x", "inf", "nan"):
 PY
 
 # 2h. The incremental state read back is checked: a row edited out of range (1e308, which gave
-#     "-inf%" in the summary) or a model's rows cut short are recomputed, not reused.
-for damage in huge short; do
+#     "-inf%" in the summary) or negative, a row moved to another incidence or side, a model's
+#     rows cut short, a loss of 1e308 or another format's state are recomputed, not reused.
+for damage in huge negative moved side short loss format; do
     rm -rf "$tmp/state-$damage" && cp -r "$tmp/a" "$tmp/state-$damage"
     "$py" - "$tmp/state-$damage" "$damage" <<'PY'
 import glob, json, sys
 for path in glob.glob(f"{sys.argv[1]}/cache/study/*.json"):
     state = json.load(open(path))
+    damage = sys.argv[2]
+    if damage == "loss":
+        state["lost_microsurface"][0][0] = 1e308
+    elif damage == "format":
+        state["format"] = "lamina-study-state v9"
     for model in state["models"].values():
-        if sys.argv[2] == "huge":
+        if damage == "huge":
             model["rows"][0][4] = 1e308
-        else:
+        elif damage == "negative":
+            model["rows"][0][4] = -1.0
+        elif damage == "moved":
+            model["rows"][0][0] = 33.0
+        elif damage == "side":
+            model["rows"][0][1] = "T" if model["rows"][0][1] == "R" else "R"
+        elif damage == "short":
             del model["rows"][1:]
     json.dump(state, open(path, "w"))
 PY
