@@ -8,6 +8,7 @@
 #include "core/packed_array.h"
 #include "core/setting.h"
 #include "core/stokes.h"
+#include "core/table.h"
 #include "lamina/version.h"
 #include "report/assets.h"
 
@@ -162,7 +163,16 @@ json read_metrics(const fs::path& path, const std::vector<double>& theta_i,
             json& arr = cell[key];
             while (arr.size() < n)
                 arr.push_back(json{nullptr, nullptr, nullptr});
-            if (v[c_supported] == "true" && !v[col].empty()) arr[i][ch] = number(col);
+            if (v[c_supported] != "true" || v[col].empty()) continue;
+            // As the study writes them (its state's check): within the tables' bound, the
+            // misplaced energies, their floors and the log RMSE never negative.
+            const double x = number(col);
+            const bool nonnegative = std::string_view(key) != "ae";
+            if (!(std::abs(x) <= kMaxBinValue) || (nonnegative && x < 0))
+                throw InputError(path.string(), fmt::format("row {}, {}", row, header[col]),
+                                 fmt::format("{} is outside {}", v[col],
+                                             nonnegative ? "[0, 1e12]" : "[-1e12, 1e12]"));
+            arr[i][ch] = x;
         }
     }
     return out;

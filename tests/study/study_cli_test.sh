@@ -235,6 +235,18 @@ def metric_not_a_number(d):
     open(f"{d}/metrics.csv", "w").write("\n".join(lines) + "\n")
 refused(damaged("metric", metric_not_a_number), "row 2, misplaced_floor: 'x' is not a finite",
         explorer)
+# Finite but beyond any metric the study writes (the page's sums overflowed), or a negative
+# misplaced energy: refused by row and column.
+for text, bound in (("1e308", "[0, 1e12]"), ("-1", "[0, 1e12]")):
+    def metric_out_of_range(d, text=text):
+        lines = open(f"{d}/metrics.csv").read().splitlines()
+        header = lines[0].split(",")
+        cells = lines[1].split(",")
+        cells[header.index("misplaced_floor")] = text
+        lines[1] = ",".join(cells)
+        open(f"{d}/metrics.csv", "w").write("\n".join(lines) + "\n")
+    refused(damaged("metric-range", metric_out_of_range),
+            f"row 2, misplaced_floor: {text} is outside {bound}", explorer)
 
 sys.path.insert(0, os.environ["LAMINA_PYTHONPATH"])
 import lamina as lam
