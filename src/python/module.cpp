@@ -800,8 +800,9 @@ void bind_export(py::module_& m) {
             BrdfSource brdf;
             if (py::isinstance<PyModel>(source)) {
                 const PyModel& pm = source.cast<const PyModel&>();
-                auto model = std::shared_ptr<const Model>(
-                    find_model(pm.name, "name").make(pm.stack, pm.options));
+                const ModelEntry& entry = find_model(pm.name, "name");
+                require_tabulable(entry, "arguments", "source");
+                auto model = std::shared_ptr<const Model>(entry.make(pm.stack, pm.options));
                 brdf = model_brdf(model, pm.stack, pm.name);
             } else {
                 brdf = table_brdf(source.cast<const BinnedTable&>(), "table", "table");
@@ -1006,6 +1007,8 @@ void bind_models(py::module_& m) {
         .def(
             "albedo",
             [](const PyModel& m, py::handle theta_i, const std::string& side) {
+                // Its adaptive quadrature is the bins' (a noisy estimator would never end it).
+                require_tabulable(find_model(m.name, "name"), "arguments", "name");
                 const std::vector<double> thetas = incidences_of(theta_i);
                 if (side != "R" && side != "T")
                     throw InputError("arguments", "side", "must be 'R' or 'T'");
@@ -1051,7 +1054,9 @@ void bind_cli(py::module_& m) {
     m.def(
         "cli",
         [](const std::vector<std::string>& args) {
-            std::vector<std::string> owned = args;
+            // argv[0] is the program's name, which the parser reads first.
+            std::vector<std::string> owned =
+                args.empty() ? std::vector<std::string>{"lamina"} : args;
             std::vector<char*> argv;
             for (std::string& a : owned)
                 argv.push_back(a.data());

@@ -376,6 +376,7 @@ std::vector<StudyConfiguration> load_configurations(const std::filesystem::path&
             throw InputError(where, "/" + key, "unknown key; allowed: configurations");
     std::vector<StudyConfiguration> out;
     std::set<std::string> ids;
+    std::map<std::string, std::string> categories;  // in lower case → as first written
     const auto& list = j["configurations"];
     if (list.empty()) throw InputError(where, "/configurations", "the list is empty");
     for (std::size_t i = 0; i < list.size(); ++i) {
@@ -399,6 +400,20 @@ std::vector<StudyConfiguration> load_configurations(const std::filesystem::path&
                 throw InputError(where, at + "/category", "must be a string");
             c.category = item["category"].get<std::string>();
             check_study_label(c.category, "category", where, at + "/category");
+            // The summary's groups are the categories, "CATEGORY BTDF" and "all", "all BTDF"; a
+            // category's figure is albedo-CATEGORY.png, one name in a case-blind file system.
+            const std::string key = configuration_id_key(c.category);
+            if (key == "all" || (key.size() >= 5 && key.compare(key.size() - 5, 5, " btdf") == 0))
+                throw InputError(where, at + "/category",
+                                 fmt::format("'{}' is one of the summary's group names; allowed: "
+                                             "a category other than 'all' and not ending in "
+                                             "' BTDF'",
+                                             c.category));
+            if (const auto seen = categories.emplace(key, c.category);
+                !seen.second && seen.first->second != c.category)
+                throw InputError(where, at + "/category",
+                                 fmt::format("'{}' differs from the category '{}' in case only",
+                                             c.category, seen.first->second));
         }
         if (!item.contains("stack")) throw InputError(where, at + "/stack", "a stack is required");
         try {

@@ -270,6 +270,13 @@ check_says compare-model-twice 1 "--models: 'ww09' is given twice" \
 mkdir -p "$tmp/fifo-study" && mkfifo "$tmp/fifo-study/study.json"
 check_says explorer-pipe 1 "study.json: cannot read the study's description: it is not a regular file" \
     timeout 60 "$lamina" explorer "$tmp/fifo-study"
+# A --configs category may not take a summary group's name, nor differ from another in case only.
+printf '{"configurations": [{"id": "a", "category": "all BTDF", "stack": {"layers": [{"interface": {"type": "lambertian", "albedo": 0.5}}]}}]}' >"$tmp/cat-group.json"
+check_says study-category-group 1 "/configurations/0/category: 'all BTDF' is one of the summary's group names" \
+    "$lamina" study --configs "$tmp/cat-group.json" --out "$tmp/cat-group"
+printf '{"configurations": [{"id": "a", "category": "x", "stack": {"layers": [{"interface": {"type": "lambertian", "albedo": 0.5}}]}}, {"id": "b", "category": "X", "stack": {"layers": [{"interface": {"type": "lambertian", "albedo": 0.5}}]}}]}' >"$tmp/cat-case.json"
+check_says study-category-case 1 "/configurations/1/category: 'X' differs from the category 'x' in case only" \
+    "$lamina" study --configs "$tmp/cat-case.json" --out "$tmp/cat-case"
 # A stack file without end, or past 16 MiB, is refused without being read to its end.
 check_says validate-endless 1 "/dev/zero: the stack file holds more than 16 MiB" "$lamina" validate /dev/zero
 check_says export-check-endless 1 "/dev/zero: the file holds more than 16 MiB (it is not a regular file)" \

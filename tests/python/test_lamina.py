@@ -758,9 +758,14 @@ def test_random_walk_microsurface_option():
     with pytest.raises(lamina.InputError):
         lamina.Model("random-walk", gold, microsurface="many")
     # Not tabulated: the bins' adaptive quadrature would read its noise as quadrature error.
+    rw = lamina.Model("random-walk", gold)
+    for call in (lambda: rw.binned(theta_i=[30], grid=(1, 1)), lambda: rw.albedo(30)):
+        with pytest.raises(lamina.InputError) as e:
+            call()
+        assert e.value.field == "name" and "stochastic estimator" in e.value.problem
     with pytest.raises(lamina.InputError) as e:
-        lamina.Model("random-walk", gold).binned(theta_i=[30], grid=(1, 1))
-    assert e.value.field == "name" and "stochastic estimator" in e.value.problem
+        lamina.export(rw, "/tmp/never.bsdf")
+    assert e.value.field == "source" and "stochastic estimator" in e.value.problem
 
 
 def run_module(*args):
@@ -894,3 +899,9 @@ def test_one_incidence_is_one_value_whatever_its_type():
         with pytest.raises(lamina.InputError) as e:
             m.albedo(truth)
         assert e.value.field.startswith("theta_i") and "expected a number" in e.value.problem
+
+
+def test_cli_without_a_program_name_runs():
+    """The command line's argv[0] is the program's name: an empty argv is the bare program (its
+    usage, exit 0 or 1), never a read past the list."""
+    assert lamina._lamina.cli([]) in (0, 1)
