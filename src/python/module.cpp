@@ -767,6 +767,8 @@ void bind_simulation(py::module_& m) {
     // The goniophotometer's settings and their defaults, by name (core/setting.h): Python's
     // keyword arguments of simulate, compare and study.
     m.attr("SIMULATION_SETTINGS") = python_of(settings_to_json(SimulationSettings{}));
+    // The most bins along θ and along φ a grid may have (core/grid.h, as --grid takes).
+    m.attr("GRID_MAX_COUNT") = HemisphereGrid::kMaxCount;
     // The named references (layers/transport_settings.h): the settings each one sets.
     nlohmann::json physics = nlohmann::json::object();
     for (const auto& n : enum_names(ReferencePhysics{})) {

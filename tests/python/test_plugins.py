@@ -273,6 +273,28 @@ def test_phi_i_out_of_range_is_refused():
         assert e.value.field == "phi_i"
 
 
+def test_incidences_and_grids_are_checked_before_the_model_is_asked():
+    class Watched(Lambert):
+        calls = 0
+
+        def eval(self, wi, wo):
+            Watched.calls += 1
+            return super().eval(wi, wo)
+
+    bad = [({"theta_i": [float("nan")]}, "theta_i"), ({"theta_i": [95]}, "theta_i"),
+           ({"grid": (30000, 30000)}, "grid"), ({"grid": "abc"}, "grid"),
+           ({"grid": (2.5, 3)}, "grid"), ({"grid": {"n_theta": 3}}, "grid")]
+    for kwargs, field in bad:
+        args = {"theta_i": [30], "grid": (3, 3), **kwargs}
+        with pytest.raises(lamina.InputError) as e:
+            lamina.bin_model(Watched, PLASTIC, **args)
+        assert e.value.field == field, (kwargs, e.value)
+    assert Watched.calls == 0
+    # simulate's form of a grid serves too.
+    t = lamina.bin_model(Lambert, PLASTIC, [30], grid={"n_theta": 3, "n_phi": 4})
+    assert t.f.shape[-3:-1] == (3, 4)
+
+
 def test_truth_values_and_bad_node_counts_are_refused(tmp_path):
     # True would be read as 1 degree or one node; a node count outside [1, MAX] would bin with
     # no node or allocate without bound (a study of built-in models only checks it too).

@@ -18,6 +18,7 @@ _StackSource = Union["Stack", Dict[str, Any], _Path]
 
 DEFAULT_THETA_I: List[float]
 SIMULATION_SETTINGS: Dict[str, Any]
+GRID_MAX_COUNT: int
 REFERENCE_PHYSICS: Dict[str, Dict[str, Any]]
 
 class InputError(ValueError):

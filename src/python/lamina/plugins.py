@@ -162,6 +162,9 @@ def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32, phi_i=0.0)
     theta_i = [float(t) for t in np.atleast_1d(theta_i)]
     if not theta_i:
         raise input_error("arguments", "theta_i", "at least one incidence is needed")
+    for t in theta_i:  # checked before the model is asked anything
+        if not 0 <= t < 90:  # NaN too
+            raise input_error("arguments", "theta_i", f"{t} degrees is outside [0, 90)")
     if np.asarray(phi_i).dtype.kind == "b":
         raise input_error("arguments", "phi_i", f"expected degrees, got {phi_i!r}")
     phi = np.atleast_1d(np.asarray(phi_i, dtype=np.float64))
@@ -174,9 +177,20 @@ def bin_model(obj, stack, theta_i, grid=None, nodes=4, peak_nodes=32, phi_i=0.0)
     if grid is None:
         default = _lamina.SIMULATION_SETTINGS["grid"]
         grid = (default["n_theta"], default["n_phi"])
+    if isinstance(grid, dict):  # as simulate takes it
+        grid = (grid.get("n_theta"), grid.get("n_phi"))
+    try:
+        counts = [int(g) for g in grid]
+        if len(counts) != 2 or any(c != g for c, g in zip(counts, grid)):
+            raise ValueError
+    except (TypeError, ValueError, OverflowError):
+        raise input_error("arguments", "grid", f"expected (n_theta, n_phi), got {grid!r}")
+    if not all(1 <= c <= _lamina.GRID_MAX_COUNT for c in counts):  # as --grid
+        raise input_error("arguments", "grid", f"{counts[0]} × {counts[1]} bins: allowed counts "
+                          f"in [1, {_lamina.GRID_MAX_COUNT}] along θ and φ")
     unfolded = _lamina._unfolded(stack, phi_i)
-    n_theta = int(grid[0])
-    n_phi = int(grid[1]) * (2 if unfolded else 1)      # φ bins of the table
+    n_theta = counts[0]
+    n_phi = counts[1] * (2 if unfolded else 1)      # φ bins of the table
     span = 2 * np.pi if unfolded else np.pi
     t_edges = np.linspace(0, np.pi / 2, n_theta + 1)
     p_edges = np.linspace(0, span, n_phi + 1)
