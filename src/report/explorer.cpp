@@ -777,10 +777,13 @@ ExplorerSummary write_explorer_unchecked(const fs::path& study_dir) {
                       {"parameters", c.value("parameters", json::object())}};
         item.digest =
             inputs_digest(study_dir / "configs" / id, item.entry, theta_i, n_theta, n_phi);
+        // The data file must be the one written then (its digest in the stamp): a truncated or
+        // edited one is encoded again.
         const fs::path script = study_dir / "explorer" / "data" / (id + ".js");
         if (stamps.contains(id) && stamps[id].is_object() &&
             stamps[id].value("digest", "") == item.digest && stamps[id].contains("entry") &&
-            fs::exists(script)) {
+            fs::exists(script) &&
+            stamps[id].value("script", "") == digest_hex(fnv1a(digest_bytes(script)))) {
             item.entry = stamps[id]["entry"];
             item.unchanged = true;
             summary.data_bytes += fs::file_size(script);
@@ -804,14 +807,17 @@ ExplorerSummary write_explorer_unchecked(const fs::path& study_dir) {
     for (std::size_t k = 0; k < items.size(); ++k) {
         if (failures[k]) std::rethrow_exception(failures[k]);
         Item& item = items[k];
+        std::string script_digest = items[k].unchanged ? stamps[item.id].value("script", "") : "";
         if (encoded[k]) {
             const ConfigData& d = *encoded[k];
             item.entry["albedo"] = d.albedo;
             item.entry["albedo_se"] = d.albedo_se;
             summary.data_bytes += d.script.size();
             data_out.add_if_changed(item.id + ".js", d.script);
+            script_digest = digest_hex(fnv1a(d.script));
         }
-        new_stamps[item.id] = {{"digest", item.digest}, {"entry", item.entry}};
+        new_stamps[item.id] = {
+            {"digest", item.digest}, {"entry", item.entry}, {"script", script_digest}};
         index["configs"].push_back(item.entry);
         ++summary.configurations;
     }

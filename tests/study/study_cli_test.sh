@@ -44,6 +44,12 @@ grep -q 'figures: 0 drawn' "$tmp/a2.log" && ok || { fail "rerun redrew figures:"
 snapshot "$tmp/a" >"$tmp/a.after"
 diff "$tmp/a.before" "$tmp/a.after" >"$tmp/a.diff" && ok || { fail "rerun rewrote files:"; cat "$tmp/a.diff"; }
 grep -q 'Findings' "$tmp/a2.log" && ok || fail "findings printed on a rerun"
+# A truncated explorer data file is encoded again, not trusted from the stamps.
+rm -rf "$tmp/a-js" && cp -r "$tmp/a" "$tmp/a-js"
+js=$(find "$tmp/a-js/explorer/data" -name 'plastic-*.js' | head -1)
+cp "$js" "$tmp/a-js.saved" && truncate -s 100 "$js"
+"$lamina" explorer "$tmp/a-js" >/dev/null 2>&1 && cmp -s "$js" "$tmp/a-js.saved" && ok \
+    || fail "a truncated explorer data file was kept"
 
 # 2b. Adding a model computes that model's tables only (no reference piece, nothing for the
 #     others), and gives bitwise the metrics and tables of a fresh study with the three models.
