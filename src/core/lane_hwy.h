@@ -173,6 +173,102 @@ struct VecLane : VecLaneOps<DF> {
     static constexpr bool kSinglePrecision = true;
 };
 
+/// Two vectors of float lanes as one lane value: the lane templates instantiated on VecLane2 run
+/// every operation on both vectors, the two operations side by side. A template's operations form
+/// long dependent chains (a rough dielectric's event: a visible normal, then its Fresnel factor,
+/// then the chosen direction, then its masking), during which one vector leaves the processor's
+/// units idle; two independent vectors in one instruction stream fill them (measured in
+/// docs/performance.md). The pair is the SIMD kernel's two lane sets (kernel_simd.cpp) at one
+/// event.
+struct VF2 {
+    VF a, b;
+};
+struct MF2 {
+    MF a, b;
+};
+HWY_INLINE VF2 operator+(VF2 x, VF2 y) {
+    return {hn::Add(x.a, y.a), hn::Add(x.b, y.b)};
+}
+HWY_INLINE VF2 operator-(VF2 x, VF2 y) {
+    return {hn::Sub(x.a, y.a), hn::Sub(x.b, y.b)};
+}
+HWY_INLINE VF2 operator*(VF2 x, VF2 y) {
+    return {hn::Mul(x.a, y.a), hn::Mul(x.b, y.b)};
+}
+HWY_INLINE VF2 operator/(VF2 x, VF2 y) {
+    return {hn::Div(x.a, y.a), hn::Div(x.b, y.b)};
+}
+
+/// The operations of core/lane.h on pairs of vectors: VecLane's, on each vector.
+struct VecLane2 {
+    using Value = VF2;
+    using Mask = MF2;
+    using V = VF2;
+    using M = MF2;
+    template <typename F>
+    static HWY_INLINE V each(V x, F f) {
+        return {f(x.a), f(x.b)};
+    }
+    static HWY_INLINE V constant(double x) {
+        const VF c = VecLane::constant(x);
+        return {c, c};
+    }
+    static HWY_INLINE V min(V a, V b) { return {hn::Min(a.a, b.a), hn::Min(a.b, b.b)}; }
+    static HWY_INLINE V max(V a, V b) { return {hn::Max(a.a, b.a), hn::Max(a.b, b.b)}; }
+    static HWY_INLINE V sqrt(V x) {
+        return each(x, [](VF y) { return VecLane::sqrt(y); });
+    }
+    static HWY_INLINE V exp(V x) {
+        return each(x, [](VF y) { return VecLane::exp(y); });
+    }
+    static HWY_INLINE V log(V x) {
+        return each(x, [](VF y) { return VecLane::log(y); });
+    }
+    static HWY_INLINE V log1p(V x) {
+        return each(x, [](VF y) { return VecLane::log1p(y); });
+    }
+    static HWY_INLINE V abs(V x) {
+        return each(x, [](VF y) { return VecLane::abs(y); });
+    }
+    static HWY_INLINE V inv_sqrt(V x) {
+        return each(x, [](VF y) { return VecLane::inv_sqrt(y); });
+    }
+    static HWY_INLINE V select(M m, V a, V b) {
+        return {hn::IfThenElse(m.a, a.a, b.a), hn::IfThenElse(m.b, a.b, b.b)};
+    }
+    static HWY_INLINE M less(V a, V b) { return {hn::Lt(a.a, b.a), hn::Lt(a.b, b.b)}; }
+    static HWY_INLINE V copysign(V a, V b) {
+        return {hn::CopySign(a.a, b.a), hn::CopySign(a.b, b.b)};
+    }
+    static HWY_INLINE V mul_add(V a, V b, V c) {
+        return {hn::MulAdd(a.a, b.a, c.a), hn::MulAdd(a.b, b.b, c.b)};
+    }
+    static HWY_INLINE V neg_mul_add(V a, V b, V c) {
+        return {hn::NegMulAdd(a.a, b.a, c.a), hn::NegMulAdd(a.b, b.b, c.b)};
+    }
+    static HWY_INLINE M both(M m, M n) { return {hn::And(m.a, n.a), hn::And(m.b, n.b)}; }
+    static HWY_INLINE M either(M m, M n) { return {hn::Or(m.a, n.a), hn::Or(m.b, n.b)}; }
+    static HWY_INLINE M negate(M m) { return {hn::Not(m.a), hn::Not(m.b)}; }
+    static HWY_INLINE bool none(M m) { return hn::AllFalse(DF(), hn::Or(m.a, m.b)); }
+    static HWY_INLINE void cos_sin_2pi(V u, V& c, V& s) {
+        CosSin2Pi(u.a, c.a, s.a);
+        CosSin2Pi(u.b, c.b, s.b);
+    }
+    static constexpr double kBetaArgumentMax = VecLane::kBetaArgumentMax;
+    static constexpr bool kSinglePrecision = true;
+};
+
+/// A direction of the pair's lanes, from each vector's; and each vector's back.
+HWY_INLINE LaneVec3<VF2> Pair(const V3& a, const V3& b) {
+    return {{a.x, b.x}, {a.y, b.y}, {a.z, b.z}};
+}
+HWY_INLINE V3 First(const LaneVec3<VF2>& p) {
+    return {p.x.a, p.y.a, p.z.a};
+}
+HWY_INLINE V3 Second(const LaneVec3<VF2>& p) {
+    return {p.x.b, p.y.b, p.z.b};
+}
+
 // Lanes of doubles, half as many as of floats in a vector of the same width: the few formulas
 // the kernel evaluates in double (a thin film's Airy sums, physics/thin_film_airy.h).
 using DD = hn::ScalableTag<double>;

@@ -26,6 +26,16 @@
 // runs on both, and a two-sample chi-square test compares them; tests/physics/lanes_test.cpp and
 // tests/simulator/kernel_simd_test.cpp compare each template's instantiations).
 //
+// Two lane sets. The lanes are two vectors' worth, two sets (LaneSet) that step together at the
+// group largest over both, and the first events take two vectors of particles at a time. At an
+// interface the event runs on the pair of the two sets' vectors (VecLane2, core/lane_hwy.h):
+// every operation twice, side by side, on independent data. One vector's event is a long chain of
+// dependent operations during which the processor's units wait; the second chain fills them
+// (docs/performance.md, "Against the yardstick"). Paired: a dielectric's event (unpolarized) and
+// walk, a bare conductor's event and walk, a Lambertian's (InterfaceStepPair); each set alone:
+// spectral runs, filmed conductors, a polarized dielectric's single-scattering event, sets whose
+// polarization states differ in their channels, scattering media, and the tallies and refills.
+//
 // Multiple scattering on the microsurfaces (physics/microsurface_walk.h). At a rough interface
 // the lanes of the event walk from facet to facet together: while any of them walks, every lane of
 // the vector draws its numbers, and the event ends when each has escaped, met its facet cap or a
@@ -239,9 +249,10 @@ class BlockTracer {
     void Trace(BlockBudget& block) {
         block_ = &block;
         if constexpr (kSpectral)
-            for (auto& term : particle_loss_)
-                for (auto& channel : term)
-                    std::fill(std::begin(channel), std::end(channel), 0.0);
+            for (auto& set : particle_loss_)
+                for (auto& term : set)
+                    for (auto& channel : term)
+                        std::fill(std::begin(channel), std::end(channel), 0.0);
         scratch_.resize(job_.count, kPolarized);
         SeedParticles(job_.seed, job_.stream, job_.first, job_.count, scratch_.state.data(),
                       scratch_.inc.data());
@@ -261,7 +272,7 @@ class BlockTracer {
             for (int t = 0; t < kLossTerms; ++t)
                 if (v.touched[t]) {
                     if constexpr (kSpectral)
-                        AddToLanes(particle_loss_[t][c], v.loss[t][c]);
+                        AddToLanes(particle_loss_[v.set][t][c], v.loss[t][c]);
                     else
                         sums_.add(t, c, v.loss[t][c]);
                     v.loss[t][c] = zero_;
@@ -319,14 +330,14 @@ class BlockTracer {
         hn::Store(v.group, di, group_out_);
         Flush(v);
     }
-    // Lane l's particle's losses (staged) booked to its wavelength group and colour projections,
-    // and cleared for the lane's next particle.
-    HWY_INLINE void BookLosses(std::size_t l) {
+    // Lane l's particle's losses (staged; lane set `set`'s) booked to its wavelength group and
+    // colour projections, and cleared for the lane's next particle.
+    HWY_INLINE void BookLosses(int set, std::size_t l) {
         PathLosses losses;
         bool any = false;
         for (int t = 0; t < kLossTerms; ++t)
             for (int c = 0; c < 3; ++c) {
-                double& lost = particle_loss_[t][c][l];
+                double& lost = particle_loss_[set][t][c][l];
                 losses.term[std::size_t(int(BudgetTerm::AbsorbedMedium) + t)][std::size_t(c)] =
                     lost;
                 any = any || lost != 0.0;
@@ -534,19 +545,88 @@ class BlockTracer {
         return hn::And(going, hn::RebindMask(DF(), hn::Ne(v.mid_walk, hn::Zero(DI()))));
     }
 
+    // A lane set of the main loop: its lanes, their generators and its steps since its float
+    // sums were last flushed.
+    struct LaneSet {
+        LaneVectors v;
+        LaneRng rng;
+        int steps_since_flush = 0;
+    };
+
     void InterfaceStep(LaneVectors& v, LaneRng& rng, int group, MF going) {
+        MF degenerate_event = hn::FirstN(DF(), 0);  // all false
+        Arrive(v, group, going);
+        Event(stack_.layers[group], group, v, rng, going, degenerate_event);
+        Depart(v, group, going, degenerate_event);
+    }
+
+    // Two lane sets' interface step at one interface (StepPair, the first events): as
+    // InterfaceStep on each, the event on the pair of their vectors where it has a pair form (the
+    // file's comment, "Two lane sets").
+    void InterfaceStepPair(LaneSet& s, LaneSet& t, int group, MF going_s, MF going_t) {
+        const CompiledLayer<float>& layer = stack_.layers[group];
+        MF degenerate_s = hn::FirstN(DF(), 0), degenerate_t = degenerate_s;
+        Arrive(s.v, group, going_s);
+        Arrive(t.v, group, going_t);
         const DF df;
+        if (!kSpectral && !layer.multiple && layer.type == InterfaceType::Dielectric &&
+            !kPolarized) {
+            const VF uc_s = s.rng.Uniform(), u1_s = s.rng.Uniform(), u2_s = s.rng.Uniform();
+            const VF uc_t = t.rng.Uniform(), u1_t = t.rng.Uniform(), u2_t = t.rng.Uniform();
+            DielectricEventPair<kAnisotropic>(layer.dielectric, hn::Set(df, layer.dielectric.eta),
+                                              hn::Set(df, layer.dielectric.inv_eta()), going_s,
+                                              going_t, s.v, t.v, {uc_s, uc_t}, {u1_s, u1_t},
+                                              {u2_s, u2_t}, degenerate_s, degenerate_t);
+        } else if (!kSpectral && layer.multiple && layer.type == InterfaceType::Dielectric &&
+                   s.v.pol.channels == t.v.pol.channels) {
+            DielectricWalkEventPair<kPolarized, kAnisotropic>(
+                layer.dielectric, hn::Set(df, layer.dielectric.eta),
+                hn::Set(df, layer.dielectric.inv_eta()), going_s, going_t, s.v, t.v, s.rng, t.rng,
+                stack_.max_microsurface_order, degenerate_s, degenerate_t, may_suspend_);
+        } else if (!kSpectral && layer.multiple && layer.type == InterfaceType::Conductor &&
+                   !layer.has_film && s.v.pol.channels == t.v.pol.channels) {
+            ConductorWalkEventPair<kPolarized, kAnisotropic>(
+                layer.conductor, going_s, going_t, s.v, t.v, s.rng, t.rng,
+                stack_.max_microsurface_order, degenerate_s, degenerate_t, may_suspend_);
+        } else if (!kSpectral && !layer.multiple && layer.type == InterfaceType::Conductor &&
+                   !layer.has_film && s.v.pol.channels == t.v.pol.channels) {
+            const VF u1_s = s.rng.Uniform(), u2_s = s.rng.Uniform();
+            const VF u1_t = t.rng.Uniform(), u2_t = t.rng.Uniform();
+            ConductorEventPair<kPolarized, kAnisotropic>(layer.conductor, going_s, going_t, s.v,
+                                                         t.v, {u1_s, u1_t}, {u2_s, u2_t},
+                                                         degenerate_s, degenerate_t);
+        } else if (!kSpectral && layer.type == InterfaceType::Lambertian) {
+            VF albedo[3];
+            for (int c = 0; c < 3; ++c)
+                albedo[c] = hn::Set(df, layer.lambertian.albedo[c]);
+            const VF u1_s = s.rng.Uniform(), u2_s = s.rng.Uniform();
+            const VF u1_t = t.rng.Uniform(), u2_t = t.rng.Uniform();
+            LambertianEventPair<kPolarized>(albedo, going_s, going_t, s.v, t.v, {u1_s, u1_t},
+                                            {u2_s, u2_t}, degenerate_s, degenerate_t);
+        } else {
+            Event(layer, group, s.v, s.rng, going_s, degenerate_s);
+            Event(layer, group, t.v, t.rng, going_t, degenerate_t);
+        }
+        Depart(s.v, group, going_s, degenerate_s);
+        Depart(t.v, group, going_t, degenerate_t);
+    }
+
+    // The lanes of `going` arrive at interface `group`: their event is counted (a suspended walk
+    // going on is the same event: counted, and its secondary wavelengths ended, once).
+    HWY_INLINE void Arrive(LaneVectors& v, int group, MF going) const {
         const DI di;
-        // A suspended walk going on is the same event: counted, and its secondary wavelengths
-        // ended, once.
         const MF arriving = hn::AndNot(MidWalk(v, going), going);
         v.events = hn::IfThenElse(hn::RebindMask(di, arriving), hn::Add(v.events, hn::Set(di, 1)),
                                   v.events);
-        MF degenerate_event = hn::FirstN(df, 0);  // all false
+        if constexpr (kSpectral) EndSecondaries(v, group, arriving);
+    }
+
+    // After the event of the lanes of `going` at interface `group`: failed samples and grazing
+    // directions booked, ended particles marked, the others leave the interface.
+    HWY_INLINE void Depart(LaneVectors& v, int group, MF going, MF degenerate_event) {
+        const DF df;
         const CompiledLayer<float>& layer = stack_.layers[group];
         const bool dielectric = layer.type == InterfaceType::Dielectric;
-        if constexpr (kSpectral) EndSecondaries(v, group, arriving);
-        Event(layer, group, v, rng, going, degenerate_event);
         const MF done = hn::AndNot(MidWalk(v, going), going);  // the lanes whose event is over
         // A failed sample loses the flux to the microsurface; an exactly grazing new direction is
         // lost to the microsurface (dielectric) or the base (opaque), as in trace_particle.
@@ -672,7 +752,7 @@ class BlockTracer {
             const std::size_t l = std::size_t(std::countr_zero(ended_bits));
             const std::int32_t why = finish_[l];
             if (why != kEnded) TallyExit(l, why, known_bins);
-            if constexpr (kSpectral) BookLosses(l);
+            if constexpr (kSpectral) BookLosses(v.set, l);
             on_lane(l);
         }
     }
@@ -690,56 +770,78 @@ class BlockTracer {
         QueueArrays& queue = scratch_.queue;
         queue.size = 0;
         if constexpr (kSpectral) scratch_.queue_spectral.clear();
-        LaneVectors p;
-        Clear(p);
-        [[maybe_unused]] const StokesLanes<VF> incident = p.pol.stokes;
-        LaneRng prng;
-        std::uint64_t chunks = 0;
-        for (std::uint64_t base = 0; base < job_.count; base += n_lanes_) {
-            const std::size_t n = std::size_t(std::min<std::uint64_t>(n_lanes_, job_.count - base));
-            for (std::size_t l = 0; l < n_lanes_; ++l) {
-                prng.state[l] = l < n ? scratch_.state[base + l] : 0;
-                prng.inc[l] = l < n ? scratch_.inc[base + l] : 1;
-            }
-            prng.SyncIn();
-            const MF going = hn::FirstN(df, n);
-            p.d = {hn::Set(df, -job_.wi.x), hn::Set(df, -job_.wi.y), hn::Set(df, -job_.wi.z)};
-            for (int c = 0; c < 3; ++c)
-                p.w[c] = hn::IfThenElseZero(going, one_);
-            p.k = p.in_medium = p.events = p.finish = hn::Zero(di);
-            p.depth = zero_;
-            if constexpr (kPolarized) p.pol.stokes = incident;
-            if constexpr (kSpectral) DrawStacks(p, prng, base);
-            InterfaceStep(p, prng, 0, going);
-            const MF ended = hn::RebindMask(df, hn::Ne(p.finish, hn::Zero(di)));
-            if (!hn::AllFalse(df, ended)) EndParticles(p, ended, [](std::size_t) {});
-            prng.SyncOut();
-            if constexpr (kSpectral) {
-                // The waiting particles' losses of their first event, booked now (the queue does
-                // not carry them).
-                StageSpectral(p);
-                for (std::uint64_t bits = MaskBits(hn::AndNot(ended, going)); bits != 0;
-                     bits &= bits - 1)
-                    BookLosses(std::size_t(std::countr_zero(bits)));
-            }
-            const MF waits = hn::AndNot(ended, going);
-            Enqueue(p, waits);
-            [[maybe_unused]] HWY_ALIGN std::int32_t qsecondaries[kMaxLanes];
-            if constexpr (kSpectral) hn::Store(p.secondaries, di, qsecondaries);
-            std::size_t j = queue.size;
-            for (std::uint64_t bits = MaskBits(waits); bits != 0; bits &= bits - 1) {
-                const std::size_t l = std::size_t(std::countr_zero(bits));
-                if constexpr (kSpectral)
-                    scratch_.queue_spectral.push_back({at_out_[l], group_out_[l], qsecondaries[l]});
-                queue.state[j] = prng.state[l];
-                queue.inc[j] = prng.inc[l];
-                ++j;
-            }
-            queue.size = j;
-            if (++chunks % kFlushSteps == 0) Flush(p);
+        // Two chunks of particles at a time, one per lane set (their events on the pair of
+        // vectors, InterfaceStepPair), queued in order.
+        LaneSet chunk[2];
+        for (int i = 0; i < 2; ++i) {
+            Clear(chunk[i].v);
+            chunk[i].v.set = i;
         }
-        Flush(p);
-        sums_.add_events(p.events_done);
+        [[maybe_unused]] const StokesLanes<VF> incident = chunk[0].v.pol.stokes;
+        for (std::uint64_t base = 0; base < job_.count; base += 2 * n_lanes_) {
+            std::size_t n[2];
+            MF going[2];
+            for (int i = 0; i < 2; ++i) {
+                const std::uint64_t first = base + std::uint64_t(i) * n_lanes_;
+                n[i] = std::size_t(
+                    first < job_.count ? std::min<std::uint64_t>(n_lanes_, job_.count - first) : 0);
+                LaneVectors& p = chunk[i].v;
+                LaneRng& prng = chunk[i].rng;
+                for (std::size_t l = 0; l < n_lanes_; ++l) {
+                    prng.state[l] = l < n[i] ? scratch_.state[first + l] : 0;
+                    prng.inc[l] = l < n[i] ? scratch_.inc[first + l] : 1;
+                }
+                prng.SyncIn();
+                going[i] = hn::FirstN(df, n[i]);
+                p.d = {hn::Set(df, -job_.wi.x), hn::Set(df, -job_.wi.y), hn::Set(df, -job_.wi.z)};
+                for (int c = 0; c < 3; ++c)
+                    p.w[c] = hn::IfThenElseZero(going[i], one_);
+                p.k = p.in_medium = p.events = p.finish = hn::Zero(di);
+                p.depth = zero_;
+                if constexpr (kPolarized) p.pol.stokes = incident;
+                if constexpr (kSpectral)
+                    if (n[i] > 0) DrawStacks(p, prng, first);
+            }
+            InterfaceStepPair(chunk[0], chunk[1], 0, going[0], going[1]);
+            for (int i = 0; i < 2 && n[i] > 0; ++i) {
+                LaneVectors& p = chunk[i].v;
+                LaneRng& prng = chunk[i].rng;
+                const MF ended = hn::RebindMask(df, hn::Ne(p.finish, hn::Zero(di)));
+                if (!hn::AllFalse(df, ended)) EndParticles(p, ended, [](std::size_t) {});
+                prng.SyncOut();
+                if constexpr (kSpectral) {
+                    // The waiting particles' losses of their first event, booked now (the queue
+                    // does not carry them).
+                    StageSpectral(p);
+                    for (std::uint64_t bits = MaskBits(hn::AndNot(ended, going[i])); bits != 0;
+                         bits &= bits - 1)
+                        BookLosses(p.set, std::size_t(std::countr_zero(bits)));
+                }
+                const MF waits = hn::AndNot(ended, going[i]);
+                Enqueue(p, waits);
+                [[maybe_unused]] HWY_ALIGN std::int32_t qsecondaries[kMaxLanes];
+                if constexpr (kSpectral) hn::Store(p.secondaries, di, qsecondaries);
+                std::size_t j = queue.size;
+                for (std::uint64_t bits = MaskBits(waits); bits != 0; bits &= bits - 1) {
+                    const std::size_t l = std::size_t(std::countr_zero(bits));
+                    if constexpr (kSpectral)
+                        scratch_.queue_spectral.push_back(
+                            {at_out_[l], group_out_[l], qsecondaries[l]});
+                    queue.state[j] = prng.state[l];
+                    queue.inc[j] = prng.inc[l];
+                    ++j;
+                }
+                queue.size = j;
+                if (++chunk[i].steps_since_flush == kFlushSteps) {
+                    Flush(p);
+                    chunk[i].steps_since_flush = 0;
+                }
+            }
+        }
+        for (LaneSet& c : chunk) {
+            Flush(c.v);
+            sums_.add_events(c.v.events_done);
+        }
     }
 
     // The stacks of the chunk's particles (job.first + base + l in lane l): each draws its
@@ -826,7 +928,7 @@ class BlockTracer {
 
     // Gives lane l the queue's next particle (its generator and spectral lane here, the rest in
     // Restart), or retires the lane when none is left.
-    HWY_INLINE void TakeParticle(std::size_t l) {
+    HWY_INLINE void TakeParticle(LaneRng& rng, std::size_t l) {
         const QueueArrays& queue = scratch_.queue;
         if (next_ < queue.size) {
             if constexpr (kSpectral) {
@@ -836,14 +938,14 @@ class BlockTracer {
                 s_group_[l] = q.group;
                 s_secondaries_[l] = q.secondaries;
             }
-            rng_.state[l] = queue.state[next_];
-            rng_.inc[l] = queue.inc[next_];
+            rng.state[l] = queue.state[next_];
+            rng.inc[l] = queue.inc[next_];
             taking_ |= std::uint64_t(1) << l;
             ++next_;
         } else {
             s_at_[l] = s_hero_[l] = s_group_[l] = s_secondaries_[l] = 0;
-            rng_.state[l] = 0;
-            rng_.inc[l] = 1;
+            rng.state[l] = 0;
+            rng.inc[l] = 1;
         }
     }
 
@@ -914,95 +1016,168 @@ class BlockTracer {
     // medium, whichever group is largest (ties to the first). The lanes of a two-interface stack
     // then alternate between its interfaces in phase, so each step runs one interface's code on
     // nearly full vectors.
+    template <int kSets>
     struct Group {
         int layer;
         bool is_medium;
-        MF lanes;
+        MF lanes[kSets];
     };
-    HWY_INLINE Group PickGroup(const LaneVectors& v, MF live_mask) const {
+    template <int kSets>
+    HWY_INLINE Group<kSets> PickGroup(const LaneVectors* const (&v)[kSets],
+                                      const MF (&live_mask)[kSets]) const {
         const DF df;
         const DI di;
-        const MF in_med = hn::And(live_mask, hn::RebindMask(df, hn::Ne(v.in_medium, hn::Zero(di))));
-        const MF at_interface = hn::AndNot(in_med, live_mask);
+        MF in_med[kSets], at_interface[kSets];
+        bool any_in_medium = false;
+        for (int i = 0; i < kSets; ++i) {
+            in_med[i] =
+                hn::And(live_mask[i], hn::RebindMask(df, hn::Ne(v[i]->in_medium, hn::Zero(di))));
+            at_interface[i] = hn::AndNot(in_med[i], live_mask[i]);
+            any_in_medium = any_in_medium || !hn::AllFalse(df, in_med[i]);
+        }
         int group = 0;
         bool group_is_medium = false;
         std::size_t group_size = 0;
         for (int j = 0; j < n_layers_; ++j) {
-            const std::size_t at_j = hn::CountTrue(df, hn::And(at_interface, LaneIs(v.k, j)));
+            std::size_t at_j = 0;
+            for (int i = 0; i < kSets; ++i)
+                at_j += hn::CountTrue(df, hn::And(at_interface[i], LaneIs(v[i]->k, j)));
             if (at_j > group_size) {
                 group = j;
                 group_size = at_j;
             }
         }
-        if (!hn::AllFalse(df, in_med))
+        if (any_in_medium)
             for (int j = 0; j < n_layers_; ++j) {
                 if (!stack_.layers[j].medium.scatters) continue;
-                const std::size_t in_j = hn::CountTrue(df, hn::And(in_med, LaneIs(v.k, j)));
+                std::size_t in_j = 0;
+                for (int i = 0; i < kSets; ++i)
+                    in_j += hn::CountTrue(df, hn::And(in_med[i], LaneIs(v[i]->k, j)));
                 if (in_j > group_size) {
                     group = j;
                     group_is_medium = true;
                     group_size = in_j;
                 }
             }
-        return {group, group_is_medium,
-                hn::And(group_is_medium ? in_med : at_interface, LaneIs(v.k, group))};
+        Group<kSets> g{group, group_is_medium, {}};
+        for (int i = 0; i < kSets; ++i)
+            g.lanes[i] =
+                hn::And(group_is_medium ? in_med[i] : at_interface[i], LaneIs(v[i]->k, group));
+        return g;
     }
 
-    // The queued particles through the lanes, one group's step at a time, until the queue is
-    // empty and every lane retired.
-    void Steps() {
+    // Set s (the kernel's set `index`) given its first particles from the queue.
+    HWY_INLINE void Start(LaneSet& s, int index) {
+        Clear(s.v);
+        s.v.set = index;
+        for (std::size_t l = 0; l < n_lanes_; ++l)
+            TakeParticle(s.rng, l);
+        s.rng.SyncIn();
+        Restart(s.v, hn::FirstN(DF(), n_lanes_));
+    }
+
+    // The start of a step of set s: its float sums flushed every kFlushSteps steps, its lanes'
+    // ends cleared; returns its live lanes.
+    HWY_INLINE MF BeginStep(LaneSet& s) {
         const DF df;
         const DI di;
-        may_suspend_ = true;
-        LaneVectors v;
-        Clear(v);
-        for (std::size_t l = 0; l < n_lanes_; ++l)
-            TakeParticle(l);
-        rng_.SyncIn();
-        Restart(v, hn::FirstN(df, n_lanes_));
-
-        int steps_since_flush = 0;
-        while (true) {
-            if (++steps_since_flush == kFlushSteps) {
-                Flush(v);
-                steps_since_flush = 0;
-            }
-            v.finish = hn::Zero(di);
-            const MF live_mask = hn::RebindMask(df, hn::Ne(v.live, hn::Zero(di)));
-            if (hn::AllFalse(df, live_mask)) break;
-            const Group group = PickGroup(v, live_mask);
-
-            // Cut-off (trace_particle: checked before every event; a suspended walk is the event
-            // already begun).
-            const MF cut = hn::AndNot(
-                MidWalk(v, group.lanes),
-                hn::And(group.lanes,
-                        hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job_.max_events - 1)))));
-            if (!hn::AllFalse(df, cut)) v.Keep(cut, kLossCutOff, zero_);
-            v.End(cut, kEnded);
-            const MF going = hn::AndNot(cut, group.lanes);
-
-            if (group.is_medium) {
-                // ---- A scattering-medium step ----
-                const CompiledMedium<float>& med = stack_.layers[group.layer].medium;
-                if constexpr (kSpectral)
-                    ScatteringStep<kPolarized>(SpectralMedium(med, group.layer, v.at), going, v,
-                                               rng_);
-                else
-                    ScatteringStep<kPolarized>(med, going, v, rng_);
-                v.End(hn::And(going, v.Black()), kEnded);
-            } else {
-                InterfaceStep(v, rng_, group.layer, going);
-            }
-            const MF ended = hn::RebindMask(df, hn::Ne(v.finish, hn::Zero(di)));
-            if (hn::AllFalse(df, ended)) continue;
-            rng_.SyncOut();
-            EndParticles(v, ended, [this](std::size_t l) { TakeParticle(l); });
-            rng_.SyncIn();
-            Restart(v, ended);
+        if (++s.steps_since_flush == kFlushSteps) {
+            Flush(s.v);
+            s.steps_since_flush = 0;
         }
-        Flush(v);
-        sums_.add_events(v.events_done);
+        s.v.finish = hn::Zero(di);
+        return hn::RebindMask(df, hn::Ne(s.v.live, hn::Zero(di)));
+    }
+
+    // The lanes of the group that go on to their event: the cut-off (trace_particle: checked
+    // before every event; a suspended walk is the event already begun) ends the others.
+    HWY_INLINE MF CutOff(LaneVectors& v, MF lanes) {
+        const DF df;
+        const DI di;
+        const MF cut = hn::AndNot(
+            MidWalk(v, lanes),
+            hn::And(lanes, hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job_.max_events - 1)))));
+        if (!hn::AllFalse(df, cut)) v.Keep(cut, kLossCutOff, zero_);
+        v.End(cut, kEnded);
+        return hn::AndNot(cut, lanes);
+    }
+
+    // A scattering-medium step of set s's lanes of `going`, inside layer `layer`'s medium.
+    HWY_INLINE void MediumStep(LaneSet& s, int layer, MF going) {
+        const CompiledMedium<float>& med = stack_.layers[layer].medium;
+        if constexpr (kSpectral)
+            ScatteringStep<kPolarized>(SpectralMedium(med, layer, s.v.at), going, s.v, s.rng);
+        else
+            ScatteringStep<kPolarized>(med, going, s.v, s.rng);
+        s.v.End(hn::And(going, s.v.Black()), kEnded);
+    }
+
+    // The end of a step of set s: its ended lanes' tallies and refills from the queue.
+    HWY_INLINE void EndStep(LaneSet& s) {
+        const DF df;
+        const DI di;
+        const MF ended = hn::RebindMask(df, hn::Ne(s.v.finish, hn::Zero(di)));
+        if (hn::AllFalse(df, ended)) return;
+        s.rng.SyncOut();
+        EndParticles(s.v, ended, [this, &s](std::size_t l) { TakeParticle(s.rng, l); });
+        s.rng.SyncIn();
+        Restart(s.v, ended);
+    }
+
+    // One step of set s's lanes: one group's event or free flight, then the ended lanes' tallies
+    // and refills from the queue. False once none of its lanes lives.
+    HWY_INLINE bool Step(LaneSet& s) {
+        const MF live[1] = {BeginStep(s)};
+        if (hn::AllFalse(DF(), live[0])) return false;
+        const LaneVectors* const vs[1] = {&s.v};
+        const Group<1> group = PickGroup<1>(vs, live);
+        const MF going = CutOff(s.v, group.lanes[0]);
+        if (group.is_medium)
+            MediumStep(s, group.layer, going);
+        else
+            InterfaceStep(s.v, s.rng, group.layer, going);
+        EndStep(s);
+        return true;
+    }
+
+    // One step of two sets together, at the group largest over both (each set's lanes of it
+    // step): an interface's event then runs on the pair of their vectors where it can
+    // (InterfaceStepPair). False once either set has no live lane (nothing done then).
+    HWY_INLINE bool StepPair(LaneSet& s, LaneSet& t) {
+        const MF live[2] = {BeginStep(s), BeginStep(t)};
+        if (hn::AllFalse(DF(), live[0]) || hn::AllFalse(DF(), live[1])) return false;
+        const LaneVectors* const vs[2] = {&s.v, &t.v};
+        const Group<2> group = PickGroup<2>(vs, live);
+        const MF going_s = CutOff(s.v, group.lanes[0]);
+        const MF going_t = CutOff(t.v, group.lanes[1]);
+        if (group.is_medium) {
+            MediumStep(s, group.layer, going_s);
+            MediumStep(t, group.layer, going_t);
+        } else {
+            InterfaceStepPair(s, t, group.layer, going_s, going_t);
+        }
+        EndStep(s);
+        EndStep(t);
+        return true;
+    }
+
+    // The queued particles through the lanes of two sets, stepped together (StepPair) until one
+    // of them has no live lane, then the other alone (Step), until the queue is empty and every
+    // lane retired.
+    void Steps() {
+        may_suspend_ = true;
+        LaneSet sets[2];
+        for (int i = 0; i < 2; ++i)
+            Start(sets[i], i);
+        while (StepPair(sets[0], sets[1])) {
+        }
+        for (LaneSet& s : sets)
+            while (Step(s)) {
+            }
+        for (LaneSet& s : sets) {
+            Flush(s.v);
+            sums_.add_events(s.v.events_done);
+        }
     }
 
     const BlockJob& job_;
@@ -1031,8 +1206,6 @@ class BlockTracer {
     [[maybe_unused]] HWY_ALIGN float stokes_out_[3][4][kMaxLanes];
     const bool stokes_tallies_;
 
-    // The main loop's generators.
-    LaneRng rng_;
     // Compress (Enqueue) on vectors where they hold 16 lanes or more: AVX-512 has it as one
     // instruction; with fewer lanes Highway 1.0 builds it from a table of permutations, which it
     // copies onto the stack at every call (the AVX2 kernel ran 23 % slower with it), and the lanes
@@ -1045,11 +1218,12 @@ class BlockTracer {
     std::uint64_t taking_ = 0;    // the lanes given one since (bit l for lane l)
 
     // Spectral runs: the staged lanes' stacks, heroes, groups and secondaries; the ended lanes'
-    // stacks and groups (StageSpectral); each lane's particle's losses (Flush); the block's sums.
+    // stacks and groups (StageSpectral); each lane's particle's losses, per lane set (Flush); the
+    // block's sums.
     [[maybe_unused]] HWY_ALIGN std::int32_t s_at_[kMaxLanes], s_hero_[kMaxLanes],
         s_group_[kMaxLanes], s_secondaries_[kMaxLanes];
     [[maybe_unused]] HWY_ALIGN std::int32_t at_out_[kMaxLanes], group_out_[kMaxLanes];
-    [[maybe_unused]] HWY_ALIGN double particle_loss_[kLossTerms][3][kMaxLanes];
+    [[maybe_unused]] HWY_ALIGN double particle_loss_[2][kLossTerms][3][kMaxLanes];
     BlockBudget* block_ = nullptr;
 };
 

@@ -9,6 +9,8 @@
 #include "physics/fresnel.h"
 #include "physics/polarization.h"
 
+#include <type_traits>
+
 // Highway's per-target include guard: the body once per instruction set.
 #if defined(LAMINA_SIMULATOR_LANE_CONDUCTOR_H) == defined(HWY_TARGET_TOGGLE)
 #ifdef LAMINA_SIMULATOR_LANE_CONDUCTOR_H
@@ -26,32 +28,41 @@ HWY_INLINE VF FresnelConductor(VF cos_theta, float eta, float k) {
     return fresnel_conductor<VF, VecLane>(cos_theta, hn::Set(df, eta), hn::Set(df, k));
 }
 
+// The operations struct of the lanes of T: a vector's (VecLane) or a pair's (VecLane2, the
+// kernel's two lane sets at one event).
+template <typename T>
+using PairOr = std::conditional_t<std::is_same_v<T, VF2>, VecLane2, VecLane>;
+
 // The conductor's Fresnel factors per channel at the facet cosine (fresnel.h fresnel_conductor,
-// the same template); channels with the same index share the computation.
+// the same template) on a vector or a pair of vectors; channels with the same index share the
+// computation.
 struct ConductorFresnel {
     const ConductorInterface<float>& iface;
-    HWY_INLINE void operator()(VF cos_theta, VF* factors) const {
+    template <typename T, typename L = PairOr<T>>
+    HWY_INLINE void operator()(T cos_theta, T* factors) const {
         for (int c = 0; c < 3; ++c) {
             const bool same =
                 c > 0 && iface.eta[c] == iface.eta[c - 1] && iface.k[c] == iface.k[c - 1];
-            factors[c] =
-                same ? factors[c - 1] : FresnelConductor(cos_theta, iface.eta[c], iface.k[c]);
+            factors[c] = same ? factors[c - 1]
+                              : fresnel_conductor<T, L>(cos_theta, L::constant(iface.eta[c]),
+                                                        L::constant(iface.k[c]));
         }
     }
 };
 
 // The conductor's reflection Mueller matrices per channel (polarization.h
-// fresnel_conductor_mueller, the same template); channels with the same index share them.
+// fresnel_conductor_mueller, the same template) on a vector or a pair of vectors; channels with
+// the same index share them.
 struct ConductorMueller {
     const ConductorInterface<float>& iface;
-    HWY_INLINE void operator()(VF cos_theta, InterfaceMueller<VF>* m) const {
-        const DF df;
+    template <typename T, typename L = PairOr<T>>
+    HWY_INLINE void operator()(T cos_theta, InterfaceMueller<T>* m) const {
         for (int c = 0; c < 3; ++c) {
             const bool same =
                 c > 0 && iface.eta[c] == iface.eta[c - 1] && iface.k[c] == iface.k[c - 1];
             m[c] = same ? m[c - 1]
-                        : fresnel_conductor_mueller<VF, VecLane>(
-                              cos_theta, hn::Set(df, iface.eta[c]), hn::Set(df, iface.k[c]));
+                        : fresnel_conductor_mueller<T, L>(cos_theta, L::constant(iface.eta[c]),
+                                                          L::constant(iface.k[c]));
         }
     }
 };

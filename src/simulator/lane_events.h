@@ -62,6 +62,7 @@ struct LaneVectors {
     VI mid_walk;
     VF walk_h, walk_side, walk_order, walk_weight[3];
     bool touched[kLossTerms] = {};  // loss terms some lane may have booked in this block
+    int set = 0;  // which of the kernel's lane sets these lanes are (its per-lane records)
     // Polarized runs: the lanes' polarization (physics/polarization.h); pol.flux points at w.
     PolarizationLanes<VF> pol;
 
@@ -105,18 +106,56 @@ HWY_INLINE GgxLanes<VF, kAnisotropic> VecGgx(const GGX<float>& ggx) {
             hn::Set(df, g.d_alpha2), hn::Set(df, g.bx),     hn::Set(df, g.by)};
 }
 
+// The same on a pair of vectors (VecLane2).
+template <bool kAnisotropic>
+HWY_INLINE GgxLanes<VF2, kAnisotropic> VecGgxPair(const GGX<float>& ggx) {
+    const auto g = VecGgx<kAnisotropic>(ggx);
+    return {{g.alpha, g.alpha},       {g.alpha2, g.alpha2}, {g.d_alpha, g.d_alpha},
+            {g.d_alpha2, g.d_alpha2}, {g.bx, g.bx},         {g.by, g.by}};
+}
+
+// Two lane sets' polarization states as their pair's (the sets' channels alike), their fluxes
+// `flux` (the pair's), and back.
+HWY_INLINE PolarizationLanes<VF2> PairPolarization(const PolarizationLanes<VF>& a,
+                                                   const PolarizationLanes<VF>& b,
+                                                   const VF2* flux) {
+    PolarizationLanes<VF2> p;
+    p.stokes.x = Pair(a.stokes.x, b.stokes.x);
+    for (int c = 0; c < 3; ++c) {
+        p.stokes.q[c] = {a.stokes.q[c], b.stokes.q[c]};
+        p.stokes.u[c] = {a.stokes.u[c], b.stokes.u[c]};
+        p.stokes.v[c] = {a.stokes.v[c], b.stokes.v[c]};
+        p.factor[c] = {a.factor[c], b.factor[c]};
+    }
+    p.channels = a.channels;
+    p.flux = flux;
+    return p;
+}
+HWY_INLINE void SplitPolarization(const PolarizationLanes<VF2>& p, PolarizationLanes<VF>& a,
+                                  PolarizationLanes<VF>& b) {
+    a.stokes.x = First(p.stokes.x);
+    b.stokes.x = Second(p.stokes.x);
+    for (int c = 0; c < 3; ++c) {
+        a.stokes.q[c] = p.stokes.q[c].a;
+        b.stokes.q[c] = p.stokes.q[c].b;
+        a.stokes.u[c] = p.stokes.u[c].a;
+        b.stokes.u[c] = p.stokes.u[c].b;
+        a.stokes.v[c] = p.stokes.v[c].a;
+        b.stokes.v[c] = p.stokes.v[c].b;
+        a.factor[c] = p.factor[c].a;
+        b.factor[c] = p.factor[c].b;
+    }
+}
+
 // A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
 // instantiates at one lane): the particle arrives along d (wi = −d), the relative index eta (and
 // its inverse) per lane: the interface's, or a spectral lane's. Polarized (kPolarized): the
 // event's polarized form on the lanes' states; where the channels' states differ, its reweighting
 // of the channels is booked with the base, as trace_particle does.
-template <bool kPolarized, bool kAnisotropic>
-HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, VF eta, VF inv_eta, MF m,
-                                LaneVectors& v, VF uc, VF u1, VF u2, MF& degenerate) {
-    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
-    const InterfaceEventLanes<VF, MF> e = dielectric_event<VF, VecLane, kPolarized>(
-        eta, inv_eta, VecGgx<kAnisotropic>(iface.distribution()), iface.event_shape(), wi, uc, u1,
-        u2, m, kPolarized ? &v.pol : nullptr);
+template <bool kPolarized>
+HWY_INLINE void KeepDielectricEvent(const DielectricInterface<float>& iface,
+                                    const InterfaceEventLanes<VF, MF>& e, MF m, LaneVectors& v,
+                                    MF& degenerate) {
     degenerate = hn::Or(degenerate, e.degenerate);
     const MF ok = hn::AndNot(e.degenerate, m);
     if constexpr (kPolarized)
@@ -124,11 +163,48 @@ HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, VF eta,
     if (!iface.is_smooth()) v.Keep(ok, kLossMicro, e.shadowing);
     v.d = Select(ok, e.wo, v.d);
 }
+template <bool kPolarized, bool kAnisotropic>
+HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, VF eta, VF inv_eta, MF m,
+                                LaneVectors& v, VF uc, VF u1, VF u2, MF& degenerate) {
+    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
+    KeepDielectricEvent<kPolarized>(
+        iface,
+        dielectric_event<VF, VecLane, kPolarized>(
+            eta, inv_eta, VecGgx<kAnisotropic>(iface.distribution()), iface.event_shape(), wi, uc,
+            u1, u2, m, kPolarized ? &v.pol : nullptr),
+        m, v, degenerate);
+}
+
+// The same event (unpolarized) on two lane sets at once, the template instantiated on their pair
+// (VecLane2): the two sets' lanes m and n, their numbers uc, u1, u2 (first and second vector).
+template <bool kAnisotropic>
+HWY_INLINE void DielectricEventPair(const DielectricInterface<float>& iface, VF eta, VF inv_eta,
+                                    MF m, MF n, LaneVectors& v, LaneVectors& w, VF2 uc, VF2 u1,
+                                    VF2 u2, MF& degenerate_v, MF& degenerate_w) {
+    const GgxLanes<VF2, kAnisotropic> g2 = VecGgxPair<kAnisotropic>(iface.distribution());
+    const LaneVec3<VF2> wi = Pair({hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)},
+                                  {hn::Neg(w.d.x), hn::Neg(w.d.y), hn::Neg(w.d.z)});
+    const InterfaceEventLanes<VF2, MF2> e = dielectric_event<VF2, VecLane2, false>(
+        {eta, eta}, {inv_eta, inv_eta}, g2, iface.event_shape(), wi, uc, u1, u2, {m, n});
+    KeepDielectricEvent<false>(iface, {First(e.wo), e.shadowing.a, e.reflected.a, e.degenerate.a},
+                               m, v, degenerate_v);
+    KeepDielectricEvent<false>(iface, {Second(e.wo), e.shadowing.b, e.reflected.b, e.degenerate.b},
+                               n, w, degenerate_w);
+}
 
 // A rough or smooth conductor (conductor.h conductor_event, the same template): light from above
 // only. Polarized: the Fresnel factors are the reflected fractions of the lanes' states. The
 // reflection at a facet comes from `fresnel_of` and `mueller_of` (lane_conductor.h: the bare
 // conductor's; a filmed conductor's, FilmReflection).
+HWY_INLINE void KeepConductorEvent(const ConductorInterface<float>& iface,
+                                   const InterfaceEventLanes<VF, MF>& e, const VF fresnel[3], MF m,
+                                   LaneVectors& v, MF& degenerate) {
+    degenerate = hn::Or(degenerate, e.degenerate);
+    const MF ok = hn::AndNot(e.degenerate, m);
+    v.Keep(ok, kLossBase, fresnel);
+    if (!iface.is_smooth()) v.Keep(ok, kLossMicro, e.shadowing);
+    v.d = Select(ok, e.wo, v.d);
+}
 template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
 HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, const Fresnel& fresnel_of,
                                const Mueller& mueller_of, MF m, LaneVectors& v, VF u1, VF u2,
@@ -144,11 +220,40 @@ HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, const Fre
         e = conductor_event<VF, VecLane>(VecGgx<kAnisotropic>(iface.distribution()),
                                          iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
                                          u2, m, fresnel_of, fresnel);
-    degenerate = hn::Or(degenerate, e.degenerate);
-    const MF ok = hn::AndNot(e.degenerate, m);
-    v.Keep(ok, kLossBase, fresnel);
-    if (!iface.is_smooth()) v.Keep(ok, kLossMicro, e.shadowing);
-    v.d = Select(ok, e.wo, v.d);
+    KeepConductorEvent(iface, e, fresnel, m, v, degenerate);
+}
+
+// The bare conductor's event on two lane sets at once (VecLane2; DielectricEventPair), its
+// reflection ConductorFresnel and ConductorMueller on the pair; polarized, the states' channels
+// alike.
+template <bool kPolarized, bool kAnisotropic>
+HWY_INLINE void ConductorEventPair(const ConductorInterface<float>& iface, MF m, MF n,
+                                   LaneVectors& v, LaneVectors& w, VF2 u1, VF2 u2, MF& degenerate_v,
+                                   MF& degenerate_w) {
+    const LaneVec3<VF2> wi = Pair({hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)},
+                                  {hn::Neg(w.d.x), hn::Neg(w.d.y), hn::Neg(w.d.z)});
+    const ConductorFresnel fresnel_of{iface};
+    VF2 fresnel[3];
+    InterfaceEventLanes<VF2, MF2> e;
+    if constexpr (kPolarized) {
+        const VF2 flux[3] = {{v.w[0], w.w[0]}, {v.w[1], w.w[1]}, {v.w[2], w.w[2]}};
+        PolarizationLanes<VF2> pol = PairPolarization(v.pol, w.pol, flux);
+        e = conductor_event<VF2, VecLane2>(VecGgxPair<kAnisotropic>(iface.distribution()),
+                                           iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
+                                           u2, MF2{m, n}, fresnel_of, fresnel, &pol,
+                                           ConductorMueller{iface});
+        SplitPolarization(pol, v.pol, w.pol);
+    } else {
+        e = conductor_event<VF2, VecLane2>(VecGgxPair<kAnisotropic>(iface.distribution()),
+                                           iface.is_smooth(), iface.uncorrelated_shadowing, wi, u1,
+                                           u2, MF2{m, n}, fresnel_of, fresnel);
+    }
+    const VF fresnel_v[3] = {fresnel[0].a, fresnel[1].a, fresnel[2].a};
+    const VF fresnel_w[3] = {fresnel[0].b, fresnel[1].b, fresnel[2].b};
+    KeepConductorEvent(iface, {First(e.wo), e.shadowing.a, e.reflected.a, e.degenerate.a},
+                       fresnel_v, m, v, degenerate_v);
+    KeepConductorEvent(iface, {Second(e.wo), e.shadowing.b, e.reflected.b, e.degenerate.b},
+                       fresnel_w, n, w, degenerate_w);
 }
 
 // A rough interface with multiple scattering on its microsurface (physics/microsurface_walk.h
@@ -164,27 +269,24 @@ HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, const Fre
 // direction of travel): they wait at the interface, and go on the next time the kernel steps it
 // (the lanes of m with mid_walk set), beside the lanes that arrive there, instead of holding the
 // vector for the few more facets most of them need. Nothing is booked for a suspended lane.
-template <bool kAnisotropic, typename Facet>
-HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, const Facet& facet,
-                                      MF m, LaneVectors& v, LaneRng& rng, int max_order,
-                                      MF& degenerate, bool may_suspend, bool weighted = false) {
+// The lanes of m whose walks were suspended (v.mid_walk) and where they stand.
+HWY_INLINE MF ResumedWalks(const LaneVectors& v, MF m) {
+    return hn::And(m, hn::RebindMask(DF(), hn::Ne(v.mid_walk, hn::Zero(DI()))));
+}
+HWY_INLINE MicrosurfaceWalkResume<VF, MF> WalkResume(const LaneVectors& v, MF resumed) {
+    return {resumed,
+            v.walk_h,
+            v.walk_side,
+            v.walk_order,
+            {v.walk_weight[0], v.walk_weight[1], v.walk_weight[2]}};
+}
+
+// What the walk of the lanes of m did, booked on v (MicrosurfaceWalkEvent).
+HWY_INLINE void KeepWalk(const MicrosurfaceWalkLanes<VF, MF>& walk, MF m, LaneVectors& v,
+                         bool two_sided, bool weighted, MF& degenerate) {
     const DF df;
     const DI di;
     const VF zero = hn::Zero(df);
-    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
-    auto draw = [&] { return rng.Uniform(); };
-    const MF resumed = hn::And(m, hn::RebindMask(df, hn::Ne(v.mid_walk, hn::Zero(di))));
-    const MicrosurfaceWalkResume<VF, MF> resume{
-        resumed,
-        v.walk_h,
-        v.walk_side,
-        v.walk_order,
-        {v.walk_weight[0], v.walk_weight[1], v.walk_weight[2]}};
-    const std::size_t quarter = hn::Lanes(df) / 4;
-    auto suspend = [&](MF walking) { return may_suspend && hn::CountTrue(df, walking) <= quarter; };
-    const MicrosurfaceWalkLanes<VF, MF> walk = microsurface_walk<VF, VecLane>(
-        VecGgx<kAnisotropic>(ggx), wi, m, two_sided, facet, draw, max_order, MicrosurfaceNoVisit{},
-        hn::AllFalse(df, resumed) ? nullptr : &resume, suspend);
     degenerate = hn::Or(degenerate, walk.degenerate);
     if (!two_sided || weighted) v.Keep(walk.escaped, kLossBase, walk.weight);
     v.Keep(walk.capped, kLossMicro, zero);
@@ -200,6 +302,78 @@ HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, con
         v.walk_weight[c] = hn::IfThenElse(walk.suspended, walk.weight[c], v.walk_weight[c]);
 }
 
+template <bool kAnisotropic, typename Facet>
+HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, const Facet& facet,
+                                      MF m, LaneVectors& v, LaneRng& rng, int max_order,
+                                      MF& degenerate, bool may_suspend, bool weighted = false) {
+    const DF df;
+    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
+    auto draw = [&] { return rng.Uniform(); };
+    const MF resumed = ResumedWalks(v, m);
+    const MicrosurfaceWalkResume<VF, MF> resume = WalkResume(v, resumed);
+    const std::size_t quarter = hn::Lanes(df) / 4;
+    auto suspend = [&](MF walking) { return may_suspend && hn::CountTrue(df, walking) <= quarter; };
+    KeepWalk(microsurface_walk<VF, VecLane>(VecGgx<kAnisotropic>(ggx), wi, m, two_sided, facet,
+                                            draw, max_order, MicrosurfaceNoVisit{},
+                                            hn::AllFalse(df, resumed) ? nullptr : &resume, suspend),
+             m, v, two_sided, weighted, degenerate);
+}
+
+// The same walks on two lane sets at once (VecLane2): the lanes of m of v and of n of w, their
+// numbers drawn from rng_v and rng_w; the suspension rule counts the lanes of both (a quarter of
+// the pair's). The facet is the pair's.
+template <bool kAnisotropic, typename Facet>
+HWY_INLINE void MicrosurfaceWalkEventPair(const GGX<float>& ggx, bool two_sided, const Facet& facet,
+                                          MF m, MF n, LaneVectors& v, LaneVectors& w,
+                                          LaneRng& rng_v, LaneRng& rng_w, int max_order,
+                                          MF& degenerate_v, MF& degenerate_w, bool may_suspend,
+                                          bool weighted = false) {
+    const DF df;
+    const LaneVec3<VF2> wi = Pair({hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)},
+                                  {hn::Neg(w.d.x), hn::Neg(w.d.y), hn::Neg(w.d.z)});
+    auto draw = [&] {
+        const VF a = rng_v.Uniform();
+        const VF b = rng_w.Uniform();
+        return VF2{a, b};
+    };
+    const MF2 resumed{ResumedWalks(v, m), ResumedWalks(w, n)};
+    const MicrosurfaceWalkResume<VF, MF> rv = WalkResume(v, resumed.a),
+                                         rw = WalkResume(w, resumed.b);
+    const MicrosurfaceWalkResume<VF2, MF2> resume{
+        resumed,
+        {rv.h, rw.h},
+        {rv.side, rw.side},
+        {rv.order, rw.order},
+        {{rv.weight[0], rw.weight[0]}, {rv.weight[1], rw.weight[1]}, {rv.weight[2], rw.weight[2]}}};
+    const std::size_t quarter = 2 * hn::Lanes(df) / 4;
+    auto suspend = [&](MF2 walking) {
+        return may_suspend &&
+               hn::CountTrue(df, walking.a) + hn::CountTrue(df, walking.b) <= quarter;
+    };
+    const GgxLanes<VF2, kAnisotropic> g2 = VecGgxPair<kAnisotropic>(ggx);
+    const MicrosurfaceWalkLanes<VF2, MF2> walk = microsurface_walk<VF2, VecLane2>(
+        g2, wi, MF2{m, n}, two_sided, facet, draw, max_order, MicrosurfaceNoVisit{},
+        VecLane2::none(resumed) ? nullptr : &resume, suspend);
+    auto part = [&](bool second) {
+        auto pick = [second](VF2 x) { return second ? x.b : x.a; };
+        auto pick_m = [second](MF2 x) { return second ? x.b : x.a; };
+        MicrosurfaceWalkLanes<VF, MF> r;
+        r.wo = second ? Second(walk.wo) : First(walk.wo);
+        for (int c = 0; c < 3; ++c)
+            r.weight[c] = pick(walk.weight[c]);
+        r.order = pick(walk.order);
+        r.escaped = pick_m(walk.escaped);
+        r.capped = pick_m(walk.capped);
+        r.degenerate = pick_m(walk.degenerate);
+        r.suspended = pick_m(walk.suspended);
+        r.h = pick(walk.h);
+        r.side = pick(walk.side);
+        return r;
+    };
+    KeepWalk(part(false), m, v, two_sided, weighted, degenerate_v);
+    KeepWalk(part(true), n, w, two_sided, weighted, degenerate_w);
+}
+
 template <bool kPolarized, bool kAnisotropic>
 HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, VF eta, VF inv_eta,
                                     MF m, LaneVectors& v, LaneRng& rng, int max_order,
@@ -209,6 +383,29 @@ HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, VF 
         eta, inv_eta, draw, kPolarized ? &v.pol : nullptr};
     MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), true, facet, m, v, rng, max_order,
                                         degenerate, may_suspend, kPolarized && v.pol.channels == 3);
+}
+
+// DielectricWalkEvent on two lane sets at once (MicrosurfaceWalkEventPair); polarized, their
+// states' channels alike.
+template <bool kPolarized, bool kAnisotropic>
+HWY_INLINE void DielectricWalkEventPair(const DielectricInterface<float>& iface, VF eta, VF inv_eta,
+                                        MF m, MF n, LaneVectors& v, LaneVectors& w, LaneRng& rng_v,
+                                        LaneRng& rng_w, int max_order, MF& degenerate_v,
+                                        MF& degenerate_w, bool may_suspend) {
+    auto draw = [&] {
+        const VF a = rng_v.Uniform();
+        const VF b = rng_w.Uniform();
+        return VF2{a, b};
+    };
+    const VF2 flux[3] = {{v.w[0], w.w[0]}, {v.w[1], w.w[1]}, {v.w[2], w.w[2]}};
+    PolarizationLanes<VF2> pol;
+    if constexpr (kPolarized) pol = PairPolarization(v.pol, w.pol, flux);
+    const MicrosurfaceDielectricFacet<VF2, VecLane2, decltype(draw), kPolarized> facet{
+        {eta, eta}, {inv_eta, inv_eta}, draw, kPolarized ? &pol : nullptr};
+    MicrosurfaceWalkEventPair<kAnisotropic>(iface.distribution(), true, facet, m, n, v, w, rng_v,
+                                            rng_w, max_order, degenerate_v, degenerate_w,
+                                            may_suspend, kPolarized && v.pol.channels == 3);
+    if constexpr (kPolarized) SplitPolarization(pol, v.pol, w.pol);
 }
 
 template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
@@ -224,6 +421,33 @@ HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, const
         const MicrosurfaceConductorFacet<VF, VecLane, Fresnel> facet{fresnel};
         MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
                                             max_order, degenerate, may_suspend);
+    }
+}
+
+// ConductorWalkEvent on two lane sets at once (MicrosurfaceWalkEventPair): the bare conductor's
+// reflection (ConductorFresnel, ConductorMueller on the pair); polarized, the states' channels
+// alike.
+template <bool kPolarized, bool kAnisotropic>
+HWY_INLINE void ConductorWalkEventPair(const ConductorInterface<float>& iface, MF m, MF n,
+                                       LaneVectors& v, LaneVectors& w, LaneRng& rng_v,
+                                       LaneRng& rng_w, int max_order, MF& degenerate_v,
+                                       MF& degenerate_w, bool may_suspend) {
+    const ConductorFresnel fresnel{iface};
+    const VF2 flux[3] = {{v.w[0], w.w[0]}, {v.w[1], w.w[1]}, {v.w[2], w.w[2]}};
+    if constexpr (kPolarized) {
+        const ConductorMueller mueller{iface};
+        PolarizationLanes<VF2> pol = PairPolarization(v.pol, w.pol, flux);
+        const MicrosurfaceConductorFacet<VF2, VecLane2, ConductorFresnel, ConductorMueller> facet{
+            fresnel, &pol, &mueller};
+        MicrosurfaceWalkEventPair<kAnisotropic>(iface.distribution(), false, facet, m, n, v, w,
+                                                rng_v, rng_w, max_order, degenerate_v, degenerate_w,
+                                                may_suspend);
+        SplitPolarization(pol, v.pol, w.pol);
+    } else {
+        const MicrosurfaceConductorFacet<VF2, VecLane2, ConductorFresnel> facet{fresnel};
+        MicrosurfaceWalkEventPair<kAnisotropic>(iface.distribution(), false, facet, m, n, v, w,
+                                                rng_v, rng_w, max_order, degenerate_v, degenerate_w,
+                                                may_suspend);
     }
 }
 
@@ -264,16 +488,30 @@ HWY_NOINLINE void FilmConductorEvent(const CompiledLayer<float>& layer,
 // weight = albedo (per channel and lane: the interface's, or a spectral lane's); it depolarizes
 // (polarized runs).
 template <bool kPolarized>
-HWY_INLINE void LambertianEvent(const VF albedo[3], MF m, LaneVectors& v, VF u1, VF u2,
-                                MF& degenerate) {
+HWY_INLINE void KeepLambertianEvent(const VF albedo[3], MF m, LaneVectors& v, const V3& wo,
+                                    MF& degenerate) {
     const DF df;
     const MF bad = hn::And(m, hn::Eq(v.d.z, hn::Zero(df)));
     degenerate = hn::Or(degenerate, bad);
     const MF ok = hn::AndNot(bad, m);
-    const V3 wo = lambertian_event<VF, VecLane>(hn::Neg(v.d.z), u1, u2);
     v.Keep(ok, kLossBase, albedo);
     v.d = Select(ok, wo, v.d);
     if constexpr (kPolarized) stokes_depolarize<VF, VecLane>(v.pol.stokes, 3, ok);
+}
+template <bool kPolarized>
+HWY_INLINE void LambertianEvent(const VF albedo[3], MF m, LaneVectors& v, VF u1, VF u2,
+                                MF& degenerate) {
+    KeepLambertianEvent<kPolarized>(
+        albedo, m, v, lambertian_event<VF, VecLane>(hn::Neg(v.d.z), u1, u2), degenerate);
+}
+// The same event on two lane sets at once (VecLane2; DielectricEventPair).
+template <bool kPolarized>
+HWY_INLINE void LambertianEventPair(const VF albedo[3], MF m, MF n, LaneVectors& v, LaneVectors& w,
+                                    VF2 u1, VF2 u2, MF& degenerate_v, MF& degenerate_w) {
+    const LaneVec3<VF2> wo =
+        lambertian_event<VF2, VecLane2>({hn::Neg(v.d.z), hn::Neg(w.d.z)}, u1, u2);
+    KeepLambertianEvent<kPolarized>(albedo, m, v, First(wo), degenerate_v);
+    KeepLambertianEvent<kPolarized>(albedo, n, w, Second(wo), degenerate_w);
 }
 
 // ---- Media (physics/medium.h, the templates the scalar kernel instantiates at one lane) -------

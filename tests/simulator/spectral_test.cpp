@@ -114,35 +114,39 @@ TEST(SpectralStat, GreyStackIsTheRgbTable) {
         SimulationSettings spectral = spectral_settings({30}, 1'500'000, grid, 6, kernel);
         spectral.spectral_bins = 6;
         const auto b = simulate(stack, spectral);
-        // A direction's six wavelength bins share one expectation, the RGB table's, and the RGB
-        // estimate's error: compared with it one by one, they would count that error six times
-        // (correlated terms, a χ² of larger variance than its count says). So the RGB table is
-        // compared with their mean, and the bins with each other by their spread about it:
-        // Σ_l (b_l − b̄)² / s̄², s̄² the mean of their variances, whose expectation is n − 1.
-        constexpr std::size_t kBins = 6;
+        // A direction's six wavelength bins share one expectation, the RGB table's. They are two
+        // estimates, not six: bin c·2 + g holds channel c of the particles of wavelength group g
+        // (docs/physics.md §10), and in a grey stack a particle's three wavelengths follow one path
+        // with equal fluxes, so the three channels of a group are the same number (checked
+        // exactly). The RGB table is compared with the groups' mean, and the two groups with each
+        // other: (g0 − g1)² / (s0² + s1²), one degree of freedom per direction.
+        constexpr std::size_t kBins = 6, kGroups = 2;
         test::TableComparison against_rgb, spread;
         const BinnedLobe& lobe = a.table.lobe(0, Side::Reflection);
         for (std::size_t j = 0; j < grid.size(); ++j) {
-            double mean = 0, variance = 0;
-            for (std::size_t l = 0; l < kBins; ++l) {
-                const std::size_t at = b.spectral.index(0, 0, j, l);
-                mean += b.spectral.f[at] / kBins;
-                variance += b.spectral.se[at] * b.spectral.se[at] / kBins;
+            double group_f[kGroups], group_se[kGroups];
+            for (std::size_t g = 0; g < kGroups; ++g) {
+                group_f[g] = b.spectral.f[b.spectral.index(0, 0, j, g)];
+                group_se[g] = b.spectral.se[b.spectral.index(0, 0, j, g)];
+                for (std::size_t c = 1; c < kBins / kGroups; ++c) {
+                    const std::size_t at = b.spectral.index(0, 0, j, c * kGroups + g);
+                    EXPECT_EQ(b.spectral.f[at], group_f[g]) << "bin " << j << " group " << g;
+                    EXPECT_EQ(b.spectral.se[at], group_se[g]) << "bin " << j << " group " << g;
+                }
             }
-            const double se = std::sqrt(lobe.se[j][0] * lobe.se[j][0] + variance / kBins);
+            const double mean = (group_f[0] + group_f[1]) / 2;
+            const double variance = (group_se[0] * group_se[0] + group_se[1] * group_se[1]) / 4;
+            const double se = std::sqrt(lobe.se[j][0] * lobe.se[j][0] + variance);
             if (se == 0) continue;
             const double z = (mean - lobe.f[j][0]) / se;
             ++against_rgb.bins;
             against_rgb.chi2 += z * z;
             against_rgb.max_abs_z = std::max(against_rgb.max_abs_z, std::abs(z));
             if (variance == 0) continue;
-            for (std::size_t l = 0; l < kBins; ++l) {
-                const double d = b.spectral.f[b.spectral.index(0, 0, j, l)] - mean;
-                spread.chi2 += d * d / variance;
-                spread.max_abs_z = std::max(
-                    spread.max_abs_z, std::abs(d) / std::sqrt(variance * (kBins - 1) / kBins));
-            }
-            spread.bins += kBins - 1;
+            const double z_groups = (group_f[0] - group_f[1]) / (2 * std::sqrt(variance));
+            ++spread.bins;
+            spread.chi2 += z_groups * z_groups;
+            spread.max_abs_z = std::max(spread.max_abs_z, std::abs(z_groups));
         }
         test::expect_agreement(against_rgb);
         test::expect_agreement(spread);

@@ -282,6 +282,65 @@ void InterfaceEventsForTest(int kind, const float* params, const std::int32_t* f
     }
 }
 
+// InterfaceEventsForTest on pairs of vectors (VecLane2): the lanes of io.base in
+// the first vector, the next vector's worth in the second.
+void InterfaceEventPairsForTest(int kind, const float* params, const std::int32_t* flags,
+                                const float* wi, const float* u, std::size_t n, float* wo,
+                                float* shadowing, float* fresnel, std::int32_t* reflected,
+                                std::int32_t* degenerate) {
+    const DF df;
+    LaneIo io[2] = {{df}, {df}};
+    io[0].n = io[1].n = n;
+    const std::size_t lanes = hn::Lanes(df);
+    for (std::size_t base = 0; base < n; base += 2 * lanes) {
+        io[0].base = base;
+        io[1].base = std::min(base + lanes, n);
+        auto pair = [&](const float* a, float pad) {
+            return VF2{io[0].Load(a, pad), io[1].Load(a, pad)};
+        };
+        const LaneVec3<VF2> w = Pair(io[0].Load3(wi), io[1].Load3(wi));
+        const VF2 uc = pair(u, 0.f), u1 = pair(u + n, 0.f), u2 = pair(u + 2 * n, 0.f);
+        const MF2 active{io[0].Active(), io[1].Active()};
+        InterfaceEventLanes<VF2, MF2> e;
+        if (kind == 0) {
+            const DielectricEventShape shape{flags[0] != 0, flags[1] != 0, flags[2] != 0,
+                                             flags[3] != 0};
+            const VF alpha = hn::Set(df, params[1]);
+            e = dielectric_event<VF2, VecLane2>(
+                VecLane2::constant(params[0]), VecLane2::constant(1.f / params[0]),
+                ggx_isotropic_lanes<VF2, VecLane2>(VF2{alpha, alpha}), shape, w, uc, u1, u2,
+                active);
+        } else if (kind == 1) {
+            ConductorInterface<float> iface{Rgbf(params[1], params[2], params[3]),
+                                            Rgbf(params[4], params[5], params[6]), params[0]};
+            const VF alpha = hn::Set(df, params[0]);
+            VF2 f[3];
+            e = conductor_event<VF2, VecLane2>(
+                ggx_isotropic_lanes<VF2, VecLane2>(VF2{alpha, alpha}), flags[0] != 0, flags[1] != 0,
+                w, u1, u2, active, ConductorFresnel{iface}, f);
+            for (int c = 0; c < 3; ++c) {
+                io[0].Store(f[c].a, fresnel + c * n);
+                io[1].Store(f[c].b, fresnel + c * n);
+            }
+        } else {
+            e.wo = lambertian_event<VF2, VecLane2>(w.z, u1, u2);
+            e.shadowing = VecLane2::constant(1);
+            e.reflected = active;
+            const VF zero = hn::Zero(df);
+            e.degenerate = {hn::And(active.a, hn::Eq(w.z.a, zero)),
+                            hn::And(active.b, hn::Eq(w.z.b, zero))};
+        }
+        io[0].Store3(First(e.wo), wo);
+        io[1].Store3(Second(e.wo), wo);
+        io[0].Store(e.shadowing.a, shadowing);
+        io[1].Store(e.shadowing.b, shadowing);
+        io[0].StoreMask(e.reflected.a, reflected);
+        io[1].StoreMask(e.reflected.b, reflected);
+        io[0].StoreMask(e.degenerate.a, degenerate);
+        io[1].StoreMask(e.degenerate.b, degenerate);
+    }
+}
+
 void FresnelMuellerForTest(int kind, const float* cos_theta, std::size_t n, float eta, float k,
                            float* out) {
     const DF df;
@@ -575,6 +634,7 @@ HWY_EXPORT(BeerLambertLanesForTest);
 HWY_EXPORT(MicrosurfaceWalkForTest);
 HWY_EXPORT(GgxLanesForTest);
 HWY_EXPORT(InterfaceEventsForTest);
+HWY_EXPORT(InterfaceEventPairsForTest);
 HWY_EXPORT(MediumStepForTest);
 HWY_EXPORT(FilmReflectionForTest);
 HWY_EXPORT(FresnelMuellerForTest);
@@ -663,7 +723,8 @@ void simd_ggx_lanes(float alpha, const std::vector<float>& w, const std::vector<
 
 SimdEventResult simd_interface_events(int kind, const std::vector<float>& params,
                                       const std::vector<std::int32_t>& flags,
-                                      const std::vector<float>& wi, const std::vector<float>& u) {
+                                      const std::vector<float>& wi, const std::vector<float>& u,
+                                      bool on_pairs) {
     select_simd_target();
     const std::size_t n = wi.size() / 3;
     SimdEventResult r;
@@ -672,9 +733,10 @@ SimdEventResult simd_interface_events(int kind, const std::vector<float>& params
     r.fresnel.assign(3 * n, 1.f);
     r.reflected.resize(n);
     r.degenerate.resize(n);
-    LAMINA_PROBE_DISPATCH(InterfaceEventsForTest)
-    (kind, params.data(), flags.data(), wi.data(), u.data(), n, r.wo.data(), r.shadowing.data(),
-     r.fresnel.data(), r.reflected.data(), r.degenerate.data());
+    const auto probe = on_pairs ? LAMINA_PROBE_DISPATCH(InterfaceEventPairsForTest)
+                                : LAMINA_PROBE_DISPATCH(InterfaceEventsForTest);
+    probe(kind, params.data(), flags.data(), wi.data(), u.data(), n, r.wo.data(),
+          r.shadowing.data(), r.fresnel.data(), r.reflected.data(), r.degenerate.data());
     return r;
 }
 

@@ -90,9 +90,12 @@ struct SimdEventResult {
     std::vector<float> wo, shadowing, fresnel;
     std::vector<std::int32_t> reflected, degenerate;
 };
+/// on_pairs: the template instantiated on pairs of vectors (VecLane2, the
+/// kernel's two lane sets at one event), particles j and j + (the vector's lanes) side by side.
 SimdEventResult simd_interface_events(int kind, const std::vector<float>& params,
                                       const std::vector<std::int32_t>& flags,
-                                      const std::vector<float>& wi, const std::vector<float>& u);
+                                      const std::vector<float>& wi, const std::vector<float>& u,
+                                      bool on_pairs = false);
 
 /// one scattering-medium step (physics/medium.h medium_free_flight, then
 /// medium_scatter for the lanes that scatter) on the dispatched instruction set's vectors, one
