@@ -319,61 +319,6 @@ HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, con
              m, v, two_sided, weighted, degenerate);
 }
 
-// The same walks on two lane sets at once (VecLane2): the lanes of m of v and of n of w, their
-// numbers drawn from rng_v and rng_w; the suspension rule counts the lanes of both (a quarter of
-// the pair's). The facet is the pair's.
-template <bool kAnisotropic, typename Facet>
-HWY_INLINE void MicrosurfaceWalkEventPair(const GGX<float>& ggx, bool two_sided, const Facet& facet,
-                                          MF m, MF n, LaneVectors& v, LaneVectors& w,
-                                          LaneRng& rng_v, LaneRng& rng_w, int max_order,
-                                          MF& degenerate_v, MF& degenerate_w, bool may_suspend,
-                                          bool weighted = false) {
-    const DF df;
-    const LaneVec3<VF2> wi = Pair({hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)},
-                                  {hn::Neg(w.d.x), hn::Neg(w.d.y), hn::Neg(w.d.z)});
-    auto draw = [&] {
-        const VF a = rng_v.Uniform();
-        const VF b = rng_w.Uniform();
-        return VF2{a, b};
-    };
-    const MF2 resumed{ResumedWalks(v, m), ResumedWalks(w, n)};
-    const MicrosurfaceWalkResume<VF, MF> rv = WalkResume(v, resumed.a),
-                                         rw = WalkResume(w, resumed.b);
-    const MicrosurfaceWalkResume<VF2, MF2> resume{
-        resumed,
-        {rv.h, rw.h},
-        {rv.side, rw.side},
-        {rv.order, rw.order},
-        {{rv.weight[0], rw.weight[0]}, {rv.weight[1], rw.weight[1]}, {rv.weight[2], rw.weight[2]}}};
-    const std::size_t quarter = 2 * hn::Lanes(df) / 4;
-    auto suspend = [&](MF2 walking) {
-        return may_suspend &&
-               hn::CountTrue(df, walking.a) + hn::CountTrue(df, walking.b) <= quarter;
-    };
-    const GgxLanes<VF2, kAnisotropic> g2 = VecGgxPair<kAnisotropic>(ggx);
-    const MicrosurfaceWalkLanes<VF2, MF2> walk = microsurface_walk<VF2, VecLane2>(
-        g2, wi, MF2{m, n}, two_sided, facet, draw, max_order, MicrosurfaceNoVisit{},
-        VecLane2::none(resumed) ? nullptr : &resume, suspend);
-    auto part = [&](bool second) {
-        auto pick = [second](VF2 x) { return second ? x.b : x.a; };
-        auto pick_m = [second](MF2 x) { return second ? x.b : x.a; };
-        MicrosurfaceWalkLanes<VF, MF> r;
-        r.wo = second ? Second(walk.wo) : First(walk.wo);
-        for (int c = 0; c < 3; ++c)
-            r.weight[c] = pick(walk.weight[c]);
-        r.order = pick(walk.order);
-        r.escaped = pick_m(walk.escaped);
-        r.capped = pick_m(walk.capped);
-        r.degenerate = pick_m(walk.degenerate);
-        r.suspended = pick_m(walk.suspended);
-        r.h = pick(walk.h);
-        r.side = pick(walk.side);
-        return r;
-    };
-    KeepWalk(part(false), m, v, two_sided, weighted, degenerate_v);
-    KeepWalk(part(true), n, w, two_sided, weighted, degenerate_w);
-}
-
 template <bool kPolarized, bool kAnisotropic>
 HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, VF eta, VF inv_eta,
                                     MF m, LaneVectors& v, LaneRng& rng, int max_order,
@@ -383,29 +328,6 @@ HWY_INLINE void DielectricWalkEvent(const DielectricInterface<float>& iface, VF 
         eta, inv_eta, draw, kPolarized ? &v.pol : nullptr};
     MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), true, facet, m, v, rng, max_order,
                                         degenerate, may_suspend, kPolarized && v.pol.channels == 3);
-}
-
-// DielectricWalkEvent on two lane sets at once (MicrosurfaceWalkEventPair); polarized, their
-// states' channels alike.
-template <bool kPolarized, bool kAnisotropic>
-HWY_INLINE void DielectricWalkEventPair(const DielectricInterface<float>& iface, VF eta, VF inv_eta,
-                                        MF m, MF n, LaneVectors& v, LaneVectors& w, LaneRng& rng_v,
-                                        LaneRng& rng_w, int max_order, MF& degenerate_v,
-                                        MF& degenerate_w, bool may_suspend) {
-    auto draw = [&] {
-        const VF a = rng_v.Uniform();
-        const VF b = rng_w.Uniform();
-        return VF2{a, b};
-    };
-    const VF2 flux[3] = {{v.w[0], w.w[0]}, {v.w[1], w.w[1]}, {v.w[2], w.w[2]}};
-    PolarizationLanes<VF2> pol;
-    if constexpr (kPolarized) pol = PairPolarization(v.pol, w.pol, flux);
-    const MicrosurfaceDielectricFacet<VF2, VecLane2, decltype(draw), kPolarized> facet{
-        {eta, eta}, {inv_eta, inv_eta}, draw, kPolarized ? &pol : nullptr};
-    MicrosurfaceWalkEventPair<kAnisotropic>(iface.distribution(), true, facet, m, n, v, w, rng_v,
-                                            rng_w, max_order, degenerate_v, degenerate_w,
-                                            may_suspend, kPolarized && v.pol.channels == 3);
-    if constexpr (kPolarized) SplitPolarization(pol, v.pol, w.pol);
 }
 
 template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
@@ -421,33 +343,6 @@ HWY_INLINE void ConductorWalkEvent(const ConductorInterface<float>& iface, const
         const MicrosurfaceConductorFacet<VF, VecLane, Fresnel> facet{fresnel};
         MicrosurfaceWalkEvent<kAnisotropic>(iface.distribution(), false, facet, m, v, rng,
                                             max_order, degenerate, may_suspend);
-    }
-}
-
-// ConductorWalkEvent on two lane sets at once (MicrosurfaceWalkEventPair): the bare conductor's
-// reflection (ConductorFresnel, ConductorMueller on the pair); polarized, the states' channels
-// alike.
-template <bool kPolarized, bool kAnisotropic>
-HWY_INLINE void ConductorWalkEventPair(const ConductorInterface<float>& iface, MF m, MF n,
-                                       LaneVectors& v, LaneVectors& w, LaneRng& rng_v,
-                                       LaneRng& rng_w, int max_order, MF& degenerate_v,
-                                       MF& degenerate_w, bool may_suspend) {
-    const ConductorFresnel fresnel{iface};
-    const VF2 flux[3] = {{v.w[0], w.w[0]}, {v.w[1], w.w[1]}, {v.w[2], w.w[2]}};
-    if constexpr (kPolarized) {
-        const ConductorMueller mueller{iface};
-        PolarizationLanes<VF2> pol = PairPolarization(v.pol, w.pol, flux);
-        const MicrosurfaceConductorFacet<VF2, VecLane2, ConductorFresnel, ConductorMueller> facet{
-            fresnel, &pol, &mueller};
-        MicrosurfaceWalkEventPair<kAnisotropic>(iface.distribution(), false, facet, m, n, v, w,
-                                                rng_v, rng_w, max_order, degenerate_v, degenerate_w,
-                                                may_suspend);
-        SplitPolarization(pol, v.pol, w.pol);
-    } else {
-        const MicrosurfaceConductorFacet<VF2, VecLane2, ConductorFresnel> facet{fresnel};
-        MicrosurfaceWalkEventPair<kAnisotropic>(iface.distribution(), false, facet, m, n, v, w,
-                                                rng_v, rng_w, max_order, degenerate_v, degenerate_w,
-                                                may_suspend);
     }
 }
 
