@@ -31,14 +31,14 @@ HWY_INLINE VF FresnelConductor(VF cos_theta, float eta, float k) {
 // The operations struct of the lanes of T: a vector's (VecLane) or a pair's (VecLane2, the
 // kernel's two lane sets at one event).
 template <typename T>
-using PairOr = std::conditional_t<std::is_same_v<T, VF2>, VecLane2, VecLane>;
+using VecLaneOf = std::conditional_t<std::is_same_v<T, VF2>, VecLane2, VecLane>;
 
 // The conductor's Fresnel factors per channel at the facet cosine (fresnel.h fresnel_conductor,
 // the same template) on a vector or a pair of vectors; channels with the same index share the
 // computation.
 struct ConductorFresnel {
     const ConductorInterface<float>& iface;
-    template <typename T, typename L = PairOr<T>>
+    template <typename T, typename L = VecLaneOf<T>>
     HWY_INLINE void operator()(T cos_theta, T* factors) const {
         for (int c = 0; c < 3; ++c) {
             const bool same =
@@ -55,7 +55,7 @@ struct ConductorFresnel {
 // the same index share them.
 struct ConductorMueller {
     const ConductorInterface<float>& iface;
-    template <typename T, typename L = PairOr<T>>
+    template <typename T, typename L = VecLaneOf<T>>
     HWY_INLINE void operator()(T cos_theta, InterfaceMueller<T>* m) const {
         for (int c = 0; c < 3; ++c) {
             const bool same =

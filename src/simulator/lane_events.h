@@ -147,11 +147,7 @@ HWY_INLINE void SplitPolarization(const PolarizationLanes<VF2>& p, PolarizationL
     }
 }
 
-// A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
-// instantiates at one lane): the particle arrives along d (wi = −d), the relative index eta (and
-// its inverse) per lane: the interface's, or a spectral lane's. Polarized (kPolarized): the
-// event's polarized form on the lanes' states; where the channels' states differ, its reweighting
-// of the channels is booked with the base, as trace_particle does.
+// What a dielectric's event did to the lanes of m, booked on v (DielectricEvent).
 template <bool kPolarized>
 HWY_INLINE void KeepDielectricEvent(const DielectricInterface<float>& iface,
                                     const InterfaceEventLanes<VF, MF>& e, MF m, LaneVectors& v,
@@ -163,6 +159,12 @@ HWY_INLINE void KeepDielectricEvent(const DielectricInterface<float>& iface,
     if (!iface.is_smooth()) v.Keep(ok, kLossMicro, e.shadowing);
     v.d = Select(ok, e.wo, v.d);
 }
+
+// A rough or smooth dielectric (dielectric.h dielectric_event, the template the scalar kernel
+// instantiates at one lane): the particle arrives along d (wi = −d), the relative index eta (and
+// its inverse) per lane: the interface's, or a spectral lane's. Polarized (kPolarized): the
+// event's polarized form on the lanes' states; where the channels' states differ, its reweighting
+// of the channels is booked with the base, as trace_particle does.
 template <bool kPolarized, bool kAnisotropic>
 HWY_INLINE void DielectricEvent(const DielectricInterface<float>& iface, VF eta, VF inv_eta, MF m,
                                 LaneVectors& v, VF uc, VF u1, VF u2, MF& degenerate) {
@@ -192,10 +194,8 @@ HWY_INLINE void DielectricEventPair(const DielectricInterface<float>& iface, VF 
                                n, w, degenerate_w);
 }
 
-// A rough or smooth conductor (conductor.h conductor_event, the same template): light from above
-// only. Polarized: the Fresnel factors are the reflected fractions of the lanes' states. The
-// reflection at a facet comes from `fresnel_of` and `mueller_of` (lane_conductor.h: the bare
-// conductor's; a filmed conductor's, FilmReflection).
+// What a conductor's event did to the lanes of m, its Fresnel factors `fresnel`, booked on v
+// (ConductorEvent).
 HWY_INLINE void KeepConductorEvent(const ConductorInterface<float>& iface,
                                    const InterfaceEventLanes<VF, MF>& e, const VF fresnel[3], MF m,
                                    LaneVectors& v, MF& degenerate) {
@@ -205,6 +205,11 @@ HWY_INLINE void KeepConductorEvent(const ConductorInterface<float>& iface,
     if (!iface.is_smooth()) v.Keep(ok, kLossMicro, e.shadowing);
     v.d = Select(ok, e.wo, v.d);
 }
+
+// A rough or smooth conductor (conductor.h conductor_event, the same template): light from above
+// only. Polarized: the Fresnel factors are the reflected fractions of the lanes' states. The
+// reflection at a facet comes from `fresnel_of` and `mueller_of` (lane_conductor.h: the bare
+// conductor's; a filmed conductor's, FilmReflection).
 template <bool kPolarized, bool kAnisotropic, typename Fresnel, typename Mueller>
 HWY_INLINE void ConductorEvent(const ConductorInterface<float>& iface, const Fresnel& fresnel_of,
                                const Mueller& mueller_of, MF m, LaneVectors& v, VF u1, VF u2,
@@ -269,24 +274,27 @@ HWY_INLINE void ConductorEventPair(const ConductorInterface<float>& iface, MF m,
 // direction of travel): they wait at the interface, and go on the next time the kernel steps it
 // (the lanes of m with mid_walk set), beside the lanes that arrive there, instead of holding the
 // vector for the few more facets most of them need. Nothing is booked for a suspended lane.
-// The lanes of m whose walks were suspended (v.mid_walk) and where they stand.
-HWY_INLINE MF ResumedWalks(const LaneVectors& v, MF m) {
-    return hn::And(m, hn::RebindMask(DF(), hn::Ne(v.mid_walk, hn::Zero(DI()))));
-}
-HWY_INLINE MicrosurfaceWalkResume<VF, MF> WalkResume(const LaneVectors& v, MF resumed) {
-    return {resumed,
-            v.walk_h,
-            v.walk_side,
-            v.walk_order,
-            {v.walk_weight[0], v.walk_weight[1], v.walk_weight[2]}};
-}
-
-// What the walk of the lanes of m did, booked on v (MicrosurfaceWalkEvent).
-HWY_INLINE void KeepWalk(const MicrosurfaceWalkLanes<VF, MF>& walk, MF m, LaneVectors& v,
-                         bool two_sided, bool weighted, MF& degenerate) {
+template <bool kAnisotropic, typename Facet>
+HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, const Facet& facet,
+                                      MF m, LaneVectors& v, LaneRng& rng, int max_order,
+                                      MF& degenerate, bool may_suspend, bool weighted = false) {
     const DF df;
     const DI di;
     const VF zero = hn::Zero(df);
+    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
+    auto draw = [&] { return rng.Uniform(); };
+    const MF resumed = hn::And(m, hn::RebindMask(df, hn::Ne(v.mid_walk, hn::Zero(di))));
+    const MicrosurfaceWalkResume<VF, MF> resume{
+        resumed,
+        v.walk_h,
+        v.walk_side,
+        v.walk_order,
+        {v.walk_weight[0], v.walk_weight[1], v.walk_weight[2]}};
+    const std::size_t quarter = hn::Lanes(df) / 4;
+    auto suspend = [&](MF walking) { return may_suspend && hn::CountTrue(df, walking) <= quarter; };
+    const MicrosurfaceWalkLanes<VF, MF> walk = microsurface_walk<VF, VecLane>(
+        VecGgx<kAnisotropic>(ggx), wi, m, two_sided, facet, draw, max_order, MicrosurfaceNoVisit{},
+        hn::AllFalse(df, resumed) ? nullptr : &resume, suspend);
     degenerate = hn::Or(degenerate, walk.degenerate);
     if (!two_sided || weighted) v.Keep(walk.escaped, kLossBase, walk.weight);
     v.Keep(walk.capped, kLossMicro, zero);
@@ -300,23 +308,6 @@ HWY_INLINE void KeepWalk(const MicrosurfaceWalkLanes<VF, MF>& walk, MF m, LaneVe
     v.walk_order = hn::IfThenElse(walk.suspended, walk.order, v.walk_order);
     for (int c = 0; c < 3; ++c)
         v.walk_weight[c] = hn::IfThenElse(walk.suspended, walk.weight[c], v.walk_weight[c]);
-}
-
-template <bool kAnisotropic, typename Facet>
-HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, const Facet& facet,
-                                      MF m, LaneVectors& v, LaneRng& rng, int max_order,
-                                      MF& degenerate, bool may_suspend, bool weighted = false) {
-    const DF df;
-    const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
-    auto draw = [&] { return rng.Uniform(); };
-    const MF resumed = ResumedWalks(v, m);
-    const MicrosurfaceWalkResume<VF, MF> resume = WalkResume(v, resumed);
-    const std::size_t quarter = hn::Lanes(df) / 4;
-    auto suspend = [&](MF walking) { return may_suspend && hn::CountTrue(df, walking) <= quarter; };
-    KeepWalk(microsurface_walk<VF, VecLane>(VecGgx<kAnisotropic>(ggx), wi, m, two_sided, facet,
-                                            draw, max_order, MicrosurfaceNoVisit{},
-                                            hn::AllFalse(df, resumed) ? nullptr : &resume, suspend),
-             m, v, two_sided, weighted, degenerate);
 }
 
 template <bool kPolarized, bool kAnisotropic>
@@ -399,6 +390,7 @@ HWY_INLINE void LambertianEvent(const VF albedo[3], MF m, LaneVectors& v, VF u1,
     KeepLambertianEvent<kPolarized>(
         albedo, m, v, lambertian_event<VF, VecLane>(hn::Neg(v.d.z), u1, u2), degenerate);
 }
+
 // The same event on two lane sets at once (VecLane2; DielectricEventPair).
 template <bool kPolarized>
 HWY_INLINE void LambertianEventPair(const VF albedo[3], MF m, MF n, LaneVectors& v, LaneVectors& w,
