@@ -24,6 +24,7 @@ directly. Exit code 3: matplotlib or numpy is missing (install python3-matplotli
 import argparse
 import csv
 import fnmatch
+import glob
 import hashlib
 import json
 import math
@@ -724,10 +725,30 @@ def main():
         import multiprocessing
         # Ctrl-C ends the workers silently, each removing its temporary file (not Python's
         # KeyboardInterrupt with a traceback in each); this process says it in one line.
-        with multiprocessing.get_context("fork").Pool(
-                min(a.jobs, len(todo)),
-                initializer=signal.signal, initargs=(signal.SIGINT, end_on_signal)) as pool:
+        # Ended by close() and join(): each worker leaves when it reads the end of the tasks.
+        # Not by the context manager, whose terminate() signals the workers: a worker's SIGTERM
+        # (end_on_signal, inherited) that arrives just before it blocks on the task queue's lock
+        # is seen only when that lock returns, which it never does (the pool holds it), and the
+        # script then waited for that worker for ever (seen once in five runs of
+        # study_cli_test). A task that failed ends the others at once (SIGKILL, no handler to
+        # wait for), and their temporary files are removed here.
+        pool = multiprocessing.get_context("fork").Pool(
+            min(a.jobs, len(todo)),
+            initializer=signal.signal, initargs=(signal.SIGINT, end_on_signal))
+        try:
             done = list(pool.imap_unordered(draw, todo))
+        except BaseException:
+            workers = multiprocessing.active_children()
+            for child in workers:
+                child.kill()
+            for child in workers:
+                child.join()
+                for path in glob.glob(os.path.join(fig_dir, "**", f"*.tmp-{child.pid}.*"),
+                                      recursive=True):
+                    os.unlink(path)
+            raise
+        pool.close()
+        pool.join()
     else:
         done = [draw(t) for t in todo]
     for t in todo:
