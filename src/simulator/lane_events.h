@@ -14,6 +14,7 @@
 #include "physics/medium.h"
 #include "physics/microsurface_walk.h"
 #include "physics/polarization.h"
+#include "simulator/lane_conductor.h"
 #include "simulator/lane_film.h"
 #include "simulator/lane_rng.h"
 
