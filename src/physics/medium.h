@@ -131,9 +131,10 @@ LAMINA_LANE_INLINE MediumFlightLanes<T, typename L::Mask> medium_free_flight(con
     };
     const T sigma = pick(med.tau_t[0], med.tau_t[1], med.tau_t[2]);
     const T u_flight = uniform();
+    // ln(1 − u) of a uniform float (a multiple of 2^-24): 1 − u is exact, log1p is not needed.
     const auto extinct = L::less(zero, sigma);
     const T flight = L::select(
-        extinct, (zero - L::log1p(zero - u_flight)) / L::select(extinct, sigma, one), infinity);
+        extinct, (zero - L::log(one - u_flight)) / L::select(extinct, sigma, one), infinity);
     r.leaves = L::either(L::negate(has_flux), L::negate(L::less(flight, to_boundary)));
     const T t = L::select(r.leaves, to_boundary, flight);
     r.depth = L::min(L::max(L::neg_mul_add(d.z, flight, depth), zero), one);

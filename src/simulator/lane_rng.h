@@ -149,8 +149,12 @@ struct LaneRng {
         // The low words of the 64-bit lanes, in lane order.
         const VU x = hn::ConcatEven(du, hn::BitCast(du, xs[1]), hn::BitCast(du, xs[0]));
         const VU r = hn::ConcatEven(du, hn::BitCast(du, rot[1]), hn::BitCast(du, rot[0]));
+#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+        return VU{_mm512_rorv_epi32(x.raw, r.raw)};  // AVX-512F rotates by a lane's own count
+#else
         const VU left = hn::And(hn::Sub(hn::Set(du, 32u), r), hn::Set(du, 31u));
         return hn::Or(x >> r, x << left);
+#endif
     }
     HWY_INLINE VF Uniform() {
         const DF df;
