@@ -50,6 +50,37 @@
 
 namespace py = pybind11;
 
+// An object made with `Cls.__new__(Cls)` and never given its `__init__` holds no C++ value, and
+// pybind11 would hand its methods uninitialized memory (a crash, or garbage). The casters of the
+// module's classes refuse such an object with a TypeError before any method sees it. pybind11
+// constructs through `__init__` without these casters (it reaches the value and holder directly).
+namespace pybind11::detail {
+template <typename T>
+class initialized_caster : public type_caster_base<T> {
+  public:
+    bool load(handle src, bool convert) {
+        const type_info* info = get_type_info(typeid(T));
+        if (src && info != nullptr && PyObject_TypeCheck(src.ptr(), info->type)) {
+            const value_and_holder v_h =
+                reinterpret_cast<instance*>(src.ptr())->get_value_and_holder(info, false);
+            if (v_h.inst != nullptr && !v_h.holder_constructed())
+                throw type_error(
+                    "a lamina." +
+                    handle(reinterpret_cast<PyObject*>(info->type))
+                        .attr("__name__")
+                        .cast<std::string>() +
+                    " made without its __init__ (by __new__) cannot be used: construct it by "
+                    "calling the class");
+        }
+        return type_caster_base<T>::load(src, convert);
+    }
+};
+template <>
+class type_caster<lamina::Stack> : public initialized_caster<lamina::Stack> {};
+template <>
+class type_caster<lamina::BinnedTable> : public initialized_caster<lamina::BinnedTable> {};
+}  // namespace pybind11::detail
+
 namespace lamina {
 namespace {
 
@@ -273,6 +304,19 @@ struct PyModel {
     ModelOptions options;
     std::unique_ptr<Model> model;
 };
+
+}  // namespace
+}  // namespace lamina
+
+namespace pybind11::detail {
+template <>
+class type_caster<lamina::PySimulation> : public initialized_caster<lamina::PySimulation> {};
+template <>
+class type_caster<lamina::PyModel> : public initialized_caster<lamina::PyModel> {};
+}  // namespace pybind11::detail
+
+namespace lamina {
+namespace {
 
 std::string option_text(py::handle v) {
     if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "on" : "off";

@@ -905,3 +905,41 @@ def test_cli_without_a_program_name_runs():
     """The command line's argv[0] is the program's name: an empty argv is the bare program (its
     usage, exit 0 or 1), never a read past the list."""
     assert lamina._lamina.cli([]) in (0, 1)
+
+
+@pytest.mark.parametrize("cls, call", [("Model", "o.eval([0, 0, 1], [0, 0, 1])"),
+                                       ("Stack", "o.__eq__(o)"), ("Table", "o.to_csv()"),
+                                       ("SimulationResult", "repr(o)")])
+def test_an_object_made_without_init_is_refused_not_used(cls, call):
+    # Cls.__new__ without __init__ gives an object with no C++ value behind it: every method and
+    # property must raise TypeError, never crash the interpreter or read uninitialized memory.
+    # Run in a child interpreter, so that a crash fails this test and not the whole session.
+    code = f"""
+import lamina
+c = lamina.{cls}
+o = c.__new__(c)
+names = [n for n in dir(o) if not n.startswith("_")] + ["__repr__"]
+assert len(names) > 2, names
+for name in names:
+    try:
+        a = getattr(o, name)
+        if callable(a):
+            a()
+        raise SystemExit(f"{{name}}: no error")
+    except TypeError as e:
+        # Methods that take arguments are refused for their missing arguments before self is
+        # read; the call with arguments below reaches self.
+        if "without its __init__" in str(e) or "incompatible function arguments" in str(e):
+            continue
+        raise
+try:
+    {call}
+    raise SystemExit("{call}: no error")
+except TypeError as e:
+    assert "without its __init__" in str(e), str(e)
+print("refused", len(names))
+"""
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       env=os.environ.copy(), timeout=60)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert r.stdout.startswith("refused"), r.stdout
