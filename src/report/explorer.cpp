@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "core/grid.h"
 #include "core/hash.h"
+#include "core/incidences.h"
 #include "core/json_text.h"
 #include "core/packed_array.h"
 #include "core/setting.h"
@@ -441,6 +442,13 @@ ConfigData encode_configuration(const fs::path& dir, const std::string& id,
         throw InputError(
             cfg_path.string(), "/phi_i",
             fmt::format("{} azimuths for {} incidences (theta_i)", phi_i.size(), theta_i.size()));
+    if (unfolded)
+        for (std::size_t i = 0; i < theta_i.size(); ++i) {
+            check_incidence(theta_i[i], cfg_path.string(), "/theta_i");
+            if (!(phi_i[i] >= 0 && phi_i[i] <= 360))  // NaN too
+                throw InputError(cfg_path.string(), "/phi_i",
+                                 fmt::format("{} degrees is outside [0, 360]", phi_i[i]));
+        }
     // A spectral reference's channels are linear sRGB under D65 over its range (docs/formats.md).
     if (cfg.contains("spectral") && cfg["spectral"].is_object())
         entry["spectral"] = cfg["spectral"];
@@ -722,7 +730,15 @@ ExplorerSummary write_explorer_unchecked(const fs::path& study_dir) {
                          "not found: expected a study directory written by `lamina study` or "
                          "`lamina compare`");
     const json study = read_json(study_path, "the study's description");
-    const auto theta_i = field<std::vector<double>>(study, "theta_i", study_path);
+    // The page draws from what it is given: the incidences in range, the model names strings.
+    auto theta_i = field<std::vector<double>>(study, "theta_i", study_path);
+    check_incidence_list(theta_i, study_path.string(), "/theta_i");
+    if (study.contains("models")) {
+        const auto names = field<std::vector<std::string>>(study, "models", study_path);
+        for (const std::string& name : names)
+            if (name.empty())
+                throw InputError(study_path.string(), "/models", "a model name is empty");
+    }
     const json grid = field<json>(study, "grid", study_path);
     // Counts in range (they size every array below); read wide so that 1e18 is not wrapped.
     const HemisphereGrid checked_grid = HemisphereGrid::checked(

@@ -188,6 +188,16 @@ def set_grid(d):
     json.dump(info, open(f"{d}/study.json", "w"))
 refused(damaged("grid", set_grid), "/grid: -9 × ", export, explorer)
 
+def study_field(key, value):  # the page drew nothing from these (the explorer's JavaScript failed)
+    def change(d):
+        info = json.load(open(f"{d}/study.json"))
+        info[key] = value
+        json.dump(info, open(f"{d}/study.json", "w"))
+    return change
+refused(damaged("theta", study_field("theta_i", [0, 1e308])),
+        "/theta_i: 1e+308 is outside the allowed range [0, 90) degrees", explorer)
+refused(damaged("models", study_field("models", ["lamina-1", 3])), "models", explorer)
+
 def device(d):
     os.remove(f"{d}/configs/{cfg}/reference_se.lza")
     os.symlink("/dev/zero", f"{d}/configs/{cfg}/reference_se.lza")
