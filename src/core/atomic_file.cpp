@@ -264,6 +264,9 @@ bool write_file_if_changed(const fs::path& path, std::string_view content) {
 }
 
 StagedOutput::StagedOutput(fs::path dir, std::string field) : dir_(std::move(dir)) {
+    if (dir_.empty())  // an option on the command line, an argument in Python
+        throw InputError(field.rfind("--", 0) == 0 ? "command line" : "arguments", field,
+                         "the output folder is an empty path; name a folder");
     std::error_code ec;
     // The folders create_directories will make, deepest first: the target and those of its
     // parents that are not there.

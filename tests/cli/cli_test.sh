@@ -48,6 +48,8 @@ check_says cli11-unknown-option 1 "lamina: command line: --bogus: unknown option
     "$lamina" simulate "$src/examples/plastic.json" --bogus --out "$tmp/never"
 check_says cli11-unknown-option-first 1 "lamina: command line: --bogus: unknown option" \
     "$lamina" simulate --bogus
+check_says out-empty 1 "lamina: command line: --out: the output folder is an empty path" \
+    "$lamina" simulate "$src/examples/plastic.json" --particles 100 --out ''
 check_says cli11-missing-value 1 "lamina: command line: --model: expects a value (text) after it" \
     "$lamina" eval --model
 check_says cli11-given-twice 1 "lamina: command line: --particles: given 2 times; it takes one value, given once" \
