@@ -131,7 +131,8 @@ LAMINA_LANE_INLINE MediumFlightLanes<T, typename L::Mask> medium_free_flight(con
     };
     const T sigma = pick(med.tau_t[0], med.tau_t[1], med.tau_t[2]);
     const T u_flight = uniform();
-    // ln(1 − u) of a uniform float (a multiple of 2^-24): 1 − u is exact, log1p is not needed.
+    // ln(1 − u) of a uniform number (a multiple of 2^-24 in float, 2^-53 in double: core/rng.h):
+    // 1 − u is exact, so log1p is not needed.
     const auto extinct = L::less(zero, sigma);
     const T flight = L::select(
         extinct, (zero - L::log(one - u_flight)) / L::select(extinct, sigma, one), infinity);

@@ -121,8 +121,9 @@ inline MicrosurfaceHit<T, typename L::Mask> microsurface_next_height(const GgxLa
     // ln C1(h), C1 kept above 1e-30: C1 = 0 (the lowest height) would give 0 · ∞ for a tiny Λ.
     // Going up, u ≥ 1 − C1^Λ ⟺ ln(1 − u) ≤ Λ ln C1: the escape test needs no power.
     const T log_c = at_top ? zero : L::log(L::max(c, L::constant(1e-30)));
-    // ln(1 − u) as a logarithm of 1 − u: u is a multiple of 2^-24 (the generators' floats), so
-    // 1 − u is exact and log1p would only add its correction (a division), by exactly 1.
+    // ln(1 − u) as a logarithm of 1 − u: u is a multiple of its generator's resolution (2^-24 in
+    // float, 2^-53 in double: core/rng.h), so 1 − u is exact and log1p would only add its
+    // correction (a division), by exactly 1.
     const T log_1mu = L::log(one - u);
     const auto escapes_masked = L::both(up, L::negate(L::less(lambda_signed * log_c, log_1mu)));
     const auto escapes = L::either(
