@@ -124,6 +124,7 @@ StudySettings settings_from(const CommonArgs& a, const std::string& preset) {
     // A particle count given by hand is not the preset's budget: say so wherever it is shown.
     const bool by_hand = a.cmd->count("--particles") > 0;
     if (!by_hand) s.reference.particles = budget;
+    check_reference_particles(s);
     s.preset = by_hand ? "custom" : preset;
     figure_options(a);  // validates --formats before any work
     if (!a.models.empty()) {

@@ -967,8 +967,17 @@ std::string describe_times(const StudyTimes& t, std::size_t slowest) {
     return out;
 }
 
+void check_reference_particles(const StudySettings& s) {
+    if (s.reference.particles < 2)
+        throw InputError("command line", "--particles",
+                         fmt::format("{} is too few: a study simulates each incidence in two "
+                                     "halves (its noise floor compares them); give 2 or more",
+                                     s.reference.particles));
+}
+
 StudyResult run_study(const std::vector<StudyConfiguration>& configs, const StudySettings& s,
                       const std::filesystem::path& out_dir) {
+    check_reference_particles(s);
     const std::vector<std::string> model_names = study_models(s);
 
     StagedOutput probe(out_dir);  // the folder must be writable before any work starts

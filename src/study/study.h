@@ -88,6 +88,11 @@ struct StudyResult {
     StudyTimes times;
 };
 
+/// InputError unless the reference has two particles per incidence at least: each piece is
+/// simulated in two halves, whose difference is the noise floor (study/reference.h). run_study
+/// checks it; a caller that computes pieces before (the processes under mpirun) checks it first.
+void check_reference_particles(const StudySettings& settings);
+
 /// Runs (or resumes) the study into `out_dir`; each configuration at its incidences, on its grid
 /// (study_incidences, study_grid: an anisotropic one, or any under --phi-i ≠ 0, unfolded).
 /// Incremental: each configuration's outputs carry the digest of their inputs (the reference

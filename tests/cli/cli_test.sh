@@ -48,6 +48,8 @@ check_says cli11-unknown-option 1 "lamina: command line: --bogus: unknown option
     "$lamina" simulate "$src/examples/plastic.json" --bogus --out "$tmp/never"
 check_says cli11-unknown-option-first 1 "lamina: command line: --bogus: unknown option" \
     "$lamina" simulate --bogus
+check_says compare-one-particle 1 "lamina: command line: --particles: 1 is too few: a study simulates each incidence in two halves" \
+    "$lamina" compare "$src/examples/plastic.json" --particles 1 --out "$tmp/never"
 check_says out-empty 1 "lamina: command line: --out: the output folder is an empty path" \
     "$lamina" simulate "$src/examples/plastic.json" --particles 100 --out ''
 check_says cli11-missing-value 1 "lamina: command line: --model: expects a value (text) after it" \
