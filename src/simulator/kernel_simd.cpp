@@ -431,12 +431,6 @@ class BlockTracer {
         }
     }
 
-    // The lanes of `going` whose microsurface walks are suspended (lane_events.h
-    // MicrosurfaceWalkEvent): they wait at their interface.
-    HWY_INLINE MF MidWalk(const LaneVectors& v, MF going) const {
-        return hn::And(going, hn::RebindMask(DF(), hn::Ne(v.mid_walk, hn::Zero(DI()))));
-    }
-
     // A lane set of the main loop: its lanes, their generators and its steps since its float
     // sums were last flushed.
     struct LaneSet {
@@ -496,7 +490,7 @@ class BlockTracer {
     // going on is the same event: counted, and its secondary wavelengths ended, once).
     HWY_INLINE void Arrive(LaneVectors& v, int group, MF going) const {
         const DI di;
-        const MF arriving = hn::AndNot(MidWalk(v, going), going);
+        const MF arriving = hn::AndNot(v.MidWalk(going), going);
         v.events = hn::IfThenElse(hn::RebindMask(di, arriving), hn::Add(v.events, hn::Set(di, 1)),
                                   v.events);
         if constexpr (kSpectral) EndSecondaries(v, group, arriving);
@@ -508,7 +502,7 @@ class BlockTracer {
         const DF df;
         const CompiledLayer<float>& layer = stack_.layers[group];
         const bool dielectric = layer.type == InterfaceType::Dielectric;
-        const MF done = hn::AndNot(MidWalk(v, going), going);  // the lanes whose event is over
+        const MF done = hn::AndNot(v.MidWalk(going), going);  // the lanes whose event is over
         // A failed sample loses the flux to the microsurface; an exactly grazing new direction is
         // lost to the microsurface (dielectric) or the base (opaque), as in trace_particle.
         const MF grazing = hn::AndNot(degenerate_event, hn::And(done, hn::Eq(v.d.z, zero_)));
@@ -976,7 +970,7 @@ class BlockTracer {
         const DF df;
         const DI di;
         const MF cut = hn::AndNot(
-            MidWalk(v, lanes),
+            v.MidWalk(lanes),
             hn::And(lanes, hn::RebindMask(df, hn::Gt(v.events, hn::Set(di, job_.max_events - 1)))));
         if (!hn::AllFalse(df, cut)) v.Keep(cut, kLossCutOff, zero_);
         v.End(cut, kEnded);

@@ -86,6 +86,11 @@ struct LaneVectors {
         const VF zero = hn::Zero(df);
         return hn::And(hn::And(hn::Eq(w[0], zero), hn::Eq(w[1], zero)), hn::Eq(w[2], zero));
     }
+    // The lanes of m whose microsurface walks are suspended (MicrosurfaceWalkEvent): they wait
+    // at their interface.
+    HWY_INLINE MF MidWalk(MF m) const {
+        return hn::And(m, hn::RebindMask(DF(), hn::Ne(mid_walk, hn::Zero(DI()))));
+    }
     HWY_INLINE void End(MF m, Finish why) {
         const DI di;
         finish = hn::IfThenElse(hn::RebindMask(di, m), hn::Set(di, why), finish);
@@ -284,7 +289,7 @@ HWY_INLINE void MicrosurfaceWalkEvent(const GGX<float>& ggx, bool two_sided, con
     const VF zero = hn::Zero(df);
     const V3 wi = {hn::Neg(v.d.x), hn::Neg(v.d.y), hn::Neg(v.d.z)};
     auto draw = [&] { return rng.Uniform(); };
-    const MF resumed = hn::And(m, hn::RebindMask(df, hn::Ne(v.mid_walk, hn::Zero(di))));
+    const MF resumed = v.MidWalk(m);
     const MicrosurfaceWalkResume<VF, MF> resume{
         resumed,
         v.walk_h,
